@@ -1,0 +1,191 @@
+"""Delimited text tables with a header row, read with errors that name file, row and column.
+
+Rows are numbered as a spreadsheet shows them: the header is row 1, the first data row is 2.
+The delimiter (comma, semicolon, tab or whitespace) is detected from the header line. Lines
+starting with ``#`` are comments.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+import tempfile
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Union
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+@dataclass(frozen=True)
+class Table:
+    """Raw text cells of a table: ``columns`` in file order, ``rows`` with their line numbers."""
+
+    path: str
+    columns: tuple[str, ...]
+    rows: tuple[tuple[str, ...], ...]
+    line_numbers: tuple[int, ...]
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+
+def read_table(path: PathLike) -> Table:
+    """Read a delimited table; raise :class:`InputError` for a missing, empty or ragged file."""
+    p = Path(path)
+    if not p.is_file():
+        raise InputError("file not found", path=str(p))
+    try:
+        text = p.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"not a UTF-8 text table ({exc.reason})", path=str(p)) from exc
+    lines = [
+        (i + 1, line)
+        for i, line in enumerate(text.splitlines())
+        if line.strip() and not line.lstrip().startswith("#")
+    ]
+    if not lines:
+        raise InputError("the table is empty (no header row)", path=str(p))
+    header_no, header = lines[0]
+    delimiter = _detect_delimiter(header)
+    parsed = _split(lines, delimiter)
+    columns = tuple(c.strip() for c in parsed[0])
+    if any(not c for c in columns):
+        raise InputError("the header has an empty column name", path=str(p), row=header_no)
+    seen: set[str] = set()
+    for c in columns:
+        key = normalise(c)
+        if key in seen:
+            raise InputError(f"column '{c}' appears twice in the header", path=str(p), row=1)
+        seen.add(key)
+    rows = []
+    numbers = []
+    for (number, _), cells in zip(lines[1:], parsed[1:]):
+        if len(cells) != len(columns):
+            raise InputError(
+                f"has {len(cells)} values but the header has {len(columns)} columns",
+                path=str(p),
+                row=number,
+            )
+        rows.append(tuple(c.strip() for c in cells))
+        numbers.append(number)
+    if not rows:
+        raise InputError("the table has a header but no data rows", path=str(p))
+    return Table(str(p), columns, tuple(rows), tuple(numbers))
+
+
+def normalise(name: str) -> str:
+    return name.strip().lower().replace(" ", "_").replace("-", "_")
+
+
+def find_column(
+    table: Table, aliases: Sequence[str], *, required: bool = True, what: str | None = None
+) -> int | None:
+    """Index of the first column whose normalised name is one of ``aliases``."""
+    names = [normalise(c) for c in table.columns]
+    for alias in aliases:
+        if alias in names:
+            return names.index(alias)
+    if required:
+        raise InputError(
+            f"no column for {what or aliases[0]} (accepted names: {', '.join(aliases)}; "
+            f"found: {', '.join(table.columns)})",
+            path=table.path,
+        )
+    return None
+
+
+def float_column(
+    table: Table, index: int, *, finite: bool = True, allow_empty: bool = False
+) -> NDArray[np.float64]:
+    """Parse one column as floats; the error names the row and the column.
+
+    With ``allow_empty`` an empty cell becomes NaN (for optional values such as time).
+    """
+    out = np.empty(len(table), dtype=np.float64)
+    name = table.columns[index]
+    for k, (row, number) in enumerate(zip(table.rows, table.line_numbers)):
+        cell = row[index]
+        if allow_empty and not cell:
+            out[k] = np.nan
+            continue
+        try:
+            value = float(cell)
+        except ValueError:
+            raise InputError(
+                f"'{cell}' is not a number", path=table.path, row=number, column=name
+            ) from None
+        if finite and not math.isfinite(value):
+            raise InputError(
+                f"'{cell}' is not a finite number", path=table.path, row=number, column=name
+            )
+        out[k] = value
+    return out
+
+
+def text_column(table: Table, index: int, *, nonempty: bool = True) -> tuple[str, ...]:
+    values = tuple(row[index] for row in table.rows)
+    if nonempty:
+        for value, number in zip(values, table.line_numbers):
+            if not value:
+                raise InputError(
+                    "empty value", path=table.path, row=number, column=table.columns[index]
+                )
+    return values
+
+
+def unique_ids(table: Table, index: int) -> tuple[str, ...]:
+    """A text column whose values must be unique (e.g. image ids)."""
+    values = text_column(table, index)
+    first: dict[str, int] = {}
+    for value, number in zip(values, table.line_numbers):
+        if value in first:
+            raise InputError(
+                f"'{value}' already appears in row {first[value]}",
+                path=table.path,
+                row=number,
+                column=table.columns[index],
+            )
+        first[value] = number
+    return values
+
+
+def write_csv_atomic(
+    path: PathLike, columns: Sequence[str], rows: Iterable[Sequence[object]]
+) -> None:
+    """Write a CSV to a temporary file in the same folder, then move it into place.
+
+    A crash or an error while writing never leaves a half-written file at ``path``.
+    """
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(fd, "w", newline="", encoding="utf-8") as fh:
+            writer = csv.writer(fh, lineterminator="\n")
+            writer.writerow(columns)
+            writer.writerows(rows)
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _detect_delimiter(header: str) -> str | None:
+    for delimiter in (",", ";", "\t"):
+        if delimiter in header:
+            return delimiter
+    return None  # whitespace
+
+
+def _split(lines: list[tuple[int, str]], delimiter: str | None) -> list[list[str]]:
+    if delimiter is None:
+        return [line.split() for _, line in lines]
+    return list(csv.reader((line for _, line in lines), delimiter=delimiter))

@@ -1,0 +1,109 @@
+"""Frames: pyproj chains, ENU against PROJ's topocentric conversion, convergence, curvature."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pyproj import Proj, Transformer
+
+from lidarphoto.core.errors import CrsError
+from lidarphoto.core.frames import NED_TO_ENU, LocalFrame, MappingFrame
+
+RNG = np.random.default_rng(11)
+UTM23S = "EPSG:31983"  # SIRGAS 2000 / UTM zone 23S (GRS80), the paper's area
+
+
+@pytest.fixture(scope="module")
+def frame() -> MappingFrame:
+    return MappingFrame.from_user_input(UTM23S)
+
+
+def _points(n: int = 200) -> np.ndarray:
+    return np.column_stack(
+        [
+            RNG.uniform(380e3, 420e3, n),
+            RNG.uniform(7.52e6, 7.56e6, n),
+            RNG.uniform(500, 3000, n),
+        ]
+    )
+
+
+def test_round_trips(frame):
+    p = _points()
+    np.testing.assert_allclose(frame.geodetic_to_map(frame.map_to_geodetic(p)), p, atol=1e-8, rtol=0)
+    # PROJ's geocentric inverse iterates: 1e-7 m absolute is ~1e-14 of the ECEF magnitudes
+    ecef = frame.map_to_ecef(p)
+    np.testing.assert_allclose(frame.ecef_to_map(ecef), p, atol=1e-7, rtol=0)
+    local = LocalFrame.at_map_point(frame, p.mean(axis=0))
+    enu = local.map_to_enu(p)
+    np.testing.assert_allclose(local.enu_to_map(enu), p, atol=1e-7, rtol=0)
+    np.testing.assert_allclose(local.ecef_to_enu(local.enu_to_ecef(enu)), enu, atol=1e-8, rtol=0)
+
+
+def test_enu_matches_proj_topocentric(frame):
+    p = _points()
+    local = LocalFrame.at_map_point(frame, p[0])
+    lat0, lon0, h0 = local.origin_llh
+    peer = Transformer.from_pipeline(
+        "+proj=pipeline +step +proj=unitconvert +xy_in=deg +xy_out=rad "
+        "+step +proj=cart +ellps=GRS80 "
+        f"+step +proj=topocentric +ellps=GRS80 +lat_0={lat0!r} +lon_0={lon0!r} +h_0={h0!r}"
+    )
+    llh = frame.map_to_geodetic(p)
+    e, n, u = peer.transform(llh[:, 1], llh[:, 0], llh[:, 2])
+    np.testing.assert_allclose(local.map_to_enu(p), np.column_stack([e, n, u]), atol=1e-6, rtol=0)
+    np.testing.assert_allclose(local.map_to_enu(p[:1]), 0.0, atol=1e-8)
+
+
+def test_grid_north_azimuth_matches_proj_factors(frame):
+    llh = frame.map_to_geodetic(_points(20))
+    ours = np.degrees(frame.grid_north_azimuth(llh))
+    proj = Proj(frame.crs)
+    factors = proj.get_factors(llh[:, 1], llh[:, 0])
+    # PROJ's meridian_convergence has the opposite sign to our clockwise grid azimuth.
+    np.testing.assert_allclose(ours, -np.asarray(factors.meridian_convergence), atol=1e-8)
+    # textbook approximation for transverse Mercator: gamma ~ (lon - lon0) sin(lat)
+    approx = -(llh[:, 1] - (-45.0)) * np.sin(np.radians(llh[:, 0]))
+    np.testing.assert_allclose(ours, approx, atol=2e-3)
+
+
+def test_grid_frame_axes_follow_the_grid(frame):
+    p = np.array([[385000.0, 7530000.0, 900.0]])
+    llh = frame.map_to_geodetic(p)
+    local = LocalFrame(frame, tuple(llh[0]))
+    # 50 m along grid north, seen in the ENU frame at p, is the grid frame's y axis.
+    step = local.map_to_enu(p + [0.0, 50.0, 0.0])[0]
+    predicted = local.grid_to_local(llh)[0] @ np.array([0.0, 1.0, 0.0])
+    angle = np.arccos(np.dot(step[:2], predicted[:2]) / np.linalg.norm(step[:2]))
+    assert angle < 1e-6
+    assert abs(np.degrees(np.arctan2(predicted[0], predicted[1]))) > 0.1  # convergence is real
+
+
+def test_local_vertical_tilts_with_distance(frame):
+    centre = np.array([400000.0, 7540000.0, 900.0])
+    local = LocalFrame.at_map_point(frame, centre)
+    far = centre + [2000.0, 0.0, 0.0]
+    llh = frame.map_to_geodetic(np.vstack([centre, far]))
+    r = local.ned_to_local(llh)
+    np.testing.assert_allclose(r[0], NED_TO_ENU, atol=1e-12)
+    down_far = r[1] @ np.array([0.0, 0.0, 1.0])
+    tilt = np.arctan2(-down_far[0], -down_far[2])
+    # 2 km on a sphere of radius ~6.38e6 m: ~3.1e-4 rad (about 1 arc-minute)
+    assert tilt == pytest.approx(2000.0 / 6.38e6, rel=0.01)
+    # Earth curvature: a point 2 km away at the same height is ~0.31 m below the tangent plane
+    assert local.map_to_enu(far[None])[0, 2] == pytest.approx(-(2000.0**2) / (2 * 6.38e6), rel=0.02)
+
+
+@pytest.mark.parametrize(
+    ("crs", "words"),
+    [
+        ("EPSG:4326", "must be projected"),
+        ("EPSG:2994", "metres"),  # NAD83(CSRS) / Oregon Lambert (ft), the Autzen CRS
+        ("EPSG:2154+5720", "grid"),  # Lambert-93 + NGF-IGN69: geoid grid not installed
+        ("not a crs", "not a valid CRS"),
+        ("", "missing"),
+    ],
+)
+def test_bad_crs_is_explained(crs, words):
+    with pytest.raises(CrsError, match=words):
+        MappingFrame.from_user_input(crs)
