@@ -28,7 +28,8 @@ from .io.tables import (
     unique_ids,
     write_csv_atomic,
 )
-from .rotations import opk_to_matrix
+from .frames import LocalFrame
+from .rotations import matrix_to_opk, opk_to_matrix
 
 EO_COLUMNS = ("image_id", "time", "group", "X", "Y", "Z", "omega_deg", "phi_deg", "kappa_deg")
 
@@ -108,3 +109,28 @@ def read_eo_csv(path: Union[str, Path], crs_wkt: str = "") -> ExteriorOrientatio
         row = table.line_numbers[int(np.argmax(np.abs(opk[:, 1]) > 90.0))]
         raise InputError("phi must lie within [-90, 90] degrees", path=table.path, row=row)
     return ExteriorOrientationTable(ids, time, group, xyz, np.radians(opk), crs_wkt)
+
+
+def eo_map_to_local(
+    xyz: NDArray[np.float64], opk: NDArray[np.float64], local: LocalFrame
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Mapping-frame EO -> (centres (N, 3) in the ENU frame, world-to-camera M (N, 3, 3) there).
+
+    ``opk`` is relative to the grid frame at each centre (as in the EO CSV); the rotation into
+    the ENU frame includes grid convergence and the tilt of the local vertical.
+    """
+    llh = local.mapping.map_to_geodetic(xyz)
+    r_c_m = np.swapaxes(opk_to_matrix(opk[:, 0], opk[:, 1], opk[:, 2]), -1, -2)
+    r_c_l = local.grid_to_local(llh) @ r_c_m
+    return local.geodetic_to_enu(llh), np.swapaxes(r_c_l, -1, -2)
+
+
+def eo_local_to_map(
+    centres: NDArray[np.float64], m_local: NDArray[np.float64], local: LocalFrame
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Inverse of :func:`eo_map_to_local`: -> (xyz (N, 3) mapping CRS, opk (N, 3) radians)."""
+    llh = local.mapping.ecef_to_geodetic(local.enu_to_ecef(centres))
+    r_c_l = np.swapaxes(m_local, -1, -2)
+    r_c_m = np.swapaxes(local.grid_to_local(llh), -1, -2) @ r_c_l
+    omega, phi, kappa = matrix_to_opk(np.swapaxes(r_c_m, -1, -2))
+    return local.mapping.geodetic_to_map(llh), np.stack([omega, phi, kappa], axis=-1)

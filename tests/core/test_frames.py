@@ -107,3 +107,26 @@ def test_local_vertical_tilts_with_distance(frame):
 def test_bad_crs_is_explained(crs, words):
     with pytest.raises(CrsError, match=words):
         MappingFrame.from_user_input(crs)
+
+
+def test_eo_map_local_round_trip(frame):
+    from lidarphoto.core.orientation import eo_local_to_map, eo_map_to_local
+    from lidarphoto.core.rotations import matrix_to_opk
+
+    xyz = _points(30)
+    opk = np.column_stack(
+        [RNG.uniform(-0.1, 0.1, 30), RNG.uniform(-0.1, 0.1, 30), RNG.uniform(-3, 3, 30)]
+    )
+    local = LocalFrame.at_map_point(frame, xyz.mean(axis=0))
+    centres, m_local = eo_map_to_local(xyz, opk, local)
+    xyz2, opk2 = eo_local_to_map(centres, m_local, local)
+    np.testing.assert_allclose(xyz2, xyz, atol=1e-7)
+    np.testing.assert_allclose(opk2, opk, atol=1e-12)
+    # at the origin of the local frame, a level camera differs only by grid convergence:
+    # grid azimuth = true azimuth + theta, so kappa in ENU = kappa in the grid frame + theta
+    level = np.array([[0.0, 0.0, 0.7]])
+    _, m0 = eo_map_to_local(local.enu_to_map(np.zeros((1, 3))), level, local)
+    theta = frame.grid_north_azimuth(np.array([local.origin_llh]))[0]
+    assert abs(theta) > 1e-3
+    w, p, k = matrix_to_opk(m0[0])
+    np.testing.assert_allclose([w, p, k], [0.0, 0.0, 0.7 + theta], atol=1e-12)
