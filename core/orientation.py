@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .errors import InputError
+from .frames import LocalFrame
 from .io.tables import (
     find_column,
     float_column,
@@ -28,7 +29,6 @@ from .io.tables import (
     unique_ids,
     write_csv_atomic,
 )
-from .frames import LocalFrame
 from .rotations import matrix_to_opk, opk_to_matrix
 
 EO_COLUMNS = ("image_id", "time", "group", "X", "Y", "Z", "omega_deg", "phi_deg", "kappa_deg")

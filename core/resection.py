@@ -9,7 +9,7 @@ kappa)``. The initial pose, when not given, comes from OpenCV's solvePnP.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Optional
+from typing import Callable
 
 import cv2
 import numpy as np
@@ -80,11 +80,11 @@ def space_resection(
     pixels: ArrayLike,
     points: ArrayLike,
     camera: Camera,
-    eo0: Optional[ArrayLike] = None,
+    eo0: ArrayLike | None = None,
     sigma_px: float = 1.0,
-    options: Optional[AdjustmentOptions] = None,
-    labels: Optional[list[str]] = None,
-    should_stop: Optional[Callable[[], bool]] = None,
+    options: AdjustmentOptions | None = None,
+    labels: list[str] | None = None,
+    should_stop: Callable[[], bool] | None = None,
 ) -> ResectionResult:
     """Least-squares resection with Baarda data snooping by default.
 

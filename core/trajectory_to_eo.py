@@ -29,7 +29,7 @@ import logging
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Optional, Union
+from typing import Callable, Union
 
 import numpy as np
 from numpy.typing import NDArray
@@ -131,7 +131,9 @@ class Mount:
         elif name in MOUNT_PRESETS:
             nominal = MOUNT_PRESETS[name]
         else:
-            raise InputError(f"MOUNT '{mount}' is unknown; choose one of {', '.join(MOUNT_CHOICES)}")
+            raise InputError(
+                f"MOUNT '{mount}' is unknown; choose one of {', '.join(MOUNT_CHOICES)}"
+            )
         return cls(arm, nominal, bore)
 
 
@@ -173,9 +175,7 @@ def read_trajectory_csv(path: Union[str, Path]) -> Trajectory:
     h_col = find_column(table, ("height", "h", "z", "alt", "altitude"), what="height")
     if lat_col is not None:
         lon_col = find_column(table, ("longitude", "lon", "long"), what="longitude")
-        position = np.stack(
-            [float_column(table, c) for c in (lat_col, lon_col, h_col)], axis=1
-        )
+        position = np.stack([float_column(table, c) for c in (lat_col, lon_col, h_col)], axis=1)
         _check_range(table, lat_col, position[:, 0], 90.0)
         _check_range(table, lon_col, position[:, 1], 180.0)
     else:
@@ -246,9 +246,9 @@ def run_trajectory_to_eo(
     mount: str = "image_top_forward",
     mount_matrix: Union[str, Sequence[float]] = "",
     boresight: Union[str, Sequence[float]] = "0,0,0",
-    output_csv: Optional[Union[str, Path]] = None,
-    progress: Optional[Callable[[float], None]] = None,
-    should_stop: Optional[Callable[[], bool]] = None,
+    output_csv: Union[str, Path] | None = None,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
 ) -> ExteriorOrientationTable:
     """The ``trajectorytoeo`` job: read, georeference, optionally write the EO CSV.
 

@@ -12,7 +12,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-
 from lidarphoto.core.frames import MappingFrame
 from lidarphoto.core.orientation import read_eo_csv
 from lidarphoto.core.trajectory_to_eo import read_trajectory_csv
@@ -48,8 +47,12 @@ def main() -> int:
     kappa = np.degrees(eo.opk[:, 2])
     gap = (kappa + heading + theta + 180.0) % 360.0 - 180.0
     print(f"\ngrid convergence here: {theta.mean():+.4f} deg (true north seen from grid north)")
-    print(f"kappa + heading + convergence: max |{np.abs(gap).max():.3f}| deg (roll/pitch/boresight)")
-    print(f"lever arm 1.35 m up: Z - INS height = {np.mean(eo.xyz[:, 2] - traj.position[:, 2]):.3f} m")
+    print(
+        f"kappa + heading + convergence: max |{np.abs(gap).max():.3f}| deg (roll/pitch/boresight)"
+    )
+    print(
+        f"lever arm 1.35 m up: Z - INS height = {np.mean(eo.xyz[:, 2] - traj.position[:, 2]):.3f} m"
+    )
     print(f"\nwrote {eo_csv}")
     return 0
 

@@ -19,14 +19,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from pyproj import Proj, Transformer
-
 from lidarphoto.core.camera import camera_from_dict
 from lidarphoto.core.collinearity import project
 from lidarphoto.core.frames import LocalFrame, MappingFrame
 from lidarphoto.core.orientation import eo_local_to_map
 from lidarphoto.core.resection import initial_pose_pnp, space_resection
 from lidarphoto.core.rotations import opk_to_matrix
+from pyproj import Proj, Transformer
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "borea"
 PIXEL_MM = 0.004  # UltraCam Eagle M3 pixel; any value works, the camera is given in pixels
@@ -34,7 +33,9 @@ PIXEL_MM = 0.004  # UltraCam Eagle M3 pixel; any value works, the camera is give
 
 def _camera():
     info = dict(
-        line.split("=", 1) for line in (DATA / "Camera1.txt").read_text().splitlines() if "=" in line
+        line.split("=", 1)
+        for line in (DATA / "Camera1.txt").read_text().splitlines()
+        if "=" in line
     )
     info = {k.strip(): v.strip() for k, v in info.items()}
     return camera_from_dict(

@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from pyproj import Proj, Transformer
-
 from lidarphoto.core.errors import CrsError
 from lidarphoto.core.frames import NED_TO_ENU, LocalFrame, MappingFrame
+from pyproj import Proj, Transformer
 
 RNG = np.random.default_rng(11)
 UTM23S = "EPSG:31983"  # SIRGAS 2000 / UTM zone 23S (GRS80), the paper's area
@@ -30,7 +29,9 @@ def _points(n: int = 200) -> np.ndarray:
 
 def test_round_trips(frame):
     p = _points()
-    np.testing.assert_allclose(frame.geodetic_to_map(frame.map_to_geodetic(p)), p, atol=1e-8, rtol=0)
+    np.testing.assert_allclose(
+        frame.geodetic_to_map(frame.map_to_geodetic(p)), p, atol=1e-8, rtol=0
+    )
     # PROJ's geocentric inverse iterates: 1e-7 m absolute is ~1e-14 of the ECEF magnitudes
     ecef = frame.map_to_ecef(p)
     np.testing.assert_allclose(frame.ecef_to_map(ecef), p, atol=1e-7, rtol=0)

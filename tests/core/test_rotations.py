@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
-
 from lidarphoto.core import rotations as rot
+from scipy.spatial.transform import Rotation
 
 RNG = np.random.default_rng(7)
 N = 500

@@ -8,15 +8,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from pyproj import Geod, Proj
-from scipy.spatial.transform import Rotation
-
 from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.errors import CrsError, InputError
 from lidarphoto.core.frames import MappingFrame
 from lidarphoto.core.orientation import read_eo_csv
 from lidarphoto.core.rotations import MOUNT_PRESETS
 from lidarphoto.core.trajectory_to_eo import run_trajectory_to_eo
+from pyproj import Geod, Proj
+from scipy.spatial.transform import Rotation
 
 CRS = "EPSG:31983"  # SIRGAS 2000 / UTM 23S, GRS80
 GEOD = Geod(ellps="GRS80")
@@ -192,7 +191,9 @@ def test_custom_mount_equals_preset(tmp_path):
 
 def test_cli(tmp_path, capsys):
     out = tmp_path / "eo.csv"
-    rc = cli_main(["trajectorytoeo", "--input", str(SAMPLE), "--crs", CRS, "--output-csv", str(out)])
+    rc = cli_main(
+        ["trajectorytoeo", "--input", str(SAMPLE), "--crs", CRS, "--output-csv", str(out)]
+    )
     assert rc == 0 and len(read_eo_csv(out)) == 6
     rc = cli_main(["trajectorytoeo", "--input", str(SAMPLE), "--crs", "EPSG:4326"])
     assert rc == 2 and "must be projected" in capsys.readouterr().err
@@ -200,7 +201,16 @@ def test_cli(tmp_path, capsys):
 
 def test_python_m_entry_point():
     r = subprocess.run(
-        [sys.executable, "-m", "lidarphoto", "trajectorytoeo", "--input", str(SAMPLE), "--crs", CRS],
+        [
+            sys.executable,
+            "-m",
+            "lidarphoto",
+            "trajectorytoeo",
+            "--input",
+            str(SAMPLE),
+            "--crs",
+            CRS,
+        ],
         capture_output=True,
         text=True,
         timeout=120,
