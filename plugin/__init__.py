@@ -1,0 +1,1 @@
+"""QGIS GUI layer of the LiDAR Photogrammetry Toolkit: plugin class, actions, dependency check."""

@@ -1,0 +1,139 @@
+"""Check at load time that the core's third-party packages import in QGIS's Python.
+
+Nothing here raises: a missing package becomes one message-bar warning plus a log entry that
+gives the exact ``pip`` command for the Python interpreter QGIS runs on.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import shlex
+import sys
+import sysconfig
+from collections.abc import Iterable, Sequence
+
+#: import name -> pip requirement, in the order they are reported.
+REQUIRED_MODULES: dict[str, str] = {
+    "laspy": "laspy",
+    "lazrs": "lazrs",
+    "cv2": "opencv-python-headless",
+    "scipy": "scipy",
+    "pyproj": "pyproj",
+}
+
+MESSAGE_TITLE = "LiDAR Photogrammetry"
+LOG_TAG = "LiDAR Photogrammetry"
+
+
+def missing_modules(modules: Iterable[str] | None = None) -> list[str]:
+    """Return the names in ``modules`` (default: REQUIRED_MODULES) that fail to import."""
+    names = list(REQUIRED_MODULES) if modules is None else list(modules)
+    missing = []
+    for name in names:
+        try:
+            importlib.import_module(name)
+        except Exception:  # ImportError, but also broken binaries (numpy ABI, missing .so)
+            missing.append(name)
+    return missing
+
+
+def pip_requirements(modules: Sequence[str]) -> list[str]:
+    """Pip requirement names for import names (unknown names are passed through)."""
+    seen: list[str] = []
+    for name in modules:
+        req = REQUIRED_MODULES.get(name, name)
+        if req not in seen:
+            seen.append(req)
+    return seen
+
+
+def qgis_python() -> str:
+    """Path of the Python interpreter QGIS embeds (``sys.executable`` is often QGIS itself)."""
+    exe = sys.executable or ""
+    if os.path.basename(exe).lower().startswith("python"):
+        return exe
+    prefix = sys.exec_prefix
+    if sys.platform == "win32":  # OSGeo4W / standalone installer: <prefix>/python.exe
+        candidates = [os.path.join(prefix, "python.exe"), os.path.join(prefix, "python3.exe")]
+    else:  # Linux packages (/usr), macOS QGIS.app (.../Contents/MacOS or Frameworks)
+        ver = f"{sys.version_info.major}.{sys.version_info.minor}"
+        candidates = [
+            os.path.join(prefix, "bin", f"python{ver}"),
+            os.path.join(prefix, "bin", "python3"),
+            os.path.join(prefix, "bin", "python"),
+        ]
+    for path in candidates:
+        if os.path.isfile(path):
+            return path
+    return candidates[0] if sys.platform == "win32" else "python3"
+
+
+def _externally_managed() -> bool:
+    """True for a PEP 668 system Python (Debian/Ubuntu >= 12/23.04), where pip needs a flag."""
+    stdlib = sysconfig.get_paths().get("stdlib", "")
+    return bool(stdlib) and os.path.isfile(os.path.join(stdlib, "EXTERNALLY-MANAGED"))
+
+
+def pip_command(modules: Sequence[str]) -> str:
+    """The shell command that installs ``modules`` into QGIS's Python.
+
+    numpy is pinned to the version QGIS already uses, so pip cannot replace it by an
+    ABI-incompatible one (numpy 2 breaks GDAL's and QGIS's compiled numpy bindings).
+    """
+    python = qgis_python()
+    args = [python, "-m", "pip", "install"]
+    if sys.platform != "win32":
+        args.append("--user")
+        if _externally_managed():
+            args.append("--break-system-packages")
+    args += pip_requirements(modules)
+    try:
+        import numpy
+
+        args.append(f"numpy=={numpy.__version__}")
+    except Exception:
+        pass
+    if sys.platform == "win32":
+        return " ".join(f'"{a}"' if " " in a else a for a in args)
+    return " ".join(shlex.quote(a) for a in args)
+
+
+def _tr(text: str) -> str:
+    try:
+        from qgis.PyQt.QtCore import QCoreApplication
+
+        return QCoreApplication.translate("LidarPhotoDependencies", text)
+    except Exception:
+        return text
+
+
+def missing_message(modules: Sequence[str]) -> str:
+    """The user-facing text for missing modules."""
+    return _tr(
+        "Missing Python packages: {names}. The LiDAR Photogrammetry algorithms need them; "
+        "install them into QGIS's Python and restart QGIS: {cmd}"
+    ).format(names=", ".join(pip_requirements(modules)), cmd=pip_command(modules))
+
+
+def report_missing(iface=None, modules: Iterable[str] | None = None) -> list[str]:
+    """Check ``modules``; if any is missing, log it and push ONE message-bar warning.
+
+    Returns the missing import names. Never raises.
+    """
+    try:
+        missing = missing_modules(modules)
+    except Exception:
+        return []
+    if not missing:
+        return missing
+    text = missing_message(missing)
+    try:
+        from qgis.core import Qgis, QgsMessageLog
+
+        QgsMessageLog.logMessage(text, LOG_TAG, Qgis.MessageLevel.Warning)
+        if iface is not None:
+            iface.messageBar().pushMessage(MESSAGE_TITLE, text, Qgis.MessageLevel.Warning, 0)
+    except Exception:
+        pass
+    return missing

@@ -1,0 +1,148 @@
+"""The QGIS plugin class: Processing provider, menu and toolbar."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from qgis.core import QgsApplication
+from qgis.PyQt.QtCore import QCoreApplication
+from qgis.PyQt.QtGui import QIcon
+from qgis.PyQt.QtWidgets import QAction, QMenu
+
+from .dependencies import report_missing
+
+ICON_PATH = Path(__file__).resolve().parents[1] / "icon.svg"
+PROVIDER_ID = "lidarphoto"
+TRAJECTORY_ALG = "lidarphoto:trajectorytoeo"
+MENU_OBJECT_NAME = "lidarphotoMenu"
+TOOLBAR_OBJECT_NAME = "lidarphotoToolBar"
+
+
+class LidarPhotoPlugin:
+    """initProcessing (also used by qgis_process, where ``iface`` is None), initGui, unload."""
+
+    def __init__(self, iface) -> None:
+        self.iface = iface
+        self.provider = None
+        self.menu: QMenu | None = None
+        self.toolbar = None
+        self.actions: list[QAction] = []
+        self.missing_modules: list[str] | None = None
+        self._dialogs: list = []
+
+    def tr(self, text: str) -> str:
+        return QCoreApplication.translate("LidarPhotoPlugin", text)
+
+    # -- Processing ---------------------------------------------------------------------------
+    def initProcessing(self) -> None:
+        if self.provider is None:
+            from ..processing_provider.provider import LidarPhotoProvider
+
+            self.provider = LidarPhotoProvider()  # keep the Python reference alive
+            QgsApplication.processingRegistry().addProvider(self.provider)
+        if self.missing_modules is None:  # once per load; never raises
+            self.missing_modules = report_missing(self.iface)
+
+    # -- GUI ----------------------------------------------------------------------------------
+    def initGui(self) -> None:
+        self.initProcessing()
+        if self.iface is None:
+            return
+        window = self.iface.mainWindow()
+        icon = QIcon(str(ICON_PATH))
+
+        self.menu = QMenu(self.tr("&LiDAR Photogrammetry"), window)
+        self.menu.setObjectName(MENU_OBJECT_NAME)
+        menubar = window.menuBar()
+        help_menu = getattr(self.iface, "firstRightStandardMenu", lambda: None)()
+        if isinstance(help_menu, QMenu):  # before Help, like QGIS's own plugin menus
+            menubar.insertMenu(help_menu.menuAction(), self.menu)
+        else:
+            menubar.addMenu(self.menu)
+
+        self.toolbar = self.iface.addToolBar(self.tr("LiDAR Photogrammetry"))
+        self.toolbar.setObjectName(TOOLBAR_OBJECT_NAME)
+
+        trajectory = QAction(icon, self.tr("Trajectory to Exterior Orientation…"), window)
+        trajectory.setObjectName("lidarphotoTrajectoryToEo")
+        trajectory.setToolTip(
+            self.tr("Exterior orientation of each image from an INS/GNSS trajectory")
+        )
+        trajectory.triggered.connect(self.open_trajectory_dialog)
+
+        toolbox = QAction(
+            QgsApplication.getThemeIcon("/processingAlgorithm.svg"),
+            self.tr("Show the Algorithms in the Processing Toolbox"),
+            window,
+        )
+        toolbox.setObjectName("lidarphotoShowToolbox")
+        toolbox.triggered.connect(self.show_toolbox)
+
+        for action in (trajectory, toolbox):
+            self.menu.addAction(action)
+            self.toolbar.addAction(action)
+            self.actions.append(action)
+
+    def open_trajectory_dialog(self):
+        """Open the Processing dialog of the trajectory algorithm (non-modal)."""
+        import processing
+
+        dialog = processing.createAlgorithmDialog(TRAJECTORY_ALG, {})
+        if dialog is None:
+            self._warn(self.tr("The algorithm {} is not available.").format(TRAJECTORY_ALG))
+            return None
+        self._dialogs = [d for d in self._dialogs if d.isVisible()] + [dialog]
+        dialog.show()
+        return dialog
+
+    def show_toolbox(self) -> bool:
+        """Show the Processing toolbox filtered to this provider's algorithms."""
+        from qgis import utils
+
+        toolbox = getattr(utils.plugins.get("processing"), "toolbox", None)
+        if toolbox is None:
+            self._warn(self.tr("The Processing plugin is not enabled."))
+            return False
+        if hasattr(toolbox, "setUserVisible"):
+            toolbox.setUserVisible(True)
+        else:
+            toolbox.show()
+        search = getattr(toolbox, "searchBox", None)
+        if search is not None:
+            search.setText(PROVIDER_ID)  # every algorithm of ours carries this tag
+        return True
+
+    def _warn(self, text: str) -> None:
+        if self.iface is not None:
+            from qgis.core import Qgis
+
+            self.iface.messageBar().pushMessage(
+                self.tr("LiDAR Photogrammetry"), text, Qgis.MessageLevel.Warning, 5
+            )
+
+    # -- unload -------------------------------------------------------------------------------
+    def unload(self) -> None:
+        for dialog in self._dialogs:
+            dialog.close()
+            dialog.deleteLater()
+        self._dialogs = []
+        for action in self.actions:
+            if self.menu is not None:
+                self.menu.removeAction(action)
+            if self.toolbar is not None:
+                self.toolbar.removeAction(action)
+            action.deleteLater()
+        self.actions = []
+        if self.menu is not None:
+            if self.iface is not None:
+                self.iface.mainWindow().menuBar().removeAction(self.menu.menuAction())
+            self.menu.deleteLater()
+            self.menu = None
+        if self.toolbar is not None:
+            if self.iface is not None:
+                self.iface.mainWindow().removeToolBar(self.toolbar)
+            self.toolbar.deleteLater()
+            self.toolbar = None
+        if self.provider is not None:
+            QgsApplication.processingRegistry().removeProvider(self.provider)
+            self.provider = None

@@ -1,0 +1,1 @@
+"""QGIS Processing provider of the LiDAR Photogrammetry Toolkit: thin adapters around ``core``."""

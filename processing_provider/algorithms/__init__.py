@@ -1,0 +1,1 @@
+"""One QgsProcessingAlgorithm per module, each a thin adapter around one core function."""

@@ -1,0 +1,145 @@
+"""Common base of the toolkit's algorithms and the bridge from core calls to QGIS feedback."""
+
+from __future__ import annotations
+
+import configparser
+import logging
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, Callable
+
+from qgis.core import QgsProcessingAlgorithm, QgsProcessingException, QgsProcessingFeedback
+from qgis.PyQt.QtCore import QCoreApplication
+
+from ..core.errors import Cancelled, LidarPhotoError
+
+_PLUGIN_DIR = Path(__file__).resolve().parents[1]
+#: Logger of the whole package ("lidarphoto"); the core logs below it ("lidarphoto.core.*").
+PACKAGE_LOGGER = __name__.split(".")[0]
+
+
+def _homepage() -> str:
+    meta = configparser.ConfigParser()
+    meta.read(_PLUGIN_DIR / "metadata.txt", encoding="utf-8")
+    return meta.get("general", "homepage", fallback="")
+
+
+class _FeedbackLogHandler(logging.Handler):
+    """Forwards core ``logging`` records to a QgsProcessingFeedback."""
+
+    def __init__(self, feedback: QgsProcessingFeedback) -> None:
+        super().__init__(logging.DEBUG)
+        self.feedback = feedback
+        self.setFormatter(logging.Formatter("%(message)s"))
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            text = self.format(record)
+            if record.levelno >= logging.ERROR:
+                self.feedback.reportError(text, False)
+            elif record.levelno >= logging.WARNING:
+                self.feedback.pushWarning(text)
+            elif record.levelno >= logging.INFO:
+                self.feedback.pushInfo(text)
+            else:
+                self.feedback.pushDebugInfo(text)
+        except Exception:  # logging must never break the run
+            self.handleError(record)
+
+
+@contextmanager
+def forward_logging(feedback: QgsProcessingFeedback, level: int = logging.INFO):
+    """Within the block, core log records of ``level`` and above go to ``feedback``."""
+    logger = logging.getLogger(PACKAGE_LOGGER)
+    handler = _FeedbackLogHandler(feedback)
+    old_level = logger.level
+    if logger.level == logging.NOTSET or logger.level > level:
+        logger.setLevel(level)
+    logger.addHandler(handler)
+    try:
+        yield handler
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(old_level)
+
+
+def progress_callback(feedback: QgsProcessingFeedback) -> Callable[[float], None]:
+    """Core progress (a fraction in [0, 1]) -> ``feedback.setProgress`` (percent)."""
+
+    def progress(fraction: float) -> None:
+        feedback.setProgress(100.0 * min(max(float(fraction), 0.0), 1.0))
+
+    return progress
+
+
+def stop_callback(feedback: QgsProcessingFeedback) -> Callable[[], bool]:
+    """Core ``should_stop`` -> ``feedback.isCanceled``."""
+    return feedback.isCanceled
+
+
+@contextmanager
+def core_errors(cancelled_text: str = "Cancelled"):
+    """Turn ``LidarPhotoError``, ``ValueError`` and ``OSError`` into QgsProcessingException.
+
+    The exception keeps the core's message (which names the file, row and column).
+    """
+    try:
+        yield
+    except Cancelled as exc:
+        raise QgsProcessingException(str(exc) or cancelled_text) from exc
+    except (LidarPhotoError, ValueError, OSError) as exc:
+        raise QgsProcessingException(str(exc)) from exc
+
+
+class BaseAlgorithm(QgsProcessingAlgorithm):
+    """tr/createInstance/group/helpUrl for every algorithm of the provider.
+
+    Subclasses set ``GROUP`` (English, translated on display) and ``GROUP_ID``, and implement
+    name/displayName/shortHelpString/initAlgorithm/processAlgorithm.
+    """
+
+    GROUP = ""
+    GROUP_ID = ""
+    TAGS: tuple[str, ...] = ()
+
+    def tr(self, text: str) -> str:
+        return QCoreApplication.translate(type(self).__name__, text)
+
+    def createInstance(self):
+        return type(self)()
+
+    def group(self) -> str:
+        return self.tr(self.GROUP)
+
+    def groupId(self) -> str:
+        return self.GROUP_ID
+
+    def tags(self) -> list[str]:
+        return ["lidarphoto", "lidar", "photogrammetry", *self.TAGS]
+
+    def helpUrl(self) -> str:
+        home = _homepage()
+        return f"{home.rstrip('/')}/algorithms/{self.name()}" if home else ""
+
+    def canExecute(self):
+        from ..plugin.dependencies import missing_message, missing_modules
+
+        missing = missing_modules()
+        if missing:
+            return False, missing_message(missing)
+        return True, ""
+
+    def run_core(self, func: Callable[..., Any], *args: Any, feedback=None, **kwargs: Any) -> Any:
+        """Call a core function with progress/cancel wired to ``feedback`` and its log forwarded.
+
+        Errors the core raises on purpose become ``QgsProcessingException`` (see core_errors).
+        """
+        if feedback is None:
+            feedback = QgsProcessingFeedback()
+        with forward_logging(feedback), core_errors(self.tr("Cancelled by the user")):
+            return func(
+                *args,
+                progress=progress_callback(feedback),
+                should_stop=stop_callback(feedback),
+                **kwargs,
+            )

@@ -1,0 +1,56 @@
+"""QGIS enums resolved once, for QGIS 3.22 to 4.x (STYLE.md section 5, rule 3).
+
+The enums moved to ``Qgis.*`` in QGIS 3.30-3.36; the old class-scoped names are deprecated
+aliases there. Each value is chosen with ``hasattr`` (never ``a or b``: several values are 0).
+"""
+
+from __future__ import annotations
+
+from qgis.core import (
+    Qgis,
+    QgsCoordinateReferenceSystem,
+    QgsFeatureSink,
+    QgsProcessing,
+    QgsProcessingParameterDefinition,
+    QgsProcessingParameterFile,
+    QgsWkbTypes,
+)
+from qgis.PyQt.QtCore import QVariant
+
+if hasattr(Qgis, "ProcessingSourceType"):  # QGIS >= 3.36
+    SOURCE_VECTOR_POINT = Qgis.ProcessingSourceType.VectorPoint
+else:  # QGIS 3.22-3.34
+    SOURCE_VECTOR_POINT = QgsProcessing.SourceType.TypeVectorPoint
+
+if hasattr(Qgis, "ProcessingParameterFlag"):  # QGIS >= 3.36
+    FLAG_ADVANCED = Qgis.ProcessingParameterFlag.Advanced
+    FLAG_OPTIONAL = Qgis.ProcessingParameterFlag.Optional
+else:
+    FLAG_ADVANCED = QgsProcessingParameterDefinition.Flag.FlagAdvanced
+    FLAG_OPTIONAL = QgsProcessingParameterDefinition.Flag.FlagOptional
+
+if hasattr(Qgis, "ProcessingFileParameterBehavior"):  # QGIS >= 3.36
+    FILE_BEHAVIOR_FILE = Qgis.ProcessingFileParameterBehavior.File
+else:
+    FILE_BEHAVIOR_FILE = QgsProcessingParameterFile.Behavior.File
+
+if hasattr(Qgis, "WkbType"):  # QGIS >= 3.30
+    WKB_POINT_Z = Qgis.WkbType.PointZ
+else:
+    WKB_POINT_Z = QgsWkbTypes.Type.PointZ
+
+if hasattr(Qgis, "CrsWktVariant"):  # QGIS >= 3.36
+    WKT_PREFERRED = Qgis.CrsWktVariant.Preferred
+else:
+    WKT_PREFERRED = QgsCoordinateReferenceSystem.WktVariant.WKT_PREFERRED
+
+SINK_FAST_INSERT = QgsFeatureSink.Flag.FastInsert  # same name on 3.22 and 4.x
+
+# QgsField types: QVariant.<Type> works on 3.22 and is patched to QMetaType.Type on Qt6 builds
+# (STYLE.md section 5, rule 4; flake8-qgis QGS402 is expected here).
+FIELD_STRING = QVariant.String
+FIELD_DOUBLE = QVariant.Double
+
+MSG_INFO = Qgis.MessageLevel.Info
+MSG_WARNING = Qgis.MessageLevel.Warning
+MSG_CRITICAL = Qgis.MessageLevel.Critical

@@ -1,0 +1,39 @@
+"""The QGIS Processing provider ``lidarphoto``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from qgis.core import QgsProcessingProvider
+from qgis.PyQt.QtCore import QCoreApplication
+from qgis.PyQt.QtGui import QIcon
+
+from .algorithms.trajectory_to_eo import TrajectoryToEoAlgorithm
+
+ICON_PATH = Path(__file__).resolve().parents[1] / "icon.svg"
+
+
+class LidarPhotoProvider(QgsProcessingProvider):
+    """Provider ``lidarphoto``; its id and the algorithm names are API (models, scripts)."""
+
+    def tr(self, text: str) -> str:
+        return QCoreApplication.translate("LidarPhotoProvider", text)
+
+    def id(self) -> str:
+        return "lidarphoto"
+
+    def name(self) -> str:
+        return self.tr("LiDAR Photogrammetry")
+
+    def longName(self) -> str:
+        return self.tr("LiDAR Photogrammetry Toolkit")
+
+    def icon(self) -> QIcon:
+        return QIcon(str(ICON_PATH))
+
+    def svgIconPath(self) -> str:
+        return str(ICON_PATH)
+
+    def loadAlgorithms(self) -> None:
+        for alg in (TrajectoryToEoAlgorithm(),):
+            self.addAlgorithm(alg)

@@ -1,0 +1,27 @@
+"""The command line mirrors the toolbox: same algorithm ids, same parameter names."""
+
+from __future__ import annotations
+
+import configparser
+import tomllib
+from pathlib import Path
+
+from lidarphoto.core.cli import parameter_names
+from qgis_helpers import ROOT
+
+# Outputs only QGIS can make (layers) have no command-line counterpart.
+QGIS_ONLY = {"OUTPUT"}
+
+
+def test_cli_options_are_the_processing_parameters(provider):
+    for algorithm in provider.algorithms():
+        qgis_names = {p.name() for p in algorithm.parameterDefinitions()} - QGIS_ONLY
+        assert set(parameter_names(algorithm.name())) == qgis_names, algorithm.name()
+
+
+def test_versions_agree():
+    meta = configparser.ConfigParser()
+    meta.read(Path(ROOT) / "metadata.txt", encoding="utf-8")
+    with open(Path(ROOT) / "pyproject.toml", "rb") as fh:
+        project = tomllib.load(fh)["project"]
+    assert project["version"] == meta.get("general", "version")
