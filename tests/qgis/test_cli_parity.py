@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import configparser
-import tomllib
 from pathlib import Path
 
+import tomllib
 from lidarphoto.core.cli import parameter_names
 from qgis_helpers import ROOT
 
