@@ -79,18 +79,6 @@ __all__ = [
 ]
 
 
-def _check_positive(value: Any, what: str) -> float:
-    if isinstance(value, bool):
-        raise InputError(f"{what} must be a number, got {value!r}")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{what} must be a number, got {value!r}") from None
-    if not (math.isfinite(number) and number > 0.0):
-        raise InputError(f"{what} must be a positive finite number, got {value!r}")
-    return number
-
-
 def _check_finite(value: Any, what: str) -> float:
     if isinstance(value, bool):
         raise InputError(f"{what} must be a number, got {value!r}")
@@ -100,6 +88,13 @@ def _check_finite(value: Any, what: str) -> float:
         raise InputError(f"{what} must be a number, got {value!r}") from None
     if not math.isfinite(number):
         raise InputError(f"{what} must be finite, got {value!r}")
+    return number
+
+
+def _check_positive(value: Any, what: str) -> float:
+    number = _check_finite(value, what)
+    if number <= 0.0:
+        raise InputError(f"{what} must be a positive finite number, got {value!r}")
     return number
 
 

@@ -23,6 +23,7 @@ from lidarphoto.core.distortion import (
     distortion_from_dict,
 )
 from lidarphoto.core.errors import InputError
+from numdiff import central_difference
 from numpy.testing import assert_allclose
 
 W, H, PS, F = 26000, 17000, 0.004, 100.0
@@ -39,17 +40,6 @@ def frame_grid(cam: Camera, n_cols: int = 41, n_rows: int = 27) -> np.ndarray:
         np.linspace(0.0, cam.width_px, n_cols), np.linspace(0.0, cam.height_px, n_rows)
     )
     return np.column_stack([cols.ravel(), rows.ravel()])
-
-
-def central_difference(fun, x: np.ndarray, steps) -> np.ndarray:
-    """d fun / d x by central differences; fun maps (P,) -> (N, 2); returns (N, 2, P)."""
-    cols = []
-    for j, h in enumerate(steps):
-        xp, xm = x.copy(), x.copy()
-        xp[j] += h
-        xm[j] -= h
-        cols.append((fun(xp) - fun(xm)) / (2.0 * h))
-    return np.stack(cols, axis=-1)
 
 
 def assert_jacobian_close(analytic: np.ndarray, numeric: np.ndarray, rel: float = 1e-6) -> None:

@@ -19,6 +19,7 @@ from lidarphoto.core.collinearity import (
 )
 from lidarphoto.core.distortion import BrownConrady, NoDistortion
 from lidarphoto.core.rotations import opk_to_matrix
+from numdiff import central_difference
 from numpy.testing import assert_allclose
 
 W, H, PS, F = 26000, 17000, 0.004, 100.0
@@ -33,17 +34,6 @@ def scene(n: int = 60, seed: int = 0) -> np.ndarray:
     rng = np.random.default_rng(seed)
     xy = EO[:2] + rng.uniform(-250.0, 250.0, size=(n, 2))
     return np.column_stack([xy, rng.uniform(-20.0, 60.0, n)])
-
-
-def central_difference(fun, x: np.ndarray, steps) -> np.ndarray:
-    """d fun / d x by central differences; fun maps (P,) -> (N, 2); returns (N, 2, P)."""
-    cols = []
-    for j, h in enumerate(steps):
-        xp, xm = x.copy(), x.copy()
-        xp[j] += h
-        xm[j] -= h
-        cols.append((fun(xp) - fun(xm)) / (2.0 * h))
-    return np.stack(cols, axis=-1)
 
 
 def column_errors(analytic: np.ndarray, numeric: np.ndarray) -> np.ndarray:
