@@ -18,7 +18,7 @@ nearest to a reference point ``c`` (the centre of the contact zone) solve
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import numpy as np
@@ -65,6 +65,7 @@ def intersect_three_planes(
     # J_i = -inv[:, :, i] outer [X', 1]: (T, 3 planes, 3, 4)
     jac = -inv.transpose(0, 2, 1)[:, :, :, None] * xh[:, None, None, :]
     c_ok = np.einsum("tpik,tpkl,tpjl->tij", jac, cov[ok], jac)
+    c_ok = 0.5 * (c_ok + c_ok.transpose(0, 2, 1))
     x[ok], c[ok] = xo, c_ok
     return x, c, np.where(ok, cond, np.inf)
 
@@ -114,7 +115,8 @@ def intersect_two_planes(
     cp[:, :4, :4] = np.asarray(cov1, dtype=float)[good]
     cp[:, 4:, 4:] = np.asarray(cov2, dtype=float)[good]
     x0[good] = xg
-    cov[good] = jac @ cp @ jac.transpose(0, 2, 1)
+    cg = jac @ cp @ jac.transpose(0, 2, 1)
+    cov[good] = 0.5 * (cg + cg.transpose(0, 2, 1))  # exactly symmetric, as tables store it
     return x0, u, cov
 
 
@@ -264,9 +266,24 @@ class ControlLine:
 
     @property
     def sigma_perpendicular(self) -> float:
-        """RMS standard deviation of X0 across the line (the along-line part is arbitrary)."""
+        """RMS standard deviation across the line at X0 (the along-line part is arbitrary)."""
+        return self.sigma_across(0.0)
+
+    def sigma_across(self, t: float) -> float:
+        """RMS standard deviation across the line at ``X0 + t u`` (the direction's uncertainty
+        grows it away from X0)."""
         p = np.eye(3) - np.outer(self.direction, self.direction)
-        return float(np.sqrt(np.trace(p @ self.covariance[:3, :3] @ p) / 2.0))
+        jac = np.hstack([np.eye(3), t * np.eye(3)])
+        cov = jac @ self.covariance @ jac.T
+        return float(np.sqrt(np.trace(p @ cov @ p) / 2.0))
+
+    @property
+    def sigma_ends(self) -> tuple[float, float]:
+        """:meth:`sigma_across` at the start and the end point."""
+        return tuple(  # type: ignore[return-value]
+            self.sigma_across(float((e - self.point) @ self.direction))
+            for e in (self.start, self.end)
+        )
 
 
 @dataclass(frozen=True)
@@ -433,7 +450,26 @@ def _three_plane_points(cand, by_id, pts, ids, options, rejected) -> list[Contro
         out.append(
             ControlPoint(len(out) + 1, x[t], cov[t], tri, min_angle, float(cond[t]), support)
         )
-    return out
+    return _merge_duplicates(out, options.delta, rejected)
+
+
+def _merge_duplicates(points: list[ControlPoint], radius: float, rejected) -> list[ControlPoint]:
+    """One LCP per corner: where more than three planes meet (a pyramid apex), several triples
+    give the same point; keep the most precise (smallest trace of the covariance)."""
+    if len(points) < 2:
+        return points
+    kept: list[ControlPoint] = []
+    for p in sorted(points, key=lambda p: float(np.trace(p.covariance))):
+        twin = next((k for k in kept if np.linalg.norm(k.xyz - p.xyz) < radius), None)
+        if twin is None:
+            kept.append(p)
+        else:
+            rejected.append(
+                Rejection(p.plane_ids, f"same corner as planes {twin.plane_ids}, which give a "
+                          "more precise point")
+            )  # fmt: skip
+    kept.sort(key=lambda p: p.id)
+    return [replace(p, id=i + 1) for i, p in enumerate(kept)]
 
 
 def _two_plane_lines(cand, by_id, pts, ids, adjacency, options, rejected) -> list[ControlLine]:
@@ -500,3 +536,79 @@ def _line_kind(n1, n2, x0, u, c1, c2) -> str:
     if side[0] < 0 and side[1] < 0:
         return "valley"
     return "other"
+
+
+# ----------------------------------------------------------------------------- job
+def parse_id_groups(text: str, size: int, name: str) -> list[tuple[int, ...]] | None:
+    """``"1,2,3; 4,5,6"`` -> [(1, 2, 3), (4, 5, 6)]; empty text -> None (automatic)."""
+    text = (text or "").strip()
+    if not text:
+        return None
+    out = []
+    for part in text.replace("\n", ";").split(";"):
+        if not part.strip():
+            continue
+        try:
+            ids = tuple(int(v) for v in part.replace(" ", ",").split(",") if v)
+        except ValueError:
+            raise InputError(f"{name}: '{part.strip()}' is not a list of plane ids") from None
+        if len(ids) != size:
+            raise InputError(f"{name}: '{part.strip()}' must have {size} plane ids")
+        out.append(ids)
+    return out
+
+
+def run_create_lcps(
+    planes_csv,
+    cloud,
+    crs=None,
+    options: ControlOptions = ControlOptions(),
+    triples: str = "",
+    pairs: str = "",
+    points_csv=None,
+    lines_csv=None,
+    graph_csv=None,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> tuple[LidarControl, object]:
+    """The ``createlcps`` job: plane table + cloud with a ``plane_id`` dimension -> control.
+
+    Distances in ``options`` are in the cloud's CRS unit. Returns the result and the cloud's
+    :class:`~lidarphoto.core.pointcloud.CloudInfo`. Every input is read and checked before
+    any output is written; outputs are written atomically.
+    """
+    from .io.control import write_graph_csv, write_lcps_csv, write_lines_csv
+    from .planes import read_planes_csv
+    from .pointcloud import read_info, read_points
+
+    user_triples = parse_id_groups(triples, 3, "TRIPLES")
+    user_pairs = parse_id_groups(pairs, 2, "PAIRS")
+    planes = read_planes_csv(planes_csv)
+    info = read_info(cloud, crs=crs)
+    if "plane_id" not in info.dimensions:
+        raise InputError(
+            "the cloud has no 'plane_id' dimension: use the cloud written by "
+            "lidarphoto:extractroofplanes",
+            path=str(cloud),
+        )
+
+    def sub(lo: float, hi: float):
+        return None if progress is None else (lambda f: progress(lo + (hi - lo) * f))
+
+    arrays, info = read_points(
+        cloud, ("x", "y", "z", "plane_id"), crs=crs, progress=sub(0.0, 0.3), should_stop=should_stop
+    )
+    xyz = np.column_stack([arrays["x"], arrays["y"], arrays["z"]])
+    result = lidar_control(
+        planes, xyz, arrays["plane_id"], options, user_triples, user_pairs,
+        progress=sub(0.3, 0.95), should_stop=should_stop,
+    )  # fmt: skip
+    if points_csv:
+        write_lcps_csv(points_csv, result.points)
+    if lines_csv:
+        write_lines_csv(lines_csv, result.lines)
+    if graph_csv:
+        write_graph_csv(graph_csv, result.adjacency)
+    if progress is not None:
+        progress(1.0)
+    return result, info

@@ -179,9 +179,9 @@ def test_pyramid_apex_from_faces_touching_only_at_the_apex():
               enumerate(planes_nd)]  # fmt: skip
     result = lidar_control(planes, pts, lab, ControlOptions(delta=0.4, min_boundary=2.0))
     assert len(corner_candidates(result.adjacency)) == 4
-    assert len(result.points) == 4
-    for p in result.points:
-        np.testing.assert_allclose(p.xyz, apex, atol=1e-9)
+    assert len(result.points) == 1  # four triples, one corner
+    np.testing.assert_allclose(result.points[0].xyz, apex, atol=1e-9)
+    assert sum("same corner" in r.reason for r in result.rejected) == 3
 
 
 def test_degenerate_cases_are_rejected_with_reasons():
@@ -226,3 +226,41 @@ def test_adjacency_requires_a_long_enough_boundary():
     pts, lab, *_ = _hip_roof_cloud()
     adj = plane_adjacency(pts, lab, delta=0.4, min_length=50.0)
     assert len(adj.pairs) > 0 and not np.any(adj.adjacent)
+
+
+def test_tables_round_trip(tmp_path):
+    from lidarphoto.core.io.control import (
+        read_lcps_csv,
+        read_lines_csv,
+        write_graph_csv,
+        write_lcps_csv,
+        write_lines_csv,
+    )
+
+    pts, lab, planes, *_ = _hip_roof_cloud()
+    for p in planes:  # realistic, full-rank covariances
+        object.__setattr__(p, "covariance", _random_cov(1e-4, 1e-2))
+    result = lidar_control(planes, pts, lab, ControlOptions(delta=0.4, min_boundary=2.0))
+    write_lcps_csv(tmp_path / "lcp.csv", result.points)
+    write_lines_csv(tmp_path / "lines.csv", result.lines)
+    write_graph_csv(tmp_path / "graph.csv", result.adjacency)
+    back = read_lcps_csv(tmp_path / "lcp.csv")
+    assert [p.plane_ids for p in back] == [p.plane_ids for p in result.points]
+    for a, b in zip(back, result.points):
+        np.testing.assert_array_equal(a.xyz, b.xyz)
+        np.testing.assert_allclose(a.covariance, b.covariance, rtol=1e-15, atol=0)
+    lines = read_lines_csv(tmp_path / "lines.csv")
+    assert [(ln.plane_ids, ln.kind) for ln in lines] == [
+        (ln.plane_ids, ln.kind) for ln in result.lines
+    ]
+    for a, b in zip(lines, result.lines):
+        np.testing.assert_allclose(a.covariance, b.covariance, rtol=1e-15, atol=0)
+        assert a.sigma_ends == pytest.approx(b.sigma_ends, rel=1e-12)
+    graph = (tmp_path / "graph.csv").read_text().splitlines()
+    assert graph[0].startswith("plane_1,plane_2,adjacent") and len(graph) == 7
+    # a damaged table names the row and the column
+    text = (tmp_path / "lines.csv").read_text().splitlines()
+    text[2] = text[2].replace(",hip,", ",gutter,", 1)
+    (tmp_path / "bad.csv").write_text("\n".join(text))
+    with pytest.raises(InputError, match=r"row 3.*'kind'.*gutter"):
+        read_lines_csv(tmp_path / "bad.csv")
