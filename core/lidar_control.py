@@ -17,6 +17,7 @@ nearest to a reference point ``c`` (the centre of the contact zone) solve
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Callable
@@ -27,6 +28,8 @@ from scipy.spatial import cKDTree
 
 from .errors import Cancelled, InputError
 from .rotations import skew
+
+log = logging.getLogger(__name__)
 
 Array = NDArray[np.float64]
 
@@ -568,12 +571,14 @@ def run_create_lcps(
     points_csv=None,
     lines_csv=None,
     graph_csv=None,
+    distance_unit: str = "crs",
     progress: Callable[[float], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
 ) -> tuple[LidarControl, object]:
     """The ``createlcps`` job: plane table + cloud with a ``plane_id`` dimension -> control.
 
-    Distances in ``options`` are in the cloud's CRS unit. Returns the result and the cloud's
+    Distances in ``options`` are in the cloud's CRS unit (``distance_unit="crs"``) or in metres
+    (``"metre"``, converted); the results are in the CRS unit. Returns the result and the cloud's
     :class:`~lidarphoto.core.pointcloud.CloudInfo`. Every input is read and checked before
     any output is written; outputs are written atomically.
     """
@@ -585,6 +590,17 @@ def run_create_lcps(
     user_pairs = parse_id_groups(pairs, 2, "PAIRS")
     planes = read_planes_csv(planes_csv)
     info = read_info(cloud, crs=crs)
+    if distance_unit not in ("crs", "metre", "metres"):
+        raise InputError(f"DISTANCE_UNIT must be 'crs' or 'metres', got '{distance_unit}'")
+    if distance_unit != "crs":
+        k = 1.0 / info.unit_to_metre
+        options = replace(
+            options,
+            delta=options.delta * k,
+            min_boundary=options.min_boundary * k,
+            max_support_distance=options.max_support_distance * k,
+        )
+        log.info("distances converted from metres to %s (x %.6g)", info.horizontal_unit, k)
     if "plane_id" not in info.dimensions:
         raise InputError(
             "the cloud has no 'plane_id' dimension: use the cloud written by "

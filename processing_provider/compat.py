@@ -13,14 +13,17 @@ from qgis.core import (
     QgsProcessing,
     QgsProcessingParameterDefinition,
     QgsProcessingParameterFile,
+    QgsProcessingParameterNumber,
     QgsWkbTypes,
 )
 from qgis.PyQt.QtCore import QVariant
 
 if hasattr(Qgis, "ProcessingSourceType"):  # QGIS >= 3.36
     SOURCE_VECTOR_POINT = Qgis.ProcessingSourceType.VectorPoint
+    SOURCE_VECTOR_LINE = Qgis.ProcessingSourceType.VectorLine
 else:  # QGIS 3.22-3.34
     SOURCE_VECTOR_POINT = QgsProcessing.SourceType.TypeVectorPoint
+    SOURCE_VECTOR_LINE = QgsProcessing.SourceType.TypeVectorLine
 
 if hasattr(Qgis, "ProcessingParameterFlag"):  # QGIS >= 3.36
     FLAG_ADVANCED = Qgis.ProcessingParameterFlag.Advanced
@@ -36,8 +39,17 @@ else:
 
 if hasattr(Qgis, "WkbType"):  # QGIS >= 3.30
     WKB_POINT_Z = Qgis.WkbType.PointZ
+    WKB_LINESTRING_Z = Qgis.WkbType.LineStringZ
 else:
     WKB_POINT_Z = QgsWkbTypes.Type.PointZ
+    WKB_LINESTRING_Z = QgsWkbTypes.Type.LineStringZ
+
+if hasattr(Qgis, "ProcessingNumberParameterType"):  # QGIS >= 3.36
+    NUMBER_DOUBLE = Qgis.ProcessingNumberParameterType.Double
+    NUMBER_INTEGER = Qgis.ProcessingNumberParameterType.Integer
+else:  # QGIS 3.22-3.34
+    NUMBER_DOUBLE = QgsProcessingParameterNumber.Type.Double
+    NUMBER_INTEGER = QgsProcessingParameterNumber.Type.Integer
 
 if hasattr(Qgis, "CrsWktVariant"):  # QGIS >= 3.36
     WKT_PREFERRED = Qgis.CrsWktVariant.Preferred
@@ -50,6 +62,7 @@ SINK_FAST_INSERT = QgsFeatureSink.Flag.FastInsert  # same name on 3.22 and 4.x
 # (STYLE.md section 5, rule 4; flake8-qgis QGS402 is expected here).
 FIELD_STRING = QVariant.String
 FIELD_DOUBLE = QVariant.Double
+FIELD_INT = QVariant.Int
 
 MSG_INFO = Qgis.MessageLevel.Info
 MSG_WARNING = Qgis.MessageLevel.Warning
