@@ -1,0 +1,257 @@
+"""LAS/LAZ I/O through laspy: info, CRS and units, chunked reads, lossless rewrites, bad input."""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import laspy
+import numpy as np
+import pyproj
+import pytest
+from lidarphoto.core.errors import Cancelled, CrsError, InputError
+from lidarphoto.core.pointcloud import read_info, read_points, write_cloud
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+AHN3 = DATA / "ahn3" / "ahn3_delft_crop60.laz"
+SAMP11 = DATA / "isprs" / "samp11.laz"
+SHARED = Path(__file__).resolve().parents[3] / "shared" / "data"
+BOTH_VLRS = SHARED / "laspy-testdata" / "file_with_both_wkt_and_geotiff_vlrs.las"
+AUTZEN_TRIM = SHARED / "autzen-trim" / "autzen_trim.laz"
+NO_CRS = SHARED / "laspy-testdata" / "simple.las"
+US_FOOT = 1200.0 / 3937.0
+
+
+def _needs(path: Path):
+    return pytest.mark.skipif(not path.exists(), reason=f"{path} not available")
+
+
+def _leftovers(folder: Path) -> list[str]:
+    return sorted(p.name for p in folder.iterdir() if ".part" in p.name)
+
+
+def test_info_crs_from_geotiff_keys_in_metres():
+    info = read_info(SAMP11)
+    assert info.crs.to_epsg() == 32632
+    assert (info.version, info.point_format, info.point_count) == ("1.2", 1, 38010)
+    assert info.horizontal_unit == "metre"
+    assert info.unit_to_metre == 1.0 and info.vertical_unit_to_metre == 1.0
+    assert not info.has_return_numbers  # the ISPRS samples carry no return numbers
+    assert {"X", "Y", "Z", "classification"} <= set(info.dimensions)
+
+
+def test_compound_crs_written_into_the_crop_is_read_back():
+    info = read_info(AHN3)
+    assert info.crs.to_epsg() == 7415
+    assert info.horizontal_unit == "metre" and info.vertical_unit_to_metre == 1.0
+    assert info.has_return_numbers
+    assert np.all(info.maxs - info.mins <= [60.0, 60.0, 30.0])
+
+
+@_needs(BOTH_VLRS)
+def test_wkt_preferred_and_us_survey_feet():
+    info = read_info(BOTH_VLRS)
+    assert info.version == "1.4" and info.point_format == 6
+    assert "Nebraska" in info.crs.name  # the WKT VLR (the GeoTIFF keys give EPSG:32104, metres)
+    assert info.horizontal_unit == "US survey foot"
+    assert info.unit_to_metre == pytest.approx(US_FOOT, rel=1e-12)
+    assert info.vertical_unit_to_metre == pytest.approx(US_FOOT, rel=1e-12)  # VerticalUnitsGeoKey
+
+
+@_needs(AUTZEN_TRIM)
+def test_international_feet_from_esri_wkt():
+    info = read_info(AUTZEN_TRIM)
+    assert info.horizontal_unit == "foot"
+    assert info.unit_to_metre == pytest.approx(0.3048, rel=1e-12)
+    arrays, info = read_points(AUTZEN_TRIM, ("x", "y", "z", "return_number"))
+    assert info.has_return_numbers
+    # the file's extent is 1177 x 563 ft: in feet, not metres
+    assert np.ptp(arrays["x"]) == pytest.approx(1177.46, abs=0.05)
+
+
+def test_override_crs_and_refuse_geographic():
+    assert read_info(SAMP11, crs="EPSG:25832").crs.to_epsg() == 25832
+    assert read_info(SAMP11, crs=pyproj.CRS.from_epsg(2994)).horizontal_unit == "foot"
+    with pytest.raises(CrsError, match="geographic"):
+        read_info(SAMP11, crs=4326)
+    with pytest.raises(CrsError, match="not a valid CRS"):
+        read_info(SAMP11, crs="EPSG:999999")
+
+
+def test_chunked_read_equals_laspy(tmp_path):
+    las = laspy.read(AHN3)
+    arrays, info = read_points(
+        AHN3, ("x", "y", "z", "classification", "return_number", "gps_time"), chunk_size=7000
+    )
+    assert arrays["x"].dtype == np.float64 and arrays["classification"].dtype == np.uint8
+    np.testing.assert_array_equal(arrays["x"], las.x)
+    np.testing.assert_array_equal(arrays["z"], las.z)
+    np.testing.assert_array_equal(arrays["classification"], las.classification)
+    np.testing.assert_array_equal(arrays["gps_time"], las.gps_time)
+    assert info.has_return_numbers
+
+
+def test_unknown_field_names_the_column():
+    with pytest.raises(InputError, match="height_above_ground"):
+        read_points(AHN3, ("x", "height_above_ground"))
+
+
+@pytest.mark.parametrize("suffix", [".las", ".laz"])
+def test_rewrite_keeps_every_dimension_and_vlr(tmp_path, suffix):
+    src = laspy.read(AHN3)
+    n = len(src.points)
+    rng = np.random.default_rng(1)
+    cls = rng.integers(0, 20, n).astype(np.uint8)
+    hag = rng.normal(size=n).astype(np.float32)
+    pid = rng.integers(-5, 500, n).astype(np.int32)
+    dst = tmp_path / f"out{suffix}"
+    seen = []
+    write_cloud(
+        AHN3,
+        dst,
+        classification=cls,
+        extra={"height_above_ground": hag, "plane_id": pid},
+        chunk_size=9000,
+        progress=seen.append,
+    )
+    assert seen[-1] == 1.0 and len(seen) == 4
+    out = laspy.read(dst)
+    assert out.header.are_points_compressed == (suffix == ".laz")
+    assert out.header.version == src.header.version
+    assert out.header.point_format.id == src.header.point_format.id
+    for name in src.point_format.dimension_names:
+        if name != "classification":
+            np.testing.assert_array_equal(np.asarray(out[name]), np.asarray(src[name]), name)
+    np.testing.assert_array_equal(out.classification, cls)
+    assert out.height_above_ground.dtype == np.float32
+    np.testing.assert_array_equal(out.height_above_ground, hag)
+    assert out.plane_id.dtype == np.int32
+    np.testing.assert_array_equal(out.plane_id, pid)
+    src_vlrs = [(v.user_id, v.record_id) for v in src.header.vlrs if v.record_id != 22204]
+    out_vlrs = [(v.user_id, v.record_id) for v in out.header.vlrs]
+    assert all(v in out_vlrs for v in src_vlrs)
+    assert out.header.parse_crs().to_epsg() == 7415
+    np.testing.assert_allclose(out.header.mins, src.header.mins)
+    assert out.header.system_identifier == src.header.system_identifier
+    assert out.header.generating_software == src.header.generating_software
+    assert _leftovers(tmp_path) == []
+
+    # rewriting in place overwrites an existing extra dimension of the same dtype
+    write_cloud(dst, dst, extra={"height_above_ground": np.zeros(n, np.float32)})
+    again = laspy.read(dst)
+    assert list(again.point_format.extra_dimension_names) == ["height_above_ground", "plane_id"]
+    assert not again.height_above_ground.any()
+    np.testing.assert_array_equal(again.plane_id, pid)
+
+
+@_needs(BOTH_VLRS)
+def test_rewrite_las14_keeps_wkt(tmp_path):
+    dst = tmp_path / "out.laz"
+    src = laspy.read(BOTH_VLRS)
+    write_cloud(BOTH_VLRS, dst, extra={"h": np.ones(len(src.points), np.float64)})
+    out = laspy.read(dst)
+    assert out.header.version == "1.4" and out.header.point_format.id == 6
+    assert out.header.global_encoding.wkt == src.header.global_encoding.wkt
+    assert out.header.parse_crs() == src.header.parse_crs()
+    np.testing.assert_array_equal(out.scan_angle, src.scan_angle)
+
+
+def test_las_1_0_is_read(tmp_path):
+    dst = tmp_path / "v10.las"
+    write_cloud(SAMP11, dst)
+    with open(dst, "r+b") as fh:  # version minor byte of the public header block
+        fh.seek(25)
+        fh.write(bytes([0]))
+    info = read_info(dst)
+    assert info.version == "1.0" and info.point_count == 38010
+
+
+def test_bad_arrays_and_names(tmp_path):
+    n = read_info(SAMP11).point_count
+    with pytest.raises(InputError, match="shape"):
+        write_cloud(SAMP11, tmp_path / "a.laz", classification=np.ones(n - 1, np.uint8))
+    with pytest.raises(InputError, match="0-31"):
+        write_cloud(SAMP11, tmp_path / "a.laz", classification=np.full(n, 40, np.uint8))
+    with pytest.raises(InputError, match="standard dimension"):
+        write_cloud(SAMP11, tmp_path / "a.laz", extra={"intensity": np.ones(n, np.uint16)})
+    with pytest.raises(InputError, match=r"\.las or \.laz"):
+        write_cloud(SAMP11, tmp_path / "a.txt")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_missing_empty_and_zero_point_files(tmp_path):
+    with pytest.raises(InputError, match="not found") as err:
+        read_info(tmp_path / "nope.laz")
+    assert "nope.laz" in str(err.value)
+    empty = tmp_path / "empty.laz"
+    empty.write_bytes(b"")
+    with pytest.raises(InputError, match="empty"):
+        read_points(empty)
+    zero = tmp_path / "zero.las"
+    header = laspy.LasHeader(point_format=1, version="1.2")
+    header.add_crs(pyproj.CRS.from_epsg(28992))
+    laspy.LasData(header).write(zero)
+    with pytest.raises(InputError, match="no points") as err:
+        read_points(zero)
+    assert "zero.las" in str(err.value)
+    garbage = tmp_path / "garbage.las"
+    garbage.write_bytes(b"not a las file at all" * 20)
+    with pytest.raises(InputError, match="cannot read"):
+        read_info(garbage)
+
+
+def test_unsupported_version(tmp_path):
+    dst = tmp_path / "v19.las"
+    write_cloud(SAMP11, dst)
+    with open(dst, "r+b") as fh:
+        fh.seek(25)
+        fh.write(bytes([9]))
+    with pytest.raises(InputError, match="version") as err:
+        read_info(dst)
+    assert "v19.las" in str(err.value)
+
+
+def test_no_crs_asks_for_one(tmp_path):
+    src = laspy.read(AHN3)
+    bare = tmp_path / "bare.las"
+    header = laspy.LasHeader(point_format=src.header.point_format, version="1.2")
+    data = laspy.LasData(header)
+    data.points = src.points[:1000].copy()
+    data.write(bare)
+    with pytest.raises(CrsError, match="give the CRS") as err:
+        read_points(bare)
+    assert "bare.las" in str(err.value)
+    arrays, info = read_points(bare, crs="EPSG:7415")
+    assert info.crs.to_epsg() == 7415 and len(arrays["x"]) == 1000
+    info = read_info(bare, require_crs=False)
+    assert info.crs is None and info.horizontal_unit == "unknown"
+
+
+def test_corrupt_laz_leaves_no_output(tmp_path):
+    broken = tmp_path / "broken.laz"
+    raw = AHN3.read_bytes()
+    broken.write_bytes(raw[: len(raw) // 2])  # header intact, point chunks cut
+    with pytest.raises(InputError, match=r"broken\.laz"):
+        read_points(broken)
+    out = tmp_path / "out" / "result.laz"
+    out.parent.mkdir()
+    with pytest.raises(InputError, match=r"broken\.laz"):
+        write_cloud(broken, out)
+    assert list(out.parent.iterdir()) == []
+
+
+def test_cancel_leaves_no_output(tmp_path):
+    calls = []
+
+    def stop() -> bool:
+        calls.append(1)
+        return len(calls) > 2
+
+    out = tmp_path / "c.laz"
+    shutil.copy(AHN3, tmp_path / "src.laz")
+    with pytest.raises(Cancelled):
+        write_cloud(tmp_path / "src.laz", out, chunk_size=5000, should_stop=stop)
+    assert sorted(os.listdir(tmp_path)) == ["src.laz"]
+    with pytest.raises(Cancelled):
+        read_points(AHN3, chunk_size=5000, should_stop=lambda: True)
