@@ -70,7 +70,341 @@ def _run_trajectory_to_eo(args: argparse.Namespace) -> int:
     return 0
 
 
-_ALGORITHMS = (_add_trajectory_to_eo,)
+def _add_ground_filter(sub: argparse._SubParsersAction) -> None:
+    from .ground_filter import GroundFilterParams
+
+    d = GroundFilterParams()
+    p = sub.add_parser(
+        "groundfilter",
+        help="progressive morphological ground filter of a LAS/LAZ cloud",
+        description=(
+            "Classifies ground (class 2) with the Progressive Morphological Filter and writes "
+            "a copy of the cloud with the extra dimension height_above_ground, and optionally "
+            "the DTM as GeoTIFF. Lengths are in the cloud's CRS unit unless --distance-unit "
+            "metres."
+        ),
+    )
+    p.add_argument("--input", required=True, help="LAS/LAZ file")
+    p.add_argument("--crs", default=None, help="overrides the file's CRS (EPSG:xxxx or WKT)")
+    p.add_argument("--distance-unit", default="crs", help="crs (cloud CRS units) | metres")
+    for name, text in (
+        ("cell_size", "cell size (horizontal)"),
+        ("max_window", "maximum window size (horizontal)"),
+        ("slope", "terrain slope, rise/run"),
+        ("initial_distance", "initial elevation threshold (vertical)"),
+        ("max_distance", "maximum elevation threshold (vertical)"),
+        ("window_base", "window growth base b (cells)"),
+        ("ground_threshold", "final height tolerance (vertical)"),
+        ("slope_scalar", "tolerance added per unit of slope (vertical)"),
+        ("low_outlier_height", "low outlier depth (vertical, 0 = off)"),
+        ("low_outlier_radius", "low outlier radius (horizontal)"),
+    ):
+        default = getattr(d, name)
+        p.add_argument(f"--{name.replace('_', '-')}", type=float, default=default, help=text)
+    p.add_argument("--growth", default="linear", help="linear | exponential")
+    p.add_argument("--window-shape", default="square", help="square | disk")
+    p.add_argument("--last-returns-only", default="true", help="true | false")
+    p.add_argument("--non-ground-class", default="keep", help="keep | 1")
+    p.add_argument("--output-cloud", required=True, help="classified LAS/LAZ to write")
+    p.add_argument("--output-dtm", default=None, help="DTM GeoTIFF to write (optional)")
+    p.set_defaults(run=_run_ground_filter)
+
+
+def _run_ground_filter(args: argparse.Namespace) -> int:
+    from .errors import InputError
+    from .ground_filter import GroundFilterParams, run_ground_filter, write_geotiff
+
+    def choice(value: str, options: Sequence[str], name: str) -> int:
+        v = value.strip().lower()
+        if v.isdigit() and int(v) < len(options):
+            return int(v)
+        for i, opt in enumerate(options):
+            if v in opt.split("|"):
+                return i
+        raise InputError(f"--{name}: expected one of {', '.join(options)}, got {value!r}")
+
+    unit = ("crs", "metre")[choice(args.distance_unit, ("crs", "metre|metres|m"), "distance-unit")]
+    growth = choice(args.growth, ("linear", "exponential"), "growth")
+    shape = choice(args.window_shape, ("square", "disk"), "window-shape")
+    last = choice(args.last_returns_only, ("false|no|0", "true|yes|1"), "last-returns-only")
+    params = GroundFilterParams(
+        cell_size=args.cell_size,
+        max_window=args.max_window,
+        slope=args.slope,
+        initial_distance=args.initial_distance,
+        max_distance=args.max_distance,
+        growth=("linear", "exponential")[growth],
+        window_base=args.window_base,
+        window_shape=("square", "disk")[shape],
+        ground_threshold=args.ground_threshold,
+        slope_scalar=args.slope_scalar,
+        low_outlier_height=args.low_outlier_height,
+        low_outlier_radius=args.low_outlier_radius,
+        last_returns_only=last == 1,
+        distance_unit=unit,
+    )
+    keep = choice(args.non_ground_class, ("keep", "1|unclassified"), "non-ground-class")
+    non_ground = (None, 1)[keep]
+    run = run_ground_filter(
+        args.input, args.output_cloud, params, crs=args.crs, non_ground_class=non_ground
+    )
+    if args.output_dtm:
+        r = run.result
+        write_geotiff(args.output_dtm, r.dtm, r.geotransform, r.nodata, run.crs_wkt or None)
+    print(
+        f"{run.point_count} points, {run.ground_count} ground, {run.low_outlier_count} low "
+        f"outliers; distances in {run.unit} -> {args.output_cloud}"
+    )
+    return 0
+
+
+def _add_create_lcps(sub: argparse._SubParsersAction) -> None:
+    from .lidar_control import ControlOptions
+
+    d = ControlOptions()
+    p = sub.add_parser(
+        "createlcps",
+        help="LiDAR control points and lines from intersecting roof planes",
+        description=(
+            "Intersects the roof planes of a plane table (from extractroofplanes): three planes "
+            "at a corner give a control point, two adjacent planes a ridge/hip/valley line, each "
+            "with its covariance. Lengths are in the cloud's CRS unit unless --distance-unit "
+            "metres."
+        ),
+    )
+    p.add_argument("--planes", required=True, help="plane table CSV")
+    p.add_argument("--cloud", required=True, help="LAS/LAZ with the plane_id dimension")
+    p.add_argument("--crs", default=None, help="CRS of the cloud when the file has none")
+    p.add_argument("--distance-unit", default="crs", help="crs (cloud CRS unit) | metres")
+    p.add_argument("--delta", type=float, default=d.delta, help="adjacency distance")
+    p.add_argument("--min-boundary", type=float, default=d.min_boundary, help="common boundary")
+    p.add_argument("--min-angle", type=float, default=d.min_angle_deg, help="degrees")
+    p.add_argument("--max-condition", type=float, default=d.max_condition)
+    p.add_argument("--max-support", type=float, default=d.max_support_distance)
+    p.add_argument("--triples", default="", help='plane ids "1,2,3; 4,5,6" (default: automatic)')
+    p.add_argument("--pairs", default="", help='plane ids "1,2; 2,3" (default: automatic)')
+    p.add_argument("--points-csv", default=None, help="LCP table to write")
+    p.add_argument("--lines-csv", default=None, help="line table to write")
+    p.add_argument("--graph-csv", default=None, help="plane adjacency graph to write")
+    p.set_defaults(run=_run_create_lcps)
+
+
+def _run_create_lcps(args: argparse.Namespace) -> int:
+    from .lidar_control import ControlOptions, run_create_lcps
+
+    options = ControlOptions(
+        delta=args.delta,
+        min_boundary=args.min_boundary,
+        min_angle_deg=args.min_angle,
+        max_condition=args.max_condition,
+        max_support_distance=args.max_support,
+    )
+    result, info = run_create_lcps(
+        args.planes, args.cloud, crs=args.crs, options=options, triples=args.triples,
+        pairs=args.pairs, points_csv=args.points_csv, lines_csv=args.lines_csv,
+        graph_csv=args.graph_csv, distance_unit=args.distance_unit,
+    )  # fmt: skip
+    for r in result.rejected:
+        logging.getLogger(__name__).info("planes %s: %s", r.plane_ids, r.reason)
+    print(
+        f"{len(result.points)} control points, {len(result.lines)} lines, "
+        f"{int(result.adjacency.adjacent.sum())} adjacent plane pairs ({info.horizontal_unit})"
+    )
+    return 0
+
+
+def _add_accuracy_report(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "accuracyreport",
+        help="check points against ASPRS Ed. 2, NSSDA, PEC-PCD and the project threshold",
+        description=(
+            "Positional accuracy report. INPUT is a CSV with id, e, n, h, e_ref, n_ref, h_ref "
+            "[, group]; or MEASURED and REFERENCE point tables (id, e, n, h [, group]) joined "
+            "by id. Writes a self-contained HTML report and a JSON of every figure. Enumerations "
+            "take names or indices as in QGIS."
+        ),
+    )
+    p.add_argument("--input", default=None, help="check-point CSV (one table)")
+    for what in ("measured", "reference"):
+        p.add_argument(f"--{what}", default=None, help=f"{what} point table (CSV)")
+        p.add_argument(f"--{what}-id", default="", help="id column (default: id)")
+        p.add_argument(f"--{what}-z-field", default="", help="height column (default: h)")
+    p.add_argument("--group-field", default="", help="group column (default: group)")
+    p.add_argument("--crs", default="", help="CRS of the coordinates (reported only)")
+    p.add_argument("--reproject", action="store_true", help="QGIS only: tables carry no CRS")
+    p.add_argument("--alpha", type=float, default=0.05, help="significance level")
+    for name in ("declared-sigma-h", "declared-sigma-v", "survey-sigma-h", "survey-sigma-v"):
+        p.add_argument(f"--{name}", type=float, default=0.0, help="metres (h: per axis)")
+    p.add_argument("--outlier-rule", default="robust", help="robust, three_sigma or none")
+    p.add_argument("--exclude-outliers", action="store_true", help="drop flagged points")
+    p.add_argument("--standards", default="asprs,nssda,pec,project", help="comma list")
+    p.add_argument("--asprs-h-class-cm", type=float, default=0.0, help="0 = tightest met")
+    p.add_argument("--asprs-v-class-cm", type=float, default=0.0, help="0 = tightest met")
+    p.add_argument("--pec-scale", type=float, default=1000.0, help="scale denominator")
+    p.add_argument("--pec-equidistance", type=float, default=0.0, help="m, 0 = series value")
+    p.add_argument("--pec-class", default="A", help="declared class A, B, C or D")
+    p.add_argument("--project-h-threshold", type=float, default=0.40, help="metres")
+    p.add_argument("--project-v-threshold", type=float, default=0.0, help="m, 0 = Eq. 18")
+    p.add_argument("--flight-geometry", default="1600,452,100.4,6", help="H m,B m,f mm,px um")
+    p.add_argument("--output-html", default=None, help="HTML report to write")
+    p.add_argument("--output-json", default=None, help="JSON of every figure to write")
+    p.set_defaults(run=_run_accuracy_report)
+
+
+def _run_accuracy_report(args: argparse.Namespace) -> int:
+    from .accuracy import OUTLIER_RULES, STANDARD_KEYS, AccuracySettings, run_accuracy_report
+    from .errors import InputError
+    from .standards import PEC_CLASSES
+
+    def choice(value: str, options: tuple[str, ...], what: str) -> str:
+        v = value.strip()
+        if v.isdigit() and int(v) < len(options):
+            return options[int(v)]
+        if v.lower() in [o.lower() for o in options]:
+            return next(o for o in options if o.lower() == v.lower())
+        raise InputError(f"{what}: '{value}' is not one of {', '.join(options)}")
+
+    if args.reproject:
+        raise InputError("REPROJECT needs QGIS (point tables carry no CRS)")
+    try:
+        geometry = tuple(float(v) for v in args.flight_geometry.split(","))
+    except ValueError:
+        raise InputError(f"FLIGHT_GEOMETRY: '{args.flight_geometry}' is not 4 numbers") from None
+    settings = AccuracySettings(
+        alpha=args.alpha,
+        declared_sigma_h=args.declared_sigma_h,
+        declared_sigma_v=args.declared_sigma_v,
+        survey_sigma_h=args.survey_sigma_h,
+        survey_sigma_v=args.survey_sigma_v,
+        outlier_rule=choice(args.outlier_rule, OUTLIER_RULES, "OUTLIER_RULE"),
+        exclude_outliers=args.exclude_outliers,
+        standards=tuple(
+            choice(v, STANDARD_KEYS, "STANDARDS") for v in args.standards.split(",") if v.strip()
+        ),
+        asprs_h_class_cm=args.asprs_h_class_cm,
+        asprs_v_class_cm=args.asprs_v_class_cm,
+        pec_scale=args.pec_scale,
+        pec_equidistance=args.pec_equidistance,
+        pec_class=choice(args.pec_class, PEC_CLASSES, "PEC_CLASS"),
+        project_h_threshold=args.project_h_threshold,
+        project_v_threshold=args.project_v_threshold,
+        flight_geometry=geometry,
+    )
+    report = run_accuracy_report(
+        input_table=args.input,
+        measured_table=args.measured,
+        reference_table=args.reference,
+        measured_id=args.measured_id or None,
+        reference_id=args.reference_id or None,
+        measured_z=args.measured_z_field or None,
+        reference_z=args.reference_z_field or None,
+        group_field=args.group_field or None,
+        crs=args.crs or None,
+        settings=settings,
+        output_html=args.output_html,
+        output_json=args.output_json,
+    )
+    for key, value in report.rmse.items():
+        print(f"{key} {value:.4f}")
+    for res in report.standards:
+        for v in res.verdicts:
+            print(f"{res.key}: {v.name}: {v.status} ({v.reason})")
+    return 0
+
+
+def _add_extract_roof_planes(sub: argparse._SubParsersAction) -> None:
+    from .roof_planes import RoofPlaneParams
+
+    d = RoofPlaneParams()
+    p = sub.add_parser(
+        "extractroofplanes",
+        help="roof planes with their precision from a classified LAS/LAZ cloud",
+        description=(
+            "Local RANSAC on the K nearest neighbours, region growing, Pathak plane fits with "
+            "covariance. Writes the plane table CSV and optionally the cloud with the extra "
+            "dimension plane_id. Lengths are in the cloud's CRS unit unless --distance-unit "
+            "metres."
+        ),
+    )
+    p.add_argument("--input", required=True, help="LAS/LAZ file")
+    p.add_argument("--crs", default=None, help="overrides the file's CRS (EPSG:xxxx or WKT)")
+    p.add_argument("--distance-unit", default="crs", help="crs (cloud CRS units) | metres")
+    p.add_argument("--points", default="non_ground", help="non_ground | classes | all")
+    p.add_argument("--classes", default="6", help="classes for --points classes, e.g. 6 or 1,6")
+    for name, field, kind, text in (
+        ("k-neighbours", "k_neighbours", int, "neighbours K of the local RANSAC"),
+        ("epsilon", "epsilon", float, "point-to-plane tolerance (length)"),
+        ("min-support", "min_support", int, "minimum support of a local plane (points)"),
+        ("ransac-iterations", "ransac_iterations", int, "RANSAC triplets per point"),
+        ("min-slope", "min_slope_deg", float, "minimum slope alpha, degrees"),
+        ("max-slope", "max_slope_deg", float, "maximum slope beta, degrees"),
+        ("angle-tolerance", "angle_tolerance_deg", float, "normal angle tolerance, degrees"),
+        ("min-plane-points", "min_plane_points", int, "minimum points per plane"),
+        ("outline-cell", "outline_cell", float, "outline raster cell (length, 0 = auto)"),
+        ("seed", "seed", int, "random seed"),
+    ):
+        p.add_argument(
+            f"--{name}",
+            dest=name.replace("-", "_"),
+            type=kind,
+            default=getattr(d, field),
+            help=text,
+        )
+    p.add_argument("--output-csv", required=True, help="plane table CSV to write")
+    p.add_argument("--output-cloud", default=None, help="LAS/LAZ with plane_id (optional)")
+    p.set_defaults(run=_run_extract_roof_planes)
+
+
+def _run_extract_roof_planes(args: argparse.Namespace) -> int:
+    from .errors import InputError
+    from .roof_planes import RoofPlaneParams, run_extract_roof_planes
+
+    units = {
+        "crs": "crs",
+        "0": "crs",
+        "metre": "metre",
+        "metres": "metre",
+        "m": "metre",
+        "1": "metre",
+    }.get(args.distance_unit.strip().lower())
+    points = ("non_ground", "classes", "all")
+    sel = args.points.strip().lower().replace("-", "_")
+    sel = points[int(sel)] if sel.isdigit() and int(sel) < 3 else sel
+    if units is None or sel not in points:
+        raise InputError("--distance-unit must be crs|metres and --points non_ground|classes|all")
+    params = RoofPlaneParams(
+        k_neighbours=args.k_neighbours,
+        epsilon=args.epsilon,
+        min_support=args.min_support,
+        ransac_iterations=args.ransac_iterations,
+        min_slope_deg=args.min_slope,
+        max_slope_deg=args.max_slope,
+        angle_tolerance_deg=args.angle_tolerance,
+        min_plane_points=args.min_plane_points,
+        outline_cell=args.outline_cell,
+        seed=args.seed,
+    )
+    run = run_extract_roof_planes(
+        args.input,
+        params=params,
+        units=units,
+        selection=sel,
+        classes=args.classes,
+        crs=args.crs,
+        output_csv=args.output_csv,
+        output_cloud=args.output_cloud,
+    )
+    print(f"{run.result.message}; lengths in {run.unit} -> {args.output_csv}")
+    return 0
+
+
+_ALGORITHMS = (
+    _add_trajectory_to_eo,
+    _add_ground_filter,
+    _add_create_lcps,
+    _add_accuracy_report,
+    _add_extract_roof_planes,
+)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -8,6 +8,10 @@ from qgis.core import QgsProcessingProvider
 from qgis.PyQt.QtCore import QCoreApplication
 from qgis.PyQt.QtGui import QIcon
 
+from .algorithms.accuracy_report import AccuracyReportAlgorithm
+from .algorithms.create_lcps import CreateLcpsAlgorithm
+from .algorithms.extract_roof_planes import ExtractRoofPlanesAlgorithm
+from .algorithms.ground_filter import GroundFilterAlgorithm
 from .algorithms.trajectory_to_eo import TrajectoryToEoAlgorithm
 
 ICON_PATH = Path(__file__).resolve().parents[1] / "icon.svg"
@@ -35,5 +39,11 @@ class LidarPhotoProvider(QgsProcessingProvider):
         return str(ICON_PATH)
 
     def loadAlgorithms(self) -> None:
-        for alg in (TrajectoryToEoAlgorithm(),):
+        for alg in (
+            TrajectoryToEoAlgorithm(),
+            GroundFilterAlgorithm(),
+            CreateLcpsAlgorithm(),
+            AccuracyReportAlgorithm(),
+            ExtractRoofPlanesAlgorithm(),
+        ):
             self.addAlgorithm(alg)

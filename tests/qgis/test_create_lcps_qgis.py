@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import json
 import subprocess
+from pathlib import Path
 
 import laspy
 import numpy as np
@@ -15,7 +16,12 @@ import pyproj
 import pytest
 from lidarphoto.core.planes import fit_plane, write_planes_csv
 from lidarphoto.core.simulate_town import make_town, sample_town
-from qgis.core import QgsProcessingException, QgsVectorLayer, QgsWkbTypes
+from qgis.core import (
+    QgsProcessingException,
+    QgsProcessingModelAlgorithm,
+    QgsVectorLayer,
+    QgsWkbTypes,
+)
 from qgis_helpers import QGIS_PROCESS
 
 ALG = "lidarphoto:createlcps"
@@ -104,3 +110,57 @@ def test_qgis_process_run(qp_env, town_files, tmp_path):
     assert results["LCP_COUNT"] == 5
     layer = QgsVectorLayer(str(gpkg), "lcp", "ogr")
     assert layer.isValid() and layer.featureCount() == 5
+
+
+# ----------------------------------------------------------------------------- the whole chain
+CONTROL_MODEL = Path(__file__).resolve().parent / "data" / "lidar_control_model.model3"
+AHN3_CROP = Path(__file__).resolve().parents[1] / "data" / "ahn3" / "ahn3_delft_crop60.laz"
+
+
+def _model_outputs(tmp_path):
+    return {
+        "roofs:roof_planes": str(tmp_path / "planes.gpkg"),
+        "roofs:plane_table": str(tmp_path / "planes.csv"),
+        "roofs:plane_cloud": str(tmp_path / "planes.laz"),
+        "ground:classified_cloud": str(tmp_path / "ground.laz"),
+        "lcps:control_points": str(tmp_path / "lcp.gpkg"),
+        "lcps:control_lines": str(tmp_path / "lines.gpkg"),
+        "lcps:control_table": str(tmp_path / "lcp.csv"),
+    }
+
+
+def _check_control(tmp_path) -> None:
+    points = QgsVectorLayer(str(tmp_path / "lcp.gpkg"), "lcp", "ogr")
+    lines = QgsVectorLayer(str(tmp_path / "lines.gpkg"), "lines", "ogr")
+    assert points.isValid() and lines.isValid()
+    # the real 60 m Delft crop: a handful of corners and tens of ridges, valleys and hips
+    assert points.featureCount() >= 2 and lines.featureCount() >= 15
+    with open(tmp_path / "lcp.csv", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == points.featureCount()
+    assert all(0 < float(r["sigma_z"]) < 0.1 for r in rows)
+
+
+def test_model_chains_ground_roofs_and_control(provider, tmp_path):
+    model = QgsProcessingModelAlgorithm()
+    assert model.fromFile(str(CONTROL_MODEL))
+    ok, errors = model.validate()
+    assert ok, errors
+    assert sorted(c.algorithmId() for c in model.childAlgorithms().values()) == [
+        "lidarphoto:createlcps",
+        "lidarphoto:extractroofplanes",
+        "lidarphoto:groundfilter",
+    ]
+    processing.run(model, {"cloud": str(AHN3_CROP), "epsilon": 0.15, **_model_outputs(tmp_path)})
+    _check_control(tmp_path)
+
+
+def test_control_model_in_qgis_process(qp_env, tmp_path):
+    args = [f"{k}={v}" for k, v in _model_outputs(tmp_path).items()]
+    r = subprocess.run(
+        [QGIS_PROCESS, "--json", "run", str(CONTROL_MODEL), "--", f"cloud={AHN3_CROP}",
+         "epsilon=0.15", *args],
+        env=qp_env, capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    _check_control(tmp_path)
