@@ -16,15 +16,11 @@ from lidarphoto.core.pointcloud import read_info, read_points, write_cloud
 DATA = Path(__file__).resolve().parents[1] / "data"
 AHN3 = DATA / "ahn3" / "ahn3_delft_crop60.laz"
 SAMP11 = DATA / "isprs" / "samp11.laz"
-SHARED = Path(__file__).resolve().parents[3] / "shared" / "data"
-BOTH_VLRS = SHARED / "laspy-testdata" / "file_with_both_wkt_and_geotiff_vlrs.las"
-AUTZEN_TRIM = SHARED / "autzen-trim" / "autzen_trim.laz"
-NO_CRS = SHARED / "laspy-testdata" / "simple.las"
+TEST_DATA = Path(__file__).resolve().parents[1] / "data"
+BOTH_VLRS = TEST_DATA / "laspy" / "file_with_both_wkt_and_geotiff_vlrs.las"
+AUTZEN_TRIM = TEST_DATA / "autzen" / "autzen_trim.laz"
+NO_CRS = TEST_DATA / "laspy" / "simple.las"
 US_FOOT = 1200.0 / 3937.0
-
-
-def _needs(path: Path):
-    return pytest.mark.skipif(not path.exists(), reason=f"{path} not available")
 
 
 def _leftovers(folder: Path) -> list[str]:
@@ -49,7 +45,6 @@ def test_compound_crs_written_into_the_crop_is_read_back():
     assert np.all(info.maxs - info.mins <= [60.0, 60.0, 30.0])
 
 
-@_needs(BOTH_VLRS)
 def test_wkt_preferred_and_us_survey_feet():
     info = read_info(BOTH_VLRS)
     assert info.version == "1.4" and info.point_format == 6
@@ -59,7 +54,6 @@ def test_wkt_preferred_and_us_survey_feet():
     assert info.vertical_unit_to_metre == pytest.approx(US_FOOT, rel=1e-12)  # VerticalUnitsGeoKey
 
 
-@_needs(AUTZEN_TRIM)
 def test_international_feet_from_esri_wkt():
     info = read_info(AUTZEN_TRIM)
     assert info.horizontal_unit == "foot"
@@ -145,7 +139,6 @@ def test_rewrite_keeps_every_dimension_and_vlr(tmp_path, suffix):
     np.testing.assert_array_equal(again.plane_id, pid)
 
 
-@_needs(BOTH_VLRS)
 def test_rewrite_las14_keeps_wkt(tmp_path):
     dst = tmp_path / "out.laz"
     src = laspy.read(BOTH_VLRS)
