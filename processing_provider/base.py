@@ -8,10 +8,18 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Callable
 
-from qgis.core import QgsProcessingAlgorithm, QgsProcessingException, QgsProcessingFeedback
+from qgis.core import (
+    QgsProcessingAlgorithm,
+    QgsProcessingException,
+    QgsProcessingFeedback,
+    QgsProcessingParameterCrs,
+    QgsProcessingParameterEnum,
+    QgsProcessingParameterFile,
+)
 from qgis.PyQt.QtCore import QCoreApplication
 
 from ..core.errors import Cancelled, LidarPhotoError
+from .compat import FILE_BEHAVIOR_FILE, WKT_PREFERRED
 
 _PLUGIN_DIR = Path(__file__).resolve().parents[1]
 #: Logger of the whole package ("lidarphoto"); the core logs below it ("lidarphoto.core.*").
@@ -120,6 +128,44 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
     def helpUrl(self) -> str:
         home = _homepage()
         return f"{home.rstrip('/')}/algorithms/{self.name()}" if home else ""
+
+    # -- parameters shared by the algorithms that read a LAS/LAZ cloud -----------------------
+    DISTANCE_UNITS = ("crs", "metre")
+
+    def add_cloud_parameters(
+        self, key: str = "INPUT", label: str = "Point cloud (LAS/LAZ)"
+    ) -> None:
+        """The cloud file, ``CRS`` (overrides or supplies the file's) and ``DISTANCE_UNIT``
+        (0: the cloud's CRS unit, 1: metres) — the same names in every LiDAR algorithm."""
+        self.addParameter(
+            QgsProcessingParameterFile(
+                key,
+                self.tr(label),
+                behavior=FILE_BEHAVIOR_FILE,
+                fileFilter=self.tr("LAS/LAZ files (*.las *.laz *.LAS *.LAZ)"),
+            )
+        )
+        self.addParameter(
+            QgsProcessingParameterCrs("CRS", self.tr("CRS (overrides the file's)"), None, True)
+        )
+        self.addParameter(
+            QgsProcessingParameterEnum(
+                "DISTANCE_UNIT",
+                self.tr("Distance unit"),
+                [self.tr("cloud CRS units"), self.tr("metres")],
+                False,
+                0,
+            )
+        )
+
+    def cloud_crs(self, parameters, context) -> str | None:
+        """The ``CRS`` parameter for the core (authority id, else WKT), None when not given."""
+        crs = self.parameterAsCrs(parameters, "CRS", context)
+        return (crs.authid() or crs.toWkt(WKT_PREFERRED)) if crs.isValid() else None
+
+    def distance_unit(self, parameters, context) -> str:
+        """``"crs"`` or ``"metre"`` from the ``DISTANCE_UNIT`` parameter."""
+        return self.DISTANCE_UNITS[self.parameterAsEnum(parameters, "DISTANCE_UNIT", context)]
 
     def canExecute(self):
         from ..plugin.dependencies import missing_message, missing_modules

@@ -15,8 +15,6 @@ from qgis.core import (
     QgsPoint,
     QgsProcessingException,
     QgsProcessingOutputNumber,
-    QgsProcessingParameterCrs,
-    QgsProcessingParameterEnum,
     QgsProcessingParameterFeatureSink,
     QgsProcessingParameterFile,
     QgsProcessingParameterFileDestination,
@@ -37,10 +35,8 @@ from ..compat import (
     SOURCE_VECTOR_POINT,
     WKB_LINESTRING_Z,
     WKB_POINT_Z,
-    WKT_PREFERRED,
 )
 
-_UNITS = ("crs", "metre")
 _POINT_FIELDS = (
     ("id", FIELD_INT), ("sigma_x", FIELD_DOUBLE), ("sigma_y", FIELD_DOUBLE),
     ("sigma_z", FIELD_DOUBLE), ("ellipsoid_a", FIELD_DOUBLE), ("ellipsoid_b", FIELD_DOUBLE),
@@ -110,24 +106,7 @@ class CreateLcpsAlgorithm(BaseAlgorithm):
                 fileFilter=self.tr("CSV files (*.csv);;All files (*.*)"),
             )
         )  # fmt: skip
-        self.addParameter(
-            QgsProcessingParameterFile(
-                self.CLOUD, self.tr("Cloud with plane ids (LAS/LAZ)"),
-                behavior=FILE_BEHAVIOR_FILE,
-                fileFilter=self.tr("LAS/LAZ files (*.las *.laz);;All files (*.*)"),
-            )
-        )  # fmt: skip
-        crs = QgsProcessingParameterCrs(
-            self.CRS, self.tr("CRS of the cloud (when the file has none)"), optional=True
-        )
-        crs.setFlags(crs.flags() | FLAG_ADVANCED)
-        self.addParameter(crs)
-        self.addParameter(
-            QgsProcessingParameterEnum(
-                self.DISTANCE_UNIT, self.tr("Distance unit of the parameters"),
-                [self.tr("cloud CRS unit"), self.tr("metres")], False, 0,
-            )
-        )  # fmt: skip
+        self.add_cloud_parameters(self.CLOUD, "Cloud with plane ids (LAS/LAZ)")
         for key, label, default in (
             (self.DELTA, "Adjacency distance delta", 1.0),
             (self.MIN_BOUNDARY, "Minimum common boundary", 2.0),
@@ -179,10 +158,6 @@ class CreateLcpsAlgorithm(BaseAlgorithm):
     def processAlgorithm(self, parameters, context, feedback):
         from ...core.lidar_control import ControlOptions, error_ellipsoid, run_create_lcps
 
-        crs_param = self.parameterAsCrs(parameters, self.CRS, context)
-        crs = (
-            (crs_param.authid() or crs_param.toWkt(WKT_PREFERRED)) if crs_param.isValid() else None
-        )
         options = ControlOptions(
             delta=self.parameterAsDouble(parameters, self.DELTA, context),
             min_boundary=self.parameterAsDouble(parameters, self.MIN_BOUNDARY, context),
@@ -196,14 +171,14 @@ class CreateLcpsAlgorithm(BaseAlgorithm):
             run_create_lcps,
             self.parameterAsFile(parameters, self.PLANES, context),
             self.parameterAsFile(parameters, self.CLOUD, context),
-            crs=crs,
+            crs=self.cloud_crs(parameters, context),
             options=options,
             triples=self.parameterAsString(parameters, self.TRIPLES, context),
             pairs=self.parameterAsString(parameters, self.PAIRS, context),
             points_csv=csvs[self.POINTS_CSV],
             lines_csv=csvs[self.LINES_CSV],
             graph_csv=csvs[self.GRAPH_CSV],
-            distance_unit=_UNITS[self.parameterAsEnum(parameters, self.DISTANCE_UNIT, context)],
+            distance_unit=self.distance_unit(parameters, context),
             feedback=feedback,
         )
         for rejection in result.rejected:

@@ -15,10 +15,8 @@ from qgis.core import (
     QgsProcessingException,
     QgsProcessingOutputNumber,
     QgsProcessingOutputString,
-    QgsProcessingParameterCrs,
     QgsProcessingParameterEnum,
     QgsProcessingParameterFeatureSink,
-    QgsProcessingParameterFile,
     QgsProcessingParameterFileDestination,
     QgsProcessingParameterNumber,
     QgsProcessingParameterString,
@@ -29,10 +27,8 @@ from ..base import BaseAlgorithm, core_errors
 from ..compat import (
     FIELD_DOUBLE,
     FIELD_INT,
-    FILE_BEHAVIOR_FILE,
     FLAG_ADVANCED,
     SINK_FAST_INSERT,
-    WKT_PREFERRED,
 )
 
 if hasattr(Qgis, "WkbType"):  # QGIS >= 3.30
@@ -74,7 +70,6 @@ _NUMBERS = (
     ),
     ("SEED", "seed", "Random seed", _INT, 0, 0, True),
 )
-_UNITS = ("crs", "metre")
 _SELECTIONS = ("non_ground", "classes", "all")
 _TABLE = ("a", "b", "c", "d", "centroid_x", "centroid_y", "centroid_z")
 
@@ -127,23 +122,7 @@ class ExtractRoofPlanesAlgorithm(BaseAlgorithm):
         return self.tr(_HELP)
 
     def initAlgorithm(self, config=None):
-        self.addParameter(
-            QgsProcessingParameterFile(
-                self.INPUT,
-                self.tr("Point cloud (LAS/LAZ)"),
-                behavior=FILE_BEHAVIOR_FILE,
-                fileFilter=self.tr("LAS/LAZ files (*.las *.laz *.LAS *.LAZ)"),
-            )
-        )
-        self.addParameter(
-            QgsProcessingParameterCrs(self.CRS, self.tr("CRS (overrides the file's)"), None, True)
-        )
-        units = [self.tr("cloud CRS units"), self.tr("metres")]
-        self.addParameter(
-            QgsProcessingParameterEnum(
-                self.DISTANCE_UNIT, self.tr("Distance unit"), units, False, 0
-            )
-        )
+        self.add_cloud_parameters(self.INPUT)
         points = [self.tr("non-ground (class != 2)"), self.tr("the classes below"), self.tr("all")]
         self.addParameter(
             QgsProcessingParameterEnum(self.POINTS, self.tr("Points"), points, False, 0)
@@ -190,17 +169,16 @@ class ExtractRoofPlanesAlgorithm(BaseAlgorithm):
             values[field] = get(parameters, key, context)
         with core_errors():
             params = RoofPlaneParams(**values)
-        crs = self.parameterAsCrs(parameters, self.CRS, context)
         out_csv = self.parameterAsFileOutput(parameters, self.OUTPUT_CSV, context)
         out_cloud = self.parameterAsFileOutput(parameters, self.OUTPUT_CLOUD, context)
         run = self.run_core(
             run_extract_roof_planes,
             self.parameterAsFile(parameters, self.INPUT, context),
             params=params,
-            units=_UNITS[self.parameterAsEnum(parameters, self.DISTANCE_UNIT, context)],
+            units=self.distance_unit(parameters, context),
             selection=_SELECTIONS[self.parameterAsEnum(parameters, self.POINTS, context)],
             classes=self.parameterAsString(parameters, self.CLASSES, context),
-            crs=(crs.authid() or crs.toWkt(WKT_PREFERRED)) if crs.isValid() else None,
+            crs=self.cloud_crs(parameters, context),
             output_csv=out_csv,
             output_cloud=out_cloud or None,
             feedback=feedback,

@@ -7,16 +7,14 @@ from qgis.core import (
     QgsProcessingOutputNumber,
     QgsProcessingOutputString,
     QgsProcessingParameterBoolean,
-    QgsProcessingParameterCrs,
     QgsProcessingParameterEnum,
-    QgsProcessingParameterFile,
     QgsProcessingParameterFileDestination,
     QgsProcessingParameterNumber,
     QgsProcessingParameterRasterDestination,
 )
 
 from ..base import BaseAlgorithm, core_errors
-from ..compat import FILE_BEHAVIOR_FILE, FLAG_ADVANCED, WKT_PREFERRED
+from ..compat import FLAG_ADVANCED
 
 #: (parameter, GroundFilterParams field, label, default, advanced) of the numeric parameters.
 _NUMBERS = (
@@ -31,7 +29,6 @@ _NUMBERS = (
     ("LOW_OUTLIER_HEIGHT", "low_outlier_height", "Low outlier depth (0 = off)", 1.0, True),
     ("LOW_OUTLIER_RADIUS", "low_outlier_radius", "Low outlier radius (horizontal)", 5.0, True),
 )
-_UNITS = ("crs", "metre")
 _GROWTH = ("linear", "exponential")
 _SHAPES = ("square", "disk")
 _NON_GROUND = (None, 1)
@@ -77,26 +74,7 @@ class GroundFilterAlgorithm(BaseAlgorithm):
         return self.tr(_HELP)
 
     def initAlgorithm(self, config=None):
-        self.addParameter(
-            QgsProcessingParameterFile(
-                self.INPUT,
-                self.tr("Point cloud (LAS/LAZ)"),
-                behavior=FILE_BEHAVIOR_FILE,
-                fileFilter=self.tr("LAS/LAZ files (*.las *.laz *.LAS *.LAZ)"),
-            )
-        )
-        self.addParameter(
-            QgsProcessingParameterCrs(self.CRS, self.tr("CRS (overrides the file's)"), None, True)
-        )
-        self.addParameter(
-            QgsProcessingParameterEnum(
-                self.DISTANCE_UNIT,
-                self.tr("Distance unit"),
-                [self.tr("cloud CRS units"), self.tr("metres")],
-                False,
-                0,
-            )
-        )
+        self.add_cloud_parameters(self.INPUT)
         for key, _field, label, default, advanced in _NUMBERS:
             param = QgsProcessingParameterNumber(
                 key, self.tr(label), QgsProcessingParameterNumber.Type.Double, default, False, 0.0
@@ -148,14 +126,13 @@ class GroundFilterAlgorithm(BaseAlgorithm):
     def processAlgorithm(self, parameters, context, feedback):
         from ...core.ground_filter import GroundFilterParams, run_ground_filter
 
-        crs = self.parameterAsCrs(parameters, self.CRS, context)
         values = {f: self.parameterAsDouble(parameters, key, context) for key, f, *_ in _NUMBERS}
         params = GroundFilterParams(
             **values,
             growth=_GROWTH[self.parameterAsEnum(parameters, self.GROWTH, context)],
             window_shape=_SHAPES[self.parameterAsEnum(parameters, self.WINDOW_SHAPE, context)],
             last_returns_only=self.parameterAsBool(parameters, self.LAST_RETURNS_ONLY, context),
-            distance_unit=_UNITS[self.parameterAsEnum(parameters, self.DISTANCE_UNIT, context)],
+            distance_unit=self.distance_unit(parameters, context),
         )
         out_cloud = self.parameterAsFileOutput(parameters, self.OUTPUT_CLOUD, context)
         out_dtm = self.parameterAsOutputLayer(parameters, self.OUTPUT_DTM, context)
@@ -164,7 +141,7 @@ class GroundFilterAlgorithm(BaseAlgorithm):
             self.parameterAsFile(parameters, self.INPUT, context),
             out_cloud,
             params,
-            crs=(crs.authid() or crs.toWkt(WKT_PREFERRED)) if crs.isValid() else None,
+            crs=self.cloud_crs(parameters, context),
             non_ground_class=_NON_GROUND[
                 self.parameterAsEnum(parameters, self.NON_GROUND_CLASS, context)
             ],

@@ -20,6 +20,7 @@ MODEL = HERE / "data" / "ground_roof_model.model3"
 
 
 def build_model():
+    from model_tools import static_defaults
     from qgis.core import (
         QgsProcessingModelAlgorithm,
         QgsProcessingModelChildAlgorithm,
@@ -56,7 +57,7 @@ def build_model():
     out.setChildOutputName("OUTPUT_CLOUD")
     out.setPosition(QPointF(650.0, 40.0))
     ground.setModelOutputs({"classified_cloud": out})
-    _static_defaults(ground)  # addChildAlgorithm stores a copy: complete the child first
+    static_defaults(ground)  # addChildAlgorithm stores a copy: complete the child first
     model.addChildAlgorithm(ground)
 
     roofs = QgsProcessingModelChildAlgorithm("lidarphoto:extractroofplanes")
@@ -75,53 +76,14 @@ def build_model():
         o.setPosition(QPointF(700.0, 200.0 + 60.0 * len(outputs)))
         outputs[name] = o
     roofs.setModelOutputs(outputs)
-    _static_defaults(roofs)
+    static_defaults(roofs)
     model.addChildAlgorithm(roofs)
     model.updateDestinationParameters()
     return model
 
 
-def _static_defaults(child) -> None:
-    """Every parameter not wired above gets its default as a static value (as the modeler
-    dialog does), so the model validates and stores the full parameter set."""
-    from qgis.core import QgsApplication, QgsProcessingDestinationParameter
-    from qgis.core import QgsProcessingModelChildParameterSource as Src
-
-    alg = QgsApplication.processingRegistry().algorithmById(child.algorithmId())
-    for param in alg.parameterDefinitions():
-        if param.name() in child.parameterSources() or isinstance(
-            param, QgsProcessingDestinationParameter
-        ):
-            continue
-        child.addParameterSources(param.name(), [Src.fromStaticValue(param.defaultValue())])
-
-
-def main() -> int:
-    sys.path.insert(0, str(HERE))
-    from qgis.core import QgsApplication
-
-    app = QgsApplication([], False)
-    app.initQgis()
-    sys.path.append("/usr/share/qgis/python/plugins")
-    from processing.core.Processing import Processing
-
-    Processing.initialize()
-    import lidarphoto
-
-    plugin = lidarphoto.classFactory(None)
-    plugin.initProcessing()
-    model = build_model()
-    ok, errors = model.validate()
-    if not ok:
-        print("\n".join(errors), file=sys.stderr)
-        return 1
-    MODEL.parent.mkdir(parents=True, exist_ok=True)
-    if not model.toFile(str(MODEL)):
-        return 1
-    print(f"wrote {MODEL}")
-    plugin.unload()
-    return 0
-
-
 if __name__ == "__main__":
-    raise SystemExit(main())
+    sys.path.insert(0, str(HERE))
+    from model_tools import write_model
+
+    raise SystemExit(write_model(build_model, MODEL))

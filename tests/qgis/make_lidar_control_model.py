@@ -20,8 +20,8 @@ MODEL = HERE / "data" / "lidar_control_model.model3"
 
 
 def build_model():
-    from make_ground_roof_model import _static_defaults
     from make_ground_roof_model import build_model as ground_roof_model
+    from model_tools import static_defaults
     from qgis.core import QgsProcessingModelChildAlgorithm, QgsProcessingModelOutput
     from qgis.core import QgsProcessingModelChildParameterSource as Src
     from qgis.PyQt.QtCore import QPointF
@@ -57,37 +57,14 @@ def build_model():
         o.setPosition(QPointF(700.0, 400.0 + 60.0 * len(outs)))
         outs[name] = o
     lcps.setModelOutputs(outs)
-    _static_defaults(lcps)
+    static_defaults(lcps)
     model.addChildAlgorithm(lcps)
     model.updateDestinationParameters()
     return model
 
 
-def main() -> int:
-    sys.path.insert(0, str(HERE))
-    from qgis.core import QgsApplication
-
-    app = QgsApplication([], False)
-    app.initQgis()
-    sys.path.append("/usr/share/qgis/python/plugins")
-    from processing.core.Processing import Processing
-
-    Processing.initialize()
-    import lidarphoto
-
-    plugin = lidarphoto.classFactory(None)
-    plugin.initProcessing()
-    model = build_model()
-    ok, errors = model.validate()
-    if not ok:
-        print("\n".join(errors), file=sys.stderr)
-        return 1
-    if not model.toFile(str(MODEL)):
-        return 1
-    print(f"wrote {MODEL}")
-    plugin.unload()
-    return 0
-
-
 if __name__ == "__main__":
-    raise SystemExit(main())
+    sys.path.insert(0, str(HERE))
+    from model_tools import write_model
+
+    raise SystemExit(write_model(build_model, MODEL))

@@ -65,32 +65,8 @@ def build_model():
     return model
 
 
-def main() -> int:
-    sys.path.insert(0, str(HERE))
-    from qgis.core import QgsApplication
-
-    app = QgsApplication([], False)
-    app.initQgis()
-    sys.path.append("/usr/share/qgis/python/plugins")
-    from processing.core.Processing import Processing
-
-    Processing.initialize()
-    import lidarphoto
-
-    plugin = lidarphoto.classFactory(None)
-    plugin.initProcessing()
-    model = build_model()
-    ok, errors = model.validate()
-    if not ok:
-        print("\n".join(errors), file=sys.stderr)
-        return 1
-    MODEL.parent.mkdir(parents=True, exist_ok=True)
-    if not model.toFile(str(MODEL)):
-        return 1
-    print(f"wrote {MODEL}")
-    plugin.unload()
-    return 0
-
-
 if __name__ == "__main__":
-    raise SystemExit(main())
+    sys.path.insert(0, str(HERE))
+    from model_tools import write_model
+
+    raise SystemExit(write_model(build_model, MODEL))
