@@ -398,12 +398,86 @@ def _run_extract_roof_planes(args: argparse.Namespace) -> int:
     return 0
 
 
+def _add_boresight_calibration(sub: argparse._SubParsersAction) -> None:
+    from .trajectory_to_eo import MOUNT_CHOICES
+
+    p = sub.add_parser(
+        "boresightcalibration",
+        help="boresight (and lever arm, interior) from LiDAR roof planes, lines and LCPs",
+        description=(
+            "Adjusts the camera-INS misalignment per group of images from image observations "
+            "on LiDAR roof planes (tie), lines (line), control points (lcp) and paper 000's "
+            "single-image model (paper). Writes the results table, the updated exterior "
+            "orientations, the residual table and an HTML summary. Enumerations take names or "
+            "indices as in QGIS."
+        ),
+    )
+    p.add_argument("--camera", required=True, help="camera JSON")
+    p.add_argument("--trajectory", required=True, help="trajectory CSV")
+    p.add_argument("--crs", required=True, help="mapping CRS (projected), EPSG:xxxx or WKT")
+    p.add_argument("--lever-arm", default="0,0,0", help="x,y,z in metres, body frame")
+    p.add_argument("--mount", default=MOUNT_CHOICES[0], help=f"{', '.join(MOUNT_CHOICES)}")
+    p.add_argument("--mount-matrix", default="", help="9 numbers, R_c^b row-major (custom)")
+    p.add_argument("--boresight", default="0,0,0", help="initial domega,dphi,dkappa, degrees")
+    p.add_argument("--observations", required=True, help="image observation CSV")
+    p.add_argument("--planes", default=None, help="plane table CSV")
+    p.add_argument("--lines", default=None, help="line table CSV")
+    p.add_argument("--lcps", default=None, help="LCP table CSV")
+    p.add_argument("--cloud", default=None, help="LAS/LAZ with plane_id (paper mode only)")
+    p.add_argument("--grouping", default="group", help="single | group | direction")
+    p.add_argument("--control-types", default="tie,line,lcp,paper", help="comma list")
+    p.add_argument("--estimate-lever-arm", action="store_true", help="estimate the lever arm")
+    p.add_argument("--estimate-interior", action="store_true", help="estimate f, x0, y0")
+    p.add_argument("--ins-grade", default="pos_av_310", help="pos_av_310 | custom")
+    p.add_argument(
+        "--ins-sigmas", default="0.02,0.05,0.015,0.035", help="custom: h m, v m, rp deg, hd deg"
+    )
+    p.add_argument("--snooping", default="true", help="Baarda data snooping: true | false")
+    p.add_argument("--output-table", default=None, help="results CSV (one row per group)")
+    p.add_argument("--residuals-csv", default=None, help="residual table CSV")
+    p.add_argument("--output-eo", default=None, help="updated exterior orientation CSV")
+    p.add_argument("--output-html", default=None, help="HTML summary")
+    p.set_defaults(run=_run_boresight_calibration)
+
+
+def _run_boresight_calibration(args: argparse.Namespace) -> int:
+    from .boresight_run import run_boresight_calibration
+    from .errors import InputError
+
+    snoop = args.snooping.strip().lower()
+    if snoop not in ("true", "false", "yes", "no", "1", "0"):
+        raise InputError(f"--snooping: expected true or false, got {args.snooping!r}")
+    run = run_boresight_calibration(
+        args.camera, args.trajectory, args.crs, args.observations, lever_arm=args.lever_arm,
+        mount=args.mount, mount_matrix=args.mount_matrix, boresight=args.boresight,
+        planes=args.planes, lines=args.lines, lcps=args.lcps, cloud=args.cloud,
+        grouping=args.grouping, estimate_lever_arm=args.estimate_lever_arm,
+        estimate_interior=args.estimate_interior, ins_grade=args.ins_grade,
+        ins_sigmas=args.ins_sigmas, control_types=args.control_types,
+        snooping=snoop in ("true", "yes", "1"), output_table=args.output_table,
+        output_eo=args.output_eo, output_html=args.output_html,
+        residuals_csv=args.residuals_csv,
+    )  # fmt: skip
+    res = run.result
+    print(f"{'group':8} {'angle':8} {'deg':>12} {'arcsec':>10} {'sigma':>8}")
+    for row in res.table_rows():
+        print(
+            f"{row['group']:8} {row['parameter']:8} {row['value_deg']:12.6f} "
+            f"{row['value_arcsec']:10.1f} {row['std_arcsec']:8.1f}"
+        )
+    test = "passed" if res.chi2_passed else "failed"
+    print(f"sigma0 {res.sigma0:.3f}, redundancy {res.redundancy}, global test {test}, "
+          f"{int(res.residuals.rejected.sum())} observations rejected")  # fmt: skip
+    return 0
+
+
 _ALGORITHMS = (
     _add_trajectory_to_eo,
     _add_ground_filter,
     _add_create_lcps,
     _add_accuracy_report,
     _add_extract_roof_planes,
+    _add_boresight_calibration,
 )
 
 

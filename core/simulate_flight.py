@@ -47,11 +47,15 @@ from .simulate_town import Town, make_town
 from .trajectory_to_eo import Mount, Trajectory, georeference_ecef
 
 __all__ = [
+    "ControlFlightConfig",
+    "ControlFlightSimulation",
     "FlightConfig",
     "FlightSimulation",
     "FlightTruth",
     "paper_config",
     "simulate_flight",
+    "simulate_flight_over",
+    "small_format_camera",
     "ultracam_xp",
 ]
 
@@ -659,3 +663,294 @@ def _direction_names(cfg: FlightConfig) -> list[str]:
 def check_point_local(sim: FlightSimulation, local: LocalFrame) -> dict[str, Array]:
     """True check points in an adjustment frame, by LCP id."""
     return {k: local.map_to_enu(v[None])[0] for k, v in sim.truth.check_points.items()}
+
+
+# ----------------------------------------------------------------------------- over real control
+
+
+def small_format_camera() -> Camera:
+    """A 24 Mpx small-format survey camera: f = 35 mm, 4.5 um pixels, 6000 x 4000 px."""
+    return Camera(
+        "small format 35 mm", focal_mm=35.0, pixel_size_mm=0.0045, width_px=6000, height_px=4000
+    )
+
+
+@dataclass(frozen=True)
+class ControlFlightConfig:
+    """A calibration flight over existing LiDAR control (real planes, lines and LCPs).
+
+    Attributes are those of :class:`FlightConfig` where they share a name; ``centre`` is the
+    block centre (mapping CRS) and ``flying_height_m`` is above the lowest LiDAR point.
+    ``n_check`` roof points (on the planes) are made check points: measured in every image
+    that sees them, never adjusted.
+    """
+
+    crs: str = "EPSG:28992"
+    centre: tuple[float, float] = (84940.0, 447595.0)
+    camera: Camera = field(default_factory=small_format_camera)
+    flying_height_m: float = 130.0
+    forward_overlap: float = 0.8
+    side_overlap: float = 0.6
+    images_per_line: int = 5
+    n_lines: int = 2
+    heading_deg: float = 0.0
+    opposite: bool = True
+    mount: str = "image_top_forward"
+    true_boresight_deg: tuple[tuple[float, float, float], ...] = ((0.12, -0.25, 0.40),)
+    initial_boresight_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    lever_arm_m: tuple[float, float, float] = (0.10, -0.05, -0.20)
+    ins_grade: Union[str, InsGrade] = "pos_av_310"
+    attitude_jitter_deg: float = 1.0
+    types: tuple[str, ...] = ("tie", "line", "lcp", "check")
+    ties_per_plane: int = 2
+    line_points_per_image: int = 2
+    n_check: int = 15
+    sigma_px: float = 0.5
+    margin_px: float = 50.0
+
+
+@dataclass(frozen=True)
+class ControlFlightSimulation:
+    """Trajectory, mount and image observations over given control, with the truth.
+
+    ``check_points`` maps each check point id (``K<k>``, the ``target_id`` of its ``check``
+    rows) to its true position (mapping CRS).
+    """
+
+    config: ControlFlightConfig
+    trajectory: Trajectory
+    camera: Camera
+    mount: Mount
+    observations: ImageObservations
+    truth: FlightTruth
+    check_points: dict[str, Array]
+
+    def write(self, folder: Union[str, Path]) -> dict[str, Path]:
+        """Write trajectory.csv, camera.json, observations.csv, check_points.csv (id, e, n, h:
+        the truth) and truth.json; returns their paths by name."""
+        out = Path(folder)
+        out.mkdir(parents=True, exist_ok=True)
+        paths = {k: out / f"{k}.csv" for k in ("trajectory", "observations", "check_points")}
+        paths.update(camera=out / "camera.json", truth=out / "truth.json")
+        _write_trajectory(paths["trajectory"], self.trajectory)
+        write_camera_json(self.camera, paths["camera"])
+        write_observations_csv(paths["observations"], self.observations)
+        write_csv_atomic(
+            paths["check_points"],
+            ("id", "e", "n", "h"),
+            [(k, *(repr(float(v)) for v in p)) for k, p in self.check_points.items()],
+        )
+        truth = {
+            "crs": self.config.crs,
+            "boresight_deg": {g: np.degrees(b).tolist() for g, b in self.truth.boresight.items()},
+            "initial_boresight_deg": np.degrees(self.mount.boresight).tolist(),
+            "lever_arm_m": self.truth.lever_arm.tolist(),
+            "mount": self.config.mount,
+        }
+        tmp = paths["truth"].with_suffix(".json.tmp")
+        tmp.write_text(json.dumps(truth, indent=2), encoding="utf-8")
+        tmp.replace(paths["truth"])
+        return paths
+
+
+def _write_trajectory(path: Path, t: Trajectory) -> None:
+    deg = np.degrees(t.rph)
+    write_csv_atomic(
+        path,
+        ("image_id", "time", "group", "easting", "northing", "height", "roll", "pitch", "heading"),
+        [
+            (i, repr(float(tt)), g, *(repr(float(v)) for v in p), *(repr(float(v)) for v in a))
+            for i, tt, g, p, a in zip(t.image_id, t.time, t.group, t.position, deg)
+        ],
+    )
+
+
+def simulate_flight_over(
+    planes: list[Plane],
+    lines: list[ControlLine],
+    lcps: list[ControlPoint],
+    lidar_points: Array,
+    lidar_plane_ids: NDArray[np.integer],
+    config: ControlFlightConfig | None = None,
+    seed: int = 0,
+) -> ControlFlightSimulation:
+    """Simulate a calibration flight over real LiDAR control (e.g. from a real tile).
+
+    The given planes, lines and LCPs are taken as the true roof geometry (the LiDAR fit is the
+    truth here, so the simulation isolates the image and INS side). Tie and check points are
+    LiDAR points of a plane moved onto it (so they lie where the roof really is), line points
+    are spread along each line's clipped segment, LCPs are measured where they are. Visibility
+    is the image frame only (no occlusion).
+
+    Parameters
+    ----------
+    planes, lines, lcps : sequences of Plane, ControlLine, ControlPoint
+        Mapping CRS.
+    lidar_points : ndarray, shape (M, 3)
+        Points of the planes (mapping CRS) with their ``lidar_plane_ids`` (M,) (-1: none).
+    config : ControlFlightConfig, optional
+    seed : int
+        Seed of every random choice and noise.
+
+    Returns
+    -------
+    ControlFlightSimulation
+    """
+    cfg = config if config is not None else ControlFlightConfig()
+    rng = np.random.default_rng(seed)
+    frame = MappingFrame.from_user_input(cfg.crs)
+    cam = cfg.camera
+    grade = _grade(cfg.ins_grade)
+    if cfg.mount not in MOUNT_PRESETS:
+        raise InputError(f"mount '{cfg.mount}' is not a preset")
+    nominal = MOUNT_PRESETS[cfg.mount]
+    pts = np.asarray(lidar_points, dtype=np.float64).reshape(-1, 3)
+    pid = np.asarray(lidar_plane_ids).astype(np.int64)
+    if not planes or pts.shape[0] != pid.shape[0]:
+        raise InputError("simulate_flight_over needs planes and their LiDAR points")
+
+    # ---- flight lines (as simulate_flight), true attitude and poses via ECEF
+    along_axis = 1 if cfg.mount in ("image_top_forward", "image_bottom_forward") else 0
+    size_px = (cam.width_px, cam.height_px)
+    scale = cfg.flying_height_m / cam.focal_mm
+    base = (1 - cfg.forward_overlap) * size_px[along_axis] * cam.pixel_size_mm * scale
+    spacing = (1 - cfg.side_overlap) * size_px[1 - along_axis] * cam.pixel_size_mm * scale
+    h0 = float(pts[:, 2].min()) + cfg.flying_height_m
+    az = math.radians(cfg.heading_deg)
+    fwd = np.array([math.sin(az), math.cos(az)])
+    right = np.array([math.cos(az), -math.sin(az)])
+    names = _direction_names(cfg)  # type: ignore[arg-type]
+    pos, head, groups, ids = [], [], [], []
+    m = cfg.images_per_line
+    for line in range(cfg.n_lines):
+        back = cfg.opposite and line % 2 == 1
+        off = (line - (cfg.n_lines - 1) / 2) * spacing
+        for k in range(m - 1, -1, -1) if back else range(m):
+            pos.append(np.array(cfg.centre) + (k - (m - 1) / 2) * base * fwd + off * right)
+            head.append(az + (math.pi if back else 0.0))
+            groups.append(names[line])
+            ids.append(f"L{line + 1}_{len(ids) + 1:03d}")
+    n = len(ids)
+    enh = np.column_stack([np.array(pos), np.full(n, h0)])
+    llh = frame.map_to_geodetic(enh)
+    theta = frame.grid_north_azimuth(llh)
+    jit = math.radians(cfg.attitude_jitter_deg)
+    rph_true = np.column_stack(
+        [
+            rng.normal(0, jit, n),
+            rng.normal(0, jit, n),
+            np.angle(np.exp(1j * (np.array(head) - theta + rng.normal(0, jit, n)))),
+        ]
+    )
+    time = np.arange(n, dtype=np.float64) * 2.0
+    traj_true = Trajectory(tuple(ids), time, tuple(groups), enh, False, rph_true)
+    rows = np.radians(np.array(cfg.true_boresight_deg, dtype=np.float64).reshape(-1, 3))
+    if rows.shape[0] not in (1, cfg.n_lines):
+        raise InputError("true_boresight_deg needs one row or one per line")
+    bore_of = {names[k]: rows[min(k, rows.shape[0] - 1)] for k in range(cfg.n_lines)}
+    lever = np.array(cfg.lever_arm_m, dtype=np.float64)
+    local = local_frame_for(traj_true, frame)
+    eo_true = np.empty((n, 6))
+    for g, b in bore_of.items():
+        sel = np.array([x == g for x in groups])
+        sub = Trajectory(
+            tuple(np.array(ids)[sel]),
+            time[sel],
+            tuple(np.array(groups)[sel]),
+            enh[sel],
+            False,
+            rph_true[sel],
+        )
+        poses = georeference_ecef(sub, Mount(lever, nominal, b), frame)
+        r_cl = local.rotation @ poses.camera_to_ecef
+        eo_true[sel, :3] = local.ecef_to_enu(poses.centre_ecef)
+        eo_true[sel, 3:] = np.column_stack(matrix_to_opk(np.swapaxes(r_cl, 1, 2)))
+
+    # ---- true ground points: (map xyz, type, target id, point id)
+    plane_of = {int(p.id): p for p in planes}
+
+    def on_plane(k_points: int, exclude: set[int]) -> tuple[Array, list[str]]:
+        out, tgt = [], []
+        for p in planes:
+            idx = np.flatnonzero(pid == int(p.id))
+            idx = np.setdiff1d(idx, list(exclude))
+            if idx.size == 0:
+                continue
+            take = rng.choice(idx, min(k_points, idx.size), replace=False)
+            exclude.update(take.tolist())
+            q = pts[take]
+            out.append(q - np.outer(q @ p.normal + p.d, p.normal))  # onto the plane
+            tgt += [str(p.id)] * len(take)
+        return (np.vstack(out) if out else np.empty((0, 3))), tgt
+
+    used: set[int] = set()
+    targets: list[tuple[Array, str, list[str], list[str]]] = []
+    check_points: dict[str, Array] = {}
+    if "check" in cfg.types and cfg.n_check > 0:
+        cand = np.flatnonzero(np.isin(pid, list(plane_of)))
+        take = rng.choice(cand, min(cfg.n_check, cand.size), replace=False)
+        used.update(take.tolist())
+        q = pts[take]
+        nrm = np.array([plane_of[int(i)].normal for i in pid[take]])
+        dd = np.array([plane_of[int(i)].d for i in pid[take]])
+        q = q - nrm * (np.einsum("ij,ij->i", q, nrm) + dd)[:, None]
+        check_points = {f"K{k}": q[k] for k in range(len(q))}
+        targets.append((q, "check", list(check_points), list(check_points)))
+    if "tie" in cfg.types:
+        q, tgt = on_plane(cfg.ties_per_plane, used)
+        targets.append((q, "tie", tgt, [f"T{k}" for k in range(len(q))]))
+    if "lcp" in cfg.types and lcps:
+        q = np.array([c.xyz for c in lcps], dtype=np.float64)
+        targets.append((q, "lcp", [str(c.id) for c in lcps], [f"C{c.id}" for c in lcps]))
+    rec: dict[str, list] = {k: [] for k in ("image", "point", "px", "type", "target")}
+    local_targets = [(local.map_to_enu(q), kind, t, p) for q, kind, t, p in targets if len(q)]
+    for i in range(n):
+        for q, kind, tgt, pnames in local_targets:
+            px = project(q, eo_true[i], cam)
+            for j in np.flatnonzero(cam.in_frame(px, cfg.margin_px)):
+                rec["image"].append(ids[i])
+                rec["point"].append(pnames[j])
+                rec["px"].append(px[j])
+                rec["type"].append(kind)
+                rec["target"].append(tgt[j])
+        if "line" in cfg.types and lines:
+            t = rng.uniform(0.1, 0.9, (len(lines), cfg.line_points_per_image))
+            a = np.array([ln.start for ln in lines])
+            b = np.array([ln.end for ln in lines])
+            q = a[:, None] + t[:, :, None] * (b - a)[:, None]
+            px = project(local.map_to_enu(q.reshape(-1, 3)), eo_true[i], cam)
+            for j in np.flatnonzero(cam.in_frame(px, cfg.margin_px)):
+                li = j // cfg.line_points_per_image
+                rec["image"].append(ids[i])
+                rec["point"].append(f"R{lines[li].id}_{i}_{j % cfg.line_points_per_image}")
+                rec["px"].append(px[j])
+                rec["type"].append("line")
+                rec["target"].append(str(lines[li].id))
+    pixels = np.array(rec["px"]).reshape(-1, 2)
+    kinds = np.array(rec["type"])
+    # tie points seen in fewer than two images carry no information: drop them
+    names_arr = np.array(rec["point"])
+    uniq, cnt = np.unique(names_arr[kinds == "tie"], return_counts=True)
+    keep = ~((kinds == "tie") & np.isin(names_arr, uniq[cnt < 2]))
+    pixels = pixels[keep] + rng.normal(0, cfg.sigma_px, (int(keep.sum()), 2))
+    obs = ImageObservations.from_arrays(
+        [v for v, k in zip(rec["image"], keep) if k],
+        [v for v, k in zip(rec["point"], keep) if k],
+        pixels,
+        np.full(len(pixels), cfg.sigma_px),
+        list(kinds[keep]),
+        [v for v, k in zip(rec["target"], keep) if k],
+    )
+
+    # ---- INS measurements: the truth plus the grade's noise
+    r_nl = local.ned_to_local(llh)
+    enu_i = r_nl @ np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]]).T
+    noise = np.einsum("nij,nj->ni", enu_i, rng.normal(0, 1, (n, 3)) * grade.sigma_position)
+    enh_meas = local.enu_to_map(local.map_to_enu(enh) + noise)
+    rph_meas = rph_true + rng.normal(0, 1, (n, 3)) * grade.sigma_attitude
+    traj = Trajectory(tuple(ids), time, tuple(groups), enh_meas, False, rph_meas)
+    mount = Mount(lever, nominal, np.radians(cfg.initial_boresight_deg))
+    truth = FlightTruth(
+        tuple(groups), bore_of, lever, traj_true, check_points, np.empty(0, dtype=np.int64)
+    )
+    return ControlFlightSimulation(cfg, traj, cam, mount, obs, truth, check_points)

@@ -9,6 +9,7 @@ from qgis.PyQt.QtCore import QCoreApplication
 from qgis.PyQt.QtGui import QIcon
 
 from .algorithms.accuracy_report import AccuracyReportAlgorithm
+from .algorithms.boresight_calibration import BoresightCalibrationAlgorithm
 from .algorithms.create_lcps import CreateLcpsAlgorithm
 from .algorithms.extract_roof_planes import ExtractRoofPlanesAlgorithm
 from .algorithms.ground_filter import GroundFilterAlgorithm
@@ -45,5 +46,6 @@ class LidarPhotoProvider(QgsProcessingProvider):
             CreateLcpsAlgorithm(),
             AccuracyReportAlgorithm(),
             ExtractRoofPlanesAlgorithm(),
+            BoresightCalibrationAlgorithm(),
         ):
             self.addAlgorithm(alg)
