@@ -346,6 +346,50 @@ def _roof_corners(town: Town, faces: set[int]):
 # ----------------------------------------------------------------------------- main
 
 
+def _true_flight(cfg, cam, h0: float, frame, rng, seconds_per_image: float):
+    """Flight lines over ``cfg.centre`` at height ``h0`` (grid azimuth ``cfg.heading_deg``,
+    overlaps from the camera footprint), true attitudes with jitter, and the true boresight of
+    each group. Returns (true trajectory, {group: boresight (3,) rad}, geodetic (N, 3))."""
+    along_axis = 1 if cfg.mount in ("image_top_forward", "image_bottom_forward") else 0
+    size_px = (cam.width_px, cam.height_px)
+    scale = cfg.flying_height_m / cam.focal_mm
+    base = (1 - cfg.forward_overlap) * size_px[along_axis] * cam.pixel_size_mm * scale
+    spacing = (1 - cfg.side_overlap) * size_px[1 - along_axis] * cam.pixel_size_mm * scale
+    az = math.radians(cfg.heading_deg)
+    fwd = np.array([math.sin(az), math.cos(az)])
+    right = np.array([math.cos(az), -math.sin(az)])
+    names = _direction_names(cfg)
+    pos, head, groups, ids = [], [], [], []
+    m = cfg.images_per_line
+    for line in range(cfg.n_lines):
+        back = cfg.opposite and line % 2 == 1
+        off = (line - (cfg.n_lines - 1) / 2) * spacing
+        for k in range(m - 1, -1, -1) if back else range(m):
+            pos.append(np.array(cfg.centre) + (k - (m - 1) / 2) * base * fwd + off * right)
+            head.append(az + (math.pi if back else 0.0))
+            groups.append(names[line])
+            ids.append(f"L{line + 1}_{len(ids) + 1:03d}")
+    n = len(ids)
+    enh = np.column_stack([np.array(pos), np.full(n, h0)])
+    llh = frame.map_to_geodetic(enh)
+    theta = frame.grid_north_azimuth(llh)
+    jit = math.radians(cfg.attitude_jitter_deg)
+    rph_true = np.column_stack(
+        [
+            rng.normal(0, jit, n),
+            rng.normal(0, jit, n),
+            np.angle(np.exp(1j * (np.array(head) - theta + rng.normal(0, jit, n)))),
+        ]
+    )
+    time = np.arange(n, dtype=np.float64) * seconds_per_image
+    traj_true = Trajectory(tuple(ids), time, tuple(groups), enh, False, rph_true)
+    rows = np.radians(np.array(cfg.true_boresight_deg, dtype=np.float64).reshape(-1, 3))
+    if rows.shape[0] not in (1, cfg.n_lines):
+        raise InputError("true_boresight_deg needs one row or one per line")
+    bore_of = {names[k]: rows[min(k, rows.shape[0] - 1)] for k in range(cfg.n_lines)}
+    return traj_true, bore_of, llh
+
+
 def simulate_flight(config: FlightConfig, seed: int = 0, exact: bool = False) -> FlightSimulation:
     """Simulate a calibration flight (module docstring).
 
@@ -387,51 +431,11 @@ def simulate_flight(config: FlightConfig, seed: int = 0, exact: bool = False) ->
     kept = [f.face_id for f in town.faces][: cfg.n_planes]
     kept_set = set(kept)
 
-    # ---- flight lines (grid azimuths), true attitude
-    along_axis = 1 if cfg.mount in ("image_top_forward", "image_bottom_forward") else 0
-    size_px = (cam.width_px, cam.height_px)
-    scale = cfg.flying_height_m / cam.focal_mm
-    along = size_px[along_axis] * cam.pixel_size_mm * scale
-    across = size_px[1 - along_axis] * cam.pixel_size_mm * scale
-    base = (1 - cfg.forward_overlap) * along
-    spacing = (1 - cfg.side_overlap) * across
+    # ---- flight lines (grid azimuths), true attitude and boresight
     h0 = float(town.terrain_z(np.array([cfg.centre]))[0]) + cfg.flying_height_m
-    az = math.radians(cfg.heading_deg)
-    fwd = np.array([math.sin(az), math.cos(az)])
-    right = np.array([math.cos(az), -math.sin(az)])
-    pos, head, groups, ids = [], [], [], []
-    names = _direction_names(cfg)
-    m = cfg.images_per_line
-    for line in range(cfg.n_lines):
-        back = cfg.opposite and line % 2 == 1
-        off = (line - (cfg.n_lines - 1) / 2) * spacing
-        order = range(m - 1, -1, -1) if back else range(m)
-        for k in order:
-            s = (k - (m - 1) / 2) * base
-            pos.append(np.array(cfg.centre) + s * fwd + off * right)
-            head.append(az + (math.pi if back else 0.0))
-            groups.append(names[line])
-            ids.append(f"L{line + 1}_{len(ids) + 1:03d}")
-    n = len(ids)
-    enh = np.column_stack([np.array(pos), np.full(n, h0)])
-    llh = frame.map_to_geodetic(enh)
-    theta = frame.grid_north_azimuth(llh)
-    jit = math.radians(cfg.attitude_jitter_deg)
-    rph_true = np.column_stack(
-        [
-            rng.normal(0, jit, n),
-            rng.normal(0, jit, n),
-            np.angle(np.exp(1j * (np.array(head) - theta + rng.normal(0, jit, n)))),
-        ]
-    )
-    time = np.arange(n, dtype=np.float64) * 10.0
-    traj_true = Trajectory(tuple(ids), time, tuple(groups), enh, False, rph_true)
-
-    # ---- true boresight per group, true poses in the adjustment frame (via ECEF)
-    rows = np.radians(np.array(cfg.true_boresight_deg, dtype=np.float64).reshape(-1, 3))
-    if rows.shape[0] not in (1, cfg.n_lines):
-        raise InputError("true_boresight_deg needs one row or one per line")
-    bore_of = {names[k]: rows[min(k, rows.shape[0] - 1)] for k in range(cfg.n_lines)}
+    traj_true, bore_of, llh = _true_flight(cfg, cam, h0, frame, rng, seconds_per_image=10.0)
+    ids, groups, enh = traj_true.image_id, traj_true.group, traj_true.position
+    time, rph_true, n = traj_true.time, traj_true.rph, len(traj_true)
     lever = np.array(cfg.lever_arm_m, dtype=np.float64)
     local = local_frame_for(traj_true, frame)
     centre_l = np.empty((n, 3))
@@ -810,44 +814,10 @@ def simulate_flight_over(
         raise InputError("simulate_flight_over needs planes and their LiDAR points")
 
     # ---- flight lines (as simulate_flight), true attitude and poses via ECEF
-    along_axis = 1 if cfg.mount in ("image_top_forward", "image_bottom_forward") else 0
-    size_px = (cam.width_px, cam.height_px)
-    scale = cfg.flying_height_m / cam.focal_mm
-    base = (1 - cfg.forward_overlap) * size_px[along_axis] * cam.pixel_size_mm * scale
-    spacing = (1 - cfg.side_overlap) * size_px[1 - along_axis] * cam.pixel_size_mm * scale
     h0 = float(pts[:, 2].min()) + cfg.flying_height_m
-    az = math.radians(cfg.heading_deg)
-    fwd = np.array([math.sin(az), math.cos(az)])
-    right = np.array([math.cos(az), -math.sin(az)])
-    names = _direction_names(cfg)  # type: ignore[arg-type]
-    pos, head, groups, ids = [], [], [], []
-    m = cfg.images_per_line
-    for line in range(cfg.n_lines):
-        back = cfg.opposite and line % 2 == 1
-        off = (line - (cfg.n_lines - 1) / 2) * spacing
-        for k in range(m - 1, -1, -1) if back else range(m):
-            pos.append(np.array(cfg.centre) + (k - (m - 1) / 2) * base * fwd + off * right)
-            head.append(az + (math.pi if back else 0.0))
-            groups.append(names[line])
-            ids.append(f"L{line + 1}_{len(ids) + 1:03d}")
-    n = len(ids)
-    enh = np.column_stack([np.array(pos), np.full(n, h0)])
-    llh = frame.map_to_geodetic(enh)
-    theta = frame.grid_north_azimuth(llh)
-    jit = math.radians(cfg.attitude_jitter_deg)
-    rph_true = np.column_stack(
-        [
-            rng.normal(0, jit, n),
-            rng.normal(0, jit, n),
-            np.angle(np.exp(1j * (np.array(head) - theta + rng.normal(0, jit, n)))),
-        ]
-    )
-    time = np.arange(n, dtype=np.float64) * 2.0
-    traj_true = Trajectory(tuple(ids), time, tuple(groups), enh, False, rph_true)
-    rows = np.radians(np.array(cfg.true_boresight_deg, dtype=np.float64).reshape(-1, 3))
-    if rows.shape[0] not in (1, cfg.n_lines):
-        raise InputError("true_boresight_deg needs one row or one per line")
-    bore_of = {names[k]: rows[min(k, rows.shape[0] - 1)] for k in range(cfg.n_lines)}
+    traj_true, bore_of, llh = _true_flight(cfg, cam, h0, frame, rng, seconds_per_image=2.0)
+    ids, groups, enh = traj_true.image_id, traj_true.group, traj_true.position
+    time, rph_true, n = traj_true.time, traj_true.rph, len(traj_true)
     lever = np.array(cfg.lever_arm_m, dtype=np.float64)
     local = local_frame_for(traj_true, frame)
     eo_true = np.empty((n, 6))
