@@ -57,10 +57,6 @@ class ExteriorOrientationTable:
         """(N, 3, 3) world-to-camera matrices M."""
         return opk_to_matrix(self.opk[:, 0], self.opk[:, 1], self.opk[:, 2])
 
-    def eo_vectors(self) -> NDArray[np.float64]:
-        """(N, 6) rows (X0, Y0, Z0, omega, phi, kappa), metres and radians."""
-        return np.hstack([self.xyz, self.opk])
-
     def to_csv(self, path: Union[str, Path]) -> None:
         """Write the documented CSV atomically (never a half-written file)."""
         deg = np.degrees(self.opk)

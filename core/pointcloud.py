@@ -95,11 +95,6 @@ class CloudInfo:
     dimensions: tuple[str, ...]
     has_return_numbers: bool
 
-    @property
-    def is_compressed(self) -> bool:
-        """True for LAZ (by the file name's suffix)."""
-        return Path(self.path).suffix.lower() == ".laz"
-
 
 def parse_crs(crs: CrsLike) -> pyproj.CRS | None:
     """A user's CRS (``"EPSG:7415"``, ``7415``, WKT, PROJ string or pyproj.CRS) as pyproj.CRS.

@@ -36,7 +36,7 @@ from .boresight import INS_GRADES, InsGrade, local_frame_for
 from .camera import Camera, write_camera_json
 from .collinearity import project
 from .errors import InputError
-from .frames import LocalFrame, MappingFrame
+from .frames import MappingFrame
 from .io.control import write_lcps_csv, write_lines_csv
 from .io.observations import ImageObservations, write_observations_csv
 from .io.tables import write_csv_atomic
@@ -662,11 +662,6 @@ def _direction_names(cfg: FlightConfig) -> list[str]:
     if len(set(out)) < len(out):
         out = [f"{d}{k + 1}" for k, d in enumerate(out)]
     return out
-
-
-def check_point_local(sim: FlightSimulation, local: LocalFrame) -> dict[str, Array]:
-    """True check points in an adjustment frame, by LCP id."""
-    return {k: local.map_to_enu(v[None])[0] for k, v in sim.truth.check_points.items()}
 
 
 # ----------------------------------------------------------------------------- over real control

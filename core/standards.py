@@ -106,7 +106,6 @@ PEC_RECOMMENDED_MIN_POINTS = 20  # common practice, not in the Decreto (uncertai
 PAPER_H_THRESHOLD_M = 0.40
 PAPER_FLIGHT_GEOMETRY = (1600.0, 452.0, 100.4, 6.0)  # H (m), B (m), f (mm), sigma_pix (um)
 
-STATUSES = ("pass", "fail", "insufficient", "info")
 # Limits are compared with 1e-9 m of slack so that a value equal to the limit (as printed)
 # is not refused by the last bit of floating point: "not exceeding" includes equality.
 _TOL = 1e-9

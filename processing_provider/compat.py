@@ -63,7 +63,3 @@ SINK_FAST_INSERT = QgsFeatureSink.Flag.FastInsert  # same name on 3.22 and 4.x
 FIELD_STRING = QVariant.String
 FIELD_DOUBLE = QVariant.Double
 FIELD_INT = QVariant.Int
-
-MSG_INFO = Qgis.MessageLevel.Info
-MSG_WARNING = Qgis.MessageLevel.Warning
-MSG_CRITICAL = Qgis.MessageLevel.Critical
