@@ -29,6 +29,7 @@ class LidarPhotoPlugin:
         self.actions: list[QAction] = []
         self.missing_modules: list[str] | None = None
         self._dialogs: list = []
+        self.image_dock = None
 
     def tr(self, text: str) -> str:
         return QCoreApplication.translate("LidarPhotoPlugin", text)
@@ -78,10 +79,31 @@ class LidarPhotoPlugin:
         toolbox.setObjectName("lidarphotoShowToolbox")
         toolbox.triggered.connect(self.show_toolbox)
 
-        for action in (trajectory, toolbox):
+        picking = QAction(icon, self.tr("Image Point Picking"), window)
+        picking.setObjectName("lidarphotoImagePicking")
+        picking.setToolTip(self.tr("Measure image points on LiDAR roof planes, lines and LCPs"))
+        picking.setCheckable(True)
+        picking.triggered.connect(self.toggle_image_dock)
+
+        for action in (trajectory, toolbox, picking):
             self.menu.addAction(action)
             self.toolbar.addAction(action)
             self.actions.append(action)
+
+    def toggle_image_dock(self, show: bool = True):
+        """Show (creating it once) or hide the image point picking dock."""
+        if self.image_dock is None:
+            from qgis.PyQt.QtCore import Qt
+
+            from .image_dock import ImagePickingDock
+
+            self.image_dock = ImagePickingDock(self.iface, self.iface.mainWindow())
+            self.iface.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, self.image_dock)
+        if show:
+            self.image_dock.setUserVisible(True)
+        else:
+            self.image_dock.hide()
+        return self.image_dock
 
     def open_trajectory_dialog(self):
         """Open the Processing dialog of the trajectory algorithm (non-modal)."""
@@ -122,6 +144,13 @@ class LidarPhotoPlugin:
 
     # -- unload -------------------------------------------------------------------------------
     def unload(self) -> None:
+        if self.image_dock is not None:
+            self.image_dock.store.save()
+            self.image_dock.remove_footprint()
+            if self.iface is not None:
+                self.iface.removeDockWidget(self.image_dock)
+            self.image_dock.deleteLater()
+            self.image_dock = None
         for dialog in self._dialogs:
             dialog.close()
             dialog.deleteLater()
