@@ -471,6 +471,59 @@ def _run_boresight_calibration(args: argparse.Namespace) -> int:
     return 0
 
 
+def _add_monoplot(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "monoplot",
+        help="3D points and lines from one oriented image and a LiDAR DSM",
+        description=(
+            "Intersects the rays of image observations with a DSM (raster, or LAS/LAZ "
+            "rasterised at --cell-size): direct (Dal Poz, DDA traversal) or Makarovic's "
+            "iteration; tie/paper rows on roof planes with --planes. Writes the point table "
+            "(X Y Z, sigmas, covariance, status) and the line table (WKT)."
+        ),
+    )
+    for name, text in (
+        ("observations", "image-observation CSV"),
+        ("camera", "camera JSON"),
+        ("eo", "exterior orientation CSV"),
+        ("dsm", "DSM raster or LAS/LAZ"),
+    ):
+        p.add_argument(f"--{name}", required=True, help=text)
+    p.add_argument("--crs", required=True, help="mapping CRS of the EO, e.g. EPSG:28992")
+    p.add_argument("--dsm-crs", default=None, help="CRS of the DSM when its file has none")
+    p.add_argument("--method", default="dal_poz", help="dal_poz | makarovic (or 0 | 1)")
+    p.add_argument("--cell-size", type=float, default=0.5, help="DSM cell for LAS/LAZ")
+    p.add_argument("--sigma-dsm", type=float, default=0.10, help="DSM height sigma, m")
+    p.add_argument("--line-step", type=float, default=0.0, help="px between line points")
+    p.add_argument("--min-incidence", type=float, default=5.0, help="degrees (grazing)")
+    p.add_argument("--eo-sigmas", default="0.05,0.05,0.08,0.005,0.005,0.008",
+                   help="X,Y,Z m and omega,phi,kappa deg")  # fmt: skip
+    p.add_argument("--planes", default=None, help="roof plane table CSV")
+    p.add_argument("--output-csv", default=None, help="point table CSV to write")
+    p.add_argument("--lines-csv", default=None, help="line table CSV to write")
+    p.add_argument("--output-dsm", default=None, help="DSM GeoTIFF to write (LAS/LAZ input)")
+    p.set_defaults(run=_run_monoplot)
+
+
+def _run_monoplot(args: argparse.Namespace) -> int:
+    from .errors import InputError
+    from .monoplot import METHODS, run_monoplot
+
+    method = args.method.strip().lower()
+    method = METHODS[int(method)] if method.isdigit() and int(method) < len(METHODS) else method
+    if method not in METHODS:
+        raise InputError(f"--method: expected one of {', '.join(METHODS)}, got {args.method!r}")
+    res = run_monoplot(
+        args.observations, args.camera, args.eo, args.dsm, args.crs, dsm_crs=args.dsm_crs,
+        cell_size=args.cell_size, method=method, sigma_dsm=args.sigma_dsm,
+        eo_sigmas=args.eo_sigmas, planes=args.planes, line_step_px=args.line_step,
+        min_incidence_deg=args.min_incidence, output_csv=args.output_csv,
+        lines_csv=args.lines_csv, output_dsm=args.output_dsm,
+    )  # fmt: skip
+    print(f"{len(res.rows)} rays, {len(res.lines)} lines: {res.status_counts()}")
+    return 0
+
+
 _ALGORITHMS = (
     _add_trajectory_to_eo,
     _add_ground_filter,
@@ -478,6 +531,7 @@ _ALGORITHMS = (
     _add_accuracy_report,
     _add_extract_roof_planes,
     _add_boresight_calibration,
+    _add_monoplot,
 )
 
 

@@ -13,6 +13,7 @@ from .algorithms.boresight_calibration import BoresightCalibrationAlgorithm
 from .algorithms.create_lcps import CreateLcpsAlgorithm
 from .algorithms.extract_roof_planes import ExtractRoofPlanesAlgorithm
 from .algorithms.ground_filter import GroundFilterAlgorithm
+from .algorithms.monoplot import MonoplotAlgorithm
 from .algorithms.trajectory_to_eo import TrajectoryToEoAlgorithm
 
 ICON_PATH = Path(__file__).resolve().parents[1] / "icon.svg"
@@ -47,5 +48,6 @@ class LidarPhotoProvider(QgsProcessingProvider):
             AccuracyReportAlgorithm(),
             ExtractRoofPlanesAlgorithm(),
             BoresightCalibrationAlgorithm(),
+            MonoplotAlgorithm(),
         ):
             self.addAlgorithm(alg)
