@@ -4,11 +4,17 @@ from __future__ import annotations
 
 import configparser
 import logging
+import math
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, Callable
 
 from qgis.core import (
+    NULL,
+    QgsFeature,
+    QgsField,
+    QgsFields,
+    QgsGeometry,
     QgsProcessingAlgorithm,
     QgsProcessingException,
     QgsProcessingFeedback,
@@ -19,7 +25,7 @@ from qgis.core import (
 from qgis.PyQt.QtCore import QCoreApplication
 
 from ..core.errors import Cancelled, LidarPhotoError
-from .compat import FILE_BEHAVIOR_FILE, WKT_PREFERRED
+from .compat import FIELD_INT, FIELD_STRING, FILE_BEHAVIOR_FILE, SINK_FAST_INSERT, WKT_PREFERRED
 
 _PLUGIN_DIR = Path(__file__).resolve().parents[1]
 #: Logger of the whole package ("lidarphoto"); the core logs below it ("lidarphoto.core.*").
@@ -167,6 +173,28 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
         """``"crs"`` or ``"metre"`` from the ``DISTANCE_UNIT`` parameter."""
         return self.DISTANCE_UNITS[self.parameterAsEnum(parameters, "DISTANCE_UNIT", context)]
 
+    # -- feature sinks described by (name, QVariant type) field specs -------------------------
+    def field_sink(self, parameters, context, key, spec, wkb, crs):
+        """Open the sink ``key`` with the fields of ``spec``; returns ((sink, fields), dest id)."""
+        fields = QgsFields()
+        for name, kind in spec:
+            fields.append(QgsField(name, kind))
+        sink, dest = self.parameterAsSink(parameters, key, context, fields, wkb, crs)
+        if sink is None:
+            raise QgsProcessingException(self.invalidSinkError(parameters, key))
+        return (sink, fields), dest
+
+    @staticmethod
+    def add_feature(sink_fields, spec, geometry, values) -> None:
+        """Add one feature; ``geometry`` None keeps the row without a geometry (e.g. a failed
+        point with its status); non-finite numbers become NULL."""
+        sink, fields = sink_fields
+        feature = QgsFeature(fields)
+        if geometry is not None:
+            feature.setGeometry(QgsGeometry(geometry))
+        feature.setAttributes([_field_value(v, kind) for v, (_, kind) in zip(values, spec)])
+        sink.addFeature(feature, SINK_FAST_INSERT)
+
     def canExecute(self):
         from ..plugin.dependencies import missing_message, missing_modules
 
@@ -189,3 +217,11 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
                 should_stop=stop_callback(feedback),
                 **kwargs,
             )
+
+
+def _field_value(v, kind):
+    if kind == FIELD_STRING:
+        return str(v)
+    if kind == FIELD_INT:
+        return int(v)
+    return float(v) if math.isfinite(float(v)) else NULL

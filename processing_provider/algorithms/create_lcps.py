@@ -2,18 +2,10 @@
 
 from __future__ import annotations
 
-import math
-
 from qgis.core import (
-    NULL,
     QgsCoordinateReferenceSystem,
-    QgsFeature,
-    QgsField,
-    QgsFields,
-    QgsGeometry,
     QgsLineString,
     QgsPoint,
-    QgsProcessingException,
     QgsProcessingOutputNumber,
     QgsProcessingParameterFeatureSink,
     QgsProcessingParameterFile,
@@ -30,7 +22,6 @@ from ..compat import (
     FILE_BEHAVIOR_FILE,
     FLAG_ADVANCED,
     NUMBER_DOUBLE,
-    SINK_FAST_INSERT,
     SOURCE_VECTOR_LINE,
     SOURCE_VECTOR_POINT,
     WKB_LINESTRING_Z,
@@ -188,21 +179,23 @@ class CreateLcpsAlgorithm(BaseAlgorithm):
             f"(units: {info.horizontal_unit})"
         )
         layer_crs = QgsCoordinateReferenceSystem.fromWkt(info.crs.to_wkt()) if info.crs else None
-        point_sink, point_id = self._sink(parameters, context, self.OUTPUT_POINTS, _POINT_FIELDS,
-                                          WKB_POINT_Z, layer_crs)  # fmt: skip
+        point_sink, point_id = self.field_sink(
+            parameters, context, self.OUTPUT_POINTS, _POINT_FIELDS, WKB_POINT_Z, layer_crs
+        )
         for p in result.points:
             axes, _ = error_ellipsoid(p.covariance)
             values = [p.id, *p.sigma, *axes, *p.plane_ids, p.min_angle_deg, p.condition]
-            self._add(point_sink, _POINT_FIELDS, QgsPoint(*map(float, p.xyz)), values)
-        line_sink, line_id = self._sink(parameters, context, self.OUTPUT_LINES, _LINE_FIELDS,
-                                        WKB_LINESTRING_Z, layer_crs)  # fmt: skip
+            self.add_feature(point_sink, _POINT_FIELDS, QgsPoint(*map(float, p.xyz)), values)
+        line_sink, line_id = self.field_sink(
+            parameters, context, self.OUTPUT_LINES, _LINE_FIELDS, WKB_LINESTRING_Z, layer_crs
+        )
         for ln in result.lines:
             geometry = QgsLineString(
                 [QgsPoint(*map(float, ln.start)), QgsPoint(*map(float, ln.end))]
             )
             values = [ln.id, *ln.plane_ids, ln.kind, ln.length, ln.sigma_perpendicular,
                       *ln.sigma_ends, ln.dihedral_deg]  # fmt: skip
-            self._add(line_sink, _LINE_FIELDS, geometry, values)
+            self.add_feature(line_sink, _LINE_FIELDS, geometry, values)
         return {
             self.OUTPUT_POINTS: point_id,
             self.OUTPUT_LINES: line_id,
@@ -210,28 +203,3 @@ class CreateLcpsAlgorithm(BaseAlgorithm):
             "LCP_COUNT": len(result.points),
             "LINE_COUNT": len(result.lines),
         }
-
-    def _sink(self, parameters, context, key, spec, wkb, crs):
-        fields = QgsFields()
-        for name, kind in spec:
-            fields.append(QgsField(name, kind))
-        sink, dest = self.parameterAsSink(parameters, key, context, fields, wkb, crs)
-        if sink is None:
-            raise QgsProcessingException(self.invalidSinkError(parameters, key))
-        return (sink, fields), dest
-
-    @staticmethod
-    def _add(sink_fields, spec, geometry, values) -> None:
-        sink, fields = sink_fields
-        feature = QgsFeature(fields)
-        feature.setGeometry(QgsGeometry(geometry))
-        feature.setAttributes([_value(v, kind) for v, (_, kind) in zip(values, spec)])
-        sink.addFeature(feature, SINK_FAST_INSERT)
-
-
-def _value(v, kind):
-    if kind == FIELD_STRING:
-        return str(v)
-    if kind == FIELD_INT:
-        return int(v)
-    return float(v) if math.isfinite(float(v)) else NULL

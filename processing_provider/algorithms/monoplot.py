@@ -5,12 +5,7 @@ from __future__ import annotations
 import math
 
 from qgis.core import (
-    NULL,
     QgsCoordinateReferenceSystem,
-    QgsFeature,
-    QgsField,
-    QgsFields,
-    QgsGeometry,
     QgsLineString,
     QgsPoint,
     QgsProcessingException,
@@ -33,7 +28,6 @@ from ..compat import (
     FILE_BEHAVIOR_FILE,
     FLAG_ADVANCED,
     NUMBER_DOUBLE,
-    SINK_FAST_INSERT,
     SOURCE_VECTOR_LINE,
     SOURCE_VECTOR_POINT,
     WKB_LINESTRING_Z,
@@ -172,7 +166,7 @@ class MonoplotAlgorithm(BaseAlgorithm):
         )  # fmt: skip
         feedback.pushInfo(f"status counts: {res.status_counts()}")
         layer_crs = QgsCoordinateReferenceSystem.fromWkt(res.crs_wkt)
-        psink, pid = self._sink(parameters, context, "OUTPUT_POINTS", _POINT_FIELDS,
+        psink, pid = self.field_sink(parameters, context, "OUTPUT_POINTS", _POINT_FIELDS,
                                 WKB_POINT_Z, layer_crs)  # fmt: skip
         sig = res.sigmas
         for k, (img, pt, kind, tgt, li, vi, how) in enumerate(res.rows):
@@ -181,41 +175,15 @@ class MonoplotAlgorithm(BaseAlgorithm):
             st = int(res.status[k])
             values = [img, pt, kind, tgt, li, vi, *res.pixels[k], *sig[k], st, STATUS_TEXT[st],
                       how, res.incidence_deg[k]]  # fmt: skip
-            self._add(psink, _POINT_FIELDS, geom, values)
-        lsink, lid = self._sink(parameters, context, "OUTPUT_LINES", _LINE_FIELDS,
+            self.add_feature(psink, _POINT_FIELDS, geom, values)
+        lsink, lid = self.field_sink(parameters, context, "OUTPUT_LINES", _LINE_FIELDS,
                                 WKB_LINESTRING_Z, layer_crs)  # fmt: skip
         for li, ln in enumerate(res.lines):
             v = [QgsPoint(*map(float, p)) for p in ln.vertices if all(map(math.isfinite, p))]
             length = sum(a.distance3D(b) for a, b in zip(v[:-1], v[1:]))
             values = [li, ln.image_id, ln.target_id, len(ln.vertices), ln.status,
                       STATUS_TEXT[ln.status], length, *ln.sigma_ends]  # fmt: skip
-            self._add(lsink, _LINE_FIELDS, QgsLineString(v) if len(v) > 1 else None, values)
+            self.add_feature(lsink, _LINE_FIELDS, QgsLineString(v) if len(v) > 1 else None, values)
         return {"OUTPUT_POINTS": pid, "OUTPUT_LINES": lid, **outs, "OUTPUT_DSM": dsm_out,
                 "POINT_COUNT": len(res.rows),
                 "HIT_COUNT": int(sum(s in (0, 1) for s in res.status))}  # fmt: skip
-
-    def _sink(self, parameters, context, key, spec, wkb, crs):
-        fields = QgsFields()
-        for name, kind in spec:
-            fields.append(QgsField(name, kind))
-        sink, dest = self.parameterAsSink(parameters, key, context, fields, wkb, crs)
-        if sink is None:
-            raise QgsProcessingException(self.invalidSinkError(parameters, key))
-        return (sink, fields), dest
-
-    @staticmethod
-    def _add(sink_fields, spec, geometry, values) -> None:
-        sink, fields = sink_fields
-        feature = QgsFeature(fields)
-        if geometry is not None:  # failed rays keep their row (status) without a geometry
-            feature.setGeometry(QgsGeometry(geometry))
-        feature.setAttributes([_value(v, kind) for v, (_, kind) in zip(values, spec)])
-        sink.addFeature(feature, SINK_FAST_INSERT)
-
-
-def _value(v, kind):
-    if kind == FIELD_STRING:
-        return str(v)
-    if kind == FIELD_INT:
-        return int(v)
-    return float(v) if math.isfinite(float(v)) else NULL
