@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
-AHN3 = Path("/work/shared/data/ahn3-delft")
+AHN3 = Path(__file__).resolve().parents[2] / "shared" / "data" / "ahn3-delft"
 FILES = [AHN3 / "ahn3_cropped_1.laz", AHN3 / "ahn3_cropped_2.laz"]
 
 
