@@ -18,27 +18,14 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
-from lidarphoto.core.boresight import ARCSEC, BoresightOptions, calibrate
+from lidarphoto.core.boresight import ARCSEC, BoresightOptions
 from lidarphoto.core.simulate_flight import paper_config, simulate_flight
 
 TABLE1 = {"NE": (85.0, 73.8, 336.8), "SW": (72.4, 78.2, 78.2)}  # std, arc-seconds
 
 
 def run(sim, **kw):
-    opts = BoresightOptions(**{"snooping": False, **kw})
-    return calibrate(
-        sim.trajectory,
-        sim.camera,
-        sim.mount,
-        sim.crs,
-        sim.observations,
-        sim.planes,
-        sim.lines,
-        sim.lcps,
-        sim.lidar_points,
-        sim.lidar_plane_ids,
-        options=opts,
-    )
+    return sim.calibrate(BoresightOptions(**{"snooping": False, **kw}))
 
 
 def fmt(a):

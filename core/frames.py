@@ -44,6 +44,8 @@ def parse_crs(crs: CRS | str | int, *, what: str = "CRS") -> CRS:
         return crs
     if crs is None or (isinstance(crs, str) and not crs.strip()):
         raise CrsError(f"{what} is missing: give an EPSG code (e.g. EPSG:32632) or WKT")
+    if isinstance(crs, str) and crs.strip().isdigit():
+        crs = int(crs)  # a bare EPSG code typed as text
     try:
         return CRS.from_user_input(crs)
     except Exception as exc:  # pyproj raises CRSError with PROJ's words; keep them

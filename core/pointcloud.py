@@ -25,6 +25,7 @@ import numpy as np
 import pyproj
 from numpy.typing import NDArray
 
+from . import frames
 from .errors import Cancelled, CrsError, InputError
 
 LOG = logging.getLogger(__name__)
@@ -106,20 +107,9 @@ def parse_crs(crs: CrsLike) -> pyproj.CRS | None:
     >>> parse_crs("EPSG:28992").to_epsg()
     28992
     """
-    if crs is None:
+    if crs is None or (isinstance(crs, str) and not crs.strip()):
         return None
-    if isinstance(crs, pyproj.CRS):
-        return crs
-    if isinstance(crs, str):
-        crs = crs.strip()
-        if not crs:
-            return None
-        if crs.isdigit():
-            crs = int(crs)
-    try:
-        return pyproj.CRS.from_user_input(crs)
-    except pyproj.exceptions.CRSError as exc:
-        raise CrsError(f"not a valid CRS: {str(crs)[:80]!r} ({exc})") from exc
+    return frames.parse_crs(crs)
 
 
 def _horizontal_crs(crs: pyproj.CRS) -> pyproj.CRS:

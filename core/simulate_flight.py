@@ -32,7 +32,14 @@ from typing import Union
 import numpy as np
 from numpy.typing import NDArray
 
-from .boresight import INS_GRADES, InsGrade, local_frame_for
+from .boresight import (
+    INS_GRADES,
+    BoresightOptions,
+    BoresightResult,
+    InsGrade,
+    calibrate,
+    local_frame_for,
+)
 from .camera import Camera, write_camera_json
 from .collinearity import project
 from .errors import InputError
@@ -208,6 +215,13 @@ class FlightSimulation:
     lidar_plane_ids: NDArray[np.int64]
     town: Town
     truth: FlightTruth
+
+    def calibrate(self, options: BoresightOptions | None = None) -> BoresightResult:
+        """Boresight calibration of this simulation with every control it made."""
+        return calibrate(
+            self.trajectory, self.camera, self.mount, self.crs, self.observations, self.planes,
+            self.lines, self.lcps, self.lidar_points, self.lidar_plane_ids, options=options,
+        )  # fmt: skip
 
     def true_boresight(self, groups: tuple[str, ...]) -> Array:
         """(G, 3) true boresight in the order of a result's groups, radians."""

@@ -10,7 +10,6 @@ from lidarphoto.core.boresight import (
     ARCSEC,
     BoresightNotObservable,
     BoresightOptions,
-    calibrate,
 )
 from lidarphoto.core.boresight_models import PoseSpec, collinearity, coplanarity, paper_plane
 from lidarphoto.core.camera import Camera
@@ -30,20 +29,7 @@ SMALL = FlightConfig(
 
 
 def _run(sim, **kw):
-    opts = BoresightOptions(**{"snooping": False, **kw})
-    return calibrate(
-        sim.trajectory,
-        sim.camera,
-        sim.mount,
-        sim.crs,
-        sim.observations,
-        sim.planes,
-        sim.lines,
-        sim.lcps,
-        sim.lidar_points,
-        sim.lidar_plane_ids,
-        options=opts,
-    )
+    return sim.calibrate(BoresightOptions(**{"snooping": False, **kw}))
 
 
 # ----------------------------------------------------------------------------- Jacobians
