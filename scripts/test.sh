@@ -19,6 +19,7 @@ export PIP_ROOT_USER_ACTION=ignore
 # The adjustments solve normal equations of a few hundred unknowns: threaded BLAS only adds
 # contention on a 2-core machine (measured: 50 s single-threaded vs 196 s threaded, loaded).
 export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1
+export LIDARPHOTO_REQUIRE_NUMBA=1  # tests/core/test_dda_backends.py must run, not skip
 PYTHON=${PYTHON:-python3}
 LOGDIR=$ROOT/.ci-logs
 mkdir -p "$LOGDIR"

@@ -83,3 +83,27 @@ def test_qgis_python_when_running_inside_the_qgis_binary(monkeypatch):
     ver = f"{sys.version_info.major}.{sys.version_info.minor}"
     assert exe in (f"/usr/bin/python{ver}", "/usr/bin/python3")
     assert "qgis" not in exe
+
+
+def test_missing_accelerator_is_logged_as_information_only(qgis_iface, monkeypatch):
+    from lidarphoto.plugin import dependencies
+
+    monkeypatch.setitem(dependencies.OPTIONAL_MODULES, FAKE, (FAKE, "something runs slower"))
+    logged = []
+
+    def on_message(message, tag, level):
+        logged.append((message, level))
+
+    log = QgsApplication.messageLog()
+    log.messageReceived.connect(on_message)
+    bar = qgis_iface.messageBar()
+    bar.clear_messages()
+    try:
+        assert dependencies.report_missing(qgis_iface) == []
+    finally:
+        log.messageReceived.disconnect(on_message)
+    assert bar.get_messages(Qgis.MessageLevel.Warning) == []
+    info = [m for m, level in logged if FAKE in m]
+    assert len(info) == 1 and "something runs slower" in info[0] and "pip install" in info[0]
+    assert all(level == Qgis.MessageLevel.Info for m, level in logged if FAKE in m)
+    assert "numba" not in info[0]  # installed in the test environment
