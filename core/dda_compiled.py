@@ -37,12 +37,6 @@ _EPS = 1e-9
 _TOL_T = 1e-9
 
 
-def _jit(func: Callable[..., Any]) -> Callable[..., Any]:
-    """numba.njit (lazy: compiled at the first call) when numba is there."""
-    return numba.njit(cache=True, nogil=True)(func) if AVAILABLE else func
-
-
-@_jit
 def _spatial_order(o, d, x_c, y_c, cell, zmax, rows, cols):
     """Ray indices sorted by the 16 x 16-cell block where each ray crosses the DSM's top.
 
@@ -72,15 +66,15 @@ def _spatial_order(o, d, x_c, y_c, cell, zmax, rows, cols):
 
 
 def _trace(
-    o, d, z, qmax, mstack, offsets, bcols, shifts, x_c, y_c, cell, zmin, zmax, n_lev,
+    o, d, order, z, qmax, mstack, offsets, bcols, shifts, x_c, y_c, cell, zmin, zmax, n_lev,
     min_inc_deg, t_out, st_out, qi_out, qj_out, tri_out, pts_out, w_out, grad_out, inc_out,
 ):  # fmt: skip
-    """Trace rays o + t d (CRS units) through the DSM heights z; fills the *_out arrays."""
+    """Trace rays o + t d (CRS units) through the DSM heights z, in the given order; fills
+    the *_out arrays."""
     rows, cols = z.shape
     inv = 1.0 / cell
     margin = 1e-6 * max(1.0, abs(zmax), abs(zmin))
     budget = 4 * (rows + cols) + 16
-    order = _spatial_order(o, d, x_c, y_c, cell, zmax, rows, cols)
     for r in order:
         t_out[r] = np.nan
         st_out[r] = _OUTSIDE
@@ -247,15 +241,18 @@ def _trace(
         st_out[r] = status
 
 
-_COMPILED: list[Any] = []
+_COMPILED: dict[str, Callable[..., Any]] = {}
 
 
-def _compiled() -> Callable[..., None]:
-    if not _COMPILED:
-        # cache=True keeps the machine code next to this module (a plugin folder is writable;
-        # when it is not, numba warns and compiles again next session: about 2 s)
-        _COMPILED.append(_jit(_trace))
-    return _COMPILED[0]
+def _compiled(name: str) -> Callable[..., Any]:
+    """The jitted function (compiled at its first call). cache=True keeps the machine code next
+    to this module (a plugin folder is writable; when it is not, numba warns and compiles again
+    next session: about 3 s). The two functions never call each other: a cached function that
+    references another one would be tied to the module's import name."""
+    if name not in _COMPILED:
+        func = {"order": _spatial_order, "trace": _trace}[name]
+        _COMPILED[name] = numba.njit(cache=True, nogil=True)(func)
+    return _COMPILED[name]
 
 
 def trace_rays(
@@ -285,10 +282,12 @@ def trace_rays(
         pyramid = (np.zeros(1, np.float32), *(np.zeros(1, np.int64) for _ in range(3)))
         n_lev = 0
     xc, yc = dsm.centre_origin
-    _compiled()(
-        np.ascontiguousarray(origins[rows], np.float64),
-        np.ascontiguousarray(directions[rows], np.float64),
-        z, qmax, *pyramid, float(xc), float(yc), float(dsm.cell),
+    o = np.ascontiguousarray(origins[rows], np.float64)
+    d = np.ascontiguousarray(directions[rows], np.float64)
+    order = _compiled("order")(o, d, float(xc), float(yc), float(dsm.cell),
+                               float(tracer.zmax), r_, c_)  # fmt: skip
+    _compiled("trace")(
+        o, d, order, z, qmax, *pyramid, float(xc), float(yc), float(dsm.cell),
         float(tracer.zmin), float(tracer.zmax), n_lev, float(min_incidence_deg),
         out["t"][rows], out["status"][rows], out["qi"][rows], out["qj"][rows],
         out["tri"][rows], out["points"][rows], out["weights"][rows], out["gradient"][rows],

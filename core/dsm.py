@@ -21,6 +21,7 @@ the raster's outer edge.
 from __future__ import annotations
 
 import logging
+import math
 import os
 import struct
 from collections.abc import Callable, Sequence
@@ -358,6 +359,83 @@ def read_dsm_raster(path: PathLike, crs: str | int | pyproj.CRS | None = None) -
     grid = Grid(float(gt[0]), float(gt[3]), float(gt[1]), rows, cols)
     file_crs = parse_crs(wkt) if wkt else None
     return Dsm(data, grid, parse_crs(crs) if crs else file_crs, p)
+
+
+def reproject_dsm(
+    dsm: Dsm,
+    crs: str | int | pyproj.CRS,
+    cell: float | None = None,
+    *,
+    block_rows: int = 256,
+    should_stop: Callable[[], bool] | None = None,
+) -> Dsm:
+    """The DSM resampled onto a north-up grid of another CRS, heights transformed too.
+
+    Each target cell centre is mapped back to the source CRS, the source surface (the
+    triangulated polyhedron) is sampled there and the point (x, y, height) is transformed
+    to the target: vertical datum changes are applied (2D CRSs carry ellipsoidal heights,
+    :func:`core.frames.as_3d`), and a transformation that needs a grid PROJ does not have
+    raises :class:`CrsError` instead of silently dropping it.
+
+    Parameters
+    ----------
+    dsm : Dsm
+        With its CRS.
+    crs : target CRS.
+    cell : float, optional
+        Target cell, target CRS unit (default: the source cell times the local scale
+        between the two CRSs at the DSM's centre, rounded to 1 mm).
+    block_rows : int
+        Target rows transformed per batch (memory).
+    """
+    from .frames import transformer_3d
+
+    if dsm.crs is None:
+        raise CrsError("the DSM has no CRS: it cannot be reprojected", path=dsm.source or None)
+    dst = parse_crs(crs)
+    fwd = transformer_3d(dsm.crs, dst)
+    inv = transformer_3d(dst, dsm.crs)
+    g = dsm.grid
+    rows, cols = dsm.heights.shape
+    # the footprint: the surface's outline (cell centres of the border), densified
+    k = np.linspace(0.0, 1.0, 65)
+    xc, yc = dsm.centre_origin
+    xs = xc + np.r_[k, np.ones_like(k), k[::-1], np.zeros_like(k)] * (cols - 1) * g.cell
+    ys = yc - np.r_[np.zeros_like(k), k, np.ones_like(k), k[::-1]] * (rows - 1) * g.cell
+    zmid = float(np.nanmedian(dsm.heights)) if np.isfinite(dsm.heights).any() else 0.0
+    bx, by, _ = fwd.transform(xs, ys, np.full(xs.size, zmid))
+    if not (np.isfinite(bx).all() and np.isfinite(by).all()):
+        raise CrsError(f"the DSM's footprint cannot be transformed to '{dst.name}'",
+                       path=dsm.source or None)  # fmt: skip
+    if cell is None:
+        cx, cy = xc + (cols - 1) * g.cell / 2, yc - (rows - 1) * g.cell / 2
+        px, py, _ = fwd.transform(
+            [cx, cx + g.cell, cx], [cy, cy, cy + g.cell], [zmid] * 3
+        )  # fmt: skip
+        scale = 0.5 * (math.hypot(px[1] - px[0], py[1] - py[0])
+                       + math.hypot(px[2] - px[0], py[2] - py[0])) / g.cell  # fmt: skip
+        cell = max(round(g.cell * scale, 3), 1e-3)
+    cell = float(cell)
+    out = Grid.covering((bx.min() - cell / 2, by.min() - cell / 2),
+                        (bx.max() + cell / 2, by.max() + cell / 2), cell)  # fmt: skip
+    heights = np.full((out.rows, out.cols), np.nan, np.float32)
+    cols_x = out.x0 + (np.arange(out.cols) + 0.5) * cell
+    for r0 in range(0, out.rows, max(int(block_rows), 1)):
+        _stop(should_stop)
+        r1 = min(r0 + block_rows, out.rows)
+        yy = out.y_top - (np.arange(r0, r1) + 0.5) * cell
+        tx, ty = np.meshgrid(cols_x, yy)
+        sx, sy, _ = inv.transform(tx.ravel(), ty.ravel(), np.full(tx.size, zmid))
+        h = dsm.height_at(sx, sy)
+        ok = np.isfinite(h)
+        if ok.any():
+            _, _, th = fwd.transform(sx[ok], sy[ok], h[ok])
+            block = np.full(tx.size, np.nan)
+            block[ok] = th
+            heights[r0:r1] = block.reshape(tx.shape)
+    LOG.info("DSM reprojected from '%s' to '%s': %d x %d cells of %g", dsm.crs.name, dst.name,
+             out.rows, out.cols, cell)  # fmt: skip
+    return Dsm(heights, out, dst, dsm.source)
 
 
 def load_dsm(

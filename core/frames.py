@@ -245,6 +245,18 @@ def _columns(a: ArrayLike) -> tuple[Array, Array, Array]:
     return arr[..., 0], arr[..., 1], arr[..., 2]
 
 
+def as_3d(crs: CRS) -> CRS:
+    """The CRS with its heights made explicit: compound CRSs as they are, a 2D CRS with
+    ellipsoidal heights (the convention of this package, docs/conventions.md)."""
+    return crs if crs.is_compound or len(crs.axis_info) > 2 else crs.to_3d()
+
+
+def transformer_3d(src: CRS, dst: CRS) -> Transformer:
+    """(x, y, height) from ``src`` to ``dst`` with heights per :func:`as_3d`; raises
+    CrsError instead of dropping a vertical datum change whose grid is not installed."""
+    return _exact_transformer(as_3d(src), as_3d(dst))
+
+
 def _exact_transformer(src: CRS, dst: CRS) -> Transformer:
     """Best transformation, refusing PROJ's silent 'ballpark' fallback when a grid is missing."""
     with warnings.catch_warnings():

@@ -27,8 +27,10 @@ until the height changes less than a tolerance), the intersection with a LiDAR r
 exterior-orientation covariance and the DSM (or plane) uncertainty into a 3 x 3 covariance.
 
 Each ray gets a status code (:data:`STATUS_TEXT`): a ray that leaves the DSM, crosses a
-nodata hole before hitting the surface, belongs to an image without orientation, or meets a
-DSM in another CRS is reported, never raised.
+nodata hole before hitting the surface, or belongs to an image without orientation is
+reported, never raised. A DSM in another CRS is resampled into the mapping CRS first
+(:func:`core.dsm.reproject_dsm`); when that is impossible (a vertical grid PROJ lacks) its
+rays get the status crs_mismatch.
 
 Frames: the EO table's omega-phi-kappa are relative to the grid frame at the perspective
 centre, and a straight ray in the real (ENU) world is not straight in projected coordinates
@@ -53,7 +55,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .camera import Camera, read_camera_json
 from .collinearity import collinearity_jacobians
-from .dsm import Dsm, load_dsm
+from .dsm import Dsm, load_dsm, reproject_dsm
 from .errors import Cancelled, CrsError, InputError
 from .io.observations import ImageObservations, read_observations_csv
 from .io.tables import write_csv_atomic
@@ -84,7 +86,7 @@ STATUS_TEXT = {
     STATUS_NOT_CONVERGED: "not_converged",  # Makarovic's iteration did not converge
     STATUS_PARALLEL: "parallel",  # the ray is parallel to the plane or meets it behind
     STATUS_UNKNOWN_PLANE: "unknown_plane",  # target_id is not in the plane table
-    STATUS_CRS_MISMATCH: "crs_mismatch",  # the DSM is in another CRS than the EO
+    STATUS_CRS_MISMATCH: "crs_mismatch",  # the DSM cannot be brought into the EO's CRS
 }
 METHODS = ("dal_poz", "makarovic")
 #: Exterior-orientation sigmas (X, Y, Z m; omega, phi, kappa degrees) of a survey-grade
@@ -940,8 +942,6 @@ def run_monoplot(
                        progress=sub(0.0, 0.4), should_stop=should_stop)  # fmt: skip
     elif dsm_crs:
         dsm = Dsm(dsm.heights, dsm.grid, parse_crs(dsm_crs), dsm.source)
-    if output_dsm:
-        dsm.to_geotiff(output_dsm)
 
     # --- the rays: points, then line vertices (with densified points)
     step = float(line_step_px)
@@ -978,11 +978,17 @@ def run_monoplot(
     if dsm.crs is None:
         LOG.warning("the DSM has no CRS: taken to be the mapping CRS %s", mapping_crs.name)
     elif not _crs_equal(dsm.crs, mapping_crs):
-        dsm_ok = False
-        LOG.warning(
-            "the DSM is in '%s', the exterior orientation in '%s': reproject the DSM; its "
-            "points are not monoplotted", dsm.crs.name, mapping_crs.name,
-        )  # fmt: skip
+        try:
+            source_crs = dsm.crs.name
+            dsm = reproject_dsm(dsm, mapping_crs, should_stop=should_stop)
+            LOG.warning("the DSM was in '%s': resampled into the mapping CRS '%s' (cell %g)",
+                        source_crs, mapping_crs.name, dsm.cell)  # fmt: skip
+        except CrsError as exc:
+            dsm_ok = False
+            LOG.warning("the DSM cannot be brought into the mapping CRS '%s': %s; its points "
+                        "are not monoplotted", mapping_crs.name, exc)  # fmt: skip
+    if output_dsm:
+        dsm.to_geotiff(output_dsm)
 
     plane_map: dict[str, Any] = {}
     if planes:

@@ -59,13 +59,15 @@ points every so many pixels along it); other rows are points (their target_id is
 used). With a <b>plane table</b>, rows of type <i>tie</i> or <i>paper</i> are intersected with \
 their roof plane (target_id) instead.</p>
 <p><b>DSM</b>: a raster, or a LAS/LAZ rasterised at <b>cell size</b> (highest return per \
-cell, gaps filled; optionally saved). The DSM must be in the mapping <b>CRS</b> of the \
-exterior orientation (<b>DSM CRS</b> supplies it when the file has none).</p>
+cell, gaps filled; optionally saved). A DSM in another CRS than the mapping <b>CRS</b> of the \
+exterior orientation is resampled into it, heights transformed too (<b>DSM CRS</b> supplies \
+the CRS when the file has none); when PROJ lacks a grid for that (e.g. a geoid), its points \
+get the status crs_mismatch.</p>
 <p>Each point carries a 3x3 covariance from the image sigma, the <b>EO sigmas</b> \
 (X, Y, Z in m; omega, phi, kappa in degrees) and the <b>DSM height sigma</b>, and a status: \
 ok, grazing (ray meets the face at less than the minimum angle), outside (the ray leaves the \
 DSM), nodata (it crosses a hole first), no_orientation (image not in the EO table), \
-crs_mismatch, not_converged (Makarovic), parallel / unknown_plane (planes).</p>"""
+crs_mismatch (see DSM), not_converged (Makarovic), parallel / unknown_plane (planes).</p>"""
 
 
 class MonoplotAlgorithm(BaseAlgorithm):
