@@ -102,6 +102,7 @@ __all__ = [
     "DsmTracer",
     "MonoplotLine",
     "MonoplotResult",
+    "chord_rays",
     "dal_poz_intersect",
     "dal_poz_plane",
     "intersect_dsm",
@@ -821,7 +822,7 @@ def _line_rays(
     return rays, keys
 
 
-def _chord_rays(local: Any, c_map: Array, c_loc: Array, d_loc: Array, s: Array) -> Array:
+def chord_rays(local: Any, c_map: Array, c_loc: Array, d_loc: Array, s: Array) -> Array:
     """Unit directions in the mapping frame from each centre to its ENU ray's point at ``s``."""
     far = local.enu_to_map(c_loc + s[:, None] * d_loc)
     v = far - c_map
@@ -837,13 +838,13 @@ def _two_pass(
     s_far: Array,
 ) -> tuple[Array, NDArray[np.int8], Array]:
     """Intersect along the chord to ``s_far``, then along the chord to the first hit."""
-    dirs = _chord_rays(local, c_map, c_loc, d_loc, s_far)
+    dirs = chord_rays(local, c_map, c_loc, d_loc, s_far)
     pts, status = solve(c_map, dirs)
     hit = np.isin(status, _HIT)
     if hit.any():
         s1 = np.einsum("ij,ij->i", local.map_to_enu(pts[hit]) - c_loc[hit], d_loc[hit])
         d2 = dirs.copy()
-        d2[hit] = _chord_rays(local, c_map[hit], c_loc[hit], d_loc[hit], s1)
+        d2[hit] = chord_rays(local, c_map[hit], c_loc[hit], d_loc[hit], s1)
         p2, st2 = solve(c_map, d2)
         pts, status, dirs = np.where(hit[:, None], p2, pts), np.where(hit, st2, status), d2
     return pts, status.astype(np.int8), dirs

@@ -34,10 +34,11 @@ from qgis.gui import (
     QgsProjectionSelectionWidget,
     QgsRubberBand,
 )
-from qgis.PyQt.QtCore import QPointF, Qt, pyqtSignal
+from qgis.PyQt.QtCore import QEvent, QPointF, Qt, pyqtSignal
 from qgis.PyQt.QtGui import QColor, QCursor, QKeySequence
 from qgis.PyQt.QtWidgets import (
     QAbstractItemView,
+    QApplication,
     QCheckBox,
     QComboBox,
     QDoubleSpinBox,
@@ -66,6 +67,7 @@ from ..core.planes import fit_plane
 from ..core.trajectory_to_eo import MOUNT_CHOICES
 from .image_source import ImageSource, ImageSourceError
 from .image_view import VIEW_HELP, ImageView
+from .monoplot_tool import MonoplotTool
 from .observation_store import Observation, ObservationStore, load_session, save_session
 from .overlays import GROUPS, Overlays
 
@@ -84,6 +86,10 @@ DOCK_HELP = (
     "overlap); <i>line</i> and <i>lcp</i>/<i>check</i> take the nearest line or control point. "
     "After a tie point the other images show its prediction (yellow x): Enter accepts it, a "
     "click puts it where you see it, Esc drops it.<br>"
+    "<b>Monoplot</b> (needs a DSM in the Project tab): while the button is on, a click makes a "
+    "3D point on the DSM, or a vertex of a 3D line (Enter, a double click or <i>Finish "
+    "line</i> ends it); they appear on the map at once, and the save button writes them to a "
+    "GeoPackage. Off: clicks measure observations again.<br>"
     "<b>Keys</b>: PgDown/PgUp next/previous image · Enter accept prediction · Esc cancel "
     "prediction · Delete delete selected point · Ctrl+Z undo · Ctrl+Shift+Z / Ctrl+Y redo · "
     "T/P/L/C/K picking type · " + VIEW_HELP
@@ -140,6 +146,8 @@ class ImagePickingDock(QgsDockWidget):
         self._restoring = False
         self.rubber_band = None
         self._build_ui()
+        self.monoplot_tool = MonoplotTool(self, self.project)
+        self._dsm_key: tuple | None = None
         self._connect()
         self.restore_session()
 
@@ -200,6 +208,31 @@ class ImagePickingDock(QgsDockWidget):
         form.addRow(self.tr("Lines"), self.lines_combo)
         form.addRow(self.tr("Control points"), self.lcps_combo)
         form.addRow(self.tr("Observations"), self.obs_edit)
+        # the DSM of the monoplotting tool: a raster layer of the project or a file
+        self.dsm_combo = QgsMapLayerComboBox()
+        self.dsm_combo.setObjectName("lidarphotoDsmLayer")
+        self.dsm_combo.setFilters(QgsMapLayerProxyModel.Filter.RasterLayer)
+        self.dsm_combo.setAllowEmptyLayer(True)
+        self.dsm_combo.setLayer(None)
+        self.dsm_combo.setToolTip(self.tr("DSM raster (heights) for monoplotting"))
+        dsm_row = QWidget()
+        dl = QHBoxLayout(dsm_row)
+        dl.setContentsMargins(0, 0, 0, 0)
+        self.dsm_edit = QgsFileWidget()
+        self.dsm_edit.setFilter(self.tr("DSM (*.tif *.tiff *.las *.laz);;All files (*)"))
+        self.dsm_edit.setToolTip(
+            self.tr("Or a DSM file: GeoTIFF, or a LAS/LAZ cloud rasterised at the cell size")
+        )
+        self.dsm_cell = QDoubleSpinBox()
+        self.dsm_cell.setRange(0.01, 100.0)
+        self.dsm_cell.setDecimals(2)
+        self.dsm_cell.setValue(0.5)
+        self.dsm_cell.setSuffix(self.tr(" m"))
+        self.dsm_cell.setToolTip(self.tr("Cell of the DSM made from a LAS/LAZ file"))
+        dl.addWidget(self.dsm_edit, 1)
+        dl.addWidget(self.dsm_cell)
+        form.addRow(self.tr("DSM (monoplot)"), self.dsm_combo)
+        form.addRow(self.tr("or DSM file"), dsm_row)
         tabs.addTab(proj, self.tr("Project"))
 
         cal = QWidget()
@@ -267,9 +300,42 @@ class ImagePickingDock(QgsDockWidget):
         self.help_button = QToolButton()
         self.help_button.setText("?")
         self.help_button.setToolTip(DOCK_HELP)
+        self.monoplot_button = QToolButton()
+        self.monoplot_button.setObjectName("lidarphotoMonoplot")
+        self.monoplot_button.setText(self.tr("Monoplot"))
+        self.monoplot_button.setCheckable(True)
+        self.monoplot_button.setToolTip(
+            self.tr(
+                "Monoplotting: clicks become 3D points (or line vertices) on the DSM, added to "
+                "the map at once; off: clicks measure observations again"
+            )
+        )
+        self.monoplot_mode = QComboBox()
+        self.monoplot_mode.setObjectName("lidarphotoMonoplotMode")
+        self.monoplot_mode.addItem(self.tr("points"), "point")
+        self.monoplot_mode.addItem(self.tr("lines"), "line")
+        self.monoplot_mode.setToolTip(self.tr("Monoplot points, or lines (finish: Enter)"))
+        self.finish_line_button = QToolButton()
+        self.finish_line_button.setText(self.tr("Finish line"))
+        self.finish_line_button.setToolTip(
+            self.tr("End the line being digitised (also Enter or a double click)")
+        )
+        self.finish_line_button.setEnabled(False)
+        self.save_monoplot_button = QToolButton()
+        self.save_monoplot_button.setIcon(QgsApplication.getThemeIcon("/mActionFileSave.svg"))
+        self.save_monoplot_button.setToolTip(
+            self.tr("Save the monoplotted points and lines to a GeoPackage")
+        )
         for w in (self.prev_button, self.image_combo, self.next_button, self.type_combo):
             row.addWidget(w)
         row.addStretch(1)
+        for w in (
+            self.monoplot_button,
+            self.monoplot_mode,
+            self.finish_line_button,
+            self.save_monoplot_button,
+        ):
+            row.addWidget(w)
         for w in (self.undo_button, self.redo_button, self.magnifier_button, self.help_button):
             row.addWidget(w)
         vl.addLayout(row)
@@ -329,7 +395,10 @@ class ImagePickingDock(QgsDockWidget):
         elif key == Qt.Key.Key_PageUp:
             self.previous_image()
         elif key in (Qt.Key.Key_Return, Qt.Key.Key_Enter):
-            self.accept_prediction()
+            if self.monoplot_tool.mode == "line":
+                self.finish_monoplot_line()
+            else:
+                self.accept_prediction()
         elif key == Qt.Key.Key_Escape:
             self.cancel_prediction()
         elif event.text().upper() in _TYPE_KEYS and not event.modifiers() & (
@@ -373,10 +442,30 @@ class ImagePickingDock(QgsDockWidget):
         self.view.pointPicked.connect(self.pick)
         self.view.pointMoved.connect(self._moved)
         self.view.cursorMoved.connect(self._cursor)
+        # a large image without overviews: its pyramid is built in the background
+        self.view.overviewProgress.connect(
+            lambda pct: self.status.setText(
+                self.tr("Building the overview pyramid: {:.0f} %").format(pct)
+            )
+        )
+        self.view.overviewFinished.connect(
+            lambda ok, msg: self.message(msg, warning=not ok and "cancelled" not in msg)
+        )
+        self.view.loadFailed.connect(lambda msg: self.message(msg, warning=True))
         self.store.changed.connect(self._store_changed)
         self.store.saveFailed.connect(lambda msg: self.message(msg, warning=True))
         self.table.itemSelectionChanged.connect(self._table_selection)
-        self.project.readProject.connect(lambda _doc: self.restore_session())
+        # a bound method, not a lambda: PyQt breaks the connection when the dock is deleted
+        self.project.readProject.connect(self._project_read)
+        self.dsm_combo.layerChanged.connect(self._dsm_changed)
+        self.dsm_edit.fileChanged.connect(self._dsm_changed)
+        self.dsm_cell.editingFinished.connect(self._dsm_changed)
+        self.monoplot_button.toggled.connect(self.set_monoplot)
+        self.monoplot_mode.currentIndexChanged.connect(self._monoplot_mode_changed)
+        self.finish_line_button.clicked.connect(self.finish_monoplot_line)
+        self.save_monoplot_button.clicked.connect(lambda: self.save_monoplot())
+        self.monoplot_tool.message.connect(self.message)
+        self.view.viewport().installEventFilter(self)
 
     # ================================================================ messages
     def message(self, text: str, warning: bool = False) -> None:
@@ -1022,6 +1111,9 @@ class ImagePickingDock(QgsDockWidget):
             "current_image": self.current_image,
             "images": [str(p) for p in self.image_paths.values()],
             "crs": self.eo_crs().authid(),
+            "dsm_layer": layer_id(self.dsm_combo),
+            "dsm_file": self.dsm_edit.filePath(),
+            "dsm_cell": f"{self.dsm_cell.value():g}",
         }
 
     def save_session(self, *_args) -> None:
@@ -1063,11 +1155,169 @@ class ImagePickingDock(QgsDockWidget):
                 self.images_list.addItem(f"{stem}  ({p})")
             self.current_image = s.get("current_image", "")
             self.obs_edit.setFilePath(s.get("observations", ""))
+            self.dsm_combo.setLayer(self.project.mapLayer(s.get("dsm_layer", "")))
+            self.dsm_edit.setFilePath(s.get("dsm_file", ""))
+            try:
+                self.dsm_cell.setValue(float(s.get("dsm_cell", "0.5")))
+            except ValueError:
+                pass
         finally:
             self._restoring = False
         if s.get("observations"):
             self.open_observations(s["observations"])
         self.reload_orientation()
+
+    # ================================================================ monoplotting
+    def monoplot_dsm_source(self) -> tuple[str, float, QgsCoordinateReferenceSystem | None]:
+        """(path, LAS cell size, CRS of a raster layer or None) of the chosen DSM; path ""
+        when none is chosen. A file wins over the layer."""
+        path = self.dsm_edit.filePath()
+        if path:
+            return path, float(self.dsm_cell.value()), None
+        layer = self.dsm_combo.currentLayer()
+        if layer is None:
+            return "", 0.0, None
+        return layer.source().split("|")[0], float(self.dsm_cell.value()), layer.crs()
+
+    def _dsm_changed(self, *_args) -> None:
+        self._dsm_key = None  # loaded again at the next start
+        self.save_session()
+        if self.monoplot_tool.mode:
+            self.set_monoplot(True)
+
+    def _prepare_monoplot(self) -> bool:
+        """Check the orientation and the DSM (load it once); False with a message."""
+        if self.camera is None or self.eo is None or self.scene_geometry is None:
+            self.message(
+                self.tr(
+                    "Monoplotting needs the camera and the exterior orientation (Project tab)."
+                ),
+                warning=True,
+            )
+            return False
+        path, cell, layer_crs = self.monoplot_dsm_source()
+        if not path:
+            self.message(
+                self.tr(
+                    "Choose a DSM for monoplotting in the Project tab: a raster layer, or a "
+                    "GeoTIFF or LAS/LAZ file."
+                ),
+                warning=True,
+            )
+            return False
+        crs = self.eo_crs()
+        if layer_crs is not None and layer_crs.isValid() and layer_crs != crs:
+            self.message(
+                self.tr(
+                    "The DSM layer is in {} but the exterior orientation in {}: reproject the "
+                    "DSM (Raster > Projections > Warp) or set the mapping CRS."
+                ).format(layer_crs.authid() or layer_crs.description(), crs.authid()),
+                warning=True,
+            )
+            return False
+        key = (path, cell, crs.authid() or crs.toWkt())
+        if key != self._dsm_key:
+            try:
+                QApplication.setOverrideCursor(Qt.CursorShape.WaitCursor)
+                try:
+                    self.monoplot_tool.set_dsm(path, cell)
+                finally:
+                    QApplication.restoreOverrideCursor()
+            except (InputError, OSError, ValueError) as exc:
+                self.message(self.tr("DSM not loaded: {}").format(exc), warning=True)
+                return False
+            problem = self.monoplot_tool.crs_problem(crs.toWkt())
+            if problem:
+                self.message(problem, warning=True)
+                return False
+            self._dsm_key = key
+        return True
+
+    def set_monoplot(self, on: bool) -> bool:
+        """Switch the monoplotting tool on (clicks -> 3D features) or off (clicks -> picking);
+        returns whether it is on."""
+        tool = self.monoplot_tool
+        if on and not self._prepare_monoplot():
+            on = False
+        if on:
+            self.cancel_prediction()
+            mode = self.monoplot_mode.currentData() or "point"
+            if tool.mode == "line":
+                self.finish_monoplot_line()
+            tool.start(mode)
+            self.message(
+                self.tr(
+                    "Monoplotting {}: click in the image; the 3D features appear on the map "
+                    "at once.{}"
+                ).format(
+                    self.tr("points") if mode == "point" else self.tr("lines"),
+                    self.tr(" Finish each line with Enter or a double click.")
+                    if mode == "line"
+                    else "",
+                )
+            )
+        elif tool.mode:
+            n = tool.finish_line() if tool.mode == "line" else 0
+            tool.stop()
+            self.message(
+                self.tr("Monoplotting off: clicks measure observations again.")
+                + (self.tr(" The line in progress was added.") if n else "")
+            )
+        self.monoplot_button.blockSignals(True)
+        self.monoplot_button.setChecked(on)
+        self.monoplot_button.blockSignals(False)
+        self.finish_line_button.setEnabled(on and tool.mode == "line")
+        return on
+
+    def _monoplot_mode_changed(self, _index: int) -> None:
+        if self.monoplot_tool.mode:
+            self.set_monoplot(True)
+
+    def finish_monoplot_line(self) -> int:
+        """End the line being digitised; returns its number of 3D vertices."""
+        try:
+            n = self.monoplot_tool.finish_line()
+        except (InputError, RuntimeError, ValueError) as exc:
+            self.message(str(exc), warning=True)
+            return 0
+        if n:
+            self.message(self.tr("3D line of {} vertices added.").format(n))
+        return n
+
+    def save_monoplot(self, path: str | None = None) -> list[str]:
+        """Write the monoplotted points and lines to a GeoPackage (asked for when no path is
+        given); returns the names of the layers written."""
+        if path is None:
+            start = ""
+            if self.store.path is not None:
+                start = str(self.store.path.with_name(self.store.path.stem + "_monoplot.gpkg"))
+            path, _ = QFileDialog.getSaveFileName(
+                self, self.tr("Save monoplotted features"), start, self.tr("GeoPackage (*.gpkg)")
+            )
+            if not path:
+                return []
+        try:
+            names = self.monoplot_tool.save(path)
+        except (OSError, RuntimeError) as exc:
+            self.message(self.tr("Not saved: {}").format(exc), warning=True)
+            return []
+        if names:
+            self.message(self.tr("Saved {} to {}.").format(", ".join(names), path))
+        else:
+            self.message(self.tr("Nothing monoplotted yet."))
+        return names
+
+    def eventFilter(self, watched, event) -> bool:
+        """A double click in the image ends the monoplotted line (its first click has already
+        added the last vertex)."""
+        if (
+            event.type() == QEvent.Type.MouseButtonDblClick
+            and self.monoplot_tool.mode == "line"
+            and watched is self.view.viewport()
+        ):
+            self.finish_monoplot_line()
+            return True
+        return super().eventFilter(watched, event)
 
     # ================================================================ calibration
     def calibration_parameters(self, out_dir: Path) -> dict:
@@ -1182,6 +1432,11 @@ class ImagePickingDock(QgsDockWidget):
         self._fill_table()
         self.calibrationFinished.emit(True)
 
+    def _project_read(self, _document) -> None:
+        self.restore_session()
+
     def closeEvent(self, event) -> None:
         self.store.save()
+        if self.monoplot_tool.mode:
+            self.set_monoplot(False)
         super().closeEvent(event)

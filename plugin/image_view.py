@@ -9,6 +9,15 @@ Only what is visible is read: one coarse background picture of the whole image (
 and 512 x 512 tiles of the pyramid level that matches the zoom (level L reads the image
 decimated by 2**L through :class:`ImageSource`, i.e. the GDAL overviews).
 
+The GUI thread never waits for GDAL on its own: tiles are read by a worker thread
+(:class:`~.image_loader.TileLoader`) and arrive by signal, the tiles of the previous level stay
+on screen until the new level is complete, and requests made stale by further zooming or
+panning are dropped. An image without overviews is first shown as a coarse preview read in the
+worker (a placeholder until then) while its pyramid is built in the background
+(:class:`~.image_loader.OverviewTask`, progress in :attr:`ImageView.overviewProgress` and in the
+view's status line); the sharp pyramid levels replace the preview when it is done.
+:meth:`ImageView.update_tiles` stays synchronous for callers that want the tiles now.
+
 Mouse and keys (also in :data:`VIEW_HELP`): wheel zooms about the cursor; middle or right
 button, or Space + left button, pans; left click picks, left drag on a point moves it;
 ``+``/``-`` zoom, ``F`` fits the image, ``1`` shows one image pixel per screen pixel, ``M``
@@ -18,29 +27,44 @@ toggles the magnifier, arrow keys pan.
 from __future__ import annotations
 
 import math
+import time
 from typing import Callable
 
-import numpy as np
+from qgis.core import QgsApplication
 from qgis.PyQt.QtCore import QPointF, QRectF, Qt, QTimer, pyqtSignal
-from qgis.PyQt.QtGui import QColor, QImage, QPainter, QPen, QPixmap, QTransform
-from qgis.PyQt.QtWidgets import QGraphicsPixmapItem, QGraphicsScene, QGraphicsView, QLabel
+from qgis.PyQt.QtGui import QBrush, QColor, QImage, QPainter, QPen, QPixmap, QTransform
+from qgis.PyQt.QtWidgets import (
+    QApplication,
+    QGraphicsPixmapItem,
+    QGraphicsRectItem,
+    QGraphicsScene,
+    QGraphicsView,
+    QLabel,
+)
 
+from .image_loader import OverviewTask, TileLoader, TileRequest, to_qimage
 from .image_source import ImageSource
 
 __all__ = ["TILE", "VIEW_HELP", "ImageView", "event_position"]
 
 TILE = 512
-_BACKGROUND_SIDE = 1024
 _MAX_TILES = 400
 _MAX_ZOOM = 32.0
 _DRAG_PX = 4.0
 _HIT_PX = 8.0
+_Z_PLACEHOLDER, _Z_BACKGROUND, _Z_OLD_LEVEL, _Z_TILE = -12.0, -10.0, -6.0, -5.0
+#: while the pyramid is built, the preview stands for the tiles up to this upscaling on screen
+_PREVIEW_UPSCALE = 1.5
 
 VIEW_HELP = (
     "Wheel: zoom about the cursor · middle/right drag or Space+drag: pan · "
     "left click: pick · left drag on a point: move it · +/-: zoom · F: fit · "
     "1: 100 % · M: magnifier · arrows: pan"
 )
+
+#: overview tasks still running, kept referenced until they end (a QgsTask whose Python object
+#: is collected while it runs crashes QGIS)
+_LIVE_TASKS: set = set()
 
 
 def event_position(event) -> QPointF:
@@ -51,15 +75,17 @@ def event_position(event) -> QPointF:
     return QPointF(event.localPos())
 
 
-def _to_qimage(a: np.ndarray) -> QImage:
-    """A deep-copied QImage of an 8-bit (h, w) or (h, w, 3) array."""
-    a = np.ascontiguousarray(a)
-    h, w = a.shape[:2]
-    if a.ndim == 2:
-        img = QImage(a.data, w, h, a.strides[0], QImage.Format.Format_Grayscale8)
-    else:
-        img = QImage(a.data, w, h, a.strides[0], QImage.Format.Format_RGB888)
-    return img.copy()  # own the pixels: `a` dies with this call
+_to_qimage = to_qimage  # the name used before the loader module existed
+
+
+def _shutdown(loader: TileLoader, tasks: set) -> None:
+    """When the view is destroyed: stop its worker and cancel its overview build."""
+    loader.shutdown()
+    for task in list(tasks):
+        try:
+            task.cancel()
+        except RuntimeError:  # already deleted by the task manager
+            pass
 
 
 class ImageView(QGraphicsView):
@@ -74,12 +100,24 @@ class ImageView(QGraphicsView):
     cursorMoved(col, row)
     zoomChanged(zoom)
         Screen pixels per image pixel.
+    overviewProgress(percent)
+        The background build of the image's overview pyramid, 0..100.
+    overviewFinished(ok, message)
+        The build ended: built, failed (message says why) or cancelled.
+    loadFailed(message)
+        A background read failed (message names the file).
+    tilesIdle()
+        Every tile of the visible area at the zoom's level is on screen.
     """
 
     pointPicked = pyqtSignal(float, float)  # noqa: N815 - Qt signal naming
     pointMoved = pyqtSignal(object, float, float)  # noqa: N815 - Qt signal naming
     cursorMoved = pyqtSignal(float, float)  # noqa: N815 - Qt signal naming
     zoomChanged = pyqtSignal(float)  # noqa: N815 - Qt signal naming
+    overviewProgress = pyqtSignal(float)  # noqa: N815 - Qt signal naming
+    overviewFinished = pyqtSignal(bool, str)  # noqa: N815 - Qt signal naming
+    loadFailed = pyqtSignal(str)  # noqa: N815 - Qt signal naming
+    tilesIdle = pyqtSignal()  # noqa: N815 - Qt signal naming
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -99,6 +137,7 @@ class ImageView(QGraphicsView):
         self.hit_test: Callable[[float, float, float], object] | None = None
         self._tiles: dict[tuple[int, int, int], QGraphicsPixmapItem] = {}
         self._background: QGraphicsPixmapItem | None = None
+        self._placeholder: QGraphicsRectItem | None = None
         self._level = -1
         self._press: QPointF | None = None
         self._pan_from: QPointF | None = None
@@ -109,44 +148,241 @@ class ImageView(QGraphicsView):
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
         self._timer.setInterval(0)
-        self._timer.timeout.connect(self.update_tiles)
+        self._timer.timeout.connect(self._request_tiles)
         self.magnifier = QLabel(self.viewport())
         self.magnifier.setObjectName("lidarphotoMagnifier")
         self.magnifier.setFixedSize(168, 168)
         self.magnifier.setStyleSheet("border: 2px solid #ffd400; background: #202020;")
         self.magnifier.hide()
         self.magnifier_factor = 4.0
+        #: what the background work is doing (shown at the bottom of the view)
+        self.status_label = QLabel(self.viewport())
+        self.status_label.setObjectName("lidarphotoImageStatus")
+        self.status_label.setStyleSheet(
+            "color: #ffffff; background: rgba(0, 0, 0, 170); padding: 3px;"
+        )
+        self.status_label.hide()
+        # -- background work
+        self._loader = TileLoader()
+        self._loader.previewReady.connect(self._on_preview)
+        self._loader.tileReady.connect(self._on_tile)
+        self._loader.failed.connect(self._on_failed)
+        self._sgen = 0
+        self._pending: list[tuple[int, int, int]] = []
+        self._task: OverviewTask | None = None
+        self._tasks: set = set()
+        self._build_after_preview = False
+        self.preview_shown = False
+        self.last_error = ""
+        self.destroyed.connect(
+            lambda *_a, loader=self._loader, tasks=self._tasks: _shutdown(loader, tasks)
+        )
 
     # -- image --------------------------------------------------------------------------------
-    def set_source(self, source: ImageSource | None) -> None:
-        """Show an image (None clears the view); fits it in the view."""
+    def set_source(self, source: ImageSource | None, build_overviews: bool = True) -> None:
+        """Show an image (None clears the view); fits it in the view.
+
+        Returns at once: an image whose whole-image read is slow (no overviews) is shown as a
+        placeholder, then as a coarse preview read in the worker thread; with
+        ``build_overviews`` its missing pyramid is built in the background (a running build of
+        the previous image is cancelled).
+        """
+        self._cancel_build()
+        self._build_after_preview = False
         for item in self._tiles.values():
             self.scene().removeItem(item)
         self._tiles.clear()
-        if self._background is not None:
-            self.scene().removeItem(self._background)
-            self._background = None
+        for item in (self._background, self._placeholder):
+            if item is not None:
+                self.scene().removeItem(item)
+        self._background = self._placeholder = None
+        self._pending = []
         self.source = source
         self._level = -1
+        self.preview_shown = False
+        self.last_error = ""
+        self._sgen = self._loader.set_source(source)
         if source is None:
+            self._status("")
             return
         w, h = source.width, source.height
         # room around the image so that any pixel can be brought to the centre of the view
         self.setSceneRect(QRectF(-w / 2, -h / 2, 2 * w, 2 * h))
-        f = max(1.0, max(w, h) / _BACKGROUND_SIDE)
-        a = source.read(0, 0, w, h, max(1, round(w / f)), max(1, round(h / f)))
-        self._background = self._pixmap_item(a, 0, 0, w, h, z=-10.0)
+        self._placeholder = QGraphicsRectItem(0.0, 0.0, float(w), float(h))
+        self._placeholder.setBrush(QBrush(QColor(70, 70, 70)))
+        self._placeholder.setPen(QPen(Qt.PenStyle.NoPen))
+        self._placeholder.setZValue(_Z_PLACEHOLDER)
+        self.scene().addItem(self._placeholder)
+        self._build_after_preview = bool(build_overviews and source.needs_overviews)
+        if source.quick:  # a pyramid level or the image itself is small: read it now
+            self._show_background(source.stretch(source.sample()))
+        else:
+            self._status(f"Reading a preview of {source.path.name}…")
+            self._loader.request_preview()
+        if self.preview_shown:
+            self._start_pending_build()
         self.fit()
 
+    def _show_background(self, image) -> None:
+        if self._background is not None:
+            self.scene().removeItem(self._background)
+        qimage = image if isinstance(image, QImage) else to_qimage(image)
+        w, h = self.source.width, self.source.height
+        self._background = self._pixmap_item(qimage, 0, 0, w, h, z=_Z_BACKGROUND)
+        self.preview_shown = True
+
     def _pixmap_item(self, a, x0, y0, w, h, z) -> QGraphicsPixmapItem:
-        item = QGraphicsPixmapItem(QPixmap.fromImage(_to_qimage(a)))
+        qimage = a if isinstance(a, QImage) else to_qimage(a)
+        item = QGraphicsPixmapItem(QPixmap.fromImage(qimage))
         item.setTransformationMode(Qt.TransformationMode.FastTransformation)  # crisp pixels
-        item.setTransform(QTransform.fromScale(w / a.shape[1], h / a.shape[0]))
+        item.setTransform(QTransform.fromScale(w / qimage.width(), h / qimage.height()))
         item.setPos(x0, y0)
         item.setZValue(z)
         self.scene().addItem(item)
         return item
 
+    # -- background work ----------------------------------------------------------------------
+    def _status(self, text: str) -> None:
+        if not text:
+            self.status_label.hide()
+            return
+        self.status_label.setText(text)
+        self.status_label.adjustSize()
+        self.status_label.move(6, max(0, self.viewport().height() - self.status_label.height() - 6))
+        self.status_label.show()
+
+    def _start_build(self, source: ImageSource) -> None:
+        task = OverviewTask(source)
+        self._task = task
+        self._tasks.add(task)
+        _LIVE_TASKS.add(task)
+        task.progressChanged.connect(self._on_build_progress)
+        task.done.connect(lambda ok, msg, task=task: self._on_build_done(task, ok, msg))
+        self._status(f"Building the overview pyramid of {source.path.name}: 0 %")
+        QgsApplication.taskManager().addTask(task)
+
+    def _cancel_build(self) -> None:
+        task, self._task = self._task, None
+        if task is not None:
+            try:
+                task.cancel()
+            except RuntimeError:
+                pass
+
+    def building(self) -> bool:
+        """Whether the overview build of the current image runs (or waits for the preview)."""
+        return self._task is not None or self._build_after_preview
+
+    def shutdown(self, timeout_s: float = 30.0) -> bool:
+        """Clear the view, cancel its overview build and wait until its background work has
+        ended (e.g. when the plugin unloads). True when everything stopped in time."""
+        self.set_source(None)
+        t_end = time.perf_counter() + timeout_s
+        app = QApplication.instance()
+        while self._tasks and time.perf_counter() < t_end:
+            app.processEvents()  # a cancelled task reports its end through the event loop
+            time.sleep(0.005)
+        return self._loader.join(max(0.0, t_end - time.perf_counter())) and not self._tasks
+
+    def background_tasks(self) -> int:
+        """Overview builds of this view not ended yet (a cancelled one ends shortly after)."""
+        return len(self._tasks)
+
+    def _on_build_progress(self, pct: float) -> None:
+        if self.sender() is not self._task or self.source is None:
+            return
+        self._status(f"Building the overview pyramid of {self.source.path.name}: {pct:.0f} %")
+        self.overviewProgress.emit(float(pct))
+
+    def _on_build_done(self, task: OverviewTask, ok: bool, message: str) -> None:
+        self._tasks.discard(task)
+        _LIVE_TASKS.discard(task)
+        if task is not self._task:  # the build of an image no longer shown (cancelled)
+            return
+        self._task = None
+        src = self.source
+        if ok and src is not None:
+            src.reopen()  # now it sees the pyramid
+            self._loader.reopen()
+            self._status("")
+            if src.quick:  # the pyramid's averaged level replaces the decimated preview
+                self._show_background(src.stretch(src.sample()))
+            # tiles above level 0 were decimated from full resolution: read the pyramid's
+            for key in [k for k in self._tiles if k[0] > 0]:
+                self.scene().removeItem(self._tiles.pop(key))
+            self._pending = []
+            self._schedule()
+        else:
+            self._status(message)
+        self.overviewFinished.emit(ok, message)
+
+    def _on_preview(self, sgen: int, qimage: QImage, limits) -> None:
+        if sgen != self._sgen or self.source is None:
+            return
+        if limits is not None and self.source.stretch_limits is None:
+            self.source.set_stretch_limits(*limits)
+        self._show_background(qimage)
+        if self._task is None:
+            self._status("")
+        self._start_pending_build()
+
+    def _start_pending_build(self) -> None:
+        """The pyramid build starts once the preview is shown: both read the whole image, and
+        on a tiled file (every tile decoded) running them together delays the preview ~2x."""
+        if self._build_after_preview and self.source is not None and self._task is None:
+            self._build_after_preview = False
+            self._start_build(self.source)
+
+    def _on_failed(self, sgen: int, message: str) -> None:
+        if sgen != self._sgen:
+            return
+        self.last_error = message
+        self._pending = []
+        self._status(message)
+        self._build_after_preview = False  # an unreadable image gets no pyramid either
+        self.loadFailed.emit(message)
+
+    def _on_tile(self, sgen: int, key, qimage: QImage) -> None:
+        if sgen != self._sgen or self.source is None:
+            return
+        if key in self._pending:
+            self._pending.remove(key)
+        if key[0] == self._level and key not in self._tiles:
+            _level, tx, ty = key
+            span = TILE * 2 ** key[0]
+            x0, y0 = tx * span, ty * span
+            w, h = min(span, self.source.width - x0), min(span, self.source.height - y0)
+            self._tiles[key] = self._pixmap_item(qimage, x0, y0, w, h, z=_Z_TILE)
+            self.tiles_loaded += 1
+        if not self._pending:
+            self._request_tiles()  # drops the other levels when this one is complete
+
+    def pending_tiles(self) -> int:
+        """Tiles requested from the worker and not arrived yet."""
+        return len(self._pending)
+
+    def busy(self) -> bool:
+        """Whether a preview or tiles are still being read, or the pyramid built."""
+        return bool(self._pending) or self._loader.busy() or self.building()
+
+    def wait_idle(self, timeout_s: float = 60.0, build: bool = True) -> bool:
+        """Process events until the visible tiles are all shown (and, with ``build``, the
+        pyramid is built); for tests and benchmarks. Returns False on timeout."""
+        app = QApplication.instance()
+        t_end = time.perf_counter() + timeout_s
+        while time.perf_counter() < t_end:
+            app.processEvents()
+            if self._timer.isActive():
+                continue
+            if self.last_error:
+                return False
+            waiting = bool(self._pending) or (self.source is not None and not self.preview_shown)
+            if not waiting and not (build and self.building()):
+                return True
+            time.sleep(0.002)
+        return False
+
+    # -- tiles --------------------------------------------------------------------------------
     @property
     def zoom(self) -> float:
         """Screen pixels per image pixel."""
@@ -163,41 +399,104 @@ class ImageView(QGraphicsView):
         top = max(0, math.ceil(math.log2(max(self.source.width, self.source.height) / TILE)))
         return int(min(top, max(0, math.floor(math.log2(1.0 / max(self.zoom, 1e-9))))))
 
+    def visible_tiles(self) -> tuple[int, list[TileRequest]]:
+        """The zoom's level and its tiles covering the view, nearest to the centre first."""
+        src = self.source
+        level = self.level_for_zoom()
+        if src is None:
+            return level, []
+        f = 2**level
+        span = TILE * f
+        r = self.visible_rect().intersected(QRectF(0, 0, src.width, src.height))
+        if r.isEmpty():
+            return level, []
+        tx0, ty0 = int(r.left() // span), int(r.top() // span)
+        tx1, ty1 = math.ceil(r.right() / span), math.ceil(r.bottom() / span)
+        cx, cy = r.center().x(), r.center().y()
+        out = []
+        for ty in range(ty0, ty1):
+            for tx in range(tx0, tx1):
+                x0, y0 = tx * span, ty * span
+                w, h = min(span, src.width - x0), min(span, src.height - y0)
+                ow, oh = max(1, math.ceil(w / f)), max(1, math.ceil(h / f))
+                out.append(TileRequest((level, tx, ty), x0, y0, w, h, ow, oh))
+        out.sort(key=lambda t: math.hypot(t.x0 + t.w / 2 - cx, t.y0 + t.h / 2 - cy))
+        return level, out
+
+    def _enter_level(self, level: int, keep_others: bool) -> None:
+        if level == self._level:
+            return
+        self._level = level
+        for key in [k for k in self._tiles if k[0] != level]:
+            if keep_others:  # shown under the new level until it is complete
+                self._tiles[key].setZValue(_Z_OLD_LEVEL)
+            else:
+                self.scene().removeItem(self._tiles.pop(key))
+
+    def _drop_other_levels(self) -> None:
+        for key in [k for k in self._tiles if k[0] != self._level]:
+            self.scene().removeItem(self._tiles.pop(key))
+
     def update_tiles(self) -> None:
-        """Load the tiles of the visible area at the zoom's level; drop the others."""
+        """Load the tiles of the visible area at the zoom's level now, in this thread; drop
+        the others. (The view itself loads them in the background: see the module notes.)"""
         src = self.source
         if src is None:
             return
-        level = self.level_for_zoom()
-        f = 2**level
-        span = TILE * f
-        if level != self._level:  # another level: its tiles replace the previous ones
-            for key in [k for k in self._tiles if k[0] != level]:
-                self.scene().removeItem(self._tiles.pop(key))
-            self._level = level
-        r = self.visible_rect().intersected(QRectF(0, 0, src.width, src.height))
-        if r.isEmpty():
+        level, tiles = self.visible_tiles()
+        self._enter_level(level, keep_others=False)
+        self._drop_other_levels()
+        for t in tiles:
+            if t.key in self._tiles:
+                continue
+            a = src.read(t.x0, t.y0, t.w, t.h, t.out_w, t.out_h)
+            self._tiles[t.key] = self._pixmap_item(a, t.x0, t.y0, t.w, t.h, z=_Z_TILE)
+            self.tiles_loaded += 1
+        self._pending = [k for k in self._pending if k not in self._tiles]
+        self._trim()
+
+    def _request_tiles(self) -> None:
+        """Ask the worker for the missing visible tiles (coarse ones stay until they come)."""
+        if self.source is None:
             return
-        tx0, ty0 = int(r.left() // span), int(r.top() // span)
-        tx1, ty1 = math.ceil(r.right() / span), math.ceil(r.bottom() / span)
-        for ty in range(ty0, ty1):
-            for tx in range(tx0, tx1):
-                key = (level, tx, ty)
-                if key in self._tiles:
-                    continue
-                x0, y0 = tx * span, ty * span
-                w, h = min(span, src.width - x0), min(span, src.height - y0)
-                a = src.read(x0, y0, w, h, max(1, math.ceil(w / f)), max(1, math.ceil(h / f)))
-                self._tiles[key] = self._pixmap_item(a, x0, y0, w, h, z=-5.0)
-                self.tiles_loaded += 1
-        if len(self._tiles) > _MAX_TILES:  # forget the tiles farthest from the view
-            cx, cy = r.center().x(), r.center().y()
-            far = sorted(
-                self._tiles,
-                key=lambda k: -math.hypot((k[1] + 0.5) * span - cx, (k[2] + 0.5) * span - cy),
-            )
-            for key in far[: len(self._tiles) - _MAX_TILES]:
-                self.scene().removeItem(self._tiles.pop(key))
+        level, tiles = self.visible_tiles()
+        if self._preview_suffices():
+            tiles = []
+        self._enter_level(level, keep_others=True)
+        missing = [t for t in tiles if t.key not in self._tiles]
+        if not missing:
+            self._pending = []
+            self._drop_other_levels()
+            self._trim()
+            self.tilesIdle.emit()
+            return
+        keys = [t.key for t in missing]
+        if keys != self._pending:  # a request the worker already has is not repeated
+            self._pending = keys
+            self._loader.request_tiles(missing)
+
+    def _preview_suffices(self) -> bool:
+        """Without a pyramid yet, a zoomed-out view keeps the preview instead of tiles: each
+        tile would be decimated from full resolution (every strip or tile decoded), competing
+        with the pyramid build, for a picture at most ``_PREVIEW_UPSCALE`` x sharper."""
+        src = self.source
+        if src is None or src.overview_count or self.last_error or not self.building():
+            return False  # (a preview not shown yet is on its way: the worker reads it first)
+        preview_scale = src.stretch_sample_size()[0] / src.width  # preview px per image px
+        return self.zoom <= _PREVIEW_UPSCALE * preview_scale
+
+    def _trim(self) -> None:
+        if len(self._tiles) <= _MAX_TILES:
+            return
+        r = self.visible_rect()
+        cx, cy = r.center().x(), r.center().y()
+
+        def distance(k):
+            span = TILE * 2 ** k[0]
+            return math.hypot((k[1] + 0.5) * span - cx, (k[2] + 0.5) * span - cy)
+
+        for key in sorted(self._tiles, key=distance, reverse=True)[: len(self._tiles) - _MAX_TILES]:
+            self.scene().removeItem(self._tiles.pop(key))
 
     def tile_count(self) -> int:
         return len(self._tiles)
@@ -249,6 +548,8 @@ class ImageView(QGraphicsView):
 
     def resizeEvent(self, event) -> None:
         super().resizeEvent(event)
+        if self.status_label.isVisible():  # keep it in the bottom-left corner
+            self._status(self.status_label.text())
         self._schedule()
 
     def wheelEvent(self, event) -> None:

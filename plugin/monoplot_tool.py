@@ -4,12 +4,15 @@ the QGIS map at once (core.monoplot on a LiDAR DSM).
 The tool borrows the dock's image view while it is active: the view's ``pointPicked`` signal
 goes to the tool instead of the dock's own picking, and is handed back by :meth:`stop`. It
 uses the dock's camera, exterior orientation, mapping CRS and current image, and writes to two
-memory layers (PointZ and LineStringZ, in the mapping CRS) that it adds to the project.
+memory layers (PointZ and LineStringZ, in the mapping CRS) that it adds to the project;
+:meth:`save` writes them to a GeoPackage. The dock's *Monoplot* button drives it
+(``ImagePickingDock.set_monoplot``); the vertices of a line in progress are drawn in the image.
 """
 
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 from qgis.core import (
@@ -22,7 +25,9 @@ from qgis.core import (
     QgsProject,
     QgsVectorLayer,
 )
-from qgis.PyQt.QtCore import QCoreApplication, QObject, pyqtSignal
+from qgis.PyQt.QtCore import QCoreApplication, QObject, QPointF, Qt, pyqtSignal
+from qgis.PyQt.QtGui import QColor, QPainterPath, QPen
+from qgis.PyQt.QtWidgets import QGraphicsPathItem
 
 from ..processing_provider.compat import FIELD_DOUBLE, FIELD_INT, FIELD_STRING
 
@@ -52,6 +57,7 @@ class MonoplotTool(QObject):
         self.vertices: list[tuple[float, float]] = []
         self.points_layer: QgsVectorLayer | None = None
         self.lines_layer: QgsVectorLayer | None = None
+        self._sketch: QGraphicsPathItem | None = None
 
     def tr(self, text: str) -> str:
         return QCoreApplication.translate("MonoplotTool", text)
@@ -63,6 +69,22 @@ class MonoplotTool(QObject):
         from ..core.monoplot import DsmTracer
 
         self.tracer = DsmTracer.build(load_dsm(path, cell_size, crs))
+
+    def crs_problem(self, eo_crs_wkt: str) -> str:
+        """A message when the loaded DSM is in another CRS than the exterior orientation ("" when
+        they agree, or when the DSM has no CRS: it is then taken to be the mapping CRS)."""
+        import pyproj
+
+        dsm = self.tracer.dsm if self.tracer is not None else None
+        if dsm is None or dsm.crs is None or not eo_crs_wkt:
+            return ""
+        eo_crs = pyproj.CRS.from_user_input(eo_crs_wkt)
+        if dsm.crs.equals(eo_crs, ignore_axis_order=True):
+            return ""
+        return self.tr(
+            "The DSM {} is in '{}' but the exterior orientation in '{}': reproject the DSM "
+            "(or give its CRS) first."
+        ).format(dsm.source, dsm.crs.name, eo_crs.name)
 
     def start(self, mode: str = "point") -> None:
         """Take over the dock's clicks: ``"point"`` or ``"line"`` (finish with finish_line)."""
@@ -80,6 +102,7 @@ class MonoplotTool(QObject):
             self.dock.view.pointPicked.disconnect(self._picked)
             self.dock.view.pointPicked.connect(self.dock.pick)
         self.mode = ""
+        self._draw_sketch()
 
     # ------------------------------------------------------------------ work
     def monoplot(self, pixels, image_id: str | None = None, line: bool = False):
@@ -102,9 +125,30 @@ class MonoplotTool(QObject):
             sigma_dsm=self.sigma_dsm, line_step_px=self.line_step_px if line else 0.0,
         )  # fmt: skip
 
+    def _oriented(self) -> bool:
+        """The current image has a file and an orientation; else a message."""
+        dock = self.dock
+        sg = dock.scene_geometry
+        if sg is None or not sg.has_image(dock.current_image):
+            self.message.emit(
+                self.tr("Image {} has no exterior orientation: nothing to monoplot.").format(
+                    dock.current_image
+                )
+            )
+            return False
+        return True
+
     def _picked(self, col: float, row: float) -> None:
+        if not self._oriented():
+            return
         if self.mode == "line":
             self.vertices.append((col, row))
+            self._draw_sketch()
+            self.message.emit(
+                self.tr("Line vertex {} (Enter or a double click ends the line).").format(
+                    len(self.vertices)
+                )
+            )
             return
         try:
             res = self.monoplot([(col, row)])
@@ -112,12 +156,46 @@ class MonoplotTool(QObject):
             self.message.emit(str(exc))
             return
         self._add_points(res)
+        from ..core.monoplot import STATUS_TEXT
+
+        p, st = res.points[0], int(res.status[0])
+        if np.isfinite(p).all():
+            self.message.emit(
+                self.tr("3D point {:.3f}, {:.3f}, {:.3f} (sigma Z {:.3f} m, {}).").format(
+                    *p, float(res.sigmas[0, 2]), STATUS_TEXT[st]
+                )
+            )
+        else:
+            self.message.emit(self.tr("No 3D point: {}.").format(STATUS_TEXT[st]))
         self.pointMonoplotted.emit(res)
+
+    def _draw_sketch(self) -> None:
+        """The vertices of the line in progress, as a polyline in the image."""
+        scene = self.dock.view.scene()
+        if self._sketch is not None:
+            scene.removeItem(self._sketch)
+            self._sketch = None
+        if self.mode != "line" or not self.vertices:
+            return
+        path = QPainterPath(QPointF(*self.vertices[0]))
+        for v in self.vertices[1:]:
+            path.lineTo(QPointF(*v))
+        for v in self.vertices:
+            path.addEllipse(QPointF(*v), 2.0, 2.0)
+        pen = QPen(QColor(0, 255, 255), 2.0, Qt.PenStyle.SolidLine)
+        pen.setCosmetic(True)
+        self._sketch = QGraphicsPathItem(path)
+        self._sketch.setPen(pen)
+        self._sketch.setZValue(50.0)
+        scene.addItem(self._sketch)
 
     def finish_line(self) -> int:
         """Monoplot the clicked vertices as one 3D line; returns its number of vertices."""
         vertices, self.vertices = self.vertices, []
+        self._draw_sketch()
         if self.mode != "line" or len(vertices) < 2:
+            if self.mode == "line" and vertices:
+                self.message.emit(self.tr("A line needs two vertices or more."))
             return 0
         res = self.monoplot(vertices, line=True)
         self._add_points(res)
@@ -171,3 +249,33 @@ class MonoplotTool(QObject):
         layer.dataProvider().addFeatures(features)
         layer.updateExtents()
         layer.triggerRepaint()
+
+    # ------------------------------------------------------------------ saving
+    def save(self, path: str) -> list[str]:
+        """Write the points and lines layers (those that exist) to the GeoPackage ``path``
+        (created, or its tables replaced); returns the names of the tables written."""
+        from qgis.core import QgsVectorFileWriter
+
+        written: list[str] = []
+        for layer, name in ((self.points_layer, "monoplot_points"),
+                            (self.lines_layer, "monoplot_lines")):  # fmt: skip
+            if layer is None or not layer.isValid() or layer.featureCount() == 0:
+                continue
+            options = QgsVectorFileWriter.SaveVectorOptions()
+            options.driverName = "GPKG"
+            options.layerName = name
+            first = not written and not os.path.exists(path)
+            options.actionOnExistingFile = (
+                QgsVectorFileWriter.ActionOnExistingFile.CreateOrOverwriteFile
+                if first
+                else QgsVectorFileWriter.ActionOnExistingFile.CreateOrOverwriteLayer
+            )
+            ctx = self.project.transformContext()
+            if hasattr(QgsVectorFileWriter, "writeAsVectorFormatV3"):
+                res = QgsVectorFileWriter.writeAsVectorFormatV3(layer, path, ctx, options)
+            else:  # pragma: no cover - QGIS < 3.20
+                res = QgsVectorFileWriter.writeAsVectorFormatV2(layer, path, ctx, options)
+            if res[0] != QgsVectorFileWriter.WriterError.NoError:
+                raise RuntimeError(f"{path}: {res[1]}")
+            written.append(name)
+        return written

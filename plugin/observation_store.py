@@ -6,7 +6,8 @@ followed at once by a save of the whole table to the observation CSV of
 atomically (temporary file in the same folder, then ``os.replace``): the file on disk is always
 a complete table, whatever happens to QGIS.
 
-The session (paths of the camera, EO, observation and calibration files, images and layers) is
+The session (paths of the camera, EO, observation and calibration files, images, layers and the
+monoplotting DSM) is
 kept in the QGIS project (``QgsProject.writeEntry`` under the scope ``lidarphoto_picking``), so
 reopening the project restores it.
 """
@@ -55,6 +56,9 @@ SESSION_KEYS = (
     "mount",
     "boresight",
     "current_image",
+    "dsm_layer",
+    "dsm_file",
+    "dsm_cell",
 )
 
 

@@ -145,6 +145,8 @@ class LidarPhotoPlugin:
     # -- unload -------------------------------------------------------------------------------
     def unload(self) -> None:
         if self.image_dock is not None:
+            self.image_dock.set_monoplot(False)  # hands the clicks back, ends a line in progress
+            self.image_dock.view.shutdown()  # stops the tile reader and any pyramid build
             self.image_dock.store.save()
             self.image_dock.remove_footprint()
             if self.iface is not None:

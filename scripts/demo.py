@@ -12,6 +12,15 @@
 5. Check points intersected from the images with the initial (uncalibrated) and the calibrated
    orientations, against their true positions: ``lidarphoto accuracyreport`` for both.
 6. The recovered boresight against the truth.
+7. The images themselves, rendered by ray casting (``core.render``) from the camera and each
+   image's *true* orientation onto the tile's DSM and roof planes, in flight/images/, and the
+   check that the projected LiDAR lines fall on the rendered roof edges.
+8. The QGIS project demo_output/lidarphoto_demo.qgz (scripts/make_demo_project.py, run with
+   QGIS's Python when one is installed): layers, DSM and the picking dock's session
+   (docs/demo_project.md).
+
+Steps 2-3 and 7 are functions (``lidar_step``, ``flight_step``, ``render_step``) that
+tests/qgis/test_demo_project.py calls for a smaller demo (fewer images, lower resolution).
 
 Heights: the tile is in RD New + NAP; without the NAP geoid grid installed (PROJ), the
 calibration treats the heights as ellipsoidal (EPSG:28992). The simulation is made in that
@@ -22,24 +31,45 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import shutil
 import subprocess
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from lidarphoto.core.boresight import local_frame_for
 from lidarphoto.core.boresight_run import forward_intersection
+from lidarphoto.core.camera import Camera
+from lidarphoto.core.dsm import dsm_from_las
 from lidarphoto.core.frames import MappingFrame
 from lidarphoto.core.io.control import read_lcps_csv, read_lines_csv
 from lidarphoto.core.io.observations import read_observations_csv
 from lidarphoto.core.io.tables import write_csv_atomic
-from lidarphoto.core.orientation import read_eo_csv
+from lidarphoto.core.orientation import ExteriorOrientationTable, read_eo_csv
+from lidarphoto.core.picking import PickingScene
 from lidarphoto.core.planes import read_planes_csv
 from lidarphoto.core.pointcloud import read_points
-from lidarphoto.core.simulate_flight import ControlFlightConfig, simulate_flight_over
-from lidarphoto.core.trajectory_to_eo import read_trajectory_csv
+from lidarphoto.core.render import (
+    RenderOptions,
+    RenderScene,
+    edge_offsets,
+    render_image,
+    write_rgb_tiff,
+)
+from lidarphoto.core.simulate_flight import (
+    ControlFlightConfig,
+    ControlFlightSimulation,
+    simulate_flight_over,
+)
+from lidarphoto.core.trajectory_to_eo import (
+    Mount,
+    Trajectory,
+    direct_georeference,
+    read_trajectory_csv,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLE = ROOT / "sample_data" / "trajectory_demo.csv"
@@ -49,6 +79,8 @@ CRS = "EPSG:28992"  # the tile's RD New, heights taken as ellipsoidal (module do
 ARCSEC = np.pi / (180.0 * 3600.0)
 TRUE_BORESIGHT_DEG = (0.12, -0.25, 0.40)
 LEVER_ARM = (0.10, -0.05, -0.20)
+DSM_CELL = 0.5  # metres: about 2 AHN3 points per cell
+PROJECT_SCRIPT = ROOT / "scripts" / "make_demo_project.py"
 
 
 def lidarphoto(*args: str) -> None:
@@ -84,17 +116,23 @@ def write_points(path: Path, ids, xyz) -> None:
     )
 
 
-def main() -> int:
-    start = time.perf_counter()
-    if OUT.exists():
-        shutil.rmtree(OUT)
-    OUT.mkdir()
-    georeferencing_step()
+@dataclass(frozen=True)
+class Lidar:
+    """The outputs of the LiDAR step, read back."""
 
-    # ---- 2. the real tile: ground, roof planes, LiDAR control
-    lidar = OUT / "lidar"
-    lidar.mkdir()
-    lidarphoto("groundfilter", "--input", str(TILE), "--output-cloud", str(lidar / "ground.laz"))
+    folder: Path
+    planes: list
+    lines: list
+    lcps: list
+    xyz: np.ndarray
+    classification: np.ndarray
+    plane_id: np.ndarray
+
+
+def lidar_step(lidar: Path, tile: Path = TILE) -> Lidar:
+    """Step 2: ground filter, roof planes, LiDAR control of the real tile (command line)."""
+    lidar.mkdir(parents=True, exist_ok=True)
+    lidarphoto("groundfilter", "--input", str(tile), "--output-cloud", str(lidar / "ground.laz"))
     lidarphoto(
         "extractroofplanes", "--input", str(lidar / "ground.laz"),
         "--output-csv", str(lidar / "planes.csv"), "--output-cloud", str(lidar / "planes.laz"),
@@ -103,22 +141,177 @@ def main() -> int:
         "createlcps", "--planes", str(lidar / "planes.csv"), "--cloud", str(lidar / "planes.laz"),
         "--points-csv", str(lidar / "lcps.csv"), "--lines-csv", str(lidar / "lines.csv"),
     )  # fmt: skip
-    planes = read_planes_csv(lidar / "planes.csv")
-    lines = read_lines_csv(lidar / "lines.csv")
-    lcps = read_lcps_csv(lidar / "lcps.csv")
-    arrays, _ = read_points(lidar / "planes.laz", ("x", "y", "z", "plane_id"))
-    xyz = np.column_stack([arrays["x"], arrays["y"], arrays["z"]])
+    arrays, _ = read_points(lidar / "planes.laz", ("x", "y", "z", "classification", "plane_id"))
+    return Lidar(
+        lidar,
+        read_planes_csv(lidar / "planes.csv"),
+        read_lines_csv(lidar / "lines.csv"),
+        read_lcps_csv(lidar / "lcps.csv"),
+        np.column_stack([arrays["x"], arrays["y"], arrays["z"]]),
+        arrays["classification"],
+        arrays["plane_id"],
+    )
 
-    # ---- 3. images simulated over the real roofs, with a known boresight
+
+def flight_step(
+    lidar: Lidar, flight: Path, camera: Camera | None = None, images_per_line: int = 5
+) -> tuple[ControlFlightSimulation, dict[str, Path], ExteriorOrientationTable]:
+    """Step 3: a flight simulated over the tile's roofs; writes its inputs, the truth and the
+    true exterior orientation (flight/eo_true.csv, what the images are rendered with)."""
+    xyz = lidar.xyz
+    extra = {} if camera is None else {"camera": camera}
     config = ControlFlightConfig(
         crs=CRS,
         centre=tuple(float(v) for v in (xyz[:, :2].min(axis=0) + xyz[:, :2].max(axis=0)) / 2),
         true_boresight_deg=(TRUE_BORESIGHT_DEG,),
         lever_arm_m=LEVER_ARM,
+        images_per_line=images_per_line,
+        **extra,
     )
-    sim = simulate_flight_over(planes, lines, lcps, xyz, arrays["plane_id"], config, seed=5)
-    flight = OUT / "flight"
+    sim = simulate_flight_over(
+        lidar.planes, lidar.lines, lidar.lcps, xyz, lidar.plane_id, config, seed=5
+    )
     paths = sim.write(flight)
+    eo = true_eo(sim)
+    eo.to_csv(flight / "eo_true.csv")
+    paths["eo_true"] = flight / "eo_true.csv"
+    return sim, paths, eo
+
+
+def true_eo(sim: ControlFlightSimulation) -> ExteriorOrientationTable:
+    """The images' true exterior orientation (mapping CRS): the noise-free trajectory through
+    the true lever arm and each group's true boresight."""
+    t = sim.truth.trajectory
+    frame = MappingFrame.from_user_input(sim.config.crs)
+    xyz, opk = np.empty((len(t), 3)), np.empty((len(t), 3))
+    groups = np.array(t.group)
+    for g, bore in sim.truth.boresight.items():
+        sel = groups == g
+        sub = Trajectory(tuple(np.array(t.image_id)[sel]), t.time[sel], tuple(groups[sel]),
+                         t.position[sel], t.geodetic, t.rph[sel])  # fmt: skip
+        table = direct_georeference(sub, Mount(sim.truth.lever_arm, sim.mount.nominal, bore), frame)
+        xyz[sel], opk[sel] = table.xyz, table.opk
+    return ExteriorOrientationTable(t.image_id, t.time, t.group, xyz, opk, frame.crs.to_wkt())
+
+
+def _wkt_polygon_z(ring: np.ndarray) -> str:
+    closed = np.vstack([ring, ring[:1]])
+    return "POLYGON Z ((" + ", ".join(f"{x:.4f} {y:.4f} {z:.4f}" for x, y, z in closed) + "))"
+
+
+def render_step(
+    lidar: Lidar,
+    sim: ControlFlightSimulation,
+    eo: ExteriorOrientationTable,
+    images: Path,
+    options: RenderOptions | None = None,
+) -> dict:
+    """Step 7: the DSM (lidar/dsm.tif), the plane outlines of the rendering
+    (lidar/plane_outlines.csv, with WKT), the images rendered with the true orientation, and
+    the distance from the projected LiDAR lines to the rendered edges. Returns the figures."""
+    t0 = time.perf_counter()
+    dsm = dsm_from_las(lidar.folder / "planes.laz", DSM_CELL, crs=CRS)
+    dsm.to_geotiff(lidar.folder / "dsm.tif")
+    scene = RenderScene.build(dsm, lidar.xyz, lidar.classification, lidar.plane_id,
+                              lidar.planes, lidar.lines, crs=CRS)  # fmt: skip
+    outlines = scene.outlines()
+    write_csv_atomic(
+        lidar.folder / "plane_outlines.csv",
+        ("id", "a", "b", "c", "d", "slope_deg", "aspect_deg", "n_points", "rms", "sigma_d", "wkt"),
+        [
+            (p.id, *(repr(float(v)) for v in (*p.normal, p.d, p.slope_deg, p.aspect_deg)),
+             p.n_points, repr(float(p.rms)), repr(float(p.sigma_d)), _wkt_polygon_z(outlines[p.id]))
+            for p in lidar.planes if p.id in outlines
+        ],
+    )  # fmt: skip
+    prep_s = time.perf_counter() - t0
+    cam = sim.camera
+    opt = options or RenderOptions()
+    seconds, offsets = [], []
+    picking = PickingScene(eo, cam, CRS)  # the project's projection chain, not the renderer's
+    ends = np.array([[ln.start, ln.end] for ln in lidar.lines]).reshape(-1, 3)
+    pairs = [ln.plane_ids for ln in lidar.lines]
+    images.mkdir(parents=True, exist_ok=True)
+    for k, name in enumerate(eo.image_id):
+        img = render_image(scene, cam, eo.xyz[k], eo.opk[k], _with_seed(opt, k))
+        t1 = time.perf_counter()
+        write_rgb_tiff(images / f"{name}.tif", img.rgb)
+        seconds.append((img.seconds, time.perf_counter() - t1))
+        px = picking.project(name, ends)
+        off, _ = edge_offsets(img.plane_id, px[0::2], px[1::2], pairs)
+        offsets.append(off)
+    off = np.abs(np.concatenate(offsets)) if offsets else np.empty(0)
+    render_s = np.array(seconds).reshape(-1, 2)
+    figures = {
+        "images": len(eo),
+        "size_px": [cam.width_px, cam.height_px],
+        "step_px": opt.step_px,
+        "scene_s": round(prep_s, 2),
+        "render_s_per_image": [round(float(v), 2) for v in render_s[:, 0]],
+        "write_s_per_image": [round(float(v), 2) for v in render_s[:, 1]],
+        "edge_profiles": int(off.size),
+        "edge_offset_median_px": round(float(np.median(off)), 3) if off.size else None,
+        "edge_offset_p95_px": round(float(np.percentile(off, 95)), 3) if off.size else None,
+        "edge_within_1px": round(float(np.mean(off <= 1.0)), 4) if off.size else None,
+    }
+    return figures
+
+
+def _with_seed(options: RenderOptions, k: int) -> RenderOptions:
+    from dataclasses import replace
+
+    return replace(options, seed=options.seed + k)
+
+
+def qgis_python() -> str | None:
+    """A Python that imports qgis.core (the QGIS test venv, then the system one), or None."""
+    env = dict(os.environ, QT_QPA_PLATFORM="offscreen")
+    for exe in (ROOT / ".venv-qgis" / "bin" / "python", Path("/usr/bin/python3")):
+        if exe.exists():
+            ok = subprocess.run([str(exe), "-c", "import qgis.core"], env=env,
+                                capture_output=True).returncode == 0  # fmt: skip
+            if ok:
+                return str(exe)
+    return None
+
+
+def project_command(python: str = "/usr/bin/python3") -> list[str]:
+    return [python, str(PROJECT_SCRIPT), "--demo", str(OUT)]
+
+
+def project_step() -> Path | None:
+    """Step 8: the QGIS project, made by a QGIS Python in its own process (or a hint)."""
+    python = qgis_python()
+    if python is None:
+        print(
+            "\nNo Python with QGIS found: the QGIS project was not made. With QGIS installed, "
+            "make it with:\n  QT_QPA_PLATFORM=offscreen " + " ".join(project_command())
+        )
+        return None
+    env = dict(os.environ, QT_QPA_PLATFORM="offscreen", QGIS_PREFIX_PATH="/usr")
+    env.setdefault("PROJ_DATA", "/usr/share/proj")
+    env.setdefault("XDG_RUNTIME_DIR", "/tmp/xdg-lidarphoto")
+    Path(env["XDG_RUNTIME_DIR"]).mkdir(mode=0o700, exist_ok=True)
+    print("\n$ " + " ".join(project_command(python)), flush=True)
+    subprocess.run(project_command(python), env=env, check=True)
+    return OUT / "lidarphoto_demo.qgz"
+
+
+def main() -> int:
+    start = time.perf_counter()
+    if OUT.exists():
+        shutil.rmtree(OUT)
+    OUT.mkdir()
+    georeferencing_step()
+
+    # ---- 2. the real tile: ground, roof planes, LiDAR control
+    lidar = lidar_step(OUT / "lidar")
+    planes, lines, lcps = lidar.planes, lidar.lines, lidar.lcps
+
+    # ---- 3. images simulated over the real roofs, with a known boresight
+    flight = OUT / "flight"
+    sim, paths, eo_true = flight_step(lidar, flight)
+    config = sim.config
     obs = sim.observations
     kinds, counts = np.unique(np.array(obs.type), return_counts=True)
     cam = sim.camera
@@ -139,8 +332,9 @@ def main() -> int:
         "boresightcalibration", "--camera", str(paths["camera"]),
         "--trajectory", str(paths["trajectory"]), "--crs", CRS, "--lever-arm", lever,
         "--mount", config.mount, "--boresight", "0,0,0",
-        "--observations", str(paths["observations"]), "--planes", str(lidar / "planes.csv"),
-        "--lines", str(lidar / "lines.csv"), "--lcps", str(lidar / "lcps.csv"),
+        "--observations", str(paths["observations"]),
+        "--planes", str(lidar.folder / "planes.csv"), "--lines", str(lidar.folder / "lines.csv"),
+        "--lcps", str(lidar.folder / "lcps.csv"),
         "--grouping", "group", "--control-types", "tie,line,lcp",
         "--output-table", str(cal / "boresight.csv"), "--output-eo", str(cal / "eo.csv"),
         "--residuals-csv", str(cal / "residuals.csv"), "--output-html", str(cal / "summary.html"),
@@ -191,16 +385,40 @@ def main() -> int:
     print(f"{'orientation':12} {'points':>6} {'RMSE E':>8} {'RMSE N':>8} {'RMSE H':>8}")
     for name, (n, e, nn, h) in rmse.items():
         print(f"{name:12} {n:6d} {e:8.3f} {nn:8.3f} {h:8.3f}")
+
+    # ---- 7. the images, rendered with the true orientation, and the check of their geometry
+    t0 = time.perf_counter()
+    figures = render_step(lidar, sim, eo_true, flight / "images")
+    per = figures["render_s_per_image"]
+    print(
+        f"\nRendered {figures['images']} images of {cam.width_px} x {cam.height_px} px "
+        f"({flight.relative_to(ROOT)}/images/, 8-bit RGB TIFF): {np.mean(per):.2f} s per image "
+        f"(max {np.max(per):.2f} s) + {np.mean(figures['write_s_per_image']):.2f} s writing; "
+        f"{time.perf_counter() - t0:.0f} s in all"
+    )
+    print(
+        f"LiDAR lines projected with the true orientation vs the rendered roof edges: "
+        f"{figures['edge_profiles']} profiles, median {figures['edge_offset_median_px']} px, "
+        f"95 % {figures['edge_offset_p95_px']} px, {100 * figures['edge_within_1px']:.1f} % "
+        "within 1 px"
+    )
+
+    # ---- 8. the QGIS project
+    project = project_step()
     summary = {
         "truth_arcsec": true.tolist(),
         "groups": rows,
         "check_rmse_m": {k: list(v[1:]) for k, v in rmse.items()},
+        "rendering": figures,
+        "project": str(project) if project else None,
     }
     (OUT / "demo_summary.json").write_text(json.dumps(summary, indent=2), encoding="utf-8")
     print(
-        f"\nOutputs in {OUT}/: lidar/ (ground, planes, LCPs, lines), flight/ (simulated inputs "
-        "and truth), calibration/ (boresight.csv, eo.csv, residuals.csv, summary.html, "
-        f"accuracy_initial.html, accuracy_calibrated.html); {time.perf_counter() - start:.0f} s"
+        f"\nOutputs in {OUT}/: lidar/ (ground, planes, LCPs, lines, DSM), flight/ (simulated "
+        "inputs, truth, images/), calibration/ (boresight.csv, eo.csv, residuals.csv, "
+        "summary.html, accuracy_initial.html, accuracy_calibrated.html)"
+        + (f", {project.name} (open it in QGIS: docs/demo_project.md)" if project else "")
+        + f"; {time.perf_counter() - start:.0f} s"
     )
     return 0 if worst < 4.0 else 1
 
