@@ -148,6 +148,7 @@ class ImagePickingDock(QgsDockWidget):
         self._build_ui()
         self.monoplot_tool = MonoplotTool(self, self.project)
         self._dsm_key: tuple | None = None
+        self._dsm_note = ""
         self._connect()
         self.restore_session()
 
@@ -1206,30 +1207,20 @@ class ImagePickingDock(QgsDockWidget):
             )
             return False
         crs = self.eo_crs()
-        if layer_crs is not None and layer_crs.isValid() and layer_crs != crs:
-            self.message(
-                self.tr(
-                    "The DSM layer is in {} but the exterior orientation in {}: reproject the "
-                    "DSM (Raster > Projections > Warp) or set the mapping CRS."
-                ).format(layer_crs.authid() or layer_crs.description(), crs.authid()),
-                warning=True,
-            )
-            return False
-        key = (path, cell, crs.authid() or crs.toWkt())
+        # a raster layer's CRS is the one QGIS uses for it (it may have been set by the user)
+        dsm_crs = layer_crs.toWkt() if layer_crs is not None and layer_crs.isValid() else None
+        key = (path, cell, dsm_crs, crs.authid() or crs.toWkt())
         if key != self._dsm_key:
             try:
                 QApplication.setOverrideCursor(Qt.CursorShape.WaitCursor)
                 try:
-                    self.monoplot_tool.set_dsm(path, cell)
+                    note = self.monoplot_tool.set_dsm(path, cell, dsm_crs, crs.toWkt())
                 finally:
                     QApplication.restoreOverrideCursor()
             except (InputError, OSError, ValueError) as exc:
                 self.message(self.tr("DSM not loaded: {}").format(exc), warning=True)
                 return False
-            problem = self.monoplot_tool.crs_problem(crs.toWkt())
-            if problem:
-                self.message(problem, warning=True)
-                return False
+            self._dsm_note = note  # told with the next "Monoplotting on" message
             self._dsm_key = key
         return True
 
@@ -1245,8 +1236,10 @@ class ImagePickingDock(QgsDockWidget):
             if tool.mode == "line":
                 self.finish_monoplot_line()
             tool.start(mode)
+            note, self._dsm_note = self._dsm_note, ""
             self.message(
-                self.tr(
+                (note + " " if note else "")
+                + self.tr(
                     "Monoplotting {}: click in the image; the 3D features appear on the map "
                     "at once.{}"
                 ).format(

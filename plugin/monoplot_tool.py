@@ -63,28 +63,36 @@ class MonoplotTool(QObject):
         return QCoreApplication.translate("MonoplotTool", text)
 
     # ------------------------------------------------------------------ setup
-    def set_dsm(self, path: str, cell_size: float = 0.5, crs: str | None = None) -> None:
-        """Load (or rasterise) the DSM once and prepare it for ray casting."""
-        from ..core.dsm import load_dsm
-        from ..core.monoplot import DsmTracer
+    def set_dsm(
+        self,
+        path: str,
+        cell_size: float = 0.5,
+        crs: str | None = None,
+        target_crs: str | None = None,
+    ) -> str:
+        """Load (or rasterise) the DSM once and prepare it for ray casting.
 
-        self.tracer = DsmTracer.build(load_dsm(path, cell_size, crs))
-
-    def crs_problem(self, eo_crs_wkt: str) -> str:
-        """A message when the loaded DSM is in another CRS than the exterior orientation ("" when
-        they agree, or when the DSM has no CRS: it is then taken to be the mapping CRS)."""
+        ``crs`` overrides the file's CRS; a DSM in another CRS than ``target_crs`` (the
+        exterior orientation's) is resampled into it once, heights transformed (raises
+        CrsError when PROJ cannot, e.g. a missing geoid grid). Returns a note for the user
+        ("" when the DSM was used as it is)."""
         import pyproj
 
-        dsm = self.tracer.dsm if self.tracer is not None else None
-        if dsm is None or dsm.crs is None or not eo_crs_wkt:
-            return ""
-        eo_crs = pyproj.CRS.from_user_input(eo_crs_wkt)
-        if dsm.crs.equals(eo_crs, ignore_axis_order=True):
-            return ""
-        return self.tr(
-            "The DSM {} is in '{}' but the exterior orientation in '{}': reproject the DSM "
-            "(or give its CRS) first."
-        ).format(dsm.source, dsm.crs.name, eo_crs.name)
+        from ..core.dsm import load_dsm, reproject_dsm
+        from ..core.monoplot import DsmTracer
+
+        dsm = load_dsm(path, cell_size, crs)
+        note = ""
+        if target_crs and dsm.crs is not None:
+            target = pyproj.CRS.from_user_input(target_crs)
+            if not dsm.crs.equals(target, ignore_axis_order=True):
+                source = dsm.crs.name
+                dsm = reproject_dsm(dsm, target)
+                note = self.tr(
+                    "The DSM was in '{}': resampled into '{}' (cell {:g}) for monoplotting."
+                ).format(source, target.name, dsm.cell)
+        self.tracer = DsmTracer.build(dsm)
+        return note
 
     def start(self, mode: str = "point") -> None:
         """Take over the dock's clicks: ``"point"`` or ``"line"`` (finish with finish_line)."""

@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from lidarphoto.core.camera import Camera, write_camera_json
-from lidarphoto.core.dsm import dsm_from_las
-from lidarphoto.core.io.observations import read_observations_csv
+from lidarphoto.core.dsm import dsm_from_las, reproject_dsm
+from lidarphoto.core.io.observations import ImageObservations, read_observations_csv
 from lidarphoto.core.monoplot import run_monoplot
 from lidarphoto.core.orientation import ExteriorOrientationTable
 from lidarphoto.core.picking import PickingScene
@@ -21,7 +21,6 @@ from lidarphoto.core.pointcloud import read_points
 from lidarphoto.core.render import RenderOptions, RenderScene, render_image, write_rgb_tiff
 from lidarphoto.plugin.image_dock import ImagePickingDock
 from qgis.core import (
-    QgsCoordinateReferenceSystem,
     QgsFeature,
     QgsGeometry,
     QgsPoint,
@@ -45,6 +44,7 @@ def scene(tmp_path_factory):
     folder = tmp_path_factory.mktemp("monodock")
     dsm = dsm_from_las(AHN3, 0.5, crs=CRS)
     dsm.to_geotiff(folder / "dsm.tif")
+    reproject_dsm(dsm, "EPSG:32631").to_geotiff(folder / "dsm_utm.tif")
     write_camera_json(CAMERA, folder / "camera.json")
     g = dsm.grid
     table = ExteriorOrientationTable(
@@ -63,8 +63,6 @@ def scene(tmp_path_factory):
     truth = np.column_stack([x, y, dsm.height_at(x, y)])
     pixels = PickingScene(table, CAMERA, CRS).project("img1", truth)
     # keep the points the image sees (not hidden by a roof or a tree): as the core finds them
-    from lidarphoto.core.io.observations import ImageObservations
-
     obs = ImageObservations.from_arrays(["img1"] * 60, [f"p{k}" for k in range(60)], pixels,
                                         0.5, ["check"] * 60, ["0"] * 60)  # fmt: skip
     core = run_monoplot(obs, CAMERA, table, dsm, CRS)
@@ -100,21 +98,41 @@ def _xyz(feature) -> np.ndarray:
     return np.array([p.x(), p.y(), p.z()])
 
 
-def test_button_needs_a_dsm_in_the_same_crs(dock, scene):
+def test_button_needs_a_dsm_resamples_one_in_another_crs(dock, scene, qgis_app):
     dock.monoplot_button.click()  # no DSM chosen
     assert not dock.monoplot_button.isChecked() and dock.monoplot_tool.mode == ""
     assert "Choose a DSM" in dock.messages[-1]
-    wrong = QgsRasterLayer(str(scene["dir"] / "dsm.tif"), "dsm in another crs")
-    wrong.setCrs(QgsCoordinateReferenceSystem("EPSG:32631"))
-    QgsProject.instance().addMapLayer(wrong)
-    dock.dsm_combo.setLayer(wrong)
+    # the tile's DSM resampled into UTM 31N: brought back into RD New for monoplotting
+    utm = QgsRasterLayer(str(scene["dir"] / "dsm_utm.tif"), "dsm in UTM")
+    assert utm.crs().authid() == "EPSG:32631"
+    QgsProject.instance().addMapLayer(utm)
+    dock.dsm_combo.setLayer(utm)
+    dock.monoplot_button.click()
+    assert dock.monoplot_button.isChecked() and dock.monoplot_tool.mode == "point"
+    assert "resampled" in dock.messages[-1] and "UTM zone 31N" in dock.messages[-1]
+    assert dock.monoplot_tool.tracer.dsm.crs.to_epsg() == 28992
+    for k in range(10):
+        dock.view.pointPicked.emit(*map(float, scene["pixels"][k]))
+    got = np.array([_xyz(f) for f in dock.monoplot_tool.points_layer.getFeatures()])
+    # the same as the core's run_monoplot on that file (resampling accuracy: tests/core)
+    n = 10
+    ids = [str(k) for k in range(n)]
+    obs = ImageObservations.from_arrays(
+        ["img1"] * n, ids, scene["pixels"][:n], 0.5, ["check"] * n, ["0"] * n
+    )
+    folder = scene["dir"]
+    core = run_monoplot(obs, folder / "camera.json", folder / "eo.csv", folder / "dsm_utm.tif", CRS)
+    np.testing.assert_allclose(got, core.points, atol=1e-6)
+    # two resamplings of a 0.5 m city DSM (trees, walls): most points within a few decimetres
+    assert np.median(np.linalg.norm(got - scene["truth"][:10], axis=1)) < 0.5
+    dock.monoplot_button.click()
+    # the LAZ in RD New + NAP: NAP heights need a geoid grid PROJ does not have here
+    dock.dsm_edit.setFilePath(str(AHN3))
     dock.monoplot_button.click()
     assert not dock.monoplot_button.isChecked()
-    assert "EPSG:32631" in dock.messages[-1] and "reproject" in dock.messages[-1]
-    # the same raster in the mapping CRS: on
-    right = QgsRasterLayer(str(scene["dir"] / "dsm.tif"), "dsm")
-    QgsProject.instance().addMapLayer(right)
-    dock.dsm_combo.setLayer(right)
+    assert "DSM not loaded" in dock.messages[-1] and "nlgeo" in dock.messages[-1]
+    # the raster in the mapping CRS: on
+    dock.dsm_edit.setFilePath(str(scene["dir"] / "dsm.tif"))
     dock.monoplot_button.click()
     assert dock.monoplot_button.isChecked() and dock.monoplot_tool.mode == "point"
     # no orientation: the camera file cleared
