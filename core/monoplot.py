@@ -278,12 +278,6 @@ class DsmTracer:
         return cls(dsm, pairs, qflat, tuple(out), zmin, zmax, mstack, offsets, bcols, shifts)
 
 
-def _axis_exit(p0: Array, dp: Array, lo: Array, hi: Array) -> Array:
-    """Ray parameter where the coordinate ``p0 + dp t`` leaves [lo, hi] forwards."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(dp > 0, (hi - p0) / dp, np.where(dp < 0, (lo - p0) / dp, np.inf))
-
-
 def _slab(p0: Array, dp: Array, lo: float, hi: float) -> tuple[Array, Array]:
     inside = (p0 >= lo) & (p0 <= hi)
     with np.errstate(divide="ignore", invalid="ignore"):
