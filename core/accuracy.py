@@ -49,7 +49,7 @@ from numpy.typing import NDArray
 from scipy import stats
 
 from . import standards as std_mod
-from .errors import Cancelled, CrsError, InputError
+from .errors import CrsError, InputError, stop_if_asked
 from .io.tables import Table, find_column, float_column, normalise, read_table, text_column
 
 __all__ = [
@@ -768,8 +768,7 @@ class AccuracyReport:
 
 
 def _tick(progress, should_stop, fraction: float) -> None:
-    if should_stop is not None and should_stop():
-        raise Cancelled("accuracy report cancelled")
+    stop_if_asked(should_stop, "making the accuracy report")
     if progress is not None:
         progress(fraction)
 

@@ -80,10 +80,10 @@ from scipy import stats
 
 from .errors import (
     AdjustmentError,
-    Cancelled,
     ConvergenceError,
     InputError,
     NotObservableError,
+    stop_if_asked,
 )
 
 __all__ = [
@@ -1209,8 +1209,7 @@ def _run(
     it = 0
     nrm: _Normal | None = None
     for it in range(1, opts.max_iterations + 1):
-        if should_stop is not None and should_stop():
-            raise Cancelled("adjustment cancelled")
+        stop_if_asked(should_stop, "adjusting")
         progress((it - 1) / opts.max_iterations)
         nrm, rowscale = problem.normal(lin, active, rowscale)
         if use_sparse is None:

@@ -33,7 +33,7 @@ import numpy as np
 import pyproj
 from numpy.typing import ArrayLike, NDArray
 
-from .errors import Cancelled, CrsError, InputError
+from .errors import CrsError, InputError, stop_if_asked
 from .ground_filter import Grid, fill_holes, write_geotiff
 from .pointcloud import parse_crs, read_points
 
@@ -137,10 +137,6 @@ class Dsm:
         write_geotiff(os.fspath(path), data, self.grid.geotransform, DSM_NODATA, self.crs)
 
 
-def _stop(should_stop: Callable[[], bool] | None) -> None:
-    if should_stop is not None and should_stop():
-        raise Cancelled("cancelled while building the DSM")
-
 
 def dsm_from_points(
     x: ArrayLike,
@@ -236,7 +232,7 @@ def dsm_from_las(
         should_stop=should_stop,
         require_crs=False,
     )
-    _stop(should_stop)
+    stop_if_asked(should_stop, "building the DSM")
     if distance_unit not in ("crs", "metre"):
         raise InputError(f"distance unit must be 'crs' or 'metre', got {distance_unit!r}")
     if distance_unit == "metre":
@@ -421,7 +417,7 @@ def reproject_dsm(
     heights = np.full((out.rows, out.cols), np.nan, np.float32)
     cols_x = out.x0 + (np.arange(out.cols) + 0.5) * cell
     for r0 in range(0, out.rows, max(int(block_rows), 1)):
-        _stop(should_stop)
+        stop_if_asked(should_stop, "building the DSM")
         r1 = min(r0 + block_rows, out.rows)
         yy = out.y_top - (np.arange(r0, r1) + 0.5) * cell
         tx, ty = np.meshgrid(cols_x, yy)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 
 class LidarPhotoError(Exception):
@@ -39,6 +39,12 @@ class CrsError(InputError):
 
 class Cancelled(LidarPhotoError):
     """The user cancelled a long computation (raised when ``should_stop()`` returns True)."""
+
+
+def stop_if_asked(should_stop: Callable[[], bool] | None, doing: str) -> None:
+    """Raise :class:`Cancelled` ("cancelled while <doing>") when ``should_stop()`` says so."""
+    if should_stop is not None and should_stop():
+        raise Cancelled(f"cancelled while {doing}")
 
 
 class AdjustmentError(LidarPhotoError):

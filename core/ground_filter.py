@@ -43,7 +43,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .errors import Cancelled, InputError
+from .errors import InputError, stop_if_asked
 
 LOG = logging.getLogger(__name__)
 
@@ -406,10 +406,6 @@ def fill_holes(surface: NDArray[np.float32], valid: NDArray[np.bool_]) -> NDArra
     return out.astype(np.float32)
 
 
-def _stop(should_stop: Callable[[], bool] | None) -> None:
-    if should_stop is not None and should_stop():
-        raise Cancelled("ground filter cancelled")
-
 
 def ground_filter(
     x: NDArray[np.float64],
@@ -488,7 +484,7 @@ def ground_filter(
     flat = np.empty(n, dtype=np.int64)
     zr = np.empty(n, dtype=np.float32)
     for start in range(0, n, _POINT_CHUNK):
-        _stop(should_stop)
+        stop_if_asked(should_stop, "filtering the ground")
         s = slice(start, start + _POINT_CHUNK)
         flat[s] = grid.flat_index(x[s], y[s])
         zr[s] = z[s] - z0
@@ -516,14 +512,14 @@ def ground_filter(
             zmin = _min_grid(grid, flat, zc)
         valid = np.isfinite(zmin)
         filled = _fill_nearest(zmin, valid)
-    _stop(should_stop)
+    stop_if_asked(should_stop, "filtering the ground")
     report(0.45)
 
     windows, thresholds = pmf_windows(p)
     surface = filled
     objects = np.zeros(surface.shape, dtype=bool)
     for w, dh in zip(windows, thresholds):
-        _stop(should_stop)
+        stop_if_asked(should_stop, "filtering the ground")
         opened = _opening(surface, w, p.window_shape)
         objects |= (surface - opened) > dh
         surface = opened
@@ -546,7 +542,7 @@ def ground_filter(
     hag = np.empty(n, dtype=np.float32)
     nodata_flat = outside.ravel()
     for start in range(0, n, _POINT_CHUNK):
-        _stop(should_stop)
+        stop_if_asked(should_stop, "filtering the ground")
         s = slice(start, start + _POINT_CHUNK)
         h = zr[s] - grid.bilinear(dtm, x[s], y[s])
         f = flat[s]

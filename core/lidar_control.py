@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from .errors import Cancelled, InputError
+from .errors import InputError, stop_if_asked
 from .rotations import skew
 
 log = logging.getLogger(__name__)
@@ -391,8 +391,7 @@ def lidar_control(
 
 
 def _tick(progress, should_stop, value: float) -> None:
-    if should_stop is not None and should_stop():
-        raise Cancelled("cancelled while building LiDAR control")
+    stop_if_asked(should_stop, "building LiDAR control")
     if progress is not None:
         progress(value)
 

@@ -56,7 +56,7 @@ from numpy.typing import ArrayLike, NDArray
 from .camera import Camera, read_camera_json
 from .collinearity import collinearity_jacobians
 from .dsm import Dsm, load_dsm, reproject_dsm
-from .errors import Cancelled, CrsError, InputError
+from .errors import Cancelled, CrsError, InputError, stop_if_asked
 from .io.observations import ImageObservations, read_observations_csv
 from .io.tables import write_csv_atomic
 from .orientation import ExteriorOrientationTable, eo_map_to_local, read_eo_csv
@@ -498,8 +498,7 @@ def intersect_dsm(
             "gradient": np.empty((n, 2)), "incidence": np.empty(n),
         }  # fmt: skip
         for start in range(0, n, step):
-            if should_stop is not None and should_stop():
-                raise Cancelled("cancelled while intersecting rays with the DSM")
+            stop_if_asked(should_stop, "intersecting rays with the DSM")
             sl = slice(start, min(start + step, n))
             dda_compiled.trace_rays(tr, o, d, accelerate, min_incidence_deg, out, sl)
             if progress is not None:
@@ -514,8 +513,7 @@ def intersect_dsm(
     tri = np.full(n, -1, np.int8)
     good = np.isfinite(o).all(axis=1) & np.isfinite(d).all(axis=1) & (np.abs(d).sum(axis=1) > 0)
     for start in range(0, n, step):
-        if should_stop is not None and should_stop():
-            raise Cancelled("cancelled while intersecting rays with the DSM")
+        stop_if_asked(should_stop, "intersecting rays with the DSM")
         sl = slice(start, min(start + step, n))
         sel = np.flatnonzero(good[sl]) + start
         if sel.size:

@@ -26,7 +26,7 @@ import pyproj
 from numpy.typing import NDArray
 
 from . import frames
-from .errors import Cancelled, CrsError, InputError
+from .errors import Cancelled, CrsError, InputError, stop_if_asked
 
 LOG = logging.getLogger(__name__)
 
@@ -272,10 +272,6 @@ def _check_fields(info: CloudInfo, fields: Sequence[str]) -> list[str]:
     return out
 
 
-def _stop(should_stop: Callable[[], bool] | None) -> None:
-    if should_stop is not None and should_stop():
-        raise Cancelled("cancelled while processing the point cloud")
-
 
 def read_points(
     path: PathLike,
@@ -331,7 +327,7 @@ def read_points(
         done = 0
         try:
             for chunk in reader.chunk_iterator(max(int(chunk_size), 1)):
-                _stop(should_stop)
+                stop_if_asked(should_stop, "processing the point cloud")
                 m = len(chunk)
                 if done + m > n:
                     raise InputError(f"more points than the header's {n}", path=path)
@@ -468,7 +464,7 @@ def write_cloud(
                 done = 0
                 try:
                     for chunk in reader.chunk_iterator(max(int(chunk_size), 1)):
-                        _stop(should_stop)
+                        stop_if_asked(should_stop, "processing the point cloud")
                         m = len(chunk)
                         out = laspy.ScaleAwarePointRecord.zeros(m, header=writer.header)
                         for name in chunk.array.dtype.names:

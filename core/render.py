@@ -60,7 +60,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .camera import Camera
 from .dsm import Dsm
-from .errors import Cancelled, CrsError, InputError
+from .errors import CrsError, InputError, stop_if_asked
 from .frames import LocalFrame, MappingFrame
 from .ground_filter import Grid
 from .monoplot import DsmTracer, chord_rays, intersect_dsm
@@ -674,10 +674,6 @@ class RenderedImage:
     seconds: float
 
 
-def _stop(should_stop: Callable[[], bool] | None) -> None:
-    if should_stop is not None and should_stop():
-        raise Cancelled("cancelled while rendering")
-
 
 def render_image(
     scene: RenderScene,
@@ -719,7 +715,7 @@ def render_image(
     origin = np.asarray(xyz, dtype=np.float64).reshape(3)
     angles = np.asarray(opk, dtype=np.float64).reshape(3)
     rays = _Rays.build(scene, camera, origin, angles, int(opt.direction_grid_px))
-    _stop(should_stop)
+    stop_if_asked(should_stop, "rendering")
 
     # ---- coarse: one DSM ray per k x k block, at the block centre
     w, h = -(-width // k), -(-height // k)
@@ -740,7 +736,7 @@ def render_image(
     t_dsm = np.where(hit, hits.t, np.nan)
     lab_dsm = np.where(hit, scene.regions.at(px, py), NO_PLANE).astype(np.int32)
     del rgb, face, grad
-    _stop(should_stop)
+    stop_if_asked(should_stop, "rendering")
 
     # ---- coarse plane labels: the plane under the DSM hit and its neighbours, exactly
     n_planes = len(scene.plane_ids)
@@ -759,7 +755,7 @@ def render_image(
     del dirs
     if progress is not None:
         progress(0.7)
-    _stop(should_stop)
+    stop_if_asked(should_stop, "rendering")
 
     # ---- full resolution: upsample, then decide the plane per pixel near label changes
     label_c = label_c.reshape(h, w)
@@ -777,7 +773,7 @@ def render_image(
         edge_pixels = int(br.size)
         chunk = 1 << 20
         for s in range(0, br.size, chunk):
-            _stop(should_stop)
+            stop_if_asked(should_stop, "rendering")
             r, c = br[s : s + chunk], bc[s : s + chunk]
             rk, ck = r // k, c // k
             d = rays.at(c + 0.5, r + 0.5)

@@ -47,7 +47,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from .errors import Cancelled, InputError
+from .errors import InputError, stop_if_asked
 from .planes import Plane, fit_plane, write_planes_csv
 
 __all__ = [
@@ -175,10 +175,6 @@ class RoofPlaneResult:
     message: str = ""
 
 
-def _check_stop(should_stop: ShouldStop) -> None:
-    if should_stop is not None and should_stop():
-        raise Cancelled("roof-plane extraction cancelled")
-
 
 def _eig_normals(cov: NDArray) -> NDArray:
     """Upward unit normals (smallest eigenvectors) of a batch of 3x3 scatter matrices (B,3,3)."""
@@ -211,7 +207,7 @@ def _local_ransac(
     bs = params.batch_size
     n_batches = (n + bs - 1) // bs
     for bi in range(n_batches):
-        _check_stop(should_stop)
+        stop_if_asked(should_stop, "extracting roof planes")
         lo, hi = bi * bs, min(n, (bi + 1) * bs)
         dist, idx = tree.query(q[lo:hi], k=k, workers=-1)
         knn[lo:hi] = idx[:, :g]
@@ -315,7 +311,7 @@ def _grow(
         frontier = seeds
         retried = False
         while True:
-            _check_stop(should_stop)
+            stop_if_asked(should_stop, "extracting roof planes")
             cand, reg = _claims(
                 q, keep, normals, labels, knn, frontier, reg_n, reg_c, cos_tol, params.epsilon
             )
@@ -445,7 +441,7 @@ def _reassign(
         return out, ambiguous
     normals, centroids, _ = _fit_labels(q, labels)
     for lo in range(0, len(q), batch):
-        _check_stop(should_stop)
+        stop_if_asked(should_stop, "extracting roof planes")
         hi = min(len(q), lo + batch)
         cand = np.concatenate([labels[lo:hi, None], labels[knn[lo:hi]]], axis=1)  # (B, G+1)
         valid = cand >= 0
@@ -591,7 +587,7 @@ def extract_roof_planes(
     # centred once: map coordinates (1e5-1e6) would cost digits in every product below
     origin = np.floor(xyz.min(axis=0))
     q = xyz - origin
-    _check_stop(should_stop)
+    stop_if_asked(should_stop, "extracting roof planes")
     tree = cKDTree(q, balanced_tree=False, compact_nodes=False)
     keep, normals, quality, knn, spacing = _local_ransac(q, tree, params, progress, should_stop)
     del tree
@@ -665,7 +661,7 @@ def _final_planes(
     planes = []
     for pid, idx in enumerate(members):
         if pid % 64 == 0:
-            _check_stop(should_stop)
+            stop_if_asked(should_stop, "extracting roof planes")
             if progress is not None:
                 progress(0.9 + 0.1 * pid / len(members))
         pts = xyz[idx]
