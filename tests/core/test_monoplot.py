@@ -398,3 +398,13 @@ def test_monoplot_on_a_dsm_in_another_crs_reaches_the_truth():
     # two triangulations of a surface with curvature 1.1e-3 /m at 0.5 m: ~0.1 mm in height
     assert np.abs(res.points - truth).max() < 1e-3
     assert res.dsm.crs.to_epsg() == 28992
+
+
+def test_reprojecting_a_dsm_without_crs_is_refused():
+    from lidarphoto.core.dsm import reproject_dsm
+    from lidarphoto.core.errors import CrsError
+
+    utm, _ = _utm_dsm(rows=4, cols=4)
+    bare = Dsm(utm.heights, utm.grid, None, "bare.tif")
+    with pytest.raises(CrsError, match=r"bare\.tif.*no CRS"):
+        reproject_dsm(bare, CRS)
