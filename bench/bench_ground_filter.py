@@ -65,12 +65,12 @@ def peak_rss_mb() -> float:
 
 def worker(tool: str, path: str, feet: bool, runs: int) -> dict:
     """One measurement in this process; returns a JSON-able dict."""
-    from lidarphoto.core.ground_filter import (
+    from lidarphoto.core.io.pointcloud import read_points, write_cloud
+    from lidarphoto.core.lidar.ground_filter import (
         GroundFilterParams,
         ground_filter,
         score_classification,
     )
-    from lidarphoto.core.pointcloud import read_points, write_cloud
 
     t_wall = time.perf_counter()
     out: dict = {"tool": tool, "path": path}
@@ -168,8 +168,8 @@ def run_worker(tool: str, path: Path, feet: bool, runs: int) -> dict:
 
 
 def isprs_table() -> list[str]:
-    from lidarphoto.core.ground_filter import ground_filter, score_classification
-    from lidarphoto.core.pointcloud import read_points
+    from lidarphoto.core.io.pointcloud import read_points
+    from lidarphoto.core.lidar.ground_filter import ground_filter, score_classification
 
     smrf = {"samp11": 9.9, "samp12": 3.15, "samp51": 5.58}
     pmf = {"samp11": 17.16, "samp12": 5.88, "samp51": 6.95}

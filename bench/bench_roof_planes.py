@@ -59,7 +59,7 @@ def child(tool: str, tiles: int, n_planes: int) -> dict:
     out = {"tool": tool, "tiles": tiles, "points_in": len(xyz), "points": len(pts)}
     if tool == "lidarphoto":
         sys.path.insert(0, str(HERE.parent.parent))
-        from lidarphoto.core.roof_planes import extract_roof_planes
+        from lidarphoto.core.lidar.roof_planes import extract_roof_planes
 
         t = time.perf_counter()
         res = extract_roof_planes(pts)

@@ -8,9 +8,9 @@ Run: .venv/bin/python bench/lidar_control_accuracy.py  (about a minute); prints 
 from __future__ import annotations
 
 import numpy as np
-from lidarphoto.core.lidar_control import ControlOptions, lidar_control
-from lidarphoto.core.planes import fit_plane
-from lidarphoto.core.simulate_town import make_town, sample_town
+from lidarphoto.core.geometry.planes import fit_plane
+from lidarphoto.core.lidar.control import ControlOptions, lidar_control
+from lidarphoto.core.simulation.town import make_town, sample_town
 
 DRAWS = 60
 

@@ -16,11 +16,11 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from lidarphoto.core.ground_filter import run_ground_filter
-from lidarphoto.core.lidar_control import run_create_lcps
-from lidarphoto.core.planes import read_planes_csv
-from lidarphoto.core.pointcloud import read_points
-from lidarphoto.core.roof_planes import run_extract_roof_planes
+from lidarphoto.core.geometry.planes import read_planes_csv
+from lidarphoto.core.io.pointcloud import read_points
+from lidarphoto.core.lidar.control import run_create_lcps
+from lidarphoto.core.lidar.ground_filter import run_ground_filter
+from lidarphoto.core.lidar.roof_planes import run_extract_roof_planes
 from scipy.ndimage import grey_dilation
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"

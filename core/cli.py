@@ -19,7 +19,7 @@ from .errors import LidarPhotoError
 
 
 def _add_trajectory_to_eo(sub: argparse._SubParsersAction) -> None:
-    from .trajectory_to_eo import MOUNT_CHOICES
+    from .photo.georeference import MOUNT_CHOICES
 
     p = sub.add_parser(
         "trajectorytoeo",
@@ -46,7 +46,7 @@ def _add_trajectory_to_eo(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_trajectory_to_eo(args: argparse.Namespace) -> int:
-    from .trajectory_to_eo import run_trajectory_to_eo
+    from .photo.georeference import run_trajectory_to_eo
 
     table = run_trajectory_to_eo(
         args.input,
@@ -71,7 +71,7 @@ def _run_trajectory_to_eo(args: argparse.Namespace) -> int:
 
 
 def _add_ground_filter(sub: argparse._SubParsersAction) -> None:
-    from .ground_filter import GroundFilterParams
+    from .lidar.ground_filter import GroundFilterParams
 
     d = GroundFilterParams()
     p = sub.add_parser(
@@ -112,7 +112,7 @@ def _add_ground_filter(sub: argparse._SubParsersAction) -> None:
 
 def _run_ground_filter(args: argparse.Namespace) -> int:
     from .errors import InputError
-    from .ground_filter import GroundFilterParams, run_ground_filter, write_geotiff
+    from .lidar.ground_filter import GroundFilterParams, run_ground_filter, write_geotiff
 
     def choice(value: str, options: Sequence[str], name: str) -> int:
         v = value.strip().lower()
@@ -159,7 +159,7 @@ def _run_ground_filter(args: argparse.Namespace) -> int:
 
 
 def _add_create_lcps(sub: argparse._SubParsersAction) -> None:
-    from .lidar_control import ControlOptions
+    from .lidar.control import ControlOptions
 
     d = ControlOptions()
     p = sub.add_parser(
@@ -190,7 +190,7 @@ def _add_create_lcps(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_create_lcps(args: argparse.Namespace) -> int:
-    from .lidar_control import ControlOptions, run_create_lcps
+    from .lidar.control import ControlOptions, run_create_lcps
 
     options = ControlOptions(
         delta=args.delta,
@@ -252,9 +252,14 @@ def _add_accuracy_report(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_accuracy_report(args: argparse.Namespace) -> int:
-    from .accuracy import OUTLIER_RULES, STANDARD_KEYS, AccuracySettings, run_accuracy_report
     from .errors import InputError
-    from .standards import PEC_CLASSES
+    from .quality.accuracy import (
+        OUTLIER_RULES,
+        STANDARD_KEYS,
+        AccuracySettings,
+        run_accuracy_report,
+    )
+    from .quality.standards import PEC_CLASSES
 
     def choice(value: str, options: tuple[str, ...], what: str) -> str:
         v = value.strip()
@@ -313,7 +318,7 @@ def _run_accuracy_report(args: argparse.Namespace) -> int:
 
 
 def _add_extract_roof_planes(sub: argparse._SubParsersAction) -> None:
-    from .roof_planes import RoofPlaneParams
+    from .lidar.roof_planes import RoofPlaneParams
 
     d = RoofPlaneParams()
     p = sub.add_parser(
@@ -357,7 +362,7 @@ def _add_extract_roof_planes(sub: argparse._SubParsersAction) -> None:
 
 def _run_extract_roof_planes(args: argparse.Namespace) -> int:
     from .errors import InputError
-    from .roof_planes import RoofPlaneParams, run_extract_roof_planes
+    from .lidar.roof_planes import RoofPlaneParams, run_extract_roof_planes
 
     units = {
         "crs": "crs",
@@ -399,7 +404,7 @@ def _run_extract_roof_planes(args: argparse.Namespace) -> int:
 
 
 def _add_boresight_calibration(sub: argparse._SubParsersAction) -> None:
-    from .trajectory_to_eo import MOUNT_CHOICES
+    from .photo.georeference import MOUNT_CHOICES
 
     p = sub.add_parser(
         "boresightcalibration",
@@ -441,8 +446,8 @@ def _add_boresight_calibration(sub: argparse._SubParsersAction) -> None:
 
 
 def _run_boresight_calibration(args: argparse.Namespace) -> int:
-    from .boresight_run import run_boresight_calibration
     from .errors import InputError
+    from .jobs.boresight_calibration import run_boresight_calibration
 
     snoop = args.snooping.strip().lower()
     if snoop not in ("true", "false", "yes", "no", "1", "0"):
@@ -507,7 +512,7 @@ def _add_monoplot(sub: argparse._SubParsersAction) -> None:
 
 def _run_monoplot(args: argparse.Namespace) -> int:
     from .errors import InputError
-    from .monoplot import METHODS, run_monoplot
+    from .photo.monoplot import METHODS, run_monoplot
 
     method = args.method.strip().lower()
     method = METHODS[int(method)] if method.isdigit() and int(method) < len(METHODS) else method

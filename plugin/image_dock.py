@@ -59,12 +59,12 @@ from qgis.PyQt.QtWidgets import (
     QWidget,
 )
 
-from ..core.camera import read_camera_json
 from ..core.errors import InputError
-from ..core.orientation import read_eo_csv
-from ..core.picking import PickingScene, nearest_point, nearest_segment
-from ..core.planes import fit_plane
-from ..core.trajectory_to_eo import MOUNT_CHOICES
+from ..core.geometry.camera import read_camera_json
+from ..core.geometry.planes import fit_plane
+from ..core.photo.georeference import MOUNT_CHOICES
+from ..core.photo.orientation import read_eo_csv
+from ..core.photo.picking import PickingScene, nearest_point, nearest_segment
 from .image_source import ImageSource, ImageSourceError
 from .image_view import VIEW_HELP, ImageView
 from .monoplot_tool import MonoplotTool

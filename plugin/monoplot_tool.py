@@ -78,8 +78,8 @@ class MonoplotTool(QObject):
         ("" when the DSM was used as it is)."""
         import pyproj
 
-        from ..core.dsm import load_dsm, reproject_dsm
-        from ..core.monoplot import DsmTracer
+        from ..core.lidar.dsm import load_dsm, reproject_dsm
+        from ..core.photo.monoplot import DsmTracer
 
         dsm = load_dsm(path, cell_size, crs)
         note = ""
@@ -116,7 +116,7 @@ class MonoplotTool(QObject):
     def monoplot(self, pixels, image_id: str | None = None, line: bool = False):
         """Monoplot pixels (N, 2) of an image (default: the dock's current one)."""
         from ..core.io.observations import ImageObservations
-        from ..core.monoplot import run_monoplot
+        from ..core.photo.monoplot import run_monoplot
 
         crs = self.dock.eo_crs()
         if self.tracer is None or self.dock.camera is None or self.dock.eo is None:
@@ -164,7 +164,7 @@ class MonoplotTool(QObject):
             self.message.emit(str(exc))
             return
         self._add_points(res)
-        from ..core.monoplot import STATUS_TEXT
+        from ..core.photo.monoplot import STATUS_TEXT
 
         p, st = res.points[0], int(res.status[0])
         if np.isfinite(p).all():
@@ -208,7 +208,7 @@ class MonoplotTool(QObject):
         res = self.monoplot(vertices, line=True)
         self._add_points(res)
         v = [QgsPoint(*map(float, p)) for p in res.lines[0].vertices if np.isfinite(p).all()]
-        from ..core.monoplot import STATUS_TEXT
+        from ..core.photo.monoplot import STATUS_TEXT
 
         layer = self._layer("lines")
         feature = QgsFeature(layer.fields())
@@ -239,7 +239,7 @@ class MonoplotTool(QObject):
         return layer
 
     def _add_points(self, res) -> None:
-        from ..core.monoplot import STATUS_TEXT
+        from ..core.photo.monoplot import STATUS_TEXT
 
         layer = self._layer("points")
         sig = res.sigmas

@@ -9,7 +9,7 @@ from qgis.PyQt.QtCore import QCoreApplication
 from qgis.PyQt.QtGui import QIcon
 from qgis.PyQt.QtWidgets import QAction, QMenu
 
-from .dependencies import report_missing
+from .dependency_check import report_missing
 
 ICON_PATH = Path(__file__).resolve().parents[1] / "icon.svg"
 PROVIDER_ID = "lidarphoto"

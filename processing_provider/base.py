@@ -196,7 +196,7 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
         sink.addFeature(feature, SINK_FAST_INSERT)
 
     def canExecute(self):
-        from ..plugin.dependencies import missing_message, missing_modules
+        from ..core.dependencies import missing_message, missing_modules
 
         missing = missing_modules()
         if missing:

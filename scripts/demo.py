@@ -40,35 +40,35 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from lidarphoto.core.boresight import local_frame_for
-from lidarphoto.core.boresight_run import forward_intersection
-from lidarphoto.core.camera import Camera
-from lidarphoto.core.dsm import dsm_from_las
-from lidarphoto.core.frames import MappingFrame
+from lidarphoto.core.geometry.camera import Camera
+from lidarphoto.core.geometry.frames import MappingFrame
+from lidarphoto.core.geometry.planes import read_planes_csv
 from lidarphoto.core.io.control import read_lcps_csv, read_lines_csv
 from lidarphoto.core.io.observations import read_observations_csv
+from lidarphoto.core.io.pointcloud import read_points
 from lidarphoto.core.io.tables import write_csv_atomic
-from lidarphoto.core.orientation import ExteriorOrientationTable, read_eo_csv
-from lidarphoto.core.picking import PickingScene
-from lidarphoto.core.planes import read_planes_csv
-from lidarphoto.core.pointcloud import read_points
-from lidarphoto.core.render import (
+from lidarphoto.core.jobs.boresight_calibration import forward_intersection
+from lidarphoto.core.lidar.dsm import dsm_from_las
+from lidarphoto.core.photo.boresight import local_frame_for
+from lidarphoto.core.photo.georeference import (
+    Mount,
+    Trajectory,
+    direct_georeference,
+    read_trajectory_csv,
+)
+from lidarphoto.core.photo.orientation import ExteriorOrientationTable, read_eo_csv
+from lidarphoto.core.photo.picking import PickingScene
+from lidarphoto.core.simulation.flight import (
+    ControlFlightConfig,
+    ControlFlightSimulation,
+    simulate_flight_over,
+)
+from lidarphoto.core.simulation.render import (
     RenderOptions,
     RenderScene,
     edge_offsets,
     render_image,
     write_rgb_tiff,
-)
-from lidarphoto.core.simulate_flight import (
-    ControlFlightConfig,
-    ControlFlightSimulation,
-    simulate_flight_over,
-)
-from lidarphoto.core.trajectory_to_eo import (
-    Mount,
-    Trajectory,
-    direct_georeference,
-    read_trajectory_csv,
 )
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -31,7 +31,7 @@ from typing import Union
 import numpy as np
 
 from ..errors import InputError
-from ..lidar_control import LINE_KINDS, Adjacency, ControlLine, ControlPoint, error_ellipsoid
+from ..lidar.control import LINE_KINDS, Adjacency, ControlLine, ControlPoint, error_ellipsoid
 from .tables import find_column, float_column, read_table, text_column, write_csv_atomic
 
 _IU3 = np.triu_indices(3)

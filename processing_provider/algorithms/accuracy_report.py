@@ -266,7 +266,7 @@ class AccuracyReportAlgorithm(BaseAlgorithm):
 
     def _layer_points(self, parameters, context, layer_key, id_key, z_key, group_key, to_crs):
         """Read a point layer into a core PointSet (reprojected to ``to_crs`` if given)."""
-        from ...core.accuracy import point_set
+        from ...core.quality.accuracy import point_set
 
         source = self.parameterAsSource(parameters, layer_key, context)
         id_field = (self.parameterAsFields(parameters, id_key, context) or [None])[0]
@@ -314,7 +314,7 @@ class AccuracyReportAlgorithm(BaseAlgorithm):
             )
 
     def processAlgorithm(self, parameters, context, feedback):
-        from ...core.accuracy import AccuracySettings, join_points, run_accuracy_report
+        from ...core.quality.accuracy import AccuracySettings, join_points, run_accuracy_report
 
         table = self.parameterAsFile(parameters, self.INPUT, context)
         has_layers = self.parameterAsSource(parameters, self.MEASURED, context) is not None

@@ -40,7 +40,7 @@ from .trajectory_to_eo import _MOUNT_LABELS, MOUNT_CHOICES
 _GROUPINGS = ("single", "group", "direction")  # core.boresight_run.GROUPINGS
 _TYPES = ("tie", "line", "lcp", "paper")  # core.boresight_run.CONTROL_TYPES
 try:
-    from ...core.boresight import INS_GRADES
+    from ...core.photo.boresight import INS_GRADES
 
     _GRADE_LABELS = {k: g.name for k, g in INS_GRADES.items()}
 except ImportError:  # a third-party package of the core is missing: canExecute() says which
@@ -227,8 +227,8 @@ class BoresightCalibrationAlgorithm(BaseAlgorithm):
         self.addOutput(QgsProcessingOutputNumber("SIGMA0", self.tr("Sigma0 a-posteriori")))
 
     def processAlgorithm(self, parameters, context, feedback):
-        from ...core.boresight import BoresightNotObservable
-        from ...core.boresight_run import run_boresight_calibration
+        from ...core.jobs.boresight_calibration import run_boresight_calibration
+        from ...core.photo.boresight import BoresightNotObservable
 
         crs = self.parameterAsCrs(parameters, "CRS", context)
         if not crs.isValid():

@@ -147,7 +147,7 @@ class CreateLcpsAlgorithm(BaseAlgorithm):
         self.addOutput(QgsProcessingOutputNumber("LINE_COUNT", self.tr("Number of lines")))
 
     def processAlgorithm(self, parameters, context, feedback):
-        from ...core.lidar_control import ControlOptions, error_ellipsoid, run_create_lcps
+        from ...core.lidar.control import ControlOptions, error_ellipsoid, run_create_lcps
 
         options = ControlOptions(
             delta=self.parameterAsDouble(parameters, self.DELTA, context),

@@ -160,8 +160,8 @@ class ExtractRoofPlanesAlgorithm(BaseAlgorithm):
         self.addOutput(QgsProcessingOutputString("UNIT", self.tr("Unit of the lengths")))
 
     def processAlgorithm(self, parameters, context, feedback):
-        from ...core.planes import COV_COLUMNS
-        from ...core.roof_planes import RoofPlaneParams, run_extract_roof_planes
+        from ...core.geometry.planes import COV_COLUMNS
+        from ...core.lidar.roof_planes import RoofPlaneParams, run_extract_roof_planes
 
         values = {}
         for key, field, _l, kind, *_ in _NUMBERS:

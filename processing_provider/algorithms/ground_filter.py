@@ -124,7 +124,7 @@ class GroundFilterAlgorithm(BaseAlgorithm):
         self.addOutput(QgsProcessingOutputString("UNIT", self.tr("Unit of the distances")))
 
     def processAlgorithm(self, parameters, context, feedback):
-        from ...core.ground_filter import GroundFilterParams, run_ground_filter
+        from ...core.lidar.ground_filter import GroundFilterParams, run_ground_filter
 
         values = {f: self.parameterAsDouble(parameters, key, context) for key, f, *_ in _NUMBERS}
         params = GroundFilterParams(

@@ -140,7 +140,7 @@ class MonoplotAlgorithm(BaseAlgorithm):
         self.addOutput(QgsProcessingOutputNumber("HIT_COUNT", self.tr("Rays with a 3D point")))
 
     def processAlgorithm(self, parameters, context, feedback):
-        from ...core.monoplot import STATUS_TEXT, run_monoplot
+        from ...core.photo.monoplot import STATUS_TEXT, run_monoplot
 
         def crs(key):
             c = self.parameterAsCrs(parameters, key, context)

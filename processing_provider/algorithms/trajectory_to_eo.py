@@ -34,7 +34,7 @@ from ..compat import (
 )
 
 try:
-    from ...core.trajectory_to_eo import MOUNT_CHOICES
+    from ...core.photo.georeference import MOUNT_CHOICES
 except ImportError:  # a third-party package of the core is missing: canExecute() says which
     MOUNT_CHOICES = (
         "image_top_forward",
@@ -152,7 +152,7 @@ class TrajectoryToEoAlgorithm(BaseAlgorithm):
         self.addOutput(QgsProcessingOutputNumber(self.IMAGE_COUNT, self.tr("Number of images")))
 
     def processAlgorithm(self, parameters, context, feedback):
-        from ...core.trajectory_to_eo import run_trajectory_to_eo
+        from ...core.photo.georeference import run_trajectory_to_eo
 
         crs = self.parameterAsCrs(parameters, self.CRS, context)
         if not crs.isValid():

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from lidarphoto.core.accuracy import (
+from lidarphoto.core.errors import Cancelled, CrsError, InputError
+from lidarphoto.core.quality.accuracy import (
     AccuracySettings,
     CheckPoints,
     assess_accuracy,
@@ -24,7 +25,6 @@ from lidarphoto.core.accuracy import (
     run_accuracy_report,
     screen_outliers,
 )
-from lidarphoto.core.errors import Cancelled, CrsError, InputError
 from scipy import stats
 
 HEADER = "id,e,n,h,e_ref,n_ref,h_ref,group\n"

@@ -11,8 +11,9 @@ import time
 
 import numpy as np
 import pytest
-from lidarphoto.core import adjustment as adj
-from lidarphoto.core.adjustment import (
+from lidarphoto.core.errors import AdjustmentError, Cancelled, InputError, NotObservableError
+from lidarphoto.core.lsq import adjustment as adj
+from lidarphoto.core.lsq.adjustment import (
     AdjustmentOptions,
     Constraint,
     GaussHelmertBlock,
@@ -20,7 +21,6 @@ from lidarphoto.core.adjustment import (
     adjust,
     prior_block,
 )
-from lidarphoto.core.errors import AdjustmentError, Cancelled, InputError, NotObservableError
 from scipy import optimize, stats
 
 # ----------------------------------------------------------------------------- helpers

@@ -19,12 +19,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from lidarphoto.core.camera import camera_from_dict
-from lidarphoto.core.collinearity import project
-from lidarphoto.core.frames import LocalFrame, MappingFrame
-from lidarphoto.core.orientation import eo_local_to_map
-from lidarphoto.core.resection import initial_pose_pnp, space_resection
-from lidarphoto.core.rotations import opk_to_matrix
+from lidarphoto.core.geometry.camera import camera_from_dict
+from lidarphoto.core.geometry.collinearity import project
+from lidarphoto.core.geometry.frames import LocalFrame, MappingFrame
+from lidarphoto.core.geometry.rotations import opk_to_matrix
+from lidarphoto.core.photo.orientation import eo_local_to_map
+from lidarphoto.core.photo.resection import initial_pose_pnp, space_resection
 from pyproj import Proj, Transformer
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "borea"

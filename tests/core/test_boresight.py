@@ -6,16 +6,12 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from lidarphoto.core.boresight import (
-    ARCSEC,
-    BoresightNotObservable,
-    BoresightOptions,
-)
-from lidarphoto.core.boresight_models import PoseSpec, collinearity, coplanarity, paper_plane
-from lidarphoto.core.camera import Camera
-from lidarphoto.core.distortion import distortion_from_dict
-from lidarphoto.core.rotations import MOUNT_PRESETS, rph_to_matrix
-from lidarphoto.core.simulate_flight import FlightConfig, simulate_flight
+from lidarphoto.core.geometry.camera import Camera
+from lidarphoto.core.geometry.distortion import distortion_from_dict
+from lidarphoto.core.geometry.rotations import MOUNT_PRESETS, rph_to_matrix
+from lidarphoto.core.photo.boresight import ARCSEC, BoresightNotObservable, BoresightOptions
+from lidarphoto.core.photo.boresight_models import PoseSpec, collinearity, coplanarity, paper_plane
+from lidarphoto.core.simulation.flight import FlightConfig, simulate_flight
 from numdiff import central_difference
 
 # A small, fast block: 2 x 3 images over ~30 roof planes, every control type.

@@ -9,18 +9,18 @@ from html.parser import HTMLParser
 
 import numpy as np
 import pytest
-from lidarphoto.core.boresight import ARCSEC, BoresightNotObservable, local_frame_for
-from lidarphoto.core.boresight_report import render_boresight_html
-from lidarphoto.core.boresight_run import (
+from lidarphoto.core.errors import InputError
+from lidarphoto.core.geometry.frames import MappingFrame
+from lidarphoto.core.jobs.boresight_calibration import (
     TABLE_COLUMNS,
     forward_intersection,
     parse_ins_grade,
     run_boresight_calibration,
 )
-from lidarphoto.core.errors import InputError
-from lidarphoto.core.frames import MappingFrame
-from lidarphoto.core.orientation import read_eo_csv
-from lidarphoto.core.simulate_flight import (
+from lidarphoto.core.photo.boresight import ARCSEC, BoresightNotObservable, local_frame_for
+from lidarphoto.core.photo.orientation import read_eo_csv
+from lidarphoto.core.quality.boresight_html import render_boresight_html
+from lidarphoto.core.simulation.flight import (
     ControlFlightConfig,
     FlightConfig,
     simulate_flight,

@@ -13,8 +13,14 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from lidarphoto.core.camera import Camera, camera_from_dict, read_camera_json, write_camera_json
-from lidarphoto.core.distortion import (
+from lidarphoto.core.errors import InputError
+from lidarphoto.core.geometry.camera import (
+    Camera,
+    camera_from_dict,
+    read_camera_json,
+    write_camera_json,
+)
+from lidarphoto.core.geometry.distortion import (
     DISTORTION_MODELS,
     BrownConrady,
     DistortionInversionError,
@@ -22,7 +28,6 @@ from lidarphoto.core.distortion import (
     NoDistortion,
     distortion_from_dict,
 )
-from lidarphoto.core.errors import InputError
 from numdiff import central_difference
 from numpy.testing import assert_allclose
 

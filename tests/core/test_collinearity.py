@@ -9,16 +9,16 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
-from lidarphoto.core.camera import Camera
-from lidarphoto.core.collinearity import (
+from lidarphoto.core.geometry.camera import Camera
+from lidarphoto.core.geometry.collinearity import (
     EO_NAMES,
     collinearity_jacobians,
     image_rays,
     project,
     project_with_status,
 )
-from lidarphoto.core.distortion import BrownConrady, NoDistortion
-from lidarphoto.core.rotations import opk_to_matrix
+from lidarphoto.core.geometry.distortion import BrownConrady, NoDistortion
+from lidarphoto.core.geometry.rotations import opk_to_matrix
 from numdiff import central_difference
 from numpy.testing import assert_allclose
 

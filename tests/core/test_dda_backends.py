@@ -11,11 +11,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from lidarphoto.core import dda_compiled
-from lidarphoto.core.dsm import Dsm, dsm_from_las
 from lidarphoto.core.errors import InputError
-from lidarphoto.core.ground_filter import Grid
-from lidarphoto.core.monoplot import DsmTracer, intersect_dsm
+from lidarphoto.core.geometry import raycast_numba as dda_compiled
+from lidarphoto.core.lidar.dsm import Dsm, dsm_from_las
+from lidarphoto.core.lidar.ground_filter import Grid
+from lidarphoto.core.photo.monoplot import DsmTracer, intersect_dsm
 
 AHN3 = Path(__file__).resolve().parents[1] / "data" / "ahn3" / "ahn3_delft_crop60.laz"
 

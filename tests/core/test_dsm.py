@@ -8,10 +8,10 @@ import laspy
 import numpy as np
 import pyproj
 import pytest
-from lidarphoto.core import dsm as dsm_mod
-from lidarphoto.core.dsm import Dsm, dsm_from_las, dsm_from_points, load_dsm, read_dsm_raster
 from lidarphoto.core.errors import InputError
-from lidarphoto.core.ground_filter import Grid
+from lidarphoto.core.lidar import dsm as dsm_mod
+from lidarphoto.core.lidar.dsm import Dsm, dsm_from_las, dsm_from_points, load_dsm, read_dsm_raster
+from lidarphoto.core.lidar.ground_filter import Grid
 
 AHN3 = Path(__file__).resolve().parents[1] / "data" / "ahn3" / "ahn3_delft_crop60.laz"
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from lidarphoto.core.errors import CrsError
-from lidarphoto.core.frames import NED_TO_ENU, LocalFrame, MappingFrame
+from lidarphoto.core.geometry.frames import NED_TO_ENU, LocalFrame, MappingFrame
 from pyproj import Proj, Transformer
 
 RNG = np.random.default_rng(11)
@@ -111,8 +111,8 @@ def test_bad_crs_is_explained(crs, words):
 
 
 def test_eo_map_local_round_trip(frame):
-    from lidarphoto.core.orientation import eo_local_to_map, eo_map_to_local
-    from lidarphoto.core.rotations import matrix_to_opk
+    from lidarphoto.core.geometry.rotations import matrix_to_opk
+    from lidarphoto.core.photo.orientation import eo_local_to_map, eo_map_to_local
 
     xyz = _points(30)
     opk = np.column_stack(

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.errors import Cancelled, InputError
-from lidarphoto.core.ground_filter import (
+from lidarphoto.core.io.pointcloud import read_points
+from lidarphoto.core.lidar.ground_filter import (
     GROUND_CLASS,
     HEIGHT_FIELD,
     LOW_NOISE_CLASS,
@@ -22,7 +23,6 @@ from lidarphoto.core.ground_filter import (
     score_classification,
     write_geotiff,
 )
-from lidarphoto.core.pointcloud import read_points
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 AHN3 = DATA / "ahn3" / "ahn3_delft_crop60.laz"

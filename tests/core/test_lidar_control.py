@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
-from lidarphoto.core.lidar_control import (
+from lidarphoto.core.lidar.control import (
     ControlOptions,
     corner_candidates,
     intersect_three_planes,

@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from lidarphoto.core.lidar_control import ControlOptions, lidar_control
-from lidarphoto.core.planes import fit_plane
-from lidarphoto.core.simulate_town import make_town, sample_town
+from lidarphoto.core.geometry.planes import fit_plane
+from lidarphoto.core.lidar.control import ControlOptions, lidar_control
+from lidarphoto.core.simulation.town import make_town, sample_town
 
 SIGMA = 0.05  # m, LiDAR noise per coordinate
 DENSITY = 8.0  # points per m^2

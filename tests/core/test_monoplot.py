@@ -10,14 +10,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from lidarphoto.core.camera import Camera
-from lidarphoto.core.collinearity import image_rays, project
-from lidarphoto.core.distortion import distortion_from_dict
-from lidarphoto.core.dsm import Dsm, dsm_from_las
-from lidarphoto.core.frames import LocalFrame, MappingFrame
-from lidarphoto.core.ground_filter import Grid
+from lidarphoto.core.geometry.camera import Camera
+from lidarphoto.core.geometry.collinearity import image_rays, project
+from lidarphoto.core.geometry.distortion import distortion_from_dict
+from lidarphoto.core.geometry.frames import LocalFrame, MappingFrame
+from lidarphoto.core.geometry.planes import fit_plane, write_planes_csv
+from lidarphoto.core.geometry.rotations import matrix_to_opk
 from lidarphoto.core.io.observations import ImageObservations
-from lidarphoto.core.monoplot import (
+from lidarphoto.core.lidar.dsm import Dsm, dsm_from_las
+from lidarphoto.core.lidar.ground_filter import Grid
+from lidarphoto.core.photo.monoplot import (
     STATUS_TEXT,
     DsmTracer,
     dal_poz_intersect,
@@ -28,9 +30,7 @@ from lidarphoto.core.monoplot import (
     propagate_covariance,
     run_monoplot,
 )
-from lidarphoto.core.orientation import ExteriorOrientationTable, eo_map_to_local
-from lidarphoto.core.planes import fit_plane, write_planes_csv
-from lidarphoto.core.rotations import matrix_to_opk
+from lidarphoto.core.photo.orientation import ExteriorOrientationTable, eo_map_to_local
 
 AHN3 = Path(__file__).resolve().parents[1] / "data" / "ahn3" / "ahn3_delft_crop60.laz"
 CRS = "EPSG:28992"
@@ -356,7 +356,7 @@ def _utm_dsm(rows: int = 160, cols: int = 150, cell: float = 0.5) -> tuple[Dsm, 
 
 def test_dsm_in_another_crs_is_resampled_and_heights_transformed():
     import pyproj
-    from lidarphoto.core.dsm import reproject_dsm
+    from lidarphoto.core.lidar.dsm import reproject_dsm
 
     utm, f = _utm_dsm()
     rd = reproject_dsm(utm, CRS)
@@ -401,8 +401,8 @@ def test_monoplot_on_a_dsm_in_another_crs_reaches_the_truth():
 
 
 def test_reprojecting_a_dsm_without_crs_is_refused():
-    from lidarphoto.core.dsm import reproject_dsm
     from lidarphoto.core.errors import CrsError
+    from lidarphoto.core.lidar.dsm import reproject_dsm
 
     utm, _ = _utm_dsm(rows=4, cols=4)
     bare = Dsm(utm.heights, utm.grid, None, "bare.tif")

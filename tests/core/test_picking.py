@@ -8,15 +8,15 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
-from lidarphoto.core.frames import MappingFrame
-from lidarphoto.core.picking import (
+from lidarphoto.core.geometry.frames import MappingFrame
+from lidarphoto.core.photo.georeference import Mount, direct_georeference
+from lidarphoto.core.photo.picking import (
     PickingScene,
     nearest_point,
     nearest_segment,
     points_in_polygons,
 )
-from lidarphoto.core.simulate_flight import FlightConfig, simulate_flight
-from lidarphoto.core.trajectory_to_eo import Mount, direct_georeference
+from lidarphoto.core.simulation.flight import FlightConfig, simulate_flight
 
 SMALL = FlightConfig(
     n_buildings=9,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
-from lidarphoto.core.planes import (
+from lidarphoto.core.geometry.planes import (
     COV_COLUMNS,
     PLANE_COLUMNS,
     fit_plane,

@@ -11,7 +11,7 @@ import numpy as np
 import pyproj
 import pytest
 from lidarphoto.core.errors import Cancelled, CrsError, InputError
-from lidarphoto.core.pointcloud import read_info, read_points, write_cloud
+from lidarphoto.core.io.pointcloud import read_info, read_points, write_cloud
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 AHN3 = DATA / "ahn3" / "ahn3_delft_crop60.laz"

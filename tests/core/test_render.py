@@ -13,17 +13,17 @@ import math
 import cv2
 import numpy as np
 import pytest
-from lidarphoto.core.camera import Camera, camera_from_dict
-from lidarphoto.core.dsm import Dsm, dsm_from_points
 from lidarphoto.core.errors import CrsError, InputError
-from lidarphoto.core.frames import LocalFrame, MappingFrame
-from lidarphoto.core.ground_filter import Grid
-from lidarphoto.core.lidar_control import ControlLine
-from lidarphoto.core.monoplot import chord_rays
-from lidarphoto.core.orientation import ExteriorOrientationTable, eo_map_to_local
-from lidarphoto.core.picking import PickingScene
-from lidarphoto.core.planes import fit_plane
-from lidarphoto.core.render import (
+from lidarphoto.core.geometry.camera import Camera, camera_from_dict
+from lidarphoto.core.geometry.frames import LocalFrame, MappingFrame
+from lidarphoto.core.geometry.planes import fit_plane
+from lidarphoto.core.lidar.control import ControlLine
+from lidarphoto.core.lidar.dsm import Dsm, dsm_from_points
+from lidarphoto.core.lidar.ground_filter import Grid
+from lidarphoto.core.photo.monoplot import chord_rays
+from lidarphoto.core.photo.orientation import ExteriorOrientationTable, eo_map_to_local
+from lidarphoto.core.photo.picking import PickingScene
+from lidarphoto.core.simulation.render import (
     CLASS_ALBEDO,
     PLANE_TINTS,
     RenderOptions,

@@ -8,9 +8,9 @@ from html.parser import HTMLParser
 
 import numpy as np
 import pytest
-from lidarphoto.core.accuracy import AccuracySettings, CheckPoints, assess_accuracy
-from lidarphoto.core.report_html import render_html
-from lidarphoto.core.svg_plots import histogram, nice_step, qq_plot, vector_map
+from lidarphoto.core.quality.accuracy import AccuracySettings, CheckPoints, assess_accuracy
+from lidarphoto.core.quality.accuracy_html import render_html
+from lidarphoto.core.quality.svg_plots import histogram, nice_step, qq_plot, vector_map
 from scipy import stats
 
 SVG = "{http://www.w3.org/2000/svg}"

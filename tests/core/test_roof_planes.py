@@ -10,18 +10,13 @@ import pyproj
 import pytest
 from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.errors import Cancelled, CrsError, InputError
-from lidarphoto.core.planes import read_planes_csv
-from lidarphoto.core.roof_planes import (
+from lidarphoto.core.geometry.planes import read_planes_csv
+from lidarphoto.core.lidar.roof_planes import (
     RoofPlaneParams,
     extract_roof_planes,
     run_extract_roof_planes,
 )
-from lidarphoto.core.simulate_town import (
-    CLASS_GROUND,
-    CLASS_VEGETATION,
-    make_town,
-    sample_town,
-)
+from lidarphoto.core.simulation.town import CLASS_GROUND, CLASS_VEGETATION, make_town, sample_town
 from scipy.stats import chi2
 
 SIGMA = 0.03  # m, noise per coordinate

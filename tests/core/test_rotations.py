@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from lidarphoto.core import rotations as rot
+from lidarphoto.core.geometry import rotations as rot
 from scipy.spatial.transform import Rotation
 
 RNG = np.random.default_rng(7)

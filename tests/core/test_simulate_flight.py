@@ -6,14 +6,14 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from lidarphoto.core.boresight import BoresightOptions, calibrate
-from lidarphoto.core.camera import read_camera_json
 from lidarphoto.core.errors import InputError
+from lidarphoto.core.geometry.camera import read_camera_json
+from lidarphoto.core.geometry.planes import read_planes_csv
 from lidarphoto.core.io.control import read_lcps_csv, read_lines_csv
 from lidarphoto.core.io.observations import read_observations_csv
-from lidarphoto.core.planes import read_planes_csv
-from lidarphoto.core.simulate_flight import FlightConfig, paper_config, simulate_flight
-from lidarphoto.core.trajectory_to_eo import Mount, read_trajectory_csv
+from lidarphoto.core.photo.boresight import BoresightOptions, calibrate
+from lidarphoto.core.photo.georeference import Mount, read_trajectory_csv
+from lidarphoto.core.simulation.flight import FlightConfig, paper_config, simulate_flight
 
 
 def test_paper_preset_has_the_papers_geometry():

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
-from lidarphoto.core.simulate_town import (
+from lidarphoto.core.simulation.town import (
     CLASS_BUILDING,
     CLASS_GROUND,
     CLASS_VEGETATION,

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
-from lidarphoto.core.standards import (
+from lidarphoto.core.quality.standards import (
     NSSDA_HORIZONTAL_FACTOR,
     NSSDA_RADIAL_FACTOR,
     NSSDA_VERTICAL_FACTOR,

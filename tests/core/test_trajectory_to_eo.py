@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.errors import CrsError, InputError
-from lidarphoto.core.frames import MappingFrame
-from lidarphoto.core.orientation import read_eo_csv
-from lidarphoto.core.rotations import MOUNT_PRESETS
-from lidarphoto.core.trajectory_to_eo import run_trajectory_to_eo
+from lidarphoto.core.geometry.frames import MappingFrame
+from lidarphoto.core.geometry.rotations import MOUNT_PRESETS
+from lidarphoto.core.photo.georeference import run_trajectory_to_eo
+from lidarphoto.core.photo.orientation import read_eo_csv
 from pyproj import Geod, Proj
 from scipy.spatial.transform import Rotation
 

@@ -12,7 +12,7 @@ from dataclasses import replace
 import numpy as np
 import processing
 import pytest
-from lidarphoto.core.simulate_flight import FlightConfig, simulate_flight
+from lidarphoto.core.simulation.flight import FlightConfig, simulate_flight
 from qgis.core import QgsProcessingException, QgsVectorLayer, QgsWkbTypes
 from qgis_helpers import QGIS_PROCESS
 

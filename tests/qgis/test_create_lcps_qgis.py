@@ -14,8 +14,8 @@ import numpy as np
 import processing
 import pyproj
 import pytest
-from lidarphoto.core.planes import fit_plane, write_planes_csv
-from lidarphoto.core.simulate_town import make_town, sample_town
+from lidarphoto.core.geometry.planes import fit_plane, write_planes_csv
+from lidarphoto.core.simulation.town import make_town, sample_town
 from qgis.core import (
     QgsProcessingException,
     QgsProcessingModelAlgorithm,

@@ -21,13 +21,13 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from lidarphoto.core.camera import Camera
-from lidarphoto.core.frames import MappingFrame
+from lidarphoto.core.geometry.camera import Camera
+from lidarphoto.core.geometry.frames import MappingFrame
 from lidarphoto.core.io.observations import read_observations_csv
-from lidarphoto.core.orientation import read_eo_csv
-from lidarphoto.core.picking import PickingScene
-from lidarphoto.core.render import RenderOptions, RenderScene, render_image
-from lidarphoto.core.trajectory_to_eo import direct_georeference
+from lidarphoto.core.photo.georeference import direct_georeference
+from lidarphoto.core.photo.orientation import read_eo_csv
+from lidarphoto.core.photo.picking import PickingScene
+from lidarphoto.core.simulation.render import RenderOptions, RenderScene, render_image
 from lidarphoto.plugin.image_dock import ImagePickingDock
 from qgis.core import QgsProject
 from qgis.PyQt.QtCore import QPointF, Qt

@@ -11,7 +11,7 @@ FAKE = "lidarphoto_no_such_module_4711"
 
 
 def test_nothing_missing_in_the_test_environment():
-    from lidarphoto.plugin.dependencies import REQUIRED_MODULES, missing_modules
+    from lidarphoto.core.dependencies import REQUIRED_MODULES, missing_modules
 
     assert set(REQUIRED_MODULES) == {"laspy", "lazrs", "cv2", "scipy", "pyproj"}
     assert REQUIRED_MODULES["cv2"] == "opencv-python-headless"
@@ -19,7 +19,7 @@ def test_nothing_missing_in_the_test_environment():
 
 
 def test_fake_module_is_reported():
-    from lidarphoto.plugin.dependencies import missing_modules, pip_command
+    from lidarphoto.core.dependencies import missing_modules, pip_command
 
     assert missing_modules([FAKE, "cv2", "scipy"]) == [FAKE]
     cmd = pip_command([FAKE, "cv2"])
@@ -31,7 +31,7 @@ def test_fake_module_is_reported():
 
 
 def test_report_pushes_one_message_and_logs(qgis_iface):
-    from lidarphoto.plugin.dependencies import report_missing
+    from lidarphoto.plugin.dependency_check import report_missing
 
     logged = []
 
@@ -61,7 +61,7 @@ def test_report_pushes_one_message_and_logs(qgis_iface):
 
 def test_qgis_python_is_a_python_interpreter():
     """Here sys.executable is a python; the derivation from sys.exec_prefix must agree."""
-    from lidarphoto.plugin import dependencies
+    from lidarphoto.core import dependencies
 
     exe = dependencies.qgis_python()
     r = subprocess.run(
@@ -75,7 +75,7 @@ def test_qgis_python_is_a_python_interpreter():
 
 def test_qgis_python_when_running_inside_the_qgis_binary(monkeypatch):
     """Inside QGIS on Linux sys.executable is /usr/bin/qgis: derive python from exec_prefix."""
-    from lidarphoto.plugin import dependencies
+    from lidarphoto.core import dependencies
 
     monkeypatch.setattr(sys, "executable", "/usr/bin/qgis")
     monkeypatch.setattr(sys, "exec_prefix", "/usr")
@@ -86,7 +86,8 @@ def test_qgis_python_when_running_inside_the_qgis_binary(monkeypatch):
 
 
 def test_missing_accelerator_is_logged_as_information_only(qgis_iface, monkeypatch):
-    from lidarphoto.plugin import dependencies
+    from lidarphoto.core import dependencies
+    from lidarphoto.plugin.dependency_check import report_missing
 
     monkeypatch.setitem(dependencies.OPTIONAL_MODULES, FAKE, (FAKE, "something runs slower"))
     logged = []
@@ -99,7 +100,7 @@ def test_missing_accelerator_is_logged_as_information_only(qgis_iface, monkeypat
     bar = qgis_iface.messageBar()
     bar.clear_messages()
     try:
-        assert dependencies.report_missing(qgis_iface) == []
+        assert report_missing(qgis_iface) == []
     finally:
         log.messageReceived.disconnect(on_message)
     assert bar.get_messages(Qgis.MessageLevel.Warning) == []

@@ -18,14 +18,14 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from lidarphoto.core.camera import Camera
-from lidarphoto.core.frames import MappingFrame
+from lidarphoto.core.geometry.camera import Camera
+from lidarphoto.core.geometry.frames import MappingFrame
+from lidarphoto.core.geometry.planes import write_planes_csv
 from lidarphoto.core.io.control import write_lcps_csv, write_lines_csv
 from lidarphoto.core.io.observations import read_observations_csv, write_observations_csv
-from lidarphoto.core.picking import PickingScene
-from lidarphoto.core.planes import write_planes_csv
-from lidarphoto.core.simulate_flight import FlightConfig, simulate_flight
-from lidarphoto.core.trajectory_to_eo import Mount, direct_georeference
+from lidarphoto.core.photo.georeference import Mount, direct_georeference
+from lidarphoto.core.photo.picking import PickingScene
+from lidarphoto.core.simulation.flight import FlightConfig, simulate_flight
 from lidarphoto.plugin.image_dock import ImagePickingDock
 from lidarphoto.plugin.image_source import ImageSource
 from lidarphoto.plugin.observation_store import ObservationStore

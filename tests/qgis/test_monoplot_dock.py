@@ -11,14 +11,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from lidarphoto.core.camera import Camera, write_camera_json
-from lidarphoto.core.dsm import dsm_from_las, reproject_dsm
+from lidarphoto.core.geometry.camera import Camera, write_camera_json
 from lidarphoto.core.io.observations import ImageObservations, read_observations_csv
-from lidarphoto.core.monoplot import run_monoplot
-from lidarphoto.core.orientation import ExteriorOrientationTable
-from lidarphoto.core.picking import PickingScene
-from lidarphoto.core.pointcloud import read_points
-from lidarphoto.core.render import RenderOptions, RenderScene, render_image, write_rgb_tiff
+from lidarphoto.core.io.pointcloud import read_points
+from lidarphoto.core.lidar.dsm import dsm_from_las, reproject_dsm
+from lidarphoto.core.photo.monoplot import run_monoplot
+from lidarphoto.core.photo.orientation import ExteriorOrientationTable
+from lidarphoto.core.photo.picking import PickingScene
+from lidarphoto.core.simulation.render import (
+    RenderOptions,
+    RenderScene,
+    render_image,
+    write_rgb_tiff,
+)
 from lidarphoto.plugin.image_dock import ImagePickingDock
 from qgis.core import (
     QgsFeature,

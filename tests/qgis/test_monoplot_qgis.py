@@ -11,14 +11,14 @@ from pathlib import Path
 import numpy as np
 import processing
 import pytest
-from lidarphoto.core.camera import Camera, write_camera_json
-from lidarphoto.core.collinearity import project
-from lidarphoto.core.dsm import dsm_from_las
-from lidarphoto.core.frames import LocalFrame, MappingFrame
+from lidarphoto.core.geometry.camera import Camera, write_camera_json
+from lidarphoto.core.geometry.collinearity import project
+from lidarphoto.core.geometry.frames import LocalFrame, MappingFrame
+from lidarphoto.core.geometry.rotations import matrix_to_opk
 from lidarphoto.core.io.observations import ImageObservations, write_observations_csv
-from lidarphoto.core.monoplot import run_monoplot
-from lidarphoto.core.orientation import ExteriorOrientationTable, eo_map_to_local
-from lidarphoto.core.rotations import matrix_to_opk
+from lidarphoto.core.lidar.dsm import dsm_from_las
+from lidarphoto.core.photo.monoplot import run_monoplot
+from lidarphoto.core.photo.orientation import ExteriorOrientationTable, eo_map_to_local
 from qgis.core import QgsProcessingException, QgsVectorLayer, QgsWkbTypes
 from qgis_helpers import QGIS_PROCESS
 

@@ -1,0 +1,118 @@
+"""Which third-party packages of the core are missing, and the pip command that installs them.
+
+Qt-free: the plugin shows these messages at load time (one message-bar warning plus a log
+entry) and every algorithm's ``canExecute`` uses them; nothing here raises.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import shlex
+import sys
+import sysconfig
+from collections.abc import Iterable, Sequence
+
+#: import name -> pip requirement, in the order they are reported.
+REQUIRED_MODULES: dict[str, str] = {
+    "laspy": "laspy",
+    "lazrs": "lazrs",
+    "cv2": "opencv-python-headless",
+    "scipy": "scipy",
+    "pyproj": "pyproj",
+}
+
+#: optional accelerators: import name -> (pip requirement, what is slower without it).
+OPTIONAL_MODULES: dict[str, tuple[str, str]] = {
+    "numba": ("numba", "ray casting on the DSM (monoplotting) runs 2-3x slower"),
+}
+
+
+def missing_modules(modules: Iterable[str] | None = None) -> list[str]:
+    """Return the names in ``modules`` (default: REQUIRED_MODULES) that fail to import."""
+    names = list(REQUIRED_MODULES) if modules is None else list(modules)
+    missing = []
+    for name in names:
+        try:
+            importlib.import_module(name)
+        except Exception:  # ImportError, but also broken binaries (numpy ABI, missing .so)
+            missing.append(name)
+    return missing
+
+
+def pip_requirements(modules: Sequence[str]) -> list[str]:
+    """Pip requirement names for import names (unknown names are passed through)."""
+    seen: list[str] = []
+    for name in modules:
+        req = REQUIRED_MODULES.get(name, name)
+        if req not in seen:
+            seen.append(req)
+    return seen
+
+
+def qgis_python() -> str:
+    """Path of the Python interpreter QGIS embeds (``sys.executable`` is often QGIS itself)."""
+    exe = sys.executable or ""
+    if os.path.basename(exe).lower().startswith("python"):
+        return exe
+    prefix = sys.exec_prefix
+    if sys.platform == "win32":  # OSGeo4W / standalone installer: <prefix>/python.exe
+        candidates = [os.path.join(prefix, "python.exe"), os.path.join(prefix, "python3.exe")]
+    else:  # Linux packages (/usr), macOS QGIS.app (.../Contents/MacOS or Frameworks)
+        ver = f"{sys.version_info.major}.{sys.version_info.minor}"
+        candidates = [
+            os.path.join(prefix, "bin", f"python{ver}"),
+            os.path.join(prefix, "bin", "python3"),
+            os.path.join(prefix, "bin", "python"),
+        ]
+    for path in candidates:
+        if os.path.isfile(path):
+            return path
+    return candidates[0] if sys.platform == "win32" else "python3"
+
+
+def _externally_managed() -> bool:
+    """True for a PEP 668 system Python (Debian/Ubuntu >= 12/23.04), where pip needs a flag."""
+    stdlib = sysconfig.get_paths().get("stdlib", "")
+    return bool(stdlib) and os.path.isfile(os.path.join(stdlib, "EXTERNALLY-MANAGED"))
+
+
+def pip_command(modules: Sequence[str]) -> str:
+    """The shell command that installs ``modules`` into QGIS's Python.
+
+    numpy is pinned to the version QGIS already uses, so pip cannot replace it by an
+    ABI-incompatible one (numpy 2 breaks GDAL's and QGIS's compiled numpy bindings).
+    """
+    python = qgis_python()
+    args = [python, "-m", "pip", "install"]
+    if sys.platform != "win32":
+        args.append("--user")
+        if _externally_managed():
+            args.append("--break-system-packages")
+    args += pip_requirements(modules)
+    try:
+        import numpy
+
+        args.append(f"numpy=={numpy.__version__}")
+    except Exception:
+        pass
+    if sys.platform == "win32":
+        return " ".join(f'"{a}"' if " " in a else a for a in args)
+    return " ".join(shlex.quote(a) for a in args)
+
+
+def missing_message(modules: Sequence[str]) -> str:
+    """The user-facing text for missing modules."""
+    return (
+        "Missing Python packages: {names}. The LiDAR Photogrammetry algorithms need them; "
+        "install them into QGIS's Python and restart QGIS: {cmd}"
+    ).format(names=", ".join(pip_requirements(modules)), cmd=pip_command(modules))
+
+
+def optional_message(modules: Sequence[str]) -> str:
+    """The log text for missing optional accelerators."""
+    effects = "; ".join(OPTIONAL_MODULES[m][1] for m in modules if m in OPTIONAL_MODULES)
+    reqs = [OPTIONAL_MODULES[m][0] if m in OPTIONAL_MODULES else m for m in modules]
+    return (
+        "Optional Python packages not installed: {names} ({effects}). To install: {cmd}"
+    ).format(names=", ".join(reqs), effects=effects, cmd=pip_command(reqs))

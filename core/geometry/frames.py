@@ -1,0 +1,281 @@
+"""Coordinate frames: mapping CRS <-> geodetic <-> ECEF <-> local ENU adjustment frame.
+
+Every datum and projection step goes through pyproj; only the rigid ECEF <-> ENU rotation,
+which is exact linear algebra, is written here with numpy (it is checked against PROJ's own
+``topocentric`` conversion in the tests).
+
+Frames (see docs/conventions.md):
+
+- mapping frame m: the user's projected CRS (easting, northing) plus height. The height is
+  ellipsoidal for a 2D projected CRS, or in the vertical datum of a compound CRS (the geoid
+  grid must then be installed for PROJ; a missing grid raises :class:`CrsError`).
+- geodetic: latitude, longitude in degrees and ellipsoidal height in metres on the datum of
+  the mapping CRS.
+- ECEF: the geocentric Cartesian frame of that datum, metres.
+- adjustment frame: local east-north-up (ENU) Cartesian frame tangent to the ellipsoid at an
+  origin (usually the project centre), metres.
+- local-level NED at a point: north, east, down at that point's own latitude and longitude.
+- grid frame at a point: grid east, grid north and the local ellipsoidal up at that point;
+  it differs from local ENU by the grid convergence (a rotation about up). Omega-phi-kappa
+  "in the mapping CRS" are relative to this frame.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from pyproj import CRS, Transformer
+from pyproj.transformer import TransformerGroup
+
+from ..errors import CrsError
+
+Array = NDArray[np.float64]
+
+# NED -> ENU axis swap: (n, e, d) -> (e, n, u)
+NED_TO_ENU = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+
+
+def parse_crs(crs: CRS | str | int, *, what: str = "CRS") -> CRS:
+    """Read a CRS given as EPSG code, ``"EPSG:xxxx"``, WKT or PROJ string; clear error if not."""
+    if isinstance(crs, CRS):
+        return crs
+    if crs is None or (isinstance(crs, str) and not crs.strip()):
+        raise CrsError(f"{what} is missing: give an EPSG code (e.g. EPSG:32632) or WKT")
+    if isinstance(crs, str) and crs.strip().isdigit():
+        crs = int(crs)  # a bare EPSG code typed as text
+    try:
+        return CRS.from_user_input(crs)
+    except Exception as exc:  # pyproj raises CRSError with PROJ's words; keep them
+        raise CrsError(f"{what} '{str(crs)[:80]}' is not a valid CRS: {exc}") from exc
+
+
+def enu_rotation(lat_deg: ArrayLike, lon_deg: ArrayLike) -> Array:
+    """Rotation ``R`` with rows (east, north, up) expressed in ECEF: ``enu = R @ ecef_vector``.
+
+    Shape ``S + (3, 3)`` for latitude/longitude arrays of shape ``S`` (degrees).
+    """
+    lat = np.radians(np.asarray(lat_deg, dtype=np.float64))
+    lon = np.radians(np.asarray(lon_deg, dtype=np.float64))
+    sl, cl = np.sin(lat), np.cos(lat)
+    so, co = np.sin(lon), np.cos(lon)
+    out = np.empty((*lat.shape, 3, 3))
+    out[..., 0, :] = np.stack([-so, co, np.zeros_like(so)], axis=-1)
+    out[..., 1, :] = np.stack([-sl * co, -sl * so, cl], axis=-1)
+    out[..., 2, :] = np.stack([cl * co, cl * so, sl], axis=-1)
+    return out
+
+
+def ned_to_ecef_rotation(lat_deg: ArrayLike, lon_deg: ArrayLike) -> Array:
+    """``R_n^e``: columns are north, east, down at (lat, lon) expressed in ECEF."""
+    r_enu = enu_rotation(lat_deg, lon_deg)  # rows e, n, u
+    return np.swapaxes(NED_TO_ENU @ r_enu, -1, -2)
+
+
+def grid_rotation(theta: ArrayLike) -> Array:
+    """Rotation from local ENU to the grid frame, given the grid azimuth ``theta`` of true north.
+
+    ``theta`` (radians) is the clockwise angle from grid north to true north. A vector with
+    true azimuth ``a`` has grid azimuth ``a + theta``; up is unchanged.
+    """
+    t = np.asarray(theta, dtype=np.float64)
+    c, s = np.cos(t), np.sin(t)
+    out = np.zeros((*t.shape, 3, 3))
+    out[..., 0, 0], out[..., 0, 1] = c, s
+    out[..., 1, 0], out[..., 1, 1] = -s, c
+    out[..., 2, 2] = 1.0
+    return out
+
+
+@dataclass(frozen=True)
+class MappingFrame:
+    """A projected mapping CRS and the transformations the core needs around it.
+
+    Parameters
+    ----------
+    crs:
+        The mapping CRS (projected, optionally compound with a vertical CRS).
+    """
+
+    crs: CRS
+    geodetic: CRS = field(init=False)
+    geocentric: CRS = field(init=False)
+    _to_geod: Transformer = field(init=False, repr=False)
+    _from_geod: Transformer = field(init=False, repr=False)
+    _geod_to_ecef: Transformer = field(init=False, repr=False)
+    _ecef_to_geod: Transformer = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        crs = self.crs
+        horizontal = crs.sub_crs_list[0] if crs.is_compound else crs
+        if not horizontal.is_projected:
+            raise CrsError(
+                f"the mapping CRS must be projected (metres on a map grid); "
+                f"'{crs.name}' is {crs.type_name}"
+            )
+        for axis in horizontal.axis_info[:2]:
+            if axis.unit_name not in ("metre", "meter"):
+                raise CrsError(
+                    f"the mapping CRS '{crs.name}' has {axis.unit_name} units; the core works in "
+                    "metres: reproject to a metric CRS first"
+                )
+        geodetic = horizontal.geodetic_crs.to_3d()
+        ellipsoid = geodetic.ellipsoid
+        geocentric = CRS.from_proj4(
+            f"+proj=geocent +a={ellipsoid.semi_major_metre!r} "
+            f"+rf={ellipsoid.inverse_flattening!r} +units=m +no_defs"
+        )
+        src = crs if crs.is_compound else horizontal.to_3d()
+        object.__setattr__(self, "geodetic", geodetic)
+        object.__setattr__(self, "geocentric", geocentric)
+        object.__setattr__(self, "_to_geod", _exact_transformer(src, geodetic))
+        object.__setattr__(self, "_from_geod", _exact_transformer(geodetic, src))
+        object.__setattr__(self, "_geod_to_ecef", _exact_transformer(geodetic, geocentric))
+        object.__setattr__(self, "_ecef_to_geod", _exact_transformer(geocentric, geodetic))
+
+    @classmethod
+    def from_user_input(cls, crs: CRS | str | int) -> MappingFrame:
+        return cls(parse_crs(crs, what="mapping CRS"))
+
+    # -- positions -----------------------------------------------------------------------
+    def map_to_geodetic(self, enh: ArrayLike) -> Array:
+        """(N, 3) easting, northing, height -> (N, 3) latitude, longitude (deg), ellipsoidal h."""
+        e, n, h = _columns(enh)
+        lon, lat, hh = self._to_geod.transform(e, n, h)
+        return np.stack([lat, lon, hh], axis=-1)
+
+    def geodetic_to_map(self, llh: ArrayLike) -> Array:
+        """(N, 3) latitude, longitude (deg), ellipsoidal h -> (N, 3) easting, northing, height."""
+        lat, lon, h = _columns(llh)
+        e, n, hh = self._from_geod.transform(lon, lat, h)
+        return np.stack([e, n, hh], axis=-1)
+
+    def geodetic_to_ecef(self, llh: ArrayLike) -> Array:
+        lat, lon, h = _columns(llh)
+        x, y, z = self._geod_to_ecef.transform(lon, lat, h)
+        return np.stack([x, y, z], axis=-1)
+
+    def ecef_to_geodetic(self, xyz: ArrayLike) -> Array:
+        x, y, z = _columns(xyz)
+        lon, lat, h = self._ecef_to_geod.transform(x, y, z)
+        return np.stack([lat, lon, h], axis=-1)
+
+    def map_to_ecef(self, enh: ArrayLike) -> Array:
+        return self.geodetic_to_ecef(self.map_to_geodetic(enh))
+
+    def ecef_to_map(self, xyz: ArrayLike) -> Array:
+        return self.geodetic_to_map(self.ecef_to_geodetic(xyz))
+
+    # -- orientation ---------------------------------------------------------------------
+    def grid_north_azimuth(self, llh: ArrayLike, step_deg: float = 1e-4) -> Array:
+        """Clockwise angle (radians) from grid north to true north at each point.
+
+        Computed from the projection itself (central differences along the meridian), so it
+        holds for any projected CRS; it is the negative of the usual "grid convergence" sign in
+        some texts, hence the explicit name.
+        """
+        lat, lon, h = _columns(llh)
+        north = self.geodetic_to_map(np.stack([lat + step_deg, lon, h], axis=-1))
+        south = self.geodetic_to_map(np.stack([lat - step_deg, lon, h], axis=-1))
+        d = north - south
+        return np.arctan2(d[..., 0], d[..., 1])
+
+    def ned_to_grid(self, llh: ArrayLike) -> Array:
+        """``R_n^m`` per point: NED at the point -> grid frame (grid E, grid N, up)."""
+        return grid_rotation(self.grid_north_azimuth(llh)) @ NED_TO_ENU
+
+
+@dataclass(frozen=True)
+class LocalFrame:
+    """Local ENU adjustment frame tangent to the ellipsoid at ``origin_llh``.
+
+    ``origin_llh`` is (latitude, longitude in degrees, ellipsoidal height in metres).
+    """
+
+    mapping: MappingFrame
+    origin_llh: tuple[float, float, float]
+    origin_ecef: Array = field(init=False, repr=False)
+    rotation: Array = field(init=False, repr=False)  # rows e, n, u in ECEF
+
+    def __post_init__(self) -> None:
+        lat, lon, h = (float(v) for v in self.origin_llh)
+        object.__setattr__(self, "origin_llh", (lat, lon, h))
+        ecef = self.mapping.geodetic_to_ecef(np.array([[lat, lon, h]]))[0]
+        object.__setattr__(self, "origin_ecef", ecef)
+        object.__setattr__(self, "rotation", enu_rotation(lat, lon))
+
+    @classmethod
+    def at_map_point(cls, mapping: MappingFrame, enh: ArrayLike) -> LocalFrame:
+        """Frame tangent at a point given in the mapping CRS (e.g. the project centre)."""
+        llh = mapping.map_to_geodetic(np.asarray(enh, dtype=np.float64).reshape(1, 3))[0]
+        return cls(mapping, (llh[0], llh[1], llh[2]))
+
+    def ecef_to_enu(self, xyz: ArrayLike) -> Array:
+        return (np.asarray(xyz, dtype=np.float64) - self.origin_ecef) @ self.rotation.T
+
+    def enu_to_ecef(self, enu: ArrayLike) -> Array:
+        return np.asarray(enu, dtype=np.float64) @ self.rotation + self.origin_ecef
+
+    def map_to_enu(self, enh: ArrayLike) -> Array:
+        return self.ecef_to_enu(self.mapping.map_to_ecef(enh))
+
+    def enu_to_map(self, enu: ArrayLike) -> Array:
+        return self.mapping.ecef_to_map(self.enu_to_ecef(enu))
+
+    def geodetic_to_enu(self, llh: ArrayLike) -> Array:
+        return self.ecef_to_enu(self.mapping.geodetic_to_ecef(llh))
+
+    def ned_to_local(self, llh: ArrayLike) -> Array:
+        """``R_n^l`` per point: NED at each point -> this ENU frame (curvature included)."""
+        lat, lon, _ = _columns(llh)
+        return self.rotation @ ned_to_ecef_rotation(lat, lon)
+
+    def grid_to_local(self, llh: ArrayLike) -> Array:
+        """Rotation from the grid frame at each point to this ENU frame."""
+        r_ng = self.mapping.ned_to_grid(llh)
+        return self.ned_to_local(llh) @ np.swapaxes(r_ng, -1, -2)
+
+
+def _columns(a: ArrayLike) -> tuple[Array, Array, Array]:
+    arr = np.asarray(a, dtype=np.float64)
+    if arr.shape[-1] != 3:
+        raise ValueError(f"expected coordinates with 3 columns, got shape {arr.shape}")
+    return arr[..., 0], arr[..., 1], arr[..., 2]
+
+
+def as_3d(crs: CRS) -> CRS:
+    """The CRS with its heights made explicit: compound CRSs as they are, a 2D CRS with
+    ellipsoidal heights (the convention of this package, docs/conventions.md)."""
+    return crs if crs.is_compound or len(crs.axis_info) > 2 else crs.to_3d()
+
+
+def transformer_3d(src: CRS, dst: CRS) -> Transformer:
+    """(x, y, height) from ``src`` to ``dst`` with heights per :func:`as_3d`; raises
+    CrsError instead of dropping a vertical datum change whose grid is not installed."""
+    return _exact_transformer(as_3d(src), as_3d(dst))
+
+
+def _exact_transformer(src: CRS, dst: CRS) -> Transformer:
+    """Best transformation, refusing PROJ's silent 'ballpark' fallback when a grid is missing."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # reported below as a CrsError instead
+        group = TransformerGroup(src, dst, always_xy=True)
+    if not group.transformers:
+        raise CrsError(f"no transformation from '{src.name}' to '{dst.name}' is available")
+    if not group.best_available:
+        missing = sorted(
+            {
+                grid.short_name
+                for op in group.unavailable_operations
+                for grid in op.grids
+                if not grid.available
+            }
+        )
+        raise CrsError(
+            f"transforming '{src.name}' to '{dst.name}' needs grid(s) not installed for PROJ: "
+            f"{', '.join(missing) or 'unknown'}; install them (e.g. projsync --file NAME, or copy "
+            "the file into the PROJ data folder) or use ellipsoidal heights (a 2D projected CRS)"
+        )
+    return group.transformers[0]

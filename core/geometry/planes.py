@@ -1,0 +1,417 @@
+"""Planes fitted to points with their precision, and the plane table (CSV).
+
+Convention (docs/conventions.md, DESIGN.md "Planes"): a plane is ``n . p + d = 0`` with the unit
+normal ``n = (a, b, c)`` pointing up (``c >= 0``), ``p`` in the cloud's projected CRS (all lengths
+in the CRS's unit: metres, or international feet for e.g. Autzen).
+
+Fit: the weighted eigen method of Pathak et al. (2010), computed on centred coordinates. With
+weights ``w_i`` (relative: point i has a residual variance ``sigma0^2 / w_i``) the plane
+minimising ``sum w_i (n . p_i + d)^2`` passes through the weighted centroid ``m`` and its normal
+is the eigenvector of the smallest eigenvalue ``l3`` of the weighted scatter matrix
+``S = sum w_i (p_i - m)(p_i - m)^T`` (eigenpairs ``l1 >= l2 >= l3``, ``v1, v2, v3``). The raw
+moment matrix of ``[x y z 1]`` used in paper 000 (Eq. 5) is never formed: with map coordinates
+of 1e5-1e6 m its smallest eigenvalue drowns in rounding.
+
+Precision (first-order propagation of a noise along the normal, equal to Pathak's closed form
+from the Hessian of the weighted sum of squares; checked by Monte Carlo in
+tests/core/test_planes.py)::
+
+    sigma0^2 = sum w_i r_i^2 / (n - 3)                      a-posteriori variance factor
+    C_nn     = sigma0^2 (v1 v1^T / (l1 - l3) + v2 v2^T / (l2 - l3))
+    var(s)   = sigma0^2 / sum w_i                            offset of the plane at m
+    d = -n . m  =>  C_nd = -C_nn m,  var(d) = m^T C_nn m + sigma0^2 / sum w_i
+
+``sigma_d = sqrt(var(d))`` is Khoshelham's (2016) standard deviation of d, used by paper 000
+Eq. (17) (printed there as ``sqrt(Cx^2 + Cy^2 + Cz^2) + sigma^2 / n``, a misprint of the same
+propagation with an isotropic normal variance). ``d`` is the distance of the CRS origin to the
+plane, so with map coordinates sigma_d is dominated by the lever ``m`` and is strongly
+correlated with the normal: use the full covariance (the plane table keeps all of it) when
+propagating, e.g. to plane intersections.
+
+Plane table CSV (``write_planes_csv``/``read_planes_csv``), one row per plane, header::
+
+    id,a,b,c,d,centroid_x,centroid_y,centroid_z,n_points,rms,sigma_d,slope_deg,aspect_deg,
+    cov_aa,cov_ab,cov_ac,cov_ad,cov_bb,cov_bc,cov_bd,cov_cc,cov_cd,cov_dd
+
+id (integer, as in the cloud's ``plane_id`` dimension), a b c d (plane parameters; a b c
+unitless, d in the CRS unit), centroid (CRS unit), n_points, rms of the point-to-plane residuals
+(CRS unit), sigma_d (CRS unit), slope (degrees from horizontal), aspect (degrees clockwise from
+grid north of the downslope direction; meaningless for flat planes), and the 10 upper-triangle
+elements of the covariance of (a, b, c, d). Paper 000's plane list (id, parameters, centroid,
+point count) is the first nine columns. Numbers are written with full round-trip precision.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Union
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InputError
+from ..io.tables import find_column, float_column, read_table, write_csv_atomic
+
+__all__ = [
+    "COV_COLUMNS",
+    "PLANE_COLUMNS",
+    "Plane",
+    "fit_plane",
+    "read_planes_csv",
+    "write_planes_csv",
+]
+
+Array = NDArray[np.float64]
+
+_PARAMS = "abcd"
+#: Upper-triangle covariance column names, row-major: cov_aa, cov_ab, ..., cov_dd.
+COV_COLUMNS: tuple[str, ...] = tuple(
+    f"cov_{_PARAMS[i]}{_PARAMS[j]}" for i in range(4) for j in range(i, 4)
+)
+#: The header of the plane table, in order.
+PLANE_COLUMNS: tuple[str, ...] = (
+    "id",
+    "a",
+    "b",
+    "c",
+    "d",
+    "centroid_x",
+    "centroid_y",
+    "centroid_z",
+    "n_points",
+    "rms",
+    "sigma_d",
+    "slope_deg",
+    "aspect_deg",
+    *COV_COLUMNS,
+)
+_IU = np.triu_indices(4)
+
+
+@dataclass(frozen=True)
+class Plane:
+    """A plane ``n . p + d = 0`` fitted to points, with its precision.
+
+    Attributes
+    ----------
+    id : int
+        Plane id (as in the cloud's ``plane_id`` dimension; -1 for a plane not yet numbered).
+    normal : ndarray, shape (3,)
+        Unit normal (a, b, c), ``c >= 0`` (up for roofs).
+    d : float
+        Offset, CRS unit: ``n . p + d = 0``.
+    centroid : ndarray, shape (3,)
+        Weighted centroid of the points, CRS unit.
+    n_points : int
+        Number of points fitted.
+    rms : float
+        Weighted root mean square of the point-to-plane residuals, CRS unit.
+    sigma_d : float
+        Standard deviation of d (Khoshelham 2016), CRS unit: ``sqrt(covariance[3, 3])``.
+    covariance : ndarray, shape (4, 4)
+        Covariance of (a, b, c, d), scaled by the a-posteriori variance factor. Rank 3: the
+        normal's length is fixed, so ``covariance @ (a, b, c, 0) = 0``.
+    slope_deg : float
+        Angle between the plane and the horizontal, degrees in [0, 90].
+    aspect_deg : float
+        Direction of steepest descent, degrees clockwise from grid north in [0, 360).
+    outline : ndarray, shape (M, 3)
+        Outline polygon (not closed: the first vertex is not repeated), CRS unit; empty when
+        unknown (e.g. read back from a plane table).
+    """
+
+    id: int
+    normal: Array
+    d: float
+    centroid: Array
+    n_points: int
+    rms: float
+    sigma_d: float
+    covariance: Array
+    slope_deg: float
+    aspect_deg: float
+    outline: Array = field(default_factory=lambda: np.empty((0, 3)))
+
+    @property
+    def params(self) -> Array:
+        """(a, b, c, d), shape (4,)."""
+        return np.append(self.normal, self.d)
+
+    def distance(self, points: ArrayLike) -> Array:
+        """Signed distances of points (N, 3) to the plane, CRS unit, positive above (N,).
+
+        >>> p = fit_plane([[0, 0, 1], [1, 0, 1], [0, 1, 1], [1, 1, 1.0]])
+        >>> p.distance([[5.0, 5.0, 3.0]]).round(6).tolist()
+        [2.0]
+        """
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        # relative to the centroid: map coordinates of 1e6 would lose digits in n.p + d
+        return (pts - self.centroid) @ self.normal
+
+    def with_id(self, new_id: int) -> Plane:
+        """The same plane with another id."""
+        return Plane(
+            int(new_id),
+            self.normal,
+            self.d,
+            self.centroid,
+            self.n_points,
+            self.rms,
+            self.sigma_d,
+            self.covariance,
+            self.slope_deg,
+            self.aspect_deg,
+            self.outline,
+        )
+
+    def with_outline(self, outline: ArrayLike) -> Plane:
+        """The same plane with an outline polygon (M, 3)."""
+        return Plane(
+            self.id,
+            self.normal,
+            self.d,
+            self.centroid,
+            self.n_points,
+            self.rms,
+            self.sigma_d,
+            self.covariance,
+            self.slope_deg,
+            self.aspect_deg,
+            np.asarray(outline, dtype=np.float64).reshape(-1, 3),
+        )
+
+
+def orient_up(normal: Array) -> Array:
+    """Flip a unit normal (3,) so that c >= 0 (for c == 0: b >= 0, then a >= 0)."""
+    for comp in normal[::-1]:
+        if comp != 0.0:
+            return normal if comp > 0.0 else -normal
+    return normal
+
+
+def slope_aspect_deg(normal: Array) -> tuple[float, float]:
+    """Slope (degrees from horizontal) and aspect (degrees clockwise from grid north of the
+    downslope direction) of an upward unit normal (3,).
+
+    The downslope direction of ``z = -(a x + b y + d) / c`` is ``(a, b)``.
+
+    >>> [round(v, 6) for v in slope_aspect_deg(np.array([0.5, 0.0, math.sqrt(0.75)]))]
+    [30.0, 90.0]
+    """
+    a, b, c = (float(v) for v in normal)
+    slope = math.degrees(math.atan2(math.hypot(a, b), abs(c)))
+    aspect = math.degrees(math.atan2(a, b)) % 360.0
+    return slope, aspect
+
+
+def fit_plane(points: ArrayLike, weights: ArrayLike | None = None, *, plane_id: int = -1) -> Plane:
+    """Weighted least-squares plane (Pathak et al. 2010) with its covariance.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 3)
+        Points in a projected CRS (any unit; the results are in the same unit), N >= 3.
+    weights : array_like, shape (N,), optional
+        Relative weights (inverse variances up to a common factor), all > 0. Default: 1.
+    plane_id : int
+        Id stored in the result.
+
+    Returns
+    -------
+    Plane
+        Normal up (c >= 0), d, centroid, rms, sigma_d and the 4x4 covariance of (a, b, c, d),
+        scaled by the a-posteriori variance factor ``sum w r^2 / (N - 3)`` (with N = 3 the
+        covariance is zero: no redundancy).
+
+    Raises
+    ------
+    InputError
+        Fewer than 3 points, non-finite values, bad weights, or (near) collinear points.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(1)
+    >>> xy = rng.uniform(0, 10, (200, 2))
+    >>> z = 2.0 + 0.5 * xy[:, 0]
+    >>> p = fit_plane(np.column_stack([xy, z]))
+    >>> round(p.slope_deg, 6), round(p.aspect_deg, 6), round(p.rms, 9)
+    (26.565051, 270.0, 0.0)
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise InputError(f"points must have shape (N, 3), got {pts.shape}")
+    n = len(pts)
+    if n < 3:
+        raise InputError(f"a plane needs at least 3 points, got {n}")
+    if not np.isfinite(pts).all():
+        raise InputError("points contain NaN or infinite coordinates")
+    if weights is None:
+        w = np.ones(n)
+    else:
+        w = np.asarray(weights, dtype=np.float64).reshape(-1)
+        if w.shape != (n,):
+            raise InputError(f"weights must have shape ({n},), got {w.shape}")
+        if not (np.isfinite(w).all() and (w > 0).all()):
+            raise InputError("weights must be finite and > 0")
+    w_sum = float(w.sum())
+    # Centre in two steps (first point, then the weighted mean) so that large map coordinates
+    # never meet in one product.
+    ref = pts[0]
+    q = pts - ref
+    centroid = ref + (w @ q) / w_sum
+    q = pts - centroid
+    scatter = (q * w[:, None]).T @ q
+    lam, vec = np.linalg.eigh(scatter)  # ascending
+    extent = lam[2]
+    if not extent > 0 or lam[1] <= 1e-12 * extent:
+        raise InputError("the points are collinear or coincident: no unique plane")
+    normal = orient_up(vec[:, 0].copy())
+    d = -float(normal @ centroid)
+    r = q @ normal
+    wrr = float(w @ (r * r))
+    rms = math.sqrt(wrr / w_sum)
+    sigma0_sq = wrr / (n - 3) if n > 3 else 0.0
+    # Eigen-structure of the scatter matrix: tilts of the normal towards v_k are resisted by the
+    # spread along v_k (l_k - l3); the offset along n by the total weight.
+    c_nn = sigma0_sq * (
+        np.outer(vec[:, 2], vec[:, 2]) / (lam[2] - lam[0])
+        + np.outer(vec[:, 1], vec[:, 1]) / (lam[1] - lam[0])
+    )
+    var_s = sigma0_sq / w_sum
+    cov = np.empty((4, 4))
+    cov[:3, :3] = c_nn
+    c_nd = -c_nn @ centroid
+    cov[:3, 3] = c_nd
+    cov[3, :3] = c_nd
+    cov[3, 3] = float(centroid @ c_nn @ centroid) + var_s
+    slope, aspect = slope_aspect_deg(normal)
+    return Plane(
+        id=int(plane_id),
+        normal=normal,
+        d=d,
+        centroid=centroid,
+        n_points=n,
+        rms=rms,
+        sigma_d=math.sqrt(max(cov[3, 3], 0.0)),
+        covariance=cov,
+        slope_deg=slope,
+        aspect_deg=aspect,
+    )
+
+
+def _fmt(value: float) -> str:
+    return repr(float(value))
+
+
+def write_planes_csv(path: Union[str, Path], planes: Sequence[Plane]) -> None:
+    """Write the plane table (header ``PLANE_COLUMNS``, see the module docstring) atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV to write; written to a temporary file in the same folder, then moved into place.
+    planes : sequence of Plane
+        Planes, written in the given order (an empty sequence writes only the header).
+    """
+    rows = []
+    for p in planes:
+        rows.append(
+            [
+                str(int(p.id)),
+                *(_fmt(v) for v in p.normal),
+                _fmt(p.d),
+                *(_fmt(v) for v in p.centroid),
+                str(int(p.n_points)),
+                _fmt(p.rms),
+                _fmt(p.sigma_d),
+                _fmt(p.slope_deg),
+                _fmt(p.aspect_deg),
+                *(_fmt(v) for v in p.covariance[_IU]),
+            ]
+        )
+    write_csv_atomic(path, PLANE_COLUMNS, rows)
+
+
+def _header_only(path: Union[str, Path]) -> bool:
+    """True for a readable table holding the plane header and no data rows (no planes)."""
+    try:
+        text = Path(path).read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError):
+        return False  # read_table reports it
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    return len(lines) == 1 and {c.strip().lower() for c in lines[0].split(",")} >= set(
+        PLANE_COLUMNS
+    )
+
+
+def read_planes_csv(path: Union[str, Path]) -> list[Plane]:
+    """Read a plane table written by :func:`write_planes_csv` (or by hand, same header).
+
+    Columns are found by name (case-insensitive, any order, extra columns ignored). Every
+    column of ``PLANE_COLUMNS`` is required. The normal is checked to be unit length with
+    c >= 0; outlines are not part of the table (empty).
+
+    Raises
+    ------
+    InputError
+        Missing file or column, a cell that is not a number (names file, row and column), a
+        non-integer id or point count, a duplicate id, or a normal that is not unit length.
+    """
+    if _header_only(path):
+        return []
+    table = read_table(path)
+    cols = {
+        name: float_column(table, find_column(table, (name,), what=name)) for name in PLANE_COLUMNS
+    }
+    id_col = find_column(table, ("id",))
+    np_col = find_column(table, ("n_points",))
+    planes = []
+    seen: dict[int, int] = {}
+    for k, row_no in enumerate(table.line_numbers):
+        for name, col in (("id", id_col), ("n_points", np_col)):
+            value = cols[name][k]
+            if value != round(value):
+                raise InputError(
+                    f"'{table.rows[k][col]}' is not an integer",
+                    path=table.path,
+                    row=row_no,
+                    column=table.columns[col],
+                )
+        pid = int(cols["id"][k])
+        if pid in seen:
+            raise InputError(
+                f"id {pid} already appears in row {seen[pid]}",
+                path=table.path,
+                row=row_no,
+                column=table.columns[id_col],
+            )
+        seen[pid] = row_no
+        normal = np.array([cols["a"][k], cols["b"][k], cols["c"][k]])
+        if abs(np.linalg.norm(normal) - 1.0) > 1e-6 or normal[2] < 0:
+            raise InputError(
+                "the normal (a, b, c) must be a unit vector with c >= 0",
+                path=table.path,
+                row=row_no,
+                column="a",
+            )
+        cov = np.empty((4, 4))
+        cov[_IU] = [cols[name][k] for name in COV_COLUMNS]
+        cov.T[_IU] = cov[_IU]
+        planes.append(
+            Plane(
+                id=pid,
+                normal=normal,
+                d=float(cols["d"][k]),
+                centroid=np.array([cols[f"centroid_{a}"][k] for a in "xyz"]),
+                n_points=int(cols["n_points"][k]),
+                rms=float(cols["rms"][k]),
+                sigma_d=float(cols["sigma_d"][k]),
+                covariance=cov,
+                slope_deg=float(cols["slope_deg"][k]),
+                aspect_deg=float(cols["aspect_deg"][k]),
+            )
+        )
+    return planes

@@ -1,0 +1,498 @@
+"""LAS/LAZ point clouds (versions 1.0-1.4) through laspy with the lazrs backend.
+
+Reading streams laspy's ``chunk_iterator`` into preallocated arrays, so a 10-million-point
+file costs the arrays asked for plus one chunk. Writing copies the source file chunk by chunk
+into a temporary file next to the destination (keeping every dimension, header field and VLR)
+and moves it into place only when it is complete.
+
+Units are never assumed: :func:`read_info` reports the horizontal unit of the cloud's CRS and
+its size in metres, so that callers can interpret distance parameters in the cloud's own unit
+(the Autzen files are in international feet) or convert metres explicitly.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import tempfile
+from collections.abc import Callable, Mapping, Sequence
+from copy import deepcopy
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Union
+
+import numpy as np
+import pyproj
+from numpy.typing import NDArray
+
+from ..errors import Cancelled, CrsError, InputError, stop_if_asked
+from ..geometry import frames
+
+LOG = logging.getLogger(__name__)
+
+PathLike = Union[str, "os.PathLike[str]"]
+CrsLike = Union[str, int, pyproj.CRS, None]
+
+#: LAS versions this module accepts (laspy reads 1.0 as 1.1: the header layouts are equal).
+SUPPORTED_VERSIONS = ("1.0", "1.1", "1.2", "1.3", "1.4")
+#: Extra-dimension dtypes a LAS extra-bytes VLR can describe.
+EXTRA_DTYPES = ("u1", "i1", "u2", "i2", "u4", "i4", "u8", "i8", "f4", "f8")
+#: Sizes in metres of the linear units of GeoTIFF keys (EPSG unit codes).
+_EPSG_LINEAR_UNITS = {
+    9001: ("metre", 1.0),
+    9002: ("foot", 0.3048),
+    9003: ("US survey foot", 1200.0 / 3937.0),
+}
+_VERTICAL_UNITS_GEOKEY = 4099
+_SCALED = ("x", "y", "z")
+
+
+@dataclass(frozen=True)
+class CloudInfo:
+    """What the header of a LAS/LAZ file says, plus the CRS and its units.
+
+    Attributes
+    ----------
+    path : str
+        The file.
+    point_count : int
+        Number of point records.
+    version : str
+        LAS version, e.g. ``"1.2"``.
+    point_format : int
+        LAS point data record format id (0-10).
+    crs : pyproj.CRS or None
+        From the file's WKT VLR (preferred) or GeoTIFF keys, or the user's override. None only
+        when ``require_crs=False`` and the file has none.
+    horizontal_unit : str
+        Unit of x and y: ``"metre"``, ``"foot"``, ``"US survey foot"``... (``"unknown"``
+        without CRS).
+    unit_to_metre : float
+        Size of one horizontal coordinate unit in metres (1.0, 0.3048, 1200/3937; NaN when
+        unknown).
+    vertical_unit_to_metre : float
+        Size of one z unit in metres: from the vertical part of a compound CRS, else the GeoTIFF
+        VerticalUnitsGeoKey, else the horizontal unit.
+    mins, maxs : NDArray[np.float64]
+        (3,) bounding box of the scaled coordinates, from the header.
+    dimensions : tuple[str, ...]
+        Every dimension name of the point format, extra bytes included.
+    has_return_numbers : bool
+        False when every return number is 0 (e.g. the ISPRS samples). From the header's
+        points-by-return counts in :func:`read_info`, from the data in :func:`read_points`
+        when ``return_number`` is read.
+    """
+
+    path: str
+    point_count: int
+    version: str
+    point_format: int
+    crs: pyproj.CRS | None
+    horizontal_unit: str
+    unit_to_metre: float
+    vertical_unit_to_metre: float
+    mins: NDArray[np.float64]
+    maxs: NDArray[np.float64]
+    dimensions: tuple[str, ...]
+    has_return_numbers: bool
+
+
+def parse_crs(crs: CrsLike) -> pyproj.CRS | None:
+    """A user's CRS (``"EPSG:7415"``, ``7415``, WKT, PROJ string or pyproj.CRS) as pyproj.CRS.
+
+    Empty strings and None give None.
+
+    Examples
+    --------
+    >>> parse_crs("EPSG:28992").to_epsg()
+    28992
+    """
+    if crs is None or (isinstance(crs, str) and not crs.strip()):
+        return None
+    return frames.parse_crs(crs)
+
+
+def _horizontal_crs(crs: pyproj.CRS) -> pyproj.CRS:
+    if crs.is_compound and crs.sub_crs_list:
+        return crs.sub_crs_list[0]
+    return crs
+
+
+def _linear_unit(crs: pyproj.CRS) -> tuple[str, float]:
+    axes = crs.axis_info
+    if not axes:
+        return "unknown", float("nan")
+    return axes[0].unit_name, float(axes[0].unit_conversion_factor)
+
+
+def _vertical_geokey_unit(header: Any) -> float | None:
+    """Size in metres of the GeoTIFF VerticalUnitsGeoKey, when the file has a known one."""
+    for vlr in header.vlrs:
+        for key in getattr(vlr, "geo_keys", ()):
+            if key.id == _VERTICAL_UNITS_GEOKEY and key.tiff_tag_location == 0:
+                unit = _EPSG_LINEAR_UNITS.get(int(key.value_offset))
+                return unit[1] if unit else None
+    return None
+
+
+def crs_units(
+    crs: pyproj.CRS, vertical_geokey_to_metre: float | None = None
+) -> tuple[str, float, float]:
+    """Horizontal unit name, its size in metres, and the vertical unit's size in metres.
+
+    Raises
+    ------
+    CrsError
+        When the CRS is geographic or geocentric (no linear horizontal unit).
+
+    Examples
+    --------
+    >>> crs_units(pyproj.CRS.from_epsg(2994))[:2]
+    ('foot', 0.3048)
+    """
+    horizontal = _horizontal_crs(crs)
+    if horizontal.is_geographic or horizontal.is_geocentric:
+        raise CrsError(
+            f"the CRS {horizontal.name!r} is geographic/geocentric: the algorithms need a "
+            "projected CRS with a linear unit (reproject the cloud, or give its projected CRS)"
+        )
+    name, to_metre = _linear_unit(horizontal)
+    vertical = to_metre
+    if crs.is_compound and len(crs.sub_crs_list) > 1:
+        vertical = _linear_unit(crs.sub_crs_list[1])[1]
+    elif vertical_geokey_to_metre is not None:
+        vertical = vertical_geokey_to_metre
+    return name, to_metre, vertical
+
+
+def _open(path: str) -> Any:
+    import laspy
+
+    if not os.path.isfile(path):
+        raise InputError("file not found", path=path)
+    if os.path.getsize(path) == 0:
+        raise InputError("empty file (0 bytes)", path=path)
+    try:
+        return laspy.open(path)
+    except Exception as exc:  # laspy/lazrs raise many types for bad bytes
+        raise InputError(f"cannot read as LAS/LAZ: {exc}", path=path) from exc
+
+
+def _info_from_header(path: str, header: Any, crs: CrsLike, require_crs: bool) -> CloudInfo:
+    version = f"{header.version.major}.{header.version.minor}"
+    if version not in SUPPORTED_VERSIONS:
+        raise InputError(
+            f"LAS version {version} is not supported (supported: {', '.join(SUPPORTED_VERSIONS)})",
+            path=path,
+        )
+    count = int(header.point_count)
+    if count == 0:
+        raise InputError("the file holds no points", path=path)
+    user_crs = parse_crs(crs)
+    file_crs = None
+    if user_crs is None:
+        try:
+            file_crs = header.parse_crs(prefer_wkt=True)
+        except Exception as exc:  # a malformed WKT or GeoTIFF key set
+            LOG.warning("%s: CRS records present but not understood (%s)", path, exc)
+    use = user_crs if user_crs is not None else file_crs
+    if use is None:
+        if require_crs:
+            raise CrsError(
+                "the file has no CRS that can be read (no WKT VLR and no EPSG code in its GeoTIFF "
+                "keys): give the CRS of the cloud (CRS parameter, e.g. EPSG:28992)",
+                path=path,
+            )
+        unit, to_metre, vertical = "unknown", float("nan"), float("nan")
+    else:
+        try:
+            unit, to_metre, vertical = crs_units(use, _vertical_geokey_unit(header))
+        except CrsError as exc:
+            if require_crs:
+                raise CrsError(str(exc), path=path) from exc
+            unit, to_metre, vertical = "unknown", float("nan"), float("nan")
+    by_return = np.asarray(header.number_of_points_by_return)
+    return CloudInfo(
+        path=path,
+        point_count=count,
+        version=version,
+        point_format=int(header.point_format.id),
+        crs=use,
+        horizontal_unit=unit,
+        unit_to_metre=to_metre,
+        vertical_unit_to_metre=vertical,
+        mins=np.asarray(header.mins, dtype=np.float64).copy(),
+        maxs=np.asarray(header.maxs, dtype=np.float64).copy(),
+        dimensions=tuple(header.point_format.dimension_names),
+        has_return_numbers=bool(by_return.sum() > 0),
+    )
+
+
+def read_info(path: PathLike, crs: CrsLike = None, *, require_crs: bool = True) -> CloudInfo:
+    """Read the header of a LAS/LAZ file, its CRS and units, without reading points.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        LAS or LAZ file, version 1.0-1.4.
+    crs : str, int, pyproj.CRS or None
+        Overrides the file's CRS (EPSG code, ``"EPSG:xxxx"``, WKT).
+    require_crs : bool
+        When True (default) a cloud without a readable CRS, or with a geographic one, raises
+        CrsError; when False its ``crs`` is None and its units ``"unknown"``/NaN.
+
+    Returns
+    -------
+    CloudInfo
+
+    Raises
+    ------
+    InputError
+        Missing, empty, unreadable file, unsupported version, 0 points (names the file).
+    CrsError
+        No CRS and no override, or a geographic CRS.
+    """
+    path = os.fspath(path)
+    with _open(path) as reader:
+        return _info_from_header(path, reader.header, crs, require_crs)
+
+
+def _check_fields(info: CloudInfo, fields: Sequence[str]) -> list[str]:
+    known = {name.lower(): name for name in info.dimensions}
+    out = []
+    for field in fields:
+        key = field.lower() if field.lower() in _SCALED else field
+        if key not in _SCALED and key not in info.dimensions and key.lower() not in known:
+            raise InputError(
+                f"no dimension {field!r} (the file has: {', '.join(info.dimensions)})",
+                path=info.path,
+                column=field,
+            )
+        out.append(key if key in _SCALED or key in info.dimensions else known[key.lower()])
+    return out
+
+
+
+def read_points(
+    path: PathLike,
+    fields: Sequence[str] = ("x", "y", "z"),
+    crs: CrsLike = None,
+    chunk_size: int = 1_000_000,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+    *,
+    require_crs: bool = True,
+) -> tuple[dict[str, NDArray[Any]], CloudInfo]:
+    """Read chosen dimensions of every point, streaming ``chunk_size`` points at a time.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        LAS or LAZ file.
+    fields : sequence of str
+        Dimension names: ``x``, ``y``, ``z`` (scaled, float64, in the CRS units) and any other
+        dimension of the file (``classification``, ``return_number``, ``number_of_returns``,
+        ``intensity``, extra bytes...) in its own dtype.
+    crs, require_crs
+        As in :func:`read_info`.
+    chunk_size : int
+        Points decoded per chunk (memory of one chunk on top of the result arrays).
+    progress : callable, optional
+        Receives the fraction read, after every chunk.
+    should_stop : callable, optional
+        Checked before every chunk; True raises Cancelled.
+
+    Returns
+    -------
+    arrays : dict[str, NDArray]
+        One (N,) array per field, keyed as asked.
+    info : CloudInfo
+        With ``has_return_numbers`` taken from the data when ``return_number`` was read.
+
+    Raises
+    ------
+    InputError
+        Unreadable, truncated or corrupt file, unknown field (names the file).
+    CrsError
+        As in :func:`read_info`.
+    Cancelled
+        When ``should_stop()`` returns True.
+    """
+    path = os.fspath(path)
+    with _open(path) as reader:
+        info = _info_from_header(path, reader.header, crs, require_crs)
+        names = _check_fields(info, fields)
+        n = info.point_count
+        out: dict[str, NDArray[Any]] = {}
+        done = 0
+        try:
+            for chunk in reader.chunk_iterator(max(int(chunk_size), 1)):
+                stop_if_asked(should_stop, "processing the point cloud")
+                m = len(chunk)
+                if done + m > n:
+                    raise InputError(f"more points than the header's {n}", path=path)
+                for key, name in zip(fields, names):
+                    values = np.asarray(chunk[name])
+                    if key not in out:
+                        dtype = np.float64 if name in _SCALED else values.dtype
+                        out[key] = np.empty(n, dtype=dtype)
+                    out[key][done : done + m] = values
+                done += m
+                if progress is not None:
+                    progress(done / n)
+        except (InputError, Cancelled):
+            raise
+        except Exception as exc:  # lazrs/laspy decoding errors: corrupt or truncated file
+            raise InputError(
+                f"corrupt or truncated point data after {done} of {n} points: {exc}", path=path
+            ) from exc
+    if done != n:
+        raise InputError(f"truncated: {done} points read, the header says {n}", path=path)
+    if "return_number" in names:
+        rn = out[fields[names.index("return_number")]]
+        info = replace(info, has_return_numbers=bool(np.any(rn > 0)))
+    return out, info
+
+
+def _check_values(
+    path: str, n: int, point_format: int, classification: Any, extra: Mapping[str, Any] | None
+) -> tuple[NDArray[Any] | None, dict[str, NDArray[Any]]]:
+    cls = None
+    if classification is not None:
+        cls = np.asarray(classification)
+        if cls.shape != (n,):
+            raise InputError(f"classification has shape {cls.shape}, expected ({n},)", path=path)
+        top = 31 if point_format < 6 else 255
+        if cls.size and (cls.min() < 0 or cls.max() > top):
+            raise InputError(
+                f"classification values must be 0-{top} in point format {point_format}"
+            )
+    arrays = {}
+    for name, values in (extra or {}).items():
+        arr = np.asarray(values)
+        if arr.shape != (n,):
+            raise InputError(f"extra dimension {name!r} has shape {arr.shape}, expected ({n},)")
+        if arr.dtype.str[1:] not in EXTRA_DTYPES:
+            raise InputError(
+                f"extra dimension {name!r}: dtype {arr.dtype} is not one of "
+                f"{', '.join(EXTRA_DTYPES)}"
+            )
+        arrays[name] = arr
+    return cls, arrays
+
+
+def write_cloud(
+    src_path: PathLike,
+    dst_path: PathLike,
+    *,
+    classification: NDArray[Any] | None = None,
+    extra: Mapping[str, NDArray[Any]] | None = None,
+    chunk_size: int = 1_000_000,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> None:
+    """Write a copy of ``src_path`` with a new classification and added extra dimensions.
+
+    Every original dimension, header field (version, point format, scales, offsets, system
+    identifier, generating software, dates, global encoding) and VLR/EVLR is kept; bounds and
+    counts are recomputed. LAZ or LAS is chosen by the suffix of ``dst_path``. The copy is
+    streamed chunk by chunk into a temporary file in the destination folder and moved into
+    place (``os.replace``) only when complete: a failure or a cancel leaves no partial output.
+
+    Parameters
+    ----------
+    src_path, dst_path : str or os.PathLike
+        Source LAS/LAZ and destination (``.las`` or ``.laz``; may equal the source).
+    classification : (N,) integer array, optional
+        Replaces the classification of every point (0-31 for point formats 0-5).
+    extra : dict[str, (N,) array], optional
+        Extra dimensions to add (their dtype is kept: uint8 ... float64). A name the source
+        already has as an extra dimension of the same dtype is overwritten.
+    chunk_size, progress, should_stop
+        As in :func:`read_points`.
+
+    Raises
+    ------
+    InputError
+        Bad source, bad arrays, unknown suffix, name clash with a standard dimension.
+    Cancelled
+        When ``should_stop()`` returns True (nothing is left behind).
+    """
+    import laspy
+
+    src = os.fspath(src_path)
+    dst = os.fspath(dst_path)
+    suffix = Path(dst).suffix.lower()
+    if suffix not in (".las", ".laz"):
+        raise InputError("the output must end with .las or .laz", path=dst)
+    folder = os.path.dirname(os.path.abspath(dst))
+    if not os.path.isdir(folder):
+        raise InputError("the output folder does not exist", path=dst)
+
+    with _open(src) as reader:
+        info = _info_from_header(src, reader.header, None, require_crs=False)
+        n = info.point_count
+        cls, arrays = _check_values(src, n, info.point_format, classification, extra)
+        header = deepcopy(reader.header)
+        extra_names = set(header.point_format.extra_dimension_names)
+        new_params = []
+        for name, arr in arrays.items():
+            if name in extra_names:
+                have = header.point_format.dimension_by_name(name).dtype
+                if np.dtype(have) != arr.dtype:
+                    raise InputError(
+                        f"extra dimension {name!r} exists with dtype {have}, not {arr.dtype}",
+                        path=src,
+                        column=name,
+                    )
+            elif name in header.point_format.dimension_names:
+                raise InputError(
+                    f"{name!r} is a standard dimension, not an extra one", path=src, column=name
+                )
+            else:
+                new_params.append(laspy.ExtraBytesParams(name=name, type=arr.dtype))
+        if new_params:
+            header.add_extra_dims(new_params)
+        evlrs = list(reader.header.evlrs or [])
+
+        fd, tmp = tempfile.mkstemp(
+            prefix=f".{Path(dst).stem}.", suffix=f"{suffix}.part", dir=folder
+        )
+        os.close(fd)
+        try:
+            with laspy.open(tmp, mode="w", header=header, do_compress=suffix == ".laz") as writer:
+                done = 0
+                try:
+                    for chunk in reader.chunk_iterator(max(int(chunk_size), 1)):
+                        stop_if_asked(should_stop, "processing the point cloud")
+                        m = len(chunk)
+                        out = laspy.ScaleAwarePointRecord.zeros(m, header=writer.header)
+                        for name in chunk.array.dtype.names:
+                            out.array[name] = chunk.array[name]
+                        if cls is not None:
+                            out.classification = cls[done : done + m]
+                        for name, arr in arrays.items():
+                            out[name] = arr[done : done + m]
+                        writer.write_points(out)
+                        done += m
+                        if progress is not None:
+                            progress(done / n)
+                except (InputError, Cancelled):
+                    raise
+                except Exception as exc:
+                    raise InputError(
+                        f"corrupt or truncated point data after {done} of {n} points: {exc}",
+                        path=src,
+                    ) from exc
+                if done != n:
+                    raise InputError(
+                        f"truncated: {done} points read, the header says {n}", path=src
+                    )
+                if evlrs:
+                    writer.write_evlrs(laspy.VLRList(evlrs))
+            os.replace(tmp, dst)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+            raise
+    LOG.info("wrote %d points to %s", n, dst)

@@ -1,0 +1,1 @@
+"""LiDAR science: ground filter, DSM, roof planes, LiDAR control points and lines."""

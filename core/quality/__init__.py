@@ -1,0 +1,1 @@
+"""Quality: accuracy statistics, published standards, HTML reports and their SVG plots."""

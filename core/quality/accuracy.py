@@ -1,0 +1,1046 @@
+"""Positional accuracy of check points: discrepancies, statistics, tests and standards.
+
+Sign convention: a discrepancy is ``d = measured - reference`` (the product minus the
+independent, more accurate source), per component dE, dN, dH in metres, in one projected CRS
+(the mapping frame of docs/conventions.md). ``dHoriz = sqrt(dE^2 + dN^2)`` and
+``d3D = sqrt(dE^2 + dN^2 + dH^2)``.
+
+Check-point table (CSV, header row; names are case-insensitive, aliases in parentheses)::
+
+    id (point, point_id, name)                          text, unique
+    e (easting, x, e_measured, measured_e)              measured position (m)
+    n (northing, y, n_measured, measured_n)
+    h (height, z, h_measured, measured_h)
+    e_ref (easting_ref, x_ref, e_reference, reference_e) reference position (m)
+    n_ref (northing_ref, y_ref, n_reference, reference_n)
+    h_ref (height_ref, z_ref, h_reference, reference_h)
+    group (direction, model, block, strip)              optional
+
+Point table (two of them, joined by id; ``read_point_table``)::
+
+    id, e, n, h [, group]                               with the aliases above
+
+Statistics (per component and per group, and overall): mean, sample standard deviation
+(n - 1), RMSE = sqrt(mean(d^2)), minimum, maximum; Shapiro-Wilk normality test (W, p,
+decision at alpha; scipy's implementation of Royston's algorithm); Student's t test of a
+zero mean (bias), two-sided; chi-square test of the standard deviation against a declared
+precision sigma0, one-sided (``(n-1) s^2 / sigma0^2 <= chi2_{1-alpha, n-1}`` accepts the
+declared precision). Outliers are screened by the robust modified z-score of Iglewicz and
+Hoaglin (1993) (``|0.6745 (x - median) / MAD| > 3.5``) or by three sigma
+(``|x - mean| > 3 s``); flagged points are always reported and only excluded from the
+statistics when the caller asks.
+"""
+
+from __future__ import annotations
+
+import datetime
+import json
+import logging
+import math
+import os
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Callable, Union
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import stats
+
+from ..errors import CrsError, InputError, stop_if_asked
+from ..io.tables import Table, find_column, float_column, normalise, read_table, text_column
+from . import standards as std_mod
+
+__all__ = [
+    "OUTLIER_RULES",
+    "STANDARD_KEYS",
+    "AccuracyReport",
+    "AccuracySettings",
+    "BiasTest",
+    "CheckPoints",
+    "ComponentStatistics",
+    "GroupStatistics",
+    "NormalityTest",
+    "OutlierScreen",
+    "PointSet",
+    "PrecisionTest",
+    "assess_accuracy",
+    "bias_test",
+    "component_statistics",
+    "join_points",
+    "normality_test",
+    "point_set",
+    "precision_test",
+    "read_checkpoint_table",
+    "read_point_table",
+    "report_to_dict",
+    "run_accuracy_report",
+    "screen_outliers",
+]
+
+log = logging.getLogger(__name__)
+PathLike = Union[str, "os.PathLike[str]"]
+
+COMPONENTS = ("E", "N", "H")
+OUTLIER_RULES = ("robust", "three_sigma", "none")
+STANDARD_KEYS = ("asprs", "nssda", "pec", "project")
+
+_ID = ("id", "point", "point_id", "name")
+_GROUP = ("group", "direction", "model", "block", "strip")
+_MEASURED = (
+    ("e", "easting", "x", "e_measured", "measured_e"),
+    ("n", "northing", "y", "n_measured", "measured_n"),
+    ("h", "height", "z", "h_measured", "measured_h"),
+)
+_REFERENCE = (
+    ("e_ref", "easting_ref", "x_ref", "e_reference", "reference_e"),
+    ("n_ref", "northing_ref", "y_ref", "n_reference", "reference_n"),
+    ("h_ref", "height_ref", "z_ref", "h_reference", "reference_h"),
+)
+_ROBUST_THRESHOLD = 3.5  # Iglewicz & Hoaglin (1993)
+_SIGMA_THRESHOLD = 3.0
+
+
+# ----------------------------------------------------------------------------- inputs
+
+
+@dataclass(frozen=True)
+class PointSet:
+    """Points with ids, read from one table or layer.
+
+    ``xyz`` (N, 3) float64 in metres (E, N, H); ``groups`` ``""`` when not grouped; ``crs``
+    an authority id or WKT, None when unknown; ``locations`` the row numbers (tables, header
+    is row 1) or feature ids (layers) used in error messages, ``location_kind`` says which.
+    """
+
+    ids: tuple[str, ...]
+    xyz: NDArray[np.float64]
+    groups: tuple[str, ...]
+    crs: str | None = None
+    source: str = ""
+    locations: tuple[int, ...] = ()
+    location_kind: str = "row"
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+
+@dataclass(frozen=True)
+class CheckPoints:
+    """Measured and reference positions of the same points, (N, 3) each, in one CRS."""
+
+    ids: tuple[str, ...]
+    measured: NDArray[np.float64]
+    reference: NDArray[np.float64]
+    groups: tuple[str, ...]
+    crs: str | None = None
+    source: str = ""
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+    @property
+    def discrepancies(self) -> NDArray[np.float64]:
+        """``measured - reference``, (N, 3), metres."""
+        return self.measured - self.reference
+
+
+def point_set(
+    ids: Sequence[object],
+    xyz: NDArray[np.float64],
+    groups: Sequence[object] | None = None,
+    *,
+    crs: str | None = None,
+    source: str = "",
+    locations: Sequence[int] | None = None,
+    location_kind: str = "feature",
+) -> PointSet:
+    """Build a validated :class:`PointSet` (used by the QGIS adapter for layers).
+
+    Raises :class:`InputError` naming the source, the feature/row and the coordinate for
+    empty ids, duplicate ids and NaN or infinite coordinates.
+
+    Examples
+    --------
+    >>> ps = point_set(["a", "b"], np.array([[0.0, 0, 0], [1, 1, 1]]))
+    >>> len(ps), ps.groups
+    (2, ('', ''))
+    """
+    ids_ = tuple("" if i is None else str(i).strip() for i in ids)
+    arr = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+    if len(arr) != len(ids_):
+        raise InputError(f"{len(ids_)} ids but {len(arr)} positions", path=source or None)
+    locs = (
+        tuple(int(v) for v in locations)
+        if locations is not None
+        else tuple(range(1, len(ids_) + 1))
+    )
+    grp = tuple("" if g is None else str(g) for g in groups) if groups is not None else None
+    if grp is None:
+        grp = ("",) * len(ids_)
+    kind = location_kind
+
+    def where(k: int) -> str:
+        return f"{kind} {locs[k]}"
+
+    for k, value in enumerate(ids_):
+        if not value or value.upper() == "NULL":
+            raise InputError(f"{where(k)}: empty id", path=source or None)
+    bad = np.argwhere(~np.isfinite(arr))
+    if len(bad):
+        k, c = (int(v) for v in bad[0])
+        raise InputError(
+            f"{where(k)} (id '{ids_[k]}'): {COMPONENTS[c]} is not a finite number "
+            f"({len(np.unique(bad[:, 0]))} point(s) affected)",
+            path=source or None,
+            column=COMPONENTS[c],
+        )
+    _check_unique(ids_, [where(k) for k in range(len(ids_))], source)
+    return PointSet(ids_, arr, grp, crs or None, source, locs, kind)
+
+
+def _check_unique(ids: Sequence[str], where: Sequence[str], source: str) -> None:
+    first: dict[str, int] = {}
+    dups = []
+    for k, value in enumerate(ids):
+        if value in first:
+            dups.append(f"'{value}' ({where[first[value]]} and {where[k]})")
+        else:
+            first[value] = k
+    if dups:
+        raise InputError(
+            f"duplicate id{'s' if len(dups) > 1 else ''}: {', '.join(dups[:10])}"
+            + (f" and {len(dups) - 10} more" if len(dups) > 10 else ""),
+            path=source or None,
+        )
+
+
+def _table_ids(table: Table) -> tuple[str, ...]:
+    index = find_column(table, _ID, what="the point id")
+    values = text_column(table, index)
+    _check_unique(values, [f"row {n}" for n in table.line_numbers], table.path)
+    return values
+
+
+def _table_groups(table: Table, column: str | None) -> tuple[str, ...]:
+    if column:
+        index = find_column(table, (normalise(column),), what=f"the group ({column})")
+    else:
+        index = find_column(table, _GROUP, required=False)
+    if index is None:
+        return ("",) * len(table)
+    return text_column(table, index, nonempty=False)
+
+
+def read_checkpoint_table(
+    path: PathLike, *, group_column: str | None = None, crs: str | None = None
+) -> CheckPoints:
+    """Read the one-table format (see the module docstring).
+
+    Errors name the file, the row (header is row 1) and the column.
+
+    Parameters
+    ----------
+    path : path-like
+        CSV file.
+    group_column : str, optional
+        Column holding the group; default the first of group, direction, model, block, strip.
+    crs : str, optional
+        CRS of the coordinates (reported only).
+    """
+    table = read_table(path)
+    ids = _table_ids(table)
+    measured = np.column_stack(
+        [float_column(table, find_column(table, a, what=a[0])) for a in _MEASURED]
+    )
+    reference = np.column_stack(
+        [float_column(table, find_column(table, a, what=a[0])) for a in _REFERENCE]
+    )
+    groups = _table_groups(table, group_column)
+    return CheckPoints(ids, measured, reference, groups, crs or None, str(path))
+
+
+def read_point_table(
+    path: PathLike,
+    *,
+    id_column: str | None = None,
+    z_column: str | None = None,
+    group_column: str | None = None,
+    crs: str | None = None,
+) -> PointSet:
+    """Read a point table ``id, e, n, h [, group]`` (aliases as in the module docstring).
+
+    ``id_column`` and ``z_column`` name other columns for the id and the height.
+    """
+    table = read_table(path)
+    if id_column:
+        id_index = find_column(table, (normalise(id_column),), what=f"the id ({id_column})")
+        ids = text_column(table, id_index)
+        _check_unique(ids, [f"row {n}" for n in table.line_numbers], table.path)
+    else:
+        ids = _table_ids(table)
+    cols = []
+    for k, aliases in enumerate(_MEASURED):
+        if k == 2 and z_column:
+            aliases = (normalise(z_column),)
+        cols.append(float_column(table, find_column(table, aliases, what=aliases[0])))
+    groups = _table_groups(table, group_column)
+    return PointSet(
+        ids, np.column_stack(cols), groups, crs or None, str(path), table.line_numbers, "row"
+    )
+
+
+def _same_crs(a: str | None, b: str | None) -> bool:
+    if not a or not b or a == b:
+        return True
+    from pyproj import CRS
+    from pyproj.exceptions import CRSError
+
+    try:
+        return CRS.from_user_input(a) == CRS.from_user_input(b)
+    except CRSError as exc:
+        raise CrsError(f"cannot read the CRS ({exc})") from exc
+
+
+def _crs_name(crs: str) -> str:
+    try:
+        from pyproj import CRS
+
+        c = CRS.from_user_input(crs)
+        auth = c.to_authority()
+        return f"{c.name} ({':'.join(auth)})" if auth else c.name
+    except Exception:
+        return crs[:60]
+
+
+def join_points(measured: PointSet, reference: PointSet) -> CheckPoints:
+    """Pair measured and reference points by id.
+
+    Raises
+    ------
+    CrsError
+        The two sets are in different CRSs (reproject one first).
+    InputError
+        Ids present in one set only (all of them named).
+
+    The order and the groups are those of ``measured`` (the groups of ``reference`` are used
+    when ``measured`` has none).
+    """
+    if not _same_crs(measured.crs, reference.crs):
+        raise CrsError(
+            f"the measured points ({measured.source or 'measured'}) are in "
+            f"{_crs_name(measured.crs or '')} but the reference points "
+            f"({reference.source or 'reference'}) in {_crs_name(reference.crs or '')}; "
+            "give both in one CRS (in QGIS, REPROJECT reprojects the reference layer)"
+        )
+    ref_index = {value: k for k, value in enumerate(reference.ids)}
+    missing = [i for i in measured.ids if i not in ref_index]
+    meas_set = set(measured.ids)
+    extra = [i for i in reference.ids if i not in meas_set]
+    if missing or extra:
+        parts = []
+        if missing:
+            parts.append(
+                f"{len(missing)} measured id(s) without a reference point: "
+                + ", ".join(f"'{m}'" for m in missing[:20])
+                + (" ..." if len(missing) > 20 else "")
+            )
+        if extra:
+            parts.append(
+                f"{len(extra)} reference id(s) without a measured point: "
+                + ", ".join(f"'{m}'" for m in extra[:20])
+                + (" ..." if len(extra) > 20 else "")
+            )
+        raise InputError(
+            "unmatched ids between "
+            f"{measured.source or 'measured'} and {reference.source or 'reference'}: "
+            + "; ".join(parts)
+        )
+    order = np.array([ref_index[i] for i in measured.ids], dtype=np.int64)
+    groups = measured.groups
+    if not any(groups):
+        groups = tuple(reference.groups[k] for k in order)
+    return CheckPoints(
+        measured.ids,
+        measured.xyz,
+        reference.xyz[order],
+        groups,
+        measured.crs or reference.crs,
+        f"{measured.source} / {reference.source}",
+    )
+
+
+# ----------------------------------------------------------------------------- tests
+
+
+@dataclass(frozen=True)
+class NormalityTest:
+    """Shapiro-Wilk: ``normal`` is True when H0 (normal) is not rejected at ``alpha``."""
+
+    statistic: float
+    p_value: float
+    alpha: float
+    normal: bool | None
+    message: str
+
+
+@dataclass(frozen=True)
+class BiasTest:
+    """Student's t test of H0: mean = 0 (two-sided); ``biased`` True when H0 is rejected."""
+
+    t: float
+    critical: float
+    p_value: float
+    dof: int
+    alpha: float
+    biased: bool | None
+    message: str
+
+
+@dataclass(frozen=True)
+class PrecisionTest:
+    """Chi-square test of H0: sigma <= sigma0; ``accepted`` True when s is compatible."""
+
+    sigma0: float
+    s: float
+    chi2: float
+    critical: float
+    p_value: float
+    dof: int
+    alpha: float
+    accepted: bool | None
+    message: str
+
+
+def normality_test(x: NDArray[np.float64], alpha: float = 0.05) -> NormalityTest:
+    """Shapiro-Wilk test of one component (scipy.stats.shapiro), n >= 3.
+
+    Examples
+    --------
+    >>> t = normality_test(np.array([148, 154, 158, 160, 161, 162, 166, 170, 182, 195, 236.0]))
+    >>> round(t.statistic, 2), t.normal
+    (0.79, False)
+    """
+    x = np.asarray(x, dtype=np.float64)
+    if x.size < 3:
+        return NormalityTest(
+            math.nan, math.nan, alpha, None, f"needs at least 3 points, has {x.size}"
+        )
+    if np.ptp(x) == 0.0:
+        return NormalityTest(math.nan, math.nan, alpha, None, "all values are equal")
+    w, p = stats.shapiro(x)
+    normal = bool(p > alpha)
+    return NormalityTest(
+        float(w),
+        float(p),
+        alpha,
+        normal,
+        f"W = {w:.4f}, p = {p:.4f} {'>' if normal else '<='} {alpha:g}: "
+        + ("normality not rejected" if normal else "normality rejected"),
+    )
+
+
+def bias_test(x: NDArray[np.float64], alpha: float = 0.05) -> BiasTest:
+    """Student's t test of a zero mean: ``t = mean / (s / sqrt(n))``, dof n - 1.
+
+    Examples
+    --------
+    >>> b = bias_test(np.array([0.1, 0.2, 0.3]))
+    >>> round(b.t, 4), round(b.critical, 3), b.biased
+    (3.4641, 4.303, False)
+    """
+    x = np.asarray(x, dtype=np.float64)
+    n = x.size
+    if n < 2:
+        return BiasTest(
+            math.nan, math.nan, math.nan, 0, alpha, None, f"needs at least 2 points, has {n}"
+        )
+    mean = float(x.mean())
+    s = float(x.std(ddof=1))
+    dof = n - 1
+    crit = float(stats.t.ppf(1.0 - alpha / 2.0, dof))
+    if s == 0.0:
+        t = math.inf if mean != 0.0 else 0.0
+        p = 0.0 if mean != 0.0 else 1.0
+    else:
+        t = mean / (s / math.sqrt(n))
+        p = float(2.0 * stats.t.sf(abs(t), dof))
+    biased = bool(abs(t) > crit)
+    return BiasTest(
+        t,
+        crit,
+        p,
+        dof,
+        alpha,
+        biased,
+        f"|t| = {abs(t):.3f} {'>' if biased else '<='} t({1 - alpha / 2:g}, {dof}) = {crit:.3f}, "
+        f"p = {p:.4f}: " + ("mean differs from zero (bias)" if biased else "no significant bias"),
+    )
+
+
+def precision_test(x: NDArray[np.float64], sigma0: float, alpha: float = 0.05) -> PrecisionTest:
+    """Chi-square test of the standard deviation against a declared ``sigma0`` (one-sided).
+
+    ``chi2 = (n - 1) s^2 / sigma0^2`` compared with ``chi2_{1-alpha}(n - 1)``.
+
+    Examples
+    --------
+    >>> p = precision_test(np.array([0.1, -0.1, 0.2, -0.2]), 0.2)
+    >>> round(p.chi2, 4), p.accepted
+    (2.5, True)
+    """
+    x = np.asarray(x, dtype=np.float64)
+    n = x.size
+    if not (math.isfinite(sigma0) and sigma0 > 0):
+        raise InputError(f"the declared precision must be positive, got {sigma0}")
+    if n < 2:
+        return PrecisionTest(
+            sigma0,
+            math.nan,
+            math.nan,
+            math.nan,
+            math.nan,
+            0,
+            alpha,
+            None,
+            f"needs 2 points, has {n}",
+        )
+    s = float(x.std(ddof=1))
+    dof = n - 1
+    chi2 = dof * s**2 / sigma0**2
+    crit = float(stats.chi2.ppf(1.0 - alpha, dof))
+    p = float(stats.chi2.sf(chi2, dof))
+    ok = bool(chi2 <= crit)
+    return PrecisionTest(
+        sigma0,
+        s,
+        chi2,
+        crit,
+        p,
+        dof,
+        alpha,
+        ok,
+        f"chi2 = {chi2:.3f} {'<=' if ok else '>'} chi2({1 - alpha:g}, {dof}) = {crit:.3f}: "
+        + (
+            f"s = {s:.3f} m compatible with {sigma0:g} m"
+            if ok
+            else f"s = {s:.3f} m worse than {sigma0:g} m"
+        ),
+    )
+
+
+# ----------------------------------------------------------------------------- statistics
+
+
+@dataclass(frozen=True)
+class ComponentStatistics:
+    """Summary of one component (E, N, H) or of a resultant (horizontal, 3D), metres."""
+
+    name: str
+    n: int
+    mean: float
+    std: float
+    rmse: float
+    minimum: float
+    maximum: float
+    normality: NormalityTest | None = None
+    bias: BiasTest | None = None
+    precision: PrecisionTest | None = None
+
+
+@dataclass(frozen=True)
+class GroupStatistics:
+    """Statistics of one group (or of all points): E, N, H, horizontal and 3D."""
+
+    name: str
+    n: int
+    components: dict[str, ComponentStatistics]
+
+    @property
+    def rmse(self) -> dict[str, float]:
+        return {k: v.rmse for k, v in self.components.items()}
+
+
+def component_statistics(
+    x: NDArray[np.float64],
+    name: str,
+    *,
+    alpha: float = 0.05,
+    sigma0: float | None = None,
+    tests: bool = True,
+) -> ComponentStatistics:
+    """Mean, standard deviation (n - 1), RMSE, min, max and, with ``tests``, the three tests.
+
+    Examples
+    --------
+    >>> c = component_statistics(np.array([0.3, -0.4]), "E", tests=False)
+    >>> round(c.rmse, 4), round(c.mean, 2)
+    (0.3536, -0.05)
+    """
+    x = np.asarray(x, dtype=np.float64)
+    n = x.size
+    if n == 0:
+        return ComponentStatistics(name, 0, math.nan, math.nan, math.nan, math.nan, math.nan)
+    return ComponentStatistics(
+        name,
+        n,
+        float(x.mean()),
+        float(x.std(ddof=1)) if n > 1 else math.nan,
+        float(np.sqrt(np.mean(x * x))),
+        float(x.min()),
+        float(x.max()),
+        normality_test(x, alpha) if tests else None,
+        bias_test(x, alpha) if tests else None,
+        precision_test(x, sigma0, alpha) if tests and sigma0 else None,
+    )
+
+
+def group_statistics(
+    d: NDArray[np.float64],
+    name: str,
+    *,
+    alpha: float = 0.05,
+    declared_sigma: Sequence[float] = (0.0, 0.0, 0.0),
+) -> GroupStatistics:
+    """Statistics of discrepancies ``d`` (N, 3): E, N, H with tests, horizontal and 3D."""
+    d = np.asarray(d, dtype=np.float64).reshape(-1, 3)
+    comps = {
+        c: component_statistics(d[:, k], c, alpha=alpha, sigma0=declared_sigma[k] or None)
+        for k, c in enumerate(COMPONENTS)
+    }
+    comps["horizontal"] = component_statistics(
+        np.hypot(d[:, 0], d[:, 1]), "horizontal", tests=False
+    )
+    comps["3D"] = component_statistics(np.linalg.norm(d, axis=1), "3D", tests=False)
+    return GroupStatistics(name, len(d), comps)
+
+
+@dataclass(frozen=True)
+class OutlierScreen:
+    """Outlier flags: ``scores`` and ``flags`` (N, 3) per component, ``any`` (N,)."""
+
+    rule: str
+    threshold: float
+    description: str
+    scores: NDArray[np.float64]
+    flags: NDArray[np.bool_]
+
+    @property
+    def any(self) -> NDArray[np.bool_]:
+        return self.flags.any(axis=1)
+
+
+def screen_outliers(d: NDArray[np.float64], rule: str = "robust") -> OutlierScreen:
+    """Flag outlying discrepancies per component.
+
+    ``robust``: modified z-score ``0.6745 (x - median) / MAD`` beyond 3.5 (Iglewicz &
+    Hoaglin 1993; with MAD = 0 the mean absolute deviation times 1.2533 stands in);
+    ``three_sigma``: ``|x - mean| / s`` beyond 3 (the outliers inflate s, so this rule misses
+    them in small samples); ``none``: nothing flagged.
+
+    Examples
+    --------
+    >>> d = np.zeros((10, 3)); d[:, 0] = np.linspace(-0.1, 0.1, 10); d[3, 0] = 5.0
+    >>> screen_outliers(d).any.nonzero()[0].tolist()
+    [3]
+    """
+    d = np.asarray(d, dtype=np.float64).reshape(-1, 3)
+    rule = (rule or "none").strip().lower().replace("-", "_")
+    if rule not in OUTLIER_RULES:
+        raise InputError(f"unknown outlier rule '{rule}' ({', '.join(OUTLIER_RULES)})")
+    if rule == "none" or len(d) < 3:
+        zeros = np.zeros_like(d)
+        return OutlierScreen(rule, math.inf, "no outlier screening", zeros, zeros.astype(bool))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if rule == "robust":
+            med = np.median(d, axis=0)
+            mad = np.median(np.abs(d - med), axis=0)
+            mean_ad = np.mean(np.abs(d - med), axis=0)
+            scale = np.where(mad > 0, mad / 0.6745, 1.2533 * mean_ad)
+            scores = np.where(scale > 0, (d - med) / scale, 0.0)
+            threshold = _ROBUST_THRESHOLD
+            text = "robust modified z-score |0.6745 (x - median) / MAD| > 3.5 (Iglewicz & Hoaglin)"
+        else:
+            s = d.std(axis=0, ddof=1)
+            scores = np.where(s > 0, (d - d.mean(axis=0)) / s, 0.0)
+            threshold = _SIGMA_THRESHOLD
+            text = "three sigma |x - mean| > 3 s"
+    flags = np.abs(scores) > threshold
+    return OutlierScreen(rule, threshold, text, scores, flags)
+
+
+# ----------------------------------------------------------------------------- the report
+
+
+@dataclass(frozen=True)
+class AccuracySettings:
+    """Everything the report depends on besides the points. Lengths in metres.
+
+    ``declared_sigma_h`` / ``survey_sigma_h`` are per horizontal axis (E and N);
+    ``flight_geometry`` is (H m, B m, f mm, sigma_pix um) for Eq. 18 of paper 000.
+    """
+
+    alpha: float = 0.05
+    declared_sigma_h: float = 0.0
+    declared_sigma_v: float = 0.0
+    survey_sigma_h: float = 0.0
+    survey_sigma_v: float = 0.0
+    outlier_rule: str = "robust"
+    exclude_outliers: bool = False
+    standards: tuple[str, ...] = STANDARD_KEYS
+    asprs_h_class_cm: float = 0.0
+    asprs_v_class_cm: float = 0.0
+    pec_scale: float = 1000.0
+    pec_equidistance: float = 0.0
+    pec_class: str = "A"
+    project_h_threshold: float = std_mod.PAPER_H_THRESHOLD_M
+    project_v_threshold: float = 0.0
+    flight_geometry: tuple[float, float, float, float] = std_mod.PAPER_FLIGHT_GEOMETRY
+    title: str = "Positional accuracy report"
+
+    def validated(self) -> AccuracySettings:
+        if not (0.0 < self.alpha < 0.5):
+            raise InputError(f"the significance level must be in (0, 0.5), got {self.alpha}")
+        for name in (
+            "declared_sigma_h",
+            "declared_sigma_v",
+            "survey_sigma_h",
+            "survey_sigma_v",
+            "asprs_h_class_cm",
+            "asprs_v_class_cm",
+            "pec_equidistance",
+            "project_v_threshold",
+        ):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise InputError(f"{name} must be zero or positive, got {value}")
+        keys = tuple(k.strip().lower() for k in self.standards if k.strip())
+        unknown = [k for k in keys if k not in STANDARD_KEYS]
+        if unknown:
+            raise InputError(f"unknown standard(s) {unknown} ({', '.join(STANDARD_KEYS)})")
+        rule = self.outlier_rule.strip().lower().replace("-", "_")
+        if rule not in OUTLIER_RULES:
+            raise InputError(f"unknown outlier rule '{self.outlier_rule}'")
+        return replace(self, standards=keys, outlier_rule=rule)
+
+
+@dataclass(frozen=True)
+class AccuracyReport:
+    """Result of :func:`assess_accuracy`.
+
+    ``discrepancies`` (N, 3); ``used`` (N,) the points in the statistics (all unless
+    outliers are excluded); ``overall`` and ``groups`` the statistics; ``standards`` the
+    verdicts on the used points of all groups; ``group_thresholds`` the project threshold per
+    group (as paper 000 judges each flight direction).
+    """
+
+    points: CheckPoints
+    settings: AccuracySettings
+    discrepancies: NDArray[np.float64]
+    outliers: OutlierScreen
+    used: NDArray[np.bool_]
+    overall: GroupStatistics
+    groups: dict[str, GroupStatistics]
+    standards: tuple[std_mod.StandardResult, ...]
+    group_thresholds: dict[str, std_mod.StandardResult] = field(default_factory=dict)
+    created: str = ""
+
+    @property
+    def horizontal(self) -> NDArray[np.float64]:
+        return np.hypot(self.discrepancies[:, 0], self.discrepancies[:, 1])
+
+    @property
+    def d3(self) -> NDArray[np.float64]:
+        return np.linalg.norm(self.discrepancies, axis=1)
+
+    @property
+    def rmse(self) -> dict[str, float]:
+        """RMSE_E, RMSE_N, RMSE_H (height), RMSE_HORIZ, RMSE_3D of the used points (m)."""
+        c = self.overall.components
+        return {
+            "RMSE_E": c["E"].rmse,
+            "RMSE_N": c["N"].rmse,
+            "RMSE_H": c["H"].rmse,
+            "RMSE_HORIZ": c["horizontal"].rmse,
+            "RMSE_3D": c["3D"].rmse,
+        }
+
+
+def _tick(progress, should_stop, fraction: float) -> None:
+    stop_if_asked(should_stop, "making the accuracy report")
+    if progress is not None:
+        progress(fraction)
+
+
+def assess_accuracy(
+    points: CheckPoints,
+    settings: AccuracySettings | None = None,
+    *,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> AccuracyReport:
+    """Discrepancies, outlier screening, statistics per group and overall, and standards.
+
+    Parameters
+    ----------
+    points : CheckPoints
+        N >= 1 pairs in one projected CRS (metres).
+    settings : AccuracySettings, optional
+        Defaults: alpha 0.05, robust outlier screening without exclusion, every standard.
+
+    Returns
+    -------
+    AccuracyReport
+
+    Examples
+    --------
+    >>> ref = np.zeros((4, 3)); meas = ref + [[0.1, 0, 0], [-0.1, 0, 0], [0, 0.1, 0], [0, -0.1, 0]]
+    >>> r = assess_accuracy(CheckPoints(("a", "b", "c", "d"), meas, ref, ("",) * 4))
+    >>> round(r.rmse["RMSE_HORIZ"], 3)
+    0.1
+    """
+    s = (settings or AccuracySettings()).validated()
+    if len(points) == 0:
+        raise InputError("no check points")
+    d = points.discrepancies
+    if not np.all(np.isfinite(d)):
+        k = int(np.argwhere(~np.isfinite(d))[0, 0])
+        raise InputError(f"point '{points.ids[k]}' has a coordinate that is not a number")
+    _tick(progress, should_stop, 0.05)
+    outliers = screen_outliers(d, s.outlier_rule)
+    used = ~outliers.any if s.exclude_outliers else np.ones(len(d), dtype=bool)
+    if not used.any():
+        raise InputError("every point was flagged as an outlier; nothing left to assess")
+    sig = (s.declared_sigma_h, s.declared_sigma_h, s.declared_sigma_v)
+    du = d[used]
+    overall = group_statistics(du, "all points", alpha=s.alpha, declared_sigma=sig)
+    _tick(progress, should_stop, 0.3)
+    groups: dict[str, GroupStatistics] = {}
+    thresholds: dict[str, std_mod.StandardResult] = {}
+    names = list(dict.fromkeys(points.groups))
+    garr = np.asarray(points.groups, dtype=object)
+    if len(names) > 1 or (names and names[0]):
+        for g in names:
+            mask = (garr == g) & used
+            label = g or "(no group)"
+            groups[label] = group_statistics(d[mask], label, alpha=s.alpha, declared_sigma=sig)
+            if "project" in s.standards and mask.any():
+                thresholds[label] = std_mod.project_threshold(
+                    d[mask],
+                    h_threshold=s.project_h_threshold,
+                    v_threshold=s.project_v_threshold or None,
+                    flight_geometry=s.flight_geometry,
+                )
+            _tick(progress, should_stop, 0.3 + 0.4 * len(groups) / len(names))
+    results = []
+    comps = overall.components
+    for key in s.standards:
+        if key == "asprs":
+            results.append(
+                std_mod.asprs_2023(
+                    du,
+                    survey_sigma_h=s.survey_sigma_h,
+                    survey_sigma_v=s.survey_sigma_v,
+                    h_class_cm=s.asprs_h_class_cm,
+                    v_class_cm=s.asprs_v_class_cm,
+                )
+            )
+        elif key == "nssda":
+            results.append(
+                std_mod.nssda(
+                    du,
+                    normal=[comps[c].normality.normal for c in COMPONENTS],
+                    biased=[comps[c].bias.biased for c in COMPONENTS],
+                )
+            )
+        elif key == "pec":
+            results.append(
+                std_mod.pec_pcd(
+                    du,
+                    scale=s.pec_scale,
+                    equidistance=s.pec_equidistance or None,
+                    target_class=s.pec_class,
+                )
+            )
+        elif key == "project":
+            results.append(
+                std_mod.project_threshold(
+                    du,
+                    h_threshold=s.project_h_threshold,
+                    v_threshold=s.project_v_threshold or None,
+                    flight_geometry=s.flight_geometry,
+                )
+            )
+    _tick(progress, should_stop, 0.8)
+    n_flag = int(outliers.any.sum())
+    if n_flag:
+        log.warning(
+            "%d point(s) flagged as outliers (%s)%s",
+            n_flag,
+            outliers.description,
+            "; excluded from the statistics" if s.exclude_outliers else "; kept in the statistics",
+        )
+    return AccuracyReport(
+        points,
+        s,
+        d,
+        outliers,
+        used,
+        overall,
+        groups,
+        tuple(results),
+        thresholds,
+        datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+    )
+
+
+# ----------------------------------------------------------------------------- JSON
+
+
+def _num(x: Any) -> Any:
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    if isinstance(x, (int, np.integer)):
+        return int(x)
+    if isinstance(x, (float, np.floating)):
+        return float(x) if math.isfinite(float(x)) else None
+    return x
+
+
+def _obj(o: Any) -> Any:
+    if o is None:
+        return None
+    if hasattr(o, "__dataclass_fields__"):
+        return {k: _obj(getattr(o, k)) for k in o.__dataclass_fields__}
+    if isinstance(o, dict):
+        return {str(k): _obj(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_obj(v) for v in o]
+    if isinstance(o, np.ndarray):
+        return _obj(o.tolist())
+    return _num(o)
+
+
+def report_to_dict(report: AccuracyReport) -> dict[str, Any]:
+    """Every figure of the report as JSON-ready data (NaN and infinities become null)."""
+    d = report.discrepancies
+    pts = report.points
+    return {
+        "title": report.settings.title,
+        "created": report.created,
+        "source": pts.source,
+        "crs": pts.crs,
+        "sign_convention": "d = measured - reference (metres)",
+        "n_points": len(pts),
+        "n_used": int(report.used.sum()),
+        "settings": _obj(report.settings),
+        "rmse": _obj(report.rmse),
+        "outliers": {
+            "rule": report.outliers.rule,
+            "description": report.outliers.description,
+            "threshold": _num(report.outliers.threshold),
+            "excluded": bool(report.settings.exclude_outliers),
+            "flagged_ids": [pts.ids[k] for k in np.flatnonzero(report.outliers.any)],
+        },
+        "overall": _obj(report.overall),
+        "groups": _obj(report.groups),
+        "standards": _obj(report.standards),
+        "group_thresholds": _obj(report.group_thresholds),
+        "points": [
+            {
+                "id": pts.ids[k],
+                "group": pts.groups[k],
+                "measured": _obj(pts.measured[k]),
+                "reference": _obj(pts.reference[k]),
+                "dE": _num(d[k, 0]),
+                "dN": _num(d[k, 1]),
+                "dH": _num(d[k, 2]),
+                "dHoriz": _num(report.horizontal[k]),
+                "d3D": _num(report.d3[k]),
+                "outlier": bool(report.outliers.any[k]),
+                "outlier_scores": _obj(report.outliers.scores[k]),
+                "used": bool(report.used[k]),
+            }
+            for k in range(len(pts))
+        ],
+    }
+
+
+def write_text_atomic(path: PathLike, text: str) -> None:
+    """Write ``text`` to a temporary file in the same folder, then move it into place."""
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
+            fh.write(text)
+        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a report is meant to be shared
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def run_accuracy_report(
+    points: CheckPoints | None = None,
+    *,
+    input_table: PathLike | None = None,
+    measured_table: PathLike | None = None,
+    reference_table: PathLike | None = None,
+    measured_id: str | None = None,
+    reference_id: str | None = None,
+    measured_z: str | None = None,
+    reference_z: str | None = None,
+    group_field: str | None = None,
+    crs: str | None = None,
+    settings: AccuracySettings | None = None,
+    output_html: PathLike | None = None,
+    output_json: PathLike | None = None,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> AccuracyReport:
+    """The ``accuracyreport`` job: read (unless ``points`` is given), assess, write.
+
+    Exactly one input: ``points`` (already joined, e.g. by the QGIS adapter), ``input_table``
+    (one table) or ``measured_table`` + ``reference_table`` (joined by id). Both outputs are
+    built in memory and written atomically only when everything succeeded.
+    """
+    given = [points is not None, input_table is not None, measured_table is not None]
+    if sum(given) != 1 or (measured_table is not None) != (reference_table is not None):
+        raise InputError(
+            "give either one check-point table (INPUT) or a measured and a reference point "
+            "table (MEASURED and REFERENCE)"
+        )
+    if input_table is not None:
+        points = read_checkpoint_table(input_table, group_column=group_field, crs=crs)
+    elif measured_table is not None:
+        m = read_point_table(
+            measured_table,
+            id_column=measured_id,
+            z_column=measured_z,
+            group_column=group_field,
+            crs=crs,
+        )
+        r = read_point_table(reference_table, id_column=reference_id, z_column=reference_z, crs=crs)
+        points = join_points(m, r)
+    assert points is not None
+    log.info("%d check points from %s", len(points), points.source)
+    report = assess_accuracy(points, settings, progress=progress, should_stop=should_stop)
+    html_text = json_text = None
+    if output_html:
+        from .accuracy_html import render_html
+
+        html_text = render_html(report)
+    if output_json:
+        json_text = json.dumps(report_to_dict(report), indent=1, allow_nan=False)
+    _tick(progress, should_stop, 0.95)
+    if html_text is not None:
+        write_text_atomic(output_html, html_text)
+        log.info("wrote %s", output_html)
+    if json_text is not None:
+        write_text_atomic(output_json, json_text)
+        log.info("wrote %s", output_json)
+    if progress is not None:
+        progress(1.0)
+    return report

@@ -1,0 +1,273 @@
+"""Short self-contained HTML summary of a boresight calibration (inline CSS and SVG).
+
+Sections: settings; the boresight per group in degrees and arc-seconds with a-posteriori and
+a-priori standard deviations; lever arm and interior orientation when estimated; sigma0,
+redundancy and the global chi-square test; the correlation matrix of the calibration
+parameters; rejected observations (Baarda data snooping); residual histograms in pixels.
+When the set-up is not observable the page carries the diagnosis instead of numbers.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+import os
+import tempfile
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Union
+
+import numpy as np
+
+from .. import __version__
+from .svg_plots import histogram
+
+if TYPE_CHECKING:
+    from ..jobs.boresight_calibration import BoresightRun
+
+__all__ = ["render_boresight_html", "write_boresight_html"]
+
+ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
+_ANGLES = ("omega", "phi", "kappa")
+
+_CSS = """
+body{font-family:sans-serif;margin:24px;color:#222;max-width:1100px}
+h1{font-size:22px}h2{font-size:18px;border-bottom:1px solid #aaa;margin-top:26px}
+table{border-collapse:collapse;margin:8px 0 16px 0;font-size:13px}
+th,td{border:1px solid #bbb;padding:3px 7px;text-align:right}
+th{background:#eee}td.t,th.t{text-align:left}
+.pass{background:#d8f0d8}.fail{background:#f7d4d4}.diag{background:#fbecc4;padding:8px}
+.plots svg{margin:4px;border:1px solid #ddd}.note{font-size:12px;color:#444}
+"""
+
+
+def _e(text: object) -> str:
+    return html.escape(str(text), quote=True)
+
+
+def _n(x: float | None, digits: int = 2) -> str:
+    if x is None or not math.isfinite(float(x)):
+        return "&ndash;"
+    return f"{float(x):.{digits}f}"
+
+
+def _table(header: Sequence[str], rows: Sequence[Sequence[str]], css: Sequence[str] = ()) -> str:
+    head = "".join(
+        f'<th class="t">{h}</th>' if i == 0 else f"<th>{h}</th>" for i, h in enumerate(header)
+    )
+    body = []
+    for k, row in enumerate(rows):
+        cls = f' class="{css[k]}"' if k < len(css) and css[k] else ""
+        cells = "".join(
+            f'<td class="t">{c}</td>' if i == 0 else f"<td>{c}</td>" for i, c in enumerate(row)
+        )
+        body.append(f"<tr{cls}>{cells}</tr>")
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+def _dms(rad: float) -> str:
+    """Signed degrees, arc-minutes and arc-seconds, e.g. -0&deg;07'48.0"."""
+    s = rad * ARCSEC_PER_RAD
+    sign = "-" if s < 0 else "+"
+    s = abs(s)
+    d, rem = divmod(s, 3600.0)
+    m, sec = divmod(rem, 60.0)
+    return f"{sign}{int(d)}&deg;{int(m):02d}'{sec:04.1f}\""
+
+
+def render_boresight_html(
+    run: BoresightRun | None,
+    settings: Mapping[str, str],
+    diagnosis: Sequence[str] | None = None,
+) -> str:
+    """The HTML page as a string.
+
+    Parameters
+    ----------
+    run : BoresightRun or None
+        The calibration (None when it failed as not observable).
+    settings : mapping of str to str
+        Shown as given.
+    diagnosis : sequence of str, optional
+        Sentences of :class:`core.boresight.BoresightNotObservable`; shown instead of results.
+
+    Examples
+    --------
+    >>> page = render_boresight_html(None, {"images": "6"}, ["kappa is not observable."])
+    >>> "kappa is not observable." in page and page.startswith("<!DOCTYPE html>")
+    True
+    """
+    parts = [
+        "<!DOCTYPE html>",
+        '<html lang="en"><head><meta charset="utf-8">',
+        "<title>Boresight calibration</title>",
+        f"<style>{_CSS}</style></head><body>",
+        "<h1>Boresight calibration</h1>",
+        f'<p class="note">lidarphoto {_e(__version__)}. Angles: d_omega, d_phi, d_kappa about '
+        "the camera axes x, y, z (R_c^b = R_nominal dR); standard deviations are a-posteriori "
+        "(scaled by sigma0) unless labelled a-priori.</p>",
+        "<h2>Settings</h2>",
+        _table(
+            ["setting", "value"],
+            [[_e(k), f'<span class="t">{_e(v)}</span>'] for k, v in settings.items()],
+        ),
+    ]
+    if diagnosis:
+        parts.append("<h2>Not observable</h2>")
+        parts.append('<div class="diag"><p>The calibration was not computed:</p><ul>')
+        parts += [f"<li>{_e(s)}</li>" for s in diagnosis]
+        parts.append("</ul></div>")
+    if run is not None:
+        parts += _results(run)
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def _results(run: BoresightRun) -> list[str]:
+    res = run.result
+    out = ["<h2>Boresight</h2>"]
+    rows = []
+    for g, name in enumerate(res.groups):
+        for k, angle in enumerate(_ANGLES):
+            b = float(res.boresight[g, k])
+            rows.append(
+                [
+                    _e(name) if k == 0 else "",
+                    f"d_{angle}",
+                    f"{math.degrees(b):.6f}",
+                    _dms(b),
+                    _n(b * ARCSEC_PER_RAD, 1),
+                    _n(res.std[g, k] * ARCSEC_PER_RAD, 1),
+                    _n(res.std_prior[g, k] * ARCSEC_PER_RAD, 1),
+                ]
+            )
+    out.append(
+        _table(
+            [
+                "group",
+                "angle",
+                "value (deg)",
+                "value (d m s)",
+                "value (arcsec)",
+                "sigma (arcsec)",
+                "sigma a-priori (arcsec)",
+            ],
+            rows,
+        )
+    )
+    if res.lever_arm is not None:
+        out.append("<h3>Lever arm (body frame)</h3>")
+        out.append(
+            _table(
+                ["axis", "value (m)", "sigma (m)"],
+                [
+                    [a, _n(v, 4), _n(s, 4)]
+                    for a, v, s in zip("xyz", res.lever_arm, res.lever_arm_std)
+                ],
+            )
+        )
+    if res.interior is not None:
+        out.append("<h3>Interior orientation</h3>")
+        out.append(
+            _table(
+                ["parameter", "value (mm)", "sigma (mm)"],
+                [
+                    [a, _n(v, 5), _n(s, 5)]
+                    for a, v, s in zip(("f", "x0", "y0"), res.interior, res.interior_std)
+                ],
+            )
+        )
+    t = res.adjustment.global_test
+    out.append("<h2>Adjustment</h2>")
+    out.append(
+        _table(
+            ["figure", "value"],
+            [
+                ["sigma0 (a-posteriori, a-priori 1)", _n(res.sigma0, 3)],
+                ["redundancy", str(res.redundancy)],
+                [
+                    "observations / constraints",
+                    f"{res.adjustment.n_observations} / {res.adjustment.n_constraints}",
+                ],
+                ["global chi-square statistic", _n(t.statistic, 1)],
+                [
+                    f"acceptance interval (alpha = {t.alpha:g})",
+                    f"[{_n(t.lower, 1)}, {_n(t.upper, 1)}]",
+                ],
+                ["p-value", _n(t.p_value, 3)],
+                ["global test", "passed" if t.passed else "failed"],
+                [
+                    "iterations",
+                    f"{res.adjustment.iterations} (converged: "
+                    f"{'yes' if res.adjustment.converged else 'no'})",
+                ],
+                ["outlier detection", _e(res.adjustment.outlier_method)],
+            ],
+            [""] * 6 + ["pass" if t.passed else "fail", "", ""],
+        )
+    )
+    out.append("<h2>Correlation of the calibration parameters</h2>")
+    names = [_e(n.replace("bore[", "").replace("].", " ")) for n in res.parameter_names]
+    corr = np.asarray(res.correlation)
+    out.append(
+        _table(["", *names], [[names[i], *(_n(v, 2) for v in corr[i])] for i in range(len(names))])
+    )
+    r = res.residuals
+    obs = run.observations
+    out.append("<h2>Rejected observations</h2>")
+    rej = np.flatnonzero(r.rejected)
+    if rej.size:
+        out.append(
+            _table(
+                ["image", "point", "type", "target", "|v| (px)", "w"],
+                [
+                    [
+                        _e(obs.image_id[k]),
+                        _e(obs.point_id[k]),
+                        _e(obs.type[k]),
+                        _e(obs.target_id[k]),
+                        _n(float(np.hypot(*r.v_px[k])), 2),
+                        _n(r.w[k], 1),
+                    ]
+                    for k in rej
+                ],
+            )
+        )
+    else:
+        out.append("<p>None.</p>")
+    if res.warnings:
+        out.append("<h2>Warnings</h2><ul>" + "".join(f"<li>{_e(w)}</li>" for w in res.warnings))
+        out.append("</ul>")
+    keep = r.used & ~r.rejected & np.isfinite(r.v_px).all(axis=1)
+    if keep.any():
+        rms = np.sqrt(np.mean(r.v_px[keep] ** 2, axis=0))
+        out.append("<h2>Image residuals</h2>")
+        out.append(
+            f"<p>{int(keep.sum())} image points kept: RMS residual {_n(rms[0], 3)} px (col), "
+            f"{_n(rms[1], 3)} px (row).</p>"
+        )
+        out.append('<div class="plots">')
+        out.append(histogram(r.v_px[keep, 0], title="Residual vx", xlabel="col residual (px)"))
+        out.append(histogram(r.v_px[keep, 1], title="Residual vy", xlabel="row residual (px)"))
+        out.append("</div>")
+    return out
+
+
+def write_boresight_html(
+    path: Union[str, Path],
+    run: BoresightRun | None,
+    settings: Mapping[str, str],
+    diagnosis: Sequence[str] | None = None,
+) -> None:
+    """Write :func:`render_boresight_html` atomically (a temporary file, then ``os.replace``)."""
+    target = Path(path)
+    text = render_boresight_html(run, settings, diagnosis)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent or ".")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, target)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise

@@ -1,0 +1,935 @@
+"""Flight simulator: complete boresight-calibration inputs over a synthetic town, with the truth.
+
+A town (:func:`core.simulate_town.make_town`) is flown in straight lines (optionally in
+opposite directions) with a frame camera; the true camera poses come from the rigorous ECEF
+direct georeferencing of :func:`core.trajectory_to_eo.georeference_ecef` (independent of the
+calibration's own chain) with a true boresight per group and a true lever arm. The simulator
+returns what the calibration reads, in the mapping CRS:
+
+- the INS trajectory with noise of a named grade (:data:`core.boresight.INS_GRADES`);
+- the camera, the mount with the *initial* boresight;
+- roof planes fitted (``fit_plane``) to LiDAR points sampled on the true faces with noise
+  (or the true planes with the covariance of such a fit: ``plane_source="exact"``);
+- ridge/hip lines from two fitted planes and LCPs from three (``lidar_control``'s
+  intersections, with their propagated covariances);
+- image observations of every control type with pixel noise and optional blunders, and check
+  points (LCPs measured in the images but not adjusted).
+
+Geometry (town layout) and noise take separate seeds, so Monte-Carlo draws keep the geometry.
+``exact=True`` gives noise-free observations of the truth with the same covariances (used to
+evaluate the Cramer-Rao bound at the truth).
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Union
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError
+from ..geometry.camera import Camera, write_camera_json
+from ..geometry.collinearity import project
+from ..geometry.frames import MappingFrame
+from ..geometry.planes import Plane, fit_plane, write_planes_csv
+from ..geometry.rotations import MOUNT_PRESETS, matrix_to_opk
+from ..io.control import write_lcps_csv, write_lines_csv
+from ..io.observations import ImageObservations, write_observations_csv
+from ..io.tables import write_csv_atomic
+from ..lidar.control import ControlLine, ControlPoint, intersect_three_planes, intersect_two_planes
+from ..photo.boresight import (
+    INS_GRADES,
+    BoresightOptions,
+    BoresightResult,
+    InsGrade,
+    calibrate,
+    local_frame_for,
+)
+from ..photo.georeference import Mount, Trajectory, georeference_ecef
+from .town import Town, make_town
+
+__all__ = [
+    "ControlFlightConfig",
+    "ControlFlightSimulation",
+    "FlightConfig",
+    "FlightSimulation",
+    "FlightTruth",
+    "paper_config",
+    "simulate_flight",
+    "simulate_flight_over",
+    "small_format_camera",
+    "ultracam_xp",
+]
+
+Array = NDArray[np.float64]
+
+
+def ultracam_xp() -> Camera:
+    """UltraCam XP panchromatic frame as in paper 000: f = 100.4 mm, 6 um, 17310 x 11310 px.
+
+    11310 px is the side along track with the ``image_top_forward`` mount (the image height).
+    """
+    return Camera(
+        "UltraCam XP", focal_mm=100.4, pixel_size_mm=0.006, width_px=17310, height_px=11310
+    )
+
+
+@dataclass(frozen=True)
+class FlightConfig:
+    """A simulated calibration flight.
+
+    Attributes
+    ----------
+    crs : str
+        Mapping CRS (projected, metres).
+    centre : (float, float)
+        Block centre, easting and northing in ``crs``.
+    camera : Camera
+    flying_height_m : float
+        Above the terrain at the centre.
+    forward_overlap, side_overlap : float
+    images_per_line, n_lines : int
+    heading_deg : float
+        Grid azimuth of the first line; with ``opposite`` every other line is flown back.
+    mount : str
+        Nominal mount preset (``core.rotations.MOUNT_PRESETS``).
+    true_boresight_deg : tuple of (float, float, float)
+        One row for all lines, or one per line (d_omega, d_phi, d_kappa), degrees.
+    initial_boresight_deg : (float, float, float)
+        What the calibration starts from (the mount's boresight).
+    lever_arm_m : (float, float, float)
+    ins_grade : str or InsGrade
+    attitude_jitter_deg : float
+        Spread of the true roll, pitch and crab angle about level flight.
+    n_buildings, roof_types, town_size_m, town_seed : town layout
+    n_planes : int or None
+        Keep the first n roof faces (None: all).
+    lidar_density, lidar_noise_m : float
+        Roof points per m^2 and their noise (x, y, z), metres.
+    plane_source : {"fit", "exact"}
+    types : tuple of str
+        Observation types to make: tie, line, lcp, paper, check.
+    ties_per_plane, line_points_per_image : int
+    n_check : int
+        LCPs used as check points (the rest are control).
+    sigma_px : float
+        Pixel noise, pixels.
+    roof_roughness_m : float
+        True departure of tie points from their plane, metres.
+    n_blunders : int
+        Tie/LCP measurements given a gross error of ``blunder_px`` pixels.
+    margin_px : float
+        Points closer than this to the image border are not measured.
+    """
+
+    crs: str = "EPSG:28992"
+    centre: tuple[float, float] = (85500.0, 447500.0)
+    camera: Camera = field(default_factory=ultracam_xp)
+    flying_height_m: float = 1600.0
+    forward_overlap: float = 0.6
+    side_overlap: float = 0.3
+    images_per_line: int = 3
+    n_lines: int = 2
+    heading_deg: float = 45.0
+    opposite: bool = True
+    mount: str = "image_top_forward"
+    true_boresight_deg: tuple[tuple[float, float, float], ...] = ((0.07, -0.13, 0.005),)
+    initial_boresight_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    lever_arm_m: tuple[float, float, float] = (0.15, -0.05, -0.60)
+    ins_grade: Union[str, InsGrade] = "pos_av_310"
+    attitude_jitter_deg: float = 1.0
+    n_buildings: int = 23
+    roof_types: tuple[str, ...] = ("gable", "hip", "pyramid")
+    town_size_m: float = 900.0
+    town_seed: int = 7
+    n_planes: int | None = 76
+    lidar_density: float = 5.0
+    lidar_noise_m: float = 0.05
+    plane_source: str = "fit"
+    types: tuple[str, ...] = ("tie", "line", "lcp", "paper", "check")
+    ties_per_plane: int = 1
+    line_points_per_image: int = 2
+    n_check: int = 15
+    sigma_px: float = 0.5
+    roof_roughness_m: float = 0.0
+    n_blunders: int = 0
+    blunder_px: float = 25.0
+    margin_px: float = 50.0
+
+
+def paper_config(**changes) -> FlightConfig:
+    """Paper 000's configuration (its section 3): UltraCam XP, 1600 m, 60 %/30 % overlap,
+    6 images in two opposite directions (3 NE, 3 SW), 76 roof planes, 15 check points,
+    Applanix POS AV 310. Plane-constrained tie points and paper-mode points are made."""
+    base = FlightConfig(types=("tie", "paper", "check"))
+    return replace(base, **changes)
+
+
+@dataclass(frozen=True)
+class FlightTruth:
+    """The truth of a simulation.
+
+    Attributes
+    ----------
+    groups : tuple of str
+        Group of each flight line's images (the trajectory's group column).
+    boresight : dict of str to ndarray (3,)
+        True boresight per group, radians.
+    lever_arm : ndarray, shape (3,)
+    trajectory : Trajectory
+        Noise-free INS poses.
+    check_points : dict of str to ndarray (3,)
+        True check-point coordinates (mapping CRS) by LCP id.
+    blunders : ndarray of int
+        Observation rows given a gross error.
+    """
+
+    groups: tuple[str, ...]
+    boresight: dict[str, Array]
+    lever_arm: Array
+    trajectory: Trajectory
+    check_points: dict[str, Array]
+    blunders: NDArray[np.int64]
+
+
+@dataclass(frozen=True)
+class FlightSimulation:
+    """Inputs of :func:`core.boresight.calibrate` plus the truth (mapping CRS throughout)."""
+
+    config: FlightConfig
+    crs: str
+    trajectory: Trajectory
+    camera: Camera
+    mount: Mount
+    planes: list[Plane]
+    lines: list[ControlLine]
+    lcps: list[ControlPoint]
+    check_lcps: list[ControlPoint]
+    observations: ImageObservations
+    lidar_points: Array
+    lidar_plane_ids: NDArray[np.int64]
+    town: Town
+    truth: FlightTruth
+
+    def calibrate(self, options: BoresightOptions | None = None) -> BoresightResult:
+        """Boresight calibration of this simulation with every control it made."""
+        return calibrate(
+            self.trajectory, self.camera, self.mount, self.crs, self.observations, self.planes,
+            self.lines, self.lcps, self.lidar_points, self.lidar_plane_ids, options=options,
+        )  # fmt: skip
+
+    def true_boresight(self, groups: tuple[str, ...]) -> Array:
+        """(G, 3) true boresight in the order of a result's groups, radians."""
+        return np.array([self.truth.boresight[g] for g in groups])
+
+    def write(self, folder: Union[str, Path]) -> dict[str, Path]:
+        """Write every input as the project's files; returns their paths by name."""
+        out = Path(folder)
+        out.mkdir(parents=True, exist_ok=True)
+        paths = {
+            "trajectory": out / "trajectory.csv",
+            "camera": out / "camera.json",
+            "planes": out / "planes.csv",
+            "lines": out / "lines.csv",
+            "lcps": out / "lcps.csv",
+            "observations": out / "observations.csv",
+            "lidar_points": out / "lidar_roof_points.csv",
+            "truth": out / "truth.json",
+        }
+        t = self.trajectory
+        deg = np.degrees(t.rph)
+        write_csv_atomic(
+            paths["trajectory"],
+            (
+                "image_id",
+                "time",
+                "group",
+                "easting",
+                "northing",
+                "height",
+                "roll",
+                "pitch",
+                "heading",
+            ),
+            [
+                (i, repr(float(tt)), g, *(repr(float(v)) for v in p), *(repr(float(v)) for v in a))
+                for i, tt, g, p, a in zip(t.image_id, t.time, t.group, t.position, deg)
+            ],
+        )
+        write_camera_json(self.camera, paths["camera"])
+        write_planes_csv(paths["planes"], self.planes)
+        write_lines_csv(paths["lines"], self.lines)
+        write_lcps_csv(paths["lcps"], self.lcps + self.check_lcps)
+        write_observations_csv(paths["observations"], self.observations)
+        write_csv_atomic(
+            paths["lidar_points"],
+            ("x", "y", "z", "plane_id"),
+            [
+                (*(repr(float(v)) for v in p), int(i))
+                for p, i in zip(self.lidar_points, self.lidar_plane_ids)
+            ],
+        )
+        truth = {
+            "crs": self.crs,
+            "boresight_deg": {g: np.degrees(b).tolist() for g, b in self.truth.boresight.items()},
+            "initial_boresight_deg": np.degrees(self.mount.boresight).tolist(),
+            "lever_arm_m": self.truth.lever_arm.tolist(),
+            "mount": self.config.mount,
+            "check_points": {k: v.tolist() for k, v in self.truth.check_points.items()},
+        }
+        tmp = paths["truth"].with_suffix(".json.tmp")
+        tmp.write_text(json.dumps(truth, indent=2), encoding="utf-8")
+        tmp.replace(paths["truth"])
+        return paths
+
+
+# ----------------------------------------------------------------------------- helpers
+
+
+def _grade(grade: Union[str, InsGrade]) -> InsGrade:
+    return grade if isinstance(grade, InsGrade) else INS_GRADES[str(grade)]
+
+
+def _roof_samples(town: Town, density: float, rng) -> tuple[Array, NDArray[np.int64]]:
+    """Uniform points on the roofs (map), with their face ids: (M, 3), (M,)."""
+    xyz, fid = [], []
+    for b in town.buildings:
+        n = max(round(density * b.length * b.width), 10)
+        uv = rng.uniform(-0.5, 0.5, (n, 2)) * [b.length, b.width]
+        c, s = math.cos(b.rotation_rad), math.sin(b.rotation_rad)
+        xy = b.centre + np.column_stack([c * uv[:, 0] - s * uv[:, 1], s * uv[:, 0] + c * uv[:, 1]])
+        z, f = town.roof_z(b, xy)
+        xyz.append(np.column_stack([xy, z]))
+        fid.append(f)
+    return np.vstack(xyz), np.concatenate(fid).astype(np.int64)
+
+
+def _face_points(town: Town, faces: list[int], per_face: int, rng, inset: float = 0.15):
+    """``per_face`` random points strictly inside each face (map), (F * per_face, 3)."""
+    pts, ids = _roof_samples(town, 40.0, rng)
+    out = np.empty((len(faces), per_face, 3))
+    for k, f in enumerate(faces):
+        cand = pts[ids == f]
+        centroid = cand.mean(axis=0)
+        # pull towards the centroid: keeps measured points away from the roof edges
+        pick = cand[rng.choice(len(cand), per_face, replace=len(cand) < per_face)]
+        out[k] = centroid + (1.0 - inset) * (pick - centroid)
+    return out.reshape(-1, 3)
+
+
+def _roof_lines(town: Town, faces: set[int]):
+    """(segment (2, 3), face a, face b) for every ridge/hip between two kept faces."""
+    out = []
+    for b in town.buildings:
+        fs = [town.faces[f] for f in b.face_ids]
+        for seg in b.ridges:
+            mid = seg.mean(axis=0)
+            on = [f.face_id for f in fs if abs(float(f.normal @ mid + f.d)) < 1e-6]
+            if len(on) == 2 and set(on) <= faces:
+                out.append((seg, on[0], on[1]))
+    return out
+
+
+def _roof_corners(town: Town, faces: set[int]):
+    """(point (3,), (f1, f2, f3)) where three kept faces of a building meet, deduplicated."""
+    out = []
+    for b in town.buildings:
+        ids = [f for f in b.face_ids if f in faces]
+        found: list[Array] = []
+        for tri in itertools.combinations(ids, 3):
+            n = np.array([town.faces[f].normal for f in tri])
+            d = np.array([town.faces[f].d for f in tri])
+            if abs(np.linalg.det(n)) < 1e-6:
+                continue
+            p = np.linalg.solve(n, -d)
+            z, _ = town.roof_z(b, p[None, :2])
+            if not b.inside(p[None, :2])[0] or abs(z[0] - p[2]) > 1e-6:
+                continue
+            if any(np.linalg.norm(p - q) < 1e-6 for q in found):
+                continue
+            found.append(p)
+            out.append((p, tri))
+    return out
+
+
+# ----------------------------------------------------------------------------- main
+
+
+def _true_flight(cfg, cam, h0: float, frame, rng, seconds_per_image: float):
+    """Flight lines over ``cfg.centre`` at height ``h0`` (grid azimuth ``cfg.heading_deg``,
+    overlaps from the camera footprint), true attitudes with jitter, and the true boresight of
+    each group. Returns (true trajectory, {group: boresight (3,) rad}, geodetic (N, 3))."""
+    along_axis = 1 if cfg.mount in ("image_top_forward", "image_bottom_forward") else 0
+    size_px = (cam.width_px, cam.height_px)
+    scale = cfg.flying_height_m / cam.focal_mm
+    base = (1 - cfg.forward_overlap) * size_px[along_axis] * cam.pixel_size_mm * scale
+    spacing = (1 - cfg.side_overlap) * size_px[1 - along_axis] * cam.pixel_size_mm * scale
+    az = math.radians(cfg.heading_deg)
+    fwd = np.array([math.sin(az), math.cos(az)])
+    right = np.array([math.cos(az), -math.sin(az)])
+    names = _direction_names(cfg)
+    pos, head, groups, ids = [], [], [], []
+    m = cfg.images_per_line
+    for line in range(cfg.n_lines):
+        back = cfg.opposite and line % 2 == 1
+        off = (line - (cfg.n_lines - 1) / 2) * spacing
+        for k in range(m - 1, -1, -1) if back else range(m):
+            pos.append(np.array(cfg.centre) + (k - (m - 1) / 2) * base * fwd + off * right)
+            head.append(az + (math.pi if back else 0.0))
+            groups.append(names[line])
+            ids.append(f"L{line + 1}_{len(ids) + 1:03d}")
+    n = len(ids)
+    enh = np.column_stack([np.array(pos), np.full(n, h0)])
+    llh = frame.map_to_geodetic(enh)
+    theta = frame.grid_north_azimuth(llh)
+    jit = math.radians(cfg.attitude_jitter_deg)
+    rph_true = np.column_stack(
+        [
+            rng.normal(0, jit, n),
+            rng.normal(0, jit, n),
+            np.angle(np.exp(1j * (np.array(head) - theta + rng.normal(0, jit, n)))),
+        ]
+    )
+    time = np.arange(n, dtype=np.float64) * seconds_per_image
+    traj_true = Trajectory(tuple(ids), time, tuple(groups), enh, False, rph_true)
+    rows = np.radians(np.array(cfg.true_boresight_deg, dtype=np.float64).reshape(-1, 3))
+    if rows.shape[0] not in (1, cfg.n_lines):
+        raise InputError("true_boresight_deg needs one row or one per line")
+    bore_of = {names[k]: rows[min(k, rows.shape[0] - 1)] for k in range(cfg.n_lines)}
+    return traj_true, bore_of, llh
+
+
+def simulate_flight(config: FlightConfig, seed: int = 0, exact: bool = False) -> FlightSimulation:
+    """Simulate a calibration flight (module docstring).
+
+    Parameters
+    ----------
+    config : FlightConfig
+    seed : int
+        Seed of every noise (INS, LiDAR, pixels, blunders, point choice); the town layout uses
+        ``config.town_seed``.
+    exact : bool
+        Noise-free INS, planes (true parameters with the fitted covariance), lines, LCPs and
+        pixels; no blunders.
+
+    Returns
+    -------
+    FlightSimulation
+    """
+    cfg = config
+    rng = np.random.default_rng(seed)
+    frame = MappingFrame.from_user_input(cfg.crs)
+    cam = cfg.camera
+    grade = _grade(cfg.ins_grade)
+    if cfg.mount not in MOUNT_PRESETS:
+        raise InputError(f"mount '{cfg.mount}' is not a preset")
+    nominal = MOUNT_PRESETS[cfg.mount]
+
+    # ---- town
+    cols = max(1, math.ceil(math.sqrt(cfg.n_buildings)))
+    cell = max(25.0, cfg.town_size_m / cols)
+    origin = (cfg.centre[0] - cols * cell / 2, cfg.centre[1] - cols * cell / 2)
+    town = make_town(
+        n_buildings=cfg.n_buildings,
+        roof_types=cfg.roof_types,
+        n_trees=0,
+        origin=origin,
+        cell=cell,
+        seed=cfg.town_seed,
+    )
+    kept = [f.face_id for f in town.faces][: cfg.n_planes]
+    kept_set = set(kept)
+
+    # ---- flight lines (grid azimuths), true attitude and boresight
+    h0 = float(town.terrain_z(np.array([cfg.centre]))[0]) + cfg.flying_height_m
+    traj_true, bore_of, llh = _true_flight(cfg, cam, h0, frame, rng, seconds_per_image=10.0)
+    ids, groups, enh = traj_true.image_id, traj_true.group, traj_true.position
+    time, rph_true, n = traj_true.time, traj_true.rph, len(traj_true)
+    lever = np.array(cfg.lever_arm_m, dtype=np.float64)
+    local = local_frame_for(traj_true, frame)
+    centre_l = np.empty((n, 3))
+    r_cl = np.empty((n, 3, 3))
+    for g, b in bore_of.items():
+        sel = np.array([x == g for x in groups])
+        sub = Trajectory(
+            tuple(np.array(ids)[sel]),
+            time[sel],
+            tuple(np.array(groups)[sel]),
+            enh[sel],
+            False,
+            rph_true[sel],
+        )
+        poses = georeference_ecef(sub, Mount(lever, nominal, b), frame)
+        centre_l[sel] = local.ecef_to_enu(poses.centre_ecef)
+        r_cl[sel] = local.rotation @ poses.camera_to_ecef
+    m_true = np.swapaxes(r_cl, 1, 2)
+    opk = np.column_stack(matrix_to_opk(m_true))
+    eo_true = np.hstack([centre_l, opk])
+
+    # ---- LiDAR roof points and planes
+    lidar, lid = _roof_samples(town, cfg.lidar_density, rng)
+    keep = np.isin(lid, kept)
+    lidar, lid = lidar[keep], lid[keep]
+    lidar_noisy = lidar + rng.normal(0, cfg.lidar_noise_m, lidar.shape)
+    planes = []
+    for f in kept:
+        fit = fit_plane(lidar_noisy[lid == f], plane_id=f)
+        if exact or cfg.plane_source == "exact":
+            face = town.faces[f]
+            c = fit.centroid - (fit.centroid @ face.normal + face.d) * face.normal
+            fit = Plane(
+                f,
+                face.normal.copy(),
+                float(-face.normal @ c),
+                c,
+                fit.n_points,
+                fit.rms,
+                fit.sigma_d,
+                fit.covariance,
+                fit.slope_deg,
+                fit.aspect_deg,
+            )
+        planes.append(fit)
+    plane_of = {p.id: p for p in planes}
+
+    # ---- lines and LCPs from the (fitted) planes
+    lines: list[ControlLine] = []
+    line_truth = []
+    for seg, fa, fb in _roof_lines(town, kept_set):
+        pa, pb = plane_of[fa], plane_of[fb]
+        x0, u, cov = intersect_two_planes(
+            pa.normal[None],
+            np.array([pa.d]),
+            pa.covariance[None],
+            pb.normal[None],
+            np.array([pb.d]),
+            pb.covariance[None],
+            seg.mean(axis=0)[None],
+        )
+        if not np.isfinite(x0).all():
+            continue
+        kind = "ridge" if abs(seg[0, 2] - seg[1, 2]) < 1e-6 else "hip"
+        dih = math.degrees(math.acos(min(1.0, abs(float(pa.normal @ pb.normal)))))
+        lines.append(
+            ControlLine(len(lines), (fa, fb), kind, seg[0], seg[1], x0[0], u[0], cov[0], dih)
+        )
+        line_truth.append(seg)
+    corners = _roof_corners(town, kept_set)
+    all_lcps: list[ControlPoint] = []
+    lcp_truth = []
+    for k, (p, tri) in enumerate(corners):
+        ps = [plane_of[f] for f in tri]
+        x, c, cond = intersect_three_planes(
+            np.array([q.normal for q in ps])[None],
+            np.array([[q.d for q in ps]]),
+            np.array([q.covariance for q in ps])[None],
+        )
+        if not np.isfinite(x).all():
+            continue
+        xyz = p.copy() if exact else x[0]
+        all_lcps.append(
+            ControlPoint(k, xyz, c[0], tuple(int(f) for f in tri), 0.0, float(cond[0]), np.zeros(3))
+        )
+        lcp_truth.append(p)
+    order = rng.permutation(len(all_lcps))
+    n_check = min(cfg.n_check, len(all_lcps)) if "check" in cfg.types else 0
+    check_lcps = [all_lcps[i] for i in order[:n_check]]
+    control_lcps = [all_lcps[i] for i in order[n_check:]]
+    check_truth = {str(all_lcps[i].id): lcp_truth[i] for i in order[:n_check]}
+    control_truth = [lcp_truth[i] for i in order[n_check:]]
+
+    # ---- image observations: (true map point, type, target, point id)
+    targets: list[tuple[Array, str, list[str], list[str]]] = []
+    if "tie" in cfg.types:
+        p = _face_points(town, kept, cfg.ties_per_plane, rng)
+        fids = np.repeat(kept, cfg.ties_per_plane)
+        if cfg.roof_roughness_m > 0 and not exact:
+            nrm = np.array([town.faces[f].normal for f in fids])
+            p = p + nrm * rng.normal(0, cfg.roof_roughness_m, (len(p), 1))
+        targets.append((p, "tie", [str(f) for f in fids], [f"T{k}" for k in range(len(p))]))
+    if "lcp" in cfg.types and control_truth:
+        targets.append(
+            (
+                np.array(control_truth),
+                "lcp",
+                [str(c.id) for c in control_lcps],
+                [f"C{c.id}" for c in control_lcps],
+            )
+        )
+    if "check" in cfg.types and check_lcps:
+        targets.append(
+            (
+                np.array([check_truth[str(c.id)] for c in check_lcps]),
+                "check",
+                [str(c.id) for c in check_lcps],
+                [f"K{c.id}" for c in check_lcps],
+            )
+        )
+    rec: dict[str, list] = {k: [] for k in ("image", "point", "px", "type", "target")}
+    local_targets = []
+    for pts, kind, tgt, pid in targets:
+        local_targets.append((local.map_to_enu(pts), kind, tgt, pid))
+    for i in range(n):
+        for pts, kind, tgt, pid in local_targets:
+            px = project(pts, eo_true[i], cam)
+            vis = np.flatnonzero(cam.in_frame(px, cfg.margin_px))
+            for j in vis:
+                rec["image"].append(ids[i])
+                rec["point"].append(pid[j])
+                rec["px"].append(px[j])
+                rec["type"].append(kind)
+                rec["target"].append(tgt[j])
+        if "paper" in cfg.types:
+            p = local.map_to_enu(_face_points(town, kept, 1, rng))
+            px = project(p, eo_true[i], cam)
+            for j in np.flatnonzero(cam.in_frame(px, cfg.margin_px)):
+                rec["image"].append(ids[i])
+                rec["point"].append(f"P{i}_{kept[j]}")
+                rec["px"].append(px[j])
+                rec["type"].append("paper")
+                rec["target"].append(str(kept[j]))
+        if "line" in cfg.types and lines:
+            t = rng.uniform(0.1, 0.9, (len(lines), cfg.line_points_per_image))
+            seg = np.array(line_truth)
+            p = seg[:, None, 0] + t[:, :, None] * (seg[:, None, 1] - seg[:, None, 0])
+            px = project(local.map_to_enu(p.reshape(-1, 3)), eo_true[i], cam)
+            for j in np.flatnonzero(cam.in_frame(px, cfg.margin_px)):
+                li = j // cfg.line_points_per_image
+                rec["image"].append(ids[i])
+                rec["point"].append(f"R{li}_{j % cfg.line_points_per_image}")
+                rec["px"].append(px[j])
+                rec["type"].append("line")
+                rec["target"].append(str(lines[li].id))
+    pixels = np.array(rec["px"]).reshape(-1, 2)
+    kinds = np.array(rec["type"])
+    # tie points seen in fewer than two images carry no information: drop them
+    if "tie" in cfg.types:
+        pid = np.array(rec["point"])
+        tie = kinds == "tie"
+        uniq, cnt = np.unique(pid[tie], return_counts=True)
+        single = set(uniq[cnt < 2])
+        drop = tie & np.isin(pid, list(single))
+        keep_rows = ~drop
+        pixels = pixels[keep_rows]
+        kinds = kinds[keep_rows]
+        for key in ("image", "point", "target"):
+            rec[key] = [v for v, k in zip(rec[key], keep_rows) if k]
+    blunders = np.empty(0, dtype=np.int64)
+    if not exact:
+        pixels = pixels + rng.normal(0, cfg.sigma_px, pixels.shape)
+        if cfg.n_blunders:
+            cand = np.flatnonzero(np.isin(kinds, ("tie", "lcp")))
+            blunders = np.sort(rng.choice(cand, cfg.n_blunders, replace=False))
+            ang = rng.uniform(0, 2 * math.pi, blunders.size)
+            pixels[blunders] += cfg.blunder_px * np.column_stack([np.cos(ang), np.sin(ang)])
+    obs = ImageObservations.from_arrays(
+        rec["image"],
+        rec["point"],
+        pixels,
+        np.full(len(pixels), cfg.sigma_px),
+        list(kinds),
+        rec["target"],
+    )
+
+    # ---- INS measurements
+    if exact:
+        enh_meas, rph_meas = enh, rph_true
+    else:
+        r_nl = local.ned_to_local(llh)
+        enu_i = r_nl @ np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]]).T
+        noise = np.einsum("nij,nj->ni", enu_i, rng.normal(0, 1, (n, 3)) * grade.sigma_position)
+        enh_meas = local.enu_to_map(local.map_to_enu(enh) + noise)
+        rph_meas = rph_true + rng.normal(0, 1, (n, 3)) * grade.sigma_attitude
+    traj = Trajectory(tuple(ids), time, tuple(groups), enh_meas, False, rph_meas)
+    mount = Mount(lever, nominal, np.radians(cfg.initial_boresight_deg))
+    truth = FlightTruth(tuple(groups), bore_of, lever, traj_true, check_truth, blunders)
+    return FlightSimulation(
+        cfg,
+        cfg.crs,
+        traj,
+        cam,
+        mount,
+        planes,
+        lines,
+        control_lcps,
+        check_lcps,
+        obs,
+        lidar_noisy if not exact else lidar,
+        lid,
+        town,
+        truth,
+    )
+
+
+def _direction_names(cfg: FlightConfig) -> list[str]:
+    """Group name of each line: its compass direction, with a line number when repeated."""
+    compass = ("N", "NE", "E", "SE", "S", "SW", "W", "NW")
+    out = []
+    for line in range(cfg.n_lines):
+        h = cfg.heading_deg + (180.0 if cfg.opposite and line % 2 == 1 else 0.0)
+        out.append(compass[round(h % 360.0 / 45.0) % 8])
+    if len(set(out)) < len(out):
+        out = [f"{d}{k + 1}" for k, d in enumerate(out)]
+    return out
+
+
+# ----------------------------------------------------------------------------- over real control
+
+
+def small_format_camera() -> Camera:
+    """A 24 Mpx small-format survey camera: f = 35 mm, 4.5 um pixels, 6000 x 4000 px."""
+    return Camera(
+        "small format 35 mm", focal_mm=35.0, pixel_size_mm=0.0045, width_px=6000, height_px=4000
+    )
+
+
+@dataclass(frozen=True)
+class ControlFlightConfig:
+    """A calibration flight over existing LiDAR control (real planes, lines and LCPs).
+
+    Attributes are those of :class:`FlightConfig` where they share a name; ``centre`` is the
+    block centre (mapping CRS) and ``flying_height_m`` is above the lowest LiDAR point.
+    ``n_check`` roof points (on the planes) are made check points: measured in every image
+    that sees them, never adjusted.
+    """
+
+    crs: str = "EPSG:28992"
+    centre: tuple[float, float] = (84940.0, 447595.0)
+    camera: Camera = field(default_factory=small_format_camera)
+    flying_height_m: float = 130.0
+    forward_overlap: float = 0.8
+    side_overlap: float = 0.6
+    images_per_line: int = 5
+    n_lines: int = 2
+    heading_deg: float = 0.0
+    opposite: bool = True
+    mount: str = "image_top_forward"
+    true_boresight_deg: tuple[tuple[float, float, float], ...] = ((0.12, -0.25, 0.40),)
+    initial_boresight_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    lever_arm_m: tuple[float, float, float] = (0.10, -0.05, -0.20)
+    ins_grade: Union[str, InsGrade] = "pos_av_310"
+    attitude_jitter_deg: float = 1.0
+    types: tuple[str, ...] = ("tie", "line", "lcp", "check")
+    ties_per_plane: int = 2
+    line_points_per_image: int = 2
+    n_check: int = 15
+    sigma_px: float = 0.5
+    margin_px: float = 50.0
+
+
+@dataclass(frozen=True)
+class ControlFlightSimulation:
+    """Trajectory, mount and image observations over given control, with the truth.
+
+    ``check_points`` maps each check point id (``K<k>``, the ``target_id`` of its ``check``
+    rows) to its true position (mapping CRS).
+    """
+
+    config: ControlFlightConfig
+    trajectory: Trajectory
+    camera: Camera
+    mount: Mount
+    observations: ImageObservations
+    truth: FlightTruth
+    check_points: dict[str, Array]
+
+    def write(self, folder: Union[str, Path]) -> dict[str, Path]:
+        """Write trajectory.csv, camera.json, observations.csv, check_points.csv (id, e, n, h:
+        the truth) and truth.json; returns their paths by name."""
+        out = Path(folder)
+        out.mkdir(parents=True, exist_ok=True)
+        paths = {k: out / f"{k}.csv" for k in ("trajectory", "observations", "check_points")}
+        paths.update(camera=out / "camera.json", truth=out / "truth.json")
+        _write_trajectory(paths["trajectory"], self.trajectory)
+        write_camera_json(self.camera, paths["camera"])
+        write_observations_csv(paths["observations"], self.observations)
+        write_csv_atomic(
+            paths["check_points"],
+            ("id", "e", "n", "h"),
+            [(k, *(repr(float(v)) for v in p)) for k, p in self.check_points.items()],
+        )
+        truth = {
+            "crs": self.config.crs,
+            "boresight_deg": {g: np.degrees(b).tolist() for g, b in self.truth.boresight.items()},
+            "initial_boresight_deg": np.degrees(self.mount.boresight).tolist(),
+            "lever_arm_m": self.truth.lever_arm.tolist(),
+            "mount": self.config.mount,
+        }
+        tmp = paths["truth"].with_suffix(".json.tmp")
+        tmp.write_text(json.dumps(truth, indent=2), encoding="utf-8")
+        tmp.replace(paths["truth"])
+        return paths
+
+
+def _write_trajectory(path: Path, t: Trajectory) -> None:
+    deg = np.degrees(t.rph)
+    write_csv_atomic(
+        path,
+        ("image_id", "time", "group", "easting", "northing", "height", "roll", "pitch", "heading"),
+        [
+            (i, repr(float(tt)), g, *(repr(float(v)) for v in p), *(repr(float(v)) for v in a))
+            for i, tt, g, p, a in zip(t.image_id, t.time, t.group, t.position, deg)
+        ],
+    )
+
+
+def simulate_flight_over(
+    planes: list[Plane],
+    lines: list[ControlLine],
+    lcps: list[ControlPoint],
+    lidar_points: Array,
+    lidar_plane_ids: NDArray[np.integer],
+    config: ControlFlightConfig | None = None,
+    seed: int = 0,
+) -> ControlFlightSimulation:
+    """Simulate a calibration flight over real LiDAR control (e.g. from a real tile).
+
+    The given planes, lines and LCPs are taken as the true roof geometry (the LiDAR fit is the
+    truth here, so the simulation isolates the image and INS side). Tie and check points are
+    LiDAR points of a plane moved onto it (so they lie where the roof really is), line points
+    are spread along each line's clipped segment, LCPs are measured where they are. Visibility
+    is the image frame only (no occlusion).
+
+    Parameters
+    ----------
+    planes, lines, lcps : sequences of Plane, ControlLine, ControlPoint
+        Mapping CRS.
+    lidar_points : ndarray, shape (M, 3)
+        Points of the planes (mapping CRS) with their ``lidar_plane_ids`` (M,) (-1: none).
+    config : ControlFlightConfig, optional
+    seed : int
+        Seed of every random choice and noise.
+
+    Returns
+    -------
+    ControlFlightSimulation
+    """
+    cfg = config if config is not None else ControlFlightConfig()
+    rng = np.random.default_rng(seed)
+    frame = MappingFrame.from_user_input(cfg.crs)
+    cam = cfg.camera
+    grade = _grade(cfg.ins_grade)
+    if cfg.mount not in MOUNT_PRESETS:
+        raise InputError(f"mount '{cfg.mount}' is not a preset")
+    nominal = MOUNT_PRESETS[cfg.mount]
+    pts = np.asarray(lidar_points, dtype=np.float64).reshape(-1, 3)
+    pid = np.asarray(lidar_plane_ids).astype(np.int64)
+    if not planes or pts.shape[0] != pid.shape[0]:
+        raise InputError("simulate_flight_over needs planes and their LiDAR points")
+
+    # ---- flight lines (as simulate_flight), true attitude and poses via ECEF
+    h0 = float(pts[:, 2].min()) + cfg.flying_height_m
+    traj_true, bore_of, llh = _true_flight(cfg, cam, h0, frame, rng, seconds_per_image=2.0)
+    ids, groups, enh = traj_true.image_id, traj_true.group, traj_true.position
+    time, rph_true, n = traj_true.time, traj_true.rph, len(traj_true)
+    lever = np.array(cfg.lever_arm_m, dtype=np.float64)
+    local = local_frame_for(traj_true, frame)
+    eo_true = np.empty((n, 6))
+    for g, b in bore_of.items():
+        sel = np.array([x == g for x in groups])
+        sub = Trajectory(
+            tuple(np.array(ids)[sel]),
+            time[sel],
+            tuple(np.array(groups)[sel]),
+            enh[sel],
+            False,
+            rph_true[sel],
+        )
+        poses = georeference_ecef(sub, Mount(lever, nominal, b), frame)
+        r_cl = local.rotation @ poses.camera_to_ecef
+        eo_true[sel, :3] = local.ecef_to_enu(poses.centre_ecef)
+        eo_true[sel, 3:] = np.column_stack(matrix_to_opk(np.swapaxes(r_cl, 1, 2)))
+
+    # ---- true ground points: (map xyz, type, target id, point id)
+    plane_of = {int(p.id): p for p in planes}
+
+    def on_plane(k_points: int, exclude: set[int]) -> tuple[Array, list[str]]:
+        out, tgt = [], []
+        for p in planes:
+            idx = np.flatnonzero(pid == int(p.id))
+            idx = np.setdiff1d(idx, list(exclude))
+            if idx.size == 0:
+                continue
+            take = rng.choice(idx, min(k_points, idx.size), replace=False)
+            exclude.update(take.tolist())
+            q = pts[take]
+            out.append(q - np.outer(q @ p.normal + p.d, p.normal))  # onto the plane
+            tgt += [str(p.id)] * len(take)
+        return (np.vstack(out) if out else np.empty((0, 3))), tgt
+
+    used: set[int] = set()
+    targets: list[tuple[Array, str, list[str], list[str]]] = []
+    check_points: dict[str, Array] = {}
+    if "check" in cfg.types and cfg.n_check > 0:
+        cand = np.flatnonzero(np.isin(pid, list(plane_of)))
+        take = rng.choice(cand, min(cfg.n_check, cand.size), replace=False)
+        used.update(take.tolist())
+        q = pts[take]
+        nrm = np.array([plane_of[int(i)].normal for i in pid[take]])
+        dd = np.array([plane_of[int(i)].d for i in pid[take]])
+        q = q - nrm * (np.einsum("ij,ij->i", q, nrm) + dd)[:, None]
+        check_points = {f"K{k}": q[k] for k in range(len(q))}
+        targets.append((q, "check", list(check_points), list(check_points)))
+    if "tie" in cfg.types:
+        q, tgt = on_plane(cfg.ties_per_plane, used)
+        targets.append((q, "tie", tgt, [f"T{k}" for k in range(len(q))]))
+    if "lcp" in cfg.types and lcps:
+        q = np.array([c.xyz for c in lcps], dtype=np.float64)
+        targets.append((q, "lcp", [str(c.id) for c in lcps], [f"C{c.id}" for c in lcps]))
+    rec: dict[str, list] = {k: [] for k in ("image", "point", "px", "type", "target")}
+    local_targets = [(local.map_to_enu(q), kind, t, p) for q, kind, t, p in targets if len(q)]
+    for i in range(n):
+        for q, kind, tgt, pnames in local_targets:
+            px = project(q, eo_true[i], cam)
+            for j in np.flatnonzero(cam.in_frame(px, cfg.margin_px)):
+                rec["image"].append(ids[i])
+                rec["point"].append(pnames[j])
+                rec["px"].append(px[j])
+                rec["type"].append(kind)
+                rec["target"].append(tgt[j])
+        if "line" in cfg.types and lines:
+            t = rng.uniform(0.1, 0.9, (len(lines), cfg.line_points_per_image))
+            a = np.array([ln.start for ln in lines])
+            b = np.array([ln.end for ln in lines])
+            q = a[:, None] + t[:, :, None] * (b - a)[:, None]
+            px = project(local.map_to_enu(q.reshape(-1, 3)), eo_true[i], cam)
+            for j in np.flatnonzero(cam.in_frame(px, cfg.margin_px)):
+                li = j // cfg.line_points_per_image
+                rec["image"].append(ids[i])
+                rec["point"].append(f"R{lines[li].id}_{i}_{j % cfg.line_points_per_image}")
+                rec["px"].append(px[j])
+                rec["type"].append("line")
+                rec["target"].append(str(lines[li].id))
+    pixels = np.array(rec["px"]).reshape(-1, 2)
+    kinds = np.array(rec["type"])
+    # tie points seen in fewer than two images carry no information: drop them
+    names_arr = np.array(rec["point"])
+    uniq, cnt = np.unique(names_arr[kinds == "tie"], return_counts=True)
+    keep = ~((kinds == "tie") & np.isin(names_arr, uniq[cnt < 2]))
+    pixels = pixels[keep] + rng.normal(0, cfg.sigma_px, (int(keep.sum()), 2))
+    obs = ImageObservations.from_arrays(
+        [v for v, k in zip(rec["image"], keep) if k],
+        [v for v, k in zip(rec["point"], keep) if k],
+        pixels,
+        np.full(len(pixels), cfg.sigma_px),
+        list(kinds[keep]),
+        [v for v, k in zip(rec["target"], keep) if k],
+    )
+
+    # ---- INS measurements: the truth plus the grade's noise
+    r_nl = local.ned_to_local(llh)
+    enu_i = r_nl @ np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]]).T
+    noise = np.einsum("nij,nj->ni", enu_i, rng.normal(0, 1, (n, 3)) * grade.sigma_position)
+    enh_meas = local.enu_to_map(local.map_to_enu(enh) + noise)
+    rph_meas = rph_true + rng.normal(0, 1, (n, 3)) * grade.sigma_attitude
+    traj = Trajectory(tuple(ids), time, tuple(groups), enh_meas, False, rph_meas)
+    mount = Mount(lever, nominal, np.radians(cfg.initial_boresight_deg))
+    truth = FlightTruth(
+        tuple(groups), bore_of, lever, traj_true, check_points, np.empty(0, dtype=np.int64)
+    )
+    return ControlFlightSimulation(cfg, traj, cam, mount, obs, truth, check_points)
