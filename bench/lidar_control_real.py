@@ -16,7 +16,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from lidarphoto.core.geometry.planes import read_planes_csv
+from lidarphoto.core.io.planes import read_planes_csv
 from lidarphoto.core.io.pointcloud import read_points
 from lidarphoto.core.lidar.control import run_create_lcps
 from lidarphoto.core.lidar.ground_filter import run_ground_filter

@@ -60,10 +60,10 @@ from qgis.PyQt.QtWidgets import (
 )
 
 from ..core.errors import InputError
-from ..core.geometry.camera import read_camera_json
 from ..core.geometry.planes import fit_plane
-from ..core.photo.georeference import MOUNT_CHOICES
-from ..core.photo.orientation import read_eo_csv
+from ..core.io.camera import read_camera_json
+from ..core.io.orientation import read_eo_csv
+from ..core.photo.mount import MOUNT_CHOICES
 from ..core.photo.picking import PickingScene, nearest_point, nearest_segment
 from .image_source import ImageSource, ImageSourceError
 from .image_view import VIEW_HELP, ImageView

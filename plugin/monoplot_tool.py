@@ -78,8 +78,9 @@ class MonoplotTool(QObject):
         ("" when the DSM was used as it is)."""
         import pyproj
 
-        from ..core.lidar.dsm import load_dsm, reproject_dsm
-        from ..core.photo.monoplot import DsmTracer
+        from ..core.geometry.raycast import DsmTracer
+        from ..core.geometry.surface import reproject_dsm
+        from ..core.io.dsm import load_dsm
 
         dsm = load_dsm(path, cell_size, crs)
         note = ""
@@ -115,8 +116,8 @@ class MonoplotTool(QObject):
     # ------------------------------------------------------------------ work
     def monoplot(self, pixels, image_id: str | None = None, line: bool = False):
         """Monoplot pixels (N, 2) of an image (default: the dock's current one)."""
-        from ..core.io.observations import ImageObservations
         from ..core.photo.monoplot import run_monoplot
+        from ..core.photo.observations import ImageObservations
 
         crs = self.dock.eo_crs()
         if self.tracer is None or self.dock.camera is None or self.dock.eo is None:

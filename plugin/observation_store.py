@@ -23,12 +23,8 @@ from qgis.PyQt.QtCore import QObject, pyqtSignal
 from qgis.PyQt.QtWidgets import QUndoCommand, QUndoStack
 
 from ..core.errors import InputError
-from ..core.io.observations import (
-    DEFAULT_SIGMA_PX,
-    ImageObservations,
-    read_observations_csv,
-    write_observations_csv,
-)
+from ..core.io.observations import read_observations_csv, write_observations_csv
+from ..core.photo.observations import DEFAULT_SIGMA_PX, ImageObservations
 
 __all__ = [
     "SESSION_KEYS",

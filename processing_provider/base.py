@@ -1,4 +1,5 @@
-"""Common base of the toolkit's algorithms and the bridge from core calls to QGIS feedback."""
+"""The base of the toolkit's algorithms: a QGIS algorithm generated from a core job's spec,
+and the bridge from core calls to QGIS feedback (progress, cancel, log, errors)."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import logging
 import math
 from contextlib import contextmanager
 from pathlib import Path
+from types import ModuleType
 from typing import Any, Callable
 
 from qgis.core import (
@@ -18,14 +20,15 @@ from qgis.core import (
     QgsProcessingAlgorithm,
     QgsProcessingException,
     QgsProcessingFeedback,
-    QgsProcessingParameterCrs,
-    QgsProcessingParameterEnum,
-    QgsProcessingParameterFile,
 )
 from qgis.PyQt.QtCore import QCoreApplication
 
+from ..core.dependencies import missing_message, missing_modules
 from ..core.errors import Cancelled, LidarPhotoError
-from .compat import FIELD_INT, FIELD_STRING, FILE_BEHAVIOR_FILE, SINK_FAST_INSERT, WKT_PREFERRED
+from ..core.jobs.runner import JobResult, run_job
+from ..core.jobs.spec import AlgorithmSpec
+from .compat import FIELD_INT, FIELD_STRING, SINK_FAST_INSERT
+from .parameters import make_output, make_parameter, read_parameter
 
 _PLUGIN_DIR = Path(__file__).resolve().parents[1]
 #: Logger of the whole package ("lidarphoto"); the core logs below it ("lidarphoto.core.*").
@@ -106,102 +109,85 @@ def core_errors(cancelled_text: str = "Cancelled"):
 
 
 class BaseAlgorithm(QgsProcessingAlgorithm):
-    """tr/createInstance/group/helpUrl for every algorithm of the provider.
+    """A QGIS algorithm made from a core job (``core/jobs/<algorithm>.py``).
 
-    Subclasses set ``GROUP`` (English, translated on display) and ``GROUP_ID``, and implement
-    name/displayName/shortHelpString/initAlgorithm/processAlgorithm.
+    Subclasses set ``JOB`` (the job module: its ``SPEC`` gives the id, names, help, parameters
+    and outputs; its ``run`` does the work) and, where the algorithm has layer outputs or layer
+    inputs, override :meth:`write_layers` and :meth:`prepare`.
     """
 
-    GROUP = ""
-    GROUP_ID = ""
-    TAGS: tuple[str, ...] = ()
+    JOB: ModuleType
 
     def tr(self, text: str) -> str:
         return QCoreApplication.translate(type(self).__name__, text)
 
+    @property
+    def spec(self) -> AlgorithmSpec:
+        return self.JOB.SPEC
+
     def createInstance(self):
         return type(self)()
 
+    def name(self) -> str:
+        return self.spec.name
+
+    def displayName(self) -> str:
+        return self.tr(self.spec.title)
+
     def group(self) -> str:
-        return self.tr(self.GROUP)
+        return self.tr(self.spec.group)
 
     def groupId(self) -> str:
-        return self.GROUP_ID
+        return self.spec.group_id
 
     def tags(self) -> list[str]:
-        return ["lidarphoto", "lidar", "photogrammetry", *self.TAGS]
+        return ["lidarphoto", "lidar", "photogrammetry", *self.spec.tags]
+
+    def shortHelpString(self) -> str:
+        return self.tr(self.spec.help_html())
 
     def helpUrl(self) -> str:
         home = _homepage()
         return f"{home.rstrip('/')}/algorithms/{self.name()}" if home else ""
 
-    # -- parameters shared by the algorithms that read a LAS/LAZ cloud -----------------------
-    DISTANCE_UNITS = ("crs", "metre")
-
-    def add_cloud_parameters(
-        self, key: str = "INPUT", label: str = "Point cloud (LAS/LAZ)"
-    ) -> None:
-        """The cloud file, ``CRS`` (overrides or supplies the file's) and ``DISTANCE_UNIT``
-        (0: the cloud's CRS unit, 1: metres) — the same names in every LiDAR algorithm."""
-        self.addParameter(
-            QgsProcessingParameterFile(
-                key,
-                self.tr(label),
-                behavior=FILE_BEHAVIOR_FILE,
-                fileFilter=self.tr("LAS/LAZ files (*.las *.laz *.LAS *.LAZ)"),
-            )
-        )
-        self.addParameter(
-            QgsProcessingParameterCrs("CRS", self.tr("CRS (overrides the file's)"), None, True)
-        )
-        self.addParameter(
-            QgsProcessingParameterEnum(
-                "DISTANCE_UNIT",
-                self.tr("Distance unit"),
-                [self.tr("cloud CRS units"), self.tr("metres")],
-                False,
-                0,
-            )
-        )
-
-    def cloud_crs(self, parameters, context) -> str | None:
-        """The ``CRS`` parameter for the core (authority id, else WKT), None when not given."""
-        crs = self.parameterAsCrs(parameters, "CRS", context)
-        return (crs.authid() or crs.toWkt(WKT_PREFERRED)) if crs.isValid() else None
-
-    def distance_unit(self, parameters, context) -> str:
-        """``"crs"`` or ``"metre"`` from the ``DISTANCE_UNIT`` parameter."""
-        return self.DISTANCE_UNITS[self.parameterAsEnum(parameters, "DISTANCE_UNIT", context)]
-
-    # -- feature sinks described by (name, QVariant type) field specs -------------------------
-    def field_sink(self, parameters, context, key, spec, wkb, crs):
-        """Open the sink ``key`` with the fields of ``spec``; returns ((sink, fields), dest id)."""
-        fields = QgsFields()
-        for name, kind in spec:
-            fields.append(QgsField(name, kind))
-        sink, dest = self.parameterAsSink(parameters, key, context, fields, wkb, crs)
-        if sink is None:
-            raise QgsProcessingException(self.invalidSinkError(parameters, key))
-        return (sink, fields), dest
-
-    @staticmethod
-    def add_feature(sink_fields, spec, geometry, values) -> None:
-        """Add one feature; ``geometry`` None keeps the row without a geometry (e.g. a failed
-        point with its status); non-finite numbers become NULL."""
-        sink, fields = sink_fields
-        feature = QgsFeature(fields)
-        if geometry is not None:
-            feature.setGeometry(QgsGeometry(geometry))
-        feature.setAttributes([_field_value(v, kind) for v, (_, kind) in zip(values, spec)])
-        sink.addFeature(feature, SINK_FAST_INSERT)
+    def initAlgorithm(self, config=None):
+        for p in self.spec.params:
+            self.addParameter(make_parameter(p, self.tr))
+        for r in self.spec.results:
+            self.addOutput(make_output(r, self.tr))
 
     def canExecute(self):
-        from ..core.dependencies import missing_message, missing_modules
-
         missing = missing_modules()
         if missing:
             return False, missing_message(missing)
         return True, ""
+
+    def processAlgorithm(self, parameters, context, feedback):
+        raw = {
+            p.name: read_parameter(self, p, parameters, context)
+            for p in self.spec.params
+            if p.kind != "sink"
+        }
+        raw = self.prepare(raw, parameters, context, feedback)
+        result = self.run_core(run_job, self.JOB, raw, feedback=feedback)
+        for line in result.lines:
+            feedback.pushInfo(line)
+        outputs = {p.name: raw.get(p.name) for p in self.spec.outputs if p.kind != "sink"}
+        outputs.update(result.results)
+        outputs.update(self.write_layers(result, parameters, context, feedback))
+        return outputs
+
+    def error(self, text: str) -> QgsProcessingException:
+        """An error for the user (translated)."""
+        return QgsProcessingException(self.tr(text))
+
+    def prepare(self, raw: dict, parameters, context, feedback) -> dict:
+        """Turn QGIS-only inputs (layers) into what the job takes; the default keeps ``raw``."""
+        return raw
+
+    def write_layers(self, result: JobResult, parameters, context, feedback) -> dict:
+        """Fill the feature sinks from the job's result; returns {sink name: layer id}."""
+        return {}
 
     def run_core(self, func: Callable[..., Any], *args: Any, feedback=None, **kwargs: Any) -> Any:
         """Call a core function with progress/cancel wired to ``feedback`` and its log forwarded.
@@ -217,6 +203,32 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
                 should_stop=stop_callback(feedback),
                 **kwargs,
             )
+
+    # -- feature sinks described by (name, QVariant type) field specs -------------------------
+    def field_sink(self, parameters, context, key, spec, wkb, crs):
+        """Open the sink ``key`` with the fields of ``spec``; returns ((sink, fields), dest id).
+
+        ((None, fields), None) when the user did not ask for the layer."""
+        fields = QgsFields()
+        for name, kind in spec:
+            fields.append(QgsField(name, kind))
+        sink, dest = self.parameterAsSink(parameters, key, context, fields, wkb, crs)
+        if sink is None and parameters.get(key) not in (None, ""):
+            raise QgsProcessingException(self.invalidSinkError(parameters, key))
+        return (sink, fields), dest
+
+    @staticmethod
+    def add_feature(sink_fields, spec, geometry, values) -> None:
+        """Add one feature; ``geometry`` None keeps the row without a geometry (e.g. a failed
+        point with its status); non-finite numbers become NULL."""
+        sink, fields = sink_fields
+        if sink is None:
+            return
+        feature = QgsFeature(fields)
+        if geometry is not None:
+            feature.setGeometry(QgsGeometry(geometry))
+        feature.setAttributes([_field_value(v, kind) for v, (_, kind) in zip(values, spec)])
+        sink.addFeature(feature, SINK_FAST_INSERT)
 
 
 def _field_value(v, kind):

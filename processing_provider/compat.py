@@ -12,6 +12,7 @@ from qgis.core import (
     QgsFeatureSink,
     QgsProcessing,
     QgsProcessingParameterDefinition,
+    QgsProcessingParameterField,
     QgsProcessingParameterFile,
     QgsProcessingParameterNumber,
     QgsWkbTypes,
@@ -21,9 +22,11 @@ from qgis.PyQt.QtCore import QVariant
 if hasattr(Qgis, "ProcessingSourceType"):  # QGIS >= 3.36
     SOURCE_VECTOR_POINT = Qgis.ProcessingSourceType.VectorPoint
     SOURCE_VECTOR_LINE = Qgis.ProcessingSourceType.VectorLine
+    SOURCE_VECTOR_POLYGON = Qgis.ProcessingSourceType.VectorPolygon
 else:  # QGIS 3.22-3.34
     SOURCE_VECTOR_POINT = QgsProcessing.SourceType.TypeVectorPoint
     SOURCE_VECTOR_LINE = QgsProcessing.SourceType.TypeVectorLine
+    SOURCE_VECTOR_POLYGON = QgsProcessing.SourceType.TypeVectorPolygon
 
 if hasattr(Qgis, "ProcessingParameterFlag"):  # QGIS >= 3.36
     FLAG_ADVANCED = Qgis.ProcessingParameterFlag.Advanced
@@ -40,9 +43,11 @@ else:
 if hasattr(Qgis, "WkbType"):  # QGIS >= 3.30
     WKB_POINT_Z = Qgis.WkbType.PointZ
     WKB_LINESTRING_Z = Qgis.WkbType.LineStringZ
+    WKB_POLYGON_Z = Qgis.WkbType.PolygonZ
 else:
     WKB_POINT_Z = QgsWkbTypes.Type.PointZ
     WKB_LINESTRING_Z = QgsWkbTypes.Type.LineStringZ
+    WKB_POLYGON_Z = QgsWkbTypes.Type.PolygonZ
 
 if hasattr(Qgis, "ProcessingNumberParameterType"):  # QGIS >= 3.36
     NUMBER_DOUBLE = Qgis.ProcessingNumberParameterType.Double
@@ -50,6 +55,13 @@ if hasattr(Qgis, "ProcessingNumberParameterType"):  # QGIS >= 3.36
 else:  # QGIS 3.22-3.34
     NUMBER_DOUBLE = QgsProcessingParameterNumber.Type.Double
     NUMBER_INTEGER = QgsProcessingParameterNumber.Type.Integer
+
+if hasattr(Qgis, "ProcessingFieldParameterDataType"):  # QGIS >= 3.36
+    FIELD_TYPE_ANY = Qgis.ProcessingFieldParameterDataType.Any
+    FIELD_TYPE_NUMERIC = Qgis.ProcessingFieldParameterDataType.Numeric
+else:
+    FIELD_TYPE_ANY = QgsProcessingParameterField.DataType.Any
+    FIELD_TYPE_NUMERIC = QgsProcessingParameterField.DataType.Numeric
 
 if hasattr(Qgis, "CrsWktVariant"):  # QGIS >= 3.36
     WKT_PREFERRED = Qgis.CrsWktVariant.Preferred

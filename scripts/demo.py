@@ -42,21 +42,20 @@ from pathlib import Path
 import numpy as np
 from lidarphoto.core.geometry.camera import Camera
 from lidarphoto.core.geometry.frames import MappingFrame
-from lidarphoto.core.geometry.planes import read_planes_csv
 from lidarphoto.core.io.control import read_lcps_csv, read_lines_csv
+from lidarphoto.core.io.dsm import dsm_from_las, write_dsm
 from lidarphoto.core.io.observations import read_observations_csv
+from lidarphoto.core.io.orientation import read_eo_csv, write_eo_csv
+from lidarphoto.core.io.planes import read_planes_csv
 from lidarphoto.core.io.pointcloud import read_points
+from lidarphoto.core.io.raster import write_rgb_tiff
 from lidarphoto.core.io.tables import write_csv_atomic
-from lidarphoto.core.jobs.boresight_calibration import forward_intersection
-from lidarphoto.core.lidar.dsm import dsm_from_las
+from lidarphoto.core.io.trajectory import read_trajectory_csv
 from lidarphoto.core.photo.boresight import local_frame_for
-from lidarphoto.core.photo.georeference import (
-    Mount,
-    Trajectory,
-    direct_georeference,
-    read_trajectory_csv,
-)
-from lidarphoto.core.photo.orientation import ExteriorOrientationTable, read_eo_csv
+from lidarphoto.core.photo.georeference import Trajectory, direct_georeference
+from lidarphoto.core.photo.intersection import forward_intersection
+from lidarphoto.core.photo.mount import Mount
+from lidarphoto.core.photo.orientation import ExteriorOrientationTable
 from lidarphoto.core.photo.picking import PickingScene
 from lidarphoto.core.simulation.flight import (
     ControlFlightConfig,
@@ -68,7 +67,6 @@ from lidarphoto.core.simulation.render import (
     RenderScene,
     edge_offsets,
     render_image,
-    write_rgb_tiff,
 )
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -173,7 +171,7 @@ def flight_step(
     )
     paths = sim.write(flight)
     eo = true_eo(sim)
-    eo.to_csv(flight / "eo_true.csv")
+    write_eo_csv(flight / "eo_true.csv", eo)
     paths["eo_true"] = flight / "eo_true.csv"
     return sim, paths, eo
 
@@ -211,7 +209,7 @@ def render_step(
     the distance from the projected LiDAR lines to the rendered edges. Returns the figures."""
     t0 = time.perf_counter()
     dsm = dsm_from_las(lidar.folder / "planes.laz", DSM_CELL, crs=CRS)
-    dsm.to_geotiff(lidar.folder / "dsm.tif")
+    write_dsm(lidar.folder / "dsm.tif", dsm)
     scene = RenderScene.build(dsm, lidar.xyz, lidar.classification, lidar.plane_id,
                               lidar.planes, lidar.lines, crs=CRS)  # fmt: skip
     outlines = scene.outlines()

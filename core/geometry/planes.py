@@ -28,68 +28,22 @@ plane, so with map coordinates sigma_d is dominated by the lever ``m`` and is st
 correlated with the normal: use the full covariance (the plane table keeps all of it) when
 propagating, e.g. to plane intersections.
 
-Plane table CSV (``write_planes_csv``/``read_planes_csv``), one row per plane, header::
-
-    id,a,b,c,d,centroid_x,centroid_y,centroid_z,n_points,rms,sigma_d,slope_deg,aspect_deg,
-    cov_aa,cov_ab,cov_ac,cov_ad,cov_bb,cov_bc,cov_bd,cov_cc,cov_cd,cov_dd
-
-id (integer, as in the cloud's ``plane_id`` dimension), a b c d (plane parameters; a b c
-unitless, d in the CRS unit), centroid (CRS unit), n_points, rms of the point-to-plane residuals
-(CRS unit), sigma_d (CRS unit), slope (degrees from horizontal), aspect (degrees clockwise from
-grid north of the downslope direction; meaningless for flat planes), and the 10 upper-triangle
-elements of the covariance of (a, b, c, d). Paper 000's plane list (id, parameters, centroid,
-point count) is the first nine columns. Numbers are written with full round-trip precision.
+The plane table (CSV) is :mod:`core.io.planes`.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
-from ..io.tables import find_column, float_column, read_table, write_csv_atomic
 
-__all__ = [
-    "COV_COLUMNS",
-    "PLANE_COLUMNS",
-    "Plane",
-    "fit_plane",
-    "read_planes_csv",
-    "write_planes_csv",
-]
+__all__ = ["Plane", "fit_plane", "orient_up", "slope_aspect_deg"]
 
 Array = NDArray[np.float64]
-
-_PARAMS = "abcd"
-#: Upper-triangle covariance column names, row-major: cov_aa, cov_ab, ..., cov_dd.
-COV_COLUMNS: tuple[str, ...] = tuple(
-    f"cov_{_PARAMS[i]}{_PARAMS[j]}" for i in range(4) for j in range(i, 4)
-)
-#: The header of the plane table, in order.
-PLANE_COLUMNS: tuple[str, ...] = (
-    "id",
-    "a",
-    "b",
-    "c",
-    "d",
-    "centroid_x",
-    "centroid_y",
-    "centroid_z",
-    "n_points",
-    "rms",
-    "sigma_d",
-    "slope_deg",
-    "aspect_deg",
-    *COV_COLUMNS,
-)
-_IU = np.triu_indices(4)
-
 
 @dataclass(frozen=True)
 class Plane:
@@ -302,116 +256,3 @@ def fit_plane(points: ArrayLike, weights: ArrayLike | None = None, *, plane_id: 
     )
 
 
-def _fmt(value: float) -> str:
-    return repr(float(value))
-
-
-def write_planes_csv(path: Union[str, Path], planes: Sequence[Plane]) -> None:
-    """Write the plane table (header ``PLANE_COLUMNS``, see the module docstring) atomically.
-
-    Parameters
-    ----------
-    path : str or Path
-        CSV to write; written to a temporary file in the same folder, then moved into place.
-    planes : sequence of Plane
-        Planes, written in the given order (an empty sequence writes only the header).
-    """
-    rows = []
-    for p in planes:
-        rows.append(
-            [
-                str(int(p.id)),
-                *(_fmt(v) for v in p.normal),
-                _fmt(p.d),
-                *(_fmt(v) for v in p.centroid),
-                str(int(p.n_points)),
-                _fmt(p.rms),
-                _fmt(p.sigma_d),
-                _fmt(p.slope_deg),
-                _fmt(p.aspect_deg),
-                *(_fmt(v) for v in p.covariance[_IU]),
-            ]
-        )
-    write_csv_atomic(path, PLANE_COLUMNS, rows)
-
-
-def _header_only(path: Union[str, Path]) -> bool:
-    """True for a readable table holding the plane header and no data rows (no planes)."""
-    try:
-        text = Path(path).read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError):
-        return False  # read_table reports it
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-    return len(lines) == 1 and {c.strip().lower() for c in lines[0].split(",")} >= set(
-        PLANE_COLUMNS
-    )
-
-
-def read_planes_csv(path: Union[str, Path]) -> list[Plane]:
-    """Read a plane table written by :func:`write_planes_csv` (or by hand, same header).
-
-    Columns are found by name (case-insensitive, any order, extra columns ignored). Every
-    column of ``PLANE_COLUMNS`` is required. The normal is checked to be unit length with
-    c >= 0; outlines are not part of the table (empty).
-
-    Raises
-    ------
-    InputError
-        Missing file or column, a cell that is not a number (names file, row and column), a
-        non-integer id or point count, a duplicate id, or a normal that is not unit length.
-    """
-    if _header_only(path):
-        return []
-    table = read_table(path)
-    cols = {
-        name: float_column(table, find_column(table, (name,), what=name)) for name in PLANE_COLUMNS
-    }
-    id_col = find_column(table, ("id",))
-    np_col = find_column(table, ("n_points",))
-    planes = []
-    seen: dict[int, int] = {}
-    for k, row_no in enumerate(table.line_numbers):
-        for name, col in (("id", id_col), ("n_points", np_col)):
-            value = cols[name][k]
-            if value != round(value):
-                raise InputError(
-                    f"'{table.rows[k][col]}' is not an integer",
-                    path=table.path,
-                    row=row_no,
-                    column=table.columns[col],
-                )
-        pid = int(cols["id"][k])
-        if pid in seen:
-            raise InputError(
-                f"id {pid} already appears in row {seen[pid]}",
-                path=table.path,
-                row=row_no,
-                column=table.columns[id_col],
-            )
-        seen[pid] = row_no
-        normal = np.array([cols["a"][k], cols["b"][k], cols["c"][k]])
-        if abs(np.linalg.norm(normal) - 1.0) > 1e-6 or normal[2] < 0:
-            raise InputError(
-                "the normal (a, b, c) must be a unit vector with c >= 0",
-                path=table.path,
-                row=row_no,
-                column="a",
-            )
-        cov = np.empty((4, 4))
-        cov[_IU] = [cols[name][k] for name in COV_COLUMNS]
-        cov.T[_IU] = cov[_IU]
-        planes.append(
-            Plane(
-                id=pid,
-                normal=normal,
-                d=float(cols["d"][k]),
-                centroid=np.array([cols[f"centroid_{a}"][k] for a in "xyz"]),
-                n_points=int(cols["n_points"][k]),
-                rms=float(cols["rms"][k]),
-                sigma_d=float(cols["sigma_d"][k]),
-                covariance=cov,
-                slope_deg=float(cols["slope_deg"][k]),
-                aspect_deg=float(cols["aspect_deg"][k]),
-            )
-        )
-    return planes

@@ -1,10 +1,10 @@
 """Ray / DSM traversal compiled with numba: the same algorithm as the vectorised numpy
-traversal of :mod:`core.monoplot`, one ray after the other, 10-30x faster.
+traversal of :mod:`core.geometry.raycast`, one ray after the other, 10-30x faster.
 
 numba is an optional dependency: :data:`AVAILABLE` tells whether it imports, and
-:func:`core.monoplot.intersect_dsm` falls back to numpy without it. Both back ends visit the
+:func:`core.geometry.raycast.intersect_dsm` falls back to numpy without it. Both back ends visit the
 quads of a ray in the same order (the 2D DDA from the camera), skip the same provably empty
-space (the dilated maximum pyramid of :class:`core.monoplot.DsmTracer`) and intersect the
+space (the dilated maximum pyramid of :class:`core.geometry.raycast.DsmTracer`) and intersect the
 same two triangles per quad with Dal Poz's Eq. 9, so they return the same first hit; the
 tests compare them ray by ray.
 
@@ -31,7 +31,7 @@ except Exception:  # ImportError, or a numba built against another numpy
 
 __all__ = ["AVAILABLE", "trace_rays"]
 
-# status codes, as in core.monoplot (not imported: the compiled function takes plain ints)
+# status codes, as in core.geometry.raycast (not imported: the compiled function takes plain ints)
 _OK, _GRAZING, _OUTSIDE, _NODATA, _NOT_CONVERGED = 0, 1, 2, 3, 5
 _EPS = 1e-9
 _TOL_T = 1e-9
@@ -266,7 +266,7 @@ def trace_rays(
 ) -> None:
     """Trace ``origins[rows]``, ``directions[rows]`` into ``out[...][rows]`` (see DsmHits).
 
-    ``tracer`` is a :class:`core.monoplot.DsmTracer`; ``out`` holds the arrays t, status,
+    ``tracer`` is a :class:`core.geometry.raycast.DsmTracer`; ``out`` holds the arrays t, status,
     qi, qj, tri, points, weights, gradient and incidence of :func:`intersect_dsm`.
     """
     if not AVAILABLE:

@@ -160,15 +160,3 @@ def is_rotation(r: ArrayLike, atol: float = 1e-9) -> bool:
     )
 
 
-# Nominal camera mounts R_c^b: columns are the camera axes x_c, y_c, z_c in the body frame
-# (x forward, y right, z down). The camera looks along -z_c, i.e. straight down (+z_b) for all.
-MOUNT_PRESETS: dict[str, Array] = {
-    # image top (+y_c) points forward, image right (+x_c) points to the right wing
-    "image_top_forward": np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]]),
-    # image right (+x_c) points forward, image top (+y_c) points to the left wing
-    "image_right_forward": np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]]),
-    # image bottom (-y_c) points forward
-    "image_bottom_forward": np.array([[0.0, -1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, -1.0]]),
-    # image left (-x_c) points forward
-    "image_left_forward": np.array([[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]]),
-}

@@ -1,4 +1,4 @@
-"""Image observations for boresight calibration: the CSV table and its in-memory form.
+"""Image observations: the CSV table (the in-memory form is :mod:`core.photo.observations`).
 
 One row per measurement of a point in one image (header row; names case-insensitive)::
 
@@ -31,122 +31,21 @@ writes the same table.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Union
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from ..errors import InputError
+from ..photo.observations import DEFAULT_SIGMA_PX, OBSERVATION_TYPES, ImageObservations
 from .tables import find_column, float_column, read_table, text_column, write_csv_atomic
 
-__all__ = [
-    "DEFAULT_SIGMA_PX",
-    "OBSERVATION_COLUMNS",
-    "OBSERVATION_TYPES",
-    "ImageObservations",
-    "read_observations_csv",
-    "write_observations_csv",
-]
+__all__ = ["OBSERVATION_COLUMNS", "read_observations_csv", "write_observations_csv"]
 
 OBSERVATION_COLUMNS = ("image_id", "point_id", "col", "row", "sigma_px", "type", "target_id")
-OBSERVATION_TYPES = ("tie", "line", "lcp", "paper", "check")
-DEFAULT_SIGMA_PX = 0.5
 
 Array = NDArray[np.float64]
-
-
-@dataclass(frozen=True)
-class ImageObservations:
-    """N image measurements (see the module docstring for the meaning of each field).
-
-    Attributes
-    ----------
-    image_id, point_id, type, target_id : tuple of str, shape (N,)
-    pixels : ndarray, shape (N, 2)
-        (col, row) in pixels.
-    sigma_px : ndarray, shape (N,)
-        Standard deviation of col and row, pixels.
-    """
-
-    image_id: tuple[str, ...]
-    point_id: tuple[str, ...]
-    pixels: Array
-    sigma_px: Array
-    type: tuple[str, ...]
-    target_id: tuple[str, ...]
-
-    def __post_init__(self) -> None:
-        n = len(self.image_id)
-        px = np.asarray(self.pixels, dtype=np.float64).reshape(-1, 2)
-        sig = np.broadcast_to(np.asarray(self.sigma_px, dtype=np.float64), (n,)).copy()
-        object.__setattr__(self, "pixels", px)
-        object.__setattr__(self, "sigma_px", sig)
-        for name in ("image_id", "point_id", "type", "target_id"):
-            object.__setattr__(self, name, tuple(str(v) for v in getattr(self, name)))
-        if not all(len(getattr(self, k)) == n for k in ("point_id", "type", "target_id")) or (
-            px.shape[0] != n
-        ):
-            raise InputError("image observations: all fields must have the same length")
-        bad = sorted(set(self.type) - set(OBSERVATION_TYPES))
-        if bad:
-            raise InputError(
-                f"unknown observation type(s) {bad}; use one of {', '.join(OBSERVATION_TYPES)}"
-            )
-        if not (np.isfinite(px).all() and np.isfinite(sig).all() and (sig > 0).all()):
-            raise InputError("image observations: pixels must be finite and sigma_px > 0")
-
-    def __len__(self) -> int:
-        return len(self.image_id)
-
-    @classmethod
-    def from_arrays(
-        cls,
-        image_id: Sequence[str],
-        point_id: Sequence[str],
-        pixels: ArrayLike,
-        sigma_px: ArrayLike,
-        type: Sequence[str],
-        target_id: Sequence[object],
-    ) -> ImageObservations:
-        """Build from sequences (ids are converted to text)."""
-        return cls(
-            tuple(map(str, image_id)),
-            tuple(map(str, point_id)),
-            np.asarray(pixels, dtype=np.float64),
-            np.asarray(sigma_px, dtype=np.float64),
-            tuple(map(str, type)),
-            tuple(map(str, target_id)),
-        )
-
-    def mask(self, kind: str) -> NDArray[np.bool_]:
-        """(N,) rows of one observation type."""
-        return np.array([t == kind for t in self.type], dtype=bool)
-
-    def subset(self, keep: ArrayLike) -> ImageObservations:
-        """Rows selected by a boolean mask or an index array."""
-        idx = np.arange(len(self))[np.asarray(keep)]
-        return ImageObservations(
-            tuple(self.image_id[i] for i in idx),
-            tuple(self.point_id[i] for i in idx),
-            self.pixels[idx],
-            self.sigma_px[idx],
-            tuple(self.type[i] for i in idx),
-            tuple(self.target_id[i] for i in idx),
-        )
-
-    def concat(self, other: ImageObservations) -> ImageObservations:
-        """Rows of ``self`` followed by those of ``other``."""
-        return ImageObservations(
-            self.image_id + other.image_id,
-            self.point_id + other.point_id,
-            np.vstack([self.pixels, other.pixels]),
-            np.concatenate([self.sigma_px, other.sigma_px]),
-            self.type + other.type,
-            self.target_id + other.target_id,
-        )
 
 
 def read_observations_csv(path: Union[str, Path]) -> ImageObservations:

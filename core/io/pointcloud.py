@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import logging
 import os
-import tempfile
 from collections.abc import Callable, Mapping, Sequence
 from copy import deepcopy
 from dataclasses import dataclass, replace
@@ -27,6 +26,7 @@ from numpy.typing import NDArray
 
 from ..errors import Cancelled, CrsError, InputError, stop_if_asked
 from ..geometry import frames
+from .atomic import atomic_path
 
 LOG = logging.getLogger(__name__)
 
@@ -397,7 +397,8 @@ def write_cloud(
     identifier, generating software, dates, global encoding) and VLR/EVLR is kept; bounds and
     counts are recomputed. LAZ or LAS is chosen by the suffix of ``dst_path``. The copy is
     streamed chunk by chunk into a temporary file in the destination folder and moved into
-    place (``os.replace``) only when complete: a failure or a cancel leaves no partial output.
+    place only when complete (:func:`core.io.atomic.atomic_path`): a failure or a cancel
+    leaves no partial output.
 
     Parameters
     ----------
@@ -455,11 +456,7 @@ def write_cloud(
             header.add_extra_dims(new_params)
         evlrs = list(reader.header.evlrs or [])
 
-        fd, tmp = tempfile.mkstemp(
-            prefix=f".{Path(dst).stem}.", suffix=f"{suffix}.part", dir=folder
-        )
-        os.close(fd)
-        try:
+        with atomic_path(dst) as tmp:
             with laspy.open(tmp, mode="w", header=header, do_compress=suffix == ".laz") as writer:
                 done = 0
                 try:
@@ -490,9 +487,4 @@ def write_cloud(
                     )
                 if evlrs:
                     writer.write_evlrs(laspy.VLRList(evlrs))
-            os.replace(tmp, dst)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.remove(tmp)
-            raise
     LOG.info("wrote %d points to %s", n, dst)

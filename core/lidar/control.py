@@ -24,7 +24,6 @@ from typing import Callable
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial import cKDTree
 
 from ..errors import InputError, stop_if_asked
 from ..geometry.rotations import skew
@@ -170,6 +169,8 @@ def plane_adjacency(
     ``plane_ids`` (N,) gives each point's plane, negative for none. The boundary length is the
     extent of the contact points along their principal horizontal direction.
     """
+    from scipy.spatial import cKDTree
+
     pts = np.asarray(points, dtype=np.float64)
     ids = np.asarray(plane_ids)
     keep = ids >= 0
@@ -415,6 +416,8 @@ def _stack(by_id: dict, ids: NDArray[np.int64]) -> tuple[Array, Array, Array]:
 
 
 def _three_plane_points(cand, by_id, pts, ids, options, rejected) -> list[ControlPoint]:
+    from scipy.spatial import cKDTree
+
     if cand.shape[0] == 0:
         return []
     n, d, c = _stack(by_id, cand)
@@ -517,6 +520,8 @@ def _two_plane_lines(cand, by_id, pts, ids, adjacency, options, rejected) -> lis
 
 
 def _closest_points(pa: Array, pb: Array, radius: float) -> Array:
+    from scipy.spatial import cKDTree
+
     if pa.shape[0] == 0 or pb.shape[0] == 0:
         return np.zeros((0, 3))
     tb = cKDTree(pb)
@@ -538,92 +543,3 @@ def _line_kind(n1, n2, x0, u, c1, c2) -> str:
     if side[0] < 0 and side[1] < 0:
         return "valley"
     return "other"
-
-
-# ----------------------------------------------------------------------------- job
-def parse_id_groups(text: str, size: int, name: str) -> list[tuple[int, ...]] | None:
-    """``"1,2,3; 4,5,6"`` -> [(1, 2, 3), (4, 5, 6)]; empty text -> None (automatic)."""
-    text = (text or "").strip()
-    if not text:
-        return None
-    out = []
-    for part in text.replace("\n", ";").split(";"):
-        if not part.strip():
-            continue
-        try:
-            ids = tuple(int(v) for v in part.replace(" ", ",").split(",") if v)
-        except ValueError:
-            raise InputError(f"{name}: '{part.strip()}' is not a list of plane ids") from None
-        if len(ids) != size:
-            raise InputError(f"{name}: '{part.strip()}' must have {size} plane ids")
-        out.append(ids)
-    return out
-
-
-def run_create_lcps(
-    planes_csv,
-    cloud,
-    crs=None,
-    options: ControlOptions = ControlOptions(),
-    triples: str = "",
-    pairs: str = "",
-    points_csv=None,
-    lines_csv=None,
-    graph_csv=None,
-    distance_unit: str = "crs",
-    progress: Callable[[float], None] | None = None,
-    should_stop: Callable[[], bool] | None = None,
-) -> tuple[LidarControl, object]:
-    """The ``createlcps`` job: plane table + cloud with a ``plane_id`` dimension -> control.
-
-    Distances in ``options`` are in the cloud's CRS unit (``distance_unit="crs"``) or in metres
-    (``"metre"``, converted); the results are in the CRS unit. Returns the result and the cloud's
-    :class:`~lidarphoto.core.pointcloud.CloudInfo`. Every input is read and checked before
-    any output is written; outputs are written atomically.
-    """
-    from ..geometry.planes import read_planes_csv
-    from ..io.control import write_graph_csv, write_lcps_csv, write_lines_csv
-    from ..io.pointcloud import read_info, read_points
-
-    user_triples = parse_id_groups(triples, 3, "TRIPLES")
-    user_pairs = parse_id_groups(pairs, 2, "PAIRS")
-    planes = read_planes_csv(planes_csv)
-    info = read_info(cloud, crs=crs)
-    if distance_unit not in ("crs", "metre", "metres"):
-        raise InputError(f"DISTANCE_UNIT must be 'crs' or 'metres', got '{distance_unit}'")
-    if distance_unit != "crs":
-        k = 1.0 / info.unit_to_metre
-        options = replace(
-            options,
-            delta=options.delta * k,
-            min_boundary=options.min_boundary * k,
-            max_support_distance=options.max_support_distance * k,
-        )
-        log.info("distances converted from metres to %s (x %.6g)", info.horizontal_unit, k)
-    if "plane_id" not in info.dimensions:
-        raise InputError(
-            "the cloud has no 'plane_id' dimension: use the cloud written by "
-            "lidarphoto:extractroofplanes",
-            path=str(cloud),
-        )
-
-    def sub(lo: float, hi: float):
-        return None if progress is None else (lambda f: progress(lo + (hi - lo) * f))
-
-    arrays, info = read_points(
-        cloud, ("x", "y", "z", "plane_id"), crs=crs, progress=sub(0.0, 0.3), should_stop=should_stop
-    )
-    xyz = np.column_stack([arrays["x"], arrays["y"], arrays["z"]])
-    result = lidar_control(
-        planes, xyz, arrays["plane_id"], options, user_triples, user_pairs,
-        progress=sub(0.3, 0.95), should_stop=should_stop,
-    )  # fmt: skip
-    if points_csv:
-        write_lcps_csv(points_csv, result.points)
-    if lines_csv:
-        write_lines_csv(lines_csv, result.lines)
-    if graph_csv:
-        write_graph_csv(graph_csv, result.adjacency)
-    if progress is not None:
-        progress(1.0)
-    return result, info

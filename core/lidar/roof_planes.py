@@ -37,28 +37,16 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass, field, replace
-from pathlib import Path
-from typing import Callable, Union
+from dataclasses import dataclass
+from typing import Any, Callable, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
 
 from ..errors import InputError, stop_if_asked
-from ..geometry.planes import Plane, fit_plane, write_planes_csv
+from ..geometry.planes import Plane, fit_plane
 
-__all__ = [
-    "UNIT_CHOICES",
-    "RoofPlaneParams",
-    "RoofPlaneResult",
-    "RoofPlaneRun",
-    "extract_roof_planes",
-    "parse_classes",
-    "run_extract_roof_planes",
-]
+__all__ = ["SELECTION_CHOICES", "RoofPlaneParams", "RoofPlaneResult", "extract_roof_planes"]
 
 log = logging.getLogger(__name__)
 
@@ -74,8 +62,6 @@ SEED_VOXEL = 8.0
 SEED_ROUNDS = 4
 #: Reassignment passes (each reaches one more ring of unassigned points around a plane).
 REASSIGN_PASSES = 3
-#: How distance parameters are given: in the cloud's CRS unit, or in metres (converted).
-UNIT_CHOICES: tuple[str, ...] = ("crs", "metre")
 #: Point selections: non-ground (class != 2), the listed classes, or every point.
 SELECTION_CHOICES: tuple[str, ...] = ("non_ground", "classes", "all")
 
@@ -145,10 +131,6 @@ class RoofPlaneParams:
             if not ok:
                 raise InputError(message)
 
-    def scaled(self, factor: float) -> RoofPlaneParams:
-        """The same parameters with the lengths (epsilon, outline_cell) multiplied by factor."""
-        return replace(self, epsilon=self.epsilon * factor, outline_cell=self.outline_cell * factor)
-
 
 @dataclass(frozen=True)
 class RoofPlaneResult:
@@ -185,7 +167,7 @@ def _eig_normals(cov: NDArray) -> NDArray:
 
 def _local_ransac(
     q: Array,
-    tree: cKDTree,
+    tree: Any,
     params: RoofPlaneParams,
     progress: Progress,
     should_stop: ShouldStop,
@@ -490,6 +472,9 @@ def _merge_coplanar(
     same &= (da < params.epsilon) & (db < params.epsilon)
     if not same.any():
         return labels
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
     graph = coo_matrix(
         (np.ones(int(same.sum()), dtype=np.int8), (la[same], lb[same])), shape=(nl, nl)
     )
@@ -588,6 +573,8 @@ def extract_roof_planes(
     origin = np.floor(xyz.min(axis=0))
     q = xyz - origin
     stop_if_asked(should_stop, "extracting roof planes")
+    from scipy.spatial import cKDTree
+
     tree = cKDTree(q, balanced_tree=False, compact_nodes=False)
     keep, normals, quality, knn, spacing = _local_ransac(q, tree, params, progress, should_stop)
     del tree
@@ -670,173 +657,3 @@ def _final_planes(
         plane = fit_plane(fit_pts, plane_id=pid)
         planes.append(plane.with_outline(_outline(pts, plane, cell)))
     return planes, plane_id
-
-
-def parse_classes(text: str) -> tuple[int, ...]:
-    """LAS classes from user text ``"6"``, ``"6,17"`` or ``"6 17"``.
-
-    >>> parse_classes("6, 17")
-    (6, 17)
-    """
-    parts = [p for p in text.replace(",", " ").replace(";", " ").split() if p]
-    try:
-        classes = tuple(int(p) for p in parts)
-    except ValueError:
-        raise InputError(f"classes must be integers separated by commas, got {text!r}") from None
-    if not classes or any(not 0 <= c <= 255 for c in classes):
-        raise InputError(f"give one or more classes between 0 and 255, got {text!r}")
-    return classes
-
-
-@dataclass(frozen=True)
-class RoofPlaneRun:
-    """What :func:`run_extract_roof_planes` did.
-
-    ``unit`` is the name of the CRS's horizontal unit (the unit of every length in the planes
-    and the table); ``params`` are the parameters actually used, in that unit; ``crs_wkt`` the
-    cloud's CRS.
-    """
-
-    result: RoofPlaneResult
-    params: RoofPlaneParams
-    unit: str
-    unit_to_metre: float
-    crs_wkt: str
-    n_points: int
-    n_selected: int
-    messages: tuple[str, ...] = field(default_factory=tuple)
-
-
-def run_extract_roof_planes(
-    input_path: Union[str, Path],
-    *,
-    params: RoofPlaneParams | None = None,
-    units: str = "crs",
-    selection: str = "non_ground",
-    classes: str = "",
-    crs: str | None = None,
-    output_csv: Union[str, Path, None] = None,
-    output_cloud: Union[str, Path, None] = None,
-    progress: Progress = None,
-    should_stop: ShouldStop = None,
-) -> RoofPlaneRun:
-    """Read a LAS/LAZ cloud, extract roof planes, write the plane table and the cloud.
-
-    Parameters
-    ----------
-    input_path : str or Path
-        LAS/LAZ file (classified by a ground filter unless ``selection="all"``).
-    params : RoofPlaneParams, optional
-        Lengths (epsilon, outline_cell) in the unit given by ``units``.
-    units : {"crs", "metre"}
-        ``"crs"``: lengths are in the cloud's CRS unit (e.g. international feet for Autzen);
-        ``"metre"``: lengths are metres, converted to the CRS unit.
-    selection : {"non_ground", "classes", "all"}
-        Points searched: class != 2, the classes listed in ``classes``, or all points (a cloud
-        that is already non-ground).
-    classes : str
-        Classes for ``selection="classes"``, e.g. ``"6"`` or ``"1,6"``.
-    crs : str, optional
-        Overrides the file's CRS (EPSG code or WKT); needed when the file has none.
-    output_csv : str or Path, optional
-        Plane table to write (see :mod:`lidarphoto.core.planes`).
-    output_cloud : str or Path, optional
-        Copy of the input (.las/.laz) with an int32 extra dimension ``plane_id`` (-1 = none).
-    progress, should_stop
-        As in :func:`extract_roof_planes`.
-
-    Raises
-    ------
-    InputError, CrsError
-        Unreadable/empty/corrupt file, no or geographic CRS, horizontal and vertical units that
-        differ, unknown selection/units, no point of the selected classes.
-    """
-    from ..io.pointcloud import read_points, write_cloud
-
-    params = params or RoofPlaneParams()
-    if units not in UNIT_CHOICES:
-        raise InputError(f"units must be one of {', '.join(UNIT_CHOICES)}, got {units!r}")
-    if selection not in SELECTION_CHOICES:
-        raise InputError(
-            f"selection must be one of {', '.join(SELECTION_CHOICES)}, got {selection!r}"
-        )
-    wanted = parse_classes(classes) if selection == "classes" else ()
-    stage = _Stages(progress, (0.15, 0.7, 0.15) if output_cloud else (0.2, 0.8, 0.0))
-    fields = ("x", "y", "z") if selection == "all" else ("x", "y", "z", "classification")
-    arrays, info = read_points(
-        input_path, fields, crs=crs or None, progress=stage(0), should_stop=should_stop
-    )
-    ratio = info.vertical_unit_to_metre / info.unit_to_metre
-    if not math.isfinite(ratio) or abs(ratio - 1.0) > 1e-9:
-        raise InputError(
-            f"horizontal unit ({info.horizontal_unit}) and vertical unit "
-            f"({info.vertical_unit_to_metre} m) differ: planes need x, y and z in one unit; "
-            "convert the heights first",
-            path=str(input_path),
-        )
-    if units == "metre":
-        params = params.scaled(1.0 / info.unit_to_metre)
-    messages = [
-        f"lengths in {info.horizontal_unit} (1 unit = {info.unit_to_metre:g} m): "
-        f"epsilon = {params.epsilon:g}, outline cell = {params.outline_cell:g} (0 = auto)"
-    ]
-    n = info.point_count
-    if selection == "all":
-        sel = np.ones(n, dtype=bool)
-    elif selection == "classes":
-        sel = np.isin(arrays["classification"], wanted)
-    else:
-        sel = arrays["classification"] != 2
-    n_sel = int(sel.sum())
-    if n_sel == 0:
-        what = {"classes": f"of class {classes}", "non_ground": "that is not ground (class 2)"}
-        raise InputError(f"no point {what.get(selection, '')} in the cloud", path=str(input_path))
-    xyz = np.column_stack([arrays["x"][sel], arrays["y"][sel], arrays["z"][sel]])
-    del arrays
-    result = extract_roof_planes(xyz, params, progress=stage(1), should_stop=should_stop)
-    del xyz
-    messages.append(result.message)
-    plane_id = np.full(n, -1, dtype=np.int32)
-    plane_id[sel] = result.plane_id
-    if output_cloud:  # the slow output first; each file is written atomically
-        write_cloud(
-            input_path,
-            output_cloud,
-            extra={"plane_id": plane_id},
-            progress=stage(2),
-            should_stop=should_stop,
-        )
-    if output_csv:
-        try:
-            write_planes_csv(output_csv, result.planes)
-        except BaseException:
-            if output_cloud:  # no half set of outputs
-                Path(output_cloud).unlink(missing_ok=True)
-            raise
-    if progress is not None:
-        progress(1.0)
-    return RoofPlaneRun(
-        result=replace(result, plane_id=plane_id),
-        params=params,
-        unit=info.horizontal_unit,
-        unit_to_metre=info.unit_to_metre,
-        crs_wkt=info.crs.to_wkt() if info.crs is not None else "",
-        n_points=n,
-        n_selected=n_sel,
-        messages=tuple(messages),
-    )
-
-
-class _Stages:
-    """Split one progress callback into consecutive stages with given weights."""
-
-    def __init__(self, progress: Progress, weights: tuple[float, ...]) -> None:
-        self.progress = progress
-        self.starts = np.concatenate([[0.0], np.cumsum(weights)[:-1]])
-        self.weights = weights
-
-    def __call__(self, k: int) -> Progress:
-        if self.progress is None:
-            return None
-        start, weight, report = float(self.starts[k]), self.weights[k], self.progress
-        return lambda f: report(start + weight * min(max(float(f), 0.0), 1.0))

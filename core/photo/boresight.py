@@ -63,7 +63,6 @@ from scipy.spatial import cKDTree
 from ..errors import InputError, NotObservableError
 from ..geometry.camera import Camera
 from ..geometry.frames import NED_TO_ENU, LocalFrame, MappingFrame
-from ..io.observations import ImageObservations
 from ..lsq.adjustment import (
     AdjustmentOptions,
     AdjustmentResult,
@@ -80,16 +79,17 @@ from .boresight_models import (
     paper_plane,
     pose_chain,
 )
-from .georeference import Mount, Trajectory
+from .georeference import Trajectory
+from .ins import INS_GRADES, InsGrade
+from .mount import Mount
+from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_local_to_map
 
 __all__ = [
     "ARCSEC",
-    "INS_GRADES",
     "BoresightNotObservable",
     "BoresightOptions",
     "BoresightResult",
-    "InsGrade",
     "ObservationResiduals",
     "calibrate",
     "diagnose",
@@ -104,55 +104,6 @@ Array = NDArray[np.float64]
 ARCSEC = math.pi / (180.0 * 3600.0)
 ANGLES = ("d_omega", "d_phi", "d_kappa")
 INS_NAMES = ("E", "N", "U", "roll", "pitch", "heading")
-
-
-@dataclass(frozen=True)
-class InsGrade:
-    """Accuracy of an INS/GNSS solution (post-processed, 1 sigma / RMS).
-
-    Attributes
-    ----------
-    name : str
-    sigma_horizontal_m, sigma_vertical_m : float
-        Position, metres.
-    sigma_roll_pitch_deg, sigma_heading_deg : float
-        Attitude, degrees.
-    source : str
-        Where the numbers come from.
-    """
-
-    name: str
-    sigma_horizontal_m: float
-    sigma_vertical_m: float
-    sigma_roll_pitch_deg: float
-    sigma_heading_deg: float
-    source: str = "user"
-
-    @property
-    def sigma_position(self) -> Array:
-        """(E, N, U) sigmas, metres."""
-        h, v = self.sigma_horizontal_m, self.sigma_vertical_m
-        return np.array([h, h, v])
-
-    @property
-    def sigma_attitude(self) -> Array:
-        """(roll, pitch, heading) sigmas, radians."""
-        rp, hd = self.sigma_roll_pitch_deg, self.sigma_heading_deg
-        return np.radians([rp, rp, hd])
-
-
-#: Named INS grades. Only grades whose accuracies can be cited are listed; anything else is a
-#: custom :class:`InsGrade`.
-INS_GRADES: dict[str, InsGrade] = {
-    "pos_av_310": InsGrade(
-        "Applanix POS AV 310",
-        0.02,
-        0.05,
-        0.015,
-        0.035,
-        "paper 000, section 3: post-processed absolute accuracy (RMS) quoted from Applanix",
-    ),
-}
 
 
 @dataclass(frozen=True)
@@ -407,7 +358,7 @@ def transform_lcps(points: Sequence, local: LocalFrame) -> tuple[Array, Array]:
 # ----------------------------------------------------------------------------- helpers
 
 
-def _group_labels(trajectory: Trajectory, groups: Union[str, Mapping[str, str]]) -> list[str]:
+def group_labels(trajectory: Trajectory, groups: Union[str, Mapping[str, str]]) -> list[str]:
     if isinstance(groups, Mapping):
         missing = [i for i in trajectory.image_id if i not in groups]
         if missing:
@@ -538,7 +489,7 @@ def calibrate(
     llh = _trajectory_llh(trajectory, frame)
     ins_pos = local.geodetic_to_enu(llh)
     r_nl = local.ned_to_local(llh)
-    labels = _group_labels(trajectory, opts.groups)
+    labels = group_labels(trajectory, opts.groups)
     group_names = tuple(dict.fromkeys(labels))
     gidx = np.array([group_names.index(g) for g in labels])
     spec = PoseSpec(
@@ -1093,3 +1044,54 @@ def diagnose(parameters: Sequence[str], groups: Sequence[str] = ()) -> list[str]
     if not out:
         out.append(f"parameters not observable: {', '.join(list(parameters)[:10])}")
     return out
+
+
+@dataclass
+class BoresightRun:
+    """What :func:`run_boresight_calibration` computed.
+
+    Attributes
+    ----------
+    result : BoresightResult
+    observations : ImageObservations
+        The N observation rows, in file order.
+    ground : ndarray, shape (N, 3)
+        Ground position of each row in the mapping CRS (NaN where none can be computed).
+    image_group : tuple of str, shape (N,)
+        Boresight group of the image of each row ("" for unknown images).
+    settings : dict of str to str
+        The run's settings as text (also in the HTML).
+    crs_wkt : str
+        Mapping CRS (WKT).
+    """
+
+    result: BoresightResult
+    observations: ImageObservations
+    ground: Array
+    image_group: tuple[str, ...]
+    settings: dict[str, str] = field(default_factory=dict)
+    crs_wkt: str = ""
+
+    def residual_rows(self) -> list[tuple[object, ...]]:
+        """Rows of the residual table (``RESIDUAL_COLUMNS``)."""
+        r = self.result.residuals
+        obs = self.observations
+        v = np.hypot(r.v_px[:, 0], r.v_px[:, 1])
+        return [
+            (
+                obs.image_id[k],
+                obs.point_id[k],
+                obs.type[k],
+                obs.target_id[k],
+                self.image_group[k],
+                *self.ground[k],
+                *obs.pixels[k],
+                *r.v_px[k],
+                v[k],
+                r.v_d[k],
+                r.w[k],
+                int(r.rejected[k]),
+                int(r.used[k]),
+            )
+            for k in range(len(obs))
+        ]

@@ -5,20 +5,7 @@ independent, more accurate source), per component dE, dN, dH in metres, in one p
 (the mapping frame of docs/conventions.md). ``dHoriz = sqrt(dE^2 + dN^2)`` and
 ``d3D = sqrt(dE^2 + dN^2 + dH^2)``.
 
-Check-point table (CSV, header row; names are case-insensitive, aliases in parentheses)::
-
-    id (point, point_id, name)                          text, unique
-    e (easting, x, e_measured, measured_e)              measured position (m)
-    n (northing, y, n_measured, measured_n)
-    h (height, z, h_measured, measured_h)
-    e_ref (easting_ref, x_ref, e_reference, reference_e) reference position (m)
-    n_ref (northing_ref, y_ref, n_reference, reference_n)
-    h_ref (height_ref, z_ref, h_reference, reference_h)
-    group (direction, model, block, strip)              optional
-
-Point table (two of them, joined by id; ``read_point_table``)::
-
-    id, e, n, h [, group]                               with the aliases above
+The check-point and point tables (CSV) are read by :mod:`core.io.checkpoints`.
 
 Statistics (per component and per group, and overall): mean, sample standard deviation
 (n - 1), RMSE = sqrt(mean(d^2)), minimum, maximum; Shapiro-Wilk normality test (W, p,
@@ -34,22 +21,17 @@ statistics when the caller asks.
 from __future__ import annotations
 
 import datetime
-import json
 import logging
 import math
 import os
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 from typing import Any, Callable, Union
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import stats
 
 from ..errors import CrsError, InputError, stop_if_asked
-from ..io.tables import Table, find_column, float_column, normalise, read_table, text_column
 from . import standards as std_mod
 
 __all__ = [
@@ -67,15 +49,13 @@ __all__ = [
     "PrecisionTest",
     "assess_accuracy",
     "bias_test",
+    "check_unique_ids",
     "component_statistics",
     "join_points",
     "normality_test",
     "point_set",
     "precision_test",
-    "read_checkpoint_table",
-    "read_point_table",
     "report_to_dict",
-    "run_accuracy_report",
     "screen_outliers",
 ]
 
@@ -86,18 +66,6 @@ COMPONENTS = ("E", "N", "H")
 OUTLIER_RULES = ("robust", "three_sigma", "none")
 STANDARD_KEYS = ("asprs", "nssda", "pec", "project")
 
-_ID = ("id", "point", "point_id", "name")
-_GROUP = ("group", "direction", "model", "block", "strip")
-_MEASURED = (
-    ("e", "easting", "x", "e_measured", "measured_e"),
-    ("n", "northing", "y", "n_measured", "measured_n"),
-    ("h", "height", "z", "h_measured", "measured_h"),
-)
-_REFERENCE = (
-    ("e_ref", "easting_ref", "x_ref", "e_reference", "reference_e"),
-    ("n_ref", "northing_ref", "y_ref", "n_reference", "reference_n"),
-    ("h_ref", "height_ref", "z_ref", "h_reference", "reference_h"),
-)
 _ROBUST_THRESHOLD = 3.5  # Iglewicz & Hoaglin (1993)
 _SIGMA_THRESHOLD = 3.0
 
@@ -196,11 +164,11 @@ def point_set(
             path=source or None,
             column=COMPONENTS[c],
         )
-    _check_unique(ids_, [where(k) for k in range(len(ids_))], source)
+    check_unique_ids(ids_, [where(k) for k in range(len(ids_))], source)
     return PointSet(ids_, arr, grp, crs or None, source, locs, kind)
 
 
-def _check_unique(ids: Sequence[str], where: Sequence[str], source: str) -> None:
+def check_unique_ids(ids: Sequence[str], where: Sequence[str], source: str) -> None:
     first: dict[str, int] = {}
     dups = []
     for k, value in enumerate(ids):
@@ -214,81 +182,6 @@ def _check_unique(ids: Sequence[str], where: Sequence[str], source: str) -> None
             + (f" and {len(dups) - 10} more" if len(dups) > 10 else ""),
             path=source or None,
         )
-
-
-def _table_ids(table: Table) -> tuple[str, ...]:
-    index = find_column(table, _ID, what="the point id")
-    values = text_column(table, index)
-    _check_unique(values, [f"row {n}" for n in table.line_numbers], table.path)
-    return values
-
-
-def _table_groups(table: Table, column: str | None) -> tuple[str, ...]:
-    if column:
-        index = find_column(table, (normalise(column),), what=f"the group ({column})")
-    else:
-        index = find_column(table, _GROUP, required=False)
-    if index is None:
-        return ("",) * len(table)
-    return text_column(table, index, nonempty=False)
-
-
-def read_checkpoint_table(
-    path: PathLike, *, group_column: str | None = None, crs: str | None = None
-) -> CheckPoints:
-    """Read the one-table format (see the module docstring).
-
-    Errors name the file, the row (header is row 1) and the column.
-
-    Parameters
-    ----------
-    path : path-like
-        CSV file.
-    group_column : str, optional
-        Column holding the group; default the first of group, direction, model, block, strip.
-    crs : str, optional
-        CRS of the coordinates (reported only).
-    """
-    table = read_table(path)
-    ids = _table_ids(table)
-    measured = np.column_stack(
-        [float_column(table, find_column(table, a, what=a[0])) for a in _MEASURED]
-    )
-    reference = np.column_stack(
-        [float_column(table, find_column(table, a, what=a[0])) for a in _REFERENCE]
-    )
-    groups = _table_groups(table, group_column)
-    return CheckPoints(ids, measured, reference, groups, crs or None, str(path))
-
-
-def read_point_table(
-    path: PathLike,
-    *,
-    id_column: str | None = None,
-    z_column: str | None = None,
-    group_column: str | None = None,
-    crs: str | None = None,
-) -> PointSet:
-    """Read a point table ``id, e, n, h [, group]`` (aliases as in the module docstring).
-
-    ``id_column`` and ``z_column`` name other columns for the id and the height.
-    """
-    table = read_table(path)
-    if id_column:
-        id_index = find_column(table, (normalise(id_column),), what=f"the id ({id_column})")
-        ids = text_column(table, id_index)
-        _check_unique(ids, [f"row {n}" for n in table.line_numbers], table.path)
-    else:
-        ids = _table_ids(table)
-    cols = []
-    for k, aliases in enumerate(_MEASURED):
-        if k == 2 and z_column:
-            aliases = (normalise(z_column),)
-        cols.append(float_column(table, find_column(table, aliases, what=aliases[0])))
-    groups = _table_groups(table, group_column)
-    return PointSet(
-        ids, np.column_stack(cols), groups, crs or None, str(path), table.line_numbers, "row"
-    )
 
 
 def _same_crs(a: str | None, b: str | None) -> bool:
@@ -422,6 +315,8 @@ def normality_test(x: NDArray[np.float64], alpha: float = 0.05) -> NormalityTest
     >>> round(t.statistic, 2), t.normal
     (0.79, False)
     """
+    from scipy import stats
+
     x = np.asarray(x, dtype=np.float64)
     if x.size < 3:
         return NormalityTest(
@@ -450,6 +345,8 @@ def bias_test(x: NDArray[np.float64], alpha: float = 0.05) -> BiasTest:
     >>> round(b.t, 4), round(b.critical, 3), b.biased
     (3.4641, 4.303, False)
     """
+    from scipy import stats
+
     x = np.asarray(x, dtype=np.float64)
     n = x.size
     if n < 2:
@@ -490,6 +387,8 @@ def precision_test(x: NDArray[np.float64], sigma0: float, alpha: float = 0.05) -
     >>> round(p.chi2, 4), p.accepted
     (2.5, True)
     """
+    from scipy import stats
+
     x = np.asarray(x, dtype=np.float64)
     n = x.size
     if not (math.isfinite(sigma0) and sigma0 > 0):
@@ -965,82 +864,3 @@ def report_to_dict(report: AccuracyReport) -> dict[str, Any]:
             for k in range(len(pts))
         ],
     }
-
-
-def write_text_atomic(path: PathLike, text: str) -> None:
-    """Write ``text`` to a temporary file in the same folder, then move it into place."""
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
-        os.chmod(tmp, 0o644)  # mkstemp creates 0600; a report is meant to be shared
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def run_accuracy_report(
-    points: CheckPoints | None = None,
-    *,
-    input_table: PathLike | None = None,
-    measured_table: PathLike | None = None,
-    reference_table: PathLike | None = None,
-    measured_id: str | None = None,
-    reference_id: str | None = None,
-    measured_z: str | None = None,
-    reference_z: str | None = None,
-    group_field: str | None = None,
-    crs: str | None = None,
-    settings: AccuracySettings | None = None,
-    output_html: PathLike | None = None,
-    output_json: PathLike | None = None,
-    progress: Callable[[float], None] | None = None,
-    should_stop: Callable[[], bool] | None = None,
-) -> AccuracyReport:
-    """The ``accuracyreport`` job: read (unless ``points`` is given), assess, write.
-
-    Exactly one input: ``points`` (already joined, e.g. by the QGIS adapter), ``input_table``
-    (one table) or ``measured_table`` + ``reference_table`` (joined by id). Both outputs are
-    built in memory and written atomically only when everything succeeded.
-    """
-    given = [points is not None, input_table is not None, measured_table is not None]
-    if sum(given) != 1 or (measured_table is not None) != (reference_table is not None):
-        raise InputError(
-            "give either one check-point table (INPUT) or a measured and a reference point "
-            "table (MEASURED and REFERENCE)"
-        )
-    if input_table is not None:
-        points = read_checkpoint_table(input_table, group_column=group_field, crs=crs)
-    elif measured_table is not None:
-        m = read_point_table(
-            measured_table,
-            id_column=measured_id,
-            z_column=measured_z,
-            group_column=group_field,
-            crs=crs,
-        )
-        r = read_point_table(reference_table, id_column=reference_id, z_column=reference_z, crs=crs)
-        points = join_points(m, r)
-    assert points is not None
-    log.info("%d check points from %s", len(points), points.source)
-    report = assess_accuracy(points, settings, progress=progress, should_stop=should_stop)
-    html_text = json_text = None
-    if output_html:
-        from .accuracy_html import render_html
-
-        html_text = render_html(report)
-    if output_json:
-        json_text = json.dumps(report_to_dict(report), indent=1, allow_nan=False)
-    _tick(progress, should_stop, 0.95)
-    if html_text is not None:
-        write_text_atomic(output_html, html_text)
-        log.info("wrote %s", output_html)
-    if json_text is not None:
-        write_text_atomic(output_json, json_text)
-        log.info("wrote %s", output_json)
-    if progress is not None:
-        progress(1.0)
-    return report

@@ -11,11 +11,8 @@ from __future__ import annotations
 
 import html
 import math
-import os
-import tempfile
 from collections.abc import Mapping, Sequence
-from pathlib import Path
-from typing import TYPE_CHECKING, Union
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -23,9 +20,9 @@ from .. import __version__
 from .svg_plots import histogram
 
 if TYPE_CHECKING:
-    from ..jobs.boresight_calibration import BoresightRun
+    from ..photo.boresight import BoresightRun
 
-__all__ = ["render_boresight_html", "write_boresight_html"]
+__all__ = ["render_boresight_html"]
 
 ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
 _ANGLES = ("omega", "phi", "kappa")
@@ -251,23 +248,3 @@ def _results(run: BoresightRun) -> list[str]:
         out.append(histogram(r.v_px[keep, 1], title="Residual vy", xlabel="row residual (px)"))
         out.append("</div>")
     return out
-
-
-def write_boresight_html(
-    path: Union[str, Path],
-    run: BoresightRun | None,
-    settings: Mapping[str, str],
-    diagnosis: Sequence[str] | None = None,
-) -> None:
-    """Write :func:`render_boresight_html` atomically (a temporary file, then ``os.replace``)."""
-    target = Path(path)
-    text = render_boresight_html(run, settings, diagnosis)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent or ".")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, target)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise

@@ -39,7 +39,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import integrate, optimize, stats
 
 from ..errors import InputError
 
@@ -344,6 +343,8 @@ def bivariate_radius(sigma_x: float, sigma_y: float, probability: float = 0.95) 
     >>> round(bivariate_radius(1.0, 1.0), 4)  # circular case: sqrt(-2 ln 0.05)
     2.4477
     """
+    from scipy import integrate, optimize, stats
+
     sx, sy = abs(float(sigma_x)), abs(float(sigma_y))
     if sx == 0.0 and sy == 0.0:
         return 0.0
@@ -352,6 +353,7 @@ def bivariate_radius(sigma_x: float, sigma_y: float, probability: float = 0.95) 
 
     def cdf(radius: float) -> float:
         # P(r <= R) = 1/(2 pi sx sy) * int_0^2pi (1 - exp(-R^2 q / 2)) / q dtheta
+
         def integrand(theta: float) -> float:
             q = math.cos(theta) ** 2 / sx**2 + math.sin(theta) ** 2 / sy**2
             return -math.expm1(-0.5 * radius**2 * q) / q

@@ -33,24 +33,22 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from ..geometry.camera import Camera, write_camera_json
+from ..geometry.camera import Camera
 from ..geometry.collinearity import project
 from ..geometry.frames import MappingFrame
-from ..geometry.planes import Plane, fit_plane, write_planes_csv
-from ..geometry.rotations import MOUNT_PRESETS, matrix_to_opk
+from ..geometry.planes import Plane, fit_plane
+from ..geometry.rotations import matrix_to_opk
+from ..io.camera import write_camera_json
 from ..io.control import write_lcps_csv, write_lines_csv
-from ..io.observations import ImageObservations, write_observations_csv
+from ..io.observations import write_observations_csv
+from ..io.planes import write_planes_csv
 from ..io.tables import write_csv_atomic
 from ..lidar.control import ControlLine, ControlPoint, intersect_three_planes, intersect_two_planes
-from ..photo.boresight import (
-    INS_GRADES,
-    BoresightOptions,
-    BoresightResult,
-    InsGrade,
-    calibrate,
-    local_frame_for,
-)
-from ..photo.georeference import Mount, Trajectory, georeference_ecef
+from ..photo.boresight import BoresightOptions, BoresightResult, calibrate, local_frame_for
+from ..photo.georeference import Trajectory, georeference_ecef
+from ..photo.ins import INS_GRADES, InsGrade
+from ..photo.mount import MOUNT_PRESETS, Mount
+from ..photo.observations import ImageObservations
 from .town import Town, make_town
 
 __all__ = [
@@ -261,7 +259,7 @@ class FlightSimulation:
                 for i, tt, g, p, a in zip(t.image_id, t.time, t.group, t.position, deg)
             ],
         )
-        write_camera_json(self.camera, paths["camera"])
+        write_camera_json(paths["camera"], self.camera)
         write_planes_csv(paths["planes"], self.planes)
         write_lines_csv(paths["lines"], self.lines)
         write_lcps_csv(paths["lcps"], self.lcps + self.check_lcps)
@@ -746,7 +744,7 @@ class ControlFlightSimulation:
         paths = {k: out / f"{k}.csv" for k in ("trajectory", "observations", "check_points")}
         paths.update(camera=out / "camera.json", truth=out / "truth.json")
         _write_trajectory(paths["trajectory"], self.trajectory)
-        write_camera_json(self.camera, paths["camera"])
+        write_camera_json(paths["camera"], self.camera)
         write_observations_csv(paths["observations"], self.observations)
         write_csv_atomic(
             paths["check_points"],

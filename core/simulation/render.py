@@ -61,11 +61,12 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import CrsError, InputError, stop_if_asked
 from ..geometry.camera import Camera
 from ..geometry.frames import LocalFrame, MappingFrame
+from ..geometry.grid import Grid
 from ..geometry.planes import Plane
+from ..geometry.raycast import DsmTracer, chord_rays, intersect_dsm
+from ..geometry.surface import Dsm
 from ..io.pointcloud import parse_crs
-from ..lidar.dsm import Dsm
-from ..lidar.ground_filter import Grid
-from ..photo.monoplot import DsmTracer, chord_rays, intersect_dsm
+from ..io.raster import write_rgb_tiff
 from ..photo.orientation import ExteriorOrientationTable, eo_map_to_local
 
 LOG = logging.getLogger(__name__)
@@ -85,7 +86,6 @@ __all__ = [
     "render_image",
     "render_images",
     "sun_vector",
-    "write_rgb_tiff",
 ]
 
 #: Albedo (R, G, B in [0, 1]) of a DSM hit by the LAS class of its cell; others: ``_OTHER``.
@@ -802,22 +802,6 @@ def render_image(
         progress(1.0)
     return RenderedImage(np.ascontiguousarray(base), plane_id, n, edge_pixels,
                          time.perf_counter() - t0)  # fmt: skip
-
-
-def write_rgb_tiff(path: PathLike, rgb: NDArray[np.uint8]) -> None:
-    """Write an (H, W, 3) RGB image as an LZW TIFF (no georeferencing), atomically."""
-    import cv2
-
-    p = Path(os.fspath(path))
-    tmp = p.with_name(f".{p.stem}.tmp{p.suffix or '.tif'}")
-    bgr = cv2.cvtColor(np.ascontiguousarray(rgb), cv2.COLOR_RGB2BGR)
-    try:
-        if not cv2.imwrite(str(tmp), bgr, [cv2.IMWRITE_TIFF_COMPRESSION, 5]):
-            raise InputError("OpenCV could not write the image", path=str(p))
-        os.replace(tmp, p)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
 
 
 def render_images(

@@ -9,6 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 from lidarphoto.core.errors import Cancelled, CrsError, InputError
+from lidarphoto.core.io.checkpoints import read_checkpoint_table, read_point_table
+from lidarphoto.core.jobs import accuracy_report
+from lidarphoto.core.jobs.runner import run_job
 from lidarphoto.core.quality.accuracy import (
     AccuracySettings,
     CheckPoints,
@@ -19,10 +22,7 @@ from lidarphoto.core.quality.accuracy import (
     normality_test,
     point_set,
     precision_test,
-    read_checkpoint_table,
-    read_point_table,
     report_to_dict,
-    run_accuracy_report,
     screen_outliers,
 )
 from scipy import stats
@@ -315,7 +315,10 @@ def test_run_writes_html_and_json_with_every_figure(tmp_path):
     cp = _simulate(n=15)
     table = _write_table(tmp_path / "cp.csv", cp)
     html, js = tmp_path / "out" / "r.html", tmp_path / "out" / "r.json"
-    r = run_accuracy_report(input_table=table, crs="EPSG:31983", output_html=html, output_json=js)
+    r = run_job(
+        accuracy_report,
+        {"INPUT": str(table), "CRS": "EPSG:31983", "OUTPUT_HTML": html, "OUTPUT_JSON": js},
+    ).data
     data = json.loads(js.read_text(encoding="utf-8"))
     for key, value in r.rmse.items():
         assert data["rmse"][key] == pytest.approx(value)
@@ -325,17 +328,17 @@ def test_run_writes_html_and_json_with_every_figure(tmp_path):
         r.overall.components["E"].normality.statistic
     )
     assert html.read_text(encoding="utf-8").startswith("<!DOCTYPE html>")
-    assert not list((tmp_path / "out").glob(".*tmp"))
+    assert not list((tmp_path / "out").glob(".*"))
 
 
 def test_bad_input_leaves_no_output(tmp_path):
     p = tmp_path / "bad.csv"
     p.write_text(HEADER + "a,1,2,3,1,2,3,G\nb,1,x,3,1,2,3,G\n", encoding="utf-8")
     with pytest.raises(InputError):
-        run_accuracy_report(input_table=p, output_html=tmp_path / "r.html")
+        run_job(accuracy_report, {"INPUT": str(p), "OUTPUT_HTML": tmp_path / "r.html"})
     assert not (tmp_path / "r.html").exists()
     with pytest.raises(InputError, match="either"):
-        run_accuracy_report(input_table=p, measured_table=p, reference_table=p)
+        run_job(accuracy_report, {"INPUT": str(p), "MEASURED": str(p), "REFERENCE": str(p)})
 
 
 def test_cancel_and_progress():

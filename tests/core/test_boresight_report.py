@@ -11,14 +11,13 @@ import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
 from lidarphoto.core.geometry.frames import MappingFrame
-from lidarphoto.core.jobs.boresight_calibration import (
-    TABLE_COLUMNS,
-    forward_intersection,
-    parse_ins_grade,
-    run_boresight_calibration,
-)
+from lidarphoto.core.io.orientation import read_eo_csv
+from lidarphoto.core.jobs import boresight_calibration
+from lidarphoto.core.jobs.boresight_calibration import TABLE_COLUMNS
+from lidarphoto.core.jobs.runner import run_job
 from lidarphoto.core.photo.boresight import ARCSEC, BoresightNotObservable, local_frame_for
-from lidarphoto.core.photo.orientation import read_eo_csv
+from lidarphoto.core.photo.ins import ins_grade
+from lidarphoto.core.photo.intersection import forward_intersection
 from lidarphoto.core.quality.boresight_html import render_boresight_html
 from lidarphoto.core.simulation.flight import (
     ControlFlightConfig,
@@ -34,6 +33,14 @@ SMALL = FlightConfig(
     n_check=3,
     types=("tie", "line", "lcp", "check"),
 )
+
+
+def run_boresight_calibration(camera, trajectory, crs, observations, **params):
+    """The boresightcalibration job on files; returns what it computed (BoresightRun)."""
+    raw = {"CAMERA": str(camera), "TRAJECTORY": str(trajectory), "CRS": crs,
+           "OBSERVATIONS": str(observations)}  # fmt: skip
+    raw.update({k.upper(): v for k, v in params.items()})
+    return run_job(boresight_calibration, raw).data
 
 
 class _Balanced(HTMLParser):
@@ -196,11 +203,11 @@ def test_not_observable_writes_the_diagnosis_then_raises(tmp_path):
 def test_render_without_results_and_option_errors():
     page = render_boresight_html(None, {"grouping": "single"}, ["x is not observable."])
     assert "x is not observable." in page and "Boresight</h2>" not in page
-    assert parse_ins_grade("custom", "0.1,0.1,0.01,0.02").sigma_heading_deg == 0.02
+    assert ins_grade("custom", (0.1, 0.1, 0.01, 0.02)).sigma_heading_deg == 0.02
     with pytest.raises(InputError, match="INS_SIGMAS"):
-        parse_ins_grade("custom", "0.1,0.1,0.01")
+        ins_grade("custom", (0.1, 0.1, 0.01))
     with pytest.raises(InputError, match="INS grade"):
-        parse_ins_grade("tactical")
+        ins_grade("tactical")
 
 
 def test_flight_over_given_control_and_check_point_intersection(tmp_path):

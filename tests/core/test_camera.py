@@ -14,12 +14,7 @@ import cv2
 import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
-from lidarphoto.core.geometry.camera import (
-    Camera,
-    camera_from_dict,
-    read_camera_json,
-    write_camera_json,
-)
+from lidarphoto.core.geometry.camera import Camera, camera_from_dict
 from lidarphoto.core.geometry.distortion import (
     DISTORTION_MODELS,
     BrownConrady,
@@ -28,6 +23,7 @@ from lidarphoto.core.geometry.distortion import (
     NoDistortion,
     distortion_from_dict,
 )
+from lidarphoto.core.io.camera import read_camera_json, write_camera_json
 from numdiff import central_difference
 from numpy.testing import assert_allclose
 
@@ -315,7 +311,7 @@ def test_brown_conrady_against_opencv_model() -> None:
 def test_camera_json_round_trip(tmp_path: Path) -> None:
     cam = Camera("UltraCam", 100.5 + 1e-13, 0.0052, 17310, 11310, 0.0123456789, -1 / 3, BC)
     path = tmp_path / "cam.json"
-    write_camera_json(cam, path)
+    write_camera_json(path, cam)
     back = read_camera_json(path)
     assert back == cam  # exact: JSON floats are written with repr()
     data = json.loads(path.read_text())
@@ -325,7 +321,7 @@ def test_camera_json_round_trip(tmp_path: Path) -> None:
         "distortion",
     }  # fmt: skip
     plain = Camera("p", 50.0, 0.01, 100, 80)
-    write_camera_json(plain, path)
+    write_camera_json(path, plain)
     assert read_camera_json(path) == plain
 
 

@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
 from lidarphoto.core.geometry import raycast_numba as dda_compiled
-from lidarphoto.core.lidar.dsm import Dsm, dsm_from_las
-from lidarphoto.core.lidar.ground_filter import Grid
-from lidarphoto.core.photo.monoplot import DsmTracer, intersect_dsm
+from lidarphoto.core.geometry.grid import Grid
+from lidarphoto.core.geometry.raycast import DsmTracer, intersect_dsm
+from lidarphoto.core.geometry.surface import Dsm
+from lidarphoto.core.io.dsm import dsm_from_las
 
 AHN3 = Path(__file__).resolve().parents[1] / "data" / "ahn3" / "ahn3_delft_crop60.laz"
 

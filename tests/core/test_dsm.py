@@ -9,9 +9,11 @@ import numpy as np
 import pyproj
 import pytest
 from lidarphoto.core.errors import InputError
-from lidarphoto.core.lidar import dsm as dsm_mod
-from lidarphoto.core.lidar.dsm import Dsm, dsm_from_las, dsm_from_points, load_dsm, read_dsm_raster
-from lidarphoto.core.lidar.ground_filter import Grid
+from lidarphoto.core.geometry.grid import Grid
+from lidarphoto.core.geometry.surface import Dsm
+from lidarphoto.core.io import raster as raster_mod
+from lidarphoto.core.io.dsm import dsm_from_las, load_dsm, read_dsm_raster, write_dsm
+from lidarphoto.core.lidar.dsm import dsm_from_points
 
 AHN3 = Path(__file__).resolve().parents[1] / "data" / "ahn3" / "ahn3_delft_crop60.laz"
 
@@ -66,13 +68,13 @@ def test_geotiff_round_trip(tmp_path, monkeypatch, with_gdal):
     if with_gdal:
         pytest.importorskip("osgeo")
     else:
-        monkeypatch.setattr(dsm_mod, "_gdal_read", lambda path: None)
+        monkeypatch.setattr(raster_mod, "_gdal_read", lambda path: None)
     z = np.arange(12, dtype=np.float32).reshape(3, 4) + 100.25
     z[1, 2] = np.nan
     for crs in ("EPSG:28992", pyproj.CRS.from_proj4("+proj=tmerc +lon_0=5 +ellps=GRS80")):
         src = Dsm(z, Grid(84900.0, 447650.0, 0.5, 3, 4), pyproj.CRS.from_user_input(crs))
         path = tmp_path / "dsm.tif"
-        src.to_geotiff(path)
+        write_dsm(path, src)
         back = read_dsm_raster(path)
         np.testing.assert_array_equal(np.isnan(back.heights), np.isnan(z))
         np.testing.assert_array_equal(back.heights[~np.isnan(z)], z[~np.isnan(z)])
@@ -96,7 +98,7 @@ def test_surface_is_the_two_triangles_of_each_quad():
 
 
 def test_bad_rasters(tmp_path, monkeypatch):
-    monkeypatch.setattr(dsm_mod, "_gdal_read", lambda path: None)
+    monkeypatch.setattr(raster_mod, "_gdal_read", lambda path: None)
     with pytest.raises(InputError, match="not found"):
         read_dsm_raster(tmp_path / "none.tif")
     bad = tmp_path / "bad.tif"

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import struct
 from pathlib import Path
+from types import SimpleNamespace
 
 import laspy
 import numpy as np
@@ -12,6 +13,10 @@ import pytest
 from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.errors import Cancelled, InputError
 from lidarphoto.core.io.pointcloud import read_points
+from lidarphoto.core.io.raster import write_geotiff
+from lidarphoto.core.jobs import ground_filter as ground_filter_job
+from lidarphoto.core.jobs.common import lengths_in_cloud_units
+from lidarphoto.core.jobs.runner import run_job
 from lidarphoto.core.lidar.ground_filter import (
     GROUND_CLASS,
     HEIGHT_FIELD,
@@ -19,14 +24,23 @@ from lidarphoto.core.lidar.ground_filter import (
     GroundFilterParams,
     ground_filter,
     pmf_windows,
-    run_ground_filter,
     score_classification,
-    write_geotiff,
 )
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 AHN3 = DATA / "ahn3" / "ahn3_delft_crop60.laz"
 FT = 0.3048
+
+
+def run_ground_filter(src, dst, non_ground_class=None):
+    """The groundfilter job: (counts and unit, the filter's result)."""
+    raw = {"INPUT": src, "OUTPUT_CLOUD": dst}
+    if non_ground_class == 1:
+        raw["NON_GROUND_CLASS"] = "unclassified"
+    job = run_job(ground_filter_job, raw)
+    return SimpleNamespace(
+        result=job.data, unit=job.results["UNIT"], ground_count=job.results["GROUND_COUNT"]
+    )
 
 # Measured with the default parameters (2026-11-22) and PEERS.md's PDAL filters.smrf defaults,
 # in percent: (type I, type II, total, kappa) ours; total SMRF.
@@ -102,7 +116,11 @@ def test_feet_and_metres_give_the_same_answer():
     x, y, z, truth = _scene(rng, 0.03)
     ref = ground_filter(x, y, z)
     # the same scene stored in international feet, parameters given in metres
-    p = GroundFilterParams(distance_unit="metre")
+    info = SimpleNamespace(unit_to_metre=FT, vertical_unit_to_metre=FT, path="feet.las")
+    p = lengths_in_cloud_units(
+        GroundFilterParams(), info, "metre", ground_filter_job.HORIZONTAL_LENGTHS,
+        ground_filter_job.VERTICAL_LENGTHS,
+    )  # fmt: skip
     feet = ground_filter(
         x / FT, y / FT, z / FT, p, unit_to_metre=FT, vertical_unit_to_metre=FT, unit="foot"
     )

@@ -14,26 +14,43 @@ from lidarphoto.core.geometry.camera import Camera
 from lidarphoto.core.geometry.collinearity import image_rays, project
 from lidarphoto.core.geometry.distortion import distortion_from_dict
 from lidarphoto.core.geometry.frames import LocalFrame, MappingFrame
-from lidarphoto.core.geometry.planes import fit_plane, write_planes_csv
-from lidarphoto.core.geometry.rotations import matrix_to_opk
-from lidarphoto.core.io.observations import ImageObservations
-from lidarphoto.core.lidar.dsm import Dsm, dsm_from_las
-from lidarphoto.core.lidar.ground_filter import Grid
-from lidarphoto.core.photo.monoplot import (
-    STATUS_TEXT,
+from lidarphoto.core.geometry.grid import Grid
+from lidarphoto.core.geometry.planes import fit_plane
+from lidarphoto.core.geometry.raycast import (
     DsmTracer,
     dal_poz_intersect,
     dal_poz_plane,
     intersect_dsm,
+)
+from lidarphoto.core.geometry.rotations import matrix_to_opk
+from lidarphoto.core.geometry.surface import Dsm
+from lidarphoto.core.io.dsm import dsm_from_las
+from lidarphoto.core.io.monoplot import write_monoplot_lines_csv, write_monoplot_points_csv
+from lidarphoto.core.io.planes import read_planes_csv, write_planes_csv
+from lidarphoto.core.photo.monoplot import (
+    STATUS_TEXT,
     intersect_planes,
     makarovic,
+    monoplot,
     propagate_covariance,
-    run_monoplot,
 )
+from lidarphoto.core.photo.observations import ImageObservations
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable, eo_map_to_local
 
 AHN3 = Path(__file__).resolve().parents[1] / "data" / "ahn3" / "ahn3_delft_crop60.laz"
 CRS = "EPSG:28992"
+
+
+def run_monoplot(obs, camera, table, dsm, crs, planes=None, output_csv=None, lines_csv=None,
+                 **options):  # fmt: skip
+    """Monoplot with the plane table read from a file and the tables written, as the job."""
+    res = monoplot(obs, camera, table, dsm, crs, planes=read_planes_csv(planes) if planes else (),
+                   **options)  # fmt: skip
+    if output_csv:
+        write_monoplot_points_csv(output_csv, res)
+    if lines_csv:
+        write_monoplot_lines_csv(lines_csv, res)
+    return res
 CAMERA = Camera(
     "sim", focal_mm=35.0, pixel_size_mm=0.005, width_px=4000, height_px=3000,
     x0_mm=0.02, y0_mm=-0.01, distortion=distortion_from_dict({"model": "brown_conrady",
@@ -356,7 +373,7 @@ def _utm_dsm(rows: int = 160, cols: int = 150, cell: float = 0.5) -> tuple[Dsm, 
 
 def test_dsm_in_another_crs_is_resampled_and_heights_transformed():
     import pyproj
-    from lidarphoto.core.lidar.dsm import reproject_dsm
+    from lidarphoto.core.geometry.surface import reproject_dsm
 
     utm, f = _utm_dsm()
     rd = reproject_dsm(utm, CRS)
@@ -402,7 +419,7 @@ def test_monoplot_on_a_dsm_in_another_crs_reaches_the_truth():
 
 def test_reprojecting_a_dsm_without_crs_is_refused():
     from lidarphoto.core.errors import CrsError
-    from lidarphoto.core.lidar.dsm import reproject_dsm
+    from lidarphoto.core.geometry.surface import reproject_dsm
 
     utm, _ = _utm_dsm(rows=4, cols=4)
     bare = Dsm(utm.heights, utm.grid, None, "bare.tif")

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
 from lidarphoto.core.geometry.frames import MappingFrame
-from lidarphoto.core.photo.georeference import Mount, direct_georeference
+from lidarphoto.core.photo.georeference import direct_georeference
+from lidarphoto.core.photo.mount import Mount
 from lidarphoto.core.photo.picking import (
     PickingScene,
     nearest_point,

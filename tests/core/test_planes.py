@@ -5,13 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
-from lidarphoto.core.geometry.planes import (
-    COV_COLUMNS,
-    PLANE_COLUMNS,
-    fit_plane,
-    read_planes_csv,
-    write_planes_csv,
-)
+from lidarphoto.core.geometry.planes import fit_plane
+from lidarphoto.core.io.planes import COV_COLUMNS, PLANE_COLUMNS, read_planes_csv, write_planes_csv
 from scipy.stats import chi2
 
 ORIGIN = np.array([85000.0, 447000.0, 10.0])  # RD New-like map coordinates

@@ -16,11 +16,12 @@ import pytest
 from lidarphoto.core.errors import CrsError, InputError
 from lidarphoto.core.geometry.camera import Camera, camera_from_dict
 from lidarphoto.core.geometry.frames import LocalFrame, MappingFrame
+from lidarphoto.core.geometry.grid import Grid
 from lidarphoto.core.geometry.planes import fit_plane
+from lidarphoto.core.geometry.raycast import chord_rays
+from lidarphoto.core.geometry.surface import Dsm
 from lidarphoto.core.lidar.control import ControlLine
-from lidarphoto.core.lidar.dsm import Dsm, dsm_from_points
-from lidarphoto.core.lidar.ground_filter import Grid
-from lidarphoto.core.photo.monoplot import chord_rays
+from lidarphoto.core.lidar.dsm import dsm_from_points
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable, eo_map_to_local
 from lidarphoto.core.photo.picking import PickingScene
 from lidarphoto.core.simulation.render import (

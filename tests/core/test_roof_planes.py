@@ -10,12 +10,10 @@ import pyproj
 import pytest
 from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.errors import Cancelled, CrsError, InputError
-from lidarphoto.core.geometry.planes import read_planes_csv
-from lidarphoto.core.lidar.roof_planes import (
-    RoofPlaneParams,
-    extract_roof_planes,
-    run_extract_roof_planes,
-)
+from lidarphoto.core.io.planes import read_planes_csv
+from lidarphoto.core.jobs import extract_roof_planes as roof_planes_job
+from lidarphoto.core.jobs.runner import run_job
+from lidarphoto.core.lidar.roof_planes import RoofPlaneParams, extract_roof_planes
 from lidarphoto.core.simulation.town import CLASS_GROUND, CLASS_VEGETATION, make_town, sample_town
 from scipy.stats import chi2
 
@@ -23,6 +21,21 @@ SIGMA = 0.03  # m, noise per coordinate
 DENSITY = 8.0  # points / m^2
 AHN3 = Path(__file__).resolve().parents[1] / "data" / "ahn3" / "ahn3_delft_crop60.laz"
 RD_NEW = "EPSG:28992"
+
+
+def run_extract_roof_planes(
+    path, output_csv=None, output_cloud=None, units="crs", selection="non_ground", classes="6",
+    crs=None,
+):
+    """The extractroofplanes job on a file; returns what it did (RoofPlaneRun)."""
+    import tempfile
+
+    if output_csv is None:  # the table is required: a scratch one
+        output_csv = Path(tempfile.mkdtemp()) / "planes.csv"
+    raw = {"INPUT": str(path), "OUTPUT_CSV": str(output_csv), "DISTANCE_UNIT": units,
+           "POINTS": selection, "CLASSES": classes, "CRS": crs,
+           "OUTPUT_CLOUD": str(output_cloud) if output_cloud else None}  # fmt: skip
+    return run_job(roof_planes_job, raw).data
 
 
 @pytest.fixture(scope="module")
@@ -291,8 +304,8 @@ def test_bad_files_fail_clearly_and_leave_no_outputs(small_town_file, tmp_path):
         (no_crs, {}, CrsError, None),
         (mixed, {}, InputError, "unit"),
         (path, {"selection": "classes", "classes": "17"}, InputError, "no point"),
-        (path, {"selection": "classes", "classes": "x"}, InputError, "classes"),
-        (path, {"units": "yards"}, InputError, "units"),
+        (path, {"selection": "classes", "classes": "x"}, InputError, "CLASSES"),
+        (path, {"units": "yards"}, InputError, "DISTANCE_UNIT"),
     ]
     for src, kwargs, exc, match in cases:
         with pytest.raises(exc, match=match):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from lidarphoto.core.geometry import rotations as rot
+from lidarphoto.core.photo.mount import MOUNT_PRESETS
 from scipy.spatial.transform import Rotation
 
 RNG = np.random.default_rng(7)
@@ -89,16 +90,16 @@ def test_skew_is_cross_product():
     np.testing.assert_allclose(rot.skew(a) @ b[..., None], np.cross(a, b)[..., None])
 
 
-@pytest.mark.parametrize("name", sorted(rot.MOUNT_PRESETS))
+@pytest.mark.parametrize("name", sorted(MOUNT_PRESETS))
 def test_mount_presets_look_down(name):
-    r = rot.MOUNT_PRESETS[name]
+    r = MOUNT_PRESETS[name]
     assert rot.is_rotation(r)
     # The camera looks along -z_c; in the body frame that is straight down (+z_b).
     np.testing.assert_allclose(r @ np.array([0.0, 0.0, -1.0]), [0.0, 0.0, 1.0])
 
 
 def test_mount_preset_meaning():
-    up = rot.MOUNT_PRESETS["image_top_forward"] @ np.array([0.0, 1.0, 0.0])
+    up = MOUNT_PRESETS["image_top_forward"] @ np.array([0.0, 1.0, 0.0])
     np.testing.assert_allclose(up, [1.0, 0.0, 0.0])  # image top (y_c) -> forward
-    right = rot.MOUNT_PRESETS["image_right_forward"] @ np.array([1.0, 0.0, 0.0])
+    right = MOUNT_PRESETS["image_right_forward"] @ np.array([1.0, 0.0, 0.0])
     np.testing.assert_allclose(right, [1.0, 0.0, 0.0])

@@ -7,12 +7,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
-from lidarphoto.core.geometry.camera import read_camera_json
-from lidarphoto.core.geometry.planes import read_planes_csv
+from lidarphoto.core.io.camera import read_camera_json
 from lidarphoto.core.io.control import read_lcps_csv, read_lines_csv
 from lidarphoto.core.io.observations import read_observations_csv
+from lidarphoto.core.io.planes import read_planes_csv
+from lidarphoto.core.io.trajectory import read_trajectory_csv
 from lidarphoto.core.photo.boresight import BoresightOptions, calibrate
-from lidarphoto.core.photo.georeference import Mount, read_trajectory_csv
+from lidarphoto.core.photo.mount import Mount
 from lidarphoto.core.simulation.flight import FlightConfig, paper_config, simulate_flight
 
 

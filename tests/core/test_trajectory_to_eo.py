@@ -11,9 +11,10 @@ import pytest
 from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.errors import CrsError, InputError
 from lidarphoto.core.geometry.frames import MappingFrame
-from lidarphoto.core.geometry.rotations import MOUNT_PRESETS
-from lidarphoto.core.photo.georeference import run_trajectory_to_eo
-from lidarphoto.core.photo.orientation import read_eo_csv
+from lidarphoto.core.io.orientation import read_eo_csv
+from lidarphoto.core.jobs import trajectory_to_eo
+from lidarphoto.core.jobs.runner import run_job
+from lidarphoto.core.photo.mount import MOUNT_PRESETS
 from pyproj import Geod, Proj
 from scipy.spatial.transform import Rotation
 
@@ -21,6 +22,13 @@ CRS = "EPSG:31983"  # SIRGAS 2000 / UTM 23S, GRS80
 GEOD = Geod(ellps="GRS80")
 SAMPLE = Path(__file__).resolve().parents[2] / "sample_data" / "trajectory_demo.csv"
 HEADER = "image_id,time,group,easting,northing,height,roll,pitch,heading\n"
+
+
+def run_trajectory_to_eo(path, crs, output_csv=None, **params):
+    """The trajectorytoeo job on a file; returns its EO table."""
+    raw = {"INPUT": str(path), "CRS": crs, "OUTPUT_CSV": output_csv}
+    raw.update({k.upper(): v for k, v in params.items()})
+    return run_job(trajectory_to_eo, raw).data
 
 
 def _write(tmp_path: Path, rows: list[str], header: str = HEADER, name: str = "traj.csv") -> Path:
@@ -161,10 +169,10 @@ def test_bad_trajectory_names_row_and_column(tmp_path, rows, header, words):
 @pytest.mark.parametrize(
     ("kwargs", "error", "words"),
     [
-        ({"mount": "sideways"}, InputError, "MOUNT 'sideways' is unknown"),
+        ({"mount": "sideways"}, InputError, "MOUNT: 'sideways' is not one of"),
         ({"mount": "custom", "mount_matrix": "1,0,0,0,1,0,0,0,2"}, InputError, "not a rotation"),
-        ({"mount": "custom", "mount_matrix": ""}, InputError, "MOUNT_MATRIX must be 9"),
-        ({"boresight": "1,2"}, InputError, "BORESIGHT must be 3"),
+        ({"mount": "custom", "mount_matrix": ""}, InputError, "needs MOUNT_MATRIX: 9 numbers"),
+        ({"boresight": "1,2"}, InputError, "BORESIGHT: expected 3 numbers"),
         ({"lever_arm": "1,x,3"}, InputError, "LEVER_ARM"),
         ({"crs": "EPSG:4326"}, CrsError, "projected"),
     ],

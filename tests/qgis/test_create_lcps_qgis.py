@@ -14,7 +14,8 @@ import numpy as np
 import processing
 import pyproj
 import pytest
-from lidarphoto.core.geometry.planes import fit_plane, write_planes_csv
+from lidarphoto.core.geometry.planes import fit_plane
+from lidarphoto.core.io.planes import write_planes_csv
 from lidarphoto.core.simulation.town import make_town, sample_town
 from qgis.core import (
     QgsProcessingException,

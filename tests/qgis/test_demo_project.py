@@ -24,8 +24,8 @@ import pytest
 from lidarphoto.core.geometry.camera import Camera
 from lidarphoto.core.geometry.frames import MappingFrame
 from lidarphoto.core.io.observations import read_observations_csv
+from lidarphoto.core.io.orientation import read_eo_csv, write_eo_csv
 from lidarphoto.core.photo.georeference import direct_georeference
-from lidarphoto.core.photo.orientation import read_eo_csv
 from lidarphoto.core.photo.picking import PickingScene
 from lidarphoto.core.simulation.render import RenderOptions, RenderScene, render_image
 from lidarphoto.plugin.image_dock import ImagePickingDock
@@ -73,7 +73,7 @@ def demo(tmp_path_factory):
     figures = DEMO.render_step(lidar, sim, eo_true, out / "flight" / "images")
     (out / "calibration").mkdir()
     initial = direct_georeference(sim.trajectory, sim.mount, MappingFrame.from_user_input(CRS))
-    initial.to_csv(out / "calibration" / "eo_initial.csv")
+    write_eo_csv(out / "calibration" / "eo_initial.csv", initial)
     build_s = time.perf_counter() - t0
     print(f"\nreduced demo built in {build_s:.1f} s; rendering {figures}")
     return {"out": out, "lidar": lidar, "sim": sim, "paths": paths, "eo_true": eo_true,

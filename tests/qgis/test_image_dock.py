@@ -20,10 +20,12 @@ import numpy as np
 import pytest
 from lidarphoto.core.geometry.camera import Camera
 from lidarphoto.core.geometry.frames import MappingFrame
-from lidarphoto.core.geometry.planes import write_planes_csv
 from lidarphoto.core.io.control import write_lcps_csv, write_lines_csv
 from lidarphoto.core.io.observations import read_observations_csv, write_observations_csv
-from lidarphoto.core.photo.georeference import Mount, direct_georeference
+from lidarphoto.core.io.orientation import write_eo_csv
+from lidarphoto.core.io.planes import write_planes_csv
+from lidarphoto.core.photo.georeference import direct_georeference
+from lidarphoto.core.photo.mount import Mount
 from lidarphoto.core.photo.picking import PickingScene
 from lidarphoto.core.simulation.flight import FlightConfig, simulate_flight
 from lidarphoto.plugin.image_dock import ImagePickingDock
@@ -118,7 +120,7 @@ def block(tmp_path_factory):
     group = sim.truth.groups[0]
     mount = Mount(sim.truth.lever_arm, sim.mount.nominal, sim.truth.boresight[group])
     eo = direct_georeference(sim.truth.trajectory, mount, MappingFrame.from_user_input(CRS))
-    eo.to_csv(out / "eo.csv")
+    write_eo_csv(out / "eo.csv", eo)
     faces = {f.face_id: f for f in sim.town.faces}
     outlines = [faces[int(p.id)].polygon for p in sim.planes]
     scene = PickingScene(eo, CAMERA, CRS)

@@ -11,19 +11,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from lidarphoto.core.geometry.camera import Camera, write_camera_json
-from lidarphoto.core.io.observations import ImageObservations, read_observations_csv
+from lidarphoto.core.geometry.camera import Camera
+from lidarphoto.core.geometry.surface import reproject_dsm
+from lidarphoto.core.io.camera import write_camera_json
+from lidarphoto.core.io.dsm import dsm_from_las, write_dsm
+from lidarphoto.core.io.observations import read_observations_csv
+from lidarphoto.core.io.orientation import write_eo_csv
 from lidarphoto.core.io.pointcloud import read_points
-from lidarphoto.core.lidar.dsm import dsm_from_las, reproject_dsm
+from lidarphoto.core.io.raster import write_rgb_tiff
 from lidarphoto.core.photo.monoplot import run_monoplot
+from lidarphoto.core.photo.observations import ImageObservations
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable
 from lidarphoto.core.photo.picking import PickingScene
-from lidarphoto.core.simulation.render import (
-    RenderOptions,
-    RenderScene,
-    render_image,
-    write_rgb_tiff,
-)
+from lidarphoto.core.simulation.render import RenderOptions, RenderScene, render_image
 from lidarphoto.plugin.image_dock import ImagePickingDock
 from qgis.core import (
     QgsFeature,
@@ -48,15 +48,15 @@ def scene(tmp_path_factory):
     from the DSM, and DSM surface points visible in it with their exact pixels."""
     folder = tmp_path_factory.mktemp("monodock")
     dsm = dsm_from_las(AHN3, 0.5, crs=CRS)
-    dsm.to_geotiff(folder / "dsm.tif")
-    reproject_dsm(dsm, "EPSG:32631").to_geotiff(folder / "dsm_utm.tif")
-    write_camera_json(CAMERA, folder / "camera.json")
+    write_dsm(folder / "dsm.tif", dsm)
+    write_dsm(folder / "dsm_utm.tif", reproject_dsm(dsm, "EPSG:32631"))
+    write_camera_json(folder / "camera.json", CAMERA)
     g = dsm.grid
     table = ExteriorOrientationTable(
         ("img1",), np.array([np.nan]), ("",), np.array([[g.x0 + 31.0, g.y_top - 29.0, 125.0]]),
         np.radians([[1.5, -2.0, 15.0]]), CRS,
     )  # fmt: skip
-    table.to_csv(folder / "eo.csv")
+    write_eo_csv(folder / "eo.csv", table)
     arrays, _ = read_points(AHN3, ("x", "y", "z", "classification"), crs=CRS)
     xyz = np.column_stack([arrays["x"], arrays["y"], arrays["z"]])
     rs = RenderScene.build(dsm, xyz, arrays["classification"], crs=CRS)

@@ -11,13 +11,16 @@ from pathlib import Path
 import numpy as np
 import processing
 import pytest
-from lidarphoto.core.geometry.camera import Camera, write_camera_json
+from lidarphoto.core.geometry.camera import Camera
 from lidarphoto.core.geometry.collinearity import project
 from lidarphoto.core.geometry.frames import LocalFrame, MappingFrame
 from lidarphoto.core.geometry.rotations import matrix_to_opk
-from lidarphoto.core.io.observations import ImageObservations, write_observations_csv
-from lidarphoto.core.lidar.dsm import dsm_from_las
+from lidarphoto.core.io.camera import write_camera_json
+from lidarphoto.core.io.dsm import dsm_from_las, write_dsm
+from lidarphoto.core.io.observations import write_observations_csv
+from lidarphoto.core.io.orientation import write_eo_csv
 from lidarphoto.core.photo.monoplot import run_monoplot
+from lidarphoto.core.photo.observations import ImageObservations
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable, eo_map_to_local
 from qgis.core import QgsProcessingException, QgsVectorLayer, QgsWkbTypes
 from qgis_helpers import QGIS_PROCESS
@@ -33,14 +36,14 @@ def scene(tmp_path_factory):
     dock would store them; the DSM also as a GeoTIFF."""
     folder = tmp_path_factory.mktemp("mono")
     dsm = dsm_from_las(AHN3, 0.5, crs=CRS)
-    dsm.to_geotiff(folder / "dsm.tif")
+    write_dsm(folder / "dsm.tif", dsm)
     cam = Camera("sim", focal_mm=35.0, pixel_size_mm=0.005, width_px=4000, height_px=3000)
-    write_camera_json(cam, folder / "camera.json")
+    write_camera_json(folder / "camera.json", cam)
     g = dsm.grid
     centre = np.array([[g.x0 + 39.0, g.y_top - 37.0, 140.0]])
     table = ExteriorOrientationTable(("img1",), np.array([np.nan]), ("",), centre,
                                      np.radians([[2.0, -3.0, 25.0]]), CRS)  # fmt: skip
-    table.to_csv(folder / "eo.csv")
+    write_eo_csv(folder / "eo.csv", table)
     rng = np.random.default_rng(8)
     xc, yc = dsm.centre_origin
     x, y = xc + rng.uniform(1, 58, 123), yc - rng.uniform(1, 58, 123)

@@ -47,7 +47,7 @@ def _angle_diff_deg(a: float, b: float) -> float:
 
 
 def test_algorithm_parameters_are_the_documented_api(provider):
-    from lidarphoto.core.photo.georeference import MOUNT_CHOICES
+    from lidarphoto.core.photo.mount import MOUNT_CHOICES
 
     alg = provider.algorithm("trajectorytoeo")
     assert alg.id() == ALG

@@ -20,7 +20,7 @@ MODEL = DATA / "ground_roof_model.model3"
 
 
 def _check_outputs(layer, csv_path: Path, cloud_path: Path | None = None):
-    from lidarphoto.core.geometry.planes import read_planes_csv
+    from lidarphoto.core.io.planes import read_planes_csv
 
     planes = read_planes_csv(csv_path)
     assert len(planes) > 30

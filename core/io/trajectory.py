@@ -1,0 +1,74 @@
+"""The trajectory table: the INS/GNSS solution at each image's exposure time.
+
+CSV with a header row (names are case-insensitive, aliases in parentheses)::
+
+    image_id (id, image, name, photo)      text, unique
+    time (gps_time, t)                     optional, seconds
+    group (line, strip, flight_line)       optional, flight line or direction
+    easting (e, x), northing (n, y), height (h, z, alt)         in the mapping CRS, or
+    latitude (lat), longitude (lon, long), height (h, z, alt)   degrees on the CRS's datum
+    roll, pitch, heading (yaw)             degrees; body x forward, y right, z down;
+                                           heading clockwise from true north
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Union
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError
+from ..photo.georeference import Trajectory
+from .tables import find_column, float_column, read_table, text_column, unique_ids
+
+Array = NDArray[np.float64]
+
+
+def read_trajectory_csv(path: Union[str, Path]) -> Trajectory:
+    """Read the trajectory table (format in the module docstring)."""
+    table = read_table(path)
+    ids = unique_ids(table, find_column(table, ("image_id", "id", "image", "name", "photo")))
+    t_col = find_column(table, ("time", "gps_time", "t"), required=False)
+    time = (
+        float_column(table, t_col, allow_empty=True)
+        if t_col is not None
+        else np.full(len(ids), np.nan)
+    )
+    g_col = find_column(table, ("group", "line", "strip", "flight_line"), required=False)
+    group = text_column(table, g_col, nonempty=False) if g_col is not None else ("",) * len(ids)
+    lat_col = find_column(table, ("latitude", "lat"), required=False)
+    e_col = find_column(table, ("easting", "e", "x"), required=False)
+    if (lat_col is None) == (e_col is None):
+        raise InputError(
+            "give either easting/northing/height or latitude/longitude/height columns "
+            f"(found: {', '.join(table.columns)})",
+            path=table.path,
+        )
+    h_col = find_column(table, ("height", "h", "z", "alt", "altitude"), what="height")
+    if lat_col is not None:
+        lon_col = find_column(table, ("longitude", "lon", "long"), what="longitude")
+        position = np.stack([float_column(table, c) for c in (lat_col, lon_col, h_col)], axis=1)
+        _check_range(table, lat_col, position[:, 0], 90.0)
+        _check_range(table, lon_col, position[:, 1], 180.0)
+    else:
+        n_col = find_column(table, ("northing", "n", "y"), what="northing")
+        position = np.stack([float_column(table, c) for c in (e_col, n_col, h_col)], axis=1)
+    cols = [find_column(table, names) for names in (("roll",), ("pitch",), ("heading", "yaw"))]
+    rph_deg = np.stack([float_column(table, c) for c in cols], axis=1)
+    _check_range(table, cols[0], rph_deg[:, 0], 180.0)
+    _check_range(table, cols[1], rph_deg[:, 1], 90.0)
+    _check_range(table, cols[2], rph_deg[:, 2], 360.0)
+    return Trajectory(ids, time, group, position, lat_col is not None, np.radians(rph_deg))
+
+
+def _check_range(table, column: int, values: Array, limit: float) -> None:
+    bad = np.flatnonzero(np.abs(values) > limit)
+    if bad.size:
+        raise InputError(
+            f"{values[bad[0]]} is outside [-{limit:g}, {limit:g}] degrees",
+            path=table.path,
+            row=table.line_numbers[bad[0]],
+            column=table.columns[column],
+        )

@@ -1,0 +1,221 @@
+"""``accuracyreport``: positional accuracy of check points against published standards."""
+
+from __future__ import annotations
+
+import logging
+
+from ..errors import InputError
+from ..quality.accuracy import OUTLIER_RULES, STANDARD_KEYS, AccuracySettings
+from ..quality.standards import PEC_CLASSES
+from .common import CSV_FILTER
+from .runner import JobResult
+from .spec import AlgorithmSpec, Param, Result, Values
+
+log = logging.getLogger(__name__)
+
+_D = AccuracySettings()
+_STANDARD_LABELS = (
+    "ASPRS Positional Accuracy Standards, Edition 2 (2023)",
+    "NSSDA (FGDC-STD-007.3-1998)",
+    "PEC-PCD (Decreto 89.817 / ET-CQDG)",
+    "Project threshold (Pedrosa & dos Santos 2020: 0.40 m, dz of Eq. 18)",
+)
+_OUTLIER_LABELS = (
+    "robust: modified z-score > 3.5 (median/MAD)",
+    "three sigma: |d - mean| > 3 s",
+    "none",
+)
+#: (parameter, AccuracySettings field, label, unit, minimum, advanced)
+_NUMBERS = (
+    ("ALPHA", "alpha", "Significance level of the tests", "", 0.0001, False),
+    ("DECLARED_SIGMA_H", "declared_sigma_h", "Declared precision per horizontal axis", "m",
+     0.0, False),
+    ("DECLARED_SIGMA_V", "declared_sigma_v", "Declared precision in height", "m", 0.0, False),
+    ("SURVEY_SIGMA_H", "survey_sigma_h", "Check-point survey sigma per horizontal axis", "m",
+     0.0, False),
+    ("SURVEY_SIGMA_V", "survey_sigma_v", "Check-point survey sigma in height", "m", 0.0, False),
+)  # fmt: skip
+_STANDARD_NUMBERS = (
+    ("ASPRS_H_CLASS_CM", "asprs_h_class_cm", "ASPRS horizontal class (0 = tightest met)", "cm",
+     0.0, False),
+    ("ASPRS_V_CLASS_CM", "asprs_v_class_cm", "ASPRS vertical class (0 = tightest met)", "cm",
+     0.0, False),
+    ("PEC_SCALE", "pec_scale", "PEC-PCD scale denominator (1:N)", "", 1.0, False),
+    ("PEC_EQUIDISTANCE", "pec_equidistance", "PEC-PCD equidistance (0 = series value)", "m",
+     0.0, False),
+)  # fmt: skip
+_PROJECT_NUMBERS = (
+    ("PROJECT_H_THRESHOLD", "project_h_threshold", "Project planimetric threshold", "m", 0.0,
+     False),
+    ("PROJECT_V_THRESHOLD", "project_v_threshold", "Project vertical threshold (0 = Eq. 18)",
+     "m", 0.0, False),
+)  # fmt: skip
+
+
+def _numbers(rows) -> tuple[Param, ...]:
+    return tuple(
+        Param(key, "number", label, getattr(_D, field), unit=unit, minimum=minimum,
+              advanced=advanced)
+        for key, field, label, unit, minimum, advanced in rows
+    )  # fmt: skip
+
+
+def _point_params(what: str) -> tuple[Param, ...]:
+    key = what.upper()
+    return (
+        Param(key, "points", f"{what.capitalize()} points", optional=True,
+              help=f"{what} point table (CSV: id, e, n, h [, group]) or point layer"),
+        Param(f"{key}_ID", "field", f"{what.capitalize()} id field", "", parent=key,
+              optional=True, help="id column (default: id)"),
+        Param(f"{key}_Z_FIELD", "field", f"{what.capitalize()} height field (empty: geometry Z)",
+              "", parent=key, optional=True, numeric_field=True,
+              help="height column (default: h; in QGIS empty takes the geometry's Z)"),
+    )  # fmt: skip
+
+
+SPEC = AlgorithmSpec(
+    name="accuracyreport",
+    title="Positional accuracy report",
+    group="Quality",
+    group_id="quality",
+    summary="check points against ASPRS Ed. 2, NSSDA, PEC-PCD and the project threshold",
+    description="""\
+Compares measured check points with reference coordinates and reports their positional
+accuracy: discrepancies d = measured - reference (dE, dN, dH, horizontal, 3D), mean, standard
+deviation, RMSE, minimum and maximum per component, per group and overall; Shapiro-Wilk
+normality, Student's t test for bias, chi-square test of the standard deviation against a
+declared precision; outlier screening (flagged points are reported, excluded only on
+request); and the verdicts of the ASPRS Positional Accuracy Standards Edition 2 (2023),
+NSSDA (FGDC-STD-007.3-1998), the Brazilian PEC-PCD (classes A-D for a scale) and the project
+threshold of Pedrosa & dos Santos (2020): 0.40 m planimetric, dz = sqrt(2) H^2 / (B f)
+sigma_pix.
+
+## Input: one table or two point tables/layers
+Check-point table (CSV): id, e, n, h (measured) and e_ref, n_ref, h_ref (reference),
+optional group; metres in one projected CRS (give it as CRS).
+
+Or Measured points and Reference points (CSV tables id, e, n, h [, group], or point layers in
+QGIS) joined by their ids. Ids present in only one set, duplicate ids and missing coordinates
+are errors. Layers in different CRSs are refused unless Reproject is checked (QGIS only: the
+reference layer is then transformed to the measured layer's CRS, heights unchanged).
+
+## Settings
+Declared precision and check-point survey sigma are per horizontal axis and in height (m;
+0 = not given). ASPRS classes in cm (0 = report the tightest class met); PEC-PCD scale
+denominator, equidistance (0 = the series' value) and declared class; project thresholds
+(vertical 0 = dz of Eq. 18 from the flight geometry "H m, B m, f mm, pixel um").
+
+## Outputs
+A self-contained HTML report (tables, verdicts, SVG plots), a JSON of every figure, a PointZ
+layer at the reference positions with id, group, dE, dN, dH, dHoriz, d3D, outlier, and the
+RMSE values as numeric outputs.""",
+    params=(
+        Param("INPUT", "file", "Check-point table (CSV: id, e, n, h, e_ref, n_ref, h_ref, group)",
+              optional=True, file_filter=CSV_FILTER),
+        *_point_params("measured"),
+        *_point_params("reference"),
+        Param("GROUP_FIELD", "field", "Group field (flight direction, model, block)", "",
+              parent="MEASURED", optional=True, help="group column (default: group)"),
+        Param("CRS", "crs", "CRS of the check-point table", optional=True,
+              help="CRS of the coordinates (reported only)"),
+        Param("REPROJECT", "boolean", "Reproject the reference layer to the measured CRS",
+              False, help="QGIS only: point tables carry no CRS"),
+        *_numbers(_NUMBERS),
+        Param("OUTLIER_RULE", "enum", "Outlier screening", _D.outlier_rule,
+              options=OUTLIER_RULES, labels=_OUTLIER_LABELS),
+        Param("EXCLUDE_OUTLIERS", "boolean", "Exclude flagged outliers from the statistics",
+              _D.exclude_outliers),
+        Param("STANDARDS", "enum", "Standards", _D.standards, options=STANDARD_KEYS,
+              labels=_STANDARD_LABELS, multiple=True),
+        *_numbers(_STANDARD_NUMBERS),
+        Param("PEC_CLASS", "enum", "PEC-PCD declared class", _D.pec_class,
+              options=PEC_CLASSES),
+        *_numbers(_PROJECT_NUMBERS),
+        Param("FLIGHT_GEOMETRY", "numbers", "Flight geometry for Eq. 18: H, B, f, pixel",
+              _D.flight_geometry, count=4, unit="m, m, mm, um", advanced=True),
+        Param("OUTPUT", "sink", "Check points with discrepancies", geometry="point"),
+        Param("OUTPUT_HTML", "file_out", "Accuracy report (HTML)", optional=True,
+              file_filter="HTML files (*.html)"),
+        Param("OUTPUT_JSON", "file_out", "Accuracy figures (JSON)", optional=True,
+              create_by_default=False, file_filter="JSON files (*.json)"),
+    ),
+    results=tuple(
+        Result(key, "number", f"{key} (m)")
+        for key in ("RMSE_E", "RMSE_N", "RMSE_H", "RMSE_HORIZ", "RMSE_3D")
+    ),
+    tags=("accuracy", "rmse", "check points", "asprs", "nssda", "pec", "pec-pcd", "quality"),
+    references=(
+        "ASPRS (2023)",
+        "FGDC (1998)",
+        "Brasil (1984), DSG (2016)",
+        "Pedrosa & dos Santos (2020)",
+        "Iglewicz & Hoaglin (1993)",
+    ),
+)
+
+
+def _points(v: Values):
+    """The check points from the table, or the two point sets (paths or the QGIS adapter's
+    PointSet objects), joined by id."""
+    from ..io.checkpoints import read_checkpoint_table, read_point_table
+    from ..quality.accuracy import PointSet, join_points
+
+    has_table = v.input is not None
+    has_points = v.measured is not None or v.reference is not None
+    if has_table == has_points or (has_points and (v.measured is None or v.reference is None)):
+        raise InputError(
+            "give either one check-point table (INPUT) or a measured and a reference point "
+            "table (MEASURED and REFERENCE)"
+        )
+    if has_table:
+        return read_checkpoint_table(v.input, group_column=v.group_field or None, crs=v.crs)
+    if isinstance(v.measured, PointSet) and isinstance(v.reference, PointSet):
+        return join_points(v.measured, v.reference)
+    if v.reproject:
+        raise InputError("REPROJECT needs QGIS (point tables carry no CRS)")
+    measured = read_point_table(
+        v.measured, id_column=v.measured_id or None, z_column=v.measured_z_field or None,
+        group_column=v.group_field or None, crs=v.crs,
+    )  # fmt: skip
+    reference = read_point_table(
+        v.reference, id_column=v.reference_id or None, z_column=v.reference_z_field or None,
+        crs=v.crs,
+    )  # fmt: skip
+    return join_points(measured, reference)
+
+
+def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
+    """Read the check points, assess them, write the HTML report and the JSON."""
+    import json
+
+    from ..errors import stop_if_asked
+    from ..io.atomic import write_text_atomic
+    from ..quality.accuracy import assess_accuracy, report_to_dict
+    from ..quality.accuracy_html import render_html
+
+    settings = AccuracySettings(
+        **{f: v[k] for k, f, *_ in _NUMBERS + _STANDARD_NUMBERS + _PROJECT_NUMBERS},
+        outlier_rule=v.outlier_rule,
+        exclude_outliers=v.exclude_outliers,
+        standards=v.standards,
+        pec_class=v.pec_class,
+        flight_geometry=v.flight_geometry,
+    )
+    points = _points(v)
+    log.info("%d check points from %s", len(points), points.source)
+    report = assess_accuracy(points, settings, progress=progress, should_stop=should_stop)
+    stop_if_asked(should_stop, "writing the report")
+    if out.requested("OUTPUT_HTML"):
+        write_text_atomic(out.path("OUTPUT_HTML"), render_html(report))
+    if out.requested("OUTPUT_JSON"):
+        text = json.dumps(report_to_dict(report), indent=1, allow_nan=False)
+        write_text_atomic(out.path("OUTPUT_JSON"), text)
+    if progress is not None:
+        progress(1.0)
+    lines = [f"{key} {value:.4f}" for key, value in report.rmse.items()]
+    lines += [
+        f"{res.key}: {verdict.name}: {verdict.status} ({verdict.reason})"
+        for res in report.standards
+        for verdict in res.verdicts
+    ]
+    return JobResult(results=dict(report.rmse), lines=lines, data=report)

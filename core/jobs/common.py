@@ -1,0 +1,90 @@
+"""Parameters shared by several algorithms: the camera mount, the LiDAR cloud and its units.
+
+Written once here so that every algorithm names, documents and defaults them the same way.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import replace
+from typing import Any
+
+from ..photo.mount import MOUNT_CHOICES, MOUNT_LABELS
+from .spec import Param
+
+CSV_FILTER = "CSV files (*.csv *.txt)"
+CSV_OUT = "CSV files (*.csv)"
+LAS_FILTER = "LAS/LAZ files (*.las *.laz *.LAS *.LAZ)"
+DISTANCE_UNITS = ("crs", "metre")
+
+
+def mount_params() -> tuple[Param, ...]:
+    """LEVER_ARM, MOUNT, MOUNT_MATRIX and BORESIGHT (``core.photo.mount``)."""
+    return (
+        Param("LEVER_ARM", "numbers", "Lever arm x,y,z", (0.0, 0.0, 0.0), count=3,
+              unit="m, body frame",
+              help="camera perspective centre in the INS body frame (x forward, y right, "
+              "z down)"),
+        Param("MOUNT", "enum", "Camera mount", MOUNT_CHOICES[0], options=MOUNT_CHOICES,
+              labels=tuple(f"{m}: {MOUNT_LABELS[m]}" for m in MOUNT_CHOICES),
+              help="nominal camera-to-body rotation; custom uses MOUNT_MATRIX"),
+        Param("MOUNT_MATRIX", "numbers", "Mount matrix R_c^b (9 numbers, row-major)",
+              count=9, optional=True, advanced=True,
+              help="the nominal mount R_c^b when MOUNT is custom"),
+        Param("BORESIGHT", "numbers", "Boresight domega,dphi,dkappa", (0.0, 0.0, 0.0),
+              count=3, unit="degrees",
+              help="small misalignment about the camera axes x, y, z"),
+    )  # fmt: skip
+
+
+def mount_from(values: Mapping[str, Any]):
+    """The :class:`~lidarphoto.core.photo.mount.Mount` of :func:`mount_params` values."""
+    from ..photo.mount import Mount
+
+    return Mount.from_parameters(
+        values["LEVER_ARM"], values["MOUNT"], values["MOUNT_MATRIX"], values["BORESIGHT"]
+    )
+
+
+def cloud_params(key: str = "INPUT", label: str = "Point cloud (LAS/LAZ)") -> tuple[Param, ...]:
+    """The cloud file, ``CRS`` (overrides or supplies the file's) and ``DISTANCE_UNIT``."""
+    return (
+        Param(key, "file", label, file_filter=LAS_FILTER),
+        Param("CRS", "crs", "CRS (overrides the file's)", optional=True,
+              help="the cloud's CRS when the file has none or a wrong one (EPSG:xxxx or WKT)"),
+        Param("DISTANCE_UNIT", "enum", "Distance unit", "crs", options=DISTANCE_UNITS,
+              labels=("cloud CRS units", "metres"), aliases={"metres": "metre", "m": "metre"},
+              help="unit of the length parameters: the cloud's CRS unit (e.g. international "
+              "feet) or metres, converted"),
+    )  # fmt: skip
+
+
+def lengths_in_cloud_units(
+    params: Any,
+    info: Any,
+    distance_unit: str,
+    horizontal: Iterable[str] = (),
+    vertical: Iterable[str] = (),
+) -> Any:
+    """``params`` (a dataclass) with its length fields expressed in the cloud's units.
+
+    The one place where metres become CRS units: with ``distance_unit`` ``"metre"`` the
+    ``horizontal`` fields are divided by the size of the cloud's horizontal unit and the
+    ``vertical`` ones by its vertical unit (``info`` is a CloudInfo); with ``"crs"`` the
+    parameters are returned unchanged.
+    """
+    from ..errors import CrsError
+
+    if distance_unit == "crs":
+        return params
+    h, v = info.unit_to_metre, info.vertical_unit_to_metre
+    if not (h > 0 and v > 0):
+        raise CrsError("DISTANCE_UNIT metres needs a cloud CRS with known units", path=info.path)
+    changes = {name: getattr(params, name) / h for name in horizontal}
+    changes.update({name: getattr(params, name) / v for name in vertical})
+    return replace(params, **changes)
+
+
+def unit_text(info: Any, distance_unit: str) -> str:
+    """How the job reports the unit its lengths were taken in."""
+    return "metre (converted)" if distance_unit == "metre" else info.horizontal_unit

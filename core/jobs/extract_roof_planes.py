@@ -1,0 +1,207 @@
+"""``extractroofplanes``: roof planes with their precision from a classified LAS/LAZ cloud."""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ..lidar.roof_planes import SELECTION_CHOICES, RoofPlaneParams
+from .common import CSV_OUT, cloud_params, lengths_in_cloud_units
+from .runner import JobResult, stages
+from .spec import AlgorithmSpec, Param, Result, Values
+
+log = logging.getLogger(__name__)
+
+_D = RoofPlaneParams()
+#: (parameter, RoofPlaneParams field, label, kind, unit, minimum, advanced)
+_NUMBERS = (
+    ("K_NEIGHBOURS", "k_neighbours", "Neighbours K of the local RANSAC", "integer", "", 6,
+     False),
+    ("EPSILON", "epsilon", "Point-to-plane tolerance epsilon", "number", "length", 0.0, False),
+    ("MIN_SUPPORT", "min_support", "Minimum support of a local plane", "integer", "points", 3,
+     False),
+    ("RANSAC_ITERATIONS", "ransac_iterations", "RANSAC triplets per point", "integer", "", 1,
+     True),
+    ("MIN_SLOPE", "min_slope_deg", "Minimum slope alpha", "number", "degrees", 0.0, False),
+    ("MAX_SLOPE", "max_slope_deg", "Maximum slope beta", "number", "degrees", 0.0, False),
+    ("ANGLE_TOLERANCE", "angle_tolerance_deg", "Normal angle tolerance", "number", "degrees",
+     0.0, True),
+    ("MIN_PLANE_POINTS", "min_plane_points", "Minimum points per plane", "integer", "", 3,
+     False),
+    ("OUTLINE_CELL", "outline_cell", "Outline raster cell (0 = auto)", "number", "length",
+     0.0, True),
+    ("SEED", "seed", "Random seed", "integer", "", 0, True),
+)  # fmt: skip
+_LENGTHS = ("epsilon", "outline_cell")
+
+SPEC = AlgorithmSpec(
+    name="extractroofplanes",
+    title="Extract roof planes",
+    group="LiDAR",
+    group_id="lidar",
+    summary="roof planes with their precision from a classified LAS/LAZ cloud",
+    description="""\
+Extracts roof planes from a LiDAR cloud classified by a ground filter (Pedrosa & dos Santos
+2020, section 2.1): for every point, RANSAC on its K nearest neighbours with tolerance
+epsilon; the point is kept when the plane has the minimum support, the point lies on it and
+its slope is between alpha and beta (rejects vegetation and walls). Kept points are grown into
+regions (distance to the region's plane and normal angle), small regions dropped, ridge and
+eave points attached to the nearest plane, coplanar neighbours merged. Each plane is fitted by
+the weighted eigen method of Pathak et al. (2010) on centred coordinates, with the full
+covariance of (a, b, c, d) and the standard deviation of d (Khoshelham 2016). The same input
+and seed give the same planes.
+
+## Points
+Non-ground (class != 2), the listed Classes (e.g. 6), or all points (a cloud that is already
+non-ground). CRS overrides the file's CRS.
+
+## Units
+With Distance unit = cloud CRS units, epsilon and the outline cell are in the unit of the
+cloud's CRS (international feet for Autzen); with metres they are converted. Plane
+parameters, centroids, rms and sigma_d are always in the CRS unit (the UNIT output names it).
+
+## Outputs
+Plane outlines (PolygonZ, concave hull for display) with every attribute; the plane table
+CSV: id, a, b, c, d (n.p + d = 0, normal up), centroid_x/y/z, n_points, rms, sigma_d,
+slope_deg, aspect_deg (clockwise from grid north, downslope), and the 10 upper-triangle
+covariance elements cov_aa ... cov_dd; optionally a copy of the cloud with the int32 extra
+dimension plane_id (-1 = none). A cloud without roofs gives zero planes and a message, not an
+error.""",
+    params=(
+        *cloud_params("INPUT"),
+        Param("POINTS", "enum", "Points", "non_ground", options=SELECTION_CHOICES,
+              labels=("non-ground (class != 2)", "the classes below", "all"),
+              aliases={"non-ground": "non_ground"}),
+        Param("CLASSES", "string", "Classes (e.g. 6)", "6", optional=True,
+              help="LAS classes searched when POINTS is classes, e.g. 6 or 1,6"),
+        *(
+            Param(key, kind, label, getattr(_D, field), unit=unit, minimum=minimum,
+                  advanced=advanced)
+            for key, field, label, kind, unit, minimum, advanced in _NUMBERS
+        ),
+        Param("OUTPUT", "sink", "Roof planes", geometry="polygon"),
+        Param("OUTPUT_CSV", "file_out", "Plane table (CSV)", file_filter=CSV_OUT),
+        Param("OUTPUT_CLOUD", "file_out", "Point cloud with plane_id", optional=True,
+              create_by_default=False, file_filter="LAZ files (*.laz);;LAS files (*.las)"),
+    ),
+    results=(
+        Result("PLANE_COUNT", "number", "Number of planes"),
+        Result("UNIT", "string", "Unit of the lengths"),
+    ),
+    tags=("roof", "plane", "ransac", "building", "las", "laz", "point cloud", "segmentation"),
+    references=("Pedrosa & dos Santos (2020)", "Pathak et al. (2010)", "Khoshelham (2016)"),
+)
+
+
+def parse_classes(text: str) -> tuple[int, ...]:
+    """LAS classes from user text ``"6"``, ``"6,17"`` or ``"6 17"``.
+
+    >>> parse_classes("6, 17")
+    (6, 17)
+    """
+    parts = [p for p in text.replace(",", " ").replace(";", " ").split() if p]
+    try:
+        classes = tuple(int(p) for p in parts)
+    except ValueError:
+        raise InputError(f"CLASSES must be integers separated by commas, got {text!r}") from None
+    if not classes or any(not 0 <= c <= 255 for c in classes):
+        raise InputError(f"CLASSES: give one or more classes between 0 and 255, got {text!r}")
+    return classes
+
+
+@dataclass(frozen=True)
+class RoofPlaneRun:
+    """What the job did: the planes (``result``, with the plane id of every point of the
+    file), the parameters actually used in the cloud's unit ``unit``, the cloud's CRS."""
+
+    result: Any
+    params: RoofPlaneParams
+    unit: str
+    unit_to_metre: float
+    crs_wkt: str
+    n_points: int
+    n_selected: int
+    messages: tuple[str, ...] = ()
+
+
+def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
+    """Read the cloud, extract roof planes, write the plane table (and the cloud)."""
+    from ..io.planes import write_planes_csv
+    from ..io.pointcloud import read_points, write_cloud
+    from ..lidar.roof_planes import extract_roof_planes
+
+    params = RoofPlaneParams(**{field: v[key] for key, field, *_ in _NUMBERS})
+    selection = v.points
+    wanted = parse_classes(v.classes) if selection == "classes" else ()
+    weights = (0.15, 0.7, 0.15) if out.requested("OUTPUT_CLOUD") else (0.2, 0.8, 0.0)
+    read, compute, write = stages(progress, *weights)
+    fields = ("x", "y", "z") if selection == "all" else ("x", "y", "z", "classification")
+    arrays, info = read_points(
+        v.input, fields, crs=v.crs or None, progress=read, should_stop=should_stop
+    )
+    ratio = info.vertical_unit_to_metre / info.unit_to_metre
+    if not math.isfinite(ratio) or abs(ratio - 1.0) > 1e-9:
+        raise InputError(
+            f"horizontal unit ({info.horizontal_unit}) and vertical unit "
+            f"({info.vertical_unit_to_metre} m) differ: planes need x, y and z in one unit; "
+            "convert the heights first",
+            path=str(v.input),
+        )
+    params = lengths_in_cloud_units(params, info, v.distance_unit, _LENGTHS)
+    messages = [
+        f"lengths in {info.horizontal_unit} (1 unit = {info.unit_to_metre:g} m): "
+        f"epsilon = {params.epsilon:g}, outline cell = {params.outline_cell:g} (0 = auto)"
+    ]
+    n = info.point_count
+    if selection == "all":
+        sel = np.ones(n, dtype=bool)
+    elif selection == "classes":
+        sel = np.isin(arrays["classification"], wanted)
+    else:
+        sel = arrays["classification"] != 2
+    n_sel = int(sel.sum())
+    if n_sel == 0:
+        what = {"classes": f"of class {v.classes}", "non_ground": "that is not ground (class 2)"}
+        raise InputError(f"no point {what.get(selection, '')} in the cloud", path=str(v.input))
+    xyz = np.column_stack([arrays["x"][sel], arrays["y"][sel], arrays["z"][sel]])
+    del arrays
+    result = extract_roof_planes(xyz, params, progress=compute, should_stop=should_stop)
+    del xyz
+    messages.append(result.message)
+    plane_id = np.full(n, -1, dtype=np.int32)
+    plane_id[sel] = result.plane_id
+    if out.requested("OUTPUT_CLOUD"):
+        write_cloud(
+            v.input,
+            out.path("OUTPUT_CLOUD"),
+            extra={"plane_id": plane_id},
+            progress=write,
+            should_stop=should_stop,
+        )
+    write_planes_csv(out.path("OUTPUT_CSV"), result.planes)
+    if progress is not None:
+        progress(1.0)
+    run_info = RoofPlaneRun(
+        result=replace(result, plane_id=plane_id),
+        params=params,
+        unit=info.horizontal_unit,
+        unit_to_metre=info.unit_to_metre,
+        crs_wkt=info.crs.to_wkt() if info.crs is not None else "",
+        n_points=n,
+        n_selected=n_sel,
+        messages=tuple(messages),
+    )
+    for message in messages:
+        log.info(message)
+    return JobResult(
+        results={"PLANE_COUNT": len(result.planes), "UNIT": info.horizontal_unit},
+        lines=[
+            f"{result.message}; lengths in {info.horizontal_unit} -> {out.target('OUTPUT_CSV')}"
+        ],
+        data=run_info,
+    )

@@ -1,0 +1,113 @@
+"""``monoplot``: 3D points and lines from one oriented image and a LiDAR DSM."""
+
+from __future__ import annotations
+
+import logging
+
+from ..photo.monoplot import DEFAULT_EO_SIGMAS, METHODS
+from .common import CSV_FILTER, CSV_OUT
+from .runner import JobResult, stages
+from .spec import AlgorithmSpec, Param, Result, Values
+
+log = logging.getLogger(__name__)
+
+SPEC = AlgorithmSpec(
+    name="monoplot",
+    title="Monoplot image points and lines on a LiDAR DSM",
+    group="Monoplotting",
+    group_id="monoplotting",
+    summary="3D points and lines from one oriented image and a LiDAR DSM",
+    description="""\
+Monoplotting (dos Santos, Dal Poz & Dalmolin 2010): the ray of each image point is
+intersected with the LiDAR surface. Direct (Dal Poz 1991): the ray walks the DSM's cells in
+order from the camera and meets the two triangles of each cell in the determinant form of
+Eqs. 6-10; the first face hit is the visible point (occlusion). Makarovic: the classical
+iteration height -> position -> height.
+
+Observations: the image-observation CSV of the picking dock (image_id, point_id, col, row,
+sigma_px, type, target_id). Rows of type line with the same image and target_id form one 3D
+line (vertices in file order; line step adds points every so many pixels along it); other
+rows are points (their target_id is not used). With a plane table, rows of type tie or paper
+are intersected with their roof plane (target_id) instead.
+
+DSM: a raster, or a LAS/LAZ rasterised at cell size (highest return per cell, gaps filled;
+optionally saved). A DSM in another CRS than the mapping CRS of the exterior orientation is
+resampled into it, heights transformed too (DSM CRS supplies the CRS when the file has none);
+when PROJ lacks a grid for that (e.g. a geoid), its points get the status crs_mismatch.
+
+Each point carries a 3x3 covariance from the image sigma, the EO sigmas (X, Y, Z in m;
+omega, phi, kappa in degrees) and the DSM height sigma, and a status: ok, grazing (ray meets
+the face at less than the minimum angle), outside (the ray leaves the DSM), nodata (it crosses
+a hole first), no_orientation (image not in the EO table), crs_mismatch (see DSM),
+not_converged (Makarovic), parallel / unknown_plane (planes).""",
+    params=(
+        Param("OBSERVATIONS", "file", "Image observations (CSV)", file_filter=CSV_FILTER),
+        Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
+        Param("EO", "file", "Exterior orientation (CSV)", file_filter=CSV_FILTER),
+        Param("DSM", "file", "DSM (raster, or LAS/LAZ)",
+              file_filter="DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"),
+        Param("PLANES", "file", "Roof plane table (CSV)", optional=True, file_filter=CSV_FILTER),
+        Param("CRS", "crs", "Mapping CRS of the EO", help="e.g. EPSG:28992"),
+        Param("DSM_CRS", "crs", "DSM CRS (if the file has none)", optional=True),
+        Param("METHOD", "enum", "Method", METHODS[0], options=METHODS,
+              labels=("direct (Dal Poz, DDA)", "Makarovic iteration")),
+        Param("CELL_SIZE", "number", "DSM cell size for LAS/LAZ", 0.5, unit="CRS unit",
+              minimum=0.0),
+        Param("SIGMA_DSM", "number", "DSM height sigma", 0.10, unit="m", minimum=0.0),
+        Param("LINE_STEP", "number", "Points along lines every (0 = end points)", 0.0,
+              unit="pixels", minimum=0.0),
+        Param("MIN_INCIDENCE", "number", "Minimum angle ray / face", 5.0, unit="degrees",
+              minimum=0.0, advanced=True),
+        Param("EO_SIGMAS", "numbers", "EO sigmas: X, Y, Z, omega, phi, kappa", DEFAULT_EO_SIGMAS,
+              count=6, unit="m, degrees"),
+        Param("OUTPUT_POINTS", "sink", "Monoplotted points", geometry="point"),
+        Param("OUTPUT_LINES", "sink", "Monoplotted lines", geometry="line"),
+        Param("OUTPUT_CSV", "file_out", "Point table (CSV)", optional=True,
+              create_by_default=False, file_filter=CSV_OUT),
+        Param("LINES_CSV", "file_out", "Line table", optional=True, create_by_default=False,
+              file_filter=CSV_OUT),
+        Param("OUTPUT_DSM", "raster_out", "DSM made from the LAS/LAZ", optional=True,
+              create_by_default=False),
+    ),
+    results=(
+        Result("POINT_COUNT", "number", "Rays monoplotted"),
+        Result("HIT_COUNT", "number", "Rays with a 3D point"),
+    ),
+    tags=("monoplotting", "monorestitution", "dsm", "dal poz", "makarovic", "3d lines"),
+    references=("dos Santos, Dal Poz & Dalmolin (2010)", "Dal Poz (1991)", "Makarovic (1973)"),
+)
+
+
+def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
+    """Read the observations, camera, EO, DSM (and planes), monoplot, write the tables."""
+    from ..io.camera import read_camera_json
+    from ..io.dsm import load_dsm, write_dsm
+    from ..io.monoplot import write_monoplot_lines_csv, write_monoplot_points_csv
+    from ..io.observations import read_observations_csv
+    from ..io.orientation import read_eo_csv
+    from ..io.planes import read_planes_csv
+    from ..photo.monoplot import monoplot
+
+    obs = read_observations_csv(v.observations)
+    camera = read_camera_json(v.camera)
+    eo = read_eo_csv(v.eo)
+    planes = read_planes_csv(v.planes) if v.planes else ()
+    load, compute = stages(progress, 0.4, 0.6)
+    dsm = load_dsm(v.dsm, v.cell_size, v.dsm_crs, progress=load, should_stop=should_stop)
+    result = monoplot(
+        obs, camera, eo, dsm, v.crs, method=v.method, sigma_dsm=v.sigma_dsm,
+        eo_sigmas=v.eo_sigmas, planes=planes, line_step_px=v.line_step,
+        min_incidence_deg=v.min_incidence, progress=compute, should_stop=should_stop,
+    )  # fmt: skip
+    if out.requested("OUTPUT_DSM"):
+        write_dsm(out.path("OUTPUT_DSM"), result.dsm)
+    if out.requested("OUTPUT_CSV"):
+        write_monoplot_points_csv(out.path("OUTPUT_CSV"), result)
+    if out.requested("LINES_CSV"):
+        write_monoplot_lines_csv(out.path("LINES_CSV"), result)
+    hits = int(sum(int(s) in (0, 1) for s in result.status))
+    return JobResult(
+        results={"POINT_COUNT": len(result.rows), "HIT_COUNT": hits},
+        lines=[f"{len(result.rows)} rays, {len(result.lines)} lines: {result.status_counts()}"],
+        data=result,
+    )

@@ -1,0 +1,422 @@
+"""Declarative parameter specs: each algorithm's parameters written once, for every view.
+
+A job module (``core/jobs/<algorithm>.py``) declares ``SPEC``, an :class:`AlgorithmSpec` whose
+:class:`Param` entries carry the name (the QGIS key, ``CELL_SIZE``, and the command-line
+option, ``--cell-size``), the kind, label, default, unit, valid range and help. The QGIS
+algorithm (``processing_provider/spec_algorithm.py``), the command line (``core/cli.py``) and
+both help texts are generated from it, so a default or a help text is written in one place.
+
+Kinds of inputs (the value a job receives):
+
+========== =================================== ==========================================
+kind       QGIS parameter                      value
+========== =================================== ==========================================
+file       QgsProcessingParameterFile          path (str) or None
+crs        QgsProcessingParameterCrs           authority id or WKT (str) or None
+number     QgsProcessingParameterNumber        float
+integer    QgsProcessingParameterNumber (int)  int
+boolean    QgsProcessingParameterBoolean       bool
+enum       QgsProcessingParameterEnum          option name (tuple of names if multiple)
+string     QgsProcessingParameterString        str
+numbers    QgsProcessingParameterString        tuple of ``count`` floats ("x,y,z")
+points     QgsProcessingParameterFeatureSource path of a point table (CLI); the QGIS
+                                               adapter hands the job its own object
+field      QgsProcessingParameterField         column / field name (str), "" when none
+========== =================================== ==========================================
+
+Outputs: ``file_out`` (QgsProcessingParameterFileDestination), ``raster_out``
+(…RasterDestination), both a path or None; ``sink`` (…FeatureSink): a layer, QGIS only.
+Results (numbers and strings a job reports) are :class:`Result` entries.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..errors import InputError
+
+INPUT_KINDS = (
+    "file",
+    "crs",
+    "number",
+    "integer",
+    "boolean",
+    "enum",
+    "string",
+    "numbers",
+    "points",
+    "field",
+)
+OUTPUT_KINDS = ("file_out", "raster_out", "sink")
+RESULT_KINDS = ("number", "string")
+_TRUE = ("true", "yes", "1", "on")
+_FALSE = ("false", "no", "0", "off")
+
+
+@dataclass(frozen=True)
+class Param:
+    """One parameter of an algorithm (see the module docstring for the kinds).
+
+    ``unit`` is shown with the label and in the help ("m", "deg", "px", "cloud unit", ...);
+    ``minimum``/``maximum`` bound numbers (both views refuse values outside, naming the
+    parameter); ``options`` are an enum's machine names (what the command line takes; QGIS
+    shows ``labels``); ``aliases`` are extra command-line spellings of options;
+    ``qgis_default`` overrides ``default`` in QGIS only (e.g. ``"ProjectCrs"``).
+    """
+
+    name: str
+    kind: str
+    label: str
+    default: Any = None
+    help: str = ""
+    unit: str = ""
+    optional: bool = False
+    advanced: bool = False
+    minimum: float | None = None
+    maximum: float | None = None
+    options: tuple[str, ...] = ()
+    labels: tuple[str, ...] = ()
+    aliases: Mapping[str, str] = field(default_factory=dict)
+    multiple: bool = False
+    count: int = 0
+    file_filter: str = ""
+    create_by_default: bool = True
+    geometry: str = ""
+    parent: str = ""
+    numeric_field: bool = False
+    qgis_default: Any = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in INPUT_KINDS + OUTPUT_KINDS:
+            raise ValueError(f"{self.name}: unknown kind {self.kind!r}")
+        if not re.fullmatch(r"[A-Z][A-Z0-9_]*", self.name):
+            raise ValueError(f"{self.name}: names are upper case with underscores")
+        if self.kind == "enum" and not self.options:
+            raise ValueError(f"{self.name}: an enum needs options")
+        if self.labels and len(self.labels) != len(self.options):
+            raise ValueError(f"{self.name}: one label per option")
+        if self.kind == "numbers" and self.count < 1:
+            raise ValueError(f"{self.name}: numbers need a count")
+
+    @property
+    def option(self) -> str:
+        """The command-line option: ``CELL_SIZE`` -> ``--cell-size``."""
+        return "--" + self.name.lower().replace("_", "-")
+
+    @property
+    def is_output(self) -> bool:
+        return self.kind in OUTPUT_KINDS
+
+    @property
+    def title(self) -> str:
+        """The label with its unit, as both views show it."""
+        return f"{self.label} ({self.unit})" if self.unit else self.label
+
+    @property
+    def required(self) -> bool:
+        """The user must give it (no default, not optional)."""
+        return not self.optional and self.default is None and self.kind not in ("sink",)
+
+    def default_text(self) -> str:
+        """The default as a user types it ("" when there is none)."""
+        d = self.default
+        if d is None or d == "" or d == ():
+            return ""
+        if self.kind == "enum" and self.multiple:
+            return ",".join(d)
+        if self.kind == "numbers":
+            return ",".join(f"{v:g}" for v in d)
+        if self.kind == "boolean":
+            return "true" if d else "false"
+        if isinstance(d, float):
+            return f"{d:g}"
+        return str(d)
+
+
+@dataclass(frozen=True)
+class Result:
+    """A number or text the algorithm reports (QGIS output ``name``; printed by the CLI)."""
+
+    name: str
+    kind: str
+    label: str
+
+    def __post_init__(self) -> None:
+        if self.kind not in RESULT_KINDS:
+            raise ValueError(f"{self.name}: unknown result kind {self.kind!r}")
+
+
+@dataclass(frozen=True)
+class AlgorithmSpec:
+    """An algorithm: id, names, help and its parameters.
+
+    ``description`` is plain text: paragraphs separated by blank lines, ``## heading`` lines
+    and ``- item`` lists; it becomes the QGIS help (HTML) and the command line's description.
+    ``references`` are citations of docs/references.md ("Zhang et al. (2003)").
+    """
+
+    name: str
+    title: str
+    group: str
+    group_id: str
+    summary: str
+    description: str
+    params: tuple[Param, ...]
+    results: tuple[Result, ...] = ()
+    tags: tuple[str, ...] = ()
+    references: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        names = [p.name for p in self.params] + [r.name for r in self.results]
+        dupes = {n for n in names if names.count(n) > 1}
+        if dupes:
+            raise ValueError(f"{self.name}: duplicate names {sorted(dupes)}")
+        known = {p.name for p in self.params}
+        for p in self.params:
+            if p.kind == "field" and p.parent not in known:
+                raise ValueError(f"{self.name}.{p.name}: unknown parent {p.parent!r}")
+
+    def param(self, name: str) -> Param:
+        for p in self.params:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    @property
+    def inputs(self) -> tuple[Param, ...]:
+        return tuple(p for p in self.params if not p.is_output)
+
+    @property
+    def outputs(self) -> tuple[Param, ...]:
+        return tuple(p for p in self.params if p.is_output)
+
+    def help_html(self) -> str:
+        """The QGIS help: the description, the parameters with defaults, units and ranges,
+        and the references."""
+        parts = [text_to_html(self.description)]
+        rows = []
+        for p in self.params:
+            cells = (p.help or p.label, _default_for_help(p), _range_text(p))
+            rows.append(
+                f"<tr><td><b>{p.name}</b></td>" + "".join(f"<td>{_esc(c)}</td>" for c in cells)
+                + "</tr>"
+            )  # fmt: skip
+        parts.append(
+            "<h3>Parameters</h3><table><tr><th>name</th><th>meaning</th><th>default</th>"
+            "<th>unit, range</th></tr>" + "".join(rows) + "</table>"
+        )
+        if self.references:
+            items = "".join(f"<li>{_esc(r)}</li>" for r in self.references)
+            parts.append(f"<h3>References</h3><ul>{items}</ul>")
+        return "\n".join(parts)
+
+    def help_text(self) -> str:
+        """The command line's description (plain text)."""
+        text = re.sub(r"(?m)^## (.*)$", r"\1:", self.description)
+        if self.references:
+            text += "\n\nReferences: " + "; ".join(self.references) + "."
+        return text
+
+
+def _esc(text: str) -> str:
+    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
+def _default_for_help(p: Param) -> str:
+    if p.is_output:
+        return "optional" if p.optional else ""
+    text = p.default_text()
+    return text if text else ("optional" if p.optional else "required")
+
+
+def _range_text(p: Param) -> str:
+    bits = [p.unit] if p.unit else []
+    if p.kind == "enum":
+        bits.append(" | ".join(p.options))
+    if p.minimum is not None and p.maximum is not None:
+        bits.append(f"{p.minimum:g} to {p.maximum:g}")
+    elif p.minimum is not None:
+        bits.append(f">= {p.minimum:g}")
+    elif p.maximum is not None:
+        bits.append(f"<= {p.maximum:g}")
+    return ", ".join(bits)
+
+
+def text_to_html(text: str) -> str:
+    r"""Plain-text help (paragraphs, ``## heading``, ``- item``) as simple HTML.
+
+    >>> text_to_html("## Units\nIn metres.\n\n- a\n- b")
+    '<h3>Units</h3><p>In metres.</p>\n<ul><li>a</li><li>b</li></ul>'
+    """
+    blocks = []
+    for block in re.split(r"\n\s*\n", text.strip()):
+        out: list[str] = []
+        items: list[str] = []
+        para: list[str] = []
+        for line in block.splitlines():
+            s = line.strip()
+            if items and line.startswith("  ") and not s.startswith("- "):
+                items[-1] += " " + s
+            elif s.startswith("## "):
+                _flush_para(out, para)
+                _flush_items(out, items)
+                out.append(f"<h3>{_esc(s[3:])}</h3>")
+            elif s.startswith("- "):
+                _flush_para(out, para)
+                items.append(s[2:])
+            else:
+                _flush_items(out, items)
+                para.append(s)
+        _flush_para(out, para)
+        _flush_items(out, items)
+        blocks.append("".join(out))
+    return "\n".join(blocks)
+
+
+def _flush_para(out: list[str], para: list[str]) -> None:
+    if para:
+        out.append("<p>" + _esc(" ".join(para)) + "</p>")
+        para.clear()
+
+
+def _flush_items(out: list[str], items: list[str]) -> None:
+    if items:
+        out.append("<ul>" + "".join(f"<li>{_esc(i)}</li>" for i in items) + "</ul>")
+        items.clear()
+
+
+# ----------------------------------------------------------------------------- values
+class Values(dict):
+    """Parameter values by name, also readable as attributes in lower case.
+
+    >>> v = Values({"CELL_SIZE": 1.0})
+    >>> v.cell_size, v["CELL_SIZE"]
+    (1.0, 1.0)
+    """
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            return self[name.upper()]
+        except KeyError:
+            raise AttributeError(name) from None
+
+
+def parse_numbers(text: str | Sequence[float], count: int, name: str) -> tuple[float, ...]:
+    """``"0.1, -2, 3e-1"`` -> (0.1, -2.0, 0.3); exactly ``count`` finite numbers.
+
+    >>> parse_numbers("0.12,-0.05,-1.35", 3, "LEVER_ARM")
+    (0.12, -0.05, -1.35)
+    """
+    if isinstance(text, str):
+        parts = [p for p in re.split(r"[,;\s]+", text.strip()) if p]
+        try:
+            values = tuple(float(p) for p in parts)
+        except ValueError:
+            raise InputError(f"{name}: '{text}' is not a list of numbers") from None
+    else:
+        values = tuple(float(v) for v in text)
+    if len(values) != count:
+        raise InputError(f"{name}: expected {count} numbers, got {len(values)} ('{text}')")
+    if not all(math.isfinite(v) for v in values):
+        raise InputError(f"{name}: every number must be finite ('{text}')")
+    return values
+
+
+def _enum_one(p: Param, raw: Any) -> str:
+    if isinstance(raw, int) and not isinstance(raw, bool):
+        if 0 <= raw < len(p.options):
+            return p.options[raw]
+    text = str(raw).strip()
+    if text.isdigit() and int(text) < len(p.options):
+        return p.options[int(text)]
+    low = text.lower().replace("-", "_").replace(" ", "_")
+    for opt in p.options:
+        if low == opt.lower():
+            return opt
+    for alias, opt in p.aliases.items():
+        if low == alias.lower():
+            return opt
+    raise InputError(f"{p.name}: '{raw}' is not one of {', '.join(p.options)}")
+
+
+def parse_value(p: Param, raw: Any) -> Any:
+    """Turn what the user gave (text on the command line, or a Python value) into the value
+    of the parameter's kind; None (not given) becomes the default. Raises InputError naming
+    the parameter when the value is malformed or out of range."""
+    if raw is None or (isinstance(raw, str) and raw == "" and p.kind not in ("string", "field")):
+        value = p.default
+    elif p.kind == "number":
+        try:
+            value = float(raw)
+        except (TypeError, ValueError):
+            raise InputError(f"{p.name}: '{raw}' is not a number") from None
+    elif p.kind == "integer":
+        try:
+            f = float(raw)
+        except (TypeError, ValueError):
+            raise InputError(f"{p.name}: '{raw}' is not an integer") from None
+        if not f.is_integer():
+            raise InputError(f"{p.name}: '{raw}' is not an integer")
+        value = int(f)
+    elif p.kind == "boolean":
+        if isinstance(raw, bool):
+            value = raw
+        else:
+            t = str(raw).strip().lower()
+            if t not in _TRUE + _FALSE:
+                raise InputError(f"{p.name}: expected true or false, got '{raw}'")
+            value = t in _TRUE
+    elif p.kind == "enum":
+        if p.multiple:
+            items = raw.split(",") if isinstance(raw, str) else list(raw)
+            value = tuple(_enum_one(p, i) for i in items if str(i).strip() != "")
+        else:
+            value = _enum_one(p, raw)
+    elif p.kind == "numbers":
+        value = parse_numbers(raw, p.count, p.name)
+    else:
+        value = str(raw) if not isinstance(raw, str) else raw
+    check_value(p, value)
+    return value
+
+
+def check_value(p: Param, value: Any) -> None:
+    """Raise InputError when ``value`` is outside the parameter's range."""
+    if value is None:
+        if p.required and not p.is_output:
+            raise InputError(f"{p.name} ({p.label}) is required")
+        return
+    if p.kind in ("number", "integer"):
+        if not math.isfinite(value):
+            raise InputError(f"{p.name}: must be a finite number, got {value}")
+        if p.minimum is not None and value < p.minimum:
+            raise InputError(f"{p.name}: must be >= {p.minimum:g}, got {value:g}")
+        if p.maximum is not None and value > p.maximum:
+            raise InputError(f"{p.name}: must be <= {p.maximum:g}, got {value:g}")
+
+
+def parse_values(spec: AlgorithmSpec, raw: Mapping[str, Any]) -> Values:
+    """Every input and output parameter of ``spec`` from ``raw`` (missing -> default).
+
+    Unknown names are refused, so a misspelt parameter never passes silently.
+    """
+    known = {p.name for p in spec.params}
+    unknown = sorted(set(raw) - known)
+    if unknown:
+        raise InputError(f"{spec.name}: unknown parameter(s) {', '.join(unknown)}")
+    out = Values()
+    for p in spec.params:
+        if p.kind == "sink":
+            continue
+        value = raw.get(p.name)
+        if p.is_output:
+            out[p.name] = str(value) if value else None
+        elif p.kind == "points" and value is not None and not isinstance(value, str):
+            out[p.name] = value  # an object the QGIS adapter made from a layer
+        else:
+            out[p.name] = parse_value(p, value)
+    return out
