@@ -29,7 +29,7 @@ from qgis.PyQt.QtCore import QCoreApplication, QObject, QPointF, Qt, pyqtSignal
 from qgis.PyQt.QtGui import QColor, QPainterPath, QPen
 from qgis.PyQt.QtWidgets import QGraphicsPathItem
 
-from ..processing_provider.compat import FIELD_DOUBLE, FIELD_INT, FIELD_STRING
+from ..processing_provider import FIELD_DOUBLE, FIELD_INT, FIELD_STRING
 
 _FIELDS = (
     ("image_id", FIELD_STRING), ("col", FIELD_DOUBLE), ("row", FIELD_DOUBLE),
@@ -116,7 +116,7 @@ class MonoplotTool(QObject):
     # ------------------------------------------------------------------ work
     def monoplot(self, pixels, image_id: str | None = None, line: bool = False):
         """Monoplot pixels (N, 2) of an image (default: the dock's current one)."""
-        from ..core.photo.monoplot import run_monoplot
+        from ..core.photo.monoplot import monoplot
         from ..core.photo.observations import ImageObservations
 
         crs = self.dock.eo_crs()
@@ -129,7 +129,7 @@ class MonoplotTool(QObject):
             [image] * n, [str(k) for k in range(n)], px, 0.5, ["line" if line else "check"] * n,
             ["0"] * n,
         )  # fmt: skip
-        return run_monoplot(
+        return monoplot(
             obs, self.dock.camera, self.dock.eo, self.tracer, crs.authid() or crs.toWkt(),
             sigma_dsm=self.sigma_dsm, line_step_px=self.line_step_px if line else 0.0,
         )  # fmt: skip

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from qgis.core import QgsApplication
+from qgis.core import Qgis, QgsApplication, QgsMessageLog
 from qgis.PyQt.QtCore import QCoreApplication
 from qgis.PyQt.QtGui import QIcon
 from qgis.PyQt.QtWidgets import QAction, QMenu
 
-from .dependency_check import report_missing
+from .dependency_check import LOG_TAG, report_missing
 
 ICON_PATH = Path(__file__).resolve().parents[1] / "icon.svg"
 PROVIDER_ID = "lidarphoto"
@@ -36,13 +36,20 @@ class LidarPhotoPlugin:
 
     # -- Processing ---------------------------------------------------------------------------
     def initProcessing(self) -> None:
-        if self.provider is None:
-            from ..processing_provider.provider import LidarPhotoProvider
-
-            self.provider = LidarPhotoProvider()  # keep the Python reference alive
-            QgsApplication.processingRegistry().addProvider(self.provider)
         if self.missing_modules is None:  # once per load; never raises
             self.missing_modules = report_missing(self.iface)
+        if self.provider is None:
+            try:
+                from ..processing_provider import LidarPhotoProvider
+            except ImportError as exc:  # a core package is missing: the message bar said which
+                QgsMessageLog.logMessage(
+                    self.tr("The algorithms are not loaded: {}").format(exc),
+                    LOG_TAG,
+                    Qgis.MessageLevel.Warning,
+                )
+                return
+            self.provider = LidarPhotoProvider()  # keep the Python reference alive
+            QgsApplication.processingRegistry().addProvider(self.provider)
 
     # -- GUI ----------------------------------------------------------------------------------
     def initGui(self) -> None:

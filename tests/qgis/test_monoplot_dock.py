@@ -13,13 +13,13 @@ import numpy as np
 import pytest
 from lidarphoto.core.geometry.camera import Camera
 from lidarphoto.core.geometry.surface import reproject_dsm
-from lidarphoto.core.io.camera import write_camera_json
-from lidarphoto.core.io.dsm import dsm_from_las, write_dsm
+from lidarphoto.core.io.camera import read_camera_json, write_camera_json
+from lidarphoto.core.io.dsm import dsm_from_las, load_dsm, write_dsm
 from lidarphoto.core.io.observations import read_observations_csv
-from lidarphoto.core.io.orientation import write_eo_csv
+from lidarphoto.core.io.orientation import read_eo_csv, write_eo_csv
 from lidarphoto.core.io.pointcloud import read_points
 from lidarphoto.core.io.raster import write_rgb_tiff
-from lidarphoto.core.photo.monoplot import run_monoplot
+from lidarphoto.core.photo.monoplot import monoplot
 from lidarphoto.core.photo.observations import ImageObservations
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable
 from lidarphoto.core.photo.picking import PickingScene
@@ -70,7 +70,7 @@ def scene(tmp_path_factory):
     # keep the points the image sees (not hidden by a roof or a tree): as the core finds them
     obs = ImageObservations.from_arrays(["img1"] * 60, [f"p{k}" for k in range(60)], pixels,
                                         0.5, ["check"] * 60, ["0"] * 60)  # fmt: skip
-    core = run_monoplot(obs, CAMERA, table, dsm, CRS)
+    core = monoplot(obs, CAMERA, table, dsm, CRS)
     seen = np.flatnonzero(np.linalg.norm(core.points - truth, axis=1) < 1e-3)
     assert seen.size >= 30
     return {"dir": folder, "truth": truth[seen], "pixels": pixels[seen]}
@@ -119,14 +119,15 @@ def test_button_needs_a_dsm_resamples_one_in_another_crs(dock, scene, qgis_app):
     for k in range(10):
         dock.view.pointPicked.emit(*map(float, scene["pixels"][k]))
     got = np.array([_xyz(f) for f in dock.monoplot_tool.points_layer.getFeatures()])
-    # the same as the core's run_monoplot on that file (resampling accuracy: tests/core)
+    # the same as the core's monoplot on that file (resampling accuracy: tests/core)
     n = 10
     ids = [str(k) for k in range(n)]
     obs = ImageObservations.from_arrays(
         ["img1"] * n, ids, scene["pixels"][:n], 0.5, ["check"] * n, ["0"] * n
     )
     folder = scene["dir"]
-    core = run_monoplot(obs, folder / "camera.json", folder / "eo.csv", folder / "dsm_utm.tif", CRS)
+    core = monoplot(obs, read_camera_json(folder / "camera.json"), read_eo_csv(folder / "eo.csv"),
+                    load_dsm(folder / "dsm_utm.tif"), CRS)  # fmt: skip
     np.testing.assert_allclose(got, core.points, atol=1e-6)
     # two resamplings of a 0.5 m city DSM (trees, walls): most points within a few decimetres
     assert np.median(np.linalg.norm(got - scene["truth"][:10], axis=1)) < 0.5

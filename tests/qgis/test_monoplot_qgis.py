@@ -19,7 +19,8 @@ from lidarphoto.core.io.camera import write_camera_json
 from lidarphoto.core.io.dsm import dsm_from_las, write_dsm
 from lidarphoto.core.io.observations import write_observations_csv
 from lidarphoto.core.io.orientation import write_eo_csv
-from lidarphoto.core.photo.monoplot import run_monoplot
+from lidarphoto.core.jobs import monoplot as monoplot_job
+from lidarphoto.core.jobs.runner import run_job
 from lidarphoto.core.photo.observations import ImageObservations
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable, eo_map_to_local
 from qgis.core import QgsProcessingException, QgsVectorLayer, QgsWkbTypes
@@ -95,8 +96,11 @@ def test_processing_run_from_laz(provider, scene, tmp_path):
     # points hidden behind a roof or tree come back on the occluding surface (core tests)
     assert len(err) > 100 and np.mean(err < 1e-3) > 0.85
     # the layer holds exactly what the core computes from the same files
-    core = run_monoplot(folder / "obs.csv", folder / "camera.json", folder / "eo.csv", AHN3,
-                        CRS, dsm_crs=CRS, line_step_px=40.0)  # fmt: skip
+    core = run_job(monoplot_job, {
+        "OBSERVATIONS": str(folder / "obs.csv"), "CAMERA": str(folder / "camera.json"),
+        "EO": str(folder / "eo.csv"), "DSM": str(AHN3), "CRS": CRS, "DSM_CRS": CRS,
+        "LINE_STEP": 40.0,
+    }).data  # fmt: skip
     got = np.array([[f.geometry().constGet().x(), f.geometry().constGet().y(),
                      f.geometry().constGet().z()] for f in points.getFeatures()])  # fmt: skip
     np.testing.assert_allclose(got, core.points, atol=1e-6)
@@ -158,8 +162,10 @@ def test_monoplot_tool_in_the_picking_dock(qgis_parent, qgis_app, qgis_new_proje
     tool = MonoplotTool(dock)
     tool.set_dsm(str(folder / "dsm.tif"))
     pixels = read_observations_csv(folder / "obs.csv").pixels
-    core = run_monoplot(folder / "obs.csv", folder / "camera.json", folder / "eo.csv",
-                        folder / "dsm.tif", CRS)  # fmt: skip
+    core = run_job(monoplot_job, {
+        "OBSERVATIONS": str(folder / "obs.csv"), "CAMERA": str(folder / "camera.json"),
+        "EO": str(folder / "eo.csv"), "DSM": str(folder / "dsm.tif"), "CRS": CRS,
+    }).data  # fmt: skip
     visible = [k for k in range(120) if np.linalg.norm(core.points[k] - truth[k]) < 1e-3][:3]
     tool.start("point")
     for k in visible:
