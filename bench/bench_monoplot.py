@@ -1,4 +1,4 @@
-"""Benchmark: ray / DSM intersection (core.monoplot.intersect_dsm) against a ray-marching
+"""Benchmark: ray / DSM intersection (core.geometry.raycast.intersect_dsm) against a ray-marching
 baseline written with numpy here, on a 10-million-cell DSM made from the real AHN3 Delft crop.
 
 Run (one core, as the figures in bench/monoplot.md)::
@@ -24,13 +24,12 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
+from lidarphoto.core.geometry.grid import Grid
+from lidarphoto.core.geometry.raycast import DsmTracer, intersect_dsm
+from lidarphoto.core.geometry.surface import Dsm
+from lidarphoto.core.io.dsm import dsm_from_las
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from core.dsm import Dsm, dsm_from_las  # noqa: E402
-from core.ground_filter import Grid  # noqa: E402
-from core.monoplot import DsmTracer, intersect_dsm  # noqa: E402
 
 AHN3 = ROOT / "tests" / "data" / "ahn3" / "ahn3_delft_crop60.laz"
 

@@ -1,5 +1,5 @@
-"""Boresight calibration on simulation: recovery per control type, paper 000's configuration
-next to its Table 1, Cramer-Rao bound vs Monte Carlo, and the paper-mode finding.
+"""Boresight calibration on simulation: recovery per control type, the configuration of Pedrosa &
+dos Santos (2020) next to its Table 1, Cramer-Rao bound vs Monte Carlo, and the paper-mode finding.
 
 Run: ``OMP_NUM_THREADS=1 .venv/bin/python bench/boresight_paper.py [draws]``; writes
 bench/boresight.md. (Single-threaded BLAS: the 300-parameter normal matrices are too small for
@@ -43,7 +43,7 @@ def main(draws: int = 100) -> None:
         "mixed tie+line+lcp": ("tie", "line", "lcp"),
     }
     out = [
-        "# Boresight calibration on simulation (paper 000 configuration)",
+        "# Boresight calibration on simulation (configuration of Pedrosa & dos Santos 2020)",
         "",
         "Noise: INS Applanix POS AV 310 (0.02 m horizontal, 0.05 m vertical, 0.015 deg "
         "roll/pitch, 0.035 deg heading, independent per image); 0.5 px image noise; LiDAR "

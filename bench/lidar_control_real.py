@@ -18,9 +18,8 @@ import cv2
 import numpy as np
 from lidarphoto.core.io.planes import read_planes_csv
 from lidarphoto.core.io.pointcloud import read_points
-from lidarphoto.core.lidar.control import run_create_lcps
-from lidarphoto.core.lidar.ground_filter import run_ground_filter
-from lidarphoto.core.lidar.roof_planes import run_extract_roof_planes
+from lidarphoto.core.jobs import create_lcps, extract_roof_planes, ground_filter
+from lidarphoto.core.jobs.runner import run_job
 from scipy.ndimage import grey_dilation
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
@@ -41,14 +40,15 @@ def _reason(text: str) -> str:
 
 def run(name: str, path: Path, crs, unit: str, work: Path):
     t0 = time.perf_counter()
-    run_ground_filter(path, work / "ground.laz", crs=crs)
-    run_extract_roof_planes(
-        work / "ground.laz", units=unit, crs=crs, output_csv=work / "planes.csv",
-        output_cloud=work / "planes.laz",
-    )  # fmt: skip
-    result, info = run_create_lcps(
-        work / "planes.csv", work / "planes.laz", crs=crs, distance_unit=unit
-    )
+    run_job(ground_filter, {"INPUT": str(path), "OUTPUT_CLOUD": work / "ground.laz", "CRS": crs})
+    run_job(extract_roof_planes, {
+        "INPUT": str(work / "ground.laz"), "DISTANCE_UNIT": unit, "CRS": crs,
+        "OUTPUT_CSV": work / "planes.csv", "OUTPUT_CLOUD": work / "planes.laz",
+    })  # fmt: skip
+    result, info = run_job(create_lcps, {
+        "PLANES": str(work / "planes.csv"), "CLOUD": str(work / "planes.laz"), "CRS": crs,
+        "DISTANCE_UNIT": unit,
+    }).data  # fmt: skip
     seconds = time.perf_counter() - t0
     planes = read_planes_csv(work / "planes.csv")
     return result, info, planes, seconds

@@ -12,9 +12,9 @@
 5. Check points intersected from the images with the initial (uncalibrated) and the calibrated
    orientations, against their true positions: ``lidarphoto accuracyreport`` for both.
 6. The recovered boresight against the truth.
-7. The images themselves, rendered by ray casting (``core.render``) from the camera and each
-   image's *true* orientation onto the tile's DSM and roof planes, in flight/images/, and the
-   check that the projected LiDAR lines fall on the rendered roof edges.
+7. The images themselves, rendered by ray casting (``core.simulation.render``) from the camera
+   and each image's *true* orientation onto the tile's DSM and roof planes, in flight/images/, and
+   the check that the projected LiDAR lines fall on the rendered roof edges.
 8. The QGIS project demo_output/lidarphoto_demo.qgz (scripts/make_demo_project.py, run with
    QGIS's Python when one is installed): layers, DSM and the picking dock's session
    (docs/demo_project.md).

@@ -165,8 +165,10 @@ else
   NFAIL=$((NFAIL + 1)) FAILED_SUITES+=("ruff")
 fi
 
-run_pytest core "$ROOT/.venv/bin/python" tests/core
-run_pytest core-numpy1 "$ROOT/.venv-qgis/bin/python" tests/core -p no:pytest_qgis -p no:pytestqt
+# tests/core plus every docstring example of the core (--doctest-modules)
+run_pytest core "$ROOT/.venv/bin/python" tests/core core --doctest-modules
+run_pytest core-numpy1 "$ROOT/.venv-qgis/bin/python" tests/core core --doctest-modules \
+  -p no:pytest_qgis -p no:pytestqt
 run_pytest qgis "$ROOT/.venv-qgis/bin/python" tests/qgis
 
 step "done"

@@ -13,7 +13,7 @@ Conventions (the project's, from DESIGN.md)
   The principal point ``(x0_mm, y0_mm)`` is given in this system.
 - **Camera frame**: x right, y up, z towards the viewer; the camera looks along -z. A
   measured image point ``(x, y)`` corresponds to the ray ``(x - x0 + dx, y - y0 + dy, -f)``
-  where ``d`` is the lens correction of :mod:`core.distortion` evaluated at the measured,
+  where ``d`` is the lens correction of :mod:`core.geometry.distortion` evaluated at the measured,
   centred coordinate. "Ideal" coordinates below are ``(x - x0 + dx, y - y0 + dy)``.
 
 Camera files (JSON) are read and written by :mod:`core.io.camera`, which documents the
@@ -95,7 +95,7 @@ class Camera:
     x0_mm, y0_mm : float
         Principal point in image coordinates (x right, y up, from the image centre), mm.
     distortion : DistortionModel
-        Lens correction (measured -> ideal), :class:`~core.distortion.NoDistortion` by
+        Lens correction (measured -> ideal), :class:`~core.geometry.distortion.NoDistortion` by
         default.
 
     Raises
@@ -103,7 +103,7 @@ class Camera:
     InputError
         Naming the field, for a non-positive or non-finite focal length or pixel size, a
         non-positive or fractional image size, a non-finite principal point or a
-        distortion that is not a :class:`~core.distortion.DistortionModel`.
+        distortion that is not a :class:`~core.geometry.distortion.DistortionModel`.
 
     Examples
     --------
@@ -228,7 +228,7 @@ class Camera:
         measured : (N, 2) ndarray
             ``(x - x0, y - y0)`` in mm; NaN where the inversion failed.
         converged : (N,) ndarray of bool
-            See :meth:`core.distortion.DistortionModel.distort_with_status`.
+            See :meth:`core.geometry.distortion.DistortionModel.distort_with_status`.
         """
         return self.distortion.distort_with_status(
             xy_ideal, tol_mm=tol_px * self.pixel_size_mm, max_iter=max_iter
@@ -259,7 +259,7 @@ class Camera:
 
         Raises
         ------
-        core.distortion.DistortionInversionError
+        core.geometry.distortion.DistortionInversionError
             If the lens inversion fails for any point (use
             :meth:`pixel_from_ideal_with_status` to get NaN rows and a mask instead).
         """

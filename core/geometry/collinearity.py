@@ -5,7 +5,7 @@ Conventions
 - **Exterior orientation** (EO) of an image, always in this order:
   ``(X0, Y0, Z0, omega, phi, kappa)``: the perspective centre in object space (metres, a
   Cartesian frame such as the local ENU adjustment frame) and the omega-phi-kappa angles
-  (radians). ``M = R3(kappa) R2(phi) R1(omega)`` (:func:`core.rotations.opk_to_matrix`)
+  (radians). ``M = R3(kappa) R2(phi) R1(omega)`` (:func:`core.geometry.rotations.opk_to_matrix`)
   rotates object-space vectors into the camera frame.
 - **Camera frame**: x right, y up, z towards the viewer; the camera looks along -z. With
   ``(u, v, w) = M (X - X0, Y - Y0, Z - Z0)`` a point is in front of the camera iff ``w < 0``.
@@ -14,9 +14,9 @@ Conventions
       x_i = -f u / w,   y_i = -f v / w
 
   the measured image coordinates are ``x0 + distort(x_i, y_i)`` (the inverse of the lens
-  correction of :mod:`core.distortion`) and the pixel position is
+  correction of :mod:`core.geometry.distortion`) and the pixel position is
   ``col = x / pixel_size + W/2``, ``row = H/2 - y / pixel_size`` (pixels as in
-  :mod:`core.camera`: origin at the top-left corner of the top-left pixel, rows down).
+  :mod:`core.geometry.camera`: origin at the top-left corner of the top-left pixel, rows down).
 
 Every function is vectorised over N points (rows). ``eo`` is (6,) for one image shared by
 all points, or (N, 6) for one EO per point.
@@ -107,7 +107,7 @@ def project_with_status(
     converged : (N,) ndarray of bool
         True where the lens inversion succeeded; False where it failed or was not attempted
         (points not in front). Whether a pixel falls inside the frame is not checked here:
-        see :meth:`core.camera.Camera.in_frame`.
+        see :meth:`core.geometry.camera.Camera.in_frame`.
     """
     _, _, _, q = _to_camera_frame(points, eo)
     ideal, in_front = _ideal(q, camera.focal_mm)

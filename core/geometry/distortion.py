@@ -9,7 +9,7 @@ coordinate, centred on the principal point, to give the ideal (distortion-free) 
     x_ideal = x_bar + dx(x_bar, y_bar)
     y_ideal = y_bar + dy(x_bar, y_bar)
 
-The image frame has x to the right and y up (see :mod:`core.camera`); every length here is
+The image frame has x to the right and y up (see :mod:`core.geometry.camera`); every length here is
 in millimetres and every model coefficient is defined for millimetre coordinates (so
 Brown-Conrady's ``k1`` is in mm^-2, ``k2`` in mm^-4, ``p1``/``p2`` in mm^-1).
 
@@ -43,7 +43,7 @@ from ..errors import InputError, LidarPhotoError
 Array = NDArray[np.float64]
 
 #: Default stopping tolerance of the Newton inversion, in millimetres: 1e-6 px for a 1 µm
-#: pixel, i.e. finer than 1e-6 px for every real sensor. :class:`core.camera.Camera` passes
+#: pixel, i.e. finer than 1e-6 px for every real sensor. :class:`core.geometry.camera.Camera` passes
 #: its own tolerance of 1e-6 px converted with its pixel size.
 DEFAULT_TOL_MM = 1e-9
 DEFAULT_MAX_ITER = 50

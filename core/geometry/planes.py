@@ -5,12 +5,12 @@ normal ``n = (a, b, c)`` pointing up (``c >= 0``), ``p`` in the cloud's projecte
 in the CRS's unit: metres, or international feet for e.g. Autzen).
 
 Fit: the weighted eigen method of Pathak et al. (2010), computed on centred coordinates. With
-weights ``w_i`` (relative: point i has a residual variance ``sigma0^2 / w_i``) the plane
-minimising ``sum w_i (n . p_i + d)^2`` passes through the weighted centroid ``m`` and its normal
-is the eigenvector of the smallest eigenvalue ``l3`` of the weighted scatter matrix
-``S = sum w_i (p_i - m)(p_i - m)^T`` (eigenpairs ``l1 >= l2 >= l3``, ``v1, v2, v3``). The raw
-moment matrix of ``[x y z 1]`` used in paper 000 (Eq. 5) is never formed: with map coordinates
-of 1e5-1e6 m its smallest eigenvalue drowns in rounding.
+weights ``w_i`` (relative: point i has a residual variance ``sigma0^2 / w_i``) the plane minimising
+``sum w_i (n . p_i + d)^2`` passes through the weighted centroid ``m`` and its normal is the
+eigenvector of the smallest eigenvalue ``l3`` of the weighted scatter matrix ``S = sum w_i (p_i -
+m)(p_i - m)^T`` (eigenpairs ``l1 >= l2 >= l3``, ``v1, v2, v3``). The raw moment matrix of ``[x y z
+1]`` used by Pedrosa & dos Santos (2020, Eq. 5) is never formed: with map coordinates of 1e5-1e6 m
+its smallest eigenvalue drowns in rounding.
 
 Precision (first-order propagation of a noise along the normal, equal to Pathak's closed form
 from the Hessian of the weighted sum of squares; checked by Monte Carlo in
@@ -21,10 +21,10 @@ tests/core/test_planes.py)::
     var(s)   = sigma0^2 / sum w_i                            offset of the plane at m
     d = -n . m  =>  C_nd = -C_nn m,  var(d) = m^T C_nn m + sigma0^2 / sum w_i
 
-``sigma_d = sqrt(var(d))`` is Khoshelham's (2016) standard deviation of d, used by paper 000
-Eq. (17) (printed there as ``sqrt(Cx^2 + Cy^2 + Cz^2) + sigma^2 / n``, a misprint of the same
-propagation with an isotropic normal variance). ``d`` is the distance of the CRS origin to the
-plane, so with map coordinates sigma_d is dominated by the lever ``m`` and is strongly
+``sigma_d = sqrt(var(d))`` is Khoshelham's (2016) standard deviation of d, used by Pedrosa & dos
+Santos (2020) Eq. (17) (printed there as ``sqrt(Cx^2 + Cy^2 + Cz^2) + sigma^2 / n``, a misprint of
+the same propagation with an isotropic normal variance). ``d`` is the distance of the CRS origin to
+the plane, so with map coordinates sigma_d is dominated by the lever ``m`` and is strongly
 correlated with the normal: use the full covariance (the plane table keeps all of it) when
 propagating, e.g. to plane intersections.
 

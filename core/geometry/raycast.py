@@ -1,4 +1,5 @@
-"""Ray casting on a gridded surface: the first intersection of rays with a DSM (paper 001).
+"""Ray casting on a gridded surface: the first intersection of rays with a DSM (dos Santos et al.
+2010).
 
 The surface is the DSM polyhedron of :mod:`core.geometry.surface`. For each ray:
 
@@ -65,7 +66,7 @@ __all__ = [
 
 # --------------------------------------------------------------------------- Eqs. 6-10
 def dal_poz_plane(o: ArrayLike, p: ArrayLike, q: ArrayLike) -> tuple[Array, Array]:
-    """Plane ``A . X + B = 0`` of the faces OPQ (paper 001, Eqs. 5-7), vectorised.
+    """Plane ``A . X + B = 0`` of the faces OPQ (dos Santos et al. 2010, Eqs. 5-7), vectorised.
 
     Parameters
     ----------
@@ -87,7 +88,8 @@ def dal_poz_plane(o: ArrayLike, p: ArrayLike, q: ArrayLike) -> tuple[Array, Arra
 def dal_poz_intersect(
     centre: ArrayLike, direction: ArrayLike, a: ArrayLike, b: ArrayLike
 ) -> tuple[Array, Array]:
-    """Direct monorestitution (paper 001, Eqs. 9-10): ray ``CP + t N`` with ``A . X + B = 0``.
+    """Direct monorestitution (dos Santos et al. 2010, Eqs. 9-10): ray ``CP + t N`` with ``A . X + B
+    = 0``.
 
     Parameters
     ----------

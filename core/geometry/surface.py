@@ -1,13 +1,13 @@
-"""A gridded surface model (DSM or DTM) and its surface, the polyhedron of paper 001.
+"""A gridded surface model (DSM or DTM) and its surface, the polyhedron of dos Santos et al. (2010).
 
 A DSM is a north-up grid of heights given at the cell *centres* (``Grid`` of
 :mod:`core.geometry.grid`: cell (row, col) covers ``x0 + col c .. x0 + (col + 1) c`` and
 ``y_top - (row + 1) c .. y_top - row c``). NaN marks nodata.
 
-The surface is the polyhedron of paper 001 (Dal Poz 1991): the centres of four neighbouring
-cells ``(r, c), (r, c+1), (r+1, c), (r+1, c+1)`` span a *quad*, split along its diagonal from
-``(r, c)`` to ``(r+1, c+1)`` into two triangles. With the quad's local coordinates
-``u = (x - x_c) / cell`` (east) and ``v = (y_r - y) / cell`` (south), in [0, 1]:
+The surface is the polyhedron of dos Santos et al. (2010) after Dal Poz (1991): the centres of four
+neighbouring cells ``(r, c), (r, c+1), (r+1, c), (r+1, c+1)`` span a *quad*, split along its
+diagonal from ``(r, c)`` to ``(r+1, c+1)`` into two triangles. With the quad's local coordinates ``u
+= (x - x_c) / cell`` (east) and ``v = (y_r - y) / cell`` (south), in [0, 1]:
 
 - triangle 0 (``u >= v``): vertices (0, 0), (1, 0), (1, 1), i.e. cells (r, c), (r, c+1),
   (r+1, c+1);
@@ -125,7 +125,7 @@ def reproject_dsm(
     Each target cell centre is mapped back to the source CRS, the source surface (the
     triangulated polyhedron) is sampled there and the point (x, y, height) is transformed
     to the target: vertical datum changes are applied (2D CRSs carry ellipsoidal heights,
-    :func:`core.frames.as_3d`), and a transformation that needs a grid PROJ does not have
+    :func:`core.geometry.frames.as_3d`), and a transformation that needs a grid PROJ does not have
     raises :class:`CrsError` instead of silently dropping it.
 
     Parameters

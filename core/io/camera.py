@@ -20,7 +20,7 @@ given in pixels: ``"focal_px"`` replaces ``"focal_mm"`` and ``"ppx_px"``/``"ppy_
 principal point as a pixel position (col, row) in the convention above (defaults ``W/2``,
 ``H/2``), replace ``"x0_mm"``/``"y0_mm"``; ``"pixel_size_mm"`` is still required, since
 the project works in millimetres. Distortion coefficients are always those of
-:mod:`core.distortion`, defined for millimetre coordinates (not OpenCV's normalised ones).
+:mod:`core.geometry.distortion`, defined for millimetre coordinates (not OpenCV's normalised ones).
 Keys ``"description"`` and any key starting with ``"_"`` are ignored (comments); any other
 unknown key is an error, so that a misspelt key is never silently dropped.
 """

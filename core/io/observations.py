@@ -19,8 +19,8 @@ type
     ``tie``   a roof point measured in two or more images, lying on plane ``target_id``;
     ``line``  a point anywhere on the LiDAR line ``target_id`` (ridge, hip or valley);
     ``lcp``   the LiDAR control point ``target_id`` (three-plane intersection);
-    ``paper`` a point on plane ``target_id`` for the single-image model of paper 000 (its
-              Eqs. 12-17);
+    ``paper`` a point on plane ``target_id`` for the single-image model of Pedrosa & dos
+              Santos (2020) (its Eqs. 12-17);
     ``check`` the LiDAR control point ``target_id`` used only as a check point (not adjusted).
 target_id
     Id of the plane, line or LCP in its table (integers in the project's tables).

@@ -360,7 +360,7 @@ def lidar_control(
     """Adjacency, LCPs and lines from fitted planes and the points that support them.
 
     ``planes`` are objects with ``id``, ``normal`` (3,), ``d``, ``covariance`` (4, 4) (e.g.
-    :class:`lidarphoto.core.planes.Plane`). ``triples``/``pairs``: user-chosen plane ids to
+    :class:`lidarphoto.core.geometry.planes.Plane`). ``triples``/``pairs``: user-chosen plane ids to
     intersect instead of the automatic mutually adjacent ones (still checked for geometry).
     """
     by_id = {int(p.id): p for p in planes}

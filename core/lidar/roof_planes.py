@@ -1,6 +1,7 @@
 """Roof planes from non-ground LiDAR points: local RANSAC, region growing, plane precision.
 
-Method (paper 000, section 2.1, made rigorous; every length in the cloud's CRS unit):
+Method (Pedrosa & dos Santos 2020, section 2.1, made rigorous; every length in the cloud's CRS
+unit):
 
 1. **Local RANSAC** (paper's conditions a and b). For every point, its ``k_neighbours``
    nearest neighbours (scipy cKDTree, the point included) get ``ransac_iterations`` random
@@ -24,7 +25,7 @@ Method (paper 000, section 2.1, made rigorous; every length in the cloud's CRS u
    lies within ``epsilon`` (``REASSIGN_PASSES`` times, refitting in between); adjacent planes
    that are coplanar (normals within ``angle_tolerance_deg``, each centroid within ``epsilon``
    of the other plane) are merged; regions below ``min_plane_points`` are dropped again.
-4. **Fit** of each region by :func:`lidarphoto.core.planes.fit_plane` (Pathak's weighted
+4. **Fit** of each region by :func:`lidarphoto.core.geometry.planes.fit_plane` (Pathak's weighted
    eigen method on centred coordinates, covariance, sigma_d), ids ordered by decreasing point
    count (ties: first point index), and an **outline**: the plane's points rasterised in x, y
    at ``outline_cell`` (default: the median distance to the 4th nearest neighbour, about one
@@ -551,7 +552,7 @@ def extract_roof_planes(
 
     Examples
     --------
-    >>> from lidarphoto.core.simulate_town import simulate_town
+    >>> from lidarphoto.core.simulation.town import simulate_town
     >>> town, pts = simulate_town(n_buildings=2, n_trees=0, density=6.0, seed=2)
     >>> res = extract_roof_planes(pts.xyz[pts.classification != 2])
     >>> len(res.planes), len(town.faces)

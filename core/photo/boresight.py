@@ -3,7 +3,7 @@
 Model
 -----
 Everything runs in a local ENU adjustment frame tangent to the ellipsoid at the block centre
-(:class:`~lidarphoto.core.frames.LocalFrame`). For image i with INS position ``p_i`` and
+(:class:`~lidarphoto.core.geometry.frames.LocalFrame`). For image i with INS position ``p_i`` and
 attitude ``R_b^n(roll, pitch, heading)`` (NED at the image's own position, rotated rigorously
 into the ENU frame by ``R_n^l = LocalFrame.ned_to_local``)::
 
@@ -16,7 +16,7 @@ focal length and principal point, the tie-point coordinates, the LCP coordinates
 image, the INS position and attitude as nuisance parameters with weighted prior observations
 (sigmas of a named INS grade, :data:`INS_GRADES`, or custom).
 
-Control types (any mix, one adjustment; :mod:`core.boresight_models` has the equations):
+Control types (any mix, one adjustment; :mod:`core.photo.boresight_models` has the equations):
 
 1. ``tie``: plane-constrained tie points (primary mode). A roof point measured in >= 2 images:
    collinearity for each measurement (Gauss-Markov) with the point as unknown, and the
@@ -29,20 +29,20 @@ Control types (any mix, one adjustment; :mod:`core.boresight_models` has the equ
    one group. One image suffices.
 3. ``lcp``: LiDAR control points: collinearity, the LCP an unknown point with a prior from its
    3 x 3 covariance.
-4. ``paper``: paper 000's single-image model (its Eqs. 12-17): the ray cut at a height z taken
-   from the LiDAR points of the plane nearest the picked point (located with the *initial*
-   orientation, once), with the plane offset d as the observation and sigma_d from Eq. 17 as
-   printed (``sqrt(Cx^2 + Cy^2 + Cz^2) + sigma^2 / n`` with the centroid in the mapping CRS;
-   its misprint is discussed in :mod:`core.planes`) or, with ``paper_sigma="propagated"``, the
-   plane's propagated standard deviation. The pixel is not an observation there (as in the
-   paper), so this model's sigmas ignore the image noise and its z depends on the initial
-   boresight: see bench/boresight.md for what this does.
+4. ``paper``: the single-image model of Pedrosa & dos Santos (2020) (its Eqs. 12-17): the ray
+   cut at a height z taken from the LiDAR points of the plane nearest the picked point
+   (located with the *initial* orientation, once), with the plane offset d as the observation
+   and sigma_d from Eq. 17 as printed (``sqrt(Cx^2 + Cy^2 + Cz^2) + sigma^2 / n`` with the
+   centroid in the mapping CRS; its misprint is discussed in :mod:`core.io.planes`) or, with
+   ``paper_sigma="propagated"``, the plane's propagated standard deviation. The pixel is not an
+   observation there (as in the paper), so this model's sigmas ignore the image noise and its
+   z depends on the initial boresight: see bench/boresight.md for what this does.
 
 Planes, lines and LCPs are given in the mapping CRS; they are carried into the adjustment
 frame with the local Jacobian of the map -> ENU transformation (scale factor, convergence and
 the tilt of the vertical included), covariances propagated to first order.
 
-The adjustment is :func:`core.adjustment.adjust` (Gauss-Markov/Gauss-Helmert, Levenberg-
+The adjustment is :func:`core.lsq.adjustment.adjust` (Gauss-Markov/Gauss-Helmert, Levenberg-
 Marquardt, Baarda data snooping). When a parameter is not observable, :func:`calibrate`
 raises :class:`BoresightNotObservable` whose ``diagnosis`` says which flight pattern or
 control would fix it.
@@ -122,8 +122,9 @@ class BoresightOptions:
     ins_grade : str or InsGrade
         Key of :data:`INS_GRADES` or a custom grade: sigmas of the INS prior observations.
     ins_as_parameters : bool
-        True: INS positions and attitudes are nuisance parameters with their priors. False:
-        held at the INS values (weighted with 1e-6 times the grade's sigmas), as paper 000.
+        True: INS positions and attitudes are nuisance parameters with their priors. False: held at
+        the INS values (weighted with 1e-6 times the grade's sigmas), as Pedrosa & dos Santos
+        (2020).
     roof_roughness_m : float
         Standard deviation of a roof point about its plane (tiles, sag), metres (> 0).
     use_types : tuple of str
@@ -696,7 +697,7 @@ def calibrate(
             )
         )
 
-    # ---- 4. paper 000's single-image model
+    # ---- 4. the single-image model of Pedrosa & dos Santos (2020)
     paper_rows = rows_all[used & (kinds == "paper")]
     if paper_rows.size:
         blocks.append(

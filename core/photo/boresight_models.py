@@ -1,4 +1,5 @@
-"""Observation models of boresight calibration, with analytic Jacobians (see core/boresight.py).
+"""Observation models of boresight calibration, with analytic Jacobians (see
+core/photo/boresight.py).
 
 Every function is batched over ``G`` measurements (rows) and works in the local ENU adjustment
 frame. Each measurement depends on a *pose vector* ``xp`` of its image (shape (G, P)):

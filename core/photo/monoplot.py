@@ -1,12 +1,13 @@
-"""Monoplotting: 3D points and lines from one oriented image and a LiDAR DSM (paper 001).
+"""Monoplotting: 3D points and lines from one oriented image and a LiDAR DSM (dos Santos et al.
+2010).
 
-The collinearity ray of an image point, ``G = CP + t N`` with ``N = M^T (x - x0, y - y0, -f)``
-(paper 001, Eqs. 1-4), is intersected with the DSM polyhedron: directly, with the traversal
-and Dal Poz's Eq. 9 of :mod:`core.geometry.raycast`, or by Makarovic's iterative method
-(height -> planimetric position -> DSM height ..., until the height changes less than a
-tolerance); rows on LiDAR roof planes are intersected with their plane (Eqs. 7-10 with the
-fitted plane). The image-point sigma, the exterior-orientation covariance and the DSM (or
-plane) uncertainty are propagated into a 3 x 3 covariance per point.
+The collinearity ray of an image point, ``G = CP + t N`` with ``N = M^T (x - x0, y - y0, -f)`` (dos
+Santos et al. 2010, Eqs. 1-4), is intersected with the DSM polyhedron: directly, with the traversal
+and Dal Poz's Eq. 9 of :mod:`core.geometry.raycast`, or by Makarovic's iterative method (height ->
+planimetric position -> DSM height ..., until the height changes less than a tolerance); rows on
+LiDAR roof planes are intersected with their plane (Eqs. 7-10 with the fitted plane). The
+image-point sigma, the exterior-orientation covariance and the DSM (or plane) uncertainty are
+propagated into a 3 x 3 covariance per point.
 
 Each ray gets a status code (:data:`STATUS_TEXT`): a ray that leaves the DSM, crosses a
 nodata hole before hitting the surface, or belongs to an image without orientation is

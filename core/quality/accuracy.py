@@ -577,7 +577,7 @@ class AccuracySettings:
     """Everything the report depends on besides the points. Lengths in metres.
 
     ``declared_sigma_h`` / ``survey_sigma_h`` are per horizontal axis (E and N);
-    ``flight_geometry`` is (H m, B m, f mm, sigma_pix um) for Eq. 18 of paper 000.
+    ``flight_geometry`` is (H m, B m, f mm, sigma_pix um) for Eq. 18 of Pedrosa & dos Santos (2020).
     """
 
     alpha: float = 0.05
@@ -631,7 +631,7 @@ class AccuracyReport:
     ``discrepancies`` (N, 3); ``used`` (N,) the points in the statistics (all unless
     outliers are excluded); ``overall`` and ``groups`` the statistics; ``standards`` the
     verdicts on the used points of all groups; ``group_thresholds`` the project threshold per
-    group (as paper 000 judges each flight direction).
+    group (as Pedrosa & dos Santos (2020) judge each flight direction).
     """
 
     points: CheckPoints

@@ -86,7 +86,7 @@ def render_boresight_html(
     settings : mapping of str to str
         Shown as given.
     diagnosis : sequence of str, optional
-        Sentences of :class:`core.boresight.BoresightNotObservable`; shown instead of results.
+        Sentences of :class:`core.photo.boresight.BoresightNotObservable`; shown instead of results.
 
     Examples
     --------

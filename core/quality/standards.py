@@ -671,7 +671,8 @@ def pec_pcd(
 def stereo_height_precision(
     flight_height_m: float, base_m: float, focal_mm: float, pixel_um: float
 ) -> float:
-    """Height precision of a stereo pair, Eq. 18 of paper 000: sqrt(2) H^2 / (B f) sigma_pix.
+    """Height precision of a stereo pair, Eq. 18 of Pedrosa & dos Santos (2020): sqrt(2) H^2 / (B f)
+    sigma_pix.
 
     Parameters
     ----------
@@ -762,7 +763,7 @@ def project_threshold(
     )
     return StandardResult(
         key="project",
-        title="Project threshold (paper 000, section 3)",
+        title="Project threshold (Pedrosa & dos Santos 2020, section 3)",
         reference="Pedrosa & dos Santos (2020), section 3, Eq. 18 and Tables 2-5",
         n_points=n,
         verdicts=verdicts,

@@ -1,12 +1,12 @@
 """Flight simulator: complete boresight-calibration inputs over a synthetic town, with the truth.
 
-A town (:func:`core.simulate_town.make_town`) is flown in straight lines (optionally in
+A town (:func:`core.simulation.town.make_town`) is flown in straight lines (optionally in
 opposite directions) with a frame camera; the true camera poses come from the rigorous ECEF
-direct georeferencing of :func:`core.trajectory_to_eo.georeference_ecef` (independent of the
+direct georeferencing of :func:`core.photo.georeference.georeference_ecef` (independent of the
 calibration's own chain) with a true boresight per group and a true lever arm. The simulator
 returns what the calibration reads, in the mapping CRS:
 
-- the INS trajectory with noise of a named grade (:data:`core.boresight.INS_GRADES`);
+- the INS trajectory with noise of a named grade (:data:`core.photo.ins.INS_GRADES`);
 - the camera, the mount with the *initial* boresight;
 - roof planes fitted (``fit_plane``) to LiDAR points sampled on the true faces with noise
   (or the true planes with the covariance of such a fit: ``plane_source="exact"``);
@@ -68,7 +68,8 @@ Array = NDArray[np.float64]
 
 
 def ultracam_xp() -> Camera:
-    """UltraCam XP panchromatic frame as in paper 000: f = 100.4 mm, 6 um, 17310 x 11310 px.
+    """UltraCam XP panchromatic frame as in Pedrosa & dos Santos (2020): f = 100.4 mm, 6 um, 17310 x
+    11310 px.
 
     11310 px is the side along track with the ``image_top_forward`` mount (the image height).
     """
@@ -95,7 +96,7 @@ class FlightConfig:
     heading_deg : float
         Grid azimuth of the first line; with ``opposite`` every other line is flown back.
     mount : str
-        Nominal mount preset (``core.rotations.MOUNT_PRESETS``).
+        Nominal mount preset (``core.photo.mount.MOUNT_PRESETS``).
     true_boresight_deg : tuple of (float, float, float)
         One row for all lines, or one per line (d_omega, d_phi, d_kappa), degrees.
     initial_boresight_deg : (float, float, float)
@@ -197,7 +198,7 @@ class FlightTruth:
 
 @dataclass(frozen=True)
 class FlightSimulation:
-    """Inputs of :func:`core.boresight.calibrate` plus the truth (mapping CRS throughout)."""
+    """Inputs of :func:`core.photo.boresight.calibrate` plus the truth (mapping CRS throughout)."""
 
     config: FlightConfig
     crs: str

@@ -1,20 +1,21 @@
 """Synthetic aerial images: ray casting through a frame camera onto a LiDAR DSM and roof planes.
 
 Each image is rendered from its camera (lens model included) and its exterior orientation in
-the mapping CRS, with the ray construction of :func:`core.monoplot.run_monoplot`: rays are
+the mapping CRS, with the ray construction of :func:`core.photo.monoplot.monoplot`: rays are
 built in a local ENU frame tangent at the DSM's centre and intersected with the surface along
-their chord in the mapping frame (:func:`core.monoplot.chord_rays`), so that a pixel shows the
-object point that the project's collinearity chain projects onto it.
+their chord in the mapping frame (:func:`core.geometry.raycast.chord_rays`), so that a pixel shows
+the object point that the project's collinearity chain projects onto it.
 
 Surfaces, from coarse to fine:
 
-1. **DSM** (:class:`core.dsm.Dsm`, traced by :func:`core.monoplot.intersect_dsm`): one ray per
-   ``step_px`` x ``step_px`` block of pixels (the block centre). Each hit is shaded with
-   Lambert's law on the DSM face normal and an albedo by LAS class (the class of the highest
-   point of the DSM cell: ground grey-green, vegetation green, building grey, water blue).
-   Rays that leave the DSM show a dark "sky".
-2. **Roof planes** (:class:`core.planes.Plane`): each plane owns a region in x, y (a raster of
-   ``region_cell``: every cell takes the plane of its nearest LiDAR point, when that point
+1. **DSM** (:class:`core.geometry.surface.Dsm`, traced by
+   :func:`core.geometry.raycast.intersect_dsm`): one ray per ``step_px`` x ``step_px`` block
+   of pixels (the block centre). Each hit is shaded with Lambert's law on the DSM face normal
+   and an albedo by LAS class (the class of the highest point of the DSM cell: ground
+   grey-green, vegetation green, building grey, water blue). Rays that leave the DSM show a
+   dark "sky".
+2. **Roof planes** (:class:`core.geometry.planes.Plane`): each plane owns a region in x, y (a
+   raster of ``region_cell``: every cell takes the plane of its nearest LiDAR point, when that point
    belongs to a plane; so the eaves lie halfway between the last roof point and the first
    point off the roof). Where the DSM hit falls in a plane's region, the ray is intersected
    with the plane itself and the plane's tint is shaded with its exact normal.
@@ -26,7 +27,7 @@ Surfaces, from coarse to fine:
    each face below the other's extension on its side of the line, the sides read from the
    regions beside the line), above it for a concave one (valley). The nearest kept hit wins.
    Rendered ridges and valleys are therefore the projections of the planes' intersection
-   lines, i.e. of the LiDAR lines (:mod:`core.lidar_control`), to a fraction of a pixel; the
+   lines, i.e. of the LiDAR lines (:mod:`core.lidar.control`), to a fraction of a pixel; the
    eaves follow the plane regions (raster ``region_cell``).
 
 A DSM hit more than ``occlusion_tol_m`` in front of a plane's hit, on a point that belongs to
@@ -195,7 +196,7 @@ def lambert(normals: ArrayLike, sun: ArrayLike, ambient: float) -> Array:
 
     Examples
     --------
-    >>> lambert([[0.0, 0.0, 1.0]], [0.0, 0.6, 0.8], 0.25).tolist()
+    >>> lambert([[0.0, 0.0, 1.0]], [0.0, 0.6, 0.8], 0.25).round(12).tolist()
     [0.85]
     """
     n = np.atleast_2d(np.asarray(normals, dtype=np.float64))
@@ -358,7 +359,7 @@ class RenderScene:
         Parameters
         ----------
         dsm : Dsm
-            The surface (e.g. :func:`core.dsm.dsm_from_las` of the cloud).
+            The surface (e.g. :func:`core.io.dsm.dsm_from_las` of the cloud).
         points : (M, 3) array_like
             The LiDAR points (mapping CRS) that label the surface.
         classification : (M,) array_like
@@ -368,7 +369,7 @@ class RenderScene:
         planes : sequence of Plane
             The roof planes those ids refer to.
         lines : sequence of ControlLine
-            LiDAR lines (:mod:`core.lidar_control`): the plane pairs whose shared edge is
+            LiDAR lines (:mod:`core.lidar.control`): the plane pairs whose shared edge is
             rendered exactly.
         crs : optional
             Mapping CRS (default: the DSM's).
@@ -499,7 +500,7 @@ class _Rays:
         zmin = scene.tracer.zmin
         xc = dsm.grid.x0 + dsm.grid.cols * dsm.cell / 2
         yc = dsm.grid.y_top - dsm.grid.rows * dsm.cell / 2
-        # the frame and the far point of the chord as in core.monoplot.run_monoplot
+        # the frame and the far point of the chord as in core.photo.monoplot.monoplot
         local = LocalFrame.at_map_point(mapping, [xc, yc, zmin])
         c_loc, m_loc = eo_map_to_local(xyz[None], opk[None], local)
         nx = math.ceil(camera.width_px / spacing) + 1

@@ -1,4 +1,5 @@
-"""core.accuracy: statistics against independent computations, tests, outliers, inputs, job."""
+"""core.quality.accuracy: statistics against independent computations, tests, outliers,
+inputs, job."""
 
 from __future__ import annotations
 
@@ -156,7 +157,8 @@ def test_student_t_against_scipy_and_the_paper_critical_value():
     t_hand = x.mean() / (x.std(ddof=1) / math.sqrt(15))
     assert b.t == pytest.approx(t_hand) and b.t == pytest.approx(ref.statistic)
     assert b.p_value == pytest.approx(ref.pvalue)
-    assert b.critical == pytest.approx(2.145, abs=5e-4)  # paper 000 Table 4, 14 dof
+    # Pedrosa & dos Santos (2020), Table 4: 14 dof
+    assert b.critical == pytest.approx(2.145, abs=5e-4)
     assert b.biased == (abs(t_hand) > b.critical)
 
 

@@ -1,4 +1,5 @@
-"""Tests of core.camera and core.distortion: pixels <-> mm, lens models, camera files.
+"""Tests of core.geometry.camera and core.geometry.distortion: pixels <-> mm, lens models, camera
+files.
 
 Tolerances are derived in the comments next to them. The reference camera is a 100 mm
 camera with a 104 x 68 mm frame (26000 x 17000 px of 4 µm), with strong Brown-Conrady

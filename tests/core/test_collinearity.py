@@ -1,4 +1,5 @@
-"""Tests of core.collinearity: projection, back-projection, analytic Jacobians, OpenCV peer.
+"""Tests of core.geometry.collinearity: projection, back-projection, analytic Jacobians, OpenCV
+peer.
 
 The scene: a 100 mm camera (26000 x 17000 px of 4 µm) about 1000 m above points spread
 over +-300 m, tilted by a few degrees, with strong Brown-Conrady coefficients.

@@ -1,5 +1,5 @@
-"""The compiled ray traversal (core/dda_compiled.py, numba) against the vectorised numpy one:
-the same hits, statuses, faces, weights, gradients and incidence angles ray by ray, on the
+"""The compiled ray traversal (core/geometry/raycast_numba.py, numba) against the vectorised numpy
+one: the same hits, statuses, faces, weights, gradients and incidence angles ray by ray, on the
 real AHN3 DSM, on a hilly synthetic DSM, through nodata holes and on degenerate rays.
 
 The numpy traversal itself is checked against brute force and truth in test_monoplot.py."""

@@ -1,4 +1,4 @@
-"""core.picking: point-in-outline, hit tests and tie-point prediction against a simulated
+"""core.photo.picking: point-in-outline, hit tests and tie-point prediction against a simulated
 flight (the simulation's own projection chain, through ECEF, is the independent truth)."""
 
 from __future__ import annotations

@@ -1,9 +1,10 @@
-"""Rendering of synthetic aerial images (core.render) against the project's collinearity chain.
+"""Rendering of synthetic aerial images (core.simulation.render) against the project's
+collinearity chain.
 
-The truth of every geometric check is core.picking.PickingScene (EO in the mapping CRS -> a
-local frame at the mean perspective centre -> core.collinearity.project with the lens model),
-independent of the renderer's rays (local frame at the DSM centre, chords in the mapping CRS,
-DDA traversal, ray-plane intersections).
+The truth of every geometric check is core.photo.picking.PickingScene (EO in the mapping CRS ->
+a local frame at the mean perspective centre -> core.geometry.collinearity.project with the lens
+model), independent of the renderer's rays (local frame at the DSM centre, chords in the mapping
+CRS, DDA traversal, ray-plane intersections).
 """
 
 from __future__ import annotations
@@ -229,7 +230,7 @@ def test_ray_directions_interpolated_within_a_microradian(hip):
     rng = np.random.default_rng(1)
     pix = rng.uniform([0, 0], [cam.width_px, cam.height_px], (400, 2))
     got = rays.at(pix[:, 0], pix[:, 1])
-    # exact: the chord of each pixel's own ENU ray, as core.monoplot builds it
+    # exact: the chord of each pixel's own ENU ray, as core.photo.monoplot builds it
     dsm = scene.dsm
     xc = dsm.grid.x0 + dsm.grid.cols * dsm.cell / 2
     yc = dsm.grid.y_top - dsm.grid.rows * dsm.cell / 2

@@ -1,4 +1,5 @@
-"""core.report_html and core.svg_plots: the page parses, holds the tables, verdicts and plots."""
+"""core.quality.accuracy_html and core.quality.svg_plots: the page parses, holds the tables,
+verdicts and plots."""
 
 from __future__ import annotations
 

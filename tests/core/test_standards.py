@@ -1,4 +1,5 @@
-"""core.standards: factors from their definitions, class limits at the boundaries, counts."""
+"""core.quality.standards: factors from their definitions, class limits at the boundaries,
+counts."""
 
 from __future__ import annotations
 
@@ -34,7 +35,7 @@ def _horizontal(r: np.ndarray) -> np.ndarray:
     return np.column_stack([0.6 * r, 0.8 * r, np.zeros_like(r)])
 
 
-# ----------------------------------------------------------------------------- paper 000
+# ----------------------------------------------------- Pedrosa & dos Santos (2020)
 
 
 def test_eq18_gives_the_paper_threshold():

@@ -1,5 +1,6 @@
 """lidarphoto:accuracyreport in real QGIS: processing.run (CSV, memory and GeoPackage layers),
-mixed CRSs, qgis_process, and the HTML report of 15 simulated check points as in paper 000.
+mixed CRSs, qgis_process, and the HTML report of 15 simulated check points as in Pedrosa & dos
+Santos (2020).
 
 The statistics themselves are tested in tests/core; here the wiring, with expectations from
 the simulation's known bias and sigma or from numpy on the same numbers.
@@ -30,8 +31,8 @@ from qgis_helpers import CRS, QGIS_PROCESS
 
 ALG = "lidarphoto:accuracyreport"
 HEADER = "id,e,n,h,e_ref,n_ref,h_ref,group\n"
-# Simulation in the spirit of paper 000 (section 3): 15 check points, 8 flown north-east and
-# 7 south-west, a known bias and sigma per component (m).
+# Simulation in the spirit of Pedrosa & dos Santos (2020) (section 3): 15 check points, 8 flown
+# north-east and 7 south-west, a known bias and sigma per component (m).
 BIAS = np.array([0.05, -0.04, 0.08])
 SIGMA = np.array([0.20, 0.20, 0.25])
 

@@ -1,0 +1,177 @@
+"""The layers of docs/architecture.md, read from the code's own imports (every import, also those
+inside functions): what may import what, no import cycle, no file I/O in the science."""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+PKG = "lidarphoto"
+
+#: core subpackages by layer: a module may import its own layer and the layers below.
+CORE_LAYERS = {
+    "errors": 0,
+    "dependencies": 0,
+    "": 0,  # core/__init__.py (the version)
+    "geometry": 1,
+    "lsq": 1,
+    "lidar": 2,
+    "photo": 3,
+    "quality": 4,
+    "io": 5,
+    "simulation": 6,
+    "jobs": 7,
+    "cli": 8,
+}
+SCIENCE = ("geometry", "lsq", "lidar", "photo", "quality")
+#: what reading or writing files looks like in Python (the science must not do it)
+FILE_IO = re.compile(
+    r"\bopen\(|\.read_text\(|\.write_text\(|\.read_bytes\(|\.write_bytes\(|\blaspy\b|"
+    r"os\.replace\(|\btempfile\b|cv2\.imwrite|cv2\.imread|json\.load|json\.dump\("
+)
+
+
+def _module_name(path: Path) -> str:
+    parts = [PKG, *path.relative_to(ROOT).with_suffix("").parts]
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for folder in ("core", "processing_provider", "plugin"):
+        for path in (ROOT / folder).rglob("*.py"):
+            out[_module_name(path)] = path
+    out[PKG] = ROOT / "__init__.py"
+    out[f"{PKG}.__main__"] = ROOT / "__main__.py"
+    return out
+
+
+MODULES = _modules()
+
+
+def _imports(name: str, path: Path | None = None) -> set[str]:
+    """Every lidarphoto module (or package) ``name`` imports, resolved to absolute names."""
+    path = MODULES[name] if path is None else path
+    is_pkg = path.name == "__init__.py"
+    base = name.split(".") if is_pkg else name.split(".")[:-1]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                parent = base[: len(base) - node.level + 1]
+                target = ".".join(parent + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            if not target.startswith(PKG):
+                continue
+            for alias in node.names:  # "from pkg import module" imports the module
+                sub = f"{target}.{alias.name}"
+                found.add(sub if sub in MODULES else target)
+        elif isinstance(node, ast.Import):
+            found.update(a.name for a in node.names if a.name.startswith(PKG))
+    return found
+
+
+GRAPH = {name: _imports(name) for name in MODULES}
+
+
+def _layer(name: str) -> tuple[str, int] | None:
+    """(core subpackage or module, layer) of a core module, None outside core."""
+    parts = name.split(".")
+    if parts[:2] != [PKG, "core"]:
+        return None
+    key = parts[2] if len(parts) > 2 else ""
+    return key, CORE_LAYERS[key]
+
+
+def test_every_core_module_has_a_layer():
+    for name in MODULES:
+        if name.startswith(f"{PKG}.core"):
+            assert _layer(name) is not None, name
+
+
+def _layer_violations(name: str, targets: set[str]) -> list[str]:
+    key, rank = _layer(name)
+    out = []
+    for target in sorted(targets):
+        if not target.startswith(f"{PKG}.core"):
+            out.append(f"{name} imports {target} (outside core)")
+            continue
+        tkey, trank = _layer(target)
+        if trank > rank or (key in SCIENCE and tkey in ("io", "simulation", "jobs", "cli")):
+            out.append(f"{name} ({key}, layer {rank}) imports {target} ({tkey}, layer {trank})")
+    return out
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES if n.startswith(f"{PKG}.core")))
+def test_core_imports_only_its_layer_and_below(name):
+    assert _layer_violations(name, GRAPH[name]) == []
+
+
+def test_no_import_cycle():
+    """Depth-first search over all imports (also those inside functions)."""
+    state: dict[str, int] = {}
+    stack: list[str] = []
+
+    def visit(node: str) -> None:
+        state[node] = 1
+        stack.append(node)
+        for nxt in sorted(GRAPH.get(node, ())):
+            if nxt not in GRAPH:
+                continue
+            if state.get(nxt) == 1:
+                cycle = stack[stack.index(nxt) :] + [nxt]
+                raise AssertionError("import cycle: " + " -> ".join(cycle))
+            if nxt not in state:
+                visit(nxt)
+        stack.pop()
+        state[node] = 2
+
+    for name in sorted(GRAPH):
+        if name not in state:
+            visit(name)
+
+
+def test_qgis_side_imports_one_way():
+    for name, targets in GRAPH.items():
+        if name.startswith(f"{PKG}.processing_provider"):
+            assert not [t for t in targets if t.startswith(f"{PKG}.plugin")], name
+        if name.startswith(f"{PKG}.plugin"):
+            provider = [t for t in targets if t.startswith(f"{PKG}.processing_provider")]
+            assert set(provider) <= {f"{PKG}.processing_provider"}, (name, provider)
+
+
+def test_shipped_code_never_needs_the_simulators():
+    sim = f"{PKG}.core.simulation"
+    for name, targets in GRAPH.items():
+        if not name.startswith(sim):
+            assert not [t for t in targets if t.startswith(sim)], name
+
+
+def test_core_is_qt_and_qgis_free():
+    for name, path in MODULES.items():
+        if name.startswith(f"{PKG}.core"):
+            text = path.read_text(encoding="utf-8")
+            assert not re.search(r"^\s*(from|import) (qgis|PyQt\d)\b", text, re.M), name
+
+
+@pytest.mark.parametrize("package", SCIENCE)
+def test_science_does_no_file_io(package):
+    for path in sorted((ROOT / "core" / package).rglob("*.py")):
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            code = line.split("#")[0]
+            assert not FILE_IO.search(code), f"{path.relative_to(ROOT)}:{number}: {line.strip()}"
+
+
+def test_the_checker_sees_a_wrong_way_import(tmp_path):
+    """A planted science -> I/O import (inside a function) is found and refused."""
+    bad = tmp_path / "bad.py"
+    bad.write_text("def f():\n    from ..io.tables import read_table\n", encoding="utf-8")
+    name = f"{PKG}.core.geometry.bad"
+    targets = _imports(name, bad)
+    assert targets == {f"{PKG}.core.io.tables"}
+    assert _layer_violations(name, targets)
