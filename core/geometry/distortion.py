@@ -432,11 +432,7 @@ class NoDistortion(DistortionModel):
         return np.zeros((as_points(xy, 2, "xy").shape[0], 2, 0))
 
     def distort_with_status(
-        self,
-        xy: ArrayLike,
-        *,
-        tol_mm: float = DEFAULT_TOL_MM,
-        max_iter: int = DEFAULT_MAX_ITER,
+        self, xy: ArrayLike, *, tol_mm: float = DEFAULT_TOL_MM, max_iter: int = DEFAULT_MAX_ITER
     ) -> Tuple[Array, NDArray[np.bool_]]:
         """Identity (copy of ``xy``), all points converged."""
         m = as_points(xy, 2, "xy").copy()

@@ -34,7 +34,7 @@ The plane table (CSV) is :mod:`core.io.planes`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -107,35 +107,11 @@ class Plane:
 
     def with_id(self, new_id: int) -> Plane:
         """The same plane with another id."""
-        return Plane(
-            int(new_id),
-            self.normal,
-            self.d,
-            self.centroid,
-            self.n_points,
-            self.rms,
-            self.sigma_d,
-            self.covariance,
-            self.slope_deg,
-            self.aspect_deg,
-            self.outline,
-        )
+        return replace(self, id=int(new_id))
 
     def with_outline(self, outline: ArrayLike) -> Plane:
         """The same plane with an outline polygon (M, 3)."""
-        return Plane(
-            self.id,
-            self.normal,
-            self.d,
-            self.centroid,
-            self.n_points,
-            self.rms,
-            self.sigma_d,
-            self.covariance,
-            self.slope_deg,
-            self.aspect_deg,
-            np.asarray(outline, dtype=np.float64).reshape(-1, 3),
-        )
+        return replace(self, outline=np.asarray(outline, dtype=np.float64).reshape(-1, 3))
 
 
 def orient_up(normal: Array) -> Array:

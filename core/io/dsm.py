@@ -11,7 +11,7 @@ from typing import Union
 import numpy as np
 import pyproj
 
-from ..errors import CrsError, InputError, stop_if_asked
+from ..errors import InputError, stop_if_asked
 from ..geometry.grid import Grid
 from ..geometry.surface import Dsm
 from ..lidar.dsm import NOISE_CLASSES, dsm_from_points
@@ -71,12 +71,7 @@ def dsm_from_las(
         require_crs=False,
     )
     stop_if_asked(should_stop, "building the DSM")
-    if distance_unit not in ("crs", "metre"):
-        raise InputError(f"distance unit must be 'crs' or 'metre', got {distance_unit!r}")
-    if distance_unit == "metre":
-        if not np.isfinite(info.unit_to_metre):
-            raise CrsError("the cloud has no CRS: give the cell size in its own unit", path=path)
-        cell = cell / info.unit_to_metre
+    cell = cell * info.length_factors(distance_unit)[0]
     keep = ~np.isin(arrays["classification"], NOISE_CLASSES)
     heights, grid = dsm_from_points(
         arrays["x"][keep], arrays["y"][keep], arrays["z"][keep], cell, fill=True

@@ -96,6 +96,25 @@ class CloudInfo:
     dimensions: tuple[str, ...]
     has_return_numbers: bool
 
+    def length_factors(self, distance_unit: str) -> tuple[float, float]:
+        """Factors that turn horizontal and vertical lengths given in ``distance_unit``
+        (``"crs"``: the cloud's own units; ``"metre"``) into the cloud's units.
+
+        The one place where metres become CRS units (every LiDAR algorithm uses it).
+        """
+        if distance_unit == "crs":
+            return 1.0, 1.0
+        if distance_unit != "metre":
+            raise InputError(f"DISTANCE_UNIT must be 'crs' or 'metre', got {distance_unit!r}")
+        h, v = self.unit_to_metre, self.vertical_unit_to_metre
+        if not (h > 0 and v > 0):
+            raise CrsError(
+                "lengths in metres need a cloud CRS with known units: give the CRS, or the "
+                "lengths in the cloud's own unit",
+                path=self.path,
+            )
+        return 1.0 / h, 1.0 / v
+
 
 def parse_crs(crs: CrsLike) -> pyproj.CRS | None:
     """A user's CRS (``"EPSG:7415"``, ``7415``, WKT, PROJ string or pyproj.CRS) as pyproj.CRS.

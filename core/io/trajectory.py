@@ -21,7 +21,14 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..photo.georeference import Trajectory
-from .tables import find_column, float_column, read_table, text_column, unique_ids
+from .tables import (
+    find_column,
+    float_column,
+    read_table,
+    text_column,
+    unique_ids,
+    write_csv_atomic,
+)
 
 Array = NDArray[np.float64]
 
@@ -72,3 +79,25 @@ def _check_range(table, column: int, values: Array, limit: float) -> None:
             row=table.line_numbers[bad[0]],
             column=table.columns[column],
         )
+
+
+TRAJECTORY_COLUMNS = (
+    "image_id", "time", "group", "easting", "northing", "height", "roll", "pitch", "heading",
+)
+
+
+def write_trajectory_csv(path: Union[str, Path], trajectory: Trajectory) -> None:
+    """Write a projected trajectory (easting, northing, height; angles in degrees), atomically;
+    numbers with full round-trip precision."""
+    if trajectory.geodetic:
+        raise InputError("only a trajectory in map coordinates can be written")
+    deg = np.degrees(trajectory.rph)
+    t = trajectory
+    write_csv_atomic(
+        path,
+        TRAJECTORY_COLUMNS,
+        [
+            (i, repr(float(tt)), g, *(repr(float(v)) for v in p), *(repr(float(v)) for v in a))
+            for i, tt, g, p, a in zip(t.image_id, t.time, t.group, t.position, deg)
+        ],
+    )

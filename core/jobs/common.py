@@ -66,22 +66,14 @@ def lengths_in_cloud_units(
     horizontal: Iterable[str] = (),
     vertical: Iterable[str] = (),
 ) -> Any:
-    """``params`` (a dataclass) with its length fields expressed in the cloud's units.
-
-    The one place where metres become CRS units: with ``distance_unit`` ``"metre"`` the
-    ``horizontal`` fields are divided by the size of the cloud's horizontal unit and the
-    ``vertical`` ones by its vertical unit (``info`` is a CloudInfo); with ``"crs"`` the
-    parameters are returned unchanged.
-    """
-    from ..errors import CrsError
-
-    if distance_unit == "crs":
+    """``params`` (a dataclass) with its ``horizontal`` and ``vertical`` length fields turned
+    from ``distance_unit`` into the cloud's units (``info``: a CloudInfo, whose
+    :meth:`~lidarphoto.core.io.pointcloud.CloudInfo.length_factors` holds the rule)."""
+    h, v = info.length_factors(distance_unit)
+    if (h, v) == (1.0, 1.0):
         return params
-    h, v = info.unit_to_metre, info.vertical_unit_to_metre
-    if not (h > 0 and v > 0):
-        raise CrsError("DISTANCE_UNIT metres needs a cloud CRS with known units", path=info.path)
-    changes = {name: getattr(params, name) / h for name in horizontal}
-    changes.update({name: getattr(params, name) / v for name in vertical})
+    changes = {name: getattr(params, name) * h for name in horizontal}
+    changes.update({name: getattr(params, name) * v for name in vertical})
     return replace(params, **changes)
 
 

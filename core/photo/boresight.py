@@ -702,21 +702,8 @@ def calibrate(
     if paper_rows.size:
         blocks.append(
             _paper_block(
-                paper_rows,
-                observations,
-                img,
-                pose_idx,
-                r_nl,
-                spec,
-                planes,
-                plane_by_id,
-                p_params,
-                p_cov,
-                local,
-                lidar_points,
-                lidar_plane_ids,
-                opts,
-                x_init,
+                paper_rows, observations, img, pose_idx, r_nl, spec, planes, plane_by_id,
+                p_params, p_cov, local, lidar_points, lidar_plane_ids, opts, x_init,
             )
         )
         maps.append(("paper planes", paper_rows[:, None], "paper"))
@@ -906,7 +893,8 @@ def _paper_block(
     opts,
     x_init,
 ) -> GaussMarkovBlock:
-    """Paper 000's Eq. 15 with d observed; z from the LiDAR points near the picked point."""
+    """Eq. 15 of Pedrosa & dos Santos (2020) with d observed; z from the LiDAR points near the
+    picked point."""
     if lidar_points is None or lidar_plane_ids is None:
         raise InputError("paper-mode observations need the LiDAR points and their plane ids")
     pk = _index([obs.target_id[r] for r in rows], plane_by_id, "plane", rows)

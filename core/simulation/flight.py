@@ -38,11 +38,13 @@ from ..geometry.collinearity import project
 from ..geometry.frames import MappingFrame
 from ..geometry.planes import Plane, fit_plane
 from ..geometry.rotations import matrix_to_opk
+from ..io.atomic import write_text_atomic
 from ..io.camera import write_camera_json
 from ..io.control import write_lcps_csv, write_lines_csv
 from ..io.observations import write_observations_csv
 from ..io.planes import write_planes_csv
 from ..io.tables import write_csv_atomic
+from ..io.trajectory import write_trajectory_csv
 from ..lidar.control import ControlLine, ControlPoint, intersect_three_planes, intersect_two_planes
 from ..photo.boresight import BoresightOptions, BoresightResult, calibrate, local_frame_for
 from ..photo.georeference import Trajectory, georeference_ecef
@@ -79,8 +81,31 @@ def ultracam_xp() -> Camera:
 
 
 @dataclass(frozen=True)
-class FlightConfig:
-    """A simulated calibration flight.
+class FlightPlan:
+    """What every simulated flight has: CRS, block, camera, lines, mount, INS (attributes as in
+    :class:`FlightConfig`)."""
+
+    crs: str = "EPSG:28992"
+    centre: tuple[float, float] = (85500.0, 447500.0)
+    camera: Camera = field(default_factory=ultracam_xp)
+    flying_height_m: float = 1600.0
+    forward_overlap: float = 0.6
+    side_overlap: float = 0.3
+    images_per_line: int = 3
+    n_lines: int = 2
+    heading_deg: float = 45.0
+    opposite: bool = True
+    mount: str = "image_top_forward"
+    true_boresight_deg: tuple[tuple[float, float, float], ...] = ((0.07, -0.13, 0.005),)
+    initial_boresight_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    lever_arm_m: tuple[float, float, float] = (0.15, -0.05, -0.60)
+    ins_grade: Union[str, InsGrade] = "pos_av_310"
+    attitude_jitter_deg: float = 1.0
+
+
+@dataclass(frozen=True)
+class FlightConfig(FlightPlan):
+    """A simulated calibration flight over a simulated town.
 
     Attributes
     ----------
@@ -126,22 +151,6 @@ class FlightConfig:
         Points closer than this to the image border are not measured.
     """
 
-    crs: str = "EPSG:28992"
-    centre: tuple[float, float] = (85500.0, 447500.0)
-    camera: Camera = field(default_factory=ultracam_xp)
-    flying_height_m: float = 1600.0
-    forward_overlap: float = 0.6
-    side_overlap: float = 0.3
-    images_per_line: int = 3
-    n_lines: int = 2
-    heading_deg: float = 45.0
-    opposite: bool = True
-    mount: str = "image_top_forward"
-    true_boresight_deg: tuple[tuple[float, float, float], ...] = ((0.07, -0.13, 0.005),)
-    initial_boresight_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    lever_arm_m: tuple[float, float, float] = (0.15, -0.05, -0.60)
-    ins_grade: Union[str, InsGrade] = "pos_av_310"
-    attitude_jitter_deg: float = 1.0
     n_buildings: int = 23
     roof_types: tuple[str, ...] = ("gable", "hip", "pyramid")
     town_size_m: float = 900.0
@@ -162,8 +171,8 @@ class FlightConfig:
 
 
 def paper_config(**changes) -> FlightConfig:
-    """Paper 000's configuration (its section 3): UltraCam XP, 1600 m, 60 %/30 % overlap,
-    6 images in two opposite directions (3 NE, 3 SW), 76 roof planes, 15 check points,
+    """The configuration of Pedrosa & dos Santos (2020), section 3: UltraCam XP, 1600 m, 60 %/30 %
+    overlap, 6 images in two opposite directions (3 NE, 3 SW), 76 roof planes, 15 check points,
     Applanix POS AV 310. Plane-constrained tie points and paper-mode points are made."""
     base = FlightConfig(types=("tie", "paper", "check"))
     return replace(base, **changes)
@@ -240,26 +249,7 @@ class FlightSimulation:
             "lidar_points": out / "lidar_roof_points.csv",
             "truth": out / "truth.json",
         }
-        t = self.trajectory
-        deg = np.degrees(t.rph)
-        write_csv_atomic(
-            paths["trajectory"],
-            (
-                "image_id",
-                "time",
-                "group",
-                "easting",
-                "northing",
-                "height",
-                "roll",
-                "pitch",
-                "heading",
-            ),
-            [
-                (i, repr(float(tt)), g, *(repr(float(v)) for v in p), *(repr(float(v)) for v in a))
-                for i, tt, g, p, a in zip(t.image_id, t.time, t.group, t.position, deg)
-            ],
-        )
+        write_trajectory_csv(paths["trajectory"], self.trajectory)
         write_camera_json(paths["camera"], self.camera)
         write_planes_csv(paths["planes"], self.planes)
         write_lines_csv(paths["lines"], self.lines)
@@ -273,25 +263,22 @@ class FlightSimulation:
                 for p, i in zip(self.lidar_points, self.lidar_plane_ids)
             ],
         )
-        truth = {
-            "crs": self.crs,
-            "boresight_deg": {g: np.degrees(b).tolist() for g, b in self.truth.boresight.items()},
-            "initial_boresight_deg": np.degrees(self.mount.boresight).tolist(),
-            "lever_arm_m": self.truth.lever_arm.tolist(),
-            "mount": self.config.mount,
-            "check_points": {k: v.tolist() for k, v in self.truth.check_points.items()},
-        }
-        tmp = paths["truth"].with_suffix(".json.tmp")
-        tmp.write_text(json.dumps(truth, indent=2), encoding="utf-8")
-        tmp.replace(paths["truth"])
+        truth = _truth(self.config, self.truth, self.mount)
+        truth["check_points"] = {k: v.tolist() for k, v in self.truth.check_points.items()}
+        write_text_atomic(paths["truth"], json.dumps(truth, indent=2))
         return paths
 
 
 # ----------------------------------------------------------------------------- helpers
 
 
-def _grade(grade: Union[str, InsGrade]) -> InsGrade:
-    return grade if isinstance(grade, InsGrade) else INS_GRADES[str(grade)]
+def _plan_basics(cfg: FlightPlan) -> tuple[MappingFrame, InsGrade, Array]:
+    """The mapping frame, the INS grade and the nominal mount of a flight plan."""
+    if cfg.mount not in MOUNT_PRESETS:
+        raise InputError(f"mount '{cfg.mount}' is not a preset")
+    grade = cfg.ins_grade
+    grade = grade if isinstance(grade, InsGrade) else INS_GRADES[str(grade)]
+    return MappingFrame.from_user_input(cfg.crs), grade, MOUNT_PRESETS[cfg.mount]
 
 
 def _roof_samples(town: Town, density: float, rng) -> tuple[Array, NDArray[np.int64]]:
@@ -422,12 +409,8 @@ def simulate_flight(config: FlightConfig, seed: int = 0, exact: bool = False) ->
     """
     cfg = config
     rng = np.random.default_rng(seed)
-    frame = MappingFrame.from_user_input(cfg.crs)
+    frame, grade, nominal = _plan_basics(cfg)
     cam = cfg.camera
-    grade = _grade(cfg.ins_grade)
-    if cfg.mount not in MOUNT_PRESETS:
-        raise InputError(f"mount '{cfg.mount}' is not a preset")
-    nominal = MOUNT_PRESETS[cfg.mount]
 
     # ---- town
     cols = max(1, math.ceil(math.sqrt(cfg.n_buildings)))
@@ -450,22 +433,7 @@ def simulate_flight(config: FlightConfig, seed: int = 0, exact: bool = False) ->
     ids, groups, enh = traj_true.image_id, traj_true.group, traj_true.position
     time, rph_true, n = traj_true.time, traj_true.rph, len(traj_true)
     lever = np.array(cfg.lever_arm_m, dtype=np.float64)
-    local = local_frame_for(traj_true, frame)
-    centre_l = np.empty((n, 3))
-    r_cl = np.empty((n, 3, 3))
-    for g, b in bore_of.items():
-        sel = np.array([x == g for x in groups])
-        sub = Trajectory(
-            tuple(np.array(ids)[sel]),
-            time[sel],
-            tuple(np.array(groups)[sel]),
-            enh[sel],
-            False,
-            rph_true[sel],
-        )
-        poses = georeference_ecef(sub, Mount(lever, nominal, b), frame)
-        centre_l[sel] = local.ecef_to_enu(poses.centre_ecef)
-        r_cl[sel] = local.rotation @ poses.camera_to_ecef
+    local, centre_l, r_cl = _true_poses(traj_true, bore_of, lever, nominal, frame)
     m_true = np.swapaxes(r_cl, 1, 2)
     opk = np.column_stack(matrix_to_opk(m_true))
     eo_true = np.hstack([centre_l, opk])
@@ -569,55 +537,39 @@ def simulate_flight(config: FlightConfig, seed: int = 0, exact: bool = False) ->
                 [f"K{c.id}" for c in check_lcps],
             )
         )
-    rec: dict[str, list] = {k: [] for k in ("image", "point", "px", "type", "target")}
-    local_targets = []
-    for pts, kind, tgt, pid in targets:
-        local_targets.append((local.map_to_enu(pts), kind, tgt, pid))
+    rec = _Records()
+    local_targets = [(local.map_to_enu(pts), kind, tgt, pid) for pts, kind, tgt, pid in targets]
+    per_line = cfg.line_points_per_image
     for i in range(n):
         for pts, kind, tgt, pid in local_targets:
             px = project(pts, eo_true[i], cam)
-            vis = np.flatnonzero(cam.in_frame(px, cfg.margin_px))
-            for j in vis:
-                rec["image"].append(ids[i])
-                rec["point"].append(pid[j])
-                rec["px"].append(px[j])
-                rec["type"].append(kind)
-                rec["target"].append(tgt[j])
+            rec.add(ids[i], px, np.flatnonzero(cam.in_frame(px, cfg.margin_px)), pid, kind, tgt)
         if "paper" in cfg.types:
             p = local.map_to_enu(_face_points(town, kept, 1, rng))
             px = project(p, eo_true[i], cam)
-            for j in np.flatnonzero(cam.in_frame(px, cfg.margin_px)):
-                rec["image"].append(ids[i])
-                rec["point"].append(f"P{i}_{kept[j]}")
-                rec["px"].append(px[j])
-                rec["type"].append("paper")
-                rec["target"].append(str(kept[j]))
+            rec.add(ids[i], px, np.flatnonzero(cam.in_frame(px, cfg.margin_px)),
+                    [f"P{i}_{f}" for f in kept], "paper", [str(f) for f in kept])  # fmt: skip
         if "line" in cfg.types and lines:
-            t = rng.uniform(0.1, 0.9, (len(lines), cfg.line_points_per_image))
+            t = rng.uniform(0.1, 0.9, (len(lines), per_line))
             seg = np.array(line_truth)
             p = seg[:, None, 0] + t[:, :, None] * (seg[:, None, 1] - seg[:, None, 0])
             px = project(local.map_to_enu(p.reshape(-1, 3)), eo_true[i], cam)
-            for j in np.flatnonzero(cam.in_frame(px, cfg.margin_px)):
-                li = j // cfg.line_points_per_image
-                rec["image"].append(ids[i])
-                rec["point"].append(f"R{li}_{j % cfg.line_points_per_image}")
-                rec["px"].append(px[j])
-                rec["type"].append("line")
-                rec["target"].append(str(lines[li].id))
-    pixels = np.array(rec["px"]).reshape(-1, 2)
-    kinds = np.array(rec["type"])
+            m = len(px)
+            rec.add(ids[i], px, np.flatnonzero(cam.in_frame(px, cfg.margin_px)),
+                    [f"R{j // per_line}_{j % per_line}" for j in range(m)], "line",
+                    [str(lines[j // per_line].id) for j in range(m)])  # fmt: skip
+    rec_point, rec_target, rec_image = rec.point, rec.target, rec.image
+    pixels = np.array(rec.px).reshape(-1, 2)
+    kinds = np.array(rec.type)
     # tie points seen in fewer than two images carry no information: drop them
     if "tie" in cfg.types:
-        pid = np.array(rec["point"])
-        tie = kinds == "tie"
-        uniq, cnt = np.unique(pid[tie], return_counts=True)
-        single = set(uniq[cnt < 2])
-        drop = tie & np.isin(pid, list(single))
-        keep_rows = ~drop
+        keep_rows = _seen_twice(kinds, rec_point)
         pixels = pixels[keep_rows]
         kinds = kinds[keep_rows]
-        for key in ("image", "point", "target"):
-            rec[key] = [v for v, k in zip(rec[key], keep_rows) if k]
+        rec_image, rec_point, rec_target = (
+            [v for v, k in zip(values, keep_rows) if k]
+            for values in (rec_image, rec_point, rec_target)
+        )
     blunders = np.empty(0, dtype=np.int64)
     if not exact:
         pixels = pixels + rng.normal(0, cfg.sigma_px, pixels.shape)
@@ -627,23 +579,14 @@ def simulate_flight(config: FlightConfig, seed: int = 0, exact: bool = False) ->
             ang = rng.uniform(0, 2 * math.pi, blunders.size)
             pixels[blunders] += cfg.blunder_px * np.column_stack([np.cos(ang), np.sin(ang)])
     obs = ImageObservations.from_arrays(
-        rec["image"],
-        rec["point"],
-        pixels,
-        np.full(len(pixels), cfg.sigma_px),
-        list(kinds),
-        rec["target"],
+        rec_image, rec_point, pixels, np.full(len(pixels), cfg.sigma_px), list(kinds), rec_target
     )
 
     # ---- INS measurements
     if exact:
         enh_meas, rph_meas = enh, rph_true
     else:
-        r_nl = local.ned_to_local(llh)
-        enu_i = r_nl @ np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]]).T
-        noise = np.einsum("nij,nj->ni", enu_i, rng.normal(0, 1, (n, 3)) * grade.sigma_position)
-        enh_meas = local.enu_to_map(local.map_to_enu(enh) + noise)
-        rph_meas = rph_true + rng.normal(0, 1, (n, 3)) * grade.sigma_attitude
+        enh_meas, rph_meas = _ins_measurements(local, llh, enh, rph_true, grade, rng)
     traj = Trajectory(tuple(ids), time, tuple(groups), enh_meas, False, rph_meas)
     mount = Mount(lever, nominal, np.radians(cfg.initial_boresight_deg))
     truth = FlightTruth(tuple(groups), bore_of, lever, traj_true, check_truth, blunders)
@@ -688,31 +631,25 @@ def small_format_camera() -> Camera:
 
 
 @dataclass(frozen=True)
-class ControlFlightConfig:
+class ControlFlightConfig(FlightPlan):
     """A calibration flight over existing LiDAR control (real planes, lines and LCPs).
 
-    Attributes are those of :class:`FlightConfig` where they share a name; ``centre`` is the
-    block centre (mapping CRS) and ``flying_height_m`` is above the lowest LiDAR point.
-    ``n_check`` roof points (on the planes) are made check points: measured in every image
-    that sees them, never adjusted.
+    Attributes are those of :class:`FlightConfig` where they share a name (a small-format
+    camera low over a city block by default); ``centre`` is the block centre (mapping CRS)
+    and ``flying_height_m`` is above the lowest LiDAR point. ``n_check`` roof points (on the
+    planes) are made check points: measured in every image that sees them, never adjusted.
     """
 
-    crs: str = "EPSG:28992"
-    centre: tuple[float, float] = (84940.0, 447595.0)
+    # the defaults that differ from FlightPlan's (the fields keep FlightPlan's order)
     camera: Camera = field(default_factory=small_format_camera)
+    centre: tuple[float, float] = (84940.0, 447595.0)
     flying_height_m: float = 130.0
+    heading_deg: float = 0.0
+    images_per_line: int = 5
     forward_overlap: float = 0.8
     side_overlap: float = 0.6
-    images_per_line: int = 5
-    n_lines: int = 2
-    heading_deg: float = 0.0
-    opposite: bool = True
-    mount: str = "image_top_forward"
-    true_boresight_deg: tuple[tuple[float, float, float], ...] = ((0.12, -0.25, 0.40),)
-    initial_boresight_deg: tuple[float, float, float] = (0.0, 0.0, 0.0)
     lever_arm_m: tuple[float, float, float] = (0.10, -0.05, -0.20)
-    ins_grade: Union[str, InsGrade] = "pos_av_310"
-    attitude_jitter_deg: float = 1.0
+    true_boresight_deg: tuple[tuple[float, float, float], ...] = ((0.12, -0.25, 0.40),)
     types: tuple[str, ...] = ("tie", "line", "lcp", "check")
     ties_per_plane: int = 2
     line_points_per_image: int = 2
@@ -744,7 +681,7 @@ class ControlFlightSimulation:
         out.mkdir(parents=True, exist_ok=True)
         paths = {k: out / f"{k}.csv" for k in ("trajectory", "observations", "check_points")}
         paths.update(camera=out / "camera.json", truth=out / "truth.json")
-        _write_trajectory(paths["trajectory"], self.trajectory)
+        write_trajectory_csv(paths["trajectory"], self.trajectory)
         write_camera_json(paths["camera"], self.camera)
         write_observations_csv(paths["observations"], self.observations)
         write_csv_atomic(
@@ -752,29 +689,78 @@ class ControlFlightSimulation:
             ("id", "e", "n", "h"),
             [(k, *(repr(float(v)) for v in p)) for k, p in self.check_points.items()],
         )
-        truth = {
-            "crs": self.config.crs,
-            "boresight_deg": {g: np.degrees(b).tolist() for g, b in self.truth.boresight.items()},
-            "initial_boresight_deg": np.degrees(self.mount.boresight).tolist(),
-            "lever_arm_m": self.truth.lever_arm.tolist(),
-            "mount": self.config.mount,
-        }
-        tmp = paths["truth"].with_suffix(".json.tmp")
-        tmp.write_text(json.dumps(truth, indent=2), encoding="utf-8")
-        tmp.replace(paths["truth"])
+        write_text_atomic(
+            paths["truth"], json.dumps(_truth(self.config, self.truth, self.mount), indent=2)
+        )
         return paths
 
 
-def _write_trajectory(path: Path, t: Trajectory) -> None:
-    deg = np.degrees(t.rph)
-    write_csv_atomic(
-        path,
-        ("image_id", "time", "group", "easting", "northing", "height", "roll", "pitch", "heading"),
-        [
-            (i, repr(float(tt)), g, *(repr(float(v)) for v in p), *(repr(float(v)) for v in a))
-            for i, tt, g, p, a in zip(t.image_id, t.time, t.group, t.position, deg)
-        ],
-    )
+class _Records:
+    """Image measurements as they are made: image, point name, pixel, type, target."""
+
+    def __init__(self) -> None:
+        self.image: list[str] = []
+        self.point: list[str] = []
+        self.px: list[Array] = []
+        self.type: list[str] = []
+        self.target: list[str] = []
+
+    def add(self, image: str, px: Array, rows, names, kind: str, targets) -> None:
+        """The rows ``rows`` of ``px`` (N, 2), measured in ``image``."""
+        for j in rows:
+            self.image.append(image)
+            self.point.append(names[j])
+            self.px.append(px[j])
+            self.type.append(kind)
+            self.target.append(targets[j])
+
+
+def _seen_twice(kinds: NDArray, names: list[str]) -> NDArray[np.bool_]:
+    """Rows to keep: tie points seen in fewer than two images carry no information."""
+    names_arr = np.array(names)
+    uniq, cnt = np.unique(names_arr[kinds == "tie"], return_counts=True)
+    return ~((kinds == "tie") & np.isin(names_arr, uniq[cnt < 2]))
+
+
+def _ins_measurements(local, llh: Array, enh: Array, rph: Array, grade: InsGrade, rng):
+    """The INS solution: the true positions and attitudes plus the grade's noise."""
+    n = len(enh)
+    r_nl = local.ned_to_local(llh)
+    enu_i = r_nl @ np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]]).T
+    noise = np.einsum("nij,nj->ni", enu_i, rng.normal(0, 1, (n, 3)) * grade.sigma_position)
+    enh_meas = local.enu_to_map(local.map_to_enu(enh) + noise)
+    return enh_meas, rph + rng.normal(0, 1, (n, 3)) * grade.sigma_attitude
+
+
+def _true_poses(traj: Trajectory, bore_of: dict, lever: Array, nominal: Array, frame):
+    """The true camera poses in the local ENU frame of the flight: (frame, centres (N, 3),
+    camera-to-local rotations (N, 3, 3)), each flight line with its own boresight."""
+    local = local_frame_for(traj, frame)
+    n = len(traj)
+    centre_l = np.empty((n, 3))
+    r_cl = np.empty((n, 3, 3))
+    groups = np.array(traj.group)
+    for g, b in bore_of.items():
+        sel = groups == g
+        sub = Trajectory(
+            tuple(np.array(traj.image_id)[sel]), traj.time[sel], tuple(groups[sel]),
+            traj.position[sel], False, traj.rph[sel],
+        )  # fmt: skip
+        poses = georeference_ecef(sub, Mount(lever, nominal, b), frame)
+        centre_l[sel] = local.ecef_to_enu(poses.centre_ecef)
+        r_cl[sel] = local.rotation @ poses.camera_to_ecef
+    return local, centre_l, r_cl
+
+
+def _truth(config: FlightPlan, truth: FlightTruth, mount: Mount) -> dict:
+    """The truth of a flight as JSON-ready data."""
+    return {
+        "crs": config.crs,
+        "boresight_deg": {g: np.degrees(b).tolist() for g, b in truth.boresight.items()},
+        "initial_boresight_deg": np.degrees(mount.boresight).tolist(),
+        "lever_arm_m": truth.lever_arm.tolist(),
+        "mount": config.mount,
+    }
 
 
 def simulate_flight_over(
@@ -810,12 +796,8 @@ def simulate_flight_over(
     """
     cfg = config if config is not None else ControlFlightConfig()
     rng = np.random.default_rng(seed)
-    frame = MappingFrame.from_user_input(cfg.crs)
+    frame, grade, nominal = _plan_basics(cfg)
     cam = cfg.camera
-    grade = _grade(cfg.ins_grade)
-    if cfg.mount not in MOUNT_PRESETS:
-        raise InputError(f"mount '{cfg.mount}' is not a preset")
-    nominal = MOUNT_PRESETS[cfg.mount]
     pts = np.asarray(lidar_points, dtype=np.float64).reshape(-1, 3)
     pid = np.asarray(lidar_plane_ids).astype(np.int64)
     if not planes or pts.shape[0] != pid.shape[0]:
@@ -827,22 +809,8 @@ def simulate_flight_over(
     ids, groups, enh = traj_true.image_id, traj_true.group, traj_true.position
     time, rph_true, n = traj_true.time, traj_true.rph, len(traj_true)
     lever = np.array(cfg.lever_arm_m, dtype=np.float64)
-    local = local_frame_for(traj_true, frame)
-    eo_true = np.empty((n, 6))
-    for g, b in bore_of.items():
-        sel = np.array([x == g for x in groups])
-        sub = Trajectory(
-            tuple(np.array(ids)[sel]),
-            time[sel],
-            tuple(np.array(groups)[sel]),
-            enh[sel],
-            False,
-            rph_true[sel],
-        )
-        poses = georeference_ecef(sub, Mount(lever, nominal, b), frame)
-        r_cl = local.rotation @ poses.camera_to_ecef
-        eo_true[sel, :3] = local.ecef_to_enu(poses.centre_ecef)
-        eo_true[sel, 3:] = np.column_stack(matrix_to_opk(np.swapaxes(r_cl, 1, 2)))
+    local, centre_l, r_cl = _true_poses(traj_true, bore_of, lever, nominal, frame)
+    eo_true = np.hstack([centre_l, np.column_stack(matrix_to_opk(np.swapaxes(r_cl, 1, 2)))])
 
     # ---- true ground points: (map xyz, type, target id, point id)
     plane_of = {int(p.id): p for p in planes}
@@ -880,52 +848,38 @@ def simulate_flight_over(
     if "lcp" in cfg.types and lcps:
         q = np.array([c.xyz for c in lcps], dtype=np.float64)
         targets.append((q, "lcp", [str(c.id) for c in lcps], [f"C{c.id}" for c in lcps]))
-    rec: dict[str, list] = {k: [] for k in ("image", "point", "px", "type", "target")}
+    rec = _Records()
     local_targets = [(local.map_to_enu(q), kind, t, p) for q, kind, t, p in targets if len(q)]
+    per_line = cfg.line_points_per_image
     for i in range(n):
         for q, kind, tgt, pnames in local_targets:
             px = project(q, eo_true[i], cam)
-            for j in np.flatnonzero(cam.in_frame(px, cfg.margin_px)):
-                rec["image"].append(ids[i])
-                rec["point"].append(pnames[j])
-                rec["px"].append(px[j])
-                rec["type"].append(kind)
-                rec["target"].append(tgt[j])
+            rec.add(ids[i], px, np.flatnonzero(cam.in_frame(px, cfg.margin_px)), pnames, kind, tgt)
         if "line" in cfg.types and lines:
-            t = rng.uniform(0.1, 0.9, (len(lines), cfg.line_points_per_image))
+            t = rng.uniform(0.1, 0.9, (len(lines), per_line))
             a = np.array([ln.start for ln in lines])
             b = np.array([ln.end for ln in lines])
             q = a[:, None] + t[:, :, None] * (b - a)[:, None]
             px = project(local.map_to_enu(q.reshape(-1, 3)), eo_true[i], cam)
-            for j in np.flatnonzero(cam.in_frame(px, cfg.margin_px)):
-                li = j // cfg.line_points_per_image
-                rec["image"].append(ids[i])
-                rec["point"].append(f"R{lines[li].id}_{i}_{j % cfg.line_points_per_image}")
-                rec["px"].append(px[j])
-                rec["type"].append("line")
-                rec["target"].append(str(lines[li].id))
-    pixels = np.array(rec["px"]).reshape(-1, 2)
-    kinds = np.array(rec["type"])
-    # tie points seen in fewer than two images carry no information: drop them
-    names_arr = np.array(rec["point"])
-    uniq, cnt = np.unique(names_arr[kinds == "tie"], return_counts=True)
-    keep = ~((kinds == "tie") & np.isin(names_arr, uniq[cnt < 2]))
+            m = len(px)
+            rec.add(ids[i], px, np.flatnonzero(cam.in_frame(px, cfg.margin_px)),
+                    [f"R{lines[j // per_line].id}_{i}_{j % per_line}" for j in range(m)], "line",
+                    [str(lines[j // per_line].id) for j in range(m)])  # fmt: skip
+    pixels = np.array(rec.px).reshape(-1, 2)
+    kinds = np.array(rec.type)
+    keep = _seen_twice(kinds, rec.point)
     pixels = pixels[keep] + rng.normal(0, cfg.sigma_px, (int(keep.sum()), 2))
     obs = ImageObservations.from_arrays(
-        [v for v, k in zip(rec["image"], keep) if k],
-        [v for v, k in zip(rec["point"], keep) if k],
+        [v for v, k in zip(rec.image, keep) if k],
+        [v for v, k in zip(rec.point, keep) if k],
         pixels,
         np.full(len(pixels), cfg.sigma_px),
         list(kinds[keep]),
-        [v for v, k in zip(rec["target"], keep) if k],
+        [v for v, k in zip(rec.target, keep) if k],
     )
 
     # ---- INS measurements: the truth plus the grade's noise
-    r_nl = local.ned_to_local(llh)
-    enu_i = r_nl @ np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]]).T
-    noise = np.einsum("nij,nj->ni", enu_i, rng.normal(0, 1, (n, 3)) * grade.sigma_position)
-    enh_meas = local.enu_to_map(local.map_to_enu(enh) + noise)
-    rph_meas = rph_true + rng.normal(0, 1, (n, 3)) * grade.sigma_attitude
+    enh_meas, rph_meas = _ins_measurements(local, llh, enh, rph_true, grade, rng)
     traj = Trajectory(tuple(ids), time, tuple(groups), enh_meas, False, rph_meas)
     mount = Mount(lever, nominal, np.radians(cfg.initial_boresight_deg))
     truth = FlightTruth(

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.errors import Cancelled, InputError
-from lidarphoto.core.io.pointcloud import read_points
+from lidarphoto.core.io.pointcloud import CloudInfo, read_points
 from lidarphoto.core.io.raster import write_geotiff
 from lidarphoto.core.jobs import ground_filter as ground_filter_job
 from lidarphoto.core.jobs.common import lengths_in_cloud_units
@@ -116,7 +116,8 @@ def test_feet_and_metres_give_the_same_answer():
     x, y, z, truth = _scene(rng, 0.03)
     ref = ground_filter(x, y, z)
     # the same scene stored in international feet, parameters given in metres
-    info = SimpleNamespace(unit_to_metre=FT, vertical_unit_to_metre=FT, path="feet.las")
+    info = CloudInfo("feet.las", len(x), "1.2", 1, None, "foot", FT, FT, np.zeros(3),
+                     np.zeros(3), (), False)  # fmt: skip
     p = lengths_in_cloud_units(
         GroundFilterParams(), info, "metre", ground_filter_job.HORIZONTAL_LENGTHS,
         ground_filter_job.VERTICAL_LENGTHS,
