@@ -63,14 +63,9 @@ from scipy.spatial import cKDTree
 from ..errors import InputError, NotObservableError
 from ..geometry.camera import Camera
 from ..geometry.frames import NED_TO_ENU, LocalFrame, MappingFrame
-from ..lsq.adjustment import (
-    AdjustmentOptions,
-    AdjustmentResult,
-    GaussHelmertBlock,
-    GaussMarkovBlock,
-    adjust,
-    prior_block,
-)
+from ..lsq.adjustment import adjust
+from ..lsq.model import AdjustmentOptions, GaussHelmertBlock, GaussMarkovBlock, prior_block
+from ..lsq.results import AdjustmentResult
 from .boresight_models import (
     PoseSpec,
     camera_ray,

@@ -19,7 +19,9 @@ from ..errors import InputError
 from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians
 from ..geometry.rotations import matrix_to_opk
-from ..lsq.adjustment import AdjustmentOptions, AdjustmentResult, GaussMarkovBlock, adjust
+from ..lsq.adjustment import adjust
+from ..lsq.model import AdjustmentOptions, GaussMarkovBlock
+from ..lsq.results import AdjustmentResult
 
 Array = NDArray[np.float64]
 

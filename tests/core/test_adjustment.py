@@ -13,12 +13,12 @@ import numpy as np
 import pytest
 from lidarphoto.core.errors import AdjustmentError, Cancelled, InputError, NotObservableError
 from lidarphoto.core.lsq import adjustment as adj
-from lidarphoto.core.lsq.adjustment import (
+from lidarphoto.core.lsq.adjustment import adjust
+from lidarphoto.core.lsq.model import (
     AdjustmentOptions,
     Constraint,
     GaussHelmertBlock,
     GaussMarkovBlock,
-    adjust,
     prior_block,
 )
 from scipy import optimize, stats

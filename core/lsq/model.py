@@ -1,0 +1,202 @@
+"""What a least-squares adjustment is given: observation blocks (Gauss-Markov and
+Gauss-Helmert), hard constraints, a-priori parameters and the options (:mod:`.adjustment`
+describes the method)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+Array = NDArray[np.float64]
+
+
+@dataclass
+class GaussMarkovBlock:
+    """Observation equations ``l + v = f(x)`` for ``G`` groups of ``c`` observations.
+
+    Parameters
+    ----------
+    name : str
+        Unique name of the block (key of :attr:`AdjustmentResult.residuals`).
+    observed : ndarray, shape (G, c)
+        Observations ``l``.
+    sigma : ndarray, shape (G, c) or (G, c, c)
+        Standard deviations (anything broadcastable to ``(G, c)``) or full covariance matrices
+        of each group, in the units of the observations.
+    param_index : ndarray of int, shape (G, k)
+        Indices into ``x`` of the parameters each group depends on.
+    model : callable
+        ``model(x_local) -> (f, J)`` with ``x_local = x[param_index]`` of shape (G, k),
+        ``f`` of shape (G, c) and ``J = df/dx_local`` of shape (G, c, k). It is always called
+        with all ``G`` groups (rejected groups are excluded afterwards), so it may close over
+        per-group arrays of length ``G``.
+    labels : sequence of str, shape (G,), optional
+        Names of the groups (e.g. ``"img 12 / pt 345"``); default ``"<name>[g]"``.
+    row_names : sequence of str, shape (c,), optional
+        Names of the rows of a group (e.g. ``("col", "row")``); default ``"0", "1", ...``.
+    """
+
+    name: str
+    observed: ArrayLike
+    sigma: ArrayLike
+    param_index: ArrayLike
+    model: Callable[[Array], tuple[Array, Array]]
+    labels: Sequence[str] | None = None
+    row_names: Sequence[str] | None = None
+
+
+@dataclass
+class GaussHelmertBlock:
+    """Condition equations ``g(x, l + v) = 0`` for ``G`` groups of ``o`` observations.
+
+    Parameters
+    ----------
+    name : str
+        Unique name of the block.
+    observed : ndarray, shape (G, o)
+        Observations ``l``.
+    sigma : ndarray, shape (G, o) or (G, o, o)
+        Standard deviations (broadcastable to ``(G, o)``) or covariance matrices.
+    param_index : ndarray of int, shape (G, k)
+        Indices into ``x`` used by each group.
+    condition : callable
+        ``condition(x_local, l_hat) -> (g, A, B)`` with ``x_local`` (G, k), the current
+        estimate of the observations ``l_hat = l + v`` (G, o), and ``g`` (G, c),
+        ``A = dg/dx_local`` (G, c, k), ``B = dg/dl`` (G, c, o). ``B S B'`` must be positive
+        definite (``c <= o`` independent conditions per group). Called with all ``G`` groups.
+    labels : sequence of str, shape (G,), optional
+        Names of the groups.
+    row_names : sequence of str, shape (o,), optional
+        Names of the observations of a group.
+    """
+
+    name: str
+    observed: ArrayLike
+    sigma: ArrayLike
+    param_index: ArrayLike
+    condition: Callable[[Array, Array], tuple[Array, Array, Array]]
+    labels: Sequence[str] | None = None
+    row_names: Sequence[str] | None = None
+
+
+@dataclass
+class Constraint:
+    """Hard constraints ``h(x) = 0`` enforced with Lagrange multipliers.
+
+    Parameters
+    ----------
+    name : str
+        Name of the constraint set.
+    param_index : ndarray of int, shape (G, k)
+        Indices into ``x`` used by each group of constraints.
+    function : callable
+        ``function(x_local) -> (h, H)`` with ``x_local`` (G, k), ``h`` (G, c) and
+        ``H = dh/dx_local`` (G, c, k). The ``G * c`` constraint rows must be independent.
+    labels : sequence of str, shape (G,), optional
+        Names of the groups.
+    """
+
+    name: str
+    param_index: ArrayLike
+    function: Callable[[Array], tuple[Array, Array]]
+    labels: Sequence[str] | None = None
+
+
+class _PriorModel:
+    """Identity model ``f(x) = x`` of weighted parameter observations (see :func:`prior_block`)."""
+
+    def __call__(self, x_local: Array) -> tuple[Array, Array]:
+        return x_local.copy(), np.ones((x_local.shape[0], 1, 1))
+
+
+def prior_block(
+    name: str,
+    index: ArrayLike,
+    value: ArrayLike,
+    sigma: ArrayLike,
+    labels: Sequence[str] | None = None,
+) -> GaussMarkovBlock:
+    """Weighted parameter observations: a-priori values of parameters with their sigmas.
+
+    Parameters
+    ----------
+    name : str
+        Name of the block.
+    index : int or ndarray of int, shape (G,)
+        Indices of the observed parameters.
+    value : float or ndarray, shape (G,)
+        A-priori values, in the units of the parameters.
+    sigma : float or ndarray, shape (G,)
+        Their standard deviations (same units, > 0).
+    labels : sequence of str, shape (G,), optional
+        Group labels; by default the names of the parameters.
+
+    Returns
+    -------
+    GaussMarkovBlock
+        A block with ``c = k = 1`` and the identity model.
+    """
+    idx = np.atleast_1d(np.asarray(index)).astype(np.intp).ravel()
+    g = idx.size
+    val = np.broadcast_to(np.asarray(value, dtype=np.float64), (g,)).astype(np.float64)
+    sig = np.broadcast_to(np.asarray(sigma, dtype=np.float64), (g,)).astype(np.float64)
+    return GaussMarkovBlock(
+        name=name,
+        observed=val[:, None],
+        sigma=sig[:, None],
+        param_index=idx[:, None],
+        model=_PriorModel(),
+        labels=None if labels is None else list(labels),
+        row_names=("value",),
+    )
+
+
+@dataclass
+class AdjustmentOptions:
+    """Options of :func:`adjust`.
+
+    Attributes
+    ----------
+    max_iterations : int
+        Maximum number of linearisations of one adjustment (each snooping round has its own).
+    tolerance : float
+        Convergence threshold on the Gauss-Newton step in units of parameter precision
+        (``|dx_i| sqrt(N_ii)``) and on the relative change of ``v'Pv``.
+    damping : bool
+        Levenberg-Marquardt (Marquardt's diagonal scaling) on top of Gauss-Newton; plain
+        Gauss-Newton when False.
+    sparse : bool or None
+        Force the sparse (True) or dense (False) solver; None chooses sparse when
+        ``n > 300`` and the normal matrix is at most 5 % full.
+    sigma0_prior : float
+        A-priori standard deviation of unit weight.
+    alpha : float
+        Significance level of the two-sided global chi-square test.
+    snooping : bool
+        Baarda data snooping with iterative rejection of the worst group.
+    snooping_alpha : float
+        Two-sided significance per observation (0.001 -> critical ``|w|`` = 3.29).
+    max_rejections : int
+        Maximum number of rejected groups.
+    condition_limit : float
+        Largest accepted condition number of the Jacobi-scaled normal matrix.
+    compute_covariance : bool
+        Compute ``Qxx`` and everything derived from it (standard deviations, correlations,
+        standardised residuals). Forced on when ``snooping`` is True.
+    """
+
+    max_iterations: int = 50
+    tolerance: float = 1e-10
+    damping: bool = True
+    sparse: bool | None = None
+    sigma0_prior: float = 1.0
+    alpha: float = 0.05
+    snooping: bool = False
+    snooping_alpha: float = 0.001
+    max_rejections: int = 50
+    condition_limit: float = 1e12
+    compute_covariance: bool = True
