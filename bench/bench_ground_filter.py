@@ -66,6 +66,8 @@ def peak_rss_mb() -> float:
 def worker(tool: str, path: str, feet: bool, runs: int) -> dict:
     """One measurement in this process; returns a JSON-able dict."""
     from lidarphoto.core.io.pointcloud import read_points, write_cloud
+    from lidarphoto.core.jobs.common import lengths_in_cloud_units
+    from lidarphoto.core.jobs.ground_filter import HORIZONTAL_LENGTHS, VERTICAL_LENGTHS
     from lidarphoto.core.lidar.ground_filter import (
         GroundFilterParams,
         ground_filter,
@@ -97,7 +99,9 @@ def worker(tool: str, path: str, feet: bool, runs: int) -> dict:
         n = len(arrays["x"])
         ref = arrays["classification"] == 2
         if tool == "ours":
-            params = GroundFilterParams(distance_unit="metre")
+            params = lengths_in_cloud_units(
+                GroundFilterParams(), info, "metre", HORIZONTAL_LENGTHS, VERTICAL_LENGTHS
+            )
             times = []
             for _ in range(runs):
                 t = time.perf_counter()

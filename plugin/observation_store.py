@@ -1,30 +1,29 @@
 """The editable observation table of the picking dock, with undo/redo and autosave.
 
-Every change (add, move, delete, and their undo/redo) goes through a ``QUndoStack`` and is
-followed at once by a save of the whole table to the observation CSV of
-:mod:`core.io.observations` (``image_id,point_id,col,row,sigma_px,type,target_id``), written
-atomically (temporary file in the same folder, then ``os.replace``): the file on disk is always
-a complete table, whatever happens to QGIS.
+The rows and their undo history are the Qt-free
+:class:`~lidarphoto.core.photo.picking_session.ObservationList`; every change (add, move,
+delete, and their undo/redo) is followed at once by a save of the whole table to the
+observation CSV of :mod:`core.io.observations`
+(``image_id,point_id,col,row,sigma_px,type,target_id``), written atomically (temporary file in
+the same folder, then ``os.replace``): the file on disk is always a complete table, whatever
+happens to QGIS.
 
 The session (paths of the camera, EO, observation and calibration files, images, layers and the
-monoplotting DSM) is
-kept in the QGIS project (``QgsProject.writeEntry`` under the scope ``lidarphoto_picking``), so
-reopening the project restores it.
+monoplotting DSM) is kept in the QGIS project (``QgsProject.writeEntry`` under the scope
+``lidarphoto_picking``), so reopening the project restores it.
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, replace
 from pathlib import Path
 
-import numpy as np
 from qgis.PyQt.QtCore import QObject, pyqtSignal
-from qgis.PyQt.QtWidgets import QUndoCommand, QUndoStack
 
 from ..core.errors import InputError
 from ..core.io.observations import read_observations_csv, write_observations_csv
-from ..core.photo.observations import DEFAULT_SIGMA_PX, ImageObservations
+from ..core.photo.observation_list import Observation, ObservationList
+from ..core.photo.observations import ImageObservations
 
 __all__ = [
     "SESSION_KEYS",
@@ -58,19 +57,6 @@ SESSION_KEYS = (
 )
 
 
-@dataclass(frozen=True)
-class Observation:
-    """One row of the observation table (see :mod:`core.io.observations`)."""
-
-    image_id: str
-    point_id: str
-    col: float
-    row: float
-    type: str
-    target_id: str
-    sigma_px: float = DEFAULT_SIGMA_PX
-
-
 def _header_only(path: Path) -> bool:
     """True for an empty file or a table with a header and no rows (what an empty store
     writes; the core reader refuses it)."""
@@ -82,55 +68,10 @@ def _header_only(path: Path) -> bool:
     return len(lines) <= 1
 
 
-class _Add(QUndoCommand):
-    def __init__(self, store, rows: list[Observation], text: str) -> None:
-        super().__init__(text)
-        self.store, self.rows, self.at = store, rows, len(store.rows)
-
-    def redo(self) -> None:
-        self.store.rows[self.at : self.at] = self.rows
-        self.store._changed()
-
-    def undo(self) -> None:
-        del self.store.rows[self.at : self.at + len(self.rows)]
-        self.store._changed()
-
-
-class _Move(QUndoCommand):
-    def __init__(self, store, index: int, col: float, row: float) -> None:
-        super().__init__(f"move {store.rows[index].point_id}")
-        self.store, self.index = store, index
-        self.before = store.rows[index]
-        self.after = replace(self.before, col=float(col), row=float(row))
-
-    def redo(self) -> None:
-        self.store.rows[self.index] = self.after
-        self.store._changed()
-
-    def undo(self) -> None:
-        self.store.rows[self.index] = self.before
-        self.store._changed()
-
-
-class _Delete(QUndoCommand):
-    def __init__(self, store, indices: list[int]) -> None:
-        super().__init__(f"delete {len(indices)} point(s)")
-        self.store = store
-        self.removed = [(i, store.rows[i]) for i in sorted(set(indices))]
-
-    def redo(self) -> None:
-        for i, _ in reversed(self.removed):
-            del self.store.rows[i]
-        self.store._changed()
-
-    def undo(self) -> None:
-        for i, row in self.removed:
-            self.store.rows.insert(i, row)
-        self.store._changed()
-
-
 class ObservationStore(QObject):
-    """The observation rows, an undo stack and the autosaved CSV.
+    """The observation rows with their undo history (a core
+    :class:`~lidarphoto.core.photo.picking_session.ObservationList`, :attr:`log`) and the
+    autosaved CSV.
 
     Signals
     -------
@@ -144,13 +85,21 @@ class ObservationStore(QObject):
     changed = pyqtSignal()
     saveFailed = pyqtSignal(str)  # noqa: N815 - Qt signal naming
 
-    def __init__(self, path: str | os.PathLike | None = None, parent=None) -> None:
+    def __init__(
+        self,
+        path: str | os.PathLike | None = None,
+        parent=None,
+        log: ObservationList | None = None,
+    ) -> None:
         super().__init__(parent)
-        self.rows: list[Observation] = []
-        self.undo_stack = QUndoStack(self)
+        self.log = log if log is not None else ObservationList()
         self.path: Path | None = Path(path) if path else None
         self.save_count = 0
         self.last_error = ""
+
+    @property
+    def rows(self) -> list[Observation]:
+        return self.log.rows
 
     # -- file ---------------------------------------------------------------------------------
     def load(self, path: str | os.PathLike) -> int:
@@ -166,16 +115,9 @@ class ObservationStore(QObject):
         p = Path(path)
         rows: list[Observation] = []
         if p.is_file() and not _header_only(p):
-            obs = read_observations_csv(p)
-            rows = [
-                Observation(i, pt, float(c), float(r), t, g, float(s))
-                for i, pt, (c, r), s, t, g in zip(
-                    obs.image_id, obs.point_id, obs.pixels, obs.sigma_px, obs.type, obs.target_id
-                )
-            ]
-        self.rows = rows
+            rows = ObservationList.rows_of(read_observations_csv(p))
+        self.log.reset(rows)
         self.path = p
-        self.undo_stack.clear()
         if not p.exists():
             self.save()
         self.changed.emit()
@@ -200,54 +142,48 @@ class ObservationStore(QObject):
         self.changed.emit()
 
     def to_observations(self) -> ImageObservations:
-        r = self.rows
-        return ImageObservations.from_arrays(
-            [o.image_id for o in r],
-            [o.point_id for o in r],
-            np.array([[o.col, o.row] for o in r], dtype=np.float64).reshape(-1, 2),
-            np.array([o.sigma_px for o in r], dtype=np.float64),
-            [o.type for o in r],
-            [o.target_id for o in r],
-        )
+        return self.log.to_observations()
 
-    # -- edits --------------------------------------------------------------------------------
+    # -- edits (each one undoable, then saved) -----------------------------------------------
     def add(self, rows: Observation | list[Observation], text: str = "") -> int:
         """Append one or more rows as one undoable step; returns the index of the first."""
-        batch = [rows] if isinstance(rows, Observation) else list(rows)
-        if not batch:
-            return -1
-        at = len(self.rows)
-        self.undo_stack.push(_Add(self, batch, text or f"add {batch[0].point_id}"))
+        at = self.log.add(rows, text)
+        if at >= 0:
+            self._changed()
         return at
 
     def move(self, index: int, col: float, row: float) -> None:
-        self.undo_stack.push(_Move(self, index, col, row))
+        self.log.move(index, col, row)
+        self._changed()
 
     def delete(self, indices: int | list[int]) -> None:
-        idx = [indices] if isinstance(indices, int) else list(indices)
-        if idx:
-            self.undo_stack.push(_Delete(self, idx))
+        before = self.log.version
+        self.log.delete(indices)
+        if self.log.version != before:
+            self._changed()
 
     def undo(self) -> None:
-        self.undo_stack.undo()
+        if self.log.undo() is not None:
+            self._changed()
 
     def redo(self) -> None:
-        self.undo_stack.redo()
+        if self.log.redo() is not None:
+            self._changed()
+
+    def edited(self) -> None:
+        """Save and signal after an edit made on :attr:`log` directly."""
+        self._changed()
 
     # -- queries ------------------------------------------------------------------------------
     def indices_of_image(self, image_id: str) -> list[int]:
-        return [k for k, o in enumerate(self.rows) if o.image_id == image_id]
+        return self.log.indices_of_image(image_id)
 
     def image_ids(self) -> set[str]:
-        return {o.image_id for o in self.rows}
+        return self.log.image_ids()
 
     def next_point_id(self, prefix: str) -> str:
         """A point id ``<prefix><n>`` not used yet."""
-        used = {o.point_id for o in self.rows}
-        n = len(self.rows) + 1
-        while f"{prefix}{n}" in used:
-            n += 1
-        return f"{prefix}{n}"
+        return self.log.next_point_id(prefix)
 
 
 def save_session(project, values: dict) -> None:

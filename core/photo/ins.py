@@ -47,6 +47,7 @@ class InsGrade:
         rp, hd = self.sigma_roll_pitch_deg, self.sigma_heading_deg
         return np.radians([rp, rp, hd])
 
+
 #: Named INS grades. Only grades whose accuracies can be cited are listed; anything else is a
 #: custom :class:`InsGrade`.
 INS_GRADES: dict[str, InsGrade] = {

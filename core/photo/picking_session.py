@@ -2,12 +2,13 @@
 
 :class:`PickingSession` holds what the dock shows and edits:
 
-- the observations (:class:`ObservationList`: the rows of the observation table, with an undo
-  and redo history of add, move and delete edits);
-- the LiDAR control as core objects (:class:`ControlSet`: roof planes, lines and control
-  points), made once from the QGIS layers' features (:class:`~.picking.ControlFeature`) and, for
-  the ids they list, from the plane, line and LCP tables; the overlays, the picking and the
-  calibration all use these same objects;
+- the observations (:class:`~.observation_list.ObservationList`: the rows of the observation
+  table, with an undo and redo history of add, move and delete edits);
+- the LiDAR control as core objects (:class:`~.control_features.ControlSet`: roof planes,
+  lines and control points), made once from the QGIS layers' features
+  (:class:`~.control_features.ControlFeature`) and, for the ids they list, from the plane,
+  line and LCP tables; the overlays, the picking and the calibration all use these same
+  objects;
 - the tie point waiting for its other images (:class:`TiePrediction`);
 - the last boresight calibration (:class:`~.boresight.BoresightRun`) and, from it, the residual
   of each current observation row.
@@ -20,37 +21,23 @@ first pixel is (0.5, 0.5)); coordinates are in the mapping CRS of the exterior o
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Union
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..geometry.planes import Plane
-from ..lidar.control import ControlLine, ControlPoint
-from .observations import DEFAULT_SIGMA_PX, ImageObservations
-from .picking import (
-    ControlFeature,
-    PickingScene,
-    lcp_from_feature,
-    line_from_feature,
-    nearest_point,
-    nearest_segment,
-    plane_from_feature,
-)
+from ..geometry.camera import Camera
+from .control_features import ControlSet
+from .observation_list import Observation, ObservationList
+from .orientation import ExteriorOrientationTable
+from .picking import PickingScene, nearest_point, nearest_segment
 
 if TYPE_CHECKING:
     from .boresight import BoresightRun
 
 __all__ = [
     "PICK_TYPES",
-    "AddRows",
-    "ControlSet",
-    "DeleteRows",
-    "MoveRow",
-    "Observation",
-    "ObservationList",
     "PickTarget",
     "PickingSession",
     "ProjectedControl",
@@ -65,326 +52,6 @@ _PREFIX = {"tie": "T", "paper": "P", "line": "R", "lcp": "C", "check": "K"}
 _CONTROL_OF = {"tie": "planes", "paper": "planes", "line": "lines", "lcp": "lcps", "check": "lcps"}
 
 
-# ----------------------------------------------------------------------------- observations
-@dataclass(frozen=True)
-class Observation:
-    """One row of the observation table (:mod:`core.io.observations`): an image point in
-    pixels (col, row) and what it measures."""
-
-    image_id: str
-    point_id: str
-    col: float
-    row: float
-    type: str
-    target_id: str
-    sigma_px: float = DEFAULT_SIGMA_PX
-
-
-@dataclass(frozen=True)
-class AddRows:
-    """Insert ``rows`` at index ``at``."""
-
-    at: int
-    rows: tuple[Observation, ...]
-    text: str = ""
-
-    def apply(self, rows: list[Observation]) -> None:
-        rows[self.at : self.at] = self.rows
-
-    def revert(self, rows: list[Observation]) -> None:
-        del rows[self.at : self.at + len(self.rows)]
-
-
-@dataclass(frozen=True)
-class MoveRow:
-    """Replace the row at ``index`` (``before``) by ``after`` (the same point, moved)."""
-
-    index: int
-    before: Observation
-    after: Observation
-    text: str = ""
-
-    def apply(self, rows: list[Observation]) -> None:
-        rows[self.index] = self.after
-
-    def revert(self, rows: list[Observation]) -> None:
-        rows[self.index] = self.before
-
-
-@dataclass(frozen=True)
-class DeleteRows:
-    """Remove the rows ``removed`` ((index, row) pairs, ascending indices)."""
-
-    removed: tuple[tuple[int, Observation], ...]
-    text: str = ""
-
-    def apply(self, rows: list[Observation]) -> None:
-        for i, _ in reversed(self.removed):
-            del rows[i]
-
-    def revert(self, rows: list[Observation]) -> None:
-        for i, row in self.removed:
-            rows.insert(i, row)
-
-
-Edit = Union[AddRows, MoveRow, DeleteRows]
-
-
-class ObservationList:
-    """The observation rows and the history of their edits (undo, redo).
-
-    Every change is an edit object with ``apply`` and ``revert``; :meth:`push` applies one and
-    records it (a new edit drops what was undone). :attr:`version` grows with every change.
-    """
-
-    def __init__(self, rows: Iterable[Observation] = ()) -> None:
-        self.rows: list[Observation] = list(rows)
-        self._done: list[Edit] = []
-        self._undone: list[Edit] = []
-        self.version = 0
-
-    def reset(self, rows: Iterable[Observation] = ()) -> None:
-        """Replace every row (a file opened); the history is cleared."""
-        self.rows = list(rows)
-        self._done.clear()
-        self._undone.clear()
-        self.version += 1
-
-    # -- edits --------------------------------------------------------------------------------
-    def push(self, edit: Edit) -> None:
-        """Apply an edit and record it for undo."""
-        edit.apply(self.rows)
-        self._done.append(edit)
-        self._undone.clear()
-        self.version += 1
-
-    def add(self, rows: Observation | Sequence[Observation], text: str = "") -> int:
-        """Append one or more rows as one edit; the index of the first (-1: none given)."""
-        batch = (rows,) if isinstance(rows, Observation) else tuple(rows)
-        if not batch:
-            return -1
-        at = len(self.rows)
-        self.push(AddRows(at, batch, text or f"add {batch[0].point_id}"))
-        return at
-
-    def move(self, index: int, col: float, row: float) -> None:
-        """Move the point of row ``index`` to (col, row)."""
-        before = self.rows[index]
-        after = replace(before, col=float(col), row=float(row))
-        self.push(MoveRow(index, before, after, f"move {before.point_id}"))
-
-    def delete(self, indices: int | Iterable[int]) -> None:
-        """Delete rows (one edit)."""
-        idx = sorted({indices} if isinstance(indices, int) else set(indices))
-        if idx:
-            removed = tuple((i, self.rows[i]) for i in idx)
-            self.push(DeleteRows(removed, f"delete {len(idx)} point(s)"))
-
-    @property
-    def can_undo(self) -> bool:
-        return bool(self._done)
-
-    @property
-    def can_redo(self) -> bool:
-        return bool(self._undone)
-
-    def undo(self) -> Edit | None:
-        """Revert the last edit; None when there is none."""
-        if not self._done:
-            return None
-        edit = self._done.pop()
-        edit.revert(self.rows)
-        self._undone.append(edit)
-        self.version += 1
-        return edit
-
-    def redo(self) -> Edit | None:
-        """Apply again the last undone edit; None when there is none."""
-        if not self._undone:
-            return None
-        edit = self._undone.pop()
-        edit.apply(self.rows)
-        self._done.append(edit)
-        self.version += 1
-        return edit
-
-    # -- queries ------------------------------------------------------------------------------
-    def indices_of_image(self, image_id: str) -> list[int]:
-        return [k for k, o in enumerate(self.rows) if o.image_id == image_id]
-
-    def image_ids(self) -> set[str]:
-        return {o.image_id for o in self.rows}
-
-    def pixels(self, indices: Sequence[int]) -> Array:
-        """(N, 2) pixels of the given rows."""
-        return np.array([[self.rows[k].col, self.rows[k].row] for k in indices]).reshape(-1, 2)
-
-    def next_point_id(self, prefix: str) -> str:
-        """A point id ``<prefix><n>`` not used yet."""
-        used = {o.point_id for o in self.rows}
-        n = len(self.rows) + 1
-        while f"{prefix}{n}" in used:
-            n += 1
-        return f"{prefix}{n}"
-
-    def to_observations(self) -> ImageObservations:
-        r = self.rows
-        return ImageObservations.from_arrays(
-            [o.image_id for o in r],
-            [o.point_id for o in r],
-            np.array([[o.col, o.row] for o in r], dtype=np.float64).reshape(-1, 2),
-            np.array([o.sigma_px for o in r], dtype=np.float64),
-            [o.type for o in r],
-            [o.target_id for o in r],
-        )
-
-    @staticmethod
-    def rows_of(obs: ImageObservations) -> list[Observation]:
-        """The rows of an observation table, in its order."""
-        return [
-            Observation(i, p, float(c), float(r), t, g, float(s))
-            for i, p, (c, r), s, t, g in zip(
-                obs.image_id, obs.point_id, obs.pixels, obs.sigma_px, obs.type, obs.target_id
-            )
-        ]
-
-
-# ----------------------------------------------------------------------------- control
-@dataclass(frozen=True)
-class ControlSet:
-    """The LiDAR control of the dock: planes, lines and control points with the target ids the
-    observations name them by (parallel tuples). Mapping CRS of the exterior orientation.
-
-    ``skipped`` counts the layer features that gave no object (e.g. an outline without heights
-    and without plane parameters), by kind.
-    """
-
-    planes: tuple[Plane, ...] = ()
-    plane_ids: tuple[str, ...] = ()
-    lines: tuple[ControlLine, ...] = ()
-    line_ids: tuple[str, ...] = ()
-    lcps: tuple[ControlPoint, ...] = ()
-    lcp_ids: tuple[str, ...] = ()
-    skipped: dict[str, int] = field(default_factory=dict)
-
-    @classmethod
-    def from_features(
-        cls,
-        planes: Iterable[ControlFeature] = (),
-        lines: Iterable[ControlFeature] = (),
-        lcps: Iterable[ControlFeature] = (),
-    ) -> ControlSet:
-        """Core objects of layer features (:func:`~.picking.plane_from_feature` and the line
-        and LCP ones); features without a usable geometry are counted in ``skipped``."""
-        out: dict[str, tuple] = {}
-        skipped: dict[str, int] = {}
-        for kind, feats, make in (
-            ("planes", planes, plane_from_feature),
-            ("lines", lines, line_from_feature),
-            ("lcps", lcps, lcp_from_feature),
-        ):
-            objs, ids = [], []
-            for f in feats:
-                obj = make(f)
-                if obj is None:
-                    skipped[kind] = skipped.get(kind, 0) + 1
-                    continue
-                objs.append(obj)
-                ids.append(str(f.id))
-            out[kind] = (tuple(objs), tuple(ids))
-        return cls(*out["planes"], *out["lines"], *out["lcps"], skipped=skipped)
-
-    def with_tables(
-        self,
-        planes: Sequence[Plane] | None = None,
-        lines: Sequence[ControlLine] | None = None,
-        lcps: Sequence[ControlPoint] | None = None,
-    ) -> ControlSet:
-        """The control with the rows of the plane, line and LCP tables (None: no table).
-
-        A table row replaces the layer's object of the same id (its parameters and full
-        covariance are the LiDAR adjustment's; a plane keeps the layer's outline); rows
-        without a layer feature are added (a plane without an outline is not drawn and
-        cannot be clicked, but the calibration uses it).
-        """
-        out = {}
-        for kind, table in (("planes", planes), ("lines", lines), ("lcps", lcps)):
-            objs, ids = self.items(kind)
-            if table is None:
-                out[kind] = (objs, ids)
-                continue
-            layer = {str(o.id) if o.id >= 0 else i: k for k, (o, i) in enumerate(zip(objs, ids))}
-            new_objs, new_ids, used = [], [], set()
-            for t in table:
-                k = layer.get(str(t.id))
-                if k is None:
-                    new_objs.append(t)
-                    new_ids.append(str(t.id))
-                    continue
-                used.add(k)
-                new_objs.append(t.with_outline(objs[k].outline) if kind == "planes" else t)
-                new_ids.append(ids[k])
-            for k, (o, i) in enumerate(zip(objs, ids)):
-                if k not in used:
-                    new_objs.append(o)
-                    new_ids.append(i)
-            out[kind] = (tuple(new_objs), tuple(new_ids))
-        return ControlSet(*out["planes"], *out["lines"], *out["lcps"], skipped=self.skipped)
-
-    def items(self, kind: str) -> tuple[tuple, tuple[str, ...]]:
-        """(objects, target ids) of ``"planes"``, ``"lines"`` or ``"lcps"``."""
-        return {
-            "planes": (self.planes, self.plane_ids),
-            "lines": (self.lines, self.line_ids),
-            "lcps": (self.lcps, self.lcp_ids),
-        }[kind]
-
-    def for_calibration(self) -> tuple[list[Plane], list[ControlLine], list[ControlPoint]]:
-        """Planes, lines and LCPs with an integer id (the tables' key), first of each id."""
-        out = []
-        for kind in ("planes", "lines", "lcps"):
-            seen: set[int] = set()
-            keep = []
-            for o in self.items(kind)[0]:
-                if o.id >= 0 and o.id not in seen:
-                    seen.add(o.id)
-                    keep.append(o)
-            out.append(keep)
-        return out[0], out[1], out[2]
-
-    # -- arrays -------------------------------------------------------------------------------
-    @property
-    def outlines(self) -> list[Array]:
-        return [p.outline for p in self.planes]
-
-    @property
-    def normals(self) -> Array:
-        return np.array([p.normal for p in self.planes], dtype=np.float64).reshape(-1, 3)
-
-    @property
-    def centroids(self) -> Array:
-        return np.array([p.centroid for p in self.planes], dtype=np.float64).reshape(-1, 3)
-
-    @property
-    def line_starts(self) -> Array:
-        return np.array([ln.start for ln in self.lines], dtype=np.float64).reshape(-1, 3)
-
-    @property
-    def line_ends(self) -> Array:
-        return np.array([ln.end for ln in self.lines], dtype=np.float64).reshape(-1, 3)
-
-    @property
-    def lcp_xyz(self) -> Array:
-        return np.array([c.xyz for c in self.lcps], dtype=np.float64).reshape(-1, 3)
-
-    def ground_height(self) -> float:
-        """Mean height of the plane outlines, else of the control points, else 0."""
-        zs = [p.outline[:, 2] for p in self.planes if len(p.outline)]
-        if zs:
-            return float(np.nanmean(np.concatenate(zs)))
-        if self.lcps:
-            return float(np.nanmean(self.lcp_xyz[:, 2]))
-        return 0.0
 
 
 # ----------------------------------------------------------------------------- picking
@@ -432,12 +99,36 @@ class PickingSession:
     def __init__(self, observations: ObservationList | None = None) -> None:
         self.observations = observations if observations is not None else ObservationList()
         self.control = ControlSet()
+        self.camera: Camera | None = None
+        self.eo: ExteriorOrientationTable | None = None
         self.scene: PickingScene | None = None
         self.pending: TiePrediction | None = None
         self.calibration: BoresightRun | None = None
         self._residuals: tuple[int, int, dict[int, Array]] | None = None
 
     # -- orientation --------------------------------------------------------------------------
+    def set_orientation(
+        self,
+        camera: Camera | None,
+        eo: ExteriorOrientationTable | None,
+        crs: str = "",
+    ) -> None:
+        """The camera and the exterior orientation (mapping CRS ``crs``, EPSG code or WKT);
+        the picking scene is made when both are given.
+
+        Raises
+        ------
+        InputError
+            No CRS, or an empty table (camera and table are kept, the scene is None).
+        """
+        self.camera, self.eo, self.scene = camera, eo, None
+        if camera is not None and eo is not None:
+            self.scene = PickingScene(eo, camera, crs)
+
+    def has_orientation(self, image_id: str) -> bool:
+        """The exterior orientation table lists the image (with or without a camera)."""
+        return self.eo is not None and image_id in self.eo.image_id
+
     def oriented(self, image_id: str) -> bool:
         """The image has an exterior orientation (and a camera)."""
         return self.scene is not None and self.scene.has_image(image_id)

@@ -12,6 +12,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from lidarphoto.core.errors import InputError
 from lidarphoto.core.geometry.frames import MappingFrame
 from lidarphoto.core.io.control import (
     read_lcps_csv,
@@ -20,15 +21,16 @@ from lidarphoto.core.io.control import (
     write_lines_csv,
 )
 from lidarphoto.core.io.planes import read_planes_csv, write_planes_csv
+from lidarphoto.core.photo.control_features import (
+    DEFAULT_CONTROL_SIGMA_M,
+    ControlFeature,
+    ControlSet,
+)
 from lidarphoto.core.photo.georeference import direct_georeference
 from lidarphoto.core.photo.mount import Mount
-from lidarphoto.core.photo.picking import DEFAULT_CONTROL_SIGMA_M, ControlFeature, PickingScene
-from lidarphoto.core.photo.picking_session import (
-    ControlSet,
-    Observation,
-    ObservationList,
-    PickingSession,
-)
+from lidarphoto.core.photo.observation_list import Observation, ObservationList
+from lidarphoto.core.photo.picking import PickingScene
+from lidarphoto.core.photo.picking_session import PickingSession
 from lidarphoto.core.simulation.flight import FlightConfig, simulate_flight
 
 CONFIG = FlightConfig(
@@ -215,7 +217,13 @@ def test_pick_tie_prediction_line_and_lcp(flight):
     sim, eo, outlines = flight
     session = PickingSession()
     session.control = ControlSet.from_features(*_features(sim, outlines))
-    session.scene = PickingScene(eo, sim.camera)
+    # no CRS anywhere: the camera and the table are kept, there is no scene to pick in
+    with pytest.raises(InputError, match="CRS"):
+        session.set_orientation(sim.camera, replace(eo, crs_wkt=""))
+    assert session.eo is not None and session.scene is None
+    assert session.has_orientation(eo.image_id[0]) and not session.oriented(eo.image_id[0])
+    session.set_orientation(sim.camera, eo, sim.crs)
+    assert isinstance(session.scene, PickingScene)
     obs = sim.observations  # noise-free: the true pixels
     names = np.array(obs.point_id)
     ties = [n for n in np.unique(names[np.array(obs.type) == "tie"])]

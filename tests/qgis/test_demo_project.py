@@ -128,18 +128,20 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
     dock.show()
     QTest.qWaitForWindowExposed(dock, 2000)
     ids = list(sim.trajectory.image_id)
-    assert [dock.image_combo.itemData(k) for k in range(dock.image_combo.count())] == ids
+    assert [
+        dock.viewer.image_combo.itemData(k) for k in range(dock.viewer.image_combo.count())
+    ] == ids
     assert all(dock.image_status(i) == "ok" for i in ids)  # file on disk and orientation
-    assert dock.planes_combo.currentLayer() is layers["Roof planes"]
-    assert dock.lines_combo.currentLayer() is layers["LiDAR lines"]
-    assert dock.lcps_combo.currentLayer() is layers["LiDAR control points"]
-    assert dock.dsm_combo.currentLayer() is dsm
-    assert dock.eo_edit.filePath() == str(out / "calibration" / "eo_initial.csv")
+    assert dock.project_panel.planes_combo.currentLayer() is layers["Roof planes"]
+    assert dock.project_panel.lines_combo.currentLayer() is layers["LiDAR lines"]
+    assert dock.project_panel.lcps_combo.currentLayer() is layers["LiDAR control points"]
+    assert dock.project_panel.dsm_combo.currentLayer() is dsm
+    assert dock.project_panel.eo_edit.filePath() == str(out / "calibration" / "eo_initial.csv")
     simulated = [o for o in read_observations_csv(demo["paths"]["observations"]).type
                  if o in ("tie", "line", "lcp")]  # fmt: skip
     n0 = len(dock.store.rows)
     assert n0 == len(simulated) and dock.store.path == out / "picking" / "observations.csv"
-    assert dock.overlays.counts["planes"] >= 10
+    assert dock.viewer.overlays.counts["planes"] >= 10
     restore_s = time.perf_counter() - t0
 
     # ---- a tie point on a rendered roof, predicted in a second image, corrected there
@@ -160,7 +162,7 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
     pixel, depth = _deep_pixel(rendered.plane_id, best)
     assert depth > 60  # px: deeper than the offset of the uncalibrated overlays
     dock.show_image(a)
-    dock.type_combo.setCurrentText("tie")
+    dock.viewer.type_combo.setCurrentText("tie")
     got = _click(dock.view, qgis_app, pixel, zoom=1.0)
     tie = dock.store.rows[-1]
     assert (tie.image_id, tie.type, tie.target_id) == (a, "tie", str(best))
@@ -169,11 +171,11 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
     assert rendered.plane_id[int(tie.row), int(tie.col)] == best  # on the rendered roof
     plane = planes[best]
     true_b = truth.predict_tie(a, (tie.col, tie.row), plane.normal, plane.centroid)[b]
-    pred_b = dock.pending["pixels"][b]
+    pred_b = dock.session.pending.pixels[b]
     miss_px = math.hypot(*(np.asarray(pred_b) - true_b))
     assert miss_px < 60  # the uncalibrated boresight: the user corrects the prediction
     dock.show_image(b)
-    assert dock.overlays.counts["predictions"] == 1
+    assert dock.viewer.overlays.counts["predictions"] == 1
     got = _click(dock.view, qgis_app, true_b, zoom=1.0)
     tie_b = dock.store.rows[-1]
     assert (tie_b.image_id, tie_b.point_id, tie_b.target_id) == (b, tie.point_id, str(best))
@@ -187,7 +189,7 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
     assert len(set(lcp.plane_ids) & set(np.unique(win).tolist())) >= 2  # a rendered corner
     dock.show_image(a)
     dock.view.fit()
-    dock.type_combo.setCurrentText("lcp")
+    dock.viewer.type_combo.setCurrentText("lcp")
     _click(dock.view, qgis_app, true_px)
     c_obs = dock.store.rows[-1]
     assert (c_obs.type, c_obs.target_id) == ("lcp", str(lcp.id))
@@ -212,8 +214,8 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
     assert dock.run_calibration()
     assert _wait(qgis_app, lambda: bool(done)), "the calibration task did not finish"
     calib_s = time.perf_counter() - t1
-    assert done == [True], dock.result_label.text()
-    with open(dock._params["OUTPUT_TABLE"], encoding="utf-8") as fh:
+    assert done == [True], dock.calibration_panel.result_label.text()
+    with open(dock.calibration.params["OUTPUT_TABLE"], encoding="utf-8") as fh:
         table = list(csv.DictReader(fh))
     assert {r["group"] for r in table} == set(sim.truth.groups)
     for row in table:
@@ -221,21 +223,36 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
         for j, angle in enumerate(("omega", "phi", "kappa")):
             est, sd = float(row[f"d_{angle}_arcsec"]), float(row[f"std_d_{angle}_arcsec"])
             assert abs(est - true[j]) < 3.5 * sd, (row["group"], angle, est, true[j], sd)
-    assert "RMS" in dock.result_label.text()
-    assert len(dock.residuals) > 0.9 * len(rows)
+    assert "RMS" in dock.calibration_panel.result_label.text()
+    assert len(dock.session.residuals()) > 0.9 * len(rows)
     dock.show_image(a)
-    assert dock.overlays.counts["residuals"] > 20
+    assert dock.viewer.overlays.counts["residuals"] > 20
     # the calibrated orientation puts the LCP's overlay on the rendered corner
-    cal = read_eo_csv(dock._params["OUTPUT_EO"])
+    cal = read_eo_csv(dock.calibration.params["OUTPUT_EO"])
+    kept = dock.session.calibration.result.eo  # the result the dock keeps is what was written
+    assert kept.image_id == cal.image_id  # (the file has 0.1 mm and 1e-10 degrees)
+    assert np.abs(kept.xyz - cal.xyz).max() <= 5e-5
+    assert np.degrees(np.abs(kept.opk - cal.opk)).max() <= 5e-11
     moved = PickingScene(cal, HALF, CRS).project(a, [lcp.xyz])[0]
     before = PickingScene(dock.eo, HALF, CRS).project(a, [lcp.xyz])[0]
     assert math.hypot(*(moved - true_px)) < 2.0 < math.hypot(*(before - true_px))
 
     # ---- the calibrated orientation in the dock: the overlays now sit on the rendered roofs
-    dock.eo_edit.setFilePath(dock._params["OUTPUT_EO"])
+    # (the result's, from memory, with one button; the Project tab then names its file)
+    button = dock.calibration_panel.use_eo_button
+    assert button.isEnabled()
+    QTest.mouseClick(button, Qt.MouseButton.LeftButton)
+    assert dock.eo is kept
+    assert dock.project_panel.eo_edit.filePath() == dock.calibration.params["OUTPUT_EO"]
     dock.show_image(a)
-    lcp_k = dock.lcps["ids"].index(str(lcp.id))
-    assert math.hypot(*(dock.projected["lcps"][lcp_k] - true_px)) < 2.0
+    lcp_k = dock.session.control.lcp_ids.index(str(lcp.id))
+    assert math.hypot(*(dock.picking.projected.lcps[lcp_k] - true_px)) < 2.0
+    # the same from the file (as a user sets it, or the project restores it)
+    dock.project_panel.eo_edit.setFilePath("")
+    dock.project_panel.eo_edit.setFilePath(dock.calibration.params["OUTPUT_EO"])
+    assert dock.eo is not kept
+    dock.show_image(a)
+    assert math.hypot(*(dock.picking.projected.lcps[lcp_k] - true_px)) < 2.0
 
     # ---- the screenshot: roofs with their outlines, lines, LCPs, picks and residual vectors
     split = dock.widget().findChild(QSplitter)

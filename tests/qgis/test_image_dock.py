@@ -23,7 +23,7 @@ from lidarphoto.core.geometry.frames import MappingFrame
 from lidarphoto.core.io.control import write_lcps_csv, write_lines_csv
 from lidarphoto.core.io.observations import read_observations_csv, write_observations_csv
 from lidarphoto.core.io.orientation import write_eo_csv
-from lidarphoto.core.io.planes import write_planes_csv
+from lidarphoto.core.io.planes import read_planes_csv, write_planes_csv
 from lidarphoto.core.photo.georeference import direct_georeference
 from lidarphoto.core.photo.mount import Mount
 from lidarphoto.core.photo.picking import PickingScene
@@ -198,9 +198,9 @@ def _dock(qgis_parent, qgis_app, block, layers, tmp_path, iface=None, obs_name="
     dock.show()
     QTest.qWaitForWindowExposed(dock, 2000)
     planes, lines, lcps = layers
-    dock.planes_combo.setLayer(planes)
-    dock.lines_combo.setLayer(lines)
-    dock.lcps_combo.setLayer(lcps)
+    dock.project_panel.planes_combo.setLayer(planes)
+    dock.project_panel.lines_combo.setLayer(lines)
+    dock.project_panel.lcps_combo.setLayer(lcps)
     dock.set_project_files(
         camera=str(block["paths"]["camera"]),
         eo=str(block["eo"]),
@@ -368,7 +368,7 @@ def test_click_adds_observation_undo_redo_move_reload(
     dock = _dock(qgis_parent, qgis_app, block, layers, tmp_path)
     image = block["sim"].trajectory.image_id[1]
     dock.show_image(image)
-    assert dock.overlays.counts["planes"] >= 5 and dock.overlays.counts["lcps"] >= 1
+    assert dock.viewer.overlays.counts["planes"] >= 5 and dock.viewer.overlays.counts["lcps"] >= 1
     target, centre = _inside_plane(block, image)
     view = dock.view
     view.set_zoom(2.0, QPointF(*centre))
@@ -389,7 +389,7 @@ def test_click_adds_observation_undo_redo_move_reload(
     planes = layers[0]
     sel = [f["id"] for f in planes.getSelectedFeatures()]
     assert sel == [int(target)]
-    assert dock.pending is not None and len(dock.pending["pixels"]) >= 1
+    assert dock.session.pending is not None and len(dock.session.pending.pixels) >= 1
 
     # drag the point by (+20, -10) screen px = (+10, -5) image px
     QTest.mousePress(
@@ -422,7 +422,7 @@ def test_click_adds_observation_undo_redo_move_reload(
         [moved.col, moved.row]
     )
     # delete the selected point, undo the deletion
-    dock.selected_index = 0
+    dock.picking.selected_index = 0
     QTest.keyClick(view, Qt.Key.Key_Delete)
     assert dock.store.rows == []
     dock.store.undo()
@@ -446,16 +446,16 @@ def test_tie_prediction_within_a_pixel(qgis_parent, qgis_app, block, layers, tmp
         a = rows[0]
         dock.cancel_prediction()
         dock.show_image(obs.image_id[a])
-        dock.type_combo.setCurrentText("tie")
+        dock.viewer.type_combo.setCurrentText("tie")
         k = dock.pick(*obs.pixels[a])
         assert k >= 0 and dock.store.rows[k].target_id == obs.target_id[a]
         for b in rows[1:]:
-            pred = dock.pending["pixels"][obs.image_id[b]]
+            pred = dock.session.pending.pixels[obs.image_id[b]]
             errors.append(math.hypot(*(pred - obs.pixels[b])))
         # confirm in the second image with Enter: stored at the prediction
         b = rows[1]
         dock.show_image(obs.image_id[b])
-        assert dock.overlays.counts["predictions"] == 1
+        assert dock.viewer.overlays.counts["predictions"] == 1
         dock.view.setFocus()
         QTest.keyClick(dock.view, Qt.Key.Key_Return)
         last = dock.store.rows[-1]
@@ -495,7 +495,7 @@ def test_bad_inputs_and_other_crs(qgis_parent, qgis_app, block, layers, tmp_path
     kept = read_observations_csv(foreign)
     assert kept.image_id == ("OTHER_1", image)
     # the plane layer in WGS 84: reprojected, the same overlay within 0.05 px
-    ref = [r.copy() for r in dock.projected["rings"]]
+    ref = [r.copy() for r in dock.picking.projected.rings]
     planes_wgs = _memory_layer("PolygonZ", "EPSG:4326", "planes wgs84")
     ct_src = layers[0]
     from qgis.core import QgsCoordinateTransform
@@ -511,8 +511,8 @@ def test_bad_inputs_and_other_crs(qgis_parent, qgis_app, block, layers, tmp_path
         ids.append(f["id"])
     _add(planes_wgs, geoms, ids)
     QgsProject.instance().addMapLayer(planes_wgs)
-    dock.planes_combo.setLayer(planes_wgs)
-    got = dock.projected["rings"]
+    dock.project_panel.planes_combo.setLayer(planes_wgs)
+    got = dock.picking.projected.rings
     assert len(got) == len(ref)
     assert max(np.abs(a - b).max() for a, b in zip(got, ref)) < 0.05
     dock.close()
@@ -525,14 +525,14 @@ def test_canvas_sync_and_session_restore(
     image = block["sim"].trajectory.image_id[3]
     dock.show_image(image)
     # the footprint on the canvas: 4 corners, around the image centre's ground point
-    band = dock.rubber_band
+    band = dock.canvas_footprint.rubber_band
     assert band is not None and band.numberOfVertices() >= 4
     corners = dock.footprint()
     centre = dock.scene_geometry.ray_plane(
         image,
         (CAMERA.width_px / 2, CAMERA.height_px / 2),
         [[0, 0, 1.0]],
-        [[*dock.eo.xyz[3, :2], dock._ground_height()]],
+        [[*dock.eo.xyz[3, :2], dock.session.control.ground_height()]],
     )[0][0]
     assert QgsGeometry.fromPolygonXY([[*(QgsPointXY_(c) for c in corners)]]).contains(
         QgsGeometry.fromPointXY(QgsPointXY_(centre))
@@ -545,21 +545,21 @@ def test_canvas_sync_and_session_restore(
     qgis_app.processEvents()
     assert dock.highlighted()[0] == {target}
     # a session stored in the project comes back in a new dock
-    dock.type_combo.setCurrentText("lcp")
-    lcp_px = dock.projected["lcps"]
+    dock.viewer.type_combo.setCurrentText("lcp")
+    lcp_px = dock.picking.projected.lcps
     k = int(np.flatnonzero(np.isfinite(lcp_px).all(axis=1))[0])
     assert dock.pick(*(lcp_px[k] + 1.0)) >= 0
-    assert dock.store.rows[-1].target_id == dock.lcps["ids"][k]
-    dock.trajectory_edit.setFilePath(str(block["paths"]["trajectory"]))
+    assert dock.store.rows[-1].target_id == dock.session.control.lcp_ids[k]
+    dock.calibration_panel.trajectory_edit.setFilePath(str(block["paths"]["trajectory"]))
     dock.save_session()
     rows = list(dock.store.rows)
     dock.close()
     again = ImagePickingDock(None, qgis_parent)
     assert again.store.rows == rows
     assert again.current_image == image and again.source is not None
-    assert again.trajectory_edit.filePath() == str(block["paths"]["trajectory"])
-    assert again.planes_combo.currentLayer() is planes
-    assert again.overlays.counts["planes"] >= 5
+    assert again.calibration_panel.trajectory_edit.filePath() == str(block["paths"]["trajectory"])
+    assert again.project_panel.planes_combo.currentLayer() is planes
+    assert again.viewer.overlays.counts["planes"] >= 5
     again.close()
     dock.remove_footprint()
 
@@ -576,33 +576,53 @@ def test_run_calibration_shows_residuals_and_screenshot(
     shutil.copy(block["dir"] / "measured.csv", tmp_path / "measured.csv")
     dock = _dock(qgis_parent, qgis_app, block, layers, tmp_path, obs_name="measured.csv")
     sim, paths = block["sim"], block["paths"]
-    dock.trajectory_edit.setFilePath(str(paths["trajectory"]))
-    dock.lever_edit.setText(",".join(repr(float(v)) for v in sim.mount.lever_arm))
-    dock.planes_csv_edit.setFilePath(str(paths["planes"]))
-    dock.lines_csv_edit.setFilePath(str(paths["lines"]))
-    dock.lcps_csv_edit.setFilePath(str(paths["lcps"]))
+    dock.calibration_panel.trajectory_edit.setFilePath(str(paths["trajectory"]))
+    dock.calibration_panel.lever_edit.setText(",".join(repr(float(v)) for v in sim.mount.lever_arm))
+    dock.calibration_panel.planes_csv_edit.setFilePath(str(paths["planes"]))
+    dock.calibration_panel.lines_csv_edit.setFilePath(str(paths["lines"]))
+    dock.calibration_panel.lcps_csv_edit.setFilePath(str(paths["lcps"]))
     done = []
     dock.calibrationFinished.connect(done.append)
-    QTest.mouseClick(dock.run_button, Qt.MouseButton.LeftButton)
+    QTest.mouseClick(dock.calibration_panel.run_button, Qt.MouseButton.LeftButton)
     assert _wait(qgis_app, lambda: bool(done), 90.0), "the calibration task did not finish"
-    assert done == [True], dock.result_label.text()
+    assert done == [True], dock.calibration_panel.result_label.text()
     # the truth within 3 sigma (noise-free INS, 0.5 px pixel noise)
     import csv
 
-    with open(dock._params["OUTPUT_TABLE"], encoding="utf-8") as fh:
+    with open(dock.calibration.params["OUTPUT_TABLE"], encoding="utf-8") as fh:
         for row in csv.DictReader(fh):
             true = sim.truth.boresight[row["group"]] / ARCSEC
             for k, angle in enumerate(("omega", "phi", "kappa")):
                 est, sd = float(row[f"d_{angle}_arcsec"]), float(row[f"std_d_{angle}_arcsec"])
                 assert abs(est - true[k]) < 3 * sd + 0.5, (angle, est, true[k], sd)
-    v = np.array([math.hypot(*x) for x in dock.residuals.values() if np.isfinite(x).all()])
+    v = np.array(
+        [math.hypot(*x) for x in dock.session.residuals().values() if np.isfinite(x).all()]
+    )
     assert v.size > 100
     rms = float(np.sqrt(np.mean(v**2)))
     assert 0.2 < rms < 1.2  # 0.5 px per coordinate put in
-    assert "RMS" in dock.result_label.text()
+    assert "RMS" in dock.calibration_panel.result_label.text()
+    # what the dock shows is the result object's, and the files written say the same
+    run = dock.session.calibration
+    assert run is not None and len(run.observations) == len(dock.store.rows)
+    with open(dock.calibration.params["RESIDUALS_CSV"], encoding="utf-8") as fh:
+        written = list(csv.DictReader(fh))
+    shown = dock.session.residuals()
+    for k, vec in list(shown.items())[:50]:
+        o, w = dock.store.rows[k], written[k]
+        assert (w["image_id"], w["point_id"], w["target_id"]) == (
+            o.image_id,
+            o.point_id,
+            o.target_id,
+        )
+        assert (float(w["vx_px"]), float(w["vy_px"])) == pytest.approx(tuple(vec), abs=1e-12)
+    # the control the calibration read is the dock's (the tables' rows, outlines of the layer)
+    params = dock.calibration.params
+    assert params["PLANES"].endswith("control_planes.csv") and Path(params["PLANES"]).is_file()
+    assert len(read_planes_csv(params["PLANES"])) == len(dock.session.control.planes)
     image = sim.trajectory.image_id[1]
     dock.show_image(image)
-    assert dock.overlays.counts["residuals"] > 10
+    assert dock.viewer.overlays.counts["residuals"] > 10
     assert dock.table.item(0, 6).text() != ""
     # the screenshot: the dock with roof outlines, ids, lines, LCPs, points and residuals
     _target, centre = _inside_plane(block, image)
@@ -627,7 +647,7 @@ def test_plugin_action_shows_and_unload_removes_the_dock(qgis_iface, qgis_app, q
         action.trigger()
         dock = plugin.image_dock
         assert isinstance(dock, ImagePickingDock) and not dock.isHidden()
-        assert "Ctrl+Z" in dock.help_button.toolTip()  # the keyboard help
+        assert "Ctrl+Z" in dock.viewer.help_button.toolTip()  # the keyboard help
         action.trigger()  # a checkable action: the second trigger hides the dock
         assert dock.isHidden() and plugin.image_dock is dock
     finally:

@@ -88,7 +88,7 @@ def dock(qgis_parent, qgis_app, qgis_new_project, scene, tmp_path):
     d.resize(900, 900)
     d.show()
     QTest.qWaitForWindowExposed(d, 2000)
-    d.lcps_combo.setLayer(lcps)
+    d.project_panel.lcps_combo.setLayer(lcps)
     folder = scene["dir"]
     d.set_project_files(camera=str(folder / "camera.json"), eo=str(folder / "eo.csv"), crs=CRS,
                         images=[str(folder / "img1.tif")],
@@ -104,16 +104,16 @@ def _xyz(feature) -> np.ndarray:
 
 
 def test_button_needs_a_dsm_resamples_one_in_another_crs(dock, scene, qgis_app):
-    dock.monoplot_button.click()  # no DSM chosen
-    assert not dock.monoplot_button.isChecked() and dock.monoplot_tool.mode == ""
+    dock.viewer.monoplot_button.click()  # no DSM chosen
+    assert not dock.viewer.monoplot_button.isChecked() and dock.monoplot_tool.mode == ""
     assert "Choose a DSM" in dock.messages[-1]
     # the tile's DSM resampled into UTM 31N: brought back into RD New for monoplotting
     utm = QgsRasterLayer(str(scene["dir"] / "dsm_utm.tif"), "dsm in UTM")
     assert utm.crs().authid() == "EPSG:32631"
     QgsProject.instance().addMapLayer(utm)
-    dock.dsm_combo.setLayer(utm)
-    dock.monoplot_button.click()
-    assert dock.monoplot_button.isChecked() and dock.monoplot_tool.mode == "point"
+    dock.project_panel.dsm_combo.setLayer(utm)
+    dock.viewer.monoplot_button.click()
+    assert dock.viewer.monoplot_button.isChecked() and dock.monoplot_tool.mode == "point"
     assert "resampled" in dock.messages[-1] and "UTM zone 31N" in dock.messages[-1]
     assert dock.monoplot_tool.tracer.dsm.crs.to_epsg() == 28992
     for k in range(10):
@@ -131,28 +131,30 @@ def test_button_needs_a_dsm_resamples_one_in_another_crs(dock, scene, qgis_app):
     np.testing.assert_allclose(got, core.points, atol=1e-6)
     # two resamplings of a 0.5 m city DSM (trees, walls): most points within a few decimetres
     assert np.median(np.linalg.norm(got - scene["truth"][:10], axis=1)) < 0.5
-    dock.monoplot_button.click()
+    dock.viewer.monoplot_button.click()
     # the LAZ in RD New + NAP: NAP heights need a geoid grid PROJ does not have here
-    dock.dsm_edit.setFilePath(str(AHN3))
-    dock.monoplot_button.click()
-    assert not dock.monoplot_button.isChecked()
+    dock.project_panel.dsm_edit.setFilePath(str(AHN3))
+    dock.viewer.monoplot_button.click()
+    assert not dock.viewer.monoplot_button.isChecked()
     assert "DSM not loaded" in dock.messages[-1] and "nlgeo" in dock.messages[-1]
     # the raster in the mapping CRS: on
-    dock.dsm_edit.setFilePath(str(scene["dir"] / "dsm.tif"))
-    dock.monoplot_button.click()
-    assert dock.monoplot_button.isChecked() and dock.monoplot_tool.mode == "point"
+    dock.project_panel.dsm_edit.setFilePath(str(scene["dir"] / "dsm.tif"))
+    dock.viewer.monoplot_button.click()
+    assert dock.viewer.monoplot_button.isChecked() and dock.monoplot_tool.mode == "point"
     # no orientation: the camera file cleared
-    dock.monoplot_button.click()
-    dock.camera_edit.setFilePath("")
-    dock.monoplot_button.click()
-    assert not dock.monoplot_button.isChecked() and "exterior orientation" in dock.messages[-1]
+    dock.viewer.monoplot_button.click()
+    dock.project_panel.camera_edit.setFilePath("")
+    dock.viewer.monoplot_button.click()
+    assert (
+        not dock.viewer.monoplot_button.isChecked() and "exterior orientation" in dock.messages[-1]
+    )
 
 
 def test_points_and_lines_on_the_map_within_a_millimetre(dock, scene, tmp_path, qgis_app):
     truth, pixels = scene["truth"], scene["pixels"]
-    dock.dsm_edit.setFilePath(str(scene["dir"] / "dsm.tif"))
-    dock.monoplot_button.click()
-    assert dock.monoplot_button.isChecked()
+    dock.project_panel.dsm_edit.setFilePath(str(scene["dir"] / "dsm.tif"))
+    dock.viewer.monoplot_button.click()
+    assert dock.viewer.monoplot_button.isChecked()
     # a real mouse click: a point on the map where the view puts the click
     view = dock.view
     view.set_zoom(1.0, QPointF(*pixels[0]))
@@ -180,8 +182,8 @@ def test_points_and_lines_on_the_map_within_a_millimetre(dock, scene, tmp_path, 
     assert dock.store.rows == []  # monoplotting measures no observation
 
     # lines: two vertices + Enter, then three vertices + a double click
-    dock.monoplot_mode.setCurrentIndex(dock.monoplot_mode.findData("line"))
-    assert dock.monoplot_tool.mode == "line" and dock.finish_line_button.isEnabled()
+    dock.viewer.monoplot_mode.setCurrentIndex(dock.viewer.monoplot_mode.findData("line"))
+    assert dock.monoplot_tool.mode == "line" and dock.viewer.finish_line_button.isEnabled()
     for k in (11, 12):
         view.pointPicked.emit(*map(float, pixels[k]))
     view.setFocus()
@@ -210,9 +212,9 @@ def test_points_and_lines_on_the_map_within_a_millimetre(dock, scene, tmp_path, 
     assert QgsWkbTypes.hasZ(back.wkbType())
 
     # off: clicks measure observations again (an LCP at its projection)
-    dock.monoplot_button.click()
-    assert not dock.monoplot_button.isChecked() and dock.monoplot_tool.mode == ""
-    dock.type_combo.setCurrentText("lcp")
+    dock.viewer.monoplot_button.click()
+    assert not dock.viewer.monoplot_button.isChecked() and dock.monoplot_tool.mode == ""
+    dock.viewer.type_combo.setCurrentText("lcp")
     view.pointPicked.emit(*map(float, pixels[0]))
     assert len(dock.store.rows) == 1 and dock.store.rows[0].target_id == "7"
     assert read_observations_csv(dock.store.path).image_id == ("img1",)
@@ -220,13 +222,13 @@ def test_points_and_lines_on_the_map_within_a_millimetre(dock, scene, tmp_path, 
 
 
 def test_dsm_choice_is_kept_in_the_session(dock, scene, qgis_parent):
-    dock.dsm_edit.setFilePath(str(scene["dir"] / "dsm.tif"))
-    dock.dsm_cell.setValue(0.25)
+    dock.project_panel.dsm_edit.setFilePath(str(scene["dir"] / "dsm.tif"))
+    dock.project_panel.dsm_cell.setValue(0.25)
     dock.save_session()
     dock.close()
     again = ImagePickingDock(None, qgis_parent)
-    assert again.dsm_edit.filePath() == str(scene["dir"] / "dsm.tif")
-    assert again.dsm_cell.value() == pytest.approx(0.25)
+    assert again.project_panel.dsm_edit.filePath() == str(scene["dir"] / "dsm.tif")
+    assert again.project_panel.dsm_cell.value() == pytest.approx(0.25)
     assert again.set_monoplot(True) and again.monoplot_tool.mode == "point"
     # an image without orientation: no 3D point, a message
     again.set_images([str(scene["dir"] / "img1.tif"), str(scene["dir"] / "dsm.tif")])

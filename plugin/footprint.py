@@ -1,0 +1,50 @@
+"""The ground footprint of the current image on the QGIS map canvas (a ``QgsRubberBand``)."""
+
+from __future__ import annotations
+
+import numpy as np
+from qgis.core import QgsCoordinateTransform, QgsPointXY, QgsWkbTypes
+from qgis.gui import QgsRubberBand
+from qgis.PyQt.QtGui import QColor
+
+__all__ = ["CanvasFootprint"]
+
+if hasattr(QgsWkbTypes, "PolygonGeometry"):  # QGIS 3.22-3.28
+    _POLYGON_GEOMETRY = QgsWkbTypes.PolygonGeometry
+else:  # pragma: no cover - QGIS >= 3.30 / 4
+    from qgis.core import Qgis
+
+    _POLYGON_GEOMETRY = Qgis.GeometryType.Polygon
+
+
+class CanvasFootprint:
+    """Draws four ground corners (mapping CRS) on the canvas of ``iface`` (none: nothing)."""
+
+    def __init__(self, iface, project) -> None:
+        self.iface = iface
+        self.project = project
+        self.rubber_band: QgsRubberBand | None = None
+
+    def show(self, corners: np.ndarray | None, crs) -> None:
+        """Draw the footprint ((4, 3) corners in ``crs``; None or NaN: cleared)."""
+        canvas = self.iface.mapCanvas() if self.iface is not None else None
+        if canvas is None:
+            return
+        if self.rubber_band is None:
+            self.rubber_band = QgsRubberBand(canvas, _POLYGON_GEOMETRY)
+            self.rubber_band.setStrokeColor(QColor(255, 212, 0))
+            self.rubber_band.setFillColor(QColor(255, 212, 0, 40))
+            self.rubber_band.setWidth(2)
+        self.rubber_band.reset(_POLYGON_GEOMETRY)
+        if corners is None or not np.isfinite(corners).all():
+            return
+        dest = canvas.mapSettings().destinationCrs()
+        ct = QgsCoordinateTransform(crs, dest, self.project)
+        for k, (x, y, _z) in enumerate(corners):
+            self.rubber_band.addPoint(ct.transform(QgsPointXY(x, y)), k == 3)
+        self.rubber_band.show()
+
+    def remove(self) -> None:
+        if self.rubber_band is not None and self.iface is not None:
+            self.iface.mapCanvas().scene().removeItem(self.rubber_band)
+        self.rubber_band = None

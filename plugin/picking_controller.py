@@ -1,0 +1,207 @@
+"""Clicks in the picking dock's image -> observations, and what the image and the table show.
+
+The decisions (which plane, line or control point a click measures, the point ids, the tie
+point's prediction in the other images, the residuals of the last calibration) are the core
+:class:`~lidarphoto.core.photo.picking_session.PickingSession`'s; this glue asks the user when
+outlines overlap, selects the target on the map, and redraws the overlays and the table.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from qgis.PyQt.QtCore import QObject, QPointF
+from qgis.PyQt.QtGui import QCursor
+from qgis.PyQt.QtWidgets import QMenu
+
+from ..core.photo.picking_session import PickTarget, ProjectedControl
+
+__all__ = ["HIT_SCREEN_PX", "PickingController"]
+
+#: hit tolerance of lines, control points and observations, screen pixels
+HIT_SCREEN_PX = 10.0
+_LAYER_OF = {"tie": "planes", "paper": "planes", "lcp": "lcps", "check": "lcps"}
+
+
+class PickingController(QObject):
+    """Picking and drawing for one dock (its session, store, viewer, table and map links)."""
+
+    def __init__(self, dock) -> None:
+        super().__init__(dock)
+        self.dock = dock
+        self.session, self.store = dock.session, dock.store
+        self.viewer, self.table = dock.viewer, dock.table
+        self.projected: ProjectedControl | None = None
+        self.selected_index = -1
+        self.viewer.view.hit_test = self.hit_observation
+        self.viewer.view.pointMoved.connect(self.moved)
+        self.viewer.residual_scale.valueChanged.connect(self.refresh)
+        self.table.rowSelected.connect(self.select_row)
+        self.store.changed.connect(self.store_changed)
+
+    def tr(self, text: str) -> str:
+        return self.dock.tr(text)
+
+    def oriented(self) -> bool:
+        return self.session.oriented(self.dock.current_image) and self.viewer.source is not None
+
+    # -- drawing ------------------------------------------------------------------------------
+    def highlighted(self) -> tuple[set[str], set[str]]:
+        """Ids of the planes and LCPs selected on the map."""
+        links = self.dock.loader.links
+        return links.selected("planes"), links.selected("lcps")
+
+    def refresh(self, *_args) -> None:
+        """Project the control into the current image and redraw every overlay (also when
+        the selection of a layer changes: its arguments are not used)."""
+        overlays = self.viewer.overlays
+        self.projected = None
+        if not self.oriented():
+            overlays.clear_all()
+            self.fill_table()
+            return
+        p = self.projected = self.session.project(self.dock.current_image)
+        control = self.session.control
+        hot_planes, hot_lcps = self.highlighted()
+        overlays.set_planes(p.rings, control.plane_ids, hot_planes)
+        overlays.set_lines(p.line_starts, p.line_ends, control.line_ids)
+        overlays.set_lcps(p.lcps, control.lcp_ids, hot_lcps)
+        self.draw_observations()
+        self.fill_table()
+
+    def draw_observations(self) -> None:
+        """The observations of the current image, their residuals and the prediction."""
+        img, overlays, log = self.dock.current_image, self.viewer.overlays, self.store.log
+        rows = log.indices_of_image(img) if self.oriented() else []
+        px = log.pixels(rows)
+        sel = rows.index(self.selected_index) if self.selected_index in rows else -1
+        overlays.set_observations(px, [log.rows[k].point_id for k in rows], sel)
+        res = self.session.residuals()
+        v = np.array([res.get(k, (np.nan, np.nan)) for k in rows]).reshape(-1, 2)
+        overlays.set_residuals(px, v, self.viewer.residual_scale.value())
+        pred = self.session.prediction(img)
+        pending = self.session.pending
+        overlays.set_predictions(
+            np.reshape(pred if pred is not None else [], (-1, 2)),
+            [pending.point_id] if pred is not None and pending is not None else [],
+        )
+
+    def fill_table(self) -> None:
+        log = self.store.log
+        rows = log.indices_of_image(self.dock.current_image)
+        self.table.fill(log.rows, rows, self.session.residuals(), self.selected_index)
+
+    def store_changed(self) -> None:
+        if self.selected_index >= len(self.store.rows):
+            self.selected_index = -1
+        if self.oriented():
+            self.draw_observations()
+        else:
+            self.viewer.overlays.clear("observations")
+        self.fill_table()
+
+    # -- picking ------------------------------------------------------------------------------
+    def _choose(self, targets: list[PickTarget]) -> PickTarget | None:
+        """The plane of a click; the user chooses when outlines overlap (None: cancelled)."""
+        if len(targets) == 1:
+            return targets[0]
+        labels = [
+            self.tr("plane {} ({:.1f} m away)").format(t.target_id, t.range_m) for t in targets
+        ]
+        return self.dock.choose_candidate(targets, labels)
+
+    def choose_from_menu(self, candidates: list, labels: list[str]):
+        """Let the user resolve an ambiguous plane (menu at the cursor); None: cancelled."""
+        menu = QMenu(self.dock)
+        actions = [menu.addAction(label) for label in labels]
+        chosen = menu.exec(QCursor.pos())
+        return candidates[actions.index(chosen)] if chosen in actions else None
+
+    def pick(self, col: float, row: float) -> int:
+        """A click at a pixel: add an observation of the current type; its row index, or -1
+        (with a message) when nothing was added."""
+        dock, session = self.dock, self.session
+        img = dock.current_image
+        if self.viewer.source is None:
+            dock.message(self.tr("No image shown."), warning=True)
+            return -1
+        if not self.oriented():
+            dock.message(
+                self.tr(
+                    "Image {} has no orientation: picking needs the camera and the "
+                    "exterior orientation."
+                ).format(img),
+                warning=True,
+            )
+            return -1
+        if session.prediction(img) is not None:
+            return self._added(session.confirm_prediction(img, (col, row)))  # corrected
+        kind = self.viewer.type_combo.currentText()
+        tol = HIT_SCREEN_PX / max(self.viewer.view.zoom, 1e-9)
+        targets = session.targets_at(img, (col, row), kind, tol, self.projected)
+        if not targets:
+            what = {"tie": "plane", "paper": "plane", "line": "line"}.get(kind, "lcp")
+            self.dock.message(
+                {
+                    "plane": self.tr("No roof plane under the cursor."),
+                    "line": self.tr("No line within {:.0f} px.").format(HIT_SCREEN_PX),
+                    "lcp": self.tr("No control point within {:.0f} px.").format(HIT_SCREEN_PX),
+                }[what]
+            )
+            return -1
+        target = self._choose(targets)
+        if target is None:
+            return -1
+        if kind in _LAYER_OF:
+            dock.loader.links.select(_LAYER_OF[kind], target.target_id)
+        index = session.add_observation(img, (col, row), target)  # saved by _added
+        point_id = self.store.rows[index].point_id
+        if kind == "tie":
+            n = len(session.pending.pixels) if session.pending is not None else 0
+            dock.message(
+                self.tr(
+                    "Tie {} on plane {}: predicted in {} other image(s) "
+                    "(Enter accepts, click corrects)."
+                ).format(point_id, target.target_id, n)
+            )
+        elif kind == "paper":
+            dock.message(self.tr("{} on plane {}.").format(point_id, target.target_id))
+        return self._added(index)
+
+    def _added(self, index: int) -> int:
+        if index >= 0:
+            self.store.edited()
+            self.selected_index = index
+            self.draw_observations()
+        return index
+
+    def accept_prediction(self) -> int:
+        """Accept the predicted position of the pending tie point in the current image."""
+        return self._added(self.session.confirm_prediction(self.dock.current_image))
+
+    def cancel_prediction(self) -> None:
+        self.session.cancel_prediction()
+        self.draw_observations()
+
+    # -- editing ------------------------------------------------------------------------------
+    def hit_observation(self, col: float, row: float, tol: float):
+        if not self.oriented():
+            return None
+        return self.session.observation_at(self.dock.current_image, (col, row), tol)
+
+    def moved(self, key, col: float, row: float) -> None:
+        self.store.move(int(key), col, row)
+        self.selected_index = int(key)
+
+    def delete_selected(self) -> None:
+        if 0 <= self.selected_index < len(self.store.rows):
+            self.store.delete(self.selected_index)
+            self.selected_index = -1
+
+    def select_row(self, k: int) -> None:
+        """A row chosen in the table: select its target on the map, centre the view on it."""
+        self.selected_index = k
+        o = self.store.rows[k]
+        if o.type in _LAYER_OF:
+            self.dock.loader.links.select(_LAYER_OF[o.type], o.target_id)
+        self.viewer.view.centerOn(QPointF(o.col, o.row))
+        self.draw_observations()

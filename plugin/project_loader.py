@@ -1,0 +1,181 @@
+"""What the picking dock's Project and Calibration tabs name, loaded into its core session once:
+the camera and exterior orientation (the picking scene), the control of the layers and tables,
+the observation file; and the tabs kept in the QGIS project (the session, restored on reading
+the project)."""
+
+from __future__ import annotations
+
+from qgis.core import QgsCoordinateReferenceSystem
+from qgis.PyQt.QtCore import QObject
+
+from ..core.errors import InputError
+from ..core.io.camera import read_camera_json
+from ..core.io.orientation import read_eo_csv
+from .control_layers import ControlLinks, read_control, read_tables
+from .observation_store import SESSION_SCOPE, load_session, save_session
+
+__all__ = ["ProjectLoader"]
+
+
+class ProjectLoader(QObject):
+    """Loads the inputs of a picking dock into ``dock.session`` and keeps its session."""
+
+    def __init__(self, dock) -> None:
+        super().__init__(dock)
+        self.dock = dock
+        self.session, self.store = dock.session, dock.store
+        self.inputs, self.settings = dock.project_panel, dock.calibration_panel
+        #: the layer feature of each target id (map selection)
+        self.links = ControlLinks()
+        self.restoring = False
+
+    def tr(self, text: str) -> str:
+        return self.dock.tr(text)
+
+    # -- orientation and control --------------------------------------------------------------
+    def set_project_files(self, camera="", eo="", crs="", images=(), observations="") -> None:
+        """Set the main inputs in one go (what the widgets do one by one)."""
+        p = self.inputs
+        p.blockSignals(True)
+        try:
+            if crs:
+                p.crs_widget.setCrs(QgsCoordinateReferenceSystem(crs))
+            p.camera_edit.setFilePath(str(camera))
+            p.eo_edit.setFilePath(str(eo))
+        finally:
+            p.blockSignals(False)
+        self.reload_orientation()
+        if images:
+            self.dock.set_images(images)
+        if observations:
+            p.obs_edit.setFilePath(str(observations))
+
+    def reload_orientation(self) -> None:
+        """Read the camera and the EO table; rebuild the picking scene."""
+        if self.restoring:
+            return
+        cam_path, eo_path = self.inputs.camera_edit.filePath(), self.inputs.eo_edit.filePath()
+        crs = self.inputs.crs()
+        self.session.set_orientation(None, None)
+        try:
+            camera = read_camera_json(cam_path) if cam_path else None
+            eo = read_eo_csv(eo_path, crs.toWkt()) if eo_path else None
+            # keeps the camera and the table when the scene cannot be made (e.g. no CRS)
+            self.session.set_orientation(camera, eo, crs.authid() or crs.toWkt())
+        except (InputError, OSError, ValueError) as exc:
+            self.dock.message(self.tr("Orientation not loaded: {}").format(exc), warning=True)
+        self.reload_control()
+        self.dock.fill_images()
+        self.check_foreign_observations()
+        self.save()
+
+    def use_orientation(self, eo, path: str) -> None:
+        """Take an exterior orientation table already in memory (the calibrated one); the
+        Project tab names ``path``, the file it was written to."""
+        p = self.inputs
+        p.blockSignals(True)
+        try:
+            p.eo_edit.setFilePath(str(path))
+        finally:
+            p.blockSignals(False)
+        crs = p.crs()
+        try:
+            self.session.set_orientation(self.session.camera, eo, crs.authid() or crs.toWkt())
+        except InputError as exc:
+            self.dock.message(self.tr("Orientation not loaded: {}").format(exc), warning=True)
+        self.dock.fill_images()
+        self.save()
+
+    def reload_control(self) -> None:
+        """Read the plane, line and LCP layers (and tables) into the session's control."""
+        try:
+            tables = read_tables(*self.settings.table_paths())
+        except (InputError, OSError) as exc:
+            self.dock.message(self.tr("Control table not read: {}").format(exc), warning=True)
+            tables = (None, None, None)
+        layers = self.inputs.layers()
+        control, self.links = read_control(layers, tables, self.inputs.crs(), self.dock.project)
+        self.session.control = control
+        skipped = control.skipped.get("planes", 0)
+        if skipped:
+            text = self.tr("{} plane(s) of {} have no heights and no a,b,c,d fields: skipped.")
+            self.dock.message(text.format(skipped, layers["planes"].name()), warning=True)
+        for layer in (layers["planes"], layers["lcps"]):
+            if layer is not None:
+                try:
+                    layer.selectionChanged.disconnect(self.dock.picking.refresh)
+                except TypeError:
+                    pass
+                layer.selectionChanged.connect(self.dock.picking.refresh)
+        self.dock.picking.refresh()
+        self.save()
+
+    # -- observations -------------------------------------------------------------------------
+    def open_observations(self, path: str) -> None:
+        """Open (or create) the observation file; it is autosaved after every change."""
+        if not path:
+            return
+        try:
+            n = self.store.load(path)
+        except InputError as exc:
+            self.dock.message(self.tr("Observations not loaded: {}").format(exc), warning=True)
+            return
+        self.session.set_calibration(None)  # its residuals were of the rows before
+        self.dock.picking.store_changed()
+        self.dock.message(self.tr("{} observation(s) in {}.").format(n, path))
+        self.check_foreign_observations()
+        self.save()
+
+    def check_foreign_observations(self) -> None:
+        eo = self.session.eo
+        if eo is None or not self.store.rows:
+            return
+        unknown = sorted(self.store.image_ids() - set(eo.image_id))
+        if unknown:
+            n = sum(o.image_id in unknown for o in self.store.rows)
+            self.dock.message(
+                self.tr(
+                    "{} observation row(s) name image(s) not in the exterior "
+                    "orientation ({}…): is the file from another project? They "
+                    "are kept in the file but not shown."
+                ).format(n, ", ".join(unknown[:3])),
+                warning=True,
+            )
+
+    # -- the session in the QGIS project ------------------------------------------------------
+    def values(self) -> dict:
+        values = self.inputs.values()
+        values.update(self.settings.values())
+        values["current_image"] = self.dock.current_image
+        return values
+
+    def save(self) -> None:
+        if self.restoring:
+            return
+        values = self.values()
+        project = self.dock.project
+        save_session(project, values)
+        project.writeEntry(SESSION_SCOPE, "crs", values["crs"])
+
+    def restore(self) -> None:
+        """Restore the session saved in the current QGIS project (if any)."""
+        project = self.dock.project
+        s = load_session(project)
+        crs, ok = project.readEntry(SESSION_SCOPE, "crs", "")
+        if not s:
+            return
+        panels = (self.inputs, self.settings)
+        self.restoring = True
+        for panel in panels:
+            panel.blockSignals(True)
+        try:
+            self.inputs.restore(s, project, crs if ok else "")
+            self.settings.restore(s)
+            self.dock.current_image = s.get("current_image", "")
+        finally:
+            for panel in panels:
+                panel.blockSignals(False)
+            self.restoring = False
+        if s.get("observations"):
+            self.open_observations(s["observations"])
+        self.reload_orientation()
