@@ -697,21 +697,8 @@ def calibrate(
     if paper_rows.size:
         blocks.append(
             _paper_block(
-                paper_rows,
-                observations,
-                img,
-                pose_idx,
-                r_nl,
-                spec,
-                planes,
-                plane_by_id,
-                p_params,
-                p_cov,
-                local,
-                lidar_points,
-                lidar_plane_ids,
-                opts,
-                x_init,
+                paper_rows, observations, img, pose_idx, r_nl, spec, planes, plane_by_id,
+                p_params, p_cov, local, lidar_points, lidar_plane_ids, opts, x_init,
             )
         )
         maps.append(("paper planes", paper_rows[:, None], "paper"))
