@@ -230,6 +230,11 @@ def _info_from_header(path: str, header: Any, crs: CrsLike, require_crs: bool) -
             if require_crs:
                 raise CrsError(str(exc), path=path) from exc
             unit, to_metre, vertical = "unknown", float("nan"), float("nan")
+    mins = np.asarray(header.mins, dtype=np.float64).copy()
+    maxs = np.asarray(header.maxs, dtype=np.float64).copy()
+    if use is not None:  # a CRS that cannot hold these coordinates (or a unit mix-up)
+        frames.check_area_of_use(use, mins[:2], maxs[:2], what="the cloud (header extent)",
+                                 path=path)  # fmt: skip
     by_return = np.asarray(header.number_of_points_by_return)
     return CloudInfo(
         path=path,
@@ -240,8 +245,8 @@ def _info_from_header(path: str, header: Any, crs: CrsLike, require_crs: bool) -
         horizontal_unit=unit,
         unit_to_metre=to_metre,
         vertical_unit_to_metre=vertical,
-        mins=np.asarray(header.mins, dtype=np.float64).copy(),
-        maxs=np.asarray(header.maxs, dtype=np.float64).copy(),
+        mins=mins,
+        maxs=maxs,
         dimensions=tuple(header.point_format.dimension_names),
         has_return_numbers=bool(by_return.sum() > 0),
     )
