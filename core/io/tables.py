@@ -157,6 +157,45 @@ def unique_ids(table: Table, index: int) -> tuple[str, ...]:
     return values
 
 
+def check_covariance(cov: NDArray[np.float64], table: Table, k: int, what: str) -> None:
+    """Refuse (naming the file and row) a covariance matrix that is not positive
+    semi-definite: a negative variance or an impossible correlation.
+
+    >>> t = Table("p.csv", ("id",), (("1",),), (2,))
+    >>> try:
+    ...     check_covariance(np.diag([1.0, -1e-3]), t, 0, "covariance of (a, b)")
+    ... except InputError as exc:
+    ...     print(exc)  # doctest: +NORMALIZE_WHITESPACE
+    p.csv, row 2: the covariance of (a, b) is not positive semi-definite (smallest
+    eigenvalue -0.001)
+    """
+    scale = max(1.0, float(np.abs(cov).max()))
+    low = float(np.linalg.eigvalsh(cov).min())
+    if not np.isfinite(low) or low < -1e-12 * scale:
+        raise InputError(
+            f"the {what} is not positive semi-definite (smallest eigenvalue {low:.3g})",
+            path=table.path,
+            row=table.line_numbers[k],
+        )
+
+
+def unique_integer_ids(table: Table, values: NDArray[np.float64], index: int) -> list[int]:
+    """The id column as integers, each once; errors name the file, row and column."""
+    seen: dict[int, int] = {}
+    out = []
+    for k, (value, number) in enumerate(zip(values, table.line_numbers)):
+        if value != round(value):
+            raise InputError(f"'{table.rows[k][index]}' is not an integer id", path=table.path,
+                             row=number, column=table.columns[index])  # fmt: skip
+        key = int(value)
+        if key in seen:
+            raise InputError(f"id {key} already appears in row {seen[key]}", path=table.path,
+                             row=number, column=table.columns[index])  # fmt: skip
+        seen[key] = number
+        out.append(key)
+    return out
+
+
 def write_csv_atomic(
     path: PathLike,
     columns: Sequence[str],

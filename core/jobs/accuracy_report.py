@@ -188,7 +188,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the check points, assess them, write the HTML report and the JSON."""
     import json
 
+    import numpy as np
+
     from ..errors import stop_if_asked
+    from ..geometry.frames import check_area_of_use, parse_crs
     from ..io.atomic import write_text_atomic
     from ..quality.accuracy import assess_accuracy, report_to_dict
     from ..quality.accuracy_html import render_html
@@ -203,6 +206,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     )
     points = _points(v)
     log.info("%d check points from %s", len(points), points.source)
+    if points.crs:  # coordinates that cannot be in the stated CRS are refused
+        xyz = np.vstack([points.measured, points.reference])
+        check_area_of_use(parse_crs(points.crs), xyz.min(axis=0), xyz.max(axis=0),
+                          what="the check points", path=points.source or None)  # fmt: skip
     report = assess_accuracy(points, settings, progress=progress, should_stop=should_stop)
     stop_if_asked(should_stop, "writing the report")
     if out.requested("OUTPUT_HTML"):
@@ -213,6 +220,13 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if progress is not None:
         progress(1.0)
     lines = [f"{key} {value:.4f}" for key, value in report.rmse.items()]
+    if report.contrast is not None:
+        n_flag = int(report.outliers.any.sum())
+        lines.append(
+            f"{n_flag} point(s) flagged as outliers ({report.overall.name} above); "
+            f"{report.contrast.name}: "
+            + ", ".join(f"{k} {v:.4f}" for k, v in report.rmse_contrast.items())
+        )
     lines += [
         f"{res.key}: {verdict.name}: {verdict.status} ({verdict.reason})"
         for res in report.standards
