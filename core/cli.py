@@ -167,6 +167,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"lidarphoto {args.algorithm}: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
+    except MemoryError:
+        print(f"lidarphoto {args.algorithm}: error: out of memory; nothing was written (use a "
+              "coarser cell or a smaller input)", file=sys.stderr)  # fmt: skip
+        return 2
     if result.stdout:
         sys.stdout.write(result.stdout)
     for line in result.lines:

@@ -374,7 +374,8 @@ def check_area_of_use(
         )
         raise CrsError(
             f"{what} ({box}) lies outside the area of use of '{horizontal.name}' "
-            f"({area.name}: longitude {area.west:g} to {area.east:g}, latitude {area.south:g} "
+            f"({area.name.rstrip('.')}: longitude {area.west:g} to {area.east:g}, latitude "
+            f"{area.south:g} "
             f"to {area.north:g} deg; {where}): wrong CRS, or coordinates in another unit or "
             "axis order",
             path=path,

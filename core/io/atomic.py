@@ -140,12 +140,27 @@ def same_file(a: PathLike, b: PathLike) -> bool:
     return os.path.realpath(a) == os.path.realpath(b)
 
 
+def _check_writable(name: str, target: Path) -> None:
+    """Refuse, before any work, an output that cannot be written: a folder in its place, a
+    file where a folder of its path should be, or a folder without write permission."""
+    if target.is_dir():
+        raise InputError(f"{name}: {target} is a folder; give a file name")
+    folder = target.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise InputError(f"{name}: cannot write {target}: {folder} is a file, not a folder")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise InputError(f"{name}: cannot write {target}: no permission to write in {folder}")
+
+
 class OutputSet:
     """The output files of one job, committed together.
 
     ``outputs`` maps a parameter name to its path (None or "" when not requested); ``inputs``
     maps parameter names to the input files. The constructor refuses (InputError) an output
-    that is an input or another output, before anything is read. The job writes each output
+    that is an input or another output, or that cannot be written (a folder, a file on its
+    path, a folder without write permission), before anything is read. The job writes each output
     through :meth:`path` (a temporary name) and the caller calls :meth:`commit` once the job
     succeeded, or :meth:`discard` (also the effect of leaving the ``with`` block by an error).
     Temporaries of the outputs older than an hour, which only a killed process leaves behind,
@@ -187,6 +202,8 @@ class OutputSet:
             for b in names[i + 1 :]:
                 if same_file(self.targets[a], self.targets[b]):
                     raise InputError(f"{a} and {b} are the same file ({self.targets[a]})")
+        for name, target in self.targets.items():
+            _check_writable(name, target)
         for target in self.targets.values():  # left by a killed run of this job (SIGKILL)
             remove_stale_temporaries(target)
 

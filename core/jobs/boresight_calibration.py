@@ -104,7 +104,7 @@ written and each starts with a warning (CSV: comment lines beginning with #)."""
         Param("INS_SIGMAS", "numbers",
               "Custom INS sigmas: horizontal, vertical, roll/pitch, heading",
               (0.02, 0.05, 0.015, 0.035), count=4, unit="m, m, deg, deg", optional=True,
-              advanced=True),
+              advanced=True, minimum=0.0001, maximum=100.0),
         Param("SNOOPING", "boolean", "Data snooping (Baarda)", True),
         Param("MAX_BORESIGHT", "number", "Largest plausible boresight angle", 2.0,
               unit="degrees", minimum=0.001, maximum=45.0, advanced=True,
@@ -229,7 +229,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         warning.insert(0, "WARNING: this calibration failed its checks and was written only "
                        "because ACCEPT_DOUBTFUL was set; do not use it without review")
         for line in warning:
-            log.warning(line)
+            log.warning(line.removeprefix("WARNING: "))
     ground = ground_positions(result, obs, cam, plane_list, line_list, lcp_list)
     image_group = dict(zip(traj.image_id, group_labels(traj, options.groups)))
     run = BoresightRun(
@@ -281,17 +281,21 @@ def doubts_about(result, max_boresight_deg: float, max_sigma0: float) -> list[st
             "than their sigmas say (wrong sigma_px or INS grade, or undetected blunders)"
         )
     deg = result.boresight_deg
+    large, nonfinite = [], []
     for g, name in enumerate(result.groups):
         for k, angle in enumerate(("d_omega", "d_phi", "d_kappa")):
             value = float(deg[g, k])
             if not np.isfinite(value) or not np.isfinite(result.std[g, k]):
-                out.append(f"group {name}: {angle} is not a finite number")
+                nonfinite.append(f"{angle} of group {name}")
             elif abs(value) > max_boresight_deg:
-                out.append(
-                    f"group {name}: {angle} = {value:.4f} deg exceeds MAX_BORESIGHT "
-                    f"{max_boresight_deg:g} deg: implausible for a misalignment (wrong MOUNT, "
-                    "image ids or observations)"
-                )
+                large.append(f"{angle} = {value:.4f} deg in group {name}")
+    if nonfinite:
+        out.append(f"not a finite number: {', '.join(nonfinite)}")
+    if large:
+        out.append(
+            f"{', '.join(large)} beyond MAX_BORESIGHT {max_boresight_deg:g} deg: implausible "
+            "for a misalignment (wrong MOUNT, image ids or observations?)"
+        )
     return out
 
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import logging
 
-from ..lidar.ground_filter import GROWTH_CHOICES, WINDOW_SHAPES, GroundFilterParams
 from ..errors import InputError
+from ..lidar.ground_filter import GROWTH_CHOICES, WINDOW_SHAPES, GroundFilterParams
 from .checks import GROUND_FILTER_BYTES_PER_CELL, GROUND_FILTER_BYTES_PER_POINT, check_cell_size
 from .common import cloud_params, lengths_in_cloud_units, unit_text
 from .runner import JobResult, stages

@@ -64,8 +64,9 @@ class Param:
     ``unit`` is shown with the label and in the help ("m", "deg", "px", "cloud unit", ...);
     ``minimum``/``maximum`` bound numbers, and each of ``numbers``, to the physically
     meaningful range (both views refuse values outside, naming the parameter); ``options``
-    are an enum's machine names (what the command line takes; QGIS shows ``labels``); ``aliases`` are extra command-line spellings of options;
-    ``qgis_default`` overrides ``default`` in QGIS only (e.g. ``"ProjectCrs"``).
+    are an enum's machine names (what the command line takes; QGIS shows ``labels``);
+    ``aliases`` are extra command-line spellings of options; ``qgis_default`` overrides
+    ``default`` in QGIS only (e.g. ``"ProjectCrs"``).
     """
 
     name: str

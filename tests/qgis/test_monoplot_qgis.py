@@ -110,11 +110,14 @@ def test_processing_run_from_laz(provider, scene, tmp_path):
     assert (tmp_path / "dsm.tif").stat().st_size > 120 * 120 * 4
 
 
-def test_dsm_in_another_crs_is_reported_per_point(provider, scene):
+def test_dsm_whose_geoid_grid_is_missing_is_refused(provider, scene, tmp_path):
     folder, _ = scene
-    result = processing.run(ALG, _params(folder, DSM=str(AHN3)))  # the file says EPSG:7415
-    status = {f["status_text"] for f in result["OUTPUT_POINTS"].getFeatures()}
-    assert status == {"crs_mismatch"} and result["HIT_COUNT"] == 0
+    out = tmp_path / "pts.csv"
+    # the file says EPSG:7415 (RD New + NAP); the NAP geoid grid is not installed
+    with pytest.raises(QgsProcessingException, match=r"cannot be brought into the mapping CRS"
+                       r".*nl_nsgi_nlgeo2018"):
+        processing.run(ALG, _params(folder, DSM=str(AHN3), OUTPUT_CSV=str(out)))
+    assert not out.exists() and not list(tmp_path.iterdir())
 
 
 def test_missing_camera_is_an_error(provider, scene, tmp_path):
