@@ -25,9 +25,8 @@ type
 target_id
     Id of the plane, line or LCP in its table (integers in the project's tables).
 
-A point is measured once per image: a second row with the same image_id and point_id is an
-error (it would count twice). Errors name the file, the row (the header is row 1) and the
-column. The image-picking dock writes the same table.
+A row repeated (same image_id, point_id, type, target_id, col and row) is an error: it would
+count twice. Errors name the file, the row (the header is row 1) and the column. The image-picking dock writes the same table.
 """
 
 from __future__ import annotations
@@ -65,8 +64,7 @@ def read_observations_csv(
     ------
     InputError
         Missing columns, non-numeric values, sigma_px not in (0, 100] px, unknown types, a
-        point measured twice in one image, a pixel off the camera's image; naming the file,
-        row and column.
+        duplicate row, a pixel off the camera's image; naming the file, row and column.
     """
     table = read_table(path)
     image = text_column(table, find_column(table, ("image_id", "image", "photo")))
@@ -102,15 +100,16 @@ def read_observations_csv(
     g_col = find_column(table, ("target_id", "target", "plane_id", "line_id", "lcp_id"))
     target = text_column(table, g_col)
     # tie rows need their plane id; every other type needs its target too
-    first: dict[tuple[str, str], int] = {}
-    for key, number in zip(zip(image, point), table.line_numbers):
+    # a row copied twice would count twice; the same point measured again (another pixel)
+    # is a second measurement, as the picking dock records it
+    first: dict[tuple[object, ...], int] = {}
+    for key, number in zip(zip(image, point, kinds, target, col, row), table.line_numbers):
         if key in first:
             raise InputError(
-                f"point '{key[1]}' is measured twice in image '{key[0]}' (rows "
-                f"{first[key]} and {number}): remove one of them",
+                f"row {first[key]} again (point '{key[1]}' of image '{key[0]}' at the same "
+                "pixel): a duplicate row would count twice; remove one of them",
                 path=table.path,
                 row=number,
-                column=table.columns[point_col],
             )
         first[key] = number
     if camera is not None:

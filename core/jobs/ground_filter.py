@@ -202,10 +202,11 @@ def _check_against_data(v: Values, info) -> None:
     check_cell_size("CELL_SIZE", v.cell_size, unit, mins, maxs, GROUND_FILTER_BYTES_PER_CELL,
                     extra_bytes=info.point_count * per_point)  # fmt: skip
     width, height = maxs - mins
-    if v.max_window > max(width, height):
+    # a window wider than the data opens it as one the data's size does: harmless up to a
+    # point, a unit or typing mistake beyond twice the extent
+    if v.max_window > 2.0 * max(width, height):
         raise InputError(
-            f"MAX_WINDOW: {v.max_window:g} {unit} is larger than the data's extent "
-            f"({width:.4g} x {height:.4g} {unit}): give a window smaller than the extent "
-            "(about the size of the largest building)"
+            f"MAX_WINDOW: {v.max_window:g} {unit} is more than twice the data's extent "
+            f"({width:.4g} x {height:.4g} {unit}): give about the size of the largest building"
         )
 

@@ -397,7 +397,8 @@ def check_value(p: Param, value: Any) -> None:
         items = [(f" (number {k + 1} of {len(value)})", v) for k, v in enumerate(value)]
     else:
         return
-    unit = f" {p.unit}" if p.unit and "," not in p.unit else ""
+    # a unit in the message, not a description of one ("m, degrees", "horizontal length")
+    unit = f" {p.unit}" if p.unit and "," not in p.unit and "length" not in p.unit else ""
     for which, v in items:
         if not math.isfinite(v):
             raise InputError(f"{p.name}{which}: must be a finite number, got {v}")

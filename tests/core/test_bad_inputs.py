@@ -185,7 +185,7 @@ def _traj(inp: Path, rows: list[str], crs: str = RD) -> list[str]:
 CASES = [
     # -- parameters outside their physical range, named
     Case("cell size zero", lambda i, o, f: _ground(i, o, "--cell-size", "0"),
-         r"CELL_SIZE: must be >= 0\.01 horizontal length, got 0$"),
+         r"CELL_SIZE: must be >= 0\.01, got 0$"),
     Case("slope beyond 10:1", lambda i, o, f: _ground(i, o, "--slope", "50"),
          r"SLOPE: must be <= 10 rise/run, got 50$"),
     Case("lever arm in millimetres", lambda i, o, f: _traj(i, ["a,0,,85000,447500,500,0,0,0"])
@@ -214,7 +214,8 @@ CASES = [
          r"CELL_SIZE: 100 metre is larger than the data's extent \(60 x 59\.99 metre\): give "
          r"a cell smaller than the extent$"),
     Case("window larger than the tile", lambda i, o, f: _ground(i, o, "--max-window", "500"),
-         r"MAX_WINDOW: 500 metre is larger than the data's extent \(60 x 59\.99 metre\)"),
+         r"MAX_WINDOW: 500 metre is more than twice the data's extent \(60 x 59\.99 metre\): "
+         r"give about the size of the largest building$"),
     Case("grid too large for the memory", lambda i, o, f: _ground(i, o, "--cell-size", "0.02"),
          r"CELL_SIZE 0\.02 metre: a grid of 3001 x 3000 cells over 60 x 59\.99 metre needs "
          r"about 723\.4 MB of memory; 100\.0 MB is free: give a larger cell$",
@@ -238,10 +239,11 @@ CASES = [
         i, ["img,p1,500,400,0.5,check,1", "img,p2,1200,400,0.5,check,1"]) + ["--dsm-crs", RD],
          r"obs\.csv, row 3, column 'col': 1200 px is off the image: the camera 'test' has "
          r"width_px 1000 \(pixels from 0 to 1000\); 1 row\(s\) affected$"),
-    Case("point measured twice in one image", lambda i, o, f: _monoplot_inputs(
-        i, ["img,p1,500,400,0.5,check,1", "img,p1,501,400,0.5,check,1"]) + ["--dsm-crs", RD],
-         r"obs\.csv, row 3, column 'point_id': point 'p1' is measured twice in image 'img' "
-         r"\(rows 2 and 3\)"),
+    Case("observation row twice", lambda i, o, f: _monoplot_inputs(
+        i, ["img,p1,500,400,0.5,check,1", "img,p2,501,400,0.5,check,1",
+            "img,p1,500,400,0.5,check,1"]) + ["--dsm-crs", RD],
+         r"obs\.csv, row 4: row 2 again \(point 'p1' of image 'img' at the same pixel\): a "
+         r"duplicate row would count twice; remove one of them$"),
     Case("sigma_px in micrometres", lambda i, o, f: _monoplot_inputs(
         i, ["img,p1,500,400,450,check,1"]) + ["--dsm-crs", RD],
          r"obs\.csv, row 2, column 'sigma_px': sigma_px must be > 0 and <= 100 pixels, got "
