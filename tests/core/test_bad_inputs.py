@@ -389,7 +389,7 @@ def test_stop_signal_removes_every_temporary(tmp_path, signum, code, words):
     argv = _ground(inp, out, "--output-dtm", str(out / "dtm.tif"))
     before = _snapshot(inp)
     proc = subprocess.Popen(
-        [sys.executable, "-c", _SLOW_WRITER, *argv],
+        [sys.executable, "-W", "ignore", "-c", _SLOW_WRITER, *argv],  # (library warnings)
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
     try:
