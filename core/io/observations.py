@@ -26,7 +26,8 @@ target_id
     Id of the plane, line or LCP in its table (integers in the project's tables).
 
 A row repeated (same image_id, point_id, type, target_id, col and row) is an error: it would
-count twice. Errors name the file, the row (the header is row 1) and the column. The image-picking dock writes the same table.
+count twice. Errors name the file, the row (the header is row 1) and the column. The
+image-picking dock writes the same table.
 """
 
 from __future__ import annotations
