@@ -22,7 +22,9 @@ principal point as a pixel position (col, row) in the convention above (defaults
 the project works in millimetres. Distortion coefficients are always those of
 :mod:`core.geometry.distortion`, defined for millimetre coordinates (not OpenCV's normalised ones).
 Keys ``"description"`` and any key starting with ``"_"`` are ignored (comments); any other
-unknown key is an error, so that a misspelt key is never silently dropped.
+unknown key is an error, so that a misspelt key is never silently dropped. Values outside the
+physical ranges (a pixel of 0.5 um to 0.5 mm, a focal length of 1 mm to 5 m, at most 200000
+pixels a side, the principal point on the image) are refused: they are in another unit.
 """
 
 from __future__ import annotations

@@ -16,24 +16,31 @@ CSV_FILTER = "CSV files (*.csv *.txt)"
 CSV_OUT = "CSV files (*.csv)"
 LAS_FILTER = "LAS/LAZ files (*.las *.laz *.LAS *.LAZ)"
 DISTANCE_UNITS = ("crs", "metre")
+#: Largest lever-arm component (m): longer than any survey aircraft, so a larger value is a
+#: unit mistake (millimetres typed as metres).
+MAX_LEVER_ARM_M = 50.0
+#: Largest boresight angle (degrees) an input may have: a misalignment is a fraction of a
+#: degree; a rotation of the mount belongs in MOUNT / MOUNT_MATRIX.
+MAX_BORESIGHT_DEG = 10.0
 
 
 def mount_params() -> tuple[Param, ...]:
     """LEVER_ARM, MOUNT, MOUNT_MATRIX and BORESIGHT (``core.photo.mount``)."""
     return (
         Param("LEVER_ARM", "numbers", "Lever arm x,y,z", (0.0, 0.0, 0.0), count=3,
-              unit="m, body frame",
+              unit="m, body frame", minimum=-MAX_LEVER_ARM_M, maximum=MAX_LEVER_ARM_M,
               help="camera perspective centre in the INS body frame (x forward, y right, "
               "z down)"),
         Param("MOUNT", "enum", "Camera mount", MOUNT_CHOICES[0], options=MOUNT_CHOICES,
               labels=tuple(f"{m}: {MOUNT_LABELS[m]}" for m in MOUNT_CHOICES),
               help="nominal camera-to-body rotation; custom uses MOUNT_MATRIX"),
         Param("MOUNT_MATRIX", "numbers", "Mount matrix R_c^b (9 numbers, row-major)",
-              count=9, optional=True, advanced=True,
+              count=9, optional=True, advanced=True, minimum=-1.0, maximum=1.0,
               help="the nominal mount R_c^b when MOUNT is custom"),
         Param("BORESIGHT", "numbers", "Boresight domega,dphi,dkappa", (0.0, 0.0, 0.0),
-              count=3, unit="degrees",
-              help="small misalignment about the camera axes x, y, z"),
+              count=3, unit="degrees", minimum=-MAX_BORESIGHT_DEG, maximum=MAX_BORESIGHT_DEG,
+              help="small misalignment about the camera axes x, y, z (a larger rotation "
+              "belongs in MOUNT)"),
     )  # fmt: skip
 
 

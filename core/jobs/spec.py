@@ -62,10 +62,11 @@ class Param:
     """One parameter of an algorithm (see the module docstring for the kinds).
 
     ``unit`` is shown with the label and in the help ("m", "deg", "px", "cloud unit", ...);
-    ``minimum``/``maximum`` bound numbers (both views refuse values outside, naming the
-    parameter); ``options`` are an enum's machine names (what the command line takes; QGIS
-    shows ``labels``); ``aliases`` are extra command-line spellings of options;
-    ``qgis_default`` overrides ``default`` in QGIS only (e.g. ``"ProjectCrs"``).
+    ``minimum``/``maximum`` bound numbers, and each of ``numbers``, to the physically
+    meaningful range (both views refuse values outside, naming the parameter); ``options``
+    are an enum's machine names (what the command line takes; QGIS shows ``labels``);
+    ``aliases`` are extra command-line spellings of options; ``qgis_default`` overrides
+    ``default`` in QGIS only (e.g. ``"ProjectCrs"``).
     """
 
     name: str
@@ -391,12 +392,20 @@ def check_value(p: Param, value: Any) -> None:
             raise InputError(f"{p.name} ({p.label}) is required")
         return
     if p.kind in ("number", "integer"):
-        if not math.isfinite(value):
-            raise InputError(f"{p.name}: must be a finite number, got {value}")
-        if p.minimum is not None and value < p.minimum:
-            raise InputError(f"{p.name}: must be >= {p.minimum:g}, got {value:g}")
-        if p.maximum is not None and value > p.maximum:
-            raise InputError(f"{p.name}: must be <= {p.maximum:g}, got {value:g}")
+        items = [("", value)]
+    elif p.kind == "numbers":
+        items = [(f" (number {k + 1} of {len(value)})", v) for k, v in enumerate(value)]
+    else:
+        return
+    # a unit in the message, not a description of one ("m, degrees", "horizontal length")
+    unit = f" {p.unit}" if p.unit and "," not in p.unit and "length" not in p.unit else ""
+    for which, v in items:
+        if not math.isfinite(v):
+            raise InputError(f"{p.name}{which}: must be a finite number, got {v}")
+        if p.minimum is not None and v < p.minimum:
+            raise InputError(f"{p.name}{which}: must be >= {p.minimum:g}{unit}, got {v:g}")
+        if p.maximum is not None and v > p.maximum:
+            raise InputError(f"{p.name}{which}: must be <= {p.maximum:g}{unit}, got {v:g}")
 
 
 def parse_values(spec: AlgorithmSpec, raw: Mapping[str, Any]) -> Values:

@@ -166,6 +166,21 @@ def test_low_outliers_are_removed_and_never_ground():
     assert score_classification(off.ground[others], truth[others]).type1 > s.type1
 
 
+def test_a_point_without_neighbours_is_no_low_outlier():
+    """Only cells holding points count as neighbours: a lone point (a pole, the edge of a
+    strip) has nothing around it to be lower than, whatever its height."""
+    rng = np.random.default_rng(11)
+    x, y, z, _ = _scene(rng, 0.05, spacing=1.0)
+    lone = np.array([[200.0, 60.0, 5.0], [60.0, 200.0, -30.0]])  # 80 m beyond the scene
+    x, y, z = np.r_[x, lone[:, 0]], np.r_[y, lone[:, 1]], np.r_[z, lone[:, 2]]
+    r = ground_filter(x, y, z)
+    assert not r.low_outlier[-2:].any()
+    assert r.low_outlier.sum() == 0
+    # a real pit inside the scene is still found
+    z[100] -= 6.0
+    assert ground_filter(x, y, z).low_outlier[[100]].all()
+
+
 def test_only_last_returns_can_be_ground():
     rng = np.random.default_rng(9)
     x, y, z, truth = _scene(rng, 0.05)
