@@ -16,6 +16,7 @@ from __future__ import annotations
 import contextlib
 import os
 import tempfile
+import time
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import IO, Any, Union
@@ -260,3 +261,46 @@ class OutputSet:
                 Path(side).unlink(missing_ok=True)
         self._temps.clear()
         self._done = True
+
+
+def remove_stale_temporaries(path: PathLike, older_than_s: float = 3600.0) -> list[str]:
+    """Remove the temporaries of ``path`` left by writes that never finished (a killed
+    process): the files ``.<stem>.*.part<suffix>`` next to it last modified more than
+    ``older_than_s`` seconds ago. Younger ones may belong to a write in progress and are kept.
+
+    Returns the paths removed. A file that cannot be removed (or vanishes meanwhile) is left.
+
+    >>> import os, tempfile, pathlib, time
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> old, new = folder / ".obs.abc123.part.csv", folder / ".obs.xyz789.part.csv"
+    >>> for p in (old, new, folder / "obs.csv"):
+    ...     _ = p.write_text("x")
+    >>> os.utime(old, (time.time() - 7200, time.time() - 7200))
+    >>> [pathlib.Path(p).name for p in remove_stale_temporaries(folder / "obs.csv")]
+    ['.obs.abc123.part.csv']
+    >>> sorted(p.name for p in folder.iterdir())
+    ['.obs.xyz789.part.csv', 'obs.csv']
+    """
+    target = Path(path)
+    prefix, suffix = f".{target.stem}.", TEMP_SUFFIX + target.suffix
+    folder = target.parent
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    limit = time.time() - older_than_s
+    removed = []
+    for name in sorted(names):
+        if not (
+            name.startswith(prefix) and name.endswith(suffix) and len(name) > len(prefix + suffix)
+        ):
+            continue
+        candidate = folder / name
+        try:
+            if not candidate.is_file() or candidate.stat().st_mtime > limit:
+                continue
+            candidate.unlink()
+        except OSError:
+            continue
+        removed.append(str(candidate))
+    return removed

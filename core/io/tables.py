@@ -10,7 +10,6 @@ from __future__ import annotations
 import csv
 import math
 import os
-import tempfile
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from .atomic import atomic_write
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -160,22 +160,15 @@ def unique_ids(table: Table, index: int) -> tuple[str, ...]:
 def write_csv_atomic(
     path: PathLike, columns: Sequence[str], rows: Iterable[Sequence[object]]
 ) -> None:
-    """Write a CSV to a temporary file in the same folder, then move it into place.
+    """Write a CSV to a temporary file in the same folder, then move it into place
+    (:func:`.atomic.atomic_write`: the file keeps its mode, a new one gets the umask's).
 
     A crash or an error while writing never leaves a half-written file at ``path``.
     """
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    try:
-        with os.fdopen(fd, "w", newline="", encoding="utf-8") as fh:
-            writer = csv.writer(fh, lineterminator="\n")
-            writer.writerow(columns)
-            writer.writerows(rows)
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_write(path, newline="") as fh:
+        writer = csv.writer(fh, lineterminator="\n")
+        writer.writerow(columns)
+        writer.writerows(rows)
 
 
 def _detect_delimiter(header: str) -> str | None:
