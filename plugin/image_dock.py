@@ -73,7 +73,7 @@ class ImagePickingDock(QgsDockWidget):
         self.setWindowTitle(self.tr("Image Point Picking"))
         self.project = QgsProject.instance()
         self.session = PickingSession()
-        self.store = ObservationStore(parent=self, log=self.session.observations)
+        self.store = ObservationStore(parent=self, session=self.session)
         self.current_image = ""
         self.messages: list[str] = []
         self._build_ui()

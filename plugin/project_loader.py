@@ -12,7 +12,7 @@ from ..core.errors import InputError
 from ..core.io.camera import read_camera_json
 from ..core.io.orientation import read_eo_csv
 from .control_layers import ControlLinks, read_control, read_tables
-from .observation_store import SESSION_SCOPE, load_session, save_session
+from .observation_store import SESSION_SCOPE, gc_deferred, load_session, save_session
 
 __all__ = ["ProjectLoader"]
 
@@ -103,10 +103,10 @@ class ProjectLoader(QObject):
         for layer in (layers["planes"], layers["lcps"]):
             if layer is not None:
                 try:
-                    layer.selectionChanged.disconnect(self.dock.picking.refresh)
+                    layer.selectionChanged.disconnect(self.dock.picking.selection_changed)
                 except TypeError:
                     pass
-                layer.selectionChanged.connect(self.dock.picking.refresh)
+                layer.selectionChanged.connect(self.dock.picking.selection_changed)
         self.dock.picking.refresh()
         self.save()
 
@@ -159,6 +159,10 @@ class ProjectLoader(QObject):
 
     def restore(self) -> None:
         """Restore the session saved in the current QGIS project (if any)."""
+        with gc_deferred():  # (many short-lived objects: see gc_deferred)
+            self._restore()
+
+    def _restore(self) -> None:
         project = self.dock.project
         s = load_session(project)
         crs, ok = project.readEntry(SESSION_SCOPE, "crs", "")
