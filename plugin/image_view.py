@@ -47,7 +47,7 @@ from qgis.PyQt.QtWidgets import (
 )
 
 from .image_loader import OverviewTask, TileLoader, TileRequest, to_qimage
-from .image_source import ImageSource
+from .image_source import ImageSource, ImageSourceError
 
 __all__ = ["TILE", "VIEW_HELP", "ImageView", "event_position", "pointer_position"]
 
@@ -335,7 +335,11 @@ class ImageView(QGraphicsView):
         self._task = None
         src = self.source
         if ok and src is not None:
-            src.reopen()  # now it sees the pyramid
+            try:
+                src.reopen()  # now it sees the pyramid
+            except ImageSourceError as exc:  # e.g. QGIS shutting down (GDAL's drivers gone)
+                ok, message = False, str(exc)
+        if ok and src is not None:
             self._loader.reopen()
             self._status("")
             if src.quick:  # the pyramid's averaged level replaces the decimated preview

@@ -15,6 +15,7 @@ planes and control points whose highlight changed (:meth:`Overlays.set_highlight
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Hashable, Sequence
 
 import numpy as np
@@ -89,6 +90,8 @@ class Overlays:
         self._brushes = {name: QBrush(c) for name, c in COLOURS.items()}
         #: synchronised groups: key -> (key, items...)
         self._synced: dict[str, dict[Hashable, tuple]] = {}
+        #: the selected observation: (row, its marker items) or None
+        self._selected: tuple | None = None
         #: planes and LCPs by id: [(items..., hot)] for restyling the highlight
         self._by_id: dict[str, dict[str, list[list]]] = {"planes": {}, "lcps": {}}
         for name in GROUPS:
@@ -102,6 +105,8 @@ class Overlays:
         self.scene.addItem(group)
         self.groups[name] = group
         self._synced[name] = {}
+        if name == "observations":
+            self._selected = None
         if name in self._by_id:
             self._by_id[name] = {}
         return group
@@ -275,28 +280,41 @@ class Overlays:
         return {t for t, entries in self._by_id[kind].items() if any(e[2] for e in entries)}
 
     # -- measurements -------------------------------------------------------------------------
-    def _observation(self, parent, key) -> tuple:
-        text, x, y, sel = key
-        colour, size = ("selected", 10) if sel else ("observations", 7)
+    def _observation(self, parent, o) -> tuple:
+        x, y = float(o.col), float(o.row)
         return (
-            self._add_marker(parent, x, y, "cross", size, colour, 2.0),
-            self._add_marker(parent, x, y, "circle", size, colour, 1.0),
-            self._label(parent, text, x, y, colour),
+            self._add_marker(parent, x, y, "cross", 7, "observations", 2.0),
+            self._add_marker(parent, x, y, "circle", 7, "observations", 1.0),
+            self._label(parent, str(o.point_id), x, y, "observations"),
         )
 
-    def set_observations(
-        self, pixels: np.ndarray, labels: Sequence[str], selected: int = -1
-    ) -> None:
-        """Measured points (N, 2) of the current image; ``selected`` is drawn larger. Only
-        the markers that changed are redrawn."""
-        p = np.reshape(pixels, (-1, 2))
-        ok = _finite_rows(p)
-        keys = [
-            (text, x, y, k == selected)
-            for k, ((x, y), text, good) in enumerate(zip(p.tolist(), labels, ok.tolist()))
-            if good
-        ]
-        self._sync("observations", keys, self._observation)
+    def set_observations(self, rows: Sequence, selected: int = -1) -> None:
+        """Measured points of the current image: ``rows`` are observation rows (``col``,
+        ``row``, ``point_id``; immutable and hashable, as
+        :class:`~lidarphoto.core.photo.observation_list.Observation`); ``rows[selected]`` is
+        drawn larger, in white, on top. Only the markers of rows that changed are redrawn."""
+        ok = [o for o in rows if math.isfinite(o.col) and math.isfinite(o.row)]
+        self._sync("observations", ok, self._observation)
+        sel = rows[selected] if 0 <= selected < len(rows) else None
+        if sel is not None and not (math.isfinite(sel.col) and math.isfinite(sel.row)):
+            sel = None
+        if self._selected is not None and self._selected[0] == sel:
+            return
+        if self._selected is not None:
+            for item in self._selected[1:]:
+                if item.scene() is not None:
+                    self.scene.removeItem(item)
+            self._selected = None
+        if sel is not None:
+            parent, x, y = self.groups["observations"], float(sel.col), float(sel.row)
+            items = (
+                self._add_marker(parent, x, y, "cross", 10, "selected", 2.0),
+                self._add_marker(parent, x, y, "circle", 10, "selected", 1.0),
+                self._label(parent, str(sel.point_id), x, y, "selected"),
+            )
+            for item in items:
+                item.setZValue(1.0)  # over the unselected markers
+            self._selected = (sel, *items)
 
     def _residual(self, parent, key) -> tuple:
         x, y, dx, dy = key

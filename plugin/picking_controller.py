@@ -14,8 +14,11 @@ The control is projected again only when the image, the orientation or the contr
 
 from __future__ import annotations
 
+import bisect
+import contextlib
+
 import numpy as np
-from qgis.PyQt.QtCore import QObject, QPointF
+from qgis.PyQt.QtCore import QObject, QPointF, QTimer
 from qgis.PyQt.QtGui import QCursor
 from qgis.PyQt.QtWidgets import QMenu
 
@@ -38,6 +41,8 @@ class PickingController(QObject):
         self.viewer, self.table = dock.viewer, dock.table
         self.projected: ProjectedControl | None = None
         self.selected_index = -1
+        self._later = 0  # markers_later() depth
+        self._missed = False  # a marker draw was skipped meanwhile
         self.viewer.view.hit_test = self.hit_observation
         self.viewer.view.pointMoved.connect(self.moved)
         self.viewer.residual_scale.valueChanged.connect(lambda *_: self.draw_observations())
@@ -80,20 +85,45 @@ class PickingController(QObject):
         if self.projected is not None:
             self.viewer.overlays.set_highlighted(*self.highlighted())
 
+    @contextlib.contextmanager
+    def markers_later(self):
+        """Draw the observation markers after the block, in a later turn of the event loop
+        (the dock's opening: the image and the control are on screen first, and QGIS handles
+        its events between the two steps)."""
+        self._later += 1
+        try:
+            yield
+        finally:
+            self._later -= 1
+            if not self._later and self._missed:
+                self._missed = False
+                QTimer.singleShot(0, self._draw_later)
+
+    def _draw_later(self) -> None:
+        try:
+            self.draw_observations()
+        except RuntimeError:  # the dock was deleted meanwhile
+            pass
+
     def draw_observations(self) -> None:
         """The observations of the current image, their residuals and the prediction (only
         what changed is redrawn)."""
+        if self._later:
+            self._missed = True
+            return
         img, overlays, log = self.dock.current_image, self.viewer.overlays, self.store.log
         rows = log.indices_of_image(img) if self.oriented() else []
-        px = log.pixels(rows)
-        sel = rows.index(self.selected_index) if self.selected_index in rows else -1
-        overlays.set_observations(px, [log.rows[k].point_id for k in rows], sel)
+        all_rows = log.rows
+        k, sel = self.selected_index, -1
+        if 0 <= k < len(all_rows) and all_rows[k].image_id == img:
+            sel = bisect.bisect_left(rows, k)  # (rows ascending, k among them)
+        overlays.set_observations([all_rows[k] for k in rows], sel)
         res = self.session.residuals()
-        v = np.full((len(rows), 2), np.nan)
         if res:
-            for j, k in enumerate(rows):
-                if k in res:
-                    v[j] = res[k]
+            drawn = [k for k in rows if k in res]
+            px, v = log.pixels(drawn), np.array([res[k] for k in drawn]).reshape(-1, 2)
+        else:
+            px = v = np.empty((0, 2))
         overlays.set_residuals(px, v, self.viewer.residual_scale.value())
         self.draw_predictions()
 

@@ -159,7 +159,9 @@ class ProjectLoader(QObject):
 
     def restore(self) -> None:
         """Restore the session saved in the current QGIS project (if any)."""
-        with gc_deferred():  # (many short-lived objects: see gc_deferred)
+        # many short-lived objects (see gc_deferred); the observation markers are drawn in
+        # the next turn of the event loop, after the dock's first paint
+        with gc_deferred(), self.dock.picking.markers_later():
             self._restore()
 
     def _restore(self) -> None:

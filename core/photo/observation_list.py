@@ -135,6 +135,7 @@ class ObservationList:
         self.rows: list[Observation] = list(rows)
         self.attached: Any = None
         self._by_image: tuple[int, list[Observation], dict[str, list[int]]] | None = None
+        self._pixels: tuple | None = None
         self._done: list[Step] = []
         self._undone: list[Step] = []
         self.version = 0
@@ -255,6 +256,17 @@ class ObservationList:
     def pixels(self, indices: Sequence[int]) -> Array:
         """(N, 2) pixels of the given rows."""
         return np.array([[self.rows[k].col, self.rows[k].row] for k in indices]).reshape(-1, 2)
+
+    def pixels_of_image(self, image_id: str) -> tuple[list[int], Array]:
+        """The rows of one image and their (N, 2) pixels (kept until the next change: the
+        hit test of every mouse press asks for them)."""
+        cache = self._pixels
+        if cache is None or cache[:2] != (self.version, image_id) or cache[2] is not self.rows:
+            rows = self.indices_of_image(image_id)
+            px = self.pixels(rows)
+            px.flags.writeable = False  # shared by the callers until the next change
+            cache = self._pixels = (self.version, image_id, self.rows, rows, px)
+        return list(cache[3]), cache[4]
 
     def next_point_id(self, prefix: str) -> str:
         """A point id ``<prefix><n>`` not used yet."""

@@ -319,10 +319,10 @@ class PickingSession:
 
     def observation_at(self, image_id: str, pixel: ArrayLike, tol_px: float) -> int | None:
         """Row index of the observation of an image nearest to ``pixel`` within ``tol_px``."""
-        rows = self.observations.indices_of_image(image_id)
+        rows, px = self.observations.pixels_of_image(image_id)
         if not rows:
             return None
-        k, _d = nearest_point(pixel, self.observations.pixels(rows), tol_px)
+        k, _d = nearest_point(pixel, px, tol_px)
         return rows[k] if k >= 0 else None
 
     # -- calibration --------------------------------------------------------------------------

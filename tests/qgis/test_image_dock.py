@@ -566,6 +566,10 @@ def test_canvas_sync_and_session_restore(
     again = ImagePickingDock(None, qgis_parent)
     assert again.store.rows == rows
     assert again.current_image == image and again.source is not None
+    # the markers come right after the dock's first paint (the next turn of the event loop)
+    qgis_app.processEvents()
+    shown = [o for o in rows if o.image_id == image]
+    assert again.viewer.overlays.counts["observations"] == len(shown) >= 1
     assert again.calibration_panel.trajectory_edit.filePath() == str(block["paths"]["trajectory"])
     assert again.project_panel.planes_combo.currentLayer() is planes
     assert again.viewer.overlays.counts["planes"] >= 5
@@ -811,9 +815,10 @@ def test_undo_and_redo_take_the_prediction_with_the_tie_point(
 
 
 def test_a_click_redraws_only_what_changed(qgis_parent, qgis_app, block, layers, tmp_path):
-    """With 600 observations in the image, a tie click adds the three items of its marker and
-    keeps every other overlay item (none is made again); the map selection it makes restyles
-    the plane (the same item, highlighted); undo removes exactly the three items."""
+    """With 600 observations in the image, a tie click adds the three items of its marker
+    (and three for its selection) and keeps every other overlay item (none is made again); the
+    map selection it makes restyles the plane (the same item, highlighted); undo removes
+    exactly the new items."""
     image = block["sim"].trajectory.image_id[1]
     rng = np.random.default_rng(3)
     n = 600
@@ -849,7 +854,7 @@ def test_a_click_redraws_only_what_changed(qgis_parent, qgis_app, block, layers,
     assert len(dock.store.rows) == n + 1 and dock.store.rows[-1].target_id == target
     after = {name: items(name) for name in overlays.groups}
     assert before["observations"] < after["observations"]
-    assert len(after["observations"] - before["observations"]) == 3
+    assert len(after["observations"] - before["observations"]) == 3 + 3  # marker, selection
     for name in ("planes", "lines", "lcps"):
         assert after[name] == before[name], name  # not drawn again
     assert overlays.highlighted("planes") == {target}  # restyled: selected on the map
