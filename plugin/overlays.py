@@ -140,19 +140,23 @@ class Overlays:
             self._pens[key] = _pen(COLOURS[colour], width, style)
         return self._pens[key]
 
+    # (an item is set up before it joins its parent in the scene: each change of an item in a
+    # scene notifies the scene, about a third of the cost of making it)
     def _label(self, parent, text: str, x: float, y: float, colour: str):
-        item = QGraphicsSimpleTextItem(text, parent)
+        item = QGraphicsSimpleTextItem(text)
         item.setBrush(self._brushes[colour])
         item.setFont(self._font)
         item.setFlag(_IGNORES_TRANSFORMATIONS, True)
         item.setPos(x, y)
+        item.setParentItem(parent)
         return item
 
     def _add_marker(self, parent, x, y, shape, size, colour, width=1.5) -> QGraphicsPathItem:
-        item = QGraphicsPathItem(self._path(shape, size), parent)
+        item = QGraphicsPathItem(self._path(shape, size))
         item.setPen(self._pen_of(colour, width))
         item.setFlag(_IGNORES_TRANSFORMATIONS, True)
         item.setPos(x, y)
+        item.setParentItem(parent)
         return item
 
     def _sync(
@@ -218,11 +222,12 @@ class Overlays:
             path = QPainterPath()
             path.addPolygon(QPolygonF([QPointF(x, y) for x, y in r.tolist()]))
             path.closeSubpath()
-            item = QGraphicsPathItem(path, group)
+            item = QGraphicsPathItem(path)
             cx, cy = r.mean(axis=0).tolist()
             items = (item, self._label(group, str(pid), cx, cy, "planes"))
             hot = str(pid) in highlighted
             self._plane_style(items, hot)
+            item.setParentItem(group)
             by_id.setdefault(str(pid), []).append([*items, hot])
             self.counts["planes"] += 1
 
@@ -236,8 +241,9 @@ class Overlays:
         for (ax, ay), (bx, by), lid in zip(a[ok].tolist(), b[ok].tolist(), ids):
             path = QPainterPath(QPointF(ax, ay))
             path.lineTo(bx, by)
-            item = QGraphicsPathItem(path, group)
+            item = QGraphicsPathItem(path)
             item.setPen(pen)
+            item.setParentItem(group)
             self._label(group, f"L{lid}", (ax + bx) / 2, (ay + by) / 2, "lines")
             self.counts["lines"] += 1
 
@@ -249,12 +255,13 @@ class Overlays:
         ok = _finite_rows(p)
         ids = [i for i, good in zip(ids, ok.tolist()) if good]
         for (x, y), cid in zip(p[ok].tolist(), ids):
-            marker = QGraphicsPathItem(group)
+            marker = QGraphicsPathItem()
             marker.setFlag(_IGNORES_TRANSFORMATIONS, True)
             marker.setPos(x, y)
             items = (marker, self._label(group, f"C{cid}", x + 2, y + 2, "lcps"))
             hot = str(cid) in highlighted
             self._lcp_style(items, hot)
+            marker.setParentItem(group)
             by_id.setdefault(str(cid), []).append([*items, hot])
             self.counts["lcps"] += 1
 
@@ -320,8 +327,9 @@ class Overlays:
         x, y, dx, dy = key
         path = QPainterPath(QPointF(x, y))
         path.lineTo(x + dx, y + dy)
-        item = QGraphicsPathItem(path, parent)
+        item = QGraphicsPathItem(path)
         item.setPen(self._pen_of("residuals", 2.0))
+        item.setParentItem(parent)
         return (item,)
 
     def set_residuals(self, pixels: np.ndarray, v: np.ndarray, scale: float) -> None:

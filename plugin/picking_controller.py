@@ -15,7 +15,6 @@ The control is projected again only when the image, the orientation or the contr
 from __future__ import annotations
 
 import bisect
-import contextlib
 
 import numpy as np
 from qgis.PyQt.QtCore import QObject, QPointF, QTimer
@@ -41,8 +40,9 @@ class PickingController(QObject):
         self.viewer, self.table = dock.viewer, dock.table
         self.projected: ProjectedControl | None = None
         self.selected_index = -1
-        self._later = 0  # markers_later() depth
+        self._later = 0  # hold_markers() depth
         self._missed = False  # a marker draw was skipped meanwhile
+        self._scheduled = False  # ... and is scheduled
         self.viewer.view.hit_test = self.hit_observation
         self.viewer.view.pointMoved.connect(self.moved)
         self.viewer.residual_scale.valueChanged.connect(lambda *_: self.draw_observations())
@@ -85,21 +85,25 @@ class PickingController(QObject):
         if self.projected is not None:
             self.viewer.overlays.set_highlighted(*self.highlighted())
 
-    @contextlib.contextmanager
-    def markers_later(self):
-        """Draw the observation markers after the block, in a later turn of the event loop
-        (the dock's opening: the image and the control are on screen first, and QGIS handles
-        its events between the two steps)."""
+    def hold_markers(self) -> None:
+        """Draw no observation markers until :meth:`release_markers` (the dock's opening:
+        the image and the control are on screen first; the markers come in a turn of the
+        event loop of their own)."""
         self._later += 1
-        try:
-            yield
-        finally:
-            self._later -= 1
-            if not self._later and self._missed:
-                self._missed = False
-                QTimer.singleShot(0, self._draw_later)
+
+    def release_markers(self) -> None:
+        self._later = max(0, self._later - 1)
+        if not self._later and self._missed:
+            self._missed, self._scheduled = False, True
+            QTimer.singleShot(0, self._draw_later)
+
+    @property
+    def markers_held(self) -> bool:
+        """Markers are held, or their draw is scheduled."""
+        return bool(self._later) or self._missed or self._scheduled
 
     def _draw_later(self) -> None:
+        self._scheduled = False
         try:
             self.draw_observations()
         except RuntimeError:  # the dock was deleted meanwhile

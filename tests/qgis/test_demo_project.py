@@ -128,6 +128,7 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
     dock.resize(1000, 950)
     dock.show()
     QTest.qWaitForWindowExposed(dock, 2000)
+    assert dock.wait_restored()  # (the files are read in steps, QGIS responsive between)
     ids = list(sim.trajectory.image_id)
     assert [
         dock.viewer.image_combo.itemData(k) for k in range(dock.viewer.image_combo.count())
@@ -205,6 +206,7 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
     dock.resize(1000, 1280)
     dock.show()
     QTest.qWaitForWindowExposed(dock, 2000)
+    assert dock.wait_restored()
     assert dock.store.rows == rows
     assert dock.current_image == a and dock.source is not None
 

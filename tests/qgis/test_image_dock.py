@@ -564,10 +564,12 @@ def test_canvas_sync_and_session_restore(
     rows = list(dock.store.rows)
     dock.close()
     again = ImagePickingDock(None, qgis_parent)
-    assert again.store.rows == rows
+    # the tabs at once; the files in steps of their own, the observation markers last
+    assert again.calibration_panel.trajectory_edit.filePath() == str(block["paths"]["trajectory"])
+    assert again.loader.steps_left == 4 and again.store.rows == []
+    assert again.wait_restored()
+    assert again.loader.steps_left == 0 and again.store.rows == rows
     assert again.current_image == image and again.source is not None
-    # the markers come right after the dock's first paint (the next turn of the event loop)
-    qgis_app.processEvents()
     shown = [o for o in rows if o.image_id == image]
     assert again.viewer.overlays.counts["observations"] == len(shown) >= 1
     assert again.calibration_panel.trajectory_edit.filePath() == str(block["paths"]["trajectory"])

@@ -231,6 +231,7 @@ def test_dsm_choice_is_kept_in_the_session(dock, scene, qgis_parent):
     dock.save_session()
     dock.close()
     again = ImagePickingDock(None, qgis_parent)
+    assert again.wait_restored()  # (the files are read in steps after the constructor)
     assert again.project_panel.dsm_edit.filePath() == str(scene["dir"] / "dsm.tif")
     assert again.project_panel.dsm_cell.value() == pytest.approx(0.25)
     assert again.set_monoplot(True) and again.monoplot_tool.mode == "point"
