@@ -30,7 +30,7 @@ from lidarphoto.core.photo.picking import PickingScene
 from lidarphoto.core.simulation.render import RenderOptions, RenderScene, render_image
 from lidarphoto.plugin.image_dock import ImagePickingDock
 from qgis.core import QgsProject
-from qgis.PyQt.QtCore import QPointF, Qt
+from qgis.PyQt.QtCore import QPoint, QPointF, Qt
 from qgis.PyQt.QtTest import QTest
 from qgis.PyQt.QtWidgets import QSplitter
 
@@ -89,15 +89,16 @@ def _deep_pixel(labels: np.ndarray, plane_id: int) -> tuple[np.ndarray, float]:
 
 
 def _click(view, app, pixel, zoom=None) -> QPointF:
-    """Left click where the image pixel is shown (centred at ``zoom`` if given); returns the
-    scene position the click maps to."""
+    """Left click on the screen pixel that shows the image point ``pixel`` (centred at
+    ``zoom`` if given); returns the scene position of that screen pixel's centre."""
     if zoom is not None:
         view.set_zoom(zoom, QPointF(*pixel))
     app.processEvents()
-    pos = view.mapFromScene(QPointF(*pixel))
+    at = view.viewportTransform().map(QPointF(*pixel))
+    pos = QPoint(math.floor(at.x()), math.floor(at.y()))
     QTest.mouseClick(view.viewport(), Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier,
                      pos)  # fmt: skip
-    return view._scene_f(QPointF(pos))
+    return view._scene_f(QPointF(pos) + QPointF(0.5, 0.5))
 
 
 def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, provider):
@@ -127,6 +128,7 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
     dock.resize(1000, 950)
     dock.show()
     QTest.qWaitForWindowExposed(dock, 2000)
+    assert dock.wait_restored()  # (the files are read in steps, QGIS responsive between)
     ids = list(sim.trajectory.image_id)
     assert [
         dock.viewer.image_combo.itemData(k) for k in range(dock.viewer.image_combo.count())
@@ -204,6 +206,7 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
     dock.resize(1000, 1280)
     dock.show()
     QTest.qWaitForWindowExposed(dock, 2000)
+    assert dock.wait_restored()
     assert dock.store.rows == rows
     assert dock.current_image == a and dock.source is not None
 
