@@ -32,6 +32,9 @@ _METAVAR = {
     "field": "COLUMN",
     "file_out": "FILE",
     "raster_out": "FILE",
+    "files": "PATH",
+    "layer": "FILE",
+    "folder_out": "FOLDER",
 }
 
 
@@ -71,6 +74,8 @@ def _add_algorithm(sub: argparse._SubParsersAction, spec: AlgorithmSpec, job: ob
             kwargs["metavar"] = "|".join(p.options) if len(p.options) <= 4 else "NAME"
         elif p.kind == "numbers":
             kwargs["metavar"] = ",".join(["N"] * p.count) if p.count <= 4 else f"{p.count}xN"
+        elif p.kind == "files":
+            kwargs.update(nargs="+", metavar="PATH")
         else:
             kwargs["metavar"] = _METAVAR.get(p.kind, "VALUE")
         if p.required:
