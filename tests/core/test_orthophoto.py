@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 from lidarphoto.core.geometry.camera import Camera, camera_from_dict
 from lidarphoto.core.geometry.collinearity import project
-from lidarphoto.core.geometry.frames import LocalFrame, MappingFrame
+from lidarphoto.core.geometry.frames import MappingFrame
 from lidarphoto.core.geometry.grid import Grid
 from lidarphoto.core.geometry.raycast import intersect_dsm
 from lidarphoto.core.geometry.rotations import matrix_to_opk
