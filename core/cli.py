@@ -33,7 +33,6 @@ _METAVAR = {
     "file_out": "FILE",
     "raster_out": "FILE",
     "files": "PATH",
-    "layer": "FILE",
     "folder_out": "FOLDER",
 }
 

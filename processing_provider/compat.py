@@ -30,12 +30,8 @@ else:  # QGIS 3.22-3.34
 
 if hasattr(Qgis, "ProcessingSourceType"):  # QGIS >= 3.36
     SOURCE_FILE = Qgis.ProcessingSourceType.File
-    SOURCE_RASTER = Qgis.ProcessingSourceType.Raster
-    SOURCE_POINT_CLOUD = Qgis.ProcessingSourceType.PointCloud
 else:  # QGIS 3.22-3.34
     SOURCE_FILE = QgsProcessing.SourceType.TypeFile
-    SOURCE_RASTER = QgsProcessing.SourceType.TypeRaster
-    SOURCE_POINT_CLOUD = QgsProcessing.SourceType.TypePointCloud
 
 if hasattr(Qgis, "ProcessingParameterFlag"):  # QGIS >= 3.36
     FLAG_ADVANCED = Qgis.ProcessingParameterFlag.Advanced
@@ -53,10 +49,12 @@ if hasattr(Qgis, "WkbType"):  # QGIS >= 3.30
     WKB_POINT_Z = Qgis.WkbType.PointZ
     WKB_LINESTRING_Z = Qgis.WkbType.LineStringZ
     WKB_POLYGON_Z = Qgis.WkbType.PolygonZ
+    WKB_MULTIPOLYGON = Qgis.WkbType.MultiPolygon
 else:
     WKB_POINT_Z = QgsWkbTypes.Type.PointZ
     WKB_LINESTRING_Z = QgsWkbTypes.Type.LineStringZ
     WKB_POLYGON_Z = QgsWkbTypes.Type.PolygonZ
+    WKB_MULTIPOLYGON = QgsWkbTypes.Type.MultiPolygon
 
 if hasattr(Qgis, "ProcessingNumberParameterType"):  # QGIS >= 3.36
     NUMBER_DOUBLE = Qgis.ProcessingNumberParameterType.Double

@@ -5,7 +5,6 @@ from __future__ import annotations
 from typing import Any, Callable
 
 from qgis.core import (
-    QgsMapLayer,
     QgsProcessingOutputNumber,
     QgsProcessingOutputString,
     QgsProcessingParameterBoolean,
@@ -18,12 +17,10 @@ from qgis.core import (
     QgsProcessingParameterFile,
     QgsProcessingParameterFileDestination,
     QgsProcessingParameterFolderDestination,
-    QgsProcessingParameterMapLayer,
     QgsProcessingParameterMultipleLayers,
     QgsProcessingParameterNumber,
     QgsProcessingParameterRasterDestination,
     QgsProcessingParameterString,
-    QgsProcessingUtils,
 )
 
 from ..core.jobs.spec import Param, Result
@@ -35,8 +32,6 @@ from .compat import (
     NUMBER_DOUBLE,
     NUMBER_INTEGER,
     SOURCE_FILE,
-    SOURCE_POINT_CLOUD,
-    SOURCE_RASTER,
     SOURCE_VECTOR_LINE,
     SOURCE_VECTOR_POINT,
     SOURCE_VECTOR_POLYGON,
@@ -93,10 +88,6 @@ def make_parameter(p: Param, tr: Callable[[str], str]) -> QgsProcessingParameter
         )  # fmt: skip
     elif k == "files":
         q = QgsProcessingParameterMultipleLayers(p.name, title, SOURCE_FILE, None, p.optional)
-    elif k == "layer":
-        q = QgsProcessingParameterMapLayer(
-            p.name, title, None, p.optional, [SOURCE_RASTER, SOURCE_POINT_CLOUD]
-        )
     elif k == "folder_out":
         q = QgsProcessingParameterFolderDestination(
             p.name, title, optional=p.optional, createByDefault=p.create_by_default
@@ -160,24 +151,8 @@ def read_parameter(alg, p: Param, parameters: dict, context) -> Any:
         return (alg.parameterAsFields(parameters, p.name, context) or [""])[0]
     if k == "files":
         return tuple(alg.parameterAsFileList(parameters, p.name, context)) or None
-    if k == "layer":
-        return _layer_path(alg, p, parameters, context)
     if k in ("file_out", "folder_out"):
         return alg.parameterAsFileOutput(parameters, p.name, context) or None
     if k == "raster_out":
         return alg.parameterAsOutputLayer(parameters, p.name, context) or None
     raise ValueError(f"{p.name}: no value for kind {k}")
-
-
-def _layer_path(alg, p: Param, parameters: dict, context) -> str | None:
-    """The file of a layer parameter: a layer of the project (or one QGIS already holds) gives
-    its source; any other text is taken as a path, never loaded here (loading a LAS/LAZ as a
-    point cloud layer would start QGIS's indexing of it)."""
-    value = parameters.get(p.name)
-    if isinstance(value, QgsMapLayer):
-        return value.source() or None
-    text = alg.parameterAsString(parameters, p.name, context)
-    if not text:
-        return None
-    layer = QgsProcessingUtils.mapLayerFromString(text, context, False)
-    return layer.source() if layer is not None else text

@@ -41,7 +41,7 @@ def input_files(spec: AlgorithmSpec, values: Mapping[str, Any]) -> dict[str, Any
     return {
         p.name: values[p.name]
         for p in spec.inputs
-        if (p.kind in ("file", "points", "layer") and isinstance(values.get(p.name), str))
+        if (p.kind in ("file", "points") and isinstance(values.get(p.name), str))
         or (p.kind == "files" and values.get(p.name))
     }
 

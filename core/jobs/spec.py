@@ -24,8 +24,6 @@ points     QgsProcessingParameterFeatureSource path of a point table (CLI); the 
 field      QgsProcessingParameterField         column / field name (str), "" when none
 files      QgsProcessingParameterMultipleLayers tuple of paths (files or folders) or None
            (files)
-layer      QgsProcessingParameterMapLayer      path (str) or None: a file, or the source
-           (raster, point cloud)               file of a project layer
 ========== =================================== ==========================================
 
 Outputs: ``file_out`` (QgsProcessingParameterFileDestination), ``raster_out``
@@ -57,7 +55,6 @@ INPUT_KINDS = (
     "points",
     "field",
     "files",
-    "layer",
 )
 OUTPUT_KINDS = ("file_out", "raster_out", "folder_out", "sink")
 RESULT_KINDS = ("number", "string")

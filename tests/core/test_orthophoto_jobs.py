@@ -202,7 +202,7 @@ def test_feathering_blends_linearly_across_the_seam():
             MosaicSource("b", grid, (75.0, 25.0, 1000.0), 0.0, None)]  # fmt: skip
 
     def read(k, win):
-        c0, r0, w, h = win
+        _, _, w, h = win
         return np.full((1, h, w), 100.0 * (k + 1), np.float32), np.ones((h, w), bool)
 
     feather = 10.0
@@ -217,7 +217,6 @@ def test_feathering_blends_linearly_across_the_seam():
 
 
 def test_bad_inputs_are_refused_before_writing(block, tmp_path):
-    f = block["folder"]
     out = tmp_path / "out"
     # an image without exterior orientation: named
     extra = tmp_path / "imgs"
@@ -312,7 +311,7 @@ def test_dsm_not_covering_the_image_is_warned(block, tmp_path, caplog):
     with caplog.at_level(logging.WARNING, logger="lidarphoto"):
         run_job(orthorectify, _values(args))
     assert any("does not cover all of image sw" in r.message for r in caplog.records)
-    info, _, mask = _read(tmp_path / "out" / "sw_ortho.tif")
+    info, _, _ = _read(tmp_path / "out" / "sw_ortho.tif")
     # the orthophoto stops at the DSM's last cell centre
     east = info.geotransform[0] + info.width * GSD
     assert east <= g.x0 + (g.cols // 2) * g.cell + GSD

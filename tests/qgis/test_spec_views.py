@@ -32,7 +32,6 @@ QGIS_TYPE = {
     "folder_out": "folderDestination",
     "sink": "sink",
     "files": "multilayer",
-    "layer": "layer",
 }
 SPECS = {job.SPEC.name: job.SPEC for job in ALGORITHMS}
 
