@@ -56,6 +56,7 @@ from ..geometry.grid import Grid
 from ..geometry.raycast import STATUS_GRAZING, STATUS_OK, DsmTracer, intersect_dsm
 from ..geometry.surface import Dsm
 from .orientation import eo_map_to_local
+from .orthophoto_numba import remap_maps
 
 LOG = logging.getLogger(__name__)
 
@@ -594,8 +595,9 @@ def _tile(
     c_hi = min(math.ceil(cv.max() - 0.5) + pad + 1, cam.width_px)
     r_hi = min(math.ceil(rv.max() - 0.5) + pad + 1, cam.height_px)
     src = read_window((c_lo, r_lo, c_hi - c_lo, r_hi - r_lo))
-    mapx = np.where(valid, col - (0.5 + c_lo), -1.0).astype(np.float32)
-    mapy = np.where(valid, row - (0.5 + r_lo), -1.0).astype(np.float32)
+    if opt.true_ortho:
+        col = np.where(valid, col, np.nan)
+    mapx, mapy = remap_maps(col, row, c_lo, r_lo)
     out = _remap(src, mapx, mapy, opt.resampling)
     out[:, ~valid] = 0
     return OrthoTile(row0, col0, out, valid, occluded, no_surface)

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..geometry.raycast_numba import AVAILABLE, numba
 
-__all__ = ["AVAILABLE", "cell_pixels"]
+__all__ = ["AVAILABLE", "cell_pixels", "remap_maps"]
 
 
 def _cell_pixels(
@@ -30,12 +30,17 @@ def _cell_pixels(
     cx0, ps, cy0, wpx, hpx = nolens[0], nolens[1], nolens[2], nolens[3], nolens[4]
     has_lens = lens.shape[0] > 1
     my, mx = lens.shape[0], lens.shape[1]
+    rl = np.empty((nx, 6))
     for i in range(h):
         y = y0 - i * g
         v = (yc - y) * inv_cell
         fi = i / step
         ki = min(int(fi), ny - 2)
         ti = fi - ki
+        # the lattice interpolated to this row once; per cell only along the row
+        for kj in range(nx):
+            for k in range(6):
+                rl[kj, k] = lat[ki, kj, k] * (1 - ti) + lat[ki + 1, kj, k] * ti
         for j in range(w):
             out_col[i, j] = np.nan
             out_row[i, j] = np.nan
@@ -62,21 +67,10 @@ def _cell_pixels(
             fj = j / step
             kj = min(int(fj), nx - 2)
             tj = fj - kj
-            # q = a + z b, a and b interpolated bilinearly between the lattice nodes
-            w00, w01 = (1 - ti) * (1 - tj), (1 - ti) * tj
-            w10, w11 = ti * (1 - tj), ti * tj
-            q0 = (w00 * (lat[ki, kj, 0] + zz * lat[ki, kj, 3])
-                  + w01 * (lat[ki, kj + 1, 0] + zz * lat[ki, kj + 1, 3])
-                  + w10 * (lat[ki + 1, kj, 0] + zz * lat[ki + 1, kj, 3])
-                  + w11 * (lat[ki + 1, kj + 1, 0] + zz * lat[ki + 1, kj + 1, 3]))
-            q1 = (w00 * (lat[ki, kj, 1] + zz * lat[ki, kj, 4])
-                  + w01 * (lat[ki, kj + 1, 1] + zz * lat[ki, kj + 1, 4])
-                  + w10 * (lat[ki + 1, kj, 1] + zz * lat[ki + 1, kj, 4])
-                  + w11 * (lat[ki + 1, kj + 1, 1] + zz * lat[ki + 1, kj + 1, 4]))
-            q2 = (w00 * (lat[ki, kj, 2] + zz * lat[ki, kj, 5])
-                  + w01 * (lat[ki, kj + 1, 2] + zz * lat[ki, kj + 1, 5])
-                  + w10 * (lat[ki + 1, kj, 2] + zz * lat[ki + 1, kj, 5])
-                  + w11 * (lat[ki + 1, kj + 1, 2] + zz * lat[ki + 1, kj + 1, 5]))
+            # q = a + z b, a and b interpolated between the lattice nodes
+            q0 = (rl[kj, 0] + zz * rl[kj, 3]) * (1 - tj) + (rl[kj + 1, 0] + zz * rl[kj + 1, 3]) * tj
+            q1 = (rl[kj, 1] + zz * rl[kj, 4]) * (1 - tj) + (rl[kj + 1, 1] + zz * rl[kj + 1, 4]) * tj
+            q2 = (rl[kj, 2] + zz * rl[kj, 5]) * (1 - tj) + (rl[kj + 1, 2] + zz * rl[kj + 1, 5]) * tj
             if not q2 < 0.0:  # behind the camera
                 continue
             xi = -focal * q0 / q2
@@ -101,13 +95,50 @@ def _cell_pixels(
                 out_row[i, j] = row
 
 
+def _remap_maps(col, row, c0, r0, mapx, mapy):
+    """OpenCV's float32 maps of an image window starting at (c0, r0): pixel centres at
+    integers; -1 (outside) where there is no pixel. Returns the number of cells with one."""
+    n = 0
+    for i in range(col.shape[0]):
+        for j in range(col.shape[1]):
+            c = col[i, j]
+            if math.isfinite(c):
+                mapx[i, j] = c - (0.5 + c0)
+                mapy[i, j] = row[i, j] - (0.5 + r0)
+                n += 1
+            else:
+                mapx[i, j] = -1.0
+                mapy[i, j] = -1.0
+    return n
+
+
 _COMPILED: dict[str, Callable[..., Any]] = {}
+
+
+def _compiled(name: str) -> Callable[..., Any]:
+    if name not in _COMPILED:
+        func = {"cells": _cell_pixels, "maps": _remap_maps}[name]
+        _COMPILED[name] = numba.njit(cache=True, nogil=True)(func)
+    return _COMPILED[name]
 
 
 def cell_pixels(*args: Any) -> None:
     """Run the compiled loop (compiled at the first call, cached next to this module)."""
     if not AVAILABLE:
         raise RuntimeError("numba is not installed")
-    if "cells" not in _COMPILED:
-        _COMPILED["cells"] = numba.njit(cache=True, nogil=True)(_cell_pixels)
-    _COMPILED["cells"](*args)
+    _compiled("cells")(*args)
+
+
+def remap_maps(
+    col: np.ndarray, row: np.ndarray, c0: int, r0: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """float32 maps for cv2.remap of a window at (c0, r0) (see :func:`_remap_maps`)."""
+    mapx = np.empty(col.shape, np.float32)
+    mapy = np.empty(col.shape, np.float32)
+    if AVAILABLE:
+        _compiled("maps")(col, row, int(c0), int(r0), mapx, mapy)
+    else:
+        ok = np.isfinite(col)
+        mapx[...] = np.where(ok, col - (0.5 + c0), -1.0)
+        mapy[...] = np.where(ok, row - (0.5 + r0), -1.0)
+    return mapx, mapy

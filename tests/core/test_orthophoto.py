@@ -76,6 +76,12 @@ def _scene():
 
 @pytest.fixture(scope="module")
 def exact():
+    return exact_case()
+
+
+def exact_case() -> dict:
+    """The exact case (module docstring): the rendered image, its orthophotos (plain and
+    true) and every truth; bench/bench_ortho.py reports its figures."""
     scene, dsm = _scene()
     cam = camera_from_dict({"name": "k1", "focal_mm": 10.0, "pixel_size_mm": 0.01,
                             "width_px": 800, "height_px": 600,

@@ -1,0 +1,334 @@
+"""Benchmark: orthorectification (lidarphoto:orthorectify) against orthority, on the same images,
+orientation and DEM, with the same output grid, resampling and file settings; and the exact case
+of tests/core/test_orthophoto.py.
+
+Run (figures in bench/ortho.md)::
+
+    python3 -m venv /tmp/orthority-venv && /tmp/orthority-venv/bin/pip install orthority==0.7.0
+    .venv/bin/python bench/bench_ortho.py --orthority-python /tmp/orthority-venv/bin/python
+
+orthority (pip package, GPL/AGPL-free peer by Dugal Harris) lives in its own throw-away venv: it
+needs ``opencv-python``, which clashes with our ``opencv-python-headless``; each run of either
+tool is a fresh process (timing from its first call to the closed file, imports excluded; peak
+memory from the process's maximum resident set).
+
+Data: the demo's rendered images (``make demo``: 10 frames of 6000 x 4000 px, 8-bit RGB, LZW,
+camera 130 m above the AHN3 Delft tile, GSD 1.67 cm), their true orientation (the images are
+rendered with it) and the LiDAR DSM (0.5 m, GeoTIFF). With ``--demo DIR`` missing, the demo's
+steps are run into it first.
+
+Equal output: orthority with ``aligned_pixels`` at GSD 1/64 m (0.015625, binary-exact: both
+tools put their cells on the same multiples), bilinear resampling of the image and of the DEM,
+internal mask, overviews, and our GeoTIFF creation options (tiled 512, DEFLATE with predictor
+2, pixel interleave, RGB, NUM_THREADS); ours on orthority's exact extent. Agreement where both
+have data: RMS of the differences (DN) and the shift between the two by phase correlation on
+256 x 256 windows of flat ground (core.quality.registration; magnitude-weighted, and whitened).
+The camera models are first compared point by point (orthority's world_to_pixel against
+collinearity in our local ENU frame).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import datetime
+import importlib.util
+import json
+import math
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+GSD = 1.0 / 64.0
+CRS = "EPSG:28992"
+CREATION = {"tiled": True, "blockxsize": 512, "blockysize": 512, "compress": "deflate",
+            "predictor": 2, "interleave": "pixel", "photometric": "rgb", "bigtiff": "if_safer",
+            "num_threads": str(max(1, min(4, os.cpu_count() or 1)))}  # fmt: skip
+
+ORTHORITY = r"""
+import json, math, resource, sys, time, warnings
+warnings.simplefilter("ignore")
+import numpy as np
+from orthority.camera import PinholeCamera
+from orthority.ortho import Ortho
+a = json.loads(sys.argv[1])
+cam = PinholeCamera(tuple(a["size"]), a["focal_mm"], sensor_size=tuple(a["sensor_mm"]),
+                    cx=a["cx"], cy=a["cy"], xyz=tuple(a["xyz"]), opk=tuple(a["opk"]))
+t0 = time.perf_counter()
+o = Ortho(a["image"], a["dem"], cam, crs=a["crs"])
+o.process(a["out"], resolution=(a["gsd"], a["gsd"]), interp="bilinear", dem_interp="bilinear",
+          write_mask=True, creation_options=a["creation"], build_ovw=True, overwrite=True,
+          aligned_pixels=True)
+t = time.perf_counter() - t0
+pts = np.array(a["points"], float).T
+px = cam.world_to_pixel(pts).T
+print(json.dumps({"seconds": t, "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+                  / 1024, "pixels": px.tolist()}))
+"""
+
+OURS = r"""
+import json, resource, sys, time
+a = json.loads(sys.argv[1])
+from lidarphoto.core.jobs import orthorectify
+from lidarphoto.core.jobs.runner import run_job
+import lidarphoto.core.photo.orthophoto_numba as k
+import numpy as np
+if k.AVAILABLE:  # load the compiled kernel from its cache before the clock starts
+    k.cell_pixels(0.0, 0.0, 1.0, 0, 0, np.zeros((2, 2), np.float32), 0.0, 0.0, 1.0,
+                  np.zeros((2, 2, 6)), 2.0, 1.0, np.zeros((1, 1, 2)), 0.0, 0.0, 1.0,
+                  np.zeros(5), np.zeros((0, 0)), np.zeros((0, 0)), np.zeros((0, 0)))
+t0 = time.perf_counter()
+r = run_job(orthorectify, a["values"])
+t = time.perf_counter() - t0
+print(json.dumps({"seconds": t, "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+                  / 1024, "occluded": r.results["OCCLUDED_FRACTION"]}))
+"""
+
+
+def _run(python: str, code: str, arg: dict) -> dict:
+    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+    r = subprocess.run([python, "-c", code, json.dumps(arg)], capture_output=True, text=True,
+                       env=env, timeout=900)  # fmt: skip
+    if r.returncode:
+        raise RuntimeError(r.stderr[-3000:])
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def _demo(folder: Path) -> None:
+    """The demo's LiDAR, flight and rendering steps into ``folder`` (when not there yet)."""
+    if (folder / "flight" / "images").is_dir() and (folder / "lidar" / "dsm.tif").is_file():
+        return
+    spec = importlib.util.spec_from_file_location("lidarphoto_demo", ROOT / "scripts" / "demo.py")
+    demo = importlib.util.module_from_spec(spec)
+    sys.modules["lidarphoto_demo"] = demo
+    spec.loader.exec_module(demo)
+    lidar = demo.lidar_step(folder / "lidar")
+    sim, _, eo = demo.flight_step(lidar, folder / "flight")
+    demo.render_step(lidar, sim, eo, folder / "flight" / "images")
+
+
+def _peer_camera(cam, eo, k: int) -> dict:
+    """orthority's pinhole camera for our camera and row k of the EO: its rotation is ours
+    (R_c^m = Rx(omega) Ry(phi) Rz(kappa), camera x right, y up, z back), its principal point
+    in units of the larger image side from the image centre, rows down."""
+    side = max(cam.width_px, cam.height_px)
+    return {"size": [cam.width_px, cam.height_px], "focal_mm": cam.focal_mm,
+            "sensor_mm": [cam.width_px * cam.pixel_size_mm, cam.height_px * cam.pixel_size_mm],
+            "cx": cam.x0_mm / cam.pixel_size_mm / side,
+            "cy": -cam.y0_mm / cam.pixel_size_mm / side,
+            "xyz": eo.xyz[k].tolist(), "opk": eo.opk[k].tolist()}  # fmt: skip
+
+
+def _read(path: Path):
+    from lidarphoto.core.io.raster import RasterReader
+
+    with RasterReader(path) as src:
+        return src.info, src.read(), src.read_mask()
+
+
+def _agreement(a_path: Path, b_path: Path, dsm) -> dict:
+    """RMS difference and phase-correlation shifts (b relative to a) where both have data."""
+    from lidarphoto.core.quality.registration import phase_correlation
+
+    ia, a, ma = _read(a_path)
+    ib, b, mb = _read(b_path)
+    if ia.geotransform != ib.geotransform or a.shape != b.shape:
+        raise RuntimeError(f"grids differ: {ia.geotransform} {a.shape} / {ib.geotransform} "
+                           f"{b.shape}")  # fmt: skip
+    both = ma & mb
+    d = a.astype(float)[:, both] - b.astype(float)[:, both]
+    gt = ia.geotransform
+    xs = gt[0] + (np.arange(ia.width) + 0.5) * gt[1]
+    ys = gt[3] + (np.arange(ia.height) + 0.5) * gt[5]
+    gx, gy = np.meshgrid(xs, ys)
+    z = dsm.height_at(gx.ravel(), gy.ravel()).reshape(gx.shape)
+    ground = both & (z < np.nanpercentile(z[both], 40) + 0.3)
+    shifts, white = [], []
+    size = 256
+    for r0 in range(0, ia.height - size, size):
+        for c0 in range(0, ia.width - size, size):
+            if ground[r0 : r0 + size, c0 : c0 + size].mean() < 0.95:
+                continue
+            ga = a[:, r0 : r0 + size, c0 : c0 + size].astype(float).mean(axis=0)
+            gb = b[:, r0 : r0 + size, c0 : c0 + size].astype(float).mean(axis=0)
+            dx, dy, _ = phase_correlation(ga, gb)
+            wx, wy, _ = phase_correlation(ga, gb, whiten=True)
+            shifts.append(math.hypot(dx, dy))
+            white.append(math.hypot(wx, wy))
+    return {"cells": int(both.sum()), "rms_dn": float(np.sqrt(np.mean(d**2))),
+            "rms_dn_ground": float(np.sqrt(np.mean((a.astype(float)[:, ground]
+                                                    - b.astype(float)[:, ground]) ** 2))),
+            "windows": len(shifts), "shift_px": shifts, "shift_whitened_px": white}  # fmt: skip
+
+
+def exact_figures() -> dict:
+    """The figures of the exact case (tests/core/test_orthophoto.py)."""
+    import cv2
+    from lidarphoto.core.quality.registration import phase_correlation
+
+    spec = importlib.util.spec_from_file_location("t_ortho",
+                                                  ROOT / "tests" / "core" / "test_orthophoto.py")
+    sys.path.insert(0, str(ROOT / "tests" / "core"))
+    t = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(t)
+    e = t.exact_case()
+    out = {}
+    for name, region in (("ground", (e["z"] < 3.0) & np.isfinite(e["col"]) & ~e["hidden"]),
+                         ("roof", (e["z"] > 7.9) & np.isfinite(e["col"]))):  # fmt: skip
+        keep = t._interior(region, 3)
+        err = e["gap"][keep] / t.GSD
+        out[f"geometry_rms_px_{name}"] = float(np.sqrt(np.mean(err**2)))
+        out[f"geometry_max_px_{name}"] = float(err.max())
+    gray = np.array([0.299, 0.587, 0.114])
+    ortho = np.moveaxis(e["plain"], 0, 2).astype(float) @ gray
+    truth = np.nan_to_num(e["truth"]) @ gray
+    keep = t._interior(e["plain_valid"] & (e["z"] < 3.0) & ~e["hidden"], 4)
+    inner = cv2.erode(keep.astype(np.uint8), np.ones((257, 257), np.uint8), borderValue=0)
+    rr, cc = np.argwhere(inner)[len(np.argwhere(inner)) // 2] - 128
+    dx, dy, _ = phase_correlation(truth[rr : rr + 256, cc : cc + 256],
+                                  ortho[rr : rr + 256, cc : cc + 256])  # fmt: skip
+    out["texture_shift_px"] = math.hypot(dx, dy)
+    squares = (np.floor(e["gx"] - t.X0) + np.floor(e["gy"] - t.Y0)) % 2
+    flat = t._interior(keep & (squares == 0), 3) | t._interior(keep & (squares == 1), 3)
+    out["texture_rms_dn_flat"] = float(np.sqrt(np.mean((ortho[flat] - truth[flat]) ** 2)))
+    both = e["plain_valid"]
+    occluded = both & ~e["true_valid"]
+    hidden = e["hidden"] & both
+    k = np.ones((3, 3), np.uint8)
+    border = cv2.dilate(hidden.astype(np.uint8), k) != cv2.erode(hidden.astype(np.uint8), k)
+    sure = both & ~border
+    out["hidden_cells"] = int(hidden.sum())
+    out["occluded_cells"] = int(occluded.sum())
+    out["occlusion_agreement_off_border"] = float(np.mean(occluded[sure] == hidden[sure]))
+    out["occlusion_disagreement_cells"] = int((occluded != hidden)[both].sum())
+    return out
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--orthority-python", default=os.environ.get("ORTHORITY_PYTHON", ""),
+                    help="python of a venv with orthority installed")  # fmt: skip
+    ap.add_argument("--demo", type=Path, default=ROOT / "demo_output")
+    ap.add_argument("--images", type=int, default=10)
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--json", type=Path, default=None, help="write the figures here")
+    args = ap.parse_args()
+
+    from lidarphoto.core.geometry.collinearity import project
+    from lidarphoto.core.geometry.rotations import matrix_to_opk
+    from lidarphoto.core.io.camera import read_camera_json
+    from lidarphoto.core.io.dsm import read_dsm_raster
+    from lidarphoto.core.io.orientation import read_eo_csv
+    from lidarphoto.core.photo.orientation import eo_map_to_local
+    from lidarphoto.core.photo.orthophoto import OrthoProjector
+
+    figures: dict = {"date": datetime.date.today().isoformat(), "machine": platform.node(),
+                     "cpus": os.cpu_count(), "load_start": os.getloadavg()[0]}  # fmt: skip
+    print("exact case ...", flush=True)
+    figures["exact"] = exact_figures()
+    print(json.dumps(figures["exact"], indent=1))
+    if not args.orthority_python:
+        print("no --orthority-python: peer comparison skipped")
+        return 0
+    _demo(args.demo)
+    cam = read_camera_json(args.demo / "flight" / "camera.json")
+    eo = read_eo_csv(args.demo / "flight" / "eo_true.csv")
+    dsm_path = args.demo / "lidar" / "dsm.tif"
+    dsm = read_dsm_raster(dsm_path)
+    work = Path(tempfile.mkdtemp(prefix="bench_ortho_"))
+    rows = []
+    for k in range(min(args.images, len(eo))):
+        name = eo.image_id[k]
+        image = args.demo / "flight" / "images" / f"{name}.tif"
+        # the cameras, point by point: ground points of the DSM seen by the image
+        proj = OrthoProjector.build(cam, eo.xyz[k], eo.opk[k], dsm, CRS)
+        box = proj.footprint()
+        rng = np.random.default_rng(k)
+        pts_xy = np.column_stack([rng.uniform(box[0], box[2], 400),
+                                  rng.uniform(box[1], box[3], 400)])  # fmt: skip
+        pts = np.column_stack([pts_xy, dsm.height_at(pts_xy[:, 0], pts_xy[:, 1])])
+        pts = pts[np.isfinite(pts[:, 2])]
+        c_loc, m_loc = eo_map_to_local(eo.xyz[k : k + 1], eo.opk[k : k + 1], proj.local)
+        ours_px = project(proj.local.map_to_enu(pts), np.r_[c_loc[0], matrix_to_opk(m_loc[0])],
+                          cam)  # fmt: skip
+        peer_arg = {**_peer_camera(cam, eo, k), "image": str(image), "dem": str(dsm_path),
+                    "crs": CRS, "gsd": GSD, "creation": CREATION, "points": pts.tolist()}  # fmt: skip
+        best = {"peer": math.inf, "ours": math.inf, "true": math.inf}
+        mem = {"peer": 0.0, "ours": 0.0, "true": 0.0}
+        for rep in range(args.repeats):
+            peer_arg["out"] = str(work / f"{name}_orthority.tif")
+            res = _run(args.orthority_python, ORTHORITY, peer_arg)
+            best["peer"] = min(best["peer"], res["seconds"])
+            mem["peer"] = max(mem["peer"], res["maxrss_mb"])
+            if rep == 0:
+                # orthority's pixels have their centres at integers (OpenCV): ours at +0.5
+                peer_px = np.array(res["pixels"]) + 0.5
+                cam_diff = np.abs(peer_px - ours_px)
+                from lidarphoto.core.io.raster import RasterReader
+
+                with RasterReader(work / f"{name}_orthority.tif") as src:
+                    gt, w, h = src.info.geotransform, src.info.width, src.info.height
+                extent = (gt[0], gt[3] - h * GSD + GSD / 2, gt[0] + w * GSD - GSD / 2,
+                          gt[3] - GSD / 2)  # fmt: skip
+            for mode in ("ours", "true"):
+                out = work / mode
+                values = {"CAMERA": str(args.demo / "flight" / "camera.json"),
+                          "EO": str(args.demo / "flight" / "eo_true.csv"),
+                          "IMAGES": [str(image)], "DSM": str(dsm_path), "CRS": CRS,
+                          "GSD": GSD, "EXTENT": ",".join(repr(v) for v in extent),
+                          "RESAMPLING": "bilinear", "TRUE_ORTHO": mode == "true",
+                          "OUTPUT_FOLDER": str(out)}  # fmt: skip
+                res = _run(sys.executable, OURS, {"values": values})
+                best[mode] = min(best[mode], res["seconds"])
+                mem[mode] = max(mem[mode], res["maxrss_mb"])
+        agree = _agreement(work / f"{name}_orthority.tif", work / "ours" / f"{name}_ortho.tif",
+                           dsm)  # fmt: skip
+        row = {"image": name, "cells": w * h, "orthority_s": best["peer"], "ours_s": best["ours"],
+               "ours_true_s": best["true"], "orthority_mb": mem["peer"], "ours_mb": mem["ours"],
+               "ours_true_mb": mem["true"], "camera_max_px": float(cam_diff.max()),
+               "camera_rms_px": float(np.sqrt(np.mean(cam_diff**2))), **agree}  # fmt: skip
+        rows.append(row)
+        print(f"{name}: {w} x {h} cells; orthority {best['peer']:.2f} s, ours {best['ours']:.2f} "
+              f"s ({best['peer'] / best['ours']:.2f}x), true ortho {best['true']:.2f} s; "
+              f"camera models {row['camera_max_px']:.4f} px; RMS {agree['rms_dn']:.2f} DN; "
+              f"shift median {np.median(agree['shift_px']):.3f} px over {agree['windows']} "
+              "windows", flush=True)  # fmt: skip
+    cells = sum(r["cells"] for r in rows)
+    tp = {k: cells / sum(r[f"{k}_s"] for r in rows) / 1e6
+          for k in ("orthority", "ours", "ours_true")}  # fmt: skip
+    shifts = np.concatenate([r["shift_px"] for r in rows])
+    white = np.concatenate([r["shift_whitened_px"] for r in rows])
+    figures.update(
+        images=len(rows), cells=cells, throughput_mpx_s=tp,
+        speed_ratio=tp["ours"] / tp["orthority"], true_ratio=tp["ours_true"] / tp["orthority"],
+        shift_px={"median": float(np.median(shifts)), "p95": float(np.percentile(shifts, 95)),
+                  "max": float(shifts.max()), "windows": int(shifts.size)},
+        shift_whitened_px={"median": float(np.median(white)), "max": float(white.max())},
+        rms_dn=float(np.sqrt(np.mean([r["rms_dn"] ** 2 for r in rows]))),
+        rms_dn_ground=float(np.sqrt(np.mean([r["rms_dn_ground"] ** 2 for r in rows]))),
+        camera_max_px=max(r["camera_max_px"] for r in rows),
+        memory_mb={k: max(r[f"{k}_mb"] for r in rows) for k in ("orthority", "ours",
+                                                               "ours_true")},
+        load_end=os.getloadavg()[0], rows=rows,
+    )  # fmt: skip
+    print(json.dumps({k: v for k, v in figures.items() if k != "rows"}, indent=1))
+    if args.json:
+        args.json.write_text(json.dumps(figures, indent=1), encoding="utf-8")
+    with open(work / "rows.csv", "w", newline="", encoding="utf-8") as fh:
+        keys = [k for k in rows[0] if not isinstance(rows[0][k], list)]
+        w_ = csv.DictWriter(fh, keys, extrasaction="ignore")
+        w_.writeheader()
+        w_.writerows(rows)
+    print(f"files in {work}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
