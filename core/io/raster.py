@@ -220,17 +220,39 @@ class RasterReader:
                              f"{self.info.height}")  # fmt: skip
         return c0, r0, w, h
 
-    def read(self, window: Window | None = None, bands: Sequence[int] | None = None) -> NDArray:
-        """(bands, rows, cols) array of the window (all bands by default; 1-based numbers)."""
+    def read(
+        self,
+        window: Window | None = None,
+        bands: Sequence[int] | None = None,
+        decimation: int = 1,
+    ) -> NDArray:
+        """(bands, rows, cols) array of the window (all bands by default; 1-based numbers).
+
+        With ``decimation`` f > 1 (the window's sides multiples of f), each output pixel is
+        the average of f x f pixels (GDAL reads a fitting overview level instead when the file
+        has one)."""
         c0, r0, w, h = self._window(window)
         which = list(bands) if bands is not None else list(range(1, self.info.bands + 1))
+        f = max(1, int(decimation))
+        bw, bh = w // f, h // f
         ds = self._handle()
         if self.backend == "gdal":
-            out = ds.ReadAsArray(c0, r0, w, h, band_list=which)
-            return out.reshape(len(which), h, w)
+            if f == 1:
+                out = ds.ReadAsArray(c0, r0, w, h, band_list=which)
+            else:
+                from osgeo import gdal
+
+                out = ds.ReadAsArray(c0, r0, w, h, buf_xsize=bw, buf_ysize=bh, band_list=which,
+                                     resample_alg=gdal.GRIORA_Average)  # fmt: skip
+            return out.reshape(len(which), bh, bw)
         from rasterio.windows import Window as RioWindow
 
-        return ds.read(which, window=RioWindow(c0, r0, w, h))
+        if f == 1:
+            return ds.read(which, window=RioWindow(c0, r0, w, h))
+        from rasterio.enums import Resampling
+
+        return ds.read(which, window=RioWindow(c0, r0, w, h), out_shape=(len(which), bh, bw),
+                       resampling=Resampling.average)  # fmt: skip
 
     def read_mask(self, window: Window | None = None) -> NDArray[np.bool_]:
         """(rows, cols) True where band 1 holds data: GDAL's mask band (an internal or

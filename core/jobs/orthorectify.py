@@ -134,7 +134,7 @@ def list_images(paths: tuple[str, ...] | list[str]) -> list[Path]:
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Check every input, then orthorectify the images one after the other."""
     from ..errors import CrsError, InputError
-    from ..geometry.frames import parse_crs
+    from ..geometry.frames import LocalFrame, MappingFrame, parse_crs
     from ..geometry.raycast import DsmTracer
     from ..geometry.surface import reproject_dsm
     from ..io.atomic import OutputSet
@@ -181,9 +181,13 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                     dsm.cell)  # fmt: skip
     tracer = DsmTracer.build(dsm)
     lens = _lens_lattice(camera)
+    g = dsm.grid  # one ENU frame (at the DSM's centre) and one lens lattice for every image
+    local = LocalFrame.at_map_point(MappingFrame(mapping), [g.x0 + g.cols * g.cell / 2,
+                                                           g.y_top - g.rows * g.cell / 2,
+                                                           tracer.zmin])  # fmt: skip
     projectors = {f.stem: OrthoProjector.build(camera, eo.xyz[row_of[f.stem]],
                                                eo.opk[row_of[f.stem]], tracer, mapping,
-                                               lens=lens) for f in images}  # fmt: skip
+                                               local=local, lens=lens) for f in images}  # fmt: skip
     boxes = {k: p.footprint() for k, p in projectors.items()}
     ground_z = {k: _median_height(dsm, b) for k, b in boxes.items()}
     gsd = float(v.gsd)
@@ -249,7 +253,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 def _tiles(proj, grid, src, info, options, progress, should_stop):
     from ..photo.orthophoto import orthorectify_tiles
 
-    return orthorectify_tiles(proj, grid, src.read, info.bands, info.dtype, options,
+    def read(window, f):
+        return src.read(window, decimation=f)
+
+    return orthorectify_tiles(proj, grid, read, info.bands, info.dtype, options,
                               progress=progress, should_stop=should_stop)  # fmt: skip
 
 

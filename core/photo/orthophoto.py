@@ -61,8 +61,9 @@ from .orthophoto_numba import remap_maps
 LOG = logging.getLogger(__name__)
 
 Array = NDArray[np.float64]
-#: read_window((col0, row0, cols, rows)) -> (bands, rows, cols) array of the source image
-ReadWindow = Callable[[tuple[int, int, int, int]], NDArray]
+#: read_window((col0, row0, cols, rows), f) -> (bands, rows // f, cols // f) array of the
+#: source image, each pixel the mean of f x f (f = 1: the pixels themselves)
+ReadWindow = Callable[[tuple[int, int, int, int], int], NDArray]
 
 RESAMPLING = ("nearest", "bilinear", "cubic")
 _PAD = {"nearest": 1, "bilinear": 1, "cubic": 2}
@@ -100,6 +101,9 @@ class OrthoOptions:
         Spacing of the exact projection nodes within a tile, cells.
     workers : int
         Threads (0: one per CPU, at most 4).
+    antialias : bool
+        Where a cell spans f >= 2 image pixels, resample the image averaged over f x f
+        pixels (else the resampling aliases fine texture).
     """
 
     gsd: float = 0.0
@@ -109,6 +113,7 @@ class OrthoOptions:
     tile_px: int = 512
     lattice_px: int = 64
     workers: int = 0
+    antialias: bool = True
 
     def __post_init__(self) -> None:
         if self.resampling not in RESAMPLING:
@@ -540,6 +545,18 @@ def _occlusion(
     return occ & valid
 
 
+def _decimation(col: Array, row: Array) -> int:
+    """Whole image pixels per cell (the median over the tile of the larger step of the image
+    position from one cell to the next); 1 when below 2."""
+    with np.errstate(invalid="ignore"):
+        dc = np.hypot(np.diff(col, axis=1), np.diff(row, axis=1))
+        dr = np.hypot(np.diff(col, axis=0), np.diff(row, axis=0))
+    steps = np.r_[dc[np.isfinite(dc)], dr[np.isfinite(dr)]]
+    if steps.size == 0:
+        return 1
+    return max(1, math.floor(float(np.median(steps))))
+
+
 def _remap(src: NDArray, mapx: NDArray[np.float32], mapy: NDArray[np.float32],
            resampling: str) -> NDArray:  # fmt: skip
     """(bands, rows, cols) of the source sampled at the maps (OpenCV pixel-centre convention)."""
@@ -589,14 +606,25 @@ def _tile(
         return OrthoTile(row0, col0, data, valid, occluded, no_surface)
     pad = _PAD[opt.resampling]
     cam = proj.camera
+    # image pixels per cell: when the cells are 2 or more pixels wide, the image is read
+    # averaged over f x f pixels (anti-aliasing; an overview level when the file has one)
+    f = _decimation(col, row) if opt.antialias else 1
     cv, rv = col[valid], row[valid]
-    c_lo = max(math.floor(cv.min() - 0.5) - pad, 0)
-    r_lo = max(math.floor(rv.min() - 0.5) - pad, 0)
-    c_hi = min(math.ceil(cv.max() - 0.5) + pad + 1, cam.width_px)
-    r_hi = min(math.ceil(rv.max() - 0.5) + pad + 1, cam.height_px)
-    src = read_window((c_lo, r_lo, c_hi - c_lo, r_hi - r_lo))
+    c_lo = max(math.floor(cv.min() - 0.5) - pad * f, 0)
+    r_lo = max(math.floor(rv.min() - 0.5) - pad * f, 0)
+    c_hi = min(math.ceil(cv.max() - 0.5) + (pad + 1) * f, cam.width_px)
+    r_hi = min(math.ceil(rv.max() - 0.5) + (pad + 1) * f, cam.height_px)
+    if f > 1:  # sides that are multiples of f
+        c_hi = c_lo + (c_hi - c_lo) // f * f
+        r_hi = r_lo + (r_hi - r_lo) // f * f
+        if c_hi - c_lo < f or r_hi - r_lo < f:
+            f, c_hi, r_hi = 1, min(c_hi + f, cam.width_px), min(r_hi + f, cam.height_px)
+    src = read_window((c_lo, r_lo, c_hi - c_lo, r_hi - r_lo), f)
     if opt.true_ortho:
         col = np.where(valid, col, np.nan)
+    if f > 1:  # decimated pixel k covers [c_lo + k f, c_lo + (k + 1) f): its centre
+        col = c_lo + (col - c_lo) / f
+        row = r_lo + (row - r_lo) / f
     mapx, mapy = remap_maps(col, row, c_lo, r_lo)
     out = _remap(src, mapx, mapy, opt.resampling)
     out[:, ~valid] = 0
@@ -622,8 +650,9 @@ def orthorectify_tiles(
     grid : Grid
         The output grid (mapping CRS; :func:`ortho_grid`).
     read_window : callable
-        ``read_window((col0, row0, cols, rows))`` -> (bands, rows, cols) array of the source
-        image (pixels of the camera); called from several threads.
+        ``read_window((col0, row0, cols, rows), f)`` -> (bands, rows // f, cols // f) array
+        of the source image (pixels of the camera; each the mean of f x f pixels); called from
+        several threads.
     bands, dtype
         Of the source image (and of the tiles).
     options : OrthoOptions

@@ -93,9 +93,7 @@ def exact_case() -> dict:
     proj = OrthoProjector.build(cam, xyz, opk, dsm, CRS)
     grid = ortho_grid(proj.footprint(), GSD)
 
-    def read(win):
-        c0, r0, w, h = win
-        return np.moveaxis(img.rgb[r0 : r0 + h, c0 : c0 + w], 2, 0)
+    read = _reader(np.moveaxis(img.rgb, 2, 0))
 
     def ortho(**kw):
         o = OrthoOptions(gsd=GSD, tile_px=128, **kw)
@@ -139,6 +137,21 @@ def exact_case() -> dict:
             "plain": plain, "plain_valid": plain_valid, "true": true_, "true_valid": true_valid,
             "col": col, "row": row, "z": z, "gap": gap, "hidden": hidden, "truth": truth,
             "gx": gx, "gy": gy, "img": img}  # fmt: skip
+
+
+def _reader(image: np.ndarray):
+    """read_window of an in-memory (bands, rows, cols) image, f x f means as GDAL's average."""
+
+    def read(win, f=1):
+        c0, r0, w, h = win
+        block = image[:, r0 : r0 + h, c0 : c0 + w]
+        if f == 1:
+            return block
+        b = block.reshape(block.shape[0], h // f, f, w // f, f).mean(axis=(2, 4))
+        return np.rint(b).astype(image.dtype) if image.dtype.kind in "ui" else b.astype(
+            image.dtype)  # fmt: skip
+
+    return read
 
 
 def _interior(mask: np.ndarray, px: int) -> np.ndarray:
@@ -305,20 +318,22 @@ def test_projection_chain_exact_far_from_the_central_meridian():
     np.testing.assert_allclose(zz[ii, jj], dsm.height_at(pts[:, 0], pts[:, 1]), atol=1e-4)
 
 
-def test_remap_reproduces_a_linear_image():
+@pytest.mark.parametrize("gsd", [0.05, 0.25])
+def test_remap_reproduces_a_linear_image(gsd):
     """An image whose value is linear in (col, row): the orthophoto's value at a cell is that
-    function at the cell's image position, up to OpenCV's 1/32-pixel interpolation steps."""
+    function at the cell's image position, up to OpenCV's 1/32-pixel interpolation steps. At
+    0.25 m a cell spans 4 image pixels: the image is read as 4 x 4 means (a linear function
+    is its own mean over a square centred on the point), so the steps are 4 times coarser."""
     _, dsm = _scene()
     cam = Camera("c", focal_mm=10.0, pixel_size_mm=0.01, width_px=800, height_px=600)
     xyz = np.array([X0 + 21.0, Y0 + 18.0, 60.0])
     proj = OrthoProjector.build(cam, xyz, np.radians([1.0, 2.0, -15.0]), dsm, CRS)
-    grid = ortho_grid(proj.footprint(), 0.05)
+    grid = ortho_grid(proj.footprint(), gsd)
+    f = 4 if gsd > 0.1 else 1
     cc, rr = np.meshgrid(np.arange(800) + 0.5, np.arange(600) + 0.5)
     img = (10.0 * cc + 3.0 * rr).astype(np.float32)[None]
 
-    def read(win):
-        c0, r0, w, h = win
-        return img[:, r0 : r0 + h, c0 : c0 + w]
+    read = _reader(img)
 
     col, row, _ = proj.pixels(grid, 0, 0, grid.rows, grid.cols)
     expected = 10.0 * col + 3.0 * row
@@ -330,13 +345,32 @@ def test_remap_reproduces_a_linear_image():
         # away from the image border (replicated there)
         sub_c = col[tile.row0 : tile.row0 + h, tile.col0 : tile.col0 + w]
         sub_r = row[tile.row0 : tile.row0 + h, tile.col0 : tile.col0 + w]
-        inner &= (sub_c > 1) & (sub_c < 799) & (sub_r > 1) & (sub_r < 599)
+        inner &= (sub_c > 2 * f) & (sub_c < 800 - 2 * f) & (sub_r > 2 * f) & (sub_r < 600 - 2 * f)
         if not inner.any():
             continue
         err = np.abs(tile.data[0][inner] - want[inner])
-        assert err.max() <= (10.0 + 3.0) / 64 + 1e-3
+        assert err.max() <= f * (10.0 + 3.0) / 64 + 1e-3
         checked += int(inner.sum())
     assert checked > 0.5 * grid.rows * grid.cols
+
+
+def test_cells_wider_than_pixels_are_not_aliased():
+    """A checkerboard of single pixels (0, 200) seen at 4 pixels per cell: averaged, every
+    cell is near 100; resampled without averaging, it swings between the two."""
+    _, dsm = _scene()
+    cam = Camera("c", focal_mm=10.0, pixel_size_mm=0.01, width_px=800, height_px=600)
+    proj = OrthoProjector.build(cam, [X0 + 21.0, Y0 + 18.0, 60.0], np.radians([1, 2, -15.0]),
+                                dsm, CRS)  # fmt: skip
+    grid = ortho_grid(proj.footprint(), 0.25)
+    cc, rr = np.meshgrid(np.arange(800), np.arange(600))
+    img = (200 * ((cc + rr) % 2)).astype(np.uint8)[None]
+    spread = {}
+    for antialias in (True, False):
+        vals = np.concatenate([t.data[0][t.valid] for t in orthorectify_tiles(
+            proj, grid, _reader(img), 1, np.uint8, OrthoOptions(antialias=antialias))])  # fmt: skip
+        spread[antialias] = np.percentile(vals, [5, 95])
+    assert 95 <= spread[True][0] and spread[True][1] <= 105, spread
+    assert spread[False][1] - spread[False][0] > 100, spread
 
 
 def test_auto_gsd_and_grid_alignment():
