@@ -10,7 +10,7 @@ Run (figures in bench/ortho.md)::
 orthority (pip package, GPL/AGPL-free peer by Dugal Harris) lives in its own throw-away venv: it
 needs ``opencv-python``, which clashes with our ``opencv-python-headless``; each run of either
 tool is a fresh process (timing from its first call to the closed file, imports excluded; peak
-memory from the process's maximum resident set).
+memory: the process's VmHWM, its largest resident set since it started).
 
 Data: the demo's rendered images (``make demo``: 10 frames of 6000 x 4000 px, 8-bit RGB, LZW,
 camera 130 m above the AHN3 Delft tile, GSD 1.67 cm), their true orientation (the images are
@@ -19,10 +19,12 @@ steps are run into it first.
 
 Equal output: orthority with ``aligned_pixels`` at GSD 1/64 m (0.015625, binary-exact: both
 tools put their cells on the same multiples), bilinear resampling of the image and of the DEM,
-internal mask, overviews, and our GeoTIFF creation options (tiled 512, DEFLATE with predictor
-2, pixel interleave, RGB, NUM_THREADS); ours on orthority's exact extent. Agreement where both
-have data: RMS of the differences (DN) and the shift between the two by phase correlation on
-256 x 256 windows of flat ground (core.quality.registration; magnitude-weighted, and whitened).
+internal mask, overviews, and our GeoTIFF creation options (tiled 512, DEFLATE level 1 with
+predictor 2, pixel interleave, RGB, NUM_THREADS); ours on orthority's exact extent. At
+1/64 m a cell is smaller than an image pixel (1.67 cm): no averaged reads on our side.
+Agreement where both have data: RMS of the differences (DN) and the shift between the two by
+phase correlation on 256 x 256 windows of flat ground (core.quality.registration;
+magnitude-weighted, and whitened).
 The camera models are first compared point by point (orthority's world_to_pixel against
 collinearity in our local ENU frame).
 """
@@ -40,7 +42,6 @@ import platform
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -48,12 +49,14 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 GSD = 1.0 / 64.0
 CRS = "EPSG:28992"
+#: our GeoTIFF creation options for orthophotos (core/io/raster.py, COMPRESSION=deflate)
 CREATION = {"tiled": True, "blockxsize": 512, "blockysize": 512, "compress": "deflate",
-            "predictor": 2, "interleave": "pixel", "photometric": "rgb", "bigtiff": "if_safer",
+            "zlevel": 1, "predictor": 2, "interleave": "pixel", "photometric": "rgb",
+            "bigtiff": "if_safer",
             "num_threads": str(max(1, min(4, os.cpu_count() or 1)))}  # fmt: skip
 
 ORTHORITY = r"""
-import json, math, resource, sys, time, warnings
+import json, math, sys, time, warnings
 warnings.simplefilter("ignore")
 import numpy as np
 from orthority.camera import PinholeCamera
@@ -61,34 +64,44 @@ from orthority.ortho import Ortho
 a = json.loads(sys.argv[1])
 cam = PinholeCamera(tuple(a["size"]), a["focal_mm"], sensor_size=tuple(a["sensor_mm"]),
                     cx=a["cx"], cy=a["cy"], xyz=tuple(a["xyz"]), opk=tuple(a["opk"]))
+import resource
+u0 = resource.getrusage(resource.RUSAGE_SELF)
 t0 = time.perf_counter()
 o = Ortho(a["image"], a["dem"], cam, crs=a["crs"])
 o.process(a["out"], resolution=(a["gsd"], a["gsd"]), interp="bilinear", dem_interp="bilinear",
           write_mask=True, creation_options=a["creation"], build_ovw=True, overwrite=True,
           aligned_pixels=True)
 t = time.perf_counter() - t0
+u1 = resource.getrusage(resource.RUSAGE_SELF)
+cpu = u1.ru_utime + u1.ru_stime - u0.ru_utime - u0.ru_stime
 pts = np.array(a["points"], float).T
 px = cam.world_to_pixel(pts).T
-print(json.dumps({"seconds": t, "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-                  / 1024, "pixels": px.tolist()}))
+hwm = [int(x.split()[1]) for x in open("/proc/self/status") if x.startswith("VmHWM")][0]
+print(json.dumps({"seconds": t, "cpu": cpu, "maxrss_mb": hwm / 1024, "pixels": px.tolist()}))
 """
 
 OURS = r"""
-import json, resource, sys, time
+import json, sys, time
 a = json.loads(sys.argv[1])
 from lidarphoto.core.jobs import orthorectify
 from lidarphoto.core.jobs.runner import run_job
 import lidarphoto.core.photo.orthophoto_numba as k
 import numpy as np
-if k.AVAILABLE:  # load the compiled kernel from its cache before the clock starts
+if k.AVAILABLE:  # load the compiled kernels from their cache before the clock starts
     k.cell_pixels(0.0, 0.0, 1.0, 0, 0, np.zeros((2, 2), np.float32), 0.0, 0.0, 1.0,
                   np.zeros((2, 2, 6)), 2.0, 1.0, np.zeros((1, 1, 2)), 0.0, 0.0, 1.0,
                   np.zeros(5), np.zeros((0, 0)), np.zeros((0, 0)), np.zeros((0, 0)))
+    k.remap_maps(np.zeros((1, 1)), np.zeros((1, 1)), 0, 0)
+import resource
+u0 = resource.getrusage(resource.RUSAGE_SELF)
 t0 = time.perf_counter()
 r = run_job(orthorectify, a["values"])
 t = time.perf_counter() - t0
-print(json.dumps({"seconds": t, "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-                  / 1024, "occluded": r.results["OCCLUDED_FRACTION"]}))
+u1 = resource.getrusage(resource.RUSAGE_SELF)
+cpu = u1.ru_utime + u1.ru_stime - u0.ru_utime - u0.ru_stime
+hwm = [int(x.split()[1]) for x in open("/proc/self/status") if x.startswith("VmHWM")][0]
+print(json.dumps({"seconds": t, "cpu": cpu, "maxrss_mb": hwm / 1024,
+                  "occluded": r.results["OCCLUDED_FRACTION"]}))
 """
 
 
@@ -112,6 +125,38 @@ def _demo(folder: Path) -> None:
     lidar = demo.lidar_step(folder / "lidar")
     sim, _, eo = demo.flight_step(lidar, folder / "flight")
     demo.render_step(lidar, sim, eo, folder / "flight" / "images")
+
+
+def _local_tm(demo: Path, work: Path, eo, dsm) -> tuple[str, Path, Path]:
+    """The EO and the DSM in a transverse Mercator tangent at the tile (scale 1 there, on the
+    same Bessel ellipsoid, heights unchanged): the CRS, EO CSV and DSM GeoTIFF. In it a map
+    is as Cartesian as the ground can be (orthority's assumption); in RD New the scale is
+    0.99994 at Delft."""
+    import pyproj
+    from lidarphoto.core.geometry.frames import LocalFrame, MappingFrame
+    from lidarphoto.core.geometry.surface import reproject_dsm
+    from lidarphoto.core.io.dsm import write_dsm
+    from lidarphoto.core.io.orientation import write_eo_csv
+    from lidarphoto.core.photo.orientation import (
+        ExteriorOrientationTable,
+        eo_local_to_map,
+        eo_map_to_local,
+    )
+
+    g = dsm.grid
+    rd = MappingFrame.from_user_input(CRS)
+    mid = [g.x0 + g.cols * g.cell / 2, g.y_top - g.rows * g.cell / 2, 0.0]
+    lat, lon, _ = (float(v) for v in rd.map_to_geodetic(np.array([mid]))[0])
+    tm = pyproj.CRS.from_proj4(f"+proj=tmerc +lat_0={lat!r} +lon_0={lon!r} +k=1 +x_0=1000 "
+                               "+y_0=1000 +ellps=bessel +units=m +no_defs")  # fmt: skip
+    local = LocalFrame.at_map_point(rd, mid)
+    c, m = eo_map_to_local(eo.xyz, eo.opk, local)
+    local_tm = LocalFrame(MappingFrame(tm), local.origin_llh)
+    xyz, opk = eo_local_to_map(c, m, local_tm)
+    table = ExteriorOrientationTable(eo.image_id, eo.time, eo.group, xyz, opk, tm.to_wkt())
+    write_eo_csv(work / "eo_tm.csv", table)
+    write_dsm(work / "dsm_tm.tif", reproject_dsm(dsm, tm, cell=g.cell))
+    return tm.to_wkt(), work / "eo_tm.csv", work / "dsm_tm.tif"
 
 
 def _peer_camera(cam, eo, k: int) -> dict:
@@ -239,81 +284,122 @@ def main() -> int:
         return 0
     _demo(args.demo)
     cam = read_camera_json(args.demo / "flight" / "camera.json")
-    eo = read_eo_csv(args.demo / "flight" / "eo_true.csv")
-    dsm_path = args.demo / "lidar" / "dsm.tif"
-    dsm = read_dsm_raster(dsm_path)
+    eo_rd = read_eo_csv(args.demo / "flight" / "eo_true.csv")
+    dsm_rd_path = args.demo / "lidar" / "dsm.tif"
+    dsm_rd = read_dsm_raster(dsm_rd_path)
     work = Path(tempfile.mkdtemp(prefix="bench_ortho_"))
-    rows = []
-    for k in range(min(args.images, len(eo))):
-        name = eo.image_id[k]
-        image = args.demo / "flight" / "images" / f"{name}.tif"
-        # the cameras, point by point: ground points of the DSM seen by the image
-        proj = OrthoProjector.build(cam, eo.xyz[k], eo.opk[k], dsm, CRS)
+    tm_wkt, tm_eo_csv, tm_dsm_path = _local_tm(args.demo, work, eo_rd, dsm_rd)
+    frames = {
+        "rd": (CRS, args.demo / "flight" / "eo_true.csv", eo_rd, dsm_rd_path, dsm_rd),
+        "tm": (tm_wkt, tm_eo_csv, read_eo_csv(tm_eo_csv), tm_dsm_path,
+               read_dsm_raster(tm_dsm_path)),
+    }  # fmt: skip
+
+    def camera_points(frame: str, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """400 DSM points seen by image k and their pixels by our rigorous chain."""
+        crs, _, eo, _, dsm = frames[frame]
+        proj = OrthoProjector.build(cam, eo.xyz[k], eo.opk[k], dsm, crs)
         box = proj.footprint()
         rng = np.random.default_rng(k)
-        pts_xy = np.column_stack([rng.uniform(box[0], box[2], 400),
-                                  rng.uniform(box[1], box[3], 400)])  # fmt: skip
-        pts = np.column_stack([pts_xy, dsm.height_at(pts_xy[:, 0], pts_xy[:, 1])])
+        xy = np.column_stack([rng.uniform(box[0], box[2], 400), rng.uniform(box[1], box[3], 400)])
+        pts = np.column_stack([xy, dsm.height_at(xy[:, 0], xy[:, 1])])
         pts = pts[np.isfinite(pts[:, 2])]
         c_loc, m_loc = eo_map_to_local(eo.xyz[k : k + 1], eo.opk[k : k + 1], proj.local)
-        ours_px = project(proj.local.map_to_enu(pts), np.r_[c_loc[0], matrix_to_opk(m_loc[0])],
-                          cam)  # fmt: skip
-        peer_arg = {**_peer_camera(cam, eo, k), "image": str(image), "dem": str(dsm_path),
-                    "crs": CRS, "gsd": GSD, "creation": CREATION, "points": pts.tolist()}  # fmt: skip
-        best = {"peer": math.inf, "ours": math.inf, "true": math.inf}
-        mem = {"peer": 0.0, "ours": 0.0, "true": 0.0}
-        for rep in range(args.repeats):
-            peer_arg["out"] = str(work / f"{name}_orthority.tif")
-            res = _run(args.orthority_python, ORTHORITY, peer_arg)
-            best["peer"] = min(best["peer"], res["seconds"])
-            mem["peer"] = max(mem["peer"], res["maxrss_mb"])
-            if rep == 0:
-                # orthority's pixels have their centres at integers (OpenCV): ours at +0.5
-                peer_px = np.array(res["pixels"]) + 0.5
-                cam_diff = np.abs(peer_px - ours_px)
-                from lidarphoto.core.io.raster import RasterReader
+        px = project(proj.local.map_to_enu(pts), np.r_[c_loc[0], matrix_to_opk(m_loc[0])], cam)
+        return pts, px
 
-                with RasterReader(work / f"{name}_orthority.tif") as src:
-                    gt, w, h = src.info.geotransform, src.info.width, src.info.height
-                extent = (gt[0], gt[3] - h * GSD + GSD / 2, gt[0] + w * GSD - GSD / 2,
-                          gt[3] - GSD / 2)  # fmt: skip
+    def peer(frame: str, k: int, out: Path) -> dict:
+        crs, _, eo, dsm_path, _ = frames[frame]
+        pts, px = camera_points(frame, k)
+        arg = {**_peer_camera(cam, eo, k), "image": str(images[k]), "dem": str(dsm_path),
+               "crs": crs, "gsd": GSD, "creation": CREATION, "points": pts.tolist(),
+               "out": str(out)}  # fmt: skip
+        res = _run(args.orthority_python, ORTHORITY, arg)
+        # orthority's pixels have their centres at integers (OpenCV's): ours at + 0.5
+        diff = np.abs(np.array(res["pixels"]) + 0.5 - px)
+        res["camera_max_px"] = float(diff.max())
+        return res
+
+    def ours(frame: str, k: int, ref: Path, out: Path, true_ortho: bool) -> dict:
+        """Our job on the extent of orthority's output ``ref`` (the same cells)."""
+        from lidarphoto.core.io.raster import RasterReader
+
+        crs, eo_csv, _, dsm_path, _ = frames[frame]
+        with RasterReader(ref) as src:
+            gt, w, h = src.info.geotransform, src.info.width, src.info.height
+        extent = (gt[0], gt[3] - h * GSD + GSD / 2, gt[0] + w * GSD - GSD / 2, gt[3] - GSD / 2)
+        values = {"CAMERA": str(args.demo / "flight" / "camera.json"), "EO": str(eo_csv),
+                  "IMAGES": [str(images[k])], "DSM": str(dsm_path), "CRS": crs, "GSD": GSD,
+                  "EXTENT": ",".join(repr(v) for v in extent), "RESAMPLING": "bilinear",
+                  "TRUE_ORTHO": true_ortho, "OUTPUT_FOLDER": str(out)}  # fmt: skip
+        res = _run(sys.executable, OURS, {"values": values})
+        res["cells"] = w * h
+        return res
+
+    images = [args.demo / "flight" / "images" / f"{i}.tif" for i in eo_rd.image_id]
+    rows = []
+    for k in range(min(args.images, len(eo_rd))):
+        name = eo_rd.image_id[k]
+        best = {"peer": math.inf, "ours": math.inf, "true": math.inf}
+        cpu = {"peer": math.inf, "ours": math.inf, "true": math.inf}
+        mem = {"peer": 0.0, "ours": 0.0, "true": 0.0}
+        ref = work / "rd" / f"{name}_orthority.tif"
+        ref.parent.mkdir(exist_ok=True)
+        for _ in range(args.repeats):  # alternating, in RD New: what the user runs
+            res = peer("rd", k, ref)
+            best["peer"], mem["peer"] = min(best["peer"], res["seconds"]), max(
+                mem["peer"], res["maxrss_mb"])  # fmt: skip
+            cpu["peer"] = min(cpu["peer"], res["cpu"])
+            cam_rd = res["camera_max_px"]
             for mode in ("ours", "true"):
-                out = work / mode
-                values = {"CAMERA": str(args.demo / "flight" / "camera.json"),
-                          "EO": str(args.demo / "flight" / "eo_true.csv"),
-                          "IMAGES": [str(image)], "DSM": str(dsm_path), "CRS": CRS,
-                          "GSD": GSD, "EXTENT": ",".join(repr(v) for v in extent),
-                          "RESAMPLING": "bilinear", "TRUE_ORTHO": mode == "true",
-                          "OUTPUT_FOLDER": str(out)}  # fmt: skip
-                res = _run(sys.executable, OURS, {"values": values})
-                best[mode] = min(best[mode], res["seconds"])
-                mem[mode] = max(mem[mode], res["maxrss_mb"])
-        agree = _agreement(work / f"{name}_orthority.tif", work / "ours" / f"{name}_ortho.tif",
-                           dsm)  # fmt: skip
-        row = {"image": name, "cells": w * h, "orthority_s": best["peer"], "ours_s": best["ours"],
-               "ours_true_s": best["true"], "orthority_mb": mem["peer"], "ours_mb": mem["ours"],
-               "ours_true_mb": mem["true"], "camera_max_px": float(cam_diff.max()),
-               "camera_rms_px": float(np.sqrt(np.mean(cam_diff**2))), **agree}  # fmt: skip
+                got = ours("rd", k, ref, work / "rd" / mode, mode == "true")
+                best[mode], mem[mode] = min(best[mode], got["seconds"]), max(
+                    mem[mode], got["maxrss_mb"])  # fmt: skip
+                cpu[mode] = min(cpu[mode], got["cpu"])
+                cells = got["cells"]
+        agree_rd = _agreement(ref, work / "rd" / "ours" / f"{name}_ortho.tif", frames["rd"][4])
+        ref_tm = work / "tm" / f"{name}_orthority.tif"
+        ref_tm.parent.mkdir(exist_ok=True)
+        cam_tm = peer("tm", k, ref_tm)["camera_max_px"]
+        ours("tm", k, ref_tm, work / "tm" / "ours", False)
+        agree_tm = _agreement(ref_tm, work / "tm" / "ours" / f"{name}_ortho.tif",
+                              frames["tm"][4])  # fmt: skip
+        row = {"image": name, "cells": cells, "orthority_s": best["peer"],
+               "ours_s": best["ours"], "ours_true_s": best["true"],
+               "orthority_cpu": cpu["peer"], "ours_cpu": cpu["ours"], "ours_true_cpu": cpu["true"],
+               "orthority_mb": mem["peer"], "ours_mb": mem["ours"], "ours_true_mb": mem["true"],
+               "camera_max_px_rd": cam_rd, "camera_max_px_tm": cam_tm,
+               **{f"{key}_rd": v for key, v in agree_rd.items()},
+               **{f"{key}_tm": v for key, v in agree_tm.items()}}  # fmt: skip
         rows.append(row)
-        print(f"{name}: {w} x {h} cells; orthority {best['peer']:.2f} s, ours {best['ours']:.2f} "
-              f"s ({best['peer'] / best['ours']:.2f}x), true ortho {best['true']:.2f} s; "
-              f"camera models {row['camera_max_px']:.4f} px; RMS {agree['rms_dn']:.2f} DN; "
-              f"shift median {np.median(agree['shift_px']):.3f} px over {agree['windows']} "
-              "windows", flush=True)  # fmt: skip
+        print(f"{name}: {cells / 1e6:.1f} Mcells; orthority {best['peer']:.2f} s "
+              f"({cpu['peer']:.2f} CPU s), ours {best['ours']:.2f} s ({cpu['ours']:.2f}; "
+              f"{best['peer'] / best['ours']:.2f}x), true {best['true']:.2f}"
+              f" s; cameras differ by {cam_rd:.3f} px (RD) / {cam_tm:.3f} px (TM); shift median "
+              f"{np.median(agree_rd['shift_px']):.3f} (RD) / {np.median(agree_tm['shift_px']):.3f}"
+              f" (TM) px; RMS {agree_tm['rms_dn']:.2f} DN (TM)", flush=True)  # fmt: skip
     cells = sum(r["cells"] for r in rows)
     tp = {k: cells / sum(r[f"{k}_s"] for r in rows) / 1e6
           for k in ("orthority", "ours", "ours_true")}  # fmt: skip
-    shifts = np.concatenate([r["shift_px"] for r in rows])
-    white = np.concatenate([r["shift_whitened_px"] for r in rows])
+
+    def stats(key: str) -> dict:
+        v = np.concatenate([r[key] for r in rows])
+        return {"median": float(np.median(v)), "p95": float(np.percentile(v, 95)),
+                "max": float(v.max()), "windows": int(v.size)}  # fmt: skip
+
+    tp_cpu = {k: cells / sum(r[f"{k}_cpu"] for r in rows) / 1e6
+              for k in ("orthority", "ours", "ours_true")}  # fmt: skip
     figures.update(
-        images=len(rows), cells=cells, throughput_mpx_s=tp,
+        images=len(rows), cells=cells, throughput_mcells_s=tp,
+        throughput_mcells_per_cpu_s=tp_cpu, cpu_ratio=tp_cpu["ours"] / tp_cpu["orthority"],
         speed_ratio=tp["ours"] / tp["orthority"], true_ratio=tp["ours_true"] / tp["orthority"],
-        shift_px={"median": float(np.median(shifts)), "p95": float(np.percentile(shifts, 95)),
-                  "max": float(shifts.max()), "windows": int(shifts.size)},
-        shift_whitened_px={"median": float(np.median(white)), "max": float(white.max())},
-        rms_dn=float(np.sqrt(np.mean([r["rms_dn"] ** 2 for r in rows]))),
-        rms_dn_ground=float(np.sqrt(np.mean([r["rms_dn_ground"] ** 2 for r in rows]))),
-        camera_max_px=max(r["camera_max_px"] for r in rows),
+        shift_px_rd=stats("shift_px_rd"), shift_px_tm=stats("shift_px_tm"),
+        shift_whitened_px_tm=stats("shift_whitened_px_tm"),
+        rms_dn_rd=float(np.sqrt(np.mean([r["rms_dn_rd"] ** 2 for r in rows]))),
+        rms_dn_tm=float(np.sqrt(np.mean([r["rms_dn_tm"] ** 2 for r in rows]))),
+        rms_dn_ground_tm=float(np.sqrt(np.mean([r["rms_dn_ground_tm"] ** 2 for r in rows]))),
+        camera_max_px_rd=max(r["camera_max_px_rd"] for r in rows),
+        camera_max_px_tm=max(r["camera_max_px_tm"] for r in rows),
         memory_mb={k: max(r[f"{k}_mb"] for r in rows) for k in ("orthority", "ours",
                                                                "ours_true")},
         load_end=os.getloadavg()[0], rows=rows,

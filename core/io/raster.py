@@ -185,8 +185,10 @@ class RasterReader:
                     import rasterio
                     from rasterio.errors import NotGeoreferencedWarning
 
-                    with warnings.catch_warnings(), rasterio.Env(GTIFF_REPORT_COMPD_CS=True):
-                        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+                    # camera frames have no georeferencing: nothing to warn about (a filter
+                    # for the process: catch_warnings is not thread-safe)
+                    warnings.filterwarnings("ignore", category=NotGeoreferencedWarning)
+                    with rasterio.Env(GTIFF_REPORT_COMPD_CS=True):
                         h = rasterio.open(self.path)
             except Exception as exc:  # GDAL's RuntimeError / rasterio's RasterioIOError
                 raise InputError(f"not a readable raster ({exc})", path=self.path) from exc
@@ -328,7 +330,10 @@ class GeoTiffWriter:
         Nodata value of every band.
     mask : bool
         Write an internal per-dataset mask (:meth:`write` takes it per window).
-    compress : {"DEFLATE", "LZW", "NONE"}
+    compress : {"DEFLATE", "ZSTD", "LZW", "JPEG", "NONE"}
+        JPEG (lossy, quality 90, YCbCr for three 8-bit bands) needs 8-bit data.
+    level : int, optional
+        DEFLATE (1-9) or ZSTD (1-22) level (default: GDAL's, 6 and 9).
     tile : int
         Block side, pixels (multiple of 16); 0 writes strips.
     photometric : str, optional
@@ -350,6 +355,7 @@ class GeoTiffWriter:
         nodata: float | None = None,
         mask: bool = False,
         compress: str = "DEFLATE",
+        level: int | None = None,
         tile: int = 256,
         photometric: str | None = None,
         metadata: Mapping[str, str] | None = None,
@@ -370,8 +376,16 @@ class GeoTiffWriter:
             opts.update(TILED="YES", BLOCKXSIZE=str(int(tile)), BLOCKYSIZE=str(int(tile)))
         if compress in ("DEFLATE", "LZW", "ZSTD"):
             opts["PREDICTOR"] = "2" if integer else "3"
+        if level is not None and compress in ("DEFLATE", "ZSTD"):
+            opts["ZLEVEL" if compress == "DEFLATE" else "ZSTD_LEVEL"] = str(int(level))
         if photometric:
             opts["PHOTOMETRIC"] = photometric.upper()
+        if compress == "JPEG":
+            if self.dtype != np.uint8:
+                raise InputError(f"JPEG compression needs 8-bit data, not {self.dtype}")
+            opts["JPEG_QUALITY"] = "90"
+            if self.bands == 3:
+                opts["PHOTOMETRIC"] = "YCBCR"
         crs_text = _crs_text(crs)
         gt = tuple(float(v) for v in geotransform) if geotransform is not None else None
         if self.backend == "gdal":

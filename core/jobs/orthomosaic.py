@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..photo.mosaic import METHODS, MosaicOptions
-from .common import CSV_OUT
+from .common import CSV_OUT, compression_param
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -49,6 +49,7 @@ MultiPolygon in the mosaic's CRS).""",
               labels=("most nadir view", "nearest image centre")),
         Param("FEATHER", "number", "Feathering width across seamlines (0 = none)",
               _D.feather_px, unit="cells", minimum=0.0),
+        compression_param(),
         Param("OUTPUT", "raster_out", "Orthomosaic"),
         Param("OUTPUT_SEAMLINES", "sink", "Seamlines (region of each image)",
               geometry="polygon"),
@@ -102,6 +103,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.raster import GeoTiffWriter, RasterReader, polygonize
     from ..io.tables import write_csv_atomic
     from ..photo.mosaic import MosaicSource, mosaic_grid, mosaic_tiles
+    from .common import compression_args
     from .orthorectify import list_images
 
     files = list_images(v.orthophotos)
@@ -150,7 +152,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         meta_out = {"LIDARPHOTO_SOURCES": ",".join(s.name for s in sources)}
         with GeoTiffWriter(out.path("OUTPUT"), grid.cols, grid.rows, first.bands, first.dtype,
                            grid.geotransform, crs, mask=True, tile=512,
-                           photometric=photometric, metadata=meta_out) as writer:  # fmt: skip
+                           photometric=photometric, metadata=meta_out,
+                           **compression_args(v.compression)) as writer:  # fmt: skip
             for tile in mosaic_tiles(sources, grid, read, first.bands, first.dtype, options,
                                      progress=mosaic, should_stop=should_stop):  # fmt: skip
                 writer.write(tile.data, tile.col0, tile.row0, tile.valid)

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..photo.orthophoto import RESAMPLING, OrthoOptions
-from .common import CSV_FILTER
+from .common import CSV_FILTER, compression_param
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -52,8 +52,8 @@ grid) the run stops with PROJ's reason.
 
 ## Output
 One GeoTIFF per image, <image_id>_ortho.tif in the output folder: the image's bands and type,
-tiled, DEFLATE-compressed, with overviews, the CRS and an internal mask (no data outside the
-image, beyond the DSM and, for true orthophotos, where occluded). Its metadata keep the
+tiled, compressed (DEFLATE by default), with overviews, the CRS and an internal mask (no data
+outside the image, beyond the DSM and, for true orthophotos, where occluded). Its metadata keep the
 perspective centre, which Orthomosaic uses. GSD 0 takes the images' nadir GSD (the median
 over the images, 2 significant digits); the grids are aligned on multiples of the GSD. The
 extent is each image's footprint on the DSM, or the extent given (xmin, ymin, xmax, ymax).
@@ -78,6 +78,7 @@ Nothing is written when an input is wrong; the files appear together when all ar
               _D.true_ortho),
         Param("OCCLUSION_TOLERANCE", "number", "Occlusion tolerance along the ray",
               _D.occlusion_tol_m, unit="CRS unit", minimum=0.0, advanced=True),
+        compression_param(),
         Param("OUTPUT_FOLDER", "folder_out", "Output folder"),
     ),
     results=(
@@ -143,6 +144,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.orientation import read_eo_csv
     from ..io.raster import GeoTiffWriter, RasterReader
     from ..photo.orthophoto import OrthoProjector, _lens_lattice, auto_gsd, ortho_grid
+    from .common import compression_args
 
     camera = read_camera_json(v.camera)
     eo = read_eo_csv(v.eo)
@@ -199,6 +201,13 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         gsd = float(np.median(gsds))
     written: list[OrthoFile] = []
     total_valid = total_occluded = 0
+    beyond = {k: _beyond_dsm(p, ground_z[k]) for k, p in projectors.items()
+              if boxes[k] is not None}  # fmt: skip
+    beyond = {k: v for k, v in beyond.items() if v > 0}
+    if beyond:
+        log.warning("the DSM does not cover all of %d image(s) (share of the image's border "
+                    "beyond it: %s): no data there", len(beyond),
+                    ", ".join(f"{k} {round(100 * v)} %" for k, v in beyond.items()))  # fmt: skip
     with OutputSet({k: str(p) for k, p in targets.items()}, inputs) as files:
         for m, f in enumerate(images):
             name = f.stem
@@ -207,7 +216,6 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             if box is None:
                 log.warning("image %s does not overlap the DSM: no orthophoto", name)
                 continue
-            _warn_coverage(proj, ground_z[name], name)
             grid = ortho_grid(box, gsd)
             sub = None if work is None else (
                 lambda fr, m=m: work((m + fr) / len(images)))  # fmt: skip
@@ -227,8 +235,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                 photometric = "RGB" if info.bands == 3 and info.dtype == np.uint8 else None
                 with GeoTiffWriter(files.path(name), grid.cols, grid.rows, info.bands,
                                    info.dtype, grid.geotransform, mapping, mask=True,
-                                   tile=512, photometric=photometric,
-                                   metadata=meta) as writer:  # fmt: skip
+                                   tile=512, photometric=photometric, metadata=meta,
+                                   **compression_args(v.compression)) as writer:  # fmt: skip
                     for tile in _tiles(proj, grid, src, info, options, sub, should_stop):
                         writer.write(tile.data, tile.col0, tile.row0, tile.valid)
                         valid += int(np.count_nonzero(tile.valid))
@@ -276,8 +284,8 @@ def _median_height(dsm, box) -> float:
     return float(np.median(vals)) if vals.size else math.nan
 
 
-def _warn_coverage(proj, ground_z: float, name: str) -> None:
-    """Warn when the image sees ground beyond the DSM (those cells are no data)."""
+def _beyond_dsm(proj, ground_z: float) -> float:
+    """Share of the image's border whose ground (at the median height) lies beyond the DSM."""
     cam = proj.camera
     k = np.linspace(0.0, 1.0, 33)
     w, h = cam.width_px, cam.height_px
@@ -290,7 +298,4 @@ def _warn_coverage(proj, ground_z: float, name: str) -> None:
     xc, yc = proj.dsm.centre_origin
     inside = ((xy[:, 0] >= xc) & (xy[:, 0] <= xc + (g.cols - 1) * g.cell)
               & (xy[:, 1] <= yc) & (xy[:, 1] >= yc - (g.rows - 1) * g.cell))  # fmt: skip
-    if not inside.all():
-        share = round(100 * (1 - inside.mean()))
-        log.warning("the DSM does not cover all of image %s: %d %% of its border falls "
-                    "beyond it (no data there)", name, share)  # fmt: skip
+    return float(1.0 - inside.mean())

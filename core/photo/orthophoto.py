@@ -545,16 +545,20 @@ def _occlusion(
     return occ & valid
 
 
-def _decimation(col: Array, row: Array) -> int:
-    """Whole image pixels per cell (the median over the tile of the larger step of the image
-    position from one cell to the next); 1 when below 2."""
+def _decimation(proj: OrthoProjector, grid: Grid, lattice_px: int) -> int:
+    """Whole image pixels per cell over the orthophoto: the 5th percentile, over a 64 x 64
+    sample of the grid, of the larger step of the image position from one cell to the next;
+    1 when below 2. One value per orthophoto, so that no tile border shows a change."""
+    s = max(1, min(grid.rows, grid.cols) // 64)
+    coarse = Grid(grid.x0, grid.y_top, grid.cell * s, -(-grid.rows // s), -(-grid.cols // s))
+    col, row, _ = proj.pixels(coarse, 0, 0, coarse.rows, coarse.cols, lattice_px=lattice_px)
     with np.errstate(invalid="ignore"):
         dc = np.hypot(np.diff(col, axis=1), np.diff(row, axis=1))
         dr = np.hypot(np.diff(col, axis=0), np.diff(row, axis=0))
-    steps = np.r_[dc[np.isfinite(dc)], dr[np.isfinite(dr)]]
+    steps = np.r_[dc[np.isfinite(dc)], dr[np.isfinite(dr)]] / s
     if steps.size == 0:
         return 1
-    return max(1, math.floor(float(np.median(steps))))
+    return max(1, math.floor(float(np.percentile(steps, 5))))
 
 
 def _remap(src: NDArray, mapx: NDArray[np.float32], mapy: NDArray[np.float32],
@@ -592,6 +596,7 @@ def _tile(
     bands: int,
     dtype: np.dtype,
     opt: OrthoOptions,
+    f: int = 1,
 ) -> OrthoTile:
     col, row, z = proj.pixels(grid, row0, col0, rows, cols, lattice_px=opt.lattice_px)
     valid = np.isfinite(col)
@@ -606,9 +611,6 @@ def _tile(
         return OrthoTile(row0, col0, data, valid, occluded, no_surface)
     pad = _PAD[opt.resampling]
     cam = proj.camera
-    # image pixels per cell: when the cells are 2 or more pixels wide, the image is read
-    # averaged over f x f pixels (anti-aliasing; an overview level when the file has one)
-    f = _decimation(col, row) if opt.antialias else 1
     cv, rv = col[valid], row[valid]
     c_lo = max(math.floor(cv.min() - 0.5) - pad * f, 0)
     r_lo = max(math.floor(rv.min() - 0.5) - pad * f, 0)
@@ -664,9 +666,12 @@ def orthorectify_tiles(
     windows = [(r0, c0, min(size, grid.rows - r0), min(size, grid.cols - c0))
                for r0 in range(0, grid.rows, size) for c0 in range(0, grid.cols, size)]  # fmt: skip
     kind = np.dtype(dtype)
+    # image pixels per cell: when the cells are 2 or more pixels wide, the image is read
+    # averaged over f x f pixels (anti-aliasing; an overview level when the file has one)
+    f = _decimation(projector, grid, opt.lattice_px) if opt.antialias else 1
 
     def one(win: tuple[int, int, int, int]) -> OrthoTile:
-        return _tile(projector, grid, *win, read_window, bands, kind, opt)
+        return _tile(projector, grid, *win, read_window, bands, kind, opt, f)
 
     yield from ordered_map(one, windows, opt.workers, progress, should_stop, "orthorectifying")
 
