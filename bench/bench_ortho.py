@@ -70,7 +70,7 @@ t0 = time.perf_counter()
 o = Ortho(a["image"], a["dem"], cam, crs=a["crs"])
 o.process(a["out"], resolution=(a["gsd"], a["gsd"]), interp="bilinear", dem_interp="bilinear",
           write_mask=True, creation_options=a["creation"], build_ovw=True, overwrite=True,
-          aligned_pixels=True)
+          aligned_pixels=True, compress=a.get("compress"))
 t = time.perf_counter() - t0
 u1 = resource.getrusage(resource.RUSAGE_SELF)
 cpu = u1.ru_utime + u1.ru_stime - u0.ru_utime - u0.ru_stime
@@ -256,6 +256,69 @@ def exact_figures() -> dict:
     return out
 
 
+LARGE = r"""
+import json, sys, time
+a = json.loads(sys.argv[1])
+from lidarphoto.core.jobs import orthorectify
+from lidarphoto.core.jobs.runner import run_job
+t0 = time.perf_counter()
+r = run_job(orthorectify, a["values"])
+t = time.perf_counter() - t0
+hwm = [int(x.split()[1]) for x in open("/proc/self/status") if x.startswith("VmHWM")][0]
+print(json.dumps({"seconds": t, "maxrss_mb": hwm / 1024}))
+"""
+
+
+def large_frame(work: Path) -> dict:
+    """Memory and time for one 196 Mpx frame (UltraCam XP size, 17310 x 11310, 8-bit RGB,
+    tiled): its orthophoto at the image's GSD on a flat DSM, in a fresh process."""
+    import pyproj
+    from lidarphoto.core.geometry.grid import Grid
+    from lidarphoto.core.geometry.surface import Dsm
+    from lidarphoto.core.io.camera import write_camera_json
+    from lidarphoto.core.io.dsm import write_dsm
+    from lidarphoto.core.io.orientation import write_eo_csv
+    from lidarphoto.core.io.raster import GeoTiffWriter
+    from lidarphoto.core.photo.orientation import ExteriorOrientationTable
+    from lidarphoto.core.simulation.flight import ultracam_xp
+
+    cam = ultracam_xp()
+    w, h = cam.width_px, cam.height_px
+    image = work / "large" / "big.tif"
+    image.parent.mkdir(parents=True, exist_ok=True)
+    with GeoTiffWriter(image, w, h, 3, np.uint8, None, tile=512, photometric="RGB",
+                       compress="LZW") as out:  # fmt: skip
+        jj = np.arange(512)
+        for r0 in range(0, h, 512):
+            for c0 in range(0, w, 512):
+                cc, rr = np.meshgrid(c0 + jj, r0 + jj)
+                band = ((cc // 7 + rr // 11) % 2 * 120 + (cc * 3 + rr) % 97).astype(np.uint8)
+                out.write(np.stack([band, band[::-1], band.T])[:, : min(512, h - r0),
+                                                                : min(512, w - c0)], c0, r0)
+        out.close(overviews=False)
+    height = 1000.0  # GSD 6 cm; footprint 1040 x 680 m on a flat DSM of 1 m
+    gsd = height * cam.pixel_size_mm / cam.focal_mm
+    dsm = Dsm(np.zeros((900, 1300), np.float32), Grid(99350.0, 400450.0, 1.0, 900, 1300),
+              pyproj.CRS.from_epsg(28992))  # fmt: skip
+    write_dsm(work / "large" / "flat.tif", dsm)
+    write_camera_json(work / "large" / "camera.json", cam)
+    eo = ExteriorOrientationTable(("big",), np.array([0.0]), ("",),
+                                  np.array([[100000.0, 400000.0, height]]),
+                                  np.radians([[0.5, -0.3, 90.0]]), CRS)  # fmt: skip
+    write_eo_csv(work / "large" / "eo.csv", eo)
+    values = {"CAMERA": str(work / "large" / "camera.json"), "EO": str(work / "large" / "eo.csv"),
+              "IMAGES": [str(image)], "DSM": str(work / "large" / "flat.tif"), "CRS": CRS,
+              "GSD": round(gsd, 3), "OUTPUT_FOLDER": str(work / "large" / "out")}  # fmt: skip
+    res = _run(sys.executable, LARGE, {"values": values})
+    from lidarphoto.core.io.raster import RasterReader
+
+    with RasterReader(work / "large" / "out" / "big_ortho.tif") as src:
+        res["cells"] = src.info.width * src.info.height
+    res["image_px"] = w * h
+    image.unlink()
+    return res
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--orthority-python", default=os.environ.get("ORTHORITY_PYTHON", ""),
@@ -264,7 +327,14 @@ def main() -> int:
     ap.add_argument("--images", type=int, default=10)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--json", type=Path, default=None, help="write the figures here")
+    ap.add_argument("--large", action="store_true", help="only the 196 Mpx frame")
     args = ap.parse_args()
+    if args.large:
+        res = large_frame(Path(tempfile.mkdtemp(prefix="bench_ortho_large_")))
+        print(json.dumps(res, indent=1))
+        if args.json:
+            args.json.write_text(json.dumps(res, indent=1), encoding="utf-8")
+        return 0
 
     from lidarphoto.core.geometry.collinearity import project
     from lidarphoto.core.geometry.rotations import matrix_to_opk
@@ -308,11 +378,14 @@ def main() -> int:
         px = project(proj.local.map_to_enu(pts), np.r_[c_loc[0], matrix_to_opk(m_loc[0])], cam)
         return pts, px
 
-    def peer(frame: str, k: int, out: Path) -> dict:
+    def peer(frame: str, k: int, out: Path, own_defaults: bool = False) -> dict:
+        """orthority on image k; with our creation options, or with its own lossless default
+        (DEFLATE at GDAL's level 6, no predictor, tiled 512)."""
         crs, _, eo, dsm_path, _ = frames[frame]
         pts, px = camera_points(frame, k)
         arg = {**_peer_camera(cam, eo, k), "image": str(images[k]), "dem": str(dsm_path),
-               "crs": crs, "gsd": GSD, "creation": CREATION, "points": pts.tolist(),
+               "crs": crs, "gsd": GSD, "creation": None if own_defaults else CREATION,
+               "compress": "deflate" if own_defaults else None, "points": pts.tolist(),
                "out": str(out)}  # fmt: skip
         res = _run(args.orthority_python, ORTHORITY, arg)
         # orthority's pixels have their centres at integers (OpenCV's): ours at + 0.5
@@ -340,9 +413,9 @@ def main() -> int:
     rows = []
     for k in range(min(args.images, len(eo_rd))):
         name = eo_rd.image_id[k]
-        best = {"peer": math.inf, "ours": math.inf, "true": math.inf}
-        cpu = {"peer": math.inf, "ours": math.inf, "true": math.inf}
-        mem = {"peer": 0.0, "ours": 0.0, "true": 0.0}
+        best = {"peer": math.inf, "ours": math.inf, "true": math.inf, "own": math.inf}
+        cpu = {"peer": math.inf, "ours": math.inf, "true": math.inf, "own": math.inf}
+        mem = {"peer": 0.0, "ours": 0.0, "true": 0.0, "own": 0.0}
         ref = work / "rd" / f"{name}_orthority.tif"
         ref.parent.mkdir(exist_ok=True)
         for _ in range(args.repeats):  # alternating, in RD New: what the user runs
@@ -351,6 +424,9 @@ def main() -> int:
                 mem["peer"], res["maxrss_mb"])  # fmt: skip
             cpu["peer"] = min(cpu["peer"], res["cpu"])
             cam_rd = res["camera_max_px"]
+            res = peer("rd", k, work / "rd" / f"{name}_orthority_own.tif", own_defaults=True)
+            best["own"], cpu["own"] = min(best["own"], res["seconds"]), min(cpu["own"],
+                                                                            res["cpu"])  # fmt: skip
             for mode in ("ours", "true"):
                 got = ours("rd", k, ref, work / "rd" / mode, mode == "true")
                 best[mode], mem[mode] = min(best[mode], got["seconds"]), max(
@@ -367,6 +443,7 @@ def main() -> int:
         row = {"image": name, "cells": cells, "orthority_s": best["peer"],
                "ours_s": best["ours"], "ours_true_s": best["true"],
                "orthority_cpu": cpu["peer"], "ours_cpu": cpu["ours"], "ours_true_cpu": cpu["true"],
+               "orthority_own_s": best["own"], "orthority_own_cpu": cpu["own"],
                "orthority_mb": mem["peer"], "ours_mb": mem["ours"], "ours_true_mb": mem["true"],
                "camera_max_px_rd": cam_rd, "camera_max_px_tm": cam_tm,
                **{f"{key}_rd": v for key, v in agree_rd.items()},
@@ -379,20 +456,20 @@ def main() -> int:
               f"{np.median(agree_rd['shift_px']):.3f} (RD) / {np.median(agree_tm['shift_px']):.3f}"
               f" (TM) px; RMS {agree_tm['rms_dn']:.2f} DN (TM)", flush=True)  # fmt: skip
     cells = sum(r["cells"] for r in rows)
-    tp = {k: cells / sum(r[f"{k}_s"] for r in rows) / 1e6
-          for k in ("orthority", "ours", "ours_true")}  # fmt: skip
+    kinds = ("orthority", "orthority_own", "ours", "ours_true")
+    tp = {k: cells / sum(r[f"{k}_s"] for r in rows) / 1e6 for k in kinds}
 
     def stats(key: str) -> dict:
         v = np.concatenate([r[key] for r in rows])
         return {"median": float(np.median(v)), "p95": float(np.percentile(v, 95)),
                 "max": float(v.max()), "windows": int(v.size)}  # fmt: skip
 
-    tp_cpu = {k: cells / sum(r[f"{k}_cpu"] for r in rows) / 1e6
-              for k in ("orthority", "ours", "ours_true")}  # fmt: skip
+    tp_cpu = {k: cells / sum(r[f"{k}_cpu"] for r in rows) / 1e6 for k in kinds}
     figures.update(
         images=len(rows), cells=cells, throughput_mcells_s=tp,
         throughput_mcells_per_cpu_s=tp_cpu, cpu_ratio=tp_cpu["ours"] / tp_cpu["orthority"],
         speed_ratio=tp["ours"] / tp["orthority"], true_ratio=tp["ours_true"] / tp["orthority"],
+        speed_ratio_own_defaults=tp["ours"] / tp["orthority_own"],
         shift_px_rd=stats("shift_px_rd"), shift_px_tm=stats("shift_px_tm"),
         shift_whitened_px_tm=stats("shift_whitened_px_tm"),
         rms_dn_rd=float(np.sqrt(np.mean([r["rms_dn_rd"] ** 2 for r in rows]))),
