@@ -137,16 +137,20 @@ class RasterInfo:
 
 
 class RasterReader:
-    """A raster opened for reading by window; safe to share between threads (each thread
-    reads through its own GDAL handle). Use as a context manager, or call :meth:`close`.
+    """A raster opened for reading by window; safe to share between threads. Use as a context
+    manager, or call :meth:`close`.
+
+    One GDAL handle serves every thread, one read at a time (a handle is not thread-safe): the
+    blocks a read decodes stay in GDAL's cache for the next read, whichever thread makes it.
+    A handle per thread would decode the blocks shared by neighbouring windows once per thread
+    (measured: 60-90 % more CPU for the same reads, and no shorter wall time).
     """
 
     def __init__(self, path: PathLike) -> None:
         self.path = os.fspath(path)
         self.backend = raster_backend()
-        self._local = threading.local()
-        self._handles: list[Any] = []
-        self._lock = threading.Lock()
+        self._ds: Any = None
+        self._lock = threading.RLock()
         if "://" not in self.path and ":" not in Path(self.path).name and not (
             Path(self.path).exists()
         ):
@@ -161,41 +165,36 @@ class RasterReader:
 
     def close(self) -> None:
         with self._lock:
-            for h in self._handles:
-                if self.backend == "rasterio":
-                    h.close()
-            self._handles.clear()
-        self._local = threading.local()
+            if self._ds is not None and self.backend == "rasterio":
+                self._ds.close()
+            self._ds = None
 
     def _handle(self) -> Any:
-        h = getattr(self._local, "ds", None)
-        if h is None:
-            try:
-                # a compound CRS (e.g. RD New + NAP) is read whole, heights' datum included
-                if self.backend == "gdal":
-                    from osgeo import gdal
+        if self._ds is not None:
+            return self._ds
+        try:
+            # a compound CRS (e.g. RD New + NAP) is read whole, heights' datum included
+            if self.backend == "gdal":
+                from osgeo import gdal
 
-                    gdal.UseExceptions()
-                    gdal.SetThreadLocalConfigOption("GTIFF_REPORT_COMPD_CS", "YES")
-                    try:
-                        h = gdal.Open(self.path, gdal.GA_ReadOnly)
-                    finally:
-                        gdal.SetThreadLocalConfigOption("GTIFF_REPORT_COMPD_CS", None)
-                else:
-                    import rasterio
-                    from rasterio.errors import NotGeoreferencedWarning
+                gdal.UseExceptions()
+                gdal.SetThreadLocalConfigOption("GTIFF_REPORT_COMPD_CS", "YES")
+                try:
+                    self._ds = gdal.Open(self.path, gdal.GA_ReadOnly)
+                finally:
+                    gdal.SetThreadLocalConfigOption("GTIFF_REPORT_COMPD_CS", None)
+            else:
+                import rasterio
+                from rasterio.errors import NotGeoreferencedWarning
 
-                    # camera frames have no georeferencing: nothing to warn about (a filter
-                    # for the process: catch_warnings is not thread-safe)
-                    warnings.filterwarnings("ignore", category=NotGeoreferencedWarning)
-                    with rasterio.Env(GTIFF_REPORT_COMPD_CS=True):
-                        h = rasterio.open(self.path)
-            except Exception as exc:  # GDAL's RuntimeError / rasterio's RasterioIOError
-                raise InputError(f"not a readable raster ({exc})", path=self.path) from exc
-            self._local.ds = h
-            with self._lock:
-                self._handles.append(h)
-        return h
+                # camera frames have no georeferencing: nothing to warn about (a filter for
+                # the process: catch_warnings is not thread-safe)
+                warnings.filterwarnings("ignore", category=NotGeoreferencedWarning)
+                with rasterio.Env(GTIFF_REPORT_COMPD_CS=True):
+                    self._ds = rasterio.open(self.path)
+        except Exception as exc:  # GDAL's RuntimeError / rasterio's RasterioIOError
+            raise InputError(f"not a readable raster ({exc})", path=self.path) from exc
+        return self._ds
 
     def _describe(self, h: Any) -> RasterInfo:
         if self.backend == "gdal":
@@ -237,6 +236,11 @@ class RasterReader:
         which = list(bands) if bands is not None else list(range(1, self.info.bands + 1))
         f = max(1, int(decimation))
         bw, bh = w // f, h // f
+        with self._lock:
+            return self._read(c0, r0, w, h, which, f, bw, bh)
+
+    def _read(self, c0: int, r0: int, w: int, h: int, which: list[int], f: int, bw: int,
+              bh: int) -> NDArray:  # fmt: skip
         ds = self._handle()
         if self.backend == "gdal":
             if f == 1:
@@ -260,13 +264,14 @@ class RasterReader:
         """(rows, cols) True where band 1 holds data: GDAL's mask band (an internal or
         sidecar mask, an alpha band, or the nodata value)."""
         c0, r0, w, h = self._window(window)
-        ds = self._handle()
-        if self.backend == "gdal":
-            m = ds.GetRasterBand(1).GetMaskBand().ReadAsArray(c0, r0, w, h)
-        else:
-            from rasterio.windows import Window as RioWindow
+        with self._lock:
+            ds = self._handle()
+            if self.backend == "gdal":
+                m = ds.GetRasterBand(1).GetMaskBand().ReadAsArray(c0, r0, w, h)
+            else:
+                from rasterio.windows import Window as RioWindow
 
-            m = ds.read_masks(1, window=RioWindow(c0, r0, w, h))
+                m = ds.read_masks(1, window=RioWindow(c0, r0, w, h))
         return np.asarray(m).reshape(h, w) > 0
 
     def overview_count(self) -> int:

@@ -181,14 +181,16 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                            f"'{mapping.name}': {exc}", path=str(v.dsm)) from exc  # fmt: skip
         log.warning("the DSM was in '%s': resampled into '%s' (cell %g)", source, mapping.name,
                     dsm.cell)  # fmt: skip
-    tracer = DsmTracer.build(dsm)
+    # the skipping pyramid of the ray casting only for true orthophotos (built once)
+    surface = DsmTracer.build(dsm) if options.true_ortho else dsm
+    zmin = float(np.nanmin(dsm.heights))
     lens = _lens_lattice(camera)
     g = dsm.grid  # one ENU frame (at the DSM's centre) and one lens lattice for every image
     local = LocalFrame.at_map_point(MappingFrame(mapping), [g.x0 + g.cols * g.cell / 2,
                                                            g.y_top - g.rows * g.cell / 2,
-                                                           tracer.zmin])  # fmt: skip
+                                                           zmin])  # fmt: skip
     projectors = {f.stem: OrthoProjector.build(camera, eo.xyz[row_of[f.stem]],
-                                               eo.opk[row_of[f.stem]], tracer, mapping,
+                                               eo.opk[row_of[f.stem]], surface, mapping,
                                                local=local, lens=lens) for f in images}  # fmt: skip
     boxes = {k: p.footprint() for k, p in projectors.items()}
     ground_z = {k: _median_height(dsm, b) for k, b in boxes.items()}

@@ -286,8 +286,11 @@ class OrthoProjector:
     xyz : (3,) perspective centre, mapping CRS
     dsm : Dsm
         The surface, in the mapping CRS.
-    tracer : DsmTracer
-        For the visibility test (shared between the images of a block).
+    tracer : DsmTracer or None
+        For the visibility test (shared between the images of a block); built by
+        :func:`orthorectify_tiles` when a true orthophoto needs it.
+    z_range : (2,)
+        Lowest and highest surface heights.
     local : LocalFrame
         The ENU frame the collinearity is evaluated in.
     centre_local : (3,)
@@ -300,11 +303,12 @@ class OrthoProjector:
     xyz: Array
     opk: Array
     dsm: Dsm
-    tracer: DsmTracer
+    tracer: DsmTracer | None
     local: LocalFrame
     centre_local: Array
     m_local: Array
     lens: tuple[Array, float, float, float]
+    z_range: tuple[float, float] = (0.0, 0.0)
 
     @classmethod
     def build(
@@ -335,18 +339,20 @@ class OrthoProjector:
         lens : optional
             A lens lattice of the same camera (:func:`_lens_lattice`), to share between images.
         """
-        tracer = dsm if isinstance(dsm, DsmTracer) else DsmTracer.build(dsm)
-        surface = tracer.dsm
+        tracer = dsm if isinstance(dsm, DsmTracer) else None
+        surface = tracer.dsm if tracer is not None else dsm
+        zr = (tracer.zmin, tracer.zmax) if tracer is not None else surface.z_range
         if local is None:
             mapping = MappingFrame(parse_crs(crs))
             g = surface.grid
             xc, yc = g.x0 + g.cols * g.cell / 2, g.y_top - g.rows * g.cell / 2
-            local = LocalFrame.at_map_point(mapping, [xc, yc, tracer.zmin])
+            local = LocalFrame.at_map_point(mapping, [xc, yc, zr[0]])
         centre = np.asarray(xyz, dtype=np.float64).reshape(3)
         angles = np.asarray(opk, dtype=np.float64).reshape(3)
         c_loc, m_loc = eo_map_to_local(centre[None], angles[None], local)
         return cls(camera, centre, angles, surface, tracer, local, c_loc[0], m_loc[0],
-                   lens if lens is not None else _lens_lattice(camera))  # fmt: skip
+                   lens if lens is not None else _lens_lattice(camera),
+                   (float(zr[0]), float(zr[1])))  # fmt: skip
 
     # ------------------------------------------------------------------ geometry
     def _lattice(self, grid: Grid, row0: int, col0: int, h: int, w: int, step: int) -> Array:
@@ -412,6 +418,9 @@ class OrthoProjector:
         d = g - self.xyz
         if g.shape[0] == 0:
             return np.ones(0, bool)
+        if self.tracer is None:
+            raise ValueError("no DsmTracer: build the projector with one (or through "
+                             "orthorectify_tiles) for the visibility test")  # fmt: skip
         hits = intersect_dsm(self.tracer, np.broadcast_to(self.xyz, g.shape), d,
                              min_incidence_deg=0.0, chunk_size=max(g.shape[0], 1))  # fmt: skip
         dist = np.linalg.norm(d, axis=1)
@@ -457,7 +466,7 @@ class OrthoProjector:
         if not (d[:, 2] < -1e-9).all():  # the view reaches the horizon: the whole surface
             return surf if clip else (-np.inf, -np.inf, np.inf, np.inf)
         pts = []
-        for zz in self.tracer.zmin, self.tracer.zmax:
+        for zz in self.z_range:
             mid = np.array([[(surf[0] + surf[2]) / 2, (surf[1] + surf[3]) / 2, zz]])
             up = self.local.map_to_enu(mid)[0, 2]
             s = (up - self.centre_local[2]) / d[:, 2]
@@ -666,6 +675,10 @@ def orthorectify_tiles(
     windows = [(r0, c0, min(size, grid.rows - r0), min(size, grid.cols - c0))
                for r0 in range(0, grid.rows, size) for c0 in range(0, grid.cols, size)]  # fmt: skip
     kind = np.dtype(dtype)
+    if opt.true_ortho and projector.tracer is None:
+        from dataclasses import replace
+
+        projector = replace(projector, tracer=DsmTracer.build(projector.dsm))
     # image pixels per cell: when the cells are 2 or more pixels wide, the image is read
     # averaged over f x f pixels (anti-aliasing; an overview level when the file has one)
     f = _decimation(projector, grid, opt.lattice_px) if opt.antialias else 1
