@@ -2,7 +2,8 @@
 collinearity and lens lookup of every orthophoto cell in one pass, the same arithmetic as the
 vectorised numpy version (the tests compare them cell by cell).
 
-numba is optional (:data:`AVAILABLE`); without it the numpy version runs (about 3x slower).
+numba is optional (:data:`AVAILABLE`); without it the numpy version runs (10x slower: 2.2 CPU
+s instead of 0.22 for 10 M cells).
 The compiled function releases the GIL, so that tiles run in parallel threads.
 """
 
