@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import argparse
 import logging
-import os
 import sys
 from collections.abc import Sequence
 
@@ -100,6 +99,8 @@ GDAL_CACHE_MB = "256"
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    import os
+
     args = build_parser().parse_args(argv)
     os.environ.setdefault("GDAL_CACHEMAX", GDAL_CACHE_MB)  # read by GDAL at its first use
     logging.basicConfig(
