@@ -339,6 +339,8 @@ class GeoTiffWriter:
         JPEG (lossy, quality 90, YCbCr for three 8-bit bands) needs 8-bit data.
     level : int, optional
         DEFLATE (1-9) or ZSTD (1-22) level (default: GDAL's, 6 and 9).
+    predictor : bool
+        Horizontal (integers) or floating-point predictor before DEFLATE, ZSTD, LZW.
     tile : int
         Block side, pixels (multiple of 16); 0 writes strips.
     photometric : str, optional
@@ -361,6 +363,7 @@ class GeoTiffWriter:
         mask: bool = False,
         compress: str = "DEFLATE",
         level: int | None = None,
+        predictor: bool = True,
         tile: int = 256,
         photometric: str | None = None,
         metadata: Mapping[str, str] | None = None,
@@ -379,7 +382,7 @@ class GeoTiffWriter:
                                 "NUM_THREADS": str(_threads()), "INTERLEAVE": "PIXEL"}  # fmt: skip
         if tile:
             opts.update(TILED="YES", BLOCKXSIZE=str(int(tile)), BLOCKYSIZE=str(int(tile)))
-        if compress in ("DEFLATE", "LZW", "ZSTD"):
+        if predictor and compress in ("DEFLATE", "LZW", "ZSTD"):
             opts["PREDICTOR"] = "2" if integer else "3"
         if level is not None and compress in ("DEFLATE", "ZSTD"):
             opts["ZLEVEL" if compress == "DEFLATE" else "ZSTD_LEVEL"] = str(int(level))
@@ -532,8 +535,8 @@ def write_rgb_tiff(path: PathLike, rgb: NDArray[np.uint8]) -> None:
         raise ValueError(f"expected an (H, W, 3) uint8 image, got {a.shape} {a.dtype}")
     h, w, _ = a.shape
     with atomic_path(path) as tmp:
-        with GeoTiffWriter(tmp, w, h, 3, np.uint8, None, compress="LZW", tile=512,
-                           photometric="RGB") as out:  # fmt: skip
+        with GeoTiffWriter(tmp, w, h, 3, np.uint8, None, compress="LZW", predictor=True,
+                           tile=512, photometric="RGB") as out:  # fmt: skip
             out.write(np.moveaxis(a, 2, 0))
             out.close(overviews=False)
 
