@@ -22,11 +22,12 @@ and is moved into place only when complete.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import threading
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Union
@@ -71,6 +72,24 @@ def raster_backend() -> str:
             continue
         return name
     raise InputError(_INSTALL)
+
+
+@contextlib.contextmanager
+def _rio_env(**options: Any) -> Iterator[None]:
+    """``rasterio.Env(**options)`` that reads the PROJ database of rasterio's own wheel.
+
+    rasterio points PROJ at ``PROJ_DATA`` each time a first ``Env`` starts, when that variable
+    is set; a wheel's PROJ then refuses an older system ``proj.db`` (Debian 12's, which QGIS
+    set-ups export) and no CRS parses. pyproj's wheels prefer their own data; so does this."""
+    import rasterio
+    from rasterio.env import PROJDataFinder, set_proj_data_search_path
+
+    with rasterio.Env(**options):
+        bundled = PROJDataFinder().search_wheel()
+        if bundled:
+            set_proj_data_search_path(bundled)
+        yield
+
 
 
 def _threads() -> int:
@@ -190,7 +209,7 @@ class RasterReader:
                 # camera frames have no georeferencing: nothing to warn about (a filter for
                 # the process: catch_warnings is not thread-safe)
                 warnings.filterwarnings("ignore", category=NotGeoreferencedWarning)
-                with rasterio.Env(GTIFF_REPORT_COMPD_CS=True):
+                with _rio_env(GTIFF_REPORT_COMPD_CS=True):
                     self._ds = rasterio.open(self.path)
         except Exception as exc:  # GDAL's RuntimeError / rasterio's RasterioIOError
             raise InputError(f"not a readable raster ({exc})", path=self.path) from exc
@@ -429,7 +448,7 @@ class GeoTiffWriter:
             from rasterio.errors import NotGeoreferencedWarning
             from rasterio.transform import Affine
 
-            self._env = rasterio.Env(GDAL_TIFF_INTERNAL_MASK=True)
+            self._env = _rio_env(GDAL_TIFF_INTERNAL_MASK=True)
             self._env.__enter__()
             kwargs: dict[str, Any] = {k.lower(): v for k, v in opts.items()}
             kwargs.pop("tiled", None)
@@ -583,7 +602,9 @@ def polygonize(
         from rasterio import features
         from rasterio.transform import Affine
 
-        for geom, value in features.shapes(lab, mask=lab != empty, transform=Affine.from_gdal(*gt)):
+        with _rio_env():
+            shapes = list(features.shapes(lab, mask=lab != empty, transform=Affine.from_gdal(*gt)))
+        for geom, value in shapes:
             rings = ", ".join(
                 "(" + ", ".join(f"{x!r} {y!r}" for x, y in ring) + ")"
                 for ring in geom["coordinates"]

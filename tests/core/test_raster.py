@@ -4,6 +4,8 @@ reads, the polygons of a label raster, atomic writes."""
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pyproj
 import pytest
@@ -98,3 +100,30 @@ def test_output_set_commits_the_geotiff_and_its_sidecars(tmp_path):
 
 def test_backend_is_a_gdal_binding():
     assert raster_backend() in ("gdal", "rasterio")
+
+
+def test_rasterio_keeps_its_own_proj_database_when_proj_data_points_elsewhere(tmp_path):
+    """A QGIS set-up exports PROJ_DATA=/usr/share/proj (Debian's older proj.db); rasterio's
+    wheel must still parse CRSs (the CI failure of 2026-11: 'DATABASE.LAYOUT.VERSION.MINOR')."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    pytest.importorskip("rasterio")
+    decoy = tmp_path / "proj"
+    decoy.mkdir()
+    (decoy / "proj.db").write_bytes(b"not a database")  # any foreign proj.db
+    code = (
+        "import numpy as np\n"
+        "from lidarphoto.core.io.raster import GeoTiffWriter, RasterReader\n"
+        f"p = {str(tmp_path / 'c.tif')!r}\n"
+        "with GeoTiffWriter(p, 4, 3, 1, np.uint8, (85000.0, 1, 0, 447000.0, 0, -1),"
+        " 'EPSG:28992') as w:\n"
+        "    w.write(np.ones((1, 3, 4), np.uint8), 0, 0)\n"
+        "print(RasterReader(p).info.crs_wkt[:40])\n"
+    )
+    env = dict(os.environ, PROJ_DATA=str(decoy), LIDARPHOTO_RASTER_BACKEND="rasterio")
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                          cwd=Path(__file__).resolve().parents[2], timeout=120)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "Amersfoort" in done.stdout
