@@ -313,8 +313,8 @@ def check_area_of_use(
     ...     check_area_of_use(rd, (4.35, 52.0), (4.36, 52.01))
     ... except CrsError as exc:
     ...     print(exc)  # doctest: +NORMALIZE_WHITESPACE
-    the data (x 4.35 to 4.36, y 52 to 52.01 metre) look like longitude and latitude in
-    degrees, not coordinates of 'Amersfoort / RD New' (projected, metre)
+    the data (x 4.35 to 4.36, y 52 to 52.01) looks like longitude and latitude in degrees,
+    not coordinates of 'Amersfoort / RD New' (projected, metre)
     >>> try:  # coordinates in feet taken as metres: 3.3 times too far from the origin
     ...     check_area_of_use(rd, (275000, 1463000), (282000, 1470000))
     ... except CrsError as exc:
@@ -336,8 +336,9 @@ def check_area_of_use(
         and np.all(np.abs(np.r_[lo[1], hi[1]]) <= 90.0)
         and np.all(hi - lo < 1.0)
     ):
+        plain = f"x {lo[0]:.10g} to {hi[0]:.10g}, y {lo[1]:.10g} to {hi[1]:.10g}"
         raise CrsError(
-            f"{what} ({box}) look like longitude and latitude in degrees, not coordinates "
+            f"{what} ({plain}) looks like longitude and latitude in degrees, not coordinates "
             f"of '{horizontal.name}' (projected, {unit})",
             path=path,
         )

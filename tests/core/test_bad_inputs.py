@@ -270,8 +270,8 @@ CASES = [
          r"outside the area of use of 'SIRGAS 2000 / UTM zone 23S'"),
     Case("trajectory in degrees", lambda i, o, f: _traj(i, ["a,0,,4.35,52.0,500,0,0,0",
                                                           "b,1,,4.36,52.01,500,0,0,0"]),
-         r"look like longitude and latitude in degrees, not coordinates of 'Amersfoort / RD "
-         r"New' \(projected, metre\)$"),
+         r"\(x 4\.35 to 4\.36, y 52 to 52\.01\) looks like longitude and latitude in degrees, "
+         r"not coordinates of 'Amersfoort / RD New' \(projected, metre\)$"),
     Case("cloud in another country's CRS",
          lambda i, o, f: _ground(i, o, "--crs", "EPSG:31983"),
          r"ahn3_delft_crop60\.laz: the cloud \(header extent\) \(x 84910\.001 to 84969\.999, y "
