@@ -269,7 +269,9 @@ class OutputSet:
         except BaseException as exc:  # an OS error, or Ctrl+C / a stop signal mid-way
             for target, backup, existed in reversed(moved):
                 if backup is not None:
+                    # a no-op when the move never happened (both names are links to one file)
                     os.replace(backup, target)
+                    Path(backup).unlink(missing_ok=True)
                 elif not existed:
                     target.unlink(missing_ok=True)
             self.discard()
