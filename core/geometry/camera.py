@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from . import ap_models as _ap_models  # noqa: F401  (registers the AP families' lens models)
 from .distortion import (
     DEFAULT_MAX_ITER,
     DistortionModel,
