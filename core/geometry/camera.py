@@ -295,7 +295,7 @@ class Camera:
 
 _MM_KEYS = ("focal_mm", "x0_mm", "y0_mm")
 _PX_KEYS = ("focal_px", "ppx_px", "ppy_px")
-_KNOWN_KEYS = {"name", "pixel_size_mm", "width_px", "height_px", "distortion"}
+_KNOWN_KEYS = {"name", "pixel_size_mm", "width_px", "height_px", "distortion", "sigmas"}
 _KNOWN_KEYS.update(_MM_KEYS, _PX_KEYS)
 
 

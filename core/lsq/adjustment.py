@@ -1159,10 +1159,15 @@ def _finish(
     )
 
 
-def _worst(result: AdjustmentResult) -> tuple[int, int, int, float] | None:
-    """(block number, group, row, w) of the largest |w| among the groups kept."""
+def _worst(
+    result: AdjustmentResult, blocks: Sequence[str] | None = None
+) -> tuple[int, int, int, float] | None:
+    """(block number, group, row, w) of the largest |w| among the groups kept (of the named
+    blocks only, when given)."""
     best = None
-    for bi, table in enumerate(result.residuals.values()):
+    for bi, (name, table) in enumerate(result.residuals.items()):
+        if blocks is not None and name not in blocks:
+            continue
         w = np.where(table.rejected[:, None], np.nan, np.abs(table.w))
         if w.size == 0 or not np.isfinite(w).any():
             continue
@@ -1397,7 +1402,7 @@ def adjust(
     else:
         round_no = 0
         while True:
-            worst = _worst(result)
+            worst = _worst(result, opts.snooping_blocks)
             if worst is None or worst[3] <= crit:
                 break
             if len(rejected) >= opts.max_rejections:

@@ -207,7 +207,10 @@ class AdjustmentOptions:
     robust_blocks : sequence of str or None
         Names of the blocks that are reweighted (and set aside when flagged); None: every
         block. Typically the measurements, not the control whose misfits mostly reflect an
-        imperfect model (those stay to data snooping).
+        imperfect model.
+    snooping_blocks : sequence of str or None
+        Names of the blocks whose groups data snooping may reject; None: every block. The
+        others are tested (their w is reported) but never removed.
     """
 
     max_iterations: int = 50
@@ -226,3 +229,4 @@ class AdjustmentOptions:
     robust_k: float | None = None
     robust_iterations: int = 20
     robust_blocks: Sequence[str] | None = None
+    snooping_blocks: Sequence[str] | None = None

@@ -688,6 +688,18 @@ def _prepare(
             f"exterior orientations; there are {control_pt.size} control points and no EO "
             "sigmas (or choose a free-network datum: inner or minimal)"
         )
+    if eo_obs is None:
+        # without observed orientations an image needs three points (six equations for its
+        # six unknowns) to be oriented at all
+        per_image = np.bincount(obs_img[obs_pt >= 0], minlength=len(images))
+        few = np.flatnonzero(per_image < 3)
+        if few.size:
+            names = ", ".join(f"{images[k]} ({per_image[k]})" for k in few[:20])
+            raise InputError(
+                f"{few.size} image(s) have fewer than three measured points and cannot be "
+                f"oriented without observed exterior orientations: {names}",
+                path=obs.source or None,
+            )
     xyz0 = _approximate_points(cams, image_cam, eo0, obs, obs_img, obs_pt, len(adjusted))
     if control_pt.size:
         xyz0[control_pt] = control_local
@@ -894,8 +906,8 @@ def _dopk_dm(m: Array) -> Array:
     out = np.zeros((n, 3, 9))
     m21, m22 = m[:, 2, 1], m[:, 2, 2]
     den = m21**2 + m22**2
-    out[:, 0, 7] = m22 / den  # omega = atan2(-m21, m22)
-    out[:, 0, 8] = -m21 / den
+    out[:, 0, 7] = -m22 / den  # omega = atan2(-m21, m22)
+    out[:, 0, 8] = m21 / den
     a, b0, b1 = m[:, 2, 0], m[:, 0, 0], m[:, 1, 0]
     h = np.hypot(b0, b1)
     r2 = a**2 + h**2
@@ -1073,13 +1085,16 @@ def _run(setup: _Setup, obs: ImageObservations, cams: list[Camera], free: list,
     cons = _datum_constraints(setup, lay, options.datum, setup.xyz0, setup.eo0)
     opts = AdjustmentOptions(
         robust_blocks=bnames,
+        snooping_blocks=bnames,
         max_iterations=options.max_iterations,
         snooping=snooping,
         snooping_alpha=options.snooping_alpha,
         robust=robust,
         eliminate=lay.points,
         max_rejections=max(50, len(obs) // 20),
-        tolerance=1e-8,
+        # a millionth of each parameter's precision: far below anything reported, and the
+        # linear convergence of large-residual blocks reaches it in a few iterations
+        tolerance=1e-6,
         compute_covariance=options.covariance,
     )
     result = adjust(lay.x0, lay.names, blocks, cons, opts, progress=progress,

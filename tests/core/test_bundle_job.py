@@ -1,0 +1,158 @@
+"""The ``bundleadjustment`` job on files: every output written and readable by the project's
+readers, the check-point table chaining into the accuracy report, the command line."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+from lidarphoto.core.cli import main as cli_main
+from lidarphoto.core.errors import InputError
+from lidarphoto.core.io.camera import read_cameras_json
+from lidarphoto.core.io.checkpoints import read_checkpoint_table
+from lidarphoto.core.io.orientation import read_eo_csv_full
+from lidarphoto.core.jobs import accuracy_report, bundle_adjustment
+from lidarphoto.core.jobs.runner import run_job
+from lidarphoto.core.simulation.uav_block import simulate_uav_block
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("uav")
+    blk = simulate_uav_block("bauer", seed=1, n_tie=400)
+    return blk, blk.write(folder), folder
+
+
+def _outputs(folder, tag):
+    return {
+        "OUTPUT_EO": str(folder / f"{tag}_eo.csv"),
+        "OUTPUT_CAMERA": str(folder / f"{tag}_camera.json"),
+        "OUTPUT_POINTS": str(folder / f"{tag}_points.csv"),
+        "OUTPUT_RESIDUALS": str(folder / f"{tag}_residuals.csv"),
+        "OUTPUT_CHECK_CSV": str(folder / f"{tag}_check.csv"),
+        "OUTPUT_COMPARISON": str(folder / f"{tag}_comparison.csv"),
+        "OUTPUT_HTML": str(folder / f"{tag}.html"),
+    }
+
+
+def _read(path):
+    with open(path, newline="", encoding="utf-8") as fh:
+        return list(csv.DictReader(fh))
+
+
+def test_all_models_compared_and_every_output_readable(files):
+    blk, paths, folder = files
+    outs = _outputs(folder, "all")
+    res = run_job(
+        bundle_adjustment,
+        {
+            "CAMERA": str(paths["camera"]),
+            "OBSERVATIONS": str(paths["observations"]),
+            "GROUND_POINTS": str(paths["ground_points"]),
+            "EO": str(paths["eo"]),
+            "CRS": "EPSG:31983",
+            "AP_MODEL": "all",
+            "ROBUST": "none",
+            "SNOOPING": False,
+            "AP_SELECTION": False,
+            **outs,
+        },
+    )
+    best = res.results["MODEL"]
+    # Bauer's distortion was inserted: the winner can represent it (Bauer, or the richer
+    # Jacobsen / Brown sets), never a radial-only model
+    assert best in ("bauer", "jacobsen", "brown")
+    assert res.results["CHECK_RMS"] < 0.2
+    comp = _read(outs["OUTPUT_COMPARISON"])
+    assert next(r["model"] for r in comp) == best and len(comp) == 7
+    assert {r["model"] for r in comp} == set(bundle_adjustment.AP_CHOICES) - {"all"}
+    rms = [float(r["rms_3d"]) for r in comp]
+    assert rms == sorted(rms)
+    # the orientations with sigmas read back as observed orientations
+    eo = read_eo_csv_full(outs["OUTPUT_EO"], "")
+    assert eo.sigma is not None and len(eo.eo) == 15
+    # heights: the principal distance is estimated over flat ground (correlated, ~1 m)
+    assert np.all(eo.sigma[:, :2] < 0.5) and np.all(eo.sigma[:, 2] < 2.0)
+    assert np.all(np.degrees(eo.sigma[:, 3:]) < 0.05)
+    assert np.abs(eo.eo.xyz - blk.eo_true.xyz).max() < 0.5
+    cam = read_cameras_json(outs["OUTPUT_CAMERA"])[0]
+    assert cam.distortion.model == bundle_adjustment.AP_FAMILIES[best]
+    data = json.loads(open(outs["OUTPUT_CAMERA"]).read())
+    assert data["sigmas"]["focal_mm"] > 0 and data["_bundle"]["ap_model"] == best
+    pts = _read(outs["OUTPUT_POINTS"])
+    assert {r["role"] for r in pts} == {"tie", "control", "check"}
+    assert all(float(r["sigma_Z"]) > 0 for r in pts if r["role"] != "check")
+    resid = _read(outs["OUTPUT_RESIDUALS"])
+    assert len(resid) == len(blk.observations)
+    assert sum(int(r["used"]) for r in resid) == sum(r["role"] != "check" for r in resid)
+    # the check table: every model as a group, readable by the accuracy report ...
+    chk = read_checkpoint_table(outs["OUTPUT_CHECK_CSV"])
+    assert set(chk.groups) == {r["model"] for r in comp}
+    n_check = int(comp[0]["n_check"])
+    assert len(chk.ids) == 7 * n_check
+    # ... and the accuracy report runs on it (the model chain of the QGIS test)
+    rep = run_job(
+        accuracy_report,
+        {"INPUT": outs["OUTPUT_CHECK_CSV"], "OUTPUT_HTML": str(folder / "acc.html")},
+    )
+    assert (folder / "acc.html").is_file() and rep.results
+    page = open(outs["OUTPUT_HTML"], encoding="utf-8").read()
+    for text in (
+        "AP models compared",
+        "Interior orientation and additional parameters",
+        "Correlations",
+        "Image residuals",
+        "Check points",
+        "global chi-square",
+    ):
+        assert text in page, text
+
+
+def test_command_line_single_model(files, capsys):
+    _blk, paths, folder = files
+    outs = _outputs(folder, "cli")
+    args = [
+        "bundleadjustment",
+        "--camera",
+        str(paths["camera"]),
+        "--observations",
+        str(paths["observations"]),
+        "--ground-points",
+        str(paths["ground_points"]),
+        "--eo",
+        str(paths["eo"]),
+        "--crs",
+        "EPSG:31983",
+        "--ap-model",
+        "bauer",
+        "--output-eo",
+        outs["OUTPUT_EO"],
+        "--output-check-csv",
+        outs["OUTPUT_CHECK_CSV"],
+    ]
+    assert cli_main(args) == 0
+    text = capsys.readouterr().out
+    assert "bauer: sigma0" in text and "check points" in text
+    assert len(read_checkpoint_table(outs["OUTPUT_CHECK_CSV"]).ids) >= 4
+
+
+def test_bad_ground_point_table_names_row_and_column(files, tmp_path):
+    _blk, paths, _folder = files
+    bad = tmp_path / "gp.csv"
+    lines = open(paths["ground_points"]).read().splitlines()
+    lines[3] = lines[3].replace("control", "contrl")
+    bad.write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError, match=r"gp\.csv.*row 4.*column 'role'.*contrl"):
+        run_job(
+            bundle_adjustment,
+            {
+                "CAMERA": str(paths["camera"]),
+                "OBSERVATIONS": str(paths["observations"]),
+                "GROUND_POINTS": str(bad),
+                "EO": str(paths["eo"]),
+                "CRS": "EPSG:31983",
+                "OUTPUT_EO": str(tmp_path / "eo.csv"),
+            },
+        )
