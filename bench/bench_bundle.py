@@ -3,9 +3,9 @@ Marquardt) against SciPy's ``least_squares`` with a sparse finite-difference Jac
 SciPy cookbook's bundle adjustment) on the BAL problems, from the same start; and a synthetic
 1,000-image block with 200,000 points (time and peak memory of the whole process).
 
-Run: ``.venv/bin/python bench/bench_bundle.py [bal|large|all]``; writes bench/bundle_speed.md
-(bench/bundle.md collects it with the accuracy results). The BAL files are read from
-``../shared/data/bal`` (not in the repository).
+Run: ``.venv/bin/python bench/bench_bundle.py [bal|large|all]``; writes its section of
+bench/bundle.md (bench/bundle_ap_models.py writes the accuracy section). The BAL files are read
+from ``../shared/data/bal`` (not in the repository).
 """
 
 from __future__ import annotations
@@ -90,7 +90,9 @@ def engine(problem: BalProblem, tolerance: float = 1e-10) -> dict:
     BAL problems have no datum: the seven similarity parameters are held by minimal
     constraints (the first camera's rotation and translation, and the translation component
     of the second camera that a change of scale moves most), which changes no projection and
-    hence not the minimum of the cost.
+    hence not the minimum of the cost. A few points of these problems are seen along nearly
+    parallel rays and drift away as the cost keeps falling by tiny amounts; the run stops after
+    40 iterations (the condition limit is raised to 1e16 so that they are accepted).
     """
     nc, npt = problem.cameras.shape[0], problem.points.shape[0]
     ci, pi = problem.camera_index, problem.point_index
@@ -197,7 +199,7 @@ def large(covariance: bool) -> dict:
 
 def main(what: str = "all") -> None:
     lines = [
-        "# Bundle adjustment speed",
+        "## Speed",
         "",
         f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()} ({os.cpu_count()} cores, "
         f"shared), Python {platform.python_version()}, numpy {np.__version__}, scipy "
@@ -207,17 +209,18 @@ def main(what: str = "all") -> None:
     ]
     if what in ("bal", "all"):
         lines += [
-            "## BAL problems: our engine against SciPy's cookbook, same start, same cost",
+            "### BAL problems: our engine against SciPy's cookbook, same start, same cost",
             "",
             "Cost = 0.5 sum r^2 (pixels). SciPy: `least_squares(method='trf', x_scale='jac', "
             "ftol=1e-4, jac_sparsity=...)` with its finite-difference Jacobian (the cookbook). "
             "Ours: analytic Jacobians, points eliminated (reduced camera system), "
-            "Levenberg-Marquardt, run to convergence (step < 1e-10 sigma); 'ours to SciPy's "
-            "cost' is the time until our cost first fell to SciPy's final cost.",
+            "Levenberg-Marquardt, 40 iterations (BAL's nearly unobservable points keep drifting "
+            "at tiny gains in cost, so neither solver converges in the strict sense); 'ours to "
+            "SciPy's cost' is the time until our cost first fell to SciPy's final cost.",
             "",
             "| problem | residuals | initial cost | SciPy final cost | SciPy s (evals) | "
             "ours final cost | ours s (iterations) | ours to SciPy's cost s | speed-up (to "
-            "SciPy's cost) | speed-up (to convergence) |",
+            "SciPy's cost) | speed-up (SciPy's run against our 40 iterations) |",
             "|---|---|---|---|---|---|---|---|---|---|",
         ]
         for name in PROBLEMS:
@@ -240,7 +243,7 @@ def main(what: str = "all") -> None:
         lines.append("")
     if what in ("large", "all"):
         lines += [
-            "## Synthetic 1,000-image block, 200,000 points",
+            "### Synthetic 1,000-image block, 200,000 points",
             "",
             "`simulate_uav_block` with 25 strips of 40 images (60 %/30 % overlap), 200,000 "
             "tie points drawn (those in two or more images kept), 60 control and 20 check "
@@ -261,7 +264,19 @@ def main(what: str = "all") -> None:
             )
             print(lines[-1], flush=True)
         lines.append("")
-    (HERE / "bundle_speed.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    write_section(HERE / "bundle.md", "speed", "\n".join(lines))
+
+
+def write_section(path: Path, name: str, text: str) -> None:
+    """Replace the section ``name`` of a Markdown file (between HTML comment markers)."""
+    begin, end = f"<!-- {name} begin -->", f"<!-- {name} end -->"
+    old = path.read_text(encoding="utf-8") if path.is_file() else "# Bundle adjustment\n"
+    block = f"{begin}\n{text}\n{end}"
+    if begin in old and end in old:
+        new = old[: old.index(begin)] + block + old[old.index(end) + len(end) :]
+    else:
+        new = old.rstrip() + "\n\n" + block + "\n"
+    path.write_text(new, encoding="utf-8")
 
 
 if __name__ == "__main__":

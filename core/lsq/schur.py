@@ -73,7 +73,10 @@ class _Reducer:
 
     def __init__(self, keys: Index, n_keys: int, chunk: int = _CHUNK) -> None:
         keys = np.asarray(keys, dtype=np.intp)
-        self.order = np.argsort(keys, kind="stable")
+        # already sorted (pairs are stored in key order): the items are taken as slices
+        self.identity = bool(keys.size < 2 or (keys[1:] >= keys[:-1]).all())
+        self.order = (np.arange(keys.size, dtype=np.intp) if self.identity
+                      else np.argsort(keys, kind="stable"))  # fmt: skip
         sk = keys[self.order]
         self.n_keys = int(n_keys)
         self.n_items = int(keys.size)
@@ -107,7 +110,7 @@ class _Reducer:
         ends = np.r_[self.starts[1:], self.n_items]
         for a, b in zip(self.bounds[:-1], self.bounds[1:]):
             lo, hi = int(self.starts[a]), int(ends[b - 1])
-            items = self.order[lo:hi]
+            items = slice(lo, hi) if self.identity else self.order[lo:hi]
             A = X(items)
             B = A if Y is None else Y(items)
             if per_key:
@@ -166,7 +169,13 @@ class _OccSet:
 
 @dataclass
 class _PairList:
-    """All pairs (o1, o2) of occurrences of sets s1 <= s2 at the same eliminated block."""
+    """Pairs (o1, o2) of occurrences of sets s1 <= s2 at the same eliminated block, in the
+    order of their key (sig1, sig2).
+
+    ``mirror``: each pair stands for itself and its reverse (o2, o1), whose contribution is
+    the transposed block (all pairs between two sets; the pairs o1 < o2 within a set); the
+    pairs o1 == o2 within a set are a list of their own without mirror.
+    """
 
     s1: int
     s2: int
@@ -177,6 +186,7 @@ class _PairList:
     key_sig2: Index
     n1: int  # occurrences in s1 and s2
     n2: int
+    mirror: bool = True
     _o1_reducer: _Reducer | None = None
     _o2_reducer: _Reducer | None = None
 
@@ -189,8 +199,8 @@ class _PairList:
 
     @property
     def o2_reducer(self) -> _Reducer | None:
-        """By o2 when s1 != s2 (the reverse direction), else None."""
-        if self.s1 == self.s2:
+        """By o2 for mirrored lists (the reverse direction), else None."""
+        if not self.mirror:
             return None
         if self._o2_reducer is None:
             self._o2_reducer = _Reducer(self.o2, self.n2)
@@ -216,6 +226,12 @@ def _unique_rows(a: Index) -> tuple[Index, Index]:
     """(first row of each distinct row, inverse) of an integer matrix (G, k)."""
     if a.shape[1] == 0:
         return np.zeros(min(1, a.shape[0]), dtype=np.intp), np.zeros(a.shape[0], dtype=np.intp)
+    # usually the first column determines the row (e.g. an image's six orientation
+    # parameters): a 1-D unique, verified, is much faster than the row-wise one
+    _, first, inv = np.unique(a[:, 0], return_index=True, return_inverse=True)
+    inv = np.asarray(inv, dtype=np.intp).ravel()
+    if (a[first][inv] == a).all():
+        return first.astype(np.intp), inv
     _, first, inv = np.unique(a, axis=0, return_index=True, return_inverse=True)
     return first.astype(np.intp), np.asarray(inv, dtype=np.intp).ravel()
 
@@ -389,25 +405,27 @@ class EliminationPlan:
             for s2 in range(s1, len(self.sets)):
                 a, b = self.sets[s1], self.sets[s2]
                 o1, o2 = _pairs(a.point, b.point)
-                if o1.size == 0:
-                    continue
+                if s1 == s2:
+                    # o1 < o2 mirrored, o1 == o2 on their own: half the products
+                    parts = [(o1[o1 < o2], o2[o1 < o2], True), (o1[o1 == o2], o2[o1 == o2], False)]
+                else:
+                    parts = [(o1, o2, True)]
                 nsig2 = b.rows.shape[0]
-                key = a.sig[o1] * nsig2 + b.sig[o2]
-                ukey, kinv = np.unique(key, return_inverse=True)
-                kinv = np.asarray(kinv, dtype=np.intp).ravel()
-                self.pairs.append(
-                    _PairList(
-                        s1,
-                        s2,
-                        o1,
-                        o2,
-                        _Reducer(kinv, ukey.size),
-                        (ukey // nsig2).astype(np.intp),
-                        (ukey % nsig2).astype(np.intp),
-                        a.point.size,
-                        b.point.size,
-                    )
-                )
+                for p1, p2, mirror in parts:
+                    if p1.size == 0:
+                        continue
+                    key = a.sig[p1] * nsig2 + b.sig[p2]
+                    order = np.argsort(key, kind="stable")
+                    p1, p2, key = p1[order], p2[order], key[order]
+                    ukey, kinv = np.unique(key, return_inverse=True)
+                    kinv = np.asarray(kinv, dtype=np.intp).ravel()
+                    self.pairs.append(
+                        _PairList(
+                            s1, s2, p1, p2, _Reducer(kinv, ukey.size),
+                            (ukey // nsig2).astype(np.intp), (ukey % nsig2).astype(np.intp),
+                            a.point.size, b.point.size, mirror,
+                        )
+                    )  # fmt: skip
 
 
 @dataclass
@@ -498,7 +516,7 @@ class ReducedNormal:
             rows.append(rr)
             cols.append(cc)
             vals.append(-blocks.ravel())
-            if pl.s1 != pl.s2:
+            if pl.mirror:
                 rows.append(cc)
                 cols.append(rr)
                 vals.append(-blocks.ravel())
