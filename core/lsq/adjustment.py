@@ -81,7 +81,8 @@ With :attr:`AdjustmentOptions.robust` the adjustment first runs as iteratively r
 least squares (Huber 1964; the Cauchy weight function): each group gets the weight
 ``psi(u)/u`` of its standardised misfit ``u = |w_g| / sqrt(c) / s`` (``w_g`` the whitened
 misclosure, ``s`` the robust scale: the median of ``u`` over the observation groups divided by
-its expected value), until the weights settle. Groups with ``u`` above the critical value of
+its expected value, but at least 1, the a-priori unit weight that data snooping also uses),
+until the weights settle. Groups with ``u`` above the critical value of
 data snooping at the robust solution are then set aside (reported as rejected in round 0),
 and the ordinary adjustment, with its statistics and data snooping, runs on the rest from the
 robust estimate, so that several gross errors cannot mask one another.
@@ -1178,6 +1179,29 @@ def _worst(
     return best
 
 
+def _cascade(
+    problem: _Problem, active: list[NDArray[np.bool_]]
+) -> tuple[list[NDArray[np.bool_]], list[tuple[int, int]]]:
+    """With eliminated blocks: an eliminated block (an object point) left with fewer rows
+    than parameters by the groups set aside cannot be determined; its remaining groups are set
+    aside with it (a tie point of two rays goes when one ray is rejected). Returns the new
+    active masks and the (block, group) pairs this added."""
+    plan = problem.plan
+    if plan is None:
+        return active, []
+    rows = plan.rows_per_block([b.c for b in problem.blocks], active)
+    seen = plan.rows_per_block([b.c for b in problem.blocks], None)
+    dead = (rows < plan.b) & (seen > 0)
+    if not dead.any():
+        return active, []
+    out, gone = [], []
+    for bi, (a, bp) in enumerate(zip(active, plan.plans)):
+        hit = a & (bp.point >= 0) & dead[np.maximum(bp.point, 0)]
+        gone += [(bi, int(g)) for g in np.flatnonzero(hit)]
+        out.append(a & ~hit)
+    return out, gone
+
+
 def _robust(
     problem: _Problem,
     x: Array,
@@ -1234,8 +1258,10 @@ def _robust(
                 [u[i][active[i]] / ref[i] for i in scale_blocks] or [np.zeros(0)]
             )
             scale = float(np.median(pool)) if pool.size else 1.0
-            if not scale > 0:
-                scale = 1.0
+            # never below the a-priori unit weight: measurements that fit as well as their
+            # stated sigmas (or better, when those are pessimistic) are not outliers, the same
+            # reference as data snooping's
+            scale = max(scale, 1.0) if np.isfinite(scale) else 1.0
             new = []
             for i, ui in enumerate(u):
                 t = ui / (k * scale)
@@ -1362,6 +1388,7 @@ def adjust(
             f"standardised misfit above {crit:.2f} set aside"
         )
         trial = [a & ~f for a, f in zip(active, flagged)]
+        trial, gone = _cascade(problem, trial)
         try:
             _run(problem, x, vhat, trial, opts, reporter, should_stop, initial=False)
             ok = True
@@ -1372,6 +1399,8 @@ def adjust(
                 "groups it flagged would leave the adjustment not observable; they are kept"
             )
         if ok:
+            for bj, gj in gone:
+                flagged[bj][gj] = True
             for bi, f in enumerate(flagged):
                 for g in np.flatnonzero(f):
                     u = rob["u"][bi][g]
@@ -1418,6 +1447,7 @@ def adjust(
             reporter.span(lo, lo + 0.5 ** (round_no + 1))
             trial = [a.copy() for a in active]
             trial[bi][g] = False
+            trial, gone = _cascade(problem, trial)
             try:
                 new_run = _run(
                     problem,
@@ -1446,6 +1476,9 @@ def adjust(
             rejected.append(
                 RejectedObservation(b.name, b.labels[g], b.row_names[i], signed, round_no)
             )
+            for bj, gj in gone:
+                rejected.append(RejectedObservation(obs[bj].name, obs[bj].labels[gj],
+                                                    "(with its point)", math.nan, round_no))  # fmt: skip
             active, run, result = trial, new_run, new_result
         untested = sum(
             int((np.isnan(t.w) & ~t.rejected[:, None]).sum()) for t in result.residuals.values()

@@ -384,6 +384,19 @@ class EliminationPlan:
                 )
         return bp
 
+    def rows_per_block(self, rows_per_group, active) -> Index:
+        """Observation rows touching each eliminated block (of the active groups, or of all
+        groups when ``active`` is None)."""
+        out = np.zeros(self.P, dtype=np.intp)
+        for k, bp in enumerate(self.plans):
+            c = rows_per_group[k] or 0
+            sel = bp.point >= 0
+            if active is not None:
+                sel = sel & active[k]
+            if bp.ec.size and sel.any():
+                out += c * np.bincount(bp.point[sel], minlength=self.P)
+        return out
+
     def finish(self, mc: int) -> None:
         """Add the constraint occurrences (``mc`` rows) and enumerate the pairs (once)."""
         if self.mc is not None:
@@ -448,6 +461,7 @@ class ReducedNormal:
     T: list[Array]  # per occurrence set (O, kk, b)
     hs: Array  # (mc,) scaled constraint values
     mc: int
+    dead: NDArray[np.bool_] | None = None  # (P,) blocks without any active observation
     use_sparse: bool = False
     _cache: dict = field(default_factory=dict)
 
@@ -484,6 +498,8 @@ class ReducedNormal:
         ev = np.linalg.eigvalsh(Vs)
         with np.errstate(divide="ignore", invalid="ignore"):
             cond = np.where(ev[:, 0] > 0, ev[:, -1] / ev[:, 0], np.inf)
+        if self.dead is not None:
+            cond[self.dead] = 1.0  # set aside, not adjusted
         return cond
 
     # -- the reduced system ----------------------------------------------------------------
@@ -635,11 +651,14 @@ class ReducedNormal:
                     )
         Qpp = Vinv + Vinv @ inner @ Vinv
         Qpp = 0.5 * (Qpp + np.swapaxes(Qpp, 1, 2))
+        if self.dead is not None and self.dead.any():
+            Qpp[self.dead] = np.nan  # not adjusted: no precision
         cross = [-(A @ Vinv[s.point]) for A, s in zip(acc, plan.sets)]
         d = self.d
         dr = d[plan.reduced]
         de = d[plan.elim]  # (P, b)
-        if not (np.isfinite(M).all() and np.isfinite(Qpp).all()):
+        live = np.ones(plan.P, dtype=bool) if self.dead is None else ~self.dead
+        if not (np.isfinite(M).all() and np.isfinite(Qpp[live]).all()):
             raise SingularSystem("non-finite cofactor matrix")
         return BlockCofactor(
             reduced_index=plan.reduced.copy(),
@@ -837,6 +856,12 @@ def build_reduced_normal(
                     T[bp.cset] = bp.c_reducer.sum_outer(
                         lambda it, Rc=Rc: Rc[it], lambda it, Ew=Ew: Ew[it], kc, b
                     )
+    # blocks whose every group is set aside (see adjustment._cascade) stay where they are:
+    # a unit block keeps the reduced system regular and their step zero
+    dead = np.einsum("pii->p", V) == 0.0
+    if dead.any():
+        V[dead] = np.eye(b)
+        g_e[dead] = 0.0
     g_r = grad[plan.reduced] * dinv[plan.reduced]
     ns = grad * dinv
     hs = np.zeros(0)
@@ -875,6 +900,7 @@ def build_reduced_normal(
         T=T,  # type: ignore[arg-type]
         hs=hs,
         mc=mc,
+        dead=dead,
     )
     if nred > _DENSE_MAX:
         try:

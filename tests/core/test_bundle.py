@@ -455,3 +455,69 @@ def test_observed_orientation_model_jacobian():
         q[:, j] -= 1e-7
         num = (model(p)[0] - model(q)[0]) / 2e-7
         assert np.abs(num - J[:, :, j]).max() < 1e-6, j
+
+
+def test_two_cameras_each_get_their_own_interior_orientation(blocks, tmp_path):
+    """The block split between two cameras (JSON {"cameras": [...]} and a camera per image):
+    each camera's principal distance, principal point and k1, k2 are estimated from its own
+    images and agree with the (shared) truth within 3 sigma."""
+    from lidarphoto.core.io.camera import read_cameras_json, write_cameras_json
+
+    blk = blocks["lens_k1k2"]
+    cams = [replace(blk.camera, name="left"), replace(blk.camera, name="right")]
+    write_cameras_json(tmp_path / "cams.json", cams)
+    cams = read_cameras_json(tmp_path / "cams.json")
+    assert [c.name for c in cams] == ["left", "right"]
+    mapping = {im: ("left" if im < "IMG_03" else "right") for im in blk.eo_dg.image_id}
+    res = bundle_adjust(
+        cams,
+        blk.observations,
+        blk.ground,
+        blk.mapping,
+        blk.eo_dg,
+        blk.eo_sigma,
+        image_camera=mapping,
+        options=BundleOptions(ap_model="lens_k1k2", **PLAIN),
+    )
+    assert set(res.cameras) == {"left", "right"}
+    for p in res.interior:
+        assert abs(p.value - _truth(blk, p.name)) < 3 * p.std, (p.camera, p.name)
+    assert res.image_camera == tuple(mapping[i] for i in res.eo.image_id)
+    with pytest.raises(InputError, match="has no camera"):
+        bundle_adjust(
+            cams,
+            blk.observations,
+            blk.ground,
+            blk.mapping,
+            blk.eo_dg,
+            blk.eo_sigma,
+            options=BundleOptions(**PLAIN),
+        )
+
+
+def test_planted_blunders_are_rejected_by_the_default_pipeline(blocks):
+    """Twelve measurements moved by 8-30 px: the robust stage and data snooping reject all of
+    them, and the APs come out as without them."""
+    from lidarphoto.core.photo.observations import ImageObservations
+
+    blk = blocks["bauer"]
+    obs = blk.observations
+    rng = np.random.default_rng(21)
+    tie = np.array([k for k, p in enumerate(obs.point_id) if p.startswith("T")])
+    bad = rng.choice(tie, 12, replace=False)
+    px = obs.pixels.copy()
+    px[bad] += rng.choice([-1, 1], (12, 2)) * rng.uniform(8, 30, (12, 2))
+    dirty = ImageObservations(obs.image_id, obs.point_id, px, obs.sigma_px, obs.type, obs.target_id)
+    res = bundle_adjust(
+        [blk.camera],
+        dirty,
+        blk.ground,
+        blk.mapping,
+        blk.eo_dg,
+        blk.eo_sigma,
+        options=BundleOptions(ap_model="bauer", ap_selection=False),
+    )
+    assert set(bad) <= set(np.flatnonzero(res.rejected))
+    clean = _run(blk, "bauer")
+    for p, q in zip(res.interior, clean.interior):
+        assert abs(p.value - q.value) < 0.5 * q.std, p.name
