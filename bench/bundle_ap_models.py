@@ -22,7 +22,7 @@ from lidarphoto.core.photo.orientation import eo_map_to_local
 from lidarphoto.core.simulation.uav_block import simulate_uav_block
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_bundle import write_section  # noqa: E402
+from bench_bundle import write_section
 
 HERE = Path(__file__).resolve().parent
 FAMILIES = ("none", "lens_k1k2", "bauer", "jacobsen", "ebner", "brown", "conrady_brown")

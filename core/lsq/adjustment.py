@@ -1477,8 +1477,10 @@ def adjust(
                 RejectedObservation(b.name, b.labels[g], b.row_names[i], signed, round_no)
             )
             for bj, gj in gone:
-                rejected.append(RejectedObservation(obs[bj].name, obs[bj].labels[gj],
-                                                    "(with its point)", math.nan, round_no))  # fmt: skip
+                lab = obs[bj].labels[gj]
+                rejected.append(
+                    RejectedObservation(obs[bj].name, lab, "(with its point)", math.nan, round_no)
+                )
             active, run, result = trial, new_run, new_result
         untested = sum(
             int((np.isnan(t.w) & ~t.rejected[:, None]).sum()) for t in result.residuals.values()
