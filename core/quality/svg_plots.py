@@ -385,7 +385,7 @@ def correlation_heatmap(
     k = len(names)
     left = 14 + 7 * max((len(n) for n in names), default=1)
     top = 28 + left
-    width = left + k * cell + 12
+    width = max(left + k * cell + 12, 8 * len(title) + 20)
     height = top + k * cell + 12
     colours = _diverging(np.nan_to_num(c.ravel()), 1.0)
     body = []

@@ -168,6 +168,12 @@ class UavBlock:
     tie_id: tuple[str, ...]
     tie_true: Array
 
+    def terrain(self, e: Array, n: Array) -> Array:
+        """Ellipsoidal height (m) of the simulated terrain at easting/northing arrays (the
+        surface the points lie on; for orthophotos and DSMs of the block)."""
+        return _terrain(self.config, np.asarray(e, dtype=np.float64),
+                        np.asarray(n, dtype=np.float64))  # fmt: skip
+
     def write(self, folder: Union[str, Path], eo: str = "dg") -> dict[str, Path]:
         """Write the bundle inputs (camera, observations, ground points, EO with sigmas) and
         the truth (JSON); ``eo`` is ``"dg"`` (the direct-georeferencing start) or ``"true"``.
@@ -268,6 +274,9 @@ def simulate_uav_block(
     >>> blk = simulate_uav_block("bauer", seed=1, n_tie=300)
     >>> len(blk.eo_true), len(blk.ground), blk.ap_model
     (15, 21, 'bauer')
+    >>> bool(abs(blk.terrain(blk.ground_true[:1, 0], blk.ground_true[:1, 1])[0]
+    ...          - blk.ground_true[0, 2]) < 1e-9)
+    True
     """
     cfg = replace(config or UavBlockConfig(), **changes)
     if ap_model not in AP_FAMILIES and ap_model != "real":
