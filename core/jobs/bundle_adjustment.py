@@ -81,6 +81,16 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
             help="approximate values, or observations when the sigma columns are filled",
         ),
         Param(
+            "EO_SIGMAS",
+            "numbers",
+            "EO sigmas when the table has none: X, Y, Z, omega, phi, kappa",
+            count=6,
+            unit="m, degrees",
+            optional=True,
+            help="makes an EO table without sigma columns (e.g. from trajectorytoeo) "
+            "observations; empty: approximate values only",
+        ),
+        Param(
             "CRS",
             "crs",
             "Mapping CRS",
@@ -239,6 +249,12 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if v.eo:
         f = read_eo_csv_full(v.eo, frame.crs.to_wkt())
         eo, sigma, eo_rows, eo_source = f.eo, f.sigma, f.rows, f.path
+        if sigma is None and v.eo_sigmas:
+            s6 = np.array(v.eo_sigmas, dtype=float)
+            if not (s6 > 0).all():
+                raise InputError("EO_SIGMAS: every sigma must be > 0")
+            s6[3:] = np.radians(s6[3:])
+            sigma = np.tile(s6, (len(eo), 1))
         if f.camera is not None:
             image_camera.update(zip(f.eo.image_id, f.camera))
     for k, (im, cam) in enumerate(zip(obs.image_id, obs.camera)):

@@ -156,3 +156,48 @@ def test_bad_ground_point_table_names_row_and_column(files, tmp_path):
                 "OUTPUT_EO": str(tmp_path / "eo.csv"),
             },
         )
+
+
+def test_eo_without_sigmas_becomes_observed_with_eo_sigmas(files, tmp_path):
+    """An EO table without sigma columns (as trajectorytoeo writes it) with EO_SIGMAS: the
+    orientations are observations (the settings say so and the datum needs no control)."""
+    from lidarphoto.core.io.orientation import write_eo_csv
+
+    blk, paths, _ = files
+    plain = tmp_path / "eo_plain.csv"
+    write_eo_csv(plain, blk.eo_dg)
+    html = tmp_path / "s.html"
+    checks = tmp_path / "checks.csv"
+    lines = open(paths["ground_points"], encoding="utf-8").read().splitlines()
+    checks.write_text("\n".join(line.replace(",control", ",check") for line in lines) + "\n")
+    # a control point may be measured once, a check point not: those rows go
+    from lidarphoto.core.io.observations import write_observations_csv
+
+    obs = blk.observations
+    once = {p for p in set(obs.point_id) if obs.point_id.count(p) < 2}
+    obs_path = tmp_path / "obs.csv"
+    write_observations_csv(obs_path, obs.subset([p not in once for p in obs.point_id]))
+    res = run_job(
+        bundle_adjustment,
+        {
+            "CAMERA": str(paths["camera"]),
+            "OBSERVATIONS": str(obs_path),
+            "GROUND_POINTS": str(checks),
+            "EO": str(plain),
+            "EO_SIGMAS": "5,5,5,1,1,1",
+            "CRS": "EPSG:31983",
+            "DATUM": "control",
+            "ESTIMATE_INTERIOR": False,
+            "ROBUST": "none",
+            "SNOOPING": False,
+            "OUTPUT_EO": str(tmp_path / "eo.csv"),
+            "OUTPUT_HTML": str(html),
+        },
+    )
+    assert res.data.adjustment.converged
+    assert "observed (with sigmas)" in html.read_text(encoding="utf-8")
+    # every surveyed point is a check point here: the datum comes from the observed
+    # orientations alone (no control block, no constraints)
+    adj = res.data.adjustment
+    assert "observed orientation" in adj.residuals and "control points" not in adj.residuals
+    assert adj.n_constraints == 0 and len(res.data.check.point_id) >= 15
