@@ -11,9 +11,12 @@ exist only in QGIS; their content is in the file outputs.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
+import signal
 import sys
-from collections.abc import Sequence
+import threading
+from collections.abc import Iterator, Sequence
 
 from . import __version__
 from .errors import Cancelled, LidarPhotoError
@@ -32,7 +35,52 @@ _METAVAR = {
     "field": "COLUMN",
     "file_out": "FILE",
     "raster_out": "FILE",
+    "files": "PATH",
+    "folder_out": "FOLDER",
 }
+
+
+#: Signals that end a run like Ctrl+C does: the outputs' temporaries are removed first.
+_STOP_SIGNALS = tuple(
+    getattr(signal, name) for name in ("SIGTERM", "SIGHUP") if hasattr(signal, name)
+)
+
+
+class Terminated(BaseException):
+    """A stop signal (SIGTERM, SIGHUP) turned into an exception, so that every ``finally``
+    and the output set's clean-up run before the process exits (not an ``Exception``: the
+    core's handlers of reading errors must not take it for a bad file)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+    @property
+    def name(self) -> str:
+        return signal.Signals(self.signum).name
+
+
+@contextlib.contextmanager
+def stop_signals_raise() -> Iterator[None]:
+    """Within the block, SIGTERM and SIGHUP raise :class:`Terminated` (once: a second signal
+    during the clean-up is ignored); the previous handlers come back afterwards. Only the
+    main thread can set handlers; elsewhere this does nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    fired = []
+
+    def handler(signum: int, frame: object) -> None:
+        if not fired:
+            fired.append(signum)
+            raise Terminated(signum)
+
+    previous = {s: signal.signal(s, handler) for s in _STOP_SIGNALS}
+    try:
+        yield
+    finally:
+        for s, old in previous.items():
+            signal.signal(s, old)
 
 
 def _option_help(p: Param) -> str:
@@ -71,6 +119,8 @@ def _add_algorithm(sub: argparse._SubParsersAction, spec: AlgorithmSpec, job: ob
             kwargs["metavar"] = "|".join(p.options) if len(p.options) <= 4 else "NAME"
         elif p.kind == "numbers":
             kwargs["metavar"] = ",".join(["N"] * p.count) if p.count <= 4 else f"{p.count}xN"
+        elif p.kind == "files":
+            kwargs.update(nargs="+", metavar="PATH")
         else:
             kwargs["metavar"] = _METAVAR.get(p.kind, "VALUE")
         if p.required:
@@ -89,8 +139,16 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: GDAL's block cache for the command line, MB (GDAL's default, 5 % of the RAM, holds the
+#: blocks of a large raster being written until it is full: 1.6 GB for a 196 Mpx orthophoto)
+GDAL_CACHE_MB = "256"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    import os
+
     args = build_parser().parse_args(argv)
+    os.environ.setdefault("GDAL_CACHEMAX", GDAL_CACHE_MB)  # read by GDAL at its first use
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
@@ -102,7 +160,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         if p.kind != "sink" and getattr(args, p.name) is not None
     }
     try:
-        result = run_job(args.job, raw)
+        with stop_signals_raise():
+            result = run_job(args.job, raw)
+    except Terminated as exc:
+        print(f"lidarphoto {args.algorithm}: stopped by {exc.name}; nothing was written",
+              file=sys.stderr)  # fmt: skip
+        return 128 + exc.signum
     except Cancelled as exc:
         print(f"lidarphoto {args.algorithm}: {exc}", file=sys.stderr)
         return 130
@@ -115,6 +178,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as exc:
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"lidarphoto {args.algorithm}: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print(f"lidarphoto {args.algorithm}: error: out of memory; nothing was written (use a "
+              "coarser cell or a smaller input)", file=sys.stderr)  # fmt: skip
         return 2
     if result.stdout:
         sys.stdout.write(result.stdout)

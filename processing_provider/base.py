@@ -96,7 +96,8 @@ def stop_callback(feedback: QgsProcessingFeedback) -> Callable[[], bool]:
 
 @contextmanager
 def core_errors(cancelled_text: str = "Cancelled"):
-    """Turn ``LidarPhotoError``, ``ValueError`` and ``OSError`` into QgsProcessingException.
+    """Turn ``LidarPhotoError``, ``ValueError``, ``OSError`` and ``MemoryError`` into
+    QgsProcessingException.
 
     The exception keeps the core's message (which names the file, row and column).
     """
@@ -106,6 +107,10 @@ def core_errors(cancelled_text: str = "Cancelled"):
         raise QgsProcessingException(str(exc) or cancelled_text) from exc
     except (LidarPhotoError, ValueError, OSError) as exc:
         raise QgsProcessingException(str(exc)) from exc
+    except MemoryError as exc:
+        raise QgsProcessingException(
+            "out of memory; nothing was written (use a coarser cell or a smaller input)"
+        ) from exc
 
 
 class BaseAlgorithm(QgsProcessingAlgorithm):

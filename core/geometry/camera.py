@@ -293,6 +293,11 @@ class Camera:
         }
 
 
+#: Physical ranges of a camera file's values: a pixel of 0.5 um to 0.5 mm (scanned film), a
+#: focal length of 1 mm to 5 m, at most 200000 pixels a side.
+PIXEL_SIZE_RANGE_MM = (0.0005, 0.5)
+FOCAL_RANGE_MM = (1.0, 5000.0)
+MAX_IMAGE_SIDE_PX = 200_000
 _MM_KEYS = ("focal_mm", "x0_mm", "y0_mm")
 _PX_KEYS = ("focal_px", "ppx_px", "ppy_px")
 _KNOWN_KEYS = {"name", "pixel_size_mm", "width_px", "height_px", "distortion", "sigmas"}
@@ -379,6 +384,22 @@ def camera_from_dict(data: Any, source: str | None = None, default_name: str = "
         y0 = (0.5 * height - number("ppy_px", positive=False)) * pixel_size
     else:
         y0 = 0.0
+    # physical ranges: outside them the value is in another unit (um for mm, px for mm)
+    for key, value, lo, hi, unit in (
+        ("pixel_size_mm", pixel_size, *PIXEL_SIZE_RANGE_MM, "mm"),
+        ("focal_mm", focal, *FOCAL_RANGE_MM, "mm"),
+        ("width_px", width, 1, MAX_IMAGE_SIDE_PX, "px"),
+        ("height_px", height, 1, MAX_IMAGE_SIDE_PX, "px"),
+    ):
+        if not lo <= value <= hi:
+            shown = "focal_px" if key == "focal_mm" and "focal_px" in data else key
+            raise fail(shown, f"{value:g} {unit} is outside the physical range {lo:g} to {hi:g} "
+                       f"{unit} (a value in another unit?)")  # fmt: skip
+    for key, value, half in (("x0_mm", x0, 0.5 * width), ("y0_mm", y0, 0.5 * height)):
+        if abs(value) > half * pixel_size:
+            shown = key if key in data else ("ppx_px" if key == "x0_mm" else "ppy_px")
+            raise fail(shown, f"the principal point ({value:g} mm from the image centre) lies "
+                       f"outside the image ({half * pixel_size:g} mm to its edge)")  # fmt: skip
     distortion = distortion_from_dict(data.get("distortion", {}), source, "distortion")
     return Camera(name, focal, pixel_size, width, height, x0, y0, distortion)
 

@@ -279,3 +279,105 @@ def _exact_transformer(src: CRS, dst: CRS) -> Transformer:
             "the file into the PROJ data folder) or use ellipsoidal heights (a 2D projected CRS)"
         )
     return group.transformers[0]
+
+
+#: How far (degrees of longitude and latitude) data may lie outside the area of use of its
+#: CRS before it is refused: the projection still holds a little beyond the published area
+#: (a block across a zone border), a wrong CRS or unit puts the data hundreds of km away.
+AREA_MARGIN_DEG = 2.0
+
+
+def check_area_of_use(
+    crs: CRS,
+    mins: ArrayLike,
+    maxs: ArrayLike,
+    *,
+    what: str = "the data",
+    path: str | None = None,
+    margin_deg: float = AREA_MARGIN_DEG,
+) -> None:
+    """Refuse (CrsError) data whose coordinates cannot be in ``crs``.
+
+    ``mins``/``maxs`` are the (x, y) box of the data in ``crs`` (its horizontal part for a
+    compound CRS). Refused: non-finite coordinates; coordinates that look like longitude and
+    latitude in degrees (within +-180/+-90 and less than one unit wide) in a projected CRS;
+    a box whose corners fall more than ``margin_deg`` outside the CRS's area of use (a wrong
+    CRS, a unit mix-up such as feet for metres, or swapped axes). A CRS without an area of
+    use, or a geographic one, passes the last test.
+
+    Examples
+    --------
+    >>> rd = CRS.from_epsg(28992)  # Amersfoort / RD New: the Netherlands
+    >>> check_area_of_use(rd, (84000, 446000), (86000, 448000))  # Delft: fine
+    >>> try:
+    ...     check_area_of_use(rd, (4.35, 52.0), (4.36, 52.01))
+    ... except CrsError as exc:
+    ...     print(exc)  # doctest: +NORMALIZE_WHITESPACE
+    the data (x 4.35 to 4.36, y 52 to 52.01 metre) look like longitude and latitude in
+    degrees, not coordinates of 'Amersfoort / RD New' (projected, metre)
+    >>> try:  # coordinates in feet taken as metres: 3.3 times too far from the origin
+    ...     check_area_of_use(rd, (275000, 1463000), (282000, 1470000))
+    ... except CrsError as exc:
+    ...     print(str(exc)[:79])
+    the data (x 275000 to 282000, y 1463000 to 1470000 metre) lies outside the area
+    """
+    lo = np.asarray(mins, dtype=np.float64).ravel()[:2]
+    hi = np.asarray(maxs, dtype=np.float64).ravel()[:2]
+    if not (np.isfinite(lo).all() and np.isfinite(hi).all()):
+        raise CrsError(f"{what} has coordinates that are not finite numbers", path=path)
+    horizontal = crs.sub_crs_list[0] if crs.is_compound and crs.sub_crs_list else crs
+    if not horizontal.is_projected:
+        return
+    axes = horizontal.axis_info
+    unit = axes[0].unit_name if axes else "unit"
+    box = f"x {lo[0]:.10g} to {hi[0]:.10g}, y {lo[1]:.10g} to {hi[1]:.10g} {unit}"
+    if (
+        np.all(np.abs(np.r_[lo[0], hi[0]]) <= 180.0)
+        and np.all(np.abs(np.r_[lo[1], hi[1]]) <= 90.0)
+        and np.all(hi - lo < 1.0)
+    ):
+        raise CrsError(
+            f"{what} ({box}) look like longitude and latitude in degrees, not coordinates "
+            f"of '{horizontal.name}' (projected, {unit})",
+            path=path,
+        )
+    area = crs.area_of_use or horizontal.area_of_use
+    if area is None:
+        return
+    west, south, east, north = area.bounds
+    wrap = east < west  # the area crosses the antimeridian
+    if wrap:
+        east += 360.0
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            to_geo = Transformer.from_crs(horizontal, horizontal.geodetic_crs, always_xy=True)
+            xs = np.array([lo[0], hi[0], hi[0], lo[0], 0.5 * (lo[0] + hi[0])])
+            ys = np.array([lo[1], lo[1], hi[1], hi[1], 0.5 * (lo[1] + hi[1])])
+            lon, lat = to_geo.transform(xs, ys, errcheck=False)
+    except Exception:  # PROJ refuses points far outside the projection's domain
+        lon = lat = np.full(5, np.nan)
+    lon, lat = np.asarray(lon, dtype=np.float64), np.asarray(lat, dtype=np.float64)
+    if wrap:
+        lon = np.where(lon < west, lon + 360.0, lon)
+    m = float(margin_deg)
+    inside = (
+        np.isfinite(lon) & np.isfinite(lat)
+        & (lon >= west - m) & (lon <= east + m) & (lat >= south - m) & (lat <= north + m)
+    )  # fmt: skip
+    if not inside.all():
+        k = int(np.argmin(inside))
+        where = (
+            f"a corner maps to longitude {lon[k]:.2f}, latitude {lat[k]:.2f} deg"
+            if np.isfinite(lon[k]) and np.isfinite(lat[k])
+            else "a corner is outside the projection's domain"
+        )
+        raise CrsError(
+            f"{what} ({box}) lies outside the area of use of '{horizontal.name}' "
+            f"({area.name.rstrip('.')}: longitude {area.west:g} to {area.east:g}, latitude "
+            f"{area.south:g} "
+            f"to {area.north:g} deg; {where}): wrong CRS, or coordinates in another unit or "
+            "axis order",
+            path=path,
+        )
+

@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import tempfile
+import time
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import IO, Any, Union
@@ -138,14 +140,31 @@ def same_file(a: PathLike, b: PathLike) -> bool:
     return os.path.realpath(a) == os.path.realpath(b)
 
 
+def _check_writable(name: str, target: Path) -> None:
+    """Refuse, before any work, an output that cannot be written: a folder in its place, a
+    file where a folder of its path should be, or a folder without write permission."""
+    if target.is_dir():
+        raise InputError(f"{name}: {target} is a folder; give a file name")
+    folder = target.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise InputError(f"{name}: cannot write {target}: {folder} is a file, not a folder")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise InputError(f"{name}: cannot write {target}: no permission to write in {folder}")
+
+
 class OutputSet:
     """The output files of one job, committed together.
 
     ``outputs`` maps a parameter name to its path (None or "" when not requested); ``inputs``
     maps parameter names to the input files. The constructor refuses (InputError) an output
-    that is an input or another output, before anything is read. The job writes each output
+    that is an input or another output, or that cannot be written (a folder, a file on its
+    path, a folder without write permission), before anything is read. The job writes each output
     through :meth:`path` (a temporary name) and the caller calls :meth:`commit` once the job
     succeeded, or :meth:`discard` (also the effect of leaving the ``with`` block by an error).
+    Temporaries of the outputs older than an hour, which only a killed process leaves behind,
+    are removed first (:func:`remove_stale_temporaries`).
 
     >>> import tempfile, pathlib
     >>> d = pathlib.Path(tempfile.mkdtemp())
@@ -183,6 +202,10 @@ class OutputSet:
             for b in names[i + 1 :]:
                 if same_file(self.targets[a], self.targets[b]):
                     raise InputError(f"{a} and {b} are the same file ({self.targets[a]})")
+        for name, target in self.targets.items():
+            _check_writable(name, target)
+        for target in self.targets.values():  # left by a killed run of this job (SIGKILL)
+            remove_stale_temporaries(target)
 
     def __enter__(self) -> OutputSet:
         return self
@@ -216,37 +239,44 @@ class OutputSet:
     def commit(self, names: Iterable[str] | None = None) -> None:
         """Move the written outputs (all, or ``names``) into place.
 
-        When one move fails, the outputs already moved get their previous content back (kept
-        as hard links while committing), so the user finds the old set or the new one.
+        When one move fails (or Ctrl+C or a stop signal comes in between), the outputs already
+        moved get their previous content back (kept as hard links while committing), so the
+        user finds the old set or the new one.
         """
         chosen = list(self._temps) if names is None else [n for n in names if n in self._temps]
-        moved: list[tuple[Path, str | None]] = []
+        # (target, hard link to its old content or None, whether it existed), recorded before
+        # the move so that an interruption right after it is undone too
+        moved: list[tuple[Path, str | None, bool]] = []
+        current: Path | None = None
         try:
             for name in chosen:
-                tmp, target = self._temps[name], self.targets[name]
+                tmp, current = self._temps[name], self.targets[name]
+                existed = current.exists()
                 backup = None
-                if target.exists():
-                    backup = _temp_name(target)
+                if existed:
+                    backup = _temp_name(current)
                     os.unlink(backup)
                     try:
-                        os.link(target, backup)
+                        os.link(current, backup)
                     except OSError:  # no hard links here: no restore for this file
                         backup = None
-                os.chmod(tmp, final_mode(target))
-                os.replace(tmp, target)
-                moved.append((target, backup))
+                os.chmod(tmp, final_mode(current))
+                moved.append((current, backup, existed))
+                os.replace(tmp, current)
                 for side, ext in _sidecars(tmp):  # e.g. a GeoTIFF's .aux.xml
-                    os.replace(side, str(target) + ext)
+                    os.replace(side, str(current) + ext)
                 del self._temps[name]
-        except OSError as exc:
-            for target, backup in reversed(moved):
+        except BaseException as exc:  # an OS error, or Ctrl+C / a stop signal mid-way
+            for target, backup, existed in reversed(moved):
                 if backup is not None:
                     os.replace(backup, target)
-                else:
+                elif not existed:
                     target.unlink(missing_ok=True)
             self.discard()
-            raise _os_error(exc, target) from exc
-        for _, backup in moved:
+            if isinstance(exc, OSError):
+                raise _os_error(exc, current or "output") from exc
+            raise
+        for _, backup, _ in moved:
             if backup is not None:
                 Path(backup).unlink(missing_ok=True)
         if names is None:
@@ -260,3 +290,52 @@ class OutputSet:
                 Path(side).unlink(missing_ok=True)
         self._temps.clear()
         self._done = True
+
+
+def remove_stale_temporaries(path: PathLike, older_than_s: float = 3600.0) -> list[str]:
+    """Remove the temporaries an interrupted writer left next to ``path``; their paths.
+
+    A temporary of ``path`` is a file ``.<stem>.*.part<suffix>`` in its folder (the names
+    :func:`atomic_path` and :class:`OutputSet` use), with any sidecar a writer put beside it
+    (``.aux.xml``). Only those last modified more than ``older_than_s`` seconds ago are removed,
+    so the fresh temporary of a writer still at work is left alone. Errors (a folder that
+    does not exist, a file another process removed first) are ignored.
+
+    >>> import os, tempfile, pathlib, time
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> names = (".dtm.k1.part.tif", ".dtm.k2.part.tif", ".dtm.v.k3.part.tif", "dtm.tif")
+    >>> for name in names:
+    ...     _ = (folder / name).write_text("")
+    >>> hour_ago = time.time() - 3601
+    >>> for name in names[0], names[2]:  # the first and the one of "dtm.v.tif" are old
+    ...     os.utime(folder / name, (hour_ago, hour_ago))
+    >>> [pathlib.Path(p).name for p in remove_stale_temporaries(folder / "dtm.tif")]
+    ['.dtm.k1.part.tif']
+    >>> sorted(p.name for p in folder.iterdir())
+    ['.dtm.k2.part.tif', '.dtm.v.k3.part.tif', 'dtm.tif']
+    """
+    target = Path(path)
+    # the random part of mkstemp's names has no dot, so "dtm.tif" never claims the
+    # temporaries of "dtm.x.tif"; a sidecar adds its own extension after the suffix
+    pattern = re.compile(
+        rf"\.{re.escape(target.stem)}\.[^.]+{re.escape(TEMP_SUFFIX + target.suffix)}(\..+)?"
+    )
+    folder = str(target.parent) or "."
+    try:
+        names = sorted(os.listdir(folder))
+    except OSError:
+        return []
+    limit = time.time() - float(older_than_s)
+    removed = []
+    for name in names:
+        if not pattern.fullmatch(name):
+            continue
+        full = os.path.join(folder, name)
+        try:
+            if os.stat(full).st_mtime >= limit:
+                continue
+            os.unlink(full)
+        except OSError:
+            continue
+        removed.append(full)
+    return removed

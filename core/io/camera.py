@@ -22,9 +22,12 @@ principal point as a pixel position (col, row) in the convention above (defaults
 the project works in millimetres. Distortion coefficients are always those of
 :mod:`core.geometry.distortion`, defined for millimetre coordinates (not OpenCV's normalised ones).
 Keys ``"description"`` and any key starting with ``"_"`` are ignored (comments); any other
-unknown key is an error, so that a misspelt key is never silently dropped. ``"sigmas"`` (an
-object of standard deviations by parameter name, e.g. ``{"focal_mm": 0.002, "k1": 1e-6}``,
-written by the bundle adjustment for its estimates) is informative and ignored on reading.
+unknown key is an error, so that a misspelt key is never silently dropped. Values outside the
+physical ranges (a pixel of 0.5 um to 0.5 mm, a focal length of 1 mm to 5 m, at most 200000
+pixels a side, the principal point on the image) are refused: they are in another unit.
+``"sigmas"`` (an object of standard deviations by parameter name, e.g. ``{"focal_mm": 0.002,
+"k1": 1e-6}``, written by the bundle adjustment for its estimates) is informative and ignored
+on reading.
 
 Several cameras (a block flown with more than one) are one file ``{"cameras": [camera, ...]}``
 (:func:`read_cameras_json`, :func:`write_cameras_json`); each camera's ``name`` then tells

@@ -32,7 +32,15 @@ import numpy as np
 
 from ..errors import InputError
 from ..lidar.control import LINE_KINDS, Adjacency, ControlLine, ControlPoint, error_ellipsoid
-from .tables import find_column, float_column, read_table, text_column, write_csv_atomic
+from .tables import (
+    check_covariance,
+    find_column,
+    float_column,
+    read_table,
+    text_column,
+    unique_integer_ids,
+    write_csv_atomic,
+)
 
 _IU3 = np.triu_indices(3)
 _IU6 = np.triu_indices(6)
@@ -72,20 +80,21 @@ def write_lcps_csv(path: PathLike, points: Sequence[ControlPoint]) -> None:
 
 
 def read_lcps_csv(path: PathLike) -> list[ControlPoint]:
-    """Read an LCP table; errors name the file, row and column."""
+    """Read an LCP table; errors name the file, row and column (an id that is not a unique
+    integer, a covariance that is not positive semi-definite)."""
     table = read_table(path)
     col = {name: find_column(table, (name.lower(),)) for name in LCP_COLUMNS}
     num = {name: float_column(table, col[name]) for name in LCP_COLUMNS}
+    ids = unique_integer_ids(table, num["id"], col["id"])
     out = []
-    for k, row in enumerate(table.line_numbers):
+    for k, _row in enumerate(table.line_numbers):
         cov = np.zeros((3, 3))
         cov[_IU3] = [num[c][k] for c in LCP_COV]
         cov = cov + np.triu(cov, 1).T
-        if np.any(np.linalg.eigvalsh(cov) < -1e-12 * max(1.0, np.abs(cov).max())):
-            raise InputError("covariance is not positive semi-definite", path=table.path, row=row)
+        check_covariance(cov, table, k, "covariance of (X, Y, Z)")
         out.append(
             ControlPoint(
-                id=int(num["id"][k]),
+                id=ids[k],
                 xyz=np.array([num["X"][k], num["Y"][k], num["Z"][k]]),
                 covariance=cov,
                 plane_ids=tuple(int(num[f"plane_{i}"][k]) for i in (1, 2, 3)),
@@ -108,11 +117,14 @@ def write_lines_csv(path: PathLike, lines: Sequence[ControlLine]) -> None:
 
 
 def read_lines_csv(path: PathLike) -> list[ControlLine]:
-    """Read a line table; errors name the file, row and column."""
+    """Read a line table; errors name the file, row and column (an id that is not a unique
+    integer, an unknown kind, a direction that is not a unit vector, a covariance that is not
+    positive semi-definite)."""
     table = read_table(path)
     numeric = [c for c in LINE_COLUMNS if c != "kind"]
     num = {name: float_column(table, find_column(table, (name.lower(),))) for name in numeric}
     kinds = text_column(table, find_column(table, ("kind",)))
+    ids = unique_integer_ids(table, num["id"], find_column(table, ("id",)))
     out = []
     for k, row in enumerate(table.line_numbers):
         if kinds[k] not in LINE_KINDS:
@@ -125,6 +137,7 @@ def read_lines_csv(path: PathLike) -> list[ControlLine]:
         cov = np.zeros((6, 6))
         cov[_IU6] = [num[c][k] for c in LINE_COV]
         cov = cov + np.triu(cov, 1).T
+        check_covariance(cov, table, k, "covariance of (X0, u)")
         u = np.array([num["ux"][k], num["uy"][k], num["uz"][k]])
         if abs(np.linalg.norm(u) - 1.0) > 1e-6:
             raise InputError(
@@ -132,7 +145,7 @@ def read_lines_csv(path: PathLike) -> list[ControlLine]:
             )
         out.append(
             ControlLine(
-                id=int(num["id"][k]),
+                id=ids[k],
                 plane_ids=(int(num["plane_1"][k]), int(num["plane_2"][k])),
                 kind=kinds[k],
                 start=np.array([num["x1"][k], num["y1"][k], num["z1"][k]]),

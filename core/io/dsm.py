@@ -12,6 +12,7 @@ import numpy as np
 import pyproj
 
 from ..errors import InputError, stop_if_asked
+from ..geometry.frames import check_area_of_use
 from ..geometry.grid import Grid
 from ..geometry.surface import Dsm
 from ..lidar.dsm import NOISE_CLASSES, dsm_from_points
@@ -88,7 +89,7 @@ def dsm_from_las(
 
 
 def read_dsm_raster(path: PathLike, crs: str | int | pyproj.CRS | None = None) -> Dsm:
-    """Read a north-up, single-band DSM raster (GDAL when importable, else uncompressed TIFF).
+    """Read a north-up, single-band DSM raster (any format GDAL reads).
 
     ``crs`` overrides (or supplies) the raster's CRS.
     """
@@ -101,7 +102,11 @@ def read_dsm_raster(path: PathLike, crs: str | int | pyproj.CRS | None = None) -
     rows, cols = data.shape
     grid = Grid(float(gt[0]), float(gt[3]), float(gt[1]), rows, cols)
     file_crs = parse_crs(wkt) if wkt else None
-    return Dsm(data, grid, parse_crs(crs) if crs else file_crs, p)
+    use = parse_crs(crs) if crs else file_crs
+    if use is not None:
+        x1, y0 = grid.x0 + cols * grid.cell, grid.y_top - rows * grid.cell
+        check_area_of_use(use, (grid.x0, y0), (x1, grid.y_top), what="the DSM", path=p)
+    return Dsm(data, grid, use, p)
 
 
 def load_dsm(

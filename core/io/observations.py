@@ -14,7 +14,7 @@ col, row
     Measured pixel position: origin at the top-left corner of the top-left pixel, so the
     centre of the first pixel is (0.5, 0.5); columns grow to the right, rows downwards.
 sigma_px
-    A-priori standard deviation of col and row, pixels (> 0). Empty: 0.5 px.
+    A-priori standard deviation of col and row, pixels (> 0, at most 100). Empty: 0.5 px.
 type
     ``tie``   a roof point measured in two or more images, lying on plane ``target_id``;
     ``line``  a point anywhere on the LiDAR line ``target_id`` (ridge, hip or valley);
@@ -30,8 +30,9 @@ camera
     Optional: the camera (its ``name`` in the camera JSON) of the row's image, for blocks
     flown with several cameras.
 
-Errors name the file, the row (the header is row 1) and the column. The image-picking dock
-writes the same table.
+A row repeated (same image_id, point_id, type, target_id, col and row) is an error: it would
+count twice. Errors name the file, the row (the header is row 1) and the column. The
+image-picking dock writes the same table.
 """
 
 from __future__ import annotations
@@ -43,41 +44,56 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from ..geometry.camera import Camera
 from ..photo.observations import DEFAULT_SIGMA_PX, OBSERVATION_TYPES, ImageObservations
 from .tables import find_column, float_column, read_table, text_column, write_csv_atomic
 
-__all__ = ["OBSERVATION_COLUMNS", "read_observations_csv", "write_observations_csv"]
+__all__ = [
+    "OBSERVATION_COLUMNS",
+    "observation_cells",
+    "read_observations_csv",
+    "write_observations_csv",
+]
 
 OBSERVATION_COLUMNS = ("image_id", "point_id", "col", "row", "sigma_px", "type", "target_id")
+#: Largest a-priori sigma of an image measurement, pixels: beyond it the row cannot inform the
+#: adjustment and is most likely in another unit (micrometres, millimetres).
+MAX_SIGMA_PX = 100.0
 
 Array = NDArray[np.float64]
 
 
-def read_observations_csv(path: Union[str, Path]) -> ImageObservations:
+def read_observations_csv(
+    path: Union[str, Path], camera: Camera | None = None
+) -> ImageObservations:
     """Read the observation table (format in the module docstring).
+
+    With ``camera``, every measured pixel must lie on the image (0 <= col <= width_px,
+    0 <= row <= height_px).
 
     Raises
     ------
     InputError
-        Missing columns, non-numeric or non-positive values, unknown types; naming the file,
-        row and column.
+        Missing columns, non-numeric values, sigma_px not in (0, 100] px, unknown types, a
+        duplicate row, a pixel off the camera's image; naming the file, row and column.
     """
     table = read_table(path)
     image = text_column(table, find_column(table, ("image_id", "image", "photo")))
     point_col = find_column(table, ("point_id", "point", "id", "name"))
     point = text_column(table, point_col)
-    col = float_column(table, find_column(table, ("col", "column", "x_px")))
-    row = float_column(table, find_column(table, ("row", "y_px")))
+    c_col = find_column(table, ("col", "column", "x_px"))
+    r_col = find_column(table, ("row", "y_px"))
+    col, row = float_column(table, c_col), float_column(table, r_col)
     s_col = find_column(table, ("sigma_px", "sigma"), required=False)
     if s_col is None:
         sigma = np.full(len(table), DEFAULT_SIGMA_PX)
     else:
         sigma = float_column(table, s_col, allow_empty=True)
         sigma = np.where(np.isnan(sigma), DEFAULT_SIGMA_PX, sigma)
-        bad = np.flatnonzero(sigma <= 0)
+        bad = np.flatnonzero((sigma <= 0) | (sigma > MAX_SIGMA_PX))
         if bad.size:
             raise InputError(
-                f"sigma_px must be > 0, got {sigma[bad[0]]}",
+                f"sigma_px must be > 0 and <= {MAX_SIGMA_PX:g} pixels, got {sigma[bad[0]]:g}",
                 path=table.path,
                 row=table.line_numbers[bad[0]],
                 column=table.columns[s_col],
@@ -99,19 +115,66 @@ def read_observations_csv(path: Union[str, Path]) -> ImageObservations:
         table, ("target_id", "target", "plane_id", "line_id", "lcp_id"), required=False
     )
     target = ("",) * len(table) if g_col is None else text_column(table, g_col, nonempty=False)
-    c_col = find_column(table, ("camera", "camera_id", "camera_name"), required=False)
-    camera = () if c_col is None else text_column(table, c_col)
-    # tie rows need their plane id for the boresight calibration, which checks it
+    cam_col = find_column(table, ("camera", "camera_id", "camera_name"), required=False)
+    cameras = () if cam_col is None else text_column(table, cam_col)
+    # tie rows need their plane id for the boresight calibration, which checks it.
+    # A row copied twice would count twice; the same point measured again (another pixel)
+    # is a second measurement, as the picking dock records it
+    first: dict[tuple[object, ...], int] = {}
+    for key, number in zip(zip(image, point, kinds, target, col, row), table.line_numbers):
+        if key in first:
+            raise InputError(
+                f"row {first[key]} again (point '{key[1]}' of image '{key[0]}' at the same "
+                "pixel): a duplicate row would count twice; remove one of them",
+                path=table.path,
+                row=number,
+            )
+        first[key] = number
+    if camera is not None:
+        for values, index, size, what in (
+            (col, c_col, camera.width_px, "width_px"),
+            (row, r_col, camera.height_px, "height_px"),
+        ):
+            off = np.flatnonzero((values < 0) | (values > size))
+            if off.size:
+                k = int(off[0])
+                raise InputError(
+                    f"{values[k]:g} px is off the image: the camera '{camera.name}' has "
+                    f"{what} {size} (pixels from 0 to {size}); {off.size} row(s) affected",
+                    path=table.path,
+                    row=table.line_numbers[k],
+                    column=table.columns[index],
+                )
     return ImageObservations(
         image, point, np.column_stack([col, row]), sigma, kinds, target,
-        table.line_numbers, table.path, camera,
+        table.line_numbers, table.path, cameras,
     )  # fmt: skip
+
+
+def observation_cells(
+    image_id: str, point_id: str, col: float, row: float, sigma_px: float, kind: str, target: str
+) -> tuple[str, ...]:
+    """The cells of one row as :func:`write_observations_csv` writes them (numbers by
+    ``repr``: they read back to the same float).
+
+    >>> observation_cells("img1", "T1", 10.5, 20.25, 0.5, "tie", "7")
+    ('img1', 'T1', '10.5', '20.25', '0.5', 'tie', '7')
+    """
+    return (
+        str(image_id),
+        str(point_id),
+        repr(float(col)),
+        repr(float(row)),
+        repr(float(sigma_px)),
+        str(kind),
+        str(target),
+    )
 
 
 def write_observations_csv(path: Union[str, Path], obs: ImageObservations) -> None:
     """Write the table atomically (never a half-written file)."""
     rows = (
-        (i, p, repr(float(c)), repr(float(r)), repr(float(s)), t, g)
+        observation_cells(i, p, c, r, s, t, g)
         for i, p, (c, r), s, t, g in zip(
             obs.image_id, obs.point_id, obs.pixels, obs.sigma_px, obs.type, obs.target_id
         )

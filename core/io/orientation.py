@@ -7,7 +7,8 @@ CSV format (header row, comma separated, one image per row)::
 X, Y, Z: perspective centre in the mapping CRS (easting, northing, height; metres).
 omega, phi, kappa: degrees, ``M = R3(kappa) R2(phi) R1(omega)`` rotates vectors of the grid
 frame at the perspective centre (grid east, grid north, local up) into the camera frame.
-``time`` may be empty (NaN) and ``group`` (flight line or direction) may be empty.
+``time`` may be empty (NaN) and ``group`` (flight line or direction) may be empty. Lines
+starting with ``#`` are comments (a calibration accepted despite failed checks says so there).
 
 Observed orientations (GNSS/INS, for the bundle adjustment) add their standard deviations,
 all six or none (the bundle adjustment writes them for its adjusted orientations too)::
@@ -23,7 +24,7 @@ from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Union
@@ -79,9 +80,12 @@ def _eo_rows(eo: ExteriorOrientationTable) -> Iterator[tuple[str, ...]]:
         )
 
 
-def write_eo_csv(path: Union[str, Path], eo: ExteriorOrientationTable) -> None:
-    """Write the documented CSV atomically (never a half-written file)."""
-    write_csv_atomic(path, EO_COLUMNS, _eo_rows(eo))
+def write_eo_csv(
+    path: Union[str, Path], eo: ExteriorOrientationTable, comments: Sequence[str] = ()
+) -> None:
+    """Write the documented CSV atomically (never a half-written file); ``comments`` become
+    ``# text`` lines before the header (e.g. a warning)."""
+    write_csv_atomic(path, EO_COLUMNS, _eo_rows(eo), comments)
 
 
 def eo_csv_text(eo: ExteriorOrientationTable) -> str:

@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..geometry.planes import Plane
-from .tables import find_column, float_column, read_table, write_csv_atomic
+from .tables import check_covariance, find_column, float_column, read_table, write_csv_atomic
 
 _PARAMS = "abcd"
 
@@ -109,7 +109,9 @@ def read_planes_csv(path: Union[str, Path]) -> list[Plane]:
     ------
     InputError
         Missing file or column, a cell that is not a number (names file, row and column), a
-        non-integer id or point count, a duplicate id, or a normal that is not unit length.
+        non-integer id or point count, a duplicate id, a normal that is not unit length, a
+        negative rms or sigma_d, fewer than 3 points, or a covariance that is not positive
+        semi-definite.
     """
     if _header_only(path):
         return []
@@ -148,9 +150,17 @@ def read_planes_csv(path: Union[str, Path]) -> list[Plane]:
                 row=row_no,
                 column="a",
             )
+        for name in ("rms", "sigma_d"):
+            if not cols[name][k] >= 0:
+                raise InputError(f"{name} must be >= 0, got {cols[name][k]:g}",
+                                 path=table.path, row=row_no, column=name)  # fmt: skip
+        if cols["n_points"][k] < 3:
+            raise InputError("a plane needs at least 3 points", path=table.path, row=row_no,
+                             column="n_points")  # fmt: skip
         cov = np.empty((4, 4))
         cov[_IU] = [cols[name][k] for name in COV_COLUMNS]
         cov.T[_IU] = cov[_IU]
+        check_covariance(cov, table, k, "covariance of (a, b, c, d)")
         planes.append(
             Plane(
                 id=pid,

@@ -230,6 +230,11 @@ def _info_from_header(path: str, header: Any, crs: CrsLike, require_crs: bool) -
             if require_crs:
                 raise CrsError(str(exc), path=path) from exc
             unit, to_metre, vertical = "unknown", float("nan"), float("nan")
+    mins = np.asarray(header.mins, dtype=np.float64).copy()
+    maxs = np.asarray(header.maxs, dtype=np.float64).copy()
+    if use is not None:  # a CRS that cannot hold these coordinates (or a unit mix-up)
+        frames.check_area_of_use(use, mins[:2], maxs[:2], what="the cloud (header extent)",
+                                 path=path)  # fmt: skip
     by_return = np.asarray(header.number_of_points_by_return)
     return CloudInfo(
         path=path,
@@ -240,11 +245,42 @@ def _info_from_header(path: str, header: Any, crs: CrsLike, require_crs: bool) -
         horizontal_unit=unit,
         unit_to_metre=to_metre,
         vertical_unit_to_metre=vertical,
-        mins=np.asarray(header.mins, dtype=np.float64).copy(),
-        maxs=np.asarray(header.maxs, dtype=np.float64).copy(),
+        mins=mins,
+        maxs=maxs,
         dimensions=tuple(header.point_format.dimension_names),
         has_return_numbers=bool(by_return.sum() > 0),
     )
+
+
+def _check_record_count(path: str, header: Any) -> None:
+    """An uncompressed file must hold exactly the header's number of point records.
+
+    laspy reads as many records as the header says: extra records would be dropped silently,
+    missing ones found only at the end of a long read. (A LAZ file's compressed chunks cannot
+    be counted without decompressing them: its missing points are found by the reader.)
+    """
+    if header.are_points_compressed:
+        return
+    size = os.path.getsize(path)
+    end = size
+    if int(getattr(header, "number_of_evlrs", 0) or 0) > 0:
+        start = int(getattr(header, "start_of_first_evlr", 0) or 0)
+        end = start if 0 < start <= size else size
+    record = int(header.point_format.size)
+    held, rest = divmod(max(end - int(header.offset_to_point_data), 0), record)
+    n = int(header.point_count)
+    if held > n:
+        raise InputError(
+            f"the file holds {held} point records but its header says {n}: the header is "
+            "wrong (the points beyond it would be dropped); rewrite the file with a tool that "
+            "updates the header",
+            path=path,
+        )
+    if held < n:
+        raise InputError(f"truncated: the file holds {held} point records, the header says {n}",
+                         path=path)  # fmt: skip
+    if held == n and rest:
+        LOG.warning("%s: %d stray bytes after the last point record", path, rest)
 
 
 def read_info(path: PathLike, crs: CrsLike = None, *, require_crs: bool = True) -> CloudInfo:
@@ -273,6 +309,7 @@ def read_info(path: PathLike, crs: CrsLike = None, *, require_crs: bool = True) 
     """
     path = os.fspath(path)
     with _open(path) as reader:
+        _check_record_count(path, reader.header)
         return _info_from_header(path, reader.header, crs, require_crs)
 
 
@@ -331,7 +368,8 @@ def read_points(
     Raises
     ------
     InputError
-        Unreadable, truncated or corrupt file, unknown field (names the file).
+        Unreadable, truncated or corrupt file, a header that counts fewer points than an
+        uncompressed file holds, unknown field (names the file).
     CrsError
         As in :func:`read_info`.
     Cancelled
@@ -339,6 +377,7 @@ def read_points(
     """
     path = os.fspath(path)
     with _open(path) as reader:
+        _check_record_count(path, reader.header)
         info = _info_from_header(path, reader.header, crs, require_crs)
         names = _check_fields(info, fields)
         n = info.point_count
@@ -450,6 +489,7 @@ def write_cloud(
         raise InputError("the output folder does not exist", path=dst)
 
     with _open(src) as reader:
+        _check_record_count(src, reader.header)
         info = _info_from_header(src, reader.header, None, require_crs=False)
         n = info.point_count
         cls, arrays = _check_values(src, n, info.point_format, classification, extra)

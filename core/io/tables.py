@@ -10,7 +10,6 @@ from __future__ import annotations
 import csv
 import math
 import os
-import tempfile
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from .atomic import atomic_write
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -157,25 +157,63 @@ def unique_ids(table: Table, index: int) -> tuple[str, ...]:
     return values
 
 
-def write_csv_atomic(
-    path: PathLike, columns: Sequence[str], rows: Iterable[Sequence[object]]
-) -> None:
-    """Write a CSV to a temporary file in the same folder, then move it into place.
+def check_covariance(cov: NDArray[np.float64], table: Table, k: int, what: str) -> None:
+    """Refuse (naming the file and row) a covariance matrix that is not positive
+    semi-definite: a negative variance or an impossible correlation.
 
-    A crash or an error while writing never leaves a half-written file at ``path``.
+    >>> t = Table("p.csv", ("id",), (("1",),), (2,))
+    >>> try:
+    ...     check_covariance(np.diag([1.0, -1e-3]), t, 0, "covariance of (a, b)")
+    ... except InputError as exc:
+    ...     print(exc)  # doctest: +NORMALIZE_WHITESPACE
+    p.csv, row 2: the covariance of (a, b) is not positive semi-definite (smallest
+    eigenvalue -0.001)
     """
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    try:
-        with os.fdopen(fd, "w", newline="", encoding="utf-8") as fh:
-            writer = csv.writer(fh, lineterminator="\n")
-            writer.writerow(columns)
-            writer.writerows(rows)
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    scale = max(1.0, float(np.abs(cov).max()))
+    low = float(np.linalg.eigvalsh(cov).min())
+    if not np.isfinite(low) or low < -1e-12 * scale:
+        raise InputError(
+            f"the {what} is not positive semi-definite (smallest eigenvalue {low:.3g})",
+            path=table.path,
+            row=table.line_numbers[k],
+        )
+
+
+def unique_integer_ids(table: Table, values: NDArray[np.float64], index: int) -> list[int]:
+    """The id column as integers, each once; errors name the file, row and column."""
+    seen: dict[int, int] = {}
+    out = []
+    for k, (value, number) in enumerate(zip(values, table.line_numbers)):
+        if value != round(value):
+            raise InputError(f"'{table.rows[k][index]}' is not an integer id", path=table.path,
+                             row=number, column=table.columns[index])  # fmt: skip
+        key = int(value)
+        if key in seen:
+            raise InputError(f"id {key} already appears in row {seen[key]}", path=table.path,
+                             row=number, column=table.columns[index])  # fmt: skip
+        seen[key] = number
+        out.append(key)
+    return out
+
+
+def write_csv_atomic(
+    path: PathLike,
+    columns: Sequence[str],
+    rows: Iterable[Sequence[object]],
+    comments: Sequence[str] = (),
+) -> None:
+    """Write a CSV through :func:`~lidarphoto.core.io.atomic.atomic_write`: a temporary file in
+    the same folder moved into place, so a crash never leaves a half-written file at ``path``.
+
+    ``comments`` are written before the header as ``# text`` lines (the readers of this
+    package skip them), e.g. a warning the user must not miss.
+    """
+    with atomic_write(path, newline="") as fh:
+        for line in comments:
+            fh.write("# " + " ".join(str(line).split()) + "\n")
+        writer = csv.writer(fh, lineterminator="\n")
+        writer.writerow(columns)
+        writer.writerows(rows)
 
 
 def _detect_delimiter(header: str) -> str | None:

@@ -9,6 +9,8 @@ from . import (
     extract_roof_planes,
     ground_filter,
     monoplot,
+    orthomosaic,
+    orthorectify,
     trajectory_to_eo,
 )
 
@@ -22,4 +24,6 @@ ALGORITHMS = (
     boresight_calibration,
     monoplot,
     bundle_adjustment,
+    orthorectify,
+    orthomosaic,
 )

@@ -25,38 +25,40 @@ _OUTLIER_LABELS = (
     "three sigma: |d - mean| > 3 s",
     "none",
 )
-#: (parameter, AccuracySettings field, label, unit, minimum, advanced)
+#: (parameter, AccuracySettings field, label, unit, minimum, maximum, advanced)
 _NUMBERS = (
-    ("ALPHA", "alpha", "Significance level of the tests", "", 0.0001, False),
+    ("ALPHA", "alpha", "Significance level of the tests", "", 0.0001, 0.25, False),
     ("DECLARED_SIGMA_H", "declared_sigma_h", "Declared precision per horizontal axis", "m",
-     0.0, False),
-    ("DECLARED_SIGMA_V", "declared_sigma_v", "Declared precision in height", "m", 0.0, False),
+     0.0, 100.0, False),
+    ("DECLARED_SIGMA_V", "declared_sigma_v", "Declared precision in height", "m", 0.0, 100.0,
+     False),
     ("SURVEY_SIGMA_H", "survey_sigma_h", "Check-point survey sigma per horizontal axis", "m",
-     0.0, False),
-    ("SURVEY_SIGMA_V", "survey_sigma_v", "Check-point survey sigma in height", "m", 0.0, False),
+     0.0, 100.0, False),
+    ("SURVEY_SIGMA_V", "survey_sigma_v", "Check-point survey sigma in height", "m", 0.0, 100.0,
+     False),
 )  # fmt: skip
 _STANDARD_NUMBERS = (
     ("ASPRS_H_CLASS_CM", "asprs_h_class_cm", "ASPRS horizontal class (0 = tightest met)", "cm",
-     0.0, False),
+     0.0, 10000.0, False),
     ("ASPRS_V_CLASS_CM", "asprs_v_class_cm", "ASPRS vertical class (0 = tightest met)", "cm",
-     0.0, False),
-    ("PEC_SCALE", "pec_scale", "PEC-PCD scale denominator (1:N)", "", 1.0, False),
+     0.0, 10000.0, False),
+    ("PEC_SCALE", "pec_scale", "PEC-PCD scale denominator (1:N)", "", 1.0, 1e8, False),
     ("PEC_EQUIDISTANCE", "pec_equidistance", "PEC-PCD equidistance (0 = series value)", "m",
-     0.0, False),
+     0.0, 1000.0, False),
 )  # fmt: skip
 _PROJECT_NUMBERS = (
     ("PROJECT_H_THRESHOLD", "project_h_threshold", "Project planimetric threshold", "m", 0.0,
-     False),
+     1000.0, False),
     ("PROJECT_V_THRESHOLD", "project_v_threshold", "Project vertical threshold (0 = Eq. 18)",
-     "m", 0.0, False),
+     "m", 0.0, 1000.0, False),
 )  # fmt: skip
 
 
 def _numbers(rows) -> tuple[Param, ...]:
     return tuple(
         Param(key, "number", label, getattr(_D, field), unit=unit, minimum=minimum,
-              advanced=advanced)
-        for key, field, label, unit, minimum, advanced in rows
+              maximum=maximum, advanced=advanced)
+        for key, field, label, unit, minimum, maximum, advanced in rows
     )  # fmt: skip
 
 
@@ -132,7 +134,8 @@ RMSE values as numeric outputs.""",
               options=PEC_CLASSES),
         *_numbers(_PROJECT_NUMBERS),
         Param("FLIGHT_GEOMETRY", "numbers", "Flight geometry for Eq. 18: H, B, f, pixel",
-              _D.flight_geometry, count=4, unit="m, m, mm, um", advanced=True),
+              _D.flight_geometry, count=4, unit="m, m, mm, um", advanced=True, minimum=0.001,
+              maximum=100000.0),
         Param("OUTPUT", "sink", "Check points with discrepancies", geometry="point"),
         Param("OUTPUT_HTML", "file_out", "Accuracy report (HTML)", optional=True,
               file_filter="HTML files (*.html)"),
@@ -188,7 +191,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the check points, assess them, write the HTML report and the JSON."""
     import json
 
+    import numpy as np
+
     from ..errors import stop_if_asked
+    from ..geometry.frames import check_area_of_use, parse_crs
     from ..io.atomic import write_text_atomic
     from ..quality.accuracy import assess_accuracy, report_to_dict
     from ..quality.accuracy_html import render_html
@@ -203,6 +209,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     )
     points = _points(v)
     log.info("%d check points from %s", len(points), points.source)
+    if points.crs:  # coordinates that cannot be in the stated CRS are refused
+        xyz = np.vstack([points.measured, points.reference])
+        check_area_of_use(parse_crs(points.crs), xyz.min(axis=0), xyz.max(axis=0),
+                          what="the check points", path=points.source or None)  # fmt: skip
     report = assess_accuracy(points, settings, progress=progress, should_stop=should_stop)
     stop_if_asked(should_stop, "writing the report")
     if out.requested("OUTPUT_HTML"):
@@ -213,6 +223,13 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if progress is not None:
         progress(1.0)
     lines = [f"{key} {value:.4f}" for key, value in report.rmse.items()]
+    if report.contrast is not None:
+        n_flag = int(report.outliers.any.sum())
+        lines.append(
+            f"{n_flag} point(s) flagged as outliers ({report.overall.name} above); "
+            f"{report.contrast.name}: "
+            + ", ".join(f"{k} {v:.4f}" for k, v in report.rmse_contrast.items())
+        )
     lines += [
         f"{res.key}: {verdict.name}: {verdict.status} ({verdict.reason})"
         for res in report.standards

@@ -69,7 +69,14 @@ Grouping: one boresight for all images, one per value of the trajectory's group 
 Outputs: the boresight per group (CSV), the updated exterior orientation (CSV), the image
 residuals (a layer at each observation's ground position, and optionally CSV) and an HTML
 summary; a set-up that cannot determine the boresight is an error that names the
-parameters and why (the HTML then carries the diagnosis).""",
+parameters and why (the HTML then carries the diagnosis).
+
+## Checks of the result
+The run fails (nothing but the HTML summary, which says why, is written) when the
+adjustment did not converge, when its global test fails with sigma0 above the largest sigma0
+(the observations do not fit their sigmas), or when an estimated angle exceeds the largest
+plausible boresight. With Write the results even when the checks fail, the outputs are
+written and each starts with a warning (CSV: comment lines beginning with #).""",
     params=(
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
         Param("TRAJECTORY", "file", "Trajectory table (CSV)", file_filter=CSV_FILTER),
@@ -97,8 +104,20 @@ parameters and why (the HTML then carries the diagnosis).""",
         Param("INS_SIGMAS", "numbers",
               "Custom INS sigmas: horizontal, vertical, roll/pitch, heading",
               (0.02, 0.05, 0.015, 0.035), count=4, unit="m, m, deg, deg", optional=True,
-              advanced=True),
+              advanced=True, minimum=0.0001, maximum=100.0),
         Param("SNOOPING", "boolean", "Data snooping (Baarda)", True),
+        Param("MAX_BORESIGHT", "number", "Largest plausible boresight angle", 2.0,
+              unit="degrees", minimum=0.001, maximum=45.0, advanced=True,
+              help="an estimated angle beyond this fails the run (wrong MOUNT, image ids or "
+              "observations)"),
+        Param("MAX_SIGMA0", "number", "Largest sigma0 when the global test fails", 3.0,
+              minimum=1.0, maximum=1000.0, advanced=True,
+              help="a failed global test with sigma0 above this fails the run (wrong "
+              "sigma_px or INS grade, or blunders data snooping did not catch)"),
+        Param("ACCEPT_DOUBTFUL", "boolean", "Write the results even when the checks fail",
+              False,
+              help="no convergence, global test beyond MAX_SIGMA0 or boresight beyond "
+              "MAX_BORESIGHT: write the outputs anyway, each with a warning at its top"),
         Param("OUTPUT_TABLE", "file_out", "Boresight per group (CSV)", file_filter=CSV_OUT),
         Param("OUTPUT_RESIDUALS", "sink", "Image residuals", geometry="point"),
         Param("RESIDUALS_CSV", "file_out", "Image residuals (CSV)", optional=True,
@@ -115,8 +134,8 @@ parameters and why (the HTML then carries the diagnosis).""",
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the inputs, calibrate, write the outputs."""
-    from ..errors import InputError, stop_if_asked
-    from ..geometry.frames import MappingFrame
+    from ..errors import AdjustmentError, InputError, stop_if_asked
+    from ..geometry.frames import MappingFrame, check_area_of_use
     from ..io.atomic import write_text_atomic
     from ..io.camera import read_camera_json
     from ..io.control import read_lcps_csv, read_lines_csv
@@ -145,10 +164,21 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         raise InputError(f"CONTROL_TYPES: choose at least one of {', '.join(CONTROL_TYPES)}")
     cam = read_camera_json(v.camera)
     traj = read_trajectory_csv(v.trajectory)
-    obs = read_observations_csv(v.observations)
+    if not traj.geodetic:
+        check_area_of_use(frame.crs, traj.position.min(axis=0), traj.position.max(axis=0),
+                          what="the trajectory", path=v.trajectory)  # fmt: skip
+    obs = read_observations_csv(v.observations, camera=cam)
     plane_list = read_planes_csv(v.planes) if v.planes else []
     line_list = read_lines_csv(v.lines) if v.lines else []
     lcp_list = read_lcps_csv(v.lcps) if v.lcps else []
+    for name, path, xyz in (
+        ("planes", v.planes, [p.centroid for p in plane_list]),
+        ("lines", v.lines, [ln.point for ln in line_list]),
+        ("LCPs", v.lcps, [p.xyz for p in lcp_list]),
+    ):
+        if xyz:
+            check_area_of_use(frame.crs, np.min(xyz, axis=0), np.max(xyz, axis=0),
+                              what=f"the {name}", path=path)  # fmt: skip
     lidar_xyz = lidar_ids = None
     if "paper" in types and "paper" in obs.type:
         if not v.cloud:
@@ -179,6 +209,27 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             write_text_atomic(out.path("OUTPUT_HTML"), page)
             out.commit(["OUTPUT_HTML"])
         raise
+    doubts = doubts_about(result, v.max_boresight, v.max_sigma0)
+    if doubts and not v.accept_doubtful:
+        if out.requested("OUTPUT_HTML"):  # the failed numbers are the user's diagnosis
+            failed = BoresightRun(result, obs, np.full((len(obs), 3), np.nan),
+                                  ("",) * len(obs), settings, frame.crs.to_wkt())  # fmt: skip
+            page = render_boresight_html(failed, settings, problems=doubts, accepted=False)
+            write_text_atomic(out.path("OUTPUT_HTML"), page)
+            out.commit(["OUTPUT_HTML"])
+        raise AdjustmentError(
+            "the boresight calibration failed its checks: " + "; ".join(doubts)
+            + ". No result was written"
+            + (" (the HTML summary shows the failed adjustment)" if out.requested("OUTPUT_HTML")
+               else "")
+            + "; ACCEPT_DOUBTFUL writes them with a warning"
+        )  # fmt: skip
+    warning = [f"WARNING: {d}" for d in doubts]
+    if doubts:
+        warning.insert(0, "WARNING: this calibration failed its checks and was written only "
+                       "because ACCEPT_DOUBTFUL was set; do not use it without review")
+        for line in warning:
+            log.warning(line.removeprefix("WARNING: "))
     ground = ground_positions(result, obs, cam, plane_list, line_list, lcp_list)
     image_group = dict(zip(traj.image_id, group_labels(traj, options.groups)))
     run = BoresightRun(
@@ -190,15 +241,16 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         frame.crs.to_wkt(),
     )
     if out.requested("OUTPUT_TABLE"):
-        write_csv_atomic(out.path("OUTPUT_TABLE"), TABLE_COLUMNS, _table_rows(run))
+        write_csv_atomic(out.path("OUTPUT_TABLE"), TABLE_COLUMNS, _table_rows(run), warning)
     if out.requested("OUTPUT_EO"):
-        write_eo_csv(out.path("OUTPUT_EO"), result.eo)
+        write_eo_csv(out.path("OUTPUT_EO"), result.eo, warning)
     if out.requested("RESIDUALS_CSV"):
         rows = [_text(r) for r in run.residual_rows()]
-        write_csv_atomic(out.path("RESIDUALS_CSV"), RESIDUAL_COLUMNS, rows)
+        write_csv_atomic(out.path("RESIDUALS_CSV"), RESIDUAL_COLUMNS, rows, warning)
     if out.requested("OUTPUT_HTML"):
-        write_text_atomic(out.path("OUTPUT_HTML"), render_boresight_html(run, settings))
-    lines = [f"{'group':8} {'angle':8} {'deg':>12} {'arcsec':>10} {'sigma':>8}"]
+        page = render_boresight_html(run, settings, problems=doubts, accepted=True)
+        write_text_atomic(out.path("OUTPUT_HTML"), page)
+    lines = [*warning, f"{'group':8} {'angle':8} {'deg':>12} {'arcsec':>10} {'sigma':>8}"]
     for row in result.table_rows():
         lines.append(
             f"{row['group']:8} {row['parameter']:8} {row['value_deg']:12.6f} "
@@ -210,6 +262,41 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         f"{int(result.residuals.rejected.sum())} observations rejected"
     )
     return JobResult(results={"SIGMA0": result.sigma0}, lines=lines, data=run)
+
+
+def doubts_about(result, max_boresight_deg: float, max_sigma0: float) -> list[str]:
+    """Why the calibration's numbers cannot be trusted (empty when they can): no convergence,
+    a global test failed with sigma0 above ``max_sigma0``, an angle beyond
+    ``max_boresight_deg``, numbers that are not finite."""
+    out = []
+    adj = result.adjustment
+    if not adj.converged:
+        why = "; ".join(w for w in adj.warnings if "converg" in w or "reduced" in w)
+        out.append(f"the adjustment did not converge after {adj.iterations} iterations"
+                   + (f" ({why})" if why else ""))  # fmt: skip
+    if not result.chi2_passed and result.sigma0 > max_sigma0:
+        out.append(
+            f"the global test failed with sigma0 = {result.sigma0:.3g} > MAX_SIGMA0 "
+            f"{max_sigma0:g}: the observations are {result.sigma0:.3g} times less precise "
+            "than their sigmas say (wrong sigma_px or INS grade, or undetected blunders)"
+        )
+    deg = result.boresight_deg
+    large, nonfinite = [], []
+    for g, name in enumerate(result.groups):
+        for k, angle in enumerate(("d_omega", "d_phi", "d_kappa")):
+            value = float(deg[g, k])
+            if not np.isfinite(value) or not np.isfinite(result.std[g, k]):
+                nonfinite.append(f"{angle} of group {name}")
+            elif abs(value) > max_boresight_deg:
+                large.append(f"{angle} = {value:.4f} deg in group {name}")
+    if nonfinite:
+        out.append(f"not a finite number: {', '.join(nonfinite)}")
+    if large:
+        out.append(
+            f"{', '.join(large)} beyond MAX_BORESIGHT {max_boresight_deg:g} deg: implausible "
+            "for a misalignment (wrong MOUNT, image ids or observations?)"
+        )
+    return out
 
 
 def _settings(v, cam, traj, obs, planes, lines, lcps, frame, mount, grade) -> dict[str, str]:

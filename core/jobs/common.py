@@ -16,24 +16,31 @@ CSV_FILTER = "CSV files (*.csv *.txt)"
 CSV_OUT = "CSV files (*.csv)"
 LAS_FILTER = "LAS/LAZ files (*.las *.laz *.LAS *.LAZ)"
 DISTANCE_UNITS = ("crs", "metre")
+#: Largest lever-arm component (m): longer than any survey aircraft, so a larger value is a
+#: unit mistake (millimetres typed as metres).
+MAX_LEVER_ARM_M = 50.0
+#: Largest boresight angle (degrees) an input may have: a misalignment is a fraction of a
+#: degree; a rotation of the mount belongs in MOUNT / MOUNT_MATRIX.
+MAX_BORESIGHT_DEG = 10.0
 
 
 def mount_params() -> tuple[Param, ...]:
     """LEVER_ARM, MOUNT, MOUNT_MATRIX and BORESIGHT (``core.photo.mount``)."""
     return (
         Param("LEVER_ARM", "numbers", "Lever arm x,y,z", (0.0, 0.0, 0.0), count=3,
-              unit="m, body frame",
+              unit="m, body frame", minimum=-MAX_LEVER_ARM_M, maximum=MAX_LEVER_ARM_M,
               help="camera perspective centre in the INS body frame (x forward, y right, "
               "z down)"),
         Param("MOUNT", "enum", "Camera mount", MOUNT_CHOICES[0], options=MOUNT_CHOICES,
               labels=tuple(f"{m}: {MOUNT_LABELS[m]}" for m in MOUNT_CHOICES),
               help="nominal camera-to-body rotation; custom uses MOUNT_MATRIX"),
         Param("MOUNT_MATRIX", "numbers", "Mount matrix R_c^b (9 numbers, row-major)",
-              count=9, optional=True, advanced=True,
+              count=9, optional=True, advanced=True, minimum=-1.0, maximum=1.0,
               help="the nominal mount R_c^b when MOUNT is custom"),
         Param("BORESIGHT", "numbers", "Boresight domega,dphi,dkappa", (0.0, 0.0, 0.0),
-              count=3, unit="degrees",
-              help="small misalignment about the camera axes x, y, z"),
+              count=3, unit="degrees", minimum=-MAX_BORESIGHT_DEG, maximum=MAX_BORESIGHT_DEG,
+              help="small misalignment about the camera axes x, y, z (a larger rotation "
+              "belongs in MOUNT)"),
     )  # fmt: skip
 
 
@@ -80,3 +87,22 @@ def lengths_in_cloud_units(
 def unit_text(info: Any, distance_unit: str) -> str:
     """How the job reports the unit its lengths were taken in."""
     return "metre (converted)" if distance_unit == "metre" else info.horizontal_unit
+
+
+#: GeoTIFF compressions of the image outputs (orthophotos, mosaics).
+COMPRESSIONS = ("deflate", "zstd", "lzw", "jpeg", "none")
+
+
+def compression_param() -> Param:
+    """COMPRESSION of an image output (:class:`~lidarphoto.core.io.raster.GeoTiffWriter`)."""
+    return Param("COMPRESSION", "enum", "GeoTIFF compression", COMPRESSIONS[0],
+                 options=COMPRESSIONS, advanced=True,
+                 labels=("DEFLATE (lossless, level 1: fast)", "ZSTD (lossless, level 1)",
+                         "LZW (lossless)", "JPEG (lossy, quality 90; 8-bit images)", "none"),
+                 help="deflate and zstd at their fastest level (files about 15 % larger than "
+                 "at the default level); jpeg is lossy and only for 8-bit images")  # fmt: skip
+
+
+def compression_args(name: str) -> dict[str, Any]:
+    """GeoTiffWriter keywords of a COMPRESSION value."""
+    return {"compress": name.upper(), "level": 1 if name in ("deflate", "zstd") else None}

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..lidar.roof_planes import SELECTION_CHOICES, RoofPlaneParams
+from .checks import check_memory
 from .common import CSV_OUT, cloud_params, lengths_in_cloud_units
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Result, Values
@@ -18,26 +19,32 @@ from .spec import AlgorithmSpec, Param, Result, Values
 log = logging.getLogger(__name__)
 
 _D = RoofPlaneParams()
-#: (parameter, RoofPlaneParams field, label, kind, unit, minimum, advanced)
+#: (parameter, RoofPlaneParams field, label, kind, unit, minimum, maximum, advanced)
 _NUMBERS = (
-    ("K_NEIGHBOURS", "k_neighbours", "Neighbours K of the local RANSAC", "integer", "", 6,
+    ("K_NEIGHBOURS", "k_neighbours", "Neighbours K of the local RANSAC", "integer", "", 6, 500,
      False),
-    ("EPSILON", "epsilon", "Point-to-plane tolerance epsilon", "number", "length", 0.0, False),
+    ("EPSILON", "epsilon", "Point-to-plane tolerance epsilon", "number", "length", 0.001,
+     100.0, False),
     ("MIN_SUPPORT", "min_support", "Minimum support of a local plane", "integer", "points", 3,
-     False),
+     500, False),
     ("RANSAC_ITERATIONS", "ransac_iterations", "RANSAC triplets per point", "integer", "", 1,
-     True),
-    ("MIN_SLOPE", "min_slope_deg", "Minimum slope alpha", "number", "degrees", 0.0, False),
-    ("MAX_SLOPE", "max_slope_deg", "Maximum slope beta", "number", "degrees", 0.0, False),
-    ("ANGLE_TOLERANCE", "angle_tolerance_deg", "Normal angle tolerance", "number", "degrees",
-     0.0, True),
-    ("MIN_PLANE_POINTS", "min_plane_points", "Minimum points per plane", "integer", "", 3,
+     1000, True),
+    ("MIN_SLOPE", "min_slope_deg", "Minimum slope alpha", "number", "degrees", 0.0, 90.0,
      False),
+    ("MAX_SLOPE", "max_slope_deg", "Maximum slope beta", "number", "degrees", 0.0, 90.0,
+     False),
+    ("ANGLE_TOLERANCE", "angle_tolerance_deg", "Normal angle tolerance", "number", "degrees",
+     0.1, 89.9, True),
+    ("MIN_PLANE_POINTS", "min_plane_points", "Minimum points per plane", "integer", "", 3,
+     1e9, False),
     ("OUTLINE_CELL", "outline_cell", "Outline raster cell (0 = auto)", "number", "length",
-     0.0, True),
-    ("SEED", "seed", "Random seed", "integer", "", 0, True),
+     0.0, 1000.0, True),
+    ("SEED", "seed", "Random seed", "integer", "", 0, 2**32 - 1, True),
 )  # fmt: skip
 _LENGTHS = ("epsilon", "outline_cell")
+#: Bytes per RANSAC sample (point x triplet) of a batch: the float32 distances, their
+#: product and the inlier flags (about 10 B; rounded up).
+RANSAC_BYTES_PER_SAMPLE = 16
 
 SPEC = AlgorithmSpec(
     name="extractroofplanes",
@@ -81,8 +88,8 @@ error.""",
               help="LAS classes searched when POINTS is classes, e.g. 6 or 1,6"),
         *(
             Param(key, kind, label, getattr(_D, field), unit=unit, minimum=minimum,
-                  advanced=advanced)
-            for key, field, label, kind, unit, minimum, advanced in _NUMBERS
+                  maximum=maximum, advanced=advanced)
+            for key, field, label, kind, unit, minimum, maximum, advanced in _NUMBERS
         ),
         Param("OUTPUT", "sink", "Roof planes", geometry="polygon"),
         Param("OUTPUT_CSV", "file_out", "Plane table (CSV)", file_filter=CSV_OUT),
@@ -135,7 +142,23 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.pointcloud import read_points, write_cloud
     from ..lidar.roof_planes import extract_roof_planes
 
+    if v.min_support > v.k_neighbours:
+        raise InputError(
+            f"MIN_SUPPORT ({v.min_support}) must not exceed K_NEIGHBOURS ({v.k_neighbours})"
+        )
+    if v.min_slope > v.max_slope:
+        raise InputError(
+            f"MIN_SLOPE ({v.min_slope:g}) must not exceed MAX_SLOPE ({v.max_slope:g} degrees)"
+        )
     params = RoofPlaneParams(**{field: v[key] for key, field, *_ in _NUMBERS})
+    # RANSAC works on batches of points: each holds batch x iterations x K samples
+    check_memory(
+        float(params.batch_size) * params.ransac_iterations * params.k_neighbours
+        * RANSAC_BYTES_PER_SAMPLE,
+        f"K_NEIGHBOURS {params.k_neighbours} with RANSAC_ITERATIONS "
+        f"{params.ransac_iterations}: one batch of {params.batch_size} points",
+        "give fewer neighbours or iterations",
+    )  # fmt: skip
     selection = v.points
     wanted = parse_classes(v.classes) if selection == "classes" else ()
     weights = (0.15, 0.7, 0.15) if out.requested("OUTPUT_CLOUD") else (0.2, 0.8, 0.0)

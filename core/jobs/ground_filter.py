@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import logging
 
+from ..errors import InputError
 from ..lidar.ground_filter import GROWTH_CHOICES, WINDOW_SHAPES, GroundFilterParams
+from .checks import GROUND_FILTER_BYTES_PER_CELL, GROUND_FILTER_BYTES_PER_POINT, check_cell_size
 from .common import cloud_params, lengths_in_cloud_units, unit_text
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Result, Values
@@ -13,21 +15,24 @@ log = logging.getLogger(__name__)
 
 _D = GroundFilterParams()
 H, V = "horizontal length", "vertical length"
-#: (parameter, GroundFilterParams field, label, unit, advanced)
+#: (parameter, GroundFilterParams field, label, unit, advanced, minimum, maximum): the ranges
+#: are physical (a cell of 1 cm to 1 km, a slope up to 10:1) and hold in feet as in metres.
 _NUMBERS = (
-    ("CELL_SIZE", "cell_size", "Cell size", H, False),
-    ("MAX_WINDOW", "max_window", "Maximum window size", H, False),
-    ("SLOPE", "slope", "Terrain slope", "rise/run", False),
-    ("INITIAL_DISTANCE", "initial_distance", "Initial elevation threshold", V, False),
-    ("MAX_DISTANCE", "max_distance", "Maximum elevation threshold", V, False),
-    ("WINDOW_BASE", "window_base", "Window growth base b", "cells", True),
-    ("GROUND_THRESHOLD", "ground_threshold", "Final height tolerance", V, False),
-    ("SLOPE_SCALAR", "slope_scalar", "Tolerance added per unit of slope", V, True),
-    ("LOW_OUTLIER_HEIGHT", "low_outlier_height", "Low outlier depth (0 = off)", V, True),
-    ("LOW_OUTLIER_RADIUS", "low_outlier_radius", "Low outlier radius", H, True),
-)
-HORIZONTAL_LENGTHS = tuple(f for _, f, _, unit, _ in _NUMBERS if unit == H)
-VERTICAL_LENGTHS = tuple(f for _, f, _, unit, _ in _NUMBERS if unit == V)
+    ("CELL_SIZE", "cell_size", "Cell size", H, False, 0.01, 1000.0),
+    ("MAX_WINDOW", "max_window", "Maximum window size", H, False, 0.01, 10000.0),
+    ("SLOPE", "slope", "Terrain slope", "rise/run", False, 0.0, 10.0),
+    ("INITIAL_DISTANCE", "initial_distance", "Initial elevation threshold", V, False, 0.0,
+     1000.0),
+    ("MAX_DISTANCE", "max_distance", "Maximum elevation threshold", V, False, 0.0, 1000.0),
+    ("WINDOW_BASE", "window_base", "Window growth base b", "cells", True, 0.5, 100.0),
+    ("GROUND_THRESHOLD", "ground_threshold", "Final height tolerance", V, False, 0.0, 1000.0),
+    ("SLOPE_SCALAR", "slope_scalar", "Tolerance added per unit of slope", V, True, 0.0, 1000.0),
+    ("LOW_OUTLIER_HEIGHT", "low_outlier_height", "Low outlier depth (0 = off)", V, True, 0.0,
+     1000.0),
+    ("LOW_OUTLIER_RADIUS", "low_outlier_radius", "Low outlier radius", H, True, 0.0, 10000.0),
+)  # fmt: skip
+HORIZONTAL_LENGTHS = tuple(f for _, f, _, unit, *_ in _NUMBERS if unit == H)
+VERTICAL_LENGTHS = tuple(f for _, f, _, unit, *_ in _NUMBERS if unit == V)
 
 SPEC = AlgorithmSpec(
     name="groundfilter",
@@ -54,9 +59,9 @@ ground (other classes kept, or set to 1), and the extra dimension height_above_g
     params=(
         *cloud_params("INPUT"),
         *(
-            Param(key, "number", label, getattr(_D, field), unit=unit, minimum=0.0,
+            Param(key, "number", label, getattr(_D, field), unit=unit, minimum=lo, maximum=hi,
                   advanced=advanced)
-            for key, field, label, unit, advanced in _NUMBERS
+            for key, field, label, unit, advanced, lo, hi in _NUMBERS
         ),
         Param("GROWTH", "enum", "Window growth", _D.growth, options=GROWTH_CHOICES,
               advanced=True),
@@ -100,9 +105,11 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         window_shape=v.window_shape,
         last_returns_only=v.last_returns_only,
     )
+    _check_together(v)
     params.validate()
     read, compute, write = stages(progress, 0.3, 0.3, 0.4)
     info = read_info(v.input, v.crs)
+    _check_against_data(v, info)
     params = lengths_in_cloud_units(
         params, info, v.distance_unit, HORIZONTAL_LENGTHS, VERTICAL_LENGTHS
     )
@@ -167,3 +174,39 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         ],
         data=result,
     )
+
+
+def _check_together(v: Values) -> None:
+    """Parameters that are only meaningful together."""
+    if v.max_window < v.cell_size:
+        raise InputError(
+            f"MAX_WINDOW ({v.max_window:g}) must be at least one cell (CELL_SIZE {v.cell_size:g})"
+        )
+    if v.initial_distance > v.max_distance:
+        raise InputError(
+            f"INITIAL_DISTANCE ({v.initial_distance:g}) must not exceed MAX_DISTANCE "
+            f"({v.max_distance:g})"
+        )
+    if v.growth == "exponential" and v.window_base <= 1:
+        raise InputError(f"WINDOW_BASE must be > 1 for exponential growth, got {v.window_base:g}")
+
+
+def _check_against_data(v: Values, info) -> None:
+    """Cell and window sizes against the cloud's extent (from its header) and the memory the
+    grids will take (lengths compared in the unit the user gave them)."""
+    metre = v.distance_unit == "metre"
+    factor = info.unit_to_metre if metre else 1.0
+    unit = "m" if metre else info.horizontal_unit
+    mins, maxs = info.mins[:2] * factor, info.maxs[:2] * factor
+    per_point = GROUND_FILTER_BYTES_PER_POINT + 27  # + x, y, z, class, returns as read
+    check_cell_size("CELL_SIZE", v.cell_size, unit, mins, maxs, GROUND_FILTER_BYTES_PER_CELL,
+                    extra_bytes=info.point_count * per_point)  # fmt: skip
+    width, height = maxs - mins
+    # a window wider than the data opens it as one the data's size does: harmless up to a
+    # point, a unit or typing mistake beyond twice the extent
+    if v.max_window > 2.0 * max(width, height):
+        raise InputError(
+            f"MAX_WINDOW: {v.max_window:g} {unit} is more than twice the data's extent "
+            f"({width:.4g} x {height:.4g} {unit}): give about the size of the largest building"
+        )
+

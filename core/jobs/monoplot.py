@@ -4,12 +4,19 @@ from __future__ import annotations
 
 import logging
 
+import numpy as np
+
 from ..photo.monoplot import DEFAULT_EO_SIGMAS, METHODS
+from .checks import DSM_BYTES_PER_CELL, check_cell_size, check_memory
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Result, Values
 
 log = logging.getLogger(__name__)
+
+#: Bytes per monoplotted ray: its point, 3 x 3 covariance, pixel, status, the row of text
+#: and the intermediate arrays of the intersection (a generous round figure).
+BYTES_PER_RAY = 1000
 
 SPEC = AlgorithmSpec(
     name="monoplot",
@@ -32,14 +39,15 @@ are intersected with their roof plane (target_id) instead.
 
 DSM: a raster, or a LAS/LAZ rasterised at cell size (highest return per cell, gaps filled;
 optionally saved). A DSM in another CRS than the mapping CRS of the exterior orientation is
-resampled into it, heights transformed too (DSM CRS supplies the CRS when the file has none);
-when PROJ lacks a grid for that (e.g. a geoid), its points get the status crs_mismatch.
+resampled into it, heights transformed too (DSM CRS supplies the CRS when the file has none,
+or replaces it); when PROJ lacks a grid for that (e.g. a geoid), the run is refused: install
+the grid, or give the DSM's CRS with ellipsoidal heights as DSM CRS.
 
 Each point carries a 3x3 covariance from the image sigma, the EO sigmas (X, Y, Z in m;
 omega, phi, kappa in degrees) and the DSM height sigma, and a status: ok, grazing (ray meets
 the face at less than the minimum angle), outside (the ray leaves the DSM), nodata (it crosses
-a hole first), no_orientation (image not in the EO table), crs_mismatch (see DSM),
-not_converged (Makarovic), parallel / unknown_plane (planes).""",
+a hole first), no_orientation (image not in the EO table), not_converged (Makarovic),
+parallel / unknown_plane (planes).""",
     params=(
         Param("OBSERVATIONS", "file", "Image observations (CSV)", file_filter=CSV_FILTER),
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
@@ -48,18 +56,21 @@ not_converged (Makarovic), parallel / unknown_plane (planes).""",
               file_filter="DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"),
         Param("PLANES", "file", "Roof plane table (CSV)", optional=True, file_filter=CSV_FILTER),
         Param("CRS", "crs", "Mapping CRS of the EO", help="e.g. EPSG:28992"),
-        Param("DSM_CRS", "crs", "DSM CRS (if the file has none)", optional=True),
+        Param("DSM_CRS", "crs", "DSM CRS (overrides the file's)", optional=True,
+              help="the DSM's CRS when the file has none or a wrong one; a 2D CRS takes the "
+              "heights as ellipsoidal"),
         Param("METHOD", "enum", "Method", METHODS[0], options=METHODS,
               labels=("direct (Dal Poz, DDA)", "Makarovic iteration")),
         Param("CELL_SIZE", "number", "DSM cell size for LAS/LAZ", 0.5, unit="CRS unit",
-              minimum=0.0),
-        Param("SIGMA_DSM", "number", "DSM height sigma", 0.10, unit="m", minimum=0.0),
+              minimum=0.01, maximum=1000.0),
+        Param("SIGMA_DSM", "number", "DSM height sigma", 0.10, unit="m", minimum=0.0,
+              maximum=100.0),
         Param("LINE_STEP", "number", "Points along lines every (0 = end points)", 0.0,
-              unit="pixels", minimum=0.0),
+              unit="pixels", minimum=0.0, maximum=1e6),
         Param("MIN_INCIDENCE", "number", "Minimum angle ray / face", 5.0, unit="degrees",
-              minimum=0.0, advanced=True),
+              minimum=0.0, maximum=90.0, advanced=True),
         Param("EO_SIGMAS", "numbers", "EO sigmas: X, Y, Z, omega, phi, kappa", DEFAULT_EO_SIGMAS,
-              count=6, unit="m, degrees"),
+              count=6, unit="m, degrees", minimum=0.0, maximum=100.0),
         Param("OUTPUT_POINTS", "sink", "Monoplotted points", geometry="point"),
         Param("OUTPUT_LINES", "sink", "Monoplotted lines", geometry="line"),
         Param("OUTPUT_CSV", "file_out", "Point table (CSV)", optional=True,
@@ -80,20 +91,37 @@ not_converged (Makarovic), parallel / unknown_plane (planes).""",
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the observations, camera, EO, DSM (and planes), monoplot, write the tables."""
+    from pathlib import Path
+
+    from ..geometry.frames import check_area_of_use, parse_crs
     from ..io.camera import read_camera_json
-    from ..io.dsm import load_dsm, write_dsm
+    from ..io.dsm import CLOUD_SUFFIXES, load_dsm, write_dsm
     from ..io.monoplot import write_monoplot_lines_csv, write_monoplot_points_csv
     from ..io.observations import read_observations_csv
     from ..io.orientation import read_eo_csv
     from ..io.planes import read_planes_csv
+    from ..io.pointcloud import read_info
     from ..photo.monoplot import monoplot
 
-    obs = read_observations_csv(v.observations)
     camera = read_camera_json(v.camera)
+    obs = read_observations_csv(v.observations, camera=camera)
     eo = read_eo_csv(v.eo)
+    check_area_of_use(parse_crs(v.crs, what="CRS"), eo.xyz.min(axis=0), eo.xyz.max(axis=0),
+                      what="the perspective centres", path=v.eo)  # fmt: skip
     planes = read_planes_csv(v.planes) if v.planes else ()
+    rays = ray_count(obs, v.line_step)
+    check_memory(rays * BYTES_PER_RAY, f"LINE_STEP {v.line_step:g} px: {rays} rays",
+                 "give a larger step (or 0: the end points only)")  # fmt: skip
+    if Path(v.dsm).suffix.lower() in CLOUD_SUFFIXES:
+        info = read_info(v.dsm, v.dsm_crs, require_crs=False)
+        unit = info.horizontal_unit if info.crs is not None else "CRS unit"
+        check_cell_size("CELL_SIZE", v.cell_size, unit, info.mins[:2], info.maxs[:2],
+                        DSM_BYTES_PER_CELL, extra_bytes=40.0 * info.point_count)  # fmt: skip
     load, compute = stages(progress, 0.4, 0.6)
     dsm = load_dsm(v.dsm, v.cell_size, v.dsm_crs, progress=load, should_stop=should_stop)
+    rows, cols = dsm.heights.shape
+    check_memory(float(rows) * cols * DSM_BYTES_PER_CELL,
+                 f"the DSM of {rows} x {cols} cells ({v.dsm})", "give a coarser DSM")  # fmt: skip
     result = monoplot(
         obs, camera, eo, dsm, v.crs, method=v.method, sigma_dsm=v.sigma_dsm,
         eo_sigmas=v.eo_sigmas, planes=planes, line_step_px=v.line_step,
@@ -111,3 +139,21 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         lines=[f"{len(result.rows)} rays, {len(result.lines)} lines: {result.status_counts()}"],
         data=result,
     )
+
+
+def ray_count(obs, line_step_px: float) -> int:
+    """How many rays :func:`~lidarphoto.core.photo.monoplot.monoplot` will cast: one per
+    observation row plus, with ``line_step_px > 0``, the points added along each line."""
+    total = len(obs)
+    if line_step_px <= 0:
+        return total
+    lines: dict[tuple[str, str], list[int]] = {}
+    for k, (img, kind, tgt) in enumerate(zip(obs.image_id, obs.type, obs.target_id)):
+        if kind == "line":
+            lines.setdefault((img, tgt), []).append(k)
+    for rows in lines.values():
+        px = obs.pixels[rows]
+        length = np.linalg.norm(np.diff(px, axis=0), axis=1)
+        total += int(np.sum(np.maximum(np.ceil(length / line_step_px) - 1, 0)))
+    return total
+

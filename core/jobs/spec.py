@@ -22,10 +22,14 @@ numbers    QgsProcessingParameterString        tuple of ``count`` floats ("x,y,z
 points     QgsProcessingParameterFeatureSource path of a point table (CLI); the QGIS
                                                adapter hands the job its own object
 field      QgsProcessingParameterField         column / field name (str), "" when none
+files      QgsProcessingParameterMultipleLayers tuple of paths (files or folders) or None
+           (files)
 ========== =================================== ==========================================
 
 Outputs: ``file_out`` (QgsProcessingParameterFileDestination), ``raster_out``
-(…RasterDestination), both a path or None; ``sink`` (…FeatureSink): a layer, QGIS only.
+(…RasterDestination), both a path or None; ``folder_out`` (…FolderDestination): a folder
+the job fills itself (not part of the runner's output set); ``sink`` (…FeatureSink): a layer,
+QGIS only.
 Results (numbers and strings a job reports) are :class:`Result` entries.
 """
 
@@ -50,8 +54,9 @@ INPUT_KINDS = (
     "numbers",
     "points",
     "field",
+    "files",
 )
-OUTPUT_KINDS = ("file_out", "raster_out", "sink")
+OUTPUT_KINDS = ("file_out", "raster_out", "folder_out", "sink")
 RESULT_KINDS = ("number", "string")
 _TRUE = ("true", "yes", "1", "on")
 _FALSE = ("false", "no", "0", "off")
@@ -62,10 +67,11 @@ class Param:
     """One parameter of an algorithm (see the module docstring for the kinds).
 
     ``unit`` is shown with the label and in the help ("m", "deg", "px", "cloud unit", ...);
-    ``minimum``/``maximum`` bound numbers (both views refuse values outside, naming the
-    parameter); ``options`` are an enum's machine names (what the command line takes; QGIS
-    shows ``labels``); ``aliases`` are extra command-line spellings of options;
-    ``qgis_default`` overrides ``default`` in QGIS only (e.g. ``"ProjectCrs"``).
+    ``minimum``/``maximum`` bound numbers, and each of ``numbers``, to the physically
+    meaningful range (both views refuse values outside, naming the parameter); ``options``
+    are an enum's machine names (what the command line takes; QGIS shows ``labels``);
+    ``aliases`` are extra command-line spellings of options; ``qgis_default`` overrides
+    ``default`` in QGIS only (e.g. ``"ProjectCrs"``).
     """
 
     name: str
@@ -378,6 +384,9 @@ def parse_value(p: Param, raw: Any) -> Any:
             value = _enum_one(p, raw)
     elif p.kind == "numbers":
         value = parse_numbers(raw, p.count, p.name)
+    elif p.kind == "files":
+        items = [raw] if isinstance(raw, str) else list(raw)
+        value = tuple(str(i) for i in items if str(i).strip()) or p.default
     else:
         value = str(raw) if not isinstance(raw, str) else raw
     check_value(p, value)
@@ -391,12 +400,20 @@ def check_value(p: Param, value: Any) -> None:
             raise InputError(f"{p.name} ({p.label}) is required")
         return
     if p.kind in ("number", "integer"):
-        if not math.isfinite(value):
-            raise InputError(f"{p.name}: must be a finite number, got {value}")
-        if p.minimum is not None and value < p.minimum:
-            raise InputError(f"{p.name}: must be >= {p.minimum:g}, got {value:g}")
-        if p.maximum is not None and value > p.maximum:
-            raise InputError(f"{p.name}: must be <= {p.maximum:g}, got {value:g}")
+        items = [("", value)]
+    elif p.kind == "numbers":
+        items = [(f" (number {k + 1} of {len(value)})", v) for k, v in enumerate(value)]
+    else:
+        return
+    # a unit in the message, not a description of one ("m, degrees", "horizontal length")
+    unit = f" {p.unit}" if p.unit and "," not in p.unit and "length" not in p.unit else ""
+    for which, v in items:
+        if not math.isfinite(v):
+            raise InputError(f"{p.name}{which}: must be a finite number, got {v}")
+        if p.minimum is not None and v < p.minimum:
+            raise InputError(f"{p.name}{which}: must be >= {p.minimum:g}{unit}, got {v:g}")
+        if p.maximum is not None and v > p.maximum:
+            raise InputError(f"{p.name}{which}: must be <= {p.maximum:g}{unit}, got {v:g}")
 
 
 def parse_values(spec: AlgorithmSpec, raw: Mapping[str, Any]) -> Values:

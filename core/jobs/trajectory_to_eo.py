@@ -57,7 +57,7 @@ CSV (on the command line, printed when no file is given), and the number of imag
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the trajectory, georeference every image, write the EO table."""
     from ..errors import stop_if_asked
-    from ..geometry.frames import MappingFrame
+    from ..geometry.frames import MappingFrame, check_area_of_use
     from ..io.orientation import eo_csv_text, write_eo_csv
     from ..io.trajectory import read_trajectory_csv
     from ..photo.georeference import direct_georeference
@@ -65,6 +65,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     frame = MappingFrame.from_user_input(v.crs)
     mount = mount_from(v)
     traj = read_trajectory_csv(v.input)
+    if not traj.geodetic:
+        check_area_of_use(frame.crs, traj.position.min(axis=0), traj.position.max(axis=0),
+                          what="the trajectory", path=v.input)  # fmt: skip
     log.info("read %d images from %s", len(traj), v.input)
     stop_if_asked(should_stop, "georeferencing")
     if progress is not None:

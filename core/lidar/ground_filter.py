@@ -8,7 +8,8 @@ Steps (all grid work is vectorised with OpenCV/scipy.ndimage, all point work wit
    of the nearest filled cell (Euclidean distance transform).
 3. **Low outliers.** A point lower than every other cell's minimum within
    ``low_outlier_radius`` by more than ``low_outlier_height`` is a low outlier (multipath or
-   range errors: nothing real lies below the ground around it). Low
+   range errors: nothing real lies below the ground around it); only cells holding points
+   count, so an isolated point with no neighbour in the radius is never one. Low
    outliers are removed before the PMF (a single one punches a pit that every opening widens),
    get class 7 (low point, noise) and are never ground. The minimum grid is rebuilt without them.
 4. **PMF.** Openings (erosion then dilation, square or disk windows counted in cells) of the
@@ -338,9 +339,10 @@ def ground_filter(
         radius = max(round(p.low_outlier_radius / p.cell_size), 1)
         # A few passes: a deeper outlier nearby can hide a shallower one until it is removed.
         for _ in range(3):
-            # empty cells stay +inf here, so an outlier's value never stands in for a neighbour
+            # empty cells stay +inf here, so an outlier's value never stands in for a neighbour;
+            # a point without any real neighbour (+inf) has nothing to be lower than
             reference = _neighbour_min(zmin, radius).ravel() - np.float32(p.low_outlier_height)
-            new = zc < reference[flat]
+            new = (zc < reference[flat]) & np.isfinite(reference[flat])
             if not new.any():
                 break
             low |= new

@@ -13,7 +13,8 @@ Each ray gets a status code (:data:`STATUS_TEXT`): a ray that leaves the DSM, cr
 nodata hole before hitting the surface, or belongs to an image without orientation is
 reported, never raised. A DSM in another CRS is resampled into the mapping CRS first
 (:func:`core.geometry.surface.reproject_dsm`); when that is impossible (a vertical grid PROJ
-lacks) its rays get the status crs_mismatch.
+lacks) the run is refused with :class:`CrsError`, as docs/conventions.md says: heights are
+never taken without their datum.
 
 Frames: the EO table's omega-phi-kappa are relative to the grid frame at the perspective
 centre, and a straight ray in the real (ENU) world is not straight in projected coordinates
@@ -62,14 +63,12 @@ Array = NDArray[np.float64]
 STATUS_NO_ORIENTATION = 4
 STATUS_PARALLEL = 6
 STATUS_UNKNOWN_PLANE = 7
-STATUS_CRS_MISMATCH = 8
 #: Meaning of each status code (the outputs carry both).
 STATUS_TEXT = {
     **RAY_STATUS_TEXT,
     STATUS_NO_ORIENTATION: "no_orientation",  # the image is not in the EO table
     STATUS_PARALLEL: "parallel",  # the ray is parallel to the plane or meets it behind
     STATUS_UNKNOWN_PLANE: "unknown_plane",  # target_id is not in the plane table
-    STATUS_CRS_MISMATCH: "crs_mismatch",  # the DSM cannot be brought into the EO's CRS
 }
 METHODS = ("dal_poz", "makarovic")
 #: Exterior-orientation sigmas (X, Y, Z m; omega, phi, kappa degrees) of a survey-grade
@@ -433,19 +432,20 @@ def monoplot(
         missing = sorted({obs.image_id[k] for k in src[img_idx < 0]})
         LOG.warning("no exterior orientation for image(s) %s", ", ".join(missing[:10]))
 
-    dsm_ok = True
     if dsm.crs is None:
         LOG.warning("the DSM has no CRS: taken to be the mapping CRS %s", mapping_crs.name)
     elif not _crs_equal(dsm.crs, mapping_crs):
+        source_crs = dsm.crs.name
         try:
-            source_crs = dsm.crs.name
             dsm = reproject_dsm(dsm, mapping_crs, should_stop=should_stop)
-            LOG.warning("the DSM was in '%s': resampled into the mapping CRS '%s' (cell %g)",
-                        source_crs, mapping_crs.name, dsm.cell)  # fmt: skip
-        except CrsError as exc:
-            dsm_ok = False
-            LOG.warning("the DSM cannot be brought into the mapping CRS '%s': %s; its points "
-                        "are not monoplotted", mapping_crs.name, exc)  # fmt: skip
+        except CrsError as exc:  # docs/conventions.md: never a height without its datum
+            raise CrsError(
+                f"the DSM in '{source_crs}' cannot be brought into the mapping CRS "
+                f"'{mapping_crs.name}': {exc}",
+                path=dsm.source or None,
+            ) from exc
+        LOG.warning("the DSM was in '%s': resampled into the mapping CRS '%s' (cell %g)",
+                    source_crs, mapping_crs.name, dsm.cell)  # fmt: skip
     kinds = [obs.type[k] for k in src]
     targets = [obs.target_id[k] for k in src]
     on_plane = np.array(
@@ -454,10 +454,8 @@ def monoplot(
     unknown = on_plane & np.array([t not in plane_map for t in targets])
     status[unknown & (img_idx >= 0)] = STATUS_UNKNOWN_PLANE
     on_plane &= ~unknown
-    if not dsm_ok:
-        status[(img_idx >= 0) & ~on_plane & ~unknown] = STATUS_CRS_MISMATCH
 
-    todo = np.flatnonzero((img_idx >= 0) & ~unknown & (on_plane | dsm_ok))
+    todo = np.flatnonzero((img_idx >= 0) & ~unknown)
     if todo.size:
         if should_stop is not None and should_stop():
             raise Cancelled("cancelled before monoplotting")

@@ -14,8 +14,10 @@ zero mean (bias), two-sided; chi-square test of the standard deviation against a
 precision sigma0, one-sided (``(n-1) s^2 / sigma0^2 <= chi2_{1-alpha, n-1}`` accepts the
 declared precision). Outliers are screened by the robust modified z-score of Iglewicz and
 Hoaglin (1993) (``|0.6745 (x - median) / MAD| > 3.5``) or by three sigma
-(``|x - mean| > 3 s``); flagged points are always reported and only excluded from the
-statistics when the caller asks.
+(``|x - mean| > 3 s``) before any statistic is computed; flagged points are always reported
+and only excluded from the statistics when the caller asks, and the overall statistics are
+then also given the other way (without the flagged points, or with them), so that a gross
+blunder is seen for what it does to the figures.
 """
 
 from __future__ import annotations
@@ -631,7 +633,9 @@ class AccuracyReport:
     ``discrepancies`` (N, 3); ``used`` (N,) the points in the statistics (all unless
     outliers are excluded); ``overall`` and ``groups`` the statistics; ``standards`` the
     verdicts on the used points of all groups; ``group_thresholds`` the project threshold per
-    group (as Pedrosa & dos Santos (2020) judge each flight direction).
+    group (as Pedrosa & dos Santos (2020) judge each flight direction); ``contrast`` the
+    overall statistics of the other choice when points were flagged: without them when they
+    are kept, with them when they are excluded (None when nothing was flagged).
     """
 
     points: CheckPoints
@@ -644,6 +648,7 @@ class AccuracyReport:
     standards: tuple[std_mod.StandardResult, ...]
     group_thresholds: dict[str, std_mod.StandardResult] = field(default_factory=dict)
     created: str = ""
+    contrast: GroupStatistics | None = None
 
     @property
     def horizontal(self) -> NDArray[np.float64]:
@@ -656,14 +661,23 @@ class AccuracyReport:
     @property
     def rmse(self) -> dict[str, float]:
         """RMSE_E, RMSE_N, RMSE_H (height), RMSE_HORIZ, RMSE_3D of the used points (m)."""
-        c = self.overall.components
-        return {
-            "RMSE_E": c["E"].rmse,
-            "RMSE_N": c["N"].rmse,
-            "RMSE_H": c["H"].rmse,
-            "RMSE_HORIZ": c["horizontal"].rmse,
-            "RMSE_3D": c["3D"].rmse,
-        }
+        return _rmse_of(self.overall)
+
+    @property
+    def rmse_contrast(self) -> dict[str, float]:
+        """The same RMSEs for :attr:`contrast` (empty when nothing was flagged)."""
+        return _rmse_of(self.contrast) if self.contrast is not None else {}
+
+
+def _rmse_of(stats: GroupStatistics) -> dict[str, float]:
+    c = stats.components
+    return {
+        "RMSE_E": c["E"].rmse,
+        "RMSE_N": c["N"].rmse,
+        "RMSE_H": c["H"].rmse,
+        "RMSE_HORIZ": c["horizontal"].rmse,
+        "RMSE_3D": c["3D"].rmse,
+    }
 
 
 def _tick(progress, should_stop, fraction: float) -> None:
@@ -713,7 +727,22 @@ def assess_accuracy(
         raise InputError("every point was flagged as an outlier; nothing left to assess")
     sig = (s.declared_sigma_h, s.declared_sigma_h, s.declared_sigma_v)
     du = d[used]
-    overall = group_statistics(du, "all points", alpha=s.alpha, declared_sigma=sig)
+    flagged = outliers.any
+    n_flag = int(flagged.sum())
+    label = f"without the {n_flag} flagged point(s)" if s.exclude_outliers and n_flag else (
+        "all points"
+    )
+    overall = group_statistics(du, label, alpha=s.alpha, declared_sigma=sig)
+    contrast = None
+    if n_flag:  # the user sees what the flagged points do to the figures, both ways
+        other = np.ones(len(d), dtype=bool) if s.exclude_outliers else ~flagged
+        if other.any():
+            other_label = (
+                "all points (flagged included)"
+                if s.exclude_outliers
+                else f"without the {n_flag} flagged point(s)"
+            )
+            contrast = group_statistics(d[other], other_label, alpha=s.alpha, declared_sigma=sig)
     _tick(progress, should_stop, 0.3)
     groups: dict[str, GroupStatistics] = {}
     thresholds: dict[str, std_mod.StandardResult] = {}
@@ -772,7 +801,6 @@ def assess_accuracy(
                 )
             )
     _tick(progress, should_stop, 0.8)
-    n_flag = int(outliers.any.sum())
     if n_flag:
         log.warning(
             "%d point(s) flagged as outliers (%s)%s",
@@ -791,6 +819,7 @@ def assess_accuracy(
         tuple(results),
         thresholds,
         datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        contrast,
     )
 
 
@@ -843,6 +872,8 @@ def report_to_dict(report: AccuracyReport) -> dict[str, Any]:
             "flagged_ids": [pts.ids[k] for k in np.flatnonzero(report.outliers.any)],
         },
         "overall": _obj(report.overall),
+        "contrast": _obj(report.contrast) if report.contrast is not None else None,
+        "rmse_contrast": _obj(report.rmse_contrast),
         "groups": _obj(report.groups),
         "standards": _obj(report.standards),
         "group_thresholds": _obj(report.group_thresholds),

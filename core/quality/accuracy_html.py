@@ -152,6 +152,20 @@ def _standard_section(res) -> str:
     )
 
 
+def _summary(report: AccuracyReport) -> str:
+    """The RMSEs, and beside them those of the other choice when points were flagged."""
+    if report.contrast is None:
+        return _table(["RMSE", "value (m)"], [[k, _m(v, 4)] for k, v in report.rmse.items()])
+    other = report.rmse_contrast
+    head = [
+        "RMSE",
+        f"{_e(report.overall.name)}, used (m)",
+        f"{_e(report.contrast.name)} (m)",
+    ]
+    rows = [[k, _m(v, 4), _m(other[k], 4)] for k, v in report.rmse.items()]
+    return _table(head, rows)
+
+
 def render_html(report: AccuracyReport) -> str:
     """The report as one HTML document (UTF-8 text)."""
     pts = report.points
@@ -159,7 +173,6 @@ def render_html(report: AccuracyReport) -> str:
     d = report.discrepancies
     used = report.used
     flagged = np.flatnonzero(report.outliers.any)
-    rm = report.rmse
     parts = [
         "<!DOCTYPE html>",
         '<html lang="en"><head><meta charset="utf-8">',
@@ -177,10 +190,7 @@ def render_html(report: AccuracyReport) -> str:
             ],
         ),
         "<h2>Summary</h2>",
-        _table(
-            ["RMSE", "value (m)"],
-            [[k, _m(v, 4)] for k, v in rm.items()],
-        ),
+        _summary(report),
         "<h2>Standards</h2>",
     ]
     if report.standards:
@@ -196,9 +206,14 @@ def render_html(report: AccuracyReport) -> str:
                 css.append(v.status)
         parts.append(_table(["group", "check", "status", "reason"], rows, css))
     parts.append("<h2>Statistics</h2>")
-    parts.append(f'<h3 class="group">All points ({report.overall.n})</h3>')
+    parts.append(f'<h3 class="group">{_e(report.overall.name.capitalize())} '
+                 f"({report.overall.n})</h3>")  # fmt: skip
     parts.append(_stats_table(report.overall))
     parts.append(_tests_table(report.overall))
+    if report.contrast is not None:
+        parts.append(f'<h3 class="group">For comparison: {_e(report.contrast.name)} '
+                     f"({report.contrast.n})</h3>")  # fmt: skip
+        parts.append(_stats_table(report.contrast))
     for name, g in report.groups.items():
         parts.append(f'<h3 class="group">Group {_e(name)} ({g.n})</h3>')
         parts.append(_stats_table(g))

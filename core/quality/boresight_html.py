@@ -35,6 +35,7 @@ th,td{border:1px solid #bbb;padding:3px 7px;text-align:right}
 th{background:#eee}td.t,th.t{text-align:left}
 .pass{background:#d8f0d8}.fail{background:#f7d4d4}.diag{background:#fbecc4;padding:8px}
 .plots svg{margin:4px;border:1px solid #ddd}.note{font-size:12px;color:#444}
+.alarm{background:#c62828;color:#fff;padding:8px 14px;font-size:15px}
 """
 
 
@@ -76,6 +77,9 @@ def render_boresight_html(
     run: BoresightRun | None,
     settings: Mapping[str, str],
     diagnosis: Sequence[str] | None = None,
+    *,
+    problems: Sequence[str] = (),
+    accepted: bool = False,
 ) -> str:
     """The HTML page as a string.
 
@@ -87,6 +91,10 @@ def render_boresight_html(
         Shown as given.
     diagnosis : sequence of str, optional
         Sentences of :class:`core.photo.boresight.BoresightNotObservable`; shown instead of results.
+    problems : sequence of str
+        Checks the result failed (no convergence, global test, implausible angles): shown in a
+        red box at the top, saying whether the results were refused or written anyway
+        (``accepted``).
 
     Examples
     --------
@@ -100,6 +108,7 @@ def render_boresight_html(
         "<title>Boresight calibration</title>",
         f"<style>{_CSS}</style></head><body>",
         "<h1>Boresight calibration</h1>",
+        *_problems(problems, accepted),
         f'<p class="note">lidarphoto {_e(__version__)}. Angles: d_omega, d_phi, d_kappa about '
         "the camera axes x, y, z (R_c^b = R_nominal dR); standard deviations are a-posteriori "
         "(scaled by sigma0) unless labelled a-priori.</p>",
@@ -118,6 +127,20 @@ def render_boresight_html(
         parts += _results(run)
     parts.append("</body></html>")
     return "\n".join(parts)
+
+
+def _problems(problems: Sequence[str], accepted: bool) -> list[str]:
+    if not problems:
+        return []
+    verdict = (
+        "These results FAILED their checks and were written only because the user asked "
+        "for them (ACCEPT_DOUBTFUL): do not use them without review."
+        if accepted
+        else "The calibration FAILED its checks: no table and no exterior orientation were "
+        "written. The numbers below show the failed adjustment, for diagnosis only."
+    )
+    items = "".join(f"<li>{_e(p)}</li>" for p in problems)
+    return [f'<div class="alarm"><p><b>{_e(verdict)}</b></p><ul>{items}</ul></div>']
 
 
 def _results(run: BoresightRun) -> list[str]:

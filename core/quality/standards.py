@@ -323,13 +323,16 @@ def bivariate_radius(sigma_x: float, sigma_y: float, probability: float = 0.95) 
     """Radius holding ``probability`` of a zero-mean bivariate normal with independent axes.
 
     This is the quantity NSSDA approximates with 2.4477 * 0.5 (RMSE_x + RMSE_y); it is
-    computed here exactly, by integrating the density in polar coordinates (1-D quadrature
-    over the angle) and solving for the radius.
+    computed here exactly: with ``a >= b`` the two sigmas, ``P(r <= R) = int_-R^R phi(x / a) /
+    a * erf(sqrt(R^2 - x^2) / (b sqrt 2)) dx``, integrated over ``x = R sin t`` (a smooth
+    integrand, whatever the ratio b / a) and solved for R between the one-dimensional radius
+    ``a z`` and ``a sqrt(-2 ln(1 - p))``, which bracket it. Any ratio of the sigmas works (a
+    gross blunder in one axis gives b / a of 1e-8), tending to the one-dimensional radius.
 
     Parameters
     ----------
     sigma_x, sigma_y : float
-        Standard deviations of the two axes (m), not both zero.
+        Standard deviations of the two axes (m), finite.
     probability : float
         Probability in (0, 1).
 
@@ -342,27 +345,38 @@ def bivariate_radius(sigma_x: float, sigma_y: float, probability: float = 0.95) 
     --------
     >>> round(bivariate_radius(1.0, 1.0), 4)  # circular case: sqrt(-2 ln 0.05)
     2.4477
+    >>> round(bivariate_radius(1e6, 0.01), 1)  # a blunder on one axis: 1.96 a
+    1959964.0
     """
     from scipy import integrate, optimize, stats
 
-    sx, sy = abs(float(sigma_x)), abs(float(sigma_y))
-    if sx == 0.0 and sy == 0.0:
+    a, b = sorted((abs(float(sigma_x)), abs(float(sigma_y))), reverse=True)
+    if not (math.isfinite(a) and 0.0 < probability < 1.0):
+        raise ValueError(f"bivariate_radius: sigmas must be finite, got {sigma_x}, {sigma_y}")
+    if a == 0.0:
         return 0.0
-    if min(sx, sy) == 0.0:
-        return max(sx, sy) * float(stats.norm.ppf(0.5 + probability / 2.0))
+    z = float(stats.norm.ppf(0.5 + probability / 2.0))
+    rho = b / a
+    if rho < 1e-9:  # the second axis changes the radius by about rho^2: one-dimensional
+        return a * z
+    scale = 1.0 / (rho * math.sqrt(2.0))
 
     def cdf(radius: float) -> float:
-        # P(r <= R) = 1/(2 pi sx sy) * int_0^2pi (1 - exp(-R^2 q / 2)) / q dtheta
+        def integrand(t: float) -> float:
+            c = math.cos(t)
+            return math.exp(-0.5 * (radius * math.sin(t)) ** 2) * math.erf(radius * c * scale) * c
 
-        def integrand(theta: float) -> float:
-            q = math.cos(theta) ** 2 / sx**2 + math.sin(theta) ** 2 / sy**2
-            return -math.expm1(-0.5 * radius**2 * q) / q
+        value, _ = integrate.quad(integrand, 0.0, 0.5 * math.pi, epsabs=1e-13, epsrel=1e-12,
+                                  limit=200)  # fmt: skip
+        return 2.0 * radius * value / math.sqrt(2.0 * math.pi)
 
-        value, _ = integrate.quad(integrand, 0.0, 0.5 * math.pi, epsabs=1e-12, epsrel=1e-12)
-        return 4.0 * value / (2.0 * math.pi * sx * sy)
-
-    hi = 10.0 * max(sx, sy)
-    return float(optimize.brentq(lambda r: cdf(r) - probability, 0.0, hi, xtol=1e-12))
+    lo, hi = z, math.sqrt(-2.0 * math.log1p(-probability))
+    f_lo, f_hi = cdf(lo) - probability, cdf(hi) - probability
+    if f_lo >= 0.0:  # at the rounding level of the quadrature
+        return a * lo
+    if f_hi <= 0.0:
+        return a * hi
+    return a * float(optimize.brentq(lambda r: cdf(r) - probability, lo, hi, xtol=1e-13))
 
 
 def nssda(

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from lidarphoto.core.errors import CrsError
 from lidarphoto.core.geometry.camera import Camera
 from lidarphoto.core.geometry.collinearity import image_rays, project
 from lidarphoto.core.geometry.distortion import distortion_from_dict
@@ -310,10 +311,13 @@ def test_bad_input_gives_statuses_not_crashes(tmp_path, dsm):
         rows = list(csv.DictReader(fh))
     assert [r["status_text"] for r in rows[40:]] == ["outside", "no_orientation"]
     assert rows[40]["X"] == "" and float(rows[0]["sigma_z"]) > 0
-    # the DSM in its own CRS (RD New + NAP) while the EO is in RD New: flagged, not mixed
+    # the DSM in its own CRS (RD New + NAP) while the EO is in RD New and PROJ lacks the NAP
+    # geoid: refused (docs/conventions.md), never heights of two datums mixed
     other = dsm_from_las(AHN3, 0.5)
-    res = run_monoplot(obs, CAMERA, table, other, CRS)
-    assert {STATUS_TEXT[int(s)] for s in res.status[:41]} == {"crs_mismatch"}
+    with pytest.raises(CrsError, match=r"RD New \+ NAP height' cannot be brought into .*"
+                       r"nl_nsgi_nlgeo2018"):
+        run_monoplot(obs, CAMERA, table, other, CRS, output_csv=tmp_path / "refused.csv")
+    assert not (tmp_path / "refused.csv").exists()
     # a nodata hole under the points: the rays that cross it are reported
     holes = dsm.heights.copy()
     holes[40:80, 40:80] = np.nan

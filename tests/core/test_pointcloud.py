@@ -66,7 +66,10 @@ def test_international_feet_from_esri_wkt():
 
 def test_override_crs_and_refuse_geographic():
     assert read_info(SAMP11, crs="EPSG:25832").crs.to_epsg() == 25832
-    assert read_info(SAMP11, crs=pyproj.CRS.from_epsg(2994)).horizontal_unit == "foot"
+    # Vaihingen (UTM 32N) labelled as Oregon in feet: refused, the extent is not in Oregon
+    with pytest.raises(CrsError, match=r"samp11\.laz: the cloud .* outside the area of use "
+                       r"of 'NAD83\(HARN\) / Oregon GIC Lambert \(ft\)'"):
+        read_info(SAMP11, crs=pyproj.CRS.from_epsg(2994))
     with pytest.raises(CrsError, match="geographic"):
         read_info(SAMP11, crs=4326)
     with pytest.raises(CrsError, match="not a valid CRS"):
@@ -209,6 +212,7 @@ def test_no_crs_asks_for_one(tmp_path):
     src = laspy.read(AHN3)
     bare = tmp_path / "bare.las"
     header = laspy.LasHeader(point_format=src.header.point_format, version="1.2")
+    header.scales, header.offsets = src.header.scales, src.header.offsets
     data = laspy.LasData(header)
     data.points = src.points[:1000].copy()
     data.write(bare)

@@ -56,8 +56,11 @@ def test_page_is_self_contained_and_has_every_section():
     text = " ".join(col.text)
     assert not col.external  # nothing fetched from outside
     assert col.tags.get("svg") == 7  # vector map + 3 histograms + 3 Q-Q plots
-    # info + RMSE, standards (4), project per group, (overall + 2 groups) x 2, points
-    assert col.tags.get("table", 0) == 2 + 4 + 1 + 6 + 1
+    # info + RMSE, standards (4), project per group, (overall + 2 groups) x 2, the overall
+    # statistics without the flagged point, points
+    assert col.tags.get("table", 0) == 2 + 4 + 1 + 6 + 1 + 1
+    assert rep.outliers.any.sum() == 1 and "For comparison: without the 1 flagged point(s)" in text
+    assert f"{rep.rmse_contrast['RMSE_N']:.4f}" in text
     for word in ("ASPRS", "NSSDA", "PEC-PCD", "Project threshold", "Shapiro-Wilk", "Student t"):
         assert word in text, word
     assert "CP<0>" in text and "CP&lt;0>" not in text  # escaped in the source, intact as text

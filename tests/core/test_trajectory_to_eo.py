@@ -170,7 +170,11 @@ def test_bad_trajectory_names_row_and_column(tmp_path, rows, header, words):
     ("kwargs", "error", "words"),
     [
         ({"mount": "sideways"}, InputError, "MOUNT: 'sideways' is not one of"),
-        ({"mount": "custom", "mount_matrix": "1,0,0,0,1,0,0,0,2"}, InputError, "not a rotation"),
+        ({"mount": "custom", "mount_matrix": "1,0,0,0,1,0,0,0,-1"}, InputError, "not a rotation"),
+        ({"mount": "custom", "mount_matrix": "1,0,0,0,1,0,0,0,2"}, InputError,
+         r"MOUNT_MATRIX \(number 9 of 9\): must be <= 1, got 2"),
+        ({"lever_arm": "0,0,1350"}, InputError, r"LEVER_ARM \(number 3 of 3\): must be <= 50"),
+        ({"boresight": "0,0,45"}, InputError, r"BORESIGHT \(number 3 of 3\): must be <= 10"),
         ({"mount": "custom", "mount_matrix": ""}, InputError, "needs MOUNT_MATRIX: 9 numbers"),
         ({"boresight": "1,2"}, InputError, "BORESIGHT: expected 3 numbers"),
         ({"lever_arm": "1,x,3"}, InputError, "LEVER_ARM"),

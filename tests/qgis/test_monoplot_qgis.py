@@ -23,7 +23,7 @@ from lidarphoto.core.jobs import monoplot as monoplot_job
 from lidarphoto.core.jobs.runner import run_job
 from lidarphoto.core.photo.observations import ImageObservations
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable, eo_map_to_local
-from qgis.core import QgsProcessingException, QgsVectorLayer, QgsWkbTypes
+from qgis.core import QgsProcessingException, QgsRasterLayer, QgsVectorLayer, QgsWkbTypes
 from qgis_helpers import QGIS_PROCESS
 
 ALG = "lidarphoto:monoplot"
@@ -47,11 +47,14 @@ def scene(tmp_path_factory):
     write_eo_csv(folder / "eo.csv", table)
     rng = np.random.default_rng(8)
     xc, yc = dsm.centre_origin
-    x, y = xc + rng.uniform(1, 58, 123), yc - rng.uniform(1, 58, 123)
+    x, y = xc + rng.uniform(1, 58, 200), yc - rng.uniform(1, 58, 200)
     truth = np.column_stack([x, y, dsm.height_at(x, y)])
     local = LocalFrame.at_map_point(MappingFrame.from_user_input(CRS), truth.mean(axis=0))
     c, m = eo_map_to_local(table.xyz, table.opk, local)
     pixels = project(local.map_to_enu(truth), np.r_[c[0], matrix_to_opk(m[0])], cam)
+    # only what the image shows can be picked (an off-image pixel is refused)
+    seen = np.flatnonzero(((pixels >= 0) & (pixels <= [cam.width_px, cam.height_px])).all(1))
+    truth, pixels = truth[seen[:123]], pixels[seen[:123]]
     kinds = ["check"] * 120 + ["line"] * 3
     targets = ["0"] * 120 + ["4"] * 3  # the CSV needs a target id; points ignore it
     ids = [f"p{k}" for k in range(123)]
@@ -107,14 +110,21 @@ def test_processing_run_from_laz(provider, scene, tmp_path):
     with open(tmp_path / "pts.csv", encoding="utf-8") as fh:
         rows = list(csv.DictReader(fh))
     assert len(rows) == points.featureCount() and {"cov_xy", "status_text"} <= set(rows[0])
-    assert (tmp_path / "dsm.tif").stat().st_size > 120 * 120 * 4
+    dsm_out = QgsRasterLayer(str(tmp_path / "dsm.tif"), "dsm")  # compressed, tiled GeoTIFF
+    assert dsm_out.isValid() and (dsm_out.width(), dsm_out.height()) >= (120, 120)
 
 
-def test_dsm_in_another_crs_is_reported_per_point(provider, scene):
+def test_dsm_whose_geoid_grid_is_missing_is_refused(provider, scene, tmp_path):
     folder, _ = scene
-    result = processing.run(ALG, _params(folder, DSM=str(AHN3)))  # the file says EPSG:7415
-    status = {f["status_text"] for f in result["OUTPUT_POINTS"].getFeatures()}
-    assert status == {"crs_mismatch"} and result["HIT_COUNT"] == 0
+    out = tmp_path / "pts.csv"
+    # the file says EPSG:7415 (RD New + NAP); the NAP geoid grid is not installed
+    with pytest.raises(
+        QgsProcessingException,
+        match=r"cannot be brought into the mapping CRS"
+        r".*nl_nsgi_nlgeo2018",
+    ):
+        processing.run(ALG, _params(folder, DSM=str(AHN3), OUTPUT_CSV=str(out)))
+    assert not out.exists() and not list(tmp_path.iterdir())
 
 
 def test_missing_camera_is_an_error(provider, scene, tmp_path):

@@ -90,7 +90,7 @@ def test_processing_bad_input_raises_and_leaves_nothing(provider, tmp_path):
                 "OUTPUT_CSV": str(csv_path),
             },
         )
-    with pytest.raises(QgsProcessingException, match="min_support"):
+    with pytest.raises(QgsProcessingException, match="MIN_SUPPORT"):
         processing.run(
             ALG,
             {
