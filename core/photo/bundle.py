@@ -39,7 +39,10 @@ correlations; for every AP its t-test (value over its a-posteriori standard devi
 Student's t with the redundancy as degrees of freedom) and correlations above a limit with the
 other interior parameters. Automatic selection drops, one at a time, the least significant
 insignificant AP, or the less significant AP of a too-correlated pair, re-adjusts, and reports
-what it dropped and why. Outliers: robust reweighting (Huber) before Baarda's data snooping.
+what it dropped and why. Outliers: robust reweighting (Huber or Cauchy) before Baarda's data
+snooping, both on the image measurements only (control points and observed orientations are
+tested, their w reported, but never removed: their misfits mostly reflect an imperfect
+model); a tie point left with one ray by a rejection is set aside with it.
 """
 
 from __future__ import annotations
