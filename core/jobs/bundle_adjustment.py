@@ -87,6 +87,8 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
             count=6,
             unit="m, degrees",
             optional=True,
+            minimum=0.0001,
+            maximum=100.0,
             help="makes an EO table without sigma columns (e.g. from trajectorytoeo) "
             "observations; empty: approximate values only",
         ),
@@ -222,7 +224,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     import numpy as np
 
     from ..errors import InputError
-    from ..geometry.frames import MappingFrame
+    from ..geometry.frames import MappingFrame, check_area_of_use
     from ..io.atomic import write_text_atomic
     from ..io.bundle import (
         write_bundle_points,
@@ -240,8 +242,12 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
     frame = MappingFrame.from_user_input(v.crs)
     cams = read_cameras_json(v.camera)
-    obs = read_observations_csv(v.observations)
+    # one camera: its image size bounds every pixel as the table is read (several: below)
+    obs = read_observations_csv(v.observations, camera=cams[0] if len(cams) == 1 else None)
     ground = read_ground_points_csv(v.ground_points) if v.ground_points else GroundPoints.empty()
+    if len(ground):
+        check_area_of_use(frame.crs, ground.xyz.min(axis=0), ground.xyz.max(axis=0),
+                          what="the ground points", path=v.ground_points)  # fmt: skip
     eo = sigma = None
     eo_rows: tuple[int, ...] = ()
     eo_source = ""
@@ -249,6 +255,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if v.eo:
         f = read_eo_csv_full(v.eo, frame.crs.to_wkt())
         eo, sigma, eo_rows, eo_source = f.eo, f.sigma, f.rows, f.path
+        check_area_of_use(frame.crs, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
+                          what="the perspective centres", path=v.eo)  # fmt: skip
         if sigma is None and v.eo_sigmas:
             s6 = np.array(v.eo_sigmas, dtype=float)
             if not (s6 > 0).all():
@@ -263,6 +271,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                 f"image '{im}' is given camera '{cam}' here and '{image_camera[im]}' elsewhere",
                 **obs.where(k),
             )
+    if len(cams) > 1:
+        _check_on_image(obs, image_camera, cams)
     models = tuple(m for m in AP_FAMILIES) if v.ap_model == "all" else (v.ap_model,)
     parts = stages(progress, *([1.0] * len(models)))
     stage = dict(zip(models, parts))
@@ -349,6 +359,27 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         lines=lines,
         data=res,
     )
+
+
+def _check_on_image(obs, image_camera: dict[str, str], cams) -> None:
+    """Refuse a measured pixel off its camera's image (0 <= col <= width_px, 0 <= row <=
+    height_px), naming the row; images of unknown cameras are left to the adjustment."""
+    import numpy as np
+
+    from ..errors import InputError
+
+    size = {c.name: (c.width_px, c.height_px) for c in cams}
+    wh = np.array([size.get(image_camera.get(im, ""), (np.inf, np.inf)) for im in obs.image_id],
+                  dtype=float).reshape(-1, 2)  # fmt: skip
+    off = np.flatnonzero(((obs.pixels < 0) | (obs.pixels > wh)).any(axis=1))
+    if off.size:
+        k = int(off[0])
+        cam = image_camera[obs.image_id[k]]
+        raise InputError(
+            f"pixel ({obs.pixels[k, 0]:g}, {obs.pixels[k, 1]:g}) is off the image: camera "
+            f"'{cam}' has {size[cam][0]} x {size[cam][1]} pixels; {off.size} row(s) affected",
+            **obs.where(k),
+        )
 
 
 def _settings(v, cams, obs, ground, eo, sigma, frame) -> dict[str, str]:

@@ -201,3 +201,82 @@ def test_eo_without_sigmas_becomes_observed_with_eo_sigmas(files, tmp_path):
     adj = res.data.adjustment
     assert "observed orientation" in adj.residuals and "control points" not in adj.residuals
     assert adj.n_constraints == 0 and len(res.data.check.point_id) >= 15
+
+
+def _base(paths, tmp_path, **changes):
+    values = {
+        "CAMERA": str(paths["camera"]),
+        "OBSERVATIONS": str(paths["observations"]),
+        "GROUND_POINTS": str(paths["ground_points"]),
+        "EO": str(paths["eo"]),
+        "CRS": "EPSG:31983",
+        "OUTPUT_EO": str(tmp_path / "eo.csv"),
+    }
+    values.update(changes)
+    return values
+
+
+def test_inputs_checked_before_the_adjustment(files, tmp_path):
+    """Project-wide checks hold for the bundle too: a pixel off the camera's image, ground
+    points in degrees and perspective centres in another CRS, an EO sigma of zero; each
+    refused naming the file (and row), nothing written."""
+    from lidarphoto.core.errors import CrsError
+
+    blk, paths, _folder = files
+    # a pixel off the 4000 x 3000 image (row 5 of the table)
+    obs = open(paths["observations"], encoding="utf-8").read().splitlines()
+    head = obs[0].split(",")
+    cells = obs[4].split(",")
+    cells[head.index("col")] = str(blk.camera.width_px + 10)
+    obs[4] = ",".join(cells)
+    bad_obs = tmp_path / "obs_off.csv"
+    bad_obs.write_text("\n".join(obs) + "\n", encoding="utf-8")
+    with pytest.raises(InputError, match=r"obs_off\.csv.*row 5.*column 'col'.*off the image"):
+        run_job(bundle_adjustment, _base(paths, tmp_path, OBSERVATIONS=str(bad_obs)))
+    # ground points given in geographic degrees
+    gp = _read(paths["ground_points"])
+    deg = tmp_path / "gp_deg.csv"
+    with open(deg, "w", newline="", encoding="utf-8") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(gp[0]))
+        w.writeheader()
+        for k, r in enumerate(gp):
+            w.writerow({**r, "X": f"{-43.7 + 1e-4 * k}", "Y": f"{-22.75 + 1e-4 * k}"})
+    with pytest.raises(CrsError, match=r"gp_deg\.csv.*ground points.*longitude and latitude"):
+        run_job(bundle_adjustment, _base(paths, tmp_path, GROUND_POINTS=str(deg)))
+    # perspective centres of another CRS (SIRGAS 2000 / UTM 23S expected; given 1000 km north)
+    eo = _read(paths["eo"])
+    far = tmp_path / "eo_far.csv"
+    with open(far, "w", newline="", encoding="utf-8") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(eo[0]))
+        w.writeheader()
+        for r in eo:
+            w.writerow({**r, "Y": f"{float(r['Y']) + 9.0e6:.3f}"})
+    with pytest.raises(CrsError, match=r"eo_far\.csv.*perspective centres.*outside the area"):
+        run_job(bundle_adjustment, _base(paths, tmp_path, EO=str(far)))
+    with pytest.raises(InputError, match=r"EO_SIGMAS \(number 4 of 6\): must be >= 0\.0001"):
+        run_job(bundle_adjustment, _base(paths, tmp_path, EO_SIGMAS="5,5,5,0,1,1"))
+    assert not (tmp_path / "eo.csv").exists()
+
+
+def test_pixels_checked_against_each_camera_of_a_block():
+    """With several cameras each row is bounded by its own image's camera."""
+    from dataclasses import replace
+
+    from lidarphoto.core.jobs.bundle_adjustment import _check_on_image
+    from lidarphoto.core.photo.observations import ImageObservations
+
+    blk = simulate_uav_block("bauer", seed=1, n_tie=50)
+    small = replace(blk.camera, name="small", width_px=1000, height_px=800)
+    obs = ImageObservations.from_arrays(
+        ["A", "B", "B"],
+        ["P1", "P1", "P2"],
+        [[3500.0, 2500.0], [900.0, 700.0], [999.0, 850.0]],
+        [0.5] * 3,
+        ["tie"] * 3,
+        [""] * 3,
+    )
+    obs = replace(obs, rows=(2, 3, 4), source="obs.csv")
+    cams = [replace(blk.camera, name="big"), small]
+    _check_on_image(obs.subset([True, True, False]), {"A": "big", "B": "small"}, cams)
+    with pytest.raises(InputError, match=r"obs\.csv.*row 4.*\(999, 850\).*'small'.*1000 x 800"):
+        _check_on_image(obs, {"A": "big", "B": "small"}, cams)
