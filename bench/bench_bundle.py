@@ -204,7 +204,7 @@ def main(what: str = "all") -> None:
         f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()} ({os.cpu_count()} cores, "
         f"shared), Python {platform.python_version()}, numpy {np.__version__}, scipy "
         f"{scipy.__version__}; one BLAS thread. Wall times carry the noise of a shared machine "
-        "(about +/-30 %).",
+        f"(about +/-30 %; load average {os.getloadavg()[0]:.1f} when the run started).",
         "",
     ]
     if what in ("bal", "all"):
