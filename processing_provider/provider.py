@@ -10,6 +10,7 @@ from qgis.PyQt.QtGui import QIcon
 
 from .algorithms.accuracy_report import AccuracyReportAlgorithm
 from .algorithms.boresight_calibration import BoresightCalibrationAlgorithm
+from .algorithms.bundle_adjustment import BundleAdjustmentAlgorithm
 from .algorithms.create_lcps import CreateLcpsAlgorithm
 from .algorithms.extract_roof_planes import ExtractRoofPlanesAlgorithm
 from .algorithms.ground_filter import GroundFilterAlgorithm
@@ -51,6 +52,7 @@ class LidarPhotoProvider(QgsProcessingProvider):
             ExtractRoofPlanesAlgorithm(),
             BoresightCalibrationAlgorithm(),
             MonoplotAlgorithm(),
+            BundleAdjustmentAlgorithm(),
             OrthorectifyAlgorithm(),
             OrthomosaicAlgorithm(),
         ):

@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from . import ap_models as _ap_models  # noqa: F401  (registers the AP families' lens models)
 from .distortion import (
     DEFAULT_MAX_ITER,
     DistortionModel,
@@ -299,7 +300,7 @@ FOCAL_RANGE_MM = (1.0, 5000.0)
 MAX_IMAGE_SIDE_PX = 200_000
 _MM_KEYS = ("focal_mm", "x0_mm", "y0_mm")
 _PX_KEYS = ("focal_px", "ppx_px", "ppy_px")
-_KNOWN_KEYS = {"name", "pixel_size_mm", "width_px", "height_px", "distortion"}
+_KNOWN_KEYS = {"name", "pixel_size_mm", "width_px", "height_px", "distortion", "sigmas"}
 _KNOWN_KEYS.update(_MM_KEYS, _PX_KEYS)
 
 

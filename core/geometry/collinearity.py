@@ -168,6 +168,7 @@ def collinearity_jacobians(
     *,
     tol_px: float = DEFAULT_TOL_PX,
     max_iter: int = DEFAULT_MAX_ITER,
+    image_index: ArrayLike | None = None,
 ) -> Dict[str, Any]:
     """Predicted measured pixels and their analytic Jacobians.
 
@@ -183,6 +184,10 @@ def collinearity_jacobians(
         Which Jacobians to compute.
     tol_px, max_iter
         Tolerance (pixels) and iteration limit of the lens inversion.
+    image_index : (N,) array_like of int, optional
+        With it, ``eo`` is (M, 6), one row per image, and point ``n`` is seen by image
+        ``image_index[n]``: the rotations and their derivatives are computed once per image
+        (a bundle adjustment has far fewer images than measurements).
 
     Returns
     -------
@@ -211,7 +216,17 @@ def collinearity_jacobians(
     if unknown:
         raise ValueError(f"wrt: unknown Jacobian(s) {unknown}; use 'eo', 'point', 'interior'")
 
-    e, d, rot, q = _to_camera_frame(points, eo)
+    if image_index is None:
+        e, d, rot, q = _to_camera_frame(points, eo)
+        per_image = None
+    else:
+        p = as_points(points, 3, "points")
+        per_image = np.asarray(image_index, dtype=np.intp)
+        eo_img = np.asarray(eo, dtype=np.float64).reshape(-1, 6)
+        e = eo_img[per_image]
+        d = p - e[:, :3]
+        rot = opk_to_matrix(eo_img[:, 3], eo_img[:, 4], eo_img[:, 5])[per_image]
+        q = np.einsum("nij,nj->ni", rot, d)
     f = camera.focal_mm
     ps = camera.pixel_size_mm
     ideal, in_front = _ideal(q, f)
@@ -238,8 +253,15 @@ def collinearity_jacobians(
         if "point" in wanted:
             out["point"] = dpx_dpoint
         if "eo" in wanted:
-            dm = opk_derivatives(e[:, 3], e[:, 4], e[:, 5])  # (N, 3 angles, 3, 3)
-            dq_dangles = np.einsum("nkij,nj->nik", dm, d)
+            if per_image is None:
+                dm = opk_derivatives(e[:, 3], e[:, 4], e[:, 5])  # (N, 3 angles, 3, 3)
+                dq_dangles = np.einsum("nkij,nj->nik", dm, d)
+            else:
+                # one angle at a time: the (N, 3, 3, 3) gather would dominate the memory
+                dm_img = opk_derivatives(eo_img[:, 3], eo_img[:, 4], eo_img[:, 5])
+                dq_dangles = np.empty((d.shape[0], 3, 3))
+                for k in range(3):
+                    dq_dangles[:, :, k] = np.einsum("nij,nj->ni", dm_img[per_image, k], d)
             out["eo"] = np.concatenate([-dpx_dpoint, dpx_dq @ dq_dangles], axis=2)
 
     if "interior" in wanted:

@@ -25,17 +25,89 @@ Keys ``"description"`` and any key starting with ``"_"`` are ignored (comments);
 unknown key is an error, so that a misspelt key is never silently dropped. Values outside the
 physical ranges (a pixel of 0.5 um to 0.5 mm, a focal length of 1 mm to 5 m, at most 200000
 pixels a side, the principal point on the image) are refused: they are in another unit.
+``"sigmas"`` (an object of standard deviations by parameter name, e.g. ``{"focal_mm": 0.002,
+"k1": 1e-6}``, written by the bundle adjustment for its estimates) is informative and ignored
+on reading.
+
+Several cameras (a block flown with more than one) are one file ``{"cameras": [camera, ...]}``
+(:func:`read_cameras_json`, :func:`write_cameras_json`); each camera's ``name`` then tells
+them apart.
 """
 
 from __future__ import annotations
 
 import json
+import math
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Union
+from typing import Any, Union
 
 from ..errors import InputError
 from ..geometry.camera import Camera, camera_from_dict
 from .atomic import write_text_atomic
+
+
+def _load(path: Path) -> Any:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read camera file: {exc}", path=str(path)) from exc
+
+    def no_constants(token: str) -> float:
+        raise ValueError(f"{token} is not allowed")
+
+    try:
+        return json.loads(text, parse_constant=no_constants)
+    except json.JSONDecodeError as exc:
+        raise InputError(
+            f"invalid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}", path=str(path)
+        ) from exc
+    except ValueError as exc:
+        raise InputError(f"invalid JSON: {exc}", path=str(path)) from exc
+
+
+def read_cameras_json(path: Union[str, Path]) -> list[Camera]:
+    """Read a file with one camera, or several as ``{"cameras": [...]}`` (unique names)."""
+    path = Path(path)
+    data = _load(path)
+    if isinstance(data, Mapping) and "cameras" in data:
+        items = data["cameras"]
+        if not isinstance(items, list) or not items:
+            raise InputError("key 'cameras': must be a non-empty list", path=str(path))
+        cams = [
+            camera_from_dict(
+                {k: v for k, v in item.items() if k != "sigmas"} if isinstance(item, Mapping)
+                else item,
+                source=str(path), default_name=f"{path.stem}_{i + 1}",
+            )
+            for i, item in enumerate(items)
+        ]  # fmt: skip
+        names = [c.name for c in cams]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise InputError(f"two cameras are named {dup[0]!r}", path=str(path))
+        return cams
+    return [read_camera_json(path)]
+
+
+def write_cameras_json(
+    path: Union[str, Path],
+    cameras: Sequence[Camera],
+    sigmas: Sequence[Mapping[str, float]] | None = None,
+    extra: Mapping[str, Any] | None = None,
+) -> None:
+    """Write one camera (an object) or several (``{"cameras": [...]}``), each with its
+    ``"sigmas"`` when given, and ``extra`` informative keys (names starting with ``_``)."""
+    items = []
+    for k, cam in enumerate(cameras):
+        d = cam.to_dict()
+        if sigmas is not None and sigmas[k]:
+            d["sigmas"] = {n: float(v) for n, v in sigmas[k].items() if math.isfinite(v)}
+        items.append(d)
+    data: dict[str, Any] = items[0] if len(items) == 1 else {"cameras": items}
+    if extra:
+        data = {**data, **{k if k.startswith("_") else f"_{k}": v for k, v in extra.items()}}
+    write_text_atomic(path, json.dumps(data, indent=2, allow_nan=False) + "\n")
 
 
 def read_camera_json(path: Union[str, Path]) -> Camera:

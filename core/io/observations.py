@@ -22,8 +22,13 @@ type
     ``paper`` a point on plane ``target_id`` for the single-image model of Pedrosa & dos
               Santos (2020) (its Eqs. 12-17);
     ``check`` the LiDAR control point ``target_id`` used only as a check point (not adjusted).
+    Optional: without the column every row is ``tie``.
 target_id
-    Id of the plane, line or LCP in its table (integers in the project's tables).
+    Id of the plane, line or LCP in its table (integers in the project's tables). Optional
+    (empty) for the bundle adjustment, whose points are named by ``point_id`` alone.
+camera
+    Optional: the camera (its ``name`` in the camera JSON) of the row's image, for blocks
+    flown with several cameras.
 
 A row repeated (same image_id, point_id, type, target_id, col and row) is an error: it would
 count twice. Errors name the file, the row (the header is row 1) and the column. The
@@ -93,20 +98,27 @@ def read_observations_csv(
                 row=table.line_numbers[bad[0]],
                 column=table.columns[s_col],
             )
-    t_col = find_column(table, ("type", "kind", "control_type"))
-    kinds = tuple(v.strip().lower() for v in text_column(table, t_col))
-    for k, number in zip(kinds, table.line_numbers):
-        if k not in OBSERVATION_TYPES:
-            raise InputError(
-                f"'{k}' is not an observation type ({', '.join(OBSERVATION_TYPES)})",
-                path=table.path,
-                row=number,
-                column=table.columns[t_col],
-            )
-    g_col = find_column(table, ("target_id", "target", "plane_id", "line_id", "lcp_id"))
-    target = text_column(table, g_col)
-    # tie rows need their plane id; every other type needs its target too
-    # a row copied twice would count twice; the same point measured again (another pixel)
+    t_col = find_column(table, ("type", "kind", "control_type"), required=False)
+    if t_col is None:
+        kinds = ("tie",) * len(table)
+    else:
+        kinds = tuple(v.strip().lower() for v in text_column(table, t_col))
+        for k, number in zip(kinds, table.line_numbers):
+            if k not in OBSERVATION_TYPES:
+                raise InputError(
+                    f"'{k}' is not an observation type ({', '.join(OBSERVATION_TYPES)})",
+                    path=table.path,
+                    row=number,
+                    column=table.columns[t_col],
+                )
+    g_col = find_column(
+        table, ("target_id", "target", "plane_id", "line_id", "lcp_id"), required=False
+    )
+    target = ("",) * len(table) if g_col is None else text_column(table, g_col, nonempty=False)
+    cam_col = find_column(table, ("camera", "camera_id", "camera_name"), required=False)
+    cameras = () if cam_col is None else text_column(table, cam_col)
+    # tie rows need their plane id for the boresight calibration, which checks it.
+    # A row copied twice would count twice; the same point measured again (another pixel)
     # is a second measurement, as the picking dock records it
     first: dict[tuple[object, ...], int] = {}
     for key, number in zip(zip(image, point, kinds, target, col, row), table.line_numbers):
@@ -133,7 +145,10 @@ def read_observations_csv(
                     row=table.line_numbers[k],
                     column=table.columns[index],
                 )
-    return ImageObservations(image, point, np.column_stack([col, row]), sigma, kinds, target)
+    return ImageObservations(
+        image, point, np.column_stack([col, row]), sigma, kinds, target,
+        table.line_numbers, table.path, cameras,
+    )  # fmt: skip
 
 
 def observation_cells(

@@ -9,6 +9,15 @@ omega, phi, kappa: degrees, ``M = R3(kappa) R2(phi) R1(omega)`` rotates vectors 
 frame at the perspective centre (grid east, grid north, local up) into the camera frame.
 ``time`` may be empty (NaN) and ``group`` (flight line or direction) may be empty. Lines
 starting with ``#`` are comments (a calibration accepted despite failed checks says so there).
+
+Observed orientations (GNSS/INS, for the bundle adjustment) add their standard deviations,
+all six or none (the bundle adjustment writes them for its adjusted orientations too)::
+
+    sigma_X,sigma_Y,sigma_Z            metres (aliases sx, sy, sz)
+    sigma_omega_deg,sigma_phi_deg,sigma_kappa_deg    degrees (aliases s_omega_deg, ...)
+
+and an optional ``camera`` column names the camera of each image (blocks with several
+cameras). Tables without these columns are read as before.
 """
 
 from __future__ import annotations
@@ -16,16 +25,41 @@ from __future__ import annotations
 import csv
 import io
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Union
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..photo.orientation import ExteriorOrientationTable
 from .tables import find_column, float_column, read_table, text_column, unique_ids, write_csv_atomic
 
 EO_COLUMNS = ("image_id", "time", "group", "X", "Y", "Z", "omega_deg", "phi_deg", "kappa_deg")
+EO_SIGMA_COLUMNS = (
+    "sigma_X", "sigma_Y", "sigma_Z", "sigma_omega_deg", "sigma_phi_deg", "sigma_kappa_deg",
+)  # fmt: skip
+_SIGMA_ALIASES = (
+    ("sigma_x", "sx", "s_x"), ("sigma_y", "sy", "s_y"), ("sigma_z", "sz", "s_z"),
+    ("sigma_omega_deg", "s_omega_deg", "sigma_omega"), ("sigma_phi_deg", "s_phi_deg", "sigma_phi"),
+    ("sigma_kappa_deg", "s_kappa_deg", "sigma_kappa"),
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class EoFile:
+    """An EO table with what the bundle adjustment also reads from it.
+
+    ``sigma`` (M, 6): metres and radians, or None (approximate orientations only);
+    ``camera``: camera name per image, or None; ``rows``: the file rows of the images.
+    """
+
+    eo: ExteriorOrientationTable
+    sigma: NDArray[np.float64] | None
+    camera: tuple[str, ...] | None
+    rows: tuple[int, ...]
+    path: str
 
 
 def _eo_rows(eo: ExteriorOrientationTable) -> Iterator[tuple[str, ...]]:
@@ -89,3 +123,58 @@ def read_eo_csv(path: Union[str, Path], crs_wkt: str = "") -> ExteriorOrientatio
         row = table.line_numbers[int(np.argmax(np.abs(opk[:, 1]) > 90.0))]
         raise InputError("phi must lie within [-90, 90] degrees", path=table.path, row=row)
     return ExteriorOrientationTable(ids, time, group, xyz, np.radians(opk), crs_wkt)
+
+
+def read_eo_csv_full(path: Union[str, Path], crs_wkt: str = "") -> EoFile:
+    """Read the EO table with its optional sigma and camera columns (module docstring)."""
+    eo = read_eo_csv(path, crs_wkt)
+    table = read_table(path)
+    cols = [find_column(table, a, required=False) for a in _SIGMA_ALIASES]
+    sigma = None
+    given = [c for c in cols if c is not None]
+    if given and len(given) < 6:
+        missing = [EO_SIGMA_COLUMNS[k] for k, c in enumerate(cols) if c is None]
+        raise InputError(
+            f"EO sigma columns must be given all six or none; missing {', '.join(missing)}",
+            path=table.path,
+        )
+    if given:
+        values = np.column_stack([float_column(table, c, allow_empty=True) for c in cols])
+        empty = np.isnan(values)
+        if empty.all():
+            sigma = None
+        else:
+            bad = np.flatnonzero(empty.any(axis=1) | (values <= 0).any(axis=1))
+            if bad.size:
+                k = int(bad[0])
+                j = int(np.flatnonzero(empty[k] | (values[k] <= 0))[0])
+                raise InputError(
+                    "every sigma must be a number > 0 (or leave all of them empty)",
+                    path=table.path,
+                    row=table.line_numbers[k],
+                    column=table.columns[cols[j]],
+                )
+            sigma = values.copy()
+            sigma[:, 3:] = np.radians(sigma[:, 3:])
+    c_col = find_column(table, ("camera", "camera_id", "camera_name"), required=False)
+    camera = None if c_col is None else text_column(table, c_col)
+    return EoFile(eo, sigma, camera, table.line_numbers, table.path)
+
+
+def write_eo_csv_with_sigmas(
+    path: Union[str, Path],
+    eo: ExteriorOrientationTable,
+    sigma: NDArray[np.float64],
+    camera: tuple[str, ...] | None = None,
+) -> None:
+    """Write the EO table with its sigmas (M, 6: metres, radians) and optional cameras."""
+    sig = np.asarray(sigma, dtype=np.float64).copy()
+    sig[:, 3:] = np.degrees(sig[:, 3:])
+    cols = EO_COLUMNS + EO_SIGMA_COLUMNS + (("camera",) if camera is not None else ())
+
+    def rows() -> Iterator[tuple[str, ...]]:
+        for k, base in enumerate(_eo_rows(eo)):
+            s = tuple("" if not np.isfinite(v) else f"{v:.6g}" for v in sig[k])
+            yield base + s + ((camera[k],) if camera is not None else ())
+
+    write_csv_atomic(path, cols, rows())

@@ -4,6 +4,7 @@ and the command line are both made (docs/architecture.md, "Adding an algorithm")
 from . import (
     accuracy_report,
     boresight_calibration,
+    bundle_adjustment,
     create_lcps,
     extract_roof_planes,
     ground_filter,
@@ -22,6 +23,7 @@ ALGORITHMS = (
     extract_roof_planes,
     boresight_calibration,
     monoplot,
+    bundle_adjustment,
     orthorectify,
     orthomosaic,
 )

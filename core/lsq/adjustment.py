@@ -36,11 +36,16 @@ models), which is what the step acceptance compares.
 Each iteration computes the Gauss-Newton step; with ``damping`` it is kept only when it does
 not increase the cost, otherwise Levenberg-Marquardt steps ``(N_s + lambda I) z = -n_s``
 (Marquardt's scaling: ``lambda diag(N)`` in the original variables) are tried with growing
-``lambda``. With constraints the merit function is ``Omega + nu ||h||_1`` (an exact penalty,
-``nu`` above the multipliers). Convergence is declared when the Gauss-Newton step is below
-``tolerance`` in units of parameter precision, or at the rounding floor of parameters with large
-values (such as map coordinates): the relative change of the cost is below ``tolerance``, the
-step is below ``sqrt(tolerance)`` and has stopped shrinking (more than half the previous one).
+``lambda`` (doubling factors after each rejection). The next iteration starts from the
+``lambda`` that worked, reduced by Nielsen's (1999) rule from the gain ratio (by ten when the
+quadratic model predicted the decrease well), and Gauss-Newton is tried again once it falls
+below 1e-7 (lowered a hundredfold after each rejected Gauss-Newton step, so that nearly
+singular directions keep a little damping). With constraints the merit function is
+``Omega + nu ||h||_1`` (an exact penalty, ``nu`` above the multipliers). Convergence is
+declared when the Gauss-Newton step is below ``tolerance`` in units of parameter precision,
+or at the rounding floor of parameters with large values (such as map coordinates): the
+relative change of the cost is below ``tolerance``, the step is below ``sqrt(tolerance)`` and
+has stopped shrinking (more than half the previous one).
 
 Observability: before trusting a solve, the Jacobi-scaled ``N + C'C`` (``C`` the constraint rows
 normalised in the scaled space) is checked with a dense symmetric eigen-decomposition (up to a
@@ -57,8 +62,30 @@ is the two-sided chi-square test of ``Omega / sigma0_prior^2`` with ``r`` degree
 For every group ``Qvv = S B' Pe (Pe^-1 - A Qxx A') Pe B S`` (only the ``k x k`` blocks of ``Qxx``
 at the parameter indices of the group are needed), redundancy numbers ``diag(Qvv S^-1)`` and
 Baarda's standardised residuals ``w_i = (S^-1 v)_i / (sigma0_prior sqrt((S^-1 Qvv S^-1)_ii))``.
-Outliers are flagged by Baarda's data snooping with iterative rejection of whole groups (the
-only outlier method of this module; no robust estimator).
+Outliers are flagged by Baarda's data snooping with iterative rejection of whole groups,
+optionally preceded by a robust estimator (below).
+
+Eliminated blocks
+-----------------
+With :attr:`AdjustmentOptions.eliminate` the normal equations are assembled and solved in
+reduced form (:mod:`.schur`): the named blocks (object points) are eliminated by the Schur
+complement, damping, constraints (also on eliminated parameters), the observability analysis
+(of every eliminated block, then of the reduced system ``S + C~'C~``, whose null space is that
+of the full system projected on the reduced parameters) and the statistics are the same as
+above; ``Qxx`` is formed in blocks (reduced parameters in full, each eliminated block, and the
+cross blocks each group needs for its standardised residuals).
+
+Robust estimation
+-----------------
+With :attr:`AdjustmentOptions.robust` the adjustment first runs as iteratively reweighted
+least squares (Huber 1964; the Cauchy weight function): each group gets the weight
+``psi(u)/u`` of its standardised misfit ``u = |w_g| / sqrt(c) / s`` (``w_g`` the whitened
+misclosure, ``s`` the robust scale: the median of ``u`` over the observation groups divided by
+its expected value, but at least 1, the a-priori unit weight that data snooping also uses),
+until the weights settle. Groups with ``u`` above the critical value of
+data snooping at the robust solution are then set aside (reported as rejected in round 0),
+and the ordinary adjustment, with its statistics and data snooping, runs on the rest from the
+robust estimate, so that several gross errors cannot mask one another.
 
 Sigmas define the weights ``P = S^-1``; ``sigma0_prior`` is the a-priori standard deviation of
 unit weight, so ``Omega / sigma0_prior^2`` is chi-square distributed when the sigmas are right.
@@ -68,7 +95,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable, Union
 
 import numpy as np
@@ -93,6 +120,7 @@ from .model import (
     _PriorModel,
 )
 from .results import AdjustmentResult, ChiSquareTest, RejectedObservation, ResidualTable
+from .schur import EliminationPlan, ReducedNormal, SingularSystem, build_reduced_normal
 
 __all__ = ["adjust"]
 
@@ -118,6 +146,10 @@ _REDUNDANCY_EPS = 1e-9
 _QXX_CHUNK = 512
 # Largest lambda of Levenberg-Marquardt before the cost is declared irreducible.
 _LAMBDA_MAX = 1e12
+# First lambda after a rejected Gauss-Newton step, and the smallest kept before returning to
+# Gauss-Newton (in the Jacobi-scaled space, where the diagonal of N is one).
+_LAMBDA_START = 1e-3
+_LAMBDA_MIN = 1e-7
 # Maximum number of names quoted in an error message (the full list is on the exception).
 _MAX_NAMES_IN_MESSAGE = 30
 
@@ -134,8 +166,12 @@ class _NonFiniteError(Exception):
         self.label = label
 
 
-class _SingularError(Exception):
-    """A factorisation failed or gave non-finite numbers (leads to the observability analysis)."""
+# A factorisation failed or gave non-finite numbers (leads to the observability analysis).
+_SingularError = SingularSystem
+# Groups per chunk when the standardised residuals are computed (bounds the k x k cofactor
+# blocks held at once).
+_RESIDUAL_CHUNK = 20000
+_ROBUST_K = {"huber": 1.5, "cauchy": 2.385}
 
 
 @dataclass
@@ -315,11 +351,15 @@ class _Problem:
         names: list[str],
         blocks: list[_Obs],
         constraints: list[_Con],
+        plan: EliminationPlan | None = None,
     ) -> None:
         self.names = names
         self.n = len(names)
         self.blocks = blocks
         self.constraints = constraints
+        self.plan = plan
+        # Robust (IRLS) weights of the groups of each block, or None.
+        self.weights: list[Array] | None = None
         self._row_template: tuple[NDArray[np.intp], NDArray[np.intp], int] | None = None
         self._con_template: tuple[NDArray[np.intp], NDArray[np.intp], int] | None = None
 
@@ -397,6 +437,12 @@ class _Problem:
     def linearize(self, x: Array, vhat: list[Array], active: list[NDArray[np.bool_]]) -> _Lin:
         """Evaluate every block and constraint at ``x`` (raises _NonFiniteError)."""
         lins = [self._eval_block(b, x, v) for b, v in zip(self.blocks, vhat)]
+        if self.weights is not None:
+            for bl, wt in zip(lins, self.weights):
+                s = np.sqrt(wt)
+                bl.abar = bl.abar * s[:, None, None]
+                bl.wbar = bl.wbar * s[:, None]
+                bl.K = bl.K / s[:, None, None]
         hs, Hs = [], []
         for c in self.constraints:
             h, H = self._eval_constraint(c, x)
@@ -469,6 +515,16 @@ class _Problem:
         rowscale: Array | None,
     ) -> tuple[_Normal, Array | None]:
         """Jacobi-scaled normal equations; returns the constraint row scale it used."""
+        if self.plan is not None:
+            return build_reduced_normal(
+                self.plan,
+                self.blocks,
+                lin.blocks,
+                active,
+                self.constraint_matrix(lin),
+                lin.h,
+                rowscale,
+            )
         A, wbar = self.design(lin, active)
         N = (A.T @ A).tocsr()
         diag = N.diagonal()
@@ -510,6 +566,8 @@ def _solve(nrm: _Normal, lam: float, use_sparse: bool) -> tuple[Array, Array]:
     Solves ``(N_s + lam I) z + C_s' k = -n_s``, ``C_s z = -h_s``. Raises _SingularError when a
     factorisation fails or gives non-finite numbers.
     """
+    if isinstance(nrm, ReducedNormal):
+        return nrm.solve(lam)
     n = nrm.ns.size
     if use_sparse:
         Nl = (nrm.Ns + lam * sp.identity(n, format="csr")).tocsc()
@@ -658,6 +716,8 @@ def _check_observability(
     nrm: _Normal, names: list[str], limit: float, constraint_names: Sequence[str] = ()
 ) -> float:
     """Condition number of the Jacobi-scaled ``N + C'C``; raises NotObservableError."""
+    if isinstance(nrm, ReducedNormal):
+        return _check_reduced(nrm, names, limit, constraint_names)
     n = nrm.ns.size
     Ms = nrm.Ns
     if nrm.Cs is not None:
@@ -708,6 +768,36 @@ def _check_observability(
         parameters=unseen,
         condition_number=cond,
     )
+
+
+def _check_reduced(
+    red: ReducedNormal, names: list[str], limit: float, constraint_names: Sequence[str]
+) -> float:
+    """Observability of a reduced system: each eliminated block, then ``S + C~'C~``."""
+    plan = red.plan
+    cond_p = red.point_conditions()
+    bad = np.flatnonzero(~(cond_p <= limit))
+    if bad.size:
+        who = [names[i] for i in plan.elim[bad].ravel()]
+        worst = float(np.max(cond_p[bad]))
+        raise NotObservableError(
+            f"Not observable: the observations do not determine {_join_names(who)} "
+            f"({bad.size} eliminated block(s), condition number up to {worst:.3g} > limit "
+            f"{limit:.3g}); each of them needs observations that fix it on their own (an "
+            "object point needs rays from two or more images that intersect at an angle)",
+            parameters=who,
+            condition_number=worst,
+        )
+    try:
+        S, Ct = red.observability_parts()
+    except SingularSystem:
+        raise NotObservableError(
+            "Not observable: the eliminated blocks are singular", parameters=[]
+        ) from None
+    sub = _Normal(A=None, d=red.d[plan.reduced], Ns=S, ns=red.g_r, Cs=Ct, hs=red.hs)
+    rnames = [names[i] for i in plan.reduced]
+    cond = _check_observability(sub, rnames, limit, constraint_names)
+    return max(cond, float(np.max(cond_p)) if cond_p.size else 1.0)
 
 
 # ----------------------------------------------------------------------------- iteration
@@ -778,6 +868,12 @@ def _run(
     use_sparse: bool | None = opts.sparse
     tol = opts.tolerance
     lam_memory = 0.0
+    lam_good = _LAMBDA_START  # the last positive damping that reduced the cost
+    nu_lm = 2.0  # growth factor of the damping after rejected steps (Nielsen 1999)
+    # Damping below which Gauss-Newton is tried again; lowered after each rejected
+    # Gauss-Newton step (nearly singular directions, e.g. points far away, need a little
+    # damping all the way).
+    lam_floor = _LAMBDA_MIN
     nu = 0.0
     prev_step = math.inf
     converged = False
@@ -788,24 +884,36 @@ def _run(
         stop_if_asked(should_stop, "adjusting")
         progress((it - 1) / opts.max_iterations)
         nrm, rowscale = problem.normal(lin, active, rowscale)
-        if use_sparse is None:
+        if isinstance(nrm, ReducedNormal):
+            use_sparse = nrm.use_sparse
+        elif use_sparse is None:
             n = problem.n
             use_sparse = n > _SPARSE_AUTO_MIN_N and nrm.Ns.nnz <= _SPARSE_AUTO_MAX_DENSITY * n * n
         if it == 1:
             _check_observability(
                 nrm, problem.names, opts.condition_limit, problem.constraint_labels()
             )
-        try:
-            z, k = _solve(nrm, 0.0, use_sparse)
-        except _SingularError:
-            _check_observability(
-                nrm, problem.names, opts.condition_limit, problem.constraint_labels()
-            )
-            raise AdjustmentError("the normal equations could not be solved") from None
-        step = float(np.abs(z).max()) if z.size else 0.0
-        if k.size:
-            # Exact-penalty weight above the Lagrange multipliers of min ||.||^2 (= 2 k).
-            nu = max(nu, 2.5 * float(np.abs(k).max()))
+        def gauss_newton(nrm=nrm, use_sparse=use_sparse) -> tuple[Array, Array]:
+            try:
+                return _solve(nrm, 0.0, use_sparse)
+            except _SingularError:
+                _check_observability(
+                    nrm, problem.names, opts.condition_limit, problem.constraint_labels()
+                )
+                raise AdjustmentError("the normal equations could not be solved") from None
+
+        # While damping is still needed the Gauss-Newton step is not solved for (it would be
+        # rejected); it is solved again once the damping has shrunk back to zero, or when no
+        # damped step reduces the cost (to tell convergence from a stall).
+        if opts.damping and lam_memory > 0:
+            z = None
+            step = math.inf
+        else:
+            z, k = gauss_newton()
+            step = float(np.abs(z).max()) if z.size else 0.0
+            if k.size:
+                # Exact-penalty weight above the Lagrange multipliers of min ||.||^2 (= 2 k).
+                nu = max(nu, 2.5 * float(np.abs(k).max()))
         if step <= tol:
             x, vhat = _apply(problem, lin, nrm, z)
             try:
@@ -825,7 +933,11 @@ def _run(
                 ) from None
         else:
             new = None
-            lam = 0.0
+            # Start from the damping that last worked (0: Gauss-Newton): in a long curved
+            # valley (e.g. focal length against flying height) the accepted damping then
+            # shrinks by ten per step and the steps grow back to Gauss-Newton, instead of
+            # crawling at the smallest damping after every rejected Gauss-Newton step.
+            lam = lam_memory
             while True:
                 if lam > 0:
                     try:
@@ -841,13 +953,37 @@ def _run(
                     except _NonFiniteError:
                         cand = None
                     # Ties at rounding level are accepted: the cost cannot go lower.
-                    if cand is not None and _merit(cand, rowscale, nu) <= m_old * (1 + 1e-13):
+                    m_try = _merit(cand, rowscale, nu) if cand is not None else math.inf
+                    if m_try <= m_old * (1 + 1e-13):
                         new = cand
-                        lam_memory = lam / 10.0 if lam > 0 else lam_memory / 10.0
+                        factor = 0.1
+                        if lam > 0:
+                            lam_good = lam
+                            # Nielsen's update from the gain ratio: the damping shrinks
+                            # little when the quadratic model predicted the decrease badly
+                            pred = lam * float(z_try @ z_try) - float(nrm.ns @ z_try)
+                            if pred > 0:
+                                rho = (m_old - m_try) / pred
+                                if rho < 0.9:
+                                    factor = max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
+                        nu_lm = 2.0
+                        lam_memory = lam * factor if lam * factor >= lam_floor else 0.0
+                        if lam > 0 and float(np.abs(z_try).max(initial=0.0)) <= math.sqrt(tol):
+                            # near the optimum: let the Gauss-Newton step test convergence
+                            lam_memory = 0.0
                         break
-                lam = max(lam_memory, 1e-3) if lam == 0 else lam * 10.0
+                # after a rejected Gauss-Newton step go back to the damping that last worked
+                if lam == 0:
+                    lam = lam_good
+                    lam_floor = max(lam_floor * 1e-2, 1e-14)
+                else:
+                    lam *= nu_lm
+                    nu_lm *= 2.0
                 if lam > _LAMBDA_MAX:
                     break
+            if new is None and z is None:
+                z, k = gauss_newton()
+                step = float(np.abs(z).max()) if z.size else 0.0
             if new is None:
                 if step <= math.sqrt(tol):
                     converged = True
@@ -885,34 +1021,35 @@ def _residual_tables(
     problem: _Problem,
     lin: _Lin,
     active: list[NDArray[np.bool_]],
-    Q: Array | None,
+    qgg: Callable[[int, NDArray[np.intp]], Array] | None,
     sigma0_prior: float,
 ) -> dict[str, ResidualTable]:
+    """Residuals and their tests; ``qgg(block, groups)`` gives the groups' Qxx blocks."""
     tables: dict[str, ResidualTable] = {}
-    for b, bl, a in zip(problem.blocks, lin.blocks, active):
+    for bi, (b, bl, a) in enumerate(zip(problem.blocks, lin.blocks, active)):
         g, o = b.groups, b.o
         # Zero-step residuals: for Gauss-Markov f(x) - l, for Gauss-Helmert the v that
         # satisfies the conditions linearised at the final point.
         v = -np.einsum("goc,gc->go", bl.K, bl.wbar)
         w = np.full((g, o), np.nan)
         red = np.full((g, o), np.nan)
-        if Q is not None and g:
-            idx = b.param_index
-            Qgg = Q[idx[:, :, None], idx[:, None, :]]
-            S = bl.abar @ Qgg @ np.swapaxes(bl.abar, 1, 2)
+        for lo in range(0, g if qgg is not None else 0, _RESIDUAL_CHUNK):
+            sel = np.arange(lo, min(g, lo + _RESIDUAL_CHUNK))
+            ab, K, ac = bl.abar[sel], bl.K[sel], a[sel]
+            S = ab @ qgg(bi, sel) @ np.swapaxes(ab, 1, 2)
             eye = np.eye(S.shape[1])
             # Kept groups: Q_ww = Pe^-1 - A Qxx A'; rejected: prediction, Pe^-1 + A Qxx A'.
-            inner = np.where(a[:, None, None], eye - S, eye + S)
-            Qvv = bl.K @ inner @ np.swapaxes(bl.K, 1, 2)
-            P = b.weight
+            inner = np.where(ac[:, None, None], eye - S, eye + S)
+            Qvv = K @ inner @ np.swapaxes(K, 1, 2)
+            P = b.weight[sel]
             r = np.einsum("gij,gji->gi", Qvv, P)
             pqp = np.einsum("gij,gjk,gki->gi", P, Qvv, P)
-            Pv = np.einsum("gij,gj->gi", P, v)
+            Pv = np.einsum("gij,gj->gi", P, v[sel])
             with np.errstate(invalid="ignore", divide="ignore"):
-                w = Pv / (sigma0_prior * np.sqrt(np.where(pqp > 0, pqp, np.nan)))
-            untestable = a[:, None] & (r < _REDUNDANCY_EPS)
-            w = np.where(untestable, np.nan, w)
-            red = np.where(a[:, None], r, np.nan)
+                ws = Pv / (sigma0_prior * np.sqrt(np.where(pqp > 0, pqp, np.nan)))
+            untestable = ac[:, None] & (r < _REDUNDANCY_EPS)
+            w[sel] = np.where(untestable, np.nan, ws)
+            red[sel] = np.where(ac[:, None], r, np.nan)
         tables[b.name] = ResidualTable(
             labels=list(b.labels),
             row_names=list(b.row_names),
@@ -949,12 +1086,27 @@ def _finish(
     )
     n = problem.n
     Q = None
-    if want_cov:
+    blocks = None
+    qd = None
+    qgg = None
+    if want_cov and isinstance(nrm, ReducedNormal):
+        try:
+            blocks = nrm.cofactor()
+        except (np.linalg.LinAlgError, RuntimeError, _SingularError):
+            raise AdjustmentError("the cofactor matrix could not be computed") from None
+        qd = np.clip(blocks.diagonal(), 0.0, None)
+        qgg = blocks.group_blocks
+    elif want_cov:
         try:
             Qs = _scaled_cofactor(nrm, run.use_sparse)
         except (np.linalg.LinAlgError, RuntimeError, _SingularError):
             raise AdjustmentError("the cofactor matrix could not be computed") from None
         Q = Qs / np.outer(nrm.d, nrm.d)
+        qd = np.clip(np.diag(Q), 0.0, None)
+
+        def qgg(bi: int, sel: NDArray[np.intp], Q: Array = Q) -> Array:
+            idx = problem.blocks[bi].param_index[sel]
+            return Q[idx[:, :, None], idx[:, None, :]]
     omega = run.lin.phi
     mc = problem.constraint_rows()
     m = problem.rows(active)
@@ -967,12 +1119,12 @@ def _finish(
     cov = cov_prior = corr = None
     std = np.full(n, np.nan)
     std_prior = np.full(n, np.nan)
-    if Q is not None:
-        qd = np.clip(np.diag(Q), 0.0, None)
-        cov_prior = s0p**2 * Q
-        cov = sigma0**2 * Q if r > 0 else np.full_like(Q, np.nan)
+    if qd is not None:
         std_prior = s0p * np.sqrt(qd)
         std = sigma0 * np.sqrt(qd) if r > 0 else np.full(n, np.nan)
+    if Q is not None:
+        cov_prior = s0p**2 * Q
+        cov = sigma0**2 * Q if r > 0 else np.full_like(Q, np.nan)
         sq = np.sqrt(qd)
         with np.errstate(invalid="ignore", divide="ignore"):
             # Parameters fixed exactly by constraints have no correlation (NaN).
@@ -981,7 +1133,7 @@ def _finish(
         corr[tiny, :] = np.nan
         corr[:, tiny] = np.nan
         corr = np.clip(corr, -1.0, 1.0)
-    residuals = _residual_tables(problem, run.lin, active, Q, s0p)
+    residuals = _residual_tables(problem, run.lin, active, qgg, s0p)
     return AdjustmentResult(
         x=run.lin.x.copy(),
         names=list(problem.names),
@@ -1004,13 +1156,19 @@ def _finish(
         solver="sparse" if run.use_sparse else "dense",
         n_observations=int(m),
         n_constraints=int(mc),
+        cofactor_blocks=blocks,
     )
 
 
-def _worst(result: AdjustmentResult) -> tuple[int, int, int, float] | None:
-    """(block number, group, row, w) of the largest |w| among the groups kept."""
+def _worst(
+    result: AdjustmentResult, blocks: Sequence[str] | None = None
+) -> tuple[int, int, int, float] | None:
+    """(block number, group, row, w) of the largest |w| among the groups kept (of the named
+    blocks only, when given)."""
     best = None
-    for bi, table in enumerate(result.residuals.values()):
+    for bi, (name, table) in enumerate(result.residuals.items()):
+        if blocks is not None and name not in blocks:
+            continue
         w = np.where(table.rejected[:, None], np.nan, np.abs(table.w))
         if w.size == 0 or not np.isfinite(w).any():
             continue
@@ -1019,6 +1177,113 @@ def _worst(result: AdjustmentResult) -> tuple[int, int, int, float] | None:
         if best is None or w[g, i] > best[3]:
             best = (bi, int(g), int(i), float(w[g, i]))
     return best
+
+
+def _cascade(
+    problem: _Problem, active: list[NDArray[np.bool_]]
+) -> tuple[list[NDArray[np.bool_]], list[tuple[int, int]]]:
+    """With eliminated blocks: an eliminated block (an object point) left with fewer rows
+    than parameters by the groups set aside cannot be determined; its remaining groups are set
+    aside with it (a tie point of two rays goes when one ray is rejected). Returns the new
+    active masks and the (block, group) pairs this added."""
+    plan = problem.plan
+    if plan is None:
+        return active, []
+    rows = plan.rows_per_block([b.c for b in problem.blocks], active)
+    seen = plan.rows_per_block([b.c for b in problem.blocks], None)
+    dead = (rows < plan.b) & (seen > 0)
+    if not dead.any():
+        return active, []
+    out, gone = [], []
+    for bi, (a, bp) in enumerate(zip(active, plan.plans)):
+        hit = a & (bp.point >= 0) & dead[np.maximum(bp.point, 0)]
+        gone += [(bi, int(g)) for g in np.flatnonzero(hit)]
+        out.append(a & ~hit)
+    return out, gone
+
+
+def _robust(
+    problem: _Problem,
+    x: Array,
+    vhat: list[Array],
+    active: list[NDArray[np.bool_]],
+    opts: AdjustmentOptions,
+    crit: float,
+    reporter: _Progress,
+    should_stop: Callable[[], bool] | None,
+) -> tuple[Array, list[Array], list[NDArray[np.bool_]], dict]:
+    """Iteratively reweighted least squares (see the module docstring).
+
+    Returns the robust estimate, its residual estimates, the groups flagged (standardised
+    misfit above ``crit``) and a summary (tuning constant, rounds, scale, misfits per row).
+    """
+    k = opts.robust_k if opts.robust_k is not None else _ROBUST_K[opts.robust]
+    if not k > 0:
+        raise InputError(f"robust_k must be > 0, got {k}")
+    blocks = problem.blocks
+    weights = [np.ones(b.groups) for b in blocks]
+    if opts.robust_blocks is None:
+        chosen = list(range(len(blocks)))
+    else:
+        known = [b.name for b in blocks]
+        unknown = sorted(set(opts.robust_blocks) - set(known))
+        if unknown:
+            raise InputError(f"robust_blocks: unknown block(s) {', '.join(unknown)}")
+        chosen = [i for i, b in enumerate(blocks) if b.name in opts.robust_blocks]
+    # Scale from the observation blocks proper (a-priori parameter values have tiny misfits
+    # that would drag the median down); all chosen blocks when there are no others.
+    scale_blocks = [i for i in chosen if not isinstance(blocks[i].func, _PriorModel)]
+    if not scale_blocks:
+        scale_blocks = chosen
+    rounds = 0
+    scale = 1.0
+    u_rows: list[Array] = []
+    try:
+        for rounds in range(1, opts.robust_iterations + 1):
+            problem.weights = weights
+            # The first round converges from the approximate values; later rounds start at
+            # the previous estimate and take a few steps each (the weights and the estimate
+            # converge together).
+            short = replace(opts, max_iterations=min(4, opts.max_iterations))
+            inner = opts if rounds == 1 else short
+            run = _run(problem, x, vhat, active, inner, reporter, should_stop,
+                       initial=rounds == 1)  # fmt: skip
+            x, vhat = run.lin.x, run.lin.vhat
+            # Unweighted whitened misclosures at the estimate (the linearisation holds them
+            # multiplied by sqrt(weight)).
+            u_rows = [bl.wbar / np.sqrt(w)[:, None] for bl, w in zip(run.lin.blocks, weights)]
+            u = [np.sqrt(np.sum(r * r, axis=1) / r.shape[1]) for r in u_rows]
+            ref = [math.sqrt(stats.chi2.ppf(0.5, b.c) / b.c) for b in blocks]
+            pool = np.concatenate(
+                [u[i][active[i]] / ref[i] for i in scale_blocks] or [np.zeros(0)]
+            )
+            scale = float(np.median(pool)) if pool.size else 1.0
+            # never below the a-priori unit weight: measurements that fit as well as their
+            # stated sigmas (or better, when those are pessimistic) are not outliers, the same
+            # reference as data snooping's
+            scale = max(scale, 1.0) if np.isfinite(scale) else 1.0
+            new = []
+            for i, ui in enumerate(u):
+                t = ui / (k * scale)
+                if i not in chosen:
+                    new.append(np.ones_like(ui))
+                elif opts.robust == "huber":
+                    new.append(np.where(t <= 1.0, 1.0, 1.0 / np.where(t > 0, t, 1.0)))
+                else:
+                    new.append(1.0 / (1.0 + t * t))
+            change = max((float(np.max(np.abs(a - b))) for a, b in zip(new, weights) if a.size),
+                         default=0.0)  # fmt: skip
+            weights = new
+            if change < 1e-2:
+                break
+    finally:
+        problem.weights = None
+    flagged = [
+        a & (np.sqrt(np.sum(r * r, axis=1) / r.shape[1]) / scale > crit) & (i in chosen)
+        for i, (r, a) in enumerate(zip(u_rows, active))
+    ]
+    u_std = [r / scale for r in u_rows]
+    return x, vhat, flagged, {"k": k, "rounds": rounds, "scale": scale, "u": u_std}
 
 
 # ----------------------------------------------------------------------------- entry point
@@ -1096,31 +1361,77 @@ def adjust(
         idx = _as_index(c.param_index, n, where)
         labels = _labels(c.labels, idx.shape[0], lambda i, nm=c.name: f"{nm}[{i}]", where, "labels")
         cons.append(_Con(c.name, idx, c.function, labels, None))
-    problem = _Problem(name_list, obs, cons)
+    plan = None
+    if opts.eliminate is not None:
+        plan = EliminationPlan(n, opts.eliminate, obs, [c.param_index for c in cons])
+    problem = _Problem(name_list, obs, cons, plan)
+    if opts.robust not in ("none", *_ROBUST_K):
+        raise InputError(f"robust must be none, huber or cauchy, got {opts.robust!r}")
 
     reporter = _Progress(progress)
     want_cov = opts.compute_covariance or opts.snooping
     active = [np.ones(b.groups, dtype=bool) for b in obs]
     vhat = [np.zeros((b.groups, b.o)) for b in obs]
+    crit = float(stats.norm.ppf(1 - opts.snooping_alpha / 2))
+    rejected: list[RejectedObservation] = []
+    extra_warnings: list[str] = []
+    robust_text = ""
+    initial = True
+    if opts.robust != "none":
+        reporter.span(0.0, 0.3)
+        x, vhat, flagged, rob = _robust(problem, x, vhat, active, opts, crit, reporter,
+                                        should_stop)  # fmt: skip
+        initial = False
+        robust_text = (
+            f"{opts.robust.capitalize()} reweighting (k = {rob['k']:g} robust scale units, "
+            f"{rob['rounds']} rounds, robust scale {rob['scale']:.3g}), groups with a "
+            f"standardised misfit above {crit:.2f} set aside"
+        )
+        trial = [a & ~f for a, f in zip(active, flagged)]
+        trial, gone = _cascade(problem, trial)
+        try:
+            _run(problem, x, vhat, trial, opts, reporter, should_stop, initial=False)
+            ok = True
+        except NotObservableError:
+            ok = False
+            extra_warnings.append(
+                f"robust estimation: setting aside the {int(sum(f.sum() for f in flagged))} "
+                "groups it flagged would leave the adjustment not observable; they are kept"
+            )
+        if ok:
+            for bj, gj in gone:
+                flagged[bj][gj] = True
+            for bi, f in enumerate(flagged):
+                for g in np.flatnonzero(f):
+                    u = rob["u"][bi][g]
+                    rejected.append(
+                        RejectedObservation(obs[bi].name, obs[bi].labels[g],
+                                            obs[bi].row_names[int(np.argmax(np.abs(u)))],
+                                            float(u[int(np.argmax(np.abs(u)))]), 0)
+                    )  # fmt: skip
+            active = trial
     if opts.snooping:
-        reporter.span(0.0, 0.5)
-    run = _run(problem, x, vhat, active, opts, reporter, should_stop, initial=True)
+        reporter.span(0.3 if opts.robust != "none" else 0.0, 0.5)
+    elif opts.robust != "none":
+        reporter.span(0.3, 1.0)
+    run = _run(problem, x, vhat, active, opts, reporter, should_stop, initial=initial)
     result = _finish(problem, run, active, opts, want_cov)
     if not opts.snooping:
-        result.outlier_method = "none (data snooping disabled)"
+        result.outlier_method = (
+            robust_text + "; no data snooping" if robust_text else "none (data snooping disabled)"
+        )
+        result.rejected = rejected
+        result.warnings.extend(extra_warnings)
         reporter.span(0.0, 1.0)
         reporter(1.0)
         return result
 
-    crit = float(stats.norm.ppf(1 - opts.snooping_alpha / 2))
-    rejected: list[RejectedObservation] = []
-    extra_warnings: list[str] = []
     if not result.converged:
         extra_warnings.append("data snooping skipped: the adjustment did not converge")
     else:
         round_no = 0
         while True:
-            worst = _worst(result)
+            worst = _worst(result, opts.snooping_blocks)
             if worst is None or worst[3] <= crit:
                 break
             if len(rejected) >= opts.max_rejections:
@@ -1136,6 +1447,7 @@ def adjust(
             reporter.span(lo, lo + 0.5 ** (round_no + 1))
             trial = [a.copy() for a in active]
             trial[bi][g] = False
+            trial, gone = _cascade(problem, trial)
             try:
                 new_run = _run(
                     problem,
@@ -1164,6 +1476,11 @@ def adjust(
             rejected.append(
                 RejectedObservation(b.name, b.labels[g], b.row_names[i], signed, round_no)
             )
+            for bj, gj in gone:
+                lab = obs[bj].labels[gj]
+                rejected.append(
+                    RejectedObservation(obs[bj].name, lab, "(with its point)", math.nan, round_no)
+                )
             active, run, result = trial, new_run, new_result
         untested = sum(
             int((np.isnan(t.w) & ~t.rejected[:, None]).sum()) for t in result.residuals.values()
@@ -1177,6 +1494,8 @@ def adjust(
         f"Baarda data snooping (alpha = {opts.snooping_alpha:g} per observation, critical "
         f"|w| = {crit:.2f}, iterative rejection of whole groups)"
     )
+    if robust_text:
+        result.outlier_method = robust_text + ", then " + result.outlier_method
     result.rejected = rejected
     result.warnings.extend(extra_warnings)
     reporter.span(0.0, 1.0)

@@ -187,6 +187,30 @@ class AdjustmentOptions:
     compute_covariance : bool
         Compute ``Qxx`` and everything derived from it (standard deviations, correlations,
         standardised residuals). Forced on when ``snooping`` is True.
+    eliminate : array_like of int, shape (P, b), optional
+        Parameter indices of ``P`` small independent blocks (e.g. the object points of a
+        bundle adjustment, ``b = 3``) eliminated from the normal equations by the Schur
+        complement (:mod:`.schur`): the solver factorises the reduced system of the other
+        parameters only. Each observation group may depend on at most one block. The
+        estimates are those of the full system; ``Qxx`` is returned in blocks
+        (:attr:`AdjustmentResult.cofactor_blocks`) instead of as one matrix.
+    robust : {"none", "huber", "cauchy"}
+        Iteratively reweighted least squares with Huber's or the Cauchy weight function
+        before the final least-squares run: groups whose standardised misfit at the robust
+        solution exceeds the critical value of data snooping are set aside, then the
+        adjustment (and data snooping, when on) runs on the rest.
+    robust_k : float or None
+        Tuning constant of the weight function in units of the robust scale of the
+        whitened residuals (None: 1.5 for Huber, 2.385 for Cauchy).
+    robust_iterations : int
+        Maximum number of reweighting rounds.
+    robust_blocks : sequence of str or None
+        Names of the blocks that are reweighted (and set aside when flagged); None: every
+        block. Typically the measurements, not the control whose misfits mostly reflect an
+        imperfect model.
+    snooping_blocks : sequence of str or None
+        Names of the blocks whose groups data snooping may reject; None: every block. The
+        others are tested (their w is reported) but never removed.
     """
 
     max_iterations: int = 50
@@ -200,3 +224,9 @@ class AdjustmentOptions:
     max_rejections: int = 50
     condition_limit: float = 1e12
     compute_covariance: bool = True
+    eliminate: ArrayLike | None = None
+    robust: str = "none"
+    robust_k: float | None = None
+    robust_iterations: int = 20
+    robust_blocks: Sequence[str] | None = None
+    snooping_blocks: Sequence[str] | None = None

@@ -6,7 +6,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
+
+from .schur import BlockCofactor
 
 Array = NDArray[np.float64]
 
@@ -131,6 +133,10 @@ class AdjustmentResult:
         Hard constraint rows.
     outlier_method : str
         How outliers were flagged.
+    cofactor_blocks : BlockCofactor or None
+        ``Qxx`` in blocks when parameter blocks were eliminated
+        (:attr:`AdjustmentOptions.eliminate`); ``cofactor``, ``covariance`` and
+        ``correlation`` are then None (use :meth:`covariance_of`).
     """
 
     x: Array
@@ -156,6 +162,26 @@ class AdjustmentResult:
     n_observations: int = 0
     n_constraints: int = 0
     outlier_method: str = "none"
+    cofactor_blocks: BlockCofactor | None = None
+
+    def covariance_of(self, index: ArrayLike, prior: bool = False) -> Array:
+        """Covariance matrix (k, k) of the parameters ``index`` (a posteriori sigma0, or the
+        a-priori one with ``prior``); with eliminated blocks, the parameters must all be
+        reduced ones or all belong to one block."""
+        idx = np.asarray(index, dtype=np.intp).ravel()
+        s2 = self.sigma0_prior**2 if prior else self.sigma0**2
+        if self.cofactor is not None:
+            return s2 * self.cofactor[np.ix_(idx, idx)]
+        if self.cofactor_blocks is not None:
+            return s2 * self.cofactor_blocks.block(idx)
+        return np.full((idx.size, idx.size), np.nan)
+
+    def correlation_of(self, index: ArrayLike) -> Array:
+        """Correlation matrix (k, k) of the parameters ``index`` (see :meth:`covariance_of`)."""
+        q = self.covariance_of(index, prior=True)
+        s = np.sqrt(np.clip(np.diag(q), 0.0, None))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.clip(q / np.outer(s, s), -1.0, 1.0)
 
     def parameter(self, name: str) -> tuple[float, float]:
         """Return ``(value, std)`` of the parameter called ``name`` (KeyError if unknown)."""

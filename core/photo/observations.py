@@ -33,6 +33,12 @@ class ImageObservations:
         (col, row) in pixels.
     sigma_px : ndarray, shape (N,)
         Standard deviation of col and row, pixels.
+    rows : tuple of int, shape (N,) or ()
+        Row of each measurement in its file (header = row 1), for error messages.
+    source : str
+        The file they were read from ("" when made in memory).
+    camera : tuple of str, shape (N,) or ()
+        Camera of each measurement's image, when the table names it.
     """
 
     image_id: tuple[str, ...]
@@ -41,6 +47,9 @@ class ImageObservations:
     sigma_px: Array
     type: tuple[str, ...]
     target_id: tuple[str, ...]
+    rows: tuple[int, ...] = ()
+    source: str = ""
+    camera: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         n = len(self.image_id)
@@ -61,6 +70,15 @@ class ImageObservations:
             )
         if not (np.isfinite(px).all() and np.isfinite(sig).all() and (sig > 0).all()):
             raise InputError("image observations: pixels must be finite and sigma_px > 0")
+        for name in ("rows", "camera"):
+            value = tuple(getattr(self, name))
+            if value and len(value) != n:
+                raise InputError(f"image observations: {name} must have one entry per row")
+            object.__setattr__(self, name, value)
+
+    def where(self, i: int) -> dict:
+        """``path``/``row`` keywords of :class:`InputError` for measurement ``i``."""
+        return {"path": self.source or None, "row": self.rows[i] if self.rows else None}
 
     def __len__(self) -> int:
         return len(self.image_id)
@@ -99,6 +117,9 @@ class ImageObservations:
             self.sigma_px[idx],
             tuple(self.type[i] for i in idx),
             tuple(self.target_id[i] for i in idx),
+            tuple(self.rows[i] for i in idx) if self.rows else (),
+            self.source,
+            tuple(self.camera[i] for i in idx) if self.camera else (),
         )
 
     def concat(self, other: ImageObservations) -> ImageObservations:

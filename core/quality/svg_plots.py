@@ -14,7 +14,14 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import stats
 
-__all__ = ["histogram", "nice_step", "qq_plot", "vector_map"]
+__all__ = [
+    "correlation_heatmap",
+    "histogram",
+    "image_vector_field",
+    "nice_step",
+    "qq_plot",
+    "vector_map",
+]
 
 _FONT = 'font-family="sans-serif" font-size="11"'
 _NEG, _POS, _MID = (33, 102, 172), (178, 24, 43), (240, 240, 240)
@@ -355,3 +362,120 @@ def qq_plot(
     for a, b in zip(fr.px(q), fr.py(v)):
         body.append(f'<circle cx="{a:.1f}" cy="{b:.1f}" r="3" fill="#2b5d8a"/>')
     return _svg(width, height, title, body, "qq-plot")
+
+
+def correlation_heatmap(
+    names: Sequence[str],
+    corr: NDArray[np.float64],
+    *,
+    title: str,
+    flag: float = 0.9,
+    cell: int = 22,
+) -> str:
+    """Correlation matrix as coloured cells (blue -1 .. white 0 .. red +1), with the value in
+    each cell and a bold frame where |r| exceeds ``flag``.
+
+    Examples
+    --------
+    >>> correlation_heatmap(["a", "b"], np.array([[1.0, 0.95], [0.95, 1.0]]),
+    ...                     title="r").count("<rect") >= 4
+    True
+    """
+    c = np.asarray(corr, dtype=np.float64)
+    k = len(names)
+    left = 14 + 7 * max((len(n) for n in names), default=1)
+    top = 28 + left
+    width = max(left + k * cell + 12, 8 * len(title) + 20)
+    height = top + k * cell + 12
+    colours = _diverging(np.nan_to_num(c.ravel()), 1.0)
+    body = []
+    for i in range(k):
+        y = top + i * cell
+        body.append(
+            f'<text x="{left - 4}" y="{y + cell * 0.7:.1f}" text-anchor="end" {_FONT}>'
+            f"{_esc(names[i])}</text>"
+        )
+        x = left + i * cell + cell * 0.6
+        body.append(
+            f'<text x="{x:.1f}" y="{top - 4}" {_FONT} transform="rotate(-90 {x:.1f} {top - 4})">'
+            f"{_esc(names[i])}</text>"
+        )
+        for j in range(k):
+            r = c[i, j]
+            strong = i != j and np.isfinite(r) and abs(r) > flag
+            stroke = 'stroke="#000" stroke-width="2"' if strong else 'stroke="#fff"'
+            body.append(
+                f'<rect x="{left + j * cell}" y="{y}" width="{cell}" height="{cell}" '
+                f'fill="{colours[i * k + j]}" {stroke}><title>{_esc(names[i])} / '
+                f"{_esc(names[j])}: {r:.3f}</title></rect>"
+            )
+            if k <= 20 and np.isfinite(r):
+                body.append(
+                    f'<text x="{left + j * cell + cell / 2:.1f}" y="{y + cell * 0.65:.1f}" '
+                    f'text-anchor="middle" font-family="sans-serif" font-size="8">'
+                    f"{r:.1f}</text>"
+                )
+    return _svg(width, height, title, body, "heatmap")
+
+
+def image_vector_field(
+    col: NDArray[np.float64],
+    row: NDArray[np.float64],
+    dcol: NDArray[np.float64],
+    drow: NDArray[np.float64],
+    width_px: int,
+    height_px: int,
+    *,
+    title: str,
+    cells: tuple[int, int] = (12, 9),
+    width: int = 480,
+) -> str:
+    """Image-space residual vectors averaged in a grid of cells over the frame (all images of
+    a camera together), so that systematic patterns (radial, affine, decentring) show; the
+    arrow scale is written under the plot.
+
+    Examples
+    --------
+    >>> s = image_vector_field(np.array([10.0, 90.0]), np.array([10.0, 60.0]),
+    ...                        np.array([0.5, -0.5]), np.array([0.2, 0.1]), 100, 80, title="v")
+    >>> s.count("<polygon") == 2
+    True
+    """
+    height = round(width * height_px / width_px) + 60
+    left, top = 10, 28
+    pw = width - 2 * left
+    ph = height - top - 32
+    nx, ny = cells
+    ix = np.clip((np.asarray(col) / width_px * nx).astype(int), 0, nx - 1)
+    iy = np.clip((np.asarray(row) / height_px * ny).astype(int), 0, ny - 1)
+    key = iy * nx + ix
+    n = np.bincount(key, minlength=nx * ny)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mx = np.bincount(key, weights=dcol, minlength=nx * ny) / n
+        my = np.bincount(key, weights=drow, minlength=nx * ny) / n
+    ok = n > 0
+    length = np.hypot(mx[ok], my[ok])
+    biggest = float(length.max()) if length.size else 0.0
+    cw, chh = pw / nx, ph / ny
+    scale = 0.45 * min(cw, chh) / biggest if biggest > 0 else 0.0
+    body = [
+        f'<rect x="{left}" y="{top}" width="{pw}" height="{ph}" fill="white" stroke="#444"/>'
+    ]
+    for gx in range(1, nx):
+        x = left + gx * cw
+        body.append(f'<line x1="{x:.1f}" y1="{top}" x2="{x:.1f}" y2="{top + ph}" stroke="#eee"/>')
+    for gy in range(1, ny):
+        y = top + gy * chh
+        body.append(f'<line x1="{left}" y1="{y:.1f}" x2="{left + pw}" y2="{y:.1f}" stroke="#eee"/>')
+    k = np.flatnonzero(ok)
+    cx = left + (k % nx + 0.5) * cw
+    cy = top + (k // nx + 0.5) * chh
+    # rows grow downwards in the image and on the page
+    body.append(_arrows(cx, cy, cx + mx[ok] * scale, cy + my[ok] * scale, "#b2182b"))
+    ref = _nice_floor(biggest) if biggest > 0 else 0.0
+    body.append(
+        f'<text x="{width / 2:.1f}" y="{height - 10}" text-anchor="middle" {_FONT}>'
+        f"mean residual per cell; {_fmt(ref)} px = {ref * scale:.0f} px on screen; "
+        f"largest {_fmt(biggest)} px</text>"
+    )
+    return _svg(width, height, title, body, "image-vectors")

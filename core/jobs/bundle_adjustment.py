@@ -1,0 +1,403 @@
+"""``bundleadjustment``: aerotriangulation of a block with self-calibration.
+
+Outputs: the adjusted exterior orientation with sigmas (EO CSV), the adjusted camera(s) with
+their APs and sigmas (camera JSON), the object points with sigmas (CSV and a point layer), the
+residual of every image measurement with its w-test (CSV), the check-point discrepancies in
+the table the accuracy report reads (CSV), the comparison of the AP models (CSV, with
+``AP_MODEL=all``) and the HTML summary.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from ..geometry.ap_models import AP_FAMILIES
+from .common import CSV_FILTER, CSV_OUT
+from .runner import JobResult
+from .spec import AlgorithmSpec, Param, Result, Values
+
+log = logging.getLogger(__name__)
+
+AP_CHOICES = (*AP_FAMILIES, "all")
+ROBUST_CHOICES = ("none", "huber", "cauchy")
+DATUM_CHOICES = ("control", "inner", "minimal")
+
+SPEC = AlgorithmSpec(
+    name="bundleadjustment",
+    title="Bundle adjustment with self-calibration",
+    group="Aerotriangulation",
+    group_id="aerotriangulation",
+    summary="exterior orientations, object points, interior orientation and APs of a block",
+    description="""\
+Bundle adjustment of a block of frame images: the exterior orientation of every image, the
+object points (tie, control with sigmas; check points kept out and reported), and per camera
+the interior orientation (principal distance, principal point) with the additional
+parameters (APs) of one family, in one rigorous least-squares adjustment in a local
+east-north-up frame (results in the mapping CRS).
+
+AP families (Lima, Debiasi & Menezes compare them on a UAV block): lens_k1k2 (radial k1, k2),
+bauer (3: radial, affinity, shear; Bauer & Mueller 1972), jacobsen (4), ebner (12, orthogonal
+on a 3 x 3 grid; Ebner 1976), brown (14-term polynomial; Brown 1976 as in Murai et al. 1984),
+conrady_brown (physical k1 k2 k3 p1 p2); none holds the camera's own lens model. all runs every
+family on the same block, writes the comparison table (mean, standard deviation and RMS of the
+check-point discrepancies, sigma0, significant APs) and the outputs of the best model.
+
+Inputs: camera JSON (one camera, or {"cameras": [...]} with a camera column in the EO or
+observation table), image observations (image_id, point_id, col, row, sigma_px), ground
+points (point_id, X, Y, Z, sx, sy, sz, role = control | check), optionally exterior
+orientations: approximate (e.g. direct georeferencing, a few degrees and metres off), or
+observed when the table has sigma columns (GNSS/INS with sigmas; lever arm and boresight
+corrections can be estimated). Without orientations the images that see four or more control
+points are resected and the rest of the block grows by intersection and resection.
+
+Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
+and |correlation| above 0.9 flagged; automatic selection drops insignificant or too
+correlated APs one at a time and says which and why. Outliers: robust reweighting (Huber or
+Cauchy) then Baarda's data snooping. Datum: control points and/or observed orientations, or a
+free network (inner or minimal constraints). Tables that cannot make a block (an image
+without observations, a tie point seen once, duplicated rows, unknown images, ground points
+in another CRS, unconnected parts) are refused with the file and row named.""",
+    params=(
+        Param(
+            "CAMERA",
+            "file",
+            'Camera (JSON; several as {"cameras": [...]})',
+            file_filter="JSON files (*.json)",
+        ),
+        Param("OBSERVATIONS", "file", "Image observations (CSV)", file_filter=CSV_FILTER),
+        Param(
+            "GROUND_POINTS",
+            "file",
+            "Ground points (CSV: point_id,X,Y,Z,sx,sy,sz,role)",
+            optional=True,
+            file_filter=CSV_FILTER,
+        ),
+        Param(
+            "EO",
+            "file",
+            "Exterior orientation, approximate or observed (CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            help="approximate values, or observations when the sigma columns are filled",
+        ),
+        Param(
+            "EO_SIGMAS",
+            "numbers",
+            "EO sigmas when the table has none: X, Y, Z, omega, phi, kappa",
+            count=6,
+            unit="m, degrees",
+            optional=True,
+            minimum=0.0001,
+            maximum=100.0,
+            help="makes an EO table without sigma columns (e.g. from trajectorytoeo) "
+            "observations; empty: approximate values only",
+        ),
+        Param(
+            "CRS",
+            "crs",
+            "Mapping CRS",
+            qgis_default="ProjectCrs",
+            help="projected CRS of the ground points and exterior orientations",
+        ),
+        Param(
+            "AP_MODEL",
+            "enum",
+            "Additional parameters",
+            "none",
+            options=AP_CHOICES,
+            labels=(
+                "none (camera fixed)",
+                "lens distortion k1, k2",
+                "Bauer (3)",
+                "Jacobsen (4)",
+                "Ebner (12)",
+                "Brown (14)",
+                "Conrady-Brown k1 k2 k3 p1 p2",
+                "all (compare every family)",
+            ),
+        ),
+        Param("ESTIMATE_INTERIOR", "boolean", "Estimate principal distance and point", True),
+        Param("AP_SELECTION", "boolean", "Drop insignificant or correlated APs", True),
+        Param(
+            "ROBUST",
+            "enum",
+            "Robust reweighting before data snooping",
+            "huber",
+            options=ROBUST_CHOICES,
+        ),
+        Param("SNOOPING", "boolean", "Data snooping (Baarda)", True),
+        Param(
+            "DATUM",
+            "enum",
+            "Datum",
+            "control",
+            options=DATUM_CHOICES,
+            labels=(
+                "control points / observed EO",
+                "free network: inner constraints",
+                "free network: minimal constraints",
+            ),
+        ),
+        Param(
+            "ESTIMATE_MOUNT",
+            "boolean",
+            "Estimate lever arm and boresight corrections",
+            False,
+            advanced=True,
+            help="needs observed exterior orientations",
+        ),
+        Param("OUTPUT_EO", "file_out", "Adjusted exterior orientation (CSV)", file_filter=CSV_OUT),
+        Param(
+            "OUTPUT_CAMERA",
+            "file_out",
+            "Adjusted camera (JSON)",
+            optional=True,
+            file_filter="JSON files (*.json)",
+        ),
+        Param(
+            "OUTPUT_POINTS", "file_out", "Object points (CSV)", optional=True, file_filter=CSV_OUT
+        ),
+        Param("OUTPUT_POINTS_LAYER", "sink", "Object points", geometry="point"),
+        Param(
+            "OUTPUT_RESIDUALS",
+            "file_out",
+            "Image residuals with w-tests (CSV)",
+            optional=True,
+            file_filter=CSV_OUT,
+        ),
+        Param(
+            "OUTPUT_CHECK_CSV",
+            "file_out",
+            "Check-point discrepancies (CSV)",
+            optional=True,
+            file_filter=CSV_OUT,
+        ),
+        Param(
+            "OUTPUT_COMPARISON",
+            "file_out",
+            "AP model comparison (CSV)",
+            optional=True,
+            create_by_default=False,
+            file_filter=CSV_OUT,
+        ),
+        Param(
+            "OUTPUT_HTML",
+            "file_out",
+            "Summary (HTML)",
+            optional=True,
+            file_filter="HTML files (*.html)",
+        ),
+    ),
+    results=(
+        Result("SIGMA0", "number", "Sigma0 a-posteriori"),
+        Result("CHECK_RMS", "number", "Check-point RMS 3D (m)"),
+        Result("MODEL", "string", "AP model of the outputs"),
+    ),
+    tags=(
+        "bundle adjustment",
+        "aerotriangulation",
+        "self-calibration",
+        "additional parameters",
+        "uav",
+        "drone",
+        "ebner",
+        "brown",
+        "bauer",
+        "jacobsen",
+    ),
+    references=(
+        "Lima, Debiasi & Menezes",
+        "Bauer & Mueller (1972)",
+        "Ebner (1976)",
+        "Brown (1976)",
+        "Murai, Matsuoka & Okuda (1984)",
+        "Baarda (1968)",
+        "Huber (1964)",
+        "Triggs et al. (2000)",
+        "Nielsen (1999)",
+    ),
+)
+
+
+def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
+    """Read the inputs, adjust (each AP family for ``all``), write the outputs."""
+    import numpy as np
+
+    from ..errors import InputError
+    from ..geometry.frames import MappingFrame, check_area_of_use
+    from ..io.atomic import write_text_atomic
+    from ..io.bundle import (
+        write_bundle_points,
+        write_bundle_residuals,
+        write_check_points,
+        write_comparison,
+    )
+    from ..io.camera import read_cameras_json, write_cameras_json
+    from ..io.ground_points import read_ground_points_csv
+    from ..io.observations import read_observations_csv
+    from ..io.orientation import read_eo_csv_full, write_eo_csv_with_sigmas
+    from ..photo.bundle import BundleOptions, GroundPoints, bundle_adjust, compare_ap_models
+    from ..quality.bundle_html import render_bundle_html
+    from .runner import stages
+
+    frame = MappingFrame.from_user_input(v.crs)
+    cams = read_cameras_json(v.camera)
+    # one camera: its image size bounds every pixel as the table is read (several: below)
+    obs = read_observations_csv(v.observations, camera=cams[0] if len(cams) == 1 else None)
+    ground = read_ground_points_csv(v.ground_points) if v.ground_points else GroundPoints.empty()
+    if len(ground):
+        check_area_of_use(frame.crs, ground.xyz.min(axis=0), ground.xyz.max(axis=0),
+                          what="the ground points", path=v.ground_points)  # fmt: skip
+    eo = sigma = None
+    eo_rows: tuple[int, ...] = ()
+    eo_source = ""
+    image_camera: dict[str, str] = {}
+    if v.eo:
+        f = read_eo_csv_full(v.eo, frame.crs.to_wkt())
+        eo, sigma, eo_rows, eo_source = f.eo, f.sigma, f.rows, f.path
+        check_area_of_use(frame.crs, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
+                          what="the perspective centres", path=v.eo)  # fmt: skip
+        if sigma is None and v.eo_sigmas:
+            s6 = np.array(v.eo_sigmas, dtype=float)
+            if not (s6 > 0).all():
+                raise InputError("EO_SIGMAS: every sigma must be > 0")
+            s6[3:] = np.radians(s6[3:])
+            sigma = np.tile(s6, (len(eo), 1))
+        if f.camera is not None:
+            image_camera.update(zip(f.eo.image_id, f.camera))
+    for k, (im, cam) in enumerate(zip(obs.image_id, obs.camera)):
+        if image_camera.setdefault(im, cam) != cam:
+            raise InputError(
+                f"image '{im}' is given camera '{cam}' here and '{image_camera[im]}' elsewhere",
+                **obs.where(k),
+            )
+    if len(cams) > 1:
+        _check_on_image(obs, image_camera, cams)
+    models = tuple(m for m in AP_FAMILIES) if v.ap_model == "all" else (v.ap_model,)
+    parts = stages(progress, *([1.0] * len(models)))
+    stage = dict(zip(models, parts))
+
+    def one(model: str):
+        opts = BundleOptions(
+            ap_model=model,
+            estimate_interior=v.estimate_interior,
+            ap_selection=v.ap_selection,
+            robust=v.robust,
+            snooping=v.snooping,
+            datum=v.datum,
+            estimate_mount=v.estimate_mount,
+        )
+        log.info("bundle adjustment with AP model %s", model)
+        return bundle_adjust(cams, obs, ground, frame, eo, sigma, image_camera, opts, eo_rows,
+                             eo_source, stage[model], should_stop)  # fmt: skip
+
+    if len(models) == 1:
+        res = one(models[0])
+        rows = [{**res.summary_row(), "rank": 1}]
+        results = {models[0]: res}
+    else:
+        rows, results = compare_ap_models(models, one)
+        if not results:
+            raise InputError(
+                "no AP model could be adjusted: " + "; ".join(str(r.get("error")) for r in rows)
+            )
+    best = str(next(r["model"] for r in rows if r["model"] in results))
+    res = results[best]
+    settings = _settings(v, cams, obs, ground, eo, sigma, frame)
+    if out.requested("OUTPUT_EO"):
+        multi = len(cams) > 1
+        write_eo_csv_with_sigmas(out.path("OUTPUT_EO"), res.eo, res.eo_sigma,
+                                 res.image_camera if multi else None)  # fmt: skip
+    if out.requested("OUTPUT_CAMERA"):
+        sig = [
+            {p.name: p.std for p in res.interior if p.camera == c.name and p.status == "estimated"}
+            for c in res.cameras.values()
+        ]
+        write_cameras_json(out.path("OUTPUT_CAMERA"), list(res.cameras.values()), sig,
+                           {"_bundle": {"ap_model": best, "sigma0": res.sigma0,
+                                        "dropped": [list(d) for d in res.dropped]}})  # fmt: skip
+    if out.requested("OUTPUT_POINTS"):
+        write_bundle_points(out.path("OUTPUT_POINTS"), res)
+    if out.requested("OUTPUT_RESIDUALS"):
+        write_bundle_residuals(out.path("OUTPUT_RESIDUALS"), res)
+    if out.requested("OUTPUT_CHECK_CSV"):
+        write_check_points(out.path("OUTPUT_CHECK_CSV"), results.values())
+    if out.requested("OUTPUT_COMPARISON"):
+        write_comparison(out.path("OUTPUT_COMPARISON"), rows)
+    if out.requested("OUTPUT_HTML"):
+        page = render_bundle_html(results, best, settings, rows if len(models) > 1 else ())
+        write_text_atomic(out.path("OUTPUT_HTML"), page)
+    st = res.check.statistics()
+    lines = []
+    if len(models) > 1:
+        lines.append(f"{'rank':>4} {'model':14} {'check RMS 3D m':>14} {'planimetric m':>13} "
+                     f"{'sigma0':>7} {'sig. APs':>8}")  # fmt: skip
+        for r in rows:
+            if r.get("error"):
+                lines.append(f"{'-':>4} {r['model']:14} not observable")
+                continue
+            lines.append(f"{r['rank']:>4} {r['model']:14} {r['rms_3d']:14.3f} "
+                         f"{r['rms_planimetric']:13.3f} {r['sigma0']:7.3f} "
+                         f"{r['n_significant']:8d}")  # fmt: skip
+    a = res.adjustment
+    lines.append(
+        f"{best}: sigma0 {a.sigma0:.3f}, redundancy {a.redundancy}, global test "
+        f"{'passed' if a.global_test.passed else 'failed'}, {int(res.rejected.sum())} "
+        f"measurements rejected, {len(res.dropped)} APs dropped"
+    )
+    if len(res.check.point_id):
+        lines.append(
+            f"check points ({int(st['n'])}): RMS E/N/H {st['rms_e']:.3f} / {st['rms_n']:.3f} / "
+            f"{st['rms_h']:.3f} m, 3D {st['rms_3d']:.3f} m"
+        )
+    return JobResult(
+        results={
+            "SIGMA0": float(a.sigma0),
+            "CHECK_RMS": float(st["rms_3d"]) if np.isfinite(st["rms_3d"]) else float("nan"),
+            "MODEL": best,
+        },
+        lines=lines,
+        data=res,
+    )
+
+
+def _check_on_image(obs, image_camera: dict[str, str], cams) -> None:
+    """Refuse a measured pixel off its camera's image (0 <= col <= width_px, 0 <= row <=
+    height_px), naming the row; images of unknown cameras are left to the adjustment."""
+    import numpy as np
+
+    from ..errors import InputError
+
+    size = {c.name: (c.width_px, c.height_px) for c in cams}
+    wh = np.array([size.get(image_camera.get(im, ""), (np.inf, np.inf)) for im in obs.image_id],
+                  dtype=float).reshape(-1, 2)  # fmt: skip
+    off = np.flatnonzero(((obs.pixels < 0) | (obs.pixels > wh)).any(axis=1))
+    if off.size:
+        k = int(off[0])
+        cam = image_camera[obs.image_id[k]]
+        raise InputError(
+            f"pixel ({obs.pixels[k, 0]:g}, {obs.pixels[k, 1]:g}) is off the image: camera "
+            f"'{cam}' has {size[cam][0]} x {size[cam][1]} pixels; {off.size} row(s) affected",
+            **obs.where(k),
+        )
+
+
+def _settings(v, cams, obs, ground, eo, sigma, frame) -> dict[str, str]:
+    roles = list(ground.role)
+    return {
+        "cameras": "; ".join(
+            f"{c.name} (f = {c.focal_mm:g} mm, {c.width_px} x {c.height_px} px of "
+            f"{c.pixel_size_mm * 1000:g} um, lens {c.distortion.model})" for c in cams
+        ),
+        "images / measurements": f"{len(set(obs.image_id))} / {len(obs)}",
+        "ground points": f"{roles.count('control')} control, {roles.count('check')} check",
+        "exterior orientation": "none (resection and growth)" if eo is None else (
+            "observed (with sigmas)" if sigma is not None else "approximate values"),
+        "mapping CRS": frame.crs.name,
+        "AP model": v.ap_model,
+        "interior orientation": "estimated" if v.estimate_interior else "fixed",
+        "AP selection": "on" if v.ap_selection else "off",
+        "outliers": f"robust {v.robust}, data snooping {'on' if v.snooping else 'off'}",
+        "datum": v.datum,
+        "lever arm / boresight": "estimated" if v.estimate_mount else "held",
+    }  # fmt: skip

@@ -1,0 +1,911 @@
+"""Reduced normal equations: small independent parameter blocks eliminated by the Schur complement.
+
+Used by :func:`~lidarphoto.core.lsq.adjustment.adjust` when
+:attr:`~lidarphoto.core.lsq.model.AdjustmentOptions.eliminate` names ``P`` blocks of ``b``
+parameters (the object points of a bundle adjustment, ``b = 3``). Every observation group may
+depend on at most one of these blocks, so that the normal matrix, ordered as (reduced
+parameters r, eliminated parameters e), is::
+
+    N = [[U, W], [W', V]]       V = diag(V_1, ..., V_P), each V_p of size b x b
+
+and the eliminated parameters leave the reduced system (the reduced camera system of a bundle
+adjustment; Brown 1976, Triggs et al. 2000)::
+
+    S = U - W V^-1 W',   S z_r = -n_r + W V^-1 n_e,   z_e = V^-1 (-n_e - W' z_r).
+
+Hard constraints ``C z = -h`` are carried as extra rows of the reduced system: with the
+augmented ``U+ = [[U, C_r'], [C_r, 0]]`` and ``W+_p = [W_p; C_e,p]`` the reduced (bordered)
+matrix is ``U+ - sum_p W+_p V_p^-1 W+_p'``, which also covers constraints on eliminated
+parameters (inner constraints on object points).
+
+Assembly never forms the design matrix: per linearisation the whitened, Jacobi-scaled rows of
+each group are split into their reduced part ``R_g`` and eliminated part ``E_g``; ``U`` is
+summed per *signature* (groups with the same reduced columns, e.g. one image), ``V_p`` per
+block, and ``W V^-1 W'`` from pairs of *occurrences* of the same block: an occurrence is a group
+(its columns that vary from group to group, e.g. the exterior orientation) or, for the columns
+shared by every group of an observation block (e.g. the interior orientation of its camera),
+the sum over the block's groups at one point, so that shared columns cost one product per
+point instead of one per pair of rays. Every sum is a sorted segment reduction in bounded
+chunks.
+
+The cofactor matrix is returned in blocks (:class:`BlockCofactor`): ``Q_rr`` of the reduced
+parameters in full, ``Q_pp`` (b x b) of every eliminated block, and, for the standardised
+residuals of each group, the cross block ``Q_rp = -M W+_p V_p^-1`` restricted to the group's
+columns (``M`` the inverse of the reduced bordered matrix).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InputError
+
+Array = NDArray[np.float64]
+Index = NDArray[np.intp]
+
+__all__ = ["BlockCofactor", "EliminationPlan", "ReducedNormal", "SingularSystem"]
+
+# Items (groups or pairs of occurrences) per chunk of a reduction: bounds the temporaries.
+_CHUNK = 1 << 16
+# Reduced systems up to this size are solved densely (Cholesky / LU); above, sparse LU when
+# the reduced matrix is sparse enough.
+_DENSE_MAX = 2500
+_SPARSE_MAX_DENSITY = 0.1
+
+
+class SingularSystem(Exception):
+    """A factorisation failed or gave non-finite numbers."""
+
+
+class _Reducer:
+    """Sums of per-item values by key, in chunks aligned to whole keys.
+
+    The items are sorted by key once; :meth:`sum` asks ``values(items)`` for a chunk of item
+    numbers at a time and reduces the chunk with ``np.add.reduceat``.
+    """
+
+    def __init__(self, keys: Index, n_keys: int, chunk: int = _CHUNK) -> None:
+        keys = np.asarray(keys, dtype=np.intp)
+        # already sorted (pairs are stored in key order): the items are taken as slices
+        self.identity = bool(keys.size < 2 or (keys[1:] >= keys[:-1]).all())
+        self.order = (np.arange(keys.size, dtype=np.intp) if self.identity
+                      else np.argsort(keys, kind="stable"))  # fmt: skip
+        sk = keys[self.order]
+        self.n_keys = int(n_keys)
+        self.n_items = int(keys.size)
+        if sk.size:
+            starts = np.flatnonzero(np.r_[True, sk[1:] != sk[:-1]])
+        else:
+            starts = np.zeros(0, dtype=np.intp)
+        self.keys = sk[starts]
+        self.starts = starts
+        # Chunk boundaries on key boundaries: a new chunk starts at the first key start past
+        # the running limit, so that no key is split between chunks.
+        bounds = [0]
+        if starts.size:
+            while bounds[-1] < starts.size:
+                lo = starts[bounds[-1]]
+                nxt = int(np.searchsorted(starts, lo + chunk, side="right"))
+                bounds.append(max(nxt, bounds[-1] + 1))
+        self.bounds = bounds
+
+    def sum_outer(
+        self, X: Callable[[Index], Array], Y: Callable[[Index], Array] | None, k1: int, k2: int
+    ) -> Array:
+        """Per key ``sum_items X' Y`` with ``X(items)`` (n, m, k1) and ``Y(items)`` (n, m, k2)
+        (``Y = X`` when None). Keys holding enough work are one matrix product each (BLAS on
+        views of the chunk, whose rows are the items' m rows); otherwise batched products are
+        reduced."""
+        out = np.zeros((self.n_keys, k1, k2))
+        if not self.starts.size:
+            return out
+        per_key = self.n_items * k1 * k2 >= 2000 * self.starts.size
+        ends = np.r_[self.starts[1:], self.n_items]
+        for a, b in zip(self.bounds[:-1], self.bounds[1:]):
+            lo, hi = int(self.starts[a]), int(ends[b - 1])
+            items = slice(lo, hi) if self.identity else self.order[lo:hi]
+            A = X(items)
+            B = A if Y is None else Y(items)
+            if per_key:
+                m = A.shape[1]
+                A2 = np.ascontiguousarray(A).reshape(-1, k1)
+                B2 = A2 if Y is None else np.ascontiguousarray(B).reshape(-1, k2)
+                for key, s0, s1 in zip(self.keys[a:b], self.starts[a:b] - lo, ends[a:b] - lo):
+                    out[key] = A2[s0 * m : s1 * m].T @ B2[s0 * m : s1 * m]
+            else:
+                vals = np.swapaxes(A, 1, 2) @ B
+                out[self.keys[a:b]] = np.add.reduceat(vals, self.starts[a:b] - lo, axis=0)
+        return out
+
+    def sum(self, values: Callable[[Index], Array], shape: tuple[int, ...]) -> Array:
+        out = np.zeros((self.n_keys, *shape))
+        ends = np.r_[self.starts[1:], self.n_items] if self.starts.size else self.starts
+        for a, b in zip(self.bounds[:-1], self.bounds[1:]):
+            lo, hi = int(self.starts[a]), int(ends[b - 1])
+            vals = values(self.order[lo:hi])
+            out[self.keys[a:b]] = np.add.reduceat(vals, self.starts[a:b] - lo, axis=0)
+        return out
+
+
+@dataclass
+class _BlockPlan:
+    """How the columns of one observation block split into reduced and eliminated ones."""
+
+    rc: Index  # (kr,) column positions that are reduced parameters
+    ec: Index  # (ke,) column positions that are eliminated parameters
+    rrows: Index  # (G, kr) reduced row numbers of the rc columns
+    eslot: Index  # (G, ke) slot of the ec columns in their eliminated block
+    point: Index  # (G,) eliminated block of each group, -1 for none
+    vc: Index  # positions within rc of the columns that vary between groups
+    cc: Index  # positions within rc of the columns every group shares
+    sig: Index  # (G,) signature (distinct rows of rrows)
+    sig_rows: Index  # (n_sig, kr)
+    u_reducer: _Reducer | None = None
+    v_reducer: _Reducer | None = None  # groups with a point, keyed by point
+    with_point: Index = field(default_factory=lambda: np.zeros(0, dtype=np.intp))
+    vset: int = -1  # occurrence set of the varying columns (occurrence = group)
+    cset: int = -1  # occurrence set of the shared columns (occurrence = point of the block)
+    c_occ: Index = field(default_factory=lambda: np.zeros(0, dtype=np.intp))  # (G,)
+    c_reducer: _Reducer | None = None  # groups with a point, keyed by c_occ
+    eslot_identity: bool = False  # every group's ec columns are the slots 0..b-1 in order
+
+
+@dataclass
+class _OccSet:
+    """Occurrences of eliminated blocks in reduced rows (see the module docstring)."""
+
+    point: Index  # (O,)
+    sig: Index  # (O,)
+    rows: Index  # (n_sig, kk) rows of the reduced (bordered) system
+    source: tuple[str, int]  # ("v" | "c" | "k", block number)
+
+
+@dataclass
+class _PairList:
+    """Pairs (o1, o2) of occurrences of sets s1 <= s2 at the same eliminated block, in the
+    order of their key (sig1, sig2).
+
+    ``mirror``: each pair stands for itself and its reverse (o2, o1), whose contribution is
+    the transposed block (all pairs between two sets; the pairs o1 < o2 within a set); the
+    pairs o1 == o2 within a set are a list of their own without mirror.
+    """
+
+    s1: int
+    s2: int
+    o1: Index
+    o2: Index
+    key_reducer: _Reducer  # by (sig1, sig2)
+    key_sig1: Index  # (n_keys,)
+    key_sig2: Index
+    n1: int  # occurrences in s1 and s2
+    n2: int
+    mirror: bool = True
+    _o1_reducer: _Reducer | None = None
+    _o2_reducer: _Reducer | None = None
+
+    @property
+    def o1_reducer(self) -> _Reducer:
+        """By o1 (for the cofactor; made on first use)."""
+        if self._o1_reducer is None:
+            self._o1_reducer = _Reducer(self.o1, self.n1)
+        return self._o1_reducer
+
+    @property
+    def o2_reducer(self) -> _Reducer | None:
+        """By o2 for mirrored lists (the reverse direction), else None."""
+        if not self.mirror:
+            return None
+        if self._o2_reducer is None:
+            self._o2_reducer = _Reducer(self.o2, self.n2)
+        return self._o2_reducer
+
+
+def _pairs(pa: Index, pb: Index) -> tuple[Index, Index]:
+    """Every (i, j) with ``pa[i] == pb[j]`` (item numbers into pa and pb)."""
+    order_b = np.argsort(pb, kind="stable")
+    sb = pb[order_b]
+    lo = np.searchsorted(sb, pa, side="left")
+    hi = np.searchsorted(sb, pa, side="right")
+    cnt = hi - lo
+    i = np.repeat(np.arange(pa.size, dtype=np.intp), cnt)
+    # offset of each pair within its run: arange minus the run start
+    run_start = np.repeat(np.cumsum(cnt) - cnt, cnt)
+    within = np.arange(i.size, dtype=np.intp) - run_start
+    j = order_b[np.repeat(lo, cnt) + within]
+    return i, j
+
+
+def _unique_rows(a: Index) -> tuple[Index, Index]:
+    """(first row of each distinct row, inverse) of an integer matrix (G, k)."""
+    if a.shape[1] == 0:
+        return np.zeros(min(1, a.shape[0]), dtype=np.intp), np.zeros(a.shape[0], dtype=np.intp)
+    # usually the first column determines the row (e.g. an image's six orientation
+    # parameters): a 1-D unique, verified, is much faster than the row-wise one
+    _, first, inv = np.unique(a[:, 0], return_index=True, return_inverse=True)
+    inv = np.asarray(inv, dtype=np.intp).ravel()
+    if (a[first][inv] == a).all():
+        return first.astype(np.intp), inv
+    _, first, inv = np.unique(a, axis=0, return_index=True, return_inverse=True)
+    return first.astype(np.intp), np.asarray(inv, dtype=np.intp).ravel()
+
+
+class EliminationPlan:
+    """The fixed structure of a reduced system: block splits, signatures, occurrences, pairs.
+
+    Parameters
+    ----------
+    n : int
+        Number of parameters.
+    eliminate : array_like of int, shape (P, b)
+        Parameter indices of the eliminated blocks.
+    blocks : sequence
+        The validated observation blocks of the adjustment (with ``param_index``, ``name``).
+    constraint_index : sequence of ndarray (G_c, k_c)
+        Parameter indices of each hard-constraint set.
+    """
+
+    def __init__(
+        self,
+        n: int,
+        eliminate: ArrayLike,
+        blocks: Sequence,
+        constraint_index: Sequence[Index],
+    ) -> None:
+        e = np.asarray(eliminate)
+        if e.ndim != 2 or e.size == 0:
+            raise InputError(f"eliminate must have shape (P, b) with P, b >= 1, got {e.shape}")
+        if not np.issubdtype(e.dtype, np.integer):
+            raise InputError(f"eliminate must be integers, got {e.dtype}")
+        e = e.astype(np.intp)
+        if e.min() < 0 or e.max() >= n:
+            raise InputError(f"eliminate: indices outside 0..{n - 1}")
+        if np.unique(e).size != e.size:
+            raise InputError("eliminate: a parameter appears twice")
+        self.n = n
+        self.elim = e
+        self.P, self.b = e.shape
+        point_of = np.full(n, -1, dtype=np.intp)
+        slot_of = np.full(n, -1, dtype=np.intp)
+        point_of[e.ravel()] = np.repeat(np.arange(self.P), self.b)
+        slot_of[e.ravel()] = np.tile(np.arange(self.b), self.P)
+        self.point_of = point_of
+        self.reduced = np.flatnonzero(point_of < 0)
+        self.n_r = int(self.reduced.size)
+        rmap = np.full(n, -1, dtype=np.intp)
+        rmap[self.reduced] = np.arange(self.n_r)
+        self.rmap = rmap
+        self.sets: list[_OccSet] = []
+        self.plans: list[_BlockPlan] = []
+        for bi, bk in enumerate(blocks):
+            self.plans.append(self._block_plan(bi, bk, point_of, slot_of, rmap))
+        seen = np.zeros(self.P, dtype=bool)
+        for bp in self.plans:
+            seen[bp.point[bp.point >= 0]] = True
+        self.constraint_points = np.unique(
+            np.concatenate(
+                [point_of[ci.ravel()] for ci in constraint_index] or [np.zeros(0, np.intp)]
+            )
+        )
+        self.constraint_points = self.constraint_points[self.constraint_points >= 0]
+        self.unobserved = np.flatnonzero(~seen)
+        self.mc: int | None = None
+        self.pairs: list[_PairList] = []
+
+    # -- structure -------------------------------------------------------------------------
+
+    def _block_plan(
+        self, bi: int, bk, point_of: Index, slot_of: Index, rmap: Index
+    ) -> _BlockPlan:
+        where = f"block '{bk.name}'"
+        idx = bk.param_index
+        g, k = idx.shape
+        pt = point_of[idx]
+        el = pt >= 0
+        col_any = el.any(axis=0) if g else np.zeros(k, dtype=bool)
+        col_all = el.all(axis=0) if g else np.zeros(k, dtype=bool)
+        if (col_any != col_all).any():
+            raise InputError(
+                f"{where}: a column holds eliminated parameters in some groups and other "
+                "parameters in others; order the columns the same way in every group"
+            )
+        ec = np.flatnonzero(col_any)
+        rc = np.flatnonzero(~col_any)
+        if g and k > 1:
+            srt = np.sort(idx, axis=1)
+            if (srt[:, 1:] == srt[:, :-1]).any():
+                raise InputError(
+                    f"{where}: a group uses the same parameter twice, which the elimination "
+                    "of blocks does not support"
+                )
+        if ec.size:
+            gp = pt[:, ec]
+            point = gp[:, 0].copy()
+            if (gp != point[:, None]).any():
+                bad = int(np.flatnonzero((gp != point[:, None]).any(axis=1))[0])
+                raise InputError(
+                    f"{where}: group {bk.labels[bad]} depends on two eliminated blocks; each "
+                    "group may depend on at most one"
+                )
+        else:
+            point = np.full(g, -1, dtype=np.intp)
+        eslot = slot_of[idx[:, ec]]
+        rrows = rmap[idx[:, rc]]
+        if g:
+            const = (rrows == rrows[:1]).all(axis=0)
+        else:
+            const = np.ones(rc.size, dtype=bool)
+        vc = np.flatnonzero(~const)
+        cc = np.flatnonzero(const)
+        first, sig = _unique_rows(rrows[:, vc])
+        sig_rows = rrows[first] if g else np.zeros((0, rc.size), dtype=np.intp)
+        bp = _BlockPlan(rc, ec, rrows, eslot, point, vc, cc, sig, sig_rows)
+        bp.eslot_identity = bool(
+            ec.size == self.b and (eslot == np.arange(self.b)[None, :]).all()
+        )
+        if rc.size and g:
+            bp.u_reducer = _Reducer(sig, sig_rows.shape[0])
+        wp = np.flatnonzero(point >= 0)
+        bp.with_point = wp
+        if ec.size and wp.size:
+            bp.v_reducer = _Reducer(point[wp], self.P)
+            if vc.size:
+                bp.vset = len(self.sets)
+                used, inv = np.unique(sig[wp], return_inverse=True)
+                self.sets.append(
+                    _OccSet(
+                        point=point[wp],
+                        sig=np.asarray(inv, dtype=np.intp).ravel(),
+                        rows=sig_rows[used][:, vc],
+                        source=("v", bi),
+                    )
+                )
+            if cc.size:
+                bp.cset = len(self.sets)
+                upts, inv = np.unique(point[wp], return_inverse=True)
+                inv = np.asarray(inv, dtype=np.intp).ravel()
+                c_occ = np.full(g, -1, dtype=np.intp)
+                c_occ[wp] = inv
+                bp.c_occ = c_occ
+                bp.c_reducer = _Reducer(inv, upts.size)
+                self.sets.append(
+                    _OccSet(
+                        point=upts.astype(np.intp),
+                        sig=np.zeros(upts.size, dtype=np.intp),
+                        rows=rrows[:1, cc],
+                        source=("c", bi),
+                    )
+                )
+        return bp
+
+    def rows_per_block(self, rows_per_group, active) -> Index:
+        """Observation rows touching each eliminated block (of the active groups, or of all
+        groups when ``active`` is None)."""
+        out = np.zeros(self.P, dtype=np.intp)
+        for k, bp in enumerate(self.plans):
+            c = rows_per_group[k] or 0
+            sel = bp.point >= 0
+            if active is not None:
+                sel = sel & active[k]
+            if bp.ec.size and sel.any():
+                out += c * np.bincount(bp.point[sel], minlength=self.P)
+        return out
+
+    def finish(self, mc: int) -> None:
+        """Add the constraint occurrences (``mc`` rows) and enumerate the pairs (once)."""
+        if self.mc is not None:
+            return
+        self.mc = int(mc)
+        if mc and self.constraint_points.size:
+            self.kset = len(self.sets)
+            self.sets.append(
+                _OccSet(
+                    point=self.constraint_points.astype(np.intp),
+                    sig=np.zeros(self.constraint_points.size, dtype=np.intp),
+                    rows=(self.n_r + np.arange(mc, dtype=np.intp))[None, :],
+                    source=("k", -1),
+                )
+            )
+        else:
+            self.kset = -1
+        for s1 in range(len(self.sets)):
+            for s2 in range(s1, len(self.sets)):
+                a, b = self.sets[s1], self.sets[s2]
+                o1, o2 = _pairs(a.point, b.point)
+                if s1 == s2:
+                    # o1 < o2 mirrored, o1 == o2 on their own: half the products
+                    parts = [(o1[o1 < o2], o2[o1 < o2], True), (o1[o1 == o2], o2[o1 == o2], False)]
+                else:
+                    parts = [(o1, o2, True)]
+                nsig2 = b.rows.shape[0]
+                for p1, p2, mirror in parts:
+                    if p1.size == 0:
+                        continue
+                    key = a.sig[p1] * nsig2 + b.sig[p2]
+                    order = np.argsort(key, kind="stable")
+                    p1, p2, key = p1[order], p2[order], key[order]
+                    ukey, kinv = np.unique(key, return_inverse=True)
+                    kinv = np.asarray(kinv, dtype=np.intp).ravel()
+                    self.pairs.append(
+                        _PairList(
+                            s1, s2, p1, p2, _Reducer(kinv, ukey.size),
+                            (ukey // nsig2).astype(np.intp), (ukey % nsig2).astype(np.intp),
+                            a.point.size, b.point.size, mirror,
+                        )
+                    )  # fmt: skip
+
+
+@dataclass
+class ReducedNormal:
+    """Jacobi-scaled normal equations of one linearisation, in reduced form.
+
+    ``d`` is the Jacobi scale of all ``n`` parameters (as for the full normal equations);
+    everything else is in the scaled variables ``z = D dx``.
+    """
+
+    plan: EliminationPlan
+    d: Array  # (n,)
+    ns: Array  # (n,) scaled gradient A' w (for the step-length test only)
+    u_rows: Index  # COO of U+ (reduced block and constraint borders)
+    u_cols: Index
+    u_vals: Array
+    g_r: Array  # (n_r,) reduced gradient
+    V: Array  # (P, b, b)
+    g_e: Array  # (P, b)
+    T: list[Array]  # per occurrence set (O, kk, b)
+    hs: Array  # (mc,) scaled constraint values
+    mc: int
+    dead: NDArray[np.bool_] | None = None  # (P,) blocks without any active observation
+    use_sparse: bool = False
+    _cache: dict = field(default_factory=dict)
+
+    @property
+    def n_red(self) -> int:
+        return self.plan.n_r + self.mc
+
+    # -- factorising the point blocks ------------------------------------------------------
+
+    def point_factors(self, lam: float) -> tuple[Array, Array]:
+        """(Li, Vinv): inverse Cholesky factors and inverses of ``V_p + lam I``."""
+        key = ("vf", lam)
+        if key in self._cache:
+            return self._cache[key]
+        b = self.plan.b
+        Vl = self.V + lam * np.eye(b)
+        try:
+            L = np.linalg.cholesky(Vl)
+        except np.linalg.LinAlgError:
+            raise SingularSystem("an eliminated block is singular") from None
+        eye = np.broadcast_to(np.eye(b), L.shape)
+        Li = np.linalg.solve(L, eye)
+        Vinv = np.swapaxes(Li, 1, 2) @ Li
+        if not (np.isfinite(Li).all() and np.isfinite(Vinv).all()):
+            raise SingularSystem("an eliminated block is singular")
+        self._cache[key] = (Li, Vinv)
+        return Li, Vinv
+
+    def point_conditions(self) -> Array:
+        """Condition number of each Jacobi-scaled point block ``V_p`` (inf when singular)."""
+        dg = np.sqrt(np.clip(np.einsum("pii->pi", self.V), 0.0, None))
+        dg = np.where(dg > 0, dg, 1.0)
+        Vs = self.V / (dg[:, :, None] * dg[:, None, :])
+        ev = np.linalg.eigvalsh(Vs)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cond = np.where(ev[:, 0] > 0, ev[:, -1] / ev[:, 0], np.inf)
+        if self.dead is not None:
+            cond[self.dead] = 1.0  # set aside, not adjusted
+        return cond
+
+    # -- the reduced system ----------------------------------------------------------------
+
+    def reduced_matrix(self, lam: float) -> sp.csr_matrix:
+        """``U+ + lam I_r - sum_p W+_p (V_p + lam I)^-1 W+_p'`` (sparse, symmetric)."""
+        key = ("K", lam)
+        if key in self._cache:
+            return self._cache[key]
+        plan = self.plan
+        Li, _ = self.point_factors(lam)
+        # Z' = Li T' per occurrence, (O, b, kk): rows stack without copies in sum_outer
+        Z = [Li[s.point] @ np.swapaxes(T, 1, 2) for T, s in zip(self.T, plan.sets)]
+        rows = [self.u_rows, np.arange(plan.n_r)]
+        cols = [self.u_cols, np.arange(plan.n_r)]
+        vals = [self.u_vals, np.full(plan.n_r, lam)]
+        for pl in plan.pairs:
+            a, b = plan.sets[pl.s1], plan.sets[pl.s2]
+            Za, Zb = Z[pl.s1], Z[pl.s2]
+            o1, o2 = pl.o1, pl.o2
+            kk1, kk2 = a.rows.shape[1], b.rows.shape[1]
+
+            blocks = pl.key_reducer.sum_outer(
+                lambda it, Za=Za, o1=o1: Za[o1[it]], lambda it, Zb=Zb, o2=o2: Zb[o2[it]], kk1, kk2
+            )
+            r1 = a.rows[pl.key_sig1]
+            r2 = b.rows[pl.key_sig2]
+            rr = np.broadcast_to(r1[:, :, None], blocks.shape).ravel()
+            cc = np.broadcast_to(r2[:, None, :], blocks.shape).ravel()
+            rows.append(rr)
+            cols.append(cc)
+            vals.append(-blocks.ravel())
+            if pl.mirror:
+                rows.append(cc)
+                cols.append(rr)
+                vals.append(-blocks.ravel())
+        n = self.n_red
+        K = sp.coo_matrix(
+            (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)
+        ).tocsr()
+        K.sum_duplicates()
+        self._cache[key] = K
+        return K
+
+    def reduced_rhs(self, lam: float) -> Array:
+        """``[-g_r; -h] + sum_p W+_p (V_p + lam I)^-1 g_e,p``."""
+        _, Vinv = self.point_factors(lam)
+        y = np.einsum("pij,pj->pi", Vinv, self.g_e)
+        rhs = np.concatenate([-self.g_r, -self.hs])
+        for T, s in zip(self.T, self.plan.sets):
+            contrib = (T @ y[s.point][:, :, None])[:, :, 0]
+            rows = s.rows[s.sig]
+            rhs += np.bincount(rows.ravel(), weights=contrib.ravel(), minlength=rhs.size)
+        return rhs
+
+    def solve(self, lam: float) -> tuple[Array, Array]:
+        """Scaled step ``z`` (n,) and multipliers ``k`` (mc,) of the damped system."""
+        plan = self.plan
+        K = self.reduced_matrix(lam)
+        rhs = self.reduced_rhs(lam)
+        n_r, mc = plan.n_r, self.mc
+        try:
+            if self.use_sparse:
+                lu = spla.splu(
+                    K.tocsc(),
+                    permc_spec="MMD_AT_PLUS_A",
+                    diag_pivot_thresh=0.0 if mc == 0 else 1.0,
+                    options={"SymmetricMode": mc == 0},
+                )
+                sol = lu.solve(rhs)
+            else:
+                Kd = K.toarray()
+                if mc == 0:
+                    cf = sla.cho_factor(Kd, lower=True, check_finite=False)
+                    sol = sla.cho_solve(cf, rhs, check_finite=False)
+                else:
+                    sol = sla.solve(Kd, rhs, assume_a="sym", check_finite=False)
+        except (RuntimeError, np.linalg.LinAlgError, ValueError) as exc:
+            raise SingularSystem(str(exc)) from None
+        if not np.isfinite(sol).all():
+            raise SingularSystem("non-finite solution")
+        zr, k = sol[:n_r], sol[n_r:]
+        _, Vinv = self.point_factors(lam)
+        acc = -self.g_e.copy()
+        for T, s in zip(self.T, plan.sets):
+            zs = sol[s.rows[s.sig]]  # (O, kk)
+            contrib = (zs[:, None, :] @ T)[:, 0, :]
+            for j in range(plan.b):
+                acc[:, j] -= np.bincount(s.point, weights=contrib[:, j], minlength=plan.P)
+        ze = np.einsum("pij,pj->pi", Vinv, acc)
+        z = np.empty(plan.n)
+        z[plan.reduced] = zr
+        z[plan.elim.ravel()] = ze.ravel()
+        if not np.isfinite(z).all():
+            raise SingularSystem("non-finite solution")
+        return z, k
+
+    def observability_parts(self) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
+        """(S, C~) at lam = 0: the reduced matrix and the reduced constraint rows."""
+        K = self.reduced_matrix(0.0)
+        n_r = self.plan.n_r
+        S = K[:n_r, :n_r].tocsr()
+        C = K[n_r:, :n_r].tocsr() if self.mc else None
+        return S, C
+
+    # -- cofactor ----------------------------------------------------------------------------
+
+    def cofactor(self) -> BlockCofactor:
+        """Blocks of ``Qxx`` in the original units (see :class:`BlockCofactor`)."""
+        plan = self.plan
+        K = self.reduced_matrix(0.0).toarray()
+        n_r = plan.n_r
+        try:
+            if self.mc == 0:
+                cf = sla.cho_factor(K, lower=True, check_finite=False)
+                M = sla.cho_solve(cf, np.eye(K.shape[0]), check_finite=False)
+            else:
+                M = sla.inv(K, check_finite=False)
+        except (np.linalg.LinAlgError, ValueError) as exc:
+            raise SingularSystem(str(exc)) from None
+        M = 0.5 * (M + M.T)
+        _, Vinv = self.point_factors(0.0)
+        acc = [np.zeros_like(T) for T in self.T]
+        for pl in plan.pairs:
+            a, b = plan.sets[pl.s1], plan.sets[pl.s2]
+            Ta, Tb = self.T[pl.s1], self.T[pl.s2]
+            kb = Tb.shape[1:]
+            ka = Ta.shape[1:]
+
+            def fwd(items: Index, a=a, b=b, Tb=Tb, o1=pl.o1, o2=pl.o2) -> Array:
+                ra, rb = a.rows[a.sig[o1[items]]], b.rows[b.sig[o2[items]]]
+                return M[ra[:, :, None], rb[:, None, :]] @ Tb[o2[items]]
+
+            acc[pl.s1] += pl.o1_reducer.sum(fwd, (ka[0], kb[1]))
+            if pl.o2_reducer is not None:
+
+                def bwd(items: Index, a=a, b=b, Ta=Ta, o1=pl.o1, o2=pl.o2) -> Array:
+                    ra, rb = a.rows[a.sig[o1[items]]], b.rows[b.sig[o2[items]]]
+                    return M[rb[:, :, None], ra[:, None, :]] @ Ta[o1[items]]
+
+                acc[pl.s2] += pl.o2_reducer.sum(bwd, (kb[0], ka[1]))
+        inner = np.zeros((plan.P, plan.b, plan.b))
+        for T, A, s in zip(self.T, acc, plan.sets):
+            contrib = np.swapaxes(T, 1, 2) @ A  # (O, b, b)
+            for i in range(plan.b):
+                for j in range(plan.b):
+                    inner[:, i, j] += np.bincount(
+                        s.point, weights=contrib[:, i, j], minlength=plan.P
+                    )
+        Qpp = Vinv + Vinv @ inner @ Vinv
+        Qpp = 0.5 * (Qpp + np.swapaxes(Qpp, 1, 2))
+        if self.dead is not None and self.dead.any():
+            Qpp[self.dead] = np.nan  # not adjusted: no precision
+        cross = [-(A @ Vinv[s.point]) for A, s in zip(acc, plan.sets)]
+        d = self.d
+        dr = d[plan.reduced]
+        de = d[plan.elim]  # (P, b)
+        live = np.ones(plan.P, dtype=bool) if self.dead is None else ~self.dead
+        if not (np.isfinite(M).all() and np.isfinite(Qpp[live]).all()):
+            raise SingularSystem("non-finite cofactor matrix")
+        return BlockCofactor(
+            reduced_index=plan.reduced.copy(),
+            Q_reduced=M[:n_r, :n_r] / np.outer(dr, dr),
+            eliminated_index=plan.elim.copy(),
+            Q_eliminated=Qpp / (de[:, :, None] * de[:, None, :]),
+            _plan=plan,
+            _M=M,
+            _Qpp_s=Qpp,
+            _cross=cross,
+            _d=d,
+        )
+
+
+@dataclass
+class BlockCofactor:
+    """The cofactor matrix ``Qxx`` of an adjustment with eliminated blocks, in blocks.
+
+    Attributes
+    ----------
+    reduced_index : ndarray of int, shape (n_r,)
+        Parameters that were not eliminated, in the order of ``Q_reduced``.
+    Q_reduced : ndarray, shape (n_r, n_r)
+        Their cofactor matrix (full).
+    eliminated_index : ndarray of int, shape (P, b)
+        The eliminated blocks.
+    Q_eliminated : ndarray, shape (P, b, b)
+        The cofactor matrix of each block (cross blocks between blocks are not formed).
+    """
+
+    reduced_index: Index
+    Q_reduced: Array
+    eliminated_index: Index
+    Q_eliminated: Array
+    _plan: EliminationPlan = field(repr=False)
+    _M: Array = field(repr=False)
+    _Qpp_s: Array = field(repr=False)
+    _cross: list[Array] = field(repr=False)
+    _d: Array = field(repr=False)
+
+    def diagonal(self) -> Array:
+        """``diag(Qxx)`` of all ``n`` parameters."""
+        out = np.empty(self._plan.n)
+        out[self.reduced_index] = np.diag(self.Q_reduced)
+        out[self.eliminated_index.ravel()] = np.einsum("pii->pi", self.Q_eliminated).ravel()
+        return out
+
+    def block(self, index: ArrayLike) -> Array:
+        """``Qxx[index][:, index]`` for parameters that are all reduced, or all of one block.
+
+        Raises
+        ------
+        InputError
+            When the indices mix blocks (cross-covariances between points are not formed).
+        """
+        idx = np.asarray(index, dtype=np.intp).ravel()
+        plan = self._plan
+        pts = plan.point_of[idx]
+        if (pts < 0).all():
+            r = plan.rmap[idx]
+            return self.Q_reduced[np.ix_(r, r)]
+        if (pts >= 0).all() and np.unique(pts).size == 1:
+            p = int(pts[0])
+            slots = np.array([int(np.flatnonzero(plan.elim[p] == i)[0]) for i in idx])
+            return self.Q_eliminated[p][np.ix_(slots, slots)]
+        raise InputError(
+            "the cofactor blocks hold the reduced parameters and each eliminated block alone; "
+            "the requested parameters span several of them"
+        )
+
+    def group_blocks(self, block: int, sel: Index) -> Array:
+        """``Qxx`` at the parameter indices of the groups ``sel`` of observation block
+        ``block``: (len(sel), k, k), in the original units."""
+        plan = self._plan
+        bp = plan.plans[block]
+        kr, ke = bp.rc.size, bp.ec.size
+        k = kr + ke
+        g = sel.size
+        Q = np.zeros((g, k, k))
+        rr = bp.rrows[sel]
+        if kr:
+            Q[:, bp.rc[:, None], bp.rc[None, :]] = self._M[rr[:, :, None], rr[:, None, :]]
+        if ke:
+            pt = bp.point[sel]
+            es = bp.eslot[sel]
+            Qp = self._Qpp_s[pt]  # (g, b, b)
+            Q[:, bp.ec[:, None], bp.ec[None, :]] = Qp[
+                np.arange(g)[:, None, None], es[:, :, None], es[:, None, :]
+            ]
+            if kr:
+                # cross block rows in rc order: varying columns from the group's own
+                # occurrence, shared columns from the block's occurrence at the point
+                X = np.zeros((g, kr, plan.b))
+                if bp.vc.size:
+                    occ = np.searchsorted(bp.with_point, sel)
+                    X[:, bp.vc, :] = self._cross[bp.vset][occ]
+                if bp.cc.size:
+                    X[:, bp.cc, :] = self._cross[bp.cset][bp.c_occ[sel]]
+                Xe = np.take_along_axis(X, es[:, None, :], axis=2)  # (g, kr, ke)
+                Q[:, bp.rc[:, None], bp.ec[None, :]] = Xe
+                Q[:, bp.ec[:, None], bp.rc[None, :]] = np.swapaxes(Xe, 1, 2)
+        dl = np.concatenate(
+            [
+                self._d[plan.reduced][rr] if kr else np.zeros((g, 0)),
+                self._d[plan.elim[bp.point[sel][:, None], bp.eslot[sel]]]
+                if ke
+                else np.zeros((g, 0)),
+            ],
+            axis=1,
+        )
+        order = np.concatenate([bp.rc, bp.ec])
+        dk = np.empty((g, k))
+        dk[:, order] = dl
+        return Q / (dk[:, :, None] * dk[:, None, :])
+
+
+def build_reduced_normal(
+    plan: EliminationPlan,
+    blocks: Sequence,
+    lins: Sequence,
+    active: Sequence[NDArray[np.bool_]],
+    C: sp.csr_matrix | None,
+    h: Array,
+    rowscale: Array | None,
+) -> tuple[ReducedNormal, Array | None]:
+    """Assemble the reduced system of one linearisation (see the module docstring).
+
+    ``lins`` are the whitened linearisations of the blocks (``abar`` (G, c, k), ``wbar``
+    (G, c)); ``C`` the constraint Jacobian (mc, n) and ``h`` its values. Returns the system
+    and the constraint row scale (computed on the first call, then reused).
+    """
+    n = plan.n
+    diag = np.zeros(n)
+    grad = np.zeros(n)
+    for bk, bl, a in zip(blocks, lins, active):
+        if bk.groups == 0:
+            continue
+        A = bl.abar * a[:, None, None]
+        w = bl.wbar * a[:, None]
+        diag += np.bincount(bk.param_index.ravel(), weights=(A * A).sum(axis=1).ravel(),
+                            minlength=n)  # fmt: skip
+        grad += np.bincount(bk.param_index.ravel(),
+                            weights=(w[:, None, :] @ A)[:, 0, :].ravel(), minlength=n)  # fmt: skip
+    d = np.sqrt(np.clip(diag, 0.0, None))
+    if C is not None:
+        cn = np.sqrt(np.asarray(C.multiply(C).sum(axis=0)).ravel())
+        d = np.where(d > 0, d, cn)
+    d = np.where(d > 0, d, 1.0)
+    dinv = 1.0 / d
+    mc = 0 if C is None else C.shape[0]
+    plan.finish(mc)
+    n_r, b, P = plan.n_r, plan.b, plan.P
+    urows: list[Index] = []
+    ucols: list[Index] = []
+    uvals: list[Array] = []
+    V = np.zeros((P, b, b))
+    g_e = np.zeros((P, b))
+    T: list[Array | None] = [None] * len(plan.sets)
+    for bk, bl, a, bp in zip(blocks, lins, active, plan.plans):
+        g = bk.groups
+        if g == 0:
+            continue
+        As = bl.abar * (a[:, None, None] * dinv[bk.param_index][:, None, :])
+        w = bl.wbar * a[:, None]
+        R = As[:, :, bp.rc]
+        ke = bp.ec.size
+        if ke and bp.eslot_identity:
+            E = As[:, :, bp.ec]
+        elif ke:
+            E = np.zeros((g, As.shape[1], b))
+            for j in range(ke):
+                E[np.arange(g), :, bp.eslot[:, j]] += As[:, :, bp.ec[j]]
+        kr = bp.rc.size
+        if kr and bp.u_reducer is not None:
+            UR = bp.u_reducer.sum_outer(lambda it, R=R: R[it], None, kr, kr)
+            rs = bp.sig_rows
+            urows.append(np.broadcast_to(rs[:, :, None], UR.shape).ravel())
+            ucols.append(np.broadcast_to(rs[:, None, :], UR.shape).ravel())
+            uvals.append(UR.ravel())
+        if ke and bp.v_reducer is not None:
+            wp = bp.with_point
+            every = wp.size == g
+            Ew, ww = (E, w) if every else (E[wp], w[wp])
+            V += bp.v_reducer.sum_outer(lambda it, Ew=Ew: Ew[it], None, b, b)
+            g_e += bp.v_reducer.sum(
+                lambda it, Ew=Ew, ww=ww: (ww[it][:, None, :] @ Ew[it])[:, 0, :], (b,)
+            )
+            if kr:
+                Rw = R if every else R[wp]
+                if bp.vset >= 0:
+                    T[bp.vset] = np.swapaxes(Rw[:, :, bp.vc], 1, 2) @ Ew
+                if bp.cset >= 0:
+                    Rc = Rw[:, :, bp.cc]
+                    kc = bp.cc.size
+                    T[bp.cset] = bp.c_reducer.sum_outer(
+                        lambda it, Rc=Rc: Rc[it], lambda it, Ew=Ew: Ew[it], kc, b
+                    )
+    # blocks whose every group is set aside (see adjustment._cascade) stay where they are:
+    # a unit block keeps the reduced system regular and their step zero
+    dead = np.einsum("pii->p", V) == 0.0
+    if dead.any():
+        V[dead] = np.eye(b)
+        g_e[dead] = 0.0
+    g_r = grad[plan.reduced] * dinv[plan.reduced]
+    ns = grad * dinv
+    hs = np.zeros(0)
+    if C is not None:
+        Cd = sp.csr_matrix(C @ sp.diags(dinv))
+        if rowscale is None:
+            rn = np.sqrt(np.asarray(Cd.multiply(Cd).sum(axis=1)).ravel())
+            rowscale = np.where(rn > 0, 1.0 / np.where(rn > 0, rn, 1.0), 1.0)
+        Cs = sp.csr_matrix(sp.diags(rowscale) @ Cd)
+        hs = rowscale * h
+        Cr = Cs[:, plan.reduced].tocoo()
+        # the borders of U+: C_r at rows n_r.., and its transpose
+        urows += [n_r + Cr.row, Cr.col]
+        ucols += [Cr.col, n_r + Cr.row]
+        uvals += [Cr.data, Cr.data]
+        if plan.kset >= 0:
+            cols = plan.elim[plan.sets[plan.kset].point].ravel()  # (Ok * b,)
+            Ce = Cs[:, cols].toarray()  # (mc, Ok * b)
+            T[plan.kset] = np.ascontiguousarray(
+                Ce.reshape(mc, -1, b).transpose(1, 0, 2)
+            )  # (Ok, mc, b)
+    for i, s in enumerate(plan.sets):
+        if T[i] is None:
+            T[i] = np.zeros((s.point.size, s.rows.shape[1], b))
+    nred = n_r + mc
+    red = ReducedNormal(
+        plan=plan,
+        d=d,
+        ns=ns,
+        u_rows=np.concatenate(urows) if urows else np.zeros(0, dtype=np.intp),
+        u_cols=np.concatenate(ucols) if ucols else np.zeros(0, dtype=np.intp),
+        u_vals=np.concatenate(uvals) if uvals else np.zeros(0),
+        g_r=g_r,
+        V=V,
+        g_e=g_e,
+        T=T,  # type: ignore[arg-type]
+        hs=hs,
+        mc=mc,
+        dead=dead,
+    )
+    if nred > _DENSE_MAX:
+        try:
+            nnz = red.reduced_matrix(0.0).nnz
+        except SingularSystem:
+            nnz = 0  # diagnosed by the observability check
+        red.use_sparse = nnz <= _SPARSE_MAX_DENSITY * nred * nred
+    return red, rowscale
