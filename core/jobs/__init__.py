@@ -8,6 +8,7 @@ from . import (
     extract_roof_planes,
     ground_filter,
     monoplot,
+    resection,
     trajectory_to_eo,
 )
 
@@ -20,4 +21,5 @@ ALGORITHMS = (
     extract_roof_planes,
     boresight_calibration,
     monoplot,
+    resection,
 )

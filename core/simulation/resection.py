@@ -84,6 +84,81 @@ class ResectionScene:
         return ResectionData(**kw)
 
 
+def write_scene_files(
+    folder,
+    scene: ResectionScene,
+    data: ResectionData,
+    crs: str = "EPSG:32632",
+    origin_map=(500000.0, 5500000.0, 100.0),
+    image_id: str = "img1",
+) -> dict:
+    """Write one image's observations and control as the resection job's files, placing the
+    scene's local frame (ENU) at ``origin_map`` of the mapping CRS ``crs``.
+
+    Files: ``camera.json``, ``observations.csv`` (control points as ``lcp`` rows, line points
+    as ``line`` rows), ``control_points.csv`` (point_id,X,Y,Z,sx,sy,sz),
+    ``control_lines.csv`` (id,x1..z2,sigma_start,sigma_end) and ``eo_true.csv`` (the true
+    orientation in the mapping CRS). Returns the paths by name and the ``local`` frame.
+    """
+    from pathlib import Path
+
+    from ..geometry.frames import LocalFrame, MappingFrame
+    from ..geometry.rotations import opk_to_matrix
+    from ..io.camera import write_camera_json
+    from ..io.observations import write_observations_csv
+    from ..io.orientation import write_eo_csv
+    from ..io.tables import write_csv_atomic
+    from ..photo.observations import ImageObservations
+    from ..photo.orientation import ExteriorOrientationTable, eo_local_to_map
+
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    mapping = MappingFrame.from_user_input(crs)
+    local = LocalFrame.at_map_point(mapping, np.asarray(origin_map, dtype=np.float64))
+    paths = {k: out / f"{k}.csv" for k in ("observations", "control_points", "control_lines",
+                                            "eo_true")}  # fmt: skip
+    paths["camera"] = out / "camera.json"
+    write_camera_json(paths["camera"], scene.camera)
+    rows = {"image_id": [], "point_id": [], "pixels": [], "sigma_px": [], "type": [],
+            "target_id": []}  # fmt: skip
+
+    def add(pid, px, sig, kind, target):
+        rows["image_id"].append(image_id)
+        rows["point_id"].append(pid)
+        rows["pixels"].append(px)
+        rows["sigma_px"].append(sig)
+        rows["type"].append(kind)
+        rows["target_id"].append(target)
+
+    for pid, px, sig in zip(data.point_ids, data.pixels, data.sigma_px):
+        add(pid, px, sig, "lcp", pid)
+    for lid, pxs, sigs in zip(data.line_ids, data.line_pixels, data.line_sigma_px):
+        for j, (px, sig) in enumerate(zip(pxs, sigs)):
+            add(f"{lid}_{j + 1}", px, sig, "line", lid)
+    write_observations_csv(paths["observations"], ImageObservations.from_arrays(
+        rows["image_id"], rows["point_id"], np.array(rows["pixels"]).reshape(-1, 2),
+        rows["sigma_px"], rows["type"], rows["target_id"]))  # fmt: skip
+    xyz = local.enu_to_map(data.xyz) if data.n_points else np.empty((0, 3))
+    sig = np.sqrt(np.clip(np.diagonal(data.xyz_cov, axis1=1, axis2=2), 0, None))
+    write_csv_atomic(paths["control_points"], ("point_id", "X", "Y", "Z", "sx", "sy", "sz"),
+                     [(i, *map(repr, map(float, p)), *map(repr, map(float, s)))
+                      for i, p, s in zip(data.point_ids, xyz, sig)])  # fmt: skip
+    p1 = local.enu_to_map(data.line_p1) if data.n_lines else np.empty((0, 3))
+    p2 = local.enu_to_map(data.line_p2) if data.n_lines else np.empty((0, 3))
+    # the 3D sigma of each end: sqrt of the trace of its 3 x 3 covariance
+    s3 = np.sqrt(np.clip(np.trace(data.line_cov[:, :3, :3], axis1=1, axis2=2), 0, None))
+    s3b = np.sqrt(np.clip(np.trace(data.line_cov[:, 3:, 3:], axis1=1, axis2=2), 0, None))
+    write_csv_atomic(paths["control_lines"],
+                     ("id", "x1", "y1", "z1", "x2", "y2", "z2", "sigma_start", "sigma_end"),
+                     [(i, *map(repr, map(float, a)), *map(repr, map(float, b)), repr(float(u)),
+                       repr(float(w))) for i, a, b, u, w in zip(data.line_ids, p1, p2, s3, s3b)])
+    m = opk_to_matrix(*scene.eo[3:])[None]
+    exyz, eopk = eo_local_to_map(scene.eo[None, :3], m, local)
+    write_eo_csv(paths["eo_true"], ExteriorOrientationTable(
+        (image_id,), np.array([np.nan]), ("",), exyz, eopk, mapping.crs.to_wkt()))
+    return {**paths, "local": local}
+
+
 def _draw(rng: np.random.Generator, cov: Array) -> Array:
     """One sample of N(0, cov) per row of a (G, n, n) stack (semi-definite allowed)."""
     w, v = np.linalg.eigh(cov)
