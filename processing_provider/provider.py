@@ -14,6 +14,8 @@ from .algorithms.create_lcps import CreateLcpsAlgorithm
 from .algorithms.extract_roof_planes import ExtractRoofPlanesAlgorithm
 from .algorithms.ground_filter import GroundFilterAlgorithm
 from .algorithms.monoplot import MonoplotAlgorithm
+from .algorithms.orthomosaic import OrthomosaicAlgorithm
+from .algorithms.orthorectify import OrthorectifyAlgorithm
 from .algorithms.resection import ResectionAlgorithm
 from .algorithms.trajectory_to_eo import TrajectoryToEoAlgorithm
 
@@ -51,5 +53,7 @@ class LidarPhotoProvider(QgsProcessingProvider):
             BoresightCalibrationAlgorithm(),
             MonoplotAlgorithm(),
             ResectionAlgorithm(),
+            OrthorectifyAlgorithm(),
+            OrthomosaicAlgorithm(),
         ):
             self.addAlgorithm(alg)

@@ -8,6 +8,8 @@ from . import (
     extract_roof_planes,
     ground_filter,
     monoplot,
+    orthomosaic,
+    orthorectify,
     resection,
     trajectory_to_eo,
 )
@@ -22,4 +24,6 @@ ALGORITHMS = (
     boresight_calibration,
     monoplot,
     resection,
+    orthorectify,
+    orthomosaic,
 )
