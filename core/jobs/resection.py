@@ -96,13 +96,13 @@ lines parallel).""",
               file_filter=CSV_OUT),
         Param("OUTPUT_HTML", "file_out", "Summary (HTML)", optional=True,
               file_filter="HTML files (*.html)"),
-    ),  # fmt: skip
+    ),
     results=(
         Result("IMAGE_COUNT", "number", "Images resected"),
         Result("SIGMA0", "number", "Largest sigma0 a-posteriori"),
     ),
     tags=("resection", "orientation", "exterior orientation", "straight lines", "lidar lines",
-          "equivalent planes", "pnp"),  # fmt: skip
+          "equivalent planes", "pnp"),
     references=(
         "dos Santos, Dal Poz & Dalmolin (2010)",
         "Tommaselli & Tozzi (1996)",

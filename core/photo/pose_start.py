@@ -167,33 +167,43 @@ def _system(
     return a, p, np.einsum("li,lj->lij", p, a).reshape(-1, 9)  # kron(P, a) per row
 
 
-def _refine(k_sqrt: Array, r0: Array, iterations: int = 30) -> tuple[Array, float]:
-    """Gauss-Newton with damping on SO(3): min ||L vec(R)||^2, ``R = exp([d]x) R0``."""
+def _exp(step: Array) -> Array:
+    """Rotation matrices (S, 3, 3) of rotation vectors (S, 3) (Rodrigues)."""
+    angle = np.linalg.norm(step, axis=1)
+    axis = step / np.where(angle > 0, angle, 1.0)[:, None]
+    kx = skew(axis)
+    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
+    return np.eye(3) + s * kx + (1 - c) * (kx @ kx)
+
+
+def _refine(k_sqrt: Array, r0: Array, iterations: int = 40) -> tuple[Array, Array]:
+    """Levenberg-Marquardt on SO(3) for a batch of starts ``r0`` (S, 3, 3): min ||L vec(R)||^2
+    with ``R = exp([d]x) R``; returns the rotations (S, 3, 3) and their costs (S,)."""
     r = r0.copy()
-    cost = float(np.sum((k_sqrt @ _vec(r)) ** 2))
-    lam = 1e-6
+    cost = np.sum((_vec(r) @ k_sqrt.T) ** 2, axis=1)
+    lam = np.full(len(r), 1e-6)
     gens = skew(np.eye(3))  # [e_k]x, (3, 3, 3)
     for _ in range(iterations):
-        res = k_sqrt @ _vec(r)
-        jac = k_sqrt @ _vec(gens @ r).T  # (9, 3)
-        n = jac.T @ jac
-        g = jac.T @ res
-        improved = False
-        while lam < 1e8:
-            step = -np.linalg.solve(n + lam * np.diag(np.diag(n) + 1e-12), g)
-            angle = float(np.linalg.norm(step))
-            kx = skew(step / angle) if angle > 0 else np.zeros((3, 3))
-            rot = np.eye(3) + np.sin(angle) * kx + (1 - np.cos(angle)) * kx @ kx
-            trial = rot @ r
-            c = float(np.sum((k_sqrt @ _vec(trial)) ** 2))
-            if c <= cost:
-                r, cost, lam, improved = trial, c, lam * 0.1, True
-                break
-            lam *= 10.0
-        if not improved or angle < 1e-12:
+        res = _vec(r) @ k_sqrt.T  # (S, 9)
+        jac = np.einsum("ij,skj->sik", k_sqrt, _vec(gens[None] @ r[:, None]))  # (S, 9, 3)
+        n = np.swapaxes(jac, 1, 2) @ jac
+        g = np.einsum("sik,si->sk", jac, res)
+        damp = lam[:, None, None] * (np.eye(3) * (np.diagonal(n, axis1=1, axis2=2)[:, None, :]
+                                                  + 1e-12))  # fmt: skip
+        step = -np.linalg.solve(n + damp, g[:, :, None])[:, :, 0]
+        trial = _exp(step) @ r
+        c = np.sum((_vec(trial) @ k_sqrt.T) ** 2, axis=1)
+        better = c <= cost
+        r = np.where(better[:, None, None], trial, r)
+        cost = np.where(better, c, cost)
+        lam = np.where(better, lam * 0.1, lam * 10.0)
+        if (np.linalg.norm(step, axis=1)[better] < 1e-12).all() and (better | (lam > 1e8)).all():
             break
     u, _, vt = np.linalg.svd(r)
-    return u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt, cost
+    d = np.linalg.det(u @ vt)
+    fix = np.ones((len(r), 3))
+    fix[:, 2] = d
+    return (u * fix[:, None, :]) @ vt, cost
 
 
 def pose_candidates(
@@ -277,8 +287,9 @@ def pose_candidates(
     if _ROTATIONS is None:
         _ROTATIONS = _samples()
     vr = _vec(_ROTATIONS)
-    costs = np.einsum("si,ij,sj->s", vr, kmat, vr)
-    order = np.argsort(costs)
+    costs = np.sum((vr @ kmat) * vr, axis=1)
+    best = np.argpartition(costs, 2000)[:2000]
+    order = best[np.argsort(costs[best])]
     seeds: list[Array] = []
     for i in order:
         r = _ROTATIONS[i]
@@ -291,8 +302,9 @@ def pose_candidates(
                 break
     a_pinv = np.linalg.pinv(a)
     out: list[PoseCandidate] = []
-    for r0 in seeds:
-        r, cost = _refine(k_sqrt, r0)
+    refined, refined_cost = _refine(k_sqrt, np.array(seeds))
+    for r, cost in zip(refined, refined_cost):
+        cost = float(cost)
         t = -a_pinv @ (b @ _vec(r))
         cam_pts = (p @ r.T) + t
         front = float(np.mean(cam_pts[:, 2] < 0))
@@ -318,7 +330,7 @@ def pose_candidates(
             t = m @ (centre - eo[:3])
             res = a @ t + b @ _vec(m)
             out.append(PoseCandidate(eo, float(res @ res), front, "OpenCV solvePnP (SQPnP)"))
-        except Exception:  # noqa: BLE001 - the global candidates remain
+        except Exception:
             pass
     out.sort(key=lambda c: c.cost)
     return out

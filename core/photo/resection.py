@@ -28,9 +28,9 @@ from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians
 from ..geometry.frames import LocalFrame, MappingFrame
 from ..geometry.lines import camera_vectors, coplanarity, image_vectors, parametrisation
+from ..geometry.rotations import matrix_to_opk, opk_to_matrix
 from ..lsq.adjustment import adjust
 from ..lsq.model import AdjustmentOptions, GaussMarkovBlock, prior_block
-from ..geometry.rotations import matrix_to_opk, opk_to_matrix
 from ..lsq.results import AdjustmentResult, ChiSquareTest
 from .observations import ImageObservations
 from .orientation import eo_local_to_map, eo_map_to_local
@@ -130,6 +130,8 @@ def space_resection(
 
 #: Line models of :func:`resect` (the first is the default).
 MODELS = ("coplanarity", "equivalent_planes")
+#: Equivalent-planes parametrisations: per line (the source's rule), or one for all lines.
+PARAMETRISATIONS = ("auto", "horizontal", "vertical")
 #: Names of the interior orientation parameters refined with ``estimate_interior``.
 IO_NAMES = ("focal_mm", "x0_mm", "y0_mm")
 #: Along-line standard deviation given to the end points of a 3D line (metres): where a line
@@ -145,7 +147,7 @@ MIN_LINE_LENGTH_M = 1e-3
 #: 1e-4 to 1e-3 sigma at the rounding floor of the cost (pixels of 1e3 to 1e4 carry 1e-12 of
 #: rounding), and the Gauss-Helmert cost of lines, non-linear in the 3D points, is met only
 #: to about that level by the linearised cost the step control compares.
-RESECTION_TOLERANCE = 1e-4
+RESECTION_TOLERANCE = 1e-6
 #: Largest angle (degrees) between 3D lines still counted as parallel by the diagnosis.
 PARALLEL_DEG = 1.0
 
@@ -270,6 +272,10 @@ class ResectionOptions:
     eo_prior_sigma : tuple of 6 floats, optional
         With a start pose, weight it as observations with these sigmas (m, m, m, rad, rad,
         rad): the source's weighted constraints on the approximate orientation.
+    parametrisation : str
+        Equivalent planes only: ``"auto"`` (per line by its direction, the source's rule),
+        ``"horizontal"`` (``y = a x + b`` for every line) or ``"vertical"`` (``x = a* y +
+        b*``), for studies of the two parametrisations.
     """
 
     model: str = MODELS[0]
@@ -280,10 +286,14 @@ class ResectionOptions:
     damping: bool = True
     max_iterations: int = 50
     eo_prior_sigma: tuple[float, ...] | None = None
+    parametrisation: str = "auto"
 
     def __post_init__(self) -> None:
         if self.model not in MODELS:
             raise InputError(f"model '{self.model}' is not one of {', '.join(MODELS)}")
+        if self.parametrisation not in PARAMETRISATIONS:
+            raise InputError(f"parametrisation '{self.parametrisation}' is not one of "
+                             f"{', '.join(PARAMETRISATIONS)}")  # fmt: skip
         if self.eo_prior_sigma is not None:
             s = tuple(float(v) for v in self.eo_prior_sigma)
             if len(s) != 6 or not all(v > 0 and math.isfinite(v) for v in s):
@@ -469,6 +479,8 @@ class _Problem:
                                                       self._index(idx.size), labels))  # fmt: skip
                     else:
                         kind = parametrisation(image_vectors(px, camera)[0])
+                        if options.parametrisation != "auto":
+                            kind[:] = PARAMETRISATIONS.index(options.parametrisation) - 1
                         ab, ab_cov = observed_line_parameters(camera, px, sig, kind)
                         eqp = EquivalentPlanes(camera, bool(flag), data.line_p1[idx],
                                                data.line_p2[idx], kind)  # fmt: skip
@@ -676,9 +688,9 @@ def resect(
         correlation=corr[:6, :6].copy(), interior=interior, interior_std=interior_std,
         sigma0=float(adj.sigma0), redundancy=int(r), chi2=adj.global_test, chi2_critical=crit,
         point_v=point_v, point_w=point_w, point_rejected=point_rej, line_v=tuple(line_v),
-        line_distance_px=dist, line_ab_v=line_ab_v, line_w=line_w, line_rejected=line_rej, start=start,
-        start_eo=start_eo, model=opts.model, iterations=adj.iterations, adjustment=adj,
-        warnings=tuple(warnings),
+        line_distance_px=dist, line_ab_v=line_ab_v, line_w=line_w, line_rejected=line_rej,
+        start=start, start_eo=start_eo, model=opts.model, iterations=adj.iterations,
+        adjustment=adj, warnings=tuple(warnings),
     )  # fmt: skip
 
 
@@ -690,14 +702,16 @@ def line_distances(data: ResectionData, eo: ArrayLike, camera: Camera) -> tuple[
     -------
     tuple of ndarray, each (K_i,)
     """
-    out = []
+    if not data.n_lines:
+        return ()
     e = np.asarray(eo, dtype=np.float64).reshape(6)
-    for v, p1, p2 in zip(data.line_pixels, data.line_p1, data.line_p2):
-        p, _, _ = image_vectors(v[None], camera)
-        a = camera_vectors(p1[None], e)[0]
-        b = camera_vectors(p2[None], e)[0]
-        out.append(coplanarity(p, a, b)[0][0] / camera.pixel_size_mm)
-    return tuple(out)
+    counts = np.array([len(v) for v in data.line_pixels])
+    which = np.repeat(np.arange(data.n_lines), counts)
+    p, _, _ = image_vectors(np.vstack(data.line_pixels), camera)
+    a = camera_vectors(data.line_p1, e)[0][which]
+    b = camera_vectors(data.line_p2, e)[0][which]
+    d = coplanarity(p[:, None, :], a, b)[0][:, 0] / camera.pixel_size_mm
+    return tuple(np.split(d, np.cumsum(counts)[:-1]))
 
 
 # ============================================================================ control sets
