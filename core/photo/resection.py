@@ -1004,19 +1004,22 @@ def image_inputs(
         lids = list(groups)
         li = [l_index[t] for t in lids]
         pc = np.array(p_ctrl, dtype=np.int64)
-        data = ResectionData(
-            point_ids=tuple(observations.point_id[k] for k in p_rows),
-            pixels=observations.pixels[p_rows].reshape(-1, 2),
-            sigma_px=observations.sigma_px[p_rows],
-            xyz=points.xyz[pc] if points is not None else np.empty((0, 3)),
-            xyz_cov=points.covariance[pc] if points is not None else np.empty((0, 3, 3)),
-            line_ids=tuple(lids),
-            line_pixels=tuple(observations.pixels[groups[t]] for t in lids),
-            line_sigma_px=tuple(observations.sigma_px[groups[t]] for t in lids),
-            line_p1=lines.p1[li] if lines is not None else np.empty((0, 3)),
-            line_p2=lines.p2[li] if lines is not None else np.empty((0, 3)),
-            line_cov=lines.covariance[li] if lines is not None else np.empty((0, 6, 6)),
-        )
+        try:
+            data = ResectionData(
+                point_ids=tuple(observations.point_id[k] for k in p_rows),
+                pixels=observations.pixels[p_rows].reshape(-1, 2),
+                sigma_px=observations.sigma_px[p_rows],
+                xyz=points.xyz[pc] if points is not None else np.empty((0, 3)),
+                xyz_cov=points.covariance[pc] if points is not None else np.empty((0, 3, 3)),
+                line_ids=tuple(lids),
+                line_pixels=tuple(observations.pixels[groups[t]] for t in lids),
+                line_sigma_px=tuple(observations.sigma_px[groups[t]] for t in lids),
+                line_p1=lines.p1[li] if lines is not None else np.empty((0, 3)),
+                line_p2=lines.p2[li] if lines is not None else np.empty((0, 3)),
+                line_cov=lines.covariance[li] if lines is not None else np.empty((0, 6, 6)),
+            )
+        except InputError as exc:  # the checks of ResectionData, with the image named
+            raise InputError(f"image {img}: {exc}") from None
         cxyz = points.xyz[np.array(c_ctrl, dtype=np.int64)] if points is not None else (
             np.empty((0, 3)))  # fmt: skip
         out.append(ImageInput(img, data, tuple(p_rows), tuple(tuple(groups[t]) for t in lids),

@@ -214,3 +214,23 @@ def test_borea_real_images_through_the_algorithm(tmp_path):
         assert np.all(np.abs(np.radians(_angle(ang - ign[3:]))) < 5 * np.radians(sig[3:]) + 2e-5)
         assert int(r["rejected"]) < 0.05 * n
         assert 0.2 < float(r["sigma0"]) < 2.0
+
+
+def test_zero_length_image_line_names_image_and_line(scene_files, tmp_path):
+    """Both points of one image line 0.5 px apart: refused, naming the image and the line."""
+    _, data, files = scene_files
+    rows = _rows(files["observations"])
+    target = data.line_ids[2]
+    first = next(r for r in rows if r["type"] == "line" and r["target_id"] == target)
+    for r in rows:
+        if r["type"] == "line" and r["target_id"] == target and r is not first:
+            r["col"] = repr(float(first["col"]) + 0.5)
+            r["row"] = first["row"]
+    with open(tmp_path / "obs.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w.writeheader()
+        w.writerows(rows)
+    v = _values(files, tmp_path, OBSERVATIONS=str(tmp_path / "obs.csv"))
+    with pytest.raises(InputError, match=f"image img1: image line {target} has zero length"):
+        run_job(resection, v)
+    assert not (tmp_path / "eo.csv").exists()
