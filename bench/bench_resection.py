@@ -1,7 +1,7 @@
 """Space resection from points and lines against OpenCV and PoseLib, Monte Carlo, start
 without approximate values and convergence from kappa errors (bench/resection.md).
 
-    PYTHONPATH=<parent of the plugin folder>:<folder holding poselib> python bench/bench_resection.py
+    PYTHONPATH=<plugin parent>:<poselib folder> python bench/bench_resection.py
 
 PoseLib (pip ``poselib``) is a benchmark-only peer: install it in a throw-away virtualenv and put
 its package on the path; without it its columns are skipped. Synthetic scenes of
@@ -63,7 +63,7 @@ def _compare(ours_eo, centre, m):
 
 def opencv_pose(data, cam):
     uv, k = _cv_pixels(data.pixels, cam)
-    ok, rvec, tvec = cv2.solvePnP(data.xyz, uv, k, None, flags=cv2.SOLVEPNP_SQPNP)
+    _ok, rvec, tvec = cv2.solvePnP(data.xyz, uv, k, None, flags=cv2.SOLVEPNP_SQPNP)
     rvec, tvec = cv2.solvePnPRefineLM(data.xyz, uv, k, None, rvec, tvec)
     rot = cv2.Rodrigues(rvec)[0]
     return _pose_from_cv(rot, tvec.ravel())
@@ -77,13 +77,13 @@ def poselib_pose(data, cam, points=True, lines=True):
     bundle = {"loss_type": "TRIVIAL"}
     if points and not lines:
         uv, _ = _cv_pixels(data.pixels, cam)
-        pose, info = poselib.estimate_absolute_pose(uv, data.xyz, camera, ransac, bundle)
+        pose, _ = poselib.estimate_absolute_pose(uv, data.xyz, camera, ransac, bundle)
     else:
         uv = _cv_pixels(data.pixels, cam)[0] if points else np.empty((0, 2))
         xyz = data.xyz if points else np.empty((0, 3))
         a = np.array([_cv_pixels(v[:1], cam)[0][0] for v in data.line_pixels])
         b = np.array([_cv_pixels(v[-1:], cam)[0][0] for v in data.line_pixels])
-        pose, info = poselib.estimate_absolute_pose_pnpl(uv, xyz, a, b, data.line_p1,
+        pose, _info = poselib.estimate_absolute_pose_pnpl(uv, xyz, a, b, data.line_p1,
                                                           data.line_p2, camera, ransac, bundle)
     return _pose_from_cv(pose.R, np.asarray(pose.t))
 
@@ -185,7 +185,7 @@ def start_anywhere(n: int, seed: int = 31) -> list[str]:
             if poselib is not None:
                 try:
                     c, m = poselib_pose(data, scene.camera, what != "lines", what != "points")
-                    dp, da = _compare(scene.eo, c, m)
+                    dp, _da = _compare(scene.eo, c, m)
                     res_ok = bool(np.all(np.abs(dp) < 5.0 * res.std[:3] + 0.01))
                     counts[what][1] += res_ok
                 except Exception:

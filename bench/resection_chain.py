@@ -15,14 +15,12 @@ from __future__ import annotations
 
 import csv
 import importlib.util
-import math
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 from lidarphoto.core.io.observations import read_observations_csv, write_observations_csv
-from lidarphoto.core.io.orientation import read_eo_csv
 from lidarphoto.core.jobs import monoplot, resection
 from lidarphoto.core.jobs.runner import run_job
 
@@ -58,7 +56,7 @@ def main(work: Path) -> int:
     t0 = time.perf_counter()
     lidar_dir, flight = work / "lidar", work / "flight"
     lidar = demo.lidar_step(lidar_dir)
-    sim, paths, truth = demo.flight_step(lidar, flight)
+    _sim, paths, truth = demo.flight_step(lidar, flight)
     obs = read_observations_csv(paths["observations"])
     # the simulation sees some lines with a single point in an image: not a line there,
     pairs = [(i, t) if k == "line" else None for i, t, k in zip(obs.image_id, obs.target_id,

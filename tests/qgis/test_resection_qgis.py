@@ -109,7 +109,7 @@ def demo(tmp_path_factory):
     spec.loader.exec_module(module)
     out = tmp_path_factory.mktemp("resection_demo")
     lidar = module.lidar_step(out / "lidar")
-    sim, paths, _ = module.flight_step(lidar, out / "flight")
+    _sim, paths, _ = module.flight_step(lidar, out / "flight")
     obs = read_observations_csv(paths["observations"])
     span: dict = {}
     for i, t, k, px in zip(obs.image_id, obs.target_id, obs.type, obs.pixels):
