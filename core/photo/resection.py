@@ -142,11 +142,11 @@ ALONG_LINE_SIGMA_M = 1.0
 MIN_IMAGE_LINE_PX = 1.0
 MIN_LINE_LENGTH_M = 1e-3
 #: Convergence tolerance of the adjustment, in standard deviations of the parameters (the
-#: engine stops when a step is below it, or below its square root, 0.01 sigma, when the cost
-#: no longer decreases). The strong correlation of position and attitude leaves steps of
-#: 1e-4 to 1e-3 sigma at the rounding floor of the cost (pixels of 1e3 to 1e4 carry 1e-12 of
-#: rounding), and the Gauss-Helmert cost of lines, non-linear in the 3D points, is met only
-#: to about that level by the linearised cost the step control compares.
+#: engine stops when a step is below it, or below its square root, 1e-3 sigma, when the cost
+#: no longer decreases: the strong correlation of position and attitude leaves steps of 1e-4
+#: to 1e-3 sigma at the rounding floor of the cost). A step that stalls above that with lines
+#: makes the engine re-solve the Gauss-Helmert residuals at the current parameters (the cost
+#: of lines is non-linear in the 3D points) and go on from the consistent cost.
 RESECTION_TOLERANCE = 1e-6
 #: Largest angle (degrees) between 3D lines still counted as parallel by the diagnosis.
 PARALLEL_DEG = 1.0
