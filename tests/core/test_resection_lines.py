@@ -188,8 +188,9 @@ def test_models_agree_at_convergence():
 
 
 @pytest.mark.parametrize(
-    "what", [dict(points=True, lines=False), dict(points=False, lines=True)],
-    ids=["points", "lines"],
+    "what", [dict(points=True, lines=False), dict(points=False, lines=True),
+             dict(points=True, lines=True)],
+    ids=["points", "lines", "mixed"],
 )  # fmt: skip
 def test_monte_carlo_rmse_matches_reported_sigmas(what):
     """400 draws of pixel noise and of the control's noise (LiDAR lines 5 cm across, points
