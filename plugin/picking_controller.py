@@ -122,7 +122,7 @@ class PickingController(QObject):
         if 0 <= k < len(all_rows) and all_rows[k].image_id == img:
             sel = bisect.bisect_left(rows, k)  # (rows ascending, k among them)
         overlays.set_observations([all_rows[k] for k in rows], sel)
-        res = self.session.residuals()
+        res = self.session.shown_residuals()
         if res:
             drawn = [k for k in rows if k in res]
             px, v = log.pixels(drawn), np.array([res[k] for k in drawn]).reshape(-1, 2)
@@ -132,18 +132,24 @@ class PickingController(QObject):
         self.draw_predictions()
 
     def draw_predictions(self) -> None:
-        """The pending tie point's prediction in the current image (if any)."""
+        """The pending tie point's prediction in the current image (if any), and the image
+        line being measured with its LiDAR line's predicted position."""
         pending = self.session.pending
         pred = self.session.prediction(self.dock.current_image) if self.oriented() else None
         self.viewer.overlays.set_predictions(
             np.reshape(pred if pred is not None else [], (-1, 2)),
             [pending.point_id] if pred is not None and pending is not None else [],
         )
+        half = self.session.half_line
+        if half is not None and half.image_id == self.dock.current_image and self.oriented():
+            self.viewer.overlays.add_line_prediction(
+                half.start, half.predicted, f"L{half.target.target_id}"
+            )
 
     def fill_table(self) -> None:
         log = self.store.log
         rows = log.indices_of_image(self.dock.current_image)
-        self.table.fill(log.rows, rows, self.session.residuals(), self.selected_index)
+        self.table.fill(log.rows, rows, self.session.shown_residuals(), self.selected_index)
 
     def store_changed(self) -> None:
         if self.selected_index >= len(self.store.rows):
@@ -191,6 +197,10 @@ class PickingController(QObject):
         if session.prediction(img) is not None:
             return self._added(session.confirm_prediction(img, (col, row)))  # corrected
         kind = self.viewer.type_combo.currentText()
+        half = session.half_line
+        if kind == "line" and half is not None and half.image_id == img:
+            return self._line_end(img, col, row)
+        session.cancel_line()  # (another type or image since the first click)
         tol = HIT_SCREEN_PX / max(self.viewer.view.zoom, 1e-9)
         targets = session.targets_at(img, (col, row), kind, tol, self.projected)
         if not targets:
@@ -208,6 +218,15 @@ class PickingController(QObject):
             return -1
         if kind in _LAYER_OF:
             dock.loader.links.select(_LAYER_OF[kind], target.target_id)
+        if kind == "line":  # the first click of an image line: its end comes next
+            session.start_line(img, (col, row), target, self.projected)
+            dock.message(
+                self.tr("Line on LiDAR line {}: click its other end (Esc cancels).").format(
+                    target.target_id
+                )
+            )
+            self.draw_predictions()
+            return -1
         index = session.add_observation(img, (col, row), target)  # saved by _added
         point_id = self.store.rows[index].point_id
         if kind == "tie":
@@ -221,6 +240,24 @@ class PickingController(QObject):
         elif kind == "paper":
             dock.message(self.tr("{} on plane {}.").format(point_id, target.target_id))
         return self._added(index)
+
+    def _line_end(self, img: str, col: float, row: float) -> int:
+        """The second click of an image line: its two end points are added (one undo)."""
+        tid = self.session.half_line.target.target_id  # type: ignore[union-attr]
+        index = self.session.finish_line(img, (col, row))
+        if index < 0:
+            self.dock.message(self.tr("The line's ends must be 1 px apart or more."))
+            return -1
+        self.dock.message(self.tr("Image line of LiDAR line {} measured.").format(tid))
+        self.draw_predictions()
+        return self._added(index + 1)
+
+    def cancel_line(self) -> bool:
+        """Drop the half-measured image line (Esc); whether there was one."""
+        if not self.session.cancel_line():
+            return False
+        self.draw_predictions()
+        return True
 
     def _added(self, index: int) -> int:
         if index >= 0:
