@@ -6,12 +6,12 @@ that EO; the lines are clicked on the LiDAR lines' projections, stored at the ce
 clicked pixels (a uniform error of at most 0.5 px per coordinate, 0.29 px RMS).
 """
 
+# ruff: noqa: F811 - the fixtures block and layers are imported from test_image_dock
 from __future__ import annotations
 
 import math
 
 import numpy as np
-import pytest
 from lidarphoto.core.io.observations import read_observations_csv
 from lidarphoto.core.io.orientation import read_eo_csv
 from qgis.PyQt.QtCore import QPoint, QPointF, Qt
@@ -67,7 +67,7 @@ def test_two_clicks_measure_a_line_linked_to_the_lidar_line_undo_removes_both(
     qgis_app,
     block,
     layers,
-    tmp_path,  # noqa: F811 - fixtures
+    tmp_path,
 ):
     """Two real clicks: two line rows with the LiDAR line's id at the clicked pixels' centres
     (saved); the predicted LiDAR line is drawn between the clicks; Esc cancels a half line;
@@ -115,7 +115,7 @@ def test_resect_from_the_dock_recovers_the_pose(
     qgis_app,
     block,
     layers,
-    tmp_path,  # noqa: F811 - fixtures
+    tmp_path,
 ):
     """Lines measured in the dock (end points at the centres of the pixels holding the
     projected LiDAR lines: at most 0.5 px off), then Resect: the core job reads the saved
