@@ -12,8 +12,9 @@ Modules: :mod:`.project_panel` (Project tab), :mod:`.calibration_panel` (Calibra
 :mod:`.calibration_task` (the core calibration job in a QgsTask), :mod:`.resection_task` (the
 Resection tab: the core resection job of the image shown in a QgsTask), :mod:`.viewer_panel`
 (tools, image view, status), :mod:`.observation_table`, :mod:`.picking_controller` (clicks,
-image lines and drawing), :mod:`.monoplot_control` (the Monoplot button and its DSM), :mod:`.footprint`
-(the image's footprint on the map canvas), :mod:`.observation_store` (autosave, session).
+image lines and drawing), :mod:`.monoplot_control` (the Monoplot button and its DSM),
+:mod:`.footprint` (the image's footprint on the map canvas), :mod:`.observation_store`
+(autosave, session).
 """
 
 from __future__ import annotations

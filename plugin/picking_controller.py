@@ -21,12 +21,15 @@ from qgis.PyQt.QtCore import QObject, QPointF, QTimer
 from qgis.PyQt.QtGui import QCursor
 from qgis.PyQt.QtWidgets import QMenu
 
+from ..core.photo.line_edge import refine_edge_point
 from ..core.photo.picking_session import PickTarget, ProjectedControl
 
 __all__ = ["HIT_SCREEN_PX", "PickingController"]
 
 #: hit tolerance of lines, control points and observations, screen pixels
 HIT_SCREEN_PX = 10.0
+#: the window read around a line end refined on the image's edge, pixels
+_EDGE_WINDOW_PX = 25
 _LAYER_OF = {"tie": "planes", "paper": "planes", "lcp": "lcps", "check": "lcps"}
 
 
@@ -219,7 +222,10 @@ class PickingController(QObject):
         if kind in _LAYER_OF:
             dock.loader.links.select(_LAYER_OF[kind], target.target_id)
         if kind == "line":  # the first click of an image line: its end comes next
-            session.start_line(img, (col, row), target, self.projected)
+            half = session.start_line(img, (col, row), target, self.projected)
+            refined = self._on_edge(col, row, half.predicted[1] - half.predicted[0])
+            if refined is not None:
+                session.start_line(img, refined, target, self.projected)
             dock.message(
                 self.tr("Line on LiDAR line {}: click its other end (Esc cancels).").format(
                     target.target_id
@@ -243,14 +249,37 @@ class PickingController(QObject):
 
     def _line_end(self, img: str, col: float, row: float) -> int:
         """The second click of an image line: its two end points are added (one undo)."""
-        tid = self.session.half_line.target.target_id  # type: ignore[union-attr]
-        index = self.session.finish_line(img, (col, row))
+        half = self.session.half_line
+        tid = half.target.target_id  # type: ignore[union-attr]
+        # across the line measured so far (the prediction's direction when it is short)
+        d = np.array([col, row]) - half.start  # type: ignore[union-attr]
+        if np.hypot(*d) < 5.0:
+            d = half.predicted[1] - half.predicted[0]  # type: ignore[union-attr]
+        refined = self._on_edge(col, row, d)
+        index = self.session.finish_line(img, refined if refined is not None else (col, row))
         if index < 0:
             self.dock.message(self.tr("The line's ends must be 1 px apart or more."))
             return -1
         self.dock.message(self.tr("Image line of LiDAR line {} measured.").format(tid))
         self.draw_predictions()
         return self._added(index + 1)
+
+    def _on_edge(self, col: float, row: float, direction) -> np.ndarray | None:
+        """The click refined across the edge of ``direction`` (image pixels), when the
+        Resection tab asks for it; None: not asked, or no edge near."""
+        source = self.viewer.source
+        if source is None or not self.dock.resection_panel.refine_check.isChecked():
+            return None
+        if not np.isfinite(direction).all():
+            return None
+        half = _EDGE_WINDOW_PX // 2
+        x0, y0 = max(0, int(col) - half), max(0, int(row) - half)
+        n = _EDGE_WINDOW_PX
+        window = source.read_raw(x0, y0, n, n, n, n)
+        if window.size == 0:
+            return None
+        grey = window.astype(np.float64).mean(axis=2)
+        return refine_edge_point(grey, (x0, y0), (col, row), direction)
 
     def cancel_line(self) -> bool:
         """Drop the half-measured image line (Esc); whether there was one."""

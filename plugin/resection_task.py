@@ -18,7 +18,7 @@ import numpy as np
 from qgis.core import QgsApplication, QgsTask
 from qgis.PyQt import sip
 from qgis.PyQt.QtCore import QObject, Qt, pyqtSignal
-from qgis.PyQt.QtWidgets import QLabel, QPushButton, QVBoxLayout, QWidget
+from qgis.PyQt.QtWidgets import QCheckBox, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from ..core.errors import Cancelled
 from ..core.io.control import write_lcps_csv, write_lines_csv
@@ -57,7 +57,8 @@ def resection_parameters(
 
 
 class ResectionPanel(QWidget):
-    """The Resect button and the result (pose, sigmas, sigma0, residual per line and point)."""
+    """The Resect button and the result (pose, sigmas, sigma0, residual per line and point);
+    the option refining the line ends on the image's edges."""
 
     def __init__(self, parent=None) -> None:
         super().__init__(parent)
@@ -70,10 +71,18 @@ class ResectionPanel(QWidget):
                 "measured lines and control points, no approximate values"
             ).format(RESECTION_ALG)
         )
+        self.refine_check = QCheckBox(self.tr("Refine line ends on the image edge"))
+        self.refine_check.setToolTip(
+            self.tr(
+                "Line picking: each click moves across the line to the strongest grey-value "
+                "edge within 4 px (sub-pixel)"
+            )
+        )
         self.result_label = QLabel()
         self.result_label.setWordWrap(True)
         self.result_label.setTextFormat(Qt.TextFormat.RichText)
         self.result_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        layout.addWidget(self.refine_check)
         layout.addWidget(self.resect_button)
         layout.addWidget(self.result_label, 1)
 
