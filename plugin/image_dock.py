@@ -9,10 +9,12 @@ control, the picking scene, the pending tie point, the last calibration result) 
 by :class:`.overlays.Overlays` (:mod:`.picking_controller`).
 
 Modules: :mod:`.project_panel` (Project tab), :mod:`.calibration_panel` (Calibration tab),
-:mod:`.calibration_task` (the core calibration job in a QgsTask), :mod:`.viewer_panel` (tools,
-image view, status), :mod:`.observation_table`, :mod:`.picking_controller` (clicks and
-drawing), :mod:`.monoplot_control` (the Monoplot button and its DSM), :mod:`.footprint`
-(the image's footprint on the map canvas), :mod:`.observation_store` (autosave, session).
+:mod:`.calibration_task` (the core calibration job in a QgsTask), :mod:`.resection_task` (the
+Resection tab: the core resection job of the image shown in a QgsTask), :mod:`.viewer_panel`
+(tools, image view, status), :mod:`.observation_table`, :mod:`.picking_controller` (clicks,
+image lines and drawing), :mod:`.monoplot_control` (the Monoplot button and its DSM),
+:mod:`.footprint` (the image's footprint on the map canvas), :mod:`.observation_store`
+(autosave, session).
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ from .observation_table import ObservationTable
 from .picking_controller import PickingController
 from .project_loader import ProjectLoader
 from .project_panel import ProjectPanel
+from .resection_task import ResectionController, ResectionPanel
 from .viewer_panel import ViewerPanel
 
 __all__ = ["CALIBRATION_ALG", "DOCK_HELP", "ImagePickingDock"]
@@ -48,7 +51,11 @@ _TYPE_KEYS = dict(zip("TPLCK", PICK_TYPES))
 DOCK_HELP = (
     "<b>Picking</b>: choose the type, then left-click in the image. <i>tie</i> and "
     "<i>paper</i> points take the roof plane under the cursor (a menu asks when outlines "
-    "overlap); <i>line</i> and <i>lcp</i>/<i>check</i> take the nearest line or control point. "
+    "overlap); <i>line</i>: two clicks, the image line's ends, on the LiDAR line nearest to "
+    "the first (drawn solid while measuring; Esc cancels, Ctrl+Z removes both ends; the "
+    "Resection tab can refine the ends onto the image's edge); "
+    "<i>lcp</i>/<i>check</i> take the nearest control point. <b>Resect</b> (Resection tab) "
+    "orients the image shown from its lines and control points. "
     "After a tie point the other images show its prediction (yellow x): Enter accepts it, a "
     "click puts it where you see it, Esc drops it.<br>"
     "<b>Monoplot</b> (needs a DSM in the Project tab): while the button is on, a click makes a "
@@ -66,6 +73,7 @@ class ImagePickingDock(QgsDockWidget):
 
     imageChanged = pyqtSignal(str)  # noqa: N815 - Qt signal naming
     calibrationFinished = pyqtSignal(bool)  # noqa: N815 - Qt signal naming
+    resectionFinished = pyqtSignal(bool)  # noqa: N815 - Qt signal naming
 
     def __init__(self, iface=None, parent=None) -> None:
         super().__init__(parent)
@@ -85,6 +93,7 @@ class ImagePickingDock(QgsDockWidget):
         self.monoplot_tool = MonoplotTool(self, self.project)
         self.monoplot = MonoplotController(self, self.monoplot_tool)
         self.calibration = CalibrationController(self)
+        self.resection = ResectionController(self)
         self.canvas_footprint = CanvasFootprint(iface, self.project)
         self._connect()
         self.restore_session()
@@ -98,10 +107,12 @@ class ImagePickingDock(QgsDockWidget):
         self.tabs = QTabWidget()
         self.project_panel = ProjectPanel(self.project)
         self.calibration_panel = CalibrationPanel()
+        self.resection_panel = ResectionPanel()
         help_label = QLabel(DOCK_HELP)
         help_label.setWordWrap(True)
         self.tabs.addTab(self.project_panel, self.tr("Project"))
         self.tabs.addTab(self.calibration_panel, self.tr("Calibration"))
+        self.tabs.addTab(self.resection_panel, self.tr("Resection"))
         self.tabs.addTab(help_label, self.tr("Help"))
         self.viewer = ViewerPanel(DOCK_HELP)
         self.table = ObservationTable()
@@ -121,6 +132,7 @@ class ImagePickingDock(QgsDockWidget):
         c.tablesChanged.connect(self.loader.reload_control)
         c.settingsChanged.connect(self.save_session)
         self.calibration.finished.connect(self.calibrationFinished)
+        self.resection.finished.connect(self.resectionFinished)
         v.imageSelected.connect(self.show_image)
         v.undo_button.clicked.connect(self.store.undo)
         v.redo_button.clicked.connect(self.store.redo)
@@ -265,7 +277,9 @@ class ImagePickingDock(QgsDockWidget):
         return self.picking.pick(col, row)
 
     def cancel_prediction(self) -> None:
-        self.picking.cancel_prediction()
+        """Esc: drop the half-measured image line, else the pending tie point."""
+        if not self.picking.cancel_line():
+            self.picking.cancel_prediction()
 
     def _cursor(self, col: float, row: float) -> None:
         if self.source is not None:
@@ -321,6 +335,10 @@ class ImagePickingDock(QgsDockWidget):
     def run_calibration(self) -> bool:
         """Run the boresight calibration in a background task; False if it cannot start."""
         return self.calibration.run()
+
+    def run_resection(self) -> bool:
+        """Resect the image shown in a background task; False if it cannot start."""
+        return self.resection.start()
 
     def closeEvent(self, event) -> None:
         self.store.save()

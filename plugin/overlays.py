@@ -351,3 +351,20 @@ class Overlays:
             self._add_marker(group, x, y, "circle", 14, "predictions", 1.0)
             self._label(group, text + "?", x, y, "predictions")
             self.counts["predictions"] += 1
+
+    def add_line_prediction(self, start: np.ndarray, predicted: np.ndarray, label: str) -> None:
+        """An image line being measured: its first click and the linked LiDAR line's
+        predicted position (its projected end points, (2, 2) px), drawn solid over the dashed
+        LiDAR lines (in the predictions group: the next :meth:`set_predictions` clears it)."""
+        group = self.groups["predictions"]
+        a = np.reshape(predicted, (2, 2))
+        if _finite_rows(a).all():
+            path = QPainterPath(QPointF(*a[0].tolist()))
+            path.lineTo(*a[1].tolist())
+            item = QGraphicsPathItem(path)
+            item.setPen(self._pen_of("predictions", 2.5))
+            item.setParentItem(group)
+            self._label(group, label + "?", *a.mean(axis=0).tolist(), "predictions")
+        x, y = np.reshape(start, 2).tolist()
+        self._add_marker(group, x, y, "circle", 10, "predictions", 2.0)
+        self.counts["predictions"] += 1

@@ -21,12 +21,15 @@ from qgis.PyQt.QtCore import QObject, QPointF, QTimer
 from qgis.PyQt.QtGui import QCursor
 from qgis.PyQt.QtWidgets import QMenu
 
+from ..core.photo.line_edge import refine_edge_point
 from ..core.photo.picking_session import PickTarget, ProjectedControl
 
 __all__ = ["HIT_SCREEN_PX", "PickingController"]
 
 #: hit tolerance of lines, control points and observations, screen pixels
 HIT_SCREEN_PX = 10.0
+#: the window read around a line end refined on the image's edge, pixels
+_EDGE_WINDOW_PX = 25
 _LAYER_OF = {"tie": "planes", "paper": "planes", "lcp": "lcps", "check": "lcps"}
 
 
@@ -122,7 +125,7 @@ class PickingController(QObject):
         if 0 <= k < len(all_rows) and all_rows[k].image_id == img:
             sel = bisect.bisect_left(rows, k)  # (rows ascending, k among them)
         overlays.set_observations([all_rows[k] for k in rows], sel)
-        res = self.session.residuals()
+        res = self.session.shown_residuals()
         if res:
             drawn = [k for k in rows if k in res]
             px, v = log.pixels(drawn), np.array([res[k] for k in drawn]).reshape(-1, 2)
@@ -132,18 +135,24 @@ class PickingController(QObject):
         self.draw_predictions()
 
     def draw_predictions(self) -> None:
-        """The pending tie point's prediction in the current image (if any)."""
+        """The pending tie point's prediction in the current image (if any), and the image
+        line being measured with its LiDAR line's predicted position."""
         pending = self.session.pending
         pred = self.session.prediction(self.dock.current_image) if self.oriented() else None
         self.viewer.overlays.set_predictions(
             np.reshape(pred if pred is not None else [], (-1, 2)),
             [pending.point_id] if pred is not None and pending is not None else [],
         )
+        half = self.session.half_line
+        if half is not None and half.image_id == self.dock.current_image and self.oriented():
+            self.viewer.overlays.add_line_prediction(
+                half.start, half.predicted, f"L{half.target.target_id}"
+            )
 
     def fill_table(self) -> None:
         log = self.store.log
         rows = log.indices_of_image(self.dock.current_image)
-        self.table.fill(log.rows, rows, self.session.residuals(), self.selected_index)
+        self.table.fill(log.rows, rows, self.session.shown_residuals(), self.selected_index)
 
     def store_changed(self) -> None:
         if self.selected_index >= len(self.store.rows):
@@ -191,6 +200,10 @@ class PickingController(QObject):
         if session.prediction(img) is not None:
             return self._added(session.confirm_prediction(img, (col, row)))  # corrected
         kind = self.viewer.type_combo.currentText()
+        half = session.half_line
+        if kind == "line" and half is not None and half.image_id == img:
+            return self._line_end(img, col, row)
+        session.cancel_line()  # (another type or image since the first click)
         tol = HIT_SCREEN_PX / max(self.viewer.view.zoom, 1e-9)
         targets = session.targets_at(img, (col, row), kind, tol, self.projected)
         if not targets:
@@ -208,6 +221,18 @@ class PickingController(QObject):
             return -1
         if kind in _LAYER_OF:
             dock.loader.links.select(_LAYER_OF[kind], target.target_id)
+        if kind == "line":  # the first click of an image line: its end comes next
+            half = session.start_line(img, (col, row), target, self.projected)
+            refined = self._on_edge(col, row, half.predicted[1] - half.predicted[0])
+            if refined is not None:
+                session.start_line(img, refined, target, self.projected)
+            dock.message(
+                self.tr("Line on LiDAR line {}: click its other end (Esc cancels).").format(
+                    target.target_id
+                )
+            )
+            self.draw_predictions()
+            return -1
         index = session.add_observation(img, (col, row), target)  # saved by _added
         point_id = self.store.rows[index].point_id
         if kind == "tie":
@@ -221,6 +246,47 @@ class PickingController(QObject):
         elif kind == "paper":
             dock.message(self.tr("{} on plane {}.").format(point_id, target.target_id))
         return self._added(index)
+
+    def _line_end(self, img: str, col: float, row: float) -> int:
+        """The second click of an image line: its two end points are added (one undo)."""
+        half = self.session.half_line
+        tid = half.target.target_id  # type: ignore[union-attr]
+        # across the line measured so far (the prediction's direction when it is short)
+        d = np.array([col, row]) - half.start  # type: ignore[union-attr]
+        if np.hypot(*d) < 5.0:
+            d = half.predicted[1] - half.predicted[0]  # type: ignore[union-attr]
+        refined = self._on_edge(col, row, d)
+        index = self.session.finish_line(img, refined if refined is not None else (col, row))
+        if index < 0:
+            self.dock.message(self.tr("The line's ends must be 1 px apart or more."))
+            return -1
+        self.dock.message(self.tr("Image line of LiDAR line {} measured.").format(tid))
+        self.draw_predictions()
+        return self._added(index + 1)
+
+    def _on_edge(self, col: float, row: float, direction) -> np.ndarray | None:
+        """The click refined across the edge of ``direction`` (image pixels), when the
+        Resection tab asks for it; None: not asked, or no edge near."""
+        source = self.viewer.source
+        if source is None or not self.dock.resection_panel.refine_check.isChecked():
+            return None
+        if not np.isfinite(direction).all():
+            return None
+        half = _EDGE_WINDOW_PX // 2
+        x0, y0 = max(0, int(col) - half), max(0, int(row) - half)
+        n = _EDGE_WINDOW_PX
+        window = source.read_raw(x0, y0, n, n, n, n)
+        if window.size == 0:
+            return None
+        grey = window.astype(np.float64).mean(axis=2)
+        return refine_edge_point(grey, (x0, y0), (col, row), direction)
+
+    def cancel_line(self) -> bool:
+        """Drop the half-measured image line (Esc); whether there was one."""
+        if not self.session.cancel_line():
+            return False
+        self.draw_predictions()
+        return True
 
     def _added(self, index: int) -> int:
         if index >= 0:

@@ -17,6 +17,7 @@ from .algorithms.ground_filter import GroundFilterAlgorithm
 from .algorithms.monoplot import MonoplotAlgorithm
 from .algorithms.orthomosaic import OrthomosaicAlgorithm
 from .algorithms.orthorectify import OrthorectifyAlgorithm
+from .algorithms.resection import ResectionAlgorithm
 from .algorithms.trajectory_to_eo import TrajectoryToEoAlgorithm
 
 ICON_PATH = Path(__file__).resolve().parents[1] / "icon.svg"
@@ -53,6 +54,7 @@ class LidarPhotoProvider(QgsProcessingProvider):
             BoresightCalibrationAlgorithm(),
             MonoplotAlgorithm(),
             BundleAdjustmentAlgorithm(),
+            ResectionAlgorithm(),
             OrthorectifyAlgorithm(),
             OrthomosaicAlgorithm(),
         ):

@@ -11,6 +11,7 @@ from . import (
     monoplot,
     orthomosaic,
     orthorectify,
+    resection,
     trajectory_to_eo,
 )
 
@@ -24,6 +25,7 @@ ALGORITHMS = (
     boresight_calibration,
     monoplot,
     bundle_adjustment,
+    resection,
     orthorectify,
     orthomosaic,
 )

@@ -842,6 +842,23 @@ def _apply(problem: _Problem, lin: _Lin, nrm: _Normal, z: Array) -> tuple[Array,
     return x, vhat
 
 
+def _refreshed(
+    problem: _Problem, lin: _Lin, active: list[NDArray[np.bool_]], rounds: int = 3
+) -> _Lin | None:
+    """The linearisation at ``lin.x`` with the residuals of Gauss-Helmert blocks re-solved at
+    fixed parameters (a few fixed-point rounds of ``v = -S B' Pe (g - B v)``), whose cost is
+    the true cost at ``x``; None without Gauss-Helmert blocks or on non-finite values."""
+    if all(b.gauss_markov for b in problem.blocks):
+        return None
+    for _ in range(rounds):
+        vhat = [-np.einsum("goc,gc->go", bl.K, bl.wbar) for bl in lin.blocks]
+        try:
+            lin = problem.linearize(lin.x, vhat, active)
+        except _NonFiniteError:
+            return None
+    return lin
+
+
 def _merit(lin: _Lin, nrm_rowscale: Array | None, nu: float) -> float:
     if nrm_rowscale is None or lin.h.size == 0:
         return lin.phi
@@ -987,11 +1004,17 @@ def _run(
             if new is None:
                 if step <= math.sqrt(tol):
                     converged = True
-                else:
-                    warnings.append(
-                        f"the cost could not be reduced further at iteration {it} (step "
-                        f"{step:.3g} sigma): stopped without convergence"
-                    )
+                    break
+                fresh = _refreshed(problem, lin, active)
+                if fresh is not None and _merit(fresh, rowscale, nu) > m_old * (1 + 1e-12):
+                    # The Gauss-Helmert cost of this linearisation (residuals predicted by the
+                    # last step) sat below the true cost at x: continue from the consistent one.
+                    lin = fresh
+                    continue
+                warnings.append(
+                    f"the cost could not be reduced further at iteration {it} (step "
+                    f"{step:.3g} sigma): stopped without convergence"
+                )
                 break
         m_new = _merit(new, rowscale, nu)
         lin = new

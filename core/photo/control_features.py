@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -370,3 +370,33 @@ class ControlSet:
         if self.lcps:
             return float(np.nanmean(self.lcp_xyz[:, 2]))
         return 0.0
+
+
+def lines_with_end_sigmas(lines: Iterable[ControlLine]) -> list[ControlLine]:
+    """The lines as the resection takes them: a line whose direction has no covariance (a
+    layer feature without the line table's: its position known to ``sigma_perpendicular``,
+    its direction exact) gets the covariance of its two end points each known to that sigma
+    in every direction, independently; the other lines are returned as they are.
+
+    The resection needs the end points' covariance regular across the line (or none); the
+    point-and-exact-direction one makes the two ends move together. Independent ends: the
+    point (their middle) has sigma**2 / 2 and the direction 2 sigma**2 / L**2 per axis, so
+    :meth:`ControlLine.sigma_ends` is sigma again.
+
+    >>> ln = line_from_feature(ControlFeature("7", np.array([[0, 0, 10.0], [8, 0, 10.0]])))
+    >>> [round(s, 3) for s in lines_with_end_sigmas([ln])[0].sigma_ends]
+    [0.05, 0.05]
+    """
+    out = []
+    for ln in lines:
+        cov = np.asarray(ln.covariance, dtype=np.float64)
+        if np.any(cov[3:, 3:] != 0) or not np.any(cov[:3, :3] != 0):
+            out.append(ln)
+            continue
+        s2 = ln.sigma_perpendicular**2
+        new = np.zeros((6, 6))
+        new[:3, :3] = 0.5 * s2 * np.eye(3)
+        new[3:, 3:] = 2.0 * s2 / ln.length**2 * np.eye(3)
+        mid = 0.5 * (ln.start + ln.end)
+        out.append(replace(ln, point=mid, covariance=new))
+    return out

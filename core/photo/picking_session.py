@@ -41,10 +41,12 @@ if TYPE_CHECKING:
 
 __all__ = [
     "PICK_TYPES",
+    "HalfLine",
     "PickTarget",
     "PickingSession",
     "ProjectedControl",
     "TiePrediction",
+    "residual_summary",
 ]
 
 Array = NDArray[np.float64]
@@ -101,6 +103,22 @@ class PickTarget:
     range_m: float = math.nan
 
 
+@dataclass(frozen=True, eq=False)
+class HalfLine:
+    """An image line being measured: its first click (``start``, pixels) in ``image_id`` and
+    the LiDAR line it is linked to (``target``); ``predicted`` (2, 2) the LiDAR line's end
+    points projected into that image with the current camera and EO (pixels, NaN behind)."""
+
+    image_id: str
+    target: PickTarget
+    start: Array
+    predicted: Array
+
+
+#: shortest image line the dock stores, pixels (the resection refuses shorter ones)
+MIN_LINE_PX = 1.0
+
+
 class PickingSession:
     """The dock's state: observations, control, orientation, pending tie point, calibration.
 
@@ -118,6 +136,10 @@ class PickingSession:
         self.scene: PickingScene | None = None
         self.calibration: BoresightRun | None = None
         self._residuals: tuple[int, int, dict[int, Array]] | None = None
+        #: the image line waiting for its second click (not an edit: Esc drops it)
+        self.half_line: HalfLine | None = None
+        #: residual rows of the last resection (:func:`core.jobs.resection.residual_rows`)
+        self.resection_rows: list[tuple] = []
 
     @property
     def pending(self) -> TiePrediction | None:
@@ -228,6 +250,56 @@ class PickingSession:
         plane = self.control.planes[target.index]
         pending = self._predict(point_id, tid, image_id, (col, row), plane.normal, plane.centroid)
         return obs.add(new, attached=pending)
+
+    def start_line(
+        self,
+        image_id: str,
+        pixel: ArrayLike,
+        target: PickTarget,
+        projected: ProjectedControl | None = None,
+    ) -> HalfLine:
+        """The first click of an image line on the LiDAR line ``target`` (kind ``line``): kept
+        as :attr:`half_line` until :meth:`finish_line` or :meth:`cancel_line`."""
+        if target.kind != "line":
+            raise ValueError(f"an image line is linked to a LiDAR line, not a {target.kind}")
+        if projected is None or projected.image_id != image_id:
+            projected = self.project(image_id)
+        k = target.index
+        predicted = np.array([projected.line_starts[k], projected.line_ends[k]], dtype=float)
+        start = np.array(pixel, dtype=np.float64).reshape(2)
+        self.half_line = HalfLine(image_id, target, start, predicted)
+        return self.half_line
+
+    def finish_line(self, image_id: str, pixel: ArrayLike) -> int:
+        """The second click: the image line's two end points as two ``line`` rows of the
+        linked LiDAR line's id, added in one undoable step; the index of the first row.
+
+        -1 (nothing added, the half line kept) when no line is started in ``image_id`` or the
+        two clicks are less than :data:`MIN_LINE_PX` apart.
+        """
+        h = self.half_line
+        end = np.array(pixel, dtype=np.float64).reshape(2)
+        if h is None or h.image_id != image_id:
+            return -1
+        if not float(np.hypot(*(end - h.start))) >= MIN_LINE_PX:
+            return -1
+        obs, tid = self.observations, h.target.target_id
+        first = obs.next_point_id(f"R{tid}_")
+        used = {o.point_id for o in obs.rows} | {first}
+        n = int(first.rsplit("_", 1)[1]) + 1
+        while f"R{tid}_{n}" in used:
+            n += 1
+        rows = [
+            Observation(image_id, pid, float(p[0]), float(p[1]), "line", tid)
+            for pid, p in ((first, h.start), (f"R{tid}_{n}", end))
+        ]
+        self.half_line = None
+        return obs.add(rows, text=f"add line {first}, R{tid}_{n}")
+
+    def cancel_line(self) -> bool:
+        """Drop the half-measured image line; whether there was one."""
+        had, self.half_line = self.half_line is not None, None
+        return had
 
     def _predict(
         self,
@@ -366,9 +438,65 @@ class PickingSession:
             return 0, math.nan, math.nan
         return int(v.size), float(np.sqrt(np.mean(v**2))), float(v.max())
 
+    # -- resection ----------------------------------------------------------------------------
+    def set_resection(self, rows: Iterable[tuple]) -> None:
+        """Keep the residual rows of a resection (:func:`core.jobs.resection.residual_rows`:
+        image_id, point_id, type, target_id, vertex, col, row, vx, vy, distance_px, w,
+        rejected, used); empty: forget them."""
+        self.resection_rows = list(rows)
+
+    def resection_residuals(self) -> dict[int, Array]:
+        """Residual (vx, vy) in pixels of the last resection by current row index: a residual
+        row belongs to the current row of the same image, point id and type."""
+        if not self.resection_rows:
+            return {}
+        by_key = {
+            (r[0], r[1], r[2]): np.array(r[7:9], dtype=np.float64) for r in self.resection_rows
+        }
+        out: dict[int, Array] = {}
+        for i, o in enumerate(self.observations.rows):
+            v = by_key.get((o.image_id, o.point_id, o.type))
+            if v is not None and np.isfinite(v).all():
+                out[i] = v
+        return out
+
+    def shown_residuals(self) -> dict[int, Array]:
+        """The residuals the dock draws: the last calibration's, and the last resection's for
+        the rows it used (those of the resected image)."""
+        res = self.resection_residuals()
+        if not res:
+            return self.residuals()
+        out = dict(self.residuals())
+        out.update(res)
+        return out
+
     def boresight_summary(self) -> list[tuple[str, Array, float]]:
         """(group, (d_omega, d_phi, d_kappa) in arc-seconds, sigma0) of the last calibration."""
         if self.calibration is None:
             return []
         res = self.calibration.result
         return [(g, res.boresight_arcsec[k], float(res.sigma0)) for k, g in enumerate(res.groups)]
+
+
+def residual_summary(rows: Iterable[tuple]) -> list[tuple[str, str, int, float, float, bool]]:
+    """Per image line and per point of resection residual rows (see
+    :meth:`PickingSession.set_resection`): (type, target_id, points, RMS and largest
+    distance in pixels, rejected), in the rows' order. A line's distance is its points'
+    signed distance from the projected LiDAR line, a point's the length of its residual.
+
+    >>> rows = [("a", "R7_1", "line", "7", 1, 0, 0, 0.3, 0.4, 0.5, 0.1, False, True),
+    ...         ("a", "R7_2", "line", "7", 2, 9, 0, 0, 0, -0.5, 0.1, False, True),
+    ...         ("a", "C3", "lcp", "3", 0, 5, 5, 0.6, 0.8, 1.0, 0.2, False, True)]
+    >>> [(t, g, n, round(rms, 3), round(mx, 3)) for t, g, n, rms, mx, _ in residual_summary(rows)]
+    [('line', '7', 2, 0.5, 0.5), ('lcp', '3', 1, 1.0, 1.0)]
+    """
+    groups: dict[tuple[str, str, str], list[tuple]] = {}
+    for r in rows:
+        key = (r[0], r[2], r[3] if r[2] == "line" else r[1])
+        groups.setdefault(key, []).append(r)
+    out = []
+    for (_img, kind, _pid), rs in groups.items():
+        d = np.abs(np.array([float(r[9]) for r in rs]))
+        out.append((kind, str(rs[0][3]), len(rs), float(np.sqrt(np.mean(d**2))),
+                    float(d.max()), any(bool(r[11]) for r in rs)))  # fmt: skip
+    return out

@@ -1,33 +1,52 @@
-"""Space resection: the exterior orientation of one image from image points with known
-object coordinates, by least squares on the collinearity equations.
+"""Space resection: the exterior orientation of one image from control points and straight
+lines, by least squares.
 
-Object points must be in a Cartesian frame (the local ENU adjustment frame, see
+:func:`space_resection` resects from points only (collinearity, start from OpenCV's solvePnP);
+:func:`resect` from any mix of control points and image lines matched to 3D lines (the
+coplanarity model or the equivalent-planes model of Tommaselli & Tozzi 1996 used by dos
+Santos, Dal Poz & Dalmolin 2010), without an approximate orientation, with the global test,
+covariance and correlation of the six parameters, data snooping of points and lines and the
+diagnosis of what the observations cannot determine.
+
+Object coordinates must be in a Cartesian frame (the local ENU adjustment frame, see
 docs/conventions.md); the pose comes back in that frame as ``(X0, Y0, Z0, omega, phi,
-kappa)``. The initial pose, when not given, comes from OpenCV's solvePnP.
+kappa)``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
-import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InputError
+from ..errors import ConvergenceError, InputError, NotObservableError, stop_if_asked
 from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians
-from ..geometry.rotations import matrix_to_opk
+from ..geometry.frames import LocalFrame, MappingFrame
+from ..geometry.lines import camera_vectors, coplanarity, image_vectors, parametrisation
+from ..geometry.rotations import matrix_to_opk, opk_to_matrix
 from ..lsq.adjustment import adjust
-from ..lsq.model import AdjustmentOptions, GaussMarkovBlock
-from ..lsq.results import AdjustmentResult
+from ..lsq.model import AdjustmentOptions, GaussMarkovBlock, prior_block
+from ..lsq.results import AdjustmentResult, ChiSquareTest
+from .observations import ImageObservations
+from .orientation import eo_local_to_map, eo_map_to_local
+from .pose_start import initial_pose_pnp, pose_candidates
+from .resection_model import (
+    EquivalentPlanes,
+    LineConditions,
+    equivalent_planes_block,
+    line_block,
+    observed_line_parameters,
+    point_block,
+)
 
 Array = NDArray[np.float64]
 
 EO_NAMES = ("X0", "Y0", "Z0", "omega", "phi", "kappa")
-# OpenCV's camera looks along +z with y down; ours looks along -z with y up.
-_CV_FLIP = np.diag([1.0, -1.0, -1.0])
 
 
 @dataclass(frozen=True)
@@ -48,34 +67,6 @@ class ResectionResult:
     @property
     def std(self) -> Array:
         return np.sqrt(np.diag(self.covariance))
-
-
-def initial_pose_pnp(pixels: ArrayLike, points: ArrayLike, camera: Camera) -> Array:
-    """Pose from OpenCV's solvePnP (SQPnP, then its iterative refinement); lens removed first.
-
-    Returns ``(X0, Y0, Z0, omega, phi, kappa)`` in the frame of ``points``.
-    """
-    px = np.asarray(pixels, dtype=np.float64)
-    pts = np.asarray(points, dtype=np.float64)
-    ideal = camera.ideal_from_pixel(px)  # centred, corrected, mm
-    ps = camera.pixel_size_mm
-    # OpenCV puts the centre of the first pixel at (0, 0), we put it at (0.5, 0.5).
-    cx = camera.width_px / 2 + camera.x0_mm / ps - 0.5
-    cy = camera.height_px / 2 - camera.y0_mm / ps - 0.5
-    cv_px = np.column_stack([cx + ideal[:, 0] / ps, cy - ideal[:, 1] / ps])
-    k = np.array([[camera.focal_px, 0.0, cx], [0.0, camera.focal_px, cy], [0.0, 0.0, 1.0]])
-    centre = pts.mean(axis=0)  # keeps OpenCV's float arithmetic away from large coordinates
-    obj = np.ascontiguousarray(pts - centre)
-    img = np.ascontiguousarray(cv_px)
-    ok, rvec, tvec = cv2.solvePnP(obj, img, k, None, flags=cv2.SOLVEPNP_SQPNP)
-    if not ok:
-        raise InputError("OpenCV could not find an initial pose for the resection")
-    ok, rvec, tvec = cv2.solvePnP(obj, img, k, None, rvec, tvec, True, cv2.SOLVEPNP_ITERATIVE)
-    r_cv = cv2.Rodrigues(rvec)[0]
-    m = _CV_FLIP @ r_cv
-    x0 = -r_cv.T @ tvec.ravel() + centre
-    omega, phi, kappa = matrix_to_opk(m)
-    return np.array([*x0, omega, phi, kappa])
 
 
 def space_resection(
@@ -133,3 +124,904 @@ def space_resection(
         rejected=np.flatnonzero(table.rejected),
         adjustment=result,
     )
+
+
+# ============================================================================ points and lines
+
+#: Line models of :func:`resect` (the first is the default).
+MODELS = ("coplanarity", "equivalent_planes")
+#: Equivalent-planes parametrisations: per line (the source's rule), or one for all lines.
+PARAMETRISATIONS = ("auto", "horizontal", "vertical")
+#: Names of the interior orientation parameters refined with ``estimate_interior``.
+IO_NAMES = ("focal_mm", "x0_mm", "y0_mm")
+#: Along-line standard deviation given to the end points of a 3D line (metres): where a line
+#: ends along itself does not enter the conditions, only its direction and position across;
+#: this keeps the covariance of (P1, P2) regular without changing the solution.
+ALONG_LINE_SIGMA_M = 1.0
+#: Smallest length of an image line (pixels) and of a 3D line (metres).
+MIN_IMAGE_LINE_PX = 1.0
+MIN_LINE_LENGTH_M = 1e-3
+#: Convergence tolerance of the adjustment, in standard deviations of the parameters (the
+#: engine stops when a step is below it, or below its square root, 1e-3 sigma, when the cost
+#: no longer decreases: the strong correlation of position and attitude leaves steps of 1e-4
+#: to 1e-3 sigma at the rounding floor of the cost). A step that stalls above that with lines
+#: makes the engine re-solve the Gauss-Helmert residuals at the current parameters (the cost
+#: of lines is non-linear in the 3D points) and go on from the consistent cost.
+RESECTION_TOLERANCE = 1e-6
+#: Largest angle (degrees) between 3D lines still counted as parallel by the diagnosis.
+PARALLEL_DEG = 1.0
+
+
+@dataclass(frozen=True)
+class ResectionData:
+    """The observations of one image and their control, in a Cartesian object frame.
+
+    Attributes
+    ----------
+    point_ids : tuple of str, shape (N,)
+    pixels : ndarray, shape (N, 2)
+        Measured (col, row) of the control points, pixels.
+    sigma_px : ndarray, shape (N,)
+        Their standard deviation (each of col and row), pixels.
+    xyz : ndarray, shape (N, 3)
+        Object coordinates, metres.
+    xyz_cov : ndarray, shape (N, 3, 3)
+        Their covariance, m^2 (all zero: errorless control).
+    line_ids : tuple of str, shape (L,)
+    line_pixels : tuple of ndarray, each (K_i, 2)
+        Pixels measured on each image line (K_i >= 2: its end points, or more points on it).
+    line_sigma_px : tuple of ndarray, each (K_i,)
+    line_p1, line_p2 : ndarray, shape (L, 3)
+        Two points of each matched 3D line (e.g. its end points), metres.
+    line_cov : ndarray, shape (L, 6, 6)
+        Covariance of (P1, P2), m^2 (all zero: errorless); only its part across the line
+        matters.
+    """
+
+    point_ids: tuple[str, ...] = ()
+    pixels: Array = field(default_factory=lambda: np.empty((0, 2)))
+    sigma_px: Array = field(default_factory=lambda: np.empty(0))
+    xyz: Array = field(default_factory=lambda: np.empty((0, 3)))
+    xyz_cov: Array = field(default_factory=lambda: np.empty((0, 3, 3)))
+    line_ids: tuple[str, ...] = ()
+    line_pixels: tuple[Array, ...] = ()
+    line_sigma_px: tuple[Array, ...] = ()
+    line_p1: Array = field(default_factory=lambda: np.empty((0, 3)))
+    line_p2: Array = field(default_factory=lambda: np.empty((0, 3)))
+    line_cov: Array = field(default_factory=lambda: np.empty((0, 6, 6)))
+
+    def __post_init__(self) -> None:
+        n = len(self.point_ids)
+        set_ = object.__setattr__
+        set_(self, "point_ids", tuple(map(str, self.point_ids)))
+        set_(self, "pixels", np.asarray(self.pixels, dtype=np.float64).reshape(n, 2))
+        set_(self, "sigma_px", np.broadcast_to(
+            np.asarray(self.sigma_px, dtype=np.float64), (n,)).copy())  # fmt: skip
+        set_(self, "xyz", np.asarray(self.xyz, dtype=np.float64).reshape(n, 3))
+        cov = np.asarray(self.xyz_cov, dtype=np.float64)
+        set_(self, "xyz_cov", np.broadcast_to(cov, (n, 3, 3)).copy() if cov.size else
+             np.zeros((n, 3, 3)))  # fmt: skip
+        m = len(self.line_ids)
+        set_(self, "line_ids", tuple(map(str, self.line_ids)))
+        lp = tuple(np.asarray(v, dtype=np.float64).reshape(-1, 2) for v in self.line_pixels)
+        set_(self, "line_pixels", lp)
+        sig = self.line_sigma_px
+        if len(sig) != len(lp):
+            raise InputError("line_sigma_px needs one entry per image line")
+        set_(self, "line_sigma_px", tuple(
+            np.broadcast_to(np.asarray(s, dtype=np.float64), (len(v),)).copy()
+            for s, v in zip(sig, lp)))  # fmt: skip
+        set_(self, "line_p1", np.asarray(self.line_p1, dtype=np.float64).reshape(m, 3))
+        set_(self, "line_p2", np.asarray(self.line_p2, dtype=np.float64).reshape(m, 3))
+        lc = np.asarray(self.line_cov, dtype=np.float64)
+        set_(self, "line_cov", np.broadcast_to(lc, (m, 6, 6)).copy() if lc.size else
+             np.zeros((m, 6, 6)))  # fmt: skip
+        if len(lp) != m:
+            raise InputError(f"{len(lp)} image lines for {m} line ids")
+        for name, arr in (("pixels", self.pixels), ("xyz", self.xyz), ("sigma_px", self.sigma_px),
+                          ("line_p1", self.line_p1), ("line_p2", self.line_p2)):  # fmt: skip
+            if not np.isfinite(arr).all():
+                raise InputError(f"resection: {name} must be finite")
+        if (self.sigma_px <= 0).any() or any((s <= 0).any() for s in self.line_sigma_px):
+            raise InputError("resection: sigma_px must be > 0")
+        for i, v in zip(self.line_ids, lp):
+            if len(v) < 2:
+                raise InputError(f"image line {i}: needs at least 2 points, got {len(v)}")
+            span = float(np.linalg.norm(v - v[0], axis=1).max())
+            if span < MIN_IMAGE_LINE_PX:
+                raise InputError(
+                    f"image line {i} has zero length ({span:.3g} px between its points): "
+                    "measure its two ends apart"
+                )
+        length = np.linalg.norm(self.line_p2 - self.line_p1, axis=1)
+        for i, ln in zip(self.line_ids, length):
+            if not ln >= MIN_LINE_LENGTH_M:
+                raise InputError(f"3D line {i} has zero length ({ln:.3g} m): its two points "
+                                 "coincide")  # fmt: skip
+
+    @property
+    def n_points(self) -> int:
+        return len(self.point_ids)
+
+    @property
+    def n_lines(self) -> int:
+        return len(self.line_ids)
+
+
+@dataclass(frozen=True)
+class ResectionOptions:
+    """Options of :func:`resect`.
+
+    Attributes
+    ----------
+    model : str
+        Line model: ``"coplanarity"`` (parametrisation-free, the default) or
+        ``"equivalent_planes"`` (Tommaselli & Tozzi 1996, both parametrisations).
+    estimate_interior : bool
+        Refine the focal length and the principal point (needs control at different depths
+        or an oblique view; refused, naming the parameters, when the geometry cannot fix them).
+    snooping : bool
+        Baarda's data snooping (rejects whole points or lines).
+    snooping_alpha : float
+        Significance per observation of the data snooping.
+    alpha : float
+        Significance level of the global chi-square test.
+    damping : bool
+        Levenberg-Marquardt damping (plain Gauss-Newton when False, as in the source).
+    max_iterations : int
+    eo_prior_sigma : tuple of 6 floats, optional
+        With a start pose, weight it as observations with these sigmas (m, m, m, rad, rad,
+        rad): the source's weighted constraints on the approximate orientation.
+    parametrisation : str
+        Equivalent planes only: ``"auto"`` (per line by its direction, the source's rule),
+        ``"horizontal"`` (``y = a x + b`` for every line) or ``"vertical"`` (``x = a* y +
+        b*``), for studies of the two parametrisations.
+    """
+
+    model: str = MODELS[0]
+    estimate_interior: bool = False
+    snooping: bool = True
+    snooping_alpha: float = 0.001
+    alpha: float = 0.05
+    damping: bool = True
+    max_iterations: int = 50
+    eo_prior_sigma: tuple[float, ...] | None = None
+    parametrisation: str = "auto"
+
+    def __post_init__(self) -> None:
+        if self.model not in MODELS:
+            raise InputError(f"model '{self.model}' is not one of {', '.join(MODELS)}")
+        if self.parametrisation not in PARAMETRISATIONS:
+            raise InputError(f"parametrisation '{self.parametrisation}' is not one of "
+                             f"{', '.join(PARAMETRISATIONS)}")  # fmt: skip
+        if self.eo_prior_sigma is not None:
+            s = tuple(float(v) for v in self.eo_prior_sigma)
+            if len(s) != 6 or not all(v > 0 and math.isfinite(v) for v in s):
+                raise InputError("eo_prior_sigma needs 6 positive sigmas (m, m, m, rad x 3)")
+            object.__setattr__(self, "eo_prior_sigma", s)
+
+
+@dataclass(frozen=True)
+class SpaceResection:
+    """The orientation of one image from points and lines, with its statistics.
+
+    Attributes
+    ----------
+    eo : ndarray, shape (6,)
+        ``(X0, Y0, Z0, omega, phi, kappa)``, metres and radians, the data's frame.
+    covariance, covariance_prior : ndarray, shape (6, 6)
+        A-posteriori (``sigma0^2 Qxx``) and a-priori (``Qxx``) covariance of ``eo``.
+    correlation : ndarray, shape (6, 6)
+    interior, interior_std : ndarray, shape (3,) or None
+        Refined ``(focal_mm, x0_mm, y0_mm)`` and their a-posteriori standard deviations.
+    sigma0 : float
+        A-posteriori standard deviation of unit weight (NaN without redundancy).
+    redundancy : int
+    chi2 : ChiSquareTest
+        Two-sided global test (the engine's).
+    chi2_critical : float
+        The source's one-sided critical value ``chi2(1 - alpha, redundancy)``; the test
+        passes when ``chi2.statistic <= chi2_critical``.
+    point_v : ndarray, shape (N, 2)
+        Residuals of the measured pixels of the control points (adjusted minus measured).
+    point_w : ndarray, shape (N,)
+        Largest |Baarda w| of each point's observations.
+    point_rejected : ndarray of bool, shape (N,)
+    line_v : tuple of ndarray, each (K_i, 2)
+        Residuals of the pixels measured on each line (coplanarity model; NaN otherwise).
+    line_distance_px : tuple of ndarray, each (K_i,)
+        Signed distance of each measured line point from the 3D line projected with ``eo``
+        (pixels; the control as given).
+    line_ab_v : ndarray, shape (L, 2)
+        Residuals of ``(a, b)`` of each line (equivalent-planes model; NaN otherwise): ``a``
+        dimensionless, ``b`` mm.
+    line_w : ndarray, shape (L,)
+        Largest |w| of each line's observations.
+    line_rejected : ndarray of bool, shape (L,)
+    start : str
+        How the start pose was found.
+    start_eo : ndarray, shape (6,)
+    model : str
+    iterations : int
+    adjustment : AdjustmentResult
+        Every statistic of the adjustment.
+    warnings : tuple of str
+    """
+
+    eo: Array
+    covariance: Array
+    covariance_prior: Array
+    correlation: Array
+    interior: Array | None
+    interior_std: Array | None
+    sigma0: float
+    redundancy: int
+    chi2: ChiSquareTest
+    chi2_critical: float
+    point_v: Array
+    point_w: Array
+    point_rejected: NDArray[np.bool_]
+    line_v: tuple[Array, ...]
+    line_distance_px: tuple[Array, ...]
+    line_ab_v: Array
+    line_w: Array
+    line_rejected: NDArray[np.bool_]
+    start: str
+    start_eo: Array
+    model: str
+    iterations: int
+    adjustment: AdjustmentResult
+    warnings: tuple[str, ...] = ()
+
+    @property
+    def std(self) -> Array:
+        """A-posteriori standard deviations of ``eo`` (metres, radians)."""
+        return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
+
+    @property
+    def std_prior(self) -> Array:
+        """A-priori standard deviations of ``eo`` (from the observations' sigmas)."""
+        return np.sqrt(np.clip(np.diag(self.covariance_prior), 0.0, None))
+
+    @property
+    def chi2_passed(self) -> bool:
+        """The source's test: ``statistic <= chi2(1 - alpha, redundancy)`` (True without
+        redundancy)."""
+        return not (self.redundancy > 0) or self.chi2.statistic <= self.chi2_critical
+
+
+def _line_cov(data: ResectionData) -> tuple[Array, NDArray[np.bool_]]:
+    """(P1, P2) covariances made regular along the lines; which lines have one at all."""
+    cov = data.line_cov.copy()
+    has = np.abs(cov).reshape(len(cov), -1).max(axis=1) > 0 if len(cov) else np.zeros(0, bool)
+    if has.any():
+        u = data.line_p2 - data.line_p1
+        u /= np.linalg.norm(u, axis=1, keepdims=True)
+        along = ALONG_LINE_SIGMA_M**2 * np.einsum("li,lj->lij", u, u)
+        cov[:, :3, :3] += along
+        cov[:, 3:, 3:] += along
+        low = np.linalg.eigvalsh(cov[has])[:, 0]
+        bad = np.flatnonzero(low <= 1e-18)
+        if bad.size:
+            i = data.line_ids[int(np.flatnonzero(has)[bad[0]])]
+            raise InputError(
+                f"3D line {i}: its covariance leaves the line's position across itself "
+                "undetermined (singular); give a full covariance or none (errorless)"
+            )
+    return cov, has
+
+
+def _parallel_diagnosis(data: ResectionData) -> None:
+    """All lines parallel and fewer than 2 points: the position along them is free."""
+    if data.n_lines < 2 or data.n_points >= 2:
+        return
+    u = data.line_p2 - data.line_p1
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    cosines = np.abs(u @ u[0])
+    if cosines.min() < math.cos(math.radians(PARALLEL_DEG)):
+        return
+    d = u[0] * np.sign(u[0][np.argmax(np.abs(u[0]))])
+    names = [n for n, c in zip(EO_NAMES[:3], d) if abs(c) > 0.1]
+    raise NotObservableError(
+        f"Not observable: all {data.n_lines} lines are parallel (direction "
+        f"{d[0]:.3f}, {d[1]:.3f}, {d[2]:.3f} in the object frame) and there "
+        f"{'is 1 control point' if data.n_points == 1 else 'are no control points'}: the "
+        f"position along them ({', '.join(names)}) is not determined; measure lines in "
+        "another direction or control points",
+        parameters=names,
+    )
+
+
+def _conditions_count(data: ResectionData, model: str) -> int:
+    lines = (
+        sum(len(v) for v in data.line_pixels) if model == "coplanarity" else 2 * data.n_lines
+    )
+    return 2 * data.n_points + lines
+
+
+class _Problem:
+    """The blocks of one resection (shared by the start-pose ranking and the adjustment)."""
+
+    def __init__(self, data: ResectionData, camera: Camera, options: ResectionOptions) -> None:
+        self.data, self.camera, self.options = data, camera, options
+        self.n = 9 if options.estimate_interior else 6
+        self.names = list(EO_NAMES) + (list(IO_NAMES) if options.estimate_interior else [])
+        self.blocks: list = []
+        #: (block name, indices into the data) of every block, for the results
+        self.members: list[tuple[str, str, NDArray[np.int64]]] = []
+        if data.n_points:
+            has = np.abs(data.xyz_cov).reshape(data.n_points, -1).max(axis=1) > 0
+            for flag, name in ((False, "control points"), (True, "control points (weighted)")):
+                idx = np.flatnonzero(has == flag)
+                if idx.size:
+                    self.blocks.append(point_block(
+                        name, camera, data.pixels[idx], data.sigma_px[idx], data.xyz[idx],
+                        data.xyz_cov[idx] if flag else None, self._index(idx.size),
+                        [data.point_ids[i] for i in idx]))  # fmt: skip
+                    self.members.append(("point", name, idx))
+        if data.n_lines:
+            cov, has = _line_cov(data)
+            ks = np.array([len(v) for v in data.line_pixels])
+            for k in np.unique(ks):
+                for flag in (False, True):
+                    idx = np.flatnonzero((ks == k) & (has == flag))
+                    if not idx.size:
+                        continue
+                    px = np.stack([data.line_pixels[i] for i in idx])
+                    sig = np.stack([data.line_sigma_px[i] for i in idx])
+                    labels = [data.line_ids[i] for i in idx]
+                    line_cov = cov[idx] if flag else None
+                    name = f"lines ({k} points{', weighted' if flag else ''})"
+                    if options.model == "coplanarity":
+                        cond = LineConditions(camera, "coplanarity", int(k), bool(flag),
+                                              data.line_p1[idx], data.line_p2[idx])  # fmt: skip
+                        self.blocks.append(line_block(name, cond, px, sig, line_cov,
+                                                      self._index(idx.size), labels))  # fmt: skip
+                    else:
+                        kind = parametrisation(image_vectors(px, camera)[0])
+                        if options.parametrisation != "auto":
+                            kind[:] = PARAMETRISATIONS.index(options.parametrisation) - 1
+                        ab, ab_cov = observed_line_parameters(camera, px, sig, kind)
+                        eqp = EquivalentPlanes(camera, bool(flag), data.line_p1[idx],
+                                               data.line_p2[idx], kind)  # fmt: skip
+                        self.blocks.append(equivalent_planes_block(
+                            name, eqp, ab, ab_cov, line_cov, self._index(idx.size), labels))
+                    self.members.append(("line", name, idx))
+
+    def _index(self, g: int) -> Array:
+        return np.tile(np.arange(self.n), (g, 1))
+
+    def x0(self, eo: Array) -> Array:
+        io = self.camera.interior_params[:3] if self.options.estimate_interior else []
+        return np.concatenate([eo, io])
+
+    def cost(self, eo: Array) -> float:
+        """Weighted misclosure ``sum w' (B S B')^-1 w`` at the observations (inf if undefined)."""
+        x = self.x0(eo)
+        total = 0.0
+        for blk in self.blocks:
+            obs = np.asarray(blk.observed, dtype=np.float64)
+            xl = x[np.asarray(blk.param_index)]
+            s = np.asarray(blk.sigma, dtype=np.float64)
+            if s.ndim == 2:
+                s = np.einsum("gi,ij->gij", s**2, np.eye(s.shape[1]))
+            with np.errstate(all="ignore"):
+                if isinstance(blk, GaussMarkovBlock):
+                    f, _ = blk.model(xl)
+                    w, bmat = f - obs, -np.broadcast_to(np.eye(obs.shape[1]), s.shape)
+                else:
+                    w, _, bmat = blk.condition(xl, obs)
+                pe = bmat @ s @ np.swapaxes(bmat, 1, 2)
+                if not (np.isfinite(w).all() and np.isfinite(pe).all()):
+                    return math.inf
+                try:
+                    sol = np.linalg.solve(pe, w[..., None])[..., 0]
+                except np.linalg.LinAlgError:
+                    return math.inf
+            total += float(np.sum(w * sol))
+        return total if math.isfinite(total) else math.inf
+
+
+def resect(
+    data: ResectionData,
+    camera: Camera,
+    options: ResectionOptions | None = None,
+    eo0: ArrayLike | None = None,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> SpaceResection:
+    """Exterior orientation of one image from control points and straight lines.
+
+    Every observation enters one rigorous Gauss-Helmert adjustment (:mod:`.resection_model`):
+    points by collinearity, lines by the coplanarity model (default) or the equivalent-planes
+    model of Tommaselli & Tozzi (1996) in both its parametrisations, with the image points'
+    sigmas and the control's covariances propagated; optionally the focal length and the
+    principal point too. Without ``eo0`` the start pose comes from
+    :func:`.pose_start.pose_candidates` (no approximate orientation needed): the candidate
+    that fits the rigorous model best.
+
+    Parameters
+    ----------
+    data : ResectionData
+        Observations and control, in a Cartesian object frame (e.g. the local ENU frame).
+    camera : Camera
+        Interior orientation (lens correction applied, held fixed).
+    options : ResectionOptions, optional
+    eo0 : (6,) array_like, optional
+        Start pose ``(X0, Y0, Z0, omega, phi, kappa)``; weighted as observations when
+        ``options.eo_prior_sigma`` is given.
+    progress, should_stop
+        Fraction done; cancellation (:class:`core.errors.Cancelled`).
+
+    Returns
+    -------
+    SpaceResection
+
+    Raises
+    ------
+    InputError
+        Too few observations for the unknowns, image or 3D lines of zero length.
+    NotObservableError
+        The observations cannot determine the orientation (e.g. all lines parallel), or the
+        interior orientation; names the parameters.
+    ConvergenceError
+        The adjustment did not converge (no numbers are returned).
+
+    Examples
+    --------
+    Four lines and two points seen by a nadir camera 1000 m up, noise-free:
+
+    >>> from lidarphoto.core.geometry.collinearity import project
+    >>> cam = Camera("c", focal_mm=100.0, pixel_size_mm=0.01, width_px=4000, height_px=4000)
+    >>> eo = np.array([10.0, -20.0, 1000.0, 0.01, -0.02, 0.6])
+    >>> p1 = np.array([[-50, -50, 5], [40, -60, 12], [-60, 30, 0], [30, 50, 8]], float)
+    >>> p2 = p1 + [[60, 0, 0], [0, 50, 0], [40, 40, 0], [30, -20, 2]]
+    >>> pts = np.array([[0.0, 0.0, 3.0], [70.0, 80.0, 10.0]])
+    >>> lines = tuple(project(np.vstack([a, b]), eo, cam) for a, b in zip(p1, p2))
+    >>> data = ResectionData(("a", "b"), project(pts, eo, cam), 0.5, pts, None,
+    ...                      ("1", "2", "3", "4"), lines, (0.5,) * 4, p1, p2, None)
+    >>> res = resect(data, cam)
+    >>> bool(np.allclose(res.eo, eo, atol=1e-6)), res.redundancy
+    (True, 6)
+    """
+    from scipy import stats
+
+    opts = options if options is not None else ResectionOptions()
+    n_unknown = 9 if opts.estimate_interior else 6
+    m = _conditions_count(data, opts.model)
+    if m < n_unknown:
+        raise InputError(
+            f"{data.n_points} control point(s) and {data.n_lines} line(s) give {m} "
+            f"conditions for {n_unknown} unknowns"
+            + (" (exterior and interior orientation)" if opts.estimate_interior else "")
+            + ": measure more points or lines (a point gives 2 conditions, a line 2)"
+        )
+    _parallel_diagnosis(data)
+    problem = _Problem(data, camera, opts)
+    if eo0 is not None:
+        start_eo = np.asarray(eo0, dtype=np.float64).reshape(6).copy()
+        start = "given"
+    else:
+        cands = pose_candidates(camera, data.pixels, data.xyz, list(data.line_pixels),
+                                data.line_p1, data.line_p2)  # fmt: skip
+        if not cands:
+            raise ConvergenceError(
+                "no start pose puts the control in front of the camera: check that the "
+                "image ids, the point and line ids and the camera match"
+            )
+        costs = [problem.cost(c.eo) for c in cands]
+        best = int(np.argmin(costs))
+        start_eo, start = cands[best].eo.copy(), cands[best].method
+    stop_if_asked(should_stop, "starting the resection")
+    blocks = list(problem.blocks)
+    if opts.eo_prior_sigma is not None and eo0 is not None:
+        blocks.append(prior_block("approximate orientation", np.arange(6), start_eo,
+                                  opts.eo_prior_sigma))  # fmt: skip
+    aopts = AdjustmentOptions(
+        max_iterations=opts.max_iterations, tolerance=RESECTION_TOLERANCE,
+        damping=opts.damping, alpha=opts.alpha,
+        snooping=opts.snooping, snooping_alpha=opts.snooping_alpha,
+        max_rejections=max(0, (m - n_unknown) // 2),
+    )  # fmt: skip
+    try:
+        adj = adjust(problem.x0(start_eo), problem.names, blocks, options=aopts,
+                     progress=progress, should_stop=should_stop)  # fmt: skip
+    except NotObservableError as exc:
+        if opts.estimate_interior and set(exc.parameters) & set(IO_NAMES):
+            raise NotObservableError(
+                f"{exc} -- the interior orientation cannot be refined from this image: it "
+                "needs control at clearly different depths or an oblique view; resect with "
+                "the interior orientation fixed",
+                parameters=exc.parameters,
+                null_vectors=exc.null_vectors,
+                condition_number=exc.condition_number,
+            ) from None
+        raise
+    if not adj.converged:
+        why = "; ".join(adj.warnings) or f"{adj.iterations} iterations"
+        raise ConvergenceError(f"the resection did not converge ({why}) from the start pose "
+                               f"({start}); no orientation was computed")  # fmt: skip
+    x = adj.x
+    eo = x[:6].copy()
+    eo[3:] = (eo[3:] + np.pi) % (2 * np.pi) - np.pi
+    cov = adj.covariance if adj.covariance is not None else np.full((len(x), len(x)), np.nan)
+    cov_p = adj.covariance_prior if adj.covariance_prior is not None else cov
+    corr = adj.correlation if adj.correlation is not None else np.full_like(cov, np.nan)
+    point_v = np.full((data.n_points, 2), np.nan)
+    point_w = np.full(data.n_points, np.nan)
+    point_rej = np.zeros(data.n_points, bool)
+    line_v = [np.full((len(v), 2), np.nan) for v in data.line_pixels]
+    line_ab_v = np.full((data.n_lines, 2), np.nan)
+    line_w = np.full(data.n_lines, np.nan)
+    line_rej = np.zeros(data.n_lines, bool)
+    for kind, name, idx in problem.members:
+        table = adj.residuals[name]
+        wmax = np.nanmax(np.abs(table.w), axis=1) if np.isfinite(table.w).any() else (
+            np.full(len(idx), np.nan))  # fmt: skip
+        if kind == "point":
+            point_v[idx] = table.v[:, :2]
+            point_w[idx] = wmax
+            point_rej[idx] = table.rejected
+        else:
+            k = len(data.line_pixels[idx[0]])
+            for j, i in enumerate(idx):
+                if opts.model == "coplanarity":
+                    line_v[i] = table.v[j, : 2 * k].reshape(k, 2)
+                else:
+                    line_ab_v[i] = table.v[j, :2]
+            line_w[idx] = wmax
+            line_rej[idx] = table.rejected
+    interior = interior_std = None
+    if opts.estimate_interior:
+        interior = x[6:9].copy()
+        interior_std = adj.std[6:9].copy()
+    cam_final = camera.with_interior(np.concatenate([interior, camera.distortion.params])) if (
+        interior is not None) else camera  # fmt: skip
+    dist = line_distances(data, eo, cam_final)
+    r = adj.redundancy
+    crit = float(stats.chi2.ppf(1 - opts.alpha, r)) if r > 0 else math.nan
+    warnings = list(adj.warnings)
+    if start != "given" and r == 0:
+        warnings.append("no redundancy: the orientation cannot be checked")
+    return SpaceResection(
+        eo=eo, covariance=cov[:6, :6].copy(), covariance_prior=cov_p[:6, :6].copy(),
+        correlation=corr[:6, :6].copy(), interior=interior, interior_std=interior_std,
+        sigma0=float(adj.sigma0), redundancy=int(r), chi2=adj.global_test, chi2_critical=crit,
+        point_v=point_v, point_w=point_w, point_rejected=point_rej, line_v=tuple(line_v),
+        line_distance_px=dist, line_ab_v=line_ab_v, line_w=line_w, line_rejected=line_rej,
+        start=start, start_eo=start_eo, model=opts.model, iterations=adj.iterations,
+        adjustment=adj, warnings=tuple(warnings),
+    )  # fmt: skip
+
+
+def line_distances(data: ResectionData, eo: ArrayLike, camera: Camera) -> tuple[Array, ...]:
+    """Signed distance (pixels) of every measured line point from its 3D line projected with
+    ``eo`` (in the ideal image, lens correction removed).
+
+    Returns
+    -------
+    tuple of ndarray, each (K_i,)
+    """
+    if not data.n_lines:
+        return ()
+    e = np.asarray(eo, dtype=np.float64).reshape(6)
+    counts = np.array([len(v) for v in data.line_pixels])
+    which = np.repeat(np.arange(data.n_lines), counts)
+    p, _, _ = image_vectors(np.vstack(data.line_pixels), camera)
+    a = camera_vectors(data.line_p1, e)[0][which]
+    b = camera_vectors(data.line_p2, e)[0][which]
+    d = coplanarity(p[:, None, :], a, b)[0][:, 0] / camera.pixel_size_mm
+    return tuple(np.split(d, np.cumsum(counts)[:-1]))
+
+
+# ============================================================================ control sets
+
+
+@dataclass(frozen=True)
+class PointControl:
+    """Control points: ids (N,), coordinates (N, 3) and covariances (N, 3, 3) (zero:
+    errorless), in one frame."""
+
+    ids: tuple[str, ...]
+    xyz: Array
+    covariance: Array
+
+    def index(self) -> dict[str, int]:
+        return {i: k for k, i in enumerate(self.ids)}
+
+
+@dataclass(frozen=True)
+class LineControl:
+    """3D lines: ids (L,), two points each (L, 3) and the covariance (L, 6, 6) of (P1, P2)
+    (zero: errorless), in one frame."""
+
+    ids: tuple[str, ...]
+    p1: Array
+    p2: Array
+    covariance: Array
+
+    def index(self) -> dict[str, int]:
+        return {i: k for k, i in enumerate(self.ids)}
+
+
+def line_control_from_lines(lines) -> LineControl:
+    """LiDAR lines (:class:`core.lidar.control.ControlLine`: ``X0``, ``u`` and the 6 x 6
+    covariance of (X0, u)) as their end points with the propagated covariance of (P1, P2),
+    ``P = X0 + t u`` at each end's ``t``.
+
+    >>> from lidarphoto.core.lidar.control import ControlLine
+    >>> ln = ControlLine(7, (1, 2), "ridge", np.array([0.0, 0, 5]), np.array([10.0, 0, 5]),
+    ...                  np.array([5.0, 0, 5]), np.array([1.0, 0, 0]), np.eye(6) * 1e-4, 90.0)
+    >>> lc = line_control_from_lines([ln])
+    >>> lc.ids, lc.p1.tolist(), round(float(lc.covariance[0, 1, 1]), 8)
+    (('7',), [[0.0, 0.0, 5.0]], 0.0026)
+    """
+    n = len(lines)
+    p1 = np.array([ln.start for ln in lines], dtype=np.float64).reshape(n, 3)
+    p2 = np.array([ln.end for ln in lines], dtype=np.float64).reshape(n, 3)
+    x0 = np.array([ln.point for ln in lines], dtype=np.float64).reshape(n, 3)
+    u = np.array([ln.direction for ln in lines], dtype=np.float64).reshape(n, 3)
+    cov = np.array([ln.covariance for ln in lines], dtype=np.float64).reshape(n, 6, 6)
+    t1 = np.einsum("li,li->l", p1 - x0, u)
+    t2 = np.einsum("li,li->l", p2 - x0, u)
+    jac = np.zeros((n, 6, 6))
+    eye = np.eye(3)
+    jac[:, :3, :3] = eye
+    jac[:, 3:, :3] = eye
+    jac[:, :3, 3:] = t1[:, None, None] * eye
+    jac[:, 3:, 3:] = t2[:, None, None] * eye
+    c = jac @ cov @ np.swapaxes(jac, 1, 2)
+    return LineControl(tuple(str(ln.id) for ln in lines), p1, p2, 0.5 * (c + np.swapaxes(c, 1, 2)))
+
+
+# ============================================================================ mapping frame
+
+
+@dataclass(frozen=True)
+class MapResection:
+    """A resection run in the local ENU frame and reported in the mapping CRS.
+
+    Attributes
+    ----------
+    image_id : str
+    xyz : ndarray, shape (3,)
+        Perspective centre (easting, northing, height), mapping CRS.
+    opk : ndarray, shape (3,)
+        Omega, phi, kappa relative to the grid frame at the centre, radians (as the EO CSV).
+    covariance : ndarray, shape (6, 6)
+        A-posteriori covariance of ``(X, Y, Z, omega, phi, kappa)`` in that frame (m, rad).
+    result : SpaceResection
+        The adjustment, in the local frame.
+    data : ResectionData
+        Its observations and control, in the local frame.
+    local : LocalFrame
+    """
+
+    image_id: str
+    xyz: Array
+    opk: Array
+    covariance: Array
+    result: SpaceResection
+    data: ResectionData
+    local: LocalFrame
+
+    @property
+    def std(self) -> Array:
+        """Standard deviations of ``(X, Y, Z, omega, phi, kappa)``, metres and radians."""
+        return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
+
+    @property
+    def eo_local(self) -> Array:
+        return self.result.eo
+
+
+def _map_to_local(local: LocalFrame, xyz: Array, step: float = 1.0) -> tuple[Array, Array]:
+    """Mapping-frame points (K, 3) -> ENU and the Jacobian (K, 3, 3), central differences."""
+    k = xyz.shape[0]
+    if k == 0:
+        return np.empty((0, 3)), np.empty((0, 3, 3))
+    offsets = np.vstack([np.zeros(3), np.eye(3) * step, -np.eye(3) * step])
+    t = local.map_to_enu((xyz[:, None, :] + offsets[None]).reshape(-1, 3)).reshape(k, 7, 3)
+    return t[:, 0], (t[:, 1:4] - t[:, 4:7]).transpose(0, 2, 1) / (2.0 * step)
+
+
+def _eo_to_map(local: LocalFrame, eo: Array) -> Array:
+    m = opk_to_matrix(eo[3], eo[4], eo[5])[None]
+    xyz, opk = eo_local_to_map(eo[None, :3], m, local)
+    return np.concatenate([xyz[0], opk[0]])
+
+
+def data_to_local(data: ResectionData, local: LocalFrame) -> ResectionData:
+    """The control of ``data`` (mapping CRS) in the ENU frame, covariances propagated."""
+    xyz, jx = _map_to_local(local, data.xyz)
+    p1, j1 = _map_to_local(local, data.line_p1)
+    p2, j2 = _map_to_local(local, data.line_p2)
+    jl = np.zeros((data.n_lines, 6, 6))
+    jl[:, :3, :3], jl[:, 3:, 3:] = j1, j2
+    return replace(
+        data,
+        xyz=xyz,
+        xyz_cov=jx @ data.xyz_cov @ np.swapaxes(jx, 1, 2),
+        line_p1=p1,
+        line_p2=p2,
+        line_cov=jl @ data.line_cov @ np.swapaxes(jl, 1, 2),
+    )
+
+
+def resect_in_map(
+    image_id: str,
+    data: ResectionData,
+    camera: Camera,
+    mapping: MappingFrame,
+    options: ResectionOptions | None = None,
+    eo0: ArrayLike | None = None,
+    local: LocalFrame | None = None,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> MapResection:
+    """:func:`resect` with the control in a mapping CRS, run in a local ENU frame.
+
+    Parameters
+    ----------
+    image_id : str
+    data : ResectionData
+        Control coordinates in the mapping CRS (easting, northing, height, metres).
+    mapping : MappingFrame
+    eo0 : (6,) array_like, optional
+        Start ``(X, Y, Z, omega, phi, kappa)`` in the mapping CRS, angles relative to the grid
+        frame (radians), as the EO CSV.
+    local : LocalFrame, optional
+        The adjustment frame; by default tangent at the centroid of the control.
+
+    Returns
+    -------
+    MapResection
+    """
+    if local is None:
+        everything = np.vstack([data.xyz, data.line_p1, data.line_p2])
+        if not len(everything):
+            raise InputError(f"image {image_id}: no control points or lines")
+        local = LocalFrame.at_map_point(mapping, everything.mean(axis=0))
+    d_local = data_to_local(data, local)
+    start = None
+    if eo0 is not None:
+        e = np.asarray(eo0, dtype=np.float64).reshape(6)
+        centre, m = eo_map_to_local(e[None, :3], e[None, 3:], local)
+        start = np.concatenate([centre[0], matrix_to_opk(m[0])])
+    res = resect(d_local, camera, options, start, progress, should_stop)
+    out = _eo_to_map(local, res.eo)
+    # the covariance in the mapping frame through the Jacobian of the conversion
+    jac = np.empty((6, 6))
+    steps = (1e-3, 1e-3, 1e-3, 1e-7, 1e-7, 1e-7)
+    for k, h in enumerate(steps):
+        ep, em = res.eo.copy(), res.eo.copy()
+        ep[k] += h
+        em[k] -= h
+        diff = _eo_to_map(local, ep) - _eo_to_map(local, em)
+        diff[3:] = (diff[3:] + np.pi) % (2 * np.pi) - np.pi
+        jac[:, k] = diff / (2 * h)
+    cov = jac @ res.covariance @ jac.T
+    return MapResection(image_id, out[:3], out[3:], 0.5 * (cov + cov.T), res, d_local, local)
+
+
+# ============================================================================ from observations
+
+
+@dataclass(frozen=True)
+class ImageInput:
+    """What one image contributes to its resection, taken from the observation table.
+
+    Attributes
+    ----------
+    image_id : str
+    data : ResectionData
+        Control points and lines of the image (the control's frame).
+    point_rows, line_rows : tuple
+        Rows of the observation table of each control point (int) and of each line (tuple of
+        ints, the points measured on it in file order).
+    check_rows : tuple of int
+        Rows of type ``check``; ``check_xyz`` (C, 3) their control points.
+    ignored : int
+        Rows that are neither control nor check (e.g. tie points without object coordinates).
+    """
+
+    image_id: str
+    data: ResectionData
+    point_rows: tuple[int, ...]
+    line_rows: tuple[tuple[int, ...], ...]
+    check_rows: tuple[int, ...]
+    check_xyz: Array
+    ignored: int
+
+
+def image_inputs(
+    observations: ImageObservations,
+    points: PointControl | None,
+    lines: LineControl | None,
+    image_ids: Sequence[str] | None = None,
+) -> list[ImageInput]:
+    """Match the observation rows of each image to the control.
+
+    Rules: rows of type ``line`` with the same image and ``target_id`` are one image line
+    (two or more points in file order) matched to the 3D line of that id; rows of type
+    ``lcp`` are control points and ``check`` rows check points, both matched by ``target_id``;
+    rows of other types (``tie``, ``paper``) are control points when their ``point_id`` is a
+    control point id and are ignored otherwise. Without control lines (points) the line
+    (lcp, check) rows are ignored.
+
+    Raises
+    ------
+    InputError
+        An image asked for that has no observation, a line or control point id that is not in
+        the control, an image line with a single point.
+    """
+    by_image: dict[str, list[int]] = {}
+    for k, img in enumerate(observations.image_id):
+        by_image.setdefault(img, []).append(k)
+    wanted = list(by_image) if not image_ids else list(image_ids)
+    missing = [i for i in wanted if i not in by_image]
+    if missing:
+        raise InputError(f"no observations of image(s) {', '.join(missing[:10])}")
+    p_index = points.index() if points is not None else {}
+    l_index = lines.index() if lines is not None else {}
+    out = []
+    for img in wanted:
+        p_rows, p_ctrl, c_rows, c_ctrl = [], [], [], []
+        groups: dict[str, list[int]] = {}
+        ignored = 0
+        for k in by_image[img]:
+            kind, target, pid = (observations.type[k], observations.target_id[k],
+                                 observations.point_id[k])  # fmt: skip
+            if kind == "line":
+                if lines is None:
+                    ignored += 1
+                    continue
+                if target not in l_index:
+                    raise InputError(f"image {img}: line '{target}' (point {pid}) is not in the "
+                                     f"control lines ({len(l_index)} ids)")  # fmt: skip
+                groups.setdefault(target, []).append(k)
+            elif kind in ("lcp", "check"):
+                if points is None:
+                    ignored += 1
+                    continue
+                if target not in p_index:
+                    raise InputError(f"image {img}: control point '{target}' ({kind} row, point "
+                                     f"{pid}) is not in the control points")  # fmt: skip
+                (c_rows if kind == "check" else p_rows).append(k)
+                (c_ctrl if kind == "check" else p_ctrl).append(p_index[target])
+            elif pid in p_index:
+                p_rows.append(k)
+                p_ctrl.append(p_index[pid])
+            else:
+                ignored += 1
+        for target, rows in groups.items():
+            if len(rows) < 2:
+                raise InputError(
+                    f"image {img}: line '{target}' has a single point "
+                    f"({observations.point_id[rows[0]]}): measure two or more points on it "
+                    "(its two ends)"
+                )
+        lids = list(groups)
+        li = [l_index[t] for t in lids]
+        pc = np.array(p_ctrl, dtype=np.int64)
+        try:
+            data = ResectionData(
+                point_ids=tuple(observations.point_id[k] for k in p_rows),
+                pixels=observations.pixels[p_rows].reshape(-1, 2),
+                sigma_px=observations.sigma_px[p_rows],
+                xyz=points.xyz[pc] if points is not None else np.empty((0, 3)),
+                xyz_cov=points.covariance[pc] if points is not None else np.empty((0, 3, 3)),
+                line_ids=tuple(lids),
+                line_pixels=tuple(observations.pixels[groups[t]] for t in lids),
+                line_sigma_px=tuple(observations.sigma_px[groups[t]] for t in lids),
+                line_p1=lines.p1[li] if lines is not None else np.empty((0, 3)),
+                line_p2=lines.p2[li] if lines is not None else np.empty((0, 3)),
+                line_cov=lines.covariance[li] if lines is not None else np.empty((0, 6, 6)),
+            )
+        except InputError as exc:  # the checks of ResectionData, with the image named
+            raise InputError(f"image {img}: {exc}") from None
+        cxyz = points.xyz[np.array(c_ctrl, dtype=np.int64)] if points is not None else (
+            np.empty((0, 3)))  # fmt: skip
+        out.append(ImageInput(img, data, tuple(p_rows), tuple(tuple(groups[t]) for t in lids),
+                              tuple(c_rows), cxyz.reshape(-1, 3), ignored))  # fmt: skip
+    return out

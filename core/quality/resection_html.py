@@ -1,0 +1,191 @@
+"""Short self-contained HTML summary of space resections (inline CSS).
+
+Sections: settings; one row per image (orientation, sigma0, test); then per image the
+exterior orientation with a-posteriori and a-priori standard deviations, the refined interior
+orientation, the global test as the source reports it (statistic against the one-sided
+critical value) and two-sided, the correlation matrix of the six parameters, residual
+statistics of points, lines and check points, and the observations rejected by data snooping.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from .. import __version__
+
+__all__ = ["render_resection_html"]
+
+_NAMES = ("X", "Y", "Z", "omega", "phi", "kappa")
+_CSS = """
+body{font-family:sans-serif;margin:24px;color:#222;max-width:1100px}
+h1{font-size:22px}h2{font-size:18px;border-bottom:1px solid #aaa;margin-top:26px}
+h3{font-size:15px;margin-top:18px}
+table{border-collapse:collapse;margin:8px 0 16px 0;font-size:13px}
+th,td{border:1px solid #bbb;padding:3px 7px;text-align:right}
+th{background:#eee}td.t,th.t{text-align:left}
+.pass{background:#d8f0d8}.fail{background:#f7d4d4}.note{font-size:12px;color:#444}
+"""
+
+
+def _e(text: object) -> str:
+    return html.escape(str(text), quote=True)
+
+
+def _n(x: float | None, digits: int = 3) -> str:
+    if x is None or not math.isfinite(float(x)):
+        return "&ndash;"
+    return f"{float(x):.{digits}f}"
+
+
+def _table(header: Sequence[str], rows: Sequence[Sequence[str]], css: Sequence[str] = ()) -> str:
+    head = "".join(
+        f'<th class="t">{h}</th>' if i == 0 else f"<th>{h}</th>" for i, h in enumerate(header)
+    )
+    body = []
+    for k, row in enumerate(rows):
+        cls = f' class="{css[k]}"' if k < len(css) and css[k] else ""
+        cells = "".join(
+            f'<td class="t">{c}</td>' if i == 0 else f"<td>{c}</td>" for i, c in enumerate(row)
+        )
+        body.append(f"<tr{cls}>{cells}</tr>")
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+def _rms(x: np.ndarray) -> float:
+    x = np.asarray(x, dtype=np.float64)
+    x = x[np.isfinite(x)]
+    return float(np.sqrt(np.mean(x**2))) if x.size else math.nan
+
+
+def render_resection_html(
+    runs: Sequence, residuals: Sequence[Sequence[object]], settings: Mapping[str, str]
+) -> str:
+    """The HTML page as a string.
+
+    Parameters
+    ----------
+    runs : sequence of :class:`core.jobs.resection.ImageRun`
+    residuals : sequence of rows
+        The residual table (columns of :data:`core.io.resection.RESIDUAL_COLUMNS`).
+    settings : mapping of str to str
+        Shown as given.
+
+    Examples
+    --------
+    >>> page = render_resection_html([], [], {"camera": "c"})
+    >>> page.startswith("<!DOCTYPE html>") and "Space resection" in page
+    True
+    """
+    parts = [
+        "<!DOCTYPE html>",
+        '<html lang="en"><head><meta charset="utf-8">',
+        "<title>Space resection</title>",
+        f"<style>{_CSS}</style></head><body>",
+        "<h1>Space resection</h1>",
+        f'<p class="note">lidarphoto {_e(__version__)}. Position in the mapping CRS, '
+        "omega-phi-kappa relative to the grid frame at the perspective centre; standard "
+        "deviations a-posteriori (scaled by sigma0) unless labelled a-priori. Global test: "
+        "v'Pv / sigma0_prior^2 against the chi-square critical value (one-sided 5 %, as dos "
+        "Santos et al. 2010 report it) and the two-sided acceptance range.</p>",
+        "<h2>Settings</h2>",
+        _table(["setting", "value"], [[_e(k), _e(v)] for k, v in settings.items()]),
+        "<h2>Images</h2>",
+    ]
+    rows, css = [], []
+    for r in runs:
+        res = r.result.result
+        deg = np.degrees(r.result.opk)
+        rows.append([_e(r.image_id), *(_n(x, 3) for x in r.result.xyz),
+                     *(_n(a, 5) for a in deg), str(r.image.data.n_points),
+                     str(r.image.data.n_lines), _n(res.sigma0, 3),
+                     "passed" if res.chi2_passed else "FAILED"])  # fmt: skip
+        css.append("pass" if res.chi2_passed else "fail")
+    parts.append(_table(["image", "X (m)", "Y (m)", "Z (m)", "omega (deg)", "phi (deg)",
+                         "kappa (deg)", "points", "lines", "sigma0", "test"], rows, css))
+    by_image: dict[str, list] = {}
+    for row in residuals:
+        by_image.setdefault(str(row[0]), []).append(row)
+    for r in runs:
+        parts += _image(r, by_image.get(r.image_id, []))
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def _image(r, residuals: list) -> list[str]:
+    res = r.result.result
+    out = [f"<h2>Image {_e(r.image_id)}</h2>"]
+    out.append(
+        f'<p class="note">Start: {_e(res.start)}; line model: {_e(res.model)}; '
+        f"{res.iterations} iterations; {r.image.data.n_points} control points, "
+        f"{r.image.data.n_lines} lines, {len(r.image.check_rows)} check points, "
+        f"{r.image.ignored} rows without control ignored.</p>"
+    )
+    std = r.result.std
+    prior = _prior_std(r)
+    values = [*r.result.xyz, *np.degrees(r.result.opk)]
+    units = ["m"] * 3 + ["deg"] * 3
+    rows = []
+    for k, name in enumerate(_NAMES):
+        scale = 1.0 if k < 3 else math.degrees(1.0)
+        rows.append([name, _n(values[k], 4 if k < 3 else 6), units[k], _n(std[k] * scale, 5),
+                     _n(prior[k] * scale, 5),
+                     _n(std[k] * 3600 * scale, 2) if k >= 3 else ""])  # fmt: skip
+    out.append(_table(["parameter", "value", "unit", "std", "std a-priori", "std (arcsec)"],
+                      rows))  # fmt: skip
+    if res.interior is not None:
+        out.append("<h3>Interior orientation (refined)</h3>")
+        out.append(_table(["parameter", "value (mm)", "std (mm)"], [
+            [n, _n(v, 5), _n(s, 5)] for n, v, s in zip(
+                ("focal", "x0", "y0"), res.interior, res.interior_std)]))  # fmt: skip
+    t = res.chi2
+    verdict = "passed" if res.chi2_passed else "FAILED"
+    out.append("<h3>Global test</h3>")
+    out.append(_table(["quantity", "value"], [
+        ["observations (condition rows)", str(res.adjustment.n_observations)],
+        ["redundancy", str(res.redundancy)],
+        ["sigma0 a-posteriori", _n(res.sigma0, 4)],
+        ["chi-square statistic v'Pv / sigma0_prior^2", _n(t.statistic, 3)],
+        ["critical value, one-sided 5 % (as the source)", _n(res.chi2_critical, 3)],
+        ["two-sided acceptance range", f"{_n(t.lower, 3)} .. {_n(t.upper, 3)}"],
+        ["verdict (one-sided)", verdict],
+        ["condition number (scaled normal matrix)", f"{res.adjustment.condition_number:.3g}"],
+    ], ["", "", "", "", "", "pass" if res.chi2_passed else "fail"]))  # fmt: skip
+    out.append("<h3>Correlation of the six parameters</h3>")
+    corr = res.correlation
+    out.append(_table(["", *_NAMES], [
+        [name, *(_n(corr[i, j], 2) for j in range(6))] for i, name in enumerate(_NAMES)]))
+    used = [row for row in residuals if row[12]]
+    pts = [row for row in used if row[2] != "line"]
+    lns = [row for row in used if row[2] == "line"]
+    chk = [row for row in residuals if not row[12]]
+    rows = [
+        ["control points: RMS |v| (px)", str(len(pts)),
+         _n(_rms(np.array([row[9] for row in pts])), 3)],
+        ["line points: RMS distance from the projected line (px)", str(len(lns)),
+         _n(_rms(np.array([row[9] for row in lns])), 3)],
+        ["check points: RMS |projected - measured| (px)", str(len(chk)),
+         _n(_rms(np.array([row[9] for row in chk])), 3)],
+    ]  # fmt: skip
+    out.append("<h3>Residuals</h3>")
+    out.append(_table(["what", "count", "value"], rows))
+    rejected = [(b.block, b.label, b.row_name, b.w) for b in res.adjustment.rejected]
+    if rejected:
+        out.append("<h3>Rejected by data snooping</h3>")
+        out.append(_table(["block", "id", "row", "w"],
+                          [[_e(b), _e(lab), _e(rn), _n(w, 2)] for b, lab, rn, w in rejected]))
+    if res.warnings:
+        out.append('<p class="note">' + "<br>".join(_e(w) for w in res.warnings) + "</p>")
+    return out
+
+
+def _prior_std(r) -> np.ndarray:
+    """A-priori standard deviations in the mapping frame (scaled from the a-posteriori ones)."""
+    res = r.result.result
+    s0 = res.sigma0
+    if not (math.isfinite(s0) and s0 > 0):
+        return np.full(6, math.nan)
+    return r.result.std / s0 * res.adjustment.sigma0_prior

@@ -1,0 +1,258 @@
+"""The Resection tab of the picking dock: resect the image shown from its measured lines and
+control points, in a background ``QgsTask``, and show the adjusted pose and its residuals.
+
+The task writes the control the dock shows (the core objects of its
+:class:`~lidarphoto.core.photo.picking_session.ControlSet`: LiDAR lines and LCPs) to a line
+and an LCP table next to the observation file, then runs the core job ``resection`` (what the
+toolbox's ``lidarphoto:resection`` runs) on them and the saved observation file, for the image
+shown only. The job writes ``eo.csv``, ``residuals.csv`` and ``summary.html``; the dock shows
+the result objects it returns, not those files.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from qgis.core import QgsApplication, QgsTask
+from qgis.PyQt import sip
+from qgis.PyQt.QtCore import QObject, Qt, pyqtSignal
+from qgis.PyQt.QtWidgets import QCheckBox, QLabel, QPushButton, QVBoxLayout, QWidget
+
+from ..core.errors import Cancelled
+from ..core.io.control import write_lcps_csv, write_lines_csv
+from ..core.jobs import resection
+from ..core.jobs.resection import residual_rows
+from ..core.jobs.runner import JobResult, run_job
+from ..core.photo.control_features import lines_with_end_sigmas
+from ..core.photo.picking_session import residual_summary
+
+__all__ = ["RESECTION_ALG", "ResectionController", "ResectionPanel", "resection_parameters"]
+
+#: the algorithm (core job) the Resect button runs
+RESECTION_ALG = "lidarphoto:resection"
+
+
+def resection_parameters(
+    out_dir: Path, image_id: str, observations: Path, camera: str, crs: str, control: tuple
+) -> dict:
+    """Parameters of the core job ``resection`` for one image.
+
+    ``control``: the dock's (planes, lines, LCPs) (``ControlSet.for_calibration``); the line
+    and LCP tables are written to ``out_dir`` when there are lines or LCPs.
+    """
+    _planes, lines, lcps = control
+    return {
+        "CAMERA": camera,
+        "OBSERVATIONS": str(observations),
+        "CONTROL_POINTS": str(out_dir / "control_lcps.csv") if lcps else None,
+        "CONTROL_LINES": str(out_dir / "control_lines.csv") if lines else None,
+        "CRS": crs,
+        "IMAGES": image_id,
+        "OUTPUT_EO": str(out_dir / f"{image_id}_eo.csv"),
+        "OUTPUT_RESIDUALS": str(out_dir / f"{image_id}_residuals.csv"),
+        "OUTPUT_HTML": str(out_dir / f"{image_id}_summary.html"),
+    }
+
+
+class ResectionPanel(QWidget):
+    """The Resect button and the result (pose, sigmas, sigma0, residual per line and point);
+    the option refining the line ends on the image's edges."""
+
+    def __init__(self, parent=None) -> None:
+        super().__init__(parent)
+        layout = QVBoxLayout(self)
+        self.resect_button = QPushButton(self.tr("Resect the image shown"))
+        self.resect_button.setObjectName("lidarphotoResect")
+        self.resect_button.setToolTip(
+            self.tr(
+                "Runs {} in the background: the image's exterior orientation from its "
+                "measured lines and control points, no approximate values"
+            ).format(RESECTION_ALG)
+        )
+        self.refine_check = QCheckBox(self.tr("Refine line ends on the image edge"))
+        self.refine_check.setToolTip(
+            self.tr(
+                "Line picking: each click moves across the line to the strongest grey-value "
+                "edge within 4 px (sub-pixel)"
+            )
+        )
+        self.result_label = QLabel()
+        self.result_label.setWordWrap(True)
+        self.result_label.setTextFormat(Qt.TextFormat.RichText)
+        self.result_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        layout.addWidget(self.refine_check)
+        layout.addWidget(self.resect_button)
+        layout.addWidget(self.result_label, 1)
+
+    def set_running(self, running: bool) -> None:
+        self.resect_button.setEnabled(not running)
+        if running:
+            self.result_label.setText(self.tr("Resection running…"))
+
+    def show_result(self, run, rows: list[tuple]) -> str:
+        """Show one image's resection (:class:`core.jobs.resection.ImageRun`) and its
+        residual rows; returns the text shown."""
+        r, res = run.result, run.result.result
+        deg, s = np.degrees(r.opk), r.std
+        sd = np.degrees(s[3:])
+        head = (
+            f"<b>{run.image_id}</b>: X {r.xyz[0]:.3f} ± {s[0]:.3f}, Y {r.xyz[1]:.3f} ± "
+            f"{s[1]:.3f}, Z {r.xyz[2]:.3f} ± {s[2]:.3f} m<br>"
+            f"ω {deg[0]:.5f} ± {sd[0]:.5f}, φ {deg[1]:.5f} ± {sd[1]:.5f}, κ {deg[2]:.5f} ± "
+            f"{sd[2]:.5f}°<br>"
+            + self.tr("σ0 {:.3f}, redundancy {}, χ² test {}; {} point(s), {} line(s)").format(
+                res.sigma0,
+                res.redundancy,
+                self.tr("passed") if res.chi2_passed else self.tr("FAILED"),
+                run.image.data.n_points,
+                run.image.data.n_lines,
+            )
+        )
+        table = [
+            "<table><tr><th>type</th><th>id</th><th>pts</th><th>RMS px</th><th>max px</th>"
+            "<th></th></tr>"
+        ]
+        for kind, target, n, rms, vmax, rejected in residual_summary(rows):
+            flag = self.tr("rejected") if rejected else ""
+            table.append(
+                f"<tr><td>{kind}</td><td>{target}</td><td>{n}</td><td>{rms:.2f}</td>"
+                f"<td>{vmax:.2f}</td><td>{flag}</td></tr>"
+            )
+        text = head + "".join(table) + "</table>"
+        self.result_label.setText(text)
+        return text
+
+
+class _Task(QgsTask):
+    """Write the control tables, run the job; ``result`` or ``error`` afterwards."""
+
+    def __init__(self, description: str, params: dict, control: tuple, done) -> None:
+        super().__init__(description)
+        self.params, self.control, self.done = params, control, done
+        self.result: JobResult | None = None
+        self.error = ""
+        self.cancelled = False
+
+    def run(self) -> bool:  # a worker thread: no widget here
+        try:
+            Path(self.params["OUTPUT_EO"]).parent.mkdir(parents=True, exist_ok=True)
+            _planes, lines, lcps = self.control
+            if self.params["CONTROL_LINES"]:
+                write_lines_csv(self.params["CONTROL_LINES"], lines)
+            if self.params["CONTROL_POINTS"]:
+                write_lcps_csv(self.params["CONTROL_POINTS"], lcps)
+            self.result = run_job(
+                resection,
+                self.params,
+                progress=lambda f: self.setProgress(100.0 * f),
+                should_stop=self.isCanceled,
+            )
+        except Cancelled as exc:
+            self.cancelled, self.error = True, str(exc)
+            return False
+        except Exception as exc:  # every failure is reported in the dock, none is raised
+            self.error = str(exc) or type(exc).__name__
+            return False
+        return True
+
+    def finished(self, ok: bool) -> None:  # the GUI thread
+        self.done(ok, self)
+
+
+class ResectionController(QObject):
+    """The Resect button of a picking dock: one resection at a time in the QGIS task manager;
+    its residuals kept in the dock's session (drawn on the image and in the table).
+
+    Signals
+    -------
+    finished(bool)
+        The task ended; on success :attr:`run` is the image's
+        :class:`core.jobs.resection.ImageRun`, else :attr:`error` says why.
+    """
+
+    finished = pyqtSignal(bool)
+
+    def __init__(self, dock) -> None:
+        super().__init__(dock)
+        self.dock, self.panel = dock, dock.resection_panel
+        self.task: _Task | None = None
+        self.params: dict = {}
+        self.run = None
+        self.text = ""
+        self.error = ""
+        self.panel.resect_button.clicked.connect(self.start)
+
+    def tr(self, text: str) -> str:
+        return self.dock.tr(text)
+
+    @property
+    def running(self) -> bool:
+        return self.task is not None
+
+    def start(self, *_args) -> bool:
+        """Resect the image shown in a background task; False (with a message) if it cannot
+        start."""
+        dock, store = self.dock, self.dock.store
+        image = dock.current_image
+        if self.running:
+            dock.message(self.tr("A resection is already running."))
+            return False
+        if not image or not any(o.image_id == image for o in store.rows):
+            dock.message(self.tr("No observations in image {}.").format(image), warning=True)
+            return False
+        if store.path is None or not store.save():
+            dock.message(self.tr("The observations could not be saved."), warning=True)
+            return False
+        planes, lines, lcps = dock.session.control.for_calibration()
+        control = (planes, lines_with_end_sigmas(lines), lcps)
+        if not control[1] and not control[2]:
+            dock.message(self.tr("Choose the line or LCP layer."), warning=True)
+            return False
+        crs = dock.eo_crs()
+        out_dir = store.path.with_name(store.path.stem + "_resection")
+        camera = dock.project_panel.camera_edit.filePath()
+        params = resection_parameters(
+            out_dir, image, store.path, camera, crs.authid() or crs.toWkt(), control
+        )
+        self.params, self.run, self.error, self.text = params, None, "", ""
+        self.panel.set_running(True)
+        self.task = _Task(self.tr("Resection of {}").format(image), params, control, self._done)
+        QgsApplication.taskManager().addTask(self.task)
+        return True
+
+    def _done(self, ok: bool, task: _Task) -> None:
+        if sip.isdeleted(self):  # the dock was closed and deleted meanwhile
+            return
+        self.task = None
+        self.error = task.error
+        dock, panel = self.dock, self.panel
+        panel.set_running(False)
+        if not ok or task.result is None or not task.result.data:
+            if task.cancelled or task.isCanceled():
+                text = self.tr("Resection cancelled.")
+            else:
+                text = self.tr("Resection failed. {}").format(task.error)
+            panel.result_label.setText(text)
+            dock.message(text, warning=True)
+            self.finished.emit(False)
+            return
+        from ..core.io.camera import read_camera_json
+        from ..core.io.observations import read_observations_csv
+
+        run = self.run = task.result.data[0]
+        camera = read_camera_json(self.params["CAMERA"])
+        obs = read_observations_csv(self.params["OBSERVATIONS"], camera=camera)
+        rows = residual_rows(run, obs, camera)
+        dock.session.set_resection(rows)
+        self.text = panel.show_result(run, rows)
+        s0 = run.result.result.sigma0
+        dock.message(
+            self.tr("Resection of {} done: sigma0 {}; {}").format(
+                run.image_id, f"{s0:.3f}" if math.isfinite(s0) else "-", self.params["OUTPUT_HTML"]
+            )
+        )
+        dock.picking.draw_observations()
+        dock.picking.fill_table()
+        self.finished.emit(True)
