@@ -71,6 +71,7 @@ def demo(tmp_path_factory):
     lidar = DEMO.lidar_step(out / "lidar")
     sim, paths, eo_true = DEMO.flight_step(lidar, out / "flight", camera=HALF, images_per_line=2)
     figures = DEMO.render_step(lidar, sim, eo_true, out / "flight" / "images")
+    DEMO.ortho_step(out, out / "flight" / "eo_true.csv", gsd=0.1)  # no calibration here
     (out / "calibration").mkdir()
     initial = direct_georeference(sim.trajectory, sim.mount, MappingFrame.from_user_input(CRS))
     write_eo_csv(out / "calibration" / "eo_initial.csv", initial)
@@ -121,6 +122,10 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
     assert layers["LiDAR lines"].featureCount() == len(lidar.lines)
     dsm = layers["DSM 0.5 m (highest return)"]
     assert dsm.isValid() and dsm.crs().authid() == CRS
+    mosaic = layers["Orthomosaic (true orthophotos)"]
+    assert mosaic.isValid() and mosaic.crs().authid() == CRS
+    assert mosaic.renderer().type() == "multibandcolor" and mosaic.renderer().alphaBand() == 4
+    assert layers["Orthomosaic seamlines"].featureCount() == len(sim.trajectory.image_id)
 
     # ---- the dock restores the session
     dock = ImagePickingDock(None, qgis_parent)
