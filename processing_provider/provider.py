@@ -16,6 +16,7 @@ from .algorithms.ground_filter import GroundFilterAlgorithm
 from .algorithms.monoplot import MonoplotAlgorithm
 from .algorithms.orthomosaic import OrthomosaicAlgorithm
 from .algorithms.orthorectify import OrthorectifyAlgorithm
+from .algorithms.tls_calibration import TlsCalibrationAlgorithm
 from .algorithms.trajectory_to_eo import TrajectoryToEoAlgorithm
 
 ICON_PATH = Path(__file__).resolve().parents[1] / "icon.svg"
@@ -53,5 +54,6 @@ class LidarPhotoProvider(QgsProcessingProvider):
             MonoplotAlgorithm(),
             OrthorectifyAlgorithm(),
             OrthomosaicAlgorithm(),
+            TlsCalibrationAlgorithm(),
         ):
             self.addAlgorithm(alg)

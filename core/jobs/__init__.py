@@ -10,6 +10,7 @@ from . import (
     monoplot,
     orthomosaic,
     orthorectify,
+    tls_calibration,
     trajectory_to_eo,
 )
 
@@ -24,4 +25,5 @@ ALGORITHMS = (
     monoplot,
     orthorectify,
     orthomosaic,
+    tls_calibration,
 )
