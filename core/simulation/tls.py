@@ -325,3 +325,229 @@ def room_network(
 def with_aps(truth: TlsTruth, aps: dict[str, float]) -> TlsTruth:
     """The same network with other inserted APs."""
     return replace(truth, aps=dict(aps))
+
+
+# ----------------------------------------------------------------------------- scans
+
+#: Return intensities of the simulated materials (0-1).
+WALL_INTENSITY, SPHERE_INTENSITY, BLACK, WHITE = 0.35, 0.8, 0.08, 0.92
+
+
+@dataclass(frozen=True)
+class ScanScene:
+    """A box-shaped room with sphere and checkerboard targets (object frame, metres).
+
+    Attributes
+    ----------
+    room : tuple of float
+        (lx, ly, lz): the room is [0, lx] x [0, ly] x [0, lz].
+    sphere_ids, sphere_xyz, radius
+        Sphere targets: ids, centres (S, 3) and their common radius.
+    board_ids, board_xyz, board_normal, board_up, half_size
+        Checkerboards: ids, centres (B, 3), unit normals into the room (B, 3), a unit
+        in-plane direction of one pattern axis (B, 3), and the half size of the 2 x 2 pattern.
+    """
+
+    room: tuple[float, float, float]
+    sphere_ids: tuple[str, ...] = ()
+    sphere_xyz: Array = field(default_factory=lambda: np.zeros((0, 3)))
+    radius: float = 0.0725
+    board_ids: tuple[str, ...] = ()
+    board_xyz: Array = field(default_factory=lambda: np.zeros((0, 3)))
+    board_normal: Array = field(default_factory=lambda: np.zeros((0, 3)))
+    board_up: Array = field(default_factory=lambda: np.zeros((0, 3)))
+    half_size: float = 0.1
+
+
+@dataclass(frozen=True)
+class SimulatedScan:
+    """One station's scan: points in the scanner frame as the scanner records them.
+
+    ``label`` is the index of the sphere (0..S-1) or of the board (S..S+B-1) a point hit,
+    -1 for the room and -2 for an outlier.
+    """
+
+    station_id: str
+    xyz: Array
+    intensity: Array
+    label: NDArray[np.int64]
+
+
+def scene_from_network(
+    truth: TlsTruth,
+    kind: str = "sphere",
+    radius: float = 0.0725,
+    half_size: float = 0.1,
+    room: tuple[float, float, float] | None = None,
+    seed: int = 3,
+) -> tuple[ScanScene, TlsTruth]:
+    """Targets of a room network as spheres (centres moved ``1.5 radius`` off their wall into
+    the room, as on a bracket) or checkerboards (on the walls, ceiling and floor, turned at
+    random about their normal); returns the scene and the network with the target centres."""
+    lx, ly, lz = room if room is not None else tuple(
+        float(v) for v in np.max(truth.target_xyz, axis=0))  # fmt: skip
+    p = truth.target_xyz.copy()
+    normal = np.zeros_like(p)
+    for axis, top in ((0, lx), (1, ly), (2, lz)):
+        normal[np.isclose(p[:, axis], 0.0), axis] = 1.0
+        normal[np.isclose(p[:, axis], top), axis] = -1.0
+    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)
+    if kind == "sphere":
+        centres = p + 1.5 * radius * normal
+        scene = ScanScene((lx, ly, lz), truth.target_ids, centres, radius)
+    else:
+        rng = np.random.default_rng(seed)
+        centres = p + 0.002 * normal  # the board's thickness off its wall
+        ups = []
+        for n in normal:
+            a = np.array([0.0, 0.0, 1.0]) if abs(n[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+            e1 = np.cross(n, a)
+            e1 /= np.linalg.norm(e1)
+            e2 = np.cross(n, e1)
+            ang = rng.uniform(0, math.pi / 2)
+            ups.append(math.cos(ang) * e1 + math.sin(ang) * e2)
+        scene = ScanScene(
+            (lx, ly, lz),
+            board_ids=truth.target_ids,
+            board_xyz=centres,
+            board_normal=normal,
+            board_up=np.array(ups),
+            half_size=half_size,
+        )
+    return scene, replace(truth, target_xyz=centres)
+
+
+def _hits(scene: ScanScene, m: Array, x0: Array, u: Array) -> tuple[Array, Array, Array]:
+    """Nearest hit along unit rays ``u`` (N, 3) of the scanner frame: range, intensity and
+    label (the target index, -1 for a wall); the scene is moved into the scanner frame."""
+    n = u.shape[0]
+    best = np.full(n, np.inf)
+    inten = np.full(n, WALL_INTENSITY)
+    label = np.full(n, -1, dtype=np.int64)
+    lx, ly, lz = scene.room
+    for axis, top in ((0, lx), (1, ly), (2, lz)):
+        for value in (0.0, top):
+            nrm = m[:, axis]  # the object axis in the scanner frame
+            dist = value - x0[axis]
+            den = u @ nrm
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = dist / den
+            ok = (t > 1e-6) & (t < best)
+            best = np.where(ok, t, best)
+    c = (scene.sphere_xyz - x0) @ m.T
+    r = scene.radius
+    for k in range(c.shape[0]):
+        b = u @ c[k]
+        disc = b * b - (c[k] @ c[k] - r * r)
+        with np.errstate(invalid="ignore"):
+            t = b - np.sqrt(disc)
+        ok = (disc > 0) & (t > 1e-6) & (t < best)
+        best = np.where(ok, t, best)
+        inten = np.where(ok, SPHERE_INTENSITY, inten)
+        label = np.where(ok, k, label)
+    s = c.shape[0]
+    bc = (scene.board_xyz - x0) @ m.T
+    bn = scene.board_normal @ m.T
+    bu = scene.board_up @ m.T
+    for k in range(bc.shape[0]):
+        den = u @ bn[k]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = (bc[k] @ bn[k]) / den
+        q = u * t[:, None] - bc[k]
+        e1 = bu[k]
+        e2 = np.cross(bn[k], e1)
+        a1, a2 = q @ e1, q @ e2
+        h = scene.half_size
+        ok = (t > 1e-6) & (t < best) & (np.abs(a1) < h) & (np.abs(a2) < h)
+        best = np.where(ok, t, best)
+        white = np.sign(a1) * np.sign(a2) > 0
+        inten = np.where(ok, np.where(white, WHITE, BLACK), inten)
+        label = np.where(ok, s + k, label)
+    return best, inten, label
+
+
+def simulate_scan(
+    scene: ScanScene,
+    truth: TlsTruth,
+    station: int,
+    spacing_m: float = 0.003,
+    sigma_range_m: float = 0.001,
+    sigma_angle_rad: float = 20e-6,
+    sigma_intensity: float = 0.03,
+    outlier_fraction: float = 0.0,
+    hide_below: float | None = None,
+    rng: np.random.Generator | int | None = None,
+    window: float = 1.6,
+) -> SimulatedScan:
+    """Scan the targets of ``scene`` from station ``station`` of ``truth`` (its pose and APs).
+
+    Like a scanner's fine scan of each target: a grid of directions spaced ``spacing_m`` at
+    the target's distance, over ``window`` times its angular radius; each ray meets the nearest
+    surface (room, spheres, boards). The recorded polar observation is the true one plus the
+    APs of ``truth`` plus noise, turned into scanner-frame x, y, z as a scanner exports it.
+
+    Parameters
+    ----------
+    outlier_fraction : float
+        Share of the points replaced by outliers: a range anywhere from 0.3 m before to
+        0.3 m after the true hit along the same beam (mixed pixels, dust), random intensity.
+    hide_below : float, optional
+        Partial coverage: sphere points lower than ``hide_below * radius`` under the sphere
+        centre (object z) are hidden, as by a bracket or stand.
+    """
+    rng = np.random.default_rng(rng)
+    pose = truth.poses[station]
+    m = opk_to_matrix(pose[3], pose[4], pose[5])
+    x0 = pose[:3]
+    centres = np.vstack([scene.sphere_xyz, scene.board_xyz]) if len(scene.board_xyz) else (
+        scene.sphere_xyz)  # fmt: skip
+    sizes = np.r_[np.full(len(scene.sphere_xyz), scene.radius),
+                  np.full(len(scene.board_xyz), scene.half_size * math.sqrt(2))]  # fmt: skip
+    d = (centres - x0) @ m.T
+    rho_c = np.linalg.norm(d, axis=1)
+    theta_c = np.arctan2(d[:, 1], d[:, 0])
+    alpha_c = np.arctan2(d[:, 2], np.hypot(d[:, 0], d[:, 1]))
+    rays = []
+    for k in range(len(centres)):
+        if rho_c[k] < 0.5 or abs(alpha_c[k]) > math.radians(80.0):
+            continue
+        if alpha_c[k] < truth.min_elevation_rad:
+            continue
+        ang = window * math.asin(min(sizes[k] / rho_c[k], 0.99))
+        step_rad = spacing_m / rho_c[k]
+        na = max(math.ceil(2 * ang / step_rad), 3)
+        nt = max(math.ceil(2 * ang / (step_rad * max(math.cos(alpha_c[k]), 0.1))), 3)
+        tt = theta_c[k] + np.linspace(-ang, ang, nt) / max(math.cos(alpha_c[k]), 0.1)
+        aa = alpha_c[k] + np.linspace(-ang, ang, na)
+        t2, a2 = np.meshgrid(tt, aa, indexing="ij")
+        rays.append(np.column_stack([t2.ravel(), a2.ravel()]))
+    if not rays:
+        return SimulatedScan(truth.station_ids[station], np.zeros((0, 3)), np.zeros(0),
+                             np.zeros(0, dtype=np.int64))  # fmt: skip
+    ta = np.vstack(rays)
+    u = np.column_stack([np.cos(ta[:, 1]) * np.cos(ta[:, 0]),
+                         np.cos(ta[:, 1]) * np.sin(ta[:, 0]), np.sin(ta[:, 1])])  # fmt: skip
+    rho, inten, label = _hits(scene, m, x0, u)
+    keep = np.isfinite(rho)
+    if hide_below is not None and len(scene.sphere_xyz):
+        obj = (u * rho[:, None]) @ m + x0
+        sph = (label >= 0) & (label < len(scene.sphere_xyz))
+        low = np.zeros_like(keep)
+        low[sph] = obj[sph, 2] < scene.sphere_xyz[label[sph], 2] - hide_below * scene.radius
+        keep &= ~low
+    ta, rho, inten, label = ta[keep], rho[keep], inten[keep], label[keep]
+    n = rho.size
+    dr, dt, da = _corrections(truth.aps, rho, ta[:, 0], ta[:, 1], truth.wavelength_m)
+    r_obs = rho + dr + rng.normal(0.0, sigma_range_m, n)
+    t_obs = ta[:, 0] + dt + rng.normal(0.0, sigma_angle_rad, n)
+    a_obs = ta[:, 1] + da + rng.normal(0.0, sigma_angle_rad, n)
+    inten = inten + rng.normal(0.0, sigma_intensity, n)
+    if outlier_fraction > 0:
+        bad = rng.random(n) < outlier_fraction
+        r_obs[bad] = rho[bad] + rng.uniform(-0.3, 0.3, int(bad.sum()))
+        inten[bad] = rng.uniform(0.0, 1.0, int(bad.sum()))
+        label[bad] = -2
+    ca = np.cos(a_obs)
+    xyz = np.column_stack([r_obs * ca * np.cos(t_obs), r_obs * ca * np.sin(t_obs),
+                           r_obs * np.sin(a_obs)])  # fmt: skip
+    return SimulatedScan(truth.station_ids[station], xyz, inten, label)
