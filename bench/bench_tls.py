@@ -18,8 +18,6 @@ from pathlib import Path
 
 import numpy as np
 import scipy
-from scipy.optimize import least_squares
-
 from lidarphoto.core import __version__
 from lidarphoto.core.geometry.rotations import opk_to_matrix
 from lidarphoto.core.io.tls import write_tls_control_csv, write_tls_observations_csv
@@ -33,6 +31,7 @@ from lidarphoto.core.simulation.tls import (
     room_network,
 )
 from lidarphoto.core.tls.calibration import CalibrationOptions, calibrate
+from scipy.optimize import least_squares
 
 AS = math.pi / (180 * 3600)
 NAMES = ("a0", "b1", "b2", "c0")
@@ -178,8 +177,11 @@ def main(draws: int = 1000) -> None:
     print("\n## 5 the job (read + adjust + write 4 CSV + HTML)")
     with tempfile.TemporaryDirectory() as tmp:
         d = Path(tmp)
-        cases = {"cube (432 obs)": (t, 1), "room (6 stations)": (room_network(), 1),
-                 "room, 12 stations, two faces": (room_network(levelled_stations=10), 2)}  # fmt: skip
+        cases = {
+            "cube (432 obs)": (t, 1),
+            "room (6 stations)": (room_network(), 1),
+            "room, 12 stations, two faces": (room_network(levelled_stations=10), 2),
+        }
         for label, (net, faces) in cases.items():
             o, _ = observe(net, *sig, rng=3, two_faces=faces == 2)
             write_tls_observations_csv(d / "obs.csv", o)

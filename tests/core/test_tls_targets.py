@@ -7,7 +7,6 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-
 from lidarphoto.core.errors import InputError
 from lidarphoto.core.geometry.rotations import opk_to_matrix
 from lidarphoto.core.simulation.tls import room_network, scene_from_network, simulate_scan
