@@ -12,6 +12,7 @@ from .algorithms.accuracy_report import AccuracyReportAlgorithm
 from .algorithms.boresight_calibration import BoresightCalibrationAlgorithm
 from .algorithms.create_lcps import CreateLcpsAlgorithm
 from .algorithms.extract_roof_planes import ExtractRoofPlanesAlgorithm
+from .algorithms.extract_tls_targets import ExtractTlsTargetsAlgorithm
 from .algorithms.ground_filter import GroundFilterAlgorithm
 from .algorithms.monoplot import MonoplotAlgorithm
 from .algorithms.orthomosaic import OrthomosaicAlgorithm
@@ -55,5 +56,6 @@ class LidarPhotoProvider(QgsProcessingProvider):
             OrthorectifyAlgorithm(),
             OrthomosaicAlgorithm(),
             TlsCalibrationAlgorithm(),
+            ExtractTlsTargetsAlgorithm(),
         ):
             self.addAlgorithm(alg)

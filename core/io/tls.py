@@ -10,9 +10,9 @@ above the scanner's horizontal plane (a value beyond +-90 degrees is a face-II r
 s_hz and s_vt in arc-seconds. Or in scanner-frame Cartesian form (the target centres of a
 target fit)::
 
-    station_id,target_id,x,y,z[,s_x,s_y,s_z]
+    station_id,target_id,x,y,z[,s_x,s_y,s_z][,cov_xy,cov_xz,cov_yz]
 
-metres, converted to polar form with the covariance propagated. Missing sigma columns take
+metres (covariances m^2), converted to polar form with the covariance propagated. Missing sigma columns take
 the caller's defaults.
 
 Control (optional): ``target_id,X,Y,Z[,s_X,s_Y,s_Z]`` (object frame, metres; a sigma of 0
@@ -157,6 +157,15 @@ def read_tls_observations_csv(
         )
         sig = np.column_stack([_optional(t, (f"s_{c}", f"sigma_{c}"), s_r) for c in "xyz"])
         cov = np.einsum("ni,ij->nij", sig**2, np.eye(3))
+        for (i, j), name in (((0, 1), "cov_xy"), ((0, 2), "cov_xz"), ((1, 2), "cov_yz")):
+            col = find_column(t, (name,), required=False)
+            if col is not None:  # the full covariance of a target fit (extracttlstargets)
+                c = float_column(t, col, allow_empty=True)
+                cov[:, i, j] = cov[:, j, i] = np.nan_to_num(c)
+        for k in range(len(t)):
+            if np.linalg.eigvalsh(cov[k])[0] <= 0:
+                raise InputError("the covariance of (x, y, z) is not positive definite",
+                                 path=t.path, row=int(rows[k]))  # fmt: skip
         bad = np.flatnonzero(np.linalg.norm(xyz, axis=1) <= 0)
         if bad.size:
             raise InputError("the point is at the scanner's origin", path=t.path,

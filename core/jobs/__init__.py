@@ -6,6 +6,7 @@ from . import (
     boresight_calibration,
     create_lcps,
     extract_roof_planes,
+    extract_tls_targets,
     ground_filter,
     monoplot,
     orthomosaic,
@@ -26,4 +27,5 @@ ALGORITHMS = (
     orthorectify,
     orthomosaic,
     tls_calibration,
+    extract_tls_targets,
 )
