@@ -12,8 +12,8 @@ target fit)::
 
     station_id,target_id,x,y,z[,s_x,s_y,s_z][,cov_xy,cov_xz,cov_yz]
 
-metres (covariances m^2), converted to polar form with the covariance propagated. Missing sigma columns take
-the caller's defaults.
+metres (covariances m^2), converted to polar form with the covariance propagated. Missing
+sigma columns take the caller's defaults.
 
 Control (optional): ``target_id,X,Y,Z[,s_X,s_Y,s_Z]`` (object frame, metres; a sigma of 0
 holds the coordinate fixed; no sigma columns: fixed).
