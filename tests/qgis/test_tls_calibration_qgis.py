@@ -76,13 +76,15 @@ def test_qgis_process(qp_env, cube, tmp_path):
     _check(_aps(tmp_path / "a.csv"))
 
 
-def test_extract_targets_processing_run(provider, tmp_path):
-    """lidarphoto:extracttlstargets on three simulated PLY scans of 8 spheres."""
+@pytest.fixture(scope="module")
+def ply_scans(tmp_path_factory):
+    """Three simulated PLY scans (ASCII) of 8 spheres, 20 % outliers."""
     from dataclasses import replace
 
     import numpy as np
     from lidarphoto.core.simulation.tls import room_network, scene_from_network, simulate_scan
 
+    folder = tmp_path_factory.mktemp("scans")
     truth = room_network(aps={})
     scene, t2 = scene_from_network(truth, kind="sphere")
     keep = np.arange(0, 102, 13)
@@ -91,19 +93,38 @@ def test_extract_targets_processing_run(provider, tmp_path):
     paths = []
     for k in range(3):
         s = simulate_scan(scene, t2, k, outlier_fraction=0.2, rng=k)
-        p = tmp_path / f"{t2.station_ids[k]}.ply"
+        p = folder / f"{t2.station_ids[k]}.ply"
         head = (f"ply\nformat ascii 1.0\nelement vertex {len(s.xyz)}\nproperty double x\n"
                 "property double y\nproperty double z\nend_header\n")  # fmt: skip
         with open(p, "w", encoding="ascii") as fh:
             fh.write(head)
             np.savetxt(fh, s.xyz, fmt="%.6f")
         paths.append(str(p))
-    out = tmp_path / "targets.csv"
-    res = processing.run("lidarphoto:extracttlstargets",
-                         {"SCANS": paths, "KIND": 0, "OUTPUT": str(out)})  # fmt: skip
+    return paths
+
+
+def _check_targets(out, count):
     with open(out, newline="", encoding="utf-8") as fh:
         rows = list(csv.DictReader(fh))
-    assert res["TARGETS"] == len(rows) >= 18
+    assert count == len(rows) >= 18
     assert {r["station_id"] for r in rows} == {"S1", "S2", "S3"}
     ids = [{r["target_id"] for r in rows if r["station_id"] == s} for s in ("S1", "S2", "S3")]
     assert len(ids[0] & ids[1] & ids[2]) >= 4  # common ids: the scans can be registered
+
+
+def test_extract_targets_processing_run(provider, ply_scans, tmp_path):
+    out = tmp_path / "targets.csv"
+    res = processing.run("lidarphoto:extracttlstargets",
+                         {"SCANS": ply_scans, "KIND": 0, "OUTPUT": str(out)})  # fmt: skip
+    _check_targets(out, res["TARGETS"])
+
+
+def test_extract_targets_qgis_process(qp_env, ply_scans, tmp_path):
+    out = tmp_path / "targets.csv"
+    r = subprocess.run(
+        [QGIS_PROCESS, "--json", "run", "lidarphoto:extracttlstargets", "--",
+         *(f"SCANS={p}" for p in ply_scans), f"OUTPUT={out}"],
+        env=qp_env, capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    _check_targets(out, json.loads(r.stdout)["results"]["TARGETS"])
