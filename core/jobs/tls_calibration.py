@@ -11,7 +11,7 @@ import logging
 import math
 
 from ..tls.aps import AP_SETS, ARCSEC
-from ..tls.calibration import CalibrationOptions
+from ..tls.options import CalibrationOptions
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values

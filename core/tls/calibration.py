@@ -39,14 +39,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import stats
 
 from ..errors import InputError, NotObservableError
 from ..geometry.rotations import opk_derivatives, opk_to_matrix
 from ..lsq.adjustment import adjust
 from ..lsq.model import AdjustmentOptions, Constraint, GaussMarkovBlock, prior_block
 from ..lsq.results import AdjustmentResult
-from .aps import AP_TERMS, ARCSEC, ap_basis, ap_terms
+from .aps import AP_TERMS, ap_basis, ap_terms
 from .network import (
     ControlTarget,
     StationInfo,
@@ -54,6 +53,7 @@ from .network import (
     check_network,
     register_stations,
 )
+from .options import CalibrationOptions
 from .polar import cartesian_to_polar, instrument_angles, polar_jacobian, wrap_angle
 
 __all__ = [
@@ -71,63 +71,6 @@ __all__ = [
 log = logging.getLogger(__name__)
 Array = NDArray[np.float64]
 POSE_NAMES = ("X", "Y", "Z", "omega", "phi", "kappa")
-
-
-@dataclass(frozen=True)
-class CalibrationOptions:
-    """Options of :func:`calibrate`.
-
-    Attributes
-    ----------
-    ap_set : str or tuple of str
-        ``"none"`` (registration only), ``"paper"`` (a0, b1, b2, c0), ``"extended"``
-        (Lichti's physical set) or a list of terms (:mod:`.aps`).
-    levelled : bool
-        Default for stations whose table does not say: the compensator levelled the scanner,
-        so omega and phi are observed (with ``tilt_sigma_rad``); otherwise they are free.
-    tilt_sigma_rad : float
-        Standard deviation of the compensator's omega and phi (radians).
-    cyclic_wavelength_m : float
-        Modulation wavelength U of the cyclic range terms a2, a3 (metres).
-    datum : {"inner", "reference"}
-        Without control: ``"inner"`` constrains the free targets as a whole (minimum
-        constraints: their mean position and mean orientation stay those of the approximate
-        registration; only the rotation about the vertical when a station is levelled, whose
-        compensator defines the tilt), so that the standard deviations and correlations do not
-        depend on one station (free-network adjustment); ``"reference"`` holds the
-        reference station at its pose (position and kappa, also omega and phi when it is not
-        levelled).
-    reference_station : str or None
-        Station that defines the frame when there is no control: the approximate
-        registration starts from it (at its given pose, else the origin), and with
-        ``datum="reference"`` it is held there (default: the first station of the stations
-        table with a position, else the first station observed).
-    snooping, snooping_alpha : bool, float
-        Baarda data snooping (whole observations) and its significance per observation.
-    significance_alpha : float
-        Two-sided level of the Student-t test of each AP.
-    correlation_limit : float
-        Correlations (absolute) at or above this are reported as strong, and in
-        ``select_aps`` a pair of APs beyond it loses one member.
-    select_aps : bool
-        Choose the APs by significance and correlation (backward elimination from
-        ``ap_set``).
-    max_iterations : int
-        Of each adjustment.
-    """
-
-    ap_set: str | tuple[str, ...] = "paper"
-    levelled: bool = True
-    tilt_sigma_rad: float = 10.0 * ARCSEC
-    cyclic_wavelength_m: float = 1.2
-    datum: str = "inner"
-    reference_station: str | None = None
-    snooping: bool = True
-    snooping_alpha: float = 0.001
-    significance_alpha: float = 0.05
-    correlation_limit: float = 0.9
-    select_aps: bool = False
-    max_iterations: int = 50
 
 
 class TlsNotObservable(NotObservableError):
@@ -626,6 +569,8 @@ def _run(
 
 
 def _ap_stats(res: AdjustmentResult, k: int, alpha: float) -> tuple[Array, float]:
+    from scipy import stats  # here: scipy.stats takes seconds to import (QGIS start-up)
+
     std = res.std[:k]
     with np.errstate(divide="ignore", invalid="ignore"):
         t = np.abs(res.x[:k]) / std
