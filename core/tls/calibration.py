@@ -656,6 +656,38 @@ def _select(
     return tuple(current), steps
 
 
+#: A levelled station whose registration finds it tilted beyond this (radians) from its
+#: compensator reading is not levelled (a wrong flag, or control that is not z up).
+MAX_LEVEL_DISAGREEMENT_RAD = np.radians(1.0)
+
+
+def _check_levelled(
+    obs: TlsObservations,
+    infos: dict[str, StationInfo],
+    levelled_ids: list[str],
+    poses: dict[str, Array],
+    has_control: bool,
+) -> None:
+    """Refuse a station flagged levelled whose approximate registration is tilted: the
+    compensator observations would pull it to a wrong orientation."""
+    for s in levelled_ids:
+        info = infos.get(s)
+        given = info.opk[:2] if info is not None and info.opk is not None else np.zeros(2)
+        tilt = np.abs(wrap_angle(poses[s][3:5] - given))
+        if tilt.max() > MAX_LEVEL_DISAGREEMENT_RAD:
+            k = obs.station.index(s)
+            raise InputError(
+                f"station '{s}' is taken as levelled (compensator omega, phi = "
+                f"{np.degrees(given[0]):.4f}, {np.degrees(given[1]):.4f} deg) but its targets "
+                f"place it at omega, phi = {np.degrees(poses[s][3]):.2f}, "
+                f"{np.degrees(poses[s][4]):.2f} deg: mark it levelled = 0 in the stations "
+                "table (a tilted or rotated scanner)"
+                + (", or check that the control is in a frame with z up" if has_control
+                   else ""),
+                **obs.where(k),
+            )  # fmt: skip
+
+
 def calibrate(
     obs: TlsObservations,
     control: Sequence[ControlTarget] = (),
@@ -707,9 +739,20 @@ def calibrate(
     reference = opts.reference_station
     if reference is not None and reference not in known_stations:
         raise InputError(f"the reference station '{reference}' has no observations")
+    def is_levelled(sid: str) -> bool:
+        info = infos.get(sid)
+        return opts.levelled if info is None or info.levelled is None else bool(info.levelled)
+
+    levelled_ids = [s for s in obs.stations() if is_levelled(s)]
+    if reference is None and not has_control and levelled_ids:
+        # The approximate frame is that of the reference station: a levelled one keeps z up,
+        # so that the compensator readings of the others can be checked against it.
+        placed = [st.id for st in stations if st.xyz is not None and is_levelled(st.id)]
+        reference = placed[0] if placed else levelled_ids[0]
     poses, targets, ref = register_stations(obs, control, stations, reference)
     if has_control:
         ref = None
+    _check_levelled(obs, infos, levelled_ids, poses, has_control)
     steps: list[SelectionStep] = []
     if opts.select_aps and aps:
         aps, steps = _select(obs, control, infos, opts, aps, poses, targets, ref, has_control,

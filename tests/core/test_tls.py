@@ -200,6 +200,17 @@ def test_two_faces_separate_the_index_error_from_the_tilts():
 # ----------------------------------------------------------------------------- bad networks
 
 
+def test_tilted_station_flagged_levelled_is_refused():
+    """The room's two stations rolled by 90 degrees, all taken as levelled (the option's
+    default, no stations table): refused, naming the station, instead of letting the
+    compensator pull it to a wrong orientation."""
+    t = room_network()
+    obs, _ = observe(t, *SCANNER_CLASSES["high_end"], rng=5)
+    with pytest.raises(InputError, match=r"row \d+: station 'S5' is taken as levelled .* "
+                       r"place it at omega, phi = -?89.99"):  # fmt: skip
+        calibrate(obs, (), (), CalibrationOptions(levelled=True))
+
+
 def _obs(rows):
     st, tg, p = zip(*[(r[0], r[1], r[2:]) for r in rows])
     n = len(rows)
