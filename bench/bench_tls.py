@@ -2,8 +2,8 @@
 Monte Carlo against the Cramer-Rao bound, the decorrelation by tilted stations (Lichti 2010),
 an independent SciPy peer, the paper's shortfall, and what the user waits for (the job).
 
-Run: /work/tools/wt.sh <worktree> py bench/bench_tls.py [draws]   (writes nothing but stdout;
-bench/tls.md holds the tables of one run)
+Run: /work/tools/wt.sh <worktree> py bench/bench_tls.py [draws] [--targets: section 6 only]
+(writes nothing but stdout; bench/tls.md holds the tables of one run)
 """
 
 from __future__ import annotations
@@ -83,10 +83,13 @@ def peer_solve(obs, t, sig, start_poses, aps=True, fix_pose=None):
     return r.x
 
 
-def main(draws: int = 1000) -> None:
+def main(draws: int = 1000, only_targets: bool = False) -> None:
     print(f"# date {time.strftime('%Y-%m-%d')}, {platform.processor() or platform.machine()}, "
           f"python {platform.python_version()}, numpy {np.__version__}, scipy "
           f"{scipy.__version__}, lidarphoto {__version__}")  # fmt: skip
+    if only_targets:
+        targets_from_scans()
+        return
     t = paper_cube()
     ctrl = t.control()
     info = t.station_info()
@@ -201,7 +204,11 @@ def main(draws: int = 1000) -> None:
             dt = time.perf_counter() - t0
             print(f"{label}: {len(o)} observations, {dt:.2f} s, sigma0 "
                   f"{res.results['SIGMA0']:.3f}")  # fmt: skip
-    # 6. targets from scans: 102 spheres in the room, 20 % outliers, binary PLY per station
+    targets_from_scans()
+
+
+def targets_from_scans() -> None:
+    """6. targets from scans: 102 spheres in the room, 20 % outliers, binary PLY per station."""
     print("\n## 6 extracttlstargets (read PLY + detect + fit + label + write), 3 stations")
     from dataclasses import replace as _replace
 
@@ -247,4 +254,5 @@ def main(draws: int = 1000) -> None:
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 1000)
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    main(int(args[0]) if args else 1000, only_targets="--targets" in sys.argv)

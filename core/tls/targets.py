@@ -708,39 +708,69 @@ def match_targets(
     da = np.linalg.norm(pa[:, None] - pa[None], axis=-1)
     db = np.linalg.norm(pb[:, None] - pb[None], axis=-1)
     # Triangles of a: each target with its two nearest neighbours farther than 4 tolerances.
-    best = (0, None)
-    ia_all = np.arange(na)
     tri_a = []
+    fourth: dict[tuple[int, int, int], list[int]] = {}
     for i in range(na):
-        order = [j for j in np.argsort(da[i]) if da[i, j] > 4 * tolerance]
+        order = [int(j) for j in np.argsort(da[i]) if da[i, j] > 4 * tolerance]
         for j in order[:3]:
             for m in order[:4]:
                 if m != j and da[j, m] > 4 * tolerance:
                     tri_a.append((i, j, m))
-    for i, j, m in tri_a:
-        cand_k, cand_q = np.nonzero(np.abs(db - da[i, j]) < tolerance)
-        for k, kk in zip(cand_k, cand_q):
-            if k == kk:
-                continue
-            ok = np.flatnonzero(
-                (np.abs(db[k] - da[i, m]) < tolerance) & (np.abs(db[kk] - da[j, m]) < tolerance)
-            )
-            for q in ok:
-                if q in (k, kk):
+                    fourth[(i, j, m)] = [n for n in order[:7] if n not in (j, m)][:3]
+
+    from scipy.spatial import cKDTree
+
+    tree = cKDTree(pb)
+
+    def search(with_fourth: bool) -> tuple[int, tuple[Array, Array] | None]:
+        best: tuple[int, tuple[Array, Array] | None] = (0, None)
+        best_map: dict[int, int] = {}
+        ia_all = np.arange(na)
+        for i, j, m in tri_a:
+            cand_k, cand_q = np.nonzero(np.abs(db - da[i, j]) < tolerance)
+            for k, kk in zip(cand_k, cand_q):
+                if k == kk:
                     continue
-                try:
-                    r, t, _ = kabsch(pa[[i, j, m]], pb[[k, kk, q]])
-                except InputError:
-                    continue
-                moved = pa @ r.T + t
-                d = np.linalg.norm(moved[:, None] - pb[None], axis=-1)
-                nearest = np.argmin(d, axis=1)
-                hit = d[ia_all, nearest] < tolerance
-                count = int(hit.sum())
-                if count > best[0]:
-                    best = (count, (r, t))
-                if count == min(na, nb):
-                    break
+                ok = np.flatnonzero(
+                    (np.abs(db[k] - da[i, m]) < tolerance)
+                    & (np.abs(db[kk] - da[j, m]) < tolerance)
+                )
+                for q in ok:
+                    if q in (k, kk):
+                        continue
+                    # A triangle whose three pairs the best motion already matches gives that
+                    # motion again: skip its verification (most triangles of the overlap do).
+                    if best_map.get(i) == k and best_map.get(j) == kk and best_map.get(m) == q:
+                        continue
+                    # Regular target layouts repeat triangles: ask a fourth target of a to be
+                    # at matching distances from some target of b before trying the motion.
+                    if with_fourth and not any(
+                        np.any((np.abs(db[k] - da[i, n]) < tolerance)
+                               & (np.abs(db[kk] - da[j, n]) < tolerance)
+                               & (np.abs(db[q] - da[m, n]) < tolerance))
+                        for n in fourth[(i, j, m)]
+                    ):  # fmt: skip
+                        continue
+                    try:
+                        r, t, _ = kabsch(pa[[i, j, m]], pb[[k, kk, q]])
+                    except InputError:
+                        continue
+                    dist, nearest = tree.query(pa @ r.T + t, distance_upper_bound=tolerance)
+                    hit = dist < tolerance
+                    count = int(hit.sum())
+                    if count > best[0]:
+                        best = (count, (r, t))
+                        best_map = {int(a): int(b) for a, b in zip(ia_all[hit], nearest[hit])}
+                    if count == min(na, nb):
+                        return best
+        return best
+
+    # With many targets the four-point test prunes most false triangles; with few in common
+    # it may reject every true one, so the plain search follows when it finds too little.
+    best = search(with_fourth=min(na, nb) >= 8)
+    if best[0] < max(min_matches, 4) and min(na, nb) >= 8:
+        best = search(with_fourth=False)
+    ia_all = np.arange(na)
     if best[1] is None or best[0] < min_matches:
         raise InputError(f"fewer than {min_matches} targets in common could be matched "
                          f"(best {best[0]})")  # fmt: skip
