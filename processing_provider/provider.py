@@ -13,11 +13,13 @@ from .algorithms.boresight_calibration import BoresightCalibrationAlgorithm
 from .algorithms.bundle_adjustment import BundleAdjustmentAlgorithm
 from .algorithms.create_lcps import CreateLcpsAlgorithm
 from .algorithms.extract_roof_planes import ExtractRoofPlanesAlgorithm
+from .algorithms.extract_tls_targets import ExtractTlsTargetsAlgorithm
 from .algorithms.ground_filter import GroundFilterAlgorithm
 from .algorithms.monoplot import MonoplotAlgorithm
 from .algorithms.orthomosaic import OrthomosaicAlgorithm
 from .algorithms.orthorectify import OrthorectifyAlgorithm
 from .algorithms.resection import ResectionAlgorithm
+from .algorithms.tls_calibration import TlsCalibrationAlgorithm
 from .algorithms.trajectory_to_eo import TrajectoryToEoAlgorithm
 
 ICON_PATH = Path(__file__).resolve().parents[1] / "icon.svg"
@@ -57,5 +59,7 @@ class LidarPhotoProvider(QgsProcessingProvider):
             ResectionAlgorithm(),
             OrthorectifyAlgorithm(),
             OrthomosaicAlgorithm(),
+            TlsCalibrationAlgorithm(),
+            ExtractTlsTargetsAlgorithm(),
         ):
             self.addAlgorithm(alg)

@@ -7,11 +7,13 @@ from . import (
     bundle_adjustment,
     create_lcps,
     extract_roof_planes,
+    extract_tls_targets,
     ground_filter,
     monoplot,
     orthomosaic,
     orthorectify,
     resection,
+    tls_calibration,
     trajectory_to_eo,
 )
 
@@ -28,4 +30,6 @@ ALGORITHMS = (
     resection,
     orthorectify,
     orthomosaic,
+    tls_calibration,
+    extract_tls_targets,
 )

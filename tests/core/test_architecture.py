@@ -21,13 +21,14 @@ CORE_LAYERS = {
     "lsq": 1,
     "lidar": 2,
     "photo": 3,
+    "tls": 3,
     "quality": 4,
     "io": 5,
     "simulation": 6,
     "jobs": 7,
     "cli": 8,
 }
-SCIENCE = ("geometry", "lsq", "lidar", "photo", "quality")
+SCIENCE = ("geometry", "lsq", "lidar", "photo", "tls", "quality")
 #: what reading or writing files looks like in Python (the science must not do it)
 FILE_IO = re.compile(
     r"\bopen\(|\.read_text\(|\.write_text\(|\.read_bytes\(|\.write_bytes\(|\blaspy\b|"

@@ -1,0 +1,213 @@
+"""``tlscalibration``: register terrestrial laser scanner stations and calibrate the scanner.
+
+Outputs: the adjusted station poses with sigmas, the additional parameters (APs) with sigmas
+and significance, the target coordinates, the residuals per component (docs/conventions.md,
+"TLS tables") and an HTML report with the correlation matrix.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+from ..tls.aps import AP_SETS, ARCSEC
+from ..tls.options import CalibrationOptions
+from .common import CSV_FILTER, CSV_OUT
+from .runner import JobResult
+from .spec import AlgorithmSpec, Param, Result, Values
+
+log = logging.getLogger(__name__)
+
+_D = CalibrationOptions()
+ANGLE_UNITS = ("degrees", "gon", "radians")
+DATUMS = ("inner", "reference")
+#: A median disagreement of target-to-target distances between stations beyond this
+#: (relative) is not a scanner error but a wrong angle unit or convention.
+MAX_DISTANCE_DISAGREEMENT = 0.005
+
+SPEC = AlgorithmSpec(
+    name="tlscalibration",
+    title="TLS registration and self-calibration",
+    group="Calibration",
+    group_id="calibration",
+    summary="register laser scanner stations on targets and estimate the scanner's "
+    "systematic errors",
+    description="""\
+One least-squares adjustment of all stations and targets (Carvalho, Correa & dos Santos,
+Eq. 1): each station's position and omega, phi, kappa, the targets' coordinates and the
+scanner's additional parameters (APs) in polar form (Eqs. 2-5): the paper's set a0 (range
+offset), b1 sec(alpha) (collimation), b2 tan(alpha) (trunnion axis), c0 (vertical index), or
+Lichti's (2007) extended set (range scale and cyclic terms, circle eccentricities, encoder
+errors). AP set none: registration only.
+
+Observations (CSV): station_id,target_id,range,hz_deg,vt_deg[,s_range,s_hz,s_vt] (metres,
+degrees, elevation angle; a vertical angle beyond +-90 deg is a face-II reading; sigmas in m
+and arc-seconds), or hz_gon/vt_gon, or hz/vt in ANGLE UNIT; or scanner-frame target centres
+station_id,target_id,x,y,z[,s_x,s_y,s_z]. Rows without sigmas take DEFAULT SIGMAS.
+
+Control (optional): target_id,X,Y,Z[,s_X,s_Y,s_Z] (sigma 0 or none: fixed); it defines the
+datum. Without control the datum is inner constraints on the targets (free network) or the
+reference station. Stations (optional): station_id, approximate X,Y,Z and omega_deg,
+phi_deg,kappa_deg, levelled (1/0). A levelled station's omega and phi are compensator
+observations with TILT SIGMA; others are free.
+
+The report gives sigma0 and the global test, Baarda's data snooping, each AP's t-test, the
+correlation matrix of APs and station parameters with the strongly correlated pairs named and
+the network design that separates them (Lichti 2010: targets over the full vertical range,
+two faces, stations tilted by 90 degrees). SELECT APS removes correlated and insignificant
+terms one by one. A parameter the network cannot determine is an error that says why.""",
+    params=(
+        Param("OBSERVATIONS", "file", "Observations (CSV)", file_filter=CSV_FILTER),
+        Param("CONTROL", "file", "Control targets (CSV)", optional=True, file_filter=CSV_FILTER),
+        Param("STATIONS", "file", "Stations (CSV)", optional=True, file_filter=CSV_FILTER,
+              help="approximate poses, compensator tilts, levelled flags; when given, every "
+              "observed station must be in it"),
+        Param("ANGLE_UNIT", "enum", "Angle unit of hz/vt columns", "degrees",
+              options=ANGLE_UNITS,
+              help="only for columns named hz and vt; hz_deg/hz_gon say their own unit"),
+        Param("DEFAULT_SIGMAS", "numbers", "Default sigmas: range, horizontal, vertical",
+              (2.0, 10.0, 10.0), count=3, unit="mm, arcsec, arcsec", minimum=1e-6,
+              maximum=1e6, help="for rows without s_range, s_hz, s_vt (or s_x, s_y, s_z: "
+              "the range sigma)"),
+        Param("AP_SET", "enum", "Additional parameters", "paper", options=tuple(AP_SETS),
+              labels=("none (registration only)", "paper: a0, b1, b2, c0",
+                      "extended (Lichti 2007): a0-a3, b1-b6, c0-c3")),
+        Param("AP_TERMS", "string", "AP terms (overrides the set)", "", optional=True,
+              help="comma-separated, e.g. a0,b1,b2,c0,a1"),
+        Param("SELECT_APS", "boolean", "Select the APs by significance and correlation",
+              _D.select_aps),
+        Param("LEVELLED", "boolean", "Stations levelled by the compensator", _D.levelled,
+              help="default for stations whose table does not say"),
+        Param("TILT_SIGMA", "number", "Compensator sigma", _D.tilt_sigma_rad / ARCSEC,
+              unit="arcsec", minimum=0.01, maximum=36000.0),
+        Param("DATUM", "enum", "Datum without control", _D.datum, options=DATUMS,
+              labels=("inner constraints on the targets (free network)",
+                      "reference station held at its pose")),
+        Param("REFERENCE_STATION", "string", "Reference station", "", optional=True,
+              advanced=True, help="default: the first station of the stations table with a "
+              "position, else the first observed"),
+        Param("CYCLIC_WAVELENGTH", "number", "Wavelength of the cyclic range terms",
+              _D.cyclic_wavelength_m, unit="m", minimum=0.01, maximum=1000.0, advanced=True),
+        Param("SNOOPING", "boolean", "Data snooping (Baarda)", _D.snooping),
+        Param("CORRELATION_LIMIT", "number", "Strong correlation at |r| >=",
+              _D.correlation_limit, minimum=0.1, maximum=1.0, advanced=True),
+        Param("OUTPUT_STATIONS", "file_out", "Station poses (CSV)", file_filter=CSV_OUT),
+        Param("OUTPUT_APS", "file_out", "Additional parameters (CSV)", file_filter=CSV_OUT),
+        Param("OUTPUT_TARGETS", "file_out", "Target coordinates (CSV)", optional=True,
+              file_filter=CSV_OUT),
+        Param("OUTPUT_RESIDUALS", "file_out", "Residuals (CSV)", optional=True,
+              create_by_default=False, file_filter=CSV_OUT),
+        Param("OUTPUT_HTML", "file_out", "Report (HTML)", file_filter="HTML files (*.html)"),
+    ),
+    results=(
+        Result("SIGMA0", "number", "Sigma0 a-posteriori"),
+        Result("REJECTED", "number", "Observations rejected"),
+        Result("APS", "string", "Additional parameters estimated"),
+    ),
+    tags=("tls", "terrestrial laser scanner", "self-calibration", "registration",
+          "additional parameters", "targets"),
+    references=("Carvalho, Correa & dos Santos", "Lichti (2007)", "Lichti (2010)",
+                "Baarda (1968)"),
+)  # fmt: skip
+
+
+def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
+    """Read the tables, adjust, write the outputs."""
+    from ..errors import InputError
+    from ..io.atomic import write_text_atomic
+    from ..io.tls import (
+        read_tls_control_csv,
+        read_tls_observations_csv,
+        read_tls_stations_csv,
+        write_tls_aps_csv,
+        write_tls_residuals_csv,
+        write_tls_stations_csv,
+        write_tls_targets_csv,
+    )
+    from ..quality.tls_html import render_tls_html
+    from ..tls.calibration import calibrate
+    from ..tls.network import distance_consistency
+
+    s_range_mm, s_hz, s_vt = v.default_sigmas
+    obs = read_tls_observations_csv(v.observations, v.angle_unit,
+                                    (s_range_mm / 1000.0, s_hz, s_vt))  # fmt: skip
+    control = read_tls_control_csv(v.control) if v.control else []
+    stations = read_tls_stations_csv(v.stations) if v.stations else []
+    if stations:
+        listed = {s.id for s in stations}
+        for k, s in enumerate(obs.station):
+            if s not in listed:
+                raise InputError(f"station '{s}' is not in the stations table {v.stations}",
+                                 **obs.where(k))  # fmt: skip
+        observed = set(obs.station)
+        for s in stations:
+            if s.id not in observed:
+                raise InputError(f"station '{s.id}' has no observations in {v.observations}",
+                                 path=v.stations, row=s.row or None)  # fmt: skip
+    for c in control:
+        if c.id not in set(obs.target):
+            log.warning("control target '%s' (%s, row %d) is not observed", c.id, v.control,
+                        c.row)  # fmt: skip
+    median, pair = distance_consistency(obs)
+    if math.isfinite(median) and median > MAX_DISTANCE_DISAGREEMENT:
+        raise InputError(
+            f"the distances between targets disagree by {100 * median:.2g} % (median) between "
+            f"stations (worst: {pair}); a scanner error is a few 0.01 %: the angles are in "
+            "another unit (gon read as degrees?) or another convention (zenith angle instead "
+            "of elevation?)",
+            path=v.observations,
+        )
+    aps = v.ap_terms.strip() if v.ap_terms else v.ap_set
+    options = CalibrationOptions(
+        ap_set=aps,
+        levelled=v.levelled,
+        tilt_sigma_rad=v.tilt_sigma * ARCSEC,
+        cyclic_wavelength_m=v.cyclic_wavelength,
+        datum=v.datum,
+        reference_station=v.reference_station or None,
+        snooping=v.snooping,
+        correlation_limit=v.correlation_limit,
+        select_aps=v.select_aps,
+    )
+    cal = calibrate(obs, control, stations, options, progress=progress,
+                    should_stop=should_stop)  # fmt: skip
+    settings = {
+        "observations": f"{v.observations} ({len(obs)} rows, {len(obs.stations())} stations, "
+        f"{len(obs.targets())} targets, {int(obs.face_two.sum())} in face II)",
+        "control": f"{v.control} ({len(control)} targets)" if v.control else "none",
+        "stations table": v.stations or "none",
+        "additional parameters": f"{aps}" + (" with automatic selection" if v.select_aps
+                                             else ""),
+        "levelled by default": f"{v.levelled} (compensator sigma {v.tilt_sigma:g}\")",
+        "datum without control": v.datum,
+        "data snooping": "Baarda, alpha = 0.001 per observation" if v.snooping else "off",
+        "distance consistency between stations": "n/a" if not math.isfinite(median)
+        else f"{median * 1e6:.0f} ppm (median)",
+    }  # fmt: skip
+    if out.requested("OUTPUT_STATIONS"):
+        write_tls_stations_csv(out.path("OUTPUT_STATIONS"), cal)
+    if out.requested("OUTPUT_APS"):
+        write_tls_aps_csv(out.path("OUTPUT_APS"), cal)
+    if out.requested("OUTPUT_TARGETS"):
+        write_tls_targets_csv(out.path("OUTPUT_TARGETS"), cal)
+    if out.requested("OUTPUT_RESIDUALS"):
+        write_tls_residuals_csv(out.path("OUTPUT_RESIDUALS"), cal)
+    if out.requested("OUTPUT_HTML"):
+        write_text_atomic(out.path("OUTPUT_HTML"), render_tls_html(cal, settings))
+    lines = [f"{'AP':4} {'value':>10} {'sigma':>9} unit    t"]
+    for a in cal.ap_report():
+        lines.append(f"{a['name']:4} {a['value']:10.3f} {a['std']:9.3f} {a['unit']:7} "
+                     f"{a['t']:.1f}{'' if a['significant'] else ' (not significant)'}")  # fmt: skip
+    for s in cal.selection:
+        lines.append(f"removed {s.removed}: {s.reason}")
+    for a, b, r in cal.strong_pairs[:5]:
+        lines.append(f"strong correlation {a} / {b}: {r:+.3f}")
+    test = "passed" if cal.chi2_passed else "failed"
+    lines.append(f"sigma0 {cal.sigma0:.3f}, redundancy {cal.adjustment.redundancy}, global "
+                 f"test {test}, {int(cal.rejected.sum())} observations rejected")  # fmt: skip
+    return JobResult(
+        results={"SIGMA0": cal.sigma0, "REJECTED": int(cal.rejected.sum()),
+                 "APS": ",".join(cal.ap_names)},
+        lines=lines,
+        data=cal,
+    )  # fmt: skip

@@ -1,0 +1,257 @@
+"""HTML report of a terrestrial laser scanner self-calibration (one self-contained page).
+
+Sections: the settings, the adjustment's statistics, the additional parameters with their
+significance, the stations, the strongly correlated pairs with the network design that breaks
+them (Lichti 2010), the correlation matrix of the APs and the station parameters (coloured by
+|r|), the automatic AP selection, the residuals per component and the largest w-tests.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from .. import __version__
+from ..tls.aps import ARCSEC
+from ..tls.calibration import TlsCalibration, explain_pair
+
+__all__ = ["render_tls_html"]
+
+_CSS = """
+body{font-family:sans-serif;margin:24px;color:#222;max-width:1200px}
+h1{font-size:22px}h2{font-size:18px;border-bottom:1px solid #aaa;margin-top:26px}
+table{border-collapse:collapse;margin:8px 0 16px 0;font-size:13px}
+th,td{border:1px solid #bbb;padding:3px 7px;text-align:right}
+th{background:#eee}td.t,th.t{text-align:left}
+.pass{background:#d8f0d8}.fail{background:#f7d4d4}.diag{background:#fbecc4;padding:8px}
+table.corr td{padding:2px 4px;font-size:11px}table.corr th{font-size:11px;padding:2px 4px}
+.note{font-size:12px;color:#444}
+"""
+
+_DESIGN = (
+    "Correlations between the APs and the station parameters (Lichti 2010) come from the "
+    "network design, not the instrument: the rangefinder offset a0 with the station "
+    "positions when the targets lie on one side or in a narrow vertical band; the collimation "
+    "error b1 with kappa when the targets are near the horizon (sec(alpha) is then about 1); "
+    "the trunnion-axis error b2 and the vertical index c0 with omega and phi. They are broken "
+    "by targets all around the scanner and over the full vertical range (floor and ceiling), "
+    "by two-face observations, and by stations whose scanner is tilted by about 90 degrees "
+    "(which turn elevations into horizontal directions). A levelled scanner's compensator "
+    "observes omega and phi and helps b2 and c0."
+)
+
+
+def _e(text: object) -> str:
+    return html.escape(str(text), quote=True)
+
+
+def _n(x: float, digits: int = 2) -> str:
+    x = float(x)
+    return f"{x:.{digits}f}" if math.isfinite(x) else "&ndash;"
+
+
+def _table(header: Sequence[str], rows: Sequence[Sequence[str]], css: Sequence[str] = ()) -> str:
+    head = "".join(f'<th class="t">{h}</th>' if i == 0 else f"<th>{h}</th>"
+                   for i, h in enumerate(header))  # fmt: skip
+    body = []
+    for k, row in enumerate(rows):
+        cls = f' class="{css[k]}"' if k < len(css) and css[k] else ""
+        cells = "".join(f'<td class="t">{c}</td>' if i == 0 else f"<td>{c}</td>"
+                        for i, c in enumerate(row))  # fmt: skip
+        body.append(f"<tr{cls}>{cells}</tr>")
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+def _colour(r: float) -> str:
+    """White (0) to red (|r| = 1)."""
+    if not math.isfinite(r):
+        return "#ddd"
+    a = min(abs(r), 1.0)
+    g = int(255 - 200 * a)
+    return f"rgb(255,{g},{g})"
+
+
+def _correlation_table(names: Sequence[str], corr: np.ndarray, n_ap: int) -> str:
+    """AP rows against every AP and station-parameter column; without APs, the station
+    parameters against themselves."""
+    rows_idx = list(range(n_ap)) if n_ap else list(range(len(names)))
+    head = "".join(f"<th>{_e(n)}</th>" for n in names)
+    body = []
+    for i in rows_idx:
+        cells = "".join(
+            f'<td style="background:{_colour(corr[i, j])}">{_n(corr[i, j], 2)}</td>'
+            for j in range(len(names))
+        )
+        body.append(f'<tr><th class="t">{_e(names[i])}</th>{cells}</tr>')
+    return (f'<div style="overflow-x:auto"><table class="corr"><thead><tr><th></th>{head}'
+            f"</tr></thead><tbody>{''.join(body)}</tbody></table></div>")  # fmt: skip
+
+
+def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
+    """The report page of a calibration (str, UTF-8 HTML)."""
+    adj = cal.adjustment
+    out = [
+        "<!DOCTYPE html><html><head><meta charset='utf-8'>",
+        "<title>TLS self-calibration</title>",
+        f"<style>{_CSS}</style></head><body>",
+        "<h1>Terrestrial laser scanner: registration and self-calibration</h1>",
+        f"<p class='note'>lidarphoto {_e(__version__)}. Model: Carvalho, Correa &amp; dos "
+        "Santos (Eqs. 1-5), additional parameters after Lichti (2007), correlation analysis "
+        "after Lichti (2010).</p>",
+        "<h2>Settings</h2>",
+        _table(["setting", "value"], [(_e(k), _e(v)) for k, v in settings.items()]),
+    ]
+    gt = adj.global_test
+    test = "passed" if gt.passed else "failed"
+    out += [
+        "<h2>Adjustment</h2>",
+        _table(
+            ["quantity", "value"],
+            [
+                ("observations (station-target-face)", str(len(cal.observations))),
+                ("stations / targets", f"{len(cal.stations)} / {len(cal.targets)}"),
+                ("redundancy", str(adj.redundancy)),
+                ("sigma0 a-posteriori", _n(cal.sigma0, 3)),
+                (
+                    "global chi-square test",
+                    f"{test} ({_n(gt.lower, 1)} &le; {_n(gt.statistic, 1)} &le; {_n(gt.upper, 1)})",
+                ),
+                ("iterations", f"{adj.iterations} ({'converged' if adj.converged else 'NOT'})"),
+                ("observations rejected (data snooping)", str(int(cal.rejected.sum()))),
+                (
+                    "datum",
+                    ", ".join(cal.datum_fixed)
+                    or (
+                        "control"
+                        if any(k != "free" for k in cal.target_kind)
+                        else "inner constraints"
+                    ),
+                ),
+            ],
+            ["", "", "", "", "pass" if gt.passed else "fail"],
+        ),
+    ]
+    if cal.ap_names:
+        rows, css = [], []
+        for a in cal.ap_report():
+            d = 2 if a["unit"] != "mm" else 3
+            rows.append((_e(a["name"]), _e(a["formula"]), _e(a["cause"]), _n(a["value"], d),
+                         _n(a["std"], d), _n(a["std_prior"], d), _e(a["unit"]), _n(a["t"], 2),
+                         "yes" if a["significant"] else "no"))  # fmt: skip
+            css.append("" if a["significant"] else "fail")
+        out += [
+            "<h2>Additional parameters</h2>",
+            _table(
+                [
+                    "AP",
+                    "term",
+                    "cause",
+                    "value",
+                    "sigma",
+                    "sigma a-priori",
+                    "unit",
+                    "t",
+                    "significant",
+                ],
+                rows,
+                css,
+            ),
+            f"<p class='note'>t = |value| / sigma against the Student-t critical value "
+            f"{_n(cal.t_critical, 2)} (two-sided, alpha = {cal.options.significance_alpha:g}). "
+            "sigma is scaled by sigma0; sigma a-priori is the Cramer-Rao bound of the network "
+            "for the observation sigmas given.</p>",
+        ]
+    srows = []
+    for k, s in enumerate(cal.stations):
+        p, sd = cal.pose[k], cal.pose_std[k]
+        srows.append((_e(s), *(_n(x, 4) for x in p[:3]), *(_n(math.degrees(x), 6) for x in p[3:]),
+                      *(_n(x * 1000, 2) for x in sd[:3]), *(_n(x / ARCSEC, 2) for x in sd[3:]),
+                      "yes" if cal.levelled[k] else "no"))  # fmt: skip
+    out += [
+        "<h2>Stations</h2>",
+        _table(
+            [
+                "station",
+                "X m",
+                "Y m",
+                "Z m",
+                "omega deg",
+                "phi deg",
+                "kappa deg",
+                "s_X mm",
+                "s_Y mm",
+                "s_Z mm",
+                's_omega "',
+                's_phi "',
+                's_kappa "',
+                "levelled",
+            ],
+            srows,
+        ),
+    ]
+    out.append("<h2>Correlations</h2>")
+    if cal.strong_pairs:
+        prow = [(_e(a), _e(b), _n(r, 3), _e(explain_pair(a, b) or "")) for a, b, r in
+                cal.strong_pairs[:30]]  # fmt: skip
+        out.append(f"<p>Pairs with |r| &ge; {cal.options.correlation_limit:g}:</p>")
+        out.append(_table(["parameter", "parameter", "r", "why, and the design that breaks it"],
+                          prow))  # fmt: skip
+    else:
+        out.append(f"<p>No pair involving an AP reaches |r| = "
+                   f"{cal.options.correlation_limit:g}.</p>")  # fmt: skip
+    out.append(f"<p class='diag'>{_e(_DESIGN)}</p>")
+    if np.isfinite(cal.calib_correlation).any():
+        out.append(_correlation_table(cal.calib_names, cal.calib_correlation, len(cal.ap_names)))
+    if cal.selection:
+        out += [
+            "<h2>Automatic AP selection</h2>",
+            _table(
+                ["removed", "why", "remaining"],
+                [
+                    (_e(s.removed), _e(s.reason), _e(", ".join(s.remaining) or "none"))
+                    for s in cal.selection
+                ],
+            ),
+        ]
+    v = cal.residuals[~cal.rejected]
+    rms = np.sqrt(np.nanmean(v**2, axis=0)) if v.size else np.full(3, np.nan)
+    out += [
+        "<h2>Residuals</h2>",
+        _table(
+            ["component", "RMS", "unit"],
+            [
+                ("range", _n(rms[0] * 1000, 3), "mm"),
+                ("horizontal direction", _n(rms[1] / ARCSEC, 2), "arc-seconds"),
+                ("vertical angle", _n(rms[2] / ARCSEC, 2), "arc-seconds"),
+            ],
+        ),
+    ]
+    w = np.nan_to_num(np.abs(cal.w), nan=0.0).max(axis=1)
+    worst = np.argsort(-w)[:10]
+    obs = cal.observations
+    out.append(
+        _table(
+            ["station / target", "row", "v range mm", 'v hz "', 'v vt "', "max |w|", "rejected"],
+            [
+                (
+                    _e(f"{obs.station[k]} / {obs.target[k]}"),
+                    str(int(obs.rows[k])),
+                    _n(cal.residuals[k, 0] * 1000, 3),
+                    _n(cal.residuals[k, 1] / ARCSEC, 2),
+                    _n(cal.residuals[k, 2] / ARCSEC, 2),
+                    _n(w[k], 2),
+                    "yes" if cal.rejected[k] else "no",
+                )
+                for k in worst
+            ],
+            ["fail" if cal.rejected[k] else "" for k in worst],
+        )
+    )
+    if adj.warnings:
+        out.append("<h2>Warnings</h2><ul>" + "".join(f"<li>{_e(x)}</li>" for x in adj.warnings)
+                   + "</ul>")  # fmt: skip
+    out.append("</body></html>")
+    return "\n".join(out)
