@@ -110,11 +110,11 @@ def test_reported_precision_matches_scatter_over_noise_draws():
     ratio (scatter of d over draws / mean reported sigma_d^2) is also checked per face with
     chi2(R - 1) bounds.
 
-    Deviation, stated: the extraction attaches eave and ridge points that sit on one side of a
-    plane; only locally planar, unambiguous points are fitted, but a few wall points at the
-    eaves remain, so the normal's scatter exceeds its reported variance by about 1.3x here
-    (fit_plane alone is exact: tests/core/test_planes.py). The normal check therefore allows
-    up to 1.6x (upper bound 1.6 chi2 quantile); sigma_d is checked without allowance.
+    The extraction attaches eave and ridge points that sit on one side of a plane; only
+    locally planar, unambiguous points of a region's interior (every neighbour in the same
+    plane) are fitted. Measured over 160 draws (1120 planes): the normals scatter 1.09x and d
+    1.10x their reported variance (1.21x and 1.12x when the edge points were fitted), within
+    the 10 % asked; the checks below allow no inflation.
     """
     town = make_town(n_buildings=3, roof_types=("gable", "hip", "shed"), n_trees=0, seed=4)
     r = 24
@@ -138,10 +138,7 @@ def test_reported_precision_matches_scatter_over_noise_draws():
             d_by_face[truth.face_id][1].append(plane.sigma_d**2)
     n = len(z2)
     assert chi2.ppf(0.0005, n) < sum(z2) < chi2.ppf(0.9995, n), sum(z2) / n
-    inflation = 1.6
-    assert chi2.ppf(0.0005, 2 * n) < sum(maha) < inflation * chi2.ppf(0.9995, 2 * n), sum(maha) / (
-        2 * n
-    )
+    assert chi2.ppf(0.0005, 2 * n) < sum(maha) < chi2.ppf(0.9995, 2 * n), sum(maha) / (2 * n)
     lo, hi = chi2.ppf([0.0005, 0.9995], r - 1) / (r - 1)
     for face_id, (d, var) in d_by_face.items():
         ratio = np.var(d, ddof=1) / np.mean(var)
