@@ -35,6 +35,8 @@ _METAVAR = {
     "field": "COLUMN",
     "file_out": "FILE",
     "raster_out": "FILE",
+    "files": "PATH",
+    "folder_out": "FOLDER",
 }
 
 
@@ -117,6 +119,8 @@ def _add_algorithm(sub: argparse._SubParsersAction, spec: AlgorithmSpec, job: ob
             kwargs["metavar"] = "|".join(p.options) if len(p.options) <= 4 else "NAME"
         elif p.kind == "numbers":
             kwargs["metavar"] = ",".join(["N"] * p.count) if p.count <= 4 else f"{p.count}xN"
+        elif p.kind == "files":
+            kwargs.update(nargs="+", metavar="PATH")
         else:
             kwargs["metavar"] = _METAVAR.get(p.kind, "VALUE")
         if p.required:
@@ -135,8 +139,16 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: GDAL's block cache for the command line, MB (GDAL's default, 5 % of the RAM, holds the
+#: blocks of a large raster being written until it is full: 1.6 GB for a 196 Mpx orthophoto)
+GDAL_CACHE_MB = "256"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    import os
+
     args = build_parser().parse_args(argv)
+    os.environ.setdefault("GDAL_CACHEMAX", GDAL_CACHE_MB)  # read by GDAL at its first use
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",

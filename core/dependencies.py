@@ -24,7 +24,8 @@ REQUIRED_MODULES: dict[str, str] = {
 
 #: optional accelerators: import name -> (pip requirement, what is slower without it).
 OPTIONAL_MODULES: dict[str, tuple[str, str]] = {
-    "numba": ("numba", "ray casting on the DSM (monoplotting) runs 2-3x slower"),
+    "numba": ("numba", "ray casting on the DSM (monoplotting) runs 2-3x slower, orthophotos "
+              "about 2.5x"),
 }
 
 

@@ -17,6 +17,7 @@ drawing), :mod:`.monoplot_control` (the Monoplot button and its DSM), :mod:`.foo
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 from qgis.core import QgsCoordinateReferenceSystem, QgsProject
@@ -73,7 +74,7 @@ class ImagePickingDock(QgsDockWidget):
         self.setWindowTitle(self.tr("Image Point Picking"))
         self.project = QgsProject.instance()
         self.session = PickingSession()
-        self.store = ObservationStore(parent=self, log=self.session.observations)
+        self.store = ObservationStore(parent=self, session=self.session)
         self.current_image = ""
         self.messages: list[str] = []
         self._build_ui()
@@ -302,6 +303,19 @@ class ImagePickingDock(QgsDockWidget):
 
     def _project_read(self, _document) -> None:
         self.loader.restore()
+
+    def wait_restored(self, timeout_s: float = 30.0) -> bool:
+        """Process events until a restored session is all read and drawn (the steps of
+        :meth:`ProjectLoader.restore`); for tests and benchmarks. False on timeout."""
+        from qgis.PyQt.QtWidgets import QApplication
+
+        t_end = time.perf_counter() + timeout_s
+        app = QApplication.instance()
+        while self.loader.steps_left or self.picking.markers_held:
+            if time.perf_counter() > t_end:
+                return False
+            app.processEvents()
+        return True
 
     # -- calibration (the controller's) -------------------------------------------------------
     def run_calibration(self) -> bool:

@@ -249,6 +249,7 @@ class ImageSource:
         stretch_pct: tuple[float, float] = (0.5, 99.5),
         progress: Callable[[float], None] | None = None,
         should_stop: Callable[[], bool] | None = None,
+        stretch_now: bool = True,
     ) -> None:
         """Open an image.
 
@@ -260,6 +261,9 @@ class ImageSource:
             (``progress``/``should_stop`` as in :func:`build_overview_file`). The default,
             False, leaves it to the caller (the picking view builds it in the background).
         stretch_pct : percentiles of the contrast stretch.
+        stretch_now : compute the stretch of a :attr:`quick` image now (a whole-image read,
+            tens of ms); False leaves it to the first :meth:`read` or to
+            :meth:`set_stretch_limits` (the picking view has its worker compute it).
         """
         self.path = Path(path)
         if not self.path.is_file():
@@ -289,7 +293,7 @@ class ImageSource:
                 pass  # read-only folder: reads stay correct, only slower when zoomed out
             else:
                 self.reopen()
-        if self.quick:
+        if self.quick and stretch_now:
             self.set_stretch(*self.stretch_pct)
 
     # -- opening ----------------------------------------------------------------------------

@@ -2,8 +2,12 @@
 
 The scene is in full-resolution pixel units of the image in the project convention: scene point
 ``(x, y)`` is pixel position ``(col, row)`` with the origin at the top-left *corner* of the
-top-left pixel, so the centre of the first pixel is (0.5, 0.5). Picks are the exact (float)
-scene position of the mouse, so their precision is a fraction of an image pixel once zoomed in.
+top-left pixel, so the centre of the first pixel is (0.5, 0.5). A pick is the scene position of
+the *centre* of the screen pixel under the cursor (:func:`pointer_position`): Qt reports the
+cursor as the integer top-left corner of that pixel, which would put every pick half a screen
+pixel up and left of where the user points (0.7 image px at 100 %). At 100 % a click on the
+screen pixel that shows image pixel (c, r) measures (c + 0.5, r + 0.5); zoomed in, the
+precision is a fraction of an image pixel.
 
 Only what is visible is read: one coarse background picture of the whole image (<= 1024 px)
 and 512 x 512 tiles of the pyramid level that matches the zoom (level L reads the image
@@ -43,9 +47,9 @@ from qgis.PyQt.QtWidgets import (
 )
 
 from .image_loader import OverviewTask, TileLoader, TileRequest, to_qimage
-from .image_source import ImageSource
+from .image_source import ImageSource, ImageSourceError
 
-__all__ = ["TILE", "VIEW_HELP", "ImageView", "event_position"]
+__all__ = ["TILE", "VIEW_HELP", "ImageView", "event_position", "pointer_position"]
 
 TILE = 512
 _MAX_TILES = 400
@@ -68,11 +72,37 @@ _LIVE_TASKS: set = set()
 
 
 def event_position(event) -> QPointF:
-    """Float position of a mouse event in the receiving widget (Qt6 ``position()``, Qt5
-    ``localPos()``)."""
+    """Float position of a mouse or wheel event in the receiving widget, as Qt gives it (Qt6
+    and Qt 5.15 wheel events ``position()``, Qt5 mouse events ``localPos()``)."""
     if hasattr(event, "position"):
         return QPointF(event.position())
     return QPointF(event.localPos())
+
+
+def pointer_position(event, device_pixel_ratio: float = 1.0) -> QPointF:
+    """Where the user points, in the receiving widget's coordinates: the centre of the
+    (device) pixel under the cursor.
+
+    Qt gives a mouse position as the top-left corner of the pixel under the cursor's hot
+    spot: an integer number of device pixels (logical pixels times ``device_pixel_ratio``).
+    Such a coordinate is moved by half a device pixel, to the pixel's centre; a coordinate
+    that is not a whole number of device pixels (a tablet, or a touchpad that reports
+    sub-pixel positions) is the position itself and is kept.
+    """
+    p = event_position(event)
+    r = float(device_pixel_ratio) or 1.0
+    out = []
+    for v in (p.x() * r, p.y() * r):
+        if abs(v - round(v)) < 1e-6:  # a whole device pixel: its top-left corner
+            v = round(v) + 0.5
+        out.append(v / r)
+    return QPointF(out[0], out[1])
+
+
+def _pixel_ratio(widget) -> float:
+    """Device pixels per logical pixel of a widget (Qt5 ``devicePixelRatioF``)."""
+    f = getattr(widget, "devicePixelRatioF", None) or widget.devicePixelRatio
+    return float(f())
 
 
 _to_qimage = to_qimage  # the name used before the loader module existed
@@ -182,8 +212,9 @@ class ImageView(QGraphicsView):
     def set_source(self, source: ImageSource | None, build_overviews: bool = True) -> None:
         """Show an image (None clears the view); fits it in the view.
 
-        Returns at once: an image whose whole-image read is slow (no overviews) is shown as a
-        placeholder, then as a coarse preview read in the worker thread; with
+        Returns at once: an image whose whole-image read is slow (no overviews), or whose
+        contrast stretch is not computed yet (``ImageSource(stretch_now=False)``), is shown
+        as a placeholder, then as a coarse preview read in the worker thread; with
         ``build_overviews`` its missing pyramid is built in the background (a running build of
         the previous image is cancelled).
         """
@@ -214,10 +245,12 @@ class ImageView(QGraphicsView):
         self._placeholder.setZValue(_Z_PLACEHOLDER)
         self.scene().addItem(self._placeholder)
         self._build_after_preview = bool(build_overviews and source.needs_overviews)
-        if source.quick:  # a pyramid level or the image itself is small: read it now
+        if source.quick and source.stretch_limits is not None:
+            # a small pyramid level (or image) whose stretch is known: show it now
             self._show_background(source.stretch(source.sample()))
-        else:
-            self._status(f"Reading a preview of {source.path.name}…")
+        else:  # the worker reads the preview (and the stretch) without blocking
+            if not source.quick:
+                self._status(f"Reading a preview of {source.path.name}…")
             self._loader.request_preview()
         if self.preview_shown:
             self._start_pending_build()
@@ -302,7 +335,11 @@ class ImageView(QGraphicsView):
         self._task = None
         src = self.source
         if ok and src is not None:
-            src.reopen()  # now it sees the pyramid
+            try:
+                src.reopen()  # now it sees the pyramid
+            except ImageSourceError as exc:  # e.g. QGIS shutting down (GDAL's drivers gone)
+                ok, message = False, str(exc)
+        if ok and src is not None:
             self._loader.reopen()
             self._status("")
             if src.quick:  # the pyramid's averaged level replaces the decimated preview
@@ -555,12 +592,16 @@ class ImageView(QGraphicsView):
     def wheelEvent(self, event) -> None:
         steps = event.angleDelta().y() / 120.0
         if steps:
-            self.zoom_about(1.25**steps, event_position(event))
+            self.zoom_about(1.25**steps, self._pointer(event))
         event.accept()
 
     # -- mouse --------------------------------------------------------------------------------
+    def _pointer(self, event) -> QPointF:
+        """The viewport position the user points at (centre of the pixel under the cursor)."""
+        return pointer_position(event, _pixel_ratio(self.viewport()))
+
     def mousePressEvent(self, event) -> None:
-        pos = event_position(event)
+        pos = self._pointer(event)
         button = event.button()
         if button in (Qt.MouseButton.MiddleButton, Qt.MouseButton.RightButton) or (
             button == Qt.MouseButton.LeftButton and self._space
@@ -585,7 +626,7 @@ class ImageView(QGraphicsView):
         return inv.map(pos)
 
     def mouseMoveEvent(self, event) -> None:
-        pos = event_position(event)
+        pos = self._pointer(event)
         if self._pan_from is not None:
             d = pos - self._pan_from
             self._pan_from = pos
@@ -601,7 +642,7 @@ class ImageView(QGraphicsView):
         event.accept()
 
     def mouseReleaseEvent(self, event) -> None:
-        pos = event_position(event)
+        pos = self._pointer(event)
         if self._pan_from is not None:
             self._pan_from = None
             self.viewport().unsetCursor()

@@ -4,12 +4,20 @@ The decisions (which plane, line or control point a click measures, the point id
 point's prediction in the other images, the residuals of the last calibration) are the core
 :class:`~lidarphoto.core.photo.picking_session.PickingSession`'s; this glue asks the user when
 outlines overlap, selects the target on the map, and redraws the overlays and the table.
+
+What a click redraws is what it changed: the observation markers are synchronised (only the
+new, moved or removed ones are redrawn), the table is a model reset (Qt reads only the rows on
+screen), and the map selection it makes restyles only the highlighted plane or control point.
+The control is projected again only when the image, the orientation or the control change
+(:meth:`PickingController.refresh`).
 """
 
 from __future__ import annotations
 
+import bisect
+
 import numpy as np
-from qgis.PyQt.QtCore import QObject, QPointF
+from qgis.PyQt.QtCore import QObject, QPointF, QTimer
 from qgis.PyQt.QtGui import QCursor
 from qgis.PyQt.QtWidgets import QMenu
 
@@ -32,9 +40,12 @@ class PickingController(QObject):
         self.viewer, self.table = dock.viewer, dock.table
         self.projected: ProjectedControl | None = None
         self.selected_index = -1
+        self._later = 0  # hold_markers() depth
+        self._missed = False  # a marker draw was skipped meanwhile
+        self._scheduled = False  # ... and is scheduled
         self.viewer.view.hit_test = self.hit_observation
         self.viewer.view.pointMoved.connect(self.moved)
-        self.viewer.residual_scale.valueChanged.connect(self.refresh)
+        self.viewer.residual_scale.valueChanged.connect(lambda *_: self.draw_observations())
         self.table.rowSelected.connect(self.select_row)
         self.store.changed.connect(self.store_changed)
 
@@ -51,8 +62,8 @@ class PickingController(QObject):
         return links.selected("planes"), links.selected("lcps")
 
     def refresh(self, *_args) -> None:
-        """Project the control into the current image and redraw every overlay (also when
-        the selection of a layer changes: its arguments are not used)."""
+        """Project the control into the current image and redraw every overlay (the image,
+        the orientation or the control changed)."""
         overlays = self.viewer.overlays
         self.projected = None
         if not self.oriented():
@@ -68,19 +79,63 @@ class PickingController(QObject):
         self.draw_observations()
         self.fill_table()
 
+    def selection_changed(self, *_args) -> None:
+        """The selection of the plane or LCP layer changed on the map: restyle the planes and
+        control points whose highlight changed (nothing is projected again)."""
+        if self.projected is not None:
+            self.viewer.overlays.set_highlighted(*self.highlighted())
+
+    def hold_markers(self) -> None:
+        """Draw no observation markers until :meth:`release_markers` (the dock's opening:
+        the image and the control are on screen first; the markers come in a turn of the
+        event loop of their own)."""
+        self._later += 1
+
+    def release_markers(self) -> None:
+        self._later = max(0, self._later - 1)
+        if not self._later and self._missed:
+            self._missed, self._scheduled = False, True
+            QTimer.singleShot(0, self._draw_later)
+
+    @property
+    def markers_held(self) -> bool:
+        """Markers are held, or their draw is scheduled."""
+        return bool(self._later) or self._missed or self._scheduled
+
+    def _draw_later(self) -> None:
+        self._scheduled = False
+        try:
+            self.draw_observations()
+        except RuntimeError:  # the dock was deleted meanwhile
+            pass
+
     def draw_observations(self) -> None:
-        """The observations of the current image, their residuals and the prediction."""
+        """The observations of the current image, their residuals and the prediction (only
+        what changed is redrawn)."""
+        if self._later:
+            self._missed = True
+            return
         img, overlays, log = self.dock.current_image, self.viewer.overlays, self.store.log
         rows = log.indices_of_image(img) if self.oriented() else []
-        px = log.pixels(rows)
-        sel = rows.index(self.selected_index) if self.selected_index in rows else -1
-        overlays.set_observations(px, [log.rows[k].point_id for k in rows], sel)
+        all_rows = log.rows
+        k, sel = self.selected_index, -1
+        if 0 <= k < len(all_rows) and all_rows[k].image_id == img:
+            sel = bisect.bisect_left(rows, k)  # (rows ascending, k among them)
+        overlays.set_observations([all_rows[k] for k in rows], sel)
         res = self.session.residuals()
-        v = np.array([res.get(k, (np.nan, np.nan)) for k in rows]).reshape(-1, 2)
+        if res:
+            drawn = [k for k in rows if k in res]
+            px, v = log.pixels(drawn), np.array([res[k] for k in drawn]).reshape(-1, 2)
+        else:
+            px = v = np.empty((0, 2))
         overlays.set_residuals(px, v, self.viewer.residual_scale.value())
-        pred = self.session.prediction(img)
+        self.draw_predictions()
+
+    def draw_predictions(self) -> None:
+        """The pending tie point's prediction in the current image (if any)."""
         pending = self.session.pending
-        overlays.set_predictions(
+        pred = self.session.prediction(self.dock.current_image) if self.oriented() else None
+        self.viewer.overlays.set_predictions(
             np.reshape(pred if pred is not None else [], (-1, 2)),
             [pending.point_id] if pred is not None and pending is not None else [],
         )
@@ -169,9 +224,8 @@ class PickingController(QObject):
 
     def _added(self, index: int) -> int:
         if index >= 0:
-            self.store.edited()
             self.selected_index = index
-            self.draw_observations()
+            self.store.edited()  # saved; the markers and the table follow (store_changed)
         return index
 
     def accept_prediction(self) -> int:
@@ -180,7 +234,7 @@ class PickingController(QObject):
 
     def cancel_prediction(self) -> None:
         self.session.cancel_prediction()
-        self.draw_observations()
+        self.draw_predictions()
 
     # -- editing ------------------------------------------------------------------------------
     def hit_observation(self, col: float, row: float, tol: float):
@@ -189,13 +243,16 @@ class PickingController(QObject):
         return self.session.observation_at(self.dock.current_image, (col, row), tol)
 
     def moved(self, key, col: float, row: float) -> None:
-        self.store.move(int(key), col, row)
+        """A point dragged in the image (the pending prediction follows its first
+        measurement: the session's move)."""
         self.selected_index = int(key)
+        self.store.move(int(key), col, row)
 
     def delete_selected(self) -> None:
+        """Delete the selected point (its pending prediction goes with its last row)."""
         if 0 <= self.selected_index < len(self.store.rows):
-            self.store.delete(self.selected_index)
-            self.selected_index = -1
+            k, self.selected_index = self.selected_index, -1
+            self.store.delete(k)
 
     def select_row(self, k: int) -> None:
         """A row chosen in the table: select its target on the map, centre the view on it."""

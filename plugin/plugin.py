@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from qgis.core import Qgis, QgsApplication, QgsMessageLog
-from qgis.PyQt.QtCore import QCoreApplication
+from qgis.PyQt.QtCore import QCoreApplication, QTimer
 from qgis.PyQt.QtGui import QIcon
 from qgis.PyQt.QtWidgets import QAction, QMenu
 
@@ -96,6 +96,22 @@ class LidarPhotoPlugin:
             self.menu.addAction(action)
             self.toolbar.addAction(action)
             self.actions.append(action)
+        # the dock's modules (~45 ms of imports) are loaded once QGIS's event loop runs, so
+        # that the first opening of the dock does not wait for them
+        QTimer.singleShot(0, self._preload_dock)
+
+    def _preload_dock(self) -> None:
+        """Import the picking dock's modules (not while unloaded or once the dock exists)."""
+        if not self.actions or self.image_dock is not None:
+            return
+        try:
+            from . import image_dock  # noqa: F401
+        except Exception as exc:  # opening the dock will fail again and say why
+            QgsMessageLog.logMessage(
+                self.tr("The picking dock could not be loaded: {}").format(exc),
+                LOG_TAG,
+                Qgis.MessageLevel.Warning,
+            )
 
     def toggle_image_dock(self, show: bool = True):
         """Show (creating it once) or hide the image point picking dock."""

@@ -5,14 +5,17 @@ the project)."""
 
 from __future__ import annotations
 
+from collections import deque
+
 from qgis.core import QgsCoordinateReferenceSystem
-from qgis.PyQt.QtCore import QObject
+from qgis.PyQt import sip
+from qgis.PyQt.QtCore import QObject, QTimer
 
 from ..core.errors import InputError
 from ..core.io.camera import read_camera_json
 from ..core.io.orientation import read_eo_csv
 from .control_layers import ControlLinks, read_control, read_tables
-from .observation_store import SESSION_SCOPE, load_session, save_session
+from .observation_store import SESSION_SCOPE, gc_deferred, load_session, save_session
 
 __all__ = ["ProjectLoader"]
 
@@ -28,6 +31,9 @@ class ProjectLoader(QObject):
         #: the layer feature of each target id (map selection)
         self.links = ControlLinks()
         self.restoring = False
+        self._steps: deque = deque()
+        self._generation = 0
+        self._holding = False  # the markers wait for the last step of a restore
 
     def tr(self, text: str) -> str:
         return self.dock.tr(text)
@@ -51,9 +57,22 @@ class ProjectLoader(QObject):
             p.obs_edit.setFilePath(str(observations))
 
     def reload_orientation(self) -> None:
-        """Read the camera and the EO table; rebuild the picking scene."""
+        """Read the camera and the EO table; rebuild the picking scene (then the control and
+        the image shown)."""
         if self.restoring:
             return
+        self.read_orientation()
+        self.reload_control()
+        self.show_images()
+
+    def show_images(self) -> None:
+        """Fill the image selector and show the current image (with its overlays)."""
+        self.dock.fill_images()
+        self.check_foreign_observations()
+        self.save()
+
+    def read_orientation(self) -> None:
+        """Read the camera and the EO table into the session (its picking scene)."""
         cam_path, eo_path = self.inputs.camera_edit.filePath(), self.inputs.eo_edit.filePath()
         crs = self.inputs.crs()
         self.session.set_orientation(None, None)
@@ -64,10 +83,6 @@ class ProjectLoader(QObject):
             self.session.set_orientation(camera, eo, crs.authid() or crs.toWkt())
         except (InputError, OSError, ValueError) as exc:
             self.dock.message(self.tr("Orientation not loaded: {}").format(exc), warning=True)
-        self.reload_control()
-        self.dock.fill_images()
-        self.check_foreign_observations()
-        self.save()
 
     def use_orientation(self, eo, path: str) -> None:
         """Take an exterior orientation table already in memory (the calibrated one); the
@@ -103,10 +118,10 @@ class ProjectLoader(QObject):
         for layer in (layers["planes"], layers["lcps"]):
             if layer is not None:
                 try:
-                    layer.selectionChanged.disconnect(self.dock.picking.refresh)
+                    layer.selectionChanged.disconnect(self.dock.picking.selection_changed)
                 except TypeError:
                     pass
-                layer.selectionChanged.connect(self.dock.picking.refresh)
+                layer.selectionChanged.connect(self.dock.picking.selection_changed)
         self.dock.picking.refresh()
         self.save()
 
@@ -158,11 +173,21 @@ class ProjectLoader(QObject):
         project.writeEntry(SESSION_SCOPE, "crs", values["crs"])
 
     def restore(self) -> None:
-        """Restore the session saved in the current QGIS project (if any)."""
+        """Restore the session saved in the current QGIS project (if any).
+
+        The tabs are filled at once; the files are read in steps, each in its own turn of
+        the event loop, so that QGIS never waits for all of them together (the dock is on
+        screen after the first): the observation file, the orientation, the control, the
+        image with its overlays, then the observation markers (:attr:`steps_left` counts
+        the steps not run yet; :meth:`ImagePickingDock.wait_restored` waits for them).
+        """
         project = self.dock.project
         s = load_session(project)
         crs, ok = project.readEntry(SESSION_SCOPE, "crs", "")
+        self._generation += 1  # (the steps of an earlier restore are dropped)
+        self._steps.clear()
         if not s:
+            self._finish_steps()
             return
         panels = (self.inputs, self.settings)
         self.restoring = True
@@ -177,5 +202,38 @@ class ProjectLoader(QObject):
                 panel.blockSignals(False)
             self.restoring = False
         if s.get("observations"):
-            self.open_observations(s["observations"])
-        self.reload_orientation()
+            self._steps.append(lambda: self.open_observations(s["observations"]))
+        self._steps += [self.read_orientation, self.reload_control, self.show_images]
+        if not self._holding:
+            self._holding = True
+            self.dock.picking.hold_markers()  # drawn after the last step, in its own turn
+        QTimer.singleShot(0, lambda gen=self._generation: self._next_step(gen))
+
+    @property
+    def steps_left(self) -> int:
+        """Steps of a restore not run yet (0: restored)."""
+        return len(self._steps)
+
+    def _next_step(self, generation: int) -> None:
+        if generation != self._generation or not self._steps:
+            return
+        if sip.isdeleted(self.dock) or sip.isdeleted(self):  # closed and deleted meanwhile
+            self._steps.clear()
+            return
+        step = self._steps.popleft()
+        try:
+            with gc_deferred():  # (many short-lived objects: see gc_deferred)
+                step()
+        except Exception as exc:  # a slot must not raise: say it, go on with the next step
+            self.dock.message(
+                self.tr("The session was not fully restored: {}").format(exc), warning=True
+            )
+        if self._steps:
+            QTimer.singleShot(0, lambda: self._next_step(generation))
+        else:
+            self._finish_steps()
+
+    def _finish_steps(self) -> None:
+        if self._holding:
+            self._holding = False
+            self.dock.picking.release_markers()

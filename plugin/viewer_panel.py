@@ -186,7 +186,8 @@ class ViewerPanel(QWidget):
             hint = path or self.tr("add it with Images > Add")
             return False, self.tr("Image {}: {} ({}).").format(image_id, where, hint), True
         try:
-            self.source = ImageSource(path)
+            # the stretch (a whole-image read) is computed by the view's worker thread
+            self.source = ImageSource(path, stretch_now=False)
         except ImageSourceError as exc:
             self.view.set_source(None)
             return False, str(exc), True

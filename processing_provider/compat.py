@@ -28,6 +28,11 @@ else:  # QGIS 3.22-3.34
     SOURCE_VECTOR_LINE = QgsProcessing.SourceType.TypeVectorLine
     SOURCE_VECTOR_POLYGON = QgsProcessing.SourceType.TypeVectorPolygon
 
+if hasattr(Qgis, "ProcessingSourceType"):  # QGIS >= 3.36
+    SOURCE_FILE = Qgis.ProcessingSourceType.File
+else:  # QGIS 3.22-3.34
+    SOURCE_FILE = QgsProcessing.SourceType.TypeFile
+
 if hasattr(Qgis, "ProcessingParameterFlag"):  # QGIS >= 3.36
     FLAG_ADVANCED = Qgis.ProcessingParameterFlag.Advanced
     FLAG_OPTIONAL = Qgis.ProcessingParameterFlag.Optional
@@ -44,10 +49,12 @@ if hasattr(Qgis, "WkbType"):  # QGIS >= 3.30
     WKB_POINT_Z = Qgis.WkbType.PointZ
     WKB_LINESTRING_Z = Qgis.WkbType.LineStringZ
     WKB_POLYGON_Z = Qgis.WkbType.PolygonZ
+    WKB_MULTIPOLYGON = Qgis.WkbType.MultiPolygon
 else:
     WKB_POINT_Z = QgsWkbTypes.Type.PointZ
     WKB_LINESTRING_Z = QgsWkbTypes.Type.LineStringZ
     WKB_POLYGON_Z = QgsWkbTypes.Type.PolygonZ
+    WKB_MULTIPOLYGON = QgsWkbTypes.Type.MultiPolygon
 
 if hasattr(Qgis, "ProcessingNumberParameterType"):  # QGIS >= 3.36
     NUMBER_DOUBLE = Qgis.ProcessingNumberParameterType.Double

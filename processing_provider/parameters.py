@@ -16,6 +16,8 @@ from qgis.core import (
     QgsProcessingParameterField,
     QgsProcessingParameterFile,
     QgsProcessingParameterFileDestination,
+    QgsProcessingParameterFolderDestination,
+    QgsProcessingParameterMultipleLayers,
     QgsProcessingParameterNumber,
     QgsProcessingParameterRasterDestination,
     QgsProcessingParameterString,
@@ -29,6 +31,7 @@ from .compat import (
     FLAG_ADVANCED,
     NUMBER_DOUBLE,
     NUMBER_INTEGER,
+    SOURCE_FILE,
     SOURCE_VECTOR_LINE,
     SOURCE_VECTOR_POINT,
     SOURCE_VECTOR_POLYGON,
@@ -83,6 +86,12 @@ def make_parameter(p: Param, tr: Callable[[str], str]) -> QgsProcessingParameter
             p.name, title, None, p.parent, FIELD_TYPE_NUMERIC if p.numeric_field
             else FIELD_TYPE_ANY, optional=True,
         )  # fmt: skip
+    elif k == "files":
+        q = QgsProcessingParameterMultipleLayers(p.name, title, SOURCE_FILE, None, p.optional)
+    elif k == "folder_out":
+        q = QgsProcessingParameterFolderDestination(
+            p.name, title, optional=p.optional, createByDefault=p.create_by_default
+        )
     elif k == "file_out":
         q = QgsProcessingParameterFileDestination(
             p.name, title, tr(p.file_filter), optional=p.optional,
@@ -140,7 +149,9 @@ def read_parameter(alg, p: Param, parameters: dict, context) -> Any:
         return alg.parameterAsSource(parameters, p.name, context)
     if k == "field":
         return (alg.parameterAsFields(parameters, p.name, context) or [""])[0]
-    if k == "file_out":
+    if k == "files":
+        return tuple(alg.parameterAsFileList(parameters, p.name, context)) or None
+    if k in ("file_out", "folder_out"):
         return alg.parameterAsFileOutput(parameters, p.name, context) or None
     if k == "raster_out":
         return alg.parameterAsOutputLayer(parameters, p.name, context) or None

@@ -14,6 +14,8 @@ from .algorithms.create_lcps import CreateLcpsAlgorithm
 from .algorithms.extract_roof_planes import ExtractRoofPlanesAlgorithm
 from .algorithms.ground_filter import GroundFilterAlgorithm
 from .algorithms.monoplot import MonoplotAlgorithm
+from .algorithms.orthomosaic import OrthomosaicAlgorithm
+from .algorithms.orthorectify import OrthorectifyAlgorithm
 from .algorithms.trajectory_to_eo import TrajectoryToEoAlgorithm
 
 ICON_PATH = Path(__file__).resolve().parents[1] / "icon.svg"
@@ -49,5 +51,7 @@ class LidarPhotoProvider(QgsProcessingProvider):
             ExtractRoofPlanesAlgorithm(),
             BoresightCalibrationAlgorithm(),
             MonoplotAlgorithm(),
+            OrthorectifyAlgorithm(),
+            OrthomosaicAlgorithm(),
         ):
             self.addAlgorithm(alg)

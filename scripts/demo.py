@@ -15,12 +15,17 @@
 7. The images themselves, rendered by ray casting (``core.simulation.render``) from the camera
    and each image's *true* orientation onto the tile's DSM and roof planes, in flight/images/, and
    the check that the projected LiDAR lines fall on the rendered roof edges.
-8. The QGIS project demo_output/lidarphoto_demo.qgz (scripts/make_demo_project.py, run with
-   QGIS's Python when one is installed): layers, DSM and the picking dock's session
-   (docs/demo_project.md).
+8. True orthophotos of the images on the LiDAR DSM with the calibrated orientation
+   (``lidarphoto orthorectify``), and their orthomosaic with its seamlines (``lidarphoto
+   orthomosaic``: the most nadir image per cell, ground occluded in one image filled from
+   another), in ortho/.
+9. The QGIS project demo_output/lidarphoto_demo.qgz (scripts/make_demo_project.py, run with
+   QGIS's Python when one is installed): layers, DSM, the orthomosaic and the picking dock's
+   session (docs/demo_project.md).
 
-Steps 2-3 and 7 are functions (``lidar_step``, ``flight_step``, ``render_step``) that
-tests/qgis/test_demo_project.py calls for a smaller demo (fewer images, lower resolution).
+Steps 2-3, 7 and 8 are functions (``lidar_step``, ``flight_step``, ``render_step``,
+``ortho_step``) that tests/qgis/test_demo_project.py calls for a smaller demo (fewer images,
+lower resolution).
 
 Heights: the tile is in RD New + NAP; without the NAP geoid grid installed (PROJ), the
 calibration treats the heights as ellipsoidal (EPSG:28992). The simulation is made in that
@@ -78,6 +83,7 @@ ARCSEC = np.pi / (180.0 * 3600.0)
 TRUE_BORESIGHT_DEG = (0.12, -0.25, 0.40)
 LEVER_ARM = (0.10, -0.05, -0.20)
 DSM_CELL = 0.5  # metres: about 2 AHN3 points per cell
+ORTHO_GSD = 0.05  # metres: the orthomosaic's cell (the images' own GSD is 1.7 cm)
 PROJECT_SCRIPT = ROOT / "scripts" / "make_demo_project.py"
 
 
@@ -255,6 +261,29 @@ def render_step(
     return figures
 
 
+def ortho_step(demo: Path, eo_csv: Path, gsd: float = ORTHO_GSD) -> dict:
+    """Step 8: true orthophotos of the rendered images on the LiDAR DSM (ortho/orthophotos/),
+    their orthomosaic (ortho/orthomosaic.tif) and seamlines (ortho/seamlines.csv), through the
+    command line; returns the figures."""
+    t0 = time.perf_counter()
+    ortho = demo / "ortho"
+    flight, lidar = demo / "flight", demo / "lidar"
+    lidarphoto(
+        "orthorectify", "--camera", str(flight / "camera.json"), "--eo", str(eo_csv),
+        "--images", str(flight / "images"), "--dsm", str(lidar / "dsm.tif"), "--crs", CRS,
+        "--gsd", repr(gsd), "--true-ortho", "true", "--output-folder", str(ortho / "orthophotos"),
+    )  # fmt: skip
+    t1 = time.perf_counter()
+    lidarphoto(
+        "orthomosaic", "--orthophotos", str(ortho / "orthophotos"), "--feather", "6",
+        "--output", str(ortho / "orthomosaic.tif"),
+        "--seamlines-csv", str(ortho / "seamlines.csv"),
+    )  # fmt: skip
+    t2 = time.perf_counter()
+    return {"orthorectify_s": round(t1 - t0, 2), "orthomosaic_s": round(t2 - t1, 2),
+            "gsd": gsd, "eo": eo_csv.name}  # fmt: skip
+
+
 def _with_seed(options: RenderOptions, k: int) -> RenderOptions:
     from dataclasses import replace
 
@@ -401,20 +430,30 @@ def main() -> int:
         "within 1 px"
     )
 
-    # ---- 8. the QGIS project
+    # ---- 8. true orthophotos and their mosaic, with the calibrated orientation
+    ortho = ortho_step(OUT, cal / "eo.csv")
+    print(
+        f"\nTrue orthophotos of the {len(eo_true)} images on the LiDAR DSM ({ORTHO_GSD:g} m, "
+        f"calibrated orientation): {ortho['orthorectify_s']:.1f} s; orthomosaic "
+        f"(ortho/orthomosaic.tif, seamlines in ortho/seamlines.csv): {ortho['orthomosaic_s']:.1f} s"
+    )
+
+    # ---- 9. the QGIS project
     project = project_step()
     summary = {
         "truth_arcsec": true.tolist(),
         "groups": rows,
         "check_rmse_m": {k: list(v[1:]) for k, v in rmse.items()},
         "rendering": figures,
+        "ortho": ortho,
         "project": str(project) if project else None,
     }
     (OUT / "demo_summary.json").write_text(json.dumps(summary, indent=2), encoding="utf-8")
     print(
         f"\nOutputs in {OUT}/: lidar/ (ground, planes, LCPs, lines, DSM), flight/ (simulated "
         "inputs, truth, images/), calibration/ (boresight.csv, eo.csv, residuals.csv, "
-        "summary.html, accuracy_initial.html, accuracy_calibrated.html)"
+        "summary.html, accuracy_initial.html, accuracy_calibrated.html), ortho/ (true "
+        "orthophotos, orthomosaic.tif, seamlines.csv)"
         + (f", {project.name} (open it in QGIS: docs/demo_project.md)" if project else "")
         + f"; {time.perf_counter() - start:.0f} s"
     )

@@ -12,6 +12,8 @@ demo):
   image centres of the exterior orientation given to the dock (PointZ) and the check points
   (the simulation's truth);
 - the DSM (lidar/dsm.tif, 0.5 m, hillshade);
+- the orthomosaic of the images' true orthophotos (ortho/orthomosaic.tif, RGB as it is) and
+  its seamlines (the region each image fills, outlines; in demo_layers.gpkg);
 - the image point picking dock's session (plugin.observation_store.save_session): camera,
   exterior orientation (by default the INS one with the boresight not yet calibrated:
   flight/eo_initial.csv), the rendered images (flight/images/), the three layers, the
@@ -146,6 +148,10 @@ def _style(layer, kind: str) -> None:
         sym = qgc.QgsMarkerSymbol.createSimple(
             {"name": "triangle", "color": "255,212,0", "size": "3", "outline_color": "0,0,0"}
         )
+    elif kind == "seams":
+        sym = qgc.QgsFillSymbol.createSimple(
+            {"color": "0,0,0,0", "outline_color": "255,230,0", "outline_width": "0.5"}
+        )
     else:
         sym = qgc.QgsMarkerSymbol.createSimple(
             {"name": "cross2", "color": "60,255,60", "size": "2.6", "outline_color": "60,255,60"}
@@ -216,6 +222,13 @@ def build_project(
         checks = _memory_layer("PointZ", "check_points_truth", [("id", "string")])
         _fill(checks, _rows(flight / "check_points.csv"), lambda r: _point(r["e"], r["n"], r["h"]))
         tables.append(checks)
+    ortho = demo / "ortho"
+    if (ortho / "seamlines.csv").is_file():
+        seams = _memory_layer("MultiPolygon", "seamlines", [
+            ("image_id", "string"), ("cells", "integer"), ("area", "double"),
+        ])  # fmt: skip
+        _fill(seams, _rows(ortho / "seamlines.csv"), lambda r: qgc.QgsGeometry.fromWkt(r["wkt"]))
+        tables.append(seams)
     gpkg = demo / LAYERS_NAME
     _write_gpkg(tables, gpkg)
 
@@ -229,6 +242,7 @@ def build_project(
         "lidar_control_points": ("LiDAR control points", "lcps"),
         "image_centres": (f"Image centres ({eo_csv.name})", "centres"),
         "check_points_truth": ("Check points (truth)", "checks"),
+        "seamlines": ("Orthomosaic seamlines", "seams"),
     }
     layers = {}
     for table in tables:
@@ -243,8 +257,18 @@ def build_project(
         raise RuntimeError(f"cannot read {lidar / 'dsm.tif'}")
     dsm.setRenderer(qgc.QgsHillshadeRenderer(dsm.dataProvider(), 1, 315.0, 45.0))
     project.addMapLayer(dsm)
-    for name in ("check_points_truth", "image_centres", "roof_planes", "lidar_lines",
-                 "lidar_control_points"):  # fmt: skip
+    mosaic_tif = ortho / "orthomosaic.tif"
+    if mosaic_tif.is_file():
+        mosaic = qgc.QgsRasterLayer(str(mosaic_tif), "Orthomosaic (true orthophotos)")
+        if not mosaic.isValid():
+            raise RuntimeError(f"cannot read {mosaic_tif}")
+        # 8-bit RGB as it is (QGIS would stretch each band), the mask as transparency
+        rgb = qgc.QgsMultiBandColorRenderer(mosaic.dataProvider(), 1, 2, 3)
+        rgb.setAlphaBand(mosaic.renderer().alphaBand())
+        mosaic.setRenderer(rgb)
+        project.addMapLayer(mosaic)
+    for name in ("seamlines", "check_points_truth", "image_centres", "roof_planes",
+                 "lidar_lines", "lidar_control_points"):  # fmt: skip
         if name in layers:
             project.addMapLayer(layers[name])
     extent = dsm.extent()

@@ -89,7 +89,7 @@ def dsm_from_las(
 
 
 def read_dsm_raster(path: PathLike, crs: str | int | pyproj.CRS | None = None) -> Dsm:
-    """Read a north-up, single-band DSM raster (GDAL when importable, else uncompressed TIFF).
+    """Read a north-up, single-band DSM raster (any format GDAL reads).
 
     ``crs`` overrides (or supplies) the raster's CRS.
     """

@@ -43,7 +43,12 @@ from ..geometry.camera import Camera
 from ..photo.observations import DEFAULT_SIGMA_PX, OBSERVATION_TYPES, ImageObservations
 from .tables import find_column, float_column, read_table, text_column, write_csv_atomic
 
-__all__ = ["OBSERVATION_COLUMNS", "read_observations_csv", "write_observations_csv"]
+__all__ = [
+    "OBSERVATION_COLUMNS",
+    "observation_cells",
+    "read_observations_csv",
+    "write_observations_csv",
+]
 
 OBSERVATION_COLUMNS = ("image_id", "point_id", "col", "row", "sigma_px", "type", "target_id")
 #: Largest a-priori sigma of an image measurement, pixels: beyond it the row cannot inform the
@@ -131,10 +136,30 @@ def read_observations_csv(
     return ImageObservations(image, point, np.column_stack([col, row]), sigma, kinds, target)
 
 
+def observation_cells(
+    image_id: str, point_id: str, col: float, row: float, sigma_px: float, kind: str, target: str
+) -> tuple[str, ...]:
+    """The cells of one row as :func:`write_observations_csv` writes them (numbers by
+    ``repr``: they read back to the same float).
+
+    >>> observation_cells("img1", "T1", 10.5, 20.25, 0.5, "tie", "7")
+    ('img1', 'T1', '10.5', '20.25', '0.5', 'tie', '7')
+    """
+    return (
+        str(image_id),
+        str(point_id),
+        repr(float(col)),
+        repr(float(row)),
+        repr(float(sigma_px)),
+        str(kind),
+        str(target),
+    )
+
+
 def write_observations_csv(path: Union[str, Path], obs: ImageObservations) -> None:
     """Write the table atomically (never a half-written file)."""
     rows = (
-        (i, p, repr(float(c)), repr(float(r)), repr(float(s)), t, g)
+        observation_cells(i, p, c, r, s, t, g)
         for i, p, (c, r), s, t, g in zip(
             obs.image_id, obs.point_id, obs.pixels, obs.sigma_px, obs.type, obs.target_id
         )

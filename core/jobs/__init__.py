@@ -8,6 +8,8 @@ from . import (
     extract_roof_planes,
     ground_filter,
     monoplot,
+    orthomosaic,
+    orthorectify,
     trajectory_to_eo,
 )
 
@@ -20,4 +22,6 @@ ALGORITHMS = (
     extract_roof_planes,
     boresight_calibration,
     monoplot,
+    orthorectify,
+    orthomosaic,
 )

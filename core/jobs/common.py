@@ -87,3 +87,22 @@ def lengths_in_cloud_units(
 def unit_text(info: Any, distance_unit: str) -> str:
     """How the job reports the unit its lengths were taken in."""
     return "metre (converted)" if distance_unit == "metre" else info.horizontal_unit
+
+
+#: GeoTIFF compressions of the image outputs (orthophotos, mosaics).
+COMPRESSIONS = ("deflate", "zstd", "lzw", "jpeg", "none")
+
+
+def compression_param() -> Param:
+    """COMPRESSION of an image output (:class:`~lidarphoto.core.io.raster.GeoTiffWriter`)."""
+    return Param("COMPRESSION", "enum", "GeoTIFF compression", COMPRESSIONS[0],
+                 options=COMPRESSIONS, advanced=True,
+                 labels=("DEFLATE (lossless, level 1: fast)", "ZSTD (lossless, level 1)",
+                         "LZW (lossless)", "JPEG (lossy, quality 90; 8-bit images)", "none"),
+                 help="deflate and zstd at their fastest level (files about 15 % larger than "
+                 "at the default level); jpeg is lossy and only for 8-bit images")  # fmt: skip
+
+
+def compression_args(name: str) -> dict[str, Any]:
+    """GeoTiffWriter keywords of a COMPRESSION value."""
+    return {"compress": name.upper(), "level": 1 if name in ("deflate", "zstd") else None}

@@ -36,12 +36,13 @@ class JobResult:
     stdout: str = ""
 
 
-def input_files(spec: AlgorithmSpec, values: Mapping[str, Any]) -> dict[str, str]:
+def input_files(spec: AlgorithmSpec, values: Mapping[str, Any]) -> dict[str, Any]:
     """The input files named in ``values`` (what no output may overwrite)."""
     return {
         p.name: values[p.name]
         for p in spec.inputs
-        if p.kind in ("file", "points") and isinstance(values.get(p.name), str)
+        if (p.kind in ("file", "points") and isinstance(values.get(p.name), str))
+        or (p.kind == "files" and values.get(p.name))
     }
 
 
@@ -54,7 +55,9 @@ def run_job(
     """Run ``job`` (a module of core/jobs with ``SPEC`` and ``run``) on the raw values."""
     spec: AlgorithmSpec = job.SPEC
     values: Values = parse_values(spec, raw)
-    outputs = {p.name: values.get(p.name) for p in spec.outputs if p.kind != "sink"}
+    # a folder output holds files the job commits itself (core/jobs/<job>.py)
+    outputs = {p.name: values.get(p.name) for p in spec.outputs
+               if p.kind not in ("sink", "folder_out")}  # fmt: skip
     with OutputSet(outputs, input_files(spec, values)) as out:
         result = job.run(values, out, progress=progress, should_stop=should_stop)
         out.commit()

@@ -22,10 +22,14 @@ numbers    QgsProcessingParameterString        tuple of ``count`` floats ("x,y,z
 points     QgsProcessingParameterFeatureSource path of a point table (CLI); the QGIS
                                                adapter hands the job its own object
 field      QgsProcessingParameterField         column / field name (str), "" when none
+files      QgsProcessingParameterMultipleLayers tuple of paths (files or folders) or None
+           (files)
 ========== =================================== ==========================================
 
 Outputs: ``file_out`` (QgsProcessingParameterFileDestination), ``raster_out``
-(…RasterDestination), both a path or None; ``sink`` (…FeatureSink): a layer, QGIS only.
+(…RasterDestination), both a path or None; ``folder_out`` (…FolderDestination): a folder
+the job fills itself (not part of the runner's output set); ``sink`` (…FeatureSink): a layer,
+QGIS only.
 Results (numbers and strings a job reports) are :class:`Result` entries.
 """
 
@@ -50,8 +54,9 @@ INPUT_KINDS = (
     "numbers",
     "points",
     "field",
+    "files",
 )
-OUTPUT_KINDS = ("file_out", "raster_out", "sink")
+OUTPUT_KINDS = ("file_out", "raster_out", "folder_out", "sink")
 RESULT_KINDS = ("number", "string")
 _TRUE = ("true", "yes", "1", "on")
 _FALSE = ("false", "no", "0", "off")
@@ -379,6 +384,9 @@ def parse_value(p: Param, raw: Any) -> Any:
             value = _enum_one(p, raw)
     elif p.kind == "numbers":
         value = parse_numbers(raw, p.count, p.name)
+    elif p.kind == "files":
+        items = [raw] if isinstance(raw, str) else list(raw)
+        value = tuple(str(i) for i in items if str(i).strip()) or p.default
     else:
         value = str(raw) if not isinstance(raw, str) else raw
     check_value(p, value)

@@ -275,6 +275,7 @@ class PickingScene:
         outlines: Sequence[ArrayLike],
         normals: ArrayLike,
         points: ArrayLike,
+        rings: Sequence[ArrayLike] | None = None,
     ) -> list[PlaneCandidate]:
         """Planes whose reprojected outline contains ``pixel``, nearest to the camera first.
 
@@ -287,8 +288,11 @@ class PickingScene:
             Outline rings, mapping CRS.
         normals, points : (P, 3) array_like
             Plane of each outline (unit normal and a point on it), mapping CRS.
+        rings : sequence of (M_i, 2) array_like, optional
+            The outlines already projected into the image (:meth:`project_rings`), pixels.
         """
-        rings = self.project_rings(image_id, outlines)
+        if rings is None:
+            rings = self.project_rings(image_id, outlines)
         hits = points_in_polygons(pixel, rings)
         if hits.size == 0:
             return []

@@ -9,7 +9,9 @@
   (:class:`~.control_features.ControlFeature`) and, for the ids they list, from the plane,
   line and LCP tables; the overlays, the picking and the calibration all use these same
   objects;
-- the tie point waiting for its other images (:class:`TiePrediction`);
+- the tie point waiting for its other images (:class:`TiePrediction`), kept with the
+  observations (their attached value): undo and redo restore it together with the rows, and
+  deleting the last row of that point drops it;
 - the last boresight calibration (:class:`~.boresight.BoresightRun`) and, from it, the residual
   of each current observation row.
 
@@ -21,7 +23,8 @@ first pixel is (0.5, 0.5)); coordinates are in the mapping CRS of the exterior o
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -52,8 +55,6 @@ _PREFIX = {"tie": "T", "paper": "P", "line": "R", "lcp": "C", "check": "K"}
 _CONTROL_OF = {"tie": "planes", "paper": "planes", "line": "lines", "lcp": "lcps", "check": "lcps"}
 
 
-
-
 # ----------------------------------------------------------------------------- picking
 @dataclass(frozen=True)
 class ProjectedControl:
@@ -66,14 +67,27 @@ class ProjectedControl:
     lcps: Array
 
 
-@dataclass
+@dataclass(frozen=True, eq=False)
 class TiePrediction:
     """A tie point measured in one image, waiting for the others: its predicted pixel in each
-    image that sees it (entries are removed as they are measured)."""
+    image that sees it and is not measured yet.
+
+    Immutable (the undo history keeps references): :meth:`without` gives the prediction once
+    an image is measured. ``image_id`` is the image it was measured in, ``normal`` and
+    ``point`` its plane (mapping CRS), so that moving that measurement moves the prediction.
+    """
 
     point_id: str
     target_id: str
-    pixels: dict[str, Array]
+    pixels: Mapping[str, Array]
+    image_id: str = ""
+    normal: Array | None = None
+    point: Array | None = None
+
+    def without(self, image_id: str) -> TiePrediction | None:
+        """The prediction left once ``image_id`` is measured (None: no image left)."""
+        rest = {k: v for k, v in self.pixels.items() if k != image_id}
+        return replace(self, pixels=rest) if rest else None
 
 
 @dataclass(frozen=True)
@@ -102,9 +116,17 @@ class PickingSession:
         self.camera: Camera | None = None
         self.eo: ExteriorOrientationTable | None = None
         self.scene: PickingScene | None = None
-        self.pending: TiePrediction | None = None
         self.calibration: BoresightRun | None = None
         self._residuals: tuple[int, int, dict[int, Array]] | None = None
+
+    @property
+    def pending(self) -> TiePrediction | None:
+        """The tie point waiting for its other images (the observations' attached value)."""
+        return self.observations.attached
+
+    @pending.setter
+    def pending(self, value: TiePrediction | None) -> None:
+        self.observations.attached = value
 
     # -- orientation --------------------------------------------------------------------------
     def set_orientation(
@@ -165,12 +187,16 @@ class PickingSession:
 
         tie, paper: every plane whose outline holds the pixel, nearest to the camera first;
         line: the nearest line within ``tol_px``; lcp, check: the nearest control point within
-        ``tol_px``. Empty when there is nothing.
+        ``tol_px``. Empty when there is nothing. ``projected``: the control already projected
+        into that image (:meth:`project`), so that it is not projected again.
         """
         c = self.control
+        if projected is not None and projected.image_id != image_id:
+            projected = None
         if kind in ("tie", "paper"):
+            rings = projected.rings if projected is not None else None
             cands = self.scene.planes_under_pixel(  # type: ignore[union-attr]
-                image_id, pixel, c.outlines, c.normals, c.centroids
+                image_id, pixel, c.outlines, c.normals, c.centroids, rings
             )
             return [PickTarget(kind, p.index, c.plane_ids[p.index], p.range_m) for p in cands]
         proj = projected if projected is not None else self.project(image_id)
@@ -185,7 +211,8 @@ class PickingSession:
 
         Point ids: ``T<n>``/``P<n>`` for tie and paper points, ``R<line>_<n>`` for line points,
         ``C<lcp>``/``K<lcp>`` for control and check points. A tie point becomes the pending
-        :class:`TiePrediction` (its pixel in the other images that see it).
+        :class:`TiePrediction` (its pixel in the other images that see it), in the same
+        undoable step as its row.
         """
         col, row = (float(v) for v in np.asarray(pixel, dtype=np.float64).reshape(2))
         obs, kind, tid = self.observations, target.kind, target.target_id
@@ -195,14 +222,34 @@ class PickingSession:
             point_id = obs.next_point_id(f"R{tid}_")
         else:
             point_id = f"{_PREFIX[kind]}{tid}"
-        index = obs.add(Observation(image_id, point_id, col, row, kind, tid))
-        if kind == "tie":
-            plane = self.control.planes[target.index]
-            pred = self.scene.predict_tie(  # type: ignore[union-attr]
-                image_id, (col, row), plane.normal, plane.centroid
-            )
-            self.pending = TiePrediction(point_id, tid, pred)
-        return index
+        new = Observation(image_id, point_id, col, row, kind, tid)
+        if kind != "tie":
+            return obs.add(new)
+        plane = self.control.planes[target.index]
+        pending = self._predict(point_id, tid, image_id, (col, row), plane.normal, plane.centroid)
+        return obs.add(new, attached=pending)
+
+    def _predict(
+        self,
+        point_id: str,
+        target_id: str,
+        image_id: str,
+        pixel: ArrayLike,
+        normal: ArrayLike,
+        point: ArrayLike,
+        only: Iterable[str] | None = None,
+    ) -> TiePrediction | None:
+        """The prediction of a tie point measured at ``pixel`` of ``image_id`` on a plane (in
+        the images ``only``, when given); None when no other image sees it."""
+        pred = self.scene.predict_tie(image_id, pixel, normal, point)  # type: ignore[union-attr]
+        if only is not None:
+            keep = set(only)
+            pred = {k: v for k, v in pred.items() if k in keep}
+        if not pred:
+            return None
+        n = np.array(normal, dtype=np.float64).reshape(3)
+        p = np.array(point, dtype=np.float64).reshape(3)
+        return TiePrediction(point_id, target_id, pred, image_id, n, p)
 
     def prediction(self, image_id: str) -> Array | None:
         """The pending tie point's predicted pixel in an image, or None."""
@@ -212,29 +259,70 @@ class PickingSession:
 
     def confirm_prediction(self, image_id: str, pixel: ArrayLike | None = None) -> int:
         """Measure the pending tie point in an image, at ``pixel`` or (None) at its prediction;
-        returns the new row index (-1: no prediction in that image)."""
+        returns the new row index (-1: no prediction in that image). Undoing it brings the
+        prediction in that image back."""
         at = self.prediction(image_id)
-        if at is None or self.pending is None:
-            return -1
         p = self.pending
+        if at is None or p is None:
+            return -1
         col, row = (float(v) for v in np.asarray(at if pixel is None else pixel).reshape(2))
-        index = self.observations.add(
-            Observation(image_id, p.point_id, col, row, "tie", p.target_id)
+        return self.observations.add(
+            Observation(image_id, p.point_id, col, row, "tie", p.target_id),
+            attached=p.without(image_id),
         )
-        del p.pixels[image_id]
-        if not p.pixels:
-            self.pending = None
-        return index
 
     def cancel_prediction(self) -> None:
+        """Drop the pending tie point (not an edit: undoing the next edit brings back the
+        prediction that was pending before it)."""
         self.pending = None
+
+    def move(self, index: int, col: float, row: float) -> None:
+        """Move an observation; when it is the measurement the pending tie point was predicted
+        from, the prediction moves with it (in the same undoable step)."""
+        obs = self.observations
+        o, p = obs.rows[index], self.pending
+        if (
+            p is None
+            or (o.point_id, o.image_id) != (p.point_id, p.image_id)
+            or p.normal is None
+            or self.scene is None
+            or not self.scene.has_image(o.image_id)
+        ):
+            obs.move(index, col, row)
+            return
+        moved = self._predict(
+            p.point_id, p.target_id, p.image_id, (col, row), p.normal, p.point, p.pixels
+        )
+        obs.move(index, col, row, attached=moved)
+
+    def delete(self, indices: int | Iterable[int]) -> None:
+        """Delete observations (one undoable step); deleting the last row of the pending tie
+        point drops its prediction (it would otherwise be measured as a tie point without the
+        image it was predicted from)."""
+        obs = self.observations
+        idx = {indices} if isinstance(indices, int) else set(indices)
+        p = self.pending
+        if p is not None and not any(
+            o.point_id == p.point_id for k, o in enumerate(obs.rows) if k not in idx
+        ):
+            obs.delete(idx, attached=None)
+        else:
+            obs.delete(idx)
+
+    def undo(self) -> bool:
+        """Undo the last edit: the rows and the pending tie point as they were before it."""
+        return self.observations.undo() is not None
+
+    def redo(self) -> bool:
+        """Redo the last undone edit: the rows and the pending tie point as they were after."""
+        return self.observations.redo() is not None
 
     def observation_at(self, image_id: str, pixel: ArrayLike, tol_px: float) -> int | None:
         """Row index of the observation of an image nearest to ``pixel`` within ``tol_px``."""
-        rows = self.observations.indices_of_image(image_id)
+        rows, px = self.observations.pixels_of_image(image_id)
         if not rows:
             return None
-        k, _d = nearest_point(pixel, self.observations.pixels(rows), tol_px)
+        k, _d = nearest_point(pixel, px, tol_px)
         return rows[k] if k >= 0 else None
 
     # -- calibration --------------------------------------------------------------------------

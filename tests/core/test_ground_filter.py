@@ -4,18 +4,18 @@ producer's classes, the scoring and the groundfilter job."""
 
 from __future__ import annotations
 
-import struct
 from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
 
 import laspy
 import numpy as np
+import pyproj
 import pytest
 from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.errors import Cancelled, InputError
 from lidarphoto.core.io.pointcloud import CloudInfo, read_points
-from lidarphoto.core.io.raster import write_geotiff
+from lidarphoto.core.io.raster import RasterReader, overview_factors, write_geotiff
 from lidarphoto.core.jobs import ground_filter as ground_filter_job
 from lidarphoto.core.jobs.common import lengths_in_cloud_units
 from lidarphoto.core.jobs.runner import run_job
@@ -509,21 +509,6 @@ def test_ahn3_with_class_1_for_non_ground(tmp_path):
     assert (cls == 2).sum() == run.ground_count
 
 
-def _tiff_tags(path: Path) -> dict[int, tuple]:
-    raw = path.read_bytes()
-    assert raw[:4] == b"II*\0"
-    (ifd,) = struct.unpack_from("<I", raw, 4)
-    (count,) = struct.unpack_from("<H", raw, ifd)
-    tags = {}
-    sizes = {2: ("s", 1), 3: ("H", 2), 4: ("I", 4), 12: ("d", 8)}
-    for i in range(count):
-        tag, typ, n, value = struct.unpack_from("<HHII", raw, ifd + 2 + 12 * i)
-        code, size = sizes[typ]
-        at = ifd + 2 + 12 * i + 8 if n * size <= 4 else value
-        tags[tag] = struct.unpack_from(f"<{n}{code}", raw, at) if typ != 2 else raw[at : at + n]
-    return tags
-
-
 def test_cli_writes_cloud_and_geotiff_dtm(tmp_path, capsys):
     cloud, dtm = tmp_path / "g.laz", tmp_path / "dtm.tif"
     code = cli_main([
@@ -533,17 +518,17 @@ def test_cli_writes_cloud_and_geotiff_dtm(tmp_path, capsys):
     assert code == 0
     assert "distances in metre" in capsys.readouterr().out
     assert (laspy.read(cloud).classification == 2).any()
-    tags = _tiff_tags(dtm)
     r = run_ground_filter(str(AHN3), str(tmp_path / "again.laz"))
     rows, cols = r.result.dtm.shape
-    assert tags[256] == (cols,) and tags[257] == (rows,)
-    assert tags[33550][:2] == (1.0, 1.0)
-    assert tags[33922][3:5] == r.result.geotransform[0:4:3]
-    keys = tags[34735]
-    assert (3072, 0, 1, 28992) in zip(keys[4::4], keys[5::4], keys[6::4], keys[7::4])
-    raw = dtm.read_bytes()
-    values = np.frombuffer(raw[tags[273][0] : tags[273][0] + tags[279][0]], "<f4")
-    np.testing.assert_array_equal(values.reshape(rows, cols), r.result.dtm)
+    with RasterReader(dtm) as src:  # GDAL (osgeo or rasterio's), as QGIS reads it
+        info = src.info
+        assert (info.width, info.height, info.bands) == (cols, rows, 1)
+        assert info.geotransform == tuple(r.result.geotransform)
+        assert pyproj.CRS.from_wkt(info.crs_wkt).to_epsg() == 7415  # RD New + NAP, both kept
+        assert src.block_size() == (256, 256) and src.compression().upper() == "DEFLATE"
+        assert src.overview_count() == len(overview_factors(cols, rows))
+        np.testing.assert_array_equal(src.read()[0], r.result.dtm)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["again.laz", "dtm.tif", "g.laz"]
 
 
 def test_cli_reports_errors(tmp_path, capsys):
@@ -562,4 +547,6 @@ def test_geotiff_with_gdal_when_available(tmp_path):
     assert ds.GetGeoTransform() == (100.0, 2.0, 0.0, 500.0, 0.0, -2.0)
     assert ds.GetRasterBand(1).GetNoDataValue() == -9999.0
     np.testing.assert_array_equal(ds.ReadAsArray(), a)
-    assert ds.GetSpatialRef().GetAuthorityCode(None) == "28992"
+    # EPSG:7415 is RD New + NAP: both parts as GeoTIFF keys
+    srs = ds.GetSpatialRef()
+    assert srs.IsCompound() and "28992" in srs.ExportToWkt() and "5709" in srs.ExportToWkt()

@@ -344,3 +344,153 @@ def test_residuals_of_the_calibration_follow_their_rows(flight, tmp_path):
     np.testing.assert_array_equal(session.residuals()[first], v[first])
     session.set_calibration(None)
     assert session.residuals() == {}
+
+
+# ------------------------------------------------------------------ undo and the prediction
+def _tie_pair(sim):
+    """A simulated tie point seen in at least three images: (rows of it, observations)."""
+    obs = sim.observations  # noise-free: the true pixels
+    names = np.array(obs.point_id)
+    for n in np.unique(names[np.array(obs.type) == "tie"]):
+        rows = np.flatnonzero(names == n)
+        if rows.size >= 3:
+            return rows, obs
+    raise AssertionError("no tie point in three images")
+
+
+def test_undo_and_redo_restore_the_prediction_with_the_rows(flight):
+    """The pending tie point goes back and forth with its rows: after undoing a tie point no
+    image predicts it (Enter would add it to one image only); redo brings the prediction back;
+    undoing its measurement in a second image predicts it there again."""
+    sim, eo, outlines = flight
+    session = PickingSession()
+    session.control = ControlSet.from_features(*_features(sim, outlines))
+    session.set_orientation(sim.camera, eo, sim.crs)
+    log = session.observations
+    rows, obs = _tie_pair(sim)
+    a, b, c = rows[:3]
+    img_a, img_b, img_c = obs.image_id[a], obs.image_id[b], obs.image_id[c]
+    target = session.targets_at(img_a, obs.pixels[a], "tie", 10.0)[0]
+    k = session.add_observation(img_a, obs.pixels[a], target)
+    first = session.pending
+    pred_b = session.prediction(img_b).copy()
+    assert math.hypot(*(pred_b - obs.pixels[b])) < 1e-3 and session.prediction(img_c) is not None
+
+    # undo the tie point: no row, no prediction anywhere; Enter in B adds nothing
+    assert session.undo()
+    assert log.rows == [] and session.pending is None
+    assert session.prediction(img_b) is None and session.confirm_prediction(img_b) == -1
+    assert log.rows == []
+    # redo: the row and the same prediction
+    assert session.redo()
+    assert log.rows[k].image_id == img_a and session.pending is first
+    np.testing.assert_array_equal(session.prediction(img_b), pred_b)
+
+    # measured in B: B no longer predicted (C still); undo: the B row goes, B predicted again
+    kb = session.confirm_prediction(img_b)
+    assert log.rows[kb].point_id == log.rows[k].point_id and session.prediction(img_b) is None
+    assert session.prediction(img_c) is not None
+    session.undo()
+    assert len(log.rows) == 1
+    np.testing.assert_array_equal(session.prediction(img_b), pred_b)
+    session.redo()
+    assert len(log.rows) == 2 and session.prediction(img_b) is None
+    # measured in every image it was predicted in: nothing left; undo: the last one again
+    left = list(session.pending.pixels)
+    for image in left:
+        session.confirm_prediction(image)
+    assert session.pending is None and len(log.rows) == 2 + len(left)
+    session.undo()
+    assert list(session.pending.pixels) == left[-1:]
+    assert session.redo() and session.pending is None
+
+    # Esc drops the prediction (not an edit); undoing the next edit restores what was pending
+    # before that edit (nothing), not what Esc dropped
+    for _ in left:
+        session.undo()
+    assert session.prediction(img_c) is not None
+    session.cancel_prediction()
+    assert session.pending is None
+    proj = session.project(img_a)
+    j = int(np.flatnonzero(np.isfinite(proj.lcps).all(axis=1))[0])
+    session.add_observation(
+        img_a, proj.lcps[j], session.targets_at(img_a, proj.lcps[j], "lcp", 1.0, proj)[0]
+    )
+    session.undo()
+    assert session.pending is None and len(log.rows) == 2
+    # a new tie point replaces the pending one; undoing it brings the first back
+    session.redo()
+    session.undo()
+    session.undo()  # (the B row)
+    session.redo()
+    assert session.prediction(img_b) is None and session.prediction(img_c) is not None
+    t2 = session.targets_at(img_a, obs.pixels[a] + [1.0, 1.0], "tie", 10.0)[0]
+    before = session.pending
+    session.add_observation(img_a, obs.pixels[a] + [1.0, 1.0], t2)
+    assert session.pending is not before and session.pending.point_id != before.point_id
+    session.undo()
+    assert session.pending is before
+
+
+def test_deleting_or_moving_the_tie_point_updates_its_prediction(flight):
+    sim, eo, outlines = flight
+    session = PickingSession()
+    session.control = ControlSet.from_features(*_features(sim, outlines))
+    session.set_orientation(sim.camera, eo, sim.crs)
+    log = session.observations
+    rows, obs = _tie_pair(sim)
+    a, b = rows[:2]
+    img_a, img_b = obs.image_id[a], obs.image_id[b]
+    target = session.targets_at(img_a, obs.pixels[a], "tie", 10.0)[0]
+    k = session.add_observation(img_a, obs.pixels[a], target)
+    pending = session.pending
+    # moved by (+3, -2) px: the prediction follows (the ray of the new pixel on the plane)
+    session.move(k, *(obs.pixels[a] + [3.0, -2.0]))
+    plane = session.control.planes[target.index]
+    expected = session.scene.predict_tie(
+        img_a, obs.pixels[a] + [3.0, -2.0], plane.normal, plane.centroid
+    )[img_b]
+    np.testing.assert_allclose(session.prediction(img_b), expected, atol=1e-9)
+    assert math.hypot(*(session.prediction(img_b) - pending.pixels[img_b])) > 1.0
+    session.undo()  # the move undone: the first prediction again
+    assert session.pending is pending and log.rows[k].col == pytest.approx(obs.pixels[a][0])
+    # deleting the only row of the point drops its prediction; undo brings both back
+    session.delete(k)
+    assert log.rows == [] and session.pending is None and session.prediction(img_b) is None
+    session.undo()
+    assert len(log.rows) == 1 and session.pending is pending
+    # measured in B, then A's row deleted: B's row keeps the point, the prediction stays
+    kb = session.confirm_prediction(img_b)
+    rest = session.pending
+    session.delete(k)
+    assert [o.image_id for o in log.rows] == [img_b] and session.pending is rest
+    # a moved row that is not the one predicted from leaves the prediction alone
+    session.move(0, log.rows[0].col + 1.0, log.rows[0].row)
+    assert session.pending is rest
+    del kb
+
+
+def test_index_of_rows_by_image_follows_every_edit():
+    """The index behind indices_of_image (kept up to date for adds, moves and their undo)
+    against a plain scan, through a random sequence of edits."""
+    rng = np.random.default_rng(4)
+    log = ObservationList([_obs(k, "abc"[k % 3]) for k in range(20)])
+    for step in range(400):
+        r = rng.uniform()
+        if r < 0.35:
+            n = int(rng.integers(1, 4))
+            log.add([_obs(1000 + step * 4 + j, "abcd"[int(rng.integers(4))]) for j in range(n)])
+        elif r < 0.5 and log.rows:
+            k = int(rng.integers(len(log.rows)))
+            log.move(k, float(rng.uniform(0, 100)), float(rng.uniform(0, 100)))
+        elif r < 0.6 and log.rows:
+            log.delete([int(i) for i in rng.integers(len(log.rows), size=2)])
+        elif r < 0.85:
+            log.undo()
+        else:
+            log.redo()
+        for image in "abcde":
+            assert log.indices_of_image(image) == [
+                k for k, o in enumerate(log.rows) if o.image_id == image
+            ], (step, image)
+    assert log.image_ids() <= set("abcd")

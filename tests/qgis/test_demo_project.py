@@ -30,7 +30,7 @@ from lidarphoto.core.photo.picking import PickingScene
 from lidarphoto.core.simulation.render import RenderOptions, RenderScene, render_image
 from lidarphoto.plugin.image_dock import ImagePickingDock
 from qgis.core import QgsProject
-from qgis.PyQt.QtCore import QPointF, Qt
+from qgis.PyQt.QtCore import QPoint, QPointF, Qt
 from qgis.PyQt.QtTest import QTest
 from qgis.PyQt.QtWidgets import QSplitter
 
@@ -71,6 +71,7 @@ def demo(tmp_path_factory):
     lidar = DEMO.lidar_step(out / "lidar")
     sim, paths, eo_true = DEMO.flight_step(lidar, out / "flight", camera=HALF, images_per_line=2)
     figures = DEMO.render_step(lidar, sim, eo_true, out / "flight" / "images")
+    DEMO.ortho_step(out, out / "flight" / "eo_true.csv", gsd=0.1)  # no calibration here
     (out / "calibration").mkdir()
     initial = direct_georeference(sim.trajectory, sim.mount, MappingFrame.from_user_input(CRS))
     write_eo_csv(out / "calibration" / "eo_initial.csv", initial)
@@ -89,15 +90,16 @@ def _deep_pixel(labels: np.ndarray, plane_id: int) -> tuple[np.ndarray, float]:
 
 
 def _click(view, app, pixel, zoom=None) -> QPointF:
-    """Left click where the image pixel is shown (centred at ``zoom`` if given); returns the
-    scene position the click maps to."""
+    """Left click on the screen pixel that shows the image point ``pixel`` (centred at
+    ``zoom`` if given); returns the scene position of that screen pixel's centre."""
     if zoom is not None:
         view.set_zoom(zoom, QPointF(*pixel))
     app.processEvents()
-    pos = view.mapFromScene(QPointF(*pixel))
+    at = view.viewportTransform().map(QPointF(*pixel))
+    pos = QPoint(math.floor(at.x()), math.floor(at.y()))
     QTest.mouseClick(view.viewport(), Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier,
                      pos)  # fmt: skip
-    return view._scene_f(QPointF(pos))
+    return view._scene_f(QPointF(pos) + QPointF(0.5, 0.5))
 
 
 def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, provider):
@@ -120,6 +122,10 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
     assert layers["LiDAR lines"].featureCount() == len(lidar.lines)
     dsm = layers["DSM 0.5 m (highest return)"]
     assert dsm.isValid() and dsm.crs().authid() == CRS
+    mosaic = layers["Orthomosaic (true orthophotos)"]
+    assert mosaic.isValid() and mosaic.crs().authid() == CRS
+    assert mosaic.renderer().type() == "multibandcolor" and mosaic.renderer().alphaBand() == 4
+    assert layers["Orthomosaic seamlines"].featureCount() == len(sim.trajectory.image_id)
 
     # ---- the dock restores the session
     dock = ImagePickingDock(None, qgis_parent)
@@ -127,6 +133,7 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
     dock.resize(1000, 950)
     dock.show()
     QTest.qWaitForWindowExposed(dock, 2000)
+    assert dock.wait_restored()  # (the files are read in steps, QGIS responsive between)
     ids = list(sim.trajectory.image_id)
     assert [
         dock.viewer.image_combo.itemData(k) for k in range(dock.viewer.image_combo.count())
@@ -204,6 +211,7 @@ def test_demo_project_user_story(demo, qgis_app, qgis_parent, qgis_new_project, 
     dock.resize(1000, 1280)
     dock.show()
     QTest.qWaitForWindowExposed(dock, 2000)
+    assert dock.wait_restored()
     assert dock.store.rows == rows
     assert dock.current_image == a and dock.source is not None
 

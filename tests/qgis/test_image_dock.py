@@ -26,10 +26,12 @@ from lidarphoto.core.io.orientation import write_eo_csv
 from lidarphoto.core.io.planes import read_planes_csv, write_planes_csv
 from lidarphoto.core.photo.georeference import direct_georeference
 from lidarphoto.core.photo.mount import Mount
+from lidarphoto.core.photo.observations import ImageObservations
 from lidarphoto.core.photo.picking import PickingScene
 from lidarphoto.core.simulation.flight import FlightConfig, simulate_flight
 from lidarphoto.plugin.image_dock import ImagePickingDock
 from lidarphoto.plugin.image_source import ImageSource
+from lidarphoto.plugin.image_view import event_position, pointer_position
 from lidarphoto.plugin.observation_store import ObservationStore
 from osgeo import gdal
 from qgis.core import (
@@ -74,6 +76,12 @@ def _wait(app, cond, timeout_s=60.0):
         QTest.qWait(20)
         app.processEvents()
     return cond()
+
+
+def _screen_pixel(view, pixel) -> QPoint:
+    """The screen pixel (viewport) that shows the image point ``pixel`` (col, row)."""
+    p = view.viewportTransform().map(QPointF(float(pixel[0]), float(pixel[1])))
+    return QPoint(math.floor(p.x()), math.floor(p.y()))
 
 
 def _move(widget, pos: QPoint, buttons) -> None:
@@ -373,16 +381,17 @@ def test_click_adds_observation_undo_redo_move_reload(
     view = dock.view
     view.set_zoom(2.0, QPointF(*centre))
     qgis_app.processEvents()
-    click = view.mapFromScene(QPointF(*centre))
+    click = _screen_pixel(view, centre)
     QTest.mouseClick(
         view.viewport(), Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, click
     )
     assert len(dock.store.rows) == 1
     o = dock.store.rows[0]
     assert (o.image_id, o.type, o.target_id) == (image, "tie", target)
-    expected = view._scene_f(QPointF(click))  # the view transform of the click position
+    # the centre of the screen pixel clicked (zoom 2: a screen pixel is 0.5 image px)
+    expected = view._scene_f(QPointF(click) + QPointF(0.5, 0.5))
     assert abs(o.col - expected.x()) < 1e-6 and abs(o.row - expected.y()) < 1e-6
-    assert math.hypot(o.col - centre[0], o.row - centre[1]) <= 0.5  # 1 screen px = 0.5 image px
+    assert max(abs(o.col - centre[0]), abs(o.row - centre[1])) <= 0.25
     on_disk = read_observations_csv(tmp_path / "obs.csv")
     assert len(on_disk) == 1 and np.allclose(on_disk.pixels[0], (o.col, o.row), atol=1e-9)
     # image -> map: the plane is selected in its layer
@@ -555,8 +564,14 @@ def test_canvas_sync_and_session_restore(
     rows = list(dock.store.rows)
     dock.close()
     again = ImagePickingDock(None, qgis_parent)
-    assert again.store.rows == rows
+    # the tabs at once; the files in steps of their own, the observation markers last
+    assert again.calibration_panel.trajectory_edit.filePath() == str(block["paths"]["trajectory"])
+    assert again.loader.steps_left == 4 and again.store.rows == []
+    assert again.wait_restored()
+    assert again.loader.steps_left == 0 and again.store.rows == rows
     assert again.current_image == image and again.source is not None
+    shown = [o for o in rows if o.image_id == image]
+    assert again.viewer.overlays.counts["observations"] == len(shown) >= 1
     assert again.calibration_panel.trajectory_edit.filePath() == str(block["paths"]["trajectory"])
     assert again.project_panel.planes_combo.currentLayer() is planes
     assert again.viewer.overlays.counts["planes"] >= 5
@@ -623,7 +638,7 @@ def test_run_calibration_shows_residuals_and_screenshot(
     image = sim.trajectory.image_id[1]
     dock.show_image(image)
     assert dock.viewer.overlays.counts["residuals"] > 10
-    assert dock.table.item(0, 6).text() != ""
+    assert dock.table.text(0, 6) != ""
     # the screenshot: the dock with roof outlines, ids, lines, LCPs, points and residuals
     _target, centre = _inside_plane(block, image)
     dock.view.set_zoom(2.0, QPointF(*centre))
@@ -653,3 +668,207 @@ def test_plugin_action_shows_and_unload_removes_the_dock(qgis_iface, qgis_app, q
     finally:
         plugin.unload()
     assert plugin.image_dock is None
+
+
+# ------------------------------------------------------------------------------ issue 14
+
+
+def test_pointer_position_is_the_centre_of_the_pixel_or_the_sub_pixel_position(qgis_app):
+    """Qt reports a mouse position as the top-left corner of the pixel under the cursor; a
+    position between device pixels (a tablet, a touchpad, a fractional scale) is kept."""
+
+    def event(x, y):
+        return QMouseEvent(
+            QEvent.Type.MouseButtonRelease,
+            QPointF(x, y),
+            Qt.MouseButton.LeftButton,
+            Qt.MouseButton.NoButton,
+            Qt.KeyboardModifier.NoModifier,
+        )
+
+    cases = [
+        ((10.0, 7.0), 1.0, (10.5, 7.5)),  # a screen pixel: its centre
+        ((10.25, 7.0), 1.0, (10.25, 7.5)),  # sub-pixel in x: kept
+        ((10.5, 7.0), 2.0, (10.75, 7.25)),  # device pixel (21, 14) of a 2x screen: its centre
+        ((10.25, 7.75), 2.0, (10.25, 7.75)),  # between device pixels: kept
+        ((0.0, 0.0), 1.5, (1 / 3, 1 / 3)),  # a 150 % screen: device pixel 0 is 2/3 px wide
+    ]
+    for (x, y), ratio, expected in cases:
+        got = pointer_position(event(x, y), ratio)
+        assert (got.x(), got.y()) == pytest.approx(expected, abs=1e-12), (x, y, ratio)
+    assert event_position(event(10.0, 7.0)) == QPointF(10.0, 7.0)  # Qt's own, unchanged
+
+
+def test_click_stores_the_centre_of_the_clicked_screen_pixel(
+    qgis_parent, qgis_app, block, layers, tmp_path
+):
+    """A real click on the screen pixel that shows a known image pixel, at 25 %, 100 % and
+    400 %: the observation is the centre of the screen pixel clicked (< 0.01 px), computed
+    here from the zoom and the scroll offsets alone; at 100 % that is the image pixel's centre
+    (c + 0.5, r + 0.5) and the pixel on screen is that image pixel. The former code stored the
+    pixel's top-left corner: 0.5 / zoom px off in each coordinate (0.71 px at 100 %)."""
+    dock = _dock(qgis_parent, qgis_app, block, layers, tmp_path)
+    image = block["sim"].trajectory.image_id[1]
+    dock.show_image(image)
+    _target, centre = _inside_plane(block, image)
+    c, r = (int(v) for v in np.floor(centre))  # the image pixel (c, r)
+    view = dock.view
+    dock.viewer.type_combo.setCurrentText("tie")
+    for zoom in (0.25, 1.0, 4.0):
+        dock.cancel_prediction()
+        view.set_zoom(zoom, QPointF(c + 0.5, r + 0.5))
+        assert view.wait_idle(60.0, build=False)
+        assert view.zoom == pytest.approx(zoom)
+        assert view.transform().m12() == 0.0 and view.transform().m21() == 0.0
+        hs, vs = view.horizontalScrollBar().value(), view.verticalScrollBar().value()
+        # the screen pixel showing the image point (c + 0.5, r + 0.5): x = zoom * col - hs
+        sx, sy = math.floor(zoom * (c + 0.5) - hs), math.floor(zoom * (r + 0.5) - vs)
+        n = len(dock.store.rows)
+        QTest.mouseClick(
+            view.viewport(),
+            Qt.MouseButton.LeftButton,
+            Qt.KeyboardModifier.NoModifier,
+            QPoint(sx, sy),
+        )
+        assert len(dock.store.rows) == n + 1
+        o = dock.store.rows[-1]
+        expected = ((sx + 0.5 + hs) / zoom, (sy + 0.5 + vs) / zoom)
+        assert abs(o.col - expected[0]) < 0.01 and abs(o.row - expected[1]) < 0.01, (zoom, o)
+        # and the clicked screen pixel covers image pixel (c, r) (its centre at 100 %)
+        assert (sx + hs) / zoom <= c + 0.5 < (sx + 1 + hs) / zoom
+        if zoom == 1.0:
+            assert (o.col, o.row) == pytest.approx((c + 0.5, r + 0.5), abs=1e-9)
+        if zoom >= 1.0:
+            assert (math.floor(o.col), math.floor(o.row)) == (c, r)
+        on_disk = read_observations_csv(tmp_path / "obs.csv")
+        assert on_disk.pixels[-1] == pytest.approx([o.col, o.row], abs=1e-12)
+    # at 100 % the screen pixel clicked shows image pixel (c, r): the view's picture, overlays
+    # hidden, against a direct read of that pixel and its neighbours
+    view.set_zoom(1.0, QPointF(c + 0.5, r + 0.5))
+    assert view.wait_idle(60.0, build=False)
+    for name in dock.viewer.overlays.groups:
+        dock.viewer.overlays.set_visible(name, False)
+    view.update_tiles()
+    shot = view.viewport().grab().toImage()
+    hs, vs = view.horizontalScrollBar().value(), view.verticalScrollBar().value()
+    for dc, dr in ((0, 0), (1, 0), (0, 1), (-1, -1)):
+        sx, sy = c + dc - hs, r + dr - vs
+        grey = QColorValue(shot.pixel(sx, sy))
+        direct = int(view.source.read(c + dc, r + dr, 1, 1, 1, 1).reshape(-1)[0])
+        assert grey == direct, (dc, dr, grey, direct)
+    dock.close()
+
+
+def test_undo_and_redo_take_the_prediction_with_the_tie_point(
+    qgis_parent, qgis_app, block, layers, tmp_path
+):
+    """Ctrl+Z of a tie point leaves no prediction behind: the next image shows none and Enter
+    adds nothing there; Ctrl+Shift+Z brings the point and its prediction back; undoing the
+    measurement in the second image predicts it there again."""
+    dock = _dock(qgis_parent, qgis_app, block, layers, tmp_path)
+    obs = block["sim"].observations
+    names = np.array(obs.point_id)
+    rows = next(
+        np.flatnonzero(names == n)
+        for n in np.unique(names[np.array(obs.type) == "tie"])
+        if (names == n).sum() >= 2
+    )
+    a, b = rows[:2]
+    img_a, img_b = obs.image_id[a], obs.image_id[b]
+    dock.show_image(img_a)
+    dock.viewer.type_combo.setCurrentText("tie")
+    assert dock.pick(*obs.pixels[a]) == 0
+    pending = dock.session.pending
+    assert pending is not None and img_b in pending.pixels
+    view = dock.view
+    ctrl, shift = Qt.KeyboardModifier.ControlModifier, Qt.KeyboardModifier.ShiftModifier
+
+    def keys(key, mods=Qt.KeyboardModifier.NoModifier):
+        view.setFocus()
+        QTest.keyClick(view, key, mods)
+
+    keys(Qt.Key.Key_Z, ctrl)  # undo the tie point
+    assert dock.store.rows == [] and dock.session.pending is None
+    dock.show_image(img_b)
+    assert dock.viewer.overlays.counts["predictions"] == 0
+    keys(Qt.Key.Key_Return)  # Enter: nothing to accept
+    assert dock.store.rows == []
+    keys(Qt.Key.Key_Z, ctrl | shift)  # redo: the point and its prediction in B
+    assert len(dock.store.rows) == 1 and dock.session.pending is pending
+    assert dock.viewer.overlays.counts["predictions"] == 1
+    keys(Qt.Key.Key_Return)  # measured in B at its prediction
+    assert [o.image_id for o in dock.store.rows] == [img_a, img_b]
+    assert dock.store.rows[1].point_id == dock.store.rows[0].point_id
+    assert dock.viewer.overlays.counts["predictions"] == 0
+    keys(Qt.Key.Key_Z, ctrl)  # undo B: predicted in B again, drawn
+    assert [o.image_id for o in dock.store.rows] == [img_a]
+    assert dock.session.prediction(img_b) is not None
+    assert dock.viewer.overlays.counts["predictions"] == 1
+    on_disk = read_observations_csv(tmp_path / "obs.csv")
+    assert on_disk.image_id == (img_a,)  # the autosave follows the undo
+    # deleting the only row of the point drops the prediction
+    dock.show_image(img_a)
+    dock.picking.selected_index = 0
+    keys(Qt.Key.Key_Delete)
+    assert dock.store.rows == [] and dock.session.pending is None
+    keys(Qt.Key.Key_Z, ctrl)
+    assert len(dock.store.rows) == 1 and dock.session.prediction(img_b) is not None
+    dock.close()
+
+
+def test_a_click_redraws_only_what_changed(qgis_parent, qgis_app, block, layers, tmp_path):
+    """With 600 observations in the image, a tie click adds the three items of its marker
+    (and three for its selection) and keeps every other overlay item (none is made again); the
+    map selection it makes restyles the plane (the same item, highlighted); undo removes
+    exactly the new items."""
+    image = block["sim"].trajectory.image_id[1]
+    rng = np.random.default_rng(3)
+    n = 600
+    many = ImageObservations.from_arrays(
+        [image] * n,
+        [f"B{k}" for k in range(n)],
+        rng.uniform([10, 10], [CAMERA.width_px - 10, CAMERA.height_px - 10], (n, 2)),
+        np.full(n, 0.5),
+        ["tie"] * n,
+        [str(block["sim"].planes[k % len(block["sim"].planes)].id) for k in range(n)],
+    )
+    write_observations_csv(tmp_path / "many.csv", many)
+    dock = _dock(qgis_parent, qgis_app, block, layers, tmp_path, obs_name="many.csv")
+    dock.show_image(image)
+    overlays = dock.viewer.overlays
+    assert overlays.counts["observations"] == n
+
+    def items(name):
+        return set(overlays.groups[name].childItems())
+
+    before = {name: items(name) for name in overlays.groups}
+    assert len(before["observations"]) == 3 * n  # cross, circle, label
+    target, centre = _inside_plane(block, image)
+    dock.view.set_zoom(1.0, QPointF(*centre))
+    qgis_app.processEvents()
+    dock.viewer.type_combo.setCurrentText("tie")
+    QTest.mouseClick(
+        dock.view.viewport(),
+        Qt.MouseButton.LeftButton,
+        Qt.KeyboardModifier.NoModifier,
+        _screen_pixel(dock.view, centre),
+    )
+    assert len(dock.store.rows) == n + 1 and dock.store.rows[-1].target_id == target
+    after = {name: items(name) for name in overlays.groups}
+    assert before["observations"] < after["observations"]
+    assert len(after["observations"] - before["observations"]) == 3 + 3  # marker, selection
+    for name in ("planes", "lines", "lcps"):
+        assert after[name] == before[name], name  # not drawn again
+    assert overlays.highlighted("planes") == {target}  # restyled: selected on the map
+    assert dock.table.model_.rowCount() == n + 1
+    assert dock.table.text(dock.table.row_of(n), 1) == dock.store.rows[-1].point_id
+    dock.view.setFocus()
+    QTest.keyClick(dock.view, Qt.Key.Key_Z, Qt.KeyboardModifier.ControlModifier)
+    assert items("observations") == before["observations"]
+    # the map selection changed elsewhere (another plane): only the highlight follows
+    planes = layers[0]
+    other = next(f for f in planes.getFeatures() if str(f["id"]) != target)
+    planes.selectByIds([other.id()])
+    assert overlays.highlighted("planes") == {str(other["id"])}
+    assert items("planes") == before["planes"]
+    dock.close()

@@ -198,12 +198,12 @@ def test_synchronous_build_blocks_the_gui_control(view, image):
 
 
 def _expected_scene(view: ImageView, p: QPoint) -> tuple[float, float]:
-    """Scene point of a viewport pixel from the zoom and the scroll offsets (the view's
-    transform is a pure scale, scrolled)."""
+    """Scene point of the centre of a viewport pixel from the zoom and the scroll offsets
+    (the view's transform is a pure scale, scrolled)."""
     z = view.transform().m11()
     assert view.transform().m12() == 0.0 and view.transform().m21() == 0.0
     hs, vs = view.horizontalScrollBar().value(), view.verticalScrollBar().value()
-    return (p.x() + hs) / z, (p.y() + vs) / z
+    return (p.x() + 0.5 + hs) / z, (p.y() + 0.5 + vs) / z
 
 
 def test_click_after_zoom_maps_to_the_pixel(view, image):

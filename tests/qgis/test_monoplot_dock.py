@@ -7,6 +7,7 @@ image by the project's collinearity chain; an exact click must come back within 
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -34,7 +35,7 @@ from qgis.core import (
     QgsVectorLayer,
     QgsWkbTypes,
 )
-from qgis.PyQt.QtCore import QPointF, Qt
+from qgis.PyQt.QtCore import QPoint, QPointF, Qt
 from qgis.PyQt.QtTest import QTest
 
 CRS = "EPSG:28992"
@@ -159,15 +160,18 @@ def test_points_and_lines_on_the_map_within_a_millimetre(dock, scene, tmp_path, 
     view = dock.view
     view.set_zoom(1.0, QPointF(*pixels[0]))
     qgis_app.processEvents()
-    click = view.mapFromScene(QPointF(*pixels[0]))
+    # the screen pixel that shows the surface point
+    at = view.viewportTransform().map(QPointF(*pixels[0]))
+    click = QPoint(math.floor(at.x()), math.floor(at.y()))
     QTest.mouseClick(view.viewport(), Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier,
                      click)  # fmt: skip
     layer = dock.monoplot_tool.points_layer
     assert layer is not None and QgsProject.instance().mapLayer(layer.id()) is layer
     assert QgsWkbTypes.hasZ(layer.wkbType()) and layer.crs().authid() == CRS
     first = next(layer.getFeatures())
-    sp = view._scene_f(QPointF(click))
+    sp = view._scene_f(QPointF(click) + QPointF(0.5, 0.5))  # the centre of that pixel
     assert (first["col"], first["row"]) == pytest.approx((sp.x(), sp.y()), abs=1e-9)
+    assert np.abs([sp.x() - pixels[0][0], sp.y() - pixels[0][1]]).max() <= 0.5
     assert np.linalg.norm(_xyz(first)[:2] - truth[0, :2]) < 0.05  # 1 screen px ~ 3 cm
     # exact clicks (the projected surface points): within 1 mm
     for k in range(1, 11):
@@ -227,6 +231,7 @@ def test_dsm_choice_is_kept_in_the_session(dock, scene, qgis_parent):
     dock.save_session()
     dock.close()
     again = ImagePickingDock(None, qgis_parent)
+    assert again.wait_restored()  # (the files are read in steps after the constructor)
     assert again.project_panel.dsm_edit.filePath() == str(scene["dir"] / "dsm.tif")
     assert again.project_panel.dsm_cell.value() == pytest.approx(0.25)
     assert again.set_monoplot(True) and again.monoplot_tool.mode == "point"

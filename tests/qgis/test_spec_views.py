@@ -29,7 +29,9 @@ QGIS_TYPE = {
     "field": "field",
     "file_out": "fileDestination",
     "raster_out": "rasterDestination",
+    "folder_out": "folderDestination",
     "sink": "sink",
+    "files": "multilayer",
 }
 SPECS = {job.SPEC.name: job.SPEC for job in ALGORITHMS}
 
@@ -103,7 +105,7 @@ def test_defaults_agree(provider, name):
     raw = {
         p.name: read_parameter(alg, p, parameters, context)
         for p in spec.params
-        if p.kind not in ("sink", "file_out", "raster_out")
+        if p.kind not in ("sink", "file_out", "raster_out", "folder_out")
     }
     qgis = parse_values(spec, raw)
     for p in spec.inputs:

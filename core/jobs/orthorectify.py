@@ -1,0 +1,303 @@
+"""``orthorectify``: orthophotos (and true orthophotos) of oriented frame images on a LiDAR
+DSM or DTM."""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..photo.orthophoto import RESAMPLING, OrthoOptions
+from .common import CSV_FILTER, compression_param
+from .runner import JobResult, stages
+from .spec import AlgorithmSpec, Param, Result, Values
+
+log = logging.getLogger(__name__)
+
+_D = OrthoOptions()
+#: File endings taken as images when IMAGES names a folder.
+IMAGE_SUFFIXES = (".tif", ".tiff", ".jpg", ".jpeg", ".png", ".jp2", ".img")
+#: Name of the orthophoto of image ``<image_id>`` in the output folder.
+ORTHO_NAME = "{}_ortho.tif"
+DSM_FILTER = "DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"
+
+SPEC = AlgorithmSpec(
+    name="orthorectify",
+    title="Orthorectify images on a LiDAR DSM (true orthophotos)",
+    group="Orthophotos",
+    group_id="orthophotos",
+    summary="orthophotos of oriented frame images on a LiDAR DSM or DTM",
+    description="""\
+Each image is resampled onto a north-up grid of the mapping CRS through the surface: the
+height of every output cell comes from the DSM (or DTM) and its image position from the
+camera (lens model included) and the exterior orientation, by the rigorous chain of the
+toolbox (local ENU frame reached through ECEF, so the map projection's scale and the Earth's
+curvature are not neglected).
+
+With True orthophoto, ground hidden from the camera (behind buildings, under trees and
+overhangs) is found by tracing the ray from the camera to every cell through the DSM (as
+monoplotting does) and left as no data; Orthomosaic then fills it from other images.
+
+## Inputs
+Images: image files, or folders of them (tif, tiff, jpg, png, jp2, img); each image is
+matched to the row of the EO table whose image_id is its file name without extension. Every
+image must have the camera's size. DSM: a raster (a layer or a file), or a LAS/LAZ cloud
+rasterised at DSM cell size (highest return per cell, gaps filled). A DSM in another CRS is
+resampled into the mapping CRS, heights transformed too; when PROJ cannot (a missing geoid
+grid) the run stops with PROJ's reason.
+
+## Output
+One GeoTIFF per image, <image_id>_ortho.tif in the output folder: the image's bands and type,
+tiled, compressed (DEFLATE by default), with overviews, the CRS and an internal mask (no data
+outside the image, beyond the DSM and, for true orthophotos, where occluded). Its metadata keep the
+perspective centre, which Orthomosaic uses. GSD 0 takes the images' nadir GSD (the median
+over the images, 2 significant digits); the grids are aligned on multiples of the GSD. The
+extent is each image's footprint on the DSM, or the extent given (xmin, ymin, xmax, ymax).
+Nothing is written when an input is wrong; the files appear together when all are done.""",
+    params=(
+        Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
+        Param("EO", "file", "Exterior orientation (CSV)", file_filter=CSV_FILTER),
+        Param("IMAGES", "files", "Images (files or folders)",
+              help="image files, or folders whose images are all taken"),
+        Param("DSM", "file", "DSM or DTM (raster, or LAS/LAZ)", file_filter=DSM_FILTER,
+              help="a raster (the file of a raster layer) or a LAS/LAZ cloud"),
+        Param("CRS", "crs", "Mapping CRS of the EO", help="e.g. EPSG:28992"),
+        Param("DSM_CRS", "crs", "DSM CRS (if the file has none)", optional=True),
+        Param("CELL_SIZE", "number", "DSM cell size for LAS/LAZ", 0.5, unit="CRS unit",
+              minimum=0.01, maximum=1000.0),
+        Param("GSD", "number", "Output cell size (0 = image GSD)", _D.gsd, unit="CRS unit",
+              minimum=0.0, maximum=1000.0),
+        Param("EXTENT", "numbers", "Extent xmin,ymin,xmax,ymax (empty = footprint)", count=4,
+              optional=True, unit="CRS unit"),
+        Param("RESAMPLING", "enum", "Resampling", _D.resampling, options=RESAMPLING),
+        Param("TRUE_ORTHO", "boolean", "True orthophoto (occluded ground = no data)",
+              _D.true_ortho),
+        Param("OCCLUSION_TOLERANCE", "number", "Occlusion tolerance along the ray",
+              _D.occlusion_tol_m, unit="CRS unit", minimum=0.0, maximum=100.0, advanced=True),
+        compression_param(),
+        Param("OUTPUT_FOLDER", "folder_out", "Output folder"),
+    ),
+    results=(
+        Result("IMAGE_COUNT", "number", "Orthophotos written"),
+        Result("GSD_USED", "number", "Cell size used"),
+        Result("OCCLUDED_FRACTION", "number", "Share of cells occluded (true orthophotos)"),
+    ),
+    tags=("orthophoto", "orthorectification", "true orthophoto", "occlusion", "dsm", "dtm"),
+    references=("dos Santos, Dal Poz & Dalmolin (2010)", "Amhar, Jansa & Ries (1998)",
+                "Habib, Kim & Kim (2007)"),
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class OrthoFile:
+    """One orthophoto written by the job."""
+
+    image_id: str
+    path: str
+    width: int
+    height: int
+    valid_cells: int
+    occluded_cells: int
+
+
+def list_images(paths: tuple[str, ...] | list[str]) -> list[Path]:
+    """The image files named, folders expanded (their files with :data:`IMAGE_SUFFIXES`,
+    sorted); InputError for a path that does not exist or a folder without images."""
+    from ..errors import InputError
+
+    out: list[Path] = []
+    for raw in paths:
+        p = Path(raw)
+        if p.is_dir():
+            found = sorted(f for f in p.iterdir()
+                           if f.is_file() and f.suffix.lower() in IMAGE_SUFFIXES
+                           and not f.name.startswith("."))  # fmt: skip
+            if not found:
+                raise InputError("no image in this folder (" + ", ".join(IMAGE_SUFFIXES) + ")",
+                                 path=str(p))  # fmt: skip
+            out += found
+        elif p.is_file():
+            out.append(p)
+        else:
+            raise InputError("file or folder not found", path=str(p))
+    seen: dict[str, Path] = {}
+    for f in out:
+        if f.stem in seen and seen[f.stem] != f:
+            raise InputError(f"two images are named {f.stem}: {seen[f.stem]} and {f}")
+        seen[f.stem] = f
+    return list(seen.values())
+
+
+def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
+    """Check every input, then orthorectify the images one after the other."""
+    from ..errors import CrsError, InputError
+    from ..geometry.frames import LocalFrame, MappingFrame, parse_crs
+    from ..geometry.raycast import DsmTracer
+    from ..geometry.surface import reproject_dsm
+    from ..io.atomic import OutputSet
+    from ..io.camera import read_camera_json
+    from ..io.dsm import load_dsm
+    from ..io.orientation import read_eo_csv
+    from ..io.raster import GeoTiffWriter, RasterReader
+    from ..photo.orthophoto import OrthoProjector, _lens_lattice, auto_gsd, ortho_grid
+    from .common import compression_args
+
+    camera = read_camera_json(v.camera)
+    eo = read_eo_csv(v.eo)
+    mapping = parse_crs(v.crs, what="mapping CRS")
+    images = list_images(v.images)
+    row_of = {name: k for k, name in enumerate(eo.image_id)}
+    missing = [f.stem for f in images if f.stem not in row_of]
+    if missing:
+        raise InputError(f"no exterior orientation for image(s) {', '.join(missing[:10])}",
+                         path=v.eo)  # fmt: skip
+    for f in images:  # every image is checked before anything is computed
+        with RasterReader(f) as src:
+            info = src.info
+        if (info.width, info.height) != (camera.width_px, camera.height_px):
+            raise InputError(f"the image is {info.width} x {info.height} px, the camera "
+                             f"{camera.name!r} {camera.width_px} x {camera.height_px} px",
+                             path=str(f))  # fmt: skip
+    options = OrthoOptions(gsd=v.gsd, resampling=v.resampling, true_ortho=v.true_ortho,
+                           occlusion_tol_m=v.occlusion_tolerance)  # fmt: skip
+    folder = Path(v.output_folder)
+    targets = {f.stem: folder / ORTHO_NAME.format(f.stem) for f in images}
+    inputs = {"IMAGES": [str(f) for f in images], "DSM": v.dsm, "EO": v.eo, "CAMERA": v.camera}
+
+    load, work = stages(progress, 0.15, 0.85)
+    dsm = load_dsm(v.dsm, v.cell_size, v.dsm_crs, progress=load, should_stop=should_stop)
+    if dsm.crs is None:
+        log.warning("the DSM has no CRS: taken to be the mapping CRS %s", mapping.name)
+    elif not dsm.crs.equals(mapping, ignore_axis_order=True):
+        source = dsm.crs.name
+        try:
+            dsm = reproject_dsm(dsm, mapping, should_stop=should_stop)
+        except CrsError as exc:
+            raise CrsError(f"the DSM ({source}) cannot be brought into the mapping CRS "
+                           f"'{mapping.name}': {exc}", path=str(v.dsm)) from exc  # fmt: skip
+        log.warning("the DSM was in '%s': resampled into '%s' (cell %g)", source, mapping.name,
+                    dsm.cell)  # fmt: skip
+    # the skipping pyramid of the ray casting only for true orthophotos (built once)
+    surface = DsmTracer.build(dsm) if options.true_ortho else dsm
+    zmin = float(np.nanmin(dsm.heights))
+    lens = _lens_lattice(camera)
+    g = dsm.grid  # one ENU frame (at the DSM's centre) and one lens lattice for every image
+    local = LocalFrame.at_map_point(MappingFrame(mapping), [g.x0 + g.cols * g.cell / 2,
+                                                           g.y_top - g.rows * g.cell / 2,
+                                                           zmin])  # fmt: skip
+    projectors = {f.stem: OrthoProjector.build(camera, eo.xyz[row_of[f.stem]],
+                                               eo.opk[row_of[f.stem]], surface, mapping,
+                                               local=local, lens=lens) for f in images}  # fmt: skip
+    boxes = {k: p.footprint() for k, p in projectors.items()}
+    ground_z = {k: _median_height(dsm, b) for k, b in boxes.items()}
+    gsd = float(v.gsd)
+    if gsd == 0:
+        gsds = [auto_gsd(camera, p.xyz[2], ground_z[k]) for k, p in projectors.items()
+                if np.isfinite(ground_z[k])]  # fmt: skip
+        if not gsds:
+            raise InputError("no image sees the DSM", path=str(v.dsm))
+        gsd = float(np.median(gsds))
+    written: list[OrthoFile] = []
+    total_valid = total_occluded = 0
+    beyond = {k: _beyond_dsm(p, ground_z[k]) for k, p in projectors.items()
+              if boxes[k] is not None}  # fmt: skip
+    beyond = {k: v for k, v in beyond.items() if v > 0}
+    if beyond:
+        log.warning("the DSM does not cover all of %d image(s) (share of the image's border "
+                    "beyond it: %s): no data there", len(beyond),
+                    ", ".join(f"{k} {round(100 * v)} %" for k, v in beyond.items()))  # fmt: skip
+    with OutputSet({k: str(p) for k, p in targets.items()}, inputs) as files:
+        for m, f in enumerate(images):
+            name = f.stem
+            proj = projectors[name]
+            box = tuple(v.extent) if v.extent else boxes[name]
+            if box is None:
+                log.warning("image %s does not overlap the DSM: no orthophoto", name)
+                continue
+            grid = ortho_grid(box, gsd)
+            sub = None if work is None else (
+                lambda fr, m=m: work((m + fr) / len(images)))  # fmt: skip
+            centre_px = camera.principal_point_px
+            nadir = proj.ground_points([centre_px], ground_z[name])[0]
+            meta = {
+                "LIDARPHOTO_IMAGE_ID": name,
+                "LIDARPHOTO_SOURCE": os.path.basename(str(f)),
+                "LIDARPHOTO_CENTRE": ",".join(repr(float(c)) for c in proj.xyz),
+                "LIDARPHOTO_GROUND_Z": repr(float(ground_z[name])),
+                "LIDARPHOTO_PRINCIPAL_GROUND": ",".join(repr(float(c)) for c in nadir),
+                "LIDARPHOTO_TRUE_ORTHO": "yes" if options.true_ortho else "no",
+            }
+            valid = occluded = 0
+            with RasterReader(f) as src:
+                info = src.info
+                photometric = "RGB" if info.bands == 3 and info.dtype == np.uint8 else None
+                with GeoTiffWriter(files.path(name), grid.cols, grid.rows, info.bands,
+                                   info.dtype, grid.geotransform, mapping, mask=True,
+                                   tile=512, photometric=photometric, metadata=meta,
+                                   **compression_args(v.compression)) as writer:  # fmt: skip
+                    for tile in _tiles(proj, grid, src, info, options, sub, should_stop):
+                        writer.write(tile.data, tile.col0, tile.row0, tile.valid)
+                        valid += int(np.count_nonzero(tile.valid))
+                        occluded += tile.occluded
+            total_valid += valid
+            total_occluded += occluded
+            written.append(OrthoFile(name, str(targets[name]), grid.cols, grid.rows, valid,
+                                     occluded))  # fmt: skip
+            log.info("%s: %d x %d cells of %g, %d with data%s", name, grid.cols, grid.rows, gsd,
+                     valid, f", {occluded} occluded" if options.true_ortho else "")  # fmt: skip
+        files.commit()
+    frac = total_occluded / max(total_valid + total_occluded, 1)
+    lines = [f"{len(written)} orthophoto(s) of {gsd:g} in {folder}"
+             + (f"; {100 * frac:.1f} % of the cells occluded" if options.true_ortho else "")]
+    return JobResult(
+        results={"IMAGE_COUNT": len(written), "GSD_USED": gsd, "OCCLUDED_FRACTION": frac},
+        lines=lines,
+        data=written,
+    )
+
+
+def _tiles(proj, grid, src, info, options, progress, should_stop):
+    from ..photo.orthophoto import orthorectify_tiles
+
+    def read(window, f):
+        return src.read(window, decimation=f)
+
+    return orthorectify_tiles(proj, grid, read, info.bands, info.dtype, options,
+                              progress=progress, should_stop=should_stop)  # fmt: skip
+
+
+def _median_height(dsm, box) -> float:
+    """Median surface height inside the box (a subsample of its cells)."""
+    if box is None:
+        return math.nan
+    g = dsm.grid
+    c0 = max(int((box[0] - g.x0) / g.cell), 0)
+    c1 = min(math.ceil((box[2] - g.x0) / g.cell), g.cols)
+    r0 = max(int((g.y_top - box[3]) / g.cell), 0)
+    r1 = min(math.ceil((g.y_top - box[1]) / g.cell), g.rows)
+    sub = dsm.heights[r0:r1, c0:c1]
+    step = max(1, int(math.sqrt(sub.size / 250000)))
+    vals = sub[::step, ::step]
+    vals = vals[np.isfinite(vals)]
+    return float(np.median(vals)) if vals.size else math.nan
+
+
+def _beyond_dsm(proj, ground_z: float) -> float:
+    """Share of the image's border whose ground (at the median height) lies beyond the DSM."""
+    cam = proj.camera
+    k = np.linspace(0.0, 1.0, 33)
+    w, h = cam.width_px, cam.height_px
+    border = np.vstack([np.column_stack([k * w, np.zeros_like(k)]),
+                        np.column_stack([k * w, np.full_like(k, h)]),
+                        np.column_stack([np.zeros_like(k), k * h]),
+                        np.column_stack([np.full_like(k, w), k * h])])  # fmt: skip
+    xy = proj.ground_points(border, ground_z)
+    g = proj.dsm.grid
+    xc, yc = proj.dsm.centre_origin
+    inside = ((xy[:, 0] >= xc) & (xy[:, 0] <= xc + (g.cols - 1) * g.cell)
+              & (xy[:, 1] <= yc) & (xy[:, 1] >= yc - (g.rows - 1) * g.cell))  # fmt: skip
+    return float(1.0 - inside.mean())

@@ -1,0 +1,145 @@
+"""The per-cell loop of :mod:`core.photo.orthophoto` compiled with numba: surface height,
+collinearity and lens lookup of every orthophoto cell in one pass, the same arithmetic as the
+vectorised numpy version (the tests compare them cell by cell).
+
+numba is optional (:data:`AVAILABLE`); without it the numpy version runs (10x slower: 2.2 CPU
+s instead of 0.22 for 10 M cells).
+The compiled function releases the GIL, so that tiles run in parallel threads.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Callable
+
+import numpy as np
+
+from ..geometry.raycast_numba import AVAILABLE, numba
+
+__all__ = ["AVAILABLE", "cell_pixels", "remap_maps"]
+
+
+def _cell_pixels(
+    x0, y0, g, h, w, z, xc, yc, inv_cell, lat, step, focal, lens, lx0, ly0, inv_ls, nolens,
+    out_col, out_row, out_z,
+):  # fmt: skip
+    """Fill out_col, out_row (image pixels, NaN: none) and out_z (surface height) of an h x w
+    block of cells whose first centre is (x0, y0) and spacing g (see
+    :func:`core.photo.orthophoto.cell_pixels_numpy` for the arguments)."""
+    rows, cols = z.shape
+    ny, nx = lat.shape[0], lat.shape[1]
+    cx0, ps, cy0, wpx, hpx = nolens[0], nolens[1], nolens[2], nolens[3], nolens[4]
+    has_lens = lens.shape[0] > 1
+    my, mx = lens.shape[0], lens.shape[1]
+    rl = np.empty((nx, 6))
+    for i in range(h):
+        y = y0 - i * g
+        v = (yc - y) * inv_cell
+        fi = i / step
+        ki = min(int(fi), ny - 2)
+        ti = fi - ki
+        # the lattice interpolated to this row once; per cell only along the row
+        for kj in range(nx):
+            for k in range(6):
+                rl[kj, k] = lat[ki, kj, k] * (1 - ti) + lat[ki + 1, kj, k] * ti
+        for j in range(w):
+            out_col[i, j] = np.nan
+            out_row[i, j] = np.nan
+            out_z[i, j] = np.nan
+            x = x0 + j * g
+            u = (x - xc) * inv_cell
+            if not (u >= 0.0 and v >= 0.0 and u <= cols - 1 and v <= rows - 1):
+                continue
+            c = min(max(math.floor(u), 0), max(cols - 2, 0))
+            r = min(max(math.floor(v), 0), max(rows - 2, 0))
+            fu, fv = u - c, v - r
+            c1, r1 = min(c + 1, cols - 1), min(r + 1, rows - 1)
+            z00 = float(z[r, c])
+            z01 = float(z[r, c1])
+            z10 = float(z[r1, c])
+            z11 = float(z[r1, c1])
+            if fu >= fv:
+                zz = z00 + (z01 - z00) * fu + (z11 - z01) * fv
+            else:
+                zz = z00 + (z11 - z10) * fu + (z10 - z00) * fv
+            if not math.isfinite(zz):
+                continue
+            out_z[i, j] = zz
+            fj = j / step
+            kj = min(int(fj), nx - 2)
+            tj = fj - kj
+            # q = a + z b, a and b interpolated between the lattice nodes
+            q0 = (rl[kj, 0] + zz * rl[kj, 3]) * (1 - tj) + (rl[kj + 1, 0] + zz * rl[kj + 1, 3]) * tj
+            q1 = (rl[kj, 1] + zz * rl[kj, 4]) * (1 - tj) + (rl[kj + 1, 1] + zz * rl[kj + 1, 4]) * tj
+            q2 = (rl[kj, 2] + zz * rl[kj, 5]) * (1 - tj) + (rl[kj + 1, 2] + zz * rl[kj + 1, 5]) * tj
+            if not q2 < 0.0:  # behind the camera
+                continue
+            xi = -focal * q0 / q2
+            yi = -focal * q1 / q2
+            if has_lens:
+                lu = (xi - lx0) * inv_ls
+                lv = (yi - ly0) * inv_ls
+                if not (lu >= 0.0 and lv >= 0.0 and lu <= mx - 1 and lv <= my - 1):
+                    continue
+                lj = min(int(lu), mx - 2)
+                li = min(int(lv), my - 2)
+                su, sv = lu - lj, lv - li
+                col = ((lens[li, lj, 0] * (1 - su) + lens[li, lj + 1, 0] * su) * (1 - sv)
+                       + (lens[li + 1, lj, 0] * (1 - su) + lens[li + 1, lj + 1, 0] * su) * sv)
+                row = ((lens[li, lj, 1] * (1 - su) + lens[li, lj + 1, 1] * su) * (1 - sv)
+                       + (lens[li + 1, lj, 1] * (1 - su) + lens[li + 1, lj + 1, 1] * su) * sv)
+            else:
+                col = cx0 + xi / ps
+                row = cy0 - yi / ps
+            if col >= 0.0 and row >= 0.0 and col <= wpx and row <= hpx:
+                out_col[i, j] = col
+                out_row[i, j] = row
+
+
+def _remap_maps(col, row, c0, r0, mapx, mapy):
+    """OpenCV's float32 maps of an image window starting at (c0, r0): pixel centres at
+    integers; -1 (outside) where there is no pixel. Returns the number of cells with one."""
+    n = 0
+    for i in range(col.shape[0]):
+        for j in range(col.shape[1]):
+            c = col[i, j]
+            if math.isfinite(c):
+                mapx[i, j] = c - (0.5 + c0)
+                mapy[i, j] = row[i, j] - (0.5 + r0)
+                n += 1
+            else:
+                mapx[i, j] = -1.0
+                mapy[i, j] = -1.0
+    return n
+
+
+_COMPILED: dict[str, Callable[..., Any]] = {}
+
+
+def _compiled(name: str) -> Callable[..., Any]:
+    if name not in _COMPILED:
+        func = {"cells": _cell_pixels, "maps": _remap_maps}[name]
+        _COMPILED[name] = numba.njit(cache=True, nogil=True)(func)
+    return _COMPILED[name]
+
+
+def cell_pixels(*args: Any) -> None:
+    """Run the compiled loop (compiled at the first call, cached next to this module)."""
+    if not AVAILABLE:
+        raise RuntimeError("numba is not installed")
+    _compiled("cells")(*args)
+
+
+def remap_maps(
+    col: np.ndarray, row: np.ndarray, c0: int, r0: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """float32 maps for cv2.remap of a window at (c0, r0) (see :func:`_remap_maps`)."""
+    mapx = np.empty(col.shape, np.float32)
+    mapy = np.empty(col.shape, np.float32)
+    if AVAILABLE:
+        _compiled("maps")(col, row, int(c0), int(r0), mapx, mapy)
+    else:
+        ok = np.isfinite(col)
+        mapx[...] = np.where(ok, col - (0.5 + c0), -1.0)
+        mapy[...] = np.where(ok, row - (0.5 + r0), -1.0)
+    return mapx, mapy
