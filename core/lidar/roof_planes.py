@@ -393,7 +393,7 @@ def _local_planes(
         "normals": np.zeros((n, 3), dtype=np.float32),
         "quality": np.zeros(n, dtype=np.float32),
         "knn": np.empty((n, g), dtype=np.int32),
-        "spacing": np.empty(n, dtype=np.float64),
+        "spacing": np.empty(n, dtype=np.float32),
     }
     compiled = _use_numba(backend)
     tree = None
@@ -611,8 +611,8 @@ def _fit_labels(
         lab = labels[m]
         pts = q[m]
         counts = np.bincount(lab, minlength=nl).astype(np.float64)
-        centroid = np.column_stack([np.bincount(lab, pts[:, c], minlength=nl)
-                                    for c in range(3)]) / np.maximum(counts, 1)[:, None]  # fmt: skip
+        sums = np.column_stack([np.bincount(lab, pts[:, c], minlength=nl) for c in range(3)])
+        centroid = sums / np.maximum(counts, 1)[:, None]
         dev = pts - centroid[lab]
         six = np.column_stack([np.bincount(lab, dev[:, a] * dev[:, b], minlength=nl)
                                for a, b in _UPPER])  # fmt: skip
@@ -865,7 +865,10 @@ def extract_roof_planes(
     fit_mask = np.empty(n, dtype=bool)
     # points of the region's interior only: a point with a neighbour outside its plane is at a
     # ridge or an eave (where wall points attach), on one side of the plane
-    interior = (labels[knn] == labels[:, None]).all(axis=1)
+    interior = np.empty(n, dtype=bool)
+    for lo in range(0, n, 1 << 20):  # (N, G) comparisons in slices: bounded memory
+        hi = min(n, lo + (1 << 20))
+        interior[lo:hi] = (labels[knn[lo:hi]] == labels[lo:hi, None]).all(axis=1)
     fit_mask[order] = keep & ~ambiguous & interior
     planes, plane_id = _final_planes(xyz, back, fit_mask, cell, progress, should_stop)
     if planes:

@@ -158,7 +158,6 @@ def _local_planes_kernel(
             px32[j] = np.float32(qs[s, 0] - px)
             py32[j] = np.float32(qs[s, 1] - py)
             pz32[j] = np.float32(qs[s, 2] - pz)
-        best = -1
         best_support = -1
         bnx = np.float32(0.0)
         bny = np.float32(0.0)
@@ -194,7 +193,6 @@ def _local_planes_kernel(
                         support += 1
             if support > best_support:
                 best_support = support
-                best = t
                 bnx, bny, bnz, boff = nx_, ny_, nz_, off
         cnt = 0
         for j in range(k):
