@@ -250,7 +250,7 @@ def _spatial_order(
         occupied = int(np.count_nonzero(np.bincount(ij.astype(np.int64))))
         cell = float(np.sqrt(occupied * cell * cell / len(sample) * max(k, 4) / 4.0))
     # the occupied area was measured with the sample: K/4 of all the points per cell (with
-    # the sample's density instead, a 10 M-point tile got cells 23x too full)
+    # the sample's density instead, 6.8 M points got cells 33x too full)
     cell *= float(np.sqrt(len(sample) / n))
     cell = max(cell, float(np.sqrt(span[0] * span[1] / (4.0 * n))), 1e-9)
     nx = int(span[0] / cell) + 1
