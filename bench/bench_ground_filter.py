@@ -1,11 +1,25 @@
-"""Benchmark of the ground filter against CSF (run here) and PDAL (figures from PEERS.md).
+"""Benchmark of the ground filters (SMRF default, SMRF published, PMF, CSF) against the
+cloth-simulation-filter package (run here), laspy's own read + write and PDAL (PEERS.md).
 
-    /work/bench-venv/bin/python bench/bench_ground_filter.py [--quick] [--csf-runs 1]
+    python bench/bench_ground_filter.py [--quick] [--runs 3] [--out results.json]
 
-Each (tool, file) measurement runs in its own process so that its peak RSS is its own. Data:
-AHN3 Delft (both crops merged, 0.85 M points), the same repeated 3 x 4 times with 10 m gaps
-(10.2 M points, built in a temporary folder, never committed), Autzen full (10.65 M points,
-international feet), and the ISPRS samples for accuracy. Prints a markdown report.
+Needs the project's core importable as ``lidarphoto`` and, for the peer, the PyPI package
+``cloth-simulation-filter`` (module CSF) in the same venv (bench/ground_filter.md says how).
+Each (tool, data) measurement runs in its own process so that its peak RSS is its own.
+Sections:
+
+1. End to end (LAZ in, LAZ out): ``laspy.read`` + ``LasData.write`` of the file (the floor)
+   against the ``groundfilter`` job (read -> classify -> write) in the same run, 10 M points.
+2. Algorithm alone (points in memory, median of ``--runs``), peak RSS, and agreement with the
+   producer's ground class (AHN3).
+3. Synthetic terrain classes (core/simulation/terrain.py): total error of every method, of
+   SMRF with its published defaults with and without the low-outlier pre-filter (PDAL's SMRF
+   has none), and of the CSF package; the default was chosen on these and on AHN3.
+4. ISPRS samples 11, 12, 51: validation only (never used to choose), with PDAL's figures.
+
+Data: AHN3 Delft (both crops merged, 0.85 M points), the same repeated 3 x 4 with 10 m gaps
+(10.2 M points, built in a temporary folder), Autzen full (10.65 M, international feet; our
+lengths given in metres and converted, CSF's x 3.2808 as in PEERS.md).
 """
 
 from __future__ import annotations
@@ -30,6 +44,13 @@ AUTZEN = SHARED / "autzen-full" / "autzen-full.laz"
 ISPRS = ROOT / "tests" / "data" / "isprs"
 FEET = 0.3048
 FIELDS = ("x", "y", "z", "classification", "return_number", "number_of_returns")
+METHODS = ("smrf", "smrf_published", "pmf", "csf")
+#: PEERS.md, PDAL with its defaults: total error % per ISPRS sample; AHN3 x12 figures.
+PDAL_ISPRS = {
+    "smrf": {"samp11": 9.9, "samp12": 3.15, "samp51": 5.58},
+    "pmf": {"samp11": 17.16, "samp12": 5.88, "samp51": 6.95},
+    "csf": {"samp11": 38.23, "samp12": 7.53, "samp51": 18.73},
+}
 
 
 def build_ahn3(folder: Path, repeat: tuple[int, int]) -> Path:
@@ -63,191 +84,224 @@ def peak_rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
-def worker(tool: str, path: str, feet: bool, runs: int) -> dict:
-    """One measurement in this process; returns a JSON-able dict."""
-    from lidarphoto.core.io.pointcloud import read_points, write_cloud
-    from lidarphoto.core.jobs.common import lengths_in_cloud_units
-    from lidarphoto.core.jobs.ground_filter import HORIZONTAL_LENGTHS, VERTICAL_LENGTHS
+def _params(method: str):
     from lidarphoto.core.lidar.ground_filter import (
+        SMRF_PUBLISHED,
+        CsfParams,
         GroundFilterParams,
-        ground_filter,
-        score_classification,
+        SmrfParams,
     )
 
+    return {"smrf": SmrfParams(), "smrf_published": SMRF_PUBLISHED, "pmf": GroundFilterParams(),
+            "csf": CsfParams()}[method]  # fmt: skip
+
+
+def _in_units(params, info):
+    from lidarphoto.core.jobs.common import lengths_in_cloud_units
+    from lidarphoto.core.jobs.ground_filter import HORIZONTAL_LENGTHS, VERTICAL_LENGTHS
+
+    m = params.method
+    return lengths_in_cloud_units(params, info, "metre", HORIZONTAL_LENGTHS[m],
+                                  VERTICAL_LENGTHS[m])  # fmt: skip
+
+
+def _csf_package(xyz: np.ndarray, feet: bool) -> tuple[np.ndarray, float]:
+    import CSF
+
+    scale = 1.0 / FEET if feet else 1.0
+    csf = CSF.CSF()
+    csf.params.cloth_resolution *= scale
+    csf.params.class_threshold *= scale
+    csf.setPointCloud(xyz)
+    g, ng = CSF.VecInt(), CSF.VecInt()
+    t = time.perf_counter()
+    csf.do_filtering(g, ng, exportCloth=False)
+    dt = time.perf_counter() - t
+    ground = np.zeros(len(xyz), bool)
+    ground[np.asarray(g, dtype=np.int64)] = True
+    return ground, dt
+
+
+def worker(task: str, path: str, feet: bool, runs: int) -> dict:
+    """One measurement in this process; returns a JSON-able dict."""
+    from lidarphoto.core.io.pointcloud import read_points
+    from lidarphoto.core.lidar.ground_filter import ground_filter, score_classification
+
+    crs = 7415 if "ahn3" in path else None
     t_wall = time.perf_counter()
-    out: dict = {"tool": tool, "path": path}
-    if tool == "laspy":
+    out: dict = {"task": task, "path": path}
+    if task == "laspy_io":  # the floor: laspy's own read + write, LAZ to LAZ
         import laspy
 
-        times = []
-        for _ in range(runs):
-            t = time.perf_counter()
+        with tempfile.TemporaryDirectory(dir=os.path.dirname(path)) as tmp:
+            t, c = time.perf_counter(), time.process_time()
             las = laspy.read(path)
-            _ = las.x, las.y, las.z
-            times.append(time.perf_counter() - t)
-            n = len(las.points)
-            del las
-        out.update(n=n, alg_s=statistics.median(times), times=times)
-        t = time.perf_counter()
-        arrays, _ = read_points(path, ("x", "y", "z"), crs=7415 if "ahn3" in path else None)
-        out["chunked_read_s"] = time.perf_counter() - t
-    else:
-        crs = 7415 if "ahn3" in path else None
+            t1 = time.perf_counter()
+            las.write(Path(tmp) / "out.laz")
+            t2 = time.perf_counter()
+            cpu = time.process_time() - c
+        out.update(n=len(las.points), read_s=t1 - t, write_s=t2 - t1, io_s=t2 - t, cpu_s=cpu)
+    elif task == "job":  # the groundfilter job end to end, LAZ to LAZ
+        import cv2  # noqa: F401  (imports the job makes, done before the clock starts as
+        import laspy  # laspy is imported before the floor's clock)
+        import scipy.ndimage  # noqa: F401
+        from lidarphoto.core.jobs import ground_filter as job
+        from lidarphoto.core.jobs.runner import run_job
+
+        with tempfile.TemporaryDirectory(dir=os.path.dirname(path)) as tmp:
+            raw = {"INPUT": path, "OUTPUT_CLOUD": str(Path(tmp) / "out.laz"),
+                   "DISTANCE_UNIT": "metre", "CRS": "EPSG:7415" if crs else None}  # fmt: skip
+            t, c = time.perf_counter(), time.process_time()
+            res = run_job(job, raw)
+            out["io_s"], out["cpu_s"] = time.perf_counter() - t, time.process_time() - c
+        out.update(n=res.results["POINT_COUNT"], ground=res.results["GROUND_COUNT"])
+    elif task.startswith("alg_"):
+        method = task[4:]
         t = time.perf_counter()
         arrays, info = read_points(path, FIELDS, crs=crs)
         out["read_s"] = time.perf_counter() - t
         n = len(arrays["x"])
         ref = arrays["classification"] == 2
-        if tool == "ours":
-            params = lengths_in_cloud_units(
-                GroundFilterParams(), info, "metre", HORIZONTAL_LENGTHS, VERTICAL_LENGTHS
-            )
-            times = []
-            for _ in range(runs):
-                t = time.perf_counter()
-                r = ground_filter(
-                    arrays["x"],
-                    arrays["y"],
-                    arrays["z"],
-                    params,
-                    return_number=arrays["return_number"],
-                    number_of_returns=arrays["number_of_returns"],
-                    unit_to_metre=info.unit_to_metre,
-                    vertical_unit_to_metre=info.vertical_unit_to_metre,
-                    unit=info.horizontal_unit,
-                )
-                times.append(time.perf_counter() - t)
-            ground = r.ground
-            with tempfile.TemporaryDirectory(dir=os.path.dirname(path)) as tmp:
-                cls = arrays["classification"].copy()
-                cls[ground] = 2
-                t = time.perf_counter()
-                write_cloud(
-                    path,
-                    Path(tmp) / "out.laz",
-                    classification=cls,
-                    extra={"height_above_ground": r.height_above_ground},
-                )
-                out["write_s"] = time.perf_counter() - t
-        elif tool == "csf":
-            import CSF
-
-            scale = 1.0 / FEET if feet else 1.0
-            csf = CSF.CSF()
-            csf.params.cloth_resolution *= scale
-            csf.params.class_threshold *= scale
+        if method == "csf_package":
             xyz = np.column_stack([arrays["x"], arrays["y"], arrays["z"]])
             times = []
             for _ in range(runs):
-                csf = CSF.CSF()
-                csf.params.cloth_resolution *= scale
-                csf.params.class_threshold *= scale
-                csf.setPointCloud(xyz)
-                g, ng = CSF.VecInt(), CSF.VecInt()
-                t = time.perf_counter()
-                csf.do_filtering(g, ng, exportCloth=False)
-                times.append(time.perf_counter() - t)
-            ground = np.zeros(n, bool)
-            ground[np.asarray(g, dtype=np.int64)] = True
+                ground, dt = _csf_package(xyz, feet)
+                times.append(dt)
         else:
-            raise SystemExit(f"unknown tool {tool}")
-        out.update(n=n, alg_s=statistics.median(times), times=times)
-        out["ground_pct"] = 100.0 * ground.mean()
+            params = _in_units(_params(method), info)
+            times, cpus = [], []
+            for _ in range(runs):
+                t, c = time.perf_counter(), time.process_time()
+                r = ground_filter(arrays["x"], arrays["y"], arrays["z"], params,
+                                  return_number=arrays["return_number"],
+                                  number_of_returns=arrays["number_of_returns"],
+                                  unit_to_metre=info.unit_to_metre,
+                                  vertical_unit_to_metre=info.vertical_unit_to_metre,
+                                  unit=info.horizontal_unit)  # fmt: skip
+                times.append(time.perf_counter() - t)
+                cpus.append(time.process_time() - c)
+            ground = r.ground
+            out["cpu_s"] = statistics.median(cpus)
+        out.update(n=n, alg_s=statistics.median(times), times=times,
+                   ground_pct=100.0 * ground.mean())  # fmt: skip
         if ref.any():
             s = score_classification(ground, ref).as_percent()
             out["score"] = {k: round(v, 2) for k, v in s.items()}
-            out["ref_ground_pct"] = 100.0 * ref.mean()
+    else:
+        raise SystemExit(f"unknown task {task}")
     out["wall_s"] = time.perf_counter() - t_wall
     out["peak_rss_mb"] = peak_rss_mb()
     return out
 
 
-def run_worker(tool: str, path: Path, feet: bool, runs: int) -> dict:
-    cmd = [sys.executable, __file__, "--worker", tool, str(path), str(int(feet)), str(runs)]
+def run_worker(task: str, path: Path, feet: bool = False, runs: int = 1) -> dict:
+    cmd = [sys.executable, __file__, "--worker", task, str(path), str(int(feet)), str(runs)]
+    t = time.perf_counter()
     r = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if r.returncode:
         sys.stderr.write(r.stderr[-3000:])
-        return {"tool": tool, "path": str(path), "error": r.stderr[-300:]}
-    return json.loads(r.stdout.strip().splitlines()[-1])
+        return {"task": task, "path": str(path), "error": r.stderr[-300:]}
+    res = json.loads(r.stdout.strip().splitlines()[-1])
+    res["process_s"] = time.perf_counter() - t
+    print(json.dumps(res), file=sys.stderr, flush=True)
+    return res
 
 
-def isprs_table() -> list[str]:
+def synthetic_table() -> dict:
+    """Total error (%) per terrain class and method (3 densities each), and the CSF package."""
+    from dataclasses import replace
+
+    from lidarphoto.core.lidar.ground_filter import ground_filter, score_classification
+    from lidarphoto.core.simulation.terrain import TERRAIN_CLASSES, make_terrain
+
+    configs = {m: _params(m) for m in METHODS}
+    configs["smrf_published_no_prefilter"] = replace(_params("smrf_published"),
+                                                     low_outlier_height=0)  # fmt: skip
+    table: dict = {name: {} for name in [*configs, "csf_package"]}
+    agree = []
+    for cls in TERRAIN_CLASSES:
+        for density, seed in ((0.7, 10), (2.0, 11), (6.0, 12)):
+            scene = make_terrain(cls, density=density, seed=seed)
+            x, y, z = scene.xyz.T
+            for name, params in configs.items():
+                g = ground_filter(x, y, z, params).ground
+                table[name].setdefault(cls, []).append(
+                    100 * score_classification(g, scene.ground).total
+                )
+                if name == "csf":
+                    ours = g
+            try:
+                g, _ = _csf_package(scene.xyz, False)
+                table["csf_package"].setdefault(cls, []).append(
+                    100 * score_classification(g, scene.ground).total
+                )
+                agree.append(float(np.mean(g == ours)))
+            except ImportError:
+                pass
+    out = {name: {cls: float(np.mean(v)) for cls, v in t.items()} for name, t in table.items()}
+    out["csf_agreement_pct"] = 100 * float(np.mean(agree)) if agree else None
+    return out
+
+
+def isprs_table() -> dict:
     from lidarphoto.core.io.pointcloud import read_points
     from lidarphoto.core.lidar.ground_filter import ground_filter, score_classification
 
-    smrf = {"samp11": 9.9, "samp12": 3.15, "samp51": 5.58}
-    pmf = {"samp11": 17.16, "samp12": 5.88, "samp51": 6.95}
-    csf = {"samp11": 38.23, "samp12": 7.53, "samp51": 18.73}
-    rows = [
-        "| sample | T1 % | T2 % | total % | kappa % | SMRF total % | PDAL PMF total % "
-        "| CSF total % |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- |",
-    ]
-    totals = []
-    for name in smrf:
-        a, _ = read_points(ISPRS / f"{name}.laz", ("x", "y", "z", "classification"))
-        r = ground_filter(a["x"], a["y"], a["z"])
-        s = score_classification(r.ground, a["classification"] == 2).as_percent()
-        totals.append(s["total"])
-        rows.append(
-            f"| {name} | {s['type1']:.2f} | {s['type2']:.2f} | {s['total']:.2f} | "
-            f"{s['kappa']:.2f} | {smrf[name]} | {pmf[name]} | {csf[name]} |"
-        )
-    rows.append(
-        f"| mean | | | {np.mean(totals):.2f} | | {np.mean(list(smrf.values())):.2f} | "
-        f"{np.mean(list(pmf.values())):.2f} | {np.mean(list(csf.values())):.2f} |"
-    )
-    return rows
+    out: dict = {}
+    for sample in ("samp11", "samp12", "samp51"):
+        a, _ = read_points(ISPRS / f"{sample}.laz", ("x", "y", "z", "classification"))
+        ref = a["classification"] == 2
+        for m in METHODS:
+            r = ground_filter(a["x"], a["y"], a["z"], _params(m))
+            s = score_classification(r.ground, ref).as_percent()
+            out.setdefault(m, {})[sample] = {k: round(v, 2) for k, v in s.items()}
+        try:
+            g, _ = _csf_package(np.column_stack([a["x"], a["y"], a["z"]]), False)
+            s = score_classification(g, ref).as_percent()
+            out.setdefault("csf_package", {})[sample] = {k: round(v, 2) for k, v in s.items()}
+        except ImportError:
+            pass
+    return out
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--worker", nargs=4)
-    ap.add_argument("--quick", action="store_true", help="AHN3 0.85 M only")
+    ap.add_argument("--quick", action="store_true", help="AHN3 0.85 M only, no 10 M files")
     ap.add_argument("--runs", type=int, default=3)
-    ap.add_argument("--csf-runs", type=int, default=1)
+    ap.add_argument("--out", default="")
+    ap.add_argument("--e2e-only", action="store_true", help="section 1 only (10 M files)")
     args = ap.parse_args()
     if args.worker:
-        tool, path, feet, runs = args.worker
-        print(json.dumps(worker(tool, path, feet == "1", int(runs))))
+        task, path, feet, runs = args.worker
+        print(json.dumps(worker(task, path, feet == "1", int(runs))))
         return
-    results = []
+    results: dict = {"started": time.strftime("%Y-%m-%d %H:%M"), "load": os.getloadavg()}
     with tempfile.TemporaryDirectory() as tmp:
-        files = [("AHN3 Delft 0.85 M", build_ahn3(Path(tmp), (1, 1)), False)]
+        files = [] if args.e2e_only else [("AHN3 Delft 0.85 M", build_ahn3(Path(tmp), (1, 1)),
+                                           False)]  # fmt: skip
         if not args.quick:
             files.append(("AHN3 x12 10.2 M", build_ahn3(Path(tmp), (3, 4)), False))
             files.append(("Autzen full 10.65 M (ft)", AUTZEN, True))
+        rows = []
         for label, path, feet in files:
-            for tool, runs in (("laspy", args.runs), ("ours", args.runs), ("csf", args.csf_runs)):
-                r = run_worker(tool, path, feet, runs)
-                r["label"] = label
-                results.append(r)
-                print(json.dumps(r), file=sys.stderr, flush=True)
-    print(
-        "| tool | data | points | alg s (median) | points/s | read s | wall s | peak RSS MB | "
-        "result |"
-    )
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-    for r in results:
-        if "error" in r:
-            print(f"| {r['tool']} | {r['label']} | error | | | | | | {r['error'][:80]} |")
-            continue
-        score = r.get("score")
-        res = f"ground {r.get('ground_pct', 0):.2f} %"
-        if score:
-            res += (
-                f"; agree {score['agreement']} %; T1 {score['type1']} %; T2 {score['type2']} %;"
-                f" kappa {score['kappa']} %"
-            )
-        if r["tool"] == "laspy":
-            res = f"chunked read_points x,y,z {r['chunked_read_s']:.2f} s"
-        print(
-            f"| {r['tool']} | {r['label']} | {r['n']:,} | {r['alg_s']:.3f} | "
-            f"{r['n'] / r['alg_s']:,.0f} | {r.get('read_s', r['alg_s']):.2f} | "
-            f"{r['wall_s']:.2f} | {r['peak_rss_mb']:.0f} | {res} |"
-        )
-    print()
-    print("\n".join(isprs_table()))
+            # end to end: the floor and our job, twice each, alternating (the machine is shared)
+            for _ in range(2):
+                for task in ("laspy_io", "job"):
+                    rows.append({**run_worker(task, path, feet), "label": label})
+            for method in () if args.e2e_only else (*METHODS, "csf_package"):
+                runs = 1 if method.startswith("csf") else args.runs
+                rows.append({**run_worker(f"alg_{method}", path, feet, runs), "label": label})
+        results["rows"] = rows
+    if not args.e2e_only:
+        results["synthetic"] = synthetic_table()
+        results["isprs"] = isprs_table()
+    results["finished"] = time.strftime("%Y-%m-%d %H:%M")
+    text = json.dumps(results, indent=1)
+    if args.out:
+        Path(args.out).write_text(text)
+    print(text)
 
 
 if __name__ == "__main__":

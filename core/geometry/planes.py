@@ -41,7 +41,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 
-__all__ = ["Plane", "fit_plane", "orient_up", "slope_aspect_deg"]
+__all__ = ["Plane", "fit_plane", "fit_planes", "orient_up", "slope_aspect_deg"]
 
 Array = NDArray[np.float64]
 
@@ -232,3 +232,95 @@ def fit_plane(points: ArrayLike, weights: ArrayLike | None = None, *, plane_id: 
     )
 
 
+
+
+def fit_planes(
+    points: ArrayLike, labels: ArrayLike, n_planes: int | None = None
+) -> list[Plane | None]:
+    """:func:`fit_plane` (unit weights) of every label at once: plane ``l`` is fitted to the
+    points with ``labels == l`` (ids 0..L-1; -1 = no plane).
+
+    The same estimator and covariance as :func:`fit_plane`, with the moments of all planes
+    summed in one pass over the points (coordinates centred on the first point's floor, so
+    map coordinates keep their digits): the planes agree with per-plane fits to rounding.
+    A label with fewer than 3 points, or collinear ones, gives None.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, 3)
+    labels : array_like of int, shape (N,)
+    n_planes : int, optional
+        L (default: the largest label + 1).
+
+    Returns
+    -------
+    list of Plane or None, length L (ids = labels)
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> xy = rng.uniform(0, 10, (400, 2))
+    >>> z = np.where(xy[:, 0] < 5, 0.2 * xy[:, 0], 3.0 - 0.4 * xy[:, 1])
+    >>> labels = (xy[:, 0] >= 5).astype(int)
+    >>> planes = fit_planes(np.column_stack([xy, z]), labels)
+    >>> [round(p.slope_deg, 4) for p in planes], [p.n_points for p in planes]
+    ([11.3099, 21.8014], [175, 225])
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    lab = np.asarray(labels, dtype=np.int64).reshape(-1)
+    if pts.ndim != 2 or pts.shape[1] != 3 or len(pts) != len(lab):
+        raise InputError("points must have shape (N, 3) and labels (N,)")
+    nl = int(lab.max()) + 1 if n_planes is None and len(lab) else int(n_planes or 0)
+    m = (lab >= 0) & (lab < nl)
+    if not m.any():
+        return [None] * nl
+    lab = lab[m]
+    origin = np.floor(pts[m][0])
+    q = pts[m] - origin
+    counts = np.bincount(lab, minlength=nl).astype(np.float64)
+    mean = np.column_stack([np.bincount(lab, q[:, c], minlength=nl) for c in range(3)])
+    mean /= np.maximum(counts, 1.0)[:, None]
+    dev = q - mean[lab]
+    scatter = np.empty((nl, 3, 3))
+    for a in range(3):
+        for b in range(a, 3):
+            scatter[:, a, b] = scatter[:, b, a] = np.bincount(lab, dev[:, a] * dev[:, b],
+                                                              minlength=nl)  # fmt: skip
+    ok = counts >= 3
+    lam = np.zeros((nl, 3))
+    vec = np.tile(np.eye(3), (nl, 1, 1))
+    if ok.any():
+        lam[ok], vec[ok] = np.linalg.eigh(scatter[ok])
+    extent = lam[:, 2]
+    ok &= (extent > 0) & (lam[:, 1] > 1e-12 * extent)
+    normal = vec[:, :, 0].copy()
+    # orient_up, vectorised: the last non-zero component positive
+    sign = np.where(normal[:, 2] != 0, np.sign(normal[:, 2]),
+                    np.where(normal[:, 1] != 0, np.sign(normal[:, 1]), np.sign(normal[:, 0])))
+    normal *= np.where(sign < 0, -1.0, 1.0)[:, None]  # fmt: skip
+    r = (dev * normal[lab]).sum(axis=1)
+    wrr = np.bincount(lab, r * r, minlength=nl)
+    out: list[Plane | None] = []
+    for pid in range(nl):
+        if not ok[pid]:
+            out.append(None)
+            continue
+        n = int(counts[pid])
+        nrm = normal[pid]
+        centroid = origin + mean[pid]
+        sigma0_sq = wrr[pid] / (n - 3) if n > 3 else 0.0
+        l0, l1, l2 = lam[pid]
+        v1, v2 = vec[pid][:, 1], vec[pid][:, 2]
+        c_nn = sigma0_sq * (np.outer(v2, v2) / (l2 - l0) + np.outer(v1, v1) / (l1 - l0))
+        cov = np.empty((4, 4))
+        cov[:3, :3] = c_nn
+        c_nd = -c_nn @ centroid
+        cov[:3, 3] = c_nd
+        cov[3, :3] = c_nd
+        cov[3, 3] = float(centroid @ c_nn @ centroid) + sigma0_sq / n
+        slope, aspect = slope_aspect_deg(nrm)
+        out.append(Plane(id=pid, normal=nrm, d=-float(nrm @ centroid), centroid=centroid,
+                         n_points=n, rms=math.sqrt(wrr[pid] / n),
+                         sigma_d=math.sqrt(max(cov[3, 3], 0.0)), covariance=cov,
+                         slope_deg=slope, aspect_deg=aspect))  # fmt: skip
+    return out

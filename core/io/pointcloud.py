@@ -1,9 +1,14 @@
 """LAS/LAZ point clouds (versions 1.0-1.4) through laspy with the lazrs backend.
 
 Reading streams laspy's ``chunk_iterator`` into preallocated arrays, so a 10-million-point
-file costs the arrays asked for plus one chunk. Writing copies the source file chunk by chunk
-into a temporary file next to the destination (keeping every dimension, header field and VLR)
-and moves it into place only when it is complete.
+file costs the arrays asked for plus one chunk. An algorithm that writes a classified copy
+reads the file once with :func:`read_cloud`, which keeps every point record as stored (the
+packed bytes: 20-67 B per point) next to the arrays it asks for; :func:`write_cloud` then
+writes that copy from memory, chunk by chunk into a temporary file next to the destination
+(keeping every dimension, header field and VLR), and moves it into place only when it is
+complete. LAZ is decoded and encoded with lazrs on every core (laspy's ``LazrsParallel``
+back end) when lazrs is installed, so the whole read -> classify -> write costs one decoding,
+one encoding and the algorithm, without the second decoding of a copy made from the file.
 
 Units are never assumed: :func:`read_info` reports the horizontal unit of the cloud's CRS and
 its size in metres, so that callers can interpret distance parameters in the cloud's own unit
@@ -81,6 +86,8 @@ class CloudInfo:
         False when every return number is 0 (e.g. the ISPRS samples). From the header's
         points-by-return counts in :func:`read_info`, from the data in :func:`read_points`
         when ``return_number`` is read.
+    record_size : int
+        Bytes of one point record (0 when unknown).
     """
 
     path: str
@@ -95,6 +102,7 @@ class CloudInfo:
     maxs: NDArray[np.float64]
     dimensions: tuple[str, ...]
     has_return_numbers: bool
+    record_size: int = 0
 
     def length_factors(self, distance_unit: str) -> tuple[float, float]:
         """Factors that turn horizontal and vertical lengths given in ``distance_unit``
@@ -184,6 +192,15 @@ def crs_units(
     return name, to_metre, vertical
 
 
+def _laz_backend() -> Any:
+    """lazrs on every core when available (laspy's default order, made explicit), else None
+    (laspy then takes whatever back end it has)."""
+    import laspy
+
+    available = laspy.LazBackend.detect_available()
+    return laspy.LazBackend.LazrsParallel if laspy.LazBackend.LazrsParallel in available else None
+
+
 def _open(path: str) -> Any:
     import laspy
 
@@ -192,7 +209,7 @@ def _open(path: str) -> Any:
     if os.path.getsize(path) == 0:
         raise InputError("empty file (0 bytes)", path=path)
     try:
-        return laspy.open(path)
+        return laspy.open(path, laz_backend=_laz_backend())
     except Exception as exc:  # laspy/lazrs raise many types for bad bytes
         raise InputError(f"cannot read as LAS/LAZ: {exc}", path=path) from exc
 
@@ -249,6 +266,7 @@ def _info_from_header(path: str, header: Any, crs: CrsLike, require_crs: bool) -
         maxs=maxs,
         dimensions=tuple(header.point_format.dimension_names),
         has_return_numbers=bool(by_return.sum() > 0),
+        record_size=int(header.point_format.size),
     )
 
 
@@ -412,6 +430,132 @@ def read_points(
     return out, info
 
 
+@dataclass(frozen=True)
+class LasPoints:
+    """Every point record of a LAS/LAZ file, as stored (see :func:`read_cloud`).
+
+    Attributes
+    ----------
+    info : CloudInfo
+        Header, CRS and units (``has_return_numbers`` from the data).
+    header : laspy.LasHeader
+        The source's header (writers copy it).
+    chunks : list of numpy structured arrays
+        The packed point records (the point format's raw dtype: integer X, Y, Z, bit fields)
+        in file order, in the chunks they were decoded in (no copy into one array).
+    evlrs : list
+        The source's extended VLRs.
+    """
+
+    info: CloudInfo
+    header: Any
+    chunks: list[NDArray[Any]]
+    evlrs: list[Any]
+
+    def __len__(self) -> int:
+        return sum(len(c) for c in self.chunks)
+
+    def values(self, name: str) -> NDArray[Any]:
+        """One dimension as a new (N,) array: ``x``, ``y``, ``z`` scaled to float64 in the CRS
+        unit, any other (``classification``, ``return_number``, extra bytes...) in its own
+        dtype."""
+        import laspy
+
+        (key,) = _check_fields(self.info, (name,))
+        n = len(self)
+        out = None
+        done = 0
+        for chunk in self.chunks:
+            m = len(chunk)
+            if key in _SCALED:
+                axis = _SCALED.index(key)
+                if out is None:
+                    out = np.empty(n, dtype=np.float64)
+                part = out[done : done + m]
+                np.multiply(chunk[key.upper()], float(self.header.scales[axis]), out=part)
+                part += float(self.header.offsets[axis])
+            else:
+                values = np.asarray(laspy.PackedPointRecord(chunk, self.header.point_format)[key])
+                if out is None:
+                    out = np.empty(n, dtype=values.dtype)
+                out[done : done + m] = values
+            done += m
+        assert out is not None
+        return out
+
+
+def read_cloud(
+    path: PathLike,
+    crs: CrsLike = None,
+    chunk_size: int = 1_000_000,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+    *,
+    require_crs: bool = True,
+) -> LasPoints:
+    """Read every point record of a LAS/LAZ file once, to classify it and write it back.
+
+    The records are kept as stored (the packed point format, e.g. 28 B per point for format
+    1), so :func:`write_cloud` can write the copy from memory instead of decoding the file a
+    second time; :meth:`LasPoints.values` gives the arrays an algorithm needs. LAZ is decoded
+    by lazrs on every core.
+
+    Parameters
+    ----------
+    path, crs, chunk_size, progress, should_stop, require_crs
+        As in :func:`read_points` (progress and cancel are checked per chunk).
+
+    Returns
+    -------
+    LasPoints
+
+    Raises
+    ------
+    InputError, CrsError, Cancelled
+        As :func:`read_points`.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> crop = Path(__file__).parents[2] / "tests" / "data" / "ahn3" / "ahn3_delft_crop60.laz"
+    >>> cloud = read_cloud(crop)
+    >>> len(cloud), cloud.chunks[0].dtype.itemsize, cloud.info.crs.to_epsg()
+    (35231, 28, 7415)
+    """
+    path = os.fspath(path)
+    with _open(path) as reader:
+        _check_record_count(path, reader.header)
+        info = _info_from_header(path, reader.header, crs, require_crs)
+        header = deepcopy(reader.header)
+        n = info.point_count
+        chunks = []
+        done = 0
+        returns = False
+        try:
+            while done < n:
+                stop_if_asked(should_stop, "processing the point cloud")
+                chunk = reader.read_points(min(max(int(chunk_size), 1), n - done))
+                m = len(chunk)
+                if m == 0:
+                    break
+                chunks.append(chunk.array)
+                returns = returns or bool(np.any(np.asarray(chunk.return_number) > 0))
+                done += m
+                if progress is not None:
+                    progress(done / n)
+        except (InputError, Cancelled):
+            raise
+        except Exception as exc:  # lazrs/laspy decoding errors: corrupt or truncated file
+            raise InputError(
+                f"corrupt or truncated point data after {done} of {n} points: {exc}", path=path
+            ) from exc
+        evlrs = list(reader.header.evlrs or [])
+    if done != n:
+        raise InputError(f"truncated: {done} points read, the header says {n}", path=path)
+    info = replace(info, has_return_numbers=returns)
+    return LasPoints(info=info, header=header, chunks=chunks, evlrs=evlrs)
+
+
 def _check_values(
     path: str, n: int, point_format: int, classification: Any, extra: Mapping[str, Any] | None
 ) -> tuple[NDArray[Any] | None, dict[str, NDArray[Any]]]:
@@ -445,6 +589,7 @@ def write_cloud(
     *,
     classification: NDArray[Any] | None = None,
     extra: Mapping[str, NDArray[Any]] | None = None,
+    points: LasPoints | None = None,
     chunk_size: int = 1_000_000,
     progress: Callable[[float], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
@@ -453,10 +598,11 @@ def write_cloud(
 
     Every original dimension, header field (version, point format, scales, offsets, system
     identifier, generating software, dates, global encoding) and VLR/EVLR is kept; bounds and
-    counts are recomputed. LAZ or LAS is chosen by the suffix of ``dst_path``. The copy is
-    streamed chunk by chunk into a temporary file in the destination folder and moved into
-    place only when complete (:func:`core.io.atomic.atomic_path`): a failure or a cancel
-    leaves no partial output.
+    counts are recomputed. LAZ or LAS is chosen by the suffix of ``dst_path`` (LAZ encoded by
+    lazrs on every core). The copy is written chunk by chunk into a temporary file in the
+    destination folder and moved into place only when complete
+    (:func:`core.io.atomic.atomic_path`): a failure or a cancel leaves no partial output.
+    Without ``extra`` the point format is unchanged and each chunk is written as read.
 
     Parameters
     ----------
@@ -467,6 +613,10 @@ def write_cloud(
     extra : dict[str, (N,) array], optional
         Extra dimensions to add (their dtype is kept: uint8 ... float64). A name the source
         already has as an extra dimension of the same dtype is overwritten.
+    points : LasPoints, optional
+        The source's records already read by :func:`read_cloud`: the copy is made from them
+        and the file is not decoded again. Without extra dimensions the new classification
+        is written into ``points``' own records (no copy of the points is made).
     chunk_size, progress, should_stop
         As in :func:`read_points`.
 
@@ -477,8 +627,6 @@ def write_cloud(
     Cancelled
         When ``should_stop()`` returns True (nothing is left behind).
     """
-    import laspy
-
     src = os.fspath(src_path)
     dst = os.fspath(dst_path)
     suffix = Path(dst).suffix.lower()
@@ -487,63 +635,94 @@ def write_cloud(
     folder = os.path.dirname(os.path.abspath(dst))
     if not os.path.isdir(folder):
         raise InputError("the output folder does not exist", path=dst)
-
+    step = max(int(chunk_size), 1)
+    if points is not None:
+        n = len(points)
+        chunks = iter(points.chunks)
+        _write_records(src, dst, points.header, points.evlrs, n, chunks, classification,
+                       extra, progress, should_stop)  # fmt: skip
+        return
     with _open(src) as reader:
         _check_record_count(src, reader.header)
-        info = _info_from_header(src, reader.header, None, require_crs=False)
-        n = info.point_count
-        cls, arrays = _check_values(src, n, info.point_format, classification, extra)
-        header = deepcopy(reader.header)
-        extra_names = set(header.point_format.extra_dimension_names)
-        new_params = []
-        for name, arr in arrays.items():
-            if name in extra_names:
-                have = header.point_format.dimension_by_name(name).dtype
-                if np.dtype(have) != arr.dtype:
-                    raise InputError(
-                        f"extra dimension {name!r} exists with dtype {have}, not {arr.dtype}",
-                        path=src,
-                        column=name,
-                    )
-            elif name in header.point_format.dimension_names:
-                raise InputError(
-                    f"{name!r} is a standard dimension, not an extra one", path=src, column=name
-                )
-            else:
-                new_params.append(laspy.ExtraBytesParams(name=name, type=arr.dtype))
-        if new_params:
-            header.add_extra_dims(new_params)
-        evlrs = list(reader.header.evlrs or [])
+        n = int(reader.header.point_count)
+        if n == 0:
+            raise InputError("the file holds no points", path=src)
+        chunks = (chunk.array for chunk in reader.chunk_iterator(step))
+        _write_records(src, dst, reader.header, list(reader.header.evlrs or []), n, chunks,
+                       classification, extra, progress, should_stop)  # fmt: skip
 
-        with atomic_path(dst) as tmp:
-            with laspy.open(tmp, mode="w", header=header, do_compress=suffix == ".laz") as writer:
-                done = 0
-                try:
-                    for chunk in reader.chunk_iterator(max(int(chunk_size), 1)):
-                        stop_if_asked(should_stop, "processing the point cloud")
-                        m = len(chunk)
-                        out = laspy.ScaleAwarePointRecord.zeros(m, header=writer.header)
-                        for name in chunk.array.dtype.names:
-                            out.array[name] = chunk.array[name]
-                        if cls is not None:
-                            out.classification = cls[done : done + m]
-                        for name, arr in arrays.items():
-                            out[name] = arr[done : done + m]
-                        writer.write_points(out)
-                        done += m
-                        if progress is not None:
-                            progress(done / n)
-                except (InputError, Cancelled):
-                    raise
-                except Exception as exc:
-                    raise InputError(
-                        f"corrupt or truncated point data after {done} of {n} points: {exc}",
-                        path=src,
-                    ) from exc
-                if done != n:
-                    raise InputError(
-                        f"truncated: {done} points read, the header says {n}", path=src
-                    )
-                if evlrs:
-                    writer.write_evlrs(laspy.VLRList(evlrs))
+
+def _write_records(
+    src: str,
+    dst: str,
+    src_header: Any,
+    evlrs: list[Any],
+    n: int,
+    chunks: Any,
+    classification: Any,
+    extra: Mapping[str, NDArray[Any]] | None,
+    progress: Callable[[float], None] | None,
+    should_stop: Callable[[], bool] | None,
+) -> None:
+    """write_cloud's writer: raw record chunks of the source -> the temporary, then in place."""
+    import laspy
+
+    cls, arrays = _check_values(src, n, int(src_header.point_format.id), classification, extra)
+    header = deepcopy(src_header)
+    extra_names = set(header.point_format.extra_dimension_names)
+    new_params = []
+    for name, arr in arrays.items():
+        if name in extra_names:
+            have = header.point_format.dimension_by_name(name).dtype
+            if np.dtype(have) != arr.dtype:
+                raise InputError(
+                    f"extra dimension {name!r} exists with dtype {have}, not {arr.dtype}",
+                    path=src,
+                    column=name,
+                )
+        elif name in header.point_format.dimension_names:
+            raise InputError(
+                f"{name!r} is a standard dimension, not an extra one", path=src, column=name
+            )
+        else:
+            new_params.append(laspy.ExtraBytesParams(name=name, type=arr.dtype))
+    if new_params:
+        header.add_extra_dims(new_params)
+    same_format = not new_params
+    with atomic_path(dst) as tmp:
+        with laspy.open(tmp, mode="w", header=header, do_compress=dst.lower().endswith(".laz"),
+                        laz_backend=_laz_backend()) as writer:  # fmt: skip
+            fmt = writer.header.point_format
+            done = 0
+            try:
+                for raw in chunks:
+                    stop_if_asked(should_stop, "processing the point cloud")
+                    m = len(raw)
+                    if done + m > n:
+                        raise InputError(f"more points than the header's {n}", path=src)
+                    if same_format:  # the chunk itself: no copy
+                        out = laspy.PackedPointRecord(raw, fmt)
+                    else:
+                        out = laspy.PackedPointRecord.zeros(m, fmt)
+                        for name in raw.dtype.names:
+                            out.array[name] = raw[name]
+                    if cls is not None:
+                        out.classification = cls[done : done + m]
+                    for name, arr in arrays.items():
+                        out[name] = arr[done : done + m]
+                    writer.write_points(out)
+                    done += m
+                    if progress is not None:
+                        progress(done / n)
+            except (InputError, Cancelled):
+                raise
+            except Exception as exc:
+                raise InputError(
+                    f"corrupt or truncated point data after {done} of {n} points: {exc}",
+                    path=src,
+                ) from exc
+            if done != n:
+                raise InputError(f"truncated: {done} points read, the header says {n}", path=src)
+            if evlrs:
+                writer.write_evlrs(laspy.VLRList(evlrs))
     LOG.info("wrote %d points to %s", n, dst)

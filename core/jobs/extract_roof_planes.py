@@ -139,7 +139,7 @@ class RoofPlaneRun:
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the cloud, extract roof planes, write the plane table (and the cloud)."""
     from ..io.planes import write_planes_csv
-    from ..io.pointcloud import read_points, write_cloud
+    from ..io.pointcloud import read_cloud, read_points, write_cloud
     from ..lidar.roof_planes import extract_roof_planes
 
     if v.min_support > v.k_neighbours:
@@ -164,9 +164,14 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     weights = (0.15, 0.7, 0.15) if out.requested("OUTPUT_CLOUD") else (0.2, 0.8, 0.0)
     read, compute, write = stages(progress, *weights)
     fields = ("x", "y", "z") if selection == "all" else ("x", "y", "z", "classification")
-    arrays, info = read_points(
-        v.input, fields, crs=v.crs or None, progress=read, should_stop=should_stop
-    )
+    cloud = None
+    if out.requested("OUTPUT_CLOUD"):  # decoded once: the copy is written from memory
+        cloud = read_cloud(v.input, v.crs or None, progress=read, should_stop=should_stop)
+        arrays, info = {f: cloud.values(f) for f in fields}, cloud.info
+    else:
+        arrays, info = read_points(
+            v.input, fields, crs=v.crs or None, progress=read, should_stop=should_stop
+        )
     ratio = info.vertical_unit_to_metre / info.unit_to_metre
     if not math.isfinite(ratio) or abs(ratio - 1.0) > 1e-9:
         raise InputError(
@@ -203,6 +208,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             v.input,
             out.path("OUTPUT_CLOUD"),
             extra={"plane_id": plane_id},
+            points=cloud,
             progress=write,
             should_stop=should_stop,
         )

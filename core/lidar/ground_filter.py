@@ -1,6 +1,7 @@
-"""Ground filter: the Progressive Morphological Filter (Zhang et al. 2003) on a minimum grid.
+"""Ground filters on a minimum grid: PMF (Zhang et al. 2003), SMRF (Pingel et al. 2013) and
+the cloth simulation filter CSF (Zhang et al. 2016).
 
-Steps (all grid work is vectorised with OpenCV/scipy.ndimage, all point work with numpy):
+Shared steps (all grid work is vectorised with OpenCV/scipy.ndimage, all point work with numpy):
 
 1. **Candidates.** Where the file has return numbers, only last (and single) returns can be
    ground: earlier returns of a multi-return pulse were stopped by something above the ground.
@@ -10,27 +11,46 @@ Steps (all grid work is vectorised with OpenCV/scipy.ndimage, all point work wit
    ``low_outlier_radius`` by more than ``low_outlier_height`` is a low outlier (multipath or
    range errors: nothing real lies below the ground around it); only cells holding points
    count, so an isolated point with no neighbour in the radius is never one. Low
-   outliers are removed before the PMF (a single one punches a pit that every opening widens),
-   get class 7 (low point, noise) and are never ground. The minimum grid is rebuilt without them.
-4. **PMF.** Openings (erosion then dilation, square or disk windows counted in cells) of the
-   surface with windows ``w_k`` growing linearly (``w_k = 2 k b + 1``) or exponentially
-   (``w_k = 2 b^k + 1``) up to ``max_window``. At each step a cell is an object cell when the
-   surface minus its opening exceeds ``dh_k``: ``dh_1 = initial_distance``, then
-   ``dh_k = slope (w_k - w_{k-1}) c + initial_distance`` capped at ``max_distance``, where ``c``
-   is the cell size (applied once: PDAL's filters.pmf applies it twice and counts its windows in
-   map units, see PEERS.md) and ``slope`` is converted to the file's z-per-xy units.
-5. **DTM.** The minimum grid with object cells removed; the holes are filled by a pull-push
-   pyramid (weighted 2x2 averages down, bilinear up), which interpolates smoothly across
-   buildings. Cells farther than ``max_window`` from any ground cell are nodata.
-6. **Points.** Each candidate's height above the DTM (bilinear between cell centres) is compared
-   with a slope-dependent threshold as in SMRF (Pingel et al. 2013):
-   ``|h| <= ground_threshold + slope_scalar * local DTM slope`` is ground.
+   outliers are removed before the filter (a single one punches a pit that every opening
+   widens and the cloth hangs on), get class 7 (low point, noise) and are never ground. The
+   minimum grid is rebuilt without them.
 
-Distance parameters are in the cloud's horizontal unit (``cell_size``, ``max_window``,
-``low_outlier_radius``) or its vertical unit (``initial_distance``, ``max_distance``,
-``ground_threshold``, ``slope_scalar``, ``low_outlier_height``); the ``groundfilter`` job
-converts lengths given in metres (:func:`core.jobs.common.lengths_in_cloud_units`). ``slope``
-is always a ratio of real lengths (rise over run).
+Then one of the methods finds the ground cells (PMF, SMRF) or the ground surface (CSF):
+
+- **PMF** (Zhang et al. 2003): openings (erosion then dilation, square or disk windows counted
+  in cells) of the surface with windows ``w_k`` growing linearly (``w_k = 2 k b + 1``) or
+  exponentially (``w_k = 2 b^k + 1``) up to ``max_window``. At each step a cell is an object
+  cell when the surface minus its opening exceeds ``dh_k``: ``dh_1 = initial_distance``, then
+  ``dh_k = slope (w_k - w_{k-1}) c + initial_distance`` capped at ``max_distance``, where ``c``
+  is the cell size (applied once: PDAL's filters.pmf applies it twice and counts its windows in
+  map units, see PEERS.md) and ``slope`` is converted to the file's z-per-xy units.
+- **SMRF** (Pingel et al. 2013): openings with disks of radius ``r = 1, 2, ...`` cells up to
+  ``max_window / c`` (the window is a radius, as in the paper and PDAL's filters.smrf); a cell is
+  an object cell when the surface minus its opening exceeds ``slope * r * c``, a threshold that
+  grows with the window, so steep ground survives the wide windows that remove buildings.
+- **CSF** (Zhang et al. 2016): the cloud is turned upside down and a cloth of particles
+  ``resolution`` apart falls onto it (Verlet steps with damping 0.01 and gravity 0.2 m per unit
+  time squared, ``time_step`` units per step); each particle stops on the height of the point
+  nearest to it horizontally (empty cells take the nearest cell's); neighbouring particles are
+  pulled together ``rigidness`` times per step (the paper's internal forces, applied to the
+  four neighbours in a red-black order so every spring acts once). The run ends after
+  ``iterations`` steps or when no particle moved more than 1 % of ``threshold``. Optional
+  slope smoothing (``slope_smooth``) pins movable particles next to pinned ones when they lie
+  within 0.3 m of their point (the paper's post-processing for steep slopes).
+
+**DTM and points** (PMF, SMRF): the minimum grid with object cells removed, holes filled by a
+pull-push pyramid (weighted 2x2 averages down, bilinear up), which interpolates smoothly across
+buildings; cells farther than the largest window from any ground cell are nodata. Each
+candidate's height above the DTM (bilinear between cell centres) is compared with a
+slope-dependent threshold (Pingel et al. 2013): ``|h| <= threshold + scalar * local DTM slope``
+is ground. CSF: a point is ground when it lies within ``threshold`` of the cloth (bilinear
+between particles); the cloth is the DTM.
+
+Distance parameters are in the cloud's horizontal unit (cell sizes, windows, radii, the cloth
+resolution) or its vertical unit (elevation thresholds, ``slope_scalar``/``scalar``,
+``low_outlier_height``); the ``groundfilter`` job converts lengths given in metres
+(:func:`core.jobs.common.lengths_in_cloud_units`). ``slope`` is always a ratio of real lengths
+(rise over run).
 """
 
 from __future__ import annotations
@@ -39,7 +59,7 @@ import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, Union
 
 import numpy as np
 from numpy.typing import NDArray
@@ -54,14 +74,40 @@ UNCLASSIFIED_CLASS = 1
 LOW_NOISE_CLASS = 7
 NODATA = -9999.0
 HEIGHT_FIELD = "height_above_ground"
+METHODS = ("smrf", "pmf", "csf")
 GROWTH_CHOICES = ("linear", "exponential")
 WINDOW_SHAPES = ("square", "disk")
 _POINT_CHUNK = 2_000_000
+#: CSF's constants (Zhang et al. 2016): velocity damping per step, gravity (m per unit time
+#: squared), the distance within which slope smoothing pins a particle (m).
+#: SMRF's slope estimated from the cloud (SLOPE 0): this percentile of the slope of a first
+#: pass's ground surface, clipped to this range (rise/run).
+SLOPE_PERCENTILE = 90.0
+SLOPE_RANGE = (0.1, 0.7)
+#: Inner radius of the ring of the low-outlier cluster test, as a share of its radius.
+LOW_RING = 0.6
+#: Passes of the low-outlier tests (a deeper outlier nearby hides a shallower one until it is
+#: removed).
+LOW_PASSES = 10
+CSF_DAMPING = 0.01
+CSF_GRAVITY_M = 0.2
+CSF_SMOOTH_M = 0.3
+#: CSF stops when no free particle moved more than this in a step (m), and smooths slopes only
+#: in free regions of more particles than this (the authors' package).
+CSF_STOP_M = 0.005
+CSF_SMOOTH_MIN_REGION = 50
+
+
+def _check_common(p: Any) -> None:
+    for name in ("low_outlier_height", "low_outlier_radius"):
+        value = getattr(p, name)
+        if not (value >= 0 and math.isfinite(value)):
+            raise InputError(f"{name} must be >= 0", column=name)
 
 
 @dataclass(frozen=True)
 class GroundFilterParams:
-    """Parameters of :func:`ground_filter` (units: see the module docstring).
+    """Parameters of the PMF (units: see the module docstring).
 
     Attributes
     ----------
@@ -110,6 +156,8 @@ class GroundFilterParams:
     low_outlier_radius: float = 5.0
     last_returns_only: bool = True
 
+    method = "pmf"
+
     def validate(self) -> None:
         """Raise InputError naming the parameter when a value is out of range."""
         positive = ("cell_size", "max_window", "window_base")
@@ -122,13 +170,12 @@ class GroundFilterParams:
             "max_distance",
             "ground_threshold",
             "slope_scalar",
-            "low_outlier_height",
-            "low_outlier_radius",
         )
         for name in non_negative:
             value = getattr(self, name)
             if not (value >= 0 and math.isfinite(value)):
                 raise InputError(f"{name} must be >= 0", column=name)
+        _check_common(self)
         if self.growth not in GROWTH_CHOICES:
             raise InputError(f"growth must be one of {GROWTH_CHOICES}", column="growth")
         if self.growth == "exponential" and self.window_base <= 1:
@@ -137,6 +184,119 @@ class GroundFilterParams:
             raise InputError(f"window_shape must be one of {WINDOW_SHAPES}", column="window_shape")
         if self.max_window < self.cell_size:
             raise InputError("max_window must be at least one cell", column="max_window")
+
+
+@dataclass(frozen=True)
+class SmrfParams:
+    """Parameters of SMRF (Pingel et al. 2013). The defaults are the paper's (and PDAL's,
+    :data:`SMRF_PUBLISHED`) except ``threshold``, chosen on AHN3 (README).
+
+    Attributes
+    ----------
+    cell_size : float
+        Side of a grid cell (horizontal unit). Default 1.0 (published 1.0).
+    slope : float
+        Terrain slope (rise/run) allowed per unit of window radius; 0 estimates it from the
+        cloud (the 90th percentile of the ground's slope after a first pass on cells twice
+        as large, within 0.1-0.7; it over-estimates under vegetation on steep slopes, see
+        README). Default 0.15 (published 0.15).
+    max_window : float
+        Largest window radius (horizontal unit). Default 18.0 (published 18.0).
+    threshold : float
+        Final height above the DTM accepted as ground (vertical unit). Default 0.3
+        (published 0.5).
+    scalar : float
+        Added to ``threshold`` per unit of local DTM slope (vertical unit). Default 1.25
+        (published 1.25).
+    low_outlier_height, low_outlier_radius, last_returns_only
+        As in :class:`GroundFilterParams`.
+    """
+
+    cell_size: float = 1.0
+    slope: float = 0.15
+    max_window: float = 18.0
+    threshold: float = 0.3
+    scalar: float = 1.25
+    low_outlier_height: float = 1.0
+    low_outlier_radius: float = 5.0
+    last_returns_only: bool = True
+
+    method = "smrf"
+
+    def validate(self) -> None:
+        """Raise InputError naming the parameter when a value is out of range."""
+        for name in ("cell_size", "max_window"):
+            if not getattr(self, name) > 0:
+                raise InputError(f"{name} must be > 0", column=name)
+        for name in ("slope", "threshold", "scalar"):
+            value = getattr(self, name)
+            if not (value >= 0 and math.isfinite(value)):
+                raise InputError(f"{name} must be >= 0", column=name)
+        _check_common(self)
+        if self.max_window < self.cell_size:
+            raise InputError("max_window must be at least one cell", column="max_window")
+
+
+#: SMRF with the defaults of Pingel et al. (2013) and PDAL's filters.smrf.
+SMRF_PUBLISHED = SmrfParams(slope=0.15, max_window=18.0, threshold=0.5, scalar=1.25)
+
+
+@dataclass(frozen=True)
+class CsfParams:
+    """Parameters of the cloth simulation filter (Zhang et al. 2016); the defaults are those of
+    the authors' package (``cloth-simulation-filter``).
+
+    Attributes
+    ----------
+    resolution : float
+        Distance between cloth particles (horizontal unit). Default 1.0.
+    rigidness : int
+        1 (steep slopes), 2 (terraces, gentle slopes) or 3 (flat terrain). Default 3.
+    time_step : float
+        Time step of the simulation (unit time). Default 0.65.
+    threshold : float
+        Largest distance from the cloth of a ground point (vertical unit). Default 0.5.
+    iterations : int
+        Largest number of time steps. Default 500.
+    slope_smooth : bool
+        Post-processing for steep slopes. Default True.
+    low_outlier_height, low_outlier_radius, last_returns_only
+        As in :class:`GroundFilterParams`.
+    """
+
+    resolution: float = 1.0
+    rigidness: int = 3
+    time_step: float = 0.65
+    threshold: float = 0.5
+    iterations: int = 500
+    slope_smooth: bool = True
+    low_outlier_height: float = 1.0
+    low_outlier_radius: float = 5.0
+    last_returns_only: bool = True
+
+    method = "csf"
+
+    @property
+    def cell_size(self) -> float:
+        """The grid of the minimum surface and of the cloth (horizontal unit)."""
+        return self.resolution
+
+    def validate(self) -> None:
+        """Raise InputError naming the parameter when a value is out of range."""
+        if not self.resolution > 0:
+            raise InputError("resolution must be > 0", column="resolution")
+        if self.rigidness not in (1, 2, 3):
+            raise InputError("rigidness must be 1, 2 or 3", column="rigidness")
+        if not (self.time_step > 0 and math.isfinite(self.time_step)):
+            raise InputError("time_step must be > 0", column="time_step")
+        if not (self.threshold >= 0 and math.isfinite(self.threshold)):
+            raise InputError("threshold must be >= 0", column="threshold")
+        if not self.iterations >= 1:
+            raise InputError("iterations must be >= 1", column="iterations")
+        _check_common(self)
+
+
+FilterParams = Union[GroundFilterParams, SmrfParams, CsfParams]
 
 
 @dataclass(frozen=True)
@@ -157,10 +317,10 @@ class GroundFilterResult:
         GDAL order, top-left corner of the top-left cell.
     nodata : float
     windows : tuple[int, ...]
-        Opening windows used, in cells.
+        Opening windows used, in cells (empty for CSF).
     thresholds : tuple[float, ...]
         Elevation-difference threshold of each window (vertical unit).
-    params : GroundFilterParams
+    params : GroundFilterParams, SmrfParams or CsfParams
         The parameters actually used, in the cloud's units.
     unit : str
         Name of the unit the parameters were interpreted in.
@@ -174,7 +334,7 @@ class GroundFilterResult:
     nodata: float
     windows: tuple[int, ...]
     thresholds: tuple[float, ...]
-    params: GroundFilterParams
+    params: FilterParams
     unit: str = "unknown"
     stats: dict[str, Any] = field(default_factory=dict)
 
@@ -214,6 +374,21 @@ def pmf_windows(params: GroundFilterParams) -> tuple[list[int], list[float]]:
     return windows, [round(t, 12) for t in thresholds]
 
 
+def smrf_windows(params: SmrfParams) -> tuple[list[int], list[float]]:
+    """Disk windows (diameters ``2 r + 1`` in cells, r = 1 .. max_window / c) and their
+    thresholds ``slope r c`` (Pingel et al. 2013). ``slope`` in z-per-xy units here.
+
+    Examples
+    --------
+    >>> smrf_windows(SmrfParams(cell_size=2.0, slope=0.15, max_window=7.0))
+    ([3, 5, 7, 9], [0.3, 0.6, 0.9, 1.2])
+    """
+    radii = range(1, max(math.ceil(params.max_window / params.cell_size - 1e-9), 1) + 1)
+    windows = [2 * r + 1 for r in radii]
+    thresholds = [round(params.slope * r * params.cell_size, 12) for r in radii]
+    return windows, thresholds
+
+
 def _kernel(w: int, shape: str) -> NDArray[np.uint8]:
     import cv2
 
@@ -244,11 +419,97 @@ def _neighbour_min(surface: NDArray[np.float32], radius: int) -> NDArray[np.floa
     return cv2.erode(surface, kernel, borderType=cv2.BORDER_CONSTANT, borderValue=np.inf)
 
 
+def _low_outliers(
+    zmin: NDArray[np.float32],
+    zc: NDArray[np.float32],
+    flat: NDArray[np.int64],
+    radius: int,
+    depth: np.float32,
+) -> NDArray[np.bool_]:
+    """Points lower by more than ``depth`` than every other cell within ``radius`` cells (a
+    single outlier), or than every cell of the ring from ``LOW_RING`` x ``radius`` to
+    ``radius`` when the low cells inside the ring form a blob smaller than the ring's hole (a
+    cluster of multipath points, whose cells hide each other from the first test). Only
+    cells holding points count (empty ones are +inf), so an outlier's value never stands in
+    for a neighbour and a point without real neighbours is never low; a depression wider
+    than the ring's hole is never low (its own cells are in the ring), nor is ground between
+    objects (the ring holds ground as low as it)."""
+    import cv2
+
+    reference = _neighbour_min(zmin, radius).ravel() - depth
+    low = (zc < reference[flat]) & np.isfinite(reference[flat])
+    inner = math.ceil(LOW_RING * radius)
+    if radius - inner >= 1:
+        ring = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))
+        hole = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * inner + 1, 2 * inner + 1))
+        ring[radius - inner : radius + inner + 1, radius - inner : radius + inner + 1] &= 1 - hole
+        around = cv2.erode(zmin, ring, borderType=cv2.BORDER_CONSTANT, borderValue=np.inf)
+        around -= depth
+        pit = (zmin < around) & np.isfinite(around)
+        if pit.any():
+            _, labels, stats, _ = cv2.connectedComponentsWithStats(pit.astype(np.uint8), 8)
+            small = stats[:, cv2.CC_STAT_AREA] <= int(hole.sum())
+            small[0] = False
+            blob = small[labels].ravel()
+            low |= blob[flat] & (zc < around.ravel()[flat])
+    return low
+
+
+def _estimate_slope(
+    zmin: NDArray[np.float32],
+    valid: NDArray[np.bool_],
+    p: SmrfParams,
+    xy_per_z: float,
+    should_stop: Callable[[], bool] | None,
+) -> float:
+    """SMRF's slope from the cloud itself (rise/run): a first SMRF pass with the published
+    slope on cells twice as large (the minimum of each 2 x 2 block: a sixteenth of the work),
+    its ground surface, and the 90th percentile of that surface's slope over the cells it
+    reaches, clipped to ``SLOPE_RANGE``."""
+    rows, cols = zmin.shape
+    pad = np.pad(zmin, ((0, rows % 2), (0, cols % 2)), constant_values=np.inf)
+    coarse = pad.reshape(pad.shape[0] // 2, 2, pad.shape[1] // 2, 2).min(axis=(1, 3))
+    ok = np.isfinite(coarse)
+    if ok.sum() < 9:
+        return SLOPE_RANGE[0]
+    first = replace(p, cell_size=2 * p.cell_size, slope=SMRF_PUBLISHED.slope * xy_per_z)
+    windows, thresholds = smrf_windows(first)
+    objects = _progressive_opening(fill_nearest(coarse, ok), windows, thresholds, "disk",
+                                   should_stop)  # fmt: skip
+    ground = ok & ~objects
+    if not ground.any():
+        return SLOPE_RANGE[0]
+    from scipy import ndimage
+
+    surface = fill_holes(coarse, ground)
+    reach = ndimage.distance_transform_edt(~ground) <= windows[-1] / 2.0 + 1
+    gr, gc = np.gradient(surface.astype(np.float64), first.cell_size)
+    slope = np.hypot(gr, gc)[reach] / xy_per_z
+    return float(np.clip(np.percentile(slope, SLOPE_PERCENTILE), *SLOPE_RANGE))
+
+
+def _progressive_opening(
+    surface: NDArray[np.float32],
+    windows: list[int],
+    thresholds: list[float],
+    shape: str,
+    should_stop: Callable[[], bool] | None,
+) -> NDArray[np.bool_]:
+    """Object cells of the progressive opening (PMF and SMRF share it)."""
+    objects = np.zeros(surface.shape, dtype=bool)
+    for w, dh in zip(windows, thresholds):
+        stop_if_asked(should_stop, "filtering the ground")
+        opened = _opening(surface, w, shape)
+        objects |= (surface - opened) > dh
+        surface = opened
+    return objects
+
+
 def ground_filter(
     x: NDArray[np.float64],
     y: NDArray[np.float64],
     z: NDArray[np.float64],
-    params: GroundFilterParams | None = None,
+    params: FilterParams | None = None,
     *,
     return_number: NDArray[Any] | None = None,
     number_of_returns: NDArray[Any] | None = None,
@@ -258,19 +519,19 @@ def ground_filter(
     progress: Callable[[float], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
 ) -> GroundFilterResult:
-    """Classify points as ground with the Progressive Morphological Filter.
+    """Classify points as ground with SMRF, PMF or CSF (chosen by the type of ``params``).
 
     Parameters
     ----------
     x, y, z : (N,) float64
         Coordinates in a projected CRS (horizontal unit ``unit``; z in the vertical unit).
-    params : GroundFilterParams, optional
-        Defaults when None.
+    params : SmrfParams, GroundFilterParams (PMF) or CsfParams, optional
+        SMRF with its defaults when None.
     return_number, number_of_returns : (N,) integer arrays, optional
         When given and not all zero, only last returns are ground candidates.
     unit_to_metre, vertical_unit_to_metre : float
         Sizes of the horizontal and vertical units in metres (to turn the physical ``slope``
-        into z-per-xy units).
+        into z-per-xy units, and CSF's gravity into z units).
     unit : str
         Name of the horizontal unit, reported in the result.
     progress, should_stop : callable, optional
@@ -285,18 +546,18 @@ def ground_filter(
     >>> xx, yy = np.meshgrid(np.arange(0, 30, 0.5), np.arange(0, 30, 0.5))
     >>> x, y = xx.ravel(), yy.ravel()
     >>> z = np.where((abs(x - 15) < 4) & (abs(y - 15) < 4), 6.0, 0.0)
-    >>> r = ground_filter(x, y, z)
-    >>> bool(r.ground[z == 0].all()), bool(r.ground[z > 0].any())
-    (True, False)
+    >>> [bool(r.ground[z == 0].all()) and not r.ground[z > 0].any()
+    ...  for r in (ground_filter(x, y, z, p) for p in (SmrfParams(), GroundFilterParams(),
+    ...                                                  CsfParams()))]
+    [True, True, True]
     """
-    params = GroundFilterParams() if params is None else params
+    params = SmrfParams() if params is None else params
     params.validate()
-    p = params
     # slope is a ratio of real lengths: z units per xy unit = slope * (xy unit / z unit)
     xy_per_z = 1.0
     if unit_to_metre > 0 and vertical_unit_to_metre > 0:
         xy_per_z = unit_to_metre / vertical_unit_to_metre
-    p = replace(p, slope=params.slope * xy_per_z)
+    p = replace(params, slope=params.slope * xy_per_z) if hasattr(params, "slope") else params
     n = len(z)
     if n == 0 or len(x) != n or len(y) != n:
         raise InputError("x, y and z must be non-empty arrays of equal length")
@@ -308,14 +569,16 @@ def ground_filter(
             candidate = np.asarray(return_number) >= np.asarray(number_of_returns)
             # malformed records (return 0) are treated as single returns
             candidate |= np.asarray(return_number) == 0
+    cell = p.cell_size
     mins = (float(x.min()), float(y.min()))
     maxs = (float(x.max()), float(y.max()))
-    grid = Grid.covering(mins, maxs, p.cell_size)
+    grid = Grid.covering(mins, maxs, cell)
     if grid.rows * grid.cols > 400_000_000:
+        name = "resolution" if p.method == "csf" else "cell_size"
         raise InputError(
-            f"cell_size {p.cell_size:g} {unit} gives a {grid.rows} x {grid.cols} grid: too fine "
+            f"{name} {cell:g} {unit} gives a {grid.rows} x {grid.cols} grid: too fine "
             "for this extent (check the distance unit)",
-            column="cell_size",
+            column=name,
         )
     z0 = float(z.min())  # float32 grid values relative to the lowest point keep 0.1 mm
     flat = np.empty(n, dtype=np.int64)
@@ -328,57 +591,62 @@ def ground_filter(
     report(0.15)
     zc = zr if candidate is None else np.where(candidate, zr, np.inf).astype(np.float32)
     zmin = _min_grid(grid, flat, zc)
-    valid = np.isfinite(zmin)
-    if not valid.any():
+    if not np.isfinite(zmin).any():
         raise InputError("no ground candidate point (no last return?)")
-    filled = fill_nearest(zmin, valid)
     report(0.3)
 
     low = np.zeros(n, dtype=bool)
     if p.low_outlier_height > 0:
-        radius = max(round(p.low_outlier_radius / p.cell_size), 1)
+        radius = max(round(p.low_outlier_radius / cell), 1)
         # A few passes: a deeper outlier nearby can hide a shallower one until it is removed.
-        for _ in range(3):
-            # empty cells stay +inf here, so an outlier's value never stands in for a neighbour;
-            # a point without any real neighbour (+inf) has nothing to be lower than
-            reference = _neighbour_min(zmin, radius).ravel() - np.float32(p.low_outlier_height)
-            new = (zc < reference[flat]) & np.isfinite(reference[flat])
+        for _ in range(LOW_PASSES):
+            new = _low_outliers(zmin, zc, flat, radius, np.float32(p.low_outlier_height))
             if not new.any():
                 break
             low |= new
             zc = np.where(new, np.inf, zc).astype(np.float32)
             zmin = _min_grid(grid, flat, zc)
-        valid = np.isfinite(zmin)
-        filled = fill_nearest(zmin, valid)
+    valid = np.isfinite(zmin)
     stop_if_asked(should_stop, "filtering the ground")
     report(0.45)
 
-    windows, thresholds = pmf_windows(p)
-    surface = filled
-    objects = np.zeros(surface.shape, dtype=bool)
-    for w, dh in zip(windows, thresholds):
-        stop_if_asked(should_stop, "filtering the ground")
-        opened = _opening(surface, w, p.window_shape)
-        objects |= (surface - opened) > dh
-        surface = opened
-    ground_cells = valid & ~objects
-    if not ground_cells.any():
-        ground_cells = valid
-    dtm = fill_holes(zmin, ground_cells)
+    stats: dict[str, Any] = {}
+    if p.method == "csf":
+        g_xy = 1.0 / vertical_unit_to_metre if vertical_unit_to_metre > 0 else 1.0
+        dtm, windows, thresholds = _csf_cloth(grid, flat, x, y, zc, zmin, p, g_xy, should_stop)
+        reach = np.ones(dtm.shape, dtype=bool)
+        thr_cell = np.full(dtm.size, p.threshold, dtype=np.float32)
+    else:
+        filled = fill_nearest(zmin, valid)
+        if p.method == "smrf":
+            if params.slope == 0:  # estimated from the cloud
+                estimate = _estimate_slope(zmin, valid, p, xy_per_z, should_stop)
+                p = replace(p, slope=estimate * xy_per_z)
+                stats["slope_estimated"] = estimate
+                LOG.info("ground filter (smrf): terrain slope estimated at %.3f", estimate)
+            windows, thresholds = smrf_windows(p)
+            shape, final, scalar = "disk", p.threshold, p.scalar
+        else:
+            windows, thresholds = pmf_windows(p)
+            shape, final, scalar = p.window_shape, p.ground_threshold, p.slope_scalar
+        objects = _progressive_opening(filled, windows, thresholds, shape, should_stop)
+        ground_cells = valid & ~objects
+        if not ground_cells.any():
+            ground_cells = valid
+        dtm = fill_holes(zmin, ground_cells)
+        from scipy import ndimage
+
+        dist = ndimage.distance_transform_edt(~ground_cells)
+        reach = dist <= (windows[-1] / 2.0 + 1)
+        gr, gc = np.gradient(dtm, cell)
+        slope_cell = np.hypot(gr, gc).ravel()
+        # the slope term uses the physical slope (rise/run); the scalar is in z units
+        thr_cell = (final + scalar * slope_cell / xy_per_z).astype(np.float32)
     report(0.6)
-
-    from scipy import ndimage
-
-    dist = ndimage.distance_transform_edt(~ground_cells)
-    outside = dist > (windows[-1] / 2.0 + 1)
-    gr, gc = np.gradient(dtm, p.cell_size)
-    slope_cell = np.hypot(gr, gc).ravel()
-    # the slope term uses the physical slope (rise/run); slope_scalar is in z units
-    thr_cell = (p.ground_threshold + p.slope_scalar * slope_cell / xy_per_z).astype(np.float32)
 
     ground = np.empty(n, dtype=bool)
     hag = np.empty(n, dtype=np.float32)
-    nodata_flat = outside.ravel()
+    nodata_flat = ~reach.ravel()
     for start in range(0, n, _POINT_CHUNK):
         stop_if_asked(should_stop, "filtering the ground")
         s = slice(start, start + _POINT_CHUNK)
@@ -394,14 +662,15 @@ def ground_filter(
         report(0.6 + 0.4 * min(start + _POINT_CHUNK, n) / n)
 
     dtm_out = (dtm.astype(np.float64) + z0).astype(np.float32)
-    dtm_out[outside] = NODATA
+    dtm_out[~reach] = NODATA
     LOG.info(
-        "ground filter: %d points, grid %d x %d cells of %g %s, windows %s cells, thresholds %s; "
-        "%d ground (%.1f %%), %d low outliers",
+        "ground filter (%s): %d points, grid %d x %d cells of %g %s, windows %s cells, "
+        "thresholds %s; %d ground (%.1f %%), %d low outliers",
+        p.method,
         n,
         grid.rows,
         grid.cols,
-        p.cell_size,
+        cell,
         unit,
         windows,
         [round(t, 3) for t in thresholds],
@@ -420,8 +689,159 @@ def ground_filter(
         thresholds=tuple(thresholds),
         params=p,
         unit=unit,
-        stats={"ground_count": int(ground.sum()), "low_outlier_count": int(low.sum())},
+        stats={"ground_count": int(ground.sum()), "low_outlier_count": int(low.sum()), **stats},
     )
+
+
+def _csf_cloth(
+    grid: Grid,
+    flat: NDArray[np.int64],
+    x: NDArray[np.float64],
+    y: NDArray[np.float64],
+    zc: NDArray[np.float32],
+    zmin: NDArray[np.float32],
+    p: CsfParams,
+    metre: float,
+    should_stop: Callable[[], bool] | None,
+) -> tuple[NDArray[np.float32], list[int], list[float]]:
+    """The cloth (Zhang et al. 2016) as a ground surface at the cell centres, in the upright
+    frame (z relative to the lowest point); also the number of steps and the last largest move.
+
+    ``metre`` is one metre in z units (gravity, the stop criterion and slope smoothing are in
+    metres).
+    """
+    rows, cols = grid.rows, grid.cols
+    # Intersection heights: the candidate nearest to each particle (cell centre) horizontally
+    # (Zhang et al. 2016, section 2.2); in the inverted frame it is -z.
+    usable = np.isfinite(zc)
+    f = flat[usable]
+    cr = f // cols
+    cc = f - cr * cols
+    dx = x[usable] - (grid.x0 + (cc + 0.5) * grid.cell)
+    dy = y[usable] - (grid.y_top - (cr + 0.5) * grid.cell)
+    d2 = dx * dx + dy * dy
+    nearest = np.full(rows * cols, np.inf)
+    np.minimum.at(nearest, f, d2)
+    pick = d2 == nearest[f]
+    ihv = np.full(rows * cols, np.nan, dtype=np.float64)
+    ihv[f[pick]] = -zc[usable][pick].astype(np.float64)
+    has = np.isfinite(ihv).reshape(rows, cols)
+    ihv = fill_nearest(ihv.reshape(rows, cols), has)  # particles without a point: nearest one
+
+    height = np.full((rows, cols), float(ihv.max()) + 0.05 * metre)  # starts above everything
+    previous = height.copy()
+    movable = np.ones((rows, cols), dtype=bool)
+    fall = CSF_GRAVITY_M * metre * p.time_step**2
+    # Internal forces: a free particle moves towards a free neighbour by `both` of their height
+    # difference (each moves), towards a pinned one by `one` of it: the closed forms of the
+    # paper's half-difference move repeated `rigidness` times with relaxation (the values the
+    # authors' package uses: 0.3/0.42/0.468 and 0.3/0.51/0.657 for rigidness 1/2/3). Springs
+    # join each particle to its 8 neighbours and to those 2 cells away in the same 8
+    # directions, as in the package.
+    both = 0.5 * (1.0 - 0.4**p.rigidness)
+    one = 1.0 - 0.7**p.rigidness
+    pairs = _spring_pairs(rows, cols)
+    done, moved = 0, 0.0
+    for done in range(1, p.iterations + 1):
+        if done % 16 == 0:
+            stop_if_asked(should_stop, "filtering the ground")
+        new = height + (height - previous) * (1.0 - CSF_DAMPING) - fall
+        np.copyto(new, height, where=~movable)
+        previous, height = height, new
+        for _ in range(2):  # every spring acts from both of its particles
+            for a, b in pairs:
+                _spring(height, movable, a, b, both, one)
+        moved = float(np.abs(height - previous)[movable].max()) if movable.any() else 0.0
+        hit = movable & (height < ihv)
+        height[hit] = ihv[hit]
+        movable &= ~hit
+        if 0.0 < moved < CSF_STOP_M * metre or not movable.any():
+            break
+    if p.slope_smooth:
+        _csf_smooth(height, ihv, movable, CSF_SMOOTH_M * metre)
+    return (-height).astype(np.float32), [done], [round(moved, 6)]
+
+
+def _spring_pairs(rows: int, cols: int) -> list[tuple[tuple[slice, slice], tuple[slice, slice]]]:
+    """Index pairs (a, b) of views, one per batch of springs that share no particle: for every
+    spring direction (dr, dc) of length 1 or 2, the particles split by their row (or column)
+    index so that each is in at most one spring of the batch."""
+    out = []
+    for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1), (0, 2), (2, 0), (2, 2), (2, -2)):
+        ca = slice(max(-dc, 0), cols - max(dc, 0))
+        cb = slice(max(dc, 0), cols - max(-dc, 0) if dc < 0 else cols)
+        step = dr if dr else dc
+        n = rows if dr else cols
+        for colour in (0, 1):
+            for first in range(colour * step, colour * step + step):
+                lo = slice(first, n - step, 2 * step)
+                hi = slice(first + step, n, 2 * step)
+                if dr:
+                    out.append(((lo, ca), (hi, cb)))
+                else:
+                    out.append(((slice(None), lo), (slice(None), hi)))
+    return out
+
+
+def _spring(
+    h: NDArray[np.float64],
+    movable: NDArray[np.bool_],
+    a: tuple[slice, slice],
+    b: tuple[slice, slice],
+    both: float,
+    one: float,
+) -> None:
+    """Apply one batch of springs between the particles ``h[a]`` and ``h[b]`` (views), in place."""
+    ha, hb = h[a], h[b]
+    if ha.size == 0:
+        return
+    ma, mb = movable[a], movable[b]
+    diff = hb - ha
+    free = ma & mb
+    ha += np.where(free, both, np.where(ma, one, 0.0)) * diff
+    hb -= np.where(free, both, np.where(mb, one, 0.0)) * diff
+
+
+def _csf_smooth(
+    height: NDArray[np.float64], ihv: NDArray[np.float64], movable: NDArray[np.bool_], near: float
+) -> None:
+    """Slope post-processing (Zhang et al. 2016), in place: in every connected region of more
+    than 50 free particles, those reachable from a pinned particle through neighbours whose
+    point heights differ by less than ``near`` are pinned on their points (the cloth left
+    hanging over steep ground)."""
+    from scipy import ndimage
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    rows, cols = height.shape
+    labels, count = ndimage.label(movable)
+    if count == 0:
+        return
+    sizes = np.bincount(labels.ravel())
+    big = (sizes > CSF_SMOOTH_MIN_REGION)[labels] & movable
+    index = np.arange(rows * cols).reshape(rows, cols)
+    heads, tails = [], []
+    for sa, sb in (((slice(None), slice(0, -1)), (slice(None), slice(1, None))),
+                   ((slice(0, -1), slice(None)), (slice(1, None), slice(None)))):  # fmt: skip
+        close = np.abs(ihv[sa] - ihv[sb]) < near
+        heads.append(index[sa][close])
+        tails.append(index[sb][close])
+    u, v = np.concatenate(heads), np.concatenate(tails)
+    flat_big = big.ravel()
+    pinned = ~movable.ravel()
+    # the graph: close neighbours among the big free regions, plus one node for "pinned"
+    inside = flat_big[u] & flat_big[v]
+    seed_u = flat_big[u] & pinned[v]
+    seed_v = flat_big[v] & pinned[u]
+    root = rows * cols
+    gu = np.concatenate([u[inside], u[seed_u], v[seed_v]])
+    gv = np.concatenate([v[inside], np.full(seed_u.sum(), root), np.full(seed_v.sum(), root)])
+    graph = coo_matrix((np.ones(len(gu), np.int8), (gu, gv)), shape=(root + 1, root + 1))
+    _, comp = connected_components(graph, directed=False)
+    reach = (comp[:root] == comp[root]) & flat_big
+    flat_h = height.reshape(-1)
+    flat_h[reach] = ihv.reshape(-1)[reach]
+    movable.reshape(-1)[reach] = False
 
 
 @dataclass(frozen=True)

@@ -202,7 +202,8 @@ CASES = [
                                                                   "0.05,0.05,-1,0,0,0"],
          r"EO_SIGMAS \(number 3 of 6\): must be >= 0, got -1$"),
     Case("thresholds in the wrong order",
-         lambda i, o, f: _ground(i, o, "--initial-distance", "3", "--max-distance", "2"),
+         lambda i, o, f: _ground(i, o, "--method", "pmf", "--initial-distance", "3",
+                                 "--max-distance", "2"),
          r"INITIAL_DISTANCE \(3\) must not exceed MAX_DISTANCE \(2\)$"),
     Case("min support above K", lambda i, o, f: [
         "extractroofplanes", "--input", str(_copy(AHN3, i)), "--output-csv", str(o / "p.csv"),
@@ -210,16 +211,22 @@ CASES = [
          r"MIN_SUPPORT \(12\) must not exceed K_NEIGHBOURS \(10\)$"),
     # -- sizes against the data's extent and the free memory, with the figures
     Case("cell larger than the tile",
-         lambda i, o, f: _ground(i, o, "--cell-size", "100", "--max-window", "100"),
-         r"CELL_SIZE: 100 metre is larger than the data's extent \(60 x 59\.99 metre\): give "
-         r"a cell smaller than the extent$"),
-    Case("window larger than the tile", lambda i, o, f: _ground(i, o, "--max-window", "500"),
+         lambda i, o, f: _ground(i, o, "--smrf-cell-size", "100", "--smrf-window", "100"),
+         r"SMRF_CELL_SIZE: 100 metre is larger than the data's extent \(60 x 59\.99 metre\): "
+         r"give a cell smaller than the extent$"),
+    Case("window larger than the tile",
+         lambda i, o, f: _ground(i, o, "--method", "pmf", "--max-window", "500"),
          r"MAX_WINDOW: 500 metre is more than twice the data's extent \(60 x 59\.99 metre\): "
          r"give about the size of the largest building$"),
-    Case("grid too large for the memory", lambda i, o, f: _ground(i, o, "--cell-size", "0.02"),
-         r"CELL_SIZE 0\.02 metre: a grid of 3001 x 3000 cells over 60 x 59\.99 metre needs "
-         r"about 723\.4 MB of memory; 100\.0 MB is free: give a larger cell$",
+    Case("grid too large for the memory",
+         lambda i, o, f: _ground(i, o, "--smrf-cell-size", "0.02"),
+         r"SMRF_CELL_SIZE 0\.02 metre: a grid of 3001 x 3000 cells over 60 x 59\.99 metre "
+         r"needs about 724\.4 MB of memory; 100\.0 MB is free: give a larger cell$",
          patch=_low_memory),
+    Case("a parameter of another method",
+         lambda i, o, f: _ground(i, o, "--method", "csf", "--smrf-threshold", "0.5"),
+         r"SMRF_THRESHOLD: parameter of another method than METHOD csf: set METHOD, or leave "
+         r"it at the default$"),
     Case("RANSAC batch too large", lambda i, o, f: [
         "extractroofplanes", "--input", str(_copy(AHN3, i)), "--output-csv", str(o / "p.csv"),
         "--k-neighbours", "500", "--ransac-iterations", "1000"],

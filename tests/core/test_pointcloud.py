@@ -11,7 +11,7 @@ import numpy as np
 import pyproj
 import pytest
 from lidarphoto.core.errors import Cancelled, CrsError, InputError
-from lidarphoto.core.io.pointcloud import read_info, read_points, write_cloud
+from lidarphoto.core.io.pointcloud import read_cloud, read_info, read_points, write_cloud
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 AHN3 = DATA / "ahn3" / "ahn3_delft_crop60.laz"
@@ -252,3 +252,65 @@ def test_cancel_leaves_no_output(tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["src.laz"]
     with pytest.raises(Cancelled):
         read_points(AHN3, chunk_size=5000, should_stop=lambda: True)
+
+
+# ----------------------------------------------------------------------------- read once, write
+def test_read_cloud_keeps_the_records_and_gives_the_arrays():
+    cloud = read_cloud(AHN3, chunk_size=7000)
+    las = laspy.read(AHN3)
+    assert len(cloud) == len(las.points) and len(cloud.chunks) == 6  # 35231 in 7000s
+    assert cloud.info.has_return_numbers and cloud.info.record_size == 28
+    for name in ("x", "y", "z", "classification", "return_number", "gps_time", "intensity"):
+        np.testing.assert_array_equal(cloud.values(name), np.asarray(las[name]), name)
+    assert cloud.values("x").dtype == np.float64
+    with pytest.raises(InputError, match="height_above_ground"):
+        cloud.values("height_above_ground")
+    isprs = read_cloud(SAMP11)
+    assert not isprs.info.has_return_numbers  # every return number is 0
+
+
+@pytest.mark.parametrize("suffix", [".las", ".laz"])
+def test_copy_from_memory_equals_the_copy_from_the_file(tmp_path, suffix):
+    """write_cloud(points=...) writes what decoding the file again would: the same records,
+    header fields and VLRs, the new classification, and with no extra dimension the same
+    point format (each chunk written as it was read)."""
+    cloud = read_cloud(AHN3, chunk_size=10_000)
+    n = len(cloud)
+    cls = np.random.default_rng(3).integers(0, 20, n).astype(np.uint8)
+    from_file, from_memory = tmp_path / f"f{suffix}", tmp_path / f"m{suffix}"
+    write_cloud(AHN3, from_file, classification=cls)
+    seen = []
+    write_cloud(AHN3, from_memory, classification=cls, points=cloud, progress=seen.append)
+    assert seen == [10_000 / n, 20_000 / n, 30_000 / n, 1.0]
+    a, b = laspy.read(from_file), laspy.read(from_memory)
+    assert b.point_format.id == a.point_format.id == 1 and b.point_format.size == 28
+    np.testing.assert_array_equal(a.points.array, b.points.array)
+    np.testing.assert_array_equal(b.classification, cls)
+    assert [v.record_id for v in a.header.vlrs] == [v.record_id for v in b.header.vlrs]
+    np.testing.assert_allclose(a.header.mins, b.header.mins)
+    assert list(a.header.number_of_points_by_return) == list(b.header.number_of_points_by_return)
+    # an extra dimension changes the point format: copied field by field, chunk by chunk
+    hag = np.linspace(-1, 1, n).astype(np.float32)
+    write_cloud(AHN3, from_memory, extra={"height_above_ground": hag}, points=cloud)
+    c = laspy.read(from_memory)
+    assert c.point_format.id == 1 and list(c.point_format.extra_dimension_names) == [
+        "height_above_ground"
+    ]
+    np.testing.assert_array_equal(c.height_above_ground, hag)
+    np.testing.assert_array_equal(c.gps_time, a.gps_time)
+    assert _leftovers(tmp_path) == []
+
+
+def test_cancel_while_writing_from_memory_leaves_no_output(tmp_path):
+    cloud = read_cloud(AHN3, chunk_size=5000)
+    calls = []
+
+    def stop() -> bool:
+        calls.append(1)
+        return len(calls) > 2
+
+    with pytest.raises(Cancelled):
+        write_cloud(AHN3, tmp_path / "c.laz", points=cloud, should_stop=stop)
+    assert os.listdir(tmp_path) == []
+    with pytest.raises(Cancelled):
+        read_cloud(AHN3, chunk_size=5000, should_stop=lambda: True)

@@ -13,7 +13,11 @@ from lidarphoto.core.errors import Cancelled, CrsError, InputError
 from lidarphoto.core.io.planes import read_planes_csv
 from lidarphoto.core.jobs import extract_roof_planes as roof_planes_job
 from lidarphoto.core.jobs.runner import run_job
-from lidarphoto.core.lidar.roof_planes import RoofPlaneParams, extract_roof_planes
+from lidarphoto.core.lidar.roof_planes import (
+    RoofPlaneParams,
+    _spatial_order,
+    extract_roof_planes,
+)
 from lidarphoto.core.simulation.town import CLASS_GROUND, CLASS_VEGETATION, make_town, sample_town
 from scipy.stats import chi2
 
@@ -110,11 +114,11 @@ def test_reported_precision_matches_scatter_over_noise_draws():
     ratio (scatter of d over draws / mean reported sigma_d^2) is also checked per face with
     chi2(R - 1) bounds.
 
-    Deviation, stated: the extraction attaches eave and ridge points that sit on one side of a
-    plane; only locally planar, unambiguous points are fitted, but a few wall points at the
-    eaves remain, so the normal's scatter exceeds its reported variance by about 1.3x here
-    (fit_plane alone is exact: tests/core/test_planes.py). The normal check therefore allows
-    up to 1.6x (upper bound 1.6 chi2 quantile); sigma_d is checked without allowance.
+    The extraction attaches eave and ridge points that sit on one side of a plane; only
+    locally planar, unambiguous points of a region's interior (every neighbour in the same
+    plane) are fitted. Measured over 160 draws (1120 planes): the normals scatter 1.09x and d
+    1.10x their reported variance (1.21x and 1.12x when the edge points were fitted), within
+    the 10 % asked; the checks below allow no inflation.
     """
     town = make_town(n_buildings=3, roof_types=("gable", "hip", "shed"), n_trees=0, seed=4)
     r = 24
@@ -138,10 +142,7 @@ def test_reported_precision_matches_scatter_over_noise_draws():
             d_by_face[truth.face_id][1].append(plane.sigma_d**2)
     n = len(z2)
     assert chi2.ppf(0.0005, n) < sum(z2) < chi2.ppf(0.9995, n), sum(z2) / n
-    inflation = 1.6
-    assert chi2.ppf(0.0005, 2 * n) < sum(maha) < inflation * chi2.ppf(0.9995, 2 * n), sum(maha) / (
-        2 * n
-    )
+    assert chi2.ppf(0.0005, 2 * n) < sum(maha) < chi2.ppf(0.9995, 2 * n), sum(maha) / (2 * n)
     lo, hi = chi2.ppf([0.0005, 0.9995], r - 1) / (r - 1)
     for face_id, (d, var) in d_by_face.items():
         ratio = np.var(d, ddof=1) / np.mean(var)
@@ -367,3 +368,21 @@ def test_ahn3_delft_building_points_and_plane_purity():
     assert len(run.result.planes) > 30
     rms = np.median([p.rms for p in run.result.planes])
     assert rms < 0.05  # AHN3 roofs: a few cm
+
+
+@pytest.mark.parametrize("n", [150_000, 1_200_000])
+def test_grid_cells_hold_about_a_quarter_of_k_points(n):
+    """The neighbour grid's cells hold about K/4 points wherever there are points, also when
+    the cell is estimated from a sample (n > 200 k: it was sized from the sample's density,
+    so a 1.2 M cloud had cells 6x too full and the search slowed down with the cloud's size).
+    Points on 12 separate 40 m tiles with 10 m gaps, as the benchmark's tiling."""
+    rng = np.random.default_rng(3)
+    tile = rng.integers(0, 12, n)
+    x = rng.uniform(0, 40, n) + 50.0 * (tile % 4)
+    y = rng.uniform(0, 40, n) + 50.0 * (tile // 4)
+    xyz = np.column_stack([x, y, rng.normal(0, 1, n)])
+    k = RoofPlaneParams().k_neighbours
+    _, grid = _spatial_order(xyz, np.zeros(3), k)
+    per_cell = np.diff(grid.start)
+    mean = per_cell[per_cell > 0].mean()
+    assert k / 8 < mean < k / 2, mean

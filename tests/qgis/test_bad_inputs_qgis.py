@@ -59,8 +59,8 @@ def test_cancel_while_writing_leaves_no_temporary(provider, tmp_path):
     ("params", "words"),
     [
         (
-            {"CELL_SIZE": 100.0, "MAX_WINDOW": 100.0},
-            r"CELL_SIZE: 100 metre is larger than the data's extent \(60 x 59\.99 metre\)",
+            {"SMRF_CELL_SIZE": 100.0, "SMRF_WINDOW": 100.0},
+            r"SMRF_CELL_SIZE: 100 metre is larger than the data's extent \(60 x 59\.99 metre\)",
         ),
         (
             {"CRS": "EPSG:31983"},
@@ -68,7 +68,7 @@ def test_cancel_while_writing_leaves_no_temporary(provider, tmp_path):
             r"zone 23S'",
         ),
         (
-            {"INITIAL_DISTANCE": 3.0, "MAX_DISTANCE": 2.0},
+            {"METHOD": 1, "INITIAL_DISTANCE": 3.0, "MAX_DISTANCE": 2.0},
             r"INITIAL_DISTANCE \(3\) must not exceed MAX_DISTANCE \(2\)",
         ),
     ],

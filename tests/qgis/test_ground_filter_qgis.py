@@ -21,20 +21,26 @@ def test_parameters_and_outputs(provider):
     alg = provider.algorithm("groundfilter")
     assert alg.id() == ALG and alg.groupId() == "lidar"
     names = [p.name() for p in alg.parameterDefinitions()]
-    for name in ("INPUT", "CRS", "DISTANCE_UNIT", "CELL_SIZE", "MAX_WINDOW", "SLOPE",
-                 "INITIAL_DISTANCE", "MAX_DISTANCE", "GROUND_THRESHOLD", "OUTPUT_CLOUD",
+    for name in ("INPUT", "CRS", "DISTANCE_UNIT", "METHOD", "SMRF_CELL_SIZE", "SMRF_SLOPE",
+                 "SMRF_WINDOW", "SMRF_THRESHOLD", "CELL_SIZE", "MAX_WINDOW", "SLOPE",
+                 "INITIAL_DISTANCE", "MAX_DISTANCE", "GROUND_THRESHOLD", "CSF_RESOLUTION",
+                 "CSF_RIGIDNESS", "CSF_THRESHOLD", "HEIGHT_ABOVE_GROUND", "OUTPUT_CLOUD",
                  "OUTPUT_DTM"):  # fmt: skip
         assert name in names
     outputs = {o.name() for o in alg.outputDefinitions()}
     assert {"OUTPUT_CLOUD", "OUTPUT_DTM", "GROUND_COUNT", "POINT_COUNT", "UNIT"} <= outputs
     assert alg.parameterDefinition("CELL_SIZE").defaultValue() == 1.0
+    assert alg.parameterDefinition("SMRF_THRESHOLD").defaultValue() == 0.3
+    assert alg.parameterDefinition("METHOD").defaultValue() == 0  # smrf
 
 
 def test_processing_run_writes_cloud_and_dtm(provider, tmp_path):
     cloud, dtm = tmp_path / "ground.laz", tmp_path / "dtm.tif"
     result = processing.run(
-        ALG, {"INPUT": str(AHN3), "OUTPUT_CLOUD": str(cloud), "OUTPUT_DTM": str(dtm)}
-    )
+        ALG,
+        {"INPUT": str(AHN3), "OUTPUT_CLOUD": str(cloud), "OUTPUT_DTM": str(dtm),
+         "HEIGHT_ABOVE_GROUND": True},
+    )  # fmt: skip
     src, out = laspy.read(AHN3), laspy.read(cloud)
     assert result["POINT_COUNT"] == len(src.points)
     assert result["UNIT"] == "metre"
