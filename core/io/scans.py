@@ -149,8 +149,9 @@ def write_registered_scan(
     LAS/LAZ sources are streamed in chunks of ``chunk_size`` points, keeping every dimension,
     the point format, the scales and the VLRs; the offsets become the registered position of
     the scanner's origin in whole metres. PLY and E57 scans are read whole and written as
-    point format 0 (1 with intensity, scaled to 0-65535) with scales of 0.1 mm. ``dst`` is written directly: the
-    caller makes it atomic (a temporary of :class:`~core.io.atomic.OutputSet`).
+    point format 0 (1 with intensity, scaled to 0-65535) with scales of 0.1 mm. ``dst`` is
+    written directly: the caller makes it atomic (a temporary of
+    :class:`~core.io.atomic.OutputSet`).
     """
     import laspy
 
