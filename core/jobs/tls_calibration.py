@@ -66,7 +66,9 @@ Registered clouds (optional): SCANS are the stations' scans (LAS/LAZ, PLY, E57; 
 the scanner frame; the station id is the file name without its suffix, as in Extract TLS
 targets). Each is written to OUTPUT_FOLDER as <station_id>_registered.laz (LAZ scans) or
 .las (the others) with its points in the common frame, X = M' d + X0 with the adjusted
-pose (the frame of the control, or the datum above). With APs estimated and APPLY APS on,
+pose: the control's frame; without control the reference station's (its pose in the stations
+table, else the origin unrotated), held exactly (DATUM reference) or on average over the
+targets (inner constraints). With APs estimated and APPLY APS on,
 each point's recorded polar coordinates are corrected by the estimated APs before the
 pose is applied, taken as face-I readings (elevation within +-90 deg): turn it off for
 scans that mix both faces (a panoramic scanner's second half-turn), which then get the

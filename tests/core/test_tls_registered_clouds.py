@@ -212,3 +212,28 @@ def test_scan_of_an_unknown_station_is_refused(field, tmp_path):
     with pytest.raises(InputError, match="needs SCANS"):
         _run(field, tmp_path, SCANS=None)
     assert not (tmp_path / "reg").exists() and not (tmp_path / "s.csv").exists()
+
+
+def test_reference_station_datum_without_control(field, tmp_path):
+    """No control, DATUM reference: the frame is the reference station's (the first of the
+    stations table with a position, held at its given pose), as documented; with the true
+    pose of S1 given, the registered points lie on the true spheres again."""
+    _, _, t2, scene, sims = field
+    table = tmp_path / "stations.csv"
+    p = [float(x) for x in t2.poses[0]]
+    rows = [f"S1,{p[0]!r},{p[1]!r},{p[2]!r},{math.degrees(p[3])!r},{math.degrees(p[4])!r},"
+            f"{math.degrees(p[5])!r},0"]
+    rows += [f"{s},,,,,,,0" for s in t2.station_ids[1:]]
+    table.write_text("station_id,X,Y,Z,omega_deg,phi_deg,kappa_deg,levelled\n"
+                     + "\n".join(rows) + "\n", encoding="utf-8")  # fmt: skip
+    _run(field, tmp_path, CONTROL=None, DATUM="reference", STATIONS=str(table))
+    st = _stations(tmp_path / "s.csv")
+    assert all(float(st["S1"][f"s_{c}"]) == 0.0 for c in "XYZ")  # held by the datum
+    for k, sid in enumerate(t2.station_ids):
+        name = f"{sid}_registered" + (".laz" if k == 0 else ".las")
+        las = laspy.read(str(tmp_path / "reg" / name))
+        dist = _surface_distance(np.column_stack([las.x, las.y, las.z]), sims[sid], scene)
+        # the other stations' sigmas relative to S1 (up to about 0.5 mm in this network)
+        s_pos = math.sqrt(sum(float(st[sid][f"s_{c}"]) ** 2 for c in "XYZ"))
+        assert abs(float(np.mean(dist))) < 3 * s_pos + 0.1e-3, (sid, np.mean(dist))
+        assert float(np.sqrt(np.mean(dist**2))) < 1.5 * S_RANGE + 3 * s_pos, sid
