@@ -7,10 +7,17 @@ none). PLY: ASCII or binary (little or big endian) with a ``vertex`` element hol
 and optionally ``intensity`` or ``scalar_intensity``. E57: the first scan of the file, with
 its pose applied only if the user asks (we read the raw scanner-frame points), through the
 optional ``pye57`` package.
+
+Registered scans (:func:`write_registered_scan`) are written as LAS/LAZ through laspy: a
+LAS/LAZ scan chunk by chunk with every dimension and VLR kept, a PLY or E57 scan as LAS
+point format 0 (1 with intensity) at 0.1 mm resolution.
 """
 
 from __future__ import annotations
 
+import os
+from collections.abc import Callable
+from copy import deepcopy
 from pathlib import Path
 
 import numpy as np
@@ -19,9 +26,11 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from .tables import PathLike
 
-__all__ = ["SCAN_SUFFIXES", "read_scan"]
+__all__ = ["SCAN_SUFFIXES", "read_scan", "write_registered_scan"]
 
 SCAN_SUFFIXES = (".las", ".laz", ".ply", ".e57")
+#: (N, 3) scanner-frame points (m) -> (N, 3) object-frame points (m).
+Transform = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 _PLY_TYPES = {
     "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",
     "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
@@ -117,3 +126,81 @@ def read_scan(path: PathLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]
         xyz = np.column_stack([data["cartesianX"], data["cartesianY"], data["cartesianZ"]])
         return xyz.astype(np.float64), _normalise(data.get("intensity"), len(xyz))
     raise InputError(f"unknown scan format {suffix!r} (LAS, LAZ, PLY or E57)", path=str(p))
+
+
+def _new_offsets(transform: Transform) -> NDArray[np.float64]:
+    """Offsets of the registered file: where the scanner's origin goes, rounded to a metre (the
+    scan lies within a few km of it: inside the int32 range even at 0.1 mm)."""
+    origin = np.asarray(transform(np.zeros((1, 3))), dtype=np.float64)[0]
+    return np.round(origin) if np.all(np.isfinite(origin)) else np.zeros(3)
+
+
+def write_registered_scan(
+    src: PathLike,
+    dst: PathLike,
+    transform: Transform,
+    *,
+    chunk_size: int = 1_000_000,
+    should_stop: Callable[[], bool] | None = None,
+) -> int:
+    """Write scan ``src`` to ``dst`` (.las or .laz) with its points mapped by ``transform``
+    ((N, 3) scanner-frame metres -> (N, 3) object-frame metres); the number of points.
+
+    LAS/LAZ sources are streamed in chunks of ``chunk_size`` points, keeping every dimension,
+    the point format, the scales and the VLRs; the offsets become the registered position of
+    the scanner's origin in whole metres. PLY and E57 scans are read whole and written as
+    point format 0 (1 with intensity, scaled to 0-65535) with scales of 0.1 mm. ``dst`` is
+    written directly: the caller makes it atomic (a temporary of
+    :class:`~core.io.atomic.OutputSet`).
+    """
+    import laspy
+
+    from ..errors import stop_if_asked
+    from .pointcloud import _check_record_count, _laz_backend, _open
+
+    p, out = Path(src), os.fspath(dst)
+    compress = out.lower().endswith(".laz")
+    suffix = p.suffix.lower()
+    if suffix not in (".las", ".laz"):
+        xyz, intensity = read_scan(p)
+        reg = np.asarray(transform(xyz), dtype=np.float64)
+        has_i = bool(np.isfinite(intensity).any())
+        header = laspy.LasHeader(point_format=1 if has_i else 0, version="1.2")
+        header.scales = np.full(3, 0.0001)
+        header.offsets = _new_offsets(transform)
+        las = laspy.LasData(header)
+        las.x, las.y, las.z = reg[:, 0], reg[:, 1], reg[:, 2]
+        if has_i:
+            las.intensity = np.round(np.nan_to_num(intensity) * 65535).astype(np.uint16)
+        las.write(out, do_compress=compress, laz_backend=_laz_backend())
+        return len(reg)
+    if not p.is_file():
+        raise InputError("file not found", path=str(p))
+    n = 0
+    with _open(str(p)) as reader:
+        _check_record_count(str(p), reader.header)
+        header = deepcopy(reader.header)
+        header.offsets = _new_offsets(transform)
+        writer = None
+        try:
+            for chunk in reader.chunk_iterator(max(int(chunk_size), 1)):
+                stop_if_asked(should_stop, f"registering {p.name}")
+                xyz = np.column_stack([np.asarray(chunk.x), np.asarray(chunk.y),
+                                       np.asarray(chunk.z)]).astype(np.float64)  # fmt: skip
+                reg = np.asarray(transform(xyz), dtype=np.float64)
+                if writer is None:
+                    writer = laspy.open(out, mode="w", header=header, do_compress=compress,
+                                        laz_backend=_laz_backend())  # fmt: skip
+                rec = laspy.ScaleAwarePointRecord.zeros(len(reg), header=writer.header)
+                for name in chunk.point_format.dimension_names:
+                    if name not in ("X", "Y", "Z"):
+                        rec[name] = chunk[name]
+                rec.x, rec.y, rec.z = reg[:, 0], reg[:, 1], reg[:, 2]
+                writer.write_points(rec)
+                n += len(reg)
+        finally:
+            if writer is not None:
+                writer.close()
+    if n == 0:
+        raise InputError("the scan holds no points", path=str(p))
+    return n

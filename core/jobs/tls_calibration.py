@@ -2,13 +2,15 @@
 
 Outputs: the adjusted station poses with sigmas, the additional parameters (APs) with sigmas
 and significance, the target coordinates, the residuals per component (docs/conventions.md,
-"TLS tables") and an HTML report with the correlation matrix.
+"TLS tables"), an HTML report with the correlation matrix and, optionally, the scans written
+into the common frame (:data:`REGISTERED_NAME` in OUTPUT_FOLDER).
 """
 
 from __future__ import annotations
 
 import logging
 import math
+from pathlib import Path
 
 from ..tls.aps import AP_SETS, ARCSEC
 from ..tls.options import CalibrationOptions
@@ -24,6 +26,9 @@ DATUMS = ("inner", "reference")
 #: A median disagreement of target-to-target distances between stations beyond this
 #: (relative) is not a scanner error but a wrong angle unit or convention.
 MAX_DISTANCE_DISAGREEMENT = 0.005
+#: Name of station ``<station_id>``'s registered scan in OUTPUT_FOLDER (its suffix: .laz for
+#: a LAZ scan, .las for the others).
+REGISTERED_NAME = "{}_registered{}"
 
 SPEC = AlgorithmSpec(
     name="tlscalibration",
@@ -55,7 +60,20 @@ The report gives sigma0 and the global test, Baarda's data snooping, each AP's t
 correlation matrix of APs and station parameters with the strongly correlated pairs named and
 the network design that separates them (Lichti 2010: targets over the full vertical range,
 two faces, stations tilted by 90 degrees). SELECT APS removes correlated and insignificant
-terms one by one. A parameter the network cannot determine is an error that says why.""",
+terms one by one. A parameter the network cannot determine is an error that says why.
+
+Registered clouds (optional): SCANS are the stations' scans (LAS/LAZ, PLY, E57; points in
+the scanner frame; the station id is the file name without its suffix, as in Extract TLS
+targets). Each is written to OUTPUT_FOLDER as <station_id>_registered.laz (LAZ scans) or
+.las (the others) with its points in the common frame, X = M' d + X0 with the adjusted
+pose: the control's frame; without control the reference station's (its pose in the stations
+table, else the origin unrotated), held exactly (DATUM reference) or on average over the
+targets (inner constraints). With APs estimated and APPLY APS on,
+each point's recorded polar coordinates are corrected by the estimated APs before the
+pose is applied, taken as face-I readings (elevation within +-90 deg): turn it off for
+scans that mix both faces (a panoramic scanner's second half-turn), which then get the
+rigid pose only. LAS/LAZ scans are streamed in chunks (every dimension and VLR kept);
+PLY/E57 scans are read whole. All files appear together or none (a bad scan: none).""",
     params=(
         Param("OBSERVATIONS", "file", "Observations (CSV)", file_filter=CSV_FILTER),
         Param("CONTROL", "file", "Control targets (CSV)", optional=True, file_filter=CSV_FILTER),
@@ -91,6 +109,10 @@ terms one by one. A parameter the network cannot determine is an error that says
         Param("SNOOPING", "boolean", "Data snooping (Baarda)", _D.snooping),
         Param("CORRELATION_LIMIT", "number", "Strong correlation at |r| >=",
               _D.correlation_limit, minimum=0.1, maximum=1.0, advanced=True),
+        Param("SCANS", "files", "Scans to register (LAS/LAZ, PLY, E57; one station per file)",
+              optional=True, help="the file name without its suffix is the station id"),
+        Param("APPLY_APS", "boolean", "Correct the scan points by the estimated APs", True,
+              help="face-I readings; off: the rigid pose only"),
         Param("OUTPUT_STATIONS", "file_out", "Station poses (CSV)", file_filter=CSV_OUT),
         Param("OUTPUT_APS", "file_out", "Additional parameters (CSV)", file_filter=CSV_OUT),
         Param("OUTPUT_TARGETS", "file_out", "Target coordinates (CSV)", optional=True,
@@ -98,9 +120,12 @@ terms one by one. A parameter the network cannot determine is an error that says
         Param("OUTPUT_RESIDUALS", "file_out", "Residuals (CSV)", optional=True,
               create_by_default=False, file_filter=CSV_OUT),
         Param("OUTPUT_HTML", "file_out", "Report (HTML)", file_filter="HTML files (*.html)"),
+        Param("OUTPUT_FOLDER", "folder_out", "Registered scans (folder)", optional=True,
+              create_by_default=False, help="needs SCANS"),
     ),
     results=(
         Result("SIGMA0", "number", "Sigma0 a-posteriori"),
+        Result("REGISTERED", "number", "Registered scans written"),
         Result("REJECTED", "number", "Observations rejected"),
         Result("APS", "string", "Additional parameters estimated"),
     ),
@@ -128,11 +153,18 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..tls.calibration import calibrate
     from ..tls.network import distance_consistency
 
+    scans = _check_scans(v)
     s_range_mm, s_hz, s_vt = v.default_sigmas
     obs = read_tls_observations_csv(v.observations, v.angle_unit,
                                     (s_range_mm / 1000.0, s_hz, s_vt))  # fmt: skip
     control = read_tls_control_csv(v.control) if v.control else []
     stations = read_tls_stations_csv(v.stations) if v.stations else []
+    if scans:
+        observed = set(obs.station)
+        for f in scans:
+            if f.stem not in observed:
+                raise InputError(f"SCANS: the scan's station '{f.stem}' (its file name) has "
+                                 f"no observations in {v.observations}", path=str(f))  # fmt: skip
     if stations:
         listed = {s.id for s in stations}
         for k, s in enumerate(obs.station):
@@ -194,6 +226,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         write_tls_residuals_csv(out.path("OUTPUT_RESIDUALS"), cal)
     if out.requested("OUTPUT_HTML"):
         write_text_atomic(out.path("OUTPUT_HTML"), render_tls_html(cal, settings))
+    registered = _write_registered(v, scans, cal, out, should_stop) if scans else []
     lines = [f"{'AP':4} {'value':>10} {'sigma':>9} unit    t"]
     for a in cal.ap_report():
         lines.append(f"{a['name']:4} {a['value']:10.3f} {a['std']:9.3f} {a['unit']:7} "
@@ -202,12 +235,65 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         lines.append(f"removed {s.removed}: {s.reason}")
     for a, b, r in cal.strong_pairs[:5]:
         lines.append(f"strong correlation {a} / {b}: {r:+.3f}")
+    for path, n in registered:
+        lines.append(f"registered scan {path}: {n} points")
     test = "passed" if cal.chi2_passed else "failed"
     lines.append(f"sigma0 {cal.sigma0:.3f}, redundancy {cal.adjustment.redundancy}, global "
                  f"test {test}, {int(cal.rejected.sum())} observations rejected")  # fmt: skip
     return JobResult(
         results={"SIGMA0": cal.sigma0, "REJECTED": int(cal.rejected.sum()),
-                 "APS": ",".join(cal.ap_names)},
+                 "APS": ",".join(cal.ap_names), "REGISTERED": len(registered)},
         lines=lines,
         data=cal,
     )  # fmt: skip
+
+
+def _check_scans(v: Values) -> list[Path]:
+    """The scan files (folders expanded), checked before anything is computed."""
+    from ..errors import InputError
+    from .extract_tls_targets import _scan_files
+
+    if not v.scans:
+        if v.output_folder:
+            raise InputError("OUTPUT_FOLDER (registered scans) needs SCANS")
+        return []
+    if not v.output_folder:
+        raise InputError("SCANS are given but no OUTPUT_FOLDER to write them registered to")
+    files = _scan_files(v.scans)
+    for f in files:
+        if not f.is_file():
+            raise InputError("file not found", path=str(f))
+    return files
+
+
+def _write_registered(v: Values, scans, cal, out, should_stop) -> list[tuple[str, int]]:
+    """Every scan in the common frame, written together (all or none); (path, points)."""
+    from functools import partial
+
+    from ..io.atomic import OutputSet
+    from ..io.scans import write_registered_scan
+    from ..tls.registration import scanner_to_object
+
+    folder = Path(v.output_folder)
+    targets = {}
+    for f in scans:
+        suffix = ".laz" if f.suffix.lower() == ".laz" else ".las"
+        targets[f.stem] = folder / REGISTERED_NAME.format(f.stem, suffix)
+    inputs = {"SCANS": [str(f) for f in scans], "OBSERVATIONS": v.observations,
+              "CONTROL": v.control, "STATIONS": v.stations}  # fmt: skip
+    # outputs of this run are inputs too here: no scan may overwrite a table just written
+    inputs.update({k: str(out.target(k)) for k in ("OUTPUT_STATIONS", "OUTPUT_APS",
+                   "OUTPUT_TARGETS", "OUTPUT_RESIDUALS", "OUTPUT_HTML") if out.requested(k)})
+    at = {s: k for k, s in enumerate(cal.stations)}
+    names = cal.ap_names if v.apply_aps else ()
+    written = []
+    with OutputSet({k: str(p) for k, p in targets.items()}, inputs) as files:
+        for f in scans:
+            transform = partial(scanner_to_object, pose=cal.pose[at[f.stem]], names=names,
+                                values=cal.ap, wavelength_m=cal.options.cyclic_wavelength_m)
+            n = write_registered_scan(f, files.path(f.stem), transform,
+                                      should_stop=should_stop)  # fmt: skip
+            log.info("%s: %d points registered to %s", f.name, n, targets[f.stem])
+            written.append((str(targets[f.stem]), n))
+        files.commit()
+    return written

@@ -128,3 +128,69 @@ def test_extract_targets_qgis_process(qp_env, ply_scans, tmp_path):
     )  # fmt: skip
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
     _check_targets(out, json.loads(r.stdout)["results"]["TARGETS"])
+
+
+@pytest.fixture(scope="module")
+def las_field(tmp_path_factory):
+    """Room network (no APs): target-centre observations, control and three LAS/LAZ scans."""
+    from dataclasses import replace
+
+    import laspy
+    import numpy as np
+    from lidarphoto.core.simulation.tls import room_network, scene_from_network, simulate_scan
+
+    folder = tmp_path_factory.mktemp("reg")
+    scene, t2 = scene_from_network(room_network(aps={}), kind="sphere")
+    keep = np.arange(0, len(t2.target_ids), 5)
+    scene = replace(scene, sphere_ids=tuple(scene.sphere_ids[i] for i in keep),
+                    sphere_xyz=scene.sphere_xyz[keep])  # fmt: skip
+    t2 = replace(t2, target_ids=scene.sphere_ids, target_xyz=scene.sphere_xyz)
+    obs, _ = observe(t2, *SCANNER_CLASSES["high_end"], rng=8)
+    write_tls_observations_csv(folder / "obs.csv", obs)
+    write_tls_control_csv(folder / "control.csv", t2.control())
+    paths, sims = [], []
+    for k in range(3):
+        s = simulate_scan(scene, t2, k, spacing_m=0.006, rng=40 + k)
+        header = laspy.LasHeader(point_format=0, version="1.2")
+        header.scales, header.offsets = np.full(3, 0.0001), np.zeros(3)
+        las = laspy.LasData(header)
+        las.x, las.y, las.z = s.xyz[:, 0], s.xyz[:, 1], s.xyz[:, 2]
+        p = folder / f"{t2.station_ids[k]}{'.laz' if k == 0 else '.las'}"
+        las.write(str(p))
+        paths.append(str(p))
+        sims.append(s)
+    return folder, paths, t2, scene, sims
+
+
+def test_registered_scans_processing_run(provider, las_field, tmp_path):
+    import laspy
+    import numpy as np
+
+    folder, paths, t2, scene, sims = las_field
+    res = processing.run(ALG, {
+        "OBSERVATIONS": str(folder / "obs.csv"), "CONTROL": str(folder / "control.csv"),
+        "LEVELLED": False, "AP_SET": 0, "SCANS": paths, "OUTPUT_FOLDER": str(tmp_path / "reg"),
+        "OUTPUT_STATIONS": str(tmp_path / "s.csv"), "OUTPUT_APS": str(tmp_path / "a.csv"),
+        "OUTPUT_HTML": str(tmp_path / "r.html"),
+    })  # fmt: skip
+    assert res["REGISTERED"] == 3 and res["OUTPUT_FOLDER"] == str(tmp_path / "reg")
+    for k, s in enumerate(sims):
+        name = f"{t2.station_ids[k]}_registered{'.laz' if k == 0 else '.las'}"
+        las = laspy.read(str(tmp_path / "reg" / name))
+        xyz = np.column_stack([las.x, las.y, las.z])
+        on = s.label >= 0
+        dist = np.linalg.norm(xyz[on] - scene.sphere_xyz[s.label[on]], axis=1) - scene.radius
+        # 1 mm point noise, stations from 1.2 mm / 8" target centres: on the true spheres
+        assert abs(float(np.mean(dist))) < 0.5e-3
+        assert float(np.sqrt(np.mean(dist**2))) < 1.5e-3
+
+
+def test_registered_scans_need_a_folder(provider, las_field, tmp_path):
+    folder, paths, *_ = las_field
+    with pytest.raises(QgsProcessingException, match="no OUTPUT_FOLDER"):
+        processing.run(ALG, {
+            "OBSERVATIONS": str(folder / "obs.csv"), "SCANS": paths,
+            "OUTPUT_STATIONS": str(tmp_path / "s.csv"), "OUTPUT_APS": str(tmp_path / "a.csv"),
+            "OUTPUT_HTML": str(tmp_path / "r.html"),
+        })  # fmt: skip
+    assert not any(tmp_path.iterdir())
