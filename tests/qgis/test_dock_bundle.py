@@ -70,6 +70,9 @@ def test_bundle_from_the_dock_recovers_the_orientations(
     assert np.all(np.abs(dopk) < 4 * s[:, 3:]), (np.degrees(dopk), np.degrees(s[:, 3:]))
     assert np.all(s[:, 2] < 3.0) and np.all(np.degrees(s[:, 5]) < 0.2), s
     assert 0.7 < res.adjustment.sigma0 < 1.3
+    # measured: within 1.87 sigma; sigma up to 20 m in X, 8 m in Y (X-phi, Y-omega: 6 LCPs
+    # on roofs of similar height), 1.5 m in Z, 0.002 deg in kappa; sigma0 0.991; image RMS
+    # 0.25-0.46 px per coordinate
     # the LCPs as control with their table's covariance (not the layer's default 2 cm)
     table = {str(c.id): c for c in read_lcps_csv(block["paths"]["lcps"])}
     ground = dock.bundle.inputs.ground
@@ -89,7 +92,7 @@ def test_bundle_from_the_dock_recovers_the_orientations(
     shown = dock.session.shown_residuals()
     used = {k for k, o in enumerate(rows) if o.type in ("tie", "lcp")}
     assert set(shown) <= used and len(shown) >= len(used) - int(res.rejected.sum())
-    dock.show_image(truth.image_id[2])
+    assert dock.current_image in truth.image_id
     assert _wait(qgis_app, lambda: dock.viewer.overlays.counts["residuals"] > 0, 10.0)
     dock.close()
 
