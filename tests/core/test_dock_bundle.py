@@ -107,8 +107,8 @@ def test_converted_rows_adjust_to_the_true_orientations(flight):
     rng = np.random.default_rng(15)
     start = replace(eo, xyz=eo.xyz + rng.choice([-10.0, 10.0], eo.xyz.shape),
                     opk=eo.opk + np.radians(rng.choice([-1.0, 1.0], eo.opk.shape)))  # fmt: skip
-    res = bundle_adjust([cam], b.observations, b.ground, frame, start,
-                        options=BundleOptions(ap_model="none", estimate_interior=False))  # fmt: skip
+    opts = BundleOptions(ap_model="none", estimate_interior=False)
+    res = bundle_adjust([cam], b.observations, b.ground, frame, start, options=opts)
     s = res.eo_sigma
     dopk = (res.eo.opk - eo.opk + np.pi) % (2 * np.pi) - np.pi
     assert np.all(np.abs(res.eo.xyz - eo.xyz) < 4 * s[:, :3])
