@@ -128,3 +128,33 @@ def test_converted_rows_adjust_to_the_true_orientations(flight):
         == (noisy.image_id[k], noisy.point_id[k])
     )  # fmt: skip
     np.testing.assert_array_equal(by_row[k], res.v_px[j])
+
+
+def test_session_keeps_the_bundle_residuals_on_their_rows(flight):
+    """The picking session shows the bundle's residual on each adjusted row; after a row is
+    deleted the residuals follow their rows (new indices), and a resection run earlier is
+    forgotten."""
+    from lidarphoto.core.photo.observation_list import ObservationList
+    from lidarphoto.core.photo.picking_session import PickingSession
+
+    sim, cam, frame, eo, noisy = flight
+    lcps = sim.lcps + sim.check_lcps
+    b = dock_bundle_inputs(noisy, lcps, [str(c.id) for c in lcps])
+    opts = BundleOptions(ap_model="none", estimate_interior=False)
+    res = bundle_adjust([cam], b.observations, b.ground, frame, eo, options=opts)
+    session = PickingSession(ObservationList(ObservationList.rows_of(noisy)))
+    session.set_resection([("x", "C1", "lcp", "1", 0, 0, 0, 9.0, 9.0, 9.0, 0, False, True)])
+    session.set_bundle(res)
+    assert session.resection_rows == []
+    shown = session.shown_residuals()
+    expected = residuals_by_row(res, noisy)
+    assert shown.keys() == expected.keys() and len(shown) > 100
+    first = min(shown)
+    session.observations.delete(first)
+    after = session.shown_residuals()
+    assert len(after) == len(shown) - 1
+    for k, v in shown.items():
+        if k > first:
+            np.testing.assert_array_equal(after[k - 1], v)
+    session.set_bundle(None)
+    assert session.shown_residuals() == {}
