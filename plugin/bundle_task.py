@@ -38,13 +38,20 @@ def _spec_param(name: str):
 
 
 def bundle_parameters(
-    out_dir: Path, camera: str, crs: str, ap_model: str, interior: bool, eo_observed: bool
+    out_dir: Path,
+    camera: str,
+    crs: str,
+    ap_model: str,
+    interior: bool,
+    eo_observed: bool,
+    ground: bool = True,
 ) -> dict:
-    """Parameters of the core job ``bundleadjustment`` on the tables written to ``out_dir``."""
+    """Parameters of the core job ``bundleadjustment`` on the tables written to ``out_dir``
+    (``ground``: there are control or check points)."""
     return {
         "CAMERA": camera,
         "OBSERVATIONS": str(out_dir / "observations.csv"),
-        "GROUND_POINTS": str(out_dir / "ground_points.csv"),
+        "GROUND_POINTS": str(out_dir / "ground_points.csv") if ground else None,
         "EO": str(out_dir / "eo_input.csv"),
         "EO_SIGMAS": list(DEFAULT_EO_SIGMAS) if eo_observed else None,
         "CRS": crs,
@@ -166,7 +173,8 @@ class _Task(QgsTask):
         try:
             Path(self.params["OUTPUT_EO"]).parent.mkdir(parents=True, exist_ok=True)
             write_observations_csv(self.params["OBSERVATIONS"], self.inputs.observations)
-            write_ground_points_csv(self.params["GROUND_POINTS"], self.inputs.ground)
+            if self.params["GROUND_POINTS"]:
+                write_ground_points_csv(self.params["GROUND_POINTS"], self.inputs.ground)
             write_eo_csv(self.params["EO"], self.eo)
             self.result = run_job(
                 bundle_adjustment,
@@ -273,6 +281,7 @@ class BundleController(QObject):
             self.panel.ap_model(),
             self.panel.interior_check.isChecked(),
             self.panel.eo_check.isChecked(),
+            len(inputs.ground) > 0,
         )
         self.params, self.inputs, self.result, self.error, self.text = params, inputs, None, "", ""
         self.panel.set_running(True)

@@ -17,6 +17,7 @@ import numpy as np
 from lidarphoto.core.io.control import read_lcps_csv
 from lidarphoto.core.io.observations import read_observations_csv, write_observations_csv
 from lidarphoto.core.io.orientation import read_eo_csv, write_eo_csv
+from lidarphoto.core.photo.dock_bundle import DEFAULT_EO_SIGMAS
 from qgis.PyQt.QtCore import Qt
 from qgis.PyQt.QtTest import QTest
 from test_image_dock import _dock, _wait, block, layers  # noqa: F401 - fixtures
@@ -110,7 +111,8 @@ def test_bundle_refused_without_a_block(qgis_parent, qgis_app, block, layers, tm
 
 def test_bundle_job_error_shown(qgis_parent, qgis_app, block, layers, tmp_path):
     """A block the job refuses (tie points only: no control, no observed EO, no datum) shows
-    the job's own error in the panel; nothing raises."""
+    the job's own error in the panel; nothing raises. With the dock's orientations as
+    observations (the checkbox) the same rows adjust, the truth within 4 sigma."""
     measured = read_observations_csv(block["dir"] / "measured.csv")
     write_observations_csv(tmp_path / "ties.csv", measured.subset(measured.mask("tie")))
     dock = _dock(qgis_parent, qgis_app, block, layers, tmp_path, obs_name="ties.csv")
@@ -122,4 +124,15 @@ def test_bundle_job_error_shown(qgis_parent, qgis_app, block, layers, tmp_path):
     text = dock.bundle_panel.result_label.text()
     assert text.startswith("Bundle adjustment failed.") and dock.bundle.error in text
     assert dock.bundle.error and dock.bundle.result is None
+    assert "the datum needs three or more control points" in dock.bundle.error
+    # the dock's (true) orientations as observations give the datum: the same block runs
+    dock.bundle_panel.eo_check.setChecked(True)
+    done.clear()
+    assert dock.run_bundle()
+    assert _wait(qgis_app, lambda: bool(done), 120.0)
+    assert done == [True], dock.bundle.error
+    assert dock.bundle.params["EO_SIGMAS"] == list(DEFAULT_EO_SIGMAS)
+    res, truth = dock.bundle.result, read_eo_csv(block["eo"])
+    assert np.all(np.abs(res.eo.xyz - truth.xyz) < 4 * res.eo_sigma[:, :3])
+    assert np.all(res.eo_sigma[:, :3] <= DEFAULT_EO_SIGMAS[0] + 1e-9)  # never worse than given
     dock.close()
