@@ -25,7 +25,12 @@ from qgis.PyQt.QtWidgets import QCheckBox, QComboBox, QFormLayout, QLabel, QPush
 from ..core.errors import Cancelled
 from ..core.jobs import bundle_adjustment
 from ..core.jobs.runner import JobResult, run_job
-from ..core.photo.dock_bundle import DEFAULT_EO_SIGMAS, DockBundleInputs, dock_bundle_inputs
+from ..core.photo.dock_bundle import (
+    DEFAULT_EO_SIGMAS,
+    DockBundleInputs,
+    dock_bundle_inputs,
+    orientations_of,
+)
 
 __all__ = ["BUNDLE_ALG", "BundleController", "BundlePanel", "bundle_parameters"]
 
@@ -260,18 +265,7 @@ class BundleController(QObject):
                     "image(s); a block needs two or more. {}"
                 ).format(len(inputs.images), inputs.left_out_text())
             )
-        eo = session.eo
-        keep = [list(eo.image_id).index(i) for i in inputs.images]
-        from dataclasses import replace
-
-        eo = replace(
-            eo,
-            image_id=tuple(eo.image_id[k] for k in keep),
-            time=eo.time[keep],
-            group=tuple(eo.group[k] for k in keep),
-            xyz=eo.xyz[keep],
-            opk=eo.opk[keep],
-        )
+        eo = orientations_of(session.eo, inputs.images)
         crs = dock.eo_crs()
         out_dir = store.path.with_name(store.path.stem + "_bundle")
         params = bundle_parameters(

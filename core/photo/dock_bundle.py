@@ -23,7 +23,7 @@ them:
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 from ..lidar.control import ControlPoint
 from .bundle import DEFAULT_CONTROL_SIGMA_M, GroundPoints
 from .observations import ImageObservations
+from .orientation import ExteriorOrientationTable
 
 if TYPE_CHECKING:
     from .bundle import BundleResult
@@ -41,6 +42,7 @@ __all__ = [
     "MIN_CONTROL_SIGMA_M",
     "DockBundleInputs",
     "dock_bundle_inputs",
+    "orientations_of",
     "residuals_by_row",
 ]
 
@@ -200,3 +202,27 @@ def residuals_by_row(
         if vk is not None:
             out[i] = vk.copy()
     return out
+
+
+def orientations_of(
+    eo: ExteriorOrientationTable, images: Sequence[str]
+) -> ExteriorOrientationTable:
+    """The rows of ``images`` (in that order) of an orientation table (the bundle refuses an
+    image without measurements).
+
+    >>> t = ExteriorOrientationTable(("a", "b", "c"), np.arange(3.0), ("g",) * 3,
+    ...                              np.arange(9.0).reshape(3, 3), np.zeros((3, 3)), "")
+    >>> s = orientations_of(t, ["c", "a"])
+    >>> s.image_id, s.xyz[:, 0].tolist(), s.time.tolist()
+    (('c', 'a'), [6.0, 0.0], [2.0, 0.0])
+    """
+    where = {im: k for k, im in enumerate(eo.image_id)}
+    keep = np.array([where[i] for i in images], dtype=np.intp)
+    return replace(
+        eo,
+        image_id=tuple(eo.image_id[k] for k in keep),
+        time=np.asarray(eo.time)[keep],
+        group=tuple(eo.group[k] for k in keep),
+        xyz=eo.xyz[keep],
+        opk=eo.opk[keep],
+    )
