@@ -10,7 +10,8 @@ by :class:`.overlays.Overlays` (:mod:`.picking_controller`).
 
 Modules: :mod:`.project_panel` (Project tab), :mod:`.calibration_panel` (Calibration tab),
 :mod:`.calibration_task` (the core calibration job in a QgsTask), :mod:`.resection_task` (the
-Resection tab: the core resection job of the image shown in a QgsTask), :mod:`.viewer_panel`
+Resection tab: the core resection job of the image shown in a QgsTask), :mod:`.bundle_task`
+(the Bundle tab: the core bundle adjustment of the open images in a QgsTask), :mod:`.viewer_panel`
 (tools, image view, status), :mod:`.observation_table`, :mod:`.picking_controller` (clicks,
 image lines and drawing), :mod:`.monoplot_control` (the Monoplot button and its DSM),
 :mod:`.footprint` (the image's footprint on the map canvas), :mod:`.observation_store`
@@ -30,6 +31,7 @@ from qgis.PyQt.QtWidgets import QLabel, QSplitter, QTabWidget, QVBoxLayout, QWid
 
 from ..core.photo.picking import PickingScene
 from ..core.photo.picking_session import PICK_TYPES, PickingSession
+from .bundle_task import BundleController, BundlePanel
 from .calibration_panel import CALIBRATION_ALG, CalibrationPanel
 from .calibration_task import CalibrationController
 from .footprint import CanvasFootprint
@@ -55,7 +57,8 @@ DOCK_HELP = (
     "the first (drawn solid while measuring; Esc cancels, Ctrl+Z removes both ends; the "
     "Resection tab can refine the ends onto the image's edge); "
     "<i>lcp</i>/<i>check</i> take the nearest control point. <b>Resect</b> (Resection tab) "
-    "orients the image shown from its lines and control points. "
+    "orients the image shown from its lines and control points; <b>Bundle</b> (Bundle tab) "
+    "adjusts the open images from their tie, control (lcp) and check points. "
     "After a tie point the other images show its prediction (yellow x): Enter accepts it, a "
     "click puts it where you see it, Esc drops it.<br>"
     "<b>Monoplot</b> (needs a DSM in the Project tab): while the button is on, a click makes a "
@@ -74,6 +77,7 @@ class ImagePickingDock(QgsDockWidget):
     imageChanged = pyqtSignal(str)  # noqa: N815 - Qt signal naming
     calibrationFinished = pyqtSignal(bool)  # noqa: N815 - Qt signal naming
     resectionFinished = pyqtSignal(bool)  # noqa: N815 - Qt signal naming
+    bundleFinished = pyqtSignal(bool)  # noqa: N815 - Qt signal naming
 
     def __init__(self, iface=None, parent=None) -> None:
         super().__init__(parent)
@@ -94,6 +98,7 @@ class ImagePickingDock(QgsDockWidget):
         self.monoplot = MonoplotController(self, self.monoplot_tool)
         self.calibration = CalibrationController(self)
         self.resection = ResectionController(self)
+        self.bundle = BundleController(self)
         self.canvas_footprint = CanvasFootprint(iface, self.project)
         self._connect()
         self.restore_session()
@@ -108,11 +113,13 @@ class ImagePickingDock(QgsDockWidget):
         self.project_panel = ProjectPanel(self.project)
         self.calibration_panel = CalibrationPanel()
         self.resection_panel = ResectionPanel()
+        self.bundle_panel = BundlePanel()
         help_label = QLabel(DOCK_HELP)
         help_label.setWordWrap(True)
         self.tabs.addTab(self.project_panel, self.tr("Project"))
         self.tabs.addTab(self.calibration_panel, self.tr("Calibration"))
         self.tabs.addTab(self.resection_panel, self.tr("Resection"))
+        self.tabs.addTab(self.bundle_panel, self.tr("Bundle"))
         self.tabs.addTab(help_label, self.tr("Help"))
         self.viewer = ViewerPanel(DOCK_HELP)
         self.table = ObservationTable()
@@ -133,6 +140,7 @@ class ImagePickingDock(QgsDockWidget):
         c.settingsChanged.connect(self.save_session)
         self.calibration.finished.connect(self.calibrationFinished)
         self.resection.finished.connect(self.resectionFinished)
+        self.bundle.finished.connect(self.bundleFinished)
         v.imageSelected.connect(self.show_image)
         v.undo_button.clicked.connect(self.store.undo)
         v.redo_button.clicked.connect(self.store.redo)
@@ -339,6 +347,11 @@ class ImagePickingDock(QgsDockWidget):
     def run_resection(self) -> bool:
         """Resect the image shown in a background task; False if it cannot start."""
         return self.resection.start()
+
+    def run_bundle(self) -> bool:
+        """Bundle adjustment of the open images in a background task; False if it cannot
+        start."""
+        return self.bundle.start()
 
     def closeEvent(self, event) -> None:
         self.store.save()

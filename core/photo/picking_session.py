@@ -38,6 +38,7 @@ from .picking import PickingScene, nearest_point, nearest_segment
 
 if TYPE_CHECKING:
     from .boresight import BoresightRun
+    from .bundle import BundleResult
 
 __all__ = [
     "PICK_TYPES",
@@ -140,6 +141,9 @@ class PickingSession:
         self.half_line: HalfLine | None = None
         #: residual rows of the last resection (:func:`core.jobs.resection.residual_rows`)
         self.resection_rows: list[tuple] = []
+        #: the last bundle adjustment of the Bundle tab (:mod:`.dock_bundle`)
+        self.bundle: BundleResult | None = None
+        self._bundle_residuals: tuple[int, dict[int, Array]] | None = None
 
     @property
     def pending(self) -> TiePrediction | None:
@@ -461,14 +465,38 @@ class PickingSession:
         return out
 
     def shown_residuals(self) -> dict[int, Array]:
-        """The residuals the dock draws: the last calibration's, and the last resection's for
-        the rows it used (those of the resected image)."""
-        res = self.resection_residuals()
-        if not res:
+        """The residuals the dock draws: the last calibration's, the last bundle
+        adjustment's for the rows it adjusted, and the last resection's for the rows it used
+        (those of the resected image)."""
+        res, bundle = self.resection_residuals(), self.bundle_residuals()
+        if not res and not bundle:
             return self.residuals()
         out = dict(self.residuals())
+        out.update(bundle)
         out.update(res)
         return out
+
+    # -- bundle adjustment --------------------------------------------------------------------
+    def set_bundle(self, result: BundleResult | None) -> None:
+        """Keep the result of a bundle adjustment of the dock's rows (None: forget it); the
+        residuals of an earlier resection are forgotten (the bundle re-oriented the images)."""
+        self.bundle = result
+        self._bundle_residuals = None
+        if result is not None:
+            self.resection_rows = []
+
+    def bundle_residuals(self) -> dict[int, Array]:
+        """Residual (vx, vy) in pixels of the last bundle adjustment by current row index
+        (:func:`.dock_bundle.residuals_by_row`)."""
+        if self.bundle is None:
+            return {}
+        version = self.observations.version
+        if self._bundle_residuals is None or self._bundle_residuals[0] != version:
+            from .dock_bundle import residuals_by_row
+
+            out = residuals_by_row(self.bundle, self.observations.to_observations())
+            self._bundle_residuals = (version, out)
+        return self._bundle_residuals[1]
 
     def boresight_summary(self) -> list[tuple[str, Array, float]]:
         """(group, (d_omega, d_phi, d_kappa) in arc-seconds, sigma0) of the last calibration."""
