@@ -9,7 +9,8 @@ Each (tool, data) measurement runs in its own process so that its peak RSS is it
 Sections:
 
 1. End to end (LAZ in, LAZ out): ``laspy.read`` + ``LasData.write`` of the file (the floor)
-   against the ``groundfilter`` job (read -> classify -> write) in the same run, 10 M points.
+   against the ``groundfilter`` job (read -> classify -> write) in the same run, 10 M points,
+   ``--e2e-runs`` times each, alternating (``--before``: also an older copy's job).
 2. Algorithm alone (points in memory, median of ``--runs``), peak RSS, and agreement with the
    producer's ground class (AHN3).
 3. Synthetic terrain classes (core/simulation/terrain.py): total error of every method, of
@@ -134,10 +135,11 @@ def worker(task: str, path: str, feet: bool, runs: int) -> dict:
         import laspy
 
         with tempfile.TemporaryDirectory(dir=os.path.dirname(path)) as tmp:
+            par = laspy.LazBackend.LazrsParallel  # laspy's default, made explicit
             t, c = time.perf_counter(), time.process_time()
-            las = laspy.read(path)
+            las = laspy.read(path, laz_backend=par)
             t1 = time.perf_counter()
-            las.write(Path(tmp) / "out.laz")
+            las.write(Path(tmp) / "out.laz", laz_backend=par)
             t2 = time.perf_counter()
             cpu = time.process_time() - c
         out.update(n=len(las.points), read_s=t1 - t, write_s=t2 - t1, io_s=t2 - t, cpu_s=cpu)
@@ -195,15 +197,22 @@ def worker(task: str, path: str, feet: bool, runs: int) -> dict:
     return out
 
 
-def run_worker(task: str, path: Path, feet: bool = False, runs: int = 1) -> dict:
+def run_worker(task: str, path: Path, feet: bool = False, runs: int = 1,
+               pythonpath: str = "") -> dict:  # fmt: skip
+    """One measurement in a new process (``pythonpath``: another copy of the project)."""
     cmd = [sys.executable, __file__, "--worker", task, str(path), str(int(feet)), str(runs)]
+    env = {**os.environ, "PYTHONPATH": pythonpath} if pythonpath else None
+    load = os.getloadavg()[0]
     t = time.perf_counter()
-    r = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    r = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env)
     if r.returncode:
         sys.stderr.write(r.stderr[-3000:])
         return {"task": task, "path": str(path), "error": r.stderr[-300:]}
     res = json.loads(r.stdout.strip().splitlines()[-1])
     res["process_s"] = time.perf_counter() - t
+    res["load_1min"] = [load, os.getloadavg()[0]]  # before and after
+    if pythonpath:
+        res["task"] = task + "_before"
     print(json.dumps(res), file=sys.stderr, flush=True)
     return res
 
@@ -272,6 +281,10 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--out", default="")
     ap.add_argument("--e2e-only", action="store_true", help="section 1 only (10 M files)")
+    ap.add_argument("--e2e-runs", type=int, default=3, help="end-to-end runs of each tool")
+    ap.add_argument(
+        "--before", default="", help="PYTHONPATH of an older copy of the project: its job runs too"
+    )
     args = ap.parse_args()
     if args.worker:
         task, path, feet, runs = args.worker
@@ -287,9 +300,13 @@ def main() -> None:
         rows = []
         for label, path, feet in files:
             # end to end: the floor and our job, twice each, alternating (the machine is shared)
-            for _ in range(2):
+            for _ in range(args.e2e_runs):
                 for task in ("laspy_io", "job"):
                     rows.append({**run_worker(task, path, feet), "label": label})
+                if args.before:
+                    rows.append(
+                        {**run_worker("job", path, feet, pythonpath=args.before), "label": label}
+                    )
             for method in () if args.e2e_only else (*METHODS, "csf_package"):
                 runs = 1 if method.startswith("csf") else args.runs
                 rows.append({**run_worker(f"alg_{method}", path, feet, runs), "label": label})

@@ -480,6 +480,49 @@ def test_without_the_height_the_point_format_and_records_are_kept(tmp_path):
     np.testing.assert_array_equal(out.withheld, src.withheld)
 
 
+def test_laz_copy_is_the_input_records_with_the_in_memory_classes(tmp_path):
+    """LAZ in, LAZ out (the end-to-end path of bench/ground_filter.md): the written classes
+    are exactly the filter's in-memory result, and every byte of every point record other
+    than the 5 class bits is the input's (flags of the same byte included)."""
+    run = run_ground_filter(str(AHN3), str(tmp_path / "out.laz"))
+    src, out = laspy.read(AHN3), laspy.read(tmp_path / "out.laz")
+    r = run.result
+    expected = np.asarray(src.classification).copy()
+    expected[(expected == GROUND_CLASS) & ~r.ground] = 1  # former ground the filter rejects
+    expected[r.ground] = GROUND_CLASS
+    expected[r.low_outlier] = LOW_NOISE_CLASS
+    np.testing.assert_array_equal(np.asarray(out.classification), expected)
+    a, b = src.points.array, out.points.array
+    assert a.dtype == b.dtype and out.point_format.id == src.point_format.id
+    for name in a.dtype.names:
+        if name == "raw_classification":  # formats 0-5: class in bits 0-4, flags in 5-7
+            np.testing.assert_array_equal(a[name] & 0xE0, b[name] & 0xE0)
+        else:
+            assert a[name].tobytes() == b[name].tobytes(), name
+    assert out.header.scales.tolist() == src.header.scales.tolist()
+    assert out.header.offsets.tolist() == src.header.offsets.tolist()
+
+
+@pytest.mark.parametrize("method", ["smrf", "pmf"])
+def test_result_does_not_depend_on_the_point_step(monkeypatch, method):
+    """The per-point loops run in steps of _POINT_CHUNK points: any step gives the same
+    bits (low outliers, ground, heights) as the whole cloud at once."""
+    from lidarphoto.core.lidar import ground_filter as gf
+
+    x, y, z, _ = _scene(np.random.default_rng(7), 0.05)
+    z[::997] -= 5.0  # low outliers, so that the low-outlier passes run
+    results = []
+    for step in (len(z) + 1, 4096, 1000):
+        monkeypatch.setattr(gf, "_POINT_CHUNK", step)
+        results.append(ground_filter(x, y, z, PARAMS[method]))
+    assert results[0].low_outlier.sum() > 0
+    for r in results[1:]:
+        np.testing.assert_array_equal(r.ground, results[0].ground)
+        np.testing.assert_array_equal(r.low_outlier, results[0].low_outlier)
+        np.testing.assert_array_equal(r.height_above_ground, results[0].height_above_ground)
+        np.testing.assert_array_equal(r.dtm, results[0].dtm)
+
+
 @pytest.mark.parametrize("method", METHODS)
 def test_every_method_through_the_job(tmp_path, method):
     run = run_ground_filter(str(AHN3), str(tmp_path / "out.laz"), METHOD=method)
