@@ -2,7 +2,7 @@
 Monte Carlo against the Cramer-Rao bound, the decorrelation by tilted stations (Lichti 2010),
 an independent SciPy peer, the paper's shortfall, and what the user waits for (the job).
 
-Run: /work/tools/wt.sh <worktree> py bench/bench_tls.py [draws] [--targets: section 6 only]
+Run: .venv/bin/python bench/bench_tls.py [draws] [--targets: section 6 only]
 (writes nothing but stdout; bench/tls.md holds the tables of one run)
 """
 
