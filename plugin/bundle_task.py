@@ -17,20 +17,22 @@ import math
 from pathlib import Path
 
 import numpy as np
-from qgis.core import QgsApplication, QgsTask
+from qgis.core import QgsApplication
 from qgis.PyQt import sip
 from qgis.PyQt.QtCore import QObject, Qt, pyqtSignal
 from qgis.PyQt.QtWidgets import QCheckBox, QComboBox, QFormLayout, QLabel, QPushButton, QWidget
 
-from ..core.errors import Cancelled
+from ..core.io.ground_points import write_ground_points_csv
+from ..core.io.observations import write_observations_csv
+from ..core.io.orientation import write_eo_csv
 from ..core.jobs import bundle_adjustment
-from ..core.jobs.runner import JobResult, run_job
 from ..core.photo.dock_bundle import (
     DEFAULT_EO_SIGMAS,
     DockBundleInputs,
     dock_bundle_inputs,
     orientations_of,
 )
+from .job_task import JobTask
 
 __all__ = ["BUNDLE_ALG", "BundleController", "BundlePanel", "bundle_parameters"]
 
@@ -160,45 +162,6 @@ class BundlePanel(QWidget):
         return text
 
 
-class _Task(QgsTask):
-    """Write the block's tables, run the job; ``result`` or ``error`` afterwards."""
-
-    def __init__(self, description: str, params: dict, inputs: DockBundleInputs, eo, done):
-        super().__init__(description)
-        self.params, self.inputs, self.eo, self.done = params, inputs, eo, done
-        self.result: JobResult | None = None
-        self.error = ""
-        self.cancelled = False
-
-    def run(self) -> bool:  # a worker thread: no widget here
-        from ..core.io.ground_points import write_ground_points_csv
-        from ..core.io.observations import write_observations_csv
-        from ..core.io.orientation import write_eo_csv
-
-        try:
-            Path(self.params["OUTPUT_EO"]).parent.mkdir(parents=True, exist_ok=True)
-            write_observations_csv(self.params["OBSERVATIONS"], self.inputs.observations)
-            if self.params["GROUND_POINTS"]:
-                write_ground_points_csv(self.params["GROUND_POINTS"], self.inputs.ground)
-            write_eo_csv(self.params["EO"], self.eo)
-            self.result = run_job(
-                bundle_adjustment,
-                self.params,
-                progress=lambda f: self.setProgress(100.0 * f),
-                should_stop=self.isCanceled,
-            )
-        except Cancelled as exc:
-            self.cancelled, self.error = True, str(exc)
-            return False
-        except Exception as exc:  # every failure is reported in the dock, none is raised
-            self.error = str(exc) or type(exc).__name__
-            return False
-        return True
-
-    def finished(self, ok: bool) -> None:  # the GUI thread
-        self.done(ok, self)
-
-
 class BundleController(QObject):
     """The Bundle button of a picking dock: one adjustment at a time in the QGIS task
     manager; its residuals kept in the dock's session (drawn on the image and in the table).
@@ -215,7 +178,7 @@ class BundleController(QObject):
     def __init__(self, dock) -> None:
         super().__init__(dock)
         self.dock, self.panel = dock, dock.bundle_panel
-        self.task: _Task | None = None
+        self.task: JobTask | None = None
         self.params: dict = {}
         self.inputs: DockBundleInputs | None = None
         self.result = None
@@ -279,17 +242,25 @@ class BundleController(QObject):
         )
         self.params, self.inputs, self.result, self.error, self.text = params, inputs, None, "", ""
         self.panel.set_running(True)
-        self.task = _Task(
+
+        def write_block() -> None:
+            write_observations_csv(params["OBSERVATIONS"], inputs.observations)
+            if params["GROUND_POINTS"]:
+                write_ground_points_csv(params["GROUND_POINTS"], inputs.ground)
+            write_eo_csv(params["EO"], eo)
+
+        self.task = JobTask(
             self.tr("Bundle adjustment of {} images").format(len(inputs.images)),
+            bundle_adjustment,
             params,
-            inputs,
-            eo,
+            "OUTPUT_EO",
+            write_block,
             self._done,
         )
         QgsApplication.taskManager().addTask(self.task)
         return True
 
-    def _done(self, ok: bool, task: _Task) -> None:
+    def _done(self, ok: bool, task: JobTask) -> None:
         if sip.isdeleted(self):  # the dock was closed and deleted meanwhile
             return
         self.task = None
@@ -307,7 +278,7 @@ class BundleController(QObject):
             return
         res = self.result = task.result.data
         dock.session.set_bundle(res)
-        self.text = panel.show_result(res, task.inputs)
+        self.text = panel.show_result(res, self.inputs)
         s0 = res.adjustment.sigma0
         dock.message(
             self.tr("Bundle adjustment done: sigma0 {}; {}").format(

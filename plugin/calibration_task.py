@@ -13,15 +13,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from qgis.core import QgsApplication, QgsTask
+from qgis.core import QgsApplication
 from qgis.PyQt import sip
 from qgis.PyQt.QtCore import QObject, pyqtSignal
 
-from ..core.errors import Cancelled
 from ..core.io.control import write_lcps_csv, write_lines_csv
 from ..core.io.planes import write_planes_csv
 from ..core.jobs import boresight_calibration
-from ..core.jobs.runner import JobResult, run_job
+from ..core.jobs.runner import JobResult
+from .job_task import JobTask
 
 __all__ = ["CalibrationController", "calibration_parameters"]
 
@@ -71,44 +71,6 @@ def calibration_parameters(
     }
 
 
-class _Task(QgsTask):
-    """Write the control tables, run the job; ``result`` or ``error`` afterwards."""
-
-    def __init__(self, description: str, params: dict, control: tuple, done) -> None:
-        super().__init__(description)
-        self.params, self.control, self.done = params, control, done
-        self.result: JobResult | None = None
-        self.error = ""
-        self.cancelled = False
-
-    def run(self) -> bool:  # a worker thread: no widget here
-        try:
-            Path(self.params["OUTPUT_TABLE"]).parent.mkdir(parents=True, exist_ok=True)
-            for key, write, items in zip(
-                ("PLANES", "LINES", "LCPS"),
-                (write_planes_csv, write_lines_csv, write_lcps_csv),
-                self.control,
-            ):
-                if self.params[key]:
-                    write(self.params[key], items)
-            self.result = run_job(
-                boresight_calibration,
-                self.params,
-                progress=lambda f: self.setProgress(100.0 * f),
-                should_stop=self.isCanceled,
-            )
-        except Cancelled as exc:
-            self.cancelled, self.error = True, str(exc)
-            return False
-        except Exception as exc:  # every failure is reported in the dock, none is raised
-            self.error = str(exc) or type(exc).__name__
-            return False
-        return True
-
-    def finished(self, ok: bool) -> None:  # the GUI thread
-        self.done(ok, self)
-
-
 class CalibrationController(QObject):
     """The Run button of a picking dock: one calibration at a time in the QGIS task manager,
     its result kept in the dock's session.
@@ -125,7 +87,7 @@ class CalibrationController(QObject):
     def __init__(self, dock) -> None:
         super().__init__(dock)
         self.dock, self.panel = dock, dock.calibration_panel
-        self.task: _Task | None = None
+        self.task: JobTask | None = None
         self.params: dict = {}
         self.result: JobResult | None = None
         self.error = ""
@@ -167,11 +129,22 @@ class CalibrationController(QObject):
             return False
         self.params, self.result, self.error = params, None, ""
         self.panel.set_running(True)
-        self.task = _Task(self.tr("Boresight calibration"), params, control, self._done)
+
+        def write_control() -> None:
+            for key, write, items in zip(
+                ("PLANES", "LINES", "LCPS"),
+                (write_planes_csv, write_lines_csv, write_lcps_csv),
+                control,
+            ):
+                if params[key]:
+                    write(params[key], items)
+
+        self.task = JobTask(self.tr("Boresight calibration"), boresight_calibration, params,
+                            "OUTPUT_TABLE", write_control, self._done)  # fmt: skip
         QgsApplication.taskManager().addTask(self.task)
         return True
 
-    def _done(self, ok: bool, task: _Task) -> None:
+    def _done(self, ok: bool, task: JobTask) -> None:
         if sip.isdeleted(self):  # the dock was closed and deleted meanwhile
             return
         self.task = None

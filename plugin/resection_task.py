@@ -15,18 +15,17 @@ import math
 from pathlib import Path
 
 import numpy as np
-from qgis.core import QgsApplication, QgsTask
+from qgis.core import QgsApplication
 from qgis.PyQt import sip
 from qgis.PyQt.QtCore import QObject, Qt, pyqtSignal
 from qgis.PyQt.QtWidgets import QCheckBox, QLabel, QPushButton, QVBoxLayout, QWidget
 
-from ..core.errors import Cancelled
 from ..core.io.control import write_lcps_csv, write_lines_csv
 from ..core.jobs import resection
 from ..core.jobs.resection import residual_rows
-from ..core.jobs.runner import JobResult, run_job
 from ..core.photo.control_features import lines_with_end_sigmas
 from ..core.photo.picking_session import residual_summary
+from .job_task import JobTask
 
 __all__ = ["RESECTION_ALG", "ResectionController", "ResectionPanel", "resection_parameters"]
 
@@ -125,42 +124,6 @@ class ResectionPanel(QWidget):
         return text
 
 
-class _Task(QgsTask):
-    """Write the control tables, run the job; ``result`` or ``error`` afterwards."""
-
-    def __init__(self, description: str, params: dict, control: tuple, done) -> None:
-        super().__init__(description)
-        self.params, self.control, self.done = params, control, done
-        self.result: JobResult | None = None
-        self.error = ""
-        self.cancelled = False
-
-    def run(self) -> bool:  # a worker thread: no widget here
-        try:
-            Path(self.params["OUTPUT_EO"]).parent.mkdir(parents=True, exist_ok=True)
-            _planes, lines, lcps = self.control
-            if self.params["CONTROL_LINES"]:
-                write_lines_csv(self.params["CONTROL_LINES"], lines)
-            if self.params["CONTROL_POINTS"]:
-                write_lcps_csv(self.params["CONTROL_POINTS"], lcps)
-            self.result = run_job(
-                resection,
-                self.params,
-                progress=lambda f: self.setProgress(100.0 * f),
-                should_stop=self.isCanceled,
-            )
-        except Cancelled as exc:
-            self.cancelled, self.error = True, str(exc)
-            return False
-        except Exception as exc:  # every failure is reported in the dock, none is raised
-            self.error = str(exc) or type(exc).__name__
-            return False
-        return True
-
-    def finished(self, ok: bool) -> None:  # the GUI thread
-        self.done(ok, self)
-
-
 class ResectionController(QObject):
     """The Resect button of a picking dock: one resection at a time in the QGIS task manager;
     its residuals kept in the dock's session (drawn on the image and in the table).
@@ -177,7 +140,7 @@ class ResectionController(QObject):
     def __init__(self, dock) -> None:
         super().__init__(dock)
         self.dock, self.panel = dock, dock.resection_panel
-        self.task: _Task | None = None
+        self.task: JobTask | None = None
         self.params: dict = {}
         self.run = None
         self.text = ""
@@ -218,11 +181,20 @@ class ResectionController(QObject):
         )
         self.params, self.run, self.error, self.text = params, None, "", ""
         self.panel.set_running(True)
-        self.task = _Task(self.tr("Resection of {}").format(image), params, control, self._done)
+
+        def write_control() -> None:
+            _planes, lines, lcps = control
+            if params["CONTROL_LINES"]:
+                write_lines_csv(params["CONTROL_LINES"], lines)
+            if params["CONTROL_POINTS"]:
+                write_lcps_csv(params["CONTROL_POINTS"], lcps)
+
+        self.task = JobTask(self.tr("Resection of {}").format(image), resection, params,
+                            "OUTPUT_EO", write_control, self._done)  # fmt: skip
         QgsApplication.taskManager().addTask(self.task)
         return True
 
-    def _done(self, ok: bool, task: _Task) -> None:
+    def _done(self, ok: bool, task: JobTask) -> None:
         if sip.isdeleted(self):  # the dock was closed and deleted meanwhile
             return
         self.task = None
