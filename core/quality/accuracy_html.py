@@ -7,13 +7,14 @@ the sources of the standards' figures.
 
 from __future__ import annotations
 
-import html
 import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .. import __version__
+from .html_table import escape as _e
+from .html_table import table as _table
 from .svg_plots import histogram, qq_plot, vector_map
 
 if TYPE_CHECKING:
@@ -34,28 +35,10 @@ th{background:#eee}td.t,th.t{text-align:left}
 """
 
 
-def _e(text: object) -> str:
-    return html.escape(str(text), quote=True)
-
-
 def _m(x: float | None, digits: int = 3) -> str:
     if x is None or not math.isfinite(float(x)):
         return "&ndash;"
     return f"{float(x):.{digits}f}"
-
-
-def _table(header: list[str], rows: list[list[str]], css: list[str] | None = None) -> str:
-    head = "".join(
-        f'<th class="t">{h}</th>' if i == 0 else f"<th>{h}</th>" for i, h in enumerate(header)
-    )
-    body = []
-    for k, row in enumerate(rows):
-        cls = f' class="{css[k]}"' if css and css[k] else ""
-        cells = "".join(
-            f'<td class="t">{c}</td>' if i == 0 else f"<td>{c}</td>" for i, c in enumerate(row)
-        )
-        body.append(f"<tr{cls}>{cells}</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
 
 
 def _stats_table(g: GroupStatistics) -> str:

@@ -11,7 +11,6 @@ systematic patterns) and the residual histograms; warnings.
 
 from __future__ import annotations
 
-import html
 import math
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
@@ -19,6 +18,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import __version__
+from .html_table import escape as _e
+from .html_table import table as _table
 from .svg_plots import correlation_heatmap, histogram, image_vector_field
 
 if TYPE_CHECKING:
@@ -37,30 +38,12 @@ th{background:#eee}td.t,th.t{text-align:left}
 """
 
 
-def _e(text: object) -> str:
-    return html.escape(str(text), quote=True)
-
-
 def _n(x: object, fmt: str = ".3f") -> str:
     try:
         v = float(x)  # type: ignore[arg-type]
     except (TypeError, ValueError):
         return _e(x)
     return "&ndash;" if not math.isfinite(v) else format(v, fmt)
-
-
-def _table(header: Sequence[str], rows: Sequence[Sequence[str]], css: Sequence[str] = ()) -> str:
-    head = "".join(
-        f'<th class="t">{h}</th>' if i == 0 else f"<th>{h}</th>" for i, h in enumerate(header)
-    )
-    body = []
-    for k, row in enumerate(rows):
-        cls = f' class="{css[k]}"' if k < len(css) and css[k] else ""
-        cells = "".join(
-            f'<td class="t">{c}</td>' if i == 0 else f"<td>{c}</td>" for i, c in enumerate(row)
-        )
-        body.append(f"<tr{cls}>{cells}</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
 
 
 def _comparison(rows: Sequence[Mapping[str, object]], best: str) -> str:

@@ -9,13 +9,14 @@ statistics of points, lines and check points, and the observations rejected by d
 
 from __future__ import annotations
 
-import html
 import math
 from collections.abc import Mapping, Sequence
 
 import numpy as np
 
 from .. import __version__
+from .html_table import escape as _e
+from .html_table import table as _table
 
 __all__ = ["render_resection_html"]
 
@@ -31,28 +32,10 @@ th{background:#eee}td.t,th.t{text-align:left}
 """
 
 
-def _e(text: object) -> str:
-    return html.escape(str(text), quote=True)
-
-
 def _n(x: float | None, digits: int = 3) -> str:
     if x is None or not math.isfinite(float(x)):
         return "&ndash;"
     return f"{float(x):.{digits}f}"
-
-
-def _table(header: Sequence[str], rows: Sequence[Sequence[str]], css: Sequence[str] = ()) -> str:
-    head = "".join(
-        f'<th class="t">{h}</th>' if i == 0 else f"<th>{h}</th>" for i, h in enumerate(header)
-    )
-    body = []
-    for k, row in enumerate(rows):
-        cls = f' class="{css[k]}"' if k < len(css) and css[k] else ""
-        cells = "".join(
-            f'<td class="t">{c}</td>' if i == 0 else f"<td>{c}</td>" for i, c in enumerate(row)
-        )
-        body.append(f"<tr{cls}>{cells}</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
 
 
 def _rms(x: np.ndarray) -> float:

@@ -8,7 +8,6 @@ them (Lichti 2010), the correlation matrix of the APs and the station parameters
 
 from __future__ import annotations
 
-import html
 import math
 from collections.abc import Mapping, Sequence
 
@@ -17,6 +16,8 @@ import numpy as np
 from .. import __version__
 from ..tls.aps import ARCSEC
 from ..tls.calibration import TlsCalibration, explain_pair
+from .html_table import escape as _e
+from .html_table import table as _table
 
 __all__ = ["render_tls_html"]
 
@@ -44,25 +45,9 @@ _DESIGN = (
 )
 
 
-def _e(text: object) -> str:
-    return html.escape(str(text), quote=True)
-
-
 def _n(x: float, digits: int = 2) -> str:
     x = float(x)
     return f"{x:.{digits}f}" if math.isfinite(x) else "&ndash;"
-
-
-def _table(header: Sequence[str], rows: Sequence[Sequence[str]], css: Sequence[str] = ()) -> str:
-    head = "".join(f'<th class="t">{h}</th>' if i == 0 else f"<th>{h}</th>"
-                   for i, h in enumerate(header))  # fmt: skip
-    body = []
-    for k, row in enumerate(rows):
-        cls = f' class="{css[k]}"' if k < len(css) and css[k] else ""
-        cells = "".join(f'<td class="t">{c}</td>' if i == 0 else f"<td>{c}</td>"
-                        for i, c in enumerate(row))  # fmt: skip
-        body.append(f"<tr{cls}>{cells}</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
 
 
 def _colour(r: float) -> str:

@@ -1,0 +1,38 @@
+"""The HTML pieces every report shares: escaped text and a table whose first column is the
+row's name (class ``t``) and whose rows may carry a CSS class (``pass``, ``fail``...)."""
+
+from __future__ import annotations
+
+import html
+from collections.abc import Sequence
+
+
+def escape(text: object) -> str:
+    """``text`` as HTML text (quotes escaped too, so it may stand in an attribute).
+
+    >>> escape('a < b & "c"')
+    'a &lt; b &amp; &quot;c&quot;'
+    """
+    return html.escape(str(text), quote=True)
+
+
+def table(
+    header: Sequence[str], rows: Sequence[Sequence[str]], css: Sequence[str] | None = ()
+) -> str:
+    """A ``<table>`` of already formatted (escaped) cells; ``css[k]`` is row k's class.
+
+    >>> table(["id", "dX"], [["p1", "0.10"]], ["fail"]).split("<tbody>")[1]
+    '<tr class="fail"><td class="t">p1</td><td>0.10</td></tr></tbody></table>'
+    """
+    css = css or ()
+    head = "".join(
+        f'<th class="t">{h}</th>' if i == 0 else f"<th>{h}</th>" for i, h in enumerate(header)
+    )
+    body = []
+    for k, row in enumerate(rows):
+        cls = f' class="{css[k]}"' if k < len(css) and css[k] else ""
+        cells = "".join(
+            f'<td class="t">{c}</td>' if i == 0 else f"<td>{c}</td>" for i, c in enumerate(row)
+        )
+        body.append(f"<tr{cls}>{cells}</tr>")
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
