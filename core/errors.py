@@ -72,5 +72,19 @@ class NotObservableError(AdjustmentError):
         super().__init__(message)
 
 
+class DiagnosedNotObservable(NotObservableError):
+    """A :class:`NotObservableError` explained: ``diagnosis`` holds sentences that say what
+    would make the parameters observable (appended to the message)."""
+
+    def __init__(self, cause: NotObservableError, diagnosis: list[str]) -> None:
+        self.diagnosis = diagnosis
+        super().__init__(
+            f"{cause} -- diagnosis: " + " ".join(diagnosis),
+            cause.parameters,
+            cause.null_vectors,
+            cause.condition_number,
+        )
+
+
 class ConvergenceError(AdjustmentError):
     """An iterative adjustment did not converge within its iteration limit."""

@@ -60,7 +60,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from ..errors import InputError, NotObservableError
+from ..errors import DiagnosedNotObservable, InputError, NotObservableError
 from ..geometry.camera import Camera
 from ..geometry.frames import NED_TO_ENU, LocalFrame, MappingFrame
 from ..lsq.adjustment import adjust
@@ -150,17 +150,8 @@ class BoresightOptions:
     max_iterations: int = 50
 
 
-class BoresightNotObservable(NotObservableError):
+class BoresightNotObservable(DiagnosedNotObservable):
     """A calibration parameter cannot be determined; ``diagnosis`` explains what would fix it."""
-
-    def __init__(self, cause: NotObservableError, diagnosis: list[str]) -> None:
-        self.diagnosis = diagnosis
-        super().__init__(
-            f"{cause} -- diagnosis: " + " ".join(diagnosis),
-            cause.parameters,
-            cause.null_vectors,
-            cause.condition_number,
-        )
 
 
 @dataclass

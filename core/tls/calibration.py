@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError, NotObservableError
+from ..errors import DiagnosedNotObservable, InputError, NotObservableError
 from ..geometry.rotations import opk_derivatives, opk_to_matrix
 from ..lsq.adjustment import adjust
 from ..lsq.model import AdjustmentOptions, Constraint, GaussMarkovBlock, prior_block
@@ -73,17 +73,8 @@ Array = NDArray[np.float64]
 POSE_NAMES = ("X", "Y", "Z", "omega", "phi", "kappa")
 
 
-class TlsNotObservable(NotObservableError):
+class TlsNotObservable(DiagnosedNotObservable):
     """A parameter the network cannot determine; ``diagnosis`` says what would fix it."""
-
-    def __init__(self, cause: NotObservableError, diagnosis: list[str]) -> None:
-        self.diagnosis = diagnosis
-        super().__init__(
-            f"{cause} -- diagnosis: " + " ".join(diagnosis),
-            cause.parameters,
-            cause.null_vectors,
-            cause.condition_number,
-        )
 
 
 @dataclass(frozen=True)
