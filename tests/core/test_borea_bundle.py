@@ -27,33 +27,11 @@ from lidarphoto.core.photo.bundle import BundleOptions, GroundPoints, bundle_adj
 from lidarphoto.core.photo.observations import ImageObservations
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable
 from pyproj import Proj, Transformer
+from test_borea_resection import _camera as borea_camera  # the same IGN camera file
 
 HERE = Path(__file__).resolve().parents[1] / "data"
 DATA = HERE / "borea_block"
 GEOID = HERE / "borea" / "fr_ign_RAF20.tif"
-PIXEL_MM = 0.004
-
-
-def _camera():
-    from lidarphoto.core.geometry.camera import camera_from_dict
-
-    info = dict(
-        line.split("=", 1)
-        for line in (DATA / "Camera1.txt").read_text().splitlines()
-        if "=" in line
-    )
-    info = {k.strip(): v.strip() for k, v in info.items()}
-    return camera_from_dict(
-        {
-            "name": info["Name"],
-            "focal_px": float(info["focal"]),
-            "ppx_px": float(info["PPAx"]),
-            "ppy_px": float(info["PPAy"]),
-            "pixel_size_mm": PIXEL_MM,
-            "width_px": int(info["width"]),
-            "height_px": int(info["height"]),
-        }
-    )
 
 
 def _ellipsoidal(xyz: np.ndarray) -> np.ndarray:
@@ -114,7 +92,7 @@ def block():
         "mapping": mapping,
         "ign": ign,
         "ground": ground,
-        "camera": _camera(),
+        "camera": borea_camera(),
         "rows": rows,
         "opk": opk,
     }
