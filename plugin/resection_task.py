@@ -21,6 +21,7 @@ from qgis.PyQt.QtCore import QObject, Qt, pyqtSignal
 from qgis.PyQt.QtWidgets import QCheckBox, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from ..core.io.control import write_lcps_csv, write_lines_csv
+from ..core.io.observations import write_observations_csv
 from ..core.jobs import resection
 from ..core.jobs.resection import residual_rows
 from ..core.photo.control_features import lines_with_end_sigmas
@@ -176,13 +177,18 @@ class ResectionController(QObject):
         crs = dock.eo_crs()
         out_dir = store.path.with_name(store.path.stem + "_resection")
         camera = dock.project_panel.camera_edit.filePath()
+        # the rows as they are now: the store autosaves every edit made while the task runs,
+        # and the residuals are mapped back through the file the job read
+        snapshot = store.to_observations()
         params = resection_parameters(
-            out_dir, image, store.path, camera, crs.authid() or crs.toWkt(), control
-        )
+            out_dir, image, out_dir / "observations.csv", camera, crs.authid() or crs.toWkt(),
+            control,
+        )  # fmt: skip
         self.params, self.run, self.error, self.text = params, None, "", ""
         self.panel.set_running(True)
 
         def write_control() -> None:
+            write_observations_csv(params["OBSERVATIONS"], snapshot)
             _planes, lines, lcps = control
             if params["CONTROL_LINES"]:
                 write_lines_csv(params["CONTROL_LINES"], lines)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import ClassVar
 
 from qgis.core import (
+    Qgis,
     QgsFillSymbol,
     QgsMultiBandColorRenderer,
     QgsProcessingLayerPostProcessorInterface,
@@ -25,7 +26,7 @@ class OrthoStyle(QgsProcessingLayerPostProcessorInterface):
 
     def postProcessLayer(self, layer, context, feedback):
         if isinstance(layer, QgsRasterLayer) and layer.bandCount() >= 3:
-            if layer.dataProvider().dataType(1) == 1:  # Qgis.DataType.Byte
+            if layer.dataProvider().dataType(1) == Qgis.DataType.Byte:
                 renderer = QgsMultiBandColorRenderer(layer.dataProvider(), 1, 2, 3)
                 if layer.renderer() is not None:
                     renderer.setAlphaBand(layer.renderer().alphaBand())

@@ -21,9 +21,9 @@ MODEL = HERE / "data" / "ortho_model.model3"
 
 
 def build_model():
+    from lidarphoto.processing_provider.compat import NUMBER_DOUBLE, SOURCE_FILE
     from model_tools import static_defaults
     from qgis.core import (
-        QgsProcessing,
         QgsProcessingModelAlgorithm,
         QgsProcessingModelChildAlgorithm,
         QgsProcessingModelOutput,
@@ -64,11 +64,9 @@ def build_model():
             False,
             0,
         ),
-        QgsProcessingParameterMultipleLayers("images", "Images", QgsProcessing.TypeFile),
+        QgsProcessingParameterMultipleLayers("images", "Images", SOURCE_FILE),
         QgsProcessingParameterFile("dsm", "DSM (raster or LAS/LAZ)"),
-        QgsProcessingParameterNumber(
-            "gsd", "Orthophoto cell size", QgsProcessingParameterNumber.Double, 0.0
-        ),
+        QgsProcessingParameterNumber("gsd", "Orthophoto cell size", NUMBER_DOUBLE, 0.0),
     ]
     for k, p in enumerate(inputs):
         mp = QgsProcessingModelParameter(p.name())
