@@ -181,7 +181,8 @@ class BundleOptions:
     estimate_mount : bool
         With observed orientations: estimate a common lever-arm correction (camera axes,
         metres) and boresight correction (about the camera axes) between the observed and
-        the adjusted orientations.
+        the adjusted orientations, signed as in DESIGN.md: ``X_pc = X_obs + R_c^m da``,
+        ``R_c^m = R_obs dR`` (a boresight calibration's dR).
     max_iterations : int
         Iterations of each adjustment.
     covariance : bool
@@ -925,9 +926,11 @@ def _dopk_dm(m: Array) -> Array:
 
 
 class _ObservedEOModel:
-    """Observed orientation = adjusted one displaced by the lever arm and rotated by the
-    boresight correction: ``X_obs = X0 + M' da``, ``M_obs = dR' M`` with ``dR`` the
-    boresight about the camera axes. x_local = [eo(6), da(3), bore(3)]."""
+    """Observed orientation (GNSS/INS with the nominal mount) against the adjusted one, in
+    the conventions of DESIGN.md (``X_pc = X_obs + R_c^m da``, ``R_c^m = R_obs dR``):
+    ``X_obs = X0 - M' da``, ``M_obs = dR M`` with ``da`` the lever-arm correction in camera
+    axes and ``dR`` the boresight correction about the camera axes (what a boresight
+    calibration estimates). x_local = [eo(6), da(3), bore(3)]."""
 
     def __init__(self, observed: Array) -> None:
         self.observed = observed
@@ -940,13 +943,13 @@ class _ObservedEOModel:
         M = opk_to_matrix(eo[:, 3], eo[:, 4], eo[:, 5])
         dM = opk_derivatives(eo[:, 3], eo[:, 4], eo[:, 5])  # (g, 3, 3, 3)
         dR = boresight_matrix(bo[:, 0], bo[:, 1], bo[:, 2])
-        Mobs = np.swapaxes(dR, 1, 2) @ M
+        Mobs = dR @ M
         f = np.zeros((g, 6))
         J = np.zeros((g, 6, 12))
-        f[:, :3] = eo[:, :3] + np.einsum("gji,gj->gi", M, da)
+        f[:, :3] = eo[:, :3] - np.einsum("gji,gj->gi", M, da)
         J[:, :3, :3] = np.eye(3)
-        J[:, :3, 3:6] = np.einsum("gkji,gj->gik", dM, da)
-        J[:, :3, 6:9] = np.swapaxes(M, 1, 2)
+        J[:, :3, 3:6] = -np.einsum("gkji,gj->gik", dM, da)
+        J[:, :3, 6:9] = -np.swapaxes(M, 1, 2)
         om, ph, ka = matrix_to_opk(Mobs)
         f[:, 3:] = np.column_stack([om, ph, ka])
         # keep the predicted angles on the branch of the observed ones
@@ -954,16 +957,15 @@ class _ObservedEOModel:
             2 * np.pi
         ) - np.pi
         dop = _dopk_dm(Mobs)  # (g, 3, 9)
-        dRt = np.swapaxes(dR, 1, 2)
         for k in range(3):
-            dMobs = dRt @ dM[:, k]
+            dMobs = dR @ dM[:, k]
             J[:, 3:, 3 + k] = np.einsum("gaj,gj->ga", dop, dMobs.reshape(g, 9))
         # dR = Rx(a) Ry(b) Rz(c): d Rx(a)/da = Rx(a) [e_x]x, and likewise
         ra, rb, rc = rx(bo[:, 0]), ry(bo[:, 1]), rz(bo[:, 2])
         gen = [skew(e) for e in np.eye(3)]
         d_dR = (ra @ gen[0] @ rb @ rc, ra @ rb @ gen[1] @ rc, ra @ rb @ rc @ gen[2])
         for k in range(3):
-            dMobs = np.swapaxes(d_dR[k], 1, 2) @ M
+            dMobs = d_dR[k] @ M
             J[:, 3:, 9 + k] = np.einsum("gaj,gj->ga", dop, dMobs.reshape(g, 9))
         return f, J
 

@@ -9,7 +9,8 @@ the rotation ``M = R3(kappa) R2(phi) R1(omega)`` from the object frame into its 
     d = M (X - X0)
 
 so a levelled scanner has omega = phi = 0 and kappa is the angle from the object x axis to the
-scanner's x axis, clockwise seen from above (the scanner's zero direction). The scanner frame
+scanner's x axis, counter-clockwise seen from above (the scanner's zero direction: its x axis
+is the object direction (cos kappa, sin kappa, 0), the first row of M). The scanner frame
 and the polar observations are defined in :mod:`.polar`.
 """
 

@@ -234,8 +234,9 @@ def test_observed_orientations_with_lever_arm_and_boresight(blocks):
 
     local = LocalFrame.at_map_point(blk.mapping, blk.ground.xyz.mean(axis=0))
     c, M = eo_map_to_local(blk.eo_true.xyz, blk.eo_true.opk, local)
-    Mobs = np.swapaxes(boresight_matrix(*bore), 0, 1) @ M
-    cobs = c + np.einsum("nji,j->ni", M, lever) + rng.normal(0, sig_p, c.shape)
+    # DESIGN.md: X_pc = X_obs + R_c^m lever, R_c^m = R_obs dR (so M_obs = dR M)
+    Mobs = boresight_matrix(*bore) @ M
+    cobs = c - np.einsum("nji,j->ni", M, lever) + rng.normal(0, sig_p, c.shape)
     om, ph, ka = matrix_to_opk(Mobs)
     Mobs = opk_to_matrix(
         om + rng.normal(0, sig_a, om.size),
