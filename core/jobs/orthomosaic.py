@@ -134,11 +134,14 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             name = meta.get("LIDARPHOTO_IMAGE_ID") or f.stem
             sources.append(MosaicSource(name, Grid(gt[0], gt[3], gt[1], info.height, info.width),
                                         centre, ground[0] if ground else None, pg))  # fmt: skip
-        if v.method == "nadir" and any(s.centre is None for s in sources):
+        method = v.method
+        if method == "nadir" and any(s.centre is None for s in sources):
+            # a nadir angle and a distance are not comparable scores: one rule for all
             log.warning("some orthophotos have no perspective centre in their metadata (not "
-                        "made by orthorectify): the nearest raster centre is used for them")
+                        "made by orthorectify): every cell takes the nearest image centre")
+            method = "centre"
         grid = mosaic_grid(sources)
-        options = MosaicOptions(method=v.method, feather_px=v.feather)
+        options = MosaicOptions(method=method, feather_px=v.feather)
 
         def read(k: int, win: tuple[int, int, int, int]):
             return readers[k].read(win), readers[k].read_mask(win)

@@ -138,8 +138,12 @@ def mosaic_grid(sources: Sequence[MosaicSource]) -> Grid:
 
 
 def _scores(src: MosaicSource, xs: NDArray, ys: NDArray, method: str, z_ref: float) -> NDArray:
-    """(rows, cols) score of a source at cell centres ys x xs: lower is better."""
-    if method == "nadir" and src.centre is not None:
+    """(rows, cols) score of a source at cell centres ys x xs: lower is better. ``nadir``
+    needs every source's centre (a tangent and a distance do not compare)."""
+    if method == "nadir":
+        if src.centre is None:
+            raise InputError(f"orthophoto '{src.name}' has no perspective centre: "
+                             "use the method centre")  # fmt: skip
         cx, cy, cz = src.centre
         height = max(cz - z_ref, 1e-6)
         return np.hypot(xs[None, :] - cx, ys[:, None] - cy) / height

@@ -193,6 +193,34 @@ def test_mosaic_choice_is_the_most_nadir_view():
     assert (label[hole] != 1).all() and (label == 1).sum() > 1000
 
 
+def test_mosaic_nadir_weighs_the_flying_height_and_needs_every_centre():
+    """Centres at different heights: the choice is the smallest tangent of the nadir angle
+    (horizontal distance / height), not the nearest centre; a source without a centre is
+    refused for the nadir method (its distance would not compare with a tangent)."""
+    grid = Grid(0.0, 100.0, 1.0, 100, 100)
+    centres = [(20.0, 50.0, 100.0), (70.0, 50.0, 400.0)]  # the second is four times higher
+    srcs = [MosaicSource(f"i{k}", grid, c, 0.0, None) for k, c in enumerate(centres)]
+
+    def read(k, win):
+        _c0, _r0, w, h = win
+        return np.full((1, h, w), k + 1, np.uint8), np.ones((h, w), bool)
+
+    label = np.zeros((grid.rows, grid.cols), int)
+    for t in mosaic_tiles(srcs, grid, read, 1, np.uint8, MosaicOptions(tile_px=64)):
+        h, w = t.label.shape
+        label[t.row0 : t.row0 + h, t.col0 : t.col0 + w] = t.label
+    xs = np.arange(grid.cols) + 0.5
+    ys = grid.y_top - (np.arange(grid.rows) + 0.5)
+    gx, gy = np.meshgrid(xs, ys)
+    tan = np.stack([np.hypot(gx - c[0], gy - c[1]) / c[2] for c in centres])
+    dist = np.stack([np.hypot(gx - c[0], gy - c[1]) for c in centres])
+    np.testing.assert_array_equal(label, np.argmin(tan, axis=0))
+    assert (np.argmin(tan, axis=0) != np.argmin(dist, axis=0)).sum() > 500  # it matters here
+    srcs[0] = MosaicSource("i0", grid, None, 0.0, None)
+    with pytest.raises(InputError, match="'i0' has no perspective centre"):
+        list(mosaic_tiles(srcs, grid, read, 1, np.uint8, MosaicOptions(tile_px=64)))
+
+
 def test_feathering_blends_linearly_across_the_seam():
     """Two constant orthophotos (100 and 200) with the seam half-way between their centres:
     across it the mosaic goes from 100 to 200 linearly over the feathering width."""
