@@ -1400,6 +1400,7 @@ def adjust(
     extra_warnings: list[str] = []
     robust_text = ""
     initial = True
+    robust_run, ok = None, False
     if opts.robust != "none":
         reporter.span(0.0, 0.3)
         x, vhat, flagged, rob = _robust(problem, x, vhat, active, opts, crit, reporter,
@@ -1412,8 +1413,9 @@ def adjust(
         )
         trial = [a & ~f for a, f in zip(active, flagged)]
         trial, gone = _cascade(problem, trial)
-        try:
-            _run(problem, x, vhat, trial, opts, reporter, should_stop, initial=False)
+        try:  # the adjustment without the flagged groups: kept as the final run below
+            robust_run = _run(problem, x, vhat, trial, opts, reporter, should_stop,
+                              initial=False)  # fmt: skip
             ok = True
         except NotObservableError:
             ok = False
@@ -1437,7 +1439,10 @@ def adjust(
         reporter.span(0.3 if opts.robust != "none" else 0.0, 0.5)
     elif opts.robust != "none":
         reporter.span(0.3, 1.0)
-    run = _run(problem, x, vhat, active, opts, reporter, should_stop, initial=initial)
+    if robust_run is not None and ok:
+        run = robust_run  # the same adjustment (same start, same active groups): not again
+    else:
+        run = _run(problem, x, vhat, active, opts, reporter, should_stop, initial=initial)
     result = _finish(problem, run, active, opts, want_cov)
     if not opts.snooping:
         result.outlier_method = (

@@ -157,7 +157,9 @@ def test_sparse_reduced_system_equals_the_dense_one(monkeypatch):
     eo = prior_block("eo", np.arange(n_eo), x_true[:n_eo], 1.0)
     dense = adjust(x0, names, [block, pri, eo], options=AdjustmentOptions(eliminate=elim))
     monkeypatch.setattr(schur, "_DENSE_MAX", 10)
+    monkeypatch.setattr(schur, "_SPARSE_MAX_DENSITY", 1.0)  # this small block is dense
     sparse = adjust(x0, names, [block, pri, eo], options=AdjustmentOptions(eliminate=elim))
+    assert dense.solver == "dense" and sparse.solver == "sparse"  # two paths compared
     assert_allclose(sparse.x, dense.x, atol=1e-9 * np.abs(dense.x).max())
     assert_allclose(sparse.std, dense.std, rtol=1e-8)
 
