@@ -589,9 +589,11 @@ def resect(
     opts = options if options is not None else ResectionOptions()
     n_unknown = 9 if opts.estimate_interior else 6
     m = _conditions_count(data, opts.model)
-    if m < n_unknown:
+    # what fixes the pose: 2 per point and 2 per line, however many points a line has
+    determined = 2 * data.n_points + 2 * data.n_lines
+    if determined < n_unknown:
         raise InputError(
-            f"{data.n_points} control point(s) and {data.n_lines} line(s) give {m} "
+            f"{data.n_points} control point(s) and {data.n_lines} line(s) give {determined} "
             f"conditions for {n_unknown} unknowns"
             + (" (exterior and interior orientation)" if opts.estimate_interior else "")
             + ": measure more points or lines (a point gives 2 conditions, a line 2)"

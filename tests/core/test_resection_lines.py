@@ -331,6 +331,20 @@ def test_bad_input_is_refused(kwargs, message):
         resect(ResectionData(**kwargs), make_scene(0).camera)
 
 
+def test_two_lines_measured_at_three_points_are_two_lines():
+    """Points on one image line add equations, not information: two lines (4 conditions)
+    are refused before the start-pose search, whatever the points measured on them."""
+    scene = make_scene(3, n_points=0, n_lines=2)
+    data = scene.observe(None, points=False)
+    from dataclasses import replace
+
+    data = replace(data, line_pixels=tuple(
+        np.vstack([p[0], 0.5 * (p[0] + p[-1]), p[-1]]) for p in data.line_pixels),
+        line_sigma_px=tuple(np.full(3, 0.5) for _ in data.line_pixels))  # fmt: skip
+    with pytest.raises(InputError, match="2 line\\(s\\) give 4 conditions for 6 unknowns"):
+        resect(data, scene.camera)
+
+
 def test_too_few_for_the_interior_orientation():
     scene = make_scene(3, n_points=4, n_lines=0)
     with pytest.raises(InputError, match="8 conditions for 9 unknowns"):
