@@ -7,11 +7,12 @@ Spheres
 -------
 RANSAC (Fischler & Bolles 1981) on four-point spheres (algebraic solution of
 ``|p|^2 + D.p + E = 0``), hypotheses whose radius is far from the known one discarded, the
-inliers scored with the known radius. Then a Gauss-Helmert adjustment (:mod:`core.lsq`) of
-the condition ``|p_i + v_i - c| - R = 0`` with each point's covariance from the scanner's
-noise (range along the beam, angles across it): the centre ``c`` (and, optionally, ``R``) with
-its a-posteriori covariance. Outliers beyond 3.5 sigma of the refined sphere are dropped and
-the fit repeated once.
+inliers scored with the known radius. Then a least-squares fit (:mod:`core.lsq`) of the
+radial misfits ``|p_i - c| - R``, each weighted with its point's variance along the sphere
+normal from the scanner's noise (range along the beam, angles across it): the Gauss-Helmert
+equivalent weight at the approximate centre. It gives the centre ``c`` (and, optionally, ``R``)
+with its a-posteriori covariance. Outliers beyond 3.5 sigma of the refined sphere are dropped
+and the fit repeated once; the inlier count and RMS reported are those of the points fitted.
 
 Checkerboards
 -------------
@@ -269,6 +270,7 @@ def fit_sphere(
             raise InputError(f"only {int(inl.sum())} points on the sphere (at least "
                              f"{min_points} needed)")  # fmt: skip
         c, ccov, r, s0 = _sphere_lsq(p[inl], cov[inl], c, r, free)
+        fitted = inl  # the set the centre, radius and covariance come from
         d = np.linalg.norm(p - c, axis=1) - r
         # Normalised distance with each point's sigma along the sphere normal.
         u = (p - c) / np.linalg.norm(p - c, axis=1)[:, None]
@@ -277,9 +279,9 @@ def fit_sphere(
         if np.array_equal(new, inl):
             break
         inl = new
-    rms = float(np.sqrt(np.mean(d[inl] ** 2)))
+    rms = float(np.sqrt(np.mean(d[fitted] ** 2)))
     towards = -c / max(np.linalg.norm(c), 1e-12)
-    return TargetFit("sphere", c, ccov, p.shape[0], int(inl.sum()), rms, s0, r, towards)
+    return TargetFit("sphere", c, ccov, p.shape[0], int(fitted.sum()), rms, s0, r, towards)
 
 
 # ----------------------------------------------------------------------------- checkerboards
