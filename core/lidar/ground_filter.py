@@ -632,7 +632,9 @@ def ground_filter(
     stats: dict[str, Any] = {}
     if p.method == "csf":
         g_xy = 1.0 / vertical_unit_to_metre if vertical_unit_to_metre > 0 else 1.0
-        dtm, windows, thresholds = _csf_cloth(grid, flat, x, y, zc, zmin, p, g_xy, should_stop)
+        dtm, steps, moved = _csf_cloth(grid, flat, x, y, zc, p, g_xy, should_stop)
+        windows, thresholds = [], []  # no openings in CSF
+        stats["csf_steps"], stats["csf_last_move"] = steps, moved
         reach = np.ones(dtm.shape, dtype=bool)
         thr_cell = np.full(dtm.size, p.threshold, dtype=np.float32)
     else:
@@ -718,11 +720,10 @@ def _csf_cloth(
     x: NDArray[np.float64],
     y: NDArray[np.float64],
     zc: NDArray[np.float32],
-    zmin: NDArray[np.float32],
     p: CsfParams,
     metre: float,
     should_stop: Callable[[], bool] | None,
-) -> tuple[NDArray[np.float32], list[int], list[float]]:
+) -> tuple[NDArray[np.float32], int, float]:
     """The cloth (Zhang et al. 2016) as a ground surface at the cell centres, in the upright
     frame (z relative to the lowest point); also the number of steps and the last largest move.
 
@@ -778,7 +779,7 @@ def _csf_cloth(
             break
     if p.slope_smooth:
         _csf_smooth(height, ihv, movable, CSF_SMOOTH_M * metre)
-    return (-height).astype(np.float32), [done], [round(moved, 6)]
+    return (-height).astype(np.float32), done, round(moved, 6)
 
 
 def _spring_pairs(rows: int, cols: int) -> list[tuple[tuple[slice, slice], tuple[slice, slice]]]:
