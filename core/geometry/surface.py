@@ -20,6 +20,7 @@ the raster's outer edge.
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 from collections.abc import Callable
@@ -70,9 +71,9 @@ class Dsm:
         """(x, y) of the centre of cell (0, 0)."""
         return self.grid.x0 + 0.5 * self.grid.cell, self.grid.y_top - 0.5 * self.grid.cell
 
-    @property
+    @functools.cached_property
     def z_range(self) -> tuple[float, float]:
-        """(min, max) of the valid heights."""
+        """(min, max) of the valid heights (computed once: a DSM's heights are not edited)."""
         return float(np.nanmin(self.heights)), float(np.nanmax(self.heights))
 
     def to_grid_uv(self, x: ArrayLike, y: ArrayLike) -> tuple[Array, Array]:

@@ -183,7 +183,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                     dsm.cell)  # fmt: skip
     # the skipping pyramid of the ray casting only for true orthophotos (built once)
     surface = DsmTracer.build(dsm) if options.true_ortho else dsm
-    zmin = float(np.nanmin(dsm.heights))
+    zmin = dsm.z_range[0]
     lens = _lens_lattice(camera)
     g = dsm.grid  # one ENU frame (at the DSM's centre) and one lens lattice for every image
     local = LocalFrame.at_map_point(MappingFrame(mapping), [g.x0 + g.cols * g.cell / 2,
