@@ -1159,48 +1159,48 @@ def _interior_table(run: _Run, options: BundleOptions, dropped: dict) -> tuple[
 
 
 def _drop_candidate(run: _Run, options: BundleOptions) -> tuple[int, int, str] | None:
-    """(camera, interior position, reason) of the AP to drop next, or None."""
+    """(camera, interior position, reason) of the AP to drop next, or None: the least
+    significant insignificant AP of any camera first; only when every AP is significant, the
+    AP of the most correlated pair (a t-value and a correlation are never compared)."""
     res = run.result
     r = max(res.redundancy, 1)
     tcrit = float(stats.t.ppf(1 - options.ap_alpha / 2, r))
-    worst = None
+    per_camera = []
     for c, cam in enumerate(run.cams):
         idx = run.lay.interior[c]
-        free = run.lay.free[c]
-        if not idx.size:
-            continue
-        vals, sds = res.x[idx], res.std[idx]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = np.abs(vals) / sds
-        names = cam.interior_names
-        for k in range(idx.size):
-            if free[k] < 3 or not t[k] <= tcrit:
-                continue
-            cand = (float(t[k]), c, int(free[k]),
-                    f"insignificant (t = {t[k]:.2f} <= {tcrit:.2f}, alpha {options.ap_alpha:g})")
-            if worst is None or cand[0] < worst[0]:
-                worst = cand
-        if worst is not None:
-            continue
+        if idx.size:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = np.abs(res.x[idx]) / res.std[idx]
+            per_camera.append((c, cam, idx, run.lay.free[c], t))
+    insignificant = [
+        (float(t[k]), c, int(free[k]),
+         f"insignificant (t = {t[k]:.2f} <= {tcrit:.2f}, alpha {options.ap_alpha:g})")
+        for c, _cam, idx, free, t in per_camera
+        for k in range(idx.size)
+        if free[k] >= 3 and t[k] <= tcrit
+    ]  # fmt: skip
+    if insignificant:
+        _, c, k, why = min(insignificant, key=lambda q: q[0])
+        return c, k, why
+    correlated = []
+    for c, cam, idx, free, t in per_camera:
         corr = res.correlation_of(idx)
+        names = cam.interior_names
         for a in range(idx.size):
             for b in range(a + 1, idx.size):
-                if not abs(corr[a, b]) > options.max_correlation:
+                pick = [k for k in (a, b) if free[k] >= 3]
+                if not abs(corr[a, b]) > options.max_correlation or not pick:
                     continue
                 # drop the AP of the pair (the less significant one when both are APs)
-                pick = [k for k in (a, b) if free[k] >= 3]
-                if not pick:
-                    continue
                 k = min(pick, key=lambda q: t[q])
                 other = b if k == a else a
-                cand = (-abs(float(corr[a, b])), c, int(free[k]),
-                        f"|correlation| {abs(corr[a, b]):.3f} > {options.max_correlation:g} "
-                        f"with {names[free[other]]}")  # fmt: skip
-                if worst is None or cand[0] < worst[0]:
-                    worst = cand
-    if worst is None:
-        return None
-    return worst[1], worst[2], worst[3]
+                why = (f"|correlation| {abs(corr[a, b]):.3f} > {options.max_correlation:g} "
+                       f"with {names[free[other]]}")  # fmt: skip
+                correlated.append((abs(float(corr[a, b])), c, int(free[k]), why))
+    if correlated:
+        _, c, k, why = max(correlated, key=lambda q: q[0])
+        return c, k, why
+    return None
 
 
 def _check_points(setup: _Setup, obs: ImageObservations, cams: list[Camera], eo: Array,
