@@ -32,6 +32,7 @@ from ..core.photo.dock_bundle import (
     dock_bundle_inputs,
     orientations_of,
 )
+from ..core.quality.html_table import escape
 from .job_task import JobTask
 
 __all__ = ["BUNDLE_ALG", "BundleController", "BundlePanel", "bundle_parameters"]
@@ -145,7 +146,7 @@ class BundlePanel(QWidget):
             if p.status == "estimated":
                 flag = self.tr("significant") if p.significant else ""
             else:
-                flag = p.status + (f": {p.reason}" if p.reason else "")
+                flag = escape(p.status + (f": {p.reason}" if p.reason else ""))
             ap.append(
                 f"<tr><td>{p.name}</td><td>{p.value:.6g}</td><td>"
                 f"{p.std:.3g}</td><td>{flag}</td></tr>"
@@ -155,7 +156,7 @@ class BundlePanel(QWidget):
         ap.append("</table>")
         img = ["<table><tr><th>image</th><th>RMS col px</th><th>RMS row px</th></tr>"]
         for image_id, (rc, rr) in res.image_rms.items():
-            img.append(f"<tr><td>{image_id}</td><td>{rc:.2f}</td><td>{rr:.2f}</td></tr>")
+            img.append(f"<tr><td>{escape(image_id)}</td><td>{rc:.2f}</td><td>{rr:.2f}</td></tr>")
         img.append("</table>")
         text = head + "".join(ap) + "".join(img)
         self.result_label.setText(text)

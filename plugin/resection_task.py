@@ -26,6 +26,7 @@ from ..core.jobs import resection
 from ..core.jobs.resection import residual_rows
 from ..core.photo.control_features import lines_with_end_sigmas
 from ..core.photo.picking_session import residual_summary
+from ..core.quality.html_table import escape
 from .job_task import JobTask
 
 __all__ = ["RESECTION_ALG", "ResectionController", "ResectionPanel", "resection_parameters"]
@@ -117,7 +118,7 @@ class ResectionPanel(QWidget):
         for kind, target, n, rms, vmax, rejected in residual_summary(rows):
             flag = self.tr("rejected") if rejected else ""
             table.append(
-                f"<tr><td>{kind}</td><td>{target}</td><td>{n}</td><td>{rms:.2f}</td>"
+                f"<tr><td>{kind}</td><td>{escape(target)}</td><td>{n}</td><td>{rms:.2f}</td>"
                 f"<td>{vmax:.2f}</td><td>{flag}</td></tr>"
             )
         text = head + "".join(table) + "</table>"
