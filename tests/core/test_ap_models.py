@@ -177,6 +177,8 @@ def test_every_family_is_registered_and_read_from_a_camera_file():
     for option, model in AP_FAMILIES.items():
         assert model in DISTORTION_MODELS, option
         lens = make_ap_model(option, 6.16, 4.62, 5.0)
+        # distinct non-zero coefficients: a swapped or misnamed one would not read back equal
+        lens = lens.with_params(1e-6 * (1.0 + np.arange(lens.params.size)))
         cam = camera_from_dict(
             {
                 "focal_mm": 5.0,
