@@ -533,12 +533,11 @@ def _eo_to_local(eo: ExteriorOrientationTable, local: LocalFrame) -> Array:
 
 def _eo_cov_to_local(eo: ExteriorOrientationTable, sigma: Array, local: LocalFrame) -> Array:
     """Covariance (M, 6, 6) in the local frame of orientations with map-frame sigmas (M, 6)."""
-    base = _eo_to_local(eo, local)
     jac = np.zeros((len(eo), 6, 6))
     steps = np.array([0.01, 0.01, 0.01, 1e-6, 1e-6, 1e-6])
+    values = np.concatenate([eo.xyz, eo.opk], axis=1)
     for k in range(6):
-        plus = np.concatenate([eo.xyz, eo.opk], axis=1)
-        minus = plus.copy()
+        plus, minus = values.copy(), values.copy()
         plus[:, k] += steps[k]
         minus[:, k] -= steps[k]
         tp = replace(eo, xyz=plus[:, :3], opk=plus[:, 3:])
@@ -546,7 +545,6 @@ def _eo_cov_to_local(eo: ExteriorOrientationTable, sigma: Array, local: LocalFra
         d = _eo_to_local(tp, local) - _eo_to_local(tm, local)
         d[:, 3:] = (d[:, 3:] + np.pi) % (2 * np.pi) - np.pi
         jac[:, :, k] = d / (2 * steps[k])
-    del base
     cov_map = np.zeros((len(eo), 6, 6))
     cov_map[:, np.arange(6), np.arange(6)] = sigma**2
     return jac @ cov_map @ np.swapaxes(jac, 1, 2)
