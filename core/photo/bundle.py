@@ -65,6 +65,7 @@ from ..geometry.rotations import matrix_to_opk, opk_derivatives, opk_to_matrix
 from ..lsq.adjustment import adjust
 from ..lsq.model import AdjustmentOptions, Constraint, GaussMarkovBlock
 from ..lsq.results import AdjustmentResult
+from .intersection import meet_rays
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_local_to_map, eo_map_to_local
 
@@ -463,32 +464,6 @@ def _components(img: NDArray[np.intp], pts: NDArray[np.intp], n_img: int, n_pts:
     return connected_components(graph, directed=False)
 
 
-# ----------------------------------------------------------------------------- growth
-
-
-def _intersect(
-    centres: Array, rays: Array, point_of: NDArray[np.intp], n_points: int
-) -> tuple[Array, NDArray[np.intp]]:
-    """Least-squares meeting point of the rays of each point (and the ray count)."""
-    proj = np.eye(3) - rays[:, :, None] * rays[:, None, :]
-    a = np.zeros((n_points, 3, 3))
-    b = np.zeros((n_points, 3))
-    for i in range(3):
-        for j in range(3):
-            a[:, i, j] = np.bincount(point_of, weights=proj[:, i, j], minlength=n_points)
-        b[:, i] = np.bincount(point_of, weights=np.einsum("nij,nj->ni", proj, centres)[:, i],
-                              minlength=n_points)  # fmt: skip
-    counts = np.bincount(point_of, minlength=n_points)
-    xyz = np.full((n_points, 3), np.nan)
-    ok = np.flatnonzero(counts >= 2)
-    if ok.size:
-        # rays meeting at less than about 0.05 degrees do not fix a point
-        good = ok[np.linalg.eigvalsh(a[ok])[:, 0] > 1e-7]
-        if good.size:
-            xyz[good] = np.linalg.solve(a[good], b[good][:, :, None])[:, :, 0]
-    return xyz, counts
-
-
 # ----------------------------------------------------------------------------- the problem
 
 
@@ -762,7 +737,7 @@ def _rays(cams, image_cam, eo, obs, obs_img, rows):
 def _approximate_points(cams, image_cam, eo, obs, obs_img, obs_pt, n_points) -> Array:
     rows = np.flatnonzero(obs_pt >= 0)
     o, d = _rays(cams, image_cam, eo, obs, obs_img, rows)
-    return _intersect(o, d, obs_pt[rows], n_points)[0]
+    return meet_rays(o, d, obs_pt[rows], n_points)[0]
 
 
 def _grow(cams, image_cam, obs, obs_img, obs_pt, control_pt, control_local, n_img, n_pts,
@@ -803,7 +778,7 @@ def _grow(cams, image_cam, obs, obs_img, obs_pt, control_pt, control_local, n_im
         rows = np.flatnonzero((obs_pt >= 0) & oriented[obs_img])
         if rows.size:
             o, d = _rays(cams, image_cam, np.nan_to_num(eo), obs, obs_img, rows)
-            xyz = _intersect(o, d, obs_pt[rows], n_pts)[0]
+            xyz = meet_rays(o, d, obs_pt[rows], n_pts)[0]
             new = np.isfinite(xyz).all(axis=1) & ~np.isfinite(known).all(axis=1)
             if new.any():
                 known[new] = xyz[new]
@@ -1211,7 +1186,7 @@ def _check_points(setup: _Setup, obs: ImageObservations, cams: list[Camera], eo:
         return CheckPointResult((), z, z, z, np.zeros(0, dtype=np.int64))
     pt = setup.obs_check[rows]
     o, d = _rays(cams, setup.image_cam, eo, obs, setup.obs_img, rows)
-    xyz, counts = _intersect(o, d, pt, n)
+    xyz, counts = meet_rays(o, d, pt, n)
     cov = np.full((n, 3, 3), np.nan)
     for _ in range(10):
         N = np.zeros((n, 3, 3))

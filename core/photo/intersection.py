@@ -17,6 +17,47 @@ from .orientation import ExteriorOrientationTable, eo_map_to_local
 Array = NDArray[np.float64]
 
 
+def meet_rays(
+    centres: Array, rays: Array, point_of: NDArray[np.intp], n_points: int
+) -> tuple[Array, NDArray[np.intp]]:
+    """Least-squares meeting point of the rays of each point, and each point's ray count.
+
+    Parameters
+    ----------
+    centres, rays : ndarray, shape (N, 3)
+        Ray origins and unit directions, one Cartesian frame (metres).
+    point_of : ndarray of int, shape (N,)
+        Point number ``0 .. n_points - 1`` of every ray.
+
+    Returns
+    -------
+    xyz : ndarray, shape (n_points, 3)
+        The point minimising the sum of squared perpendicular distances to its rays; NaN for
+        points with fewer than two rays or rays meeting at less than about 0.05 degrees,
+        which do not fix a point.
+    counts : ndarray of int, shape (n_points,)
+
+    >>> c = np.array([[0.0, 0, 10], [10, 0, 10]])
+    >>> r = np.array([[0.0, 0, -1], [-1, 0, -1]]) / np.array([[1.0], [np.sqrt(2)]])
+    >>> xyz, n = meet_rays(c, r, np.array([0, 0]), 1)
+    >>> np.round(xyz, 9).tolist(), n.tolist()
+    ([[0.0, 0.0, 0.0]], [2])
+    """
+    proj = np.eye(3) - rays[:, :, None] * rays[:, None, :]  # removes the along-ray component
+    a = np.zeros((n_points, 3, 3))
+    b = np.zeros((n_points, 3))
+    np.add.at(a, point_of, proj)
+    np.add.at(b, point_of, np.einsum("nij,nj->ni", proj, centres))
+    counts = np.bincount(point_of, minlength=n_points)
+    xyz = np.full((n_points, 3), np.nan)
+    ok = np.flatnonzero(counts >= 2)
+    if ok.size:
+        good = ok[np.linalg.eigvalsh(a[ok])[:, 0] > 1e-7]
+        if good.size:
+            xyz[good] = np.linalg.solve(a[good], b[good][:, :, None])[:, :, 0]
+    return xyz, counts
+
+
 def forward_intersection(
     observations: ImageObservations,
     eo: ExteriorOrientationTable,
@@ -28,7 +69,8 @@ def forward_intersection(
 
     Each point is the least-squares meeting point of its rays (minimum sum of squared
     perpendicular distances), solved in the adjustment frame ``local`` and returned in the
-    mapping CRS. Points seen in fewer than two images are skipped.
+    mapping CRS. Points seen in fewer than two images, or whose rays are nearly parallel,
+    are skipped.
 
     Returns
     -------
@@ -41,7 +83,6 @@ def forward_intersection(
     image_of = {i: k for k, i in enumerate(eo.image_id)}
     sel = np.array([r for r in sel if observations.image_id[r] in image_of], dtype=np.intp)
     names, inv = np.unique(np.array(observations.point_id)[sel], return_inverse=True)
-    counts = np.bincount(inv, minlength=len(names))
     if sel.size == 0:
         return [], np.empty((0, 3)), np.empty(0, dtype=np.int64)
     centres, m = eo_map_to_local(eo.xyz, eo.opk, local)
@@ -50,13 +91,9 @@ def forward_intersection(
     ray_c = np.column_stack([ideal, np.full(sel.size, -camera.focal_mm)])
     d = np.einsum("nji,nj->ni", m[img], ray_c)
     d /= np.linalg.norm(d, axis=1, keepdims=True)
-    proj = np.eye(3) - d[:, :, None] * d[:, None, :]  # removes the along-ray component
-    a = np.zeros((len(names), 3, 3))
-    b = np.zeros((len(names), 3))
-    np.add.at(a, inv, proj)
-    np.add.at(b, inv, np.einsum("nij,nj->ni", proj, centres[img]))
-    ok = counts >= 2
-    xyz = np.linalg.solve(a[ok], b[ok][:, :, None])[:, :, 0]
+    xyz, counts = meet_rays(centres[img], d, inv, len(names))
+    ok = np.isfinite(xyz[:, 0])
+    xyz = xyz[ok]
     return [str(v) for v in names[ok]], local.enu_to_map(xyz), counts[ok].astype(np.int64)
 
 
