@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.spatial.transform import Rotation
 
 from ..errors import InputError, NotObservableError
 from ..geometry.camera import Camera
@@ -167,15 +168,6 @@ def _system(
     return a, p, np.einsum("li,lj->lij", p, a).reshape(-1, 9)  # kron(P, a) per row
 
 
-def _exp(step: Array) -> Array:
-    """Rotation matrices (S, 3, 3) of rotation vectors (S, 3) (Rodrigues)."""
-    angle = np.linalg.norm(step, axis=1)
-    axis = step / np.where(angle > 0, angle, 1.0)[:, None]
-    kx = skew(axis)
-    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
-    return np.eye(3) + s * kx + (1 - c) * (kx @ kx)
-
-
 def _refine(k_sqrt: Array, r0: Array, iterations: int = 40) -> tuple[Array, Array]:
     """Levenberg-Marquardt on SO(3) for a batch of starts ``r0`` (S, 3, 3): min ||L vec(R)||^2
     with ``R = exp([d]x) R``; returns the rotations (S, 3, 3) and their costs (S,)."""
@@ -191,7 +183,7 @@ def _refine(k_sqrt: Array, r0: Array, iterations: int = 40) -> tuple[Array, Arra
         damp = lam[:, None, None] * (np.eye(3) * (np.diagonal(n, axis1=1, axis2=2)[:, None, :]
                                                   + 1e-12))  # fmt: skip
         step = -np.linalg.solve(n + damp, g[:, :, None])[:, :, 0]
-        trial = _exp(step) @ r
+        trial = Rotation.from_rotvec(step).as_matrix() @ r
         c = np.sum((_vec(trial) @ k_sqrt.T) ** 2, axis=1)
         better = c <= cost
         r = np.where(better[:, None, None], trial, r)
