@@ -34,7 +34,15 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..photo.orientation import ExteriorOrientationTable
-from .tables import find_column, float_column, read_table, text_column, unique_ids, write_csv_atomic
+from .tables import (
+    Table,
+    find_column,
+    float_column,
+    read_table,
+    text_column,
+    unique_ids,
+    write_csv_atomic,
+)
 
 EO_COLUMNS = ("image_id", "time", "group", "X", "Y", "Z", "omega_deg", "phi_deg", "kappa_deg")
 EO_SIGMA_COLUMNS = (
@@ -99,7 +107,10 @@ def eo_csv_text(eo: ExteriorOrientationTable) -> str:
 
 def read_eo_csv(path: Union[str, Path], crs_wkt: str = "") -> ExteriorOrientationTable:
     """Read a table written by :meth:`ExteriorOrientationTable.to_csv` (or made by hand)."""
-    table = read_table(path)
+    return _eo_from_table(read_table(path), crs_wkt)
+
+
+def _eo_from_table(table: Table, crs_wkt: str) -> ExteriorOrientationTable:
     ids = unique_ids(table, find_column(table, ("image_id", "image", "id", "name")))
     t_col = find_column(table, ("time",), required=False)
     g_col = find_column(table, ("group",), required=False)
@@ -127,8 +138,8 @@ def read_eo_csv(path: Union[str, Path], crs_wkt: str = "") -> ExteriorOrientatio
 
 def read_eo_csv_full(path: Union[str, Path], crs_wkt: str = "") -> EoFile:
     """Read the EO table with its optional sigma and camera columns (module docstring)."""
-    eo = read_eo_csv(path, crs_wkt)
     table = read_table(path)
+    eo = _eo_from_table(table, crs_wkt)
     cols = [find_column(table, a, required=False) for a in _SIGMA_ALIASES]
     sigma = None
     given = [c for c in cols if c is not None]
