@@ -30,7 +30,8 @@ unit):
    count (ties: first point index), and an **outline**: the plane's points rasterised in x, y
    at ``outline_cell`` (default: the median distance to the 4th nearest neighbour, about one
    point spacing), closed morphologically (3x3, OpenCV), the outer contour of the largest
-   blob (cv2.findContours) simplified by Douglas-Peucker at half a cell, with z on the plane.
+   blob (cv2.findContours) simplified by Douglas-Peucker at half a cell, counter-clockwise in
+   x, y, with z on the plane.
    It is a concave hull for display, not a measured building outline.
 """
 
@@ -761,7 +762,8 @@ def _outline(xyz: Array, plane: Plane, cell: float) -> Array:
         poly = biggest.reshape(-1, 2).astype(np.float64)
     # cell (i, j) covers [i, i + 1) * cell from lo - 2 cells: its centre is at i + 0.5
     pxy = lo + (poly - 2 + 0.5) * cell
-    if cv2.contourArea(poly.astype(np.float32)) < 0:  # keep counter-clockwise in x, y
+    x, y = pxy[:, 0], pxy[:, 1]
+    if np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y) < 0:  # shoelace: clockwise
         pxy = pxy[::-1]
     a, b, c = plane.normal
     z = (

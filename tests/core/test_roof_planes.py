@@ -180,9 +180,11 @@ def test_outlines_cover_the_faces(town, scene):
     for plane in res.planes:
         truth = town.faces[by_plane[plane.id]]
         xy = plane.outline[:, :2]
-        area = 0.5 * abs(
+        signed = 0.5 * (
             np.dot(xy[:, 0], np.roll(xy[:, 1], -1)) - np.dot(xy[:, 1], np.roll(xy[:, 0], -1))
         )
+        assert signed > 0, plane.id  # counter-clockwise in x, y (docs/conventions.md)
+        area = signed
         plan_area = truth.area * truth.normal[2]
         assert 0.7 * plan_area < area < 1.4 * plan_area, (plane.id, area, plan_area)
         assert np.abs(plane.distance(plane.outline)).max() < 1e-6  # vertices on the plane
