@@ -98,8 +98,19 @@ def test_output_set_commits_the_geotiff_and_its_sidecars(tmp_path):
         assert src.info.nodata == -9999.0
 
 
-def test_backend_is_a_gdal_binding():
-    assert raster_backend() in ("gdal", "rasterio")
+def test_backend_prefers_osgeo_and_honours_the_override(monkeypatch):
+    import importlib.util
+
+    monkeypatch.delenv("LIDARPHOTO_RASTER_BACKEND", raising=False)
+    have_gdal = importlib.util.find_spec("osgeo") is not None
+    have_rio = importlib.util.find_spec("rasterio") is not None
+    assert raster_backend() == ("gdal" if have_gdal else "rasterio")
+    if have_rio:
+        monkeypatch.setenv("LIDARPHOTO_RASTER_BACKEND", "rasterio")
+        assert raster_backend() == "rasterio"
+    if have_gdal:
+        monkeypatch.setenv("LIDARPHOTO_RASTER_BACKEND", "GDAL")
+        assert raster_backend() == "gdal"
 
 
 def test_rasterio_keeps_its_own_proj_database_when_proj_data_points_elsewhere(tmp_path):
