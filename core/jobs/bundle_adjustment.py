@@ -368,16 +368,19 @@ def _check_on_image(obs, image_camera: dict[str, str], cams) -> None:
 
     from ..errors import InputError
 
-    size = {c.name: (c.width_px, c.height_px) for c in cams}
-    wh = np.array([size.get(image_camera.get(im, ""), (np.inf, np.inf)) for im in obs.image_id],
-                  dtype=float).reshape(-1, 2)  # fmt: skip
-    off = np.flatnonzero(((obs.pixels < 0) | (obs.pixels > wh)).any(axis=1))
+    cam_of = np.array([image_camera.get(im, "") for im in obs.image_id], dtype=object)
+    outside = np.zeros(len(cam_of), dtype=bool)
+    for c in cams:
+        rows = cam_of == c.name
+        outside[rows] = ~c.in_frame(obs.pixels[rows])
+    off = np.flatnonzero(outside)
     if off.size:
         k = int(off[0])
-        cam = image_camera[obs.image_id[k]]
+        cam = next(c for c in cams if c.name == cam_of[k])
         raise InputError(
             f"pixel ({obs.pixels[k, 0]:g}, {obs.pixels[k, 1]:g}) is off the image: camera "
-            f"'{cam}' has {size[cam][0]} x {size[cam][1]} pixels; {off.size} row(s) affected",
+            f"'{cam.name}' has {cam.width_px} x {cam.height_px} pixels; {off.size} row(s) "
+            "affected",
             **obs.where(k),
         )
 
