@@ -187,6 +187,17 @@ class MappingFrame:
         return grid_rotation(self.grid_north_azimuth(llh)) @ NED_TO_ENU
 
 
+def _jacobian(f, xyz: ArrayLike, step: float) -> tuple[Array, Array]:
+    """``f`` at points (K, 3) and its Jacobian (K, 3, 3) by central differences."""
+    x = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+    k = x.shape[0]
+    if k == 0:
+        return np.empty((0, 3)), np.empty((0, 3, 3))
+    offsets = np.vstack([np.zeros(3), np.eye(3) * step, -np.eye(3) * step])  # (7, 3)
+    t = f((x[:, None, :] + offsets[None]).reshape(-1, 3)).reshape(k, 7, 3)
+    return t[:, 0], (t[:, 1:4] - t[:, 4:7]).transpose(0, 2, 1) / (2.0 * step)
+
+
 @dataclass(frozen=True)
 class LocalFrame:
     """Local ENU adjustment frame tangent to the ellipsoid at ``origin_llh``.
@@ -226,6 +237,18 @@ class LocalFrame:
 
     def geodetic_to_enu(self, llh: ArrayLike) -> Array:
         return self.ecef_to_enu(self.mapping.geodetic_to_ecef(llh))
+
+    def map_to_enu_jacobian(self, enh: ArrayLike, step: float = 1.0) -> tuple[Array, Array]:
+        """Map -> ENU at points (K, 3) and the Jacobian ``d enu / d map`` (K, 3, 3).
+
+        Central differences of ``step`` (CRS unit): the transformation is smooth at that scale,
+        so the Jacobian is exact to far below the precision of any covariance it carries.
+        """
+        return _jacobian(self.map_to_enu, enh, step)
+
+    def enu_to_map_jacobian(self, enu: ArrayLike, step: float = 1.0) -> tuple[Array, Array]:
+        """ENU -> map at points (K, 3) and the Jacobian ``d map / d enu`` (K, 3, 3), metres."""
+        return _jacobian(self.enu_to_map, enu, step)
 
     def ned_to_local(self, llh: ArrayLike) -> Array:
         """``R_n^l`` per point: NED at each point -> this ENU frame (curvature included)."""

@@ -276,16 +276,6 @@ def _trajectory_llh(trajectory: Trajectory, frame: MappingFrame) -> Array:
     return pos if trajectory.geodetic else frame.map_to_geodetic(pos)
 
 
-def _map_jacobian(local: LocalFrame, xyz: Array, step: float = 1.0) -> tuple[Array, Array]:
-    """Map -> ENU at points (K, 3) and its Jacobian (K, 3, 3) by central differences."""
-    k = xyz.shape[0]
-    offsets = np.vstack([np.zeros(3), np.eye(3) * step, -np.eye(3) * step])  # (7, 3)
-    pts = (xyz[:, None, :] + offsets[None]).reshape(-1, 3)
-    t = local.map_to_enu(pts).reshape(k, 7, 3)
-    jac = (t[:, 1:4] - t[:, 4:7]).transpose(0, 2, 1) / (2.0 * step)
-    return t[:, 0], jac
-
-
 def transform_planes(planes: Sequence, local: LocalFrame) -> tuple[Array, Array, Array]:
     """Planes of the mapping CRS -> (params (P, 4), covariance (P, 4, 4), centroid (P, 3)) in ENU.
 
@@ -297,7 +287,7 @@ def transform_planes(planes: Sequence, local: LocalFrame) -> tuple[Array, Array,
     c = np.array([p.centroid for p in planes], dtype=np.float64)
     pi = np.array([p.params for p in planes], dtype=np.float64)
     cov = np.array([p.covariance for p in planes], dtype=np.float64)
-    tc, jac = _map_jacobian(local, c)
+    tc, jac = local.map_to_enu_jacobian(c)
     kmat = np.linalg.inv(np.swapaxes(jac, 1, 2))
     lin = np.zeros((len(planes), 4, 4))
     lin[:, :3, :3] = kmat
@@ -320,7 +310,7 @@ def transform_lines(lines: Sequence, local: LocalFrame) -> tuple[Array, Array, A
     x0 = np.array([ln.point for ln in lines], dtype=np.float64)
     u = np.array([ln.direction for ln in lines], dtype=np.float64)
     cov = np.array([ln.covariance for ln in lines], dtype=np.float64)
-    tx, jac = _map_jacobian(local, x0)
+    tx, jac = local.map_to_enu_jacobian(x0)
     ju = np.einsum("lij,lj->li", jac, u)
     s = np.linalg.norm(ju, axis=1)
     ul = ju / s[:, None]
@@ -337,7 +327,7 @@ def transform_lcps(points: Sequence, local: LocalFrame) -> tuple[Array, Array]:
         return np.empty((0, 3)), np.empty((0, 3, 3))
     xyz = np.array([p.xyz for p in points], dtype=np.float64)
     cov = np.array([p.covariance for p in points], dtype=np.float64)
-    tx, jac = _map_jacobian(local, xyz)
+    tx, jac = local.map_to_enu_jacobian(xyz)
     c = jac @ cov @ np.swapaxes(jac, 1, 2)
     return tx, 0.5 * (c + np.swapaxes(c, 1, 2))
 

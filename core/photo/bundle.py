@@ -700,26 +700,12 @@ def _prepare(
 
 def _cov_map_to_local(xyz: Array, sigma: Array, local: LocalFrame) -> Array:
     """(N, 3, 3) covariance in the local frame of map coordinates with sigmas (N, 3)."""
-    n = xyz.shape[0]
-    if n == 0:
-        return np.zeros((0, 3, 3))
-    jac = np.zeros((n, 3, 3))
-    for k in range(3):
-        step = np.zeros(3)
-        step[k] = 1.0
-        jac[:, :, k] = (local.map_to_enu(xyz + step) - local.map_to_enu(xyz - step)) / 2.0
-    cov = np.zeros((n, 3, 3))
-    cov[:, np.arange(3), np.arange(3)] = sigma**2
-    return jac @ cov @ np.swapaxes(jac, 1, 2)
+    jac = local.map_to_enu_jacobian(xyz)[1]
+    return jac @ (sigma[:, :, None] ** 2 * np.eye(3)) @ np.swapaxes(jac, 1, 2)
 
 
 def _cov_local_to_map(xyz_local: Array, cov: Array, local: LocalFrame) -> Array:
-    n = xyz_local.shape[0]
-    jac = np.zeros((n, 3, 3))
-    for k in range(3):
-        step = np.zeros(3)
-        step[k] = 1.0
-        jac[:, :, k] = (local.enu_to_map(xyz_local + step) - local.enu_to_map(xyz_local - step)) / 2
+    jac = local.enu_to_map_jacobian(xyz_local)[1]
     return jac @ cov @ np.swapaxes(jac, 1, 2)
 
 

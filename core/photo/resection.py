@@ -817,16 +817,6 @@ class MapResection:
         return self.result.eo
 
 
-def _map_to_local(local: LocalFrame, xyz: Array, step: float = 1.0) -> tuple[Array, Array]:
-    """Mapping-frame points (K, 3) -> ENU and the Jacobian (K, 3, 3), central differences."""
-    k = xyz.shape[0]
-    if k == 0:
-        return np.empty((0, 3)), np.empty((0, 3, 3))
-    offsets = np.vstack([np.zeros(3), np.eye(3) * step, -np.eye(3) * step])
-    t = local.map_to_enu((xyz[:, None, :] + offsets[None]).reshape(-1, 3)).reshape(k, 7, 3)
-    return t[:, 0], (t[:, 1:4] - t[:, 4:7]).transpose(0, 2, 1) / (2.0 * step)
-
-
 def _eo_to_map(local: LocalFrame, eo: Array) -> Array:
     m = opk_to_matrix(eo[3], eo[4], eo[5])[None]
     xyz, opk = eo_local_to_map(eo[None, :3], m, local)
@@ -835,9 +825,9 @@ def _eo_to_map(local: LocalFrame, eo: Array) -> Array:
 
 def data_to_local(data: ResectionData, local: LocalFrame) -> ResectionData:
     """The control of ``data`` (mapping CRS) in the ENU frame, covariances propagated."""
-    xyz, jx = _map_to_local(local, data.xyz)
-    p1, j1 = _map_to_local(local, data.line_p1)
-    p2, j2 = _map_to_local(local, data.line_p2)
+    xyz, jx = local.map_to_enu_jacobian(data.xyz)
+    p1, j1 = local.map_to_enu_jacobian(data.line_p1)
+    p2, j2 = local.map_to_enu_jacobian(data.line_p2)
     jl = np.zeros((data.n_lines, 6, 6))
     jl[:, :3, :3], jl[:, 3:, 3:] = j1, j2
     return replace(

@@ -68,6 +68,24 @@ def test_grid_north_azimuth_matches_proj_factors(frame):
     np.testing.assert_allclose(ours, approx, atol=2e-3)
 
 
+def test_map_enu_jacobians_are_inverse_and_carry_the_scale_factor(frame):
+    p = _points(20)
+    local = LocalFrame.at_map_point(frame, p[0])
+    enu, j = local.map_to_enu_jacobian(p)
+    np.testing.assert_allclose(enu, local.map_to_enu(p), atol=1e-9, rtol=0)
+    back, jinv = local.enu_to_map_jacobian(enu)
+    np.testing.assert_allclose(back, p, atol=1e-7, rtol=0)
+    np.testing.assert_allclose(j @ jinv, np.broadcast_to(np.eye(3), j.shape), atol=1e-8)
+    # a map metre is 1/k ground metres at the point (k: PROJ's point scale factor); the
+    # ellipsoidal height maps 1:1 to the vertical up to the local tilt
+    llh = frame.map_to_geodetic(p)
+    k = np.asarray(Proj(frame.crs).get_factors(llh[:, 1], llh[:, 0]).meridional_scale)
+    ground = np.linalg.svd(j[:, :, :2], compute_uv=False)  # stretch of map E and N, (20, 2)
+    want = (1.0 + llh[:, 2] / 6.371e6) / k  # at height h a map metre spans (R + h) / R more
+    np.testing.assert_allclose(ground, np.column_stack([want, want]), rtol=2e-5)
+    assert local.map_to_enu_jacobian(np.empty((0, 3)))[1].shape == (0, 3, 3)
+
+
 def test_grid_frame_axes_follow_the_grid(frame):
     p = np.array([[385000.0, 7530000.0, 900.0]])
     llh = frame.map_to_geodetic(p)
