@@ -13,7 +13,10 @@ equations of all K patches are formed as one batched product ``J^T J`` and solve
 Resampling is bicubic by default (Keys 1981, a = -0.5; the gradient is the derivative of the
 same interpolating surface): with bilinear resampling the interpolation error of a textured
 patch dominated sigma0 and biased the shift by up to 0.009 px on the synthetic textures of
-the tests; ``interpolation="bilinear"`` is kept for speed.
+the tests; ``interpolation="bilinear"`` is kept (numpy only). With numba installed the
+bicubic inner loop (sampling and the normal equations of each patch) runs compiled
+(:mod:`core.photo.least_squares_matching_numba`, ``backend="auto"``; ``"numpy"`` forces the
+vectorised numpy path, which gives the same numbers).
 
 Convergence: the shift update ``|(da0, db0)|`` below ``shift_tol_px`` (default 0.001 px) within
 ``max_iterations`` (default 30). A posteriori: ``sigma0^2 = v^T v / (n - 8)`` (grey values^2,
@@ -35,6 +38,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from . import least_squares_matching_numba as _numba
 
 Array = NDArray[np.float64]
 
@@ -58,6 +63,7 @@ class LsmOptions:
     min_correlation: float = 0.7
     max_sigma_px: float = 0.2
     interpolation: str = "bicubic"
+    backend: str = "auto"
 
 
 @dataclass(frozen=True)
@@ -240,41 +246,62 @@ def lsm_batch(
     p = x.size
     fv = f.reshape(k_n, p)
     start_pos = a[:, :, 0].copy()
-    # Radiometric start: the gain and offset that map g's window statistics onto f's.
     rad = np.zeros((k_n, 2))
-    rad[:, 1] = 1.0
     status = np.zeros(k_n, dtype=np.int8)
     iters = np.zeros(k_n, dtype=np.int32)
     active = np.ones(k_n, dtype=bool)
     nmat = np.zeros((k_n, 8, 8))
-    first = True
+    fast = cubic and opt.backend != "numpy" and _numba.AVAILABLE
+    if fast:
+        g = np.ascontiguousarray(g)
+        fv = np.ascontiguousarray(fv)
+    # Radiometric start: the gain and offset that map g's statistics at the start onto f's.
+    if fast:
+        gv0 = _numba.samples(g, a, x, y)
+    else:
+        cs = a[:, 0, 0:1] + a[:, 0, 1:2] * x + a[:, 0, 2:3] * y
+        rs = a[:, 1, 0:1] + a[:, 1, 1:2] * x + a[:, 1, 2:3] * y
+        gv0 = _sample(g, np.arange(k_n)[:, None], cs, rs, cubic, grads)[0]
+    sg = gv0.std(axis=1)
+    rad[:, 1] = np.where(sg > 0, fv.std(axis=1) / np.where(sg > 0, sg, 1.0), 1.0)
+    rad[:, 0] = fv.mean(axis=1) - rad[:, 1] * gv0.mean(axis=1)
     for it in range(1, opt.max_iterations + 1):
         idx = np.flatnonzero(active)
         if idx.size == 0:
             break
-        aa = a[idx]
-        cs = aa[:, 0, 0:1] + aa[:, 0, 1:2] * x + aa[:, 0, 2:3] * y
-        rs = aa[:, 1, 0:1] + aa[:, 1, 1:2] * x + aa[:, 1, 2:3] * y
-        outside = ((cs < lo) | (rs < lo) | (cs > hi_c) | (rs > hi_r)).any(axis=1)
-        gv, gxv, gyv = _sample(g, idx[:, None], cs, rs, cubic, grads)
-        if first:
-            sg = gv.std(axis=1)
-            gain = np.where(sg > 0, fv[idx].std(axis=1) / np.where(sg > 0, sg, 1.0), 1.0)
-            rad[idx, 1] = gain
-            rad[idx, 0] = fv[idx].mean(axis=1) - gain * gv.mean(axis=1)
-            first = False
-        r0 = rad[idx, 0:1]
-        r1 = rad[idx, 1:2]
-        resid = fv[idx] - (r0 + r1 * gv)
-        ux = r1 * gxv
-        uy = r1 * gyv
-        jac = np.stack([ux, ux * x, ux * y, uy, uy * x, uy * y, np.ones_like(gv), gv], axis=1)
-        nn = jac @ jac.transpose(0, 2, 1)
-        rhs = np.einsum("kip,kp->ki", jac, resid)
-        det_ok = np.linalg.cond(nn) < 1e12
+        if fast:
+            nn, rhs, outside = _numba.normals(g, idx, a, rad, fv, x, y)
+        else:
+            aa = a[idx]
+            cs = aa[:, 0, 0:1] + aa[:, 0, 1:2] * x + aa[:, 0, 2:3] * y
+            rs = aa[:, 1, 0:1] + aa[:, 1, 1:2] * x + aa[:, 1, 2:3] * y
+            outside = ((cs < lo) | (rs < lo) | (cs > hi_c) | (rs > hi_r)).any(axis=1)
+            gv, gxv, gyv = _sample(g, idx[:, None], cs, rs, cubic, grads)
+            r0 = rad[idx, 0:1]
+            r1 = rad[idx, 1:2]
+            resid = fv[idx] - (r0 + r1 * gv)
+            ux = r1 * gxv
+            uy = r1 * gyv
+            jac = np.stack([ux, ux * x, ux * y, uy, uy * x, uy * y, np.ones_like(gv), gv],
+                           axis=1)  # fmt: skip
+            nn = jac @ jac.transpose(0, 2, 1)
+            rhs = np.einsum("kip,kp->ki", jac, resid)
+        # Singular normal equations (a template without texture: zero gain, no gradient):
+        # tested on the first iteration (an SVD per patch); later a failed solve is caught.
+        if it == 1:
+            det_ok = np.linalg.cond(nn) < 1e12
+        else:
+            det_ok = np.isfinite(nn).all(axis=(1, 2))
         sol = np.zeros((idx.size, 8))
         if det_ok.any():
-            sol[det_ok] = np.linalg.solve(nn[det_ok], rhs[det_ok][:, :, None])[:, :, 0]
+            try:
+                sol[det_ok] = np.linalg.solve(nn[det_ok], rhs[det_ok][:, :, None])[:, :, 0]
+            except np.linalg.LinAlgError:
+                for q in np.flatnonzero(det_ok):
+                    try:
+                        sol[q] = np.linalg.solve(nn[q], rhs[q])
+                    except np.linalg.LinAlgError:
+                        det_ok[q] = False
         a[idx, 0, :] += sol[:, 0:3]
         a[idx, 1, :] += sol[:, 3:6]
         rad[idx] += sol[:, 6:8]
@@ -293,13 +320,19 @@ def lsm_batch(
     rs = a[:, 1, 0:1] + a[:, 1, 1:2] * x + a[:, 1, 2:3] * y
     outside = ((cs < lo) | (rs < lo) | (cs > hi_c) | (rs > hi_r)).any(axis=1)
     status[(status == OK) & outside] = LEFT_WINDOW
-    gv = _sample(g, np.arange(k_n)[:, None], cs, rs, cubic, grads)[0]
+    if fast:
+        gv = _numba.samples(g, a, x, y)
+    else:
+        gv = _sample(g, np.arange(k_n)[:, None], cs, rs, cubic, grads)[0]
     resid = fv - (rad[:, 0:1] + rad[:, 1:2] * gv)
     s0 = np.sqrt((resid**2).sum(axis=1) / max(p - 8, 1))
     cov = np.full((k_n, 2, 2), np.nan)
     good = status != NO_TEXTURE
     if good.any():
-        q = np.linalg.inv(nmat[good])
+        try:
+            q = np.linalg.inv(nmat[good])
+        except np.linalg.LinAlgError:
+            q = np.linalg.pinv(nmat[good])
         sub = q[:, [0, 3]][:, :, [0, 3]]
         cov[good] = s0[good, None, None] ** 2 * sub
     sig = np.sqrt(np.stack([cov[:, 0, 0], cov[:, 1, 1]], axis=1))

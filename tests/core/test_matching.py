@@ -84,6 +84,21 @@ def test_lsm_bias_and_sigma_against_monte_carlo(seed):
     np.testing.assert_allclose(res.radiometry.mean(axis=0), [OFFSET, GAIN], rtol=0.02, atol=0.5)
 
 
+def test_numba_and_numpy_back_ends_agree():
+    from lidarphoto.core.photo import least_squares_matching_numba as nb
+
+    if not nb.AVAILABLE:
+        pytest.skip("numba not installed")
+    f, g = _pair(5, 20, 2.0, np.random.default_rng(1))
+    c = (S - 1) / 2
+    start = affine_start(np.full((20, 2), c) + np.random.default_rng(2).normal(0, 0.7, (20, 2)))
+    a = lsm_batch(f, g, start, options=LsmOptions(backend="numba"))
+    b = lsm_batch(f, g, start, options=LsmOptions(backend="numpy"))
+    np.testing.assert_array_equal(a.status, b.status)
+    np.testing.assert_allclose(a.affine, b.affine, atol=1e-9)
+    np.testing.assert_allclose(a.sigma_px, b.sigma_px, rtol=1e-9)
+
+
 def test_lsm_noise_free_within_the_interpolation_error():
     f, g = _pair(4, 1, 0.0, np.random.default_rng(0))
     centre = (S - 1) / 2
