@@ -19,16 +19,15 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("MKL_NUM_THREADS", "1")
 
-import cv2  # noqa: E402
-import numpy as np  # noqa: E402
-
-from lidarphoto.core.photo.least_squares_matching import (  # noqa: E402
+import cv2
+import numpy as np
+from lidarphoto.core.photo.least_squares_matching import (
     LsmOptions,
     affine_start,
     lsm_batch,
     lsm_in_image,
 )
-from lidarphoto.core.photo.template_matching import ncc_search  # noqa: E402
+from lidarphoto.core.photo.template_matching import ncc_search
 
 cv2.setNumThreads(1)
 HERE = Path(__file__).resolve().parent
@@ -78,8 +77,15 @@ def ecc_peer(f, g, start):
         # warp: template (x, y) from its top-left -> input (col, row)
         w = np.array([[1, 0, start[i, 0] - h], [0, 1, start[i, 1] - h]], np.float32)
         try:
-            _, w = cv2.findTransformECC(f[i].astype(np.float32), g[i].astype(np.float32), w,
-                                        cv2.MOTION_AFFINE, crit, None, 1)  # fmt: skip
+            _, w = cv2.findTransformECC(
+                f[i].astype(np.float32),
+                g[i].astype(np.float32),
+                w,
+                cv2.MOTION_AFFINE,
+                crit,
+                None,
+                1,
+            )
         except cv2.error:
             continue
         out[i] = w[:, :2] @ [h, h] + w[:, 2]
@@ -97,16 +103,30 @@ def speed_table():
         res = lsm_batch(f, g, affine_start(start), options=opt)
         dt = time.perf_counter() - t0
         err = np.hypot(*(res.position - truth).T)[res.ok]
-        rows.append((f"ours, LSM {interp} (batch of 2000)", len(f) / dt, res.ok.mean(),
-                     np.median(err), np.sqrt(np.mean(err**2))))  # fmt: skip
+        rows.append(
+            (
+                f"ours, LSM {interp} (batch of 2000)",
+                len(f) / dt,
+                res.ok.mean(),
+                np.median(err),
+                np.sqrt(np.mean(err**2)),
+            )
+        )
     n = 500
     t0 = time.perf_counter()
     pos = ecc_peer(f[:n], g[:n], start[:n])
     dt = time.perf_counter() - t0
     ok = np.isfinite(pos[:, 0])
     err = np.hypot(*(pos - truth[:n]).T)[ok]
-    rows.append(("OpenCV findTransformECC affine (per patch, 500)", n / dt, ok.mean(),
-                 np.median(err), np.sqrt(np.mean(err**2))))  # fmt: skip
+    rows.append(
+        (
+            "OpenCV findTransformECC affine (per patch, 500)",
+            n / dt,
+            ok.mean(),
+            np.median(err),
+            np.sqrt(np.mean(err**2)),
+        )
+    )
     return rows
 
 
@@ -167,8 +187,14 @@ def real_pair(name, img1, img2, h_true):
     # points: SIFT inlier keypoints of img1 far enough from both borders
     pts = p1[inl]
     q = apply_h(h_true, pts)
-    keep = ((pts > 30).all(1) & (pts[:, 0] < a.shape[1] - 30) & (pts[:, 1] < a.shape[0] - 30)
-            & (q > 30).all(1) & (q[:, 0] < b.shape[1] - 30) & (q[:, 1] < b.shape[0] - 30))  # fmt: skip
+    keep = (
+        (pts > 30).all(1)
+        & (pts[:, 0] < a.shape[1] - 30)
+        & (pts[:, 1] < a.shape[0] - 30)
+        & (q > 30).all(1)
+        & (q[:, 0] < b.shape[1] - 30)
+        & (q[:, 1] < b.shape[0] - 30)
+    )
     pts = pts[keep][:400]
     truth = apply_h(h_true, pts)
     start = apply_h(h_est, pts)
@@ -186,8 +212,9 @@ def real_pair(name, img1, img2, h_true):
         refs[i] = p - [c - h, r - h]
         jinv = np.linalg.inv(j)
         warp = np.hstack([jinv, (p - jinv @ [h, h])[:, None]])
-        t_img = cv2.warpAffine(a.astype(np.float32), warp, (M, M),
-                               flags=cv2.INTER_CUBIC | cv2.WARP_INVERSE_MAP)  # fmt: skip
+        t_img = cv2.warpAffine(
+            a.astype(np.float32), warp, (M, M), flags=cv2.INTER_CUBIC | cv2.WARP_INVERSE_MAP
+        )
         sc, sr = int(np.rint(s[0])), int(np.rint(s[1]))
         win = bf[sr - h - 4 : sr + h + 5, sc - h - 4 : sc + h + 5]
         m = ncc_search(t_img, win)
@@ -197,8 +224,12 @@ def real_pair(name, img1, img2, h_true):
     ok = np.zeros(len(pts), bool)
     t0 = time.perf_counter()
     for i in range(len(pts)):
-        res = lsm_in_image(tmpl[i][None], bf, affine_start(ncc_pos[i][None], jac[i][None]),
-                           reference=tuple(refs[i]))  # fmt: skip
+        res = lsm_in_image(
+            tmpl[i][None],
+            bf,
+            affine_start(ncc_pos[i][None], jac[i][None]),
+            reference=tuple(refs[i]),
+        )
         lsm_pos[i] = res.position[0]
         ok[i] = res.ok[0]
     dt = time.perf_counter() - t0
@@ -212,43 +243,64 @@ def real_pair(name, img1, img2, h_true):
     h_fit_s, _ = cv2.findHomography(p1[inl], p2[inl], cv2.LMEDS)
     fit_s = np.hypot(*(p2[inl] - apply_h(h_fit_s, p1[inl])).T)
     return {
-        "pair": name, "sift_n": int(inl.sum()), "sift": np.median(sift_err),
-        "sift_fit": np.median(fit_s), "n": len(pts), "ncc": np.median(ncc_err),
-        "ncc_fit": np.median(fit_n), "lsm_ok": int(ok.sum()), "lsm": np.median(lsm_err),
-        "lsm_fit": np.median(fit_res), "lsm_rate": len(pts) / dt,
+        "pair": name,
+        "sift_n": int(inl.sum()),
+        "sift": np.median(sift_err),
+        "sift_fit": np.median(fit_s),
+        "n": len(pts),
+        "ncc": np.median(ncc_err),
+        "ncc_fit": np.median(fit_n),
+        "lsm_ok": int(ok.sum()),
+        "lsm": np.median(lsm_err),
+        "lsm_fit": np.median(fit_res),
+        "lsm_rate": len(pts) / dt,
         "lsm_bias": np.median(lsm_pos[ok] - truth[ok], axis=0),
-    }  # fmt: skip
+    }
 
 
 def main() -> int:
     import subprocess
 
     load = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
-    print(f"date {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; {platform.processor() or platform.machine()}; "
-          f"python {sys.version.split()[0]}, numpy {np.__version__}, opencv {cv2.__version__}; "
-          f"uptime: {load}")  # fmt: skip
+    print(
+        f"date {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; {platform.processor() or platform.machine()}; "
+        f"python {sys.version.split()[0]}, numpy {np.__version__}, opencv {cv2.__version__}; "
+        f"uptime: {load}"
+    )
     print("\n| method | matches/s (1 thread) | accepted | median error (px) | RMS error (px) |")
     print("|---|---|---|---|---|")
     for name, rate, acc, med, rms in speed_table():
         print(f"| {name} | {rate:,.0f} | {acc:.1%} | {med:.4f} | {rms:.4f} |")
     hp = SHARED / "data" / "homography-pairs"
     ga = SHARED / "data" / "opencv-aerial"
-    pairs = [("boat 1->2", hp / "boat/img1.png", hp / "boat/img2.png", read_h(hp / "boat/H1to2p")),
-             ("bikes 1->2", hp / "bikes/img1.png", hp / "bikes/img2.png",
-              read_h(hp / "bikes/H1to2p"))]  # fmt: skip
+    pairs = [
+        ("boat 1->2", hp / "boat/img1.png", hp / "boat/img2.png", read_h(hp / "boat/H1to2p")),
+        ("bikes 1->2", hp / "bikes/img1.png", hp / "bikes/img2.png", read_h(hp / "bikes/H1to2p")),
+    ]
     pairs.append(("graf 1->3", ga / "graf1.png", ga / "graf3.png", read_h(ga / "H1to3p.xml")))
     for name, i1, i2, h in list(pairs):
         shape = cv2.imread(str(i2), cv2.IMREAD_GRAYSCALE).shape
-        pairs.append((f"{name.split()[0]} 1 -> 1 warped by the H of {name.split()[1]}, "
-                      "noise 1 grey value", i1, warped(i1, h, shape), h))  # fmt: skip
-    print("\n| pair | SIFT matches | SIFT vs truth | SIFT vs own H | points | NCC vs truth | "
-          "NCC vs own H | LSM accepted | LSM vs truth | LSM vs own H | LSM median dx, dy |")
+        pairs.append(
+            (
+                f"{name.split()[0]} 1 -> 1 warped by the H of {name.split()[1]}, "
+                "noise 1 grey value",
+                i1,
+                warped(i1, h, shape),
+                h,
+            )
+        )
+    print(
+        "\n| pair | SIFT matches | SIFT vs truth | SIFT vs own H | points | NCC vs truth | "
+        "NCC vs own H | LSM accepted | LSM vs truth | LSM vs own H | LSM median dx, dy |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for name, i1, i2, h in pairs:
         r = real_pair(name, i1, i2, h)
-        print(f"| {r['pair']} | {r['sift_n']} | {r['sift']:.3f} | {r['sift_fit']:.3f} | {r['n']} | "
-              f"{r['ncc']:.3f} | {r['ncc_fit']:.3f} | {r['lsm_ok']} | {r['lsm']:.3f} | "
-              f"{r['lsm_fit']:.3f} | {r['lsm_bias'][0]:+.3f}, {r['lsm_bias'][1]:+.3f} |")  # fmt: skip
+        print(
+            f"| {r['pair']} | {r['sift_n']} | {r['sift']:.3f} | {r['sift_fit']:.3f} | {r['n']} | "
+            f"{r['ncc']:.3f} | {r['ncc_fit']:.3f} | {r['lsm_ok']} | {r['lsm']:.3f} | "
+            f"{r['lsm_fit']:.3f} | {r['lsm_bias'][0]:+.3f}, {r['lsm_bias'][1]:+.3f} |"
+        )
     return 0
 
 
