@@ -262,8 +262,9 @@ def main() -> int:
     import subprocess
 
     load = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
+    when = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
     print(
-        f"date {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; {platform.processor() or platform.machine()}; "
+        f"date {when}; {platform.processor() or platform.machine()}; "
         f"python {sys.version.split()[0]}, numpy {np.__version__}, opencv {cv2.__version__}; "
         f"uptime: {load}"
     )
