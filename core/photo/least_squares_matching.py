@@ -34,6 +34,7 @@ and the resampled g at the solution below ``min_correlation``, or the position s
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,7 +44,10 @@ from . import least_squares_matching_numba as _numba
 
 Array = NDArray[np.float64]
 
-__all__ = ["STATUS_TEXT", "LsmOptions", "LsmResult", "affine_start", "lsm_batch", "lsm_in_image"]
+__all__ = [
+    "STATUS_TEXT", "LsmOptions", "LsmResult", "PointMatch", "affine_start", "lsm_batch",
+    "lsm_in_image", "match_point",
+]  # fmt: skip
 
 OK, NO_TEXTURE, LEFT_WINDOW, NOT_CONVERGED, DRIFTED, LOW_CORRELATION, SIGMA_TOO_LARGE = range(7)
 #: Status code -> reason.
@@ -405,3 +409,76 @@ def lsm_in_image(
             status[(status != NO_TEXTURE) & touch] = LEFT_WINDOW
     return LsmResult(aff, res.radiometry, res.sigma_px, res.cov_px, res.sigma0,
                      res.correlation, res.iterations, status)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class PointMatch:
+    """One point refined by :func:`match_point` (search-window array coordinates).
+
+    col, row : matched position (NaN when refused); sigma_px : (col, row) sigmas, pixels;
+    correlation : LSM correlation at the solution; reason : "" when accepted, else why not.
+    """
+
+    col: float
+    row: float
+    sigma_px: tuple[float, float]
+    correlation: float
+    reason: str
+
+    @property
+    def ok(self) -> bool:
+        """True when accepted."""
+        return not self.reason
+
+
+def match_point(
+    template_window: ArrayLike,
+    template_xy: tuple[float, float],
+    search_window: ArrayLike,
+    start_xy: tuple[float, float],
+    half_size: int = 10,
+    search_px: int = 6,
+    min_ncc: float = 0.6,
+    options: LsmOptions | None = None,
+) -> PointMatch:
+    """Snap ``start_xy`` in ``search_window`` to the match of the patch around ``template_xy``
+    of ``template_window`` (both in their windows' array coordinates): NCC within
+    ``search_px`` pixels, then least-squares matching (the picking dock's refine action).
+
+    Examples
+    --------
+    >>> import cv2
+    >>> rng = np.random.default_rng(3)
+    >>> g = cv2.GaussianBlur(rng.normal(0, 40, (64, 64)), (0, 0), 2.0) + 100
+    >>> m = match_point(g, (30.25, 33.5), g[2:, 3:] * 0.8, (29.0, 29.0))
+    >>> m.reason, round(m.col, 2), round(m.row, 2)
+    ('', 27.25, 31.5)
+    """
+    from .template_matching import ncc_search
+
+    t = np.asarray(template_window, dtype=np.float64)
+    s = np.asarray(search_window, dtype=np.float64)
+    c, r = int(np.rint(template_xy[0])), int(np.rint(template_xy[1]))
+    h = int(half_size)
+    if c - h < 0 or r - h < 0 or c + h >= t.shape[1] or r + h >= t.shape[0]:
+        return PointMatch(math.nan, math.nan, (math.nan, math.nan), math.nan,
+                          "the template point is too close to its image's border")  # fmt: skip
+    tmpl = t[r - h : r + h + 1, c - h : c + h + 1]
+    ref = (template_xy[0] - (c - h), template_xy[1] - (r - h))
+    sc, sr = int(np.rint(start_xy[0])), int(np.rint(start_xy[1]))
+    reach = h + int(search_px)
+    if sc - reach < 0 or sr - reach < 0 or sc + reach >= s.shape[1] or sr + reach >= s.shape[0]:
+        return PointMatch(math.nan, math.nan, (math.nan, math.nan), math.nan,
+                          "the point is too close to the image's border")  # fmt: skip
+    sub = s[sr - reach : sr + reach + 1, sc - reach : sc + reach + 1]
+    m = ncc_search(tmpl, sub)
+    if m.peak < min_ncc:
+        return PointMatch(math.nan, math.nan, (math.nan, math.nan), m.peak,
+                          f"low correlation (NCC {m.peak:.2f} < {min_ncc:.2f})")  # fmt: skip
+    # the NCC centre is the template's centre pixel; the point is at ref from its corner
+    start = np.array([sc - reach + m.col - h + ref[0], sr - reach + m.row - h + ref[1]])
+    res = lsm_in_image(tmpl[None], s, affine_start(start[None]), reference=ref, options=options)
+    reason = "" if res.ok[0] else f"LSM: {res.reasons()[0]}"
+    return PointMatch(float(res.position[0, 0]), float(res.position[0, 1]),
+                      (float(res.sigma_px[0, 0]), float(res.sigma_px[0, 1])),
+                      float(res.correlation[0]), reason)  # fmt: skip
