@@ -237,6 +237,31 @@ def test_eo_sigmas_set_the_search_window_and_a_wrong_eo_is_found(block):
     assert all(p.reason and p.search_px[0] == 5.0 for p in narrow.pairs)
 
 
+def test_transfer_carries_the_master_offset_to_images_whose_chip_search_failed(block):
+    """A common EO error (0.8 m in X: 8 px in every image, as a boresight error would give):
+    I0's sigmas are wide (its chip match succeeds), I1 and I2 claim 0.05 m (5 px windows
+    around a prediction 8 px off: the chip search fails); the transfer from I0 predicts with
+    I0's offset and finds both within 0.1 px of the truth."""
+    from dataclasses import replace
+
+    _, images, eo, chip = block
+    shifted = replace(eo, xyz=eo.xyz + [0.8, 0, 0])
+    sig = np.tile([0.05, 0.05, 0.05, 1e-5, 1e-5, 1e-5], (3, 1))
+    sig[0, :3] = 0.5
+    res = locate_control_points([chip], shifted, CAM, _reader(images), eo_sigmas=sig)
+    truth = _truth(eo, POINT)
+    by_image = {p.image_id: p for p in res.pairs}
+    assert by_image["I0"].source == "chip" and by_image["I0"].status == "ok"
+    for iid in ("I1", "I2"):
+        p = by_image[iid]
+        assert (p.status, p.source) == ("ok", "transfer from I0"), p.reason
+        assert math.hypot(p.col - truth[iid][0], p.row - truth[iid][1]) < 0.1
+        assert p.sigma_col > by_image["I0"].sigma_col * 0.9  # the master's sigma is added
+    off = locate_control_points([chip], shifted, CAM, _reader(images), eo_sigmas=sig,
+                                options=LocateOptions(transfer=False))  # fmt: skip
+    assert [p.status for p in off.pairs] == ["ok", "rejected", "rejected"]
+
+
 def test_bad_chips_and_points_get_their_reasons(block):
     tex, images, eo, _ = block
     flat = make_chip("FLAT", None, POINT, 0.1)
@@ -309,3 +334,47 @@ def test_the_job_writes_observations_report_and_gallery(block, tmp_path):
     assert {r["reason"] for r in rows if r["point_id"] == "FLAT"} == {"chip refused: no texture"}
     page = (tmp_path / "report.html").read_text()
     assert page.count("data:image/png;base64,") == 6 and "no texture" in page
+
+
+def test_located_control_feeds_the_resection_directly(block, tmp_path):
+    """Five chips spread over the common area, located in the three images; the observation
+    CSV goes unchanged into `resection` with the control CSV (the EO as weighted start values:
+    the narrow 2.7-degree field of view cannot separate X0 from phi alone): every located
+    point is used as control, the
+    residuals are below 0.1 px and the pose agrees with the truth within 3 sigma."""
+    from lidarphoto.core.io.camera import write_camera_json
+    from lidarphoto.core.io.observations import write_observations_csv
+    from lidarphoto.core.io.orientation import read_eo_csv_full, write_eo_csv
+    from lidarphoto.core.jobs import resection
+    from lidarphoto.core.jobs.runner import run_job
+
+    tex, images, eo, _ = block
+    offsets = [(0, 0), (-3, 2), (3, 2), (-3, -2), (3, -2)]
+    chips = [make_chip(f"G{k}", tex, POINT + [dx, dy, 0.0], 0.1, noise=1.0, seed=k)
+             for k, (dx, dy) in enumerate(offsets)]  # fmt: skip
+    res = locate_control_points(chips, eo, CAM, _reader(images))
+    per_image = {i: res.observations.image_id.count(i) for i in eo.image_id}
+    assert min(per_image.values()) >= 4, per_image  # near a border: refused with the reason
+    assert all(p.reason == "template partly outside the image" for p in res.pairs if p.reason)
+    write_observations_csv(tmp_path / "obs.csv", res.observations)
+    with open(tmp_path / "control.csv", "w") as fh:
+        fh.write("point_id,X,Y,Z\n")
+        for c in chips:
+            fh.write(f"{c.point_id},{c.xyz[0]:.4f},{c.xyz[1]:.4f},{c.xyz[2]:.4f}\n")
+    write_camera_json(tmp_path / "camera.json", CAM)
+    write_eo_csv(tmp_path / "eo_in.csv", eo)
+    run_job(resection, {"CAMERA": str(tmp_path / "camera.json"),
+                        "OBSERVATIONS": str(tmp_path / "obs.csv"),
+                        "CONTROL_POINTS": str(tmp_path / "control.csv"), "CRS": "EPSG:25832",
+                        "APPROX_EO": str(tmp_path / "eo_in.csv"),
+                        "APPROX_EO_SIGMAS": [1.0, 1.0, 1.0, 0.05, 0.05, 0.05],
+                        "OUTPUT_RESIDUALS": str(tmp_path / "res.csv"),
+                        "OUTPUT_EO": str(tmp_path / "eo_out.csv")})  # fmt: skip
+    rows = list(csv.DictReader(open(tmp_path / "res.csv")))
+    assert len(rows) == len(res.observations)
+    assert all(r["used"] == "1" and float(r["distance_px"]) < 0.1 for r in rows), rows
+    out = read_eo_csv_full(tmp_path / "eo_out.csv")
+    for k, iid in enumerate(out.eo.image_id):
+        j = eo.image_id.index(iid)
+        err = out.eo.xyz[k] - eo.xyz[j]
+        assert np.all(np.abs(err) < 3 * out.sigma[k, :3] + 1e-3), (iid, err, out.sigma[k, :3])
