@@ -130,6 +130,30 @@ def speed_table():
     return rows
 
 
+def monte_carlo_table():
+    """Per texture: 500 noise draws (sigma 2 grey values in both images) of one pair with a
+    known affine, gain 0.8 and offset 10: bias of the mean position and the ratio of the
+    reported sigma to the Monte Carlo spread."""
+    rows = []
+    a_true = np.array([[1.05, 0.03], [-0.02, 0.97]])
+    t_true = np.array([0.37, -0.21])
+    yy, xx = np.mgrid[0:M, 0:M] - (M - 1) / 2
+    yy2, xx2 = np.mgrid[0:S, 0:S] - (S - 1) / 2
+    for seed in (1, 2, 3, 4, 5):
+        rng = np.random.default_rng(100 + seed)
+        u = a_true[0, 0] * xx + a_true[0, 1] * yy + t_true[0]
+        v = a_true[1, 0] * xx + a_true[1, 1] * yy + t_true[1]
+        k = 500
+        f = 0.8 * waves(u, v, seed) + 10 + rng.normal(0, 2.0, (k, M, M))
+        g = waves(xx2, yy2, seed) + rng.normal(0, 2.0, (k, S, S))
+        c = (S - 1) / 2
+        res = lsm_batch(f, g, affine_start(np.full((k, 2), c)))
+        err = res.position[res.ok] - (c + t_true)
+        ratio = np.sqrt((res.sigma_px[res.ok] ** 2).mean(axis=0)) / err.std(axis=0)
+        rows.append((seed, res.ok.mean(), err.mean(axis=0), err.std(axis=0), ratio))
+    return rows
+
+
 def read_h(path: Path) -> np.ndarray:
     if path.suffix == ".xml":
         fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_READ)
@@ -272,6 +296,16 @@ def main() -> int:
     print("|---|---|---|---|---|")
     for name, rate, acc, med, rms in speed_table():
         print(f"| {name} | {rate:,.0f} | {acc:.1%} | {med:.4f} | {rms:.4f} |")
+    print(
+        "\n| texture seed | accepted | bias col, row (px) | MC sigma col, row (px) | "
+        "reported / MC sigma |"
+    )
+    print("|---|---|---|---|---|")
+    for seed, acc, bias, mc, ratio in monte_carlo_table():
+        print(
+            f"| {seed} | {acc:.0%} | {bias[0]:+.4f}, {bias[1]:+.4f} | {mc[0]:.4f}, {mc[1]:.4f} | "
+            f"{ratio[0]:.2f}, {ratio[1]:.2f} |"
+        )
     hp = SHARED / "data" / "homography-pairs"
     ga = SHARED / "data" / "opencv-aerial"
     pairs = [
