@@ -296,13 +296,11 @@ def test_bad_chips_and_points_get_their_reasons(block):
     assert set(res.observations.point_id) <= {"EDGE"}
 
 
-def test_the_job_writes_observations_report_and_gallery(block, tmp_path):
+def _write_inputs(block, tmp_path):
+    """Images (8-bit), chips GCP1 and FLAT (GeoTIFF), control, camera and EO files."""
     from lidarphoto.core.io.camera import write_camera_json
-    from lidarphoto.core.io.observations import read_observations_csv
     from lidarphoto.core.io.orientation import write_eo_csv
     from lidarphoto.core.io.raster import write_geotiff, write_rgb_tiff
-    from lidarphoto.core.jobs import locate_control_points as job
-    from lidarphoto.core.jobs.runner import run_job
 
     _, images, eo, chip = block
     (tmp_path / "img").mkdir()
@@ -319,6 +317,15 @@ def test_the_job_writes_observations_report_and_gallery(block, tmp_path):
                  f"FLAT,{POINT[0] + 0.5},{POINT[1]},{POINT[2]}\n")  # fmt: skip
     write_camera_json(tmp_path / "camera.json", CAM)
     write_eo_csv(tmp_path / "eo.csv", eo)
+    return eo
+
+
+def test_the_job_writes_observations_report_and_gallery(block, tmp_path):
+    from lidarphoto.core.io.observations import read_observations_csv
+    from lidarphoto.core.jobs import locate_control_points as job
+    from lidarphoto.core.jobs.runner import run_job
+
+    eo = _write_inputs(block, tmp_path)
     v = {"CHIPS": [str(tmp_path / "chips")], "CONTROL_POINTS": str(tmp_path / "control.csv"),
          "CAMERA": str(tmp_path / "camera.json"), "EO": str(tmp_path / "eo.csv"),
          "IMAGES": [str(tmp_path / "img")], "CRS": "EPSG:25832",
@@ -378,3 +385,38 @@ def test_located_control_feeds_the_resection_directly(block, tmp_path):
         j = eo.image_id.index(iid)
         err = out.eo.xyz[k] - eo.xyz[j]
         assert np.all(np.abs(err) < 3 * out.sigma[k, :3] + 1e-3), (iid, err, out.sigma[k, :3])
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        ("unknown_chip", r"chips of unknown points \(not in the control table\): EXTRA"),
+        ("no_image", r"no image of the EO table among the images given"),
+    ],
+)
+def test_bad_job_inputs_are_refused_by_name(block, tmp_path, capsys, change, message):
+    """The command line refuses with one line naming the problem; nothing is written."""
+    import re
+    import shutil
+
+    from lidarphoto.core.cli import main
+
+    _write_inputs(block, tmp_path)
+    images = tmp_path / "img"
+    if change == "unknown_chip":
+        shutil.copy(tmp_path / "chips" / "GCP1.tif", tmp_path / "chips" / "EXTRA.tif")
+    else:
+        images = tmp_path / "other"
+        images.mkdir()
+        shutil.copy(tmp_path / "img" / "I0.tif", images / "X9.tif")
+    out = tmp_path / "out"
+    out.mkdir()
+    code = main(["locatecontrolpoints", "--chips", str(tmp_path / "chips"),
+                 "--control-points", str(tmp_path / "control.csv"),
+                 "--camera", str(tmp_path / "camera.json"), "--eo", str(tmp_path / "eo.csv"),
+                 "--images", str(images), "--crs", "EPSG:25832",
+                 "--output", str(out / "obs.csv")])  # fmt: skip
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code != 0 and len(err) == 1, err
+    assert re.search(message, err[0]), err[0]
+    assert list(out.iterdir()) == []
