@@ -144,6 +144,7 @@ class ImagePickingDock(QgsDockWidget):
         v.imageSelected.connect(self.show_image)
         v.undo_button.clicked.connect(self.store.undo)
         v.redo_button.clicked.connect(self.store.redo)
+        v.refine_button.clicked.connect(lambda *_: self.picking.refine_selected())
         v.view.pointPicked.connect(self.pick)
         v.view.cursorMoved.connect(self._cursor)
         # a large image without overviews: its pyramid is built in the background

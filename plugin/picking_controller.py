@@ -15,6 +15,7 @@ The control is projected again only when the image, the orientation or the contr
 from __future__ import annotations
 
 import bisect
+import math
 
 import numpy as np
 from qgis.PyQt.QtCore import QObject, QPointF, QTimer
@@ -30,6 +31,9 @@ __all__ = ["HIT_SCREEN_PX", "PickingController"]
 HIT_SCREEN_PX = 10.0
 #: the window read around a line end refined on the image's edge, pixels
 _EDGE_WINDOW_PX = 25
+#: half side of the refine action's template and its NCC search radius, pixels
+_REFINE_HALF_PX = 10
+_REFINE_SEARCH_PX = 6
 _LAYER_OF = {"tie": "planes", "paper": "planes", "lcp": "lcps", "check": "lcps"}
 
 
@@ -314,6 +318,75 @@ class PickingController(QObject):
         self.selected_index = int(key)
         self.store.move(int(key), col, row)
 
+    def refine_selected(self) -> bool:
+        """Snap the selected observation to the least-squares match of the same point's
+        observation in another image (the template); True when it moved. The matching is the
+        core's (:func:`~lidarphoto.core.photo.least_squares_matching.match_point`)."""
+        from ..core.photo.least_squares_matching import match_point
+        from .image_source import ImageSource, ImageSourceError
+
+        img, source = self.dock.current_image, self.viewer.source
+        k = self.selected_index
+        if (
+            source is None
+            or not 0 <= k < len(self.store.rows)
+            or (self.store.rows[k].image_id != img)
+        ):
+            self.dock.message(self.tr("Select a point of the image shown first."), warning=True)
+            return False
+        obs = self.store.rows[k]
+        others = [o for o in self.store.rows if o.point_id == obs.point_id and o.image_id != img]
+        path = next(
+            (
+                self.dock.image_paths.get(o.image_id)
+                for o in others
+                if self.dock.image_paths.get(o.image_id)
+            ),
+            None,
+        )
+        if path is None:
+            self.dock.message(
+                self.tr("Point {} is measured in no other image: no template.").format(
+                    obs.point_id
+                ),
+                warning=True,
+            )
+            return False
+        tmpl = next(o for o in others if self.dock.image_paths.get(o.image_id) == path)
+        half, search = _REFINE_HALF_PX, _REFINE_SEARCH_PX
+        try:
+            other = ImageSource(path, stretch_now=False)
+        except ImageSourceError as exc:
+            self.dock.message(str(exc), warning=True)
+            return False
+        try:
+            t_win, t_xy = _grey_window(other, tmpl.col, tmpl.row, half + 3)
+        finally:
+            other.close()
+        s_win, s_xy = _grey_window(source, obs.col, obs.row, half + search + 6)
+        m = match_point(t_win, t_xy, s_win, s_xy, half, search)
+        if not m.ok:
+            self.dock.message(
+                self.tr("Point {} not refined: {}").format(obs.point_id, m.reason), warning=True
+            )
+            return False
+        col = obs.col + (m.col - s_xy[0])
+        row = obs.row + (m.row - s_xy[1])
+        self.store.move(k, col, row)
+        self.dock.message(
+            self.tr(
+                "Point {} refined by least-squares matching on image {}: moved {:.2f} px, "
+                "sigma {:.3f} px, correlation {:.2f}."
+            ).format(
+                obs.point_id,
+                tmpl.image_id,
+                math.hypot(col - obs.col, row - obs.row),
+                max(m.sigma_px),
+                m.correlation,
+            )
+        )
+        return True
+
     def delete_selected(self) -> None:
         """Delete the selected point (its pending prediction goes with its last row)."""
         if 0 <= self.selected_index < len(self.store.rows):
@@ -328,3 +401,14 @@ class PickingController(QObject):
             self.dock.loader.links.select(_LAYER_OF[o.type], o.target_id)
         self.viewer.view.centerOn(QPointF(o.col, o.row))
         self.draw_observations()
+
+
+def _grey_window(source, col: float, row: float, half: int) -> tuple[np.ndarray, tuple]:
+    """Grey window of ``source`` around pixel (col, row) (corner convention) and the point's
+    array coordinates in it."""
+    c0, r0 = math.floor(col) - half, math.floor(row) - half
+    n = 2 * half + 1
+    raw = source.read_raw(c0, r0, n, n, n, n)
+    # read_raw clips at the border: the window starts at max(0, c0)
+    c0, r0 = max(c0, 0), max(r0, 0)
+    return raw.astype(np.float64).mean(axis=2), (col - 0.5 - c0, row - 0.5 - r0)

@@ -90,8 +90,17 @@ class ViewerPanel(QWidget):
             icon="/mActionFileSave.svg",
             tip=self.tr("Save the monoplotted points and lines to a GeoPackage"),
         )
+        self.refine_button = _tool(
+            self.tr("Refine"),
+            tip=self.tr(
+                "Snap the selected point to the least-squares match (6 affine + 2 radiometric "
+                "parameters) of the same point measured in another image"
+            ),
+        )
+        self.refine_button.setObjectName("lidarphotoRefineLsm")
         for w in (self.prev_button, self.image_combo, self.next_button, self.type_combo):
             row.addWidget(w)
+        row.addWidget(self.refine_button)
         row.addStretch(1)
         for w in (
             self.monoplot_button,

@@ -1,0 +1,343 @@
+"""Least-squares matching: speed (one core) and accuracy, against OpenCV's ECC as the peer, on
+synthetic pairs (known affine + gain/offset + noise) and on real pairs with known homographies
+(Oxford boat 1->2, bikes 1->2, graffiti 1->3; Mikolajczyk et al. 2005).
+
+Run with one thread: ``OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python bench/bench_lsm.py``
+(the script also tells OpenCV to use one thread). Data: ``../shared/data`` next to the
+repository (or LIDARPHOTO_SHARED). Prints markdown tables for bench/matching.md.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import sys
+import time
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MKL_NUM_THREADS", "1")
+
+import cv2
+import numpy as np
+from lidarphoto.core.photo.least_squares_matching import (
+    LsmOptions,
+    affine_start,
+    lsm_batch,
+    lsm_in_image,
+)
+from lidarphoto.core.photo.template_matching import ncc_search
+
+cv2.setNumThreads(1)
+HERE = Path(__file__).resolve().parent
+SHARED = Path(os.environ.get("LIDARPHOTO_SHARED", HERE.parent.parent / "shared"))
+M, S = 21, 41
+
+
+def waves(x, y, seed, fmax=0.25, n=40):
+    """Analytic texture: exact grey values at any sub-pixel position."""
+    rng = np.random.default_rng(seed)
+    f = rng.uniform(0.03, fmax, n)
+    th = rng.uniform(0, np.pi, n)
+    ph = rng.uniform(0, 2 * np.pi, n)
+    amp = 1.0 / (1 + (f / 0.1) ** 2)
+    out = np.zeros(np.broadcast(x, y).shape)
+    for k in range(n):
+        out += amp[k] * np.cos(2 * np.pi * f[k] * (np.cos(th[k]) * x + np.sin(th[k]) * y) + ph[k])
+    return 100 + 40 * out
+
+
+def synthetic(k: int, noise: float, seed: int = 0):
+    """k pairs, each its own texture, affine, shift, gain and offset; truth positions."""
+    rng = np.random.default_rng(seed)
+    yy, xx = np.mgrid[0:M, 0:M] - (M - 1) / 2
+    yy2, xx2 = np.mgrid[0:S, 0:S] - (S - 1) / 2
+    f = np.empty((k, M, M))
+    g = np.empty((k, S, S))
+    truth = np.empty((k, 2))
+    for i in range(k):
+        a = np.eye(2) + rng.normal(0, 0.03, (2, 2))
+        t = rng.uniform(-0.5, 0.5, 2)
+        u = a[0, 0] * xx + a[0, 1] * yy + t[0]
+        v = a[1, 0] * xx + a[1, 1] * yy + t[1]
+        gain, off = rng.uniform(0.7, 1.3), rng.uniform(-20, 20)
+        f[i] = gain * waves(u, v, 1000 + i) + off + rng.normal(0, noise, (M, M))
+        g[i] = waves(xx2, yy2, 1000 + i) + rng.normal(0, noise, (S, S))
+        truth[i] = (S - 1) / 2 + t
+    return f, g, truth
+
+
+def ecc_peer(f, g, start):
+    """cv2.findTransformECC (MOTION_AFFINE) per patch: template f, input g."""
+    out = np.full((len(f), 2), np.nan)
+    crit = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 30, 1e-4)
+    h = (M - 1) / 2
+    for i in range(len(f)):
+        # warp: template (x, y) from its top-left -> input (col, row)
+        w = np.array([[1, 0, start[i, 0] - h], [0, 1, start[i, 1] - h]], np.float32)
+        try:
+            _, w = cv2.findTransformECC(
+                f[i].astype(np.float32),
+                g[i].astype(np.float32),
+                w,
+                cv2.MOTION_AFFINE,
+                crit,
+                None,
+                1,
+            )
+        except cv2.error:
+            continue
+        out[i] = w[:, :2] @ [h, h] + w[:, 2]
+    return out
+
+
+def speed_table():
+    rows = []
+    f, g, truth = synthetic(2000, 2.0)
+    start = np.round(truth)
+    for interp in ("bicubic", "bilinear"):
+        opt = LsmOptions(interpolation=interp)
+        lsm_batch(f[:50], g[:50], affine_start(start[:50]), options=opt)  # warm-up
+        t0 = time.perf_counter()
+        res = lsm_batch(f, g, affine_start(start), options=opt)
+        dt = time.perf_counter() - t0
+        err = np.hypot(*(res.position - truth).T)[res.ok]
+        rows.append(
+            (
+                f"ours, LSM {interp} (batch of 2000)",
+                len(f) / dt,
+                res.ok.mean(),
+                np.median(err),
+                np.sqrt(np.mean(err**2)),
+            )
+        )
+    n = 500
+    t0 = time.perf_counter()
+    pos = ecc_peer(f[:n], g[:n], start[:n])
+    dt = time.perf_counter() - t0
+    ok = np.isfinite(pos[:, 0])
+    err = np.hypot(*(pos - truth[:n]).T)[ok]
+    rows.append(
+        (
+            "OpenCV findTransformECC affine (per patch, 500)",
+            n / dt,
+            ok.mean(),
+            np.median(err),
+            np.sqrt(np.mean(err**2)),
+        )
+    )
+    return rows
+
+
+def monte_carlo_table():
+    """Per texture: 500 noise draws (sigma 2 grey values in both images) of one pair with a
+    known affine, gain 0.8 and offset 10: bias of the mean position and the ratio of the
+    reported sigma to the Monte Carlo spread."""
+    rows = []
+    a_true = np.array([[1.05, 0.03], [-0.02, 0.97]])
+    t_true = np.array([0.37, -0.21])
+    yy, xx = np.mgrid[0:M, 0:M] - (M - 1) / 2
+    yy2, xx2 = np.mgrid[0:S, 0:S] - (S - 1) / 2
+    for seed in (1, 2, 3, 4, 5):
+        rng = np.random.default_rng(100 + seed)
+        u = a_true[0, 0] * xx + a_true[0, 1] * yy + t_true[0]
+        v = a_true[1, 0] * xx + a_true[1, 1] * yy + t_true[1]
+        k = 500
+        f = 0.8 * waves(u, v, seed) + 10 + rng.normal(0, 2.0, (k, M, M))
+        g = waves(xx2, yy2, seed) + rng.normal(0, 2.0, (k, S, S))
+        c = (S - 1) / 2
+        res = lsm_batch(f, g, affine_start(np.full((k, 2), c)))
+        err = res.position[res.ok] - (c + t_true)
+        ratio = np.sqrt((res.sigma_px[res.ok] ** 2).mean(axis=0)) / err.std(axis=0)
+        rows.append((seed, res.ok.mean(), err.mean(axis=0), err.std(axis=0), ratio))
+    return rows
+
+
+def read_h(path: Path) -> np.ndarray:
+    if path.suffix == ".xml":
+        fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_READ)
+        h = fs.getNode("H13").mat()
+        fs.release()
+        if h is None:
+            h = np.loadtxt(path)
+        return h / h[2, 2]
+    h = np.loadtxt(path)
+    return h / h[2, 2]
+
+
+def apply_h(h, p):
+    q = np.c_[p, np.ones(len(p))] @ h.T
+    return q[:, :2] / q[:, 2:]
+
+
+def local_affine(h, p):
+    """(N, 2, 2) Jacobian of the homography at p."""
+    eps = 0.5
+    jx = (apply_h(h, p + [eps, 0]) - apply_h(h, p - [eps, 0])) / (2 * eps)
+    jy = (apply_h(h, p + [0, eps]) - apply_h(h, p - [0, eps])) / (2 * eps)
+    return np.stack([jx, jy], axis=2)
+
+
+def warped(img1, h_true, shape):
+    """img1 resampled exactly (float coordinates, cubic B-spline) into the geometry of the
+    second image by h_true: a pair whose truth has no error of its own."""
+    from scipy import ndimage
+
+    a = cv2.imread(str(img1), cv2.IMREAD_GRAYSCALE).astype(np.float64)
+    rr, cc = np.mgrid[0 : shape[0], 0 : shape[1]]
+    src = apply_h(np.linalg.inv(h_true), np.c_[cc.ravel(), rr.ravel()].astype(np.float64))
+    out = ndimage.map_coordinates(a, [src[:, 1], src[:, 0]], order=3, mode="constant", cval=0)
+    rng = np.random.default_rng(0)
+    return np.clip(out.reshape(shape) + rng.normal(0, 1.0, shape), 0, 255)
+
+
+def real_pair(name, img1, img2, h_true):
+    a = cv2.imread(str(img1), cv2.IMREAD_GRAYSCALE)
+    if isinstance(img2, np.ndarray):
+        b = np.round(img2).astype(np.uint8)
+    else:
+        b = cv2.imread(str(img2), cv2.IMREAD_GRAYSCALE)
+    sift = cv2.SIFT_create(4000)
+    k1, d1 = sift.detectAndCompute(a, None)
+    k2, d2 = sift.detectAndCompute(b, None)
+    knn = cv2.BFMatcher().knnMatch(d1, d2, k=2)
+    good = [m for m, n in knn if m.distance < 0.75 * n.distance]
+    p1 = np.float64([k1[m.queryIdx].pt for m in good])
+    p2 = np.float64([k2[m.trainIdx].pt for m in good])
+    h_est, inl = cv2.findHomography(p1, p2, cv2.RANSAC, 3.0)
+    inl = inl.ravel().astype(bool)
+    sift_err = np.hypot(*(p2[inl] - apply_h(h_true, p1[inl])).T)
+    # points: SIFT inlier keypoints of img1 far enough from both borders
+    pts = p1[inl]
+    q = apply_h(h_true, pts)
+    keep = (
+        (pts > 30).all(1)
+        & (pts[:, 0] < a.shape[1] - 30)
+        & (pts[:, 1] < a.shape[0] - 30)
+        & (q > 30).all(1)
+        & (q[:, 0] < b.shape[1] - 30)
+        & (q[:, 1] < b.shape[0] - 30)
+    )
+    pts = pts[keep][:400]
+    truth = apply_h(h_true, pts)
+    start = apply_h(h_est, pts)
+    jac = local_affine(h_est, pts)
+    h = M // 2
+    # NCC: img1 template warped into img2 geometry, +-4 px around the SIFT-homography position
+    ncc_pos = np.full((len(pts), 2), np.nan)
+    tmpl = np.empty((len(pts), M, M))
+    refs = np.empty((len(pts), 2))
+    af = a.astype(np.float64)
+    bf = b.astype(np.float64)
+    for i, (p, s, j) in enumerate(zip(pts, start, jac)):
+        c, r = int(np.rint(p[0])), int(np.rint(p[1]))
+        tmpl[i] = af[r - h : r + h + 1, c - h : c + h + 1]
+        refs[i] = p - [c - h, r - h]
+        jinv = np.linalg.inv(j)
+        warp = np.hstack([jinv, (p - jinv @ [h, h])[:, None]])
+        t_img = cv2.warpAffine(
+            a.astype(np.float32), warp, (M, M), flags=cv2.INTER_CUBIC | cv2.WARP_INVERSE_MAP
+        )
+        sc, sr = int(np.rint(s[0])), int(np.rint(s[1]))
+        win = bf[sr - h - 4 : sr + h + 5, sc - h - 4 : sc + h + 5]
+        m = ncc_search(t_img, win)
+        ncc_pos[i] = (sc - h - 4 + m.col, sr - h - 4 + m.row)
+    # LSM per point (each has its own reference); batched by the reference's rounding
+    lsm_pos = np.full((len(pts), 2), np.nan)
+    ok = np.zeros(len(pts), bool)
+    t0 = time.perf_counter()
+    for i in range(len(pts)):
+        res = lsm_in_image(
+            tmpl[i][None],
+            bf,
+            affine_start(ncc_pos[i][None], jac[i][None]),
+            reference=tuple(refs[i]),
+        )
+        lsm_pos[i] = res.position[0]
+        ok[i] = res.ok[0]
+    dt = time.perf_counter() - t0
+    ncc_err = np.hypot(*(ncc_pos - truth).T)
+    lsm_err = np.hypot(*(lsm_pos - truth).T)[ok]
+    # internal precision: residuals of a homography fitted to the LSM matches
+    h_fit, _ = cv2.findHomography(pts[ok], lsm_pos[ok], cv2.LMEDS)
+    fit_res = np.hypot(*(lsm_pos[ok] - apply_h(h_fit, pts[ok])).T)
+    h_fit_n, _ = cv2.findHomography(pts, ncc_pos, cv2.LMEDS)
+    fit_n = np.hypot(*(ncc_pos - apply_h(h_fit_n, pts)).T)
+    h_fit_s, _ = cv2.findHomography(p1[inl], p2[inl], cv2.LMEDS)
+    fit_s = np.hypot(*(p2[inl] - apply_h(h_fit_s, p1[inl])).T)
+    return {
+        "pair": name,
+        "sift_n": int(inl.sum()),
+        "sift": np.median(sift_err),
+        "sift_fit": np.median(fit_s),
+        "n": len(pts),
+        "ncc": np.median(ncc_err),
+        "ncc_fit": np.median(fit_n),
+        "lsm_ok": int(ok.sum()),
+        "lsm": np.median(lsm_err),
+        "lsm_fit": np.median(fit_res),
+        "lsm_rate": len(pts) / dt,
+        "lsm_bias": np.median(lsm_pos[ok] - truth[ok], axis=0),
+    }
+
+
+def main() -> int:
+    import subprocess
+
+    load = subprocess.run(["uptime"], capture_output=True, text=True).stdout.strip()
+    when = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    print(
+        f"date {when}; {platform.processor() or platform.machine()}; "
+        f"python {sys.version.split()[0]}, numpy {np.__version__}, opencv {cv2.__version__}; "
+        f"uptime: {load}"
+    )
+    print("\n| method | matches/s (1 thread) | accepted | median error (px) | RMS error (px) |")
+    print("|---|---|---|---|---|")
+    for name, rate, acc, med, rms in speed_table():
+        print(f"| {name} | {rate:,.0f} | {acc:.1%} | {med:.4f} | {rms:.4f} |")
+    print(
+        "\n| texture seed | accepted | bias col, row (px) | MC sigma col, row (px) | "
+        "reported / MC sigma |"
+    )
+    print("|---|---|---|---|---|")
+    for seed, acc, bias, mc, ratio in monte_carlo_table():
+        print(
+            f"| {seed} | {acc:.0%} | {bias[0]:+.4f}, {bias[1]:+.4f} | {mc[0]:.4f}, {mc[1]:.4f} | "
+            f"{ratio[0]:.2f}, {ratio[1]:.2f} |"
+        )
+    hp = SHARED / "data" / "homography-pairs"
+    ga = SHARED / "data" / "opencv-aerial"
+    pairs = [
+        ("boat 1->2", hp / "boat/img1.png", hp / "boat/img2.png", read_h(hp / "boat/H1to2p")),
+        ("bikes 1->2", hp / "bikes/img1.png", hp / "bikes/img2.png", read_h(hp / "bikes/H1to2p")),
+    ]
+    pairs.append(("graf 1->3", ga / "graf1.png", ga / "graf3.png", read_h(ga / "H1to3p.xml")))
+    for name, i1, i2, h in list(pairs):
+        shape = cv2.imread(str(i2), cv2.IMREAD_GRAYSCALE).shape
+        pairs.append(
+            (
+                f"{name.split()[0]} 1 -> 1 warped by the H of {name.split()[1]}, "
+                "noise 1 grey value",
+                i1,
+                warped(i1, h, shape),
+                h,
+            )
+        )
+    print(
+        "\n| pair | SIFT matches | SIFT vs truth | SIFT vs own H | points | NCC vs truth | "
+        "NCC vs own H | LSM accepted | LSM vs truth | LSM vs own H | LSM median dx, dy |"
+    )
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for name, i1, i2, h in pairs:
+        r = real_pair(name, i1, i2, h)
+        print(
+            f"| {r['pair']} | {r['sift_n']} | {r['sift']:.3f} | {r['sift_fit']:.3f} | {r['n']} | "
+            f"{r['ncc']:.3f} | {r['ncc_fit']:.3f} | {r['lsm_ok']} | {r['lsm']:.3f} | "
+            f"{r['lsm_fit']:.3f} | {r['lsm_bias'][0]:+.3f}, {r['lsm_bias'][1]:+.3f} |"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,237 @@
+"""``locatecontrolpoints``: ground control points located in oriented images from control chips
+(NCC with an adaptive template, least-squares matching, transfer between images)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..photo.control_location import LocateOptions
+from ..photo.least_squares_matching import LsmOptions
+from .common import CSV_FILTER, CSV_OUT
+from .runner import JobResult, stages
+from .spec import AlgorithmSpec, Param, Result, Values
+
+_D = LocateOptions()
+_L = LsmOptions()
+
+SPEC = AlgorithmSpec(
+    name="locatecontrolpoints",
+    title="Locate control points in images (chips, NCC + least-squares matching)",
+    group="Aerotriangulation",
+    group_id="aerotriangulation",
+    summary="control points measured automatically in oriented images from control chips",
+    description="""\
+Each control point is projected into each image with its exterior orientation; its control
+chip (a north-up GeoTIFF of the ground around the point, rectified onto the plane Z = Z_point,
+file name = point id) is searched there by normalised cross-correlation with an adaptive
+template size (grown until the predicted least-squares precision from the texture, Förstner
+1986, passes), then refined by least-squares matching (Gruen 1985: 6 affine + 2 radiometric
+parameters) from the chip's pixels with the local chip-to-image affine as start. Search
+window: the EO sigmas (columns sigma_X .. sigma_kappa_deg of the EO CSV) propagated to the
+image, times 3; without them +-SEARCH_PX pixels. A match is rejected, with the reason, for a
+chip without texture, low correlation, no convergence, a sigma above MAX_SIGMA, a match
+outside the search ellipse or a template partly outside the image. With TRANSFER, images where
+the chip match failed are matched from the point's best image (image-to-image LSM).
+
+Output: the image-observation CSV (image_id, point_id, col, row, sigma_px, type tie, empty
+target_id; point_id = the control point's id), which bundleadjustment (with the control points
+as ground points) and resection (with them as control points) read directly; sigma_px is the
+LSM sigma, at least SIGMA_FLOOR (LSM does not see the chip's own errors). The report CSV has
+one row per point and image with the status and reason; the HTML report shows the chips.""",
+    params=(
+        Param(
+            "CHIPS",
+            "files",
+            "Control chips (GeoTIFF files or folders)",
+            help="one GeoTIFF per point, named <point_id>.tif",
+        ),
+        Param(
+            "CONTROL_POINTS",
+            "file",
+            "Control points (CSV)",
+            file_filter=CSV_FILTER,
+            help="point_id,X,Y,Z in the mapping CRS (the chips' CRS)",
+        ),
+        Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
+        Param(
+            "EO",
+            "file",
+            "Exterior orientation (CSV)",
+            file_filter=CSV_FILTER,
+            help="with sigma columns: the search window follows from them",
+        ),
+        Param(
+            "IMAGES",
+            "files",
+            "Images (files or folders)",
+            help="image files (name = image_id), or folders whose images are all taken",
+        ),
+        Param("CRS", "crs", "Mapping CRS of the EO and control", help="e.g. EPSG:25832"),
+        Param(
+            "SEARCH_PX",
+            "number",
+            "Search half-width without EO sigmas",
+            _D.default_search_px,
+            unit="pixels",
+            minimum=1.0,
+            maximum=1000.0,
+        ),
+        Param("MIN_NCC", "number", "Smallest NCC peak", _D.min_ncc, minimum=0.0, maximum=1.0),
+        Param(
+            "MIN_CORRELATION",
+            "number",
+            "Smallest LSM correlation",
+            _L.min_correlation,
+            minimum=0.0,
+            maximum=1.0,
+        ),
+        Param(
+            "MAX_SIGMA",
+            "number",
+            "Largest LSM sigma",
+            _L.max_sigma_px,
+            unit="pixels",
+            minimum=0.0001,
+            maximum=10.0,
+        ),
+        Param(
+            "SIGMA_FLOOR",
+            "number",
+            "Smallest sigma written",
+            _D.sigma_floor_px,
+            unit="pixels",
+            minimum=0.0001,
+            maximum=100.0,
+        ),
+        Param("TRANSFER", "boolean", "Transfer to images where the chip failed", _D.transfer),
+        Param("OUTPUT", "file_out", "Image observations (CSV)", file_filter=CSV_OUT),
+        Param(
+            "OUTPUT_REPORT",
+            "file_out",
+            "Report per point and image (CSV)",
+            optional=True,
+            file_filter=CSV_OUT,
+        ),
+        Param(
+            "OUTPUT_HTML",
+            "file_out",
+            "Report with chip gallery (HTML)",
+            optional=True,
+            file_filter="HTML files (*.html)",
+        ),
+    ),
+    results=(
+        Result("LOCATED", "number", "Observations written"),
+        Result("REJECTED", "number", "Point-image pairs rejected"),
+    ),
+    tags=("control points", "gcp", "matching", "least-squares matching", "ncc", "chips"),
+    references=("Gruen (1985)", "Förstner (1986)", "Immerkær (1996)", "Keys (1981)"),
+)
+
+
+class _Images:
+    """Grey windows of the image files (NaN outside the image)."""
+
+    def __init__(self, files: dict) -> None:
+        self.files = files
+        self.readers: dict = {}
+
+    def __call__(self, image_id: str, c0: int, r0: int, w: int, h: int) -> np.ndarray:
+        from ..io.raster import RasterReader
+
+        if image_id not in self.readers:
+            self.readers[image_id] = RasterReader(self.files[image_id])
+        src = self.readers[image_id]
+        out = np.full((h, w), np.nan)
+        cs, rs = max(c0, 0), max(r0, 0)
+        ce, re = min(c0 + w, src.info.width), min(r0 + h, src.info.height)
+        if ce <= cs or re <= rs:
+            return out
+        data = src.read((cs, rs, ce - cs, re - rs)).astype(np.float64)
+        grey = 0.299 * data[0] + 0.587 * data[1] + 0.114 * data[2] if data.shape[0] >= 3 \
+            else data[0]  # fmt: skip
+        out[rs - r0 : re - r0, cs - c0 : ce - c0] = grey
+        return out
+
+    def close(self) -> None:
+        for r in self.readers.values():
+            r.close()
+
+
+def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
+    """Read chips, control, camera, EO and images; locate; write the outputs."""
+    from dataclasses import replace
+
+    from ..errors import InputError
+    from ..geometry.frames import check_area_of_use, parse_crs
+    from ..io.atomic import write_text_atomic
+    from ..io.camera import read_camera_json
+    from ..io.chips import list_chips, read_control_chip, write_location_report
+    from ..io.observations import write_observations_csv
+    from ..io.orientation import read_eo_csv_full
+    from ..io.resection import read_point_control_csv
+    from ..photo.control_location import locate_control_points
+    from ..quality.control_location_html import render_location_html
+    from .orthorectify import list_images
+
+    crs = parse_crs(v.crs, what="CRS")
+    camera = read_camera_json(v.camera)
+    eo_file = read_eo_csv_full(v.eo, crs.to_wkt())
+    eo = eo_file.eo
+    control = read_point_control_csv(v.control_points)
+    check_area_of_use(crs, control.xyz.min(axis=0), control.xyz.max(axis=0),
+                      what="the control points", path=v.control_points)  # fmt: skip
+    chip_files = list_chips(v.chips)
+    ids = list(control.ids)
+    unknown = sorted(set(chip_files) - set(ids))
+    if unknown:
+        raise InputError(f"chips of unknown points (not in the control table): "
+                         f"{', '.join(unknown[:10])}", path=v.control_points)  # fmt: skip
+    chips = [read_control_chip(chip_files[p], p, control.xyz[ids.index(p)])
+             for p in sorted(chip_files)]  # fmt: skip
+    images = {f.stem: f for f in list_images(v.images)}
+    keep = [k for k, i in enumerate(eo.image_id) if i in images]
+    if not keep:
+        raise InputError("no image of the EO table among the images given", path=v.eo)
+    sub = replace(
+        eo,
+        image_id=tuple(eo.image_id[k] for k in keep),
+        time=eo.time[keep],
+        group=tuple(eo.group[k] for k in keep),
+        xyz=eo.xyz[keep],
+        opk=eo.opk[keep],
+    )
+    sig = eo_file.sigma[keep] if eo_file.sigma is not None else None
+    opt = LocateOptions(
+        default_search_px=v.search_px, min_ncc=v.min_ncc, transfer=v.transfer,
+        sigma_floor_px=v.sigma_floor,
+        lsm=replace(_L, min_correlation=v.min_correlation, max_sigma_px=v.max_sigma),
+    )  # fmt: skip
+    reader = _Images(images)
+    compute, _ = stages(progress, 0.95, 0.05)
+    try:
+        res = locate_control_points(chips, sub, camera, reader, sig, opt, progress=compute,
+                                    should_stop=should_stop)  # fmt: skip
+    finally:
+        reader.close()
+    write_observations_csv(out.path("OUTPUT"), res.observations)
+    if out.requested("OUTPUT_REPORT"):
+        write_location_report(out.path("OUTPUT_REPORT"), res.pairs)
+    if out.requested("OUTPUT_HTML"):
+        settings = {
+            "chips": str(len(chips)),
+            "images": str(len(sub)),
+            "search window": "EO sigmas x 3" if sig is not None else f"+-{v.search_px:g} px",
+            "transfer": "yes" if v.transfer else "no",
+        }
+        write_text_atomic(out.path("OUTPUT_HTML"), render_location_html(res.pairs, settings))
+    counts = res.counts()
+    rejected = counts.get("rejected", 0) + counts.get("outside", 0)
+    lines = [f"{len(res.observations)} observations of {len(chips)} points in {len(sub)} images;"
+             f" {rejected} rejected"]  # fmt: skip
+    for p in res.pairs:
+        if p.status != "ok":
+            where = f" in {p.image_id}" if p.image_id else ""
+            lines.append(f"  {p.point_id}{where}: {p.reason}")
+    return JobResult(results={"LOCATED": len(res.observations), "REJECTED": rejected},
+                     lines=lines, data=res)  # fmt: skip

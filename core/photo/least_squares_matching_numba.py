@@ -1,0 +1,165 @@
+"""The inner loop of least-squares matching compiled with numba: for each patch, bicubic (Keys
+1981) samples of the search window and of its derivative at the affine positions, accumulated
+straight into the 8 x 8 normal equations (no (K, 8, P) design matrix in memory).
+
+The same arithmetic as the numpy path of :mod:`core.photo.least_squares_matching` (the tests
+compare them); numba is optional: :data:`AVAILABLE` tells whether it imports.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import numpy as np
+
+try:  # pragma: no cover - depends on the environment
+    import numba
+
+    AVAILABLE = True
+except Exception:  # ImportError, or a numba built against another numpy
+    numba = None
+    AVAILABLE = False
+
+__all__ = ["AVAILABLE", "normals", "samples"]
+
+
+def _normals(g, idx, aff, rad, f, x, y, nn, rhs, outside):  # pragma: no cover - compiled
+    h = g.shape[1]
+    w = g.shape[2]
+    p_n = x.shape[0]
+    jv = np.empty(8)
+    for q in range(idx.shape[0]):
+        k = idx[q]
+        a0, a1, a2 = aff[k, 0, 0], aff[k, 0, 1], aff[k, 0, 2]
+        b0, b1, b2 = aff[k, 1, 0], aff[k, 1, 1], aff[k, 1, 2]
+        r0, r1 = rad[k, 0], rad[k, 1]
+        out = False
+        for i in range(8):
+            rhs[q, i] = 0.0
+            for j in range(8):
+                nn[q, i, j] = 0.0
+        for p in range(p_n):
+            c = a0 + a1 * x[p] + a2 * y[p]
+            r = b0 + b1 * x[p] + b2 * y[p]
+            if c < 1.0 or r < 1.0 or c > w - 3.0 or r > h - 3.0:
+                out = True
+                c = min(max(c, 1.0), w - 3.000001)
+                r = min(max(r, 1.0), h - 3.000001)
+            ci = int(c)
+            ri = int(r)
+            tx = c - ci
+            ty = r - ri
+            t2 = tx * tx
+            t3 = t2 * tx
+            wx0 = -0.5 * t3 + t2 - 0.5 * tx
+            wx1 = 1.5 * t3 - 2.5 * t2 + 1.0
+            wx2 = -1.5 * t3 + 2.0 * t2 + 0.5 * tx
+            wx3 = 0.5 * t3 - 0.5 * t2
+            dx0 = -1.5 * t2 + 2.0 * tx - 0.5
+            dx1 = 4.5 * t2 - 5.0 * tx
+            dx2 = -4.5 * t2 + 4.0 * tx + 0.5
+            dx3 = 1.5 * t2 - tx
+            t2 = ty * ty
+            t3 = t2 * ty
+            wy0 = -0.5 * t3 + t2 - 0.5 * ty
+            wy1 = 1.5 * t3 - 2.5 * t2 + 1.0
+            wy2 = -1.5 * t3 + 2.0 * t2 + 0.5 * ty
+            wy3 = 0.5 * t3 - 0.5 * t2
+            dy0 = -1.5 * t2 + 2.0 * ty - 0.5
+            dy1 = 4.5 * t2 - 5.0 * ty
+            dy2 = -4.5 * t2 + 4.0 * ty + 0.5
+            dy3 = 1.5 * t2 - ty
+            val = 0.0
+            gcol = 0.0
+            grow = 0.0
+            for m in range(4):
+                rr = ri - 1 + m
+                s0 = g[k, rr, ci - 1]
+                s1 = g[k, rr, ci]
+                s2 = g[k, rr, ci + 1]
+                s3 = g[k, rr, ci + 2]
+                ax = wx0 * s0 + wx1 * s1 + wx2 * s2 + wx3 * s3
+                dxv = dx0 * s0 + dx1 * s1 + dx2 * s2 + dx3 * s3
+                wym = wy0 if m == 0 else (wy1 if m == 1 else (wy2 if m == 2 else wy3))
+                dym = dy0 if m == 0 else (dy1 if m == 1 else (dy2 if m == 2 else dy3))
+                val += wym * ax
+                gcol += wym * dxv
+                grow += dym * ax
+            res = f[k, p] - (r0 + r1 * val)
+            ux = r1 * gcol
+            uy = r1 * grow
+            jv[0] = ux
+            jv[1] = ux * x[p]
+            jv[2] = ux * y[p]
+            jv[3] = uy
+            jv[4] = uy * x[p]
+            jv[5] = uy * y[p]
+            jv[6] = 1.0
+            jv[7] = val
+            for i in range(8):
+                rhs[q, i] += jv[i] * res
+                for j in range(i, 8):
+                    nn[q, i, j] += jv[i] * jv[j]
+        for i in range(8):
+            for j in range(i):
+                nn[q, i, j] = nn[q, j, i]
+        outside[q] = out
+
+
+def _samples(g, aff, x, y, out):  # pragma: no cover - compiled
+    h = g.shape[1]
+    w = g.shape[2]
+    for k in range(aff.shape[0]):
+        for p in range(x.shape[0]):
+            c = aff[k, 0, 0] + aff[k, 0, 1] * x[p] + aff[k, 0, 2] * y[p]
+            r = aff[k, 1, 0] + aff[k, 1, 1] * x[p] + aff[k, 1, 2] * y[p]
+            c = min(max(c, 1.0), w - 3.000001)
+            r = min(max(r, 1.0), h - 3.000001)
+            ci = int(c)
+            ri = int(r)
+            tx = c - ci
+            ty = r - ri
+            t2 = tx * tx
+            t3 = t2 * tx
+            wx = (-0.5 * t3 + t2 - 0.5 * tx, 1.5 * t3 - 2.5 * t2 + 1.0,
+                  -1.5 * t3 + 2.0 * t2 + 0.5 * tx, 0.5 * t3 - 0.5 * t2)  # fmt: skip
+            t2 = ty * ty
+            t3 = t2 * ty
+            wy = (-0.5 * t3 + t2 - 0.5 * ty, 1.5 * t3 - 2.5 * t2 + 1.0,
+                  -1.5 * t3 + 2.0 * t2 + 0.5 * ty, 0.5 * t3 - 0.5 * t2)  # fmt: skip
+            val = 0.0
+            for m in range(4):
+                ax = 0.0
+                for n in range(4):
+                    ax += wx[n] * g[k, ri - 1 + m, ci - 1 + n]
+                val += wy[m] * ax
+            out[k, p] = val
+
+
+_COMPILED: dict[str, Callable[..., Any]] = {}
+
+
+def _compiled(name: str) -> Callable[..., Any]:
+    """The jitted function (compiled at its first call; cached next to this module)."""
+    if name not in _COMPILED:
+        func = {"normals": _normals, "samples": _samples}[name]
+        _COMPILED[name] = numba.njit(cache=True, nogil=True)(func)
+    return _COMPILED[name]
+
+
+def normals(g, idx, aff, rad, f, x, y):
+    """(n, 8, 8) normal matrices, (n, 8) right-hand sides and (n,) "left the window" flags of
+    the patches ``idx`` (see :func:`core.photo.least_squares_matching.lsm_batch`)."""
+    n = idx.shape[0]
+    nn = np.empty((n, 8, 8))
+    rhs = np.empty((n, 8))
+    outside = np.empty(n, dtype=np.bool_)
+    _compiled("normals")(g, idx.astype(np.int64), aff, rad, f, x, y, nn, rhs, outside)
+    return nn, rhs, outside
+
+
+def samples(g, aff, x, y):
+    """(K, P) bicubic samples of each patch's window at its affine positions."""
+    out = np.empty((aff.shape[0], x.shape[0]))
+    _compiled("samples")(g, np.ascontiguousarray(aff), x, y, out)
+    return out
