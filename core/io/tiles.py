@@ -150,8 +150,10 @@ def index_block(
     """
     path = Path(source)
     if path.is_dir():
-        files = sorted(p for p in path.iterdir()
-                       if p.suffix.lower() in CLOUD_SUFFIXES and not p.name.startswith("."))  # fmt: skip
+        files = sorted(
+            p for p in path.iterdir()
+            if p.suffix.lower() in CLOUD_SUFFIXES and not p.name.startswith(".")
+        )  # fmt: skip
         if not files:
             raise InputError("no .las or .laz file in the folder", path=str(path))
         return _index_files(str(path), "folder", [(p.stem, str(p), None) for p in files], crs)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 import math
 import os
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -68,7 +69,10 @@ lines.csv (the formats of Extract roof planes and Create LCPs) and block_report.
 tile: points, ground, seconds, peak memory, errors). Lengths are in the CRS unit unless
 DISTANCE_UNIT is metres.""",
     params=(
-        *cloud_params("INPUT", "Block: folder of LAS/LAZ tiles, .vpc or one LAS/LAZ file"),
+        Param("INPUT", "file", "Block: folder of LAS/LAZ tiles, .vpc or one LAS/LAZ file",
+              file_filter="LAS/LAZ or virtual point cloud (*.las *.laz *.vpc)",
+              help="a folder path is accepted too (its *.las/*.laz)"),
+        *cloud_params("INPUT")[1:],
         Param("TILE_SIZE", "number", "Tile size (one large file)", 500.0, unit="length",
               minimum=1.0, maximum=1e6, help="side of the square tiles one file is cut into"),
         Param("SMRF_CELL_SIZE", "number", "SMRF cell size", _S.cell_size, unit="length",
@@ -99,11 +103,14 @@ DISTANCE_UNIT is metres.""",
               minimum=0, maximum=1024),
         Param("MEMORY_LIMIT", "number", "Local cluster: memory limit per worker (0 = RAM / "
               "workers)", 0.0, unit="GB", minimum=0.0, maximum=4096.0),
-        Param("LOCAL_CLUSTER", "enum", "Local cluster workers", "processes",
-              options=("processes", "threads"),
-              labels=("processes (one per worker)", "threads of this process"),
-              qgis_default="threads", advanced=True,
-              help="threads inside QGIS: a process cluster would start QGIS's own executable"),
+        Param("LOCAL_CLUSTER", "enum", "Local cluster workers", "auto",
+              options=("auto", "processes", "threads"),
+              labels=("auto (processes on the command line, threads inside QGIS)",
+                      "processes (one per worker)", "threads of this process"),
+              advanced=True,
+              help="auto: processes on the command line, threads inside QGIS or "
+              "qgis_process, where a process cluster would start QGIS's own executable for "
+              "each worker"),
         Param("OUTPUT_FOLDER", "folder_out", "Output folder (tiles, VPC, tables, report)"),
     ),
     results=(
@@ -219,7 +226,8 @@ def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOu
     xyz = np.column_stack([a["x"], a["y"], a["z"]])
     r = settings.roof_buffer
     near = ((a["x"] >= own[0] - r) & (a["x"] <= own[2] + r) & (a["y"] >= own[1] - r)
-            & (a["y"] <= own[3] + r) & (cls != GROUND_CLASS) & (cls != LOW_NOISE_CLASS))  # fmt: skip
+            & (a["y"] <= own[3] + r))  # fmt: skip
+    near &= (cls != GROUND_CLASS) & (cls != LOW_NOISE_CLASS)
     pieces = []
     if near.sum() >= settings.roof.min_plane_points:
         roofs = extract_roof_planes(xyz[near], settings.roof)
@@ -262,11 +270,17 @@ def open_client(v: Values):
         try:
             return Client(v.cluster, timeout="20s"), None
         except (OSError, TimeoutError) as exc:
-            raise InputError(f"CLUSTER: cannot reach the dask scheduler {v.cluster}: {exc}") from exc
+            raise InputError(
+                f"CLUSTER: cannot reach the dask scheduler {v.cluster}: {exc}"
+            ) from exc
     n = v.workers or os.cpu_count() or 1
     memory = f"{v.memory_limit}GB" if v.memory_limit > 0 else "auto"
+    # inside QGIS (or qgis_process) a worker process would be started with QGIS's own
+    # executable: threads there
+    processes = v.local_cluster == "processes" or (
+        v.local_cluster == "auto" and "qgis.core" not in sys.modules)
     cluster = LocalCluster(n_workers=n, threads_per_worker=1, memory_limit=memory,
-                           processes=v.local_cluster == "processes", dashboard_address=None,
+                           processes=processes, dashboard_address=None,
                            silence_logs=logging.ERROR)  # fmt: skip
     return Client(cluster), cluster
 

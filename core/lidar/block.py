@@ -3,13 +3,18 @@ LiDAR control points and lines deduplicated (no file access: core/jobs/lidar_blo
 and writes).
 
 Buffer rule (:func:`ground_buffer`): SMRF and PMF decide a cell from the lowest-point grid
-through openings (an erosion then a dilation) with windows up to radius ``R`` = max_window,
-(SMRF's max_window, half PMF's window width), so a cell depends on cells up to ``2 R`` away; the low-outlier test looks ``low_outlier_radius``
-further, the final test interpolates the DTM one cell away and its slope one more cell.
-A tile read with a buffer of ``2 R + low_outlier_radius + 3 cells`` gets, on its core, the
-classification a run on the whole cloud gives (the rare exceptions: points within float32
-rounding of the height tolerance, since each tile stores heights relative to its own lowest
-point, and empty areas wider than the buffer that the nearest-cell fill bridges differently).
+through openings (an erosion then a dilation) with windows up to radius ``R`` (SMRF's
+max_window, half PMF's window width), so a cell depends on cells up to ``2 R`` away; the
+low-outlier test looks ``low_outlier_radius`` further, the final test interpolates the DTM
+one cell away and its slope one more cell. Hence a buffer of
+``2 R + low_outlier_radius + 3 cells``. Tile grids are aligned with the whole cloud's (cells
+on multiples of the cell size), so on a tile's core the openings, and the ground cells, are
+those of a run on the whole cloud. What is not local is the pull-push filling of the DTM
+under objects (:func:`lidarphoto.core.geometry.grid.fill_holes`): its pyramid starts at the
+grid's corner, which is the tile's, so under and next to buildings the filled DTM differs by
+millimetres to centimetres and a point whose height is that close to the tolerance can change
+class. Measured on a simulated town in 60 m tiles: 99.99 % of the points agree (9 of 75 256
+differ, each where the two DTMs differ by more than 1 mm; tests/core/test_lidar_block.py).
 CSF, whose cloth couples every cell, and a slope estimated from the cloud (SMRF slope 0) have
 no finite buffer and are refused for blocks.
 

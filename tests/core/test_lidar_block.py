@@ -16,18 +16,18 @@ import pytest
 
 pytest.importorskip("distributed")
 
-from lidarphoto.core import cli  # noqa: E402
-from lidarphoto.core.errors import Cancelled, CrsError  # noqa: E402
-from lidarphoto.core.geometry.grid import Grid  # noqa: E402
-from lidarphoto.core.io.planes import read_planes_csv  # noqa: E402
-from lidarphoto.core.io.tiles import index_block, read_buffered, write_vpc  # noqa: E402
-from lidarphoto.core.jobs import lidar_block  # noqa: E402
-from lidarphoto.core.jobs.runner import run_job  # noqa: E402
-from lidarphoto.core.lidar.block import ground_buffer  # noqa: E402
-from lidarphoto.core.lidar.control import lidar_control  # noqa: E402
-from lidarphoto.core.lidar.ground_filter import SmrfParams, ground_filter  # noqa: E402
-from lidarphoto.core.lidar.roof_planes import extract_roof_planes  # noqa: E402
-from lidarphoto.core.simulation.block import town_tiles, write_las  # noqa: E402
+from lidarphoto.core import cli
+from lidarphoto.core.errors import Cancelled, CrsError
+from lidarphoto.core.geometry.grid import Grid
+from lidarphoto.core.io.planes import read_planes_csv
+from lidarphoto.core.io.tiles import index_block, read_buffered, write_vpc
+from lidarphoto.core.jobs import lidar_block
+from lidarphoto.core.jobs.runner import run_job
+from lidarphoto.core.lidar.block import ground_buffer
+from lidarphoto.core.lidar.control import lidar_control
+from lidarphoto.core.lidar.ground_filter import SmrfParams, ground_filter
+from lidarphoto.core.lidar.roof_planes import extract_roof_planes
+from lidarphoto.core.simulation.block import town_tiles, write_las
 
 TILE = 60.0  # m: the town's 30 m cells put tile borders through buildings
 THREADS = {"WORKERS": 2, "LOCAL_CLUSTER": "threads"}
@@ -50,7 +50,7 @@ def block(tmp_path_factory):
     """A simulated town (75 k points) in 14 tiles of 60 m, the block run on it (2 thread
     workers), and the whole-cloud ground filter of the same points."""
     root = tmp_path_factory.mktemp("block")
-    xyz, truth, files = town_tiles(root / "tiles", TILE, density=4.0)
+    xyz, _, files = town_tiles(root / "tiles", TILE, density=4.0)
     out = root / "out"
     result = run_job(lidar_block, {"INPUT": str(root / "tiles"), "OUTPUT_FOLDER": str(out),
                                    **THREADS})  # fmt: skip
@@ -177,7 +177,8 @@ def test_bad_tiles_reported_by_name_the_rest_finishes(block, tmp_path, capsys):
     victim.write_bytes(data[: len(data) // 2])  # header fine, points truncated
     (tiles / "tile_zz_garbage.laz").write_bytes(b"not a LAZ file at all" * 10)
     code = cli.main(["lidarblock", "--input", str(tiles), "--output-folder",
-                     str(tmp_path / "out"), "--workers", "2", "--local-cluster", "threads"])  # fmt: skip
+                     str(tmp_path / "out"), "--workers", "2",
+                     "--local-cluster", "threads"])  # fmt: skip
     assert code == lidar_block.INCOMPLETE_EXIT == 3
     out = capsys.readouterr().out
     assert "INCOMPLETE" in out and victim.stem in out and "tile_zz_garbage" in out
@@ -241,8 +242,8 @@ def test_a_killed_worker_task_is_rerun_without_lost_or_duplicated_points(block, 
     staging = tmp_path / "staging"
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                       dashboard_address=None) as cluster, Client(cluster) as client:  # fmt: skip
-        res = lidar_block.run_block(index, settings, str(staging), client,
-                                    task=functools.partial(_kill_once, marker=str(marker)))  # fmt: skip
+        task = functools.partial(_kill_once, marker=str(marker))
+        res = lidar_block.run_block(index, settings, str(staging), client, task=task)
     assert marker.exists()  # the worker was killed
     assert all(o.ok for o in res["outcomes"])
     ids, cls = _read_tiles(staging)
