@@ -251,3 +251,29 @@ def test_a_killed_worker_task_is_rerun_without_lost_or_duplicated_points(block, 
     ids0, cls0 = _read_tiles(block["out"])
     assert np.array_equal(ids, ids0) and np.array_equal(cls, cls0)
     assert not [p for p in (staging / "tiles").iterdir() if p.name.startswith(".")]
+
+
+def test_an_existing_cluster_by_address_is_used_and_left_running(block, tmp_path):
+    from distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster:  # fmt: skip
+        res = run_job(lidar_block, {"INPUT": str(block["root"] / "tiles"),
+                                    "OUTPUT_FOLDER": str(tmp_path / "o"),
+                                    "CLUSTER": cluster.scheduler_address})  # fmt: skip
+        with Client(cluster) as client:  # still up: the job closed only its own client
+            assert len(client.scheduler_info()["workers"]) == 2
+    assert res.results["POINT_COUNT"] == len(block["xyz"])
+    ids, cls = _read_tiles(tmp_path / "o")
+    ids0, cls0 = _read_tiles(block["out"])
+    assert np.array_equal(ids, ids0) and np.array_equal(cls, cls0)
+
+
+def test_an_unreachable_cluster_is_an_input_error(block, tmp_path):
+    from lidarphoto.core.errors import InputError
+
+    with pytest.raises(InputError, match="CLUSTER"):
+        run_job(lidar_block, {"INPUT": str(block["root"] / "tiles"),
+                              "OUTPUT_FOLDER": str(tmp_path / "o"),
+                              "CLUSTER": "tcp://127.0.0.1:9"})  # fmt: skip
+    assert not (tmp_path / "o").exists()
