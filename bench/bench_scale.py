@@ -60,6 +60,8 @@ def main() -> None:
         rss = [t["peak_rss_mb"] for t in rep["tiles"]]
         pts = [t["points"] for t in rep["tiles"]]
         read = [t["points_read"] for t in rep["tiles"]]
+        stage = {k: round(sum(t["stage_seconds"].get(k, 0.0) for t in rep["tiles"]), 1)
+                 for k in ("read", "ground", "write", "roof_planes")}  # fmt: skip
         print(json.dumps({
             "workers": n, "load_before": round(load, 2), "wall_s": round(wall, 1),
             "points": res.results["POINT_COUNT"], "tiles": len(secs),
@@ -68,6 +70,8 @@ def main() -> None:
             "tile_points_median": int(statistics.median(pts)),
             "read_over_core": round(sum(read) / max(sum(pts), 1), 3),
             "worker_peak_rss_mb_max": max(rss), "tasks_s": rep["seconds"],
+            "stage_s_sum": stage, "merge_control_s": round(rep["seconds"] - rep["tasks_s"], 1)
+            if "tasks_s" in rep else None,
             "planes": res.results["PLANE_COUNT"], "lcps": res.results["LCP_COUNT"],
             "lines": res.results["LINE_COUNT"], "complete": rep["complete"],
             "out_mb": round(sum(p.stat().st_size for p in (out / "tiles").glob("*.laz")) / 1e6,
