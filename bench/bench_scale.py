@@ -61,7 +61,7 @@ def main() -> None:
         pts = [t["points"] for t in rep["tiles"]]
         read = [t["points_read"] for t in rep["tiles"]]
         stage = {k: round(sum(t["stage_seconds"].get(k, 0.0) for t in rep["tiles"]), 1)
-                 for k in ("read", "ground", "write", "roof_planes")}  # fmt: skip
+                 for k in ("read", "ground", "write", "roof_planes", "cpu")}  # fmt: skip
         print(json.dumps({
             "workers": n, "load_before": round(load, 2), "wall_s": round(wall, 1),
             "points": res.results["POINT_COUNT"], "tiles": len(secs),

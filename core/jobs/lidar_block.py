@@ -192,6 +192,7 @@ def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOu
     from ..lidar.roof_planes import extract_roof_planes
 
     t0 = time.perf_counter()
+    c0 = time.process_time()  # the worker's CPU (its decoder threads too): load-independent
     tile = index.tiles[i]
     try:
         buf = read_buffered(index, i, max(settings.ground_buffer, settings.roof_buffer),
@@ -245,6 +246,7 @@ def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOu
             if len(pts) >= 3:  # a plane only in the buffer belongs to the neighbour
                 pieces.append(PlanePiece(i, plane, pts))
     stages["roof_planes"] = time.perf_counter() - t0 - sum(stages.values())
+    stages["cpu"] = time.process_time() - c0
     ids = a["id"][:n_core]
     cx = xyz[:n_core]
     return TileOutcome(
