@@ -144,6 +144,24 @@ def build_parser() -> argparse.ArgumentParser:
 GDAL_CACHE_MB = "256"
 
 
+def _progress_bar(job):
+    """A text progress bar on stderr for the jobs that ask for one (``CLI_PROGRESS``)."""
+    if not getattr(job, "CLI_PROGRESS", False):
+        return None
+    shown = [-1]
+
+    def bar(fraction: float) -> None:
+        percent = int(100 * min(max(fraction, 0.0), 1.0))
+        if percent != shown[0]:
+            shown[0] = percent
+            done = percent * 40 // 100
+            end = "\n" if percent == 100 else ""
+            sys.stderr.write(f"\r[{'#' * done}{'.' * (40 - done)}] {percent:3d} %{end}")
+            sys.stderr.flush()
+
+    return bar
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     import os
 
@@ -161,7 +179,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     }
     try:
         with stop_signals_raise():
-            result = run_job(args.job, raw)
+            result = run_job(args.job, raw, progress=_progress_bar(args.job))
     except Terminated as exc:
         print(f"lidarphoto {args.algorithm}: stopped by {exc.name}; nothing was written",
               file=sys.stderr)  # fmt: skip
@@ -187,4 +205,4 @@ def main(argv: Sequence[str] | None = None) -> int:
         sys.stdout.write(result.stdout)
     for line in result.lines:
         print(line)
-    return 0
+    return result.exit_code

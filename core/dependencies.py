@@ -22,10 +22,12 @@ REQUIRED_MODULES: dict[str, str] = {
     "pyproj": "pyproj",
 }
 
-#: optional accelerators: import name -> (pip requirement, what is slower without it).
+#: optional packages: import name -> (pip requirement, what is slower or missing without it).
 OPTIONAL_MODULES: dict[str, tuple[str, str]] = {
     "numba": ("numba", "ray casting on the DSM (monoplotting) runs 2-3x slower, orthophotos "
               "about 2.5x, roof planes about 3.5x"),
+    "distributed": ("distributed", "the LiDAR block algorithm (lidarblock, tiles on dask) "
+                    "cannot run"),
 }
 
 

@@ -15,6 +15,7 @@ from .algorithms.create_lcps import CreateLcpsAlgorithm
 from .algorithms.extract_roof_planes import ExtractRoofPlanesAlgorithm
 from .algorithms.extract_tls_targets import ExtractTlsTargetsAlgorithm
 from .algorithms.ground_filter import GroundFilterAlgorithm
+from .algorithms.lidar_block import LidarBlockAlgorithm
 from .algorithms.locate_control_points import LocateControlPointsAlgorithm
 from .algorithms.monoplot import MonoplotAlgorithm
 from .algorithms.orthomosaic import OrthomosaicAlgorithm
@@ -63,5 +64,6 @@ class LidarPhotoProvider(QgsProcessingProvider):
             TlsCalibrationAlgorithm(),
             ExtractTlsTargetsAlgorithm(),
             LocateControlPointsAlgorithm(),
+            LidarBlockAlgorithm(),
         ):
             self.addAlgorithm(alg)

@@ -9,6 +9,7 @@ from . import (
     extract_roof_planes,
     extract_tls_targets,
     ground_filter,
+    lidar_block,
     locate_control_points,
     monoplot,
     orthomosaic,
@@ -34,4 +35,5 @@ ALGORITHMS = (
     tls_calibration,
     extract_tls_targets,
     locate_control_points,
+    lidar_block,
 )

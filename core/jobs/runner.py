@@ -34,6 +34,8 @@ class JobResult:
     lines: list[str] = field(default_factory=list)
     data: Any = None
     stdout: str = ""
+    #: exit status of the command line (e.g. 3: a block processed incompletely)
+    exit_code: int = 0
 
 
 def input_files(spec: AlgorithmSpec, values: Mapping[str, Any]) -> dict[str, Any]:
