@@ -157,7 +157,7 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
 
     def initAlgorithm(self, config=None):
         for p in self.spec.params:
-            self.addParameter(make_parameter(p, self.tr))
+            self.addParameter(make_parameter(p, self.tr, self.spec))
         for r in self.spec.results:
             self.addOutput(make_output(r, self.tr))
 

@@ -57,8 +57,8 @@ are listed in the log with the reason.""",
               help='plane ids "1,2,3; 4,5,6" (default: automatic)'),
         Param("PAIRS", "string", "Plane pairs", "", optional=True, advanced=True,
               help='plane ids "1,2; 2,3" (default: automatic)'),
-        Param("OUTPUT_POINTS", "sink", "LiDAR control points", geometry="point"),
-        Param("OUTPUT_LINES", "sink", "LiDAR control lines", geometry="line"),
+        Param("OUTPUT_POINTS", "sink", "LiDAR control points", geometry="point", optional=True),
+        Param("OUTPUT_LINES", "sink", "LiDAR control lines", geometry="line", optional=True),
         Param("POINTS_CSV", "file_out", "Control point table (CSV)", optional=True,
               create_by_default=False, file_filter=CSV_OUT),
         Param("LINES_CSV", "file_out", "Control line table (CSV)", optional=True,
@@ -71,6 +71,7 @@ are listed in the log with the reason.""",
         Result("LINE_COUNT", "number", "Number of lines"),
     ),
     tags=("lcp", "control point", "roof", "ridge", "plane intersection", "covariance"),
+    references=("Pedrosa & dos Santos (2020)",),
 )
 
 
