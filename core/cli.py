@@ -126,7 +126,10 @@ def _add_algorithm(sub: argparse._SubParsersAction, spec: AlgorithmSpec, job: ob
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="lidarphoto", description=__doc__.split("\n\n")[0])
     parser.add_argument("--version", action="version", version=f"lidarphoto {__version__}")
-    parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
+    parser.add_argument(
+        "-v", "--verbose", action="count", default=0,
+        help="log progress to stderr; -vv also the details (e.g. every rejected candidate)",
+    )  # fmt: skip
     sub = parser.add_subparsers(dest="algorithm", metavar="ALGORITHM", required=True)
     for job in ALGORITHMS:
         _add_algorithm(sub, job.SPEC, job)
@@ -147,6 +150,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         level=logging.INFO if args.verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
     )
+    if args.verbose >= 2:  # the toolkit's details, not those of the libraries it uses
+        logging.getLogger(__name__.split(".")[0]).setLevel(logging.DEBUG)
     spec: AlgorithmSpec = args.job.SPEC
     raw = {
         p.name: getattr(args, p.name)

@@ -201,7 +201,12 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
         """
         if feedback is None:
             feedback = QgsProcessingFeedback()
-        with forward_logging(feedback), core_errors(self.tr("Cancelled by the user")):
+        # debug records (details such as every rejected candidate) go to pushDebugInfo, which
+        # QGIS shows in grey in the dialog's log and qgis_process prints with --verbose
+        with (
+            forward_logging(feedback, logging.DEBUG),
+            core_errors(self.tr("Cancelled by the user")),
+        ):
             return func(
                 *args,
                 progress=progress_callback(feedback),
