@@ -12,7 +12,7 @@ from ..compat import FIELD_DOUBLE, FIELD_INT, FIELD_STRING, WKB_POINT_Z, WKT_PRE
 
 S, D = FIELD_STRING, FIELD_DOUBLE
 _FIELDS = (
-    ("id", S), ("group", S), ("dE", D), ("dN", D), ("dH", D), ("dHoriz", D), ("d3D", D),
+    ("id", S), ("group", S), ("dE", D), ("dN", D), ("dU", D), ("dHorizontal", D), ("d3D", D),
     ("outlier", FIELD_INT),
 )  # fmt: skip
 
