@@ -4,8 +4,8 @@ Sign convention: a discrepancy is ``d = measured - reference`` (the product minu
 independent, more accurate source), per component dE, dN, dU (up: the height) in metres, in
 one projected CRS (the mapping frame of docs/conventions.md).
 ``dHorizontal = sqrt(dE^2 + dN^2)`` and ``d3D = sqrt(dE^2 + dN^2 + dU^2)``. The names of
-the figures (RMSE_E, RMSE_N, RMSE_U, RMSE_HORIZONTAL, RMSE_3D, ...) are one scheme for the JSON, the HTML, the QGIS outputs and
-the layers: docs/formats.md, "Accuracy figures".
+the figures (RMSE_E, RMSE_N, RMSE_U, RMSE_HORIZONTAL, RMSE_3D, ...) are one scheme for the
+JSON, the HTML, the QGIS outputs and the layers: docs/formats.md, "Accuracy figures".
 
 The check-point and point tables (CSV) are read by :mod:`core.io.checkpoints`.
 
