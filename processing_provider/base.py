@@ -180,7 +180,23 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
         outputs = {p.name: raw.get(p.name) for p in self.spec.outputs if p.kind != "sink"}
         outputs.update(result.results)
         outputs.update(self.write_layers(result, parameters, context, feedback))
+        self.attach_styles(outputs, context)
         return outputs
+
+    #: (output name, style function of processing_provider/layer_styles.py) pairs: how each
+    #: output layer looks when QGIS loads it after the run.
+    STYLES: tuple[tuple[str, Callable[[Any], None]], ...] = ()
+
+    def attach_styles(self, outputs: dict, context) -> None:
+        """Give each output QGIS will load its style from :attr:`STYLES`."""
+        from .layer_styles import LayerStyle
+
+        for name, func in self.STYLES:
+            dest = outputs.get(name)
+            if dest and context.willLoadLayerOnCompletion(dest):
+                context.layerToLoadOnCompletionDetails(dest).setPostProcessor(
+                    LayerStyle.create(func)
+                )
 
     def error(self, text: str) -> QgsProcessingException:
         """An error for the user (translated)."""
