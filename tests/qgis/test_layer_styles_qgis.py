@@ -11,7 +11,6 @@ from lidarphoto.processing_provider.layer_styles import (
     MAX_SIZE_MM,
     MIN_SIZE_MM,
     style_control_lines,
-    style_discrepancies,
     style_dtm,
     style_image_residuals,
     style_lcps,
