@@ -80,6 +80,16 @@ def forward_logging(feedback: QgsProcessingFeedback, level: int = logging.INFO):
         logger.setLevel(old_level)
 
 
+def verbose_log(context) -> bool:
+    """Whether ``context`` asks for a verbose log (QgsProcessingContext.logLevel() Verbose or
+    ModelDebug; QGIS 3.22 to 4)."""
+    try:
+        level = context.logLevel()
+    except AttributeError:
+        return False
+    return int(getattr(level, "value", level)) >= 1
+
+
 def progress_callback(feedback: QgsProcessingFeedback) -> Callable[[float], None]:
     """Core progress (a fraction in [0, 1]) -> ``feedback.setProgress`` (percent)."""
 
@@ -122,6 +132,8 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
     """
 
     JOB: ModuleType
+    #: whether the current run logs details (see :func:`verbose_log`)
+    _verbose = False
 
     def tr(self, text: str) -> str:
         return QCoreApplication.translate(type(self).__name__, text)
@@ -174,6 +186,7 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
             if p.kind != "sink"
         }
         raw = self.prepare(raw, parameters, context, feedback)
+        self._verbose = verbose_log(context)
         result = self.run_core(run_job, self.JOB, raw, feedback=feedback)
         for line in result.lines:
             feedback.pushInfo(line)
@@ -217,10 +230,12 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
         """
         if feedback is None:
             feedback = QgsProcessingFeedback()
-        # debug records (details such as every rejected candidate) go to pushDebugInfo, which
-        # QGIS shows in grey in the dialog's log and qgis_process prints with --verbose
+        # details (debug records, such as every rejected candidate) only when the processing
+        # context asks for a verbose log (Processing options: logging level Verbose), as
+        # pushDebugInfo; otherwise the summaries alone
+        level = logging.DEBUG if self._verbose else logging.INFO
         with (
-            forward_logging(feedback, logging.DEBUG),
+            forward_logging(feedback, level),
             core_errors(self.tr("Cancelled by the user")),
         ):
             return func(

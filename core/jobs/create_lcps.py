@@ -41,7 +41,7 @@ Distances are in the cloud's CRS unit (e.g. feet for a CRS in feet) unless dista
 metres; the outputs are in the CRS unit. Optionally give your own plane-id triples
 ("1,2,3; 4,5,6") or pairs ("1,2; 2,3") instead of the automatic ones. The log counts the
 rejected candidates per reason; each one, with its numbers and units, is listed only in
-verbose mode (command line: -vv; QGIS: the debug information of the log).""",
+verbose mode (command line: -vv; QGIS: Processing options, logging level Verbose).""",
     params=(
         Param("PLANES", "file", "Plane table (CSV)", file_filter=CSV_FILTER),
         *cloud_params("CLOUD", "Cloud with plane ids (LAS/LAZ)"),
@@ -145,7 +145,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         write_graph_csv(out.path("GRAPH_CSV"), result.adjacency)
     # the counts always; each candidate only in verbose mode (CLI -vv, QGIS debug info)
     if result.rejected:
-        log.info("%s (details: lidarphoto -vv, or QGIS's debug information)",
+        log.info("%s (details: lidarphoto -vv; QGIS: Processing logging level Verbose)",
                  rejection_summary(result.rejected))  # fmt: skip
     for r in result.rejected:
         log.debug("planes %s: %s", ",".join(map(str, r.plane_ids)), r.reason)
