@@ -1,6 +1,6 @@
 """``createlcps``'s log: rejected candidates counted per reason (numbers with units); each
-candidate only in verbose mode (``lidarphoto -vv``; debug records, which QGIS shows as debug
-information)."""
+candidate only in verbose mode (``lidarphoto -vv``; debug records, which QGIS forwards as
+debug information when the processing log level is Verbose)."""
 
 from __future__ import annotations
 
