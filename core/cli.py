@@ -22,7 +22,7 @@ from . import __version__
 from .errors import Cancelled, LidarPhotoError
 from .jobs import ALGORITHMS
 from .jobs.runner import run_job
-from .jobs.spec import AlgorithmSpec, Param
+from .jobs.spec import AlgorithmSpec, Param, facts_line
 
 _METAVAR = {
     "file": "FILE",
@@ -83,22 +83,16 @@ def stop_signals_raise() -> Iterator[None]:
             signal.signal(s, old)
 
 
-def _option_help(p: Param) -> str:
-    bits = [p.title]
+def _option_help(p: Param, spec: AlgorithmSpec | None = None) -> str:
+    """label; help; default, unit and valid range (the same facts as the QGIS help)."""
+    bits = [p.label]
     if p.help and p.help != p.label:
         bits.append(p.help)
+    facts = facts_line(p, spec)
     if p.kind == "enum":
-        many = "comma list of " if p.multiple else ""
-        bits.append(f"{many}{' | '.join(p.options)} (or their index)")
-    if p.minimum is not None or p.maximum is not None:
-        lo = "" if p.minimum is None else f">= {p.minimum:g}"
-        hi = "" if p.maximum is None else f"<= {p.maximum:g}"
-        bits.append(" and ".join(b for b in (lo, hi) if b))
-    default = p.default_text()
-    if default:
-        bits.append(f"default: {default}")
-    elif p.is_output or p.optional:
-        bits.append("optional")
+        many = " (a comma list)" if p.multiple else ""
+        facts += f" (or their index){many}"
+    bits.append(facts)
     return "; ".join(bits).replace("%", "%%")
 
 
@@ -112,7 +106,7 @@ def _add_algorithm(sub: argparse._SubParsersAction, spec: AlgorithmSpec, job: ob
     for p in spec.params:
         if p.kind == "sink":  # layers: QGIS only
             continue
-        kwargs: dict = {"dest": p.name, "default": None, "help": _option_help(p)}
+        kwargs: dict = {"dest": p.name, "default": None, "help": _option_help(p, spec)}
         if p.kind == "boolean":
             kwargs.update(nargs="?", const="true", metavar="true|false")
         elif p.kind == "enum":
@@ -132,7 +126,10 @@ def _add_algorithm(sub: argparse._SubParsersAction, spec: AlgorithmSpec, job: ob
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="lidarphoto", description=__doc__.split("\n\n")[0])
     parser.add_argument("--version", action="version", version=f"lidarphoto {__version__}")
-    parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
+    parser.add_argument(
+        "-v", "--verbose", action="count", default=0,
+        help="log progress to stderr; -vv also the details (e.g. every rejected candidate)",
+    )  # fmt: skip
     sub = parser.add_subparsers(dest="algorithm", metavar="ALGORITHM", required=True)
     for job in ALGORITHMS:
         _add_algorithm(sub, job.SPEC, job)
@@ -171,6 +168,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         level=logging.INFO if args.verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
     )
+    if args.verbose >= 2:  # the toolkit's details, not those of the libraries it uses
+        logging.getLogger(__name__.split(".")[0]).setLevel(logging.DEBUG)
     spec: AlgorithmSpec = args.job.SPEC
     raw = {
         p.name: getattr(args, p.name)

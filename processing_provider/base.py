@@ -80,6 +80,16 @@ def forward_logging(feedback: QgsProcessingFeedback, level: int = logging.INFO):
         logger.setLevel(old_level)
 
 
+def verbose_log(context) -> bool:
+    """Whether ``context`` asks for a verbose log (QgsProcessingContext.logLevel() Verbose or
+    ModelDebug; QGIS 3.22 to 4)."""
+    try:
+        level = context.logLevel()
+    except AttributeError:
+        return False
+    return int(getattr(level, "value", level)) >= 1
+
+
 def progress_callback(feedback: QgsProcessingFeedback) -> Callable[[float], None]:
     """Core progress (a fraction in [0, 1]) -> ``feedback.setProgress`` (percent)."""
 
@@ -122,6 +132,8 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
     """
 
     JOB: ModuleType
+    #: whether the current run logs details (see :func:`verbose_log`)
+    _verbose = False
 
     def tr(self, text: str) -> str:
         return QCoreApplication.translate(type(self).__name__, text)
@@ -157,7 +169,7 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
 
     def initAlgorithm(self, config=None):
         for p in self.spec.params:
-            self.addParameter(make_parameter(p, self.tr))
+            self.addParameter(make_parameter(p, self.tr, self.spec))
         for r in self.spec.results:
             self.addOutput(make_output(r, self.tr))
 
@@ -174,13 +186,30 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
             if p.kind != "sink"
         }
         raw = self.prepare(raw, parameters, context, feedback)
+        self._verbose = verbose_log(context)
         result = self.run_core(run_job, self.JOB, raw, feedback=feedback)
         for line in result.lines:
             feedback.pushInfo(line)
         outputs = {p.name: raw.get(p.name) for p in self.spec.outputs if p.kind != "sink"}
         outputs.update(result.results)
         outputs.update(self.write_layers(result, parameters, context, feedback))
+        self.attach_styles(outputs, context)
         return outputs
+
+    #: (output name, style function of processing_provider/layer_styles.py) pairs: how each
+    #: output layer looks when QGIS loads it after the run.
+    STYLES: tuple[tuple[str, Callable[[Any], None]], ...] = ()
+
+    def attach_styles(self, outputs: dict, context) -> None:
+        """Give each output QGIS will load its style from :attr:`STYLES`."""
+        from .layer_styles import LayerStyle
+
+        for name, func in self.STYLES:
+            dest = outputs.get(name)
+            if dest and context.willLoadLayerOnCompletion(dest):
+                context.layerToLoadOnCompletionDetails(dest).setPostProcessor(
+                    LayerStyle.create(func)
+                )
 
     def error(self, text: str) -> QgsProcessingException:
         """An error for the user (translated)."""
@@ -201,7 +230,14 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
         """
         if feedback is None:
             feedback = QgsProcessingFeedback()
-        with forward_logging(feedback), core_errors(self.tr("Cancelled by the user")):
+        # details (debug records, such as every rejected candidate) only when the processing
+        # context asks for a verbose log (Processing options: logging level Verbose), as
+        # pushDebugInfo; otherwise the summaries alone
+        level = logging.DEBUG if self._verbose else logging.INFO
+        with (
+            forward_logging(feedback, level),
+            core_errors(self.tr("Cancelled by the user")),
+        ):
             return func(
                 *args,
                 progress=progress_callback(feedback),

@@ -23,7 +23,7 @@ from qgis.core import (
     QgsProcessingParameterString,
 )
 
-from ..core.jobs.spec import Param, Result
+from ..core.jobs.spec import AlgorithmSpec, Param, Result, facts_line
 from .compat import (
     FIELD_TYPE_ANY,
     FIELD_TYPE_NUMERIC,
@@ -46,8 +46,14 @@ _SINK_TYPES = {
 }
 
 
-def make_parameter(p: Param, tr: Callable[[str], str]) -> QgsProcessingParameterDefinition:
-    """The QGIS parameter of a spec entry (label translated with ``tr``)."""
+def make_parameter(
+    p: Param, tr: Callable[[str], str], spec: AlgorithmSpec | None = None
+) -> QgsProcessingParameterDefinition:
+    """The QGIS parameter of a spec entry (label translated with ``tr``).
+
+    Its help (the tooltip, and what ``qgis_process help`` prints under the parameter) ends
+    with the default, unit and valid range, the same facts as the algorithm's help table.
+    """
     title = tr(p.label) + (f" ({p.unit})" if p.unit else "")
     k = p.kind
     default = p.qgis_default if p.qgis_default is not None else p.default
@@ -110,8 +116,10 @@ def make_parameter(p: Param, tr: Callable[[str], str]) -> QgsProcessingParameter
         raise ValueError(k)
     if p.advanced:
         q.setFlags(q.flags() | FLAG_ADVANCED)
-    if p.help:
-        q.setHelp(tr(p.help))
+    facts = facts_line(p, spec)
+    for word in ("default", "unit", "range", "values", "optional", "required"):
+        facts = facts.replace(word, tr(word))
+    q.setHelp(f"{tr(p.help)}; {facts}" if p.help else facts)
     return q
 
 

@@ -20,8 +20,9 @@ that the ids stay unique), plus ``sigma_e, sigma_n, sigma_h`` (m) and
 
 Model comparison (``OUTPUT_COMPARISON``), one row per AP model, best first::
 
-    rank, model, n_check, mean_planimetric, std_planimetric, rms_planimetric, rms_h, rms_3d
-    (m), sigma0, n_ap, n_ap_kept, n_significant, rejected, error
+    rank, model, n_check, mean_horizontal, std_horizontal, rmse_horizontal, rmse_u, rmse_3d
+    (m; the names of docs/formats.md "Accuracy figures", u = up = height), sigma0, n_ap,
+    n_ap_kept, n_significant, rejected, error
 """
 
 from __future__ import annotations
@@ -54,9 +55,14 @@ RESIDUAL_COLUMNS = (
 CHECK_COLUMNS = ("id", "e", "n", "h", "e_ref", "n_ref", "h_ref", "group", "sigma_e", "sigma_n",
                  "sigma_h", "n_images")  # fmt: skip
 COMPARISON_COLUMNS = (
-    "rank", "model", "n_check", "mean_planimetric", "std_planimetric", "rms_planimetric",
-    "rms_h", "rms_3d", "sigma0", "n_ap", "n_ap_kept", "n_significant", "rejected", "error",
+    "rank", "model", "n_check", "mean_horizontal", "std_horizontal", "rmse_horizontal",
+    "rmse_u", "rmse_3d", "sigma0", "n_ap", "n_ap_kept", "n_significant", "rejected", "error",
 )  # fmt: skip
+#: The key of :func:`core.photo.bundle.compare_ap_models`'s rows each column is written from.
+_COMPARISON_KEYS = {
+    "mean_horizontal": "mean_planimetric", "std_horizontal": "std_planimetric",
+    "rmse_horizontal": "rms_planimetric", "rmse_u": "rms_h", "rmse_3d": "rms_3d",
+}  # fmt: skip
 
 
 def _num(v: float, digits: int = 4) -> str:
@@ -115,7 +121,7 @@ def write_comparison(path: Union[str, Path], rows: Sequence[dict]) -> None:
     """The model comparison table (rows of :func:`core.photo.bundle.compare_ap_models`)."""
 
     def cell(r: dict, k: str) -> str:
-        v = r.get(k, "")
+        v = r.get(_COMPARISON_KEYS.get(k, k), "")
         if isinstance(v, float):
             return _g(v)
         return "" if v is None else str(v)

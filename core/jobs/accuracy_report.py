@@ -109,8 +109,10 @@ denominator, equidistance (0 = the series' value) and declared class; project th
 
 ## Outputs
 A self-contained HTML report (tables, verdicts, SVG plots), a JSON of every figure, a PointZ
-layer at the reference positions with id, group, dE, dN, dH, dHoriz, d3D, outlier, and the
-RMSE values as numeric outputs.""",
+layer at the reference positions with id, group, dE, dN, dU, dHorizontal, d3D, outlier, and
+the RMSE values as numeric outputs RMSE_E, RMSE_N, RMSE_U (height), RMSE_HORIZONTAL, RMSE_3D
+(docs/formats.md, "Accuracy figures"; RMSE_H and RMSE_HORIZ, their former names, are kept
+for one release).""",
     params=(
         Param("INPUT", "file", "Check-point table (CSV: id, e, n, h, e_ref, n_ref, h_ref, group)",
               optional=True, file_filter=CSV_FILTER),
@@ -136,15 +138,20 @@ RMSE values as numeric outputs.""",
         Param("FLIGHT_GEOMETRY", "numbers", "Flight geometry for Eq. 18: H, B, f, pixel",
               _D.flight_geometry, count=4, unit="m, m, mm, um", advanced=True, minimum=0.001,
               maximum=100000.0),
-        Param("OUTPUT", "sink", "Check points with discrepancies", geometry="point"),
+        Param("OUTPUT", "sink", "Check points with discrepancies", geometry="point", optional=True),
         Param("OUTPUT_HTML", "file_out", "Accuracy report (HTML)", optional=True,
               file_filter="HTML files (*.html)"),
         Param("OUTPUT_JSON", "file_out", "Accuracy figures (JSON)", optional=True,
               create_by_default=False, file_filter="JSON files (*.json)"),
     ),
-    results=tuple(
-        Result(key, "number", f"{key} (m)")
-        for key in ("RMSE_E", "RMSE_N", "RMSE_H", "RMSE_HORIZ", "RMSE_3D")
+    results=(
+        *(
+            Result(key, "number", f"{key} (m)")
+            for key in ("RMSE_E", "RMSE_N", "RMSE_U", "RMSE_HORIZONTAL", "RMSE_3D")
+        ),
+        # the names of earlier versions, for one release (docs/formats.md)
+        Result("RMSE_H", "number", "RMSE_H (m; deprecated: use RMSE_U)"),
+        Result("RMSE_HORIZ", "number", "RMSE_HORIZ (m; deprecated: use RMSE_HORIZONTAL)"),
     ),
     tags=("accuracy", "rmse", "check points", "asprs", "nssda", "pec", "pec-pcd", "quality"),
     references=(
@@ -196,7 +203,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..errors import stop_if_asked
     from ..geometry.frames import check_area_of_use, parse_crs
     from ..io.atomic import write_text_atomic
-    from ..quality.accuracy import assess_accuracy, report_to_dict
+    from ..quality.accuracy import assess_accuracy, report_to_dict, with_deprecated_keys
     from ..quality.accuracy_html import render_html
 
     settings = AccuracySettings(
@@ -235,4 +242,4 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         for res in report.standards
         for verdict in res.verdicts
     ]
-    return JobResult(results=dict(report.rmse), lines=lines, data=report)
+    return JobResult(results=with_deprecated_keys(report.rmse), lines=lines, data=report)

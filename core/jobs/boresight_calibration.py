@@ -119,7 +119,7 @@ written and each starts with a warning (CSV: comment lines beginning with #)."""
               help="no convergence, global test beyond MAX_SIGMA0 or boresight beyond "
               "MAX_BORESIGHT: write the outputs anyway, each with a warning at its top"),
         Param("OUTPUT_TABLE", "file_out", "Boresight per group (CSV)", file_filter=CSV_OUT),
-        Param("OUTPUT_RESIDUALS", "sink", "Image residuals", geometry="point"),
+        Param("OUTPUT_RESIDUALS", "sink", "Image residuals", geometry="point", optional=True),
         Param("RESIDUALS_CSV", "file_out", "Image residuals (CSV)", optional=True,
               create_by_default=False, file_filter=CSV_OUT),
         Param("OUTPUT_EO", "file_out", "Updated exterior orientation (CSV)",

@@ -157,7 +157,7 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
         Param(
             "OUTPUT_POINTS", "file_out", "Object points (CSV)", optional=True, file_filter=CSV_OUT
         ),
-        Param("OUTPUT_POINTS_LAYER", "sink", "Object points", geometry="point"),
+        Param("OUTPUT_POINTS_LAYER", "sink", "Object points", geometry="point", optional=True),
         Param(
             "OUTPUT_RESIDUALS",
             "file_out",

@@ -84,6 +84,20 @@ def lengths_in_cloud_units(
     return replace(params, **changes)
 
 
+_UNIT_SYMBOLS = {"metre": "m", "meter": "m", "foot": "ft", "us survey foot": "US ft"}
+
+
+def unit_symbol(name: str) -> str:
+    """The symbol of a CRS length unit for messages ("metre" -> "m"; unknown names as they are).
+
+    >>> unit_symbol("metre"), unit_symbol("US survey foot"), unit_symbol("")
+    ('m', 'US ft', 'CRS unit')
+    """
+    if not name:
+        return "CRS unit"
+    return _UNIT_SYMBOLS.get(name.strip().lower(), name)
+
+
 def unit_text(info: Any, distance_unit: str) -> str:
     """How the job reports the unit its lengths were taken in."""
     return "metre (converted)" if distance_unit == "metre" else info.horizontal_unit

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import logging
+from dataclasses import replace
 
 import numpy as np
 
 from ..errors import InputError
 from ..lidar.control import ControlOptions
-from .common import CSV_FILTER, CSV_OUT, cloud_params, lengths_in_cloud_units
+from .common import CSV_FILTER, CSV_OUT, cloud_params, lengths_in_cloud_units, unit_symbol
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -38,8 +39,9 @@ clipped to the common support of the two planes.
 
 Distances are in the cloud's CRS unit (e.g. feet for a CRS in feet) unless distance unit is
 metres; the outputs are in the CRS unit. Optionally give your own plane-id triples
-("1,2,3; 4,5,6") or pairs ("1,2; 2,3") instead of the automatic ones. Rejected candidates
-are listed in the log with the reason.""",
+("1,2,3; 4,5,6") or pairs ("1,2; 2,3") instead of the automatic ones. The log counts the
+rejected candidates per reason; each one, with its numbers and units, is listed only in
+verbose mode (command line: -vv; QGIS: Processing options, logging level Verbose).""",
     params=(
         Param("PLANES", "file", "Plane table (CSV)", file_filter=CSV_FILTER),
         *cloud_params("CLOUD", "Cloud with plane ids (LAS/LAZ)"),
@@ -57,8 +59,8 @@ are listed in the log with the reason.""",
               help='plane ids "1,2,3; 4,5,6" (default: automatic)'),
         Param("PAIRS", "string", "Plane pairs", "", optional=True, advanced=True,
               help='plane ids "1,2; 2,3" (default: automatic)'),
-        Param("OUTPUT_POINTS", "sink", "LiDAR control points", geometry="point"),
-        Param("OUTPUT_LINES", "sink", "LiDAR control lines", geometry="line"),
+        Param("OUTPUT_POINTS", "sink", "LiDAR control points", geometry="point", optional=True),
+        Param("OUTPUT_LINES", "sink", "LiDAR control lines", geometry="line", optional=True),
         Param("POINTS_CSV", "file_out", "Control point table (CSV)", optional=True,
               create_by_default=False, file_filter=CSV_OUT),
         Param("LINES_CSV", "file_out", "Control line table (CSV)", optional=True,
@@ -71,6 +73,7 @@ are listed in the log with the reason.""",
         Result("LINE_COUNT", "number", "Number of lines"),
     ),
     tags=("lcp", "control point", "roof", "ridge", "plane intersection", "covariance"),
+    references=("Pedrosa & dos Santos (2020)",),
 )
 
 
@@ -102,7 +105,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.control import write_graph_csv, write_lcps_csv, write_lines_csv
     from ..io.planes import read_planes_csv
     from ..io.pointcloud import read_info, read_points
-    from ..lidar.control import lidar_control
+    from ..lidar.control import lidar_control, rejection_summary
 
     user_triples = parse_id_groups(v.triples, 3, "TRIPLES")
     user_pairs = parse_id_groups(v.pairs, 2, "PAIRS")
@@ -116,6 +119,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     planes = read_planes_csv(v.planes)
     info = read_info(v.cloud, crs=v.crs)
     options = lengths_in_cloud_units(options, info, v.distance_unit, _LENGTHS)
+    options = replace(options, length_unit=unit_symbol(info.horizontal_unit))
     if v.distance_unit == "metre":
         log.info("distances converted from metres to %s", info.horizontal_unit)
     if "plane_id" not in info.dimensions:
@@ -139,8 +143,12 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         write_lines_csv(out.path("LINES_CSV"), result.lines)
     if out.requested("GRAPH_CSV"):
         write_graph_csv(out.path("GRAPH_CSV"), result.adjacency)
+    # the counts always; each candidate only in verbose mode (CLI -vv, QGIS debug info)
+    if result.rejected:
+        log.info("%s (details: lidarphoto -vv; QGIS: Processing logging level Verbose)",
+                 rejection_summary(result.rejected))  # fmt: skip
     for r in result.rejected:
-        log.info("planes %s: %s", r.plane_ids, r.reason)
+        log.debug("planes %s: %s", ",".join(map(str, r.plane_ids)), r.reason)
     pairs = int(result.adjacency.adjacent.sum())
     return JobResult(
         results={"LCP_COUNT": len(result.points), "LINE_COUNT": len(result.lines)},

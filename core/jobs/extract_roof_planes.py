@@ -91,7 +91,7 @@ error.""",
                   maximum=maximum, advanced=advanced)
             for key, field, label, kind, unit, minimum, maximum, advanced in _NUMBERS
         ),
-        Param("OUTPUT", "sink", "Roof planes", geometry="polygon"),
+        Param("OUTPUT", "sink", "Roof planes", geometry="polygon", optional=True),
         Param("OUTPUT_CSV", "file_out", "Plane table (CSV)", file_filter=CSV_OUT),
         Param("OUTPUT_CLOUD", "file_out", "Point cloud with plane_id", optional=True,
               create_by_default=False, file_filter="LAZ files (*.laz);;LAS files (*.las)"),

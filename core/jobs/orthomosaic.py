@@ -19,6 +19,9 @@ _D = MosaicOptions()
 #: Largest seamline raster kept in memory (cells); bigger mosaics are traced at a coarser step.
 MAX_LABEL_CELLS = 64_000_000
 
+#: Columns of the seamline table (docs/formats.md, "Seamline CSV").
+SEAMLINE_COLUMNS = ("image_id", "cells", "area", "wkt")
+
 SPEC = AlgorithmSpec(
     name="orthomosaic",
     title="Orthomosaic (seamlines, feathering, occlusion-aware)",
@@ -52,7 +55,7 @@ MultiPolygon in the mosaic's CRS).""",
         compression_param(),
         Param("OUTPUT", "raster_out", "Orthomosaic"),
         Param("OUTPUT_SEAMLINES", "sink", "Seamlines (region of each image)",
-              geometry="polygon"),
+              geometry="polygon", optional=True),
         Param("SEAMLINES_CSV", "file_out", "Seamline table (CSV)", optional=True,
               create_by_default=False, file_filter=CSV_OUT),
     ),
@@ -178,7 +181,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         seams(1.0)
     if out.requested("SEAMLINES_CSV"):
         rows = [(s.image_id, s.cells, repr(s.area), s.wkt) for s in seamlines]
-        write_csv_atomic(out.path("SEAMLINES_CSV"), ("image_id", "cells", "area", "wkt"), rows)
+        write_csv_atomic(out.path("SEAMLINES_CSV"), SEAMLINE_COLUMNS, rows)
     frac = covered / max(grid.rows * grid.cols, 1)
     return JobResult(
         results={"SOURCE_COUNT": len(sources), "COVERED_FRACTION": frac},

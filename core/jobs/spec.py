@@ -186,6 +186,10 @@ class AlgorithmSpec:
             if p.kind == "field" and p.parent not in known:
                 raise ValueError(f"{self.name}.{p.name}: unknown parent {p.parent!r}")
 
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.params)
+
     def param(self, name: str) -> Param:
         for p in self.params:
             if p.name == name:
@@ -201,19 +205,24 @@ class AlgorithmSpec:
         return tuple(p for p in self.params if p.is_output)
 
     def help_html(self) -> str:
-        """The QGIS help: the description, the parameters with defaults, units and ranges,
-        and the references."""
+        """The QGIS help: the description, how to use it (its workflows), the parameters with
+        default, unit and range, and the references (authors, year)."""
+        from .workflows import how_to_use
+
         parts = [text_to_html(self.description)]
+        usage = how_to_use(self.name)
+        if usage:
+            parts.append(text_to_html("## How to use\n" + usage))
         rows = []
         for p in self.params:
-            cells = (p.help or p.label, _default_for_help(p), _range_text(p))
+            cells = (p.help or p.label, *param_facts(p, self))
             rows.append(
                 f"<tr><td><b>{p.name}</b></td>" + "".join(f"<td>{_esc(c)}</td>" for c in cells)
                 + "</tr>"
             )  # fmt: skip
         parts.append(
             "<h3>Parameters</h3><table><tr><th>name</th><th>meaning</th><th>default</th>"
-            "<th>unit, range</th></tr>" + "".join(rows) + "</table>"
+            "<th>unit</th><th>valid range</th></tr>" + "".join(rows) + "</table>"
         )
         if self.references:
             items = "".join(f"<li>{_esc(r)}</li>" for r in self.references)
@@ -221,8 +230,15 @@ class AlgorithmSpec:
         return "\n".join(parts)
 
     def help_text(self) -> str:
-        """The command line's description (plain text)."""
-        text = re.sub(r"(?m)^## (.*)$", r"\1:", self.description)
+        """The command line's description (plain text): the description, how to use it and
+        the references; each option's help gives its default, unit and range."""
+        from .workflows import how_to_use
+
+        text = self.description
+        usage = how_to_use(self.name)
+        if usage:
+            text += "\n\n## How to use\n" + usage
+        text = re.sub(r"(?m)^## (.*)$", r"\1:", text)
         if self.references:
             text += "\n\nReferences: " + "; ".join(self.references) + "."
         return text
@@ -232,24 +248,68 @@ def _esc(text: str) -> str:
     return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
 
 
-def _default_for_help(p: Param) -> str:
+#: What a parameter of unit "length" is measured in (the spec's DISTANCE_UNIT chooses it).
+LENGTH_UNIT = "length (cloud CRS unit, or m when DISTANCE_UNIT is metre)"
+
+
+def unit_text(p: Param, spec: AlgorithmSpec | None = None) -> str:
+    """The unit as the help shows it: the spec's unit; "length" spelt out where the algorithm
+    has a DISTANCE_UNIT; "none" for a number without unit (a count, a ratio); "" otherwise.
+
+    >>> unit_text(Param("K", "integer", "Neighbours", 20))
+    'none'
+    """
+    if p.unit == "length" and spec is not None and "DISTANCE_UNIT" in spec.names:
+        return LENGTH_UNIT
+    if p.unit:
+        return p.unit
+    return "none" if p.kind in ("number", "integer", "numbers") else ""
+
+
+def range_text(p: Param) -> str:
+    """The valid range: "0.001 to 100", ">= 0", "<= 90", an enum's options, "any finite" for
+    an unbounded number, or "".
+
+    >>> range_text(Param("A", "number", "Angle", 1.0, minimum=0.0, maximum=90.0))
+    '0 to 90'
+    """
+    if p.kind == "enum":
+        return " | ".join(p.options)
+    if p.minimum is not None and p.maximum is not None:
+        return f"{p.minimum:g} to {p.maximum:g}"
+    if p.minimum is not None:
+        return f">= {p.minimum:g}"
+    if p.maximum is not None:
+        return f"<= {p.maximum:g}"
+    return "any finite" if p.kind in ("number", "integer", "numbers") else ""
+
+
+def default_for_help(p: Param) -> str:
+    """The default as the help shows it: the value, or "optional" / "required"."""
     if p.is_output:
-        return "optional" if p.optional else ""
+        return "optional" if p.optional else "required"
     text = p.default_text()
     return text if text else ("optional" if p.optional else "required")
 
 
-def _range_text(p: Param) -> str:
-    bits = [p.unit] if p.unit else []
-    if p.kind == "enum":
-        bits.append(" | ".join(p.options))
-    if p.minimum is not None and p.maximum is not None:
-        bits.append(f"{p.minimum:g} to {p.maximum:g}")
-    elif p.minimum is not None:
-        bits.append(f">= {p.minimum:g}")
-    elif p.maximum is not None:
-        bits.append(f"<= {p.maximum:g}")
-    return ", ".join(bits)
+def param_facts(p: Param, spec: AlgorithmSpec | None = None) -> tuple[str, str, str]:
+    """(default, unit, valid range) of a parameter, as every help shows them."""
+    return default_for_help(p), unit_text(p, spec), range_text(p)
+
+
+def facts_line(p: Param, spec: AlgorithmSpec | None = None) -> str:
+    """"default: 0.15; unit: m; range: 0.001 to 100" (the parts that apply).
+
+    >>> facts_line(Param("E", "number", "Epsilon", 0.15, unit="m", minimum=0.001))
+    'default: 0.15; unit: m; range: >= 0.001'
+    """
+    default, unit, rng = param_facts(p, spec)
+    bits = [default if default in ("optional", "required") else f"default: {default}"]
+    if unit:
+        bits.append(f"unit: {unit}")
+    if rng:
+        bits.append(f"{'values' if p.kind == 'enum' else 'range'}: {rng}")
+    return "; ".join(bits)
 
 
 def text_to_html(text: str) -> str:

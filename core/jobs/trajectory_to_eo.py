@@ -45,12 +45,13 @@ CSV (on the command line, printed when no file is given), and the number of imag
         Param("CRS", "crs", "Mapping CRS (projected)", qgis_default="ProjectCrs",
               help="projected CRS of the trajectory's eastings/northings and of the output"),
         *mount_params(),
-        Param("OUTPUT", "sink", "Exterior orientation", geometry="point"),
+        Param("OUTPUT", "sink", "Exterior orientation", geometry="point", optional=True),
         Param("OUTPUT_CSV", "file_out", "Exterior orientation table (CSV)", optional=True,
               create_by_default=False, file_filter=CSV_OUT),
     ),
     results=(Result("IMAGE_COUNT", "number", "Number of images"),),
     tags=("trajectory", "ins", "gnss", "imu", "exterior orientation", "omega phi kappa"),
+    references=("Schwarz et al. (1993)",),
 )
 
 

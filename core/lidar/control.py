@@ -290,12 +290,24 @@ class ControlLine:
         )
 
 
+#: Why a candidate was not kept: the ``kind`` of a :class:`Rejection` (the log counts them).
+REJECT_PARALLEL = "normals nearly parallel"
+REJECT_CONDITION = "planes meet in a line, not a point"
+REJECT_SUPPORT = "intersection far from a plane's points"
+REJECT_DUPLICATE = "same corner as a more precise triple"
+REJECT_NO_BOUNDARY = "no common boundary"
+REJECT_LINE_PARALLEL = "planes nearly parallel: no stable line"
+REJECT_TOO_FEW = "fewer than two planes"
+
+
 @dataclass(frozen=True)
 class Rejection:
-    """A candidate that was not kept, and why (shown to the user)."""
+    """A candidate that was not kept: ``kind`` (one of the ``REJECT_*`` texts, counted in the
+    log's summary) and ``reason`` (the details with their numbers and units)."""
 
     plane_ids: tuple[int, ...]
     reason: str
+    kind: str = ""
 
 
 @dataclass(frozen=True)
@@ -306,6 +318,7 @@ class ControlOptions:
     boundary length; min_angle_deg: every pair of normals of a triple (or of a line) must
     differ by at least this; max_condition: condition number limit of the 3 x 3 system;
     max_support_distance: an LCP must lie within this distance of the points of each plane.
+    length_unit: the symbol of the cloud's length unit, for the messages ("m", "ft").
     """
 
     delta: float = 1.0
@@ -314,6 +327,7 @@ class ControlOptions:
     max_condition: float = 50.0
     max_support_distance: float = 2.0
     neighbours: int = 12
+    length_unit: str = "m"
 
 
 @dataclass(frozen=True)
@@ -345,6 +359,22 @@ def corner_candidates(adjacency: Adjacency) -> NDArray[np.int64]:
                 if a < c:
                     out.add(tuple(sorted((a, b, c))))
     return np.array(sorted(out), dtype=np.int64).reshape(-1, 3)
+
+
+def rejection_summary(rejected: Sequence[Rejection]) -> str:
+    """Counts per reason, most frequent first: "12 rejected: 9 intersection far from a
+    plane's points, 3 normals nearly parallel" ("" when nothing was rejected).
+
+    >>> rejection_summary([Rejection((1, 2, 3), "x", REJECT_PARALLEL)] * 2)
+    '2 candidates rejected: 2 normals nearly parallel'
+    """
+    if not rejected:
+        return ""
+    counts: dict[str, int] = {}
+    for r in rejected:
+        counts[r.kind or r.reason] = counts.get(r.kind or r.reason, 0) + 1
+    parts = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
+    return f"{len(rejected)} candidates rejected: " + ", ".join(f"{n} {k}" for k, n in parts)
 
 
 def lidar_control(
@@ -387,7 +417,9 @@ def lidar_control(
     lines = _two_plane_lines(cand2, by_id, pts, ids, adjacency, options, rejected)
     _tick(progress, should_stop, 1.0)
     if len(by_id) < 2:
-        rejected.append(Rejection(tuple(by_id), "fewer than two planes: no line or point"))
+        rejected.append(
+            Rejection(tuple(by_id), "fewer than two planes: no line or point", REJECT_TOO_FEW)
+        )
     return LidarControl(control_points, lines, adjacency, rejected)
 
 
@@ -427,17 +459,19 @@ def _three_plane_points(cand, by_id, pts, ids, options, rejected) -> list[Contro
     out = []
     for t, triple in enumerate(cand.tolist()):
         tri = tuple(int(i) for i in triple)
+        u = options.length_unit
         min_angle = float(angles[t].min())
         if min_angle < options.min_angle_deg:
             rejected.append(
                 Rejection(tri, f"normals nearly parallel: {min_angle:.1f} deg between two planes "
-                          f"(< {options.min_angle_deg:g})")
+                          f"(< {options.min_angle_deg:g} deg)", REJECT_PARALLEL)
             )  # fmt: skip
             continue
         if not np.isfinite(cond[t]) or cond[t] > options.max_condition:
             rejected.append(
                 Rejection(tri, f"the planes meet in a line rather than a point "
-                          f"(condition number {cond[t]:.3g} > {options.max_condition:g})")
+                          f"(condition number {cond[t]:.3g} > {options.max_condition:g})",
+                          REJECT_CONDITION)
             )  # fmt: skip
             continue
         support = np.empty(3)
@@ -448,17 +482,19 @@ def _three_plane_points(cand, by_id, pts, ids, options, rejected) -> list[Contro
         if np.any(support > options.max_support_distance):
             far = tri[int(np.argmax(support))]
             rejected.append(
-                Rejection(tri, f"intersection {support.max():.2f} from the points of plane {far} "
-                          f"(> {options.max_support_distance:g})")
+                Rejection(tri, f"intersection {support.max():.2f} {u} from the points of plane "
+                          f"{far} (> {options.max_support_distance:g} {u})", REJECT_SUPPORT)
             )  # fmt: skip
             continue
         out.append(
             ControlPoint(len(out) + 1, x[t], cov[t], tri, min_angle, float(cond[t]), support)
         )
-    return _merge_duplicates(out, options.delta, rejected)
+    return _merge_duplicates(out, options.delta, rejected, options.length_unit)
 
 
-def _merge_duplicates(points: list[ControlPoint], radius: float, rejected) -> list[ControlPoint]:
+def _merge_duplicates(
+    points: list[ControlPoint], radius: float, rejected, unit: str = "m"
+) -> list[ControlPoint]:
     """One LCP per corner: where more than three planes meet (a pyramid apex), several triples
     give the same point; keep the most precise (smallest trace of the covariance)."""
     if len(points) < 2:
@@ -470,8 +506,8 @@ def _merge_duplicates(points: list[ControlPoint], radius: float, rejected) -> li
             kept.append(p)
         else:
             rejected.append(
-                Rejection(p.plane_ids, f"same corner as planes {twin.plane_ids}, which give a "
-                          "more precise point")
+                Rejection(p.plane_ids, f"same corner as planes {twin.plane_ids} (within "
+                          f"{radius:g} {unit}), which give a more precise point", REJECT_DUPLICATE)
             )  # fmt: skip
     kept.sort(key=lambda p: p.id)
     return [replace(p, id=i + 1) for i, p in enumerate(kept)]
@@ -500,12 +536,14 @@ def _two_plane_lines(cand, by_id, pts, ids, adjacency, options, rejected) -> lis
     for e, (a, b) in enumerate(cand.tolist()):
         pair = (int(a), int(b))
         if contact[e].shape[0] < 2:
-            rejected.append(Rejection(pair, "no common boundary between the two planes"))
+            rejected.append(
+                Rejection(pair, "no common boundary between the two planes", REJECT_NO_BOUNDARY)
+            )
             continue
         if dihedral[e] < options.min_angle_deg or not np.all(np.isfinite(x0[e])):
             rejected.append(
                 Rejection(pair, f"planes nearly parallel ({dihedral[e]:.1f} deg "
-                          f"< {options.min_angle_deg:g}): no stable line")
+                          f"< {options.min_angle_deg:g} deg): no stable line", REJECT_LINE_PARALLEL)
             )  # fmt: skip
             continue
         t = (contact[e] - x0[e]) @ u[e]

@@ -1,9 +1,11 @@
 """Positional accuracy of check points: discrepancies, statistics, tests and standards.
 
 Sign convention: a discrepancy is ``d = measured - reference`` (the product minus the
-independent, more accurate source), per component dE, dN, dH in metres, in one projected CRS
-(the mapping frame of docs/conventions.md). ``dHoriz = sqrt(dE^2 + dN^2)`` and
-``d3D = sqrt(dE^2 + dN^2 + dH^2)``.
+independent, more accurate source), per component dE, dN, dU (up: the height) in metres, in
+one projected CRS (the mapping frame of docs/conventions.md).
+``dHorizontal = sqrt(dE^2 + dN^2)`` and ``d3D = sqrt(dE^2 + dN^2 + dU^2)``. The names of
+the figures (RMSE_E, RMSE_N, RMSE_U, RMSE_HORIZONTAL, RMSE_3D, ...) are one scheme for the
+JSON, the HTML, the QGIS outputs and the layers: docs/formats.md, "Accuracy figures".
 
 The check-point and point tables (CSV) are read by :mod:`core.io.checkpoints`.
 
@@ -64,7 +66,17 @@ __all__ = [
 log = logging.getLogger(__name__)
 PathLike = Union[str, "os.PathLike[str]"]
 
-COMPONENTS = ("E", "N", "H")
+#: Components of the discrepancies (docs/formats.md "Accuracy figures"): east, north, up
+#: (the height, column h of the tables), then the derived horizontal and 3D lengths.
+COMPONENTS = ("E", "N", "U")
+HORIZONTAL, THREE_D = "HORIZONTAL", "3D"
+#: The coordinates as the point tables name them (columns e, n, h), for error messages.
+_COORDINATES = ("E", "N", "H")
+#: Keys of earlier versions still written to the JSON for one release (key -> its new name).
+DEPRECATED_KEYS = {
+    "rmse.RMSE_H": "rmse.RMSE_U (the height RMSE; RMSE_H was also ASPRS's horizontal RMSE)",
+    "rmse.RMSE_HORIZ": "rmse.RMSE_HORIZONTAL",
+}
 OUTLIER_RULES = ("robust", "three_sigma", "none")
 STANDARD_KEYS = ("asprs", "nssda", "pec", "project")
 
@@ -161,10 +173,10 @@ def point_set(
     if len(bad):
         k, c = (int(v) for v in bad[0])
         raise InputError(
-            f"{where(k)} (id '{ids_[k]}'): {COMPONENTS[c]} is not a finite number "
+            f"{where(k)} (id '{ids_[k]}'): {_COORDINATES[c]} is not a finite number "
             f"({len(np.unique(bad[:, 0]))} point(s) affected)",
             path=source or None,
-            column=COMPONENTS[c],
+            column=_COORDINATES[c],
         )
     check_unique_ids(ids_, [where(k) for k in range(len(ids_))], source)
     return PointSet(ids_, arr, grp, crs or None, source, locs, kind)
@@ -510,10 +522,10 @@ def group_statistics(
         c: component_statistics(d[:, k], c, alpha=alpha, sigma0=declared_sigma[k] or None)
         for k, c in enumerate(COMPONENTS)
     }
-    comps["horizontal"] = component_statistics(
-        np.hypot(d[:, 0], d[:, 1]), "horizontal", tests=False
+    comps[HORIZONTAL] = component_statistics(
+        np.hypot(d[:, 0], d[:, 1]), HORIZONTAL, tests=False
     )
-    comps["3D"] = component_statistics(np.linalg.norm(d, axis=1), "3D", tests=False)
+    comps[THREE_D] = component_statistics(np.linalg.norm(d, axis=1), THREE_D, tests=False)
     return GroupStatistics(name, len(d), comps)
 
 
@@ -660,7 +672,7 @@ class AccuracyReport:
 
     @property
     def rmse(self) -> dict[str, float]:
-        """RMSE_E, RMSE_N, RMSE_H (height), RMSE_HORIZ, RMSE_3D of the used points (m)."""
+        """RMSE_E, RMSE_N, RMSE_U (height), RMSE_HORIZONTAL, RMSE_3D of the used points (m)."""
         return _rmse_of(self.overall)
 
     @property
@@ -674,9 +686,9 @@ def _rmse_of(stats: GroupStatistics) -> dict[str, float]:
     return {
         "RMSE_E": c["E"].rmse,
         "RMSE_N": c["N"].rmse,
-        "RMSE_H": c["H"].rmse,
-        "RMSE_HORIZ": c["horizontal"].rmse,
-        "RMSE_3D": c["3D"].rmse,
+        "RMSE_U": c["U"].rmse,
+        "RMSE_HORIZONTAL": c[HORIZONTAL].rmse,
+        "RMSE_3D": c[THREE_D].rmse,
     }
 
 
@@ -710,7 +722,7 @@ def assess_accuracy(
     --------
     >>> ref = np.zeros((4, 3)); meas = ref + [[0.1, 0, 0], [-0.1, 0, 0], [0, 0.1, 0], [0, -0.1, 0]]
     >>> r = assess_accuracy(CheckPoints(("a", "b", "c", "d"), meas, ref, ("",) * 4))
-    >>> round(r.rmse["RMSE_HORIZ"], 3)
+    >>> round(r.rmse["RMSE_HORIZONTAL"], 3)
     0.1
     """
     s = (settings or AccuracySettings()).validated()
@@ -850,6 +862,28 @@ def _obj(o: Any) -> Any:
     return _num(o)
 
 
+#: Top-level keys of the JSON report, in order (docs/formats.md, "Accuracy report JSON").
+JSON_TOP_KEYS = (
+    "title", "created", "source", "crs", "sign_convention", "n_points", "n_used", "settings",
+    "names", "rmse", "outliers", "overall", "contrast", "rmse_contrast", "deprecated_keys",
+    "groups", "standards", "group_thresholds", "points",
+)  # fmt: skip
+
+
+def with_deprecated_keys(rmse: dict[str, float]) -> dict[str, float]:
+    """The RMSEs with the keys of earlier versions added (one release of overlap).
+
+    >>> sorted(with_deprecated_keys({"RMSE_U": 1.0, "RMSE_HORIZONTAL": 2.0}).items())
+    [('RMSE_H', 1.0), ('RMSE_HORIZ', 2.0), ('RMSE_HORIZONTAL', 2.0), ('RMSE_U', 1.0)]
+    """
+    out = dict(rmse)
+    if "RMSE_U" in rmse:
+        out["RMSE_H"] = rmse["RMSE_U"]
+    if "RMSE_HORIZONTAL" in rmse:
+        out["RMSE_HORIZ"] = rmse["RMSE_HORIZONTAL"]
+    return out
+
+
 def report_to_dict(report: AccuracyReport) -> dict[str, Any]:
     """Every figure of the report as JSON-ready data (NaN and infinities become null)."""
     d = report.discrepancies
@@ -863,7 +897,8 @@ def report_to_dict(report: AccuracyReport) -> dict[str, Any]:
         "n_points": len(pts),
         "n_used": int(report.used.sum()),
         "settings": _obj(report.settings),
-        "rmse": _obj(report.rmse),
+        "names": "docs/formats.md, Accuracy figures",
+        "rmse": _obj(with_deprecated_keys(report.rmse)),
         "outliers": {
             "rule": report.outliers.rule,
             "description": report.outliers.description,
@@ -874,6 +909,10 @@ def report_to_dict(report: AccuracyReport) -> dict[str, Any]:
         "overall": _obj(report.overall),
         "contrast": _obj(report.contrast) if report.contrast is not None else None,
         "rmse_contrast": _obj(report.rmse_contrast),
+        "deprecated_keys": {
+            old: f"deprecated, removed in the next release: use {new}"
+            for old, new in DEPRECATED_KEYS.items()
+        },
         "groups": _obj(report.groups),
         "standards": _obj(report.standards),
         "group_thresholds": _obj(report.group_thresholds),
@@ -885,8 +924,8 @@ def report_to_dict(report: AccuracyReport) -> dict[str, Any]:
                 "reference": _obj(pts.reference[k]),
                 "dE": _num(d[k, 0]),
                 "dN": _num(d[k, 1]),
-                "dH": _num(d[k, 2]),
-                "dHoriz": _num(report.horizontal[k]),
+                "dU": _num(d[k, 2]),
+                "dHorizontal": _num(report.horizontal[k]),
                 "d3D": _num(report.d3[k]),
                 "outlier": bool(report.outliers.any[k]),
                 "outlier_scores": _obj(report.outliers.scores[k]),

@@ -46,8 +46,8 @@ def _stats_table(g: GroupStatistics) -> str:
     for key, label in (
         ("E", "dE"),
         ("N", "dN"),
-        ("H", "dH"),
-        ("horizontal", "dHoriz"),
+        ("U", "dU"),
+        ("HORIZONTAL", "dHorizontal"),
         ("3D", "d3D"),
     ):
         c = g.components[key]
@@ -59,7 +59,7 @@ def _stats_table(g: GroupStatistics) -> str:
 
 def _tests_table(g: GroupStatistics) -> str:
     rows, css = [], []
-    for key in ("E", "N", "H"):
+    for key in ("E", "N", "U"):
         c = g.components[key]
         sw, bt, pt = c.normality, c.bias, c.precision
         rows.append(
@@ -261,8 +261,8 @@ def render_html(report: AccuracyReport) -> str:
                 "group",
                 "dE (m)",
                 "dN (m)",
-                "dH (m)",
-                "dHoriz (m)",
+                "dU (m)",
+                "dHorizontal (m)",
                 "d3D (m)",
                 "outlier",
                 "used",

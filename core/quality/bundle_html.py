@@ -47,8 +47,8 @@ def _n(x: object, fmt: str = ".3f") -> str:
 
 
 def _comparison(rows: Sequence[Mapping[str, object]], best: str) -> str:
-    head = ["rank", "AP model", "check points", "mean planimetric (m)", "std planimetric (m)",
-            "RMS planimetric (m)", "RMS height (m)", "RMS 3D (m)", "sigma0", "APs",
+    head = ["rank", "AP model", "check points", "mean horizontal (m)", "std horizontal (m)",
+            "RMSE_HORIZONTAL (m)", "RMSE_U (m)", "RMSE_3D (m)", "sigma0", "APs",
             "APs kept", "significant", "rejected"]  # fmt: skip
     out, css = [], []
     for r in rows:
@@ -185,12 +185,13 @@ def render_bundle_html(
                 for p, dd, s, n in zip(c.point_id, d, c.sigma, c.n_images)]  # fmt: skip
         parts += [
             "<h2>Check points (not in the adjustment)</h2>",
-            f"<p>Planimetric discrepancy: mean {_n(st['mean_planimetric'])} m, standard "
-            f"deviation {_n(st['std_planimetric'])} m, RMS {_n(st['rms_planimetric'])} m; RMS "
-            f"E/N/H {_n(st['rms_e'])} / {_n(st['rms_n'])} / {_n(st['rms_h'])} m; 3D "
-            f"{_n(st['rms_3d'])} m. Intersected with the adjusted orientations; their sigmas "
-            "carry the image noise only.</p>",
-            _table(["point", "dE (m)", "dN (m)", "dH (m)", "planimetric (m)", "sigma E (m)",
+            f"<p>Horizontal discrepancy: mean {_n(st['mean_planimetric'])} m, standard "
+            f"deviation {_n(st['std_planimetric'])} m, RMSE_HORIZONTAL "
+            f"{_n(st['rms_planimetric'])} m; RMSE_E / RMSE_N / RMSE_U {_n(st['rms_e'])} / "
+            f"{_n(st['rms_n'])} / {_n(st['rms_h'])} m; RMSE_3D {_n(st['rms_3d'])} m. "
+            "Intersected with the adjusted orientations; their sigmas carry the image noise "
+            "only.</p>",
+            _table(["point", "dE (m)", "dN (m)", "dU (m)", "dHorizontal (m)", "sigma E (m)",
                     "sigma N (m)", "sigma H (m)", "images"], rows),
         ]
     plots = []

@@ -1,6 +1,6 @@
 """Positional accuracy standards: ASPRS Ed. 2 (2023), NSSDA, PEC-PCD and the project threshold.
 
-Every function takes the check-point discrepancies ``d`` (N, 3), metres, columns dE, dN, dH,
+Every function takes the check-point discrepancies ``d`` (N, 3), metres, columns dE, dN, dU,
 ``d = measured - reference`` in one projected CRS, and returns a :class:`StandardResult`: one
 :class:`Verdict` per class or condition with ``status`` ``"pass"``, ``"fail"``,
 ``"insufficient"`` (too few check points for the standard: the figures are still computed and
@@ -177,7 +177,7 @@ def asprs_2023(
     Parameters
     ----------
     d : (N, 3) float
-        Discrepancies dE, dN, dH (m), measured minus reference.
+        Discrepancies dE, dN, dU (m), measured minus reference.
     survey_sigma_h, survey_sigma_v : float
         Standard deviation of the check-point survey per horizontal axis and in height (m).
         Edition 2 includes the survey error in the product accuracy:
@@ -198,7 +198,7 @@ def asprs_2023(
     --------
     >>> d = np.tile([[0.03, -0.04, 0.05]], (30, 1))
     >>> r = asprs_2023(d, h_class_cm=5.0, v_class_cm=5.0)
-    >>> [v.status for v in r.verdicts][:3], round(r.figures["RMSE_H"], 3)
+    >>> [v.status for v in r.verdicts][:3], round(r.figures["RMSE_HORIZONTAL_TOTAL"], 3)
     (['pass', 'pass', 'pass'], 0.05)
     """
     d = _check_d(d)
@@ -227,7 +227,9 @@ def asprs_2023(
         ("Horizontal", rmse_h, h_class_cm, ASPRS_EXAMPLE_H_CLASSES_CM),
         ("Vertical (NVA)", rmse_v, v_class_cm, ASPRS_EXAMPLE_V_CLASSES_CM),
     ):
-        sym = "RMSE_H" if label == "Horizontal" else "RMSE_V"
+        # the toolkit's name, then the standard's symbol (Table 7.1)
+        sym = ("RMSE_HORIZONTAL_TOTAL (ASPRS RMSE_H)" if label == "Horizontal"
+               else "RMSE_U_TOTAL (ASPRS RMSE_V)")  # fmt: skip
         tightest = 100.0 * value
         if target and target > 0:
             limit = target / 100.0
@@ -259,16 +261,18 @@ def asprs_2023(
         Verdict(
             "Three-dimensional accuracy",
             "info" if enough else "insufficient",
-            f"RMSE_3D = sqrt(RMSE_H^2 + RMSE_V^2) = {100 * rmse_3d:.2f} cm (reported, no class)",
+            f"RMSE_3D_TOTAL = sqrt(RMSE_HORIZONTAL_TOTAL^2 + RMSE_U_TOTAL^2) = "
+            f"{100 * rmse_3d:.2f} cm (reported, no class)",
             rmse_3d,
             None,
         )
     )
     notes = [
         "Accuracy is stated as RMSE; Edition 2 no longer uses 95 % confidence figures.",
-        f"Check-point survey error included: RMSE_H2 = {100 * rmse_h2:.2f} cm, "
-        f"RMSE_V2 = {100 * float(survey_sigma_v):.2f} cm "
-        "(0 when not given: then RMSE_H and RMSE_V are those of the check points alone).",
+        f"Check-point survey error included: RMSE_HORIZONTAL_SURVEY (ASPRS RMSE_H2) = "
+        f"{100 * rmse_h2:.2f} cm, RMSE_U_SURVEY (ASPRS RMSE_V2) = "
+        f"{100 * float(survey_sigma_v):.2f} cm (0 when not given: then the totals are "
+        "RMSE_HORIZONTAL and RMSE_U of the check points alone).",
     ]
     for label, target, survey in (
         ("horizontal", h_class_cm, rmse_h2),
@@ -302,15 +306,16 @@ def asprs_2023(
         n_points=n,
         verdicts=tuple(verdicts),
         figures={
-            "RMSE_x": rmse_e,
-            "RMSE_y": rmse_n,
-            "RMSE_H1": rmse_h1,
-            "RMSE_H2": rmse_h2,
-            "RMSE_H": rmse_h,
-            "RMSE_V1": rmse_v1,
-            "RMSE_V2": float(survey_sigma_v),
-            "RMSE_V": rmse_v,
-            "RMSE_3D": rmse_3d,
+            # docs/formats.md "Accuracy figures": ASPRS symbol in the comment
+            "RMSE_E": rmse_e,  # RMSE_x
+            "RMSE_N": rmse_n,  # RMSE_y
+            "RMSE_HORIZONTAL": rmse_h1,  # RMSE_H1
+            "RMSE_HORIZONTAL_SURVEY": rmse_h2,  # RMSE_H2
+            "RMSE_HORIZONTAL_TOTAL": rmse_h,  # RMSE_H
+            "RMSE_U": rmse_v1,  # RMSE_V1
+            "RMSE_U_SURVEY": float(survey_sigma_v),  # RMSE_V2
+            "RMSE_U_TOTAL": rmse_v,  # RMSE_V
+            "RMSE_3D_TOTAL": rmse_3d,  # RMSE_3D
         },
         notes=tuple(notes),
     )
@@ -398,7 +403,7 @@ def nssda(
     Parameters
     ----------
     d : (N, 3) float
-        Discrepancies dE, dN, dH (m).
+        Discrepancies dE, dN, dU (m).
     normal, biased : sequence of 3 bool or None, optional
         Decisions of the normality and bias tests for E, N, H (None: not tested).
 
@@ -409,7 +414,7 @@ def nssda(
     Examples
     --------
     >>> d = np.tile([[0.1, 0.1, 0.1]], (20, 1))
-    >>> round(nssda(d).figures["Accuracy_z"], 4)
+    >>> round(nssda(d).figures["ACCURACY_U_95"], 4)
     0.196
     """
     d = _check_d(d)
@@ -450,7 +455,7 @@ def nssda(
             unit="ratio",
         ),
     ]
-    names = ("E", "N", "H")
+    names = ("E", "N", "U")
     for label, decisions, bad in (
         ("normal distribution (Shapiro-Wilk)", normal, False),
         ("no systematic error (Student t)", biased, True),
@@ -495,16 +500,17 @@ def nssda(
         n_points=n,
         verdicts=tuple(verdicts),
         figures={
-            "RMSE_x": rmse_x,
-            "RMSE_y": rmse_y,
-            "RMSE_r": rmse_r,
-            "RMSE_z": rmse_z,
+            # docs/formats.md "Accuracy figures": NSSDA symbol in the comment
+            "RMSE_E": rmse_x,  # RMSE_x
+            "RMSE_N": rmse_y,  # RMSE_y
+            "RMSE_HORIZONTAL": rmse_r,  # RMSE_r
+            "RMSE_U": rmse_z,  # RMSE_z
             "ratio_min_max": ratio,
-            "Accuracy_r": acc_r,
-            "Accuracy_r_case1": acc_case1,
-            "Accuracy_r_case2": acc_case2,
-            "Accuracy_r_exact": exact,
-            "Accuracy_z": acc_z,
+            "ACCURACY_HORIZONTAL_95": acc_r,  # Accuracy_r
+            "ACCURACY_HORIZONTAL_95_CASE1": acc_case1,
+            "ACCURACY_HORIZONTAL_95_CASE2": acc_case2,
+            "ACCURACY_HORIZONTAL_95_EXACT": exact,
+            "ACCURACY_U_95": acc_z,  # Accuracy_z
         },
         notes=(
             "Accuracy_r = 1.7308 RMSE_r holds for RMSE_x = RMSE_y; the Case 2 formula "
@@ -614,7 +620,7 @@ def pec_pcd(
             unit="points",
         )
     ]
-    figures: dict[str, float] = {"RMS_planimetric": rms_h, "RMS_altimetric": rms_v}
+    figures: dict[str, float] = {"RMSE_HORIZONTAL": rms_h, "RMSE_U": rms_v}
     best = {"planimetric": None, "altimetric": None}
     for kind, values, rms, pk, ek in (
         ("planimetric", horiz, rms_h, "pec_h", "ep_h"),
@@ -784,8 +790,8 @@ def project_threshold(
         figures={
             "h_threshold": float(h_threshold),
             "v_threshold": dz,
-            "RMSE_planimetric": rms_h,
-            "RMSE_vertical": rms_v,
+            "RMSE_HORIZONTAL": rms_h,
+            "RMSE_U": rms_v,
             "points_beyond_h": float(n_h),
             "points_beyond_v": float(n_v),
         },

@@ -154,7 +154,7 @@ def vector_map(
 
     Points at (E, N) (metres, shown relative to the lower-left point so labels stay short),
     equal scales on both axes; arrows (dE, dN) exaggerated so that the longest is about 12 %
-    of the map, with a scale arrow stating the exaggeration; dots coloured by dH (blue
+    of the map, with a scale arrow stating the exaggeration; dots coloured by dU (blue
     negative, red positive); flagged outliers ringed.
 
     Examples
@@ -237,7 +237,7 @@ def vector_map(
             body.append(
                 f'<rect x="{lx:.1f}" y="{gy + 16 * j:.1f}" width="14" height="14" fill="{col}" '
                 f'stroke="#000"/><text x="{lx + 20:.1f}" y="{gy + 16 * j + 11:.1f}" {_FONT}>'
-                f"dH {_fmt(float(v))} m</text>"
+                f"dU {_fmt(float(v))} m</text>"
             )
     if flags is not None and np.any(flags):
         oy = height - bottom - 6

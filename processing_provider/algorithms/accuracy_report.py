@@ -9,10 +9,11 @@ from qgis.core import NULL, QgsCoordinateTransform, QgsPoint, QgsPointXY
 from ...core.jobs import accuracy_report
 from ..base import BaseAlgorithm, core_errors
 from ..compat import FIELD_DOUBLE, FIELD_INT, FIELD_STRING, WKB_POINT_Z, WKT_PREFERRED
+from ..layer_styles import style_discrepancies
 
 S, D = FIELD_STRING, FIELD_DOUBLE
 _FIELDS = (
-    ("id", S), ("group", S), ("dE", D), ("dN", D), ("dH", D), ("dHoriz", D), ("d3D", D),
+    ("id", S), ("group", S), ("dE", D), ("dN", D), ("dU", D), ("dHorizontal", D), ("d3D", D),
     ("outlier", FIELD_INT),
 )  # fmt: skip
 
@@ -21,6 +22,7 @@ class AccuracyReportAlgorithm(BaseAlgorithm):
     """Adapter of ``core.jobs.accuracy_report``: point layers in, check points out as a layer."""
 
     JOB = accuracy_report
+    STYLES = (("OUTPUT", style_discrepancies),)
 
     def prepare(self, raw, parameters, context, feedback):
         """Two point layers become core PointSets (the reference reprojected on request)."""

@@ -9,6 +9,7 @@ from qgis.core import QgsCoordinateReferenceSystem, QgsPoint, QgsProcessingExcep
 from ...core.jobs import boresight_calibration
 from ..base import BaseAlgorithm
 from ..compat import FIELD_DOUBLE, FIELD_INT, FIELD_STRING, WKB_POINT_Z
+from ..layer_styles import style_image_residuals
 
 S, D, N = FIELD_STRING, FIELD_DOUBLE, FIELD_INT
 _FIELDS = (
@@ -22,6 +23,7 @@ class BoresightCalibrationAlgorithm(BaseAlgorithm):
     """Adapter of ``core.jobs.boresight_calibration``: residuals as a PointZ layer."""
 
     JOB = boresight_calibration
+    STYLES = (("OUTPUT_RESIDUALS", style_image_residuals),)
 
     def processAlgorithm(self, parameters, context, feedback):
         from ...core.photo.boresight import BoresightNotObservable

@@ -7,6 +7,7 @@ from qgis.core import QgsCoordinateReferenceSystem, QgsLineString, QgsPoint
 from ...core.jobs import create_lcps
 from ..base import BaseAlgorithm
 from ..compat import FIELD_DOUBLE, FIELD_INT, FIELD_STRING, WKB_LINESTRING_Z, WKB_POINT_Z
+from ..layer_styles import style_control_lines, style_lcps
 
 N, D, S = FIELD_INT, FIELD_DOUBLE, FIELD_STRING
 _POINT_FIELDS = (
@@ -24,6 +25,7 @@ class CreateLcpsAlgorithm(BaseAlgorithm):
     """Adapter of ``core.jobs.create_lcps``: control points and lines as layers."""
 
     JOB = create_lcps
+    STYLES = (("OUTPUT_POINTS", style_lcps), ("OUTPUT_LINES", style_control_lines))
 
     def write_layers(self, result, parameters, context, feedback) -> dict:
         from ...core.lidar.control import error_ellipsoid

@@ -7,6 +7,7 @@ from qgis.core import QgsCoordinateReferenceSystem, QgsLineString, QgsPolygon
 from ...core.jobs import extract_roof_planes
 from ..base import BaseAlgorithm
 from ..compat import FIELD_DOUBLE, FIELD_INT, WKB_POLYGON_Z
+from ..layer_styles import style_planes
 
 _NAMES = (
     "id", "a", "b", "c", "d", "centroid_x", "centroid_y", "centroid_z", "n_points", "rms",
@@ -22,6 +23,7 @@ class ExtractRoofPlanesAlgorithm(BaseAlgorithm):
     """Adapter of ``core.jobs.extract_roof_planes``: plane outlines as a PolygonZ layer."""
 
     JOB = extract_roof_planes
+    STYLES = (("OUTPUT", style_planes),)
 
     def write_layers(self, result, parameters, context, feedback) -> dict:
         run = result.data

@@ -68,20 +68,20 @@ def test_statistics_by_hand_on_a_known_answer():
     assert c["E"].std == pytest.approx(math.sqrt(2 * 0.09 / 1))
     assert c["E"].rmse == pytest.approx(0.3)
     assert c["N"].rmse == pytest.approx(0.4)
-    assert c["H"].rmse == pytest.approx(math.sqrt(0.5))
-    assert c["H"].mean == pytest.approx(0.5)
-    assert (c["H"].minimum, c["H"].maximum) == (0.0, 1.0)
-    assert c["horizontal"].rmse == pytest.approx(0.5)  # 3-4-5
-    assert c["horizontal"].minimum == pytest.approx(0.5)
+    assert c["U"].rmse == pytest.approx(math.sqrt(0.5))
+    assert c["U"].mean == pytest.approx(0.5)
+    assert (c["U"].minimum, c["U"].maximum) == (0.0, 1.0)
+    assert c["HORIZONTAL"].rmse == pytest.approx(0.5)  # 3-4-5
+    assert c["HORIZONTAL"].minimum == pytest.approx(0.5)
     assert c["3D"].rmse == pytest.approx(math.sqrt(0.25 + 0.5))
-    assert r.rmse["RMSE_HORIZ"] == pytest.approx(0.5)
+    assert r.rmse["RMSE_HORIZONTAL"] == pytest.approx(0.5)
 
 
 def test_statistics_agree_with_numpy_on_simulated_points():
     cp = _simulate(n=40, seed=3)
     d = cp.measured - cp.reference
     r = assess_accuracy(cp)
-    for k, name in enumerate("ENH"):
+    for k, name in enumerate("ENU"):
         c = r.overall.components[name]
         assert c.n == 40
         assert c.mean == pytest.approx(np.mean(d[:, k]), abs=1e-12)
@@ -89,8 +89,9 @@ def test_statistics_agree_with_numpy_on_simulated_points():
         assert c.rmse == pytest.approx(np.sqrt(np.mean(d[:, k] ** 2)), abs=1e-12)
         assert c.minimum == np.min(d[:, k]) and c.maximum == np.max(d[:, k])
     h = np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2)
-    assert r.rmse["RMSE_HORIZ"] == pytest.approx(math.hypot(r.rmse["RMSE_E"], r.rmse["RMSE_N"]))
-    assert r.overall.components["horizontal"].maximum == pytest.approx(h.max())
+    horizontal = math.hypot(r.rmse["RMSE_E"], r.rmse["RMSE_N"])
+    assert r.rmse["RMSE_HORIZONTAL"] == pytest.approx(horizontal)
+    assert r.overall.components["HORIZONTAL"].maximum == pytest.approx(h.max())
     assert r.rmse["RMSE_3D"] == pytest.approx(np.sqrt(np.mean(np.sum(d**2, axis=1))))
 
 
@@ -99,7 +100,7 @@ def test_rmse_of_simulation_within_the_noncentral_chi_square_bounds():
     # RMSE must fall in its 99.9 % interval for each component.
     bias, sigma, n = np.array([0.05, -0.05, 0.10]), np.array([0.2, 0.2, 0.3]), 15
     r = assess_accuracy(_simulate(n=n, bias=bias, sigma=sigma, seed=11))
-    for k, name in enumerate("ENH"):
+    for k, name in enumerate("ENU"):
         dist = stats.ncx2(n, n * bias[k] ** 2 / sigma[k] ** 2)
         lo, hi = (sigma[k] * math.sqrt(dist.ppf(q) / n) for q in (0.0005, 0.9995))
         assert lo < r.overall.components[name].rmse < hi, name
@@ -113,7 +114,7 @@ def test_group_statistics_are_those_of_the_subsets():
     for g in ("NE", "SW"):
         mask = np.array(cp.groups) == g
         assert r.groups[g].n == mask.sum()
-        assert r.groups[g].components["H"].rmse == pytest.approx(np.sqrt(np.mean(d[mask, 2] ** 2)))
+        assert r.groups[g].components["U"].rmse == pytest.approx(np.sqrt(np.mean(d[mask, 2] ** 2)))
     assert set(r.group_thresholds) == {"NE", "SW"}
 
 
@@ -190,8 +191,8 @@ def test_declared_precision_enters_the_component_tests():
         AccuracySettings(declared_sigma_h=0.05, declared_sigma_v=1.0),
     )
     c = r.overall.components
-    assert c["E"].precision.accepted is False and c["H"].precision.accepted is True
-    assert c["horizontal"].precision is None
+    assert c["E"].precision.accepted is False and c["U"].precision.accepted is True
+    assert c["HORIZONTAL"].precision is None
 
 
 # ----------------------------------------------------------------------------- outliers
@@ -369,7 +370,7 @@ def test_command_line_with_one_table_and_with_two(tmp_path, capsys):
     assert main(["accuracyreport", "--input", str(table), "--output-html", str(html)]) == 0
     out = capsys.readouterr().out
     rmse = np.sqrt(np.mean(np.round(cp.discrepancies, 4) ** 2, axis=0))
-    assert f"RMSE_H {rmse[2]:.4f}" in out and html.exists()
+    assert f"RMSE_U {rmse[2]:.4f}" in out and html.exists()
     m, r = tmp_path / "m.csv", tmp_path / "r.csv"
     m.write_text("pid,e,n,h\nA,10.1,20,5\nB,30,40.2,6\nC,1,1,1\n", encoding="utf-8")
     r.write_text("id,e,n,elev\nB,30,40,6.5\nA,10,20,5\nC,1,1,1\n", encoding="utf-8")

@@ -509,7 +509,8 @@ def test_gross_blunder_is_flagged_and_reported_with_and_without(tmp_path, capsys
     assert figures["contrast"]["name"] == "without the 1 flagged point(s)"
     assert "1 point(s) flagged as outliers (all points above); without the 1 flagged " in std.out
     nssda = next(r for r in figures["standards"] if r["key"] == "nssda")
-    assert nssda["figures"]["Accuracy_r"] == pytest.approx(1.96 * 1e6 / np.sqrt(n), rel=1e-3)
+    radius = nssda["figures"]["ACCURACY_HORIZONTAL_95"]
+    assert radius == pytest.approx(1.96 * 1e6 / np.sqrt(n), rel=1e-3)
     page = (tmp_path / "report.html").read_text(encoding="utf-8")
     assert "For comparison: without the 1 flagged point(s) (24)" in page
 

@@ -68,7 +68,7 @@ def test_all_models_compared_and_every_output_readable(files):
     comp = _read(outs["OUTPUT_COMPARISON"])
     assert next(r["model"] for r in comp) == best and len(comp) == 7
     assert {r["model"] for r in comp} == set(bundle_adjustment.AP_CHOICES) - {"all"}
-    rms = [float(r["rms_3d"]) for r in comp]
+    rms = [float(r["rmse_3d"]) for r in comp]
     assert rms == sorted(rms)
     # the orientations with sigmas read back as observed orientations
     eo = read_eo_csv_full(outs["OUTPUT_EO"], "")

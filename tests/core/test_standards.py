@@ -87,17 +87,18 @@ def test_nssda_figures_and_conditions():
     d = rng.normal(0.0, [0.2, 0.18, 0.3], (25, 3))
     res = nssda(d, normal=[True, True, True], biased=[False, False, False])
     rx, ry, rz = np.sqrt(np.mean(d**2, axis=0))
-    assert res.figures["Accuracy_z"] == pytest.approx(1.9600 * rz)
-    assert res.figures["Accuracy_r"] == pytest.approx(2.4477 * 0.5 * (rx + ry))
-    assert res.figures["Accuracy_r_case1"] == pytest.approx(1.7308 * math.hypot(rx, ry))
+    assert res.figures["ACCURACY_U_95"] == pytest.approx(1.9600 * rz)
+    assert res.figures["ACCURACY_HORIZONTAL_95"] == pytest.approx(2.4477 * 0.5 * (rx + ry))
+    assert res.figures["ACCURACY_HORIZONTAL_95_CASE1"] == pytest.approx(1.7308 * math.hypot(rx, ry))
     # Case 2 approximates the exact radius within 1 % for ratios near 1.
-    assert res.figures["Accuracy_r"] == pytest.approx(res.figures["Accuracy_r_exact"], rel=0.01)
+    exact = res.figures["ACCURACY_HORIZONTAL_95_EXACT"]
+    assert res.figures["ACCURACY_HORIZONTAL_95"] == pytest.approx(exact, rel=0.01)
     assert _status(res, "Check-point count") == "pass"
     assert _status(res, "Horizontal approximation condition") == "pass"
     assert _status(res, "Horizontal accuracy (95 %)") == "info"
     bad = nssda(d * [1.0, 0.3, 1.0], normal=[True, False, None], biased=[True, False, False])
     assert _status(bad, "Horizontal approximation condition") == "fail"
-    assert bad.figures["Accuracy_r"] == bad.figures["Accuracy_r_exact"]
+    assert bad.figures["ACCURACY_HORIZONTAL_95"] == bad.figures["ACCURACY_HORIZONTAL_95_EXACT"]
     assert _status(bad, "Assumption: normal distribution (Shapiro-Wilk)") == "fail"
     assert _status(bad, "Assumption: no systematic error (Student t)") == "fail"
 
@@ -108,7 +109,7 @@ def test_too_few_points_are_reported_for_each_standard():
     assert _status(n, "Check-point count") == "insufficient"
     assert "15" in n.verdicts[0].reason and not n.enough_points
     assert _status(n, "Horizontal accuracy (95 %)") == "insufficient"
-    assert math.isfinite(n.figures["Accuracy_r"])  # computed, not hidden
+    assert math.isfinite(n.figures["ACCURACY_HORIZONTAL_95"])  # computed, not hidden
     a = asprs_2023(d, h_class_cm=5.0)
     assert _status(a, "Check-point count") == "insufficient"
     assert _status(a, "Horizontal class 5-cm") == "insufficient"
@@ -131,9 +132,13 @@ def test_asprs_includes_the_survey_error_and_3d():
     rx, ry, rz = np.sqrt(np.mean(d**2, axis=0))
     rmse_h = math.sqrt(rx**2 + ry**2 + 2 * 0.01**2)
     rmse_v = math.sqrt(rz**2 + 0.02**2)
-    assert res.figures["RMSE_H"] == pytest.approx(rmse_h)
-    assert res.figures["RMSE_V"] == pytest.approx(rmse_v)
-    assert res.figures["RMSE_3D"] == pytest.approx(math.hypot(rmse_h, rmse_v))
+    assert res.figures["RMSE_HORIZONTAL_TOTAL"] == pytest.approx(rmse_h)
+    assert res.figures["RMSE_U_TOTAL"] == pytest.approx(rmse_v)
+    assert res.figures["RMSE_3D_TOTAL"] == pytest.approx(math.hypot(rmse_h, rmse_v))
+    # the check points' own figures carry the names they have everywhere else
+    assert res.figures["RMSE_HORIZONTAL"] == pytest.approx(math.hypot(rx, ry))
+    assert res.figures["RMSE_U"] == pytest.approx(rz)
+    assert "RMSE_H" not in res.figures and "RMSE_V" not in res.figures
 
 
 def test_asprs_class_boundaries():

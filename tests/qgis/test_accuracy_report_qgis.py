@@ -108,7 +108,8 @@ def test_algorithm_is_registered_with_the_documented_api(provider):
     assert {"INPUT", "MEASURED", "REFERENCE", "MEASURED_ID", "REFERENCE_ID", "GROUP_FIELD"} <= names
     assert {"OUTPUT", "OUTPUT_HTML", "OUTPUT_JSON", "STANDARDS", "REPROJECT"} <= names
     outputs = {o.name() for o in alg.outputDefinitions()}
-    assert {"RMSE_E", "RMSE_N", "RMSE_H", "RMSE_HORIZ", "RMSE_3D"} <= outputs
+    assert {"RMSE_E", "RMSE_N", "RMSE_U", "RMSE_HORIZONTAL", "RMSE_3D"} <= outputs
+    assert {"RMSE_H", "RMSE_HORIZ"} <= outputs  # former names, kept for one release
 
 
 def test_csv_run_layer_and_report(provider, tmp_path):
@@ -119,22 +120,26 @@ def test_csv_run_layer_and_report(provider, tmp_path):
     rmse = np.sqrt(np.mean(d**2, axis=0))
     assert r["RMSE_E"] == pytest.approx(rmse[0], abs=1e-9)
     assert r["RMSE_N"] == pytest.approx(rmse[1], abs=1e-9)
-    assert r["RMSE_H"] == pytest.approx(rmse[2], abs=1e-9)
-    assert r["RMSE_HORIZ"] == pytest.approx(math.hypot(rmse[0], rmse[1]), abs=1e-9)
+    assert r["RMSE_U"] == r["RMSE_H"] == pytest.approx(rmse[2], abs=1e-9)
+    assert (
+        r["RMSE_HORIZONTAL"]
+        == r["RMSE_HORIZ"]
+        == pytest.approx(math.hypot(rmse[0], rmse[1]), abs=1e-9)
+    )
     assert r["RMSE_3D"] == pytest.approx(np.linalg.norm(rmse), abs=1e-9)
     layer = r["OUTPUT"]
     assert layer.isValid() and layer.featureCount() == 15
     assert QgsWkbTypes.hasZ(layer.wkbType()) and layer.crs().authid() == CRS
     names = [f.name() for f in layer.fields()]
-    assert names == ["id", "group", "dE", "dN", "dH", "dHoriz", "d3D", "outlier"]
+    assert names == ["id", "group", "dE", "dN", "dU", "dHorizontal", "d3D", "outlier"]
     ids, _, ref, groups = simulate_checkpoints()
     for f in layer.getFeatures():
         k = ids.index(f["id"])
         p = f.geometry().constGet()
         assert (p.x(), p.y(), p.z()) == pytest.approx(tuple(np.round(ref[k], 4)), abs=1e-6)
         assert f["group"] == groups[k]
-        assert f["dH"] == pytest.approx(d[k, 2], abs=1e-9)
-        assert f["dHoriz"] == pytest.approx(math.hypot(d[k, 0], d[k, 1]), abs=1e-9)
+        assert f["dU"] == pytest.approx(d[k, 2], abs=1e-9)
+        assert f["dHorizontal"] == pytest.approx(math.hypot(d[k, 0], d[k, 1]), abs=1e-9)
     # The HTML report opens: tables, verdicts and inline SVG plots.
     parser = _Html()
     parser.feed(html.read_text(encoding="utf-8"))
@@ -175,7 +180,7 @@ def test_two_layers_memory_and_geopackage(provider, tmp_path):
             "GROUP_FIELD": "grp",
         }
     )
-    for key in ("RMSE_E", "RMSE_N", "RMSE_H", "RMSE_HORIZ", "RMSE_3D"):
+    for key in ("RMSE_E", "RMSE_N", "RMSE_U", "RMSE_HORIZONTAL", "RMSE_3D"):
         assert r[key] == pytest.approx(base[key], abs=1e-6), key
     assert {f["group"] for f in r["OUTPUT"].getFeatures()} == {"NE", "SW"}
 
@@ -198,7 +203,7 @@ def test_mixed_crs_refused_unless_reprojected(provider):
     # Reprojected by QGIS and back: millimetre agreement with the UTM numbers.
     assert r["RMSE_E"] == pytest.approx(rmse[0], abs=1e-3)
     assert r["RMSE_N"] == pytest.approx(rmse[1], abs=1e-3)
-    assert r["RMSE_H"] == pytest.approx(rmse[2], abs=1e-9)
+    assert r["RMSE_U"] == pytest.approx(rmse[2], abs=1e-9)
 
 
 def test_bad_layers_give_clear_errors(provider):
@@ -242,7 +247,7 @@ def test_qgis_process_runs_the_report(qp_env, tmp_path):
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
     results = json.loads(r.stdout)["results"]
     d = _rounded_discrepancies()
-    assert results["RMSE_H"] == pytest.approx(np.sqrt(np.mean(d[:, 2] ** 2)), abs=1e-9)
+    assert results["RMSE_U"] == pytest.approx(np.sqrt(np.mean(d[:, 2] ** 2)), abs=1e-9)
     assert "<svg" in html.read_text(encoding="utf-8")
     layer = QgsVectorLayer(str(gpkg), "cp", "ogr")
     assert layer.isValid() and layer.featureCount() == 15
@@ -269,7 +274,7 @@ def test_report_of_simulated_checkpoints(provider, tmp_path):
     # non-central chi-square 99.9 % band (n RMSE^2 / sigma^2 ~ ncx2(n, n bias^2 / sigma^2)).
     from scipy import stats
 
-    for k, c in enumerate("ENH"):
+    for k, c in enumerate("ENU"):
         assert abs(comps[c]["mean"] - BIAS[k]) < 4 * SIGMA[k] / math.sqrt(15)
         dist = stats.ncx2(15, 15 * BIAS[k] ** 2 / SIGMA[k] ** 2)
         lo, hi = (SIGMA[k] * math.sqrt(dist.ppf(q) / 15) for q in (0.0005, 0.9995))
@@ -278,7 +283,7 @@ def test_report_of_simulated_checkpoints(provider, tmp_path):
     assert project["figures"]["v_threshold"] == pytest.approx(0.4787, abs=1e-4)
     lines = [f"simulated check points: {data['n_points']} (NE 8, SW 7)"]
     lines += [f"{k} = {v:.3f} m" for k, v in data["rmse"].items()]
-    for c in "ENH":
+    for c in "ENU":
         x = comps[c]
         lines.append(
             f"d{c}: mean {x['mean']:+.3f} std {x['std']:.3f} min {x['minimum']:+.3f} "
@@ -294,5 +299,5 @@ def test_report_of_simulated_checkpoints(provider, tmp_path):
         for v in s["verdicts"]:
             lines.append(f"project[{g}]: {v['name']}: {v['status']} - {v['reason']}")
     print("\n".join(lines))
-    assert re.search(r"RMSE_HORIZ = \d", "\n".join(lines))
-    assert r["RMSE_HORIZ"] == pytest.approx(data["rmse"]["RMSE_HORIZ"])
+    assert re.search(r"RMSE_HORIZONTAL = \d", "\n".join(lines))
+    assert r["RMSE_HORIZONTAL"] == pytest.approx(data["rmse"]["RMSE_HORIZONTAL"])

@@ -165,3 +165,54 @@ def test_control_model_in_qgis_process(qp_env, tmp_path):
     )  # fmt: skip
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
     _check_control(tmp_path)
+
+
+class _Log:
+    """A feedback that keeps what each channel received."""
+
+    def __init__(self):
+        from qgis.core import QgsProcessingFeedback
+
+        self.info, self.debug = [], []
+        log = self
+
+        class Feedback(QgsProcessingFeedback):
+            def pushInfo(self, text):
+                log.info.append(text)
+
+            def pushDebugInfo(self, text):
+                log.debug.append(text)
+
+        self.feedback = Feedback()
+
+
+@pytest.mark.parametrize("verbose", [False, True])
+def test_rejections_counted_in_the_log_details_only_in_a_verbose_log(provider, town_files, verbose):
+    from qgis.core import QgsProcessingContext, QgsProject
+
+    log = _Log()
+    context = QgsProcessingContext()
+    context.setProject(QgsProject.instance())
+    if verbose:  # Processing options, logging level "Verbose"
+        context.setLogLevel(QgsProcessingContext.Verbose)
+    processing.run(
+        ALG,
+        {"PLANES": str(town_files / "planes.csv"), "CLOUD": str(town_files / "roofs.las"),
+         "POINTS_CSV": "TEMPORARY_OUTPUT"},  # no layer asked: the sinks are optional
+        feedback=log.feedback,
+        context=context,
+    )  # fmt: skip
+    summary = [t for t in log.info if "candidates rejected:" in t]
+    assert len(summary) == 1, log.info
+    count = int(summary[0].split()[0])
+    details = [t for t in log.debug if t.startswith("planes ")]
+    assert not any(t.startswith("planes ") for t in log.info)
+    if not verbose:
+        assert details == []
+        return
+    assert len(details) == count > 0  # one debug line per rejected candidate
+    for t in details:  # every length with its unit (RD New: metres), angles in degrees
+        if "from the points of plane" in t:
+            assert " m from the points of plane " in t and t.rstrip().endswith(" m)"), t
+        if "parallel" in t:
+            assert t.count(" deg") == 2, t

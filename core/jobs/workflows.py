@@ -1,0 +1,120 @@
+"""Typical chains of algorithms: the "How to use" section of every algorithm's help.
+
+Each :class:`Workflow` is a chain of steps (algorithm id, what the step takes and gives, in the
+step's own parameter names). The help of an algorithm (QGIS and ``lidarphoto <alg> --help``)
+lists every workflow it belongs to, with its own step marked, so a new algorithm gets a "How
+to use" section by joining a workflow here (``tests/core/test_help.py`` checks that every
+algorithm is in one, that every id exists and that every parameter name a note gives is a
+parameter of that step).
+"""
+
+from __future__ import annotations
+
+import textwrap
+from dataclasses import dataclass
+
+#: Width of the help text (the descriptions of the specs are wrapped at this width).
+_WIDTH = 95
+
+
+@dataclass(frozen=True)
+class Workflow:
+    """A chain of algorithms: ``steps`` are (algorithm id, note) in the order a user runs
+    them; a note names the step's own parameters (upper case) where it takes or gives files."""
+
+    title: str
+    steps: tuple[tuple[str, str], ...]
+
+    @property
+    def ids(self) -> tuple[str, ...]:
+        return tuple(alg for alg, _ in self.steps)
+
+    def chain(self, mark: str = "") -> str:
+        """``a -> b -> [c] -> d`` with ``mark`` in brackets.
+
+        >>> Workflow("x", (("a", ""), ("b", ""))).chain("b")
+        'a -> [b]'
+        """
+        return " -> ".join(f"[{a}]" if a == mark else a for a in self.ids)
+
+
+WORKFLOWS: tuple[Workflow, ...] = (
+    Workflow(
+        "Boresight calibration with LiDAR control (Pedrosa & dos Santos 2020)",
+        (
+            ("trajectorytoeo", "INPUT = the GNSS/INS trajectory CSV; OUTPUT_CSV = the "
+             "exterior orientation of every image"),
+            ("groundfilter", "INPUT = the LAS/LAZ; OUTPUT_CLOUD = the cloud classified into "
+             "ground (2) and non-ground"),
+            ("extractroofplanes", "INPUT = the classified cloud; OUTPUT_CSV = the plane table, "
+             "OUTPUT_CLOUD = the cloud with plane_id"),
+            ("createlcps", "PLANES and CLOUD = the two outputs of extractroofplanes; "
+             "POINTS_CSV and LINES_CSV = LiDAR control points and lines"),
+            ("boresightcalibration", "TRAJECTORY = the exterior orientation, PLANES / LINES / "
+             "LCPS = the control, OBSERVATIONS = image measurements made in the picking dock; "
+             "OUTPUT_TABLE = boresight per group, OUTPUT_EO = corrected orientation"),
+            ("accuracyreport", "INPUT = check points measured with the corrected orientation; "
+             "OUTPUT_HTML and OUTPUT_JSON = the accuracy figures against the standards"),
+        ),
+    ),
+    Workflow(
+        "Monoplotting on a LiDAR surface (dos Santos, Dal Poz & Dalmolin 2010)",
+        (
+            ("groundfilter", "INPUT = the LAS/LAZ; OUTPUT_DTM = the terrain model (or use the "
+             "cloud itself as DSM)"),
+            ("extractroofplanes", "OUTPUT_CSV = roof planes, used by monoplot for points on "
+             "roofs"),
+            ("resection", "OBSERVATIONS + CONTROL_POINTS (or lines) of one image; OUTPUT_EO = "
+             "its exterior orientation"),
+            ("monoplot", "OBSERVATIONS of the image, EO, DSM (raster or LAS/LAZ), optional "
+             "PLANES; OUTPUT_CSV = 3D points"),
+            ("accuracyreport", "INPUT = monoplotted check points against their reference"),
+        ),
+    ),
+    Workflow(
+        "Aerial triangulation and orthophotos",
+        (
+            ("bundleadjustment", "CAMERA, OBSERVATIONS, GROUND_POINTS, EO (approximate); "
+             "OUTPUT_EO = adjusted orientation, OUTPUT_CAMERA = calibrated camera"),
+            ("groundfilter", "OUTPUT_DTM = the terrain for the orthophotos"),
+            ("orthorectify", "CAMERA and EO from the bundle, IMAGES, DSM = the DTM or DSM; "
+             "OUTPUT_FOLDER = one orthophoto per image"),
+            ("orthomosaic", "ORTHOPHOTOS = that folder; OUTPUT = the mosaic, SEAMLINES_CSV = "
+             "the region of each image"),
+            ("accuracyreport", "INPUT = check points measured on the mosaic"),
+        ),
+    ),
+    Workflow(
+        "Terrestrial laser scanner calibration (Lichti 2007)",
+        (
+            ("extracttlstargets", "SCANS = the station clouds, CONTROL = target ids; OUTPUT = "
+             "target observations"),
+            ("tlscalibration", "OBSERVATIONS = those targets, CONTROL and STATIONS; "
+             "OUTPUT_APS = the scanner's additional parameters, OUTPUT_HTML = the report"),
+        ),
+    ),
+)
+
+
+def workflows_of(name: str) -> tuple[Workflow, ...]:
+    """The workflows algorithm ``name`` is a step of.
+
+    >>> [w.title.split()[0] for w in workflows_of("createlcps")]
+    ['Boresight']
+    """
+    return tuple(w for w in WORKFLOWS if name in w.ids)
+
+
+def how_to_use(name: str) -> str:
+    """The "How to use" section of an algorithm's help (plain text, see ``spec.text_to_html``);
+    "" when the algorithm is in no workflow."""
+    blocks = []
+    for w in workflows_of(name):
+        lines = textwrap.wrap(f"{w.title}: {w.chain(name)}", _WIDTH, break_on_hyphens=False)
+        for alg, note in w.steps:
+            here = " (this algorithm)" if alg == name else ""
+            lines += textwrap.wrap(
+                f"- {alg}{here}: {note}", _WIDTH, subsequent_indent="  ", break_on_hyphens=False
+            )
+        blocks.append("\n".join(lines))
+    return "\n\n".join(blocks)

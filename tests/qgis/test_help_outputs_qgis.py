@@ -1,0 +1,92 @@
+"""Help and outputs as a user meets them in QGIS: ``qgis_process help`` shows each parameter's
+default, unit and range and a "How to use"; layer outputs are optional where a file carries
+the same content (qgis_process runs without them); HTML reports are HTML outputs (QGIS opens
+them in the results viewer)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from pathlib import Path
+
+import pytest
+from lidarphoto.core.jobs import ALGORITHMS
+from qgis.core import QgsProcessingOutputHtml
+from qgis_helpers import QGIS_PROCESS, ROOT
+
+AHN3 = Path(ROOT) / "tests" / "data" / "ahn3" / "ahn3_delft_crop60.laz"
+SPECS = {job.SPEC.name: job.SPEC for job in ALGORITHMS}
+
+
+def _qgis_process(args, env):
+    return subprocess.run(
+        [QGIS_PROCESS, *args], env=env, capture_output=True, text=True, timeout=600
+    )
+
+
+def test_qgis_process_help_shows_defaults_units_ranges_and_usage(qp_env):
+    r = _qgis_process(["help", "lidarphoto:createlcps"], qp_env)
+    assert r.returncode == 0, r.stderr[-2000:]
+    args = r.stdout.split("Arguments")[1]
+    # under each parameter (the "Arguments" section), not only in the description
+    assert (
+        "MIN_ANGLE: Minimum angle between normals (degrees)\n"
+        "\tdefault: 10; unit: degrees; range: 0 to 90"
+    ) in args
+    assert (
+        "DELTA: Adjacency distance delta (length)\n\tdefault: 1; unit: length (cloud CRS unit, "
+        "or m when DISTANCE_UNIT is metre); range: 0.001 to 1000"
+    ) in args
+    assert "MAX_CONDITION: Maximum condition number\n\tdefault: 50; unit: none" in args
+    assert "PLANES: Plane table (CSV)\n\trequired" in args
+    assert "default: crs; values: crs | metre" in args
+    description = r.stdout.split("Arguments")[0]
+    assert "<h3>How to use</h3>" in description
+    assert "extractroofplanes -&gt; [createlcps] -&gt; boresightcalibration" in description
+    assert "<h3>References</h3>" in description and "Pedrosa &amp; dos Santos (2020)" in (
+        description
+    )
+
+
+@pytest.mark.parametrize("name", sorted(SPECS))
+def test_layer_outputs_are_optional(provider, name):
+    alg = provider.algorithm(name)
+    for p in SPECS[name].params:
+        if p.kind == "sink":
+            d = alg.parameterDefinition(p.name)
+            assert d.flags() & d.Flag.FlagOptional, p.name
+            assert d.createByDefault(), p.name  # the dialog still makes the layer
+
+
+@pytest.mark.parametrize("name", sorted(SPECS))
+def test_html_reports_are_html_outputs(provider, name):
+    alg = provider.algorithm(name)
+    html = [p.name for p in SPECS[name].params if p.kind == "file_out" and "html" in
+            p.file_filter.lower()]  # fmt: skip
+    for key in html:
+        assert isinstance(alg.outputDefinition(key), QgsProcessingOutputHtml), key
+
+
+def test_qgis_process_runs_extractroofplanes_without_the_layer(qp_env, tmp_path):
+    csv_path, cloud = tmp_path / "planes.csv", tmp_path / "planes.laz"
+    r = _qgis_process(
+        [
+            "--json",
+            "run",
+            "lidarphoto:extractroofplanes",
+            "--",
+            f"INPUT={AHN3}",
+            "DISTANCE_UNIT=1",
+            f"OUTPUT_CSV={csv_path}",
+            f"OUTPUT_CLOUD={cloud}",
+        ],
+        qp_env,
+    )
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    results = json.loads(r.stdout)["results"]
+    assert results["PLANE_COUNT"] > 30
+    from lidarphoto.core.io.planes import read_planes_csv
+
+    assert len(read_planes_csv(csv_path)) == results["PLANE_COUNT"]
+    assert cloud.stat().st_size > 1000
+    assert not results.get("OUTPUT")  # no layer was made
