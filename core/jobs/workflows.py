@@ -74,6 +74,9 @@ WORKFLOWS: tuple[Workflow, ...] = (
     Workflow(
         "Aerial triangulation and orthophotos",
         (
+            ("locatecontrolpoints", "CHIPS = one GeoTIFF chip per control point, "
+             "CONTROL_POINTS, CAMERA, approximate EO, IMAGES; OUTPUT = the control points' "
+             "image observations, without clicking them"),
             ("bundleadjustment", "CAMERA, OBSERVATIONS, GROUND_POINTS, EO (approximate); "
              "OUTPUT_EO = adjusted orientation, OUTPUT_CAMERA = calibrated camera"),
             ("groundfilter", "OUTPUT_DTM = the terrain for the orthophotos"),
@@ -82,6 +85,15 @@ WORKFLOWS: tuple[Workflow, ...] = (
             ("orthomosaic", "ORTHOPHOTOS = that folder; OUTPUT = the mosaic, SEAMLINES_CSV = "
              "the region of each image"),
             ("accuracyreport", "INPUT = check points measured on the mosaic"),
+        ),
+    ),
+    Workflow(
+        "LiDAR control for a whole block of tiles (dask.distributed)",
+        (
+            ("lidarblock", "INPUT = a folder of LAS/LAZ tiles or a .vpc; OUTPUT_FOLDER = "
+             "classified tiles, block.vpc, planes.csv, lcps.csv and lines.csv"),
+            ("boresightcalibration", "PLANES / LINES / LCPS = the block's tables, TRAJECTORY "
+             "and OBSERVATIONS as above"),
         ),
     ),
     Workflow(
