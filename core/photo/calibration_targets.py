@@ -9,7 +9,8 @@ target's plane (metres, ``Z = 0``; X along the target's columns, Y along its row
   + ``cv2.cornerSubPix``.
 - **charuco**: a ChArUco board of ``squares_x x squares_y`` squares with ArUco markers in the
   white squares; the field is the chessboard corners, with OpenCV's ChArUco corner ids
-  (``cv2.aruco.CharucoDetector``).
+  (``cv2.aruco.CharucoDetector``, then ``cv2.cornerSubPix``: OpenCV 4.11's ChArUco corners
+  lie 0.5 px off the true ones on a rendered board).
 - **aruco**: an ArUco grid board of ``markers_x x markers_y`` markers; the field is the four
   corners of every marker, id ``= 4 * marker_id + corner`` (corner 0..3: OpenCV's order,
   top-left, top-right, bottom-right, bottom-left of the marker), refined to sub-pixel
@@ -212,6 +213,10 @@ def detect_target(image: NDArray[Any], spec: TargetSpec, name: str = "") -> Dete
         corners, ids, _, _ = det.detectBoard(grey)
         if ids is None or len(ids) == 0:
             return Detection(name, np.zeros(0, np.int64), np.zeros((0, 2)))
+        # CharucoDetector's corners sit 0.5 px off those of cornerSubPix and of the
+        # chessboard detectors on a synthetic board (see the tests): refine them again.
+        crit = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 50, 1e-3)
+        corners = cv2.cornerSubPix(grey, np.asarray(corners, np.float32), (4, 4), (-1, -1), crit)
         px = np.asarray(corners, dtype=np.float64).reshape(-1, 2) + _CV_TO_PROJECT_PX
         return Detection(name, np.asarray(ids, dtype=np.int64).ravel(), px)
     params = cv2.aruco.DetectorParameters()

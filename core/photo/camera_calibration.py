@@ -127,7 +127,8 @@ class CalibrationResult:
         t-test of every estimated lens coefficient.
     t_critical : float
     sigma0 : float
-        A-posteriori standard deviation of unit weight (a-priori ``sigma_px``).
+        A-posteriori standard deviation of unit weight (a-priori 1: the observations'
+        sigma is ``sigma_px``, so ``sigma0 * sigma_px`` is the a-posteriori point sigma, px).
     sigma0_prior, redundancy, n_points, iterations, condition_number
     rms_px : float
         Reprojection RMS over all points (OpenCV's definition, see the module docstring).
@@ -418,7 +419,7 @@ def calibrate_camera(
             return xl.copy(), np.ones((xl.shape[0], 1, 1))
 
         constraints.append(Constraint("datum: third point in Z = 0", [[zc]], plane))
-    aopts = AdjustmentOptions(max_iterations=opts.max_iterations, sigma0_prior=sigma)
+    aopts = AdjustmentOptions(max_iterations=opts.max_iterations)
     try:
         res = adjust(x0v, pnames, blocks, constraints, aopts, progress=progress,
                      should_stop=should_stop)  # fmt: skip
@@ -471,7 +472,7 @@ def calibrate_camera(
     return CalibrationResult(
         camera=cam, sigmas=sigmas, parameter_names=io_names, correlation=corr,
         t_values=t_values, significant=significant, t_critical=tcrit, sigma0=res.sigma0,
-        sigma0_prior=sigma, redundancy=res.redundancy, n_points=int(view.size),
+        sigma0_prior=1.0, redundancy=res.redundancy, n_points=int(view.size),
         iterations=res.iterations, condition_number=res.condition_number,
         rms_px=math.sqrt(float(np.mean(d2))), view_names=names, view_rms_px=view_rms,
         view_points=view_pts, eo=eo, eo_sigma=eo_sigma, residuals=rows, field_xyz=xyz,
@@ -495,7 +496,7 @@ def simulate_views(
     >>> fld = target_field(TargetSpec("chessboard", 4, 3, 0.1))
     >>> det = simulate_views(cam, fld, np.array([[0.15, 0.1, 1.0, 0.0, 0.0, 0.0]]))
     >>> det[0].pixels[0].round(6).tolist()
-    [440.0, 420.0]
+    [350.0, 500.0]
     """
     from ..geometry.collinearity import project
 
