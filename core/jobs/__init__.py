@@ -5,6 +5,7 @@ from . import (
     accuracy_report,
     boresight_calibration,
     bundle_adjustment,
+    calibrate_camera,
     create_lcps,
     extract_roof_planes,
     extract_tls_targets,
@@ -32,4 +33,5 @@ ALGORITHMS = (
     orthomosaic,
     tls_calibration,
     extract_tls_targets,
+    calibrate_camera,
 )

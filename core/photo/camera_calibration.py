@@ -147,6 +147,9 @@ class CalibrationResult:
         Initial values (focal_px, principal point) and how they were found.
     adjustment : AdjustmentResult
     warnings : list of str
+    sigma_px : float
+        The a-priori sigma of a detected point, pixels.
+    projection : str
     """
 
     camera: Camera
@@ -174,6 +177,8 @@ class CalibrationResult:
     initial: dict
     adjustment: AdjustmentResult
     warnings: list[str] = field(default_factory=list)
+    sigma_px: float = 0.0
+    projection: str = "perspective"
 
 
 # ----------------------------------------------------------------------------- initial values
@@ -477,6 +482,7 @@ def calibrate_camera(
         rms_px=math.sqrt(float(np.mean(d2))), view_names=names, view_rms_px=view_rms,
         view_points=view_pts, eo=eo, eo_sigma=eo_sigma, residuals=rows, field_xyz=xyz,
         field_ids=fld.ids.copy(), initial=initial, adjustment=res, warnings=warnings,
+        sigma_px=sigma, projection=opts.projection,
     )  # fmt: skip
 
 
