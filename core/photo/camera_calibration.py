@@ -24,8 +24,9 @@ distance).
 
 Initial values: the perspective projection from OpenCV's ``calibrateCamera`` (Zhang's
 homography method); a fisheye projection from a search of the focal length that makes each
-view's back-projected rays closest to a plane homography (a wrong focal length bends the
-grid's lines), then ``cv2.solvePnP`` per view. The lens coefficients start at zero.
+view's back-projected rays closest to those of a plane seen by a central camera (the DLT of
+``ray ~ H (X, Y, 1)``, valid beyond 90 degrees off the axis; a wrong focal length bends the
+grid's lines), the poses from those ``H``. The lens coefficients start at zero.
 
 Statistics: sigma0 and the global test, standard deviations, the correlation matrix of the
 interior orientation, per-view RMS residuals (``sqrt(sum(vcol^2 + vrow^2) / points)``,
@@ -62,9 +63,6 @@ LENS_NAMES = INTERIOR_NAMES[3:]
 FIELD_MODES = ("fixed", "free")
 # Points a view needs for its own pose (6 unknowns) with some redundancy.
 MIN_POINTS_PER_VIEW = 6
-# Largest angle off the axis of the points used for the initial pose of a fisheye view: the
-# perspective PnP of the initial values degrades towards 90 degrees.
-_INIT_MAX_THETA = math.radians(70.0)
 
 
 @dataclass(frozen=True)
@@ -183,57 +181,80 @@ class CalibrationResult:
 
 # ----------------------------------------------------------------------------- initial values
 def _cv_pose_to_eo(rvec: Array, tvec: Array) -> Array:
-    """OpenCV pose (x right, y down, z forward) -> EO in the target frame (project's camera:
-    x right, y up, looking along -z)."""
+    """OpenCV pose (rotation vector or matrix; camera x right, y down, z forward) -> EO in
+    the target frame (the project's camera: x right, y up, looking along -z)."""
     import cv2
 
-    r_cv, _ = cv2.Rodrigues(np.asarray(rvec, dtype=np.float64).reshape(3))
+    r = np.asarray(rvec, dtype=np.float64)
+    r_cv = r if r.shape == (3, 3) else cv2.Rodrigues(r.reshape(3))[0]
     m = np.diag([1.0, -1.0, -1.0]) @ r_cv
     centre = -r_cv.T @ np.asarray(tvec, dtype=np.float64).reshape(3)
     om, ph, ka = matrix_to_opk(m)
     return np.array([*centre, float(om), float(ph), float(ka)])
 
 
-def _normalised_rays(px: Array, f_px: float, pp: Array, projection: str) -> tuple[Array, Array]:
-    """Pixels -> OpenCV-normalised perspective coordinates (x/z, y/z, y down) and the angle
-    off the axis, with the given focal length and principal point and no lens correction."""
+def _rays_cv(px: Array, f_px: float, pp: Array, projection: str) -> Array:
+    """Pixels -> unit rays in OpenCV's camera frame (x right, y down, z forward) with the given
+    focal length and principal point and no lens correction; NaN outside the projection."""
     xy = np.column_stack([px[:, 0] - pp[0], pp[1] - px[:, 1]])  # y up, pixels
-    ray = ray_from_ideal(xy, f_px, projection)  # camera frame, looking along -z
-    with np.errstate(divide="ignore", invalid="ignore"):
-        theta = np.arctan2(np.hypot(ray[:, 0], ray[:, 1]), -ray[:, 2])
-        nx, ny = ray[:, 0] / -ray[:, 2], -ray[:, 1] / -ray[:, 2]
-    return np.column_stack([nx, ny]), theta
+    ray = ray_from_ideal(xy, f_px, projection)  # the project's frame, looking along -z
+    ray = ray * np.array([1.0, -1.0, -1.0])
+    return ray / np.linalg.norm(ray, axis=1, keepdims=True)
+
+
+def _plane_pose(xy: Array, rays: Array) -> tuple[Array, Array, float]:
+    """Pose of a plane (points ``xy`` (N, 2) in Z = 0) seen along unit ``rays`` (N, 3):
+    the DLT of ``ray ~ H (X, Y, 1)`` (valid for rays beyond 90 degrees off the axis, unlike
+    a homography of image points), ``H = [r1 r2 t]``. Returns R, t (OpenCV frame) and the RMS
+    angle (rad) between the rays and ``H x``."""
+    c = xy.mean(axis=0)
+    s = math.sqrt(2.0) / max(float(np.mean(np.linalg.norm(xy - c, axis=1))), 1e-12)
+    t_norm = np.array([[s, 0, -s * c[0]], [0, s, -s * c[1]], [0, 0, 1.0]])
+    x = np.column_stack([xy, np.ones(len(xy))]) @ t_norm.T
+    zero = np.zeros_like(x)
+    rx, ry, rz = rays[:, :1], rays[:, 1:2], rays[:, 2:3]
+    # rows of ray x (H x) = 0: two independent per point
+    a = np.vstack([np.hstack([zero, -rz * x, ry * x]), np.hstack([rz * x, zero, -rx * x])])
+    h = np.linalg.svd(a)[2][-1].reshape(3, 3) @ t_norm
+    hx = np.column_stack([xy, np.ones(len(xy))]) @ h.T
+    if np.sum(np.sum(hx * rays, axis=1) > 0) < 0.5 * len(xy):
+        h, hx = -h, -hx
+    cosang = np.sum(hx * rays, axis=1) / np.linalg.norm(hx, axis=1)
+    misfit = float(np.sqrt(np.mean(np.arccos(np.clip(cosang, -1.0, 1.0)) ** 2)))
+    lam = 2.0 / (np.linalg.norm(h[:, 0]) + np.linalg.norm(h[:, 1]))
+    r1, r2 = lam * h[:, 0], lam * h[:, 1]
+    u, _, vt = np.linalg.svd(np.column_stack([r1, r2, np.cross(r1, r2)]))
+    rot = u @ vt
+    if np.linalg.det(rot) < 0:
+        rot = u @ np.diag([1.0, 1.0, -1.0]) @ vt
+    return rot, lam * h[:, 2], misfit
 
 
 def _init_fisheye(views: list[tuple[Array, Array]], size: tuple[int, int], projection: str):
-    """Focal length (px) whose back-projection makes the views closest to homographies."""
-    import cv2
-
+    """Focal length (px) whose back-projected rays make every view closest to a plane seen by
+    a central camera (a wrong focal length bends the grid's lines), and the views' poses."""
     w, h = size
     pp = np.array([0.5 * w, 0.5 * h])
 
     def misfit(f_px: float) -> float:
-        total, count = 0.0, 0
+        total = 0.0
         for xyz, px in views:
-            n, theta = _normalised_rays(px, f_px, pp, projection)
-            ok = np.isfinite(theta) & (theta < _INIT_MAX_THETA)
-            if ok.sum() < MIN_POINTS_PER_VIEW:
-                continue
-            src = xyz[ok, :2].astype(np.float64)
-            hom, _ = cv2.findHomography(src, n[ok], 0)
-            if hom is None:
-                continue
-            pred = cv2.perspectiveTransform(src[None], hom)[0]
-            total += float(np.sum((pred - n[ok]) ** 2)) * f_px * f_px
-            count += int(ok.sum())
-        return total / count if count else np.inf
+            rays = _rays_cv(px, f_px, pp, projection)
+            ok = np.isfinite(rays).all(axis=1)
+            if ok.sum() < len(px):  # a point outside the projection: f too small
+                return np.inf
+            total += _plane_pose(xyz[:, :2], rays)[2] ** 2
+        return total
 
     diag = math.hypot(w, h)
     grid = np.geomspace(0.05 * diag, 2.0 * diag, 60)
     costs = np.array([misfit(f) for f in grid])
-    k = int(np.nanargmin(costs))
+    if not np.isfinite(costs).any():
+        raise InputError(f"no focal length puts every target point inside the {projection} "
+                         "projection's image (a wider projection may fit)")  # fmt: skip
+    k = int(np.argmin(costs))
     lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
-    for _ in range(30):  # golden-section refinement within the bracket
+    for _ in range(40):  # golden-section refinement within the bracket
         a = hi - 0.618 * (hi - lo)
         b = lo + 0.618 * (hi - lo)
         if misfit(a) < misfit(b):
@@ -243,14 +264,8 @@ def _init_fisheye(views: list[tuple[Array, Array]], size: tuple[int, int], proje
     f_px = 0.5 * (lo + hi)
     eos = []
     for xyz, px in views:
-        n, theta = _normalised_rays(px, f_px, pp, projection)
-        ok = np.isfinite(theta) & (theta < _INIT_MAX_THETA)
-        if ok.sum() < 4:
-            ok = np.isfinite(theta) & (theta < math.radians(85.0))
-        good, rvec, tvec = cv2.solvePnP(xyz[ok], n[ok], np.eye(3), None)
-        if not good:
-            raise InputError("no initial pose for a view (its points are degenerate)")
-        eos.append(_cv_pose_to_eo(rvec, tvec))
+        rot, t, _ = _plane_pose(xyz[:, :2], _rays_cv(px, f_px, pp, projection))
+        eos.append(_cv_pose_to_eo(rot, t))
     return f_px, pp, np.array(eos)
 
 
@@ -363,7 +378,7 @@ def calibrate_camera(
         how = "OpenCV calibrateCamera (Zhang)"
     else:
         f_px, pp, eo0 = _init_fisheye(per_view, (width_px, height_px), opts.projection)
-        how = "focal-length search on plane homographies of the back-projected rays + solvePnP"
+        how = "focal-length search: plane DLT of the back-projected rays (Z = 0 target)"
     ps = float(pixel_size_mm)
     base = Camera(
         name, f_px * ps, ps, width_px, height_px,
