@@ -13,7 +13,6 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-
 from lidarphoto.core.geometry.camera import Camera
 from lidarphoto.core.geometry.collinearity import project
 from lidarphoto.core.io.calibration import read_image_grey
@@ -62,11 +61,11 @@ def charuco() -> list[str]:
     fld = target_field(spec)
     files = sorted((DATA / "aruco-markers" / "charuco-calibration").glob("img_*.jpg"))
     det = [detect_target(read_image_grey(p), spec, p.name) for p in files]
-    res, ours = _ours(fld, det, (640, 480), "perspective")
+    _, ours = _ours(fld, det, (640, 480), "perspective")
     obj = [fld.coordinates(d.ids).astype(np.float32) for d in det]
     img = [(d.pixels - 0.5).astype(np.float32) for d in det]
     t = time.perf_counter()
-    rms, k, dist, rv, tv, sd_int, _, _ = cv2.calibrateCameraExtended(obj, img, (640, 480), None,
+    rms, k, dist, _, _, sd_int, _, _ = cv2.calibrateCameraExtended(obj, img, (640, 480), None,
                                                                     None)  # fmt: skip
     dt = time.perf_counter() - t
     sd = sd_int.ravel()
@@ -102,7 +101,7 @@ def fisheye() -> list[str]:
     for proj in ("equidistant", "equisolid", "stereographic", "orthographic"):
         try:
             res, ours = _ours(fld, det, (640, 720), proj)
-        except Exception as exc:  # noqa: BLE001 - the bench reports every failure
+        except Exception as exc:
             rows.append(f"| ours {proj} | failed: {type(exc).__name__}: "
                         f"{str(exc)[:120]} | | | | |")  # fmt: skip
             continue

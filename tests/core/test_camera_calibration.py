@@ -8,13 +8,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from lidarphoto.core.errors import InputError, NotObservableError
 from lidarphoto.core.geometry.camera import Camera
 from lidarphoto.core.geometry.collinearity import collinearity_jacobians, image_rays, project
 from lidarphoto.core.geometry.distortion import BrownConrady
 from lidarphoto.core.geometry.projection import (
-    FISHEYE_PROJECTIONS,
     PROJECTIONS,
     ideal_from_camera,
     radius_factor,
@@ -43,7 +41,8 @@ def _camera(projection: str) -> Camera:
         return Camera("t", 1000 * PS, PS, 1280, 960, 0.02, -0.015,
                       BrownConrady(k1=-2e-3, k2=5e-5, p1=1e-4, p2=-5e-5))  # fmt: skip
     return Camera("t", 300 * PS, PS, 1280, 960, 0.02, -0.015,
-                  BrownConrady(k1=-1e-3, k2=2e-5, p1=1e-4, p2=-5e-5), projection=projection)  # fmt: skip
+                  BrownConrady(k1=-1e-3, k2=2e-5, p1=1e-4, p2=-5e-5),
+                  projection=projection)  # fmt: skip
 
 
 def _views(projection: str, n: int = 12, seed: int = 1, parallel: bool = False) -> np.ndarray:
@@ -222,7 +221,7 @@ def test_parallel_views_do_not_determine_the_focal_length():
     cam = _camera("perspective")
     fld = target_field(TargetSpec("chessboard", 9, 6, 0.05))
     det = simulate_views(cam, fld, _views("perspective", n=5, parallel=True), 0.0)
-    with pytest.raises(NotObservableError, match="views all parallel|not all parallel") as exc:
+    with pytest.raises(NotObservableError, match=r"not all parallel") as exc:
         calibrate_camera(fld, det, 1280, 960, PS, CalibrationOptions(
             lens_parameters=(), sigma_px=0.2))  # fmt: skip
     assert "focal_mm" in exc.value.parameters
@@ -276,7 +275,7 @@ def test_charuco_calibration_on_real_views_matches_opencv():
     res = calibrate_camera(fld, det, 640, 480, 0.003, CalibrationOptions(sigma_px=0.2))
     obj = [fld.coordinates(d.ids).astype(np.float32) for d in det]
     img = [(d.pixels - 0.5).astype(np.float32) for d in det]
-    rms, k, dist, _, _ = cv2.calibrateCamera(obj, img, (640, 480), None, None)
+    rms, k, _, _, _ = cv2.calibrateCamera(obj, img, (640, 480), None, None)
     # same RMS within 5 % (the two lens models differ: OpenCV distorts ideal points, ours
     # corrects measured ones)
     assert abs(res.rms_px - rms) < 0.05 * rms
