@@ -312,3 +312,30 @@ def test_fisheye_calibration_on_real_views_matches_boofcv():
     mei = 398.77492706579216 * x * (1 + k1 * x * x + k2 * x**4)
     ours = project(ray, [0, 0, 0, math.pi, 0, 0], res.camera)[:, 0] - cx
     assert np.max(np.abs(ours - mei)) < 3.0
+
+
+def test_perspective_only_algorithms_refuse_a_fisheye_camera():
+    """Their kernels are perspective-only: a fisheye camera is refused, never treated as a
+    perspective one (the readers of the jobs refuse it first, naming the file)."""
+    import inspect
+
+    from lidarphoto.core.photo.boresight import calibrate
+    from lidarphoto.core.photo.bundle import bundle_adjust
+    from lidarphoto.core.photo.monoplot import monoplot
+    from lidarphoto.core.photo.orthophoto import OrthoProjector
+    from lidarphoto.core.photo.resection import resect
+
+    cam = _camera("equisolid")
+    for func, who in ((monoplot, "monoplotting"), (resect, "the resection"),
+                      (calibrate, "the boresight calibration"),
+                      (bundle_adjust, "the bundle adjustment"),
+                      (OrthoProjector.build, "orthorectification")):  # fmt: skip
+        params = inspect.signature(func).parameters
+        kwargs = {n: None for n, p in params.items()
+                  if p.default is inspect.Parameter.empty and n not in ("self", "cls")}  # fmt: skip
+        if "cameras" in kwargs:
+            kwargs["cameras"] = [cam]
+        else:
+            kwargs["camera"] = cam
+        with pytest.raises(InputError, match=f"equisolid \\(fisheye\\) projection; {who} handles"):
+            func(**kwargs)
