@@ -36,7 +36,8 @@ the last row held in the plane Z = 0).
 
 Outputs: the camera JSON (usable by every algorithm; a fisheye camera is refused by those whose
 kernels are perspective-only), a report JSON (sigmas, correlations, sigma0, the t-test of every
-lens coefficient, per-view RMS and poses) and the residual table (CSV). PIXEL_SIZE only scales
+lens coefficient, per-view RMS and poses), the same as an HTML page, and the residual table
+(CSV). PIXEL_SIZE only scales
 the millimetre values of the camera file: the calibration itself is in pixels.""",
     params=(
         Param("IMAGES", "files", "Target images (files or folders)",
@@ -69,6 +70,8 @@ the millimetre values of the camera file: the calibration itself is in pixels.""
         Param("OUTPUT_CAMERA", "file_out", "Calibrated camera (JSON)", file_filter=JSON_FILTER),
         Param("OUTPUT_REPORT", "file_out", "Calibration report (JSON)", optional=True,
               create_by_default=False, file_filter=JSON_FILTER),
+        Param("OUTPUT_HTML", "file_out", "Calibration report (HTML)", optional=True,
+              create_by_default=False, file_filter="HTML files (*.html)"),
         Param("OUTPUT_RESIDUALS", "file_out", "Residuals per point (CSV)", optional=True,
               create_by_default=False, file_filter="CSV files (*.csv)"),
     ),
@@ -138,6 +141,16 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                                               "points": result.n_points}})  # fmt: skip
     if out.requested("OUTPUT_REPORT"):
         write_report_json(out.path("OUTPUT_REPORT"), result, extra)
+    if out.requested("OUTPUT_HTML"):
+        from ..io.atomic import write_text_atomic
+        from ..quality.calibration_html import render_calibration_html
+
+        settings = {"images": f"{len(images)} ({found} with the target)",
+                    "target": f"{spec.kind} {spec.cols} x {spec.rows}, spacing "
+                              f"{spec.spacing_m:g} m", "field": opts.field,
+                    "lens coefficients": ", ".join(opts.lens_parameters) or "none",
+                    "initial values": result.initial["method"]}  # fmt: skip
+        write_text_atomic(out.path("OUTPUT_HTML"), render_calibration_html(result, settings))
     if out.requested("OUTPUT_RESIDUALS"):
         write_residuals_csv(out.path("OUTPUT_RESIDUALS"), result)
     cam = result.camera

@@ -55,7 +55,7 @@ def test_processing_run_recovers_the_camera(provider, views, tmp_path):
         "IMAGES": [str(views)], "TARGET": 0, "COLUMNS": 9, "ROWS": 6, "SPACING": SQ_M,
         "LENS_PARAMETERS": [0, 1], "PIXEL_SIZE": 0.005, "OUTPUT_CAMERA": str(out),
         "OUTPUT_REPORT": str(tmp_path / "report.json"),
-        "OUTPUT_RESIDUALS": str(tmp_path / "res.csv"),
+        "OUTPUT_RESIDUALS": str(tmp_path / "res.csv"), "OUTPUT_HTML": str(tmp_path / "r.html"),
     })  # fmt: skip
     assert res["VIEW_COUNT"] == 8 and res["POINT_COUNT"] == 8 * 54
     assert res["RMS_PX"] < 0.1
@@ -67,6 +67,8 @@ def test_processing_run_recovers_the_camera(provider, views, tmp_path):
     report = json.loads((tmp_path / "report.json").read_text())
     assert report["parameters"] == ["focal_mm", "x0_mm", "y0_mm", "k1", "k2"]
     assert len(report["views"]) == 8
+    page = (tmp_path / "r.html").read_text()
+    assert "Camera calibration: camera (perspective)" in page and page.count("<tr") > 20
     lines = (tmp_path / "res.csv").read_text().splitlines()
     assert lines[0] == "image,point_id,col,row,v_col,v_row,w_col,w_row" and len(lines) == 433
 
