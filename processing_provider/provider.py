@@ -11,6 +11,7 @@ from qgis.PyQt.QtGui import QIcon
 from .algorithms.accuracy_report import AccuracyReportAlgorithm
 from .algorithms.boresight_calibration import BoresightCalibrationAlgorithm
 from .algorithms.bundle_adjustment import BundleAdjustmentAlgorithm
+from .algorithms.calibrate_camera import CalibrateCameraAlgorithm
 from .algorithms.create_lcps import CreateLcpsAlgorithm
 from .algorithms.extract_roof_planes import ExtractRoofPlanesAlgorithm
 from .algorithms.extract_tls_targets import ExtractTlsTargetsAlgorithm
@@ -65,5 +66,6 @@ class LidarPhotoProvider(QgsProcessingProvider):
             ExtractTlsTargetsAlgorithm(),
             LocateControlPointsAlgorithm(),
             LidarBlockAlgorithm(),
+            CalibrateCameraAlgorithm(),
         ):
             self.addAlgorithm(alg)

@@ -40,6 +40,7 @@ from .distortion import (
     as_points,
     distortion_from_dict,
 )
+from .projection import PROJECTIONS, ray_from_ideal
 
 Array = NDArray[np.float64]
 
@@ -98,6 +99,10 @@ class Camera:
     distortion : DistortionModel
         Lens correction (measured -> ideal), :class:`~core.geometry.distortion.NoDistortion` by
         default.
+    projection : str
+        ``"perspective"`` (default: the central projection ``r = f tan(theta)``) or a fisheye
+        projection of :mod:`core.geometry.projection` (``"equidistant"``, ``"equisolid"``,
+        ``"orthographic"``, ``"stereographic"``); the lens correction is added to any of them.
 
     Raises
     ------
@@ -121,6 +126,7 @@ class Camera:
     x0_mm: float = 0.0
     y0_mm: float = 0.0
     distortion: DistortionModel = field(default_factory=NoDistortion)
+    projection: str = "perspective"
 
     def __post_init__(self) -> None:
         """Validate and normalise the fields (raises :class:`InputError` naming the field)."""
@@ -136,12 +142,40 @@ class Camera:
         set_(self, "height_px", _check_size(self.height_px, who + "height_px"))
         set_(self, "x0_mm", _check_finite(self.x0_mm, who + "x0_mm"))
         set_(self, "y0_mm", _check_finite(self.y0_mm, who + "y0_mm"))
+        if self.projection not in PROJECTIONS:
+            raise InputError(
+                who + f"projection must be one of {', '.join(PROJECTIONS)}, "
+                f"got {self.projection!r}"
+            )
         if not isinstance(self.distortion, DistortionModel):
             raise InputError(
                 who + f"distortion must be a DistortionModel, got {type(self.distortion).__name__}"
             )
 
     # ------------------------------------------------------------------ derived values
+    @property
+    def is_perspective(self) -> bool:
+        """True for the central perspective projection (the default), False for a fisheye."""
+        return self.projection == "perspective"
+
+    def require_perspective(self, who: str, path: str | None = None) -> None:
+        """Raise :class:`InputError` naming ``who`` (and ``path``) for a fisheye camera.
+
+        For the algorithms whose kernels implement the perspective projection only: they must
+        refuse a fisheye camera rather than treat it as a perspective one.
+        """
+        if not self.is_perspective:
+            raise InputError(
+                f"camera {self.name!r} has the {self.projection} (fisheye) projection; "
+                f"{who} handles perspective cameras only",
+                path=path,
+            )
+
+    def ray_from_ideal(self, xy_ideal: ArrayLike) -> Array:
+        """Camera-frame rays (N, 3) of ideal centred coordinates (N, 2) mm (see
+        :func:`core.geometry.projection.ray_from_ideal`; ``(x, y, -f)`` for perspective)."""
+        return ray_from_ideal(xy_ideal, self.focal_mm, self.projection)
+
     @property
     def focal_px(self) -> float:
         """Principal distance in pixels, ``focal_mm / pixel_size_mm``."""
@@ -280,8 +314,11 @@ class Camera:
 
     # ------------------------------------------------------------------ files
     def to_dict(self) -> Dict[str, Any]:
-        """Return the camera as a JSON-ready dict in millimetres (the format of this module)."""
-        return {
+        """Return the camera as a JSON-ready dict in millimetres (the format of this module).
+
+        ``"projection"`` is written only for a fisheye camera (perspective is the default).
+        """
+        out: Dict[str, Any] = {
             "name": self.name,
             "focal_mm": self.focal_mm,
             "pixel_size_mm": self.pixel_size_mm,
@@ -291,6 +328,9 @@ class Camera:
             "y0_mm": self.y0_mm,
             "distortion": self.distortion.to_dict(),
         }
+        if not self.is_perspective:
+            out["projection"] = self.projection
+        return out
 
 
 #: Physical ranges of a camera file's values: a pixel of 0.5 um to 0.5 mm (scanned film), a
@@ -300,7 +340,9 @@ FOCAL_RANGE_MM = (1.0, 5000.0)
 MAX_IMAGE_SIDE_PX = 200_000
 _MM_KEYS = ("focal_mm", "x0_mm", "y0_mm")
 _PX_KEYS = ("focal_px", "ppx_px", "ppy_px")
-_KNOWN_KEYS = {"name", "pixel_size_mm", "width_px", "height_px", "distortion", "sigmas"}
+_KNOWN_KEYS = {
+    "name", "pixel_size_mm", "width_px", "height_px", "distortion", "sigmas", "projection",
+}  # fmt: skip
 _KNOWN_KEYS.update(_MM_KEYS, _PX_KEYS)
 
 
@@ -401,6 +443,10 @@ def camera_from_dict(data: Any, source: str | None = None, default_name: str = "
             raise fail(shown, f"the principal point ({value:g} mm from the image centre) lies "
                        f"outside the image ({half * pixel_size:g} mm to its edge)")  # fmt: skip
     distortion = distortion_from_dict(data.get("distortion", {}), source, "distortion")
-    return Camera(name, focal, pixel_size, width, height, x0, y0, distortion)
+    projection = data.get("projection", "perspective")
+    if projection not in PROJECTIONS:
+        raise fail("projection", f"unknown projection {projection!r} "
+                   f"(known: {', '.join(PROJECTIONS)})")  # fmt: skip
+    return Camera(name, focal, pixel_size, width, height, x0, y0, distortion, projection)
 
 

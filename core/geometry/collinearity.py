@@ -13,6 +13,9 @@ Conventions
 
       x_i = -f u / w,   y_i = -f v / w
 
+  for a perspective camera; a fisheye camera maps the angle off the axis instead
+  (:mod:`core.geometry.projection`), and "in front" then means inside its field of view
+
   the measured image coordinates are ``x0 + distort(x_i, y_i)`` (the inverse of the lens
   correction of :mod:`core.geometry.distortion`) and the pixel position is
   ``col = x / pixel_size + W/2``, ``row = H/2 - y / pixel_size`` (pixels as in
@@ -31,6 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .camera import DEFAULT_TOL_PX, Camera
 from .distortion import DEFAULT_MAX_ITER, as_points, inv2x2
+from .projection import ideal_from_camera
 from .rotations import opk_derivatives, opk_to_matrix
 
 Array = NDArray[np.float64]
@@ -67,14 +71,11 @@ def _to_camera_frame(points: ArrayLike, eo: ArrayLike) -> Tuple[Array, Array, Ar
     return e, d, m, q
 
 
-def _ideal(q: Array, focal_mm: float) -> Tuple[Array, NDArray[np.bool_]]:
-    """Ideal centred image coordinates (N, 2) mm from camera-frame vectors, and w < 0."""
-    w = q[:, 2]
-    in_front = w < 0.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ideal = -focal_mm * q[:, :2] / w[:, np.newaxis]
-    ideal[~in_front] = np.nan
-    return ideal, in_front
+def _ideal(q: Array, camera: Camera) -> Tuple[Array, NDArray[np.bool_]]:
+    """Ideal centred image coordinates (N, 2) mm from camera-frame vectors, and the mask of
+    the vectors the camera's projection images (w < 0 for a perspective camera)."""
+    ideal, valid = ideal_from_camera(q, camera.focal_mm, camera.projection)
+    return ideal, valid
 
 
 def project_with_status(
@@ -110,7 +111,7 @@ def project_with_status(
         see :meth:`core.geometry.camera.Camera.in_frame`.
     """
     _, _, _, q = _to_camera_frame(points, eo)
-    ideal, in_front = _ideal(q, camera.focal_mm)
+    ideal, in_front = _ideal(q, camera)
     pixels, converged = camera.pixel_from_ideal_with_status(ideal, tol_px=tol_px, max_iter=max_iter)
     return pixels, in_front, converged
 
@@ -153,7 +154,7 @@ def image_rays(pixels: ArrayLike, eo: ArrayLike, camera: Camera) -> Tuple[Array,
     ideal = camera.ideal_from_pixel(pixels)
     e = _eo_rows(eo, ideal.shape[0])
     m = opk_to_matrix(e[:, 3], e[:, 4], e[:, 5])
-    ray_c = np.column_stack([ideal, np.full(ideal.shape[0], -camera.focal_mm)])
+    ray_c = camera.ray_from_ideal(ideal)
     # M rotates object -> camera, so its transpose takes the camera-frame ray to object space.
     d = np.einsum("nji,nj->ni", m, ray_c)
     d /= np.linalg.norm(d, axis=1, keepdims=True)
@@ -229,7 +230,10 @@ def collinearity_jacobians(
         q = np.einsum("nij,nj->ni", rot, d)
     f = camera.focal_mm
     ps = camera.pixel_size_mm
-    ideal, in_front = _ideal(q, f)
+    if "eo" in wanted or "point" in wanted:
+        ideal, in_front, a = ideal_from_camera(q, f, camera.projection, jacobian=True)
+    else:
+        ideal, in_front = _ideal(q, camera)
     measured, converged = camera.measured_from_ideal(ideal, tol_px=tol_px, max_iter=max_iter)
     pixels = camera.image_to_pixel(measured + np.array([camera.x0_mm, camera.y0_mm]))
     out: Dict[str, Any] = {"pixels": pixels, "in_front": in_front, "converged": converged}
@@ -241,13 +245,6 @@ def collinearity_jacobians(
     sg[:, 1, :] /= -ps
 
     if "eo" in wanted or "point" in wanted:
-        u, v, w = q[:, 0], q[:, 1], q[:, 2]
-        a = np.zeros((n, 2, 3))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            a[:, 0, 0] = -f / w
-            a[:, 1, 1] = -f / w
-            a[:, 0, 2] = f * u / (w * w)
-            a[:, 1, 2] = f * v / (w * w)
         dpx_dq = sg @ a
         dpx_dpoint = dpx_dq @ rot
         if "point" in wanted:
@@ -267,7 +264,7 @@ def collinearity_jacobians(
     if "interior" in wanted:
         p = camera.distortion.n_params
         jac = np.empty((n, 2, 3 + p))
-        # i = -f (u, v) / w is linear in f, so di/df = i / f.
+        # every projection's ideal point (r = f g(theta)) is linear in f, so di/df = i / f.
         jac[:, :, 0] = np.einsum("nij,nj->ni", sg, ideal / f)
         jac[:, 0, 1], jac[:, 1, 1] = 1.0 / ps, 0.0
         jac[:, 0, 2], jac[:, 1, 2] = 0.0, -1.0 / ps

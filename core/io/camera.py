@@ -29,6 +29,13 @@ pixels a side, the principal point on the image) are refused: they are in anothe
 "k1": 1e-6}``, written by the bundle adjustment for its estimates) is informative and ignored
 on reading.
 
+``"projection"`` (optional, default ``"perspective"``) is the camera's projection:
+``"perspective"``, or one of the fisheye projections ``"equidistant"``, ``"equisolid"``,
+``"orthographic"``, ``"stereographic"`` (:mod:`core.geometry.projection`), each with the
+same lens correction added. Readers refuse a fisheye camera unless the caller states that
+it handles one (``projections=``): the algorithms whose kernels are perspective-only thus
+name the file instead of treating a fisheye as perspective.
+
 Several cameras (a block flown with more than one) are one file ``{"cameras": [camera, ...]}``
 (:func:`read_cameras_json`, :func:`write_cameras_json`); each camera's ``name`` then tells
 them apart.
@@ -66,8 +73,23 @@ def _load(path: Path) -> Any:
         raise InputError(f"invalid JSON: {exc}", path=str(path)) from exc
 
 
-def read_cameras_json(path: Union[str, Path]) -> list[Camera]:
-    """Read a file with one camera, or several as ``{"cameras": [...]}`` (unique names)."""
+def _check_projection(cam: Camera, path: Path, projections: Sequence[str]) -> Camera:
+    if cam.projection not in projections:
+        raise InputError(
+            f"camera {cam.name!r} has the {cam.projection} (fisheye) projection; this "
+            f"algorithm handles {' and '.join(projections)} cameras only",
+            path=str(path),
+        )
+    return cam
+
+
+def read_cameras_json(
+    path: Union[str, Path], projections: Sequence[str] = ("perspective",)
+) -> list[Camera]:
+    """Read a file with one camera, or several as ``{"cameras": [...]}`` (unique names).
+
+    ``projections``: the projections the caller handles (others raise :class:`InputError`).
+    """
     path = Path(path)
     data = _load(path)
     if isinstance(data, Mapping) and "cameras" in data:
@@ -82,12 +104,14 @@ def read_cameras_json(path: Union[str, Path]) -> list[Camera]:
             )
             for i, item in enumerate(items)
         ]  # fmt: skip
+        for cam in cams:
+            _check_projection(cam, path, projections)
         names = [c.name for c in cams]
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup:
             raise InputError(f"two cameras are named {dup[0]!r}", path=str(path))
         return cams
-    return [read_camera_json(path)]
+    return [read_camera_json(path, projections)]
 
 
 def write_cameras_json(
@@ -110,8 +134,12 @@ def write_cameras_json(
     write_text_atomic(path, json.dumps(data, indent=2, allow_nan=False) + "\n")
 
 
-def read_camera_json(path: Union[str, Path]) -> Camera:
+def read_camera_json(
+    path: Union[str, Path], projections: Sequence[str] = ("perspective",)
+) -> Camera:
     """Read a camera JSON file (format in the module docstring).
+
+    ``projections``: the projections the caller handles (others raise :class:`InputError`).
 
     Raises
     ------
@@ -136,7 +164,8 @@ def read_camera_json(path: Union[str, Path]) -> Camera:
         ) from exc
     except ValueError as exc:
         raise InputError(f"invalid JSON: {exc}", path=str(path)) from exc
-    return camera_from_dict(data, source=str(path), default_name=path.stem)
+    cam = camera_from_dict(data, source=str(path), default_name=path.stem)
+    return _check_projection(cam, path, projections)
 
 
 def write_camera_json(path: Union[str, Path], camera: Camera) -> None:

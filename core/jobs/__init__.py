@@ -5,6 +5,7 @@ from . import (
     accuracy_report,
     boresight_calibration,
     bundle_adjustment,
+    calibrate_camera,
     create_lcps,
     extract_roof_planes,
     extract_tls_targets,
@@ -36,4 +37,5 @@ ALGORITHMS = (
     extract_tls_targets,
     locate_control_points,
     lidar_block,
+    calibrate_camera,
 )

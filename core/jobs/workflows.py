@@ -74,6 +74,8 @@ WORKFLOWS: tuple[Workflow, ...] = (
     Workflow(
         "Aerial triangulation and orthophotos",
         (
+            ("calibratecamera", "IMAGES = views of a chessboard or ChArUco target; "
+             "OUTPUT_CAMERA = the camera JSON (start values for the block, or held fixed)"),
             ("locatecontrolpoints", "CHIPS = one GeoTIFF chip per control point, "
              "CONTROL_POINTS, CAMERA, approximate EO, IMAGES; OUTPUT = the control points' "
              "image observations, without clicking them"),

@@ -386,6 +386,7 @@ def monoplot(
     MonoplotResult
         With ``dsm`` the surface actually used (in ``crs``).
     """
+    camera.require_perspective("monoplotting")
     from ..geometry.frames import MappingFrame, parse_crs
 
     if method not in METHODS:

@@ -339,6 +339,7 @@ class OrthoProjector:
         lens : optional
             A lens lattice of the same camera (:func:`_lens_lattice`), to share between images.
         """
+        camera.require_perspective("orthorectification")
         tracer = dsm if isinstance(dsm, DsmTracer) else None
         surface = tracer.dsm if tracer is not None else dsm
         zr = (tracer.zmin, tracer.zmax) if tracer is not None else surface.z_range

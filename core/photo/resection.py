@@ -584,6 +584,7 @@ def resect(
     >>> bool(np.allclose(res.eo, eo, atol=1e-6)), res.redundancy
     (True, 6)
     """
+    camera.require_perspective("the resection")
     from scipy import stats
 
     opts = options if options is not None else ResectionOptions()

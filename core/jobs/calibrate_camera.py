@@ -1,0 +1,170 @@
+"""``calibratecamera``: camera calibration from images of a chessboard, ChArUco or ArUco target."""
+
+from __future__ import annotations
+
+from ..geometry.projection import PROJECTIONS
+from ..photo.calibration_targets import DICTIONARIES, TARGET_KINDS
+from ..photo.camera_calibration import FIELD_MODES, LENS_NAMES, CalibrationOptions
+from .runner import JobResult
+from .spec import AlgorithmSpec, Param, Result, Values
+
+_D = CalibrationOptions()
+JSON_FILTER = "JSON files (*.json)"
+
+SPEC = AlgorithmSpec(
+    name="calibratecamera",
+    title="Calibrate a camera from target images",
+    group="Photogrammetry",
+    group_id="photogrammetry",
+    summary="Interior orientation and lens distortion (perspective or fisheye) from views of "
+    "a planar target",
+    description="""\
+Detects a planar target in every image of a folder with OpenCV (chessboard:
+findChessboardCornersSB; ChArUco: CharucoDetector; ArUco grid board: ArucoDetector with
+sub-pixel corners) and calibrates the camera with the project's own least-squares adjustment:
+a self-calibrating bundle with one pose per view, the interior orientation f, x0, y0 and the
+Brown-Conrady coefficients k1 k2 k3 p1 p2 (any subset), for the perspective projection or a
+fisheye projection (equidistant, equisolid-angle, orthographic, stereographic; Schneider,
+Schwalbe & Maas 2009) with the Brown correction added.
+
+Target: chessboard COLUMNS x ROWS inner corners, SPACING the square side; ChArUco COLUMNS x ROWS
+squares, SPACING the square side, MARKER the marker side; ArUco grid board COLUMNS x ROWS
+markers, SPACING the marker side, MARKER the gap between markers. The field is fixed (its
+nominal coordinates) or free (estimated; datum: the origin corner and the end of the first row
+held at their nominal coordinates, which sets the scale from the square size, and the start of
+the last row held in the plane Z = 0).
+
+Outputs: the camera JSON (usable by every algorithm; a fisheye camera is refused by those whose
+kernels are perspective-only), a report JSON (sigmas, correlations, sigma0, the t-test of every
+lens coefficient, per-view RMS and poses), the same as an HTML page, and the residual table
+(CSV). PIXEL_SIZE only scales
+the millimetre values of the camera file: the calibration itself is in pixels.""",
+    params=(
+        Param("IMAGES", "files", "Target images (files or folders)",
+              help="image files, or folders whose images are all taken"),
+        Param("TARGET", "enum", "Target", TARGET_KINDS[0], options=TARGET_KINDS,
+              labels=("chessboard", "ChArUco board", "ArUco grid board")),
+        Param("COLUMNS", "integer", "Columns (inner corners / squares / markers)", 9,
+              minimum=2, maximum=200),
+        Param("ROWS", "integer", "Rows (inner corners / squares / markers)", 6, minimum=2,
+              maximum=200),
+        Param("SPACING", "number", "Square side (ArUco: marker side)", 0.025, unit="m",
+              minimum=1e-4, maximum=10.0),
+        Param("MARKER", "number", "ChArUco marker side / ArUco gap", 0.0, unit="m",
+              minimum=0.0, maximum=10.0),
+        Param("DICTIONARY", "enum", "ArUco dictionary", "DICT_6X6_250", options=DICTIONARIES),
+        Param("PROJECTION", "enum", "Projection", _D.projection, options=PROJECTIONS,
+              labels=("perspective (central)", "fisheye: equidistant",
+                      "fisheye: equisolid-angle", "fisheye: orthographic",
+                      "fisheye: stereographic")),
+        Param("LENS_PARAMETERS", "enum", "Lens coefficients estimated", _D.lens_parameters,
+              options=LENS_NAMES, multiple=True,
+              help="Brown-Conrady coefficients; the others are held at zero"),
+        Param("FIELD", "enum", "Target field", _D.field, options=FIELD_MODES,
+              labels=("fixed (nominal coordinates)", "free (estimated, minimal datum)")),
+        Param("PIXEL_SIZE", "number", "Pixel size", 0.003, unit="mm", minimum=0.0005,
+              maximum=0.5),
+        Param("SIGMA_PX", "number", "A-priori sigma of a detected point", _D.sigma_px,
+              unit="px", minimum=0.001, maximum=10.0),
+        Param("CAMERA_NAME", "string", "Camera name", "camera"),
+        Param("OUTPUT_CAMERA", "file_out", "Calibrated camera (JSON)", file_filter=JSON_FILTER),
+        Param("OUTPUT_REPORT", "file_out", "Calibration report (JSON)", optional=True,
+              create_by_default=False, file_filter=JSON_FILTER),
+        Param("OUTPUT_HTML", "file_out", "Calibration report (HTML)", optional=True,
+              create_by_default=False, file_filter="HTML files (*.html)"),
+        Param("OUTPUT_RESIDUALS", "file_out", "Residuals per point (CSV)", optional=True,
+              create_by_default=False, file_filter="CSV files (*.csv)"),
+    ),
+    results=(
+        Result("VIEW_COUNT", "number", "Views used"),
+        Result("POINT_COUNT", "number", "Target points used"),
+        Result("RMS_PX", "number", "Reprojection RMS (px)"),
+        Result("SIGMA0", "number", "Sigma0 (a-priori 1)"),
+        Result("FOCAL_PX", "number", "Focal length (px)"),
+    ),
+    tags=("camera calibration", "fisheye", "chessboard", "charuco", "aruco", "brown",
+          "self-calibration", "interior orientation"),
+    references=("Schneider, Schwalbe & Maas (2009)", "Brown (1971)", "Zhang (2000)",
+                "Garrido-Jurado et al. (2014)"),
+)  # fmt: skip
+
+
+def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
+    """Read the images, detect the target, calibrate, write the camera, report and residuals."""
+    from ..errors import InputError, stop_if_asked
+    from ..io.calibration import read_image_grey, write_report_json, write_residuals_csv
+    from ..io.camera import write_cameras_json
+    from ..photo.calibration_targets import TargetSpec, detect_target, target_field
+    from ..photo.camera_calibration import calibrate_camera
+    from .orthorectify import list_images
+    from .runner import stages
+
+    spec = TargetSpec(v.target, int(v.columns), int(v.rows), v.spacing, v.marker,
+                      v.dictionary)  # fmt: skip
+    opts = CalibrationOptions(projection=v.projection, lens_parameters=tuple(v.lens_parameters),
+                              field=v.field, sigma_px=v.sigma_px)  # fmt: skip
+    fld = target_field(spec)
+    images = list_images(v.images)
+    detect, adjust = stages(progress, 0.7, 0.3)
+    detections, size = [], None
+    for i, path in enumerate(images):
+        stop_if_asked(should_stop, "detecting the target")
+        img = read_image_grey(path)
+        shape = (img.shape[1], img.shape[0])
+        if size is None:
+            size = shape
+        elif shape != size:
+            raise InputError(f"image size {shape[0]} x {shape[1]} differs from that of the "
+                             f"first image ({size[0]} x {size[1]}): one camera, one size",
+                             path=str(path))  # fmt: skip
+        detections.append(detect_target(img, spec, path.name))
+        if detect:
+            detect((i + 1) / len(images))
+    found = sum(d.ids.size > 0 for d in detections)
+    if found == 0:
+        raise InputError(f"the {v.target} target ({v.columns} x {v.rows}) was found in none "
+                         f"of the {len(images)} images")  # fmt: skip
+    result = calibrate_camera(fld, detections, size[0], size[1], v.pixel_size, opts,
+                              name=v.camera_name, progress=adjust,
+                              should_stop=should_stop)  # fmt: skip
+    missing = [d.image for d in detections if d.ids.size == 0]
+    if missing:
+        result.warnings.insert(0, f"target not found in {len(missing)} image(s): "
+                               + ", ".join(missing))  # fmt: skip
+    extra = {"target": {"kind": spec.kind, "columns": spec.cols, "rows": spec.rows,
+                        "spacing_m": spec.spacing_m, "marker_m": spec.marker_m,
+                        "dictionary": spec.dictionary if spec.kind != "chessboard" else None},
+             "field": opts.field, "images": len(images), "images_with_target": found}
+    write_cameras_json(out.path("OUTPUT_CAMERA"), [result.camera], sigmas=[result.sigmas],
+                       extra={"calibration": {"rms_px": result.rms_px, "sigma0": result.sigma0,
+                                              "views": len(result.view_names),
+                                              "points": result.n_points}})  # fmt: skip
+    if out.requested("OUTPUT_REPORT"):
+        write_report_json(out.path("OUTPUT_REPORT"), result, extra)
+    if out.requested("OUTPUT_HTML"):
+        from ..io.atomic import write_text_atomic
+        from ..quality.calibration_html import render_calibration_html
+
+        settings = {"images": f"{len(images)} ({found} with the target)",
+                    "target": f"{spec.kind} {spec.cols} x {spec.rows}, spacing "
+                              f"{spec.spacing_m:g} m", "field": opts.field,
+                    "lens coefficients": ", ".join(opts.lens_parameters) or "none",
+                    "initial values": result.initial["method"]}  # fmt: skip
+        write_text_atomic(out.path("OUTPUT_HTML"), render_calibration_html(result, settings))
+    if out.requested("OUTPUT_RESIDUALS"):
+        write_residuals_csv(out.path("OUTPUT_RESIDUALS"), result)
+    cam = result.camera
+    ppx, ppy = cam.principal_point_px
+    s = result.sigmas
+    lines = [
+        f"{len(result.view_names)} views ({found} of {len(images)} images with the target), "
+        f"{result.n_points} points; RMS {result.rms_px:.3f} px, sigma0 {result.sigma0:.3f}",
+        f"{cam.projection}: f {cam.focal_px:.3f} +- {s['focal_mm'] / cam.pixel_size_mm:.3f} px, "
+        f"principal point ({ppx:.2f}, {ppy:.2f}) px",
+        *result.warnings,
+    ]
+    return JobResult(
+        results={"VIEW_COUNT": len(result.view_names), "POINT_COUNT": result.n_points,
+                 "RMS_PX": result.rms_px, "SIGMA0": result.sigma0, "FOCAL_PX": cam.focal_px},
+        lines=lines, data=result,
+    )  # fmt: skip

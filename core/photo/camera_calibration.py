@@ -1,0 +1,560 @@
+"""Camera calibration from views of a planar target: a self-calibrating bundle adjustment.
+
+Model
+-----
+Every detected target point (col, row) in view ``j`` is a Gauss-Markov observation of the
+collinearity equations (:func:`core.geometry.collinearity.collinearity_jacobians`) of the
+camera's projection (perspective, or a fisheye projection of :mod:`core.geometry.projection`)
+with the Brown-Conrady lens correction added (:class:`core.geometry.distortion.BrownConrady`:
+``ideal = measured + d(measured)``). Unknowns:
+
+- the interior orientation ``f, x0, y0`` (mm) and the lens coefficients ``k1 k2 k3 p1 p2``
+  (any subset may be held at zero);
+- one exterior orientation ``X0 Y0 Z0 omega phi kappa`` per view, in the target's frame;
+- with a *free* field, the coordinates of the target points as well.
+
+Datum: a *fixed* field (its nominal coordinates taken as exact) defines position, orientation
+and scale. A *free* field is given the minimal datum of seven conditions: the origin point
+and a second point along the first row (X axis) are held at their nominal coordinates (six:
+position, two rotations and the scale from their nominal distance, i.e. the printed square
+size), and a third point off that line is held in the plane ``Z = 0`` (the rotation about
+the first row). The interior orientation does not depend on the datum; the free field
+absorbs a target that is not flat or not printed to scale (the scale then rests on one
+distance).
+
+Initial values: the perspective projection from OpenCV's ``calibrateCamera`` (Zhang's
+homography method); a fisheye projection from a search of the focal length that makes each
+view's back-projected rays closest to those of a plane seen by a central camera (the DLT of
+``ray ~ H (X, Y, 1)``, valid beyond 90 degrees off the axis; a wrong focal length bends the
+grid's lines), the poses from those ``H``. The lens coefficients start at zero.
+
+Statistics: sigma0 and the global test, standard deviations, the correlation matrix of the
+interior orientation, per-view RMS residuals (``sqrt(sum(vcol^2 + vrow^2) / points)``,
+OpenCV's definition of the reprojection error), Baarda's standardised residuals, and the
+significance of every lens coefficient (Student's t-test of the value over its standard
+deviation, the redundancy as the degrees of freedom).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import stats
+
+from ..errors import InputError, NotObservableError
+from ..geometry.camera import Camera
+from ..geometry.collinearity import collinearity_jacobians
+from ..geometry.distortion import BrownConrady
+from ..geometry.projection import PROJECTIONS, ray_from_ideal
+from ..geometry.rotations import matrix_to_opk
+from ..lsq.adjustment import adjust
+from ..lsq.model import AdjustmentOptions, GaussMarkovBlock
+from ..lsq.results import AdjustmentResult
+from .calibration_targets import Detection, TargetField
+
+Array = NDArray[np.float64]
+
+INTERIOR_NAMES = ("focal_mm", "x0_mm", "y0_mm", "k1", "k2", "k3", "p1", "p2")
+LENS_NAMES = INTERIOR_NAMES[3:]
+FIELD_MODES = ("fixed", "free")
+# Points a view needs for its own pose (6 unknowns) with some redundancy.
+MIN_POINTS_PER_VIEW = 6
+
+
+@dataclass(frozen=True)
+class CalibrationOptions:
+    """Options of :func:`calibrate_camera`.
+
+    Attributes
+    ----------
+    projection : str
+        ``"perspective"`` or a fisheye projection (:data:`core.geometry.projection.PROJECTIONS`).
+    lens_parameters : tuple of str
+        Lens coefficients to estimate (the others are held at zero), of
+        ``k1 k2 k3 p1 p2``.
+    field : {"fixed", "free"}
+        Target coordinates as given (fixed) or estimated with a minimal datum (free).
+    sigma_px : float
+        A-priori standard deviation of a detected point, pixels (each coordinate).
+    alpha : float
+        Significance level of the t-tests of the lens coefficients.
+    max_iterations : int
+        Of the adjustment.
+    """
+
+    projection: str = "perspective"
+    lens_parameters: tuple[str, ...] = LENS_NAMES
+    field: str = "fixed"
+    sigma_px: float = 0.2
+    alpha: float = 0.05
+    max_iterations: int = 100
+
+    def __post_init__(self) -> None:
+        """Check the choices (raises :class:`InputError`)."""
+        if self.projection not in PROJECTIONS:
+            raise InputError(f"projection must be one of {', '.join(PROJECTIONS)}, "
+                             f"got {self.projection!r}")  # fmt: skip
+        bad = [p for p in self.lens_parameters if p not in LENS_NAMES]
+        if bad:
+            raise InputError(f"unknown lens parameter(s) {bad}: use some of {list(LENS_NAMES)}")
+        if self.field not in FIELD_MODES:
+            raise InputError(f"field must be fixed or free, got {self.field!r}")
+        if not self.sigma_px > 0:
+            raise InputError(f"sigma_px must be positive, got {self.sigma_px}")
+
+
+@dataclass
+class CalibrationResult:
+    """Estimates and statistics of a camera calibration.
+
+    Attributes
+    ----------
+    camera : Camera
+        The calibrated camera (Brown-Conrady lens model, the chosen projection).
+    sigmas : dict of str to float
+        A-posteriori standard deviations of the estimated interior parameters (mm, per mm^n).
+    parameter_names : list of str
+        Names of the estimated interior parameters (rows of ``correlation``).
+    correlation : ndarray (p, p)
+        Their correlation matrix.
+    t_values, significant : dict of str to float / bool
+        t-test of every estimated lens coefficient.
+    t_critical : float
+    sigma0 : float
+        A-posteriori standard deviation of unit weight (a-priori 1: the observations'
+        sigma is ``sigma_px``, so ``sigma0 * sigma_px`` is the a-posteriori point sigma, px).
+    sigma0_prior, redundancy, n_points, iterations, condition_number
+    rms_px : float
+        Reprojection RMS over all points (OpenCV's definition, see the module docstring).
+    view_names : list of str
+    view_rms_px : ndarray (V,)
+    view_points : ndarray (V,) of int
+    eo : ndarray (V, 6)
+        Pose of each view in the target frame: X0 Y0 Z0 (m), omega phi kappa (rad).
+    eo_sigma : ndarray (V, 6)
+    residuals : list of tuple
+        ``(view, point_id, col, row, v_col, v_row, w_col, w_row)`` per observation, pixels.
+    field_xyz : ndarray (M, 3)
+        Target coordinates after the adjustment (the nominal ones for a fixed field).
+    field_ids : ndarray (M,)
+    initial : dict
+        Initial values (focal_px, principal point) and how they were found.
+    adjustment : AdjustmentResult
+    warnings : list of str
+    sigma_px : float
+        The a-priori sigma of a detected point, pixels.
+    projection : str
+    """
+
+    camera: Camera
+    sigmas: dict[str, float]
+    parameter_names: list[str]
+    correlation: Array
+    t_values: dict[str, float]
+    significant: dict[str, bool]
+    t_critical: float
+    sigma0: float
+    sigma0_prior: float
+    redundancy: int
+    n_points: int
+    iterations: int
+    condition_number: float
+    rms_px: float
+    view_names: list[str]
+    view_rms_px: Array
+    view_points: NDArray[np.int64]
+    eo: Array
+    eo_sigma: Array
+    residuals: list[tuple]
+    field_xyz: Array
+    field_ids: NDArray[np.int64]
+    initial: dict
+    adjustment: AdjustmentResult
+    warnings: list[str] = field(default_factory=list)
+    sigma_px: float = 0.0
+    projection: str = "perspective"
+
+
+# ----------------------------------------------------------------------------- initial values
+def _cv_pose_to_eo(rvec: Array, tvec: Array) -> Array:
+    """OpenCV pose (rotation vector or matrix; camera x right, y down, z forward) -> EO in
+    the target frame (the project's camera: x right, y up, looking along -z)."""
+    import cv2
+
+    r = np.asarray(rvec, dtype=np.float64)
+    r_cv = r if r.shape == (3, 3) else cv2.Rodrigues(r.reshape(3))[0]
+    m = np.diag([1.0, -1.0, -1.0]) @ r_cv
+    centre = -r_cv.T @ np.asarray(tvec, dtype=np.float64).reshape(3)
+    om, ph, ka = matrix_to_opk(m)
+    return np.array([*centre, float(om), float(ph), float(ka)])
+
+
+def _rays_cv(px: Array, f_px: float, pp: Array, projection: str) -> Array:
+    """Pixels -> unit rays in OpenCV's camera frame (x right, y down, z forward) with the given
+    focal length and principal point and no lens correction; NaN outside the projection."""
+    xy = np.column_stack([px[:, 0] - pp[0], pp[1] - px[:, 1]])  # y up, pixels
+    ray = ray_from_ideal(xy, f_px, projection)  # the project's frame, looking along -z
+    ray = ray * np.array([1.0, -1.0, -1.0])
+    return ray / np.linalg.norm(ray, axis=1, keepdims=True)
+
+
+def _plane_pose(xy: Array, rays: Array) -> tuple[Array, Array, float]:
+    """Pose of a plane (points ``xy`` (N, 2) in Z = 0) seen along unit ``rays`` (N, 3):
+    the DLT of ``ray ~ H (X, Y, 1)`` (valid for rays beyond 90 degrees off the axis, unlike
+    a homography of image points), ``H = [r1 r2 t]``. Returns R, t (OpenCV frame) and the RMS
+    angle (rad) between the rays and ``H x``."""
+    c = xy.mean(axis=0)
+    s = math.sqrt(2.0) / max(float(np.mean(np.linalg.norm(xy - c, axis=1))), 1e-12)
+    t_norm = np.array([[s, 0, -s * c[0]], [0, s, -s * c[1]], [0, 0, 1.0]])
+    x = np.column_stack([xy, np.ones(len(xy))]) @ t_norm.T
+    zero = np.zeros_like(x)
+    rx, ry, rz = rays[:, :1], rays[:, 1:2], rays[:, 2:3]
+    # rows of ray x (H x) = 0: two independent per point
+    a = np.vstack([np.hstack([zero, -rz * x, ry * x]), np.hstack([rz * x, zero, -rx * x])])
+    h = np.linalg.svd(a)[2][-1].reshape(3, 3) @ t_norm
+    hx = np.column_stack([xy, np.ones(len(xy))]) @ h.T
+    if np.sum(np.sum(hx * rays, axis=1) > 0) < 0.5 * len(xy):
+        h, hx = -h, -hx
+    cosang = np.sum(hx * rays, axis=1) / np.linalg.norm(hx, axis=1)
+    misfit = float(np.sqrt(np.mean(np.arccos(np.clip(cosang, -1.0, 1.0)) ** 2)))
+    lam = 2.0 / (np.linalg.norm(h[:, 0]) + np.linalg.norm(h[:, 1]))
+    r1, r2 = lam * h[:, 0], lam * h[:, 1]
+    u, _, vt = np.linalg.svd(np.column_stack([r1, r2, np.cross(r1, r2)]))
+    rot = u @ vt
+    if np.linalg.det(rot) < 0:
+        rot = u @ np.diag([1.0, 1.0, -1.0]) @ vt
+    return rot, lam * h[:, 2], misfit
+
+
+def _init_fisheye(views: list[tuple[Array, Array]], size: tuple[int, int], projection: str):
+    """Focal length (px) whose back-projected rays make every view closest to a plane seen by
+    a central camera (a wrong focal length bends the grid's lines), and the views' poses."""
+    w, h = size
+    pp = np.array([0.5 * w, 0.5 * h])
+
+    def misfit(f_px: float) -> float:
+        total = 0.0
+        for xyz, px in views:
+            rays = _rays_cv(px, f_px, pp, projection)
+            ok = np.isfinite(rays).all(axis=1)
+            if ok.sum() < len(px):  # a point outside the projection: f too small
+                return np.inf
+            total += _plane_pose(xyz[:, :2], rays)[2] ** 2
+        return total
+
+    diag = math.hypot(w, h)
+    grid = np.geomspace(0.05 * diag, 2.0 * diag, 60)
+    costs = np.array([misfit(f) for f in grid])
+    if not np.isfinite(costs).any():
+        raise InputError(f"no focal length puts every target point inside the {projection} "
+                         "projection's image (a wider projection may fit)")  # fmt: skip
+    k = int(np.argmin(costs))
+    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+    for _ in range(40):  # golden-section refinement within the bracket
+        a = hi - 0.618 * (hi - lo)
+        b = lo + 0.618 * (hi - lo)
+        if misfit(a) < misfit(b):
+            hi = b
+        else:
+            lo = a
+    f_px = 0.5 * (lo + hi)
+    eos = []
+    for xyz, px in views:
+        rot, t, _ = _plane_pose(xyz[:, :2], _rays_cv(px, f_px, pp, projection))
+        eos.append(_cv_pose_to_eo(rot, t))
+    return f_px, pp, np.array(eos)
+
+
+def _init_perspective(views: list[tuple[Array, Array]], size: tuple[int, int]):
+    import cv2
+
+    obj = [xyz.astype(np.float32) for xyz, _ in views]
+    img = [(px - 0.5).astype(np.float32) for _, px in views]  # OpenCV pixel centres
+    _, k, _, rvecs, tvecs = cv2.calibrateCamera(obj, img, size, None, None)
+    f_px = 0.5 * (k[0, 0] + k[1, 1])
+    pp = np.array([k[0, 2] + 0.5, k[1, 2] + 0.5])
+    eos = np.array([_cv_pose_to_eo(r, t) for r, t in zip(rvecs, tvecs)])
+    return f_px, pp, eos
+
+
+# ----------------------------------------------------------------------------- model
+class _ViewModel:
+    """Collinearity of one block of observations: x_local = [eo (6), interior (p), point (3)?]."""
+
+    def __init__(self, base: Camera, free: NDArray[np.intp], view: NDArray[np.intp],
+                 const_xyz: Array | None) -> None:  # fmt: skip
+        self.base = base
+        self.free = free
+        self.const_xyz = const_xyz
+        _, self.first, inv = np.unique(view, return_index=True, return_inverse=True)
+        self.inv = np.asarray(inv).ravel()
+
+    def __call__(self, xl: Array) -> tuple[Array, Array]:
+        p = self.free.size
+        full = self.base.interior_params
+        full[self.free] = xl[0, 6 : 6 + p]
+        cam = self.base.with_interior(full)
+        xyz = self.const_xyz if self.const_xyz is not None else xl[:, 6 + p : 9 + p]
+        wrt = ("eo", "interior") if self.const_xyz is not None else ("eo", "interior", "point")
+        out = collinearity_jacobians(xyz, xl[self.first, :6], cam, wrt=wrt, image_index=self.inv)
+        parts = [out["eo"], out["interior"][:, :, self.free]]
+        if self.const_xyz is None:
+            parts.append(out["point"])
+        return out["pixels"], np.concatenate(parts, axis=2)
+
+
+def _flat(detections: Sequence[Detection], fld: TargetField):
+    lookup = {int(i): k for k, i in enumerate(fld.ids)}
+    views, pts, pxs, names = [], [], [], []
+    for det in detections:
+        known = np.array([int(i) in lookup for i in det.ids], dtype=bool)
+        if known.sum() < MIN_POINTS_PER_VIEW:
+            continue
+        names.append(det.image)
+        j = len(names) - 1
+        views.append(np.full(int(known.sum()), j))
+        pts.append(np.array([lookup[int(i)] for i in det.ids[known]], dtype=np.intp))
+        pxs.append(det.pixels[known])
+    if not names:
+        raise InputError(f"no view has the {MIN_POINTS_PER_VIEW} target points a pose needs")
+    return np.concatenate(views), np.concatenate(pts), np.concatenate(pxs), names
+
+
+def calibrate_camera(
+    fld: TargetField,
+    detections: Sequence[Detection],
+    width_px: int,
+    height_px: int,
+    pixel_size_mm: float,
+    options: CalibrationOptions | None = None,
+    name: str = "camera",
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> CalibrationResult:
+    """Calibrate a camera from detections of a planar target (see the module docstring).
+
+    Parameters
+    ----------
+    fld : TargetField
+        The target's points (ids, nominal coordinates in metres).
+    detections : sequence of Detection
+        Per view, the ids and pixel positions (project convention) found; views with fewer
+        than :data:`MIN_POINTS_PER_VIEW` known points are left out (named in the warnings).
+    width_px, height_px : int
+        Image size.
+    pixel_size_mm : float
+        Pixel pitch; it only scales the millimetre values (the calibration is in pixels).
+    options : CalibrationOptions
+    name : str
+        Name of the calibrated camera.
+
+    Raises
+    ------
+    InputError
+        Too few usable views or points, inconsistent detections.
+    NotObservableError
+        A parameter the views cannot determine (e.g. the focal length and the decentring from
+        views all parallel to the target, or too few views); the message names it.
+    """
+    opts = options or CalibrationOptions()
+    view, pt, px, names = _flat(detections, fld)
+    skipped = [d.image for d in detections if d.image not in names]
+    warnings = [f"view {s!r} left out: fewer than {MIN_POINTS_PER_VIEW} target points"
+                for s in skipped]  # fmt: skip
+    n_views = len(names)
+    if n_views < 2:
+        raise NotObservableError(
+            f"camera calibration needs at least 2 views of the target (3 or more, tilted in "
+            f"different directions, to determine f, x0, y0 and the decentring); got {n_views}",
+            parameters=["focal_mm", "x0_mm", "y0_mm"],
+        )
+    per_view = [(fld.xyz[pt[view == j]], px[view == j]) for j in range(n_views)]
+    if opts.projection == "perspective":
+        f_px, pp, eo0 = _init_perspective(per_view, (width_px, height_px))
+        how = "OpenCV calibrateCamera (Zhang)"
+    else:
+        f_px, pp, eo0 = _init_fisheye(per_view, (width_px, height_px), opts.projection)
+        how = "focal-length search: plane DLT of the back-projected rays (Z = 0 target)"
+    ps = float(pixel_size_mm)
+    base = Camera(
+        name, f_px * ps, ps, width_px, height_px,
+        x0_mm=(pp[0] - 0.5 * width_px) * ps, y0_mm=(0.5 * height_px - pp[1]) * ps,
+        distortion=BrownConrady(), projection=opts.projection,
+    )  # fmt: skip
+    initial = {"focal_px": float(f_px), "ppx_px": float(pp[0]), "ppy_px": float(pp[1]),
+               "method": how}  # fmt: skip
+    free_io = np.array([0, 1, 2] + [3 + LENS_NAMES.index(p) for p in LENS_NAMES
+                                    if p in opts.lens_parameters], dtype=np.intp)  # fmt: skip
+    io_names = [INTERIOR_NAMES[i] for i in free_io]
+    n_io = free_io.size
+    # parameter vector: [interior (n_io), eo (6 V), free points (3 each)]
+    x0 = [base.interior_params[free_io], eo0.ravel()]
+    pnames = list(io_names)
+    pnames += [f"{n}:{p}" for n in names for p in ("X0", "Y0", "Z0", "omega", "phi", "kappa")]
+    seen = np.unique(pt)
+    if opts.field == "free":
+        datum = [int(np.flatnonzero(fld.ids == d)[0]) for d in fld.datum]
+        if not np.isin(datum, seen).all():
+            raise InputError("a free target field needs its datum points (origin, end of the "
+                             "first row, start of the last row) seen in some view")  # fmt: skip
+        fixed_pts = set(datum[:2])
+        free_pts = [int(k) for k in seen if int(k) not in fixed_pts]
+    else:
+        free_pts = []
+    point_index = {k: n_io + 6 * n_views + 3 * i for i, k in enumerate(free_pts)}
+    for k in free_pts:
+        x0.append(fld.xyz[k])
+        pnames += [f"point {int(fld.ids[k])}:{c}" for c in "XYZ"]
+    x0v = np.concatenate([np.asarray(a, dtype=np.float64).ravel() for a in x0])
+    eo_idx = n_io + 6 * view[:, None] + np.arange(6)[None, :]
+    io_idx = np.broadcast_to(np.arange(n_io), (view.size, n_io))
+    is_free = np.array([int(k) in point_index for k in pt], dtype=bool)
+    blocks = []
+    sigma = opts.sigma_px
+    labels = [f"{names[v]} / {int(fld.ids[k])}" for v, k in zip(view, pt)]
+    for sel, free in ((~is_free, False), (is_free, True)):
+        if not sel.any():
+            continue
+        idx = [eo_idx[sel], io_idx[sel]]
+        if free:
+            idx.append(np.array([point_index[int(k)] for k in pt[sel]])[:, None]
+                       + np.arange(3)[None, :])  # fmt: skip
+        blocks.append(GaussMarkovBlock(
+            name="free points" if free else "fixed points",
+            observed=px[sel], sigma=sigma, param_index=np.concatenate(idx, axis=1),
+            model=_ViewModel(base, free_io, view[sel], None if free else fld.xyz[pt[sel]]),
+            labels=[labels[i] for i in np.flatnonzero(sel)], row_names=("col", "row"),
+        ))  # fmt: skip
+    constraints = []
+    if opts.field == "free":
+        from ..lsq.model import Constraint
+
+        zc = point_index[datum[2]] + 2
+
+        def plane(xl: Array) -> tuple[Array, Array]:
+            return xl.copy(), np.ones((xl.shape[0], 1, 1))
+
+        constraints.append(Constraint("datum: third point in Z = 0", [[zc]], plane))
+    aopts = AdjustmentOptions(max_iterations=opts.max_iterations)
+    try:
+        res = adjust(x0v, pnames, blocks, constraints, aopts, progress=progress,
+                     should_stop=should_stop)  # fmt: skip
+    except NotObservableError as exc:
+        raise NotObservableError(
+            f"camera calibration: {exc}. The views cannot determine these parameters: use "
+            "more views, tilted in different directions (not all parallel to the target), "
+            "with the target filling the image corners, or estimate fewer lens parameters",
+            parameters=exc.parameters,
+        ) from exc
+    if not res.converged:
+        from ..errors import ConvergenceError
+
+        raise ConvergenceError(f"camera calibration did not converge in {res.iterations} "
+                               "iterations")  # fmt: skip
+    full = base.interior_params
+    full[free_io] = res.x[:n_io]
+    cam = base.with_interior(full)
+    std = res.std
+    sigmas = {n: float(std[i]) for i, n in enumerate(io_names)}
+    corr = res.correlation_of(np.arange(n_io))
+    tcrit = float(stats.t.ppf(1 - opts.alpha / 2, max(res.redundancy, 1)))
+    t_values = {n: abs(float(res.x[i])) / float(std[i]) for i, n in enumerate(io_names)
+                if n in LENS_NAMES}  # fmt: skip
+    significant = {n: bool(t > tcrit) for n, t in t_values.items()}
+    # residuals by view
+    v_all = np.zeros_like(px)
+    w_all = np.full_like(px, np.nan)
+    for b in blocks:
+        sel = ~is_free if b.name == "fixed points" else is_free
+        tab = res.residuals[b.name]
+        v_all[sel] = tab.v
+        w_all[sel] = tab.w
+    d2 = np.sum(v_all**2, axis=1)
+    view_rms = np.array([math.sqrt(float(np.mean(d2[view == j]))) for j in range(n_views)])
+    view_pts = np.bincount(view, minlength=n_views).astype(np.int64)
+    eo = res.x[n_io : n_io + 6 * n_views].reshape(n_views, 6)
+    eo_sigma = std[n_io : n_io + 6 * n_views].reshape(n_views, 6)
+    xyz = fld.xyz.copy()
+    for k, i in point_index.items():
+        xyz[k] = res.x[i : i + 3]
+    rows = [(names[v], int(fld.ids[k]), float(c), float(r), float(a), float(b), float(wc),
+             float(wr)) for v, k, (c, r), (a, b), (wc, wr)
+            in zip(view, pt, px, v_all, w_all)]  # fmt: skip
+    for n, sig in significant.items():
+        if not sig:
+            warnings.append(f"{n} is not significant (t = {t_values[n]:.2f} < {tcrit:.2f}): "
+                            "consider holding it at zero")  # fmt: skip
+    warnings += list(res.warnings)
+    return CalibrationResult(
+        camera=cam, sigmas=sigmas, parameter_names=io_names, correlation=corr,
+        t_values=t_values, significant=significant, t_critical=tcrit, sigma0=res.sigma0,
+        sigma0_prior=1.0, redundancy=res.redundancy, n_points=int(view.size),
+        iterations=res.iterations, condition_number=res.condition_number,
+        rms_px=math.sqrt(float(np.mean(d2))), view_names=names, view_rms_px=view_rms,
+        view_points=view_pts, eo=eo, eo_sigma=eo_sigma, residuals=rows, field_xyz=xyz,
+        field_ids=fld.ids.copy(), initial=initial, adjustment=res, warnings=warnings,
+        sigma_px=sigma, projection=opts.projection,
+    )  # fmt: skip
+
+
+def simulate_views(
+    camera: Camera,
+    fld: TargetField,
+    eos: Array,
+    noise_px: float = 0.0,
+    seed: int = 0,
+) -> list[Detection]:
+    """Project a target field into views with known EO (N, 6) and add Gaussian pixel noise.
+
+    Points outside the image or outside the projection are left out. For tests and benches.
+
+    >>> from .calibration_targets import TargetSpec, target_field
+    >>> cam = Camera("c", 4.0, 0.004, 1000, 800)
+    >>> fld = target_field(TargetSpec("chessboard", 4, 3, 0.1))
+    >>> det = simulate_views(cam, fld, np.array([[0.15, 0.1, 1.0, 0.0, 0.0, 0.0]]))
+    >>> det[0].pixels[0].round(6).tolist()
+    [350.0, 500.0]
+    """
+    from ..geometry.collinearity import project
+
+    rng = np.random.default_rng(seed)
+    out = []
+    for j, e in enumerate(np.asarray(eos, dtype=np.float64).reshape(-1, 6)):
+        p = project(fld.xyz, e, camera)
+        ok = np.isfinite(p).all(axis=1) & camera.in_frame(np.nan_to_num(p, nan=-1.0))
+        p = p[ok] + rng.normal(0.0, noise_px, size=(int(ok.sum()), 2)) if noise_px else p[ok]
+        out.append(Detection(f"view{j:02d}", fld.ids[ok].copy(), p))
+    return out
+
+
+def look_at_eo(centre: Array, target: Array, roll_rad: float = 0.0) -> Array:
+    """EO (6,) of a camera at ``centre`` looking at ``target`` (object frame, Z up-ish), the
+    image x axis kept horizontal, then rolled by ``roll_rad`` about the viewing axis."""
+    c = np.asarray(centre, dtype=np.float64)
+    back = c - np.asarray(target, dtype=np.float64)
+    zc = back / np.linalg.norm(back)  # camera z points back, towards the viewer
+    up = np.array([0.0, 1.0, 0.0]) if abs(zc[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    xc = np.cross(up, zc)
+    xc /= np.linalg.norm(xc)
+    yc = np.cross(zc, xc)
+    m = np.vstack([xc, yc, zc])  # rows: camera axes in object coordinates -> object to camera
+    cr, sr = math.cos(roll_rad), math.sin(roll_rad)
+    m = np.array([[cr, sr, 0.0], [-sr, cr, 0.0], [0.0, 0.0, 1.0]]) @ m
+    om, ph, ka = matrix_to_opk(m)
+    return np.array([*c, float(om), float(ph), float(ka)])
+
+
+__all__ = [
+    "FIELD_MODES",
+    "INTERIOR_NAMES",
+    "LENS_NAMES",
+    "CalibrationOptions",
+    "CalibrationResult",
+    "calibrate_camera",
+    "look_at_eo",
+    "simulate_views",
+]
