@@ -19,6 +19,7 @@ from .algorithms.monoplot import MonoplotAlgorithm
 from .algorithms.orthomosaic import OrthomosaicAlgorithm
 from .algorithms.orthorectify import OrthorectifyAlgorithm
 from .algorithms.resection import ResectionAlgorithm
+from .algorithms.tie_points import TiePointsAlgorithm
 from .algorithms.tls_calibration import TlsCalibrationAlgorithm
 from .algorithms.trajectory_to_eo import TrajectoryToEoAlgorithm
 
@@ -61,5 +62,6 @@ class LidarPhotoProvider(QgsProcessingProvider):
             OrthomosaicAlgorithm(),
             TlsCalibrationAlgorithm(),
             ExtractTlsTargetsAlgorithm(),
+            TiePointsAlgorithm(),
         ):
             self.addAlgorithm(alg)

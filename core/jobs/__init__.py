@@ -13,6 +13,7 @@ from . import (
     orthomosaic,
     orthorectify,
     resection,
+    tie_points,
     tls_calibration,
     trajectory_to_eo,
 )
@@ -32,4 +33,5 @@ ALGORITHMS = (
     orthomosaic,
     tls_calibration,
     extract_tls_targets,
+    tie_points,
 )
