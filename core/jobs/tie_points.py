@@ -164,7 +164,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if out.requested("OUTPUT_PAIRS"):
         rows = ((ids[p.i], ids[p.j], f"{p.overlap:.4g}", res.features[p.i], res.features[p.j],
                  p.n_ratio, p.n_mutual, p.n_inliers,
-                 f"{float(np_median(p.residual_px)):.4g}" if p.n_inliers else "", p.status)
+                 f"{np_median(p.residual_px):.4g}" if p.residual_px.size else "", p.status)
                 for p in res.pairs)  # fmt: skip
         write_csv_atomic(out.path("OUTPUT_PAIRS"), PAIR_COLUMNS, rows)
     lines = [
