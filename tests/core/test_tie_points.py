@@ -232,6 +232,14 @@ def test_bad_inputs_are_named(block, tmp_path):
     with pytest.raises(InputError, match="no tie point found: 0 of 1 pairs"):
         run_job(job, {"IMAGES": far, "OUTPUT_OBSERVATIONS": str(tmp_path / "y.csv")})
     assert not (tmp_path / "y.csv").exists()
+    # one image without overlap among overlapping ones: reported, not an error
+    three = [str(folder / "images" / f"IMG_{n}.png") for n in ("0101", "0102", "0403")]
+    res = run_job(job, {"IMAGES": three, "PAIR_MODE": "all", "MAX_FEATURES": 800,
+                        "OUTPUT_OBSERVATIONS": str(tmp_path / "w.csv")})  # fmt: skip
+    assert res.results["PAIRS_TRIED"] == 3 and res.results["PAIRS_KEPT"] == 1
+    assert any("1 image(s) without tie points" in line and "IMG_0403" in line
+               for line in res.lines)  # fmt: skip
+    assert set(read_observations_csv(tmp_path / "w.csv").image_id) == {"IMG_0101", "IMG_0102"}
     # EO without camera
     with pytest.raises(InputError, match="both"):
         run_job(job, {"IMAGES": far, "EO": str(folder / "eo.csv"),
