@@ -137,6 +137,7 @@ def main() -> None:
     ap.add_argument("--per-strip", type=int, default=10)
     ap.add_argument("--peer-images", type=int, default=12)
     ap.add_argument("--keep", action="store_true")
+    ap.add_argument("--no-peer", action="store_true", help="ours only")
     ap.add_argument("--orb", action="store_true", help="also run ours with ORB")
     a = ap.parse_args()
     folder = Path(tempfile.mkdtemp(prefix="bench_tie_"))
@@ -187,6 +188,9 @@ def main() -> None:
         ours("ours_orb", files, ("--detector", "orb", "--max-dimension", "0"))
     sub = files[: a.peer_images]
     ours("ours_sift_subset", sub)
+    if a.no_peer:
+        print(json.dumps(rows, indent=1))
+        return
     tracks, wall, cpu, t_det, kept, tried = run_peer(sub)
     ids = [f.stem for f in sub]
     err, bad = truth_errors(tb, ids, tracks.image, tracks.track, tracks.pixels)

@@ -183,25 +183,28 @@ def test_bundle_with_automatic_tie_points(block, matched):
     assert np.abs(auto.eo.xyz - blk.eo_true.xyz).max() < 0.3
 
 
-def test_orb_and_downscaled_detection_scale_back(block):
+def test_downscaled_detection_scale_back_without_bias(block):
     """Detection on the image reduced by 2 (decoded at half size) gives full-resolution
-    coordinates: matched keypoints agree with the truth as well as at full size, scaled."""
+    coordinates without bias: between images turned by 180 degrees (neighbouring strips of
+    the serpentine block) a constant keypoint offset would show twice. OpenCV's SIFT without
+    its precise upscaling: 0.5 px at factor 1, 1.0 px at factor 2 (measured)."""
     tb, folder = block
     from lidarphoto.core.io.images import read_gray
 
     names = tb.block.eo_true.image_id
-    errs = {}
-    for det, factor in (("sift", 2), ("orb", 1)):
+    for det, factor, tol in (("sift", 2, 0.25), ("sift", 1, 0.2), ("orb", 1, 1.0)):
         opt = TiePointOptions(detector=det, max_features=2000)
-        f = [detect_features(read_gray(folder / "images" / f"{n}.png", factor), n, opt,
-                             factor=factor) for n in names[:2]]  # fmt: skip
-        m = match_pair(f[0], f[1], opt)
-        assert m.kept and m.n_inliers > 100
-        g = tb.local.map_to_enu(ground_of_pixels(tb, f[0].pixels[m.idx_i], 0))
-        px, _, _ = project_with_status(g, tb.eo_local[1], tb.block.true_camera)
-        errs[det] = np.median(np.hypot(*(px - f[1].pixels[m.idx_j]).T))
-    assert errs["sift"] < 0.8  # twice the full-resolution figure at most
-    assert errs["orb"] < 1.5
+        f = {k: detect_features(read_gray(folder / "images" / f"{names[k]}.png", factor),
+                                names[k], opt, factor=factor) for k in (0, 1, 7)}  # fmt: skip
+        for a, b in ((0, 1), (0, 7)):  # same heading, opposite heading
+            m = match_pair(f[a], f[b], opt)
+            assert m.kept and m.n_inliers > 100
+            g = tb.local.map_to_enu(ground_of_pixels(tb, f[a].pixels[m.idx_i], a))
+            px, _, _ = project_with_status(g, tb.eo_local[b], tb.block.true_camera)
+            d = f[b].pixels[m.idx_j] - px
+            assert np.median(np.hypot(*d.T)) < tol, (det, factor, a, b)
+            if det == "sift":
+                assert np.all(np.abs(np.median(d, axis=0)) < 0.05), (factor, a, b)
 
 
 def test_no_eo_sequential_and_cancel(block):
