@@ -190,6 +190,8 @@ def main() -> None:
     ours("ours_sift_subset", sub)
     if a.no_peer:
         print(json.dumps(rows, indent=1))
+        if not a.keep:
+            shutil.rmtree(folder)
         return
     tracks, wall, cpu, t_det, kept, tried = run_peer(sub)
     ids = [f.stem for f in sub]
