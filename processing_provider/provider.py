@@ -22,6 +22,7 @@ from .algorithms.monoplot import MonoplotAlgorithm
 from .algorithms.orthomosaic import OrthomosaicAlgorithm
 from .algorithms.orthorectify import OrthorectifyAlgorithm
 from .algorithms.resection import ResectionAlgorithm
+from .algorithms.tie_points import TiePointsAlgorithm
 from .algorithms.tls_calibration import TlsCalibrationAlgorithm
 from .algorithms.trajectory_to_eo import TrajectoryToEoAlgorithm
 
@@ -67,5 +68,6 @@ class LidarPhotoProvider(QgsProcessingProvider):
             LocateControlPointsAlgorithm(),
             LidarBlockAlgorithm(),
             CalibrateCameraAlgorithm(),
+            TiePointsAlgorithm(),
         ):
             self.addAlgorithm(alg)

@@ -16,6 +16,7 @@ from . import (
     orthomosaic,
     orthorectify,
     resection,
+    tie_points,
     tls_calibration,
     trajectory_to_eo,
 )
@@ -38,4 +39,5 @@ ALGORITHMS = (
     locate_control_points,
     lidar_block,
     calibrate_camera,
+    tie_points,
 )

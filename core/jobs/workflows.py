@@ -76,6 +76,8 @@ WORKFLOWS: tuple[Workflow, ...] = (
         (
             ("calibratecamera", "IMAGES = views of a chessboard or ChArUco target; "
              "OUTPUT_CAMERA = the camera JSON (start values for the block, or held fixed)"),
+            ("tiepoints", "IMAGES (and the approximate EO + CAMERA to pair images by their "
+             "footprints); OUTPUT_OBSERVATIONS = tie points for the bundle"),
             ("locatecontrolpoints", "CHIPS = one GeoTIFF chip per control point, "
              "CONTROL_POINTS, CAMERA, approximate EO, IMAGES; OUTPUT = the control points' "
              "image observations, without clicking them"),

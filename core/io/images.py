@@ -1,0 +1,96 @@
+"""Camera images for feature matching: grey, optionally decoded at a reduced size.
+
+Images are read by OpenCV (JPEG, PNG, TIFF, ...) as stored in the file: the EXIF orientation
+tag is ignored, so pixel positions refer to the raster as written (as GDAL and the picking
+dock read it). A reduction by 2, 4 or 8 is done while decoding (JPEG's scaled inverse DCT:
+much faster than decoding the full image); each reduced pixel ``k`` covers the full-resolution
+pixels ``f k .. f (k + 1)``. The full size is read from the file's header (GDAL/rasterio).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Union
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError
+
+__all__ = ["IMAGE_SUFFIXES", "decode_factor", "image_size", "list_image_files", "read_gray"]
+
+PathLike = Union[str, "os.PathLike[str]"]
+#: File endings taken as images when a folder is named.
+IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".jp2")
+
+
+def list_image_files(paths) -> list[Path]:
+    """The image files named, folders expanded (their files with :data:`IMAGE_SUFFIXES`,
+    sorted by name); InputError for a missing path, an empty folder or two images with the
+    same name (the image id is the file name without extension)."""
+    out: list[Path] = []
+    for raw in paths:
+        p = Path(raw)
+        if p.is_dir():
+            found = sorted(f for f in p.iterdir()
+                           if f.is_file() and f.suffix.lower() in IMAGE_SUFFIXES
+                           and not f.name.startswith("."))  # fmt: skip
+            if not found:
+                raise InputError("no image in this folder (" + ", ".join(IMAGE_SUFFIXES) + ")",
+                                 path=str(p))  # fmt: skip
+            out += found
+        elif p.is_file():
+            out.append(p)
+        else:
+            raise InputError("file or folder not found", path=str(p))
+    seen: dict[str, Path] = {}
+    for f in out:
+        if f.stem in seen and seen[f.stem] != f:
+            raise InputError(f"two images are named {f.stem}: {seen[f.stem]} and {f}")
+        seen[f.stem] = f
+    return list(seen.values())
+
+
+def image_size(path: PathLike) -> tuple[int, int]:
+    """(width, height) of an image from its header (nothing decoded); InputError if the
+    file is missing or not an image."""
+    from .raster import RasterReader
+
+    with RasterReader(os.fspath(path)) as src:
+        return int(src.info.width), int(src.info.height)
+
+
+def decode_factor(factor: int) -> int:
+    """The largest of 8, 4, 2, 1 dividing ``factor``: the part of a reduction done while
+    decoding (the rest is a box average of the decoded image).
+
+    >>> [decode_factor(f) for f in (1, 2, 3, 4, 6, 12, 16)]
+    [1, 2, 1, 4, 2, 4, 8]
+    """
+    return next(f for f in (8, 4, 2, 1) if factor % f == 0)
+
+
+def read_gray(path: PathLike, factor: int = 1) -> NDArray[np.uint8]:
+    """Read an image as 8-bit grey, reduced by ``factor`` (1, 2, 4 or 8) while decoding.
+
+    Raises
+    ------
+    InputError
+        The file does not exist or cannot be decoded (named).
+    """
+    import cv2
+
+    p = os.fspath(path)
+    if not Path(p).is_file():
+        raise InputError("image file not found", path=p)
+    flags = {1: cv2.IMREAD_GRAYSCALE, 2: cv2.IMREAD_REDUCED_GRAYSCALE_2,
+             4: cv2.IMREAD_REDUCED_GRAYSCALE_4, 8: cv2.IMREAD_REDUCED_GRAYSCALE_8}  # fmt: skip
+    if factor not in flags:
+        raise ValueError(f"decoding reduces by 1, 2, 4 or 8, not {factor}")
+    img = cv2.imread(p, flags[factor] | cv2.IMREAD_IGNORE_ORIENTATION)
+    if img is None:
+        raise InputError("cannot read the image (not an image file, or damaged)", path=p)
+    if img.dtype != np.uint8:  # 16-bit: stretched to 8 bits (features need contrast only)
+        img = cv2.normalize(img, None, 0, 255, cv2.NORM_MINMAX).astype(np.uint8)
+    return img

@@ -1,0 +1,199 @@
+"""``tiepoints``: automatic tie points of a block of images (SIFT or ORB, ratio test, mutual
+check, fundamental-matrix RANSAC, tracks), written as the image-observation CSV."""
+
+from __future__ import annotations
+
+import logging
+
+from ..photo.tie_points import DETECTORS, PAIR_MODES, RANSAC_METHODS, TiePointOptions
+from .common import CSV_FILTER, CSV_OUT
+from .runner import JobResult
+from .spec import AlgorithmSpec, Param, Result, Values
+
+log = logging.getLogger(__name__)
+
+_D = TiePointOptions()
+#: Columns of the pair table (OUTPUT_PAIRS).
+PAIR_COLUMNS = ("image_a", "image_b", "overlap", "features_a", "features_b", "ratio_matches",
+                "mutual_matches", "inliers", "epipolar_median_px", "status")  # fmt: skip
+
+SPEC = AlgorithmSpec(
+    name="tiepoints",
+    title="Automatic tie points",
+    group="Orientation",
+    group_id="orientation",
+    summary="tie points of overlapping images by feature matching, for the bundle adjustment",
+    description="""\
+Finds tie points in a block of images without an operator. Features: SIFT (Lowe 2004) or
+ORB (Rublee et al. 2011, faster, less precise), detected once per image, on the image reduced
+by the smallest integer factor that brings its longer side to at most Detection size (0: full
+resolution; reductions by 2, 4 and 8 are made while decoding JPEGs); the keypoints are
+scaled back to full-resolution pixels.
+
+Pairs: with an exterior orientation and a camera, the pairs whose ground footprints (image
+corners met with the plane at Mean terrain height) overlap by at least Minimum overlap of the
+smaller footprint; without them, each image with the next Window images in file-name order
+(sequential), or all pairs. An image the EO table lacks is paired with every image.
+
+Matching: nearest neighbours in descriptor space (FLANN k-d trees for SIFT, Muja & Lowe 2009;
+brute force for ORB), Lowe's ratio test, a mutual check, then RANSAC on the fundamental
+matrix (Fischler & Bolles 1981; MAGSAC++ by default) with a threshold on the distance to the
+epipolar line in full-resolution pixels. Pairs with fewer than Minimum inliers are dropped
+(the pair table gives the reason). Tracks: the matches of all pairs are merged (connected
+components); a track holding two different points of one image is dropped, as are tracks
+seen in fewer than Minimum track length images.
+
+Output: the image-observation CSV (type tie, point ids tp000001 ..., target_id empty), read
+directly by Bundle adjustment. sigma_px: the value given, or 0.5 px times the detection
+reduction factor. No least-squares refinement of the points yet.""",
+    params=(
+        Param("IMAGES", "files", "Images (files or folders)",
+              help="image files, or folders whose images are all taken; the image id is the "
+              "file name without extension"),
+        Param("EO", "file", "Exterior orientation (CSV) for pair selection", optional=True,
+              file_filter=CSV_FILTER, help="with CAMERA: pairs from ground footprints"),
+        Param("CAMERA", "file", "Camera (JSON)", optional=True,
+              file_filter="JSON files (*.json)"),
+        Param("HEIGHT", "number", "Mean terrain height", 0.0, unit="m", minimum=-1000.0,
+              maximum=9000.0, help="the plane the footprints are computed on (EO heights)"),
+        Param("DETECTOR", "enum", "Detector", _D.detector, options=DETECTORS,
+              labels=("SIFT (Lowe 2004)", "ORB (fast)")),
+        Param("MAX_FEATURES", "integer", "Features per image", _D.max_features, minimum=100,
+              maximum=100000),
+        Param("MAX_DIMENSION", "integer", "Detection size (longer side, 0 = full resolution)",
+              _D.max_dimension_px, unit="pixels", minimum=0, maximum=100000),
+        Param("RATIO", "number", "Ratio test (best / second best)", _D.ratio, minimum=0.3,
+              maximum=1.0),
+        Param("RANSAC_THRESHOLD", "number", "RANSAC threshold (epipolar distance)",
+              _D.ransac_px, unit="pixels", minimum=0.05, maximum=100.0),
+        Param("RANSAC_METHOD", "enum", "RANSAC method", _D.ransac_method,
+              options=RANSAC_METHODS, labels=("MAGSAC++", "RANSAC"), advanced=True),
+        Param("MIN_INLIERS", "integer", "Minimum inliers per pair", _D.min_inliers, minimum=8,
+              maximum=100000),
+        Param("MIN_TRACK_LENGTH", "integer", "Minimum track length", _D.min_track_length,
+              unit="images", minimum=2, maximum=1000),
+        Param("PAIR_MODE", "enum", "Pairs", _D.pair_mode, options=PAIR_MODES,
+              labels=("footprints with EO, else sequential", "footprints (EO + camera)",
+                      "all pairs", "sequential window")),
+        Param("WINDOW", "integer", "Sequential window", _D.window, unit="images", minimum=1,
+              maximum=1000),
+        Param("MIN_OVERLAP", "number", "Minimum footprint overlap", _D.min_overlap, minimum=0.0,
+              maximum=1.0, help="share of the smaller footprint"),
+        Param("SIGMA", "number", "sigma_px written (0 = 0.5 px x reduction)", _D.sigma_px,
+              unit="pixels", minimum=0.0, maximum=100.0, advanced=True),
+        Param("OUTPUT_OBSERVATIONS", "file_out", "Tie points (observation CSV)",
+              file_filter=CSV_OUT),
+        Param("OUTPUT_PAIRS", "file_out", "Pair table (CSV)", optional=True,
+              create_by_default=False, file_filter=CSV_OUT),
+    ),
+    results=(
+        Result("TRACK_COUNT", "number", "Tie points (tracks)"),
+        Result("MEASUREMENT_COUNT", "number", "Image measurements"),
+        Result("PAIRS_TRIED", "number", "Image pairs tried"),
+        Result("PAIRS_KEPT", "number", "Image pairs kept"),
+    ),
+    tags=("tie points", "sift", "orb", "matching", "ransac", "fundamental matrix", "tracks"),
+    references=("Lowe (2004)", "Fischler & Bolles (1981)", "Rublee et al. (2011)",
+                "Muja & Lowe (2009)", "Barath et al. (2020)"),
+)  # fmt: skip
+
+
+def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
+    """Read the images one by one (features only are kept), match, write the tables."""
+    from ..errors import InputError
+    from ..io.camera import read_camera_json
+    from ..io.images import decode_factor, image_size, list_image_files, read_gray
+    from ..io.observations import write_observations_csv
+    from ..io.orientation import read_eo_csv
+    from ..io.tables import write_csv_atomic
+    from ..photo.tie_points import detect_features, footprints, reduction_factor, tie_points
+
+    options = TiePointOptions(
+        detector=v.detector, max_features=int(v.max_features),
+        max_dimension_px=int(v.max_dimension), ratio=v.ratio, ransac_px=v.ransac_threshold,
+        ransac_method=v.ransac_method, min_inliers=int(v.min_inliers),
+        min_track_length=int(v.min_track_length), pair_mode=v.pair_mode, window=int(v.window),
+        min_overlap=v.min_overlap, sigma_px=v.sigma,
+    )  # fmt: skip
+    files = list_image_files(v.images)
+    if len(files) < 2:
+        raise InputError("tie points need at least two images")
+    ids = [f.stem for f in files]
+    if bool(v.eo) != bool(v.camera):
+        raise InputError("give both the exterior orientation and the camera (footprint pairs) "
+                         "or neither")  # fmt: skip
+    footprint = None
+    camera = None
+    if v.eo:
+        camera = read_camera_json(v.camera)
+        eo = read_eo_csv(v.eo)
+        row = {name: k for k, name in enumerate(eo.image_id)}
+        fps = footprints(camera, eo.xyz, eo.opk, v.height)
+        footprint = [fps[row[i]] if i in row else None for i in ids]
+        missing = [i for i in ids if i not in row]
+        if len(missing) == len(ids):
+            raise InputError("no image has a row in the exterior orientation (image_id = "
+                             "file name without extension)", path=v.eo)  # fmt: skip
+        if missing:
+            log.warning("%d image(s) without exterior orientation, paired with every image: "
+                        "%s", len(missing), ", ".join(missing[:10]))  # fmt: skip
+    elif options.pair_mode == "footprints":
+        raise InputError("footprint pairs need EO and CAMERA")
+    sizes = [image_size(f) for f in files]  # every header read before any work
+    if camera is not None:
+        for f, (w, h) in zip(files, sizes):
+            if (w, h) != (camera.width_px, camera.height_px):
+                raise InputError(
+                    f"the image is {w} x {h} px, the camera {camera.name!r} "
+                    f"{camera.width_px} x {camera.height_px} px",
+                    path=str(f),
+                )
+
+    def load(k: int):
+        need = reduction_factor(*sizes[k], options.max_dimension_px)
+        dec = decode_factor(need)
+        gray = read_gray(files[k], dec)
+        return detect_features(gray, ids[k], options, factor=dec, size_px=sizes[k])
+
+    res = tie_points(ids, load, options, footprint, progress=progress, should_stop=should_stop)
+    s = res.summary()
+    if s["tracks"] == 0:
+        raise InputError(f"no tie point found: {s['pairs_kept']} of {s['pairs_tried']} pairs "
+                         f"matched; dropped pairs: {s['dropped_pairs'] or 'none'}")  # fmt: skip
+    write_observations_csv(out.path("OUTPUT_OBSERVATIONS"), res.observations())
+    if out.requested("OUTPUT_PAIRS"):
+        rows = ((ids[p.i], ids[p.j], f"{p.overlap:.4g}", res.features[p.i], res.features[p.j],
+                 p.n_ratio, p.n_mutual, p.n_inliers,
+                 f"{np_median(p.residual_px):.4g}" if p.residual_px.size else "", p.status)
+                for p in res.pairs)  # fmt: skip
+        write_csv_atomic(out.path("OUTPUT_PAIRS"), PAIR_COLUMNS, rows)
+    lines = [
+        f"{s['images']} images, {sum(res.features)} features; pairs: {s['pairs_kept']} of "
+        f"{s['pairs_tried']} kept (inliers per pair: median {s['inliers_median']:g}, min "
+        f"{s['inliers_min']}, max {s['inliers_max']}; epipolar distance median "
+        f"{s['epipolar_median_px']:.2f} px, 95 % {s['epipolar_p95_px']:.2f} px)",
+        f"{s['tracks']} tracks, {s['measurements']} measurements; tracks by length "
+        + ", ".join(f"{k}: {n}" for k, n in s["tracks_by_length"].items())
+        + f"; {s['rejected_inconsistent']} tracks dropped (two points in one image)",
+    ]
+    if s["dropped_pairs"]:
+        dropped = ", ".join(f"{k}: {n}" for k, n in s["dropped_pairs"].items())
+        lines.append("dropped pairs: " + dropped)
+    if s["images_without_tie"]:
+        lines.append(f"{len(s['images_without_tie'])} image(s) without tie points (no "
+                     f"overlap matched): {', '.join(s['images_without_tie'][:20])}")  # fmt: skip
+    for line in lines:
+        log.info("%s", line)
+    return JobResult(
+        results={"TRACK_COUNT": s["tracks"], "MEASUREMENT_COUNT": s["measurements"],
+                 "PAIRS_TRIED": s["pairs_tried"], "PAIRS_KEPT": s["pairs_kept"]},
+        lines=lines,
+        data=res,
+    )  # fmt: skip
+
+
+def np_median(values) -> float:
+    """Median of an array (NaN when empty)."""
+    import numpy as np
+
+    return float(np.median(values)) if len(values) else float("nan")

@@ -1,0 +1,779 @@
+"""Automatic tie points: features, pair selection, matching, tracks.
+
+The chain (one image's features are computed once and kept; the images themselves are not):
+
+1. **Features** (:func:`detect_features`): SIFT (Lowe 2004; OpenCV's with its precise
+   upscaling, without which every keypoint is 0.25 detection px off) or ORB (Rublee et al. 2011) on
+   the grey image, optionally detected on a reduced image (an integer factor ``f``, 2 x 2 ...
+   box averages) whose keypoints are scaled back to full resolution: a keypoint at OpenCV
+   position ``x`` (pixel centres at integers) of the reduced image lies at
+   ``col = (x + 0.5) * f`` in the project's pixel convention (centre of the first pixel at
+   0.5). Descriptors are kept as 8-bit (SIFT's are integers 0..255 in OpenCV; ORB's are
+   bytes): 4,000 SIFT features take 0.5 MB per image.
+2. **Pairs** (:func:`select_pairs`): with an exterior orientation and a camera, the pairs
+   whose ground footprints (the image corners' rays met with the plane Z = mean terrain
+   height) overlap by at least ``min_overlap`` of the smaller footprint; otherwise all pairs,
+   or each image with the next ``window`` images (a sequential window, the order of the
+   file names).
+3. **Matching** (:func:`match_pair`): nearest neighbours (SIFT: FLANN k-d trees, Muja & Lowe
+   2009; ORB: brute force, Hamming), Lowe's ratio
+   test (2004), a mutual check (the match must also be the best one in the other direction),
+   then RANSAC on the fundamental matrix (Fischler & Bolles 1981; MAGSAC++ of Barath et al.
+   2020 by default), threshold in full-resolution pixels. A pair with fewer than
+   ``min_inliers`` inliers is dropped, with its reason.
+4. **Tracks** (:func:`build_tracks`): the pairwise matches are the edges of a graph whose
+   nodes are the keypoints of all images; its connected components (union-find) are the
+   tracks. A track holding two different keypoints of the same image is inconsistent and is
+   dropped whole; tracks shorter than ``min_track_length`` images are dropped.
+
+The tie points are measured at the keypoint positions: there is no least-squares refinement
+here (a refinement step would move ``Tracks.pixels`` after step 4).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError, stop_if_asked
+from ..geometry.camera import Camera
+from ..geometry.collinearity import image_rays
+
+Array = NDArray[np.float64]
+
+__all__ = [
+    "DETECTORS",
+    "PAIR_MODES",
+    "RANSAC_METHODS",
+    "ImageFeatures",
+    "PairMatch",
+    "TiePointOptions",
+    "TiePointResult",
+    "Tracks",
+    "build_tracks",
+    "detect_features",
+    "footprints",
+    "match_pair",
+    "polygon_overlap",
+    "select_pairs",
+    "tie_points",
+]
+
+DETECTORS = ("sift", "orb")
+#: ``auto``: footprints when an orientation is given, else the sequential window.
+PAIR_MODES = ("auto", "footprints", "all", "sequential")
+RANSAC_METHODS = ("magsac", "ransac")
+
+
+@dataclass(frozen=True)
+class TiePointOptions:
+    """Settings of :func:`tie_points` (units in the names).
+
+    detector : "sift" or "orb"
+    max_features : int
+        Strongest keypoints kept per image.
+    max_dimension_px : int
+        Features are detected on the image reduced by the smallest integer factor that
+        brings its longer side to at most this; 0 detects at full resolution.
+    ratio : float
+        Lowe's ratio: best distance / second best must be below it.
+    mutual : bool
+        Keep a match only if it is also the best in the other direction.
+    ransac_px : float
+        RANSAC threshold on the distance to the epipolar line, full-resolution pixels.
+    ransac_method : "magsac" (MAGSAC++) or "ransac"
+    min_inliers : int
+        Fewer inliers: the pair is dropped.
+    min_track_length : int
+        Images a track must span.
+    pair_mode : one of :data:`PAIR_MODES`
+    window : int
+        Sequential mode: each image is matched with the next ``window`` images.
+    min_overlap : float
+        Footprint mode: overlap / smaller footprint area at least this.
+    sigma_px : float
+        A-priori sigma written with every measurement, pixels; 0 = 0.5 px times the
+        detection reduction factor.
+    coherence : float
+        Motion coherence: an inlier whose displacement differs from the median displacement
+        of its 8 nearest inliers by more than this share of the image diagonal is dropped
+        (0: no test). It removes wrong matches that slide along the epipolar line, which
+        the fundamental matrix cannot see (aerial strips: all epipolar lines are parallel).
+    """
+
+    detector: str = "sift"
+    max_features: int = 4000
+    max_dimension_px: int = 3000
+    ratio: float = 0.8
+    mutual: bool = True
+    ransac_px: float = 2.0
+    ransac_method: str = "magsac"
+    min_inliers: int = 15
+    min_track_length: int = 2
+    pair_mode: str = "auto"
+    window: int = 5
+    min_overlap: float = 0.05
+    sigma_px: float = 0.0
+    coherence: float = 0.03
+
+    def __post_init__(self) -> None:
+        if self.detector not in DETECTORS:
+            raise InputError(f"detector must be one of {', '.join(DETECTORS)}")
+        if self.pair_mode not in PAIR_MODES:
+            raise InputError(f"pair mode must be one of {', '.join(PAIR_MODES)}")
+        if self.ransac_method not in RANSAC_METHODS:
+            raise InputError(f"RANSAC method must be one of {', '.join(RANSAC_METHODS)}")
+        if not 0.0 < self.ratio <= 1.0:
+            raise InputError(f"ratio must be in (0, 1], got {self.ratio:g}")
+        if self.min_track_length < 2:
+            raise InputError("a track needs at least 2 images")
+        if self.min_inliers < 8:
+            raise InputError("the fundamental matrix needs at least 8 inliers")
+
+
+@dataclass(frozen=True)
+class ImageFeatures:
+    """Keypoints of one image (full-resolution pixels, project convention).
+
+    Attributes
+    ----------
+    image_id : str
+    size_px : (int, int)
+        Width and height of the full image.
+    factor : int
+        Reduction factor of the detection image (1: full resolution).
+    pixels : (N, 2) float64
+        col, row of each keypoint, pixels of the full image (centre of the first pixel 0.5).
+    scale_px : (N,) float32
+        Keypoint diameter, full-resolution pixels.
+    descriptors : (N, D) uint8
+        SIFT (D = 128) or ORB (D = 32 bytes).
+    """
+
+    image_id: str
+    size_px: tuple[int, int]
+    factor: int
+    pixels: Array
+    scale_px: NDArray[np.float32]
+    descriptors: NDArray[np.uint8]
+
+    def __len__(self) -> int:
+        return int(self.pixels.shape[0])
+
+
+def reduction_factor(width_px: int, height_px: int, max_dimension_px: int) -> int:
+    """Smallest integer factor bringing the longer side to at most ``max_dimension_px``.
+
+    >>> reduction_factor(4000, 3000, 3000), reduction_factor(4000, 3000, 0)
+    (2, 1)
+    """
+    if max_dimension_px <= 0:
+        return 1
+    return max(1, math.ceil(max(width_px, height_px) / max_dimension_px))
+
+
+def _detector(options: TiePointOptions):
+    """The OpenCV detector and the shift (detection pixels) its keypoints need.
+
+    OpenCV's SIFT doubles the image first; by default its doubling is centre-aligned while
+    the keypoints are halved as if it were corner-aligned, which puts every keypoint 0.25
+    detection pixels right of and below the feature (measured here: 0.5 px between images
+    turned by 180 degrees). ``enable_precise_upscale`` (OpenCV >= 4.8) removes the bias;
+    with an older OpenCV the keypoints are shifted back by 0.25 px.
+    """
+    import cv2
+
+    if options.detector == "sift":
+        try:
+            return cv2.SIFT_create(nfeatures=int(options.max_features),
+                                   enable_precise_upscale=True), 0.0  # fmt: skip
+        except TypeError:  # OpenCV < 4.8
+            return cv2.SIFT_create(nfeatures=int(options.max_features)), -0.25
+    return cv2.ORB_create(nfeatures=int(options.max_features), scaleFactor=1.2, nlevels=8,
+                          fastThreshold=10), 0.0  # fmt: skip
+
+
+def detect_features(
+    gray: NDArray,
+    image_id: str,
+    options: TiePointOptions,
+    *,
+    factor: int = 1,
+    size_px: tuple[int, int] | None = None,
+) -> ImageFeatures:
+    """Detect and describe keypoints of one grey image.
+
+    Parameters
+    ----------
+    gray : (H, W) uint8
+        The image, possibly already reduced by ``factor`` (e.g. decoded at 1/2, 1/4).
+    image_id : str
+    options : TiePointOptions
+        The image is reduced further (box average, an integer factor) until its longer side,
+        at full resolution, divided by the total factor is at most ``max_dimension_px``.
+    factor : int
+        Full-resolution pixels per pixel of ``gray``.
+    size_px : (width, height), optional
+        The full image's size (default: ``gray``'s times ``factor``).
+
+    Returns
+    -------
+    ImageFeatures
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> img = (rng.random((64, 64)) * 255).astype(np.uint8)
+    >>> import cv2; img = cv2.resize(img, (512, 512), interpolation=cv2.INTER_CUBIC)
+    >>> f = detect_features(img, "a", TiePointOptions(max_features=200, max_dimension_px=256))
+    >>> f.factor, f.descriptors.dtype.name, 0 < len(f) <= 200
+    (2, 'uint8', True)
+    """
+    import cv2
+
+    img = np.asarray(gray)
+    if img.ndim != 2:
+        raise InputError(f"image {image_id}: a grey image is needed (got shape {img.shape})")
+    if img.dtype != np.uint8:
+        img = cv2.normalize(img, None, 0, 255, cv2.NORM_MINMAX).astype(np.uint8)
+    h, w = img.shape
+    full = size_px or (w * factor, h * factor)
+    need = reduction_factor(full[0], full[1], options.max_dimension_px)
+    extra = max(1, -(-need // factor))
+    if extra > 1:  # an exact box average: crop to a multiple of the factor first
+        hh, ww = (h // extra) * extra, (w // extra) * extra
+        img = cv2.resize(img[:hh, :ww], (ww // extra, hh // extra), interpolation=cv2.INTER_AREA)
+    total = factor * extra
+    detector, shift = _detector(options)
+    kps, desc = detector.detectAndCompute(img, None)
+    if desc is None or not kps:
+        width = 128 if options.detector == "sift" else 32
+        return ImageFeatures(image_id, (int(full[0]), int(full[1])), total, np.zeros((0, 2)),
+                             np.zeros(0, np.float32), np.zeros((0, width), np.uint8))  # fmt: skip
+    xy = np.array([k.pt for k in kps], dtype=np.float64) + shift
+    if options.detector == "orb":
+        # ORB's pyramid levels are resized centre-aligned but their keypoints are scaled as
+        # if corner-aligned: level l (scale 1.2^l) needs 0.5 (scale - 1) px added
+        scale = 1.2 ** np.array([k.octave for k in kps], dtype=np.float64)
+        xy += 0.5 * (scale - 1.0)[:, None]
+    size = np.array([k.size for k in kps], dtype=np.float32) * total
+    px = (xy + 0.5) * total
+    inside = (px[:, 0] > 0) & (px[:, 1] > 0) & (px[:, 0] < full[0]) & (px[:, 1] < full[1])
+    # SIFT descriptors are whole numbers 0..255 in OpenCV: 8 bits keep them exactly
+    d8 = np.clip(np.rint(desc), 0, 255).astype(np.uint8) if desc.dtype != np.uint8 else desc
+    return ImageFeatures(image_id, (int(full[0]), int(full[1])), total, px[inside],
+                         size[inside], np.ascontiguousarray(d8[inside]))  # fmt: skip
+
+
+# --------------------------------------------------------------------------- pairs
+def footprints(
+    camera: Camera, xyz: Array, opk: Array, height_m: float, max_range_factor: float = 10.0
+) -> list[Array]:
+    """Ground footprint of each image: its four corners' rays met with Z = ``height_m``.
+
+    The mapping frame is taken as Cartesian over one image (good enough to choose pairs:
+    the footprints are compared with a tolerance, ``min_overlap``). A corner ray that does
+    not go down to the plane (oblique views) is cut at ``max_range_factor`` times the
+    flying height.
+
+    Parameters
+    ----------
+    camera : Camera
+    xyz : (M, 3) perspective centres, metres; opk : (M, 3) radians
+    height_m : float
+
+    Returns
+    -------
+    list of (4, 2) arrays
+        Easting, northing of the corners (image order: top-left, top-right, bottom-right,
+        bottom-left).
+
+    Examples
+    --------
+    >>> cam = Camera("c", focal_mm=10.0, pixel_size_mm=0.01, width_px=1000, height_px=500)
+    >>> fp = footprints(cam, np.array([[0.0, 0.0, 100.0]]), np.zeros((1, 3)), 0.0)
+    >>> np.round(fp[0], 6).tolist()
+    [[-50.0, 25.0], [50.0, 25.0], [50.0, -25.0], [-50.0, -25.0]]
+    """
+    w, h = camera.width_px, camera.height_px
+    corners = np.array([[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]])
+    out = []
+    for x, a in zip(np.asarray(xyz, float), np.asarray(opk, float)):
+        o, d = image_rays(corners, np.concatenate([x, a]), camera)
+        depth = x[2] - height_m
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = (height_m - o[:, 2]) / d[:, 2]
+        t = np.where((t > 0) & np.isfinite(t), t, np.inf)
+        t = np.minimum(t, max_range_factor * abs(depth))
+        out.append(o[:, :2] + t[:, None] * d[:, :2])
+    return out
+
+
+def _clip(subject: Array, clip: Array) -> Array:
+    """Sutherland-Hodgman: the part of polygon ``subject`` inside convex ``clip`` (CCW)."""
+    out = subject
+    n = len(clip)
+    for k in range(n):
+        if len(out) == 0:
+            break
+        a, b = clip[k], clip[(k + 1) % n]
+        e = b - a
+        side = e[0] * (out[:, 1] - a[1]) - e[1] * (out[:, 0] - a[0])  # > 0: inside (left)
+        nxt = np.roll(out, -1, axis=0)
+        side_n = np.roll(side, -1)
+        pts = []
+        for p, q, sp, sq in zip(out, nxt, side, side_n):
+            if sp >= 0:
+                pts.append(p)
+            if (sp >= 0) != (sq >= 0):
+                pts.append(p + (q - p) * (sp / (sp - sq)))
+        out = np.array(pts).reshape(-1, 2)
+    return out
+
+
+def _area(poly: Array) -> float:
+    if len(poly) < 3:
+        return 0.0
+    x, y = poly[:, 0], poly[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+
+
+def polygon_overlap(a: Array, b: Array) -> float:
+    """Intersection area of two convex polygons / the smaller one's area (0..1).
+
+    >>> sq = np.array([[0, 0], [2, 0], [2, 2], [0, 2]], float)
+    >>> polygon_overlap(sq, sq + [1.0, 0.0]), polygon_overlap(sq, sq + [3.0, 0.0])
+    (0.5, 0.0)
+    """
+    a = np.asarray(a, float)
+    b = np.asarray(b, float)
+    if _area(a) < 0:
+        a = a[::-1]
+    if _area(b) < 0:
+        b = b[::-1]
+    small = min(_area(a), _area(b))
+    if small <= 0:
+        return 0.0
+    return max(0.0, _area(_clip(a, b))) / small
+
+
+def select_pairs(
+    n_images: int,
+    mode: str,
+    window: int = 5,
+    footprint: Sequence[Array | None] | None = None,
+    min_overlap: float = 0.05,
+) -> tuple[list[tuple[int, int]], dict[tuple[int, int], float]]:
+    """Image pairs to match, ``i < j``, and the footprint overlap of each (NaN if unknown).
+
+    ``footprint`` mode: pairs whose footprints overlap by ``min_overlap`` of the smaller one;
+    an image without a footprint (no orientation) is paired with every other image.
+
+    >>> select_pairs(4, "sequential", window=2)[0]
+    [(0, 1), (0, 2), (1, 2), (1, 3), (2, 3)]
+    >>> len(select_pairs(5, "all")[0])
+    10
+    """
+    pairs: list[tuple[int, int]] = []
+    overlap: dict[tuple[int, int], float] = {}
+    if mode == "all":
+        pairs = [(i, j) for i in range(n_images) for j in range(i + 1, n_images)]
+    elif mode == "sequential":
+        pairs = [(i, j) for i in range(n_images)
+                 for j in range(i + 1, min(n_images, i + 1 + max(1, window)))]  # fmt: skip
+    elif mode == "footprints":
+        if footprint is None or len(footprint) != n_images:
+            raise InputError("footprint pairs need the orientation and camera of the images")
+        boxes = np.array([[np.nan] * 4 if f is None else [*f.min(0), *f.max(0)]
+                          for f in footprint])  # fmt: skip
+        for i in range(n_images):
+            for j in range(i + 1, n_images):
+                if footprint[i] is None or footprint[j] is None:
+                    pairs.append((i, j))
+                    overlap[(i, j)] = math.nan
+                    continue
+                bi, bj = boxes[i], boxes[j]
+                if bi[0] > bj[2] or bj[0] > bi[2] or bi[1] > bj[3] or bj[1] > bi[3]:
+                    continue
+                ov = polygon_overlap(footprint[i], footprint[j])
+                if ov >= min_overlap:
+                    pairs.append((i, j))
+                    overlap[(i, j)] = ov
+    else:
+        raise InputError(f"unknown pair mode {mode!r}")
+    return pairs, overlap
+
+
+# --------------------------------------------------------------------------- matching
+@dataclass(frozen=True)
+class PairMatch:
+    """Result of matching one pair (indices into the two images' keypoints).
+
+    ``status`` is ``ok`` or the reason the pair was dropped; ``residual_px`` is the
+    symmetric distance of each inlier to its epipolar lines (full-resolution pixels, the mean
+    of the two images' distances).
+    """
+
+    i: int
+    j: int
+    idx_i: NDArray[np.intp]
+    idx_j: NDArray[np.intp]
+    n_ratio: int
+    n_mutual: int
+    n_inliers: int
+    residual_px: Array
+    status: str
+    overlap: float = math.nan
+
+    @property
+    def kept(self) -> bool:
+        return self.status == "ok"
+
+
+def _knn(a: NDArray, b: NDArray, binary: bool, k: int):
+    """(best index, best distance, second distance) of each row of ``a`` in ``b``.
+
+    SIFT: FLANN's randomised k-d trees (Muja & Lowe 2009; 4 trees, 64 checks), an
+    approximate search several times faster than brute force at a few thousand features;
+    ORB: brute force on the Hamming distance.
+    """
+    import cv2
+
+    if binary:
+        matcher = cv2.BFMatcher(cv2.NORM_HAMMING)
+        qa, qb = a, b
+    else:
+        matcher = cv2.FlannBasedMatcher({"algorithm": 1, "trees": 4}, {"checks": 64})
+        qa, qb = a.astype(np.float32), b.astype(np.float32)
+    if len(qb) < k:
+        k = len(qb)
+    res = matcher.knnMatch(qa, qb, k=k)
+    n = len(res)
+    idx = np.full(n, -1, np.intp)
+    d1 = np.full(n, np.inf)
+    d2 = np.full(n, np.inf)
+    for r, m in enumerate(res):
+        if m:
+            idx[r] = m[0].trainIdx
+            d1[r] = m[0].distance
+            if len(m) > 1:
+                d2[r] = m[1].distance
+    return idx, d1, d2
+
+
+def epipolar_distances(f: Array, pa: Array, pb: Array) -> Array:
+    """Mean of the distances of b to the epipolar line F a and of a to F^T b, pixels.
+
+    >>> f = np.array([[0, 0, 0], [0, 0, -1], [0, 1, 0.0]])  # a pure sideways shift
+    >>> epipolar_distances(f, np.array([[5.0, 3.0]]), np.array([[9.0, 3.5]])).tolist()
+    [0.5]
+    """
+    ha = np.column_stack([pa, np.ones(len(pa))])
+    hb = np.column_stack([pb, np.ones(len(pb))])
+    la = ha @ f.T  # lines in b
+    lb = hb @ f  # lines in a
+    num = np.abs(np.sum(hb * la, axis=1))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        db = num / np.hypot(la[:, 0], la[:, 1])
+        da = num / np.hypot(lb[:, 0], lb[:, 1])
+    return 0.5 * (da + db)
+
+
+def match_pair(
+    fa: ImageFeatures,
+    fb: ImageFeatures,
+    options: TiePointOptions,
+    i: int = 0,
+    j: int = 1,
+    overlap: float = math.nan,
+) -> PairMatch:
+    """Ratio test, mutual check and fundamental-matrix RANSAC between two images.
+
+    The RANSAC works on the project pixel coordinates (full resolution) with a fixed seed
+    (OpenCV's), so a run is repeatable.
+    """
+    import cv2
+
+    empty = np.zeros(0, np.intp)
+
+    def drop(reason: str, nr: int = 0, nm: int = 0) -> PairMatch:
+        return PairMatch(i, j, empty, empty, nr, nm, 0, np.zeros(0), reason, overlap)
+
+    if len(fa) < 2 or len(fb) < 2:
+        return drop("too few features")
+    binary = options.detector == "orb"
+    best, d1, d2 = _knn(fa.descriptors, fb.descriptors, binary, 2)
+    ok = (best >= 0) & (d1 < options.ratio * d2)
+    ia = np.flatnonzero(ok)
+    ib = best[ia]
+    n_ratio = int(ia.size)
+    if options.mutual and ia.size:
+        back, _, _ = _knn(fb.descriptors[ib], fa.descriptors, binary, 1)
+        keep = back == ia
+        ia, ib = ia[keep], ib[keep]
+    # a keypoint of b chosen by two of a (possible without the mutual check): drop both
+    uniq, counts = np.unique(ib, return_counts=True)
+    single = np.isin(ib, uniq[counts == 1])
+    ia, ib = ia[single], ib[single]
+    n_mutual = int(ia.size)
+    if n_mutual < options.min_inliers:
+        return drop(f"too few matches ({n_mutual} after the ratio test and mutual check)",
+                    n_ratio, n_mutual)  # fmt: skip
+    pa, pb = fa.pixels[ia], fb.pixels[ib]
+    method = cv2.USAC_MAGSAC if options.ransac_method == "magsac" else cv2.FM_RANSAC
+    cv2.setRNGSeed(12345)
+    try:
+        f, mask = cv2.findFundamentalMat(pa, pb, method, float(options.ransac_px), 0.999, 10000)
+    except cv2.error:
+        f, mask = None, None
+    if f is None or mask is None or f.shape != (3, 3):
+        return drop("no fundamental matrix found (RANSAC failed)", n_ratio, n_mutual)
+    inl = mask.ravel().astype(bool)
+    res = epipolar_distances(f, pa[inl], pb[inl])
+    # MAGSAC's mask is its own weighting: keep the hard threshold as well
+    good = np.isfinite(res) & (res <= options.ransac_px)
+    sel = np.flatnonzero(inl)[good]
+    if options.coherence > 0 and sel.size > _NEIGHBOURS:
+        diag = math.hypot(*fa.size_px)
+        coherent = _coherent(pa[sel], pb[sel] - pa[sel], options.coherence * diag)
+        sel, res = sel[coherent], res[good][coherent]
+    else:
+        res = res[good]
+    n_in = int(sel.size)
+    if n_in < options.min_inliers:
+        return PairMatch(i, j, empty, empty, n_ratio, n_mutual, n_in, np.zeros(0),
+                         f"too few RANSAC inliers ({n_in} < {options.min_inliers})",
+                         overlap)  # fmt: skip
+    return PairMatch(i, j, ia[sel], ib[sel], n_ratio, n_mutual, n_in, res, "ok", overlap)
+
+
+_NEIGHBOURS = 8
+
+
+def _coherent(p: Array, d: Array, tol_px: float) -> NDArray[np.bool_]:
+    """Matches whose displacement ``d`` agrees within ``tol_px`` with the median
+    displacement of their nearest matches (positions ``p`` in the first image).
+
+    >>> p = np.random.default_rng(1).random((40, 2)) * 100
+    >>> d = np.tile([5.0, 0.0], (40, 1)); d[3] = [60.0, 0.0]
+    >>> np.flatnonzero(~_coherent(p, d, 10.0)).tolist()
+    [3]
+    """
+    from scipy.spatial import cKDTree
+
+    _, nn = cKDTree(p).query(p, k=_NEIGHBOURS + 1)
+    med = np.median(d[nn[:, 1:]], axis=1)
+    return np.hypot(*(d - med).T) <= tol_px
+
+
+# --------------------------------------------------------------------------- tracks
+@dataclass(frozen=True)
+class Tracks:
+    """Tie points: one row per measurement (image, track), sorted by track then image.
+
+    ``track`` numbers the tracks 0..T-1; ``feature`` is the keypoint index in its image.
+    ``rejected_inconsistent`` counts the tracks dropped for holding two keypoints of one
+    image, ``rejected_short`` those below the minimum length.
+    """
+
+    track: NDArray[np.intp]
+    image: NDArray[np.intp]
+    feature: NDArray[np.intp]
+    pixels: Array
+    rejected_inconsistent: int
+    rejected_short: int
+
+    @property
+    def n_tracks(self) -> int:
+        return int(self.track.max()) + 1 if self.track.size else 0
+
+    def lengths(self) -> NDArray[np.intp]:
+        """Images per track."""
+        return np.bincount(self.track, minlength=self.n_tracks)
+
+
+def build_tracks(
+    features: Sequence[ImageFeatures], matches: Sequence[PairMatch], min_track_length: int = 2
+) -> Tracks:
+    """Merge the kept pairwise matches into tracks (connected components, union-find).
+
+    Examples
+    --------
+    >>> z = np.zeros((3, 2)); d = np.zeros((3, 128), np.uint8); s = np.ones(3, np.float32)
+    >>> fs = [ImageFeatures(n, (10, 10), 1, z, s, d) for n in "abc"]
+    >>> e = np.array([0, 1]); r = np.zeros(2)
+    >>> m = [PairMatch(0, 1, e, e, 2, 2, 2, r, "ok"), PairMatch(1, 2, e, e[::-1], 2, 2, 2, r, "ok")]
+    >>> t = build_tracks(fs, m)  # a0-b0-c1 and a1-b1-c0
+    >>> t.n_tracks, t.lengths().tolist(), t.feature.tolist()
+    (2, [3, 3], [0, 0, 1, 1, 1, 0])
+    >>> m.append(PairMatch(0, 2, e[:1], e[:1], 1, 1, 1, r[:1], "ok"))  # a0-c0: joins both
+    >>> t = build_tracks(fs, m); t.n_tracks, t.rejected_inconsistent
+    (0, 1)
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    counts = np.array([len(f) for f in features], dtype=np.intp)
+    offset = np.concatenate([[0], np.cumsum(counts)])
+    kept = [m for m in matches if m.kept and m.idx_i.size]
+    empty = np.zeros(0, np.intp)
+    if not kept:
+        return Tracks(empty, empty, empty, np.zeros((0, 2)), 0, 0)
+    a = np.concatenate([offset[m.i] + m.idx_i for m in kept])
+    b = np.concatenate([offset[m.j] + m.idx_j for m in kept])
+    nodes, inv = np.unique(np.concatenate([a, b]), return_inverse=True)
+    n = nodes.size
+    ea, eb = inv[: a.size], inv[a.size :]
+    graph = coo_matrix((np.ones(ea.size, np.int8), (ea, eb)), shape=(n, n))
+    _, comp = connected_components(graph, directed=False)
+    img = np.searchsorted(offset, nodes, side="right") - 1
+    feat = nodes - offset[img]
+    order = np.lexsort((img, comp))
+    comp, img, feat, nodes = comp[order], img[order], feat[order], nodes[order]
+    # two keypoints of one image in a track: sorted by (track, image), they are neighbours
+    dup = (comp[1:] == comp[:-1]) & (img[1:] == img[:-1])
+    bad = np.zeros(comp.max() + 1, bool)
+    bad[comp[1:][dup]] = True
+    length = np.bincount(comp)
+    short = (length < min_track_length) & ~bad
+    keep_comp = ~bad & ~short
+    keep = keep_comp[comp]
+    new_id = np.cumsum(keep_comp) - 1
+    track = new_id[comp[keep]]
+    pix = np.vstack([f.pixels for f in features])[nodes[keep]]
+    return Tracks(track.astype(np.intp), img[keep].astype(np.intp), feat[keep].astype(np.intp),
+                  pix, int(bad.sum()), int(short.sum()))  # fmt: skip
+
+
+# --------------------------------------------------------------------------- the chain
+@dataclass
+class TiePointResult:
+    """Everything :func:`tie_points` found.
+
+    Attributes
+    ----------
+    image_ids : tuple of str
+    features : list of int
+        Keypoints per image.
+    factors : list of int
+        Detection reduction factor per image.
+    pairs : list of PairMatch
+        Every pair tried, kept or not (with the reason).
+    tracks : Tracks
+    sigma_px : ndarray
+        A-priori sigma of each measurement of ``tracks``, pixels.
+    """
+
+    image_ids: tuple[str, ...]
+    features: list[int]
+    factors: list[int]
+    pairs: list[PairMatch]
+    tracks: Tracks
+    sigma_px: Array = field(default_factory=lambda: np.zeros(0))
+
+    def summary(self) -> dict[str, object]:
+        """Counts for reports: pairs tried and kept, matches per kept pair (median, min,
+        max), tracks by length, measurements, reasons of the dropped pairs."""
+        kept = [p for p in self.pairs if p.kept]
+        inl = np.array([p.n_inliers for p in kept]) if kept else np.zeros(0, int)
+        reasons: dict[str, int] = {}
+        for p in self.pairs:
+            if not p.kept:
+                key = p.status.split(" (")[0]
+                reasons[key] = reasons.get(key, 0) + 1
+        lengths = self.tracks.lengths()
+        by_len = {int(k): int(v) for k, v in zip(*np.unique(lengths, return_counts=True))}
+        res = np.concatenate([p.residual_px for p in kept]) if kept else np.zeros(0)
+        seen = set(np.unique(self.tracks.image).tolist())
+        return {
+            "images": len(self.image_ids),
+            "pairs_tried": len(self.pairs),
+            "pairs_kept": len(kept),
+            "inliers_median": float(np.median(inl)) if inl.size else 0.0,
+            "inliers_min": int(inl.min()) if inl.size else 0,
+            "inliers_max": int(inl.max()) if inl.size else 0,
+            "epipolar_median_px": float(np.median(res)) if res.size else math.nan,
+            "epipolar_p95_px": float(np.percentile(res, 95)) if res.size else math.nan,
+            "tracks": self.tracks.n_tracks,
+            "tracks_by_length": by_len,
+            "measurements": int(self.tracks.track.size),
+            "rejected_inconsistent": self.tracks.rejected_inconsistent,
+            "images_without_tie": [i for k, i in enumerate(self.image_ids) if k not in seen],
+            "dropped_pairs": reasons,
+        }
+
+    def observations(self, prefix: str = "tp"):
+        """The tie points as :class:`~lidarphoto.core.photo.observations.ImageObservations`
+        (type ``tie``, point ids ``<prefix>000001`` ..., target_id empty)."""
+        from .observations import ImageObservations
+
+        t = self.tracks
+        n = t.track.size
+        width = max(6, len(str(t.n_tracks)))
+        return ImageObservations(
+            tuple(self.image_ids[k] for k in t.image),
+            tuple(f"{prefix}{k + 1:0{width}d}" for k in t.track),
+            t.pixels,
+            self.sigma_px if self.sigma_px.size == n else np.full(n, 0.5),
+            ("tie",) * n,
+            ("",) * n,
+        )
+
+
+def tie_points(
+    image_ids: Sequence[str],
+    load: Callable[[int], ImageFeatures],
+    options: TiePointOptions,
+    footprint: Sequence[Array | None] | None = None,
+    *,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+    on_features: Callable[[ImageFeatures], None] | None = None,
+) -> TiePointResult:
+    """The whole chain (module docstring).
+
+    Parameters
+    ----------
+    image_ids : sequence of str
+    load : callable
+        ``load(k)`` returns the :class:`ImageFeatures` of image ``k`` (the caller reads the
+        image and calls :func:`detect_features`: only the features are kept here).
+    options : TiePointOptions
+    footprint : sequence of (4, 2) arrays or None, optional
+        Ground footprints (:func:`footprints`), for the footprint pair mode.
+    progress, should_stop
+        Fraction done (features 0..0.5, matching 0.5..1); cancellation per image and pair.
+    """
+    n = len(image_ids)
+    feats: list[ImageFeatures] = []
+    for k in range(n):
+        stop_if_asked(should_stop, f"detecting features ({image_ids[k]})")
+        f = load(k)
+        feats.append(f)
+        if on_features is not None:
+            on_features(f)
+        if progress is not None:
+            progress(0.5 * (k + 1) / n)
+    mode = options.pair_mode
+    if mode == "auto":
+        mode = "footprints" if footprint is not None else "sequential"
+    pairs, overlap = select_pairs(n, mode, options.window, footprint, options.min_overlap)
+    results: list[PairMatch] = []
+    for m, (i, j) in enumerate(pairs):
+        stop_if_asked(should_stop, f"matching {image_ids[i]} with {image_ids[j]}")
+        results.append(match_pair(feats[i], feats[j], options, i, j,
+                                  overlap.get((i, j), math.nan)))  # fmt: skip
+        if progress is not None:
+            progress(0.5 + 0.5 * (m + 1) / max(len(pairs), 1))
+    tracks = build_tracks(feats, results, options.min_track_length)
+    factors = [f.factor for f in feats]
+    if options.sigma_px > 0:
+        sigma = np.full(tracks.track.size, float(options.sigma_px))
+    else:
+        sigma = 0.5 * np.asarray(factors, float)[tracks.image] if tracks.track.size else np.zeros(0)
+    return TiePointResult(tuple(image_ids), [len(f) for f in feats], factors, results, tracks,
+                          sigma)  # fmt: skip

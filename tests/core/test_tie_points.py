@@ -1,0 +1,283 @@
+"""Automatic tie points (core/photo/tie_points.py, core/jobs/tie_points.py) against truth.
+
+A textured rendering of the simulated UAV block (known camera, poses and terrain) is matched
+by the job; every measurement is compared with the projection of the true ground point of
+its track, and the block is adjusted with the automatic tie points and the simulator's
+control/check measurements.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from lidarphoto.core.errors import Cancelled, InputError
+from lidarphoto.core.geometry.camera import Camera
+from lidarphoto.core.geometry.collinearity import project_with_status
+from lidarphoto.core.io.camera import write_camera_json
+from lidarphoto.core.io.observations import read_observations_csv
+from lidarphoto.core.io.orientation import write_eo_csv
+from lidarphoto.core.jobs import tie_points as job
+from lidarphoto.core.jobs.runner import run_job
+from lidarphoto.core.photo.tie_points import (
+    ImageFeatures,
+    PairMatch,
+    TiePointOptions,
+    build_tracks,
+    detect_features,
+    footprints,
+    match_pair,
+    select_pairs,
+)
+from lidarphoto.core.simulation.textured_block import (
+    TexturedBlock,
+    ground_of_pixels,
+    make_texture,
+    render_view,
+)
+from lidarphoto.core.simulation.uav_block import simulate_uav_block
+
+cv2 = pytest.importorskip("cv2")
+
+KAP = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "odm-copr-kap-gcp"
+SMALL = Camera("small", focal_mm=5.0, pixel_size_mm=0.00616, width_px=1000, height_px=750)
+#: Rendering noise (grey levels) and the keypoint precision it allows; see test_truth.
+NOISE_DN = 2.0
+
+
+@pytest.fixture(scope="module")
+def block(tmp_path_factory):
+    """15 rendered images (1000 x 750 px, GSD 23 cm) of the UAV block, no lens distortion."""
+    folder = tmp_path_factory.mktemp("tie")
+    blk = simulate_uav_block("none", seed=3, n_tie=50, camera=SMALL, true_focal_mm=5.03,
+                             true_x0_mm=0.03, true_y0_mm=-0.02)  # fmt: skip
+    tb = TexturedBlock.of(blk)
+    tex = make_texture(tb.extent(), 0.2, seed=1)
+    images = folder / "images"
+    images.mkdir()
+    for k, name in enumerate(blk.eo_true.image_id):
+        cv2.imwrite(str(images / f"{name}.png"), render_view(tb, tex, k, noise_dn=NOISE_DN))
+    write_eo_csv(folder / "eo.csv", blk.eo_dg)
+    write_camera_json(folder / "camera.json", blk.camera)
+    return tb, folder
+
+
+@pytest.fixture(scope="module")
+def matched(block):
+    tb, folder = block
+    seen = []
+    res = run_job(job, {
+        "IMAGES": [str(folder / "images")], "EO": str(folder / "eo.csv"),
+        "CAMERA": str(folder / "camera.json"), "HEIGHT": tb.block.config.ground_height_m,
+        "MAX_FEATURES": 1500, "OUTPUT_OBSERVATIONS": str(folder / "tie.csv"),
+        "OUTPUT_PAIRS": str(folder / "pairs.csv"),
+    }, progress=seen.append)  # fmt: skip
+    return res, read_observations_csv(folder / "tie.csv", camera=tb.block.camera), seen
+
+
+def _truth_errors(tb, obs):
+    """|measured - projected true point| per row, pixels; the true point of a track is the
+    median of the exact ground points of its measurements (a wrong measurement cannot move
+    it when the others agree)."""
+    ids = list(tb.block.eo_true.image_id)
+    img = np.array([ids.index(i) for i in obs.image_id])
+    _, track = np.unique(obs.point_id, return_inverse=True)
+    ground = np.zeros((len(obs), 3))
+    for k in np.unique(img):
+        sel = img == k
+        ground[sel] = ground_of_pixels(tb, obs.pixels[sel], k)
+    local = tb.local.map_to_enu(ground)
+    med = np.array([np.median(local[track == t], axis=0) for t in range(track.max() + 1)])
+    err = np.zeros(len(obs))
+    for k in np.unique(img):
+        sel = np.flatnonzero(img == k)
+        px, _, _ = project_with_status(med[track[sel]], tb.eo_local[k], tb.block.true_camera)
+        err[sel] = np.hypot(*(px - obs.pixels[sel]).T)
+    return err, track
+
+
+def test_renderer_interpolation_is_exact_to_a_hundredth_of_a_pixel(block):
+    """The rendered image's ground map is interpolated between lattice nodes: at random
+    pixels the interpolated ground point reprojects within 0.01 px of the pixel."""
+    tb, _ = block
+    from lidarphoto.core.simulation.textured_block import _bilinear_matrix
+
+    rng = np.random.default_rng(0)
+    px = rng.uniform([0, 0], [SMALL.width_px, SMALL.height_px], (200, 2))
+    step = 16
+    nc = math.ceil((SMALL.width_px - 1) / step) + 1
+    nr = math.ceil((SMALL.height_px - 1) / step) + 1
+    grid = np.stack(np.meshgrid(0.5 + np.arange(nc) * step, 0.5 + np.arange(nr) * step),
+                    -1).reshape(-1, 2)  # fmt: skip
+    g = tb.local.map_to_enu(ground_of_pixels(tb, grid, 4))
+    ar = _bilinear_matrix(SMALL.height_px, step, nr).astype(float)
+    ac = _bilinear_matrix(SMALL.width_px, step, nc).astype(float)
+    c, r = np.floor(px).astype(int).T
+    interp = np.column_stack([np.sum(ar[r] @ g[:, j].reshape(nr, nc) * ac[c], axis=1)
+                              for j in range(3)])  # fmt: skip
+    back, _, _ = project_with_status(interp, tb.eo_local[4], tb.block.true_camera)
+    assert np.abs(back - (np.floor(px) + 0.5)).max() < 0.01
+
+
+def test_truth_image_errors_and_no_wrong_tracks(block, matched):
+    res, obs, _ = matched
+    tb, _ = block
+    err, track = _truth_errors(tb, obs)
+    # two independent SIFT detections at 2 grey levels of noise: a few tenths of a pixel
+    assert np.median(err) < 0.4 and np.percentile(err, 95) < 1.2
+    # wrong measurements (> 3 px off the true point's projection) are rare
+    bad_tracks = np.unique(track[err > 3.0])
+    assert bad_tracks.size <= 0.002 * (track.max() + 1)
+    assert res.results["TRACK_COUNT"] == track.max() + 1 > 1000
+    assert set(obs.type) == {"tie"} and set(obs.target_id) == {""}
+    # the sigma written is the automatic one (detection at full resolution: 0.5 px)
+    assert np.all(obs.sigma_px == 0.5)
+
+
+def test_pairs_from_footprints_and_the_pair_table(block, matched):
+    tb, folder = block
+    blk = tb.block
+    fp = footprints(blk.camera, blk.eo_dg.xyz, blk.eo_dg.opk, blk.config.ground_height_m)
+    pairs, overlap = select_pairs(15, "footprints", footprint=fp, min_overlap=0.05)
+    # strips 1 and 4 (1.2 image widths apart) never overlap; neighbours in a strip do
+    strip = np.array([int(i[4:6]) for i in blk.eo_true.image_id])
+    assert all(abs(strip[i] - strip[j]) <= 2 for i, j in pairs)
+    assert (0, 1) in pairs and overlap[(0, 1)] > 0.5
+    with open(folder / "pairs.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == len(pairs) == matched[0].results["PAIRS_TRIED"]
+    kept = [r for r in rows if r["status"] == "ok"]
+    assert len(kept) == matched[0].results["PAIRS_KEPT"] >= len(rows) - 2
+    assert all(int(r["inliers"]) >= 15 for r in kept)
+    # a dropped pair is a thin overlap, with its reason
+    assert all(float(r["overlap"]) < 0.25 and r["status"].startswith("too few")
+               for r in rows if r["status"] != "ok")  # fmt: skip
+    assert matched[2] and matched[2][-1] == pytest.approx(1.0)
+
+
+def test_bundle_with_automatic_tie_points(block, matched):
+    """The block adjusted with the automatic tie points (and the simulator's control and
+    check measurements) reaches the check-point RMSE of the simulator's perfect tie points
+    within 10 %, and below 0.15 m in plan at a GSD of 23 cm."""
+    from lidarphoto.core.photo.bundle import BundleOptions, bundle_adjust
+
+    tb, _ = block
+    blk = tb.block
+    _, obs, _ = matched
+    sim = blk.observations
+    gcp = sim.subset(np.array([p.startswith("GCP") for p in sim.point_id]))
+    opts = BundleOptions(ap_model="none", ap_selection=False, robust="none", snooping=False)
+    ref = bundle_adjust([blk.camera], sim, blk.ground, blk.mapping, blk.eo_dg, blk.eo_sigma,
+                        options=opts)  # fmt: skip
+    auto = bundle_adjust([blk.camera], gcp.concat(obs), blk.ground, blk.mapping, blk.eo_dg,
+                         blk.eo_sigma, options=opts)  # fmt: skip
+    r_ref = ref.check.statistics()["rms_3d"]
+    r_auto = auto.check.statistics()["rms_3d"]
+    # measured: 0.46 m against 0.58 m (heights dominate: the principal distance is
+    # estimated over gently undulating ground); planimetric 0.10 m against 0.21 m
+    assert r_auto <= 1.1 * r_ref, (r_auto, r_ref)
+    assert auto.check.statistics()["rms_planimetric"] < 0.15
+    assert np.abs(auto.eo.xyz - blk.eo_true.xyz).max() < 0.3
+
+
+def test_downscaled_detection_scale_back_without_bias(block):
+    """Detection on the image reduced by 2 (decoded at half size) gives full-resolution
+    coordinates without bias: between images turned by 180 degrees (neighbouring strips of
+    the serpentine block) a constant keypoint offset would show twice. OpenCV's SIFT without
+    its precise upscaling: 0.5 px at factor 1, 1.0 px at factor 2 (measured)."""
+    tb, folder = block
+    from lidarphoto.core.io.images import read_gray
+
+    names = tb.block.eo_true.image_id
+    for det, factor, tol in (("sift", 2, 0.25), ("sift", 1, 0.2), ("orb", 1, 1.0)):
+        opt = TiePointOptions(detector=det, max_features=2000)
+        f = {k: detect_features(read_gray(folder / "images" / f"{names[k]}.png", factor),
+                                names[k], opt, factor=factor) for k in (0, 1, 7)}  # fmt: skip
+        for a, b in ((0, 1), (0, 7)):  # same heading, opposite heading
+            m = match_pair(f[a], f[b], opt)
+            assert m.kept and m.n_inliers > 100
+            g = tb.local.map_to_enu(ground_of_pixels(tb, f[a].pixels[m.idx_i], a))
+            px, _, _ = project_with_status(g, tb.eo_local[b], tb.block.true_camera)
+            d = f[b].pixels[m.idx_j] - px
+            assert np.median(np.hypot(*d.T)) < tol, (det, factor, a, b)
+            if det == "sift":
+                assert np.all(np.abs(np.median(d, axis=0)) < 0.05), (factor, a, b)
+
+
+def test_no_eo_sequential_and_cancel(block):
+    _tb, folder = block
+    out = folder / "seq.csv"
+    values = {"IMAGES": [str(folder / "images")], "PAIR_MODE": "sequential", "WINDOW": 2,
+              "MAX_FEATURES": 800, "OUTPUT_OBSERVATIONS": str(out)}  # fmt: skip
+    res = run_job(job, values)
+    assert res.results["PAIRS_TRIED"] == 14 + 13
+    assert res.results["TRACK_COUNT"] > 500
+    calls = []
+    with pytest.raises(Cancelled):
+        run_job(job, {"IMAGES": [str(folder / "images")], "MAX_FEATURES": 500,
+                      "OUTPUT_OBSERVATIONS": str(folder / "c.csv")},
+                should_stop=lambda: calls.append(1) or len(calls) > 3)  # fmt: skip
+    assert not (folder / "c.csv").exists()
+
+
+def test_bad_inputs_are_named(block, tmp_path):
+    _tb, folder = block
+    broken = tmp_path / "IMG_9999.jpg"
+    broken.write_bytes(b"not a jpeg")
+    with pytest.raises(InputError, match="IMG_9999"):
+        run_job(job, {"IMAGES": [str(folder / "images" / "IMG_0101.png"), str(broken)],
+                      "OUTPUT_OBSERVATIONS": str(tmp_path / "x.csv")})  # fmt: skip
+    # two images that do not overlap: the pair is reported, and nothing matched is an error
+    far = [str(folder / "images" / "IMG_0101.png"), str(folder / "images" / "IMG_0403.png")]
+    with pytest.raises(InputError, match="no tie point found: 0 of 1 pairs"):
+        run_job(job, {"IMAGES": far, "OUTPUT_OBSERVATIONS": str(tmp_path / "y.csv")})
+    assert not (tmp_path / "y.csv").exists()
+    # one image without overlap among overlapping ones: reported, not an error
+    three = [str(folder / "images" / f"IMG_{n}.png") for n in ("0101", "0102", "0403")]
+    res = run_job(job, {"IMAGES": three, "PAIR_MODE": "all", "MAX_FEATURES": 800,
+                        "OUTPUT_OBSERVATIONS": str(tmp_path / "w.csv")})  # fmt: skip
+    assert res.results["PAIRS_TRIED"] == 3 and res.results["PAIRS_KEPT"] == 1
+    assert any("1 image(s) without tie points" in line and "IMG_0403" in line
+               for line in res.lines)  # fmt: skip
+    assert set(read_observations_csv(tmp_path / "w.csv").image_id) == {"IMG_0101", "IMG_0102"}
+    # EO without camera
+    with pytest.raises(InputError, match="both"):
+        run_job(job, {"IMAGES": far, "EO": str(folder / "eo.csv"),
+                      "OUTPUT_OBSERVATIONS": str(tmp_path / "z.csv")})  # fmt: skip
+
+
+def test_tracks_reject_two_points_of_one_image():
+    z = np.zeros((3, 2))
+    d = np.zeros((3, 128), np.uint8)
+    s = np.ones(3, np.float32)
+    fs = [ImageFeatures(n, (10, 10), 1, z, s, d) for n in "abcd"]
+    e = np.array([0, 1])
+    r = np.zeros(2)
+    chain = [PairMatch(0, 1, e, e, 2, 2, 2, r, "ok"), PairMatch(1, 2, e, e, 2, 2, 2, r, "ok"),
+             PairMatch(2, 3, e[:1], e[:1], 1, 1, 1, r[:1], "ok")]  # fmt: skip
+    t = build_tracks(fs, chain, min_track_length=3)
+    assert t.n_tracks == 2 and t.lengths().tolist() == [4, 3]
+    t = build_tracks(fs, chain, min_track_length=4)
+    assert t.n_tracks == 1 and t.rejected_short == 1
+    wrong = [*chain, PairMatch(0, 2, e[:1], e[1:], 1, 1, 1, r[:1], "ok")]  # a0 - c1
+    t = build_tracks(fs, wrong)
+    assert t.n_tracks == 0 and t.rejected_inconsistent == 1
+
+
+@pytest.mark.skipif(not KAP.is_dir(), reason="../shared/data/odm-copr-kap-gcp is absent")
+def test_real_kite_block_without_eo(tmp_path):
+    """14 kite photos (CC BY-SA, read in place) without orientation: sequential pairs."""
+    out = tmp_path / "kap.csv"
+    res = run_job(job, {"IMAGES": [str(KAP / "images")], "PAIR_MODE": "sequential",
+                        "WINDOW": 3, "MAX_FEATURES": 3000, "OUTPUT_OBSERVATIONS": str(out),
+                        "OUTPUT_PAIRS": str(tmp_path / "kap_pairs.csv")})  # fmt: skip
+    s = res.data.summary()
+    # the manifest: neighbouring images share 30+ RANSAC inliers; the block is connected
+    assert s["pairs_kept"] >= 13 and not s["images_without_tie"]
+    assert s["epipolar_median_px"] < 0.5
+    assert res.results["TRACK_COUNT"] > 1000
+    obs = read_observations_csv(out)
+    assert len(set(obs.image_id)) == 14
