@@ -15,6 +15,7 @@ from .algorithms.create_lcps import CreateLcpsAlgorithm
 from .algorithms.extract_roof_planes import ExtractRoofPlanesAlgorithm
 from .algorithms.extract_tls_targets import ExtractTlsTargetsAlgorithm
 from .algorithms.ground_filter import GroundFilterAlgorithm
+from .algorithms.make_control_chips import MakeControlChipsAlgorithm
 from .algorithms.monoplot import MonoplotAlgorithm
 from .algorithms.orthomosaic import OrthomosaicAlgorithm
 from .algorithms.orthorectify import OrthorectifyAlgorithm
@@ -61,5 +62,6 @@ class LidarPhotoProvider(QgsProcessingProvider):
             OrthomosaicAlgorithm(),
             TlsCalibrationAlgorithm(),
             ExtractTlsTargetsAlgorithm(),
+            MakeControlChipsAlgorithm(),
         ):
             self.addAlgorithm(alg)

@@ -9,6 +9,7 @@ from . import (
     extract_roof_planes,
     extract_tls_targets,
     ground_filter,
+    make_control_chips,
     monoplot,
     orthomosaic,
     orthorectify,
@@ -32,4 +33,5 @@ ALGORITHMS = (
     orthomosaic,
     tls_calibration,
     extract_tls_targets,
+    make_control_chips,
 )
