@@ -251,17 +251,21 @@ def rectify_to_plane(
     f = (np.arange(n * s) + 0.5) / s  # sub-sample centres, in cells
     xs = x0 - ox + f * g
     ys = y0 - oy - f * g
-    gx, gy = np.meshgrid(xs, ys)
-    pts = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, z)])
-    px, front, conv = project_with_status(pts, e, camera)
-    good = front & conv & camera.in_frame(np.nan_to_num(px, nan=-1.0), margin_px=0.5)
-    mx = np.where(good, px[:, 0] - 0.5, -1e6).astype(np.float32).reshape(n * s, n * s)
-    my = np.where(good, px[:, 1] - 0.5, -1e6).astype(np.float32).reshape(n * s, n * s)
-    sub = cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
-                    borderValue=np.nan)  # fmt: skip
-    sub = sub.reshape(n, s, n, s)
-    # a cell with any sub-sample outside the photo is NaN (no partial cells)
-    chip = sub.mean(axis=(1, 3)).astype(np.float32)
+    chip = np.empty((n, n), np.float32)
+    rows_per_block = max(1, (1 << 20) // (n * s * s))  # about a million sub-samples a block
+    for r0 in range(0, n, rows_per_block):
+        r1 = min(n, r0 + rows_per_block)
+        gx, gy = np.meshgrid(xs, ys[r0 * s : r1 * s])
+        pts = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, z)])
+        px, front, conv = project_with_status(pts, e, camera)
+        good = front & conv & camera.in_frame(np.nan_to_num(px, nan=-1.0), margin_px=0.5)
+        shape = gx.shape
+        mx = np.where(good, px[:, 0] - 0.5, -1e6).astype(np.float32).reshape(shape)
+        my = np.where(good, px[:, 1] - 0.5, -1e6).astype(np.float32).reshape(shape)
+        sub = cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
+                        borderValue=np.nan)  # fmt: skip
+        # a cell with any sub-sample outside the photo is NaN (no partial cells)
+        chip[r0:r1] = sub.reshape(r1 - r0, s, n, s).mean(axis=(1, 3))
     return chip, s
 
 

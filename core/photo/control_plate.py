@@ -25,7 +25,8 @@ Detection (:func:`detect_plate`)
    one inside the other, with about the same centre (within 15 % of the outer side), whose
    inner corners the homography of the outer corners onto the square (+-1, +-1) takes to
    (+-r, +-r), r = inner/outer, within 0.12 (perspective keeps this; a blob merged with the
-   plate's edge or a random pair of ground shapes does not). Pairs sharing a centre (found in
+   plate's edge or a random pair of ground shapes does not), and whose frame is at least half
+   as wide as expected and 5 px wide (one edge found at two thresholds is not a plate). Pairs sharing a centre (found in
    several binarisations) are one plate: the best fitting is kept.
 2. **Edges** at sub-pixel precision: across each of the eight sides of the candidate pair, grey
    profiles sampled every 0.25 px (bilinear on the photo smoothed with a Gaussian of 1 px) on
@@ -87,6 +88,8 @@ _IDENTITY_EO = np.zeros(6)
 PROFILE_STEP_PX = 0.25
 #: Half width of the window of the gradient centroid, pixels.
 EDGE_WINDOW_PX = 1.5
+#: Narrowest frame (half the difference of the sides) taken as a plate's, pixels.
+MIN_FRAME_PX = 5.0
 #: Fraction of each side (its middle) sampled for edge points.
 SIDE_FRACTION = 0.8
 
@@ -330,6 +333,12 @@ def _pairs(quads: list[Array], ratio: float, tol: float = 0.12) -> list[tuple[Ar
             if not area_ratio / 2.0 <= areas[j] / areas[i] <= area_ratio * 2.0:
                 continue
             if np.hypot(*(centres[i] - centres[j])) > 0.15 * side:
+                continue
+            # two edges, not one edge found at two thresholds (a blurred edge spreads its
+            # contours over a few pixels): a frame at least half as wide as the plate's and
+            # MIN_FRAME_PX wide (the edge profiles of its two sides must not overlap)
+            gap = side - math.sqrt(areas[j])
+            if gap < max(2.0 * MIN_FRAME_PX, 0.5 * (1.0 - ratio) * side):
                 continue
             if not all(_inside(p, outer) for p in inner):
                 continue

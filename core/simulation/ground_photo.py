@@ -126,12 +126,15 @@ def render_ground_photo(
 ) -> NDArray[np.float32]:
     """(rows, cols) float32 grey photo of the patch (and plate) from ``eo`` (local frame,
     metres and radians)."""
+    import cv2
+
     e = np.asarray(eo, dtype=np.float64)
     w, h, s = camera.width_px, camera.height_px, int(supersample)
     sub = (np.arange(s) + 0.5) / s
     cols = (np.arange(w)[:, None] + sub[None, :]).ravel()
     img = np.empty((h, w), np.float64)
-    mixed = np.zeros((h, w), bool)
+    lo = np.zeros((h, w), np.uint8)
+    hi = np.zeros((h, w), np.uint8)
     block = max(1, (1 << 20) // (w * s * s))
     for r0 in range(0, h, block):
         rows = (np.arange(r0, min(h, r0 + block))[:, None] + sub[None, :]).ravel()
@@ -141,7 +144,13 @@ def render_ground_photo(
         n = len(rows) // s
         img[r0 : r0 + n] = val.reshape(n, s, w, s).mean(axis=(1, 3))
         lab = lab.reshape(n, s, w, s)
-        mixed[r0 : r0 + n] = lab.min(axis=(1, 3)) != lab.max(axis=(1, 3))
+        lo[r0 : r0 + n] = lab.min(axis=(1, 3))
+        hi[r0 : r0 + n] = lab.max(axis=(1, 3))
+    # a pixel on an edge: its rays see two things, or a neighbour sees something else (with
+    # few rays per pixel an edge can pass between them)
+    lo = cv2.erode(lo, np.ones((3, 3), np.uint8))
+    hi = cv2.dilate(hi, np.ones((3, 3), np.uint8))
+    mixed = lo != hi
     # pixels on the plate's edges again with EDGE_SUPERSAMPLE^2 rays: the edge's position in
     # the grey level is then exact to 1/EDGE_SUPERSAMPLE^2 of a pixel's area
     r, c = np.nonzero(mixed)
