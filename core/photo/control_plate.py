@@ -26,8 +26,8 @@ Detection (:func:`detect_plate`)
    inner corners the homography of the outer corners onto the square (+-1, +-1) takes to
    (+-r, +-r), r = inner/outer, within 0.12 (perspective keeps this; a blob merged with the
    plate's edge or a random pair of ground shapes does not), and whose frame is at least half
-   as wide as expected and 5 px wide (one edge found at two thresholds is not a plate). Pairs sharing a centre (found in
-   several binarisations) are one plate: the best fitting is kept.
+   as wide as expected and 5 px wide (one edge found at two thresholds is not a plate). Pairs
+   sharing a centre (found in several binarisations) are one plate: the best fitting is kept.
 2. **Edges** at sub-pixel precision: across each of the eight sides of the candidate pair, grey
    profiles sampled every 0.25 px (bilinear on the photo smoothed with a Gaussian of 1 px) on
    normals spaced 1 px along the side's middle 80 % (bicubic), the edge point is the centroid

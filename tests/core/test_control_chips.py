@@ -18,7 +18,6 @@ from pathlib import Path
 import numpy as np
 import pyproj
 import pytest
-
 from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.geometry.camera import camera_from_dict
 from lidarphoto.core.geometry.collinearity import project
