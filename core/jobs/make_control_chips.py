@@ -44,8 +44,8 @@ homography) and resected from the matched ground points.
 point: the chip (the plate hides the ground, hence the plate-free photo). Without a
 plate-free photo, Chip from the plate photo makes it from the plate photo.
 
-Ground points: the ground-point CSV (point_id, X, Y, Z; a role column is ignored) in the
-mapping CRS. Photos: a ground-photo table (point_id, plate_photo, free_photo, and optional
+Ground points: the ground-point CSV of the bundle adjustment (point_id, X, Y, Z, role; every
+point gets a chip, whatever its role) in the mapping CRS. Photos: a ground-photo table (point_id, plate_photo, free_photo, and optional
 photo_azimuth_deg, plate_azimuth_deg), or files / folders searched by name:
 <point_id><plate suffix>.<ext> and <point_id><free suffix>.<ext>.
 
@@ -57,7 +57,7 @@ too large, too few SIFT matches, chip partly outside the photo) gets its reason 
 the others are written.""",
     params=(
         Param("POINTS", "file", "Ground points (CSV)", file_filter=CSV_FILTER,
-              help="point_id, X, Y, Z in the mapping CRS"),
+              help="point_id, X, Y, Z, role (the bundle adjustment's table)"),
         Param("CRS", "crs", "Mapping CRS of the points", help="e.g. EPSG:31983"),
         Param("CAMERA", "file", "Ground camera (JSON)", file_filter="JSON files (*.json)"),
         Param("PHOTO_TABLE", "file", "Ground-photo table (CSV)", optional=True,
