@@ -45,8 +45,9 @@ point: the chip (the plate hides the ground, hence the plate-free photo). Withou
 plate-free photo, Chip from the plate photo makes it from the plate photo.
 
 Ground points: the ground-point CSV of the bundle adjustment (point_id, X, Y, Z, role; every
-point gets a chip, whatever its role) in the mapping CRS. Photos: a ground-photo table (point_id, plate_photo, free_photo, and optional
-photo_azimuth_deg, plate_azimuth_deg), or files / folders searched by name:
+point gets a chip, whatever its role) in the mapping CRS. Photos: a ground-photo table
+(point_id, plate_photo, free_photo, and optional photo_azimuth_deg, plate_azimuth_deg), or
+files / folders searched by name:
 <point_id><plate suffix>.<ext> and <point_id><free suffix>.<ext>.
 
 Output folder: <point_id>.tif per chip (float32 grey, nodata -9999, the geotransform puts the
@@ -159,6 +160,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         write_report_json,
     )
     from ..io.ground_points import read_ground_points_csv
+    from ..io.raster import RasterReader
     from ..photo.control_chips import ChipResult, make_chip
 
     points = read_ground_points_csv(v.points)
@@ -186,6 +188,15 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                           max_sigma0=v.max_sigma0, sift_ratio=v.sift_ratio,
                           ransac_px=v.ransac_threshold, min_matches=int(v.min_matches),
                           from_plate_photo=bool(v.from_plate_photo))  # fmt: skip
+    for pair in pairs.values():  # every photo checked before anything is computed
+        for path in (pair.plate_photo, pair.free_photo):
+            if path:
+                with RasterReader(path) as src:
+                    w, h = src.info.width, src.info.height
+                if (w, h) != (camera.width_px, camera.height_px):
+                    raise InputError(f"the photo is {w} x {h} px, the camera {camera.name!r} "
+                                     f"{camera.width_px} x {camera.height_px} px",
+                                     path=path)  # fmt: skip
     folder = Path(v.output_folder)
     ids = [p for p in points.point_id if p in pairs]
     targets = {pid: folder / f"{pid}.tif" for pid in ids}

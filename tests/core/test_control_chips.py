@@ -285,4 +285,8 @@ def test_job_photo_table_and_refusals(scene, job_files, tmp_path):
     bad = d / "bad.csv"
     bad.write_text("point_id,plate_photo\nGCP1,photos/missing.tif\n")
     assert cli_main([*base, "--photo-table", str(bad), "--output-folder", str(out_b)]) != 0
+    small = d / "small.csv"
+    _write_grey(d / "small.tif", scene["plate"][:100, :100])
+    small.write_text("point_id,plate_photo\nGCP1,small.tif\n")
+    assert cli_main([*base, "--photo-table", str(small), "--output-folder", str(out_b)]) != 0
     assert not out_b.exists() or not any(out_b.iterdir())
