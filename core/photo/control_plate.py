@@ -396,9 +396,9 @@ def _edge_points(smooth: NDArray[np.float32], a: Array, b: Array) -> Array:
     inner = (k > 0) & (k < len(s) - 1) & ok
     rows = np.arange(len(k))
     peak = grad[rows, k]
-    # the centroid of the squared gradient within EDGE_WINDOW_PX of its peak, above the profile's
-    # median gradient (the ground's texture): the peak itself snaps to the pixel grid (the
-    # bilinear profile is piecewise linear), the centroid does not
+    # the centroid of the squared gradient within EDGE_WINDOW_PX of its peak, above the
+    # profile's median gradient (the ground's texture): the peak itself snaps towards the pixel
+    # grid (an interpolated profile), the centroid much less
     near = np.abs(s[None, :] - s[k][:, None]) <= EDGE_WINDOW_PX
     above = np.clip(grad - np.median(grad, axis=1, keepdims=True), 0, None)
     wgt = np.where(near, above * above, 0.0)
