@@ -18,6 +18,7 @@ from .algorithms.extract_tls_targets import ExtractTlsTargetsAlgorithm
 from .algorithms.ground_filter import GroundFilterAlgorithm
 from .algorithms.lidar_block import LidarBlockAlgorithm
 from .algorithms.locate_control_points import LocateControlPointsAlgorithm
+from .algorithms.make_control_chips import MakeControlChipsAlgorithm
 from .algorithms.monoplot import MonoplotAlgorithm
 from .algorithms.orthomosaic import OrthomosaicAlgorithm
 from .algorithms.orthorectify import OrthorectifyAlgorithm
@@ -69,5 +70,6 @@ class LidarPhotoProvider(QgsProcessingProvider):
             LidarBlockAlgorithm(),
             CalibrateCameraAlgorithm(),
             TiePointsAlgorithm(),
+            MakeControlChipsAlgorithm(),
         ):
             self.addAlgorithm(alg)

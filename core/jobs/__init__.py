@@ -12,6 +12,7 @@ from . import (
     ground_filter,
     lidar_block,
     locate_control_points,
+    make_control_chips,
     monoplot,
     orthomosaic,
     orthorectify,
@@ -40,4 +41,5 @@ ALGORITHMS = (
     lidar_block,
     calibrate_camera,
     tie_points,
+    make_control_chips,
 )

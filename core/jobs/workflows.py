@@ -78,6 +78,9 @@ WORKFLOWS: tuple[Workflow, ...] = (
              "OUTPUT_CAMERA = the camera JSON (start values for the block, or held fixed)"),
             ("tiepoints", "IMAGES (and the approximate EO + CAMERA to pair images by their "
              "footprints); OUTPUT_OBSERVATIONS = tie points for the bundle"),
+            ("makecontrolchips", "POINTS = the surveyed control, PHOTOS = ground photos of "
+             "each point with and without the control plate, CAMERA = the ground camera; "
+             "OUTPUT_FOLDER = one chip per point at the GSD of the aerial images"),
             ("locatecontrolpoints", "CHIPS = one GeoTIFF chip per control point, "
              "CONTROL_POINTS, CAMERA, approximate EO, IMAGES; OUTPUT = the control points' "
              "image observations, without clicking them"),

@@ -77,6 +77,11 @@ def test_example_is_read_by_its_reader_and_matches_its_columns(example, tmp_path
             pass
 
 
+# readers that cannot run on the example alone: a photograph; a table whose rows must name
+# photos that exist next to it (its columns are still documented in formats.md)
+_NEEDS_MORE_THAN_THE_FILE = {"control_chips.read_grey_photo", "control_chips.read_photo_table"}
+
+
 def test_every_table_reader_of_core_io_has_an_example():
     named = {tags["reader"] for _, _, tags, _ in EXAMPLES if "reader" in tags}
     # no text example possible: LAS/LAZ, GeoTIFF, BAL, E57 (chips: GeoTIFF; tiles: LAS/LAZ;
@@ -88,6 +93,8 @@ def test_every_table_reader_of_core_io_has_an_example():
             continue
         for name in re.findall(r"^def (read_\w+)\(", module.read_text(encoding="utf-8"), re.M):
             if name == "read_table":  # the generic CSV reader under all of them
+                continue
+            if f"{module.stem}.{name}" in _NEEDS_MORE_THAN_THE_FILE:
                 continue
             assert f"core.io.{module.stem}.{name}" in named, f"{module.stem}.{name}"
 

@@ -1,0 +1,136 @@
+"""Control plates and chips on synthetic ground photos: our corners against OpenCV's
+cornerSubPix (the peer, started 1 px off the truth), the plate photo's pose, the chip against
+the orthographic truth, and the time of the whole job per point (read + compute + write).
+
+Run: python -m lidarphoto.bench.bench_control_chips (or the file with the package on the
+path); writes nothing but a temporary folder. Figures in bench/control_chips.md.
+"""
+
+from __future__ import annotations
+
+import math
+import platform
+import resource
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+from lidarphoto.core.geometry.camera import camera_from_dict
+from lidarphoto.core.geometry.collinearity import project
+from lidarphoto.core.io.camera import write_camera_json
+from lidarphoto.core.io.raster import GeoTiffWriter
+from lidarphoto.core.jobs import make_control_chips as job
+from lidarphoto.core.jobs.runner import run_job
+from lidarphoto.core.photo.control_chips import ChipOptions, make_chip
+from lidarphoto.core.photo.control_plate import (
+    PlateGeometry,
+    detect_plate,
+    photo_azimuth,
+    resect_plate,
+)
+from lidarphoto.core.quality.registration import phase_correlation
+from lidarphoto.core.simulation.ground_photo import (
+    make_ground_patch,
+    render_ground_photo,
+    render_ortho,
+)
+
+PLATE = PlateGeometry(0.5, 0.25, 0.0, 20.0)
+POINT = np.array([457_321.25, 7_552_104.75, 431.2])
+GSD, SIZE = 0.01, 101
+
+
+def _match(found: np.ndarray, truth: np.ndarray) -> np.ndarray:
+    best = None
+    for turn in range(4):
+        order = np.r_[(np.arange(4) + turn) % 4, 4 + (np.arange(4) + turn) % 4]
+        err = np.linalg.norm(found - truth[order], axis=1)
+        if best is None or err.max() < best.max():
+            best = err
+    return best
+
+
+def main(seeds: int = 4) -> None:
+    cam = camera_from_dict({"name": "ground", "focal_mm": 3.0, "pixel_size_mm": 0.005,
+                            "width_px": 960, "height_px": 720,
+                            "distortion": {"model": "brown_conrady", "k1": 4e-3}})  # fmt: skip
+    rng = np.random.default_rng(0)
+    ours, peer, pose_m, pose_deg, ncc, off, t_job = [], [], [], [], [], [], []
+    for seed in range(seeds):
+        eo = np.array([0.45 + 0.1 * rng.standard_normal(), -0.3 + 0.1 * rng.standard_normal(),
+                       1.8 + 0.1 * rng.standard_normal(),
+                       *np.radians([3 * rng.standard_normal(), 3 * rng.standard_normal(),
+                                    360 * rng.uniform()])])  # fmt: skip
+        free_eo = eo + np.array([0.004, -0.003, 0.002, *np.radians([1.0, 0.5, 4.0])])
+        patch = make_ground_patch(seed=10 + seed)
+        a = render_ground_photo(patch, cam, eo, PLATE, supersample=2, seed=2 * seed)
+        b = render_ground_photo(patch, cam, free_eo, None, supersample=2, seed=2 * seed + 1)
+        truth = project(PLATE.corners(), eo, cam)
+        det = detect_plate(a, cam, PLATE)
+        ours.append(_match(det.corners_px, truth))
+        start = (truth + rng.uniform(-1, 1, truth.shape) - 0.5).astype(np.float32)
+        sub = cv2.cornerSubPix(
+            a,
+            start.reshape(-1, 1, 2).copy(),
+            (5, 5),
+            (-1, -1),
+            (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 40, 1e-3),
+        )
+        peer.append(np.linalg.norm(sub.reshape(-1, 2) + 0.5 - truth, axis=1))
+        pr = resect_plate(det, cam, PLATE, photo_azimuth(eo) + 20.0)
+        pose_m.append(np.abs(pr.eo[:3] - eo[:3]).max())
+        d_ang = np.angle(np.exp(1j * (pr.eo[3:] - eo[3:])))  # wrapped to +-pi
+        pose_deg.append(math.degrees(np.abs(d_ang).max()))
+        res = make_chip("P", POINT, a, b, cam, PLATE, ChipOptions(gsd_m=GSD, size_px=SIZE),
+                        photo_azimuth(eo))  # fmt: skip
+        gt = res.geotransform
+        local = (gt[0] - POINT[0], GSD, 0.0, gt[3] - POINT[1], 0.0, -GSD)
+        tr = render_ortho(patch, local, SIZE)
+        ncc.append(np.corrcoef(res.chip.ravel(), tr.ravel())[0, 1])
+        dx, dy, _ = phase_correlation(tr, res.chip)
+        off.append(math.hypot(dx, dy))
+        with tempfile.TemporaryDirectory() as tmp:
+            d = Path(tmp)
+            for name, img in (("P_plate", a), ("P_free", b)):
+                u8 = np.clip(np.rint(img), 0, 255).astype(np.uint8)
+                with GeoTiffWriter(str(d / f"{name}.tif"), 960, 720, 1, np.uint8, None,
+                                   None) as w:  # fmt: skip
+                    w.write(u8)
+            write_camera_json(d / "camera.json", cam)
+            (d / "pts.csv").write_text(f"point_id,X,Y,Z,role\nP,{POINT[0]},{POINT[1]},"
+                                       f"{POINT[2]},control\n")  # fmt: skip
+            t0 = time.perf_counter()
+            run_job(job, {"POINTS": str(d / "pts.csv"), "CRS": "EPSG:31983",
+                          "CAMERA": str(d / "camera.json"), "PHOTOS": [str(d)],
+                          "OUTER_SIDE": 0.5, "INNER_SIDE": 0.25, "PLATE_AZIMUTH": 20.0,
+                          "PHOTO_AZIMUTH": photo_azimuth(eo), "GSD": GSD, "CHIP_SIZE": SIZE,
+                          "OUTPUT_FOLDER": str(d / "out")})  # fmt: skip
+            t_job.append(time.perf_counter() - t0)
+    ours_a, peer_a = np.array(ours), np.array(peer)
+    print(
+        f"python {sys.version.split()[0]}, numpy {np.__version__}, OpenCV {cv2.__version__}, "
+        f"{platform.machine()}; {seeds} synthetic points (960 x 720 px, Brown k1, 1 DN noise)"
+    )
+    for name, e in (("ours", ours_a), ("cv2.cornerSubPix", peer_a)):
+        print(
+            f"corner error {name:17s}: outer RMS {np.sqrt(np.mean(e[:, :4] ** 2)):.3f} px, "
+            f"max {e[:, :4].max():.3f}; inner RMS {np.sqrt(np.mean(e[:, 4:] ** 2)):.3f} px, "
+            f"max {e[:, 4:].max():.3f}"
+        )
+    print(
+        f"plate photo pose: max position error {1000 * max(pose_m):.1f} mm, "
+        f"max angle error {max(pose_deg):.3f} deg"
+    )
+    print(f"chip vs orthographic truth: NCC min {min(ncc):.4f}, offset max {max(off):.3f} px")
+    print(
+        f"job (read 2 photos + detect + resect + SIFT + rectify + write): "
+        f"median {np.median(t_job):.2f} s per point; peak RSS of the process "
+        f"{resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB"
+    )
+
+
+if __name__ == "__main__":
+    main()
