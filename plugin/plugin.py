@@ -53,6 +53,12 @@ class LidarPhotoPlugin:
 
     # -- GUI ----------------------------------------------------------------------------------
     def initGui(self) -> None:
+        try:  # before any widget is made: QGIS's language (locale/userLocale)
+            from ..processing_provider import install_translator
+
+            install_translator()
+        except ImportError:  # no pyproj etc.: initProcessing says so, the GUI stays English
+            pass
         self.initProcessing()
         if self.iface is None:
             return

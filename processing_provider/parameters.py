@@ -22,6 +22,7 @@ from qgis.core import (
     QgsProcessingParameterRasterDestination,
     QgsProcessingParameterString,
 )
+from qgis.PyQt.QtCore import QCoreApplication
 
 from ..core.jobs.spec import Param, Result
 from .compat import (
@@ -38,7 +39,11 @@ from .compat import (
     WKT_PREFERRED,
 )
 
-_ALL_FILES = "All files (*.*)"
+
+def _all_files() -> str:
+    return QCoreApplication.translate("LidarPhotoProvider", "All files (*.*)")
+
+
 _SINK_TYPES = {
     "point": SOURCE_VECTOR_POINT,
     "line": SOURCE_VECTOR_LINE,
@@ -52,7 +57,7 @@ def make_parameter(p: Param, tr: Callable[[str], str]) -> QgsProcessingParameter
     k = p.kind
     default = p.qgis_default if p.qgis_default is not None else p.default
     if k == "file":
-        flt = f"{tr(p.file_filter)};;{tr(_ALL_FILES)}" if p.file_filter else tr(_ALL_FILES)
+        flt = f"{tr(p.file_filter)};;{_all_files()}" if p.file_filter else _all_files()
         q = QgsProcessingParameterFile(
             p.name, title, behavior=FILE_BEHAVIOR_FILE, fileFilter=flt, optional=p.optional
         )

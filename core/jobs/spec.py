@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -59,6 +59,8 @@ INPUT_KINDS = (
 OUTPUT_KINDS = ("file_out", "raster_out", "folder_out", "sink")
 RESULT_KINDS = ("number", "string")
 _TRUE = ("true", "yes", "1", "on")
+#: Translation context of the help's fixed words (``make i18n`` collects ``t("...")`` calls).
+TR_CONTEXT = "AlgorithmHelp"
 _FALSE = ("false", "no", "0", "off")
 
 
@@ -200,51 +202,59 @@ class AlgorithmSpec:
     def outputs(self) -> tuple[Param, ...]:
         return tuple(p for p in self.params if p.is_output)
 
-    def help_html(self) -> str:
+    def help_html(self, tr: Callable[[str], str] | None = None) -> str:
         """The QGIS help: the description, the parameters with defaults, units and ranges,
-        and the references."""
+        and the references. ``tr`` translates its fixed words (context ``AlgorithmHelp``;
+        the spec's own texts are translated by :func:`core.jobs.translate.translate_spec`)."""
+        t = tr or _same
         parts = [text_to_html(self.description)]
         rows = []
         for p in self.params:
-            cells = (p.help or p.label, _default_for_help(p), _range_text(p))
+            cells = (p.help or p.label, _default_for_help(p, t), _range_text(p, t))
             rows.append(
                 f"<tr><td><b>{p.name}</b></td>" + "".join(f"<td>{_esc(c)}</td>" for c in cells)
                 + "</tr>"
             )  # fmt: skip
         parts.append(
-            "<h3>Parameters</h3><table><tr><th>name</th><th>meaning</th><th>default</th>"
-            "<th>unit, range</th></tr>" + "".join(rows) + "</table>"
-        )
+            f"<h3>{t('Parameters')}</h3><table><tr><th>{t('name')}</th><th>{t('meaning')}</th>"
+            f"<th>{t('default')}</th><th>{t('unit, range')}</th></tr>" + "".join(rows)
+            + "</table>"
+        )  # fmt: skip
         if self.references:
             items = "".join(f"<li>{_esc(r)}</li>" for r in self.references)
-            parts.append(f"<h3>References</h3><ul>{items}</ul>")
+            parts.append(f"<h3>{t('References')}</h3><ul>{items}</ul>")
         return "\n".join(parts)
 
-    def help_text(self) -> str:
-        """The command line's description (plain text)."""
+    def help_text(self, tr: Callable[[str], str] | None = None) -> str:
+        """The command line's description (plain text); ``tr`` as in :meth:`help_html`."""
+        t = tr or _same
         text = re.sub(r"(?m)^## (.*)$", r"\1:", self.description)
         if self.references:
-            text += "\n\nReferences: " + "; ".join(self.references) + "."
+            text += "\n\n" + t("References") + ": " + "; ".join(self.references) + "."
         return text
+
+
+def _same(text: str) -> str:
+    return text
 
 
 def _esc(text: str) -> str:
     return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
 
 
-def _default_for_help(p: Param) -> str:
+def _default_for_help(p: Param, t: Callable[[str], str] = _same) -> str:
     if p.is_output:
-        return "optional" if p.optional else ""
+        return t("optional") if p.optional else ""
     text = p.default_text()
-    return text if text else ("optional" if p.optional else "required")
+    return text if text else (t("optional") if p.optional else t("required"))
 
 
-def _range_text(p: Param) -> str:
+def _range_text(p: Param, t: Callable[[str], str] = _same) -> str:
     bits = [p.unit] if p.unit else []
     if p.kind == "enum":
         bits.append(" | ".join(p.options))
     if p.minimum is not None and p.maximum is not None:
-        bits.append(f"{p.minimum:g} to {p.maximum:g}")
+        bits.append(t("{} to {}").format(f"{p.minimum:g}", f"{p.maximum:g}"))
     elif p.minimum is not None:
         bits.append(f">= {p.minimum:g}")
     elif p.maximum is not None:
