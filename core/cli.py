@@ -18,11 +18,12 @@ import sys
 import threading
 from collections.abc import Iterator, Sequence
 
-from . import __version__
+from . import __version__, i18n
 from .errors import Cancelled, LidarPhotoError
 from .jobs import ALGORITHMS
 from .jobs.runner import run_job
-from .jobs.spec import AlgorithmSpec, Param
+from .jobs.spec import TR_CONTEXT, AlgorithmSpec, Param
+from .jobs.translate import translate_spec
 
 _METAVAR = {
     "file": "FILE",
@@ -102,11 +103,16 @@ def _option_help(p: Param) -> str:
     return "; ".join(bits).replace("%", "%%")
 
 
-def _add_algorithm(sub: argparse._SubParsersAction, spec: AlgorithmSpec, job: object) -> None:
+def _add_algorithm(
+    sub: argparse._SubParsersAction, spec: AlgorithmSpec, job: object, lang: str = "en"
+) -> None:
+    if lang != "en":  # the help in the user's language (names and options stay)
+        table = i18n.catalogue(lang)
+        spec = translate_spec(spec, lambda ctx, text: table.get((ctx, text), text))
     parser = sub.add_parser(
         spec.name,
         help=spec.summary,
-        description=spec.help_text(),
+        description=spec.help_text(i18n.translator(TR_CONTEXT, lang)),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     for p in spec.params:
@@ -129,14 +135,36 @@ def _add_algorithm(sub: argparse._SubParsersAction, spec: AlgorithmSpec, job: ob
     parser.set_defaults(job=job)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(lang: str = "en") -> argparse.ArgumentParser:
+    """The parser; ``lang`` (a catalogue of :mod:`core.i18n`, e.g. ``pt_BR``) translates the
+    algorithms' help."""
     parser = argparse.ArgumentParser(prog="lidarphoto", description=__doc__.split("\n\n")[0])
     parser.add_argument("--version", action="version", version=f"lidarphoto {__version__}")
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress to stderr")
+    parser.add_argument(
+        "--lang",
+        metavar="LANG",
+        help="language of the help and the HTML reports (en, "
+        + ", ".join(i18n.available_languages())
+        + "; default: from LANG/LC_ALL)",
+    )
     sub = parser.add_subparsers(dest="algorithm", metavar="ALGORITHM", required=True)
     for job in ALGORITHMS:
-        _add_algorithm(sub, job.SPEC, job)
+        _add_algorithm(sub, job.SPEC, job, lang)
     return parser
+
+
+def _language(argv: Sequence[str]) -> str:
+    """The --lang option (``--lang pt_BR`` or ``--lang=pt_BR``) before the algorithm, else the
+    environment's language."""
+    for k, arg in enumerate(argv):
+        if arg == "--lang" and k + 1 < len(argv):
+            return i18n.normalise_language(argv[k + 1])
+        if arg.startswith("--lang="):
+            return i18n.normalise_language(arg.split("=", 1)[1])
+        if not arg.startswith("-"):
+            break
+    return i18n.language_from_env()
 
 
 #: GDAL's block cache for the command line, MB (GDAL's default, 5 % of the RAM, holds the
@@ -147,7 +175,9 @@ GDAL_CACHE_MB = "256"
 def main(argv: Sequence[str] | None = None) -> int:
     import os
 
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    lang = i18n.set_language(_language(argv))
+    args = build_parser(lang).parse_args(argv)
     os.environ.setdefault("GDAL_CACHEMAX", GDAL_CACHE_MB)  # read by GDAL at its first use
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,
