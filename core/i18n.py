@@ -28,6 +28,7 @@ __all__ = [
     "available_languages",
     "catalogue",
     "current_language",
+    "html_lang",
     "language_from_env",
     "normalise_language",
     "set_language",
@@ -89,6 +90,15 @@ def set_language(lang: str | None) -> str:
 def current_language() -> str:
     """The language set by :func:`set_language` (``en`` by default)."""
     return _language
+
+
+def html_lang(lang: str | None = None) -> str:
+    """The ``lang`` attribute of an HTML page in ``lang`` (default: the current language).
+
+    >>> html_lang("en")
+    'en'
+    """
+    return normalise_language(lang or _language).replace("_", "-")
 
 
 @functools.lru_cache(maxsize=8)

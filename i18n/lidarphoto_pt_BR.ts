@@ -693,6 +693,949 @@
         </message>
     </context>
     <context>
+        <name>Report</name>
+        <message>
+            <source>component</source>
+            <translation>componente</translation>
+        </message>
+        <message>
+            <source>mean (m)</source>
+            <translation>média (m)</translation>
+        </message>
+        <message>
+            <source>std (m)</source>
+            <translation>desvio-padrão (m)</translation>
+        </message>
+        <message>
+            <source>min (m)</source>
+            <translation>mín. (m)</translation>
+        </message>
+        <message>
+            <source>max (m)</source>
+            <translation>máx. (m)</translation>
+        </message>
+        <message>
+            <source>Statistics: standard deviation with n &amp;minus; 1; RMSE = sqrt(mean(d&amp;sup2;)); Shapiro-Wilk by scipy (Royston's algorithm); Student t two-sided for a zero mean; chi-square one-sided, (n &amp;minus; 1) s&amp;sup2; / sigma0&amp;sup2; against chi-square(1 &amp;minus; alpha, n &amp;minus; 1).</source>
+            <translation>Estatísticas: desvio-padrão com n &amp;minus; 1; RMSE = sqrt(média(d&amp;sup2;)); Shapiro-Wilk pelo scipy (algoritmo de Royston); t de Student bilateral para média nula; qui-quadrado unilateral, (n &amp;minus; 1) s&amp;sup2; / sigma0&amp;sup2; contra qui-quadrado(1 &amp;minus; alfa, n &amp;minus; 1).</translation>
+        </message>
+        <message>
+            <source>Figures marked &lt;i&gt;uncertain&lt;/i&gt; in the verdicts come from our reading of the standard or from secondary sources; check them against the official text before a contractual statement.</source>
+            <translation>Os valores marcados como &lt;i&gt;incertos&lt;/i&gt; nos vereditos vêm da nossa leitura do padrão ou de fontes secundárias; confira-os com o texto oficial antes de uma declaração contratual.</translation>
+        </message>
+        <message>
+            <source>Status INSUFFICIENT: the standard needs more check points than were given; the figures are computed but no conformance is claimed.</source>
+            <translation>Estado INSUFICIENTE: o padrão exige mais pontos de verificação do que os informados; os valores são calculados, mas nenhuma conformidade é declarada.</translation>
+        </message>
+        <message>
+            <source>decision</source>
+            <translation>decisão</translation>
+        </message>
+        <message>
+            <source>Student t</source>
+            <translation>t de Student</translation>
+        </message>
+        <message>
+            <source>t critical</source>
+            <translation>t crítico</translation>
+        </message>
+        <message>
+            <source>chi-square</source>
+            <translation>qui-quadrado</translation>
+        </message>
+        <message>
+            <source>chi-square critical</source>
+            <translation>qui-quadrado crítico</translation>
+        </message>
+        <message>
+            <source>value (m)</source>
+            <translation>valor (m)</translation>
+        </message>
+        <message>
+            <source>{}, used (m)</source>
+            <translation>{}, usado (m)</translation>
+        </message>
+        <message>
+            <source>item</source>
+            <translation>item</translation>
+        </message>
+        <message>
+            <source>value</source>
+            <translation>valor</translation>
+        </message>
+        <message>
+            <source>Summary</source>
+            <translation>Resumo</translation>
+        </message>
+        <message>
+            <source>Standards</source>
+            <translation>Padrões</translation>
+        </message>
+        <message>
+            <source>Statistics</source>
+            <translation>Estatísticas</translation>
+        </message>
+        <message>
+            <source>Outliers</source>
+            <translation>Outliers</translation>
+        </message>
+        <message>
+            <source>Plots</source>
+            <translation>Gráficos</translation>
+        </message>
+        <message>
+            <source>Histogram of {}</source>
+            <translation>Histograma de {}</translation>
+        </message>
+        <message>
+            <source>Check points</source>
+            <translation>Pontos de verificação</translation>
+        </message>
+        <message>
+            <source>group</source>
+            <translation>grupo</translation>
+        </message>
+        <message>
+            <source>outlier</source>
+            <translation>outlier</translation>
+        </message>
+        <message>
+            <source>used</source>
+            <translation>usado</translation>
+        </message>
+        <message>
+            <source>check</source>
+            <translation>verificação</translation>
+        </message>
+        <message>
+            <source>status</source>
+            <translation>estado</translation>
+        </message>
+        <message>
+            <source>measured</source>
+            <translation>medido</translation>
+        </message>
+        <message>
+            <source>limit</source>
+            <translation>limite</translation>
+        </message>
+        <message>
+            <source>reason</source>
+            <translation>motivo</translation>
+        </message>
+        <message>
+            <source>check points</source>
+            <translation>pontos de verificação</translation>
+        </message>
+        <message>
+            <source>source</source>
+            <translation>fonte</translation>
+        </message>
+        <message>
+            <source>CRS</source>
+            <translation>SRC</translation>
+        </message>
+        <message>
+            <source>sign convention</source>
+            <translation>convenção de sinal</translation>
+        </message>
+        <message>
+            <source>d = measured &amp;minus; reference, metres</source>
+            <translation>d = medido &amp;minus; referência, metros</translation>
+        </message>
+        <message>
+            <source>significance level</source>
+            <translation>nível de significância</translation>
+        </message>
+        <message>
+            <source>created</source>
+            <translation>criado</translation>
+        </message>
+        <message>
+            <source>No standard was selected.</source>
+            <translation>Nenhum padrão foi selecionado.</translation>
+        </message>
+        <message>
+            <source>Project threshold per group</source>
+            <translation>Limiar do projeto por grupo</translation>
+        </message>
+        <message>
+            <source>No point flagged.</source>
+            <translation>Nenhum ponto marcado.</translation>
+        </message>
+        <message>
+            <source>yes</source>
+            <translation>sim</translation>
+        </message>
+        <message>
+            <source>no</source>
+            <translation>não</translation>
+        </message>
+        <message>
+            <source>normal</source>
+            <translation>normal</translation>
+        </message>
+        <message>
+            <source>bias</source>
+            <translation>tendência</translation>
+        </message>
+        <message>
+            <source>not tested</source>
+            <translation>não testado</translation>
+        </message>
+        <message>
+            <source>Notes</source>
+            <translation>Notas</translation>
+        </message>
+        <message>
+            <source>not normal</source>
+            <translation>não normal</translation>
+        </message>
+        <message>
+            <source>no bias</source>
+            <translation>sem tendência</translation>
+        </message>
+        <message>
+            <source>Source: {}. {} check points.</source>
+            <translation>Fonte: {}. {} pontos de verificação.</translation>
+        </message>
+        <message>
+            <source>{} ({} in the statistics)</source>
+            <translation>{} ({} nas estatísticas)</translation>
+        </message>
+        <message>
+            <source>not stated</source>
+            <translation>não informado</translation>
+        </message>
+        <message>
+            <source>For comparison: {} ({})</source>
+            <translation>Para comparação: {} ({})</translation>
+        </message>
+        <message>
+            <source>Group {} ({})</source>
+            <translation>Grupo {} ({})</translation>
+        </message>
+        <message>
+            <source>; excluded from the statistics and the standards.</source>
+            <translation>; excluídos das estatísticas e dos padrões.</translation>
+        </message>
+        <message>
+            <source>; kept in the statistics (not excluded).</source>
+            <translation>; mantidos nas estatísticas (não excluídos).</translation>
+        </message>
+        <message>
+            <source>Normal Q-Q plot of {}</source>
+            <translation>Gráfico Q-Q normal de {}</translation>
+        </message>
+        <message>
+            <source>accepted</source>
+            <translation>aceito</translation>
+        </message>
+        <message>
+            <source>rejected</source>
+            <translation>rejeitado</translation>
+        </message>
+        <message>
+            <source>Rule: {}.</source>
+            <translation>Regra: {}.</translation>
+        </message>
+        <message>
+            <source>{} point(s) flagged: </source>
+            <translation>{} ponto(s) marcado(s): </translation>
+        </message>
+        <message>
+            <source>These results FAILED their checks and were written only because the user asked for them (ACCEPT_DOUBTFUL): do not use them without review.</source>
+            <translation>Estes resultados FALHARAM nas verificações e foram gravados apenas porque o usuário os pediu (ACCEPT_DOUBTFUL): não os use sem revisão.</translation>
+        </message>
+        <message>
+            <source>The calibration FAILED its checks: no table and no exterior orientation were written. The numbers below show the failed adjustment, for diagnosis only.</source>
+            <translation>A calibração FALHOU nas verificações: nenhuma tabela e nenhuma orientação exterior foram gravadas. Os números abaixo mostram o ajustamento que falhou, apenas para diagnóstico.</translation>
+        </message>
+        <message>
+            <source>Boresight calibration</source>
+            <translation>Calibração de boresight</translation>
+        </message>
+        <message>
+            <source>Angles: d_omega, d_phi, d_kappa about the camera axes x, y, z (R_c^b = R_nominal dR); standard deviations are a-posteriori (scaled by sigma0) unless labelled a-priori.</source>
+            <translation>Ângulos: d_omega, d_phi, d_kappa em torno dos eixos x, y, z da câmera (R_c^b = R_nominal dR); os desvios-padrão são a posteriori (escalados por sigma0), salvo quando indicados como a priori.</translation>
+        </message>
+        <message>
+            <source>Settings</source>
+            <translation>Configurações</translation>
+        </message>
+        <message>
+            <source>setting</source>
+            <translation>configuração</translation>
+        </message>
+        <message>
+            <source>Boresight</source>
+            <translation>Boresight</translation>
+        </message>
+        <message>
+            <source>angle</source>
+            <translation>ângulo</translation>
+        </message>
+        <message>
+            <source>value (deg)</source>
+            <translation>valor (graus)</translation>
+        </message>
+        <message>
+            <source>value (d m s)</source>
+            <translation>valor (g m s)</translation>
+        </message>
+        <message>
+            <source>value (arcsec)</source>
+            <translation>valor (segundos de arco)</translation>
+        </message>
+        <message>
+            <source>sigma (arcsec)</source>
+            <translation>sigma (segundos de arco)</translation>
+        </message>
+        <message>
+            <source>sigma a-priori (arcsec)</source>
+            <translation>sigma a priori (segundos de arco)</translation>
+        </message>
+        <message>
+            <source>Adjustment</source>
+            <translation>Ajustamento</translation>
+        </message>
+        <message>
+            <source>figure</source>
+            <translation>grandeza</translation>
+        </message>
+        <message>
+            <source>Correlation of the calibration parameters</source>
+            <translation>Correlação dos parâmetros de calibração</translation>
+        </message>
+        <message>
+            <source>Rejected observations</source>
+            <translation>Observações rejeitadas</translation>
+        </message>
+        <message>
+            <source>Not observable</source>
+            <translation>Não observável</translation>
+        </message>
+        <message>
+            <source>The calibration was not computed:</source>
+            <translation>A calibração não foi calculada:</translation>
+        </message>
+        <message>
+            <source>Lever arm (body frame)</source>
+            <translation>Braço de alavanca (referencial do corpo)</translation>
+        </message>
+        <message>
+            <source>axis</source>
+            <translation>eixo</translation>
+        </message>
+        <message>
+            <source>sigma (m)</source>
+            <translation>sigma (m)</translation>
+        </message>
+        <message>
+            <source>Interior orientation</source>
+            <translation>Orientação interior</translation>
+        </message>
+        <message>
+            <source>parameter</source>
+            <translation>parâmetro</translation>
+        </message>
+        <message>
+            <source>value (mm)</source>
+            <translation>valor (mm)</translation>
+        </message>
+        <message>
+            <source>sigma (mm)</source>
+            <translation>sigma (mm)</translation>
+        </message>
+        <message>
+            <source>sigma0 (a-posteriori, a-priori 1)</source>
+            <translation>sigma0 (a posteriori, a priori 1)</translation>
+        </message>
+        <message>
+            <source>redundancy</source>
+            <translation>redundância</translation>
+        </message>
+        <message>
+            <source>observations / constraints</source>
+            <translation>observações / injunções</translation>
+        </message>
+        <message>
+            <source>global chi-square statistic</source>
+            <translation>estatística qui-quadrado global</translation>
+        </message>
+        <message>
+            <source>p-value</source>
+            <translation>valor p</translation>
+        </message>
+        <message>
+            <source>global test</source>
+            <translation>teste global</translation>
+        </message>
+        <message>
+            <source>iterations</source>
+            <translation>iterações</translation>
+        </message>
+        <message>
+            <source>outlier detection</source>
+            <translation>detecção de outliers</translation>
+        </message>
+        <message>
+            <source>image</source>
+            <translation>imagem</translation>
+        </message>
+        <message>
+            <source>point</source>
+            <translation>ponto</translation>
+        </message>
+        <message>
+            <source>type</source>
+            <translation>tipo</translation>
+        </message>
+        <message>
+            <source>target</source>
+            <translation>alvo</translation>
+        </message>
+        <message>
+            <source>None.</source>
+            <translation>Nenhuma.</translation>
+        </message>
+        <message>
+            <source>Image residuals</source>
+            <translation>Resíduos das imagens</translation>
+        </message>
+        <message>
+            <source>Residual vx</source>
+            <translation>Resíduo vx</translation>
+        </message>
+        <message>
+            <source>col residual (px)</source>
+            <translation>resíduo em coluna (px)</translation>
+        </message>
+        <message>
+            <source>Residual vy</source>
+            <translation>Resíduo vy</translation>
+        </message>
+        <message>
+            <source>row residual (px)</source>
+            <translation>resíduo em linha (px)</translation>
+        </message>
+        <message>
+            <source>passed</source>
+            <translation>aprovado</translation>
+        </message>
+        <message>
+            <source>failed</source>
+            <translation>reprovado</translation>
+        </message>
+        <message>
+            <source>Warnings</source>
+            <translation>Avisos</translation>
+        </message>
+        <message>
+            <source>acceptance interval (alpha = {})</source>
+            <translation>intervalo de aceitação (alfa = {})</translation>
+        </message>
+        <message>
+            <source>{} (converged: {})</source>
+            <translation>{} (convergiu: {})</translation>
+        </message>
+        <message>
+            <source>{} image points kept: RMS residual {} px (col), {} px (row).</source>
+            <translation>{} pontos de imagem mantidos: resíduo RMS {} px (coluna), {} px (linha).</translation>
+        </message>
+        <message>
+            <source>rank</source>
+            <translation>posição</translation>
+        </message>
+        <message>
+            <source>AP model</source>
+            <translation>modelo de PAs</translation>
+        </message>
+        <message>
+            <source>mean planimetric (m)</source>
+            <translation>média planimétrica (m)</translation>
+        </message>
+        <message>
+            <source>std planimetric (m)</source>
+            <translation>desvio-padrão planimétrico (m)</translation>
+        </message>
+        <message>
+            <source>RMS planimetric (m)</source>
+            <translation>RMS planimétrico (m)</translation>
+        </message>
+        <message>
+            <source>RMS height (m)</source>
+            <translation>RMS em altura (m)</translation>
+        </message>
+        <message>
+            <source>APs</source>
+            <translation>PAs</translation>
+        </message>
+        <message>
+            <source>APs kept</source>
+            <translation>PAs mantidos</translation>
+        </message>
+        <message>
+            <source>significant</source>
+            <translation>significativo</translation>
+        </message>
+        <message>
+            <source>camera</source>
+            <translation>câmera</translation>
+        </message>
+        <message>
+            <source>std</source>
+            <translation>desvio-padrão</translation>
+        </message>
+        <message>
+            <source>converged</source>
+            <translation>convergiu</translation>
+        </message>
+        <message>
+            <source>sigma0 a posteriori</source>
+            <translation>sigma0 a posteriori</translation>
+        </message>
+        <message>
+            <source>global chi-square test</source>
+            <translation>teste qui-quadrado global</translation>
+        </message>
+        <message>
+            <source>outliers</source>
+            <translation>outliers</translation>
+        </message>
+        <message>
+            <source>condition number (reduced system)</source>
+            <translation>número de condição (sistema reduzido)</translation>
+        </message>
+        <message>
+            <source>details</source>
+            <translation>detalhes</translation>
+        </message>
+        <message>
+            <source>NO</source>
+            <translation>NÃO</translation>
+        </message>
+        <message>
+            <source>FAILED</source>
+            <translation>REPROVADO</translation>
+        </message>
+        <message>
+            <source>no redundancy</source>
+            <translation>sem redundância</translation>
+        </message>
+        <message>
+            <source>significant ({})</source>
+            <translation>significativo ({})</translation>
+        </message>
+        <message>
+            <source>mapping CRS and units in the settings; image residuals in pixels (adjusted minus measured).</source>
+            <translation>SRC de mapeamento e unidades nas configurações; resíduos das imagens em pixels (ajustado menos medido).</translation>
+        </message>
+        <message>
+            <source>Interior orientation and additional parameters</source>
+            <translation>Orientação interior e parâmetros adicionais</translation>
+        </message>
+        <message>
+            <source>Images</source>
+            <translation>Imagens</translation>
+        </message>
+        <message>
+            <source>points used</source>
+            <translation>pontos usados</translation>
+        </message>
+        <message>
+            <source>RMS col (px)</source>
+            <translation>RMS col (px)</translation>
+        </message>
+        <message>
+            <source>RMS row (px)</source>
+            <translation>RMS lin (px)</translation>
+        </message>
+        <message>
+            <source>Rejected measurements ({})</source>
+            <translation>Medições rejeitadas ({})</translation>
+        </message>
+        <message>
+            <source>after {} iterations</source>
+            <translation>após {} iterações</translation>
+        </message>
+        <message>
+            <source>a priori {}</source>
+            <translation>a priori {}</translation>
+        </message>
+        <message>
+            <source>{} observation rows, {} parameters, {} constraint rows</source>
+            <translation>{} linhas de observação, {} parâmetros, {} linhas de injunção</translation>
+        </message>
+        <message>
+            <source>AP models compared (check-point discrepancies)</source>
+            <translation>Modelos de PAs comparados (discrepâncias nos pontos de verificação)</translation>
+        </message>
+        <message>
+            <source>Planimetric discrepancy = horizontal distance between the intersected and the surveyed check point; ranked by the 3D RMS (sigma0 without check points). The outputs are those of the best model (highlighted).</source>
+            <translation>Discrepância planimétrica = distância horizontal entre o ponto de verificação intersectado e o levantado; ordenados pelo RMS 3D (sigma0 sem pontos de verificação). As saídas são as do melhor modelo (destacado).</translation>
+        </message>
+        <message>
+            <source>Lever arm and boresight corrections (camera axes)</source>
+            <translation>Correções do braço de alavanca e do boresight (eixos da câmera)</translation>
+        </message>
+        <message>
+            <source>Check points (not in the adjustment)</source>
+            <translation>Pontos de verificação (fora do ajustamento)</translation>
+        </message>
+        <message>
+            <source>planimetric (m)</source>
+            <translation>planimétrica (m)</translation>
+        </message>
+        <message>
+            <source>images</source>
+            <translation>imagens</translation>
+        </message>
+        <message>
+            <source>v col</source>
+            <translation>v col</translation>
+        </message>
+        <message>
+            <source>residual (px)</source>
+            <translation>resíduo (px)</translation>
+        </message>
+        <message>
+            <source>v row</source>
+            <translation>v lin</translation>
+        </message>
+        <message>
+            <source>Residuals</source>
+            <translation>Resíduos</translation>
+        </message>
+        <message>
+            <source>w col</source>
+            <translation>w col</translation>
+        </message>
+        <message>
+            <source>w row</source>
+            <translation>w lin</translation>
+        </message>
+        <message>
+            <source>statistic {}, accepted [{}, {}], p = {}</source>
+            <translation>estatística {}, aceita em [{}, {}], p = {}</translation>
+        </message>
+        <message>
+            <source>Bundle adjustment: {}</source>
+            <translation>Ajustamento por feixes de raios: {}</translation>
+        </message>
+        <message>
+            <source>Bundle adjustment with self-calibration ({})</source>
+            <translation>Ajustamento por feixes de raios com autocalibração ({})</translation>
+        </message>
+        <message>
+            <source>Dropped by the selection, in order: </source>
+            <translation>Descartados pela seleção, em ordem: </translation>
+        </message>
+        <message>
+            <source>lever dx (m)</source>
+            <translation>braço dx (m)</translation>
+        </message>
+        <message>
+            <source>lever dy (m)</source>
+            <translation>braço dy (m)</translation>
+        </message>
+        <message>
+            <source>lever dz (m)</source>
+            <translation>braço dz (m)</translation>
+        </message>
+        <message>
+            <source>boresight d_omega (deg)</source>
+            <translation>boresight d_omega (graus)</translation>
+        </message>
+        <message>
+            <source>boresight d_phi (deg)</source>
+            <translation>boresight d_phi (graus)</translation>
+        </message>
+        <message>
+            <source>boresight d_kappa (deg)</source>
+            <translation>boresight d_kappa (graus)</translation>
+        </message>
+        <message>
+            <source>Planimetric discrepancy: mean {} m, standard deviation {} m, RMS {} m; RMS E/N/H {} / {} / {} m; 3D {} m. Intersected with the adjusted orientations; their sigmas carry the image noise only.</source>
+            <translation>Discrepância planimétrica: média {} m, desvio-padrão {} m, RMS {} m; RMS E/N/H {} / {} / {} m; 3D {} m. Intersectados com as orientações ajustadas; os seus desvios-padrão trazem apenas o ruído das imagens.</translation>
+        </message>
+        <message>
+            <source>not observable: {}</source>
+            <translation>não observável: {}</translation>
+        </message>
+        <message>
+            <source>|correlation| above {} in the final adjustment: </source>
+            <translation>|correlação| acima de {} no ajustamento final: </translation>
+        </message>
+        <message>
+            <source>Correlations: {}</source>
+            <translation>Correlações: {}</translation>
+        </message>
+        <message>
+            <source>Image residuals: {}</source>
+            <translation>Resíduos das imagens: {}</translation>
+        </message>
+        <message>
+            <source>control points: RMS |v| (px)</source>
+            <translation>pontos de controle: RMS |v| (px)</translation>
+        </message>
+        <message>
+            <source>line points: RMS distance from the projected line (px)</source>
+            <translation>pontos de linha: RMS da distância à linha projetada (px)</translation>
+        </message>
+        <message>
+            <source>check points: RMS |projected - measured| (px)</source>
+            <translation>pontos de verificação: RMS |projetado - medido| (px)</translation>
+        </message>
+        <message>
+            <source>Space resection</source>
+            <translation>Resseção espacial</translation>
+        </message>
+        <message>
+            <source>Position in the mapping CRS, omega-phi-kappa relative to the grid frame at the perspective centre; standard deviations a-posteriori (scaled by sigma0) unless labelled a-priori. Global test: v'Pv / sigma0_prior^2 against the chi-square critical value (one-sided 5 %, as dos Santos et al. 2010 report it) and the two-sided acceptance range.</source>
+            <translation>Posição no SRC de mapeamento, omega-phi-kappa relativos ao referencial da quadrícula no centro perspectivo; desvios-padrão a posteriori (escalados por sigma0), salvo quando indicados como a priori. Teste global: v'Pv / sigma0_prior^2 contra o valor crítico do qui-quadrado (unilateral 5 %, como dos Santos et al. 2010 o relatam) e o intervalo de aceitação bilateral.</translation>
+        </message>
+        <message>
+            <source>points</source>
+            <translation>pontos</translation>
+        </message>
+        <message>
+            <source>lines</source>
+            <translation>linhas</translation>
+        </message>
+        <message>
+            <source>test</source>
+            <translation>teste</translation>
+        </message>
+        <message>
+            <source>unit</source>
+            <translation>unidade</translation>
+        </message>
+        <message>
+            <source>std a-priori</source>
+            <translation>desvio-padrão a priori</translation>
+        </message>
+        <message>
+            <source>std (arcsec)</source>
+            <translation>desvio-padrão (segundos de arco)</translation>
+        </message>
+        <message>
+            <source>Global test</source>
+            <translation>Teste global</translation>
+        </message>
+        <message>
+            <source>quantity</source>
+            <translation>grandeza</translation>
+        </message>
+        <message>
+            <source>Correlation of the six parameters</source>
+            <translation>Correlação dos seis parâmetros</translation>
+        </message>
+        <message>
+            <source>what</source>
+            <translation>o quê</translation>
+        </message>
+        <message>
+            <source>count</source>
+            <translation>quantidade</translation>
+        </message>
+        <message>
+            <source>Interior orientation (refined)</source>
+            <translation>Orientação interior (refinada)</translation>
+        </message>
+        <message>
+            <source>std (mm)</source>
+            <translation>desvio-padrão (mm)</translation>
+        </message>
+        <message>
+            <source>observations (condition rows)</source>
+            <translation>observações (linhas de condição)</translation>
+        </message>
+        <message>
+            <source>sigma0 a-posteriori</source>
+            <translation>sigma0 a posteriori</translation>
+        </message>
+        <message>
+            <source>chi-square statistic v'Pv / sigma0_prior^2</source>
+            <translation>estatística qui-quadrado v'Pv / sigma0_prior^2</translation>
+        </message>
+        <message>
+            <source>critical value, one-sided 5 % (as the source)</source>
+            <translation>valor crítico, unilateral 5 % (como na fonte)</translation>
+        </message>
+        <message>
+            <source>two-sided acceptance range</source>
+            <translation>intervalo de aceitação bilateral</translation>
+        </message>
+        <message>
+            <source>verdict (one-sided)</source>
+            <translation>veredito (unilateral)</translation>
+        </message>
+        <message>
+            <source>condition number (scaled normal matrix)</source>
+            <translation>número de condição (matriz normal escalada)</translation>
+        </message>
+        <message>
+            <source>Rejected by data snooping</source>
+            <translation>Rejeitados pelo data snooping</translation>
+        </message>
+        <message>
+            <source>block</source>
+            <translation>bloco</translation>
+        </message>
+        <message>
+            <source>row</source>
+            <translation>lin</translation>
+        </message>
+        <message>
+            <source>Image {}</source>
+            <translation>Imagem {}</translation>
+        </message>
+        <message>
+            <source>Start: {}; line model: {}; {} iterations; {} control points, {} lines, {} check points, {} rows without control ignored.</source>
+            <translation>Início: {}; modelo de linha: {}; {} iterações; {} pontos de controle, {} linhas, {} pontos de verificação, {} linhas sem controle ignoradas.</translation>
+        </message>
+        <message>
+            <source>Correlations between the APs and the station parameters (Lichti 2010) come from the network design, not the instrument: the rangefinder offset a0 with the station positions when the targets lie on one side or in a narrow vertical band; the collimation error b1 with kappa when the targets are near the horizon (sec(alpha) is then about 1); the trunnion-axis error b2 and the vertical index c0 with omega and phi. They are broken by targets all around the scanner and over the full vertical range (floor and ceiling), by two-face observations, and by stations whose scanner is tilted by about 90 degrees (which turn elevations into horizontal directions). A levelled scanner's compensator observes omega and phi and helps b2 and c0.</source>
+            <translation>As correlações entre os PAs e os parâmetros das estações (Lichti 2010) vêm da geometria da rede, não do instrumento: o deslocamento do distanciômetro a0 com as posições das estações quando os alvos estão de um só lado ou em uma faixa vertical estreita; o erro de colimação b1 com kappa quando os alvos estão próximos do horizonte (sec(alfa) é então cerca de 1); o erro do eixo secundário b2 e o índice vertical c0 com omega e phi. Elas são quebradas por alvos em toda a volta do escâner e em toda a faixa vertical (piso e teto), por observações nas duas posições da luneta e por estações cujo escâner está inclinado de cerca de 90 graus (o que transforma elevações em direções horizontais). O compensador de um escâner nivelado observa omega e phi e ajuda b2 e c0.</translation>
+        </message>
+        <message>
+            <source>TLS self-calibration</source>
+            <translation>Autocalibração TLS</translation>
+        </message>
+        <message>
+            <source>Terrestrial laser scanner: registration and self-calibration</source>
+            <translation>Laser scanner terrestre: registro e autocalibração</translation>
+        </message>
+        <message>
+            <source>Model: Carvalho, Correa &amp;amp; dos Santos (Eqs. 1-5), additional parameters after Lichti (2007), correlation analysis after Lichti (2010).</source>
+            <translation>Modelo: Carvalho, Correa &amp;amp; dos Santos (Eqs. 1-5), parâmetros adicionais segundo Lichti (2007), análise de correlação segundo Lichti (2010).</translation>
+        </message>
+        <message>
+            <source>Stations</source>
+            <translation>Estações</translation>
+        </message>
+        <message>
+            <source>station</source>
+            <translation>estação</translation>
+        </message>
+        <message>
+            <source>levelled</source>
+            <translation>nivelada</translation>
+        </message>
+        <message>
+            <source>Correlations</source>
+            <translation>Correlações</translation>
+        </message>
+        <message>
+            <source>station / target</source>
+            <translation>estação / alvo</translation>
+        </message>
+        <message>
+            <source>v range mm</source>
+            <translation>v distância mm</translation>
+        </message>
+        <message>
+            <source>observations (station-target-face)</source>
+            <translation>observações (estação-alvo-posição)</translation>
+        </message>
+        <message>
+            <source>stations / targets</source>
+            <translation>estações / alvos</translation>
+        </message>
+        <message>
+            <source>observations rejected (data snooping)</source>
+            <translation>observações rejeitadas (data snooping)</translation>
+        </message>
+        <message>
+            <source>datum</source>
+            <translation>referencial (datum)</translation>
+        </message>
+        <message>
+            <source>Additional parameters</source>
+            <translation>Parâmetros adicionais</translation>
+        </message>
+        <message>
+            <source>AP</source>
+            <translation>PA</translation>
+        </message>
+        <message>
+            <source>term</source>
+            <translation>termo</translation>
+        </message>
+        <message>
+            <source>cause</source>
+            <translation>causa</translation>
+        </message>
+        <message>
+            <source>sigma a-priori</source>
+            <translation>sigma a priori</translation>
+        </message>
+        <message>
+            <source>why, and the design that breaks it</source>
+            <translation>por quê, e a geometria que a quebra</translation>
+        </message>
+        <message>
+            <source>Automatic AP selection</source>
+            <translation>Seleção automática de PAs</translation>
+        </message>
+        <message>
+            <source>removed</source>
+            <translation>removido</translation>
+        </message>
+        <message>
+            <source>why</source>
+            <translation>por quê</translation>
+        </message>
+        <message>
+            <source>remaining</source>
+            <translation>restantes</translation>
+        </message>
+        <message>
+            <source>range</source>
+            <translation>distância</translation>
+        </message>
+        <message>
+            <source>horizontal direction</source>
+            <translation>direção horizontal</translation>
+        </message>
+        <message>
+            <source>arc-seconds</source>
+            <translation>segundos de arco</translation>
+        </message>
+        <message>
+            <source>vertical angle</source>
+            <translation>ângulo vertical</translation>
+        </message>
+        <message>
+            <source>control</source>
+            <translation>controle</translation>
+        </message>
+        <message>
+            <source>inner constraints</source>
+            <translation>injunções internas</translation>
+        </message>
+        <message>
+            <source>t = |value| / sigma against the Student-t critical value {} (two-sided, alpha = {}). sigma is scaled by sigma0; sigma a-priori is the Cramer-Rao bound of the network for the observation sigmas given.</source>
+            <translation>t = |valor| / sigma contra o valor crítico t de Student {} (bilateral, alfa = {}). sigma é escalado por sigma0; sigma a priori é o limite de Cramér-Rao da rede para os desvios-padrão de observação informados.</translation>
+        </message>
+        <message>
+            <source>Pairs with |r| &amp;ge; {}:</source>
+            <translation>Pares com |r| &amp;ge; {}:</translation>
+        </message>
+        <message>
+            <source>No pair involving an AP reaches |r| = {}.</source>
+            <translation>Nenhum par envolvendo um PA atinge |r| = {}.</translation>
+        </message>
+        <message>
+            <source>NOT</source>
+            <translation>NÃO</translation>
+        </message>
+        <message>
+            <source>none</source>
+            <translation>nenhuma</translation>
+        </message>
+    </context>
+    <context>
         <name>ResectionController</name>
         <message>
             <source>A resection is already running.</source>

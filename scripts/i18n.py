@@ -85,6 +85,20 @@ def _spec_messages() -> list[tuple[str, str]]:
             sys.path.remove(tmp)
 
 
+def _module_context(path: Path) -> str | None:
+    """The TR_CONTEXT a module assigns, None when it has none."""
+    if not path.is_file():
+        return None
+    for node in ast.parse(path.read_text(encoding="utf-8")).body:
+        if (
+            isinstance(node, ast.Assign)
+            and any(isinstance(t, ast.Name) and t.id == "TR_CONTEXT" for t in node.targets)
+            and isinstance(node.value, ast.Constant)
+        ):
+            return node.value.value
+    return None
+
+
 def _core_messages() -> list[tuple[str, str]]:
     """``t("...")``/``tr("...")`` literals of core modules that define ``TR_CONTEXT``."""
     out = []
@@ -94,6 +108,10 @@ def _core_messages() -> list[tuple[str, str]]:
         tree = ast.parse(path.read_text(encoding="utf-8"))
         context = None
         for node in tree.body:
+            if isinstance(node, ast.ImportFrom) and any(
+                a.name == "TR_CONTEXT" for a in node.names
+            ):  # the context of the module it comes from (a sibling: ``from .x import``)
+                context = _module_context(path.parent / f"{node.module}.py")
             if (
                 isinstance(node, ast.Assign)
                 and any(isinstance(t, ast.Name) and t.id == "TR_CONTEXT" for t in node.targets)
