@@ -383,6 +383,17 @@
         </message>
     </context>
     <context>
+        <name>Messages</name>
+        <message>
+            <source>Missing Python packages: {names}. The LiDAR Photogrammetry algorithms need them; install them into QGIS's Python and restart QGIS: {cmd}</source>
+            <translation>Pacotes Python ausentes: {names}. Os algoritmos de Fotogrametria LiDAR precisam deles; instale-os no Python do QGIS e reinicie o QGIS: {cmd}</translation>
+        </message>
+        <message>
+            <source>Optional Python packages not installed: {names} ({effects}). To install: {cmd}</source>
+            <translation>Pacotes Python opcionais não instalados: {names} ({effects}). Para instalar: {cmd}</translation>
+        </message>
+    </context>
+    <context>
         <name>MonoplotController</name>
         <message>
             <source>Monoplotting needs the camera and the exterior orientation (Project tab).</source>

@@ -117,6 +117,33 @@ def test_qgis_process_in_portuguese(qp_env, compiled_qm):
     assert "Separates ground from objects" not in out
 
 
+@needs_tools
+def test_report_follows_the_qgis_language(qp_env, compiled_qm, tmp_path):
+    """qgis_process in pt_BR writes the accuracy report (HTML) in Portuguese."""
+    ini = Path(qp_env["QGIS_CUSTOM_CONFIG_PATH"]) / "profiles" / "default" / "QGIS" / "QGIS3.ini"
+    ini.write_text(
+        ini.read_text(encoding="utf-8") + "\n[locale]\noverrideFlag=true\nuserLocale=pt_BR\n",
+        encoding="utf-8",
+    )
+    rows = ["id,e,n,h,e_ref,n_ref,h_ref"]
+    for k in range(8):
+        e, n, h = 500000.0 + 37 * k, 7450000.0 + 53 * k, 10.0 + k
+        rows.append(f"P{k},{e + 0.03 * (-1) ** k},{n - 0.02 * (k % 3)},{h + 0.05},{e},{n},{h}")
+    table = tmp_path / "check.csv"
+    table.write_text("\n".join(rows) + "\n", encoding="utf-8")
+    html = tmp_path / "report.html"
+    r = subprocess.run(
+        [QGIS_PROCESS, "run", "lidarphoto:accuracyreport", "--", f"INPUT={table}",
+         "CRS=EPSG:31983", f"OUTPUT_HTML={html}", f"OUTPUT={tmp_path / 'cp.gpkg'}"],
+        env=qp_env, capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    page = html.read_text(encoding="utf-8")
+    assert '<html lang="pt-BR">' in page
+    assert "<h2>Resumo</h2>" in page and "<h2>Estatísticas</h2>" in page
+    assert "<h2>Summary</h2>" not in page
+
+
 def test_provider_and_dock_in_portuguese(compiled_qm, provider, qgis_iface, tmp_path):
     """With the pt_BR translator: algorithm names, groups, help, parameter labels, the
     dock's tabs, help and observation table, the plugin's menu; and back to English."""
