@@ -1506,6 +1506,34 @@
             <translation>Início: {}; modelo de linha: {}; {} iterações; {} pontos de controle, {} linhas, {} pontos de verificação, {} linhas sem controle ignoradas.</translation>
         </message>
         <message>
+            <source>Horizontal discrepancy vectors</source>
+            <translation>Vetores de discrepância horizontal</translation>
+        </message>
+        <message>
+            <source>normal quantile</source>
+            <translation>quantil normal</translation>
+        </message>
+        <message>
+            <source>discrepancy (m)</source>
+            <translation>discrepância (m)</translation>
+        </message>
+        <message>
+            <source>(vectors x {})</source>
+            <translation>(vetores x {})</translation>
+        </message>
+        <message>
+            <source>{} m on the ground</source>
+            <translation>{} m no terreno</translation>
+        </message>
+        <message>
+            <source>mean residual per cell; {} px = {} px on screen; largest {} px</source>
+            <translation>resíduo médio por célula; {} px = {} px na tela; maior {} px</translation>
+        </message>
+        <message>
+            <source>{} m discrepancy</source>
+            <translation>discrepância de {} m</translation>
+        </message>
+        <message>
             <source>Correlations between the APs and the station parameters (Lichti 2010) come from the network design, not the instrument: the rangefinder offset a0 with the station positions when the targets lie on one side or in a narrow vertical band; the collimation error b1 with kappa when the targets are near the horizon (sec(alpha) is then about 1); the trunnion-axis error b2 and the vertical index c0 with omega and phi. They are broken by targets all around the scanner and over the full vertical range (floor and ceiling), by two-face observations, and by stations whose scanner is tilted by about 90 degrees (which turn elevations into horizontal directions). A levelled scanner's compensator observes omega and phi and helps b2 and c0.</source>
             <translation>As correlações entre os PAs e os parâmetros das estações (Lichti 2010) vêm da geometria da rede, não do instrumento: o deslocamento do distanciômetro a0 com as posições das estações quando os alvos estão de um só lado ou em uma faixa vertical estreita; o erro de colimação b1 com kappa quando os alvos estão próximos do horizonte (sec(alfa) é então cerca de 1); o erro do eixo secundário b2 e o índice vertical c0 com omega e phi. Elas são quebradas por alvos em toda a volta do escâner e em toda a faixa vertical (piso e teto), por observações nas duas posições da luneta e por estações cujo escâner está inclinado de cerca de 90 graus (o que transforma elevações em direções horizontais). O compensador de um escâner nivelado observa omega e phi e ajuda b2 e c0.</translation>
         </message>

@@ -12,8 +12,9 @@ Where the messages come from:
   "...")``;
 - the algorithms' specs (core/jobs): pylupdate cannot see them, so every job's texts are
   listed by ``core.jobs.translate.spec_messages`` in the context ``lidarphoto:<algorithm>``;
-- the rest of the core (the help's fixed words, the HTML reports): calls ``t("...")`` /
-  ``tr("...")`` with a literal, in modules that define ``TR_CONTEXT = "<context>"``.
+- the rest of the core (the help's fixed words, the HTML reports): calls ``t("...")``,
+  ``tr("...")``, ``_t("...")`` or ``_tr("...")`` with a literal, in modules that define
+  ``TR_CONTEXT = "<context>"`` or import it (``from .html_table import TR_CONTEXT``).
 
 Existing translations are kept; a new message is added as unfinished; a message the code no
 longer has is kept as ``vanished`` only if it was translated (a hint for its successor).
@@ -124,7 +125,7 @@ def _core_messages() -> list[tuple[str, str]]:
             if (
                 isinstance(node, ast.Call)
                 and isinstance(node.func, ast.Name)
-                and node.func.id in ("t", "tr", "_t")
+                and node.func.id in ("t", "tr", "_t", "_tr")
                 and node.args
                 and isinstance(node.args[0], ast.Constant)
                 and isinstance(node.args[0].value, str)
