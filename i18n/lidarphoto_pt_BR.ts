@@ -527,6 +527,13 @@
         </message>
     </context>
     <context>
+        <name>OverviewTask</name>
+        <message>
+            <source>Overview pyramid of {}</source>
+            <translation>Pirâmide de visões gerais de {}</translation>
+        </message>
+    </context>
+    <context>
         <name>PickingController</name>
         <message>
             <source>plane {} ({:.1f} m away)</source>
