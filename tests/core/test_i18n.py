@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from lidarphoto.core import i18n
 from lidarphoto.core.cli import build_parser
 from lidarphoto.core.jobs import ALGORITHMS

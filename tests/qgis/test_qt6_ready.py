@@ -47,8 +47,10 @@ REMOVED = {
 #: (file, class) allowed to use enum values unscoped: QgsField's QVariant.<Type> is needed on
 #: 3.22 and patched to QMetaType.Type by Qt6 builds of QGIS (STYLE.md section 5, rule 4)
 ALLOWED = {("processing_provider/compat.py", "QVariant")}
-WIDGETS_NOT_IN_QTGUI = re.compile(r"from qgis\.PyQt\.QtGui import[^\n]*\bQ(Widget|Dialog|Label|"
-                                  r"PushButton|LineEdit|ComboBox|Menu|MessageBox|ToolButton)\b")  # fmt: skip
+WIDGETS_NOT_IN_QTGUI = re.compile(
+    r"from qgis\.PyQt\.QtGui import[^\n]*"
+    r"\bQ(Widget|Dialog|Label|PushButton|LineEdit|ComboBox|Menu|MessageBox|ToolButton)\b"
+)
 
 
 def _imports(tree: ast.Module) -> dict[str, object]:
