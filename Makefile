@@ -1,7 +1,7 @@
 # LiDAR Photogrammetry Toolkit - developer entry points (Debian 12; see scripts/test.sh).
 SHELL := /bin/bash
 .DEFAULT_GOAL := test
-.PHONY: test demo package lint format model clean
+.PHONY: test demo package lint format model clean i18n
 
 ## test: install what is missing (apt QGIS, .venv, .venv-qgis), ruff, core + QGIS test suites
 test:
@@ -15,6 +15,10 @@ demo:
 ## package: lidarphoto.zip, installable with QGIS "Install from ZIP"
 package:
 	bash scripts/package.sh lidarphoto.zip
+
+## i18n: add the code's new strings to i18n/*.ts (then translate them), build the .qm files
+i18n:
+	$(if $(wildcard .venv/bin/python),.venv/bin/python,python3) scripts/i18n.py
 
 lint:
 	bash scripts/test.sh --core-env

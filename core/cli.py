@@ -18,11 +18,12 @@ import sys
 import threading
 from collections.abc import Iterator, Sequence
 
-from . import __version__
+from . import __version__, i18n
 from .errors import Cancelled, LidarPhotoError
 from .jobs import ALGORITHMS
 from .jobs.runner import run_job
-from .jobs.spec import AlgorithmSpec, Param, facts_line
+from .jobs.spec import TR_CONTEXT, AlgorithmSpec, Param, facts_line
+from .jobs.translate import translate_spec
 
 _METAVAR = {
     "file": "FILE",
@@ -83,12 +84,13 @@ def stop_signals_raise() -> Iterator[None]:
             signal.signal(s, old)
 
 
-def _option_help(p: Param, spec: AlgorithmSpec | None = None) -> str:
-    """label; help; default, unit and valid range (the same facts as the QGIS help)."""
+def _option_help(p: Param, spec: AlgorithmSpec | None = None, t=None) -> str:
+    """label; help; default, unit and valid range (the same facts as the QGIS help); ``t``
+    translates the fixed words of the facts."""
     bits = [p.label]
     if p.help and p.help != p.label:
         bits.append(p.help)
-    facts = facts_line(p, spec)
+    facts = facts_line(p, spec, t) if t is not None else facts_line(p, spec)
     if p.kind == "enum":
         many = " (a comma list)" if p.multiple else ""
         facts += f" (or their index){many}"
@@ -96,17 +98,23 @@ def _option_help(p: Param, spec: AlgorithmSpec | None = None) -> str:
     return "; ".join(bits).replace("%", "%%")
 
 
-def _add_algorithm(sub: argparse._SubParsersAction, spec: AlgorithmSpec, job: object) -> None:
+def _add_algorithm(
+    sub: argparse._SubParsersAction, spec: AlgorithmSpec, job: object, lang: str = "en"
+) -> None:
+    if lang != "en":  # the help in the user's language (names and options stay)
+        table = i18n.catalogue(lang)
+        spec = translate_spec(spec, lambda ctx, text: table.get((ctx, text), text))
     parser = sub.add_parser(
         spec.name,
         help=spec.summary,
-        description=spec.help_text(),
+        description=spec.help_text(i18n.translator(TR_CONTEXT, lang)),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     for p in spec.params:
         if p.kind == "sink":  # layers: QGIS only
             continue
-        kwargs: dict = {"dest": p.name, "default": None, "help": _option_help(p, spec)}
+        help_words = i18n.translator(TR_CONTEXT, lang)
+        kwargs: dict = {"dest": p.name, "default": None, "help": _option_help(p, spec, help_words)}
         if p.kind == "boolean":
             kwargs.update(nargs="?", const="true", metavar="true|false")
         elif p.kind == "enum":
@@ -123,17 +131,39 @@ def _add_algorithm(sub: argparse._SubParsersAction, spec: AlgorithmSpec, job: ob
     parser.set_defaults(job=job)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(lang: str = "en") -> argparse.ArgumentParser:
+    """The parser; ``lang`` (a catalogue of :mod:`core.i18n`, e.g. ``pt_BR``) translates the
+    algorithms' help."""
     parser = argparse.ArgumentParser(prog="lidarphoto", description=__doc__.split("\n\n")[0])
     parser.add_argument("--version", action="version", version=f"lidarphoto {__version__}")
     parser.add_argument(
         "-v", "--verbose", action="count", default=0,
         help="log progress to stderr; -vv also the details (e.g. every rejected candidate)",
     )  # fmt: skip
+    parser.add_argument(
+        "--lang",
+        metavar="LANG",
+        help="language of the help and the HTML reports (en, "
+        + ", ".join(i18n.available_languages())
+        + "; default: from LANG/LC_ALL)",
+    )
     sub = parser.add_subparsers(dest="algorithm", metavar="ALGORITHM", required=True)
     for job in ALGORITHMS:
-        _add_algorithm(sub, job.SPEC, job)
+        _add_algorithm(sub, job.SPEC, job, lang)
     return parser
+
+
+def _language(argv: Sequence[str]) -> str:
+    """The --lang option (``--lang pt_BR`` or ``--lang=pt_BR``) before the algorithm, else the
+    environment's language."""
+    for k, arg in enumerate(argv):
+        if arg == "--lang" and k + 1 < len(argv):
+            return i18n.normalise_language(argv[k + 1])
+        if arg.startswith("--lang="):
+            return i18n.normalise_language(arg.split("=", 1)[1])
+        if not arg.startswith("-"):
+            break
+    return i18n.language_from_env()
 
 
 #: GDAL's block cache for the command line, MB (GDAL's default, 5 % of the RAM, holds the
@@ -162,7 +192,9 @@ def _progress_bar(job):
 def main(argv: Sequence[str] | None = None) -> int:
     import os
 
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    lang = i18n.set_language(_language(argv))
+    args = build_parser(lang).parse_args(argv)
     os.environ.setdefault("GDAL_CACHEMAX", GDAL_CACHE_MB)  # read by GDAL at its first use
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,

@@ -13,6 +13,16 @@ import sys
 import sysconfig
 from collections.abc import Iterable, Sequence
 
+from .i18n import translator  # standard library only, like this module
+
+#: translation context of the messages below (``make i18n`` collects the ``t("...")`` calls)
+TR_CONTEXT = "Messages"
+
+
+def t(text: str) -> str:
+    """``text`` in the language set by :func:`core.i18n.set_language`."""
+    return translator(TR_CONTEXT)(text)
+
 #: import name -> pip requirement, in the order they are reported.
 REQUIRED_MODULES: dict[str, str] = {
     "laspy": "laspy",
@@ -105,8 +115,8 @@ def pip_command(modules: Sequence[str]) -> str:
 
 
 def missing_message(modules: Sequence[str]) -> str:
-    """The user-facing text for missing modules."""
-    return (
+    """The user-facing text for missing modules (in the language of :mod:`core.i18n`)."""
+    return t(
         "Missing Python packages: {names}. The LiDAR Photogrammetry algorithms need them; "
         "install them into QGIS's Python and restart QGIS: {cmd}"
     ).format(names=", ".join(pip_requirements(modules)), cmd=pip_command(modules))
@@ -116,6 +126,6 @@ def optional_message(modules: Sequence[str]) -> str:
     """The log text for missing optional accelerators."""
     effects = "; ".join(OPTIONAL_MODULES[m][1] for m in modules if m in OPTIONAL_MODULES)
     reqs = [OPTIONAL_MODULES[m][0] if m in OPTIONAL_MODULES else m for m in modules]
-    return (
+    return t(
         "Optional Python packages not installed: {names} ({effects}). To install: {cmd}"
     ).format(names=", ".join(reqs), effects=effects, cmd=pip_command(reqs))

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from qgis.core import QgsApplication
 from qgis.PyQt import sip
-from qgis.PyQt.QtCore import QObject, Qt, pyqtSignal
+from qgis.PyQt.QtCore import QCoreApplication, QObject, Qt, pyqtSignal
 from qgis.PyQt.QtWidgets import QCheckBox, QComboBox, QFormLayout, QLabel, QPushButton, QWidget
 
 from ..core.io.ground_points import write_ground_points_csv
@@ -71,6 +71,11 @@ def bundle_parameters(
         "OUTPUT_RESIDUALS": str(out_dir / "residuals.csv"),
         "OUTPUT_HTML": str(out_dir / "summary.html"),
     }
+
+
+def _header_row(*cells: str) -> str:
+    """The start of an HTML table with one header row."""
+    return "<table><tr>" + "".join(f"<th>{c}</th>" for c in cells) + "</tr>"
 
 
 class BundlePanel(QWidget):
@@ -141,7 +146,7 @@ class BundlePanel(QWidget):
             head += "<br>" + self.tr("Check points ({}): RMS 3D {:.3f} m").format(
                 int(st["n"]), st["rms_3d"]
             )
-        ap = ["<table><tr><th>parameter</th><th>value</th><th>σ</th><th></th></tr>"]
+        ap = [_header_row(self.tr("parameter"), self.tr("value"), "σ", "")]
         for p in res.interior:
             if p.status == "estimated":
                 flag = self.tr("significant") if p.significant else ""
@@ -154,7 +159,7 @@ class BundlePanel(QWidget):
                 else f"<tr><td>{p.name}</td><td>{p.value:.6g}</td><td>-</td><td>{flag}</td></tr>"
             )
         ap.append("</table>")
-        img = ["<table><tr><th>image</th><th>RMS col px</th><th>RMS row px</th></tr>"]
+        img = [_header_row(self.tr("image"), self.tr("RMS col px"), self.tr("RMS row px"))]
         for image_id, (rc, rr) in res.image_rms.items():
             img.append(f"<tr><td>{escape(image_id)}</td><td>{rc:.2f}</td><td>{rr:.2f}</td></tr>")
         img.append("</table>")
@@ -188,7 +193,7 @@ class BundleController(QObject):
         self.panel.run_button.clicked.connect(self.start)
 
     def tr(self, text: str) -> str:
-        return self.dock.tr(text)
+        return QCoreApplication.translate("BundleController", text)  # the context lupdate gives it
 
     @property
     def running(self) -> bool:

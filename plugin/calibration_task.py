@@ -15,7 +15,7 @@ from pathlib import Path
 
 from qgis.core import QgsApplication
 from qgis.PyQt import sip
-from qgis.PyQt.QtCore import QObject, pyqtSignal
+from qgis.PyQt.QtCore import QCoreApplication, QObject, pyqtSignal
 
 from ..core.io.control import write_lcps_csv, write_lines_csv
 from ..core.io.planes import write_planes_csv
@@ -95,7 +95,9 @@ class CalibrationController(QObject):
         self.panel.use_eo_button.clicked.connect(self.use_orientation)
 
     def tr(self, text: str) -> str:
-        return self.dock.tr(text)
+        return QCoreApplication.translate(
+            "CalibrationController", text
+        )  # the context lupdate gives it
 
     @property
     def running(self) -> bool:

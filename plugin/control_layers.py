@@ -13,7 +13,7 @@ selection on the map.
 from __future__ import annotations
 
 import numpy as np
-from qgis.core import QgsCoordinateTransform, QgsGeometry, QgsWkbTypes
+from qgis.core import Qgis, QgsCoordinateTransform, QgsGeometry, QgsWkbTypes
 from qgis.PyQt.QtCore import QVariant
 
 from ..core.io.control import read_lcps_csv, read_lines_csv
@@ -25,12 +25,10 @@ __all__ = ["KINDS", "ControlLinks", "layer_features", "read_control", "read_tabl
 #: the control kinds, in the order of the dock's layer choosers
 KINDS = ("planes", "lines", "lcps")
 
-if hasattr(QgsWkbTypes, "PolygonGeometry"):  # QGIS 3.22-3.28
-    _POLYGON = QgsWkbTypes.PolygonGeometry
-else:  # pragma: no cover - QGIS >= 3.30 / 4
-    from qgis.core import Qgis
-
+if hasattr(Qgis, "GeometryType"):  # pragma: no cover - QGIS >= 3.30 / 4
     _POLYGON = Qgis.GeometryType.Polygon
+else:  # QGIS 3.22-3.28 (scoped: PyQt6 has no unscoped enum values)
+    _POLYGON = QgsWkbTypes.GeometryType.PolygonGeometry
 
 
 def _vertices(geometry: QgsGeometry) -> np.ndarray:

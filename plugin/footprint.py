@@ -3,18 +3,16 @@
 from __future__ import annotations
 
 import numpy as np
-from qgis.core import QgsCoordinateTransform, QgsPointXY, QgsWkbTypes
+from qgis.core import Qgis, QgsCoordinateTransform, QgsPointXY, QgsWkbTypes
 from qgis.gui import QgsRubberBand
 from qgis.PyQt.QtGui import QColor
 
 __all__ = ["CanvasFootprint"]
 
-if hasattr(QgsWkbTypes, "PolygonGeometry"):  # QGIS 3.22-3.28
-    _POLYGON_GEOMETRY = QgsWkbTypes.PolygonGeometry
-else:  # pragma: no cover - QGIS >= 3.30 / 4
-    from qgis.core import Qgis
-
+if hasattr(Qgis, "GeometryType"):  # pragma: no cover - QGIS >= 3.30 / 4
     _POLYGON_GEOMETRY = Qgis.GeometryType.Polygon
+else:  # QGIS 3.22-3.28 (scoped: PyQt6 has no unscoped enum values)
+    _POLYGON_GEOMETRY = QgsWkbTypes.GeometryType.PolygonGeometry
 
 
 class CanvasFootprint:

@@ -25,7 +25,7 @@ from pathlib import Path
 
 from qgis.core import QgsCoordinateReferenceSystem, QgsProject
 from qgis.gui import QgsDockWidget
-from qgis.PyQt.QtCore import Qt, pyqtSignal
+from qgis.PyQt.QtCore import QT_TRANSLATE_NOOP, QCoreApplication, Qt, pyqtSignal
 from qgis.PyQt.QtGui import QKeySequence
 from qgis.PyQt.QtWidgets import QLabel, QSplitter, QTabWidget, QVBoxLayout, QWidget
 
@@ -35,7 +35,7 @@ from .bundle_task import BundleController, BundlePanel
 from .calibration_panel import CALIBRATION_ALG, CalibrationPanel
 from .calibration_task import CalibrationController
 from .footprint import CanvasFootprint
-from .image_view import VIEW_HELP
+from .image_view import view_help
 from .monoplot_control import MonoplotController
 from .monoplot_tool import MonoplotTool
 from .observation_store import ObservationStore
@@ -46,11 +46,12 @@ from .project_panel import ProjectPanel
 from .resection_task import ResectionController, ResectionPanel
 from .viewer_panel import ViewerPanel
 
-__all__ = ["CALIBRATION_ALG", "DOCK_HELP", "ImagePickingDock"]
+__all__ = ["CALIBRATION_ALG", "DOCK_HELP", "ImagePickingDock", "dock_help"]
 
 _TYPE_KEYS = dict(zip("TPLCK", PICK_TYPES))
 
-DOCK_HELP = (
+DOCK_HELP = QT_TRANSLATE_NOOP(
+    "ImagePickingDock",
     "<b>Picking</b>: choose the type, then left-click in the image. <i>tie</i> and "
     "<i>paper</i> points take the roof plane under the cursor (a menu asks when outlines "
     "overlap); <i>line</i>: two clicks, the image line's ends, on the LiDAR line nearest to "
@@ -67,8 +68,13 @@ DOCK_HELP = (
     "GeoPackage. Off: clicks measure observations again.<br>"
     "<b>Keys</b>: PgDown/PgUp next/previous image · Enter accept prediction · Esc cancel "
     "prediction · Delete delete selected point · Ctrl+Z undo · Ctrl+Shift+Z / Ctrl+Y redo · "
-    "T/P/L/C/K picking type · " + VIEW_HELP
+    "T/P/L/C/K picking type · ",
 )
+
+
+def dock_help() -> str:
+    """The dock's help (picking, monoplotting, keys), in QGIS's language."""
+    return QCoreApplication.translate("ImagePickingDock", DOCK_HELP) + view_help()
 
 
 class ImagePickingDock(QgsDockWidget):
@@ -114,14 +120,14 @@ class ImagePickingDock(QgsDockWidget):
         self.calibration_panel = CalibrationPanel()
         self.resection_panel = ResectionPanel()
         self.bundle_panel = BundlePanel()
-        help_label = QLabel(DOCK_HELP)
+        help_label = QLabel(dock_help())
         help_label.setWordWrap(True)
         self.tabs.addTab(self.project_panel, self.tr("Project"))
         self.tabs.addTab(self.calibration_panel, self.tr("Calibration"))
         self.tabs.addTab(self.resection_panel, self.tr("Resection"))
         self.tabs.addTab(self.bundle_panel, self.tr("Bundle"))
         self.tabs.addTab(help_label, self.tr("Help"))
-        self.viewer = ViewerPanel(DOCK_HELP)
+        self.viewer = ViewerPanel(dock_help())
         self.table = ObservationTable()
         for w in (self.tabs, self.viewer, self.table):
             split.addWidget(w)

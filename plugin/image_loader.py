@@ -25,7 +25,7 @@ from typing import NamedTuple
 
 import numpy as np
 from qgis.core import QgsTask
-from qgis.PyQt.QtCore import QObject, pyqtSignal
+from qgis.PyQt.QtCore import QCoreApplication, QObject, pyqtSignal
 from qgis.PyQt.QtGui import QImage
 
 from ..core.errors import Cancelled
@@ -269,7 +269,8 @@ class OverviewTask(QgsTask):
     done = pyqtSignal(bool, str)
 
     def __init__(self, source: ImageSource) -> None:
-        super().__init__(f"Overview pyramid of {source.path.name}", QgsTask.Flag.CanCancel)
+        name = QCoreApplication.translate("OverviewTask", "Overview pyramid of {}")
+        super().__init__(name.format(source.path.name), QgsTask.Flag.CanCancel)
         self.path = source.path
         self.message = ""
         self.ovr_path = None

@@ -35,7 +35,15 @@ import time
 from typing import Callable
 
 from qgis.core import QgsApplication
-from qgis.PyQt.QtCore import QPointF, QRectF, Qt, QTimer, pyqtSignal
+from qgis.PyQt.QtCore import (
+    QT_TRANSLATE_NOOP,
+    QCoreApplication,
+    QPointF,
+    QRectF,
+    Qt,
+    QTimer,
+    pyqtSignal,
+)
 from qgis.PyQt.QtGui import QBrush, QColor, QImage, QPainter, QPen, QPixmap, QTransform
 from qgis.PyQt.QtWidgets import (
     QApplication,
@@ -49,7 +57,14 @@ from qgis.PyQt.QtWidgets import (
 from .image_loader import OverviewTask, TileLoader, TileRequest, to_qimage
 from .image_source import ImageSource, ImageSourceError
 
-__all__ = ["TILE", "VIEW_HELP", "ImageView", "event_position", "pointer_position"]
+__all__ = [
+    "TILE",
+    "VIEW_HELP",
+    "ImageView",
+    "event_position",
+    "pointer_position",
+    "view_help",
+]
 
 TILE = 512
 _MAX_TILES = 400
@@ -60,11 +75,18 @@ _Z_PLACEHOLDER, _Z_BACKGROUND, _Z_OLD_LEVEL, _Z_TILE = -12.0, -10.0, -6.0, -5.0
 #: while the pyramid is built, the preview stands for the tiles up to this upscaling on screen
 _PREVIEW_UPSCALE = 1.5
 
-VIEW_HELP = (
+VIEW_HELP = QT_TRANSLATE_NOOP(
+    "ImageView",
     "Wheel: zoom about the cursor · middle/right drag or Space+drag: pan · "
     "left click: pick · left drag on a point: move it · +/-: zoom · F: fit · "
-    "1: 100 % · M: magnifier · arrows: pan"
+    "1: 100 % · M: magnifier · arrows: pan",
 )
+
+
+def view_help() -> str:
+    """The viewer's mouse and keys, in QGIS's language."""
+    return QCoreApplication.translate("ImageView", VIEW_HELP)
+
 
 #: overview tasks still running, kept referenced until they end (a QgsTask whose Python object
 #: is collected while it runs crashes QGIS)
@@ -161,7 +183,7 @@ class ImageView(QGraphicsView):
         self.setViewportUpdateMode(QGraphicsView.ViewportUpdateMode.SmartViewportUpdate)
         self.setMouseTracking(True)
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
-        self.setToolTip(VIEW_HELP)
+        self.setToolTip(view_help())
         self.source: ImageSource | None = None
         #: ``hit_test(col, row, tolerance_px) -> key or None``: a movable point under the mouse
         self.hit_test: Callable[[float, float, float], object] | None = None
@@ -250,7 +272,7 @@ class ImageView(QGraphicsView):
             self._show_background(source.stretch(source.sample()))
         else:  # the worker reads the preview (and the stretch) without blocking
             if not source.quick:
-                self._status(f"Reading a preview of {source.path.name}…")
+                self._status(self.tr("Reading a preview of {}…").format(source.path.name))
             self._loader.request_preview()
         if self.preview_shown:
             self._start_pending_build()
@@ -291,7 +313,9 @@ class ImageView(QGraphicsView):
         _LIVE_TASKS.add(task)
         task.progressChanged.connect(self._on_build_progress)
         task.done.connect(lambda ok, msg, task=task: self._on_build_done(task, ok, msg))
-        self._status(f"Building the overview pyramid of {source.path.name}: 0 %")
+        self._status(
+            self.tr("Building the overview pyramid of {}: {:.0f} %").format(source.path.name, 0)
+        )
         QgsApplication.taskManager().addTask(task)
 
     def _cancel_build(self) -> None:
@@ -324,7 +348,11 @@ class ImageView(QGraphicsView):
     def _on_build_progress(self, pct: float) -> None:
         if self.sender() is not self._task or self.source is None:
             return
-        self._status(f"Building the overview pyramid of {self.source.path.name}: {pct:.0f} %")
+        self._status(
+            self.tr("Building the overview pyramid of {}: {:.0f} %").format(
+                self.source.path.name, pct
+            )
+        )
         self.overviewProgress.emit(float(pct))
 
     def _on_build_done(self, task: OverviewTask, ok: bool, message: str) -> None:

@@ -4,7 +4,7 @@ The clicks themselves are handled by :class:`~.monoplot_tool.MonoplotTool`."""
 
 from __future__ import annotations
 
-from qgis.PyQt.QtCore import QEvent, QObject, Qt
+from qgis.PyQt.QtCore import QCoreApplication, QEvent, QObject, Qt
 from qgis.PyQt.QtWidgets import QApplication, QFileDialog
 
 from ..core.errors import InputError
@@ -30,7 +30,9 @@ class MonoplotController(QObject):
         v.view.viewport().installEventFilter(self)
 
     def tr(self, text: str) -> str:
-        return self.dock.tr(text)
+        return QCoreApplication.translate(
+            "MonoplotController", text
+        )  # the context lupdate gives it
 
     def _dsm_changed(self) -> None:
         self._dsm_key = None  # loaded again at the next start

@@ -228,8 +228,10 @@ class MonoplotTool(QObject):
         if layer is None or not layer.isValid():
             geom = "PointZ" if kind == "points" else "LineStringZ"
             crs = self.dock.eo_crs()
-            layer = QgsVectorLayer(f"{geom}?crs={crs.authid()}", self.tr(f"Monoplotted {kind}"),
-                                   "memory")  # fmt: skip
+            title = (
+                self.tr("Monoplotted points") if kind == "points" else self.tr("Monoplotted lines")
+            )
+            layer = QgsVectorLayer(f"{geom}?crs={crs.authid()}", title, "memory")
             if not crs.authid():
                 layer.setCrs(crs)
             spec = _FIELDS if kind == "points" else _LINE_FIELDS

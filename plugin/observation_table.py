@@ -12,12 +12,28 @@ import math
 from collections.abc import Mapping, Sequence
 
 import numpy as np
-from qgis.PyQt.QtCore import QAbstractTableModel, QItemSelectionModel, QModelIndex, Qt, pyqtSignal
+from qgis.PyQt.QtCore import (
+    QT_TRANSLATE_NOOP,
+    QAbstractTableModel,
+    QCoreApplication,
+    QItemSelectionModel,
+    QModelIndex,
+    Qt,
+    pyqtSignal,
+)
 from qgis.PyQt.QtWidgets import QAbstractItemView, QTableView
 
 __all__ = ["ObservationModel", "ObservationTable"]
 
-_COLUMNS = ("image", "point", "type", "target", "col", "row", "|v| px")
+_COLUMNS = (  # header texts, translated when shown
+    QT_TRANSLATE_NOOP("ObservationModel", "image"),
+    QT_TRANSLATE_NOOP("ObservationModel", "point"),
+    QT_TRANSLATE_NOOP("ObservationModel", "type"),
+    QT_TRANSLATE_NOOP("ObservationModel", "target"),
+    QT_TRANSLATE_NOOP("ObservationModel", "col"),
+    QT_TRANSLATE_NOOP("ObservationModel", "row"),
+    QT_TRANSLATE_NOOP("ObservationModel", "|v| px"),
+)
 
 
 class ObservationModel(QAbstractTableModel):
@@ -69,7 +85,7 @@ class ObservationModel(QAbstractTableModel):
 
     def headerData(self, section, orientation, role=Qt.ItemDataRole.DisplayRole):
         if role == Qt.ItemDataRole.DisplayRole and orientation == Qt.Orientation.Horizontal:
-            return self.tr(_COLUMNS[section])
+            return QCoreApplication.translate("ObservationModel", _COLUMNS[section])
         return super().headerData(section, orientation, role)
 
 

@@ -18,7 +18,7 @@ import bisect
 import math
 
 import numpy as np
-from qgis.PyQt.QtCore import QObject, QPointF, QTimer
+from qgis.PyQt.QtCore import QCoreApplication, QObject, QPointF, QTimer
 from qgis.PyQt.QtGui import QCursor
 from qgis.PyQt.QtWidgets import QMenu
 
@@ -57,7 +57,7 @@ class PickingController(QObject):
         self.store.changed.connect(self.store_changed)
 
     def tr(self, text: str) -> str:
-        return self.dock.tr(text)
+        return QCoreApplication.translate("PickingController", text)  # the context lupdate gives it
 
     def oriented(self) -> bool:
         return self.session.oriented(self.dock.current_image) and self.viewer.source is not None

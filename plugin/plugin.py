@@ -36,6 +36,12 @@ class LidarPhotoPlugin:
 
     # -- Processing ---------------------------------------------------------------------------
     def initProcessing(self) -> None:
+        try:  # first: QGIS's language (locale/userLocale) for every message and widget
+            from ..processing_provider import install_translator
+
+            install_translator()
+        except ImportError:  # a core package is missing: said below, in English
+            pass
         if self.missing_modules is None:  # once per load; never raises
             self.missing_modules = report_missing(self.iface)
         if self.provider is None:

@@ -9,7 +9,7 @@ from collections import deque
 
 from qgis.core import QgsCoordinateReferenceSystem
 from qgis.PyQt import sip
-from qgis.PyQt.QtCore import QObject, QTimer
+from qgis.PyQt.QtCore import QCoreApplication, QObject, QTimer
 
 from ..core.errors import InputError
 from ..core.io.camera import read_camera_json
@@ -36,7 +36,7 @@ class ProjectLoader(QObject):
         self._holding = False  # the markers wait for the last step of a restore
 
     def tr(self, text: str) -> str:
-        return self.dock.tr(text)
+        return QCoreApplication.translate("ProjectLoader", text)  # the context lupdate gives it
 
     # -- orientation and control --------------------------------------------------------------
     def set_project_files(self, camera="", eo="", crs="", images=(), observations="") -> None:

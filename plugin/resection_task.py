@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 from qgis.core import QgsApplication
 from qgis.PyQt import sip
-from qgis.PyQt.QtCore import QObject, Qt, pyqtSignal
+from qgis.PyQt.QtCore import QCoreApplication, QObject, Qt, pyqtSignal
 from qgis.PyQt.QtWidgets import QCheckBox, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from ..core.io.control import write_lcps_csv, write_lines_csv
@@ -112,8 +112,18 @@ class ResectionPanel(QWidget):
             )
         )
         table = [
-            "<table><tr><th>type</th><th>id</th><th>pts</th><th>RMS px</th><th>max px</th>"
-            "<th></th></tr>"
+            "<table><tr><th>"
+            + "</th><th>".join(
+                (
+                    self.tr("type"),
+                    self.tr("id"),
+                    self.tr("pts"),
+                    self.tr("RMS px"),
+                    self.tr("max px"),
+                    "",
+                )
+            )
+            + "</th></tr>"
         ]
         for kind, target, n, rms, vmax, rejected in residual_summary(rows):
             flag = self.tr("rejected") if rejected else ""
@@ -150,7 +160,9 @@ class ResectionController(QObject):
         self.panel.resect_button.clicked.connect(self.start)
 
     def tr(self, text: str) -> str:
-        return self.dock.tr(text)
+        return QCoreApplication.translate(
+            "ResectionController", text
+        )  # the context lupdate gives it
 
     @property
     def running(self) -> bool:

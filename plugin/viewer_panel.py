@@ -147,12 +147,21 @@ class ViewerPanel(QWidget):
             box.toggled.connect(lambda on, n=name: self.overlays.set_visible(n, on))
 
     # -- the image selector -------------------------------------------------------------------
+    def _status_text(self, status: str) -> str:
+        """An image status code of the dock ("no orientation", ...) as the user reads it."""
+        texts = {
+            "no orientation": self.tr("no orientation"),
+            "no file": self.tr("no file"),
+            "missing on disk": self.tr("missing on disk"),
+        }
+        return texts.get(status, status)
+
     def fill_images(self, items: list[tuple[str, str]]) -> None:
         """The selector's images: (id, status) pairs; a status other than "ok" is shown."""
         self.image_combo.blockSignals(True)
         self.image_combo.clear()
         for image_id, status in items:
-            label = image_id if status == "ok" else f"{image_id} ({status})"
+            label = image_id if status == "ok" else f"{image_id} ({self._status_text(status)})"
             self.image_combo.addItem(label, image_id)
         self.image_combo.blockSignals(False)
 

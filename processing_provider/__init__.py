@@ -12,7 +12,13 @@ from typing import Any
 
 from .compat import FIELD_DOUBLE, FIELD_INT, FIELD_STRING
 
-__all__ = ["FIELD_DOUBLE", "FIELD_INT", "FIELD_STRING", "LidarPhotoProvider"]
+__all__ = [
+    "FIELD_DOUBLE",
+    "FIELD_INT",
+    "FIELD_STRING",
+    "LidarPhotoProvider",
+    "install_translator",
+]
 
 
 def __getattr__(name: str) -> Any:
@@ -20,4 +26,8 @@ def __getattr__(name: str) -> Any:
         from .provider import LidarPhotoProvider
 
         return LidarPhotoProvider
+    if name == "install_translator":
+        from .i18n import install_translator
+
+        return install_translator
     raise AttributeError(name)

@@ -28,6 +28,7 @@ from ..core.errors import Cancelled, LidarPhotoError
 from ..core.jobs.runner import JobResult, run_job
 from ..core.jobs.spec import AlgorithmSpec
 from .compat import FIELD_INT, FIELD_STRING, SINK_FAST_INSERT
+from .i18n import spec_help_html, spec_translator
 from .parameters import make_output, make_parameter, read_parameter
 
 _PLUGIN_DIR = Path(__file__).resolve().parents[1]
@@ -119,7 +120,10 @@ def core_errors(cancelled_text: str = "Cancelled"):
         raise QgsProcessingException(str(exc)) from exc
     except MemoryError as exc:
         raise QgsProcessingException(
-            "out of memory; nothing was written (use a coarser cell or a smaller input)"
+            QCoreApplication.translate(
+                "BaseAlgorithm",
+                "out of memory; nothing was written (use a coarser cell or a smaller input)",
+            )
         ) from exc
 
 
@@ -136,7 +140,14 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
     _verbose = False
 
     def tr(self, text: str) -> str:
-        return QCoreApplication.translate(type(self).__name__, text)
+        """Translate in the class's context (where lupdate files a subclass's ``self.tr``),
+        else in ``BaseAlgorithm``'s (the strings written in this file)."""
+        out = QCoreApplication.translate(type(self).__name__, text)
+        return out if out != text else QCoreApplication.translate("BaseAlgorithm", text)
+
+    def spec_tr(self, text: str) -> str:
+        """Translate a text of the spec (context ``lidarphoto:<algorithm>``)."""
+        return spec_translator(self.spec)(text)
 
     @property
     def spec(self) -> AlgorithmSpec:
@@ -149,10 +160,10 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
         return self.spec.name
 
     def displayName(self) -> str:
-        return self.tr(self.spec.title)
+        return self.spec_tr(self.spec.title)
 
     def group(self) -> str:
-        return self.tr(self.spec.group)
+        return self.spec_tr(self.spec.group)
 
     def groupId(self) -> str:
         return self.spec.group_id
@@ -161,7 +172,7 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
         return ["lidarphoto", "lidar", "photogrammetry", *self.spec.tags]
 
     def shortHelpString(self) -> str:
-        return self.tr(self.spec.help_html())
+        return spec_help_html(self.spec)
 
     def helpUrl(self) -> str:
         home = _homepage()
@@ -169,9 +180,9 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
 
     def initAlgorithm(self, config=None):
         for p in self.spec.params:
-            self.addParameter(make_parameter(p, self.tr, self.spec))
+            self.addParameter(make_parameter(p, self.spec_tr, self.spec))
         for r in self.spec.results:
-            self.addOutput(make_output(r, self.tr))
+            self.addOutput(make_output(r, self.spec_tr))
 
     def canExecute(self):
         missing = missing_modules()

@@ -22,6 +22,7 @@ from qgis.core import (
     QgsProcessingParameterRasterDestination,
     QgsProcessingParameterString,
 )
+from qgis.PyQt.QtCore import QCoreApplication
 
 from ..core.jobs.spec import AlgorithmSpec, Param, Result, facts_line
 from .compat import (
@@ -37,8 +38,13 @@ from .compat import (
     SOURCE_VECTOR_POLYGON,
     WKT_PREFERRED,
 )
+from .i18n import help_tr
 
-_ALL_FILES = "All files (*.*)"
+
+def _all_files() -> str:
+    return QCoreApplication.translate("LidarPhotoProvider", "All files (*.*)")
+
+
 _SINK_TYPES = {
     "point": SOURCE_VECTOR_POINT,
     "line": SOURCE_VECTOR_LINE,
@@ -58,7 +64,7 @@ def make_parameter(
     k = p.kind
     default = p.qgis_default if p.qgis_default is not None else p.default
     if k == "file":
-        flt = f"{tr(p.file_filter)};;{tr(_ALL_FILES)}" if p.file_filter else tr(_ALL_FILES)
+        flt = f"{tr(p.file_filter)};;{_all_files()}" if p.file_filter else _all_files()
         q = QgsProcessingParameterFile(
             p.name, title, behavior=FILE_BEHAVIOR_FILE, fileFilter=flt, optional=p.optional
         )
@@ -116,9 +122,7 @@ def make_parameter(
         raise ValueError(k)
     if p.advanced:
         q.setFlags(q.flags() | FLAG_ADVANCED)
-    facts = facts_line(p, spec)
-    for word in ("default", "unit", "range", "values", "optional", "required"):
-        facts = facts.replace(word, tr(word))
+    facts = facts_line(p, spec, help_tr)
     q.setHelp(f"{tr(p.help)}; {facts}" if p.help else facts)
     return q
 

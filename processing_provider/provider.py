@@ -26,12 +26,17 @@ from .algorithms.resection import ResectionAlgorithm
 from .algorithms.tie_points import TiePointsAlgorithm
 from .algorithms.tls_calibration import TlsCalibrationAlgorithm
 from .algorithms.trajectory_to_eo import TrajectoryToEoAlgorithm
+from .i18n import install_translator
 
 ICON_PATH = Path(__file__).resolve().parents[1] / "icon.svg"
 
 
 class LidarPhotoProvider(QgsProcessingProvider):
     """Provider ``lidarphoto``; its id and the algorithm names are API (models, scripts)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        install_translator()  # QGIS's language, also under qgis_process (no initGui)
 
     def tr(self, text: str) -> str:
         return QCoreApplication.translate("LidarPhotoProvider", text)

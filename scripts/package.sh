@@ -17,6 +17,7 @@ import os
 import stat
 import subprocess
 import sys
+import tempfile
 import zipfile
 
 PREFIX = "lidarphoto/"
@@ -40,6 +41,8 @@ for raw in files:
         continue
     if os.path.abspath(path) == out:
         continue
+    if path.startswith("i18n/") and path.endswith(".qm"):
+        continue  # built below from the .ts, never a stale local copy
     keep.append(path)
 
 for required in ("metadata.txt", "__init__.py", "LICENSE"):
@@ -48,6 +51,14 @@ for required in ("metadata.txt", "__init__.py", "LICENSE"):
 meta = configparser.ConfigParser()
 meta.read("metadata.txt", encoding="utf-8")
 version = meta.get("general", "version")
+
+# the compiled translations (lrelease): QGIS loads the .qm, the core reads the .ts
+qm_dir = tempfile.mkdtemp(prefix="lidarphoto-qm-")
+r = subprocess.run([sys.executable, "scripts/i18n.py", "--qm", qm_dir], capture_output=True, text=True)
+if r.returncode != 0:
+    sys.exit(f"package.sh: cannot build the translations:\n{r.stdout}{r.stderr}")
+built = {f"i18n/{name}": os.path.join(qm_dir, name) for name in sorted(os.listdir(qm_dir))}
+keep = sorted(keep + list(built))
 
 tmp = out + ".part"
 with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
@@ -61,12 +72,16 @@ with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
                 info = zipfile.ZipInfo(d, date_time=(2020, 1, 1, 0, 0, 0))
                 info.external_attr = (stat.S_IFDIR | 0o755) << 16 | 0x10
                 zf.writestr(info, b"")
+        source = built.get(path, path)
         info = zipfile.ZipInfo(PREFIX + path, date_time=(2020, 1, 1, 0, 0, 0))
-        mode = 0o755 if os.stat(path).st_mode & stat.S_IXUSR else 0o644
+        mode = 0o755 if os.stat(source).st_mode & stat.S_IXUSR else 0o644
         info.external_attr = (stat.S_IFREG | mode) << 16
         info.compress_type = zipfile.ZIP_DEFLATED
-        with open(path, "rb") as fh:
+        with open(source, "rb") as fh:
             zf.writestr(info, fh.read())
 os.replace(tmp, out)
+for path in built.values():
+    os.remove(path)
+os.rmdir(qm_dir)
 print(f"{out}: lidarphoto {version}, {len(keep)} files")
 PY

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -59,6 +59,8 @@ INPUT_KINDS = (
 OUTPUT_KINDS = ("file_out", "raster_out", "folder_out", "sink")
 RESULT_KINDS = ("number", "string")
 _TRUE = ("true", "yes", "1", "on")
+#: Translation context of the help's fixed words (``make i18n`` collects ``t("...")`` calls).
+TR_CONTEXT = "AlgorithmHelp"
 _FALSE = ("false", "no", "0", "off")
 
 
@@ -204,55 +206,61 @@ class AlgorithmSpec:
     def outputs(self) -> tuple[Param, ...]:
         return tuple(p for p in self.params if p.is_output)
 
-    def help_html(self) -> str:
+    def help_html(self, tr: Callable[[str], str] | None = None) -> str:
         """The QGIS help: the description, how to use it (its workflows), the parameters with
-        default, unit and range, and the references (authors, year)."""
+        default, unit and range, and the references (authors, year). ``tr`` translates the
+        fixed words (context ``AlgorithmHelp``; the spec's own texts are translated by
+        :func:`core.jobs.translate.translate_spec`)."""
         from .workflows import how_to_use
 
+        t = tr or _same
         parts = [text_to_html(self.description)]
-        usage = how_to_use(self.name)
+        usage = how_to_use(self.name, tr)
         if usage:
-            parts.append(text_to_html("## How to use\n" + usage))
+            parts.append(text_to_html(f"## {t('How to use')}\n" + usage))
         rows = []
         for p in self.params:
-            cells = (p.help or p.label, *param_facts(p, self))
+            cells = (p.help or p.label, *param_facts(p, self, t))
             rows.append(
                 f"<tr><td><b>{p.name}</b></td>" + "".join(f"<td>{_esc(c)}</td>" for c in cells)
                 + "</tr>"
             )  # fmt: skip
         parts.append(
-            "<h3>Parameters</h3><table><tr><th>name</th><th>meaning</th><th>default</th>"
-            "<th>unit</th><th>valid range</th></tr>" + "".join(rows) + "</table>"
-        )
+            f"<h3>{t('Parameters')}</h3><table><tr><th>{t('name')}</th><th>{t('meaning')}</th>"
+            f"<th>{t('default')}</th><th>{t('unit')}</th><th>{t('valid range')}</th></tr>"
+            + "".join(rows) + "</table>"
+        )  # fmt: skip
         if self.references:
             items = "".join(f"<li>{_esc(r)}</li>" for r in self.references)
-            parts.append(f"<h3>References</h3><ul>{items}</ul>")
+            parts.append(f"<h3>{t('References')}</h3><ul>{items}</ul>")
         return "\n".join(parts)
 
-    def help_text(self) -> str:
+    def help_text(self, tr: Callable[[str], str] | None = None) -> str:
         """The command line's description (plain text): the description, how to use it and
-        the references; each option's help gives its default, unit and range."""
+        the references; each option's help gives its default, unit and range. ``tr`` as in
+        :meth:`help_html`."""
         from .workflows import how_to_use
 
+        t = tr or _same
         text = self.description
-        usage = how_to_use(self.name)
+        usage = how_to_use(self.name, tr)
         if usage:
-            text += "\n\n## How to use\n" + usage
+            text += f"\n\n## {t('How to use')}\n" + usage
         text = re.sub(r"(?m)^## (.*)$", r"\1:", text)
         if self.references:
-            text += "\n\nReferences: " + "; ".join(self.references) + "."
+            text += "\n\n" + t("References") + ": " + "; ".join(self.references) + "."
         return text
+
+
+def _same(text: str) -> str:
+    return text
 
 
 def _esc(text: str) -> str:
     return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
 
 
-#: What a parameter of unit "length" is measured in (the spec's DISTANCE_UNIT chooses it).
-LENGTH_UNIT = "length (cloud CRS unit, or m when DISTANCE_UNIT is metre)"
-
-
-def unit_text(p: Param, spec: AlgorithmSpec | None = None) -> str:
+def unit_text(p: Param, spec: AlgorithmSpec | None = None, t: Callable[[str], str] = _same) -> str:
     """The unit as the help shows it: the spec's unit; "length" spelt out where the algorithm
     has a DISTANCE_UNIT; "none" for a number without unit (a count, a ratio); "" otherwise.
 
@@ -260,13 +268,13 @@ def unit_text(p: Param, spec: AlgorithmSpec | None = None) -> str:
     'none'
     """
     if p.unit == "length" and spec is not None and "DISTANCE_UNIT" in spec.names:
-        return LENGTH_UNIT
+        return t("length (cloud CRS unit, or m when DISTANCE_UNIT is metre)")
     if p.unit:
         return p.unit
-    return "none" if p.kind in ("number", "integer", "numbers") else ""
+    return t("none") if p.kind in ("number", "integer", "numbers") else ""
 
 
-def range_text(p: Param) -> str:
+def range_text(p: Param, t: Callable[[str], str] = _same) -> str:
     """The valid range: "0.001 to 100", ">= 0", "<= 90", an enum's options, "any finite" for
     an unbounded number, or "".
 
@@ -276,39 +284,42 @@ def range_text(p: Param) -> str:
     if p.kind == "enum":
         return " | ".join(p.options)
     if p.minimum is not None and p.maximum is not None:
-        return f"{p.minimum:g} to {p.maximum:g}"
+        return t("{} to {}").format(f"{p.minimum:g}", f"{p.maximum:g}")
     if p.minimum is not None:
         return f">= {p.minimum:g}"
     if p.maximum is not None:
         return f"<= {p.maximum:g}"
-    return "any finite" if p.kind in ("number", "integer", "numbers") else ""
+    return t("any finite") if p.kind in ("number", "integer", "numbers") else ""
 
 
-def default_for_help(p: Param) -> str:
+def default_for_help(p: Param, t: Callable[[str], str] = _same) -> str:
     """The default as the help shows it: the value, or "optional" / "required"."""
     if p.is_output:
-        return "optional" if p.optional else "required"
+        return t("optional") if p.optional else t("required")
     text = p.default_text()
-    return text if text else ("optional" if p.optional else "required")
+    return text if text else (t("optional") if p.optional else t("required"))
 
 
-def param_facts(p: Param, spec: AlgorithmSpec | None = None) -> tuple[str, str, str]:
+def param_facts(
+    p: Param, spec: AlgorithmSpec | None = None, t: Callable[[str], str] = _same
+) -> tuple[str, str, str]:
     """(default, unit, valid range) of a parameter, as every help shows them."""
-    return default_for_help(p), unit_text(p, spec), range_text(p)
+    return default_for_help(p, t), unit_text(p, spec, t), range_text(p, t)
 
 
-def facts_line(p: Param, spec: AlgorithmSpec | None = None) -> str:
+def facts_line(p: Param, spec: AlgorithmSpec | None = None, t: Callable[[str], str] = _same) -> str:
     """"default: 0.15; unit: m; range: 0.001 to 100" (the parts that apply).
 
     >>> facts_line(Param("E", "number", "Epsilon", 0.15, unit="m", minimum=0.001))
     'default: 0.15; unit: m; range: >= 0.001'
     """
-    default, unit, rng = param_facts(p, spec)
-    bits = [default if default in ("optional", "required") else f"default: {default}"]
+    default, unit, rng = param_facts(p, spec, t)
+    has_value = p.default_text() != "" and not p.is_output
+    bits = [t("default: {}").format(default) if has_value else default]
     if unit:
-        bits.append(f"unit: {unit}")
+        bits.append(t("unit: {}").format(unit))
     if rng:
-        bits.append(f"{'values' if p.kind == 'enum' else 'range'}: {rng}")
+        bits.append((t("values: {}") if p.kind == "enum" else t("range: {}")).format(rng))
     return "; ".join(bits)
 
 

@@ -11,7 +11,16 @@ parameter of that step).
 from __future__ import annotations
 
 import textwrap
+from collections.abc import Callable
 from dataclasses import dataclass
+
+from .spec import TR_CONTEXT  # noqa: F401  (the catalogue context of these texts: scripts/i18n.py)
+
+
+def _t(text: str) -> str:
+    """Marks a text for the translation catalogue; :func:`how_to_use` translates it."""
+    return text
+
 
 #: Width of the help text (the descriptions of the specs are wrapped at this width).
 _WIDTH = 95
@@ -40,76 +49,76 @@ class Workflow:
 
 WORKFLOWS: tuple[Workflow, ...] = (
     Workflow(
-        "Boresight calibration with LiDAR control (Pedrosa & dos Santos 2020)",
+        _t("Boresight calibration with LiDAR control (Pedrosa & dos Santos 2020)"),
         (
-            ("trajectorytoeo", "INPUT = the GNSS/INS trajectory CSV; OUTPUT_CSV = the "
-             "exterior orientation of every image"),
-            ("groundfilter", "INPUT = the LAS/LAZ; OUTPUT_CLOUD = the cloud classified into "
-             "ground (2) and non-ground"),
-            ("extractroofplanes", "INPUT = the classified cloud; OUTPUT_CSV = the plane table, "
-             "OUTPUT_CLOUD = the cloud with plane_id"),
-            ("createlcps", "PLANES and CLOUD = the two outputs of extractroofplanes; "
-             "POINTS_CSV and LINES_CSV = LiDAR control points and lines"),
-            ("boresightcalibration", "TRAJECTORY = the exterior orientation, PLANES / LINES / "
+            ("trajectorytoeo", _t("INPUT = the GNSS/INS trajectory CSV; OUTPUT_CSV = the "
+             "exterior orientation of every image")),
+            ("groundfilter", _t("INPUT = the LAS/LAZ; OUTPUT_CLOUD = the cloud classified into "
+             "ground (2) and non-ground")),
+            ("extractroofplanes", _t("INPUT = the classified cloud; OUTPUT_CSV = the plane table, "
+             "OUTPUT_CLOUD = the cloud with plane_id")),
+            ("createlcps", _t("PLANES and CLOUD = the two outputs of extractroofplanes; "
+             "POINTS_CSV and LINES_CSV = LiDAR control points and lines")),
+            ("boresightcalibration", _t("TRAJECTORY = the exterior orientation, PLANES / LINES / "
              "LCPS = the control, OBSERVATIONS = image measurements made in the picking dock; "
-             "OUTPUT_TABLE = boresight per group, OUTPUT_EO = corrected orientation"),
-            ("accuracyreport", "INPUT = check points measured with the corrected orientation; "
-             "OUTPUT_HTML and OUTPUT_JSON = the accuracy figures against the standards"),
+             "OUTPUT_TABLE = boresight per group, OUTPUT_EO = corrected orientation")),
+            ("accuracyreport", _t("INPUT = check points measured with the corrected orientation; "
+             "OUTPUT_HTML and OUTPUT_JSON = the accuracy figures against the standards")),
         ),
     ),
     Workflow(
-        "Monoplotting on a LiDAR surface (dos Santos, Dal Poz & Dalmolin 2010)",
+        _t("Monoplotting on a LiDAR surface (dos Santos, Dal Poz & Dalmolin 2010)"),
         (
-            ("groundfilter", "INPUT = the LAS/LAZ; OUTPUT_DTM = the terrain model (or use the "
-             "cloud itself as DSM)"),
-            ("extractroofplanes", "OUTPUT_CSV = roof planes, used by monoplot for points on "
-             "roofs"),
-            ("resection", "OBSERVATIONS + CONTROL_POINTS (or lines) of one image; OUTPUT_EO = "
-             "its exterior orientation"),
-            ("monoplot", "OBSERVATIONS of the image, EO, DSM (raster or LAS/LAZ), optional "
-             "PLANES; OUTPUT_CSV = 3D points"),
-            ("accuracyreport", "INPUT = monoplotted check points against their reference"),
+            ("groundfilter", _t("INPUT = the LAS/LAZ; OUTPUT_DTM = the terrain model (or use the "
+             "cloud itself as DSM)")),
+            ("extractroofplanes", _t("OUTPUT_CSV = roof planes, used by monoplot for points on "
+             "roofs")),
+            ("resection", _t("OBSERVATIONS + CONTROL_POINTS (or lines) of one image; OUTPUT_EO = "
+             "its exterior orientation")),
+            ("monoplot", _t("OBSERVATIONS of the image, EO, DSM (raster or LAS/LAZ), optional "
+             "PLANES; OUTPUT_CSV = 3D points")),
+            ("accuracyreport", _t("INPUT = monoplotted check points against their reference")),
         ),
     ),
     Workflow(
-        "Aerial triangulation and orthophotos",
+        _t("Aerial triangulation and orthophotos"),
         (
-            ("calibratecamera", "IMAGES = views of a chessboard or ChArUco target; "
-             "OUTPUT_CAMERA = the camera JSON (start values for the block, or held fixed)"),
-            ("tiepoints", "IMAGES (and the approximate EO + CAMERA to pair images by their "
-             "footprints); OUTPUT_OBSERVATIONS = tie points for the bundle"),
-            ("makecontrolchips", "POINTS = the surveyed control, PHOTOS = ground photos of "
+            ("calibratecamera", _t("IMAGES = views of a chessboard or ChArUco target; "
+             "OUTPUT_CAMERA = the camera JSON (start values for the block, or held fixed)")),
+            ("tiepoints", _t("IMAGES (and the approximate EO + CAMERA to pair images by their "
+             "footprints); OUTPUT_OBSERVATIONS = tie points for the bundle")),
+            ("makecontrolchips", _t("POINTS = the surveyed control, PHOTOS = ground photos of "
              "each point with and without the control plate, CAMERA = the ground camera; "
-             "OUTPUT_FOLDER = one chip per point at the GSD of the aerial images"),
-            ("locatecontrolpoints", "CHIPS = one GeoTIFF chip per control point, "
+             "OUTPUT_FOLDER = one chip per point at the GSD of the aerial images")),
+            ("locatecontrolpoints", _t("CHIPS = one GeoTIFF chip per control point, "
              "CONTROL_POINTS, CAMERA, approximate EO, IMAGES; OUTPUT = the control points' "
-             "image observations, without clicking them"),
-            ("bundleadjustment", "CAMERA, OBSERVATIONS, GROUND_POINTS, EO (approximate); "
-             "OUTPUT_EO = adjusted orientation, OUTPUT_CAMERA = calibrated camera"),
-            ("groundfilter", "OUTPUT_DTM = the terrain for the orthophotos"),
-            ("orthorectify", "CAMERA and EO from the bundle, IMAGES, DSM = the DTM or DSM; "
-             "OUTPUT_FOLDER = one orthophoto per image"),
-            ("orthomosaic", "ORTHOPHOTOS = that folder; OUTPUT = the mosaic, SEAMLINES_CSV = "
-             "the region of each image"),
-            ("accuracyreport", "INPUT = check points measured on the mosaic"),
+             "image observations, without clicking them")),
+            ("bundleadjustment", _t("CAMERA, OBSERVATIONS, GROUND_POINTS, EO (approximate); "
+             "OUTPUT_EO = adjusted orientation, OUTPUT_CAMERA = calibrated camera")),
+            ("groundfilter", _t("OUTPUT_DTM = the terrain for the orthophotos")),
+            ("orthorectify", _t("CAMERA and EO from the bundle, IMAGES, DSM = the DTM or DSM; "
+             "OUTPUT_FOLDER = one orthophoto per image")),
+            ("orthomosaic", _t("ORTHOPHOTOS = that folder; OUTPUT = the mosaic, SEAMLINES_CSV = "
+             "the region of each image")),
+            ("accuracyreport", _t("INPUT = check points measured on the mosaic")),
         ),
     ),
     Workflow(
-        "LiDAR control for a whole block of tiles (dask.distributed)",
+        _t("LiDAR control for a whole block of tiles (dask.distributed)"),
         (
-            ("lidarblock", "INPUT = a folder of LAS/LAZ tiles or a .vpc; OUTPUT_FOLDER = "
-             "classified tiles, block.vpc, planes.csv, lcps.csv and lines.csv"),
-            ("boresightcalibration", "PLANES / LINES / LCPS = the block's tables, TRAJECTORY "
-             "and OBSERVATIONS as above"),
+            ("lidarblock", _t("INPUT = a folder of LAS/LAZ tiles or a .vpc; OUTPUT_FOLDER = "
+             "classified tiles, block.vpc, planes.csv, lcps.csv and lines.csv")),
+            ("boresightcalibration", _t("PLANES / LINES / LCPS = the block's tables, TRAJECTORY "
+             "and OBSERVATIONS as above")),
         ),
     ),
     Workflow(
-        "Terrestrial laser scanner calibration (Lichti 2007)",
+        _t("Terrestrial laser scanner calibration (Lichti 2007)"),
         (
-            ("extracttlstargets", "SCANS = the station clouds, CONTROL = target ids; OUTPUT = "
-             "target observations"),
-            ("tlscalibration", "OBSERVATIONS = those targets, CONTROL and STATIONS; "
-             "OUTPUT_APS = the scanner's additional parameters, OUTPUT_HTML = the report"),
+            ("extracttlstargets", _t("SCANS = the station clouds, CONTROL = target ids; OUTPUT = "
+             "target observations")),
+            ("tlscalibration", _t("OBSERVATIONS = those targets, CONTROL and STATIONS; "
+             "OUTPUT_APS = the scanner's additional parameters, OUTPUT_HTML = the report")),
         ),
     ),
 )
@@ -124,16 +133,19 @@ def workflows_of(name: str) -> tuple[Workflow, ...]:
     return tuple(w for w in WORKFLOWS if name in w.ids)
 
 
-def how_to_use(name: str) -> str:
+def how_to_use(name: str, tr: Callable[[str], str] | None = None) -> str:
     """The "How to use" section of an algorithm's help (plain text, see ``spec.text_to_html``);
-    "" when the algorithm is in no workflow."""
+    "" when the algorithm is in no workflow. ``tr`` translates the titles and notes (context
+    ``AlgorithmHelp``)."""
+    t = tr or _t
     blocks = []
     for w in workflows_of(name):
-        lines = textwrap.wrap(f"{w.title}: {w.chain(name)}", _WIDTH, break_on_hyphens=False)
+        lines = textwrap.wrap(f"{t(w.title)}: {w.chain(name)}", _WIDTH, break_on_hyphens=False)
         for alg, note in w.steps:
-            here = " (this algorithm)" if alg == name else ""
+            here = " " + t("(this algorithm)") if alg == name else ""
             lines += textwrap.wrap(
-                f"- {alg}{here}: {note}", _WIDTH, subsequent_indent="  ", break_on_hyphens=False
-            )
+                f"- {alg}{here}: {t(note)}", _WIDTH, subsequent_indent="  ",
+                break_on_hyphens=False,
+            )  # fmt: skip
         blocks.append("\n".join(lines))
     return "\n\n".join(blocks)

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import __version__
+from .html_table import TR_CONTEXT, html_lang, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 from .svg_plots import histogram, qq_plot, vector_map
@@ -21,6 +22,7 @@ if TYPE_CHECKING:
     from .accuracy import AccuracyReport, GroupStatistics
 
 __all__ = ["render_html"]
+
 
 _CSS = """
 body{font-family:sans-serif;margin:24px;color:#222;max-width:1200px}
@@ -54,7 +56,16 @@ def _stats_table(g: GroupStatistics) -> str:
         rows.append(
             [label, str(c.n), _m(c.mean), _m(c.std), _m(c.rmse), _m(c.minimum), _m(c.maximum)]
         )
-    return _table(["component", "n", "mean (m)", "std (m)", "RMSE (m)", "min (m)", "max (m)"], rows)
+    head = [
+        t("component"),
+        "n",
+        t("mean (m)"),
+        t("std (m)"),
+        "RMSE (m)",
+        t("min (m)"),
+        t("max (m)"),
+    ]
+    return _table(head, rows)
 
 
 def _tests_table(g: GroupStatistics) -> str:
@@ -68,24 +79,24 @@ def _tests_table(g: GroupStatistics) -> str:
                 _m(sw.statistic, 4) if sw else "&ndash;",
                 _m(sw.p_value, 4) if sw else "&ndash;",
                 _e(
-                    "normal"
+                    t("normal")
                     if sw and sw.normal
-                    else ("not normal" if sw and sw.normal is False else "not tested")
+                    else (t("not normal") if sw and sw.normal is False else t("not tested"))
                 ),
                 _m(bt.t, 3) if bt else "&ndash;",
                 _m(bt.critical, 3) if bt else "&ndash;",
                 _m(bt.p_value, 4) if bt else "&ndash;",
                 _e(
-                    "bias"
+                    t("bias")
                     if bt and bt.biased
-                    else ("no bias" if bt and bt.biased is False else "not tested")
+                    else (t("no bias") if bt and bt.biased is False else t("not tested"))
                 ),
                 _m(pt.chi2, 3) if pt else "&ndash;",
                 _m(pt.critical, 3) if pt else "&ndash;",
                 _e(
-                    ("accepted" if pt.accepted else "rejected") + f" (sigma0 {pt.sigma0:g} m)"
+                    (t("accepted") if pt.accepted else t("rejected")) + f" (sigma0 {pt.sigma0:g} m)"
                     if pt and pt.accepted is not None
-                    else "not tested"
+                    else t("not tested")
                 ),
             ]
         )
@@ -93,17 +104,17 @@ def _tests_table(g: GroupStatistics) -> str:
         css.append("fail" if bad else "pass")
     return _table(
         [
-            "component",
+            t("component"),
             "Shapiro-Wilk W",
             "p",
-            "decision",
-            "Student t",
-            "t critical",
+            t("decision"),
+            t("Student t"),
+            t("t critical"),
             "p",
-            "decision",
-            "chi-square",
-            "chi-square critical",
-            "decision",
+            t("decision"),
+            t("chi-square"),
+            t("chi-square critical"),
+            t("decision"),
         ],
         rows,
         css,
@@ -129,8 +140,10 @@ def _standard_section(res) -> str:
     notes = "".join(f'<li class="note">{_e(n)}</li>' for n in res.notes)
     return (
         f'<h3 class="standard" id="std-{_e(res.key)}">{_e(res.title)}</h3>'
-        f'<p class="note">Source: {_e(res.reference)}. {res.n_points} check points.</p>'
-        + _table(["check", "status", "measured", "limit", "reason"], rows, css)
+        + '<p class="note">'
+        + t("Source: {}. {} check points.").format(_e(res.reference), res.n_points)
+        + "</p>"
+        + _table([t("check"), t("status"), t("measured"), t("limit"), t("reason")], rows, css)
         + (f"<ul>{notes}</ul>" if notes else "")
     )
 
@@ -138,11 +151,11 @@ def _standard_section(res) -> str:
 def _summary(report: AccuracyReport) -> str:
     """The RMSEs, and beside them those of the other choice when points were flagged."""
     if report.contrast is None:
-        return _table(["RMSE", "value (m)"], [[k, _m(v, 4)] for k, v in report.rmse.items()])
+        return _table(["RMSE", t("value (m)")], [[k, _m(v, 4)] for k, v in report.rmse.items()])
     other = report.rmse_contrast
     head = [
         "RMSE",
-        f"{_e(report.overall.name)}, used (m)",
+        t("{}, used (m)").format(_e(report.overall.name)),
         f"{_e(report.contrast.name)} (m)",
     ]
     rows = [[k, _m(v, 4), _m(other[k], 4)] for k, v in report.rmse.items()]
@@ -158,66 +171,71 @@ def render_html(report: AccuracyReport) -> str:
     flagged = np.flatnonzero(report.outliers.any)
     parts = [
         "<!DOCTYPE html>",
-        '<html lang="en"><head><meta charset="utf-8">',
+        f'<html lang="{html_lang()}"><head><meta charset="utf-8">',
         f"<title>{_e(s.title)}</title><style>{_CSS}</style></head><body>",
         f"<h1>{_e(s.title)}</h1>",
         _table(
-            ["item", "value"],
+            [t("item"), t("value")],
             [
-                ["check points", f"{len(pts)} ({int(used.sum())} in the statistics)"],
-                ["source", _e(pts.source)],
-                ["CRS", _e(pts.crs or "not stated")],
-                ["sign convention", "d = measured &minus; reference, metres"],
-                ["significance level", f"{s.alpha:g}"],
-                ["created", _e(f"{report.created}, lidarphoto {__version__}")],
+                [
+                    t("check points"),
+                    t("{} ({} in the statistics)").format(len(pts), int(used.sum())),
+                ],
+                [t("source"), _e(pts.source)],
+                [t("CRS"), _e(pts.crs or t("not stated"))],
+                [t("sign convention"), t("d = measured &minus; reference, metres")],
+                [t("significance level"), f"{s.alpha:g}"],
+                [t("created"), _e(f"{report.created}, lidarphoto {__version__}")],
             ],
         ),
-        "<h2>Summary</h2>",
+        f"<h2>{t('Summary')}</h2>",
         _summary(report),
-        "<h2>Standards</h2>",
+        f"<h2>{t('Standards')}</h2>",
     ]
     if report.standards:
         parts.extend(_standard_section(r) for r in report.standards)
     else:
-        parts.append("<p>No standard was selected.</p>")
+        parts.append(f"<p>{t('No standard was selected.')}</p>")
     if report.group_thresholds:
-        parts.append("<h3>Project threshold per group</h3>")
+        parts.append(f"<h3>{t('Project threshold per group')}</h3>")
         rows, css = [], []
         for g, res in report.group_thresholds.items():
             for v in res.verdicts:
                 rows.append([_e(g), _e(v.name), _e(v.status.upper()), _e(v.reason)])
                 css.append(v.status)
-        parts.append(_table(["group", "check", "status", "reason"], rows, css))
-    parts.append("<h2>Statistics</h2>")
+        parts.append(_table([t("group"), t("check"), t("status"), t("reason")], rows, css))
+    parts.append(f"<h2>{t('Statistics')}</h2>")
     parts.append(f'<h3 class="group">{_e(report.overall.name.capitalize())} '
                  f"({report.overall.n})</h3>")  # fmt: skip
     parts.append(_stats_table(report.overall))
     parts.append(_tests_table(report.overall))
     if report.contrast is not None:
-        parts.append(f'<h3 class="group">For comparison: {_e(report.contrast.name)} '
-                     f"({report.contrast.n})</h3>")  # fmt: skip
+        parts.append('<h3 class="group">' + t("For comparison: {} ({})").format(
+            _e(report.contrast.name), report.contrast.n) + "</h3>")  # fmt: skip
         parts.append(_stats_table(report.contrast))
     for name, g in report.groups.items():
-        parts.append(f'<h3 class="group">Group {_e(name)} ({g.n})</h3>')
+        parts.append('<h3 class="group">' + t("Group {} ({})").format(_e(name), g.n) + "</h3>")
         parts.append(_stats_table(g))
         parts.append(_tests_table(g))
-    parts.append("<h2>Outliers</h2>")
+    parts.append(f"<h2>{t('Outliers')}</h2>")
     parts.append(
-        f"<p>Rule: {_e(report.outliers.description)}. "
+        "<p>"
+        + t("Rule: {}.").format(_e(report.outliers.description))
+        + " "
         + (
-            f"{len(flagged)} point(s) flagged: "
+            t("{} point(s) flagged: ").format(len(flagged))
             + ", ".join(_e(pts.ids[k]) for k in flagged)
             + (
-                "; excluded from the statistics and the standards."
+                t("; excluded from the statistics and the standards.")
                 if s.exclude_outliers
-                else "; kept in the statistics (not excluded)."
+                else t("; kept in the statistics (not excluded).")
             )
             if len(flagged)
-            else "No point flagged."
+            else t("No point flagged.")
         )
         + "</p>"
     )
-    parts.append('<h2>Plots</h2><div class="plots">')
+    parts.append(f'<h2>{t("Plots")}</h2><div class="plots">')
     labels = list(pts.ids)
     parts.append(
         vector_map(
@@ -232,12 +250,13 @@ def render_html(report: AccuracyReport) -> str:
     )
     parts.append('</div><div class="plots">')
     for k, c in enumerate("ENH"):
-        parts.append(histogram(d[used, k], title=f"Histogram of d{c}", xlabel=f"d{c} (m)"))
+        title = t("Histogram of {}").format(f"d{c}")
+        parts.append(histogram(d[used, k], title=title, xlabel=f"d{c} (m)"))
     parts.append('</div><div class="plots">')
     for k, c in enumerate("ENH"):
-        parts.append(qq_plot(d[used, k], title=f"Normal Q-Q plot of d{c}"))
+        parts.append(qq_plot(d[used, k], title=t("Normal Q-Q plot of {}").format(f"d{c}")))
     parts.append("</div>")
-    parts.append("<h2>Check points</h2>")
+    parts.append(f"<h2>{t('Check points')}</h2>")
     rows, css = [], []
     for k in range(len(pts)):
         rows.append(
@@ -249,8 +268,8 @@ def render_html(report: AccuracyReport) -> str:
                 _m(d[k, 2]),
                 _m(report.horizontal[k]),
                 _m(report.d3[k]),
-                "yes" if report.outliers.any[k] else "no",
-                "yes" if used[k] else "no",
+                t("yes") if report.outliers.any[k] else t("no"),
+                t("yes") if used[k] else t("no"),
             ]
         )
         css.append("fail" if report.outliers.any[k] else "")
@@ -258,30 +277,40 @@ def render_html(report: AccuracyReport) -> str:
         _table(
             [
                 "id",
-                "group",
+                t("group"),
                 "dE (m)",
                 "dN (m)",
                 "dU (m)",
                 "dHorizontal (m)",
                 "d3D (m)",
-                "outlier",
-                "used",
+                t("outlier"),
+                t("used"),
             ],
             rows,
             css,
         )
     )
+    notes = (
+        t(
+            "Statistics: standard deviation with n &minus; 1; RMSE = sqrt(mean(d&sup2;)); "
+            "Shapiro-Wilk by scipy (Royston's algorithm); Student t two-sided for a zero mean; "
+            "chi-square one-sided, (n &minus; 1) s&sup2; / sigma0&sup2; against chi-square(1 "
+            "&minus; alpha, n &minus; 1)."
+        ),
+        t(
+            "Figures marked <i>uncertain</i> in the verdicts come from our reading of the "
+            "standard or from secondary sources; check them against the official text before a "
+            "contractual statement."
+        ),
+        t(
+            "Status INSUFFICIENT: the standard needs more check points than were given; the "
+            "figures are computed but no conformance is claimed."
+        ),
+    )
     parts.append(
-        '<h2>Notes</h2><ul class="note">'
-        "<li>Statistics: standard deviation with n &minus; 1; RMSE = sqrt(mean(d&sup2;)); "
-        "Shapiro-Wilk by scipy (Royston's algorithm); Student t two-sided for a zero mean; "
-        "chi-square one-sided, (n &minus; 1) s&sup2; / sigma0&sup2; against chi-square(1 &minus; "
-        "alpha, n &minus; 1).</li>"
-        "<li>Figures marked <i>uncertain</i> in the verdicts come from our reading of the "
-        "standard or from secondary sources; check them against the official text before a "
-        "contractual statement.</li>"
-        "<li>Status INSUFFICIENT: the standard needs more check points than were given; the "
-        "figures are computed but no conformance is claimed.</li></ul>"
+        f'<h2>{t("Notes")}</h2><ul class="note">'
+        + "".join(f"<li>{n}</li>" for n in notes)
+        + "</ul>"
     )
     parts.append("</body></html>")
     return "\n".join(parts)

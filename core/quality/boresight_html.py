@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import __version__
+from .html_table import TR_CONTEXT, html_lang, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 from .svg_plots import histogram
@@ -87,23 +88,27 @@ def render_boresight_html(
     """
     parts = [
         "<!DOCTYPE html>",
-        '<html lang="en"><head><meta charset="utf-8">',
-        "<title>Boresight calibration</title>",
+        f'<html lang="{html_lang()}"><head><meta charset="utf-8">',
+        f"<title>{t('Boresight calibration')}</title>",
         f"<style>{_CSS}</style></head><body>",
-        "<h1>Boresight calibration</h1>",
+        f"<h1>{t('Boresight calibration')}</h1>",
         *_problems(problems, accepted),
-        f'<p class="note">lidarphoto {_e(__version__)}. Angles: d_omega, d_phi, d_kappa about '
-        "the camera axes x, y, z (R_c^b = R_nominal dR); standard deviations are a-posteriori "
-        "(scaled by sigma0) unless labelled a-priori.</p>",
-        "<h2>Settings</h2>",
+        f'<p class="note">lidarphoto {_e(__version__)}. '
+        + t(
+            "Angles: d_omega, d_phi, d_kappa about the camera axes x, y, z (R_c^b = R_nominal "
+            "dR); standard deviations are a-posteriori (scaled by sigma0) unless labelled "
+            "a-priori."
+        )
+        + "</p>",
+        f"<h2>{t('Settings')}</h2>",
         _table(
-            ["setting", "value"],
+            [t("setting"), t("value")],
             [[_e(k), f'<span class="t">{_e(v)}</span>'] for k, v in settings.items()],
         ),
     ]
     if diagnosis:
-        parts.append("<h2>Not observable</h2>")
-        parts.append('<div class="diag"><p>The calibration was not computed:</p><ul>')
+        parts.append(f"<h2>{t('Not observable')}</h2>")
+        parts.append(f'<div class="diag"><p>{t("The calibration was not computed:")}</p><ul>')
         parts += [f"<li>{_e(s)}</li>" for s in diagnosis]
         parts.append("</ul></div>")
     if run is not None:
@@ -116,11 +121,15 @@ def _problems(problems: Sequence[str], accepted: bool) -> list[str]:
     if not problems:
         return []
     verdict = (
-        "These results FAILED their checks and were written only because the user asked "
-        "for them (ACCEPT_DOUBTFUL): do not use them without review."
+        t(
+            "These results FAILED their checks and were written only because the user asked "
+            "for them (ACCEPT_DOUBTFUL): do not use them without review."
+        )
         if accepted
-        else "The calibration FAILED its checks: no table and no exterior orientation were "
-        "written. The numbers below show the failed adjustment, for diagnosis only."
+        else t(
+            "The calibration FAILED its checks: no table and no exterior orientation were "
+            "written. The numbers below show the failed adjustment, for diagnosis only."
+        )
     )
     items = "".join(f"<li>{_e(p)}</li>" for p in problems)
     return [f'<div class="alarm"><p><b>{_e(verdict)}</b></p><ul>{items}</ul></div>']
@@ -128,7 +137,7 @@ def _problems(problems: Sequence[str], accepted: bool) -> list[str]:
 
 def _results(run: BoresightRun) -> list[str]:
     res = run.result
-    out = ["<h2>Boresight</h2>"]
+    out = [f"<h2>{t('Boresight')}</h2>"]
     rows = []
     for g, name in enumerate(res.groups):
         for k, angle in enumerate(_ANGLES):
@@ -147,22 +156,22 @@ def _results(run: BoresightRun) -> list[str]:
     out.append(
         _table(
             [
-                "group",
-                "angle",
-                "value (deg)",
-                "value (d m s)",
-                "value (arcsec)",
-                "sigma (arcsec)",
-                "sigma a-priori (arcsec)",
+                t("group"),
+                t("angle"),
+                t("value (deg)"),
+                t("value (d m s)"),
+                t("value (arcsec)"),
+                t("sigma (arcsec)"),
+                t("sigma a-priori (arcsec)"),
             ],
             rows,
         )
     )
     if res.lever_arm is not None:
-        out.append("<h3>Lever arm (body frame)</h3>")
+        out.append(f"<h3>{t('Lever arm (body frame)')}</h3>")
         out.append(
             _table(
-                ["axis", "value (m)", "sigma (m)"],
+                [t("axis"), t("value (m)"), t("sigma (m)")],
                 [
                     [a, _n(v, 4), _n(s, 4)]
                     for a, v, s in zip("xyz", res.lever_arm, res.lever_arm_std)
@@ -170,46 +179,48 @@ def _results(run: BoresightRun) -> list[str]:
             )
         )
     if res.interior is not None:
-        out.append("<h3>Interior orientation</h3>")
+        out.append(f"<h3>{t('Interior orientation')}</h3>")
         out.append(
             _table(
-                ["parameter", "value (mm)", "sigma (mm)"],
+                [t("parameter"), t("value (mm)"), t("sigma (mm)")],
                 [
                     [a, _n(v, 5), _n(s, 5)]
                     for a, v, s in zip(("f", "x0", "y0"), res.interior, res.interior_std)
                 ],
             )
         )
-    t = res.adjustment.global_test
-    out.append("<h2>Adjustment</h2>")
+    gt = res.adjustment.global_test
+    out.append(f"<h2>{t('Adjustment')}</h2>")
     out.append(
         _table(
-            ["figure", "value"],
+            [t("figure"), t("value")],
             [
-                ["sigma0 (a-posteriori, a-priori 1)", _n(res.sigma0, 3)],
-                ["redundancy", str(res.redundancy)],
+                [t("sigma0 (a-posteriori, a-priori 1)"), _n(res.sigma0, 3)],
+                [t("redundancy"), str(res.redundancy)],
                 [
-                    "observations / constraints",
+                    t("observations / constraints"),
                     f"{res.adjustment.n_observations} / {res.adjustment.n_constraints}",
                 ],
-                ["global chi-square statistic", _n(t.statistic, 1)],
+                [t("global chi-square statistic"), _n(gt.statistic, 1)],
                 [
-                    f"acceptance interval (alpha = {t.alpha:g})",
-                    f"[{_n(t.lower, 1)}, {_n(t.upper, 1)}]",
+                    t("acceptance interval (alpha = {})").format(f"{gt.alpha:g}"),
+                    f"[{_n(gt.lower, 1)}, {_n(gt.upper, 1)}]",
                 ],
-                ["p-value", _n(t.p_value, 3)],
-                ["global test", "passed" if t.passed else "failed"],
+                [t("p-value"), _n(gt.p_value, 3)],
+                [t("global test"), t("passed") if gt.passed else t("failed")],
                 [
-                    "iterations",
-                    f"{res.adjustment.iterations} (converged: "
-                    f"{'yes' if res.adjustment.converged else 'no'})",
+                    t("iterations"),
+                    t("{} (converged: {})").format(
+                        res.adjustment.iterations,
+                        t("yes") if res.adjustment.converged else t("no"),
+                    ),
                 ],
-                ["outlier detection", _e(res.adjustment.outlier_method)],
+                [t("outlier detection"), _e(res.adjustment.outlier_method)],
             ],
-            [""] * 6 + ["pass" if t.passed else "fail", "", ""],
+            [""] * 6 + ["pass" if gt.passed else "fail", "", ""],
         )
     )
-    out.append("<h2>Correlation of the calibration parameters</h2>")
+    out.append(f"<h2>{t('Correlation of the calibration parameters')}</h2>")
     names = [_e(n.replace("bore[", "").replace("].", " ")) for n in res.parameter_names]
     corr = np.asarray(res.correlation)
     out.append(
@@ -217,12 +228,12 @@ def _results(run: BoresightRun) -> list[str]:
     )
     r = res.residuals
     obs = run.observations
-    out.append("<h2>Rejected observations</h2>")
+    out.append(f"<h2>{t('Rejected observations')}</h2>")
     rej = np.flatnonzero(r.rejected)
     if rej.size:
         out.append(
             _table(
-                ["image", "point", "type", "target", "|v| (px)", "w"],
+                [t("image"), t("point"), t("type"), t("target"), "|v| (px)", "w"],
                 [
                     [
                         _e(obs.image_id[k]),
@@ -237,20 +248,29 @@ def _results(run: BoresightRun) -> list[str]:
             )
         )
     else:
-        out.append("<p>None.</p>")
+        out.append(f"<p>{t('None.')}</p>")
     if res.warnings:
-        out.append("<h2>Warnings</h2><ul>" + "".join(f"<li>{_e(w)}</li>" for w in res.warnings))
+        out.append(
+            f"<h2>{t('Warnings')}</h2><ul>" + "".join(f"<li>{_e(w)}</li>" for w in res.warnings)
+        )
         out.append("</ul>")
     keep = r.used & ~r.rejected & np.isfinite(r.v_px).all(axis=1)
     if keep.any():
         rms = np.sqrt(np.mean(r.v_px[keep] ** 2, axis=0))
-        out.append("<h2>Image residuals</h2>")
+        out.append(f"<h2>{t('Image residuals')}</h2>")
         out.append(
-            f"<p>{int(keep.sum())} image points kept: RMS residual {_n(rms[0], 3)} px (col), "
-            f"{_n(rms[1], 3)} px (row).</p>"
+            "<p>"
+            + t("{} image points kept: RMS residual {} px (col), {} px (row).").format(
+                int(keep.sum()), _n(rms[0], 3), _n(rms[1], 3)
+            )
+            + "</p>"
         )
         out.append('<div class="plots">')
-        out.append(histogram(r.v_px[keep, 0], title="Residual vx", xlabel="col residual (px)"))
-        out.append(histogram(r.v_px[keep, 1], title="Residual vy", xlabel="row residual (px)"))
+        out.append(
+            histogram(r.v_px[keep, 0], title=t("Residual vx"), xlabel=t("col residual (px)"))
+        )
+        out.append(
+            histogram(r.v_px[keep, 1], title=t("Residual vy"), xlabel=t("row residual (px)"))
+        )
         out.append("</div>")
     return out

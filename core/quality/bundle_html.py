@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import __version__
+from .html_table import TR_CONTEXT, html_lang, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 from .svg_plots import correlation_heatmap, histogram, image_vector_field
@@ -47,13 +48,13 @@ def _n(x: object, fmt: str = ".3f") -> str:
 
 
 def _comparison(rows: Sequence[Mapping[str, object]], best: str) -> str:
-    head = ["rank", "AP model", "check points", "mean horizontal (m)", "std horizontal (m)",
-            "RMSE_HORIZONTAL (m)", "RMSE_U (m)", "RMSE_3D (m)", "sigma0", "APs",
-            "APs kept", "significant", "rejected"]  # fmt: skip
+    head = [t("rank"), t("AP model"), t("check points"), t("mean horizontal (m)"),
+            t("std horizontal (m)"), "RMSE_HORIZONTAL (m)", "RMSE_U (m)", "RMSE_3D (m)",
+            "sigma0", t("APs"), t("APs kept"), t("significant"), t("rejected")]  # fmt: skip
     out, css = [], []
     for r in rows:
         if "error" in r and r.get("error"):
-            out.append(["&ndash;", _e(r["model"]), f'not observable: {_e(r["error"])}'] +
+            out.append(["&ndash;", _e(r["model"]), t("not observable: {}").format(_e(r["error"]))] +
                        [""] * 10)  # fmt: skip
             css.append("fail")
             continue
@@ -69,26 +70,32 @@ def _comparison(rows: Sequence[Mapping[str, object]], best: str) -> str:
 
 def _adjustment(res: BundleResult) -> str:
     a = res.adjustment
-    t = a.global_test
+    gt = a.global_test
     rows = [
-        ["converged", "yes" if a.converged else "NO", f"after {a.iterations} iterations"],
-        ["sigma0 a posteriori", _n(a.sigma0, ".4f"), f"a priori {a.sigma0_prior:g}"],
-        ["redundancy", _e(a.redundancy), f"{a.n_observations} observation rows, "
-         f"{len(a.x)} parameters, {a.n_constraints} constraint rows"],
-        ["global chi-square test", "passed" if t.passed else "FAILED",
-         f"statistic {t.statistic:.1f}, accepted [{t.lower:.1f}, {t.upper:.1f}], "
-         f"p = {t.p_value:.3g}" if t.dof > 0 else "no redundancy"],
-        ["outliers", _e(int(res.rejected.sum())), _e(a.outlier_method)],
-        ["condition number (reduced system)", _n(a.condition_number, ".3g"), ""],
+        [t("converged"), t("yes") if a.converged else t("NO"),
+         t("after {} iterations").format(a.iterations)],
+        [t("sigma0 a posteriori"), _n(a.sigma0, ".4f"),
+         t("a priori {}").format(f"{a.sigma0_prior:g}")],
+        [t("redundancy"), _e(a.redundancy),
+         t("{} observation rows, {} parameters, {} constraint rows").format(
+             a.n_observations, len(a.x), a.n_constraints)],
+        [t("global chi-square test"), t("passed") if gt.passed else t("FAILED"),
+         t("statistic {}, accepted [{}, {}], p = {}").format(
+             f"{gt.statistic:.1f}", f"{gt.lower:.1f}", f"{gt.upper:.1f}", f"{gt.p_value:.3g}")
+         if gt.dof > 0 else t("no redundancy")],
+        [t("outliers"), _e(int(res.rejected.sum())), _e(a.outlier_method)],
+        [t("condition number (reduced system)"), _n(a.condition_number, ".3g"), ""],
     ]  # fmt: skip
-    return _table(["", "value", "details"], rows, ["", "", "", "pass" if t.passed else "fail"])
+    return _table(
+        ["", t("value"), t("details")], rows, ["", "", "", "pass" if gt.passed else "fail"]
+    )
 
 
 def _interior(res: BundleResult, alpha_text: str) -> str:
     rows, css = [], []
     for p in res.interior:
         if p.status == "estimated":
-            sig = "yes" if p.significant else "no"
+            sig = t("yes") if p.significant else t("no")
         else:
             sig = "&ndash;"
         rows.append([
@@ -96,8 +103,8 @@ def _interior(res: BundleResult, alpha_text: str) -> str:
             sig, _e(p.status), _e(p.reason),
         ])  # fmt: skip
         css.append("drop" if p.status == "dropped" else "")
-    head = ["camera", "parameter", "value", "std", "t", f"significant ({alpha_text})",
-            "status", "reason"]  # fmt: skip
+    head = [t("camera"), t("parameter"), t("value"), t("std"), "t",
+            t("significant ({})").format(alpha_text), t("status"), t("reason")]  # fmt: skip
     return _table(head, rows, css)
 
 
@@ -113,34 +120,45 @@ def render_bundle_html(
     every model that ran."""
     res = results[best]
     parts = [
-        "<!DOCTYPE html><html><head><meta charset='utf-8'>",
-        f"<title>Bundle adjustment: {_e(best)}</title><style>{_CSS}</style></head><body>",
-        f"<h1>Bundle adjustment with self-calibration ({_e(best)})</h1>",
-        f'<p class="note">lidarphoto {_e(__version__)}; mapping CRS and units in the '
-        "settings; image residuals in pixels (adjusted minus measured).</p>",
-        "<h2>Settings</h2>",
-        _table(["setting", "value"], [[_e(k), _e(v)] for k, v in settings.items()]),
+        f"<!DOCTYPE html><html lang='{html_lang()}'><head><meta charset='utf-8'>",
+        "<title>" + t("Bundle adjustment: {}").format(_e(best)) + "</title>"
+        f"<style>{_CSS}</style></head><body>",
+        "<h1>" + t("Bundle adjustment with self-calibration ({})").format(_e(best)) + "</h1>",
+        f'<p class="note">lidarphoto {_e(__version__)}; '
+        + t(
+            "mapping CRS and units in the settings; image residuals in pixels (adjusted minus "
+            "measured)."
+        )
+        + "</p>",
+        f"<h2>{t('Settings')}</h2>",
+        _table([t("setting"), t("value")], [[_e(k), _e(v)] for k, v in settings.items()]),
     ]
     if len(comparison) > 1:
         parts += [
-            "<h2>AP models compared (check-point discrepancies)</h2>",
-            '<p class="note">Planimetric discrepancy = horizontal distance between the '
-            "intersected and the surveyed check point; ranked by the 3D RMS (sigma0 without "
-            "check points). The outputs are those of the best model (highlighted).</p>",
+            f"<h2>{t('AP models compared (check-point discrepancies)')}</h2>",
+            '<p class="note">'
+            + t(
+                "Planimetric discrepancy = horizontal distance between the intersected and the "
+                "surveyed check point; ranked by the 3D RMS (sigma0 without check points). The "
+                "outputs are those of the best model (highlighted)."
+            )
+            + "</p>",
             _comparison(comparison, best),
         ]
-    parts += ["<h2>Adjustment</h2>", _adjustment(res)]
-    parts += ["<h2>Interior orientation and additional parameters</h2>",
+    parts += [f"<h2>{t('Adjustment')}</h2>", _adjustment(res)]
+    parts += [f"<h2>{t('Interior orientation and additional parameters')}</h2>",
               _interior(res, alpha_text)]  # fmt: skip
     if res.dropped:
         parts.append(
-            "<p>Dropped by the selection, in order: "
+            "<p>"
+            + t("Dropped by the selection, in order: ")
             + "; ".join(f"{_e(c)} {_e(n)} ({_e(w)})" for c, n, w in res.dropped)
             + "</p>"
         )
     if res.flagged_correlations:
         parts.append(
-            f"<p>|correlation| above {max_correlation:g} in the final adjustment: "
+            "<p>"
+            + t("|correlation| above {} in the final adjustment: ").format(f"{max_correlation:g}")
             + "; ".join(f"{_e(c)} {_e(a)} / {_e(b)}: {r:+.3f}"
                         for c, a, b, r in res.flagged_correlations)
             + "</p>"
@@ -148,20 +166,21 @@ def render_bundle_html(
     plots = []
     for cam, (names, corr) in res.interior_correlation.items():
         if len(names) > 1:
-            plots.append(correlation_heatmap(names, corr, title=f"Correlations: {cam}",
+            plots.append(correlation_heatmap(names, corr, title=t("Correlations: {}").format(cam),
                                              flag=max_correlation))  # fmt: skip
     if plots:
         parts += ['<div class="plots">', *plots, "</div>"]
     if res.mount is not None:
         m = res.mount
         rows = [[_e(n), _n(v, ".4f"), _n(s, ".4f")] for n, v, s in zip(
-            ("lever dx (m)", "lever dy (m)", "lever dz (m)"), m["lever_arm_m"],
+            (t("lever dx (m)"), t("lever dy (m)"), t("lever dz (m)")), m["lever_arm_m"],
             m["lever_arm_std_m"])]  # fmt: skip
         rows += [[_e(n), _n(np.degrees(v), ".5f"), _n(np.degrees(s), ".5f")] for n, v, s in zip(
-            ("boresight d_omega (deg)", "boresight d_phi (deg)", "boresight d_kappa (deg)"),
+            (t("boresight d_omega (deg)"), t("boresight d_phi (deg)"),
+             t("boresight d_kappa (deg)")),
             m["boresight_rad"], m["boresight_std_rad"])]  # fmt: skip
-        parts += ["<h2>Lever arm and boresight corrections (camera axes)</h2>",
-                  _table(["parameter", "value", "std"], rows)]  # fmt: skip
+        parts += [f"<h2>{t('Lever arm and boresight corrections (camera axes)')}</h2>",
+                  _table([t("parameter"), t("value"), t("std")], rows)]  # fmt: skip
     # per image
     rows = []
     for k, im in enumerate(res.eo.image_id):
@@ -171,8 +190,8 @@ def render_bundle_html(
                      *(_n(v, ".3f") for v in res.eo_sigma[k, :3]),
                      *(_n(np.degrees(v) * 3600, ".1f") for v in res.eo_sigma[k, 3:])])  # fmt: skip
     parts += [
-        "<h2>Images</h2>",
-        _table(["image", "camera", "points used", "RMS col (px)", "RMS row (px)",
+        f"<h2>{t('Images')}</h2>",
+        _table([t("image"), t("camera"), t("points used"), t("RMS col (px)"), t("RMS row (px)"),
                 "sigma X (m)", "sigma Y (m)", "sigma Z (m)", 'sigma omega (")', 'sigma phi (")',
                 'sigma kappa (")'], rows),
     ]
@@ -184,15 +203,19 @@ def render_bundle_html(
                  *(_n(v) for v in s), _e(n)]
                 for p, dd, s, n in zip(c.point_id, d, c.sigma, c.n_images)]  # fmt: skip
         parts += [
-            "<h2>Check points (not in the adjustment)</h2>",
-            f"<p>Horizontal discrepancy: mean {_n(st['mean_planimetric'])} m, standard "
-            f"deviation {_n(st['std_planimetric'])} m, RMSE_HORIZONTAL "
-            f"{_n(st['rms_planimetric'])} m; RMSE_E / RMSE_N / RMSE_U {_n(st['rms_e'])} / "
-            f"{_n(st['rms_n'])} / {_n(st['rms_h'])} m; RMSE_3D {_n(st['rms_3d'])} m. "
-            "Intersected with the adjusted orientations; their sigmas carry the image noise "
-            "only.</p>",
-            _table(["point", "dE (m)", "dN (m)", "dU (m)", "dHorizontal (m)", "sigma E (m)",
-                    "sigma N (m)", "sigma H (m)", "images"], rows),
+            f"<h2>{t('Check points (not in the adjustment)')}</h2>",
+            "<p>"
+            + t(
+                "Horizontal discrepancy: mean {} m, standard deviation {} m, RMSE_HORIZONTAL "
+                "{} m; RMSE_E / RMSE_N / RMSE_U {} / {} / {} m; RMSE_3D {} m. Intersected with "
+                "the adjusted orientations; their sigmas carry the image noise only."
+            ).format(
+                _n(st["mean_planimetric"]), _n(st["std_planimetric"]), _n(st["rms_planimetric"]),
+                _n(st["rms_e"]), _n(st["rms_n"]), _n(st["rms_h"]), _n(st["rms_3d"]),
+            )
+            + "</p>",
+            _table([t("point"), "dE (m)", "dN (m)", "dU (m)", "dHorizontal (m)", "sigma E (m)",
+                    "sigma N (m)", "sigma H (m)", t("images")], rows),
         ]
     plots = []
     obs = res.observations
@@ -204,22 +227,25 @@ def render_bundle_html(
         if sel.any():
             plots.append(image_vector_field(
                 obs.pixels[sel, 0], obs.pixels[sel, 1], res.v_px[sel, 0], res.v_px[sel, 1],
-                cam.width_px, cam.height_px, title=f"Image residuals: {name}"))  # fmt: skip
+                cam.width_px, cam.height_px,
+                title=t("Image residuals: {}").format(name)))  # fmt: skip
     used_v = res.v_px[res.used]
     if used_v.size:
-        plots.append(histogram(used_v[:, 0], title="v col", xlabel="residual (px)"))
-        plots.append(histogram(used_v[:, 1], title="v row", xlabel="residual (px)"))
+        plots.append(histogram(used_v[:, 0], title=t("v col"), xlabel=t("residual (px)")))
+        plots.append(histogram(used_v[:, 1], title=t("v row"), xlabel=t("residual (px)")))
     if plots:
-        parts += ["<h2>Residuals</h2>", '<div class="plots">', *plots, "</div>"]
+        parts += [f"<h2>{t('Residuals')}</h2>", '<div class="plots">', *plots, "</div>"]
     if res.rejected.any():
         rej = np.flatnonzero(res.rejected)[:200]
         rows = [[_e(obs.image_id[i]), _e(obs.point_id[i]), _n(res.v_px[i, 0], ".2f"),
                  _n(res.v_px[i, 1], ".2f"), _n(res.w[i, 0], ".2f"), _n(res.w[i, 1], ".2f")]
                 for i in rej]  # fmt: skip
-        parts += [f"<h2>Rejected measurements ({int(res.rejected.sum())})</h2>",
-                  _table(["image", "point", "v col", "v row", "w col", "w row"], rows)]  # fmt: skip
+        title = t("Rejected measurements ({})").format(int(res.rejected.sum()))
+        parts += [f"<h2>{title}</h2>",
+                  _table([t("image"), t("point"), t("v col"), t("v row"), t("w col"),
+                          t("w row")], rows)]  # fmt: skip
     if res.warnings:
-        parts += ["<h2>Warnings</h2><ul>",
+        parts += [f"<h2>{t('Warnings')}</h2><ul>",
                   *(f"<li>{_e(w)}</li>" for w in res.warnings), "</ul>"]  # fmt: skip
     parts.append("</body></html>")
     return "\n".join(parts)

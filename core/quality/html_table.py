@@ -6,6 +6,18 @@ from __future__ import annotations
 import html
 from collections.abc import Sequence
 
+from ..i18n import html_lang, translator
+
+__all__ = ["TR_CONTEXT", "escape", "html_lang", "t", "table"]
+#: translation context of the reports' texts (``make i18n`` collects the ``t("...")`` calls of
+#: every module that defines or imports TR_CONTEXT)
+TR_CONTEXT = "Report"
+
+
+def t(text: str) -> str:
+    """``text`` in the language of the reports (:func:`core.i18n.set_language`)."""
+    return translator(TR_CONTEXT)(text)
+
 
 def escape(text: object) -> str:
     """``text`` as HTML text (quotes escaped too, so it may stand in an attribute).

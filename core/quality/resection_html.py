@@ -15,6 +15,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from .. import __version__
+from .html_table import TR_CONTEXT, html_lang, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 
@@ -65,18 +66,22 @@ def render_resection_html(
     """
     parts = [
         "<!DOCTYPE html>",
-        '<html lang="en"><head><meta charset="utf-8">',
-        "<title>Space resection</title>",
+        f'<html lang="{html_lang()}"><head><meta charset="utf-8">',
+        f"<title>{t('Space resection')}</title>",
         f"<style>{_CSS}</style></head><body>",
-        "<h1>Space resection</h1>",
-        f'<p class="note">lidarphoto {_e(__version__)}. Position in the mapping CRS, '
-        "omega-phi-kappa relative to the grid frame at the perspective centre; standard "
-        "deviations a-posteriori (scaled by sigma0) unless labelled a-priori. Global test: "
-        "v'Pv / sigma0_prior^2 against the chi-square critical value (one-sided 5 %, as dos "
-        "Santos et al. 2010 report it) and the two-sided acceptance range.</p>",
-        "<h2>Settings</h2>",
-        _table(["setting", "value"], [[_e(k), _e(v)] for k, v in settings.items()]),
-        "<h2>Images</h2>",
+        f"<h1>{t('Space resection')}</h1>",
+        f'<p class="note">lidarphoto {_e(__version__)}. '
+        + t(
+            "Position in the mapping CRS, omega-phi-kappa relative to the grid frame at the "
+            "perspective centre; standard deviations a-posteriori (scaled by sigma0) unless "
+            "labelled a-priori. Global test: v'Pv / sigma0_prior^2 against the chi-square "
+            "critical value (one-sided 5 %, as dos Santos et al. 2010 report it) and the "
+            "two-sided acceptance range."
+        )
+        + "</p>",
+        f"<h2>{t('Settings')}</h2>",
+        _table([t("setting"), t("value")], [[_e(k), _e(v)] for k, v in settings.items()]),
+        f"<h2>{t('Images')}</h2>",
     ]
     rows, css = [], []
     for r in runs:
@@ -85,10 +90,11 @@ def render_resection_html(
         rows.append([_e(r.image_id), *(_n(x, 3) for x in r.result.xyz),
                      *(_n(a, 5) for a in deg), str(r.image.data.n_points),
                      str(r.image.data.n_lines), _n(res.sigma0, 3),
-                     "passed" if res.chi2_passed else "FAILED"])  # fmt: skip
+                     t("passed") if res.chi2_passed else t("FAILED")])  # fmt: skip
         css.append("pass" if res.chi2_passed else "fail")
-    parts.append(_table(["image", "X (m)", "Y (m)", "Z (m)", "omega (deg)", "phi (deg)",
-                         "kappa (deg)", "points", "lines", "sigma0", "test"], rows, css))
+    parts.append(_table([t("image"), "X (m)", "Y (m)", "Z (m)", "omega (deg)", "phi (deg)",
+                         "kappa (deg)", t("points"), t("lines"), "sigma0", t("test")], rows,
+                        css))  # fmt: skip
     by_image: dict[str, list] = {}
     for row in residuals:
         by_image.setdefault(str(row[0]), []).append(row)
@@ -100,13 +106,18 @@ def render_resection_html(
 
 def _image(r, residuals: list) -> list[str]:
     res = r.result.result
-    out = [f"<h2>Image {_e(r.image_id)}</h2>"]
+    out = ["<h2>" + t("Image {}").format(_e(r.image_id)) + "</h2>"]
     out.append(
-        f'<p class="note">Start: {_e(res.start)}; line model: {_e(res.model)}; '
-        f"{res.iterations} iterations; {r.image.data.n_points} control points, "
-        f"{r.image.data.n_lines} lines, {len(r.image.check_rows)} check points, "
-        f"{r.image.ignored} rows without control ignored.</p>"
-    )
+        '<p class="note">'
+        + t(
+            "Start: {}; line model: {}; {} iterations; {} control points, {} lines, {} check "
+            "points, {} rows without control ignored."
+        ).format(
+            _e(res.start), _e(res.model), res.iterations, r.image.data.n_points,
+            r.image.data.n_lines, len(r.image.check_rows), r.image.ignored,
+        )
+        + "</p>"
+    )  # fmt: skip
     std = r.result.std
     prior = _prior_std(r)
     values = [*r.result.xyz, *np.degrees(r.result.opk)]
@@ -117,27 +128,28 @@ def _image(r, residuals: list) -> list[str]:
         rows.append([name, _n(values[k], 4 if k < 3 else 6), units[k], _n(std[k] * scale, 5),
                      _n(prior[k] * scale, 5),
                      _n(std[k] * 3600 * scale, 2) if k >= 3 else ""])  # fmt: skip
-    out.append(_table(["parameter", "value", "unit", "std", "std a-priori", "std (arcsec)"],
-                      rows))  # fmt: skip
+    out.append(_table([t("parameter"), t("value"), t("unit"), t("std"), t("std a-priori"),
+                       t("std (arcsec)")], rows))  # fmt: skip
     if res.interior is not None:
-        out.append("<h3>Interior orientation (refined)</h3>")
-        out.append(_table(["parameter", "value (mm)", "std (mm)"], [
+        out.append(f"<h3>{t('Interior orientation (refined)')}</h3>")
+        out.append(_table([t("parameter"), t("value (mm)"), t("std (mm)")], [
             [n, _n(v, 5), _n(s, 5)] for n, v, s in zip(
                 ("focal", "x0", "y0"), res.interior, res.interior_std)]))  # fmt: skip
-    t = res.chi2
-    verdict = "passed" if res.chi2_passed else "FAILED"
-    out.append("<h3>Global test</h3>")
-    out.append(_table(["quantity", "value"], [
-        ["observations (condition rows)", str(res.adjustment.n_observations)],
-        ["redundancy", str(res.redundancy)],
-        ["sigma0 a-posteriori", _n(res.sigma0, 4)],
-        ["chi-square statistic v'Pv / sigma0_prior^2", _n(t.statistic, 3)],
-        ["critical value, one-sided 5 % (as the source)", _n(res.chi2_critical, 3)],
-        ["two-sided acceptance range", f"{_n(t.lower, 3)} .. {_n(t.upper, 3)}"],
-        ["verdict (one-sided)", verdict],
-        ["condition number (scaled normal matrix)", f"{res.adjustment.condition_number:.3g}"],
+    gt = res.chi2
+    verdict = t("passed") if res.chi2_passed else t("FAILED")
+    out.append(f"<h3>{t('Global test')}</h3>")
+    out.append(_table([t("quantity"), t("value")], [
+        [t("observations (condition rows)"), str(res.adjustment.n_observations)],
+        [t("redundancy"), str(res.redundancy)],
+        [t("sigma0 a-posteriori"), _n(res.sigma0, 4)],
+        [t("chi-square statistic v'Pv / sigma0_prior^2"), _n(gt.statistic, 3)],
+        [t("critical value, one-sided 5 % (as the source)"), _n(res.chi2_critical, 3)],
+        [t("two-sided acceptance range"), f"{_n(gt.lower, 3)} .. {_n(gt.upper, 3)}"],
+        [t("verdict (one-sided)"), verdict],
+        [t("condition number (scaled normal matrix)"),
+         f"{res.adjustment.condition_number:.3g}"],
     ], ["", "", "", "", "", "pass" if res.chi2_passed else "fail"]))  # fmt: skip
-    out.append("<h3>Correlation of the six parameters</h3>")
+    out.append(f"<h3>{t('Correlation of the six parameters')}</h3>")
     corr = res.correlation
     out.append(_table(["", *_NAMES], [
         [name, *(_n(corr[i, j], 2) for j in range(6))] for i, name in enumerate(_NAMES)]))
@@ -146,19 +158,19 @@ def _image(r, residuals: list) -> list[str]:
     lns = [row for row in used if row[2] == "line"]
     chk = [row for row in residuals if not row[12]]
     rows = [
-        ["control points: RMS |v| (px)", str(len(pts)),
+        [t("control points: RMS |v| (px)"), str(len(pts)),
          _n(_rms(np.array([row[9] for row in pts])), 3)],
-        ["line points: RMS distance from the projected line (px)", str(len(lns)),
+        [t("line points: RMS distance from the projected line (px)"), str(len(lns)),
          _n(_rms(np.array([row[9] for row in lns])), 3)],
-        ["check points: RMS |projected - measured| (px)", str(len(chk)),
+        [t("check points: RMS |projected - measured| (px)"), str(len(chk)),
          _n(_rms(np.array([row[9] for row in chk])), 3)],
     ]  # fmt: skip
-    out.append("<h3>Residuals</h3>")
-    out.append(_table(["what", "count", "value"], rows))
+    out.append(f"<h3>{t('Residuals')}</h3>")
+    out.append(_table([t("what"), t("count"), t("value")], rows))
     rejected = [(b.block, b.label, b.row_name, b.w) for b in res.adjustment.rejected]
     if rejected:
-        out.append("<h3>Rejected by data snooping</h3>")
-        out.append(_table(["block", "id", "row", "w"],
+        out.append(f"<h3>{t('Rejected by data snooping')}</h3>")
+        out.append(_table([t("block"), "id", t("row"), "w"],
                           [[_e(b), _e(lab), _e(rn), _n(w, 2)] for b, lab, rn, w in rejected]))
     if res.warnings:
         out.append('<p class="note">' + "<br>".join(_e(w) for w in res.warnings) + "</p>")

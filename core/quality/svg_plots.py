@@ -14,6 +14,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import stats
 
+from .html_table import TR_CONTEXT  # noqa: F401 - the context of _tr (make i18n)
+from .html_table import t as _tr  # (many plots use ``t`` for other things)
+
 __all__ = [
     "correlation_heatmap",
     "histogram",
@@ -146,7 +149,7 @@ def vector_map(
     labels: Sequence[str] | None = None,
     flags: NDArray[np.bool_] | None = None,
     *,
-    title: str = "Horizontal discrepancy vectors",
+    title: str | None = None,
     width: int = 640,
     height: int = 520,
 ) -> str:
@@ -181,6 +184,8 @@ def vector_map(
         ys = xs / ratio
     cx, cy = (x.min() + x.max()) / 2, (y.min() + y.max()) / 2
     fr = _Frame(cx - xs / 2, cx + xs / 2, cy - ys / 2, cy + ys / 2, left, top, pw, ph)
+    if title is None:
+        title = _tr("Horizontal discrepancy vectors")
     body = fr.axes(f"E - {e0:.1f} (m)", f"N - {n0:.1f} (m)")
     length = np.hypot(de, dn)
     dmax = float(length.max()) if length.size else 0.0
@@ -217,8 +222,11 @@ def vector_map(
         _arrows(np.array([lx]), np.array([ly]), np.array([lx + arrow_px]), np.array([ly]), "#222")
     )
     body.append(
-        f'<text x="{lx:.1f}" y="{ly + 16:.1f}" {_FONT}>{_fmt(vec)} m discrepancy</text>'
-        f'<text x="{lx:.1f}" y="{ly + 30:.1f}" {_FONT}>(vectors x {exaggeration:,.0f})</text>'
+        f'<text x="{lx:.1f}" y="{ly + 16:.1f}" {_FONT}>'
+        + _tr("{} m discrepancy").format(_fmt(vec))
+        + f'</text><text x="{lx:.1f}" y="{ly + 30:.1f}" {_FONT}>'
+        + _tr("(vectors x {})").format(f"{exaggeration:,.0f}")
+        + "</text>"
     )
     # Longest 1-2-5 ground distance that fits the legend (about 110 px).
     bar = _nice_floor(110.0 * xs / pw)
@@ -227,7 +235,9 @@ def vector_map(
     body.append(
         f'<line x1="{lx:.1f}" y1="{by:.1f}" x2="{lx + bar_px:.1f}" y2="{by:.1f}" '
         'stroke="#000" stroke-width="3"/>'
-        f'<text x="{lx:.1f}" y="{by + 16:.1f}" {_FONT}>{_fmt(bar)} m on the ground</text>'
+        f'<text x="{lx:.1f}" y="{by + 16:.1f}" {_FONT}>'
+        + _tr("{} m on the ground").format(_fmt(bar))
+        + "</text>"
     )
     if dh is not None and dh.size:
         lim = float(np.max(np.abs(dh)))
@@ -243,7 +253,9 @@ def vector_map(
         oy = height - bottom - 6
         body.append(
             f'<circle cx="{lx + 7:.1f}" cy="{oy - 4:.1f}" r="7" fill="none" stroke="#d00" '
-            f'stroke-width="2"/><text x="{lx + 20:.1f}" y="{oy:.1f}" {_FONT}>outlier</text>'
+            f'stroke-width="2"/><text x="{lx + 20:.1f}" y="{oy:.1f}" {_FONT}>'
+            + _tr("outlier")
+            + "</text>"
         )
     return _svg(width, height, title, body, "vector-map")
 
@@ -274,7 +286,7 @@ def histogram(
     values: NDArray[np.float64],
     *,
     title: str,
-    xlabel: str = "discrepancy (m)",
+    xlabel: str | None = None,
     bins: int | None = None,
     width: int = 360,
     height: int = 260,
@@ -302,7 +314,7 @@ def histogram(
     if v.size > 1 and v.std(ddof=1) > 0:
         dens = stats.norm.pdf(xs, v.mean(), v.std(ddof=1)) * v.size * (edges[1] - edges[0])
     fr = _Frame(lo, hi, 0.0, max(float(counts.max()), float(dens.max())) * 1.15, left, top, pw, ph)
-    body = fr.axes(xlabel, "count")
+    body = fr.axes(_tr("discrepancy (m)") if xlabel is None else xlabel, _tr("count"))
     x0, x1 = fr.px(edges[:-1]), fr.px(edges[1:])
     y = fr.py(counts)
     base = float(fr.py(0.0))
@@ -346,7 +358,7 @@ def qq_plot(
     lo, hi = float(v.min()), float(v.max())
     pad = 0.1 * (hi - lo) if hi > lo else 0.5
     fr = _Frame(qlo, qhi, lo - pad, hi + pad, left, top, pw, ph)
-    body = fr.axes("normal quantile", "discrepancy (m)")
+    body = fr.axes(_tr("normal quantile"), _tr("discrepancy (m)"))
     if n > 1:
         m, s = float(v.mean()), float(v.std(ddof=1))
         a, b = qlo, qhi
@@ -475,7 +487,9 @@ def image_vector_field(
     ref = _nice_floor(biggest) if biggest > 0 else 0.0
     body.append(
         f'<text x="{width / 2:.1f}" y="{height - 10}" text-anchor="middle" {_FONT}>'
-        f"mean residual per cell; {_fmt(ref)} px = {ref * scale:.0f} px on screen; "
-        f"largest {_fmt(biggest)} px</text>"
+        + _tr("mean residual per cell; {} px = {} px on screen; largest {} px").format(
+            _fmt(ref), f"{ref * scale:.0f}", _fmt(biggest)
+        )
+        + "</text>"
     )
     return _svg(width, height, title, body, "image-vectors")

@@ -16,6 +16,7 @@ import numpy as np
 from .. import __version__
 from ..tls.aps import ARCSEC
 from ..tls.calibration import TlsCalibration, explain_pair
+from .html_table import TR_CONTEXT, html_lang, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 
@@ -32,17 +33,19 @@ table.corr td{padding:2px 4px;font-size:11px}table.corr th{font-size:11px;paddin
 .note{font-size:12px;color:#444}
 """
 
-_DESIGN = (
-    "Correlations between the APs and the station parameters (Lichti 2010) come from the "
-    "network design, not the instrument: the rangefinder offset a0 with the station "
-    "positions when the targets lie on one side or in a narrow vertical band; the collimation "
-    "error b1 with kappa when the targets are near the horizon (sec(alpha) is then about 1); "
-    "the trunnion-axis error b2 and the vertical index c0 with omega and phi. They are broken "
-    "by targets all around the scanner and over the full vertical range (floor and ceiling), "
-    "by two-face observations, and by stations whose scanner is tilted by about 90 degrees "
-    "(which turn elevations into horizontal directions). A levelled scanner's compensator "
-    "observes omega and phi and helps b2 and c0."
-)
+def _design() -> str:
+    """How the network design breaks the correlations (Lichti 2010), translated."""
+    return t(
+        "Correlations between the APs and the station parameters (Lichti 2010) come from the "
+        "network design, not the instrument: the rangefinder offset a0 with the station "
+        "positions when the targets lie on one side or in a narrow vertical band; the collimation "
+        "error b1 with kappa when the targets are near the horizon (sec(alpha) is then about 1); "
+        "the trunnion-axis error b2 and the vertical index c0 with omega and phi. They are broken "
+        "by targets all around the scanner and over the full vertical range (floor and ceiling), "
+        "by two-face observations, and by stations whose scanner is tilted by about 90 degrees "
+        "(which turn elevations into horizontal directions). A levelled scanner's compensator "
+        "observes omega and phi and helps b2 and c0."
+    )
 
 
 def _n(x: float, digits: int = 2) -> str:
@@ -79,40 +82,46 @@ def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
     """The report page of a calibration (str, UTF-8 HTML)."""
     adj = cal.adjustment
     out = [
-        "<!DOCTYPE html><html><head><meta charset='utf-8'>",
-        "<title>TLS self-calibration</title>",
+        f"<!DOCTYPE html><html lang='{html_lang()}'><head><meta charset='utf-8'>",
+        f"<title>{t('TLS self-calibration')}</title>",
         f"<style>{_CSS}</style></head><body>",
-        "<h1>Terrestrial laser scanner: registration and self-calibration</h1>",
-        f"<p class='note'>lidarphoto {_e(__version__)}. Model: Carvalho, Correa &amp; dos "
-        "Santos (Eqs. 1-5), additional parameters after Lichti (2007), correlation analysis "
-        "after Lichti (2010).</p>",
-        "<h2>Settings</h2>",
-        _table(["setting", "value"], [(_e(k), _e(v)) for k, v in settings.items()]),
+        f"<h1>{t('Terrestrial laser scanner: registration and self-calibration')}</h1>",
+        f"<p class='note'>lidarphoto {_e(__version__)}. "
+        + t(
+            "Model: Carvalho, Correa &amp; dos Santos (Eqs. 1-5), additional parameters after "
+            "Lichti (2007), correlation analysis after Lichti (2010)."
+        )
+        + "</p>",
+        f"<h2>{t('Settings')}</h2>",
+        _table([t("setting"), t("value")], [(_e(k), _e(v)) for k, v in settings.items()]),
     ]
     gt = adj.global_test
-    test = "passed" if gt.passed else "failed"
+    test = t("passed") if gt.passed else t("failed")
     out += [
-        "<h2>Adjustment</h2>",
+        f"<h2>{t('Adjustment')}</h2>",
         _table(
-            ["quantity", "value"],
+            [t("quantity"), t("value")],
             [
-                ("observations (station-target-face)", str(len(cal.observations))),
-                ("stations / targets", f"{len(cal.stations)} / {len(cal.targets)}"),
-                ("redundancy", str(adj.redundancy)),
-                ("sigma0 a-posteriori", _n(cal.sigma0, 3)),
+                (t("observations (station-target-face)"), str(len(cal.observations))),
+                (t("stations / targets"), f"{len(cal.stations)} / {len(cal.targets)}"),
+                (t("redundancy"), str(adj.redundancy)),
+                (t("sigma0 a-posteriori"), _n(cal.sigma0, 3)),
                 (
-                    "global chi-square test",
+                    t("global chi-square test"),
                     f"{test} ({_n(gt.lower, 1)} &le; {_n(gt.statistic, 1)} &le; {_n(gt.upper, 1)})",
                 ),
-                ("iterations", f"{adj.iterations} ({'converged' if adj.converged else 'NOT'})"),
-                ("observations rejected (data snooping)", str(int(cal.rejected.sum()))),
                 (
-                    "datum",
+                    t("iterations"),
+                    f"{adj.iterations} ({t('converged') if adj.converged else t('NOT')})",
+                ),
+                (t("observations rejected (data snooping)"), str(int(cal.rejected.sum()))),
+                (
+                    t("datum"),
                     ", ".join(cal.datum_fixed)
                     or (
-                        "control"
+                        t("control")
                         if any(k != "free" for k in cal.target_kind)
-                        else "inner constraints"
+                        else t("inner constraints")
                     ),
                 ),
             ],
@@ -125,41 +134,44 @@ def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
             d = 2 if a["unit"] != "mm" else 3
             rows.append((_e(a["name"]), _e(a["formula"]), _e(a["cause"]), _n(a["value"], d),
                          _n(a["std"], d), _n(a["std_prior"], d), _e(a["unit"]), _n(a["t"], 2),
-                         "yes" if a["significant"] else "no"))  # fmt: skip
+                         t("yes") if a["significant"] else t("no")))  # fmt: skip
             css.append("" if a["significant"] else "fail")
         out += [
-            "<h2>Additional parameters</h2>",
+            f"<h2>{t('Additional parameters')}</h2>",
             _table(
                 [
-                    "AP",
-                    "term",
-                    "cause",
-                    "value",
+                    t("AP"),
+                    t("term"),
+                    t("cause"),
+                    t("value"),
                     "sigma",
-                    "sigma a-priori",
-                    "unit",
+                    t("sigma a-priori"),
+                    t("unit"),
                     "t",
-                    "significant",
+                    t("significant"),
                 ],
                 rows,
                 css,
             ),
-            f"<p class='note'>t = |value| / sigma against the Student-t critical value "
-            f"{_n(cal.t_critical, 2)} (two-sided, alpha = {cal.options.significance_alpha:g}). "
-            "sigma is scaled by sigma0; sigma a-priori is the Cramer-Rao bound of the network "
-            "for the observation sigmas given.</p>",
+            "<p class='note'>"
+            + t(
+                "t = |value| / sigma against the Student-t critical value {} (two-sided, alpha "
+                "= {}). sigma is scaled by sigma0; sigma a-priori is the Cramer-Rao bound of the "
+                "network for the observation sigmas given."
+            ).format(_n(cal.t_critical, 2), f"{cal.options.significance_alpha:g}")
+            + "</p>",
         ]
     srows = []
     for k, s in enumerate(cal.stations):
         p, sd = cal.pose[k], cal.pose_std[k]
         srows.append((_e(s), *(_n(x, 4) for x in p[:3]), *(_n(math.degrees(x), 6) for x in p[3:]),
                       *(_n(x * 1000, 2) for x in sd[:3]), *(_n(x / ARCSEC, 2) for x in sd[3:]),
-                      "yes" if cal.levelled[k] else "no"))  # fmt: skip
+                      t("yes") if cal.levelled[k] else t("no")))  # fmt: skip
     out += [
-        "<h2>Stations</h2>",
+        f"<h2>{t('Stations')}</h2>",
         _table(
             [
-                "station",
+                t("station"),
                 "X m",
                 "Y m",
                 "Z m",
@@ -172,31 +184,32 @@ def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
                 's_omega "',
                 's_phi "',
                 's_kappa "',
-                "levelled",
+                t("levelled"),
             ],
             srows,
         ),
     ]
-    out.append("<h2>Correlations</h2>")
+    out.append(f"<h2>{t('Correlations')}</h2>")
     if cal.strong_pairs:
         prow = [(_e(a), _e(b), _n(r, 3), _e(explain_pair(a, b) or "")) for a, b, r in
                 cal.strong_pairs[:30]]  # fmt: skip
-        out.append(f"<p>Pairs with |r| &ge; {cal.options.correlation_limit:g}:</p>")
-        out.append(_table(["parameter", "parameter", "r", "why, and the design that breaks it"],
-                          prow))  # fmt: skip
+        limit = f"{cal.options.correlation_limit:g}"
+        out.append("<p>" + t("Pairs with |r| &ge; {}:").format(limit) + "</p>")
+        out.append(_table([t("parameter"), t("parameter"), "r",
+                           t("why, and the design that breaks it")], prow))  # fmt: skip
     else:
-        out.append(f"<p>No pair involving an AP reaches |r| = "
-                   f"{cal.options.correlation_limit:g}.</p>")  # fmt: skip
-    out.append(f"<p class='diag'>{_e(_DESIGN)}</p>")
+        limit = f"{cal.options.correlation_limit:g}"
+        out.append("<p>" + t("No pair involving an AP reaches |r| = {}.").format(limit) + "</p>")
+    out.append(f"<p class='diag'>{_e(_design())}</p>")
     if np.isfinite(cal.calib_correlation).any():
         out.append(_correlation_table(cal.calib_names, cal.calib_correlation, len(cal.ap_names)))
     if cal.selection:
         out += [
-            "<h2>Automatic AP selection</h2>",
+            f"<h2>{t('Automatic AP selection')}</h2>",
             _table(
-                ["removed", "why", "remaining"],
+                [t("removed"), t("why"), t("remaining")],
                 [
-                    (_e(s.removed), _e(s.reason), _e(", ".join(s.remaining) or "none"))
+                    (_e(s.removed), _e(s.reason), _e(", ".join(s.remaining) or t("none")))
                     for s in cal.selection
                 ],
             ),
@@ -204,13 +217,13 @@ def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
     v = cal.residuals[~cal.rejected]
     rms = np.sqrt(np.nanmean(v**2, axis=0)) if v.size else np.full(3, np.nan)
     out += [
-        "<h2>Residuals</h2>",
+        f"<h2>{t('Residuals')}</h2>",
         _table(
-            ["component", "RMS", "unit"],
+            [t("component"), "RMS", t("unit")],
             [
-                ("range", _n(rms[0] * 1000, 3), "mm"),
-                ("horizontal direction", _n(rms[1] / ARCSEC, 2), "arc-seconds"),
-                ("vertical angle", _n(rms[2] / ARCSEC, 2), "arc-seconds"),
+                (t("range"), _n(rms[0] * 1000, 3), "mm"),
+                (t("horizontal direction"), _n(rms[1] / ARCSEC, 2), t("arc-seconds")),
+                (t("vertical angle"), _n(rms[2] / ARCSEC, 2), t("arc-seconds")),
             ],
         ),
     ]
@@ -219,7 +232,8 @@ def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
     obs = cal.observations
     out.append(
         _table(
-            ["station / target", "row", "v range mm", 'v hz "', 'v vt "', "max |w|", "rejected"],
+            [t("station / target"), t("row"), t("v range mm"), 'v hz "', 'v vt "', "max |w|",
+             t("rejected")],
             [
                 (
                     _e(f"{obs.station[k]} / {obs.target[k]}"),
@@ -228,7 +242,7 @@ def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
                     _n(cal.residuals[k, 1] / ARCSEC, 2),
                     _n(cal.residuals[k, 2] / ARCSEC, 2),
                     _n(w[k], 2),
-                    "yes" if cal.rejected[k] else "no",
+                    t("yes") if cal.rejected[k] else t("no"),
                 )
                 for k in worst
             ],
@@ -236,7 +250,7 @@ def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
         )
     )
     if adj.warnings:
-        out.append("<h2>Warnings</h2><ul>" + "".join(f"<li>{_e(x)}</li>" for x in adj.warnings)
-                   + "</ul>")  # fmt: skip
+        out.append(f"<h2>{t('Warnings')}</h2><ul>"
+                   + "".join(f"<li>{_e(x)}</li>" for x in adj.warnings) + "</ul>")  # fmt: skip
     out.append("</body></html>")
     return "\n".join(out)

@@ -4,7 +4,13 @@ from __future__ import annotations
 
 import math
 
-from qgis.core import NULL, QgsCoordinateTransform, QgsPoint, QgsPointXY
+from qgis.core import (
+    NULL,
+    QgsCoordinateTransform,
+    QgsPoint,
+    QgsPointXY,
+    QgsProcessingException,
+)
 
 from ...core.jobs import accuracy_report
 from ..base import BaseAlgorithm, core_errors
@@ -40,7 +46,7 @@ class AccuracyReportAlgorithm(BaseAlgorithm):
         source = self.parameterAsSource(parameters, key, context)
         id_field = (self.parameterAsFields(parameters, f"{key}_ID", context) or [None])[0]
         if id_field is None:
-            raise self.error(f"{key}: choose its id field ({key}_ID).")
+            raise QgsProcessingException(self.tr("{0}: choose its id field ({0}_ID).").format(key))
         z_field = (self.parameterAsFields(parameters, f"{key}_Z_FIELD", context) or [None])[0]
         group = None
         if group_key:

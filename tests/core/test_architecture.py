@@ -16,6 +16,7 @@ PKG = "lidarphoto"
 CORE_LAYERS = {
     "errors": 0,
     "dependencies": 0,
+    "i18n": 0,  # the catalogue of the core's translated texts (reads i18n/*.ts)
     "": 0,  # core/__init__.py (the version)
     "geometry": 1,
     "lsq": 1,

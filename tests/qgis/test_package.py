@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import configparser
 import importlib.util
+import os
 import shutil
 import subprocess
 import sys
@@ -11,7 +13,7 @@ from pathlib import Path
 
 import pytest
 from qgis.core import QgsApplication
-from qgis_helpers import PLUGIN, ROOT
+from qgis_helpers import PLUGIN, QGIS_PROCESS, ROOT
 
 pytestmark = pytest.mark.skipif(
     shutil.which("git") is None or not (ROOT / ".git").exists(), reason="needs a git work tree"
@@ -45,6 +47,8 @@ def test_zip_layout(package):
         "lidarphoto/plugin/plugin.py",
         "lidarphoto/processing_provider/provider.py",
         "lidarphoto/processing_provider/algorithms/trajectory_to_eo.py",
+        "lidarphoto/i18n/lidarphoto_pt_BR.ts",  # the core's catalogue (CLI, HTML reports)
+        "lidarphoto/i18n/lidarphoto_pt_BR.qm",  # Qt's, built by lrelease at packaging
     ):
         assert required in names, required
     for excluded in (
@@ -90,3 +94,98 @@ def test_installed_zip_loads_in_qgis(package, tmp_path, qgis_plugin_paths, qgis_
     assert Path(sys.modules[alg.__class__.__module__].__file__).is_relative_to(plugins)
     assert qgis.utils.unloadPlugin(PLUGIN)
     assert registry.providerById("lidarphoto") is None
+
+
+def test_metadata_is_complete(package):
+    """What plugins.qgis.org asks for, filled in, in the zip's metadata.txt."""
+    meta = configparser.ConfigParser()
+    meta.read_string(zipfile.ZipFile(package).read("lidarphoto/metadata.txt").decode("utf-8"))
+    general = meta["general"]
+    for key in (
+        "name", "qgisMinimumVersion", "qgisMaximumVersion", "description", "about", "version",
+        "author", "email", "homepage", "repository", "tracker", "tags", "changelog", "icon",
+        "category", "experimental", "hasProcessingProvider", "supportsQt6",
+    ):  # fmt: skip
+        assert general.get(key, "").strip(), key
+    assert (
+        general["icon"] and f"lidarphoto/{general['icon']}" in zipfile.ZipFile(package).namelist()
+    )
+    for url in ("homepage", "repository", "tracker"):
+        assert general[url].startswith("https://"), url
+    assert general["experimental"] in ("True", "False")
+    assert general["version"] in general["changelog"]
+    about = general["about"].lower()
+    for capability in (
+        "ground filter", "roof planes", "control points", "boresight", "bundle adjustment",
+        "resection", "orthophotos", "laser scanning", "monoplotting", "accuracy reports",
+    ):  # fmt: skip
+        assert capability in about, capability
+
+
+@pytest.mark.skipif(not os.path.exists(QGIS_PROCESS), reason="no qgis_process")
+def test_zip_in_a_clean_profile_under_qgis_process(package, tmp_path):
+    """The zip unpacked into the python/plugins folder of a new QGIS profile (nothing else on
+    the plugin path), enabled in that profile with the user locale pt_BR: QGIS itself finds
+    it, registers every algorithm and shows them in Portuguese (the zip's .qm)."""
+    from lidarphoto.core.jobs import ALGORITHMS
+
+    config = tmp_path / "qgis-config"
+    profile = config / "profiles" / "default"
+    plugins = profile / "python" / "plugins"
+    plugins.mkdir(parents=True)
+    _qgis_unzip()(str(package), str(plugins))
+    ini = profile / "QGIS" / "QGIS3.ini"
+    ini.parent.mkdir(parents=True)
+    ini.write_text(
+        f"[PythonPlugins]\n{PLUGIN}=true\n[locale]\noverrideFlag=true\nuserLocale=pt_BR\n",
+        encoding="utf-8",
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("QGIS_OPTS", "QGIS_PLUGINPATH")}
+    env.update(
+        QT_QPA_PLATFORM="offscreen",
+        QGIS_CUSTOM_CONFIG_PATH=str(config),
+        PROJ_DATA=os.environ.get("PROJ_DATA", "/usr/share/proj"),
+        PYTHONPATH=__import__("sysconfig").get_paths()["purelib"],  # laspy & co. of the venv
+    )
+    r = subprocess.run([QGIS_PROCESS, "list"], env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    ours = [
+        line.strip() for line in r.stdout.splitlines() if line.strip().startswith("lidarphoto:")
+    ]
+    assert len(ours) == len(ALGORITHMS), r.stdout[-3000:]
+    listed = "\n".join(ours)
+    assert "lidarphoto:groundfilter\tFiltro de terreno (SMRF, PMF, simulação de tecido)" in listed
+    assert "lidarphoto:bundleadjustment\tAjustamento por feixes de raios" in listed
+    assert "\nFotogrametria LiDAR\n" in r.stdout  # the provider's name
+
+
+def test_installed_zip_registers_everything_and_translates(
+    package, tmp_path, qgis_plugin_paths, qgis_processing
+):
+    """Loaded with qgis.utils from a fresh profile folder: every algorithm of the core is
+    registered, and the translator of the installed copy loads (its own .qm)."""
+    import qgis.utils
+
+    plugins = tmp_path / "profile" / "python" / "plugins"
+    _qgis_unzip()(str(package), str(plugins))
+    qgis_plugin_paths(plugins)
+    assert qgis.utils.loadPlugin(PLUGIN) and qgis.utils.startProcessingPlugin(PLUGIN)
+    jobs = sys.modules[f"{PLUGIN}.core.jobs"]  # the installed copy's (imported by the provider)
+    assert Path(jobs.__file__).resolve().is_relative_to(plugins.resolve())
+    names = {job.SPEC.name for job in jobs.ALGORITHMS}
+    assert len(names) >= 13
+    registry = QgsApplication.processingRegistry()
+    registered = {a.name() for a in registry.providerById("lidarphoto").algorithms()}
+    assert registered == names
+    i18n = sys.modules[f"{PLUGIN}.processing_provider.i18n"]
+    assert Path(i18n.__file__).resolve().is_relative_to(plugins.resolve())
+    try:
+        assert i18n.install_translator("pt_BR") == "pt_BR"
+        alg = registry.algorithmById("lidarphoto:createlcps")
+        assert alg.displayName() == "Criar pontos e linhas de controle LiDAR"
+    finally:
+        i18n.remove_translator()
+    assert registry.algorithmById("lidarphoto:createlcps").displayName() == (
+        "Create LiDAR control points and lines"
+    )
+    assert qgis.utils.unloadPlugin(PLUGIN)

@@ -1,0 +1,4505 @@
+<?xml version="1.0" encoding="utf-8"?>
+<!DOCTYPE TS>
+<TS version="2.1" language="pt_BR">
+    <context>
+        <name>AccuracyReportAlgorithm</name>
+        <message>
+            <source>{0}: choose its id field ({0}_ID).</source>
+            <translation>{0}: escolha o seu campo de identificador ({0}_ID).</translation>
+        </message>
+    </context>
+    <context>
+        <name>AlgorithmHelp</name>
+        <message>
+            <source>optional</source>
+            <translation>opcional</translation>
+        </message>
+        <message>
+            <source>required</source>
+            <translation>obrigatório</translation>
+        </message>
+        <message>
+            <source>{} to {}</source>
+            <translation>{} a {}</translation>
+        </message>
+        <message>
+            <source>References</source>
+            <translation>Referências</translation>
+        </message>
+        <message>
+            <source>Parameters</source>
+            <translation>Parâmetros</translation>
+        </message>
+        <message>
+            <source>name</source>
+            <translation>nome</translation>
+        </message>
+        <message>
+            <source>meaning</source>
+            <translation>significado</translation>
+        </message>
+        <message>
+            <source>default</source>
+            <translation>padrão</translation>
+        </message>
+        <message>
+            <source>unit, range</source>
+            <translation>unidade, intervalo</translation>
+        </message>
+    </context>
+    <context>
+        <name>BaseAlgorithm</name>
+        <message>
+            <source>out of memory; nothing was written (use a coarser cell or a smaller input)</source>
+            <translation>memória insuficiente; nada foi gravado (use uma célula maior ou uma entrada menor)</translation>
+        </message>
+        <message>
+            <source>Cancelled by the user</source>
+            <translation>Cancelado pelo usuário</translation>
+        </message>
+    </context>
+    <context>
+        <name>BundleController</name>
+        <message>
+            <source>A bundle adjustment is already running.</source>
+            <translation>Um ajustamento por feixes de raios já está em execução.</translation>
+        </message>
+        <message>
+            <source>Choose the camera and the exterior orientation.</source>
+            <translation>Escolha a câmera e a orientação exterior.</translation>
+        </message>
+        <message>
+            <source>The observations could not be saved.</source>
+            <translation>Não foi possível salvar as observações.</translation>
+        </message>
+        <message>
+            <source>Bundle adjustment refused: {}</source>
+            <translation>Ajustamento por feixes de raios recusado: {}</translation>
+        </message>
+        <message>
+            <source>Bundle adjustment refused: tie or control points are measured in {} open image(s); a block needs two or more. {}</source>
+            <translation>Ajustamento por feixes de raios recusado: pontos de enlace ou de controle estão medidos em {} imagem(ns) aberta(s); um bloco precisa de duas ou mais. {}</translation>
+        </message>
+        <message>
+            <source>Bundle adjustment of {} images</source>
+            <translation>Ajustamento por feixes de raios de {} imagens</translation>
+        </message>
+        <message>
+            <source>Bundle adjustment cancelled.</source>
+            <translation>Ajustamento por feixes de raios cancelado.</translation>
+        </message>
+        <message>
+            <source>Bundle adjustment failed. {}</source>
+            <translation>O ajustamento por feixes de raios falhou. {}</translation>
+        </message>
+        <message>
+            <source>Bundle adjustment done: sigma0 {}; {}</source>
+            <translation>Ajustamento por feixes de raios concluído: sigma0 {}; {}</translation>
+        </message>
+    </context>
+    <context>
+        <name>BundlePanel</name>
+        <message>
+            <source>The dock's orientations are observations (σ {} m, {}°)</source>
+            <translation>As orientações do painel são observações (σ {} m, {}°)</translation>
+        </message>
+        <message>
+            <source>Off: approximate values only (the datum comes from the control points)</source>
+            <translation>Desligado: apenas valores aproximados (o referencial vem dos pontos de controle)</translation>
+        </message>
+        <message>
+            <source>Bundle adjustment of the open images</source>
+            <translation>Ajustamento por feixes de raios das imagens abertas</translation>
+        </message>
+        <message>
+            <source>Runs {} in the background: tie points, LCPs as control points (with their sigmas) and check points of the images open in the dock</source>
+            <translation>Executa {} em segundo plano: pontos de enlace, LCPs como pontos de controle (com seus desvios-padrão) e pontos de verificação das imagens abertas no painel</translation>
+        </message>
+        <message>
+            <source>Additional parameters</source>
+            <translation>Parâmetros adicionais</translation>
+        </message>
+        <message>
+            <source>Bundle adjustment running…</source>
+            <translation>Ajustamento por feixes de raios em execução…</translation>
+        </message>
+        <message>
+            <source>&lt;b&gt;{}&lt;/b&gt;: σ0 {:.3f}, redundancy {}, χ² test {}; {} image(s), {} measurement(s), {} rejected</source>
+            <translation>&lt;b&gt;{}&lt;/b&gt;: σ0 {:.3f}, redundância {}, teste χ² {}; {} imagem(ns), {} medição(ões), {} rejeitada(s)</translation>
+        </message>
+        <message>
+            <source>passed</source>
+            <translation>aprovado</translation>
+        </message>
+        <message>
+            <source>FAILED</source>
+            <translation>REPROVADO</translation>
+        </message>
+        <message>
+            <source>Left out: {}</source>
+            <translation>Deixado de fora: {}</translation>
+        </message>
+        <message>
+            <source>Check points ({}): RMS 3D {:.3f} m</source>
+            <translation>Pontos de verificação ({}): RMS 3D {:.3f} m</translation>
+        </message>
+        <message>
+            <source>parameter</source>
+            <translation>parâmetro</translation>
+        </message>
+        <message>
+            <source>value</source>
+            <translation>valor</translation>
+        </message>
+        <message>
+            <source>significant</source>
+            <translation>significativo</translation>
+        </message>
+        <message>
+            <source>image</source>
+            <translation>imagem</translation>
+        </message>
+        <message>
+            <source>RMS col px</source>
+            <translation>RMS col px</translation>
+        </message>
+        <message>
+            <source>RMS row px</source>
+            <translation>RMS lin px</translation>
+        </message>
+    </context>
+    <context>
+        <name>CalibrationController</name>
+        <message>
+            <source>A calibration is already running.</source>
+            <translation>Uma calibração já está em execução.</translation>
+        </message>
+        <message>
+            <source>No observations to calibrate with.</source>
+            <translation>Não há observações para calibrar.</translation>
+        </message>
+        <message>
+            <source>Choose the plane, line or LCP layer of the observed types.</source>
+            <translation>Escolha a camada de planos, de linhas ou de LCPs dos tipos observados.</translation>
+        </message>
+        <message>
+            <source>Boresight calibration</source>
+            <translation>Calibração de boresight</translation>
+        </message>
+        <message>
+            <source>Calibration cancelled.</source>
+            <translation>Calibração cancelada.</translation>
+        </message>
+        <message>
+            <source>Calibration failed. {}</source>
+            <translation>A calibração falhou. {}</translation>
+        </message>
+        <message>
+            <source>Calibration done: {}</source>
+            <translation>Calibração concluída: {}</translation>
+        </message>
+    </context>
+    <context>
+        <name>CalibrationPanel</name>
+        <message>
+            <source>Trajectory CSV (*.csv *.txt)</source>
+            <translation>Trajetória CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>CSV (*.csv)</source>
+            <translation>CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Optional: its rows replace the layer's features of the same id (with their full covariance) in the overlays and the calibration</source>
+            <translation>Opcional: suas linhas substituem as feições da camada com o mesmo identificador (com a covariância completa) nas sobreposições e na calibração</translation>
+        </message>
+        <message>
+            <source>Run boresight calibration</source>
+            <translation>Executar a calibração de boresight</translation>
+        </message>
+        <message>
+            <source>Runs {} in the background with the current observations</source>
+            <translation>Executa {} em segundo plano com as observações atuais</translation>
+        </message>
+        <message>
+            <source>Show with the calibrated orientation</source>
+            <translation>Mostrar com a orientação calibrada</translation>
+        </message>
+        <message>
+            <source>Overlays, predictions and monoplotting with the exterior orientation of the last calibration (its file, eo_calibrated.csv, becomes the Project tab's)</source>
+            <translation>Sobreposições, predições e monorrestituição com a orientação exterior da última calibração (seu arquivo, eo_calibrated.csv, passa a ser o da aba Projeto)</translation>
+        </message>
+        <message>
+            <source>Trajectory</source>
+            <translation>Trajetória</translation>
+        </message>
+        <message>
+            <source>Lever arm x,y,z (m)</source>
+            <translation>Braço de alavanca x,y,z (m)</translation>
+        </message>
+        <message>
+            <source>Mount</source>
+            <translation>Montagem</translation>
+        </message>
+        <message>
+            <source>Initial boresight (deg)</source>
+            <translation>Boresight inicial (graus)</translation>
+        </message>
+        <message>
+            <source>Plane table</source>
+            <translation>Tabela de planos</translation>
+        </message>
+        <message>
+            <source>Line table</source>
+            <translation>Tabela de linhas</translation>
+        </message>
+        <message>
+            <source>LCP table</source>
+            <translation>Tabela de LCPs</translation>
+        </message>
+        <message>
+            <source>Calibration running…</source>
+            <translation>Calibração em execução…</translation>
+        </message>
+        <message>
+            <source>{} residuals: RMS {:.2f} px, max {:.2f} px</source>
+            <translation>{} resíduos: RMS {:.2f} px, máx. {:.2f} px</translation>
+        </message>
+    </context>
+    <context>
+        <name>ImagePickingDock</name>
+        <message>
+            <source>&lt;b&gt;Picking&lt;/b&gt;: choose the type, then left-click in the image. &lt;i&gt;tie&lt;/i&gt; and &lt;i&gt;paper&lt;/i&gt; points take the roof plane under the cursor (a menu asks when outlines overlap); &lt;i&gt;line&lt;/i&gt;: two clicks, the image line's ends, on the LiDAR line nearest to the first (drawn solid while measuring; Esc cancels, Ctrl+Z removes both ends; the Resection tab can refine the ends onto the image's edge); &lt;i&gt;lcp&lt;/i&gt;/&lt;i&gt;check&lt;/i&gt; take the nearest control point. &lt;b&gt;Resect&lt;/b&gt; (Resection tab) orients the image shown from its lines and control points; &lt;b&gt;Bundle&lt;/b&gt; (Bundle tab) adjusts the open images from their tie, control (lcp) and check points. After a tie point the other images show its prediction (yellow x): Enter accepts it, a click puts it where you see it, Esc drops it.&lt;br&gt;&lt;b&gt;Monoplot&lt;/b&gt; (needs a DSM in the Project tab): while the button is on, a click makes a 3D point on the DSM, or a vertex of a 3D line (Enter, a double click or &lt;i&gt;Finish line&lt;/i&gt; ends it); they appear on the map at once, and the save button writes them to a GeoPackage. Off: clicks measure observations again.&lt;br&gt;&lt;b&gt;Keys&lt;/b&gt;: PgDown/PgUp next/previous image · Enter accept prediction · Esc cancel prediction · Delete delete selected point · Ctrl+Z undo · Ctrl+Shift+Z / Ctrl+Y redo · T/P/L/C/K picking type · </source>
+            <translation>&lt;b&gt;Medição&lt;/b&gt;: escolha o tipo e clique com o botão esquerdo na imagem. Pontos &lt;i&gt;tie&lt;/i&gt; (de enlace) e &lt;i&gt;paper&lt;/i&gt; tomam o plano de telhado sob o cursor (um menu pergunta quando os contornos se sobrepõem); &lt;i&gt;line&lt;/i&gt;: dois cliques, as extremidades da linha na imagem, sobre a linha LiDAR mais próxima do primeiro (desenhada em traço contínuo durante a medição; Esc cancela, Ctrl+Z remove as duas extremidades; a aba Resseção pode refinar as extremidades sobre a borda na imagem); &lt;i&gt;lcp&lt;/i&gt;/&lt;i&gt;check&lt;/i&gt; tomam o ponto de controle mais próximo. &lt;b&gt;Resseção&lt;/b&gt; (aba Resseção) orienta a imagem exibida a partir das suas linhas e pontos de controle; &lt;b&gt;Feixes&lt;/b&gt; (aba Feixes) ajusta as imagens abertas a partir dos seus pontos de enlace, de controle (lcp) e de verificação. Após um ponto de enlace, as outras imagens mostram a sua predição (x amarelo): Enter a aceita, um clique a coloca onde você a vê, Esc a descarta.&lt;br&gt;&lt;b&gt;Monorrestituir&lt;/b&gt; (requer um MDS na aba Projeto): enquanto o botão está ligado, um clique cria um ponto 3D sobre o MDS, ou um vértice de uma linha 3D (Enter, um clique duplo ou &lt;i&gt;Terminar linha&lt;/i&gt; a encerra); eles aparecem no mapa imediatamente, e o botão salvar os grava em um GeoPackage. Desligado: os cliques voltam a medir observações.&lt;br&gt;&lt;b&gt;Teclas&lt;/b&gt;: PgDown/PgUp imagem seguinte/anterior · Enter aceitar a predição · Esc cancelar a predição · Delete excluir o ponto selecionado · Ctrl+Z desfazer · Ctrl+Shift+Z / Ctrl+Y refazer · T/P/L/C/K tipo de medição · </translation>
+        </message>
+        <message>
+            <source>Image Point Picking</source>
+            <translation>Medição de Pontos na Imagem</translation>
+        </message>
+        <message>
+            <source>Project</source>
+            <translation>Projeto</translation>
+        </message>
+        <message>
+            <source>Calibration</source>
+            <translation>Calibração</translation>
+        </message>
+        <message>
+            <source>Resection</source>
+            <translation>Resseção</translation>
+        </message>
+        <message>
+            <source>Bundle</source>
+            <translation>Feixes</translation>
+        </message>
+        <message>
+            <source>Help</source>
+            <translation>Ajuda</translation>
+        </message>
+        <message>
+            <source>Building the overview pyramid: {:.0f} %</source>
+            <translation>Construindo a pirâmide de visões gerais: {:.0f} %</translation>
+        </message>
+        <message>
+            <source>Image picking</source>
+            <translation>Medição na imagem</translation>
+        </message>
+    </context>
+    <context>
+        <name>ImageView</name>
+        <message>
+            <source>Wheel: zoom about the cursor · middle/right drag or Space+drag: pan · left click: pick · left drag on a point: move it · +/-: zoom · F: fit · 1: 100 % · M: magnifier · arrows: pan</source>
+            <translation>Roda: zoom em torno do cursor · arrastar com o botão do meio/direito ou Espaço+arrastar: deslocar · clique esquerdo: medir · arrastar um ponto com o botão esquerdo: movê-lo · +/-: zoom · F: ajustar · 1: 100 % · M: lupa · setas: deslocar</translation>
+        </message>
+        <message>
+            <source>Reading a preview of {}…</source>
+            <translation>Lendo uma pré-visualização de {}…</translation>
+        </message>
+        <message>
+            <source>Building the overview pyramid of {}: {:.0f} %</source>
+            <translation>Construindo a pirâmide de visões gerais de {}: {:.0f} %</translation>
+        </message>
+    </context>
+    <context>
+        <name>LidarPhotoPlugin</name>
+        <message>
+            <source>The algorithms are not loaded: {}</source>
+            <translation>Os algoritmos não foram carregados: {}</translation>
+        </message>
+        <message>
+            <source>&amp;LiDAR Photogrammetry</source>
+            <translation>&amp;Fotogrametria LiDAR</translation>
+        </message>
+        <message>
+            <source>LiDAR Photogrammetry</source>
+            <translation>Fotogrametria LiDAR</translation>
+        </message>
+        <message>
+            <source>Trajectory to Exterior Orientation…</source>
+            <translation>Trajetória para Orientação Exterior…</translation>
+        </message>
+        <message>
+            <source>Exterior orientation of each image from an INS/GNSS trajectory</source>
+            <translation>Orientação exterior de cada imagem a partir de uma trajetória INS/GNSS</translation>
+        </message>
+        <message>
+            <source>Show the Algorithms in the Processing Toolbox</source>
+            <translation>Mostrar os algoritmos na Caixa de Ferramentas de Processamento</translation>
+        </message>
+        <message>
+            <source>Image Point Picking</source>
+            <translation>Medição de Pontos na Imagem</translation>
+        </message>
+        <message>
+            <source>Measure image points on LiDAR roof planes, lines and LCPs</source>
+            <translation>Medir pontos na imagem sobre planos de telhado, linhas e LCPs do LiDAR</translation>
+        </message>
+        <message>
+            <source>The picking dock could not be loaded: {}</source>
+            <translation>Não foi possível carregar o painel de medição: {}</translation>
+        </message>
+        <message>
+            <source>The algorithm {} is not available.</source>
+            <translation>O algoritmo {} não está disponível.</translation>
+        </message>
+        <message>
+            <source>The Processing plugin is not enabled.</source>
+            <translation>O complemento Processamento não está habilitado.</translation>
+        </message>
+    </context>
+    <context>
+        <name>LidarPhotoProvider</name>
+        <message>
+            <source>All files (*.*)</source>
+            <translation>Todos os arquivos (*.*)</translation>
+        </message>
+        <message>
+            <source>LiDAR Photogrammetry</source>
+            <translation>Fotogrametria LiDAR</translation>
+        </message>
+        <message>
+            <source>LiDAR Photogrammetry Toolkit</source>
+            <translation>Kit de Ferramentas de Fotogrametria LiDAR</translation>
+        </message>
+    </context>
+    <context>
+        <name>Messages</name>
+        <message>
+            <source>Missing Python packages: {names}. The LiDAR Photogrammetry algorithms need them; install them into QGIS's Python and restart QGIS: {cmd}</source>
+            <translation>Pacotes Python ausentes: {names}. Os algoritmos de Fotogrametria LiDAR precisam deles; instale-os no Python do QGIS e reinicie o QGIS: {cmd}</translation>
+        </message>
+        <message>
+            <source>Optional Python packages not installed: {names} ({effects}). To install: {cmd}</source>
+            <translation>Pacotes Python opcionais não instalados: {names} ({effects}). Para instalar: {cmd}</translation>
+        </message>
+    </context>
+    <context>
+        <name>MonoplotController</name>
+        <message>
+            <source>Monoplotting needs the camera and the exterior orientation (Project tab).</source>
+            <translation>A monorrestituição precisa da câmera e da orientação exterior (aba Projeto).</translation>
+        </message>
+        <message>
+            <source>Choose a DSM for monoplotting in the Project tab: a raster layer, or a GeoTIFF or LAS/LAZ file.</source>
+            <translation>Escolha um MDS para a monorrestituição na aba Projeto: uma camada raster, ou um arquivo GeoTIFF ou LAS/LAZ.</translation>
+        </message>
+        <message>
+            <source>DSM not loaded: {}</source>
+            <translation>MDS não carregado: {}</translation>
+        </message>
+        <message>
+            <source>Monoplotting {}: click in the image; the 3D features appear on the map at once.{}</source>
+            <translation>Monorrestituição de {}: clique na imagem; as feições 3D aparecem no mapa imediatamente.{}</translation>
+        </message>
+        <message>
+            <source>points</source>
+            <translation>pontos</translation>
+        </message>
+        <message>
+            <source>lines</source>
+            <translation>linhas</translation>
+        </message>
+        <message>
+            <source> Finish each line with Enter or a double click.</source>
+            <translation> Termine cada linha com Enter ou um clique duplo.</translation>
+        </message>
+        <message>
+            <source>Monoplotting off: clicks measure observations again.</source>
+            <translation>Monorrestituição desligada: os cliques voltam a medir observações.</translation>
+        </message>
+        <message>
+            <source> The line in progress was added.</source>
+            <translation> A linha em andamento foi adicionada.</translation>
+        </message>
+        <message>
+            <source>3D line of {} vertices added.</source>
+            <translation>Linha 3D de {} vértices adicionada.</translation>
+        </message>
+        <message>
+            <source>Save monoplotted features</source>
+            <translation>Salvar as feições monorrestituídas</translation>
+        </message>
+        <message>
+            <source>GeoPackage (*.gpkg)</source>
+            <translation>GeoPackage (*.gpkg)</translation>
+        </message>
+        <message>
+            <source>Not saved: {}</source>
+            <translation>Não salvo: {}</translation>
+        </message>
+        <message>
+            <source>Saved {} to {}.</source>
+            <translation>{} salvo(s) em {}.</translation>
+        </message>
+        <message>
+            <source>Nothing monoplotted yet.</source>
+            <translation>Nada foi monorrestituído ainda.</translation>
+        </message>
+    </context>
+    <context>
+        <name>MonoplotTool</name>
+        <message>
+            <source>The DSM was in '{}': resampled into '{}' (cell {:g}) for monoplotting.</source>
+            <translation>O MDS estava em '{}': reamostrado em '{}' (célula {:g}) para a monorrestituição.</translation>
+        </message>
+        <message>
+            <source>Load the camera, the orientation and a DSM first</source>
+            <translation>Carregue primeiro a câmera, a orientação e um MDS</translation>
+        </message>
+        <message>
+            <source>Image {} has no exterior orientation: nothing to monoplot.</source>
+            <translation>A imagem {} não tem orientação exterior: nada a monorrestituir.</translation>
+        </message>
+        <message>
+            <source>Line vertex {} (Enter or a double click ends the line).</source>
+            <translation>Vértice de linha {} (Enter ou um clique duplo termina a linha).</translation>
+        </message>
+        <message>
+            <source>3D point {:.3f}, {:.3f}, {:.3f} (sigma Z {:.3f} m, {}).</source>
+            <translation>Ponto 3D {:.3f}, {:.3f}, {:.3f} (sigma Z {:.3f} m, {}).</translation>
+        </message>
+        <message>
+            <source>No 3D point: {}.</source>
+            <translation>Nenhum ponto 3D: {}.</translation>
+        </message>
+        <message>
+            <source>A line needs two vertices or more.</source>
+            <translation>Uma linha precisa de dois vértices ou mais.</translation>
+        </message>
+        <message>
+            <source>Monoplotted points</source>
+            <translation>Pontos monorrestituídos</translation>
+        </message>
+        <message>
+            <source>Monoplotted lines</source>
+            <translation>Linhas monorrestituídas</translation>
+        </message>
+    </context>
+    <context>
+        <name>ObservationModel</name>
+        <message>
+            <source>image</source>
+            <translation>imagem</translation>
+        </message>
+        <message>
+            <source>point</source>
+            <translation>ponto</translation>
+        </message>
+        <message>
+            <source>type</source>
+            <translation>tipo</translation>
+        </message>
+        <message>
+            <source>target</source>
+            <translation>alvo</translation>
+        </message>
+        <message>
+            <source>col</source>
+            <translation>col</translation>
+        </message>
+        <message>
+            <source>row</source>
+            <translation>lin</translation>
+        </message>
+        <message>
+            <source>|v| px</source>
+            <translation>|v| px</translation>
+        </message>
+    </context>
+    <context>
+        <name>OverviewTask</name>
+        <message>
+            <source>Overview pyramid of {}</source>
+            <translation>Pirâmide de visões gerais de {}</translation>
+        </message>
+    </context>
+    <context>
+        <name>PickingController</name>
+        <message>
+            <source>plane {} ({:.1f} m away)</source>
+            <translation>plano {} (a {:.1f} m)</translation>
+        </message>
+        <message>
+            <source>No image shown.</source>
+            <translation>Nenhuma imagem exibida.</translation>
+        </message>
+        <message>
+            <source>Image {} has no orientation: picking needs the camera and the exterior orientation.</source>
+            <translation>A imagem {} não tem orientação: a medição precisa da câmera e da orientação exterior.</translation>
+        </message>
+        <message>
+            <source>No roof plane under the cursor.</source>
+            <translation>Nenhum plano de telhado sob o cursor.</translation>
+        </message>
+        <message>
+            <source>No line within {:.0f} px.</source>
+            <translation>Nenhuma linha a menos de {:.0f} px.</translation>
+        </message>
+        <message>
+            <source>No control point within {:.0f} px.</source>
+            <translation>Nenhum ponto de controle a menos de {:.0f} px.</translation>
+        </message>
+        <message>
+            <source>Line on LiDAR line {}: click its other end (Esc cancels).</source>
+            <translation>Linha sobre a linha LiDAR {}: clique na outra extremidade (Esc cancela).</translation>
+        </message>
+        <message>
+            <source>Tie {} on plane {}: predicted in {} other image(s) (Enter accepts, click corrects).</source>
+            <translation>Enlace {} no plano {}: previsto em {} outra(s) imagem(ns) (Enter aceita, um clique corrige).</translation>
+        </message>
+        <message>
+            <source>{} on plane {}.</source>
+            <translation>{} no plano {}.</translation>
+        </message>
+        <message>
+            <source>The line's ends must be 1 px apart or more.</source>
+            <translation>As extremidades da linha devem estar a 1 px ou mais uma da outra.</translation>
+        </message>
+        <message>
+            <source>Image line of LiDAR line {} measured.</source>
+            <translation>Linha da imagem da linha LiDAR {} medida.</translation>
+        </message>
+    </context>
+    <context>
+        <name>ProjectLoader</name>
+        <message>
+            <source>Orientation not loaded: {}</source>
+            <translation>Orientação não carregada: {}</translation>
+        </message>
+        <message>
+            <source>Control table not read: {}</source>
+            <translation>Tabela de controle não lida: {}</translation>
+        </message>
+        <message>
+            <source>{} plane(s) of {} have no heights and no a,b,c,d fields: skipped.</source>
+            <translation>{} plano(s) de {} não têm alturas nem campos a,b,c,d: ignorado(s).</translation>
+        </message>
+        <message>
+            <source>Observations not loaded: {}</source>
+            <translation>Observações não carregadas: {}</translation>
+        </message>
+        <message>
+            <source>{} observation(s) in {}.</source>
+            <translation>{} observação(ões) em {}.</translation>
+        </message>
+        <message>
+            <source>{} observation row(s) name image(s) not in the exterior orientation ({}…): is the file from another project? They are kept in the file but not shown.</source>
+            <translation>{} linha(s) de observação citam imagem(ns) ausente(s) da orientação exterior ({}…): o arquivo é de outro projeto? Elas são mantidas no arquivo, mas não são exibidas.</translation>
+        </message>
+        <message>
+            <source>The session was not fully restored: {}</source>
+            <translation>A sessão não foi restaurada por completo: {}</translation>
+        </message>
+    </context>
+    <context>
+        <name>ProjectPanel</name>
+        <message>
+            <source>Camera JSON (*.json)</source>
+            <translation>Câmera JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>EO CSV (*.csv *.txt)</source>
+            <translation>OE CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Exterior orientation from 'Trajectory to EO'</source>
+            <translation>Orientação exterior de 'Trajetória para OE'</translation>
+        </message>
+        <message>
+            <source>Mapping CRS of the exterior orientation</source>
+            <translation>SRC de mapeamento da orientação exterior</translation>
+        </message>
+        <message>
+            <source>Add…</source>
+            <translation>Adicionar…</translation>
+        </message>
+        <message>
+            <source>Clear</source>
+            <translation>Limpar</translation>
+        </message>
+        <message>
+            <source>Observation CSV (*.csv)</source>
+            <translation>Observações CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Saved after every change (atomic write)</source>
+            <translation>Salvo após cada alteração (gravação atômica)</translation>
+        </message>
+        <message>
+            <source>Camera</source>
+            <translation>Câmera</translation>
+        </message>
+        <message>
+            <source>Exterior orientation</source>
+            <translation>Orientação exterior</translation>
+        </message>
+        <message>
+            <source>Mapping CRS</source>
+            <translation>SRC de mapeamento</translation>
+        </message>
+        <message>
+            <source>Images</source>
+            <translation>Imagens</translation>
+        </message>
+        <message>
+            <source>Roof planes</source>
+            <translation>Planos de telhado</translation>
+        </message>
+        <message>
+            <source>Lines</source>
+            <translation>Linhas</translation>
+        </message>
+        <message>
+            <source>Control points</source>
+            <translation>Pontos de controle</translation>
+        </message>
+        <message>
+            <source>Observations</source>
+            <translation>Observações</translation>
+        </message>
+        <message>
+            <source>DSM raster (heights) for monoplotting</source>
+            <translation>Raster MDS (alturas) para a monorrestituição</translation>
+        </message>
+        <message>
+            <source>DSM (*.tif *.tiff *.las *.laz);;All files (*)</source>
+            <translation>MDS (*.tif *.tiff *.las *.laz);;Todos os arquivos (*)</translation>
+        </message>
+        <message>
+            <source>Or a DSM file: GeoTIFF, or a LAS/LAZ cloud rasterised at the cell size</source>
+            <translation>Ou um arquivo de MDS: GeoTIFF, ou uma nuvem LAS/LAZ rasterizada no tamanho de célula</translation>
+        </message>
+        <message>
+            <source> m</source>
+            <translation> m</translation>
+        </message>
+        <message>
+            <source>Cell of the DSM made from a LAS/LAZ file</source>
+            <translation>Célula do MDS gerado a partir de um arquivo LAS/LAZ</translation>
+        </message>
+        <message>
+            <source>DSM (monoplot)</source>
+            <translation>MDS (monorrestituição)</translation>
+        </message>
+        <message>
+            <source>or DSM file</source>
+            <translation>ou arquivo de MDS</translation>
+        </message>
+        <message>
+            <source>Images (*.tif *.tiff *.jpg *.jpeg *.png *.jp2 *.vrt *.img);;All files (*)</source>
+            <translation>Imagens (*.tif *.tiff *.jpg *.jpeg *.png *.jp2 *.vrt *.img);;Todos os arquivos (*)</translation>
+        </message>
+    </context>
+    <context>
+        <name>Report</name>
+        <message>
+            <source>component</source>
+            <translation>componente</translation>
+        </message>
+        <message>
+            <source>mean (m)</source>
+            <translation>média (m)</translation>
+        </message>
+        <message>
+            <source>std (m)</source>
+            <translation>desvio-padrão (m)</translation>
+        </message>
+        <message>
+            <source>min (m)</source>
+            <translation>mín. (m)</translation>
+        </message>
+        <message>
+            <source>max (m)</source>
+            <translation>máx. (m)</translation>
+        </message>
+        <message>
+            <source>Statistics: standard deviation with n &amp;minus; 1; RMSE = sqrt(mean(d&amp;sup2;)); Shapiro-Wilk by scipy (Royston's algorithm); Student t two-sided for a zero mean; chi-square one-sided, (n &amp;minus; 1) s&amp;sup2; / sigma0&amp;sup2; against chi-square(1 &amp;minus; alpha, n &amp;minus; 1).</source>
+            <translation>Estatísticas: desvio-padrão com n &amp;minus; 1; RMSE = sqrt(média(d&amp;sup2;)); Shapiro-Wilk pelo scipy (algoritmo de Royston); t de Student bilateral para média nula; qui-quadrado unilateral, (n &amp;minus; 1) s&amp;sup2; / sigma0&amp;sup2; contra qui-quadrado(1 &amp;minus; alfa, n &amp;minus; 1).</translation>
+        </message>
+        <message>
+            <source>Figures marked &lt;i&gt;uncertain&lt;/i&gt; in the verdicts come from our reading of the standard or from secondary sources; check them against the official text before a contractual statement.</source>
+            <translation>Os valores marcados como &lt;i&gt;incertos&lt;/i&gt; nos vereditos vêm da nossa leitura do padrão ou de fontes secundárias; confira-os com o texto oficial antes de uma declaração contratual.</translation>
+        </message>
+        <message>
+            <source>Status INSUFFICIENT: the standard needs more check points than were given; the figures are computed but no conformance is claimed.</source>
+            <translation>Estado INSUFICIENTE: o padrão exige mais pontos de verificação do que os informados; os valores são calculados, mas nenhuma conformidade é declarada.</translation>
+        </message>
+        <message>
+            <source>decision</source>
+            <translation>decisão</translation>
+        </message>
+        <message>
+            <source>Student t</source>
+            <translation>t de Student</translation>
+        </message>
+        <message>
+            <source>t critical</source>
+            <translation>t crítico</translation>
+        </message>
+        <message>
+            <source>chi-square</source>
+            <translation>qui-quadrado</translation>
+        </message>
+        <message>
+            <source>chi-square critical</source>
+            <translation>qui-quadrado crítico</translation>
+        </message>
+        <message>
+            <source>value (m)</source>
+            <translation>valor (m)</translation>
+        </message>
+        <message>
+            <source>{}, used (m)</source>
+            <translation>{}, usado (m)</translation>
+        </message>
+        <message>
+            <source>item</source>
+            <translation>item</translation>
+        </message>
+        <message>
+            <source>value</source>
+            <translation>valor</translation>
+        </message>
+        <message>
+            <source>Summary</source>
+            <translation>Resumo</translation>
+        </message>
+        <message>
+            <source>Standards</source>
+            <translation>Padrões</translation>
+        </message>
+        <message>
+            <source>Statistics</source>
+            <translation>Estatísticas</translation>
+        </message>
+        <message>
+            <source>Outliers</source>
+            <translation>Outliers</translation>
+        </message>
+        <message>
+            <source>Plots</source>
+            <translation>Gráficos</translation>
+        </message>
+        <message>
+            <source>Histogram of {}</source>
+            <translation>Histograma de {}</translation>
+        </message>
+        <message>
+            <source>Check points</source>
+            <translation>Pontos de verificação</translation>
+        </message>
+        <message>
+            <source>group</source>
+            <translation>grupo</translation>
+        </message>
+        <message>
+            <source>outlier</source>
+            <translation>outlier</translation>
+        </message>
+        <message>
+            <source>used</source>
+            <translation>usado</translation>
+        </message>
+        <message>
+            <source>check</source>
+            <translation>verificação</translation>
+        </message>
+        <message>
+            <source>status</source>
+            <translation>estado</translation>
+        </message>
+        <message>
+            <source>measured</source>
+            <translation>medido</translation>
+        </message>
+        <message>
+            <source>limit</source>
+            <translation>limite</translation>
+        </message>
+        <message>
+            <source>reason</source>
+            <translation>motivo</translation>
+        </message>
+        <message>
+            <source>check points</source>
+            <translation>pontos de verificação</translation>
+        </message>
+        <message>
+            <source>source</source>
+            <translation>fonte</translation>
+        </message>
+        <message>
+            <source>CRS</source>
+            <translation>SRC</translation>
+        </message>
+        <message>
+            <source>sign convention</source>
+            <translation>convenção de sinal</translation>
+        </message>
+        <message>
+            <source>d = measured &amp;minus; reference, metres</source>
+            <translation>d = medido &amp;minus; referência, metros</translation>
+        </message>
+        <message>
+            <source>significance level</source>
+            <translation>nível de significância</translation>
+        </message>
+        <message>
+            <source>created</source>
+            <translation>criado</translation>
+        </message>
+        <message>
+            <source>No standard was selected.</source>
+            <translation>Nenhum padrão foi selecionado.</translation>
+        </message>
+        <message>
+            <source>Project threshold per group</source>
+            <translation>Limiar do projeto por grupo</translation>
+        </message>
+        <message>
+            <source>No point flagged.</source>
+            <translation>Nenhum ponto marcado.</translation>
+        </message>
+        <message>
+            <source>yes</source>
+            <translation>sim</translation>
+        </message>
+        <message>
+            <source>no</source>
+            <translation>não</translation>
+        </message>
+        <message>
+            <source>normal</source>
+            <translation>normal</translation>
+        </message>
+        <message>
+            <source>bias</source>
+            <translation>tendência</translation>
+        </message>
+        <message>
+            <source>not tested</source>
+            <translation>não testado</translation>
+        </message>
+        <message>
+            <source>Notes</source>
+            <translation>Notas</translation>
+        </message>
+        <message>
+            <source>not normal</source>
+            <translation>não normal</translation>
+        </message>
+        <message>
+            <source>no bias</source>
+            <translation>sem tendência</translation>
+        </message>
+        <message>
+            <source>Source: {}. {} check points.</source>
+            <translation>Fonte: {}. {} pontos de verificação.</translation>
+        </message>
+        <message>
+            <source>{} ({} in the statistics)</source>
+            <translation>{} ({} nas estatísticas)</translation>
+        </message>
+        <message>
+            <source>not stated</source>
+            <translation>não informado</translation>
+        </message>
+        <message>
+            <source>For comparison: {} ({})</source>
+            <translation>Para comparação: {} ({})</translation>
+        </message>
+        <message>
+            <source>Group {} ({})</source>
+            <translation>Grupo {} ({})</translation>
+        </message>
+        <message>
+            <source>; excluded from the statistics and the standards.</source>
+            <translation>; excluídos das estatísticas e dos padrões.</translation>
+        </message>
+        <message>
+            <source>; kept in the statistics (not excluded).</source>
+            <translation>; mantidos nas estatísticas (não excluídos).</translation>
+        </message>
+        <message>
+            <source>Normal Q-Q plot of {}</source>
+            <translation>Gráfico Q-Q normal de {}</translation>
+        </message>
+        <message>
+            <source>accepted</source>
+            <translation>aceito</translation>
+        </message>
+        <message>
+            <source>rejected</source>
+            <translation>rejeitado</translation>
+        </message>
+        <message>
+            <source>Rule: {}.</source>
+            <translation>Regra: {}.</translation>
+        </message>
+        <message>
+            <source>{} point(s) flagged: </source>
+            <translation>{} ponto(s) marcado(s): </translation>
+        </message>
+        <message>
+            <source>These results FAILED their checks and were written only because the user asked for them (ACCEPT_DOUBTFUL): do not use them without review.</source>
+            <translation>Estes resultados FALHARAM nas verificações e foram gravados apenas porque o usuário os pediu (ACCEPT_DOUBTFUL): não os use sem revisão.</translation>
+        </message>
+        <message>
+            <source>The calibration FAILED its checks: no table and no exterior orientation were written. The numbers below show the failed adjustment, for diagnosis only.</source>
+            <translation>A calibração FALHOU nas verificações: nenhuma tabela e nenhuma orientação exterior foram gravadas. Os números abaixo mostram o ajustamento que falhou, apenas para diagnóstico.</translation>
+        </message>
+        <message>
+            <source>Boresight calibration</source>
+            <translation>Calibração de boresight</translation>
+        </message>
+        <message>
+            <source>Angles: d_omega, d_phi, d_kappa about the camera axes x, y, z (R_c^b = R_nominal dR); standard deviations are a-posteriori (scaled by sigma0) unless labelled a-priori.</source>
+            <translation>Ângulos: d_omega, d_phi, d_kappa em torno dos eixos x, y, z da câmera (R_c^b = R_nominal dR); os desvios-padrão são a posteriori (escalados por sigma0), salvo quando indicados como a priori.</translation>
+        </message>
+        <message>
+            <source>Settings</source>
+            <translation>Configurações</translation>
+        </message>
+        <message>
+            <source>setting</source>
+            <translation>configuração</translation>
+        </message>
+        <message>
+            <source>Boresight</source>
+            <translation>Boresight</translation>
+        </message>
+        <message>
+            <source>angle</source>
+            <translation>ângulo</translation>
+        </message>
+        <message>
+            <source>value (deg)</source>
+            <translation>valor (graus)</translation>
+        </message>
+        <message>
+            <source>value (d m s)</source>
+            <translation>valor (g m s)</translation>
+        </message>
+        <message>
+            <source>value (arcsec)</source>
+            <translation>valor (segundos de arco)</translation>
+        </message>
+        <message>
+            <source>sigma (arcsec)</source>
+            <translation>sigma (segundos de arco)</translation>
+        </message>
+        <message>
+            <source>sigma a-priori (arcsec)</source>
+            <translation>sigma a priori (segundos de arco)</translation>
+        </message>
+        <message>
+            <source>Adjustment</source>
+            <translation>Ajustamento</translation>
+        </message>
+        <message>
+            <source>figure</source>
+            <translation>grandeza</translation>
+        </message>
+        <message>
+            <source>Correlation of the calibration parameters</source>
+            <translation>Correlação dos parâmetros de calibração</translation>
+        </message>
+        <message>
+            <source>Rejected observations</source>
+            <translation>Observações rejeitadas</translation>
+        </message>
+        <message>
+            <source>Not observable</source>
+            <translation>Não observável</translation>
+        </message>
+        <message>
+            <source>The calibration was not computed:</source>
+            <translation>A calibração não foi calculada:</translation>
+        </message>
+        <message>
+            <source>Lever arm (body frame)</source>
+            <translation>Braço de alavanca (referencial do corpo)</translation>
+        </message>
+        <message>
+            <source>axis</source>
+            <translation>eixo</translation>
+        </message>
+        <message>
+            <source>sigma (m)</source>
+            <translation>sigma (m)</translation>
+        </message>
+        <message>
+            <source>Interior orientation</source>
+            <translation>Orientação interior</translation>
+        </message>
+        <message>
+            <source>parameter</source>
+            <translation>parâmetro</translation>
+        </message>
+        <message>
+            <source>value (mm)</source>
+            <translation>valor (mm)</translation>
+        </message>
+        <message>
+            <source>sigma (mm)</source>
+            <translation>sigma (mm)</translation>
+        </message>
+        <message>
+            <source>sigma0 (a-posteriori, a-priori 1)</source>
+            <translation>sigma0 (a posteriori, a priori 1)</translation>
+        </message>
+        <message>
+            <source>redundancy</source>
+            <translation>redundância</translation>
+        </message>
+        <message>
+            <source>observations / constraints</source>
+            <translation>observações / injunções</translation>
+        </message>
+        <message>
+            <source>global chi-square statistic</source>
+            <translation>estatística qui-quadrado global</translation>
+        </message>
+        <message>
+            <source>p-value</source>
+            <translation>valor p</translation>
+        </message>
+        <message>
+            <source>global test</source>
+            <translation>teste global</translation>
+        </message>
+        <message>
+            <source>iterations</source>
+            <translation>iterações</translation>
+        </message>
+        <message>
+            <source>outlier detection</source>
+            <translation>detecção de outliers</translation>
+        </message>
+        <message>
+            <source>image</source>
+            <translation>imagem</translation>
+        </message>
+        <message>
+            <source>point</source>
+            <translation>ponto</translation>
+        </message>
+        <message>
+            <source>type</source>
+            <translation>tipo</translation>
+        </message>
+        <message>
+            <source>target</source>
+            <translation>alvo</translation>
+        </message>
+        <message>
+            <source>None.</source>
+            <translation>Nenhuma.</translation>
+        </message>
+        <message>
+            <source>Image residuals</source>
+            <translation>Resíduos das imagens</translation>
+        </message>
+        <message>
+            <source>Residual vx</source>
+            <translation>Resíduo vx</translation>
+        </message>
+        <message>
+            <source>col residual (px)</source>
+            <translation>resíduo em coluna (px)</translation>
+        </message>
+        <message>
+            <source>Residual vy</source>
+            <translation>Resíduo vy</translation>
+        </message>
+        <message>
+            <source>row residual (px)</source>
+            <translation>resíduo em linha (px)</translation>
+        </message>
+        <message>
+            <source>passed</source>
+            <translation>aprovado</translation>
+        </message>
+        <message>
+            <source>failed</source>
+            <translation>reprovado</translation>
+        </message>
+        <message>
+            <source>Warnings</source>
+            <translation>Avisos</translation>
+        </message>
+        <message>
+            <source>acceptance interval (alpha = {})</source>
+            <translation>intervalo de aceitação (alfa = {})</translation>
+        </message>
+        <message>
+            <source>{} (converged: {})</source>
+            <translation>{} (convergiu: {})</translation>
+        </message>
+        <message>
+            <source>{} image points kept: RMS residual {} px (col), {} px (row).</source>
+            <translation>{} pontos de imagem mantidos: resíduo RMS {} px (coluna), {} px (linha).</translation>
+        </message>
+        <message>
+            <source>rank</source>
+            <translation>posição</translation>
+        </message>
+        <message>
+            <source>AP model</source>
+            <translation>modelo de PAs</translation>
+        </message>
+        <message>
+            <source>mean planimetric (m)</source>
+            <translation>média planimétrica (m)</translation>
+        </message>
+        <message>
+            <source>std planimetric (m)</source>
+            <translation>desvio-padrão planimétrico (m)</translation>
+        </message>
+        <message>
+            <source>RMS planimetric (m)</source>
+            <translation>RMS planimétrico (m)</translation>
+        </message>
+        <message>
+            <source>RMS height (m)</source>
+            <translation>RMS em altura (m)</translation>
+        </message>
+        <message>
+            <source>APs</source>
+            <translation>PAs</translation>
+        </message>
+        <message>
+            <source>APs kept</source>
+            <translation>PAs mantidos</translation>
+        </message>
+        <message>
+            <source>significant</source>
+            <translation>significativo</translation>
+        </message>
+        <message>
+            <source>camera</source>
+            <translation>câmera</translation>
+        </message>
+        <message>
+            <source>std</source>
+            <translation>desvio-padrão</translation>
+        </message>
+        <message>
+            <source>converged</source>
+            <translation>convergiu</translation>
+        </message>
+        <message>
+            <source>sigma0 a posteriori</source>
+            <translation>sigma0 a posteriori</translation>
+        </message>
+        <message>
+            <source>global chi-square test</source>
+            <translation>teste qui-quadrado global</translation>
+        </message>
+        <message>
+            <source>outliers</source>
+            <translation>outliers</translation>
+        </message>
+        <message>
+            <source>condition number (reduced system)</source>
+            <translation>número de condição (sistema reduzido)</translation>
+        </message>
+        <message>
+            <source>details</source>
+            <translation>detalhes</translation>
+        </message>
+        <message>
+            <source>NO</source>
+            <translation>NÃO</translation>
+        </message>
+        <message>
+            <source>FAILED</source>
+            <translation>REPROVADO</translation>
+        </message>
+        <message>
+            <source>no redundancy</source>
+            <translation>sem redundância</translation>
+        </message>
+        <message>
+            <source>significant ({})</source>
+            <translation>significativo ({})</translation>
+        </message>
+        <message>
+            <source>mapping CRS and units in the settings; image residuals in pixels (adjusted minus measured).</source>
+            <translation>SRC de mapeamento e unidades nas configurações; resíduos das imagens em pixels (ajustado menos medido).</translation>
+        </message>
+        <message>
+            <source>Interior orientation and additional parameters</source>
+            <translation>Orientação interior e parâmetros adicionais</translation>
+        </message>
+        <message>
+            <source>Images</source>
+            <translation>Imagens</translation>
+        </message>
+        <message>
+            <source>points used</source>
+            <translation>pontos usados</translation>
+        </message>
+        <message>
+            <source>RMS col (px)</source>
+            <translation>RMS col (px)</translation>
+        </message>
+        <message>
+            <source>RMS row (px)</source>
+            <translation>RMS lin (px)</translation>
+        </message>
+        <message>
+            <source>Rejected measurements ({})</source>
+            <translation>Medições rejeitadas ({})</translation>
+        </message>
+        <message>
+            <source>after {} iterations</source>
+            <translation>após {} iterações</translation>
+        </message>
+        <message>
+            <source>a priori {}</source>
+            <translation>a priori {}</translation>
+        </message>
+        <message>
+            <source>{} observation rows, {} parameters, {} constraint rows</source>
+            <translation>{} linhas de observação, {} parâmetros, {} linhas de injunção</translation>
+        </message>
+        <message>
+            <source>AP models compared (check-point discrepancies)</source>
+            <translation>Modelos de PAs comparados (discrepâncias nos pontos de verificação)</translation>
+        </message>
+        <message>
+            <source>Planimetric discrepancy = horizontal distance between the intersected and the surveyed check point; ranked by the 3D RMS (sigma0 without check points). The outputs are those of the best model (highlighted).</source>
+            <translation>Discrepância planimétrica = distância horizontal entre o ponto de verificação intersectado e o levantado; ordenados pelo RMS 3D (sigma0 sem pontos de verificação). As saídas são as do melhor modelo (destacado).</translation>
+        </message>
+        <message>
+            <source>Lever arm and boresight corrections (camera axes)</source>
+            <translation>Correções do braço de alavanca e do boresight (eixos da câmera)</translation>
+        </message>
+        <message>
+            <source>Check points (not in the adjustment)</source>
+            <translation>Pontos de verificação (fora do ajustamento)</translation>
+        </message>
+        <message>
+            <source>planimetric (m)</source>
+            <translation>planimétrica (m)</translation>
+        </message>
+        <message>
+            <source>images</source>
+            <translation>imagens</translation>
+        </message>
+        <message>
+            <source>v col</source>
+            <translation>v col</translation>
+        </message>
+        <message>
+            <source>residual (px)</source>
+            <translation>resíduo (px)</translation>
+        </message>
+        <message>
+            <source>v row</source>
+            <translation>v lin</translation>
+        </message>
+        <message>
+            <source>Residuals</source>
+            <translation>Resíduos</translation>
+        </message>
+        <message>
+            <source>w col</source>
+            <translation>w col</translation>
+        </message>
+        <message>
+            <source>w row</source>
+            <translation>w lin</translation>
+        </message>
+        <message>
+            <source>statistic {}, accepted [{}, {}], p = {}</source>
+            <translation>estatística {}, aceita em [{}, {}], p = {}</translation>
+        </message>
+        <message>
+            <source>Bundle adjustment: {}</source>
+            <translation>Ajustamento por feixes de raios: {}</translation>
+        </message>
+        <message>
+            <source>Bundle adjustment with self-calibration ({})</source>
+            <translation>Ajustamento por feixes de raios com autocalibração ({})</translation>
+        </message>
+        <message>
+            <source>Dropped by the selection, in order: </source>
+            <translation>Descartados pela seleção, em ordem: </translation>
+        </message>
+        <message>
+            <source>lever dx (m)</source>
+            <translation>braço dx (m)</translation>
+        </message>
+        <message>
+            <source>lever dy (m)</source>
+            <translation>braço dy (m)</translation>
+        </message>
+        <message>
+            <source>lever dz (m)</source>
+            <translation>braço dz (m)</translation>
+        </message>
+        <message>
+            <source>boresight d_omega (deg)</source>
+            <translation>boresight d_omega (graus)</translation>
+        </message>
+        <message>
+            <source>boresight d_phi (deg)</source>
+            <translation>boresight d_phi (graus)</translation>
+        </message>
+        <message>
+            <source>boresight d_kappa (deg)</source>
+            <translation>boresight d_kappa (graus)</translation>
+        </message>
+        <message>
+            <source>Planimetric discrepancy: mean {} m, standard deviation {} m, RMS {} m; RMS E/N/H {} / {} / {} m; 3D {} m. Intersected with the adjusted orientations; their sigmas carry the image noise only.</source>
+            <translation>Discrepância planimétrica: média {} m, desvio-padrão {} m, RMS {} m; RMS E/N/H {} / {} / {} m; 3D {} m. Intersectados com as orientações ajustadas; os seus desvios-padrão trazem apenas o ruído das imagens.</translation>
+        </message>
+        <message>
+            <source>not observable: {}</source>
+            <translation>não observável: {}</translation>
+        </message>
+        <message>
+            <source>|correlation| above {} in the final adjustment: </source>
+            <translation>|correlação| acima de {} no ajustamento final: </translation>
+        </message>
+        <message>
+            <source>Correlations: {}</source>
+            <translation>Correlações: {}</translation>
+        </message>
+        <message>
+            <source>Image residuals: {}</source>
+            <translation>Resíduos das imagens: {}</translation>
+        </message>
+        <message>
+            <source>control points: RMS |v| (px)</source>
+            <translation>pontos de controle: RMS |v| (px)</translation>
+        </message>
+        <message>
+            <source>line points: RMS distance from the projected line (px)</source>
+            <translation>pontos de linha: RMS da distância à linha projetada (px)</translation>
+        </message>
+        <message>
+            <source>check points: RMS |projected - measured| (px)</source>
+            <translation>pontos de verificação: RMS |projetado - medido| (px)</translation>
+        </message>
+        <message>
+            <source>Space resection</source>
+            <translation>Resseção espacial</translation>
+        </message>
+        <message>
+            <source>Position in the mapping CRS, omega-phi-kappa relative to the grid frame at the perspective centre; standard deviations a-posteriori (scaled by sigma0) unless labelled a-priori. Global test: v'Pv / sigma0_prior^2 against the chi-square critical value (one-sided 5 %, as dos Santos et al. 2010 report it) and the two-sided acceptance range.</source>
+            <translation>Posição no SRC de mapeamento, omega-phi-kappa relativos ao referencial da quadrícula no centro perspectivo; desvios-padrão a posteriori (escalados por sigma0), salvo quando indicados como a priori. Teste global: v'Pv / sigma0_prior^2 contra o valor crítico do qui-quadrado (unilateral 5 %, como dos Santos et al. 2010 o relatam) e o intervalo de aceitação bilateral.</translation>
+        </message>
+        <message>
+            <source>points</source>
+            <translation>pontos</translation>
+        </message>
+        <message>
+            <source>lines</source>
+            <translation>linhas</translation>
+        </message>
+        <message>
+            <source>test</source>
+            <translation>teste</translation>
+        </message>
+        <message>
+            <source>unit</source>
+            <translation>unidade</translation>
+        </message>
+        <message>
+            <source>std a-priori</source>
+            <translation>desvio-padrão a priori</translation>
+        </message>
+        <message>
+            <source>std (arcsec)</source>
+            <translation>desvio-padrão (segundos de arco)</translation>
+        </message>
+        <message>
+            <source>Global test</source>
+            <translation>Teste global</translation>
+        </message>
+        <message>
+            <source>quantity</source>
+            <translation>grandeza</translation>
+        </message>
+        <message>
+            <source>Correlation of the six parameters</source>
+            <translation>Correlação dos seis parâmetros</translation>
+        </message>
+        <message>
+            <source>what</source>
+            <translation>o quê</translation>
+        </message>
+        <message>
+            <source>count</source>
+            <translation>quantidade</translation>
+        </message>
+        <message>
+            <source>Interior orientation (refined)</source>
+            <translation>Orientação interior (refinada)</translation>
+        </message>
+        <message>
+            <source>std (mm)</source>
+            <translation>desvio-padrão (mm)</translation>
+        </message>
+        <message>
+            <source>observations (condition rows)</source>
+            <translation>observações (linhas de condição)</translation>
+        </message>
+        <message>
+            <source>sigma0 a-posteriori</source>
+            <translation>sigma0 a posteriori</translation>
+        </message>
+        <message>
+            <source>chi-square statistic v'Pv / sigma0_prior^2</source>
+            <translation>estatística qui-quadrado v'Pv / sigma0_prior^2</translation>
+        </message>
+        <message>
+            <source>critical value, one-sided 5 % (as the source)</source>
+            <translation>valor crítico, unilateral 5 % (como na fonte)</translation>
+        </message>
+        <message>
+            <source>two-sided acceptance range</source>
+            <translation>intervalo de aceitação bilateral</translation>
+        </message>
+        <message>
+            <source>verdict (one-sided)</source>
+            <translation>veredito (unilateral)</translation>
+        </message>
+        <message>
+            <source>condition number (scaled normal matrix)</source>
+            <translation>número de condição (matriz normal escalada)</translation>
+        </message>
+        <message>
+            <source>Rejected by data snooping</source>
+            <translation>Rejeitados pelo data snooping</translation>
+        </message>
+        <message>
+            <source>block</source>
+            <translation>bloco</translation>
+        </message>
+        <message>
+            <source>row</source>
+            <translation>lin</translation>
+        </message>
+        <message>
+            <source>Image {}</source>
+            <translation>Imagem {}</translation>
+        </message>
+        <message>
+            <source>Start: {}; line model: {}; {} iterations; {} control points, {} lines, {} check points, {} rows without control ignored.</source>
+            <translation>Início: {}; modelo de linha: {}; {} iterações; {} pontos de controle, {} linhas, {} pontos de verificação, {} linhas sem controle ignoradas.</translation>
+        </message>
+        <message>
+            <source>Horizontal discrepancy vectors</source>
+            <translation>Vetores de discrepância horizontal</translation>
+        </message>
+        <message>
+            <source>normal quantile</source>
+            <translation>quantil normal</translation>
+        </message>
+        <message>
+            <source>discrepancy (m)</source>
+            <translation>discrepância (m)</translation>
+        </message>
+        <message>
+            <source>(vectors x {})</source>
+            <translation>(vetores x {})</translation>
+        </message>
+        <message>
+            <source>{} m on the ground</source>
+            <translation>{} m no terreno</translation>
+        </message>
+        <message>
+            <source>mean residual per cell; {} px = {} px on screen; largest {} px</source>
+            <translation>resíduo médio por célula; {} px = {} px na tela; maior {} px</translation>
+        </message>
+        <message>
+            <source>{} m discrepancy</source>
+            <translation>discrepância de {} m</translation>
+        </message>
+        <message>
+            <source>Correlations between the APs and the station parameters (Lichti 2010) come from the network design, not the instrument: the rangefinder offset a0 with the station positions when the targets lie on one side or in a narrow vertical band; the collimation error b1 with kappa when the targets are near the horizon (sec(alpha) is then about 1); the trunnion-axis error b2 and the vertical index c0 with omega and phi. They are broken by targets all around the scanner and over the full vertical range (floor and ceiling), by two-face observations, and by stations whose scanner is tilted by about 90 degrees (which turn elevations into horizontal directions). A levelled scanner's compensator observes omega and phi and helps b2 and c0.</source>
+            <translation>As correlações entre os PAs e os parâmetros das estações (Lichti 2010) vêm da geometria da rede, não do instrumento: o deslocamento do distanciômetro a0 com as posições das estações quando os alvos estão de um só lado ou em uma faixa vertical estreita; o erro de colimação b1 com kappa quando os alvos estão próximos do horizonte (sec(alfa) é então cerca de 1); o erro do eixo secundário b2 e o índice vertical c0 com omega e phi. Elas são quebradas por alvos em toda a volta do escâner e em toda a faixa vertical (piso e teto), por observações nas duas posições da luneta e por estações cujo escâner está inclinado de cerca de 90 graus (o que transforma elevações em direções horizontais). O compensador de um escâner nivelado observa omega e phi e ajuda b2 e c0.</translation>
+        </message>
+        <message>
+            <source>TLS self-calibration</source>
+            <translation>Autocalibração TLS</translation>
+        </message>
+        <message>
+            <source>Terrestrial laser scanner: registration and self-calibration</source>
+            <translation>Laser scanner terrestre: registro e autocalibração</translation>
+        </message>
+        <message>
+            <source>Model: Carvalho, Correa &amp;amp; dos Santos (Eqs. 1-5), additional parameters after Lichti (2007), correlation analysis after Lichti (2010).</source>
+            <translation>Modelo: Carvalho, Correa &amp;amp; dos Santos (Eqs. 1-5), parâmetros adicionais segundo Lichti (2007), análise de correlação segundo Lichti (2010).</translation>
+        </message>
+        <message>
+            <source>Stations</source>
+            <translation>Estações</translation>
+        </message>
+        <message>
+            <source>station</source>
+            <translation>estação</translation>
+        </message>
+        <message>
+            <source>levelled</source>
+            <translation>nivelada</translation>
+        </message>
+        <message>
+            <source>Correlations</source>
+            <translation>Correlações</translation>
+        </message>
+        <message>
+            <source>station / target</source>
+            <translation>estação / alvo</translation>
+        </message>
+        <message>
+            <source>v range mm</source>
+            <translation>v distância mm</translation>
+        </message>
+        <message>
+            <source>observations (station-target-face)</source>
+            <translation>observações (estação-alvo-posição)</translation>
+        </message>
+        <message>
+            <source>stations / targets</source>
+            <translation>estações / alvos</translation>
+        </message>
+        <message>
+            <source>observations rejected (data snooping)</source>
+            <translation>observações rejeitadas (data snooping)</translation>
+        </message>
+        <message>
+            <source>datum</source>
+            <translation>referencial (datum)</translation>
+        </message>
+        <message>
+            <source>Additional parameters</source>
+            <translation>Parâmetros adicionais</translation>
+        </message>
+        <message>
+            <source>AP</source>
+            <translation>PA</translation>
+        </message>
+        <message>
+            <source>term</source>
+            <translation>termo</translation>
+        </message>
+        <message>
+            <source>cause</source>
+            <translation>causa</translation>
+        </message>
+        <message>
+            <source>sigma a-priori</source>
+            <translation>sigma a priori</translation>
+        </message>
+        <message>
+            <source>why, and the design that breaks it</source>
+            <translation>por quê, e a geometria que a quebra</translation>
+        </message>
+        <message>
+            <source>Automatic AP selection</source>
+            <translation>Seleção automática de PAs</translation>
+        </message>
+        <message>
+            <source>removed</source>
+            <translation>removido</translation>
+        </message>
+        <message>
+            <source>why</source>
+            <translation>por quê</translation>
+        </message>
+        <message>
+            <source>remaining</source>
+            <translation>restantes</translation>
+        </message>
+        <message>
+            <source>range</source>
+            <translation>distância</translation>
+        </message>
+        <message>
+            <source>horizontal direction</source>
+            <translation>direção horizontal</translation>
+        </message>
+        <message>
+            <source>arc-seconds</source>
+            <translation>segundos de arco</translation>
+        </message>
+        <message>
+            <source>vertical angle</source>
+            <translation>ângulo vertical</translation>
+        </message>
+        <message>
+            <source>control</source>
+            <translation>controle</translation>
+        </message>
+        <message>
+            <source>inner constraints</source>
+            <translation>injunções internas</translation>
+        </message>
+        <message>
+            <source>t = |value| / sigma against the Student-t critical value {} (two-sided, alpha = {}). sigma is scaled by sigma0; sigma a-priori is the Cramer-Rao bound of the network for the observation sigmas given.</source>
+            <translation>t = |valor| / sigma contra o valor crítico t de Student {} (bilateral, alfa = {}). sigma é escalado por sigma0; sigma a priori é o limite de Cramér-Rao da rede para os desvios-padrão de observação informados.</translation>
+        </message>
+        <message>
+            <source>Pairs with |r| &amp;ge; {}:</source>
+            <translation>Pares com |r| &amp;ge; {}:</translation>
+        </message>
+        <message>
+            <source>No pair involving an AP reaches |r| = {}.</source>
+            <translation>Nenhum par envolvendo um PA atinge |r| = {}.</translation>
+        </message>
+        <message>
+            <source>NOT</source>
+            <translation>NÃO</translation>
+        </message>
+        <message>
+            <source>none</source>
+            <translation>nenhuma</translation>
+        </message>
+    </context>
+    <context>
+        <name>ResectionController</name>
+        <message>
+            <source>A resection is already running.</source>
+            <translation>Uma resseção já está em execução.</translation>
+        </message>
+        <message>
+            <source>No observations in image {}.</source>
+            <translation>Não há observações na imagem {}.</translation>
+        </message>
+        <message>
+            <source>The observations could not be saved.</source>
+            <translation>Não foi possível salvar as observações.</translation>
+        </message>
+        <message>
+            <source>Choose the line or LCP layer.</source>
+            <translation>Escolha a camada de linhas ou de LCPs.</translation>
+        </message>
+        <message>
+            <source>Resection of {}</source>
+            <translation>Resseção de {}</translation>
+        </message>
+        <message>
+            <source>Resection cancelled.</source>
+            <translation>Resseção cancelada.</translation>
+        </message>
+        <message>
+            <source>Resection failed. {}</source>
+            <translation>A resseção falhou. {}</translation>
+        </message>
+        <message>
+            <source>Resection of {} done: sigma0 {}; {}</source>
+            <translation>Resseção de {} concluída: sigma0 {}; {}</translation>
+        </message>
+    </context>
+    <context>
+        <name>ResectionPanel</name>
+        <message>
+            <source>Resect the image shown</source>
+            <translation>Fazer a resseção da imagem exibida</translation>
+        </message>
+        <message>
+            <source>Runs {} in the background: the image's exterior orientation from its measured lines and control points, no approximate values</source>
+            <translation>Executa {} em segundo plano: a orientação exterior da imagem a partir de suas linhas e pontos de controle medidos, sem valores aproximados</translation>
+        </message>
+        <message>
+            <source>Refine line ends on the image edge</source>
+            <translation>Refinar as extremidades da linha sobre a borda na imagem</translation>
+        </message>
+        <message>
+            <source>Line picking: each click moves across the line to the strongest grey-value edge within 4 px (sub-pixel)</source>
+            <translation>Medição de linhas: cada clique se desloca transversalmente à linha até a borda de nível de cinza mais forte a até 4 px (subpixel)</translation>
+        </message>
+        <message>
+            <source>Resection running…</source>
+            <translation>Resseção em execução…</translation>
+        </message>
+        <message>
+            <source>σ0 {:.3f}, redundancy {}, χ² test {}; {} point(s), {} line(s)</source>
+            <translation>σ0 {:.3f}, redundância {}, teste χ² {}; {} ponto(s), {} linha(s)</translation>
+        </message>
+        <message>
+            <source>passed</source>
+            <translation>aprovado</translation>
+        </message>
+        <message>
+            <source>FAILED</source>
+            <translation>REPROVADO</translation>
+        </message>
+        <message>
+            <source>type</source>
+            <translation>tipo</translation>
+        </message>
+        <message>
+            <source>id</source>
+            <translation>id</translation>
+        </message>
+        <message>
+            <source>pts</source>
+            <translation>pts</translation>
+        </message>
+        <message>
+            <source>RMS px</source>
+            <translation>RMS px</translation>
+        </message>
+        <message>
+            <source>max px</source>
+            <translation>máx. px</translation>
+        </message>
+        <message>
+            <source>rejected</source>
+            <translation>rejeitado</translation>
+        </message>
+    </context>
+    <context>
+        <name>ViewerPanel</name>
+        <message>
+            <source>Type of the next point (T/P/L/C/K)</source>
+            <translation>Tipo do próximo ponto (T/P/L/C/K)</translation>
+        </message>
+        <message>
+            <source>Undo (Ctrl+Z)</source>
+            <translation>Desfazer (Ctrl+Z)</translation>
+        </message>
+        <message>
+            <source>Redo (Ctrl+Shift+Z)</source>
+            <translation>Refazer (Ctrl+Shift+Z)</translation>
+        </message>
+        <message>
+            <source>Magnifier (M)</source>
+            <translation>Lupa (M)</translation>
+        </message>
+        <message>
+            <source>Monoplot</source>
+            <translation>Monorrestituir</translation>
+        </message>
+        <message>
+            <source>Monoplotting: clicks become 3D points (or line vertices) on the DSM, added to the map at once; off: clicks measure observations again</source>
+            <translation>Monorrestituição: os cliques tornam-se pontos 3D (ou vértices de linha) sobre o MDS, adicionados ao mapa imediatamente; desligada: os cliques voltam a medir observações</translation>
+        </message>
+        <message>
+            <source>points</source>
+            <translation>pontos</translation>
+        </message>
+        <message>
+            <source>lines</source>
+            <translation>linhas</translation>
+        </message>
+        <message>
+            <source>Monoplot points, or lines (finish: Enter)</source>
+            <translation>Monorrestituir pontos ou linhas (terminar: Enter)</translation>
+        </message>
+        <message>
+            <source>Finish line</source>
+            <translation>Terminar linha</translation>
+        </message>
+        <message>
+            <source>End the line being digitised (also Enter or a double click)</source>
+            <translation>Termina a linha em digitalização (também Enter ou um clique duplo)</translation>
+        </message>
+        <message>
+            <source>Save the monoplotted points and lines to a GeoPackage</source>
+            <translation>Salvar os pontos e linhas monorrestituídos em um GeoPackage</translation>
+        </message>
+        <message>
+            <source>Scale of the residual vectors</source>
+            <translation>Escala dos vetores de resíduos</translation>
+        </message>
+        <message>
+            <source>no orientation</source>
+            <translation>sem orientação</translation>
+        </message>
+        <message>
+            <source>no file</source>
+            <translation>sem arquivo</translation>
+        </message>
+        <message>
+            <source>missing on disk</source>
+            <translation>ausente do disco</translation>
+        </message>
+        <message>
+            <source>file missing on disk</source>
+            <translation>arquivo ausente do disco</translation>
+        </message>
+        <message>
+            <source>no image file</source>
+            <translation>sem arquivo de imagem</translation>
+        </message>
+        <message>
+            <source>add it with Images &gt; Add</source>
+            <translation>adicione-a com Imagens &gt; Adicionar</translation>
+        </message>
+        <message>
+            <source>Image {}: {} ({}).</source>
+            <translation>Imagem {}: {} ({}).</translation>
+        </message>
+        <message>
+            <source>Image {} has no exterior orientation: no overlays, no picking.</source>
+            <translation>A imagem {} não tem orientação exterior: sem sobreposições, sem medição.</translation>
+        </message>
+        <message>
+            <source>Image {} is {} x {} px but the camera is {} x {} px.</source>
+            <translation>A imagem {} tem {} x {} px, mas a câmera tem {} x {} px.</translation>
+        </message>
+        <message>
+            <source>Image {}: {} x {} px, {} band(s), {}.</source>
+            <translation>Imagem {}: {} x {} px, {} banda(s), {}.</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:accuracyreport</name>
+        <message>
+            <source>Positional accuracy report</source>
+            <translation>Relatório de acurácia posicional</translation>
+        </message>
+        <message>
+            <source>Quality</source>
+            <translation>Qualidade</translation>
+        </message>
+        <message>
+            <source>check points against ASPRS Ed. 2, NSSDA, PEC-PCD and the project threshold</source>
+            <translation>pontos de verificação segundo ASPRS Ed. 2, NSSDA, PEC-PCD e o limiar do projeto</translation>
+        </message>
+        <message>
+            <source>Compares measured check points with reference coordinates and reports their positional
+accuracy: discrepancies d = measured - reference (dE, dN, dH, horizontal, 3D), mean, standard
+deviation, RMSE, minimum and maximum per component, per group and overall; Shapiro-Wilk
+normality, Student's t test for bias, chi-square test of the standard deviation against a
+declared precision; outlier screening (flagged points are reported, excluded only on
+request); and the verdicts of the ASPRS Positional Accuracy Standards Edition 2 (2023),
+NSSDA (FGDC-STD-007.3-1998), the Brazilian PEC-PCD (classes A-D for a scale) and the project
+threshold of Pedrosa &amp; dos Santos (2020): 0.40 m planimetric, dz = sqrt(2) H^2 / (B f)
+sigma_pix.</source>
+            <translation>Compara pontos de verificação medidos com coordenadas de referência e relata sua acurácia
+posicional: discrepâncias d = medido - referência (dE, dN, dH, horizontal, 3D), média,
+desvio-padrão, RMSE, mínimo e máximo por componente, por grupo e no total; teste de normalidade
+de Shapiro-Wilk, teste t de Student para tendência, teste qui-quadrado do desvio-padrão contra
+uma precisão declarada; triagem de outliers (os pontos marcados são relatados e excluídos
+apenas a pedido); e os vereditos dos Padrões de Acurácia Posicional da ASPRS, Edição 2 (2023),
+do NSSDA (FGDC-STD-007.3-1998), do PEC-PCD brasileiro (classes A-D para uma escala) e do limiar
+de projeto de Pedrosa &amp; dos Santos (2020): 0,40 m planimétrico, dz = sqrt(2) H^2 / (B f)
+sigma_pix.</translation>
+        </message>
+        <message>
+            <source>## Input: one table or two point tables/layers
+Check-point table (CSV): id, e, n, h (measured) and e_ref, n_ref, h_ref (reference),
+optional group; metres in one projected CRS (give it as CRS).</source>
+            <translation>## Entrada: uma tabela ou duas tabelas/camadas de pontos
+Tabela de pontos de verificação (CSV): id, e, n, h (medidos) e e_ref, n_ref, h_ref
+(referência), group opcional; metros em um SRC projetado (informe-o em SRC).</translation>
+        </message>
+        <message>
+            <source>Or Measured points and Reference points (CSV tables id, e, n, h [, group], or point layers in
+QGIS) joined by their ids. Ids present in only one set, duplicate ids and missing coordinates
+are errors. Layers in different CRSs are refused unless Reproject is checked (QGIS only: the
+reference layer is then transformed to the measured layer's CRS, heights unchanged).</source>
+            <translation>Ou Pontos medidos e Pontos de referência (tabelas CSV id, e, n, h [, group], ou camadas de
+pontos no QGIS) associados por seus identificadores. Identificadores presentes em apenas um
+conjunto, identificadores repetidos e coordenadas ausentes são erros. Camadas em SRCs
+diferentes são recusadas, a menos que Reprojetar esteja marcado (somente no QGIS: a camada de
+referência é então transformada para o SRC da camada medida, alturas inalteradas).</translation>
+        </message>
+        <message>
+            <source>## Settings
+Declared precision and check-point survey sigma are per horizontal axis and in height (m;
+0 = not given). ASPRS classes in cm (0 = report the tightest class met); PEC-PCD scale
+denominator, equidistance (0 = the series' value) and declared class; project thresholds
+(vertical 0 = dz of Eq. 18 from the flight geometry "H m, B m, f mm, pixel um").</source>
+            <translation>## Configurações
+A precisão declarada e o sigma do levantamento dos pontos de verificação são por eixo
+horizontal e em altura (m; 0 = não informado). Classes ASPRS em cm (0 = relatar a classe mais
+rigorosa atendida); denominador da escala do PEC-PCD, equidistância (0 = o valor da série) e
+classe declarada; limiares do projeto (vertical 0 = dz da Eq. 18 a partir da geometria do voo
+"H m, B m, f mm, pixel um").</translation>
+        </message>
+        <message>
+            <source>## Outputs
+A self-contained HTML report (tables, verdicts, SVG plots), a JSON of every figure, a PointZ
+layer at the reference positions with id, group, dE, dN, dH, dHoriz, d3D, outlier, and the
+RMSE values as numeric outputs.</source>
+            <translation>## Saídas
+Um relatório HTML autocontido (tabelas, vereditos, gráficos SVG), um JSON com todos os valores,
+uma camada PointZ nas posições de referência com id, group, dE, dN, dH, dHoriz, d3D, outlier, e
+os valores de RMSE como saídas numéricas.</translation>
+        </message>
+        <message>
+            <source>Check-point table (CSV: id, e, n, h, e_ref, n_ref, h_ref, group)</source>
+            <translation>Tabela de pontos de verificação (CSV: id, e, n, h, e_ref, n_ref, h_ref, group)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Measured points</source>
+            <translation>Pontos medidos</translation>
+        </message>
+        <message>
+            <source>measured point table (CSV: id, e, n, h [, group]) or point layer</source>
+            <translation>tabela de pontos medidos (CSV: id, e, n, h [, group]) ou camada de pontos</translation>
+        </message>
+        <message>
+            <source>Measured id field</source>
+            <translation>Campo de identificador dos pontos medidos</translation>
+        </message>
+        <message>
+            <source>id column (default: id)</source>
+            <translation>coluna de identificador (padrão: id)</translation>
+        </message>
+        <message>
+            <source>Measured height field (empty: geometry Z)</source>
+            <translation>Campo de altura dos pontos medidos (vazio: Z da geometria)</translation>
+        </message>
+        <message>
+            <source>height column (default: h; in QGIS empty takes the geometry's Z)</source>
+            <translation>coluna de altura (padrão: h; no QGIS, vazio usa o Z da geometria)</translation>
+        </message>
+        <message>
+            <source>Reference points</source>
+            <translation>Pontos de referência</translation>
+        </message>
+        <message>
+            <source>reference point table (CSV: id, e, n, h [, group]) or point layer</source>
+            <translation>tabela de pontos de referência (CSV: id, e, n, h [, group]) ou camada de pontos</translation>
+        </message>
+        <message>
+            <source>Reference id field</source>
+            <translation>Campo de identificador dos pontos de referência</translation>
+        </message>
+        <message>
+            <source>Reference height field (empty: geometry Z)</source>
+            <translation>Campo de altura dos pontos de referência (vazio: Z da geometria)</translation>
+        </message>
+        <message>
+            <source>Group field (flight direction, model, block)</source>
+            <translation>Campo de grupo (direção de voo, modelo, bloco)</translation>
+        </message>
+        <message>
+            <source>group column (default: group)</source>
+            <translation>coluna de grupo (padrão: group)</translation>
+        </message>
+        <message>
+            <source>CRS of the check-point table</source>
+            <translation>SRC da tabela de pontos de verificação</translation>
+        </message>
+        <message>
+            <source>CRS of the coordinates (reported only)</source>
+            <translation>SRC das coordenadas (apenas relatado)</translation>
+        </message>
+        <message>
+            <source>Reproject the reference layer to the measured CRS</source>
+            <translation>Reprojetar a camada de referência para o SRC dos pontos medidos</translation>
+        </message>
+        <message>
+            <source>QGIS only: point tables carry no CRS</source>
+            <translation>Somente no QGIS: tabelas de pontos não têm SRC</translation>
+        </message>
+        <message>
+            <source>Significance level of the tests</source>
+            <translation>Nível de significância dos testes</translation>
+        </message>
+        <message>
+            <source>Declared precision per horizontal axis</source>
+            <translation>Precisão declarada por eixo horizontal</translation>
+        </message>
+        <message>
+            <source>Declared precision in height</source>
+            <translation>Precisão declarada em altura</translation>
+        </message>
+        <message>
+            <source>Check-point survey sigma per horizontal axis</source>
+            <translation>Sigma do levantamento dos pontos de verificação por eixo horizontal</translation>
+        </message>
+        <message>
+            <source>Check-point survey sigma in height</source>
+            <translation>Sigma do levantamento dos pontos de verificação em altura</translation>
+        </message>
+        <message>
+            <source>Outlier screening</source>
+            <translation>Triagem de outliers</translation>
+        </message>
+        <message>
+            <source>robust: modified z-score &gt; 3.5 (median/MAD)</source>
+            <translation>robusta: escore z modificado &gt; 3,5 (mediana/MAD)</translation>
+        </message>
+        <message>
+            <source>three sigma: |d - mean| &gt; 3 s</source>
+            <translation>três sigmas: |d - média| &gt; 3 s</translation>
+        </message>
+        <message>
+            <source>none</source>
+            <translation>nenhuma</translation>
+        </message>
+        <message>
+            <source>Exclude flagged outliers from the statistics</source>
+            <translation>Excluir das estatísticas os outliers marcados</translation>
+        </message>
+        <message>
+            <source>Standards</source>
+            <translation>Padrões</translation>
+        </message>
+        <message>
+            <source>ASPRS Positional Accuracy Standards, Edition 2 (2023)</source>
+            <translation>Padrões de Acurácia Posicional da ASPRS, Edição 2 (2023)</translation>
+        </message>
+        <message>
+            <source>NSSDA (FGDC-STD-007.3-1998)</source>
+            <translation>NSSDA (FGDC-STD-007.3-1998)</translation>
+        </message>
+        <message>
+            <source>PEC-PCD (Decreto 89.817 / ET-CQDG)</source>
+            <translation>PEC-PCD (Decreto 89.817 / ET-CQDG)</translation>
+        </message>
+        <message>
+            <source>Project threshold (Pedrosa &amp; dos Santos 2020: 0.40 m, dz of Eq. 18)</source>
+            <translation>Limiar do projeto (Pedrosa &amp; dos Santos 2020: 0,40 m, dz da Eq. 18)</translation>
+        </message>
+        <message>
+            <source>ASPRS horizontal class (0 = tightest met)</source>
+            <translation>Classe horizontal ASPRS (0 = a mais rigorosa atendida)</translation>
+        </message>
+        <message>
+            <source>ASPRS vertical class (0 = tightest met)</source>
+            <translation>Classe vertical ASPRS (0 = a mais rigorosa atendida)</translation>
+        </message>
+        <message>
+            <source>PEC-PCD scale denominator (1:N)</source>
+            <translation>Denominador da escala do PEC-PCD (1:N)</translation>
+        </message>
+        <message>
+            <source>PEC-PCD equidistance (0 = series value)</source>
+            <translation>Equidistância do PEC-PCD (0 = valor da série)</translation>
+        </message>
+        <message>
+            <source>PEC-PCD declared class</source>
+            <translation>Classe declarada do PEC-PCD</translation>
+        </message>
+        <message>
+            <source>Project planimetric threshold</source>
+            <translation>Limiar planimétrico do projeto</translation>
+        </message>
+        <message>
+            <source>Project vertical threshold (0 = Eq. 18)</source>
+            <translation>Limiar vertical do projeto (0 = Eq. 18)</translation>
+        </message>
+        <message>
+            <source>Flight geometry for Eq. 18: H, B, f, pixel</source>
+            <translation>Geometria do voo para a Eq. 18: H, B, f, pixel</translation>
+        </message>
+        <message>
+            <source>Check points with discrepancies</source>
+            <translation>Pontos de verificação com discrepâncias</translation>
+        </message>
+        <message>
+            <source>Accuracy report (HTML)</source>
+            <translation>Relatório de acurácia (HTML)</translation>
+        </message>
+        <message>
+            <source>HTML files (*.html)</source>
+            <translation>Arquivos HTML (*.html)</translation>
+        </message>
+        <message>
+            <source>Accuracy figures (JSON)</source>
+            <translation>Valores de acurácia (JSON)</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>RMSE_E (m)</source>
+            <translation>RMSE_E (m)</translation>
+        </message>
+        <message>
+            <source>RMSE_N (m)</source>
+            <translation>RMSE_N (m)</translation>
+        </message>
+        <message>
+            <source>RMSE_H (m)</source>
+            <translation>RMSE_H (m)</translation>
+        </message>
+        <message>
+            <source>RMSE_HORIZ (m)</source>
+            <translation>RMSE_HORIZ (m)</translation>
+        </message>
+        <message>
+            <source>RMSE_3D (m)</source>
+            <translation>RMSE_3D (m)</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:boresightcalibration</name>
+        <message>
+            <source>Boresight calibration</source>
+            <translation>Calibração de boresight</translation>
+        </message>
+        <message>
+            <source>Calibration</source>
+            <translation>Calibração</translation>
+        </message>
+        <message>
+            <source>boresight (and lever arm, interior) from LiDAR roof planes, lines and LCPs</source>
+            <translation>boresight (e braço de alavanca, orientação interior) a partir de planos de telhado, linhas e LCPs do LiDAR</translation>
+        </message>
+        <message>
+            <source>Estimates the angular misalignment (boresight) between the camera and the INS, per group of
+images, from image points on roofs whose geometry comes from LiDAR: plane-constrained tie
+points (a roof point in two or more images lying on its LiDAR plane), points on LiDAR
+ridge/hip lines (coplanarity, one image suffices), LiDAR control points (lcp, three-plane
+corners) and the single-image model of Pedrosa &amp; dos Santos (2020) (paper, its Eqs. 12-17;
+needs the cloud with plane ids). INS positions and attitudes are weighted observations (the
+INS grade); optionally the lever arm and the interior orientation are estimated. The
+adjustment runs in a local east-north-up frame with the rigorous navigation frame of each
+image.</source>
+            <translation>Estima o desalinhamento angular (boresight) entre a câmera e o INS, por grupo de imagens, a
+partir de pontos de imagem sobre telhados cuja geometria vem do LiDAR: pontos de enlace com
+restrição de plano (um ponto de telhado em duas ou mais imagens situado sobre o seu plano
+LiDAR), pontos sobre linhas de cumeeira/espigão do LiDAR (coplanaridade; uma imagem basta),
+pontos de controle LiDAR (lcp, cantos de três planos) e o modelo de imagem única de Pedrosa &amp;
+dos Santos (2020) (paper, suas Eqs. 12-17; requer a nuvem com os identificadores de plano). As
+posições e atitudes do INS são observações ponderadas (a classe do INS); opcionalmente, o braço
+de alavanca e a orientação interior são estimados. O ajustamento é feito em um referencial
+local leste-norte-acima, com o referencial de navegação rigoroso de cada imagem.</translation>
+        </message>
+        <message>
+            <source>Inputs: camera JSON, trajectory CSV (as Trajectory to exterior orientation), the mount with
+the initial boresight (degrees), the image observation CSV (image_id, point_id, col, row,
+sigma_px, type, target_id), and the plane / line / LCP tables of Extract roof planes and
+Create LiDAR control points and lines.</source>
+            <translation>Entradas: JSON da câmera, CSV da trajetória (como em Trajetória para orientação exterior), a
+montagem com o boresight inicial (graus), o CSV de observações de imagem (image_id, point_id,
+col, row, sigma_px, type, target_id) e as tabelas de planos / linhas / LCPs de Extrair planos
+de telhado e Criar pontos e linhas de controle LiDAR.</translation>
+        </message>
+        <message>
+            <source>Grouping: one boresight for all images, one per value of the trajectory's group column
+(flight line, direction or session) or one per heading octant.</source>
+            <translation>Agrupamento: um boresight para todas as imagens, um por valor da coluna de grupo da trajetória
+(faixa de voo, direção ou sessão) ou um por octante de rumo.</translation>
+        </message>
+        <message>
+            <source>Outputs: the boresight per group (CSV), the updated exterior orientation (CSV), the image
+residuals (a layer at each observation's ground position, and optionally CSV) and an HTML
+summary; a set-up that cannot determine the boresight is an error that names the
+parameters and why (the HTML then carries the diagnosis).</source>
+            <translation>Saídas: o boresight por grupo (CSV), a orientação exterior atualizada (CSV), os resíduos das
+imagens (uma camada na posição no terreno de cada observação e, opcionalmente, CSV) e um resumo
+HTML; uma configuração que não permite determinar o boresight é um erro que nomeia os
+parâmetros e o motivo (o HTML traz então o diagnóstico).</translation>
+        </message>
+        <message>
+            <source>## Checks of the result
+The run fails (nothing but the HTML summary, which says why, is written) when the
+adjustment did not converge, when its global test fails with sigma0 above the largest sigma0
+(the observations do not fit their sigmas), or when an estimated angle exceeds the largest
+plausible boresight. With Write the results even when the checks fail, the outputs are
+written and each starts with a warning (CSV: comment lines beginning with #).</source>
+            <translation>## Verificações do resultado
+A execução falha (nada é gravado além do resumo HTML, que diz o motivo) quando o ajustamento
+não convergiu, quando o seu teste global falha com sigma0 acima do maior sigma0 (as observações
+não se ajustam aos seus desvios-padrão), ou quando um ângulo estimado excede o maior boresight
+plausível. Com Gravar os resultados mesmo quando as verificações falham, as saídas são gravadas
+e cada uma começa com um aviso (CSV: linhas de comentário iniciadas por #).</translation>
+        </message>
+        <message>
+            <source>Camera (JSON)</source>
+            <translation>Câmera (JSON)</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>Trajectory table (CSV)</source>
+            <translation>Tabela da trajetória (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Mapping CRS</source>
+            <translation>SRC de mapeamento</translation>
+        </message>
+        <message>
+            <source>projected CRS of the trajectory and of the LiDAR tables</source>
+            <translation>SRC projetado da trajetória e das tabelas LiDAR</translation>
+        </message>
+        <message>
+            <source>Lever arm x,y,z</source>
+            <translation>Braço de alavanca x,y,z</translation>
+        </message>
+        <message>
+            <source>camera perspective centre in the INS body frame (x forward, y right, z down)</source>
+            <translation>centro perspectivo da câmera no referencial do corpo do INS (x para a frente, y para a direita, z para baixo)</translation>
+        </message>
+        <message>
+            <source>Camera mount</source>
+            <translation>Montagem da câmera</translation>
+        </message>
+        <message>
+            <source>nominal camera-to-body rotation; custom uses MOUNT_MATRIX</source>
+            <translation>rotação nominal da câmera para o corpo; custom usa MOUNT_MATRIX</translation>
+        </message>
+        <message>
+            <source>image_top_forward: image top towards the flight direction (nose)</source>
+            <translation>image_top_forward: topo da imagem no sentido do voo (nariz)</translation>
+        </message>
+        <message>
+            <source>image_right_forward: image right side towards the flight direction</source>
+            <translation>image_right_forward: lado direito da imagem no sentido do voo</translation>
+        </message>
+        <message>
+            <source>image_bottom_forward: image bottom towards the flight direction</source>
+            <translation>image_bottom_forward: base da imagem no sentido do voo</translation>
+        </message>
+        <message>
+            <source>image_left_forward: image left side towards the flight direction</source>
+            <translation>image_left_forward: lado esquerdo da imagem no sentido do voo</translation>
+        </message>
+        <message>
+            <source>custom: custom matrix (MOUNT_MATRIX)</source>
+            <translation>custom: matriz definida pelo usuário (MOUNT_MATRIX)</translation>
+        </message>
+        <message>
+            <source>Mount matrix R_c^b (9 numbers, row-major)</source>
+            <translation>Matriz de montagem R_c^b (9 números, por linhas)</translation>
+        </message>
+        <message>
+            <source>the nominal mount R_c^b when MOUNT is custom</source>
+            <translation>a montagem nominal R_c^b quando MOUNT é custom</translation>
+        </message>
+        <message>
+            <source>Boresight domega,dphi,dkappa</source>
+            <translation>Boresight domega,dphi,dkappa</translation>
+        </message>
+        <message>
+            <source>small misalignment about the camera axes x, y, z (a larger rotation belongs in MOUNT)</source>
+            <translation>pequeno desalinhamento em torno dos eixos x, y, z da câmera (uma rotação maior pertence a MOUNT)</translation>
+        </message>
+        <message>
+            <source>Image observations (CSV)</source>
+            <translation>Observações de imagem (CSV)</translation>
+        </message>
+        <message>
+            <source>Plane table (CSV)</source>
+            <translation>Tabela de planos (CSV)</translation>
+        </message>
+        <message>
+            <source>Line table (CSV)</source>
+            <translation>Tabela de linhas (CSV)</translation>
+        </message>
+        <message>
+            <source>LiDAR control point table (CSV)</source>
+            <translation>Tabela de pontos de controle LiDAR (CSV)</translation>
+        </message>
+        <message>
+            <source>Cloud with plane ids (LAS/LAZ, paper mode only)</source>
+            <translation>Nuvem com identificadores de plano (LAS/LAZ, somente no modo paper)</translation>
+        </message>
+        <message>
+            <source>LAS/LAZ files (*.las *.laz *.LAS *.LAZ)</source>
+            <translation>Arquivos LAS/LAZ (*.las *.laz *.LAS *.LAZ)</translation>
+        </message>
+        <message>
+            <source>Boresight groups</source>
+            <translation>Grupos de boresight</translation>
+        </message>
+        <message>
+            <source>one boresight for all images</source>
+            <translation>um boresight para todas as imagens</translation>
+        </message>
+        <message>
+            <source>one per trajectory group (flight line, direction, session)</source>
+            <translation>um por grupo da trajetória (faixa de voo, direção, sessão)</translation>
+        </message>
+        <message>
+            <source>one per heading direction (octant)</source>
+            <translation>um por direção de rumo (octante)</translation>
+        </message>
+        <message>
+            <source>Control types</source>
+            <translation>Tipos de controle</translation>
+        </message>
+        <message>
+            <source>Estimate the lever arm</source>
+            <translation>Estimar o braço de alavanca</translation>
+        </message>
+        <message>
+            <source>Estimate focal length and principal point</source>
+            <translation>Estimar a distância focal e o ponto principal</translation>
+        </message>
+        <message>
+            <source>INS grade</source>
+            <translation>Classe do INS</translation>
+        </message>
+        <message>
+            <source>Applanix POS AV 310</source>
+            <translation>Applanix POS AV 310</translation>
+        </message>
+        <message>
+            <source>custom (INS sigmas)</source>
+            <translation>personalizada (sigmas do INS)</translation>
+        </message>
+        <message>
+            <source>Custom INS sigmas: horizontal, vertical, roll/pitch, heading</source>
+            <translation>Sigmas do INS personalizados: horizontal, vertical, rolagem/arfagem, rumo</translation>
+        </message>
+        <message>
+            <source>Data snooping (Baarda)</source>
+            <translation>Detecção de erros grosseiros (data snooping de Baarda)</translation>
+        </message>
+        <message>
+            <source>Largest plausible boresight angle</source>
+            <translation>Maior ângulo de boresight plausível</translation>
+        </message>
+        <message>
+            <source>an estimated angle beyond this fails the run (wrong MOUNT, image ids or observations)</source>
+            <translation>um ângulo estimado além deste faz a execução falhar (MOUNT, identificadores de imagem ou observações errados)</translation>
+        </message>
+        <message>
+            <source>Largest sigma0 when the global test fails</source>
+            <translation>Maior sigma0 quando o teste global falha</translation>
+        </message>
+        <message>
+            <source>a failed global test with sigma0 above this fails the run (wrong sigma_px or INS grade, or blunders data snooping did not catch)</source>
+            <translation>um teste global reprovado com sigma0 acima deste faz a execução falhar (sigma_px ou classe do INS errados, ou erros grosseiros que o data snooping não detectou)</translation>
+        </message>
+        <message>
+            <source>Write the results even when the checks fail</source>
+            <translation>Gravar os resultados mesmo quando as verificações falham</translation>
+        </message>
+        <message>
+            <source>no convergence, global test beyond MAX_SIGMA0 or boresight beyond MAX_BORESIGHT: write the outputs anyway, each with a warning at its top</source>
+            <translation>sem convergência, teste global além de MAX_SIGMA0 ou boresight além de MAX_BORESIGHT: grava as saídas mesmo assim, cada uma com um aviso no início</translation>
+        </message>
+        <message>
+            <source>Boresight per group (CSV)</source>
+            <translation>Boresight por grupo (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Image residuals</source>
+            <translation>Resíduos das imagens</translation>
+        </message>
+        <message>
+            <source>Image residuals (CSV)</source>
+            <translation>Resíduos das imagens (CSV)</translation>
+        </message>
+        <message>
+            <source>Updated exterior orientation (CSV)</source>
+            <translation>Orientação exterior atualizada (CSV)</translation>
+        </message>
+        <message>
+            <source>Summary (HTML)</source>
+            <translation>Resumo (HTML)</translation>
+        </message>
+        <message>
+            <source>HTML files (*.html)</source>
+            <translation>Arquivos HTML (*.html)</translation>
+        </message>
+        <message>
+            <source>Sigma0 a-posteriori</source>
+            <translation>Sigma0 a posteriori</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:bundleadjustment</name>
+        <message>
+            <source>Bundle adjustment with self-calibration</source>
+            <translation>Ajustamento por feixes de raios com autocalibração</translation>
+        </message>
+        <message>
+            <source>Aerotriangulation</source>
+            <translation>Aerotriangulação</translation>
+        </message>
+        <message>
+            <source>exterior orientations, object points, interior orientation and APs of a block</source>
+            <translation>orientações exteriores, pontos-objeto, orientação interior e parâmetros adicionais de um bloco</translation>
+        </message>
+        <message>
+            <source>Bundle adjustment of a block of frame images: the exterior orientation of every image, the
+object points (tie, control with sigmas; check points kept out and reported), and per camera
+the interior orientation (principal distance, principal point) with the additional
+parameters (APs) of one family, in one rigorous least-squares adjustment in a local
+east-north-up frame (results in the mapping CRS).</source>
+            <translation>Ajustamento por feixes de raios de um bloco de imagens de quadro: a orientação exterior de cada
+imagem, os pontos-objeto (de enlace, de controle com seus desvios-padrão; os pontos de
+verificação ficam de fora e são relatados) e, por câmera, a orientação interior (distância
+principal, ponto principal) com os parâmetros adicionais (PAs) de uma família, em um único
+ajustamento rigoroso por mínimos quadrados em um referencial local leste-norte-acima
+(resultados no SRC de mapeamento).</translation>
+        </message>
+        <message>
+            <source>AP families (Lima, Debiasi &amp; Menezes compare them on a UAV block): lens_k1k2 (radial k1, k2),
+bauer (3: radial, affinity, shear; Bauer &amp; Mueller 1972), jacobsen (4), ebner (12, orthogonal
+on a 3 x 3 grid; Ebner 1976), brown (14-term polynomial; Brown 1976 as in Murai et al. 1984),
+conrady_brown (physical k1 k2 k3 p1 p2); none holds the camera's own lens model. all runs every
+family on the same block, writes the comparison table (mean, standard deviation and RMS of the
+check-point discrepancies, sigma0, significant APs) and the outputs of the best model.</source>
+            <translation>Famílias de PAs (Lima, Debiasi &amp; Menezes as comparam em um bloco de VANT): lens_k1k2 (radial
+k1, k2), bauer (3: radial, afinidade, cisalhamento; Bauer &amp; Mueller 1972), jacobsen (4), ebner
+(12, ortogonais em uma grade 3 x 3; Ebner 1976), brown (polinômio de 14 termos; Brown 1976 como
+em Murai et al. 1984), conrady_brown (físicos k1 k2 k3 p1 p2); none mantém o modelo de lente da
+própria câmera. all executa todas as famílias no mesmo bloco, grava a tabela comparativa
+(média, desvio-padrão e RMS das discrepâncias nos pontos de verificação, sigma0, PAs
+significativos) e as saídas do melhor modelo.</translation>
+        </message>
+        <message>
+            <source>Inputs: camera JSON (one camera, or {"cameras": [...]} with a camera column in the EO or
+observation table), image observations (image_id, point_id, col, row, sigma_px), ground
+points (point_id, X, Y, Z, sx, sy, sz, role = control | check), optionally exterior
+orientations: approximate (e.g. direct georeferencing, a few degrees and metres off), or
+observed when the table has sigma columns (GNSS/INS with sigmas; lever arm and boresight
+corrections can be estimated). Without orientations the images that see four or more control
+points are resected and the rest of the block grows by intersection and resection.</source>
+            <translation>Entradas: JSON da câmera (uma câmera, ou {"cameras": [...]} com uma coluna camera na tabela de
+OE ou de observações), observações de imagem (image_id, point_id, col, row, sigma_px), pontos
+de apoio (point_id, X, Y, Z, sx, sy, sz, role = control | check) e, opcionalmente, orientações
+exteriores: aproximadas (por exemplo, da georreferenciação direta, com alguns graus e metros de
+erro) ou observadas quando a tabela tem colunas de desvio-padrão (GNSS/INS com desvios-padrão;
+correções do braço de alavanca e do boresight podem ser estimadas). Sem orientações, as imagens
+que veem quatro ou mais pontos de controle passam por resseção e o restante do bloco cresce por
+interseção e resseção.</translation>
+        </message>
+        <message>
+            <source>Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
+and |correlation| above 0.9 flagged; automatic selection drops insignificant or too
+correlated APs one at a time and says which and why. Outliers: robust reweighting (Huber or
+Cauchy) then Baarda's data snooping. Datum: control points and/or observed orientations, or a
+free network (inner or minimal constraints). Tables that cannot make a block (an image
+without observations, a tie point seen once, duplicated rows, unknown images, ground points
+in another CRS, unconnected parts) are refused with the file and row named.</source>
+            <translation>Estatísticas: sigma0, o teste global qui-quadrado, desvios-padrão e correlações; teste t de
+cada PA e |correlação| acima de 0,9 marcada; a seleção automática descarta, um por vez, os PAs
+não significativos ou correlacionados demais e diz quais e por quê. Outliers: reponderação
+robusta (Huber ou Cauchy) seguida do data snooping de Baarda. Referencial (datum): pontos de
+controle e/ou orientações observadas, ou uma rede livre (injunções internas ou mínimas).
+Tabelas que não formam um bloco (uma imagem sem observações, um ponto de enlace visto uma só
+vez, linhas repetidas, imagens desconhecidas, pontos de apoio em outro SRC, partes desconexas)
+são recusadas, com o arquivo e a linha indicados.</translation>
+        </message>
+        <message>
+            <source>Camera (JSON; several as {"cameras": [...]})</source>
+            <translation>Câmera (JSON; várias como {"cameras": [...]})</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>Image observations (CSV)</source>
+            <translation>Observações de imagem (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Ground points (CSV: point_id,X,Y,Z,sx,sy,sz,role)</source>
+            <translation>Pontos de apoio (CSV: point_id,X,Y,Z,sx,sy,sz,role)</translation>
+        </message>
+        <message>
+            <source>Exterior orientation, approximate or observed (CSV)</source>
+            <translation>Orientação exterior, aproximada ou observada (CSV)</translation>
+        </message>
+        <message>
+            <source>approximate values, or observations when the sigma columns are filled</source>
+            <translation>valores aproximados, ou observações quando as colunas de desvio-padrão estão preenchidas</translation>
+        </message>
+        <message>
+            <source>EO sigmas when the table has none: X, Y, Z, omega, phi, kappa</source>
+            <translation>Desvios-padrão da OE quando a tabela não os tem: X, Y, Z, omega, phi, kappa</translation>
+        </message>
+        <message>
+            <source>makes an EO table without sigma columns (e.g. from trajectorytoeo) observations; empty: approximate values only</source>
+            <translation>torna observações uma tabela de OE sem colunas de desvio-padrão (por exemplo, de trajectorytoeo); vazio: apenas valores aproximados</translation>
+        </message>
+        <message>
+            <source>Mapping CRS</source>
+            <translation>SRC de mapeamento</translation>
+        </message>
+        <message>
+            <source>projected CRS of the ground points and exterior orientations</source>
+            <translation>SRC projetado dos pontos de apoio e das orientações exteriores</translation>
+        </message>
+        <message>
+            <source>Additional parameters</source>
+            <translation>Parâmetros adicionais</translation>
+        </message>
+        <message>
+            <source>none (camera fixed)</source>
+            <translation>nenhum (câmera fixa)</translation>
+        </message>
+        <message>
+            <source>lens distortion k1, k2</source>
+            <translation>distorção da lente k1, k2</translation>
+        </message>
+        <message>
+            <source>Bauer (3)</source>
+            <translation>Bauer (3)</translation>
+        </message>
+        <message>
+            <source>Jacobsen (4)</source>
+            <translation>Jacobsen (4)</translation>
+        </message>
+        <message>
+            <source>Ebner (12)</source>
+            <translation>Ebner (12)</translation>
+        </message>
+        <message>
+            <source>Brown (14)</source>
+            <translation>Brown (14)</translation>
+        </message>
+        <message>
+            <source>Conrady-Brown k1 k2 k3 p1 p2</source>
+            <translation>Conrady-Brown k1 k2 k3 p1 p2</translation>
+        </message>
+        <message>
+            <source>all (compare every family)</source>
+            <translation>todas (comparar todas as famílias)</translation>
+        </message>
+        <message>
+            <source>Estimate principal distance and point</source>
+            <translation>Estimar a distância principal e o ponto principal</translation>
+        </message>
+        <message>
+            <source>Drop insignificant or correlated APs</source>
+            <translation>Descartar PAs não significativos ou correlacionados</translation>
+        </message>
+        <message>
+            <source>Robust reweighting before data snooping</source>
+            <translation>Reponderação robusta antes do data snooping</translation>
+        </message>
+        <message>
+            <source>Data snooping (Baarda)</source>
+            <translation>Detecção de erros grosseiros (data snooping de Baarda)</translation>
+        </message>
+        <message>
+            <source>Datum</source>
+            <translation>Referencial (datum)</translation>
+        </message>
+        <message>
+            <source>control points / observed EO</source>
+            <translation>pontos de controle / OE observada</translation>
+        </message>
+        <message>
+            <source>free network: inner constraints</source>
+            <translation>rede livre: injunções internas</translation>
+        </message>
+        <message>
+            <source>free network: minimal constraints</source>
+            <translation>rede livre: injunções mínimas</translation>
+        </message>
+        <message>
+            <source>Estimate lever arm and boresight corrections</source>
+            <translation>Estimar correções do braço de alavanca e do boresight</translation>
+        </message>
+        <message>
+            <source>needs observed exterior orientations</source>
+            <translation>requer orientações exteriores observadas</translation>
+        </message>
+        <message>
+            <source>Adjusted exterior orientation (CSV)</source>
+            <translation>Orientação exterior ajustada (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Adjusted camera (JSON)</source>
+            <translation>Câmera ajustada (JSON)</translation>
+        </message>
+        <message>
+            <source>Object points (CSV)</source>
+            <translation>Pontos-objeto (CSV)</translation>
+        </message>
+        <message>
+            <source>Object points</source>
+            <translation>Pontos-objeto</translation>
+        </message>
+        <message>
+            <source>Image residuals with w-tests (CSV)</source>
+            <translation>Resíduos das imagens com testes w (CSV)</translation>
+        </message>
+        <message>
+            <source>Check-point discrepancies (CSV)</source>
+            <translation>Discrepâncias nos pontos de verificação (CSV)</translation>
+        </message>
+        <message>
+            <source>AP model comparison (CSV)</source>
+            <translation>Comparação dos modelos de PAs (CSV)</translation>
+        </message>
+        <message>
+            <source>Summary (HTML)</source>
+            <translation>Resumo (HTML)</translation>
+        </message>
+        <message>
+            <source>HTML files (*.html)</source>
+            <translation>Arquivos HTML (*.html)</translation>
+        </message>
+        <message>
+            <source>Sigma0 a-posteriori</source>
+            <translation>Sigma0 a posteriori</translation>
+        </message>
+        <message>
+            <source>Check-point RMS 3D (m)</source>
+            <translation>RMS 3D nos pontos de verificação (m)</translation>
+        </message>
+        <message>
+            <source>AP model of the outputs</source>
+            <translation>Modelo de PAs das saídas</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:createlcps</name>
+        <message>
+            <source>Create LiDAR control points and lines</source>
+            <translation>Criar pontos e linhas de controle LiDAR</translation>
+        </message>
+        <message>
+            <source>LiDAR</source>
+            <translation>LiDAR</translation>
+        </message>
+        <message>
+            <source>LiDAR control points and lines from intersecting roof planes</source>
+            <translation>pontos e linhas de controle LiDAR a partir da interseção de planos de telhado</translation>
+        </message>
+        <message>
+            <source>Intersects roof planes found by Extract roof planes: three planes meeting at a roof corner
+give a LiDAR control point (LCP), two adjacent planes give a 3D line (ridge, hip, valley or
+other), each with a covariance propagated from the plane fits.</source>
+            <translation>Intersecta os planos de telhado encontrados por Extrair planos de telhado: três planos que se
+encontram em um canto de telhado dão um ponto de controle LiDAR (LCP), dois planos adjacentes
+dão uma linha 3D (cumeeira, espigão, rincão ou outra), cada um com uma covariância propagada a
+partir dos ajustes dos planos.</translation>
+        </message>
+        <message>
+            <source>Planes: the plane table CSV; Cloud: the LAS/LAZ written by the same algorithm (with its
+plane_id dimension). Two planes are adjacent when their points come within delta of each
+other along a common boundary at least min boundary long. A corner is kept only when every
+pair of its normals differ by at least min angle, the 3x3 system is well conditioned (max
+condition) and the point lies within max support distance of the points of each plane; where
+more than three planes meet (a pyramid apex) the most precise triple is kept. Lines are
+clipped to the common support of the two planes.</source>
+            <translation>Planos: o CSV da tabela de planos; Nuvem: o LAS/LAZ gravado pelo mesmo algoritmo (com a sua
+dimensão plane_id). Dois planos são adjacentes quando seus pontos chegam a menos de delta uns
+dos outros ao longo de uma fronteira comum de comprimento mínimo min boundary. Um canto só é
+mantido quando cada par de suas normais difere de pelo menos o ângulo mínimo, o sistema 3x3 é
+bem condicionado (número de condição máximo) e o ponto está a menos da distância máxima de
+suporte dos pontos de cada plano; onde mais de três planos se encontram (o ápice de uma
+pirâmide), a tripla mais precisa é mantida. As linhas são recortadas ao suporte comum dos dois
+planos.</translation>
+        </message>
+        <message>
+            <source>Distances are in the cloud's CRS unit (e.g. feet for a CRS in feet) unless distance unit is
+metres; the outputs are in the CRS unit. Optionally give your own plane-id triples
+("1,2,3; 4,5,6") or pairs ("1,2; 2,3") instead of the automatic ones. Rejected candidates
+are listed in the log with the reason.</source>
+            <translation>As distâncias estão na unidade do SRC da nuvem (por exemplo, pés para um SRC em pés), a menos
+que a unidade de distância seja metros; as saídas estão na unidade do SRC. Opcionalmente,
+informe suas próprias triplas ("1,2,3; 4,5,6") ou pares ("1,2; 2,3") de identificadores de
+plano em vez dos automáticos. Os candidatos rejeitados são listados no log com o motivo.</translation>
+        </message>
+        <message>
+            <source>Plane table (CSV)</source>
+            <translation>Tabela de planos (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Cloud with plane ids (LAS/LAZ)</source>
+            <translation>Nuvem com identificadores de plano (LAS/LAZ)</translation>
+        </message>
+        <message>
+            <source>LAS/LAZ files (*.las *.laz *.LAS *.LAZ)</source>
+            <translation>Arquivos LAS/LAZ (*.las *.laz *.LAS *.LAZ)</translation>
+        </message>
+        <message>
+            <source>CRS (overrides the file's)</source>
+            <translation>SRC (substitui o do arquivo)</translation>
+        </message>
+        <message>
+            <source>the cloud's CRS when the file has none or a wrong one (EPSG:xxxx or WKT)</source>
+            <translation>o SRC da nuvem quando o arquivo não tem nenhum ou tem um errado (EPSG:xxxx ou WKT)</translation>
+        </message>
+        <message>
+            <source>Distance unit</source>
+            <translation>Unidade de distância</translation>
+        </message>
+        <message>
+            <source>unit of the length parameters: the cloud's CRS unit (e.g. international feet) or metres, converted</source>
+            <translation>unidade dos parâmetros de comprimento: a unidade do SRC da nuvem (por exemplo, pés internacionais) ou metros, convertidos</translation>
+        </message>
+        <message>
+            <source>cloud CRS units</source>
+            <translation>unidades do SRC da nuvem</translation>
+        </message>
+        <message>
+            <source>metres</source>
+            <translation>metros</translation>
+        </message>
+        <message>
+            <source>Adjacency distance delta</source>
+            <translation>Distância de adjacência delta</translation>
+        </message>
+        <message>
+            <source>Minimum common boundary</source>
+            <translation>Fronteira comum mínima</translation>
+        </message>
+        <message>
+            <source>Maximum distance of a corner from each plane's points</source>
+            <translation>Distância máxima de um canto aos pontos de cada plano</translation>
+        </message>
+        <message>
+            <source>Minimum angle between normals</source>
+            <translation>Ângulo mínimo entre as normais</translation>
+        </message>
+        <message>
+            <source>Maximum condition number</source>
+            <translation>Número de condição máximo</translation>
+        </message>
+        <message>
+            <source>Plane triples</source>
+            <translation>Triplas de planos</translation>
+        </message>
+        <message>
+            <source>plane ids "1,2,3; 4,5,6" (default: automatic)</source>
+            <translation>identificadores de plano "1,2,3; 4,5,6" (padrão: automático)</translation>
+        </message>
+        <message>
+            <source>Plane pairs</source>
+            <translation>Pares de planos</translation>
+        </message>
+        <message>
+            <source>plane ids "1,2; 2,3" (default: automatic)</source>
+            <translation>identificadores de plano "1,2; 2,3" (padrão: automático)</translation>
+        </message>
+        <message>
+            <source>LiDAR control points</source>
+            <translation>Pontos de controle LiDAR</translation>
+        </message>
+        <message>
+            <source>LiDAR control lines</source>
+            <translation>Linhas de controle LiDAR</translation>
+        </message>
+        <message>
+            <source>Control point table (CSV)</source>
+            <translation>Tabela de pontos de controle (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Control line table (CSV)</source>
+            <translation>Tabela de linhas de controle (CSV)</translation>
+        </message>
+        <message>
+            <source>Plane adjacency graph (CSV)</source>
+            <translation>Grafo de adjacência dos planos (CSV)</translation>
+        </message>
+        <message>
+            <source>Number of LCPs</source>
+            <translation>Número de LCPs</translation>
+        </message>
+        <message>
+            <source>Number of lines</source>
+            <translation>Número de linhas</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:extractroofplanes</name>
+        <message>
+            <source>Extract roof planes</source>
+            <translation>Extrair planos de telhado</translation>
+        </message>
+        <message>
+            <source>LiDAR</source>
+            <translation>LiDAR</translation>
+        </message>
+        <message>
+            <source>roof planes with their precision from a classified LAS/LAZ cloud</source>
+            <translation>planos de telhado com a sua precisão a partir de uma nuvem LAS/LAZ classificada</translation>
+        </message>
+        <message>
+            <source>Extracts roof planes from a LiDAR cloud classified by a ground filter (Pedrosa &amp; dos Santos
+2020, section 2.1): for every point, RANSAC on its K nearest neighbours with tolerance
+epsilon; the point is kept when the plane has the minimum support, the point lies on it and
+its slope is between alpha and beta (rejects vegetation and walls). Kept points are grown into
+regions (distance to the region's plane and normal angle), small regions dropped, ridge and
+eave points attached to the nearest plane, coplanar neighbours merged. Each plane is fitted by
+the weighted eigen method of Pathak et al. (2010) on centred coordinates, with the full
+covariance of (a, b, c, d) and the standard deviation of d (Khoshelham 2016). The same input
+and seed give the same planes.</source>
+            <translation>Extrai planos de telhado de uma nuvem LiDAR classificada por um filtro de terreno (Pedrosa &amp;
+dos Santos 2020, seção 2.1): para cada ponto, RANSAC sobre os seus K vizinhos mais próximos com
+tolerância epsilon; o ponto é mantido quando o plano tem o suporte mínimo, o ponto está sobre
+ele e a sua declividade está entre alfa e beta (rejeita vegetação e paredes). Os pontos
+mantidos crescem em regiões (distância ao plano da região e ângulo da normal), regiões pequenas
+são descartadas, pontos de cumeeira e de beiral são ligados ao plano mais próximo e vizinhos
+coplanares são fundidos. Cada plano é ajustado pelo método de autovalores ponderado de Pathak
+et al. (2010) sobre coordenadas centradas, com a covariância completa de (a, b, c, d) e o
+desvio-padrão de d (Khoshelham 2016). A mesma entrada e a mesma semente dão os mesmos planos.</translation>
+        </message>
+        <message>
+            <source>## Points
+Non-ground (class != 2), the listed Classes (e.g. 6), or all points (a cloud that is already
+non-ground). CRS overrides the file's CRS.</source>
+            <translation>## Pontos
+Não terreno (classe != 2), as Classes listadas (por exemplo, 6) ou todos os pontos (uma nuvem
+que já é não terreno). SRC substitui o SRC do arquivo.</translation>
+        </message>
+        <message>
+            <source>## Units
+With Distance unit = cloud CRS units, epsilon and the outline cell are in the unit of the
+cloud's CRS (international feet for Autzen); with metres they are converted. Plane
+parameters, centroids, rms and sigma_d are always in the CRS unit (the UNIT output names it).</source>
+            <translation>## Unidades
+Com Unidade de distância = unidades do SRC da nuvem, epsilon e a célula do contorno estão na
+unidade do SRC da nuvem (pés internacionais para Autzen); com metros, são convertidos. Os
+parâmetros dos planos, centroides, rms e sigma_d estão sempre na unidade do SRC (a saída UNIT a
+nomeia).</translation>
+        </message>
+        <message>
+            <source>## Outputs
+Plane outlines (PolygonZ, concave hull for display) with every attribute; the plane table
+CSV: id, a, b, c, d (n.p + d = 0, normal up), centroid_x/y/z, n_points, rms, sigma_d,
+slope_deg, aspect_deg (clockwise from grid north, downslope), and the 10 upper-triangle
+covariance elements cov_aa ... cov_dd; optionally a copy of the cloud with the int32 extra
+dimension plane_id (-1 = none). A cloud without roofs gives zero planes and a message, not an
+error.</source>
+            <translation>## Saídas
+Contornos dos planos (PolygonZ, envoltória côncava para exibição) com todos os atributos; o CSV
+da tabela de planos: id, a, b, c, d (n.p + d = 0, normal para cima), centroid_x/y/z, n_points,
+rms, sigma_d, slope_deg, aspect_deg (no sentido horário a partir do norte da quadrícula, no
+sentido do declive) e os 10 elementos do triângulo superior da covariância cov_aa ... cov_dd;
+opcionalmente, uma cópia da nuvem com a dimensão extra int32 plane_id (-1 = nenhum). Uma nuvem
+sem telhados dá zero planos e uma mensagem, não um erro.</translation>
+        </message>
+        <message>
+            <source>Point cloud (LAS/LAZ)</source>
+            <translation>Nuvem de pontos (LAS/LAZ)</translation>
+        </message>
+        <message>
+            <source>LAS/LAZ files (*.las *.laz *.LAS *.LAZ)</source>
+            <translation>Arquivos LAS/LAZ (*.las *.laz *.LAS *.LAZ)</translation>
+        </message>
+        <message>
+            <source>CRS (overrides the file's)</source>
+            <translation>SRC (substitui o do arquivo)</translation>
+        </message>
+        <message>
+            <source>the cloud's CRS when the file has none or a wrong one (EPSG:xxxx or WKT)</source>
+            <translation>o SRC da nuvem quando o arquivo não tem nenhum ou tem um errado (EPSG:xxxx ou WKT)</translation>
+        </message>
+        <message>
+            <source>Distance unit</source>
+            <translation>Unidade de distância</translation>
+        </message>
+        <message>
+            <source>unit of the length parameters: the cloud's CRS unit (e.g. international feet) or metres, converted</source>
+            <translation>unidade dos parâmetros de comprimento: a unidade do SRC da nuvem (por exemplo, pés internacionais) ou metros, convertidos</translation>
+        </message>
+        <message>
+            <source>cloud CRS units</source>
+            <translation>unidades do SRC da nuvem</translation>
+        </message>
+        <message>
+            <source>metres</source>
+            <translation>metros</translation>
+        </message>
+        <message>
+            <source>Points</source>
+            <translation>Pontos</translation>
+        </message>
+        <message>
+            <source>non-ground (class != 2)</source>
+            <translation>não terreno (classe != 2)</translation>
+        </message>
+        <message>
+            <source>the classes below</source>
+            <translation>as classes abaixo</translation>
+        </message>
+        <message>
+            <source>all</source>
+            <translation>todos</translation>
+        </message>
+        <message>
+            <source>Classes (e.g. 6)</source>
+            <translation>Classes (por exemplo, 6)</translation>
+        </message>
+        <message>
+            <source>LAS classes searched when POINTS is classes, e.g. 6 or 1,6</source>
+            <translation>classes LAS pesquisadas quando POINTS é classes, por exemplo, 6 ou 1,6</translation>
+        </message>
+        <message>
+            <source>Neighbours K of the local RANSAC</source>
+            <translation>Vizinhos K do RANSAC local</translation>
+        </message>
+        <message>
+            <source>Point-to-plane tolerance epsilon</source>
+            <translation>Tolerância ponto-plano epsilon</translation>
+        </message>
+        <message>
+            <source>Minimum support of a local plane</source>
+            <translation>Suporte mínimo de um plano local</translation>
+        </message>
+        <message>
+            <source>RANSAC triplets per point</source>
+            <translation>Triplas do RANSAC por ponto</translation>
+        </message>
+        <message>
+            <source>Minimum slope alpha</source>
+            <translation>Declividade mínima alfa</translation>
+        </message>
+        <message>
+            <source>Maximum slope beta</source>
+            <translation>Declividade máxima beta</translation>
+        </message>
+        <message>
+            <source>Normal angle tolerance</source>
+            <translation>Tolerância do ângulo das normais</translation>
+        </message>
+        <message>
+            <source>Minimum points per plane</source>
+            <translation>Mínimo de pontos por plano</translation>
+        </message>
+        <message>
+            <source>Outline raster cell (0 = auto)</source>
+            <translation>Célula do raster de contorno (0 = automática)</translation>
+        </message>
+        <message>
+            <source>Random seed</source>
+            <translation>Semente aleatória</translation>
+        </message>
+        <message>
+            <source>Roof planes</source>
+            <translation>Planos de telhado</translation>
+        </message>
+        <message>
+            <source>Plane table (CSV)</source>
+            <translation>Tabela de planos (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Point cloud with plane_id</source>
+            <translation>Nuvem de pontos com plane_id</translation>
+        </message>
+        <message>
+            <source>LAZ files (*.laz);;LAS files (*.las)</source>
+            <translation>Arquivos LAZ (*.laz);;Arquivos LAS (*.las)</translation>
+        </message>
+        <message>
+            <source>Number of planes</source>
+            <translation>Número de planos</translation>
+        </message>
+        <message>
+            <source>Unit of the lengths</source>
+            <translation>Unidade dos comprimentos</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:extracttlstargets</name>
+        <message>
+            <source>Extract TLS targets from scans</source>
+            <translation>Extrair alvos TLS das varreduras</translation>
+        </message>
+        <message>
+            <source>Calibration</source>
+            <translation>Calibração</translation>
+        </message>
+        <message>
+            <source>sphere or checkerboard target centres with covariance from laser scans</source>
+            <translation>centros de alvos esféricos ou em tabuleiro de xadrez, com covariância, a partir de varreduras laser</translation>
+        </message>
+        <message>
+            <source>Finds the targets in each scan and writes their centres in the scanner frame with their
+3 x 3 covariance: the observation table of TLS registration and self-calibration.</source>
+            <translation>Encontra os alvos em cada varredura e grava os seus centros no referencial do escâner com a sua
+covariância 3 x 3: a tabela de observações do registro e da autocalibração TLS.</translation>
+        </message>
+        <message>
+            <source>Scans: one station per file (LAS/LAZ, PLY, or E57 with the optional pye57 package), points
+in the scanner's own frame in metres (the scanner at the origin, as exported for a single
+station, not registered); the station id is the file name without its suffix.</source>
+            <translation>Varreduras: uma estação por arquivo (LAS/LAZ, PLY, ou E57 com o pacote opcional pye57), pontos
+no referencial próprio do escâner em metros (o escâner na origem, como exportado para uma
+estação isolada, não registrada); o identificador da estação é o nome do arquivo sem a
+extensão.</translation>
+        </message>
+        <message>
+            <source>Spheres of a known radius: every point votes for the centre along its normal, the peaks are
+verified by RANSAC (Fischler &amp; Bolles 1981) and a least-squares fit with each point's
+covariance (range along the beam, angles across it). Checkerboards (2 x 2 pattern of a known
+half size): RANSAC plane and a least-squares fit of the intensity pattern; their reported
+sigma is 2-3 times optimistic on simulations (the centre itself within 0.5 mm).</source>
+            <translation>Esferas de raio conhecido: cada ponto vota no centro ao longo da sua normal, os picos são
+verificados por RANSAC (Fischler &amp; Bolles 1981) e por um ajuste por mínimos quadrados com a
+covariância de cada ponto (distância ao longo do feixe, ângulos transversais a ele). Tabuleiros
+de xadrez (padrão 2 x 2 de meio lado conhecido): plano por RANSAC e ajuste por mínimos
+quadrados do padrão de intensidade; o desvio-padrão relatado é 2-3 vezes otimista em simulações
+(o próprio centro a menos de 0,5 mm).</translation>
+        </message>
+        <message>
+            <source>Ids: targets are matched between scans by their mutual distances (a rigid motion keeps them),
+and take the ids of CONTROL points when given (matched the same way).</source>
+            <translation>Identificadores: os alvos são associados entre varreduras pelas suas distâncias mútuas (um
+movimento rígido as preserva) e recebem os identificadores dos pontos de CONTROLE quando
+informados (associados da mesma maneira).</translation>
+        </message>
+        <message>
+            <source>Scans (LAS/LAZ, PLY, E57; one station per file)</source>
+            <translation>Varreduras (LAS/LAZ, PLY, E57; uma estação por arquivo)</translation>
+        </message>
+        <message>
+            <source>Target kind</source>
+            <translation>Tipo de alvo</translation>
+        </message>
+        <message>
+            <source>Sphere radius</source>
+            <translation>Raio da esfera</translation>
+        </message>
+        <message>
+            <source>Checkerboard half size</source>
+            <translation>Meio lado do tabuleiro de xadrez</translation>
+        </message>
+        <message>
+            <source>Scan point noise: range, angle</source>
+            <translation>Ruído dos pontos da varredura: distância, ângulo</translation>
+        </message>
+        <message>
+            <source>Distance tolerance of the matching</source>
+            <translation>Tolerância de distância da associação</translation>
+        </message>
+        <message>
+            <source>Control targets (CSV, for their ids)</source>
+            <translation>Alvos de controle (CSV, para os seus identificadores)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Target observations (CSV)</source>
+            <translation>Observações dos alvos (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Target centres found (all scans)</source>
+            <translation>Centros de alvos encontrados (todas as varreduras)</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:groundfilter</name>
+        <message>
+            <source>Ground filter (SMRF, PMF, cloth simulation)</source>
+            <translation>Filtro de terreno (SMRF, PMF, simulação de tecido)</translation>
+        </message>
+        <message>
+            <source>LiDAR</source>
+            <translation>LiDAR</translation>
+        </message>
+        <message>
+            <source>ground filter of a LAS/LAZ cloud: SMRF, PMF or cloth simulation</source>
+            <translation>filtro de terreno de uma nuvem LAS/LAZ: SMRF, PMF ou simulação de tecido</translation>
+        </message>
+        <message>
+            <source>Separates ground from objects. Low outliers are removed first (class 7); only last returns
+can be ground when the file has return numbers. Methods:</source>
+            <translation>Separa o terreno dos objetos. Os outliers baixos são removidos primeiro (classe 7); apenas os
+últimos retornos podem ser terreno quando o arquivo tem números de retorno. Métodos:</translation>
+        </message>
+        <message>
+            <source>- smrf (default): the Simple Morphological Filter of Pingel et al. (2013): openings of the
+  lowest-point grid with disks of growing radius, a threshold growing with the radius
+  (slope x radius), then each point within a slope-dependent tolerance of the ground surface
+  is ground. The defaults are the published ones (cell 1 m, slope 0.15, window radius 18 m,
+  scalar 1.25) except the final tolerance SMRF_THRESHOLD, 0.3 m instead of 0.5 m (chosen on
+  AHN3, README). SMRF_SLOPE 0 estimates the terrain slope from the cloud (a first pass on
+  cells twice as large; the 90th percentile of its ground slope, within 0.1-0.7); it
+  over-estimates where vegetation covers steep slopes.
+- pmf: the Progressive Morphological Filter of Zhang et al. (2003), with SMRF's final test.
+- csf: the cloth simulation filter of Zhang et al. (2016): a cloth dropped on the cloud
+  turned upside down; points within CSF_THRESHOLD of it are ground.</source>
+            <translation>- smrf (padrão): o Filtro Morfológico Simples de Pingel et al. (2013): aberturas da grade de
+  pontos mais baixos com discos de raio crescente, um limiar que cresce com o raio (declividade
+  x raio); em seguida, cada ponto dentro de uma tolerância, dependente da declividade, da
+  superfície do terreno é terreno. Os valores padrão são os publicados (célula 1 m, declividade
+  0,15, raio da janela 18 m, escalar 1,25), exceto a tolerância final SMRF_THRESHOLD, 0,3 m em
+  vez de 0,5 m (escolhida no AHN3, README). SMRF_SLOPE 0 estima a declividade do terreno a
+  partir da nuvem (uma primeira passada em células duas vezes maiores; o percentil 90 da
+  declividade do seu terreno, entre 0,1 e 0,7); superestima onde a vegetação cobre encostas
+  íngremes.
+- pmf: o Filtro Morfológico Progressivo de Zhang et al. (2003), com o teste final do SMRF.
+- csf: o filtro de simulação de tecido de Zhang et al. (2016): um tecido lançado sobre a nuvem
+  virada de cabeça para baixo; os pontos a menos de CSF_THRESHOLD dele são terreno.</translation>
+        </message>
+        <message>
+            <source>A parameter of another method than METHOD must keep its default (it would be ignored).</source>
+            <translation>Um parâmetro de um método diferente de METHOD deve manter o seu valor padrão (seria ignorado).</translation>
+        </message>
+        <message>
+            <source>## Units
+With Distance unit = cloud CRS units, every length is in the unit of the cloud's CRS (e.g.
+international feet for Autzen); with metres, they are converted. The log and the UNIT output
+say which unit was used. CRS overrides the file's CRS (needed when the file has none).</source>
+            <translation>## Unidades
+Com Unidade de distância = unidades do SRC da nuvem, todo comprimento está na unidade do SRC da
+nuvem (por exemplo, pés internacionais para Autzen); com metros, eles são convertidos. O log e
+a saída UNIT dizem qual unidade foi usada. SRC substitui o SRC do arquivo (necessário quando o
+arquivo não tem nenhum).</translation>
+        </message>
+        <message>
+            <source>## Outputs
+A copy of the cloud (LAS/LAZ by suffix) with every original dimension and VLR, class 2 for
+ground (other classes kept, or set to 1), in the same point format; with Height above ground
+also the extra dimension height_above_ground (float32); optionally the DTM as GeoTIFF.</source>
+            <translation>## Saídas
+Uma cópia da nuvem (LAS/LAZ conforme a extensão) com todas as dimensões e VLRs originais,
+classe 2 para o terreno (as outras classes mantidas, ou definidas como 1), no mesmo formato de
+ponto; com Altura acima do terreno, também a dimensão extra height_above_ground (float32);
+opcionalmente, o MDT em GeoTIFF.</translation>
+        </message>
+        <message>
+            <source>Point cloud (LAS/LAZ)</source>
+            <translation>Nuvem de pontos (LAS/LAZ)</translation>
+        </message>
+        <message>
+            <source>LAS/LAZ files (*.las *.laz *.LAS *.LAZ)</source>
+            <translation>Arquivos LAS/LAZ (*.las *.laz *.LAS *.LAZ)</translation>
+        </message>
+        <message>
+            <source>CRS (overrides the file's)</source>
+            <translation>SRC (substitui o do arquivo)</translation>
+        </message>
+        <message>
+            <source>the cloud's CRS when the file has none or a wrong one (EPSG:xxxx or WKT)</source>
+            <translation>o SRC da nuvem quando o arquivo não tem nenhum ou tem um errado (EPSG:xxxx ou WKT)</translation>
+        </message>
+        <message>
+            <source>Distance unit</source>
+            <translation>Unidade de distância</translation>
+        </message>
+        <message>
+            <source>unit of the length parameters: the cloud's CRS unit (e.g. international feet) or metres, converted</source>
+            <translation>unidade dos parâmetros de comprimento: a unidade do SRC da nuvem (por exemplo, pés internacionais) ou metros, convertidos</translation>
+        </message>
+        <message>
+            <source>cloud CRS units</source>
+            <translation>unidades do SRC da nuvem</translation>
+        </message>
+        <message>
+            <source>metres</source>
+            <translation>metros</translation>
+        </message>
+        <message>
+            <source>Method</source>
+            <translation>Método</translation>
+        </message>
+        <message>
+            <source>SMRF (Pingel et al. 2013)</source>
+            <translation>SMRF (Pingel et al. 2013)</translation>
+        </message>
+        <message>
+            <source>PMF (Zhang et al. 2003)</source>
+            <translation>PMF (Zhang et al. 2003)</translation>
+        </message>
+        <message>
+            <source>cloth simulation (Zhang et al. 2016)</source>
+            <translation>simulação de tecido (Zhang et al. 2016)</translation>
+        </message>
+        <message>
+            <source>SMRF cell size</source>
+            <translation>Tamanho da célula do SMRF</translation>
+        </message>
+        <message>
+            <source>SMRF terrain slope (0 = estimated from the cloud)</source>
+            <translation>Declividade do terreno do SMRF (0 = estimada a partir da nuvem)</translation>
+        </message>
+        <message>
+            <source>SMRF largest window radius</source>
+            <translation>Maior raio de janela do SMRF</translation>
+        </message>
+        <message>
+            <source>SMRF final height tolerance</source>
+            <translation>Tolerância final de altura do SMRF</translation>
+        </message>
+        <message>
+            <source>SMRF tolerance added per unit of slope</source>
+            <translation>Tolerância do SMRF acrescida por unidade de declividade</translation>
+        </message>
+        <message>
+            <source>PMF cell size</source>
+            <translation>Tamanho da célula do PMF</translation>
+        </message>
+        <message>
+            <source>PMF maximum window size</source>
+            <translation>Tamanho máximo da janela do PMF</translation>
+        </message>
+        <message>
+            <source>PMF terrain slope</source>
+            <translation>Declividade do terreno do PMF</translation>
+        </message>
+        <message>
+            <source>PMF initial elevation threshold</source>
+            <translation>Limiar inicial de elevação do PMF</translation>
+        </message>
+        <message>
+            <source>PMF maximum elevation threshold</source>
+            <translation>Limiar máximo de elevação do PMF</translation>
+        </message>
+        <message>
+            <source>PMF window growth base b</source>
+            <translation>Base b do crescimento da janela do PMF</translation>
+        </message>
+        <message>
+            <source>PMF final height tolerance</source>
+            <translation>Tolerância final de altura do PMF</translation>
+        </message>
+        <message>
+            <source>PMF tolerance added per unit of slope</source>
+            <translation>Tolerância do PMF acrescida por unidade de declividade</translation>
+        </message>
+        <message>
+            <source>CSF cloth resolution</source>
+            <translation>Resolução do tecido do CSF</translation>
+        </message>
+        <message>
+            <source>CSF rigidness (1 steep, 2 terraces, 3 flat)</source>
+            <translation>Rigidez do CSF (1 íngreme, 2 terraços, 3 plano)</translation>
+        </message>
+        <message>
+            <source>CSF distance to the cloth</source>
+            <translation>Distância ao tecido do CSF</translation>
+        </message>
+        <message>
+            <source>CSF time step</source>
+            <translation>Passo de tempo do CSF</translation>
+        </message>
+        <message>
+            <source>CSF largest number of steps</source>
+            <translation>Maior número de passos do CSF</translation>
+        </message>
+        <message>
+            <source>Low outlier depth (0 = off)</source>
+            <translation>Profundidade dos outliers baixos (0 = desligado)</translation>
+        </message>
+        <message>
+            <source>Low outlier radius</source>
+            <translation>Raio dos outliers baixos</translation>
+        </message>
+        <message>
+            <source>PMF window growth</source>
+            <translation>Crescimento da janela do PMF</translation>
+        </message>
+        <message>
+            <source>PMF window shape</source>
+            <translation>Forma da janela do PMF</translation>
+        </message>
+        <message>
+            <source>CSF slope smoothing</source>
+            <translation>Suavização de encostas do CSF</translation>
+        </message>
+        <message>
+            <source>Only last returns can be ground</source>
+            <translation>Apenas os últimos retornos podem ser terreno</translation>
+        </message>
+        <message>
+            <source>Non-ground points</source>
+            <translation>Pontos não terreno</translation>
+        </message>
+        <message>
+            <source>keep their class</source>
+            <translation>manter a sua classe</translation>
+        </message>
+        <message>
+            <source>set to 1 (unclassified)</source>
+            <translation>definir como 1 (não classificado)</translation>
+        </message>
+        <message>
+            <source>Add the height above the DTM to the cloud</source>
+            <translation>Adicionar à nuvem a altura acima do MDT</translation>
+        </message>
+        <message>
+            <source>the extra dimension height_above_ground (float32, vertical unit); it changes the point format (extra bytes) and makes the file larger</source>
+            <translation>a dimensão extra height_above_ground (float32, unidade vertical); altera o formato de ponto (bytes extras) e torna o arquivo maior</translation>
+        </message>
+        <message>
+            <source>Classified point cloud</source>
+            <translation>Nuvem de pontos classificada</translation>
+        </message>
+        <message>
+            <source>LAZ files (*.laz);;LAS files (*.las)</source>
+            <translation>Arquivos LAZ (*.laz);;Arquivos LAS (*.las)</translation>
+        </message>
+        <message>
+            <source>DTM</source>
+            <translation>MDT</translation>
+        </message>
+        <message>
+            <source>Number of points</source>
+            <translation>Número de pontos</translation>
+        </message>
+        <message>
+            <source>Number of ground points</source>
+            <translation>Número de pontos de terreno</translation>
+        </message>
+        <message>
+            <source>Number of low outliers</source>
+            <translation>Número de outliers baixos</translation>
+        </message>
+        <message>
+            <source>Unit of the distances</source>
+            <translation>Unidade das distâncias</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:monoplot</name>
+        <message>
+            <source>Monoplot image points and lines on a LiDAR DSM</source>
+            <translation>Monorrestituir pontos e linhas da imagem sobre um MDS LiDAR</translation>
+        </message>
+        <message>
+            <source>Monoplotting</source>
+            <translation>Monorrestituição</translation>
+        </message>
+        <message>
+            <source>3D points and lines from one oriented image and a LiDAR DSM</source>
+            <translation>pontos e linhas 3D a partir de uma imagem orientada e de um MDS LiDAR</translation>
+        </message>
+        <message>
+            <source>Monoplotting (dos Santos, Dal Poz &amp; Dalmolin 2010): the ray of each image point is
+intersected with the LiDAR surface. Direct (Dal Poz 1991): the ray walks the DSM's cells in
+order from the camera and meets the two triangles of each cell in the determinant form of
+Eqs. 6-10; the first face hit is the visible point (occlusion). Makarovic: the classical
+iteration height -&gt; position -&gt; height.</source>
+            <translation>Monorrestituição (dos Santos, Dal Poz &amp; Dalmolin 2010): o raio de cada ponto da imagem é
+intersectado com a superfície LiDAR. Direto (Dal Poz 1991): o raio percorre as células do MDS
+em ordem a partir da câmera e encontra os dois triângulos de cada célula na forma de
+determinantes das Eqs. 6-10; a primeira face atingida é o ponto visível (oclusão). Makarovic: a
+iteração clássica altura -&gt; posição -&gt; altura.</translation>
+        </message>
+        <message>
+            <source>Observations: the image-observation CSV of the picking dock (image_id, point_id, col, row,
+sigma_px, type, target_id). Rows of type line with the same image and target_id form one 3D
+line (vertices in file order; line step adds points every so many pixels along it); other
+rows are points (their target_id is not used). With a plane table, rows of type tie or paper
+are intersected with their roof plane (target_id) instead.</source>
+            <translation>Observações: o CSV de observações de imagem do painel de medição (image_id, point_id, col, row,
+sigma_px, type, target_id). Linhas do tipo line com a mesma imagem e o mesmo target_id formam
+uma linha 3D (vértices na ordem do arquivo; o passo ao longo das linhas acrescenta pontos a
+cada tantos pixels); as outras linhas são pontos (o seu target_id não é usado). Com uma tabela
+de planos, as linhas do tipo tie ou paper são, em vez disso, intersectadas com o seu plano de
+telhado (target_id).</translation>
+        </message>
+        <message>
+            <source>DSM: a raster, or a LAS/LAZ rasterised at cell size (highest return per cell, gaps filled;
+optionally saved). A DSM in another CRS than the mapping CRS of the exterior orientation is
+resampled into it, heights transformed too (DSM CRS supplies the CRS when the file has none,
+or replaces it); when PROJ lacks a grid for that (e.g. a geoid), the run is refused: install
+the grid, or give the DSM's CRS with ellipsoidal heights as DSM CRS.</source>
+            <translation>MDS: um raster, ou um LAS/LAZ rasterizado no tamanho de célula (o retorno mais alto por célula,
+lacunas preenchidas; opcionalmente salvo). Um MDS em um SRC diferente do SRC de mapeamento da
+orientação exterior é reamostrado nele, com as alturas também transformadas (SRC do MDS fornece
+o SRC quando o arquivo não tem nenhum, ou o substitui); quando o PROJ não tem uma grade para
+isso (por exemplo, um geoide), a execução é recusada: instale a grade, ou informe como SRC do
+MDS o SRC do MDS com alturas elipsoidais.</translation>
+        </message>
+        <message>
+            <source>Each point carries a 3x3 covariance from the image sigma, the EO sigmas (X, Y, Z in m;
+omega, phi, kappa in degrees) and the DSM height sigma, and a status: ok, grazing (ray meets
+the face at less than the minimum angle), outside (the ray leaves the DSM), nodata (it crosses
+a hole first), no_orientation (image not in the EO table), not_converged (Makarovic),
+parallel / unknown_plane (planes).</source>
+            <translation>Cada ponto traz uma covariância 3x3 a partir do desvio-padrão da imagem, dos desvios-padrão da
+OE (X, Y, Z em m; omega, phi, kappa em graus) e do desvio-padrão da altura do MDS, e um estado:
+ok, grazing (o raio encontra a face com ângulo menor que o mínimo), outside (o raio sai do
+MDS), nodata (ele cruza primeiro um buraco), no_orientation (imagem ausente da tabela de OE),
+not_converged (Makarovic), parallel / unknown_plane (planos).</translation>
+        </message>
+        <message>
+            <source>Image observations (CSV)</source>
+            <translation>Observações de imagem (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Camera (JSON)</source>
+            <translation>Câmera (JSON)</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>Exterior orientation (CSV)</source>
+            <translation>Orientação exterior (CSV)</translation>
+        </message>
+        <message>
+            <source>DSM (raster, or LAS/LAZ)</source>
+            <translation>MDS (raster, ou LAS/LAZ)</translation>
+        </message>
+        <message>
+            <source>DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)</source>
+            <translation>MDS (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)</translation>
+        </message>
+        <message>
+            <source>Roof plane table (CSV)</source>
+            <translation>Tabela de planos de telhado (CSV)</translation>
+        </message>
+        <message>
+            <source>Mapping CRS of the EO</source>
+            <translation>SRC de mapeamento da OE</translation>
+        </message>
+        <message>
+            <source>e.g. EPSG:28992</source>
+            <translation>por exemplo, EPSG:28992</translation>
+        </message>
+        <message>
+            <source>DSM CRS (overrides the file's)</source>
+            <translation>SRC do MDS (substitui o do arquivo)</translation>
+        </message>
+        <message>
+            <source>the DSM's CRS when the file has none or a wrong one; a 2D CRS takes the heights as ellipsoidal</source>
+            <translation>o SRC do MDS quando o arquivo não tem nenhum ou tem um errado; um SRC 2D toma as alturas como elipsoidais</translation>
+        </message>
+        <message>
+            <source>Method</source>
+            <translation>Método</translation>
+        </message>
+        <message>
+            <source>direct (Dal Poz, DDA)</source>
+            <translation>direto (Dal Poz, DDA)</translation>
+        </message>
+        <message>
+            <source>Makarovic iteration</source>
+            <translation>iteração de Makarovic</translation>
+        </message>
+        <message>
+            <source>DSM cell size for LAS/LAZ</source>
+            <translation>Tamanho de célula do MDS para LAS/LAZ</translation>
+        </message>
+        <message>
+            <source>DSM height sigma</source>
+            <translation>Desvio-padrão da altura do MDS</translation>
+        </message>
+        <message>
+            <source>Points along lines every (0 = end points)</source>
+            <translation>Pontos ao longo das linhas a cada (0 = extremidades)</translation>
+        </message>
+        <message>
+            <source>Minimum angle ray / face</source>
+            <translation>Ângulo mínimo raio / face</translation>
+        </message>
+        <message>
+            <source>EO sigmas: X, Y, Z, omega, phi, kappa</source>
+            <translation>Desvios-padrão da OE: X, Y, Z, omega, phi, kappa</translation>
+        </message>
+        <message>
+            <source>Monoplotted points</source>
+            <translation>Pontos monorrestituídos</translation>
+        </message>
+        <message>
+            <source>Monoplotted lines</source>
+            <translation>Linhas monorrestituídas</translation>
+        </message>
+        <message>
+            <source>Point table (CSV)</source>
+            <translation>Tabela de pontos (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Line table</source>
+            <translation>Tabela de linhas</translation>
+        </message>
+        <message>
+            <source>DSM made from the LAS/LAZ</source>
+            <translation>MDS gerado a partir do LAS/LAZ</translation>
+        </message>
+        <message>
+            <source>Rays monoplotted</source>
+            <translation>Raios monorrestituídos</translation>
+        </message>
+        <message>
+            <source>Rays with a 3D point</source>
+            <translation>Raios com um ponto 3D</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:orthomosaic</name>
+        <message>
+            <source>Orthomosaic (seamlines, feathering, occlusion-aware)</source>
+            <translation>Ortomosaico (linhas de costura, suavização das bordas, com tratamento de oclusões)</translation>
+        </message>
+        <message>
+            <source>Orthophotos</source>
+            <translation>Ortofotos</translation>
+        </message>
+        <message>
+            <source>orthophotos into one mosaic, each cell from the image that sees it best</source>
+            <translation>ortofotos em um único mosaico, cada célula a partir da imagem que melhor a vê</translation>
+        </message>
+        <message>
+            <source>Every cell of the mosaic takes the orthophoto that sees it most nadir (the smallest angle
+between the vertical and the ray to the camera's perspective centre, kept in the metadata of
+the orthophotos Orthorectify writes) or, with method centre, the one whose image centre is
+nearest. Only orthophotos with data at the cell compete: with true orthophotos, ground
+occluded in one image is filled from another that sees it.</source>
+            <translation>Cada célula do mosaico recebe a ortofoto que a vê mais perto do nadir (o menor ângulo entre a
+vertical e o raio até o centro perspectivo da câmera, guardado nos metadados das ortofotos que
+Ortorretificar grava) ou, com o método centre, aquela cujo centro da imagem está mais próximo.
+Apenas as ortofotos com dados na célula concorrem: com ortofotos verdadeiras, o terreno oculto
+em uma imagem é preenchido a partir de outra que o vê.</translation>
+        </message>
+        <message>
+            <source>Feathering blends the images across the seamlines over the given width (cells), linearly,
+centred on the seamline; 0 leaves hard seams.</source>
+            <translation>A suavização das bordas (feathering) mistura as imagens através das linhas de costura na
+largura informada (células), linearmente, centrada na linha de costura; 0 deixa costuras
+abruptas.</translation>
+        </message>
+        <message>
+            <source>## Inputs
+Orthophotos: GeoTIFFs of one CRS and cell size, aligned on multiples of it (Orthorectify
+with one GSD makes them so), or folders of them.</source>
+            <translation>## Entradas
+Ortofotos: GeoTIFFs de um mesmo SRC e tamanho de célula, alinhados em múltiplos dele
+(Ortorretificar com um único GSD os produz assim), ou pastas com eles.</translation>
+        </message>
+        <message>
+            <source>## Outputs
+The mosaic (GeoTIFF: tiled, compressed, overviews, internal mask), and the seamline polygons:
+the region each image fills, as a layer and as a CSV (image_id, cells, area, WKT
+MultiPolygon in the mosaic's CRS).</source>
+            <translation>## Saídas
+O mosaico (GeoTIFF: em blocos, comprimido, com visões gerais e máscara interna) e os polígonos
+das linhas de costura: a região que cada imagem preenche, como camada e como CSV (image_id,
+cells, area, WKT MultiPolygon no SRC do mosaico).</translation>
+        </message>
+        <message>
+            <source>Orthophotos (files or folders)</source>
+            <translation>Ortofotos (arquivos ou pastas)</translation>
+        </message>
+        <message>
+            <source>Image chosen per cell</source>
+            <translation>Imagem escolhida por célula</translation>
+        </message>
+        <message>
+            <source>most nadir view</source>
+            <translation>visada mais próxima do nadir</translation>
+        </message>
+        <message>
+            <source>nearest image centre</source>
+            <translation>centro de imagem mais próximo</translation>
+        </message>
+        <message>
+            <source>Feathering width across seamlines (0 = none)</source>
+            <translation>Largura da suavização através das linhas de costura (0 = nenhuma)</translation>
+        </message>
+        <message>
+            <source>GeoTIFF compression</source>
+            <translation>Compressão do GeoTIFF</translation>
+        </message>
+        <message>
+            <source>deflate and zstd at their fastest level (files about 15 % larger than at the default level); jpeg is lossy and only for 8-bit images</source>
+            <translation>deflate e zstd no seu nível mais rápido (arquivos cerca de 15 % maiores que no nível padrão); jpeg tem perdas e serve apenas para imagens de 8 bits</translation>
+        </message>
+        <message>
+            <source>DEFLATE (lossless, level 1: fast)</source>
+            <translation>DEFLATE (sem perdas, nível 1: rápido)</translation>
+        </message>
+        <message>
+            <source>ZSTD (lossless, level 1)</source>
+            <translation>ZSTD (sem perdas, nível 1)</translation>
+        </message>
+        <message>
+            <source>LZW (lossless)</source>
+            <translation>LZW (sem perdas)</translation>
+        </message>
+        <message>
+            <source>JPEG (lossy, quality 90; 8-bit images)</source>
+            <translation>JPEG (com perdas, qualidade 90; imagens de 8 bits)</translation>
+        </message>
+        <message>
+            <source>none</source>
+            <translation>nenhuma</translation>
+        </message>
+        <message>
+            <source>Orthomosaic</source>
+            <translation>Ortomosaico</translation>
+        </message>
+        <message>
+            <source>Seamlines (region of each image)</source>
+            <translation>Linhas de costura (região de cada imagem)</translation>
+        </message>
+        <message>
+            <source>Seamline table (CSV)</source>
+            <translation>Tabela das linhas de costura (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Orthophotos mosaicked</source>
+            <translation>Ortofotos no mosaico</translation>
+        </message>
+        <message>
+            <source>Share of the mosaic's cells with data</source>
+            <translation>Fração das células do mosaico com dados</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:orthorectify</name>
+        <message>
+            <source>Orthorectify images on a LiDAR DSM (true orthophotos)</source>
+            <translation>Ortorretificar imagens sobre um MDS LiDAR (ortofotos verdadeiras)</translation>
+        </message>
+        <message>
+            <source>Orthophotos</source>
+            <translation>Ortofotos</translation>
+        </message>
+        <message>
+            <source>orthophotos of oriented frame images on a LiDAR DSM or DTM</source>
+            <translation>ortofotos de imagens de quadro orientadas sobre um MDS ou MDT LiDAR</translation>
+        </message>
+        <message>
+            <source>Each image is resampled onto a north-up grid of the mapping CRS through the surface: the
+height of every output cell comes from the DSM (or DTM) and its image position from the
+camera (lens model included) and the exterior orientation, by the rigorous chain of the
+toolbox (local ENU frame reached through ECEF, so the map projection's scale and the Earth's
+curvature are not neglected).</source>
+            <translation>Cada imagem é reamostrada em uma grade orientada ao norte do SRC de mapeamento através da
+superfície: a altura de cada célula de saída vem do MDS (ou MDT) e a sua posição na imagem vem
+da câmera (modelo de lente incluído) e da orientação exterior, pela cadeia rigorosa do kit de
+ferramentas (referencial local ENU alcançado através do ECEF, de modo que a escala da projeção
+cartográfica e a curvatura da Terra não são desprezadas).</translation>
+        </message>
+        <message>
+            <source>With True orthophoto, ground hidden from the camera (behind buildings, under trees and
+overhangs) is found by tracing the ray from the camera to every cell through the DSM (as
+monoplotting does) and left as no data; Orthomosaic then fills it from other images.</source>
+            <translation>Com Ortofoto verdadeira, o terreno oculto à câmera (atrás de edifícios, sob árvores e beirais)
+é encontrado traçando o raio da câmera até cada célula através do MDS (como faz a
+monorrestituição) e deixado sem dados; o Ortomosaico o preenche então a partir de outras
+imagens.</translation>
+        </message>
+        <message>
+            <source>## Inputs
+Images: image files, or folders of them (tif, tiff, jpg, png, jp2, img); each image is
+matched to the row of the EO table whose image_id is its file name without extension. Every
+image must have the camera's size. DSM: a raster (a layer or a file), or a LAS/LAZ cloud
+rasterised at DSM cell size (highest return per cell, gaps filled). A DSM in another CRS is
+resampled into the mapping CRS, heights transformed too; when PROJ cannot (a missing geoid
+grid) the run stops with PROJ's reason.</source>
+            <translation>## Entradas
+Imagens: arquivos de imagem, ou pastas com eles (tif, tiff, jpg, png, jp2, img); cada imagem é
+associada à linha da tabela de OE cujo image_id é o nome do seu arquivo sem extensão. Toda
+imagem deve ter o tamanho da câmera. MDS: um raster (uma camada ou um arquivo), ou uma nuvem
+LAS/LAZ rasterizada no tamanho de célula do MDS (o retorno mais alto por célula, lacunas
+preenchidas). Um MDS em outro SRC é reamostrado no SRC de mapeamento, com as alturas também
+transformadas; quando o PROJ não consegue (falta a grade de um geoide), a execução para com o
+motivo dado pelo PROJ.</translation>
+        </message>
+        <message>
+            <source>## Output
+One GeoTIFF per image, &lt;image_id&gt;_ortho.tif in the output folder: the image's bands and type,
+tiled, compressed (DEFLATE by default), with overviews, the CRS and an internal mask (no data
+outside the image, beyond the DSM and, for true orthophotos, where occluded). Its metadata keep the
+perspective centre, which Orthomosaic uses. GSD 0 takes the images' nadir GSD (the median
+over the images, 2 significant digits); the grids are aligned on multiples of the GSD. The
+extent is each image's footprint on the DSM, or the extent given (xmin, ymin, xmax, ymax).
+Nothing is written when an input is wrong; the files appear together when all are done.</source>
+            <translation>## Saída
+Um GeoTIFF por imagem, &lt;image_id&gt;_ortho.tif na pasta de saída: as bandas e o tipo da imagem, em
+blocos, comprimido (DEFLATE por padrão), com visões gerais, o SRC e uma máscara interna (sem
+dados fora da imagem, além do MDS e, nas ortofotos verdadeiras, onde há oclusão). Os seus
+metadados guardam o centro perspectivo, que o Ortomosaico usa. GSD 0 toma o GSD no nadir das
+imagens (a mediana sobre as imagens, 2 algarismos significativos); as grades são alinhadas em
+múltiplos do GSD. A extensão é a projeção de cada imagem sobre o MDS, ou a extensão informada
+(xmin, ymin, xmax, ymax). Nada é gravado quando uma entrada está errada; os arquivos aparecem
+juntos quando todos estão prontos.</translation>
+        </message>
+        <message>
+            <source>Camera (JSON)</source>
+            <translation>Câmera (JSON)</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>Exterior orientation (CSV)</source>
+            <translation>Orientação exterior (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Images (files or folders)</source>
+            <translation>Imagens (arquivos ou pastas)</translation>
+        </message>
+        <message>
+            <source>image files, or folders whose images are all taken</source>
+            <translation>arquivos de imagem, ou pastas cujas imagens são todas tomadas</translation>
+        </message>
+        <message>
+            <source>DSM or DTM (raster, or LAS/LAZ)</source>
+            <translation>MDS ou MDT (raster, ou LAS/LAZ)</translation>
+        </message>
+        <message>
+            <source>a raster (the file of a raster layer) or a LAS/LAZ cloud</source>
+            <translation>um raster (o arquivo de uma camada raster) ou uma nuvem LAS/LAZ</translation>
+        </message>
+        <message>
+            <source>DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)</source>
+            <translation>MDS (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)</translation>
+        </message>
+        <message>
+            <source>Mapping CRS of the EO</source>
+            <translation>SRC de mapeamento da OE</translation>
+        </message>
+        <message>
+            <source>e.g. EPSG:28992</source>
+            <translation>por exemplo, EPSG:28992</translation>
+        </message>
+        <message>
+            <source>DSM CRS (if the file has none)</source>
+            <translation>SRC do MDS (se o arquivo não tiver nenhum)</translation>
+        </message>
+        <message>
+            <source>DSM cell size for LAS/LAZ</source>
+            <translation>Tamanho de célula do MDS para LAS/LAZ</translation>
+        </message>
+        <message>
+            <source>Output cell size (0 = image GSD)</source>
+            <translation>Tamanho da célula de saída (0 = GSD da imagem)</translation>
+        </message>
+        <message>
+            <source>Extent xmin,ymin,xmax,ymax (empty = footprint)</source>
+            <translation>Extensão xmin,ymin,xmax,ymax (vazio = projeção da imagem no terreno)</translation>
+        </message>
+        <message>
+            <source>Resampling</source>
+            <translation>Reamostragem</translation>
+        </message>
+        <message>
+            <source>True orthophoto (occluded ground = no data)</source>
+            <translation>Ortofoto verdadeira (terreno ocluso = sem dados)</translation>
+        </message>
+        <message>
+            <source>Occlusion tolerance along the ray</source>
+            <translation>Tolerância de oclusão ao longo do raio</translation>
+        </message>
+        <message>
+            <source>GeoTIFF compression</source>
+            <translation>Compressão do GeoTIFF</translation>
+        </message>
+        <message>
+            <source>deflate and zstd at their fastest level (files about 15 % larger than at the default level); jpeg is lossy and only for 8-bit images</source>
+            <translation>deflate e zstd no seu nível mais rápido (arquivos cerca de 15 % maiores que no nível padrão); jpeg tem perdas e serve apenas para imagens de 8 bits</translation>
+        </message>
+        <message>
+            <source>DEFLATE (lossless, level 1: fast)</source>
+            <translation>DEFLATE (sem perdas, nível 1: rápido)</translation>
+        </message>
+        <message>
+            <source>ZSTD (lossless, level 1)</source>
+            <translation>ZSTD (sem perdas, nível 1)</translation>
+        </message>
+        <message>
+            <source>LZW (lossless)</source>
+            <translation>LZW (sem perdas)</translation>
+        </message>
+        <message>
+            <source>JPEG (lossy, quality 90; 8-bit images)</source>
+            <translation>JPEG (com perdas, qualidade 90; imagens de 8 bits)</translation>
+        </message>
+        <message>
+            <source>none</source>
+            <translation>nenhuma</translation>
+        </message>
+        <message>
+            <source>Output folder</source>
+            <translation>Pasta de saída</translation>
+        </message>
+        <message>
+            <source>Orthophotos written</source>
+            <translation>Ortofotos gravadas</translation>
+        </message>
+        <message>
+            <source>Cell size used</source>
+            <translation>Tamanho de célula usado</translation>
+        </message>
+        <message>
+            <source>Share of cells occluded (true orthophotos)</source>
+            <translation>Fração das células oclusas (ortofotos verdadeiras)</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:resection</name>
+        <message>
+            <source>Space resection from points and lines</source>
+            <translation>Resseção espacial a partir de pontos e linhas</translation>
+        </message>
+        <message>
+            <source>Orientation</source>
+            <translation>Orientação</translation>
+        </message>
+        <message>
+            <source>exterior orientation of single images from control points and straight lines</source>
+            <translation>orientação exterior de imagens isoladas a partir de pontos de controle e retas</translation>
+        </message>
+        <message>
+            <source>Orients each image on its own from control points (collinearity) and straight lines: image
+lines matched to 3D lines, such as the ridge, hip and valley lines of Create LiDAR control
+points and lines, or lines monoplotted on another image (dos Santos, Dal Poz &amp; Dalmolin 2010).
+No approximate orientation is needed: a global search over the rotation with the position
+eliminated in closed form (Hesch &amp; Roumeliotis 2011; Mirzaei &amp; Roumeliotis 2011) gives the
+start, OpenCV's solvePnP another when there are four or more points, and the one that fits
+best starts the rigorous adjustment.</source>
+            <translation>Orienta cada imagem isoladamente a partir de pontos de controle (colinearidade) e de retas:
+linhas da imagem associadas a linhas 3D, como as linhas de cumeeira, espigão e rincão de Criar
+pontos e linhas de controle LiDAR, ou linhas monorrestituídas em outra imagem (dos Santos, Dal
+Poz &amp; Dalmolin 2010). Nenhuma orientação aproximada é necessária: uma busca global sobre a
+rotação, com a posição eliminada em forma fechada (Hesch &amp; Roumeliotis 2011; Mirzaei &amp;
+Roumeliotis 2011), dá o ponto de partida, o solvePnP do OpenCV dá outro quando há quatro ou
+mais pontos, e o que melhor se ajusta inicia o ajustamento rigoroso.</translation>
+        </message>
+        <message>
+            <source>Line models: coplanarity (every point measured on an image line lies on the projected 3D
+line; no parametrisation, the default) or the equivalent-planes model of Tommaselli &amp; Tozzi
+(1996) as used by dos Santos et al. (2010), in its two parametrisations y = a x + b and
+x = a* y + b*, chosen per line by its direction. Both give the same estimate at convergence;
+they differ in how far from the solution they converge. The pixel sigmas and the covariance
+of the control (LCP and line tables, or sx, sy, sz) are propagated; the focal length and the
+principal point can be refined when the control has depth.</source>
+            <translation>Modelos de linha: coplanaridade (todo ponto medido sobre uma linha da imagem está sobre a linha
+3D projetada; sem parametrização, o padrão) ou o modelo de planos equivalentes de Tommaselli &amp;
+Tozzi (1996), como usado por dos Santos et al. (2010), nas suas duas parametrizações y = a x +
+b e x = a* y + b*, escolhida para cada linha pela sua direção. Ambos dão a mesma estimativa na
+convergência; diferem em quão longe da solução convergem. Os desvios-padrão em pixels e a
+covariância do controle (tabelas de LCPs e de linhas, ou sx, sy, sz) são propagados; a
+distância focal e o ponto principal podem ser refinados quando o controle tem profundidade.</translation>
+        </message>
+        <message>
+            <source>Observations: the image-observation CSV (image_id, point_id, col, row, sigma_px, type,
+target_id). Rows of type line with the same image and target_id are one image line (two or
+more points: its ends); lcp rows are control points and check rows check points (target_id:
+the control point id); tie and paper rows whose point_id is a control point are control
+points too. LINE_OBSERVATIONS may hold the line rows in a second file.</source>
+            <translation>Observações: o CSV de observações de imagem (image_id, point_id, col, row, sigma_px, type,
+target_id). Linhas do tipo line com a mesma imagem e o mesmo target_id são uma linha da imagem
+(dois ou mais pontos: as suas extremidades); linhas lcp são pontos de controle e linhas check
+são pontos de verificação (target_id: o identificador do ponto de controle); linhas tie e paper
+cujo point_id é um ponto de controle também são pontos de controle. LINE_OBSERVATIONS pode
+conter as linhas do tipo line em um segundo arquivo.</translation>
+        </message>
+        <message>
+            <source>Control points: point_id,X,Y,Z[,sx,sy,sz] or the LCP table. Control lines: the line table of
+Create LiDAR control points and lines, a segment table id,x1,y1,z1,x2,y2,z2[,sigma_start,
+sigma_end], or the line table of Monoplot. APPROX_EO (an EO table) replaces the automatic
+start; with APPROX_EO_SIGMAS it is weighted as observations (the source's weighted
+constraints).</source>
+            <translation>Pontos de controle: point_id,X,Y,Z[,sx,sy,sz] ou a tabela de LCPs. Linhas de controle: a tabela
+de linhas de Criar pontos e linhas de controle LiDAR, uma tabela de segmentos
+id,x1,y1,z1,x2,y2,z2[,sigma_start,sigma_end] ou a tabela de linhas de Monorrestituir. APPROX_EO
+(uma tabela de OE) substitui o ponto de partida automático; com APPROX_EO_SIGMAS, ela é
+ponderada como observações (as injunções ponderadas da fonte).</translation>
+        </message>
+        <message>
+            <source>Statistics per image: sigma0, the global chi-square test (the statistic against the
+one-sided 5 % critical value, as the source reports it, and the two-sided test), the
+standard deviations and correlations of the six parameters, Baarda's data snooping of points
+and whole lines, and a diagnosis naming what the observations cannot determine (e.g. all
+lines parallel).</source>
+            <translation>Estatísticas por imagem: sigma0, o teste global qui-quadrado (a estatística contra o valor
+crítico unilateral de 5 %, como a fonte o relata, e o teste bilateral), os desvios-padrão e as
+correlações dos seis parâmetros, o data snooping de Baarda de pontos e de linhas inteiras, e um
+diagnóstico que nomeia o que as observações não conseguem determinar (por exemplo, todas as
+linhas paralelas).</translation>
+        </message>
+        <message>
+            <source>Camera (JSON)</source>
+            <translation>Câmera (JSON)</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>Image observations (CSV)</source>
+            <translation>Observações de imagem (CSV)</translation>
+        </message>
+        <message>
+            <source>points (and line points) measured in the images</source>
+            <translation>pontos (e pontos de linhas) medidos nas imagens</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Image line observations (CSV)</source>
+            <translation>Observações de linhas da imagem (CSV)</translation>
+        </message>
+        <message>
+            <source>rows of type line in a second observation file</source>
+            <translation>linhas do tipo line em um segundo arquivo de observações</translation>
+        </message>
+        <message>
+            <source>Control points (CSV)</source>
+            <translation>Pontos de controle (CSV)</translation>
+        </message>
+        <message>
+            <source>point_id,X,Y,Z[,sx,sy,sz] or the LCP table</source>
+            <translation>point_id,X,Y,Z[,sx,sy,sz] ou a tabela de LCPs</translation>
+        </message>
+        <message>
+            <source>Control lines (CSV)</source>
+            <translation>Linhas de controle (CSV)</translation>
+        </message>
+        <message>
+            <source>LiDAR line table, 3D segments (id,x1..z2) or monoplotted lines</source>
+            <translation>tabela de linhas LiDAR, segmentos 3D (id,x1..z2) ou linhas monorrestituídas</translation>
+        </message>
+        <message>
+            <source>Mapping CRS of the control</source>
+            <translation>SRC de mapeamento do controle</translation>
+        </message>
+        <message>
+            <source>projected CRS of the control points and lines (and of APPROX_EO)</source>
+            <translation>SRC projetado dos pontos e linhas de controle (e de APPROX_EO)</translation>
+        </message>
+        <message>
+            <source>Approximate exterior orientation (CSV)</source>
+            <translation>Orientação exterior aproximada (CSV)</translation>
+        </message>
+        <message>
+            <source>start values instead of the automatic start (images not in it start automatically)</source>
+            <translation>valores iniciais em vez do ponto de partida automático (as imagens ausentes dela partem automaticamente)</translation>
+        </message>
+        <message>
+            <source>Weights of the approximate EO: X, Y, Z, omega, phi, kappa</source>
+            <translation>Pesos da OE aproximada: X, Y, Z, omega, phi, kappa</translation>
+        </message>
+        <message>
+            <source>empty: start values only; given: weighted observations</source>
+            <translation>vazio: apenas valores iniciais; informado: observações ponderadas</translation>
+        </message>
+        <message>
+            <source>Images (comma separated; empty: all)</source>
+            <translation>Imagens (separadas por vírgulas; vazio: todas)</translation>
+        </message>
+        <message>
+            <source>Line model</source>
+            <translation>Modelo de linha</translation>
+        </message>
+        <message>
+            <source>coplanarity (no parametrisation)</source>
+            <translation>coplanaridade (sem parametrização)</translation>
+        </message>
+        <message>
+            <source>equivalent planes (Tommaselli &amp; Tozzi 1996)</source>
+            <translation>planos equivalentes (Tommaselli &amp; Tozzi 1996)</translation>
+        </message>
+        <message>
+            <source>Refine focal length and principal point</source>
+            <translation>Refinar a distância focal e o ponto principal</translation>
+        </message>
+        <message>
+            <source>Data snooping (Baarda)</source>
+            <translation>Detecção de erros grosseiros (data snooping de Baarda)</translation>
+        </message>
+        <message>
+            <source>Exterior orientation with sigmas (CSV)</source>
+            <translation>Orientação exterior com desvios-padrão (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Residuals (CSV)</source>
+            <translation>Resíduos (CSV)</translation>
+        </message>
+        <message>
+            <source>Summary (HTML)</source>
+            <translation>Resumo (HTML)</translation>
+        </message>
+        <message>
+            <source>HTML files (*.html)</source>
+            <translation>Arquivos HTML (*.html)</translation>
+        </message>
+        <message>
+            <source>Images resected</source>
+            <translation>Imagens com resseção</translation>
+        </message>
+        <message>
+            <source>Largest sigma0 a-posteriori</source>
+            <translation>Maior sigma0 a posteriori</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:tlscalibration</name>
+        <message>
+            <source>TLS registration and self-calibration</source>
+            <translation>Registro e autocalibração TLS</translation>
+        </message>
+        <message>
+            <source>Calibration</source>
+            <translation>Calibração</translation>
+        </message>
+        <message>
+            <source>register laser scanner stations on targets and estimate the scanner's systematic errors</source>
+            <translation>registrar estações de laser scanner sobre alvos e estimar os erros sistemáticos do escâner</translation>
+        </message>
+        <message>
+            <source>One least-squares adjustment of all stations and targets (Carvalho, Correa &amp; dos Santos,
+Eq. 1): each station's position and omega, phi, kappa, the targets' coordinates and the
+scanner's additional parameters (APs) in polar form (Eqs. 2-5): the paper's set a0 (range
+offset), b1 sec(alpha) (collimation), b2 tan(alpha) (trunnion axis), c0 (vertical index), or
+Lichti's (2007) extended set (range scale and cyclic terms, circle eccentricities, encoder
+errors). AP set none: registration only.</source>
+            <translation>Um único ajustamento por mínimos quadrados de todas as estações e alvos (Carvalho, Correa &amp; dos
+Santos, Eq. 1): a posição e omega, phi, kappa de cada estação, as coordenadas dos alvos e os
+parâmetros adicionais (PAs) do escâner na forma polar (Eqs. 2-5): o conjunto do artigo a0
+(deslocamento da distância), b1 sec(alfa) (colimação), b2 tan(alfa) (eixo secundário), c0
+(índice vertical), ou o conjunto estendido de Lichti (2007) (escala da distância e termos
+cíclicos, excentricidades dos círculos, erros dos codificadores). Conjunto de PAs none: apenas
+o registro.</translation>
+        </message>
+        <message>
+            <source>Observations (CSV): station_id,target_id,range,hz_deg,vt_deg[,s_range,s_hz,s_vt] (metres,
+degrees, elevation angle; a vertical angle beyond +-90 deg is a face-II reading; sigmas in m
+and arc-seconds), or hz_gon/vt_gon, or hz/vt in ANGLE UNIT; or scanner-frame target centres
+station_id,target_id,x,y,z[,s_x,s_y,s_z]. Rows without sigmas take DEFAULT SIGMAS.</source>
+            <translation>Observações (CSV): station_id,target_id,range,hz_deg,vt_deg[,s_range,s_hz,s_vt] (metros, graus,
+ângulo de elevação; um ângulo vertical além de +-90 graus é uma leitura na posição II;
+desvios-padrão em m e em segundos de arco), ou hz_gon/vt_gon, ou hz/vt na UNIDADE ANGULAR; ou
+centros de alvos no referencial do escâner station_id,target_id,x,y,z[,s_x,s_y,s_z]. Linhas sem
+desvios-padrão recebem os DESVIOS-PADRÃO PADRÃO.</translation>
+        </message>
+        <message>
+            <source>Control (optional): target_id,X,Y,Z[,s_X,s_Y,s_Z] (sigma 0 or none: fixed); it defines the
+datum. Without control the datum is inner constraints on the targets (free network) or the
+reference station. Stations (optional): station_id, approximate X,Y,Z and omega_deg,
+phi_deg,kappa_deg, levelled (1/0). A levelled station's omega and phi are compensator
+observations with TILT SIGMA; others are free.</source>
+            <translation>Controle (opcional): target_id,X,Y,Z[,s_X,s_Y,s_Z] (sigma 0 ou nenhum: fixo); ele define o
+referencial (datum). Sem controle, o referencial são injunções internas sobre os alvos (rede
+livre) ou a estação de referência. Estações (opcional): station_id, X,Y,Z aproximados e
+omega_deg,phi_deg,kappa_deg, nivelada (1/0). O omega e o phi de uma estação nivelada são
+observações do compensador com o SIGMA DE INCLINAÇÃO; os das outras são livres.</translation>
+        </message>
+        <message>
+            <source>The report gives sigma0 and the global test, Baarda's data snooping, each AP's t-test, the
+correlation matrix of APs and station parameters with the strongly correlated pairs named and
+the network design that separates them (Lichti 2010: targets over the full vertical range,
+two faces, stations tilted by 90 degrees). SELECT APS removes correlated and insignificant
+terms one by one. A parameter the network cannot determine is an error that says why.</source>
+            <translation>O relatório dá sigma0 e o teste global, o data snooping de Baarda, o teste t de cada PA, a
+matriz de correlação dos PAs e dos parâmetros das estações, com os pares fortemente
+correlacionados nomeados e a geometria de rede que os separa (Lichti 2010: alvos em toda a
+faixa vertical, duas posições da luneta, estações inclinadas de 90 graus). SELECT APS remove,
+um a um, os termos correlacionados e não significativos. Um parâmetro que a rede não consegue
+determinar é um erro que diz o porquê.</translation>
+        </message>
+        <message>
+            <source>Registered clouds (optional): SCANS are the stations' scans (LAS/LAZ, PLY, E57; points in
+the scanner frame; the station id is the file name without its suffix, as in Extract TLS
+targets). Each is written to OUTPUT_FOLDER as &lt;station_id&gt;_registered.laz (LAZ scans) or
+.las (the others) with its points in the common frame, X = M' d + X0 with the adjusted
+pose: the control's frame; without control the reference station's (its pose in the stations
+table, else the origin unrotated), held exactly (DATUM reference) or on average over the
+targets (inner constraints). With APs estimated and APPLY APS on,
+each point's recorded polar coordinates are corrected by the estimated APs before the
+pose is applied, taken as face-I readings (elevation within +-90 deg): turn it off for
+scans that mix both faces (a panoramic scanner's second half-turn), which then get the
+rigid pose only. LAS/LAZ scans are streamed in chunks (every dimension and VLR kept);
+PLY/E57 scans are read whole. All files appear together or none (a bad scan: none).</source>
+            <translation>Nuvens registradas (opcional): SCANS são as varreduras das estações (LAS/LAZ, PLY, E57; pontos
+no referencial do escâner; o identificador da estação é o nome do arquivo sem a extensão, como
+em Extrair alvos TLS). Cada uma é gravada em OUTPUT_FOLDER como &lt;station_id&gt;_registered.laz
+(varreduras LAZ) ou .las (as outras), com os seus pontos no referencial comum, X = M' d + X0
+com a pose ajustada: o referencial do controle; sem controle, o da estação de referência (a sua
+pose na tabela de estações, senão a origem sem rotação), mantido exatamente (DATUM reference)
+ou em média sobre os alvos (injunções internas). Com PAs estimados e APPLY APS ligado, as
+coordenadas polares registradas de cada ponto são corrigidas pelos PAs estimados antes de
+aplicar a pose, tomadas como leituras na posição I (elevação dentro de +-90 graus): desligue-o
+para varreduras que misturam as duas posições (a segunda meia-volta de um escâner panorâmico),
+que então recebem apenas a pose rígida. As varreduras LAS/LAZ são lidas em blocos (todas as
+dimensões e VLRs mantidas); as varreduras PLY/E57 são lidas inteiras. Todos os arquivos
+aparecem juntos ou nenhum (uma varredura ruim: nenhum).</translation>
+        </message>
+        <message>
+            <source>Observations (CSV)</source>
+            <translation>Observações (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Control targets (CSV)</source>
+            <translation>Alvos de controle (CSV)</translation>
+        </message>
+        <message>
+            <source>Stations (CSV)</source>
+            <translation>Estações (CSV)</translation>
+        </message>
+        <message>
+            <source>approximate poses, compensator tilts, levelled flags; when given, every observed station must be in it</source>
+            <translation>poses aproximadas, inclinações do compensador, indicadores de nivelamento; quando informada, toda estação observada deve estar nela</translation>
+        </message>
+        <message>
+            <source>Angle unit of hz/vt columns</source>
+            <translation>Unidade angular das colunas hz/vt</translation>
+        </message>
+        <message>
+            <source>only for columns named hz and vt; hz_deg/hz_gon say their own unit</source>
+            <translation>apenas para as colunas chamadas hz e vt; hz_deg/hz_gon dizem a sua própria unidade</translation>
+        </message>
+        <message>
+            <source>Default sigmas: range, horizontal, vertical</source>
+            <translation>Desvios-padrão padrão: distância, horizontal, vertical</translation>
+        </message>
+        <message>
+            <source>for rows without s_range, s_hz, s_vt (or s_x, s_y, s_z: the range sigma)</source>
+            <translation>para linhas sem s_range, s_hz, s_vt (ou s_x, s_y, s_z: o desvio-padrão da distância)</translation>
+        </message>
+        <message>
+            <source>Additional parameters</source>
+            <translation>Parâmetros adicionais</translation>
+        </message>
+        <message>
+            <source>none (registration only)</source>
+            <translation>nenhum (apenas o registro)</translation>
+        </message>
+        <message>
+            <source>paper: a0, b1, b2, c0</source>
+            <translation>artigo: a0, b1, b2, c0</translation>
+        </message>
+        <message>
+            <source>extended (Lichti 2007): a0-a3, b1-b6, c0-c3</source>
+            <translation>estendido (Lichti 2007): a0-a3, b1-b6, c0-c3</translation>
+        </message>
+        <message>
+            <source>AP terms (overrides the set)</source>
+            <translation>Termos de PA (substituem o conjunto)</translation>
+        </message>
+        <message>
+            <source>comma-separated, e.g. a0,b1,b2,c0,a1</source>
+            <translation>separados por vírgulas, por exemplo, a0,b1,b2,c0,a1</translation>
+        </message>
+        <message>
+            <source>Select the APs by significance and correlation</source>
+            <translation>Selecionar os PAs por significância e correlação</translation>
+        </message>
+        <message>
+            <source>Stations levelled by the compensator</source>
+            <translation>Estações niveladas pelo compensador</translation>
+        </message>
+        <message>
+            <source>default for stations whose table does not say</source>
+            <translation>padrão para as estações cuja tabela não o diz</translation>
+        </message>
+        <message>
+            <source>Compensator sigma</source>
+            <translation>Desvio-padrão do compensador</translation>
+        </message>
+        <message>
+            <source>Datum without control</source>
+            <translation>Referencial (datum) sem controle</translation>
+        </message>
+        <message>
+            <source>inner constraints on the targets (free network)</source>
+            <translation>injunções internas sobre os alvos (rede livre)</translation>
+        </message>
+        <message>
+            <source>reference station held at its pose</source>
+            <translation>estação de referência mantida na sua pose</translation>
+        </message>
+        <message>
+            <source>Reference station</source>
+            <translation>Estação de referência</translation>
+        </message>
+        <message>
+            <source>default: the first station of the stations table with a position, else the first observed</source>
+            <translation>padrão: a primeira estação da tabela de estações com posição, senão a primeira observada</translation>
+        </message>
+        <message>
+            <source>Wavelength of the cyclic range terms</source>
+            <translation>Comprimento de onda dos termos cíclicos da distância</translation>
+        </message>
+        <message>
+            <source>Data snooping (Baarda)</source>
+            <translation>Detecção de erros grosseiros (data snooping de Baarda)</translation>
+        </message>
+        <message>
+            <source>Strong correlation at |r| &gt;=</source>
+            <translation>Correlação forte para |r| &gt;=</translation>
+        </message>
+        <message>
+            <source>Scans to register (LAS/LAZ, PLY, E57; one station per file)</source>
+            <translation>Varreduras a registrar (LAS/LAZ, PLY, E57; uma estação por arquivo)</translation>
+        </message>
+        <message>
+            <source>the file name without its suffix is the station id</source>
+            <translation>o nome do arquivo sem a extensão é o identificador da estação</translation>
+        </message>
+        <message>
+            <source>Correct the scan points by the estimated APs</source>
+            <translation>Corrigir os pontos da varredura pelos PAs estimados</translation>
+        </message>
+        <message>
+            <source>face-I readings; off: the rigid pose only</source>
+            <translation>leituras na posição I; desligado: apenas a pose rígida</translation>
+        </message>
+        <message>
+            <source>Station poses (CSV)</source>
+            <translation>Poses das estações (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Additional parameters (CSV)</source>
+            <translation>Parâmetros adicionais (CSV)</translation>
+        </message>
+        <message>
+            <source>Target coordinates (CSV)</source>
+            <translation>Coordenadas dos alvos (CSV)</translation>
+        </message>
+        <message>
+            <source>Residuals (CSV)</source>
+            <translation>Resíduos (CSV)</translation>
+        </message>
+        <message>
+            <source>Report (HTML)</source>
+            <translation>Relatório (HTML)</translation>
+        </message>
+        <message>
+            <source>HTML files (*.html)</source>
+            <translation>Arquivos HTML (*.html)</translation>
+        </message>
+        <message>
+            <source>Registered scans (folder)</source>
+            <translation>Varreduras registradas (pasta)</translation>
+        </message>
+        <message>
+            <source>needs SCANS</source>
+            <translation>requer SCANS</translation>
+        </message>
+        <message>
+            <source>Sigma0 a-posteriori</source>
+            <translation>Sigma0 a posteriori</translation>
+        </message>
+        <message>
+            <source>Registered scans written</source>
+            <translation>Varreduras registradas gravadas</translation>
+        </message>
+        <message>
+            <source>Observations rejected</source>
+            <translation>Observações rejeitadas</translation>
+        </message>
+        <message>
+            <source>Additional parameters estimated</source>
+            <translation>Parâmetros adicionais estimados</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:trajectorytoeo</name>
+        <message>
+            <source>Trajectory to exterior orientation</source>
+            <translation>Trajetória para orientação exterior</translation>
+        </message>
+        <message>
+            <source>Direct georeferencing</source>
+            <translation>Georreferenciação direta</translation>
+        </message>
+        <message>
+            <source>INS/GNSS trajectory + camera mount -&gt; exterior orientation per image</source>
+            <translation>trajetória INS/GNSS + montagem da câmera -&gt; orientação exterior por imagem</translation>
+        </message>
+        <message>
+            <source>Computes the exterior orientation (perspective centre and omega, phi, kappa) of every image
+from the INS/GNSS solution at its exposure time (direct georeferencing: X_pc = X_ins +
+R_b^m a_b, R_c^m = R_b^m R_c^b, composed rigorously through the Earth-centred frame, so grid
+convergence and Earth curvature are accounted for).</source>
+            <translation>Calcula a orientação exterior (centro perspectivo e omega, phi, kappa) de cada imagem a partir
+da solução INS/GNSS no seu instante de exposição (georreferenciação direta: X_pc = X_ins +
+R_b^m a_b, R_c^m = R_b^m R_c^b, composta rigorosamente através do referencial geocêntrico, de
+modo que a convergência meridiana e a curvatura da Terra são levadas em conta).</translation>
+        </message>
+        <message>
+            <source>## Trajectory table (INPUT)
+CSV with a header row (column names are case-insensitive) and one row per image:
+- image_id (unique) and time (seconds);
+- either easting, northing, height in the mapping CRS, or latitude, longitude, height
+  (degrees, on the geodetic datum of the CRS); heights in metres;
+- roll, pitch, heading in degrees; body frame x forward, y right, z down; heading clockwise
+  from true north;
+- optional group (flight line, camera, ...).</source>
+            <translation>## Tabela da trajetória (INPUT)
+CSV com uma linha de cabeçalho (os nomes das colunas não diferenciam maiúsculas de minúsculas)
+e uma linha por imagem:
+- image_id (único) e time (segundos);
+- ou easting, northing, height no SRC de mapeamento, ou latitude, longitude, height (graus, no
+  datum geodésico do SRC); alturas em metros;
+- roll, pitch, heading em graus; referencial do corpo x para a frente, y para a direita, z para
+  baixo; heading no sentido horário a partir do norte verdadeiro;
+- group opcional (faixa de voo, câmera, ...).</translation>
+        </message>
+        <message>
+            <source>## Mounting
+Lever arm: the camera perspective centre in the body frame, metres. Camera mount: the
+nominal camera-to-body rotation; custom uses the mount matrix (9 numbers, row-major R_c^b).
+Boresight: the small misalignment in degrees about the camera axes x, y, z.</source>
+            <translation>## Montagem
+Braço de alavanca: o centro perspectivo da câmera no referencial do corpo, em metros. Montagem
+da câmera: a rotação nominal da câmera para o corpo; custom usa a matriz de montagem (9
+números, R_c^b por linhas). Boresight: o pequeno desalinhamento em graus em torno dos eixos x,
+y, z da câmera.</translation>
+        </message>
+        <message>
+            <source>## Outputs
+A PointZ layer in the mapping CRS with image_id, time, group, X, Y, Z, omega_deg, phi_deg,
+kappa_deg (angles relative to the grid frame at each image), optionally the same table as
+CSV (on the command line, printed when no file is given), and the number of images.</source>
+            <translation>## Saídas
+Uma camada PointZ no SRC de mapeamento com image_id, time, group, X, Y, Z, omega_deg, phi_deg,
+kappa_deg (ângulos relativos ao referencial da quadrícula em cada imagem), opcionalmente a
+mesma tabela em CSV (na linha de comando, impressa quando nenhum arquivo é informado) e o
+número de imagens.</translation>
+        </message>
+        <message>
+            <source>Trajectory table (CSV)</source>
+            <translation>Tabela da trajetória (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Mapping CRS (projected)</source>
+            <translation>SRC de mapeamento (projetado)</translation>
+        </message>
+        <message>
+            <source>projected CRS of the trajectory's eastings/northings and of the output</source>
+            <translation>SRC projetado dos eastings/northings da trajetória e da saída</translation>
+        </message>
+        <message>
+            <source>Lever arm x,y,z</source>
+            <translation>Braço de alavanca x,y,z</translation>
+        </message>
+        <message>
+            <source>camera perspective centre in the INS body frame (x forward, y right, z down)</source>
+            <translation>centro perspectivo da câmera no referencial do corpo do INS (x para a frente, y para a direita, z para baixo)</translation>
+        </message>
+        <message>
+            <source>Camera mount</source>
+            <translation>Montagem da câmera</translation>
+        </message>
+        <message>
+            <source>nominal camera-to-body rotation; custom uses MOUNT_MATRIX</source>
+            <translation>rotação nominal da câmera para o corpo; custom usa MOUNT_MATRIX</translation>
+        </message>
+        <message>
+            <source>image_top_forward: image top towards the flight direction (nose)</source>
+            <translation>image_top_forward: topo da imagem no sentido do voo (nariz)</translation>
+        </message>
+        <message>
+            <source>image_right_forward: image right side towards the flight direction</source>
+            <translation>image_right_forward: lado direito da imagem no sentido do voo</translation>
+        </message>
+        <message>
+            <source>image_bottom_forward: image bottom towards the flight direction</source>
+            <translation>image_bottom_forward: base da imagem no sentido do voo</translation>
+        </message>
+        <message>
+            <source>image_left_forward: image left side towards the flight direction</source>
+            <translation>image_left_forward: lado esquerdo da imagem no sentido do voo</translation>
+        </message>
+        <message>
+            <source>custom: custom matrix (MOUNT_MATRIX)</source>
+            <translation>custom: matriz definida pelo usuário (MOUNT_MATRIX)</translation>
+        </message>
+        <message>
+            <source>Mount matrix R_c^b (9 numbers, row-major)</source>
+            <translation>Matriz de montagem R_c^b (9 números, por linhas)</translation>
+        </message>
+        <message>
+            <source>the nominal mount R_c^b when MOUNT is custom</source>
+            <translation>a montagem nominal R_c^b quando MOUNT é custom</translation>
+        </message>
+        <message>
+            <source>Boresight domega,dphi,dkappa</source>
+            <translation>Boresight domega,dphi,dkappa</translation>
+        </message>
+        <message>
+            <source>small misalignment about the camera axes x, y, z (a larger rotation belongs in MOUNT)</source>
+            <translation>pequeno desalinhamento em torno dos eixos x, y, z da câmera (uma rotação maior pertence a MOUNT)</translation>
+        </message>
+        <message>
+            <source>Exterior orientation</source>
+            <translation>Orientação exterior</translation>
+        </message>
+        <message>
+            <source>Exterior orientation table (CSV)</source>
+            <translation>Tabela de orientação exterior (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Number of images</source>
+            <translation>Número de imagens</translation>
+        </message>
+    </context>
+</TS>
