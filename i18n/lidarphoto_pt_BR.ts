@@ -11,6 +11,18 @@
     <context>
         <name>AlgorithmHelp</name>
         <message>
+            <source>length (cloud CRS unit, or m when DISTANCE_UNIT is metre)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>none</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>any finite</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
             <source>optional</source>
             <translation>opcional</translation>
         </message>
@@ -23,8 +35,28 @@
             <translation>{} a {}</translation>
         </message>
         <message>
+            <source>default: {}</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>unit: {}</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
             <source>References</source>
             <translation>Referências</translation>
+        </message>
+        <message>
+            <source>How to use</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>values: {}</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>range: {}</source>
+            <translation type="unfinished" />
         </message>
         <message>
             <source>Parameters</source>
@@ -43,8 +75,136 @@
             <translation>padrão</translation>
         </message>
         <message>
+            <source>unit</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>valid range</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Boresight calibration with LiDAR control (Pedrosa &amp; dos Santos 2020)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Monoplotting on a LiDAR surface (dos Santos, Dal Poz &amp; Dalmolin 2010)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Aerial triangulation and orthophotos</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>LiDAR control for a whole block of tiles (dask.distributed)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Terrestrial laser scanner calibration (Lichti 2007)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>INPUT = the GNSS/INS trajectory CSV; OUTPUT_CSV = the exterior orientation of every image</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>INPUT = the LAS/LAZ; OUTPUT_CLOUD = the cloud classified into ground (2) and non-ground</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>INPUT = the classified cloud; OUTPUT_CSV = the plane table, OUTPUT_CLOUD = the cloud with plane_id</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>PLANES and CLOUD = the two outputs of extractroofplanes; POINTS_CSV and LINES_CSV = LiDAR control points and lines</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>TRAJECTORY = the exterior orientation, PLANES / LINES / LCPS = the control, OBSERVATIONS = image measurements made in the picking dock; OUTPUT_TABLE = boresight per group, OUTPUT_EO = corrected orientation</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>INPUT = check points measured with the corrected orientation; OUTPUT_HTML and OUTPUT_JSON = the accuracy figures against the standards</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>INPUT = the LAS/LAZ; OUTPUT_DTM = the terrain model (or use the cloud itself as DSM)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>OUTPUT_CSV = roof planes, used by monoplot for points on roofs</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>OBSERVATIONS + CONTROL_POINTS (or lines) of one image; OUTPUT_EO = its exterior orientation</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>OBSERVATIONS of the image, EO, DSM (raster or LAS/LAZ), optional PLANES; OUTPUT_CSV = 3D points</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>INPUT = monoplotted check points against their reference</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>IMAGES = views of a chessboard or ChArUco target; OUTPUT_CAMERA = the camera JSON (start values for the block, or held fixed)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>IMAGES (and the approximate EO + CAMERA to pair images by their footprints); OUTPUT_OBSERVATIONS = tie points for the bundle</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>POINTS = the surveyed control, PHOTOS = ground photos of each point with and without the control plate, CAMERA = the ground camera; OUTPUT_FOLDER = one chip per point at the GSD of the aerial images</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>CHIPS = one GeoTIFF chip per control point, CONTROL_POINTS, CAMERA, approximate EO, IMAGES; OUTPUT = the control points' image observations, without clicking them</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>CAMERA, OBSERVATIONS, GROUND_POINTS, EO (approximate); OUTPUT_EO = adjusted orientation, OUTPUT_CAMERA = calibrated camera</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>OUTPUT_DTM = the terrain for the orthophotos</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>CAMERA and EO from the bundle, IMAGES, DSM = the DTM or DSM; OUTPUT_FOLDER = one orthophoto per image</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>ORTHOPHOTOS = that folder; OUTPUT = the mosaic, SEAMLINES_CSV = the region of each image</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>INPUT = check points measured on the mosaic</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>INPUT = a folder of LAS/LAZ tiles or a .vpc; OUTPUT_FOLDER = classified tiles, block.vpc, planes.csv, lcps.csv and lines.csv</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>PLANES / LINES / LCPS = the block's tables, TRAJECTORY and OBSERVATIONS as above</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>SCANS = the station clouds, CONTROL = target ids; OUTPUT = target observations</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>OBSERVATIONS = those targets, CONTROL and STATIONS; OUTPUT_APS = the scanner's additional parameters, OUTPUT_HTML = the report</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>(this algorithm)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
             <source>unit, range</source>
-            <translation>unidade, intervalo</translation>
+            <translation type="vanished">unidade, intervalo</translation>
         </message>
     </context>
     <context>
@@ -578,6 +738,22 @@
         <message>
             <source>Image line of LiDAR line {} measured.</source>
             <translation>Linha da imagem da linha LiDAR {} medida.</translation>
+        </message>
+        <message>
+            <source>Select a point of the image shown first.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Point {} is measured in no other image: no template.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Point {} not refined: {}</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Point {} refined by least-squares matching on image {}: moved {:.2f} px, sigma {:.3f} px, correlation {:.2f}.</source>
+            <translation type="unfinished" />
         </message>
     </context>
     <context>
@@ -1169,20 +1345,12 @@
             <translation>modelo de PAs</translation>
         </message>
         <message>
-            <source>mean planimetric (m)</source>
-            <translation>média planimétrica (m)</translation>
+            <source>mean horizontal (m)</source>
+            <translation type="unfinished" />
         </message>
         <message>
-            <source>std planimetric (m)</source>
-            <translation>desvio-padrão planimétrico (m)</translation>
-        </message>
-        <message>
-            <source>RMS planimetric (m)</source>
-            <translation>RMS planimétrico (m)</translation>
-        </message>
-        <message>
-            <source>RMS height (m)</source>
-            <translation>RMS em altura (m)</translation>
+            <source>std horizontal (m)</source>
+            <translation type="unfinished" />
         </message>
         <message>
             <source>APs</source>
@@ -1301,10 +1469,6 @@
             <translation>Pontos de verificação (fora do ajustamento)</translation>
         </message>
         <message>
-            <source>planimetric (m)</source>
-            <translation>planimétrica (m)</translation>
-        </message>
-        <message>
             <source>images</source>
             <translation>imagens</translation>
         </message>
@@ -1373,8 +1537,8 @@
             <translation>boresight d_kappa (graus)</translation>
         </message>
         <message>
-            <source>Planimetric discrepancy: mean {} m, standard deviation {} m, RMS {} m; RMS E/N/H {} / {} / {} m; 3D {} m. Intersected with the adjusted orientations; their sigmas carry the image noise only.</source>
-            <translation>Discrepância planimétrica: média {} m, desvio-padrão {} m, RMS {} m; RMS E/N/H {} / {} / {} m; 3D {} m. Intersectados com as orientações ajustadas; os seus desvios-padrão trazem apenas o ruído das imagens.</translation>
+            <source>Horizontal discrepancy: mean {} m, standard deviation {} m, RMSE_HORIZONTAL {} m; RMSE_E / RMSE_N / RMSE_U {} / {} / {} m; RMSE_3D {} m. Intersected with the adjusted orientations; their sigmas carry the image noise only.</source>
+            <translation type="unfinished" />
         </message>
         <message>
             <source>not observable: {}</source>
@@ -1680,6 +1844,30 @@
             <source>none</source>
             <translation>nenhuma</translation>
         </message>
+        <message>
+            <source>mean planimetric (m)</source>
+            <translation type="vanished">média planimétrica (m)</translation>
+        </message>
+        <message>
+            <source>std planimetric (m)</source>
+            <translation type="vanished">desvio-padrão planimétrico (m)</translation>
+        </message>
+        <message>
+            <source>RMS planimetric (m)</source>
+            <translation type="vanished">RMS planimétrico (m)</translation>
+        </message>
+        <message>
+            <source>RMS height (m)</source>
+            <translation type="vanished">RMS em altura (m)</translation>
+        </message>
+        <message>
+            <source>planimetric (m)</source>
+            <translation type="vanished">planimétrica (m)</translation>
+        </message>
+        <message>
+            <source>Planimetric discrepancy: mean {} m, standard deviation {} m, RMS {} m; RMS E/N/H {} / {} / {} m; 3D {} m. Intersected with the adjusted orientations; their sigmas carry the image noise only.</source>
+            <translation type="vanished">Discrepância planimétrica: média {} m, desvio-padrão {} m, RMS {} m; RMS E/N/H {} / {} / {} m; 3D {} m. Intersectados com as orientações ajustadas; os seus desvios-padrão trazem apenas o ruído das imagens.</translation>
+        </message>
     </context>
     <context>
         <name>ResectionController</name>
@@ -1826,6 +2014,14 @@
             <translation>Salvar os pontos e linhas monorrestituídos em um GeoPackage</translation>
         </message>
         <message>
+            <source>Refine</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Snap the selected point to the least-squares match (6 affine + 2 radiometric parameters) of the same point measured in another image</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
             <source>Scale of the residual vectors</source>
             <translation>Escala dos vetores de resíduos</translation>
         </message>
@@ -1939,12 +2135,11 @@ classe declarada; limiares do projeto (vertical 0 = dz da Eq. 18 a partir da geo
         <message>
             <source>## Outputs
 A self-contained HTML report (tables, verdicts, SVG plots), a JSON of every figure, a PointZ
-layer at the reference positions with id, group, dE, dN, dH, dHoriz, d3D, outlier, and the
-RMSE values as numeric outputs.</source>
-            <translation>## Saídas
-Um relatório HTML autocontido (tabelas, vereditos, gráficos SVG), um JSON com todos os valores,
-uma camada PointZ nas posições de referência com id, group, dE, dN, dH, dHoriz, d3D, outlier, e
-os valores de RMSE como saídas numéricas.</translation>
+layer at the reference positions with id, group, dE, dN, dU, dHorizontal, d3D, outlier, and
+the RMSE values as numeric outputs RMSE_E, RMSE_N, RMSE_U (height), RMSE_HORIZONTAL, RMSE_3D
+(docs/formats.md, "Accuracy figures"; RMSE_H and RMSE_HORIZ, their former names, are kept
+for one release).</source>
+            <translation type="unfinished" />
         </message>
         <message>
             <source>Check-point table (CSV: id, e, n, h, e_ref, n_ref, h_ref, group)</source>
@@ -2139,16 +2334,42 @@ os valores de RMSE como saídas numéricas.</translation>
             <translation>RMSE_N (m)</translation>
         </message>
         <message>
-            <source>RMSE_H (m)</source>
-            <translation>RMSE_H (m)</translation>
+            <source>RMSE_U (m)</source>
+            <translation type="unfinished" />
         </message>
         <message>
-            <source>RMSE_HORIZ (m)</source>
-            <translation>RMSE_HORIZ (m)</translation>
+            <source>RMSE_HORIZONTAL (m)</source>
+            <translation type="unfinished" />
         </message>
         <message>
             <source>RMSE_3D (m)</source>
             <translation>RMSE_3D (m)</translation>
+        </message>
+        <message>
+            <source>RMSE_H (m; deprecated: use RMSE_U)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>RMSE_HORIZ (m; deprecated: use RMSE_HORIZONTAL)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>## Outputs
+A self-contained HTML report (tables, verdicts, SVG plots), a JSON of every figure, a PointZ
+layer at the reference positions with id, group, dE, dN, dH, dHoriz, d3D, outlier, and the
+RMSE values as numeric outputs.</source>
+            <translation type="vanished">## Saídas
+Um relatório HTML autocontido (tabelas, vereditos, gráficos SVG), um JSON com todos os valores,
+uma camada PointZ nas posições de referência com id, group, dE, dN, dH, dHoriz, d3D, outlier, e
+os valores de RMSE como saídas numéricas.</translation>
+        </message>
+        <message>
+            <source>RMSE_H (m)</source>
+            <translation type="vanished">RMSE_H (m)</translation>
+        </message>
+        <message>
+            <source>RMSE_HORIZ (m)</source>
+            <translation type="vanished">RMSE_HORIZ (m)</translation>
         </message>
     </context>
     <context>
@@ -2680,6 +2901,196 @@ são recusadas, com o arquivo e a linha indicados.</translation>
         </message>
     </context>
     <context>
+        <name>lidarphoto:calibratecamera</name>
+        <message>
+            <source>Calibrate a camera from target images</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Photogrammetry</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Interior orientation and lens distortion (perspective or fisheye) from views of a planar target</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Detects a planar target in every image of a folder with OpenCV (chessboard:
+findChessboardCornersSB; ChArUco: CharucoDetector; ArUco grid board: ArucoDetector with
+sub-pixel corners) and calibrates the camera with the project's own least-squares adjustment:
+a self-calibrating bundle with one pose per view, the interior orientation f, x0, y0 and the
+Brown-Conrady coefficients k1 k2 k3 p1 p2 (any subset), for the perspective projection or a
+fisheye projection (equidistant, equisolid-angle, orthographic, stereographic; Schneider,
+Schwalbe &amp; Maas 2009) with the Brown correction added.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Target: chessboard COLUMNS x ROWS inner corners, SPACING the square side; ChArUco COLUMNS x ROWS
+squares, SPACING the square side, MARKER the marker side; ArUco grid board COLUMNS x ROWS
+markers, SPACING the marker side, MARKER the gap between markers. The field is fixed (its
+nominal coordinates) or free (estimated; datum: the origin corner and the end of the first row
+held at their nominal coordinates, which sets the scale from the square size, and the start of
+the last row held in the plane Z = 0).</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Outputs: the camera JSON (usable by every algorithm; a fisheye camera is refused by those whose
+kernels are perspective-only), a report JSON (sigmas, correlations, sigma0, the t-test of every
+lens coefficient, per-view RMS and poses), the same as an HTML page, and the residual table
+(CSV). PIXEL_SIZE only scales
+the millimetre values of the camera file: the calibration itself is in pixels.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Target images (files or folders)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>image files, or folders whose images are all taken</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Target</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>chessboard</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>ChArUco board</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>ArUco grid board</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Columns (inner corners / squares / markers)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Rows (inner corners / squares / markers)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Square side (ArUco: marker side)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>ChArUco marker side / ArUco gap</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>ArUco dictionary</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Projection</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>perspective (central)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>fisheye: equidistant</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>fisheye: equisolid-angle</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>fisheye: orthographic</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>fisheye: stereographic</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Lens coefficients estimated</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Brown-Conrady coefficients; the others are held at zero</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Target field</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>fixed (nominal coordinates)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>free (estimated, minimal datum)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Pixel size</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>A-priori sigma of a detected point</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Camera name</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Calibrated camera (JSON)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Calibration report (JSON)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Calibration report (HTML)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>HTML files (*.html)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Residuals per point (CSV)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Views used</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Target points used</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Reprojection RMS (px)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Sigma0 (a-priori 1)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Focal length (px)</source>
+            <translation type="unfinished" />
+        </message>
+    </context>
+    <context>
         <name>lidarphoto:createlcps</name>
         <message>
             <source>Create LiDAR control points and lines</source>
@@ -2722,12 +3133,10 @@ planos.</translation>
         <message>
             <source>Distances are in the cloud's CRS unit (e.g. feet for a CRS in feet) unless distance unit is
 metres; the outputs are in the CRS unit. Optionally give your own plane-id triples
-("1,2,3; 4,5,6") or pairs ("1,2; 2,3") instead of the automatic ones. Rejected candidates
-are listed in the log with the reason.</source>
-            <translation>As distâncias estão na unidade do SRC da nuvem (por exemplo, pés para um SRC em pés), a menos
-que a unidade de distância seja metros; as saídas estão na unidade do SRC. Opcionalmente,
-informe suas próprias triplas ("1,2,3; 4,5,6") ou pares ("1,2; 2,3") de identificadores de
-plano em vez dos automáticos. Os candidatos rejeitados são listados no log com o motivo.</translation>
+("1,2,3; 4,5,6") or pairs ("1,2; 2,3") instead of the automatic ones. The log counts the
+rejected candidates per reason; each one, with its numbers and units, is listed only in
+verbose mode (command line: -vv; QGIS: Processing options, logging level Verbose).</source>
+            <translation type="unfinished" />
         </message>
         <message>
             <source>Plane table (CSV)</source>
@@ -2836,6 +3245,16 @@ plano em vez dos automáticos. Os candidatos rejeitados são listados no log com
         <message>
             <source>Number of lines</source>
             <translation>Número de linhas</translation>
+        </message>
+        <message>
+            <source>Distances are in the cloud's CRS unit (e.g. feet for a CRS in feet) unless distance unit is
+metres; the outputs are in the CRS unit. Optionally give your own plane-id triples
+("1,2,3; 4,5,6") or pairs ("1,2; 2,3") instead of the automatic ones. Rejected candidates
+are listed in the log with the reason.</source>
+            <translation type="vanished">As distâncias estão na unidade do SRC da nuvem (por exemplo, pés para um SRC em pés), a menos
+que a unidade de distância seja metros; as saídas estão na unidade do SRC. Opcionalmente,
+informe suas próprias triplas ("1,2,3; 4,5,6") ou pares ("1,2; 2,3") de identificadores de
+plano em vez dos automáticos. Os candidatos rejeitados são listados no log com o motivo.</translation>
         </message>
     </context>
     <context>
@@ -3388,6 +3807,531 @@ opcionalmente, o MDT em GeoTIFF.</translation>
         <message>
             <source>Unit of the distances</source>
             <translation>Unidade das distâncias</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:lidarblock</name>
+        <message>
+            <source>LiDAR block: ground, roof planes and control, tile by tile (dask)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>LiDAR</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>a whole LiDAR block tile by tile on dask.distributed: ground filter, roof planes, LiDAR control points and lines</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Runs the ground filter (SMRF, Pingel et al. 2013), the roof planes and the LiDAR control of
+a whole block, one dask task per tile, on a local dask.distributed cluster (one worker per
+core by default) or on an existing cluster (CLUSTER: its scheduler address, e.g.
+tcp://10.0.0.5:8786; every worker must have lidarphoto and read the input paths).</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Input: a folder of LAS/LAZ tiles, a virtual point cloud (.vpc, as made by PDAL or QGIS), or
+one large LAS/LAZ file cut into square tiles of TILE_SIZE read in chunks. Tiles in different
+CRSs are refused. Neighbours are found from the headers' bounding boxes.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Buffers: each tile is filtered with the points of its neighbours within 2 x SMRF_WINDOW +
+LOW_OUTLIER_RADIUS + 3 cells of its box, so its classes are those of a run on the whole cloud
+(except a few points next to buildings within millimetres of the height tolerance: the DTM
+filled under objects depends on the tile's grid corner; 9 of 75 256 points in the tests); only
+the tile's own points are written. Roof planes are extracted on the tile plus twice the
+radius of a K_NEIGHBOURS patch; planes cut by a tile border are merged (same plane by the
+parameter test, adjacent points) and refitted with their covariance from all their points;
+control points and lines found by several tiles are kept once.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>A tile that cannot be read is reported by name and skipped; the rest finishes and the block
+is marked incomplete (report "complete": false, result COMPLETE 0, command-line exit
+status 3).</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>## Outputs
+OUTPUT_FOLDER (must be new, empty, or a previous block output) receives, all at once when
+the block is done: tiles/&lt;tile&gt;.laz (each tile's own points, class 2 ground, 7 low outliers,
+other classes kept), block.vpc (the tiles as a virtual point cloud), planes.csv, lcps.csv,
+lines.csv (the formats of Extract roof planes and Create LCPs) and block_report.json (per
+tile: points, ground, seconds, peak memory, errors). Lengths are in the CRS unit unless
+DISTANCE_UNIT is metres.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Block: folder of LAS/LAZ tiles, .vpc or one LAS/LAZ file</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>a folder path is accepted too (its *.las/*.laz)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>LAS/LAZ or virtual point cloud (*.las *.laz *.vpc)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>CRS (overrides the file's)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>the cloud's CRS when the file has none or a wrong one (EPSG:xxxx or WKT)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Distance unit</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>unit of the length parameters: the cloud's CRS unit (e.g. international feet) or metres, converted</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>cloud CRS units</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>metres</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Tile size (one large file)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>side of the square tiles one file is cut into</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>SMRF cell size</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>SMRF terrain slope</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>SMRF largest window radius</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>SMRF final height tolerance</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>SMRF tolerance added per unit of slope</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Low outlier radius</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Roof planes: point-to-plane tolerance</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Roof planes: neighbours of the local RANSAC</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Roof planes: smallest plane (points)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Control: adjacency distance delta</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Control: minimum common boundary</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>dask scheduler address (empty: a local cluster)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>e.g. tcp://10.0.0.5:8786</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Local cluster: workers (0 = one per core)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Local cluster: memory limit per worker (0 = RAM / workers)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Local cluster workers</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>auto: processes on the command line, threads inside QGIS or qgis_process, where a process cluster would start QGIS's own executable for each worker</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>auto (processes on the command line, threads inside QGIS)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>processes (one per worker)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>threads of this process</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Output folder (tiles, VPC, tables, report)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Tiles processed</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Tiles that failed</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>1 when every tile was processed, else 0</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Points written</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Ground points</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Roof planes</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>LiDAR control points</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>LiDAR control lines</source>
+            <translation type="unfinished" />
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:locatecontrolpoints</name>
+        <message>
+            <source>Locate control points in images (chips, NCC + least-squares matching)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Aerotriangulation</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>control points measured automatically in oriented images from control chips</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Each control point is projected into each image with its exterior orientation; its control
+chip (a north-up GeoTIFF of the ground around the point, rectified onto the plane Z = Z_point,
+file name = point id) is searched there by normalised cross-correlation with an adaptive
+template size (grown until the predicted least-squares precision from the texture, Förstner
+1986, passes), then refined by least-squares matching (Gruen 1985: 6 affine + 2 radiometric
+parameters) from the chip's pixels with the local chip-to-image affine as start. Search
+window: the EO sigmas (columns sigma_X .. sigma_kappa_deg of the EO CSV) propagated to the
+image, times 3; without them +-SEARCH_PX pixels. A match is rejected, with the reason, for a
+chip without texture, low correlation, no convergence, a sigma above MAX_SIGMA, a match
+outside the search ellipse or a template partly outside the image. With TRANSFER, images where
+the chip match failed are matched from the point's best image (image-to-image LSM).</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Output: the image-observation CSV (image_id, point_id, col, row, sigma_px, type tie, empty
+target_id; point_id = the control point's id), which bundleadjustment (with the control points
+as ground points) and resection (with them as control points) read directly; sigma_px is the
+LSM sigma, at least SIGMA_FLOOR (LSM does not see the chip's own errors). The report CSV has
+one row per point and image with the status and reason; the HTML report shows the chips.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Control chips (GeoTIFF files or folders)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>one GeoTIFF per point, named &lt;point_id&gt;.tif</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Control points (CSV)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>point_id,X,Y,Z in the mapping CRS (the chips' CRS)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Camera (JSON)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Exterior orientation (CSV)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>with sigma columns: the search window follows from them</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Images (files or folders)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>image files (name = image_id), or folders whose images are all taken</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Mapping CRS of the EO and control</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>e.g. EPSG:25832</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Search half-width without EO sigmas</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Smallest NCC peak</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Smallest LSM correlation</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Largest LSM sigma</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Smallest sigma written</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Transfer to images where the chip failed</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Image observations (CSV)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Report per point and image (CSV)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Report with chip gallery (HTML)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>HTML files (*.html)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Observations written</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Point-image pairs rejected</source>
+            <translation type="unfinished" />
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:makecontrolchips</name>
+        <message>
+            <source>Make control chips from ground photos</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Image matching</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Control chips: ground photos of surveyed points rectified at the aerial GSD</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Control chips for the automatic location of control points in aerial images (Berveglieri &amp;
+Tommaselli 2014). For each surveyed point two ground photos taken from the same spot looking
+down: one with the control plate over the point, one without it.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>1. The plate (a square with an outer and an inner square edge; its centre vertically above
+the point at plate height, levelled, one side along the plate azimuth) is found in the plate
+photo; its eight corners are located at sub-pixel precision (edges fitted as straight lines
+and intersected, the lens model removed), and the photo is resected from them (data snooping;
+sigma0 and the sigmas in the report). The four quarter turns of the square are told apart by
+the photo azimuth (the approximate grid azimuth of the photos' up direction, within 45
+degrees).
+2. The plate-free photo is matched to the plate photo by SIFT (Lowe 2004; ratio test, RANSAC
+homography) and resected from the matched ground points.
+3. It is rectified onto the horizontal plane Z = Z_point at the GSD, north up, centred on the
+point: the chip (the plate hides the ground, hence the plate-free photo). Without a
+plate-free photo, Chip from the plate photo makes it from the plate photo.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Ground points: the ground-point CSV of the bundle adjustment (point_id, X, Y, Z, role; every
+point gets a chip, whatever its role) in the mapping CRS. Photos: a ground-photo table
+(point_id, plate_photo, free_photo, and optional photo_azimuth_deg, plate_azimuth_deg), or
+files / folders searched by name:
+&lt;point_id&gt;&lt;plate suffix&gt;.&lt;ext&gt; and &lt;point_id&gt;&lt;free suffix&gt;.&lt;ext&gt;.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Output folder: &lt;point_id&gt;.tif per chip (float32 grey, nodata -9999, the geotransform puts the
+point at its X, Y: the chip's centre) and the report control_chips.csv / .json (per point:
+status and reason, corners found, corner sigmas, resection sigma0 and sigmas, SIFT matches and
+inliers). A point that fails (plate not found, only one square, ambiguous, resection sigma0
+too large, too few SIFT matches, chip partly outside the photo) gets its reason and no chip;
+the others are written.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Ground points (CSV)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>point_id, X, Y, Z, role (the bundle adjustment's table)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Mapping CRS of the points</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>e.g. EPSG:31983</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Ground camera (JSON)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Ground-photo table (CSV)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>point_id, plate_photo, free_photo; else PHOTOS are searched by name</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Ground photos (files or folders)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>searched by name when no table is given</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Plate photo name suffix</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Plate-free photo name suffix</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Plate outer side</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Plate inner side</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Plate height above the point</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Plate side azimuth (grid)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Photo up azimuth (grid, +-45)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Chip GSD (the aerial images')</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Chip size</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Largest resection sigma0</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Corner sigma (0 = from the line fits)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>SIFT ratio test</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>RANSAC threshold</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Fewest SIFT inliers</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Chip from the plate photo when no plate-free photo</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Output folder</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Chips written</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Points without a chip</source>
+            <translation type="unfinished" />
         </message>
     </context>
     <context>
@@ -4081,6 +5025,200 @@ linhas paralelas).</translation>
         <message>
             <source>Largest sigma0 a-posteriori</source>
             <translation>Maior sigma0 a posteriori</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:tiepoints</name>
+        <message>
+            <source>Automatic tie points</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Orientation</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>tie points of overlapping images by feature matching, for the bundle adjustment</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Finds tie points in a block of images without an operator. Features: SIFT (Lowe 2004) or
+ORB (Rublee et al. 2011, faster, less precise), detected once per image, on the image reduced
+by the smallest integer factor that brings its longer side to at most Detection size (0: full
+resolution; reductions by 2, 4 and 8 are made while decoding JPEGs); the keypoints are
+scaled back to full-resolution pixels.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Pairs: with an exterior orientation and a camera, the pairs whose ground footprints (image
+corners met with the plane at Mean terrain height) overlap by at least Minimum overlap of the
+smaller footprint; without them, each image with the next Window images in file-name order
+(sequential), or all pairs. An image the EO table lacks is paired with every image.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Matching: nearest neighbours in descriptor space (FLANN k-d trees for SIFT, Muja &amp; Lowe 2009;
+brute force for ORB), Lowe's ratio test, a mutual check, then RANSAC on the fundamental
+matrix (Fischler &amp; Bolles 1981; MAGSAC++ by default) with a threshold on the distance to the
+epipolar line in full-resolution pixels. Pairs with fewer than Minimum inliers are dropped
+(the pair table gives the reason). Tracks: the matches of all pairs are merged (connected
+components); a track holding two different points of one image is dropped, as are tracks
+seen in fewer than Minimum track length images.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Output: the image-observation CSV (type tie, point ids tp000001 ..., target_id empty), read
+directly by Bundle adjustment. sigma_px: the value given, or 0.5 px times the detection
+reduction factor. No least-squares refinement of the points yet.</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Images (files or folders)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>image files, or folders whose images are all taken; the image id is the file name without extension</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Exterior orientation (CSV) for pair selection</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>with CAMERA: pairs from ground footprints</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Camera (JSON)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Mean terrain height</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>the plane the footprints are computed on (EO heights)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Detector</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>SIFT (Lowe 2004)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>ORB (fast)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Features per image</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Detection size (longer side, 0 = full resolution)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Ratio test (best / second best)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>RANSAC threshold (epipolar distance)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>RANSAC method</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>MAGSAC++</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>RANSAC</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Minimum inliers per pair</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Minimum track length</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Pairs</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>footprints with EO, else sequential</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>footprints (EO + camera)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>all pairs</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>sequential window</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Sequential window</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Minimum footprint overlap</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>share of the smaller footprint</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>sigma_px written (0 = 0.5 px x reduction)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Tie points (observation CSV)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Pair table (CSV)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Tie points (tracks)</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Image measurements</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Image pairs tried</source>
+            <translation type="unfinished" />
+        </message>
+        <message>
+            <source>Image pairs kept</source>
+            <translation type="unfinished" />
         </message>
     </context>
     <context>
