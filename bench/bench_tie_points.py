@@ -195,7 +195,8 @@ def main() -> None:
     if a.orb:
         ours("ours_orb", files, ("--detector", "orb", "--max-dimension", "0"))
     sub = files[: a.peer_images]
-    ours("ours_sift_subset", sub)
+    if not a.no_peer:  # ours on the peer's subset
+        ours("ours_sift_subset", sub)
     if a.no_peer:
         print(json.dumps(rows, indent=1))
         if not a.keep:
