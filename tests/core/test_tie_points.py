@@ -285,15 +285,22 @@ def test_real_kite_block_without_eo(tmp_path):
 
 # --------------------------------------------------------------------------- refinement
 @pytest.fixture(scope="module")
-def refined(block):
-    tb, folder = block
+def refined(block, matched):
+    """The tracks of ``matched`` refined (the job's path with REFINE is the 3-image test)."""
+    import dataclasses
+
+    from lidarphoto.core.io.images import read_gray
+    from lidarphoto.core.photo.tie_points import refine_tracks
+
+    _tb, folder = block
+    data = matched[0].data
+    names = [folder / "images" / f"{i}.png" for i in data.image_ids]
     seen = []
-    res = run_job(job, {
-        "IMAGES": [str(folder / "images")], "EO": str(folder / "eo.csv"),
-        "CAMERA": str(folder / "camera.json"), "HEIGHT": tb.block.config.ground_height_m,
-        "MAX_FEATURES": 1500, "REFINE": True, "OUTPUT_OBSERVATIONS": str(folder / "ref.csv"),
-    }, progress=seen.append)  # fmt: skip
-    return res, read_observations_csv(folder / "ref.csv", camera=tb.block.camera), seen
+    tracks, sigma, stats = refine_tracks(
+        data.tracks, data.sigma_px, len(names), lambda k: read_gray(names[k]),
+        TiePointOptions(refine=True), progress=seen.append)  # fmt: skip
+    res = dataclasses.replace(data, tracks=tracks, sigma_px=sigma, refinement=stats)
+    return res, res.observations(), seen
 
 
 def _heading_offsets(tb, obs, err_fn=None):
@@ -342,7 +349,7 @@ def test_refinement_against_truth(block, matched, refined):
     # the sigma written: the LSM sigma with its floor, of the order of the true scatter
     # (robust per-axis scatter of the offsets to the reference; measured 0.03 px against
     # a median sigma of 0.021 px: the LSM sigma is 1.4x optimistic here)
-    rf = res.data.refinement
+    rf = res.refinement
     assert obs.sigma_px.min() >= 0.02
     moved = obs.sigma_px < 0.5
     scatter = 1.4826 * np.median(np.abs(np.vstack(list(d1.values()))))
@@ -351,8 +358,7 @@ def test_refinement_against_truth(block, matched, refined):
     assert rf.refined > 0.95 * (len(obs) - (t1.max() + 1))
     assert sum(rf.dropped.values()) < 0.01 * len(obs0)
     assert set(rf.dropped) <= {"moved too far", "low correlation"}
-    assert any(line.startswith("least-squares refinement:") for line in res.lines)
-    assert seen[-1] == pytest.approx(1.0) and any(0.8 < x < 1.0 for x in seen)
+    assert len(seen) == 15 and seen[-1] == pytest.approx(1.0)
 
 
 def test_bundle_with_refined_tie_points(block, matched, refined):
@@ -377,7 +383,8 @@ def test_bundle_with_refined_tie_points(block, matched, refined):
 
 
 def test_refinement_cancel_and_rules(block, tmp_path):
-    """Cancelling during the refinement writes nothing; SIGMA given wins over the LSM's."""
+    """The job with REFINE: progress through the refinement (0.8..1), its log line;
+    cancelling during the refinement writes nothing; SIGMA given wins over the LSM's."""
     _tb, folder = block
     three = [str(folder / "images" / f"IMG_{n}.png") for n in ("0101", "0102", "0103")]
     seen = []
@@ -387,6 +394,16 @@ def test_refinement_cancel_and_rules(block, tmp_path):
                 progress=seen.append,
                 should_stop=lambda: bool(seen) and seen[-1] >= 0.8)  # fmt: skip
     assert not (tmp_path / "c.csv").exists()
+    seen.clear()
+    res = run_job(job, {"IMAGES": three, "MAX_FEATURES": 500, "REFINE": True,
+                        "OUTPUT_OBSERVATIONS": str(tmp_path / "r.csv")},
+                  progress=seen.append)  # fmt: skip
+    assert seen[-1] == pytest.approx(1.0) and any(0.8 < x < 1.0 for x in seen)
+    assert any(line.startswith("least-squares refinement:") for line in res.lines)
+    rf = res.data.refinement
+    assert rf.refined > 300 and rf.shift_median_px < 0.5
+    obs = read_observations_csv(tmp_path / "r.csv")
+    assert len(obs) == res.results["MEASUREMENT_COUNT"] and 0.02 <= np.median(obs.sigma_px) < 0.1
     res = run_job(job, {"IMAGES": three, "MAX_FEATURES": 500, "REFINE": True, "SIGMA": 0.3,
                         "OUTPUT_OBSERVATIONS": str(tmp_path / "s.csv")})  # fmt: skip
     assert res.data.refinement.refined > 300
