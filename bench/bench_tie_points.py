@@ -19,7 +19,11 @@ Accuracy: each measurement against the projection of its track's true ground poi
 median of the exact ground points of the track's measurements), pixels; a measurement more
 than 3 px off is wrong.
 
-Usage: python bench/bench_tie_points.py [--strips 10 --per-strip 10 --peer-images 12 --orb]
+With ``--refine`` ours is also run with the least-squares refinement (``--refine true``) on
+the whole block: the cost is the difference of the two runs' times.
+
+Usage: python bench/bench_tie_points.py [--strips 10 --per-strip 10 --peer-images 12 --orb
+--refine --no-peer]
 """
 
 from __future__ import annotations
@@ -139,6 +143,8 @@ def main() -> None:
     ap.add_argument("--keep", action="store_true")
     ap.add_argument("--no-peer", action="store_true", help="ours only")
     ap.add_argument("--orb", action="store_true", help="also run ours with ORB")
+    ap.add_argument("--refine", action="store_true",
+                    help="also run ours with the least-squares refinement (--refine true)")
     a = ap.parse_args()
     folder = Path(tempfile.mkdtemp(prefix="bench_tie_"))
     print("load:", os.getloadavg(), "folder:", folder)
@@ -184,10 +190,13 @@ def main() -> None:
         print(rows[-1])
 
     ours("ours_sift", files)
+    if a.refine:
+        ours("ours_sift_refine", files, ("--refine", "true"))
     if a.orb:
         ours("ours_orb", files, ("--detector", "orb", "--max-dimension", "0"))
     sub = files[: a.peer_images]
-    ours("ours_sift_subset", sub)
+    if not a.no_peer:  # ours on the peer's subset
+        ours("ours_sift_subset", sub)
     if a.no_peer:
         print(json.dumps(rows, indent=1))
         if not a.keep:

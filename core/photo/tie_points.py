@@ -26,8 +26,12 @@ The chain (one image's features are computed once and kept; the images themselve
    tracks. A track holding two different keypoints of the same image is inconsistent and is
    dropped whole; tracks shorter than ``min_track_length`` images are dropped.
 
-The tie points are measured at the keypoint positions: there is no least-squares refinement
-here (a refinement step would move ``Tracks.pixels`` after step 4).
+5. **Refinement** (optional, :func:`refine_tracks`): least-squares matching (Gruen 1985) of
+   every measurement of a track against a template cut around the track's reference
+   measurement (its first image), in the full-resolution grey images (read again, one at a
+   time, in image order: each image once).
+
+Without step 5 the tie points are measured at the keypoint positions.
 """
 
 from __future__ import annotations
@@ -51,6 +55,7 @@ __all__ = [
     "RANSAC_METHODS",
     "ImageFeatures",
     "PairMatch",
+    "RefineStats",
     "TiePointOptions",
     "TiePointResult",
     "Tracks",
@@ -59,6 +64,7 @@ __all__ = [
     "footprints",
     "match_pair",
     "polygon_overlap",
+    "refine_tracks",
     "select_pairs",
     "tie_points",
 ]
@@ -103,6 +109,13 @@ class TiePointOptions:
         of its 8 nearest inliers by more than this share of the image diagonal is dropped
         (0: no test). It removes wrong matches that slide along the epipolar line, which
         the fundamental matrix cannot see (aerial strips: all epipolar lines are parallel).
+    refine : bool
+        Least-squares refinement of the tracks (:func:`refine_tracks`).
+    refine_half_px : int
+        Half size of the LSM template, full-resolution pixels (template 2 h + 1 square).
+    refine_sigma_floor_px : float
+        Smallest sigma_px written for a refined measurement (the LSM sigma ignores the
+        model errors of the affine patch model, e.g. relief inside the patch).
     """
 
     detector: str = "sift"
@@ -119,6 +132,9 @@ class TiePointOptions:
     min_overlap: float = 0.05
     sigma_px: float = 0.0
     coherence: float = 0.03
+    refine: bool = False
+    refine_half_px: int = 10
+    refine_sigma_floor_px: float = 0.02
 
     def __post_init__(self) -> None:
         if self.detector not in DETECTORS:
@@ -133,6 +149,8 @@ class TiePointOptions:
             raise InputError("a track needs at least 2 images")
         if self.min_inliers < 8:
             raise InputError("the fundamental matrix needs at least 8 inliers")
+        if self.refine_half_px < 3:
+            raise InputError("the refinement template needs a half size of at least 3 px")
 
 
 @dataclass(frozen=True)
@@ -649,6 +667,224 @@ def build_tracks(
                   pix, int(bad.sum()), int(short.sum()))  # fmt: skip
 
 
+# --------------------------------------------------------------------------- refinement
+#: LSM statuses that say the measurement is not the reference's point: dropped. The other
+#: failures (no texture, left the window, not converged, sigma too large) say nothing
+#: about the keypoint, which is kept as matched.
+_BLUNDER_TEXT = ("moved too far", "low correlation")
+#: Correspondences a start affine is fitted to (nearest tracks seen in both images).
+_START_NEIGHBOURS = 12
+_LSM_CHUNK = 4000
+
+
+@dataclass(frozen=True)
+class RefineStats:
+    """What :func:`refine_tracks` did, per measurement other than the references.
+
+    refined : measurements moved to their LSM position.
+    kept : reason -> count of measurements left at the keypoint (LSM could not decide).
+    dropped : reason -> count of measurements removed (LSM says: another point).
+    tracks_dropped : tracks left with fewer than the minimum length.
+    shift_median_px : median distance keypoint -> LSM position of the refined ones.
+    """
+
+    refined: int
+    kept: dict[str, int]
+    dropped: dict[str, int]
+    tracks_dropped: int
+    shift_median_px: float
+
+
+def _start_linear(pr: Array, pk: Array, query: Array) -> tuple[Array, NDArray[np.bool_]]:
+    """Local affine (linear part, (Q, 2, 2)) from image r to image k at ``query`` (positions
+    in r), fitted to the nearest correspondences ``pr`` -> ``pk``; False where fewer than 6
+    or degenerate (nearly collinear) correspondences are at hand.
+
+    >>> rng = np.random.default_rng(0); pr = rng.random((30, 2)) * 100
+    >>> lin, ok = _start_linear(pr, -pr + 7.0, pr[:2])  # turned by 180 degrees
+    >>> bool(ok.all()), np.round(lin[0], 9).tolist() == [[-1, 0], [0, -1]]
+    (True, True)
+    """
+    from scipy.spatial import cKDTree
+
+    q = query.shape[0]
+    lin = np.broadcast_to(np.eye(2), (q, 2, 2)).copy()
+    if pr.shape[0] < 6:
+        return lin, np.zeros(q, bool)
+    kn = min(_START_NEIGHBOURS, pr.shape[0])
+    _, nn = cKDTree(pr).query(query, k=kn)
+    a = pr[nn]
+    b = pk[nn]
+    a = a - a.mean(axis=1, keepdims=True)
+    b = b - b.mean(axis=1, keepdims=True)
+    saa = np.einsum("qni,qnj->qij", a, a)
+    sba = np.einsum("qni,qnj->qij", b, a)
+    det = np.linalg.det(saa)
+    tr = np.trace(saa, axis1=1, axis2=2)
+    ok = det > 1e-3 * tr * tr  # eigenvalue ratio of the spread above ~1e-3
+    lin[ok] = sba[ok] @ np.linalg.inv(saa[ok])
+    return lin, ok
+
+
+def refine_tracks(
+    tracks: Tracks,
+    sigma_px: Array,
+    n_images: int,
+    load_image: Callable[[int], NDArray],
+    options: TiePointOptions,
+    *,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> tuple[Tracks, Array, RefineStats]:
+    """Least-squares refinement of tie point tracks (Gruen 1985, 6 affine + 2 radiometric).
+
+    Each track's reference is its measurement in its first image (lowest index), kept fixed.
+    A template of ``2 refine_half_px + 1`` full-resolution pixels is cut around it and every
+    other measurement of the track is matched to it by :func:`lsm_in_image`, starting at its
+    keypoint with the local affine between the two images fitted to the 12 nearest tracks
+    the two images share (handles rotation, e.g. strips flown in opposite directions, and
+    scale). Images are processed in index order, each read once (``load_image(k)``: the
+    full-resolution grey image, array coordinates = project pixels - 0.5): an image's
+    measurements are matched to the templates of earlier images, then its own templates are
+    cut; a template is freed once its track's last image is done, so one image and the
+    templates of the open tracks are held at a time.
+
+    Rules: an accepted match moves the measurement and sets its sigma to the LSM position
+    sigma (root mean square of col and row) with the floor ``refine_sigma_floor_px``; the
+    reference gets the median sigma of its refined measurements. LSM saying the patch is
+    another point (moved farther than 3 px from the keypoint, or correlation below 0.7)
+    drops the measurement; any other failure (no texture, the template or patch reaches the
+    image border, no convergence, sigma above 0.2 px, no start affine) keeps the keypoint
+    and its sigma. Tracks left shorter than ``min_track_length`` are dropped.
+
+    Returns
+    -------
+    tracks, sigma_px, stats
+    """
+    from .least_squares_matching import STATUS_TEXT, LsmOptions, lsm_in_image
+
+    t = tracks
+    n = t.track.size
+    h = int(options.refine_half_px)
+    size = 2 * h + 1
+    lsm_opt = LsmOptions()
+    pix = t.pixels.copy()
+    sigma = np.asarray(sigma_px, float).copy()
+    keep = np.ones(n, bool)
+    refined = np.zeros(n, bool)
+    kept: dict[str, int] = {}
+    dropped: dict[str, int] = {}
+    if n == 0:
+        return t, sigma, RefineStats(0, kept, dropped, 0, math.nan)
+    first = np.r_[True, t.track[1:] != t.track[:-1]]
+    start = np.flatnonzero(first)
+    ref_row = start[t.track]  # each row's reference row
+    last_img = t.image[np.r_[start[1:] - 1, n - 1]]  # per track
+    by_image = np.argsort(t.image, kind="stable")
+    bounds = np.searchsorted(t.image[by_image], np.arange(n_images + 1))
+    # templates of the open tracks: reference image -> (sorted track ids, templates, offsets)
+    store: dict[int, tuple[NDArray[np.intp], NDArray[np.float32], Array]] = {}
+
+    def count(d: dict[str, int], reason: str, m: int = 1) -> None:
+        if m:
+            d[reason] = d.get(reason, 0) + m
+
+    active = [k for k in range(n_images) if bounds[k + 1] > bounds[k]]
+    for done, k in enumerate(active):
+        stop_if_asked(should_stop, f"refining tie points (image {k + 1} of {n_images})")
+        rows_k = by_image[bounds[k] : bounds[k + 1]]  # sorted by track
+        img = np.asarray(load_image(k))
+        if img.ndim != 2:
+            raise InputError(f"image {k}: a grey image is needed for the refinement")
+        img = img.astype(np.float64)
+        targets = rows_k[~first[rows_k]]
+        tracks_k = t.track[rows_k]
+        tmpl = np.zeros((targets.size, size, size), np.float32)
+        lin = np.zeros((targets.size, 2, 2))
+        d_off = np.zeros((targets.size, 2))
+        usable = np.zeros(targets.size, bool)
+        for r in np.unique(t.image[ref_row[targets]]):
+            sel = np.flatnonzero(t.image[ref_row[targets]] == r)
+            rows_r = by_image[bounds[r] : bounds[r + 1]]
+            _, ir, ik = np.intersect1d(t.track[rows_r], tracks_k, assume_unique=True,
+                                       return_indices=True)  # fmt: skip
+            pr, pk = t.pixels[rows_r[ir]], t.pixels[rows_k[ik]]
+            lin[sel], ok = _start_linear(pr, pk, t.pixels[ref_row[targets[sel]]])
+            ids, tp, off = store[int(r)]
+            pos = np.searchsorted(ids, t.track[targets[sel]])
+            valid = np.isfinite(off[pos, 0])
+            tmpl[sel] = tp[pos]
+            d_off[sel] = off[pos]
+            usable[sel] = ok & valid
+            count(kept, "no start affine (fewer than 6 shared tracks)", int(np.sum(~ok)))
+            count(kept, "template at the image border", int(np.sum(ok & ~valid)))
+        idx = np.flatnonzero(usable)
+        for c0 in range(0, idx.size, _LSM_CHUNK):
+            sel = idx[c0 : c0 + _LSM_CHUNK]
+            rows = targets[sel]
+            arr = pix[rows] - 0.5
+            # the template's centre pixel maps to the keypoint minus the linear part of the
+            # reference's sub-pixel offset from that centre
+            a0 = arr - np.einsum("qij,qj->qi", lin[sel], d_off[sel])
+            st = np.concatenate([a0[:, :, None], lin[sel]], axis=2)
+            res = lsm_in_image(tmpl[sel], img, st, None, lsm_opt)
+            new = res.affine[:, :, 0] + np.einsum("qij,qj->qi", res.affine[:, :, 1:], d_off[sel])
+            ok = res.ok
+            pix[rows[ok]] = new[ok] + 0.5
+            s = np.sqrt(0.5 * (res.sigma_px[ok] ** 2).sum(axis=1))
+            sigma[rows[ok]] = np.maximum(s, float(options.refine_sigma_floor_px))
+            refined[rows[ok]] = True
+            for code in np.unique(res.status[~ok]):
+                reason = STATUS_TEXT[int(code)]
+                m = int(np.sum(res.status == code))
+                if reason in _BLUNDER_TEXT:
+                    keep[rows[res.status == code]] = False
+                    count(dropped, reason, m)
+                else:
+                    count(kept, reason, m)
+        # this image's own templates (the tracks it is the reference of)
+        refs = rows_k[first[rows_k]]
+        arr = t.pixels[refs] - 0.5
+        c = np.rint(arr).astype(np.intp)
+        inside = ((c[:, 0] >= h) & (c[:, 1] >= h) & (c[:, 0] < img.shape[1] - h)
+                  & (c[:, 1] < img.shape[0] - h))  # fmt: skip
+        tp = np.zeros((refs.size, size, size), np.float32)
+        if inside.any():
+            ci = c[inside]
+            rr = ci[:, 1, None, None] + np.arange(-h, h + 1)[None, :, None]
+            cc = ci[:, 0, None, None] + np.arange(-h, h + 1)[None, None, :]
+            tp[inside] = img[rr, cc]
+        off = np.where(inside[:, None], arr - c, np.nan)
+        store[k] = (t.track[refs], tp, off)
+        for r in [r for r, v in store.items() if v[0].size == 0 or last_img[v[0]].max() <= k]:
+            del store[r]
+        del img
+        if progress is not None:
+            progress((done + 1) / len(active))
+    # the reference: the median sigma of its refined measurements
+    tr = np.flatnonzero(refined)
+    if tr.size:
+        order = np.argsort(t.track[tr], kind="stable")
+        tt = t.track[tr][order]
+        ss = sigma[tr][order]
+        cut = np.flatnonzero(np.r_[True, tt[1:] != tt[:-1]])
+        med = np.array([np.median(v) for v in np.split(ss, cut[1:])])
+        sigma[start[tt[cut]]] = med
+    shift = np.hypot(*(pix[refined] - t.pixels[refined]).T)
+    # tracks too short after the drops
+    length = np.bincount(t.track[keep], minlength=t.n_tracks)
+    ok_track = length >= options.min_track_length
+    had = np.bincount(t.track, minlength=t.n_tracks) > 0
+    keep &= ok_track[t.track]
+    new_id = np.cumsum(ok_track) - 1
+    out = Tracks(new_id[t.track[keep]].astype(np.intp), t.image[keep], t.feature[keep],
+                 pix[keep], t.rejected_inconsistent, t.rejected_short)  # fmt: skip
+    stats = RefineStats(int(np.sum(refined & keep)), kept, dropped,
+                        int(np.sum(had & ~ok_track)),
+                        float(np.median(shift)) if shift.size else math.nan)  # fmt: skip
+    return out, sigma[keep], stats
+
+
 # --------------------------------------------------------------------------- the chain
 @dataclass
 class TiePointResult:
@@ -666,6 +902,8 @@ class TiePointResult:
     tracks : Tracks
     sigma_px : ndarray
         A-priori sigma of each measurement of ``tracks``, pixels.
+    refinement : RefineStats or None
+        What the least-squares refinement did (None: not run).
     """
 
     image_ids: tuple[str, ...]
@@ -674,6 +912,7 @@ class TiePointResult:
     pairs: list[PairMatch]
     tracks: Tracks
     sigma_px: Array = field(default_factory=lambda: np.zeros(0))
+    refinement: RefineStats | None = None
 
     def summary(self) -> dict[str, object]:
         """Counts for reports: pairs tried and kept, matches per kept pair (median, min,
@@ -704,6 +943,7 @@ class TiePointResult:
             "rejected_inconsistent": self.tracks.rejected_inconsistent,
             "images_without_tie": [i for k, i in enumerate(self.image_ids) if k not in seen],
             "dropped_pairs": reasons,
+            "refinement": self.refinement,
         }
 
     def observations(self, prefix: str = "tp"):
@@ -733,6 +973,7 @@ def tie_points(
     progress: Callable[[float], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
     on_features: Callable[[ImageFeatures], None] | None = None,
+    load_image: Callable[[int], NDArray] | None = None,
 ) -> TiePointResult:
     """The whole chain (module docstring).
 
@@ -746,8 +987,14 @@ def tie_points(
     footprint : sequence of (4, 2) arrays or None, optional
         Ground footprints (:func:`footprints`), for the footprint pair mode.
     progress, should_stop
-        Fraction done (features 0..0.5, matching 0.5..1); cancellation per image and pair.
+        Fraction done (features 0..0.5, matching 0.5..1; with the refinement 0..0.4,
+        0.4..0.8, refinement 0.8..1); cancellation per image and pair.
+    load_image : callable, optional
+        ``load_image(k)``: the full-resolution grey image ``k``, for ``options.refine``.
     """
+    if options.refine and load_image is None:
+        raise InputError("the least-squares refinement needs the images (load_image)")
+    share = (0.4, 0.8) if options.refine else (0.5, 1.0)
     n = len(image_ids)
     feats: list[ImageFeatures] = []
     for k in range(n):
@@ -757,7 +1004,7 @@ def tie_points(
         if on_features is not None:
             on_features(f)
         if progress is not None:
-            progress(0.5 * (k + 1) / n)
+            progress(share[0] * (k + 1) / n)
     mode = options.pair_mode
     if mode == "auto":
         mode = "footprints" if footprint is not None else "sequential"
@@ -768,12 +1015,21 @@ def tie_points(
         results.append(match_pair(feats[i], feats[j], options, i, j,
                                   overlap.get((i, j), math.nan)))  # fmt: skip
         if progress is not None:
-            progress(0.5 + 0.5 * (m + 1) / max(len(pairs), 1))
+            progress(share[0] + (share[1] - share[0]) * (m + 1) / max(len(pairs), 1))
     tracks = build_tracks(feats, results, options.min_track_length)
     factors = [f.factor for f in feats]
+    counts = [len(f) for f in feats]
     if options.sigma_px > 0:
         sigma = np.full(tracks.track.size, float(options.sigma_px))
     else:
         sigma = 0.5 * np.asarray(factors, float)[tracks.image] if tracks.track.size else np.zeros(0)
-    return TiePointResult(tuple(image_ids), [len(f) for f in feats], factors, results, tracks,
-                          sigma)  # fmt: skip
+    stats = None
+    if options.refine:
+        del feats[:]  # the descriptors are not needed any more: free them before the images
+        sub = None if progress is None else (lambda x: progress(share[1] + (1 - share[1]) * x))
+        tracks, sigma, stats = refine_tracks(tracks, sigma, n, load_image, options,
+                                             progress=sub, should_stop=should_stop)  # fmt: skip
+        if options.sigma_px > 0:  # the value given wins
+            sigma = np.full(tracks.track.size, float(options.sigma_px))
+    return TiePointResult(tuple(image_ids), counts, factors, results, tracks, sigma,
+                          stats)  # fmt: skip
