@@ -14,7 +14,9 @@ import textwrap
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from .spec import TR_CONTEXT  # noqa: F401  (the catalogue context of these texts: scripts/i18n.py)
+#: The catalogue context of these texts (scripts/i18n.py): the help's, ``spec.TR_CONTEXT``
+#: (not imported: spec imports this module; tests/core/test_help.py checks they agree).
+TR_CONTEXT = "AlgorithmHelp"
 
 
 def _t(text: str) -> str:

@@ -89,3 +89,9 @@ def test_references_name_authors_and_year_and_are_in_references_md(name):
             f"**{r}"
         )[1][:80], r
     assert "References: " in spec.help_text() and "<h3>References</h3>" in spec.help_html()
+
+
+def test_workflow_texts_share_the_help_catalogue_context():
+    from lidarphoto.core.jobs import spec, workflows
+
+    assert workflows.TR_CONTEXT == spec.TR_CONTEXT
