@@ -12,15 +12,15 @@
         <name>AlgorithmHelp</name>
         <message>
             <source>length (cloud CRS unit, or m when DISTANCE_UNIT is metre)</source>
-            <translation type="unfinished" />
+            <translation>comprimento (unidade do SRC da nuvem, ou m quando DISTANCE_UNIT é metro)</translation>
         </message>
         <message>
             <source>none</source>
-            <translation type="unfinished" />
+            <translation>nenhuma</translation>
         </message>
         <message>
             <source>any finite</source>
-            <translation type="unfinished" />
+            <translation>qualquer valor finito</translation>
         </message>
         <message>
             <source>optional</source>
@@ -36,11 +36,11 @@
         </message>
         <message>
             <source>default: {}</source>
-            <translation type="unfinished" />
+            <translation>padrão: {}</translation>
         </message>
         <message>
             <source>unit: {}</source>
-            <translation type="unfinished" />
+            <translation>unidade: {}</translation>
         </message>
         <message>
             <source>References</source>
@@ -48,15 +48,15 @@
         </message>
         <message>
             <source>How to use</source>
-            <translation type="unfinished" />
+            <translation>Como usar</translation>
         </message>
         <message>
             <source>values: {}</source>
-            <translation type="unfinished" />
+            <translation>valores: {}</translation>
         </message>
         <message>
             <source>range: {}</source>
-            <translation type="unfinished" />
+            <translation>intervalo: {}</translation>
         </message>
         <message>
             <source>Parameters</source>
@@ -76,131 +76,131 @@
         </message>
         <message>
             <source>unit</source>
-            <translation type="unfinished" />
+            <translation>unidade</translation>
         </message>
         <message>
             <source>valid range</source>
-            <translation type="unfinished" />
+            <translation>intervalo válido</translation>
         </message>
         <message>
             <source>Boresight calibration with LiDAR control (Pedrosa &amp; dos Santos 2020)</source>
-            <translation type="unfinished" />
+            <translation>Calibração de boresight com controle LiDAR (Pedrosa &amp; dos Santos 2020)</translation>
         </message>
         <message>
             <source>Monoplotting on a LiDAR surface (dos Santos, Dal Poz &amp; Dalmolin 2010)</source>
-            <translation type="unfinished" />
+            <translation>Monorrestituição sobre uma superfície LiDAR (dos Santos, Dal Poz &amp; Dalmolin 2010)</translation>
         </message>
         <message>
             <source>Aerial triangulation and orthophotos</source>
-            <translation type="unfinished" />
+            <translation>Aerotriangulação e ortofotos</translation>
         </message>
         <message>
             <source>LiDAR control for a whole block of tiles (dask.distributed)</source>
-            <translation type="unfinished" />
+            <translation>Controle LiDAR para um bloco inteiro de tiles (dask.distributed)</translation>
         </message>
         <message>
             <source>Terrestrial laser scanner calibration (Lichti 2007)</source>
-            <translation type="unfinished" />
+            <translation>Calibração de laser scanner terrestre (Lichti 2007)</translation>
         </message>
         <message>
             <source>INPUT = the GNSS/INS trajectory CSV; OUTPUT_CSV = the exterior orientation of every image</source>
-            <translation type="unfinished" />
+            <translation>INPUT = o CSV da trajetória GNSS/INS; OUTPUT_CSV = a orientação exterior de cada imagem</translation>
         </message>
         <message>
             <source>INPUT = the LAS/LAZ; OUTPUT_CLOUD = the cloud classified into ground (2) and non-ground</source>
-            <translation type="unfinished" />
+            <translation>INPUT = o LAS/LAZ; OUTPUT_CLOUD = a nuvem classificada em terreno (2) e não terreno</translation>
         </message>
         <message>
             <source>INPUT = the classified cloud; OUTPUT_CSV = the plane table, OUTPUT_CLOUD = the cloud with plane_id</source>
-            <translation type="unfinished" />
+            <translation>INPUT = a nuvem classificada; OUTPUT_CSV = a tabela de planos, OUTPUT_CLOUD = a nuvem com plane_id</translation>
         </message>
         <message>
             <source>PLANES and CLOUD = the two outputs of extractroofplanes; POINTS_CSV and LINES_CSV = LiDAR control points and lines</source>
-            <translation type="unfinished" />
+            <translation>PLANES e CLOUD = as duas saídas de extractroofplanes; POINTS_CSV e LINES_CSV = pontos e linhas de controle LiDAR</translation>
         </message>
         <message>
             <source>TRAJECTORY = the exterior orientation, PLANES / LINES / LCPS = the control, OBSERVATIONS = image measurements made in the picking dock; OUTPUT_TABLE = boresight per group, OUTPUT_EO = corrected orientation</source>
-            <translation type="unfinished" />
+            <translation>TRAJECTORY = a orientação exterior, PLANES / LINES / LCPS = o controle, OBSERVATIONS = medições nas imagens feitas no painel de medição; OUTPUT_TABLE = boresight por grupo, OUTPUT_EO = orientação corrigida</translation>
         </message>
         <message>
             <source>INPUT = check points measured with the corrected orientation; OUTPUT_HTML and OUTPUT_JSON = the accuracy figures against the standards</source>
-            <translation type="unfinished" />
+            <translation>INPUT = pontos de verificação medidos com a orientação corrigida; OUTPUT_HTML e OUTPUT_JSON = os valores de acurácia em relação às normas</translation>
         </message>
         <message>
             <source>INPUT = the LAS/LAZ; OUTPUT_DTM = the terrain model (or use the cloud itself as DSM)</source>
-            <translation type="unfinished" />
+            <translation>INPUT = o LAS/LAZ; OUTPUT_DTM = o modelo do terreno (ou use a própria nuvem como MDS)</translation>
         </message>
         <message>
             <source>OUTPUT_CSV = roof planes, used by monoplot for points on roofs</source>
-            <translation type="unfinished" />
+            <translation>OUTPUT_CSV = planos de telhado, usados por monoplot para pontos sobre telhados</translation>
         </message>
         <message>
             <source>OBSERVATIONS + CONTROL_POINTS (or lines) of one image; OUTPUT_EO = its exterior orientation</source>
-            <translation type="unfinished" />
+            <translation>OBSERVATIONS + CONTROL_POINTS (ou linhas) de uma imagem; OUTPUT_EO = a sua orientação exterior</translation>
         </message>
         <message>
             <source>OBSERVATIONS of the image, EO, DSM (raster or LAS/LAZ), optional PLANES; OUTPUT_CSV = 3D points</source>
-            <translation type="unfinished" />
+            <translation>OBSERVATIONS da imagem, EO, DSM (raster ou LAS/LAZ), PLANES opcional; OUTPUT_CSV = pontos 3D</translation>
         </message>
         <message>
             <source>INPUT = monoplotted check points against their reference</source>
-            <translation type="unfinished" />
+            <translation>INPUT = pontos de verificação monorrestituídos comparados com a sua referência</translation>
         </message>
         <message>
             <source>IMAGES = views of a chessboard or ChArUco target; OUTPUT_CAMERA = the camera JSON (start values for the block, or held fixed)</source>
-            <translation type="unfinished" />
+            <translation>IMAGES = vistas de um alvo xadrez ou ChArUco; OUTPUT_CAMERA = o JSON da câmera (valores iniciais para o bloco, ou mantidos fixos)</translation>
         </message>
         <message>
             <source>IMAGES (and the approximate EO + CAMERA to pair images by their footprints); OUTPUT_OBSERVATIONS = tie points for the bundle</source>
-            <translation type="unfinished" />
+            <translation>IMAGES (e a EO aproximada + CAMERA para formar pares de imagens pelas suas projeções no terreno); OUTPUT_OBSERVATIONS = pontos de enlace para o ajustamento por feixes de raios</translation>
         </message>
         <message>
             <source>POINTS = the surveyed control, PHOTOS = ground photos of each point with and without the control plate, CAMERA = the ground camera; OUTPUT_FOLDER = one chip per point at the GSD of the aerial images</source>
-            <translation type="unfinished" />
+            <translation>POINTS = o controle levantado, PHOTOS = fotos terrestres de cada ponto com e sem a placa de controle, CAMERA = a câmera terrestre; OUTPUT_FOLDER = um recorte (chip) por ponto no GSD das imagens aéreas</translation>
         </message>
         <message>
             <source>CHIPS = one GeoTIFF chip per control point, CONTROL_POINTS, CAMERA, approximate EO, IMAGES; OUTPUT = the control points' image observations, without clicking them</source>
-            <translation type="unfinished" />
+            <translation>CHIPS = um recorte (chip) GeoTIFF por ponto de controle, CONTROL_POINTS, CAMERA, EO aproximada, IMAGES; OUTPUT = as observações de imagem dos pontos de controle, sem clicar neles</translation>
         </message>
         <message>
             <source>CAMERA, OBSERVATIONS, GROUND_POINTS, EO (approximate); OUTPUT_EO = adjusted orientation, OUTPUT_CAMERA = calibrated camera</source>
-            <translation type="unfinished" />
+            <translation>CAMERA, OBSERVATIONS, GROUND_POINTS, EO (aproximada); OUTPUT_EO = orientação ajustada, OUTPUT_CAMERA = câmera calibrada</translation>
         </message>
         <message>
             <source>OUTPUT_DTM = the terrain for the orthophotos</source>
-            <translation type="unfinished" />
+            <translation>OUTPUT_DTM = o terreno para as ortofotos</translation>
         </message>
         <message>
             <source>CAMERA and EO from the bundle, IMAGES, DSM = the DTM or DSM; OUTPUT_FOLDER = one orthophoto per image</source>
-            <translation type="unfinished" />
+            <translation>CAMERA e EO do ajustamento por feixes de raios, IMAGES, DSM = o MDT ou MDS; OUTPUT_FOLDER = uma ortofoto por imagem</translation>
         </message>
         <message>
             <source>ORTHOPHOTOS = that folder; OUTPUT = the mosaic, SEAMLINES_CSV = the region of each image</source>
-            <translation type="unfinished" />
+            <translation>ORTHOPHOTOS = essa pasta; OUTPUT = o mosaico, SEAMLINES_CSV = a região de cada imagem</translation>
         </message>
         <message>
             <source>INPUT = check points measured on the mosaic</source>
-            <translation type="unfinished" />
+            <translation>INPUT = pontos de verificação medidos no mosaico</translation>
         </message>
         <message>
             <source>INPUT = a folder of LAS/LAZ tiles or a .vpc; OUTPUT_FOLDER = classified tiles, block.vpc, planes.csv, lcps.csv and lines.csv</source>
-            <translation type="unfinished" />
+            <translation>INPUT = uma pasta de tiles LAS/LAZ ou um .vpc; OUTPUT_FOLDER = tiles classificados, block.vpc, planes.csv, lcps.csv e lines.csv</translation>
         </message>
         <message>
             <source>PLANES / LINES / LCPS = the block's tables, TRAJECTORY and OBSERVATIONS as above</source>
-            <translation type="unfinished" />
+            <translation>PLANES / LINES / LCPS = as tabelas do bloco, TRAJECTORY e OBSERVATIONS como acima</translation>
         </message>
         <message>
             <source>SCANS = the station clouds, CONTROL = target ids; OUTPUT = target observations</source>
-            <translation type="unfinished" />
+            <translation>SCANS = as nuvens das estações, CONTROL = ids dos alvos; OUTPUT = observações dos alvos</translation>
         </message>
         <message>
             <source>OBSERVATIONS = those targets, CONTROL and STATIONS; OUTPUT_APS = the scanner's additional parameters, OUTPUT_HTML = the report</source>
-            <translation type="unfinished" />
+            <translation>OBSERVATIONS = esses alvos, CONTROL e STATIONS; OUTPUT_APS = os parâmetros adicionais do scanner, OUTPUT_HTML = o relatório</translation>
         </message>
         <message>
             <source>(this algorithm)</source>
-            <translation type="unfinished" />
+            <translation>(este algoritmo)</translation>
         </message>
         <message>
             <source>unit, range</source>
@@ -741,19 +741,19 @@
         </message>
         <message>
             <source>Select a point of the image shown first.</source>
-            <translation type="unfinished" />
+            <translation>Selecione primeiro um ponto da imagem exibida.</translation>
         </message>
         <message>
             <source>Point {} is measured in no other image: no template.</source>
-            <translation type="unfinished" />
+            <translation>O ponto {} não está medido em nenhuma outra imagem: sem modelo (template).</translation>
         </message>
         <message>
             <source>Point {} not refined: {}</source>
-            <translation type="unfinished" />
+            <translation>Ponto {} não refinado: {}</translation>
         </message>
         <message>
             <source>Point {} refined by least-squares matching on image {}: moved {:.2f} px, sigma {:.3f} px, correlation {:.2f}.</source>
-            <translation type="unfinished" />
+            <translation>Ponto {} refinado por correspondência por mínimos quadrados na imagem {}: deslocado {:.2f} px, sigma {:.3f} px, correlação {:.2f}.</translation>
         </message>
     </context>
     <context>
@@ -1346,11 +1346,11 @@
         </message>
         <message>
             <source>mean horizontal (m)</source>
-            <translation type="unfinished" />
+            <translation>média horizontal (m)</translation>
         </message>
         <message>
             <source>std horizontal (m)</source>
-            <translation type="unfinished" />
+            <translation>desvio-padrão horizontal (m)</translation>
         </message>
         <message>
             <source>APs</source>
@@ -1538,7 +1538,7 @@
         </message>
         <message>
             <source>Horizontal discrepancy: mean {} m, standard deviation {} m, RMSE_HORIZONTAL {} m; RMSE_E / RMSE_N / RMSE_U {} / {} / {} m; RMSE_3D {} m. Intersected with the adjusted orientations; their sigmas carry the image noise only.</source>
-            <translation type="unfinished" />
+            <translation>Discrepância horizontal: média {} m, desvio-padrão {} m, RMSE_HORIZONTAL {} m; RMSE_E / RMSE_N / RMSE_U {} / {} / {} m; RMSE_3D {} m. Interseção com as orientações ajustadas; os seus sigmas refletem apenas o ruído das imagens.</translation>
         </message>
         <message>
             <source>not observable: {}</source>
@@ -2015,11 +2015,11 @@
         </message>
         <message>
             <source>Refine</source>
-            <translation type="unfinished" />
+            <translation>Refinar</translation>
         </message>
         <message>
             <source>Snap the selected point to the least-squares match (6 affine + 2 radiometric parameters) of the same point measured in another image</source>
-            <translation type="unfinished" />
+            <translation>Ajusta o ponto selecionado à correspondência por mínimos quadrados (6 parâmetros afins + 2 radiométricos) do mesmo ponto medido em outra imagem</translation>
         </message>
         <message>
             <source>Scale of the residual vectors</source>
@@ -2139,7 +2139,12 @@ layer at the reference positions with id, group, dE, dN, dU, dHorizontal, d3D, o
 the RMSE values as numeric outputs RMSE_E, RMSE_N, RMSE_U (height), RMSE_HORIZONTAL, RMSE_3D
 (docs/formats.md, "Accuracy figures"; RMSE_H and RMSE_HORIZ, their former names, are kept
 for one release).</source>
-            <translation type="unfinished" />
+            <translation>## Saídas
+Um relatório HTML autocontido (tabelas, vereditos, gráficos SVG), um JSON com todos os valores, uma camada
+PointZ nas posições de referência com id, group, dE, dN, dU, dHorizontal, d3D, outlier, e
+os valores de RMSE como saídas numéricas RMSE_E, RMSE_N, RMSE_U (altura), RMSE_HORIZONTAL, RMSE_3D
+(docs/formats.md, "Accuracy figures"; RMSE_H e RMSE_HORIZ, os seus nomes anteriores, são mantidos
+por uma versão).</translation>
         </message>
         <message>
             <source>Check-point table (CSV: id, e, n, h, e_ref, n_ref, h_ref, group)</source>
@@ -2335,11 +2340,11 @@ for one release).</source>
         </message>
         <message>
             <source>RMSE_U (m)</source>
-            <translation type="unfinished" />
+            <translation>RMSE_U (m)</translation>
         </message>
         <message>
             <source>RMSE_HORIZONTAL (m)</source>
-            <translation type="unfinished" />
+            <translation>RMSE_HORIZONTAL (m)</translation>
         </message>
         <message>
             <source>RMSE_3D (m)</source>
@@ -2347,11 +2352,11 @@ for one release).</source>
         </message>
         <message>
             <source>RMSE_H (m; deprecated: use RMSE_U)</source>
-            <translation type="unfinished" />
+            <translation>RMSE_H (m; obsoleto: use RMSE_U)</translation>
         </message>
         <message>
             <source>RMSE_HORIZ (m; deprecated: use RMSE_HORIZONTAL)</source>
-            <translation type="unfinished" />
+            <translation>RMSE_HORIZ (m; obsoleto: use RMSE_HORIZONTAL)</translation>
         </message>
         <message>
             <source>## Outputs
@@ -2904,15 +2909,15 @@ são recusadas, com o arquivo e a linha indicados.</translation>
         <name>lidarphoto:calibratecamera</name>
         <message>
             <source>Calibrate a camera from target images</source>
-            <translation type="unfinished" />
+            <translation>Calibrar uma câmera a partir de imagens de um alvo</translation>
         </message>
         <message>
             <source>Photogrammetry</source>
-            <translation type="unfinished" />
+            <translation>Fotogrametria</translation>
         </message>
         <message>
             <source>Interior orientation and lens distortion (perspective or fisheye) from views of a planar target</source>
-            <translation type="unfinished" />
+            <translation>Orientação interior e distorção da lente (perspectiva ou olho de peixe) a partir de vistas de um alvo plano</translation>
         </message>
         <message>
             <source>Detects a planar target in every image of a folder with OpenCV (chessboard:
@@ -2922,7 +2927,13 @@ a self-calibrating bundle with one pose per view, the interior orientation f, x0
 Brown-Conrady coefficients k1 k2 k3 p1 p2 (any subset), for the perspective projection or a
 fisheye projection (equidistant, equisolid-angle, orthographic, stereographic; Schneider,
 Schwalbe &amp; Maas 2009) with the Brown correction added.</source>
-            <translation type="unfinished" />
+            <translation>Detecta um alvo plano em cada imagem de uma pasta com o OpenCV (xadrez:
+findChessboardCornersSB; ChArUco: CharucoDetector; placa em grade ArUco: ArucoDetector com
+cantos subpixel) e calibra a câmera com o ajustamento por mínimos quadrados do próprio projeto:
+um feixe autocalibrável com uma pose por vista, a orientação interior f, x0, y0 e os
+coeficientes de Brown-Conrady k1 k2 k3 p1 p2 (qualquer subconjunto), para a projeção perspectiva ou uma
+projeção olho de peixe (equidistante, de ângulo equissólido, ortográfica, estereográfica; Schneider,
+Schwalbe &amp; Maas 2009) com a correção de Brown acrescentada.</translation>
         </message>
         <message>
             <source>Target: chessboard COLUMNS x ROWS inner corners, SPACING the square side; ChArUco COLUMNS x ROWS
@@ -2931,7 +2942,12 @@ markers, SPACING the marker side, MARKER the gap between markers. The field is f
 nominal coordinates) or free (estimated; datum: the origin corner and the end of the first row
 held at their nominal coordinates, which sets the scale from the square size, and the start of
 the last row held in the plane Z = 0).</source>
-            <translation type="unfinished" />
+            <translation>Alvo: xadrez com COLUMNS x ROWS cantos internos, SPACING o lado do quadrado; ChArUco com COLUMNS x ROWS
+quadrados, SPACING o lado do quadrado, MARKER o lado do marcador; placa em grade ArUco com COLUMNS x ROWS
+marcadores, SPACING o lado do marcador, MARKER o espaço entre marcadores. O campo é fixo (suas
+coordenadas nominais) ou livre (estimado; datum: o canto de origem e o fim da primeira linha
+mantidos nas suas coordenadas nominais, o que define a escala a partir do tamanho do quadrado, e o início da
+última linha mantido no plano Z = 0).</translation>
         </message>
         <message>
             <source>Outputs: the camera JSON (usable by every algorithm; a fisheye camera is refused by those whose
@@ -2939,155 +2955,159 @@ kernels are perspective-only), a report JSON (sigmas, correlations, sigma0, the 
 lens coefficient, per-view RMS and poses), the same as an HTML page, and the residual table
 (CSV). PIXEL_SIZE only scales
 the millimetre values of the camera file: the calibration itself is in pixels.</source>
-            <translation type="unfinished" />
+            <translation>Saídas: o JSON da câmera (utilizável por todos os algoritmos; uma câmera olho de peixe é recusada por aqueles cujos
+núcleos são apenas perspectivos), um JSON de relatório (sigmas, correlações, sigma0, o teste t de cada
+coeficiente da lente, RMS e poses por vista), o mesmo como página HTML, e a tabela de resíduos
+(CSV). PIXEL_SIZE apenas escala
+os valores em milímetros do arquivo da câmera: a calibração em si é em pixels.</translation>
         </message>
         <message>
             <source>Target images (files or folders)</source>
-            <translation type="unfinished" />
+            <translation>Imagens do alvo (arquivos ou pastas)</translation>
         </message>
         <message>
             <source>image files, or folders whose images are all taken</source>
-            <translation type="unfinished" />
+            <translation>arquivos de imagem, ou pastas cujas imagens são todas tomadas</translation>
         </message>
         <message>
             <source>Target</source>
-            <translation type="unfinished" />
+            <translation>Alvo</translation>
         </message>
         <message>
             <source>chessboard</source>
-            <translation type="unfinished" />
+            <translation>xadrez</translation>
         </message>
         <message>
             <source>ChArUco board</source>
-            <translation type="unfinished" />
+            <translation>placa ChArUco</translation>
         </message>
         <message>
             <source>ArUco grid board</source>
-            <translation type="unfinished" />
+            <translation>placa em grade ArUco</translation>
         </message>
         <message>
             <source>Columns (inner corners / squares / markers)</source>
-            <translation type="unfinished" />
+            <translation>Colunas (cantos internos / quadrados / marcadores)</translation>
         </message>
         <message>
             <source>Rows (inner corners / squares / markers)</source>
-            <translation type="unfinished" />
+            <translation>Linhas (cantos internos / quadrados / marcadores)</translation>
         </message>
         <message>
             <source>Square side (ArUco: marker side)</source>
-            <translation type="unfinished" />
+            <translation>Lado do quadrado (ArUco: lado do marcador)</translation>
         </message>
         <message>
             <source>ChArUco marker side / ArUco gap</source>
-            <translation type="unfinished" />
+            <translation>Lado do marcador ChArUco / espaço ArUco</translation>
         </message>
         <message>
             <source>ArUco dictionary</source>
-            <translation type="unfinished" />
+            <translation>Dicionário ArUco</translation>
         </message>
         <message>
             <source>Projection</source>
-            <translation type="unfinished" />
+            <translation>Projeção</translation>
         </message>
         <message>
             <source>perspective (central)</source>
-            <translation type="unfinished" />
+            <translation>perspectiva (central)</translation>
         </message>
         <message>
             <source>fisheye: equidistant</source>
-            <translation type="unfinished" />
+            <translation>olho de peixe: equidistante</translation>
         </message>
         <message>
             <source>fisheye: equisolid-angle</source>
-            <translation type="unfinished" />
+            <translation>olho de peixe: ângulo equissólido</translation>
         </message>
         <message>
             <source>fisheye: orthographic</source>
-            <translation type="unfinished" />
+            <translation>olho de peixe: ortográfica</translation>
         </message>
         <message>
             <source>fisheye: stereographic</source>
-            <translation type="unfinished" />
+            <translation>olho de peixe: estereográfica</translation>
         </message>
         <message>
             <source>Lens coefficients estimated</source>
-            <translation type="unfinished" />
+            <translation>Coeficientes da lente estimados</translation>
         </message>
         <message>
             <source>Brown-Conrady coefficients; the others are held at zero</source>
-            <translation type="unfinished" />
+            <translation>Coeficientes de Brown-Conrady; os demais são mantidos em zero</translation>
         </message>
         <message>
             <source>Target field</source>
-            <translation type="unfinished" />
+            <translation>Campo do alvo</translation>
         </message>
         <message>
             <source>fixed (nominal coordinates)</source>
-            <translation type="unfinished" />
+            <translation>fixo (coordenadas nominais)</translation>
         </message>
         <message>
             <source>free (estimated, minimal datum)</source>
-            <translation type="unfinished" />
+            <translation>livre (estimado, datum mínimo)</translation>
         </message>
         <message>
             <source>Pixel size</source>
-            <translation type="unfinished" />
+            <translation>Tamanho do pixel</translation>
         </message>
         <message>
             <source>A-priori sigma of a detected point</source>
-            <translation type="unfinished" />
+            <translation>Sigma a priori de um ponto detectado</translation>
         </message>
         <message>
             <source>Camera name</source>
-            <translation type="unfinished" />
+            <translation>Nome da câmera</translation>
         </message>
         <message>
             <source>Calibrated camera (JSON)</source>
-            <translation type="unfinished" />
+            <translation>Câmera calibrada (JSON)</translation>
         </message>
         <message>
             <source>JSON files (*.json)</source>
-            <translation type="unfinished" />
+            <translation>Arquivos JSON (*.json)</translation>
         </message>
         <message>
             <source>Calibration report (JSON)</source>
-            <translation type="unfinished" />
+            <translation>Relatório da calibração (JSON)</translation>
         </message>
         <message>
             <source>Calibration report (HTML)</source>
-            <translation type="unfinished" />
+            <translation>Relatório da calibração (HTML)</translation>
         </message>
         <message>
             <source>HTML files (*.html)</source>
-            <translation type="unfinished" />
+            <translation>Arquivos HTML (*.html)</translation>
         </message>
         <message>
             <source>Residuals per point (CSV)</source>
-            <translation type="unfinished" />
+            <translation>Resíduos por ponto (CSV)</translation>
         </message>
         <message>
             <source>CSV files (*.csv)</source>
-            <translation type="unfinished" />
+            <translation>Arquivos CSV (*.csv)</translation>
         </message>
         <message>
             <source>Views used</source>
-            <translation type="unfinished" />
+            <translation>Vistas usadas</translation>
         </message>
         <message>
             <source>Target points used</source>
-            <translation type="unfinished" />
+            <translation>Pontos do alvo usados</translation>
         </message>
         <message>
             <source>Reprojection RMS (px)</source>
-            <translation type="unfinished" />
+            <translation>RMS de reprojeção (px)</translation>
         </message>
         <message>
             <source>Sigma0 (a-priori 1)</source>
-            <translation type="unfinished" />
+            <translation>Sigma0 (a priori 1)</translation>
         </message>
         <message>
             <source>Focal length (px)</source>
-            <translation type="unfinished" />
+            <translation>Distância focal (px)</translation>
         </message>
     </context>
     <context>
@@ -3136,7 +3156,11 @@ metres; the outputs are in the CRS unit. Optionally give your own plane-id tripl
 ("1,2,3; 4,5,6") or pairs ("1,2; 2,3") instead of the automatic ones. The log counts the
 rejected candidates per reason; each one, with its numbers and units, is listed only in
 verbose mode (command line: -vv; QGIS: Processing options, logging level Verbose).</source>
-            <translation type="unfinished" />
+            <translation>As distâncias estão na unidade do SRC da nuvem (por exemplo, pés para um SRC em pés), a menos que a unidade de distância seja
+metros; as saídas estão na unidade do SRC. Opcionalmente, dê as suas próprias triplas de ids de planos
+("1,2,3; 4,5,6") ou pares ("1,2; 2,3") em vez das automáticas. O log conta os
+candidatos rejeitados por motivo; cada um, com os seus números e unidades, é listado apenas no
+modo verboso (linha de comando: -vv; QGIS: opções do Processamento, nível de log Verbose).</translation>
         </message>
         <message>
             <source>Plane table (CSV)</source>
@@ -3813,28 +3837,33 @@ opcionalmente, o MDT em GeoTIFF.</translation>
         <name>lidarphoto:lidarblock</name>
         <message>
             <source>LiDAR block: ground, roof planes and control, tile by tile (dask)</source>
-            <translation type="unfinished" />
+            <translation>Bloco LiDAR: terreno, planos de telhado e controle, tile por tile (dask)</translation>
         </message>
         <message>
             <source>LiDAR</source>
-            <translation type="unfinished" />
+            <translation>LiDAR</translation>
         </message>
         <message>
             <source>a whole LiDAR block tile by tile on dask.distributed: ground filter, roof planes, LiDAR control points and lines</source>
-            <translation type="unfinished" />
+            <translation>um bloco LiDAR inteiro, tile por tile, no dask.distributed: filtro de terreno, planos de telhado, pontos e linhas de controle LiDAR</translation>
         </message>
         <message>
             <source>Runs the ground filter (SMRF, Pingel et al. 2013), the roof planes and the LiDAR control of
 a whole block, one dask task per tile, on a local dask.distributed cluster (one worker per
 core by default) or on an existing cluster (CLUSTER: its scheduler address, e.g.
 tcp://10.0.0.5:8786; every worker must have lidarphoto and read the input paths).</source>
-            <translation type="unfinished" />
+            <translation>Executa o filtro de terreno (SMRF, Pingel et al. 2013), os planos de telhado e o controle LiDAR de
+um bloco inteiro, uma tarefa dask por tile, em um cluster dask.distributed local (um trabalhador (worker) por
+núcleo por padrão) ou em um cluster existente (CLUSTER: o endereço do seu scheduler, por exemplo,
+tcp://10.0.0.5:8786; todo trabalhador deve ter o lidarphoto e conseguir ler os caminhos de entrada).</translation>
         </message>
         <message>
             <source>Input: a folder of LAS/LAZ tiles, a virtual point cloud (.vpc, as made by PDAL or QGIS), or
 one large LAS/LAZ file cut into square tiles of TILE_SIZE read in chunks. Tiles in different
 CRSs are refused. Neighbours are found from the headers' bounding boxes.</source>
-            <translation type="unfinished" />
+            <translation>Entrada: uma pasta de tiles LAS/LAZ, uma nuvem de pontos virtual (.vpc, como as criadas pelo PDAL ou QGIS), ou
+um único arquivo LAS/LAZ grande, cortado em tiles quadrados de TILE_SIZE lidos em partes. Tiles em SRCs
+diferentes são recusados. Os vizinhos são encontrados pelas caixas envolventes dos cabeçalhos.</translation>
         </message>
         <message>
             <source>Buffers: each tile is filtered with the points of its neighbours within 2 x SMRF_WINDOW +
@@ -3845,13 +3874,22 @@ the tile's own points are written. Roof planes are extracted on the tile plus tw
 radius of a K_NEIGHBOURS patch; planes cut by a tile border are merged (same plane by the
 parameter test, adjacent points) and refitted with their covariance from all their points;
 control points and lines found by several tiles are kept once.</source>
-            <translation type="unfinished" />
+            <translation>Buffers: cada tile é filtrado com os pontos dos seus vizinhos a até 2 x SMRF_WINDOW +
+LOW_OUTLIER_RADIUS + 3 células da sua caixa, de modo que as suas classes são as de uma execução sobre a nuvem inteira
+(exceto alguns pontos junto a edificações a milímetros da tolerância de altura: o MDT
+preenchido sob os objetos depende do canto da grade do tile; 9 de 75 256 pontos nos testes); apenas
+os pontos do próprio tile são gravados. Os planos de telhado são extraídos no tile mais duas vezes o
+raio de uma vizinhança K_NEIGHBOURS; planos cortados por uma borda de tile são unidos (mesmo plano pelo
+teste de parâmetros, pontos adjacentes) e reajustados com a sua covariância a partir de todos os seus pontos;
+pontos e linhas de controle encontrados por vários tiles são mantidos uma única vez.</translation>
         </message>
         <message>
             <source>A tile that cannot be read is reported by name and skipped; the rest finishes and the block
 is marked incomplete (report "complete": false, result COMPLETE 0, command-line exit
 status 3).</source>
-            <translation type="unfinished" />
+            <translation>Um tile que não pode ser lido é informado pelo nome e ignorado; o restante termina e o bloco
+é marcado como incompleto (relatório "complete": false, resultado COMPLETE 0, status de saída da
+linha de comando 3).</translation>
         </message>
         <message>
             <source>## Outputs
@@ -3861,182 +3899,188 @@ other classes kept), block.vpc (the tiles as a virtual point cloud), planes.csv,
 lines.csv (the formats of Extract roof planes and Create LCPs) and block_report.json (per
 tile: points, ground, seconds, peak memory, errors). Lengths are in the CRS unit unless
 DISTANCE_UNIT is metres.</source>
-            <translation type="unfinished" />
+            <translation>## Saídas
+OUTPUT_FOLDER (deve ser nova, vazia, ou uma saída de bloco anterior) recebe, tudo de uma vez quando
+o bloco termina: tiles/&lt;tile&gt;.laz (os pontos do próprio tile, classe 2 terreno, 7 outliers baixos,
+demais classes mantidas), block.vpc (os tiles como nuvem de pontos virtual), planes.csv, lcps.csv,
+lines.csv (os formatos de Extrair planos de telhado e Criar LCPs) e block_report.json (por
+tile: pontos, terreno, segundos, pico de memória, erros). Os comprimentos estão na unidade do SRC, a menos que
+DISTANCE_UNIT seja metros.</translation>
         </message>
         <message>
             <source>Block: folder of LAS/LAZ tiles, .vpc or one LAS/LAZ file</source>
-            <translation type="unfinished" />
+            <translation>Bloco: pasta de tiles LAS/LAZ, .vpc ou um arquivo LAS/LAZ</translation>
         </message>
         <message>
             <source>a folder path is accepted too (its *.las/*.laz)</source>
-            <translation type="unfinished" />
+            <translation>um caminho de pasta também é aceito (os seus *.las/*.laz)</translation>
         </message>
         <message>
             <source>LAS/LAZ or virtual point cloud (*.las *.laz *.vpc)</source>
-            <translation type="unfinished" />
+            <translation>LAS/LAZ ou nuvem de pontos virtual (*.las *.laz *.vpc)</translation>
         </message>
         <message>
             <source>CRS (overrides the file's)</source>
-            <translation type="unfinished" />
+            <translation>SRC (substitui o do arquivo)</translation>
         </message>
         <message>
             <source>the cloud's CRS when the file has none or a wrong one (EPSG:xxxx or WKT)</source>
-            <translation type="unfinished" />
+            <translation>o SRC da nuvem quando o arquivo não tem nenhum ou tem um errado (EPSG:xxxx ou WKT)</translation>
         </message>
         <message>
             <source>Distance unit</source>
-            <translation type="unfinished" />
+            <translation>Unidade de distância</translation>
         </message>
         <message>
             <source>unit of the length parameters: the cloud's CRS unit (e.g. international feet) or metres, converted</source>
-            <translation type="unfinished" />
+            <translation>unidade dos parâmetros de comprimento: a unidade do SRC da nuvem (por exemplo, pés internacionais) ou metros, convertidos</translation>
         </message>
         <message>
             <source>cloud CRS units</source>
-            <translation type="unfinished" />
+            <translation>unidades do SRC da nuvem</translation>
         </message>
         <message>
             <source>metres</source>
-            <translation type="unfinished" />
+            <translation>metros</translation>
         </message>
         <message>
             <source>Tile size (one large file)</source>
-            <translation type="unfinished" />
+            <translation>Tamanho do tile (um arquivo grande)</translation>
         </message>
         <message>
             <source>side of the square tiles one file is cut into</source>
-            <translation type="unfinished" />
+            <translation>lado dos tiles quadrados em que um arquivo é cortado</translation>
         </message>
         <message>
             <source>SMRF cell size</source>
-            <translation type="unfinished" />
+            <translation>Tamanho da célula do SMRF</translation>
         </message>
         <message>
             <source>SMRF terrain slope</source>
-            <translation type="unfinished" />
+            <translation>Declividade do terreno do SMRF</translation>
         </message>
         <message>
             <source>SMRF largest window radius</source>
-            <translation type="unfinished" />
+            <translation>Maior raio de janela do SMRF</translation>
         </message>
         <message>
             <source>SMRF final height tolerance</source>
-            <translation type="unfinished" />
+            <translation>Tolerância final de altura do SMRF</translation>
         </message>
         <message>
             <source>SMRF tolerance added per unit of slope</source>
-            <translation type="unfinished" />
+            <translation>Tolerância do SMRF acrescida por unidade de declividade</translation>
         </message>
         <message>
             <source>Low outlier radius</source>
-            <translation type="unfinished" />
+            <translation>Raio dos outliers baixos</translation>
         </message>
         <message>
             <source>Roof planes: point-to-plane tolerance</source>
-            <translation type="unfinished" />
+            <translation>Planos de telhado: tolerância ponto-plano</translation>
         </message>
         <message>
             <source>Roof planes: neighbours of the local RANSAC</source>
-            <translation type="unfinished" />
+            <translation>Planos de telhado: vizinhos do RANSAC local</translation>
         </message>
         <message>
             <source>Roof planes: smallest plane (points)</source>
-            <translation type="unfinished" />
+            <translation>Planos de telhado: menor plano (pontos)</translation>
         </message>
         <message>
             <source>Control: adjacency distance delta</source>
-            <translation type="unfinished" />
+            <translation>Controle: distância de adjacência delta</translation>
         </message>
         <message>
             <source>Control: minimum common boundary</source>
-            <translation type="unfinished" />
+            <translation>Controle: fronteira comum mínima</translation>
         </message>
         <message>
             <source>dask scheduler address (empty: a local cluster)</source>
-            <translation type="unfinished" />
+            <translation>endereço do scheduler dask (vazio: um cluster local)</translation>
         </message>
         <message>
             <source>e.g. tcp://10.0.0.5:8786</source>
-            <translation type="unfinished" />
+            <translation>por exemplo, tcp://10.0.0.5:8786</translation>
         </message>
         <message>
             <source>Local cluster: workers (0 = one per core)</source>
-            <translation type="unfinished" />
+            <translation>Cluster local: trabalhadores (workers) (0 = um por núcleo)</translation>
         </message>
         <message>
             <source>Local cluster: memory limit per worker (0 = RAM / workers)</source>
-            <translation type="unfinished" />
+            <translation>Cluster local: limite de memória por trabalhador (worker) (0 = RAM / trabalhadores)</translation>
         </message>
         <message>
             <source>Local cluster workers</source>
-            <translation type="unfinished" />
+            <translation>Trabalhadores (workers) do cluster local</translation>
         </message>
         <message>
             <source>auto: processes on the command line, threads inside QGIS or qgis_process, where a process cluster would start QGIS's own executable for each worker</source>
-            <translation type="unfinished" />
+            <translation>auto: processos na linha de comando, threads dentro do QGIS ou do qgis_process, onde um cluster de processos iniciaria o próprio executável do QGIS para cada trabalhador (worker)</translation>
         </message>
         <message>
             <source>auto (processes on the command line, threads inside QGIS)</source>
-            <translation type="unfinished" />
+            <translation>auto (processos na linha de comando, threads dentro do QGIS)</translation>
         </message>
         <message>
             <source>processes (one per worker)</source>
-            <translation type="unfinished" />
+            <translation>processos (um por trabalhador)</translation>
         </message>
         <message>
             <source>threads of this process</source>
-            <translation type="unfinished" />
+            <translation>threads deste processo</translation>
         </message>
         <message>
             <source>Output folder (tiles, VPC, tables, report)</source>
-            <translation type="unfinished" />
+            <translation>Pasta de saída (tiles, VPC, tabelas, relatório)</translation>
         </message>
         <message>
             <source>Tiles processed</source>
-            <translation type="unfinished" />
+            <translation>Tiles processados</translation>
         </message>
         <message>
             <source>Tiles that failed</source>
-            <translation type="unfinished" />
+            <translation>Tiles que falharam</translation>
         </message>
         <message>
             <source>1 when every tile was processed, else 0</source>
-            <translation type="unfinished" />
+            <translation>1 quando todos os tiles foram processados, senão 0</translation>
         </message>
         <message>
             <source>Points written</source>
-            <translation type="unfinished" />
+            <translation>Pontos gravados</translation>
         </message>
         <message>
             <source>Ground points</source>
-            <translation type="unfinished" />
+            <translation>Pontos de terreno</translation>
         </message>
         <message>
             <source>Roof planes</source>
-            <translation type="unfinished" />
+            <translation>Planos de telhado</translation>
         </message>
         <message>
             <source>LiDAR control points</source>
-            <translation type="unfinished" />
+            <translation>Pontos de controle LiDAR</translation>
         </message>
         <message>
             <source>LiDAR control lines</source>
-            <translation type="unfinished" />
+            <translation>Linhas de controle LiDAR</translation>
         </message>
     </context>
     <context>
         <name>lidarphoto:locatecontrolpoints</name>
         <message>
             <source>Locate control points in images (chips, NCC + least-squares matching)</source>
-            <translation type="unfinished" />
+            <translation>Localizar pontos de controle em imagens (recortes/chips, NCC + correspondência por mínimos quadrados)</translation>
         </message>
         <message>
             <source>Aerotriangulation</source>
-            <translation type="unfinished" />
+            <translation>Aerotriangulação</translation>
         </message>
         <message>
             <source>control points measured automatically in oriented images from control chips</source>
-            <translation type="unfinished" />
+            <translation>pontos de controle medidos automaticamente em imagens orientadas a partir de recortes (chips) de controle</translation>
         </message>
         <message>
             <source>Each control point is projected into each image with its exterior orientation; its control
@@ -4050,7 +4094,17 @@ image, times 3; without them +-SEARCH_PX pixels. A match is rejected, with the r
 chip without texture, low correlation, no convergence, a sigma above MAX_SIGMA, a match
 outside the search ellipse or a template partly outside the image. With TRANSFER, images where
 the chip match failed are matched from the point's best image (image-to-image LSM).</source>
-            <translation type="unfinished" />
+            <translation>Cada ponto de controle é projetado em cada imagem com a sua orientação exterior; o seu recorte (chip)
+de controle (um GeoTIFF com o norte para cima do terreno em torno do ponto, retificado sobre o plano Z = Z_point,
+nome do arquivo = id do ponto) é buscado ali por correlação cruzada normalizada com um tamanho de
+modelo (template) adaptativo (aumentado até que a precisão prevista por mínimos quadrados a partir da textura, Förstner
+1986, seja aceita), e então refinado por correspondência por mínimos quadrados (Gruen 1985: 6 parâmetros afins + 2 radiométricos)
+a partir dos pixels do recorte, com a afinidade local recorte-imagem como valor inicial. Janela
+de busca: os sigmas da EO (colunas sigma_X .. sigma_kappa_deg do CSV da EO) propagados para a
+imagem, vezes 3; sem eles, +-SEARCH_PX pixels. Uma correspondência é rejeitada, com o motivo, para um
+recorte sem textura, correlação baixa, ausência de convergência, um sigma acima de MAX_SIGMA, uma correspondência
+fora da elipse de busca ou um modelo parcialmente fora da imagem. Com TRANSFER, as imagens em que
+a correspondência do recorte falhou são correspondidas a partir da melhor imagem do ponto (LSM imagem a imagem).</translation>
         </message>
         <message>
             <source>Output: the image-observation CSV (image_id, point_id, col, row, sigma_px, type tie, empty
@@ -4058,132 +4112,138 @@ target_id; point_id = the control point's id), which bundleadjustment (with the 
 as ground points) and resection (with them as control points) read directly; sigma_px is the
 LSM sigma, at least SIGMA_FLOOR (LSM does not see the chip's own errors). The report CSV has
 one row per point and image with the status and reason; the HTML report shows the chips.</source>
-            <translation type="unfinished" />
+            <translation>Saída: o CSV de observações de imagem (image_id, point_id, col, row, sigma_px, type tie, target_id
+vazio; point_id = o id do ponto de controle), que bundleadjustment (com os pontos de controle
+como pontos de apoio) e resection (com eles como pontos de controle) leem diretamente; sigma_px é o
+sigma da LSM, no mínimo SIGMA_FLOOR (a LSM não vê os erros do próprio recorte). O CSV do relatório tem
+uma linha por ponto e imagem com o status e o motivo; o relatório HTML mostra os recortes.</translation>
         </message>
         <message>
             <source>Control chips (GeoTIFF files or folders)</source>
-            <translation type="unfinished" />
+            <translation>Recortes (chips) de controle (arquivos GeoTIFF ou pastas)</translation>
         </message>
         <message>
             <source>one GeoTIFF per point, named &lt;point_id&gt;.tif</source>
-            <translation type="unfinished" />
+            <translation>um GeoTIFF por ponto, nomeado &lt;point_id&gt;.tif</translation>
         </message>
         <message>
             <source>Control points (CSV)</source>
-            <translation type="unfinished" />
+            <translation>Pontos de controle (CSV)</translation>
         </message>
         <message>
             <source>point_id,X,Y,Z in the mapping CRS (the chips' CRS)</source>
-            <translation type="unfinished" />
+            <translation>point_id,X,Y,Z no SRC de mapeamento (o SRC dos recortes)</translation>
         </message>
         <message>
             <source>CSV files (*.csv *.txt)</source>
-            <translation type="unfinished" />
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
         </message>
         <message>
             <source>Camera (JSON)</source>
-            <translation type="unfinished" />
+            <translation>Câmera (JSON)</translation>
         </message>
         <message>
             <source>JSON files (*.json)</source>
-            <translation type="unfinished" />
+            <translation>Arquivos JSON (*.json)</translation>
         </message>
         <message>
             <source>Exterior orientation (CSV)</source>
-            <translation type="unfinished" />
+            <translation>Orientação exterior (CSV)</translation>
         </message>
         <message>
             <source>with sigma columns: the search window follows from them</source>
-            <translation type="unfinished" />
+            <translation>com colunas de sigma: a janela de busca decorre delas</translation>
         </message>
         <message>
             <source>Images (files or folders)</source>
-            <translation type="unfinished" />
+            <translation>Imagens (arquivos ou pastas)</translation>
         </message>
         <message>
             <source>image files (name = image_id), or folders whose images are all taken</source>
-            <translation type="unfinished" />
+            <translation>arquivos de imagem (nome = image_id), ou pastas cujas imagens são todas tomadas</translation>
         </message>
         <message>
             <source>Mapping CRS of the EO and control</source>
-            <translation type="unfinished" />
+            <translation>SRC de mapeamento da EO e do controle</translation>
         </message>
         <message>
             <source>e.g. EPSG:25832</source>
-            <translation type="unfinished" />
+            <translation>por exemplo, EPSG:25832</translation>
         </message>
         <message>
             <source>Search half-width without EO sigmas</source>
-            <translation type="unfinished" />
+            <translation>Semilargura da busca sem sigmas da EO</translation>
         </message>
         <message>
             <source>Smallest NCC peak</source>
-            <translation type="unfinished" />
+            <translation>Menor pico de NCC</translation>
         </message>
         <message>
             <source>Smallest LSM correlation</source>
-            <translation type="unfinished" />
+            <translation>Menor correlação da LSM</translation>
         </message>
         <message>
             <source>Largest LSM sigma</source>
-            <translation type="unfinished" />
+            <translation>Maior sigma da LSM</translation>
         </message>
         <message>
             <source>Smallest sigma written</source>
-            <translation type="unfinished" />
+            <translation>Menor sigma gravado</translation>
         </message>
         <message>
             <source>Transfer to images where the chip failed</source>
-            <translation type="unfinished" />
+            <translation>Transferir para as imagens em que o recorte falhou</translation>
         </message>
         <message>
             <source>Image observations (CSV)</source>
-            <translation type="unfinished" />
+            <translation>Observações de imagem (CSV)</translation>
         </message>
         <message>
             <source>CSV files (*.csv)</source>
-            <translation type="unfinished" />
+            <translation>Arquivos CSV (*.csv)</translation>
         </message>
         <message>
             <source>Report per point and image (CSV)</source>
-            <translation type="unfinished" />
+            <translation>Relatório por ponto e imagem (CSV)</translation>
         </message>
         <message>
             <source>Report with chip gallery (HTML)</source>
-            <translation type="unfinished" />
+            <translation>Relatório com galeria de recortes (HTML)</translation>
         </message>
         <message>
             <source>HTML files (*.html)</source>
-            <translation type="unfinished" />
+            <translation>Arquivos HTML (*.html)</translation>
         </message>
         <message>
             <source>Observations written</source>
-            <translation type="unfinished" />
+            <translation>Observações gravadas</translation>
         </message>
         <message>
             <source>Point-image pairs rejected</source>
-            <translation type="unfinished" />
+            <translation>Pares ponto-imagem rejeitados</translation>
         </message>
     </context>
     <context>
         <name>lidarphoto:makecontrolchips</name>
         <message>
             <source>Make control chips from ground photos</source>
-            <translation type="unfinished" />
+            <translation>Criar recortes (chips) de controle a partir de fotos terrestres</translation>
         </message>
         <message>
             <source>Image matching</source>
-            <translation type="unfinished" />
+            <translation>Correspondência de imagens</translation>
         </message>
         <message>
             <source>Control chips: ground photos of surveyed points rectified at the aerial GSD</source>
-            <translation type="unfinished" />
+            <translation>Recortes (chips) de controle: fotos terrestres de pontos levantados retificadas no GSD aéreo</translation>
         </message>
         <message>
             <source>Control chips for the automatic location of control points in aerial images (Berveglieri &amp;
 Tommaselli 2014). For each surveyed point two ground photos taken from the same spot looking
 down: one with the control plate over the point, one without it.</source>
-            <translation type="unfinished" />
+            <translation>Recortes (chips) de controle para a localização automática de pontos de controle em imagens aéreas (Berveglieri &amp;
+Tommaselli 2014). Para cada ponto levantado, duas fotos terrestres tomadas do mesmo local olhando para
+baixo: uma com a placa de controle sobre o ponto, outra sem ela.</translation>
         </message>
         <message>
             <source>1. The plate (a square with an outer and an inner square edge; its centre vertically above
@@ -4198,7 +4258,18 @@ homography) and resected from the matched ground points.
 3. It is rectified onto the horizontal plane Z = Z_point at the GSD, north up, centred on the
 point: the chip (the plate hides the ground, hence the plate-free photo). Without a
 plate-free photo, Chip from the plate photo makes it from the plate photo.</source>
-            <translation type="unfinished" />
+            <translation>1. A placa (um quadrado com uma borda quadrada externa e uma interna; o seu centro na vertical acima
+do ponto à altura da placa, nivelada, um lado ao longo do azimute da placa) é encontrada na foto
+com placa; os seus oito cantos são localizados com precisão subpixel (bordas ajustadas como retas
+e intersectadas, o modelo da lente removido), e a foto é orientada por resseção a partir deles (data snooping;
+sigma0 e os sigmas no relatório). Os quatro quartos de volta do quadrado são distinguidos pelo
+azimute da foto (o azimute de quadrícula aproximado da direção para cima das fotos, dentro de 45
+graus).
+2. A foto sem placa é correspondida à foto com placa por SIFT (Lowe 2004; teste de razão, homografia
+RANSAC) e orientada por resseção a partir dos pontos do terreno correspondidos.
+3. Ela é retificada sobre o plano horizontal Z = Z_point no GSD, com o norte para cima, centrada no
+ponto: o recorte (a placa esconde o terreno, daí a foto sem placa). Sem uma
+foto sem placa, Recorte a partir da foto com placa o gera a partir da foto com placa.</translation>
         </message>
         <message>
             <source>Ground points: the ground-point CSV of the bundle adjustment (point_id, X, Y, Z, role; every
@@ -4206,7 +4277,11 @@ point gets a chip, whatever its role) in the mapping CRS. Photos: a ground-photo
 (point_id, plate_photo, free_photo, and optional photo_azimuth_deg, plate_azimuth_deg), or
 files / folders searched by name:
 &lt;point_id&gt;&lt;plate suffix&gt;.&lt;ext&gt; and &lt;point_id&gt;&lt;free suffix&gt;.&lt;ext&gt;.</source>
-            <translation type="unfinished" />
+            <translation>Pontos de apoio: o CSV de pontos de apoio do ajustamento por feixes de raios (point_id, X, Y, Z, role; todo
+ponto recebe um recorte, qualquer que seja a sua função) no SRC de mapeamento. Fotos: uma tabela de fotos terrestres
+(point_id, plate_photo, free_photo, e opcionalmente photo_azimuth_deg, plate_azimuth_deg), ou
+arquivos / pastas buscados pelo nome:
+&lt;point_id&gt;&lt;plate suffix&gt;.&lt;ext&gt; e &lt;point_id&gt;&lt;free suffix&gt;.&lt;ext&gt;.</translation>
         </message>
         <message>
             <source>Output folder: &lt;point_id&gt;.tif per chip (float32 grey, nodata -9999, the geotransform puts the
@@ -4215,123 +4290,128 @@ status and reason, corners found, corner sigmas, resection sigma0 and sigmas, SI
 inliers). A point that fails (plate not found, only one square, ambiguous, resection sigma0
 too large, too few SIFT matches, chip partly outside the photo) gets its reason and no chip;
 the others are written.</source>
-            <translation type="unfinished" />
+            <translation>Pasta de saída: &lt;point_id&gt;.tif por recorte (float32 em tons de cinza, nodata -9999, a geotransformação põe o
+ponto no seu X, Y: o centro do recorte) e o relatório control_chips.csv / .json (por ponto:
+status e motivo, cantos encontrados, sigmas dos cantos, sigma0 e sigmas da resseção, correspondências SIFT e
+inliers). Um ponto que falha (placa não encontrada, apenas um quadrado, ambíguo, sigma0 da resseção
+grande demais, poucas correspondências SIFT, recorte parcialmente fora da foto) recebe o seu motivo e nenhum recorte;
+os demais são gravados.</translation>
         </message>
         <message>
             <source>Ground points (CSV)</source>
-            <translation type="unfinished" />
+            <translation>Pontos de apoio (CSV)</translation>
         </message>
         <message>
             <source>point_id, X, Y, Z, role (the bundle adjustment's table)</source>
-            <translation type="unfinished" />
+            <translation>point_id, X, Y, Z, role (a tabela do ajustamento por feixes de raios)</translation>
         </message>
         <message>
             <source>CSV files (*.csv *.txt)</source>
-            <translation type="unfinished" />
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
         </message>
         <message>
             <source>Mapping CRS of the points</source>
-            <translation type="unfinished" />
+            <translation>SRC de mapeamento dos pontos</translation>
         </message>
         <message>
             <source>e.g. EPSG:31983</source>
-            <translation type="unfinished" />
+            <translation>por exemplo, EPSG:31983</translation>
         </message>
         <message>
             <source>Ground camera (JSON)</source>
-            <translation type="unfinished" />
+            <translation>Câmera terrestre (JSON)</translation>
         </message>
         <message>
             <source>JSON files (*.json)</source>
-            <translation type="unfinished" />
+            <translation>Arquivos JSON (*.json)</translation>
         </message>
         <message>
             <source>Ground-photo table (CSV)</source>
-            <translation type="unfinished" />
+            <translation>Tabela de fotos terrestres (CSV)</translation>
         </message>
         <message>
             <source>point_id, plate_photo, free_photo; else PHOTOS are searched by name</source>
-            <translation type="unfinished" />
+            <translation>point_id, plate_photo, free_photo; caso contrário, PHOTOS são buscadas pelo nome</translation>
         </message>
         <message>
             <source>Ground photos (files or folders)</source>
-            <translation type="unfinished" />
+            <translation>Fotos terrestres (arquivos ou pastas)</translation>
         </message>
         <message>
             <source>searched by name when no table is given</source>
-            <translation type="unfinished" />
+            <translation>buscadas pelo nome quando nenhuma tabela é dada</translation>
         </message>
         <message>
             <source>Plate photo name suffix</source>
-            <translation type="unfinished" />
+            <translation>Sufixo do nome da foto com placa</translation>
         </message>
         <message>
             <source>Plate-free photo name suffix</source>
-            <translation type="unfinished" />
+            <translation>Sufixo do nome da foto sem placa</translation>
         </message>
         <message>
             <source>Plate outer side</source>
-            <translation type="unfinished" />
+            <translation>Lado externo da placa</translation>
         </message>
         <message>
             <source>Plate inner side</source>
-            <translation type="unfinished" />
+            <translation>Lado interno da placa</translation>
         </message>
         <message>
             <source>Plate height above the point</source>
-            <translation type="unfinished" />
+            <translation>Altura da placa acima do ponto</translation>
         </message>
         <message>
             <source>Plate side azimuth (grid)</source>
-            <translation type="unfinished" />
+            <translation>Azimute do lado da placa (quadrícula)</translation>
         </message>
         <message>
             <source>Photo up azimuth (grid, +-45)</source>
-            <translation type="unfinished" />
+            <translation>Azimute do topo da foto (quadrícula, +-45)</translation>
         </message>
         <message>
             <source>Chip GSD (the aerial images')</source>
-            <translation type="unfinished" />
+            <translation>GSD do recorte (o das imagens aéreas)</translation>
         </message>
         <message>
             <source>Chip size</source>
-            <translation type="unfinished" />
+            <translation>Tamanho do recorte</translation>
         </message>
         <message>
             <source>Largest resection sigma0</source>
-            <translation type="unfinished" />
+            <translation>Maior sigma0 da resseção</translation>
         </message>
         <message>
             <source>Corner sigma (0 = from the line fits)</source>
-            <translation type="unfinished" />
+            <translation>Sigma dos cantos (0 = a partir dos ajustes das retas)</translation>
         </message>
         <message>
             <source>SIFT ratio test</source>
-            <translation type="unfinished" />
+            <translation>Teste de razão do SIFT</translation>
         </message>
         <message>
             <source>RANSAC threshold</source>
-            <translation type="unfinished" />
+            <translation>Limiar do RANSAC</translation>
         </message>
         <message>
             <source>Fewest SIFT inliers</source>
-            <translation type="unfinished" />
+            <translation>Mínimo de inliers do SIFT</translation>
         </message>
         <message>
             <source>Chip from the plate photo when no plate-free photo</source>
-            <translation type="unfinished" />
+            <translation>Recorte a partir da foto com placa quando não houver foto sem placa</translation>
         </message>
         <message>
             <source>Output folder</source>
-            <translation type="unfinished" />
+            <translation>Pasta de saída</translation>
         </message>
         <message>
             <source>Chips written</source>
-            <translation type="unfinished" />
+            <translation>Recortes gravados</translation>
         </message>
         <message>
             <source>Points without a chip</source>
-            <translation type="unfinished" />
+            <translation>Pontos sem recorte</translation>
         </message>
     </context>
     <context>
@@ -5031,15 +5111,15 @@ linhas paralelas).</translation>
         <name>lidarphoto:tiepoints</name>
         <message>
             <source>Automatic tie points</source>
-            <translation type="unfinished" />
+            <translation>Pontos de enlace automáticos</translation>
         </message>
         <message>
             <source>Orientation</source>
-            <translation type="unfinished" />
+            <translation>Orientação</translation>
         </message>
         <message>
             <source>tie points of overlapping images by feature matching, for the bundle adjustment</source>
-            <translation type="unfinished" />
+            <translation>pontos de enlace de imagens sobrepostas por correspondência de feições, para o ajustamento por feixes de raios</translation>
         </message>
         <message>
             <source>Finds tie points in a block of images without an operator. Features: SIFT (Lowe 2004) or
@@ -5047,14 +5127,21 @@ ORB (Rublee et al. 2011, faster, less precise), detected once per image, on the 
 by the smallest integer factor that brings its longer side to at most Detection size (0: full
 resolution; reductions by 2, 4 and 8 are made while decoding JPEGs); the keypoints are
 scaled back to full-resolution pixels.</source>
-            <translation type="unfinished" />
+            <translation>Encontra pontos de enlace em um bloco de imagens sem operador. Feições: SIFT (Lowe 2004) ou
+ORB (Rublee et al. 2011, mais rápido, menos preciso), detectadas uma vez por imagem, na imagem reduzida
+pelo menor fator inteiro que leva o seu lado maior a no máximo Tamanho de detecção (0: resolução
+completa; reduções por 2, 4 e 8 são feitas durante a decodificação de JPEGs); os pontos-chave são
+reescalados para pixels da resolução completa.</translation>
         </message>
         <message>
             <source>Pairs: with an exterior orientation and a camera, the pairs whose ground footprints (image
 corners met with the plane at Mean terrain height) overlap by at least Minimum overlap of the
 smaller footprint; without them, each image with the next Window images in file-name order
 (sequential), or all pairs. An image the EO table lacks is paired with every image.</source>
-            <translation type="unfinished" />
+            <translation>Pares: com uma orientação exterior e uma câmera, os pares cujas projeções no terreno (cantos da imagem
+intersectados com o plano na Altura média do terreno) se sobrepõem em pelo menos Sobreposição mínima da
+menor projeção; sem elas, cada imagem com as próximas Janela imagens na ordem dos nomes de arquivo
+(sequencial), ou todos os pares. Uma imagem ausente da tabela de EO é pareada com todas as imagens.</translation>
         </message>
         <message>
             <source>Matching: nearest neighbours in descriptor space (FLANN k-d trees for SIFT, Muja &amp; Lowe 2009;
@@ -5064,161 +5151,169 @@ epipolar line in full-resolution pixels. Pairs with fewer than Minimum inliers a
 (the pair table gives the reason). Tracks: the matches of all pairs are merged (connected
 components); a track holding two different points of one image is dropped, as are tracks
 seen in fewer than Minimum track length images.</source>
-            <translation type="unfinished" />
+            <translation>Correspondência: vizinhos mais próximos no espaço dos descritores (árvores k-d do FLANN para SIFT, Muja &amp; Lowe 2009;
+força bruta para ORB), teste de razão de Lowe, uma verificação mútua, e então RANSAC sobre a matriz
+fundamental (Fischler &amp; Bolles 1981; MAGSAC++ por padrão) com um limiar sobre a distância à
+linha epipolar em pixels da resolução completa. Pares com menos que Mínimo de inliers são descartados
+(a tabela de pares dá o motivo). Trilhas: as correspondências de todos os pares são unidas (componentes
+conexas); uma trilha que contém dois pontos diferentes de uma mesma imagem é descartada, assim como as trilhas
+vistas em menos imagens que Comprimento mínimo da trilha.</translation>
         </message>
         <message>
             <source>Output: the image-observation CSV (type tie, point ids tp000001 ..., target_id empty), read
 directly by Bundle adjustment. sigma_px: the value given, or 0.5 px times the detection
 reduction factor. No least-squares refinement of the points yet.</source>
-            <translation type="unfinished" />
+            <translation>Saída: o CSV de observações de imagem (type tie, ids de pontos tp000001 ..., target_id vazio), lido
+diretamente pelo Ajustamento por feixes de raios. sigma_px: o valor dado, ou 0,5 px vezes o fator de
+redução da detecção. Ainda sem refinamento dos pontos por mínimos quadrados.</translation>
         </message>
         <message>
             <source>Images (files or folders)</source>
-            <translation type="unfinished" />
+            <translation>Imagens (arquivos ou pastas)</translation>
         </message>
         <message>
             <source>image files, or folders whose images are all taken; the image id is the file name without extension</source>
-            <translation type="unfinished" />
+            <translation>arquivos de imagem, ou pastas cujas imagens são todas tomadas; o id da imagem é o nome do arquivo sem extensão</translation>
         </message>
         <message>
             <source>Exterior orientation (CSV) for pair selection</source>
-            <translation type="unfinished" />
+            <translation>Orientação exterior (CSV) para a seleção de pares</translation>
         </message>
         <message>
             <source>with CAMERA: pairs from ground footprints</source>
-            <translation type="unfinished" />
+            <translation>com CAMERA: pares a partir das projeções no terreno</translation>
         </message>
         <message>
             <source>CSV files (*.csv *.txt)</source>
-            <translation type="unfinished" />
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
         </message>
         <message>
             <source>Camera (JSON)</source>
-            <translation type="unfinished" />
+            <translation>Câmera (JSON)</translation>
         </message>
         <message>
             <source>JSON files (*.json)</source>
-            <translation type="unfinished" />
+            <translation>Arquivos JSON (*.json)</translation>
         </message>
         <message>
             <source>Mean terrain height</source>
-            <translation type="unfinished" />
+            <translation>Altura média do terreno</translation>
         </message>
         <message>
             <source>the plane the footprints are computed on (EO heights)</source>
-            <translation type="unfinished" />
+            <translation>o plano sobre o qual as projeções no terreno são calculadas (alturas da EO)</translation>
         </message>
         <message>
             <source>Detector</source>
-            <translation type="unfinished" />
+            <translation>Detector</translation>
         </message>
         <message>
             <source>SIFT (Lowe 2004)</source>
-            <translation type="unfinished" />
+            <translation>SIFT (Lowe 2004)</translation>
         </message>
         <message>
             <source>ORB (fast)</source>
-            <translation type="unfinished" />
+            <translation>ORB (rápido)</translation>
         </message>
         <message>
             <source>Features per image</source>
-            <translation type="unfinished" />
+            <translation>Feições por imagem</translation>
         </message>
         <message>
             <source>Detection size (longer side, 0 = full resolution)</source>
-            <translation type="unfinished" />
+            <translation>Tamanho de detecção (lado maior, 0 = resolução completa)</translation>
         </message>
         <message>
             <source>Ratio test (best / second best)</source>
-            <translation type="unfinished" />
+            <translation>Teste de razão (melhor / segundo melhor)</translation>
         </message>
         <message>
             <source>RANSAC threshold (epipolar distance)</source>
-            <translation type="unfinished" />
+            <translation>Limiar do RANSAC (distância epipolar)</translation>
         </message>
         <message>
             <source>RANSAC method</source>
-            <translation type="unfinished" />
+            <translation>Método RANSAC</translation>
         </message>
         <message>
             <source>MAGSAC++</source>
-            <translation type="unfinished" />
+            <translation>MAGSAC++</translation>
         </message>
         <message>
             <source>RANSAC</source>
-            <translation type="unfinished" />
+            <translation>RANSAC</translation>
         </message>
         <message>
             <source>Minimum inliers per pair</source>
-            <translation type="unfinished" />
+            <translation>Mínimo de inliers por par</translation>
         </message>
         <message>
             <source>Minimum track length</source>
-            <translation type="unfinished" />
+            <translation>Comprimento mínimo da trilha</translation>
         </message>
         <message>
             <source>Pairs</source>
-            <translation type="unfinished" />
+            <translation>Pares</translation>
         </message>
         <message>
             <source>footprints with EO, else sequential</source>
-            <translation type="unfinished" />
+            <translation>projeções no terreno com EO, senão sequencial</translation>
         </message>
         <message>
             <source>footprints (EO + camera)</source>
-            <translation type="unfinished" />
+            <translation>projeções no terreno (EO + câmera)</translation>
         </message>
         <message>
             <source>all pairs</source>
-            <translation type="unfinished" />
+            <translation>todos os pares</translation>
         </message>
         <message>
             <source>sequential window</source>
-            <translation type="unfinished" />
+            <translation>janela sequencial</translation>
         </message>
         <message>
             <source>Sequential window</source>
-            <translation type="unfinished" />
+            <translation>Janela sequencial</translation>
         </message>
         <message>
             <source>Minimum footprint overlap</source>
-            <translation type="unfinished" />
+            <translation>Sobreposição mínima das projeções no terreno</translation>
         </message>
         <message>
             <source>share of the smaller footprint</source>
-            <translation type="unfinished" />
+            <translation>fração da menor projeção no terreno</translation>
         </message>
         <message>
             <source>sigma_px written (0 = 0.5 px x reduction)</source>
-            <translation type="unfinished" />
+            <translation>sigma_px gravado (0 = 0,5 px x redução)</translation>
         </message>
         <message>
             <source>Tie points (observation CSV)</source>
-            <translation type="unfinished" />
+            <translation>Pontos de enlace (CSV de observações)</translation>
         </message>
         <message>
             <source>CSV files (*.csv)</source>
-            <translation type="unfinished" />
+            <translation>Arquivos CSV (*.csv)</translation>
         </message>
         <message>
             <source>Pair table (CSV)</source>
-            <translation type="unfinished" />
+            <translation>Tabela de pares (CSV)</translation>
         </message>
         <message>
             <source>Tie points (tracks)</source>
-            <translation type="unfinished" />
+            <translation>Pontos de enlace (trilhas)</translation>
         </message>
         <message>
             <source>Image measurements</source>
-            <translation type="unfinished" />
+            <translation>Medições nas imagens</translation>
         </message>
         <message>
             <source>Image pairs tried</source>
-            <translation type="unfinished" />
+            <translation>Pares de imagens tentados</translation>
         </message>
         <message>
             <source>Image pairs kept</source>
-            <translation type="unfinished" />
+            <translation>Pares de imagens mantidos</translation>
         </message>
     </context>
     <context>
