@@ -127,7 +127,7 @@ def _vector_style(layer, dx: str, dy_up: str, length: str, largest: float, label
     symbol.setDataDefinedAngle(QgsProperty.fromExpression(f"degrees(atan2({dx}, {dy_up}))"))
     if layer.fields().indexOf("rejected") >= 0:
         symbol.symbolLayer(0).setDataDefinedProperty(
-            QgsSymbolLayer.PropertyFillColor,
+            QgsSymbolLayer.Property.PropertyFillColor,
             QgsProperty.fromExpression("if(\"rejected\" = 1, '#e31a1c', '#1f78b4')"),
         )
     layer.setRenderer(QgsSingleSymbolRenderer(symbol))
