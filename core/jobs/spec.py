@@ -59,9 +59,9 @@ INPUT_KINDS = (
 OUTPUT_KINDS = ("file_out", "raster_out", "folder_out", "sink")
 RESULT_KINDS = ("number", "string")
 _TRUE = ("true", "yes", "1", "on")
+_FALSE = ("false", "no", "0", "off")
 #: Translation context of the help's fixed words (``make i18n`` collects ``t("...")`` calls).
 TR_CONTEXT = "AlgorithmHelp"
-_FALSE = ("false", "no", "0", "off")
 
 
 @dataclass(frozen=True)
