@@ -889,6 +889,18 @@
     <context>
         <name>Report</name>
         <message>
+            <source>Positional accuracy report</source>
+            <translation>Relatório de acurácia posicional</translation>
+        </message>
+        <message>
+            <source>all points</source>
+            <translation>todos os pontos</translation>
+        </message>
+        <message>
+            <source>all points (flagged included)</source>
+            <translation>todos os pontos (incluindo os marcados)</translation>
+        </message>
+        <message>
             <source>component</source>
             <translation>componente</translation>
         </message>
@@ -907,6 +919,22 @@
         <message>
             <source>max (m)</source>
             <translation>máx. (m)</translation>
+        </message>
+        <message>
+            <source>PASS</source>
+            <translation>APROVADO</translation>
+        </message>
+        <message>
+            <source>FAIL</source>
+            <translation>REPROVADO</translation>
+        </message>
+        <message>
+            <source>INSUFFICIENT</source>
+            <translation>INSUFICIENTE</translation>
+        </message>
+        <message>
+            <source>INFO</source>
+            <translation>INFORMATIVO</translation>
         </message>
         <message>
             <source>Statistics: standard deviation with n &amp;minus; 1; RMSE = sqrt(mean(d&amp;sup2;)); Shapiro-Wilk by scipy (Royston's algorithm); Student t two-sided for a zero mean; chi-square one-sided, (n &amp;minus; 1) s&amp;sup2; / sigma0&amp;sup2; against chi-square(1 &amp;minus; alpha, n &amp;minus; 1).</source>
@@ -1557,6 +1585,94 @@
             <translation>Resíduos das imagens: {}</translation>
         </message>
         <message>
+            <source>view</source>
+            <translation>vista</translation>
+        </message>
+        <message>
+            <source>points</source>
+            <translation>pontos</translation>
+        </message>
+        <message>
+            <source>Camera calibration</source>
+            <translation>Calibração de câmera</translation>
+        </message>
+        <message>
+            <source>Standard deviations a-posteriori (scaled by sigma0). Lens coefficients: Brown-Conrady correction of measured coordinates in mm (ideal = measured + d); t = |value| / sigma against Student's t (two-sided 5 %, the redundancy as degrees of freedom).</source>
+            <translation>Desvios-padrão a posteriori (escalados por sigma0). Coeficientes da lente: correção de Brown-Conrady das coordenadas medidas em mm (ideal = medida + d); t = |valor| / sigma comparado com o t de Student (bilateral 5 %, a redundância como graus de liberdade).</translation>
+        </message>
+        <message>
+            <source>not significant</source>
+            <translation>não significativo</translation>
+        </message>
+        <message>
+            <source>test</source>
+            <translation>teste</translation>
+        </message>
+        <message>
+            <source>Correlations</source>
+            <translation>Correlações</translation>
+        </message>
+        <message>
+            <source>Views</source>
+            <translation>Vistas</translation>
+        </message>
+        <message>
+            <source>fixed</source>
+            <translation>fixo</translation>
+        </message>
+        <message>
+            <source>Camera calibration: {} ({})</source>
+            <translation>Calibração de câmera: {} ({})</translation>
+        </message>
+        <message>
+            <source>f = {} px, principal point ({}, {}) px; RMS {} px over {} points; sigma0 {} (a-priori {} px), redundancy {}, global test {}.</source>
+            <translation>f = {} px, ponto principal ({}, {}) px; RMS {} px em {} pontos; sigma0 {} (a priori {} px), redundância {}, teste global {}.</translation>
+        </message>
+        <message>
+            <source>Control point location</source>
+            <translation>Localização de pontos de controle</translation>
+        </message>
+        <message>
+            <source>NCC with an adaptive template, then least-squares matching (Gruen 1985: 6 affine + 2 radiometric parameters). Pixels: corner convention (centre of the first pixel at 0.5, 0.5); sigmas a posteriori from LSM (they do not include the chip's own errors).</source>
+            <translation>NCC com janela de referência adaptativa, seguida de correspondência por mínimos quadrados (Gruen 1985: 6 parâmetros afins + 2 radiométricos). Pixels: convenção de canto (centro do primeiro pixel em 0,5, 0,5); sigmas a posteriori da LSM (não incluem os erros do próprio recorte (chip)).</translation>
+        </message>
+        <message>
+            <source>pairs</source>
+            <translation>pares</translation>
+        </message>
+        <message>
+            <source>Points and images</source>
+            <translation>Pontos e imagens</translation>
+        </message>
+        <message>
+            <source>row</source>
+            <translation>lin</translation>
+        </message>
+        <message>
+            <source>sigma row</source>
+            <translation>sigma lin</translation>
+        </message>
+        <message>
+            <source>LSM corr.</source>
+            <translation>corr. LSM</translation>
+        </message>
+        <message>
+            <source>template px</source>
+            <translation>janela de referência (px)</translation>
+        </message>
+        <message>
+            <source>Chip gallery</source>
+            <translation>Galeria de recortes (chips)</translation>
+        </message>
+        <message>
+            <source>Left: the chip in the image geometry; right: the image at the match.</source>
+            <translation>À esquerda: o recorte (chip) na geometria da imagem; à direita: a imagem no local da correspondência.</translation>
+        </message>
+        <message>
+            <source>{} in {}: {}</source>
+            <translation>{} em {}: {}</translation>
+        </message>
+        <message>
             <source>control points: RMS |v| (px)</source>
             <translation>pontos de controle: RMS |v| (px)</translation>
         </message>
@@ -1577,16 +1693,8 @@
             <translation>Posição no SRC de mapeamento, omega-phi-kappa relativos ao referencial da quadrícula no centro perspectivo; desvios-padrão a posteriori (escalados por sigma0), salvo quando indicados como a priori. Teste global: v'Pv / sigma0_prior^2 contra o valor crítico do qui-quadrado (unilateral 5 %, como dos Santos et al. 2010 o relatam) e o intervalo de aceitação bilateral.</translation>
         </message>
         <message>
-            <source>points</source>
-            <translation>pontos</translation>
-        </message>
-        <message>
             <source>lines</source>
             <translation>linhas</translation>
-        </message>
-        <message>
-            <source>test</source>
-            <translation>teste</translation>
         </message>
         <message>
             <source>unit</source>
@@ -1665,16 +1773,72 @@
             <translation>bloco</translation>
         </message>
         <message>
-            <source>row</source>
-            <translation>lin</translation>
-        </message>
-        <message>
             <source>Image {}</source>
             <translation>Imagem {}</translation>
         </message>
         <message>
             <source>Start: {}; line model: {}; {} iterations; {} control points, {} lines, {} check points, {} rows without control ignored.</source>
             <translation>Início: {}; modelo de linha: {}; {} iterações; {} pontos de controle, {} linhas, {} pontos de verificação, {} linhas sem controle ignoradas.</translation>
+        </message>
+        <message>
+            <source>Accuracy is stated as RMSE; Edition 2 no longer uses 95 % confidence figures.</source>
+            <translation>A acurácia é expressa como RMSE; a Edição 2 não usa mais valores com 95 % de confiança.</translation>
+        </message>
+        <message>
+            <source>PEC-PCD limits: planimetric A-D 0.28/0.5/0.8/1.0 mm (EP 0.17/0.3/0.5/0.6 mm) at the map scale; altimetric A-D 0.27/0.50/0.60/0.75 of the equidistance (EP 1/6, 1/3, 2/5, 1/2).</source>
+            <translation>Limites do PEC-PCD: planimétrico A-D 0,28/0,5/0,8/1,0 mm (EP 0,17/0,3/0,5/0,6 mm) na escala da carta; altimétrico A-D 0,27/0,50/0,60/0,75 da equidistância (EP 1/6, 1/3, 2/5, 1/2).</translation>
+        </message>
+        <message>
+            <source>Check-point count</source>
+            <translation>Número de pontos de verificação</translation>
+        </message>
+        <message>
+            <source>Three-dimensional accuracy</source>
+            <translation>Acurácia tridimensional</translation>
+        </message>
+        <message>
+            <source>ASPRS Positional Accuracy Standards, Edition 2 (2023)</source>
+            <translation>Padrões de Acurácia Posicional da ASPRS, Edição 2 (2023)</translation>
+        </message>
+        <message>
+            <source>Horizontal approximation condition</source>
+            <translation>Condição da aproximação horizontal</translation>
+        </message>
+        <message>
+            <source>Horizontal accuracy (95 %)</source>
+            <translation>Acurácia horizontal (95 %)</translation>
+        </message>
+        <message>
+            <source>Vertical accuracy (95 %)</source>
+            <translation>Acurácia vertical (95 %)</translation>
+        </message>
+        <message>
+            <source>Planimetric RMSE</source>
+            <translation>RMSE planimétrico</translation>
+        </message>
+        <message>
+            <source>Vertical RMSE</source>
+            <translation>RMSE vertical</translation>
+        </message>
+        <message>
+            <source>Project threshold (Pedrosa &amp; dos Santos 2020, section 3)</source>
+            <translation>Limiar do projeto (Pedrosa &amp; dos Santos 2020, seção 3)</translation>
+        </message>
+        <message>
+            <source>accepted for E, N, H</source>
+            <translation>aceita para E, N, H</translation>
+        </message>
+        <message>
+            <source>Accuracy_r = 1.7308 RMSE_r holds for RMSE_x = RMSE_y; the Case 2 formula 2.4477 x 0.5 (RMSE_x + RMSE_y) is used for 0.6 &lt;= ratio &lt;= 1; the exact 95 % radius of the bivariate normal is also given.</source>
+            <translation>Accuracy_r = 1,7308 RMSE_r vale para RMSE_x = RMSE_y; a fórmula do Caso 2, 2,4477 x 0,5 (RMSE_x + RMSE_y), é usada para 0,6 &lt;= razão &lt;= 1; o raio exato de 95 % da normal bivariada também é apresentado.</translation>
+        </message>
+        <message>
+            <source>The paper compares the RMSE of the check-point discrepancies with 0.40 m (twice the LiDAR standard deviation) and with dz of Eq. 18.</source>
+            <translation>O artigo compara o RMSE das discrepâncias nos pontos de verificação com 0,40 m (o dobro do desvio-padrão do LiDAR) e com o dz da Eq. 18.</translation>
+        </message>
+        <message>
+            <source>no equidistance given for this scale</source>
+            <translation>nenhuma equidistância informada para esta escala</translation>
         </message>
         <message>
             <source>Horizontal discrepancy vectors</source>
@@ -1731,10 +1895,6 @@
         <message>
             <source>levelled</source>
             <translation>nivelada</translation>
-        </message>
-        <message>
-            <source>Correlations</source>
-            <translation>Correlações</translation>
         </message>
         <message>
             <source>station / target</source>

@@ -37,6 +37,8 @@ from numpy.typing import NDArray
 
 from ..errors import CrsError, InputError, stop_if_asked
 from . import standards as std_mod
+from .html_table import TR_CONTEXT  # noqa: F401 - make i18n collects the _t("...") marks
+from .standards import _t
 
 __all__ = [
     "OUTLIER_RULES",
@@ -610,7 +612,7 @@ class AccuracySettings:
     project_h_threshold: float = std_mod.PAPER_H_THRESHOLD_M
     project_v_threshold: float = 0.0
     flight_geometry: tuple[float, float, float, float] = std_mod.PAPER_FLIGHT_GEOMETRY
-    title: str = "Positional accuracy report"
+    title: str = _t("Positional accuracy report")
 
     def validated(self) -> AccuracySettings:
         if not (0.0 < self.alpha < 0.5):
@@ -742,7 +744,7 @@ def assess_accuracy(
     flagged = outliers.any
     n_flag = int(flagged.sum())
     label = f"without the {n_flag} flagged point(s)" if s.exclude_outliers and n_flag else (
-        "all points"
+        _t("all points")
     )
     overall = group_statistics(du, label, alpha=s.alpha, declared_sigma=sig)
     contrast = None
@@ -750,7 +752,7 @@ def assess_accuracy(
         other = np.ones(len(d), dtype=bool) if s.exclude_outliers else ~flagged
         if other.any():
             other_label = (
-                "all points (flagged included)"
+                _t("all points (flagged included)")
                 if s.exclude_outliers
                 else f"without the {n_flag} flagged point(s)"
             )

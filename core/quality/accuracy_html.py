@@ -121,25 +121,36 @@ def _tests_table(g: GroupStatistics) -> str:
     )
 
 
+def _status(status: str) -> str:
+    """A verdict's status in capitals, in the report's language."""
+    words = {
+        "pass": t("PASS"),
+        "fail": t("FAIL"),
+        "insufficient": t("INSUFFICIENT"),
+        "info": t("INFO"),
+    }
+    return _e(words.get(status, status.upper()))
+
+
 def _standard_section(res) -> str:
     rows = [
         [
-            _e(v.name),
-            _e(v.status.upper()),
+            _e(t(v.name)),
+            _status(v.status),
             "&ndash;"
             if v.measured is None
             else (_m(v.measured, 3) + (" " + _e(v.unit) if v.unit != "m" else " m")),
             "&ndash;"
             if v.limit is None
             else (_m(v.limit, 3) + (" " + _e(v.unit) if v.unit != "m" else " m")),
-            _e(v.reason),
+            _e(t(v.reason)),
         ]
         for v in res.verdicts
     ]
     css = [v.status for v in res.verdicts]
-    notes = "".join(f'<li class="note">{_e(n)}</li>' for n in res.notes)
+    notes = "".join(f'<li class="note">{_e(t(n))}</li>' for n in res.notes)
     return (
-        f'<h3 class="standard" id="std-{_e(res.key)}">{_e(res.title)}</h3>'
+        f'<h3 class="standard" id="std-{_e(res.key)}">{_e(t(res.title))}</h3>'
         + '<p class="note">'
         + t("Source: {}. {} check points.").format(_e(res.reference), res.n_points)
         + "</p>"
@@ -155,8 +166,8 @@ def _summary(report: AccuracyReport) -> str:
     other = report.rmse_contrast
     head = [
         "RMSE",
-        t("{}, used (m)").format(_e(report.overall.name)),
-        f"{_e(report.contrast.name)} (m)",
+        t("{}, used (m)").format(_e(t(report.overall.name))),
+        f"{_e(t(report.contrast.name))} (m)",
     ]
     rows = [[k, _m(v, 4), _m(other[k], 4)] for k, v in report.rmse.items()]
     return _table(head, rows)
@@ -172,8 +183,8 @@ def render_html(report: AccuracyReport) -> str:
     parts = [
         "<!DOCTYPE html>",
         f'<html lang="{html_lang()}"><head><meta charset="utf-8">',
-        f"<title>{_e(s.title)}</title><style>{_CSS}</style></head><body>",
-        f"<h1>{_e(s.title)}</h1>",
+        f"<title>{_e(t(s.title))}</title><style>{_CSS}</style></head><body>",
+        f"<h1>{_e(t(s.title))}</h1>",
         _table(
             [t("item"), t("value")],
             [
@@ -201,17 +212,17 @@ def render_html(report: AccuracyReport) -> str:
         rows, css = [], []
         for g, res in report.group_thresholds.items():
             for v in res.verdicts:
-                rows.append([_e(g), _e(v.name), _e(v.status.upper()), _e(v.reason)])
+                rows.append([_e(g), _e(t(v.name)), _status(v.status), _e(t(v.reason))])
                 css.append(v.status)
         parts.append(_table([t("group"), t("check"), t("status"), t("reason")], rows, css))
     parts.append(f"<h2>{t('Statistics')}</h2>")
-    parts.append(f'<h3 class="group">{_e(report.overall.name.capitalize())} '
+    parts.append(f'<h3 class="group">{_e(t(report.overall.name).capitalize())} '
                  f"({report.overall.n})</h3>")  # fmt: skip
     parts.append(_stats_table(report.overall))
     parts.append(_tests_table(report.overall))
     if report.contrast is not None:
         parts.append('<h3 class="group">' + t("For comparison: {} ({})").format(
-            _e(report.contrast.name), report.contrast.n) + "</h3>")  # fmt: skip
+            _e(t(report.contrast.name)), report.contrast.n) + "</h3>")  # fmt: skip
         parts.append(_stats_table(report.contrast))
     for name, g in report.groups.items():
         parts.append('<h3 class="group">' + t("Group {} ({})").format(_e(name), g.n) + "</h3>")

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
+from .html_table import TR_CONTEXT, html_lang, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 
@@ -55,35 +56,47 @@ def render_calibration_html(result: Any, settings: Mapping[str, str]) -> str:
     cx, cy = cam.principal_point_px
     parts = [
         "<!DOCTYPE html>",
-        '<html lang="en"><head><meta charset="utf-8">',
-        "<title>Camera calibration</title>",
+        f'<html lang="{html_lang()}"><head><meta charset="utf-8">',
+        f"<title>{t('Camera calibration')}</title>",
         f"<style>{_CSS}</style></head><body>",
-        f"<h1>Camera calibration: {_e(cam.name)} ({_e(cam.projection)})</h1>",
-        f'<p class="note">lidarphoto {_e(__version__)}. Standard deviations a-posteriori '
-        "(scaled by sigma0). Lens coefficients: Brown-Conrady correction of measured "
-        "coordinates in mm (ideal = measured + d); t = |value| / sigma against Student's t "
-        "(two-sided 5 %, the redundancy as degrees of freedom).</p>",
-        "<h2>Settings</h2>",
-        _table(["setting", "value"], [[_e(k), _e(v)] for k, v in settings.items()]),
-        "<h2>Interior orientation</h2>",
-        f"<p>f = {_n(cam.focal_px, '.3f')} px, principal point ({_n(cx, '.2f')}, "
-        f"{_n(cy, '.2f')}) px; RMS {_n(result.rms_px, '.3f')} px over {result.n_points} "
-        f"points; sigma0 {_n(result.sigma0, '.3f')} (a-priori {_n(result.sigma_px, '.3g')} px"
-        f"), redundancy {result.redundancy}, global test "
-        f"{'passed' if result.adjustment.global_test.passed else 'FAILED'}.</p>",
-    ]
+        "<h1>" + t("Camera calibration: {} ({})").format(_e(cam.name), _e(cam.projection))
+        + "</h1>",
+        f'<p class="note">lidarphoto {_e(__version__)}. '
+        + t(
+            "Standard deviations a-posteriori (scaled by sigma0). Lens coefficients: "
+            "Brown-Conrady correction of measured coordinates in mm (ideal = measured + d); "
+            "t = |value| / sigma against Student's t (two-sided 5 %, the redundancy as degrees "
+            "of freedom)."
+        )
+        + "</p>",
+        f"<h2>{t('Settings')}</h2>",
+        _table([t("setting"), t("value")], [[_e(k), _e(v)] for k, v in settings.items()]),
+        f"<h2>{t('Interior orientation')}</h2>",
+        "<p>"
+        + t(
+            "f = {} px, principal point ({}, {}) px; RMS {} px over {} points; sigma0 {} "
+            "(a-priori {} px), redundancy {}, global test {}."
+        ).format(
+            _n(cam.focal_px, ".3f"), _n(cx, ".2f"), _n(cy, ".2f"), _n(result.rms_px, ".3f"),
+            result.n_points, _n(result.sigma0, ".3f"), _n(result.sigma_px, ".3g"),
+            result.redundancy,
+            t("passed") if result.adjustment.global_test.passed else t("FAILED"),
+        )
+        + "</p>",
+    ]  # fmt: skip
     rows, css = [], []
     values = dict(zip(cam.interior_names, cam.interior_params))
     for name in cam.interior_names:
         sig = result.sigmas.get(name)
-        t = result.t_values.get(name)
+        tv = result.t_values.get(name)
         sig_px = _n(sig / ps, ".3f") if sig is not None and name.endswith("_mm") else ""
-        verdict = "" if t is None else ("significant" if result.significant[name]
-                                        else "not significant")  # fmt: skip
-        rows.append([_e(name), _n(values[name], ".6g"), _n(sig, ".3g") if sig else "fixed",
-                     sig_px, _n(t, ".2f") if t is not None else "", verdict])  # fmt: skip
-        css.append("" if t is None else ("pass" if result.significant[name] else "fail"))
-    parts.append(_table(["parameter", "value", "sigma", "sigma (px)", "t", "test"], rows, css))
+        verdict = "" if tv is None else (t("significant") if result.significant[name]
+                                         else t("not significant"))  # fmt: skip
+        rows.append([_e(name), _n(values[name], ".6g"), _n(sig, ".3g") if sig else t("fixed"),
+                     sig_px, _n(tv, ".2f") if tv is not None else "", verdict])  # fmt: skip
+        css.append("" if tv is None else ("pass" if result.significant[name] else "fail"))
+    parts.append(_table([t("parameter"), t("value"), "sigma", "sigma (px)", "t", t("test")],
+                        rows, css))  # fmt: skip
     names = list(result.parameter_names)
     corr = np.asarray(result.correlation)
     crow, ccss = [], []
@@ -91,16 +104,16 @@ def render_calibration_html(result: Any, settings: Mapping[str, str]) -> str:
         crow.append([_e(n), *(_n(corr[i, j], ".2f") for j in range(len(names)))])
         off = np.abs(np.delete(corr[i], i))
         ccss.append("fail" if off.size and np.nanmax(off) > 0.9 else "")
-    parts += ["<h2>Correlations</h2>", _table(["", *map(_e, names)], crow, ccss)]
+    parts += [f"<h2>{t('Correlations')}</h2>", _table(["", *map(_e, names)], crow, ccss)]
     vrows = [[_e(v), str(int(p)), _n(r, ".3f"), *(_n(x, ".4f") for x in e[:3]),
               *(_n(math.degrees(a), ".3f") for a in e[3:])]
              for v, p, r, e in zip(result.view_names, result.view_points, result.view_rms_px,
                                    result.eo)]  # fmt: skip
-    vhead = ["view", "points", "RMS (px)", "X0", "Y0", "Z0", "omega (deg)", "phi (deg)",
+    vhead = [t("view"), t("points"), "RMS (px)", "X0", "Y0", "Z0", "omega (deg)", "phi (deg)",
              "kappa (deg)"]  # fmt: skip
-    parts += ["<h2>Views</h2>", _table(vhead, vrows)]
+    parts += [f"<h2>{t('Views')}</h2>", _table(vhead, vrows)]
     if result.warnings:
-        parts += ["<h2>Warnings</h2>", "<ul>",
+        parts += [f"<h2>{t('Warnings')}</h2>", "<ul>",
                   *(f"<li>{_e(w)}</li>" for w in result.warnings), "</ul>"]  # fmt: skip
     parts.append("</body></html>")
     return "\n".join(parts)

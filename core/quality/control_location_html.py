@@ -17,6 +17,7 @@ import numpy as np
 
 from .. import __version__
 from ..photo.control_location import LocatedPair
+from .html_table import TR_CONTEXT, html_lang, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 
@@ -74,19 +75,23 @@ def render_location_html(pairs: Sequence[LocatedPair], settings: Mapping[str, st
         counts[p.status] = counts.get(p.status, 0) + 1
     parts = [
         "<!DOCTYPE html>",
-        '<html lang="en"><head><meta charset="utf-8">',
-        "<title>Control point location</title>",
+        f'<html lang="{html_lang()}"><head><meta charset="utf-8">',
+        f"<title>{t('Control point location')}</title>",
         f"<style>{_CSS}</style></head><body>",
-        "<h1>Control point location</h1>",
-        f'<p class="note">lidarphoto {_e(__version__)}. NCC with an adaptive template, then '
-        "least-squares matching (Gruen 1985: 6 affine + 2 radiometric parameters). Pixels: "
-        "corner convention (centre of the first pixel at 0.5, 0.5); sigmas a posteriori from "
-        "LSM (they do not include the chip's own errors).</p>",
-        "<h2>Settings</h2>",
-        _table(["setting", "value"], [[_e(k), _e(v)] for k, v in settings.items()]),
-        "<h2>Summary</h2>",
-        _table(["status", "pairs"], [[_e(k), str(v)] for k, v in sorted(counts.items())]),
-        "<h2>Points and images</h2>",
+        f"<h1>{t('Control point location')}</h1>",
+        f'<p class="note">lidarphoto {_e(__version__)}. '
+        + t(
+            "NCC with an adaptive template, then least-squares matching (Gruen 1985: 6 affine "
+            "+ 2 radiometric parameters). Pixels: corner convention (centre of the first pixel "
+            "at 0.5, 0.5); sigmas a posteriori from LSM (they do not include the chip's own "
+            "errors)."
+        )
+        + "</p>",
+        f"<h2>{t('Settings')}</h2>",
+        _table([t("setting"), t("value")], [[_e(k), _e(v)] for k, v in settings.items()]),
+        f"<h2>{t('Summary')}</h2>",
+        _table([t("status"), t("pairs")], [[_e(k), str(v)] for k, v in sorted(counts.items())]),
+        f"<h2>{t('Points and images')}</h2>",
     ]
     rows, css = [], []
     for p in pairs:
@@ -95,18 +100,21 @@ def render_location_html(pairs: Sequence[LocatedPair], settings: Mapping[str, st
                      _n(p.sigma_col, 4), _n(p.sigma_row, 4), _n(p.ncc, 3),
                      _n(p.lsm_correlation, 3), str(p.template_px or "")])  # fmt: skip
         css.append("pass" if p.status == "ok" else "fail")
-    parts.append(_table(["point", "image", "status", "reason", "source", "col", "row",
-                         "sigma col", "sigma row", "NCC", "LSM corr.", "template px"],
+    parts.append(_table([t("point"), t("image"), t("status"), t("reason"), t("source"),
+                         "col", t("row"), "sigma col", t("sigma row"), "NCC", t("LSM corr."),
+                         t("template px")],
                         rows, css))  # fmt: skip
-    parts.append("<h2>Chip gallery</h2>")
+    parts.append(f"<h2>{t('Chip gallery')}</h2>")
     parts.append(
-        '<p class="note">Left: the chip in the image geometry; right: the image at the match.</p>'
+        '<p class="note">'
+        + t("Left: the chip in the image geometry; right: the image at the match.")
+        + "</p>"
     )
     for p in pairs:
         if p.chip_patch is None and p.image_patch is None:
             continue
         cls = "" if p.status == "ok" else ' class="fail"'
-        cap = f"{_e(p.point_id)} in {_e(p.image_id)}: {_e(p.status)}"
+        cap = t("{} in {}: {}").format(_e(p.point_id), _e(p.image_id), _e(p.status))
         if p.reason:
             cap += f" ({_e(p.reason)})"
         parts.append(f'<figure{cls}><img alt="chip" src="{png_data_uri(p.chip_patch)}">'

@@ -41,6 +41,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from .html_table import TR_CONTEXT  # noqa: F401 - make i18n collects the _t("...") marks
+
+
+def _t(text: str) -> str:
+    """Mark a fixed text for translation (``make i18n``); the report translates it when shown,
+    so the results themselves stay in English."""
+    return text
+
 
 __all__ = [
     "ASPRS_MIN_CHECKPOINTS",
@@ -212,7 +220,7 @@ def asprs_2023(
     enough = n >= ASPRS_MIN_CHECKPOINTS
     verdicts = [
         Verdict(
-            "Check-point count",
+            _t("Check-point count"),
             "pass" if enough else "insufficient",
             (
                 f"{n} check points; Edition 2 requires at least {ASPRS_MIN_CHECKPOINTS} "
@@ -259,7 +267,7 @@ def asprs_2023(
             )
     verdicts.append(
         Verdict(
-            "Three-dimensional accuracy",
+            _t("Three-dimensional accuracy"),
             "info" if enough else "insufficient",
             f"RMSE_3D_TOTAL = sqrt(RMSE_HORIZONTAL_TOTAL^2 + RMSE_U_TOTAL^2) = "
             f"{100 * rmse_3d:.2f} cm (reported, no class)",
@@ -268,7 +276,7 @@ def asprs_2023(
         )
     )
     notes = [
-        "Accuracy is stated as RMSE; Edition 2 no longer uses 95 % confidence figures.",
+        _t("Accuracy is stated as RMSE; Edition 2 no longer uses 95 % confidence figures."),
         f"Check-point survey error included: RMSE_HORIZONTAL_SURVEY (ASPRS RMSE_H2) = "
         f"{100 * rmse_h2:.2f} cm, RMSE_U_SURVEY (ASPRS RMSE_V2) = "
         f"{100 * float(survey_sigma_v):.2f} cm (0 when not given: then the totals are "
@@ -298,7 +306,7 @@ def asprs_2023(
             )
     return StandardResult(
         key="asprs",
-        title="ASPRS Positional Accuracy Standards, Edition 2 (2023)",
+        title=_t("ASPRS Positional Accuracy Standards, Edition 2 (2023)"),
         reference=(
             "ASPRS Positional Accuracy Standards for Digital Geospatial Data, Edition 2, "
             "Version 1.0 (2023), section 7"
@@ -432,7 +440,7 @@ def nssda(
     enough = n >= NSSDA_MIN_CHECKPOINTS
     verdicts = [
         Verdict(
-            "Check-point count",
+            _t("Check-point count"),
             "pass" if enough else "insufficient",
             f"{n} check points; NSSDA requires at least {NSSDA_MIN_CHECKPOINTS}",
             float(n),
@@ -440,7 +448,7 @@ def nssda(
             unit="points",
         ),
         Verdict(
-            "Horizontal approximation condition",
+            _t("Horizontal approximation condition"),
             "pass" if approx_ok else "fail",
             (
                 f"RMSE_min/RMSE_max = {ratio:.3f} "
@@ -468,13 +476,17 @@ def nssda(
         reason = (
             f"rejected for {', '.join(failed)}"
             if failed
-            else (f"not testable for {', '.join(untested)}" if untested else "accepted for E, N, H")
+            else (
+                f"not testable for {', '.join(untested)}"
+                if untested
+                else _t("accepted for E, N, H")
+            )
         )
         verdicts.append(Verdict(f"Assumption: {label}", status, reason))
     tail = "" if enough else f" (only {n} of {NSSDA_MIN_CHECKPOINTS} check points)"
     verdicts.append(
         Verdict(
-            "Horizontal accuracy (95 %)",
+            _t("Horizontal accuracy (95 %)"),
             "info" if enough else "insufficient",
             f"Tested {acc_r:.3f} m horizontal accuracy at 95 % confidence level{tail}",
             acc_r,
@@ -483,7 +495,7 @@ def nssda(
     )
     verdicts.append(
         Verdict(
-            "Vertical accuracy (95 %)",
+            _t("Vertical accuracy (95 %)"),
             "info" if enough else "insufficient",
             f"Tested {acc_z:.3f} m vertical accuracy at 95 % confidence level{tail}",
             acc_z,
@@ -513,9 +525,11 @@ def nssda(
             "ACCURACY_U_95": acc_z,  # Accuracy_z
         },
         notes=(
-            "Accuracy_r = 1.7308 RMSE_r holds for RMSE_x = RMSE_y; the Case 2 formula "
-            "2.4477 x 0.5 (RMSE_x + RMSE_y) is used for 0.6 <= ratio <= 1; the exact 95 % "
-            "radius of the bivariate normal is also given.",
+            _t(
+                "Accuracy_r = 1.7308 RMSE_r holds for RMSE_x = RMSE_y; the Case 2 formula "
+                "2.4477 x 0.5 (RMSE_x + RMSE_y) is used for 0.6 <= ratio <= 1; the exact 95 % "
+                "radius of the bivariate normal is also given."
+            ),
         ),
     )
 
@@ -611,7 +625,7 @@ def pec_pcd(
     enough = n >= PEC_RECOMMENDED_MIN_POINTS
     verdicts = [
         Verdict(
-            "Check-point count",
+            _t("Check-point count"),
             "pass" if enough else "insufficient",
             f"{n} check points; fewer than {PEC_RECOMMENDED_MIN_POINTS} makes the 90 % rule "
             "weak (common practice, not in the Decreto)",
@@ -631,7 +645,7 @@ def pec_pcd(
             name = f"Class {c} {kind}"
             if not math.isfinite(pec):
                 verdicts.append(
-                    Verdict(name, "info", "no equidistance given for this scale", None, None)
+                    Verdict(name, "info", _t("no equidistance given for this scale"), None, None)
                 )
                 continue
             share = float(np.mean(values <= pec + _TOL))
@@ -656,9 +670,11 @@ def pec_pcd(
         + (f"{eq:g} m" if eq else "not given")
         + f". Best class met: planimetric {best['planimetric'] or 'none'}, altimetric "
         f"{best['altimetric'] or 'none'}.",
-        "PEC-PCD limits: planimetric A-D 0.28/0.5/0.8/1.0 mm (EP 0.17/0.3/0.5/0.6 mm) at "
-        "the map scale; altimetric A-D 0.27/0.50/0.60/0.75 of the equidistance (EP 1/6, 1/3, "
-        "2/5, 1/2).",
+        _t(
+            "PEC-PCD limits: planimetric A-D 0.28/0.5/0.8/1.0 mm (EP 0.17/0.3/0.5/0.6 mm) at "
+            "the map scale; altimetric A-D 0.27/0.50/0.60/0.75 of the equidistance (EP 1/6, "
+            "1/3, 2/5, 1/2)."
+        ),
     ]
     for kind in ("planimetric", "altimetric"):
         v = next(x for x in verdicts if x.name == f"Class {target} {kind}")
@@ -765,7 +781,7 @@ def project_threshold(
     ok_h, ok_v = rms_h <= h_threshold + _TOL, rms_v <= dz + _TOL
     verdicts = (
         Verdict(
-            "Planimetric RMSE",
+            _t("Planimetric RMSE"),
             "pass" if ok_h else "fail",
             f"RMSE {rms_h:.3f} m {'<=' if ok_h else '>'} {h_threshold:.3f} m; "
             f"{n_h} of {n} points beyond it",
@@ -773,7 +789,7 @@ def project_threshold(
             h_threshold,
         ),
         Verdict(
-            "Vertical RMSE",
+            _t("Vertical RMSE"),
             "pass" if ok_v else "fail",
             f"RMSE {rms_v:.3f} m {'<=' if ok_v else '>'} dz {dz:.3f} m ({how}); "
             f"{n_v} of {n} points beyond it",
@@ -783,7 +799,7 @@ def project_threshold(
     )
     return StandardResult(
         key="project",
-        title="Project threshold (Pedrosa & dos Santos 2020, section 3)",
+        title=_t("Project threshold (Pedrosa & dos Santos 2020, section 3)"),
         reference="Pedrosa & dos Santos (2020), section 3, Eq. 18 and Tables 2-5",
         n_points=n,
         verdicts=verdicts,
@@ -796,7 +812,9 @@ def project_threshold(
             "points_beyond_v": float(n_v),
         },
         notes=(
-            "The paper compares the RMSE of the check-point discrepancies with 0.40 m "
-            "(twice the LiDAR standard deviation) and with dz of Eq. 18.",
+            _t(
+                "The paper compares the RMSE of the check-point discrepancies with 0.40 m "
+                "(twice the LiDAR standard deviation) and with dz of Eq. 18."
+            ),
         ),
     )
