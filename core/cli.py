@@ -16,7 +16,7 @@ import logging
 import signal
 import sys
 import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 
 from . import __version__, i18n
 from .errors import Cancelled, LidarPhotoError
@@ -84,7 +84,9 @@ def stop_signals_raise() -> Iterator[None]:
             signal.signal(s, old)
 
 
-def _option_help(p: Param, spec: AlgorithmSpec | None = None, t=None) -> str:
+def _option_help(
+    p: Param, spec: AlgorithmSpec | None = None, t: Callable[[str], str] | None = None
+) -> str:
     """label; help; default, unit and valid range (the same facts as the QGIS help); ``t``
     translates the fixed words of the facts."""
     bits = [p.label]
