@@ -22,7 +22,7 @@ __all__ = ["IMAGE_SUFFIXES", "decode_factor", "image_size", "list_image_files", 
 
 PathLike = Union[str, "os.PathLike[str]"]
 #: File endings taken as images when a folder is named.
-IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".jp2")
+IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".jp2", ".img")
 
 
 def list_image_files(paths) -> list[Path]:

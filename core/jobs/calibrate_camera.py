@@ -94,9 +94,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..errors import InputError, stop_if_asked
     from ..io.calibration import read_image_grey, write_report_json, write_residuals_csv
     from ..io.camera import write_cameras_json
+    from ..io.images import list_image_files
     from ..photo.calibration_targets import TargetSpec, detect_target, target_field
     from ..photo.camera_calibration import calibrate_camera
-    from .orthorectify import list_images
     from .runner import stages
 
     spec = TargetSpec(v.target, int(v.columns), int(v.rows), v.spacing, v.marker,
@@ -104,7 +104,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     opts = CalibrationOptions(projection=v.projection, lens_parameters=tuple(v.lens_parameters),
                               field=v.field, sigma_px=v.sigma_px)  # fmt: skip
     fld = target_field(spec)
-    images = list_images(v.images)
+    images = list_image_files(v.images)
     detect, adjust = stages(progress, 0.7, 0.3)
     detections, size = [], None
     for i, path in enumerate(images):

@@ -167,12 +167,12 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.atomic import write_text_atomic
     from ..io.camera import read_camera_json
     from ..io.chips import list_chips, read_control_chip, write_location_report
+    from ..io.images import list_image_files
     from ..io.observations import write_observations_csv
     from ..io.orientation import read_eo_csv_full
     from ..io.resection import read_point_control_csv
     from ..photo.control_location import locate_control_points
     from ..quality.control_location_html import render_location_html
-    from .orthorectify import list_images
 
     crs = parse_crs(v.crs, what="CRS")
     camera = read_camera_json(v.camera)
@@ -189,7 +189,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                          f"{', '.join(unknown[:10])}", path=v.control_points)  # fmt: skip
     chips = [read_control_chip(chip_files[p], p, control.xyz[ids.index(p)])
              for p in sorted(chip_files)]  # fmt: skip
-    images = {f.stem: f for f in list_images(v.images)}
+    images = {f.stem: f for f in list_image_files(v.images)}
     keep = [k for k, i in enumerate(eo.image_id) if i in images]
     if not keep:
         raise InputError("no image of the EO table among the images given", path=v.eo)

@@ -103,13 +103,13 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
     from ..errors import InputError
     from ..geometry.grid import Grid
+    from ..io.images import list_image_files
     from ..io.raster import GeoTiffWriter, RasterReader, polygonize
     from ..io.tables import write_csv_atomic
     from ..photo.mosaic import MosaicSource, mosaic_grid, mosaic_tiles
     from .common import compression_args
-    from .orthorectify import list_images
 
-    files = list_images(v.orthophotos)
+    files = list_image_files(v.orthophotos)
     readers = [RasterReader(f) for f in files]
     try:
         first = readers[0].info

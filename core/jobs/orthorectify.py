@@ -19,8 +19,6 @@ from .spec import AlgorithmSpec, Param, Result, Values
 log = logging.getLogger(__name__)
 
 _D = OrthoOptions()
-#: File endings taken as images when IMAGES names a folder.
-IMAGE_SUFFIXES = (".tif", ".tiff", ".jpg", ".jpeg", ".png", ".jp2", ".img")
 #: Name of the orthophoto of image ``<image_id>`` in the output folder.
 ORTHO_NAME = "{}_ortho.tif"
 DSM_FILTER = "DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"
@@ -104,34 +102,6 @@ class OrthoFile:
     occluded_cells: int
 
 
-def list_images(paths: tuple[str, ...] | list[str]) -> list[Path]:
-    """The image files named, folders expanded (their files with :data:`IMAGE_SUFFIXES`,
-    sorted); InputError for a path that does not exist or a folder without images."""
-    from ..errors import InputError
-
-    out: list[Path] = []
-    for raw in paths:
-        p = Path(raw)
-        if p.is_dir():
-            found = sorted(f for f in p.iterdir()
-                           if f.is_file() and f.suffix.lower() in IMAGE_SUFFIXES
-                           and not f.name.startswith("."))  # fmt: skip
-            if not found:
-                raise InputError("no image in this folder (" + ", ".join(IMAGE_SUFFIXES) + ")",
-                                 path=str(p))  # fmt: skip
-            out += found
-        elif p.is_file():
-            out.append(p)
-        else:
-            raise InputError("file or folder not found", path=str(p))
-    seen: dict[str, Path] = {}
-    for f in out:
-        if f.stem in seen and seen[f.stem] != f:
-            raise InputError(f"two images are named {f.stem}: {seen[f.stem]} and {f}")
-        seen[f.stem] = f
-    return list(seen.values())
-
-
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Check every input, then orthorectify the images one after the other."""
     from ..errors import CrsError, InputError
@@ -149,7 +119,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     camera = read_camera_json(v.camera)
     eo = read_eo_csv(v.eo)
     mapping = parse_crs(v.crs, what="mapping CRS")
-    images = list_images(v.images)
+    from ..io.images import list_image_files
+
+    images = list_image_files(v.images)
     row_of = {name: k for k, name in enumerate(eo.image_id)}
     missing = [f.stem for f in images if f.stem not in row_of]
     if missing:
