@@ -1,8 +1,8 @@
 """How the toolkit's output layers look when QGIS loads them after a run: each style shows
 what matters in that layer (roof planes coloured by id with outlines, LiDAR control points
 sized by their sigma, control lines by kind, residual vectors scaled and labelled, the DTM as
-a hillshade). An algorithm names them in ``STYLES`` ({output name: style function}); the base
-class attaches them to the outputs QGIS will load."""
+a hillshade, 8-bit orthophotos as they are). An algorithm names them in ``STYLES`` ({output
+name: style function}); the base class attaches them to the outputs QGIS will load."""
 
 from __future__ import annotations
 
@@ -11,11 +11,13 @@ import math
 from typing import Callable, ClassVar
 
 from qgis.core import (
+    Qgis,
     QgsCategorizedSymbolRenderer,
     QgsFillSymbol,
     QgsHillshadeRenderer,
     QgsLineSymbol,
     QgsMarkerSymbol,
+    QgsMultiBandColorRenderer,
     QgsPalLayerSettings,
     QgsProcessingLayerPostProcessorInterface,
     QgsProperty,
@@ -164,6 +166,24 @@ def style_dtm(layer) -> None:
     renderer.setMultiDirectional(True)
     layer.setRenderer(renderer)
     layer.triggerRepaint()
+
+
+def style_orthophoto(layer) -> None:
+    """8-bit RGB orthophotos shown as they are (QGIS would stretch each band to its 2-98 %
+    cut; the mask stays the transparency); seamline regions as outlines."""
+    if isinstance(layer, QgsRasterLayer) and layer.bandCount() >= 3:
+        if layer.dataProvider().dataType(1) == Qgis.DataType.Byte:
+            renderer = QgsMultiBandColorRenderer(layer.dataProvider(), 1, 2, 3)
+            if layer.renderer() is not None:
+                renderer.setAlphaBand(layer.renderer().alphaBand())
+            layer.setRenderer(renderer)
+            layer.triggerRepaint()
+    elif isinstance(layer, QgsVectorLayer):
+        symbol = QgsFillSymbol.createSimple(
+            {"color": "0,0,0,0", "outline_color": "255,230,0", "outline_width": "0.5"}
+        )
+        layer.setRenderer(QgsSingleSymbolRenderer(symbol))
+        layer.triggerRepaint()
 
 
 class LayerStyle(QgsProcessingLayerPostProcessorInterface):

@@ -7,7 +7,7 @@ from qgis.core import QgsCoordinateReferenceSystem, QgsGeometry
 from ...core.jobs import orthomosaic
 from ..base import BaseAlgorithm
 from ..compat import FIELD_DOUBLE, FIELD_INT, FIELD_STRING, WKB_MULTIPOLYGON
-from .orthophoto_style import OrthoStyle
+from ..layer_styles import LayerStyle, style_orthophoto
 
 _FIELDS = (("image_id", FIELD_STRING), ("cells", FIELD_INT), ("area", FIELD_DOUBLE))
 
@@ -28,6 +28,6 @@ class OrthomosaicAlgorithm(BaseAlgorithm):
         for layer_id in (res.path, dest):
             if layer_id and context.willLoadLayerOnCompletion(layer_id):
                 context.layerToLoadOnCompletionDetails(layer_id).setPostProcessor(
-                    OrthoStyle.create()
+                    LayerStyle.create(style_orthophoto)
                 )
         return {"OUTPUT_SEAMLINES": dest}

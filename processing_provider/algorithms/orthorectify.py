@@ -6,7 +6,7 @@ from qgis.core import QgsProcessingContext
 
 from ...core.jobs import orthorectify
 from ..base import BaseAlgorithm
-from .orthophoto_style import OrthoStyle
+from ..layer_styles import LayerStyle, style_orthophoto
 
 
 class OrthorectifyAlgorithm(BaseAlgorithm):
@@ -19,6 +19,6 @@ class OrthorectifyAlgorithm(BaseAlgorithm):
             details = QgsProcessingContext.LayerDetails(
                 f"{ortho.image_id} orthophoto", context.project(), "OUTPUT_FOLDER"
             )
-            details.setPostProcessor(OrthoStyle.create())
+            details.setPostProcessor(LayerStyle.create(style_orthophoto))
             context.addLayerToLoadOnCompletion(ortho.path, details)
         return {}
