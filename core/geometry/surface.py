@@ -38,7 +38,7 @@ LOG = logging.getLogger(__name__)
 
 Array = NDArray[np.float64]
 
-__all__ = ["Dsm", "reproject_dsm"]
+__all__ = ["Dsm", "reproject_dsm", "triangle_height"]
 
 
 @dataclass(frozen=True)
@@ -92,25 +92,38 @@ class Dsm:
         [0.0, 1.5, 3.0]
         """
         u, v = self.to_grid_uv(x, y)
-        u, v = np.atleast_1d(u), np.atleast_1d(v)
-        rows, cols = self.heights.shape
-        inside = (u >= 0) & (v >= 0) & (u <= cols - 1) & (v <= rows - 1)
-        c = np.clip(np.floor(u), 0, max(cols - 2, 0)).astype(np.int64)
-        r = np.clip(np.floor(v), 0, max(rows - 2, 0)).astype(np.int64)
-        fu, fv = u - c, v - r
-        z = self.heights
-        z00 = z[r, c].astype(float)
-        z01 = z[r, np.minimum(c + 1, cols - 1)].astype(float)
-        z10 = z[np.minimum(r + 1, rows - 1), c].astype(float)
-        z11 = z[np.minimum(r + 1, rows - 1), np.minimum(c + 1, cols - 1)].astype(float)
-        upper = fu >= fv
-        out = np.where(
-            upper,
-            z00 + (z01 - z00) * fu + (z11 - z01) * fv,
-            z00 + (z11 - z10) * fu + (z10 - z00) * fv,
-        )
-        out[~inside] = np.nan
-        return out
+        return triangle_height(self.heights, np.atleast_1d(u), np.atleast_1d(v))
+
+
+
+def triangle_height(z: NDArray, u: ArrayLike, v: ArrayLike) -> Array:
+    """Height of the surface triangulated on the grid ``z`` at grid coordinates ``(u, v)``.
+
+    ``u`` counts columns and ``v`` rows from the centre of cell (0, 0) (cells); ``u`` and ``v``
+    broadcast against each other. Each cell square is split along its (0, 0)-(1, 1) diagonal;
+    NaN outside the grid (and where a corner is NaN).
+
+    >>> triangle_height(np.array([[0.0, 1.0], [2.0, 3.0]]), [0.5, 1.0], [0.25, 1.0]).tolist()
+    [1.0, 3.0]
+    """
+    u, v = np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64)
+    rows, cols = z.shape
+    inside = (u >= 0) & (v >= 0) & (u <= cols - 1) & (v <= rows - 1)
+    c = np.clip(np.floor(u), 0, max(cols - 2, 0)).astype(np.int64)
+    r = np.clip(np.floor(v), 0, max(rows - 2, 0)).astype(np.int64)
+    fu, fv = u - c, v - r
+    c1, r1 = np.minimum(c + 1, cols - 1), np.minimum(r + 1, rows - 1)
+    z00 = z[r, c].astype(np.float64)
+    z01 = z[r, c1].astype(np.float64)
+    z10 = z[r1, c].astype(np.float64)
+    z11 = z[r1, c1].astype(np.float64)
+    out = np.where(
+        fu >= fv,
+        z00 + (z01 - z00) * fu + (z11 - z01) * fv,
+        z00 + (z11 - z10) * fu + (z10 - z00) * fv,
+    )
+    out[~inside] = np.nan
+    return out
 
 
 def reproject_dsm(

@@ -54,7 +54,7 @@ from ..geometry.distortion import NoDistortion
 from ..geometry.frames import LocalFrame, MappingFrame, parse_crs
 from ..geometry.grid import Grid
 from ..geometry.raycast import STATUS_GRAZING, STATUS_OK, DsmTracer, intersect_dsm
-from ..geometry.surface import Dsm
+from ..geometry.surface import Dsm, triangle_height
 from .orientation import eo_map_to_local
 from .orthophoto_numba import remap_maps
 
@@ -213,7 +213,6 @@ def cell_pixels_numpy(
     z : (h, w) float64
         Surface height (NaN outside the DSM or on nodata).
     """
-    rows, cols = z.shape
     ny, nx = lat.shape[:2]
     ii = np.arange(h, dtype=np.float64)
     jj = np.arange(w, dtype=np.float64)
@@ -221,18 +220,7 @@ def cell_pixels_numpy(
     x = x0 + jj * g
     v = ((yc - y) * inv_cell)[:, None]
     u = ((x - xc) * inv_cell)[None, :]
-    inside = (u >= 0.0) & (v >= 0.0) & (u <= cols - 1) & (v <= rows - 1)
-    c = np.clip(np.floor(u), 0, max(cols - 2, 0)).astype(np.int64)
-    r = np.clip(np.floor(v), 0, max(rows - 2, 0)).astype(np.int64)
-    fu, fv = u - c, v - r
-    c1, r1 = np.minimum(c + 1, cols - 1), np.minimum(r + 1, rows - 1)
-    z00 = z[r, c].astype(np.float64)
-    z01 = z[r, c1].astype(np.float64)
-    z10 = z[r1, c].astype(np.float64)
-    z11 = z[r1, c1].astype(np.float64)
-    zz = np.where(fu >= fv, z00 + (z01 - z00) * fu + (z11 - z01) * fv,
-                  z00 + (z11 - z10) * fu + (z10 - z00) * fv)  # fmt: skip
-    zz[~inside] = np.nan
+    zz = triangle_height(z, u, v)
     fi, fj = ii / step, jj / step
     ki = np.minimum(fi.astype(np.int64), ny - 2)
     kj = np.minimum(fj.astype(np.int64), nx - 2)
