@@ -41,7 +41,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 
-__all__ = ["Plane", "fit_plane", "fit_planes", "orient_up", "slope_aspect_deg"]
+__all__ = ["Plane", "fit_plane", "fit_planes", "label_moments", "orient_up", "slope_aspect_deg"]
 
 Array = NDArray[np.float64]
 
@@ -234,6 +234,30 @@ def fit_plane(points: ArrayLike, weights: ArrayLike | None = None, *, plane_id: 
 
 
 
+def label_moments(
+    q: NDArray[np.float64], lab: NDArray[np.int64], nl: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Point counts (L,), centroids (L, 3) and scatter matrices (L, 3, 3) of the points ``q``
+    (N, 3) of each label ``lab`` (N,) in 0..L-1, in two passes (centroid first: no
+    cancellation), summed in point order.
+
+    >>> c, m, s = label_moments(np.array([[0., 0, 0], [2, 0, 0], [5, 5, 5]]),
+    ...                         np.array([0, 0, 1]), 2)
+    >>> c.tolist(), m[0].tolist(), float(s[0, 0, 0]), float(s[1].sum())
+    ([2.0, 1.0], [1.0, 0.0, 0.0], 2.0, 0.0)
+    """
+    counts = np.bincount(lab, minlength=nl).astype(np.float64)
+    mean = np.column_stack([np.bincount(lab, q[:, c], minlength=nl) for c in range(3)])
+    mean /= np.maximum(counts, 1.0)[:, None]
+    dev = q - mean[lab]
+    scatter = np.empty((nl, 3, 3))
+    for a in range(3):
+        for b in range(a, 3):
+            scatter[:, a, b] = scatter[:, b, a] = np.bincount(lab, dev[:, a] * dev[:, b],
+                                                              minlength=nl)  # fmt: skip
+    return counts, mean, scatter
+
+
 def fit_planes(
     points: ArrayLike, labels: ArrayLike, n_planes: int | None = None
 ) -> list[Plane | None]:
@@ -277,15 +301,8 @@ def fit_planes(
     lab = lab[m]
     origin = np.floor(pts[m][0])
     q = pts[m] - origin
-    counts = np.bincount(lab, minlength=nl).astype(np.float64)
-    mean = np.column_stack([np.bincount(lab, q[:, c], minlength=nl) for c in range(3)])
-    mean /= np.maximum(counts, 1.0)[:, None]
+    counts, mean, scatter = label_moments(q, lab, nl)
     dev = q - mean[lab]
-    scatter = np.empty((nl, 3, 3))
-    for a in range(3):
-        for b in range(a, 3):
-            scatter[:, a, b] = scatter[:, b, a] = np.bincount(lab, dev[:, a] * dev[:, b],
-                                                              minlength=nl)  # fmt: skip
     ok = counts >= 3
     lam = np.zeros((nl, 3))
     vec = np.tile(np.eye(3), (nl, 1, 1))

@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError, stop_if_asked
-from ..geometry.planes import Plane, fit_plane, fit_planes
+from ..geometry.planes import Plane, fit_plane, fit_planes, label_moments
 
 __all__ = ["SELECTION_CHOICES", "RoofPlaneParams", "RoofPlaneResult", "extract_roof_planes"]
 
@@ -610,19 +610,12 @@ def _fit_labels(
         from . import roof_planes_numba
 
         counts, centroid, six = roof_planes_numba.moments(q, labels, nl)
+        cov = np.empty((nl, 3, 3))
+        for col, (a, b) in enumerate(_UPPER):
+            cov[:, a, b] = cov[:, b, a] = six[:, col]
     else:
         m = labels >= 0
-        lab = labels[m]
-        pts = q[m]
-        counts = np.bincount(lab, minlength=nl).astype(np.float64)
-        sums = np.column_stack([np.bincount(lab, pts[:, c], minlength=nl) for c in range(3)])
-        centroid = sums / np.maximum(counts, 1)[:, None]
-        dev = pts - centroid[lab]
-        six = np.column_stack([np.bincount(lab, dev[:, a] * dev[:, b], minlength=nl)
-                               for a, b in _UPPER])  # fmt: skip
-    cov = np.empty((nl, 3, 3))
-    for col, (a, b) in enumerate(_UPPER):
-        cov[:, a, b] = cov[:, b, a] = six[:, col]
+        counts, centroid, cov = label_moments(q[m], labels[m], nl)
     return _eig_normals(cov), centroid, counts
 
 
