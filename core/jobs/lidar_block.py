@@ -47,8 +47,10 @@ core by default) or on an existing cluster (CLUSTER: its scheduler address, e.g.
 tcp://10.0.0.5:8786; every worker must have lidarphoto and read the input paths).
 
 Input: a folder of LAS/LAZ tiles, a virtual point cloud (.vpc, as made by PDAL or QGIS), or
-one large LAS/LAZ file cut into square tiles of TILE_SIZE read in chunks. Tiles in different
-CRSs are refused. Neighbours are found from the headers' bounding boxes.
+one large LAS/LAZ file cut into square tiles of TILE_SIZE read in chunks. A COPC file (Cloud
+Optimized Point Cloud) is read by octree node instead: each tile decompresses only the nodes
+around its cell and buffer, where a plain LAZ is streamed whole by every tile. Tiles in
+different CRSs are refused. Neighbours are found from the headers' bounding boxes.
 
 Buffers: each tile is filtered with the points of its neighbours within 2 x SMRF_WINDOW +
 LOW_OUTLIER_RADIUS + 3 cells of its box, so its classes are those of a run on the whole cloud
@@ -73,7 +75,8 @@ DISTANCE_UNIT is metres.""",
     params=(
         Param("INPUT", "file", "Block: folder of LAS/LAZ tiles, .vpc or one LAS/LAZ file",
               file_filter="LAS/LAZ or virtual point cloud (*.las *.laz *.vpc)",
-              help="a folder path is accepted too (its *.las/*.laz)"),
+              help="a folder path is accepted too (its *.las/*.laz); COPC files are read by "
+              "octree node"),
         *cloud_params("INPUT")[1:],
         Param("TILE_SIZE", "number", "Tile size (one large file)", 500.0, unit="length",
               minimum=1.0, maximum=1e6, help="side of the square tiles one file is cut into"),
