@@ -52,9 +52,9 @@ def main() -> None:
     ap.add_argument("--folder", default="/tmp/copc-bench")
     args = ap.parse_args()
 
-    import copclib
+    from importlib.metadata import version
+
     import laspy
-    import lazrs
 
     from lidarphoto.core.io import tiles as tiles_mod
     from lidarphoto.core.jobs import lidar_block
@@ -75,8 +75,8 @@ def main() -> None:
     write_las(folder / "town.laz", xyz)
     del pts
     print(f"# {platform.node()} {os.cpu_count()} cores, load {os.getloadavg()}")
-    print(f"# laspy {laspy.__version__}, lazrs {getattr(lazrs, '__version__', '?')}, "
-          f"copclib {getattr(copclib, '__version__', '2.6.3')}")
+    print(f"# laspy {laspy.__version__}, lazrs {version('lazrs')}, copclib {version('copclib')}, "
+          f"numpy {np.__version__}")
     print(f"{len(xyz)} points, {np.ptp(xyz[:, :2], axis=0).round(0)} m; COPC "
           f"{(folder / 'town.copc.laz').stat().st_size / 1e6:.1f} MB ({layout['nodes']} nodes, "
           f"depth {layout['depth']}), LAZ {(folder / 'town.laz').stat().st_size / 1e6:.1f} MB; "
