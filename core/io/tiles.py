@@ -327,8 +327,12 @@ def _copc_layout(fh: Any, path: str) -> CopcLayout:
     except Exception as exc:
         raise InputError(f"corrupt COPC header: {exc}", path=path) from exc
     nodes = []
+    seen: set[int] = set()
     while pages:
         at, nbytes = pages.pop()
+        if at in seen:  # a page listed twice would loop or count its nodes twice
+            raise InputError(f"corrupt COPC: hierarchy page at byte {at} listed twice", path=path)
+        seen.add(at)
         if at + nbytes > size or nbytes % _ENTRY.itemsize:
             raise InputError(f"corrupt or truncated COPC: a hierarchy page (bytes {at} to "
                              f"{at + nbytes}) lies past the end of the file ({size} bytes)",
