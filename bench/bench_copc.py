@@ -55,7 +55,6 @@ def main() -> None:
     from importlib.metadata import version
 
     import laspy
-
     from lidarphoto.core.io import tiles as tiles_mod
     from lidarphoto.core.jobs import lidar_block
     from lidarphoto.core.jobs.runner import run_job
