@@ -4019,11 +4019,15 @@ tcp://10.0.0.5:8786; todo trabalhador deve ter o lidarphoto e conseguir ler os c
         </message>
         <message>
             <source>Input: a folder of LAS/LAZ tiles, a virtual point cloud (.vpc, as made by PDAL or QGIS), or
-one large LAS/LAZ file cut into square tiles of TILE_SIZE read in chunks. Tiles in different
-CRSs are refused. Neighbours are found from the headers' bounding boxes.</source>
+one large LAS/LAZ file cut into square tiles of TILE_SIZE read in chunks. A COPC file (Cloud
+Optimized Point Cloud) is read by octree node instead: each tile decompresses only the nodes
+around its cell and buffer, where a plain LAZ is streamed whole by every tile. Tiles in
+different CRSs are refused. Neighbours are found from the headers' bounding boxes.</source>
             <translation>Entrada: uma pasta de tiles LAS/LAZ, uma nuvem de pontos virtual (.vpc, como as criadas pelo PDAL ou QGIS), ou
-um único arquivo LAS/LAZ grande, cortado em tiles quadrados de TILE_SIZE lidos em partes. Tiles em SRCs
-diferentes são recusados. Os vizinhos são encontrados pelas caixas envolventes dos cabeçalhos.</translation>
+um único arquivo LAS/LAZ grande, cortado em tiles quadrados de TILE_SIZE lidos em partes. Um arquivo COPC (Cloud
+Optimized Point Cloud) é lido por nó da octree: cada tile descomprime só os nós
+em torno da sua célula e do seu buffer, enquanto um LAZ comum é lido inteiro por cada tile. Tiles em
+SRCs diferentes são recusados. Os vizinhos são encontrados pelas caixas envolventes dos cabeçalhos.</translation>
         </message>
         <message>
             <source>Buffers: each tile is filtered with the points of its neighbours within 2 x SMRF_WINDOW +
@@ -4072,8 +4076,8 @@ DISTANCE_UNIT seja metros.</translation>
             <translation>Bloco: pasta de tiles LAS/LAZ, .vpc ou um arquivo LAS/LAZ</translation>
         </message>
         <message>
-            <source>a folder path is accepted too (its *.las/*.laz)</source>
-            <translation>um caminho de pasta também é aceito (os seus *.las/*.laz)</translation>
+            <source>a folder path is accepted too (its *.las/*.laz); COPC files are read by octree node</source>
+            <translation>um caminho de pasta também é aceito (os seus *.las/*.laz); arquivos COPC são lidos por nó da octree</translation>
         </message>
         <message>
             <source>LAS/LAZ or virtual point cloud (*.las *.laz *.vpc)</source>
@@ -4226,6 +4230,18 @@ DISTANCE_UNIT seja metros.</translation>
         <message>
             <source>LiDAR control lines</source>
             <translation>Linhas de controle LiDAR</translation>
+        </message>
+        <message>
+            <source>Input: a folder of LAS/LAZ tiles, a virtual point cloud (.vpc, as made by PDAL or QGIS), or
+one large LAS/LAZ file cut into square tiles of TILE_SIZE read in chunks. Tiles in different
+CRSs are refused. Neighbours are found from the headers' bounding boxes.</source>
+            <translation type="vanished">Entrada: uma pasta de tiles LAS/LAZ, uma nuvem de pontos virtual (.vpc, como as criadas pelo PDAL ou QGIS), ou
+um único arquivo LAS/LAZ grande, cortado em tiles quadrados de TILE_SIZE lidos em partes. Tiles em SRCs
+diferentes são recusados. Os vizinhos são encontrados pelas caixas envolventes dos cabeçalhos.</translation>
+        </message>
+        <message>
+            <source>a folder path is accepted too (its *.las/*.laz)</source>
+            <translation type="vanished">um caminho de pasta também é aceito (os seus *.las/*.laz)</translation>
         </message>
     </context>
     <context>

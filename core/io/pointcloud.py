@@ -723,6 +723,8 @@ def _write_records(
                 ) from exc
             if done != n:
                 raise InputError(f"truncated: {done} points read, the header says {n}", path=src)
-            if evlrs:
-                writer.write_evlrs(laspy.VLRList(evlrs))
+            if evlrs:  # (laspy has no top-level VLRList)
+                from laspy.vlrs.vlrlist import VLRList
+
+                writer.write_evlrs(VLRList(evlrs))
     LOG.info("wrote %d points to %s", n, dst)

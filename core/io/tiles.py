@@ -4,12 +4,19 @@ large file cut into a grid of tiles read in chunks; buffered reads; the output V
 The tile index is made from headers only (or the VPC's own bounding boxes): finding a tile's
 neighbours never reads points. :func:`read_buffered` then reads one tile's own points (its
 *core*) and the points of its neighbours within ``buffer`` of its box, streaming each file in
-chunks.
+chunks. A COPC file (Cloud Optimized Point Cloud: a LAZ 1.4 file whose first VLR is the
+``copc`` info record and whose LAZ chunks are the nodes of an octree) is read by bounds
+instead: only the octree nodes whose cube meets the tile's box plus buffer are decompressed
+(:func:`copc_nodes`), and the points are then kept by the same rules as when streaming (the
+half-open cell for the core, the closed buffered box), so the tile gets the same points with
+the same ids either way.
 
 Point ids: every point of the block has the id ``file offset + index in its file``, where a
 file's offset is the sum of the point counts of the files before it in the index (folder and
 VPC: sorted by name / in the VPC's order; one large file: offset 0). The id is stable across
-runs and workers, so a re-run task gives the same points with the same ids.
+runs and workers, so a re-run task gives the same points with the same ids. A COPC node's
+points have ids from the node's place in the file (its chunk's byte offset): the ids of a
+streamed read.
 
 A VPC (PDAL's and QGIS's virtual point cloud) is a STAC ItemCollection (GeoJSON
 FeatureCollection): each feature's ``assets`` hold the file (``href``, relative to the .vpc),
@@ -62,6 +69,9 @@ class Tile:
         A grid tile's half-open core [xmin, xmax) x [ymin, ymax) (the grid, on multiples of
         the tile size, has a cell past the file's maximum); None when the tile is its whole
         file.
+    copc : bool
+        The file is COPC: its neighbours' buffers (and a grid tile's core) are read by octree
+        node, not streamed.
     """
 
     name: str
@@ -70,6 +80,7 @@ class Tile:
     count: int
     offset: int
     cell: tuple[float, float, float, float] | None = None
+    copc: bool = False
 
 
 @dataclass
@@ -176,6 +187,10 @@ def _index_files(
     offset = 0
     for name, file, _ in entries:
         try:
+            copc = is_copc(file)
+            if copc:  # a truncated COPC lost its hierarchy (and its CRS, an EVLR): say so
+                with open(file, "rb") as fh:
+                    _copc_layout(fh, file)
             info = read_info(file, crs)
         except CrsError:
             raise
@@ -185,7 +200,7 @@ def _index_files(
         infos.append((name, info))
         box = (float(info.mins[0]), float(info.mins[1]), float(info.maxs[0]),
                float(info.maxs[1]))  # fmt: skip
-        tiles.append(Tile(name, file, box, info.point_count, offset))
+        tiles.append(Tile(name, file, box, info.point_count, offset, None, copc))
         offset += info.point_count
     if not tiles:
         raise InputError(f"no readable tile ({len(bad)} unreadable: {bad[0][1]})", path=source)
@@ -239,6 +254,10 @@ def _index_vpc(path: Path, crs: Any) -> BlockIndex:
 
 def _index_one_file(path: Path, crs: Any, tile_size: float) -> BlockIndex:
     info = read_info(path, crs)
+    copc = is_copc(path)
+    if copc:  # a truncated COPC fails here, by name, not in every tile task
+        with open(path, "rb") as fh:
+            _copc_layout(fh, str(path))
     xmin, ymin, xmax, ymax = (float(info.mins[0]), float(info.mins[1]), float(info.maxs[0]),
                               float(info.maxs[1]))  # fmt: skip
     size = tile_size if tile_size > 0 else max(xmax - xmin, ymax - ymin, 1.0) * 1.000001
@@ -251,8 +270,165 @@ def _index_one_file(path: Path, crs: Any, tile_size: float) -> BlockIndex:
         for c in range(cols):
             cell = (x0 + c * size, y0 + r * size, x0 + (c + 1) * size, y0 + (r + 1) * size)
             box = (max(cell[0], xmin), max(cell[1], ymin), min(cell[2], xmax), min(cell[3], ymax))
-            tiles.append(Tile(f"{path.stem}_{c}_{r}", str(path), box, info.point_count, 0, cell))
+            tiles.append(Tile(f"{path.stem}_{c}_{r}", str(path), box, info.point_count, 0, cell,
+                              copc))  # fmt: skip
     return BlockIndex(str(path), "file", tiles, info)
+
+
+# ----------------------------------------------------------------------------- COPC
+#: A COPC hierarchy entry (COPC 1.0 specification): voxel key (level, x, y, z), then the byte
+#: offset and size of the node's LAZ chunk (or of a child hierarchy page when the point count
+#: is -1) and its point count.
+_ENTRY = np.dtype([("level", "<i4"), ("x", "<i4"), ("y", "<i4"), ("z", "<i4"),
+                   ("offset", "<u8"), ("size", "<i4"), ("count", "<i4")])  # fmt: skip
+
+
+def is_copc(path: PathLike) -> bool:
+    """True when the LAS/LAZ file is COPC: its first VLR is the ``copc`` info record (user id
+    "copc", record id 1), as the COPC specification requires. Reads the header only."""
+    import laspy
+
+    try:
+        with laspy.open(os.fspath(path)) as reader:
+            vlrs = reader.header.vlrs
+            return bool(len(vlrs)) and vlrs[0].user_id == "copc" and vlrs[0].record_id == 1
+    except Exception:  # not readable as LAS/LAZ: read_info reports it
+        return False
+
+
+@dataclass(frozen=True)
+class CopcLayout:
+    """A COPC file's octree as read from its header and hierarchy pages.
+
+    ``nodes`` (structured array, :data:`_ENTRY` fields plus ``start``, the file index of the
+    node's first point: the node's chunks sorted by byte offset are the file's point order),
+    the root cube (``center`` and ``halfsize``, CRS unit), the LAZ VLR and header."""
+
+    nodes: NDArray[Any]
+    center: NDArray[np.float64]
+    halfsize: float
+    laz_vlr: bytes
+    header: Any
+
+
+def _copc_layout(fh: Any, path: str) -> CopcLayout:
+    """Read a COPC file's header and its whole hierarchy (every page: a few bytes per node)."""
+    import laspy
+
+    size = os.fstat(fh.fileno()).st_size
+    try:
+        fh.seek(0)
+        header = laspy.LasHeader.read_from(fh)
+        info = header.vlrs[0]
+        laz = header.vlrs.get("LasZipVlr")[0]
+        pages = [(int(info.hierarchy_root_offset), int(info.hierarchy_root_size))]
+        center = np.asarray(info.center, dtype=np.float64).copy()
+        halfsize = float(info.halfsize)
+    except Exception as exc:
+        raise InputError(f"corrupt COPC header: {exc}", path=path) from exc
+    nodes = []
+    seen: set[int] = set()
+    while pages:
+        at, nbytes = pages.pop()
+        if at in seen:  # a page listed twice would loop or count its nodes twice
+            raise InputError(f"corrupt COPC: hierarchy page at byte {at} listed twice", path=path)
+        seen.add(at)
+        if at + nbytes > size or nbytes % _ENTRY.itemsize:
+            raise InputError(f"corrupt or truncated COPC: a hierarchy page (bytes {at} to "
+                             f"{at + nbytes}) lies past the end of the file ({size} bytes)",
+                             path=path)  # fmt: skip
+        fh.seek(at)
+        page = np.frombuffer(fh.read(nbytes), dtype=_ENTRY)
+        pages += [(int(e["offset"]), int(e["size"])) for e in page[page["count"] == -1]]
+        nodes.append(page[page["count"] > 0])
+    entries = np.concatenate(nodes) if nodes else np.zeros(0, _ENTRY)
+    entries = np.sort(entries, order="offset")
+    end = entries["offset"].astype(np.int64) + entries["size"]
+    if len(entries) and int(end.max()) > size:
+        raise InputError(f"corrupt or truncated COPC: its last node ends at byte {int(end.max())}"
+                         f", the file has {size}", path=path)  # fmt: skip
+    if int(entries["count"].sum()) != int(header.point_count):
+        raise InputError(f"corrupt COPC: its nodes hold {int(entries['count'].sum())} points, "
+                         f"the header says {int(header.point_count)}", path=path)  # fmt: skip
+    out = np.zeros(len(entries), _ENTRY.descr + [("start", "<i8")])
+    for name in _ENTRY.names:
+        out[name] = entries[name]
+    out["start"] = np.concatenate([[0], np.cumsum(entries["count"], dtype=np.int64)[:-1]])
+    return CopcLayout(out, center, halfsize, bytes(laz.record_data), header)
+
+
+def copc_nodes(layout: CopcLayout, box: Sequence[float]) -> NDArray[Any]:
+    """The nodes whose cube meets ``box`` (xmin, ymin, xmax, ymax; closed) in x and y.
+
+    A COPC writer puts every point inside its node's cube; the cube is widened by two
+    coordinate steps so a point rounded onto a cube face is never missed.
+    """
+    n = layout.nodes
+    side = 2.0 * layout.halfsize / np.exp2(n["level"])
+    pad = 2.0 * float(np.max(layout.header.scales[:2]))
+    lo_x = layout.center[0] - layout.halfsize + n["x"] * side
+    lo_y = layout.center[1] - layout.halfsize + n["y"] * side
+    hit = ((lo_x - pad <= box[2]) & (lo_x + side + pad >= box[0]) & (lo_y - pad <= box[3])
+           & (lo_y + side + pad >= box[1]))  # fmt: skip
+    return n[hit]
+
+
+def _copc_read(path: str, box: Sequence[float]):
+    """(header, points of the nodes meeting ``box`` in file order, their ids, points decoded)
+    of a COPC file: only those nodes' chunks are read and decompressed (lazrs)."""
+    import laspy
+    import lazrs
+
+    with open(path, "rb") as fh:
+        layout = _copc_layout(fh, path)
+        nodes = copc_nodes(layout, box)
+        header = layout.header
+        fmt = header.point_format
+        total = int(nodes["count"].sum())
+        raw = np.zeros(total * fmt.size, np.uint8)
+        if total:
+            # contiguous nodes in one read (they are sorted by offset)
+            data = bytearray(int(nodes["size"].sum()))
+            view = memoryview(data)
+            pos = 0
+            at = nodes["offset"].astype(np.int64)
+            new_run = np.concatenate([[True], at[1:] != at[:-1] + nodes["size"][:-1]])
+            for k in np.flatnonzero(new_run):
+                stop = np.flatnonzero(new_run[k + 1 :])
+                last = k + 1 + int(stop[0]) if len(stop) else len(nodes)
+                nbytes = int(nodes["size"][k:last].sum())
+                fh.seek(int(at[k]))
+                if fh.readinto(view[pos : pos + nbytes]) != nbytes:
+                    raise InputError("truncated COPC: a node's chunk ends past the end of the "
+                                     "file", path=path)  # fmt: skip
+                pos += nbytes
+            table = [(int(c), int(b)) for c, b in zip(nodes["count"], nodes["size"])]
+            try:
+                lazrs.decompress_points_with_chunk_table(
+                    data, layout.laz_vlr, raw, table,
+                    laspy.DecompressionSelection.all().to_lazrs())  # fmt: skip
+            except Exception as exc:  # lazrs: corrupt chunk bytes
+                raise InputError(f"corrupt COPC point data: {exc}", path=path) from exc
+    points = laspy.ScaleAwarePointRecord(raw.view(fmt.dtype()), fmt, header.scales,
+                                         header.offsets)  # fmt: skip
+    ids = np.repeat(nodes["start"] - np.cumsum(nodes["count"]) + nodes["count"],
+                    nodes["count"]) + np.arange(total, dtype=np.int64)  # fmt: skip
+    return header, points, ids, total
+
+
+def _output_header(header: Any) -> tuple[Any, list[Any]]:
+    """A copy of a source header for a plain LAS/LAZ output, and the EVLRs to write: the
+    COPC records (info, extents, hierarchy) are dropped (the output is no octree), the other
+    EVLRs (a LAS 1.4 file's WKT CRS may be one) kept."""
+    from copy import deepcopy
+
+    out = deepcopy(header)
+    keep = [v for v in out.vlrs if v.user_id != "copc"]
+    out.vlrs.clear()
+    out.vlrs.extend(keep)
+    evlrs = [v for v in (getattr(header, "evlrs", None) or []) if v.user_id != "copc"]
+    out.evlrs = None
+    return out, deepcopy(evlrs)
 
 
 def _in_cell(x: NDArray[np.float64], y: NDArray[np.float64], cell) -> NDArray[np.bool_]:
@@ -266,12 +442,15 @@ class BufferedTile:
 
     ``arrays`` holds :data:`BUFFER_FIELDS` plus ``id`` (int64, module docstring) and ``core``
     (bool) for every point read, core points first; ``records`` the core's packed records (to
-    write the output tile); ``missing`` the neighbours whose buffer could not be read."""
+    write the output tile); ``missing`` the neighbours whose buffer could not be read;
+    ``decoded`` the points decompressed to make it (a streamed file: all its points; a COPC
+    file: those of the octree nodes meeting the buffered box)."""
 
     tile: Tile
     arrays: dict[str, NDArray[Any]]
     records: LasPoints
     missing: list[str]
+    decoded: int = 0
 
     @property
     def n_core(self) -> int:
@@ -279,7 +458,7 @@ class BufferedTile:
 
 
 def _stream(path: str, crs: Any, should_stop: Callable[[], bool] | None):
-    """(header, info, chunk record arrays with their first index) of a file, streamed."""
+    """(header, info, chunk record arrays with their ids) of a file, streamed."""
     from .pointcloud import _open
 
     with _open(path) as reader:
@@ -288,12 +467,25 @@ def _stream(path: str, crs: Any, should_stop: Callable[[], bool] | None):
         try:
             for chunk in reader.chunk_iterator(_CHUNK):
                 stop_if_asked(should_stop, "reading the tiles")
-                yield reader.header, info, chunk, done
+                yield reader.header, info, chunk, done + np.arange(len(chunk), dtype=np.int64)
                 done += len(chunk)
         except (InputError, Cancelled):
             raise
         except Exception as exc:  # lazrs/laspy decoding errors: corrupt or truncated file
             raise InputError(f"corrupt or truncated after {done} points: {exc}", path=path) from exc
+
+
+def _query(path: str, crs: Any, box: Sequence[float], should_stop: Callable[[], bool] | None):
+    """The same as :func:`_stream` for a COPC file: one part, the points of the octree nodes
+    meeting ``box``, in file order (the caller keeps the points inside by its own rule)."""
+    from .pointcloud import _open
+
+    stop_if_asked(should_stop, "reading the tiles")
+    with _open(path) as reader:  # the header with its EVLRs (a COPC's WKT is one)
+        header = reader.header
+    info = read_info(path, crs)
+    _, points, ids, _ = _copc_read(path, box)
+    yield header, info, points, ids
 
 
 def read_buffered(
@@ -307,10 +499,10 @@ def read_buffered(
 
     Neighbours come from the index's boxes (no point is read to find them). A neighbour whose
     file cannot be read is listed in ``missing`` (its buffer is then incomplete); the tile's
-    own file must be readable (InputError naming it otherwise).
+    own file must be readable (InputError naming it otherwise). A COPC file is read by bounds
+    (module docstring) unless all of it is needed (a whole-file tile's own file); the points
+    kept, their ids and order are those of a streamed read.
     """
-    from copy import deepcopy
-
     tile = index.tiles[i]
     own = tile.cell or tile.box
     outer = (own[0] - buffer, own[1] - buffer, own[2] + buffer, own[3] + buffer)
@@ -318,15 +510,19 @@ def read_buffered(
     core_records: list[NDArray[Any]] = []
     header = None
     info = None
-    files = [(tile.path, tile.offset, True)]
+    files = [(tile.path, tile.offset, True, tile.copc and tile.cell is not None)]
     for k in neighbours(index, i, buffer):
         t = index.tiles[k]
-        if (t.path, t.offset, False) not in files and t.path != tile.path:
-            files.append((t.path, t.offset, False))
+        if t.path != tile.path and all(f[0] != t.path for f in files):
+            files.append((t.path, t.offset, False, t.copc))
     missing: list[str] = []
-    for path, offset, is_own in files:
+    decoded = 0
+    for path, offset, is_own, by_query in files:
+        reads = _query(path, crs, outer, should_stop) if by_query else _stream(
+            path, crs, should_stop)  # fmt: skip
         try:
-            for head, inf, chunk, start in _stream(path, crs, should_stop):
+            for head, inf, chunk, ids in reads:
+                decoded += len(chunk)
                 x = np.asarray(chunk.x, dtype=np.float64)
                 y = np.asarray(chunk.y, dtype=np.float64)
                 if is_own and tile.cell is None:
@@ -344,7 +540,7 @@ def read_buffered(
                     continue
                 # core points first within each chunk, then the buffer points
                 order = np.concatenate([np.flatnonzero(core), np.flatnonzero(take & ~core)])
-                part = {"core": core[order], "id": offset + start + order.astype(np.int64)}
+                part = {"core": core[order], "id": offset + ids[order]}
                 for name in BUFFER_FIELDS:
                     part[name] = np.asarray(getattr(chunk, name))[order]
                 parts.append(part)
@@ -361,8 +557,9 @@ def read_buffered(
     # core points first overall (their order: file order, as in the output tile)
     first = np.argsort(~arrays["core"], kind="stable")
     arrays = {k: v[first] for k, v in arrays.items()}
-    records = LasPoints(info=info, header=deepcopy(header), chunks=core_records, evlrs=[])
-    return BufferedTile(tile, arrays, records, missing)
+    out_header, evlrs = _output_header(header)
+    records = LasPoints(info=info, header=out_header, chunks=core_records, evlrs=evlrs)
+    return BufferedTile(tile, arrays, records, missing, decoded)
 
 
 # ----------------------------------------------------------------------------- outputs

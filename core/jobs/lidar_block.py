@@ -47,8 +47,10 @@ core by default) or on an existing cluster (CLUSTER: its scheduler address, e.g.
 tcp://10.0.0.5:8786; every worker must have lidarphoto and read the input paths).
 
 Input: a folder of LAS/LAZ tiles, a virtual point cloud (.vpc, as made by PDAL or QGIS), or
-one large LAS/LAZ file cut into square tiles of TILE_SIZE read in chunks. Tiles in different
-CRSs are refused. Neighbours are found from the headers' bounding boxes.
+one large LAS/LAZ file cut into square tiles of TILE_SIZE read in chunks. A COPC file (Cloud
+Optimized Point Cloud) is read by octree node instead: each tile decompresses only the nodes
+around its cell and buffer, where a plain LAZ is streamed whole by every tile. Tiles in
+different CRSs are refused. Neighbours are found from the headers' bounding boxes.
 
 Buffers: each tile is filtered with the points of its neighbours within 2 x SMRF_WINDOW +
 LOW_OUTLIER_RADIUS + 3 cells of its box, so its classes are those of a run on the whole cloud
@@ -73,7 +75,8 @@ DISTANCE_UNIT is metres.""",
     params=(
         Param("INPUT", "file", "Block: folder of LAS/LAZ tiles, .vpc or one LAS/LAZ file",
               file_filter="LAS/LAZ or virtual point cloud (*.las *.laz *.vpc)",
-              help="a folder path is accepted too (its *.las/*.laz)"),
+              help="a folder path is accepted too (its *.las/*.laz); COPC files are read by "
+              "octree node"),
         *cloud_params("INPUT")[1:],
         Param("TILE_SIZE", "number", "Tile size (one large file)", 500.0, unit="length",
               minimum=1.0, maximum=1e6, help="side of the square tiles one file is cut into"),
@@ -166,6 +169,7 @@ class TileOutcome:
     pieces: list[Any] = field(default_factory=list)
     ids_digest: tuple[int, int, int] = (0, 0, 0)
     stages: dict[str, float] = field(default_factory=dict)
+    n_decoded: int = 0
 
 
 def _peak_rss_mb() -> float:
@@ -204,7 +208,8 @@ def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOu
     core = a["core"]
     n_core = int(core.sum())
     if n_core == 0:  # an empty cell of a large file's grid
-        return TileOutcome(i, tile.name, True, n_read=len(core), seconds=0.0)
+        return TileOutcome(i, tile.name, True, n_read=len(core), seconds=0.0,
+                           n_decoded=buf.decoded)  # fmt: skip
     own = tile.cell or tile.box
     g = settings.ground_buffer
     inside = ((a["x"] >= own[0] - g) & (a["x"] <= own[2] + g) & (a["y"] >= own[1] - g)
@@ -254,7 +259,7 @@ def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOu
         int(low[:n_core].sum()), time.perf_counter() - t0, _peak_rss_mb(), buf.missing,
         (*cx.min(axis=0).tolist(), *cx.max(axis=0).tolist()), f"tiles/{name}", pieces,
         (int(ids.min()), int(ids.max()), int(ids.sum())),
-        {k: round(t, 3) for k, t in stages.items()},
+        {k: round(t, 3) for k, t in stages.items()}, buf.decoded,
     )  # fmt: skip
 
 
@@ -443,6 +448,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             "complete": complete,
             "source": str(v.input),
             "kind": index.kind,
+            "copc_tiles": sum(t.copc for t in index.tiles),
             "crs": info.crs.name if info.crs is not None else "",
             "unit": info.horizontal_unit,
             "ground_buffer": settings.ground_buffer,
@@ -456,7 +462,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             "seconds": round(block["seconds"], 3),
             "tasks_s": round(block["seconds_tiles"], 3),
             "tiles": [{"name": o.name, "ok": o.ok, "error": o.error, "points": o.n_core,
-                       "points_read": o.n_read, "ground": o.n_ground, "low_outliers": o.n_low,
+                       "points_read": o.n_read, "points_decoded": o.n_decoded,
+                       "ground": o.n_ground, "low_outliers": o.n_low,
                        "plane_pieces": len(o.pieces), "seconds": round(o.seconds, 3),
                        "peak_rss_mb": round(o.peak_rss_mb, 1), "stage_seconds": o.stages,
                        "buffer_incomplete": o.missing,
