@@ -86,8 +86,8 @@ __all__ = [
     "fit_line_tls",
     "photo_azimuth",
     "pixels_from_plane",
-    "plane_to_pixel_jacobian",
     "plane_from_pixels",
+    "plane_to_pixel_jacobian",
     "resect_plate",
 ]
 
