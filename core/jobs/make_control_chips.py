@@ -29,9 +29,11 @@ SPEC = AlgorithmSpec(
     description="""\
 Control chips for the automatic location of control points in aerial images (Berveglieri &
 Tommaselli 2014). For each surveyed point two ground photos taken from the same spot looking
-down: one with the control plate over the point, one without it. The ground camera may be a
-perspective or a fisheye camera (equidistant, equisolid, orthographic or stereographic, with
-Brown distortion: the camera file of camera calibration), as the nadir fisheye of the source.
+down: one with the control plate over the point, one without it.
+
+The ground camera may be a perspective or a fisheye camera (equidistant, equisolid,
+orthographic or stereographic, with Brown distortion: the camera file of the camera
+calibration), as the nadir fisheye of the source.
 
 1. The plate (a square with an outer and an inner square edge; its centre vertically above
 the point at plate height, levelled, one side along the plate azimuth) is found in the plate
