@@ -37,6 +37,9 @@ from lidarphoto.core.photo.control_plate import (
     PlateGeometry,
     detect_plate,
     photo_azimuth,
+    pixels_from_plane,
+    plane_from_pixels,
+    plane_to_pixel_jacobian,
     resect_plate,
 )
 from lidarphoto.core.quality.registration import phase_correlation
@@ -95,6 +98,26 @@ def test_the_fisheye_is_far_from_a_perspective_camera(scene):
     moved = np.linalg.norm(project(PLATE.corners(), EO_PLATE, persp) - scene["truth"], axis=1)
     assert moved.max() > 2.0
     assert (scene["plate"][:3, :3] < 5).all()  # the sky in the top-left corner: grey 0
+
+
+def test_ray_plane_of_a_fisheye():
+    """Pixels <-> the ray plane z = -1 round trip, NaN for rays at or beyond 90 degrees (no
+    point on that plane), and the plane -> pixel Jacobian (corner sigmas, edge normals)
+    against central differences."""
+    cam = _camera("equidistant")
+    rng = np.random.default_rng(2)
+    px = rng.uniform([300, 200], [660, 520], (50, 2))
+    uv = plane_from_pixels(px, cam)
+    np.testing.assert_allclose(pixels_from_plane(uv, cam), px, atol=1e-6)
+    # the image corner is 97 degrees off the axis
+    assert np.isnan(plane_from_pixels([[1.0, 1.0]], cam)).all()
+    jac = plane_to_pixel_jacobian(uv, cam)
+    h = 1e-6
+    for k in range(2):
+        step = np.zeros(2)
+        step[k] = h
+        num = (pixels_from_plane(uv + step, cam) - pixels_from_plane(uv - step, cam)) / (2 * h)
+        np.testing.assert_allclose(jac[:, :, k], num, rtol=1e-5, atol=1e-3)
 
 
 def test_fisheye_corners_sub_pixel_on_textured_ground(scene):
