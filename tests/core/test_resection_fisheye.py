@@ -70,6 +70,15 @@ def test_noise_free_fisheye_resection_is_exact(projection):
     # OpenCV's start alone (rays beyond 90 degrees left out) lands near the truth
     start = initial_pose_pnp(px, pts, cam)
     np.testing.assert_allclose(start, EO, atol=1e-6)
+    # f, x0, y0 refined too (the projection's ideal point is linear in f): from a camera 2 %
+    # and 0.05 mm off, the truth again
+    if projection != "orthographic":  # ground points only: f and the height trade off
+        off = dataclasses.replace(cam, focal_mm=1.02 * cam.focal_mm, x0_mm=cam.x0_mm + 0.05,
+                                  y0_mm=cam.y0_mm - 0.05)  # fmt: skip
+        res = resect(data, off, ResectionOptions(estimate_interior=True), eo0=EO)
+        np.testing.assert_allclose(res.interior, [cam.focal_mm, cam.x0_mm, cam.y0_mm],
+                                   atol=1e-9)  # fmt: skip
+        np.testing.assert_allclose(res.eo, EO, atol=1e-8)
 
 
 @pytest.mark.parametrize("projection", ["equidistant", "equisolid"])
