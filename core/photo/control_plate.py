@@ -27,17 +27,18 @@ Detection (:func:`detect_plate`)
    (+-r, +-r), r = inner/outer, within 0.12 (perspective keeps this; a blob merged with the
    plate's edge or a random pair of ground shapes does not; for a fisheye camera the test is
    made on the camera's ray plane of step 3, where the plate is a perspective image again),
-   and whose frame is at least half
-   as wide as expected and 5 px wide (one edge found at two thresholds is not a plate). Pairs
-   sharing a centre (found in several binarisations) are one plate: the best fitting is kept.
+   and whose frame is at least half as wide as expected and 5 px wide (one edge found at two
+   thresholds is not a plate). Pairs sharing a centre (found in several binarisations) are
+   one plate: the best fitting is kept.
 2. **Edges** at sub-pixel precision: across each of the eight sides of the candidate pair, grey
    profiles sampled every 0.25 px (bilinear on the photo smoothed with a Gaussian of 1 px) on
    normals spaced 1 px along the side's middle 80 % (bicubic; for a fisheye camera along the
    side's curved image, the straight segment of the ray plane mapped to pixels, each normal
-   to the curve), the edge point is the centroid
-   of the squared gradient magnitude (less the profile's median) within 1.5 px of its peak
-   (the peak itself snaps to the pixel grid). Texture of the ground next to the outer edge
-   pulls its points by up to about a tenth of a pixel (tests/core/test_control_chips.py).
+   to the curve), the edge point is the centroid of the squared gradient magnitude (less the
+   profile's median) within 1.5 px of its peak (the peak itself snaps to the pixel grid).
+   Texture of the ground next to the outer edge pulls its points by up to about a tenth of a
+   pixel (tests/core/test_control_chips.py; up to 0.3 px for a plate of 100 px,
+   bench/control_chips.md).
 3. **Lines**: the edge points are turned into rays of the camera (its public back-projection
    :func:`core.geometry.collinearity.image_rays`, so that any central camera model, fisheye
    included, gives straight lines) and expressed on the plane z = -1 of the camera frame,
