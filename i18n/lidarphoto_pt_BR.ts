@@ -4422,6 +4422,14 @@ Tommaselli 2014). Para cada ponto levantado, duas fotos terrestres tomadas do me
 baixo: uma com a placa de controle sobre o ponto, outra sem ela.</translation>
         </message>
         <message>
+            <source>The ground camera may be a perspective or a fisheye camera (equidistant, equisolid,
+orthographic or stereographic, with Brown distortion: the camera file of the camera
+calibration), as the nadir fisheye of the source.</source>
+            <translation>A câmera terrestre pode ser perspectiva ou olho de peixe (equidistante, de ângulo equissólido,
+ortográfica ou estereográfica, com distorção de Brown: o arquivo de câmera da calibração
+de câmera), como a câmera olho de peixe nadiral da fonte.</translation>
+        </message>
+        <message>
             <source>1. The plate (a square with an outer and an inner square edge; its centre vertically above
 the point at plate height, levelled, one side along the plate azimuth) is found in the plate
 photo; its eight corners are located at sub-pixel precision (edges fitted as straight lines
@@ -4496,6 +4504,10 @@ os demais são gravados.</translation>
         <message>
             <source>Ground camera (JSON)</source>
             <translation>Câmera terrestre (JSON)</translation>
+        </message>
+        <message>
+            <source>perspective or fisheye (as written by calibratecamera)</source>
+            <translation>perspectiva ou olho de peixe (como gravada por calibratecamera)</translation>
         </message>
         <message>
             <source>JSON files (*.json)</source>

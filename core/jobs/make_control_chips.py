@@ -31,6 +31,10 @@ Control chips for the automatic location of control points in aerial images (Ber
 Tommaselli 2014). For each surveyed point two ground photos taken from the same spot looking
 down: one with the control plate over the point, one without it.
 
+The ground camera may be a perspective or a fisheye camera (equidistant, equisolid,
+orthographic or stereographic, with Brown distortion: the camera file of the camera
+calibration), as the nadir fisheye of the source.
+
 1. The plate (a square with an outer and an inner square edge; its centre vertically above
 the point at plate height, levelled, one side along the plate azimuth) is found in the plate
 photo; its eight corners are located at sub-pixel precision (edges fitted as straight lines
@@ -60,7 +64,8 @@ the others are written.""",
         Param("POINTS", "file", "Ground points (CSV)", file_filter=CSV_FILTER,
               help="point_id, X, Y, Z, role (the bundle adjustment's table)"),
         Param("CRS", "crs", "Mapping CRS of the points", help="e.g. EPSG:31983"),
-        Param("CAMERA", "file", "Ground camera (JSON)", file_filter="JSON files (*.json)"),
+        Param("CAMERA", "file", "Ground camera (JSON)", file_filter="JSON files (*.json)",
+              help="perspective or fisheye (as written by calibratecamera)"),
         Param("PHOTO_TABLE", "file", "Ground-photo table (CSV)", optional=True,
               file_filter=CSV_FILTER,
               help="point_id, plate_photo, free_photo; else PHOTOS are searched by name"),
@@ -149,6 +154,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
     from ..errors import InputError, stop_if_asked
     from ..geometry.frames import check_area_of_use, parse_crs
+    from ..geometry.projection import PROJECTIONS
     from ..io.atomic import OutputSet
     from ..io.camera import read_camera_json
     from ..io.control_chips import (
@@ -167,7 +173,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     crs = parse_crs(v.crs, what="mapping CRS")
     check_area_of_use(crs, points.xyz.min(axis=0), points.xyz.max(axis=0),
                       what="the ground points", path=v.points)  # fmt: skip
-    camera = read_camera_json(v.camera)
+    # any central projection: the plate's edges, the resection, the registration and the
+    # rectification all go through the camera's own projection (a nadir fisheye, as in the
+    # source)
+    camera = read_camera_json(v.camera, projections=PROJECTIONS)
     if v.photo_table:
         pairs = read_photo_table(v.photo_table)
         unknown = [p for p in pairs if p not in points.point_id]

@@ -12,15 +12,22 @@ Per point (:func:`make_chip`):
    (Lowe 2004: OpenCV's detector and descriptors, nearest-neighbour ratio test), the matches
    filtered by RANSAC on a homography between the two photos' ray planes (z = -1 of each
    camera frame: exact for a pure rotation of the camera and for a planar ground, whatever
-   the lens), then the inliers' rays in the plate photo are intersected with the plane
-   Z = Z_point and the plate-free photo is resected from those ground points with the
-   project's resection (:func:`core.photo.resection.space_resection`, data snooping), started
-   from the plate photo's pose;
+   the lens; a homography between the fisheye photos themselves would not be, so a fisheye
+   photo is registered on its rays, not on its pixels; rays at or beyond 90 degrees off the
+   axis, which do not meet that plane, are left out; the RANSAC threshold is ``ransac_px``
+   over the focal length in pixels, the pixel tolerance on the axis: a fisheye's ray plane
+   stretches off the axis, so there it is tighter in pixels, e.g. ``ransac_px cos^2(theta)``
+   radially for the equidistant projection), then the inliers' rays in the plate photo are
+   intersected with the plane Z = Z_point and the plate-free photo is resected from those
+   ground points with the project's resection (:func:`core.photo.resection.space_resection`,
+   data snooping, any central projection), started from the plate photo's pose;
 3. the chip: a north-up grid of ``size`` x ``size`` cells of ``gsd`` metres on the plane
    Z = Z_point, centred on the surveyed point, each cell the mean of ``s`` x ``s`` sub-samples
-   (``s`` from the ratio of the chip GSD to the photo's ground pixel, at most 8) projected into
-   the plate-free photo with its orientation (:func:`core.geometry.collinearity.project`) and
-   read bilinearly. With ``size`` cells the surveyed point is at chip pixel
+   (``s`` from the ratio of the chip GSD to the photo's ground pixel at the principal point,
+   at most 8; a fisheye's pixels cover more ground off the axis, so this errs on the side of
+   more sub-samples) projected into the plate-free photo with its orientation and the
+   camera's own projection, fisheye included (:func:`core.geometry.collinearity.project`),
+   and read bilinearly. With ``size`` cells the surveyed point is at chip pixel
    ``(size / 2, size / 2)`` (pixel corners at integers, the first pixel's centre at (0.5,
    0.5)): the geotransform puts it at its map X, Y.
 

@@ -25,15 +25,20 @@ Detection (:func:`detect_plate`)
    one inside the other, with about the same centre (within 15 % of the outer side), whose
    inner corners the homography of the outer corners onto the square (+-1, +-1) takes to
    (+-r, +-r), r = inner/outer, within 0.12 (perspective keeps this; a blob merged with the
-   plate's edge or a random pair of ground shapes does not), and whose frame is at least half
-   as wide as expected and 5 px wide (one edge found at two thresholds is not a plate). Pairs
-   sharing a centre (found in several binarisations) are one plate: the best fitting is kept.
+   plate's edge or a random pair of ground shapes does not; for a fisheye camera the test is
+   made on the camera's ray plane of step 3, where the plate is a perspective image again),
+   and whose frame is at least half as wide as expected and 5 px wide (one edge found at two
+   thresholds is not a plate). Pairs sharing a centre (found in several binarisations) are
+   one plate: the best fitting is kept.
 2. **Edges** at sub-pixel precision: across each of the eight sides of the candidate pair, grey
    profiles sampled every 0.25 px (bilinear on the photo smoothed with a Gaussian of 1 px) on
-   normals spaced 1 px along the side's middle 80 % (bicubic), the edge point is the centroid
-   of the squared gradient magnitude (less the profile's median) within 1.5 px of its peak
-   (the peak itself snaps to the pixel grid). Texture of the ground next to the outer edge
-   pulls its points by up to about a tenth of a pixel (tests/core/test_control_chips.py).
+   normals spaced 1 px along the side's middle 80 % (bicubic; for a fisheye camera along the
+   side's curved image, the straight segment of the ray plane mapped to pixels, each normal
+   to the curve), the edge point is the centroid of the squared gradient magnitude (less the
+   profile's median) within 1.5 px of its peak (the peak itself snaps to the pixel grid).
+   Texture of the ground next to the outer edge pulls its points by up to about a tenth of a
+   pixel (tests/core/test_control_chips.py; up to 0.3 px for a plate of 100 px,
+   bench/control_chips.md).
 3. **Lines**: the edge points are turned into rays of the camera (its public back-projection
    :func:`core.geometry.collinearity.image_rays`, so that any central camera model, fisheye
    included, gives straight lines) and expressed on the plane z = -1 of the camera frame,
@@ -41,7 +46,9 @@ Detection (:func:`detect_plate`)
    line is fitted to each side (points beyond 3 robust sigmas dropped, once).
 4. **Corners**: adjacent lines intersected, projected back to pixels with the camera
    (:func:`core.geometry.collinearity.project`); each corner gets the standard deviation
-   propagated from the two lines' fits (offset and direction).
+   propagated from the two lines' fits (offset and direction), to pixels by the focal length
+   (perspective) or by the projection's Jacobian at the corner (fisheye, whose scale varies
+   across the image).
 
 Reasons when no plate is returned: ``plate not found`` (no quadrilateral at all), ``only one
 square`` (quadrilaterals, but none with its inner/outer partner), ``ambiguous`` (several
@@ -52,7 +59,9 @@ four ways (quarter turns). Each is resected from OpenCV's PnP start; the one who
 "up" direction (the camera's y axis on the ground) is nearest the given approximate photo
 azimuth is kept (the quarter turns differ by 90 degrees, so a reading within +-45 degrees
 decides), then the project's rigorous resection (:func:`core.photo.resection.resect`) with
-data snooping gives the orientation, sigma0 and the sigmas.
+data snooping gives the orientation, sigma0 and the sigmas. Both take any central projection
+of the camera: the PnP start from the corners' normalised rays, the resection with the
+projection's own Jacobian (a nadir fisheye, as in the source, included).
 """
 
 from __future__ import annotations
@@ -65,7 +74,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from ..geometry.camera import Camera
-from ..geometry.collinearity import image_rays, project_with_status
+from ..geometry.collinearity import collinearity_jacobians, image_rays, project_with_status
 from ..geometry.rotations import opk_to_matrix
 
 Array = NDArray[np.float64]
@@ -79,6 +88,7 @@ __all__ = [
     "photo_azimuth",
     "pixels_from_plane",
     "plane_from_pixels",
+    "plane_to_pixel_jacobian",
     "resect_plate",
 ]
 
@@ -181,7 +191,23 @@ def plane_from_pixels(pixels: ArrayLike, camera: Camera) -> Array:
     """
     _, d = image_rays(pixels, _IDENTITY_EO, camera)
     with np.errstate(divide="ignore", invalid="ignore"):
-        return d[:, :2] / -d[:, 2:3]
+        uv = d[:, :2] / -d[:, 2:3]
+    # a fisheye's rays at or beyond 90 degrees off the axis do not meet the plane
+    uv[~(d[:, 2] < 0)] = np.nan
+    return uv
+
+
+def plane_to_pixel_jacobian(uv: ArrayLike, camera: Camera) -> Array:
+    """``d pixel / d (u, v)`` (N, 2, 2) of :func:`pixels_from_plane` (pixels per plane unit),
+    from the camera's own projection Jacobian (the lens model included).
+
+    >>> cam = Camera("c", focal_mm=10.0, pixel_size_mm=0.01, width_px=1000, height_px=800)
+    >>> plane_to_pixel_jacobian([[0.1, 0.0]], cam).round(9).tolist()
+    [[[1000.0, 0.0], [0.0, -1000.0]]]
+    """
+    p = np.asarray(uv, dtype=np.float64).reshape(-1, 2)
+    xyz = np.column_stack([p, -np.ones(len(p))])
+    return collinearity_jacobians(xyz, _IDENTITY_EO, camera, wrt=("point",))["point"][:, :, :2]
 
 
 def pixels_from_plane(uv: ArrayLike, camera: Camera) -> Array:
@@ -314,10 +340,14 @@ def _screen_ccw(q: Array) -> Array:
     return q if _area(q) < 0 else q[::-1].copy()
 
 
-def _pairs(quads: list[Array], ratio: float, tol: float = 0.12) -> list[tuple[Array, Array]]:
+def _pairs(
+    quads: list[Array], ratio: float, tol: float = 0.12, to_plane=None
+) -> list[tuple[Array, Array]]:
     """Nested, concentric quadrilaterals that are a plate: the homography taking the outer
     corners to the square (+-1, +-1) takes the inner ones to (+-ratio, +-ratio) within
-    ``tol`` (half-sides). One pair per plate (the best fitting of those sharing a centre)."""
+    ``tol`` (half-sides). One pair per plate (the best fitting of those sharing a centre).
+    ``to_plane`` (pixels -> the camera's ray plane) applies the test there: a fisheye image
+    of the plate is not a perspective one, its ray plane is."""
     import cv2
 
     square = np.array([[1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0], [1.0, -1.0]])
@@ -353,8 +383,11 @@ def _pairs(quads: list[Array], ratio: float, tol: float = 0.12) -> list[tuple[Ar
             if len(set(order.tolist())) != 4:
                 continue
             n = n[order]
-            h = cv2.getPerspectiveTransform(o.astype(np.float32), square.astype(np.float32))
-            m = cv2.perspectiveTransform(n.reshape(-1, 1, 2), h).reshape(4, 2)
+            ho, hn = (o, n) if to_plane is None else (to_plane(o), to_plane(n))
+            if not (np.isfinite(ho).all() and np.isfinite(hn).all()):
+                continue
+            h = cv2.getPerspectiveTransform(ho.astype(np.float32), square.astype(np.float32))
+            m = cv2.perspectiveTransform(hn.reshape(-1, 1, 2), h).reshape(4, 2)
             err = float(np.abs(m - ratio * square).max())
             if err <= tol:
                 scored.append((err, o, n))
@@ -368,22 +401,41 @@ def _pairs(quads: list[Array], ratio: float, tol: float = 0.12) -> list[tuple[Ar
 
 
 # ------------------------------------------------------------------ sub-pixel edges
-def _edge_points(smooth: NDArray[np.float32], a: Array, b: Array) -> Array:
-    """Sub-pixel edge points (M, 2) across the side a -> b (pixels)."""
+def _edge_points(
+    smooth: NDArray[np.float32], a: Array, b: Array, camera: Camera | None = None
+) -> Array:
+    """Sub-pixel edge points (M, 2) across the side a -> b (pixels).
+
+    With a (fisheye) ``camera`` the side is followed along its image, the straight segment
+    of the camera's ray plane mapped to pixels (curved in the photo), each profile normal to
+    the curve; without one, along the straight segment a -> b.
+    """
     import cv2
 
     length = float(np.hypot(*(b - a)))
     if length < 8:
         return np.empty((0, 2))
     u = (b - a) / length
-    nrm = np.array([-u[1], u[0]])
     m = int(length * SIDE_FRACTION)
     t = (np.arange(m) + 0.5) / m
     t = (1 - SIDE_FRACTION) / 2 + SIDE_FRACTION * t
-    base = a + t[:, None] * (b - a)
+    if camera is None:
+        nrm = np.array([-u[1], u[0]])[None, :]
+        base = a + t[:, None] * (b - a)
+    else:
+        ua, ub = plane_from_pixels(np.vstack([a, b]), camera)
+        uv = ua + t[:, None] * (ub - ua)
+        base = pixels_from_plane(uv, camera)
+        tangent = np.einsum("nij,j->ni", plane_to_pixel_jacobian(uv, camera), ub - ua)
+        tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+        nrm = np.column_stack([-tangent[:, 1], tangent[:, 0]])
+        good = np.isfinite(base).all(axis=1) & np.isfinite(nrm).all(axis=1)
+        base, nrm = base[good], nrm[good]
+        if not len(base):
+            return np.empty((0, 2))
     reach = max(3.0, 0.02 * length) + EDGE_WINDOW_PX
     s = np.arange(-reach, reach + 1e-9, PROFILE_STEP_PX)
-    pts = base[:, None, :] + s[None, :, None] * nrm
+    pts = base[:, None, :] + s[None, :, None] * nrm[:, None, :]
     # our pixel centres are at +0.5, OpenCV's at 0
     mx = (pts[..., 0] - 0.5).astype(np.float32)
     my = (pts[..., 1] - 0.5).astype(np.float32)
@@ -447,7 +499,9 @@ def detect_plate(
     quads = _quads(u8, min_area_px)
     if not quads:
         return PlateDetection(False, "plate not found: no quadrilateral in the photo")
-    pairs = _pairs(quads, plate.inner_m / plate.outer_m)
+    pairs = _pairs(quads, plate.inner_m / plate.outer_m,
+                   to_plane=None if camera.is_perspective else (
+                       lambda q: plane_from_pixels(q, camera)))  # fmt: skip
     if not pairs:
         return PlateDetection(False, f"only one square: {len(quads)} quadrilateral(s), none "
                               "with a nested square of the plate's inner/outer ratio")  # fmt: skip
@@ -462,7 +516,8 @@ def detect_plate(
     f_px = camera.focal_px
     for k, quad in enumerate((outer, inner)):
         for i in range(4):
-            pts = _edge_points(smooth, quad[i], quad[(i + 1) % 4])
+            pts = _edge_points(smooth, quad[i], quad[(i + 1) % 4],
+                               None if camera.is_perspective else camera)  # fmt: skip
             uv = plane_from_pixels(pts, camera) if len(pts) else pts
             uv = uv[np.isfinite(uv).all(axis=1)] if len(uv) else uv
             fit = _fit_side(uv)
@@ -470,7 +525,13 @@ def detect_plate(
                 return PlateDetection(False, f"edge fit failed: side {4 * k + i} has "
                                       f"{len(uv)} edge points", candidates=1)  # fmt: skip
             lines.append(fit)
-            rms[4 * k + i] = fit[3] * f_px
+            if camera.is_perspective:
+                rms[4 * k + i] = fit[3] * f_px
+            else:
+                # a fisheye's scale changes across the image: the plane's distance across
+                # the line in pixels, at the side's centroid
+                jac = plane_to_pixel_jacobian(fit[2][None], camera)[0]
+                rms[4 * k + i] = fit[3] * float(np.linalg.norm(jac @ fit[0]))
             count[4 * k + i] = fit[5]
     corners_uv = np.empty((8, 2))
     sig = np.empty(8)
@@ -479,7 +540,12 @@ def detect_plate(
             # corner i lies between side i - 1 (ending at it) and side i (starting at it)
             x, cov = _intersect(lines[4 * k + (i - 1) % 4], lines[4 * k + i])
             corners_uv[4 * k + i] = x
-            sig[4 * k + i] = math.sqrt(max(float(np.trace(cov)) / 2.0, 0.0)) * f_px
+            if camera.is_perspective:
+                sig[4 * k + i] = math.sqrt(max(float(np.trace(cov)) / 2.0, 0.0)) * f_px
+            else:
+                jac = plane_to_pixel_jacobian(x[None], camera)[0]
+                var = float(np.trace(jac @ cov @ jac.T)) / 2.0
+                sig[4 * k + i] = math.sqrt(max(var, 0.0))
     px = pixels_from_plane(corners_uv, camera)
     if not np.isfinite(px).all():
         return PlateDetection(False, "edge fit failed: a corner falls outside the camera's "

@@ -63,19 +63,48 @@ class PoseCandidate:
 def initial_pose_pnp(pixels: ArrayLike, points: ArrayLike, camera: Camera) -> Array:
     """Pose from OpenCV's solvePnP (SQPnP, then its iterative refinement); lens removed first.
 
+    A perspective camera's pixels go to OpenCV with its own camera matrix; any other central
+    projection (a fisheye) goes as normalised rays: each pixel's ray (the camera's
+    back-projection, :meth:`Camera.ray_from_ideal`) cut with the plane one unit in front of
+    the camera, with the identity camera matrix. Rays at or beyond 90 degrees off the axis
+    have no such point and are left out (at least 4 must remain).
+
     Returns ``(X0, Y0, Z0, omega, phi, kappa)`` in the frame of ``points``.
+
+    Examples
+    --------
+    >>> from lidarphoto.core.geometry.collinearity import project
+    >>> cam = Camera("f", focal_mm=2.0, pixel_size_mm=0.004, width_px=1500, height_px=1500,
+    ...              projection="equidistant")
+    >>> pts = np.array([[-1.0, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0], [0.3, 0.2, 0.5]])
+    >>> eo = np.array([0.2, -0.1, 1.5, 0.05, -0.03, 0.4])
+    >>> bool(np.allclose(initial_pose_pnp(project(pts, eo, cam), pts, cam), eo, atol=1e-6))
+    True
     """
     import cv2
 
     px = np.asarray(pixels, dtype=np.float64)
     pts = np.asarray(points, dtype=np.float64)
     ideal = camera.ideal_from_pixel(px)  # centred, corrected, mm
-    ps = camera.pixel_size_mm
-    # OpenCV puts the centre of the first pixel at (0, 0), we put it at (0.5, 0.5).
-    cx = camera.width_px / 2 + camera.x0_mm / ps - 0.5
-    cy = camera.height_px / 2 - camera.y0_mm / ps - 0.5
-    cv_px = np.column_stack([cx + ideal[:, 0] / ps, cy - ideal[:, 1] / ps])
-    k = np.array([[camera.focal_px, 0.0, cx], [0.0, camera.focal_px, cy], [0.0, 0.0, 1.0]])
+    if camera.is_perspective:
+        ps = camera.pixel_size_mm
+        # OpenCV puts the centre of the first pixel at (0, 0), we put it at (0.5, 0.5).
+        cx = camera.width_px / 2 + camera.x0_mm / ps - 0.5
+        cy = camera.height_px / 2 - camera.y0_mm / ps - 0.5
+        cv_px = np.column_stack([cx + ideal[:, 0] / ps, cy - ideal[:, 1] / ps])
+        k = np.array([[camera.focal_px, 0.0, cx], [0.0, camera.focal_px, cy], [0.0, 0.0, 1.0]])
+    else:
+        ray = camera.ray_from_ideal(ideal)
+        front = np.isfinite(ray).all(axis=1) & (ray[:, 2] < 0)
+        if front.sum() < 4:
+            raise InputError(
+                f"OpenCV's start pose needs 4 points less than 90 degrees off the axis of the "
+                f"{camera.projection} camera, got {int(front.sum())}"
+            )
+        ray, pts = ray[front], pts[front]
+        # OpenCV's normalised coordinates: its camera looks along +z with y down
+        cv_px = np.column_stack([ray[:, 0] / -ray[:, 2], ray[:, 1] / ray[:, 2]])
+        k = np.eye(3)
     centre = pts.mean(axis=0)  # keeps OpenCV's float arithmetic away from large coordinates
     obj = np.ascontiguousarray(pts - centre)
     img = np.ascontiguousarray(cv_px)
@@ -130,8 +159,8 @@ def _perpendicular(r: Array) -> Array:
 
 
 def _rays(pixels: Array, camera: Camera) -> Array:
-    ideal = camera.ideal_from_pixel(pixels)
-    v = np.column_stack([ideal, np.full(len(ideal), -camera.focal_mm)])
+    """Unit camera-frame rays of measured pixels (the camera's own projection)."""
+    v = camera.ray_from_ideal(camera.ideal_from_pixel(pixels))
     return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 

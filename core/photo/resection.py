@@ -536,7 +536,9 @@ def resect(
     points by collinearity, lines by the coplanarity model (default) or the equivalent-planes
     model of Tommaselli & Tozzi (1996) in both its parametrisations, with the image points'
     sigmas and the control's covariances propagated; optionally the focal length and the
-    principal point too. Without ``eo0`` the start pose comes from
+    principal point too. Points take any central projection of the camera (perspective or a
+    fisheye of :mod:`core.geometry.projection`, with that projection's own Jacobian); lines
+    need a perspective camera. Without ``eo0`` the start pose comes from
     :func:`.pose_start.pose_candidates` (no approximate orientation needed): the candidate
     that fits the rigorous model best.
 
@@ -545,7 +547,8 @@ def resect(
     data : ResectionData
         Observations and control, in a Cartesian object frame (e.g. the local ENU frame).
     camera : Camera
-        Interior orientation (lens correction applied, held fixed).
+        Interior orientation (lens correction applied, held fixed); any projection for
+        points, perspective for lines.
     options : ResectionOptions, optional
     eo0 : (6,) array_like, optional
         Start pose ``(X0, Y0, Z0, omega, phi, kappa)``; weighted as observations when
@@ -560,7 +563,8 @@ def resect(
     Raises
     ------
     InputError
-        Too few observations for the unknowns, image or 3D lines of zero length.
+        Too few observations for the unknowns, image or 3D lines of zero length, lines with
+        a fisheye camera.
     NotObservableError
         The observations cannot determine the orientation (e.g. all lines parallel), or the
         interior orientation; names the parameters.
@@ -584,7 +588,10 @@ def resect(
     >>> bool(np.allclose(res.eo, eo, atol=1e-6)), res.redundancy
     (True, 6)
     """
-    camera.require_perspective("the resection")
+    if data.n_lines:
+        # a straight object line is straight only in a perspective image: the line models
+        # (coplanarity in the image plane, equivalent planes) hold for that projection only
+        camera.require_perspective("the resection from straight lines (use control points)")
     from scipy import stats
 
     opts = options if options is not None else ResectionOptions()

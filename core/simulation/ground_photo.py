@@ -12,7 +12,11 @@ deviation of 30 grey levels (clipped to 40-210, darker than the plate's white an
 its black), read bilinearly. Every photo pixel is the mean of ``supersample`` x
 ``supersample`` rays (the camera's own back-projection,
 :func:`core.geometry.collinearity.image_rays`, so the lens model is the one the code under test
-inverts), ``EDGE_SUPERSAMPLE`` x ``EDGE_SUPERSAMPLE`` on the plate's edges; the
+inverts), ``EDGE_SUPERSAMPLE`` x ``EDGE_SUPERSAMPLE`` on the plate's edges. Any camera of the
+registry renders: perspective or fisheye (equidistant, equisolid, orthographic,
+stereographic, :mod:`core.geometry.projection`); a ray that does not meet the ground in front
+of the camera (a fisheye's rays at or beyond 90 degrees off a nadir axis, or outside the
+projection's image) sees the sky, grey 0; the
 orthographic truth is the mean over each cell of ``supersample`` x
 ``supersample`` points. Gaussian noise of ``noise_dn`` grey levels is added to the photos.
 """

@@ -328,10 +328,11 @@ def test_perspective_only_algorithms_refuse_a_fisheye_camera():
     from lidarphoto.core.photo.bundle import bundle_adjust
     from lidarphoto.core.photo.monoplot import monoplot
     from lidarphoto.core.photo.orthophoto import OrthoProjector
-    from lidarphoto.core.photo.resection import resect
 
+    # the resection takes fisheye control points (its lines stay perspective-only, refused by
+    # name): tests/core/test_resection_fisheye.py
     cam = _camera("equisolid")
-    for func, who in ((monoplot, "monoplotting"), (resect, "the resection"),
+    for func, who in ((monoplot, "monoplotting"),
                       (calibrate, "the boresight calibration"),
                       (bundle_adjust, "the bundle adjustment"),
                       (OrthoProjector.build, "orthorectification")):  # fmt: skip
