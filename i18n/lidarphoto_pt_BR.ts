@@ -4318,8 +4318,9 @@ a correspondência do recorte falhou são correspondidas a partir da melhor imag
 empty target_id; point_id = the control point's id, also for the rows transferred from another
 image), which bundleadjustment (with the control points as GROUND_POINTS), resection (with
 them as CONTROL_POINTS) and boresightcalibration (with them as GROUND_POINTS) read directly;
-sigma_px is the LSM sigma, at least SIGMA_FLOOR (LSM does not see the chip's own errors). The report CSV has
-one row per point and image with the status and reason; the HTML report shows the chips.</source>
+sigma_px is the LSM sigma, at least SIGMA_FLOOR (LSM does not see the chip's own errors).
+The report CSV has one row per point and image with the status and reason; the HTML report
+shows the chips.</source>
             <translation>Saída: o CSV de observações de imagem (image_id, point_id, col, row, sigma_px, type control,
 target_id vazio; point_id = o id do ponto de controle, também nas linhas transferidas de outra
 imagem), que bundleadjustment (com os pontos de controle como GROUND_POINTS), resection (com

@@ -37,8 +37,9 @@ Output: the image-observation CSV (image_id, point_id, col, row, sigma_px, type 
 empty target_id; point_id = the control point's id, also for the rows transferred from another
 image), which bundleadjustment (with the control points as GROUND_POINTS), resection (with
 them as CONTROL_POINTS) and boresightcalibration (with them as GROUND_POINTS) read directly;
-sigma_px is the LSM sigma, at least SIGMA_FLOOR (LSM does not see the chip's own errors). The report CSV has
-one row per point and image with the status and reason; the HTML report shows the chips.""",
+sigma_px is the LSM sigma, at least SIGMA_FLOOR (LSM does not see the chip's own errors).
+The report CSV has one row per point and image with the status and reason; the HTML report
+shows the chips.""",
     params=(
         Param(
             "CHIPS",

@@ -111,8 +111,8 @@ def ground_positions(
     ``tie`` and ``paper`` rows: the ray cut with the row's plane; ``line`` rows: the point of
     the line nearest the ray; ``lcp`` and ``check`` rows: the ray cut with the horizontal plane
     through the LCP; ``control`` rows: the same through the ground point ``point_id`` of
-    ``ground_points`` (control and check points). Rays use the calibrated interior orientation when it was estimated. Rows
-    whose image or target is unknown are NaN.
+    ``ground_points`` (control and check points). Rays use the calibrated interior
+    orientation when it was estimated. Rows whose image or target is unknown are NaN.
 
     Returns
     -------

@@ -8,16 +8,14 @@ import csv
 import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
-from lidarphoto.core.io.ground_points import write_ground_points_csv
 from lidarphoto.core.io.observations import read_observations_csv, write_observations_csv
 from lidarphoto.core.jobs import boresight_calibration
 from lidarphoto.core.jobs.runner import run_job
-from lidarphoto.core.photo.bundle import GroundPoints
 from lidarphoto.core.photo.observations import ImageObservations
-from lidarphoto.core.simulation.flight import FlightConfig, simulate_flight
+from lidarphoto.core.simulation.flight import FlightConfig, surveyed_control
 
-# LiDAR corners stand in for surveyed points: their true coordinates (the exact simulation)
-# plus survey noise are the ground points; the noisy simulation's lcp/check rows measure them.
+# LiDAR corners stand in for surveyed points (core.simulation.flight.surveyed_control): their
+# true coordinates plus survey noise are the ground points, measured with 0.5 px noise.
 CONFIG = FlightConfig(
     n_buildings=12, n_planes=30, town_size_m=700.0, n_check=4, types=("lcp", "check")
 )
@@ -27,27 +25,8 @@ SEED = 5
 
 def _ground_control(folder):
     """Files of a flight whose only control is surveyed points measured as ``control`` rows."""
-    sim = simulate_flight(CONFIG, seed=SEED)
-    exact = simulate_flight(CONFIG, seed=SEED, exact=True)
-    truth = {str(p.id): p.xyz for p in exact.lcps + exact.check_lcps}
-    check_ids = {str(p.id) for p in sim.check_lcps}
-    obs = sim.observations
-    point_id = tuple(f"GCP{t}" for t in obs.target_id)
-    control = ImageObservations(obs.image_id, point_id, obs.pixels, obs.sigma_px,
-                                ("control",) * len(obs), ("",) * len(obs))  # fmt: skip
-    ids = sorted(set(obs.target_id), key=int)
-    rng = np.random.default_rng(11)
-    xyz = np.array([truth[i] for i in ids]) + rng.normal(0.0, SURVEY_SIGMA, (len(ids), 3))
-    ground = GroundPoints(
-        tuple(f"GCP{i}" for i in ids),
-        xyz,
-        np.tile(SURVEY_SIGMA, (len(ids), 1)),
-        tuple("check" if i in check_ids else "control" for i in ids),
-    )
-    paths = sim.write(folder)
-    write_observations_csv(paths["observations"], control)
-    paths["ground"] = folder / "ground_points.csv"
-    write_ground_points_csv(paths["ground"], ground)
+    sim, _rows, ground, paths = surveyed_control(CONFIG, SEED, tuple(SURVEY_SIGMA),
+                                                 folder=folder)  # fmt: skip
     return sim, ground, paths
 
 
@@ -101,7 +80,7 @@ def test_control_rows_recover_the_boresight_within_their_sigmas(calibrated):
 
 
 def test_check_points_are_placed_at_their_surveyed_height_and_named(calibrated):
-    sim, ground, _paths, run, folder = calibrated
+    _sim, ground, _paths, run, folder = calibrated
     obs = run.observations
     by_id = dict(zip(ground.point_id, ground.xyz))
     role = dict(zip(ground.point_id, ground.role))
@@ -120,7 +99,7 @@ def test_check_points_are_placed_at_their_surveyed_height_and_named(calibrated):
 
 
 def test_control_row_naming_a_missing_ground_point_is_an_error_naming_the_row(calibrated):
-    sim, _ground, paths, _run_, folder = calibrated
+    sim, _ground, paths, _, folder = calibrated
     obs = read_observations_csv(paths["observations"])
     bad_obs = ImageObservations(obs.image_id, ("GCP1",) * 2 + ("NOPE",) + obs.point_id[3:],
                                 obs.pixels, obs.sigma_px, obs.type, obs.target_id)  # fmt: skip
