@@ -154,8 +154,9 @@ class BoresightOptions:
 
 
 class SurveyedPoints(Protocol):
-    """Surveyed ground points as :class:`core.photo.bundle.GroundPoints` holds them (that
-    module imports this one): ids, mapping-CRS coordinates (m), sigmas (m), roles."""
+    """Surveyed ground points as :class:`core.photo.bundle.GroundPoints` holds them (a
+    protocol: that module depends on this one): ids, mapping-CRS coordinates (m), sigmas (m),
+    roles (``control`` or ``check``)."""
 
     point_id: tuple[str, ...]
     xyz: Array
