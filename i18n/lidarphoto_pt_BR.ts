@@ -95,6 +95,10 @@
             <translation>Aerotriangulação e ortofotos</translation>
         </message>
         <message>
+            <source>Boresight calibration with surveyed ground control located automatically</source>
+            <translation>Calibração de boresight com pontos de apoio levantados e localizados automaticamente</translation>
+        </message>
+        <message>
             <source>LiDAR control for a whole block of tiles (dask.distributed)</source>
             <translation>Controle LiDAR para um bloco inteiro de tiles (dask.distributed)</translation>
         </message>
@@ -181,6 +185,10 @@
         <message>
             <source>INPUT = check points measured on the mosaic</source>
             <translation>INPUT = pontos de verificação medidos no mosaico</translation>
+        </message>
+        <message>
+            <source>OBSERVATIONS = those control rows, GROUND_POINTS = the surveyed points (role control or check), TRAJECTORY; OUTPUT_TABLE = boresight per group, OUTPUT_EO = corrected orientation</source>
+            <translation>OBSERVATIONS = essas linhas control, GROUND_POINTS = os pontos levantados (role control ou check), TRAJECTORY; OUTPUT_TABLE = boresight por grupo, OUTPUT_EO = orientação corrigida</translation>
         </message>
         <message>
             <source>INPUT = a folder of LAS/LAZ tiles or a .vpc; OUTPUT_FOLDER = classified tiles, block.vpc, planes.csv, lcps.csv and lines.csv</source>
@@ -2582,6 +2590,18 @@ col, row, sigma_px, type, target_id) e as tabelas de planos / linhas / LCPs de E
 de telhado e Criar pontos e linhas de controle LiDAR.</translation>
         </message>
         <message>
+            <source>Surveyed ground control: rows of type control (as Locate control points writes them) measure
+the point point_id of GROUND_POINTS (point_id, X, Y, Z, sx, sy, sz, role), used like an LCP
+with the diagonal covariance of its sigmas; points of role check are left out of the
+adjustment (their ground positions are in the residuals). A control row naming no ground
+point is an error.</source>
+            <translation>Controle de campo levantado: linhas do tipo control (como Localizar pontos de controle as escreve) medem
+o ponto point_id de GROUND_POINTS (point_id, X, Y, Z, sx, sy, sz, role), usado como um LCP
+com a covariância diagonal dos seus desvios-padrão; pontos de role check ficam fora do
+ajustamento (as suas posições no terreno estão nos resíduos). Uma linha control que não nomeia
+nenhum ponto de apoio é um erro.</translation>
+        </message>
+        <message>
             <source>Grouping: one boresight for all images, one per value of the trajectory's group column
 (flight line, direction or session) or one per heading octant.</source>
             <translation>Agrupamento: um boresight para todas as imagens, um por valor da coluna de grupo da trajetória
@@ -2702,6 +2722,14 @@ e cada uma começa com um aviso (CSV: linhas de comentário iniciadas por #).</t
         <message>
             <source>LiDAR control point table (CSV)</source>
             <translation>Tabela de pontos de controle LiDAR (CSV)</translation>
+        </message>
+        <message>
+            <source>Ground points (CSV)</source>
+            <translation>Pontos de apoio (CSV)</translation>
+        </message>
+        <message>
+            <source>surveyed points of the control rows: point_id, X, Y, Z, sx, sy, sz, role (control or check), in the mapping CRS</source>
+            <translation>pontos levantados das linhas control: point_id, X, Y, Z, sx, sy, sz, role (control ou check), no SRC de mapeamento</translation>
         </message>
         <message>
             <source>Cloud with plane ids (LAS/LAZ, paper mode only)</source>
@@ -2860,20 +2888,22 @@ significativos) e as saídas do melhor modelo.</translation>
         </message>
         <message>
             <source>Inputs: camera JSON (one camera, or {"cameras": [...]} with a camera column in the EO or
-observation table), image observations (image_id, point_id, col, row, sigma_px), ground
-points (point_id, X, Y, Z, sx, sy, sz, role = control | check), optionally exterior
+observation table), image observations (image_id, point_id, col, row, sigma_px; a row of
+type control, as Locate control points writes it, must name a ground point), ground points
+(point_id, X, Y, Z, sx, sy, sz, role = control | check), optionally exterior
 orientations: approximate (e.g. direct georeferencing, a few degrees and metres off), or
 observed when the table has sigma columns (GNSS/INS with sigmas; lever arm and boresight
 corrections can be estimated). Without orientations the images that see four or more control
 points are resected and the rest of the block grows by intersection and resection.</source>
             <translation>Entradas: JSON da câmera (uma câmera, ou {"cameras": [...]} com uma coluna camera na tabela de
-OE ou de observações), observações de imagem (image_id, point_id, col, row, sigma_px), pontos
-de apoio (point_id, X, Y, Z, sx, sy, sz, role = control | check) e, opcionalmente, orientações
-exteriores: aproximadas (por exemplo, da georreferenciação direta, com alguns graus e metros de
-erro) ou observadas quando a tabela tem colunas de desvio-padrão (GNSS/INS com desvios-padrão;
-correções do braço de alavanca e do boresight podem ser estimadas). Sem orientações, as imagens
-que veem quatro ou mais pontos de controle passam por resseção e o restante do bloco cresce por
-interseção e resseção.</translation>
+OE ou de observações), observações de imagem (image_id, point_id, col, row, sigma_px; uma linha
+do tipo control, como Localizar pontos de controle a escreve, deve nomear um ponto de apoio),
+pontos de apoio (point_id, X, Y, Z, sx, sy, sz, role = control | check) e, opcionalmente,
+orientações exteriores: aproximadas (por exemplo, da georreferenciação direta, com alguns graus e
+metros de erro) ou observadas quando a tabela tem colunas de desvio-padrão (GNSS/INS com
+desvios-padrão; correções do braço de alavanca e do boresight podem ser estimadas). Sem
+orientações, as imagens que veem quatro ou mais pontos de controle passam por resseção e o
+restante do bloco cresce por interseção e resseção.</translation>
         </message>
         <message>
             <source>Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
@@ -3063,6 +3093,23 @@ são recusadas, com o arquivo e a linha indicados.</translation>
         <message>
             <source>AP model of the outputs</source>
             <translation>Modelo de PAs das saídas</translation>
+        </message>
+        <message>
+            <source>Inputs: camera JSON (one camera, or {"cameras": [...]} with a camera column in the EO or
+observation table), image observations (image_id, point_id, col, row, sigma_px), ground
+points (point_id, X, Y, Z, sx, sy, sz, role = control | check), optionally exterior
+orientations: approximate (e.g. direct georeferencing, a few degrees and metres off), or
+observed when the table has sigma columns (GNSS/INS with sigmas; lever arm and boresight
+corrections can be estimated). Without orientations the images that see four or more control
+points are resected and the rest of the block grows by intersection and resection.</source>
+            <translation type="vanished">Entradas: JSON da câmera (uma câmera, ou {"cameras": [...]} com uma coluna camera na tabela de
+OE ou de observações), observações de imagem (image_id, point_id, col, row, sigma_px), pontos
+de apoio (point_id, X, Y, Z, sx, sy, sz, role = control | check) e, opcionalmente, orientações
+exteriores: aproximadas (por exemplo, da georreferenciação direta, com alguns graus e metros de
+erro) ou observadas quando a tabela tem colunas de desvio-padrão (GNSS/INS com desvios-padrão;
+correções do braço de alavanca e do boresight podem ser estimadas). Sem orientações, as imagens
+que veem quatro ou mais pontos de controle passam por resseção e o restante do bloco cresce por
+interseção e resseção.</translation>
         </message>
     </context>
     <context>
@@ -4283,16 +4330,20 @@ fora da elipse de busca ou um modelo parcialmente fora da imagem. Com TRANSFER, 
 a correspondência do recorte falhou são correspondidas a partir da melhor imagem do ponto (LSM imagem a imagem).</translation>
         </message>
         <message>
-            <source>Output: the image-observation CSV (image_id, point_id, col, row, sigma_px, type tie, empty
-target_id; point_id = the control point's id), which bundleadjustment (with the control points
-as ground points) and resection (with them as control points) read directly; sigma_px is the
-LSM sigma, at least SIGMA_FLOOR (LSM does not see the chip's own errors). The report CSV has
-one row per point and image with the status and reason; the HTML report shows the chips.</source>
-            <translation>Saída: o CSV de observações de imagem (image_id, point_id, col, row, sigma_px, type tie, target_id
-vazio; point_id = o id do ponto de controle), que bundleadjustment (com os pontos de controle
-como pontos de apoio) e resection (com eles como pontos de controle) leem diretamente; sigma_px é o
-sigma da LSM, no mínimo SIGMA_FLOOR (a LSM não vê os erros do próprio recorte). O CSV do relatório tem
-uma linha por ponto e imagem com o status e o motivo; o relatório HTML mostra os recortes.</translation>
+            <source>Output: the image-observation CSV (image_id, point_id, col, row, sigma_px, type control,
+empty target_id; point_id = the control point's id, also for the rows transferred from another
+image), which bundleadjustment (with the control points as GROUND_POINTS), resection (with
+them as CONTROL_POINTS) and boresightcalibration (with them as GROUND_POINTS) read directly;
+sigma_px is the LSM sigma, at least SIGMA_FLOOR (LSM does not see the chip's own errors).
+The report CSV has one row per point and image with the status and reason; the HTML report
+shows the chips.</source>
+            <translation>Saída: o CSV de observações de imagem (image_id, point_id, col, row, sigma_px, type control,
+target_id vazio; point_id = o id do ponto de controle, também nas linhas transferidas de outra
+imagem), que bundleadjustment (com os pontos de controle como GROUND_POINTS), resection (com
+eles como CONTROL_POINTS) e boresightcalibration (com eles como GROUND_POINTS) leem
+diretamente; sigma_px é o sigma da LSM, no mínimo SIGMA_FLOOR (a LSM não vê os erros do
+próprio recorte). O CSV do relatório tem uma linha por ponto e imagem com o status e o motivo;
+o relatório HTML mostra os recortes.</translation>
         </message>
         <message>
             <source>Control chips (GeoTIFF files or folders)</source>
@@ -4397,6 +4448,18 @@ uma linha por ponto e imagem com o status e o motivo; o relatório HTML mostra o
         <message>
             <source>Point-image pairs rejected</source>
             <translation>Pares ponto-imagem rejeitados</translation>
+        </message>
+        <message>
+            <source>Output: the image-observation CSV (image_id, point_id, col, row, sigma_px, type tie, empty
+target_id; point_id = the control point's id), which bundleadjustment (with the control points
+as ground points) and resection (with them as control points) read directly; sigma_px is the
+LSM sigma, at least SIGMA_FLOOR (LSM does not see the chip's own errors). The report CSV has
+one row per point and image with the status and reason; the HTML report shows the chips.</source>
+            <translation type="vanished">Saída: o CSV de observações de imagem (image_id, point_id, col, row, sigma_px, type tie, target_id
+vazio; point_id = o id do ponto de controle), que bundleadjustment (com os pontos de controle
+como pontos de apoio) e resection (com eles como pontos de controle) leem diretamente; sigma_px é o
+sigma da LSM, no mínimo SIGMA_FLOOR (a LSM não vê os erros do próprio recorte). O CSV do relatório tem
+uma linha por ponto e imagem com o status e o motivo; o relatório HTML mostra os recortes.</translation>
         </message>
     </context>
     <context>
@@ -5141,13 +5204,15 @@ distância focal e o ponto principal podem ser refinados quando o controle tem p
             <source>Observations: the image-observation CSV (image_id, point_id, col, row, sigma_px, type,
 target_id). Rows of type line with the same image and target_id are one image line (two or
 more points: its ends); lcp rows are control points and check rows check points (target_id:
-the control point id); tie and paper rows whose point_id is a control point are control
-points too. LINE_OBSERVATIONS may hold the line rows in a second file.</source>
+the control point id); control rows (as Locate control points writes them) are the control
+point point_id, and tie and paper rows whose point_id is a control point are control points
+too. LINE_OBSERVATIONS may hold the line rows in a second file.</source>
             <translation>Observações: o CSV de observações de imagem (image_id, point_id, col, row, sigma_px, type,
 target_id). Linhas do tipo line com a mesma imagem e o mesmo target_id são uma linha da imagem
 (dois ou mais pontos: as suas extremidades); linhas lcp são pontos de controle e linhas check
-são pontos de verificação (target_id: o identificador do ponto de controle); linhas tie e paper
-cujo point_id é um ponto de controle também são pontos de controle. LINE_OBSERVATIONS pode
+são pontos de verificação (target_id: o identificador do ponto de controle); linhas control
+(como Localizar pontos de controle as escreve) são o ponto de controle point_id, e linhas tie e
+paper cujo point_id é um ponto de controle também são pontos de controle. LINE_OBSERVATIONS pode
 conter as linhas do tipo line em um segundo arquivo.</translation>
         </message>
         <message>
@@ -5293,6 +5358,19 @@ linhas paralelas).</translation>
         <message>
             <source>Largest sigma0 a-posteriori</source>
             <translation>Maior sigma0 a posteriori</translation>
+        </message>
+        <message>
+            <source>Observations: the image-observation CSV (image_id, point_id, col, row, sigma_px, type,
+target_id). Rows of type line with the same image and target_id are one image line (two or
+more points: its ends); lcp rows are control points and check rows check points (target_id:
+the control point id); tie and paper rows whose point_id is a control point are control
+points too. LINE_OBSERVATIONS may hold the line rows in a second file.</source>
+            <translation type="vanished">Observações: o CSV de observações de imagem (image_id, point_id, col, row, sigma_px, type,
+target_id). Linhas do tipo line com a mesma imagem e o mesmo target_id são uma linha da imagem
+(dois ou mais pontos: as suas extremidades); linhas lcp são pontos de controle e linhas check
+são pontos de verificação (target_id: o identificador do ponto de controle); linhas tie e paper
+cujo point_id é um ponto de controle também são pontos de controle. LINE_OBSERVATIONS pode
+conter as linhas do tipo line em um segundo arquivo.</translation>
         </message>
     </context>
     <context>

@@ -193,6 +193,8 @@ class ResectionController(QObject):
         # the rows as they are now: the store autosaves every edit made while the task runs,
         # and the residuals are mapped back through the file the job read
         snapshot = store.to_observations()
+        # control rows name surveyed points, which the dock's LCP table does not hold
+        snapshot = snapshot.subset(~snapshot.mask("control"))
         params = resection_parameters(
             out_dir, image, out_dir / "observations.csv", camera, crs.authid() or crs.toWkt(),
             control,

@@ -8,7 +8,8 @@ image_id
     The image, as in the trajectory table.
 point_id
     Name of the measured point. For ``tie`` it names the tie point: every row with the same
-    ``point_id`` is the same ground point seen in another image. For the other types it only
+    ``point_id`` is the same ground point seen in another image. For ``control`` it is the
+    surveyed point's id in the ground (control) points table. For the other types it only
     labels the row (it may repeat across images).
 col, row
     Measured pixel position: origin at the top-left corner of the top-left pixel, so the
@@ -21,7 +22,10 @@ type
     ``lcp``   the LiDAR control point ``target_id`` (three-plane intersection);
     ``paper`` a point on plane ``target_id`` for the single-image model of Pedrosa & dos
               Santos (2020) (its Eqs. 12-17);
-    ``check`` the LiDAR control point ``target_id`` used only as a check point (not adjusted).
+    ``check`` the LiDAR control point ``target_id`` used only as a check point (not adjusted);
+    ``control`` the surveyed ground point ``point_id`` of the ground points table (its role,
+              control or check, comes from that table; ``target_id`` empty), as
+              ``locatecontrolpoints`` writes it.
     Optional: without the column every row is ``tie``.
 target_id
     Id of the plane, line or LCP in its table (integers in the project's tables). Optional

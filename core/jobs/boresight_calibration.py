@@ -1,4 +1,5 @@
-"""``boresightcalibration``: the camera-INS misalignment from LiDAR roof planes, lines, LCPs.
+"""``boresightcalibration``: the camera-INS misalignment from LiDAR roof planes, lines, LCPs
+and surveyed ground control points.
 
 Outputs: the results table (one row per boresight group: the angles in degrees and
 arc-seconds and their a-posteriori standard deviations in arc-seconds); the updated exterior
@@ -29,7 +30,7 @@ log = logging.getLogger(__name__)
 #: (flight line, direction or session, as the user filled it); one per heading octant.
 GROUPINGS = ("single", "group", "direction")
 #: Control types the adjustment can use.
-CONTROL_TYPES = ("tie", "line", "lcp", "paper")
+CONTROL_TYPES = ("tie", "line", "lcp", "paper", "control")
 _GRADES = (*INS_GRADES, "custom")
 TABLE_COLUMNS = (
     "group", "images", "observations", "d_omega_deg", "d_phi_deg", "d_kappa_deg",
@@ -63,6 +64,12 @@ the initial boresight (degrees), the image observation CSV (image_id, point_id, 
 sigma_px, type, target_id), and the plane / line / LCP tables of Extract roof planes and
 Create LiDAR control points and lines.
 
+Surveyed ground control: rows of type control (as Locate control points writes them) measure
+the point point_id of GROUND_POINTS (point_id, X, Y, Z, sx, sy, sz, role), used like an LCP
+with the diagonal covariance of its sigmas; points of role check are left out of the
+adjustment (their ground positions are in the residuals). A control row naming no ground
+point is an error.
+
 Grouping: one boresight for all images, one per value of the trajectory's group column
 (flight line, direction or session) or one per heading octant.
 
@@ -88,6 +95,10 @@ written and each starts with a warning (CSV: comment lines beginning with #)."""
         Param("LINES", "file", "Line table (CSV)", optional=True, file_filter=CSV_FILTER),
         Param("LCPS", "file", "LiDAR control point table (CSV)", optional=True,
               file_filter=CSV_FILTER),
+        Param("GROUND_POINTS", "file", "Ground points (CSV)", optional=True,
+              file_filter=CSV_FILTER,
+              help="surveyed points of the control rows: point_id, X, Y, Z, sx, sy, sz, role "
+              "(control or check), in the mapping CRS"),
         Param("CLOUD", "file", "Cloud with plane ids (LAS/LAZ, paper mode only)",
               optional=True, file_filter=LAS_FILTER),
         Param("GROUPING", "enum", "Boresight groups", "group", options=GROUPINGS,
@@ -139,6 +150,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.atomic import write_text_atomic
     from ..io.camera import read_camera_json
     from ..io.control import read_lcps_csv, read_lines_csv
+    from ..io.ground_points import read_ground_points_csv
     from ..io.observations import read_observations_csv
     from ..io.orientation import write_eo_csv
     from ..io.planes import read_planes_csv
@@ -171,10 +183,12 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     plane_list = read_planes_csv(v.planes) if v.planes else []
     line_list = read_lines_csv(v.lines) if v.lines else []
     lcp_list = read_lcps_csv(v.lcps) if v.lcps else []
+    ground = read_ground_points_csv(v.ground_points) if v.ground_points else None
     for name, path, xyz in (
         ("planes", v.planes, [p.centroid for p in plane_list]),
         ("lines", v.lines, [ln.point for ln in line_list]),
         ("LCPs", v.lcps, [p.xyz for p in lcp_list]),
+        ("ground points", v.ground_points, [] if ground is None else list(ground.xyz)),
     ):
         if xyz:
             check_area_of_use(frame.crs, np.min(xyz, axis=0), np.max(xyz, axis=0),
@@ -197,11 +211,12 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         use_types=types,
         snooping=v.snooping,
     )
-    settings = _settings(v, cam, traj, obs, plane_list, line_list, lcp_list, frame, mount, grade)
+    settings = _settings(v, cam, traj, obs, plane_list, line_list, lcp_list, frame, mount, grade,
+                         ground)  # fmt: skip
     try:
         result = calibrate(
             traj, cam, mount, frame, obs, plane_list, line_list, lcp_list, lidar_xyz,
-            lidar_ids, options, progress=progress, should_stop=should_stop,
+            lidar_ids, options, progress=progress, should_stop=should_stop, ground_points=ground,
         )  # fmt: skip
     except BoresightNotObservable as exc:
         if out.requested("OUTPUT_HTML"):  # the diagnosis is the user's answer: keep it
@@ -230,12 +245,12 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                        "because ACCEPT_DOUBTFUL was set; do not use it without review")
         for line in warning:
             log.warning(line.removeprefix("WARNING: "))
-    ground = ground_positions(result, obs, cam, plane_list, line_list, lcp_list)
+    positions = ground_positions(result, obs, cam, plane_list, line_list, lcp_list, ground)
     image_group = dict(zip(traj.image_id, group_labels(traj, options.groups)))
     run = BoresightRun(
         result,
         obs,
-        ground,
+        positions,
         tuple(image_group.get(i, "") for i in obs.image_id),
         settings,
         frame.crs.to_wkt(),
@@ -299,7 +314,8 @@ def doubts_about(result, max_boresight_deg: float, max_sigma0: float) -> list[st
     return out
 
 
-def _settings(v, cam, traj, obs, planes, lines, lcps, frame, mount, grade) -> dict[str, str]:
+def _settings(v, cam, traj, obs, planes, lines, lcps, frame, mount, grade, ground=None
+              ) -> dict[str, str]:  # fmt: skip
     """The run's settings as text (the HTML summary shows them)."""
     types = tuple(v.control_types)
     return {
@@ -310,6 +326,8 @@ def _settings(v, cam, traj, obs, planes, lines, lcps, frame, mount, grade) -> di
             f"{t} {n}" for t, n in zip(*np.unique(np.array(obs.type), return_counts=True))
         ),
         "planes / lines / LCPs": f"{len(planes)} / {len(lines)} / {len(lcps)}",
+        **({} if ground is None else {"ground points (control / check)": (
+            f"{ground.role.count('control')} / {ground.role.count('check')}")}),
         "mapping CRS": frame.crs.name,
         "grouping": v.grouping,
         "control types used": ", ".join(types),

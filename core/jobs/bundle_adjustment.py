@@ -43,8 +43,9 @@ family on the same block, writes the comparison table (mean, standard deviation 
 check-point discrepancies, sigma0, significant APs) and the outputs of the best model.
 
 Inputs: camera JSON (one camera, or {"cameras": [...]} with a camera column in the EO or
-observation table), image observations (image_id, point_id, col, row, sigma_px), ground
-points (point_id, X, Y, Z, sx, sy, sz, role = control | check), optionally exterior
+observation table), image observations (image_id, point_id, col, row, sigma_px; a row of
+type control, as Locate control points writes it, must name a ground point), ground points
+(point_id, X, Y, Z, sx, sy, sz, role = control | check), optionally exterior
 orientations: approximate (e.g. direct georeferencing, a few degrees and metres off), or
 observed when the table has sigma columns (GNSS/INS with sigmas; lever arm and boresight
 corrections can be estimated). Without orientations the images that see four or more control

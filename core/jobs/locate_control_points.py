@@ -33,11 +33,13 @@ chip without texture, low correlation, no convergence, a sigma above MAX_SIGMA, 
 outside the search ellipse or a template partly outside the image. With TRANSFER, images where
 the chip match failed are matched from the point's best image (image-to-image LSM).
 
-Output: the image-observation CSV (image_id, point_id, col, row, sigma_px, type tie, empty
-target_id; point_id = the control point's id), which bundleadjustment (with the control points
-as ground points) and resection (with them as control points) read directly; sigma_px is the
-LSM sigma, at least SIGMA_FLOOR (LSM does not see the chip's own errors). The report CSV has
-one row per point and image with the status and reason; the HTML report shows the chips.""",
+Output: the image-observation CSV (image_id, point_id, col, row, sigma_px, type control,
+empty target_id; point_id = the control point's id, also for the rows transferred from another
+image), which bundleadjustment (with the control points as GROUND_POINTS), resection (with
+them as CONTROL_POINTS) and boresightcalibration (with them as GROUND_POINTS) read directly;
+sigma_px is the LSM sigma, at least SIGMA_FLOOR (LSM does not see the chip's own errors).
+The report CSV has one row per point and image with the status and reason; the HTML report
+shows the chips.""",
     params=(
         Param(
             "CHIPS",

@@ -47,8 +47,9 @@ principal point can be refined when the control has depth.
 Observations: the image-observation CSV (image_id, point_id, col, row, sigma_px, type,
 target_id). Rows of type line with the same image and target_id are one image line (two or
 more points: its ends); lcp rows are control points and check rows check points (target_id:
-the control point id); tie and paper rows whose point_id is a control point are control
-points too. LINE_OBSERVATIONS may hold the line rows in a second file.
+the control point id); control rows (as Locate control points writes them) are the control
+point point_id, and tie and paper rows whose point_id is a control point are control points
+too. LINE_OBSERVATIONS may hold the line rows in a second file.
 
 Control points: point_id,X,Y,Z[,sx,sy,sz] or the LCP table. Control lines: the line table of
 Create LiDAR control points and lines, a segment table id,x1,y1,z1,x2,y2,z2[,sigma_start,
@@ -133,6 +134,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         raise InputError("give CONTROL_POINTS or CONTROL_LINES (the object coordinates)")
     frame = MappingFrame.from_user_input(v.crs)
     camera = read_camera_json(v.camera)
+    points = read_point_control_csv(v.control_points) if v.control_points else None
     obs = None
     for path in (v.observations, v.line_observations):
         if not path:
@@ -142,8 +144,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         o = read_observations_csv(path, camera=camera)
         if path == v.line_observations and path != v.observations:
             o = o.subset(o.mask("line"))
+        _check_control_rows(o, points)
         obs = o if obs is None else obs.concat(o)
-    points = read_point_control_csv(v.control_points) if v.control_points else None
     lines = read_line_control_csv(v.control_lines) if v.control_lines else None
     for what, path, xyz in (
         ("control points", v.control_points, None if points is None else points.xyz),
@@ -220,6 +222,22 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     sigma0 = max((r.result.result.sigma0 for r in runs), default=math.nan)
     return JobResult(results={"IMAGE_COUNT": len(runs), "SIGMA0": sigma0}, lines=lines_out,
                      data=runs)  # fmt: skip
+
+
+def _check_control_rows(obs, points) -> None:
+    """A ``control`` row measures a surveyed point: its point_id must be a control point
+    (unlike a tie row, it is never left out silently)."""
+    from ..errors import InputError
+
+    known = points.index() if points is not None else {}
+    for k in np.flatnonzero(obs.mask("control")):
+        if obs.point_id[k] not in known:
+            raise InputError(
+                f"row of type control names point '{obs.point_id[k]}', which is not in "
+                + ("CONTROL_POINTS" if points is not None else "the control: give "
+                   "CONTROL_POINTS with that point_id"),
+                **obs.where(k),
+            )  # fmt: skip
 
 
 def _prefixed(exc, image_id: str):

@@ -106,6 +106,22 @@ WORKFLOWS: tuple[Workflow, ...] = (
         ),
     ),
     Workflow(
+        _t("Boresight calibration with surveyed ground control located automatically"),
+        (
+            ("trajectorytoeo", _t("INPUT = the GNSS/INS trajectory CSV; OUTPUT_CSV = the "
+             "exterior orientation of every image")),
+            ("makecontrolchips", _t("POINTS = the surveyed control, PHOTOS = ground photos of "
+             "each point with and without the control plate, CAMERA = the ground camera; "
+             "OUTPUT_FOLDER = one chip per point at the GSD of the aerial images")),
+            ("locatecontrolpoints", _t("CHIPS = one GeoTIFF chip per control point, "
+             "CONTROL_POINTS, CAMERA, approximate EO, IMAGES; OUTPUT = the control points' "
+             "image observations, without clicking them")),
+            ("boresightcalibration", _t("OBSERVATIONS = those control rows, GROUND_POINTS = the "
+             "surveyed points (role control or check), TRAJECTORY; OUTPUT_TABLE = boresight "
+             "per group, OUTPUT_EO = corrected orientation")),
+        ),
+    ),
+    Workflow(
         _t("LiDAR control for a whole block of tiles (dask.distributed)"),
         (
             ("lidarblock", _t("INPUT = a folder of LAS/LAZ tiles or a .vpc; OUTPUT_FOLDER = "

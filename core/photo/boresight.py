@@ -28,7 +28,9 @@ Control types (any mix, one adjustment; :mod:`core.photo.boresight_models` has t
    line's (X0, u) and 6 x 6 covariance as observations; all measurements of one line share
    one group. One image suffices.
 3. ``lcp``: LiDAR control points: collinearity, the LCP an unknown point with a prior from its
-   3 x 3 covariance.
+   3 x 3 covariance. ``control``: surveyed ground points (``point_id`` in the ground points
+   table), the same model with the diagonal covariance of their sigmas (sx^2, sy^2, sz^2);
+   points of role ``check`` are left out of the adjustment, as ``check`` rows of LCPs.
 4. ``paper``: the single-image model of Pedrosa & dos Santos (2020) (its Eqs. 12-17): the ray
    cut at a height z taken from the LiDAR points of the plane nearest the picked point
    (located with the *initial* orientation, once), with the plane offset d as the observation
@@ -54,7 +56,7 @@ import logging
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Callable, Union
+from typing import Callable, Protocol, Union
 
 import numpy as np
 from numpy.typing import NDArray
@@ -86,6 +88,7 @@ __all__ = [
     "BoresightOptions",
     "BoresightResult",
     "ObservationResiduals",
+    "SurveyedPoints",
     "calibrate",
     "diagnose",
     "local_frame_for",
@@ -123,7 +126,7 @@ class BoresightOptions:
     roof_roughness_m : float
         Standard deviation of a roof point about its plane (tiles, sag), metres (> 0).
     use_types : tuple of str
-        Observation types used (``tie``, ``line``, ``lcp``, ``paper``).
+        Observation types used (``tie``, ``line``, ``lcp``, ``paper``, ``control``).
     paper_sigma : {"eq17", "propagated"}
         Standard deviation of d in paper mode (module docstring).
     lidar_sigma_m : float
@@ -141,13 +144,25 @@ class BoresightOptions:
     ins_grade: Union[str, InsGrade] = "pos_av_310"
     ins_as_parameters: bool = True
     roof_roughness_m: float = 0.01
-    use_types: tuple[str, ...] = ("tie", "line", "lcp", "paper")
+    use_types: tuple[str, ...] = ("tie", "line", "lcp", "paper", "control")
     paper_sigma: str = "eq17"
     lidar_sigma_m: float = 0.05
     paper_z_neighbours: int = 4
     snooping: bool = True
     snooping_alpha: float = 0.001
     max_iterations: int = 50
+
+
+class SurveyedPoints(Protocol):
+    """Surveyed ground points as :class:`core.photo.bundle.GroundPoints` holds them (a
+    protocol: that module depends on this one): ids, mapping-CRS coordinates (m), sigmas (m),
+    roles (``control`` or ``check``)."""
+
+    point_id: tuple[str, ...]
+    xyz: Array
+    sigma: Array
+    role: tuple[str, ...]
+    source: str
 
 
 class BoresightNotObservable(DiagnosedNotObservable):
@@ -391,6 +406,47 @@ def _block_diag(jac: Array, k: int) -> Array:
     return out.reshape(lk, k, k * p)
 
 
+@dataclass(frozen=True)
+class _KnownPoint:
+    """A surveyed point as :func:`transform_lcps` takes it (mapping CRS, m; m^2)."""
+
+    id: str
+    xyz: Array
+    covariance: Array
+
+
+def _surveyed_points(
+    obs: ImageObservations, ground: SurveyedPoints | None
+) -> tuple[list[_KnownPoint], NDArray[np.bool_]]:
+    """The ground points of ``control`` rows (covariance diag(sx^2, sy^2, sz^2)) and the rows
+    that measure a check point (N,). A control row naming no ground point is an error: a
+    surveyed point must never turn into something else silently."""
+    rows = np.flatnonzero(obs.mask("control"))
+    if ground is None or not len(ground.point_id):
+        raise InputError(
+            f"{rows.size} observation row(s) of type control measure surveyed points but no "
+            "ground points were given (GROUND_POINTS), or leave control out of the types used",
+            **obs.where(int(rows[0])),
+        )
+    index = {p: k for k, p in enumerate(ground.point_id)}
+    for r in rows:
+        if obs.point_id[r] not in index:
+            where = f" ({ground.source})" if ground.source else ""
+            raise InputError(
+                f"row of type control names point '{obs.point_id[r]}', which is not in the "
+                f"ground points{where}",
+                **obs.where(int(r)),
+            )
+    check = np.zeros(len(obs), dtype=bool)
+    check[rows] = [ground.role[index[obs.point_id[r]]] == "check" for r in rows]
+    points = [
+        _KnownPoint(p, ground.xyz[k], np.diag(ground.sigma[k] ** 2))
+        for k, p in enumerate(ground.point_id)
+        if ground.role[k] == "control"
+    ]
+    return points, check
+
+
 def _index(ids: Sequence[str], known: Mapping[str, int], what: str, rows: Array) -> Array:
     out = np.empty(len(ids), dtype=np.intp)
     for k, (i, r) in enumerate(zip(ids, rows)):
@@ -417,6 +473,7 @@ def calibrate(
     options: BoresightOptions | None = None,
     progress: Callable[[float], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
+    ground_points: SurveyedPoints | None = None,
 ) -> BoresightResult:
     """Estimate the boresight per group (module docstring: model and control types).
 
@@ -444,6 +501,9 @@ def calibrate(
     options : BoresightOptions, optional
     progress, should_stop : callables, optional
         Forwarded to the adjustment (per iteration).
+    ground_points : SurveyedPoints, optional
+        Surveyed points (mapping CRS, metres) referenced by the ``point_id`` of ``control``
+        rows; rows of its ``check`` points are not adjusted.
 
     Returns
     -------
@@ -452,7 +512,8 @@ def calibrate(
     Raises
     ------
     InputError
-        Unknown images or targets, missing LiDAR points for paper mode, ...
+        Unknown images or targets, a control row naming no ground point (the row named),
+        missing LiDAR points for paper mode, ...
     BoresightNotObservable
         With a diagnosis naming what would make the parameters observable.
     """
@@ -512,6 +573,10 @@ def calibrate(
     # ---- observations in use
     kinds = np.array(observations.type)
     used = np.isin(kinds, [t for t in opts.use_types if t != "check"])
+    surveyed: list[_KnownPoint] = []
+    if "control" in opts.use_types and (kinds == "control").any():
+        surveyed, check = _surveyed_points(observations, ground_points)
+        used &= ~check
     image_of = {iid: k for k, iid in enumerate(trajectory.image_id)}
     rows_all = np.arange(len(observations))
     img = np.full(len(observations), -1, dtype=np.intp)
@@ -635,25 +700,30 @@ def calibrate(
             )
             maps.append((name, members, "line"))
 
-    # ---- 3. LCPs
-    lcp_rows = rows_all[used & (kinds == "lcp")]
-    if lcp_rows.size:
-        lcp_by_id = {str(p.id): k for k, p in enumerate(lcps)}
-        ck = _index([observations.target_id[r] for r in lcp_rows], lcp_by_id, "LCP", lcp_rows)
-        used_lcp = np.unique(ck)
-        remap = {c: k for k, c in enumerate(used_lcp)}
-        cxyz, ccov = transform_lcps([lcps[c] for c in used_lcp], local)
-        lcp_at = len(names)
-        for c in used_lcp:
-            names += [f"lcp[{lcps[c].id}].{a}" for a in "XYZ"]
+    # ---- 3. LCPs and surveyed ground points: the point an unknown with its prior
+    for kind, what, keys, known in (
+        ("lcp", "LCP", observations.target_id, lcps),
+        ("control", "ground point", observations.point_id, surveyed),
+    ):
+        k_rows = rows_all[used & (kinds == kind)]
+        if not k_rows.size:
+            continue
+        by_id = {str(p.id): k for k, p in enumerate(known)}
+        ck = _index([keys[r] for r in k_rows], by_id, what, k_rows)
+        used_pts = np.unique(ck)
+        remap = {c: k for k, c in enumerate(used_pts)}
+        cxyz, ccov = transform_lcps([known[c] for c in used_pts], local)
+        pts_at = len(names)
+        for c in used_pts:
+            names += [f"{kind}[{known[c].id}].{a}" for a in "XYZ"]
         x_init = np.concatenate([x_init, cxyz.ravel()])
-        lcp_idx = lcp_at + 3 * np.arange(len(used_lcp))[:, None] + np.arange(3)
+        pts_idx = pts_at + 3 * np.arange(len(used_pts))[:, None] + np.arange(3)
         blocks.append(
             _collinearity_block(
-                "lcp image points",
-                lcp_rows,
+                f"{kind} image points",
+                k_rows,
                 np.array([remap[c] for c in ck]),
-                lcp_idx,
+                pts_idx,
                 observations,
                 img,
                 pose_idx,
@@ -661,15 +731,15 @@ def calibrate(
                 spec,
             )
         )
-        maps.append(("lcp image points", lcp_rows[:, None], "gm"))
+        maps.append((f"{kind} image points", k_rows[:, None], "gm"))
         blocks.append(
             GaussMarkovBlock(
-                "lcp coordinates",
+                f"{kind} coordinates",
                 cxyz,
                 ccov,
-                lcp_idx,
+                pts_idx,
                 _Identity(),
-                labels=[f"lcp {lcps[c].id}" for c in used_lcp],
+                labels=[f"{kind} {known[c].id}" for c in used_pts],
                 row_names=("X", "Y", "Z"),
             )
         )
@@ -1005,6 +1075,8 @@ def diagnose(parameters: Sequence[str], groups: Sequence[str] = ()) -> list[str]
         )
     if "lcp" in kinds:
         out.append("some LCP coordinates are not determined: give each a covariance.")
+    if "control" in kinds:
+        out.append("some ground point coordinates are not determined: give each sx, sy, sz.")
     if "ins" in kinds and not out:
         out.append("INS parameters are not determined: the INS grade sigmas must be > 0.")
     if not out:

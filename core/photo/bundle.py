@@ -398,7 +398,8 @@ def _check_observations(
     free: bool,
 ) -> None:
     """Refuse duplicated rows, unknown images, images without and points with one
-    measurement, and check rows that name no check point."""
+    measurement, check rows that name no check point and control rows that name no ground
+    point."""
     n = len(obs)
     if n == 0:
         raise InputError("the observation table has no rows", path=obs.source or None)
@@ -432,6 +433,13 @@ def _check_observations(
             )
     roles = dict(zip(ground.point_id, ground.role))
     for i, (p, t) in enumerate(zip(obs.point_id, obs.type)):
+        if t == "control" and p not in roles:  # a surveyed point never becomes a free tie
+            raise _fail(
+                f"row of type control names point '{p}', which is not in the ground point "
+                f"table{f' {ground.source}' if ground.source else ''} (give GROUND_POINTS with "
+                "that point_id)",
+                obs, i,
+            )  # fmt: skip
         if t == "check" and roles.get(p) != "check":
             raise _fail(
                 f"row of type check names point '{p}', which is not a check point of the "
@@ -1352,7 +1360,8 @@ def bundle_adjust(
     cameras : sequence of Camera
         One or more cameras (unique names).
     observations : ImageObservations
-        Image measurements (pixels); a point is a tie point unless ``ground`` names it.
+        Image measurements (pixels); a point is a tie point unless ``ground`` names it (rows
+        of type ``control`` must name a ground point).
     ground : GroundPoints
         Control and check points in the mapping CRS.
     mapping : MappingFrame

@@ -155,7 +155,8 @@ class LocatedPair:
 
 @dataclass(frozen=True)
 class LocationResult:
-    """All report rows and the accepted observations (type ``tie``, point_id = control id)."""
+    """All report rows and the accepted observations (type ``control``, point_id = control
+    id)."""
 
     pairs: tuple[LocatedPair, ...]
     observations: ImageObservations
@@ -331,7 +332,7 @@ def locate_control_points(
     if obs_rows:
         img, pid_, c, rr, s = zip(*obs_rows)
         obs = ImageObservations.from_arrays(img, pid_, np.column_stack([c, rr]), s,
-                                            ["tie"] * len(img), [""] * len(img))  # fmt: skip
+                                            ["control"] * len(img), [""] * len(img))  # fmt: skip
     else:
         obs = ImageObservations.from_arrays([], [], np.zeros((0, 2)), np.zeros(0), [], [])
     return LocationResult(tuple(pairs), obs)

@@ -8,6 +8,11 @@ measurements named by point id and a ground point table. :func:`dock_bundle_inpu
 them:
 
 - ``tie`` rows are tie points (their ``point_id``; the roof plane is not used);
+- ``control`` rows (surveyed points, as ``locatecontrolpoints`` writes them) are tie points
+  named by their ``point_id`` too: the dock holds no ground point table, so the surveyed
+  coordinates are not used here (``bundleadjustment`` with ``GROUND_POINTS`` uses them); a
+  row measured in one image only is left out like a tie point. The rows themselves are
+  kept and saved unchanged;
 - ``lcp`` rows measure the control point ``C<target_id>``: its coordinates and the square
   roots of the diagonal of the LCP's covariance (the ground point table has no
   correlations) become a control point;
@@ -54,6 +59,8 @@ DEFAULT_EO_SIGMAS = (0.1, 0.1, 0.1, 0.01, 0.01, 0.01)
 #: Smallest standard deviation of an LCP coordinate, metres: an LCP table may hold a zero
 #: covariance (errorless), which the adjustment cannot weight.
 MIN_CONTROL_SIGMA_M = 1e-4
+#: Row types the dock's block adjusts as tie points named by their point_id.
+_AS_TIE = ("tie", "control")
 
 
 @dataclass(frozen=True)
@@ -111,6 +118,13 @@ def dock_bundle_inputs(
     >>> b = dock_bundle_inputs(obs, [lcp], ["4"])
     >>> b.observations.point_id, b.images
     (('T1', 'T1', 'C4', 'C4'), ('a', 'b'))
+    >>> gcp = ImageObservations.from_arrays(["a", "b", "a"], ["GCP1", "GCP1", "GCP2"],
+    ...     np.full((3, 2), 50.0), 0.5, ["control"] * 3, [""] * 3)
+    >>> g = dock_bundle_inputs(obs.concat(gcp), [lcp], ["4"])
+    >>> g.observations.point_id[-2:], g.observations.type[-2:]
+    (('GCP1', 'GCP1'), ('tie', 'tie'))
+    >>> g.left_out["tie point(s) measured in one image only"]
+    2
     >>> b.ground.point_id, b.ground.sigma.tolist(), b.ground.role
     (('C4',), [[0.01, 0.02, 0.0001]], ('control',))
     >>> b.left_out_text()
@@ -134,7 +148,7 @@ def dock_bundle_inputs(
             leave("row(s) of images not open")
         elif kind in ("line", "paper"):
             leave(f"{kind} row(s)")
-        elif kind == "tie":
+        elif kind in ("tie", "control"):
             keep.append(i)
             point_id.append(pid)
         else:  # lcp, check
@@ -152,10 +166,10 @@ def dock_bundle_inputs(
             keep.append(i)
             point_id.append(name)
     # a tie point in one image only is one still being measured: no ray to intersect
-    ties = [p for k, p in zip(keep, point_id) if observations.type[k] == "tie"]
+    ties = [p for k, p in zip(keep, point_id) if observations.type[k] in _AS_TIE]
     images_of: dict[str, set[str]] = {}
     for k, p in zip(keep, point_id):
-        if observations.type[k] == "tie":
+        if observations.type[k] in _AS_TIE:
             images_of.setdefault(p, set()).add(observations.image_id[k])
     single = {p for p in ties if len(images_of[p]) < 2}
     if single:
@@ -163,8 +177,10 @@ def dock_bundle_inputs(
     sel = [(k, p) for k, p in zip(keep, point_id) if p not in single]
     idx = np.array([k for k, _ in sel], dtype=np.intp)
     sub = observations.subset(idx)
+    # the bundle refuses a control row naming no ground point: here they are tie points
+    kinds = tuple("tie" if t == "control" else t for t in sub.type)
     kept = ImageObservations(
-        sub.image_id, tuple(p for _, p in sel), sub.pixels, sub.sigma_px, sub.type,
+        sub.image_id, tuple(p for _, p in sel), sub.pixels, sub.sigma_px, kinds,
         sub.target_id, sub.rows, sub.source, sub.camera,
     )  # fmt: skip
     names = tuple(ground)
@@ -182,7 +198,8 @@ def residuals_by_row(
 ) -> dict[int, Array]:
     """The bundle's residual (v_col, v_row; adjusted minus measured, pixels) of each row of the
     dock's ``observations`` it adjusted, by row index. A residual belongs to the row of the
-    same image, type and point (``C<target>``/``K<target>`` for control and check rows);
+    same image, type and point (``C<target>``/``K<target>`` for lcp and check rows; a
+    ``control`` row's point was adjusted as a tie point);
     rows left out, rejected or without a finite residual have none.
     """
     r = result.observations
@@ -197,8 +214,8 @@ def residuals_by_row(
         zip(observations.image_id, observations.point_id, observations.type,
             observations.target_id)
     ):  # fmt: skip
-        name = pid if kind == "tie" else ("C" if kind == "lcp" else "K") + str(tid)
-        vk = by_key.get((im, kind, name))
+        name = pid if kind in _AS_TIE else ("C" if kind == "lcp" else "K") + str(tid)
+        vk = by_key.get((im, "tie" if kind == "control" else kind, name))
         if vk is not None:
             out[i] = vk.copy()
     return out

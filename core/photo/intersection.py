@@ -10,7 +10,7 @@ from numpy.typing import NDArray
 
 from ..geometry.camera import Camera
 from ..geometry.frames import LocalFrame
-from .boresight import BoresightResult
+from .boresight import BoresightResult, SurveyedPoints
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_map_to_local
 
@@ -104,13 +104,15 @@ def ground_positions(
     planes: Sequence = (),
     lines: Sequence = (),
     lcps: Sequence = (),
+    ground_points: SurveyedPoints | None = None,
 ) -> Array:
     """Ground position of each observation row with the adjusted orientations (mapping CRS).
 
     ``tie`` and ``paper`` rows: the ray cut with the row's plane; ``line`` rows: the point of
     the line nearest the ray; ``lcp`` and ``check`` rows: the ray cut with the horizontal plane
-    through the LCP. Rays use the calibrated interior orientation when it was estimated. Rows
-    whose image or target is unknown are NaN.
+    through the LCP; ``control`` rows: the same through the ground point ``point_id`` of
+    ``ground_points`` (control and check points). Rays use the calibrated interior
+    orientation when it was estimated. Rows whose image or target is unknown are NaN.
 
     Returns
     -------
@@ -178,6 +180,14 @@ def ground_positions(
         rows = np.flatnonzero(ok & np.isin(kinds, ("lcp", "check")) & np.isin(target, list(cid)))
         if rows.size:
             xyz = local.map_to_enu(np.array([lcps[cid[t]].xyz for t in target[rows]]))
+            t = (xyz[:, 2] - c[rows, 2]) / d[rows, 2]
+            local_pts[rows] = c[rows] + t[:, None] * d[rows]
+    if ground_points is not None and len(ground_points.point_id):
+        gid = {p: k for k, p in enumerate(ground_points.point_id)}
+        point = np.array(observations.point_id)
+        rows = np.flatnonzero(ok & (kinds == "control") & np.isin(point, list(gid)))
+        if rows.size:
+            xyz = local.map_to_enu(ground_points.xyz[[gid[p] for p in point[rows]]])
             t = (xyz[:, 2] - c[rows, 2]) / d[rows, 2]
             local_pts[rows] = c[rows] + t[:, None] * d[rows]
     good = np.isfinite(local_pts).all(axis=1)

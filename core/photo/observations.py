@@ -1,5 +1,6 @@
 """Image observations: measurements of points in images (col, row in pixels) and what they
-are measurements of (tie points on roof planes, points on LiDAR lines, LiDAR control points).
+are measurements of (tie points on roof planes, points on LiDAR lines, LiDAR control points,
+surveyed ground control points).
 
 The types, the pixel convention and the CSV form are described in
 :mod:`core.io.observations`.
@@ -17,7 +18,7 @@ from ..errors import InputError
 
 Array = NDArray[np.float64]
 
-OBSERVATION_TYPES = ("tie", "line", "lcp", "paper", "check")
+OBSERVATION_TYPES = ("tie", "line", "lcp", "paper", "check", "control")
 
 DEFAULT_SIGMA_PX = 0.5
 

@@ -41,12 +41,14 @@ from ..geometry.rotations import matrix_to_opk
 from ..io.atomic import write_text_atomic
 from ..io.camera import write_camera_json
 from ..io.control import write_lcps_csv, write_lines_csv
+from ..io.ground_points import write_ground_points_csv
 from ..io.observations import write_observations_csv
 from ..io.planes import write_planes_csv
 from ..io.tables import write_csv_atomic
 from ..io.trajectory import write_trajectory_csv
 from ..lidar.control import ControlLine, ControlPoint, intersect_three_planes, intersect_two_planes
 from ..photo.boresight import BoresightOptions, BoresightResult, calibrate, local_frame_for
+from ..photo.bundle import GroundPoints
 from ..photo.georeference import Trajectory, georeference_ecef
 from ..photo.ins import INS_GRADES, InsGrade
 from ..photo.mount import MOUNT_PRESETS, Mount
@@ -63,6 +65,7 @@ __all__ = [
     "simulate_flight",
     "simulate_flight_over",
     "small_format_camera",
+    "surveyed_control",
     "ultracam_xp",
 ]
 
@@ -606,6 +609,49 @@ def simulate_flight(config: FlightConfig, seed: int = 0, exact: bool = False) ->
         town,
         truth,
     )
+
+
+def surveyed_control(
+    config: FlightConfig,
+    seed: int,
+    survey_sigma_m: tuple[float, float, float] = (0.02, 0.02, 0.03),
+    survey_seed: int = 11,
+    folder: Union[str, Path, None] = None,
+) -> tuple[FlightSimulation, ImageObservations, GroundPoints, dict[str, Path]]:
+    """A flight whose only control is surveyed ground points measured as ``control`` rows.
+
+    The roof corners stand in for surveyed points: the ``lcp`` and ``check`` rows of
+    ``simulate_flight(config, seed)`` (true corners, pixel noise) become ``control`` rows of
+    point ``GCP<id>``, and the ground points are the true corners (from the exact simulation)
+    plus Gaussian survey noise of ``survey_sigma_m`` (sx, sy, sz, which they also carry); the
+    LCPs used as check points get the role ``check``. With ``folder`` the simulation's files
+    are written there, the observations replaced by these rows and the ground points added
+    (``paths["ground"]``).
+    """
+    sim = simulate_flight(config, seed=seed)
+    exact = simulate_flight(config, seed=seed, exact=True)
+    truth = {str(p.id): p.xyz for p in exact.lcps + exact.check_lcps}
+    check_ids = {str(p.id) for p in sim.check_lcps}
+    obs = sim.observations.subset(np.isin(sim.observations.type, ("lcp", "check")))
+    n = len(obs)
+    rows = ImageObservations(obs.image_id, tuple(f"GCP{t}" for t in obs.target_id), obs.pixels,
+                             obs.sigma_px, ("control",) * n, ("",) * n)  # fmt: skip
+    ids = sorted(set(obs.target_id), key=int)
+    sigma = np.asarray(survey_sigma_m, dtype=np.float64)
+    noise = np.random.default_rng(survey_seed).normal(0.0, sigma, (len(ids), 3))
+    ground = GroundPoints(
+        tuple(f"GCP{i}" for i in ids),
+        np.array([truth[i] for i in ids]) + noise,
+        np.tile(sigma, (len(ids), 1)),
+        tuple("check" if i in check_ids else "control" for i in ids),
+    )
+    paths: dict[str, Path] = {}
+    if folder is not None:
+        paths = sim.write(folder)
+        write_observations_csv(paths["observations"], rows)
+        paths["ground"] = Path(folder) / "ground_points.csv"
+        write_ground_points_csv(paths["ground"], ground)
+    return sim, rows, ground, paths
 
 
 def _direction_names(cfg: FlightConfig) -> list[str]:

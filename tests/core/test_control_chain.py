@@ -26,6 +26,7 @@ import time
 import numpy as np
 import pyproj
 import pytest
+from lidarphoto.core.errors import InputError
 from lidarphoto.core.geometry.camera import Camera, camera_from_dict
 from lidarphoto.core.geometry.collinearity import project_with_status
 from lidarphoto.core.geometry.frames import LocalFrame, MappingFrame
@@ -107,11 +108,13 @@ def _observations(eo, ids, xyz, rng, noise=NOISE_PX) -> ImageObservations:
 
 
 def _merge(*parts: ImageObservations) -> ImageObservations:
+    """The rows of ``parts`` with their own types (the located control: ``control``)."""
     img = [i for p in parts for i in p.image_id]
     pid = [i for p in parts for i in p.point_id]
     px = np.vstack([p.pixels for p in parts])
     sig = np.concatenate([p.sigma_px for p in parts])
-    return ImageObservations.from_arrays(img, pid, px, sig, ["tie"] * len(img), [""] * len(img))
+    kinds = [t for p in parts for t in p.type]
+    return ImageObservations.from_arrays(img, pid, px, sig, kinds, [""] * len(img))
 
 
 @pytest.fixture(scope="module")
@@ -246,6 +249,7 @@ def test_located_control_within_a_tenth_of_a_pixel(chain, located):
                 if np.isfinite(truth[k, j, 0])}  # fmt: skip
     got = set(zip(obs.image_id, obs.point_id))
     assert got >= expected, sorted(expected - got)
+    assert set(obs.type) == {"control"} and set(obs.target_id) == {""}
     err = np.array([np.hypot(*(px - truth[eo.image_id.index(i), ids.index(p)]))
                     for i, p, px in zip(obs.image_id, obs.point_id, obs.pixels)
                     if (i, p) in expected])  # fmt: skip
@@ -277,3 +281,38 @@ def test_bundle_with_located_control_reaches_the_perfect_observations(chain, loc
           f"{NOISE_PX} px {rms_ref:.4f} m, ratio {rms_auto / rms_ref:.3f}; per draw "
           f"{np.round(auto, 4).tolist()} / {np.round(ref, 4).tolist()}")  # fmt: skip
     assert rms_auto <= 1.10 * rms_ref
+
+
+def test_located_control_typed_tie_as_earlier_versions_wrote_it_gives_the_same_block(
+    chain, located
+):
+    """Back-compatibility: the located control re-typed ``tie`` (files of earlier versions)
+    joins the ground points by point_id as before: the same adjustment as type ``control``."""
+    _, obs = located
+    d, eo = chain["dir"], chain["eo"]
+    rng = np.random.default_rng(7)
+    base = (_observations(eo, chain["tie_ids"], chain["tie_xyz"], rng),
+            _observations(eo, chain["chk_ids"], chain["chk"], rng))  # fmt: skip
+    as_tie = ImageObservations.from_arrays(obs.image_id, obs.point_id, obs.pixels, obs.sigma_px,
+                                           ["tie"] * len(obs), [""] * len(obs))  # fmt: skip
+    new = _bundle(d, _merge(*base, obs), "compat_control")
+    old = _bundle(d, _merge(*base, as_tie), "compat_tie")
+    assert new["rms"] == pytest.approx(old["rms"], rel=1e-9)
+    assert new["sigma0"] == pytest.approx(old["sigma0"], rel=1e-9)
+
+
+def test_control_row_naming_no_ground_point_is_refused_with_its_row(chain, located):
+    """Unlike a tie row, a control row never becomes a free tie point."""
+    _, obs = located
+    d = chain["dir"]
+    rng = np.random.default_rng(8)
+    base = _observations(chain["eo"], chain["tie_ids"], chain["tie_xyz"], rng)
+    pid = list(obs.point_id)
+    pid[1] = "GCP_MISSING"
+    bad = ImageObservations.from_arrays(obs.image_id, pid, obs.pixels, obs.sigma_px, obs.type,
+                                        obs.target_id)  # fmt: skip
+    with pytest.raises(InputError) as err:
+        _bundle(d, _merge(base, bad), "missing")
+    row = len(base) + 1 + 2  # the header is row 1
+    assert "GCP_MISSING" in str(err.value) and f"row {row}" in str(err.value)
+    assert "missing_obs.csv" in str(err.value)

@@ -158,3 +158,33 @@ def test_session_keeps_the_bundle_residuals_on_their_rows(flight):
             np.testing.assert_array_equal(after[k - 1], v)
     session.set_bundle(None)
     assert session.shown_residuals() == {}
+
+
+def test_control_rows_are_tie_points_of_the_dock_block_and_get_their_residuals(flight):
+    """Rows of type control (located surveyed points) in the dock: adjusted as tie points
+    named by their point_id (the dock has no ground point table), their own rows unchanged,
+    the bundle's residuals given back to them."""
+    sim, cam, frame, eo, noisy = flight
+    lcps = sim.lcps + sim.check_lcps
+    ids = sorted({t for t, k in zip(noisy.target_id, noisy.type) if k == "lcp"}, key=int)
+    surveyed = set(ids[: len(ids) - 3])  # three LCPs stay control (the datum)
+    half = {k for k, (t, kind) in enumerate(zip(noisy.target_id, noisy.type))
+            if kind == "lcp" and t in surveyed}  # fmt: skip
+    kinds = tuple("control" if k in half else t for k, t in enumerate(noisy.type))
+    target = tuple("" if k in half else t for k, t in enumerate(noisy.target_id))
+    point = tuple(f"GCP{noisy.target_id[k]}" if k in half else p
+                  for k, p in enumerate(noisy.point_id))  # fmt: skip
+    rows = replace(noisy, type=kinds, target_id=target, point_id=point)
+    b = dock_bundle_inputs(rows, lcps, [str(c.id) for c in lcps])
+    as_tie = {rows.point_id[k] for k in half}
+    assert not as_tie & set(b.ground.point_id)
+    kept = {(i, p): t for i, p, t in zip(b.observations.image_id, b.observations.point_id,
+                                         b.observations.type)}  # fmt: skip
+    seen_twice = [k for k in half if sum(rows.point_id[j] == rows.point_id[k] for j in half) > 1]
+    assert seen_twice
+    assert all(kept[(rows.image_id[k], rows.point_id[k])] == "tie" for k in seen_twice)
+    opts = BundleOptions(ap_model="none", estimate_interior=False)
+    res = bundle_adjust([cam], b.observations, b.ground, frame, eo, options=opts)
+    by_row = residuals_by_row(res, rows)
+    assert set(seen_twice) <= set(by_row)
+    assert rows.type == kinds  # the dock's own rows are not changed

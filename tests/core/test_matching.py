@@ -212,7 +212,7 @@ def test_located_control_within_a_tenth_of_a_pixel(block):
         err = math.hypot(p.col - truth[p.image_id][0], p.row - truth[p.image_id][1])
         assert err < 0.1, (p.image_id, err)
         assert 0 < p.sigma_col < 0.05 and p.lsm_correlation > 0.9
-    assert res.observations.type == ("tie",) * 3
+    assert res.observations.type == ("control",) * 3
     assert res.observations.point_id == ("GCP1",) * 3
 
 

@@ -234,3 +234,34 @@ def test_zero_length_image_line_names_image_and_line(scene_files, tmp_path):
     with pytest.raises(InputError, match=f"image img1: image line {target} has zero length"):
         run_job(resection, v)
     assert not (tmp_path / "eo.csv").exists()
+
+
+def test_control_rows_join_the_control_points_by_point_id(scene_files, tmp_path):
+    """The point rows as locatecontrolpoints writes them (type control, point_id = the
+    control point's id, empty target): the same orientation as the lcp rows; a control row
+    naming no control point is refused with its file and row."""
+    from lidarphoto.core.io.observations import read_observations_csv, write_observations_csv
+
+    _, _data, files = scene_files
+    obs = read_observations_csv(files["observations"])
+    lcp = obs.mask("lcp")
+    assert lcp.sum() >= 4
+    kinds = tuple("control" if m else t for m, t in zip(lcp, obs.type))
+    pid = tuple(g if m else p for m, p, g in zip(lcp, obs.point_id, obs.target_id))
+    target = tuple("" if m else g for m, g in zip(lcp, obs.target_id))
+    control = replace(obs, type=kinds, point_id=pid, target_id=target, rows=(), source="")
+    write_observations_csv(tmp_path / "control.csv", control)
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    run_job(resection, _values(files, tmp_path / "a"))
+    run_job(resection, _values(files, tmp_path / "b", OBSERVATIONS=str(tmp_path / "control.csv")))
+    a, b = _rows(tmp_path / "a" / "eo.csv")[0], _rows(tmp_path / "b" / "eo.csv")[0]
+    assert int(b["points"]) == int(lcp.sum())
+    for c in ("X", "Y", "Z", "omega_deg", "phi_deg", "kappa_deg", "sigma0"):
+        assert float(b[c]) == pytest.approx(float(a[c]), rel=1e-9, abs=1e-9), c
+    k = int(np.flatnonzero(lcp)[1])
+    bad = replace(control, point_id=control.point_id[:k] + ("NOPE",) + control.point_id[k + 1:])
+    write_observations_csv(tmp_path / "bad.csv", bad)
+    with pytest.raises(InputError, match=r"NOPE.*CONTROL_POINTS") as err:
+        run_job(resection, _values(files, tmp_path, OBSERVATIONS=str(tmp_path / "bad.csv")))
+    assert f"row {k + 2}" in str(err.value) and "bad.csv" in str(err.value)

@@ -136,3 +136,40 @@ def test_qgis_process_run(qp_env, flight, tmp_path):
     _check_table(sim, tmp_path / "table.csv")
     layer = QgsVectorLayer(str(tmp_path / "res.gpkg"), "res", "ogr")
     assert layer.isValid() and layer.featureCount() == len(sim.observations)
+
+
+def test_processing_run_with_surveyed_ground_control(provider, tmp_path):
+    """CONTROL_TYPES control + GROUND_POINTS (the located-control path): the boresight within
+    4 sigma of the truth, every row a residual feature named by its surveyed point_id, the
+    check points not used; a control row naming no ground point fails naming the row."""
+    from lidarphoto.core.io.observations import write_observations_csv
+    from lidarphoto.core.jobs.boresight_calibration import CONTROL_TYPES
+    from lidarphoto.core.simulation.flight import surveyed_control
+
+    cfg = replace(SMALL, n_check=4, types=("lcp", "check"))
+    sim, rows, ground, paths = surveyed_control(cfg, 5, folder=tmp_path / "gcp")
+    params = {
+        "CAMERA": str(paths["camera"]), "TRAJECTORY": str(paths["trajectory"]),
+        "CRS": sim.crs, "LEVER_ARM": ",".join(repr(float(v)) for v in sim.mount.lever_arm),
+        "OBSERVATIONS": str(paths["observations"]), "GROUND_POINTS": str(paths["ground"]),
+        "GROUPING": 0, "CONTROL_TYPES": [CONTROL_TYPES.index("control")],
+        "OUTPUT_TABLE": str(tmp_path / "table.csv"), "OUTPUT_RESIDUALS": "TEMPORARY_OUTPUT",
+        "OUTPUT_EO": str(tmp_path / "eo.csv"), "OUTPUT_HTML": str(tmp_path / "summary.html"),
+    }  # fmt: skip
+    result = processing.run(ALG, params)
+    with open(result["OUTPUT_TABLE"], encoding="utf-8") as fh:
+        (row,) = list(csv.DictReader(fh))
+    true = next(iter(sim.truth.boresight.values())) / ARCSEC
+    for k, angle in enumerate(("omega", "phi", "kappa")):
+        est, sigma = float(row[f"d_{angle}_arcsec"]), float(row[f"std_d_{angle}_arcsec"])
+        assert abs(est - true[k]) < 4.0 * sigma, (angle, est, true[k], sigma)
+    role = dict(zip(ground.point_id, ground.role))
+    features = list(result["OUTPUT_RESIDUALS"].getFeatures())
+    assert len(features) == len(rows)
+    for f in features:
+        assert f["type"] == "control" and f["point_id"] in role
+        assert f["used"] == (0 if role[f["point_id"]] == "check" else 1)
+    bad = tmp_path / "bad.csv"
+    write_observations_csv(bad, replace(rows, point_id=("GCP_X",) + rows.point_id[1:]))
+    with pytest.raises(QgsProcessingException, match=r"GCP_X.*row 2|row 2.*GCP_X"):
+        processing.run(ALG, dict(params, OBSERVATIONS=str(bad)))

@@ -191,3 +191,25 @@ def test_kill_mid_write_then_open_removes_the_temporary(tmp_path, qgis_app):
     assert store.removed_temporaries == [str(temp)]
     assert _temporaries(folder) == [other.name]
     assert _mode(path) == 0o644
+
+
+def test_control_rows_of_located_control_are_kept_and_saved_unchanged(tmp_path, qgis_app):
+    """A file of locatecontrolpoints (type control, empty target) mixed with the dock's own
+    rows: loaded without refusal, saved byte for byte as the core writer writes it, and an
+    edit of another row leaves the control rows as they were."""
+    path = tmp_path / "located.csv"
+    table = ImageObservations.from_arrays(
+        ["img1", "img2", "img1"], ["GCP12", "GCP12", "T1"],
+        [[1523.4127, 988.2031], [210.75, 1990.125], [10.5, 20.5]], [0.15, 0.2, 0.5],
+        ["control", "control", "tie"], ["", "", "3"],
+    )  # fmt: skip
+    write_observations_csv(path, table)
+    original = path.read_bytes()
+    store = ObservationStore()
+    assert store.load(path) == 3
+    assert store.save() and path.read_bytes() == original
+    store.move(2, 11.5, 21.5)
+    back = read_observations_csv(path)
+    assert back.type == ("control", "control", "tie") and back.target_id[:2] == ("", "")
+    np.testing.assert_array_equal(back.pixels[:2], table.pixels[:2])
+    np.testing.assert_array_equal(back.sigma_px[:2], table.sigma_px[:2])
