@@ -112,6 +112,7 @@ from ..errors import (
     NotObservableError,
     stop_if_asked,
 )
+from ..i18n import mark as _t
 from .model import (
     AdjustmentOptions,
     Constraint,
@@ -121,6 +122,9 @@ from .model import (
 )
 from .results import AdjustmentResult, ChiSquareTest, RejectedObservation, ResidualTable
 from .schur import EliminationPlan, ReducedNormal, SingularSystem, build_reduced_normal
+
+#: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
+TR_CONTEXT = "Report"
 
 __all__ = ["adjust"]
 
@@ -1012,8 +1016,12 @@ def _run(
                     lin = fresh
                     continue
                 warnings.append(
-                    f"the cost could not be reduced further at iteration {it} (step "
-                    f"{step:.3g} sigma): stopped without convergence"
+                    _t(
+                        "the cost could not be reduced further at iteration {iteration} (step "
+                        "{step:.3g} sigma): stopped without convergence",
+                        iteration=it,
+                        step=step,
+                    )
                 )
                 break
         m_new = _merit(new, rowscale, nu)
@@ -1029,7 +1037,9 @@ def _run(
             break
         prev_step = step
     if not converged and it >= opts.max_iterations:
-        warnings.append(f"no convergence within {opts.max_iterations} iterations")
+        warnings.append(
+            _t("no convergence within {n} iterations", n=opts.max_iterations)
+        )
     # Final normal equations at the final linearisation point, checked before use.
     nrm, _ = problem.normal(lin, active, rowscale)
     if use_sparse is None:
@@ -1138,7 +1148,7 @@ def _finish(
     s0p = opts.sigma0_prior
     warnings = list(run.warnings)
     if r == 0:
-        warnings.append("no redundancy: sigma0 and the global test are undefined")
+        warnings.append(_t("no redundancy: sigma0 and the global test are undefined"))
     cov = cov_prior = corr = None
     std = np.full(n, np.nan)
     std_prior = np.full(n, np.nan)
@@ -1420,8 +1430,11 @@ def adjust(
         except NotObservableError:
             ok = False
             extra_warnings.append(
-                f"robust estimation: setting aside the {int(sum(f.sum() for f in flagged))} "
-                "groups it flagged would leave the adjustment not observable; they are kept"
+                _t(
+                    "robust estimation: setting aside the {n} groups it flagged would leave the "
+                    "adjustment not observable; they are kept",
+                    n=int(sum(f.sum() for f in flagged)),
+                )
             )
         if ok:
             for bj, gj in gone:
@@ -1455,7 +1468,7 @@ def adjust(
         return result
 
     if not result.converged:
-        extra_warnings.append("data snooping skipped: the adjustment did not converge")
+        extra_warnings.append(_t("data snooping skipped: the adjustment did not converge"))
     else:
         round_no = 0
         while True:
@@ -1464,8 +1477,13 @@ def adjust(
                 break
             if len(rejected) >= opts.max_rejections:
                 extra_warnings.append(
-                    f"data snooping stopped at max_rejections = {opts.max_rejections} with "
-                    f"|w| = {worst[3]:.2f} still above {crit:.2f}"
+                    _t(
+                        "data snooping stopped at max_rejections = {n} with |w| = {w:.2f} "
+                        "still above {critical:.2f}",
+                        n=opts.max_rejections,
+                        w=worst[3],
+                        critical=crit,
+                    )
                 )
                 break
             round_no += 1
@@ -1490,14 +1508,23 @@ def adjust(
                 new_result = _finish(problem, new_run, trial, opts, want_cov)
             except NotObservableError:
                 extra_warnings.append(
-                    f"data snooping stopped: rejecting {b.name} / {b.labels[g]} "
-                    f"(|w| = {wv:.2f}) would make the adjustment not observable; it is kept"
+                    _t(
+                        "data snooping stopped: rejecting {block} / {label} (|w| = {w:.2f}) "
+                        "would make the adjustment not observable; it is kept",
+                        block=b.name,
+                        label=b.labels[g],
+                        w=wv,
+                    )
                 )
                 break
             if not new_run.converged:
                 extra_warnings.append(
-                    f"data snooping stopped: without {b.name} / {b.labels[g]} the adjustment "
-                    "did not converge; it is kept"
+                    _t(
+                        "data snooping stopped: without {block} / {label} the adjustment did "
+                        "not converge; it is kept",
+                        block=b.name,
+                        label=b.labels[g],
+                    )
                 )
                 break
             signed = float(result.residuals[b.name].w[g, i])
@@ -1515,8 +1542,11 @@ def adjust(
         )
         if untested:
             extra_warnings.append(
-                f"{untested} observation rows have a redundancy number of about zero and "
-                "cannot be tested by data snooping"
+                _t(
+                    "{n} observation rows have a redundancy number of about zero and cannot "
+                    "be tested by data snooping",
+                    n=untested,
+                )
             )
     result.outlier_method = (
         f"Baarda data snooping (alpha = {opts.snooping_alpha:g} per observation, critical "

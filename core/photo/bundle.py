@@ -62,12 +62,16 @@ from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians, image_rays
 from ..geometry.frames import LocalFrame, MappingFrame
 from ..geometry.rotations import matrix_to_opk, opk_derivatives, opk_to_matrix
+from ..i18n import mark as _t
 from ..lsq.adjustment import adjust
 from ..lsq.model import AdjustmentOptions, Constraint, GaussMarkovBlock
 from ..lsq.results import AdjustmentResult
 from .intersection import meet_rays
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_local_to_map, eo_map_to_local
+
+#: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
+TR_CONTEXT = "Report"
 
 Array = NDArray[np.float64]
 
@@ -576,8 +580,11 @@ def _prepare(
     unobserved = [p for p in ground.point_id if p not in observed]
     if unobserved:
         warnings.append(
-            f"{len(unobserved)} ground point(s) are not measured in any image and were not "
-            f"used: {', '.join(unobserved[:20])}{' ...' if len(unobserved) > 20 else ''}"
+            _t(
+                "{n} ground point(s) are not measured in any image and were not used: {ids}",
+                n=len(unobserved),
+                ids=", ".join(unobserved[:20]) + (" ..." if len(unobserved) > 20 else ""),
+            )
         )
     free = options.datum != "control"
     adjusted: list[str] = []

@@ -67,6 +67,10 @@ from ..errors import InputError
 from ..geometry.camera import Camera
 from ..geometry.collinearity import image_rays, project_with_status
 from ..geometry.rotations import opk_to_matrix
+from ..i18n import mark as _t
+
+#: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
+TR_CONTEXT = "Report"
 
 Array = NDArray[np.float64]
 
@@ -446,13 +450,15 @@ def detect_plate(
     u8 = np.clip((img - lo) * scale, 0, 255).astype(np.uint8)
     quads = _quads(u8, min_area_px)
     if not quads:
-        return PlateDetection(False, "plate not found: no quadrilateral in the photo")
+        return PlateDetection(False, _t("plate not found: no quadrilateral in the photo"))
     pairs = _pairs(quads, plate.inner_m / plate.outer_m)
     if not pairs:
-        return PlateDetection(False, f"only one square: {len(quads)} quadrilateral(s), none "
-                              "with a nested square of the plate's inner/outer ratio")  # fmt: skip
+        return PlateDetection(False, _t("only one square: {n} quadrilateral(s), none with a "
+                                        "nested square of the plate's inner/outer ratio",
+                                        n=len(quads)))  # fmt: skip
     if len(pairs) > 1:
-        return PlateDetection(False, f"ambiguous: {len(pairs)} plate-like pairs of squares",
+        return PlateDetection(False, _t("ambiguous: {n} plate-like pairs of squares",
+                                        n=len(pairs)),
                               candidates=len(pairs))  # fmt: skip
     outer, inner = pairs[0]
     smooth = cv2.GaussianBlur(img, (0, 0), 1.0)
@@ -467,8 +473,9 @@ def detect_plate(
             uv = uv[np.isfinite(uv).all(axis=1)] if len(uv) else uv
             fit = _fit_side(uv)
             if fit is None:
-                return PlateDetection(False, f"edge fit failed: side {4 * k + i} has "
-                                      f"{len(uv)} edge points", candidates=1)  # fmt: skip
+                return PlateDetection(False, _t("edge fit failed: side {side} has {n} edge "
+                                                "points", side=4 * k + i, n=len(uv)),
+                                      candidates=1)  # fmt: skip
             lines.append(fit)
             rms[4 * k + i] = fit[3] * f_px
             count[4 * k + i] = fit[5]

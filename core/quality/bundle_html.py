@@ -246,6 +246,6 @@ def render_bundle_html(
                           t("w row")], rows)]  # fmt: skip
     if res.warnings:
         parts += [f"<h2>{t('Warnings')}</h2><ul>",
-                  *(f"<li>{_e(w)}</li>" for w in res.warnings), "</ul>"]  # fmt: skip
+                  *(f"<li>{_e(t(w))}</li>" for w in res.warnings), "</ul>"]  # fmt: skip
     parts.append("</body></html>")
     return "\n".join(parts)
