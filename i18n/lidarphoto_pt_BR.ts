@@ -316,6 +316,14 @@
             <translation>significativo</translation>
         </message>
         <message>
+            <source>dropped</source>
+            <translation>descartado</translation>
+        </message>
+        <message>
+            <source>fixed</source>
+            <translation>fixo</translation>
+        </message>
+        <message>
             <source>image</source>
             <translation>imagem</translation>
         </message>
@@ -427,6 +435,13 @@
         </message>
     </context>
     <context>
+        <name>ImageLoader</name>
+        <message>
+            <source>{path}: read failed ({error})</source>
+            <translation>{path}: falha na leitura ({error})</translation>
+        </message>
+    </context>
+    <context>
         <name>ImagePickingDock</name>
         <message>
             <source>&lt;b&gt;Picking&lt;/b&gt;: choose the type, then left-click in the image. &lt;i&gt;tie&lt;/i&gt; and &lt;i&gt;paper&lt;/i&gt; points take the roof plane under the cursor (a menu asks when outlines overlap); &lt;i&gt;line&lt;/i&gt;: two clicks, the image line's ends, on the LiDAR line nearest to the first (drawn solid while measuring; Esc cancels, Ctrl+Z removes both ends; the Resection tab can refine the ends onto the image's edge); &lt;i&gt;lcp&lt;/i&gt;/&lt;i&gt;check&lt;/i&gt; take the nearest control point. &lt;b&gt;Resect&lt;/b&gt; (Resection tab) orients the image shown from its lines and control points; &lt;b&gt;Bundle&lt;/b&gt; (Bundle tab) adjusts the open images from their tie, control (lcp) and check points. After a tie point the other images show its prediction (yellow x): Enter accepts it, a click puts it where you see it, Esc drops it.&lt;br&gt;&lt;b&gt;Monoplot&lt;/b&gt; (needs a DSM in the Project tab): while the button is on, a click makes a 3D point on the DSM, or a vertex of a 3D line (Enter, a double click or &lt;i&gt;Finish line&lt;/i&gt; ends it); they appear on the map at once, and the save button writes them to a GeoPackage. Off: clicks measure observations again.&lt;br&gt;&lt;b&gt;Keys&lt;/b&gt;: PgDown/PgUp next/previous image · Enter accept prediction · Esc cancel prediction · Delete delete selected point · Ctrl+Z undo · Ctrl+Shift+Z / Ctrl+Y redo · T/P/L/C/K picking type · </source>
@@ -463,6 +478,61 @@
         <message>
             <source>Image picking</source>
             <translation>Medição na imagem</translation>
+        </message>
+        <message>
+            <source>{image}  col {col:.2f}  row {row:.2f}  zoom {zoom:.3g}</source>
+            <translation>{image}  col {col:.2f}  lin {row:.2f}  zoom {zoom:.3g}</translation>
+        </message>
+    </context>
+    <context>
+        <name>ImageSource</name>
+        <message>
+            <source>{path}: its folder is read-only, no overview pyramid can be written next to it</source>
+            <translation>{path}: a pasta é somente leitura, nenhuma pirâmide de visões gerais pode ser gravada ao lado da imagem</translation>
+        </message>
+        <message>
+            <source>GDAL is not available ({error})</source>
+            <translation>o GDAL não está disponível ({error})</translation>
+        </message>
+        <message>
+            <source>{path}: overview build cancelled</source>
+            <translation>{path}: construção das visões gerais cancelada</translation>
+        </message>
+        <message>
+            <source>{path}: the image file does not exist</source>
+            <translation>{path}: o arquivo de imagem não existe</translation>
+        </message>
+        <message>
+            <source>{path}: GDAL cannot open it (no raster band)</source>
+            <translation>{path}: o GDAL não consegue abri-lo (nenhuma banda raster)</translation>
+        </message>
+        <message>
+            <source>{path}: neither GDAL nor OpenCV can read this image{why}</source>
+            <translation>{path}: nem o GDAL nem o OpenCV conseguem ler esta imagem{why}</translation>
+        </message>
+        <message>
+            <source>{path}: the image is closed</source>
+            <translation>{path}: a imagem está fechada</translation>
+        </message>
+        <message>
+            <source>{path}: cannot build the overview pyramid ({error})</source>
+            <translation>{path}: não foi possível construir a pirâmide de visões gerais ({error})</translation>
+        </message>
+        <message>
+            <source>{path}: cannot write the overview pyramid ({error})</source>
+            <translation>{path}: não foi possível gravar a pirâmide de visões gerais ({error})</translation>
+        </message>
+        <message>
+            <source>{path}: GDAL cannot open it ({error})</source>
+            <translation>{path}: o GDAL não consegue abri-lo ({error})</translation>
+        </message>
+        <message>
+            <source>{path}: read failed</source>
+            <translation>{path}: falha na leitura</translation>
+        </message>
+        <message>
+            <source>{path}: read failed ({error})</source>
+            <translation>{path}: falha na leitura ({error})</translation>
         </message>
     </context>
     <context>
@@ -691,6 +761,18 @@
         <message>
             <source>Overview pyramid of {}</source>
             <translation>Pirâmide de visões gerais de {}</translation>
+        </message>
+        <message>
+            <source>{path}: overview build cancelled</source>
+            <translation>{path}: construção das visões gerais cancelada</translation>
+        </message>
+        <message>
+            <source>{path}: overview build failed ({error})</source>
+            <translation>{path}: falha na construção das visões gerais ({error})</translation>
+        </message>
+        <message>
+            <source>{path}: overview pyramid built ({name})</source>
+            <translation>{path}: pirâmide de visões gerais construída ({name})</translation>
         </message>
     </context>
     <context>
@@ -927,6 +1009,14 @@
         <message>
             <source>{n} ground point(s) are not measured in any image and were not used: {ids}</source>
             <translation>{n} ponto(s) de terreno não foram medidos em nenhuma imagem e não foram usados: {ids}</translation>
+        </message>
+        <message>
+            <source>insignificant (t = {t:.2f} &lt;= {critical:.2f}, alpha {alpha:g})</source>
+            <translation>não significativo (t = {t:.2f} &lt;= {critical:.2f}, alfa {alpha:g})</translation>
+        </message>
+        <message>
+            <source>|correlation| {r:.3f} &gt; {limit:g} with {other}</source>
+            <translation>|correlação| {r:.3f} &gt; {limit:g} com {other}</translation>
         </message>
         <message>
             <source>view {view!r} left out: fewer than {minimum} target points</source>
@@ -1577,6 +1667,18 @@
             <translation>significativo</translation>
         </message>
         <message>
+            <source>estimated</source>
+            <translation>estimado</translation>
+        </message>
+        <message>
+            <source>dropped</source>
+            <translation>descartado</translation>
+        </message>
+        <message>
+            <source>fixed</source>
+            <translation>fixo</translation>
+        </message>
+        <message>
             <source>camera</source>
             <translation>câmera</translation>
         </message>
@@ -1799,10 +1901,6 @@
         <message>
             <source>Views</source>
             <translation>Vistas</translation>
-        </message>
-        <message>
-            <source>fixed</source>
-            <translation>fixo</translation>
         </message>
         <message>
             <source>Camera calibration: {} ({})</source>

@@ -1140,7 +1140,8 @@ def _drop_candidate(run: _Run, options: BundleOptions) -> tuple[int, int, str] |
             per_camera.append((c, cam, idx, run.lay.free[c], t))
     insignificant = [
         (float(t[k]), c, int(free[k]),
-         f"insignificant (t = {t[k]:.2f} <= {tcrit:.2f}, alpha {options.ap_alpha:g})")
+         _t("insignificant (t = {t:.2f} <= {critical:.2f}, alpha {alpha:g})", t=t[k],
+            critical=tcrit, alpha=options.ap_alpha))
         for c, _cam, idx, free, t in per_camera
         for k in range(idx.size)
         if free[k] >= 3 and t[k] <= tcrit
@@ -1160,8 +1161,8 @@ def _drop_candidate(run: _Run, options: BundleOptions) -> tuple[int, int, str] |
                 # drop the AP of the pair (the less significant one when both are APs)
                 k = min(pick, key=lambda q: t[q])
                 other = b if k == a else a
-                why = (f"|correlation| {abs(corr[a, b]):.3f} > {options.max_correlation:g} "
-                       f"with {names[free[other]]}")  # fmt: skip
+                why = _t("|correlation| {r:.3f} > {limit:g} with {other}", r=abs(corr[a, b]),
+                         limit=options.max_correlation, other=names[free[other]])  # fmt: skip
                 correlated.append((abs(float(corr[a, b])), c, int(free[k]), why))
     if correlated:
         _, c, k, why = max(correlated, key=lambda q: q[0])

@@ -93,6 +93,7 @@ def _adjustment(res: BundleResult) -> str:
 
 def _interior(res: BundleResult, alpha_text: str) -> str:
     rows, css = [], []
+    words = {"estimated": t("estimated"), "dropped": t("dropped"), "fixed": t("fixed")}
     for p in res.interior:
         if p.status == "estimated":
             sig = t("yes") if p.significant else t("no")
@@ -100,7 +101,7 @@ def _interior(res: BundleResult, alpha_text: str) -> str:
             sig = "&ndash;"
         rows.append([
             _e(p.camera), _e(p.name), _n(p.value, ".6g"), _n(p.std, ".3g"), _n(p.t, ".2f"),
-            sig, _e(p.status), _e(p.reason),
+            sig, _e(words.get(p.status, p.status)), _e(t(p.reason)),
         ])  # fmt: skip
         css.append("drop" if p.status == "dropped" else "")
     head = [t("camera"), t("parameter"), t("value"), t("std"), "t",
@@ -152,7 +153,7 @@ def render_bundle_html(
         parts.append(
             "<p>"
             + t("Dropped by the selection, in order: ")
-            + "; ".join(f"{_e(c)} {_e(n)} ({_e(w)})" for c, n, w in res.dropped)
+            + "; ".join(f"{_e(c)} {_e(n)} ({_e(t(w))})" for c, n, w in res.dropped)
             + "</p>"
         )
     if res.flagged_correlations:
