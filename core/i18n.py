@@ -30,6 +30,7 @@ __all__ = [
     "catalogue",
     "current_language",
     "html_lang",
+    "joined",
     "language_from_env",
     "mark",
     "normalise_language",
@@ -177,6 +178,18 @@ def mark(template: str, /, **values: object) -> Message:
     """A sentence marked for translation: modules import it as ``_t`` (``make i18n`` collects
     ``_t("...")`` in modules that set ``TR_CONTEXT``) and build ``_t("{n} points", n=3)``."""
     return Message(template, **values)
+
+
+def joined(items, sep: str = ", ") -> Message:
+    """Sentences joined by ``sep``, each rendered in the report's language (a list of
+    :class:`Message` inside another one's value).
+
+    >>> joined([Message("{a} of group {g}", a="d_phi", g="1"), "x"])
+    'd_phi of group 1, x'
+    """
+    items = list(items)
+    template = sep.join("{" + f"v{k}" + "}" for k in range(len(items)))
+    return Message(template, **{f"v{k}": item for k, item in enumerate(items)})
 
 
 def render(text: object, context: str, lang: str | None = None) -> str:

@@ -971,6 +971,34 @@
     <context>
         <name>Report</name>
         <message>
+            <source>the global test failed with sigma0 = {sigma0:.3g} &gt; MAX_SIGMA0 {maximum:g}: the observations are {sigma0:.3g} times less precise than their sigmas say (wrong sigma_px or INS grade, or undetected blunders)</source>
+            <translation>o teste global falhou com sigma0 = {sigma0:.3g} &gt; MAX_SIGMA0 {maximum:g}: as observações são {sigma0:.3g} vezes menos precisas do que dizem seus desvios-padrão (sigma_px ou classe do INS errados, ou erros grosseiros não detectados)</translation>
+        </message>
+        <message>
+            <source>not a finite number: {items}</source>
+            <translation>não é um número finito: {items}</translation>
+        </message>
+        <message>
+            <source>{items} beyond MAX_BORESIGHT {maximum:g} deg: implausible for a misalignment (wrong MOUNT, image ids or observations?)</source>
+            <translation>{items} além de MAX_BORESIGHT {maximum:g} graus: implausível para um desalinhamento (MOUNT, identificadores das imagens ou observações errados?)</translation>
+        </message>
+        <message>
+            <source>the adjustment did not converge after {n} iterations ({why})</source>
+            <translation>o ajustamento não convergiu após {n} iterações ({why})</translation>
+        </message>
+        <message>
+            <source>the adjustment did not converge after {n} iterations</source>
+            <translation>o ajustamento não convergiu após {n} iterações</translation>
+        </message>
+        <message>
+            <source>{angle} of group {group}</source>
+            <translation>{angle} do grupo {group}</translation>
+        </message>
+        <message>
+            <source>{angle} = {value:.4f} deg in group {group}</source>
+            <translation>{angle} = {value:.4f} graus no grupo {group}</translation>
+        </message>
+        <message>
             <source>no convergence within {n} iterations</source>
             <translation>sem convergência em {n} iterações</translation>
         </message>

@@ -372,3 +372,30 @@ def test_control_location_reasons_in_portuguese():
         assert text in page, text
     for text in ("chip refused", "no texture", "outside every image", ">rejected<"):
         assert text not in page, text
+
+
+def test_boresight_doubts_in_portuguese():
+    """Why a boresight calibration is refused (global test, an implausible angle), English in
+    the error and Portuguese in the pt_BR report, numbers in place."""
+    from types import SimpleNamespace as S
+
+    from lidarphoto.core.jobs.boresight_calibration import doubts_about
+    from lidarphoto.core.quality.boresight_html import render_boresight_html
+
+    result = S(adjustment=S(converged=True, iterations=4, warnings=[]), chi2_passed=False,
+               sigma0=3.5, groups=("g1",), boresight_deg=np.array([[0.01, 2.5, 0.0]]),
+               std=np.full((1, 3), 1e-3))  # fmt: skip
+    doubts = doubts_about(result, 1.0, 2.0)
+    assert doubts[0].startswith("the global test failed with sigma0 = 3.5 > MAX_SIGMA0 2:")
+    assert doubts[1] == (
+        "d_phi = 2.5000 deg in group g1 beyond MAX_BORESIGHT 1 deg: implausible for a "
+        "misalignment (wrong MOUNT, image ids or observations?)"
+    )
+    i18n.set_language("pt_BR")
+    try:
+        page = render_boresight_html(None, {}, problems=doubts)
+    finally:
+        i18n.set_language("en")
+    assert "o teste global falhou com sigma0 = 3.5 &gt; MAX_SIGMA0 2: as observações" in page
+    assert "d_phi = 2.5000 graus no grupo g1 além de MAX_BORESIGHT 1 graus" in page
+    assert "global test failed" not in page and "beyond MAX_BORESIGHT" not in page
