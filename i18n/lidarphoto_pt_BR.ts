@@ -999,12 +999,32 @@
             <translation>{angle} = {value:.4f} graus no grupo {group}</translation>
         </message>
         <message>
+            <source>Baarda data snooping (alpha = {alpha:g} per observation, critical |w| = {critical:.2f}, iterative rejection of whole groups)</source>
+            <translation>data snooping de Baarda (alfa = {alpha:g} por observação, |w| crítico = {critical:.2f}, rejeição iterativa de grupos inteiros)</translation>
+        </message>
+        <message>
+            <source>{method} reweighting (k = {k:g} robust scale units, {rounds} rounds, robust scale {scale:.3g}), groups with a standardised misfit above {critical:.2f} set aside</source>
+            <translation>reponderação {method} (k = {k:g} unidades da escala robusta, {rounds} rodadas, escala robusta {scale:.3g}), grupos com desajuste padronizado acima de {critical:.2f} afastados</translation>
+        </message>
+        <message>
+            <source>{robust}, then {snooping}</source>
+            <translation>{robust}, depois {snooping}</translation>
+        </message>
+        <message>
             <source>no convergence within {n} iterations</source>
             <translation>sem convergência em {n} iterações</translation>
         </message>
         <message>
             <source>no redundancy: sigma0 and the global test are undefined</source>
             <translation>sem redundância: sigma0 e o teste global ficam indefinidos</translation>
+        </message>
+        <message>
+            <source>{robust}; no data snooping</source>
+            <translation>{robust}; sem data snooping</translation>
+        </message>
+        <message>
+            <source>none (data snooping disabled)</source>
+            <translation>nenhuma (data snooping desativado)</translation>
         </message>
         <message>
             <source>data snooping skipped: the adjustment did not converge</source>

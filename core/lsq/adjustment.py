@@ -1416,10 +1416,14 @@ def adjust(
         x, vhat, flagged, rob = _robust(problem, x, vhat, active, opts, crit, reporter,
                                         should_stop)  # fmt: skip
         initial = False
-        robust_text = (
-            f"{opts.robust.capitalize()} reweighting (k = {rob['k']:g} robust scale units, "
-            f"{rob['rounds']} rounds, robust scale {rob['scale']:.3g}), groups with a "
-            f"standardised misfit above {crit:.2f} set aside"
+        robust_text = _t(
+            "{method} reweighting (k = {k:g} robust scale units, {rounds} rounds, robust scale "
+            "{scale:.3g}), groups with a standardised misfit above {critical:.2f} set aside",
+            method=opts.robust.capitalize(),
+            k=rob["k"],
+            rounds=rob["rounds"],
+            scale=rob["scale"],
+            critical=crit,
         )
         trial = [a & ~f for a, f in zip(active, flagged)]
         trial, gone = _cascade(problem, trial)
@@ -1459,7 +1463,9 @@ def adjust(
     result = _finish(problem, run, active, opts, want_cov)
     if not opts.snooping:
         result.outlier_method = (
-            robust_text + "; no data snooping" if robust_text else "none (data snooping disabled)"
+            _t("{robust}; no data snooping", robust=robust_text)
+            if robust_text
+            else _t("none (data snooping disabled)")
         )
         result.rejected = rejected
         result.warnings.extend(extra_warnings)
@@ -1549,11 +1555,17 @@ def adjust(
                 )
             )
     result.outlier_method = (
-        f"Baarda data snooping (alpha = {opts.snooping_alpha:g} per observation, critical "
-        f"|w| = {crit:.2f}, iterative rejection of whole groups)"
+        _t(
+            "Baarda data snooping (alpha = {alpha:g} per observation, critical |w| = "
+            "{critical:.2f}, iterative rejection of whole groups)",
+            alpha=opts.snooping_alpha,
+            critical=crit,
+        )
     )
     if robust_text:
-        result.outlier_method = robust_text + ", then " + result.outlier_method
+        result.outlier_method = _t(
+            "{robust}, then {snooping}", robust=robust_text, snooping=result.outlier_method
+        )
     result.rejected = rejected
     result.warnings.extend(extra_warnings)
     reporter.span(0.0, 1.0)

@@ -215,7 +215,7 @@ def _results(run: BoresightRun) -> list[str]:
                         t("yes") if res.adjustment.converged else t("no"),
                     ),
                 ],
-                [t("outlier detection"), _e(res.adjustment.outlier_method)],
+                [t("outlier detection"), _e(t(res.adjustment.outlier_method))],
             ],
             [""] * 6 + ["pass" if gt.passed else "fail", "", ""],
         )

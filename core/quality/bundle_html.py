@@ -83,7 +83,7 @@ def _adjustment(res: BundleResult) -> str:
          t("statistic {}, accepted [{}, {}], p = {}").format(
              f"{gt.statistic:.1f}", f"{gt.lower:.1f}", f"{gt.upper:.1f}", f"{gt.p_value:.3g}")
          if gt.dof > 0 else t("no redundancy")],
-        [t("outliers"), _e(int(res.rejected.sum())), _e(a.outlier_method)],
+        [t("outliers"), _e(int(res.rejected.sum())), _e(t(a.outlier_method))],
         [t("condition number (reduced system)"), _n(a.condition_number, ".3g"), ""],
     ]  # fmt: skip
     return _table(
