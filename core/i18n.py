@@ -25,12 +25,16 @@ from pathlib import Path
 
 __all__ = [
     "I18N_DIR",
+    "Message",
     "available_languages",
     "catalogue",
     "current_language",
     "html_lang",
+    "joined",
     "language_from_env",
+    "mark",
     "normalise_language",
+    "render",
     "set_language",
     "translator",
 ]
@@ -137,3 +141,75 @@ def translator(context: str, lang: str | None = None) -> Callable[[str], str]:
         return table.get((context, text), text)
 
     return tr
+
+
+def _message(template: str, values: dict) -> Message:
+    return Message(template, **values)
+
+
+class Message(str):
+    """An English sentence made from a template marked for translation and its values.
+
+    It *is* the English text (a ``str``: JSON, CSV and logs see plain English), and it keeps
+    ``template`` and ``values`` so that a report shows it in the user's language with
+    :func:`render`: the template is translated, then formatted with the values (a value that
+    is itself a :class:`Message` is rendered too). Modules that build such sentences mark
+    them ``_t("RMSE {value:.3f} m", value=x)`` so that ``make i18n`` collects the template.
+
+    >>> m = Message("{n} points beyond {limit:.2f} m", n=3, limit=0.4)
+    >>> m, m.template, m.values["n"]
+    ('3 points beyond 0.40 m', '{n} points beyond {limit:.2f} m', 3)
+    """
+
+    template: str
+    values: dict
+
+    def __new__(cls, template: str, /, **values: object) -> Message:
+        self = super().__new__(cls, template.format(**values) if values else template)
+        self.template = template
+        self.values = values
+        return self
+
+    def __reduce__(self):  # pickling (worker processes) and deepcopy keep the template
+        return (_message, (self.template, dict(self.values)))
+
+
+def mark(template: str, /, **values: object) -> Message:
+    """A sentence marked for translation: modules import it as ``_t`` (``make i18n`` collects
+    ``_t("...")`` in modules that set ``TR_CONTEXT``) and build ``_t("{n} points", n=3)``."""
+    return Message(template, **values)
+
+
+def joined(items, sep: str = ", ") -> Message:
+    """Sentences joined by ``sep``, each rendered in the report's language (a list of
+    :class:`Message` inside another one's value).
+
+    >>> joined([Message("{a} of group {g}", a="d_phi", g="1"), "x"])
+    'd_phi of group 1, x'
+    """
+    items = list(items)
+    template = sep.join("{" + f"v{k}" + "}" for k in range(len(items)))
+    return Message(template, **{f"v{k}": item for k, item in enumerate(items)})
+
+
+def render(text: object, context: str, lang: str | None = None) -> str:
+    """``text`` in ``lang`` (default: :func:`current_language`): a :class:`Message` through its
+    translated template and its (rendered) values, any other text looked up as it is.
+
+    A translation whose placeholders do not fit the values falls back to the English text.
+
+    >>> render(Message("{n} of {total} points", n=2, total=5), "Report", "en")
+    '2 of 5 points'
+    """
+    tr = translator(context, lang)
+    if not isinstance(text, Message):
+        return tr(str(text))
+    if not text.values:
+        return tr(text.template)
+    values = {
+        k: render(v, context, lang) if isinstance(v, Message) else v for k, v in text.values.items()
+    }
+    try:
+        return tr(text.template).format(**values)
+    except (KeyError, IndexError, ValueError):
+        return text.template.format(**values)

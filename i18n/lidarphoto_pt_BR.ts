@@ -324,6 +324,14 @@
             <translation>significativo</translation>
         </message>
         <message>
+            <source>dropped</source>
+            <translation>descartado</translation>
+        </message>
+        <message>
+            <source>fixed</source>
+            <translation>fixo</translation>
+        </message>
+        <message>
             <source>image</source>
             <translation>imagem</translation>
         </message>
@@ -435,6 +443,13 @@
         </message>
     </context>
     <context>
+        <name>ImageLoader</name>
+        <message>
+            <source>{path}: read failed ({error})</source>
+            <translation>{path}: falha na leitura ({error})</translation>
+        </message>
+    </context>
+    <context>
         <name>ImagePickingDock</name>
         <message>
             <source>&lt;b&gt;Picking&lt;/b&gt;: choose the type, then left-click in the image. &lt;i&gt;tie&lt;/i&gt; and &lt;i&gt;paper&lt;/i&gt; points take the roof plane under the cursor (a menu asks when outlines overlap); &lt;i&gt;line&lt;/i&gt;: two clicks, the image line's ends, on the LiDAR line nearest to the first (drawn solid while measuring; Esc cancels, Ctrl+Z removes both ends; the Resection tab can refine the ends onto the image's edge); &lt;i&gt;lcp&lt;/i&gt;/&lt;i&gt;check&lt;/i&gt; take the nearest control point. &lt;b&gt;Resect&lt;/b&gt; (Resection tab) orients the image shown from its lines and control points; &lt;b&gt;Bundle&lt;/b&gt; (Bundle tab) adjusts the open images from their tie, control (lcp) and check points. After a tie point the other images show its prediction (yellow x): Enter accepts it, a click puts it where you see it, Esc drops it.&lt;br&gt;&lt;b&gt;Monoplot&lt;/b&gt; (needs a DSM in the Project tab): while the button is on, a click makes a 3D point on the DSM, or a vertex of a 3D line (Enter, a double click or &lt;i&gt;Finish line&lt;/i&gt; ends it); they appear on the map at once, and the save button writes them to a GeoPackage. Off: clicks measure observations again.&lt;br&gt;&lt;b&gt;Keys&lt;/b&gt;: PgDown/PgUp next/previous image · Enter accept prediction · Esc cancel prediction · Delete delete selected point · Ctrl+Z undo · Ctrl+Shift+Z / Ctrl+Y redo · T/P/L/C/K picking type · </source>
@@ -471,6 +486,61 @@
         <message>
             <source>Image picking</source>
             <translation>Medição na imagem</translation>
+        </message>
+        <message>
+            <source>{image}  col {col:.2f}  row {row:.2f}  zoom {zoom:.3g}</source>
+            <translation>{image}  col {col:.2f}  lin {row:.2f}  zoom {zoom:.3g}</translation>
+        </message>
+    </context>
+    <context>
+        <name>ImageSource</name>
+        <message>
+            <source>{path}: its folder is read-only, no overview pyramid can be written next to it</source>
+            <translation>{path}: a pasta é somente leitura, nenhuma pirâmide de visões gerais pode ser gravada ao lado da imagem</translation>
+        </message>
+        <message>
+            <source>GDAL is not available ({error})</source>
+            <translation>o GDAL não está disponível ({error})</translation>
+        </message>
+        <message>
+            <source>{path}: overview build cancelled</source>
+            <translation>{path}: construção das visões gerais cancelada</translation>
+        </message>
+        <message>
+            <source>{path}: the image file does not exist</source>
+            <translation>{path}: o arquivo de imagem não existe</translation>
+        </message>
+        <message>
+            <source>{path}: GDAL cannot open it (no raster band)</source>
+            <translation>{path}: o GDAL não consegue abri-lo (nenhuma banda raster)</translation>
+        </message>
+        <message>
+            <source>{path}: neither GDAL nor OpenCV can read this image{why}</source>
+            <translation>{path}: nem o GDAL nem o OpenCV conseguem ler esta imagem{why}</translation>
+        </message>
+        <message>
+            <source>{path}: the image is closed</source>
+            <translation>{path}: a imagem está fechada</translation>
+        </message>
+        <message>
+            <source>{path}: cannot build the overview pyramid ({error})</source>
+            <translation>{path}: não foi possível construir a pirâmide de visões gerais ({error})</translation>
+        </message>
+        <message>
+            <source>{path}: cannot write the overview pyramid ({error})</source>
+            <translation>{path}: não foi possível gravar a pirâmide de visões gerais ({error})</translation>
+        </message>
+        <message>
+            <source>{path}: GDAL cannot open it ({error})</source>
+            <translation>{path}: o GDAL não consegue abri-lo ({error})</translation>
+        </message>
+        <message>
+            <source>{path}: read failed</source>
+            <translation>{path}: falha na leitura</translation>
+        </message>
+        <message>
+            <source>{path}: read failed ({error})</source>
+            <translation>{path}: falha na leitura ({error})</translation>
         </message>
     </context>
     <context>
@@ -700,6 +770,18 @@
             <source>Overview pyramid of {}</source>
             <translation>Pirâmide de visões gerais de {}</translation>
         </message>
+        <message>
+            <source>{path}: overview build cancelled</source>
+            <translation>{path}: construção das visões gerais cancelada</translation>
+        </message>
+        <message>
+            <source>{path}: overview build failed ({error})</source>
+            <translation>{path}: falha na construção das visões gerais ({error})</translation>
+        </message>
+        <message>
+            <source>{path}: overview pyramid built ({name})</source>
+            <translation>{path}: pirâmide de visões gerais construída ({name})</translation>
+        </message>
     </context>
     <context>
         <name>PickingController</name>
@@ -897,8 +979,252 @@
     <context>
         <name>Report</name>
         <message>
+            <source>the global test failed with sigma0 = {sigma0:.3g} &gt; MAX_SIGMA0 {maximum:g}: the observations are {sigma0:.3g} times less precise than their sigmas say (wrong sigma_px or INS grade, or undetected blunders)</source>
+            <translation>o teste global falhou com sigma0 = {sigma0:.3g} &gt; MAX_SIGMA0 {maximum:g}: as observações são {sigma0:.3g} vezes menos precisas do que dizem seus desvios-padrão (sigma_px ou classe do INS errados, ou erros grosseiros não detectados)</translation>
+        </message>
+        <message>
+            <source>not a finite number: {items}</source>
+            <translation>não é um número finito: {items}</translation>
+        </message>
+        <message>
+            <source>{items} beyond MAX_BORESIGHT {maximum:g} deg: implausible for a misalignment (wrong MOUNT, image ids or observations?)</source>
+            <translation>{items} além de MAX_BORESIGHT {maximum:g} graus: implausível para um desalinhamento (MOUNT, identificadores das imagens ou observações errados?)</translation>
+        </message>
+        <message>
+            <source>the adjustment did not converge after {n} iterations ({why})</source>
+            <translation>o ajustamento não convergiu após {n} iterações ({why})</translation>
+        </message>
+        <message>
+            <source>the adjustment did not converge after {n} iterations</source>
+            <translation>o ajustamento não convergiu após {n} iterações</translation>
+        </message>
+        <message>
+            <source>{angle} of group {group}</source>
+            <translation>{angle} do grupo {group}</translation>
+        </message>
+        <message>
+            <source>{angle} = {value:.4f} deg in group {group}</source>
+            <translation>{angle} = {value:.4f} graus no grupo {group}</translation>
+        </message>
+        <message>
+            <source>Baarda data snooping (alpha = {alpha:g} per observation, critical |w| = {critical:.2f}, iterative rejection of whole groups)</source>
+            <translation>data snooping de Baarda (alfa = {alpha:g} por observação, |w| crítico = {critical:.2f}, rejeição iterativa de grupos inteiros)</translation>
+        </message>
+        <message>
+            <source>{method} reweighting (k = {k:g} robust scale units, {rounds} rounds, robust scale {scale:.3g}), groups with a standardised misfit above {critical:.2f} set aside</source>
+            <translation>reponderação {method} (k = {k:g} unidades da escala robusta, {rounds} rodadas, escala robusta {scale:.3g}), grupos com desajuste padronizado acima de {critical:.2f} afastados</translation>
+        </message>
+        <message>
+            <source>{robust}, then {snooping}</source>
+            <translation>{robust}, depois {snooping}</translation>
+        </message>
+        <message>
+            <source>no convergence within {n} iterations</source>
+            <translation>sem convergência em {n} iterações</translation>
+        </message>
+        <message>
+            <source>no redundancy: sigma0 and the global test are undefined</source>
+            <translation>sem redundância: sigma0 e o teste global ficam indefinidos</translation>
+        </message>
+        <message>
+            <source>{robust}; no data snooping</source>
+            <translation>{robust}; sem data snooping</translation>
+        </message>
+        <message>
+            <source>none (data snooping disabled)</source>
+            <translation>nenhuma (data snooping desativado)</translation>
+        </message>
+        <message>
+            <source>data snooping skipped: the adjustment did not converge</source>
+            <translation>data snooping não executado: o ajustamento não convergiu</translation>
+        </message>
+        <message>
+            <source>{n} observation rows have a redundancy number of about zero and cannot be tested by data snooping</source>
+            <translation>{n} linhas de observação têm número de redundância próximo de zero e não podem ser testadas pelo data snooping</translation>
+        </message>
+        <message>
+            <source>the cost could not be reduced further at iteration {iteration} (step {step:.3g} sigma): stopped without convergence</source>
+            <translation>o custo não pôde ser reduzido mais na iteração {iteration} (passo de {step:.3g} sigma): interrompido sem convergência</translation>
+        </message>
+        <message>
+            <source>robust estimation: setting aside the {n} groups it flagged would leave the adjustment not observable; they are kept</source>
+            <translation>estimação robusta: afastar os {n} grupos que ela marcou deixaria o ajustamento não observável; eles foram mantidos</translation>
+        </message>
+        <message>
+            <source>data snooping stopped at max_rejections = {n} with |w| = {w:.2f} still above {critical:.2f}</source>
+            <translation>data snooping interrompido em max_rejections = {n} com |w| = {w:.2f} ainda acima de {critical:.2f}</translation>
+        </message>
+        <message>
+            <source>data snooping stopped: without {block} / {label} the adjustment did not converge; it is kept</source>
+            <translation>data snooping interrompido: sem {block} / {label} o ajustamento não convergiu; a observação foi mantida</translation>
+        </message>
+        <message>
+            <source>data snooping stopped: rejecting {block} / {label} (|w| = {w:.2f}) would make the adjustment not observable; it is kept</source>
+            <translation>data snooping interrompido: rejeitar {block} / {label} (|w| = {w:.2f}) tornaria o ajustamento não observável; a observação foi mantida</translation>
+        </message>
+        <message>
+            <source>{n} ground point(s) are not measured in any image and were not used: {ids}</source>
+            <translation>{n} ponto(s) de terreno não foram medidos em nenhuma imagem e não foram usados: {ids}</translation>
+        </message>
+        <message>
+            <source>insignificant (t = {t:.2f} &lt;= {critical:.2f}, alpha {alpha:g})</source>
+            <translation>não significativo (t = {t:.2f} &lt;= {critical:.2f}, alfa {alpha:g})</translation>
+        </message>
+        <message>
+            <source>|correlation| {r:.3f} &gt; {limit:g} with {other}</source>
+            <translation>|correlação| {r:.3f} &gt; {limit:g} com {other}</translation>
+        </message>
+        <message>
+            <source>view {view!r} left out: fewer than {minimum} target points</source>
+            <translation>vista {view!r} descartada: menos de {minimum} pontos do alvo</translation>
+        </message>
+        <message>
+            <source>{parameter} is not significant (t = {t:.2f} &lt; {critical:.2f}): consider holding it at zero</source>
+            <translation>{parameter} não é significativo (t = {t:.2f} &lt; {critical:.2f}): considere fixá-lo em zero</translation>
+        </message>
+        <message>
+            <source>resection sigma0 {sigma0:.3g} &gt; {maximum:g}</source>
+            <translation>sigma0 da resseção {sigma0:.3g} &gt; {maximum:g}</translation>
+        </message>
+        <message>
+            <source>chip from the plate photo: the plate hides the ground at the point</source>
+            <translation>recorte (chip) feito da foto com a placa: a placa encobre o terreno no ponto</translation>
+        </message>
+        <message>
+            <source>the photo sees {valid:.1f} % of the chip (&lt; {minimum:g} %)</source>
+            <translation>a foto cobre {valid:.1f} % do recorte (&lt; {minimum:g} %)</translation>
+        </message>
+        <message>
+            <source>plate resection failed: {error}</source>
+            <translation>a resseção da placa falhou: {error}</translation>
+        </message>
+        <message>
+            <source>no plate-free photo (allow the chip from the plate photo to make it anyway)</source>
+            <translation>não há foto sem a placa (permita o recorte a partir da foto com a placa para gerá-lo mesmo assim)</translation>
+        </message>
+        <message>
+            <source>too few SIFT matches: {inliers} RANSAC inliers of {matches} matches (&lt; {minimum})</source>
+            <translation>poucas correspondências SIFT: {inliers} aceitas pelo RANSAC de {matches} correspondências (&lt; {minimum})</translation>
+        </message>
+        <message>
+            <source>{n} SIFT matches rejected by data snooping</source>
+            <translation>{n} correspondências SIFT rejeitadas pelo data snooping</translation>
+        </message>
+        <message>
+            <source>plate-free photo resection failed: {error}</source>
+            <translation>a resseção da foto sem a placa falhou: {error}</translation>
+        </message>
+        <message>
+            <source>low correlation (NCC {ncc:.2f} &lt; {minimum:.2f})</source>
+            <translation>correlação baixa (NCC {ncc:.2f} &lt; {minimum:.2f})</translation>
+        </message>
+        <message>
+            <source>NCC peak on the search border</source>
+            <translation>pico da NCC na borda da área de busca</translation>
+        </message>
+        <message>
+            <source>LSM: {reason}</source>
+            <translation>LSM: {reason}</translation>
+        </message>
+        <message>
+            <source>transfer from {image}</source>
+            <translation>transferência de {image}</translation>
+        </message>
+        <message>
+            <source>{reason}; transfer from {image}: {transfer_reason}</source>
+            <translation>{reason}; transferência de {image}: {transfer_reason}</translation>
+        </message>
+        <message>
+            <source>search window outside the image</source>
+            <translation>janela de busca fora da imagem</translation>
+        </message>
+        <message>
+            <source>outside the search ellipse</source>
+            <translation>fora da elipse de busca</translation>
+        </message>
+        <message>
+            <source>chip has no-data pixels</source>
+            <translation>o recorte (chip) tem pixels sem dados</translation>
+        </message>
+        <message>
+            <source>chip refused: {why}</source>
+            <translation>recorte (chip) recusado: {why}</translation>
+        </message>
+        <message>
+            <source>outside every image</source>
+            <translation>fora de todas as imagens</translation>
+        </message>
+        <message>
+            <source>template partly outside the image</source>
+            <translation>janela de referência parcialmente fora da imagem</translation>
+        </message>
+        <message>
+            <source>plate not found: no quadrilateral in the photo</source>
+            <translation>placa não encontrada: nenhum quadrilátero na foto</translation>
+        </message>
+        <message>
+            <source>only one square: {n} quadrilateral(s), none with a nested square of the plate's inner/outer ratio</source>
+            <translation>apenas um quadrado: {n} quadrilátero(s), nenhum com um quadrado interno na razão interno/externo da placa</translation>
+        </message>
+        <message>
+            <source>ambiguous: {n} plate-like pairs of squares</source>
+            <translation>ambíguo: {n} pares de quadrados semelhantes à placa</translation>
+        </message>
+        <message>
+            <source>edge fit failed: a corner falls outside the camera's field</source>
+            <translation>o ajuste da borda falhou: um canto fica fora do campo de visão da câmera</translation>
+        </message>
+        <message>
+            <source>edge fit failed: side {side} has {n} edge points</source>
+            <translation>o ajuste da borda falhou: o lado {side} tem {n} pontos de borda</translation>
+        </message>
+        <message>
+            <source>ok</source>
+            <translation>ok</translation>
+        </message>
+        <message>
+            <source>no texture</source>
+            <translation>sem textura</translation>
+        </message>
+        <message>
+            <source>left the search window</source>
+            <translation>saiu da janela de busca</translation>
+        </message>
+        <message>
+            <source>not converged</source>
+            <translation>não convergiu</translation>
+        </message>
+        <message>
+            <source>moved too far</source>
+            <translation>deslocou-se demais</translation>
+        </message>
+        <message>
+            <source>low correlation</source>
+            <translation>correlação baixa</translation>
+        </message>
+        <message>
+            <source>sigma too large</source>
+            <translation>sigma grande demais</translation>
+        </message>
+        <message>
+            <source>no redundancy: the orientation cannot be checked</source>
+            <translation>sem redundância: a orientação não pode ser verificada</translation>
+        </message>
+        <message>
+            <source>edge only</source>
+            <translation>apenas uma borda</translation>
+        </message>
+        <message>
+            <source>weak texture</source>
+            <translation>textura fraca</translation>
+        </message>
+        <message>
             <source>Positional accuracy report</source>
             <translation>Relatório de acurácia posicional</translation>
+        </message>
+        <message>
+            <source>without the {n} flagged point(s)</source>
+            <translation>sem o(s) {n} ponto(s) marcado(s)</translation>
         </message>
         <message>
             <source>all points</source>
@@ -1401,6 +1727,18 @@
             <translation>significativo</translation>
         </message>
         <message>
+            <source>estimated</source>
+            <translation>estimado</translation>
+        </message>
+        <message>
+            <source>dropped</source>
+            <translation>descartado</translation>
+        </message>
+        <message>
+            <source>fixed</source>
+            <translation>fixo</translation>
+        </message>
+        <message>
             <source>camera</source>
             <translation>câmera</translation>
         </message>
@@ -1625,16 +1963,20 @@
             <translation>Vistas</translation>
         </message>
         <message>
-            <source>fixed</source>
-            <translation>fixo</translation>
-        </message>
-        <message>
             <source>Camera calibration: {} ({})</source>
             <translation>Calibração de câmera: {} ({})</translation>
         </message>
         <message>
             <source>f = {} px, principal point ({}, {}) px; RMS {} px over {} points; sigma0 {} (a-priori {} px), redundancy {}, global test {}.</source>
             <translation>f = {} px, ponto principal ({}, {}) px; RMS {} px em {} pontos; sigma0 {} (a priori {} px), redundância {}, teste global {}.</translation>
+        </message>
+        <message>
+            <source>outside</source>
+            <translation>fora</translation>
+        </message>
+        <message>
+            <source>chip</source>
+            <translation>recorte (chip)</translation>
         </message>
         <message>
             <source>Control point location</source>
@@ -1789,48 +2131,176 @@
             <translation>Início: {}; modelo de linha: {}; {} iterações; {} pontos de controle, {} linhas, {} pontos de verificação, {} linhas sem controle ignoradas.</translation>
         </message>
         <message>
+            <source>none</source>
+            <translation>nenhuma</translation>
+        </message>
+        <message>
+            <source>; only {n} of {minimum} check points</source>
+            <translation>; apenas {n} de {minimum} pontos de verificação</translation>
+        </message>
+        <message>
             <source>Accuracy is stated as RMSE; Edition 2 no longer uses 95 % confidence figures.</source>
             <translation>A acurácia é expressa como RMSE; a Edição 2 não usa mais valores com 95 % de confiança.</translation>
+        </message>
+        <message>
+            <source>Check-point survey error included: RMSE_HORIZONTAL_SURVEY (ASPRS RMSE_H2) = {horizontal:.2f} cm, RMSE_U_SURVEY (ASPRS RMSE_V2) = {vertical:.2f} cm (0 when not given: then the totals are RMSE_HORIZONTAL and RMSE_U of the check points alone).</source>
+            <translation>Erro do levantamento dos pontos de verificação incluído: RMSE_HORIZONTAL_SURVEY (ASPRS RMSE_H2) = {horizontal:.2f} cm, RMSE_U_SURVEY (ASPRS RMSE_V2) = {vertical:.2f} cm (0 quando não informado: então os totais são o RMSE_HORIZONTAL e o RMSE_U apenas dos pontos de verificação).</translation>
+        </message>
+        <message>
+            <source> (only {n} of {minimum} check points)</source>
+            <translation> (apenas {n} de {minimum} pontos de verificação)</translation>
+        </message>
+        <message>
+            <source>Scale 1:{scale:,.0f}; equidistance {equidistance}. Best class met: planimetric {planimetric}, altimetric {altimetric}.</source>
+            <translation>Escala 1:{scale:,.0f}; equidistância {equidistance}. Melhor classe atendida: planimétrica {planimetric}, altimétrica {altimetric}.</translation>
         </message>
         <message>
             <source>PEC-PCD limits: planimetric A-D 0.28/0.5/0.8/1.0 mm (EP 0.17/0.3/0.5/0.6 mm) at the map scale; altimetric A-D 0.27/0.50/0.60/0.75 of the equidistance (EP 1/6, 1/3, 2/5, 1/2).</source>
             <translation>Limites do PEC-PCD: planimétrico A-D 0,28/0,5/0,8/1,0 mm (EP 0,17/0,3/0,5/0,6 mm) na escala da carta; altimétrico A-D 0,27/0,50/0,60/0,75 da equidistância (EP 1/6, 1/3, 2/5, 1/2).</translation>
         </message>
         <message>
+            <source>given</source>
+            <translation>informado</translation>
+        </message>
+        <message>
+            <source>Eq. 18 with H {height:g} m, B {base:g} m, f {focal:g} mm, sigma_pix {pixel:g} um</source>
+            <translation>Eq. 18 com H {height:g} m, B {base:g} m, f {focal:g} mm, sigma_pix {pixel:g} µm</translation>
+        </message>
+        <message>
             <source>Check-point count</source>
             <translation>Número de pontos de verificação</translation>
+        </message>
+        <message>
+            <source>{n} check points; Edition 2 requires at least {minimum} (and up to {maximum} for large projects)</source>
+            <translation>{n} pontos de verificação; a Edição 2 exige pelo menos {minimum} (e até {maximum} para projetos grandes)</translation>
+        </message>
+        <message>
+            <source>Horizontal</source>
+            <translation>horizontal</translation>
+        </message>
+        <message>
+            <source>Vertical (NVA)</source>
+            <translation>vertical (NVA)</translation>
+        </message>
+        <message>
+            <source>{symbol} = {value:.2f} cm {relation} {target:g} cm{few}</source>
+            <translation>{symbol} = {value:.2f} cm {relation} {target:g} cm{few}</translation>
+        </message>
+        <message>
+            <source>{axis} class {target:g}-cm</source>
+            <translation>Classe {axis} de {target:g} cm</translation>
+        </message>
+        <message>
+            <source>{symbol} = {value:.2f} cm: meets any class of at least {value:.2f} cm{example}{few}</source>
+            <translation>{symbol} = {value:.2f} cm: atende a qualquer classe de pelo menos {value:.2f} cm{example}{few}</translation>
         </message>
         <message>
             <source>Three-dimensional accuracy</source>
             <translation>Acurácia tridimensional</translation>
         </message>
         <message>
+            <source>RMSE_3D_TOTAL = sqrt(RMSE_HORIZONTAL_TOTAL^2 + RMSE_U_TOTAL^2) = {value:.2f} cm (reported, no class)</source>
+            <translation>RMSE_3D_TOTAL = sqrt(RMSE_HORIZONTAL_TOTAL^2 + RMSE_U_TOTAL^2) = {value:.2f} cm (informado, sem classe)</translation>
+        </message>
+        <message>
+            <source>horizontal</source>
+            <translation>horizontal</translation>
+        </message>
+        <message>
+            <source>vertical</source>
+            <translation>vertical</translation>
+        </message>
+        <message>
             <source>ASPRS Positional Accuracy Standards, Edition 2 (2023)</source>
             <translation>Padrões de Acurácia Posicional da ASPRS, Edição 2 (2023)</translation>
+        </message>
+        <message>
+            <source>{n} check points; NSSDA requires at least {minimum}</source>
+            <translation>{n} pontos de verificação; o NSSDA exige pelo menos {minimum}</translation>
         </message>
         <message>
             <source>Horizontal approximation condition</source>
             <translation>Condição da aproximação horizontal</translation>
         </message>
         <message>
+            <source>Assumption: normal distribution (Shapiro-Wilk)</source>
+            <translation>Hipótese: distribuição normal (Shapiro-Wilk)</translation>
+        </message>
+        <message>
+            <source>Assumption: no systematic error (Student t)</source>
+            <translation>Hipótese: ausência de erro sistemático (t de Student)</translation>
+        </message>
+        <message>
+            <source>rejected for {components}</source>
+            <translation>rejeitada para {components}</translation>
+        </message>
+        <message>
             <source>Horizontal accuracy (95 %)</source>
             <translation>Acurácia horizontal (95 %)</translation>
+        </message>
+        <message>
+            <source>Tested {value:.3f} m horizontal accuracy at 95 % confidence level{few}</source>
+            <translation>Acurácia horizontal testada de {value:.3f} m ao nível de confiança de 95 %{few}</translation>
         </message>
         <message>
             <source>Vertical accuracy (95 %)</source>
             <translation>Acurácia vertical (95 %)</translation>
         </message>
         <message>
+            <source>Tested {value:.3f} m vertical accuracy at 95 % confidence level{few}</source>
+            <translation>Acurácia vertical testada de {value:.3f} m ao nível de confiança de 95 %{few}</translation>
+        </message>
+        <message>
+            <source>{n} check points; fewer than {minimum} makes the 90 % rule weak (common practice, not in the Decreto)</source>
+            <translation>{n} pontos de verificação; menos de {minimum} torna fraca a regra dos 90 % (prática usual, não consta do Decreto)</translation>
+        </message>
+        <message>
+            <source>{share:.1f} % of {n} points within PEC {pec:.3f} m ({share_relation} 90 %); RMS {rms:.3f} m {rms_relation} EP {ep:.3f} m</source>
+            <translation>{share:.1f} % de {n} pontos dentro do PEC de {pec:.3f} m ({share_relation} 90 %); RMS {rms:.3f} m {rms_relation} EP {ep:.3f} m</translation>
+        </message>
+        <message>
+            <source>PEC-PCD (Decreto 89.817 / ET-CQDG), 1:{scale:,.0f}</source>
+            <translation>PEC-PCD (Decreto 89.817 / ET-CQDG), 1:{scale:,.0f}</translation>
+        </message>
+        <message>
             <source>Planimetric RMSE</source>
             <translation>RMSE planimétrico</translation>
+        </message>
+        <message>
+            <source>RMSE {rmse:.3f} m {relation} {limit:.3f} m; {beyond} of {n} points beyond it</source>
+            <translation>RMSE {rmse:.3f} m {relation} {limit:.3f} m; {beyond} de {n} pontos além do limiar</translation>
         </message>
         <message>
             <source>Vertical RMSE</source>
             <translation>RMSE vertical</translation>
         </message>
         <message>
+            <source>RMSE {rmse:.3f} m {relation} dz {limit:.3f} m ({how}); {beyond} of {n} points beyond it</source>
+            <translation>RMSE {rmse:.3f} m {relation} dz {limit:.3f} m ({how}); {beyond} de {n} pontos além do limiar</translation>
+        </message>
+        <message>
             <source>Project threshold (Pedrosa &amp; dos Santos 2020, section 3)</source>
             <translation>Limiar do projeto (Pedrosa &amp; dos Santos 2020, seção 3)</translation>
+        </message>
+        <message>
+            <source>The {axis} check-point survey ({survey:.2f} cm) is not at least twice as accurate as the {target:g}-cm class (uncertain reading of Ed. 2).</source>
+            <translation>O levantamento {axis} dos pontos de verificação ({survey:.2f} cm) não é pelo menos duas vezes mais acurado que a classe de {target:g} cm (leitura incerta da Ed. 2).</translation>
+        </message>
+        <message>
+            <source>The {axis} mean error ({mean:.2f} cm) exceeds 25 % of the {target:g}-cm class: investigate a systematic error (Ed. 1 section 7.4; kept as guidance in Ed. 2, uncertain).</source>
+            <translation>O erro médio {axis} ({mean:.2f} cm) excede 25 % da classe de {target:g} cm: investigue um erro sistemático (Ed. 1, seção 7.4; mantido como orientação na Ed. 2, incerto).</translation>
+        </message>
+        <message>
+            <source>RMSE_min/RMSE_max = {ratio:.3f} &gt;= 0.6: Accuracy_r = 2.4477 x 0.5 (RMSE_x + RMSE_y)</source>
+            <translation>RMSE_min/RMSE_max = {ratio:.3f} &gt;= 0,6: Accuracy_r = 2,4477 x 0,5 (RMSE_x + RMSE_y)</translation>
+        </message>
+        <message>
+            <source>RMSE_min/RMSE_max = {ratio:.3f} &lt; 0.6: the NSSDA approximation does not hold; exact 95 % radius used</source>
+            <translation>RMSE_min/RMSE_max = {ratio:.3f} &lt; 0,6: a aproximação do NSSDA não vale; usado o raio exato de 95 %</translation>
+        </message>
+        <message>
+            <source>not testable for {components}</source>
+            <translation>não testável para {components}</translation>
         </message>
         <message>
             <source>accepted for E, N, H</source>
@@ -1841,8 +2311,40 @@
             <translation>Accuracy_r = 1,7308 RMSE_r vale para RMSE_x = RMSE_y; a fórmula do Caso 2, 2,4477 x 0,5 (RMSE_x + RMSE_y), é usada para 0,6 &lt;= razão &lt;= 1; o raio exato de 95 % da normal bivariada também é apresentado.</translation>
         </message>
         <message>
+            <source>Class {cls} planimetric</source>
+            <translation>Classe {cls} planimétrica</translation>
+        </message>
+        <message>
+            <source>Class {cls} altimetric</source>
+            <translation>Classe {cls} altimétrica</translation>
+        </message>
+        <message>
             <source>The paper compares the RMSE of the check-point discrepancies with 0.40 m (twice the LiDAR standard deviation) and with dz of Eq. 18.</source>
             <translation>O artigo compara o RMSE das discrepâncias nos pontos de verificação com 0,40 m (o dobro do desvio-padrão do LiDAR) e com o dz da Eq. 18.</translation>
+        </message>
+        <message>
+            <source>{axis} class</source>
+            <translation>Classe {axis}</translation>
+        </message>
+        <message>
+            <source>{value:g} m</source>
+            <translation>{value:g} m</translation>
+        </message>
+        <message>
+            <source>not given</source>
+            <translation>não informada</translation>
+        </message>
+        <message>
+            <source>Declared class {cls} (planimetric)</source>
+            <translation>Classe declarada {cls} (planimétrica)</translation>
+        </message>
+        <message>
+            <source>Declared class {cls} (altimetric)</source>
+            <translation>Classe declarada {cls} (altimétrica)</translation>
+        </message>
+        <message>
+            <source>; tightest example class met: {best:g}-cm</source>
+            <translation>; classe de exemplo mais restrita atendida: {best:g} cm</translation>
         </message>
         <message>
             <source>no equidistance given for this scale</source>
@@ -2007,10 +2509,6 @@
         <message>
             <source>NOT</source>
             <translation>NÃO</translation>
-        </message>
-        <message>
-            <source>none</source>
-            <translation>nenhuma</translation>
         </message>
         <message>
             <source>mean planimetric (m)</source>

@@ -22,6 +22,7 @@ from qgis.PyQt import sip
 from qgis.PyQt.QtCore import QCoreApplication, QObject, Qt, pyqtSignal
 from qgis.PyQt.QtWidgets import QCheckBox, QComboBox, QFormLayout, QLabel, QPushButton, QWidget
 
+from ..core.i18n import render
 from ..core.io.ground_points import write_ground_points_csv
 from ..core.io.observations import write_observations_csv
 from ..core.io.orientation import write_eo_csv
@@ -151,7 +152,12 @@ class BundlePanel(QWidget):
             if p.status == "estimated":
                 flag = self.tr("significant") if p.significant else ""
             else:
-                flag = escape(p.status + (f": {p.reason}" if p.reason else ""))
+                flag = escape(
+                    {"dropped": self.tr("dropped"), "fixed": self.tr("fixed")}.get(
+                        p.status, p.status
+                    )
+                    + (": " + render(p.reason, "Report") if p.reason else "")
+                )
             ap.append(
                 f"<tr><td>{p.name}</td><td>{p.value:.6g}</td><td>"
                 f"{p.std:.3g}</td><td>{flag}</td></tr>"

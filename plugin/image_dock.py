@@ -160,7 +160,7 @@ class ImagePickingDock(QgsDockWidget):
             )
         )
         v.view.overviewFinished.connect(
-            lambda ok, msg: self.message(msg, warning=not ok and "cancelled" not in msg)
+            lambda ok, msg: self.message(msg, warning=not ok and not v.view.build_cancelled)
         )
         v.view.loadFailed.connect(lambda msg: self.message(msg, warning=True))
         self.store.saveFailed.connect(lambda msg: self.message(msg, warning=True))
@@ -299,7 +299,9 @@ class ImagePickingDock(QgsDockWidget):
     def _cursor(self, col: float, row: float) -> None:
         if self.source is not None:
             self.viewer.status.setText(
-                f"{self.current_image}  col {col:.2f}  row {row:.2f}  zoom {self.view.zoom:.3g}"
+                self.tr("{image}  col {col:.2f}  row {row:.2f}  zoom {zoom:.3g}").format(
+                    image=self.current_image, col=col, row=row, zoom=self.view.zoom
+                )
             )
 
     def footprint(self):

@@ -29,7 +29,7 @@ from qgis.PyQt.QtCore import QCoreApplication, QObject, pyqtSignal
 from qgis.PyQt.QtGui import QImage
 
 from ..core.errors import Cancelled
-from .image_source import ImageSource, ImageSourceError, build_overview_file
+from .image_source import ImageSource, ImageSourceError, build_overview_file, error_text
 
 __all__ = ["OverviewTask", "TileLoader", "TileRequest", "to_qimage"]
 
@@ -225,9 +225,11 @@ class TileLoader(QObject):
                 except Exception as exc:  # reported, the worker goes on
                     if not self._stale(sgen, tgen):
                         msg = (
-                            str(exc)
+                            error_text(exc)
                             if isinstance(exc, ImageSourceError)
-                            else (f"{source.path}: read failed ({exc})")
+                            else QCoreApplication.translate(
+                                "ImageLoader", "{path}: read failed ({error})"
+                            ).format(path=source.path, error=exc)
                         )
                         self._emit(self.failed, sgen, msg)
         finally:
@@ -273,8 +275,14 @@ class OverviewTask(QgsTask):
         super().__init__(name.format(source.path.name), QgsTask.Flag.CanCancel)
         self.path = source.path
         self.message = ""
+        self.cancelled = False
         self.ovr_path = None
         self._last = -1.0
+
+    def _cancelled_text(self) -> str:
+        return QCoreApplication.translate(
+            "OverviewTask", "{path}: overview build cancelled"
+        ).format(path=self.path)
 
     def _progress(self, fraction: float) -> None:
         pct = 100.0 * fraction
@@ -288,18 +296,24 @@ class OverviewTask(QgsTask):
                 self.path, progress=self._progress, should_stop=self.isCanceled
             )
         except Cancelled:
-            self.message = f"{self.path}: overview build cancelled"
+            self.cancelled = True
+            self.message = self._cancelled_text()
             return False
         except ImageSourceError as exc:
-            self.message = str(exc)
+            self.message = error_text(exc)
             return False
         except Exception as exc:  # a task must never let an exception escape into Qt
-            self.message = f"{self.path}: overview build failed ({exc})"
+            self.message = QCoreApplication.translate(
+                "OverviewTask", "{path}: overview build failed ({error})"
+            ).format(path=self.path, error=exc)
             return False
-        self.message = f"{self.path}: overview pyramid built ({self.ovr_path.name})"
+        self.message = QCoreApplication.translate(
+            "OverviewTask", "{path}: overview pyramid built ({name})"
+        ).format(path=self.path, name=self.ovr_path.name)
         return True
 
     def finished(self, result: bool) -> None:
         if not result and not self.message:
-            self.message = f"{self.path}: overview build cancelled"
+            self.cancelled = True
+            self.message = self._cancelled_text()
         self.done.emit(bool(result), self.message)

@@ -29,12 +29,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..core.errors import Cancelled
+from ..core.i18n import mark as _t
+from ..core.i18n import render
+
+#: catalogue context of this module's ``_t("...")`` messages (``make i18n``)
+TR_CONTEXT = "ImageSource"
 
 __all__ = [
     "OVERVIEW_MIN_SIDE",
     "ImageSource",
     "ImageSourceError",
     "build_overview_file",
+    "error_text",
     "open_image",
     "overview_factors",
 ]
@@ -53,7 +59,16 @@ _TMP_TAG = ".lidarphoto-ovr-"
 
 
 class ImageSourceError(RuntimeError):
-    """An image that cannot be opened or read (the message names the file)."""
+    """An image that cannot be opened or read (the message names the file).
+
+    Its message is a :class:`core.i18n.Message` (English; :func:`error_text` shows it in the
+    language of the user interface)."""
+
+
+def error_text(exc: BaseException) -> str:
+    """The message of ``exc`` in the user's language (an :class:`ImageSourceError`'s sentence
+    translated; any other exception as it is)."""
+    return render(exc.args[0], TR_CONTEXT) if exc.args else str(exc)
 
 
 def _stretch_limits(sample: NDArray, low_pct: float, high_pct: float) -> tuple[NDArray, NDArray]:
@@ -91,7 +106,7 @@ def _gdal():
     try:
         from osgeo import gdal
     except ImportError as exc:  # QGIS always ships it; a bare Python may not
-        raise ImageSourceError(f"GDAL is not available ({exc})") from exc
+        raise ImageSourceError(_t("GDAL is not available ({error})", error=str(exc))) from exc
     gdal.UseExceptions()
     return gdal
 
@@ -162,7 +177,10 @@ def build_overview_file(
     tmp_ovr = tmp_vrt.with_name(tmp_vrt.name + ".ovr")
     if not os.access(image.parent, os.W_OK):
         raise ImageSourceError(
-            f"{image}: its folder is read-only, no overview pyramid can be written next to it"
+            _t(
+                "{path}: its folder is read-only, no overview pyramid can be written next to it",
+                path=str(image),
+            )
         )
     _sweep_stale_temporaries(image)
     if threads is None:
@@ -194,14 +212,20 @@ def build_overview_file(
         except RuntimeError as exc:
             vrt = src = None
             if stopped:
-                raise Cancelled(f"{image}: overview build cancelled") from None
-            raise ImageSourceError(f"{image}: cannot build the overview pyramid ({exc})") from exc
+                raise Cancelled(_t("{path}: overview build cancelled", path=str(image))) from None
+            raise ImageSourceError(
+                _t("{path}: cannot build the overview pyramid ({error})", path=str(image),
+                   error=str(exc))
+            ) from exc  # fmt: skip
         if stopped:  # GDAL may finish the last level after the callback said stop
-            raise Cancelled(f"{image}: overview build cancelled")
+            raise Cancelled(_t("{path}: overview build cancelled", path=str(image)))
         try:
             os.replace(tmp_ovr, target)
         except OSError as exc:
-            raise ImageSourceError(f"{target}: cannot write the overview pyramid ({exc})") from exc
+            raise ImageSourceError(
+                _t("{path}: cannot write the overview pyramid ({error})", path=str(target),
+                   error=str(exc))
+            ) from exc  # fmt: skip
     finally:
         gdal.SetThreadLocalConfigOption("GDAL_NUM_THREADS", None)
         for p in (tmp_vrt, tmp_ovr, tmp_ovr.with_name(tmp_ovr.name + ".aux.xml")):
@@ -267,7 +291,7 @@ class ImageSource:
         """
         self.path = Path(path)
         if not self.path.is_file():
-            raise ImageSourceError(f"{self.path}: the image file does not exist")
+            raise ImageSourceError(_t("{path}: the image file does not exist", path=str(self.path)))
         self._ds = None
         self._pyramid: list[NDArray] = []
         self._limits: tuple[NDArray, NDArray] | None = None
@@ -302,9 +326,13 @@ class ImageSource:
         try:
             ds = gdal.Open(str(self.path), gdal.GA_ReadOnly)
         except RuntimeError as exc:
-            raise ImageSourceError(f"{self.path}: GDAL cannot open it ({exc})") from exc
+            raise ImageSourceError(
+                _t("{path}: GDAL cannot open it ({error})", path=str(self.path), error=str(exc))
+            ) from exc
         if ds is None or ds.RasterCount < 1:
-            raise ImageSourceError(f"{self.path}: GDAL cannot open it (no raster band)")
+            raise ImageSourceError(
+                _t("{path}: GDAL cannot open it (no raster band)", path=str(self.path))
+            )
         self.width, self.height = ds.RasterXSize, ds.RasterYSize
         self.bands = 3 if ds.RasterCount >= 3 else 1
         band = ds.GetRasterBand(1)
@@ -321,7 +349,10 @@ class ImageSource:
         img = cv2.imdecode(data, cv2.IMREAD_UNCHANGED) if data.size else None
         if img is None:
             why = f" ({gdal_error.split(': ', 1)[-1]})" if gdal_error else ""
-            raise ImageSourceError(f"{self.path}: neither GDAL nor OpenCV can read this image{why}")
+            raise ImageSourceError(
+                _t("{path}: neither GDAL nor OpenCV can read this image{why}",
+                   path=str(self.path), why=why)
+            )  # fmt: skip
         if img.ndim == 3:
             img = cv2.cvtColor(img[:, :, :3], cv2.COLOR_BGR2RGB)
         self._pyramid = [img]
@@ -413,12 +444,14 @@ class ImageSource:
                     callback=callback,
                 )
             except RuntimeError as exc:
-                raise ImageSourceError(f"{self.path}: read failed ({exc})") from exc
+                raise ImageSourceError(
+                    _t("{path}: read failed ({error})", path=str(self.path), error=str(exc))
+                ) from exc
             if a is None:
-                raise ImageSourceError(f"{self.path}: read failed")
+                raise ImageSourceError(_t("{path}: read failed", path=str(self.path)))
             return a[:, :, None] if a.ndim == 2 else np.moveaxis(a, 0, -1)
         if not self._pyramid:
-            raise ImageSourceError(f"{self.path}: the image is closed")
+            raise ImageSourceError(_t("{path}: the image is closed", path=str(self.path)))
         import cv2
 
         f = (x1 - x0) / out_w

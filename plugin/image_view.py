@@ -55,7 +55,7 @@ from qgis.PyQt.QtWidgets import (
 )
 
 from .image_loader import OverviewTask, TileLoader, TileRequest, to_qimage
-from .image_source import ImageSource, ImageSourceError
+from .image_source import ImageSource, ImageSourceError, error_text
 
 __all__ = [
     "TILE",
@@ -366,7 +366,7 @@ class ImageView(QGraphicsView):
             try:
                 src.reopen()  # now it sees the pyramid
             except ImageSourceError as exc:  # e.g. QGIS shutting down (GDAL's drivers gone)
-                ok, message = False, str(exc)
+                ok, message = False, error_text(exc)
         if ok and src is not None:
             self._loader.reopen()
             self._status("")
@@ -379,6 +379,7 @@ class ImageView(QGraphicsView):
             self._schedule()
         else:
             self._status(message)
+        self.build_cancelled = bool(getattr(task, "cancelled", False))
         self.overviewFinished.emit(ok, message)
 
     def _on_preview(self, sgen: int, qimage: QImage, limits) -> None:

@@ -20,7 +20,7 @@ from qgis.PyQt.QtWidgets import (
 )
 
 from ..core.photo.picking_session import PICK_TYPES
-from .image_source import ImageSource, ImageSourceError
+from .image_source import ImageSource, ImageSourceError, error_text
 from .image_view import ImageView
 from .overlays import GROUPS, Overlays
 
@@ -208,7 +208,7 @@ class ViewerPanel(QWidget):
             self.source = ImageSource(path, stretch_now=False)
         except ImageSourceError as exc:
             self.view.set_source(None)
-            return False, str(exc), True
+            return False, error_text(exc), True
         self.view.set_source(self.source)
         src = self.source
         if not oriented:

@@ -12,8 +12,9 @@ Where the messages come from:
   "...")``;
 - the algorithms' specs (core/jobs): pylupdate cannot see them, so every job's texts are
   listed by ``core.jobs.translate.spec_messages`` in the context ``lidarphoto:<algorithm>``;
-- the rest of the core (the help's fixed words, the HTML reports): calls ``t("...")``,
-  ``tr("...")``, ``_t("...")`` or ``_tr("...")`` with a literal, in modules that define
+- the rest of the core (the help's fixed words, the HTML reports, the sentences the science
+  builds with numbers) and the plugin's Qt-free modules: calls ``t("...")``, ``tr("...")``,
+  ``_t("...")`` or ``_tr("...")`` with a literal, in modules that define
   ``TR_CONTEXT = "<context>"`` or import it (``from .html_table import TR_CONTEXT``).
 
 Existing translations are kept; a new message is added as unfinished; a message the code no
@@ -101,9 +102,10 @@ def _module_context(path: Path) -> str | None:
 
 
 def _core_messages() -> list[tuple[str, str]]:
-    """``t("...")``/``tr("...")`` literals of core modules that define ``TR_CONTEXT``."""
+    """``t("...")``/``tr("...")`` literals of core modules (and of the plugin's Qt-free ones,
+    e.g. plugin/image_source.py) that define ``TR_CONTEXT``."""
     out = []
-    for path in sorted(CORE.rglob("*.py")):
+    for path in sorted([*CORE.rglob("*.py"), *(ROOT / "plugin").rglob("*.py")]):
         if "simulation" in path.parts:
             continue
         tree = ast.parse(path.read_text(encoding="utf-8"))

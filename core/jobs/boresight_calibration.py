@@ -16,10 +16,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..i18n import joined as _joined
+from ..i18n import mark as _t
 from ..photo.ins import INS_GRADES
 from .common import CSV_FILTER, CSV_OUT, LAS_FILTER, mount_from, mount_params
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values
+
+#: catalogue context of the ``_t("...")`` sentences of the report (``make i18n``)
+TR_CONTEXT = "Report"
 
 if TYPE_CHECKING:
     from ..photo.boresight import BoresightRun
@@ -286,14 +291,22 @@ def doubts_about(result, max_boresight_deg: float, max_sigma0: float) -> list[st
     out = []
     adj = result.adjustment
     if not adj.converged:
-        why = "; ".join(w for w in adj.warnings if "converg" in w or "reduced" in w)
-        out.append(f"the adjustment did not converge after {adj.iterations} iterations"
-                   + (f" ({why})" if why else ""))  # fmt: skip
+        why = _joined([w for w in adj.warnings if "converg" in w or "reduced" in w], "; ")
+        out.append(
+            _t("the adjustment did not converge after {n} iterations ({why})",
+               n=adj.iterations, why=why)
+            if why
+            else _t("the adjustment did not converge after {n} iterations", n=adj.iterations)
+        )  # fmt: skip
     if not result.chi2_passed and result.sigma0 > max_sigma0:
         out.append(
-            f"the global test failed with sigma0 = {result.sigma0:.3g} > MAX_SIGMA0 "
-            f"{max_sigma0:g}: the observations are {result.sigma0:.3g} times less precise "
-            "than their sigmas say (wrong sigma_px or INS grade, or undetected blunders)"
+            _t(
+                "the global test failed with sigma0 = {sigma0:.3g} > MAX_SIGMA0 {maximum:g}: "
+                "the observations are {sigma0:.3g} times less precise than their sigmas say "
+                "(wrong sigma_px or INS grade, or undetected blunders)",
+                sigma0=result.sigma0,
+                maximum=max_sigma0,
+            )
         )
     deg = result.boresight_deg
     large, nonfinite = [], []
@@ -301,15 +314,22 @@ def doubts_about(result, max_boresight_deg: float, max_sigma0: float) -> list[st
         for k, angle in enumerate(("d_omega", "d_phi", "d_kappa")):
             value = float(deg[g, k])
             if not np.isfinite(value) or not np.isfinite(result.std[g, k]):
-                nonfinite.append(f"{angle} of group {name}")
+                nonfinite.append(_t("{angle} of group {group}", angle=angle, group=name))
             elif abs(value) > max_boresight_deg:
-                large.append(f"{angle} = {value:.4f} deg in group {name}")
+                large.append(
+                    _t("{angle} = {value:.4f} deg in group {group}", angle=angle, value=value,
+                       group=name)
+                )  # fmt: skip
     if nonfinite:
-        out.append(f"not a finite number: {', '.join(nonfinite)}")
+        out.append(_t("not a finite number: {items}", items=_joined(nonfinite)))
     if large:
         out.append(
-            f"{', '.join(large)} beyond MAX_BORESIGHT {max_boresight_deg:g} deg: implausible "
-            "for a misalignment (wrong MOUNT, image ids or observations?)"
+            _t(
+                "{items} beyond MAX_BORESIGHT {maximum:g} deg: implausible for a misalignment "
+                "(wrong MOUNT, image ids or observations?)",
+                items=_joined(large),
+                maximum=max_boresight_deg,
+            )
         )
     return out
 

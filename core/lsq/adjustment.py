@@ -112,6 +112,7 @@ from ..errors import (
     NotObservableError,
     stop_if_asked,
 )
+from ..i18n import mark as _t
 from .model import (
     AdjustmentOptions,
     Constraint,
@@ -121,6 +122,9 @@ from .model import (
 )
 from .results import AdjustmentResult, ChiSquareTest, RejectedObservation, ResidualTable
 from .schur import EliminationPlan, ReducedNormal, SingularSystem, build_reduced_normal
+
+#: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
+TR_CONTEXT = "Report"
 
 __all__ = ["adjust"]
 
@@ -1012,8 +1016,12 @@ def _run(
                     lin = fresh
                     continue
                 warnings.append(
-                    f"the cost could not be reduced further at iteration {it} (step "
-                    f"{step:.3g} sigma): stopped without convergence"
+                    _t(
+                        "the cost could not be reduced further at iteration {iteration} (step "
+                        "{step:.3g} sigma): stopped without convergence",
+                        iteration=it,
+                        step=step,
+                    )
                 )
                 break
         m_new = _merit(new, rowscale, nu)
@@ -1029,7 +1037,9 @@ def _run(
             break
         prev_step = step
     if not converged and it >= opts.max_iterations:
-        warnings.append(f"no convergence within {opts.max_iterations} iterations")
+        warnings.append(
+            _t("no convergence within {n} iterations", n=opts.max_iterations)
+        )
     # Final normal equations at the final linearisation point, checked before use.
     nrm, _ = problem.normal(lin, active, rowscale)
     if use_sparse is None:
@@ -1138,7 +1148,7 @@ def _finish(
     s0p = opts.sigma0_prior
     warnings = list(run.warnings)
     if r == 0:
-        warnings.append("no redundancy: sigma0 and the global test are undefined")
+        warnings.append(_t("no redundancy: sigma0 and the global test are undefined"))
     cov = cov_prior = corr = None
     std = np.full(n, np.nan)
     std_prior = np.full(n, np.nan)
@@ -1406,10 +1416,14 @@ def adjust(
         x, vhat, flagged, rob = _robust(problem, x, vhat, active, opts, crit, reporter,
                                         should_stop)  # fmt: skip
         initial = False
-        robust_text = (
-            f"{opts.robust.capitalize()} reweighting (k = {rob['k']:g} robust scale units, "
-            f"{rob['rounds']} rounds, robust scale {rob['scale']:.3g}), groups with a "
-            f"standardised misfit above {crit:.2f} set aside"
+        robust_text = _t(
+            "{method} reweighting (k = {k:g} robust scale units, {rounds} rounds, robust scale "
+            "{scale:.3g}), groups with a standardised misfit above {critical:.2f} set aside",
+            method=opts.robust.capitalize(),
+            k=rob["k"],
+            rounds=rob["rounds"],
+            scale=rob["scale"],
+            critical=crit,
         )
         trial = [a & ~f for a, f in zip(active, flagged)]
         trial, gone = _cascade(problem, trial)
@@ -1420,8 +1434,11 @@ def adjust(
         except NotObservableError:
             ok = False
             extra_warnings.append(
-                f"robust estimation: setting aside the {int(sum(f.sum() for f in flagged))} "
-                "groups it flagged would leave the adjustment not observable; they are kept"
+                _t(
+                    "robust estimation: setting aside the {n} groups it flagged would leave the "
+                    "adjustment not observable; they are kept",
+                    n=int(sum(f.sum() for f in flagged)),
+                )
             )
         if ok:
             for bj, gj in gone:
@@ -1446,7 +1463,9 @@ def adjust(
     result = _finish(problem, run, active, opts, want_cov)
     if not opts.snooping:
         result.outlier_method = (
-            robust_text + "; no data snooping" if robust_text else "none (data snooping disabled)"
+            _t("{robust}; no data snooping", robust=robust_text)
+            if robust_text
+            else _t("none (data snooping disabled)")
         )
         result.rejected = rejected
         result.warnings.extend(extra_warnings)
@@ -1455,7 +1474,7 @@ def adjust(
         return result
 
     if not result.converged:
-        extra_warnings.append("data snooping skipped: the adjustment did not converge")
+        extra_warnings.append(_t("data snooping skipped: the adjustment did not converge"))
     else:
         round_no = 0
         while True:
@@ -1464,8 +1483,13 @@ def adjust(
                 break
             if len(rejected) >= opts.max_rejections:
                 extra_warnings.append(
-                    f"data snooping stopped at max_rejections = {opts.max_rejections} with "
-                    f"|w| = {worst[3]:.2f} still above {crit:.2f}"
+                    _t(
+                        "data snooping stopped at max_rejections = {n} with |w| = {w:.2f} "
+                        "still above {critical:.2f}",
+                        n=opts.max_rejections,
+                        w=worst[3],
+                        critical=crit,
+                    )
                 )
                 break
             round_no += 1
@@ -1490,14 +1514,23 @@ def adjust(
                 new_result = _finish(problem, new_run, trial, opts, want_cov)
             except NotObservableError:
                 extra_warnings.append(
-                    f"data snooping stopped: rejecting {b.name} / {b.labels[g]} "
-                    f"(|w| = {wv:.2f}) would make the adjustment not observable; it is kept"
+                    _t(
+                        "data snooping stopped: rejecting {block} / {label} (|w| = {w:.2f}) "
+                        "would make the adjustment not observable; it is kept",
+                        block=b.name,
+                        label=b.labels[g],
+                        w=wv,
+                    )
                 )
                 break
             if not new_run.converged:
                 extra_warnings.append(
-                    f"data snooping stopped: without {b.name} / {b.labels[g]} the adjustment "
-                    "did not converge; it is kept"
+                    _t(
+                        "data snooping stopped: without {block} / {label} the adjustment did "
+                        "not converge; it is kept",
+                        block=b.name,
+                        label=b.labels[g],
+                    )
                 )
                 break
             signed = float(result.residuals[b.name].w[g, i])
@@ -1515,15 +1548,24 @@ def adjust(
         )
         if untested:
             extra_warnings.append(
-                f"{untested} observation rows have a redundancy number of about zero and "
-                "cannot be tested by data snooping"
+                _t(
+                    "{n} observation rows have a redundancy number of about zero and cannot "
+                    "be tested by data snooping",
+                    n=untested,
+                )
             )
     result.outlier_method = (
-        f"Baarda data snooping (alpha = {opts.snooping_alpha:g} per observation, critical "
-        f"|w| = {crit:.2f}, iterative rejection of whole groups)"
+        _t(
+            "Baarda data snooping (alpha = {alpha:g} per observation, critical |w| = "
+            "{critical:.2f}, iterative rejection of whole groups)",
+            alpha=opts.snooping_alpha,
+            critical=crit,
+        )
     )
     if robust_text:
-        result.outlier_method = robust_text + ", then " + result.outlier_method
+        result.outlier_method = _t(
+            "{robust}, then {snooping}", robust=robust_text, snooping=result.outlier_method
+        )
     result.rejected = rejected
     result.warnings.extend(extra_warnings)
     reporter.span(0.0, 1.0)

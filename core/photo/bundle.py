@@ -62,12 +62,16 @@ from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians, image_rays
 from ..geometry.frames import LocalFrame, MappingFrame
 from ..geometry.rotations import matrix_to_opk, opk_derivatives, opk_to_matrix
+from ..i18n import mark as _t
 from ..lsq.adjustment import adjust
 from ..lsq.model import AdjustmentOptions, Constraint, GaussMarkovBlock
 from ..lsq.results import AdjustmentResult
 from .intersection import meet_rays
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_local_to_map, eo_map_to_local
+
+#: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
+TR_CONTEXT = "Report"
 
 Array = NDArray[np.float64]
 
@@ -584,8 +588,11 @@ def _prepare(
     unobserved = [p for p in ground.point_id if p not in observed]
     if unobserved:
         warnings.append(
-            f"{len(unobserved)} ground point(s) are not measured in any image and were not "
-            f"used: {', '.join(unobserved[:20])}{' ...' if len(unobserved) > 20 else ''}"
+            _t(
+                "{n} ground point(s) are not measured in any image and were not used: {ids}",
+                n=len(unobserved),
+                ids=", ".join(unobserved[:20]) + (" ..." if len(unobserved) > 20 else ""),
+            )
         )
     free = options.datum != "control"
     adjusted: list[str] = []
@@ -1141,7 +1148,8 @@ def _drop_candidate(run: _Run, options: BundleOptions) -> tuple[int, int, str] |
             per_camera.append((c, cam, idx, run.lay.free[c], t))
     insignificant = [
         (float(t[k]), c, int(free[k]),
-         f"insignificant (t = {t[k]:.2f} <= {tcrit:.2f}, alpha {options.ap_alpha:g})")
+         _t("insignificant (t = {t:.2f} <= {critical:.2f}, alpha {alpha:g})", t=t[k],
+            critical=tcrit, alpha=options.ap_alpha))
         for c, _cam, idx, free, t in per_camera
         for k in range(idx.size)
         if free[k] >= 3 and t[k] <= tcrit
@@ -1161,8 +1169,8 @@ def _drop_candidate(run: _Run, options: BundleOptions) -> tuple[int, int, str] |
                 # drop the AP of the pair (the less significant one when both are APs)
                 k = min(pick, key=lambda q: t[q])
                 other = b if k == a else a
-                why = (f"|correlation| {abs(corr[a, b]):.3f} > {options.max_correlation:g} "
-                       f"with {names[free[other]]}")  # fmt: skip
+                why = _t("|correlation| {r:.3f} > {limit:g} with {other}", r=abs(corr[a, b]),
+                         limit=options.max_correlation, other=names[free[other]])  # fmt: skip
                 correlated.append((abs(float(corr[a, b])), c, int(free[k]), why))
     if correlated:
         _, c, k, why = max(correlated, key=lambda q: q[0])

@@ -51,10 +51,14 @@ from ..geometry.collinearity import collinearity_jacobians
 from ..geometry.distortion import BrownConrady
 from ..geometry.projection import PROJECTIONS, ray_from_ideal
 from ..geometry.rotations import matrix_to_opk
+from ..i18n import mark as _t
 from ..lsq.adjustment import adjust
 from ..lsq.model import AdjustmentOptions, GaussMarkovBlock
 from ..lsq.results import AdjustmentResult
 from .calibration_targets import Detection, TargetField
+
+#: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
+TR_CONTEXT = "Report"
 
 Array = NDArray[np.float64]
 
@@ -363,8 +367,8 @@ def calibrate_camera(
     opts = options or CalibrationOptions()
     view, pt, px, names = _flat(detections, fld)
     skipped = [d.image for d in detections if d.image not in names]
-    warnings = [f"view {s!r} left out: fewer than {MIN_POINTS_PER_VIEW} target points"
-                for s in skipped]  # fmt: skip
+    warnings = [_t("view {view!r} left out: fewer than {minimum} target points", view=s,
+                   minimum=MIN_POINTS_PER_VIEW) for s in skipped]  # fmt: skip
     n_views = len(names)
     if n_views < 2:
         raise NotObservableError(
@@ -486,8 +490,9 @@ def calibrate_camera(
             in zip(view, pt, px, v_all, w_all)]  # fmt: skip
     for n, sig in significant.items():
         if not sig:
-            warnings.append(f"{n} is not significant (t = {t_values[n]:.2f} < {tcrit:.2f}): "
-                            "consider holding it at zero")  # fmt: skip
+            warnings.append(_t("{parameter} is not significant (t = {t:.2f} < {critical:.2f}): "
+                               "consider holding it at zero", parameter=n, t=t_values[n],
+                               critical=tcrit))  # fmt: skip
     warnings += list(res.warnings)
     return CalibrationResult(
         camera=cam, sigmas=sigmas, parameter_names=io_names, correlation=corr,

@@ -52,6 +52,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import ConvergenceError, InputError, NotObservableError
 from ..geometry.camera import Camera
 from ..geometry.collinearity import image_rays, project_with_status
+from ..i18n import mark as _t
 from .control_plate import (
     PlateDetection,
     PlateGeometry,
@@ -60,6 +61,9 @@ from .control_plate import (
     plane_from_pixels,
     resect_plate,
 )
+
+#: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
+TR_CONTEXT = "Report"
 
 Array = NDArray[np.float64]
 
@@ -318,25 +322,27 @@ def make_chip(
         pr = resect_plate(det, camera, plate, photo_azimuth_deg,
                           sigma_px=opt.corner_sigma_px or None)  # fmt: skip
     except (ConvergenceError, NotObservableError, InputError) as exc:
-        return fail(f"plate resection failed: {exc}", detection=det)
+        return fail(_t("plate resection failed: {error}", error=str(exc)), detection=det)
     if not (pr.sigma0 <= opt.max_sigma0):
-        return fail(f"resection sigma0 {pr.sigma0:.3g} > {opt.max_sigma0:g}", detection=det,
+        return fail(_t("resection sigma0 {sigma0:.3g} > {maximum:g}", sigma0=pr.sigma0,
+                       maximum=opt.max_sigma0), detection=det,
                     plate=pr)  # fmt: skip
     notes = []
     if free_photo is None:
         if not opt.from_plate_photo:
-            return fail("no plate-free photo (allow the chip from the plate photo to make it "
-                        "anyway)", detection=det, plate=pr)  # fmt: skip
+            return fail(_t("no plate-free photo (allow the chip from the plate photo to make "
+                           "it anyway)"), detection=det, plate=pr)  # fmt: skip
         source_img, eo, std, s0, reg, source = ref, pr.eo, pr.std, pr.sigma0, None, "plate"
-        notes.append("chip from the plate photo: the plate hides the ground at the point")
+        notes.append(_t("chip from the plate photo: the plate hides the ground at the point"))
     else:
         from .resection import space_resection
 
         free = _grey_f32(free_photo)
         reg = register_sift(ref, free, camera, opt.sift_ratio, opt.ransac_px, opt.sift_features)
         if len(reg.ref_px) < opt.min_matches:
-            return fail(f"too few SIFT matches: {len(reg.ref_px)} RANSAC inliers of "
-                        f"{reg.matches} matches (< {opt.min_matches})", detection=det,
+            return fail(_t("too few SIFT matches: {inliers} RANSAC inliers of {matches} "
+                           "matches (< {minimum})", inliers=len(reg.ref_px),
+                           matches=reg.matches, minimum=opt.min_matches), detection=det,
                         plate=pr, sift=reg)  # fmt: skip
         ground = _on_plane(reg.ref_px, pr.eo, camera, 0.0)
         ok = np.isfinite(ground).all(axis=1)
@@ -344,18 +350,21 @@ def make_chip(
             fr = space_resection(reg.moved_px[ok], ground[ok], camera, eo0=pr.eo,
                                  sigma_px=opt.match_sigma_px)  # fmt: skip
         except (ConvergenceError, NotObservableError, InputError) as exc:
-            return fail(f"plate-free photo resection failed: {exc}", detection=det, plate=pr,
+            return fail(_t("plate-free photo resection failed: {error}", error=str(exc)),
+                        detection=det, plate=pr,
                         sift=reg)  # fmt: skip
         eo, std, s0, source = fr.eo, fr.std, float(fr.adjustment.sigma0), "free"
         source_img = free
         if len(fr.rejected):
-            notes.append(f"{len(fr.rejected)} SIFT matches rejected by data snooping")
+            notes.append(_t("{n} SIFT matches rejected by data snooping", n=len(fr.rejected)))
     chip, s = rectify_to_plane(source_img, camera, eo, gt, opt.size_px, origin_xy=p[:2], z=0.0)
     valid = float(np.isfinite(chip).mean())
     kw = dict(detection=det, plate=pr, sift=reg, free_eo=np.asarray(eo).copy(),
               free_std=np.asarray(std).copy(), free_sigma0=float(s0), source=source,
               chip=chip, valid_fraction=valid, subsamples=s, notes=tuple(notes))  # fmt: skip
     if valid < opt.min_valid:
-        return ChipResult(point_id, "failed", f"the photo sees {100 * valid:.1f} % of the chip "
-                          f"(< {100 * opt.min_valid:g} %)", geotransform=gt, **kw)  # fmt: skip
+        return ChipResult(point_id, "failed", _t("the photo sees {valid:.1f} % of the chip "
+                                                 "(< {minimum:g} %)", valid=100 * valid,
+                                                 minimum=100 * opt.min_valid),
+                          geotransform=gt, **kw)  # fmt: skip
     return ChipResult(point_id, "ok", "", geotransform=gt, **kw)

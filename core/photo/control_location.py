@@ -54,10 +54,14 @@ from ..geometry.camera import Camera
 from ..geometry.collinearity import project_with_status
 from ..geometry.frames import LocalFrame, MappingFrame
 from ..geometry.rotations import matrix_to_opk
+from ..i18n import mark as _t
 from .least_squares_matching import LsmOptions, affine_start, lsm_in_image
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_map_to_local
 from .template_matching import TextureOptions, choose_template_size, ncc_search
+
+#: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
+TR_CONTEXT = "Report"
 
 Array = NDArray[np.float64]
 
@@ -242,8 +246,8 @@ def locate_control_points(
         pc = chip.point_array
         size = choose_template_size(chip.grey, pc, opt.texture)
         if not size.ok or not np.isfinite(chip.grey).all():
-            why = size.reason if not size.ok else "chip has no-data pixels"
-            pairs.append(LocatedPair(pid, "", "rejected", f"chip refused: {why}",
+            why = size.reason if not size.ok else _t("chip has no-data pixels")
+            pairs.append(LocatedPair(pid, "", "rejected", _t("chip refused: {why}", why=why),
                                      template_px=size.size))  # fmt: skip
             continue
         h = size.size // 2
@@ -269,7 +273,7 @@ def locate_control_points(
         inside_margin &= pix[:, 0, 0] + reach <= camera.width_px
         inside_margin &= pix[:, 0, 1] + reach <= camera.height_px
         if not inside.any():
-            pairs.append(LocatedPair(pid, "", "outside", "outside every image",
+            pairs.append(LocatedPair(pid, "", "outside", _t("outside every image"),
                                      template_px=size.size))  # fmt: skip
             continue
         results: dict[int, LocatedPair] = {}
@@ -279,8 +283,8 @@ def locate_control_points(
             base = {"template_px": size.size, "predicted_col": float(pred[0]),
                     "predicted_row": float(pred[1])}  # fmt: skip
             if not inside_margin[i]:
-                results[i] = LocatedPair(pid, iid, "rejected", "template partly outside the "
-                                         "image", **base)  # fmt: skip
+                results[i] = LocatedPair(pid, iid, "rejected", _t("template partly outside "
+                                         "the image"), **base)  # fmt: skip
                 continue
             # search ellipse
             if eo_sigmas is not None:
@@ -382,7 +386,7 @@ def _match(chip_template, ref, jac, image_id, pred_corner, half_search, read, op
         # no peak can form there, and LSM flags a patch that reaches them.
         valid = ~np.isnan(win)
         if valid.sum() < side * side:
-            return _Match("search window outside the image")
+            return _Match(_t("search window outside the image"))
     pred_w = pred - origin
     ncc_win = np.where(np.isnan(win), np.nanmean(win), win)
     # restrict NCC to the search box (plus the template)
@@ -393,14 +397,15 @@ def _match(chip_template, ref, jac, image_id, pred_corner, half_search, read, op
     c_lo, r_lo = max(c_lo, 0), max(r_lo, 0)
     sub = ncc_win[r_lo:r_hi, c_lo:c_hi]
     if sub.shape[0] < side or sub.shape[1] < side:
-        return _Match("search window outside the image")
+        return _Match(_t("search window outside the image"))
     nm = ncc_search(tmpl_img, sub)
     out = _Match(ncc=nm.peak)
     if nm.peak < opt.min_ncc:
-        out.reason = f"low correlation (NCC {nm.peak:.2f} < {opt.min_ncc:.2f})"
+        out.reason = _t("low correlation (NCC {ncc:.2f} < {minimum:.2f})", ncc=nm.peak,
+                        minimum=opt.min_ncc)  # fmt: skip
         return out
     if nm.on_border:
-        out.reason = "NCC peak on the search border"
+        out.reason = _t("NCC peak on the search border")
         return out
     start_w = np.array([nm.col + c_lo, nm.row + r_lo])
     res = lsm_in_image(
@@ -421,7 +426,7 @@ def _match(chip_template, ref, jac, image_id, pred_corner, half_search, read, op
     cc, rr = int(np.rint(pos[0] - origin[0])), int(np.rint(pos[1] - origin[1]))
     out.image_patch = ncc_win[max(rr - hs, 0) : rr + hs + 1, max(cc - hs, 0) : cc + hs + 1]
     if not res.ok[0]:
-        out.reason = f"LSM: {res.reasons()[0]}"
+        out.reason = _t("LSM: {reason}", reason=res.reasons()[0])
     return out
 
 
@@ -432,7 +437,7 @@ def _finish(pid, iid, r: _Match, pred, cov_search, base, source) -> LocatedPair:
     if not reason and np.isfinite(col):
         d = np.array([col, row]) - pred
         if float(d @ np.linalg.solve(cov_search, d)) > 1.0:
-            reason = "outside the search ellipse"
+            reason = _t("outside the search ellipse")
     sig = np.sqrt(np.diag(r.cov)) if r.cov is not None else np.full(2, np.nan)
     return LocatedPair(
         pid, iid, "rejected" if reason else "ok", reason, source, col, row,
@@ -467,8 +472,9 @@ def _transfer(mres: LocatedPair, master: int, i: int, jac_chip, pix, image_ids, 
         m_cov = np.diag([mres.sigma_col**2, mres.sigma_row**2])
         r.cov = r.cov + jac @ m_cov @ jac.T
     out = _finish(old.point_id, old.image_id, r, pred, cov_search * 4.0, base,
-                  f"transfer from {image_ids[master]}")  # fmt: skip
+                  _t("transfer from {image}", image=image_ids[master]))  # fmt: skip
     if out.status != "ok":
-        reason = f"{old.reason}; transfer from {image_ids[master]}: {out.reason}"
+        reason = _t("{reason}; transfer from {image}: {transfer_reason}", reason=old.reason,
+                    image=image_ids[master], transfer_reason=out.reason)  # fmt: skip
         return LocatedPair(**{**out.__dict__, "reason": reason})
     return out

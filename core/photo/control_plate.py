@@ -76,6 +76,10 @@ from ..errors import InputError
 from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians, image_rays, project_with_status
 from ..geometry.rotations import opk_to_matrix
+from ..i18n import mark as _t
+
+#: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
+TR_CONTEXT = "Report"
 
 Array = NDArray[np.float64]
 
@@ -498,15 +502,17 @@ def detect_plate(
     u8 = np.clip((img - lo) * scale, 0, 255).astype(np.uint8)
     quads = _quads(u8, min_area_px)
     if not quads:
-        return PlateDetection(False, "plate not found: no quadrilateral in the photo")
+        return PlateDetection(False, _t("plate not found: no quadrilateral in the photo"))
     pairs = _pairs(quads, plate.inner_m / plate.outer_m,
                    to_plane=None if camera.is_perspective else (
                        lambda q: plane_from_pixels(q, camera)))  # fmt: skip
     if not pairs:
-        return PlateDetection(False, f"only one square: {len(quads)} quadrilateral(s), none "
-                              "with a nested square of the plate's inner/outer ratio")  # fmt: skip
+        return PlateDetection(False, _t("only one square: {n} quadrilateral(s), none with a "
+                                        "nested square of the plate's inner/outer ratio",
+                                        n=len(quads)))  # fmt: skip
     if len(pairs) > 1:
-        return PlateDetection(False, f"ambiguous: {len(pairs)} plate-like pairs of squares",
+        return PlateDetection(False, _t("ambiguous: {n} plate-like pairs of squares",
+                                        n=len(pairs)),
                               candidates=len(pairs))  # fmt: skip
     outer, inner = pairs[0]
     smooth = cv2.GaussianBlur(img, (0, 0), 1.0)
@@ -522,8 +528,9 @@ def detect_plate(
             uv = uv[np.isfinite(uv).all(axis=1)] if len(uv) else uv
             fit = _fit_side(uv)
             if fit is None:
-                return PlateDetection(False, f"edge fit failed: side {4 * k + i} has "
-                                      f"{len(uv)} edge points", candidates=1)  # fmt: skip
+                return PlateDetection(False, _t("edge fit failed: side {side} has {n} edge "
+                                                "points", side=4 * k + i, n=len(uv)),
+                                      candidates=1)  # fmt: skip
             lines.append(fit)
             if camera.is_perspective:
                 rms[4 * k + i] = fit[3] * f_px
@@ -548,8 +555,8 @@ def detect_plate(
                 sig[4 * k + i] = math.sqrt(max(var, 0.0))
     px = pixels_from_plane(corners_uv, camera)
     if not np.isfinite(px).all():
-        return PlateDetection(False, "edge fit failed: a corner falls outside the camera's "
-                              "field", candidates=1)  # fmt: skip
+        return PlateDetection(False, _t("edge fit failed: a corner falls outside the camera's "
+                                 "field"), candidates=1)  # fmt: skip
     return PlateDetection(True, "", px, sig, rms, count, 1)
 
 

@@ -40,7 +40,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..i18n import mark as _t
 from . import least_squares_matching_numba as _numba
+
+#: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
+TR_CONTEXT = "Report"
 
 Array = NDArray[np.float64]
 
@@ -52,8 +56,8 @@ __all__ = [
 OK, NO_TEXTURE, LEFT_WINDOW, NOT_CONVERGED, DRIFTED, LOW_CORRELATION, SIGMA_TOO_LARGE = range(7)
 #: Status code -> reason.
 STATUS_TEXT = (
-    "ok", "no texture", "left the search window", "not converged", "moved too far",
-    "low correlation", "sigma too large",
+    _t("ok"), _t("no texture"), _t("left the search window"), _t("not converged"),
+    _t("moved too far"), _t("low correlation"), _t("sigma too large"),
 )  # fmt: skip
 
 

@@ -29,6 +29,7 @@ from ..geometry.collinearity import collinearity_jacobians
 from ..geometry.frames import LocalFrame, MappingFrame
 from ..geometry.lines import camera_vectors, coplanarity, image_vectors, parametrisation
 from ..geometry.rotations import matrix_to_opk, opk_to_matrix
+from ..i18n import mark as _t
 from ..lsq.adjustment import adjust
 from ..lsq.model import AdjustmentOptions, GaussMarkovBlock, prior_block
 from ..lsq.results import AdjustmentResult, ChiSquareTest
@@ -43,6 +44,9 @@ from .resection_model import (
     observed_line_parameters,
     point_block,
 )
+
+#: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
+TR_CONTEXT = "Report"
 
 Array = NDArray[np.float64]
 
@@ -692,7 +696,7 @@ def resect(
     crit = float(stats.chi2.ppf(1 - opts.alpha, r)) if r > 0 else math.nan
     warnings = list(adj.warnings)
     if start != "given" and r == 0:
-        warnings.append("no redundancy: the orientation cannot be checked")
+        warnings.append(_t("no redundancy: the orientation cannot be checked"))
     return SpaceResection(
         eo=eo, covariance=cov[:6, :6].copy(), covariance_prior=cov_p[:6, :6].copy(),
         correlation=corr[:6, :6].copy(), interior=interior, interior_std=interior_std,

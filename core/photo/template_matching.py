@@ -34,6 +34,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..i18n import mark as _t
+
+#: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
+TR_CONTEXT = "Report"
+
 Array = NDArray[np.float64]
 
 __all__ = [
@@ -157,15 +162,15 @@ def choose_template_size(
         est = immerkaer_noise(t)
         noise = max(est, opt.noise_floor * std)
         if std <= opt.min_contrast * max(float(np.abs(t).mean()), 1.0) or std < 3.0 * est:
-            reason = "no texture"
+            reason = _t("no texture")
             continue
         lo, hi = texture_measure(t)
         pred = noise / np.sqrt(lo) if lo > 0 else float("inf")
         if hi <= 0 or lo / hi < opt.min_isotropy:
-            reason = "edge only"
+            reason = _t("edge only")
             continue
         if pred > opt.target_sigma_px:
-            reason = "weak texture"
+            reason = _t("weak texture")
             continue
         return TemplateSize(size, float(pred), noise, "")
     return TemplateSize(size, float(pred), noise, reason)

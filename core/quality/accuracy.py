@@ -743,9 +743,8 @@ def assess_accuracy(
     du = d[used]
     flagged = outliers.any
     n_flag = int(flagged.sum())
-    label = f"without the {n_flag} flagged point(s)" if s.exclude_outliers and n_flag else (
-        _t("all points")
-    )
+    without = _t("without the {n} flagged point(s)", n=n_flag)
+    label = without if s.exclude_outliers and n_flag else _t("all points")
     overall = group_statistics(du, label, alpha=s.alpha, declared_sigma=sig)
     contrast = None
     if n_flag:  # the user sees what the flagged points do to the figures, both ways
@@ -754,7 +753,7 @@ def assess_accuracy(
             other_label = (
                 _t("all points (flagged included)")
                 if s.exclude_outliers
-                else f"without the {n_flag} flagged point(s)"
+                else without
             )
             contrast = group_statistics(d[other], other_label, alpha=s.alpha, declared_sigma=sig)
     _tick(progress, should_stop, 0.3)

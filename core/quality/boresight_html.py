@@ -109,7 +109,7 @@ def render_boresight_html(
     if diagnosis:
         parts.append(f"<h2>{t('Not observable')}</h2>")
         parts.append(f'<div class="diag"><p>{t("The calibration was not computed:")}</p><ul>')
-        parts += [f"<li>{_e(s)}</li>" for s in diagnosis]
+        parts += [f"<li>{_e(t(s))}</li>" for s in diagnosis]
         parts.append("</ul></div>")
     if run is not None:
         parts += _results(run)
@@ -131,7 +131,7 @@ def _problems(problems: Sequence[str], accepted: bool) -> list[str]:
             "written. The numbers below show the failed adjustment, for diagnosis only."
         )
     )
-    items = "".join(f"<li>{_e(p)}</li>" for p in problems)
+    items = "".join(f"<li>{_e(t(p))}</li>" for p in problems)
     return [f'<div class="alarm"><p><b>{_e(verdict)}</b></p><ul>{items}</ul></div>']
 
 
@@ -215,7 +215,7 @@ def _results(run: BoresightRun) -> list[str]:
                         t("yes") if res.adjustment.converged else t("no"),
                     ),
                 ],
-                [t("outlier detection"), _e(res.adjustment.outlier_method)],
+                [t("outlier detection"), _e(t(res.adjustment.outlier_method))],
             ],
             [""] * 6 + ["pass" if gt.passed else "fail", "", ""],
         )
@@ -251,7 +251,7 @@ def _results(run: BoresightRun) -> list[str]:
         out.append(f"<p>{t('None.')}</p>")
     if res.warnings:
         out.append(
-            f"<h2>{t('Warnings')}</h2><ul>" + "".join(f"<li>{_e(w)}</li>" for w in res.warnings)
+            f"<h2>{t('Warnings')}</h2><ul>" + "".join(f"<li>{_e(t(w))}</li>" for w in res.warnings)
         )
         out.append("</ul>")
     keep = r.used & ~r.rejected & np.isfinite(r.v_px).all(axis=1)

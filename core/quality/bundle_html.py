@@ -83,7 +83,7 @@ def _adjustment(res: BundleResult) -> str:
          t("statistic {}, accepted [{}, {}], p = {}").format(
              f"{gt.statistic:.1f}", f"{gt.lower:.1f}", f"{gt.upper:.1f}", f"{gt.p_value:.3g}")
          if gt.dof > 0 else t("no redundancy")],
-        [t("outliers"), _e(int(res.rejected.sum())), _e(a.outlier_method)],
+        [t("outliers"), _e(int(res.rejected.sum())), _e(t(a.outlier_method))],
         [t("condition number (reduced system)"), _n(a.condition_number, ".3g"), ""],
     ]  # fmt: skip
     return _table(
@@ -93,6 +93,7 @@ def _adjustment(res: BundleResult) -> str:
 
 def _interior(res: BundleResult, alpha_text: str) -> str:
     rows, css = [], []
+    words = {"estimated": t("estimated"), "dropped": t("dropped"), "fixed": t("fixed")}
     for p in res.interior:
         if p.status == "estimated":
             sig = t("yes") if p.significant else t("no")
@@ -100,7 +101,7 @@ def _interior(res: BundleResult, alpha_text: str) -> str:
             sig = "&ndash;"
         rows.append([
             _e(p.camera), _e(p.name), _n(p.value, ".6g"), _n(p.std, ".3g"), _n(p.t, ".2f"),
-            sig, _e(p.status), _e(p.reason),
+            sig, _e(words.get(p.status, p.status)), _e(t(p.reason)),
         ])  # fmt: skip
         css.append("drop" if p.status == "dropped" else "")
     head = [t("camera"), t("parameter"), t("value"), t("std"), "t",
@@ -152,7 +153,7 @@ def render_bundle_html(
         parts.append(
             "<p>"
             + t("Dropped by the selection, in order: ")
-            + "; ".join(f"{_e(c)} {_e(n)} ({_e(w)})" for c, n, w in res.dropped)
+            + "; ".join(f"{_e(c)} {_e(n)} ({_e(t(w))})" for c, n, w in res.dropped)
             + "</p>"
         )
     if res.flagged_correlations:
@@ -246,6 +247,6 @@ def render_bundle_html(
                           t("w row")], rows)]  # fmt: skip
     if res.warnings:
         parts += [f"<h2>{t('Warnings')}</h2><ul>",
-                  *(f"<li>{_e(w)}</li>" for w in res.warnings), "</ul>"]  # fmt: skip
+                  *(f"<li>{_e(t(w))}</li>" for w in res.warnings), "</ul>"]  # fmt: skip
     parts.append("</body></html>")
     return "\n".join(parts)

@@ -114,6 +114,6 @@ def render_calibration_html(result: Any, settings: Mapping[str, str]) -> str:
     parts += [f"<h2>{t('Views')}</h2>", _table(vhead, vrows)]
     if result.warnings:
         parts += [f"<h2>{t('Warnings')}</h2>", "<ul>",
-                  *(f"<li>{_e(w)}</li>" for w in result.warnings), "</ul>"]  # fmt: skip
+                  *(f"<li>{_e(t(w))}</li>" for w in result.warnings), "</ul>"]  # fmt: skip
     parts.append("</body></html>")
     return "\n".join(parts)

@@ -59,6 +59,13 @@ def png_data_uri(grey: np.ndarray | None, zoom: int = 4) -> str:
     return "data:image/png;base64," + base64.b64encode(buf.tobytes()).decode("ascii") if ok else ""
 
 
+def _word(text: str) -> str:
+    """A status or source word of a pair (``ok``, ``rejected``...) in the report's language."""
+    words = {"ok": t("ok"), "rejected": t("rejected"), "outside": t("outside"),
+             "chip": t("chip")}  # fmt: skip
+    return words.get(text) or t(text)
+
+
 def _n(x: float, digits: int = 3) -> str:
     return f"{x:.{digits}f}" if x is not None and math.isfinite(x) else "&ndash;"
 
@@ -90,13 +97,15 @@ def render_location_html(pairs: Sequence[LocatedPair], settings: Mapping[str, st
         f"<h2>{t('Settings')}</h2>",
         _table([t("setting"), t("value")], [[_e(k), _e(v)] for k, v in settings.items()]),
         f"<h2>{t('Summary')}</h2>",
-        _table([t("status"), t("pairs")], [[_e(k), str(v)] for k, v in sorted(counts.items())]),
+        _table(
+            [t("status"), t("pairs")], [[_e(_word(k)), str(v)] for k, v in sorted(counts.items())]
+        ),
         f"<h2>{t('Points and images')}</h2>",
     ]
     rows, css = [], []
     for p in pairs:
-        rows.append([_e(p.point_id), _e(p.image_id), _e(p.status), _e(p.reason),
-                     _e(p.source if p.image_id else ""), _n(p.col, 3), _n(p.row, 3),
+        rows.append([_e(p.point_id), _e(p.image_id), _e(_word(p.status)), _e(t(p.reason)),
+                     _e(_word(p.source) if p.image_id else ""), _n(p.col, 3), _n(p.row, 3),
                      _n(p.sigma_col, 4), _n(p.sigma_row, 4), _n(p.ncc, 3),
                      _n(p.lsm_correlation, 3), str(p.template_px or "")])  # fmt: skip
         css.append("pass" if p.status == "ok" else "fail")
@@ -114,9 +123,9 @@ def render_location_html(pairs: Sequence[LocatedPair], settings: Mapping[str, st
         if p.chip_patch is None and p.image_patch is None:
             continue
         cls = "" if p.status == "ok" else ' class="fail"'
-        cap = t("{} in {}: {}").format(_e(p.point_id), _e(p.image_id), _e(p.status))
+        cap = t("{} in {}: {}").format(_e(p.point_id), _e(p.image_id), _e(_word(p.status)))
         if p.reason:
-            cap += f" ({_e(p.reason)})"
+            cap += f" ({_e(t(p.reason))})"
         parts.append(f'<figure{cls}><img alt="chip" src="{png_data_uri(p.chip_patch)}">'
                      f'<img alt="image" src="{png_data_uri(p.image_patch)}">'
                      f"<figcaption>{cap}</figcaption></figure>")  # fmt: skip

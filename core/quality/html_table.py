@@ -6,7 +6,7 @@ from __future__ import annotations
 import html
 from collections.abc import Sequence
 
-from ..i18n import html_lang, translator
+from ..i18n import html_lang, render
 
 __all__ = ["TR_CONTEXT", "escape", "html_lang", "t", "table"]
 #: translation context of the reports' texts (``make i18n`` collects the ``t("...")`` calls of
@@ -15,8 +15,9 @@ TR_CONTEXT = "Report"
 
 
 def t(text: str) -> str:
-    """``text`` in the language of the reports (:func:`core.i18n.set_language`)."""
-    return translator(TR_CONTEXT)(text)
+    """``text`` in the language of the reports (:func:`core.i18n.set_language`); a
+    :class:`core.i18n.Message` through its translated template and its values."""
+    return render(text, TR_CONTEXT)
 
 
 def escape(text: object) -> str:

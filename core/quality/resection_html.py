@@ -173,7 +173,7 @@ def _image(r, residuals: list) -> list[str]:
         out.append(_table([t("block"), "id", t("row"), "w"],
                           [[_e(b), _e(lab), _e(rn), _n(w, 2)] for b, lab, rn, w in rejected]))
     if res.warnings:
-        out.append('<p class="note">' + "<br>".join(_e(w) for w in res.warnings) + "</p>")
+        out.append('<p class="note">' + "<br>".join(_e(t(w)) for w in res.warnings) + "</p>")
     return out
 
 

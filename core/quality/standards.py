@@ -41,13 +41,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from ..i18n import Message
 from .html_table import TR_CONTEXT  # noqa: F401 - make i18n collects the _t("...") marks
 
 
-def _t(text: str) -> str:
-    """Mark a fixed text for translation (``make i18n``); the report translates it when shown,
-    so the results themselves stay in English."""
-    return text
+def _t(template: str, **values: object) -> Message:
+    """Mark a text (a template with named placeholders) for translation (``make i18n``): the
+    result is the English sentence and keeps the template and the values, so the results stay
+    in English and the report renders them in the user's language."""
+    return Message(template, **values)
 
 
 __all__ = [
@@ -222,18 +224,26 @@ def asprs_2023(
         Verdict(
             _t("Check-point count"),
             "pass" if enough else "insufficient",
-            (
-                f"{n} check points; Edition 2 requires at least {ASPRS_MIN_CHECKPOINTS} "
-                f"(and up to {ASPRS_MAX_CHECKPOINTS} for large projects)"
+            _t(
+                "{n} check points; Edition 2 requires at least {minimum} (and up to {maximum} "
+                "for large projects)",
+                n=n,
+                minimum=ASPRS_MIN_CHECKPOINTS,
+                maximum=ASPRS_MAX_CHECKPOINTS,
             ),
             float(n),
             float(ASPRS_MIN_CHECKPOINTS),
             unit="points",
         )
     ]
+    few = (
+        ""
+        if enough
+        else _t("; only {n} of {minimum} check points", n=n, minimum=ASPRS_MIN_CHECKPOINTS)
+    )
     for label, value, target, examples in (
-        ("Horizontal", rmse_h, h_class_cm, ASPRS_EXAMPLE_H_CLASSES_CM),
-        ("Vertical (NVA)", rmse_v, v_class_cm, ASPRS_EXAMPLE_V_CLASSES_CM),
+        (_t("Horizontal"), rmse_h, h_class_cm, ASPRS_EXAMPLE_H_CLASSES_CM),
+        (_t("Vertical (NVA)"), rmse_v, v_class_cm, ASPRS_EXAMPLE_V_CLASSES_CM),
     ):
         # the toolkit's name, then the standard's symbol (Table 7.1)
         sym = ("RMSE_HORIZONTAL_TOTAL (ASPRS RMSE_H)" if label == "Horizontal"
@@ -242,23 +252,32 @@ def asprs_2023(
         if target and target > 0:
             limit = target / 100.0
             ok = value <= limit + _TOL
-            reason = f"{sym} = {100 * value:.2f} cm {'<=' if ok else '>'} {target:g} cm" + (
-                "" if enough else f"; only {n} of {ASPRS_MIN_CHECKPOINTS} check points"
+            reason = _t(
+                "{symbol} = {value:.2f} cm {relation} {target:g} cm{few}",
+                symbol=sym,
+                value=100 * value,
+                relation="<=" if ok else ">",
+                target=target,
+                few=few,
             )
-            verdicts.append(
-                Verdict(f"{label} class {target:g}-cm", _status(ok, enough), reason, value, limit)
-            )
+            name = _t("{axis} class {target:g}-cm", axis=label, target=target)
+            verdicts.append(Verdict(name, _status(ok, enough), reason, value, limit))
         else:
             met = [c for c in examples if value <= c / 100.0 + _TOL]
             best = met[0] if met else None
-            reason = (
-                f"{sym} = {tightest:.2f} cm: meets any class of at least {tightest:.2f} cm"
-                + (f"; tightest example class met: {best:g}-cm" if best else "")
-                + ("" if enough else f"; only {n} of {ASPRS_MIN_CHECKPOINTS} check points")
+            reason = _t(
+                "{symbol} = {value:.2f} cm: meets any class of at least {value:.2f} cm"
+                "{example}{few}",
+                symbol=sym,
+                value=tightest,
+                example=(
+                    _t("; tightest example class met: {best:g}-cm", best=best) if best else ""
+                ),
+                few=few,
             )
             verdicts.append(
                 Verdict(
-                    f"{label} class",
+                    _t("{axis} class", axis=label),
                     "info" if enough else "insufficient",
                     reason,
                     value,
@@ -269,40 +288,56 @@ def asprs_2023(
         Verdict(
             _t("Three-dimensional accuracy"),
             "info" if enough else "insufficient",
-            f"RMSE_3D_TOTAL = sqrt(RMSE_HORIZONTAL_TOTAL^2 + RMSE_U_TOTAL^2) = "
-            f"{100 * rmse_3d:.2f} cm (reported, no class)",
+            _t(
+                "RMSE_3D_TOTAL = sqrt(RMSE_HORIZONTAL_TOTAL^2 + RMSE_U_TOTAL^2) = {value:.2f} cm "
+                "(reported, no class)",
+                value=100 * rmse_3d,
+            ),
             rmse_3d,
             None,
         )
     )
     notes = [
         _t("Accuracy is stated as RMSE; Edition 2 no longer uses 95 % confidence figures."),
-        f"Check-point survey error included: RMSE_HORIZONTAL_SURVEY (ASPRS RMSE_H2) = "
-        f"{100 * rmse_h2:.2f} cm, RMSE_U_SURVEY (ASPRS RMSE_V2) = "
-        f"{100 * float(survey_sigma_v):.2f} cm (0 when not given: then the totals are "
-        "RMSE_HORIZONTAL and RMSE_U of the check points alone).",
+        _t(
+            "Check-point survey error included: RMSE_HORIZONTAL_SURVEY (ASPRS RMSE_H2) = "
+            "{horizontal:.2f} cm, RMSE_U_SURVEY (ASPRS RMSE_V2) = {vertical:.2f} cm (0 when not "
+            "given: then the totals are RMSE_HORIZONTAL and RMSE_U of the check points alone).",
+            horizontal=100 * rmse_h2,
+            vertical=100 * float(survey_sigma_v),
+        ),
     ]
     for label, target, survey in (
-        ("horizontal", h_class_cm, rmse_h2),
-        ("vertical", v_class_cm, float(survey_sigma_v)),
+        (_t("horizontal"), h_class_cm, rmse_h2),
+        (_t("vertical"), v_class_cm, float(survey_sigma_v)),
     ):
         # Edition 2 relaxed the survey requirement to about twice the product accuracy
         # (Edition 1 asked for three times); our reading, marked uncertain in the report.
         if target and target > 0 and survey > 0.5 * target / 100.0:
             notes.append(
-                f"The {label} check-point survey ({100 * survey:.2f} cm) is not at least twice "
-                f"as accurate as the {target:g}-cm class (uncertain reading of Ed. 2)."
+                _t(
+                    "The {axis} check-point survey ({survey:.2f} cm) is not at least twice as "
+                    "accurate as the {target:g}-cm class (uncertain reading of Ed. 2).",
+                    axis=label,
+                    survey=100 * survey,
+                    target=target,
+                )
             )
     mean = d.mean(axis=0)
     for label, target, value in (
-        ("horizontal", h_class_cm, math.hypot(mean[0], mean[1])),
-        ("vertical", v_class_cm, abs(mean[2])),
+        (_t("horizontal"), h_class_cm, math.hypot(mean[0], mean[1])),
+        (_t("vertical"), v_class_cm, abs(mean[2])),
     ):
         if target and target > 0 and value > 0.25 * target / 100.0:
             notes.append(
-                f"The {label} mean error ({100 * value:.2f} cm) exceeds 25 % of the "
-                f"{target:g}-cm class: investigate a systematic error (Ed. 1 section 7.4; "
-                "kept as guidance in Ed. 2, uncertain)."
+                _t(
+                    "The {axis} mean error ({mean:.2f} cm) exceeds 25 % of the {target:g}-cm "
+                    "class: investigate a systematic error (Ed. 1 section 7.4; kept as guidance "
+                    "in Ed. 2, uncertain).",
+                    axis=label,
+                    mean=100 * value,
+                    target=target,
+                )
             )
     return StandardResult(
         key="asprs",
@@ -442,7 +477,11 @@ def nssda(
         Verdict(
             _t("Check-point count"),
             "pass" if enough else "insufficient",
-            f"{n} check points; NSSDA requires at least {NSSDA_MIN_CHECKPOINTS}",
+            _t(
+                "{n} check points; NSSDA requires at least {minimum}",
+                n=n,
+                minimum=NSSDA_MIN_CHECKPOINTS,
+            ),
             float(n),
             float(NSSDA_MIN_CHECKPOINTS),
             unit="points",
@@ -451,12 +490,11 @@ def nssda(
             _t("Horizontal approximation condition"),
             "pass" if approx_ok else "fail",
             (
-                f"RMSE_min/RMSE_max = {ratio:.3f} "
-                + (
-                    ">= 0.6: Accuracy_r = 2.4477 x 0.5 (RMSE_x + RMSE_y)"
-                    if approx_ok
-                    else "< 0.6: the NSSDA approximation does not hold; exact 95 % radius used"
-                )
+                _t("RMSE_min/RMSE_max = {ratio:.3f} >= 0.6: Accuracy_r = 2.4477 x 0.5 "
+                   "(RMSE_x + RMSE_y)", ratio=ratio)
+                if approx_ok
+                else _t("RMSE_min/RMSE_max = {ratio:.3f} < 0.6: the NSSDA approximation does "
+                        "not hold; exact 95 % radius used", ratio=ratio)
             ),
             ratio,
             0.6,
@@ -464,9 +502,9 @@ def nssda(
         ),
     ]
     names = ("E", "N", "U")
-    for label, decisions, bad in (
-        ("normal distribution (Shapiro-Wilk)", normal, False),
-        ("no systematic error (Student t)", biased, True),
+    for name, decisions, bad in (
+        (_t("Assumption: normal distribution (Shapiro-Wilk)"), normal, False),
+        (_t("Assumption: no systematic error (Student t)"), biased, True),
     ):
         if decisions is None:
             continue
@@ -474,21 +512,29 @@ def nssda(
         failed = [c for c, v in zip(names, decisions) if v is not None and bool(v) == bad]
         status = "fail" if failed else ("insufficient" if untested else "pass")
         reason = (
-            f"rejected for {', '.join(failed)}"
+            _t("rejected for {components}", components=", ".join(failed))
             if failed
             else (
-                f"not testable for {', '.join(untested)}"
+                _t("not testable for {components}", components=", ".join(untested))
                 if untested
                 else _t("accepted for E, N, H")
             )
         )
-        verdicts.append(Verdict(f"Assumption: {label}", status, reason))
-    tail = "" if enough else f" (only {n} of {NSSDA_MIN_CHECKPOINTS} check points)"
+        verdicts.append(Verdict(name, status, reason))
+    tail = (
+        ""
+        if enough
+        else _t(" (only {n} of {minimum} check points)", n=n, minimum=NSSDA_MIN_CHECKPOINTS)
+    )
     verdicts.append(
         Verdict(
             _t("Horizontal accuracy (95 %)"),
             "info" if enough else "insufficient",
-            f"Tested {acc_r:.3f} m horizontal accuracy at 95 % confidence level{tail}",
+            _t(
+                "Tested {value:.3f} m horizontal accuracy at 95 % confidence level{few}",
+                value=acc_r,
+                few=tail,
+            ),
             acc_r,
             None,
         )
@@ -497,7 +543,11 @@ def nssda(
         Verdict(
             _t("Vertical accuracy (95 %)"),
             "info" if enough else "insufficient",
-            f"Tested {acc_z:.3f} m vertical accuracy at 95 % confidence level{tail}",
+            _t(
+                "Tested {value:.3f} m vertical accuracy at 95 % confidence level{few}",
+                value=acc_z,
+                few=tail,
+            ),
             acc_z,
             None,
         )
@@ -627,8 +677,12 @@ def pec_pcd(
         Verdict(
             _t("Check-point count"),
             "pass" if enough else "insufficient",
-            f"{n} check points; fewer than {PEC_RECOMMENDED_MIN_POINTS} makes the 90 % rule "
-            "weak (common practice, not in the Decreto)",
+            _t(
+                "{n} check points; fewer than {minimum} makes the 90 % rule weak (common "
+                "practice, not in the Decreto)",
+                n=n,
+                minimum=PEC_RECOMMENDED_MIN_POINTS,
+            ),
             float(n),
             float(PEC_RECOMMENDED_MIN_POINTS),
             unit="points",
@@ -642,7 +696,11 @@ def pec_pcd(
     ):
         for c in PEC_CLASSES:
             pec, ep = limits[c][pk], limits[c][ek]
-            name = f"Class {c} {kind}"
+            name = (
+                _t("Class {cls} planimetric", cls=c)
+                if kind == "planimetric"
+                else _t("Class {cls} altimetric", cls=c)
+            )
             if not math.isfinite(pec):
                 verdicts.append(
                     Verdict(name, "info", _t("no equidistance given for this scale"), None, None)
@@ -651,10 +709,16 @@ def pec_pcd(
             share = float(np.mean(values <= pec + _TOL))
             ok90 = share >= PEC_FRACTION
             ok_ep = rms <= ep + _TOL
-            reason = (
-                f"{100 * share:.1f} % of {n} points within PEC {pec:.3f} m "
-                f"({'>=' if ok90 else '<'} 90 %); RMS {rms:.3f} m "
-                f"{'<=' if ok_ep else '>'} EP {ep:.3f} m"
+            reason = _t(
+                "{share:.1f} % of {n} points within PEC {pec:.3f} m ({share_relation} 90 %); "
+                "RMS {rms:.3f} m {rms_relation} EP {ep:.3f} m",
+                share=100 * share,
+                n=n,
+                pec=pec,
+                share_relation=">=" if ok90 else "<",
+                rms=rms,
+                rms_relation="<=" if ok_ep else ">",
+                ep=ep,
             )
             # The Decreto sets no minimum sample: the class verdict stands, the count verdict
             # above warns when the sample is small.
@@ -665,11 +729,16 @@ def pec_pcd(
             figures[f"{kind}_{c}_share_within_pec"] = share
     eq = _equidistance(scale, equidistance)
     figures["equidistance"] = eq if eq else math.nan
+    none = _t("none")
     notes = [
-        f"Scale 1:{float(scale):,.0f}; equidistance "
-        + (f"{eq:g} m" if eq else "not given")
-        + f". Best class met: planimetric {best['planimetric'] or 'none'}, altimetric "
-        f"{best['altimetric'] or 'none'}.",
+        _t(
+            "Scale 1:{scale:,.0f}; equidistance {equidistance}. Best class met: planimetric "
+            "{planimetric}, altimetric {altimetric}.",
+            scale=float(scale),
+            equidistance=_t("{value:g} m", value=eq) if eq else _t("not given"),
+            planimetric=best["planimetric"] or none,
+            altimetric=best["altimetric"] or none,
+        ),
         _t(
             "PEC-PCD limits: planimetric A-D 0.28/0.5/0.8/1.0 mm (EP 0.17/0.3/0.5/0.6 mm) at "
             "the map scale; altimetric A-D 0.27/0.50/0.60/0.75 of the equidistance (EP 1/6, "
@@ -680,7 +749,11 @@ def pec_pcd(
         v = next(x for x in verdicts if x.name == f"Class {target} {kind}")
         verdicts.append(
             Verdict(
-                f"Declared class {target} ({kind})",
+                (
+                    _t("Declared class {cls} (planimetric)", cls=target)
+                    if kind == "planimetric"
+                    else _t("Declared class {cls} (altimetric)", cls=target)
+                ),
                 v.status,
                 v.reason,
                 v.measured,
@@ -689,7 +762,7 @@ def pec_pcd(
         )
     return StandardResult(
         key="pec",
-        title=f"PEC-PCD (Decreto 89.817 / ET-CQDG), 1:{float(scale):,.0f}",
+        title=_t("PEC-PCD (Decreto 89.817 / ET-CQDG), 1:{scale:,.0f}", scale=float(scale)),
         reference=(
             "Decreto 89.817 de 20/06/1984, art. 8-9; PEC-PCD of the ET-ADGV (2011/2016) and "
             "ET-CQDG (2016), DSG - Exército Brasileiro"
@@ -765,7 +838,7 @@ def project_threshold(
         raise InputError(f"the planimetric threshold must be positive, got {h_threshold}")
     if v_threshold:
         dz = float(v_threshold)
-        how = "given"
+        how = _t("given")
     else:
         if len(flight_geometry) != 4:
             raise InputError(
@@ -773,7 +846,13 @@ def project_threshold(
             )
         dz = stereo_height_precision(*(float(x) for x in flight_geometry))
         h, b, f, s = flight_geometry
-        how = f"Eq. 18 with H {h:g} m, B {b:g} m, f {f:g} mm, sigma_pix {s:g} um"
+        how = _t(
+            "Eq. 18 with H {height:g} m, B {base:g} m, f {focal:g} mm, sigma_pix {pixel:g} um",
+            height=h,
+            base=b,
+            focal=f,
+            pixel=s,
+        )
     horiz = np.hypot(d[:, 0], d[:, 1])
     rms_h, rms_v = _rmse(horiz), _rmse(d[:, 2])
     n_h = int(np.sum(horiz > h_threshold + _TOL))
@@ -783,16 +862,30 @@ def project_threshold(
         Verdict(
             _t("Planimetric RMSE"),
             "pass" if ok_h else "fail",
-            f"RMSE {rms_h:.3f} m {'<=' if ok_h else '>'} {h_threshold:.3f} m; "
-            f"{n_h} of {n} points beyond it",
+            _t(
+                "RMSE {rmse:.3f} m {relation} {limit:.3f} m; {beyond} of {n} points beyond it",
+                rmse=rms_h,
+                relation="<=" if ok_h else ">",
+                limit=h_threshold,
+                beyond=n_h,
+                n=n,
+            ),
             rms_h,
             h_threshold,
         ),
         Verdict(
             _t("Vertical RMSE"),
             "pass" if ok_v else "fail",
-            f"RMSE {rms_v:.3f} m {'<=' if ok_v else '>'} dz {dz:.3f} m ({how}); "
-            f"{n_v} of {n} points beyond it",
+            _t(
+                "RMSE {rmse:.3f} m {relation} dz {limit:.3f} m ({how}); {beyond} of {n} points "
+                "beyond it",
+                rmse=rms_v,
+                relation="<=" if ok_v else ">",
+                limit=dz,
+                how=how,
+                beyond=n_v,
+                n=n,
+            ),
             rms_v,
             dz,
         ),

@@ -251,6 +251,6 @@ def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
     )
     if adj.warnings:
         out.append(f"<h2>{t('Warnings')}</h2><ul>"
-                   + "".join(f"<li>{_e(x)}</li>" for x in adj.warnings) + "</ul>")  # fmt: skip
+                   + "".join(f"<li>{_e(t(x))}</li>" for x in adj.warnings) + "</ul>")  # fmt: skip
     out.append("</body></html>")
     return "\n".join(out)

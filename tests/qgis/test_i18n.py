@@ -187,3 +187,24 @@ def test_provider_and_dock_in_portuguese(compiled_qm, provider, qgis_iface, tmp_
     alg = QgsApplication.processingRegistry().algorithmById("lidarphoto:bundleadjustment")
     assert alg.create().displayName() == "Bundle adjustment with self-calibration"
     assert core_i18n.current_language() == "en"
+
+
+def test_plugin_messages_in_portuguese(compiled_qm, tmp_path):
+    """The picking dock's image messages (the Qt-free image source's errors, the overview
+    task's) follow QGIS's language; English again without the translator."""
+    from lidarphoto.plugin.image_source import ImageSource, ImageSourceError, error_text
+    from lidarphoto.processing_provider.i18n import install_translator, remove_translator
+    from qgis.PyQt.QtCore import QCoreApplication
+
+    missing = tmp_path / "none.tif"
+    with pytest.raises(ImageSourceError) as info:
+        ImageSource(missing)
+    assert str(info.value) == f"{missing}: the image file does not exist"
+    assert install_translator("pt_BR") == "pt_BR"
+    try:
+        assert error_text(info.value) == f"{missing}: o arquivo de imagem não existe"
+        text = QCoreApplication.translate("OverviewTask", "{path}: overview build cancelled")
+        assert text.format(path="a.tif") == "a.tif: construção das visões gerais cancelada"
+    finally:
+        remove_translator()
+    assert error_text(info.value) == f"{missing}: the image file does not exist"
