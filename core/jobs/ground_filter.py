@@ -199,15 +199,14 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         v.method,
     )
     result = ground_filter(
-        cloud.values("x"),
-        cloud.values("y"),
-        cloud.values("z"),
-        params,
+        cloud.scaled_xyz(),  # the records' integers: no float64 x, y, z of every point
+        params=params,
         return_number=cloud.values("return_number") if returns else None,
         number_of_returns=cloud.values("number_of_returns") if returns else None,
         unit_to_metre=info.unit_to_metre,
         vertical_unit_to_metre=info.vertical_unit_to_metre,
         unit=info.horizontal_unit,
+        heights=v.height_above_ground,
         progress=compute,
         should_stop=should_stop,
     )
