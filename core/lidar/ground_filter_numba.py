@@ -149,8 +149,9 @@ def low_pass(flat: Any, zr: Any, candidate: Any, low: Any, reference: Any, aroun
     """:func:`_low_pass_kernel` over every point; returns the number of new low outliers."""
     use = candidate is not None
     ring = around is not None
-    return int(_compiled("low_pass")(flat, zr, candidate if use else _NO_BOOL, use, low,
-                                     reference, around if ring else _NO_FLOAT, ring, zmin))  # fmt: skip
+    kernel = _compiled("low_pass")
+    return int(kernel(flat, zr, candidate if use else _NO_BOOL, use, low, reference,
+                      around if ring else _NO_FLOAT, ring, zmin))  # fmt: skip
 
 
 def classify(part: Any, grid: Any, lo: int, flat: Any, zr: Any, dtm: Any, thr: Any, low: Any,

@@ -37,8 +37,9 @@ PARAMS = {
     "smrf": SmrfParams(),
     "smrf_slope_estimated": SmrfParams(slope=0.0),
     "pmf": GroundFilterParams(),
-    "pmf_disk_exponential": GroundFilterParams(growth="exponential", window_base=2.0,
-                                               window_shape="disk"),  # fmt: skip
+    "pmf_disk_exponential": GroundFilterParams(
+        growth="exponential", window_base=2.0, window_shape="disk"
+    ),
     "csf": CsfParams(iterations=200),
 }
 
@@ -129,7 +130,7 @@ def test_every_point_step_gives_the_same_bits_with_numba(monkeypatch):
     them: any split gives the same result."""
     from lidarphoto.core.lidar import ground_filter as gf
 
-    x, y, z, ret, number = _terrain("low_outliers", 12)
+    x, y, z, *_ = _terrain("low_outliers", 12)
     ref = ground_filter(x, y, z, backend="numpy")
     for parts in (1, 2, 7):
         xyz = _scaled(x, y, z, scale=(1e-4, 1e-4, 1e-4), offset=(0.0, 0.0, 0.0), parts=parts)
