@@ -214,7 +214,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if v.non_ground_class == "unclassified":
         cls[:] = UNCLASSIFIED_CLASS
     else:  # a point the file had as ground but the filter rejects becomes unclassified
-        cls[(cls == GROUND_CLASS) & ~result.ground] = UNCLASSIFIED_CLASS
+        cls[cls == GROUND_CLASS] = UNCLASSIFIED_CLASS  # (those it keeps get 2 again below)
     cls[result.ground] = GROUND_CLASS
     cls[result.low_outlier] = LOW_NOISE_CLASS
     write_cloud(
@@ -232,7 +232,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             out.path("OUTPUT_DTM"), result.dtm, result.geotransform, result.nodata, crs_wkt or None
         )
     unit = unit_text(info, v.distance_unit)
-    ground, low = int(result.ground.sum()), int(result.low_outlier.sum())
+    ground, low = result.stats["ground_count"], result.stats["low_outlier_count"]
     slope = result.stats.get("slope_estimated")
     estimated = f"; terrain slope estimated at {slope:.3f}" if slope is not None else ""
     return JobResult(

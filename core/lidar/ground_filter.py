@@ -569,21 +569,28 @@ def _low_references(
 def _low_points(
     reference: NDArray[np.float32],
     around: NDArray[np.float32] | None,
+    zmin: NDArray[np.float32],
     zc: NDArray[np.float32],
     flat: NDArray[np.int32],
-) -> NDArray[np.bool_]:
-    """The points below their cell's references (:func:`_low_references`), compared
-    ``_POINT_CHUNK`` at a time, so that a pass allocates one boolean per point instead of
-    several full-size temporaries (fresh memory costs page faults: a second of system time at
-    10 M points)."""
-    low = np.empty(len(zc), dtype=bool)
-    for start in range(0, len(zc), _POINT_CHUNK):
-        s = slice(start, start + _POINT_CHUNK)
-        f, z = flat[s], zc[s]
-        part = np.less(z, reference[f], out=low[s])
-        if around is not None:
-            part |= z < around[f]
-    return low
+) -> NDArray[np.intp]:
+    """Indices of the points below their cell's references (:func:`_low_references`).
+
+    Only a cell whose lowest point (``zmin``, the minimum of ``zc``) is below a reference can
+    hold such a point: the points of those cells are found with one boolean look-up per
+    point and only they are compared (low outliers are rare), instead of full-size gathers
+    and comparisons of every point."""
+    lowest = zmin.ravel()
+    suspect = lowest < reference
+    if around is not None:
+        suspect |= lowest < around
+    if not suspect.any():
+        return np.zeros(0, dtype=np.intp)
+    idx = np.flatnonzero(suspect[flat])
+    f, z = flat[idx], zc[idx]
+    below = z < reference[f]
+    if around is not None:
+        below |= z < around[f]
+    return idx[below]
 
 
 def _estimate_slope(
@@ -761,10 +768,10 @@ def ground_filter(
                 zmin = rebuilt.reshape(zmin.shape)
                 continue
             assert zc is not None
-            new = _low_points(reference, around, zc, flat)
-            if not new.any():
+            new = _low_points(reference, around, zmin, zc, flat)
+            if not len(new):
                 break
-            low |= new
+            low[new] = True
             if zc is zr:  # zr is kept for the heights: zc becomes a copy before it changes
                 zc = zr.copy()
             zc[new] = np.inf
@@ -839,6 +846,7 @@ def ground_filter(
                 hag[s] = h
             report(0.6 + 0.4 * s.stop / n)
 
+    ground_count, low_count = int(np.count_nonzero(ground)), int(np.count_nonzero(low))
     dtm_out = (dtm.astype(np.float64) + z0).astype(np.float32)
     dtm_out[~reach] = NODATA
     LOG.info(
@@ -853,9 +861,9 @@ def ground_filter(
         unit,
         windows,
         [round(t, 3) for t in thresholds],
-        int(ground.sum()),
-        100.0 * ground.mean(),
-        int(low.sum()),
+        ground_count,
+        100.0 * ground_count / n,
+        low_count,
     )
     return GroundFilterResult(
         ground=ground,
@@ -868,7 +876,7 @@ def ground_filter(
         thresholds=tuple(thresholds),
         params=p,
         unit=unit,
-        stats={"ground_count": int(ground.sum()), "low_outlier_count": int(low.sum()), **stats},
+        stats={"ground_count": ground_count, "low_outlier_count": low_count, **stats},
     )
 
 
