@@ -32,7 +32,7 @@ except Exception:  # ImportError, or a numba built against another numpy
     numba = None
     AVAILABLE = False
 
-__all__ = ["AVAILABLE", "cells", "classify", "low_pass"]
+__all__ = ["AVAILABLE", "bounds", "cells", "classify", "low_pass"]
 
 
 def _cells_kernel(X, Y, Z, sx, ox, sy, oy, sz, oz, x0, y_top, inv, cols, rows, z0, cand,
@@ -60,6 +60,16 @@ def _cells_kernel(X, Y, Z, sx, ox, sy, oy, sz, oz, x0, y_top, inv, cols, rows, z
         zr[j] = h
         if (not use_cand or cand[j]) and h < zmin[f]:
             zmin[f] = h
+
+
+def _bounds_kernel(X, Y, Z, out):
+    """Smallest and largest X, Y, Z into out (3, 2), updated (one pass over the records)."""
+    for i in range(X.shape[0]):
+        for k, v in ((0, X[i]), (1, Y[i]), (2, Z[i])):
+            if v < out[k, 0]:
+                out[k, 0] = v
+            if v > out[k, 1]:
+                out[k, 1] = v
 
 
 def _low_pass_kernel(flat, zr, cand, use_cand, low, reference, around, use_around, zmin):
@@ -124,7 +134,7 @@ def _compiled(name: str) -> Callable[..., Any]:
     this module; no kernel calls another, so the cache is not tied to the import name)."""
     if name not in _COMPILED:
         func = {"cells": _cells_kernel, "low_pass": _low_pass_kernel,
-                "classify": _classify_kernel}[name]  # fmt: skip
+                "classify": _classify_kernel, "bounds": _bounds_kernel}[name]  # fmt: skip
         _COMPILED[name] = numba.njit(cache=True, nogil=True)(func)
     return _COMPILED[name]
 
@@ -164,3 +174,13 @@ def classify(part: Any, grid: Any, lo: int, flat: Any, zr: Any, dtm: Any, thr: A
                           float(grid.y_top), 1.0 / grid.cell, int(grid.cols), int(grid.rows),
                           int(lo), flat, zr, dtm, thr, low, candidate if use else _NO_BOOL, use,
                           nodata, ground, hag if want else _NO_FLOAT, want)  # fmt: skip
+
+
+def bounds(chunks: Any) -> Any:
+    """(3, 2) smallest and largest integer X, Y, Z over chunks of (X, Y, Z) (int64)."""
+    out = np.empty((3, 2), dtype=np.int64)
+    out[:, 0] = np.iinfo(np.int64).max
+    out[:, 1] = np.iinfo(np.int64).min
+    for X, Y, Z in chunks:
+        _compiled("bounds")(X, Y, Z, out)
+    return out

@@ -118,6 +118,10 @@ def test_scaled_coordinates_are_those_of_the_las_rule():
     xyz = ScaledXYZ(chunks=(tuple(a[:400] for a in ints), tuple(a[400:] for a in ints)),
                     scales=(0.001, -0.01, 0.0025), offsets=(5e5, 6e6, -10.0))  # fmt: skip
     lo, hi = xyz.bounds()
+    assert [a.tolist() for a in xyz.bounds(compiled.bounds(xyz.chunks))] == [
+        lo.tolist(),
+        hi.tolist(),
+    ]
     for k in range(3):
         expected = ints[k] * xyz.scales[k] + xyz.offsets[k]
         assert xyz.axis(k).tobytes() == expected.tobytes()
