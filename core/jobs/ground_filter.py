@@ -290,8 +290,9 @@ def _check_against_data(v: Values, info) -> None:
     factor = info.unit_to_metre if metre else 1.0
     unit = "m" if metre else info.horizontal_unit
     mins, maxs = info.mins[:2] * factor, info.maxs[:2] * factor
-    # + x, y, z, class, returns as arrays, and the records kept for the copy
-    per_point = GROUND_FILTER_BYTES_PER_POINT + 27 + info.record_size
+    # + class and returns as arrays and the records kept for the copy (x, y, z are read from
+    # the records a block at a time)
+    per_point = GROUND_FILTER_BYTES_PER_POINT + 3 + info.record_size
     cell_key, window_key = _GRID[v.method]
     check_cell_size(cell_key, v[cell_key], unit, mins, maxs, GROUND_FILTER_BYTES_PER_CELL,
                     extra_bytes=info.point_count * per_point)  # fmt: skip
