@@ -1,7 +1,9 @@
 """Ground filters on a minimum grid: PMF (Zhang et al. 2003), SMRF (Pingel et al. 2013) and
 the cloth simulation filter CSF (Zhang et al. 2016).
 
-Shared steps (all grid work is vectorised with OpenCV/scipy.ndimage, all point work with numpy):
+Shared steps (all grid work is vectorised with OpenCV/scipy.ndimage; the point work is vectorised
+with numpy, or compiled with numba when installed (:mod:`core.lidar.ground_filter_numba`, the same
+bits); the coordinates come as float64 arrays or as the LAS records' integers, :class:`ScaledXYZ`):
 
 1. **Candidates.** Where the file has return numbers, only last (and single) returns can be
    ground: earlier returns of a multi-return pulse were stopped by something above the ground.
