@@ -644,7 +644,7 @@ def _within(cells: NDArray[np.bool_], radius: float) -> NDArray[np.bool_]:
     --------
     >>> cells = np.zeros((5, 7), bool)
     >>> cells[2, 3] = True
-    >>> _within(cells, 1.5).astype(int).sum(), _within(cells, 2.5).astype(int).sum()
+    >>> int(_within(cells, 1.5).sum()), int(_within(cells, 2.5).sum())
     (9, 21)
     """
     import cv2
