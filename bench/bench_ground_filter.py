@@ -10,7 +10,9 @@ Sections:
 
 1. End to end (LAZ in, LAZ out): ``laspy.read`` + ``LasData.write`` of the file (the floor)
    against the ``groundfilter`` job (read -> classify -> write) in the same run, 10 M points,
-   ``--e2e-runs`` times each, alternating (``--before``: also an older copy's job).
+   ``--e2e-runs`` times each, alternating: the job as shipped (numba when installed), the job
+   with the numpy back end, and with ``--before`` an older copy's job; the classes written
+   by every job run must be the same bits (SHA-1 of the classification, asserted).
 2. Algorithm alone (points in memory, median of ``--runs``), peak RSS, and agreement with the
    producer's ground class (AHN3).
 3. Synthetic terrain classes (core/simulation/terrain.py): total error of every method, of
@@ -26,6 +28,7 @@ lengths given in metres and converted, CSF's x 3.2808 as in PEERS.md).
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
 import resource
@@ -137,25 +140,39 @@ def worker(task: str, path: str, feet: bool, runs: int) -> dict:
         with tempfile.TemporaryDirectory(dir=os.path.dirname(path)) as tmp:
             par = laspy.LazBackend.LazrsParallel  # laspy's default, made explicit
             t, c = time.perf_counter(), time.process_time()
+            r0 = resource.getrusage(resource.RUSAGE_SELF)
             las = laspy.read(path, laz_backend=par)
             t1 = time.perf_counter()
             las.write(Path(tmp) / "out.laz", laz_backend=par)
             t2 = time.perf_counter()
             cpu = time.process_time() - c
-        out.update(n=len(las.points), read_s=t1 - t, write_s=t2 - t1, io_s=t2 - t, cpu_s=cpu)
-    elif task == "job":  # the groundfilter job end to end, LAZ to LAZ
+            r1 = resource.getrusage(resource.RUSAGE_SELF)
+        out.update(n=len(las.points), read_s=t1 - t, write_s=t2 - t1, io_s=t2 - t, cpu_s=cpu,
+                   user_s=r1.ru_utime - r0.ru_utime, sys_s=r1.ru_stime - r0.ru_stime)  # fmt: skip
+    elif task in ("job", "job_numpy"):  # the groundfilter job end to end, LAZ to LAZ
         import cv2  # noqa: F401  (imports the job makes, done before the clock starts as
         import laspy  # laspy is imported before the floor's clock)
         import scipy.ndimage  # noqa: F401
         from lidarphoto.core.jobs import ground_filter as job
         from lidarphoto.core.jobs.runner import run_job
 
+        if task == "job_numpy":  # the numpy back end of the per-point passes (no numba)
+            from lidarphoto.core.lidar import ground_filter as gf
+
+            if hasattr(gf, "_use_numba"):
+                gf._use_numba = lambda backend: False
         with tempfile.TemporaryDirectory(dir=os.path.dirname(path)) as tmp:
             raw = {"INPUT": path, "OUTPUT_CLOUD": str(Path(tmp) / "out.laz"),
                    "DISTANCE_UNIT": "metre", "CRS": "EPSG:7415" if crs else None}  # fmt: skip
             t, c = time.perf_counter(), time.process_time()
+            r0 = resource.getrusage(resource.RUSAGE_SELF)
             res = run_job(job, raw)
             out["io_s"], out["cpu_s"] = time.perf_counter() - t, time.process_time() - c
+            r1 = resource.getrusage(resource.RUSAGE_SELF)
+            out["user_s"], out["sys_s"] = r1.ru_utime - r0.ru_utime, r1.ru_stime - r0.ru_stime
+            # the classes written, for the bit-identity check across runs and versions
+            classes = laspy.read(Path(tmp) / "out.laz").classification
+            out["classes_sha1"] = hashlib.sha1(np.asarray(classes).tobytes()).hexdigest()
         out.update(n=res.results["POINT_COUNT"], ground=res.results["GROUND_COUNT"])
     elif task.startswith("alg_"):
         method = task[4:]
@@ -301,12 +318,16 @@ def main() -> None:
         for label, path, feet in files:
             # end to end: the floor and our job, twice each, alternating (the machine is shared)
             for _ in range(args.e2e_runs):
-                for task in ("laspy_io", "job"):
+                for task in ("laspy_io", "job", "job_numpy"):
                     rows.append({**run_worker(task, path, feet), "label": label})
                 if args.before:
                     rows.append(
                         {**run_worker("job", path, feet, pythonpath=args.before), "label": label}
                     )
+            # bit-identical classes: every run of the job, both back ends and the older copy
+            hashes = {r.get("classes_sha1") for r in rows
+                      if r["label"] == label and r["task"].startswith("job")}  # fmt: skip
+            assert len(hashes) == 1 and None not in hashes, f"{label}: classes differ: {hashes}"
             for method in () if args.e2e_only else (*METHODS, "csf_package"):
                 runs = 1 if method.startswith("csf") else args.runs
                 rows.append({**run_worker(f"alg_{method}", path, feet, runs), "label": label})

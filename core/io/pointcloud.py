@@ -455,6 +455,19 @@ class LasPoints:
     def __len__(self) -> int:
         return sum(len(c) for c in self.chunks)
 
+    def scaled_xyz(self) -> Any:
+        """x, y, z as the records hold them (:class:`core.lidar.ground_filter.ScaledXYZ`:
+        views of the integer X, Y, Z fields of each chunk, the header's scales and offsets),
+        for algorithms that read the coordinates a block at a time instead of float64 copies
+        of every point."""
+        from ..lidar.ground_filter import ScaledXYZ
+
+        return ScaledXYZ(
+            chunks=tuple((c["X"], c["Y"], c["Z"]) for c in self.chunks),
+            scales=tuple(float(v) for v in self.header.scales),
+            offsets=tuple(float(v) for v in self.header.offsets),
+        )
+
     def values(self, name: str) -> NDArray[Any]:
         """One dimension as a new (N,) array: ``x``, ``y``, ``z`` scaled to float64 in the CRS
         unit, any other (``classification``, ``return_number``, extra bytes...) in its own

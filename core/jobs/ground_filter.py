@@ -199,15 +199,14 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         v.method,
     )
     result = ground_filter(
-        cloud.values("x"),
-        cloud.values("y"),
-        cloud.values("z"),
-        params,
+        cloud.scaled_xyz(),  # the records' integers: no float64 x, y, z of every point
+        params=params,
         return_number=cloud.values("return_number") if returns else None,
         number_of_returns=cloud.values("number_of_returns") if returns else None,
         unit_to_metre=info.unit_to_metre,
         vertical_unit_to_metre=info.vertical_unit_to_metre,
         unit=info.horizontal_unit,
+        heights=v.height_above_ground,
         progress=compute,
         should_stop=should_stop,
     )
@@ -215,7 +214,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if v.non_ground_class == "unclassified":
         cls[:] = UNCLASSIFIED_CLASS
     else:  # a point the file had as ground but the filter rejects becomes unclassified
-        cls[(cls == GROUND_CLASS) & ~result.ground] = UNCLASSIFIED_CLASS
+        cls[cls == GROUND_CLASS] = UNCLASSIFIED_CLASS  # (those it keeps get 2 again below)
     cls[result.ground] = GROUND_CLASS
     cls[result.low_outlier] = LOW_NOISE_CLASS
     write_cloud(
@@ -233,7 +232,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             out.path("OUTPUT_DTM"), result.dtm, result.geotransform, result.nodata, crs_wkt or None
         )
     unit = unit_text(info, v.distance_unit)
-    ground, low = int(result.ground.sum()), int(result.low_outlier.sum())
+    ground, low = result.stats["ground_count"], result.stats["low_outlier_count"]
     slope = result.stats.get("slope_estimated")
     estimated = f"; terrain slope estimated at {slope:.3f}" if slope is not None else ""
     return JobResult(
@@ -291,8 +290,9 @@ def _check_against_data(v: Values, info) -> None:
     factor = info.unit_to_metre if metre else 1.0
     unit = "m" if metre else info.horizontal_unit
     mins, maxs = info.mins[:2] * factor, info.maxs[:2] * factor
-    # + x, y, z, class, returns as arrays, and the records kept for the copy
-    per_point = GROUND_FILTER_BYTES_PER_POINT + 27 + info.record_size
+    # + class and returns as arrays and the records kept for the copy (x, y, z are read from
+    # the records a block at a time)
+    per_point = GROUND_FILTER_BYTES_PER_POINT + 3 + info.record_size
     cell_key, window_key = _GRID[v.method]
     check_cell_size(cell_key, v[cell_key], unit, mins, maxs, GROUND_FILTER_BYTES_PER_CELL,
                     extra_bytes=info.point_count * per_point)  # fmt: skip

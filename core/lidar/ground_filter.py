@@ -1,7 +1,9 @@
 """Ground filters on a minimum grid: PMF (Zhang et al. 2003), SMRF (Pingel et al. 2013) and
 the cloth simulation filter CSF (Zhang et al. 2016).
 
-Shared steps (all grid work is vectorised with OpenCV/scipy.ndimage, all point work with numpy):
+Shared steps (all grid work is vectorised with OpenCV/scipy.ndimage; the point work is vectorised
+with numpy, or compiled with numba when installed (:mod:`core.lidar.ground_filter_numba`, the same
+bits); the coordinates come as float64 arrays or as the LAS records' integers, :class:`ScaledXYZ`):
 
 1. **Candidates.** Where the file has return numbers, only last (and single) returns can be
    ground: earlier returns of a multi-return pulse were stopped by something above the ground.
@@ -302,6 +304,117 @@ FilterParams = Union[GroundFilterParams, SmrfParams, CsfParams]
 
 
 @dataclass(frozen=True)
+class ScaledXYZ:
+    """Coordinates as LAS point records hold them: integers, ``x = X * scale + offset``
+    (float64, the LAS rule), in chunks in point order. The filter reads them a block at a time
+    instead of float64 x, y, z arrays of every point (240 MB at 10 M points, and the page
+    faults of fresh memory).
+
+    Attributes
+    ----------
+    chunks : sequence of (X, Y, Z)
+        (N_k,) integer arrays each (e.g. views of the records' X, Y, Z fields).
+    scales, offsets : tuple of 3 float
+        Of x, y, z.
+    """
+
+    chunks: tuple[tuple[NDArray[Any], NDArray[Any], NDArray[Any]], ...]
+    scales: tuple[float, float, float]
+    offsets: tuple[float, float, float]
+
+    def __len__(self) -> int:
+        return sum(len(c[0]) for c in self.chunks)
+
+    def axis(self, k: int) -> NDArray[np.float64]:
+        """Coordinate ``k`` (0 x, 1 y, 2 z) of every point as one float64 array."""
+        out = np.empty(len(self), dtype=np.float64)
+        done = 0
+        for chunk in self.chunks:
+            part = out[done : done + len(chunk[k])]
+            np.multiply(chunk[k], float(self.scales[k]), out=part)
+            part += float(self.offsets[k])
+            done += len(part)
+        return out
+
+    def bounds(
+        self, integers: NDArray[np.int64] | None = None
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(3,) minima and maxima of the scaled coordinates (exactly those of :meth:`axis`:
+        rounding is monotonic, so the extreme integers give the extreme coordinates);
+        ``integers``: the (3, 2) extreme integers when already known."""
+        if integers is None:
+            nonempty = [c for c in self.chunks if len(c[0])]
+            integers = np.array([[min(int(c[k].min()) for c in nonempty),
+                                  max(int(c[k].max()) for c in nonempty)]
+                                 for k in range(3)], dtype=np.int64)  # fmt: skip
+        ends = integers.astype(np.float64)
+        ends *= np.asarray(self.scales, dtype=np.float64)[:, None]
+        ends += np.asarray(self.offsets, dtype=np.float64)[:, None]
+        return ends.min(axis=1), ends.max(axis=1)
+
+
+class _Points:
+    """The filter's view of its points, from float64 arrays or from a :class:`ScaledXYZ`."""
+
+    def __init__(self, x: Any, y: Any, z: Any) -> None:
+        if isinstance(x, ScaledXYZ):
+            if y is not None or z is not None:
+                raise InputError("with ScaledXYZ coordinates, y and z must be None")
+            self.scaled: ScaledXYZ | None = x
+            self.n = len(x)
+        else:
+            if y is None or z is None:
+                raise InputError("x, y and z must be non-empty arrays of equal length")
+            self.scaled = None
+            self.xyz = (np.asarray(x), np.asarray(y), np.asarray(z))
+            self.n = len(self.xyz[2])
+            if len(self.xyz[0]) != self.n or len(self.xyz[1]) != self.n:
+                raise InputError("x, y and z must be non-empty arrays of equal length")
+
+    def bounds(self, compiled: bool) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        if self.scaled is not None:
+            if compiled:  # one pass over the records instead of six strided reductions
+                from .ground_filter_numba import bounds
+
+                return self.scaled.bounds(bounds(self.scaled.chunks))
+            return self.scaled.bounds()
+        return (np.array([float(a.min()) for a in self.xyz]),
+                np.array([float(a.max()) for a in self.xyz]))  # fmt: skip
+
+    def axis(self, k: int) -> NDArray[np.float64]:
+        return self.scaled.axis(k) if self.scaled is not None else self.xyz[k]
+
+    def parts(self) -> list[tuple[int, tuple[Any, ...]]]:
+        """(first index, (X, Y, Z, scales, offsets)) per chunk (arrays: one part, scale 1)."""
+        if self.scaled is None:
+            return [(0, (*self.xyz, (1.0, 1.0, 1.0), (0.0, 0.0, 0.0)))]
+        out, done = [], 0
+        for chunk in self.scaled.chunks:
+            out.append((done, (*chunk, self.scaled.scales, self.scaled.offsets)))
+            done += len(chunk[0])
+        return out
+
+    def blocks(self, should_stop: Callable[[], bool] | None, z: bool = True) -> Any:
+        """(slice, x, y, z) blocks of at most ``_POINT_CHUNK`` points, float64 (views of the
+        arrays, or computed from the integers as :meth:`ScaledXYZ.axis` does); z None when
+        not asked for."""
+        for lo, (X, Y, Z, scales, offsets) in self.parts():
+            for start in range(0, len(X), _POINT_CHUNK):
+                stop_if_asked(should_stop, "filtering the ground")
+                s = slice(start, start + _POINT_CHUNK)
+                out = []
+                for k, a in enumerate((X, Y, Z) if z else (X, Y)):
+                    if self.scaled is None:
+                        out.append(a[s])
+                    else:
+                        v = np.multiply(a[s], float(scales[k]))
+                        v += float(offsets[k])
+                        out.append(v)
+                yield (slice(lo + start, lo + start + len(out[0])), out[0], out[1],
+                       out[2] if z else None)  # fmt: skip
+
+
+@dataclass(frozen=True)
 class GroundFilterResult:
     """Result of :func:`ground_filter`.
 
@@ -311,8 +424,9 @@ class GroundFilterResult:
         (N,) True for ground points.
     low_outlier : NDArray[np.bool_]
         (N,) True for low outliers (never ground).
-    height_above_ground : NDArray[np.float32]
-        (N,) z minus the DTM at the point (vertical unit; NaN where the DTM is nodata).
+    height_above_ground : NDArray[np.float32] or None
+        (N,) z minus the DTM at the point (vertical unit; NaN where the DTM is nodata); None
+        when not asked for (``heights=False``).
     dtm : NDArray[np.float32]
         (rows, cols) ground surface at the cell centres, ``nodata`` where unknown.
     geotransform : tuple of 6 float
@@ -330,7 +444,7 @@ class GroundFilterResult:
 
     ground: NDArray[np.bool_]
     low_outlier: NDArray[np.bool_]
-    height_above_ground: NDArray[np.float32]
+    height_above_ground: NDArray[np.float32] | None
     dtm: NDArray[np.float32]
     geotransform: tuple[float, float, float, float, float, float]
     nodata: float
@@ -421,54 +535,69 @@ def _neighbour_min(surface: NDArray[np.float32], radius: int) -> NDArray[np.floa
     return cv2.erode(surface, kernel, borderType=cv2.BORDER_CONSTANT, borderValue=np.inf)
 
 
-def _low_outliers(
-    zmin: NDArray[np.float32],
-    zc: NDArray[np.float32],
-    flat: NDArray[np.int32],
-    radius: int,
-    depth: np.float32,
-) -> NDArray[np.bool_]:
-    """Points lower by more than ``depth`` than every other cell within ``radius`` cells (a
-    single outlier), or than every cell of the ring from ``LOW_RING`` x ``radius`` to
+def _low_references(
+    zmin: NDArray[np.float32], radius: int, depth: np.float32
+) -> tuple[NDArray[np.float32], NDArray[np.float32] | None]:
+    """The grid side of the low-outlier test: per cell (flat), the height a point must be
+    below to be low (``reference``), and ``around`` (or None) for the cluster test.
+
+    A point is low when lower by more than ``depth`` than every other cell within ``radius``
+    cells (a single outlier), or than every cell of the ring from ``LOW_RING`` x ``radius`` to
     ``radius`` when the low cells inside the ring form a blob smaller than the ring's hole (a
     cluster of multipath points, whose cells hide each other from the first test). Only
     cells holding points count (empty ones are +inf), so an outlier's value never stands in
     for a neighbour and a point without real neighbours is never low; a depression wider
     than the ring's hole is never low (its own cells are in the ring), nor is ground between
-    objects (the ring holds ground as low as it).
-
-    The tests are made on the grid; the points are compared with them ``_POINT_CHUNK`` at a
-    time, so that a pass allocates one boolean per point instead of several full-size
-    temporaries (fresh memory costs page faults: a second of system time at 10 M points)."""
+    objects (the ring holds ground as low as it)."""
     import cv2
 
     reference = _neighbour_min(zmin, radius).ravel() - depth
     # +inf where a cell has no real neighbour: no point is below it
     reference[~np.isfinite(reference)] = -np.inf
     inner = math.ceil(LOW_RING * radius)
-    around = blob = None
+    around = None
     if radius - inner >= 1:
         ring = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))
         hole = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * inner + 1, 2 * inner + 1))
         ring[radius - inner : radius + inner + 1, radius - inner : radius + inner + 1] &= 1 - hole
-        around = cv2.erode(zmin, ring, borderType=cv2.BORDER_CONSTANT, borderValue=np.inf)
-        around -= depth
-        pit = (zmin < around) & np.isfinite(around)
+        ring_min = cv2.erode(zmin, ring, borderType=cv2.BORDER_CONSTANT, borderValue=np.inf)
+        ring_min -= depth
+        pit = (zmin < ring_min) & np.isfinite(ring_min)
         if pit.any():
             _, labels, stats, _ = cv2.connectedComponentsWithStats(pit.astype(np.uint8), 8)
             small = stats[:, cv2.CC_STAT_AREA] <= int(hole.sum())
             small[0] = False
             blob = small[labels].ravel()
             # only blob cells count: elsewhere no point is below the ring
-            around = np.where(blob, around.ravel(), -np.inf).astype(np.float32)
-    low = np.empty(len(zc), dtype=bool)
-    for start in range(0, len(zc), _POINT_CHUNK):
-        s = slice(start, start + _POINT_CHUNK)
-        f, z = flat[s], zc[s]
-        part = np.less(z, reference[f], out=low[s])
-        if blob is not None:
-            part |= z < around[f]
-    return low
+            around = np.where(blob, ring_min.ravel(), -np.inf).astype(np.float32)
+    return reference, around
+
+
+def _low_points(
+    reference: NDArray[np.float32],
+    around: NDArray[np.float32] | None,
+    zmin: NDArray[np.float32],
+    zc: NDArray[np.float32],
+    flat: NDArray[np.int32],
+) -> NDArray[np.intp]:
+    """Indices of the points below their cell's references (:func:`_low_references`).
+
+    Only a cell whose lowest point (``zmin``, the minimum of ``zc``) is below a reference can
+    hold such a point: the points of those cells are found with one boolean look-up per
+    point and only they are compared (low outliers are rare), instead of full-size gathers
+    and comparisons of every point."""
+    lowest = zmin.ravel()
+    suspect = lowest < reference
+    if around is not None:
+        suspect |= lowest < around
+    if not suspect.any():
+        return np.zeros(0, dtype=np.intp)
+    idx = np.flatnonzero(suspect[flat])
+    f, z = flat[idx], zc[idx]
+    below = z < reference[f]
+    if around is not None:
+        below |= z < around[f]
+    return idx[below]
 
 
 def _estimate_slope(
@@ -495,13 +624,38 @@ def _estimate_slope(
     ground = ok & ~objects
     if not ground.any():
         return SLOPE_RANGE[0]
-    from scipy import ndimage
-
     surface = fill_holes(coarse, ground)
-    reach = ndimage.distance_transform_edt(~ground) <= windows[-1] / 2.0 + 1
+    reach = _within(ground, windows[-1] / 2.0 + 1)
     gr, gc = np.gradient(surface.astype(np.float64), first.cell_size)
     slope = np.hypot(gr, gc)[reach] / xy_per_z
     return float(np.clip(np.percentile(slope, SLOPE_PERCENTILE), *SLOPE_RANGE))
+
+
+def _within(cells: NDArray[np.bool_], radius: float) -> NDArray[np.bool_]:
+    """Cells whose centre is within ``radius`` cells (Euclidean) of a True cell.
+
+    OpenCV's exact distance transform (Felzenszwalb's, float32) is a third to a sixth of
+    scipy's CPU time; the radii here are half-integers (a window of ``w = 2 r + 1`` cells
+    gives ``r + 1.5``), which no distance ``sqrt(integer)`` equals, and up to 1000 cells the
+    nearest such distance is farther from the radius than float32's rounding, so both give
+    the same cells; other radii go to scipy (float64).
+
+    Examples
+    --------
+    >>> cells = np.zeros((5, 7), bool)
+    >>> cells[2, 3] = True
+    >>> int(_within(cells, 1.5).sum()), int(_within(cells, 2.5).sum())
+    (9, 21)
+    """
+    import cv2
+
+    if radius > 1000 or (2.0 * radius) % 2.0 != 1.0:
+        from scipy import ndimage
+
+        return ndimage.distance_transform_edt(~cells) <= radius
+    far = np.logical_not(cells).view(np.uint8)
+    dist = cv2.distanceTransform(far, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+    return dist <= radius
 
 
 def _progressive_opening(
@@ -522,9 +676,9 @@ def _progressive_opening(
 
 
 def ground_filter(
-    x: NDArray[np.float64],
-    y: NDArray[np.float64],
-    z: NDArray[np.float64],
+    x: NDArray[np.float64] | ScaledXYZ,
+    y: NDArray[np.float64] | None = None,
+    z: NDArray[np.float64] | None = None,
     params: FilterParams | None = None,
     *,
     return_number: NDArray[Any] | None = None,
@@ -532,6 +686,8 @@ def ground_filter(
     unit_to_metre: float = 1.0,
     vertical_unit_to_metre: float = 1.0,
     unit: str = "metre",
+    heights: bool = True,
+    backend: str = "auto",
     progress: Callable[[float], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
 ) -> GroundFilterResult:
@@ -540,7 +696,9 @@ def ground_filter(
     Parameters
     ----------
     x, y, z : (N,) float64
-        Coordinates in a projected CRS (horizontal unit ``unit``; z in the vertical unit).
+        Coordinates in a projected CRS (horizontal unit ``unit``; z in the vertical unit);
+        or ``x`` a :class:`ScaledXYZ` (the records' integers, read a block at a time) and
+        ``y``, ``z`` None.
     params : SmrfParams, GroundFilterParams (PMF) or CsfParams, optional
         SMRF with its defaults when None.
     return_number, number_of_returns : (N,) integer arrays, optional
@@ -550,6 +708,11 @@ def ground_filter(
         into z-per-xy units, and CSF's gravity into z units).
     unit : str
         Name of the horizontal unit, reported in the result.
+    heights : bool
+        Also return every point's height above the DTM (default); False saves its array.
+    backend : {"auto", "numba", "numpy"}
+        The per-point passes compiled with numba (:mod:`core.lidar.ground_filter_numba`,
+        "auto": when installed) or vectorised with numpy; both give the same bits.
     progress, should_stop : callable, optional
         Progress fraction in [0, 1]; cancellation (raises Cancelled), checked per step/chunk.
 
@@ -569,13 +732,15 @@ def ground_filter(
     """
     params = SmrfParams() if params is None else params
     params.validate()
+    compiled = _use_numba(backend)
     # slope is a ratio of real lengths: z units per xy unit = slope * (xy unit / z unit)
     xy_per_z = 1.0
     if unit_to_metre > 0 and vertical_unit_to_metre > 0:
         xy_per_z = unit_to_metre / vertical_unit_to_metre
     p = replace(params, slope=params.slope * xy_per_z) if hasattr(params, "slope") else params
-    n = len(z)
-    if n == 0 or len(x) != n or len(y) != n:
+    points = _Points(x, y, z)
+    n = points.n
+    if n == 0:
         raise InputError("x, y and z must be non-empty arrays of equal length")
     report = progress or (lambda _f: None)
 
@@ -586,9 +751,8 @@ def ground_filter(
             # malformed records (return 0) are treated as single returns
             candidate |= np.asarray(return_number) == 0
     cell = p.cell_size
-    mins = (float(x.min()), float(y.min()))
-    maxs = (float(x.max()), float(y.max()))
-    grid = Grid.covering(mins, maxs, cell)
+    mins, maxs = points.bounds(compiled)
+    grid = Grid.covering(mins[:2], maxs[:2], cell)
     if grid.rows * grid.cols > 400_000_000:
         name = "resolution" if p.method == "csf" else "cell_size"
         raise InputError(
@@ -596,18 +760,27 @@ def ground_filter(
             "for this extent (check the distance unit)",
             column=name,
         )
-    z0 = float(z.min())  # float32 grid values relative to the lowest point keep 0.1 mm
+    z0 = float(mins[2])  # float32 grid values relative to the lowest point keep 0.1 mm
     # int32 cell indices (the grid has at most 4e8 cells): half the memory of int64
     flat = np.empty(n, dtype=np.int32)
     zr = np.empty(n, dtype=np.float32)
-    for start in range(0, n, _POINT_CHUNK):
-        stop_if_asked(should_stop, "filtering the ground")
-        s = slice(start, start + _POINT_CHUNK)
-        flat[s] = grid.flat_index(x[s], y[s])
-        zr[s] = z[s] - z0
-    report(0.15)
-    zc = zr if candidate is None else np.where(candidate, zr, np.float32(np.inf))
-    zmin = _min_grid(grid, flat, zc)
+    # zc: the heights that count for the minimum grid (+inf: not a candidate, or low); the
+    # compiled passes derive it from zr, candidate and low instead of keeping a copy
+    zc: NDArray[np.float32] | None = None
+    if compiled:
+        from . import ground_filter_numba as nb
+
+        zmin = np.full(grid.rows * grid.cols, np.inf, dtype=np.float32)
+        for lo, part in points.parts():
+            stop_if_asked(should_stop, "filtering the ground")
+            nb.cells(part, grid, z0, candidate, lo, flat, zr, zmin)
+        zmin = zmin.reshape(grid.rows, grid.cols)
+    else:
+        for s, bx, by, bz in points.blocks(should_stop):
+            flat[s] = grid.flat_index(bx, by)
+            zr[s] = bz - z0
+        zc = zr if candidate is None else np.where(candidate, zr, np.float32(np.inf))
+        zmin = _min_grid(grid, flat, zc)
     if not np.isfinite(zmin).any():
         raise InputError("no ground candidate point (no last return?)")
     report(0.3)
@@ -615,12 +788,22 @@ def ground_filter(
     low = np.zeros(n, dtype=bool)
     if p.low_outlier_height > 0:
         radius = max(round(p.low_outlier_radius / cell), 1)
+        depth = np.float32(p.low_outlier_height)
         # A few passes: a deeper outlier nearby can hide a shallower one until it is removed.
         for _ in range(LOW_PASSES):
-            new = _low_outliers(zmin, zc, flat, radius, np.float32(p.low_outlier_height))
-            if not new.any():
+            stop_if_asked(should_stop, "filtering the ground")
+            reference, around = _low_references(zmin, radius, depth)
+            if compiled:
+                rebuilt = np.full(zmin.size, np.inf, dtype=np.float32)
+                if not nb.low_pass(flat, zr, candidate, low, reference, around, rebuilt):
+                    break
+                zmin = rebuilt.reshape(zmin.shape)
+                continue
+            assert zc is not None
+            new = _low_points(reference, around, zmin, zc, flat)
+            if not len(new):
                 break
-            low |= new
+            low[new] = True
             if zc is zr:  # zr is kept for the heights: zc becomes a copy before it changes
                 zc = zr.copy()
             zc[new] = np.inf
@@ -631,8 +814,14 @@ def ground_filter(
 
     stats: dict[str, Any] = {}
     if p.method == "csf":
+        if zc is None:  # the compiled passes keep no zc: made here, as the numpy passes have it
+            zc = zr.copy()
+            zc[low] = np.inf
+            if candidate is not None:
+                zc[~candidate] = np.inf
         g_xy = 1.0 / vertical_unit_to_metre if vertical_unit_to_metre > 0 else 1.0
-        dtm, steps, moved = _csf_cloth(grid, flat, x, y, zc, p, g_xy, should_stop)
+        dtm, steps, moved = _csf_cloth(grid, flat, points.axis(0), points.axis(1), zc, p, g_xy,
+                                       should_stop)  # fmt: skip
         windows, thresholds = [], []  # no openings in CSF
         stats["csf_steps"], stats["csf_last_move"] = steps, moved
         reach = np.ones(dtm.shape, dtype=bool)
@@ -655,10 +844,7 @@ def ground_filter(
         if not ground_cells.any():
             ground_cells = valid
         dtm = fill_holes(zmin, ground_cells)
-        from scipy import ndimage
-
-        dist = ndimage.distance_transform_edt(~ground_cells)
-        reach = dist <= (windows[-1] / 2.0 + 1)
+        reach = _within(ground_cells, windows[-1] / 2.0 + 1)
         gr, gc = np.gradient(dtm, cell)
         slope_cell = np.hypot(gr, gc).ravel()
         # the slope term uses the physical slope (rise/run); the scalar is in z units
@@ -666,28 +852,37 @@ def ground_filter(
     report(0.6)
 
     ground = np.empty(n, dtype=bool)
-    hag = np.empty(n, dtype=np.float32)
+    hag = np.empty(n, dtype=np.float32) if heights else None
     nodata_flat = ~reach.ravel()
-    for start in range(0, n, _POINT_CHUNK):
-        stop_if_asked(should_stop, "filtering the ground")
-        s = slice(start, start + _POINT_CHUNK)
-        h = zr[s] - grid.bilinear(dtm, x[s], y[s])
-        f = flat[s]
-        g = np.abs(h) <= thr_cell[f]
-        g &= ~low[s]
-        if candidate is not None:
-            g &= candidate[s]
-        h[nodata_flat[f]] = np.nan
-        ground[s] = g
-        hag[s] = h
-        report(0.6 + 0.4 * min(start + _POINT_CHUNK, n) / n)
+    if compiled:
+        dtm_flat = np.ascontiguousarray(dtm, dtype=np.float32).ravel()
+        for lo, part in points.parts():
+            stop_if_asked(should_stop, "filtering the ground")
+            nb.classify(part, grid, lo, flat, zr, dtm_flat, thr_cell, low, candidate,
+                        nodata_flat, ground, hag)  # fmt: skip
+            report(0.6 + 0.4 * (lo + len(part[0])) / n)
+    else:
+        for s, bx, by, _ in points.blocks(should_stop, z=False):
+            h = zr[s] - grid.bilinear(dtm, bx, by)
+            f = flat[s]
+            g = np.abs(h) <= thr_cell[f]
+            g &= ~low[s]
+            if candidate is not None:
+                g &= candidate[s]
+            ground[s] = g
+            if hag is not None:
+                h[nodata_flat[f]] = np.nan
+                hag[s] = h
+            report(0.6 + 0.4 * s.stop / n)
 
+    ground_count, low_count = int(np.count_nonzero(ground)), int(np.count_nonzero(low))
     dtm_out = (dtm.astype(np.float64) + z0).astype(np.float32)
     dtm_out[~reach] = NODATA
     LOG.info(
-        "ground filter (%s): %d points, grid %d x %d cells of %g %s, windows %s cells, "
+        "ground filter (%s, %s): %d points, grid %d x %d cells of %g %s, windows %s cells, "
         "thresholds %s; %d ground (%.1f %%), %d low outliers",
         p.method,
+        "numba" if compiled else "numpy",
         n,
         grid.rows,
         grid.cols,
@@ -695,9 +890,9 @@ def ground_filter(
         unit,
         windows,
         [round(t, 3) for t in thresholds],
-        int(ground.sum()),
-        100.0 * ground.mean(),
-        int(low.sum()),
+        ground_count,
+        100.0 * ground_count / n,
+        low_count,
     )
     return GroundFilterResult(
         ground=ground,
@@ -710,8 +905,20 @@ def ground_filter(
         thresholds=tuple(thresholds),
         params=p,
         unit=unit,
-        stats={"ground_count": int(ground.sum()), "low_outlier_count": int(low.sum()), **stats},
+        stats={"ground_count": ground_count, "low_outlier_count": low_count, **stats},
     )
+
+
+def _use_numba(backend: str) -> bool:
+    """Resolve ground_filter's ``backend`` argument."""
+    from .ground_filter_numba import AVAILABLE
+
+    if backend not in ("auto", "numba", "numpy"):
+        raise InputError(f"backend must be 'auto', 'numba' or 'numpy', got {backend!r}")
+    if backend == "numba" and not AVAILABLE:
+        raise InputError("backend 'numba' asked for, but numba is not installed "
+                         "(pip install numba)")  # fmt: skip
+    return AVAILABLE and backend != "numpy"
 
 
 def _csf_cloth(
