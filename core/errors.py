@@ -47,6 +47,21 @@ def stop_if_asked(should_stop: Callable[[], bool] | None, doing: str) -> None:
         raise Cancelled(f"cancelled while {doing}")
 
 
+def use_compiled(backend: str, available: bool) -> bool:
+    """Resolve a ``backend`` argument (``"auto"``, ``"numba"`` or ``"numpy"``) of a function
+    with a numba kernel: True to run the compiled kernel. ``available``: numba imported.
+
+    >>> use_compiled("auto", False), use_compiled("numpy", True), use_compiled("auto", True)
+    (False, False, True)
+    """
+    if backend not in ("auto", "numba", "numpy"):
+        raise InputError(f"backend must be 'auto', 'numba' or 'numpy', got {backend!r}")
+    if backend == "numba" and not available:
+        raise InputError("backend 'numba' asked for, but numba is not installed "
+                         "(pip install numba)")  # fmt: skip
+    return available and backend != "numpy"
+
+
 class AdjustmentError(LidarPhotoError):
     """A least-squares adjustment could not produce trustworthy numbers."""
 

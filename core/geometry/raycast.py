@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InputError, stop_if_asked
+from ..errors import InputError, stop_if_asked, use_compiled
 from .surface import Dsm
 
 Array = NDArray[np.float64]
@@ -480,12 +480,7 @@ def _use_numba(backend: str) -> bool:
     """Resolve intersect_dsm's ``backend`` argument."""
     from .raycast_numba import AVAILABLE
 
-    if backend not in ("auto", "numba", "numpy"):
-        raise ValueError(f"backend must be 'auto', 'numba' or 'numpy', got {backend!r}")
-    if backend == "numba" and not AVAILABLE:
-        raise InputError("backend 'numba' asked for, but numba is not installed "
-                         "(pip install numba)")  # fmt: skip
-    return AVAILABLE and backend != "numpy"
+    return use_compiled(backend, AVAILABLE)
 
 
 def _describe_hits(

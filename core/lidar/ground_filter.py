@@ -66,7 +66,7 @@ from typing import Any, Union
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError, stop_if_asked
+from ..errors import InputError, stop_if_asked, use_compiled
 from ..geometry.grid import Grid, fill_holes, fill_nearest
 
 LOG = logging.getLogger(__name__)
@@ -913,12 +913,7 @@ def _use_numba(backend: str) -> bool:
     """Resolve ground_filter's ``backend`` argument."""
     from .ground_filter_numba import AVAILABLE
 
-    if backend not in ("auto", "numba", "numpy"):
-        raise InputError(f"backend must be 'auto', 'numba' or 'numpy', got {backend!r}")
-    if backend == "numba" and not AVAILABLE:
-        raise InputError("backend 'numba' asked for, but numba is not installed "
-                         "(pip install numba)")  # fmt: skip
-    return AVAILABLE and backend != "numpy"
+    return use_compiled(backend, AVAILABLE)
 
 
 def _csf_cloth(

@@ -45,7 +45,7 @@ from typing import Any, Callable, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InputError, stop_if_asked
+from ..errors import InputError, stop_if_asked, use_compiled
 from ..geometry.planes import Plane, fit_plane, fit_planes, label_moments
 
 __all__ = ["SELECTION_CHOICES", "RoofPlaneParams", "RoofPlaneResult", "extract_roof_planes"]
@@ -438,12 +438,7 @@ def _use_numba(backend: str) -> bool:
     """Resolve extract_roof_planes's ``backend`` argument."""
     from .roof_planes_numba import AVAILABLE
 
-    if backend not in ("auto", "numba", "numpy"):
-        raise InputError(f"backend must be 'auto', 'numba' or 'numpy', got {backend!r}")
-    if backend == "numba" and not AVAILABLE:
-        raise InputError("backend 'numba' asked for, but numba is not installed "
-                         "(pip install numba)")  # fmt: skip
-    return AVAILABLE and backend != "numpy"
+    return use_compiled(backend, AVAILABLE)
 
 
 def _grow(
