@@ -25,7 +25,6 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from lidarphoto.core.geometry.camera import camera_from_dict
 from lidarphoto.core.geometry.collinearity import project
 from lidarphoto.core.io.camera import write_camera_json
 from lidarphoto.core.io.raster import GeoTiffWriter
@@ -40,6 +39,8 @@ from lidarphoto.core.photo.control_plate import (
 )
 from lidarphoto.core.quality.registration import phase_correlation
 from lidarphoto.core.simulation.ground_photo import (
+    corner_errors,
+    ground_camera,
     make_ground_patch,
     render_ground_photo,
     render_ortho,
@@ -50,30 +51,12 @@ POINT = np.array([457_321.25, 7_552_104.75, 431.2])
 GSD, SIZE = 0.01, 101
 
 
-def _match(found: np.ndarray, truth: np.ndarray) -> np.ndarray:
-    best = None
-    for turn in range(4):
-        order = np.r_[(np.arange(4) + turn) % 4, 4 + (np.arange(4) + turn) % 4]
-        err = np.linalg.norm(found - truth[order], axis=1)
-        if best is None or err.max() < best.max():
-            best = err
-    return best
 
 
-def _camera(projection: str):
-    if projection == "perspective":
-        return camera_from_dict({"name": "ground", "focal_mm": 3.0, "pixel_size_mm": 0.005,
-                                 "width_px": 960, "height_px": 720,
-                                 "distortion": {"model": "brown_conrady", "k1": 4e-3}})  # fmt: skip
-    return camera_from_dict({"name": "fisheye", "focal_mm": 1.6, "pixel_size_mm": 0.0045,
-                             "width_px": 960, "height_px": 720, "projection": projection,
-                             "x0_mm": 0.02, "y0_mm": -0.015,
-                             "distortion": {"model": "brown_conrady", "k1": 2e-3,
-                                            "k2": -1e-4}})  # fmt: skip
 
 
 def main(seeds: int = 4, projection: str = "perspective") -> None:
-    cam = _camera(projection)
+    cam = ground_camera(projection)
     feature_m = 0.012 if projection == "perspective" else 0.02
     rng = np.random.default_rng(0)
     ours, peer, pose_m, pose_deg, ncc, off, t_job, cpu_job = [], [], [], [], [], [], [], []
@@ -89,11 +72,11 @@ def main(seeds: int = 4, projection: str = "perspective") -> None:
         b = render_ground_photo(patch, cam, free_eo, None, supersample=2, seed=2 * seed + 1)
         truth = project(PLATE.corners(), eo, cam)
         det = detect_plate(a, cam, PLATE)
-        ours.append(_match(det.corners_px, truth))
+        ours.append(corner_errors(det.corners_px, truth))
         # the same pose on uniform ground: the corners without the texture's bias
         flat_patch = dataclasses.replace(patch, grey=np.full_like(patch.grey, 120.0))
         flat_photo = render_ground_photo(flat_patch, cam, eo, PLATE, supersample=2, seed=99)
-        flat.append(_match(detect_plate(flat_photo, cam, PLATE).corners_px, truth))
+        flat.append(corner_errors(detect_plate(flat_photo, cam, PLATE).corners_px, truth))
         start = (truth + rng.uniform(-1, 1, truth.shape) - 0.5).astype(np.float32)
         sub = cv2.cornerSubPix(
             a,

@@ -29,11 +29,18 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..geometry.camera import Camera
+from ..geometry.camera import Camera, camera_from_dict
 from ..geometry.collinearity import image_rays
 from ..photo.control_plate import PlateGeometry
 
-__all__ = ["GroundPatch", "make_ground_patch", "render_ground_photo", "render_ortho"]
+__all__ = [
+    "GroundPatch",
+    "corner_errors",
+    "ground_camera",
+    "make_ground_patch",
+    "render_ground_photo",
+    "render_ortho",
+]
 
 #: Grey levels of the plate: the outer frame (black) and the inner square (white).
 PLATE_DARK = 15.0
@@ -184,3 +191,37 @@ def render_ortho(
     gx, gy = np.meshgrid(x0 + f * g, y0 - f * g)
     val = patch.sample(gx, gy).reshape(size_px, s, size_px, s)
     return val.mean(axis=(1, 3)).astype(np.float32)
+
+
+def ground_camera(projection: str = "perspective") -> Camera:
+    """The ground camera of the tests and benchmarks, 960 x 720 px: perspective (f 3 mm,
+    5 um pixels, k1 4e-3) or a fisheye of the given projection (f 1.6 mm, 4.5 um pixels,
+    principal point off the centre, k1 2e-3, k2 -1e-4: the image corners look beyond 90 deg)."""
+    if projection == "perspective":
+        return camera_from_dict({"name": "ground", "focal_mm": 3.0, "pixel_size_mm": 0.005,
+                                 "width_px": 960, "height_px": 720,
+                                 "distortion": {"model": "brown_conrady", "k1": 4e-3}})  # fmt: skip
+    return camera_from_dict({"name": "fisheye", "focal_mm": 1.6, "pixel_size_mm": 0.0045,
+                             "width_px": 960, "height_px": 720, "projection": projection,
+                             "x0_mm": 0.02, "y0_mm": -0.015,
+                             "distortion": {"model": "brown_conrady", "k1": 2e-3,
+                                            "k2": -1e-4}})  # fmt: skip
+
+
+def corner_errors(found: ArrayLike, truth: ArrayLike) -> NDArray[np.float64]:
+    """(8,) distance (px) of each found plate corner to its true corner, after the quarter
+    turn that fits best: the found order must be the plate's order up to that turn (outer and
+    inner together).
+
+    >>> t = np.arange(16.0).reshape(8, 2)
+    >>> float(corner_errors(t[[1, 2, 3, 0, 5, 6, 7, 4]], t).max())
+    0.0
+    """
+    found, truth = np.asarray(found, dtype=np.float64), np.asarray(truth, dtype=np.float64)
+    best = None
+    for turn in range(4):
+        order = np.r_[(np.arange(4) + turn) % 4, 4 + (np.arange(4) + turn) % 4]
+        err = np.linalg.norm(found - truth[order], axis=1)
+        if best is None or err.max() < best.max():
+            best = err
+    return best

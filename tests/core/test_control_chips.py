@@ -33,6 +33,8 @@ from lidarphoto.core.photo.control_plate import (
 )
 from lidarphoto.core.quality.registration import phase_correlation
 from lidarphoto.core.simulation.ground_photo import (
+    corner_errors,
+    ground_camera,
     make_ground_patch,
     render_ground_photo,
     render_ortho,
@@ -53,9 +55,7 @@ EO_FREE = EO_PLATE + np.array([0.004, -0.003, 0.002, *np.radians([1.0, 0.5, 4.0]
 
 @pytest.fixture(scope="module")
 def scene():
-    cam = camera_from_dict({"name": "ground", "focal_mm": 3.0, "pixel_size_mm": 0.005,
-                            "width_px": 960, "height_px": 720,
-                            "distortion": {"model": "brown_conrady", "k1": 4e-3}})  # fmt: skip
+    cam = ground_camera()
     patch = make_ground_patch(seed=3)
     plate_photo = render_ground_photo(patch, cam, EO_PLATE, PLATE, supersample=2, seed=4)
     free_photo = render_ground_photo(patch, cam, EO_FREE, None, supersample=2, seed=5)
@@ -63,16 +63,6 @@ def scene():
             "truth": project(PLATE.corners(), EO_PLATE, cam)}  # fmt: skip
 
 
-def _matched_errors(found: np.ndarray, truth: np.ndarray) -> np.ndarray:
-    """Distance of each found corner to its true corner, after the quarter turn that fits:
-    the found order must be the plate's order up to that turn (outer and inner together)."""
-    best = None
-    for turn in range(4):
-        order = np.r_[(np.arange(4) + turn) % 4, 4 + (np.arange(4) + turn) % 4]
-        err = np.linalg.norm(found - truth[order], axis=1)
-        if best is None or err.max() < best.max():
-            best = err
-    return best
 
 
 def test_lens_is_not_negligible(scene):
@@ -88,7 +78,7 @@ def test_lens_is_not_negligible(scene):
 def test_corners_sub_pixel_on_textured_ground(scene):
     det = detect_plate(scene["plate"], scene["cam"], PLATE)
     assert det.found, det.reason
-    err = _matched_errors(det.corners_px, scene["truth"])
+    err = corner_errors(det.corners_px, scene["truth"])
     # inner edges (plate against plate): a few hundredths; outer edges (plate against the
     # ground's texture) pulled by the texture up to about a tenth of a pixel
     assert err[4:].max() < 0.06
@@ -103,7 +93,7 @@ def test_corners_on_uniform_ground_within_their_sigmas(scene):
     photo = render_ground_photo(flat, scene["cam"], EO_PLATE, PLATE, supersample=1, seed=6)
     det = detect_plate(photo, scene["cam"], PLATE)
     assert det.found, det.reason
-    err = _matched_errors(det.corners_px, scene["truth"])
+    err = corner_errors(det.corners_px, scene["truth"])
     assert err.max() < 0.06
     assert (err < 4 * det.sigma_px + 0.02).all()
 

@@ -27,7 +27,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from lidarphoto.core.cli import main as cli_main
-from lidarphoto.core.geometry.camera import camera_from_dict
 from lidarphoto.core.geometry.collinearity import project
 from lidarphoto.core.geometry.projection import PROJECTIONS
 from lidarphoto.core.io.camera import read_camera_json, write_camera_json
@@ -44,6 +43,8 @@ from lidarphoto.core.photo.control_plate import (
 )
 from lidarphoto.core.quality.registration import phase_correlation
 from lidarphoto.core.simulation.ground_photo import (
+    corner_errors,
+    ground_camera,
     make_ground_patch,
     render_ground_photo,
     render_ortho,
@@ -59,17 +60,11 @@ EO_PLATE = np.array([0.45, -0.30, 1.80, *np.radians([3.0, -2.0, 25.0])])
 EO_FREE = EO_PLATE + np.array([0.004, -0.003, 0.002, *np.radians([1.0, 0.5, 4.0])])
 
 
-def _camera(projection: str):
-    return camera_from_dict({"name": "fisheye", "focal_mm": 1.6, "pixel_size_mm": 0.0045,
-                             "width_px": 960, "height_px": 720, "projection": projection,
-                             "x0_mm": 0.02, "y0_mm": -0.015,
-                             "distortion": {"model": "brown_conrady", "k1": 2e-3,
-                                            "k2": -1e-4}})  # fmt: skip
 
 
 @pytest.fixture(scope="module", params=["equidistant", "equisolid"])
 def scene(request):
-    cam = _camera(request.param)
+    cam = ground_camera(request.param)
     # the ground's features as wide in pixels as in the perspective tests (12 mm at 3 mm per
     # pixel there, 20 mm at 5 mm here): the outer corners' texture bias depends on that
     patch = make_ground_patch(feature_m=0.02, seed=3)
@@ -79,17 +74,9 @@ def scene(request):
             "truth": project(PLATE.corners(), EO_PLATE, cam)}  # fmt: skip
 
 
-def _matched_errors(found: np.ndarray, truth: np.ndarray) -> np.ndarray:
-    best = None
-    for turn in range(4):
-        order = np.r_[(np.arange(4) + turn) % 4, 4 + (np.arange(4) + turn) % 4]
-        err = np.linalg.norm(found - truth[order], axis=1)
-        if best is None or err.max() < best.max():
-            best = err
-    return best
 
 
-def test_the_fisheye_is_far_from_a_perspective_camera(scene):
+def test_the_fisheye_is_far_from_a_perspectiveground_camera(scene):
     """The same focal length as a perspective camera puts the corners pixels away, and the
     photo's corners look beyond 90 degrees (sky): code treating the camera as perspective
     would fail these tests."""
@@ -104,7 +91,7 @@ def test_ray_plane_of_a_fisheye():
     """Pixels <-> the ray plane z = -1 round trip, NaN for rays at or beyond 90 degrees (no
     point on that plane), and the plane -> pixel Jacobian (corner sigmas, edge normals)
     against central differences."""
-    cam = _camera("equidistant")
+    cam = ground_camera("equidistant")
     rng = np.random.default_rng(2)
     px = rng.uniform([300, 200], [660, 520], (50, 2))
     uv = plane_from_pixels(px, cam)
@@ -123,7 +110,7 @@ def test_ray_plane_of_a_fisheye():
 def test_fisheye_corners_sub_pixel_on_textured_ground(scene):
     det = detect_plate(scene["plate"], scene["cam"], PLATE)
     assert det.found, det.reason
-    err = _matched_errors(det.corners_px, scene["truth"])
+    err = corner_errors(det.corners_px, scene["truth"])
     assert err[4:].max() < 0.06
     assert err.max() < CORNER_PX
     assert (det.edge_points >= 30).all()
@@ -136,7 +123,7 @@ def test_fisheye_corners_on_uniform_ground_within_their_sigmas(scene):
     photo = render_ground_photo(flat, scene["cam"], EO_PLATE, PLATE, supersample=1, seed=6)
     det = detect_plate(photo, scene["cam"], PLATE)
     assert det.found, det.reason
-    err = _matched_errors(det.corners_px, scene["truth"])
+    err = corner_errors(det.corners_px, scene["truth"])
     assert err.max() < 0.06
     assert (err < 4 * det.sigma_px + 0.02).all(), (err, det.sigma_px)
 
