@@ -49,6 +49,15 @@ class Workflow:
         return " -> ".join(f"[{a}]" if a == mark else a for a in self.ids)
 
 
+#: steps shared by two workflows (one message each in the catalogue)
+_CHIPS_STEP = ("makecontrolchips", _t(
+    "POINTS = the surveyed control, PHOTOS = ground photos of each point with and without the "
+    "control plate, CAMERA = the ground camera; OUTPUT_FOLDER = one chip per point at the GSD "
+    "of the aerial images"))  # fmt: skip
+_LOCATE_STEP = ("locatecontrolpoints", _t(
+    "CHIPS = one GeoTIFF chip per control point, CONTROL_POINTS, CAMERA, approximate EO, "
+    "IMAGES; OUTPUT = the control points' image observations, without clicking them"))  # fmt: skip
+
 WORKFLOWS: tuple[Workflow, ...] = (
     Workflow(
         _t("Boresight calibration with LiDAR control (Pedrosa & dos Santos 2020)"),
@@ -89,12 +98,8 @@ WORKFLOWS: tuple[Workflow, ...] = (
              "OUTPUT_CAMERA = the camera JSON (start values for the block, or held fixed)")),
             ("tiepoints", _t("IMAGES (and the approximate EO + CAMERA to pair images by their "
              "footprints); OUTPUT_OBSERVATIONS = tie points for the bundle")),
-            ("makecontrolchips", _t("POINTS = the surveyed control, PHOTOS = ground photos of "
-             "each point with and without the control plate, CAMERA = the ground camera; "
-             "OUTPUT_FOLDER = one chip per point at the GSD of the aerial images")),
-            ("locatecontrolpoints", _t("CHIPS = one GeoTIFF chip per control point, "
-             "CONTROL_POINTS, CAMERA, approximate EO, IMAGES; OUTPUT = the control points' "
-             "image observations, without clicking them")),
+            _CHIPS_STEP,
+            _LOCATE_STEP,
             ("bundleadjustment", _t("CAMERA, OBSERVATIONS, GROUND_POINTS, EO (approximate); "
              "OUTPUT_EO = adjusted orientation, OUTPUT_CAMERA = calibrated camera")),
             ("groundfilter", _t("OUTPUT_DTM = the terrain for the orthophotos")),
@@ -110,12 +115,8 @@ WORKFLOWS: tuple[Workflow, ...] = (
         (
             ("trajectorytoeo", _t("INPUT = the GNSS/INS trajectory CSV; OUTPUT_CSV = the "
              "exterior orientation of every image")),
-            ("makecontrolchips", _t("POINTS = the surveyed control, PHOTOS = ground photos of "
-             "each point with and without the control plate, CAMERA = the ground camera; "
-             "OUTPUT_FOLDER = one chip per point at the GSD of the aerial images")),
-            ("locatecontrolpoints", _t("CHIPS = one GeoTIFF chip per control point, "
-             "CONTROL_POINTS, CAMERA, approximate EO, IMAGES; OUTPUT = the control points' "
-             "image observations, without clicking them")),
+            _CHIPS_STEP,
+            _LOCATE_STEP,
             ("boresightcalibration", _t("OBSERVATIONS = those control rows, GROUND_POINTS = the "
              "surveyed points (role control or check), TRAJECTORY; OUTPUT_TABLE = boresight "
              "per group, OUTPUT_EO = corrected orientation")),
