@@ -1007,6 +1007,42 @@
             <translation>{angle} = {value:.4f} graus no grupo {group}</translation>
         </message>
         <message>
+            <source>{summary} (details: lidarphoto -vv; QGIS: Processing logging level Verbose)</source>
+            <translation>{summary} (detalhes: lidarphoto -vv; QGIS: opções do Processamento, nível de log Verbose)</translation>
+        </message>
+        <message>
+            <source>normals nearly parallel</source>
+            <translation>normais quase paralelas</translation>
+        </message>
+        <message>
+            <source>planes meet in a line, not a point</source>
+            <translation>os planos se encontram em uma linha, não em um ponto</translation>
+        </message>
+        <message>
+            <source>intersection far from a plane's points</source>
+            <translation>interseção longe dos pontos de um plano</translation>
+        </message>
+        <message>
+            <source>same corner as a more precise triple</source>
+            <translation>mesmo canto que um trio mais preciso</translation>
+        </message>
+        <message>
+            <source>no common boundary</source>
+            <translation>sem borda comum</translation>
+        </message>
+        <message>
+            <source>planes nearly parallel: no stable line</source>
+            <translation>planos quase paralelos: nenhuma linha estável</translation>
+        </message>
+        <message>
+            <source>fewer than two planes</source>
+            <translation>menos de dois planos</translation>
+        </message>
+        <message>
+            <source>{n} candidates rejected: {reasons}</source>
+            <translation>{n} candidatos rejeitados: {reasons}</translation>
+        </message>
+        <message>
             <source>Baarda data snooping (alpha = {alpha:g} per observation, critical |w| = {critical:.2f}, iterative rejection of whole groups)</source>
             <translation>data snooping de Baarda (alfa = {alpha:g} por observação, |w| crítico = {critical:.2f}, rejeição iterativa de grupos inteiros)</translation>
         </message>
