@@ -1043,6 +1043,18 @@
             <translation>{n} candidatos rejeitados: {reasons}</translation>
         </message>
         <message>
+            <source>no roof plane: only {n} candidate points (fewer than needed for one plane)</source>
+            <translation>nenhum plano de telhado: apenas {n} pontos candidatos (menos do que o necessário para um plano)</translation>
+        </message>
+        <message>
+            <source>{planes} roof planes, {assigned} of {n} points assigned ({kept} kept by the local RANSAC)</source>
+            <translation>{planes} planos de telhado, {assigned} de {n} pontos atribuídos ({kept} mantidos pelo RANSAC local)</translation>
+        </message>
+        <message>
+            <source>no roof plane found among {n} points ({kept} passed the local RANSAC test): the cloud has no planar, roof-like surfaces with these parameters</source>
+            <translation>nenhum plano de telhado encontrado entre {n} pontos ({kept} passaram no teste do RANSAC local): a nuvem não tem superfícies planas, semelhantes a telhados, com estes parâmetros</translation>
+        </message>
+        <message>
             <source>Baarda data snooping (alpha = {alpha:g} per observation, critical |w| = {critical:.2f}, iterative rejection of whole groups)</source>
             <translation>data snooping de Baarda (alfa = {alpha:g} por observação, |w| crítico = {critical:.2f}, rejeição iterativa de grupos inteiros)</translation>
         </message>

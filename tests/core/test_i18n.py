@@ -417,5 +417,13 @@ def test_logged_messages_render_in_portuguese():
     [kappa] = diagnose(["bore[NE].d_kappa"])
     rec = logging.LogRecord("lidarphoto.x", logging.INFO, "", 0, kappa, None, None)
     assert i18n.log_text(rec, lang="pt_BR").startswith("kappa do grupo 'NE' não é observável")
+    from lidarphoto.core.lidar.roof_planes import extract_roof_planes
+
+    few = extract_roof_planes(np.zeros((3, 3)) + np.arange(3.0)[:, None])
+    rec = logging.LogRecord("lidarphoto.x", logging.INFO, "", 0, few.message, None, None)
+    assert i18n.log_text(rec, lang="pt_BR") == (
+        "nenhum plano de telhado: apenas 3 pontos candidatos (menos do que o necessário para um "
+        "plano)"
+    )
     plain = logging.LogRecord("lidarphoto.x", logging.INFO, "", 0, "%d of %d", (2, 5), None)
     assert i18n.log_text(plain, lang="pt_BR") == "2 of 5"
