@@ -32,6 +32,7 @@ __all__ = [
     "html_lang",
     "joined",
     "language_from_env",
+    "log_text",
     "mark",
     "normalise_language",
     "render",
@@ -213,3 +214,28 @@ def render(text: object, context: str, lang: str | None = None) -> str:
         return tr(text.template).format(**values)
     except (KeyError, IndexError, ValueError):
         return text.template.format(**values)
+
+
+def log_text(record, context: str = "Report", lang: str | None = None) -> str:
+    """The text of a ``logging.LogRecord`` in ``lang`` (default: the current language): its
+    message and arguments that are :class:`Message` are rendered; the rest is formatted as
+    ``logging`` does. The Processing provider's log bridge shows core logs through it.
+
+    >>> import logging
+    >>> args = ("P1", Message("n = {n}", n=2))
+    >>> rec = logging.LogRecord("x", 20, "", 0, "point %s: %s", args, None)
+    >>> log_text(rec, lang="en")
+    'point P1: n = 2'
+    """
+    msg = record.msg
+    args = record.args
+    if isinstance(msg, Message):
+        msg = render(msg, context, lang)
+    if isinstance(args, tuple):
+        args = tuple(render(a, context, lang) if isinstance(a, Message) else a for a in args)
+    if not args:
+        return str(msg)
+    try:
+        return str(msg) % args
+    except (TypeError, ValueError):  # a translation that broke the %-format: the English
+        return record.getMessage()

@@ -1007,6 +1007,54 @@
             <translation>{angle} = {value:.4f} graus no grupo {group}</translation>
         </message>
         <message>
+            <source>{summary} (details: lidarphoto -vv; QGIS: Processing logging level Verbose)</source>
+            <translation>{summary} (detalhes: lidarphoto -vv; QGIS: opções do Processamento, nível de log Verbose)</translation>
+        </message>
+        <message>
+            <source>normals nearly parallel</source>
+            <translation>normais quase paralelas</translation>
+        </message>
+        <message>
+            <source>planes meet in a line, not a point</source>
+            <translation>os planos se encontram em uma linha, não em um ponto</translation>
+        </message>
+        <message>
+            <source>intersection far from a plane's points</source>
+            <translation>interseção longe dos pontos de um plano</translation>
+        </message>
+        <message>
+            <source>same corner as a more precise triple</source>
+            <translation>mesmo canto que um trio mais preciso</translation>
+        </message>
+        <message>
+            <source>no common boundary</source>
+            <translation>sem borda comum</translation>
+        </message>
+        <message>
+            <source>planes nearly parallel: no stable line</source>
+            <translation>planos quase paralelos: nenhuma linha estável</translation>
+        </message>
+        <message>
+            <source>fewer than two planes</source>
+            <translation>menos de dois planos</translation>
+        </message>
+        <message>
+            <source>{n} candidates rejected: {reasons}</source>
+            <translation>{n} candidatos rejeitados: {reasons}</translation>
+        </message>
+        <message>
+            <source>no roof plane: only {n} candidate points (fewer than needed for one plane)</source>
+            <translation>nenhum plano de telhado: apenas {n} pontos candidatos (menos do que o necessário para um plano)</translation>
+        </message>
+        <message>
+            <source>{planes} roof planes, {assigned} of {n} points assigned ({kept} kept by the local RANSAC)</source>
+            <translation>{planes} planos de telhado, {assigned} de {n} pontos atribuídos ({kept} mantidos pelo RANSAC local)</translation>
+        </message>
+        <message>
+            <source>no roof plane found among {n} points ({kept} passed the local RANSAC test): the cloud has no planar, roof-like surfaces with these parameters</source>
+            <translation>nenhum plano de telhado encontrado entre {n} pontos ({kept} passaram no teste do RANSAC local): a nuvem não tem superfícies planas, semelhantes a telhados, com estes parâmetros</translation>
+        </message>
+        <message>
             <source>Baarda data snooping (alpha = {alpha:g} per observation, critical |w| = {critical:.2f}, iterative rejection of whole groups)</source>
             <translation>data snooping de Baarda (alfa = {alpha:g} por observação, |w| crítico = {critical:.2f}, rejeição iterativa de grupos inteiros)</translation>
         </message>
@@ -1061,6 +1109,46 @@
         <message>
             <source>data snooping stopped: rejecting {block} / {label} (|w| = {w:.2f}) would make the adjustment not observable; it is kept</source>
             <translation>data snooping interrompido: rejeitar {block} / {label} (|w| = {w:.2f}) tornaria o ajustamento não observável; a observação foi mantida</translation>
+        </message>
+        <message>
+            <source>the lever arm cannot be separated from the INS position: it turns with the aircraft while a position error does not, so fly lines in opposite directions (horizontal components) and add height control (LCPs); its vertical component cannot be told from a vertical GNSS bias at all: measure it (total station) and keep it fixed.</source>
+            <translation>o braço de alavanca não pode ser separado da posição do INS: ele gira com a aeronave, enquanto um erro de posição não gira; portanto, voe linhas de voo em sentidos opostos (componentes horizontais) e acrescente controle altimétrico (LCPs); sua componente vertical não pode de forma alguma ser distinguida de um viés vertical do GNSS: meça-a (estação total) e mantenha-a fixa.</translation>
+        </message>
+        <message>
+            <source>the interior orientation is not separable: the focal length trades with the flying height (needs control at clearly different heights or two flying heights), the principal point with the boresight omega/phi (both shift the whole image); fix them from the lab calibration.</source>
+            <translation>a orientação interior não é separável: a distância focal se confunde com a altura de voo (requer controle em alturas claramente diferentes ou duas alturas de voo), o ponto principal com omega/phi do boresight (ambos deslocam a imagem inteira); fixe-os pela calibração de laboratório.</translation>
+        </message>
+        <message>
+            <source>some tie points are not determined: measure each in at least two images, on a plane that is not seen edge-on.</source>
+            <translation>alguns pontos de enlace não são determinados: meça cada um em pelo menos duas imagens, em um plano que não seja visto de perfil.</translation>
+        </message>
+        <message>
+            <source>some LCP coordinates are not determined: give each a covariance.</source>
+            <translation>algumas coordenadas de LCP não são determinadas: dê a cada uma uma covariância.</translation>
+        </message>
+        <message>
+            <source>some ground point coordinates are not determined: give each sx, sy, sz.</source>
+            <translation>algumas coordenadas de pontos de apoio não são determinadas: dê a cada uma sx, sy, sz.</translation>
+        </message>
+        <message>
+            <source>INS parameters are not determined: the INS grade sigmas must be &gt; 0.</source>
+            <translation>os parâmetros do INS não são determinados: os desvios-padrão da classe do INS devem ser &gt; 0.</translation>
+        </message>
+        <message>
+            <source>parameters not observable: {names}</source>
+            <translation>parâmetros não observáveis: {names}</translation>
+        </message>
+        <message>
+            <source>the boresight of group '{group}' is not determined at all: its images have no (or too few) measurements; measure control in them, or use one boresight for all images (groups = single).</source>
+            <translation>o boresight do grupo '{group}' não é determinado de forma alguma: suas imagens não têm medições (ou têm poucas demais); meça controle nelas, ou use um só boresight para todas as imagens (groups = single).</translation>
+        </message>
+        <message>
+            <source>kappa of group '{group}' is not observable: too few points, or all of them near the image centre; measure points spread over the whole image (towards the corners) on roofs facing different directions, or add LCPs or ridge lines.</source>
+            <translation>kappa do grupo '{group}' não é observável: pontos de menos, ou todos perto do centro da imagem; meça pontos distribuídos por toda a imagem (em direção aos cantos) em telhados voltados para direções diferentes, ou acrescente LCPs ou linhas de cumeeira.</translation>
+        </message>
+        <message>
+            <source>{angles} of group '{group}' cannot be separated: the points lie near the image centre or on planes of one orientation; spread points over the image on roofs of different slope and aspect, or add LCPs or lines.</source>
+            <translation>{angles} do grupo '{group}' não podem ser separados: os pontos estão perto do centro da imagem ou em planos de uma só orientação; distribua pontos pela imagem em telhados de inclinação e orientação diferentes, ou acrescente LCPs ou linhas.</translation>
         </message>
         <message>
             <source>{n} ground point(s) are not measured in any image and were not used: {ids}</source>

@@ -25,6 +25,7 @@ from qgis.PyQt.QtCore import QCoreApplication
 
 from ..core.dependencies import missing_message, missing_modules
 from ..core.errors import Cancelled, LidarPhotoError
+from ..core.i18n import log_text, render
 from ..core.jobs.runner import JobResult, run_job
 from ..core.jobs.spec import AlgorithmSpec
 from .compat import FIELD_INT, FIELD_STRING, SINK_FAST_INSERT
@@ -52,7 +53,9 @@ class _FeedbackLogHandler(logging.Handler):
 
     def emit(self, record: logging.LogRecord) -> None:
         try:
-            text = self.format(record)
+            text = log_text(record)  # core sentences (Message) in QGIS's language
+            if record.exc_info:
+                text = f"{text}\n{self.formatter.formatException(record.exc_info)}"
             if record.levelno >= logging.ERROR:
                 self.feedback.reportError(text, False)
             elif record.levelno >= logging.WARNING:
@@ -200,7 +203,7 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
         self._verbose = verbose_log(context)
         result = self.run_core(run_job, self.JOB, raw, feedback=feedback)
         for line in result.lines:
-            feedback.pushInfo(line)
+            feedback.pushInfo(render(line, "Report"))  # a Message in QGIS's language
         outputs = {p.name: raw.get(p.name) for p in self.spec.outputs if p.kind != "sink"}
         outputs.update(result.results)
         outputs.update(self.write_layers(result, parameters, context, feedback))

@@ -8,12 +8,16 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import InputError
+from ..i18n import mark as _t
 from ..lidar.control import ControlOptions
 from .common import CSV_FILTER, CSV_OUT, cloud_params, lengths_in_cloud_units, unit_symbol
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Result, Values
 
 log = logging.getLogger(__name__)
+
+#: catalogue context of this module's ``_t("...")`` log sentences
+TR_CONTEXT = "Report"
 
 _D = ControlOptions()
 _LENGTHS = ("delta", "min_boundary", "max_support_distance")
@@ -145,8 +149,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         write_graph_csv(out.path("GRAPH_CSV"), result.adjacency)
     # the counts always; each candidate only in verbose mode (CLI -vv, QGIS debug info)
     if result.rejected:
-        log.info("%s (details: lidarphoto -vv; QGIS: Processing logging level Verbose)",
-                 rejection_summary(result.rejected))  # fmt: skip
+        log.info(_t("{summary} (details: lidarphoto -vv; QGIS: Processing logging level "
+                    "Verbose)", summary=rejection_summary(result.rejected)))  # fmt: skip
     for r in result.rejected:
         log.debug("planes %s: %s", ",".join(map(str, r.plane_ids)), r.reason)
     pairs = int(result.adjacency.adjacent.sum())

@@ -27,6 +27,8 @@ from numpy.typing import NDArray
 
 from ..errors import InputError, stop_if_asked
 from ..geometry.rotations import skew
+from ..i18n import Message, joined
+from ..i18n import mark as _t
 
 log = logging.getLogger(__name__)
 
@@ -290,14 +292,17 @@ class ControlLine:
         )
 
 
+#: catalogue context of this module's ``_t("...")`` texts (the rejection summary in the log)
+TR_CONTEXT = "Report"
+
 #: Why a candidate was not kept: the ``kind`` of a :class:`Rejection` (the log counts them).
-REJECT_PARALLEL = "normals nearly parallel"
-REJECT_CONDITION = "planes meet in a line, not a point"
-REJECT_SUPPORT = "intersection far from a plane's points"
-REJECT_DUPLICATE = "same corner as a more precise triple"
-REJECT_NO_BOUNDARY = "no common boundary"
-REJECT_LINE_PARALLEL = "planes nearly parallel: no stable line"
-REJECT_TOO_FEW = "fewer than two planes"
+REJECT_PARALLEL = _t("normals nearly parallel")
+REJECT_CONDITION = _t("planes meet in a line, not a point")
+REJECT_SUPPORT = _t("intersection far from a plane's points")
+REJECT_DUPLICATE = _t("same corner as a more precise triple")
+REJECT_NO_BOUNDARY = _t("no common boundary")
+REJECT_LINE_PARALLEL = _t("planes nearly parallel: no stable line")
+REJECT_TOO_FEW = _t("fewer than two planes")
 
 
 @dataclass(frozen=True)
@@ -374,7 +379,12 @@ def rejection_summary(rejected: Sequence[Rejection]) -> str:
     for r in rejected:
         counts[r.kind or r.reason] = counts.get(r.kind or r.reason, 0) + 1
     parts = sorted(counts.items(), key=lambda kv: (-kv[1], kv[0]))
-    return f"{len(rejected)} candidates rejected: " + ", ".join(f"{n} {k}" for k, n in parts)
+    # a Message: the log bridge and the reports show it (and each reason) in the user's language
+    return _t(
+        "{n} candidates rejected: {reasons}",
+        n=len(rejected),
+        reasons=joined(Message("{n} {reason}", n=n, reason=k) for k, n in parts),
+    )
 
 
 def lidar_control(

@@ -47,10 +47,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError, stop_if_asked, use_compiled
 from ..geometry.planes import Plane, fit_plane, fit_planes, label_moments
+from ..i18n import mark as _t
 
 __all__ = ["SELECTION_CHOICES", "RoofPlaneParams", "RoofPlaneResult", "extract_roof_planes"]
 
 log = logging.getLogger(__name__)
+
+#: catalogue context of this module's ``_t("...")`` sentences (the log and the report)
+TR_CONTEXT = "Report"
 
 Array = NDArray[np.float64]
 Progress = Union[Callable[[float], None], None]
@@ -816,7 +820,8 @@ def extract_roof_planes(
     n = len(xyz)
     empty = np.full(n, -1, dtype=np.int32)
     if n < max(params.min_plane_points, params.k_neighbours):
-        msg = f"no roof plane: only {n} candidate points (fewer than needed for one plane)"
+        msg = _t("no roof plane: only {n} candidate points (fewer than needed for one plane)",
+                 n=n)  # fmt: skip
         log.info(msg)
         return RoofPlaneResult((), empty, 0, params.outline_cell, msg)
     # centred once: map coordinates (1e5-1e6) would cost digits in every product below
@@ -865,14 +870,20 @@ def extract_roof_planes(
     fit_mask[order] = keep & ~ambiguous & interior
     planes, plane_id = _final_planes(xyz, back, fit_mask, cell, progress, should_stop)
     if planes:
-        msg = (
-            f"{len(planes)} roof planes, {int((plane_id >= 0).sum())} of {n} points assigned "
-            f"({n_cand} kept by the local RANSAC)"
+        msg = _t(
+            "{planes} roof planes, {assigned} of {n} points assigned ({kept} kept by the local "
+            "RANSAC)",
+            planes=len(planes),
+            assigned=int((plane_id >= 0).sum()),
+            n=n,
+            kept=n_cand,
         )
     else:
-        msg = (
-            f"no roof plane found among {n} points ({n_cand} passed the local RANSAC test): "
-            "the cloud has no planar, roof-like surfaces with these parameters"
+        msg = _t(
+            "no roof plane found among {n} points ({kept} passed the local RANSAC test): the "
+            "cloud has no planar, roof-like surfaces with these parameters",
+            n=n,
+            kept=n_cand,
         )
     log.info(msg)
     return RoofPlaneResult(tuple(planes), plane_id, n_cand, float(cell), msg)

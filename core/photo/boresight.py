@@ -65,6 +65,7 @@ from scipy.spatial import cKDTree
 from ..errors import DiagnosedNotObservable, InputError, NotObservableError
 from ..geometry.camera import Camera
 from ..geometry.frames import NED_TO_ENU, LocalFrame, MappingFrame
+from ..i18n import mark as _t
 from ..lsq.adjustment import adjust
 from ..lsq.model import AdjustmentOptions, GaussHelmertBlock, GaussMarkovBlock, prior_block
 from ..lsq.results import AdjustmentResult
@@ -81,6 +82,9 @@ from .ins import INS_GRADES, InsGrade
 from .mount import Mount
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_local_to_map
+
+#: catalogue context of this module's ``_t("...")`` sentences (the diagnosis the report shows)
+TR_CONTEXT = "Report"
 
 __all__ = [
     "ARCSEC",
@@ -1022,6 +1026,8 @@ def _observation_residuals(res: AdjustmentResult, maps, n: int, used) -> Observa
 def diagnose(parameters: Sequence[str], groups: Sequence[str] = ()) -> list[str]:
     """Explain in words why the named parameters are not observable and what would fix it.
 
+    Each sentence is a :class:`core.i18n.Message` (English text; the report translates it).
+
     >>> diagnose(["bore[NE].d_kappa"])[0].startswith("kappa of group 'NE'")
     True
     """
@@ -1037,50 +1043,72 @@ def diagnose(parameters: Sequence[str], groups: Sequence[str] = ()) -> list[str]
     for g, angles in bore.items():
         if angles == set(ANGLES):
             out.append(
-                f"the boresight of group '{g}' is not determined at all: its images have no (or "
-                "too few) measurements; measure control in them, or use one boresight for all "
-                "images (groups = single)."
+                _t(
+                    "the boresight of group '{group}' is not determined at all: its images have "
+                    "no (or too few) measurements; measure control in them, or use one boresight "
+                    "for all images (groups = single).",
+                    group=g,
+                )
             )
         elif angles == {"d_kappa"}:
             out.append(
-                f"kappa of group '{g}' is not observable: too few points, or all of them near "
-                "the image centre; measure points spread over the whole image (towards the "
-                "corners) on roofs facing different directions, or add LCPs or ridge lines."
+                _t(
+                    "kappa of group '{group}' is not observable: too few points, or all of them "
+                    "near the image centre; measure points spread over the whole image (towards "
+                    "the corners) on roofs facing different directions, or add LCPs or ridge "
+                    "lines.",
+                    group=g,
+                )
             )
         else:
             out.append(
-                f"{', '.join(sorted(angles))} of group '{g}' cannot be separated: the points "
-                "lie near the image centre or on planes of one orientation; spread points over "
-                "the image on roofs of different slope and aspect, or add LCPs or lines."
+                _t(
+                    "{angles} of group '{group}' cannot be separated: the points lie near the "
+                    "image centre or on planes of one orientation; spread points over the image "
+                    "on roofs of different slope and aspect, or add LCPs or lines.",
+                    angles=", ".join(sorted(angles)),
+                    group=g,
+                )
             )
     if "lever_arm" in kinds:
         out.append(
-            "the lever arm cannot be separated from the INS position: it turns with the "
-            "aircraft while a position error does not, so fly lines in opposite directions "
-            "(horizontal components) and add height control (LCPs); its vertical component "
-            "cannot be told from a vertical GNSS bias at all: measure it (total station) and "
-            "keep it fixed."
+            _t(
+                "the lever arm cannot be separated from the INS position: it turns with the "
+                "aircraft while a position error does not, so fly lines in opposite directions "
+                "(horizontal components) and add height control (LCPs); its vertical component "
+                "cannot be told from a vertical GNSS bias at all: measure it (total station) and "
+                "keep it fixed."
+            )
         )
     if "interior" in kinds:
         out.append(
-            "the interior orientation is not separable: the focal length trades with the "
-            "flying height (needs control at clearly different heights or two flying "
-            "heights), the principal point with the boresight omega/phi (both shift the whole "
-            "image); fix them from the lab calibration."
+            _t(
+                "the interior orientation is not separable: the focal length trades with the "
+                "flying height (needs control at clearly different heights or two flying "
+                "heights), the principal point with the boresight omega/phi (both shift the "
+                "whole image); fix them from the lab calibration."
+            )
         )
     if "tie" in kinds:
         out.append(
-            "some tie points are not determined: measure each in at least two images, on a "
-            "plane that is not seen edge-on."
+            _t(
+                "some tie points are not determined: measure each in at least two images, on a "
+                "plane that is not seen edge-on."
+            )
         )
     if "lcp" in kinds:
-        out.append("some LCP coordinates are not determined: give each a covariance.")
+        out.append(_t("some LCP coordinates are not determined: give each a covariance."))
     if "control" in kinds:
-        out.append("some ground point coordinates are not determined: give each sx, sy, sz.")
+        out.append(_t("some ground point coordinates are not determined: give each sx, sy, sz."))
     if "ins" in kinds and not out:
-        out.append("INS parameters are not determined: the INS grade sigmas must be > 0.")
+        out.append(_t("INS parameters are not determined: the INS grade sigmas must be > 0."))
     if not out:
-        out.append(f"parameters not observable: {', '.join(list(parameters)[:10])}")
+        out.append(
+            _t(
+                "parameters not observable: {names}",
+                names=", ".join(list(parameters)[:10]),
+            )
+        )
     return out
 
 

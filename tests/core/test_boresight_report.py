@@ -9,6 +9,7 @@ from html.parser import HTMLParser
 
 import numpy as np
 import pytest
+from lidarphoto.core import i18n
 from lidarphoto.core.errors import InputError
 from lidarphoto.core.geometry.frames import MappingFrame
 from lidarphoto.core.io.orientation import read_eo_csv
@@ -198,6 +199,48 @@ def test_not_observable_writes_the_diagnosis_then_raises(tmp_path):
     assert "Not observable" in page and "group 'lonely'" in page
     assert info.value.diagnosis[0] in page
     assert not (tmp_path / "t.csv").exists()
+
+
+def test_not_observable_diagnosis_in_portuguese(tmp_path):
+    """The same set-up in pt_BR: the HTML shows each diagnosis sentence translated, with its
+    group name, and none of the English sentences (the exception keeps the English)."""
+    sim = simulate_flight(SMALL, seed=2)
+    lonely = sim.trajectory.image_id[0]
+    traj = replace(
+        sim.trajectory,
+        group=tuple(
+            "lonely" if i == lonely else g
+            for i, g in zip(sim.trajectory.image_id, sim.trajectory.group)
+        ),
+    )
+    keep = np.array([i != lonely for i in sim.observations.image_id])
+    sim = replace(sim, trajectory=traj, observations=sim.observations.subset(keep))
+    paths = sim.write(tmp_path)
+    html = tmp_path / "summary.html"
+    i18n.set_language("pt_BR")
+    try:
+        with pytest.raises(BoresightNotObservable) as info:
+            run_boresight_calibration(
+                paths["camera"],
+                paths["trajectory"],
+                sim.crs,
+                paths["observations"],
+                lever_arm=_lever(sim),
+                planes=paths["planes"],
+                lcps=paths["lcps"],
+                control_types="tie,lcp",
+                output_html=html,
+            )
+    finally:
+        i18n.set_language("en")
+    page = unescape(html.read_text(encoding="utf-8"))
+    diagnosis = info.value.diagnosis
+    assert diagnosis and all(isinstance(d, i18n.Message) for d in diagnosis)
+    assert "o boresight do grupo 'lonely' não é determinado de forma alguma" in page
+    for d in diagnosis:
+        pt = i18n.render(d, "Report", "pt_BR")
+        assert pt != str(d) and pt in page and str(d) not in page
+    assert "Not observable" not in page and "is not determined" not in page
 
 
 def test_render_without_results_and_option_errors():

@@ -399,3 +399,31 @@ def test_boresight_doubts_in_portuguese():
     assert "o teste global falhou com sigma0 = 3.5 &gt; MAX_SIGMA0 2: as observações" in page
     assert "d_phi = 2.5000 graus no grupo g1 além de MAX_BORESIGHT 1 graus" in page
     assert "global test failed" not in page and "beyond MAX_BORESIGHT" not in page
+
+
+def test_logged_messages_render_in_portuguese():
+    """A log record whose message or arguments are Messages (makecontrolchips logs
+    ``"point %s: %s"`` with the chip's reason) comes out in pt_BR through ``log_text``; plain
+    records are unchanged."""
+    import logging
+
+    from lidarphoto.core.photo.boresight import diagnose
+
+    reason = i18n.Message("outside every image")
+    rec = logging.LogRecord("lidarphoto.x", logging.WARNING, "", 0, "point %s: %s",
+                            ("P7", reason), None)  # fmt: skip
+    assert i18n.log_text(rec, lang="en") == rec.getMessage() == "point P7: outside every image"
+    assert i18n.log_text(rec, lang="pt_BR") == "point P7: fora de todas as imagens"
+    [kappa] = diagnose(["bore[NE].d_kappa"])
+    rec = logging.LogRecord("lidarphoto.x", logging.INFO, "", 0, kappa, None, None)
+    assert i18n.log_text(rec, lang="pt_BR").startswith("kappa do grupo 'NE' não é observável")
+    from lidarphoto.core.lidar.roof_planes import extract_roof_planes
+
+    few = extract_roof_planes(np.zeros((3, 3)) + np.arange(3.0)[:, None])
+    rec = logging.LogRecord("lidarphoto.x", logging.INFO, "", 0, few.message, None, None)
+    assert i18n.log_text(rec, lang="pt_BR") == (
+        "nenhum plano de telhado: apenas 3 pontos candidatos (menos do que o necessário para um "
+        "plano)"
+    )
+    plain = logging.LogRecord("lidarphoto.x", logging.INFO, "", 0, "%d of %d", (2, 5), None)
+    assert i18n.log_text(plain, lang="pt_BR") == "2 of 5"

@@ -92,3 +92,30 @@ def test_summary_orders_reasons_by_count():
         f"4 candidates rejected: 3 {REJECT_SUPPORT}, 1 {REJECT_DUPLICATE}"
     )
     assert rejection_summary([]) == ""
+
+
+def test_summary_in_portuguese_at_the_log_bridge(hip_roof_files, tmp_path):
+    """The summary record is a Message: plain English for the command line, Portuguese through
+    ``core.i18n.log_text`` (what the Processing provider's log bridge shows in pt_BR QGIS)."""
+    from lidarphoto.core.i18n import log_text
+
+    records: list[logging.LogRecord] = []
+
+    class Keep(logging.Handler):
+        def emit(self, record):
+            records.append(record)
+
+    keep = Keep(logging.INFO)
+    _reset_logging()
+    logging.getLogger("lidarphoto").addHandler(keep)
+    try:
+        assert _run(hip_roof_files, tmp_path, "-v") == 0
+    finally:
+        logging.getLogger("lidarphoto").removeHandler(keep)
+        _reset_logging()
+    summary = [r for r in records if "candidates rejected" in r.getMessage()]
+    assert len(summary) == 1
+    assert log_text(summary[0], lang="en") == summary[0].getMessage()
+    pt = log_text(summary[0], lang="pt_BR")
+    assert pt.startswith("2 candidatos rejeitados: 2 interseção longe dos pontos de um plano")
+    assert "(detalhes: lidarphoto -vv;" in pt and "candidates" not in pt and "details" not in pt

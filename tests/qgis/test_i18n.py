@@ -208,3 +208,52 @@ def test_plugin_messages_in_portuguese(compiled_qm, tmp_path):
     finally:
         remove_translator()
     assert error_text(info.value) == f"{missing}: the image file does not exist"
+
+
+def test_logged_messages_reach_the_feedback_in_portuguese(compiled_qm):
+    """The Processing log bridge (forward_logging) shows a core log record whose arguments
+    are Messages in QGIS's language: makecontrolchips' "point %s: %s" with the chip's reason,
+    createlcps' rejection summary; plain records unchanged; English without the translator."""
+    import logging
+
+    from lidarphoto.core.lidar.control import REJECT_SUPPORT, Rejection, rejection_summary
+    from lidarphoto.core.photo.control_location import _t as mark
+    from lidarphoto.processing_provider.base import forward_logging
+    from lidarphoto.processing_provider.i18n import install_translator, remove_translator
+    from qgis.core import QgsProcessingFeedback
+
+    class Feedback(QgsProcessingFeedback):
+        def __init__(self):
+            super().__init__()
+            self.lines = []
+
+        def pushInfo(self, text):
+            self.lines.append(("info", text))
+
+        def pushWarning(self, text):
+            self.lines.append(("warning", text))
+
+    log = logging.getLogger("lidarphoto.core.jobs.test")
+
+    def run():
+        feedback = Feedback()
+        with forward_logging(feedback):
+            log.warning("point %s: %s", "P7", mark("outside every image"))
+            log.info(rejection_summary([Rejection((1, 2, 3), "x", REJECT_SUPPORT)] * 2))
+            log.info("%d of %d", 2, 5)
+        return feedback.lines
+
+    assert install_translator("pt_BR") == "pt_BR"
+    try:
+        lines = run()
+    finally:
+        remove_translator()
+    assert lines == [
+        ("warning", "point P7: fora de todas as imagens"),
+        ("info", "2 candidatos rejeitados: 2 interseção longe dos pontos de um plano"),
+        ("info", "2 of 5"),
+    ]
+    assert run()[:2] == [
+        ("warning", "point P7: outside every image"),
+        ("info", "2 candidates rejected: 2 intersection far from a plane's points"),
+    ]
