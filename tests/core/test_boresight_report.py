@@ -168,7 +168,9 @@ def test_html_has_the_figures_and_parses(calibrated):
     assert "Correlation" in page and page.count("<svg") == 2 and "Not observable" not in page
 
 
-def test_not_observable_writes_the_diagnosis_then_raises(tmp_path):
+def _run_with_a_lonely_group(tmp_path, **kw):
+    """A calibration whose group 'lonely' has no observations (its boresight cannot be
+    determined): raises BoresightNotObservable after writing the HTML diagnosis."""
     sim = simulate_flight(SMALL, seed=2)
     lonely = sim.trajectory.image_id[0]
     traj = replace(
@@ -181,21 +183,24 @@ def test_not_observable_writes_the_diagnosis_then_raises(tmp_path):
     keep = np.array([i != lonely for i in sim.observations.image_id])
     sim = replace(sim, trajectory=traj, observations=sim.observations.subset(keep))
     paths = sim.write(tmp_path)
-    html = tmp_path / "summary.html"
+    run_boresight_calibration(
+        paths["camera"],
+        paths["trajectory"],
+        sim.crs,
+        paths["observations"],
+        lever_arm=_lever(sim),
+        planes=paths["planes"],
+        lcps=paths["lcps"],
+        control_types="tie,lcp",
+        output_html=tmp_path / "summary.html",
+        **kw,
+    )
+
+
+def test_not_observable_writes_the_diagnosis_then_raises(tmp_path):
     with pytest.raises(BoresightNotObservable) as info:
-        run_boresight_calibration(
-            paths["camera"],
-            paths["trajectory"],
-            sim.crs,
-            paths["observations"],
-            lever_arm=_lever(sim),
-            planes=paths["planes"],
-            lcps=paths["lcps"],
-            control_types="tie,lcp",
-            output_html=html,
-            output_table=tmp_path / "t.csv",
-        )
-    page = unescape(html.read_text(encoding="utf-8"))
+        _run_with_a_lonely_group(tmp_path, output_table=tmp_path / "t.csv")
+    page = unescape((tmp_path / "summary.html").read_text(encoding="utf-8"))
     assert "Not observable" in page and "group 'lonely'" in page
     assert info.value.diagnosis[0] in page
     assert not (tmp_path / "t.csv").exists()
@@ -204,36 +209,13 @@ def test_not_observable_writes_the_diagnosis_then_raises(tmp_path):
 def test_not_observable_diagnosis_in_portuguese(tmp_path):
     """The same set-up in pt_BR: the HTML shows each diagnosis sentence translated, with its
     group name, and none of the English sentences (the exception keeps the English)."""
-    sim = simulate_flight(SMALL, seed=2)
-    lonely = sim.trajectory.image_id[0]
-    traj = replace(
-        sim.trajectory,
-        group=tuple(
-            "lonely" if i == lonely else g
-            for i, g in zip(sim.trajectory.image_id, sim.trajectory.group)
-        ),
-    )
-    keep = np.array([i != lonely for i in sim.observations.image_id])
-    sim = replace(sim, trajectory=traj, observations=sim.observations.subset(keep))
-    paths = sim.write(tmp_path)
-    html = tmp_path / "summary.html"
     i18n.set_language("pt_BR")
     try:
         with pytest.raises(BoresightNotObservable) as info:
-            run_boresight_calibration(
-                paths["camera"],
-                paths["trajectory"],
-                sim.crs,
-                paths["observations"],
-                lever_arm=_lever(sim),
-                planes=paths["planes"],
-                lcps=paths["lcps"],
-                control_types="tie,lcp",
-                output_html=html,
-            )
+            _run_with_a_lonely_group(tmp_path)
     finally:
         i18n.set_language("en")
-    page = unescape(html.read_text(encoding="utf-8"))
+    page = unescape((tmp_path / "summary.html").read_text(encoding="utf-8"))
     diagnosis = info.value.diagnosis
     assert diagnosis and all(isinstance(d, i18n.Message) for d in diagnosis)
     assert "o boresight do grupo 'lonely' não é determinado de forma alguma" in page
