@@ -23,6 +23,15 @@ def portuguese():
     i18n.set_language("en")
 
 
+def _in_portuguese(render, *args, **kw):
+    """``render(*args, **kw)`` with the reports' language set to pt_BR (English again after)."""
+    i18n.set_language("pt_BR")
+    try:
+        return render(*args, **kw)
+    finally:
+        i18n.set_language("en")
+
+
 def test_language_names():
     assert i18n.available_languages() == ("pt_BR",)
     assert i18n.normalise_language("pt") == "pt_BR"
@@ -88,19 +97,8 @@ def test_calibration_and_location_reports_in_portuguese(portuguese):
 def test_standard_verdicts_in_portuguese():
     """The standards' fixed texts (titles, check names, status words, notes) are translated
     when shown; the results themselves stay English."""
-    rng = np.random.default_rng(5)
-    ref = np.column_stack([rng.uniform(0, 900, 12), rng.uniform(0, 900, 12),
-                           rng.uniform(0, 9, 12)])  # fmt: skip
-    cp = CheckPoints(tuple(f"p{k}" for k in range(12)), ref + rng.normal(0, 0.05, ref.shape),
-                     ref, ("a",) * 12, "EPSG:31983", "test")  # fmt: skip
-    report = assess_accuracy(cp, AccuracySettings(pec_scale=2000))
-    english = render_html(report)
+    report, english, page = _accuracy_pages(12, 0.05, 5, pec_scale=2000)
     assert "Check-point count" in english and "<h1>Positional accuracy report</h1>" in english
-    i18n.set_language("pt_BR")
-    try:
-        page = render_html(report)
-    finally:
-        i18n.set_language("en")
     for text in ("<h1>Relatório de acurácia posicional</h1>",
                  "Padrões de Acurácia Posicional da ASPRS, Edição 2 (2023)",
                  "Número de pontos de verificação", "Acurácia tridimensional",
@@ -113,20 +111,8 @@ def test_standard_verdicts_in_portuguese():
 
 
 def test_accuracy_report_in_portuguese_and_english():
-    rng = np.random.default_rng(3)
-    ref = np.column_stack([500000 + rng.uniform(0, 900, 12), 7450000 + rng.uniform(0, 900, 12),
-                           rng.uniform(0, 9, 12)])  # fmt: skip
-    meas = ref + rng.normal(0, 0.05, ref.shape)
-    ids = tuple(f"p{k}" for k in range(12))
-    cp = CheckPoints(ids, meas, ref, ("a",) * 12, "EPSG:31983", "test")
-    report = assess_accuracy(cp, AccuracySettings(pec_scale=2000))
-    english = render_html(report)
+    _, english, page = _accuracy_pages(12, 0.05, 3, pec_scale=2000)
     assert '<html lang="en">' in english and "<h2>Summary</h2>" in english
-    i18n.set_language("pt_BR")
-    try:
-        page = render_html(report)
-    finally:
-        i18n.set_language("en")
     assert '<html lang="pt-BR">' in page
     for text in ("<h2>Resumo</h2>", "<h2>Estatísticas</h2>", "Pontos de verificação", "Notas"):
         assert text in page, text
@@ -223,11 +209,7 @@ def _accuracy_pages(n: int, sigma: float, seed: int, **settings):
                      "test")  # fmt: skip
     report = assess_accuracy(cp, AccuracySettings(**settings))
     english = render_html(report)
-    i18n.set_language("pt_BR")
-    try:
-        page = render_html(report)
-    finally:
-        i18n.set_language("en")
+    page = _in_portuguese(render_html, report)
     return report, english, page
 
 
@@ -325,11 +307,7 @@ def test_calibration_warnings_in_portuguese():
     assert left in res.warnings
     weak = [w for w in res.warnings if "is not significant" in w]
     assert weak, res.warnings  # p1, p2 (zero in the camera) are not significant
-    i18n.set_language("pt_BR")
-    try:
-        page = render_calibration_html(res, {"target": "chessboard"})
-    finally:
-        i18n.set_language("en")
+    page = _in_portuguese(render_calibration_html, res, {"target": "chessboard"})
     assert (
         f"vista &#x27;few&#x27; descartada: menos de {MIN_POINTS_PER_VIEW} pontos do alvo" in page
     )
@@ -362,11 +340,7 @@ def test_control_location_reasons_in_portuguese():
     res = locate_control_points([flat, far], eo, cam, lambda *a: np.full((a[4], a[3]), np.nan))
     reasons = {p.point_id: p.reason for p in res.pairs}
     assert reasons == {"flat": "chip refused: no texture", "far": "outside every image"}
-    i18n.set_language("pt_BR")
-    try:
-        page = render_location_html(res.pairs, {"chips": "2"})
-    finally:
-        i18n.set_language("en")
+    page = _in_portuguese(render_location_html, res.pairs, {"chips": "2"})
     for text in ("recorte (chip) recusado: sem textura", "fora de todas as imagens",
                  "<td>rejeitado</td>", "<td>fora</td>"):  # fmt: skip
         assert text in page, text
@@ -391,11 +365,7 @@ def test_boresight_doubts_in_portuguese():
         "d_phi = 2.5000 deg in group g1 beyond MAX_BORESIGHT 1 deg: implausible for a "
         "misalignment (wrong MOUNT, image ids or observations?)"
     )
-    i18n.set_language("pt_BR")
-    try:
-        page = render_boresight_html(None, {}, problems=doubts)
-    finally:
-        i18n.set_language("en")
+    page = _in_portuguese(render_boresight_html, None, {}, problems=doubts)
     assert "o teste global falhou com sigma0 = 3.5 &gt; MAX_SIGMA0 2: as observações" in page
     assert "d_phi = 2.5000 graus no grupo g1 além de MAX_BORESIGHT 1 graus" in page
     assert "global test failed" not in page and "beyond MAX_BORESIGHT" not in page
