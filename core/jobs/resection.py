@@ -225,19 +225,12 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
 
 def _check_control_rows(obs, points) -> None:
-    """A ``control`` row measures a surveyed point: its point_id must be a control point
-    (unlike a tie row, it is never left out silently)."""
-    from ..errors import InputError
-
-    known = points.index() if points is not None else {}
-    for k in np.flatnonzero(obs.mask("control")):
-        if obs.point_id[k] not in known:
-            raise InputError(
-                f"row of type control names point '{obs.point_id[k]}', which is not in "
-                + ("CONTROL_POINTS" if points is not None else "the control: give "
-                   "CONTROL_POINTS with that point_id"),
-                **obs.where(k),
-            )  # fmt: skip
+    """A ``control`` row measures a surveyed point: its point_id must be a control point."""
+    obs.require_control_known(
+        points.index() if points is not None else {},
+        "CONTROL_POINTS" if points is not None
+        else "the control: give CONTROL_POINTS with that point_id",
+    )  # fmt: skip
 
 
 def _prefixed(exc, image_id: str):

@@ -433,14 +433,8 @@ def _surveyed_points(
             **obs.where(int(rows[0])),
         )
     index = {p: k for k, p in enumerate(ground.point_id)}
-    for r in rows:
-        if obs.point_id[r] not in index:
-            where = f" ({ground.source})" if ground.source else ""
-            raise InputError(
-                f"row of type control names point '{obs.point_id[r]}', which is not in the "
-                f"ground points{where}",
-                **obs.where(int(r)),
-            )
+    where = f" ({ground.source})" if ground.source else ""
+    obs.require_control_known(index, f"the ground points{where}")
     check = np.zeros(len(obs), dtype=bool)
     check[rows] = [ground.role[index[obs.point_id[r]]] == "check" for r in rows]
     points = [

@@ -436,14 +436,11 @@ def _check_observations(
                 row=row,
             )
     roles = dict(zip(ground.point_id, ground.role))
+    obs.require_control_known(
+        roles, f"the ground point table{f' {ground.source}' if ground.source else ''} (give "
+        "GROUND_POINTS with that point_id)",
+    )  # fmt: skip
     for i, (p, t) in enumerate(zip(obs.point_id, obs.type)):
-        if t == "control" and p not in roles:  # a surveyed point never becomes a free tie
-            raise _fail(
-                f"row of type control names point '{p}', which is not in the ground point "
-                f"table{f' {ground.source}' if ground.source else ''} (give GROUND_POINTS with "
-                "that point_id)",
-                obs, i,
-            )  # fmt: skip
         if t == "check" and roles.get(p) != "check":
             raise _fail(
                 f"row of type check names point '{p}', which is not a check point of the "

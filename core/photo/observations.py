@@ -8,7 +8,7 @@ The types, the pixel convention and the CSV form are described in
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -107,6 +107,26 @@ class ImageObservations:
     def mask(self, kind: str) -> NDArray[np.bool_]:
         """(N,) rows of one observation type."""
         return np.array([t == kind for t in self.type], dtype=bool)
+
+    def require_control_known(self, known: Collection[str], table: str) -> None:
+        """Raise :class:`InputError` naming the first ``control`` row whose point_id is not in
+        ``known`` (``table``: how the message names the ground-point table). A control row
+        measures a surveyed point: it never becomes a free tie point silently.
+
+        >>> o = ImageObservations(("a",), ("P9",), [[1.0, 2.0]], 0.5, ("control",), ("",))
+        >>> try:
+        ...     o.require_control_known({"P1"}, "CONTROL_POINTS")
+        ... except InputError as exc:
+        ...     print(exc)
+        row of type control names point 'P9', which is not in CONTROL_POINTS
+        """
+        for k in np.flatnonzero(self.mask("control")):
+            if self.point_id[k] not in known:
+                raise InputError(
+                    f"row of type control names point '{self.point_id[k]}', which is not in "
+                    f"{table}",
+                    **self.where(int(k)),
+                )
 
     def subset(self, keep: ArrayLike) -> ImageObservations:
         """Rows selected by a boolean mask or an index array."""
