@@ -26,6 +26,7 @@ FeatureCollection): each feature's ``assets`` hold the file (``href``, relative 
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -373,14 +374,23 @@ def copc_nodes(layout: CopcLayout, box: Sequence[float]) -> NDArray[Any]:
     return n[hit]
 
 
+@functools.lru_cache(maxsize=8)
+def _cached_layout(path: str, size: int, mtime_ns: int) -> CopcLayout:
+    """The layout of a COPC file, parsed once per worker process for all the tiles and
+    buffers it serves (size and modification time in the key: a changed file is re-read)."""
+    with open(path, "rb") as fh:
+        return _copc_layout(fh, path)
+
+
 def _copc_read(path: str, box: Sequence[float]):
     """(header, points of the nodes meeting ``box`` in file order, their ids, points decoded)
     of a COPC file: only those nodes' chunks are read and decompressed (lazrs)."""
     import laspy
     import lazrs
 
+    st = os.stat(path)
+    layout = _cached_layout(path, st.st_size, st.st_mtime_ns)
     with open(path, "rb") as fh:
-        layout = _copc_layout(fh, path)
         nodes = copc_nodes(layout, box)
         header = layout.header
         fmt = header.point_format
