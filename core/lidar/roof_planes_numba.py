@@ -43,6 +43,75 @@ LAST = 4
 SLACK = 1.0 + 1e-9
 
 
+def _jit_helper(func: Callable[..., Any]) -> Callable[..., Any]:
+    """numba.njit for a small function the kernels call (compiled into each calling kernel
+    and its cache entry); the plain function without numba, where no kernel runs."""
+    return numba.njit(nogil=True, inline="always")(func) if AVAILABLE else func
+
+
+@_jit_helper
+def _sq_dist(qs, s, px, py, pz):
+    """Squared distance of point ``s`` of ``qs`` to (px, py, pz): dx dx + dy dy + dz dz in
+    that order (the numpy back end's)."""
+    dx = qs[s, 0] - px
+    dy = qs[s, 1] - py
+    dz = qs[s, 2] - pz
+    return dx * dx + dy * dy + dz * dz
+
+
+@_jit_helper
+def _insert_nearest(bd, bi, m, k, d2, s):
+    """Point ``s`` at squared distance ``d2`` into the sorted list of the m (at most k) best
+    (bd, bi) pairs (ties: the lower index first) when it belongs there; returns the new m."""
+    if m < k:
+        t = m
+        m += 1
+    elif d2 < bd[k - 1] or (d2 == bd[k - 1] and s < bi[k - 1]):
+        t = k - 1
+    else:
+        return m
+    while t > 0 and (bd[t - 1] > d2 or (bd[t - 1] == d2 and bi[t - 1] > s)):
+        bd[t] = bd[t - 1]
+        bi[t] = bi[t - 1]
+        t -= 1
+    bd[t] = d2
+    bi[t] = s
+    return m
+
+
+@_jit_helper
+def _deviation(px32, py32, pz32, inl, j, mx, my, mz):
+    """Neighbour j's deviation from the inliers' mean (float64), zero when it is no inlier."""
+    w = 1.0 if inl[j] else 0.0
+    ex = (np.float64(px32[j]) - mx) * w
+    ey = (np.float64(py32[j]) - my) * w
+    ez = (np.float64(pz32[j]) - mz) * w
+    return ex, ey, ez
+
+
+@_jit_helper
+def _rotate(c, s, a, b):
+    """The Jacobi rotation (c, s) of the pair (a, b): (c a - s b, s a + c b)."""
+    return c * a - s * b, s * a + c * b
+
+
+@_jit_helper
+def _rotate_columns(c, s, a0, b0, a1, b1, a2, b2):
+    """The Jacobi rotation (c, s) of two columns (a, b) of the 3 x 3 eigenvectors, row by row."""
+    a0, b0 = _rotate(c, s, a0, b0)
+    a1, b1 = _rotate(c, s, a1, b1)
+    a2, b2 = _rotate(c, s, a2, b2)
+    return a0, b0, a1, b1, a2, b2
+
+
+@_jit_helper
+def _plane_dist(q, i, centre, normal, c):
+    """Distance of point i of q to plane c (row c of ``centre`` and ``normal``)."""
+    return abs((q[i, 0] - centre[c, 0]) * normal[c, 0]
+               + (q[i, 1] - centre[c, 1]) * normal[c, 1]
+               + (q[i, 2] - centre[c, 2]) * normal[c, 2])  # fmt: skip
+
+
 def _local_planes_kernel(
     qs, cell_of, start, nx, ny, x0, y0, h, offs, bound2, lo, hi, k, g, tri, eps, min_support,
     cos_lo, cos_hi, keep, normals, quality, knn, spacing,
@@ -73,11 +142,7 @@ def _local_planes_kernel(
         cut = np.inf
         for u in range(LAST):
             if last_r[u] < np.inf:
-                j = last_i[u]
-                dx = qs[j, 0] - px
-                dy = qs[j, 1] - py
-                dz = qs[j, 2] - pz
-                rr = last_r[u] + np.sqrt(dx * dx + dy * dy + dz * dz)
+                rr = last_r[u] + np.sqrt(_sq_dist(qs, last_i[u], px, py, pz))
                 rr = rr * rr * (1.0 + 1e-9)  # above any rounding of the squares below
                 if rr < cut:
                     cut = rr
@@ -104,47 +169,17 @@ def _local_planes_kernel(
                 if ex * ex + ey * ey > cut * SLACK:
                     continue
             for s in range(a, b):
-                dx = qs[s, 0] - px
-                dy = qs[s, 1] - py
-                dz = qs[s, 2] - pz
-                d2 = dx * dx + dy * dy + dz * dz
+                d2 = _sq_dist(qs, s, px, py, pz)
                 if d2 > cut:
                     continue
-                if m < k:
-                    t = m
-                    m += 1
-                elif d2 < bd[k - 1] or (d2 == bd[k - 1] and s < bi[k - 1]):
-                    t = k - 1
-                else:
-                    continue
-                while t > 0 and (bd[t - 1] > d2 or (bd[t - 1] == d2 and bi[t - 1] > s)):
-                    bd[t] = bd[t - 1]
-                    bi[t] = bi[t - 1]
-                    t -= 1
-                bd[t] = d2
-                bi[t] = s
+                # (a point not taken changes nothing: cut <= bd[k - 1] once the list is full)
+                m = _insert_nearest(bd, bi, m, k, d2, s)
                 if m == k and bd[k - 1] < cut:
                     cut = bd[k - 1]
         if m < k:  # fewer than k points within the offsets' reach: every point
             m = 0
             for s in range(qs.shape[0]):
-                dx = qs[s, 0] - px
-                dy = qs[s, 1] - py
-                dz = qs[s, 2] - pz
-                d2 = dx * dx + dy * dy + dz * dz
-                if m < k:
-                    t = m
-                    m += 1
-                elif d2 < bd[k - 1] or (d2 == bd[k - 1] and s < bi[k - 1]):
-                    t = k - 1
-                else:
-                    continue
-                while t > 0 and (bd[t - 1] > d2 or (bd[t - 1] == d2 and bi[t - 1] > s)):
-                    bd[t] = bd[t - 1]
-                    bi[t] = bi[t - 1]
-                    t -= 1
-                bd[t] = d2
-                bi[t] = s
+                m = _insert_nearest(bd, bi, m, k, _sq_dist(qs, s, px, py, pz), s)
         slot = i % max(LAST, 1)
         last_r[slot] = np.sqrt(bd[k - 1])
         last_i[slot] = i
@@ -220,10 +255,7 @@ def _local_planes_kernel(
         a12 = 0.0
         a22 = 0.0
         for j in range(k):
-            w = 1.0 if inl[j] else 0.0
-            ex = (np.float64(px32[j]) - mx) * w
-            ey = (np.float64(py32[j]) - my) * w
-            ez = (np.float64(pz32[j]) - mz) * w
+            ex, ey, ez = _deviation(px32, py32, pz32, inl, j, mx, my, mz)
             a00 += ex * ex
             a01 += ex * ey
             a02 += ex * ez
@@ -253,29 +285,20 @@ def _local_planes_kernel(
                 napp = app - tt * apq
                 naqq = aqq + tt * apq
                 if rot == 0:  # p = 0, q = 1, r = 2
-                    arp, arq = a02, a12
                     a00, a11, a01 = napp, naqq, 0.0
-                    a02 = cc_ * arp - ss * arq
-                    a12 = ss * arp + cc_ * arq
-                    v00, v01 = cc_ * v00 - ss * v01, ss * v00 + cc_ * v01
-                    v10, v11 = cc_ * v10 - ss * v11, ss * v10 + cc_ * v11
-                    v20, v21 = cc_ * v20 - ss * v21, ss * v20 + cc_ * v21
+                    a02, a12 = _rotate(cc_, ss, a02, a12)
+                    v00, v01, v10, v11, v20, v21 = _rotate_columns(
+                        cc_, ss, v00, v01, v10, v11, v20, v21)
                 elif rot == 1:  # p = 0, q = 2, r = 1
-                    arp, arq = a01, a12
                     a00, a22, a02 = napp, naqq, 0.0
-                    a01 = cc_ * arp - ss * arq
-                    a12 = ss * arp + cc_ * arq
-                    v00, v02 = cc_ * v00 - ss * v02, ss * v00 + cc_ * v02
-                    v10, v12 = cc_ * v10 - ss * v12, ss * v10 + cc_ * v12
-                    v20, v22 = cc_ * v20 - ss * v22, ss * v20 + cc_ * v22
+                    a01, a12 = _rotate(cc_, ss, a01, a12)
+                    v00, v02, v10, v12, v20, v22 = _rotate_columns(
+                        cc_, ss, v00, v02, v10, v12, v20, v22)
                 else:  # p = 1, q = 2, r = 0
-                    arp, arq = a01, a02
                     a11, a22, a12 = napp, naqq, 0.0
-                    a01 = cc_ * arp - ss * arq
-                    a02 = ss * arp + cc_ * arq
-                    v01, v02 = cc_ * v01 - ss * v02, ss * v01 + cc_ * v02
-                    v11, v12 = cc_ * v11 - ss * v12, ss * v11 + cc_ * v12
-                    v21, v22 = cc_ * v21 - ss * v22, ss * v21 + cc_ * v22
+                    a01, a02 = _rotate(cc_, ss, a01, a02)
+                    v01, v02, v11, v12, v21, v22 = _rotate_columns(
+                        cc_, ss, v01, v02, v11, v12, v21, v22)
         if a00 <= a11 and a00 <= a22:
             nx_, ny_, nz_ = v00, v10, v20
         elif a11 <= a22:
@@ -287,10 +310,7 @@ def _local_planes_kernel(
         dist_point = abs(nx_ * mx + ny_ * my + nz_ * mz)
         rr = 0.0
         for j in range(k):
-            w = 1.0 if inl[j] else 0.0
-            ex = (np.float64(px32[j]) - mx) * w
-            ey = (np.float64(py32[j]) - my) * w
-            ez = (np.float64(pz32[j]) - mz) * w
+            ex, ey, ez = _deviation(px32, py32, pz32, inl, j, mx, my, mz)
             res = ex * nx_ + ey * ny_ + ez * nz_
             rr += res * res
         quality[r] = np.sqrt(rr / cnt)
@@ -321,9 +341,7 @@ def _claims_kernel(q, keep, normals, labels, knn, frontier, reg_n, reg_c, cos_to
             j = knn[i, t]
             if not keep[j] or labels[j] >= 0:
                 continue
-            dist = abs((q[j, 0] - reg_c[reg, 0]) * reg_n[reg, 0]
-                       + (q[j, 1] - reg_c[reg, 1]) * reg_n[reg, 1]
-                       + (q[j, 2] - reg_c[reg, 2]) * reg_n[reg, 2])  # fmt: skip
+            dist = _plane_dist(q, j, reg_c, reg_n, reg)
             if not dist < eps:
                 continue
             cosang = (np.float64(normals[j, 0]) * reg_n[reg, 0]
@@ -361,9 +379,7 @@ def _reassign_kernel(q, labels, knn, centroids, normals, eps, lo, hi, out, ambig
             c = labels[i] if t == 0 else labels[knn[i, t - 1]]
             if c < 0:
                 continue
-            d = abs((q[i, 0] - centroids[c, 0]) * normals[c, 0]
-                    + (q[i, 1] - centroids[c, 1]) * normals[c, 1]
-                    + (q[i, 2] - centroids[c, 2]) * normals[c, 2])  # fmt: skip
+            d = _plane_dist(q, i, centroids, normals, c)
             if d < best:
                 best = d
                 chosen = c
@@ -374,9 +390,7 @@ def _reassign_kernel(q, labels, knn, centroids, normals, eps, lo, hi, out, ambig
                 c = labels[i] if t == 0 else labels[knn[i, t - 1]]
                 if c < 0 or c == chosen:
                     continue
-                d = abs((q[i, 0] - centroids[c, 0]) * normals[c, 0]
-                        + (q[i, 1] - centroids[c, 1]) * normals[c, 1]
-                        + (q[i, 2] - centroids[c, 2]) * normals[c, 2])  # fmt: skip
+                d = _plane_dist(q, i, centroids, normals, c)
                 if d < eps:
                     other = True
                     break
@@ -452,9 +466,8 @@ _COMPILED: dict[str, Callable[..., Any]] = {}
 
 
 def _compiled(name: str) -> Callable[..., Any]:
-    """The jitted function (compiled at its first call, cached next to this module; the
-    function calls no other jitted function, so the cache is not tied to the module's import
-    name)."""
+    """The jitted function (compiled at its first call, cached next to this module, the
+    helpers it calls compiled into its cache entry)."""
     if name not in _COMPILED:
         func = {"local_planes": _local_planes_kernel, "claims": _claims_kernel,
                 "reassign": _reassign_kernel, "pairs": _pairs_kernel, "order": _order_kernel,
