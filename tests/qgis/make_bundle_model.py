@@ -19,31 +19,13 @@ HERE = Path(__file__).resolve().parent
 MODEL = HERE / "data" / "bundle_accuracy_model.model3"
 
 
-def _outputs(child, pairs, x, y0):
-    from qgis.core import QgsProcessingModelOutput
-    from qgis.PyQt.QtCore import QPointF
-
-    outs = {}
-    for name, child_output in pairs:
-        o = QgsProcessingModelOutput(name, name)
-        o.setChildId(child.childId())
-        o.setChildOutputName(child_output)
-        o.setPosition(QPointF(x, y0 + 60.0 * len(outs)))
-        outs[name] = o
-    child.setModelOutputs(outs)
-
-
 def build_model():
-    from model_tools import static_defaults
+    from model_tools import add_child, add_inputs, output_of, param
     from qgis.core import (
         QgsProcessingModelAlgorithm,
-        QgsProcessingModelChildAlgorithm,
-        QgsProcessingModelParameter,
         QgsProcessingParameterCrs,
         QgsProcessingParameterFile,
     )
-    from qgis.core import QgsProcessingModelChildParameterSource as Src
-    from qgis.PyQt.QtCore import QPointF
 
     model = QgsProcessingModelAlgorithm(
         "Bundle adjustment and accuracy report (model)", "LiDAR Photogrammetry", "lidarphoto"
@@ -55,46 +37,21 @@ def build_model():
         QgsProcessingParameterFile("eo", "Exterior orientation (CSV)", extension="csv"),
         QgsProcessingParameterCrs("crs", "Mapping CRS", "EPSG:31983"),
     ]
-    for i, param in enumerate(inputs):
-        component = QgsProcessingModelParameter(param.name())
-        component.setPosition(QPointF(120.0, 60.0 + 70.0 * i))
-        model.addModelParameter(param, component)
+    add_inputs(model, inputs, 120.0, 60.0, 70.0)
 
-    bundle = QgsProcessingModelChildAlgorithm("lidarphoto:bundleadjustment")
-    bundle.setChildId("bundle")
-    bundle.setDescription("Bundle adjustment with self-calibration")
-    bundle.setPosition(QPointF(420.0, 140.0))
-    for key, name in (
-        ("CAMERA", "camera"),
-        ("OBSERVATIONS", "observations"),
-        ("GROUND_POINTS", "ground_points"),
-        ("EO", "eo"),
-        ("CRS", "crs"),
-    ):
-        bundle.addParameterSources(key, [Src.fromModelParameter(name)])
-    bundle.addParameterSources("AP_MODEL", [Src.fromStaticValue(7)])  # all
-    _outputs(
-        bundle,
-        (
-            ("eo", "OUTPUT_EO"),
-            ("check_points", "OUTPUT_CHECK_CSV"),
-            ("points", "OUTPUT_POINTS_LAYER"),
-        ),
-        720.0,
-        80.0,
-    )
-    static_defaults(bundle)
-    model.addChildAlgorithm(bundle)
-
-    acc = QgsProcessingModelChildAlgorithm("lidarphoto:accuracyreport")
-    acc.setChildId("accuracy")
-    acc.setDescription("Accuracy report of the check points")
-    acc.setPosition(QPointF(420.0, 360.0))
-    acc.addParameterSources("INPUT", [Src.fromChildOutput("bundle", "OUTPUT_CHECK_CSV")])
-    acc.addParameterSources("CRS", [Src.fromModelParameter("crs")])
-    _outputs(acc, (("report", "OUTPUT_HTML"), ("check_layer", "OUTPUT")), 720.0, 340.0)
-    static_defaults(acc)
-    model.addChildAlgorithm(acc)
+    sources = {key: param(name) for key, name in (
+        ("CAMERA", "camera"), ("OBSERVATIONS", "observations"),
+        ("GROUND_POINTS", "ground_points"), ("EO", "eo"), ("CRS", "crs"))}  # fmt: skip
+    sources["AP_MODEL"] = 7  # all
+    outputs = (("eo", "OUTPUT_EO"), ("check_points", "OUTPUT_CHECK_CSV"),
+               ("points", "OUTPUT_POINTS_LAYER"))  # fmt: skip
+    add_child(model, "lidarphoto:bundleadjustment", "bundle",
+              "Bundle adjustment with self-calibration", (420.0, 140.0), sources, outputs,
+              (720.0, 80.0))  # fmt: skip
+    add_child(model, "lidarphoto:accuracyreport", "accuracy",
+              "Accuracy report of the check points", (420.0, 360.0),
+              {"INPUT": output_of("bundle", "OUTPUT_CHECK_CSV"), "CRS": param("crs")},
+              (("report", "OUTPUT_HTML"), ("check_layer", "OUTPUT")), (720.0, 340.0))  # fmt: skip
     model.updateDestinationParameters()
     return model
 

@@ -20,17 +20,12 @@ MODEL = HERE / "data" / "ground_roof_model.model3"
 
 
 def build_model():
-    from model_tools import static_defaults
+    from model_tools import add_child, add_inputs, output_of, param
     from qgis.core import (
         QgsProcessingModelAlgorithm,
-        QgsProcessingModelChildAlgorithm,
-        QgsProcessingModelOutput,
-        QgsProcessingModelParameter,
         QgsProcessingParameterFile,
         QgsProcessingParameterNumber,
     )
-    from qgis.core import QgsProcessingModelChildParameterSource as Src
-    from qgis.PyQt.QtCore import QPointF
 
     model = QgsProcessingModelAlgorithm(
         "Ground filter and roof planes (model)", "LiDAR Photogrammetry", "lidarphoto"
@@ -41,43 +36,17 @@ def build_model():
             "epsilon", "Plane tolerance (m)", QgsProcessingParameterNumber.Type.Double, 0.15
         ),
     ]
-    for i, param in enumerate(inputs):
-        component = QgsProcessingModelParameter(param.name())
-        component.setPosition(QPointF(120.0, 60.0 + 70.0 * i))
-        model.addModelParameter(param, component)
+    add_inputs(model, inputs, 120.0, 60.0, 70.0)
 
-    ground = QgsProcessingModelChildAlgorithm("lidarphoto:groundfilter")
-    ground.setChildId("ground")
-    ground.setDescription("Ground filter")
-    ground.setPosition(QPointF(400.0, 80.0))
-    ground.addParameterSources("INPUT", [Src.fromModelParameter("cloud")])
-    ground.addParameterSources("DISTANCE_UNIT", [Src.fromStaticValue(1)])  # metres
-    out = QgsProcessingModelOutput("classified_cloud", "classified_cloud")
-    out.setChildId("ground")
-    out.setChildOutputName("OUTPUT_CLOUD")
-    out.setPosition(QPointF(650.0, 40.0))
-    ground.setModelOutputs({"classified_cloud": out})
-    static_defaults(ground)  # addChildAlgorithm stores a copy: complete the child first
-    model.addChildAlgorithm(ground)
-
-    roofs = QgsProcessingModelChildAlgorithm("lidarphoto:extractroofplanes")
-    roofs.setChildId("roofs")
-    roofs.setDescription("Extract roof planes")
-    roofs.setPosition(QPointF(400.0, 220.0))
-    roofs.addParameterSources("INPUT", [Src.fromChildOutput("ground", "OUTPUT_CLOUD")])
-    roofs.addParameterSources("DISTANCE_UNIT", [Src.fromStaticValue(1)])  # metres
-    roofs.addParameterSources("POINTS", [Src.fromStaticValue(0)])  # non-ground
-    roofs.addParameterSources("EPSILON", [Src.fromModelParameter("epsilon")])
-    outputs = {}
-    for name, child_output in (("roof_planes", "OUTPUT"), ("plane_table", "OUTPUT_CSV")):
-        o = QgsProcessingModelOutput(name, name)
-        o.setChildId("roofs")
-        o.setChildOutputName(child_output)
-        o.setPosition(QPointF(700.0, 200.0 + 60.0 * len(outputs)))
-        outputs[name] = o
-    roofs.setModelOutputs(outputs)
-    static_defaults(roofs)
-    model.addChildAlgorithm(roofs)
+    # DISTANCE_UNIT 1: metres; POINTS 0: the non-ground points
+    add_child(model, "lidarphoto:groundfilter", "ground", "Ground filter", (400.0, 80.0),
+              {"INPUT": param("cloud"), "DISTANCE_UNIT": 1},
+              (("classified_cloud", "OUTPUT_CLOUD"),), (650.0, 40.0))  # fmt: skip
+    sources = {"INPUT": output_of("ground", "OUTPUT_CLOUD"), "DISTANCE_UNIT": 1, "POINTS": 0,
+               "EPSILON": param("epsilon")}  # fmt: skip
+    add_child(model, "lidarphoto:extractroofplanes", "roofs", "Extract roof planes",
+              (400.0, 220.0), sources, (("roof_planes", "OUTPUT"), ("plane_table", "OUTPUT_CSV")),
+              (700.0, 200.0))  # fmt: skip
     model.updateDestinationParameters()
     return model
 

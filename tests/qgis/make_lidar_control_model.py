@@ -21,44 +21,23 @@ MODEL = HERE / "data" / "lidar_control_model.model3"
 
 def build_model():
     from make_ground_roof_model import build_model as ground_roof_model
-    from model_tools import static_defaults
-    from qgis.core import QgsProcessingModelChildAlgorithm, QgsProcessingModelOutput
-    from qgis.core import QgsProcessingModelChildParameterSource as Src
-    from qgis.PyQt.QtCore import QPointF
+    from model_tools import add_child, model_outputs, output_of
 
     model = ground_roof_model()
     model.setName("Ground filter, roof planes and LiDAR control (model)")
     roofs = model.childAlgorithm("roofs")
     outputs = dict(roofs.modelOutputs())
-    cloud_out = QgsProcessingModelOutput("plane_cloud", "plane_cloud")
-    cloud_out.setChildId("roofs")
-    cloud_out.setChildOutputName("OUTPUT_CLOUD")
-    cloud_out.setPosition(QPointF(700.0, 320.0))
-    outputs["plane_cloud"] = cloud_out
+    outputs.update(model_outputs("roofs", (("plane_cloud", "OUTPUT_CLOUD"),), 700.0, 320.0))
     roofs.setModelOutputs(outputs)
     model.setChildAlgorithm(roofs)
 
-    lcps = QgsProcessingModelChildAlgorithm("lidarphoto:createlcps")
-    lcps.setChildId("lcps")
-    lcps.setDescription("Create LiDAR control points and lines")
-    lcps.setPosition(QPointF(400.0, 380.0))
-    lcps.addParameterSources("PLANES", [Src.fromChildOutput("roofs", "OUTPUT_CSV")])
-    lcps.addParameterSources("CLOUD", [Src.fromChildOutput("roofs", "OUTPUT_CLOUD")])
-    lcps.addParameterSources("DISTANCE_UNIT", [Src.fromStaticValue(1)])  # metres
-    outs = {}
-    for name, child_output in (
-        ("control_points", "OUTPUT_POINTS"),
-        ("control_lines", "OUTPUT_LINES"),
-        ("control_table", "POINTS_CSV"),
-    ):
-        o = QgsProcessingModelOutput(name, name)
-        o.setChildId("lcps")
-        o.setChildOutputName(child_output)
-        o.setPosition(QPointF(700.0, 400.0 + 60.0 * len(outs)))
-        outs[name] = o
-    lcps.setModelOutputs(outs)
-    static_defaults(lcps)
-    model.addChildAlgorithm(lcps)
+    sources = {"PLANES": output_of("roofs", "OUTPUT_CSV"),
+               "CLOUD": output_of("roofs", "OUTPUT_CLOUD"),
+               "DISTANCE_UNIT": 1}  # metres  # fmt: skip
+    outs = (("control_points", "OUTPUT_POINTS"), ("control_lines", "OUTPUT_LINES"),
+            ("control_table", "POINTS_CSV"))  # fmt: skip
+    add_child(model, "lidarphoto:createlcps", "lcps", "Create LiDAR control points and lines",
+              (400.0, 380.0), sources, outs, (700.0, 400.0))  # fmt: skip
     model.updateDestinationParameters()
     return model
 

@@ -17,17 +17,13 @@ MODEL = HERE / "data" / "trajectory_model.model3"
 
 
 def build_model():
+    from model_tools import add_child, add_inputs, param
     from qgis.core import (
         QgsProcessingModelAlgorithm,
-        QgsProcessingModelChildAlgorithm,
-        QgsProcessingModelOutput,
-        QgsProcessingModelParameter,
         QgsProcessingParameterCrs,
         QgsProcessingParameterFile,
         QgsProcessingParameterString,
     )
-    from qgis.core import QgsProcessingModelChildParameterSource as Src
-    from qgis.PyQt.QtCore import QPointF
 
     model = QgsProcessingModelAlgorithm(
         "Trajectory to exterior orientation (model)", "LiDAR Photogrammetry", "lidarphoto"
@@ -37,30 +33,12 @@ def build_model():
         QgsProcessingParameterCrs("crs", "Mapping CRS", "EPSG:31983"),
         QgsProcessingParameterString("lever_arm", "Lever arm x,y,z (m)", "0,0,0"),
     ]
-    for i, param in enumerate(inputs):
-        component = QgsProcessingModelParameter(param.name())
-        component.setPosition(QPointF(120.0, 60.0 + 70.0 * i))
-        model.addModelParameter(param, component)
-
-    child = QgsProcessingModelChildAlgorithm("lidarphoto:trajectorytoeo")
-    child.setChildId("eo")
-    child.setDescription("Trajectory to exterior orientation")
-    child.setPosition(QPointF(420.0, 130.0))
-    child.addParameterSources("INPUT", [Src.fromModelParameter("trajectory")])
-    child.addParameterSources("CRS", [Src.fromModelParameter("crs")])
-    child.addParameterSources("LEVER_ARM", [Src.fromModelParameter("lever_arm")])
-    child.addParameterSources("MOUNT", [Src.fromStaticValue(0)])
-    child.addParameterSources("MOUNT_MATRIX", [Src.fromStaticValue("")])
-    child.addParameterSources("BORESIGHT", [Src.fromStaticValue("0,0,0")])
-    outputs = {}
-    for name, child_output in (("eo_points", "OUTPUT"), ("eo_table", "OUTPUT_CSV")):
-        out = QgsProcessingModelOutput(name, name)
-        out.setChildId("eo")
-        out.setChildOutputName(child_output)
-        out.setPosition(QPointF(700.0, 100.0 + 60.0 * len(outputs)))
-        outputs[name] = out
-    child.setModelOutputs(outputs)
-    model.addChildAlgorithm(child)
+    add_inputs(model, inputs, 120.0, 60.0, 70.0)
+    sources = {"INPUT": param("trajectory"), "CRS": param("crs"), "LEVER_ARM": param("lever_arm"),
+               "MOUNT": 0, "MOUNT_MATRIX": "", "BORESIGHT": "0,0,0"}  # fmt: skip
+    add_child(model, "lidarphoto:trajectorytoeo", "eo", "Trajectory to exterior orientation",
+              (420.0, 130.0), sources, (("eo_points", "OUTPUT"), ("eo_table", "OUTPUT_CSV")),
+              (700.0, 100.0), defaults=False)  # fmt: skip
     model.updateDestinationParameters()
     return model
 

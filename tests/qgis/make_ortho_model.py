@@ -22,12 +22,9 @@ MODEL = HERE / "data" / "ortho_model.model3"
 
 def build_model():
     from lidarphoto.processing_provider.compat import NUMBER_DOUBLE, SOURCE_FILE
-    from model_tools import static_defaults
+    from model_tools import add_child, add_inputs, output_of, param
     from qgis.core import (
         QgsProcessingModelAlgorithm,
-        QgsProcessingModelChildAlgorithm,
-        QgsProcessingModelOutput,
-        QgsProcessingModelParameter,
         QgsProcessingParameterCrs,
         QgsProcessingParameterEnum,
         QgsProcessingParameterFile,
@@ -35,8 +32,6 @@ def build_model():
         QgsProcessingParameterNumber,
         QgsProcessingParameterString,
     )
-    from qgis.core import QgsProcessingModelChildParameterSource as Src
-    from qgis.PyQt.QtCore import QPointF
 
     model = QgsProcessingModelAlgorithm("Boresight calibration to orthomosaic (model)",
                                         "LiDAR Photogrammetry")  # fmt: skip
@@ -68,59 +63,24 @@ def build_model():
         QgsProcessingParameterFile("dsm", "DSM (raster or LAS/LAZ)"),
         QgsProcessingParameterNumber("gsd", "Orthophoto cell size", NUMBER_DOUBLE, 0.0),
     ]
-    for k, p in enumerate(inputs):
-        mp = QgsProcessingModelParameter(p.name())
-        mp.setPosition(QPointF(80.0, 60.0 + 50.0 * k))
-        model.addModelParameter(p, mp)
+    add_inputs(model, inputs, 80.0, 60.0, 50.0)
 
-    bore = QgsProcessingModelChildAlgorithm("lidarphoto:boresightcalibration")
-    bore.setChildId("boresight")
-    bore.setDescription("Boresight calibration")
-    bore.setPosition(QPointF(400.0, 120.0))
-    for child, source in (("CAMERA", "camera"), ("TRAJECTORY", "trajectory"), ("CRS", "crs"),
-                          ("LEVER_ARM", "lever_arm"), ("MOUNT", "mount"),
-                          ("OBSERVATIONS", "observations"), ("PLANES", "planes"),
-                          ("LINES", "lines"), ("LCPS", "lcps")):  # fmt: skip
-        bore.addParameterSources(child, [Src.fromModelParameter(source)])
-    bore.addParameterSources("BORESIGHT", [Src.fromStaticValue("0,0,0")])
-    bore.addParameterSources("CONTROL_TYPES", [Src.fromStaticValue([0, 1, 2])])
-    table = QgsProcessingModelOutput("boresight_table", "boresight_table")
-    table.setChildId("boresight")
-    table.setChildOutputName("OUTPUT_TABLE")
-    table.setPosition(QPointF(700.0, 80.0))
-    bore.setModelOutputs({"boresight_table": table})
-    static_defaults(bore)
-    model.addChildAlgorithm(bore)
-
-    ortho = QgsProcessingModelChildAlgorithm("lidarphoto:orthorectify")
-    ortho.setChildId("ortho")
-    ortho.setDescription("Orthorectify (true orthophotos)")
-    ortho.setPosition(QPointF(400.0, 300.0))
-    ortho.addParameterSources("CAMERA", [Src.fromModelParameter("camera")])
-    ortho.addParameterSources("EO", [Src.fromChildOutput("boresight", "OUTPUT_EO")])
-    ortho.addParameterSources("IMAGES", [Src.fromModelParameter("images")])
-    ortho.addParameterSources("DSM", [Src.fromModelParameter("dsm")])
-    ortho.addParameterSources("CRS", [Src.fromModelParameter("crs")])
-    ortho.addParameterSources("GSD", [Src.fromModelParameter("gsd")])
-    ortho.addParameterSources("TRUE_ORTHO", [Src.fromStaticValue(True)])
-    static_defaults(ortho)
-    model.addChildAlgorithm(ortho)
-
-    mosaic = QgsProcessingModelChildAlgorithm("lidarphoto:orthomosaic")
-    mosaic.setChildId("mosaic")
-    mosaic.setDescription("Orthomosaic")
-    mosaic.setPosition(QPointF(400.0, 460.0))
-    mosaic.addParameterSources("ORTHOPHOTOS", [Src.fromChildOutput("ortho", "OUTPUT_FOLDER")])
-    outs = {}
-    for name, child_output in (("orthomosaic", "OUTPUT"), ("seamlines", "OUTPUT_SEAMLINES")):
-        o = QgsProcessingModelOutput(name, name)
-        o.setChildId("mosaic")
-        o.setChildOutputName(child_output)
-        o.setPosition(QPointF(700.0, 440.0 + 60.0 * len(outs)))
-        outs[name] = o
-    mosaic.setModelOutputs(outs)
-    static_defaults(mosaic)
-    model.addChildAlgorithm(mosaic)
+    sources = {key: param(key.lower()) for key in (
+        "CAMERA", "TRAJECTORY", "CRS", "LEVER_ARM", "MOUNT", "OBSERVATIONS", "PLANES", "LINES",
+        "LCPS")}  # fmt: skip
+    sources.update(BORESIGHT="0,0,0", CONTROL_TYPES=[0, 1, 2])
+    add_child(model, "lidarphoto:boresightcalibration", "boresight", "Boresight calibration",
+              (400.0, 120.0), sources, (("boresight_table", "OUTPUT_TABLE"),),
+              (700.0, 80.0))  # fmt: skip
+    sources = {"CAMERA": param("camera"), "EO": output_of("boresight", "OUTPUT_EO"),
+               "IMAGES": param("images"), "DSM": param("dsm"), "CRS": param("crs"),
+               "GSD": param("gsd"), "TRUE_ORTHO": True}  # fmt: skip
+    add_child(model, "lidarphoto:orthorectify", "ortho", "Orthorectify (true orthophotos)",
+              (400.0, 300.0), sources)  # fmt: skip
+    add_child(model, "lidarphoto:orthomosaic", "mosaic", "Orthomosaic", (400.0, 460.0),
+              {"ORTHOPHOTOS": output_of("ortho", "OUTPUT_FOLDER")},
+              (("orthomosaic", "OUTPUT"), ("seamlines", "OUTPUT_SEAMLINES")),
+              (700.0, 440.0))  # fmt: skip
     model.updateDestinationParameters()
     return model
 

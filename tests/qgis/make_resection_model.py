@@ -20,17 +20,12 @@ MODEL = HERE / "data" / "resection_model.model3"
 
 
 def build_model():
-    from model_tools import static_defaults
+    from model_tools import add_child, add_inputs, output_of, param
     from qgis.core import (
         QgsProcessingModelAlgorithm,
-        QgsProcessingModelChildAlgorithm,
-        QgsProcessingModelOutput,
-        QgsProcessingModelParameter,
         QgsProcessingParameterCrs,
         QgsProcessingParameterFile,
     )
-    from qgis.core import QgsProcessingModelChildParameterSource as Src
-    from qgis.PyQt.QtCore import QPointF
 
     model = QgsProcessingModelAlgorithm(
         "LiDAR control to space resection (model)", "LiDAR Photogrammetry"
@@ -42,44 +37,17 @@ def build_model():
         QgsProcessingParameterFile("cloud", "Cloud with plane ids (LAS/LAZ)"),
         QgsProcessingParameterCrs("crs", "Mapping CRS"),
     ]
-    for k, p in enumerate(inputs):
-        mp = QgsProcessingModelParameter(p.name())
-        mp.setPosition(QPointF(80.0, 60.0 + 50.0 * k))
-        model.addModelParameter(p, mp)
+    add_inputs(model, inputs, 80.0, 60.0, 50.0)
 
-    lcps = QgsProcessingModelChildAlgorithm("lidarphoto:createlcps")
-    lcps.setChildId("lcps")
-    lcps.setDescription("Create LiDAR control points and lines")
-    lcps.setPosition(QPointF(400.0, 120.0))
-    lcps.addParameterSources("PLANES", [Src.fromModelParameter("planes")])
-    lcps.addParameterSources("CLOUD", [Src.fromModelParameter("cloud")])
-    outs = {}
-    for name, child_output in (("lcp_table", "POINTS_CSV"), ("line_table", "LINES_CSV")):
-        o = QgsProcessingModelOutput(name, name)
-        o.setChildId("lcps")
-        o.setChildOutputName(child_output)
-        o.setPosition(QPointF(700.0, 80.0 + 50.0 * len(outs)))
-        outs[name] = o
-    lcps.setModelOutputs(outs)
-    static_defaults(lcps)
-    model.addChildAlgorithm(lcps)
-
-    resect = QgsProcessingModelChildAlgorithm("lidarphoto:resection")
-    resect.setChildId("resect")
-    resect.setDescription("Space resection from points and lines")
-    resect.setPosition(QPointF(400.0, 320.0))
-    resect.addParameterSources("CAMERA", [Src.fromModelParameter("camera")])
-    resect.addParameterSources("OBSERVATIONS", [Src.fromModelParameter("observations")])
-    resect.addParameterSources("CRS", [Src.fromModelParameter("crs")])
-    resect.addParameterSources("CONTROL_POINTS", [Src.fromChildOutput("lcps", "POINTS_CSV")])
-    resect.addParameterSources("CONTROL_LINES", [Src.fromChildOutput("lcps", "LINES_CSV")])
-    eo = QgsProcessingModelOutput("eo", "eo")
-    eo.setChildId("resect")
-    eo.setChildOutputName("OUTPUT_EO")
-    eo.setPosition(QPointF(700.0, 320.0))
-    resect.setModelOutputs({"eo": eo})
-    static_defaults(resect)
-    model.addChildAlgorithm(resect)
+    add_child(model, "lidarphoto:createlcps", "lcps", "Create LiDAR control points and lines",
+              (400.0, 120.0), {"PLANES": param("planes"), "CLOUD": param("cloud")},
+              (("lcp_table", "POINTS_CSV"), ("line_table", "LINES_CSV")), (700.0, 80.0),
+              50.0)  # fmt: skip
+    sources = {"CAMERA": param("camera"), "OBSERVATIONS": param("observations"),
+               "CRS": param("crs"), "CONTROL_POINTS": output_of("lcps", "POINTS_CSV"),
+               "CONTROL_LINES": output_of("lcps", "LINES_CSV")}  # fmt: skip
+    add_child(model, "lidarphoto:resection", "resect", "Space resection from points and lines",
+              (400.0, 320.0), sources, (("eo", "OUTPUT_EO"),), (700.0, 320.0))  # fmt: skip
     model.updateDestinationParameters()
     return model
 
