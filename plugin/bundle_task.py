@@ -17,9 +17,7 @@ import math
 from pathlib import Path
 
 import numpy as np
-from qgis.core import QgsApplication
-from qgis.PyQt import sip
-from qgis.PyQt.QtCore import QCoreApplication, QObject, Qt, pyqtSignal
+from qgis.PyQt.QtCore import Qt
 from qgis.PyQt.QtWidgets import QCheckBox, QComboBox, QFormLayout, QLabel, QPushButton, QWidget
 
 from ..core.i18n import render
@@ -34,7 +32,7 @@ from ..core.photo.dock_bundle import (
     orientations_of,
 )
 from ..core.quality.html_table import escape
-from .job_task import JobTask
+from .job_task import JobController
 
 __all__ = ["BUNDLE_ALG", "BundleController", "BundlePanel", "bundle_parameters"]
 
@@ -174,7 +172,7 @@ class BundlePanel(QWidget):
         return text
 
 
-class BundleController(QObject):
+class BundleController(JobController):
     """The Bundle button of a picking dock: one adjustment at a time in the QGIS task
     manager; its residuals kept in the dock's session (drawn on the image and in the table).
 
@@ -185,25 +183,19 @@ class BundleController(QObject):
         :class:`core.photo.bundle.BundleResult`, else :attr:`error` says why.
     """
 
-    finished = pyqtSignal(bool)
-
     def __init__(self, dock) -> None:
-        super().__init__(dock)
-        self.dock, self.panel = dock, dock.bundle_panel
-        self.task: JobTask | None = None
-        self.params: dict = {}
+        super().__init__(dock, dock.bundle_panel)
         self.inputs: DockBundleInputs | None = None
         self.result = None
         self.text = ""
-        self.error = ""
         self.panel.run_button.clicked.connect(self.start)
 
-    def tr(self, text: str) -> str:
-        return QCoreApplication.translate("BundleController", text)  # the context lupdate gives it
-
-    @property
-    def running(self) -> bool:
-        return self.task is not None
+    def _texts(self) -> dict[str, str]:
+        return {
+            "busy": self.tr("A bundle adjustment is already running."),
+            "cancelled": self.tr("Bundle adjustment cancelled."),
+            "failed": self.tr("Bundle adjustment failed. {}"),
+        }
 
     def _refuse(self, text: str) -> bool:
         self.error = text
@@ -215,8 +207,7 @@ class BundleController(QObject):
         """Adjust the open images in a background task; False (with the reason shown in the
         panel) if it cannot start."""
         dock, store, session = self.dock, self.dock.store, self.dock.session
-        if self.running:
-            dock.message(self.tr("A bundle adjustment is already running."))
+        if self._busy():
             return False
         camera = dock.project_panel.camera_edit.filePath()
         if session.eo is None or not camera:
@@ -252,8 +243,7 @@ class BundleController(QObject):
             self.panel.eo_check.isChecked(),
             len(inputs.ground) > 0,
         )
-        self.params, self.inputs, self.result, self.error, self.text = params, inputs, None, "", ""
-        self.panel.set_running(True)
+        self.inputs, self.result, self.text = inputs, None, ""
 
         def write_block() -> None:
             write_observations_csv(params["OBSERVATIONS"], inputs.observations)
@@ -261,42 +251,25 @@ class BundleController(QObject):
                 write_ground_points_csv(params["GROUND_POINTS"], inputs.ground)
             write_eo_csv(params["EO"], eo)
 
-        self.task = JobTask(
+        return self._launch(
             self.tr("Bundle adjustment of {} images").format(len(inputs.images)),
             bundle_adjustment,
             params,
             "OUTPUT_EO",
             write_block,
-            self._done,
         )
-        QgsApplication.taskManager().addTask(self.task)
-        return True
 
-    def _done(self, ok: bool, task: JobTask) -> None:
-        if sip.isdeleted(self):  # the dock was closed and deleted meanwhile
-            return
-        self.task = None
-        self.error = task.error
-        dock, panel = self.dock, self.panel
-        panel.set_running(False)
-        if not ok or task.result is None or task.result.data is None:
-            if task.cancelled or task.isCanceled():
-                text = self.tr("Bundle adjustment cancelled.")
-            else:
-                text = self.tr("Bundle adjustment failed. {}").format(task.error)
-            panel.result_label.setText(text)
-            dock.message(text, warning=True)
-            self.finished.emit(False)
-            return
-        res = self.result = task.result.data
+    def _usable(self, result) -> bool:
+        return result.data is not None
+
+    def _show(self, result) -> None:
+        dock = self.dock
+        res = self.result = result.data
         dock.session.set_bundle(res)
-        self.text = panel.show_result(res, self.inputs)
+        self.text = self.panel.show_result(res, self.inputs)
         s0 = res.adjustment.sigma0
         dock.message(
             self.tr("Bundle adjustment done: sigma0 {}; {}").format(
                 f"{s0:.3f}" if math.isfinite(s0) else "-", self.params["OUTPUT_HTML"]
             )
         )
-        dock.picking.draw_observations()
-        dock.picking.fill_table()
-        self.finished.emit(True)

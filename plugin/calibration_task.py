@@ -13,15 +13,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from qgis.core import QgsApplication
-from qgis.PyQt import sip
-from qgis.PyQt.QtCore import QCoreApplication, QObject, pyqtSignal
-
 from ..core.io.control import write_lcps_csv, write_lines_csv
 from ..core.io.planes import write_planes_csv
 from ..core.jobs import boresight_calibration
 from ..core.jobs.runner import JobResult
-from .job_task import JobTask
+from .job_task import JobController
 
 __all__ = ["CalibrationController", "calibration_parameters"]
 
@@ -71,7 +67,7 @@ def calibration_parameters(
     }
 
 
-class CalibrationController(QObject):
+class CalibrationController(JobController):
     """The Run button of a picking dock: one calibration at a time in the QGIS task manager,
     its result kept in the dock's session.
 
@@ -82,32 +78,23 @@ class CalibrationController(QObject):
         says why.
     """
 
-    finished = pyqtSignal(bool)
-
     def __init__(self, dock) -> None:
-        super().__init__(dock)
-        self.dock, self.panel = dock, dock.calibration_panel
-        self.task: JobTask | None = None
-        self.params: dict = {}
+        super().__init__(dock, dock.calibration_panel)
         self.result: JobResult | None = None
-        self.error = ""
         self.panel.run_button.clicked.connect(self.run)
         self.panel.use_eo_button.clicked.connect(self.use_orientation)
 
-    def tr(self, text: str) -> str:
-        return QCoreApplication.translate(
-            "CalibrationController", text
-        )  # the context lupdate gives it
-
-    @property
-    def running(self) -> bool:
-        return self.task is not None
+    def _texts(self) -> dict[str, str]:
+        return {
+            "busy": self.tr("A calibration is already running."),
+            "cancelled": self.tr("Calibration cancelled."),
+            "failed": self.tr("Calibration failed. {}"),
+        }
 
     def run(self) -> bool:
         """Start the calibration in a background task; False (with a message) if it cannot."""
         dock, store = self.dock, self.dock.store
-        if self.running:
-            dock.message(self.tr("A calibration is already running."))
+        if self._busy():
             return False
         if store.path is None or not store.rows:
             dock.message(self.tr("No observations to calibrate with."), warning=True)
@@ -129,8 +116,7 @@ class CalibrationController(QObject):
                 warning=True,
             )
             return False
-        self.params, self.result, self.error = params, None, ""
-        self.panel.set_running(True)
+        self.result = None
 
         def write_control() -> None:
             for key, write, items in zip(
@@ -141,35 +127,17 @@ class CalibrationController(QObject):
                 if params[key]:
                     write(params[key], items)
 
-        self.task = JobTask(self.tr("Boresight calibration"), boresight_calibration, params,
-                            "OUTPUT_TABLE", write_control, self._done)  # fmt: skip
-        QgsApplication.taskManager().addTask(self.task)
-        return True
+        return self._launch(self.tr("Boresight calibration"), boresight_calibration, params,
+                            "OUTPUT_TABLE", write_control)  # fmt: skip
 
-    def _done(self, ok: bool, task: JobTask) -> None:
-        if sip.isdeleted(self):  # the dock was closed and deleted meanwhile
-            return
-        self.task = None
-        self.result, self.error = task.result, task.error
+    def _show(self, result: JobResult) -> None:
         dock, panel = self.dock, self.panel
-        panel.set_running(False)
-        if not ok or task.result is None:
-            if task.cancelled or task.isCanceled():  # (also: cancelled before it started)
-                text = self.tr("Calibration cancelled.")
-            else:
-                text = self.tr("Calibration failed. {}").format(task.error)
-            panel.result_label.setText(text)
-            dock.message(text, warning=True)
-            self.finished.emit(False)
-            return
+        self.result = result
         session = dock.session
-        session.set_calibration(task.result.data)
+        session.set_calibration(result.data)
         panel.show_result(session.boresight_summary(), session.residual_stats())
         dock.message(self.tr("Calibration done: {}").format(self.params["OUTPUT_HTML"]))
-        dock.picking.draw_observations()
-        dock.picking.fill_table()
         panel.use_eo_button.setEnabled(True)
-        self.finished.emit(True)
 
     def use_orientation(self) -> None:
         """Show the images with the calibrated exterior orientation (the result's, in

@@ -1,6 +1,7 @@
 """One core job run in the QGIS task manager for the picking dock (calibration, resection,
 bundle adjustment): the dock's inputs written as the files the job reads, then the job, in a
-worker thread; the dock is told in the GUI thread."""
+worker thread; the dock is told in the GUI thread. :class:`JobController` is what the dock's
+three Run buttons share: one task at a time, the failure shown, the result drawn."""
 
 from __future__ import annotations
 
@@ -8,7 +9,9 @@ from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
 
-from qgis.core import QgsTask
+from qgis.core import QgsApplication, QgsTask
+from qgis.PyQt import sip
+from qgis.PyQt.QtCore import QCoreApplication, QObject, pyqtSignal
 
 from ..core.errors import Cancelled
 from ..core.jobs.runner import JobResult, run_job
@@ -58,3 +61,91 @@ class JobTask(QgsTask):
 
     def finished(self, ok: bool) -> None:  # the GUI thread
         self.done(ok, self)
+
+
+class JobController(QObject):
+    """A Run button of the picking dock: one :class:`JobTask` at a time in the QGIS task
+    manager; a failure (or cancel) shown in the panel and the dock's message bar, a result
+    handed to :meth:`_show`, then the observations redrawn.
+
+    Subclasses give :meth:`_texts` (their words, in their own translation context),
+    :meth:`_show` and, where the job's data can be empty, :meth:`_usable`; their start method
+    checks its inputs and calls :meth:`_launch`.
+
+    Signals
+    -------
+    finished(bool)
+        The task ended; on failure :attr:`error` says why.
+    """
+
+    finished = pyqtSignal(bool)
+
+    def __init__(self, dock, panel) -> None:
+        super().__init__(dock)
+        self.dock, self.panel = dock, panel
+        self.task: JobTask | None = None
+        self.params: dict = {}
+        self.error = ""
+
+    def tr(self, text: str) -> str:
+        # the context lupdate gives the subclass's self.tr("...")
+        return QCoreApplication.translate(type(self).__name__, text)
+
+    @property
+    def running(self) -> bool:
+        return self.task is not None
+
+    def _texts(self) -> dict[str, str]:
+        """``busy`` (a task is running), ``cancelled``, ``failed`` (``{}``: the error)."""
+        raise NotImplementedError
+
+    def _usable(self, result: JobResult) -> bool:
+        """Whether the job's result holds what :meth:`_show` needs."""
+        return True
+
+    def _show(self, result: JobResult) -> None:
+        """Keep and show a successful result (the GUI thread)."""
+        raise NotImplementedError
+
+    def _busy(self) -> bool:
+        """True (with a message) when a task of this button is running."""
+        if self.running:
+            self.dock.message(self._texts()["busy"])
+        return self.running
+
+    def _launch(
+        self,
+        description: str,
+        job: ModuleType,
+        params: dict,
+        output_key: str,
+        write_inputs: Callable[[], None],
+    ) -> bool:
+        """Start the job in the task manager (see :class:`JobTask`); True."""
+        self.params, self.error = params, ""
+        self.panel.set_running(True)
+        self.task = JobTask(description, job, params, output_key, write_inputs, self._done)
+        QgsApplication.taskManager().addTask(self.task)
+        return True
+
+    def _done(self, ok: bool, task: JobTask) -> None:
+        if sip.isdeleted(self):  # the dock was closed and deleted meanwhile
+            return
+        self.task = None
+        self.error = task.error
+        dock, panel = self.dock, self.panel
+        panel.set_running(False)
+        if not ok or task.result is None or not self._usable(task.result):
+            texts = self._texts()
+            if task.cancelled or task.isCanceled():  # (also: cancelled before it started)
+                text = texts["cancelled"]
+            else:
+                text = texts["failed"].format(task.error)
+            panel.result_label.setText(text)
+            dock.message(text, warning=True)
+            self.finished.emit(False)
+            return
+        self._show(task.result)
+        dock.picking.draw_observations()
+        dock.picking.fill_table()
+        self.finished.emit(True)

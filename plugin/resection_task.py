@@ -15,9 +15,7 @@ import math
 from pathlib import Path
 
 import numpy as np
-from qgis.core import QgsApplication
-from qgis.PyQt import sip
-from qgis.PyQt.QtCore import QCoreApplication, QObject, Qt, pyqtSignal
+from qgis.PyQt.QtCore import Qt
 from qgis.PyQt.QtWidgets import QCheckBox, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from ..core.io.control import write_lcps_csv, write_lines_csv
@@ -27,7 +25,7 @@ from ..core.jobs.resection import residual_rows
 from ..core.photo.control_features import lines_with_end_sigmas
 from ..core.photo.picking_session import residual_summary
 from ..core.quality.html_table import escape
-from .job_task import JobTask
+from .job_task import JobController
 
 __all__ = ["RESECTION_ALG", "ResectionController", "ResectionPanel", "resection_parameters"]
 
@@ -136,7 +134,7 @@ class ResectionPanel(QWidget):
         return text
 
 
-class ResectionController(QObject):
+class ResectionController(JobController):
     """The Resect button of a picking dock: one resection at a time in the QGIS task manager;
     its residuals kept in the dock's session (drawn on the image and in the table).
 
@@ -147,34 +145,25 @@ class ResectionController(QObject):
         :class:`core.jobs.resection.ImageRun`, else :attr:`error` says why.
     """
 
-    finished = pyqtSignal(bool)
-
     def __init__(self, dock) -> None:
-        super().__init__(dock)
-        self.dock, self.panel = dock, dock.resection_panel
-        self.task: JobTask | None = None
-        self.params: dict = {}
+        super().__init__(dock, dock.resection_panel)
         self.run = None
         self.text = ""
-        self.error = ""
         self.panel.resect_button.clicked.connect(self.start)
 
-    def tr(self, text: str) -> str:
-        return QCoreApplication.translate(
-            "ResectionController", text
-        )  # the context lupdate gives it
-
-    @property
-    def running(self) -> bool:
-        return self.task is not None
+    def _texts(self) -> dict[str, str]:
+        return {
+            "busy": self.tr("A resection is already running."),
+            "cancelled": self.tr("Resection cancelled."),
+            "failed": self.tr("Resection failed. {}"),
+        }
 
     def start(self, *_args) -> bool:
         """Resect the image shown in a background task; False (with a message) if it cannot
         start."""
         dock, store = self.dock, self.dock.store
         image = dock.current_image
-        if self.running:
-            dock.message(self.tr("A resection is already running."))
+        if self._busy():
             return False
         if not image or not any(o.image_id == image for o in store.rows):
             dock.message(self.tr("No observations in image {}.").format(image), warning=True)
@@ -199,8 +188,7 @@ class ResectionController(QObject):
             out_dir, image, out_dir / "observations.csv", camera, crs.authid() or crs.toWkt(),
             control,
         )  # fmt: skip
-        self.params, self.run, self.error, self.text = params, None, "", ""
-        self.panel.set_running(True)
+        self.run, self.text = None, ""
 
         def write_control() -> None:
             write_observations_csv(params["OBSERVATIONS"], snapshot)
@@ -210,42 +198,26 @@ class ResectionController(QObject):
             if params["CONTROL_POINTS"]:
                 write_lcps_csv(params["CONTROL_POINTS"], lcps)
 
-        self.task = JobTask(self.tr("Resection of {}").format(image), resection, params,
-                            "OUTPUT_EO", write_control, self._done)  # fmt: skip
-        QgsApplication.taskManager().addTask(self.task)
-        return True
+        return self._launch(self.tr("Resection of {}").format(image), resection, params,
+                            "OUTPUT_EO", write_control)  # fmt: skip
 
-    def _done(self, ok: bool, task: JobTask) -> None:
-        if sip.isdeleted(self):  # the dock was closed and deleted meanwhile
-            return
-        self.task = None
-        self.error = task.error
-        dock, panel = self.dock, self.panel
-        panel.set_running(False)
-        if not ok or task.result is None or not task.result.data:
-            if task.cancelled or task.isCanceled():
-                text = self.tr("Resection cancelled.")
-            else:
-                text = self.tr("Resection failed. {}").format(task.error)
-            panel.result_label.setText(text)
-            dock.message(text, warning=True)
-            self.finished.emit(False)
-            return
+    def _usable(self, result) -> bool:
+        return bool(result.data)
+
+    def _show(self, result) -> None:
         from ..core.io.camera import read_camera_json
         from ..core.io.observations import read_observations_csv
 
-        run = self.run = task.result.data[0]
+        dock = self.dock
+        run = self.run = result.data[0]
         camera = read_camera_json(self.params["CAMERA"])
         obs = read_observations_csv(self.params["OBSERVATIONS"], camera=camera)
         rows = residual_rows(run, obs, camera)
         dock.session.set_resection(rows)
-        self.text = panel.show_result(run, rows)
+        self.text = self.panel.show_result(run, rows)
         s0 = run.result.result.sigma0
         dock.message(
             self.tr("Resection of {} done: sigma0 {}; {}").format(
                 run.image_id, f"{s0:.3f}" if math.isfinite(s0) else "-", self.params["OUTPUT_HTML"]
             )
         )
-        dock.picking.draw_observations()
-        dock.picking.fill_table()
-        self.finished.emit(True)
