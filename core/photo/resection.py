@@ -25,7 +25,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ConvergenceError, InputError, NotObservableError, stop_if_asked
 from ..geometry.camera import Camera
-from ..geometry.collinearity import collinearity_jacobians
 from ..geometry.frames import LocalFrame, MappingFrame
 from ..geometry.lines import camera_vectors, coplanarity, image_vectors, parametrisation
 from ..geometry.rotations import matrix_to_opk, opk_to_matrix
@@ -83,7 +82,18 @@ def space_resection(
     labels: list[str] | None = None,
     should_stop: Callable[[], bool] | None = None,
 ) -> ResectionResult:
-    """Least-squares resection with Baarda data snooping by default.
+    """Least-squares resection from control points only, with Baarda data snooping by default.
+
+    The points-only case of :func:`resect`'s model (the same collinearity block,
+    :func:`.resection_model.point_block`, errorless points), kept as the light call for
+    code that orients many images from matched points: one start (OpenCV's solvePnP, or
+    ``eo0``), the engine's :class:`~lidarphoto.core.lsq.model.AdjustmentOptions` as given,
+    no observability diagnosis, a plain :class:`ResectionResult`. Use it for start poses
+    (the bundle adjustment's image-by-image orientation) and for points from image matching
+    (control chips). Use :func:`resect` for a user's resection: lines as well as points,
+    point sigmas and covariances, the interior orientation, the start chosen among several
+    candidates, the global test with the source's critical value and the diagnosis of what
+    the observations cannot determine (the ``resection`` algorithm runs it).
 
     Parameters
     ----------
@@ -92,6 +102,8 @@ def space_resection(
     camera : interior orientation (held fixed).
     eo0 : initial pose; solvePnP when None.
     sigma_px : a priori standard deviation of an image coordinate, pixels.
+    options : the adjustment's options; data snooping with the engine's defaults when None.
+    labels : the points' names in the residual table (their indices when None).
     """
     px = np.asarray(pixels, dtype=np.float64)
     pts = np.asarray(points, dtype=np.float64)
@@ -101,20 +113,9 @@ def space_resection(
         raise InputError(f"a resection needs at least 4 points, got {px.shape[0]}")
     x0 = initial_pose_pnp(px, pts, camera) if eo0 is None else np.asarray(eo0, dtype=float)
     n = px.shape[0]
-
-    def model(x_local: Array) -> tuple[Array, Array]:
-        out = collinearity_jacobians(pts, x_local, camera, wrt=("eo",))
-        return out["pixels"], out["eo"]
-
-    block = GaussMarkovBlock(
-        name="image points",
-        observed=px,
-        sigma=np.full((n, 2), float(sigma_px)),
-        param_index=np.tile(np.arange(6), (n, 1)),
-        model=model,
-        labels=labels if labels is not None else [str(i) for i in range(n)],
-        row_names=("col", "row"),
-    )
+    block = point_block("image points", camera, px, np.full(n, float(sigma_px)), pts, None,
+                        np.tile(np.arange(6), (n, 1)),
+                        labels if labels is not None else [str(i) for i in range(n)])  # fmt: skip
     opts = options if options is not None else AdjustmentOptions(snooping=True)
     result = adjust(x0, list(EO_NAMES), [block], options=opts, should_stop=should_stop)
     table = result.residuals["image points"]
@@ -535,6 +536,9 @@ def resect(
     should_stop: Callable[[], bool] | None = None,
 ) -> SpaceResection:
     """Exterior orientation of one image from control points and straight lines.
+
+    The full resection (what the ``resection`` algorithm and the dock run); for a quick
+    points-only pose from matched points, see :func:`space_resection`.
 
     Every observation enters one rigorous Gauss-Helmert adjustment (:mod:`.resection_model`):
     points by collinearity, lines by the coplanarity model (default) or the equivalent-planes
