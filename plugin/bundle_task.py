@@ -190,13 +190,6 @@ class BundleController(JobController):
         self.text = ""
         self.panel.run_button.clicked.connect(self.start)
 
-    def _texts(self) -> dict[str, str]:
-        return {
-            "busy": self.tr("A bundle adjustment is already running."),
-            "cancelled": self.tr("Bundle adjustment cancelled."),
-            "failed": self.tr("Bundle adjustment failed. {}"),
-        }
-
     def _refuse(self, text: str) -> bool:
         self.error = text
         self.panel.result_label.setText(text)
@@ -207,7 +200,7 @@ class BundleController(JobController):
         """Adjust the open images in a background task; False (with the reason shown in the
         panel) if it cannot start."""
         dock, store, session = self.dock, self.dock.store, self.dock.session
-        if self._busy():
+        if self._busy(self.tr("A bundle adjustment is already running.")):
             return False
         camera = dock.project_panel.camera_edit.filePath()
         if session.eo is None or not camera:
@@ -257,6 +250,8 @@ class BundleController(JobController):
             params,
             "OUTPUT_EO",
             write_block,
+            self.tr("Bundle adjustment cancelled."),
+            self.tr("Bundle adjustment failed. {}"),
         )
 
     def _usable(self, result) -> bool:

@@ -84,17 +84,10 @@ class CalibrationController(JobController):
         self.panel.run_button.clicked.connect(self.run)
         self.panel.use_eo_button.clicked.connect(self.use_orientation)
 
-    def _texts(self) -> dict[str, str]:
-        return {
-            "busy": self.tr("A calibration is already running."),
-            "cancelled": self.tr("Calibration cancelled."),
-            "failed": self.tr("Calibration failed. {}"),
-        }
-
     def run(self) -> bool:
         """Start the calibration in a background task; False (with a message) if it cannot."""
         dock, store = self.dock, self.dock.store
-        if self._busy():
+        if self._busy(self.tr("A calibration is already running.")):
             return False
         if store.path is None or not store.rows:
             dock.message(self.tr("No observations to calibrate with."), warning=True)
@@ -128,7 +121,8 @@ class CalibrationController(JobController):
                     write(params[key], items)
 
         return self._launch(self.tr("Boresight calibration"), boresight_calibration, params,
-                            "OUTPUT_TABLE", write_control)  # fmt: skip
+                            "OUTPUT_TABLE", write_control, self.tr("Calibration cancelled."),
+                            self.tr("Calibration failed. {}"))  # fmt: skip
 
     def _show(self, result: JobResult) -> None:
         dock, panel = self.dock, self.panel

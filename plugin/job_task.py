@@ -68,9 +68,9 @@ class JobController(QObject):
     manager; a failure (or cancel) shown in the panel and the dock's message bar, a result
     handed to :meth:`_show`, then the observations redrawn.
 
-    Subclasses give :meth:`_texts` (their words, in their own translation context),
-    :meth:`_show` and, where the job's data can be empty, :meth:`_usable`; their start method
-    checks its inputs and calls :meth:`_launch`.
+    Subclasses give :meth:`_show` and, where the job's data can be empty, :meth:`_usable`;
+    their start method checks :meth:`_busy` and its inputs, then calls :meth:`_launch`. The
+    words shown are the subclass's (``self.tr`` there: its own translation context).
 
     Signals
     -------
@@ -86,6 +86,7 @@ class JobController(QObject):
         self.task: JobTask | None = None
         self.params: dict = {}
         self.error = ""
+        self._failure_texts = ("", "{}")
 
     def tr(self, text: str) -> str:
         # the context lupdate gives the subclass's self.tr("...")
@@ -95,10 +96,6 @@ class JobController(QObject):
     def running(self) -> bool:
         return self.task is not None
 
-    def _texts(self) -> dict[str, str]:
-        """``busy`` (a task is running), ``cancelled``, ``failed`` (``{}``: the error)."""
-        raise NotImplementedError
-
     def _usable(self, result: JobResult) -> bool:
         """Whether the job's result holds what :meth:`_show` needs."""
         return True
@@ -107,22 +104,18 @@ class JobController(QObject):
         """Keep and show a successful result (the GUI thread)."""
         raise NotImplementedError
 
-    def _busy(self) -> bool:
-        """True (with a message) when a task of this button is running."""
+    def _busy(self, text: str) -> bool:
+        """True (with the message ``text``) when a task of this button is running."""
         if self.running:
-            self.dock.message(self._texts()["busy"])
+            self.dock.message(text)
         return self.running
 
-    def _launch(
-        self,
-        description: str,
-        job: ModuleType,
-        params: dict,
-        output_key: str,
-        write_inputs: Callable[[], None],
-    ) -> bool:
-        """Start the job in the task manager (see :class:`JobTask`); True."""
+    def _launch(self, description: str, job: ModuleType, params: dict, output_key: str,
+                write_inputs: Callable[[], None], cancelled: str, failed: str) -> bool:  # fmt: skip
+        """Start the job in the task manager (see :class:`JobTask`); True. ``cancelled`` and
+        ``failed`` (``{}``: the error) are the words shown if it does not succeed."""
         self.params, self.error = params, ""
+        self._failure_texts = (cancelled, failed)
         self.panel.set_running(True)
         self.task = JobTask(description, job, params, output_key, write_inputs, self._done)
         QgsApplication.taskManager().addTask(self.task)
@@ -136,11 +129,11 @@ class JobController(QObject):
         dock, panel = self.dock, self.panel
         panel.set_running(False)
         if not ok or task.result is None or not self._usable(task.result):
-            texts = self._texts()
+            cancelled, failed = self._failure_texts
             if task.cancelled or task.isCanceled():  # (also: cancelled before it started)
-                text = texts["cancelled"]
+                text = cancelled
             else:
-                text = texts["failed"].format(task.error)
+                text = failed.format(task.error)
             panel.result_label.setText(text)
             dock.message(text, warning=True)
             self.finished.emit(False)

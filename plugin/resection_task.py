@@ -151,19 +151,12 @@ class ResectionController(JobController):
         self.text = ""
         self.panel.resect_button.clicked.connect(self.start)
 
-    def _texts(self) -> dict[str, str]:
-        return {
-            "busy": self.tr("A resection is already running."),
-            "cancelled": self.tr("Resection cancelled."),
-            "failed": self.tr("Resection failed. {}"),
-        }
-
     def start(self, *_args) -> bool:
         """Resect the image shown in a background task; False (with a message) if it cannot
         start."""
         dock, store = self.dock, self.dock.store
         image = dock.current_image
-        if self._busy():
+        if self._busy(self.tr("A resection is already running.")):
             return False
         if not image or not any(o.image_id == image for o in store.rows):
             dock.message(self.tr("No observations in image {}.").format(image), warning=True)
@@ -199,7 +192,8 @@ class ResectionController(JobController):
                 write_lcps_csv(params["CONTROL_POINTS"], lcps)
 
         return self._launch(self.tr("Resection of {}").format(image), resection, params,
-                            "OUTPUT_EO", write_control)  # fmt: skip
+                            "OUTPUT_EO", write_control, self.tr("Resection cancelled."),
+                            self.tr("Resection failed. {}"))  # fmt: skip
 
     def _usable(self, result) -> bool:
         return bool(result.data)
