@@ -77,6 +77,30 @@ def test_ties_at_the_kth_distance_go_to_the_lower_index():
         np.testing.assert_array_equal(knn[i], best)
 
 
+def test_points_beyond_the_cells_reach_search_every_point():
+    """Isolated points with fewer than K others within the search's 64 cells (the compiled
+    search's pass over every point): the same K nearest as the numpy back end and as brute
+    force, ties included (integer coordinates)."""
+    rng = np.random.default_rng(6)
+    g = np.stack(np.meshgrid(np.arange(60), np.arange(50), np.arange(2)), -1).reshape(-1, 3)
+    far = np.array([[10000, 10000, 0], [10001, 10000, 1], [-10000, 10000, 3], [0, 10000, 2]])
+    xyz = np.vstack([g, far])[rng.permutation(len(g) + len(far))].astype(np.float64)
+    params = RoofPlaneParams(k_neighbours=12, min_support=10, batch_size=500)
+    cell = _spatial_order(xyz, np.floor(xyz.min(axis=0)), params.k_neighbours, True)[1].cell
+    out = _both_local(xyz, params)
+    _assert_same_local(out)
+    order, knn = out["numba"][0], out["numba"][4]
+    q = xyz[order]
+    far_rows = np.flatnonzero(q[:, 1] > 1000)
+    assert len(far_rows) == 4
+    for i in far_rows:
+        d2 = ((q - q[i]) ** 2).sum(axis=1)
+        best = np.lexsort((np.arange(len(q)), d2))[: knn.shape[1]]
+        np.testing.assert_array_equal(knn[i], best)
+        # the K-th neighbour lies beyond the 64 cells around the point: found by that pass
+        assert np.sqrt(d2[best[-1]]) > 65 * np.sqrt(2.0) * cell
+
+
 @pytest.mark.parametrize("source", ["town", "ahn3"])
 def test_the_same_planes_both_ways(source):
     if source == "town":
