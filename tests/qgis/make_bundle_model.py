@@ -20,16 +20,13 @@ MODEL = HERE / "data" / "bundle_accuracy_model.model3"
 
 
 def build_model():
-    from model_tools import add_child, add_inputs, output_of, param
+    from model_tools import add_child, add_inputs, new_model, output_of, param
     from qgis.core import (
-        QgsProcessingModelAlgorithm,
         QgsProcessingParameterCrs,
         QgsProcessingParameterFile,
     )
 
-    model = QgsProcessingModelAlgorithm(
-        "Bundle adjustment and accuracy report (model)", "LiDAR Photogrammetry", "lidarphoto"
-    )
+    model = new_model("Bundle adjustment and accuracy report (model)", "lidarphoto")
     inputs = [
         QgsProcessingParameterFile("camera", "Camera (JSON)", extension="json"),
         QgsProcessingParameterFile("observations", "Image observations (CSV)", extension="csv"),

@@ -20,16 +20,13 @@ MODEL = HERE / "data" / "ground_roof_model.model3"
 
 
 def build_model():
-    from model_tools import add_child, add_inputs, output_of, param
+    from model_tools import add_child, add_inputs, new_model, output_of, param
     from qgis.core import (
-        QgsProcessingModelAlgorithm,
         QgsProcessingParameterFile,
         QgsProcessingParameterNumber,
     )
 
-    model = QgsProcessingModelAlgorithm(
-        "Ground filter and roof planes (model)", "LiDAR Photogrammetry", "lidarphoto"
-    )
+    model = new_model("Ground filter and roof planes (model)", "lidarphoto")
     inputs = [
         QgsProcessingParameterFile("cloud", "Point cloud (LAS/LAZ)", extension="laz"),
         QgsProcessingParameterNumber(

@@ -17,17 +17,14 @@ MODEL = HERE / "data" / "trajectory_model.model3"
 
 
 def build_model():
-    from model_tools import add_child, add_inputs, param
+    from model_tools import add_child, add_inputs, new_model, param
     from qgis.core import (
-        QgsProcessingModelAlgorithm,
         QgsProcessingParameterCrs,
         QgsProcessingParameterFile,
         QgsProcessingParameterString,
     )
 
-    model = QgsProcessingModelAlgorithm(
-        "Trajectory to exterior orientation (model)", "LiDAR Photogrammetry", "lidarphoto"
-    )
+    model = new_model("Trajectory to exterior orientation (model)", "lidarphoto")
     inputs = [
         QgsProcessingParameterFile("trajectory", "Trajectory table (CSV)", extension="csv"),
         QgsProcessingParameterCrs("crs", "Mapping CRS", "EPSG:31983"),

@@ -22,9 +22,8 @@ MODEL = HERE / "data" / "ortho_model.model3"
 
 def build_model():
     from lidarphoto.processing_provider.compat import NUMBER_DOUBLE, SOURCE_FILE
-    from model_tools import add_child, add_inputs, output_of, param
+    from model_tools import add_child, add_inputs, new_model, output_of, param
     from qgis.core import (
-        QgsProcessingModelAlgorithm,
         QgsProcessingParameterCrs,
         QgsProcessingParameterEnum,
         QgsProcessingParameterFile,
@@ -33,8 +32,7 @@ def build_model():
         QgsProcessingParameterString,
     )
 
-    model = QgsProcessingModelAlgorithm("Boresight calibration to orthomosaic (model)",
-                                        "LiDAR Photogrammetry")  # fmt: skip
+    model = new_model("Boresight calibration to orthomosaic (model)")
     files = {
         "camera": "Camera (JSON)", "trajectory": "Trajectory (CSV)",
         "observations": "Image observations (CSV)", "planes": "Roof planes (CSV)",

@@ -20,16 +20,13 @@ MODEL = HERE / "data" / "resection_model.model3"
 
 
 def build_model():
-    from model_tools import add_child, add_inputs, output_of, param
+    from model_tools import add_child, add_inputs, new_model, output_of, param
     from qgis.core import (
-        QgsProcessingModelAlgorithm,
         QgsProcessingParameterCrs,
         QgsProcessingParameterFile,
     )
 
-    model = QgsProcessingModelAlgorithm(
-        "LiDAR control to space resection (model)", "LiDAR Photogrammetry"
-    )
+    model = new_model("LiDAR control to space resection (model)")
     inputs = [
         QgsProcessingParameterFile("camera", "Camera (JSON)"),
         QgsProcessingParameterFile("observations", "Image observations (CSV)"),

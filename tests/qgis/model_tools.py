@@ -24,6 +24,14 @@ def static_defaults(child) -> None:
         child.addParameterSources(param.name(), [Src.fromStaticValue(param.defaultValue())])
 
 
+def new_model(name: str, group_id: str = ""):
+    """An empty QgsProcessingModelAlgorithm ``name`` in the group "LiDAR Photogrammetry"
+    (with the group id ``group_id``, none by default)."""
+    from qgis.core import QgsProcessingModelAlgorithm
+
+    return QgsProcessingModelAlgorithm(name, "LiDAR Photogrammetry", group_id)
+
+
 def add_inputs(model, params, x: float, y0: float, dy: float) -> None:
     """The model's inputs (QgsProcessingParameter objects), one under the other at
     (x, y0 + dy i) on the canvas."""
