@@ -26,6 +26,7 @@ them array by array.
 
 from __future__ import annotations
 
+import threading
 from typing import Any, Callable
 
 import numpy as np
@@ -287,6 +288,7 @@ def _rect_union_kernel(src, out, ws, ds, sign, y_first, y_stop):
 
 _COMPILED: dict[str, Callable[..., Any]] = {}
 _POOL: list[Any] = []
+_POOL_LOCK = threading.Lock()
 def _compiled(name: str) -> Callable[..., Any]:
     """The jitted function (compiled at its first call for each argument type, cached next to
     this module; no kernel calls another, so the cache is not tied to the import name)."""
@@ -393,10 +395,11 @@ def _pool() -> Any:
     release the GIL: no threading layer of numba (the OpenMP one keeps its threads spinning
     after each parallel loop, CPU time spent for nothing; the workqueue one aborts when two
     threads launch at once), safe when QGIS runs algorithms in several threads."""
-    if not _POOL:
-        from concurrent.futures import ThreadPoolExecutor
+    with _POOL_LOCK:
+        if not _POOL:
+            from concurrent.futures import ThreadPoolExecutor
 
-        _POOL.append(ThreadPoolExecutor(_threads(), thread_name_prefix="lidarphoto-grid"))
+            _POOL.append(ThreadPoolExecutor(_threads(), thread_name_prefix="lidarphoto-grid"))
     return _POOL[0]
 
 
