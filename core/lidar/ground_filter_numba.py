@@ -399,8 +399,19 @@ def _pool() -> Any:
         if not _POOL:
             from concurrent.futures import ThreadPoolExecutor
 
-            _POOL.append(ThreadPoolExecutor(_threads(), thread_name_prefix="lidarphoto-grid"))
+            _POOL.append(ThreadPoolExecutor(_threads(), thread_name_prefix="lidarphoto-grid",
+                                            initializer=_block_signals))  # fmt: skip
     return _POOL[0]
+
+
+def _block_signals() -> None:
+    """In a pool thread: block the signals, so that the kernel delivers SIGINT, SIGTERM, ... to
+    the main thread, where Python handles them (one delivered to a pool thread would leave the
+    main thread asleep in a blocking call: Ctrl+C and the job's cancellation would wait)."""
+    import signal
+
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_BLOCK, signal.valid_signals())
 
 
 def morph(src: Any, kernel: Any, dilate: bool) -> Any | None:
