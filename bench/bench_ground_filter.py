@@ -2,6 +2,8 @@
 cloth-simulation-filter package (run here), laspy's own read + write and PDAL (PEERS.md).
 
     python bench/bench_ground_filter.py [--quick] [--runs 3] [--out results.json]
+    python bench/bench_ground_filter.py --e2e-only --e2e-runs 3 --before <older copy>
+    python bench/bench_ground_filter.py --openings   (SMRF's openings alone, Autzen's grid)
 
 Needs the project's core importable as ``lidarphoto`` and, for the peer, the PyPI package
 ``cloth-simulation-filter`` (module CSF) in the same venv (bench/ground_filter.md says how).
@@ -291,6 +293,39 @@ def isprs_table() -> dict:
     return out
 
 
+def openings_micro(path: Path, feet: bool, repeats: int = 3) -> dict:
+    """SMRF's 18 disk openings (default windows) of the file's filled minimum grid: OpenCV's
+    morphologyEx against the compiled kernel, CPU and wall time of each of ``repeats`` runs,
+    alternating; asserts the same bits."""
+    from lidarphoto.core.geometry.grid import Grid, fill_nearest
+    from lidarphoto.core.io.pointcloud import read_points
+    from lidarphoto.core.lidar import ground_filter as gf
+
+    arrays, _ = read_points(str(path), ("x", "y", "z"), crs=None if feet else 7415)
+    cell = 1.0 / FEET if feet else 1.0
+    x, y, z = arrays["x"], arrays["y"], arrays["z"]
+    grid = Grid.covering(np.array([x.min(), y.min()]), np.array([x.max(), y.max()]), cell)
+    zmin = gf._min_grid(grid, grid.flat_index(x, y).astype(np.int32), (z - z.min()))
+    surface = fill_nearest(zmin, np.isfinite(zmin))
+    windows, _ = gf.smrf_windows(gf.SmrfParams(cell_size=cell, max_window=18.0 * cell))
+    out: dict = {"grid": list(surface.shape), "windows": windows}
+    results = {}
+    gf._opening(surface, windows[-1], "disk", True)  # numba's start-up, not timed
+    for _ in range(repeats):
+        for name, use in (("opencv", False), ("compiled", True)):
+            s = surface
+            t, c = time.perf_counter(), time.process_time()
+            for w in windows:
+                s = gf._opening(s, w, "disk", use)
+            out.setdefault(name, []).append(
+                {"wall_s": time.perf_counter() - t, "cpu_s": time.process_time() - c}
+            )
+            results[name] = s
+    assert results["opencv"].tobytes() == results["compiled"].tobytes()
+    out["load_1min"] = os.getloadavg()[0]
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--worker", nargs=4)
@@ -298,6 +333,8 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--out", default="")
     ap.add_argument("--e2e-only", action="store_true", help="section 1 only (10 M files)")
+    ap.add_argument("--openings", action="store_true",
+                    help="only SMRF's openings of Autzen's grid: OpenCV, compiled")  # fmt: skip
     ap.add_argument("--e2e-runs", type=int, default=3, help="end-to-end runs of each tool")
     ap.add_argument(
         "--before", default="", help="PYTHONPATH of an older copy of the project: its job runs too"
@@ -306,6 +343,9 @@ def main() -> None:
     if args.worker:
         task, path, feet, runs = args.worker
         print(json.dumps(worker(task, path, feet == "1", int(runs))))
+        return
+    if args.openings:
+        print(json.dumps(openings_micro(AUTZEN, True, args.runs), indent=1))
         return
     results: dict = {"started": time.strftime("%Y-%m-%d %H:%M"), "load": os.getloadavg()}
     with tempfile.TemporaryDirectory() as tmp:

@@ -3,7 +3,8 @@ the cloth simulation filter CSF (Zhang et al. 2016).
 
 Shared steps (all grid work is vectorised with OpenCV/scipy.ndimage; the point work is vectorised
 with numpy, or compiled with numba when installed (:mod:`core.lidar.ground_filter_numba`, the same
-bits); the coordinates come as float64 arrays or as the LAS records' integers, :class:`ScaledXYZ`):
+bits), as are then the openings by larger windows (the same values as OpenCV's, on all cores);
+the coordinates come as float64 arrays or as the LAS records' integers, :class:`ScaledXYZ`):
 
 1. **Candidates.** Where the file has return numbers, only last (and single) returns can be
    ground: earlier returns of a multi-return pulse were stopped by something above the ground.
@@ -513,11 +514,30 @@ def _kernel(w: int, shape: str) -> NDArray[np.uint8]:
     return np.ones((w, w), np.uint8)
 
 
-def _opening(surface: NDArray[np.float32], w: int, shape: str) -> NDArray[np.float32]:
+#: Openings by windows of at least this many cells across go to the compiled kernel when
+#: numba is there (its cost grows with the window's radius, OpenCV's with its area: OpenCV is
+#: cheaper below).
+_COMPILED_OPENING_MIN = 7
+
+
+def _opening(
+    surface: NDArray[np.float32], w: int, shape: str, compiled: bool = False
+) -> NDArray[np.float32]:
+    """Grey-level opening of ``surface`` by the window (``w`` cells across), OpenCV's
+    ``morphologyEx``; or, when ``compiled`` (and ``surface`` has no NaN: the caller checks),
+    :func:`core.lidar.ground_filter_numba.opening`, the same values at a fraction of the cost
+    for the larger windows."""
     import cv2
 
+    kernel = _kernel(w, shape)
+    if compiled and w >= _COMPILED_OPENING_MIN:
+        from .ground_filter_numba import opening
+
+        opened = opening(surface, kernel)
+        if opened is not None:
+            return opened
     # cv2's default border for erode/dilate is neutral (ignored), as the filter needs.
-    return cv2.morphologyEx(surface, cv2.MORPH_OPEN, _kernel(w, shape))
+    return cv2.morphologyEx(surface, cv2.MORPH_OPEN, kernel)
 
 
 def _min_grid(grid: Grid, flat: NDArray[np.int32], z: NDArray[Any]) -> NDArray[np.float32]:
@@ -606,6 +626,7 @@ def _estimate_slope(
     p: SmrfParams,
     xy_per_z: float,
     should_stop: Callable[[], bool] | None,
+    compiled: bool = False,
 ) -> float:
     """SMRF's slope from the cloud itself (rise/run): a first SMRF pass with the published
     slope on cells twice as large (the minimum of each 2 x 2 block: a sixteenth of the work),
@@ -620,7 +641,7 @@ def _estimate_slope(
     first = replace(p, cell_size=2 * p.cell_size, slope=SMRF_PUBLISHED.slope * xy_per_z)
     windows, thresholds = smrf_windows(first)
     objects = _progressive_opening(fill_nearest(coarse, ok), windows, thresholds, "disk",
-                                   should_stop)  # fmt: skip
+                                   should_stop, compiled)  # fmt: skip
     ground = ok & ~objects
     if not ground.any():
         return SLOPE_RANGE[0]
@@ -664,12 +685,16 @@ def _progressive_opening(
     thresholds: list[float],
     shape: str,
     should_stop: Callable[[], bool] | None,
+    compiled: bool = False,
 ) -> NDArray[np.bool_]:
-    """Object cells of the progressive opening (PMF and SMRF share it)."""
+    """Object cells of the progressive opening (PMF and SMRF share it); ``compiled``: the
+    openings by the compiled kernel where it is cheaper (same values)."""
     objects = np.zeros(surface.shape, dtype=bool)
+    # the compiled openings give OpenCV's values on grids without NaN (openings add none)
+    compiled = compiled and not np.isnan(surface).any()
     for w, dh in zip(windows, thresholds):
         stop_if_asked(should_stop, "filtering the ground")
-        opened = _opening(surface, w, shape)
+        opened = _opening(surface, w, shape, compiled)
         objects |= (surface - opened) > dh
         surface = opened
     return objects
@@ -711,8 +736,9 @@ def ground_filter(
     heights : bool
         Also return every point's height above the DTM (default); False saves its array.
     backend : {"auto", "numba", "numpy"}
-        The per-point passes compiled with numba (:mod:`core.lidar.ground_filter_numba`,
-        "auto": when installed) or vectorised with numpy; both give the same bits.
+        The per-point passes and the larger openings compiled with numba
+        (:mod:`core.lidar.ground_filter_numba`, "auto": when installed), or vectorised with
+        numpy and OpenCV; both give the same bits.
     progress, should_stop : callable, optional
         Progress fraction in [0, 1]; cancellation (raises Cancelled), checked per step/chunk.
 
@@ -770,10 +796,8 @@ def ground_filter(
     if compiled:
         from . import ground_filter_numba as nb
 
-        zmin = np.full(grid.rows * grid.cols, np.inf, dtype=np.float32)
-        for lo, part in points.parts():
-            stop_if_asked(should_stop, "filtering the ground")
-            nb.cells(part, grid, z0, candidate, lo, flat, zr, zmin)
+        stop_if_asked(should_stop, "filtering the ground")
+        zmin = nb.cells_all(points.parts(), grid, z0, candidate, flat, zr)
         zmin = zmin.reshape(grid.rows, grid.cols)
     else:
         for s, bx, by, bz in points.blocks(should_stop):
@@ -794,8 +818,9 @@ def ground_filter(
             stop_if_asked(should_stop, "filtering the ground")
             reference, around = _low_references(zmin, radius, depth)
             if compiled:
-                rebuilt = np.full(zmin.size, np.inf, dtype=np.float32)
-                if not nb.low_pass(flat, zr, candidate, low, reference, around, rebuilt):
+                count, rebuilt = nb.low_pass_all(flat, zr, candidate, low, reference, around,
+                                                 zmin.size)  # fmt: skip
+                if not count:
                     break
                 zmin = rebuilt.reshape(zmin.shape)
                 continue
@@ -830,7 +855,7 @@ def ground_filter(
         filled = fill_nearest(zmin, valid)
         if p.method == "smrf":
             if params.slope == 0:  # estimated from the cloud
-                estimate = _estimate_slope(zmin, valid, p, xy_per_z, should_stop)
+                estimate = _estimate_slope(zmin, valid, p, xy_per_z, should_stop, compiled)
                 p = replace(p, slope=estimate * xy_per_z)
                 stats["slope_estimated"] = estimate
                 LOG.info("ground filter (smrf): terrain slope estimated at %.3f", estimate)
@@ -839,7 +864,8 @@ def ground_filter(
         else:
             windows, thresholds = pmf_windows(p)
             shape, final, scalar = p.window_shape, p.ground_threshold, p.slope_scalar
-        objects = _progressive_opening(filled, windows, thresholds, shape, should_stop)
+        objects = _progressive_opening(filled, windows, thresholds, shape, should_stop,
+                                       compiled)  # fmt: skip
         ground_cells = valid & ~objects
         if not ground_cells.any():
             ground_cells = valid
@@ -856,11 +882,10 @@ def ground_filter(
     nodata_flat = ~reach.ravel()
     if compiled:
         dtm_flat = np.ascontiguousarray(dtm, dtype=np.float32).ravel()
-        for lo, part in points.parts():
-            stop_if_asked(should_stop, "filtering the ground")
-            nb.classify(part, grid, lo, flat, zr, dtm_flat, thr_cell, low, candidate,
+        stop_if_asked(should_stop, "filtering the ground")
+        nb.classify_all(points.parts(), grid, flat, zr, dtm_flat, thr_cell, low, candidate,
                         nodata_flat, ground, hag)  # fmt: skip
-            report(0.6 + 0.4 * (lo + len(part[0])) / n)
+        report(1.0)
     else:
         for s, bx, by, _ in points.blocks(should_stop, z=False):
             h = zr[s] - grid.bilinear(dtm, bx, by)
