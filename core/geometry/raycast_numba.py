@@ -247,8 +247,8 @@ _COMPILED: dict[str, Callable[..., Any]] = {}
 def _compiled(name: str) -> Callable[..., Any]:
     """The jitted function (compiled at its first call). cache=True keeps the machine code next
     to this module (a plugin folder is writable; when it is not, numba warns and compiles again
-    next session: about 3 s). The two functions never call each other: a cached function that
-    references another one would be tied to the module's import name."""
+    next session: about 3 s). The cache is keyed by the module's import name: imported under
+    another package name, the functions compile again."""
     if name not in _COMPILED:
         func = {"order": _spatial_order, "trace": _trace}[name]
         _COMPILED[name] = numba.njit(cache=True, nogil=True)(func)

@@ -291,7 +291,7 @@ _POOL: list[Any] = []
 _POOL_LOCK = threading.Lock()
 def _compiled(name: str) -> Callable[..., Any]:
     """The jitted function (compiled at its first call for each argument type, cached next to
-    this module; no kernel calls another, so the cache is not tied to the import name)."""
+    this module, keyed by the module's import name)."""
     if name not in _COMPILED:
         func = {"cells": _cells_kernel, "low_pass": _low_pass_kernel,
                 "classify": _classify_kernel, "bounds": _bounds_kernel,
