@@ -627,7 +627,7 @@ def _tile(
         row = r_lo + (row - r_lo) / f
     mapx, mapy = remap_maps(col, row, c_lo, r_lo)
     out = _remap(src, mapx, mapy, opt.resampling)
-    out[:, ~valid] = 0
+    np.moveaxis(out, 0, -1)[~valid] = 0  # OpenCV's (rows, cols, bands) layout underneath
     return OrthoTile(row0, col0, out, valid, occluded, no_surface)
 
 
