@@ -639,15 +639,15 @@ def _write_levels_rasterio(path: str, factors: list[int], levels: list, zlevel: 
                 bands = [lib.GDALGetOverview(lib.GDALGetRasterBand(h, b + 1), k)
                          for b in range(data.shape[0])]  # fmt: skip
                 mask = np.where(valid, 255, 0).astype(np.uint8)
-                planes = [(band, np.ascontiguousarray(data[b]), _GDT[data.dtype.name])
-                          for b, band in enumerate(bands)]  # fmt: skip
+                # each band straight from the (pixel-interleaved) level: GDAL's strides
+                planes = [(band, data[b], _GDT[data.dtype.name]) for b, band in enumerate(bands)]
                 planes.append((lib.GDALGetOverview(lib.GDALGetMaskBand(
                     lib.GDALGetRasterBand(h, 1)), k), mask, 1))  # fmt: skip
                 for band, plane, gdt in planes:
                     rows, cols = plane.shape
                     if not band or lib.GDALRasterIO(band, 1, 0, 0, cols, rows,
-                                                    plane.ctypes.data, cols, rows, gdt, 0,
-                                                    0) != 0:  # fmt: skip
+                                                    plane.ctypes.data, cols, rows, gdt,
+                                                    plane.strides[1], plane.strides[0]) != 0:
                         raise OSError(f"cannot write the overviews of {path}")
         finally:
             lib.GDALClose(h)

@@ -48,11 +48,12 @@ def level_windows(n_src: int, n_dst: int) -> Windows:
 
 
 def _average_rows(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask):  # fmt: skip
-    """Cells (rows ya.size, cols xa.size) of a level from the source rows of ``src`` (bands,
-    rows, cols) and ``mask`` (rows, cols); ya, yb relative to src's first row. Each band's
-    sums in GDAL's order: along a row (first pixel, middle ones, last: one line sum per source
-    row and cell column), then the line sums over the rows."""
-    nb = src.shape[0]
+    """Cells (rows ya.size, cols xa.size) of a level from the source rows of ``src`` (rows,
+    cols, bands: pixel-interleaved) and ``mask`` (rows, cols) into ``out`` (rows, cols, bands);
+    ya, yb relative to src's first row. Each band's sums in GDAL's order: along a row (first
+    pixel, middle ones, last: one line sum per source row and cell column), then the line sums
+    over the rows."""
+    nb = src.shape[2]
     ny = yb[-1] if ya.shape[0] else 0
     nx = xa.shape[0]
     lines = np.zeros((ny, nx, nb))
@@ -75,7 +76,7 @@ def _average_rows(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask):
                     wx = 1.0
                 wline += wx
                 for bb in range(nb):
-                    lines[y, j, bb] += src[bb, y, x] * wx
+                    lines[y, j, bb] += src[y, x, bb] * wx
             wlines[y, j] = wline
             counts[y, j] = cnt
     for i in range(ya.shape[0]):
@@ -87,7 +88,7 @@ def _average_rows(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask):
             out_mask[i, j] = cnt > 0
             if cnt == 0:
                 for bb in range(nb):
-                    out[bb, i, j] = 0
+                    out[i, j, bb] = 0
                 continue
             wt = 0.0
             for y in range(y0, y1):
@@ -98,40 +99,40 @@ def _average_rows(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask):
                 for y in range(y0, y1):
                     wy = ywl[i] if y == y0 else (ywr[i] if y + 1 == y1 else 1.0)
                     tot += lines[y, j, bb] * wy
-                out[bb, i, j] = math.floor(tot / wt + 0.5)
+                out[i, j, bb] = math.floor(tot / wt + 0.5)
 
 
 def _average_rows_2x2(src, mask, out, out_mask):
     """:func:`_average_rows` where every window is 2 x 2 whole pixels (even sides: r = 2);
     in integers, ``(sum + n // 2) // n`` equals GDAL's ``int(sum / n + 0.5)`` for n <= 4."""
-    nb = src.shape[0]
+    nb = src.shape[2]
     for i in range(out_mask.shape[0]):
         y = 2 * i
         for j in range(out_mask.shape[1]):
             x = 2 * j
-            m00, m01, m10, m11 = mask[y, x], mask[y, x + 1], mask[y + 1, x], mask[y + 1, x + 1]
+            m00, m01 = mask[y, x] != 0, mask[y, x + 1] != 0
+            m10, m11 = mask[y + 1, x] != 0, mask[y + 1, x + 1] != 0
             cnt = int(m00) + int(m01) + int(m10) + int(m11)
             out_mask[i, j] = cnt > 0
+            half = cnt // 2
             for bb in range(nb):
-                if cnt == 0:
-                    out[bb, i, j] = 0
-                    continue
                 tot = 0
                 if m00:
-                    tot += int(src[bb, y, x])
+                    tot += int(src[y, x, bb])
                 if m01:
-                    tot += int(src[bb, y, x + 1])
+                    tot += int(src[y, x + 1, bb])
                 if m10:
-                    tot += int(src[bb, y + 1, x])
+                    tot += int(src[y + 1, x, bb])
                 if m11:
-                    tot += int(src[bb, y + 1, x + 1])
-                out[bb, i, j] = (tot + cnt // 2) // cnt
+                    tot += int(src[y + 1, x + 1, bb])
+                out[i, j, bb] = (tot + half) // cnt if cnt else 0
 
 
 def _average_rows_numpy(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask):  # fmt: skip
     """The same as :func:`_average_rows`, vectorised (numba not installed): windows span at
     most 3 pixels per axis (r <= 2), so each sum has at most three terms, added in GDAL's
     order (masked terms are exact zeros)."""
+    src, out = np.moveaxis(src, 2, 0), np.moveaxis(out, 2, 0)  # (bands, rows, cols) views
     w_src = src.shape[2]
     m = mask.astype(bool)
     nx, ny = xb - xa, yb - ya
@@ -187,7 +188,8 @@ def average_level(
 ) -> tuple[NDArray, NDArray[np.bool_]]:
     """The next overview level (factor 2, GDAL's AVERAGE honouring the mask) of ``data``
     (bands, rows, cols) with ``mask`` (rows, cols) True where valid: (bands, ceil(rows / 2),
-    ceil(cols / 2)) and its mask.
+    ceil(cols / 2)) and its mask. The data are a view of a pixel-interleaved array (fastest
+    when ``data`` is one too: ``np.moveaxis(data, 0, -1)`` C-contiguous).
 
     >>> d = np.array([[[10, 20, 7], [30, 40, 9]]], np.uint8)
     >>> m = np.array([[True, True, True], [True, False, False]])
@@ -197,13 +199,14 @@ def average_level(
     """
     nb, h, w = data.shape
     oh, ow = -(-h // 2), -(-w // 2)
-    out = np.empty((nb, oh, ow), data.dtype)
+    out = np.empty((oh, ow, nb), data.dtype)
     out_mask = np.empty((oh, ow), np.bool_)
     ya, yb, ywl, ywr = level_windows(h, oh)
     xa, xb, xwl, xwr = level_windows(w, ow)
-    _run_kernel(backend, data, np.asarray(mask, np.uint8), ya, yb, ywl, ywr, xa, xb, xwl, xwr,
-                out, out_mask)  # fmt: skip
-    return out, out_mask
+    _run_kernel(backend, np.ascontiguousarray(np.moveaxis(data, 0, -1)),
+                np.asarray(mask, np.uint8), ya, yb, ywl, ywr, xa, xb, xwl, xwr, out,
+                out_mask)  # fmt: skip
+    return np.moveaxis(out, 2, 0), out_mask
 
 
 class OverviewBuilder:
@@ -223,7 +226,8 @@ class OverviewBuilder:
         self.n_levels = int(levels)
         self.backend = backend
         oh, ow = -(-self.height // 2), -(-self.width // 2)
-        self.lv1 = np.zeros((self.bands, oh, ow), self.dtype)
+        self._lv1 = np.zeros((oh, ow, self.bands), self.dtype)  # pixel-interleaved
+        self.lv1 = np.moveaxis(self._lv1, 2, 0)
         self.lv1_mask = np.zeros((oh, ow), np.bool_)
         self._y = level_windows(self.height, oh)
         self._x = level_windows(self.width, ow)
@@ -239,7 +243,8 @@ class OverviewBuilder:
         if self._buf is not None and self._buf.shape[1] >= rows:
             return
         cap = max(rows, 2 * (self._buf.shape[1] if self._buf is not None else 0))
-        # pixel-interleaved (as the blocks usually come, and as GDAL stores them)
+        # pixel-interleaved (as the blocks usually come, and as GDAL stores them); the
+        # (bands, rows, cols) view of it
         buf = np.moveaxis(np.zeros((cap, self.width, self.bands), self.dtype), 2, 0)
         mbuf = np.zeros((cap, self.width), np.uint8)
         filled = np.zeros(cap, np.int64)
@@ -279,9 +284,10 @@ class OverviewBuilder:
             return
         i0 = self._next
         s0 = int(ya[i0]) - self._base
-        _run_kernel(self.backend, self._buf[:, s0:complete], self._mbuf[s0:complete],
-                    ya[i0:end] - ya[i0], yb[i0:end] - ya[i0], ywl[i0:end], ywr[i0:end],
-                    *self._x, self.lv1[:, i0:end], self.lv1_mask[i0:end])  # fmt: skip
+        _run_kernel(self.backend, np.moveaxis(self._buf, 0, -1)[s0:complete],
+                    self._mbuf[s0:complete], ya[i0:end] - ya[i0], yb[i0:end] - ya[i0],
+                    ywl[i0:end], ywr[i0:end], *self._x, self._lv1[i0:end],
+                    self.lv1_mask[i0:end])  # fmt: skip
         self._next = end
         if end >= ya.size:
             return
