@@ -44,62 +44,52 @@ def level_windows(n_src: int, n_dst: int) -> Windows:
     b = np.minimum(np.where(b == a, b + 1, b), n_src)
     wl = np.where(b == a + 1, 1.0, 1.0 - (x0 - a))
     wr = 1.0 - (b - x1)
+    if n_dst and (b - a).max() > 3:  # r <= 2: the kernels take at most 3 pixels
+        raise ValueError(f"a level of {n_dst} cells from {n_src}: more than halving")
     return a, b, wl, wr
 
 
 def _average_rows(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask):  # fmt: skip
     """Cells (rows ya.size, cols xa.size) of a level from the source rows of ``src`` (rows,
     cols, bands: pixel-interleaved) and ``mask`` (rows, cols) into ``out`` (rows, cols, bands);
-    ya, yb relative to src's first row. Each band's sums in GDAL's order: along a row (first
-    pixel, middle ones, last: one line sum per source row and cell column), then the line sums
-    over the rows."""
+    ya, yb relative to src's first row; windows of at most 3 pixels per axis (r <= 2). Each
+    band's sums in GDAL's order: along a row (first pixel weighted, middle one, last one
+    weighted), then these line sums weighted over the rows."""
     nb = src.shape[2]
-    ny = yb[-1] if ya.shape[0] else 0
-    nx = xa.shape[0]
-    lines = np.zeros((ny, nx, nb))
-    wlines = np.zeros((ny, nx))
-    counts = np.zeros((ny, nx), np.int64)
-    for y in range(ny):
-        for j in range(nx):
-            x0, x1 = xa[j], xb[j]
-            wline = 0.0
-            cnt = 0
-            for x in range(x0, x1):
-                if not mask[y, x]:
-                    continue
-                cnt += 1
-                if x == x0:
-                    wx = xwl[j]
-                elif x + 1 == x1:
-                    wx = xwr[j]
-                else:
-                    wx = 1.0
-                wline += wx
-                for bb in range(nb):
-                    lines[y, j, bb] += src[y, x, bb] * wx
-            wlines[y, j] = wline
-            counts[y, j] = cnt
-    for i in range(ya.shape[0]):
-        y0, y1 = ya[i], yb[i]
-        for j in range(nx):
-            cnt = 0
-            for y in range(y0, y1):
-                cnt += counts[y, j]
-            out_mask[i, j] = cnt > 0
-            if cnt == 0:
-                for bb in range(nb):
-                    out[i, j, bb] = 0
-                continue
-            wt = 0.0
-            for y in range(y0, y1):
-                wy = ywl[i] if y == y0 else (ywr[i] if y + 1 == y1 else 1.0)
-                wt += wlines[y, j] * wy
-            for bb in range(nb):
+    for bb in range(nb):
+        for i in range(ya.shape[0]):
+            y0 = ya[i]
+            ny = yb[i] - y0
+            for j in range(xa.shape[0]):
+                x0 = xa[j]
+                nx = xb[j] - x0
+                wl = xwl[j]
+                wr = xwr[j]
                 tot = 0.0
-                for y in range(y0, y1):
-                    wy = ywl[i] if y == y0 else (ywr[i] if y + 1 == y1 else 1.0)
-                    tot += lines[y, j, bb] * wy
-                out[i, j, bb] = math.floor(tot / wt + 0.5)
+                wt = 0.0
+                cnt = 0
+                for k in range(ny):
+                    y = y0 + k
+                    wy = ywl[i] if k == 0 else (ywr[i] if k == ny - 1 else 1.0)
+                    line = 0.0
+                    wline = 0.0
+                    if mask[y, x0]:
+                        line = src[y, x0, bb] * wl
+                        wline = wl
+                        cnt += 1
+                    if nx == 3 and mask[y, x0 + 1]:
+                        line += src[y, x0 + 1, bb]
+                        wline += 1.0
+                        cnt += 1
+                    if nx >= 2 and mask[y, x0 + nx - 1]:
+                        line += src[y, x0 + nx - 1, bb] * wr
+                        wline += wr
+                        cnt += 1
+                    tot += line * wy
+                    wt += wline * wy
+                if bb == 0:
+                    out_mask[i, j] = cnt > 0
+                out[i, j, bb] = 0 if cnt == 0 else math.floor(tot / wt + 0.5)
 
 
 def _average_rows_2x2(src, mask, out, out_mask):
