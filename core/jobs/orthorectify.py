@@ -235,8 +235,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 def _tiles(proj, grid, src, info, options, progress, should_stop):
     from ..photo.orthophoto import orthorectify_tiles
 
-    def read(window, f):
-        return src.read(window, decimation=f)
+    def read(window, f):  # pixel-interleaved: OpenCV's layout, read without a copy
+        return src.read(window, decimation=f, pixel_interleaved=True)
 
     return orthorectify_tiles(proj, grid, read, info.bands, info.dtype, options,
                               progress=progress, should_stop=should_stop)  # fmt: skip

@@ -56,7 +56,7 @@ from ..geometry.grid import Grid
 from ..geometry.raycast import STATUS_GRAZING, STATUS_OK, DsmTracer, intersect_dsm
 from ..geometry.surface import Dsm, triangle_height
 from .orientation import eo_map_to_local
-from .orthophoto_numba import remap_maps
+from .orthophoto_numba import remap_maps, remap_maps_fixed, valid_bounds
 
 LOG = logging.getLogger(__name__)
 
@@ -559,9 +559,9 @@ def _decimation(proj: OrthoProjector, grid: Grid, lattice_px: int) -> int:
     return max(1, math.floor(float(np.percentile(steps, 5))))
 
 
-def _remap(src: NDArray, mapx: NDArray[np.float32], mapy: NDArray[np.float32],
-           resampling: str) -> NDArray:  # fmt: skip
-    """(bands, rows, cols) of the source sampled at the maps (OpenCV pixel-centre convention)."""
+def _remap(src: NDArray, mapx: NDArray, mapy: NDArray, resampling: str) -> NDArray:
+    """(bands, rows, cols) of the source sampled at the maps (OpenCV pixel-centre convention:
+    float32 maps, or the fixed-point pair of :func:`remap_maps_fixed`)."""
     import cv2
 
     interp = {"nearest": cv2.INTER_NEAREST, "bilinear": cv2.INTER_LINEAR,
@@ -604,30 +604,32 @@ def _tile(
         occ = _occlusion(proj, grid, row0, col0, z, valid, opt.occlusion_tol_m)
         occluded = int(np.count_nonzero(occ))
         valid &= ~occ
-    data = np.zeros((bands, rows, cols), dtype)
-    if not valid.any():
-        return OrthoTile(row0, col0, data, valid, occluded, no_surface)
+        col = np.where(valid, col, np.nan)
+    n, c_min, c_max, r_min, r_max = valid_bounds(col, row)
+    if n == 0:
+        return OrthoTile(row0, col0, np.zeros((bands, rows, cols), dtype), valid, occluded,
+                         no_surface)  # fmt: skip
     pad = _PAD[opt.resampling]
     cam = proj.camera
-    cv, rv = col[valid], row[valid]
-    c_lo = max(math.floor(cv.min() - 0.5) - pad * f, 0)
-    r_lo = max(math.floor(rv.min() - 0.5) - pad * f, 0)
-    c_hi = min(math.ceil(cv.max() - 0.5) + (pad + 1) * f, cam.width_px)
-    r_hi = min(math.ceil(rv.max() - 0.5) + (pad + 1) * f, cam.height_px)
+    c_lo = max(math.floor(c_min - 0.5) - pad * f, 0)
+    r_lo = max(math.floor(r_min - 0.5) - pad * f, 0)
+    c_hi = min(math.ceil(c_max - 0.5) + (pad + 1) * f, cam.width_px)
+    r_hi = min(math.ceil(r_max - 0.5) + (pad + 1) * f, cam.height_px)
     if f > 1:  # sides that are multiples of f
         c_hi = c_lo + (c_hi - c_lo) // f * f
         r_hi = r_lo + (r_hi - r_lo) // f * f
         if c_hi - c_lo < f or r_hi - r_lo < f:
             f, c_hi, r_hi = 1, min(c_hi + f, cam.width_px), min(r_hi + f, cam.height_px)
     src = read_window((c_lo, r_lo, c_hi - c_lo, r_hi - r_lo), f)
-    if opt.true_ortho:
-        col = np.where(valid, col, np.nan)
     if f > 1:  # decimated pixel k covers [c_lo + k f, c_lo + (k + 1) f): its centre
         col = c_lo + (col - c_lo) / f
         row = r_lo + (row - r_lo) / f
-    mapx, mapy = remap_maps(col, row, c_lo, r_lo)
+    # bilinear and cubic: OpenCV's fixed-point maps made here in one pass (cv2.remap would
+    # convert float maps to them itself: the same pixels, tested)
+    maps = remap_maps_fixed if opt.resampling != "nearest" else remap_maps
+    mapx, mapy = maps(col, row, c_lo, r_lo)
     out = _remap(src, mapx, mapy, opt.resampling)
-    out[:, ~valid] = 0
+    np.moveaxis(out, 0, -1)[~valid] = 0  # OpenCV's (rows, cols, bands) layout underneath
     return OrthoTile(row0, col0, out, valid, occluded, no_surface)
 
 

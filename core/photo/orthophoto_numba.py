@@ -16,7 +16,7 @@ import numpy as np
 
 from ..geometry.raycast_numba import AVAILABLE, numba
 
-__all__ = ["AVAILABLE", "cell_pixels", "remap_maps"]
+__all__ = ["AVAILABLE", "cell_pixels", "remap_maps", "remap_maps_fixed", "valid_bounds"]
 
 
 def _cell_pixels(
@@ -113,12 +113,56 @@ def _remap_maps(col, row, c0, r0, mapx, mapy):
     return n
 
 
+def _remap_maps_fixed(col, row, c0, r0, xy, alpha):
+    """The same maps in OpenCV's fixed-point form (what cv2.remap makes of float maps before
+    it interpolates, done here in the same pass): integer pixel (xy) and the 1/32 fraction
+    index (alpha) of ``round(32 m)`` for the float32 map value m, rounding half to even as
+    OpenCV's cvRound. Returns the number of cells with a pixel."""
+    n = 0
+    for i in range(col.shape[0]):
+        for j in range(col.shape[1]):
+            c = col[i, j]
+            if math.isfinite(c):
+                fx = np.float32(c - (0.5 + c0))
+                fy = np.float32(row[i, j] - (0.5 + r0))
+                n += 1
+            else:
+                fx = np.float32(-1.0)
+                fy = np.float32(-1.0)
+            x = int(np.rint(np.float64(fx) * 32.0))
+            y = int(np.rint(np.float64(fy) * 32.0))
+            xy[i, j, 0] = x >> 5
+            xy[i, j, 1] = y >> 5
+            alpha[i, j] = (y & 31) * 32 + (x & 31)
+    return n
+
+
+def _valid_bounds(col, row):
+    """(cells with a pixel, smallest col, largest col, smallest row, largest row) of the
+    finite cells, in one pass (NaN bounds when none)."""
+    n = 0
+    c_lo = r_lo = math.inf
+    c_hi = r_hi = -math.inf
+    for i in range(col.shape[0]):
+        for j in range(col.shape[1]):
+            c = col[i, j]
+            if math.isfinite(c):
+                n += 1
+                r = row[i, j]
+                c_lo = min(c_lo, c)
+                c_hi = max(c_hi, c)
+                r_lo = min(r_lo, r)
+                r_hi = max(r_hi, r)
+    return n, c_lo, c_hi, r_lo, r_hi
+
+
 _COMPILED: dict[str, Callable[..., Any]] = {}
 
 
 def _compiled(name: str) -> Callable[..., Any]:
     if name not in _COMPILED:
-        func = {"cells": _cell_pixels, "maps": _remap_maps}[name]
+        func = {"cells": _cell_pixels, "maps": _remap_maps, "fixed": _remap_maps_fixed,
+                "bounds": _valid_bounds}[name]  # fmt: skip
         _COMPILED[name] = numba.njit(cache=True, nogil=True)(func)
     return _COMPILED[name]
 
@@ -143,3 +187,31 @@ def remap_maps(
         mapx[...] = np.where(ok, col - (0.5 + c0), -1.0)
         mapy[...] = np.where(ok, row - (0.5 + r0), -1.0)
     return mapx, mapy
+
+
+def remap_maps_fixed(
+    col: np.ndarray, row: np.ndarray, c0: int, r0: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """OpenCV's fixed-point maps (CV_16SC2 pixel, CV_16UC1 fraction index) of a window at
+    (c0, r0) (:func:`_remap_maps_fixed`); cv2.remap gives with them, for bilinear and cubic
+    resampling, what it gives with the float maps of :func:`remap_maps`."""
+    xy = np.empty((*col.shape, 2), np.int16)
+    alpha = np.empty(col.shape, np.uint16)
+    if AVAILABLE:
+        _compiled("fixed")(col, row, int(c0), int(r0), xy, alpha)
+        return xy, alpha
+    import cv2
+
+    mapx, mapy = remap_maps(col, row, c0, r0)
+    return cv2.convertMaps(mapx, mapy, cv2.CV_16SC2)
+
+
+def valid_bounds(col: np.ndarray, row: np.ndarray) -> tuple[int, float, float, float, float]:
+    """(count, col min, col max, row min, row max) over the cells whose col is finite."""
+    if AVAILABLE:
+        return _compiled("bounds")(col, row)
+    ok = np.isfinite(col)
+    if not ok.any():
+        return 0, math.inf, -math.inf, math.inf, -math.inf
+    cv, rv = col[ok], row[ok]
+    return int(ok.sum()), float(cv.min()), float(cv.max()), float(rv.min()), float(rv.max())

@@ -381,3 +381,28 @@ def test_auto_gsd_and_grid_alignment():
     assert g.x0 % 0.25 == 0 and g.y_top % 0.25 == 0
     assert g.x0 <= 100.01 and g.x0 + g.cols * 0.25 >= 150.0
     assert g.y_top >= 260.0 and g.y_top - g.rows * 0.25 <= 200.02
+
+
+@pytest.mark.parametrize("interp", [cv2.INTER_LINEAR, cv2.INTER_CUBIC])
+def test_fixed_point_maps_give_opencvs_own_result(interp):
+    """The maps made in one pass in OpenCV's fixed-point form (what cv2.remap makes of float
+    maps itself) resample exactly as the float maps: every pixel equal, on positions that
+    include exact ties of the 1/32 rounding (half to even), negative and missing ones."""
+    from lidarphoto.core.photo.orthophoto_numba import remap_maps, remap_maps_fixed
+
+    rng = np.random.default_rng(5)
+    src = rng.integers(0, 256, (300, 400, 3), dtype=np.uint8)
+    c0, r0 = 1000, 2000
+    col = c0 + rng.uniform(-3.0, 405.0, (256, 256))
+    row = r0 + rng.uniform(-3.0, 305.0, (256, 256))
+    col[:8] = c0 + 0.5 + np.arange(8)[:, None] / 64.0 + np.arange(256) // 7  # ties at 1/64
+    row[:, :8] = r0 + 0.5 + np.arange(8)[None, :] / 64.0
+    col[100:110, 50:90] = np.nan
+    fx, fy = remap_maps(col, row, c0, r0)
+    xy, alpha = remap_maps_fixed(col, row, c0, r0)
+    ref_xy, ref_alpha = cv2.convertMaps(fx, fy, cv2.CV_16SC2)
+    np.testing.assert_array_equal(xy, ref_xy)
+    np.testing.assert_array_equal(alpha, ref_alpha)
+    a = cv2.remap(src, fx, fy, interp, borderMode=cv2.BORDER_REPLICATE)
+    b = cv2.remap(src, xy, alpha, interp, borderMode=cv2.BORDER_REPLICATE)
+    np.testing.assert_array_equal(a, b)
