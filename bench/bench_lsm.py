@@ -436,8 +436,9 @@ def split_sample_study() -> None:
     ga = SHARED / "data" / "opencv-aerial"
     cases = []
     for seq, n in (("boat", 2), ("boat", 3), ("bikes", 2), ("bikes", 3)):
-        cases.append((f"{seq} 1->{n}", _grey(hp / seq / "img1.png"),
-                      _grey(hp / seq / f"img{n}.png"), read_h(hp / seq / f"H1to{n}p"), None))  # fmt: skip
+        img_n = _grey(hp / seq / f"img{n}.png")
+        h_n = read_h(hp / seq / f"H1to{n}p")
+        cases.append((f"{seq} 1->{n}", _grey(hp / seq / "img1.png"), img_n, h_n, None))
     cases.append(("graf 1->3 (wall: image-1 rows < 500)", _grey(ga / "graf1.png"),
                   _grey(ga / "graf3.png"), read_h(ga / "H1to3p.xml"), 500))  # fmt: skip
     b1 = _grey(hp / "boat" / "img1.png")
@@ -450,8 +451,10 @@ def split_sample_study() -> None:
         f"\n(a) Published homography against a robust refit to the accepted LSM matches "
         f"({BIG} px templates, grid {GRID} px); difference over an image-1 grid of {GRID} px:"
     )
-    print("\n| pair | matches kept by the fit | median (px) | 95th pct | max | "
-          "shift at centre dx, dy | scale | rotation | 95th pct after the affine part |")  # fmt: skip
+    print(
+        "\n| pair | matches kept by the fit | median (px) | 95th pct | max | "
+        "shift at centre dx, dy | scale | rotation | 95th pct after the affine part |"
+    )
     print("|---|---|---|---|---|---|---|---|---|")
     for r in out:
         f = r["field"]

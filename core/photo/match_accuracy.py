@@ -5,9 +5,9 @@ Fit (:func:`fit_homography`): the 8 parameters of ``H`` (``H[2, 2] = 1``) that m
 squared distances in image 2, ``sum |dst - H(src)|^2`` (Gauss-Newton on the geometric error,
 in coordinates centred and scaled for conditioning, started from Hartley's (1997) normalised
 DLT of the kept matches), the first kept set from a least-median-of-squares search
-(Rousseeuw 1984), then the matches farther than ``k`` robust standard deviations of a coordinate (the
-median distance / 1.1774, the Rayleigh median) from the current fit left out and the fit repeated until the
-set of kept matches no longer changes.
+(Rousseeuw 1984), then the matches farther than ``k`` robust standard deviations of a
+coordinate (the median distance / 1.1774, the Rayleigh median) from the current fit left out
+and the fit repeated until the set of kept matches no longer changes.
 
 Split sample (:func:`split_sample_residuals`): the image-1 plane is cut into square blocks
 coloured like a checkerboard; ``H`` is fitted to the matches of the black blocks and each
