@@ -2,12 +2,13 @@
 homography: a robust homography fit and a split-sample (checkerboard) residual.
 
 Fit (:func:`fit_homography`): the 8 parameters of ``H`` (``H[2, 2] = 1``) that minimise the
-squared distances in image 2, ``sum |dst - H(src)|^2`` (Gauss-Newton on the geometric error,
-in coordinates centred and scaled for conditioning, started from Hartley's (1997) normalised
-DLT of the kept matches), the first kept set from a least-median-of-squares search
-(Rousseeuw 1984), then the matches farther than ``k`` robust standard deviations of a
-coordinate (the median distance / 1.1774, the Rayleigh median) from the current fit left out
-and the fit repeated until the set of kept matches no longer changes.
+squared distances in image 2, ``sum |dst - H(src)|^2`` (OpenCV's ``findHomography``: Hartley's
+(1997) normalised DLT of the kept matches refined by Levenberg-Marquardt on the geometric
+error), the first kept set from its least-median-of-squares search (Rousseeuw 1984), then
+the matches farther than ``k`` robust standard deviations of a coordinate (the median
+distance / 1.1774, the Rayleigh median; never less than 1e-4 px: OpenCV fits in single
+precision, 1e-5 px at 1000 px from the origin) from the current fit left out and the fit
+repeated until the set of kept matches no longer changes.
 
 Split sample (:func:`split_sample_residuals`): the image-1 plane is cut into square blocks
 coloured like a checkerboard; ``H`` is fitted to the matches of the black blocks and each
@@ -22,6 +23,7 @@ is an upper bound of the median match error: a wrong model only inflates it.
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -49,65 +51,14 @@ def apply_homography(h: ArrayLike, points: ArrayLike) -> Array:
     return q / w[:, None]
 
 
-def _normaliser(p: Array) -> Array:
-    """Similarity moving the centroid to 0 and the mean distance to sqrt(2) (Hartley 1997)."""
-    c = p.mean(axis=0)
-    s = np.sqrt(2.0) / max(np.hypot(*(p - c).T).mean(), 1e-12)
-    return np.array([[s, 0.0, -s * c[0]], [0.0, s, -s * c[1]], [0.0, 0.0, 1.0]])
-
-
-def _dlt(a: Array, b: Array) -> Array:
-    """Homography from normalised points a -> b (direct linear transformation, SVD)."""
-    n = len(a)
-    m = np.zeros((2 * n, 9))
-    m[0::2, 0:2] = a
-    m[0::2, 2] = 1.0
-    m[0::2, 6:8] = -b[:, :1] * a
-    m[0::2, 8] = -b[:, 0]
-    m[1::2, 3:5] = a
-    m[1::2, 5] = 1.0
-    m[1::2, 6:8] = -b[:, 1:] * a
-    m[1::2, 8] = -b[:, 1]
-    h = np.linalg.svd(m, full_matrices=False)[2][-1].reshape(3, 3)
+def _opencv_fit(p: Array, q: Array, method: int) -> Array:
+    """OpenCV's homography p -> q: ``method`` 0 is the normalised DLT of all the points
+    refined by Levenberg-Marquardt on the distances in image 2, ``cv2.LMEDS`` the
+    least-median-of-squares search (then the same refinement of its inliers)."""
+    h, _ = cv2.findHomography(p, q, method)
+    if h is None:
+        raise ValueError("no homography fits these matches (degenerate configuration)")
     return h / h[2, 2]
-
-
-def _refine(h: Array, a: Array, b: Array, iterations: int = 10) -> Array:
-    """Gauss-Newton on the distances in image 2 (normalised coordinates), H[2, 2] = 1."""
-    x, y = a.T
-    for _ in range(iterations):
-        w = h[2, 0] * x + h[2, 1] * y + 1.0
-        u = (h[0, 0] * x + h[0, 1] * y + h[0, 2]) / w
-        v = (h[1, 0] * x + h[1, 1] * y + h[1, 2]) / w
-        z = np.zeros_like(x)
-        ju = np.stack([x / w, y / w, 1 / w, z, z, z, -u * x / w, -u * y / w], axis=1)
-        jv = np.stack([z, z, z, x / w, y / w, 1 / w, -v * x / w, -v * y / w], axis=1)
-        jac = np.concatenate([ju, jv])
-        res = np.concatenate([b[:, 0] - u, b[:, 1] - v])
-        step = np.linalg.lstsq(jac, res, rcond=None)[0]
-        h = h + np.append(step, 0.0).reshape(3, 3)
-        if np.abs(step).max() < 1e-12:
-            break
-    return h
-
-
-def _least_median(p: Array, q: Array, a: Array, b: Array, ta: Array, tb: Array,
-                  samples: int = 300) -> Array:  # fmt: skip
-    """Least-median-of-squares start (Rousseeuw 1984): of ``samples`` homographies through 4
-    random matches (a fixed seed: the same answer every run), the one whose median distance
-    in image 2 is smallest."""
-    if len(p) <= 4:
-        return np.linalg.solve(tb, _dlt(a, b) @ ta)
-    rng = np.random.default_rng(0)
-    best, best_med = np.eye(3), np.inf
-    for _ in range(samples):
-        i = rng.choice(len(p), 4, replace=False)
-        with np.errstate(all="ignore"):
-            h = np.linalg.solve(tb, _dlt(a[i], b[i]) @ ta)
-            med = np.median(np.hypot(*(q - apply_homography(h, p)).T))
-        if np.isfinite(med) and med < best_med:
-            best, best_med = h, med
-    return best
 
 
 def fit_homography(
@@ -126,8 +77,8 @@ def fit_homography(
     k : float
         Rejection threshold in robust standard deviations of one coordinate.
     start : (3, 3) array_like, optional
-        A homography close to the answer that decides the first kept set; by default a
-        least-median-of-squares search (Rousseeuw 1984) over 4-point samples.
+        A homography close to the answer that decides the first kept set; by default
+        OpenCV's least-median-of-squares search (``cv2.LMEDS``, Rousseeuw 1984).
 
     Returns
     -------
@@ -139,28 +90,25 @@ def fit_homography(
     >>> h = np.array([[1.1, 0.1, 5.0], [-0.05, 0.9, -3.0], [1e-4, 2e-4, 1.0]])
     >>> src = np.random.default_rng(0).uniform(0, 500, (50, 2))
     >>> fit, kept = fit_homography(src, apply_homography(h, src))
-    >>> bool(np.allclose(fit, h, atol=1e-9)), int(kept.sum())
+    >>> bool(np.allclose(fit, h, rtol=1e-4, atol=1e-7)), int(kept.sum())
     (True, 50)
     """
     p = np.asarray(src, dtype=np.float64).reshape(-1, 2)
     q = np.asarray(dst, dtype=np.float64).reshape(-1, 2)
     if len(p) < 4 or len(q) != len(p):
         raise ValueError("a homography needs at least 4 matched points, as many in both images")
-    ta, tb = _normaliser(p), _normaliser(q)
-    a = p @ ta[:2, :2].T + ta[:2, 2]
-    b = q @ tb[:2, :2].T + tb[:2, 2]
     if start is None:
-        start = _least_median(p, q, a, b, ta, tb)
+        start = _opencv_fit(p, q, cv2.LMEDS)
     r = np.hypot(*(q - apply_homography(start, p)).T)
     kept = r <= (np.inf if np.isinf(k) else k * np.median(r) / 1.1774)
     h = np.eye(3)
     for _ in range(max_rounds):
-        hn = _refine(_dlt(a[kept], b[kept]), a[kept], b[kept])
-        h = np.linalg.solve(tb, hn @ ta)
-        h /= h[2, 2]
+        if kept.sum() < 4:
+            break
+        h = _opencv_fit(p[kept], q[kept], 0)
         r = np.hypot(*(q - apply_homography(h, p)).T)
         # median distance of a 2-D Gaussian error = 1.1774 sigma (Rayleigh)
-        new = r <= (np.inf if np.isinf(k) else max(k * np.median(r[kept]) / 1.1774, 1e-9))
+        new = r <= (np.inf if np.isinf(k) else max(k * np.median(r[kept]) / 1.1774, 1e-4))
         if new.sum() < 4 or np.array_equal(new, kept):
             break
         kept = new
@@ -220,7 +168,7 @@ def fit_smooth_map(
                                    rcond=None)[0]  # fmt: skip
             h, _ = fit_homography(p[kept], (q - mono_all @ coef)[kept], k=np.inf, start=h)
         r = np.hypot(*(q - apply_homography(h, p) - mono_all @ coef).T)
-        new = r <= max(k * np.median(r[kept]) / 1.1774, 1e-9)
+        new = r <= max(k * np.median(r[kept]) / 1.1774, 1e-4)
         if new.sum() < 4 + mono_all.shape[1] or np.array_equal(new, kept):
             break
         kept = new
