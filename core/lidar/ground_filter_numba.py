@@ -231,18 +231,12 @@ def _rect_union_kernel(src, out, ws, ds, sign, y_first, y_stop):
                         p = p if p < q else q
                         r = r if r < t else t
                         bm[x] = p if p < r else r
-                elif first:
+                elif first or withv:  # one more operand: a's own cell or V
+                    c = am if first else vm
                     for x in range(n):
                         p = al[x]
                         q = ar[x]
-                        r = am[x]
-                        p = p if p < q else q
-                        bm[x] = p if p < r else r
-                elif withv:
-                    for x in range(n):
-                        p = al[x]
-                        q = ar[x]
-                        r = vm[x]
+                        r = c[x]
                         p = p if p < q else q
                         bm[x] = p if p < r else r
                 else:
