@@ -205,15 +205,17 @@ def _rect_union_kernel(src, out, ws, ds, sign, y_first, y_stop):
                 s = 1 if done == 0 else min(done, grow - done)
                 first = done == 0
                 withv = kk >= 0 and done + s == grow
-                for x in range(min(s, cols)):  # left border: indices clipped
-                    p = a[max(x - s, 0)]
-                    q = a[min(x + s, last)]
-                    p = p if p < q else q
-                    if first and a[x] < p:
-                        p = a[x]
-                    if withv and v[x] < p:
-                        p = v[x]
-                    b[x] = p
+                # the two borders (indices clipped), then the inner part
+                for lo, hi in ((0, min(s, cols)), (max(cols - s, s), cols)):
+                    for x in range(lo, hi):
+                        p = a[max(x - s, 0)]
+                        q = a[min(x + s, last)]
+                        p = p if p < q else q
+                        if first and a[x] < p:
+                            p = a[x]
+                        if withv and v[x] < p:
+                            p = v[x]
+                        b[x] = p
                 # the inner part through views indexed from 0: indices the compiler
                 # knows are not negative, so the loops are vectorised
                 n = max(cols - 2 * s, 0)
@@ -244,15 +246,6 @@ def _rect_union_kernel(src, out, ws, ds, sign, y_first, y_stop):
                         p = al[x]
                         q = ar[x]
                         bm[x] = p if p < q else q
-                for x in range(max(cols - s, s), cols):  # right border
-                    p = a[max(x - s, 0)]
-                    q = a[min(x + s, last)]
-                    p = p if p < q else q
-                    if first and a[x] < p:
-                        p = a[x]
-                    if withv and v[x] < p:
-                        p = v[x]
-                    b[x] = p
                 a, b = b, a
                 done += s
             if kk >= 0 and grow == 0:  # (not for a union of distinct widths)
