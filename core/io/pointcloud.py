@@ -500,7 +500,7 @@ class LasPoints:
 def read_cloud(
     path: PathLike,
     crs: CrsLike = None,
-    chunk_size: int = 1_000_000,
+    chunk_size: int = 4_000_000,
     progress: Callable[[float], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
     *,
@@ -680,6 +680,8 @@ def _write_records(
     """write_cloud's writer: raw record chunks of the source -> the temporary, then in place."""
     import laspy
 
+    from .las_stats import HeaderStats
+
     cls, arrays = _check_values(src, n, int(src_header.point_format.id), classification, extra)
     header = deepcopy(src_header)
     extra_names = set(header.point_format.extra_dimension_names)
@@ -706,6 +708,8 @@ def _write_records(
         with laspy.open(tmp, mode="w", header=header, do_compress=dst.lower().endswith(".laz"),
                         laz_backend=_laz_backend()) as writer:  # fmt: skip
             fmt = writer.header.point_format
+            # laspy's header growth per chunk in one compiled pass (same header; None: laspy's)
+            stats = HeaderStats.for_writer(writer) if same_format else None
             done = 0
             try:
                 for raw in chunks:
@@ -723,7 +727,11 @@ def _write_records(
                         out.classification = cls[done : done + m]
                     for name, arr in arrays.items():
                         out[name] = arr[done : done + m]
-                    writer.write_points(out)
+                    if stats is not None:
+                        stats.add(out)
+                        writer.point_writer.write_points(out)
+                    else:
+                        writer.write_points(out)
                     done += m
                     if progress is not None:
                         progress(done / n)
@@ -736,6 +744,8 @@ def _write_records(
                 ) from exc
             if done != n:
                 raise InputError(f"truncated: {done} points read, the header says {n}", path=src)
+            if stats is not None:
+                stats.apply(writer.header)
             if evlrs:  # (laspy has no top-level VLRList)
                 from laspy.vlrs.vlrlist import VLRList
 

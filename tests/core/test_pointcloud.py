@@ -314,3 +314,55 @@ def test_cancel_while_writing_from_memory_leaves_no_output(tmp_path):
     assert os.listdir(tmp_path) == []
     with pytest.raises(Cancelled):
         read_cloud(AHN3, chunk_size=5000, should_stop=lambda: True)
+
+
+def _synthetic_las(path: Path, version: str, fmt: int, scale: float, seed: int) -> None:
+    """Random records (every dimension random bytes, then X Y Z and returns set): negative and
+    positive coordinates, return numbers 0 to the field's largest; ``scale`` may be negative."""
+    rng = np.random.default_rng(seed)
+    header = laspy.LasHeader(version=version, point_format=fmt)
+    header.scales = np.array([scale, abs(scale), scale])
+    header.offsets = np.array([1000.0, -2000.0, 5.0])
+    n = 2500
+    raw = rng.integers(0, 256, (n, header.point_format.size), dtype=np.uint8)
+    rec = laspy.PackedPointRecord(raw.view(header.point_format.dtype()).ravel(),
+                                  header.point_format)  # fmt: skip
+    for axis in "XYZ":
+        rec[axis] = rng.integers(-(2**30), 2**30, n)
+    top = 15 if fmt >= 6 else 7
+    rec.return_number = rng.integers(0, top + 1, n)
+    las = laspy.LasData(header, rec)
+    las.write(path)
+
+
+@pytest.mark.parametrize(
+    ("version", "fmt", "scale"),
+    [("1.2", 1, 0.01), ("1.2", 0, -0.001), ("1.4", 6, 0.001), ("1.4", 8, -0.01)],
+)
+@pytest.mark.parametrize("suffix", [".las", ".laz"])
+def test_header_stats_are_laspys_byte_for_byte(tmp_path, monkeypatch, version, fmt, scale,
+                                               suffix):  # fmt: skip
+    """The compiled header statistics (core.io.las_stats) write the file laspy's own
+    per-chunk growth writes, byte for byte: bounds (negative scales too), points by return (0
+    and numbers above the header's slots left out), several chunks."""
+    from lidarphoto.core.io import las_stats
+
+    if not las_stats.AVAILABLE:
+        pytest.skip("numba not installed: laspy's own path is the only one")
+    src = tmp_path / f"src{suffix}"
+    _synthetic_las(src, version, fmt, scale, seed=fmt)
+    cloud = read_cloud(src, chunk_size=1000, require_crs=False)
+    cls = np.random.default_rng(1).integers(0, 20, len(cloud)).astype(np.uint8)
+    fast, slow = tmp_path / f"fast{suffix}", tmp_path / f"slow{suffix}"
+    made = []
+    real = las_stats.HeaderStats.for_writer
+    monkeypatch.setattr(las_stats.HeaderStats, "for_writer",
+                        classmethod(lambda c, w: made.append(1) or real(w)))  # fmt: skip
+    write_cloud(src, fast, classification=cls, points=cloud, chunk_size=1000)
+    assert made  # the fast path ran
+    monkeypatch.setattr(las_stats.HeaderStats, "for_writer", classmethod(lambda c, w: None))
+    write_cloud(src, slow, classification=cls, points=read_cloud(src, chunk_size=1000,
+                                                                 require_crs=False))  # fmt: skip
+    assert fast.read_bytes() == slow.read_bytes()
+    h = laspy.read(fast).header
+    assert h.point_count == 2500 and sum(h.number_of_points_by_return) < 2500  # 0s left out
