@@ -524,7 +524,7 @@ class GeoTiffWriter:
         if self.backend == "gdal":
             self._ds.WriteArray(a, xoff=int(col0), yoff=int(row0))
             if self.mask and mask is not None:
-                m = np.where(mask, 255, 0).astype(np.uint8)
+                m = _mask_bytes(mask)
                 self._ds.GetRasterBand(1).GetMaskBand().WriteArray(m, int(col0), int(row0))
         else:
             from rasterio.windows import Window as RioWindow
@@ -532,7 +532,7 @@ class GeoTiffWriter:
             win = RioWindow(int(col0), int(row0), w, h)
             self._ds.write(a, window=win)
             if self.mask and mask is not None:
-                self._ds.write_mask(np.where(mask, 255, 0).astype(np.uint8), window=win)
+                self._ds.write_mask(_mask_bytes(mask), window=win)
 
     def close(self, overviews: bool = True) -> None:
         """Build the overviews (unless ``overviews`` is False) and close the file."""
@@ -569,6 +569,12 @@ class GeoTiffWriter:
                 self._env.__exit__(None, None, None)
 
 
+def _mask_bytes(valid: NDArray) -> NDArray[np.uint8]:
+    """GDAL's mask values of a boolean array: 255 where valid, 0 elsewhere (in uint8 from the
+    start: no int64 temporary)."""
+    return np.multiply(np.asarray(valid, bool), np.uint8(255), dtype=np.uint8)
+
+
 def _write_levels_gdal(ds: Any, levels: list) -> None:
     """Write the overview levels (made empty by ``BuildOverviews("NONE")``) of an osgeo
     dataset: every band, and the mask's levels."""
@@ -576,7 +582,7 @@ def _write_levels_gdal(ds: Any, levels: list) -> None:
         for b in range(data.shape[0]):
             ds.GetRasterBand(b + 1).GetOverview(k).WriteArray(data[b])
         mask = ds.GetRasterBand(1).GetMaskBand().GetOverview(k)
-        mask.WriteArray(np.where(valid, 255, 0).astype(np.uint8))
+        mask.WriteArray(_mask_bytes(valid))
 
 
 def _rasterio_gdal() -> Any:
@@ -625,7 +631,10 @@ def _write_levels_rasterio(path: str, factors: list[int], levels: list, zlevel: 
         return
     import ctypes
 
-    options = {} if zlevel is None else {"ZLEVEL_OVERVIEW": str(int(zlevel))}
+    # the levels' blocks compressed on every core, as the full resolution's (NUM_THREADS)
+    options = {"GDAL_NUM_THREADS": str(_threads())}
+    if zlevel is not None:
+        options["ZLEVEL_OVERVIEW"] = str(int(zlevel))
     with _rio_env(**options):
         h = lib.GDALOpenEx(os.fsencode(path), 0x01 | 0x02 | 0x40, None, None, None)
         if not h:
@@ -638,7 +647,7 @@ def _write_levels_rasterio(path: str, factors: list[int], levels: list, zlevel: 
             for k, (data, valid) in enumerate(levels):
                 bands = [lib.GDALGetOverview(lib.GDALGetRasterBand(h, b + 1), k)
                          for b in range(data.shape[0])]  # fmt: skip
-                mask = np.where(valid, 255, 0).astype(np.uint8)
+                mask = _mask_bytes(valid)
                 # each band straight from the (pixel-interleaved) level: GDAL's strides
                 planes = [(band, data[b], _GDT[data.dtype.name]) for b, band in enumerate(bands)]
                 planes.append((lib.GDALGetOverview(lib.GDALGetMaskBand(

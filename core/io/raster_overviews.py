@@ -54,42 +54,51 @@ def _average_rows(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask):
     cols, bands: pixel-interleaved) and ``mask`` (rows, cols) into ``out`` (rows, cols, bands);
     ya, yb relative to src's first row; windows of at most 3 pixels per axis (r <= 2). Each
     band's sums in GDAL's order: along a row (first pixel weighted, middle one, last one
-    weighted), then these line sums weighted over the rows."""
+    weighted), then these line sums weighted over the rows. The window's weights and mask are
+    read once per cell, for every band."""
     nb = src.shape[2]
-    for bb in range(nb):
-        for i in range(ya.shape[0]):
-            y0 = ya[i]
-            ny = yb[i] - y0
-            for j in range(xa.shape[0]):
-                x0 = xa[j]
-                nx = xb[j] - x0
-                wl = xwl[j]
-                wr = xwr[j]
-                tot = 0.0
-                wt = 0.0
-                cnt = 0
-                for k in range(ny):
-                    y = y0 + k
-                    wy = ywl[i] if k == 0 else (ywr[i] if k == ny - 1 else 1.0)
+    tot = np.empty(nb)
+    for i in range(ya.shape[0]):
+        y0 = ya[i]
+        ny = yb[i] - y0
+        for j in range(xa.shape[0]):
+            x0 = xa[j]
+            nx = xb[j] - x0
+            x2 = x0 + nx - 1
+            wl = xwl[j]
+            wr = xwr[j]
+            tot[:] = 0.0
+            wt = 0.0
+            cnt = 0
+            for k in range(ny):
+                y = y0 + k
+                wy = ywl[i] if k == 0 else (ywr[i] if k == ny - 1 else 1.0)
+                m0 = mask[y, x0] != 0
+                m1 = nx == 3 and mask[y, x0 + 1] != 0
+                m2 = nx >= 2 and mask[y, x2] != 0
+                wline = 0.0
+                if m0:
+                    wline = wl
+                    cnt += 1
+                if m1:
+                    wline += 1.0
+                    cnt += 1
+                if m2:
+                    wline += wr
+                    cnt += 1
+                for bb in range(nb):
                     line = 0.0
-                    wline = 0.0
-                    if mask[y, x0]:
+                    if m0:
                         line = src[y, x0, bb] * wl
-                        wline = wl
-                        cnt += 1
-                    if nx == 3 and mask[y, x0 + 1]:
+                    if m1:
                         line += src[y, x0 + 1, bb]
-                        wline += 1.0
-                        cnt += 1
-                    if nx >= 2 and mask[y, x0 + nx - 1]:
-                        line += src[y, x0 + nx - 1, bb] * wr
-                        wline += wr
-                        cnt += 1
-                    tot += line * wy
-                    wt += wline * wy
-                if bb == 0:
-                    out_mask[i, j] = cnt > 0
-                out[i, j, bb] = 0 if cnt == 0 else math.floor(tot / wt + 0.5)
+                    if m2:
+                        line += src[y, x2, bb] * wr
+                    tot[bb] += line * wy
+                wt += wline * wy
+            out_mask[i, j] = cnt > 0
+            for bb in range(nb):
+                out[i, j, bb] = 0 if cnt == 0 else math.floor(tot[bb] / wt + 0.5)
 
 
 def _average_rows_2x2(src, mask, out, out_mask):
