@@ -391,14 +391,21 @@ def _pool() -> Any:
     return _POOL[0]
 
 
+#: signals the kernel raises in the thread that faults (a crash in a kernel): left unblocked
+#: so that Python's fault handler and the default actions still see them
+_SYNCHRONOUS = ("SIGSEGV", "SIGBUS", "SIGFPE", "SIGILL", "SIGABRT", "SIGTRAP", "SIGSYS")
+
+
 def _block_signals() -> None:
-    """In a pool thread: block the signals, so that the kernel delivers SIGINT, SIGTERM, ... to
-    the main thread, where Python handles them (one delivered to a pool thread would leave the
-    main thread asleep in a blocking call: Ctrl+C and the job's cancellation would wait)."""
+    """In a pool thread: block the asynchronous signals, so that the kernel delivers SIGINT,
+    SIGTERM, ... to the main thread, where Python handles them (one delivered to a pool thread
+    would leave the main thread asleep in a blocking call: Ctrl+C and the job's cancellation
+    would wait). The synchronous ones (:data:`_SYNCHRONOUS`) stay unblocked."""
     import signal
 
     if hasattr(signal, "pthread_sigmask"):
-        signal.pthread_sigmask(signal.SIG_BLOCK, signal.valid_signals())
+        keep = {getattr(signal, n) for n in _SYNCHRONOUS if hasattr(signal, n)}
+        signal.pthread_sigmask(signal.SIG_BLOCK, signal.valid_signals() - keep)
 
 
 def morph(src: Any, kernel: Any, dilate: bool) -> Any | None:

@@ -9,6 +9,7 @@ Each method is checked against truth in test_ground_filter.py (the default back 
 from __future__ import annotations
 
 import os
+import signal
 from dataclasses import replace
 from pathlib import Path
 
@@ -159,3 +160,15 @@ def test_back_end_argument_is_checked(monkeypatch):
     assert auto.ground.any()  # "auto" falls back to numpy
     with pytest.raises(InputError, match="y and z must be None"):
         ground_filter(_scaled(x, y, z), y, z)
+
+
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="POSIX threads' signal masks")
+def test_pool_threads_block_interrupts_but_not_faults():
+    """The grid pool's threads leave SIGINT/SIGTERM to the main thread (else Ctrl+C waits for
+    a blocking call) and keep the synchronous signals of a crash unblocked (the fault handler
+    and the default action still see them)."""
+    if not compiled.AVAILABLE:
+        pytest.skip("numba not installed: no pool")
+    mask = compiled._pool().submit(signal.pthread_sigmask, signal.SIG_BLOCK, []).result()
+    assert {signal.SIGINT, signal.SIGTERM} <= mask
+    assert not {signal.SIGSEGV, signal.SIGBUS, signal.SIGFPE, signal.SIGABRT} & mask
