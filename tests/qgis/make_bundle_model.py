@@ -1,6 +1,6 @@
 """Regenerate tests/qgis/data/bundle_accuracy_model.model3 (run once, then commit the file).
 
-    QT_QPA_PLATFORM=offscreen PROJ_DATA=/usr/share/proj \
+    QT_HASH_SEED=0 QT_QPA_PLATFORM=offscreen PROJ_DATA=/usr/share/proj \
         .venv-qgis/bin/python tests/qgis/make_bundle_model.py
 
 Bundle adjustment -> accuracy report as one graphical model: ``bundle`` =

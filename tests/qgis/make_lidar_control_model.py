@@ -1,6 +1,6 @@
 """Regenerate tests/qgis/data/lidar_control_model.model3 (run once, then commit the file).
 
-    QT_QPA_PLATFORM=offscreen PROJ_DATA=/usr/share/proj \
+    QT_HASH_SEED=0 QT_QPA_PLATFORM=offscreen PROJ_DATA=/usr/share/proj \
         .venv-qgis/bin/python tests/qgis/make_lidar_control_model.py
 
 The whole LiDAR-control chain as one graphical model: ``ground`` = lidarphoto:groundfilter ->

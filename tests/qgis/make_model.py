@@ -1,6 +1,6 @@
 """Regenerate tests/qgis/data/trajectory_model.model3 (run once, then commit the file).
 
-    QT_QPA_PLATFORM=offscreen .venv-qgis/bin/python tests/qgis/make_model.py
+    QT_HASH_SEED=0 QT_QPA_PLATFORM=offscreen .venv-qgis/bin/python tests/qgis/make_model.py
 
 The model has the inputs ``trajectory`` (file), ``crs`` and ``lever_arm``, one child
 ``eo`` = lidarphoto:trajectorytoeo and the model outputs ``eo:eo_points`` (the PointZ layer)
