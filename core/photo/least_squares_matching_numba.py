@@ -23,6 +23,21 @@ except Exception:  # ImportError, or a numba built against another numpy
 __all__ = ["AVAILABLE", "normals", "samples"]
 
 
+def _keys(t):  # pragma: no cover - compiled
+    """Keys' cubic weights (a = -0.5) of the four samples around a point a fraction ``t`` past
+    the second one, and their derivatives in t."""
+    t2 = t * t
+    t3 = t2 * t
+    return ((-0.5 * t3 + t2 - 0.5 * t, 1.5 * t3 - 2.5 * t2 + 1.0,
+             -1.5 * t3 + 2.0 * t2 + 0.5 * t, 0.5 * t3 - 0.5 * t2),
+            (-1.5 * t2 + 2.0 * t - 0.5, 4.5 * t2 - 5.0 * t,
+             -4.5 * t2 + 4.0 * t + 0.5, 1.5 * t2 - t))  # fmt: skip
+
+
+if AVAILABLE:  # inlined into the kernels (a plain function cannot be called from them)
+    _keys = numba.njit(inline="always", cache=True)(_keys)
+
+
 def _normals(g, idx, aff, rad, f, x, y, nn, rhs, outside):  # pragma: no cover - compiled
     h = g.shape[1]
     w = g.shape[2]
@@ -47,28 +62,8 @@ def _normals(g, idx, aff, rad, f, x, y, nn, rhs, outside):  # pragma: no cover -
                 r = min(max(r, 1.0), h - 3.000001)
             ci = int(c)
             ri = int(r)
-            tx = c - ci
-            ty = r - ri
-            t2 = tx * tx
-            t3 = t2 * tx
-            wx0 = -0.5 * t3 + t2 - 0.5 * tx
-            wx1 = 1.5 * t3 - 2.5 * t2 + 1.0
-            wx2 = -1.5 * t3 + 2.0 * t2 + 0.5 * tx
-            wx3 = 0.5 * t3 - 0.5 * t2
-            dx0 = -1.5 * t2 + 2.0 * tx - 0.5
-            dx1 = 4.5 * t2 - 5.0 * tx
-            dx2 = -4.5 * t2 + 4.0 * tx + 0.5
-            dx3 = 1.5 * t2 - tx
-            t2 = ty * ty
-            t3 = t2 * ty
-            wy0 = -0.5 * t3 + t2 - 0.5 * ty
-            wy1 = 1.5 * t3 - 2.5 * t2 + 1.0
-            wy2 = -1.5 * t3 + 2.0 * t2 + 0.5 * ty
-            wy3 = 0.5 * t3 - 0.5 * t2
-            dy0 = -1.5 * t2 + 2.0 * ty - 0.5
-            dy1 = 4.5 * t2 - 5.0 * ty
-            dy2 = -4.5 * t2 + 4.0 * ty + 0.5
-            dy3 = 1.5 * t2 - ty
+            (wx0, wx1, wx2, wx3), (dx0, dx1, dx2, dx3) = _keys(c - ci)
+            (wy0, wy1, wy2, wy3), (dy0, dy1, dy2, dy3) = _keys(r - ri)
             val = 0.0
             gcol = 0.0
             grow = 0.0
@@ -117,16 +112,8 @@ def _samples(g, aff, x, y, out):  # pragma: no cover - compiled
             r = min(max(r, 1.0), h - 3.000001)
             ci = int(c)
             ri = int(r)
-            tx = c - ci
-            ty = r - ri
-            t2 = tx * tx
-            t3 = t2 * tx
-            wx = (-0.5 * t3 + t2 - 0.5 * tx, 1.5 * t3 - 2.5 * t2 + 1.0,
-                  -1.5 * t3 + 2.0 * t2 + 0.5 * tx, 0.5 * t3 - 0.5 * t2)  # fmt: skip
-            t2 = ty * ty
-            t3 = t2 * ty
-            wy = (-0.5 * t3 + t2 - 0.5 * ty, 1.5 * t3 - 2.5 * t2 + 1.0,
-                  -1.5 * t3 + 2.0 * t2 + 0.5 * ty, 0.5 * t3 - 0.5 * t2)  # fmt: skip
+            wx = _keys(c - ci)[0]
+            wy = _keys(r - ri)[0]
             val = 0.0
             for m in range(4):
                 ax = 0.0
