@@ -71,6 +71,13 @@ class HeaderStats:
             return None
         if writer.header.vlrs.get("ExtraBytesVlr"):  # laspy grows their statistics too
             return None
+        import laspy
+
+        try:  # the laspy internals used here (2.x): else laspy's own path
+            view = laspy.PackedPointRecord.zeros(1, writer.header.point_format).return_number
+            view.array, int(view.bit_mask), int(view.lsb)
+        except (AttributeError, TypeError):
+            return None
         return cls(writer)
 
     def add(self, points: Any) -> None:
