@@ -111,5 +111,5 @@ class HeaderStats:
         header.maxs = np.array(self._maxs, np.float64)
         by_return = header.number_of_points_by_return
         for r in range(1, min(len(by_return), 15) + 1):
-            by_return[r - 1] += self._counts[r]
+            by_return[r - 1] += int(self._counts[r])
         header.point_count = self._n
