@@ -516,7 +516,9 @@ def read_cloud(
     Parameters
     ----------
     path, crs, chunk_size, progress, should_stop, require_crs
-        As in :func:`read_points` (progress and cancel are checked per chunk).
+        As in :func:`read_points` (progress and cancel are checked per chunk); the chunks
+        are larger by default (lazrs decodes each on all cores: fewer ends where one core
+        waits for the other).
 
     Returns
     -------

@@ -276,6 +276,8 @@ def _rect_union_kernel(src, out, ws, ds, sign, y_first, y_stop):
 _COMPILED: dict[str, Callable[..., Any]] = {}
 _POOL: list[Any] = []
 _POOL_LOCK = threading.Lock()
+
+
 def _compiled(name: str) -> Callable[..., Any]:
     """The jitted function (compiled at its first call for each argument type, cached next to
     this module, keyed by the module's import name)."""

@@ -46,9 +46,8 @@ def apply_homography(h: ArrayLike, points: ArrayLike) -> Array:
     [[2.0, 6.0]]
     """
     p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-    q = p @ np.asarray(h, float)[:2, :2].T + np.asarray(h, float)[:2, 2]
-    w = p @ np.asarray(h, float)[2, :2] + np.asarray(h, float)[2, 2]
-    return q / w[:, None]
+    h = np.asarray(h, dtype=np.float64)
+    return (p @ h[:2, :2].T + h[:2, 2]) / (p @ h[2, :2] + h[2, 2])[:, None]
 
 
 def _opencv_fit(p: Array, q: Array, method: int) -> Array:
@@ -101,10 +100,10 @@ def fit_homography(
         start = _opencv_fit(p, q, cv2.LMEDS)
     r = np.hypot(*(q - apply_homography(start, p)).T)
     kept = r <= (np.inf if np.isinf(k) else k * np.median(r) / 1.1774)
-    h = np.eye(3)
-    for _ in range(max_rounds):
-        if kept.sum() < 4:
-            break
+    if kept.sum() < 4:
+        raise ValueError(f"only {int(kept.sum())} of {len(p)} matches agree with the start: "
+                         "no homography fits them")  # fmt: skip
+    for _ in range(max(1, max_rounds)):
         h = _opencv_fit(p[kept], q[kept], 0)
         r = np.hypot(*(q - apply_homography(h, p)).T)
         # median distance of a 2-D Gaussian error = 1.1774 sigma (Rayleigh)

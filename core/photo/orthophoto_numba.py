@@ -139,7 +139,7 @@ def _remap_maps_fixed(col, row, c0, r0, xy, alpha):
 
 def _valid_bounds(col, row):
     """(cells with a pixel, smallest col, largest col, smallest row, largest row) of the
-    finite cells, in one pass (NaN bounds when none)."""
+    finite cells, in one pass (infinite bounds when none)."""
     n = 0
     c_lo = r_lo = math.inf
     c_hi = r_hi = -math.inf

@@ -85,3 +85,13 @@ def test_checkerboard_halves_are_balanced_and_blockwise():
     for key in {tuple(b) for b in blocks[:50]}:
         inside = (blocks == key).all(axis=1)
         assert black[inside].all() or not black[inside].any()
+
+
+def test_too_few_matches_agreeing_is_an_error_not_a_homography():
+    """Three of five matches exact, two far off: the start's median residual is 0, so fewer
+    than 4 matches are kept; the fit refuses instead of returning a homography."""
+    src = np.array([[10.0, 10.0], [300.0, 20.0], [40.0, 400.0], [350.0, 380.0], [200.0, 200.0]])
+    dst = apply_homography(H, src)
+    dst[3:] += 25.0
+    with pytest.raises(ValueError, match="3 of 5 matches agree"):
+        fit_homography(src, dst, start=H)
