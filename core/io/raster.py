@@ -575,14 +575,26 @@ def _mask_bytes(valid: NDArray) -> NDArray[np.uint8]:
     return np.multiply(np.asarray(valid, bool), np.uint8(255), dtype=np.uint8)
 
 
+#: Rows of an overview level written at once (a row of 512-px blocks, or several of smaller)
+_LEVEL_ROWS = 512
+
+
 def _write_levels_gdal(ds: Any, levels: list) -> None:
     """Write the overview levels (made empty by ``BuildOverviews("NONE")``) of an osgeo
     dataset: every band, and the mask's levels."""
     for k, (data, valid) in enumerate(levels):
-        for b in range(data.shape[0]):
-            ds.GetRasterBand(b + 1).GetOverview(k).WriteArray(data[b])
+        nb, rows, cols = data.shape
+        level = ds.GetRasterBand(1).GetOverview(k).GetDataset()
         mask = ds.GetRasterBand(1).GetMaskBand().GetOverview(k)
-        mask.WriteArray(_mask_bytes(valid))
+        m = _mask_bytes(valid)
+        for r0 in range(0, rows, _LEVEL_ROWS):  # as in _write_levels_rasterio
+            part = np.moveaxis(data[:, r0 : r0 + _LEVEL_ROWS], 0, -1)
+            n = part.shape[0]
+            level.WriteRaster(0, r0, cols, n, np.ascontiguousarray(part).data, cols, n,
+                              band_list=list(range(1, nb + 1)),
+                              buf_pixel_space=part.strides[1], buf_line_space=part.strides[0],
+                              buf_band_space=part.strides[2])  # fmt: skip
+            mask.WriteArray(m[r0 : r0 + _LEVEL_ROWS], 0, r0)
 
 
 def _rasterio_gdal() -> Any:
@@ -610,6 +622,11 @@ def _rasterio_gdal() -> Any:
         lib.GDALRasterIO.argtypes = [vp, ci, ci, ci, ci, ci, vp, ci, ci, ci, ci, ci]
         lib.GDALClose.restype = ci
         lib.GDALClose.argtypes = [vp]
+        lib.GDALGetBandDataset.restype = vp
+        lib.GDALGetBandDataset.argtypes = [vp]
+        lib.GDALDatasetRasterIO.restype = ci
+        lib.GDALDatasetRasterIO.argtypes = [vp, ci, ci, ci, ci, ci, vp, ci, ci, ci, ci,
+                                            ctypes.POINTER(ci), ci, ci, ci]  # fmt: skip
     except (OSError, AttributeError):
         return None
     return lib
@@ -645,18 +662,28 @@ def _write_levels_rasterio(path: str, factors: list[int], levels: list, zlevel: 
             if lib.GDALBuildOverviews(h, b"NONE", n, arr, 0, None, None, None) != 0:
                 raise OSError(f"cannot make the overview levels of {path}")
             for k, (data, valid) in enumerate(levels):
-                bands = [lib.GDALGetOverview(lib.GDALGetRasterBand(h, b + 1), k)
-                         for b in range(data.shape[0])]  # fmt: skip
-                mask = _mask_bytes(valid)
-                # each band straight from the (pixel-interleaved) level: GDAL's strides
-                planes = [(band, data[b], _GDT[data.dtype.name]) for b, band in enumerate(bands)]
-                planes.append((lib.GDALGetOverview(lib.GDALGetMaskBand(
-                    lib.GDALGetRasterBand(h, 1)), k), mask, 1))  # fmt: skip
-                for band, plane, gdt in planes:
-                    rows, cols = plane.shape
-                    if not band or lib.GDALRasterIO(band, 1, 0, 0, cols, rows,
-                                                    plane.ctypes.data, cols, rows, gdt,
-                                                    plane.strides[1], plane.strides[0]) != 0:
+                _, rows, cols = data.shape
+                first = lib.GDALGetOverview(lib.GDALGetRasterBand(h, 1), k)
+                level = lib.GDALGetBandDataset(first) if first else None
+                mask = lib.GDALGetOverview(lib.GDALGetMaskBand(lib.GDALGetRasterBand(h, 1)), k)
+                if not level or not mask:
+                    raise OSError(f"cannot write the overviews of {path}")
+                nb = data.shape[0]
+                band_map = (ctypes.c_int * nb)(*range(1, nb + 1))
+                m = _mask_bytes(valid)
+                # all bands at once, a row of blocks after the other: each block is complete
+                # when written, so GDAL's threads compress it while the next rows are copied
+                for r0 in range(0, rows, _LEVEL_ROWS):
+                    n = min(_LEVEL_ROWS, rows - r0)
+                    part = data[:, r0 : r0 + n]
+                    if lib.GDALDatasetRasterIO(level, 1, 0, r0, cols, n, part.ctypes.data, cols,
+                                               n, _GDT[data.dtype.name], nb, band_map,
+                                               part.strides[2], part.strides[1],
+                                               part.strides[0]) != 0:  # fmt: skip
+                        raise OSError(f"cannot write the overviews of {path}")
+                    mp = m[r0 : r0 + n]
+                    if lib.GDALRasterIO(mask, 1, 0, r0, cols, n, mp.ctypes.data, cols, n, 1,
+                                        mp.strides[1], mp.strides[0]) != 0:  # fmt: skip
                         raise OSError(f"cannot write the overviews of {path}")
         finally:
             lib.GDALClose(h)

@@ -236,6 +236,10 @@ class OverviewBuilder:
         self._base = 0  # raster row of the buffer's first row
         self._next = 0  # next row of level 1 to compute
         self.ok = True
+        # the next level grown from level 1's rows as they are made (GDAL makes each level
+        # from the previous), so that none is left for the end
+        self._child = (OverviewBuilder(self.bands, oh, ow, self.dtype, self.n_levels - 1,
+                                       backend) if self.n_levels > 1 else None)  # fmt: skip
 
     def _room(self, rows: int) -> None:
         """Make the buffer hold rows [base, base + rows)."""
@@ -288,6 +292,8 @@ class OverviewBuilder:
                     ywl[i0:end], ywr[i0:end], *self._x, self._lv1[i0:end],
                     self.lv1_mask[i0:end])  # fmt: skip
         self._next = end
+        if self._child is not None:
+            self._child.add(self.lv1[:, i0:end], self.lv1_mask[i0:end], 0, i0)
         if end >= ya.size:
             return
         drop = int(ya[end]) - self._base  # rows no window still needs
@@ -308,6 +314,4 @@ class OverviewBuilder:
         if not self.ok or self._next < self.lv1_mask.shape[0]:
             raise ValueError("the overview levels are incomplete: not every row was written")
         out = [(self.lv1, self.lv1_mask)]
-        for _ in range(1, self.n_levels):
-            out.append(average_level(*out[-1], backend=self.backend))
-        return out
+        return out + (self._child.levels() if self._child is not None else [])

@@ -149,3 +149,23 @@ def test_eo_map_local_round_trip(frame):
     assert abs(theta) > 1e-3
     w, p, k = matrix_to_opk(m0[0])
     np.testing.assert_allclose([w, p, k], [0.0, 0.0, 0.7 + theta], atol=1e-12)
+
+
+@pytest.mark.parametrize("code", ["EPSG:28992", "EPSG:2154", "EPSG:32633", "EPSG:3857"])
+def test_ecef_conversions_equal_proj_search(code):
+    """The geodetic <-> ECEF pipelines written directly give PROJ's own transformation (found
+    by its search of the database) to the last bit."""
+    from pyproj.transformer import TransformerGroup
+
+    frame = MappingFrame.from_user_input(code)
+    rng = np.random.default_rng(4)
+    llh = np.column_stack([rng.uniform(-89, 89, 500), rng.uniform(-180, 180, 500),
+                           rng.uniform(-500, 9000, 500)])  # fmt: skip
+    to_ecef = TransformerGroup(frame.geodetic, frame.geocentric, always_xy=True)
+    assert to_ecef.best_available
+    want = np.column_stack(to_ecef.transformers[0].transform(llh[:, 1], llh[:, 0], llh[:, 2]))
+    got = frame.geodetic_to_ecef(llh)
+    np.testing.assert_array_equal(got, want)
+    back = TransformerGroup(frame.geocentric, frame.geodetic, always_xy=True).transformers[0]
+    lon, lat, h = back.transform(want[:, 0], want[:, 1], want[:, 2])
+    np.testing.assert_array_equal(frame.ecef_to_geodetic(want), np.column_stack([lat, lon, h]))

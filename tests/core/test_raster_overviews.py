@@ -58,8 +58,9 @@ def _write(path, data, mask, in_memory, order=None, tile=128):
                       mask[r0 : r0 + tile, c0 : c0 + tile])  # fmt: skip
 
 
+# the last: level 1 written in two parts
 SIZES = [(768, 1024, np.uint8), (517, 779, np.uint8), (600, 1001, np.uint16),
-         (1003, 640, np.uint8)]  # fmt: skip
+         (1003, 640, np.uint8), (1300, 700, np.uint8)]  # fmt: skip
 
 
 @pytest.mark.parametrize(("h", "w", "dtype"), SIZES)
