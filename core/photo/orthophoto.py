@@ -38,10 +38,11 @@ from __future__ import annotations
 import logging
 import math
 import os
+import threading
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -297,6 +298,9 @@ class OrthoProjector:
     m_local: Array
     lens: tuple[Array, float, float, float]
     z_range: tuple[float, float] = (0.0, 0.0)
+    # the lattice of a whole grid, made once for its tiles (_lattice)
+    _lattices: dict = field(default_factory=dict, compare=False, repr=False)
+    _lock: threading.Lock = field(default_factory=threading.Lock, compare=False, repr=False)
 
     @classmethod
     def build(
@@ -345,9 +349,26 @@ class OrthoProjector:
 
     # ------------------------------------------------------------------ geometry
     def _lattice(self, grid: Grid, row0: int, col0: int, h: int, w: int, step: int) -> Array:
-        """``a`` and ``b`` (ny, nx, 6) at the nodes of a block (module docstring, step 2)."""
+        """``a`` and ``b`` (ny, nx, 6) at the nodes of a block (module docstring, step 2):
+        the same nodes of the whole grid's lattice, made at the first tile, for a block of the
+        grid that starts on a node (the tiles: one transformation instead of one per tile)."""
         ny = max(2, math.ceil((h - 1) / step) + 1)
         nx = max(2, math.ceil((w - 1) / step) + 1)
+        if (row0 % step or col0 % step or row0 < 0 or col0 < 0 or row0 + h > grid.rows
+                or col0 + w > grid.cols):  # fmt: skip
+            return self._nodes(grid, row0, col0, ny, nx, step)
+        key = (grid, step)
+        with self._lock:
+            full = self._lattices.get(key)
+            if full is None:
+                full = self._nodes(grid, 0, 0, math.ceil((grid.rows - 1) / step) + 2,
+                                   math.ceil((grid.cols - 1) / step) + 2, step)  # fmt: skip
+                self._lattices[key] = full
+        k, m = row0 // step, col0 // step
+        return full[k : k + ny, m : m + nx]
+
+    def _nodes(self, grid: Grid, row0: int, col0: int, ny: int, nx: int, step: int) -> Array:
+        """``a`` and ``b`` (ny, nx, 6) at nodes every ``step`` cells from cell (row0, col0)."""
         xs = grid.x0 + (col0 + np.arange(nx) * step + 0.5) * grid.cell
         ys = grid.y_top - (row0 + np.arange(ny) * step + 0.5) * grid.cell
         gx, gy = np.meshgrid(xs, ys)

@@ -25,75 +25,118 @@ def _cell_pixels(
 ):  # fmt: skip
     """Fill out_col, out_row (image pixels, NaN: none) and out_z (surface height) of an h x w
     block of cells whose first centre is (x0, y0) and spacing g (see
-    :func:`core.photo.orthophoto.cell_pixels_numpy` for the arguments)."""
+    :func:`core.photo.orthophoto.cell_pixels_numpy` for the arguments).
+
+    Written for speed: the lattice is interpolated to each row once, then along the row one
+    lattice interval after the other (no per-cell division or clamping); in each interval the
+    heights, then the pixels (without a lens in a loop the compiler vectorises)."""
     rows, cols = z.shape
     ny, nx = lat.shape[0], lat.shape[1]
     cx0, ps, cy0, wpx, hpx = nolens[0], nolens[1], nolens[2], nolens[3], nolens[4]
     has_lens = lens.shape[0] > 1
     my, mx = lens.shape[0], lens.shape[1]
+    nan = np.nan
+    istep = int(step)
+    inv_step = 1.0 / step
+    k_px = focal / ps
+    c_top = max(cols - 2, 0)
+    c_max = float(cols - 1)
     rl = np.empty((nx, 6))
+    dl = np.empty((nx, 6))
     for i in range(h):
         y = y0 - i * g
         v = (yc - y) * inv_cell
+        if not (v >= 0.0 and v <= rows - 1):  # the whole row off the DSM
+            for j in range(w):
+                out_col[i, j] = nan
+                out_row[i, j] = nan
+                out_z[i, j] = nan
+            continue
+        r = min(int(v), max(rows - 2, 0))
+        fv = v - r
+        r1 = min(r + 1, rows - 1)
         fi = i / step
         ki = min(int(fi), ny - 2)
         ti = fi - ki
-        # the lattice interpolated to this row once; per cell only along the row
+        # the lattice interpolated to this row once, and its steps between nodes
         for kj in range(nx):
             for k in range(6):
                 rl[kj, k] = lat[ki, kj, k] * (1 - ti) + lat[ki + 1, kj, k] * ti
-        for j in range(w):
-            out_col[i, j] = np.nan
-            out_row[i, j] = np.nan
-            out_z[i, j] = np.nan
-            x = x0 + j * g
-            u = (x - xc) * inv_cell
-            if not (u >= 0.0 and v >= 0.0 and u <= cols - 1 and v <= rows - 1):
+        for kj in range(nx - 1):
+            for k in range(6):
+                dl[kj, k] = rl[kj + 1, k] - rl[kj, k]
+        for kj in range(nx - 1):
+            j0 = kj * istep
+            j1 = w if kj == nx - 2 else min(j0 + istep, w)
+            a0, a1, a2 = rl[kj, 0], rl[kj, 1], rl[kj, 2]
+            b0, b1, b2 = rl[kj, 3], rl[kj, 4], rl[kj, 5]
+            da0, da1, da2 = dl[kj, 0], dl[kj, 1], dl[kj, 2]
+            db0, db1, db2 = dl[kj, 3], dl[kj, 4], dl[kj, 5]
+            # the heights first (gathers from the DSM; np.float64: numba's float() keeps
+            # float32, whose differences lose up to 1e-7 m)
+            for j in range(j0, j1):
+                u = (x0 + j * g - xc) * inv_cell
+                zz = nan
+                if u >= 0.0 and u <= c_max:
+                    c = min(int(u), c_top)
+                    fu = u - c
+                    c1 = min(c + 1, cols - 1)
+                    z00 = np.float64(z[r, c])
+                    z11 = np.float64(z[r1, c1])
+                    if fu >= fv:
+                        z01 = np.float64(z[r, c1])
+                        zz = z00 + (z01 - z00) * fu + (z11 - z01) * fv
+                    else:
+                        z10 = np.float64(z[r1, c])
+                        zz = z00 + (z11 - z10) * fu + (z10 - z00) * fv
+                out_z[i, j] = zz
+            zrow = out_z[i]
+            crow = out_col[i]
+            rrow = out_row[i]
+            if not has_lens:
+                # then the projection, q = a + z b with a and b interpolated between the
+                # lattice nodes: no branch, so that the compiler vectorises the loop
+                for j in range(j0, j1):
+                    zz = zrow[j]
+                    tj = (j - j0) * inv_step
+                    q2 = (a2 + tj * da2) + zz * (b2 + tj * db2)
+                    q0 = (a0 + tj * da0) + zz * (b0 + tj * db0)
+                    q1 = (a1 + tj * da1) + zz * (b1 + tj * db1)
+                    s = -1.0 / q2
+                    cc = cx0 + k_px * q0 * s
+                    rr = cy0 - k_px * q1 * s
+                    # NaN fails every comparison: no height, no pixel; q2 < 0: in front
+                    ok = (q2 < 0.0) & (cc >= 0.0) & (rr >= 0.0) & (cc <= wpx) & (rr <= hpx)
+                    crow[j] = cc if ok else nan
+                    rrow[j] = rr if ok else nan
                 continue
-            c = min(max(math.floor(u), 0), max(cols - 2, 0))
-            r = min(max(math.floor(v), 0), max(rows - 2, 0))
-            fu, fv = u - c, v - r
-            c1, r1 = min(c + 1, cols - 1), min(r + 1, rows - 1)
-            z00 = float(z[r, c])
-            z01 = float(z[r, c1])
-            z10 = float(z[r1, c])
-            z11 = float(z[r1, c1])
-            if fu >= fv:
-                zz = z00 + (z01 - z00) * fu + (z11 - z01) * fv
-            else:
-                zz = z00 + (z11 - z10) * fu + (z10 - z00) * fv
-            if not math.isfinite(zz):
-                continue
-            out_z[i, j] = zz
-            fj = j / step
-            kj = min(int(fj), nx - 2)
-            tj = fj - kj
-            # q = a + z b, a and b interpolated between the lattice nodes
-            q0 = (rl[kj, 0] + zz * rl[kj, 3]) * (1 - tj) + (rl[kj + 1, 0] + zz * rl[kj + 1, 3]) * tj
-            q1 = (rl[kj, 1] + zz * rl[kj, 4]) * (1 - tj) + (rl[kj + 1, 1] + zz * rl[kj + 1, 4]) * tj
-            q2 = (rl[kj, 2] + zz * rl[kj, 5]) * (1 - tj) + (rl[kj + 1, 2] + zz * rl[kj + 1, 5]) * tj
-            if not q2 < 0.0:  # behind the camera
-                continue
-            xi = -focal * q0 / q2
-            yi = -focal * q1 / q2
-            if has_lens:
-                lu = (xi - lx0) * inv_ls
-                lv = (yi - ly0) * inv_ls
-                if not (lu >= 0.0 and lv >= 0.0 and lu <= mx - 1 and lv <= my - 1):
-                    continue
-                lj = min(int(lu), mx - 2)
-                li = min(int(lv), my - 2)
-                su, sv = lu - lj, lv - li
-                col = ((lens[li, lj, 0] * (1 - su) + lens[li, lj + 1, 0] * su) * (1 - sv)
-                       + (lens[li + 1, lj, 0] * (1 - su) + lens[li + 1, lj + 1, 0] * su) * sv)
-                row = ((lens[li, lj, 1] * (1 - su) + lens[li, lj + 1, 1] * su) * (1 - sv)
-                       + (lens[li + 1, lj, 1] * (1 - su) + lens[li + 1, lj + 1, 1] * su) * sv)
-            else:
-                col = cx0 + xi / ps
-                row = cy0 - yi / ps
-            if col >= 0.0 and row >= 0.0 and col <= wpx and row <= hpx:
-                out_col[i, j] = col
-                out_row[i, j] = row
+            for j in range(j0, j1):  # with the lens lattice: measured pixels
+                zz = zrow[j]
+                col = nan
+                row = nan
+                tj = (j - j0) * inv_step
+                q2 = (a2 + tj * da2) + zz * (b2 + tj * db2)
+                if q2 < 0.0:
+                    q0 = (a0 + tj * da0) + zz * (b0 + tj * db0)
+                    q1 = (a1 + tj * da1) + zz * (b1 + tj * db1)
+                    s = -1.0 / q2
+                    lu = (focal * q0 * s - lx0) * inv_ls
+                    lv = (focal * q1 * s - ly0) * inv_ls
+                    if lu >= 0.0 and lv >= 0.0 and lu <= mx - 1 and lv <= my - 1:
+                        lj = min(int(lu), mx - 2)
+                        li = min(int(lv), my - 2)
+                        su, sv = lu - lj, lv - li
+                        cc = ((lens[li, lj, 0] * (1 - su) + lens[li, lj + 1, 0] * su) * (1 - sv)
+                              + (lens[li + 1, lj, 0] * (1 - su) + lens[li + 1, lj + 1, 0] * su)
+                              * sv)  # fmt: skip
+                        rr = ((lens[li, lj, 1] * (1 - su) + lens[li, lj + 1, 1] * su) * (1 - sv)
+                              + (lens[li + 1, lj, 1] * (1 - su) + lens[li + 1, lj + 1, 1] * su)
+                              * sv)  # fmt: skip
+                        if cc >= 0.0 and rr >= 0.0 and cc <= wpx and rr <= hpx:
+                            col = cc
+                            row = rr
+                crow[j] = col
+                rrow[j] = row
 
 
 def _remap_maps(col, row, c0, r0, mapx, mapy):
@@ -163,7 +206,9 @@ def _compiled(name: str) -> Callable[..., Any]:
     if name not in _COMPILED:
         func = {"cells": _cell_pixels, "maps": _remap_maps, "fixed": _remap_maps_fixed,
                 "bounds": _valid_bounds}[name]  # fmt: skip
-        _COMPILED[name] = numba.njit(cache=True, nogil=True)(func)
+        # numpy's error model: a float division by zero gives inf (checked after), with no
+        # test per division that would keep the cell loop from being vectorised
+        _COMPILED[name] = numba.njit(cache=True, nogil=True, error_model="numpy")(func)
     return _COMPILED[name]
 
 

@@ -268,6 +268,27 @@ def test_numba_and_numpy_back_ends_agree(exact):
         np.testing.assert_allclose(u[np.isfinite(u)], v[np.isfinite(v)], rtol=0, atol=1e-9)
 
 
+@pytest.mark.skipif(not NUMBA, reason="numba not installed")
+def test_numba_and_numpy_back_ends_agree_without_lens(exact):
+    """The compiled loop without a lens (its vectorised path) against numpy, on a block that
+    reaches beyond the DSM and the image on every side, and on a lattice interval that does
+    not divide the block."""
+    proj, grid = exact["proj"], exact["grid"]
+    cam = Camera("ideal", focal_mm=10.0, pixel_size_mm=0.01, width_px=800, height_px=600)
+    ideal = OrthoProjector.build(cam, proj.xyz, proj.opk, proj.dsm, CRS)
+    assert ideal.lens[0].shape[0] == 1  # no lens lattice
+    r0, c0 = -40, -30  # rows and columns before the grid: beyond the DSM
+    h, w = grid.rows + 80, grid.cols + 70
+    for step in (64, 37):
+        a = ideal.pixels(grid, r0, c0, h, w, lattice_px=step, backend="numba")
+        b = ideal.pixels(grid, r0, c0, h, w, lattice_px=step, backend="numpy")
+        assert np.isnan(a[2]).any() and np.isfinite(a[2]).mean() > 0.5
+        assert np.isnan(a[0][np.isfinite(a[2])]).any()  # on the DSM, off the image
+        for u, v in zip(a, b):
+            np.testing.assert_array_equal(np.isnan(u), np.isnan(v))
+            np.testing.assert_allclose(u[np.isfinite(u)], v[np.isfinite(v)], rtol=0, atol=1e-9)
+
+
 def test_projection_chain_exact_far_from_the_central_meridian():
     """UTM 31N at 0.5 deg E (2.5 deg west of the central meridian, scale 1.0008), a 1.4 km
     footprint at 1 m cells, a hilly DSM: every cell against collinearity in the ENU frame with
@@ -406,3 +427,18 @@ def test_fixed_point_maps_give_opencvs_own_result(interp):
     a = cv2.remap(src, fx, fy, interp, borderMode=cv2.BORDER_REPLICATE)
     b = cv2.remap(src, xy, alpha, interp, borderMode=cv2.BORDER_REPLICATE)
     np.testing.assert_array_equal(a, b)
+
+
+def test_tiles_take_their_nodes_from_the_whole_grids_lattice(exact):
+    """A tile that starts on a node takes its lattice from the whole grid's (made once): the
+    same nodes as its own, to rounding; a block off the nodes gets its own."""
+    proj, grid = exact["proj"], exact["grid"]
+    fresh = OrthoProjector.build(proj.camera, proj.xyz, proj.opk, proj.dsm, CRS)
+    for r0, c0, h, w in [(128, 64, 128, 128), (0, 0, grid.rows, grid.cols),
+                         (grid.rows - 5, 0, 5, 70)]:  # fmt: skip
+        ny, nx = max(2, -(-(h - 1) // 64) + 1), max(2, -(-(w - 1) // 64) + 1)
+        got = fresh._lattice(grid, r0, c0, h, w, 64)
+        own = fresh._nodes(grid, r0, c0, ny, nx, 64)
+        np.testing.assert_allclose(got, own, rtol=1e-13, atol=1e-9)
+        assert np.shares_memory(got, fresh._lattices[grid, 64]) == (r0 % 64 == 0)
+    assert list(fresh._lattices) == [(grid, 64)]
