@@ -54,51 +54,70 @@ def _average_rows(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask):
     cols, bands: pixel-interleaved) and ``mask`` (rows, cols) into ``out`` (rows, cols, bands);
     ya, yb relative to src's first row; windows of at most 3 pixels per axis (r <= 2). Each
     band's sums in GDAL's order: along a row (first pixel weighted, middle one, last one
-    weighted), then these line sums weighted over the rows. The window's weights and mask are
-    read once per cell, for every band."""
+    weighted), then these line sums weighted over the rows. The line sums of a source row
+    are made once for the (one or two) cells' rows that share it, a few rows at a time."""
     nb = src.shape[2]
-    tot = np.empty(nb)
-    for i in range(ya.shape[0]):
-        y0 = ya[i]
-        ny = yb[i] - y0
-        for j in range(xa.shape[0]):
-            x0 = xa[j]
-            nx = xb[j] - x0
-            x2 = x0 + nx - 1
-            wl = xwl[j]
-            wr = xwr[j]
-            tot[:] = 0.0
-            wt = 0.0
-            cnt = 0
-            for k in range(ny):
-                y = y0 + k
-                wy = ywl[i] if k == 0 else (ywr[i] if k == ny - 1 else 1.0)
+    oh, ow = ya.shape[0], xa.shape[0]
+    pairs = src.shape[1] == 2 * ow
+    chunk = 16  # cells' rows per pass: their line sums stay in the cache
+    line = np.empty((2 * chunk + 1, ow, nb))
+    wline = np.empty((2 * chunk + 1, ow))
+    cline = np.empty((2 * chunk + 1, ow), np.int64)
+    for i0 in range(0, oh, chunk):
+        i1 = min(i0 + chunk, oh)
+        s0 = ya[i0]
+        for y in range(s0, yb[i1 - 1]):  # the line sums: masked terms are exact zeros
+            k = y - s0
+            if pairs:  # every window 2 whole pixels along the row (an even width)
+                for j in range(ow):
+                    m0 = mask[y, 2 * j] != 0
+                    m2 = mask[y, 2 * j + 1] != 0
+                    wline[k, j] = (1.0 if m0 else 0.0) + (1.0 if m2 else 0.0)
+                    cline[k, j] = np.int64(m0) + np.int64(m2)
+                    for bb in range(nb):
+                        v0 = np.float64(src[y, 2 * j, bb])
+                        v2 = np.float64(src[y, 2 * j + 1, bb])
+                        line[k, j, bb] = (v0 if m0 else 0.0) + (v2 if m2 else 0.0)
+                continue
+            for j in range(ow):
+                x0 = xa[j]
+                nx = xb[j] - x0
+                x2 = x0 + nx - 1
+                wl = xwl[j]
+                wr = xwr[j]
                 m0 = mask[y, x0] != 0
                 m1 = nx == 3 and mask[y, x0 + 1] != 0
                 m2 = nx >= 2 and mask[y, x2] != 0
-                wline = 0.0
-                if m0:
-                    wline = wl
-                    cnt += 1
-                if m1:
-                    wline += 1.0
-                    cnt += 1
-                if m2:
-                    wline += wr
-                    cnt += 1
+                wline[k, j] = (wl if m0 else 0.0) + (1.0 if m1 else 0.0) + (wr if m2 else 0.0)
+                cline[k, j] = int(m0) + int(m1) + int(m2)
                 for bb in range(nb):
-                    line = 0.0
-                    if m0:
-                        line = src[y, x0, bb] * wl
-                    if m1:
-                        line += src[y, x0 + 1, bb]
-                    if m2:
-                        line += src[y, x2, bb] * wr
-                    tot[bb] += line * wy
-                wt += wline * wy
-            out_mask[i, j] = cnt > 0
-            for bb in range(nb):
-                out[i, j, bb] = 0 if cnt == 0 else math.floor(tot[bb] / wt + 0.5)
+                    line[k, j, bb] = ((src[y, x0, bb] * wl if m0 else 0.0)
+                                      + (src[y, x0 + 1, bb] if m1 else 0.0)
+                                      + (src[y, x2, bb] * wr if m2 else 0.0))  # fmt: skip
+        for i in range(i0, i1):  # then over the rows
+            k0 = ya[i] - s0
+            ny = yb[i] - ya[i]
+            w0 = ywl[i]
+            w2 = ywr[i]
+            for j in range(ow):
+                cnt = cline[k0, j]
+                wt = wline[k0, j] * w0
+                if ny == 2:
+                    cnt += cline[k0 + 1, j]
+                    wt += wline[k0 + 1, j] * w2
+                elif ny == 3:
+                    cnt += cline[k0 + 1, j] + cline[k0 + 2, j]
+                    wt += wline[k0 + 1, j]
+                    wt += wline[k0 + 2, j] * w2
+                out_mask[i, j] = cnt > 0
+                for bb in range(nb):
+                    tot = line[k0, j, bb] * w0
+                    if ny == 2:
+                        tot += line[k0 + 1, j, bb] * w2
+                    elif ny == 3:
+                        tot += line[k0 + 1, j, bb]
+                        tot += line[k0 + 2, j, bb] * w2
+                    out[i, j, bb] = 0 if cnt == 0 else math.floor(tot / wt + 0.5)
 
 
 def _average_rows_2x2(src, mask, out, out_mask):
