@@ -57,7 +57,7 @@ from ..geometry.grid import Grid
 from ..geometry.raycast import STATUS_GRAZING, STATUS_OK, DsmTracer, intersect_dsm
 from ..geometry.surface import Dsm, triangle_height
 from .orientation import eo_map_to_local
-from .orthophoto_numba import remap_maps, remap_maps_fixed, valid_bounds
+from .orthophoto_numba import cell_stats, remap_maps, remap_maps_fixed, valid_bounds
 
 LOG = logging.getLogger(__name__)
 
@@ -618,15 +618,14 @@ def _tile(
     f: int = 1,
 ) -> OrthoTile:
     col, row, z = proj.pixels(grid, row0, col0, rows, cols, lattice_px=opt.lattice_px)
-    valid = np.isfinite(col)
-    no_surface = int(np.count_nonzero(~np.isfinite(z)))
+    valid, n, no_surface, c_min, c_max, r_min, r_max = cell_stats(col, row, z)
     occluded = 0
-    if opt.true_ortho and valid.any():
+    if opt.true_ortho and n:
         occ = _occlusion(proj, grid, row0, col0, z, valid, opt.occlusion_tol_m)
         occluded = int(np.count_nonzero(occ))
         valid &= ~occ
         col = np.where(valid, col, np.nan)
-    n, c_min, c_max, r_min, r_max = valid_bounds(col, row)
+        n, c_min, c_max, r_min, r_max = valid_bounds(col, row)
     if n == 0:
         return OrthoTile(row0, col0, np.zeros((bands, rows, cols), dtype), valid, occluded,
                          no_surface)  # fmt: skip

@@ -16,7 +16,8 @@ import numpy as np
 
 from ..geometry.raycast_numba import AVAILABLE, numba
 
-__all__ = ["AVAILABLE", "cell_pixels", "remap_maps", "remap_maps_fixed", "valid_bounds"]
+__all__ = ["AVAILABLE", "cell_pixels", "cell_stats", "remap_maps", "remap_maps_fixed",
+           "valid_bounds"]
 
 
 def _cell_pixels(
@@ -199,13 +200,37 @@ def _valid_bounds(col, row):
     return n, c_lo, c_hi, r_lo, r_hi
 
 
+def _cell_stats(col, row, z, valid):
+    """:func:`_valid_bounds` that also fills ``valid`` (col finite) and counts the cells
+    without a height (z NaN), in the same pass."""
+    n = 0
+    no_z = 0
+    c_lo = r_lo = math.inf
+    c_hi = r_hi = -math.inf
+    for i in range(col.shape[0]):
+        for j in range(col.shape[1]):
+            c = col[i, j]
+            ok = math.isfinite(c)
+            valid[i, j] = ok
+            if not math.isfinite(z[i, j]):
+                no_z += 1
+            if ok:
+                n += 1
+                r = row[i, j]
+                c_lo = min(c_lo, c)
+                c_hi = max(c_hi, c)
+                r_lo = min(r_lo, r)
+                r_hi = max(r_hi, r)
+    return n, no_z, c_lo, c_hi, r_lo, r_hi
+
+
 _COMPILED: dict[str, Callable[..., Any]] = {}
 
 
 def _compiled(name: str) -> Callable[..., Any]:
     if name not in _COMPILED:
         func = {"cells": _cell_pixels, "maps": _remap_maps, "fixed": _remap_maps_fixed,
-                "bounds": _valid_bounds}[name]  # fmt: skip
+                "bounds": _valid_bounds, "stats": _cell_stats}[name]  # fmt: skip
         # numpy's error model: a float division by zero gives inf (checked after), with no
         # test per division that would keep the cell loop from being vectorised
         _COMPILED[name] = numba.njit(cache=True, nogil=True, error_model="numpy")(func)
@@ -260,3 +285,17 @@ def valid_bounds(col: np.ndarray, row: np.ndarray) -> tuple[int, float, float, f
         return 0, math.inf, -math.inf, math.inf, -math.inf
     cv, rv = col[ok], row[ok]
     return int(ok.sum()), float(cv.min()), float(cv.max()), float(rv.min()), float(rv.max())
+
+
+def cell_stats(
+    col: np.ndarray, row: np.ndarray, z: np.ndarray
+) -> tuple[np.ndarray, int, int, float, float, float, float]:
+    """(valid: col finite, its count, cells whose z is NaN, col min, col max, row min, row max
+    over the valid cells) in one pass."""
+    if AVAILABLE:
+        valid = np.empty(col.shape, np.bool_)
+        n, no_z, *bounds = _compiled("stats")(col, row, z, valid)
+        return (valid, n, no_z, *bounds)
+    valid = np.isfinite(col)
+    n, *bounds = valid_bounds(col, row)
+    return (valid, n, int(np.count_nonzero(~np.isfinite(z))), *bounds)

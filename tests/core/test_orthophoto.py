@@ -442,3 +442,26 @@ def test_tiles_take_their_nodes_from_the_whole_grids_lattice(exact):
         np.testing.assert_allclose(got, own, rtol=1e-13, atol=1e-9)
         assert np.shares_memory(got, fresh._lattices[grid, 64]) == (r0 % 64 == 0)
     assert list(fresh._lattices) == [(grid, 64)]
+
+
+@pytest.mark.skipif(not NUMBA, reason="numba not installed")
+def test_cell_stats_compiled_and_numpy_agree(monkeypatch):
+    """The tile's one-pass statistics (valid cells, their count and pixel bounds, cells
+    without a height) against numpy, with and without valid cells."""
+    from lidarphoto.core.photo import orthophoto_numba as k
+
+    rng = np.random.default_rng(3)
+    col, row, z = (rng.uniform(-5, 900, (40, 50)) for _ in range(3))
+    col[rng.random(col.shape) < 0.3] = np.nan
+    z[rng.random(z.shape) < 0.2] = np.nan
+    cases = [(col, row, z), (np.full_like(col, np.nan), row, np.full_like(z, np.nan))]
+    for c, r, h in cases:
+        got = k.cell_stats(c, r, h)
+        monkeypatch.setattr(k, "AVAILABLE", False)
+        want = k.cell_stats(c, r, h)
+        monkeypatch.setattr(k, "AVAILABLE", True)
+        np.testing.assert_array_equal(got[0], np.isfinite(c))
+        np.testing.assert_array_equal(want[0], np.isfinite(c))
+        assert got[1:] == want[1:]
+        assert got[1] == np.isfinite(c).sum() and got[2] == np.isnan(h).sum()
+    assert cases and got[3] == math.inf  # no valid cell: infinite bounds
