@@ -97,6 +97,11 @@ if k.AVAILABLE:  # load the compiled kernels from their cache before the clock s
         average_level(np.zeros((1, side, side), np.uint8), np.ones((side, side), bool))
 # the imports the job makes on first use (orthority's are made before its clock too)
 import cv2  # noqa: F401
+import lidarphoto.core.io.atomic  # noqa: F401
+import lidarphoto.core.io.camera  # noqa: F401
+import lidarphoto.core.io.dsm  # noqa: F401
+import lidarphoto.core.io.images  # noqa: F401
+import lidarphoto.core.io.orientation  # noqa: F401
 from lidarphoto.core.io.raster import raster_backend
 raster_backend()
 import resource
