@@ -707,11 +707,15 @@ def ordered_map(
     progress: Callable[[float], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
     doing: str = "working",
+    ahead: int = 8,
 ) -> Iterator[Any]:
     """``func`` of each item, computed by a pool of threads, yielded in the items' order.
 
-    At most ``2 * workers`` results wait at once (memory stays bounded when the consumer is
-    slower); OpenCV's own threads are set to 1 meanwhile (the pool already fills the CPUs).
+    At most ``ahead * workers`` items are submitted and not yet handed over, so memory stays
+    bounded when the consumer is slower. The default lets the workers go on while the
+    consumer works in bursts (a writer that grows overview level 1 a row of tiles at a
+    time: 2 per worker left them idle a tenth of the time). OpenCV's own threads are set to 1
+    meanwhile (the pool already fills the CPUs).
     ``should_stop`` is checked before each result is handed over (Cancelled).
     """
     import cv2
@@ -726,7 +730,7 @@ def ordered_map(
             try:
                 for item in items:
                     pending.append(pool.submit(func, item))
-                    if len(pending) < 2 * n_workers:
+                    if len(pending) < ahead * n_workers:
                         continue
                     stop_if_asked(should_stop, doing)
                     yield pending.popleft().result()

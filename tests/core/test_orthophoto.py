@@ -465,3 +465,28 @@ def test_cell_stats_compiled_and_numpy_agree(monkeypatch):
         assert got[1:] == want[1:]
         assert got[1] == np.isfinite(c).sum() and got[2] == np.isnan(h).sum()
     assert cases and got[3] == math.inf  # no valid cell: infinite bounds
+
+
+@pytest.mark.parametrize(("workers", "ahead"), [(1, 1), (2, 8), (3, 2)])
+def test_ordered_map_keeps_order_and_bounds_the_work_in_flight(workers, ahead):
+    import threading
+
+    from lidarphoto.core.errors import Cancelled
+    from lidarphoto.core.photo.orthophoto import ordered_map
+
+    lock = threading.Lock()
+    started = [0]
+
+    def f(x):
+        with lock:
+            started[0] += 1
+        return x * x
+
+    got = []
+    for k, y in enumerate(ordered_map(f, range(50), workers, ahead=ahead)):
+        got.append(y)
+        with lock:  # started but not yet handed over, this one included
+            assert started[0] - k <= ahead * workers
+    assert got == [x * x for x in range(50)]
+    with pytest.raises(Cancelled):
+        list(ordered_map(f, range(50), workers, should_stop=lambda: True, ahead=ahead))
