@@ -53,6 +53,10 @@ __all__ = [
     "write_rgb_tiff",
 ]
 
+#: Largest memory the overview levels computed from the blocks may hold (bytes); a larger
+#: raster gets GDAL's overviews, read back from the file.
+OVERVIEW_MEMORY_BYTES = 256 << 20
+
 #: Writer threads (GDAL compresses blocks in parallel; more than 4 brings nothing here).
 MAX_THREADS = 4
 _INSTALL = "GDAL is needed for rasters: it comes with QGIS; outside QGIS: pip install rasterio"
@@ -383,8 +387,9 @@ class GeoTiffWriter:
     overviews_in_memory : bool, optional
         Compute the overviews from the blocks as they are written
         (:mod:`core.io.raster_overviews`: the same pixels as GDAL's, without reading the file
-        back) and write them directly. Default: with a mask, for 8- and 16-bit unsigned data,
-        unless ``LIDARPHOTO_OVERVIEWS=gdal``; falls back to GDAL's when the blocks do not come
+        back) and write them directly. Default: with a mask, for 8- and 16-bit unsigned data
+        whose levels fit :data:`OVERVIEW_MEMORY_BYTES`, unless ``LIDARPHOTO_OVERVIEWS=gdal``;
+        falls back to GDAL's when the blocks do not come
         row band after row band or a block comes without its mask.
     """
 
@@ -417,12 +422,17 @@ class GeoTiffWriter:
         self.mask = bool(mask)
         self._closed = False
         self._level = level
+        factors = overview_factors(self.width, self.height)
         if overviews_in_memory is None:
+            # the levels held until the file is closed: level 1, a quarter of the raster and
+            # its mask, and the deeper ones (a third more)
+            held = (-(-self.height // 2) * -(-self.width // 2)
+                    * (self.bands * self.dtype.itemsize + 1) * 4 // 3)  # fmt: skip
             overviews_in_memory = (self.mask and self.dtype in (np.uint8, np.uint16)
+                                   and held <= OVERVIEW_MEMORY_BYTES
                                    and os.environ.get("LIDARPHOTO_OVERVIEWS", "").lower()
                                    != "gdal")  # fmt: skip
         self._ovr = None
-        factors = overview_factors(self.width, self.height)
         if overviews_in_memory and factors:
             from .raster_overviews import OverviewBuilder
 

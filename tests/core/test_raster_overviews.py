@@ -131,3 +131,25 @@ def test_pixel_interleaved_read(tmp_path):
             a = src.read((8, 12, 200, 100), decimation=f, pixel_interleaved=True)
             np.testing.assert_array_equal(a, src.read((8, 12, 200, 100), decimation=f))
             assert np.moveaxis(a, 0, -1).flags.c_contiguous
+
+
+def test_levels_beyond_the_memory_budget_are_gdals(tmp_path, monkeypatch):
+    """A raster whose levels would not fit OVERVIEW_MEMORY_BYTES gets GDAL's overviews (the
+    same pixels), one that fits gets them from memory."""
+    from lidarphoto.core.io import raster
+
+    data, mask = _raster(300, 400, np.uint8, seed=2)
+    held = 150 * 200 * 4 * 4 // 3  # level 1 and its mask, and the deeper levels
+    for budget, in_memory in ((held, True), (held - 1, False)):
+        monkeypatch.setattr(raster, "OVERVIEW_MEMORY_BYTES", budget)
+        w = GeoTiffWriter(tmp_path / f"{budget}.tif", 400, 300, 3, np.uint8, GT, "EPSG:28992",
+                          mask=True, tile=128, level=1)  # fmt: skip
+        assert (w._ovr is not None) == in_memory
+        with w:
+            w.write(data, 0, 0, mask)
+    _write(tmp_path / "gdal.tif", data, mask, in_memory=False)
+    n = len(overview_factors(400, 300))
+    for path in (tmp_path / f"{held}.tif", tmp_path / f"{held - 1}.tif"):
+        for (gd, gm), (md, mm) in zip(_levels(tmp_path / "gdal.tif", n), _levels(path, n)):
+            np.testing.assert_array_equal(mm, gm)
+            np.testing.assert_array_equal(md, gd)
