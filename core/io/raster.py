@@ -27,7 +27,8 @@ import math
 import os
 import threading
 import warnings
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from concurrent.futures import Executor, Future
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Union
@@ -544,11 +545,17 @@ class GeoTiffWriter:
             if self.mask and mask is not None:
                 self._ds.write_mask(_mask_bytes(mask), window=win)
 
-    def close(self, overviews: bool = True) -> None:
-        """Build the overviews (unless ``overviews`` is False) and close the file."""
+    def close(self, overviews: bool = True, finish_in: Executor | None = None) -> Future | None:
+        """Build the overviews (unless ``overviews`` is False) and close the file.
+
+        With ``finish_in``, overview levels made from the blocks in memory are written by that
+        executor, after the full resolution is closed here (a job goes on with its next image
+        meanwhile): the returned Future is done when the file is whole. Otherwise (and
+        when GDAL builds the levels) everything is done here and None is returned."""
         if self._closed:
-            return
+            return None
         self._closed = True
+        later: Callable[[], None] | None = None
         try:
             factors = overview_factors(self.width, self.height) if overviews else []
             levels = None
@@ -559,13 +566,22 @@ class GeoTiffWriter:
                     levels = None
             self._ovr = None
             if self.backend == "gdal":
-                if factors and levels is not None:
-                    self._ds.BuildOverviews("NONE", factors)  # the levels made, not computed
-                    _write_levels_gdal(self._ds, levels)
-                elif factors:
-                    self._ds.BuildOverviews("AVERAGE", factors)
-                self._ds.FlushCache()
-                self._ds = None
+                held, self._ds = [self._ds], None
+
+                def finish() -> None:
+                    ds = held.pop()
+                    if factors and levels is not None:
+                        ds.BuildOverviews("NONE", factors)  # the levels made, not computed
+                        _write_levels_gdal(ds, levels)
+                    elif factors:
+                        ds.BuildOverviews("AVERAGE", factors)
+                    ds.FlushCache()
+                    del ds  # the last reference: the file is closed here
+
+                if levels is not None:
+                    later = finish
+                else:
+                    finish()
             else:
                 from rasterio.enums import Resampling
 
@@ -573,10 +589,20 @@ class GeoTiffWriter:
                     self._ds.build_overviews(factors, Resampling.average)
                 self._ds.close()
                 if factors and levels is not None:
-                    _write_levels_rasterio(self.path, factors, levels, self._level)
+                    path, level = self.path, self._level
+
+                    def later() -> None:
+                        _write_levels_rasterio(path, factors, levels, level)
+
         finally:
             if self.backend == "rasterio":
                 self._env.__exit__(None, None, None)
+        if later is None:
+            return None
+        if finish_in is None:
+            later()
+            return None
+        return finish_in.submit(later)
 
 
 def _mask_bytes(valid: NDArray) -> NDArray[np.uint8]:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 import math
 import os
+from concurrent.futures import Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -182,45 +183,62 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         log.warning("the DSM does not cover all of %d image(s) (share of the image's border "
                     "beyond it: %s): no data there", len(beyond),
                     ", ".join(f"{k} {round(100 * v)} %" for k, v in beyond.items()))  # fmt: skip
-    with OutputSet({k: str(p) for k, p in targets.items()}, inputs) as files:
-        for m, f in enumerate(images):
-            name = f.stem
-            proj = projectors[name]
-            box = tuple(v.extent) if v.extent else boxes[name]
-            if box is None:
-                log.warning("image %s does not overlap the DSM: no orthophoto", name)
-                continue
-            grid = ortho_grid(box, gsd)
-            sub = None if work is None else (
-                lambda fr, m=m: work((m + fr) / len(images)))  # fmt: skip
-            centre_px = camera.principal_point_px
-            nadir = proj.ground_points([centre_px], ground_z[name])[0]
-            meta = {
-                "LIDARPHOTO_IMAGE_ID": name,
-                "LIDARPHOTO_SOURCE": os.path.basename(str(f)),
-                "LIDARPHOTO_CENTRE": ",".join(repr(float(c)) for c in proj.xyz),
-                "LIDARPHOTO_GROUND_Z": repr(float(ground_z[name])),
-                "LIDARPHOTO_PRINCIPAL_GROUND": ",".join(repr(float(c)) for c in nadir),
-                "LIDARPHOTO_TRUE_ORTHO": "yes" if options.true_ortho else "no",
-            }
-            valid = occluded = 0
-            with RasterReader(f) as src:
-                info = src.info
-                photometric = "RGB" if info.bands == 3 and info.dtype == np.uint8 else None
-                with GeoTiffWriter(files.path(name), grid.cols, grid.rows, info.bands,
-                                   info.dtype, grid.geotransform, mapping, mask=True,
-                                   tile=512, photometric=photometric, metadata=meta,
-                                   **compression_args(v.compression)) as writer:  # fmt: skip
-                    for tile in _tiles(proj, grid, src, info, options, sub, should_stop):
-                        writer.write(tile.data, tile.col0, tile.row0, tile.valid)
-                        valid += int(np.count_nonzero(tile.valid))
-                        occluded += tile.occluded
-            total_valid += valid
-            total_occluded += occluded
-            written.append(OrthoFile(name, str(targets[name]), grid.cols, grid.rows, valid,
-                                     occluded))  # fmt: skip
-            log.info("%s: %d x %d cells of %g, %d with data%s", name, grid.cols, grid.rows, gsd,
-                     valid, f", {occluded} occluded" if options.true_ortho else "")  # fmt: skip
+    # an image's overview levels are written (GDAL compressing them) while the next image's
+    # tiles are computed; the files are renamed into place once all are whole
+    finishing: list[Future] = []
+    with OutputSet({k: str(p) for k, p in targets.items()}, inputs) as files, \
+            ThreadPoolExecutor(max_workers=1) as finisher:  # fmt: skip
+        try:
+            for m, f in enumerate(images):
+                name = f.stem
+                proj = projectors[name]
+                box = tuple(v.extent) if v.extent else boxes[name]
+                if box is None:
+                    log.warning("image %s does not overlap the DSM: no orthophoto", name)
+                    continue
+                grid = ortho_grid(box, gsd)
+                sub = None if work is None else (
+                    lambda fr, m=m: work((m + fr) / len(images)))  # fmt: skip
+                centre_px = camera.principal_point_px
+                nadir = proj.ground_points([centre_px], ground_z[name])[0]
+                meta = {
+                    "LIDARPHOTO_IMAGE_ID": name,
+                    "LIDARPHOTO_SOURCE": os.path.basename(str(f)),
+                    "LIDARPHOTO_CENTRE": ",".join(repr(float(c)) for c in proj.xyz),
+                    "LIDARPHOTO_GROUND_Z": repr(float(ground_z[name])),
+                    "LIDARPHOTO_PRINCIPAL_GROUND": ",".join(repr(float(c)) for c in nadir),
+                    "LIDARPHOTO_TRUE_ORTHO": "yes" if options.true_ortho else "no",
+                }
+                valid = occluded = 0
+                with RasterReader(f) as src:
+                    info = src.info
+                    photometric = "RGB" if info.bands == 3 and info.dtype == np.uint8 else None
+                    writer = GeoTiffWriter(files.path(name), grid.cols, grid.rows, info.bands,
+                                           info.dtype, grid.geotransform, mapping, mask=True,
+                                           tile=512, photometric=photometric, metadata=meta,
+                                           **compression_args(v.compression))  # fmt: skip
+                    try:
+                        for tile in _tiles(proj, grid, src, info, options, sub, should_stop):
+                            writer.write(tile.data, tile.col0, tile.row0, tile.valid)
+                            valid += int(np.count_nonzero(tile.valid))
+                            occluded += tile.occluded
+                    except BaseException:
+                        writer.close(overviews=False)
+                        raise
+                    job = writer.close(finish_in=finisher)
+                    if job is not None:
+                        finishing.append(job)
+                total_valid += valid
+                total_occluded += occluded
+                written.append(OrthoFile(name, str(targets[name]), grid.cols, grid.rows, valid,
+                                         occluded))  # fmt: skip
+                log.info("%s: %d x %d cells of %g, %d with data%s", name, grid.cols, grid.rows,
+                         gsd, valid,
+                         f", {occluded} occluded" if options.true_ortho else "")  # fmt: skip
+        finally:
+            wait(finishing)  # no file is still being written when the set is discarded
+        for job in finishing:
+            job.result()  # a failure to write an image's levels fails the job: nothing renamed
         files.commit()
     frac = total_occluded / max(total_valid + total_occluded, 1)
     lines = [f"{len(written)} orthophoto(s) of {gsd:g} in {folder}"

@@ -376,3 +376,40 @@ def _values(argv: list[str]) -> dict:
     args = build_parser().parse_args(argv)
     return {p.name: getattr(args, p.name) for p in args.job.SPEC.params
             if p.kind != "sink" and getattr(args, p.name) is not None}  # fmt: skip
+
+
+def test_levels_finished_during_the_next_image_are_whole(block, tmp_path):
+    """The first image's overview levels are written while the second image is computed:
+    each file equals the one made by a job of that image alone."""
+    from test_raster_overviews import _levels
+
+    both = tmp_path / "both"
+    run_job(orthorectify, _values(_args(block, both)))
+    for name in ("ne", "sw"):
+        alone = tmp_path / name
+        args = _args(block, alone)
+        args[args.index("--images") + 1] = str(block["images"] / f"{name}.tif")
+        run_job(orthorectify, _values(args))
+        a, b = both / f"{name}_ortho.tif", alone / f"{name}_ortho.tif"
+        ia, da, ma = _read(a)
+        _, db, mb = _read(b)
+        np.testing.assert_array_equal(da, db)
+        np.testing.assert_array_equal(ma, mb)
+        n = len(overview_factors(ia.width, ia.height))
+        assert n >= 1
+        for (la, mla), (lb, mlb) in zip(_levels(a, n), _levels(b, n)):
+            np.testing.assert_array_equal(la, lb)
+            np.testing.assert_array_equal(mla, mlb)
+
+
+def test_a_failure_writing_the_levels_leaves_nothing(block, tmp_path, monkeypatch):
+    from lidarphoto.core.io import raster
+
+    def fail(*args):
+        raise OSError("disk full (simulated)")
+
+    monkeypatch.setattr(raster, "_write_levels_rasterio", fail)
+    monkeypatch.setattr(raster, "_write_levels_gdal", fail)
+    with pytest.raises(OSError, match="simulated"):
+        run_job(orthorectify, _values(_args(block, tmp_path / "out")))
+    assert not any((tmp_path / "out").iterdir())
