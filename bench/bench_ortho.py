@@ -6,6 +6,8 @@ Run (figures in bench/ortho.md)::
 
     python3 -m venv /tmp/orthority-venv && /tmp/orthority-venv/bin/pip install orthority==0.7.0
     .venv/bin/python bench/bench_ortho.py --orthority-python /tmp/orthority-venv/bin/python
+    .venv/bin/python bench/bench_ortho.py --set --orthority-python /tmp/orthority-venv/bin/python
+    .venv/bin/python bench/bench_ortho.py --large
 
 orthority (pip package, GPL/AGPL-free peer by Dugal Harris) lives in its own throw-away venv: it
 needs ``opencv-python``, which clashes with our ``opencv-python-headless``; each run of either
@@ -39,6 +41,7 @@ import json
 import math
 import os
 import platform
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -78,6 +81,29 @@ pts = np.array(a["points"], float).T
 px = cam.world_to_pixel(pts).T
 hwm = [int(x.split()[1]) for x in open("/proc/self/status") if x.startswith("VmHWM")][0]
 print(json.dumps({"seconds": t, "cpu": cpu, "maxrss_mb": hwm / 1024, "pixels": px.tolist()}))
+"""
+
+ORTHORITY_SET = r"""
+import json, sys, time, warnings
+warnings.simplefilter("ignore")
+from orthority.camera import PinholeCamera
+from orthority.ortho import Ortho
+a = json.loads(sys.argv[1])
+import resource
+u0 = resource.getrusage(resource.RUSAGE_SELF)
+t0 = time.perf_counter()
+for im in a["images"]:  # one image after the other, as its command line does
+    cam = PinholeCamera(tuple(a["size"]), a["focal_mm"], sensor_size=tuple(a["sensor_mm"]),
+                        cx=a["cx"], cy=a["cy"], xyz=tuple(im["xyz"]), opk=tuple(im["opk"]))
+    Ortho(im["image"], a["dem"], cam, crs=a["crs"]).process(
+        im["out"], resolution=(a["gsd"], a["gsd"]), interp="bilinear", dem_interp="bilinear",
+        write_mask=True, creation_options=a["creation"], build_ovw=True, overwrite=True,
+        aligned_pixels=True)
+t = time.perf_counter() - t0
+u1 = resource.getrusage(resource.RUSAGE_SELF)
+cpu = u1.ru_utime + u1.ru_stime - u0.ru_utime - u0.ru_stime
+hwm = [int(x.split()[1]) for x in open("/proc/self/status") if x.startswith("VmHWM")][0]
+print(json.dumps({"seconds": t, "cpu": cpu, "maxrss_mb": hwm / 1024}))
 """
 
 OURS = r"""
@@ -281,6 +307,70 @@ print(json.dumps({"seconds": t, "maxrss_mb": hwm / 1024}))
 """
 
 
+def _cells(folder: Path) -> int:
+    from lidarphoto.core.io.raster import RasterReader
+
+    total = 0
+    for path in sorted(folder.glob("*.tif")):
+        with RasterReader(path) as src:
+            total += src.info.width * src.info.height
+    return total
+
+
+def image_set(args) -> dict:
+    """The demo's images in one run of each tool (fresh processes, alternating, best of
+    ``--repeats``): orthority one image after the other in one process (its command line's
+    way), ours one orthorectify job (its default extents: each image's footprint on the
+    DSM). Throughput in cells of the files written per second."""
+    from lidarphoto.core.io.camera import read_camera_json
+    from lidarphoto.core.io.orientation import read_eo_csv
+
+    if not args.orthority_python:
+        raise SystemExit("--set needs --orthority-python")
+    _demo(args.demo)
+    cam = read_camera_json(args.demo / "flight" / "camera.json")
+    eo = read_eo_csv(args.demo / "flight" / "eo_true.csv")
+    n = min(args.images, len(eo))
+    images = [args.demo / "flight" / "images" / f"{i}.tif" for i in eo.image_id[:n]]
+    work = Path(tempfile.mkdtemp(prefix="bench_ortho_set_"))
+    peer_dir, ours_dir = work / "orthority", work / "ours"
+    peer_dir.mkdir()
+    base = _peer_camera(cam, eo, 0)
+    peer_arg = {**{k: base[k] for k in ("size", "focal_mm", "sensor_mm", "cx", "cy")},
+                "dem": str(args.demo / "lidar" / "dsm.tif"), "crs": CRS, "gsd": GSD,
+                "creation": CREATION,
+                "images": [{"image": str(images[k]), "xyz": eo.xyz[k].tolist(),
+                            "opk": eo.opk[k].tolist(),
+                            "out": str(peer_dir / f"{eo.image_id[k]}.tif")} for k in range(n)]}
+    values = {"CAMERA": str(args.demo / "flight" / "camera.json"),
+              "EO": str(args.demo / "flight" / "eo_true.csv"),
+              "IMAGES": [str(p) for p in images], "DSM": str(args.demo / "lidar" / "dsm.tif"),
+              "CRS": CRS, "GSD": GSD, "RESAMPLING": "bilinear", "TRUE_ORTHO": False,
+              "OUTPUT_FOLDER": str(ours_dir)}  # fmt: skip
+    load_start = os.getloadavg()[0]
+    best = {"orthority": None, "ours": None}
+    for _ in range(args.repeats):
+        for tool in ("orthority", "ours"):
+            if tool == "ours" and ours_dir.exists():
+                shutil.rmtree(ours_dir)
+            got = (_run(args.orthority_python, ORTHORITY_SET, peer_arg) if tool == "orthority"
+                   else _run(sys.executable, OURS, {"values": values}))  # fmt: skip
+            if best[tool] is None or got["seconds"] < best[tool]["seconds"]:
+                best[tool] = got
+    out = {"date": datetime.date.today().isoformat(), "cpus": os.cpu_count(),
+           "load_start": load_start, "images": n, "repeats": args.repeats}  # fmt: skip
+    for tool, folder in (("orthority", peer_dir), ("ours", ours_dir)):
+        cells = _cells(folder)
+        out[tool] = {**best[tool], "cells": cells,
+                     "mcells_per_s": cells / best[tool]["seconds"] / 1e6,
+                     "mcells_per_cpu_s": cells / best[tool]["cpu"] / 1e6}  # fmt: skip
+    out["speed_ratio"] = out["ours"]["mcells_per_s"] / out["orthority"]["mcells_per_s"]
+    out["cpu_ratio"] = out["ours"]["mcells_per_cpu_s"] / out["orthority"]["mcells_per_cpu_s"]
+    out["load_end"] = os.getloadavg()[0]
+    shutil.rmtree(work)
+    return out
+
+
 def large_frame(work: Path) -> dict:
     """Memory and time for one 196 Mpx frame (UltraCam XP size, 17310 x 11310, 8-bit RGB,
     tiled): its orthophoto at the image's GSD on a flat DSM, in a fresh process."""
@@ -344,7 +434,15 @@ def main() -> int:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--json", type=Path, default=None, help="write the figures here")
     ap.add_argument("--large", action="store_true", help="only the 196 Mpx frame")
+    ap.add_argument("--set", action="store_true",
+                    help="only the whole set of images in one run of each tool")  # fmt: skip
     args = ap.parse_args()
+    if args.set:
+        res = image_set(args)
+        print(json.dumps(res, indent=1))
+        if args.json:
+            args.json.write_text(json.dumps(res, indent=1), encoding="utf-8")
+        return 0
     if args.large:
         res = large_frame(Path(tempfile.mkdtemp(prefix="bench_ortho_large_")))
         print(json.dumps(res, indent=1))
