@@ -2,8 +2,8 @@
 collinearity and lens lookup of every orthophoto cell in one pass, the same arithmetic as the
 vectorised numpy version (the tests compare them cell by cell).
 
-numba is optional (:data:`AVAILABLE`); without it the numpy version runs (10x slower: 2.2 CPU
-s instead of 0.22 for 10 M cells).
+numba is optional (:data:`AVAILABLE`); without it the numpy version runs (29x slower: 2.1 CPU
+s instead of 0.074 for the 11.8 M cells of a demo orthophoto).
 The compiled function releases the GIL, so that tiles run in parallel threads.
 """
 
