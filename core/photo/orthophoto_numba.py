@@ -181,28 +181,10 @@ def _remap_maps_fixed(col, row, c0, r0, xy, alpha):
     return n
 
 
-def _valid_bounds(col, row):
-    """(cells with a pixel, smallest col, largest col, smallest row, largest row) of the
-    finite cells, in one pass (infinite bounds when none)."""
-    n = 0
-    c_lo = r_lo = math.inf
-    c_hi = r_hi = -math.inf
-    for i in range(col.shape[0]):
-        for j in range(col.shape[1]):
-            c = col[i, j]
-            if math.isfinite(c):
-                n += 1
-                r = row[i, j]
-                c_lo = min(c_lo, c)
-                c_hi = max(c_hi, c)
-                r_lo = min(r_lo, r)
-                r_hi = max(r_hi, r)
-    return n, c_lo, c_hi, r_lo, r_hi
-
-
 def _cell_stats(col, row, z, valid):
-    """:func:`_valid_bounds` that also fills ``valid`` (col finite) and counts the cells
-    without a height (z NaN), in the same pass."""
+    """Fill ``valid`` (col finite); (valid cells, cells whose z is not finite, smallest col,
+    largest col, smallest row, largest row of the valid cells) in one pass (infinite bounds
+    when none)."""
     n = 0
     no_z = 0
     c_lo = r_lo = math.inf
@@ -230,7 +212,7 @@ _COMPILED: dict[str, Callable[..., Any]] = {}
 def _compiled(name: str) -> Callable[..., Any]:
     if name not in _COMPILED:
         func = {"cells": _cell_pixels, "maps": _remap_maps, "fixed": _remap_maps_fixed,
-                "bounds": _valid_bounds, "stats": _cell_stats}[name]  # fmt: skip
+                "stats": _cell_stats}[name]  # fmt: skip
         # numpy's error model: a float division by zero gives inf (checked after), with no
         # test per division that would keep the cell loop from being vectorised
         _COMPILED[name] = numba.njit(cache=True, nogil=True, error_model="numpy")(func)
@@ -278,13 +260,8 @@ def remap_maps_fixed(
 
 def valid_bounds(col: np.ndarray, row: np.ndarray) -> tuple[int, float, float, float, float]:
     """(count, col min, col max, row min, row max) over the cells whose col is finite."""
-    if AVAILABLE:
-        return _compiled("bounds")(col, row)
-    ok = np.isfinite(col)
-    if not ok.any():
-        return 0, math.inf, -math.inf, math.inf, -math.inf
-    cv, rv = col[ok], row[ok]
-    return int(ok.sum()), float(cv.min()), float(cv.max()), float(rv.min()), float(rv.max())
+    _, n, _, *bounds = cell_stats(col, row, col)
+    return (n, *bounds)
 
 
 def cell_stats(
@@ -297,5 +274,9 @@ def cell_stats(
         n, no_z, *bounds = _compiled("stats")(col, row, z, valid)
         return (valid, n, no_z, *bounds)
     valid = np.isfinite(col)
-    n, *bounds = valid_bounds(col, row)
-    return (valid, n, int(np.count_nonzero(~np.isfinite(z))), *bounds)
+    no_z = int(np.count_nonzero(~np.isfinite(z)))
+    if not valid.any():
+        return valid, 0, no_z, math.inf, -math.inf, math.inf, -math.inf
+    cv, rv = col[valid], row[valid]
+    return (valid, int(valid.sum()), no_z, float(cv.min()), float(cv.max()), float(rv.min()),
+            float(rv.max()))  # fmt: skip
