@@ -624,9 +624,9 @@ def _write_levels_gdal(ds: Any, levels: list) -> None:
         mask = ds.GetRasterBand(1).GetMaskBand().GetOverview(k)
         m = _mask_bytes(valid)
         for r0 in range(0, rows, _LEVEL_ROWS):  # as in _write_levels_rasterio
-            part = np.moveaxis(data[:, r0 : r0 + _LEVEL_ROWS], 0, -1)
+            part = np.ascontiguousarray(np.moveaxis(data[:, r0 : r0 + _LEVEL_ROWS], 0, -1))
             n = part.shape[0]
-            level.WriteRaster(0, r0, cols, n, np.ascontiguousarray(part).data, cols, n,
+            level.WriteRaster(0, r0, cols, n, part.data, cols, n,
                               band_list=list(range(1, nb + 1)),
                               buf_pixel_space=part.strides[1], buf_line_space=part.strides[0],
                               buf_band_space=part.strides[2])  # fmt: skip

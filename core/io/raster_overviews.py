@@ -3,12 +3,13 @@ same pixels as GDAL's ``AVERAGE`` overviews of the written file (bit for bit).
 
 GDAL (``BuildOverviews("AVERAGE")``) reads the whole written file back, decompresses it and
 computes each level from the previous one. Here level 1 is computed from the rows of blocks as
-they are written (:class:`OverviewBuilder`), the deeper levels from level 1 in memory, and the
-file gets them written directly (:mod:`core.io.raster`). The arithmetic is GDAL's (3.x,
-``GDALResampleChunk_AverageOrRMS`` with a mask): a level of ``n_dst = ceil(n_src / 2)`` cells
-along an axis takes for cell j the source interval ``[j r, (j + 1) r)``, ``r = n_src / n_dst``
-(exactly 2 for an even ``n_src``, slightly less for an odd one): whole pixels count 1, the
-pixels cut by the interval's ends their covered fraction. Masked pixels count 0; the value is
+they are written (:class:`OverviewBuilder`), each deeper level from the rows of the one above
+as they are made, and the file gets them written directly (:mod:`core.io.raster`). The
+arithmetic is GDAL's (3.x, ``GDALResampleChunk_AverageOrRMS`` with a mask): a level of
+``n_dst = ceil(n_src / 2)`` cells along an axis takes for cell j the source interval
+``[j r, (j + 1) r)``, ``r = n_src / n_dst`` (exactly 2 for an even ``n_src``, slightly less
+for an odd one): whole pixels count 1, the pixels cut by the interval's ends their covered
+fraction. Masked pixels count 0; the value is
 ``int(sum(w v) / sum(w) + 0.5)`` in double precision, summed in GDAL's order (along each row
 first, then over the rows); a cell whose window has no valid pixel is 0 and masked.
 """
@@ -233,7 +234,8 @@ class OverviewBuilder:
     :meth:`add` takes each block as it is written; level 1 is computed as soon as the rows
     its windows need are complete (the blocks' rows in any order within a band of rows, the
     bands of rows from top to bottom), so only a band of full-resolution rows is held, and
-    level 1 (a quarter of the raster). A block that comes back above the rows already
+    the levels (level 1 a quarter of the raster); each deeper level grows the same way from
+    the rows of the one above as they are made. A block that comes back above the rows already
     consumed makes :meth:`add` return False: the caller then lets GDAL build the overviews.
     """
 

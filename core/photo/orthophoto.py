@@ -299,8 +299,9 @@ class OrthoProjector:
     lens: tuple[Array, float, float, float]
     z_range: tuple[float, float] = (0.0, 0.0)
     # the lattice of a whole grid, made once for its tiles (_lattice)
-    _lattices: dict = field(default_factory=dict, compare=False, repr=False)
-    _lock: threading.Lock = field(default_factory=threading.Lock, compare=False, repr=False)
+    _lattices: dict = field(default_factory=dict, init=False, compare=False, repr=False)
+    _lock: threading.Lock = field(default_factory=threading.Lock, init=False, compare=False,
+                                  repr=False)  # fmt: skip
 
     @classmethod
     def build(
