@@ -307,6 +307,14 @@ print(json.dumps({"seconds": t, "maxrss_mb": hwm / 1024}))
 """
 
 
+def _emit(res: dict, path: Path | None) -> int:
+    """Print the figures, and write them to ``path`` when given."""
+    print(json.dumps(res, indent=1))
+    if path:
+        path.write_text(json.dumps(res, indent=1), encoding="utf-8")
+    return 0
+
+
 def _cells(folder: Path) -> int:
     from lidarphoto.core.io.raster import RasterReader
 
@@ -439,16 +447,10 @@ def main() -> int:
     args = ap.parse_args()
     if args.set:
         res = image_set(args)
-        print(json.dumps(res, indent=1))
-        if args.json:
-            args.json.write_text(json.dumps(res, indent=1), encoding="utf-8")
-        return 0
+        return _emit(res, args.json)
     if args.large:
         res = large_frame(Path(tempfile.mkdtemp(prefix="bench_ortho_large_")))
-        print(json.dumps(res, indent=1))
-        if args.json:
-            args.json.write_text(json.dumps(res, indent=1), encoding="utf-8")
-        return 0
+        return _emit(res, args.json)
 
     from lidarphoto.core.geometry.collinearity import project
     from lidarphoto.core.geometry.rotations import matrix_to_opk

@@ -267,8 +267,8 @@ def valid_bounds(col: np.ndarray, row: np.ndarray) -> tuple[int, float, float, f
 def cell_stats(
     col: np.ndarray, row: np.ndarray, z: np.ndarray
 ) -> tuple[np.ndarray, int, int, float, float, float, float]:
-    """(valid: col finite, its count, cells whose z is NaN, col min, col max, row min, row max
-    over the valid cells) in one pass."""
+    """(valid: col finite, its count, cells whose z is not finite, col min, col max, row min,
+    row max over the valid cells) in one pass."""
     if AVAILABLE:
         valid = np.empty(col.shape, np.bool_)
         n, no_z, *bounds = _compiled("stats")(col, row, z, valid)

@@ -151,7 +151,8 @@ def test_eo_map_local_round_trip(frame):
     np.testing.assert_allclose([w, p, k], [0.0, 0.0, 0.7 + theta], atol=1e-12)
 
 
-@pytest.mark.parametrize("code", ["EPSG:28992", "EPSG:2154", "EPSG:32633", "EPSG:3857"])
+@pytest.mark.parametrize("code", ["EPSG:28992", "EPSG:2154", "EPSG:32633", "EPSG:3857",
+                                  "ESRI:53004"])  # the last on a sphere
 def test_ecef_conversions_equal_proj_search(code):
     """The geodetic <-> ECEF pipelines written directly give PROJ's own transformation (found
     by its search of the database) to the last bit."""
