@@ -46,6 +46,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from .scaling import jacobi_scale, scale_constraints
 
 Array = NDArray[np.float64]
 Index = NDArray[np.intp]
@@ -802,11 +803,7 @@ def build_reduced_normal(
                             minlength=n)  # fmt: skip
         grad += np.bincount(bk.param_index.ravel(),
                             weights=(w[:, None, :] @ A)[:, 0, :].ravel(), minlength=n)  # fmt: skip
-    d = np.sqrt(np.clip(diag, 0.0, None))
-    if C is not None:
-        cn = np.sqrt(np.asarray(C.multiply(C).sum(axis=0)).ravel())
-        d = np.where(d > 0, d, cn)
-    d = np.where(d > 0, d, 1.0)
+    d = jacobi_scale(np.sqrt(np.clip(diag, 0.0, None)), C)
     dinv = 1.0 / d
     mc = 0 if C is None else C.shape[0]
     plan.finish(mc)
@@ -856,7 +853,7 @@ def build_reduced_normal(
                     T[bp.cset] = bp.c_reducer.sum_outer(
                         lambda it, Rc=Rc: Rc[it], lambda it, Ew=Ew: Ew[it], kc, b
                     )
-    # blocks whose every group is set aside (see adjustment._cascade) stay where they are:
+    # blocks whose every group is set aside (see outliers._cascade) stay where they are:
     # a unit block keeps the reduced system regular and their step zero
     dead = np.einsum("pii->p", V) == 0.0
     if dead.any():
@@ -866,12 +863,7 @@ def build_reduced_normal(
     ns = grad * dinv
     hs = np.zeros(0)
     if C is not None:
-        Cd = sp.csr_matrix(C @ sp.diags(dinv))
-        if rowscale is None:
-            rn = np.sqrt(np.asarray(Cd.multiply(Cd).sum(axis=1)).ravel())
-            rowscale = np.where(rn > 0, 1.0 / np.where(rn > 0, rn, 1.0), 1.0)
-        Cs = sp.csr_matrix(sp.diags(rowscale) @ Cd)
-        hs = rowscale * h
+        Cs, hs, rowscale = scale_constraints(C, dinv, h, rowscale)
         Cr = Cs[:, plan.reduced].tocoo()
         # the borders of U+: C_r at rows n_r.., and its transpose
         urows += [n_r + Cr.row, Cr.col]

@@ -12,7 +12,7 @@ import time
 import numpy as np
 import pytest
 from lidarphoto.core.errors import AdjustmentError, Cancelled, InputError, NotObservableError
-from lidarphoto.core.lsq import adjustment as adj
+from lidarphoto.core.lsq import observability, solve
 from lidarphoto.core.lsq.adjustment import adjust
 from lidarphoto.core.lsq.model import (
     AdjustmentOptions,
@@ -692,7 +692,8 @@ def test_medium_network_sparse_equals_dense(monkeypatch):
         auto.cofactor, dense.cofactor, rtol=1e-8, atol=1e-10 * np.abs(dense.cofactor).max()
     )
     # The large-system path: sparse LU observability check and column-wise sparse Qxx.
-    monkeypatch.setattr(adj, "_DENSE_ANALYSIS_MAX_N", 100)
+    monkeypatch.setattr(observability, "_DENSE_ANALYSIS_MAX_N", 100)
+    monkeypatch.setattr(solve, "_DENSE_ANALYSIS_MAX_N", 100)
     big = adjust(x0, names, blocks)
     np.testing.assert_allclose(big.x, dense.x, rtol=0, atol=1e-9)
     np.testing.assert_allclose(
@@ -702,7 +703,7 @@ def test_medium_network_sparse_equals_dense(monkeypatch):
     with pytest.raises(NotObservableError) as info:
         adjust(x0, names, blocks[:1])
     assert sorted(info.value.parameters) == sorted(names)
-    monkeypatch.setattr(adj, "_DENSE_FALLBACK_MAX_N", 100)
+    monkeypatch.setattr(observability, "_DENSE_FALLBACK_MAX_N", 100)
     with pytest.raises(NotObservableError, match="too large"):
         adjust(x0, names, blocks[:1])
 

@@ -1,0 +1,398 @@
+"""The validated problem of an adjustment: observation blocks and constraints checked and
+prepared (covariance factors, weights), their batched evaluation and whitening at one
+linearisation point, and the assembly of the Jacobi-scaled normal equations (full, or reduced
+by :mod:`.schur`). The method is described in :mod:`.adjustment`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Callable, Union
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import AdjustmentError, InputError
+from .model import GaussHelmertBlock, GaussMarkovBlock, _PriorModel
+from .scaling import jacobi_scale, scale_constraints
+from .schur import EliminationPlan, build_reduced_normal
+
+Array = NDArray[np.float64]
+Block = Union[GaussMarkovBlock, GaussHelmertBlock]
+
+
+class _NonFiniteError(Exception):
+    """A model returned NaN/inf (caught: a rejected step, or reported with context)."""
+
+    def __init__(self, block: str, label: str) -> None:
+        super().__init__(f"block '{block}' returned non-finite values (group {label})")
+        self.block = block
+        self.label = label
+
+
+@dataclass
+class _Obs:
+    """A validated observation block (Gauss-Markov or Gauss-Helmert)."""
+
+    name: str
+    gauss_markov: bool
+    observed: Array  # (G, o)
+    cov: Array  # (G, o, o)
+    weight: Array  # (G, o, o) = cov^-1
+    chol: Array  # (G, o, o) lower Cholesky factor of cov
+    chol_inv: Array  # (G, o, o)
+    param_index: NDArray[np.intp]  # (G, k)
+    func: Callable
+    labels: list[str]
+    row_names: list[str]
+    c: int | None  # condition rows per group (known after the first evaluation)
+
+    @property
+    def groups(self) -> int:
+        return self.observed.shape[0]
+
+    @property
+    def o(self) -> int:
+        return self.observed.shape[1]
+
+    @property
+    def k(self) -> int:
+        return self.param_index.shape[1]
+
+
+@dataclass
+class _Con:
+    name: str
+    param_index: NDArray[np.intp]
+    func: Callable
+    labels: list[str]
+    c: int | None
+
+
+@dataclass
+class _BlockLin:
+    """Whitened linearisation of one block: rows of all groups, rejected ones included."""
+
+    abar: Array  # (G, c, k) = L^-1 A
+    wbar: Array  # (G, c) = L^-1 w
+    K: Array  # (G, o, c) = S B' L^-T, so that v = -K (A_ dx + w_)
+
+
+@dataclass
+class _Lin:
+    x: Array
+    vhat: list[Array]
+    blocks: list[_BlockLin]
+    h: Array  # (mc,)
+    H: list[Array]  # per constraint (G, c, k)
+    phi: float  # ||w_||^2 over the groups kept
+
+
+@dataclass
+class _Normal:
+    """Jacobi-scaled normal equations at one linearisation."""
+
+    A: sp.csr_matrix  # whitened design (m x n), rejected rows zero
+    d: Array  # (n,) Jacobi scale sqrt(diag N)
+    Ns: sp.csr_matrix  # D^-1 N D^-1
+    ns: Array  # D^-1 A_' w_
+    Cs: sp.csr_matrix | None  # R C D^-1
+    hs: Array  # R h
+    dense: Array | None = None  # cached Ns.toarray()
+
+
+def _as_index(value: ArrayLike, n: int, where: str) -> NDArray[np.intp]:
+    idx = np.asarray(value)
+    if idx.ndim != 2:
+        raise InputError(f"{where}: param_index must have shape (G, k), got {idx.shape}")
+    if idx.size and not np.issubdtype(idx.dtype, np.integer):
+        raise InputError(f"{where}: param_index must be integers, got {idx.dtype}")
+    idx = idx.astype(np.intp)
+    if idx.size and (idx.min() < 0 or idx.max() >= n):
+        raise InputError(f"{where}: param_index outside 0..{n - 1}")
+    return idx
+
+
+def _labels(
+    given: Sequence[str] | None, count: int, default: Callable[[int], str], where: str, what: str
+) -> list[str]:
+    if given is None:
+        return [default(i) for i in range(count)]
+    out = [str(s) for s in given]
+    if len(out) != count:
+        raise InputError(f"{where}: {what} has {len(out)} entries, expected {count}")
+    return out
+
+
+def _prepare_block(block: Block, n: int, names: list[str]) -> _Obs:
+    """Validate a block and precompute the constant parts (covariance factors, weights)."""
+    where = f"block '{block.name}'"
+    gm = isinstance(block, GaussMarkovBlock)
+    if not gm and not isinstance(block, GaussHelmertBlock):
+        raise InputError(f"{where}: not a GaussMarkovBlock or GaussHelmertBlock")
+    obs = np.asarray(block.observed, dtype=np.float64)
+    if obs.ndim != 2:
+        raise InputError(f"{where}: observed must have shape (G, c), got {obs.shape}")
+    g, o = obs.shape
+    if not np.isfinite(obs).all():
+        raise InputError(f"{where}: observed contains NaN or inf")
+    idx = _as_index(block.param_index, n, where)
+    if idx.shape[0] != g:
+        raise InputError(f"{where}: param_index has {idx.shape[0]} groups, observed has {g}")
+    sig = np.asarray(block.sigma, dtype=np.float64)
+    if sig.ndim == 3:
+        try:
+            cov = np.array(np.broadcast_to(sig, (g, o, o)))
+        except ValueError:
+            raise InputError(f"{where}: sigma of shape {sig.shape} is not (G, c, c)") from None
+        if not np.isfinite(cov).all() or not np.allclose(cov, np.swapaxes(cov, 1, 2)):
+            raise InputError(f"{where}: covariance matrices must be finite and symmetric")
+    else:
+        try:
+            s = np.broadcast_to(sig, (g, o))
+        except ValueError:
+            raise InputError(f"{where}: sigma of shape {sig.shape} is not (G, c)") from None
+        if not (np.isfinite(s).all() and (s > 0).all()):
+            raise InputError(f"{where}: sigma must be finite and > 0")
+        cov = np.zeros((g, o, o))
+        cov[:, np.arange(o), np.arange(o)] = s**2
+    try:
+        chol = np.linalg.cholesky(cov) if g else np.zeros((0, o, o))
+    except np.linalg.LinAlgError:
+        bad = np.flatnonzero(np.linalg.eigvalsh(cov)[:, 0] <= 0)
+        raise InputError(
+            f"{where}: covariance of group {int(bad[0]) if bad.size else '?'} is not "
+            "positive definite"
+        ) from None
+    chol_inv = np.linalg.inv(chol) if g else chol
+    weight = np.swapaxes(chol_inv, 1, 2) @ chol_inv
+    func = block.model if gm else block.condition
+    if isinstance(func, _PriorModel) and block.labels is None:
+        labels = [names[i] for i in idx[:, 0]]
+    else:
+        labels = _labels(block.labels, g, lambda i: f"{block.name}[{i}]", where, "labels")
+    row_names = _labels(block.row_names, o, str, where, "row_names")
+    return _Obs(
+        name=block.name,
+        gauss_markov=gm,
+        observed=obs,
+        cov=cov,
+        weight=weight,
+        chol=chol,
+        chol_inv=chol_inv,
+        param_index=idx,
+        func=func,
+        labels=labels,
+        row_names=row_names,
+        c=o if gm else None,
+    )
+
+
+def _check_finite(block: str, labels: list[str], *arrays: Array) -> None:
+    for a in arrays:
+        ok = np.isfinite(a.reshape(a.shape[0], -1)).all(axis=1)
+        if not ok.all():
+            raise _NonFiniteError(block, labels[int(np.flatnonzero(~ok)[0])])
+
+
+def _shape_error(where: str, what: str, got: tuple, want: tuple) -> InputError:
+    return InputError(f"{where}: {what} has shape {got}, expected {want}")
+
+
+class _Problem:
+    """The validated problem: blocks, constraints and the sparse assembly templates."""
+
+    def __init__(
+        self,
+        names: list[str],
+        blocks: list[_Obs],
+        constraints: list[_Con],
+        plan: EliminationPlan | None = None,
+    ) -> None:
+        self.names = names
+        self.n = len(names)
+        self.blocks = blocks
+        self.constraints = constraints
+        self.plan = plan
+        # Robust (IRLS) weights of the groups of each block, or None.
+        self.weights: list[Array] | None = None
+        self._row_template: tuple[NDArray[np.intp], NDArray[np.intp], int] | None = None
+        self._con_template: tuple[NDArray[np.intp], NDArray[np.intp], int] | None = None
+
+    # -- evaluation --------------------------------------------------------------------------
+
+    def _eval_block(self, b: _Obs, x: Array, vhat: Array) -> _BlockLin:
+        g, o, k = b.groups, b.o, b.k
+        where = f"block '{b.name}'"
+        xl = x[b.param_index]
+        if b.gauss_markov:
+            f, J = b.func(xl)
+            f = np.asarray(f, dtype=np.float64)
+            J = np.asarray(J, dtype=np.float64)
+            if f.shape != (g, o):
+                raise _shape_error(where, "model value f", f.shape, (g, o))
+            if J.shape != (g, o, k):
+                raise _shape_error(where, "model Jacobian J", J.shape, (g, o, k))
+            _check_finite(b.name, b.labels, f, J)
+            # B = -I: w = f - l does not depend on v^, and L is the Cholesky factor of S.
+            abar = b.chol_inv @ J
+            wbar = np.einsum("gij,gj->gi", b.chol_inv, f - b.observed)
+            K = -b.chol
+            return _BlockLin(abar=abar, wbar=wbar, K=K)
+        gv, A, B = b.func(xl, b.observed + vhat)
+        gv = np.asarray(gv, dtype=np.float64)
+        A = np.asarray(A, dtype=np.float64)
+        B = np.asarray(B, dtype=np.float64)
+        if gv.ndim != 2 or gv.shape[0] != g:
+            raise _shape_error(where, "condition value g", gv.shape, (g, "c"))
+        c = gv.shape[1]
+        if b.c is None:
+            b.c = c
+        elif c != b.c:
+            raise InputError(f"{where}: the number of conditions changed from {b.c} to {c}")
+        if A.shape != (g, c, k):
+            raise _shape_error(where, "condition Jacobian A", A.shape, (g, c, k))
+        if B.shape != (g, c, o):
+            raise _shape_error(where, "condition Jacobian B", B.shape, (g, c, o))
+        _check_finite(b.name, b.labels, gv, A, B)
+        w = gv - np.einsum("gco,go->gc", B, vhat)
+        SBt = b.cov @ np.swapaxes(B, 1, 2)  # (G, o, c)
+        M = B @ SBt
+        try:
+            L = np.linalg.cholesky(M)
+        except np.linalg.LinAlgError:
+            bad = np.flatnonzero(np.linalg.eigvalsh(M)[:, 0] <= 0)
+            label = b.labels[int(bad[0])] if bad.size else "?"
+            raise AdjustmentError(
+                f"{where}: B S B' is singular for group {label}: the conditions of a group "
+                "must be independent functions of its observations"
+            ) from None
+        Linv = np.linalg.inv(L)
+        abar = Linv @ A
+        wbar = np.einsum("gij,gj->gi", Linv, w)
+        K = SBt @ np.swapaxes(Linv, 1, 2)
+        return _BlockLin(abar=abar, wbar=wbar, K=K)
+
+    def _eval_constraint(self, c: _Con, x: Array) -> tuple[Array, Array]:
+        g, k = c.param_index.shape
+        where = f"constraint '{c.name}'"
+        h, H = c.func(x[c.param_index])
+        h = np.asarray(h, dtype=np.float64)
+        H = np.asarray(H, dtype=np.float64)
+        if h.ndim != 2 or h.shape[0] != g:
+            raise _shape_error(where, "value h", h.shape, (g, "c"))
+        if c.c is None:
+            c.c = h.shape[1]
+        elif h.shape[1] != c.c:
+            raise InputError(f"{where}: the number of rows changed from {c.c} to {h.shape[1]}")
+        if H.shape != (g, c.c, k):
+            raise _shape_error(where, "Jacobian H", H.shape, (g, c.c, k))
+        _check_finite(c.name, c.labels, h, H)
+        return h, H
+
+    def linearize(self, x: Array, vhat: list[Array], active: list[NDArray[np.bool_]]) -> _Lin:
+        """Evaluate every block and constraint at ``x`` (raises _NonFiniteError)."""
+        lins = [self._eval_block(b, x, v) for b, v in zip(self.blocks, vhat)]
+        if self.weights is not None:
+            for bl, wt in zip(lins, self.weights):
+                s = np.sqrt(wt)
+                bl.abar = bl.abar * s[:, None, None]
+                bl.wbar = bl.wbar * s[:, None]
+                bl.K = bl.K / s[:, None, None]
+        hs, Hs = [], []
+        for c in self.constraints:
+            h, H = self._eval_constraint(c, x)
+            hs.append(h.ravel())
+            Hs.append(H)
+        phi = float(sum(np.sum(bl.wbar[a] ** 2) for bl, a in zip(lins, active)))
+        h_all = np.concatenate(hs) if hs else np.zeros(0)
+        return _Lin(x=x, vhat=vhat, blocks=lins, h=h_all, H=Hs, phi=phi)
+
+    # -- assembly ----------------------------------------------------------------------------
+
+    @staticmethod
+    def _template(index_list: list[NDArray[np.intp]], rows_per_group: list[int]) -> tuple:
+        """CSR structure of stacked groups: every row of a group holds its k parameters."""
+        indices, indptr, start, nnz = [], [np.zeros(1, dtype=np.intp)], 0, 0
+        for idx, c in zip(index_list, rows_per_group):
+            g, k = idx.shape
+            indices.append(np.broadcast_to(idx[:, None, :], (g, c, k)).ravel())
+            indptr.append(nnz + k * np.arange(1, g * c + 1, dtype=np.intp))
+            nnz += g * c * k
+            start += g * c
+        ind = np.concatenate(indices) if indices else np.zeros(0, dtype=np.intp)
+        return ind, np.concatenate(indptr), start
+
+    def design(self, lin: _Lin, active: list[NDArray[np.bool_]]) -> tuple[sp.csr_matrix, Array]:
+        """Whitened design matrix (m, n) and misclosure (m,), rows of rejected groups zero."""
+        if self._row_template is None:
+            self._row_template = self._template(
+                [b.param_index for b in self.blocks], [int(b.c) for b in self.blocks]
+            )
+        ind, ptr, m = self._row_template
+        data = [(bl.abar * a[:, None, None]).ravel() for bl, a in zip(lin.blocks, active)]
+        wb = [(bl.wbar * a[:, None]).ravel() for bl, a in zip(lin.blocks, active)]
+        A = sp.csr_matrix(
+            (np.concatenate(data) if data else np.zeros(0), ind.copy(), ptr.copy()),
+            shape=(m, self.n),
+        )
+        # Repeated indices in a group are legitimate (the columns add up): merge them.
+        A.sum_duplicates()
+        return A, (np.concatenate(wb) if wb else np.zeros(0))
+
+    def constraint_matrix(self, lin: _Lin) -> sp.csr_matrix | None:
+        if not self.constraints:
+            return None
+        if self._con_template is None:
+            self._con_template = self._template(
+                [c.param_index for c in self.constraints], [int(c.c) for c in self.constraints]
+            )
+        ind, ptr, m = self._con_template
+        C = sp.csr_matrix(
+            (np.concatenate([H.ravel() for H in lin.H]), ind.copy(), ptr.copy()),
+            shape=(m, self.n),
+        )
+        C.sum_duplicates()
+        return C
+
+    def rows(self, active: list[NDArray[np.bool_]]) -> int:
+        return int(sum(int(b.c) * int(a.sum()) for b, a in zip(self.blocks, active)))
+
+    def constraint_rows(self) -> int:
+        return int(sum(int(c.c) * c.param_index.shape[0] for c in self.constraints))
+
+    def constraint_labels(self) -> list[str]:
+        return [c.name for c in self.constraints]
+
+    def normal(
+        self,
+        lin: _Lin,
+        active: list[NDArray[np.bool_]],
+        rowscale: Array | None,
+    ) -> tuple[_Normal, Array | None]:
+        """Jacobi-scaled normal equations; returns the constraint row scale it used."""
+        if self.plan is not None:
+            return build_reduced_normal(
+                self.plan,
+                self.blocks,
+                lin.blocks,
+                active,
+                self.constraint_matrix(lin),
+                lin.h,
+                rowscale,
+            )
+        A, wbar = self.design(lin, active)
+        N = (A.T @ A).tocsr()
+        diag = N.diagonal()
+        C = self.constraint_matrix(lin)
+        d = jacobi_scale(np.sqrt(np.where(diag > 0, diag, 0.0)), C)
+        dinv = 1.0 / d
+        Ns = sp.csr_matrix(sp.diags(dinv) @ N @ sp.diags(dinv))
+        ns = dinv * (A.T @ wbar)
+        Cs = None
+        hs = np.zeros(0)
+        if C is not None:
+            Cs, hs, rowscale = scale_constraints(C, dinv, lin.h, rowscale)
+        return _Normal(A=A, d=d, Ns=Ns, ns=ns, Cs=Cs, hs=hs), rowscale
