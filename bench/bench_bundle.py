@@ -165,7 +165,8 @@ LARGE_CODE = r"""
 import resource, sys, time, json
 t0 = time.perf_counter()
 from lidarphoto.core.simulation.uav_block import simulate_uav_block
-from lidarphoto.core.photo.bundle import bundle_adjust, BundleOptions
+from lidarphoto.core.photo.bundle import bundle_adjust
+from lidarphoto.core.photo.bundle_setup import BundleOptions
 blk = simulate_uav_block("none", seed=3, strips=(40,) * 25, n_tie=200000, n_control=60,
                          n_check=20, forward_overlap=0.6, side_overlap=0.3)
 t1 = time.perf_counter()

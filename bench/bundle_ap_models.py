@@ -18,7 +18,8 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
-from lidarphoto.core.photo.bundle import BundleOptions, bundle_adjust
+from lidarphoto.core.photo.bundle import bundle_adjust
+from lidarphoto.core.photo.bundle_setup import BundleOptions
 from lidarphoto.core.photo.orientation import eo_map_to_local
 from lidarphoto.core.simulation.uav_block import simulate_uav_block
 

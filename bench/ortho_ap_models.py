@@ -42,7 +42,8 @@ from lidarphoto.core.io.camera import write_camera_json
 from lidarphoto.core.io.dsm import write_dsm
 from lidarphoto.core.io.orientation import write_eo_csv
 from lidarphoto.core.io.raster import RasterReader, write_rgb_tiff
-from lidarphoto.core.photo.bundle import BundleOptions, bundle_adjust
+from lidarphoto.core.photo.bundle import bundle_adjust
+from lidarphoto.core.photo.bundle_setup import BundleOptions
 from lidarphoto.core.quality.registration import phase_correlation
 from lidarphoto.core.simulation.render import RenderOptions, RenderScene, render_image
 from lidarphoto.core.simulation.uav_block import simulate_uav_block

@@ -124,7 +124,7 @@ class BundlePanel(QWidget):
             self.result_label.setText(self.tr("Bundle adjustment running…"))
 
     def show_result(self, res, inputs: DockBundleInputs) -> str:
-        """Show a :class:`core.photo.bundle.BundleResult`; returns the text shown."""
+        """Show a :class:`core.photo.bundle_result.BundleResult`; returns the text shown."""
         a = res.adjustment
         head = self.tr(
             "<b>{}</b>: σ0 {:.3f}, redundancy {}, χ² test {}; {} image(s), {} measurement(s), "
@@ -180,7 +180,7 @@ class BundleController(JobController):
     -------
     finished(bool)
         The task ended; on success :attr:`result` is the
-        :class:`core.photo.bundle.BundleResult`, else :attr:`error` says why.
+        :class:`core.photo.bundle_result.BundleResult`, else :attr:`error` says why.
     """
 
     def __init__(self, dock) -> None:

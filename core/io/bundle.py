@@ -33,7 +33,7 @@ from typing import Union
 
 import numpy as np
 
-from ..photo.bundle import BundleResult
+from ..photo.bundle_result import BundleResult
 from .tables import write_csv_atomic
 
 __all__ = [

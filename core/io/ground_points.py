@@ -24,7 +24,7 @@ from typing import Union
 import numpy as np
 
 from ..errors import InputError
-from ..photo.bundle import DEFAULT_CONTROL_SIGMA_M, ROLES, GroundPoints
+from ..photo.bundle_setup import DEFAULT_CONTROL_SIGMA_M, ROLES, GroundPoints
 from .tables import find_column, float_column, read_table, text_column, write_csv_atomic
 
 __all__ = ["GROUND_POINT_COLUMNS", "read_ground_points_csv", "write_ground_points_csv"]

@@ -237,7 +237,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.ground_points import read_ground_points_csv
     from ..io.observations import read_observations_csv
     from ..io.orientation import read_eo_csv_full, write_eo_csv_with_sigmas
-    from ..photo.bundle import BundleOptions, GroundPoints, bundle_adjust, compare_ap_models
+    from ..photo.bundle import bundle_adjust, compare_ap_models
+    from ..photo.bundle_setup import BundleOptions, GroundPoints
     from ..quality.bundle_html import render_bundle_html
     from .runner import stages
 

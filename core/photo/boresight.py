@@ -158,7 +158,7 @@ class BoresightOptions:
 
 
 class SurveyedPoints(Protocol):
-    """Surveyed ground points as :class:`core.photo.bundle.GroundPoints` holds them (a
+    """Surveyed ground points as :class:`core.photo.bundle_setup.GroundPoints` holds them (a
     protocol: that module depends on this one): ids, mapping-CRS coordinates (m), sigmas (m),
     roles (``control`` or ``check``)."""
 

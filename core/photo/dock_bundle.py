@@ -35,12 +35,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..lidar.control import ControlPoint
-from .bundle import DEFAULT_CONTROL_SIGMA_M, GroundPoints
+from .bundle_setup import DEFAULT_CONTROL_SIGMA_M, GroundPoints
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable
 
 if TYPE_CHECKING:
-    from .bundle import BundleResult
+    from .bundle_result import BundleResult
 
 __all__ = [
     "DEFAULT_EO_SIGMAS",

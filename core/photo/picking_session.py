@@ -38,7 +38,7 @@ from .picking import PickingScene, nearest_point, nearest_segment
 
 if TYPE_CHECKING:
     from .boresight import BoresightRun
-    from .bundle import BundleResult
+    from .bundle_result import BundleResult
 
 __all__ = [
     "PICK_TYPES",

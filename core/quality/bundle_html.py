@@ -24,7 +24,7 @@ from .html_table import table as _table
 from .svg_plots import correlation_heatmap, histogram, image_vector_field
 
 if TYPE_CHECKING:
-    from ..photo.bundle import BundleResult
+    from ..photo.bundle_result import BundleResult
 
 __all__ = ["render_bundle_html"]
 

@@ -48,7 +48,7 @@ from ..io.tables import write_csv_atomic
 from ..io.trajectory import write_trajectory_csv
 from ..lidar.control import ControlLine, ControlPoint, intersect_three_planes, intersect_two_planes
 from ..photo.boresight import BoresightOptions, BoresightResult, calibrate, local_frame_for
-from ..photo.bundle import GroundPoints
+from ..photo.bundle_setup import GroundPoints
 from ..photo.georeference import Trajectory, georeference_ecef
 from ..photo.ins import INS_GRADES, InsGrade
 from ..photo.mount import MOUNT_PRESETS, Mount

@@ -39,7 +39,7 @@ from ..io.atomic import write_text_atomic
 from ..io.camera import write_camera_json
 from ..io.ground_points import write_ground_points_csv
 from ..io.observations import write_observations_csv
-from ..photo.bundle import GroundPoints
+from ..photo.bundle_setup import GroundPoints
 from ..photo.observations import ImageObservations
 from ..photo.orientation import ExteriorOrientationTable, eo_local_to_map
 

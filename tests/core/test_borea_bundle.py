@@ -23,7 +23,8 @@ import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
 from lidarphoto.core.geometry.frames import MappingFrame
-from lidarphoto.core.photo.bundle import BundleOptions, GroundPoints, bundle_adjust
+from lidarphoto.core.photo.bundle import bundle_adjust
+from lidarphoto.core.photo.bundle_setup import BundleOptions, GroundPoints
 from lidarphoto.core.photo.observations import ImageObservations
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable
 from pyproj import Proj, Transformer

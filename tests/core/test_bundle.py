@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError, NotObservableError
 from lidarphoto.core.geometry.ap_models import make_ap_model
-from lidarphoto.core.photo.bundle import BundleOptions, GroundPoints, bundle_adjust
+from lidarphoto.core.photo.bundle import bundle_adjust
+from lidarphoto.core.photo.bundle_setup import BundleOptions, GroundPoints
 from lidarphoto.core.simulation.uav_block import simulate_uav_block
 from scipy import stats
 
@@ -435,7 +436,7 @@ def test_too_little_control_for_the_datum_is_refused(blocks):
 def test_observed_orientation_model_jacobian():
     """The analytic Jacobian of the observed-orientation model (lever arm and boresight)
     against central differences."""
-    from lidarphoto.core.photo.bundle import _ObservedEOModel
+    from lidarphoto.core.photo.bundle_model import _ObservedEOModel
 
     rng = np.random.default_rng(0)
     g = 6

@@ -15,7 +15,8 @@ import pytest
 from lidarphoto.core.geometry.camera import Camera
 from lidarphoto.core.geometry.frames import MappingFrame
 from lidarphoto.core.lidar.control import ControlPoint
-from lidarphoto.core.photo.bundle import BundleOptions, bundle_adjust
+from lidarphoto.core.photo.bundle import bundle_adjust
+from lidarphoto.core.photo.bundle_setup import BundleOptions
 from lidarphoto.core.photo.dock_bundle import (
     MIN_CONTROL_SIGMA_M,
     dock_bundle_inputs,

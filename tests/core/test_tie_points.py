@@ -162,7 +162,8 @@ def test_bundle_with_automatic_tie_points(block, matched):
     """The block adjusted with the automatic tie points (and the simulator's control and
     check measurements) reaches the check-point RMSE of the simulator's perfect tie points
     within 10 %, and below 0.15 m in plan at a GSD of 23 cm."""
-    from lidarphoto.core.photo.bundle import BundleOptions, bundle_adjust
+    from lidarphoto.core.photo.bundle import bundle_adjust
+    from lidarphoto.core.photo.bundle_setup import BundleOptions
 
     tb, _ = block
     blk = tb.block
@@ -364,7 +365,8 @@ def test_refinement_against_truth(block, matched, refined):
 def test_bundle_with_refined_tie_points(block, matched, refined):
     """The block adjusted with refined tie points is at least as good at the check points as
     with the keypoints (measured: see the assertion message)."""
-    from lidarphoto.core.photo.bundle import BundleOptions, bundle_adjust
+    from lidarphoto.core.photo.bundle import bundle_adjust
+    from lidarphoto.core.photo.bundle_setup import BundleOptions
 
     tb, _ = block
     blk = tb.block

@@ -1,0 +1,315 @@
+"""The model of a bundle adjustment (:mod:`.bundle`): the parameter layout, the observation
+blocks (image points through the collinearity equations, control points, observed
+orientations with the mount), the datum constraints, and one run of the adjustment.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..geometry.camera import Camera
+from ..geometry.collinearity import collinearity_jacobians
+from ..geometry.rotations import matrix_to_opk, opk_derivatives, opk_to_matrix
+from ..lsq.adjustment import adjust
+from ..lsq.model import AdjustmentOptions, Constraint, GaussMarkovBlock
+from ..lsq.results import AdjustmentResult
+from .bundle_setup import EO_PARAM_NAMES, BundleOptions, _Setup
+from .observations import ImageObservations
+
+#: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
+TR_CONTEXT = "Report"
+
+Array = NDArray[np.float64]
+
+
+@dataclass
+class _Layout:
+    """Parameter layout of one adjustment run."""
+
+    names: list[str]
+    x0: Array
+    eo: NDArray[np.intp]  # (M, 6)
+    interior: list[NDArray[np.intp]]  # per camera, indices of its free interior parameters
+    free: list[NDArray[np.intp]]  # per camera, positions within Camera.interior_params
+    mount: NDArray[np.intp] | None  # (6,)
+    points: NDArray[np.intp]  # (P, 3)
+
+
+def _layout(setup: _Setup, free: list[NDArray[np.intp]], cams: list[Camera], eo: Array,
+            xyz: Array, mount: Array | None) -> _Layout:  # fmt: skip
+    names: list[str] = []
+    values: list[Array] = []
+    M = len(setup.images)
+    for im in setup.images:
+        names += [f"{im} {p}" for p in EO_PARAM_NAMES]
+    values.append(eo.ravel())
+    idx_eo = np.arange(6 * M).reshape(M, 6)
+    start = 6 * M
+    interior = []
+    for c, cam in enumerate(cams):
+        inames = cam.interior_names
+        f = free[c]
+        names += [f"{cam.name} {inames[j]}" for j in f]
+        values.append(cam.interior_params[f])
+        interior.append(np.arange(start, start + f.size))
+        start += f.size
+    idx_mount = None
+    if mount is not None:
+        names += ["lever dx_c", "lever dy_c", "lever dz_c", "boresight d_omega",
+                  "boresight d_phi", "boresight d_kappa"]  # fmt: skip
+        values.append(mount)
+        idx_mount = np.arange(start, start + 6)
+        start += 6
+    P = len(setup.points)
+    names += [f"{p} {c}" for p in setup.points for c in "XYZ"]
+    values.append(xyz.ravel())
+    idx_pts = np.arange(start, start + 3 * P).reshape(P, 3)
+    return _Layout(names, np.concatenate(values), idx_eo, interior, free, idx_mount, idx_pts)
+
+
+class _ImageModel:
+    """Collinearity of the measurements of one camera: x_local = [eo(6), point(3), interior].
+
+    ``img`` is the image of each group: the rotations are computed once per image.
+    """
+
+    def __init__(self, cam: Camera, free: NDArray[np.intp], img: NDArray[np.intp]) -> None:
+        self.cam = cam
+        self.free = free
+        _, self.first, self.inv = np.unique(img, return_index=True, return_inverse=True)
+        self.inv = np.asarray(self.inv).ravel()
+
+    def __call__(self, xl: Array) -> tuple[Array, Array]:
+        cam = self.cam
+        wrt = ("eo", "point", "interior") if self.free.size else ("eo", "point")
+        if self.free.size:
+            full = cam.interior_params
+            full[self.free] = xl[0, 9:]
+            cam = cam.with_interior(full)
+        out = collinearity_jacobians(xl[:, 6:9], xl[self.first, :6], cam, wrt=wrt,
+                                     image_index=self.inv)  # fmt: skip
+        parts = [out["eo"], out["point"]]
+        if self.free.size:
+            parts.append(out["interior"][:, :, self.free])
+        return out["pixels"], np.concatenate(parts, axis=2)
+
+
+class _IdentityModel:
+    def __call__(self, xl: Array) -> tuple[Array, Array]:
+        g, k = xl.shape
+        return xl.copy(), np.broadcast_to(np.eye(k), (g, k, k)).copy()
+
+
+def _dopk_dm(m: Array) -> Array:
+    """d (omega, phi, kappa) / d M (entries row-major), (N, 3, 9), for matrix_to_opk."""
+    n = m.shape[0]
+    out = np.zeros((n, 3, 9))
+    m21, m22 = m[:, 2, 1], m[:, 2, 2]
+    den = m21**2 + m22**2
+    out[:, 0, 7] = -m22 / den  # omega = atan2(-m21, m22)
+    out[:, 0, 8] = m21 / den
+    a, b0, b1 = m[:, 2, 0], m[:, 0, 0], m[:, 1, 0]
+    h = np.hypot(b0, b1)
+    r2 = a**2 + h**2
+    out[:, 1, 6] = h / r2  # phi = atan2(a, h)
+    out[:, 1, 0] = -a * b0 / (h * r2)
+    out[:, 1, 3] = -a * b1 / (h * r2)
+    c, d = m[:, 1, 0], m[:, 0, 0]
+    den2 = c**2 + d**2
+    out[:, 2, 3] = -d / den2  # kappa = atan2(-m10, m00)
+    out[:, 2, 0] = c / den2
+    return out
+
+
+class _ObservedEOModel:
+    """Observed orientation (GNSS/INS with the nominal mount) against the adjusted one, in
+    the conventions of DESIGN.md (``X_pc = X_obs + R_c^m da``, ``R_c^m = R_obs dR``):
+    ``X_obs = X0 - M' da``, ``M_obs = dR M`` with ``da`` the lever-arm correction in camera
+    axes and ``dR`` the boresight correction about the camera axes (what a boresight
+    calibration estimates). x_local = [eo(6), da(3), bore(3)]."""
+
+    def __init__(self, observed: Array) -> None:
+        self.observed = observed
+
+    def __call__(self, xl: Array) -> tuple[Array, Array]:
+        from ..geometry.rotations import boresight_matrix, rx, ry, rz, skew
+
+        g = xl.shape[0]
+        eo, da, bo = xl[:, :6], xl[:, 6:9], xl[:, 9:12]
+        M = opk_to_matrix(eo[:, 3], eo[:, 4], eo[:, 5])
+        dM = opk_derivatives(eo[:, 3], eo[:, 4], eo[:, 5])  # (g, 3, 3, 3)
+        dR = boresight_matrix(bo[:, 0], bo[:, 1], bo[:, 2])
+        Mobs = dR @ M
+        f = np.zeros((g, 6))
+        J = np.zeros((g, 6, 12))
+        f[:, :3] = eo[:, :3] - np.einsum("gji,gj->gi", M, da)
+        J[:, :3, :3] = np.eye(3)
+        J[:, :3, 3:6] = -np.einsum("gkji,gj->gik", dM, da)
+        J[:, :3, 6:9] = -np.swapaxes(M, 1, 2)
+        om, ph, ka = matrix_to_opk(Mobs)
+        f[:, 3:] = np.column_stack([om, ph, ka])
+        # keep the predicted angles on the branch of the observed ones
+        f[:, 3:] = self.observed[:, 3:] + (f[:, 3:] - self.observed[:, 3:] + np.pi) % (
+            2 * np.pi
+        ) - np.pi
+        dop = _dopk_dm(Mobs)  # (g, 3, 9)
+        for k in range(3):
+            dMobs = dR @ dM[:, k]
+            J[:, 3:, 3 + k] = np.einsum("gaj,gj->ga", dop, dMobs.reshape(g, 9))
+        # dR = Rx(a) Ry(b) Rz(c): d Rx(a)/da = Rx(a) [e_x]x, and likewise
+        ra, rb, rc = rx(bo[:, 0]), ry(bo[:, 1]), rz(bo[:, 2])
+        gen = [skew(e) for e in np.eye(3)]
+        d_dR = (ra @ gen[0] @ rb @ rc, ra @ rb @ gen[1] @ rc, ra @ rb @ rc @ gen[2])
+        for k in range(3):
+            dMobs = d_dR[k] @ M
+            J[:, 3:, 9 + k] = np.einsum("gaj,gj->ga", dop, dMobs.reshape(g, 9))
+        return f, J
+
+
+def _blocks(setup: _Setup, lay: _Layout, cams: list[Camera], obs: ImageObservations,
+            keep: NDArray[np.bool_]) -> tuple[list, list, list[str]]:  # fmt: skip
+    """Observation blocks; returns them, the measurement rows and the names of the
+    image-point blocks."""
+    blocks = []
+    rows_of = []
+    names = []
+    for c, cam in enumerate(cams):
+        rows = np.flatnonzero(keep & (setup.obs_pt >= 0) & (setup.image_cam[setup.obs_img] == c))
+        if rows.size == 0:
+            continue
+        img, pt = setup.obs_img[rows], setup.obs_pt[rows]
+        idx = np.concatenate(
+            [lay.eo[img], lay.points[pt], np.broadcast_to(lay.interior[c], (rows.size,
+                                                                             lay.interior[c].size))],
+            axis=1,
+        )
+        labels = [f"{obs.image_id[r]} / {obs.point_id[r]}" for r in rows]
+        blocks.append(
+            GaussMarkovBlock(
+                name=f"image points {cam.name}",
+                observed=obs.pixels[rows],
+                sigma=np.repeat(obs.sigma_px[rows, None], 2, axis=1),
+                param_index=idx,
+                model=_ImageModel(cam, lay.free[c], img),
+                labels=labels,
+                row_names=("col", "row"),
+            )
+        )
+        rows_of.append(rows)
+        names.append(blocks[-1].name)
+    if setup.control_pt.size:
+        blocks.append(
+            GaussMarkovBlock(
+                name="control points",
+                observed=setup.control_local,
+                sigma=setup.control_cov,
+                param_index=lay.points[setup.control_pt],
+                model=_IdentityModel(),
+                labels=[setup.points[i] for i in setup.control_pt],
+                row_names=("E", "N", "U"),
+            )
+        )
+    if setup.eo_obs is not None:
+        if lay.mount is not None:
+            idx = np.concatenate(
+                [lay.eo, np.broadcast_to(lay.mount, (len(setup.images), 6))], axis=1
+            )
+            model = _ObservedEOModel(setup.eo_obs)
+        else:
+            idx = lay.eo
+            model = _IdentityModel()
+        blocks.append(
+            GaussMarkovBlock(
+                name="observed orientation",
+                observed=setup.eo_obs,
+                sigma=setup.eo_obs_cov,
+                param_index=idx,
+                model=model,
+                labels=list(setup.images),
+                row_names=EO_PARAM_NAMES,
+            )
+        )
+    return blocks, rows_of, names
+
+
+def _datum_constraints(setup: _Setup, lay: _Layout, datum: str, xyz0: Array, eo0: Array):
+    if datum == "control":
+        return []
+    if datum == "inner":
+        tie = np.arange(len(setup.points))
+        P0 = xyz0[tie]
+        cen = P0.mean(axis=0)
+        q = P0 - cen
+        scale = max(float(np.sqrt(np.mean(np.sum(q * q, axis=1)))), 1e-9)
+        G = np.zeros((7, tie.size, 3))
+        G[0, :, 0] = G[1, :, 1] = G[2, :, 2] = 1.0
+        # rotations about E, N, U: the columns of -[q]x, scaled to metres at the network size
+        G[3, :, 1], G[3, :, 2] = -q[:, 2] / scale, q[:, 1] / scale
+        G[4, :, 0], G[4, :, 2] = q[:, 2] / scale, -q[:, 0] / scale
+        G[5, :, 0], G[5, :, 1] = -q[:, 1] / scale, q[:, 0] / scale
+        G[6] = q / scale
+        Gm = G.reshape(7, -1)
+        base = P0.ravel()
+
+        def inner(xl: Array, Gm=Gm, base=base) -> tuple[Array, Array]:
+            return (Gm @ (xl[0] - base))[None], Gm[None]
+
+        return [Constraint("inner constraints", lay.points[tie].ravel()[None], inner)]
+    # minimal: the first image's orientation and the largest coordinate of the baseline to
+    # the farthest centre, held at their approximate values
+    far = int(np.argmax(np.linalg.norm(eo0[:, :3] - eo0[0, :3], axis=1)))
+    axis = int(np.argmax(np.abs(eo0[far, :3] - eo0[0, :3])))
+    held = np.concatenate([lay.eo[0], [lay.eo[far, axis]]])
+    vals = np.concatenate([eo0[0], [eo0[far, axis]]])
+
+    def minimal(xl: Array, vals=vals) -> tuple[Array, Array]:
+        return (xl[0] - vals)[None], np.eye(7)[None]
+
+    return [Constraint("minimal constraints", held[None], minimal)]
+
+
+@dataclass
+class _Run:
+    result: AdjustmentResult
+    lay: _Layout
+    cams: list[Camera]
+    blocks_rows: list[NDArray[np.intp]]  # measurement rows of each image-point block
+    block_names: list[str]
+    keep: NDArray[np.bool_]
+
+
+def _run(setup: _Setup, obs: ImageObservations, cams: list[Camera], free: list,
+         options: BundleOptions, keep: NDArray[np.bool_], robust: str, snooping: bool,
+         eo: Array, xyz: Array, mount: Array | None, should_stop, progress) -> _Run:  # fmt: skip
+    lay = _layout(setup, free, cams, eo, xyz, mount)
+    blocks, rows_of, bnames = _blocks(setup, lay, cams, obs, keep)
+    cons = _datum_constraints(setup, lay, options.datum, setup.xyz0, setup.eo0)
+    opts = AdjustmentOptions(
+        robust_blocks=bnames,
+        snooping_blocks=bnames,
+        max_iterations=options.max_iterations,
+        snooping=snooping,
+        snooping_alpha=options.snooping_alpha,
+        robust=robust,
+        eliminate=lay.points,
+        max_rejections=max(50, len(obs) // 20),
+        # a millionth of each parameter's precision: far below anything reported, and the
+        # linear convergence of large-residual blocks reaches it in a few iterations
+        tolerance=1e-6,
+        compute_covariance=options.covariance,
+    )
+    result = adjust(lay.x0, lay.names, blocks, cons, opts, progress=progress,
+                    should_stop=should_stop)  # fmt: skip
+    return _Run(result, lay, cams, rows_of, bnames, keep)
+
+
+def _cams_from(run: _Run) -> list[Camera]:
+    out = []
+    for c, cam in enumerate(run.cams):
+        full = cam.interior_params
+        full[run.lay.free[c]] = run.result.x[run.lay.interior[c]]
+        out.append(cam.with_interior(full))
+    return out
