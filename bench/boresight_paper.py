@@ -18,7 +18,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
-from lidarphoto.core.photo.boresight import ARCSEC, BoresightOptions
+from lidarphoto.core.photo.boresight_setup import ARCSEC, BoresightOptions
 from lidarphoto.core.simulation.flight import paper_config, simulate_flight
 
 TABLE1 = {"NE": (85.0, 73.8, 336.8), "SW": (72.4, 78.2, 78.2)}  # std, arc-seconds

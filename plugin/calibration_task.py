@@ -5,8 +5,8 @@ The task writes the control the dock shows (the core objects of its
 calibration folder, then runs the core job ``boresight_calibration`` (what the toolbox's
 ``lidarphoto:boresightcalibration`` runs) on them and the saved observation file. The job writes
 ``boresight.csv``, ``eo_calibrated.csv``, ``residuals.csv`` and ``summary.html``; the dock
-displays the result object it returns (:class:`~lidarphoto.core.photo.boresight.BoresightRun`),
-not those files.
+displays the result object it returns
+(:class:`~lidarphoto.core.photo.boresight_result.BoresightRun`), not those files.
 """
 
 from __future__ import annotations

@@ -56,7 +56,7 @@ from lidarphoto.core.io.pointcloud import read_points
 from lidarphoto.core.io.raster import write_rgb_tiff
 from lidarphoto.core.io.tables import write_csv_atomic
 from lidarphoto.core.io.trajectory import read_trajectory_csv
-from lidarphoto.core.photo.boresight import local_frame_for
+from lidarphoto.core.photo.boresight_setup import local_frame_for
 from lidarphoto.core.photo.georeference import Trajectory, direct_georeference
 from lidarphoto.core.photo.intersection import forward_intersection
 from lidarphoto.core.photo.mount import Mount

@@ -27,7 +27,7 @@ from .spec import AlgorithmSpec, Param, Result, Values
 TR_CONTEXT = "Report"
 
 if TYPE_CHECKING:
-    from ..photo.boresight import BoresightRun
+    from ..photo.boresight_result import BoresightRun
 
 log = logging.getLogger(__name__)
 
@@ -162,13 +162,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.pointcloud import read_points
     from ..io.tables import write_csv_atomic
     from ..io.trajectory import read_trajectory_csv
-    from ..photo.boresight import (
-        BoresightNotObservable,
-        BoresightOptions,
-        BoresightRun,
-        calibrate,
-        group_labels,
-    )
+    from ..photo.boresight import calibrate
+    from ..photo.boresight_result import BoresightNotObservable, BoresightRun
+    from ..photo.boresight_setup import BoresightOptions, group_labels
     from ..photo.ins import ins_grade
     from ..photo.intersection import ground_positions
     from ..quality.boresight_html import render_boresight_html

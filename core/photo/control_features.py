@@ -19,7 +19,7 @@ from ..lidar.control import LINE_KINDS, ControlLine, ControlPoint
 Array = NDArray[np.float64]
 
 #: Standard deviation (metres, each axis) given to a LiDAR line or control point whose layer
-#: carries no precision (the LiDAR sigma of :class:`core.photo.boresight.BoresightOptions`).
+#: carries no precision (the LiDAR sigma of :class:`core.photo.boresight_setup.BoresightOptions`).
 DEFAULT_CONTROL_SIGMA_M = 0.05
 _PLANE_COV = tuple(f"cov_{'abcd'[i]}{'abcd'[j]}" for i, j in zip(*np.triu_indices(4)))
 _LINE_COV = tuple(f"cov_{i}{j}" for i, j in zip(*np.triu_indices(6)))

@@ -10,7 +10,8 @@ from numpy.typing import NDArray
 
 from ..geometry.camera import Camera
 from ..geometry.frames import LocalFrame
-from .boresight import BoresightResult, SurveyedPoints
+from .boresight_result import BoresightResult
+from .boresight_setup import SurveyedPoints
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_map_to_local
 

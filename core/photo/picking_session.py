@@ -37,7 +37,7 @@ from .orientation import ExteriorOrientationTable
 from .picking import PickingScene, nearest_point, nearest_segment
 
 if TYPE_CHECKING:
-    from .boresight import BoresightRun
+    from .boresight_result import BoresightRun
     from .bundle_result import BundleResult
 
 __all__ = [

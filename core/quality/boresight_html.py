@@ -22,7 +22,7 @@ from .html_table import table as _table
 from .svg_plots import histogram
 
 if TYPE_CHECKING:
-    from ..photo.boresight import BoresightRun
+    from ..photo.boresight_result import BoresightRun
 
 __all__ = ["render_boresight_html"]
 
@@ -74,7 +74,8 @@ def render_boresight_html(
     settings : mapping of str to str
         Shown as given.
     diagnosis : sequence of str, optional
-        Sentences of :class:`core.photo.boresight.BoresightNotObservable`; shown instead of results.
+        Sentences of :class:`core.photo.boresight_result.BoresightNotObservable`; shown
+        instead of results.
     problems : sequence of str
         Checks the result failed (no convergence, global test, implausible angles): shown in a
         red box at the top, saying whether the results were refused or written anyway

@@ -47,7 +47,9 @@ from ..io.planes import write_planes_csv
 from ..io.tables import write_csv_atomic
 from ..io.trajectory import write_trajectory_csv
 from ..lidar.control import ControlLine, ControlPoint, intersect_three_planes, intersect_two_planes
-from ..photo.boresight import BoresightOptions, BoresightResult, calibrate, local_frame_for
+from ..photo.boresight import calibrate
+from ..photo.boresight_result import BoresightResult
+from ..photo.boresight_setup import BoresightOptions, local_frame_for
 from ..photo.bundle_setup import GroundPoints
 from ..photo.georeference import Trajectory, georeference_ecef
 from ..photo.ins import INS_GRADES, InsGrade

@@ -9,8 +9,9 @@ import pytest
 from lidarphoto.core.geometry.camera import Camera
 from lidarphoto.core.geometry.distortion import distortion_from_dict
 from lidarphoto.core.geometry.rotations import rph_to_matrix
-from lidarphoto.core.photo.boresight import ARCSEC, BoresightNotObservable, BoresightOptions
 from lidarphoto.core.photo.boresight_models import PoseSpec, collinearity, coplanarity, paper_plane
+from lidarphoto.core.photo.boresight_result import BoresightNotObservable
+from lidarphoto.core.photo.boresight_setup import ARCSEC, BoresightOptions
 from lidarphoto.core.photo.mount import MOUNT_PRESETS
 from lidarphoto.core.simulation.flight import FlightConfig, simulate_flight
 from numdiff import central_difference

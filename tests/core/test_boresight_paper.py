@@ -11,7 +11,8 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from lidarphoto.core.photo.boresight import ARCSEC, BoresightOptions, calibrate
+from lidarphoto.core.photo.boresight import calibrate
+from lidarphoto.core.photo.boresight_setup import ARCSEC, BoresightOptions
 from lidarphoto.core.simulation.flight import paper_config, simulate_flight
 
 CFG = replace(paper_config(), types=("tie",), n_check=0)

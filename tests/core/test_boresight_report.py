@@ -16,7 +16,8 @@ from lidarphoto.core.io.orientation import read_eo_csv
 from lidarphoto.core.jobs import boresight_calibration
 from lidarphoto.core.jobs.boresight_calibration import TABLE_COLUMNS
 from lidarphoto.core.jobs.runner import run_job
-from lidarphoto.core.photo.boresight import ARCSEC, BoresightNotObservable, local_frame_for
+from lidarphoto.core.photo.boresight_result import BoresightNotObservable
+from lidarphoto.core.photo.boresight_setup import ARCSEC, local_frame_for
 from lidarphoto.core.photo.ins import ins_grade
 from lidarphoto.core.photo.intersection import forward_intersection
 from lidarphoto.core.quality.boresight_html import render_boresight_html

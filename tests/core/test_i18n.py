@@ -377,7 +377,7 @@ def test_logged_messages_render_in_portuguese():
     records are unchanged."""
     import logging
 
-    from lidarphoto.core.photo.boresight import diagnose
+    from lidarphoto.core.photo.boresight_result import diagnose
 
     reason = i18n.Message("outside every image")
     rec = logging.LogRecord("lidarphoto.x", logging.WARNING, "", 0, "point %s: %s",

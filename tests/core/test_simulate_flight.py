@@ -12,7 +12,8 @@ from lidarphoto.core.io.control import read_lcps_csv, read_lines_csv
 from lidarphoto.core.io.observations import read_observations_csv
 from lidarphoto.core.io.planes import read_planes_csv
 from lidarphoto.core.io.trajectory import read_trajectory_csv
-from lidarphoto.core.photo.boresight import BoresightOptions, calibrate
+from lidarphoto.core.photo.boresight import calibrate
+from lidarphoto.core.photo.boresight_setup import BoresightOptions
 from lidarphoto.core.photo.mount import Mount
 from lidarphoto.core.simulation.flight import FlightConfig, paper_config, simulate_flight
 
