@@ -91,7 +91,7 @@ def peak_rss_mb() -> float:
 
 
 def _params(method: str):
-    from lidarphoto.core.lidar.ground_filter import (
+    from lidarphoto.core.lidar.ground_filter_params import (
         SMRF_PUBLISHED,
         CsfParams,
         GroundFilterParams,
@@ -300,6 +300,8 @@ def openings_micro(path: Path, feet: bool, repeats: int = 3) -> dict:
     from lidarphoto.core.geometry.grid import Grid, fill_nearest
     from lidarphoto.core.io.pointcloud import read_points
     from lidarphoto.core.lidar import ground_filter as gf
+    from lidarphoto.core.lidar import ground_filter_morphology as morphology
+    from lidarphoto.core.lidar.ground_filter_params import SmrfParams
 
     arrays, _ = read_points(str(path), ("x", "y", "z"), crs=None if feet else 7415)
     cell = 1.0 / FEET if feet else 1.0
@@ -307,16 +309,16 @@ def openings_micro(path: Path, feet: bool, repeats: int = 3) -> dict:
     grid = Grid.covering(np.array([x.min(), y.min()]), np.array([x.max(), y.max()]), cell)
     zmin = gf._min_grid(grid, grid.flat_index(x, y).astype(np.int32), (z - z.min()))
     surface = fill_nearest(zmin, np.isfinite(zmin))
-    windows, _ = gf.smrf_windows(gf.SmrfParams(cell_size=cell, max_window=18.0 * cell))
+    windows, _ = morphology.smrf_windows(SmrfParams(cell_size=cell, max_window=18.0 * cell))
     out: dict = {"grid": list(surface.shape), "windows": windows}
     results = {}
-    gf._opening(surface, windows[-1], "disk", True)  # numba's start-up, not timed
+    morphology._opening(surface, windows[-1], "disk", True)  # numba's start-up, not timed
     for _ in range(repeats):
         for name, use in (("opencv", False), ("compiled", True)):
             s = surface
             t, c = time.perf_counter(), time.process_time()
             for w in windows:
-                s = gf._opening(s, w, "disk", use)
+                s = morphology._opening(s, w, "disk", use)
             out.setdefault(name, []).append(
                 {"wall_s": time.perf_counter() - t, "cpu_s": time.process_time() - c}
             )

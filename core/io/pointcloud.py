@@ -456,11 +456,11 @@ class LasPoints:
         return sum(len(c) for c in self.chunks)
 
     def scaled_xyz(self) -> Any:
-        """x, y, z as the records hold them (:class:`core.lidar.ground_filter.ScaledXYZ`:
+        """x, y, z as the records hold them (:class:`core.geometry.scaled_xyz.ScaledXYZ`:
         views of the integer X, Y, Z fields of each chunk, the header's scales and offsets),
         for algorithms that read the coordinates a block at a time instead of float64 copies
         of every point."""
-        from ..lidar.ground_filter import ScaledXYZ
+        from ..geometry.scaled_xyz import ScaledXYZ
 
         return ScaledXYZ(
             chunks=tuple((c["X"], c["Y"], c["Z"]) for c in self.chunks),

@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 
 from ..errors import InputError
-from ..lidar.ground_filter import (
+from ..lidar.ground_filter_params import (
     GROWTH_CHOICES,
     METHODS,
     WINDOW_SHAPES,

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import Cancelled, InputError
 from ..lidar.control import ControlOptions
-from ..lidar.ground_filter import SmrfParams
+from ..lidar.ground_filter_params import SmrfParams
 from ..lidar.roof_planes import RoofPlaneParams
 from .common import cloud_params, lengths_in_cloud_units
 from .runner import JobResult

@@ -23,16 +23,17 @@ from lidarphoto.core.lidar.ground_filter import (
     GROUND_CLASS,
     HEIGHT_FIELD,
     LOW_NOISE_CLASS,
+    ground_filter,
+    score_classification,
+)
+from lidarphoto.core.lidar.ground_filter_csf import _spring_pairs
+from lidarphoto.core.lidar.ground_filter_morphology import pmf_windows, smrf_windows
+from lidarphoto.core.lidar.ground_filter_params import (
     METHODS,
     SMRF_PUBLISHED,
     CsfParams,
     GroundFilterParams,
     SmrfParams,
-    _spring_pairs,
-    ground_filter,
-    pmf_windows,
-    score_classification,
-    smrf_windows,
 )
 from lidarphoto.core.simulation.terrain import TERRAIN_CLASSES, make_terrain
 

@@ -16,15 +16,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
+from lidarphoto.core.geometry.scaled_xyz import ScaledXYZ
 from lidarphoto.core.io.pointcloud import read_cloud
 from lidarphoto.core.lidar import ground_filter_numba as compiled
-from lidarphoto.core.lidar.ground_filter import (
-    CsfParams,
-    GroundFilterParams,
-    ScaledXYZ,
-    SmrfParams,
-    ground_filter,
-)
+from lidarphoto.core.lidar.ground_filter import ground_filter
+from lidarphoto.core.lidar.ground_filter_params import CsfParams, GroundFilterParams, SmrfParams
 from lidarphoto.core.simulation.terrain import make_terrain
 
 AHN3 = Path(__file__).resolve().parents[1] / "data" / "ahn3" / "ahn3_delft_crop60.laz"

@@ -11,8 +11,9 @@ import os
 import cv2
 import numpy as np
 import pytest
-from lidarphoto.core.lidar import ground_filter as gf
+from lidarphoto.core.lidar import ground_filter_morphology as gm
 from lidarphoto.core.lidar import ground_filter_numba as compiled
+from lidarphoto.core.lidar.ground_filter_params import SmrfParams
 
 if not compiled.AVAILABLE:
     if os.environ.get("LIDARPHOTO_REQUIRE_NUMBA") == "1":  # set by scripts/test.sh
@@ -73,15 +74,15 @@ def test_progressive_opening_same_object_cells_both_paths():
         r0, c0 = rng.integers(0, 140), rng.integers(0, 160)
         surface[r0 : r0 + rng.integers(3, 30), c0 : c0 + rng.integers(3, 30)] += 8.0
     surface = surface.astype(np.float32)
-    windows, thresholds = gf.smrf_windows(gf.SmrfParams())
+    windows, thresholds = gm.smrf_windows(SmrfParams())
     for shape in ("disk", "square"):
-        a = gf._progressive_opening(surface, windows, thresholds, shape, None, compiled=False)
-        b = gf._progressive_opening(surface, windows, thresholds, shape, None, compiled=True)
+        a = gm._progressive_opening(surface, windows, thresholds, shape, None, compiled=False)
+        b = gm._progressive_opening(surface, windows, thresholds, shape, None, compiled=True)
         assert 0 < a.sum() < a.size
         np.testing.assert_array_equal(a, b)
     # NaN cells: the compiled path hands the grid to OpenCV (same result as before)
     holed = surface.copy()
     holed[5:9, 5:9] = np.nan
-    a = gf._progressive_opening(holed, windows, thresholds, "disk", None, compiled=False)
-    b = gf._progressive_opening(holed, windows, thresholds, "disk", None, compiled=True)
+    a = gm._progressive_opening(holed, windows, thresholds, "disk", None, compiled=False)
+    b = gm._progressive_opening(holed, windows, thresholds, "disk", None, compiled=True)
     np.testing.assert_array_equal(a, b)

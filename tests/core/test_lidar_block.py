@@ -25,7 +25,8 @@ from lidarphoto.core.jobs import lidar_block
 from lidarphoto.core.jobs.runner import run_job
 from lidarphoto.core.lidar.block import ground_buffer
 from lidarphoto.core.lidar.control import lidar_control
-from lidarphoto.core.lidar.ground_filter import SmrfParams, ground_filter
+from lidarphoto.core.lidar.ground_filter import ground_filter
+from lidarphoto.core.lidar.ground_filter_params import SmrfParams
 from lidarphoto.core.lidar.roof_planes import extract_roof_planes
 from lidarphoto.core.simulation.block import town_tiles, write_las
 
