@@ -6,7 +6,7 @@ import logging
 
 from ..errors import InputError
 from ..quality.accuracy import OUTLIER_RULES, STANDARD_KEYS, AccuracySettings
-from ..quality.standards import PEC_CLASSES
+from ..quality.standards_pec import PEC_CLASSES
 from .common import CSV_FILTER
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values

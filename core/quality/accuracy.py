@@ -36,9 +36,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import CrsError, InputError, stop_if_asked
-from . import standards as std_mod
 from .html_table import TR_CONTEXT  # noqa: F401 - make i18n collects the _t("...") marks
-from .standards import _t
+from .standards import StandardResult, _t
+from .standards_asprs import asprs_2023
+from .standards_nssda import nssda
+from .standards_pec import pec_pcd
+from .standards_project import PAPER_FLIGHT_GEOMETRY, PAPER_H_THRESHOLD_M, project_threshold
 
 __all__ = [
     "OUTLIER_RULES",
@@ -609,9 +612,9 @@ class AccuracySettings:
     pec_scale: float = 1000.0
     pec_equidistance: float = 0.0
     pec_class: str = "A"
-    project_h_threshold: float = std_mod.PAPER_H_THRESHOLD_M
+    project_h_threshold: float = PAPER_H_THRESHOLD_M
     project_v_threshold: float = 0.0
-    flight_geometry: tuple[float, float, float, float] = std_mod.PAPER_FLIGHT_GEOMETRY
+    flight_geometry: tuple[float, float, float, float] = PAPER_FLIGHT_GEOMETRY
     title: str = _t("Positional accuracy report")
 
     def validated(self) -> AccuracySettings:
@@ -659,8 +662,8 @@ class AccuracyReport:
     used: NDArray[np.bool_]
     overall: GroupStatistics
     groups: dict[str, GroupStatistics]
-    standards: tuple[std_mod.StandardResult, ...]
-    group_thresholds: dict[str, std_mod.StandardResult] = field(default_factory=dict)
+    standards: tuple[StandardResult, ...]
+    group_thresholds: dict[str, StandardResult] = field(default_factory=dict)
     created: str = ""
     contrast: GroupStatistics | None = None
 
@@ -758,7 +761,7 @@ def assess_accuracy(
             contrast = group_statistics(d[other], other_label, alpha=s.alpha, declared_sigma=sig)
     _tick(progress, should_stop, 0.3)
     groups: dict[str, GroupStatistics] = {}
-    thresholds: dict[str, std_mod.StandardResult] = {}
+    thresholds: dict[str, StandardResult] = {}
     names = list(dict.fromkeys(points.groups))
     garr = np.asarray(points.groups, dtype=object)
     if len(names) > 1 or (names and names[0]):
@@ -767,7 +770,7 @@ def assess_accuracy(
             label = g or "(no group)"
             groups[label] = group_statistics(d[mask], label, alpha=s.alpha, declared_sigma=sig)
             if "project" in s.standards and mask.any():
-                thresholds[label] = std_mod.project_threshold(
+                thresholds[label] = project_threshold(
                     d[mask],
                     h_threshold=s.project_h_threshold,
                     v_threshold=s.project_v_threshold or None,
@@ -779,7 +782,7 @@ def assess_accuracy(
     for key in s.standards:
         if key == "asprs":
             results.append(
-                std_mod.asprs_2023(
+                asprs_2023(
                     du,
                     survey_sigma_h=s.survey_sigma_h,
                     survey_sigma_v=s.survey_sigma_v,
@@ -789,7 +792,7 @@ def assess_accuracy(
             )
         elif key == "nssda":
             results.append(
-                std_mod.nssda(
+                nssda(
                     du,
                     normal=[comps[c].normality.normal for c in COMPONENTS],
                     biased=[comps[c].bias.biased for c in COMPONENTS],
@@ -797,7 +800,7 @@ def assess_accuracy(
             )
         elif key == "pec":
             results.append(
-                std_mod.pec_pcd(
+                pec_pcd(
                     du,
                     scale=s.pec_scale,
                     equidistance=s.pec_equidistance or None,
@@ -806,7 +809,7 @@ def assess_accuracy(
             )
         elif key == "project":
             results.append(
-                std_mod.project_threshold(
+                project_threshold(
                     du,
                     h_threshold=s.project_h_threshold,
                     v_threshold=s.project_v_threshold or None,

@@ -8,18 +8,16 @@ import math
 import numpy as np
 import pytest
 from lidarphoto.core.errors import InputError
-from lidarphoto.core.quality.standards import (
+from lidarphoto.core.quality.standards_asprs import asprs_2023
+from lidarphoto.core.quality.standards_nssda import (
     NSSDA_HORIZONTAL_FACTOR,
     NSSDA_RADIAL_FACTOR,
     NSSDA_VERTICAL_FACTOR,
-    asprs_2023,
     bivariate_radius,
     nssda,
-    pec_pcd,
-    pec_pcd_limits,
-    project_threshold,
-    stereo_height_precision,
 )
+from lidarphoto.core.quality.standards_pec import pec_pcd, pec_pcd_limits
+from lidarphoto.core.quality.standards_project import project_threshold, stereo_height_precision
 from scipy import stats
 
 EPS = 1e-6  # metres: "just inside" / "just outside" a limit
