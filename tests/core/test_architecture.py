@@ -177,3 +177,110 @@ def test_the_checker_sees_a_wrong_way_import(tmp_path):
     targets = _imports(name, bad)
     assert targets == {f"{PKG}.core.io.tables"}
     assert _layer_violations(name, targets)
+
+
+# ----------------------------------------------------------------------------- sizes
+
+#: docs/architecture.md's limits: no file outside tests over this many lines ...
+MAX_FILE_LINES = 800
+#: ... and no function (or method, nested ones included) over this many.
+MAX_FUNCTION_LINES = 150
+#: What is not split yet, with its size when it was listed. The lists only shrink: a listed
+#: file or function may not grow, and one that is back under the limit must leave the list.
+FILES_NOT_YET_SPLIT = {
+    "core/io/raster.py": 818,
+    "core/lidar/roof_planes.py": 942,
+    "core/lsq/schur.py": 903,
+    "core/photo/resection.py": 1035,
+    "core/photo/tie_points.py": 1035,
+    "core/quality/accuracy.py": 940,
+    "core/simulation/flight.py": 936,
+    "core/simulation/render.py": 913,
+    "core/tls/calibration.py": 813,
+    "core/tls/targets.py": 886,
+}
+FUNCTIONS_NOT_YET_SPLIT = {
+    "bench/bench_ortho.py:main": 174,
+    "core/geometry/raycast_numba.py:_trace": 174,
+    "core/lidar/roof_planes_numba.py:_local_planes_kernel": 233,
+    "core/photo/camera_calibration.py:calibrate_camera": 176,
+    "core/photo/least_squares_matching.py:lsm_batch": 159,
+    "core/photo/monoplot.py:monoplot": 227,
+    "core/photo/resection.py:resect": 183,
+    "core/photo/tie_points.py:refine_tracks": 157,
+    "core/quality/accuracy_html.py:render_html": 152,
+    "core/quality/tls_html.py:render_tls_html": 176,
+    "core/simulation/flight.py:simulate_flight": 216,
+    "core/simulation/terrain.py:make_terrain": 194,
+    "core/simulation/uav_block.py:simulate_uav_block": 180,
+    "scripts/make_demo_project.py:build_project": 163,
+}
+
+
+def _code_files(root: Path = ROOT) -> list[Path]:
+    """Every .py file of the repository outside tests/ and hidden or build folders."""
+    return sorted(
+        p
+        for p in root.rglob("*.py")
+        if not any(part.startswith(".") or part in ("tests", "build") for part in
+                   p.relative_to(root).parts[:-1])
+    )  # fmt: skip
+
+
+def _sizes(root: Path = ROOT) -> tuple[dict[str, int], dict[str, int]]:
+    """({file: lines} of the files over the limit, {file:function: lines} of the functions
+    over it), paths relative to ``root``."""
+    files, functions = {}, {}
+    for path in _code_files(root):
+        rel = path.relative_to(root).as_posix()
+        text = path.read_text(encoding="utf-8")
+        lines = len(text.splitlines())
+        if lines > MAX_FILE_LINES:
+            files[rel] = lines
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                length = node.end_lineno - node.lineno + 1
+                if length > MAX_FUNCTION_LINES:
+                    key = f"{rel}:{node.name}"
+                    functions[key] = max(functions.get(key, 0), length)
+    return files, functions
+
+
+def _size_violations(found: dict[str, int], allowed: dict[str, int], limit: int) -> list[str]:
+    out = [f"{k}: {n} lines > {limit}" for k, n in found.items() if k not in allowed]
+    out += [f"{k}: grew from {allowed[k]} to {n} lines" for k, n in found.items()
+            if k in allowed and n > allowed[k]]  # fmt: skip
+    out += [f"{k}: now within {limit} lines: remove it from the list" for k in allowed
+            if k not in found]  # fmt: skip
+    return sorted(out)
+
+
+SIZES = _sizes()
+
+
+def test_no_file_over_the_limit():
+    assert _size_violations(SIZES[0], FILES_NOT_YET_SPLIT, MAX_FILE_LINES) == []
+
+
+def test_no_function_over_the_limit():
+    assert _size_violations(SIZES[1], FUNCTIONS_NOT_YET_SPLIT, MAX_FUNCTION_LINES) == []
+
+
+def test_the_size_checker_sees_a_long_file_and_function(tmp_path):
+    """A planted long file with a long function is found, and a listed entry that shrank
+    under the limit is reported as stale."""
+    (tmp_path / "core").mkdir()
+    body = "".join(f"    x{i} = {i}\n" for i in range(MAX_FUNCTION_LINES))
+    filler = "\n" * (MAX_FILE_LINES - MAX_FUNCTION_LINES)
+    (tmp_path / "core" / "big.py").write_text(f"def long():\n{body}{filler}", encoding="utf-8")
+    (tmp_path / "tests").mkdir()
+    (tmp_path / "tests" / "ignored.py").write_text("\n" * 2000, encoding="utf-8")
+    files, functions = _sizes(tmp_path)
+    assert files == {"core/big.py": MAX_FILE_LINES + 1}
+    assert functions == {"core/big.py:long": MAX_FUNCTION_LINES + 1}
+    assert _size_violations(files, {}, MAX_FILE_LINES) == [
+        f"core/big.py: {MAX_FILE_LINES + 1} lines > {MAX_FILE_LINES}"
+    ]
+    assert _size_violations({}, {"core/gone.py": 900}, MAX_FILE_LINES) == [
+        f"core/gone.py: now within {MAX_FILE_LINES} lines: remove it from the list"
+    ]
