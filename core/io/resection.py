@@ -58,7 +58,7 @@ from typing import Union
 import numpy as np
 
 from ..errors import InputError
-from ..photo.resection import LineControl, PointControl, line_control_from_lines
+from ..photo.resection_map import LineControl, PointControl, line_control_from_lines
 from .control import read_lines_csv
 from .tables import (
     check_covariance,

@@ -125,7 +125,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.observations import read_observations_csv
     from ..io.orientation import read_eo_csv
     from ..io.resection import read_line_control_csv, read_point_control_csv
-    from ..photo.resection import image_inputs, resect_in_map
+    from ..photo.resection_map import image_inputs, resect_in_map
     from ..quality.resection_html import render_resection_html
 
     if not v.observations and not v.line_observations:
