@@ -107,7 +107,7 @@ from .model import AdjustmentOptions, Constraint
 from .outliers import _ROBUST_K, _robust_stage, _snoop
 from .problem import Block, _as_index, _Con, _labels, _prepare_block, _Problem
 from .results import AdjustmentResult, RejectedObservation
-from .schur import EliminationPlan
+from .schur_plan import EliminationPlan
 from .solve import _Progress, _run
 from .statistics import _finish
 

@@ -17,7 +17,8 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import AdjustmentError, InputError
 from .model import GaussHelmertBlock, GaussMarkovBlock, _PriorModel
 from .scaling import jacobi_scale, scale_constraints
-from .schur import EliminationPlan, build_reduced_normal
+from .schur import build_reduced_normal
+from .schur_plan import EliminationPlan
 
 Array = NDArray[np.float64]
 Block = Union[GaussMarkovBlock, GaussHelmertBlock]

@@ -190,7 +190,6 @@ MAX_FUNCTION_LINES = 150
 FILES_NOT_YET_SPLIT = {
     "core/io/raster.py": 818,
     "core/lidar/roof_planes.py": 942,
-    "core/lsq/schur.py": 903,
     "core/photo/tie_points.py": 1035,
     "core/quality/accuracy.py": 940,
     "core/simulation/flight.py": 936,
