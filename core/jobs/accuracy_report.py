@@ -5,7 +5,8 @@ from __future__ import annotations
 import logging
 
 from ..errors import InputError
-from ..quality.accuracy import OUTLIER_RULES, STANDARD_KEYS, AccuracySettings
+from ..quality.accuracy import STANDARD_KEYS, AccuracySettings
+from ..quality.accuracy_statistics import OUTLIER_RULES
 from ..quality.standards_pec import PEC_CLASSES
 from .common import CSV_FILTER
 from .runner import JobResult
@@ -203,8 +204,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..errors import stop_if_asked
     from ..geometry.frames import check_area_of_use, parse_crs
     from ..io.atomic import write_text_atomic
-    from ..quality.accuracy import assess_accuracy, report_to_dict, with_deprecated_keys
+    from ..quality.accuracy import assess_accuracy
     from ..quality.accuracy_html import render_html
+    from ..quality.accuracy_json import report_to_dict, with_deprecated_keys
 
     settings = AccuracySettings(
         **{f: v[k] for k, f, *_ in _NUMBERS + _STANDARD_NUMBERS + _PROJECT_NUMBERS},

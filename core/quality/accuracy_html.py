@@ -19,7 +19,8 @@ from .html_table import table as _table
 from .svg_plots import histogram, qq_plot, vector_map
 
 if TYPE_CHECKING:
-    from .accuracy import AccuracyReport, GroupStatistics
+    from .accuracy import AccuracyReport
+    from .accuracy_statistics import GroupStatistics
 
 __all__ = ["render_html"]
 

@@ -17,13 +17,15 @@ from lidarphoto.core.quality.accuracy import (
     AccuracySettings,
     CheckPoints,
     assess_accuracy,
+    join_points,
+    point_set,
+)
+from lidarphoto.core.quality.accuracy_json import report_to_dict
+from lidarphoto.core.quality.accuracy_statistics import (
     bias_test,
     component_statistics,
-    join_points,
     normality_test,
-    point_set,
     precision_test,
-    report_to_dict,
     screen_outliers,
 )
 from scipy import stats

@@ -11,12 +11,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from lidarphoto.core.quality.accuracy import (
-    AccuracySettings,
-    CheckPoints,
-    assess_accuracy,
-    report_to_dict,
-)
+from lidarphoto.core.quality.accuracy import AccuracySettings, CheckPoints, assess_accuracy
+from lidarphoto.core.quality.accuracy_json import report_to_dict
 
 ROOT = Path(__file__).resolve().parents[2]
 SIGMA = (0.03, 0.04, 0.05)  # m, per axis

@@ -100,7 +100,7 @@ def test_every_table_reader_of_core_io_has_an_example():
 
 
 def test_the_accuracy_json_has_the_documented_keys():
-    from lidarphoto.core.quality.accuracy import JSON_TOP_KEYS, report_to_dict
+    from lidarphoto.core.quality.accuracy_json import JSON_TOP_KEYS, report_to_dict
     from test_accuracy_names import small_report
 
     assert tuple(report_to_dict(small_report())) == JSON_TOP_KEYS
