@@ -63,11 +63,8 @@ def make_project(folder: Path, n_in_image: int, n_other: int, seed: int = 3) -> 
     from lidarphoto.core.photo.georeference import direct_georeference
     from lidarphoto.core.photo.mount import Mount
     from lidarphoto.core.photo.picking import PickingScene
-    from lidarphoto.core.simulation.flight import (
-        FlightConfig,
-        simulate_flight,
-        small_format_camera,
-    )
+    from lidarphoto.core.simulation.flight import FlightConfig, simulate_flight
+    from lidarphoto.core.simulation.flight_over import small_format_camera
     from osgeo import gdal
 
     gdal.UseExceptions()

@@ -62,7 +62,7 @@ from lidarphoto.core.photo.intersection import forward_intersection
 from lidarphoto.core.photo.mount import Mount
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable
 from lidarphoto.core.photo.picking import PickingScene
-from lidarphoto.core.simulation.flight import (
+from lidarphoto.core.simulation.flight_over import (
     ControlFlightConfig,
     ControlFlightSimulation,
     simulate_flight_over,

@@ -21,12 +21,8 @@ from lidarphoto.core.photo.boresight_setup import ARCSEC, local_frame_for
 from lidarphoto.core.photo.ins import ins_grade
 from lidarphoto.core.photo.intersection import forward_intersection
 from lidarphoto.core.quality.boresight_html import render_boresight_html
-from lidarphoto.core.simulation.flight import (
-    ControlFlightConfig,
-    FlightConfig,
-    simulate_flight,
-    simulate_flight_over,
-)
+from lidarphoto.core.simulation.flight import FlightConfig, simulate_flight
+from lidarphoto.core.simulation.flight_over import ControlFlightConfig, simulate_flight_over
 
 SMALL = FlightConfig(
     n_buildings=12,
