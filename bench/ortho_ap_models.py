@@ -45,7 +45,8 @@ from lidarphoto.core.io.raster import RasterReader, write_rgb_tiff
 from lidarphoto.core.photo.bundle import bundle_adjust
 from lidarphoto.core.photo.bundle_setup import BundleOptions
 from lidarphoto.core.quality.registration import phase_correlation
-from lidarphoto.core.simulation.render import RenderOptions, RenderScene, render_image
+from lidarphoto.core.simulation.render import render_image
+from lidarphoto.core.simulation.render_scene import RenderOptions, RenderScene
 from lidarphoto.core.simulation.uav_block import simulate_uav_block
 
 HERE = Path(__file__).resolve().parent

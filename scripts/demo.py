@@ -67,12 +67,8 @@ from lidarphoto.core.simulation.flight_over import (
     ControlFlightSimulation,
     simulate_flight_over,
 )
-from lidarphoto.core.simulation.render import (
-    RenderOptions,
-    RenderScene,
-    edge_offsets,
-    render_image,
-)
+from lidarphoto.core.simulation.render import edge_offsets, render_image
+from lidarphoto.core.simulation.render_scene import RenderOptions, RenderScene
 
 ROOT = Path(__file__).resolve().parents[1]
 SAMPLE = ROOT / "sample_data" / "trajectory_demo.csv"

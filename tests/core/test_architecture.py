@@ -191,7 +191,6 @@ FILES_NOT_YET_SPLIT = {
     "core/io/raster.py": 818,
     "core/lidar/roof_planes.py": 942,
     "core/photo/tie_points.py": 1035,
-    "core/simulation/render.py": 913,
     "core/tls/calibration.py": 813,
     "core/tls/targets.py": 886,
 }

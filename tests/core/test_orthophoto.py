@@ -42,14 +42,8 @@ from lidarphoto.core.photo.orthophoto import (
 )
 from lidarphoto.core.photo.orthophoto_numba import AVAILABLE as NUMBA
 from lidarphoto.core.quality.registration import phase_correlation
-from lidarphoto.core.simulation.render import (
-    RenderOptions,
-    RenderScene,
-    _Rays,
-    lambert,
-    render_image,
-    sun_vector,
-)
+from lidarphoto.core.simulation.render import _Rays, render_image
+from lidarphoto.core.simulation.render_scene import RenderOptions, RenderScene, lambert, sun_vector
 
 CRS = "EPSG:28992"
 X0, Y0 = 85000.0, 447000.0

@@ -33,7 +33,8 @@ from lidarphoto.core.jobs.runner import run_job
 from lidarphoto.core.photo.mosaic import MosaicOptions, MosaicSource, mosaic_grid, mosaic_tiles
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable
 from lidarphoto.core.quality.registration import phase_correlation
-from lidarphoto.core.simulation.render import RenderOptions, render_image
+from lidarphoto.core.simulation.render import render_image
+from lidarphoto.core.simulation.render_scene import RenderOptions
 from test_orthophoto import CRS, X0, Y0, _scene
 
 GSD = 0.06

@@ -25,16 +25,13 @@ from lidarphoto.core.lidar.control import ControlLine
 from lidarphoto.core.lidar.dsm import dsm_from_points
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable, eo_map_to_local
 from lidarphoto.core.photo.picking import PickingScene
-from lidarphoto.core.simulation.render import (
+from lidarphoto.core.simulation.render import _Rays, edge_offsets, render_image, render_images
+from lidarphoto.core.simulation.render_scene import (
     CLASS_ALBEDO,
     PLANE_TINTS,
     RenderOptions,
     RenderScene,
-    _Rays,
-    edge_offsets,
     lambert,
-    render_image,
-    render_images,
     sun_vector,
 )
 

@@ -27,7 +27,8 @@ from lidarphoto.core.io.observations import read_observations_csv
 from lidarphoto.core.io.orientation import read_eo_csv, write_eo_csv
 from lidarphoto.core.photo.georeference import direct_georeference
 from lidarphoto.core.photo.picking import PickingScene
-from lidarphoto.core.simulation.render import RenderOptions, RenderScene, render_image
+from lidarphoto.core.simulation.render import render_image
+from lidarphoto.core.simulation.render_scene import RenderOptions, RenderScene
 from lidarphoto.plugin.image_dock import ImagePickingDock
 from qgis.core import QgsProject
 from qgis.PyQt.QtCore import QPoint, QPointF, Qt

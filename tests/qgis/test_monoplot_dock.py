@@ -24,7 +24,8 @@ from lidarphoto.core.photo.monoplot import monoplot
 from lidarphoto.core.photo.observations import ImageObservations
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable
 from lidarphoto.core.photo.picking import PickingScene
-from lidarphoto.core.simulation.render import RenderOptions, RenderScene, render_image
+from lidarphoto.core.simulation.render import render_image
+from lidarphoto.core.simulation.render_scene import RenderOptions, RenderScene
 from lidarphoto.plugin.image_dock import ImagePickingDock
 from qgis.core import (
     QgsFeature,
