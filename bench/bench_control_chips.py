@@ -27,7 +27,7 @@ import cv2
 import numpy as np
 from lidarphoto.core.geometry.collinearity import project
 from lidarphoto.core.io.camera import write_camera_json
-from lidarphoto.core.io.raster import GeoTiffWriter
+from lidarphoto.core.io.raster_write import GeoTiffWriter
 from lidarphoto.core.jobs import make_control_chips as job
 from lidarphoto.core.jobs.runner import run_job
 from lidarphoto.core.photo.control_chips import ChipOptions, make_chip

@@ -388,7 +388,7 @@ def large_frame(work: Path) -> dict:
     from lidarphoto.core.io.camera import write_camera_json
     from lidarphoto.core.io.dsm import write_dsm
     from lidarphoto.core.io.orientation import write_eo_csv
-    from lidarphoto.core.io.raster import GeoTiffWriter
+    from lidarphoto.core.io.raster_write import GeoTiffWriter
     from lidarphoto.core.photo.orientation import ExteriorOrientationTable
     from lidarphoto.core.simulation.flight import ultracam_xp
 

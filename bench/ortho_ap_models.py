@@ -41,7 +41,8 @@ from lidarphoto.core.geometry.surface import Dsm
 from lidarphoto.core.io.camera import write_camera_json
 from lidarphoto.core.io.dsm import write_dsm
 from lidarphoto.core.io.orientation import write_eo_csv
-from lidarphoto.core.io.raster import RasterReader, write_rgb_tiff
+from lidarphoto.core.io.raster import RasterReader
+from lidarphoto.core.io.raster_write import write_rgb_tiff
 from lidarphoto.core.photo.bundle import bundle_adjust
 from lidarphoto.core.photo.bundle_setup import BundleOptions
 from lidarphoto.core.quality.registration import phase_correlation

@@ -53,7 +53,7 @@ from lidarphoto.core.io.observations import read_observations_csv
 from lidarphoto.core.io.orientation import read_eo_csv, write_eo_csv
 from lidarphoto.core.io.planes import read_planes_csv
 from lidarphoto.core.io.pointcloud import read_points
-from lidarphoto.core.io.raster import write_rgb_tiff
+from lidarphoto.core.io.raster_write import write_rgb_tiff
 from lidarphoto.core.io.tables import write_csv_atomic
 from lidarphoto.core.io.trajectory import read_trajectory_csv
 from lidarphoto.core.photo.boresight_setup import local_frame_for

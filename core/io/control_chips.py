@@ -171,7 +171,7 @@ def write_chip(
     metadata: dict[str, str],
 ) -> None:
     """Write one chip (module docstring) to ``path`` (a temporary name of an OutputSet)."""
-    from .raster import GeoTiffWriter
+    from .raster_write import GeoTiffWriter
 
     data = np.where(np.isfinite(chip), chip, CHIP_NODATA).astype(np.float32)
     rows, cols = data.shape

@@ -17,7 +17,8 @@ from ..geometry.grid import Grid
 from ..geometry.surface import Dsm
 from ..lidar.dsm import NOISE_CLASSES, dsm_from_points
 from .pointcloud import parse_crs, read_points
-from .raster import read_geotiff, write_geotiff
+from .raster import read_geotiff
+from .raster_write import write_geotiff
 
 LOG = logging.getLogger(__name__)
 

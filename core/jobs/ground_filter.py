@@ -168,7 +168,7 @@ def method_params(v: Values):
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the cloud, filter its ground, write the classified copy (and the DTM)."""
     from ..io.pointcloud import read_cloud, read_info, write_cloud
-    from ..io.raster import write_geotiff
+    from ..io.raster_write import write_geotiff
     from ..lidar.ground_filter import (
         GROUND_CLASS,
         HEIGHT_FIELD,

@@ -104,7 +104,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..errors import InputError
     from ..geometry.grid import Grid
     from ..io.images import list_image_files
-    from ..io.raster import GeoTiffWriter, RasterReader, polygonize
+    from ..io.raster import RasterReader, polygonize
+    from ..io.raster_write import GeoTiffWriter
     from ..io.tables import write_csv_atomic
     from ..photo.mosaic import MosaicSource, mosaic_grid, mosaic_tiles
     from .common import compression_args

@@ -113,7 +113,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.camera import read_camera_json
     from ..io.dsm import load_dsm
     from ..io.orientation import read_eo_csv
-    from ..io.raster import GeoTiffWriter, RasterReader
+    from ..io.raster import RasterReader
+    from ..io.raster_write import GeoTiffWriter
     from ..photo.orthophoto import OrthoProjector, _lens_lattice, auto_gsd, ortho_grid
     from .common import compression_args
 

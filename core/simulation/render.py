@@ -64,7 +64,7 @@ from ..errors import CrsError, InputError, stop_if_asked
 from ..geometry.camera import Camera
 from ..geometry.frames import LocalFrame, MappingFrame
 from ..geometry.raycast import chord_rays, intersect_dsm
-from ..io.raster import write_rgb_tiff
+from ..io.raster_write import write_rgb_tiff
 from ..photo.orientation import ExteriorOrientationTable, eo_map_to_local
 from .render_scene import (
     NO_PLANE,

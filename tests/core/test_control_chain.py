@@ -34,7 +34,7 @@ from lidarphoto.core.geometry.rotations import matrix_to_opk
 from lidarphoto.core.io.camera import write_camera_json
 from lidarphoto.core.io.observations import read_observations_csv, write_observations_csv
 from lidarphoto.core.io.orientation import write_eo_csv, write_eo_csv_with_sigmas
-from lidarphoto.core.io.raster import GeoTiffWriter
+from lidarphoto.core.io.raster_write import GeoTiffWriter
 from lidarphoto.core.jobs import bundle_adjustment, locate_control_points, make_control_chips
 from lidarphoto.core.jobs.runner import run_job
 from lidarphoto.core.photo.control_plate import PlateGeometry, photo_azimuth

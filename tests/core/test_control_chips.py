@@ -23,7 +23,8 @@ from lidarphoto.core.geometry.camera import camera_from_dict
 from lidarphoto.core.geometry.collinearity import project
 from lidarphoto.core.io.camera import write_camera_json
 from lidarphoto.core.io.control_chips import CHIP_NODATA
-from lidarphoto.core.io.raster import GeoTiffWriter, RasterReader
+from lidarphoto.core.io.raster import RasterReader
+from lidarphoto.core.io.raster_write import GeoTiffWriter
 from lidarphoto.core.photo.control_chips import ChipOptions, chip_grid, make_chip
 from lidarphoto.core.photo.control_plate import (
     PlateGeometry,

@@ -30,7 +30,8 @@ from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.geometry.collinearity import project
 from lidarphoto.core.geometry.projection import PROJECTIONS
 from lidarphoto.core.io.camera import read_camera_json, write_camera_json
-from lidarphoto.core.io.raster import GeoTiffWriter, RasterReader
+from lidarphoto.core.io.raster import RasterReader
+from lidarphoto.core.io.raster_write import GeoTiffWriter
 from lidarphoto.core.photo.control_chips import ChipOptions, make_chip, register_sift
 from lidarphoto.core.photo.control_plate import (
     PlateGeometry,

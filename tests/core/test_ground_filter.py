@@ -15,7 +15,8 @@ import pytest
 from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.errors import Cancelled, InputError
 from lidarphoto.core.io.pointcloud import CloudInfo, read_points
-from lidarphoto.core.io.raster import RasterReader, overview_factors, write_geotiff
+from lidarphoto.core.io.raster import RasterReader, overview_factors
+from lidarphoto.core.io.raster_write import write_geotiff
 from lidarphoto.core.jobs import ground_filter as ground_filter_job
 from lidarphoto.core.jobs.common import lengths_in_cloud_units
 from lidarphoto.core.jobs.runner import run_job

@@ -300,7 +300,7 @@ def _write_inputs(block, tmp_path):
     """Images (8-bit), chips GCP1 and FLAT (GeoTIFF), control, camera and EO files."""
     from lidarphoto.core.io.camera import write_camera_json
     from lidarphoto.core.io.orientation import write_eo_csv
-    from lidarphoto.core.io.raster import write_geotiff, write_rgb_tiff
+    from lidarphoto.core.io.raster_write import write_geotiff, write_rgb_tiff
 
     _, images, eo, chip = block
     (tmp_path / "img").mkdir()

@@ -22,12 +22,8 @@ from lidarphoto.core.geometry.surface import Dsm, reproject_dsm
 from lidarphoto.core.io.camera import write_camera_json
 from lidarphoto.core.io.dsm import write_dsm
 from lidarphoto.core.io.orientation import write_eo_csv
-from lidarphoto.core.io.raster import (
-    GeoTiffWriter,
-    RasterReader,
-    overview_factors,
-    write_rgb_tiff,
-)
+from lidarphoto.core.io.raster import RasterReader, overview_factors
+from lidarphoto.core.io.raster_write import GeoTiffWriter, write_rgb_tiff
 from lidarphoto.core.jobs import orthomosaic, orthorectify
 from lidarphoto.core.jobs.runner import run_job
 from lidarphoto.core.photo.mosaic import MosaicOptions, MosaicSource, mosaic_grid, mosaic_tiles
@@ -404,13 +400,13 @@ def test_levels_finished_during_the_next_image_are_whole(block, tmp_path):
 
 
 def test_a_failure_writing_the_levels_leaves_nothing(block, tmp_path, monkeypatch):
-    from lidarphoto.core.io import raster
+    from lidarphoto.core.io import raster_write
 
     def fail(*args):
         raise OSError("disk full (simulated)")
 
-    monkeypatch.setattr(raster, "_write_levels_rasterio", fail)
-    monkeypatch.setattr(raster, "_write_levels_gdal", fail)
+    monkeypatch.setattr(raster_write, "_write_levels_rasterio", fail)
+    monkeypatch.setattr(raster_write, "_write_levels_gdal", fail)
     with pytest.raises(OSError, match="simulated"):
         run_job(orthorectify, _values(_args(block, tmp_path / "out")))
     assert not any((tmp_path / "out").iterdir())

@@ -11,14 +11,8 @@ import pyproj
 import pytest
 from lidarphoto.core.errors import InputError
 from lidarphoto.core.io.atomic import OutputSet
-from lidarphoto.core.io.raster import (
-    GeoTiffWriter,
-    RasterReader,
-    overview_factors,
-    polygonize,
-    raster_backend,
-    write_rgb_tiff,
-)
+from lidarphoto.core.io.raster import RasterReader, overview_factors, polygonize, raster_backend
+from lidarphoto.core.io.raster_write import GeoTiffWriter, write_rgb_tiff
 
 GT = (85000.0, 0.5, 0.0, 447100.0, 0.0, -0.5)
 
@@ -126,7 +120,8 @@ def test_rasterio_keeps_its_own_proj_database_when_proj_data_points_elsewhere(tm
     (decoy / "proj.db").write_bytes(b"not a database")  # any foreign proj.db
     code = (
         "import numpy as np\n"
-        "from lidarphoto.core.io.raster import GeoTiffWriter, RasterReader\n"
+        "from lidarphoto.core.io.raster import RasterReader\n"
+        "from lidarphoto.core.io.raster_write import GeoTiffWriter\n"
         f"p = {str(tmp_path / 'c.tif')!r}\n"
         "with GeoTiffWriter(p, 4, 3, 1, np.uint8, (85000.0, 1, 0, 447000.0, 0, -1),"
         " 'EPSG:28992') as w:\n"

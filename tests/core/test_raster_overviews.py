@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from lidarphoto.core.io.raster import GeoTiffWriter, RasterReader, overview_factors, raster_backend
+from lidarphoto.core.io.raster import RasterReader, overview_factors, raster_backend
 from lidarphoto.core.io.raster_overviews import AVAILABLE, OverviewBuilder, average_level
+from lidarphoto.core.io.raster_write import GeoTiffWriter
 
 GT = (85000.0, 0.5, 0.0, 447100.0, 0.0, -0.5)
 
@@ -136,12 +137,12 @@ def test_pixel_interleaved_read(tmp_path):
 def test_levels_beyond_the_memory_budget_are_gdals(tmp_path, monkeypatch):
     """A raster whose levels would not fit OVERVIEW_MEMORY_BYTES gets GDAL's overviews (the
     same pixels), one that fits gets them from memory."""
-    from lidarphoto.core.io import raster
+    from lidarphoto.core.io import raster_write
 
     data, mask = _raster(300, 400, np.uint8, seed=2)
     held = 150 * 200 * 4 * 4 // 3  # level 1 and its mask, and the deeper levels
     for budget, in_memory in ((held, True), (held - 1, False)):
-        monkeypatch.setattr(raster, "OVERVIEW_MEMORY_BYTES", budget)
+        monkeypatch.setattr(raster_write, "OVERVIEW_MEMORY_BYTES", budget)
         w = GeoTiffWriter(tmp_path / f"{budget}.tif", 400, 300, 3, np.uint8, GT, "EPSG:28992",
                           mask=True, tile=128, level=1)  # fmt: skip
         assert (w._ovr is not None) == in_memory

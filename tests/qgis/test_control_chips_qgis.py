@@ -15,7 +15,8 @@ import processing
 import pytest
 from lidarphoto.core.geometry.camera import camera_from_dict
 from lidarphoto.core.io.camera import write_camera_json
-from lidarphoto.core.io.raster import GeoTiffWriter, RasterReader
+from lidarphoto.core.io.raster import RasterReader
+from lidarphoto.core.io.raster_write import GeoTiffWriter
 from lidarphoto.core.jobs import make_control_chips as chips_job
 from lidarphoto.core.jobs.runner import run_job
 from lidarphoto.core.photo.control_plate import PlateGeometry, photo_azimuth

@@ -19,7 +19,7 @@ from lidarphoto.core.io.dsm import dsm_from_las, load_dsm, write_dsm
 from lidarphoto.core.io.observations import read_observations_csv
 from lidarphoto.core.io.orientation import read_eo_csv, write_eo_csv
 from lidarphoto.core.io.pointcloud import read_points
-from lidarphoto.core.io.raster import write_rgb_tiff
+from lidarphoto.core.io.raster_write import write_rgb_tiff
 from lidarphoto.core.photo.monoplot import monoplot
 from lidarphoto.core.photo.observations import ImageObservations
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable

@@ -18,7 +18,7 @@ from lidarphoto.core.geometry.rotations import matrix_to_opk
 from lidarphoto.core.io.camera import write_camera_json
 from lidarphoto.core.io.observations import read_observations_csv, write_observations_csv
 from lidarphoto.core.io.orientation import write_eo_csv
-from lidarphoto.core.io.raster import write_geotiff
+from lidarphoto.core.io.raster_write import write_geotiff
 from lidarphoto.core.photo.observations import ImageObservations
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable, eo_map_to_local
 from lidarphoto.core.simulation.control_chips import GroundTexture, make_chip, render_plane_image
