@@ -18,6 +18,9 @@ sigma columns take the caller's defaults.
 Control (optional): ``target_id,X,Y,Z[,s_X,s_Y,s_Z]`` (object frame, metres; a sigma of 0
 holds the coordinate fixed; no sigma columns: fixed).
 
+The writers of a calibration's tables take ``comments``: lines written first as ``# text``
+(the warnings of a doubtful calibration the user accepted; the readers skip them).
+
 Stations (optional): ``station_id[,X,Y,Z][,omega_deg,phi_deg,kappa_deg][,levelled]``:
 approximate positions (m) and angles (degrees), the compensator's omega, phi of a levelled
 station, and ``levelled`` (1/0, true/false; empty: the run's default).
@@ -244,7 +247,9 @@ def _num(x: float) -> str:
     return repr(float(x)) if np.isfinite(x) else ""
 
 
-def write_tls_stations_csv(path: PathLike, cal: TlsCalibration) -> None:
+def write_tls_stations_csv(
+    path: PathLike, cal: TlsCalibration, comments: Sequence[str] = ()
+) -> None:
     """Adjusted station poses with a-posteriori sigmas (:data:`STATION_COLUMNS`)."""
     obs = cal.observations
     counts = {s: len({t for st, t in zip(obs.station, obs.target) if st == s})
@@ -256,20 +261,24 @@ def write_tls_stations_csv(path: PathLike, cal: TlsCalibration) -> None:
             (s, *map(_num, p[:3]), *map(_num, np.degrees(p[3:])), *map(_num, sd[:3]),
              *map(_num, sd[3:] / ARCSEC), int(cal.levelled[k]), counts[s])
         )  # fmt: skip
-    write_csv_atomic(path, STATION_COLUMNS, rows)
+    write_csv_atomic(path, STATION_COLUMNS, rows, comments)
 
 
-def write_tls_aps_csv(path: PathLike, cal: TlsCalibration) -> None:
+def write_tls_aps_csv(
+    path: PathLike, cal: TlsCalibration, comments: Sequence[str] = ()
+) -> None:
     """The additional parameters in report units (:data:`AP_COLUMNS`)."""
     rows = [
         (a["name"], a["formula"], a["cause"], a["unit"], _num(a["value"]), _num(a["std"]),
          _num(a["std_prior"]), _num(a["t"]), int(a["significant"]))
         for a in cal.ap_report()
     ]  # fmt: skip
-    write_csv_atomic(path, AP_COLUMNS, rows)
+    write_csv_atomic(path, AP_COLUMNS, rows, comments)
 
 
-def write_tls_targets_csv(path: PathLike, cal: TlsCalibration) -> None:
+def write_tls_targets_csv(
+    path: PathLike, cal: TlsCalibration, comments: Sequence[str] = ()
+) -> None:
     """Adjusted target coordinates with sigmas (:data:`TARGET_COLUMNS`)."""
     obs = cal.observations
     seen: dict[str, set[str]] = {}
@@ -280,10 +289,12 @@ def write_tls_targets_csv(path: PathLike, cal: TlsCalibration) -> None:
          len(seen.get(t, ())))
         for k, t in enumerate(cal.targets)
     ]  # fmt: skip
-    write_csv_atomic(path, TARGET_COLUMNS, rows)
+    write_csv_atomic(path, TARGET_COLUMNS, rows, comments)
 
 
-def write_tls_residuals_csv(path: PathLike, cal: TlsCalibration) -> None:
+def write_tls_residuals_csv(
+    path: PathLike, cal: TlsCalibration, comments: Sequence[str] = ()
+) -> None:
     """Residuals (adjusted minus observed) per component, Baarda's w and the rejection flag
     (:data:`RESIDUAL_COLUMNS`); ``row`` is the observation's row in its file."""
     obs = cal.observations
@@ -295,7 +306,7 @@ def write_tls_residuals_csv(path: PathLike, cal: TlsCalibration) -> None:
          int(cal.rejected[k]), int(obs.rows[k]))
         for k in range(len(obs))
     ]  # fmt: skip
-    write_csv_atomic(path, RESIDUAL_COLUMNS, rows)
+    write_csv_atomic(path, RESIDUAL_COLUMNS, rows, comments)
 
 
 def write_tls_observations_csv(
