@@ -264,9 +264,7 @@ def write_tls_stations_csv(
     write_csv_atomic(path, STATION_COLUMNS, rows, comments)
 
 
-def write_tls_aps_csv(
-    path: PathLike, cal: TlsCalibration, comments: Sequence[str] = ()
-) -> None:
+def write_tls_aps_csv(path: PathLike, cal: TlsCalibration, comments: Sequence[str] = ()) -> None:
     """The additional parameters in report units (:data:`AP_COLUMNS`)."""
     rows = [
         (a["name"], a["formula"], a["cause"], a["unit"], _num(a["value"]), _num(a["std"]),

@@ -19,7 +19,7 @@ import numpy as np
 from ..i18n import joined as _joined
 from ..i18n import mark as _t
 from ..photo.ins import INS_GRADES
-from .common import CSV_FILTER, CSV_OUT, LAS_FILTER, mount_from, mount_params
+from .common import CSV_FILTER, CSV_OUT, LAS_FILTER, mount_from, mount_params, settle_doubts
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -150,7 +150,7 @@ written and each starts with a warning (CSV: comment lines beginning with #)."""
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the inputs, calibrate, write the outputs."""
-    from ..errors import AdjustmentError, InputError, stop_if_asked
+    from ..errors import InputError, stop_if_asked
     from ..geometry.frames import MappingFrame, check_area_of_use
     from ..io.atomic import write_text_atomic
     from ..io.camera import read_camera_json
@@ -230,26 +230,14 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             out.commit(["OUTPUT_HTML"])
         raise
     doubts = doubts_about(result, v.max_boresight, v.max_sigma0)
-    if doubts and not v.accept_doubtful:
-        if out.requested("OUTPUT_HTML"):  # the failed numbers are the user's diagnosis
-            failed = BoresightRun(result, obs, np.full((len(obs), 3), np.nan),
-                                  ("",) * len(obs), settings, frame.crs.to_wkt())  # fmt: skip
-            page = render_boresight_html(failed, settings, problems=doubts, accepted=False)
-            write_text_atomic(out.path("OUTPUT_HTML"), page)
-            out.commit(["OUTPUT_HTML"])
-        raise AdjustmentError(
-            "the boresight calibration failed its checks: " + "; ".join(doubts)
-            + ". No result was written"
-            + (" (the HTML summary shows the failed adjustment)" if out.requested("OUTPUT_HTML")
-               else "")
-            + "; ACCEPT_DOUBTFUL writes them with a warning"
-        )  # fmt: skip
-    warning = [f"WARNING: {d}" for d in doubts]
-    if doubts:
-        warning.insert(0, "WARNING: this calibration failed its checks and was written only "
-                       "because ACCEPT_DOUBTFUL was set; do not use it without review")
-        for line in warning:
-            log.warning(line.removeprefix("WARNING: "))
+
+    def failed_page() -> str:  # the failed adjustment, without the positions it would give
+        failed = BoresightRun(result, obs, np.full((len(obs), 3), np.nan), ("",) * len(obs),
+                              settings, frame.crs.to_wkt())  # fmt: skip
+        return render_boresight_html(failed, settings, problems=doubts, accepted=False)
+
+    warning = settle_doubts("boresight calibration", doubts, v.accept_doubtful, out,
+                            failed_page, "HTML summary")  # fmt: skip
     positions = ground_positions(result, obs, cam, plane_list, line_list, lcp_list, ground)
     image_group = dict(zip(traj.image_id, group_labels(traj, options.groups)))
     run = BoresightRun(

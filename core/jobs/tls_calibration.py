@@ -16,7 +16,7 @@ from ..i18n import joined as _joined
 from ..i18n import mark as _t
 from ..tls.aps import AP_SETS, ARCSEC
 from ..tls.options import CalibrationOptions
-from .common import CSV_FILTER, CSV_OUT
+from .common import CSV_FILTER, CSV_OUT, settle_doubts
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -159,7 +159,7 @@ beginning with #).""",
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the tables, adjust, check the result, write the outputs."""
-    from ..errors import AdjustmentError, InputError
+    from ..errors import InputError
     from ..io.atomic import write_text_atomic
     from ..io.tls import (
         read_tls_control_csv,
@@ -241,24 +241,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     }  # fmt: skip
     rejections = rejection_test(cal.adjustment, options.snooping_alpha) if v.snooping else None
     doubts = doubts_about(cal, v.max_sigma0, rejections)
-    if doubts and not v.accept_doubtful:
-        if out.requested("OUTPUT_HTML"):  # the failed numbers are the user's diagnosis
-            page = render_tls_html(cal, settings, doubts, accepted=False, rejections=rejections)
-            write_text_atomic(out.path("OUTPUT_HTML"), page)
-            out.commit(["OUTPUT_HTML"])
-        raise AdjustmentError(
-            "the TLS calibration failed its checks: " + "; ".join(str(d) for d in doubts)
-            + ". No result was written"
-            + (" (the HTML report shows the failed adjustment)" if out.requested("OUTPUT_HTML")
-               else "")
-            + "; ACCEPT_DOUBTFUL writes them with a warning"
-        )  # fmt: skip
-    warning = [f"WARNING: {d}" for d in doubts]
-    if doubts:
-        warning.insert(0, "WARNING: this calibration failed its checks and was written only "
-                       "because ACCEPT_DOUBTFUL was set; do not use it without review")
-        for line in warning:
-            log.warning(line.removeprefix("WARNING: "))
+    warning = settle_doubts(
+        "TLS calibration", doubts, v.accept_doubtful, out,
+        lambda: render_tls_html(cal, settings, doubts, accepted=False, rejections=rejections),
+    )  # fmt: skip
     if out.requested("OUTPUT_STATIONS"):
         write_tls_stations_csv(out.path("OUTPUT_STATIONS"), cal, warning)
     if out.requested("OUTPUT_APS"):

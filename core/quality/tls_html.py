@@ -19,7 +19,7 @@ from .. import __version__
 from ..lsq.results import RejectionTest
 from ..tls.aps import ARCSEC
 from ..tls.calibration import TlsCalibration, explain_pair
-from .html_table import TR_CONTEXT, html_lang, t  # noqa: F401 - TR_CONTEXT: make i18n
+from .html_table import TR_CONTEXT, failed_checks, html_lang, t  # noqa: F401 - TR_CONTEXT: i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 
@@ -81,23 +81,11 @@ def _correlation_table(names: Sequence[str], corr: np.ndarray, n_ap: int) -> str
             f"</tr></thead><tbody>{''.join(body)}</tbody></table></div>")  # fmt: skip
 
 
-def _problems(problems: Sequence[object], accepted: bool) -> list[str]:
-    """The alarm at the top of a calibration that failed its checks."""
-    if not problems:
-        return []
-    verdict = (
-        t(
-            "These results FAILED their checks and were written only because the user asked "
-            "for them (ACCEPT_DOUBTFUL): do not use them without review."
-        )
-        if accepted
-        else t(
-            "The calibration FAILED its checks: no table and no registered scan were written. "
-            "The numbers below show the failed adjustment, for diagnosis only."
-        )
+def _refused() -> str:
+    return t(
+        "The calibration FAILED its checks: no table and no registered scan were written. "
+        "The numbers below show the failed adjustment, for diagnosis only."
     )
-    items = "".join(f"<li>{_e(t(p))}</li>" for p in problems)
-    return [f'<div class="alarm"><p><b>{_e(verdict)}</b></p><ul>{items}</ul></div>']
 
 
 def render_tls_html(
@@ -122,7 +110,7 @@ def render_tls_html(
             "Lichti (2007), correlation analysis after Lichti (2010)."
         )
         + "</p>",
-        *_problems(problems, accepted),
+        *failed_checks(problems, accepted, _refused()),
         f"<h2>{t('Settings')}</h2>",
         _table([t("setting"), t("value")], [(_e(k), _e(v)) for k, v in settings.items()]),
     ]

@@ -118,8 +118,13 @@ def _traj_file(inp: Path, text: str) -> list[str]:
 
 
 # ----------------------------------------------------------------------------- TLS network
-def _cube(inp: Path, extra_aps: dict[str, float], seed: int = 1, sigma_factor: float = 1.3,
-          blunders: int = 0) -> tuple[Path, Path]:
+def _cube(
+    inp: Path,
+    extra_aps: dict[str, float],
+    seed: int = 1,
+    sigma_factor: float = 1.3,
+    blunders: int = 0,
+) -> tuple[Path, Path]:
     """The paper's cube with a 3 x 3 target grid per face (162 observations from three
     stations) observed with a high-end scanner's noise, its observation sigmas declared
     ``sigma_factor`` times the noise (a cautious user), the paper's APs plus ``extra_aps``
@@ -361,4 +366,3 @@ def test_the_bound_holds_its_false_alarm_rate():
         o, _ = observe(truth, *SCANNER_CLASSES["high_end"], rng=seed)
         cal = calibrate(o, truth.control(), (), CalibrationOptions(levelled=False))
         assert not rejection_test(cal.adjustment, cal.options.snooping_alpha).passed, seed
-
