@@ -13,7 +13,8 @@ target fit)::
     station_id,target_id,x,y,z[,s_x,s_y,s_z][,cov_xy,cov_xz,cov_yz]
 
 metres (covariances m^2), converted to polar form with the covariance propagated. Missing
-sigma columns take the caller's defaults.
+sigma columns take the caller's defaults. A range (or a centre's distance from the scanner)
+must be > 0 and within :data:`~.scans.MAX_SCANNER_RANGE_M`.
 
 Control (optional): ``target_id,X,Y,Z[,s_X,s_Y,s_Z]`` (object frame, metres; a sigma of 0
 holds the coordinate fixed; no sigma columns: fixed).
@@ -38,6 +39,7 @@ from ..tls.aps import ARCSEC
 from ..tls.calibration import TlsCalibration
 from ..tls.network import ControlTarget, StationInfo, TlsObservations
 from ..tls.polar import polar_covariance
+from .scans import MAX_SCANNER_RANGE_M
 from .tables import (
     PathLike,
     Table,
@@ -130,6 +132,25 @@ def _angle(table: Table, stem: str, unit: str) -> tuple[np.ndarray, str]:
     )
 
 
+def _check_ranges(t: Table, rho: np.ndarray, what: str, col: int | None) -> None:
+    """Distances from the scanner (m) that are > 0 and within a scanner's reach."""
+    where = {"path": t.path, "column": None if col is None else t.columns[col]}
+    bad = np.flatnonzero(rho <= 0)
+    if bad.size:
+        k = int(bad[0])
+        raise InputError(f"{what} is {rho[k]:g} m from the scanner: it must be > 0",
+                         row=t.line_numbers[k], **where)  # fmt: skip
+    bad = np.flatnonzero(rho > MAX_SCANNER_RANGE_M)
+    if bad.size:
+        k = int(bad[0])
+        raise InputError(
+            f"{what} is {rho[k]:g} m from the scanner, beyond the {MAX_SCANNER_RANGE_M:g} m a "
+            "terrestrial scanner reaches: another unit, or coordinates that are not in the "
+            "scanner's frame",
+            row=t.line_numbers[k], **where,
+        )  # fmt: skip
+
+
 def read_tls_observations_csv(
     path: PathLike,
     angle_unit: str = "degrees",
@@ -169,10 +190,8 @@ def read_tls_observations_csv(
             if np.linalg.eigvalsh(cov[k])[0] <= 0:
                 raise InputError("the covariance of (x, y, z) is not positive definite",
                                  path=t.path, row=int(rows[k]))  # fmt: skip
-        bad = np.flatnonzero(np.linalg.norm(xyz, axis=1) <= 0)
-        if bad.size:
-            raise InputError("the point is at the scanner's origin", path=t.path,
-                             row=int(rows[bad[0]]))  # fmt: skip
+        # hypot: no overflow for a coordinate of 1e300
+        _check_ranges(t, np.hypot(np.hypot(xyz[:, 0], xyz[:, 1]), xyz[:, 2]), "the point", None)
         polar, pcov = polar_covariance(xyz, cov)
     else:
         if rcol is None:
@@ -182,6 +201,7 @@ def read_tls_observations_csv(
                 path=t.path,
             )
         rng = float_column(t, rcol)
+        _check_ranges(t, rng, "the range", rcol)
         hz, _ = _angle(t, "hz", angle_unit)
         vt, _ = _angle(t, "vt", angle_unit)
         polar = np.column_stack([rng, hz, vt])

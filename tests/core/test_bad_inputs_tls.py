@@ -149,6 +149,15 @@ def _tls_args(obs: Path, control: Path, out: Path, *extra: str) -> list[str]:
             "--output-html", str(out / "report.html"), *extra]  # fmt: skip
 
 
+def _tls_table(inp: Path, out: Path, columns: str, rows: list[str]) -> list[str]:
+    """tlscalibration on a table of station S1 with ``columns`` and ``rows``."""
+    lines = [f"station_id,target_id,{columns}"]
+    lines += [f"S1,T{k + 1},{r}" for k, r in enumerate(rows)]
+    (inp / "obs.csv").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    (inp / "control.csv").write_text("target_id,X,Y,Z\nT1,0,0,0\n", encoding="utf-8")
+    return _tls_args(inp / "obs.csv", inp / "control.csv", out)
+
+
 # ----------------------------------------------------------------------------- the cases
 @dataclass(frozen=True)
 class Case:
@@ -262,6 +271,16 @@ CASES = [
     Case("height in millimetres", lambda i, o: _traj(i, ["a,0,,85000,447500,500000,0,0,0"]),
          r"traj\.csv, row 2, column 'height': 500000 m is outside the plausible heights -1000 "
          r"to 30000 m of a sensor \(a height in another unit\?\)$"),
+    # -- TLS observation tables: distances from the scanner
+    Case("negative range", lambda i, o: _tls_table(
+        i, o, "range,hz_deg,vt_deg", ["-5.2,10,5", "6,20,5", "7,30,5"]),
+         r"obs\.csv, row 2, column 'range': the range is -5\.2 m from the scanner: it must be "
+         r"> 0$"),
+    Case("target centre 1e300 m away", lambda i, o: _tls_table(
+        i, o, "x,y,z", ["1,2,0.5", "1e300,1,1", "3,1,0.2"]),
+         r"obs\.csv, row 3: the point is 1e\+300 m from the scanner, beyond the 10000 m a "
+         r"terrestrial scanner reaches: another unit, or coordinates that are not in the "
+         r"scanner's frame$"),
     # -- an adjustment that keeps its global test by rejecting what its model cannot explain
     Case("model error absorbed by data snooping", lambda i, o: _tls_args(
         *_cube(i, CYCLIC_ERROR), o),
