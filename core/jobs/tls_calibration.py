@@ -285,7 +285,7 @@ def doubts_about(cal, max_sigma0: float, rejections) -> list:
     """Why the calibration's numbers cannot be trusted (empty when they can): no convergence,
     a global test failed with sigma0 above ``max_sigma0``, more rejections than data
     snooping's false alarms explain (``rejections``: :class:`~core.lsq.results.RejectionTest`,
-    None without snooping), parameters that are not finite."""
+    None without snooping), estimates that are not finite."""
     import numpy as np
 
     out = []
@@ -304,8 +304,7 @@ def doubts_about(cal, max_sigma0: float, rejections) -> list:
         )
     if rejections is not None and not rejections.passed:
         out.append(rejections.message())
-    bad = [n for n, x, s in zip(adj.names, adj.x, adj.std) if not (np.isfinite(x)
-                                                                  and np.isfinite(s))]
+    bad = [n for n, x in zip(adj.names, adj.x) if not np.isfinite(x)]
     if bad:
         out.append(_t("not a finite number: {items}", items=_joined(bad[:10])))
     return out
