@@ -19,6 +19,7 @@ import laspy
 import numpy as np
 import pytest
 from lidarphoto.core.cli import main
+from lidarphoto.core.io.scans import read_scan
 from lidarphoto.core.io.tls import write_tls_control_csv, write_tls_observations_csv
 from lidarphoto.core.lsq.results import rejection_test
 from lidarphoto.core.simulation.tls import (
@@ -385,3 +386,50 @@ def test_the_bound_holds_its_false_alarm_rate():
         o, _ = observe(truth, *SCANNER_CLASSES["high_end"], rng=seed)
         cal = calibrate(o, truth.control(), (), CalibrationOptions(levelled=False))
         assert not rejection_test(cal.adjustment, cal.options.snooping_alpha).passed, seed
+
+
+# ----------------------------------------------------------------------------- E57 forms
+def test_e57_points_without_coordinates_are_left_out(tmp_path):
+    """cartesianInvalidState 2 (no return): those points are not read as points at 0."""
+    pye57 = pytest.importorskip("pye57")
+    xyz = _points(500)
+    state = np.zeros(500, dtype=np.int8)
+    state[[0, 10, 499]] = 2
+    e57 = pye57.E57(str(tmp_path / "s.e57"), mode="w")
+    e57.write_scan_raw({"cartesianX": xyz[:, 0], "cartesianY": xyz[:, 1],
+                        "cartesianZ": xyz[:, 2], "cartesianInvalidState": state})  # fmt: skip
+    e57.close()
+    got, _ = read_scan(tmp_path / "s.e57")
+    assert got.shape == (497, 3)
+    np.testing.assert_allclose(got, xyz[state == 0], atol=1e-6)  # E57's stored precision
+
+
+def test_spherical_e57_is_converted_by_the_standards_formula(tmp_path, monkeypatch):
+    """A scan stored as range, azimuth, elevation (pye57 writes Cartesian only, so its reader
+    stands in): x = r cos(el) cos(az), y = r cos(el) sin(az), z = r sin(el) (ASTM E2807),
+    the points of invalid state 1 (a direction only) left out."""
+    pye57 = pytest.importorskip("pye57")
+    xyz = _points(200)
+    r = np.linalg.norm(xyz, axis=1)
+    raw = {"sphericalRange": r, "sphericalAzimuth": np.arctan2(xyz[:, 1], xyz[:, 0]),
+           "sphericalElevation": np.arcsin(xyz[:, 2] / r),
+           "sphericalInvalidState": (np.arange(200) % 50 == 3).astype(np.int8)}  # fmt: skip
+
+    class Spherical:
+        scan_count = 1
+
+        def __init__(self, path):
+            pass
+
+        def read_scan_raw(self, index, ignore_unsupported_fields=False):
+            return raw
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(pye57, "E57", Spherical)
+    (tmp_path / "s.e57").write_bytes(b"x")
+    got, intensity = read_scan(tmp_path / "s.e57")
+    keep = raw["sphericalInvalidState"] == 0
+    np.testing.assert_allclose(got, xyz[keep], atol=1e-12)
+    assert got.shape == (196, 3) and np.isnan(intensity).all()
