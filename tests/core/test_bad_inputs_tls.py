@@ -229,6 +229,9 @@ CASES = [
     Case("LAS scan whose scale factor is 0",
          lambda i, o: _extract(_las_scan(i / "s1.las", 0.0), o),
          r"s1\.las: the header's scale factors must be finite and non-zero .* got scales 0, "),
+    Case("PLY named .las", lambda i, o: _extract(
+        _write(i / "s1.las", _ply_head(1) + b"1 2 3\n"), o),
+         r"s1\.las: cannot read as LAS/LAZ: Invalid file signature"),
     Case("empty LAZ scan", lambda i, o: _extract(_empty(i / "s1.laz"), o),
          r"s1\.laz: empty file \(0 bytes\)$"),
     Case("truncated LAZ scan", lambda i, o: _extract(
