@@ -19,7 +19,15 @@ import numpy as np
 from ..i18n import joined as _joined
 from ..i18n import mark as _t
 from ..photo.ins import INS_GRADES
-from .common import CSV_FILTER, CSV_OUT, LAS_FILTER, mount_from, mount_params, settle_doubts
+from .common import (
+    CSV_FILTER,
+    CSV_OUT,
+    LAS_FILTER,
+    doubt_params,
+    mount_from,
+    mount_params,
+    settle_doubts,
+)
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -126,14 +134,12 @@ written and each starts with a warning (CSV: comment lines beginning with #)."""
               unit="degrees", minimum=0.001, maximum=45.0, advanced=True,
               help="an estimated angle beyond this fails the run (wrong MOUNT, image ids or "
               "observations)"),
-        Param("MAX_SIGMA0", "number", "Largest sigma0 when the global test fails", 3.0,
-              minimum=1.0, maximum=1000.0, advanced=True,
-              help="a failed global test with sigma0 above this fails the run (wrong "
-              "sigma_px or INS grade, or blunders data snooping did not catch)"),
-        Param("ACCEPT_DOUBTFUL", "boolean", "Write the results even when the checks fail",
-              False,
-              help="no convergence, global test beyond MAX_SIGMA0 or boresight beyond "
-              "MAX_BORESIGHT: write the outputs anyway, each with a warning at its top"),
+        *doubt_params(
+            "a failed global test with sigma0 above this fails the run (wrong sigma_px or INS "
+            "grade, or blunders data snooping did not catch)",
+            "no convergence, global test beyond MAX_SIGMA0 or boresight beyond MAX_BORESIGHT: "
+            "write the outputs anyway, each with a warning at its top",
+        ),
         Param("OUTPUT_TABLE", "file_out", "Boresight per group (CSV)", file_filter=CSV_OUT),
         Param("OUTPUT_RESIDUALS", "sink", "Image residuals", geometry="point", optional=True),
         Param("RESIDUALS_CSV", "file_out", "Image residuals (CSV)", optional=True,

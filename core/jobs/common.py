@@ -124,6 +124,17 @@ def compression_args(name: str) -> dict[str, Any]:
     return {"compress": name.upper(), "level": 1 if name in ("deflate", "zstd") else None}
 
 
+def doubt_params(sigma0_help: str, accept_help: str) -> tuple[Param, Param]:
+    """MAX_SIGMA0 and ACCEPT_DOUBTFUL of an adjustment whose result is checked
+    (:func:`settle_doubts`); the helps say which checks."""
+    return (
+        Param("MAX_SIGMA0", "number", "Largest sigma0 when the global test fails", 3.0,
+              minimum=1.0, maximum=1000.0, advanced=True, help=sigma0_help),
+        Param("ACCEPT_DOUBTFUL", "boolean", "Write the results even when the checks fail",
+              False, help=accept_help),
+    )  # fmt: skip
+
+
 def settle_doubts(
     what: str,
     doubts: Sequence[str],

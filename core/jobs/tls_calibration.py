@@ -16,7 +16,7 @@ from ..i18n import joined as _joined
 from ..i18n import mark as _t
 from ..tls.aps import AP_SETS, ARCSEC
 from ..tls.options import CalibrationOptions
-from .common import CSV_FILTER, CSV_OUT, settle_doubts
+from .common import CSV_FILTER, CSV_OUT, doubt_params, settle_doubts
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -121,15 +121,13 @@ beginning with #).""",
         Param("SNOOPING", "boolean", "Data snooping (Baarda)", _D.snooping),
         Param("CORRELATION_LIMIT", "number", "Strong correlation at |r| >=",
               _D.correlation_limit, minimum=0.1, maximum=1.0, advanced=True),
-        Param("MAX_SIGMA0", "number", "Largest sigma0 when the global test fails", 3.0,
-              minimum=1.0, maximum=1000.0, advanced=True,
-              help="a failed global test with sigma0 above this fails the run (wrong sigmas, "
-              "a model that does not fit, or blunders data snooping did not catch)"),
-        Param("ACCEPT_DOUBTFUL", "boolean", "Write the results even when the checks fail",
-              False,
-              help="no convergence, global test beyond MAX_SIGMA0 or more rejections than "
-              "data snooping's false alarms explain: write the outputs anyway, each table with "
-              "a warning at its top"),
+        *doubt_params(
+            "a failed global test with sigma0 above this fails the run (wrong sigmas, a model "
+            "that does not fit, or blunders data snooping did not catch)",
+            "no convergence, global test beyond MAX_SIGMA0 or more rejections than data "
+            "snooping's false alarms explain: write the outputs anyway, each table with a "
+            "warning at its top",
+        ),
         Param("SCANS", "files", "Scans to register (LAS/LAZ, PLY, E57; one station per file)",
               optional=True, help="the file name without its suffix is the station id"),
         Param("APPLY_APS", "boolean", "Correct the scan points by the estimated APs", True,
