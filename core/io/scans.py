@@ -246,7 +246,7 @@ def _checked(path: Path, xyz: NDArray[np.float64], intensity: NDArray | None) ->
             raise InputError(f"point {k + 1} of {len(xyz)} has an intensity that is not "
                              f"finite ({it[k]:g}); {int(bad.sum())} point(s) affected",
                              path=where)  # fmt: skip
-    far = float(np.sqrt(np.max(np.einsum("ij,ij->i", xyz, xyz))))
+    far = float(np.max(np.hypot(np.hypot(xyz[:, 0], xyz[:, 1]), xyz[:, 2])))  # no overflow
     if far > MAX_SCANNER_RANGE_M:
         raise InputError(f"points lie up to {far / 1000:.4g} km from the scanner's origin; a "
                          f"scan in its scanner's own frame stays within "
