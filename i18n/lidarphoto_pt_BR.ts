@@ -2622,6 +2622,30 @@
             <source>Planimetric discrepancy: mean {} m, standard deviation {} m, RMS {} m; RMS E/N/H {} / {} / {} m; 3D {} m. Intersected with the adjusted orientations; their sigmas carry the image noise only.</source>
             <translation type="vanished">Discrepância planimétrica: média {} m, desvio-padrão {} m, RMS {} m; RMS E/N/H {} / {} / {} m; 3D {} m. Intersectados com as orientações ajustadas; os seus desvios-padrão trazem apenas o ruído das imagens.</translation>
         </message>
+        <message>
+            <source>The calibration FAILED its checks: no table and no registered scan were written. The numbers below show the failed adjustment, for diagnosis only.</source>
+            <translation>A calibração FALHOU nas verificações: nenhuma tabela e nenhuma varredura registrada foram gravadas. Os números abaixo mostram o ajustamento que falhou, apenas para diagnóstico.</translation>
+        </message>
+        <message>
+            <source>passed, but only after more rejections than false alarms explain</source>
+            <translation>aprovado, mas só depois de mais rejeições do que os falsos alarmes explicam</translation>
+        </message>
+        <message>
+            <source>rejections explained by false alarms</source>
+            <translation>rejeições explicadas por falsos alarmes</translation>
+        </message>
+        <message>
+            <source>at most {bound} ({expected} expected); {k} rejected: P = {p}</source>
+            <translation>no máximo {bound} ({expected} esperadas); {k} rejeitadas: P = {p}</translation>
+        </message>
+        <message>
+            <source>the global test failed with sigma0 = {sigma0:.3g} &gt; MAX_SIGMA0 {maximum:g}: the observations are {sigma0:.3g} times less precise than their sigmas say (wrong sigmas, a model that does not fit, or undetected blunders)</source>
+            <translation>o teste global falhou com sigma0 = {sigma0:.3g} &gt; MAX_SIGMA0 {maximum:g}: as observações são {sigma0:.3g} vezes menos precisas do que os seus desvios-padrão dizem (desvios-padrão errados, um modelo que não se ajusta, ou erros grosseiros não detectados)</translation>
+        </message>
+        <message>
+            <source>data snooping rejected {k} of {n} observations ({share:.1f} %); its false alarms at alpha = {alpha:g} explain at most {bound} ({expected:.2g} expected, P({k} or more) = {p:.2g}): a model that does not fit the data (parameters missing?) or many blunders, and the global test of the rest does not show it</source>
+            <translation>o data snooping rejeitou {k} de {n} observações ({share:.1f} %); os seus falsos alarmes com alfa = {alpha:g} explicam no máximo {bound} ({expected:.2g} esperadas, P({k} ou mais) = {p:.2g}): um modelo que não se ajusta aos dados (parâmetros em falta?) ou muitos erros grosseiros, e o teste global das restantes não o mostra</translation>
+        </message>
     </context>
     <context>
         <name>ResectionController</name>
@@ -6467,6 +6491,40 @@ aparecem juntos ou nenhum (uma varredura ruim: nenhum).</translation>
         <message>
             <source>Additional parameters estimated</source>
             <translation>Parâmetros adicionais estimados</translation>
+        </message>
+        <message>
+            <source>## Checks of the result
+The run fails (nothing is written but the HTML report, which says why) when the adjustment
+did not converge, when its global test fails with sigma0 above MAX SIGMA0, or when data
+snooping rejected more observations than its false alarms explain (the upper tail of their
+binomial count below 0.001: a model that does not fit the data, e.g. APs missing, or many
+blunders; the global test of the observations left then proves nothing). With ACCEPT
+DOUBTFUL the outputs are written and each table starts with a warning (comment lines
+beginning with #).</source>
+            <translation>## Verificações do resultado
+A execução falha (nada é gravado além do relatório HTML, que diz o motivo) quando o ajustamento
+não convergiu, quando o seu teste global falha com sigma0 acima de MAX SIGMA0, ou quando o
+data snooping rejeitou mais observações do que os seus falsos alarmes explicam (a cauda
+superior da sua contagem binomial abaixo de 0,001: um modelo que não se ajusta aos dados, por
+exemplo APs em falta, ou muitos erros grosseiros; o teste global das observações restantes
+então nada prova). Com ACCEPT DOUBTFUL as saídas são gravadas e cada tabela começa com um aviso
+(linhas de comentário iniciadas por #).</translation>
+        </message>
+        <message>
+            <source>Largest sigma0 when the global test fails</source>
+            <translation>Maior sigma0 quando o teste global falha</translation>
+        </message>
+        <message>
+            <source>a failed global test with sigma0 above this fails the run (wrong sigmas, a model that does not fit, or blunders data snooping did not catch)</source>
+            <translation>um teste global que falha com sigma0 acima deste valor faz a execução falhar (desvios-padrão errados, um modelo que não se ajusta, ou erros grosseiros que o data snooping não detectou)</translation>
+        </message>
+        <message>
+            <source>Write the results even when the checks fail</source>
+            <translation>Gravar os resultados mesmo quando as verificações falham</translation>
+        </message>
+        <message>
+            <source>no convergence, global test beyond MAX_SIGMA0 or more rejections than data snooping's false alarms explain: write the outputs anyway, each table with a warning at its top</source>
+            <translation>sem convergência, teste global além de MAX_SIGMA0 ou mais rejeições do que os falsos alarmes do data snooping explicam: grava as saídas mesmo assim, cada tabela com um aviso no início</translation>
         </message>
     </context>
     <context>

@@ -59,6 +59,8 @@ def _load(path: Path) -> Any:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"cannot read camera file: {exc}", path=str(path)) from exc
+    if not text.strip():
+        raise InputError("empty camera file (no JSON object)", path=str(path))
 
     def no_constants(token: str) -> float:
         raise ValueError(f"{token} is not allowed")
@@ -66,8 +68,11 @@ def _load(path: Path) -> Any:
     try:
         return json.loads(text, parse_constant=no_constants)
     except json.JSONDecodeError as exc:
+        ends = exc.pos >= len(text.rstrip()) or exc.msg.startswith("Unterminated string")
+        cut = " (the file ends inside it: truncated?)" if ends else ""
         raise InputError(
-            f"invalid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}", path=str(path)
+            f"invalid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}{cut}",
+            path=str(path),
         ) from exc
     except ValueError as exc:
         raise InputError(f"invalid JSON: {exc}", path=str(path)) from exc
@@ -144,26 +149,12 @@ def read_camera_json(
     Raises
     ------
     InputError
-        If the file cannot be read, is not valid JSON, or has a bad or missing value; the
-        message names the file and the key (or the line, for invalid JSON).
+        If the file cannot be read, is empty, truncated or not valid JSON, or has a bad or
+        missing value; the message names the file and the key (or the line, for invalid
+        JSON).
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read camera file: {exc}", path=str(path)) from exc
-
-    def no_constants(token: str) -> float:
-        raise ValueError(f"{token} is not allowed")
-
-    try:
-        data = json.loads(text, parse_constant=no_constants)
-    except json.JSONDecodeError as exc:
-        raise InputError(
-            f"invalid JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}", path=str(path)
-        ) from exc
-    except ValueError as exc:
-        raise InputError(f"invalid JSON: {exc}", path=str(path)) from exc
+    data = _load(path)
     cam = camera_from_dict(data, source=str(path), default_name=path.stem)
     return _check_projection(cam, path, projections)
 

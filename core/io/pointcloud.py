@@ -224,6 +224,15 @@ def _info_from_header(path: str, header: Any, crs: CrsLike, require_crs: bool) -
     count = int(header.point_count)
     if count == 0:
         raise InputError("the file holds no points", path=path)
+    scales = np.asarray(header.scales, dtype=np.float64)
+    offsets = np.asarray(header.offsets, dtype=np.float64)
+    if not (np.isfinite(scales).all() and (scales != 0).all() and np.isfinite(offsets).all()):
+        raise InputError(  # x = X * scale + offset: every coordinate would be 0, NaN or inf
+            "the header's scale factors must be finite and non-zero and its offsets finite, "
+            f"got scales {', '.join(f'{v:g}' for v in scales)} and offsets "
+            f"{', '.join(f'{v:g}' for v in offsets)}: a corrupt header",
+            path=path,
+        )
     user_crs = parse_crs(crs)
     file_crs = None
     if user_crs is None:
@@ -321,7 +330,8 @@ def read_info(path: PathLike, crs: CrsLike = None, *, require_crs: bool = True) 
     Raises
     ------
     InputError
-        Missing, empty, unreadable file, unsupported version, 0 points (names the file).
+        Missing, empty, unreadable file, unsupported version, 0 points, scale factors or
+        offsets that are not finite (names the file).
     CrsError
         No CRS and no override, or a geographic CRS.
     """

@@ -13,10 +13,14 @@ target fit)::
     station_id,target_id,x,y,z[,s_x,s_y,s_z][,cov_xy,cov_xz,cov_yz]
 
 metres (covariances m^2), converted to polar form with the covariance propagated. Missing
-sigma columns take the caller's defaults.
+sigma columns take the caller's defaults. A range (or a centre's distance from the scanner)
+must be > 0 and within :data:`~.scans.MAX_SCANNER_RANGE_M`.
 
 Control (optional): ``target_id,X,Y,Z[,s_X,s_Y,s_Z]`` (object frame, metres; a sigma of 0
 holds the coordinate fixed; no sigma columns: fixed).
+
+The writers of a calibration's tables take ``comments``: lines written first as ``# text``
+(the warnings of a doubtful calibration the user accepted; the readers skip them).
 
 Stations (optional): ``station_id[,X,Y,Z][,omega_deg,phi_deg,kappa_deg][,levelled]``:
 approximate positions (m) and angles (degrees), the compensator's omega, phi of a levelled
@@ -35,6 +39,7 @@ from ..tls.aps import ARCSEC
 from ..tls.calibration import TlsCalibration
 from ..tls.network import ControlTarget, StationInfo, TlsObservations
 from ..tls.polar import polar_covariance
+from .scans import MAX_SCANNER_RANGE_M
 from .tables import (
     PathLike,
     Table,
@@ -127,6 +132,25 @@ def _angle(table: Table, stem: str, unit: str) -> tuple[np.ndarray, str]:
     )
 
 
+def _check_ranges(t: Table, rho: np.ndarray, what: str, col: int | None) -> None:
+    """Distances from the scanner (m) that are > 0 and within a scanner's reach."""
+    where = {"path": t.path, "column": None if col is None else t.columns[col]}
+    bad = np.flatnonzero(rho <= 0)
+    if bad.size:
+        k = int(bad[0])
+        raise InputError(f"{what} is {rho[k]:g} m from the scanner: it must be > 0",
+                         row=t.line_numbers[k], **where)  # fmt: skip
+    bad = np.flatnonzero(rho > MAX_SCANNER_RANGE_M)
+    if bad.size:
+        k = int(bad[0])
+        raise InputError(
+            f"{what} is {rho[k]:g} m from the scanner, beyond the {MAX_SCANNER_RANGE_M:g} m a "
+            "terrestrial scanner reaches: another unit, or coordinates that are not in the "
+            "scanner's frame",
+            row=t.line_numbers[k], **where,
+        )  # fmt: skip
+
+
 def read_tls_observations_csv(
     path: PathLike,
     angle_unit: str = "degrees",
@@ -166,10 +190,8 @@ def read_tls_observations_csv(
             if np.linalg.eigvalsh(cov[k])[0] <= 0:
                 raise InputError("the covariance of (x, y, z) is not positive definite",
                                  path=t.path, row=int(rows[k]))  # fmt: skip
-        bad = np.flatnonzero(np.linalg.norm(xyz, axis=1) <= 0)
-        if bad.size:
-            raise InputError("the point is at the scanner's origin", path=t.path,
-                             row=int(rows[bad[0]]))  # fmt: skip
+        # hypot: no overflow for a coordinate of 1e300
+        _check_ranges(t, np.hypot(np.hypot(xyz[:, 0], xyz[:, 1]), xyz[:, 2]), "the point", None)
         polar, pcov = polar_covariance(xyz, cov)
     else:
         if rcol is None:
@@ -179,6 +201,7 @@ def read_tls_observations_csv(
                 path=t.path,
             )
         rng = float_column(t, rcol)
+        _check_ranges(t, rng, "the range", rcol)
         hz, _ = _angle(t, "hz", angle_unit)
         vt, _ = _angle(t, "vt", angle_unit)
         polar = np.column_stack([rng, hz, vt])
@@ -244,7 +267,9 @@ def _num(x: float) -> str:
     return repr(float(x)) if np.isfinite(x) else ""
 
 
-def write_tls_stations_csv(path: PathLike, cal: TlsCalibration) -> None:
+def write_tls_stations_csv(
+    path: PathLike, cal: TlsCalibration, comments: Sequence[str] = ()
+) -> None:
     """Adjusted station poses with a-posteriori sigmas (:data:`STATION_COLUMNS`)."""
     obs = cal.observations
     counts = {s: len({t for st, t in zip(obs.station, obs.target) if st == s})
@@ -256,20 +281,22 @@ def write_tls_stations_csv(path: PathLike, cal: TlsCalibration) -> None:
             (s, *map(_num, p[:3]), *map(_num, np.degrees(p[3:])), *map(_num, sd[:3]),
              *map(_num, sd[3:] / ARCSEC), int(cal.levelled[k]), counts[s])
         )  # fmt: skip
-    write_csv_atomic(path, STATION_COLUMNS, rows)
+    write_csv_atomic(path, STATION_COLUMNS, rows, comments)
 
 
-def write_tls_aps_csv(path: PathLike, cal: TlsCalibration) -> None:
+def write_tls_aps_csv(path: PathLike, cal: TlsCalibration, comments: Sequence[str] = ()) -> None:
     """The additional parameters in report units (:data:`AP_COLUMNS`)."""
     rows = [
         (a["name"], a["formula"], a["cause"], a["unit"], _num(a["value"]), _num(a["std"]),
          _num(a["std_prior"]), _num(a["t"]), int(a["significant"]))
         for a in cal.ap_report()
     ]  # fmt: skip
-    write_csv_atomic(path, AP_COLUMNS, rows)
+    write_csv_atomic(path, AP_COLUMNS, rows, comments)
 
 
-def write_tls_targets_csv(path: PathLike, cal: TlsCalibration) -> None:
+def write_tls_targets_csv(
+    path: PathLike, cal: TlsCalibration, comments: Sequence[str] = ()
+) -> None:
     """Adjusted target coordinates with sigmas (:data:`TARGET_COLUMNS`)."""
     obs = cal.observations
     seen: dict[str, set[str]] = {}
@@ -280,10 +307,12 @@ def write_tls_targets_csv(path: PathLike, cal: TlsCalibration) -> None:
          len(seen.get(t, ())))
         for k, t in enumerate(cal.targets)
     ]  # fmt: skip
-    write_csv_atomic(path, TARGET_COLUMNS, rows)
+    write_csv_atomic(path, TARGET_COLUMNS, rows, comments)
 
 
-def write_tls_residuals_csv(path: PathLike, cal: TlsCalibration) -> None:
+def write_tls_residuals_csv(
+    path: PathLike, cal: TlsCalibration, comments: Sequence[str] = ()
+) -> None:
     """Residuals (adjusted minus observed) per component, Baarda's w and the rejection flag
     (:data:`RESIDUAL_COLUMNS`); ``row`` is the observation's row in its file."""
     obs = cal.observations
@@ -295,7 +324,7 @@ def write_tls_residuals_csv(path: PathLike, cal: TlsCalibration) -> None:
          int(cal.rejected[k]), int(obs.rows[k]))
         for k in range(len(obs))
     ]  # fmt: skip
-    write_csv_atomic(path, RESIDUAL_COLUMNS, rows)
+    write_csv_atomic(path, RESIDUAL_COLUMNS, rows, comments)
 
 
 def write_tls_observations_csv(

@@ -3,12 +3,18 @@
 CSV with a header row (names are case-insensitive, aliases in parentheses)::
 
     image_id (id, image, name, photo)      text, unique
-    time (gps_time, t)                     optional, seconds
+    time (gps_time, t)                     optional, seconds (GPS week or standard time, UNIX
+                                           time...); rising down the table within a group
     group (line, strip, flight_line)       optional, flight line or direction
     easting (e, x), northing (n, y), height (h, z, alt)         in the mapping CRS, or
     latitude (lat), longitude (lon, long), height (h, z, alt)   degrees on the CRS's datum
     roll, pitch, heading (yaw)             degrees; body x forward, y right, z down;
                                            heading clockwise from true north
+
+Values outside their physical range are refused with the row: a time beyond
+:data:`MAX_TIME_S` (another unit, or garbage), a time earlier than the row before it in the
+same group (rows mixed up; equal times are allowed: cameras that fire together), a height
+outside :data:`HEIGHT_RANGE_M` (another unit), angles beyond their half or full turn.
 """
 
 from __future__ import annotations
@@ -31,6 +37,11 @@ from .tables import (
 )
 
 Array = NDArray[np.float64]
+#: Largest plausible |time| (s): about 300 years, beyond every GPS or UNIX time in seconds.
+MAX_TIME_S = 1e10
+#: Plausible heights of a sensor (m): below the Dead Sea's shore with the geoid's
+#: undulation, above any survey aircraft.
+HEIGHT_RANGE_M = (-1000.0, 30000.0)
 
 
 def read_trajectory_csv(path: Union[str, Path]) -> Trajectory:
@@ -38,13 +49,12 @@ def read_trajectory_csv(path: Union[str, Path]) -> Trajectory:
     table = read_table(path)
     ids = unique_ids(table, find_column(table, ("image_id", "id", "image", "name", "photo")))
     t_col = find_column(table, ("time", "gps_time", "t"), required=False)
-    time = (
-        float_column(table, t_col, allow_empty=True)
-        if t_col is not None
-        else np.full(len(ids), np.nan)
-    )
     g_col = find_column(table, ("group", "line", "strip", "flight_line"), required=False)
     group = text_column(table, g_col, nonempty=False) if g_col is not None else ("",) * len(ids)
+    time = np.full(len(ids), np.nan)
+    if t_col is not None:
+        time = float_column(table, t_col, allow_empty=True)
+        _check_times(table, t_col, time, group)
     lat_col = find_column(table, ("latitude", "lat"), required=False)
     e_col = find_column(table, ("easting", "e", "x"), required=False)
     if (lat_col is None) == (e_col is None):
@@ -62,6 +72,7 @@ def read_trajectory_csv(path: Union[str, Path]) -> Trajectory:
     else:
         n_col = find_column(table, ("northing", "n", "y"), what="northing")
         position = np.stack([float_column(table, c) for c in (e_col, n_col, h_col)], axis=1)
+    _check_heights(table, h_col, position[:, 2])
     cols = [find_column(table, names) for names in (("roll",), ("pitch",), ("heading", "yaw"))]
     rph_deg = np.stack([float_column(table, c) for c in cols], axis=1)
     _check_range(table, cols[0], rph_deg[:, 0], 180.0)
@@ -79,6 +90,43 @@ def _check_range(table, column: int, values: Array, limit: float) -> None:
             row=table.line_numbers[bad[0]],
             column=table.columns[column],
         )
+
+
+def _check_times(table, column: int, time: Array, group: tuple[str, ...]) -> None:
+    """Times within +-MAX_TIME_S, and never earlier than the row before in the same group."""
+    where = {"path": table.path, "column": table.columns[column]}
+    bad = np.flatnonzero(np.abs(time) > MAX_TIME_S)
+    if bad.size:
+        raise InputError(
+            f"{time[bad[0]]:g} s is beyond the plausible +-{MAX_TIME_S:g} s of a time in "
+            "seconds (GPS week or standard time, UNIX time): another unit, or not a time",
+            row=table.line_numbers[bad[0]], **where,
+        )  # fmt: skip
+    last: dict[str, int] = {}
+    for k, (t, g) in enumerate(zip(time, group)):
+        if np.isnan(t):
+            continue
+        j = last.get(g)
+        if j is not None and t < time[j]:
+            in_group = f" of group '{g}'" if g else ""
+            raise InputError(
+                f"time {t:.12g} s is earlier than {time[j]:.12g} s in row "
+                f"{table.line_numbers[j]}{in_group}: the rows are not in time order (rows "
+                "mixed up? sort the table by time)",
+                row=table.line_numbers[k], **where,
+            )  # fmt: skip
+        last[g] = k
+
+
+def _check_heights(table, column: int, height: Array) -> None:
+    lo, hi = HEIGHT_RANGE_M
+    bad = np.flatnonzero((height < lo) | (height > hi))
+    if bad.size:
+        raise InputError(
+            f"{height[bad[0]]:g} m is outside the plausible heights {lo:g} to {hi:g} m of a "
+            "sensor (a height in another unit?)",
+            path=table.path, row=table.line_numbers[bad[0]], column=table.columns[column],
+        )  # fmt: skip
 
 
 TRAJECTORY_COLUMNS = (

@@ -19,7 +19,15 @@ import numpy as np
 from ..i18n import joined as _joined
 from ..i18n import mark as _t
 from ..photo.ins import INS_GRADES
-from .common import CSV_FILTER, CSV_OUT, LAS_FILTER, mount_from, mount_params
+from .common import (
+    CSV_FILTER,
+    CSV_OUT,
+    LAS_FILTER,
+    doubt_params,
+    mount_from,
+    mount_params,
+    settle_doubts,
+)
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -126,14 +134,12 @@ written and each starts with a warning (CSV: comment lines beginning with #)."""
               unit="degrees", minimum=0.001, maximum=45.0, advanced=True,
               help="an estimated angle beyond this fails the run (wrong MOUNT, image ids or "
               "observations)"),
-        Param("MAX_SIGMA0", "number", "Largest sigma0 when the global test fails", 3.0,
-              minimum=1.0, maximum=1000.0, advanced=True,
-              help="a failed global test with sigma0 above this fails the run (wrong "
-              "sigma_px or INS grade, or blunders data snooping did not catch)"),
-        Param("ACCEPT_DOUBTFUL", "boolean", "Write the results even when the checks fail",
-              False,
-              help="no convergence, global test beyond MAX_SIGMA0 or boresight beyond "
-              "MAX_BORESIGHT: write the outputs anyway, each with a warning at its top"),
+        *doubt_params(
+            "a failed global test with sigma0 above this fails the run (wrong sigma_px or INS "
+            "grade, or blunders data snooping did not catch)",
+            "no convergence, global test beyond MAX_SIGMA0 or boresight beyond MAX_BORESIGHT: "
+            "write the outputs anyway, each with a warning at its top",
+        ),
         Param("OUTPUT_TABLE", "file_out", "Boresight per group (CSV)", file_filter=CSV_OUT),
         Param("OUTPUT_RESIDUALS", "sink", "Image residuals", geometry="point", optional=True),
         Param("RESIDUALS_CSV", "file_out", "Image residuals (CSV)", optional=True,
@@ -150,7 +156,7 @@ written and each starts with a warning (CSV: comment lines beginning with #)."""
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the inputs, calibrate, write the outputs."""
-    from ..errors import AdjustmentError, InputError, stop_if_asked
+    from ..errors import InputError, stop_if_asked
     from ..geometry.frames import MappingFrame, check_area_of_use
     from ..io.atomic import write_text_atomic
     from ..io.camera import read_camera_json
@@ -226,26 +232,14 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             out.commit(["OUTPUT_HTML"])
         raise
     doubts = doubts_about(result, v.max_boresight, v.max_sigma0)
-    if doubts and not v.accept_doubtful:
-        if out.requested("OUTPUT_HTML"):  # the failed numbers are the user's diagnosis
-            failed = BoresightRun(result, obs, np.full((len(obs), 3), np.nan),
-                                  ("",) * len(obs), settings, frame.crs.to_wkt())  # fmt: skip
-            page = render_boresight_html(failed, settings, problems=doubts, accepted=False)
-            write_text_atomic(out.path("OUTPUT_HTML"), page)
-            out.commit(["OUTPUT_HTML"])
-        raise AdjustmentError(
-            "the boresight calibration failed its checks: " + "; ".join(doubts)
-            + ". No result was written"
-            + (" (the HTML summary shows the failed adjustment)" if out.requested("OUTPUT_HTML")
-               else "")
-            + "; ACCEPT_DOUBTFUL writes them with a warning"
-        )  # fmt: skip
-    warning = [f"WARNING: {d}" for d in doubts]
-    if doubts:
-        warning.insert(0, "WARNING: this calibration failed its checks and was written only "
-                       "because ACCEPT_DOUBTFUL was set; do not use it without review")
-        for line in warning:
-            log.warning(line.removeprefix("WARNING: "))
+
+    def failed_page() -> str:  # the failed adjustment, without the positions it would give
+        failed = BoresightRun(result, obs, np.full((len(obs), 3), np.nan), ("",) * len(obs),
+                              settings, frame.crs.to_wkt())  # fmt: skip
+        return render_boresight_html(failed, settings, problems=doubts, accepted=False)
+
+    warning = settle_doubts("boresight calibration", doubts, v.accept_doubtful, out,
+                            failed_page, "HTML summary")  # fmt: skip
     positions = ground_positions(result, obs, cam, plane_list, line_list, lcp_list, ground)
     image_group = dict(zip(traj.image_id, group_labels(traj, options.groups)))
     run = BoresightRun(

@@ -1,11 +1,13 @@
-"""Parameters shared by several algorithms: the camera mount, the LiDAR cloud and its units.
+"""Parameters shared by several algorithms: the camera mount, the LiDAR cloud and its units;
+and how an adjustment whose result failed its checks is settled (:func:`settle_doubts`).
 
 Written once here so that every algorithm names, documents and defaults them the same way.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+import logging
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -120,3 +122,52 @@ def compression_param() -> Param:
 def compression_args(name: str) -> dict[str, Any]:
     """GeoTiffWriter keywords of a COMPRESSION value."""
     return {"compress": name.upper(), "level": 1 if name in ("deflate", "zstd") else None}
+
+
+def doubt_params(sigma0_help: str, accept_help: str) -> tuple[Param, Param]:
+    """MAX_SIGMA0 and ACCEPT_DOUBTFUL of an adjustment whose result is checked
+    (:func:`settle_doubts`); the helps say which checks."""
+    return (
+        Param("MAX_SIGMA0", "number", "Largest sigma0 when the global test fails", 3.0,
+              minimum=1.0, maximum=1000.0, advanced=True, help=sigma0_help),
+        Param("ACCEPT_DOUBTFUL", "boolean", "Write the results even when the checks fail",
+              False, help=accept_help),
+    )  # fmt: skip
+
+
+def settle_doubts(
+    what: str,
+    doubts: Sequence[str],
+    accept: bool,
+    out: Any,
+    failed_page: Callable[[], str],
+    report: str = "HTML report",
+) -> list[str]:
+    """Settle a result that failed its checks (``doubts``: why; empty when it passed them).
+
+    Refused unless ``accept`` (ACCEPT_DOUBTFUL): OUTPUT_HTML, when asked for, is written alone
+    from ``failed_page()`` (the failed numbers are the user's diagnosis) and
+    :class:`~core.errors.AdjustmentError` names ``what`` and every doubt. Accepted: the
+    warning lines every output starts with (logged too); none when there is no doubt.
+    """
+    from ..errors import AdjustmentError
+    from ..io.atomic import write_text_atomic
+
+    if doubts and not accept:
+        if out.requested("OUTPUT_HTML"):
+            write_text_atomic(out.path("OUTPUT_HTML"), failed_page())
+            out.commit(["OUTPUT_HTML"])
+        raise AdjustmentError(
+            f"the {what} failed its checks: " + "; ".join(str(d) for d in doubts)
+            + ". No result was written"
+            + (f" (the {report} shows the failed adjustment)" if out.requested("OUTPUT_HTML")
+               else "")
+            + "; ACCEPT_DOUBTFUL writes them with a warning"
+        )  # fmt: skip
+    warning = [f"WARNING: {d}" for d in doubts]
+    if doubts:
+        warning.insert(0, "WARNING: this calibration failed its checks and was written only "
+                       "because ACCEPT_DOUBTFUL was set; do not use it without review")  # fmt: skip
+        for line in warning:
+            logging.getLogger(__name__).warning(line.removeprefix("WARNING: "))
+    return warning

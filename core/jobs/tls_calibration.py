@@ -12,13 +12,16 @@ import logging
 import math
 from pathlib import Path
 
+from ..i18n import joined as _joined
+from ..i18n import mark as _t
 from ..tls.aps import AP_SETS, ARCSEC
 from ..tls.options import CalibrationOptions
-from .common import CSV_FILTER, CSV_OUT
+from .common import CSV_FILTER, CSV_OUT, doubt_params, settle_doubts
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values
 
 log = logging.getLogger(__name__)
+TR_CONTEXT = "Report"
 
 _D = CalibrationOptions()
 ANGLE_UNITS = ("degrees", "gon", "radians")
@@ -73,7 +76,16 @@ each point's recorded polar coordinates are corrected by the estimated APs befor
 pose is applied, taken as face-I readings (elevation within +-90 deg): turn it off for
 scans that mix both faces (a panoramic scanner's second half-turn), which then get the
 rigid pose only. LAS/LAZ scans are streamed in chunks (every dimension and VLR kept);
-PLY/E57 scans are read whole. All files appear together or none (a bad scan: none).""",
+PLY/E57 scans are read whole. All files appear together or none (a bad scan: none).
+
+## Checks of the result
+The run fails (nothing is written but the HTML report, which says why) when the adjustment
+did not converge, when its global test fails with sigma0 above MAX SIGMA0, or when data
+snooping rejected more observations than its false alarms explain (the upper tail of their
+binomial count below 0.001: a model that does not fit the data, e.g. APs missing, or many
+blunders; the global test of the observations left then proves nothing). With ACCEPT
+DOUBTFUL the outputs are written and each table starts with a warning (comment lines
+beginning with #).""",
     params=(
         Param("OBSERVATIONS", "file", "Observations (CSV)", file_filter=CSV_FILTER),
         Param("CONTROL", "file", "Control targets (CSV)", optional=True, file_filter=CSV_FILTER),
@@ -109,6 +121,13 @@ PLY/E57 scans are read whole. All files appear together or none (a bad scan: non
         Param("SNOOPING", "boolean", "Data snooping (Baarda)", _D.snooping),
         Param("CORRELATION_LIMIT", "number", "Strong correlation at |r| >=",
               _D.correlation_limit, minimum=0.1, maximum=1.0, advanced=True),
+        *doubt_params(
+            "a failed global test with sigma0 above this fails the run (wrong sigmas, a model "
+            "that does not fit, or blunders data snooping did not catch)",
+            "no convergence, global test beyond MAX_SIGMA0 or more rejections than data "
+            "snooping's false alarms explain: write the outputs anyway, each table with a "
+            "warning at its top",
+        ),
         Param("SCANS", "files", "Scans to register (LAS/LAZ, PLY, E57; one station per file)",
               optional=True, help="the file name without its suffix is the station id"),
         Param("APPLY_APS", "boolean", "Correct the scan points by the estimated APs", True,
@@ -137,7 +156,7 @@ PLY/E57 scans are read whole. All files appear together or none (a bad scan: non
 
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
-    """Read the tables, adjust, write the outputs."""
+    """Read the tables, adjust, check the result, write the outputs."""
     from ..errors import InputError
     from ..io.atomic import write_text_atomic
     from ..io.tls import (
@@ -149,6 +168,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         write_tls_stations_csv,
         write_tls_targets_csv,
     )
+    from ..lsq.results import rejection_test
     from ..quality.tls_html import render_tls_html
     from ..tls.calibration import calibrate
     from ..tls.network import distance_consistency
@@ -212,22 +232,30 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                                              else ""),
         "levelled by default": f"{v.levelled} (compensator sigma {v.tilt_sigma:g}\")",
         "datum without control": v.datum,
-        "data snooping": "Baarda, alpha = 0.001 per observation" if v.snooping else "off",
+        "data snooping": f"Baarda, alpha = {options.snooping_alpha:g} per observation"
+        if v.snooping else "off",
         "distance consistency between stations": "n/a" if not math.isfinite(median)
         else f"{median * 1e6:.0f} ppm (median)",
     }  # fmt: skip
+    rejections = rejection_test(cal.adjustment, options.snooping_alpha) if v.snooping else None
+    doubts = doubts_about(cal, v.max_sigma0, rejections)
+    warning = settle_doubts(
+        "TLS calibration", doubts, v.accept_doubtful, out,
+        lambda: render_tls_html(cal, settings, doubts, accepted=False, rejections=rejections),
+    )  # fmt: skip
     if out.requested("OUTPUT_STATIONS"):
-        write_tls_stations_csv(out.path("OUTPUT_STATIONS"), cal)
+        write_tls_stations_csv(out.path("OUTPUT_STATIONS"), cal, warning)
     if out.requested("OUTPUT_APS"):
-        write_tls_aps_csv(out.path("OUTPUT_APS"), cal)
+        write_tls_aps_csv(out.path("OUTPUT_APS"), cal, warning)
     if out.requested("OUTPUT_TARGETS"):
-        write_tls_targets_csv(out.path("OUTPUT_TARGETS"), cal)
+        write_tls_targets_csv(out.path("OUTPUT_TARGETS"), cal, warning)
     if out.requested("OUTPUT_RESIDUALS"):
-        write_tls_residuals_csv(out.path("OUTPUT_RESIDUALS"), cal)
+        write_tls_residuals_csv(out.path("OUTPUT_RESIDUALS"), cal, warning)
     if out.requested("OUTPUT_HTML"):
-        write_text_atomic(out.path("OUTPUT_HTML"), render_tls_html(cal, settings))
+        page = render_tls_html(cal, settings, doubts, accepted=True, rejections=rejections)
+        write_text_atomic(out.path("OUTPUT_HTML"), page)
     registered = _write_registered(v, scans, cal, out, should_stop) if scans else []
-    lines = [f"{'AP':4} {'value':>10} {'sigma':>9} unit    t"]
+    lines = [*warning, f"{'AP':4} {'value':>10} {'sigma':>9} unit    t"]
     for a in cal.ap_report():
         lines.append(f"{a['name']:4} {a['value']:10.3f} {a['std']:9.3f} {a['unit']:7} "
                      f"{a['t']:.1f}{'' if a['significant'] else ' (not significant)'}")  # fmt: skip
@@ -238,6 +266,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     for path, n in registered:
         lines.append(f"registered scan {path}: {n} points")
     test = "passed" if cal.chi2_passed else "failed"
+    if cal.chi2_passed and rejections is not None and not rejections.passed:
+        test += (f" only after rejecting more observations than false alarms explain (at most "
+                 f"{rejections.bound})")  # fmt: skip
     lines.append(f"sigma0 {cal.sigma0:.3f}, redundancy {cal.adjustment.redundancy}, global "
                  f"test {test}, {int(cal.rejected.sum())} observations rejected")  # fmt: skip
     return JobResult(
@@ -246,6 +277,35 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         lines=lines,
         data=cal,
     )  # fmt: skip
+
+
+def doubts_about(cal, max_sigma0: float, rejections) -> list:
+    """Why the calibration's numbers cannot be trusted (empty when they can): no convergence,
+    a global test failed with sigma0 above ``max_sigma0``, more rejections than data
+    snooping's false alarms explain (``rejections``: :class:`~core.lsq.results.RejectionTest`,
+    None without snooping), estimates that are not finite."""
+    import numpy as np
+
+    out = []
+    adj = cal.adjustment
+    if not adj.converged:
+        out.append(_t("the adjustment did not converge after {n} iterations", n=adj.iterations))
+    if not cal.chi2_passed and cal.sigma0 > max_sigma0:
+        out.append(
+            _t(
+                "the global test failed with sigma0 = {sigma0:.3g} > MAX_SIGMA0 {maximum:g}: "
+                "the observations are {sigma0:.3g} times less precise than their sigmas say "
+                "(wrong sigmas, a model that does not fit, or undetected blunders)",
+                sigma0=cal.sigma0,
+                maximum=max_sigma0,
+            )
+        )
+    if rejections is not None and not rejections.passed:
+        out.append(rejections.message())
+    bad = [n for n, x in zip(adj.names, adj.x) if not np.isfinite(x)]
+    if bad:
+        out.append(_t("not a finite number: {items}", items=_joined(bad[:10])))
+    return out
 
 
 def _check_scans(v: Values) -> list[Path]:

@@ -1,16 +1,34 @@
 """What a least-squares adjustment returns: estimates, covariance, statistics, residuals,
-the global test and the rejected observations (:mod:`.adjustment` describes the method)."""
+the global test and the rejected observations (:mod:`.adjustment` describes the method), and
+the check that the rejections are as few as the false alarms of data snooping explain
+(:func:`rejection_test`).
+
+Data snooping tests each row of every group kept with the w-test at ``alpha`` and rejects the
+worst group while one row exceeds the critical value. When the model is right and there is no
+blunder, a group of ``o`` independent rows is rejected with probability
+``p = 1 - (1 - alpha)^o`` (at most, when its rows are correlated), so the number of false
+rejections among ``n`` groups is a sum of binomials ``B(n_b, p_b)`` over the blocks (a
+Poisson-binomial count). A number of rejections whose upper tail ``P(X >= k)`` is below
+``level`` is not explained by false alarms: blunders by the handful, or a model that does not
+fit the data, whose largest misfits snooping throws away until the rest passes the global
+test. Such an adjustment's global test says nothing about the model: the rule flags it.
+"""
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..i18n import Message
+from ..i18n import mark as _t
 from .schur import BlockCofactor
 
 Array = NDArray[np.float64]
+TR_CONTEXT = "Report"
 
 
 @dataclass
@@ -262,3 +280,93 @@ class AdjustmentResult:
             lines.append("  warnings")
             lines.extend(f"    - {w}" for w in self.warnings)
         return "\n".join(lines)
+
+
+@dataclass(frozen=True)
+class RejectionTest:
+    """Whether data snooping rejected more groups than its false alarms explain (see the
+    module text).
+
+    Attributes
+    ----------
+    groups, rejected : int
+        Observation groups tested (kept and rejected) and rejected.
+    alpha : float
+        Significance of snooping's w-test per row.
+    level : float
+        Significance of this test: rejections with ``P(X >= rejected) < level`` fail it.
+    expected : float
+        False rejections expected when the model is right.
+    bound : int
+        The most rejections the false alarms explain at ``level``.
+    p_value : float
+        ``P(X >= rejected)`` when the model is right.
+    """
+
+    groups: int
+    rejected: int
+    alpha: float
+    level: float
+    expected: float
+    bound: int
+    p_value: float
+
+    @property
+    def passed(self) -> bool:
+        return self.rejected <= self.bound
+
+    def message(self) -> Message:
+        """One sentence (translatable) saying what the count means."""
+        share = 100.0 * self.rejected / max(self.groups, 1)
+        return _t(
+            "data snooping rejected {k} of {n} observations ({share:.1f} %); its false alarms "
+            "at alpha = {alpha:g} explain at most {bound} ({expected:.2g} expected, P({k} or "
+            "more) = {p:.2g}): a model that does not fit the data (parameters missing?) or "
+            "many blunders, and the global test of the rest does not show it",
+            k=self.rejected, n=self.groups, share=share, alpha=self.alpha, bound=self.bound,
+            expected=self.expected, p=self.p_value,
+        )  # fmt: skip
+
+
+def rejection_test(
+    result: AdjustmentResult,
+    alpha: float,
+    level: float = 0.001,
+    blocks: Sequence[str] | None = None,
+) -> RejectionTest:
+    """Test the number of groups ``result`` rejected (robust stage and data snooping) against
+    the false alarms of a w-test at ``alpha`` per row (``level``: this test's significance;
+    ``blocks``: the blocks snooping tested, default all).
+
+    >>> from types import SimpleNamespace as NS
+    >>> table = lambda n, k, o: NS(v=np.zeros((n, o)), rejected=np.arange(n) < k)
+    >>> r = NS(residuals={"polar": table(162, 15, 3), "control": table(27, 0, 1)})
+    >>> t = rejection_test(r, 0.001)
+    >>> t.groups, t.rejected, t.bound, round(t.expected, 3), t.passed
+    (189, 15, 4, 0.513, False)
+    >>> f"{t.p_value:.2g}", rejection_test(
+    ...     NS(residuals={"polar": table(162, 2, 3)}), 0.001).passed
+    ('1.2e-17', True)
+    """
+    from scipy import stats  # here: scipy.stats takes seconds to import (QGIS start-up)
+
+    counts = []
+    for name, table in result.residuals.items():
+        if blocks is not None and name not in blocks:
+            continue
+        n, o = np.shape(table.v)
+        if n:
+            counts.append((n, 1.0 - (1.0 - alpha) ** max(o, 1), int(np.sum(table.rejected))))
+    groups = sum(c[0] for c in counts)
+    k = sum(c[2] for c in counts)
+    expected = sum(n * p for n, p, _ in counts)
+    # the count distribution up to well past its mean (the tail beyond is far below level)
+    top = max(k, math.ceil(expected + 12.0 * math.sqrt(expected) + 30.0))
+    pmf = np.zeros(top + 1)
+    pmf[0] = 1.0
+    for n, p, _ in counts:
+        pmf = np.convolve(pmf, stats.binom.pmf(np.arange(min(n, top) + 1), n, p))[: top + 1]
+    upper = np.append(np.cumsum(pmf[::-1])[::-1][1:], 0.0)  # upper[b] = P(X > b)
+    bound = int(np.argmax(upper < level)) if (upper < level).any() else top
+    p_value = 1.0 if k == 0 else float(upper[k - 1])
+    return RejectionTest(groups, k, float(alpha), float(level), float(expected), bound, p_value)

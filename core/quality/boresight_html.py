@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import __version__
-from .html_table import TR_CONTEXT, html_lang, t  # noqa: F401 - TR_CONTEXT: make i18n
+from .html_table import TR_CONTEXT, failed_checks, html_lang, t  # noqa: F401 - TR_CONTEXT: i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 from .svg_plots import histogram
@@ -119,21 +119,10 @@ def render_boresight_html(
 
 
 def _problems(problems: Sequence[str], accepted: bool) -> list[str]:
-    if not problems:
-        return []
-    verdict = (
-        t(
-            "These results FAILED their checks and were written only because the user asked "
-            "for them (ACCEPT_DOUBTFUL): do not use them without review."
-        )
-        if accepted
-        else t(
-            "The calibration FAILED its checks: no table and no exterior orientation were "
-            "written. The numbers below show the failed adjustment, for diagnosis only."
-        )
-    )
-    items = "".join(f"<li>{_e(t(p))}</li>" for p in problems)
-    return [f'<div class="alarm"><p><b>{_e(verdict)}</b></p><ul>{items}</ul></div>']
+    return failed_checks(problems, accepted, t(
+        "The calibration FAILED its checks: no table and no exterior orientation were "
+        "written. The numbers below show the failed adjustment, for diagnosis only."
+    ))  # fmt: skip
 
 
 def _results(run: BoresightRun) -> list[str]:

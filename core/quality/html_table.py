@@ -8,7 +8,7 @@ from collections.abc import Sequence
 
 from ..i18n import html_lang, render
 
-__all__ = ["TR_CONTEXT", "escape", "html_lang", "t", "table"]
+__all__ = ["TR_CONTEXT", "escape", "failed_checks", "html_lang", "t", "table"]
 #: translation context of the reports' texts (``make i18n`` collects the ``t("...")`` calls of
 #: every module that defines or imports TR_CONTEXT)
 TR_CONTEXT = "Report"
@@ -49,3 +49,19 @@ def table(
         )
         body.append(f"<tr{cls}>{cells}</tr>")
     return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+def failed_checks(problems: Sequence[object], accepted: bool, refused: str) -> list[str]:
+    """The alarm at the top of a report whose results failed their checks (``problems``:
+    why; nothing when there are none): written anyway because the user asked (``accepted``),
+    or not written (``refused``: the translated sentence saying what was not)."""
+    if not problems:
+        return []
+    verdict = refused
+    if accepted:
+        verdict = t(
+            "These results FAILED their checks and were written only because the user asked "
+            "for them (ACCEPT_DOUBTFUL): do not use them without review."
+        )
+    items = "".join(f"<li>{escape(t(p))}</li>" for p in problems)
+    return [f'<div class="alarm"><p><b>{escape(verdict)}</b></p><ul>{items}</ul></div>']

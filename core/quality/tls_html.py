@@ -1,9 +1,11 @@
 """HTML report of a terrestrial laser scanner self-calibration (one self-contained page).
 
-Sections: the settings, the adjustment's statistics, the additional parameters with their
-significance, the stations, the strongly correlated pairs with the network design that breaks
-them (Lichti 2010), the correlation matrix of the APs and the station parameters (coloured by
-|r|), the automatic AP selection, the residuals per component and the largest w-tests.
+Sections: the failed checks (when there are), the settings, the adjustment's statistics
+(with the rejections against data snooping's false alarms), the additional parameters with
+their significance, the stations, the strongly correlated pairs with the network design that
+breaks them (Lichti 2010), the correlation matrix of the APs and the station parameters
+(coloured by |r|), the automatic AP selection, the residuals per component and the largest
+w-tests.
 """
 
 from __future__ import annotations
@@ -14,9 +16,10 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from .. import __version__
+from ..lsq.results import RejectionTest
 from ..tls.aps import ARCSEC
 from ..tls.calibration import TlsCalibration, explain_pair
-from .html_table import TR_CONTEXT, html_lang, t  # noqa: F401 - TR_CONTEXT: make i18n
+from .html_table import TR_CONTEXT, failed_checks, html_lang, t  # noqa: F401 - TR_CONTEXT: i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 
@@ -30,7 +33,7 @@ th,td{border:1px solid #bbb;padding:3px 7px;text-align:right}
 th{background:#eee}td.t,th.t{text-align:left}
 .pass{background:#d8f0d8}.fail{background:#f7d4d4}.diag{background:#fbecc4;padding:8px}
 table.corr td{padding:2px 4px;font-size:11px}table.corr th{font-size:11px;padding:2px 4px}
-.note{font-size:12px;color:#444}
+.note{font-size:12px;color:#444}.alarm{background:#f7d4d4;border:2px solid #c33;padding:8px}
 """
 
 def _design() -> str:
@@ -78,8 +81,23 @@ def _correlation_table(names: Sequence[str], corr: np.ndarray, n_ap: int) -> str
             f"</tr></thead><tbody>{''.join(body)}</tbody></table></div>")  # fmt: skip
 
 
-def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
-    """The report page of a calibration (str, UTF-8 HTML)."""
+def _refused() -> str:
+    return t(
+        "The calibration FAILED its checks: no table and no registered scan were written. "
+        "The numbers below show the failed adjustment, for diagnosis only."
+    )
+
+
+def render_tls_html(
+    cal: TlsCalibration,
+    settings: Mapping[str, str],
+    problems: Sequence[object] = (),
+    accepted: bool = True,
+    rejections: RejectionTest | None = None,
+) -> str:
+    """The report page of a calibration (str, UTF-8 HTML); ``problems``: why it failed its
+    checks (written anyway when ``accepted``), ``rejections``: the test of the number of
+    rejected observations against snooping's false alarms."""
     adj = cal.adjustment
     out = [
         f"<!DOCTYPE html><html lang='{html_lang()}'><head><meta charset='utf-8'>",
@@ -92,11 +110,14 @@ def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
             "Lichti (2007), correlation analysis after Lichti (2010)."
         )
         + "</p>",
+        *failed_checks(problems, accepted, _refused()),
         f"<h2>{t('Settings')}</h2>",
         _table([t("setting"), t("value")], [(_e(k), _e(v)) for k, v in settings.items()]),
     ]
     gt = adj.global_test
     test = t("passed") if gt.passed else t("failed")
+    if gt.passed and rejections is not None and not rejections.passed:
+        test = t("passed, but only after more rejections than false alarms explain")
     out += [
         f"<h2>{t('Adjustment')}</h2>",
         _table(
@@ -115,6 +136,13 @@ def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
                     f"{adj.iterations} ({t('converged') if adj.converged else t('NOT')})",
                 ),
                 (t("observations rejected (data snooping)"), str(int(cal.rejected.sum()))),
+                *(
+                    [(t("rejections explained by false alarms"),
+                      t("at most {bound} ({expected} expected); {k} rejected: P = {p}").format(
+                          bound=rejections.bound, expected=f"{rejections.expected:.2g}",
+                          k=rejections.rejected, p=f"{rejections.p_value:.2g}"))]
+                    if rejections is not None else []
+                ),
                 (
                     t("datum"),
                     ", ".join(cal.datum_fixed)
@@ -125,7 +153,8 @@ def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
                     ),
                 ),
             ],
-            ["", "", "", "", "pass" if gt.passed else "fail"],
+            ["", "", "", "", "pass" if gt.passed and (rejections is None or rejections.passed)
+             else "fail", "", "", "" if rejections is None or rejections.passed else "fail"],
         ),
     ]
     if cal.ap_names:

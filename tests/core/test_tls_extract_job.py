@@ -9,7 +9,7 @@ from dataclasses import replace
 import laspy
 import numpy as np
 import pytest
-from lidarphoto.core.errors import InputError
+from lidarphoto.core.errors import AdjustmentError, InputError
 from lidarphoto.core.io.scans import read_scan
 from lidarphoto.core.jobs import extract_tls_targets, tls_calibration
 from lidarphoto.core.jobs.runner import run_job
@@ -96,10 +96,16 @@ def test_extraction_then_registration(scans, tmp_path):
         assert np.linalg.norm(scene.sphere_xyz[j] - world) < 0.01  # APs shift it by mm
         truth_of.setdefault(r["target_id"], set()).add(j)
     assert all(len(v) == 1 for v in truth_of.values())
-    # the table registers the stations: distances between them as simulated
+    # the table registers the stations: distances between them as simulated, with the APs
+    # the scans were simulated with; without them data snooping rejects what the model
+    # cannot explain until the rest passes the global test: the run fails its checks
     outs = {"OUTPUT_STATIONS": str(tmp_path / "s.csv"), "OUTPUT_APS": str(tmp_path / "a.csv"),
             "OUTPUT_HTML": str(tmp_path / "r.html")}  # fmt: skip
-    run_job(tls_calibration, {"OBSERVATIONS": str(out), "AP_SET": "none", **outs})
+    with pytest.raises(AdjustmentError, match=r"data snooping rejected (\d+) of (\d+) "
+                       r"observations .* explain at most [0-3] "):  # fmt: skip
+        run_job(tls_calibration, {"OBSERVATIONS": str(out), "AP_SET": "none", **outs})
+    assert not (tmp_path / "s.csv").exists()
+    run_job(tls_calibration, {"OBSERVATIONS": str(out), "AP_SET": "paper", **outs})
     with open(tmp_path / "s.csv", newline="", encoding="utf-8") as fh:
         st = {r["station_id"]: np.array([float(r[c]) for c in "XYZ"]) for r in csv.DictReader(fh)}
     for a in range(3):
