@@ -410,6 +410,7 @@ def _check_output(folder: Path) -> None:
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Index the block, run it on the cluster, write the outputs together."""
+    from ..io.atomic import check_outputs
     from ..io.control import write_lcps_csv, write_lines_csv
     from ..io.planes import write_planes_csv
     from ..io.tiles import commit_folder, index_block, staging_folder, write_json, write_vpc
@@ -417,6 +418,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     target = Path(v.output_folder)
     _check_output(target)
     index = index_block(v.input, v.crs or None, v.tile_size)
+    # the folder is replaced when the block is done: no tile it reads may lie in it
+    check_outputs({}, {"INPUT": [v.input, *(t.path for t in index.tiles)]},
+                  folders={"OUTPUT_FOLDER": target})  # fmt: skip
     info = index.info
     settings = settings_from(v, info)
     log.info("%d tiles (%s), %d points; buffers: ground %.4g, roof planes %.4g %s",

@@ -12,6 +12,7 @@ import logging
 import math
 from pathlib import Path
 
+from ..io.scans import SCAN_SUFFIXES
 from ..tls.aps import AP_SETS, ARCSEC
 from ..tls.options import CalibrationOptions
 from .common import CSV_FILTER, CSV_OUT
@@ -110,7 +111,8 @@ PLY/E57 scans are read whole. All files appear together or none (a bad scan: non
         Param("CORRELATION_LIMIT", "number", "Strong correlation at |r| >=",
               _D.correlation_limit, minimum=0.1, maximum=1.0, advanced=True),
         Param("SCANS", "files", "Scans to register (LAS/LAZ, PLY, E57; one station per file)",
-              optional=True, help="the file name without its suffix is the station id"),
+              optional=True, suffixes=SCAN_SUFFIXES,
+              help="the file name without its suffix is the station id"),
         Param("APPLY_APS", "boolean", "Correct the scan points by the estimated APs", True,
               help="face-I readings; off: the rigid pose only"),
         Param("OUTPUT_STATIONS", "file_out", "Station poses (CSV)", file_filter=CSV_OUT),

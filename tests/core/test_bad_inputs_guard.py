@@ -1,0 +1,118 @@
+"""The catalogue of bad inputs, continued (issue 35, part A): an output that would overwrite an
+input named another way (a folder standing for its files, a link, ``..``, a raster's world
+file), compiled kernels under another import name and a stale cache, a LiDAR block that would
+not fit or never end, and the temporaries of a killed run. Each case states the exact message,
+that nothing was written and that the inputs are unchanged, as in test_bad_inputs.py.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from lidarphoto.core.cli import main
+from lidarphoto.core.errors import InputError
+from lidarphoto.core.io.atomic import check_outputs
+from test_bad_inputs import AHN3, _copy, _ground, _snapshot
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _images(folder: Path, *names: str) -> Path:
+    """A folder of input files (their content is never read: the guard comes first)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for k, name in enumerate(names):
+        (folder / name).write_bytes(f"image {k}".encode())
+    return folder
+
+
+def _refused(argv: list[str], error: str, capsys, *folders: Path) -> None:
+    """``argv`` fails (exit 2) with one line matching ``error``; ``folders`` unchanged."""
+    before = [_snapshot(f) for f in folders]
+    code = main(argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2, err
+    assert len(err) == 1, err
+    assert err[0].startswith(f"lidarphoto {argv[0]}: error: "), err[0]
+    assert re.search(error, err[0]), err[0]
+    assert [_snapshot(f) for f in folders] == before  # nothing written, nothing changed
+
+
+# ----------------------------------------------------------------------------- 1. the guard
+_NEVER = r": an output never overwrites an input; choose another file$"
+
+
+def test_orthomosaic_output_inside_its_orthophoto_folder(tmp_path, capsys):
+    o = _images(tmp_path / "o", "S0_0_ortho.tif", "S0_1_ortho.tif")
+    _refused(["orthomosaic", "--orthophotos", str(o), "--output", str(o / "S0_0_ortho.tif")],
+             r"OUTPUT is the input ORTHOPHOTOS \(.*/o/S0_0_ortho\.tif, read from the folder "
+             r".*/o\)" + _NEVER, capsys, o)  # fmt: skip
+
+
+def test_tiepoints_observations_onto_an_image_of_its_folder(tmp_path, capsys):
+    im = _images(tmp_path / "im", "S0_0.tif", "S0_1.tif")
+    _refused(["tiepoints", "--images", str(im), "--output-observations", str(im / "S0_0.tif")],
+             r"OUTPUT_OBSERVATIONS is the input IMAGES \(.*/im/S0_0\.tif, read from the folder "
+             r".*/im\)" + _NEVER, capsys, im)  # fmt: skip
+
+
+def test_calibratecamera_camera_onto_a_target_image(tmp_path, capsys):
+    im = _images(tmp_path / "im", "img_00.jpg", "img_01.jpg")
+    _refused(["calibratecamera", "--images", str(im), "--output-camera",
+              str(im / "img_00.jpg")],
+             r"OUTPUT_CAMERA is the input IMAGES \(.*/im/img_00\.jpg, read from the folder "
+             r".*/im\)" + _NEVER, capsys, im)  # fmt: skip
+
+
+def test_the_same_image_through_a_link_dotdot_or_a_hard_link(tmp_path, capsys):
+    im = _images(tmp_path / "im", "S0_0.tif", "S0_1.tif")
+    (tmp_path / "link").symlink_to(im, target_is_directory=True)
+    os.link(im / "S0_1.tif", tmp_path / "other_name.tif")
+    for output in (tmp_path / "link" / "S0_0.tif", tmp_path / "x" / ".." / "im" / "S0_1.tif",
+                   tmp_path / "other_name.tif"):  # fmt: skip
+        _refused(["tiepoints", "--images", str(im / "S0_0.tif"), str(im / "S0_1.tif"),
+                  "--output-observations", str(output)],
+                 r"OUTPUT_OBSERVATIONS is the input IMAGES \(.*/im/S0_[01]\.tif\)" + _NEVER,
+                 capsys, im)  # fmt: skip
+    assert not (tmp_path / "x").exists()
+
+
+def test_a_raster_s_world_file_and_metadata_are_inputs_too(tmp_path, capsys):
+    o = _images(tmp_path / "o", "S0_0_ortho.tif", "S0_0_ortho.tfw", "S0_0_ortho.tif.aux.xml")
+    for side, what in (("S0_0_ortho.tfw", "the world file"),
+                       ("S0_0_ortho.tif.aux.xml", "its metadata")):  # fmt: skip
+        _refused(["orthomosaic", "--orthophotos", str(o), "--output", str(tmp_path / "m.tif"),
+                  "--seamlines-csv", str(o / side)],
+                 rf"SEAMLINES_CSV is the input ORTHOPHOTOS \(.*/o/{re.escape(side)}, {what} of "
+                 r".*/o/S0_0_ortho\.tif\)" + _NEVER, capsys, o)  # fmt: skip
+    assert not (tmp_path / "m.tif").exists()
+
+
+def test_files_the_job_does_not_read_may_be_replaced(tmp_path):
+    """The folder stands for the files the job reads from it (its endings), no more: a table
+    beside the images, or a new file, is no input."""
+    im = _images(tmp_path / "im", "S0_0.tif", "notes.csv")
+    check_outputs({"OUTPUT": im / "notes.csv"}, {"IMAGES": [im]}, {"IMAGES": (".tif",)})
+    check_outputs({"OUTPUT": im / "S0_9.tif"}, {"IMAGES": [im]}, {"IMAGES": (".tif",)})
+    with pytest.raises(InputError, match=r"OUTPUT is the input IMAGES \(.*notes\.csv, read"):
+        check_outputs({"OUTPUT": im / "notes.csv"}, {"IMAGES": [im]})  # every file: no endings
+
+
+def test_lidarblock_refuses_an_output_folder_holding_its_input(tmp_path, capsys):
+    """The block replaces its output folder as a whole: tiles read from inside it would be
+    deleted with the previous output."""
+    out = tmp_path / "out"
+    (out / "tiles").mkdir(parents=True)
+    (out / "block_report.json").write_text("{}", encoding="utf-8")  # a previous block output
+    _copy(AHN3, out / "tiles", "t1.laz")
+    _refused(["lidarblock", "--input", str(out / "tiles"), "--output-folder", str(out)],
+             r"OUTPUT_FOLDER \(.*/out\) holds the input INPUT \(.*/out/tiles/t1\.laz, read from "
+             r"the folder .*/out/tiles\): the folder is replaced as a whole when the job is "
+             r"done; choose another folder$", capsys, tmp_path)  # fmt: skip
