@@ -116,3 +116,37 @@ def test_lidarblock_refuses_an_output_folder_holding_its_input(tmp_path, capsys)
              r"OUTPUT_FOLDER \(.*/out\) holds the input INPUT \(.*/out/tiles/t1\.laz, read from "
              r"the folder .*/out/tiles\): the folder is replaced as a whole when the job is "
              r"done; choose another folder$", capsys, tmp_path)  # fmt: skip
+
+
+# ----------------------------------------------------------------------------- 4. left behind
+def test_a_killed_run_s_temporaries_go_with_the_next_run_in_the_folder(tmp_path, capsys):
+    """kill -9 while the ground filter writes its LAZ leaves the output set's temporary and the
+    writer's temporary of it; a run of another algorithm in the folder leaves them while the
+    writer lives and removes both once it is gone (not an hour later)."""
+    from test_bad_inputs import _SLOW_WRITER, _traj
+
+    inp, out = tmp_path / "in", tmp_path / "out"
+    inp.mkdir()
+    out.mkdir()
+    argv = _ground(inp, out)
+    other = _traj(inp, ["a,0,,85000,447500,500,0,0,0"])  # writes out/eo.csv
+    before = _snapshot(inp)
+    proc = subprocess.Popen([sys.executable, "-W", "ignore", "-c", _SLOW_WRITER, *argv],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        assert proc.stdout.readline().strip() == "writing"
+        left = sorted(p.name for p in out.iterdir())
+        assert len(left) == 2, left  # .g.<t1>.part.laz and ..g.<t1>.part.<t2>.part.laz
+        assert re.fullmatch(r"\.g\.p\d+h[0-9a-f]{6}r[^.]+\.part\.laz", left[1]), left
+        assert left[0].startswith("." + left[1][:-4] + "."), left
+        assert main(other) == 0, capsys.readouterr().err
+        assert sorted(p.name for p in out.iterdir()) == sorted([*left, "eo.csv"])  # alive
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(timeout=30)
+    finally:
+        proc.kill()
+        proc.communicate()
+    assert sorted(p.name for p in out.iterdir()) == sorted([*left, "eo.csv"])  # left behind
+    assert main(other) == 0, capsys.readouterr().err
+    assert sorted(p.name for p in out.iterdir()) == ["eo.csv"]
+    assert _snapshot(inp) == before
