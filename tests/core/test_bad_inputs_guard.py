@@ -13,7 +13,6 @@ import shutil
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -116,6 +115,61 @@ def test_lidarblock_refuses_an_output_folder_holding_its_input(tmp_path, capsys)
              r"OUTPUT_FOLDER \(.*/out\) holds the input INPUT \(.*/out/tiles/t1\.laz, read from "
              r"the folder .*/out/tiles\): the folder is replaced as a whole when the job is "
              r"done; choose another folder$", capsys, tmp_path)  # fmt: skip
+
+
+# ----------------------------------------------------------------------------- 2. the cache
+_KERNEL = """
+import json, sys
+import numpy as np
+pkg = sys.argv[1]
+module = __import__(pkg + ".core.lidar.roof_planes_numba", fromlist=["counting_order"])
+order, start = module.counting_order(np.array([3, 1, 2, 1, 0], np.int64), 4)
+stats = module._compiled("order").stats
+print(json.dumps({"file": module.__file__, "order": order.tolist(), "start": start.tolist(),
+                  "cache": stats.cache_path, "hits": sum(stats.cache_hits.values())}))
+"""
+
+
+def _kernel(folder: Path, pkg: str, cache: Path) -> dict:
+    """counting_order through ``<pkg>.core...`` in a new process run in ``folder``."""
+    import json
+
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_CACHE")}
+    env.update(XDG_CACHE_HOME=str(cache), PYTHONPATH="")
+    run = subprocess.run([sys.executable, "-c", _KERNEL, pkg], cwd=folder, env=env,
+                         capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    out = json.loads(run.stdout.strip().splitlines()[-1])
+    assert Path(out["file"]).is_relative_to(folder / pkg), out["file"]  # the copy, not ours
+    assert Path(out["cache"]).is_relative_to(cache / "lidarphoto" / "numba"), out["cache"]
+    assert (out["order"], out["start"]) == ([4, 1, 3, 2, 0], [0, 1, 3, 4, 5])
+    return out
+
+
+def test_compiled_kernels_survive_another_import_name_and_a_stale_cache(tmp_path):
+    """The plugin folder imported as ``main`` (pytest's --doctest-modules, a zip's folder),
+    then renamed and imported as ``lidarphoto``: the kernels run under both names, each from
+    its own cache in the user's cache folder (nothing beside the sources); entries pickled
+    under the other name put where the new name looks (a stale cache) are compiled anew."""
+    cache = tmp_path / "cache"
+    main_pkg = tmp_path / "main"
+    main_pkg.mkdir()
+    for name in ("__init__.py", "metadata.txt"):
+        shutil.copy2(ROOT / name, main_pkg / name)
+    shutil.copytree(ROOT / "core", main_pkg / "core",
+                    ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
+    first = _kernel(tmp_path, "main", cache)
+    assert first["hits"] == 0 and "/main-" in first["cache"]
+    assert _kernel(tmp_path, "main", cache)["hits"] == 1  # the cache is used
+    main_pkg.rename(tmp_path / "lidarphoto")
+    fresh = _kernel(tmp_path, "lidarphoto", cache)
+    assert fresh["hits"] == 0 and "/lidarphoto-" in fresh["cache"]
+    # the stale cache: the entries compiled as "main" where "lidarphoto" looks for its own
+    shutil.rmtree(fresh["cache"])
+    shutil.copytree(first["cache"], fresh["cache"])
+    assert _kernel(tmp_path, "lidarphoto", cache)["hits"] == 0  # not loadable: compiled
+    assert _kernel(tmp_path, "lidarphoto", cache)["hits"] == 1  # and written anew
+    assert not list((tmp_path / "lidarphoto").rglob("*.nb[ic]"))
 
 
 # ----------------------------------------------------------------------------- 4. left behind
