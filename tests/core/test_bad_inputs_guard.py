@@ -13,6 +13,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -203,4 +204,108 @@ def test_a_killed_run_s_temporaries_go_with_the_next_run_in_the_folder(tmp_path,
     assert sorted(p.name for p in out.iterdir()) == sorted([*left, "eo.csv"])  # left behind
     assert main(other) == 0, capsys.readouterr().err
     assert sorted(p.name for p in out.iterdir()) == ["eo.csv"]
+    assert _snapshot(inp) == before
+
+
+# ----------------------------------------------------------------------------- 3. bounded work
+def _block(inp: Path, out: Path, *extra: str) -> list[str]:
+    return ["lidarblock", "--input", str(_copy(AHN3, inp)), "--output-folder", str(out / "b"),
+            *extra]  # fmt: skip
+
+
+def test_lidarblock_memory_limit_below_a_tile_is_refused_before_the_cluster(tmp_path, capsys):
+    inp, out = tmp_path / "in", tmp_path / "out"
+    inp.mkdir()
+    out.mkdir()
+    argv = _block(inp, out, "--memory-limit", "0.05", "--local-cluster", "processes")
+    t0 = time.perf_counter()
+    _refused(argv, r"MEMORY_LIMIT 0\.05 GB: a worker needs about 285\.2 MB for the largest "
+             r"tile \(ahn3_delft_crop60_0_0: about 35231 points with its buffer, a grid of 3720 "
+             r"cells\) and the worker itself \(280\.0 MB\): give at least 0\.3 GB, or 0 \(the "
+             r"memory shared among the workers\)$", capsys, tmp_path)  # fmt: skip
+    assert time.perf_counter() - t0 < 10  # no cluster started (it took minutes to hang)
+
+
+def test_lidarblock_workers_beyond_the_free_memory(tmp_path, capsys, monkeypatch):
+    inp, out = tmp_path / "in", tmp_path / "out"
+    inp.mkdir()
+    out.mkdir()
+    monkeypatch.setattr("lidarphoto.core.jobs.checks.available_memory", lambda: 500_000_000)
+    _refused(_block(inp, out, "--workers", "4"),
+             r"WORKERS 4: 4 tiles at once, each the largest tile \(ahn3_delft_crop60_0_0: about "
+             r"35231 points .*\) and the worker itself \(280\.0 MB\), needs about 1\.1 GB of "
+             r"memory; 500\.0 MB is free: give fewer WORKERS or a smaller TILE_SIZE$",
+             capsys, tmp_path)  # fmt: skip
+
+
+def test_lidarblock_tiles_smaller_than_their_buffer_or_too_many(tmp_path, capsys, monkeypatch):
+    inp, out = tmp_path / "in", tmp_path / "out"
+    inp.mkdir()
+    out.mkdir()
+    _refused(_block(inp, out, "--tile-size", "1"),
+             r"TILE_SIZE 1 metre is smaller than the buffer each tile reads around it \(44 "
+             r"metre, from SMRF_WINDOW, LOW_OUTLIER_RADIUS and SMRF_CELL_SIZE\): each tile would "
+             r"read 7921 times its own area; give at least 44 metre$", capsys, tmp_path)
+    monkeypatch.setattr("lidarphoto.core.jobs.lidar_block.MAX_TILES", 3)
+    _refused(_block(inp, out, "--tile-size", "44"),
+             r"TILE_SIZE 44 metre: the file \(60 x 59\.99 metre\) would be cut into 3 x 3 tiles, "
+             r"more than 3: give a larger TILE_SIZE$", capsys, tmp_path)  # fmt: skip
+
+
+_STOP_BLOCK = """
+import sys
+import time
+from distributed import LocalCluster
+from lidarphoto.core.cli import main
+from lidarphoto.core.jobs import lidar_block
+
+stage = sys.argv[1]
+start, gather = LocalCluster.__init__, lidar_block.gather
+
+def starting(self, *args, **kwargs):
+    print("start", flush=True)
+    return start(self, *args, **kwargs)
+
+def tiles(*args, **kwargs):
+    print("tiles", flush=True)
+    return gather(*args, **kwargs)
+
+LocalCluster.__init__, lidar_block.gather = starting, tiles
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[2:]))
+"""
+
+
+@pytest.mark.parametrize(("stage", "delay"), [("start", 0.3), ("tiles", 1.0)])
+def test_lidarblock_stops_within_a_second_of_sigterm(tmp_path, stage, delay):
+    """Process workers, SIGTERM while the cluster starts and while the tiles run: the run
+    ends (its message) within a second, nothing written, no staging folder left."""
+    inp, out = tmp_path / "in", tmp_path / "out"
+    inp.mkdir()
+    out.mkdir()
+    script = tmp_path / "stop_block.py"  # a file: the workers' processes import it as main
+    script.write_text(_STOP_BLOCK, encoding="utf-8")
+    argv = _block(inp, out, "--tile-size", "44", "--workers", "2", "--local-cluster",
+                  "processes")  # fmt: skip
+    before = _snapshot(inp)
+    proc = subprocess.Popen([sys.executable, "-W", "ignore", str(script), stage, *argv],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        while proc.stdout.readline().strip() != stage:
+            assert proc.poll() is None, proc.stderr.read()
+        time.sleep(delay)
+        t0 = time.perf_counter()
+        proc.send_signal(signal.SIGTERM)
+        line = proc.stderr.readline()
+        while line and "stopped by" not in line:
+            line = proc.stderr.readline()
+        took = time.perf_counter() - t0
+        proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert line.rstrip().endswith("lidarphoto lidarblock: stopped by SIGTERM; nothing was "
+                                  "written"), line  # fmt: skip
+    assert took < 1.0, took
+    assert proc.returncode == 143
+    assert os.listdir(out) == []  # no output, no staging folder
     assert _snapshot(inp) == before
