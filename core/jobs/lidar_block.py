@@ -292,6 +292,14 @@ def control_tile(box, planes, points, plane_ids, options: ControlOptions):
 _STOP_SIGNALS = {getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)}
 
 
+def _process_workers(v: Values) -> bool:
+    """A local cluster of processes (else threads of this process)."""
+    # inside QGIS (or qgis_process) a worker process would be started with QGIS's own
+    # executable: threads there
+    return v.local_cluster == "processes" or (
+        v.local_cluster == "auto" and "qgis.core" not in sys.modules)
+
+
 def open_client(v: Values):
     """A dask client: on CLUSTER's scheduler, or on a new LocalCluster (closed with it)."""
     from distributed import Client, LocalCluster
@@ -307,10 +315,7 @@ def open_client(v: Values):
             ) from exc
     n = v.workers or os.cpu_count() or 1
     memory = f"{v.memory_limit}GB" if v.memory_limit > 0 else "auto"
-    # inside QGIS (or qgis_process) a worker process would be started with QGIS's own
-    # executable: threads there
-    processes = v.local_cluster == "processes" or (
-        v.local_cluster == "auto" and "qgis.core" not in sys.modules)
+    processes = _process_workers(v)
     made: list[Any] = []
 
     def start() -> None:
@@ -511,7 +516,9 @@ def _check_cluster_memory(v: Values, index, settings: BlockSettings) -> None:
                          f"{math.ceil(need / 1e8) / 10:g} GB, or 0 (the memory shared among "
                          "the workers)")  # fmt: skip
     n = v.workers or os.cpu_count() or 1
-    check_memory(n * need, f"WORKERS {n}: {n} tiles at once, each {what},",
+    # thread workers share this process (its own memory counted once)
+    total = n * need if _process_workers(v) else need + (n - 1) * (need - WORKER_BASE_BYTES)
+    check_memory(total, f"WORKERS {n}: {n} tiles at once, each {what},",
                  "give fewer WORKERS or a smaller TILE_SIZE")  # fmt: skip
 
 
