@@ -193,7 +193,8 @@ _RASTER_SIDECARS = ((".aux.xml", "its metadata"), (".ovr", "its overviews"),
 
 
 def _world_files(path: Path) -> tuple[str, ...]:
-    """Names of the world files GDAL takes for ``path``: ``x.tfw``, ``x.tifw``, ``x.wld``."""
+    """Names of the georeferencing files GDAL takes for ``path``: ``x.tfw``, ``x.tifw``,
+    ``x.wld`` (world files) and ``x.tab`` (MapInfo)."""
     ext = path.suffix
     return (f"{path.stem}.{ext[1]}{ext[-1]}w", f"{path.stem}{ext}w", f"{path.stem}.wld",
             f"{path.stem}.tab")  # fmt: skip
