@@ -21,6 +21,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..compiled import cached_njit
+
 try:  # pragma: no cover - depends on the environment
     import numba
 
@@ -251,7 +253,7 @@ def _compiled(name: str) -> Callable[..., Any]:
     another package name, the functions compile again."""
     if name not in _COMPILED:
         func = {"order": _spatial_order, "trace": _trace}[name]
-        _COMPILED[name] = numba.njit(cache=True, nogil=True)(func)
+        _COMPILED[name] = cached_njit(func, nogil=True)
     return _COMPILED[name]
 
 

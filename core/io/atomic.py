@@ -4,11 +4,16 @@ Every file the core writes goes through :func:`atomic_path` (a temporary name in
 folder, moved into place with ``os.replace`` once complete) or :func:`atomic_write` (the same,
 as an open file). A job's whole set of outputs goes through :class:`OutputSet`: each output is
 written under a temporary name and the set is moved into place only when every output is
-complete, after the job has refused any output path that is one of its inputs.
+complete, after :func:`check_outputs` has refused any output that would overwrite a file the
+job reads (compared as the files themselves: links, ``..`` and the case of a case-insensitive
+file system resolved; folders expanded to the files the job reads from them; the files GDAL
+reads beside a raster).
 
-Temporary files are hidden (``.<stem>.<random>.part<suffix>``), created with the mode the final file
-should have (the existing file's mode, else the process umask), and removed on any error,
-including ``KeyboardInterrupt``.
+Temporary files are hidden (``.<stem>.<token>.part<suffix>``), created with the mode the final
+file should have (the existing file's mode, else the process umask), and removed on any error,
+including ``KeyboardInterrupt``. The token names the process that made the file (its id and a
+hash of the host name, then mkstemp's random part), so that the next job writing in the folder
+removes at once what a killed process left (:func:`remove_dead_temporaries`).
 """
 
 from __future__ import annotations
@@ -16,8 +21,10 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+import socket
 import tempfile
 import time
+import zlib
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import IO, Any, Union
@@ -43,14 +50,34 @@ def final_mode(path: PathLike) -> int:
         return 0o666 & ~_umask()
 
 
+#: Hash of this machine's name in temporary names: a process id is only compared on its host.
+_HOST = f"{zlib.crc32(socket.gethostname().encode('utf-8', 'replace')) & 0xFFFFFF:06x}"
+#: The token of a temporary name: ``p<pid>h<host hash>r<random>``.
+_TOKEN = re.compile(r"p(\d+)h([0-9a-f]{6})r[^.]+")
+#: Any temporary name (also the temporary of a temporary, ``..g.<t1>.part.<t2>.part.laz``, and
+#: a writer's sidecar of it, ``.d.<t>.part.tif.aux.xml``): (base without sidecar, token).
+_ANY_TEMP = re.compile(rf"(\..+\.([^.]+){re.escape(TEMP_SUFFIX)}(?:\.[^.]+)?)(\..+)?")
+#: Temporaries this process made and has not yet moved or removed (threads of one process,
+#: e.g. QGIS, share its id).
+_LIVE: set[str] = set()
+
+
 def _temp_name(target: Path) -> str:
     """A new empty hidden file next to ``target`` that keeps its extension (writers such as
-    laspy, GDAL and OpenCV choose the format by it): ``.name.<random>.part.tif``."""
+    laspy, GDAL and OpenCV choose the format by it): ``.name.p<pid>h<host>r<random>.part.tif``."""
     fd, tmp = tempfile.mkstemp(
-        prefix=f".{target.stem}.", suffix=TEMP_SUFFIX + target.suffix, dir=target.parent
+        prefix=f".{target.stem}.p{os.getpid()}h{_HOST}r",
+        suffix=TEMP_SUFFIX + target.suffix,
+        dir=target.parent,
     )
     os.close(fd)
+    _LIVE.add(os.path.abspath(tmp))
     return tmp
+
+
+def _forget(tmp: str) -> None:
+    """``tmp`` is no longer a temporary of this process (moved into place or removed)."""
+    _LIVE.discard(os.path.abspath(tmp))
 
 
 def _sidecars(tmp: str) -> list[tuple[str, str]]:
@@ -101,6 +128,8 @@ def atomic_path(path: PathLike) -> Iterator[str]:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+    finally:
+        _forget(tmp)
 
 
 @contextlib.contextmanager
@@ -154,17 +183,159 @@ def _check_writable(name: str, target: Path) -> None:
         raise InputError(f"{name}: cannot write {target}: no permission to write in {folder}")
 
 
+# ----------------------------------------------------------------------------- the guard
+#: Endings of the files read as rasters through GDAL, which reads the files beside them too.
+RASTER_SUFFIXES = (".tif", ".tiff", ".jpg", ".jpeg", ".png", ".jp2", ".img", ".bmp", ".gif",
+                   ".vrt", ".asc")  # fmt: skip
+#: What GDAL reads beside a raster ``x.tif``: ``x.tif`` + these.
+_RASTER_SIDECARS = ((".aux.xml", "its metadata"), (".ovr", "its overviews"),
+                    (".msk", "its mask"))  # fmt: skip
+
+
+def _world_files(path: Path) -> tuple[str, ...]:
+    """Names of the georeferencing files GDAL takes for ``path``: ``x.tfw``, ``x.tifw``,
+    ``x.wld`` (world files) and ``x.tab`` (MapInfo)."""
+    ext = path.suffix
+    return (f"{path.stem}.{ext[1]}{ext[-1]}w", f"{path.stem}{ext}w", f"{path.stem}.wld",
+            f"{path.stem}.tab")  # fmt: skip
+
+
+def _names_in(folder: Path, cache: dict[Path, dict[str, str]]) -> dict[str, str]:
+    """Lower-case name -> name of the files in ``folder`` (read once)."""
+    if folder not in cache:
+        try:
+            cache[folder] = {n.lower(): n for n in os.listdir(folder)}
+        except OSError:
+            cache[folder] = {}
+    return cache[folder]
+
+
+def read_files(
+    inputs: Mapping[str, PathLike | Iterable[PathLike] | None],
+    suffixes: Mapping[str, Iterable[str]] | None = None,
+) -> list[tuple[str, Path, str]]:
+    """Every existing file the inputs make a job read: (input name, file, how it is read).
+
+    A folder stands for its files (not recursive) with the endings ``suffixes[name]`` (every
+    file when not given), as the job's reader lists them; a raster (:data:`RASTER_SUFFIXES`)
+    brings the files GDAL reads beside it (``.aux.xml``, ``.ovr``, ``.msk``, world files; any
+    case). "How" is "" for a file named, else the words of the message.
+
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> for name in ("a.tif", "a.tfw", "notes.txt"):
+    ...     _ = (d / name).write_text("")
+    >>> for name, f, how in read_files({"IMAGES": [d]}, {"IMAGES": [".tif"]}):
+    ...     print(name, f.name, how.replace(str(d), "<d>"))
+    IMAGES a.tif , read from the folder <d>
+    IMAGES a.tfw , the world file of <d>/a.tif
+    """
+    listing: dict[Path, dict[str, str]] = {}
+    out: list[tuple[str, Path, str]] = []
+    for name, value in inputs.items():
+        if not value:
+            continue
+        many = [value] if isinstance(value, (str, os.PathLike)) else list(value)
+        ends = tuple(e.lower() for e in (suffixes or {}).get(name, ()))
+        for raw in many:
+            if not raw or not isinstance(raw, (str, os.PathLike)):
+                continue  # an object the QGIS adapter made from a layer
+            p = Path(raw)
+            if p.is_dir():
+                files = [(p / f, f", read from the folder {p}") for f in sorted(os.listdir(p))
+                         if (p / f).is_file() and (not ends or Path(f).suffix.lower() in ends)]
+            elif p.is_file():
+                files = [(p, "")]
+            else:
+                continue  # the job's reader names a missing file
+            for f, how in files:
+                out.append((name, f, how))
+                if f.suffix.lower() not in RASTER_SUFFIXES:
+                    continue
+                names = _names_in(f.parent, listing)
+                sides = [(f.name + ext, f"{what} of {f}") for ext, what in _RASTER_SIDECARS]
+                sides += [(w, f"the world file of {f}") for w in _world_files(f)]
+                for side, what in sides:
+                    found = names.get(side.lower())
+                    if found is not None and found != f.name:
+                        out.append((name, f.parent / found, f", {what}"))
+    return out
+
+
+def _identity(path: Path) -> tuple[int, int] | None:
+    """(device, inode) of an existing file: the same for every name of it (links, ``..``,
+    another case on a case-insensitive file system); None when there is none."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return (st.st_dev, st.st_ino)
+
+
+def check_outputs(
+    outputs: Mapping[str, PathLike],
+    inputs: Mapping[str, PathLike | Iterable[PathLike] | None],
+    suffixes: Mapping[str, Iterable[str]] | None = None,
+    folders: Mapping[str, PathLike] | None = None,
+) -> None:
+    """Refuse (InputError) an output that would overwrite a file the job reads.
+
+    ``outputs``: name -> file the job writes (with the sidecars GDAL may write beside a
+    raster); ``folders``: name -> a folder the job replaces as a whole (no input may lie in
+    it); ``inputs`` and ``suffixes`` as :func:`read_files`. Files are compared as files
+    (device and inode), so a link, ``..``, a folder named instead of its files or another
+    case of the name on a case-insensitive file system changes nothing. Nothing is written.
+    """
+    reads = read_files(inputs, suffixes)
+    by_id = {}
+    for name, f, how in reads:
+        key = _identity(f)
+        if key is not None:
+            by_id.setdefault(key, (name, f, how))
+    for out_name, target in outputs.items():
+        target = Path(target)
+        written = [(target, "")]
+        if target.suffix.lower() in RASTER_SUFFIXES:
+            written += [(Path(str(target) + ext), f" (with {target.name + ext}, {what})")
+                        for ext, what in _RASTER_SIDECARS]  # fmt: skip
+        for path, what in written:
+            # folders of the path still missing are made before writing: "new/../x" is "x"
+            hit = by_id.get(_identity(Path(os.path.realpath(path))))
+            if hit is not None:
+                in_name, source, how = hit
+                raise InputError(
+                    f"{out_name}{what} is the input {in_name} ({source}{how}): an output "
+                    "never overwrites an input; choose another file"
+                )
+    for out_name, folder in (folders or {}).items():
+        inside = os.path.realpath(folder)
+        for in_name, f, how in reads:
+            try:
+                common = os.path.commonpath([os.path.realpath(f), inside])
+            except ValueError:  # another drive
+                continue
+            if os.path.normcase(common) == os.path.normcase(inside):
+                raise InputError(
+                    f"{out_name} ({folder}) holds the input {in_name} ({f}{how}): the folder "
+                    "is replaced as a whole when the job is done; choose another folder"
+                )
+
+
+
 class OutputSet:
     """The output files of one job, committed together.
 
     ``outputs`` maps a parameter name to its path (None or "" when not requested); ``inputs``
-    maps parameter names to the input files. The constructor refuses (InputError) an output
-    that is an input or another output, or that cannot be written (a folder, a file on its
-    path, a folder without write permission), before anything is read. The job writes each output
+    maps parameter names to the input files or folders (``suffixes``: the file endings the job
+    reads from a folder of that input; every file when not given). The constructor refuses
+    (InputError) an output that would overwrite a file the job reads (:func:`check_outputs`)
+    or another output, or that cannot be written (a folder, a file on its path, a folder
+    without write permission), before anything is read. The job writes each output
     through :meth:`path` (a temporary name) and the caller calls :meth:`commit` once the job
     succeeded, or :meth:`discard` (also the effect of leaving the ``with`` block by an error).
-    Temporaries of the outputs older than an hour, which only a killed process leaves behind,
-    are removed first (:func:`remove_stale_temporaries`).
+    Temporaries only a killed process leaves behind are removed first: in the outputs'
+    folders every one of a process that is gone (:func:`remove_dead_temporaries`), and those
+    of the outputs older than an hour (:func:`remove_stale_temporaries`).
 
     >>> import tempfile, pathlib
     >>> d = pathlib.Path(tempfile.mkdtemp())
@@ -180,23 +351,12 @@ class OutputSet:
         self,
         outputs: Mapping[str, PathLike | None],
         inputs: Mapping[str, PathLike | Iterable[PathLike] | None],
+        suffixes: Mapping[str, Iterable[str]] | None = None,
     ) -> None:
         self.targets = {k: Path(v) for k, v in outputs.items() if v}
         self._temps: dict[str, str] = {}
         self._done = False
-        files = []
-        for name, value in inputs.items():
-            if not value:
-                continue
-            many = value if isinstance(value, (list, tuple)) else [value]
-            files += [(name, Path(v)) for v in many if v]
-        for out_name, target in self.targets.items():
-            for in_name, source in files:
-                if same_file(target, source):
-                    raise InputError(
-                        f"{out_name} is the input {in_name} ({source}): an output never "
-                        "overwrites an input; choose another file"
-                    )
+        check_outputs(self.targets, inputs, suffixes)
         names = list(self.targets)
         for i, a in enumerate(names):
             for b in names[i + 1 :]:
@@ -204,7 +364,9 @@ class OutputSet:
                     raise InputError(f"{a} and {b} are the same file ({self.targets[a]})")
         for name, target in self.targets.items():
             _check_writable(name, target)
-        for target in self.targets.values():  # left by a killed run of this job (SIGKILL)
+        for folder in sorted({t.parent for t in self.targets.values()}):
+            remove_dead_temporaries(folder)  # left by any killed job writing here
+        for target in self.targets.values():  # left by a killed run of this job elsewhere
             remove_stale_temporaries(target)
 
     def __enter__(self) -> OutputSet:
@@ -255,6 +417,7 @@ class OutputSet:
                 backup = None
                 if existed:
                     backup = _temp_name(current)
+                    _forget(backup)
                     os.unlink(backup)
                     try:
                         os.link(current, backup)
@@ -265,6 +428,7 @@ class OutputSet:
                 os.replace(tmp, current)
                 for side, ext in _sidecars(tmp):  # e.g. a GeoTIFF's .aux.xml
                     os.replace(side, str(current) + ext)
+                _forget(tmp)
                 del self._temps[name]
         except BaseException as exc:  # an OS error, or Ctrl+C / a stop signal mid-way
             for target, backup, existed in reversed(moved):
@@ -290,6 +454,7 @@ class OutputSet:
             Path(tmp).unlink(missing_ok=True)
             for side, _ in _sidecars(tmp):
                 Path(side).unlink(missing_ok=True)
+            _forget(tmp)
         self._temps.clear()
         self._done = True
 
@@ -340,4 +505,74 @@ def remove_stale_temporaries(path: PathLike, older_than_s: float = 3600.0) -> li
         except OSError:
             continue
         removed.append(full)
+    return removed
+
+
+def _process_alive(pid: int) -> bool | None:
+    """Whether process ``pid`` of this machine runs; None when it cannot be told (Windows,
+    where ``os.kill`` would end it)."""
+    if os.name == "nt":
+        return None
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    except OSError:
+        return None
+    return True
+
+
+def remove_dead_temporaries(folder: PathLike) -> list[str]:
+    """Remove every temporary in ``folder`` whose process is gone; their paths.
+
+    A temporary's name carries the id of the process that made it and a hash of its host
+    (:func:`_temp_name`); one made on this machine by a process that no longer runs (killed:
+    SIGKILL, a crash, a power cut) is removed whatever its file's name or age, also the
+    temporary of a temporary (``..g.<t1>.part.<t2>.part.laz``) and a writer's sidecar of it.
+    Temporaries of running processes, of this process, of other hosts (a shared folder) and
+    names without a process id are left alone (:func:`remove_stale_temporaries` removes
+    those of a job's outputs by age). Errors are ignored.
+
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> token = f"p{2**22 + 12345}h{_HOST}r"  # a process id beyond any pid_max
+    >>> dead = f".g.{token}k3x9q1zz.part.laz"
+    >>> inner = f".{dead[:-4]}.{token}q8m2a7bb.part.laz"  # written through the first
+    >>> for name in (dead, inner, "notes.laz"):
+    ...     _ = (folder / name).write_text("")
+    >>> sorted(pathlib.Path(p).name for p in remove_dead_temporaries(folder)) == [inner, dead]
+    True
+    >>> sorted(p.name for p in folder.iterdir())
+    ['notes.laz']
+    """
+    folder = str(folder) or "."
+    try:
+        names = sorted(os.listdir(folder))
+    except OSError:
+        return []
+    removed = []
+    alive: dict[int, bool | None] = {}
+    for name in names:
+        match = _ANY_TEMP.fullmatch(name)
+        token = _TOKEN.fullmatch(match.group(2)) if match else None
+        if token is None or token.group(2) != _HOST:
+            continue
+        pid = int(token.group(1))
+        if pid == os.getpid():  # ours while this process knows it, else an earlier process's
+            gone = os.path.abspath(os.path.join(folder, match.group(1))) not in _LIVE
+        else:
+            if pid not in alive:
+                alive[pid] = _process_alive(pid)
+            gone = alive[pid] is False
+        if not gone:
+            continue
+        full = os.path.join(folder, name)
+        try:
+            if os.path.isfile(full):
+                os.unlink(full)
+                removed.append(full)
+        except OSError:
+            continue
     return removed

@@ -18,7 +18,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..geometry.raycast_numba import AVAILABLE, numba
+from ..compiled import cached_njit
+from ..geometry.raycast_numba import AVAILABLE
 
 __all__ = ["HeaderStats"]
 
@@ -62,7 +63,7 @@ class HeaderStats:
         self._counts = np.zeros(16, np.int64)
         self._n = int(h.point_count)
         if "stats" not in _COMPILED:
-            _COMPILED["stats"] = numba.njit(cache=True, nogil=True)(_chunk_stats)
+            _COMPILED["stats"] = cached_njit(_chunk_stats, nogil=True)
 
     @classmethod
     def for_writer(cls, writer: Any) -> HeaderStats | None:

@@ -22,7 +22,8 @@ from typing import Any, Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from ..geometry.raycast_numba import AVAILABLE, numba
+from ..compiled import cached_njit
+from ..geometry.raycast_numba import AVAILABLE
 
 __all__ = ["OverviewBuilder", "average_level", "level_windows"]
 
@@ -190,8 +191,8 @@ def _run_kernel(backend: str, src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out
         _average_rows_numpy(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask)
         return
     if not _COMPILED:
-        _COMPILED["rows"] = numba.njit(cache=True, nogil=True)(_average_rows)
-        _COMPILED["2x2"] = numba.njit(cache=True, nogil=True)(_average_rows_2x2)
+        _COMPILED["rows"] = cached_njit(_average_rows, nogil=True)
+        _COMPILED["2x2"] = cached_njit(_average_rows_2x2, nogil=True)
     two = (ya.size == 0 or (np.all(yb - ya == 2) and ya[0] == 0 and np.all(np.diff(ya) == 2)
                             and np.all(ywl == 1.0) and np.all(ywr == 1.0)))
     two = two and (np.all(xb - xa == 2) and xa[0] == 0 and np.all(np.diff(xa) == 2)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ..geometry.projection import PROJECTIONS
+from ..io.images import IMAGE_SUFFIXES
 from ..photo.calibration_targets import DICTIONARIES, TARGET_KINDS
 from ..photo.camera_calibration import FIELD_MODES, LENS_NAMES, CalibrationOptions
 from .runner import JobResult
@@ -40,7 +41,7 @@ lens coefficient, per-view RMS and poses), the same as an HTML page, and the res
 (CSV). PIXEL_SIZE only scales
 the millimetre values of the camera file: the calibration itself is in pixels.""",
     params=(
-        Param("IMAGES", "files", "Target images (files or folders)",
+        Param("IMAGES", "files", "Target images (files or folders)", suffixes=IMAGE_SUFFIXES,
               help="image files, or folders whose images are all taken"),
         Param("TARGET", "enum", "Target", TARGET_KINDS[0], options=TARGET_KINDS,
               labels=("chessboard", "ChArUco board", "ArUco grid board")),

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.scans import SCAN_SUFFIXES
 from ..tls.aps import ARCSEC
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult, stages
@@ -46,7 +47,8 @@ sigma is 2-3 times optimistic on simulations (the centre itself within 0.5 mm).
 Ids: targets are matched between scans by their mutual distances (a rigid motion keeps them),
 and take the ids of CONTROL points when given (matched the same way).""",
     params=(
-        Param("SCANS", "files", "Scans (LAS/LAZ, PLY, E57; one station per file)"),
+        Param("SCANS", "files", "Scans (LAS/LAZ, PLY, E57; one station per file)",
+              suffixes=SCAN_SUFFIXES),
         Param("KIND", "enum", "Target kind", "sphere", options=KINDS),
         Param("RADIUS", "number", "Sphere radius", 0.0725, unit="m", minimum=0.005,
               maximum=2.0),

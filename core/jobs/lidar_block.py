@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 import math
 import os
+import signal
 import sys
 import time
 from collections.abc import Callable
@@ -31,6 +32,16 @@ INCOMPLETE_EXIT = 3
 #: The command line shows a progress bar for this job.
 CLI_PROGRESS = True
 REPORT_NAME = "block_report.json"
+#: Most tiles one block may have (each is a task carrying the block's index; a small
+#: TILE_SIZE over a large file would give millions).
+MAX_TILES = 20000
+#: Memory of one worker besides its tile: Python, numpy, dask, laspy and the compiled
+#: kernels loaded (a process worker: 200 MB idle, 285.6 MB peak on the 35 231-point AHN3 tile
+#: by the block report's peak_rss_mb; rounded).
+WORKER_BASE_BYTES = 280e6
+#: Bytes per point of a tile and its buffer besides the ground filter's (x, y, z, ids and
+#: flags as arrays; the LAS records are counted apart).
+TILE_BYTES_PER_POINT = 48
 
 # fmt: off
 SPEC = AlgorithmSpec(
@@ -277,6 +288,18 @@ def control_tile(box, planes, points, plane_ids, options: ControlOptions):
 
 
 # ----------------------------------------------------------------------------- the cluster
+#: Signals that stop a run (the command line raises on SIGTERM and SIGHUP; SIGINT is Ctrl+C).
+_STOP_SIGNALS = {getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)}
+
+
+def _process_workers(v: Values) -> bool:
+    """A local cluster of processes (else threads of this process)."""
+    # inside QGIS (or qgis_process) a worker process would be started with QGIS's own
+    # executable: threads there
+    return v.local_cluster == "processes" or (
+        v.local_cluster == "auto" and "qgis.core" not in sys.modules)
+
+
 def open_client(v: Values):
     """A dask client: on CLUSTER's scheduler, or on a new LocalCluster (closed with it)."""
     from distributed import Client, LocalCluster
@@ -292,14 +315,32 @@ def open_client(v: Values):
             ) from exc
     n = v.workers or os.cpu_count() or 1
     memory = f"{v.memory_limit}GB" if v.memory_limit > 0 else "auto"
-    # inside QGIS (or qgis_process) a worker process would be started with QGIS's own
-    # executable: threads there
-    processes = v.local_cluster == "processes" or (
-        v.local_cluster == "auto" and "qgis.core" not in sys.modules)
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, memory_limit=memory,
-                           processes=processes, dashboard_address=None,
-                           silence_logs=logging.ERROR)  # fmt: skip
-    return Client(cluster), cluster
+    processes = _process_workers(v)
+    made: list[Any] = []
+
+    def start() -> None:
+        # the cluster's threads (its event loop, the workers' watchers) inherit this mask:
+        # a stop signal then reaches the main thread, which waits below and raises at once
+        # (one delivered to another thread would leave it asleep until the start is done)
+        if hasattr(signal, "pthread_sigmask"):
+            signal.pthread_sigmask(signal.SIG_BLOCK, _STOP_SIGNALS)
+        try:
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, memory_limit=memory,
+                                   processes=processes, dashboard_address=None,
+                                   silence_logs=logging.ERROR)  # fmt: skip
+            made.append((Client(cluster), cluster))
+        except Exception as exc:
+            made.append(exc)
+
+    import threading
+
+    starter = threading.Thread(target=start, name="lidarblock cluster start", daemon=True)
+    starter.start()
+    while starter.is_alive():
+        starter.join(0.1)
+    if isinstance(made[0], Exception):
+        raise made[0]
+    return made[0]
 
 
 def gather(client, futures, progress, should_stop, lo: float, hi: float) -> list[Any]:
@@ -401,6 +442,101 @@ def settings_from(v: Values, info) -> BlockSettings:
                          roof_buffer(roof.k_neighbours, spacing), v.crs or None)  # fmt: skip
 
 
+def _check_tiling(v: Values) -> None:
+    """One large file: its tiles' count and their size against the buffer each reads around
+    it, from the header, before any tile is made (a small TILE_SIZE would make millions, each
+    reading many times its own area)."""
+    from ..io.pointcloud import read_info
+
+    path = Path(v.input)
+    if not (path.is_file() and path.suffix.lower() in (".las", ".laz")):
+        return
+    info = read_info(path, v.crs or None)
+    width, height = (float(d) for d in info.maxs[:2] - info.mins[:2])
+    size, unit = float(v.tile_size), info.horizontal_unit
+    if size > max(width, height):
+        return  # one tile
+    # the grid of index_block: cells on multiples of the tile size
+    cols, rows = (math.floor((float(hi) - math.floor(float(lo) / size) * size) / size) + 1
+                  for lo, hi in zip(info.mins[:2], info.maxs[:2]))  # fmt: skip
+    if cols * rows > MAX_TILES:
+        raise InputError(f"TILE_SIZE {size:g} {unit}: the file ({width:.4g} x {height:.4g} "
+                         f"{unit}) would be cut into {cols} x {rows} tiles, more than "
+                         f"{MAX_TILES}: give a larger TILE_SIZE")  # fmt: skip
+    settings = settings_from(v, info)
+    buffer = max(settings.ground_buffer, settings.roof_buffer)
+    if size < buffer:
+        ratio = ((size + 2 * buffer) / size) ** 2
+        raise InputError(f"TILE_SIZE {size:g} {unit} is smaller than the buffer each tile reads "
+                         f"around it ({buffer:.4g} {unit}, from SMRF_WINDOW, "
+                         f"LOW_OUTLIER_RADIUS and SMRF_CELL_SIZE): each tile would read "
+                         f"{ratio:.0f} times its own area; give at least {buffer:.4g} {unit}")
+
+
+def _tile_need(index, settings: BlockSettings) -> tuple[float, str]:
+    """Bytes the largest tile takes in a worker (its points with the buffer, at the block's
+    mean density, and the ground filter's grid) and the words saying so."""
+    from .checks import GROUND_FILTER_BYTES_PER_CELL, GROUND_FILTER_BYTES_PER_POINT, size_text
+
+    info = index.info
+    lo, hi = info.mins[:2], info.maxs[:2]
+    density = index.point_count / float(np.prod(np.maximum(hi - lo, 1e-9)))
+    b = max(settings.ground_buffer, settings.roof_buffer)
+    per_point = GROUND_FILTER_BYTES_PER_POINT + TILE_BYTES_PER_POINT + info.record_size
+    best = (0.0, 0, 0, "")
+    for tile in index.tiles:
+        box = tile.cell or tile.box
+        w = min(box[2] + b, hi[0]) - max(box[0] - b, lo[0])
+        h = min(box[3] + b, hi[1]) - max(box[1] - b, lo[1])
+        points = min(density * max(w, 0.0) * max(h, 0.0), index.point_count)
+        cells = (w / settings.smrf.cell_size + 1) * (h / settings.smrf.cell_size + 1)
+        need = points * per_point + max(cells, 0.0) * GROUND_FILTER_BYTES_PER_CELL
+        if need > best[0]:
+            best = (need, int(points), int(max(cells, 0.0)), tile.name)
+    need, points, cells, name = best
+    return WORKER_BASE_BYTES + need, (
+        f"the largest tile ({name}: about {points} points with its buffer, a grid of {cells} "
+        f"cells) and the worker itself ({size_text(WORKER_BASE_BYTES)})")
+
+
+def _check_cluster_memory(v: Values, index, settings: BlockSettings) -> None:
+    """A local cluster's memory against the largest tile, before it starts (a worker below
+    what a tile needs is restarted again and again: no error, no end)."""
+    from .checks import check_memory, size_text
+
+    if len(index.tiles) > MAX_TILES:
+        raise InputError(f"INPUT: the block has {len(index.tiles)} tiles, more than "
+                         f"{MAX_TILES}: split it into several blocks")  # fmt: skip
+    if v.cluster or not index.tiles:
+        return  # an existing cluster's workers have their own memory
+    need, what = _tile_need(index, settings)
+    if v.memory_limit > 0 and need > v.memory_limit * 1e9:
+        raise InputError(f"MEMORY_LIMIT {v.memory_limit:g} GB: a worker needs about "
+                         f"{size_text(need)} for {what}: give at least "
+                         f"{math.ceil(need / 1e8) / 10:g} GB, or 0 (the memory shared among "
+                         "the workers)")  # fmt: skip
+    n = v.workers or os.cpu_count() or 1
+    # thread workers share this process (its own memory counted once)
+    total = n * need if _process_workers(v) else need + (n - 1) * (need - WORKER_BASE_BYTES)
+    check_memory(total, f"WORKERS {n}: {n} tiles at once, each {what},",
+                 "give fewer WORKERS or a smaller TILE_SIZE")  # fmt: skip
+
+
+def _stop_workers(cluster) -> None:
+    """End a local cluster's worker processes at once (a stop or an error: the graceful
+    close waits seconds for each busy worker), so that SIGTERM ends the run within a second."""
+    for nanny in list(getattr(cluster, "workers", {}).values()):
+        process = getattr(getattr(nanny, "process", None), "process", None)
+        pid = getattr(process, "pid", None)
+        if pid is None:
+            continue  # a thread worker: it ends with this process
+        nanny.auto_restart = False
+        try:
+            os.kill(pid, getattr(signal, "SIGKILL", signal.SIGTERM))
+        except OSError:
+            pass
+
+
 def _check_output(folder: Path) -> None:
     if folder.exists() and (not folder.is_dir() or (any(folder.iterdir())
                                                     and not (folder / REPORT_NAME).exists())):
@@ -410,15 +546,21 @@ def _check_output(folder: Path) -> None:
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Index the block, run it on the cluster, write the outputs together."""
+    from ..io.atomic import check_outputs
     from ..io.control import write_lcps_csv, write_lines_csv
     from ..io.planes import write_planes_csv
     from ..io.tiles import commit_folder, index_block, staging_folder, write_json, write_vpc
 
     target = Path(v.output_folder)
     _check_output(target)
+    _check_tiling(v)
     index = index_block(v.input, v.crs or None, v.tile_size)
+    # the folder is replaced when the block is done: no tile it reads may lie in it
+    check_outputs({}, {"INPUT": [v.input, *(t.path for t in index.tiles)]},
+                  folders={"OUTPUT_FOLDER": target})  # fmt: skip
     info = index.info
     settings = settings_from(v, info)
+    _check_cluster_memory(v, index, settings)
     log.info("%d tiles (%s), %d points; buffers: ground %.4g, roof planes %.4g %s",
              len(index.tiles), index.kind, index.point_count, settings.ground_buffer,
              settings.roof_buffer, info.horizontal_unit)  # fmt: skip
@@ -429,6 +571,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         client, cluster = open_client(v)
         try:
             block = run_block(index, settings, str(staging), client, progress, should_stop)
+        except BaseException:
+            if cluster is not None:
+                _stop_workers(cluster)
+            raise
         finally:
             client.close()
             if cluster is not None:

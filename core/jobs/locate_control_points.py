@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..io.chips import CHIP_SUFFIXES
+from ..io.images import IMAGE_SUFFIXES
 from ..photo.control_location import LocateOptions
 from ..photo.least_squares_matching import LsmOptions
 from .common import CSV_FILTER, CSV_OUT
@@ -45,6 +47,7 @@ shows the chips.""",
             "CHIPS",
             "files",
             "Control chips (GeoTIFF files or folders)",
+            suffixes=CHIP_SUFFIXES,
             help="one GeoTIFF per point, named <point_id>.tif",
         ),
         Param(
@@ -66,6 +69,7 @@ shows the chips.""",
             "IMAGES",
             "files",
             "Images (files or folders)",
+            suffixes=IMAGE_SUFFIXES,
             help="image files (name = image_id), or folders whose images are all taken",
         ),
         Param("CRS", "crs", "Mapping CRS of the EO and control", help="e.g. EPSG:25832"),

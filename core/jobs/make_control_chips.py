@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 import math
 
+from ..io.control_chips import PHOTO_SUFFIXES
 from ..photo.control_chips import ChipOptions
 from ..photo.control_plate import PlateGeometry
 from .common import CSV_FILTER
@@ -70,7 +71,7 @@ the others are written.""",
               file_filter=CSV_FILTER,
               help="point_id, plate_photo, free_photo; else PHOTOS are searched by name"),
         Param("PHOTOS", "files", "Ground photos (files or folders)", optional=True,
-              help="searched by name when no table is given"),
+              suffixes=PHOTO_SUFFIXES, help="searched by name when no table is given"),
         Param("PLATE_SUFFIX", "string", "Plate photo name suffix", "_plate"),
         Param("FREE_SUFFIX", "string", "Plate-free photo name suffix", "_free"),
         Param("OUTER_SIDE", "number", "Plate outer side", _P.outer_m, unit="m", minimum=0.01,

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..io.images import IMAGE_SUFFIXES
 from ..photo.mosaic import METHODS, MosaicOptions
 from .common import CSV_OUT, compression_param
 from .runner import JobResult, stages
@@ -47,7 +48,7 @@ The mosaic (GeoTIFF: tiled, compressed, overviews, internal mask), and the seaml
 the region each image fills, as a layer and as a CSV (image_id, cells, area, WKT
 MultiPolygon in the mosaic's CRS).""",
     params=(
-        Param("ORTHOPHOTOS", "files", "Orthophotos (files or folders)"),
+        Param("ORTHOPHOTOS", "files", "Orthophotos (files or folders)", suffixes=IMAGE_SUFFIXES),
         Param("METHOD", "enum", "Image chosen per cell", _D.method, options=METHODS,
               labels=("most nadir view", "nearest image centre")),
         Param("FEATHER", "number", "Feathering width across seamlines (0 = none)",

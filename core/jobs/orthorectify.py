@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.images import IMAGE_SUFFIXES
 from ..photo.orthophoto import RESAMPLING, OrthoOptions
 from .common import CSV_FILTER, compression_param
 from .runner import JobResult, stages
@@ -60,7 +61,7 @@ Nothing is written when an input is wrong; the files appear together when all ar
     params=(
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
         Param("EO", "file", "Exterior orientation (CSV)", file_filter=CSV_FILTER),
-        Param("IMAGES", "files", "Images (files or folders)",
+        Param("IMAGES", "files", "Images (files or folders)", suffixes=IMAGE_SUFFIXES,
               help="image files, or folders whose images are all taken"),
         Param("DSM", "file", "DSM or DTM (raster, or LAS/LAZ)", file_filter=DSM_FILTER,
               help="a raster (the file of a raster layer) or a LAS/LAZ cloud"),

@@ -1,9 +1,11 @@
 """Run a job the same way from every view: values checked, outputs staged, committed together.
 
 The QGIS algorithm and the command line both call :func:`run_job`. It parses and checks every
-value against the job's spec (naming the parameter), refuses an output that is one of the
-inputs before anything is read, hands the job an :class:`~lidarphoto.core.io.atomic.OutputSet`
-to write into, and moves the outputs into place only when the job returned.
+value against the job's spec (naming the parameter), refuses an output that would overwrite a
+file the job reads (every file and folder input, a folder standing for the files the job
+reads from it: :func:`~lidarphoto.core.io.atomic.check_outputs`) before anything is read,
+hands the job an :class:`~lidarphoto.core.io.atomic.OutputSet` to write into, and moves the
+outputs into place only when the job returned.
 """
 
 from __future__ import annotations
@@ -39,13 +41,19 @@ class JobResult:
 
 
 def input_files(spec: AlgorithmSpec, values: Mapping[str, Any]) -> dict[str, Any]:
-    """The input files named in ``values`` (what no output may overwrite)."""
+    """The input files and folders named in ``values`` (what no output may overwrite)."""
     return {
         p.name: values[p.name]
         for p in spec.inputs
         if (p.kind in ("file", "points") and isinstance(values.get(p.name), str))
         or (p.kind == "files" and values.get(p.name))
     }
+
+
+def folder_suffixes(spec: AlgorithmSpec) -> dict[str, tuple[str, ...]]:
+    """The file endings each input reads from a folder (``Param.suffixes``; every file when
+    an input declares none)."""
+    return {p.name: p.suffixes for p in spec.inputs if p.suffixes}
 
 
 def run_job(
@@ -60,7 +68,7 @@ def run_job(
     # a folder output holds files the job commits itself (core/jobs/<job>.py)
     outputs = {p.name: values.get(p.name) for p in spec.outputs
                if p.kind not in ("sink", "folder_out")}  # fmt: skip
-    with OutputSet(outputs, input_files(spec, values)) as out:
+    with OutputSet(outputs, input_files(spec, values), folder_suffixes(spec)) as out:
         result = job.run(values, out, progress=progress, should_stop=should_stop)
         out.commit()
     return result

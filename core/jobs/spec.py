@@ -73,7 +73,9 @@ class Param:
     meaningful range (both views refuse values outside, naming the parameter); ``options``
     are an enum's machine names (what the command line takes; QGIS shows ``labels``);
     ``aliases`` are extra command-line spellings of options; ``qgis_default`` overrides
-    ``default`` in QGIS only (e.g. ``"ProjectCrs"``).
+    ``default`` in QGIS only (e.g. ``"ProjectCrs"``); ``suffixes`` are the file endings the job
+    reads from a folder given to a ``files`` (or ``file``) input (empty: every file), which no
+    output may overwrite.
     """
 
     name: str
@@ -97,6 +99,7 @@ class Param:
     parent: str = ""
     numeric_field: bool = False
     qgis_default: Any = None
+    suffixes: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.kind not in INPUT_KINDS + OUTPUT_KINDS:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import logging
 
+from ..io.images import IMAGE_SUFFIXES
 from ..photo.tie_points import DETECTORS, PAIR_MODES, RANSAC_METHODS, TiePointOptions
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult
@@ -56,7 +57,7 @@ directly by Bundle adjustment. sigma_px: the value given, or 0.5 px times the de
 reduction factor; refined measurements: the least-squares sigma (at least 0.02 px); the
 track's first-image measurement: the median of its track's refined sigmas.""",
     params=(
-        Param("IMAGES", "files", "Images (files or folders)",
+        Param("IMAGES", "files", "Images (files or folders)", suffixes=IMAGE_SUFFIXES,
               help="image files, or folders whose images are all taken; the image id is the "
               "file name without extension"),
         Param("EO", "file", "Exterior orientation (CSV) for pair selection", optional=True,

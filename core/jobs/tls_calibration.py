@@ -14,6 +14,7 @@ from pathlib import Path
 
 from ..i18n import joined as _joined
 from ..i18n import mark as _t
+from ..io.scans import SCAN_SUFFIXES
 from ..tls.aps import AP_SETS, ARCSEC
 from ..tls.options import CalibrationOptions
 from .common import CSV_FILTER, CSV_OUT, doubt_params, settle_doubts
@@ -129,7 +130,8 @@ beginning with #).""",
             "warning at its top",
         ),
         Param("SCANS", "files", "Scans to register (LAS/LAZ, PLY, E57; one station per file)",
-              optional=True, help="the file name without its suffix is the station id"),
+              optional=True, suffixes=SCAN_SUFFIXES,
+              help="the file name without its suffix is the station id"),
         Param("APPLY_APS", "boolean", "Correct the scan points by the estimated APs", True,
               help="face-I readings; off: the rigid pose only"),
         Param("OUTPUT_STATIONS", "file_out", "Station poses (CSV)", file_filter=CSV_OUT),

@@ -31,6 +31,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..compiled import cached_njit
+
 try:  # pragma: no cover - depends on the environment
     import numba
 
@@ -285,7 +287,7 @@ def _compiled(name: str) -> Callable[..., Any]:
         func = {"cells": _cells_kernel, "low_pass": _low_pass_kernel,
                 "classify": _classify_kernel, "bounds": _bounds_kernel,
                 "rect_union": _rect_union_kernel}[name]  # fmt: skip
-        _COMPILED[name] = numba.njit(cache=True, nogil=True)(func)
+        _COMPILED[name] = cached_njit(func, nogil=True)
     return _COMPILED[name]
 
 

@@ -24,6 +24,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..compiled import cached_njit
+
 try:  # pragma: no cover - depends on the environment
     import numba
 
@@ -473,7 +475,7 @@ def _compiled(name: str) -> Callable[..., Any]:
         func = {"local_planes": _local_planes_kernel, "claims": _claims_kernel,
                 "reassign": _reassign_kernel, "pairs": _pairs_kernel, "order": _order_kernel,
                 "moments": _moments_kernel}[name]  # fmt: skip
-        _COMPILED[name] = numba.njit(cache=True, nogil=True)(func)
+        _COMPILED[name] = cached_njit(func, nogil=True)
     return _COMPILED[name]
 
 

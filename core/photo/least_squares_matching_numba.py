@@ -12,6 +12,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..compiled import cached_njit
+
 try:  # pragma: no cover - depends on the environment
     import numba
 
@@ -35,7 +37,7 @@ def _keys(t):  # pragma: no cover - compiled
 
 
 if AVAILABLE:  # inlined into the kernels (a plain function cannot be called from them)
-    _keys = numba.njit(inline="always", cache=True)(_keys)
+    _keys = cached_njit(_keys, inline="always")
 
 
 def _normals(g, idx, aff, rad, f, x, y, nn, rhs, outside):  # pragma: no cover - compiled
@@ -130,7 +132,7 @@ def _compiled(name: str) -> Callable[..., Any]:
     """The jitted function (compiled at its first call; cached next to this module)."""
     if name not in _COMPILED:
         func = {"normals": _normals, "samples": _samples}[name]
-        _COMPILED[name] = numba.njit(cache=True, nogil=True)(func)
+        _COMPILED[name] = cached_njit(func, nogil=True)
     return _COMPILED[name]
 
 

@@ -14,7 +14,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..geometry.raycast_numba import AVAILABLE, numba
+from ..compiled import cached_njit
+from ..geometry.raycast_numba import AVAILABLE
 
 __all__ = ["AVAILABLE", "cell_pixels", "cell_stats", "remap_maps", "remap_maps_fixed",
            "valid_bounds"]
@@ -215,7 +216,7 @@ def _compiled(name: str) -> Callable[..., Any]:
                 "stats": _cell_stats}[name]  # fmt: skip
         # numpy's error model: a float division by zero gives inf (checked after), with no
         # test per division that would keep the cell loop from being vectorised
-        _COMPILED[name] = numba.njit(cache=True, nogil=True, error_model="numpy")(func)
+        _COMPILED[name] = cached_njit(func, nogil=True, error_model="numpy")
     return _COMPILED[name]
 
 

@@ -18,6 +18,7 @@ CORE_LAYERS = {
     "dependencies": 0,
     "i18n": 0,  # the catalogue of the core's translated texts (reads i18n/*.ts)
     "": 0,  # core/__init__.py (the version)
+    "compiled": 0,  # the compiled kernels' cache (numba)
     "geometry": 1,
     "lsq": 1,
     "lidar": 2,
