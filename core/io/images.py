@@ -18,17 +18,20 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 
-__all__ = ["IMAGE_SUFFIXES", "decode_factor", "image_size", "list_image_files", "read_gray"]
+__all__ = ["IMAGE_SUFFIXES", "check_distinct_files", "decode_factor", "image_size",
+           "list_image_files", "read_gray"]  # fmt: skip
 
 PathLike = Union[str, "os.PathLike[str]"]
 #: File endings taken as images when a folder is named.
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".jp2", ".img")
 
 
-def list_image_files(paths) -> list[Path]:
+def list_image_files(paths, twice: tuple[str, str] | None = None) -> list[Path]:
     """The image files named, folders expanded (their files with :data:`IMAGE_SUFFIXES`,
     sorted by name); InputError for a missing path, an empty folder or two images with the
-    same name (the image id is the file name without extension)."""
+    same name (the image id is the file name without extension). With ``twice`` (parameter
+    name, what a duplicate would do), a file named twice, or a copy of another, is refused
+    (:func:`check_distinct_files`); otherwise it is taken once."""
     out: list[Path] = []
     for raw in paths:
         p = Path(raw)
@@ -44,12 +47,45 @@ def list_image_files(paths) -> list[Path]:
             out.append(p)
         else:
             raise InputError("file or folder not found", path=str(p))
+    if twice is not None:
+        check_distinct_files(out, *twice)
     seen: dict[str, Path] = {}
     for f in out:
         if f.stem in seen and seen[f.stem] != f:
             raise InputError(f"two images are named {f.stem}: {seen[f.stem]} and {f}")
         seen[f.stem] = f
     return list(seen.values())
+
+
+def check_distinct_files(files, param: str, why: str) -> None:
+    """Refuse (InputError naming ``param``) a file given twice: the same file under two
+    spellings (a link, a folder and a file in it) or the same content under two names (a
+    copy; only files of equal size are hashed). ``why`` says what a duplicate would do."""
+    import hashlib
+
+    by_real: dict[str, Path] = {}
+    by_size: dict[int, list[Path]] = {}
+    for f in map(Path, files):
+        real = os.path.realpath(f)
+        if real in by_real:
+            raise InputError(f"{param}: {f} is {by_real[real]} again: {why}; give it once")
+        by_real[real] = f
+        by_size.setdefault(f.stat().st_size, []).append(f)
+
+    def digest(f: Path) -> str:
+        h = hashlib.sha256()
+        with open(f, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+        return h.hexdigest()
+
+    for same in (g for g in by_size.values() if len(g) > 1):
+        seen: dict[str, Path] = {}
+        for f in same:
+            first = seen.setdefault(digest(f), f)
+            if first is not f:
+                raise InputError(f"{param}: {f.name} has the same content as {first.name} "
+                                 f"(a copy): {why}; give it once", path=str(f))  # fmt: skip
 
 
 def image_size(path: PathLike) -> tuple[int, int]:

@@ -23,8 +23,10 @@ and is moved into place only when complete.
 from __future__ import annotations
 
 import contextlib
+import errno
 import math
 import os
+import shutil
 import threading
 import warnings
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -38,6 +40,9 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from .atomic import atomic_path
+from .gdal_binding import raster_backend
+from .gdal_binding import rio_env as _rio_env
+from .raster_polygons import polygonize
 
 PathLike = Union[str, "os.PathLike[str]"]
 Window = tuple[int, int, int, int]
@@ -58,45 +63,10 @@ __all__ = [
 #: raster gets GDAL's overviews, read back from the file.
 OVERVIEW_MEMORY_BYTES = 256 << 20
 
+#: Free bytes below which a write that just ended is taken to have hit a full device.
+MIN_FREE_BYTES = 1 << 16
 #: Writer threads (GDAL compresses blocks in parallel; more than 4 brings nothing here).
 MAX_THREADS = 4
-_INSTALL = "GDAL is needed for rasters: it comes with QGIS; outside QGIS: pip install rasterio"
-
-
-def raster_backend() -> str:
-    """``"gdal"`` (osgeo) or ``"rasterio"``: the binding this process uses (module docstring)."""
-    forced = os.environ.get("LIDARPHOTO_RASTER_BACKEND", "").strip().lower()
-    order = [forced] if forced in ("gdal", "rasterio") else ["gdal", "rasterio"]
-    for name in order:
-        try:
-            if name == "gdal":
-                from osgeo import gdal  # noqa: F401
-            else:
-                import rasterio  # noqa: F401
-        except ImportError:
-            continue
-        return name
-    raise InputError(_INSTALL)
-
-
-@contextlib.contextmanager
-def _rio_env(**options: Any) -> Iterator[None]:
-    """``rasterio.Env(**options)`` that reads the PROJ database of rasterio's own wheel.
-
-    rasterio points PROJ at ``PROJ_DATA`` each time a first ``Env`` starts, when that variable
-    is set; a wheel's PROJ then refuses an older system ``proj.db`` (Debian 12's, which QGIS
-    set-ups export) and no CRS parses. pyproj's wheels prefer their own data; so does this."""
-    import rasterio
-    from rasterio.env import PROJDataFinder, set_proj_data_search_path
-
-    with rasterio.Env(**options):
-        bundled = PROJDataFinder().search_wheel()
-        if bundled:
-            set_proj_data_search_path(bundled)
-        yield
-
-
-
 def _threads() -> int:
     return max(1, min(MAX_THREADS, os.cpu_count() or 1))
 
@@ -266,8 +236,20 @@ class RasterReader:
         out = None
         if pixel_interleaved:
             out = np.moveaxis(np.empty((bh, bw, len(which)), self.info.dtype), 2, 0)
-        with self._lock:
+        with self._lock, self._named_failure():
             return self._read(c0, r0, w, h, which, f, bw, bh, out)
+
+    @contextlib.contextmanager
+    def _named_failure(self) -> Iterator[None]:
+        """A failed read (a cut or damaged file: GDAL's RuntimeError, rasterio's "Read
+        failed. See previous exception") as an InputError naming the file and GDAL's cause."""
+        try:
+            yield
+        except (RuntimeError, OSError) as exc:
+            cause = exc.__cause__ or exc
+            detail = getattr(cause, "errmsg", None) or str(cause)
+            raise InputError(f"cannot read the pixels: the file is truncated or corrupt "
+                             f"({detail})", path=self.path) from exc  # fmt: skip
 
     def _read(self, c0: int, r0: int, w: int, h: int, which: list[int], f: int, bw: int,
               bh: int, out: NDArray | None = None) -> NDArray:  # fmt: skip
@@ -302,7 +284,7 @@ class RasterReader:
         """(rows, cols) True where band 1 holds data: GDAL's mask band (an internal or
         sidecar mask, an alpha band, or the nodata value)."""
         c0, r0, w, h = self._window(window)
-        with self._lock:
+        with self._lock, self._named_failure():
             ds = self._handle()
             if self.backend == "gdal":
                 m = ds.GetRasterBand(1).GetMaskBand().ReadAsArray(c0, r0, w, h)
@@ -577,6 +559,7 @@ class GeoTiffWriter:
                         ds.BuildOverviews("AVERAGE", factors)
                     ds.FlushCache()
                     del ds  # the last reference: the file is closed here
+                    check_written(self.path)
 
                 if levels is not None:
                     later = finish
@@ -588,11 +571,13 @@ class GeoTiffWriter:
                 if factors and levels is None:
                     self._ds.build_overviews(factors, Resampling.average)
                 self._ds.close()
+                check_written(self.path)  # (GDAL would crash on the levels of a cut file)
                 if factors and levels is not None:
                     path, level = self.path, self._level
 
                     def later() -> None:
                         _write_levels_rasterio(path, factors, levels, level)
+                        check_written(path)
 
         finally:
             if self.backend == "rasterio":
@@ -603,6 +588,26 @@ class GeoTiffWriter:
             later()
             return None
         return finish_in.submit(later)
+
+
+def check_written(path: str) -> None:
+    """Raise OSError (ENOSPC, EFBIG) when a file just written cannot be whole: the device has
+    no space left, or the file reached the process's size limit (``ulimit -f``). GDAL's TIFF
+    writer reports neither through rasterio: it logs them and closes a cut file."""
+    size = os.path.getsize(path)
+    try:
+        import resource
+
+        limit, unlimited = resource.getrlimit(resource.RLIMIT_FSIZE)[0], resource.RLIM_INFINITY
+    except (ImportError, OSError, ValueError):  # not on Windows
+        limit = unlimited = -1
+    if 0 <= limit != unlimited and size >= limit:
+        raise OSError(errno.EFBIG, f"cannot write it whole: the file reached the process's "
+                      f"file size limit of {limit} bytes (ulimit -f)", path)  # fmt: skip
+    free = shutil.disk_usage(os.path.dirname(os.path.abspath(path))).free
+    if free < MIN_FREE_BYTES:
+        raise OSError(errno.ENOSPC, f"cannot write it whole: no space left on the device "
+                      f"({free} bytes free)", path)  # fmt: skip
 
 
 def _mask_bytes(valid: NDArray) -> NDArray[np.uint8]:
@@ -763,56 +768,3 @@ def write_rgb_tiff(path: PathLike, rgb: NDArray[np.uint8]) -> None:
                            tile=512, photometric="RGB") as out:  # fmt: skip
             out.write(np.moveaxis(a, 2, 0))
             out.close(overviews=False)
-
-
-# ----------------------------------------------------------------------------- vectors
-def polygonize(
-    labels: NDArray[np.integer], geotransform: Sequence[float], empty: int = -1
-) -> dict[int, str]:
-    """The region of each label of a raster as a WKT MultiPolygon in map coordinates.
-
-    Polygons follow the pixel edges exactly (GDAL's polygonize, 4-connected regions); pixels
-    with the label ``empty`` belong to no region.
-
-    Parameters
-    ----------
-    labels : (rows, cols) integer array
-    geotransform : 6 floats, GDAL order
-
-    Returns
-    -------
-    dict
-        label -> ``MULTIPOLYGON (((x y, ...)))``.
-    """
-    lab = np.ascontiguousarray(labels, dtype=np.int32)
-    gt = tuple(float(v) for v in geotransform)
-    parts: dict[int, list[str]] = {}
-    if raster_backend() == "gdal":
-        from osgeo import gdal, ogr
-
-        gdal.UseExceptions()
-        mem = gdal.GetDriverByName("MEM").Create("", lab.shape[1], lab.shape[0], 2, gdal.GDT_Int32)
-        mem.SetGeoTransform(gt)
-        mem.GetRasterBand(1).WriteArray(lab)
-        mem.GetRasterBand(2).WriteArray((lab != empty).astype(np.int32))
-        vec = ogr.GetDriverByName("Memory").CreateDataSource("")
-        layer = vec.CreateLayer("regions")
-        layer.CreateField(ogr.FieldDefn("label", ogr.OFTInteger))
-        gdal.Polygonize(mem.GetRasterBand(1), mem.GetRasterBand(2), layer, 0, [])
-        for feat in layer:
-            geom = feat.GetGeometryRef()
-            wkt = geom.ExportToWkt()
-            parts.setdefault(int(feat.GetField(0)), []).append(wkt[len("POLYGON ") :])
-    else:
-        from rasterio import features
-        from rasterio.transform import Affine
-
-        with _rio_env():
-            shapes = list(features.shapes(lab, mask=lab != empty, transform=Affine.from_gdal(*gt)))
-        for geom, value in shapes:
-            rings = ", ".join(
-                "(" + ", ".join(f"{x!r} {y!r}" for x, y in ring) + ")"
-                for ring in geom["coordinates"]
-            )
-            parts.setdefault(int(value), []).append(f"({rings})")
-    return {k: "MULTIPOLYGON (" + ", ".join(v) + ")" for k, v in sorted(parts.items())}

@@ -109,7 +109,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..photo.mosaic import MosaicSource, mosaic_grid, mosaic_tiles
     from .common import compression_args
 
-    files = list_image_files(v.orthophotos)
+    files = list_image_files(v.orthophotos, ("ORTHOPHOTOS", "one image would count twice"))
     readers = [RasterReader(f) for f in files]
     try:
         first = readers[0].info
