@@ -1,0 +1,225 @@
+"""The catalogue of bad inputs of the photogrammetric algorithms (orthophotos, mosaics, tie
+points, control location, bundle adjustment, camera calibration), kept with
+tests/core/test_bad_inputs.py and in its style: every case runs the command line and asserts
+the exit code, the one line on stderr with the error that names the parameter or the file
+(row), that nothing was written (not even a temporary) and that the inputs are unchanged.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+import shutil
+import subprocess
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pyproj
+import pytest
+from lidarphoto.core.cli import main
+from lidarphoto.core.geometry.camera import camera_from_dict
+from lidarphoto.core.io.camera import write_camera_json
+from lidarphoto.core.io.dsm import write_dsm
+from lidarphoto.core.io.orientation import write_eo_csv
+from lidarphoto.core.io.raster import GeoTiffWriter, write_rgb_tiff
+from lidarphoto.core.photo.orientation import ExteriorOrientationTable
+from lidarphoto.core.simulation.render import RenderOptions, render_image
+from test_orthophoto import CRS, X0, Y0, _scene
+
+SHARED = Path(__file__).resolve().parents[3] / "shared" / "data"
+GSD = 0.06
+W, H = 400, 300  # the camera's image size, pixels
+
+
+# ----------------------------------------------------------------------------- inputs
+@pytest.fixture(scope="module")
+def block(tmp_path_factory):
+    """Two images of a house on sloping ground (tests/core/test_orthophoto.py's scene), with
+    their camera, EO table and DSM: the inputs every case copies and spoils."""
+    folder = tmp_path_factory.mktemp("block")
+    scene, dsm = _scene()
+    cam = camera_from_dict({"name": "k1", "focal_mm": 8.0, "pixel_size_mm": 0.01,
+                            "width_px": W, "height_px": H})  # fmt: skip
+    xyz = np.array([[X0 + 20.0, Y0 + 18.0, 60.0], [X0 + 22.0, Y0 + 19.0, 60.0]])
+    opk = np.radians([[2.0, -1.0, 10.0], [-1.0, 2.0, 12.0]])
+    eo = ExteriorOrientationTable(("sw", "ne"), np.array([0.0, 1.0]), ("a", "a"), xyz, opk,
+                                  pyproj.CRS.from_user_input(CRS).to_wkt())  # fmt: skip
+    images = folder / "images"
+    images.mkdir()
+    for k, name in enumerate(eo.image_id):
+        img = render_image(scene, cam, xyz[k], opk[k], RenderOptions(step_px=1, noise_dn=2.0))
+        write_rgb_tiff(images / f"{name}.tif", img.rgb)
+        cv2.imwrite(str(images / f"{name}.jpg"), img.rgb[:, :, ::-1])
+    write_camera_json(folder / "camera.json", cam)
+    write_eo_csv(folder / "eo.csv", eo)
+    write_dsm(folder / "dsm.tif", dsm)
+    return folder
+
+
+def _copy(src: Path, folder: Path, name: str | None = None) -> Path:
+    dst = folder / (name or src.name)
+    dst.write_bytes(src.read_bytes())
+    return dst
+
+
+def _ortho(b: Path, inp: Path, out: Path, *extra: str, image: Path | None = None,
+           eo: Path | None = None) -> list[str]:  # fmt: skip
+    """orthorectify on copies of the block's files (image: the one image taken)."""
+    (inp / "images").mkdir(exist_ok=True)
+    img = image or _copy(b / "images" / "sw.tif", inp / "images")
+    return ["orthorectify", "--camera", str(_copy(b / "camera.json", inp)),
+            "--eo", str(eo or _copy(b / "eo.csv", inp)), "--images", str(img),
+            "--dsm", str(_copy(b / "dsm.tif", inp)), "--crs", CRS, "--gsd", str(GSD),
+            "--output-folder", str(out / "orthos"), *extra]  # fmt: skip
+
+
+def _eo_lonlat(b: Path, inp: Path) -> Path:
+    """The block's EO with X, Y in longitude and latitude (degrees): the wrong table."""
+    tr = pyproj.Transformer.from_crs(CRS, "EPSG:4326", always_xy=True)
+    lines = (b / "eo.csv").read_text(encoding="utf-8").splitlines()
+    rows = [lines[0]]
+    for line in lines[1:]:
+        c = line.split(",")
+        lon, lat = tr.transform(float(c[3]), float(c[4]))
+        rows.append(",".join([*c[:3], f"{lon:.8f}", f"{lat:.8f}", *c[5:]]))
+    path = inp / "eo.csv"
+    path.write_text("\n".join(rows) + "\n", encoding="utf-8")
+    return path
+
+
+def _half(src: Path, folder: Path, name: str | None = None) -> Path:
+    """The first half of a file: a download or a copy cut short."""
+    dst = folder / (name or src.name)
+    raw = src.read_bytes()
+    dst.write_bytes(raw[: len(raw) // 2])
+    return dst
+
+
+# ----------------------------------------------------------------------------- the cases
+@dataclass(frozen=True)
+class Case:
+    """A bad input: ``build(block, inp, out)`` writes the inputs and returns argv."""
+
+    id: str
+    build: Callable[[Path, Path, Path], list[str]]
+    error: str  # regex searched in the one line on stderr
+    code: int = 2
+
+
+def _in_images(inp: Path) -> Path:
+    (inp / "images").mkdir(exist_ok=True)
+    return inp / "images"
+
+
+CASES = [
+    # -- orthorectify
+    Case("extent outside every footprint",
+         lambda b, i, o: _ortho(b, i, o, "--extent", "0,0,10,10"),
+         r"EXTENT 0,0,10,10 lies outside every image's footprint on the DSM \(the footprints "
+         r"span x 850\d\d\.\d+ to 850\d\d\.\d+, y 4470\d\d\.\d+ to 4470\d\d\.\d+\): give the "
+         r"extent in the mapping CRS, within the footprints$"),
+    Case("inverted extent",
+         lambda b, i, o: _ortho(b, i, o, "--extent", "85030,447030,85000,447000"),
+         r"EXTENT 85030,447030,85000,447000: give xmin,ymin,xmax,ymax with xmin < xmax and "
+         r"ymin < ymax$"),
+    Case("EO in longitude and latitude (orthorectify)",
+         lambda b, i, o: _ortho(b, i, o, eo=_eo_lonlat(b, i)),
+         r"eo\.csv: the perspective centres \(x 4\.3\d+ to 4\.3\d+, y 52\.\d+ to 52\.\d+\) "
+         r"looks like longitude and latitude in degrees, not coordinates of 'Amersfoort / RD "
+         r"New' \(projected, metre\)$"),
+    Case("GSD of a micrometre",
+         lambda b, i, o: _ortho(b, i, o)[:-3] + ["1e-6"] + _ortho(b, i, o)[-2:],
+         r"GSD 1e-06: the orthophoto of image sw would be \d+ x \d+ cells, beyond what a "
+         r"GeoTIFF can hold: give a larger GSD \(0: the images' own\)$"),
+    Case("half a JPEG", lambda b, i, o: _ortho(
+        b, i, o, image=_half(b / "images" / "sw.jpg", _in_images(i))),
+         r"sw\.jpg: cannot read the pixels: the file is truncated or corrupt \(.*JPEG"),
+]  # fmt: skip
+
+
+def _snapshot(folder: Path) -> dict[str, str]:
+    """Every file below ``folder`` (hidden ones too) with the SHA-256 of its content."""
+    return {
+        str(p.relative_to(folder)): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file()
+    }
+
+
+def _run(argv: list[str], inp: Path, out: Path, capsys) -> str:
+    """Run the command line; assert one error line, nothing written, inputs unchanged."""
+    before = _snapshot(inp)
+    code = main(argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2, err
+    assert len(err) == 1, err
+    assert err[0].startswith(f"lidarphoto {argv[0]}: error: "), err[0]
+    assert _snapshot(out) == {}  # no output, no temporary
+    assert _snapshot(inp) == before  # inputs untouched, nothing left beside them
+    return err[0]
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c.id for c in CASES])
+def test_bad_input(case, block, tmp_path, capsys):
+    inp, out = tmp_path / "in", tmp_path / "out"
+    inp.mkdir()
+    out.mkdir()
+    argv = case.build(block, inp, out)
+    line = _run(argv, inp, out, capsys)
+    print(line)
+    assert re.search(case.error, line), line
+
+
+def test_orthophotos_larger_than_the_free_space_are_refused(block, tmp_path, capsys,
+                                                            monkeypatch):  # fmt: skip
+    """The free space of the output folder against the orthophotos' uncompressed size (a
+    small disk: 1 MB free), both figures in the message, before anything is written."""
+    inp, out = tmp_path / "in", tmp_path / "out"
+    inp.mkdir()
+    out.mkdir()
+    argv = _ortho(block, inp, out)
+    real = shutil.disk_usage
+    monkeypatch.setattr(shutil, "disk_usage", lambda p: real(p)._replace(free=1_000_000))
+    line = _run(argv, inp, out, capsys)
+    assert re.search(r"GSD 0\.06: the 1 orthophoto\(s\) need up to 1\.5 MB \(uncompressed; "
+                     r"image sw: 581 x 476 cells\); the output folder has 1\.0 MB free: give a "
+                     r"larger GSD \(0: the images' own\) or free some space$", line), line
+
+
+_LIMITED = """
+import resource, signal, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write beyond the limit fails (EFBIG)
+resource.setrlimit(resource.RLIMIT_FSIZE, (int(sys.argv[1]), resource.RLIM_INFINITY))
+from lidarphoto.core.cli import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="no RLIMIT_FSIZE")
+def test_a_write_cut_short_names_the_output_and_the_cause(block, tmp_path):
+    """The orthophoto (about 1 MB) cannot be written whole: the process may write files of
+    250 kB only, as a full disk would cut it (the compiled kernels' cache files are smaller): the error names the output file and the cause, and
+    nothing is left behind. GDAL's TIFF writer only logs such failures."""
+    inp, out = tmp_path / "in", tmp_path / "out"
+    inp.mkdir()
+    out.mkdir()
+    argv = _ortho(block, inp, out)
+    argv[argv.index("--gsd") + 1] = "0.03"  # four times as many cells: about 1 MB
+    before = _snapshot(inp)
+    proc = subprocess.run([sys.executable, "-W", "ignore", "-c", _LIMITED, "250000", *argv],
+                          capture_output=True, text=True, timeout=300,
+                          env={**__import__("os").environ,
+                               "PYTHONDONTWRITEBYTECODE": "1"})  # fmt: skip
+    err = [e for e in proc.stderr.strip().splitlines() if not e.startswith("_tiff")]
+    assert proc.returncode == 2, proc.stderr
+    assert len(err) == 1, err
+    assert re.search(r"^lidarphoto orthorectify: error: \S+/out/orthos/sw_ortho\.tif: cannot "
+                     r"write it whole: the file reached the process's file size limit of "
+                     r"250000 bytes \(ulimit -f\); nothing was written$", err[0]), err[0]
+    assert _snapshot(out) == {}
+    assert _snapshot(inp) == before
