@@ -68,7 +68,8 @@ def check_distinct_files(files, param: str, why: str) -> None:
     for f in map(Path, files):
         real = os.path.realpath(f)
         if real in by_real:
-            raise InputError(f"{param}: {f} is {by_real[real]} again: {why}; give it once")
+            again = "given twice" if by_real[real] == f else f"{by_real[real]} again"
+            raise InputError(f"{param}: {f} is {again}: {why}; give it once")
         by_real[real] = f
         by_size.setdefault(f.stat().st_size, []).append(f)
 
@@ -84,8 +85,8 @@ def check_distinct_files(files, param: str, why: str) -> None:
         for f in same:
             first = seen.setdefault(digest(f), f)
             if first is not f:
-                raise InputError(f"{param}: {f.name} has the same content as {first.name} "
-                                 f"(a copy): {why}; give it once", path=str(f))  # fmt: skip
+                raise InputError(f"{param}: {f} has the same content as {first} (a copy): "
+                                 f"{why}; give it once")  # fmt: skip
 
 
 def image_size(path: PathLike) -> tuple[int, int]:

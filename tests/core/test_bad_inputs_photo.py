@@ -58,6 +58,10 @@ def block(tmp_path_factory):
     write_camera_json(folder / "camera.json", cam)
     write_eo_csv(folder / "eo.csv", eo)
     write_dsm(folder / "dsm.tif", dsm)
+    assert main(["orthorectify", "--camera", str(folder / "camera.json"), "--eo",
+                 str(folder / "eo.csv"), "--images", str(images / "sw.tif"),
+                 str(images / "ne.tif"), "--dsm", str(folder / "dsm.tif"), "--crs", CRS,
+                 "--gsd", "0.1", "--output-folder", str(folder / "orthos")]) == 0  # fmt: skip
     return folder
 
 
@@ -76,6 +80,24 @@ def _ortho(b: Path, inp: Path, out: Path, *extra: str, image: Path | None = None
             "--eo", str(eo or _copy(b / "eo.csv", inp)), "--images", str(img),
             "--dsm", str(_copy(b / "dsm.tif", inp)), "--crs", CRS, "--gsd", str(GSD),
             "--output-folder", str(out / "orthos"), *extra]  # fmt: skip
+
+
+def _mosaic(b: Path, inp: Path, out: Path, *names: str) -> list[str]:
+    """orthomosaic of the orthophotos named (copied into ``inp``; ``a=b``: b under name a)."""
+    paths = []
+    for n in names:
+        dst, _, src = n.partition("=")
+        target = inp / dst
+        if not target.exists():
+            _copy(b / "orthos" / (src or dst), inp, dst)
+        paths.append(str(target))
+    return ["orthomosaic", "--orthophotos", *paths, "--output", str(out / "m.tif")]
+
+
+def _link(target: Path) -> Path:
+    link = target.parent / "link.tif"
+    link.symlink_to(target.name)
+    return link
 
 
 def _eo_lonlat(b: Path, inp: Path) -> Path:
@@ -139,6 +161,27 @@ CASES = [
     Case("half a JPEG", lambda b, i, o: _ortho(
         b, i, o, image=_half(b / "images" / "sw.jpg", _in_images(i))),
          r"sw\.jpg: cannot read the pixels: the file is truncated or corrupt \(.*JPEG"),
+    # -- orthomosaic
+    Case("same orthophoto twice",
+         lambda b, i, o: _mosaic(b, i, o, "sw_ortho.tif", "ne_ortho.tif", "sw_ortho.tif"),
+         r"ORTHOPHOTOS: \S+/in/sw_ortho\.tif is given twice: one image would count twice; give "
+         r"it once$"),
+    Case("same orthophoto through a folder and by name",
+         lambda b, i, o: _mosaic(b, i, o, "sw_ortho.tif", "ne_ortho.tif")[:-2]
+         + [str(i), "--output", str(o / "m.tif")],
+         r"ORTHOPHOTOS: \S+/in/ne_ortho\.tif is given twice"),
+    Case("an orthophoto and a link to it", lambda b, i, o: _mosaic(
+        b, i, o, "sw_ortho.tif", "ne_ortho.tif")[:-2] + [str(_link(i / "sw_ortho.tif")),
+                                                       "--output", str(o / "m.tif")],
+         r"ORTHOPHOTOS: \S+/in/link\.tif is \S+/in/sw_ortho\.tif again"),
+    Case("an orthophoto copied under another name",
+         lambda b, i, o: _mosaic(b, i, o, "sw_ortho.tif", "ne_ortho.tif", "copy.tif=sw_ortho.tif"),
+         r"ORTHOPHOTOS: \S+/in/copy\.tif has the same content as \S+/in/sw_ortho\.tif \(a "
+         r"copy\): one image would count twice; give it once$"),
+    Case("a cut orthophoto", lambda b, i, o: _mosaic(b, i, o, "ne_ortho.tif")[:-2]
+         + [str(_half(b / "orthos" / "sw_ortho.tif", i)), "--output", str(o / "m.tif")],
+         r"sw_ortho\.tif: cannot read the pixels: the file is truncated or corrupt \(.*"
+         r"TIFFReadEncodedTile\(\) failed"),
 ]  # fmt: skip
 
 
