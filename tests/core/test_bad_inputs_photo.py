@@ -94,6 +94,29 @@ def _mosaic(b: Path, inp: Path, out: Path, *names: str) -> list[str]:
     return ["orthomosaic", "--orthophotos", *paths, "--output", str(out / "m.tif")]
 
 
+def _ties(b: Path, inp: Path, out: Path, *images: str, eo: Path | None = None,
+          crs: str | None = None) -> list[str]:  # fmt: skip
+    """tiepoints on images written in ``inp`` (``name.ext=src``: the pixels of the block's
+    image ``src`` saved as name.ext, re-encoded: the same pixels in another file)."""
+    folder = _in_images(inp)
+    for n in images:
+        dst, _, src = n.partition("=")
+        rgb = cv2.imread(str(b / "images" / f"{src}.tif"))
+        cv2.imwrite(str(folder / dst), rgb)
+    argv = ["tiepoints", "--images", str(folder),
+            "--output-observations", str(out / "ties.csv")]  # fmt: skip
+    if eo is not None:
+        argv += ["--eo", str(eo), "--camera", str(_copy(b / "camera.json", inp))]
+    return argv + (["--crs", crs] if crs else [])
+
+
+def _copies(argv: list[str], inp: Path) -> list[str]:
+    """The command with two byte copies of images/a.png beside it."""
+    for name in ("b.png", "c.png"):
+        _copy(inp / "images" / "a.png", inp / "images", name)
+    return argv
+
+
 def _link(target: Path) -> Path:
     link = target.parent / "link.tif"
     link.symlink_to(target.name)
@@ -182,6 +205,25 @@ CASES = [
          + [str(_half(b / "orthos" / "sw_ortho.tif", i)), "--output", str(o / "m.tif")],
          r"sw_ortho\.tif: cannot read the pixels: the file is truncated or corrupt \(.*"
          r"TIFFReadEncodedTile\(\) failed"),
+    # -- tiepoints
+    Case("three copies of one image", lambda b, i, o: _copies(_ties(b, i, o, "a.png=sw"), i),
+         r"IMAGES: \S+/b\.png has the same content as \S+/a\.png \(a copy\): identical "
+         r"images have no parallax; give it once$"),
+    Case("one image saved twice (no parallax)",
+         lambda b, i, o: _ties(b, i, o, "a.png=sw", "b.tif=sw", "c.png=ne"),
+         r"IMAGES: a and b show no parallax \(median shift 0\.00 px over \d+ matches\): the "
+         r"same view twice \(a copy of an image\?\); remove the copies$"),
+    Case("EO in longitude and latitude (tiepoints)",
+         lambda b, i, o: _ties(b, i, o, "sw.png=sw", "ne.png=ne", eo=_eo_lonlat(b, i)),
+         r"eo\.csv: the perspective centres \(x 4\.3\d+ to 4\.3\d+, y 52\.\d+ to 52\.\d+\) "
+         r"look like longitude and latitude in degrees, 60 units below them the ground: "
+         r"footprint pairs need X, Y in a projected CRS, in the unit of Z \(give CRS to check "
+         r"it\)$"),
+    Case("EO in longitude and latitude, CRS given (tiepoints)", lambda b, i, o: _ties(
+        b, i, o, "sw.png=sw", "ne.png=ne", eo=_eo_lonlat(b, i), crs=CRS),
+         r"eo\.csv: the perspective centres \(x 4\.3\d+ to 4\.3\d+, y 52\.\d+ to 52\.\d+\) "
+         r"looks like longitude and latitude in degrees, not coordinates of 'Amersfoort / RD "
+         r"New' \(projected, metre\)$"),
 ]  # fmt: skip
 
 
@@ -246,8 +288,9 @@ sys.exit(main(sys.argv[2:]))
 @pytest.mark.skipif(sys.platform == "win32", reason="no RLIMIT_FSIZE")
 def test_a_write_cut_short_names_the_output_and_the_cause(block, tmp_path):
     """The orthophoto (about 1 MB) cannot be written whole: the process may write files of
-    250 kB only, as a full disk would cut it (the compiled kernels' cache files are smaller): the error names the output file and the cause, and
-    nothing is left behind. GDAL's TIFF writer only logs such failures."""
+    250 kB only, as a full disk would cut it (the compiled kernels' cache files are smaller).
+    The error names the output file and the cause, and nothing is left behind (GDAL's TIFF
+    writer only logs such failures)."""
     inp, out = tmp_path / "in", tmp_path / "out"
     inp.mkdir()
     out.mkdir()
