@@ -117,6 +117,40 @@ def _copies(argv: list[str], inp: Path) -> list[str]:
     return argv
 
 
+def _chip(path: Path, xy: tuple[float, float], crs: str = CRS) -> Path:
+    """A 31 x 31 chip of 10 cm cells around the point, textured (a seeded pattern)."""
+    tex = np.random.default_rng(3).integers(0, 255, (31, 31), dtype=np.uint8)
+    gt = (xy[0] - 1.55, 0.1, 0.0, xy[1] + 1.55, 0.0, -0.1)
+    with GeoTiffWriter(path, 31, 31, 1, np.uint8, gt, crs, tile=0) as w:
+        w.write(tex)
+    return path
+
+
+def _locate(b: Path, inp: Path, out: Path, *images: str, chip_crs: str = CRS,
+            eo: Path | None = None, cut_chip: bool = False) -> list[str]:  # fmt: skip
+    """locatecontrolpoints on the block (one control point on the ground seen by both
+    images); ``name=src@f``: the block's image ``src`` reduced f times, saved as name."""
+    folder = _in_images(inp)
+    for n in images or ("sw.tif=sw", "ne.tif=ne"):
+        dst, _, src = n.partition("=")
+        src, _, f = src.partition("@")
+        rgb = cv2.imread(str(b / "images" / f"{src}.tif"))
+        if f:
+            rgb = cv2.resize(rgb, (W // int(f), H // int(f)), interpolation=cv2.INTER_AREA)
+        cv2.imwrite(str(folder / dst), rgb)
+    (inp / "chips").mkdir()
+    xy = (X0 + 21.0, Y0 + 18.5)
+    chip = _chip(inp / "chips" / "P1.tif", xy, chip_crs)
+    if cut_chip:
+        _half(chip, inp / "chips")
+    control = inp / "control.csv"
+    control.write_text(f"point_id,X,Y,Z\nP1,{xy[0]},{xy[1]},0.7\n", encoding="utf-8")
+    return ["locatecontrolpoints", "--chips", str(inp / "chips"), "--control-points",
+            str(control), "--camera", str(_copy(b / "camera.json", inp)), "--eo",
+            str(eo or _copy(b / "eo.csv", inp)), "--images", str(folder), "--crs", CRS,
+            "--output", str(out / "located.csv")]  # fmt: skip
+
+
 def _link(target: Path) -> Path:
     link = target.parent / "link.tif"
     link.symlink_to(target.name)
@@ -221,6 +255,25 @@ CASES = [
          r"it\)$"),
     Case("EO in longitude and latitude, CRS given (tiepoints)", lambda b, i, o: _ties(
         b, i, o, "sw.png=sw", "ne.png=ne", eo=_eo_lonlat(b, i), crs=CRS),
+         r"eo\.csv: the perspective centres \(x 4\.3\d+ to 4\.3\d+, y 52\.\d+ to 52\.\d+\) "
+         r"looks like longitude and latitude in degrees, not coordinates of 'Amersfoort / RD "
+         r"New' \(projected, metre\)$"),
+    # -- locatecontrolpoints
+    Case("image half the camera's size",
+         lambda b, i, o: _locate(b, i, o, "sw.tif=sw@2", "ne.tif=ne"),
+         r"sw\.tif: the image is 200 x 150 px, the camera 'k1' 400 x 300 px$"),
+    Case("image without an EO row",
+         lambda b, i, o: _locate(b, i, o, "sw.tif=sw", "ne.tif=ne", "extra.tif=sw"),
+         r"eo\.csv: no exterior orientation for image\(s\) extra \(image_id = file name "
+         r"without extension\)$"),
+    Case("chip in another CRS than the control",
+         lambda b, i, o: _locate(b, i, o, chip_crs="EPSG:3035"),
+         r"P1\.tif: the chip is in 'ETRS89-extended / LAEA Europe', the control points in "
+         r"'Amersfoort / RD New' \(CRS\): make the chips in the control's CRS$"),
+    Case("a cut chip", lambda b, i, o: _locate(b, i, o, cut_chip=True),
+         r"P1\.tif: cannot read the pixels: the file is truncated or corrupt \("),
+    Case("EO in longitude and latitude (locatecontrolpoints)",
+         lambda b, i, o: _locate(b, i, o, eo=_eo_lonlat(b, i)),
          r"eo\.csv: the perspective centres \(x 4\.3\d+ to 4\.3\d+, y 52\.\d+ to 52\.\d+\) "
          r"looks like longitude and latitude in degrees, not coordinates of 'Amersfoort / RD "
          r"New' \(projected, metre\)$"),
