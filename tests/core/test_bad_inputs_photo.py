@@ -8,7 +8,6 @@ the exit code, the one line on stderr with the error that names the parameter or
 from __future__ import annotations
 
 import hashlib
-import json
 import re
 import shutil
 import subprocess
@@ -362,3 +361,37 @@ def test_a_write_cut_short_names_the_output_and_the_cause(block, tmp_path):
                      r"250000 bytes \(ulimit -f\); nothing was written$", err[0]), err[0]
     assert _snapshot(out) == {}
     assert _snapshot(inp) == before
+
+
+# ----------------------------------------------------------------------------- bundle
+@pytest.fixture(scope="module")
+def uav(tmp_path_factory):
+    """The simulated UAV block of the bundle tests (15 images, ground points in each)."""
+    from lidarphoto.core.simulation.uav_block import simulate_uav_block
+
+    folder = tmp_path_factory.mktemp("uav")
+    return simulate_uav_block("bauer", seed=1, n_tie=400).write(folder)
+
+
+def test_bundle_names_the_eo_row_whose_kappa_is_turned(uav, tmp_path, capsys):
+    """Approximate orientations (no sigmas) with one kappa turned by 180 degrees: the
+    adjustment meets non-finite values (tie points behind a camera) in another image; the
+    error names the EO file, the row and the likely cause."""
+    inp, out = tmp_path / "in", tmp_path / "out"
+    inp.mkdir()
+    out.mkdir()
+    lines = uav["eo"].read_text(encoding="utf-8").splitlines()
+    rows = [line.split(",")[:9] for line in lines]  # the approximate values only
+    rows[3][8] = repr(float(rows[3][8]) + 180.0)  # IMG_0103
+    eo = inp / "eo.csv"
+    eo.write_text("\n".join(",".join(r) for r in rows) + "\n", encoding="utf-8")
+    argv = ["bundleadjustment", "--camera", str(_copy(uav["camera"], inp)),
+            "--observations", str(_copy(uav["observations"], inp)),
+            "--ground-points", str(_copy(uav["ground_points"], inp)), "--eo", str(eo),
+            "--crs", "EPSG:31983", "--output-eo", str(out / "eo.csv")]  # fmt: skip
+    line = _run(argv, inp, out, capsys)
+    assert re.search(r"eo\.csv, row 4: the approximate orientation of image IMG_0103 cannot "
+                     r"be right: its 6 ground points project more than a quarter of the image "
+                     r"away from their measurements; kappa looks 180 degrees off \(turned by "
+                     r"\+180 degrees, the ground points fit within \d+ px\) \(the adjustment: "
+                     r"block '.*' returned non-finite values", line), line
