@@ -22,10 +22,13 @@ import pyproj
 import pytest
 from lidarphoto.core.cli import main
 from lidarphoto.core.geometry.camera import camera_from_dict
+from lidarphoto.core.geometry.projection import PROJECTIONS
 from lidarphoto.core.io.camera import write_camera_json
 from lidarphoto.core.io.dsm import write_dsm
 from lidarphoto.core.io.orientation import write_eo_csv
 from lidarphoto.core.io.raster import GeoTiffWriter, write_rgb_tiff
+from lidarphoto.core.photo.calibration_targets import TargetSpec, target_field
+from lidarphoto.core.photo.camera_calibration import fisheye_evidence, simulate_views
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable
 from lidarphoto.core.simulation.render import RenderOptions, render_image
 from test_orthophoto import CRS, X0, Y0, _scene
@@ -395,3 +398,46 @@ def test_bundle_names_the_eo_row_whose_kappa_is_turned(uav, tmp_path, capsys):
                      r"away from their measurements; kappa looks 180 degrees off \(turned by "
                      r"\+180 degrees, the ground points fit within \d+ px\) \(the adjustment: "
                      r"block '.*' returned non-finite values", line), line
+
+
+# ----------------------------------------------------------------------------- calibration
+@pytest.mark.parametrize("projection", PROJECTIONS)
+def test_fisheye_views_name_their_projection(projection):
+    """Views of a target simulated through each projection (f = 300 px, lens distortion,
+    0.2 px noise; tests/core/test_camera_calibration.py's set): perspective views raise no
+    alarm, fisheye ones are recognised with their projection and focal length."""
+    from test_camera_calibration import _camera, _views
+
+    fld = target_field(TargetSpec("chessboard", 9, 6, 0.05))
+    cam = _camera(projection)
+    det = simulate_views(cam, fld, _views(projection), noise_px=0.2, seed=2)
+    views = [(fld.xyz[np.isin(fld.ids, d.ids)], d.pixels) for d in det]
+    text = fisheye_evidence(views, (cam.width_px, cam.height_px))
+    if projection == "perspective":
+        assert text == ""
+        return
+    assert re.fullmatch(
+        rf"the views look like a fisheye lens: the target's straight lines fit the "
+        rf"{projection} projection \(f 30\d px\) [\d.]+ times better than the perspective one "
+        rf"\(RMS misfit .* % of the rays' spread\) and the target is seen up to \d+ degrees "
+        rf"off the axis \(a field of view of at least 1[5-9]\d degrees\): try PROJECTION "
+        rf"{projection}", text), text  # fmt: skip
+
+
+@pytest.mark.skipif(not (SHARED / "fisheye-calibration").is_dir(), reason="shared data absent")
+def test_fisheye_images_taken_as_perspective_say_so(tmp_path, capsys):
+    """BoofCV's 190-degree fisheye chessboard views calibrated as perspective: the failure
+    says the views look like a fisheye lens and which projection to try."""
+    inp, out = tmp_path / "in", tmp_path / "out"
+    inp.mkdir()
+    out.mkdir()
+    for f in sorted((SHARED / "fisheye-calibration" / "chessboard").glob("*.jpg")):
+        _copy(f, inp)
+    argv = ["calibratecamera", "--images", str(inp), "--target", "chessboard", "--columns",
+            "4", "--rows", "6", "--spacing", "1", "--output-camera", str(out / "cam.json")]
+    line = _run(argv, inp, out, capsys)
+    assert re.search(r"camera calibration did not converge in \d+ iterations; the views look "
+                     r"like a fisheye lens: the target's straight lines fit the (equidistant|"
+                     r"equisolid|stereographic) projection \(f \d+ px\) .* field of view of at "
+                     r"least 1\d\d degrees\): try PROJECTION (equidistant|equisolid|"
+                     r"stereographic)$", line), line
