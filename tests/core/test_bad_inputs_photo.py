@@ -249,6 +249,10 @@ CASES = [
          lambda b, i, o: _ties(b, i, o, "a.png=sw", "b.tif=sw", "c.png=ne"),
          r"IMAGES: a and b show no parallax \(median shift 0\.00 px over \d+ matches\): the "
          r"same view twice \(a copy of an image\?\); remove the copies$"),
+    Case("half a JPEG (tiepoints)", lambda b, i, o: (
+        _half(b / "images" / "sw.jpg", _in_images(i)), _ties(b, i, o, "ne.jpg=ne"))[1],
+         r"sw\.jpg: truncated JPEG: its image data stop at byte \d+ without the end-of-image "
+         r"marker \(a copy or a download cut short\?\)$"),
     Case("EO in longitude and latitude (tiepoints)",
          lambda b, i, o: _ties(b, i, o, "sw.png=sw", "ne.png=ne", eo=_eo_lonlat(b, i)),
          r"eo\.csv: the perspective centres \(x 4\.3\d+ to 4\.3\d+, y 52\.\d+ to 52\.\d+\) "
@@ -426,13 +430,13 @@ def test_fisheye_views_name_their_projection(projection):
 
 @pytest.mark.skipif(not (SHARED / "fisheye-calibration").is_dir(), reason="shared data absent")
 def test_fisheye_images_taken_as_perspective_say_so(tmp_path, capsys):
-    """BoofCV's 190-degree fisheye chessboard views calibrated as perspective: the failure
+    """BoofCV's 190-degree fisheye chessboard views taken as perspective: the failure
     says the views look like a fisheye lens and which projection to try."""
     inp, out = tmp_path / "in", tmp_path / "out"
     inp.mkdir()
     out.mkdir()
-    for f in sorted((SHARED / "fisheye-calibration" / "chessboard").glob("*.jpg")):
-        _copy(f, inp)
+    for k in range(1, 26, 3):  # 9 of the 26 views (the run is shorter, the case the same)
+        _copy(SHARED / "fisheye-calibration" / "chessboard" / f"{k}.jpg", inp)
     argv = ["calibratecamera", "--images", str(inp), "--target", "chessboard", "--columns",
             "4", "--rows", "6", "--spacing", "1", "--output-camera", str(out / "cam.json")]
     line = _run(argv, inp, out, capsys)
