@@ -7,9 +7,9 @@ import contextlib
 import logging
 import math
 import os
+from collections.abc import Iterator
 from concurrent.futures import Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass
-from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -232,7 +232,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                         with contextlib.suppress(OSError):  # the first error is the one told
                             writer.close(overviews=False)
                         raise
-                    job = _named(partial(writer.close, finish_in=finisher), targets[name])
+                    with failures_named(targets[name]):
+                        job = writer.close(finish_in=finisher)
                     if job is not None:
                         finishing.append(job)
                         finished.append(name)
@@ -247,7 +248,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             wait(finishing)  # no file is still being written when the set is discarded
         for job, name in zip(finishing, finished):
             # a failure to write an image's levels fails the job: nothing renamed
-            _named(job.result, targets[name])
+            with failures_named(targets[name]):
+                job.result()
         files.commit()
     frac = total_occluded / max(total_valid + total_occluded, 1)
     lines = [f"{len(written)} orthophoto(s) of {gsd:g} in {folder}"
@@ -325,10 +327,12 @@ def _grids(boxes: dict, extent, gsd: float, infos: dict, folder: Path) -> dict:
     return shape
 
 
-def _named(write, target: Path):
-    """``write()``, an OSError (a full device, the file size limit) naming the output."""
+@contextlib.contextmanager
+def failures_named(target) -> Iterator[None]:
+    """An OSError of a write (a full device, the file size limit: the temporary's name)
+    raised again naming the output file."""
     try:
-        return write()
+        yield
     except OSError as exc:
         raise OSError(exc.errno, f"{exc.strerror or exc}; nothing was written",
                       str(target)) from exc  # fmt: skip

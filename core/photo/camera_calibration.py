@@ -325,8 +325,8 @@ def fisheye_evidence(views: list[tuple[Array, Array]], size: tuple[int, int]) ->
     return (f"the views look like a fisheye lens: the target's straight lines fit the {best} "
             f"projection (f {f_px:.0f} px) {persp / mis:.2g} times better than the perspective "
             f"one (RMS misfit {100 * mis:.2g} % against {100 * persp:.2g} % of the rays' "
-            f"spread) and the target is seen up to {math.degrees(off):.0f} degrees off the axis (a "
-            f"field of view of at least {2 * math.degrees(off):.0f} degrees): try PROJECTION "
+            f"spread) and the target is seen up to about {math.degrees(off):.0f} degrees off the "
+            f"axis (a field of view of about {2 * math.degrees(off):.0f} degrees): try PROJECTION "
             f"{best}")  # fmt: skip
 
 
