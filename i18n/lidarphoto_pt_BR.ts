@@ -6088,6 +6088,14 @@ medida da primeira imagem da trilha: a mediana dos sigmas refinados da sua trilh
             <translation>Arquivos JSON (*.json)</translation>
         </message>
         <message>
+            <source>Mapping CRS of the EO</source>
+            <translation>SRC de mapeamento da OE</translation>
+        </message>
+        <message>
+            <source>the EO is checked against its area of use</source>
+            <translation>a OE é conferida com a área de uso do SRC</translation>
+        </message>
+        <message>
             <source>Mean terrain height</source>
             <translation>Altura média do terreno</translation>
         </message>

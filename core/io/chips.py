@@ -70,12 +70,23 @@ def list_chips(paths: Iterable[PathLike]) -> dict[str, Path]:
     return out
 
 
-def read_control_chip(path: PathLike, point_id: str, xyz: Sequence[float]) -> ControlChip:
-    """Read a chip (module docstring) as a :class:`ControlChip` of the point at ``xyz``."""
+def read_control_chip(
+    path: PathLike, point_id: str, xyz: Sequence[float], crs: object = None
+) -> ControlChip:
+    """Read a chip (module docstring) as a :class:`ControlChip` of the point at ``xyz``;
+    with ``crs`` (the control's, a pyproj CRS), a chip tagged with another CRS is refused."""
     with RasterReader(path) as src:
         info = src.info
         if info.geotransform is None:
             raise InputError("the chip has no georeferencing", path=str(path))
+        if crs is not None and info.crs_wkt:
+            import pyproj
+
+            own = pyproj.CRS.from_wkt(info.crs_wkt)
+            if not _horizontal(own).equals(_horizontal(crs), ignore_axis_order=True):
+                raise InputError(f"the chip is in '{own.name}', the control points in "
+                                 f"'{crs.name}' (CRS): make the chips in the control's CRS",
+                                 path=str(path))  # fmt: skip
         data = src.read().astype(np.float64)
         valid = src.read_mask()
     if data.shape[0] >= 3:
@@ -89,6 +100,11 @@ def read_control_chip(path: PathLike, point_id: str, xyz: Sequence[float]) -> Co
         return ControlChip(point_id, grey, tuple(info.geotransform), np.asarray(xyz, float))
     except InputError as exc:
         raise InputError(str(exc), path=str(path)) from None
+
+
+def _horizontal(crs):
+    """The horizontal part of a compound CRS (the chips' planimetry is what must agree)."""
+    return crs.sub_crs_list[0] if crs.is_compound and crs.sub_crs_list else crs
 
 
 def _f(v: float, digits: int = 4) -> str:

@@ -18,17 +18,21 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 
-__all__ = ["IMAGE_SUFFIXES", "decode_factor", "image_size", "list_image_files", "read_gray"]
+__all__ = ["IMAGE_SUFFIXES", "check_distinct_files", "check_jpeg_whole", "decode_factor",
+           "image_size",
+           "list_image_files", "read_gray"]  # fmt: skip
 
 PathLike = Union[str, "os.PathLike[str]"]
 #: File endings taken as images when a folder is named.
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".jp2", ".img")
 
 
-def list_image_files(paths) -> list[Path]:
+def list_image_files(paths, twice: tuple[str, str] | None = None) -> list[Path]:
     """The image files named, folders expanded (their files with :data:`IMAGE_SUFFIXES`,
     sorted by name); InputError for a missing path, an empty folder or two images with the
-    same name (the image id is the file name without extension)."""
+    same name (the image id is the file name without extension). With ``twice`` (parameter
+    name, what a duplicate would do), a file named twice, or a copy of another, is refused
+    (:func:`check_distinct_files`); otherwise it is taken once."""
     out: list[Path] = []
     for raw in paths:
         p = Path(raw)
@@ -44,12 +48,46 @@ def list_image_files(paths) -> list[Path]:
             out.append(p)
         else:
             raise InputError("file or folder not found", path=str(p))
+    if twice is not None:
+        check_distinct_files(out, *twice)
     seen: dict[str, Path] = {}
     for f in out:
         if f.stem in seen and seen[f.stem] != f:
             raise InputError(f"two images are named {f.stem}: {seen[f.stem]} and {f}")
         seen[f.stem] = f
     return list(seen.values())
+
+
+def check_distinct_files(files, param: str, why: str) -> None:
+    """Refuse (InputError naming ``param``) a file given twice: the same file under two
+    spellings (a link, a folder and a file in it) or the same content under two names (a
+    copy; only files of equal size are hashed). ``why`` says what a duplicate would do."""
+    import hashlib
+
+    by_real: dict[str, Path] = {}
+    by_size: dict[int, list[Path]] = {}
+    for f in map(Path, files):
+        real = os.path.realpath(f)
+        if real in by_real:
+            again = "given twice" if by_real[real] == f else f"{by_real[real]} again"
+            raise InputError(f"{param}: {f} is {again}: {why}; give it once")
+        by_real[real] = f
+        by_size.setdefault(f.stat().st_size, []).append(f)
+
+    def digest(f: Path) -> str:
+        h = hashlib.sha256()
+        with open(f, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+        return h.hexdigest()
+
+    for same in (g for g in by_size.values() if len(g) > 1):
+        seen: dict[str, Path] = {}
+        for f in same:
+            first = seen.setdefault(digest(f), f)
+            if first is not f:
+                raise InputError(f"{param}: {f} has the same content as {first} (a copy): "
+                                 f"{why}; give it once")  # fmt: skip
 
 
 def image_size(path: PathLike) -> tuple[int, int]:
@@ -59,6 +97,30 @@ def image_size(path: PathLike) -> tuple[int, int]:
 
     with RasterReader(os.fspath(path)) as src:
         return int(src.info.width), int(src.info.height)
+
+
+def check_jpeg_whole(path: PathLike) -> None:
+    """Refuse (InputError) a JPEG whose image data does not end (no end-of-image marker
+    after its first scan: a copy or a download cut short). The header segments are skipped
+    by their lengths (an EXIF thumbnail holds a whole JPEG of its own); data after the end
+    (a motion photo's video) is allowed."""
+    raw = np.fromfile(os.fspath(path), dtype=np.uint8)
+    if raw.size < 4 or raw[0] != 0xFF or raw[1] != 0xD8:
+        raise InputError("not a JPEG file (no start-of-image marker)", path=os.fspath(path))
+    k = 2
+    while k + 4 <= raw.size and raw[k] == 0xFF and raw[k + 1] != 0xDA:  # up to the first scan
+        if raw[k + 1] == 0xFF:  # fill byte
+            k += 1
+            continue
+        k += 2 + (int(raw[k + 2]) << 8 | int(raw[k + 3]))
+    # in the entropy-coded data an 0xFF byte is followed by 0x00 (or a restart marker): an
+    # 0xFF 0xD9 pair is the end of the image
+    tail = raw[k:]
+    end = np.flatnonzero((tail[:-1] == 0xFF) & (tail[1:] == 0xD9)) if tail.size > 1 else ()
+    if k + 4 > raw.size or len(end) == 0:
+        raise InputError(f"truncated JPEG: its image data stop at byte {raw.size} without the "
+                         "end-of-image marker (a copy or a download cut short?)",
+                         path=os.fspath(path))  # fmt: skip
 
 
 def decode_factor(factor: int) -> int:
@@ -91,6 +153,8 @@ def read_gray(path: PathLike, factor: int = 1) -> NDArray[np.uint8]:
     img = cv2.imread(p, flags[factor] | cv2.IMREAD_IGNORE_ORIENTATION)
     if img is None:
         raise InputError("cannot read the image (not an image file, or damaged)", path=p)
+    if Path(p).suffix.lower() in (".jpg", ".jpeg"):  # OpenCV greys out a cut JPEG's rest
+        check_jpeg_whole(p)
     if img.dtype != np.uint8:  # 16-bit: stretched to 8 bits (features need contrast only)
         img = cv2.normalize(img, None, 0, 255, cv2.NORM_MINMAX).astype(np.uint8)
     return img

@@ -36,6 +36,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from .gdal_binding import raster_backend
+from .gdal_binding import rio_env as _rio_env
+from .raster_polygons import polygonize
 
 PathLike = Union[str, "os.PathLike[str]"]
 Window = tuple[int, int, int, int]
@@ -51,41 +54,6 @@ __all__ = [
 
 #: Writer threads (GDAL compresses blocks in parallel; more than 4 brings nothing here).
 MAX_THREADS = 4
-_INSTALL = "GDAL is needed for rasters: it comes with QGIS; outside QGIS: pip install rasterio"
-
-
-def raster_backend() -> str:
-    """``"gdal"`` (osgeo) or ``"rasterio"``: the binding this process uses (module docstring)."""
-    forced = os.environ.get("LIDARPHOTO_RASTER_BACKEND", "").strip().lower()
-    order = [forced] if forced in ("gdal", "rasterio") else ["gdal", "rasterio"]
-    for name in order:
-        try:
-            if name == "gdal":
-                from osgeo import gdal  # noqa: F401
-            else:
-                import rasterio  # noqa: F401
-        except ImportError:
-            continue
-        return name
-    raise InputError(_INSTALL)
-
-
-@contextlib.contextmanager
-def _rio_env(**options: Any) -> Iterator[None]:
-    """``rasterio.Env(**options)`` that reads the PROJ database of rasterio's own wheel.
-
-    rasterio points PROJ at ``PROJ_DATA`` each time a first ``Env`` starts, when that variable
-    is set; a wheel's PROJ then refuses an older system ``proj.db`` (Debian 12's, which QGIS
-    set-ups export) and no CRS parses. pyproj's wheels prefer their own data; so does this."""
-    import rasterio
-    from rasterio.env import PROJDataFinder, set_proj_data_search_path
-
-    with rasterio.Env(**options):
-        bundled = PROJDataFinder().search_wheel()
-        if bundled:
-            set_proj_data_search_path(bundled)
-        yield
-
 
 
 def _threads() -> int:
@@ -257,8 +225,21 @@ class RasterReader:
         out = None
         if pixel_interleaved:
             out = np.moveaxis(np.empty((bh, bw, len(which)), self.info.dtype), 2, 0)
-        with self._lock:
+        with self._lock, self._named_failure():
             return self._read(c0, r0, w, h, which, f, bw, bh, out)
+
+    @contextlib.contextmanager
+    def _named_failure(self) -> Iterator[None]:
+        """A failed read (a cut or damaged file: GDAL's RuntimeError, rasterio's "Read
+        failed. See previous exception") as an InputError naming the file and GDAL's cause."""
+        try:
+            yield
+        except (RuntimeError, OSError) as exc:
+            cause = exc.__cause__ or exc
+            detail = getattr(cause, "errmsg", None) or str(cause)
+            raise InputError(f"cannot read the pixels: the file is truncated or corrupt "
+                             f"({detail})", path=self.path) from exc  # fmt: skip
+
 
     def _read(self, c0: int, r0: int, w: int, h: int, which: list[int], f: int, bw: int,
               bh: int, out: NDArray | None = None) -> NDArray:  # fmt: skip
@@ -293,7 +274,7 @@ class RasterReader:
         """(rows, cols) True where band 1 holds data: GDAL's mask band (an internal or
         sidecar mask, an alpha band, or the nodata value)."""
         c0, r0, w, h = self._window(window)
-        with self._lock:
+        with self._lock, self._named_failure():
             ds = self._handle()
             if self.backend == "gdal":
                 m = ds.GetRasterBand(1).GetMaskBand().ReadAsArray(c0, r0, w, h)
@@ -339,58 +320,3 @@ def read_geotiff(path: PathLike) -> tuple[NDArray[np.float32], tuple[float, ...]
         if gt is None:
             raise InputError("the raster has no georeferencing", path=src.path)
         return data, gt, src.info.crs_wkt
-
-
-
-
-# ----------------------------------------------------------------------------- vectors
-def polygonize(
-    labels: NDArray[np.integer], geotransform: Sequence[float], empty: int = -1
-) -> dict[int, str]:
-    """The region of each label of a raster as a WKT MultiPolygon in map coordinates.
-
-    Polygons follow the pixel edges exactly (GDAL's polygonize, 4-connected regions); pixels
-    with the label ``empty`` belong to no region.
-
-    Parameters
-    ----------
-    labels : (rows, cols) integer array
-    geotransform : 6 floats, GDAL order
-
-    Returns
-    -------
-    dict
-        label -> ``MULTIPOLYGON (((x y, ...)))``.
-    """
-    lab = np.ascontiguousarray(labels, dtype=np.int32)
-    gt = tuple(float(v) for v in geotransform)
-    parts: dict[int, list[str]] = {}
-    if raster_backend() == "gdal":
-        from osgeo import gdal, ogr
-
-        gdal.UseExceptions()
-        mem = gdal.GetDriverByName("MEM").Create("", lab.shape[1], lab.shape[0], 2, gdal.GDT_Int32)
-        mem.SetGeoTransform(gt)
-        mem.GetRasterBand(1).WriteArray(lab)
-        mem.GetRasterBand(2).WriteArray((lab != empty).astype(np.int32))
-        vec = ogr.GetDriverByName("Memory").CreateDataSource("")
-        layer = vec.CreateLayer("regions")
-        layer.CreateField(ogr.FieldDefn("label", ogr.OFTInteger))
-        gdal.Polygonize(mem.GetRasterBand(1), mem.GetRasterBand(2), layer, 0, [])
-        for feat in layer:
-            geom = feat.GetGeometryRef()
-            wkt = geom.ExportToWkt()
-            parts.setdefault(int(feat.GetField(0)), []).append(wkt[len("POLYGON ") :])
-    else:
-        from rasterio import features
-        from rasterio.transform import Affine
-
-        with _rio_env():
-            shapes = list(features.shapes(lab, mask=lab != empty, transform=Affine.from_gdal(*gt)))
-        for geom, value in shapes:
-            rings = ", ".join(
-                "(" + ", ".join(f"{x!r} {y!r}" for x, y in ring) + ")"
-                for ring in geom["coordinates"]
-            )
-            parts.setdefault(int(value), []).append(f"({rings})")
-    return {k: "MULTIPOLYGON (" + ", ".join(v) + ")" for k, v in sorted(parts.items())}

@@ -5,7 +5,9 @@ writers of a whole array or an RGB image. Through GDAL: osgeo in QGIS, rasterio 
 
 from __future__ import annotations
 
+import errno
 import os
+import shutil
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import Executor, Future
@@ -16,13 +18,9 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from .atomic import atomic_path
-from .raster import (
-    _crs_text,
-    _rio_env,
-    _threads,
-    overview_factors,
-    raster_backend,
-)
+from .gdal_binding import raster_backend
+from .gdal_binding import rio_env as _rio_env
+from .raster import _crs_text, _threads, overview_factors
 
 PathLike = Union[str, "os.PathLike[str]"]
 Window = tuple[int, int, int, int]
@@ -32,6 +30,9 @@ __all__ = ["GeoTiffWriter", "write_geotiff", "write_rgb_tiff"]
 #: Largest memory the overview levels computed from the blocks may hold (bytes); a larger
 #: raster gets GDAL's overviews, read back from the file.
 OVERVIEW_MEMORY_BYTES = 256 << 20
+
+#: Free bytes below which a write that just ended is taken to have hit a full device.
+MIN_FREE_BYTES = 1 << 16
 
 _GDAL_TYPES = {
     "uint8": "Byte", "uint16": "UInt16", "int16": "Int16", "uint32": "UInt32",
@@ -259,6 +260,7 @@ class GeoTiffWriter:
                         ds.BuildOverviews("AVERAGE", factors)
                     ds.FlushCache()
                     del ds  # the last reference: the file is closed here
+                    check_written(self.path)
 
                 if levels is not None:
                     later = finish
@@ -270,11 +272,13 @@ class GeoTiffWriter:
                 if factors and levels is None:
                     self._ds.build_overviews(factors, Resampling.average)
                 self._ds.close()
+                check_written(self.path)  # (GDAL would crash on the levels of a cut file)
                 if factors and levels is not None:
                     path, level = self.path, self._level
 
                     def later() -> None:
                         _write_levels_rasterio(path, factors, levels, level)
+                        check_written(path)
 
         finally:
             if self.backend == "rasterio":
@@ -285,6 +289,26 @@ class GeoTiffWriter:
             later()
             return None
         return finish_in.submit(later)
+
+
+def check_written(path: str) -> None:
+    """Raise OSError (ENOSPC, EFBIG) when a file just written cannot be whole: the device has
+    no space left, or the file reached the process's size limit (``ulimit -f``). GDAL's TIFF
+    writer reports neither through rasterio: it logs them and closes a cut file."""
+    size = os.path.getsize(path)
+    try:
+        import resource
+
+        limit, unlimited = resource.getrlimit(resource.RLIMIT_FSIZE)[0], resource.RLIM_INFINITY
+    except (ImportError, OSError, ValueError):  # not on Windows
+        limit = unlimited = -1
+    if 0 <= limit != unlimited and size >= limit:
+        raise OSError(errno.EFBIG, f"cannot write it whole: the file reached the process's "
+                      f"file size limit of {limit} bytes (ulimit -f)", path)  # fmt: skip
+    free = shutil.disk_usage(os.path.dirname(os.path.abspath(path))).free
+    if free < MIN_FREE_BYTES:
+        raise OSError(errno.ENOSPC, f"cannot write it whole: no space left on the device "
+                      f"({free} bytes free)", path)  # fmt: skip
 
 
 def _mask_bytes(valid: NDArray) -> NDArray[np.uint8]:

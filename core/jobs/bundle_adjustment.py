@@ -224,7 +224,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the inputs, adjust (each AP family for ``all``), write the outputs."""
     import numpy as np
 
-    from ..errors import InputError
+    from ..errors import AdjustmentError, InputError
     from ..geometry.frames import MappingFrame, check_area_of_use
     from ..io.atomic import write_text_atomic
     from ..io.bundle import (
@@ -290,8 +290,13 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             estimate_mount=v.estimate_mount,
         )
         log.info("bundle adjustment with AP model %s", model)
-        return bundle_adjust(cams, obs, ground, frame, eo, sigma, image_camera, opts, eo_rows,
-                             eo_source, stage[model], should_stop)  # fmt: skip
+        try:
+            return bundle_adjust(cams, obs, ground, frame, eo, sigma, image_camera, opts,
+                                 eo_rows, eo_source, stage[model], should_stop)  # fmt: skip
+        except AdjustmentError as exc:
+            if eo is not None:  # an approximate orientation far off is the usual cause
+                _blame_eo(exc, cams, obs, ground, eo, image_camera, eo_rows, eo_source)
+            raise
 
     if len(models) == 1:
         res = one(models[0])
@@ -361,6 +366,61 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         lines=lines,
         data=res,
     )
+
+
+def _misfit(xyz, px, eo6, cam) -> float:
+    """Median distance (pixels) between measured pixels and the projections of their ground
+    points with ``eo6`` (map frame taken as the EO's grid frame: a diagnosis, not a model);
+    infinite when half the points are behind the camera."""
+    import numpy as np
+
+    from ..geometry.collinearity import project_with_status
+
+    p, front, ok = project_with_status(xyz, eo6, cam)
+    good = front & ok
+    if good.sum() * 2 <= len(px):
+        return float("inf")
+    return float(np.median(np.hypot(*(p[good] - px[good]).T)))
+
+
+def _blame_eo(exc, cams, obs, ground, eo, image_camera, rows, path) -> None:
+    """Raise an InputError naming the EO row (and the likely mistake) of the first image
+    whose approximate orientation cannot be right: the ground points it measures (three or
+    more) project, median, more than a quarter of the image's diagonal from their pixels;
+    the cause is a kappa off by 90 or 180 degrees when turning it makes them fit (within a
+    tenth of the diagonal, five times better). Returns when no image is found."""
+    import math
+
+    import numpy as np
+
+    from ..errors import InputError
+
+    where = {p: k for k, p in enumerate(ground.point_id)}
+    by_name = {c.name: c for c in cams}
+    for k, image in enumerate(eo.image_id):
+        cam = by_name.get(image_camera.get(image, ""), cams[0])
+        sel = [m for m, (im, p) in enumerate(zip(obs.image_id, obs.point_id))
+               if im == image and p in where]  # fmt: skip
+        if len(sel) < 3:
+            continue
+        xyz = ground.xyz[[where[obs.point_id[m]] for m in sel]]
+        px = obs.pixels[sel]
+        eo6 = np.r_[eo.xyz[k], eo.opk[k]]
+        diag = math.hypot(cam.width_px, cam.height_px)
+        now = _misfit(xyz, px, eo6, cam)
+        if now <= 0.25 * diag:
+            continue
+        turns = {d: _misfit(xyz, px, eo6 + np.r_[0, 0, 0, 0, 0, math.radians(d)], cam)
+                 for d in (180, 90, -90)}  # fmt: skip
+        d = min(turns, key=turns.get)
+        cause = (f"kappa looks {abs(d)} degrees off (turned by {d:+d} degrees, the ground points "
+                 f"fit within {turns[d]:.0f} px)" if turns[d] <= min(0.1 * diag, now / 5) else
+                 "the position or the angles are far off (degrees, the order omega-phi-kappa, "
+                 "the axes' signs)")  # fmt: skip
+        raise InputError(f"the approximate orientation of image {image} cannot be right: its "
+                         f"{len(sel)} ground points project more than a quarter of the image "
+                         f"away from their measurements; {cause} (the adjustment: {exc})",
+                         path=path, row=rows[k] if rows else None) from exc  # fmt: skip
 
 
 def _check_on_image(obs, image_camera: dict[str, str], cams) -> None:

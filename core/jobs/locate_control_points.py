@@ -173,7 +173,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.atomic import write_text_atomic
     from ..io.camera import read_camera_json
     from ..io.chips import list_chips, read_control_chip, write_location_report
-    from ..io.images import list_image_files
+    from ..io.images import image_size, list_image_files
     from ..io.observations import write_observations_csv
     from ..io.orientation import read_eo_csv_full
     from ..io.resection import read_point_control_csv
@@ -184,6 +184,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     camera = read_camera_json(v.camera)
     eo_file = read_eo_csv_full(v.eo, crs.to_wkt())
     eo = eo_file.eo
+    check_area_of_use(crs, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
+                      what="the perspective centres", path=v.eo)  # fmt: skip
     control = read_point_control_csv(v.control_points)
     check_area_of_use(crs, control.xyz.min(axis=0), control.xyz.max(axis=0),
                       what="the control points", path=v.control_points)  # fmt: skip
@@ -193,9 +195,18 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if unknown:
         raise InputError(f"chips of unknown points (not in the control table): "
                          f"{', '.join(unknown[:10])}", path=v.control_points)  # fmt: skip
-    chips = [read_control_chip(chip_files[p], p, control.xyz[ids.index(p)])
+    chips = [read_control_chip(chip_files[p], p, control.xyz[ids.index(p)], crs)
              for p in sorted(chip_files)]  # fmt: skip
     images = {f.stem: f for f in list_image_files(v.images)}
+    lacking = sorted(set(images) - set(eo.image_id))
+    if lacking:
+        raise InputError(f"no exterior orientation for image(s) {', '.join(lacking[:10])} "
+                         "(image_id = file name without extension)", path=v.eo)  # fmt: skip
+    for f in images.values():  # every header read before any work
+        w, h = image_size(f)
+        if (w, h) != (camera.width_px, camera.height_px):
+            raise InputError(f"the image is {w} x {h} px, the camera {camera.name!r} "
+                             f"{camera.width_px} x {camera.height_px} px", path=str(f))  # fmt: skip
     keep = [k for k, i in enumerate(eo.image_id) if i in images]
     if not keep:
         raise InputError("no image of the EO table among the images given", path=v.eo)

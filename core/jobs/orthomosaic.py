@@ -110,8 +110,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.tables import write_csv_atomic
     from ..photo.mosaic import MosaicSource, mosaic_grid, mosaic_tiles
     from .common import compression_args
+    from .orthorectify import failures_named
 
-    files = list_image_files(v.orthophotos)
+    files = list_image_files(v.orthophotos, ("ORTHOPHOTOS", "one image would count twice"))
     readers = [RasterReader(f) for f in files]
     try:
         first = readers[0].info
@@ -158,10 +159,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         mosaic, seams = stages(progress, 0.9, 0.1)
         covered = 0
         meta_out = {"LIDARPHOTO_SOURCES": ",".join(s.name for s in sources)}
-        with GeoTiffWriter(out.path("OUTPUT"), grid.cols, grid.rows, first.bands, first.dtype,
-                           grid.geotransform, crs, mask=True, tile=512,
-                           photometric=photometric, metadata=meta_out,
-                           **compression_args(v.compression)) as writer:  # fmt: skip
+        with failures_named(out.target("OUTPUT")), GeoTiffWriter(
+                out.path("OUTPUT"), grid.cols, grid.rows, first.bands, first.dtype,
+                grid.geotransform, crs, mask=True, tile=512, photometric=photometric,
+                metadata=meta_out, **compression_args(v.compression)) as writer:  # fmt: skip
             for tile in mosaic_tiles(sources, grid, read, first.bands, first.dtype, options,
                                      progress=mosaic, should_stop=should_stop):  # fmt: skip
                 writer.write(tile.data, tile.col0, tile.row0, tile.valid)

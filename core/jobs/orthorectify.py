@@ -3,9 +3,11 @@ DSM or DTM."""
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import os
+from collections.abc import Iterator
 from concurrent.futures import Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
@@ -107,7 +109,7 @@ class OrthoFile:
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Check every input, then orthorectify the images one after the other."""
     from ..errors import CrsError, InputError
-    from ..geometry.frames import LocalFrame, MappingFrame, parse_crs
+    from ..geometry.frames import LocalFrame, MappingFrame, check_area_of_use, parse_crs
     from ..geometry.raycast import DsmTracer
     from ..geometry.surface import reproject_dsm
     from ..io.atomic import OutputSet
@@ -116,12 +118,15 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.orientation import read_eo_csv
     from ..io.raster import RasterReader
     from ..io.raster_write import GeoTiffWriter
-    from ..photo.orthophoto import OrthoProjector, _lens_lattice, auto_gsd, ortho_grid
+    from ..photo.orthophoto import OrthoProjector, _lens_lattice, auto_gsd
     from .common import compression_args
 
+    mapping = parse_crs(v.crs, what="mapping CRS")
+    extent = _extent(v.extent)
     camera = read_camera_json(v.camera)
     eo = read_eo_csv(v.eo)
-    mapping = parse_crs(v.crs, what="mapping CRS")
+    check_area_of_use(mapping, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
+                      what="the perspective centres", path=v.eo)  # fmt: skip
     from ..io.images import list_image_files
 
     images = list_image_files(v.images)
@@ -130,9 +135,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if missing:
         raise InputError(f"no exterior orientation for image(s) {', '.join(missing[:10])}",
                          path=v.eo)  # fmt: skip
+    infos = {}
     for f in images:  # every image is checked before anything is computed
         with RasterReader(f) as src:
-            info = src.info
+            info = infos[f.stem] = src.info
         if (info.width, info.height) != (camera.width_px, camera.height_px):
             raise InputError(f"the image is {info.width} x {info.height} px, the camera "
                              f"{camera.name!r} {camera.width_px} x {camera.height_px} px",
@@ -176,6 +182,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         if not gsds:
             raise InputError("no image sees the DSM", path=str(v.dsm))
         gsd = float(np.median(gsds))
+    grids = _grids(boxes, extent, gsd, infos, folder)
     written: list[OrthoFile] = []
     total_valid = total_occluded = 0
     beyond = {k: _beyond_dsm(p, ground_z[k]) for k, p in projectors.items()
@@ -188,17 +195,16 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     # an image's overview levels are written (GDAL compressing them) while the next image's
     # tiles are computed; the files are renamed into place once all are whole
     finishing: list[Future] = []
+    finished: list[str] = []  # the image of each of them
     with OutputSet({k: str(p) for k, p in targets.items()}, inputs) as files, \
             ThreadPoolExecutor(max_workers=1) as finisher:  # fmt: skip
         try:
             for m, f in enumerate(images):
                 name = f.stem
                 proj = projectors[name]
-                box = tuple(v.extent) if v.extent else boxes[name]
-                if box is None:
-                    log.warning("image %s does not overlap the DSM: no orthophoto", name)
+                grid = grids.get(name)
+                if grid is None:
                     continue
-                grid = ortho_grid(box, gsd)
                 sub = None if work is None else (
                     lambda fr, m=m: work((m + fr) / len(images)))  # fmt: skip
                 centre_px = camera.principal_point_px
@@ -225,11 +231,14 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                             valid += int(np.count_nonzero(tile.valid))
                             occluded += tile.occluded
                     except BaseException:
-                        writer.close(overviews=False)
+                        with contextlib.suppress(OSError):  # the first error is the one told
+                            writer.close(overviews=False)
                         raise
-                    job = writer.close(finish_in=finisher)
+                    with failures_named(targets[name]):
+                        job = writer.close(finish_in=finisher)
                     if job is not None:
                         finishing.append(job)
+                        finished.append(name)
                 total_valid += valid
                 total_occluded += occluded
                 written.append(OrthoFile(name, str(targets[name]), grid.cols, grid.rows, valid,
@@ -239,8 +248,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                          f", {occluded} occluded" if options.true_ortho else "")  # fmt: skip
         finally:
             wait(finishing)  # no file is still being written when the set is discarded
-        for job in finishing:
-            job.result()  # a failure to write an image's levels fails the job: nothing renamed
+        for job, name in zip(finishing, finished):
+            # a failure to write an image's levels fails the job: nothing renamed
+            with failures_named(targets[name]):
+                job.result()
         files.commit()
     frac = total_occluded / max(total_valid + total_occluded, 1)
     lines = [f"{len(written)} orthophoto(s) of {gsd:g} in {folder}"
@@ -250,6 +261,83 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         lines=lines,
         data=written,
     )
+
+
+def _extent(values) -> tuple[float, float, float, float] | None:
+    """EXTENT as (xmin, ymin, xmax, ymax), refused when empty or inverted."""
+    from ..errors import InputError
+
+    if not values:
+        return None
+    x0, y0, x1, y1 = (float(a) for a in values)
+    if not (x1 > x0 and y1 > y0):
+        raise InputError(f"EXTENT {x0:g},{y0:g},{x1:g},{y1:g}: give xmin,ymin,xmax,ymax with "
+                         "xmin < xmax and ymin < ymax")  # fmt: skip
+    return x0, y0, x1, y1
+
+
+def _grids(boxes: dict, extent, gsd: float, infos: dict, folder: Path) -> dict:
+    """The output grid of each image that sees the DSM (and the extent, when given), checked
+    before anything is written: an extent outside every footprint is refused, and so are
+    grids that GDAL cannot write or the output folder cannot hold (uncompressed)."""
+    import shutil
+
+    from ..errors import InputError
+    from ..photo.orthophoto import ortho_grid
+    from .checks import size_text
+
+    for name, box in boxes.items():
+        if box is None:
+            log.warning("image %s does not overlap the DSM: no orthophoto", name)
+    seen = {k: b for k, b in boxes.items() if b is not None}
+    if extent is not None and seen:
+        inside = {k: b for k, b in seen.items() if b[0] < extent[2] and extent[0] < b[2]
+                  and b[1] < extent[3] and extent[1] < b[3]}  # fmt: skip
+        if not inside:
+            lo = np.min([b[:2] for b in seen.values()], axis=0)
+            hi = np.max([b[2:] for b in seen.values()], axis=0)
+            raise InputError(
+                "EXTENT {:.10g},{:.10g},{:.10g},{:.10g} lies outside every image's footprint "
+                "on the DSM (the footprints span x {:.10g} to {:.10g}, y {:.10g} to {:.10g}): "
+                "give the extent in the mapping CRS, within the footprints".format(
+                    *extent, lo[0], hi[0], lo[1], hi[1]))  # fmt: skip
+        for k in sorted(set(seen) - set(inside)):
+            log.warning("image %s does not see EXTENT: no orthophoto", k)
+        seen = inside
+    shape = {k: ortho_grid(extent or b, gsd) for k, b in seen.items()}
+    need = 0.0
+    for k, g in shape.items():
+        cells = float(g.rows) * g.cols
+        per_cell = infos[k].bands * infos[k].dtype.itemsize + 1  # the bands and the mask
+        # GDAL keeps a GeoTIFF's tile offsets in one array of at most 2 GB (8 bytes a tile)
+        if math.ceil(g.cols / 512) * math.ceil(g.rows / 512) * (infos[k].bands + 1) > 2**28:
+            raise InputError(f"GSD {gsd:g}: the orthophoto of image {k} would be {g.cols} x "
+                             f"{g.rows} cells, beyond what a GeoTIFF can hold: give a larger "
+                             "GSD (0: the images' own)")  # fmt: skip
+        need += cells * per_cell * 4 / 3  # the overview levels add a third
+    there = folder.absolute()
+    while not there.is_dir() and there != there.parent:  # the folder is made when written
+        there = there.parent
+    free = shutil.disk_usage(there).free
+    if need > free:
+        big = max(shape, key=lambda k: shape[k].rows * shape[k].cols)
+        g = shape[big]
+        raise InputError(f"GSD {gsd:g}: the {len(shape)} orthophoto(s) need up to "
+                         f"{size_text(need)} (uncompressed; image {big}: {g.cols} x {g.rows} "
+                         f"cells); the output folder has {size_text(free)} free: give a larger "
+                         "GSD (0: the images' own) or free some space")  # fmt: skip
+    return shape
+
+
+@contextlib.contextmanager
+def failures_named(target) -> Iterator[None]:
+    """An OSError of a write (a full device, the file size limit: the temporary's name)
+    raised again naming the output file."""
+    try:
+        yield
+    except OSError as exc:
+        raise OSError(exc.errno, f"{exc.strerror or exc}; nothing was written",
+                      str(target)) from exc  # fmt: skip
 
 
 def _tiles(proj, grid, src, info, options, progress, should_stop):

@@ -64,6 +64,8 @@ track's first-image measurement: the median of its track's refined sigmas.""",
               file_filter=CSV_FILTER, help="with CAMERA: pairs from ground footprints"),
         Param("CAMERA", "file", "Camera (JSON)", optional=True,
               file_filter="JSON files (*.json)"),
+        Param("CRS", "crs", "Mapping CRS of the EO", optional=True,
+              help="the EO is checked against its area of use"),
         Param("HEIGHT", "number", "Mean terrain height", 0.0, unit="m", minimum=-1000.0,
               maximum=9000.0, help="the plane the footprints are computed on (EO heights)"),
         Param("DETECTOR", "enum", "Detector", _D.detector, options=DETECTORS,
@@ -131,7 +133,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         min_track_length=int(v.min_track_length), pair_mode=v.pair_mode, window=int(v.window),
         min_overlap=v.min_overlap, sigma_px=v.sigma, refine=bool(v.refine),
     )  # fmt: skip
-    files = list_image_files(v.images)
+    files = list_image_files(v.images, ("IMAGES", "identical images have no parallax"))
     if len(files) < 2:
         raise InputError("tie points need at least two images")
     ids = [f.stem for f in files]
@@ -143,6 +145,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if v.eo:
         camera = read_camera_json(v.camera)
         eo = read_eo_csv(v.eo)
+        _check_eo_coordinates(eo, v.crs, v.eo, v.height)
         row = {name: k for k, name in enumerate(eo.image_id)}
         fps = footprints(camera, eo.xyz, eo.opk, v.height)
         footprint = [fps[row[i]] if i in row else None for i in ids]
@@ -173,6 +176,11 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
     res = tie_points(ids, load, options, footprint, progress=progress, should_stop=should_stop,
                      load_image=lambda k: read_gray(files[k], 1))  # fmt: skip
+    flat = [p for p in res.pairs if p.status.startswith("no parallax")]
+    if flat:
+        raise InputError("IMAGES: " + "; ".join(f"{ids[p.i]} and {ids[p.j]} show {p.status}"
+                                                for p in flat[:5])
+                         + ": the same view twice (a copy of an image?); remove the copies")
     s = res.summary()
     if s["tracks"] == 0:
         raise InputError(f"no tie point found: {s['pairs_kept']} of {s['pairs_tried']} pairs "
@@ -216,6 +224,31 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         lines=lines,
         data=res,
     )  # fmt: skip
+
+
+def _check_eo_coordinates(eo, crs: str | None, path: str, height: float) -> None:
+    """The perspective centres against the CRS's area of use; without a CRS, refused when
+    X, Y look like degrees (within +-180, +-90 and less than a unit apart) while the flying
+    height is metres: the footprints would all overlap, every pair would be tried."""
+    import numpy as np
+
+    from ..errors import CrsError
+    from ..geometry.frames import check_area_of_use, parse_crs
+
+    lo, hi = eo.xyz.min(axis=0), eo.xyz.max(axis=0)
+    if crs:
+        check_area_of_use(parse_crs(crs, what="CRS"), lo, hi, what="the perspective centres",
+                          path=path)  # fmt: skip
+        return
+    spread = float(np.max(hi[:2] - lo[:2]))
+    above = float(np.median(np.abs(eo.xyz[:, 2] - height)))
+    if abs(lo[0]) <= 180 and abs(hi[0]) <= 180 and abs(lo[1]) <= 90 and abs(hi[1]) <= 90 \
+            and spread < 1.0 and above > 10.0 * max(spread, 1e-9):  # fmt: skip
+        raise CrsError(f"the perspective centres (x {lo[0]:.10g} to {hi[0]:.10g}, y "
+                       f"{lo[1]:.10g} to {hi[1]:.10g}) look like longitude and latitude in "
+                       f"degrees, {above:.4g} units below them the ground: footprint pairs "
+                       "need X, Y in a projected CRS, in the unit of Z (give CRS to check "
+                       "it)", path=path)  # fmt: skip
 
 
 def np_median(values) -> float:

@@ -45,7 +45,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import stats
 
-from ..errors import InputError, NotObservableError
+from ..errors import AdjustmentError, ConvergenceError, InputError, NotObservableError
 from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians
 from ..geometry.distortion import BrownConrady
@@ -234,9 +234,13 @@ def _plane_pose(xy: Array, rays: Array) -> tuple[Array, Array, float]:
     return rot, lam * h[:, 2], misfit
 
 
-def _init_fisheye(views: list[tuple[Array, Array]], size: tuple[int, int], projection: str):
+def _best_focal(views: list[tuple[Array, Array]], size: tuple[int, int], projection: str,
+                relative: bool = False) -> tuple[float, float]:  # fmt: skip
     """Focal length (px) whose back-projected rays make every view closest to a plane seen by
-    a central camera (a wrong focal length bends the grid's lines), and the views' poses."""
+    a central camera (a wrong focal length bends the grid's lines), and the summed squares
+    of the views' RMS misfit angles (rad^2) there; the principal point at the centre. With
+    ``relative``, each misfit over the RMS angle of the view's rays from their mean (a long
+    focal length narrows the rays and their misfit alike: projections then compare)."""
     w, h = size
     pp = np.array([0.5 * w, 0.5 * h])
 
@@ -247,7 +251,11 @@ def _init_fisheye(views: list[tuple[Array, Array]], size: tuple[int, int], proje
             ok = np.isfinite(rays).all(axis=1)
             if ok.sum() < len(px):  # a point outside the projection: f too small
                 return np.inf
-            total += _plane_pose(xyz[:, :2], rays)[2] ** 2
+            m = _plane_pose(xyz[:, :2], rays)[2]
+            if relative:
+                mean = rays.mean(axis=0) / np.linalg.norm(rays.mean(axis=0))
+                m /= math.sqrt(float(np.mean(np.arccos(np.clip(rays @ mean, -1, 1)) ** 2)))
+            total += m**2
         return total
 
     diag = math.hypot(w, h)
@@ -266,11 +274,60 @@ def _init_fisheye(views: list[tuple[Array, Array]], size: tuple[int, int], proje
         else:
             lo = a
     f_px = 0.5 * (lo + hi)
+    return f_px, misfit(f_px)
+
+
+def _init_fisheye(views: list[tuple[Array, Array]], size: tuple[int, int], projection: str):
+    """The focal length of :func:`_best_focal` and the views' poses from it."""
+    f_px = _best_focal(views, size, projection)[0]
+    pp = np.array([0.5 * size[0], 0.5 * size[1]])
     eos = []
     for xyz, px in views:
         rot, t, _ = _plane_pose(xyz[:, :2], _rays_cv(px, f_px, pp, projection))
         eos.append(_cv_pose_to_eo(rot, t))
     return f_px, pp, np.array(eos)
+
+
+#: A fisheye projection must fit the views this many times better than the perspective one
+#: (:func:`fisheye_evidence`; real fisheye lenses, their distortion unmodelled: 2 to 3).
+FISHEYE_FIT_RATIO = 1.5
+#: ... and see the target this far off the axis, degrees (a rectilinear lens of 30 degrees
+#: off the axis in the corners is wide already; a fisheye reaches 80 to 100).
+FISHEYE_OFF_AXIS_DEG = 55.0
+
+
+def fisheye_evidence(views: list[tuple[Array, Array]], size: tuple[int, int]) -> str:
+    """"" or the sentence saying that views taken as perspective look like a fisheye lens:
+    the target's straight lines fit the best fisheye projection better than a perspective
+    one (:func:`_best_focal`'s relative misfit, principal point at the centre) by
+    :data:`FISHEYE_FIT_RATIO`, the target seen :data:`FISHEYE_OFF_AXIS_DEG` or more off the
+    axis through it; names the projection to try."""
+    import warnings
+
+    def rms(p: str) -> tuple[float, float]:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # degenerate views
+                f, cost = _best_focal(views, size, p, relative=True)
+        except InputError:  # no focal length fits the points inside that projection
+            return math.nan, math.inf
+        return f, math.sqrt(cost / len(views))
+
+    fits = {p: rms(p) for p in PROJECTIONS}
+    persp = fits["perspective"][1]
+    best = min(PROJECTIONS[1:], key=lambda p: fits[p][1])
+    f_px, mis = fits[best]
+    pp = np.array([0.5 * size[0], 0.5 * size[1]])
+    off = max(float(np.nanmax(np.arccos(np.clip(_rays_cv(px, f_px, pp, best)[:, 2], -1, 1))))
+              for _, px in views) if math.isfinite(mis) else 0.0  # fmt: skip
+    if not (mis * FISHEYE_FIT_RATIO < persp and off >= math.radians(FISHEYE_OFF_AXIS_DEG)):
+        return ""
+    return (f"the views look like a fisheye lens: the target's straight lines fit the {best} "
+            f"projection (f {f_px:.0f} px) {persp / mis:.2g} times better than the perspective "
+            f"one (RMS misfit {100 * mis:.2g} % against {100 * persp:.2g} % of the rays' "
+            f"spread) and the target is seen up to about {math.degrees(off):.0f} degrees off the "
+            f"axis (a field of view of about {2 * math.degrees(off):.0f} degrees): try PROJECTION "
+            f"{best}")  # fmt: skip
 
 
 def _init_perspective(views: list[tuple[Array, Array]], size: tuple[int, int]):
@@ -444,6 +501,12 @@ def calibrate_camera(
 
         constraints.append(Constraint("datum: third point in Z = 0", [[zc]], plane))
     aopts = AdjustmentOptions(max_iterations=opts.max_iterations)
+
+    def fisheye() -> str:  # why a perspective calibration may fail
+        text = fisheye_evidence(per_view, (width_px, height_px)) \
+            if opts.projection == "perspective" else ""  # fmt: skip
+        return f"; {text}" if text else ""
+
     try:
         res = adjust(x0v, pnames, blocks, constraints, aopts, progress=progress,
                      should_stop=should_stop)  # fmt: skip
@@ -451,14 +514,15 @@ def calibrate_camera(
         raise NotObservableError(
             f"camera calibration: {exc}. The views cannot determine these parameters: use "
             "more views, tilted in different directions (not all parallel to the target), "
-            "with the target filling the image corners, or estimate fewer lens parameters",
+            "with the target filling the image corners, or estimate fewer lens parameters"
+            + fisheye(),
             parameters=exc.parameters,
         ) from exc
+    except AdjustmentError as exc:
+        raise type(exc)(f"camera calibration: {exc}{fisheye()}") from exc
     if not res.converged:
-        from ..errors import ConvergenceError
-
         raise ConvergenceError(f"camera calibration did not converge in {res.iterations} "
-                               "iterations")  # fmt: skip
+                               f"iterations{fisheye()}")  # fmt: skip
     full = base.interior_params
     full[free_io] = res.x[:n_io]
     cam = base.with_interior(full)

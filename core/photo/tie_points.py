@@ -542,6 +542,10 @@ def match_pair(
         return drop(f"too few matches ({n_mutual} after the ratio test and mutual check)",
                     n_ratio, n_mutual)  # fmt: skip
     pa, pb = fa.pixels[ia], fb.pixels[ib]
+    shift = float(np.median(np.hypot(*(pb - pa).T)))
+    if shift < NO_PARALLAX_PX:  # the same view twice: no geometry to find
+        return drop(f"no parallax (median shift {shift:.2f} px over {n_mutual} matches)",
+                    n_ratio, n_mutual)  # fmt: skip
     method = cv2.USAC_MAGSAC if options.ransac_method == "magsac" else cv2.FM_RANSAC
     cv2.setRNGSeed(12345)
     try:
@@ -570,6 +574,9 @@ def match_pair(
 
 
 _NEIGHBOURS = 8
+#: Median shift of the matches (full-resolution pixels) below which a pair is the same view
+#: twice (a copy, or a camera that did not move): no parallax, no tie points.
+NO_PARALLAX_PX = 0.5
 
 
 def _coherent(p: Array, d: Array, tol_px: float) -> NDArray[np.bool_]:
