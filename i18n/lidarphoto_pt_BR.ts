@@ -4096,8 +4096,9 @@ its slope is between alpha and beta (rejects vegetation and walls). Kept points 
 regions (distance to the region's plane and normal angle), small regions dropped, ridge and
 eave points attached to the nearest plane, coplanar neighbours merged. Each plane is fitted by
 the weighted eigen method of Pathak et al. (2010) on centred coordinates, with the full
-covariance of (a, b, c, d) and the standard deviation of d (Khoshelham 2016). The same input
-and seed give the same planes.</source>
+covariance of (a, b, c, d) and the standard deviation of d (Khoshelham 2016). The same points
+give the same planes whatever their order, the seed or the number of threads: the RANSAC
+triplets are a fixed set, not random draws.</source>
             <translation>Extrai planos de telhado de uma nuvem LiDAR classificada por um filtro de terreno (Pedrosa &amp;
 dos Santos 2020, seção 2.1): para cada ponto, RANSAC sobre os seus K vizinhos mais próximos com
 tolerância epsilon; o ponto é mantido quando o plano tem o suporte mínimo, o ponto está sobre
@@ -4106,7 +4107,9 @@ mantidos crescem em regiões (distância ao plano da região e ângulo da normal
 são descartadas, pontos de cumeeira e de beiral são ligados ao plano mais próximo e vizinhos
 coplanares são fundidos. Cada plano é ajustado pelo método de autovalores ponderado de Pathak
 et al. (2010) sobre coordenadas centradas, com a covariância completa de (a, b, c, d) e o
-desvio-padrão de d (Khoshelham 2016). A mesma entrada e a mesma semente dão os mesmos planos.</translation>
+desvio-padrão de d (Khoshelham 2016). Os mesmos pontos dão os mesmos planos qualquer que seja
+a sua ordem, a semente ou o número de threads: as triplas do RANSAC são um conjunto fixo, não
+sorteios aleatórios.</translation>
         </message>
         <message>
             <source>## Points
@@ -4238,6 +4241,10 @@ sem telhados dá zero planos e uma mensagem, não um erro.</translation>
         <message>
             <source>Random seed</source>
             <translation>Semente aleatória</translation>
+        </message>
+        <message>
+            <source>no effect, kept for scripts and models that give it: the RANSAC triplets are a fixed set, every seed gives the same planes</source>
+            <translation>sem efeito, mantido para scripts e modelos que o informam: as triplas do RANSAC são um conjunto fixo, qualquer semente dá os mesmos planos</translation>
         </message>
         <message>
             <source>Roof planes</source>
