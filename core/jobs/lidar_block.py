@@ -57,9 +57,11 @@ LOW_OUTLIER_RADIUS + 3 cells of its box, so its classes are those of a run on th
 (except a few points next to buildings within millimetres of the height tolerance: the DTM
 filled under objects depends on the tile's grid corner; 9 of 75 256 points in the tests); only
 the tile's own points are written. Roof planes are extracted on the tile plus twice the
-radius of a K_NEIGHBOURS patch; planes cut by a tile border are merged (same plane by the
-parameter test, adjacent points) and refitted with their covariance from all their points;
-control points and lines found by several tiles are kept once.
+reach of a point's label (its K_NEIGHBOURS patch and four rings of region-growing
+neighbours); planes cut by a tile border are merged when both tiles' region growing put the
+same points of the band along the border into them (never two planes one tile kept apart)
+and refitted with their covariance, so the block has the planes of a single run; control
+points and lines found by several tiles are kept once.
 
 A tile that cannot be read is reported by name and skipped; the rest finishes and the block
 is marked incomplete (report "complete": false, result COMPLETE 0, command-line exit
