@@ -4674,8 +4674,8 @@ SRCs diferentes são recusados. Os vizinhos são encontrados pelas caixas envolv
 LOW_OUTLIER_RADIUS + 3 cells of its box, so its classes are those of a run on the whole cloud
 (except a few points next to buildings within millimetres of the height tolerance: the DTM
 filled under objects depends on the tile's grid corner; 9 of 75 256 points in the tests); only
-the tile's own points are written. Roof planes are extracted on the tile plus twice the
-reach of a point's label (its K_NEIGHBOURS patch and four rings of region-growing
+the tile's own points are written. Roof planes are extracted on the tile plus three times
+the reach of a point's label (its K_NEIGHBOURS patch and four rings of region-growing
 neighbours); planes cut by a tile border are merged when both tiles' region growing put the
 same points of the band along the border into them (never two planes one tile kept apart)
 and refitted with their covariance, so the block has the planes of a single run; control
@@ -4684,7 +4684,7 @@ points and lines found by several tiles are kept once.</source>
 LOW_OUTLIER_RADIUS + 3 células da sua caixa, de modo que as suas classes são as de uma execução sobre a nuvem inteira
 (exceto alguns pontos junto a edificações a milímetros da tolerância de altura: o MDT
 preenchido sob os objetos depende do canto da grade do tile; 9 de 75 256 pontos nos testes); apenas
-os pontos do próprio tile são gravados. Os planos de telhado são extraídos no tile mais duas vezes o
+os pontos do próprio tile são gravados. Os planos de telhado são extraídos no tile mais três vezes o
 alcance do rótulo de um ponto (a sua vizinhança K_NEIGHBOURS e quatro anéis de vizinhos do crescimento
 de regiões); planos cortados por uma borda de tile são unidos quando o crescimento de regiões dos dois
 tiles põe neles os mesmos pontos da faixa ao longo da borda (nunca dois planos que um tile manteve

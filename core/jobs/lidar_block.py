@@ -56,8 +56,8 @@ Buffers: each tile is filtered with the points of its neighbours within 2 x SMRF
 LOW_OUTLIER_RADIUS + 3 cells of its box, so its classes are those of a run on the whole cloud
 (except a few points next to buildings within millimetres of the height tolerance: the DTM
 filled under objects depends on the tile's grid corner; 9 of 75 256 points in the tests); only
-the tile's own points are written. Roof planes are extracted on the tile plus twice the
-reach of a point's label (its K_NEIGHBOURS patch and four rings of region-growing
+the tile's own points are written. Roof planes are extracted on the tile plus three times
+the reach of a point's label (its K_NEIGHBOURS patch and four rings of region-growing
 neighbours); planes cut by a tile border are merged when both tiles' region growing put the
 same points of the band along the border into them (never two planes one tile kept apart)
 and refitted with their covariance, so the block has the planes of a single run; control

@@ -279,12 +279,12 @@ def extract_roof_planes(
     compiled = _use_numba(backend)
     order, grid = _spatial_order(xyz, origin, params.k_neighbours, compiled)
     q = grid.q
-    keep, normals, quality, knn, spacing = _local_planes(grid, params, backend, progress,
+    keep, normals, quality, knn, spacing_of = _local_planes(grid, params, backend, progress,
                                                          should_stop)  # fmt: skip
     del grid
     n_cand = int(keep.sum())
     log.info("local RANSAC kept %d of %d points (%.1f %%)", n_cand, n, 100.0 * n_cand / n)
-    labels = _grow(q, keep, normals, quality, knn, spacing, params, should_stop, compiled,
+    labels = _grow(q, keep, normals, quality, knn, spacing_of, params, should_stop, compiled,
                    origin)
     del normals, quality
     if progress is not None:
@@ -305,7 +305,7 @@ def extract_roof_planes(
     labels = _drop_small(labels, params.min_plane_points)
     if progress is not None:
         progress(0.9)
-    cell = params.outline_cell or spacing
+    cell = params.outline_cell or float(np.median(spacing_of))
     # points of the region's interior only: a point with a neighbour outside its plane is at a
     # ridge or an eave (where wall points attach), on one side of the plane
     interior = np.empty(n, dtype=bool)

@@ -280,10 +280,11 @@ def _local_planes(
     backend: str,
     progress: Progress,
     should_stop: ShouldStop,
-) -> tuple[NDArray[np.bool_], NDArray[np.float32], NDArray[np.float32], NDArray[np.int32], float]:
+) -> tuple[NDArray[np.bool_], NDArray[np.float32], NDArray[np.float32], NDArray[np.int32],
+           NDArray[np.float32]]:  # fmt: skip
     """Step 1 on the sorted points. Returns keep (N,), local normals (N,3), local rms of the
-    refined plane's inliers (N,), the first GROW_NEIGHBOURS neighbours (N, G) and the median
-    distance to the 4th neighbour."""
+    refined plane's inliers (N,), the first GROW_NEIGHBOURS neighbours (N, G) and the
+    distance of each point to its 4th neighbour (N,)."""
     q = grid.q
     n = len(q)
     k = min(params.k_neighbours, n)
@@ -326,8 +327,7 @@ def _local_planes(
             )
         if progress is not None:
             progress(0.7 * (bi + 1) / n_batches)
-    med = float(np.median(out["spacing"])) if n else 0.0
-    return out["keep"], out["normals"], out["quality"], out["knn"], med
+    return out["keep"], out["normals"], out["quality"], out["knn"], out["spacing"]
 
 
 def _use_numba(backend: str) -> bool:

@@ -22,8 +22,8 @@ from .roof_planes_local import Array, ShouldStop, _eig_normals
 if TYPE_CHECKING:
     from .roof_planes import RoofPlaneParams
 
-#: Seed voxel size, in point spacings (median distance to the 4th neighbour), rounded to a
-#: power of two.
+#: Seed voxel size, in point spacings (distance to the 4th neighbour, the median over the point
+#: and its GROW_NEIGHBOURS - 1 nearest), rounded to a power of two.
 SEED_VOXEL = 8.0
 #: Seeding rounds of the region growing.
 SEED_ROUNDS = 4
@@ -35,7 +35,7 @@ def _grow(
     normals: NDArray[np.float32],
     quality: NDArray[np.float32],
     knn: NDArray[np.int32],
-    spacing: float,
+    spacing: NDArray[np.float32],
     params: RoofPlaneParams,
     should_stop: ShouldStop,
     compiled: bool = False,
@@ -60,7 +60,7 @@ def _grow(
     n = len(q)
     labels = np.full(n, -1, dtype=np.int64)
     good = keep & (quality < 0.5 * params.epsilon)
-    voxel = 2.0 ** round(math.log2(max(SEED_VOXEL * spacing, 1e-9)))
+    level = _voxel_level(spacing, knn, good)
     shift = np.zeros(3) if origin is None else np.asarray(origin, dtype=np.float64)
     cos_tol = math.cos(math.radians(params.angle_tolerance_deg))
     min_fit = 2 * params.k_neighbours  # below this the seed's local plane is the better one
@@ -71,13 +71,13 @@ def _grow(
         cand_seed = np.flatnonzero(good & (labels < 0))
         if not len(cand_seed):
             break
-        key3 = np.floor((q[cand_seed] + shift) / voxel).astype(np.int64)
-        key3 -= key3.min(axis=0)
-        dims = key3.max(axis=0) + 1
-        key = (key3[:, 0] * dims[1] + key3[:, 1]) * dims[2] + key3[:, 2]
-        order = np.lexsort((cand_seed, quality[cand_seed], key))
+        lev = level[cand_seed]
+        key3 = np.floor((q[cand_seed] + shift) / np.ldexp(1.0, lev)[:, None]).astype(np.int64)
+        order = np.lexsort((cand_seed, quality[cand_seed], key3[:, 2], key3[:, 1], key3[:, 0],
+                            lev))  # fmt: skip
+        key = np.column_stack([lev, key3])[order]
         first = np.ones(len(order), dtype=bool)
-        first[1:] = key[order][1:] != key[order][:-1]
+        first[1:] = (key[1:] != key[:-1]).any(axis=1)
         seeds = np.sort(cand_seed[order[first]])
         base = len(reg_n)
         n_new = len(seeds)
@@ -128,6 +128,25 @@ def _grow(
             reg_n[base + grown] = _eig_normals(cov)
             reg_c[base + grown] = origin[grown] + mean
     return labels
+
+
+def _voxel_level(
+    spacing: NDArray[np.float32], knn: NDArray[np.int32], good: NDArray[np.bool_]
+) -> NDArray[np.int64]:
+    """Per point (of ``good`` ones; 0 elsewhere): the seed voxel's size as a power of two,
+    ``2 ** level`` = SEED_VOXEL x the local spacing (the lower median of the 4th-neighbour
+    distances of the point and its nearest neighbours). Local, so that a tile and the whole
+    file give a point the same voxel (a median over the cloud gave tiles of another density
+    voxels twice as large, and other seeds, far from any border)."""
+    level = np.zeros(len(spacing), dtype=np.int64)
+    idx = np.flatnonzero(good)
+    g = knn.shape[1]
+    for lo in range(0, len(idx), 1 << 20):  # (B, G) spacings in slices: bounded memory
+        part = idx[lo : lo + (1 << 20)]
+        local = np.partition(spacing[knn[part]], (g - 1) // 2, axis=1)[:, (g - 1) // 2]
+        size = SEED_VOXEL * np.maximum(local.astype(np.float64), 1e-9)
+        level[part] = np.round(np.log2(size)).astype(np.int64)
+    return level
 
 
 def _claims(
