@@ -3,8 +3,9 @@ grid cell, their K nearest neighbours and the local RANSAC on a fixed set of tri
 (the compiled back end is :mod:`core.lidar.roof_planes_numba`); the eigen-solvers shared by
 both.
 
-Nothing here depends on a random draw or on the order of the input points: the triplets are
-the same for every point (:func:`triplets`), the points are sorted by cell and, within a cell,
+Nothing here depends on a random draw or on the order of the input points: each point tries
+one of a fixed set of triplet tables (:func:`triplets`), chosen by a hash of its coordinates
+(:func:`table_of`), the points are sorted by cell and, within a cell,
 by their coordinates, and the neighbours of a point are the K nearest with ties broken by that
 order. A tile that holds a point's K neighbours gives it the local plane of the whole file.
 """
@@ -102,6 +103,11 @@ class PointGrid:
     cell: float
     offsets: NDArray[np.int64]
     bound2: Array
+    table: NDArray[np.int64]
+
+
+#: Triplet tables; each point tries the one its coordinates pick (:func:`table_of`).
+TRIPLET_TABLES = 256
 
 
 def _spatial_order(
@@ -147,39 +153,58 @@ def _spatial_order(
     bound = np.hypot(np.maximum(np.abs(gx) - 1, 0), np.maximum(np.abs(gy) - 1, 0)) * cell
     o = np.lexsort((np.abs(gx) + np.abs(gy), bound))
     q = xyz[order]
+    table = table_of(q)
     q -= origin
     grid = PointGrid(
         q, key[order], start, nx, ny, float(x0), float(y0),
-        cell, np.column_stack([gx[o], gy[o]]).astype(np.int64), bound[o] ** 2,
+        cell, np.column_stack([gx[o], gy[o]]).astype(np.int64), bound[o] ** 2, table,
     )  # fmt: skip
     return order, grid
 
 
-def triplets(k: int, t: int) -> NDArray[np.int64]:
-    """The ``t`` triplets (t, 3) of neighbour ranks in [0, k) that the local RANSAC tries for
-    every point: distinct ranks, spread like uniform draws, from a fixed integer hash
-    (SplitMix64), so the same on any run, machine and numpy version. A point's planes depend
-    on its neighbours only, never on a seed or on the batch it is computed in.
+def _mix(z: Any) -> Any:
+    """SplitMix64's finaliser of a Python int or a uint64 array (which wraps modulo 2**64)."""
+    wrap = (lambda v: v & 0xFFFFFFFFFFFFFFFF) if isinstance(z, int) else (lambda v: v)
+    z = wrap((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9)
+    z = wrap((z ^ (z >> 27)) * 0x94D049BB133111EB)
+    return z ^ (z >> 31)
 
-    >>> triplets(20, 3).tolist()
-    [[1, 18, 0], [1, 19, 0], [12, 18, 11]]
+
+def triplets(k: int, t: int) -> NDArray[np.int64]:
+    """The :data:`TRIPLET_TABLES` tables (M, t, 3) of ``t`` triplets of neighbour ranks in
+    [0, k) that the local RANSAC tries: distinct ranks, spread like uniform draws, from a fixed
+    integer hash (SplitMix64), so the same on any run, machine and numpy version. One table
+    for every point tried tables of their own: the LCPs of the AHN3 crop varied from 72 to 81
+    with the table; a table per point, picked by its coordinates, averages that out as random
+    draws did, and a point's planes still depend on its neighbours only.
+
+    >>> triplets(20, 2)[0].tolist()
+    [[1, 18, 0], [1, 19, 0]]
     """
     mask = (1 << 64) - 1
     state = 0x9E3779B97F4A7C15 * (k + 1) & mask
-    out = np.empty((t, 3), dtype=np.int64)
-    for row in range(t):
+    out = np.empty((TRIPLET_TABLES, t, 3), dtype=np.int64)
+    for row in range(TRIPLET_TABLES * t):
         picked: list[int] = []
         while len(picked) < min(3, k):
             state = (state + 0x9E3779B97F4A7C15) & mask
-            z = state
-            z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & mask
-            z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & mask
-            z ^= z >> 31
-            r = z % k
+            r = _mix(state) % k
             if r not in picked:
                 picked.append(r)
-        out[row] = (picked * 3)[:3]
+        out[row // t, row % t] = (picked * 3)[:3]
     return out
+
+
+def table_of(xyz: Array) -> NDArray[np.int64]:
+    """The triplet table (0 .. TRIPLET_TABLES - 1) of each point (N,), from the bits of its map
+    coordinates (N, 3) float64: the same for the point in any tile, order or run."""
+    bits = np.ascontiguousarray(xyz, dtype=np.float64).view(np.uint64)
+    with np.errstate(over="ignore"):
+        h = bits[:, 0] * np.uint64(0x9E3779B97F4A7C15)
+        h ^= bits[:, 1] * np.uint64(0xC2B2AE3D27D4EB4F)
+        h ^= bits[:, 2] * np.uint64(0x165667B19E3779F9)
+        h = _mix(h)
+    return (h % np.uint64(TRIPLET_TABLES)).astype(np.int64)
 
 
 def _knn_numpy(tree: Any, q: Array, lo: int, hi: int, k: int) -> tuple[Array, NDArray]:
@@ -211,10 +236,9 @@ def _ransac_numpy(
     pts: NDArray[np.float32], tri: NDArray[np.int64], params: RoofPlaneParams
 ) -> tuple[NDArray[np.bool_], NDArray[np.float32], NDArray[np.float32]]:
     """The local RANSAC of a batch (the compiled back end's operations, vectorised): pts
-    (B, K, 3) float32 relative to each query point, tri (T, 3) the triplets of every point.
+    (B, K, 3) float32 relative to each query point, tri (B, T, 3) the triplets of each point.
     Returns keep, normals (B, 3), quality (B,)."""
     b, k, _ = pts.shape
-    tri = np.broadcast_to(tri, (b, *tri.shape))
     eps = np.float32(params.epsilon)
     rows = np.arange(b)[:, None]
     px, py, pz = pts[..., 0], pts[..., 1], pts[..., 2]
@@ -321,7 +345,7 @@ def _local_planes(
             out["knn"][lo:hi] = idx[:, :g]
             out["spacing"][lo:hi] = np.sqrt(d2[:, min(4, k - 1)])
             pts = (q[idx] - q[lo:hi, None, :]).astype(np.float32)
-            keep, normals, quality = _ransac_numpy(pts, tri, params)
+            keep, normals, quality = _ransac_numpy(pts, tri[grid.table[lo:hi]], params)
             out["keep"][lo:hi], out["normals"][lo:hi], out["quality"][lo:hi] = (
                 keep, normals, quality
             )

@@ -93,8 +93,8 @@ def _plane_dist(q, i, centre, normal, c):
 
 
 def _local_planes_kernel(
-    qs, cell_of, start, nx, ny, x0, y0, h, offs, bound2, lo, hi, k, g, tri, eps, min_support,
-    cos_lo, cos_hi, keep, normals, quality, knn, spacing,
+    qs, cell_of, start, nx, ny, x0, y0, h, offs, bound2, lo, hi, k, g, tri, table, eps,
+    min_support, cos_lo, cos_hi, keep, normals, quality, knn, spacing,
 ):  # fmt: skip
     """Points lo .. hi-1 of ``qs`` (sorted by grid cell): K nearest neighbours and the local
     RANSAC; outputs at [i - lo] (keep, normals, quality, knn (first g), spacing)."""
@@ -105,7 +105,7 @@ def _local_planes_kernel(
     py32 = np.empty(k, np.float32)
     pz32 = np.empty(k, np.float32)
     inl = np.empty(k, np.bool_)
-    nt = tri.shape[0]
+    nt = tri.shape[1]
     eps32 = np.float32(eps)
     tiny32 = np.float32(1e-12)
     # the k-th distance of the last points: a point's k-th distance is at most another's
@@ -200,9 +200,9 @@ def _local_planes_kernel(
         bnz = np.float32(0.0)
         boff = np.float32(0.0)
         for t in range(nt):
-            a0 = tri[t, 0]
-            a1 = tri[t, 1]
-            a2 = tri[t, 2]
+            a0 = tri[table[i], t, 0]
+            a1 = tri[table[i], t, 1]
+            a2 = tri[table[i], t, 2]
             ax, ay, az = px32[a0], py32[a0], pz32[a0]
             ux = px32[a1] - ax
             uy = py32[a1] - ay
@@ -511,7 +511,7 @@ def local_planes(
         raise RuntimeError("numba is not installed")
     _compiled("local_planes")(
         grid.q, grid.cell_of, grid.start, grid.nx, grid.ny, grid.x0, grid.y0, grid.cell,
-        grid.offsets, grid.bound2, lo, hi, k, g, tri, float(eps), int(min_support),
+        grid.offsets, grid.bound2, lo, hi, k, g, tri, grid.table, float(eps), int(min_support),
         float(cos_lo), float(cos_hi), out["keep"][lo:hi], out["normals"][lo:hi],
         out["quality"][lo:hi], out["knn"][lo:hi], out["spacing"][lo:hi],
     )  # fmt: skip
