@@ -4120,8 +4120,9 @@ its slope is between alpha and beta (rejects vegetation and walls). Kept points 
 regions (distance to the region's plane and normal angle), small regions dropped, ridge and
 eave points attached to the nearest plane, coplanar neighbours merged. Each plane is fitted by
 the weighted eigen method of Pathak et al. (2010) on centred coordinates, with the full
-covariance of (a, b, c, d) and the standard deviation of d (Khoshelham 2016). The same input
-and seed give the same planes.</source>
+covariance of (a, b, c, d) and the standard deviation of d (Khoshelham 2016). The same points
+give the same planes whatever their order, the seed or the number of threads: the RANSAC
+triplets are a fixed set, not random draws.</source>
             <translation>Extrai planos de telhado de uma nuvem LiDAR classificada por um filtro de terreno (Pedrosa &amp;
 dos Santos 2020, seção 2.1): para cada ponto, RANSAC sobre os seus K vizinhos mais próximos com
 tolerância epsilon; o ponto é mantido quando o plano tem o suporte mínimo, o ponto está sobre
@@ -4130,7 +4131,9 @@ mantidos crescem em regiões (distância ao plano da região e ângulo da normal
 são descartadas, pontos de cumeeira e de beiral são ligados ao plano mais próximo e vizinhos
 coplanares são fundidos. Cada plano é ajustado pelo método de autovalores ponderado de Pathak
 et al. (2010) sobre coordenadas centradas, com a covariância completa de (a, b, c, d) e o
-desvio-padrão de d (Khoshelham 2016). A mesma entrada e a mesma semente dão os mesmos planos.</translation>
+desvio-padrão de d (Khoshelham 2016). Os mesmos pontos dão os mesmos planos qualquer que seja
+a sua ordem, a semente ou o número de threads: as triplas do RANSAC são um conjunto fixo, não
+sorteios aleatórios.</translation>
         </message>
         <message>
             <source>## Points
@@ -4262,6 +4265,10 @@ sem telhados dá zero planos e uma mensagem, não um erro.</translation>
         <message>
             <source>Random seed</source>
             <translation>Semente aleatória</translation>
+        </message>
+        <message>
+            <source>no effect, kept for scripts and models that give it: the RANSAC triplets are a fixed set, every seed gives the same planes</source>
+            <translation>sem efeito, mantido para scripts e modelos que o informam: as triplas do RANSAC são um conjunto fixo, qualquer semente dá os mesmos planos</translation>
         </message>
         <message>
             <source>Roof planes</source>
@@ -4691,17 +4698,21 @@ SRCs diferentes são recusados. Os vizinhos são encontrados pelas caixas envolv
 LOW_OUTLIER_RADIUS + 3 cells of its box, so its classes are those of a run on the whole cloud
 (except a few points next to buildings within millimetres of the height tolerance: the DTM
 filled under objects depends on the tile's grid corner; 9 of 75 256 points in the tests); only
-the tile's own points are written. Roof planes are extracted on the tile plus twice the
-radius of a K_NEIGHBOURS patch; planes cut by a tile border are merged (same plane by the
-parameter test, adjacent points) and refitted with their covariance from all their points;
-control points and lines found by several tiles are kept once.</source>
+the tile's own points are written. Roof planes are extracted on the tile plus three times
+the reach of a point's label (its K_NEIGHBOURS patch and four rings of region-growing
+neighbours); planes cut by a tile border are merged when both tiles' region growing put the
+same points of the band along the border into them (never two planes one tile kept apart)
+and refitted with their covariance, so the block has the planes of a single run; control
+points and lines found by several tiles are kept once.</source>
             <translation>Buffers: cada tile é filtrado com os pontos dos seus vizinhos a até 2 x SMRF_WINDOW +
 LOW_OUTLIER_RADIUS + 3 células da sua caixa, de modo que as suas classes são as de uma execução sobre a nuvem inteira
 (exceto alguns pontos junto a edificações a milímetros da tolerância de altura: o MDT
 preenchido sob os objetos depende do canto da grade do tile; 9 de 75 256 pontos nos testes); apenas
-os pontos do próprio tile são gravados. Os planos de telhado são extraídos no tile mais duas vezes o
-raio de uma vizinhança K_NEIGHBOURS; planos cortados por uma borda de tile são unidos (mesmo plano pelo
-teste de parâmetros, pontos adjacentes) e reajustados com a sua covariância a partir de todos os seus pontos;
+os pontos do próprio tile são gravados. Os planos de telhado são extraídos no tile mais três vezes o
+alcance do rótulo de um ponto (a sua vizinhança K_NEIGHBOURS e quatro anéis de vizinhos do crescimento
+de regiões); planos cortados por uma borda de tile são unidos quando o crescimento de regiões dos dois
+tiles põe neles os mesmos pontos da faixa ao longo da borda (nunca dois planos que um tile manteve
+separados) e reajustados com a sua covariância, de modo que o bloco tem os planos de uma execução única;
 pontos e linhas de controle encontrados por vários tiles são mantidos uma única vez.</translation>
         </message>
         <message>

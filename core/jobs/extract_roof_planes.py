@@ -41,6 +41,9 @@ _NUMBERS = (
      0.0, 1000.0, True),
     ("SEED", "seed", "Random seed", "integer", "", 0, 2**32 - 1, True),
 )  # fmt: skip
+#: Help of the parameters that need one.
+_HELP = {"SEED": "no effect, kept for scripts and models that give it: the RANSAC triplets "
+                 "are a fixed set, every seed gives the same planes"}
 _LENGTHS = ("epsilon", "outline_cell")
 #: Bytes per RANSAC sample (point x triplet) of a batch: the float32 distances, their
 #: product and the inlier flags (about 10 B; rounded up).
@@ -60,8 +63,9 @@ its slope is between alpha and beta (rejects vegetation and walls). Kept points 
 regions (distance to the region's plane and normal angle), small regions dropped, ridge and
 eave points attached to the nearest plane, coplanar neighbours merged. Each plane is fitted by
 the weighted eigen method of Pathak et al. (2010) on centred coordinates, with the full
-covariance of (a, b, c, d) and the standard deviation of d (Khoshelham 2016). The same input
-and seed give the same planes.
+covariance of (a, b, c, d) and the standard deviation of d (Khoshelham 2016). The same points
+give the same planes whatever their order, the seed or the number of threads: the RANSAC
+triplets are a fixed set, not random draws.
 
 ## Points
 Non-ground (class != 2), the listed Classes (e.g. 6), or all points (a cloud that is already
@@ -88,7 +92,7 @@ error.""",
               help="LAS classes searched when POINTS is classes, e.g. 6 or 1,6"),
         *(
             Param(key, kind, label, getattr(_D, field), unit=unit, minimum=minimum,
-                  maximum=maximum, advanced=advanced)
+                  maximum=maximum, advanced=advanced, help=_HELP.get(key, ""))
             for key, field, label, kind, unit, minimum, maximum, advanced in _NUMBERS
         ),
         Param("OUTPUT", "sink", "Roof planes", geometry="polygon", optional=True),

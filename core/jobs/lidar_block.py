@@ -67,10 +67,12 @@ Buffers: each tile is filtered with the points of its neighbours within 2 x SMRF
 LOW_OUTLIER_RADIUS + 3 cells of its box, so its classes are those of a run on the whole cloud
 (except a few points next to buildings within millimetres of the height tolerance: the DTM
 filled under objects depends on the tile's grid corner; 9 of 75 256 points in the tests); only
-the tile's own points are written. Roof planes are extracted on the tile plus twice the
-radius of a K_NEIGHBOURS patch; planes cut by a tile border are merged (same plane by the
-parameter test, adjacent points) and refitted with their covariance from all their points;
-control points and lines found by several tiles are kept once.
+the tile's own points are written. Roof planes are extracted on the tile plus three times
+the reach of a point's label (its K_NEIGHBOURS patch and four rings of region-growing
+neighbours); planes cut by a tile border are merged when both tiles' region growing put the
+same points of the band along the border into them (never two planes one tile kept apart)
+and refitted with their covariance, so the block has the planes of a single run; control
+points and lines found by several tiles are kept once.
 
 A tile that cannot be read is reported by name and skipped; the rest finishes and the block
 is marked incomplete (report "complete": false, result COMPLETE 0, command-line exit
@@ -181,6 +183,7 @@ class TileOutcome:
     ids_digest: tuple[int, int, int] = (0, 0, 0)
     stages: dict[str, float] = field(default_factory=dict)
     n_decoded: int = 0
+    band: Any = None  # the roof-plane labels along the border (lidar.block.BandLabels)
 
 
 def _peak_rss_mb() -> float:
@@ -197,14 +200,13 @@ def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOu
     points, find the roof planes around it; the planes' pieces on its core go back."""
     from ..io.pointcloud import write_cloud
     from ..io.tiles import read_buffered
-    from ..lidar.block import PlanePiece
+    from ..lidar.block import tile_planes
     from ..lidar.ground_filter import (
         GROUND_CLASS,
         LOW_NOISE_CLASS,
         UNCLASSIFIED_CLASS,
         ground_filter,
     )
-    from ..lidar.roof_planes import extract_roof_planes
 
     t0 = time.perf_counter()
     c0 = time.process_time()  # the worker's CPU (its decoder threads too): load-independent
@@ -251,16 +253,9 @@ def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOu
     near = ((a["x"] >= own[0] - r) & (a["x"] <= own[2] + r) & (a["y"] >= own[1] - r)
             & (a["y"] <= own[3] + r))  # fmt: skip
     near &= (cls != GROUND_CLASS) & (cls != LOW_NOISE_CLASS)
-    pieces = []
-    if near.sum() >= settings.roof.min_plane_points:
-        roofs = extract_roof_planes(xyz[near], settings.roof)
-        label = np.full(len(core), -1, np.int32)
-        label[near] = roofs.plane_id
-        core_label = label[:n_core]
-        for plane in roofs.planes:
-            pts = xyz[:n_core][core_label == plane.id]
-            if len(pts) >= 3:  # a plane only in the buffer belongs to the neighbour
-                pieces.append(PlanePiece(i, plane, pts))
+    # the band next to the border, where the tile labels as a whole-file run would
+    pieces, band = tile_planes(xyz[near], core[near], a["id"][near], own, r / 2.0,
+                               settings.roof, i)  # fmt: skip
     stages["roof_planes"] = time.perf_counter() - t0 - sum(stages.values())
     stages["cpu"] = time.process_time() - c0
     ids = a["id"][:n_core]
@@ -270,7 +265,7 @@ def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOu
         int(low[:n_core].sum()), time.perf_counter() - t0, _peak_rss_mb(), buf.missing,
         (*cx.min(axis=0).tolist(), *cx.max(axis=0).tolist()), f"tiles/{name}", pieces,
         (int(ids.min()), int(ids.max()), int(ids.sum())),
-        {k: round(t, 3) for k, t in stages.items()}, buf.decoded,
+        {k: round(t, 3) for k, t in stages.items()}, buf.decoded, band,
     )  # fmt: skip
 
 
@@ -385,11 +380,12 @@ def run_block(
                for i in range(len(index.tiles))]  # fmt: skip
     outcomes: list[TileOutcome] = gather(client, futures, progress, should_stop, 0.0, 0.85)
     t_tiles = time.perf_counter() - t0
-    pieces = [p for o in outcomes if o.ok for p in o.pieces]
-    roof = settings.roof
-    spacing = settings.roof_buffer / (2.0 * math.sqrt(roof.k_neighbours / math.pi))
-    merged = merge_cut_planes(pieces, roof.angle_tolerance_deg, roof.epsilon,
-                              max(3.0 * spacing, roof.epsilon))  # fmt: skip
+    pieces, bands = [], []
+    for o in outcomes:
+        if o.ok and o.band is not None:
+            bands.append(o.band.shifted(len(pieces)))
+        pieces += o.pieces if o.ok else []
+    merged = merge_cut_planes(pieces, bands)
     planes = [m.plane for m in merged]
     # control around each tile: planes whose points come within the control reach of it
     reach = settings.control.delta + settings.control.max_support_distance

@@ -95,8 +95,8 @@ def _plane_dist(q, i, centre, normal, c):
 
 
 def _local_planes_kernel(
-    qs, cell_of, start, nx, ny, x0, y0, h, offs, bound2, lo, hi, k, g, tri, eps, min_support,
-    cos_lo, cos_hi, keep, normals, quality, knn, spacing,
+    qs, cell_of, start, nx, ny, x0, y0, h, offs, bound2, lo, hi, k, g, tri, table, eps,
+    min_support, cos_lo, cos_hi, keep, normals, quality, knn, spacing,
 ):  # fmt: skip
     """Points lo .. hi-1 of ``qs`` (sorted by grid cell): K nearest neighbours and the local
     RANSAC; outputs at [i - lo] (keep, normals, quality, knn (first g), spacing)."""
@@ -202,9 +202,9 @@ def _local_planes_kernel(
         bnz = np.float32(0.0)
         boff = np.float32(0.0)
         for t in range(nt):
-            a0 = tri[r, t, 0]
-            a1 = tri[r, t, 1]
-            a2 = tri[r, t, 2]
+            a0 = tri[table[i], t, 0]
+            a1 = tri[table[i], t, 1]
+            a2 = tri[table[i], t, 2]
             ax, ay, az = px32[a0], py32[a0], pz32[a0]
             ux = px32[a1] - ax
             uy = py32[a1] - ay
@@ -421,9 +421,10 @@ def _pairs_kernel(labels, knn, nl, out):
     return m
 
 
-def _order_kernel(key, nbins, start, order):
-    """Counting sort: ``order`` lists the indices by key, in index order within a key (what
-    numpy's stable argsort gives); ``start`` (nbins + 1) the first position of each key."""
+def _order_kernel(key, nbins, xyz, start, order):
+    """Counting sort: ``order`` lists the indices by key, and within a key by x, then y, then
+    z, then index (numpy's lexsort of (z, y, x, key)); ``start`` (nbins + 1) the first
+    position of each key. A cell holds a few points: insertion sort."""
     for i in range(key.shape[0]):
         start[key[i] + 1] += 1
     for b in range(nbins):
@@ -432,6 +433,19 @@ def _order_kernel(key, nbins, start, order):
     for i in range(key.shape[0]):
         order[fill[key[i]]] = i
         fill[key[i]] += 1
+    for b in range(nbins):
+        for u in range(start[b] + 1, start[b + 1]):
+            i = order[u]
+            t = u
+            while t > start[b]:
+                j = order[t - 1]
+                if xyz[j, 0] < xyz[i, 0] or (xyz[j, 0] == xyz[i, 0] and (
+                        xyz[j, 1] < xyz[i, 1] or (xyz[j, 1] == xyz[i, 1]
+                                                  and xyz[j, 2] <= xyz[i, 2]))):
+                    break
+                order[t] = j
+                t -= 1
+            order[t] = i
 
 
 def _moments_kernel(q, labels, nl, counts, centroid, cov):
@@ -499,7 +513,7 @@ def local_planes(
         raise RuntimeError("numba is not installed")
     _compiled("local_planes")(
         grid.q, grid.cell_of, grid.start, grid.nx, grid.ny, grid.x0, grid.y0, grid.cell,
-        grid.offsets, grid.bound2, lo, hi, k, g, tri, float(eps), int(min_support),
+        grid.offsets, grid.bound2, lo, hi, k, g, tri, grid.table, float(eps), int(min_support),
         float(cos_lo), float(cos_hi), out["keep"][lo:hi], out["normals"][lo:hi],
         out["quality"][lo:hi], out["knn"][lo:hi], out["spacing"][lo:hi],
     )  # fmt: skip
@@ -537,11 +551,15 @@ def label_pairs(labels: np.ndarray, knn: np.ndarray, nl: int) -> np.ndarray:
     return np.unique(out[:m])
 
 
-def counting_order(key: np.ndarray, nbins: int) -> tuple[np.ndarray, np.ndarray]:
-    """(order, start) of a counting sort of ``key`` in [0, nbins): numpy's stable argsort."""
+def counting_order(
+    key: np.ndarray, nbins: int, xyz: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """(order, start) of a counting sort of ``key`` in [0, nbins), each key's points by their
+    coordinates ``xyz`` (N, 3): numpy's lexsort of (z, y, x, key)."""
     start = np.zeros(nbins + 1, dtype=np.int64)
     order = np.empty(len(key), dtype=np.int64)
-    _compiled("order")(key.astype(np.int64, copy=False), int(nbins), start, order)
+    _compiled("order")(key.astype(np.int64, copy=False), int(nbins),
+                       np.ascontiguousarray(xyz, dtype=np.float64), start, order)  # fmt: skip
     return order, start
 
 
