@@ -78,6 +78,46 @@ def _correlation_table(names: Sequence[str], corr: np.ndarray, n_ap: int) -> str
             f"</tr></thead><tbody>{''.join(body)}</tbody></table></div>")  # fmt: skip
 
 
+def _residual_parts(cal: TlsCalibration) -> list[str]:
+    """The residuals section: the RMS per component and the ten largest |w|."""
+    v = cal.residuals[~cal.rejected]
+    rms = np.sqrt(np.nanmean(v**2, axis=0)) if v.size else np.full(3, np.nan)
+    out = [
+        f"<h2>{t('Residuals')}</h2>",
+        _table(
+            [t("component"), "RMS", t("unit")],
+            [
+                (t("range"), _n(rms[0] * 1000, 3), "mm"),
+                (t("horizontal direction"), _n(rms[1] / ARCSEC, 2), t("arc-seconds")),
+                (t("vertical angle"), _n(rms[2] / ARCSEC, 2), t("arc-seconds")),
+            ],
+        ),
+    ]
+    w = np.nan_to_num(np.abs(cal.w), nan=0.0).max(axis=1)
+    worst = np.argsort(-w)[:10]
+    obs = cal.observations
+    out.append(
+        _table(
+            [t("station / target"), t("row"), t("v range mm"), 'v hz "', 'v vt "', "max |w|",
+             t("rejected")],
+            [
+                (
+                    _e(f"{obs.station[k]} / {obs.target[k]}"),
+                    str(int(obs.rows[k])),
+                    _n(cal.residuals[k, 0] * 1000, 3),
+                    _n(cal.residuals[k, 1] / ARCSEC, 2),
+                    _n(cal.residuals[k, 2] / ARCSEC, 2),
+                    _n(w[k], 2),
+                    t("yes") if cal.rejected[k] else t("no"),
+                )
+                for k in worst
+            ],
+            ["fail" if cal.rejected[k] else "" for k in worst],
+        )
+    )
+    return out
+
+
 def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
     """The report page of a calibration (str, UTF-8 HTML)."""
     adj = cal.adjustment
@@ -214,41 +254,7 @@ def render_tls_html(cal: TlsCalibration, settings: Mapping[str, str]) -> str:
                 ],
             ),
         ]
-    v = cal.residuals[~cal.rejected]
-    rms = np.sqrt(np.nanmean(v**2, axis=0)) if v.size else np.full(3, np.nan)
-    out += [
-        f"<h2>{t('Residuals')}</h2>",
-        _table(
-            [t("component"), "RMS", t("unit")],
-            [
-                (t("range"), _n(rms[0] * 1000, 3), "mm"),
-                (t("horizontal direction"), _n(rms[1] / ARCSEC, 2), t("arc-seconds")),
-                (t("vertical angle"), _n(rms[2] / ARCSEC, 2), t("arc-seconds")),
-            ],
-        ),
-    ]
-    w = np.nan_to_num(np.abs(cal.w), nan=0.0).max(axis=1)
-    worst = np.argsort(-w)[:10]
-    obs = cal.observations
-    out.append(
-        _table(
-            [t("station / target"), t("row"), t("v range mm"), 'v hz "', 'v vt "', "max |w|",
-             t("rejected")],
-            [
-                (
-                    _e(f"{obs.station[k]} / {obs.target[k]}"),
-                    str(int(obs.rows[k])),
-                    _n(cal.residuals[k, 0] * 1000, 3),
-                    _n(cal.residuals[k, 1] / ARCSEC, 2),
-                    _n(cal.residuals[k, 2] / ARCSEC, 2),
-                    _n(w[k], 2),
-                    t("yes") if cal.rejected[k] else t("no"),
-                )
-                for k in worst
-            ],
-            ["fail" if cal.rejected[k] else "" for k in worst],
-        )
-    )
+    out += _residual_parts(cal)
     if adj.warnings:
         out.append(f"<h2>{t('Warnings')}</h2><ul>"
                    + "".join(f"<li>{_e(t(x))}</li>" for x in adj.warnings) + "</ul>")  # fmt: skip
