@@ -110,7 +110,7 @@ COMPRESSIONS = ("deflate", "zstd", "lzw", "jpeg", "none")
 
 
 def compression_param() -> Param:
-    """COMPRESSION of an image output (:class:`~lidarphoto.core.io.raster_write.GeoTiffWriter`)."""
+    """COMPRESSION of an image output (:class:`~lidarphoto.core.io.raster.GeoTiffWriter`)."""
     return Param("COMPRESSION", "enum", "GeoTIFF compression", COMPRESSIONS[0],
                  options=COMPRESSIONS, advanced=True,
                  labels=("DEFLATE (lossless, level 1: fast)", "ZSTD (lossless, level 1)",

@@ -174,6 +174,34 @@ def _summary(report: AccuracyReport) -> str:
     return _table(head, rows)
 
 
+def _plot_parts(report: AccuracyReport) -> list[str]:
+    """The plots section: the vector map, then the histograms and Q-Q plots of dE, dN, dH."""
+    pts, d, used = report.points, report.discrepancies, report.used
+    parts: list[str] = []
+    parts.append(f'<h2>{t("Plots")}</h2><div class="plots">')
+    labels = list(pts.ids)
+    parts.append(
+        vector_map(
+            pts.reference[:, 0],
+            pts.reference[:, 1],
+            d[:, 0],
+            d[:, 1],
+            d[:, 2],
+            labels,
+            report.outliers.any,
+        )
+    )
+    parts.append('</div><div class="plots">')
+    for k, c in enumerate("ENH"):
+        title = t("Histogram of {}").format(f"d{c}")
+        parts.append(histogram(d[used, k], title=title, xlabel=f"d{c} (m)"))
+    parts.append('</div><div class="plots">')
+    for k, c in enumerate("ENH"):
+        parts.append(qq_plot(d[used, k], title=t("Normal Q-Q plot of {}").format(f"d{c}")))
+    parts.append("</div>")
+    return parts
+
+
 def render_html(report: AccuracyReport) -> str:
     """The report as one HTML document (UTF-8 text)."""
     pts = report.points
@@ -247,27 +275,7 @@ def render_html(report: AccuracyReport) -> str:
         )
         + "</p>"
     )
-    parts.append(f'<h2>{t("Plots")}</h2><div class="plots">')
-    labels = list(pts.ids)
-    parts.append(
-        vector_map(
-            pts.reference[:, 0],
-            pts.reference[:, 1],
-            d[:, 0],
-            d[:, 1],
-            d[:, 2],
-            labels,
-            report.outliers.any,
-        )
-    )
-    parts.append('</div><div class="plots">')
-    for k, c in enumerate("ENH"):
-        title = t("Histogram of {}").format(f"d{c}")
-        parts.append(histogram(d[used, k], title=title, xlabel=f"d{c} (m)"))
-    parts.append('</div><div class="plots">')
-    for k, c in enumerate("ENH"):
-        parts.append(qq_plot(d[used, k], title=t("Normal Q-Q plot of {}").format(f"d{c}")))
-    parts.append("</div>")
+    parts.extend(_plot_parts(report))
     parts.append(f"<h2>{t('Check points')}</h2>")
     rows, css = [], []
     for k in range(len(pts)):

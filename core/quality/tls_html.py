@@ -81,6 +81,46 @@ def _correlation_table(names: Sequence[str], corr: np.ndarray, n_ap: int) -> str
             f"</tr></thead><tbody>{''.join(body)}</tbody></table></div>")  # fmt: skip
 
 
+def _residual_parts(cal: TlsCalibration) -> list[str]:
+    """The residuals section: the RMS per component and the ten largest |w|."""
+    v = cal.residuals[~cal.rejected]
+    rms = np.sqrt(np.nanmean(v**2, axis=0)) if v.size else np.full(3, np.nan)
+    out = [
+        f"<h2>{t('Residuals')}</h2>",
+        _table(
+            [t("component"), "RMS", t("unit")],
+            [
+                (t("range"), _n(rms[0] * 1000, 3), "mm"),
+                (t("horizontal direction"), _n(rms[1] / ARCSEC, 2), t("arc-seconds")),
+                (t("vertical angle"), _n(rms[2] / ARCSEC, 2), t("arc-seconds")),
+            ],
+        ),
+    ]
+    w = np.nan_to_num(np.abs(cal.w), nan=0.0).max(axis=1)
+    worst = np.argsort(-w)[:10]
+    obs = cal.observations
+    out.append(
+        _table(
+            [t("station / target"), t("row"), t("v range mm"), 'v hz "', 'v vt "', "max |w|",
+             t("rejected")],
+            [
+                (
+                    _e(f"{obs.station[k]} / {obs.target[k]}"),
+                    str(int(obs.rows[k])),
+                    _n(cal.residuals[k, 0] * 1000, 3),
+                    _n(cal.residuals[k, 1] / ARCSEC, 2),
+                    _n(cal.residuals[k, 2] / ARCSEC, 2),
+                    _n(w[k], 2),
+                    t("yes") if cal.rejected[k] else t("no"),
+                )
+                for k in worst
+            ],
+            ["fail" if cal.rejected[k] else "" for k in worst],
+        )
+    )
+    return out
+
+
 def _refused() -> str:
     return t(
         "The calibration FAILED its checks: no table and no registered scan were written. "
@@ -88,37 +128,15 @@ def _refused() -> str:
     )
 
 
-def render_tls_html(
-    cal: TlsCalibration,
-    settings: Mapping[str, str],
-    problems: Sequence[object] = (),
-    accepted: bool = True,
-    rejections: RejectionTest | None = None,
-) -> str:
-    """The report page of a calibration (str, UTF-8 HTML); ``problems``: why it failed its
-    checks (written anyway when ``accepted``), ``rejections``: the test of the number of
-    rejected observations against snooping's false alarms."""
+def _adjustment_parts(cal: TlsCalibration, rejections: RejectionTest | None) -> list[str]:
+    """The adjustment section: sigma0, the global test (with the rejections against data
+    snooping's false alarms), iterations and the datum."""
     adj = cal.adjustment
-    out = [
-        f"<!DOCTYPE html><html lang='{html_lang()}'><head><meta charset='utf-8'>",
-        f"<title>{t('TLS self-calibration')}</title>",
-        f"<style>{_CSS}</style></head><body>",
-        f"<h1>{t('Terrestrial laser scanner: registration and self-calibration')}</h1>",
-        f"<p class='note'>lidarphoto {_e(__version__)}. "
-        + t(
-            "Model: Carvalho, Correa &amp; dos Santos (Eqs. 1-5), additional parameters after "
-            "Lichti (2007), correlation analysis after Lichti (2010)."
-        )
-        + "</p>",
-        *failed_checks(problems, accepted, _refused()),
-        f"<h2>{t('Settings')}</h2>",
-        _table([t("setting"), t("value")], [(_e(k), _e(v)) for k, v in settings.items()]),
-    ]
     gt = adj.global_test
     test = t("passed") if gt.passed else t("failed")
     if gt.passed and rejections is not None and not rejections.passed:
         test = t("passed, but only after more rejections than false alarms explain")
-    out += [
+    return [
         f"<h2>{t('Adjustment')}</h2>",
         _table(
             [t("quantity"), t("value")],
@@ -157,6 +175,35 @@ def render_tls_html(
              else "fail", "", "", "" if rejections is None or rejections.passed else "fail"],
         ),
     ]
+
+
+def render_tls_html(
+    cal: TlsCalibration,
+    settings: Mapping[str, str],
+    problems: Sequence[object] = (),
+    accepted: bool = True,
+    rejections: RejectionTest | None = None,
+) -> str:
+    """The report page of a calibration (str, UTF-8 HTML); ``problems``: why it failed its
+    checks (written anyway when ``accepted``), ``rejections``: the test of the number of
+    rejected observations against snooping's false alarms."""
+    adj = cal.adjustment
+    out = [
+        f"<!DOCTYPE html><html lang='{html_lang()}'><head><meta charset='utf-8'>",
+        f"<title>{t('TLS self-calibration')}</title>",
+        f"<style>{_CSS}</style></head><body>",
+        f"<h1>{t('Terrestrial laser scanner: registration and self-calibration')}</h1>",
+        f"<p class='note'>lidarphoto {_e(__version__)}. "
+        + t(
+            "Model: Carvalho, Correa &amp; dos Santos (Eqs. 1-5), additional parameters after "
+            "Lichti (2007), correlation analysis after Lichti (2010)."
+        )
+        + "</p>",
+        *failed_checks(problems, accepted, _refused()),
+        f"<h2>{t('Settings')}</h2>",
+        _table([t("setting"), t("value")], [(_e(k), _e(v)) for k, v in settings.items()]),
+    ]
+    out += _adjustment_parts(cal, rejections)
     if cal.ap_names:
         rows, css = [], []
         for a in cal.ap_report():
@@ -243,41 +290,7 @@ def render_tls_html(
                 ],
             ),
         ]
-    v = cal.residuals[~cal.rejected]
-    rms = np.sqrt(np.nanmean(v**2, axis=0)) if v.size else np.full(3, np.nan)
-    out += [
-        f"<h2>{t('Residuals')}</h2>",
-        _table(
-            [t("component"), "RMS", t("unit")],
-            [
-                (t("range"), _n(rms[0] * 1000, 3), "mm"),
-                (t("horizontal direction"), _n(rms[1] / ARCSEC, 2), t("arc-seconds")),
-                (t("vertical angle"), _n(rms[2] / ARCSEC, 2), t("arc-seconds")),
-            ],
-        ),
-    ]
-    w = np.nan_to_num(np.abs(cal.w), nan=0.0).max(axis=1)
-    worst = np.argsort(-w)[:10]
-    obs = cal.observations
-    out.append(
-        _table(
-            [t("station / target"), t("row"), t("v range mm"), 'v hz "', 'v vt "', "max |w|",
-             t("rejected")],
-            [
-                (
-                    _e(f"{obs.station[k]} / {obs.target[k]}"),
-                    str(int(obs.rows[k])),
-                    _n(cal.residuals[k, 0] * 1000, 3),
-                    _n(cal.residuals[k, 1] / ARCSEC, 2),
-                    _n(cal.residuals[k, 2] / ARCSEC, 2),
-                    _n(w[k], 2),
-                    t("yes") if cal.rejected[k] else t("no"),
-                )
-                for k in worst
-            ],
-            ["fail" if cal.rejected[k] else "" for k in worst],
-        )
-    )
+    out += _residual_parts(cal)
     if adj.warnings:
         out.append(f"<h2>{t('Warnings')}</h2><ul>"
                    + "".join(f"<li>{_e(t(x))}</li>" for x in adj.warnings) + "</ul>")  # fmt: skip
