@@ -18,10 +18,9 @@ import numpy as np
 
 from ..i18n import joined as _joined
 from ..i18n import mark as _t
-from ..photo.ins import INS_GRADES
 from .common import CSV_FILTER, CSV_OUT, LAS_FILTER, mount_from, mount_params
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 #: catalogue context of the ``_t("...")`` sentences of the report (``make i18n``)
 TR_CONTEXT = "Report"
@@ -36,7 +35,11 @@ log = logging.getLogger(__name__)
 GROUPINGS = ("single", "group", "direction")
 #: Control types the adjustment can use.
 CONTROL_TYPES = ("tie", "line", "lcp", "paper", "control")
-_GRADES = (*INS_GRADES, "custom")
+_OPTIONS = Fields("photo.boresight", "BoresightOptions")
+_GRADES = Ref("photo.ins", "INS_GRADES", convert=lambda grades: (*grades, "custom"))
+_GRADE_LABELS = Ref("photo.ins", "INS_GRADES",
+                    convert=lambda grades: (*(g.name for g in grades.values()),
+                                            "custom (INS sigmas)"))  # fmt: skip
 TABLE_COLUMNS = (
     "group", "images", "observations", "d_omega_deg", "d_phi_deg", "d_kappa_deg",
     "d_omega_arcsec", "d_phi_arcsec", "d_kappa_arcsec", "std_d_omega_arcsec",
@@ -106,22 +109,23 @@ written and each starts with a warning (CSV: comment lines beginning with #)."""
               "(control or check), in the mapping CRS"),
         Param("CLOUD", "file", "Cloud with plane ids (LAS/LAZ, paper mode only)",
               optional=True, file_filter=LAS_FILTER),
-        Param("GROUPING", "enum", "Boresight groups", "group", options=GROUPINGS,
+        Param("GROUPING", "enum", "Boresight groups", _OPTIONS.groups, options=GROUPINGS,
               labels=("one boresight for all images",
                       "one per trajectory group (flight line, direction, session)",
                       "one per heading direction (octant)")),
-        Param("CONTROL_TYPES", "enum", "Control types", CONTROL_TYPES, options=CONTROL_TYPES,
-              multiple=True),
-        Param("ESTIMATE_LEVER_ARM", "boolean", "Estimate the lever arm", False),
+        Param("CONTROL_TYPES", "enum", "Control types", _OPTIONS.use_types,
+              options=CONTROL_TYPES, multiple=True),
+        Param("ESTIMATE_LEVER_ARM", "boolean", "Estimate the lever arm",
+              _OPTIONS.estimate_lever_arm),
         Param("ESTIMATE_INTERIOR", "boolean", "Estimate focal length and principal point",
-              False),
-        Param("INS_GRADE", "enum", "INS grade", _GRADES[0], options=_GRADES,
-              labels=(*(g.name for g in INS_GRADES.values()), "custom (INS sigmas)")),
+              _OPTIONS.estimate_interior),
+        Param("INS_GRADE", "enum", "INS grade", _OPTIONS.ins_grade, options=_GRADES,
+              labels=_GRADE_LABELS),
         Param("INS_SIGMAS", "numbers",
               "Custom INS sigmas: horizontal, vertical, roll/pitch, heading",
               (0.02, 0.05, 0.015, 0.035), count=4, unit="m, m, deg, deg", optional=True,
               advanced=True, minimum=0.0001, maximum=100.0),
-        Param("SNOOPING", "boolean", "Data snooping (Baarda)", True),
+        Param("SNOOPING", "boolean", "Data snooping (Baarda)", _OPTIONS.snooping),
         Param("MAX_BORESIGHT", "number", "Largest plausible boresight angle", 2.0,
               unit="degrees", minimum=0.001, maximum=45.0, advanced=True,
               help="an estimated angle beyond this fails the run (wrong MOUNT, image ids or "
@@ -208,14 +212,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         lidar_xyz = np.column_stack([arrays["x"], arrays["y"], arrays["z"]])
         lidar_ids = np.asarray(arrays["plane_id"]).astype(np.int64)
     stop_if_asked(should_stop, "starting the adjustment")
-    options = BoresightOptions(
-        groups=v.grouping,
-        estimate_lever_arm=v.estimate_lever_arm,
-        estimate_interior=v.estimate_interior,
-        ins_grade=grade,
-        use_types=types,
-        snooping=v.snooping,
-    )
+    options = options_from(BoresightOptions, SPEC, v, ins_grade=grade, use_types=types)
     settings = _settings(v, cam, traj, obs, plane_list, line_list, lcp_list, frame, mount, grade,
                          ground)  # fmt: skip
     try:

@@ -8,7 +8,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..tls.aps import ARCSEC
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Result, Values
@@ -93,6 +92,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.scans import read_scan
     from ..io.tables import write_csv_atomic
     from ..io.tls import read_tls_control_csv
+    from ..tls.aps import ARCSEC
     from ..tls.targets import detect_checkerboards, detect_spheres, label_targets
 
     files = _scan_files(v.scans)

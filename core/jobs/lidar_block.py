@@ -11,21 +11,25 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import Cancelled, InputError
-from ..lidar.control import ControlOptions
-from ..lidar.ground_filter import SmrfParams
-from ..lidar.roof_planes import RoofPlaneParams
 from .common import cloud_params, lengths_in_cloud_units
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
+
+if TYPE_CHECKING:
+    from ..lidar.control import ControlOptions
+    from ..lidar.ground_filter import SmrfParams
+    from ..lidar.roof_planes import RoofPlaneParams
 
 log = logging.getLogger(__name__)
 
-_S, _R, _C = SmrfParams(), RoofPlaneParams(), ControlOptions()
+_S = Fields("lidar.ground_filter", "SmrfParams")
+_R = Fields("lidar.roof_planes", "RoofPlaneParams")
+_C = Fields("lidar.control", "ControlOptions")
 #: Exit status of the command line when the block is incomplete (a tile failed).
 INCOMPLETE_EXIT = 3
 #: The command line shows a progress bar for this job.
@@ -381,18 +385,18 @@ def run_block(
 def settings_from(v: Values, info) -> BlockSettings:
     """Science parameters in the cloud's units, the buffers from their rule."""
     from ..lidar.block import ground_buffer, roof_buffer
+    from ..lidar.control import ControlOptions
+    from ..lidar.ground_filter import SmrfParams
+    from ..lidar.roof_planes import RoofPlaneParams
 
-    smrf = SmrfParams(cell_size=v.smrf_cell_size, slope=v.smrf_slope, max_window=v.smrf_window,
-                      threshold=v.smrf_threshold, scalar=v.smrf_scalar,
-                      low_outlier_radius=v.low_outlier_radius)  # fmt: skip
+    smrf = options_from(SmrfParams, SPEC, v)
     smrf = lengths_in_cloud_units(smrf, info, v.distance_unit,
                                   ("cell_size", "max_window", "low_outlier_radius"),
                                   ("threshold", "scalar", "low_outlier_height"))  # fmt: skip
-    roof = RoofPlaneParams(epsilon=v.epsilon, k_neighbours=v.k_neighbours,
-                           min_support=min(_R.min_support, v.k_neighbours),
-                           min_plane_points=v.min_plane_points)  # fmt: skip
+    roof = options_from(RoofPlaneParams, SPEC, v,
+                        min_support=min(RoofPlaneParams().min_support, v.k_neighbours))
     roof = lengths_in_cloud_units(roof, info, v.distance_unit, ("epsilon",))
-    control = ControlOptions(delta=v.delta, min_boundary=v.min_boundary)
+    control = options_from(ControlOptions, SPEC, v)
     control = lengths_in_cloud_units(control, info, v.distance_unit,
                                      ("delta", "min_boundary", "max_support_distance"))  # fmt: skip
     area = float(np.prod(np.maximum(info.maxs[:2] - info.mins[:2], 1e-9)))

@@ -5,14 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..photo.control_location import LocateOptions
-from ..photo.least_squares_matching import LsmOptions
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
-_D = LocateOptions()
-_L = LsmOptions()
+_D = Fields("photo.control_location", "LocateOptions")
+_L = Fields("photo.least_squares_matching", "LsmOptions")
 
 SPEC = AlgorithmSpec(
     name="locatecontrolpoints",
@@ -173,7 +171,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.observations import write_observations_csv
     from ..io.orientation import read_eo_csv_full
     from ..io.resection import read_point_control_csv
-    from ..photo.control_location import locate_control_points
+    from ..photo.control_location import LocateOptions, locate_control_points
+    from ..photo.least_squares_matching import LsmOptions
     from ..quality.control_location_html import render_location_html
 
     crs = parse_crs(v.crs, what="CRS")
@@ -204,11 +203,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         opk=eo.opk[keep],
     )
     sig = eo_file.sigma[keep] if eo_file.sigma is not None else None
-    opt = LocateOptions(
-        default_search_px=v.search_px, min_ncc=v.min_ncc, transfer=v.transfer,
-        sigma_floor_px=v.sigma_floor,
-        lsm=replace(_L, min_correlation=v.min_correlation, max_sigma_px=v.max_sigma),
-    )  # fmt: skip
+    opt = options_from(LocateOptions, SPEC, v, lsm=options_from(LsmOptions, SPEC, v))
     reader = _Images(images)
     compute, _ = stages(progress, 0.95, 0.05)
     try:

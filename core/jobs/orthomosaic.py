@@ -8,14 +8,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..photo.mosaic import METHODS, MosaicOptions
 from .common import CSV_OUT, compression_param
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
-_D = MosaicOptions()
+_D = Fields("photo.mosaic", "MosaicOptions")
 #: Largest seamline raster kept in memory (cells); bigger mosaics are traced at a coarser step.
 MAX_LABEL_CELLS = 64_000_000
 
@@ -48,7 +47,8 @@ the region each image fills, as a layer and as a CSV (image_id, cells, area, WKT
 MultiPolygon in the mosaic's CRS).""",
     params=(
         Param("ORTHOPHOTOS", "files", "Orthophotos (files or folders)"),
-        Param("METHOD", "enum", "Image chosen per cell", _D.method, options=METHODS,
+        Param("METHOD", "enum", "Image chosen per cell", _D.method,
+              options=Ref("photo.mosaic", "METHODS"),
               labels=("most nadir view", "nearest image centre")),
         Param("FEATHER", "number", "Feathering width across seamlines (0 = none)",
               _D.feather_px, unit="cells", minimum=0.0, maximum=1000.0),
@@ -106,7 +106,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.images import list_image_files
     from ..io.raster import GeoTiffWriter, RasterReader, polygonize
     from ..io.tables import write_csv_atomic
-    from ..photo.mosaic import MosaicSource, mosaic_grid, mosaic_tiles
+    from ..photo.mosaic import MosaicOptions, MosaicSource, mosaic_grid, mosaic_tiles
     from .common import compression_args
 
     files = list_image_files(v.orthophotos)
@@ -144,7 +144,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                         "made by orthorectify): every cell takes the nearest image centre")
             method = "centre"
         grid = mosaic_grid(sources)
-        options = MosaicOptions(method=method, feather_px=v.feather)
+        options = options_from(MosaicOptions, SPEC, v, method=method)
 
         def read(k: int, win: tuple[int, int, int, int]):
             return readers[k].read(win), readers[k].read_mask(win)

@@ -12,14 +12,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..photo.orthophoto import RESAMPLING, OrthoOptions
 from .common import CSV_FILTER, compression_param
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
-_D = OrthoOptions()
+_D = Fields("photo.orthophoto", "OrthoOptions")
 #: Name of the orthophoto of image ``<image_id>`` in the output folder.
 ORTHO_NAME = "{}_ortho.tif"
 DSM_FILTER = "DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"
@@ -72,7 +71,8 @@ Nothing is written when an input is wrong; the files appear together when all ar
               minimum=0.0, maximum=1000.0),
         Param("EXTENT", "numbers", "Extent xmin,ymin,xmax,ymax (empty = footprint)", count=4,
               optional=True, unit="CRS unit"),
-        Param("RESAMPLING", "enum", "Resampling", _D.resampling, options=RESAMPLING),
+        Param("RESAMPLING", "enum", "Resampling", _D.resampling,
+              options=Ref("photo.orthophoto", "RESAMPLING")),
         Param("TRUE_ORTHO", "boolean", "True orthophoto (occluded ground = no data)",
               _D.true_ortho),
         Param("OCCLUSION_TOLERANCE", "number", "Occlusion tolerance along the ray",
@@ -114,7 +114,13 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.dsm import load_dsm
     from ..io.orientation import read_eo_csv
     from ..io.raster import GeoTiffWriter, RasterReader
-    from ..photo.orthophoto import OrthoProjector, _lens_lattice, auto_gsd, ortho_grid
+    from ..photo.orthophoto import (
+        OrthoOptions,
+        OrthoProjector,
+        _lens_lattice,
+        auto_gsd,
+        ortho_grid,
+    )
     from .common import compression_args
 
     camera = read_camera_json(v.camera)
@@ -135,8 +141,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             raise InputError(f"the image is {info.width} x {info.height} px, the camera "
                              f"{camera.name!r} {camera.width_px} x {camera.height_px} px",
                              path=str(f))  # fmt: skip
-    options = OrthoOptions(gsd=v.gsd, resampling=v.resampling, true_ortho=v.true_ortho,
-                           occlusion_tol_m=v.occlusion_tolerance)  # fmt: skip
+    options = options_from(OrthoOptions, SPEC, v)
     folder = Path(v.output_folder)
     targets = {f.stem: folder / ORTHO_NAME.format(f.stem) for f in images}
     inputs = {"IMAGES": [str(f) for f in images], "DSM": v.dsm, "EO": v.eo, "CAMERA": v.camera}

@@ -14,12 +14,12 @@ import math
 
 import numpy as np
 
-from ..photo.resection import MODELS, ResectionOptions
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
+_OPTIONS = Fields("photo.resection", "ResectionOptions")
 
 SPEC = AlgorithmSpec(
     name="resection",
@@ -86,11 +86,13 @@ lines parallel).""",
               unit="m, degrees", optional=True, advanced=True, minimum=1e-6, maximum=1e6,
               help="empty: start values only; given: weighted observations"),
         Param("IMAGES", "string", "Images (comma separated; empty: all)", "", optional=True),
-        Param("MODEL", "enum", "Line model", MODELS[0], options=MODELS,
+        Param("MODEL", "enum", "Line model", _OPTIONS.model,
+              options=Ref("photo.resection", "MODELS"),
               labels=("coplanarity (no parametrisation)",
                       "equivalent planes (Tommaselli & Tozzi 1996)")),
-        Param("ESTIMATE_INTERIOR", "boolean", "Refine focal length and principal point", False),
-        Param("SNOOPING", "boolean", "Data snooping (Baarda)", True),
+        Param("ESTIMATE_INTERIOR", "boolean", "Refine focal length and principal point",
+              _OPTIONS.estimate_interior),
+        Param("SNOOPING", "boolean", "Data snooping (Baarda)", _OPTIONS.snooping),
         Param("OUTPUT_EO", "file_out", "Exterior orientation with sigmas (CSV)",
               file_filter=CSV_OUT),
         Param("OUTPUT_RESIDUALS", "file_out", "Residuals (CSV)", optional=True,
@@ -125,7 +127,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.observations import read_observations_csv
     from ..io.orientation import read_eo_csv
     from ..io.resection import read_line_control_csv, read_point_control_csv
-    from ..photo.resection import image_inputs, resect_in_map
+    from ..photo.resection import ResectionOptions, image_inputs, resect_in_map
     from ..quality.resection_html import render_resection_html
 
     if not v.observations and not v.line_observations:
@@ -170,8 +172,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         prior = (*s[:3], *(math.radians(a) for a in s[3:]))
     images = [s.strip() for s in (v.images or "").split(",") if s.strip()]
     inputs = image_inputs(obs, points, lines, images or None)
-    options = ResectionOptions(model=v.model, estimate_interior=v.estimate_interior,
-                               snooping=v.snooping, eo_prior_sigma=prior)  # fmt: skip
+    options = options_from(ResectionOptions, SPEC, v, eo_prior_sigma=prior)
     everything = [d.data for d in inputs]
     ctrl = np.vstack([np.vstack([d.xyz, d.line_p1, d.line_p2]) for d in everything])
     if not len(ctrl):
