@@ -249,8 +249,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
 def _check_together(v: Values) -> None:
     """Parameters that are only meaningful together, and none of another method."""
-    others = [key for key, method, field in _FIELDS
-              if method not in ("", v.method) and v[key] != _default(method, field)]  # fmt: skip
+    others = [key for key, method, _ in _FIELDS
+              if method not in ("", v.method) and v[key] != SPEC.param(key).default]  # fmt: skip
     if others:
         raise InputError(
             f"{', '.join(others)}: parameter{'s' if len(others) > 1 else ''} of another method "

@@ -14,7 +14,7 @@ from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_fro
 
 log = logging.getLogger(__name__)
 
-_D = Fields("photo.mosaic", "MosaicOptions")
+_D = Fields("photo.ortho_options", "MosaicOptions")
 #: Largest seamline raster kept in memory (cells); bigger mosaics are traced at a coarser step.
 MAX_LABEL_CELLS = 64_000_000
 
@@ -48,7 +48,7 @@ MultiPolygon in the mosaic's CRS).""",
     params=(
         Param("ORTHOPHOTOS", "files", "Orthophotos (files or folders)"),
         Param("METHOD", "enum", "Image chosen per cell", _D.method,
-              options=Ref("photo.mosaic", "METHODS"),
+              options=Ref("photo.ortho_options", "MOSAIC_METHODS"),
               labels=("most nadir view", "nearest image centre")),
         Param("FEATHER", "number", "Feathering width across seamlines (0 = none)",
               _D.feather_px, unit="cells", minimum=0.0, maximum=1000.0),

@@ -18,7 +18,7 @@ from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_fro
 
 log = logging.getLogger(__name__)
 
-_D = Fields("photo.orthophoto", "OrthoOptions")
+_D = Fields("photo.ortho_options", "OrthoOptions")
 #: Name of the orthophoto of image ``<image_id>`` in the output folder.
 ORTHO_NAME = "{}_ortho.tif"
 DSM_FILTER = "DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"
@@ -72,7 +72,7 @@ Nothing is written when an input is wrong; the files appear together when all ar
         Param("EXTENT", "numbers", "Extent xmin,ymin,xmax,ymax (empty = footprint)", count=4,
               optional=True, unit="CRS unit"),
         Param("RESAMPLING", "enum", "Resampling", _D.resampling,
-              options=Ref("photo.orthophoto", "RESAMPLING")),
+              options=Ref("photo.ortho_options", "RESAMPLING")),
         Param("TRUE_ORTHO", "boolean", "True orthophoto (occluded ground = no data)",
               _D.true_ortho),
         Param("OCCLUSION_TOLERANCE", "number", "Occlusion tolerance along the ray",
