@@ -1,4 +1,4 @@
-"""Files of the control chips (docs/conventions.md, "Control chips").
+"""Files of the control chips (docs/formats.md, "Control chips").
 
 Ground-photo table (CSV, header row; names case-insensitive, aliases in parentheses)::
 

@@ -15,7 +15,7 @@ from .spec import AlgorithmSpec, Param, Result, Values
 log = logging.getLogger(__name__)
 
 KINDS = ("sphere", "checkerboard")
-#: Columns of the table written (docs/conventions.md, "TLS tables"): the x, y, z form of the
+#: Columns of the table written (docs/formats.md, "TLS tables"): the x, y, z form of the
 #: observation table with the full covariance and the fit's figures.
 COLUMNS = (
     "station_id", "target_id", "x", "y", "z", "s_x", "s_y", "s_z", "cov_xy", "cov_xz", "cov_yz",

@@ -147,8 +147,7 @@ class Param:
     ``aliases`` are extra command-line spellings of options; ``qgis_default`` overrides
     ``default`` in QGIS only (e.g. ``"ProjectCrs"``). ``default``, ``minimum``, ``maximum``,
     ``options`` and ``labels`` may be a :class:`Ref`, resolved by :meth:`resolved`; a default
-    read from a dataclass field as it is (no ``convert``) keeps that field in ``source`` (see
-    :func:`options_from`).
+    read from a dataclass field keeps that field in ``source`` (see :func:`options_from`).
     """
 
     name: str
@@ -208,8 +207,8 @@ class Param:
         for name in self.refs:
             value = getattr(self, name).value()
             values[name] = tuple(value) if isinstance(value, (list, tuple)) else value
-        if isinstance(self.default, Ref) and self.default.field and self.default.convert is None:
-            values["source"] = self.default  # the field takes the value as it is
+        if isinstance(self.default, Ref) and self.default.field:
+            values["source"] = self.default
         return dataclasses.replace(self, **values)
 
     @property
@@ -605,8 +604,9 @@ def check_value(p: Param, value: Any) -> None:
 
 def options_from(cls: type, spec: AlgorithmSpec, values: Mapping[str, Any], **extra: Any) -> Any:
     """An instance of the science dataclass ``cls`` from the parameters whose default is one
-    of its fields (:attr:`Param.source`), with ``extra`` fields (what needs a conversion);
-    the other fields keep their defaults.
+    of its fields (:attr:`Param.source`), with ``extra`` fields (what needs a conversion: a
+    parameter whose :class:`Ref` converts, e.g. arcseconds to radians, is given there); the
+    other fields keep their defaults.
 
     >>> spec = AlgorithmSpec("x", "X", "G", "g", "s", "d", (Param("EPSILON", "number", "E",
     ...     Ref("lidar.roof_planes", "RoofPlaneParams", "epsilon")),))
@@ -617,7 +617,8 @@ def options_from(cls: type, spec: AlgorithmSpec, values: Mapping[str, Any], **ex
     fields = {
         p.source.field: values[p.name]
         for p in spec.params
-        if p.source is not None and p.name in values and p.source.names(cls)
+        if p.source is not None and p.source.convert is None and p.name in values
+        and p.source.names(cls)
     }
     fields.update(extra)
     return cls(**fields)

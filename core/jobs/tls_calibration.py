@@ -1,7 +1,7 @@
 """``tlscalibration``: register terrestrial laser scanner stations and calibrate the scanner.
 
 Outputs: the adjusted station poses with sigmas, the additional parameters (APs) with sigmas
-and significance, the target coordinates, the residuals per component (docs/conventions.md,
+and significance, the target coordinates, the residuals per component (docs/formats.md,
 "TLS tables"), an HTML report with the correlation matrix and, optionally, the scans written
 into the common frame (:data:`REGISTERED_NAME` in OUTPUT_FOLDER).
 """

@@ -27,7 +27,7 @@ x, y, z) by weighted least squares and counts the points within EPSILON of it.""
     params=(
         Param("INPUT", "file", "Points (CSV: x, y, z)", file_filter=CSV_FILTER),
         Param("EPSILON", "number", "Inlier tolerance", _ROOF.epsilon, unit="m", minimum=0.001,
-              maximum=100.0),  # fmt: skip
+              maximum=100.0),
         Param("OUTPUT", "file_out", "Plane (CSV)", file_filter=CSV_OUT),
     ),
     results=(
@@ -41,9 +41,8 @@ x, y, z) by weighted least squares and counts the points within EPSILON of it.""
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the points, fit the plane, write it."""
     import numpy as np
-
     from lidarphoto.core.geometry.planes import fit_plane
-    from lidarphoto.core.io.tables import float_column, find_column, read_table, write_csv_atomic
+    from lidarphoto.core.io.tables import find_column, float_column, read_table, write_csv_atomic
 
     table = read_table(v.input)
     xyz = np.column_stack([float_column(table, find_column(table, (c,))) for c in "xyz"])
