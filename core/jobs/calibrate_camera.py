@@ -5,7 +5,7 @@ from __future__ import annotations
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
-_D = Fields("photo.camera_calibration", "CalibrationOptions")
+_D = Fields("photo.calibration_options", "CalibrationOptions")
 _T = Fields("photo.calibration_targets", "TargetSpec")
 JSON_FILTER = "JSON files (*.json)"
 
@@ -59,10 +59,10 @@ the millimetre values of the camera file: the calibration itself is in pixels.""
                       "fisheye: equisolid-angle", "fisheye: orthographic",
                       "fisheye: stereographic")),
         Param("LENS_PARAMETERS", "enum", "Lens coefficients estimated", _D.lens_parameters,
-              options=Ref("photo.camera_calibration", "LENS_NAMES"), multiple=True,
+              options=Ref("photo.calibration_options", "LENS_NAMES"), multiple=True,
               help="Brown-Conrady coefficients; the others are held at zero"),
         Param("FIELD", "enum", "Target field", _D.field,
-              options=Ref("photo.camera_calibration", "FIELD_MODES"),
+              options=Ref("photo.calibration_options", "FIELD_MODES"),
               labels=("fixed (nominal coordinates)", "free (estimated, minimal datum)")),
         Param("PIXEL_SIZE", "number", "Pixel size", 0.003, unit="mm", minimum=0.0005,
               maximum=0.5),

@@ -9,8 +9,8 @@ from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
-_D = Fields("photo.control_location", "LocateOptions")
-_L = Fields("photo.least_squares_matching", "LsmOptions")
+_D = Fields("photo.matching_options", "LocateOptions")
+_L = Fields("photo.matching_options", "LsmOptions")
 
 SPEC = AlgorithmSpec(
     name="locatecontrolpoints",

@@ -22,11 +22,10 @@ LISTING = {"lidarphoto.core", "lidarphoto.core.errors", "lidarphoto.core.i18n",
            "lidarphoto.core.io", "lidarphoto.core.io.atomic", "lidarphoto.core.cli"}  # fmt: skip
 #: Algorithms whose defaults are read from a dataclass in a module that imports a heavy
 #: library at its top (its --help pays for it): photo/bundle.py, photo/resection.py and
-#: photo/boresight.py import lsq/adjustment.py (scipy), photo/monoplot.py geometry/frames.py
-#: (pyproj), photo/control_location.py the numba kernels of least-squares matching, and
-#: photo/camera_calibration.py scipy.stats. Each needs its options in a light module.
-HEAVY_DEFAULTS = {"bundleadjustment", "resection", "boresightcalibration", "monoplot",
-                  "locatecontrolpoints", "calibratecamera"}  # fmt: skip
+#: photo/boresight.py import lsq/adjustment.py (scipy), photo/control_location.py the numba
+#: kernels of least-squares matching. Each needs its options in a light module, as
+#: photo/ortho_options.py, calibration_options.py and monoplot_options.py are.
+HEAVY_DEFAULTS = {"bundleadjustment", "resection", "boresightcalibration", "locatecontrolpoints"}
 
 
 def _imported_by(code: str) -> dict:
