@@ -22,10 +22,10 @@ LISTING = {"lidarphoto.core", "lidarphoto.core.errors", "lidarphoto.core.i18n",
            "lidarphoto.core.io", "lidarphoto.core.io.atomic", "lidarphoto.core.cli"}  # fmt: skip
 #: Algorithms whose defaults are read from a dataclass in a module that imports a heavy
 #: library at its top (its --help pays for it): photo/bundle.py, photo/resection.py and
-#: photo/boresight.py import lsq/adjustment.py (scipy), photo/control_location.py the numba
-#: kernels of least-squares matching. Each needs its options in a light module, as
-#: photo/ortho_options.py, calibration_options.py and monoplot_options.py are.
-HEAVY_DEFAULTS = {"bundleadjustment", "resection", "boresightcalibration", "locatecontrolpoints"}
+#: photo/boresight.py import lsq/adjustment.py (scipy). Each needs its options in a light
+#: module, as photo/ortho_options.py, calibration_options.py, matching_options.py and
+#: monoplot_options.py are.
+HEAVY_DEFAULTS = {"bundleadjustment", "resection", "boresightcalibration"}
 
 
 def _imported_by(code: str) -> dict:
