@@ -18,7 +18,7 @@ from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_fro
 log = logging.getLogger(__name__)
 
 _OPTIONS = Fields("photo.bundle", "BundleOptions")
-AP_CHOICES = Ref("geometry.ap_models", "AP_FAMILIES", convert=lambda f: (*f, "all"))
+_AP_CHOICES = Ref("geometry.ap_models", "AP_FAMILIES", convert=lambda f: (*f, "all"))
 ROBUST_CHOICES = ("none", "huber", "cauchy")
 DATUM_CHOICES = ("control", "inner", "minimal")
 
@@ -105,7 +105,7 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
             "enum",
             "Additional parameters",
             _OPTIONS.ap_model,
-            options=AP_CHOICES,
+            options=_AP_CHOICES,
             labels=(
                 "none (camera fixed)",
                 "lens distortion k1, k2",
