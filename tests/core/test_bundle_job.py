@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.errors import InputError
+from lidarphoto.core.geometry.ap_models import AP_FAMILIES
 from lidarphoto.core.io.camera import read_cameras_json
 from lidarphoto.core.io.checkpoints import read_checkpoint_table
 from lidarphoto.core.io.orientation import read_eo_csv_full
@@ -79,7 +80,7 @@ def test_all_models_compared_and_every_output_readable(files):
     assert np.all(np.degrees(eo.sigma[:, 3:]) < 0.05)
     assert np.abs(eo.eo.xyz - blk.eo_true.xyz).max() < 0.5
     cam = read_cameras_json(outs["OUTPUT_CAMERA"])[0]
-    assert cam.distortion.model == bundle_adjustment.AP_FAMILIES[best]
+    assert cam.distortion.model == AP_FAMILIES[best]
     data = json.loads(open(outs["OUTPUT_CAMERA"]).read())
     assert data["sigmas"]["focal_mm"] > 0 and data["_bundle"]["ap_model"] == best
     pts = _read(outs["OUTPUT_POINTS"])
