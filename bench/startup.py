@@ -51,13 +51,13 @@ def _timed(argv: list[str], env: dict[str, str]) -> tuple[float, float]:
     return wall, cpu
 
 
-def commands(laz: Path | None, out: Path, before: Path | None) -> dict[str, tuple]:
+def commands(laz: Path | None, out: Path, before: Path | None, helps=HELP) -> dict[str, tuple]:
     """{label: (argv, env)} of every process measured."""
     trees = {"": None} if before is None else {"": None, " (before)": before}
     cmds: dict[str, tuple] = {}
     for suffix, tree in trees.items():
         env = _env(tree)
-        for words in HELP:
+        for words in helps:
             cmds[f"lidarphoto {words}{suffix}"] = (
                 [sys.executable, "-m", "lidarphoto", *words.split()], env)
         if laz is not None:
@@ -74,9 +74,11 @@ def measure(cmds: dict[str, tuple], runs: int) -> dict[str, dict]:
     """Interleaved rounds: every command once per round; medians, min and max."""
     times: dict[str, list[tuple[float, float]]] = {k: [] for k in cmds}
     loads = [os.getloadavg()[0]]
-    for _ in range(runs):
+    for k in range(runs):
         for label, (argv, env) in cmds.items():
             times[label].append(_timed(argv, env))
+            print(f"round {k + 1}: {label}: {times[label][-1][0]:.2f} s wall, "
+                  f"{times[label][-1][1]:.2f} s CPU", file=sys.stderr, flush=True)
         loads.append(os.getloadavg()[0])
     out = {}
     for label, pairs in times.items():
@@ -93,6 +95,7 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=7)
     ap.add_argument("--laz", type=Path, help="the 10 M-point LAZ (default: AHN3 x12, built)")
     ap.add_argument("--no-groundfilter", action="store_true", help="the help commands only")
+    ap.add_argument("--no-help", action="store_true", help="the groundfilter run only")
     ap.add_argument("--before", type=Path, help="the plugin folder of the code before")
     ap.add_argument("--json", type=Path)
     args = ap.parse_args()
@@ -103,8 +106,9 @@ def main() -> None:
             from bench_ground_filter import build_ahn3
 
             laz = build_ahn3(Path(tmp), (3, 4))
-        result = measure(commands(None if args.no_groundfilter else laz, Path(tmp),
-                                  args.before), args.runs)  # fmt: skip
+        cmds = commands(None if args.no_groundfilter else laz, Path(tmp), args.before,
+                        () if args.no_help else HELP)  # fmt: skip
+        result = measure(cmds, args.runs)
     load = result.pop("load")
     print(f"{args.runs} interleaved runs, load average {load['min']:.1f}-{load['max']:.1f}")
     for label, r in result.items():

@@ -14,8 +14,6 @@ from __future__ import annotations
 import logging
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from ..i18n import joined as _joined
 from ..i18n import mark as _t
 from .common import CSV_FILTER, CSV_OUT, LAS_FILTER, mount_from, mount_params
@@ -154,6 +152,8 @@ written and each starts with a warning (CSV: comment lines beginning with #)."""
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the inputs, calibrate, write the outputs."""
+    import numpy as np
+
     from ..errors import AdjustmentError, InputError, stop_if_asked
     from ..geometry.frames import MappingFrame, check_area_of_use
     from ..io.atomic import write_text_atomic
@@ -285,6 +285,7 @@ def doubts_about(result, max_boresight_deg: float, max_sigma0: float) -> list[st
     """Why the calibration's numbers cannot be trusted (empty when they can): no convergence,
     a global test failed with sigma0 above ``max_sigma0``, an angle beyond
     ``max_boresight_deg``, numbers that are not finite."""
+    import numpy as np
     out = []
     adj = result.adjustment
     if not adj.converged:
@@ -334,6 +335,7 @@ def doubts_about(result, max_boresight_deg: float, max_sigma0: float) -> list[st
 def _settings(v, cam, traj, obs, planes, lines, lcps, frame, mount, grade, ground=None
               ) -> dict[str, str]:  # fmt: skip
     """The run's settings as text (the HTML summary shows them)."""
+    import numpy as np
     types = tuple(v.control_types)
     return {
         "camera": f"{cam.name} (f = {cam.focal_mm:g} mm, {cam.width_px} x {cam.height_px} px "
@@ -387,6 +389,7 @@ def _table_rows(run: BoresightRun) -> list[tuple[str, ...]]:
 
 
 def _text(row) -> tuple[str, ...]:
+    import numpy as np
     out = []
     for v in row:
         if isinstance(v, (float, np.floating)):

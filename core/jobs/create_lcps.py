@@ -5,8 +5,6 @@ from __future__ import annotations
 import logging
 from dataclasses import replace
 
-import numpy as np
-
 from ..errors import InputError
 from ..i18n import mark as _t
 from .common import CSV_FILTER, CSV_OUT, cloud_params, lengths_in_cloud_units, unit_symbol
@@ -105,6 +103,8 @@ def parse_id_groups(text: str, size: int, name: str) -> list[tuple[int, ...]] | 
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the planes and the cloud, intersect the planes, write the tables."""
+    import numpy as np
+
     from ..io.control import write_graph_csv, write_lcps_csv, write_lines_csv
     from ..io.planes import read_planes_csv
     from ..io.pointcloud import read_info, read_points

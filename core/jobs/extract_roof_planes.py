@@ -7,8 +7,6 @@ import math
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from ..errors import InputError
 from .checks import check_memory
 from .common import CSV_OUT, cloud_params, lengths_in_cloud_units
@@ -141,6 +139,8 @@ class RoofPlaneRun:
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the cloud, extract roof planes, write the plane table (and the cloud)."""
+    import numpy as np
+
     from ..io.planes import write_planes_csv
     from ..io.pointcloud import read_cloud, read_points, write_cloud
     from ..lidar.roof_planes import RoofPlaneParams, extract_roof_planes

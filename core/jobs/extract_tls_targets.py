@@ -6,8 +6,6 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-import numpy as np
-
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Result, Values
@@ -88,6 +86,8 @@ def _scan_files(paths) -> list[Path]:
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read each scan, find its targets, label them across scans, write the table."""
+    import numpy as np
+
     from ..errors import InputError, stop_if_asked
     from ..io.scans import read_scan
     from ..io.tables import write_csv_atomic

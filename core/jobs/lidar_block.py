@@ -13,8 +13,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from ..errors import Cancelled, InputError
 from .common import cloud_params, lengths_in_cloud_units
 from .runner import JobResult
@@ -188,6 +186,8 @@ def _peak_rss_mb() -> float:
 def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOutcome:
     """One dask task: read tile ``i`` and its buffer, filter the ground, write the tile's own
     points, find the roof planes around it; the planes' pieces on its core go back."""
+    import numpy as np
+
     from ..io.pointcloud import write_cloud
     from ..io.tiles import read_buffered
     from ..lidar.block import PlanePiece
@@ -337,6 +337,8 @@ def run_block(
 ) -> dict[str, Any]:
     """Process every tile of ``index`` on ``client`` into ``staging``; merge the planes, build
     the control; the block's results (what run() writes and reports)."""
+    import numpy as np
+
     from ..lidar.block import dedupe_lines, dedupe_points, merge_cut_planes
 
     os.makedirs(os.path.join(staging, "tiles"), exist_ok=True)
@@ -384,6 +386,8 @@ def run_block(
 
 def settings_from(v: Values, info) -> BlockSettings:
     """Science parameters in the cloud's units, the buffers from their rule."""
+    import numpy as np
+
     from ..lidar.block import ground_buffer, roof_buffer
     from ..lidar.control import ControlOptions
     from ..lidar.ground_filter import SmrfParams

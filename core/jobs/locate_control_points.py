@@ -3,11 +3,14 @@
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
 
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
+
+if TYPE_CHECKING:
+    import numpy as np
 
 _D = Fields("photo.matching_options", "LocateOptions")
 _L = Fields("photo.matching_options", "LsmOptions")
@@ -137,6 +140,8 @@ class _Images:
         self.readers: dict = {}
 
     def __call__(self, image_id: str, c0: int, r0: int, w: int, h: int) -> np.ndarray:
+        import numpy as np
+
         from ..io.raster import RasterReader
 
         if image_id not in self.readers:

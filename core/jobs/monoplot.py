@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import logging
 
-import numpy as np
-
 from .checks import DSM_BYTES_PER_CELL, check_cell_size, check_memory
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult, stages
@@ -146,6 +144,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 def ray_count(obs, line_step_px: float) -> int:
     """How many rays :func:`~lidarphoto.core.photo.monoplot.monoplot` will cast: one per
     observation row plus, with ``line_step_px > 0``, the points added along each line."""
+    import numpy as np
     total = len(obs)
     if line_step_px <= 0:
         return total

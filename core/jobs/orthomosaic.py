@@ -6,8 +6,6 @@ import logging
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from .common import CSV_OUT, compression_param
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
@@ -99,6 +97,7 @@ def _floats(text: str | None, n: int) -> tuple[float, ...] | None:
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the orthophotos' grids and metadata, mosaic tile by tile, trace the seamlines."""
+    import numpy as np
     import pyproj
 
     from ..errors import InputError

@@ -10,8 +10,6 @@ from concurrent.futures import Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from .common import CSV_FILTER, compression_param
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
@@ -105,6 +103,8 @@ class OrthoFile:
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Check every input, then orthorectify the images one after the other."""
+    import numpy as np
+
     from ..errors import CrsError, InputError
     from ..geometry.frames import LocalFrame, MappingFrame, parse_crs
     from ..geometry.raycast import DsmTracer
@@ -267,6 +267,7 @@ def _tiles(proj, grid, src, info, options, progress, should_stop):
 
 def _median_height(dsm, box) -> float:
     """Median surface height inside the box (a subsample of its cells)."""
+    import numpy as np
     if box is None:
         return math.nan
     g = dsm.grid
@@ -283,6 +284,7 @@ def _median_height(dsm, box) -> float:
 
 def _beyond_dsm(proj, ground_z: float) -> float:
     """Share of the image's border whose ground (at the median height) lies beyond the DSM."""
+    import numpy as np
     cam = proj.camera
     k = np.linspace(0.0, 1.0, 33)
     w, h = cam.width_px, cam.height_px

@@ -12,8 +12,6 @@ from __future__ import annotations
 import logging
 import math
 
-import numpy as np
-
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
@@ -119,6 +117,8 @@ lines parallel).""",
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the inputs, resect each image, write the outputs."""
     from pathlib import Path
+
+    import numpy as np
 
     from ..errors import Cancelled, InputError, LidarPhotoError, stop_if_asked
     from ..geometry.frames import LocalFrame, MappingFrame, check_area_of_use
@@ -276,6 +276,8 @@ def run_eo_row(r: ImageRun) -> tuple:
 
 def residual_rows(r: ImageRun, obs, camera) -> list[tuple]:
     """Rows of the residual table of one image (see :mod:`core.io.resection`)."""
+    import numpy as np
+
     from ..geometry.collinearity import project
 
     item, res = r.image, r.result.result
@@ -307,6 +309,7 @@ def residual_rows(r: ImageRun, obs, camera) -> list[tuple]:
 
 def _settings(v, camera, obs, points, lines, frame) -> dict[str, str]:
     """The run's settings as text (the HTML summary shows them)."""
+    import numpy as np
     kinds, counts = np.unique(np.array(obs.type), return_counts=True)
     return {
         "camera": f"{camera.name} (f = {camera.focal_mm:g} mm, {camera.width_px} x "
