@@ -21,8 +21,9 @@ from collections.abc import Callable, Collection, Iterator, Sequence
 from . import __version__, i18n
 from .errors import Cancelled, LidarPhotoError
 from .jobs import algorithms
+from .jobs.runner import run_job
 from .jobs.spec import TR_CONTEXT, AlgorithmSpec, Param, facts_line
-from .jobs.translate import translate_spec
+from .jobs.translate import context_of, translate_spec
 
 _METAVAR = {
     "file": "FILE",
@@ -144,8 +145,6 @@ def _add_algorithm(
 def _summary(spec: AlgorithmSpec, lang: str) -> str:
     if lang == "en":
         return spec.summary
-    from .jobs.translate import context_of
-
     return i18n.catalogue(lang).get((context_of(spec), spec.summary), spec.summary)
 
 
@@ -247,8 +246,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         for p in spec.params
         if p.kind != "sink" and getattr(args, p.name) is not None
     }
-    from .jobs.runner import run_job
-
     try:
         with stop_signals_raise():
             result = run_job(args.job, raw, progress=_progress_bar(args.job))
