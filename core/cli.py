@@ -16,14 +16,14 @@ import logging
 import signal
 import sys
 import threading
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Collection, Iterator, Sequence
 
 from . import __version__, i18n
 from .errors import Cancelled, LidarPhotoError
-from .jobs import ALGORITHMS
+from .jobs import algorithms
 from .jobs.runner import run_job
 from .jobs.spec import TR_CONTEXT, AlgorithmSpec, Param, facts_line
-from .jobs.translate import translate_spec
+from .jobs.translate import context_of, translate_spec
 
 _METAVAR = {
     "file": "FILE",
@@ -101,8 +101,17 @@ def _option_help(
 
 
 def _add_algorithm(
-    sub: argparse._SubParsersAction, spec: AlgorithmSpec, job: object, lang: str = "en"
+    sub: argparse._SubParsersAction,
+    spec: AlgorithmSpec,
+    job: object,
+    lang: str = "en",
+    options: bool = True,
 ) -> None:
+    """The subcommand of ``spec``; without ``options`` only its name and summary (what the
+    list of algorithms shows: the parameters, read from the science, are not needed)."""
+    if not options:
+        sub.add_parser(spec.name, help=_summary(spec, lang)).set_defaults(job=job)
+        return
     if lang != "en":  # the help in the user's language (names and options stay)
         table = i18n.catalogue(lang)
         spec = translate_spec(spec, lambda ctx, text: table.get((ctx, text), text))
@@ -133,9 +142,20 @@ def _add_algorithm(
     parser.set_defaults(job=job)
 
 
-def build_parser(lang: str = "en") -> argparse.ArgumentParser:
+def _summary(spec: AlgorithmSpec, lang: str) -> str:
+    if lang == "en":
+        return spec.summary
+    return i18n.catalogue(lang).get((context_of(spec), spec.summary), spec.summary)
+
+
+def build_parser(
+    lang: str = "en", with_options: Collection[str] | None = None
+) -> argparse.ArgumentParser:
     """The parser; ``lang`` (a catalogue of :mod:`core.i18n`, e.g. ``pt_BR``) translates the
-    algorithms' help."""
+    algorithms' help. ``with_options``: the algorithms whose options are added (None: all);
+    the others have their name and summary only, so that the command line reads the
+    parameters (and imports the science behind their defaults) of the algorithm it runs
+    alone."""
     parser = argparse.ArgumentParser(prog="lidarphoto", description=__doc__.split("\n\n")[0])
     parser.add_argument("--version", action="version", version=f"lidarphoto {__version__}")
     parser.add_argument(
@@ -150,8 +170,9 @@ def build_parser(lang: str = "en") -> argparse.ArgumentParser:
         + "; default: from LANG/LC_ALL)",
     )
     sub = parser.add_subparsers(dest="algorithm", metavar="ALGORITHM", required=True)
-    for job in ALGORITHMS:
-        _add_algorithm(sub, job.SPEC, job, lang)
+    for job in algorithms():
+        name = job.SPEC.name
+        _add_algorithm(sub, job.SPEC, job, lang, with_options is None or name in with_options)
     return parser
 
 
@@ -166,6 +187,21 @@ def _language(argv: Sequence[str]) -> str:
         if not arg.startswith("-"):
             break
     return i18n.language_from_env()
+
+
+def _algorithm(argv: Sequence[str]) -> str:
+    """The algorithm named on the command line (the first word that is neither a global
+    option nor the value of --lang), "" when there is none."""
+    k = 0
+    while k < len(argv):
+        arg = argv[k]
+        if arg == "--lang":
+            k += 2
+            continue
+        if not arg.startswith("-"):
+            return arg
+        k += 1
+    return ""
 
 
 #: GDAL's block cache for the command line, MB (GDAL's default, 5 % of the RAM, holds the
@@ -196,7 +232,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     argv = sys.argv[1:] if argv is None else list(argv)
     lang = i18n.set_language(_language(argv))
-    args = build_parser(lang).parse_args(argv)
+    args = build_parser(lang, with_options={_algorithm(argv)}).parse_args(argv)
     os.environ.setdefault("GDAL_CACHEMAX", GDAL_CACHE_MB)  # read by GDAL at its first use
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,

@@ -1,34 +1,51 @@
-"""The QGIS Processing provider ``lidarphoto``."""
+"""The QGIS Processing provider ``lidarphoto``: one algorithm per job of the registry
+(:mod:`core.jobs`), in its order.
+
+An algorithm with QGIS-only behaviour (layer outputs, layer inputs, styles, its own checks)
+has its adapter in ``algorithms/<job module>.py``: the :class:`~.base.BaseAlgorithm`
+subclass whose ``JOB`` is that job. Every other job becomes a generated ``BaseAlgorithm``
+subclass (:func:`algorithm_class`): its id, names, group, help and parameters all come from
+the spec.
+"""
 
 from __future__ import annotations
 
+import importlib
+import importlib.util
 from pathlib import Path
+from types import ModuleType
 
 from qgis.core import QgsProcessingProvider
 from qgis.PyQt.QtCore import QCoreApplication
 from qgis.PyQt.QtGui import QIcon
 
-from .algorithms.accuracy_report import AccuracyReportAlgorithm
-from .algorithms.boresight_calibration import BoresightCalibrationAlgorithm
-from .algorithms.bundle_adjustment import BundleAdjustmentAlgorithm
-from .algorithms.calibrate_camera import CalibrateCameraAlgorithm
-from .algorithms.create_lcps import CreateLcpsAlgorithm
-from .algorithms.extract_roof_planes import ExtractRoofPlanesAlgorithm
-from .algorithms.extract_tls_targets import ExtractTlsTargetsAlgorithm
-from .algorithms.ground_filter import GroundFilterAlgorithm
-from .algorithms.lidar_block import LidarBlockAlgorithm
-from .algorithms.locate_control_points import LocateControlPointsAlgorithm
-from .algorithms.make_control_chips import MakeControlChipsAlgorithm
-from .algorithms.monoplot import MonoplotAlgorithm
-from .algorithms.orthomosaic import OrthomosaicAlgorithm
-from .algorithms.orthorectify import OrthorectifyAlgorithm
-from .algorithms.resection import ResectionAlgorithm
-from .algorithms.tie_points import TiePointsAlgorithm
-from .algorithms.tls_calibration import TlsCalibrationAlgorithm
-from .algorithms.trajectory_to_eo import TrajectoryToEoAlgorithm
+from ..core.jobs import algorithms
+from .base import BaseAlgorithm
 from .i18n import install_translator
 
 ICON_PATH = Path(__file__).resolve().parents[1] / "icon.svg"
+
+
+def _class_name(job: ModuleType) -> str:
+    """``...jobs.tie_points`` -> ``TiePointsAlgorithm``."""
+    module = job.__name__.rsplit(".", 1)[1]
+    return "".join(word.capitalize() for word in module.split("_")) + "Algorithm"
+
+
+def algorithm_class(job: ModuleType) -> type[BaseAlgorithm]:
+    """The QGIS algorithm of a job: its adapter in ``algorithms/`` when it has one, else a
+    ``BaseAlgorithm`` subclass made from the spec alone."""
+    module = job.__name__.rsplit(".", 1)[1]
+    adapter = f"{__package__}.algorithms.{module}"
+    if importlib.util.find_spec(adapter) is not None:
+        for value in vars(importlib.import_module(adapter)).values():
+            if isinstance(value, type) and issubclass(value, BaseAlgorithm) and (
+                value.__dict__.get("JOB") is job
+            ):
+                return value
+        raise TypeError(f"{adapter} has no BaseAlgorithm subclass with JOB = {job.__name__}")
+    doc = f"Algorithm ``{job.SPEC.name}`` made from ``core.jobs.{module}`` (file outputs only)."
+    return type(_class_name(job), (BaseAlgorithm,), {"JOB": job, "__doc__": doc})
 
 
 class LidarPhotoProvider(QgsProcessingProvider):
@@ -57,24 +74,5 @@ class LidarPhotoProvider(QgsProcessingProvider):
         return str(ICON_PATH)
 
     def loadAlgorithms(self) -> None:
-        for alg in (
-            TrajectoryToEoAlgorithm(),
-            GroundFilterAlgorithm(),
-            CreateLcpsAlgorithm(),
-            AccuracyReportAlgorithm(),
-            ExtractRoofPlanesAlgorithm(),
-            BoresightCalibrationAlgorithm(),
-            MonoplotAlgorithm(),
-            BundleAdjustmentAlgorithm(),
-            ResectionAlgorithm(),
-            OrthorectifyAlgorithm(),
-            OrthomosaicAlgorithm(),
-            TlsCalibrationAlgorithm(),
-            ExtractTlsTargetsAlgorithm(),
-            LocateControlPointsAlgorithm(),
-            LidarBlockAlgorithm(),
-            CalibrateCameraAlgorithm(),
-            TiePointsAlgorithm(),
-            MakeControlChipsAlgorithm(),
-        ):
-            self.addAlgorithm(alg)
+        for job in algorithms():
+            self.addAlgorithm(algorithm_class(job)())

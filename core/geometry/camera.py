@@ -1,6 +1,6 @@
 """Frame cameras: interior orientation, pixel <-> image coordinates.
 
-Conventions (the project's, from DESIGN.md)
+Conventions (docs/conventions.md, "Images")
 -------------------------------------------
 - **Pixels** ``(col, row)``, float: the origin is the top-left *corner* of the top-left
   pixel, columns grow to the right and rows downwards, so the centre of the first pixel is
@@ -44,7 +44,7 @@ from .projection import PROJECTIONS, ray_from_ideal
 
 Array = NDArray[np.float64]
 
-#: Tolerance of the ideal -> measured inversion, in pixels (DESIGN.md).
+#: Tolerance of the ideal -> measured inversion, in pixels (docs/conventions.md, "Images").
 DEFAULT_TOL_PX = 1e-6
 
 __all__ = [

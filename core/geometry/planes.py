@@ -1,6 +1,6 @@
 """Planes fitted to points with their precision, and the plane table (CSV).
 
-Convention (docs/conventions.md, DESIGN.md "Planes"): a plane is ``n . p + d = 0`` with the unit
+Convention (docs/conventions.md, "Planes"): a plane is ``n . p + d = 0`` with the unit
 normal ``n = (a, b, c)`` pointing up (``c >= 0``), ``p`` in the cloud's projected CRS (all lengths
 in the CRS's unit: metres, or international feet for e.g. Autzen).
 

@@ -37,6 +37,7 @@ import numpy as np
 from ..errors import InputError
 from ..photo.control_location import ControlChip, LocatedPair
 from .raster import RasterReader
+from .suffixes import CHIP_SUFFIXES
 from .tables import write_csv_atomic
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -48,7 +49,6 @@ REPORT_COLUMNS = (
     "sigma_row", "sigma0", "ncc", "lsm_correlation", "template_px", "predicted_col",
     "predicted_row", "search_col_px", "search_row_px", "iterations",
 )  # fmt: skip
-CHIP_SUFFIXES = (".tif", ".tiff")
 
 
 def list_chips(paths: Iterable[PathLike]) -> dict[str, Path]:

@@ -1,4 +1,4 @@
-"""Files of the control chips (docs/conventions.md, "Control chips").
+"""Files of the control chips (docs/formats.md, "Control chips").
 
 Ground-photo table (CSV, header row; names case-insensitive, aliases in parentheses)::
 
@@ -41,6 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from .suffixes import PHOTO_SUFFIXES
 from .tables import find_column, float_column, read_table, text_column, write_csv_atomic
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -58,7 +59,6 @@ __all__ = [
 ]
 
 CHIP_NODATA = -9999.0
-PHOTO_SUFFIXES = (".tif", ".tiff", ".jpg", ".jpeg", ".png")
 REPORT_COLUMNS = (
     "point_id", "status", "reason", "X", "Y", "Z", "plate_photo", "free_photo", "source",
     "corners_found", "corner_sigma_max_px", "edge_rms_max_px", "resection_sigma0",

@@ -17,14 +17,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from .suffixes import IMAGE_SUFFIXES
 
 __all__ = ["IMAGE_SUFFIXES", "check_distinct_files", "check_jpeg_whole", "decode_factor",
            "image_size",
            "list_image_files", "read_gray"]  # fmt: skip
 
 PathLike = Union[str, "os.PathLike[str]"]
-#: File endings taken as images when a folder is named.
-IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".jp2", ".img")
 
 
 def list_image_files(paths, twice: tuple[str, str] | None = None) -> list[Path]:

@@ -28,12 +28,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from .suffixes import SCAN_SUFFIXES
 from .tables import PathLike
 
 __all__ = ["MAX_SCANNER_RANGE_M", "SCAN_SUFFIXES", "read_scan", "write_registered_scan"]
 
 log = logging.getLogger(__name__)
-SCAN_SUFFIXES = (".las", ".laz", ".ply", ".e57")
 #: (N, 3) scanner-frame points (m) -> (N, 3) object-frame points (m).
 Transform = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 _PLY_TYPES = {

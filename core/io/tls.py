@@ -1,4 +1,4 @@
-"""CSV tables of terrestrial laser scanner networks (docs/conventions.md, "TLS tables").
+"""CSV tables of terrestrial laser scanner networks (docs/formats.md, "TLS tables").
 
 Observations, one row per station, target and face, in polar form::
 

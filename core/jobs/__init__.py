@@ -1,45 +1,50 @@
 """One module per algorithm: its parameter spec and its run(), from which the QGIS toolbox
-and the command line are both made (docs/architecture.md, "Adding an algorithm")."""
+and the command line are both made (docs/architecture.md, "Adding an algorithm").
 
-from . import (
-    accuracy_report,
-    boresight_calibration,
-    bundle_adjustment,
-    calibrate_camera,
-    create_lcps,
-    extract_roof_planes,
-    extract_tls_targets,
-    ground_filter,
-    lidar_block,
-    locate_control_points,
-    make_control_chips,
-    monoplot,
-    orthomosaic,
-    orthorectify,
-    resection,
-    tie_points,
-    tls_calibration,
-    trajectory_to_eo,
+This package is the registry. Importing it imports no job; :func:`algorithms` (and
+``ALGORITHMS``) import the job modules, which hold their specs and import their science only
+when they run (a spec's science defaults are :class:`~.spec.Ref` s, read when its parameters
+are first used), so listing the algorithms stays cheap. ``tests/core/test_startup.py`` holds
+that line.
+"""
+
+from __future__ import annotations
+
+import importlib
+from types import ModuleType
+
+#: Every algorithm's job module, in the order of the toolbox and of ``lidarphoto --help``.
+NAMES = (
+    "trajectory_to_eo",
+    "ground_filter",
+    "create_lcps",
+    "accuracy_report",
+    "extract_roof_planes",
+    "boresight_calibration",
+    "monoplot",
+    "bundle_adjustment",
+    "resection",
+    "orthorectify",
+    "orthomosaic",
+    "tls_calibration",
+    "extract_tls_targets",
+    "locate_control_points",
+    "lidar_block",
+    "calibrate_camera",
+    "tie_points",
+    "make_control_chips",
 )
 
-#: Every algorithm, in the order of the toolbox and of ``lidarphoto --help``.
-ALGORITHMS = (
-    trajectory_to_eo,
-    ground_filter,
-    create_lcps,
-    accuracy_report,
-    extract_roof_planes,
-    boresight_calibration,
-    monoplot,
-    bundle_adjustment,
-    resection,
-    orthorectify,
-    orthomosaic,
-    tls_calibration,
-    extract_tls_targets,
-    locate_control_points,
-    lidar_block,
-    calibrate_camera,
-    tie_points,
-    make_control_chips,
-)
+
+def algorithms() -> tuple[ModuleType, ...]:
+    """The job modules of :data:`NAMES`, imported (specs only: no science). A name with a dot
+    is a module path (a job kept elsewhere, e.g. the test suite's)."""
+    return tuple(
+        importlib.import_module(name if "." in name else f".{name}", __name__) for name in NAMES
+    )
+
+
+def __getattr__(name: str) -> object:
+    if name == "ALGORITHMS":  # the job modules, as the CLI, the provider and the tests use them
+        return algorithms()
+    raise AttributeError(name)

@@ -5,16 +5,13 @@ from __future__ import annotations
 import logging
 
 from ..errors import InputError
-from ..quality.accuracy import STANDARD_KEYS, AccuracySettings
-from ..quality.accuracy_statistics import OUTLIER_RULES
-from ..quality.standards_pec import PEC_CLASSES
 from .common import CSV_FILTER
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
-_D = AccuracySettings()
+_D = Fields("quality.accuracy", "AccuracySettings")
 _STANDARD_LABELS = (
     "ASPRS Positional Accuracy Standards, Edition 2 (2023)",
     "NSSDA (FGDC-STD-007.3-1998)",
@@ -127,14 +124,15 @@ for one release).""",
               False, help="QGIS only: point tables carry no CRS"),
         *_numbers(_NUMBERS),
         Param("OUTLIER_RULE", "enum", "Outlier screening", _D.outlier_rule,
-              options=OUTLIER_RULES, labels=_OUTLIER_LABELS),
+              options=Ref("quality.accuracy_statistics", "OUTLIER_RULES"), labels=_OUTLIER_LABELS),
         Param("EXCLUDE_OUTLIERS", "boolean", "Exclude flagged outliers from the statistics",
               _D.exclude_outliers),
-        Param("STANDARDS", "enum", "Standards", _D.standards, options=STANDARD_KEYS,
-              labels=_STANDARD_LABELS, multiple=True),
+        Param("STANDARDS", "enum", "Standards", _D.standards,
+              options=Ref("quality.accuracy", "STANDARD_KEYS"), labels=_STANDARD_LABELS,
+              multiple=True),
         *_numbers(_STANDARD_NUMBERS),
         Param("PEC_CLASS", "enum", "PEC-PCD declared class", _D.pec_class,
-              options=PEC_CLASSES),
+              options=Ref("quality.standards_pec", "PEC_CLASSES")),
         *_numbers(_PROJECT_NUMBERS),
         Param("FLIGHT_GEOMETRY", "numbers", "Flight geometry for Eq. 18: H, B, f, pixel",
               _D.flight_geometry, count=4, unit="m, m, mm, um", advanced=True, minimum=0.001,
@@ -204,18 +202,11 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..errors import stop_if_asked
     from ..geometry.frames import check_area_of_use, parse_crs
     from ..io.atomic import write_text_atomic
-    from ..quality.accuracy import assess_accuracy
+    from ..quality.accuracy import AccuracySettings, assess_accuracy
     from ..quality.accuracy_html import render_html
     from ..quality.accuracy_json import report_to_dict, with_deprecated_keys
 
-    settings = AccuracySettings(
-        **{f: v[k] for k, f, *_ in _NUMBERS + _STANDARD_NUMBERS + _PROJECT_NUMBERS},
-        outlier_rule=v.outlier_rule,
-        exclude_outliers=v.exclude_outliers,
-        standards=v.standards,
-        pec_class=v.pec_class,
-        flight_geometry=v.flight_geometry,
-    )
+    settings = options_from(AccuracySettings, SPEC, v)
     points = _points(v)
     log.info("%d check points from %s", len(points), points.source)
     if points.crs:  # coordinates that cannot be in the stated CRS are refused

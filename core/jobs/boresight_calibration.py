@@ -14,11 +14,8 @@ from __future__ import annotations
 import logging
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from ..i18n import joined as _joined
 from ..i18n import mark as _t
-from ..photo.ins import INS_GRADES
 from .common import (
     CSV_FILTER,
     CSV_OUT,
@@ -29,7 +26,7 @@ from .common import (
     settle_doubts,
 )
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 #: catalogue context of the ``_t("...")`` sentences of the report (``make i18n``)
 TR_CONTEXT = "Report"
@@ -44,7 +41,11 @@ log = logging.getLogger(__name__)
 GROUPINGS = ("single", "group", "direction")
 #: Control types the adjustment can use.
 CONTROL_TYPES = ("tie", "line", "lcp", "paper", "control")
-_GRADES = (*INS_GRADES, "custom")
+_OPTIONS = Fields("photo.boresight", "BoresightOptions")
+_GRADES = Ref("photo.ins", "INS_GRADES", convert=lambda grades: (*grades, "custom"))
+_GRADE_LABELS = Ref("photo.ins", "INS_GRADES",
+                    convert=lambda grades: (*(g.name for g in grades.values()),
+                                            "custom (INS sigmas)"))  # fmt: skip
 TABLE_COLUMNS = (
     "group", "images", "observations", "d_omega_deg", "d_phi_deg", "d_kappa_deg",
     "d_omega_arcsec", "d_phi_arcsec", "d_kappa_arcsec", "std_d_omega_arcsec",
@@ -114,22 +115,23 @@ written and each starts with a warning (CSV: comment lines beginning with #)."""
               "(control or check), in the mapping CRS"),
         Param("CLOUD", "file", "Cloud with plane ids (LAS/LAZ, paper mode only)",
               optional=True, file_filter=LAS_FILTER),
-        Param("GROUPING", "enum", "Boresight groups", "group", options=GROUPINGS,
+        Param("GROUPING", "enum", "Boresight groups", _OPTIONS.groups, options=GROUPINGS,
               labels=("one boresight for all images",
                       "one per trajectory group (flight line, direction, session)",
                       "one per heading direction (octant)")),
-        Param("CONTROL_TYPES", "enum", "Control types", CONTROL_TYPES, options=CONTROL_TYPES,
-              multiple=True),
-        Param("ESTIMATE_LEVER_ARM", "boolean", "Estimate the lever arm", False),
+        Param("CONTROL_TYPES", "enum", "Control types", _OPTIONS.use_types,
+              options=CONTROL_TYPES, multiple=True),
+        Param("ESTIMATE_LEVER_ARM", "boolean", "Estimate the lever arm",
+              _OPTIONS.estimate_lever_arm),
         Param("ESTIMATE_INTERIOR", "boolean", "Estimate focal length and principal point",
-              False),
-        Param("INS_GRADE", "enum", "INS grade", _GRADES[0], options=_GRADES,
-              labels=(*(g.name for g in INS_GRADES.values()), "custom (INS sigmas)")),
+              _OPTIONS.estimate_interior),
+        Param("INS_GRADE", "enum", "INS grade", _OPTIONS.ins_grade, options=_GRADES,
+              labels=_GRADE_LABELS),
         Param("INS_SIGMAS", "numbers",
               "Custom INS sigmas: horizontal, vertical, roll/pitch, heading",
               (0.02, 0.05, 0.015, 0.035), count=4, unit="m, m, deg, deg", optional=True,
               advanced=True, minimum=0.0001, maximum=100.0),
-        Param("SNOOPING", "boolean", "Data snooping (Baarda)", True),
+        Param("SNOOPING", "boolean", "Data snooping (Baarda)", _OPTIONS.snooping),
         Param("MAX_BORESIGHT", "number", "Largest plausible boresight angle", 2.0,
               unit="degrees", minimum=0.001, maximum=45.0, advanced=True,
               help="an estimated angle beyond this fails the run (wrong MOUNT, image ids or "
@@ -156,6 +158,8 @@ written and each starts with a warning (CSV: comment lines beginning with #)."""
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the inputs, calibrate, write the outputs."""
+    import numpy as np
+
     from ..errors import InputError, stop_if_asked
     from ..geometry.frames import MappingFrame, check_area_of_use
     from ..io.atomic import write_text_atomic
@@ -210,14 +214,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         lidar_xyz = np.column_stack([arrays["x"], arrays["y"], arrays["z"]])
         lidar_ids = np.asarray(arrays["plane_id"]).astype(np.int64)
     stop_if_asked(should_stop, "starting the adjustment")
-    options = BoresightOptions(
-        groups=v.grouping,
-        estimate_lever_arm=v.estimate_lever_arm,
-        estimate_interior=v.estimate_interior,
-        ins_grade=grade,
-        use_types=types,
-        snooping=v.snooping,
-    )
+    options = options_from(BoresightOptions, SPEC, v, ins_grade=grade, use_types=types)
     settings = _settings(v, cam, traj, obs, plane_list, line_list, lcp_list, frame, mount, grade,
                          ground)  # fmt: skip
     try:
@@ -278,6 +275,7 @@ def doubts_about(result, max_boresight_deg: float, max_sigma0: float) -> list[st
     """Why the calibration's numbers cannot be trusted (empty when they can): no convergence,
     a global test failed with sigma0 above ``max_sigma0``, an angle beyond
     ``max_boresight_deg``, numbers that are not finite."""
+    import numpy as np
     out = []
     adj = result.adjustment
     if not adj.converged:
@@ -327,6 +325,7 @@ def doubts_about(result, max_boresight_deg: float, max_sigma0: float) -> list[st
 def _settings(v, cam, traj, obs, planes, lines, lcps, frame, mount, grade, ground=None
               ) -> dict[str, str]:  # fmt: skip
     """The run's settings as text (the HTML summary shows them)."""
+    import numpy as np
     types = tuple(v.control_types)
     return {
         "camera": f"{cam.name} (f = {cam.focal_mm:g} mm, {cam.width_px} x {cam.height_px} px "
@@ -380,6 +379,7 @@ def _table_rows(run: BoresightRun) -> list[tuple[str, ...]]:
 
 
 def _text(row) -> tuple[str, ...]:
+    import numpy as np
     out = []
     for v in row:
         if isinstance(v, (float, np.floating)):

@@ -11,14 +11,14 @@ from __future__ import annotations
 
 import logging
 
-from ..geometry.ap_models import AP_FAMILIES
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
-AP_CHOICES = (*AP_FAMILIES, "all")
+_OPTIONS = Fields("photo.bundle", "BundleOptions")
+_AP_CHOICES = Ref("geometry.ap_models", "AP_FAMILIES", convert=lambda f: (*f, "all"))
 ROBUST_CHOICES = ("none", "huber", "cauchy")
 DATUM_CHOICES = ("control", "inner", "minimal")
 
@@ -104,8 +104,8 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
             "AP_MODEL",
             "enum",
             "Additional parameters",
-            "none",
-            options=AP_CHOICES,
+            _OPTIONS.ap_model,
+            options=_AP_CHOICES,
             labels=(
                 "none (camera fixed)",
                 "lens distortion k1, k2",
@@ -117,21 +117,28 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
                 "all (compare every family)",
             ),
         ),
-        Param("ESTIMATE_INTERIOR", "boolean", "Estimate principal distance and point", True),
-        Param("AP_SELECTION", "boolean", "Drop insignificant or correlated APs", True),
+        Param(
+            "ESTIMATE_INTERIOR",
+            "boolean",
+            "Estimate principal distance and point",
+            _OPTIONS.estimate_interior,
+        ),
+        Param(
+            "AP_SELECTION", "boolean", "Drop insignificant or correlated APs", _OPTIONS.ap_selection
+        ),
         Param(
             "ROBUST",
             "enum",
             "Robust reweighting before data snooping",
-            "huber",
+            _OPTIONS.robust,
             options=ROBUST_CHOICES,
         ),
-        Param("SNOOPING", "boolean", "Data snooping (Baarda)", True),
+        Param("SNOOPING", "boolean", "Data snooping (Baarda)", _OPTIONS.snooping),
         Param(
             "DATUM",
             "enum",
             "Datum",
-            "control",
+            _OPTIONS.datum,
             options=DATUM_CHOICES,
             labels=(
                 "control points / observed EO",
@@ -143,7 +150,7 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
             "ESTIMATE_MOUNT",
             "boolean",
             "Estimate lever arm and boresight corrections",
-            False,
+            _OPTIONS.estimate_mount,
             advanced=True,
             help="needs observed exterior orientations",
         ),
@@ -225,6 +232,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     import numpy as np
 
     from ..errors import AdjustmentError, InputError
+    from ..geometry.ap_models import AP_FAMILIES
     from ..geometry.frames import MappingFrame, check_area_of_use
     from ..io.atomic import write_text_atomic
     from ..io.bundle import (
@@ -280,15 +288,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     stage = dict(zip(models, parts))
 
     def one(model: str):
-        opts = BundleOptions(
-            ap_model=model,
-            estimate_interior=v.estimate_interior,
-            ap_selection=v.ap_selection,
-            robust=v.robust,
-            snooping=v.snooping,
-            datum=v.datum,
-            estimate_mount=v.estimate_mount,
-        )
+        opts = options_from(BundleOptions, SPEC, v, ap_model=model)
         log.info("bundle adjustment with AP model %s", model)
         try:
             return bundle_adjust(cams, obs, ground, frame, eo, sigma, image_camera, opts,

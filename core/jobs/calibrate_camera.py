@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-from ..geometry.projection import PROJECTIONS
-from ..io.images import IMAGE_SUFFIXES
-from ..photo.calibration_targets import DICTIONARIES, TARGET_KINDS
-from ..photo.camera_calibration import FIELD_MODES, LENS_NAMES, CalibrationOptions
+from ..io.suffixes import IMAGE_SUFFIXES
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
-_D = CalibrationOptions()
+_D = Fields("photo.calibration_options", "CalibrationOptions")
+_T = Fields("photo.calibration_targets", "TargetSpec")
 JSON_FILTER = "JSON files (*.json)"
 
 SPEC = AlgorithmSpec(
@@ -43,25 +41,29 @@ the millimetre values of the camera file: the calibration itself is in pixels.""
     params=(
         Param("IMAGES", "files", "Target images (files or folders)", suffixes=IMAGE_SUFFIXES,
               help="image files, or folders whose images are all taken"),
-        Param("TARGET", "enum", "Target", TARGET_KINDS[0], options=TARGET_KINDS,
+        Param("TARGET", "enum", "Target", _T.kind,
+              options=Ref("photo.calibration_targets", "TARGET_KINDS"),
               labels=("chessboard", "ChArUco board", "ArUco grid board")),
-        Param("COLUMNS", "integer", "Columns (inner corners / squares / markers)", 9,
+        Param("COLUMNS", "integer", "Columns (inner corners / squares / markers)", _T.cols,
               minimum=2, maximum=200),
-        Param("ROWS", "integer", "Rows (inner corners / squares / markers)", 6, minimum=2,
+        Param("ROWS", "integer", "Rows (inner corners / squares / markers)", _T.rows, minimum=2,
               maximum=200),
-        Param("SPACING", "number", "Square side (ArUco: marker side)", 0.025, unit="m",
+        Param("SPACING", "number", "Square side (ArUco: marker side)", _T.spacing_m, unit="m",
               minimum=1e-4, maximum=10.0),
-        Param("MARKER", "number", "ChArUco marker side / ArUco gap", 0.0, unit="m",
+        Param("MARKER", "number", "ChArUco marker side / ArUco gap", _T.marker_m, unit="m",
               minimum=0.0, maximum=10.0),
-        Param("DICTIONARY", "enum", "ArUco dictionary", "DICT_6X6_250", options=DICTIONARIES),
-        Param("PROJECTION", "enum", "Projection", _D.projection, options=PROJECTIONS,
+        Param("DICTIONARY", "enum", "ArUco dictionary", _T.dictionary,
+              options=Ref("photo.calibration_targets", "DICTIONARIES")),
+        Param("PROJECTION", "enum", "Projection", _D.projection,
+              options=Ref("geometry.projection", "PROJECTIONS"),
               labels=("perspective (central)", "fisheye: equidistant",
                       "fisheye: equisolid-angle", "fisheye: orthographic",
                       "fisheye: stereographic")),
         Param("LENS_PARAMETERS", "enum", "Lens coefficients estimated", _D.lens_parameters,
-              options=LENS_NAMES, multiple=True,
+              options=Ref("photo.calibration_options", "LENS_NAMES"), multiple=True,
               help="Brown-Conrady coefficients; the others are held at zero"),
-        Param("FIELD", "enum", "Target field", _D.field, options=FIELD_MODES,
+        Param("FIELD", "enum", "Target field", _D.field,
+              options=Ref("photo.calibration_options", "FIELD_MODES"),
               labels=("fixed (nominal coordinates)", "free (estimated, minimal datum)")),
         Param("PIXEL_SIZE", "number", "Pixel size", 0.003, unit="mm", minimum=0.0005,
               maximum=0.5),
@@ -97,13 +99,11 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.camera import write_cameras_json
     from ..io.images import list_image_files
     from ..photo.calibration_targets import TargetSpec, detect_target, target_field
-    from ..photo.camera_calibration import calibrate_camera
+    from ..photo.camera_calibration import CalibrationOptions, calibrate_camera
     from .runner import stages
 
-    spec = TargetSpec(v.target, int(v.columns), int(v.rows), v.spacing, v.marker,
-                      v.dictionary)  # fmt: skip
-    opts = CalibrationOptions(projection=v.projection, lens_parameters=tuple(v.lens_parameters),
-                              field=v.field, sigma_px=v.sigma_px)  # fmt: skip
+    spec = options_from(TargetSpec, SPEC, v)
+    opts = options_from(CalibrationOptions, SPEC, v)
     fld = target_field(spec)
     images = list_image_files(v.images)
     detect, adjust = stages(progress, 0.7, 0.3)

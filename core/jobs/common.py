@@ -11,8 +11,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
-from ..photo.mount import MOUNT_CHOICES, MOUNT_LABELS
-from .spec import Param
+from .spec import Param, Ref
 
 CSV_FILTER = "CSV files (*.csv *.txt)"
 CSV_OUT = "CSV files (*.csv)"
@@ -33,8 +32,9 @@ def mount_params() -> tuple[Param, ...]:
               unit="m, body frame", minimum=-MAX_LEVER_ARM_M, maximum=MAX_LEVER_ARM_M,
               help="camera perspective centre in the INS body frame (x forward, y right, "
               "z down)"),
-        Param("MOUNT", "enum", "Camera mount", MOUNT_CHOICES[0], options=MOUNT_CHOICES,
-              labels=tuple(f"{m}: {MOUNT_LABELS[m]}" for m in MOUNT_CHOICES),
+        Param("MOUNT", "enum", "Camera mount", Ref("photo.mount", "MOUNT_CHOICES", convert=_first),
+              options=Ref("photo.mount", "MOUNT_CHOICES"),
+              labels=Ref("photo.mount", "MOUNT_LABELS", convert=_mount_labels),
               help="nominal camera-to-body rotation; custom uses MOUNT_MATRIX"),
         Param("MOUNT_MATRIX", "numbers", "Mount matrix R_c^b (9 numbers, row-major)",
               count=9, optional=True, advanced=True, minimum=-1.0, maximum=1.0,
@@ -44,6 +44,16 @@ def mount_params() -> tuple[Param, ...]:
               help="small misalignment about the camera axes x, y, z (a larger rotation "
               "belongs in MOUNT)"),
     )  # fmt: skip
+
+
+def _first(choices: tuple[str, ...]) -> str:
+    return choices[0]
+
+
+def _mount_labels(labels: Mapping[str, str]) -> tuple[str, ...]:
+    from ..photo.mount import MOUNT_CHOICES
+
+    return tuple(f"{m}: {labels[m]}" for m in MOUNT_CHOICES)
 
 
 def mount_from(values: Mapping[str, Any]):

@@ -5,21 +5,18 @@ from __future__ import annotations
 import logging
 from dataclasses import replace
 
-import numpy as np
-
 from ..errors import InputError
 from ..i18n import mark as _t
-from ..lidar.control import ControlOptions
 from .common import CSV_FILTER, CSV_OUT, cloud_params, lengths_in_cloud_units, unit_symbol
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
 #: catalogue context of this module's ``_t("...")`` log sentences
 TR_CONTEXT = "Report"
 
-_D = ControlOptions()
+_D = Fields("lidar.control", "ControlOptions")
 _LENGTHS = ("delta", "min_boundary", "max_support_distance")
 
 SPEC = AlgorithmSpec(
@@ -106,20 +103,16 @@ def parse_id_groups(text: str, size: int, name: str) -> list[tuple[int, ...]] | 
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the planes and the cloud, intersect the planes, write the tables."""
+    import numpy as np
+
     from ..io.control import write_graph_csv, write_lcps_csv, write_lines_csv
     from ..io.planes import read_planes_csv
     from ..io.pointcloud import read_info, read_points
-    from ..lidar.control import lidar_control, rejection_summary
+    from ..lidar.control import ControlOptions, lidar_control, rejection_summary
 
     user_triples = parse_id_groups(v.triples, 3, "TRIPLES")
     user_pairs = parse_id_groups(v.pairs, 2, "PAIRS")
-    options = ControlOptions(
-        delta=v.delta,
-        min_boundary=v.min_boundary,
-        min_angle_deg=v.min_angle,
-        max_condition=v.max_condition,
-        max_support_distance=v.max_support,
-    )
+    options = options_from(ControlOptions, SPEC, v)
     planes = read_planes_csv(v.planes)
     info = read_info(v.cloud, crs=v.crs)
     options = lengths_in_cloud_units(options, info, v.distance_unit, _LENGTHS)

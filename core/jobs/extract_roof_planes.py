@@ -5,20 +5,20 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import dataclass, replace
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from ..errors import InputError
-from ..lidar.roof_planes import SELECTION_CHOICES, RoofPlaneParams
 from .checks import check_memory
 from .common import CSV_OUT, cloud_params, lengths_in_cloud_units
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
+
+if TYPE_CHECKING:
+    from ..lidar.roof_planes import RoofPlaneParams
 
 log = logging.getLogger(__name__)
 
-_D = RoofPlaneParams()
+_D = Fields("lidar.roof_planes", "RoofPlaneParams")
 #: (parameter, RoofPlaneParams field, label, kind, unit, minimum, maximum, advanced)
 _NUMBERS = (
     ("K_NEIGHBOURS", "k_neighbours", "Neighbours K of the local RANSAC", "integer", "", 6, 500,
@@ -85,7 +85,8 @@ dimension plane_id (-1 = none). A cloud without roofs gives zero planes and a me
 error.""",
     params=(
         *cloud_params("INPUT"),
-        Param("POINTS", "enum", "Points", "non_ground", options=SELECTION_CHOICES,
+        Param("POINTS", "enum", "Points", "non_ground",
+              options=Ref("lidar.roof_planes", "SELECTION_CHOICES"),
               labels=("non-ground (class != 2)", "the classes below", "all"),
               aliases={"non-ground": "non_ground"}),
         Param("CLASSES", "string", "Classes (e.g. 6)", "6", optional=True,
@@ -142,9 +143,11 @@ class RoofPlaneRun:
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the cloud, extract roof planes, write the plane table (and the cloud)."""
+    import numpy as np
+
     from ..io.planes import write_planes_csv
     from ..io.pointcloud import read_cloud, read_points, write_cloud
-    from ..lidar.roof_planes import extract_roof_planes
+    from ..lidar.roof_planes import RoofPlaneParams, extract_roof_planes
 
     if v.min_support > v.k_neighbours:
         raise InputError(
@@ -154,7 +157,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         raise InputError(
             f"MIN_SLOPE ({v.min_slope:g}) must not exceed MAX_SLOPE ({v.max_slope:g} degrees)"
         )
-    params = RoofPlaneParams(**{field: v[key] for key, field, *_ in _NUMBERS})
+    params = options_from(RoofPlaneParams, SPEC, v)
     # RANSAC works on batches of points: each holds batch x iterations x K samples
     check_memory(
         float(params.batch_size) * params.ransac_iterations * params.k_neighbours

@@ -6,10 +6,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-import numpy as np
-
-from ..io.scans import SCAN_SUFFIXES
-from ..tls.aps import ARCSEC
+from ..io.suffixes import SCAN_SUFFIXES
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Result, Values
@@ -17,7 +14,7 @@ from .spec import AlgorithmSpec, Param, Result, Values
 log = logging.getLogger(__name__)
 
 KINDS = ("sphere", "checkerboard")
-#: Columns of the table written (docs/conventions.md, "TLS tables"): the x, y, z form of the
+#: Columns of the table written (docs/formats.md, "TLS tables"): the x, y, z form of the
 #: observation table with the full covariance and the fit's figures.
 COLUMNS = (
     "station_id", "target_id", "x", "y", "z", "s_x", "s_y", "s_z", "cov_xy", "cov_xz", "cov_yz",
@@ -91,10 +88,13 @@ def _scan_files(paths) -> list[Path]:
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read each scan, find its targets, label them across scans, write the table."""
+    import numpy as np
+
     from ..errors import InputError, stop_if_asked
     from ..io.scans import read_scan
     from ..io.tables import write_csv_atomic
     from ..io.tls import read_tls_control_csv
+    from ..tls.aps import ARCSEC
     from ..tls.targets import detect_checkerboards, detect_spheres, label_targets
 
     files = _scan_files(v.scans)

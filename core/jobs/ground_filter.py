@@ -5,25 +5,18 @@ from __future__ import annotations
 import logging
 
 from ..errors import InputError
-from ..lidar.ground_filter_params import (
-    GROWTH_CHOICES,
-    METHODS,
-    WINDOW_SHAPES,
-    CsfParams,
-    GroundFilterParams,
-    SmrfParams,
-)
 from .checks import GROUND_FILTER_BYTES_PER_CELL, GROUND_FILTER_BYTES_PER_POINT, check_cell_size
 from .common import cloud_params, lengths_in_cloud_units, unit_text
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Param, Ref, Result, Values
 
 log = logging.getLogger(__name__)
 
-_P, _S, _C = GroundFilterParams(), SmrfParams(), CsfParams()
 H, V = "horizontal length", "vertical length"
-#: The method each parameter belongs to ("" = all), with its dataclass and defaults.
-_DEFAULTS = {"pmf": _P, "smrf": _S, "csf": _C}
+#: The parameter dataclass of each method (core/lidar/ground_filter.py), which holds the
+#: defaults; the parameters below name the method they belong to ("" = all).
+_CLASSES = {"smrf": "SmrfParams", "pmf": "GroundFilterParams", "csf": "CsfParams"}
+_SCIENCE = "lidar.ground_filter_params"
 #: (parameter, method, field, label, kind, unit, advanced, minimum, maximum): the ranges are
 #: physical (a cell of 1 cm to 1 km, a slope up to 10:1) and hold in feet as in metres.
 _NUMBERS = (
@@ -67,21 +60,23 @@ _NUMBERS = (
 )  # fmt: skip
 #: (parameter, method, field, label, kind, options, advanced)
 _CHOICES = (
-    ("GROWTH", "pmf", "growth", "PMF window growth", "enum", GROWTH_CHOICES, True),
-    ("WINDOW_SHAPE", "pmf", "window_shape", "PMF window shape", "enum", WINDOW_SHAPES, True),
+    ("GROWTH", "pmf", "growth", "PMF window growth", "enum",
+     Ref(_SCIENCE, "GROWTH_CHOICES"), True),
+    ("WINDOW_SHAPE", "pmf", "window_shape", "PMF window shape", "enum",
+     Ref(_SCIENCE, "WINDOW_SHAPES"), True),
     ("CSF_SLOPE_SMOOTH", "csf", "slope_smooth", "CSF slope smoothing", "boolean", (), True),
     ("LAST_RETURNS_ONLY", "", "last_returns_only", "Only last returns can be ground",
      "boolean", (), False),
 )  # fmt: skip
 _FIELDS = tuple(row[:3] for row in _NUMBERS) + tuple(row[:3] for row in _CHOICES)
 HORIZONTAL_LENGTHS = {m: tuple(f for _, pm, f, _, _, u, *_ in _NUMBERS if u == H and pm in (m, ""))
-                      for m in METHODS}  # fmt: skip
+                      for m in _CLASSES}  # fmt: skip
 VERTICAL_LENGTHS = {m: tuple(f for _, pm, f, _, _, u, *_ in _NUMBERS if u == V and pm in (m, ""))
-                    for m in METHODS}  # fmt: skip
+                    for m in _CLASSES}  # fmt: skip
 
 
-def _default(method: str, field: str):
-    return getattr(_DEFAULTS[method or "smrf"], field)
+def _default(method: str, field: str) -> Ref:
+    return Ref(_SCIENCE, _CLASSES[method or "smrf"], field)
 
 
 # fmt: off
@@ -120,7 +115,7 @@ ground (other classes kept, or set to 1), in the same point format; with Height 
 also the extra dimension height_above_ground (float32); optionally the DTM as GeoTIFF.""",
     params=(
         *cloud_params("INPUT"),
-        Param("METHOD", "enum", "Method", "smrf", options=METHODS,
+        Param("METHOD", "enum", "Method", "smrf", options=Ref(_SCIENCE, "METHODS"),
               labels=("SMRF (Pingel et al. 2013)", "PMF (Zhang et al. 2003)",
                       "cloth simulation (Zhang et al. 2016)")),
         *(
@@ -159,8 +154,10 @@ also the extra dimension height_above_ground (float32); optionally the DTM as Ge
 def method_params(v: Values):
     """The science parameters of the chosen method (SmrfParams, GroundFilterParams or
     CsfParams) from the job's values, lengths as given."""
+    from ..lidar import ground_filter as science
+
     method = v.method
-    cls = type(_DEFAULTS[method])
+    cls = getattr(science, _CLASSES[method])
     fields = {field: v[key] for key, m, field in _FIELDS if m in (method, "")}
     return cls(**fields)
 
@@ -252,8 +249,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
 def _check_together(v: Values) -> None:
     """Parameters that are only meaningful together, and none of another method."""
-    others = [key for key, method, field in _FIELDS
-              if method not in ("", v.method) and v[key] != _default(method, field)]  # fmt: skip
+    others = [key for key, method, _ in _FIELDS
+              if method not in ("", v.method) and v[key] != SPEC.param(key).default]  # fmt: skip
     if others:
         raise InputError(
             f"{', '.join(others)}: parameter{'s' if len(others) > 1 else ''} of another method "

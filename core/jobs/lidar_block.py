@@ -12,21 +12,23 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from ..errors import Cancelled, InputError
-from ..lidar.control import ControlOptions
-from ..lidar.ground_filter_params import SmrfParams
-from ..lidar.roof_planes import RoofPlaneParams
 from .common import cloud_params, lengths_in_cloud_units
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
+
+if TYPE_CHECKING:
+    from ..lidar.control import ControlOptions
+    from ..lidar.ground_filter import SmrfParams
+    from ..lidar.roof_planes import RoofPlaneParams
 
 log = logging.getLogger(__name__)
 
-_S, _R, _C = SmrfParams(), RoofPlaneParams(), ControlOptions()
+_S = Fields("lidar.ground_filter_params", "SmrfParams")
+_R = Fields("lidar.roof_planes", "RoofPlaneParams")
+_C = Fields("lidar.control", "ControlOptions")
 #: Exit status of the command line when the block is incomplete (a tile failed).
 INCOMPLETE_EXIT = 3
 #: The command line shows a progress bar for this job.
@@ -198,6 +200,8 @@ def _peak_rss_mb() -> float:
 def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOutcome:
     """One dask task: read tile ``i`` and its buffer, filter the ground, write the tile's own
     points, find the roof planes around it; the planes' pieces on its core go back."""
+    import numpy as np
+
     from ..io.pointcloud import write_cloud
     from ..io.tiles import read_buffered
     from ..lidar.block import tile_planes
@@ -369,6 +373,8 @@ def run_block(
 ) -> dict[str, Any]:
     """Process every tile of ``index`` on ``client`` into ``staging``; merge the planes, build
     the control; the block's results (what run() writes and reports)."""
+    import numpy as np
+
     from ..lidar.block import dedupe_lines, dedupe_points, merge_cut_planes
 
     os.makedirs(os.path.join(staging, "tiles"), exist_ok=True)
@@ -417,19 +423,21 @@ def run_block(
 
 def settings_from(v: Values, info) -> BlockSettings:
     """Science parameters in the cloud's units, the buffers from their rule."""
-    from ..lidar.block import ground_buffer, roof_buffer
+    import numpy as np
 
-    smrf = SmrfParams(cell_size=v.smrf_cell_size, slope=v.smrf_slope, max_window=v.smrf_window,
-                      threshold=v.smrf_threshold, scalar=v.smrf_scalar,
-                      low_outlier_radius=v.low_outlier_radius)  # fmt: skip
+    from ..lidar.block import ground_buffer, roof_buffer
+    from ..lidar.control import ControlOptions
+    from ..lidar.ground_filter import SmrfParams
+    from ..lidar.roof_planes import RoofPlaneParams
+
+    smrf = options_from(SmrfParams, SPEC, v)
     smrf = lengths_in_cloud_units(smrf, info, v.distance_unit,
                                   ("cell_size", "max_window", "low_outlier_radius"),
                                   ("threshold", "scalar", "low_outlier_height"))  # fmt: skip
-    roof = RoofPlaneParams(epsilon=v.epsilon, k_neighbours=v.k_neighbours,
-                           min_support=min(_R.min_support, v.k_neighbours),
-                           min_plane_points=v.min_plane_points)  # fmt: skip
+    roof = options_from(RoofPlaneParams, SPEC, v,
+                        min_support=min(RoofPlaneParams().min_support, v.k_neighbours))
     roof = lengths_in_cloud_units(roof, info, v.distance_unit, ("epsilon",))
-    control = ControlOptions(delta=v.delta, min_boundary=v.min_boundary)
+    control = options_from(ControlOptions, SPEC, v)
     control = lengths_in_cloud_units(control, info, v.distance_unit,
                                      ("delta", "min_boundary", "max_support_distance"))  # fmt: skip
     area = float(np.prod(np.maximum(info.maxs[:2] - info.mins[:2], 1e-9)))
@@ -472,6 +480,8 @@ def _check_tiling(v: Values) -> None:
 def _tile_need(index, settings: BlockSettings) -> tuple[float, str]:
     """Bytes the largest tile takes in a worker (its points with the buffer, at the block's
     mean density, and the ground filter's grid) and the words saying so."""
+    import numpy as np
+
     from .checks import GROUND_FILTER_BYTES_PER_CELL, GROUND_FILTER_BYTES_PER_POINT, size_text
 
     info = index.info

@@ -3,18 +3,18 @@
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
 
-from ..io.chips import CHIP_SUFFIXES
-from ..io.images import IMAGE_SUFFIXES
-from ..photo.control_location import LocateOptions
-from ..photo.least_squares_matching import LsmOptions
+from ..io.suffixes import CHIP_SUFFIXES, IMAGE_SUFFIXES
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
-_D = LocateOptions()
-_L = LsmOptions()
+if TYPE_CHECKING:
+    import numpy as np
+
+_D = Fields("photo.matching_options", "LocateOptions")
+_L = Fields("photo.matching_options", "LsmOptions")
 
 SPEC = AlgorithmSpec(
     name="locatecontrolpoints",
@@ -143,6 +143,8 @@ class _Images:
         self.readers: dict = {}
 
     def __call__(self, image_id: str, c0: int, r0: int, w: int, h: int) -> np.ndarray:
+        import numpy as np
+
         from ..io.raster import RasterReader
 
         if image_id not in self.readers:
@@ -177,7 +179,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.observations import write_observations_csv
     from ..io.orientation import read_eo_csv_full
     from ..io.resection import read_point_control_csv
-    from ..photo.control_location import locate_control_points
+    from ..photo.control_location import LocateOptions, locate_control_points
+    from ..photo.least_squares_matching import LsmOptions
     from ..quality.control_location_html import render_location_html
 
     crs = parse_crs(v.crs, what="CRS")
@@ -219,11 +222,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         opk=eo.opk[keep],
     )
     sig = eo_file.sigma[keep] if eo_file.sigma is not None else None
-    opt = LocateOptions(
-        default_search_px=v.search_px, min_ncc=v.min_ncc, transfer=v.transfer,
-        sigma_floor_px=v.sigma_floor,
-        lsm=replace(_L, min_correlation=v.min_correlation, max_sigma_px=v.max_sigma),
-    )  # fmt: skip
+    opt = options_from(LocateOptions, SPEC, v, lsm=options_from(LsmOptions, SPEC, v))
     reader = _Images(images)
     compute, _ = stages(progress, 0.95, 0.05)
     try:

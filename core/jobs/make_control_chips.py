@@ -6,17 +6,15 @@ from __future__ import annotations
 import logging
 import math
 
-from ..io.control_chips import PHOTO_SUFFIXES
-from ..photo.control_chips import ChipOptions
-from ..photo.control_plate import PlateGeometry
+from ..io.suffixes import PHOTO_SUFFIXES
 from .common import CSV_FILTER
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
-_C = ChipOptions()
-_P = PlateGeometry()
+_C = Fields("photo.control_chips", "ChipOptions")
+_P = Fields("photo.control_plate", "PlateGeometry")
 #: File names of the report in the output folder.
 REPORT_CSV = "control_chips.csv"
 REPORT_JSON = "control_chips.json"
@@ -168,7 +166,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     )
     from ..io.ground_points import read_ground_points_csv
     from ..io.raster import RasterReader
-    from ..photo.control_chips import ChipResult, make_chip
+    from ..photo.control_chips import ChipOptions, ChipResult, make_chip
+    from ..photo.control_plate import PlateGeometry
 
     points = read_ground_points_csv(v.points)
     crs = parse_crs(v.crs, what="mapping CRS")
@@ -194,10 +193,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if not v.inner_side < v.outer_side:
         raise InputError(f"INNER_SIDE ({v.inner_side:g} m) must be smaller than OUTER_SIDE "
                          f"({v.outer_side:g} m)")  # fmt: skip
-    options = ChipOptions(gsd_m=v.gsd, size_px=int(v.chip_size), corner_sigma_px=v.corner_sigma,
-                          max_sigma0=v.max_sigma0, sift_ratio=v.sift_ratio,
-                          ransac_px=v.ransac_threshold, min_matches=int(v.min_matches),
-                          from_plate_photo=bool(v.from_plate_photo))  # fmt: skip
+    options = options_from(ChipOptions, SPEC, v)
     for pair in pairs.values():  # every photo checked before anything is computed
         for path in (pair.plate_photo, pair.free_photo):
             if path:

@@ -4,13 +4,10 @@ from __future__ import annotations
 
 import logging
 
-import numpy as np
-
-from ..photo.monoplot import DEFAULT_EO_SIGMAS, METHODS
 from .checks import DSM_BYTES_PER_CELL, check_cell_size, check_memory
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Param, Ref, Result, Values
 
 log = logging.getLogger(__name__)
 
@@ -59,7 +56,9 @@ parallel / unknown_plane (planes).""",
         Param("DSM_CRS", "crs", "DSM CRS (overrides the file's)", optional=True,
               help="the DSM's CRS when the file has none or a wrong one; a 2D CRS takes the "
               "heights as ellipsoidal"),
-        Param("METHOD", "enum", "Method", METHODS[0], options=METHODS,
+        Param("METHOD", "enum", "Method",
+              Ref("photo.monoplot_options", "METHODS", convert=lambda methods: methods[0]),
+              options=Ref("photo.monoplot_options", "METHODS"),
               labels=("direct (Dal Poz, DDA)", "Makarovic iteration")),
         Param("CELL_SIZE", "number", "DSM cell size for LAS/LAZ", 0.5, unit="CRS unit",
               minimum=0.01, maximum=1000.0),
@@ -69,7 +68,8 @@ parallel / unknown_plane (planes).""",
               unit="pixels", minimum=0.0, maximum=1e6),
         Param("MIN_INCIDENCE", "number", "Minimum angle ray / face", 5.0, unit="degrees",
               minimum=0.0, maximum=90.0, advanced=True),
-        Param("EO_SIGMAS", "numbers", "EO sigmas: X, Y, Z, omega, phi, kappa", DEFAULT_EO_SIGMAS,
+        Param("EO_SIGMAS", "numbers", "EO sigmas: X, Y, Z, omega, phi, kappa",
+              Ref("photo.monoplot_options", "DEFAULT_EO_SIGMAS"),
               count=6, unit="m, degrees", minimum=0.0, maximum=100.0),
         Param("OUTPUT_POINTS", "sink", "Monoplotted points", geometry="point", optional=True),
         Param("OUTPUT_LINES", "sink", "Monoplotted lines", geometry="line", optional=True),
@@ -144,6 +144,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 def ray_count(obs, line_step_px: float) -> int:
     """How many rays :func:`~lidarphoto.core.photo.monoplot.monoplot` will cast: one per
     observation row plus, with ``line_step_px > 0``, the points added along each line."""
+    import numpy as np
     total = len(obs)
     if line_step_px <= 0:
         return total

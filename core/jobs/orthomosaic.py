@@ -6,17 +6,14 @@ import logging
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
-from ..io.images import IMAGE_SUFFIXES
-from ..photo.mosaic import METHODS, MosaicOptions
+from ..io.suffixes import IMAGE_SUFFIXES
 from .common import CSV_OUT, compression_param
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
-_D = MosaicOptions()
+_D = Fields("photo.ortho_options", "MosaicOptions")
 #: Largest seamline raster kept in memory (cells); bigger mosaics are traced at a coarser step.
 MAX_LABEL_CELLS = 64_000_000
 
@@ -49,7 +46,8 @@ the region each image fills, as a layer and as a CSV (image_id, cells, area, WKT
 MultiPolygon in the mosaic's CRS).""",
     params=(
         Param("ORTHOPHOTOS", "files", "Orthophotos (files or folders)", suffixes=IMAGE_SUFFIXES),
-        Param("METHOD", "enum", "Image chosen per cell", _D.method, options=METHODS,
+        Param("METHOD", "enum", "Image chosen per cell", _D.method,
+              options=Ref("photo.ortho_options", "MOSAIC_METHODS"),
               labels=("most nadir view", "nearest image centre")),
         Param("FEATHER", "number", "Feathering width across seamlines (0 = none)",
               _D.feather_px, unit="cells", minimum=0.0, maximum=1000.0),
@@ -100,6 +98,7 @@ def _floats(text: str | None, n: int) -> tuple[float, ...] | None:
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the orthophotos' grids and metadata, mosaic tile by tile, trace the seamlines."""
+    import numpy as np
     import pyproj
 
     from ..errors import InputError
@@ -108,7 +107,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.raster import RasterReader, polygonize
     from ..io.raster_write import GeoTiffWriter
     from ..io.tables import write_csv_atomic
-    from ..photo.mosaic import MosaicSource, mosaic_grid, mosaic_tiles
+    from ..photo.mosaic import MosaicOptions, MosaicSource, mosaic_grid, mosaic_tiles
     from .common import compression_args
     from .orthorectify import failures_named
 
@@ -147,7 +146,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                         "made by orthorectify): every cell takes the nearest image centre")
             method = "centre"
         grid = mosaic_grid(sources)
-        options = MosaicOptions(method=method, feather_px=v.feather)
+        options = options_from(MosaicOptions, SPEC, v, method=method)
 
         def read(k: int, win: tuple[int, int, int, int]):
             return readers[k].read(win), readers[k].read_mask(win)

@@ -12,17 +12,14 @@ from concurrent.futures import Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
-from ..io.images import IMAGE_SUFFIXES
-from ..photo.orthophoto import RESAMPLING, OrthoOptions
+from ..io.suffixes import IMAGE_SUFFIXES
 from .common import CSV_FILTER, compression_param
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
-_D = OrthoOptions()
+_D = Fields("photo.ortho_options", "OrthoOptions")
 #: Name of the orthophoto of image ``<image_id>`` in the output folder.
 ORTHO_NAME = "{}_ortho.tif"
 DSM_FILTER = "DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"
@@ -75,7 +72,8 @@ Nothing is written when an input is wrong; the files appear together when all ar
               minimum=0.0, maximum=1000.0),
         Param("EXTENT", "numbers", "Extent xmin,ymin,xmax,ymax (empty = footprint)", count=4,
               optional=True, unit="CRS unit"),
-        Param("RESAMPLING", "enum", "Resampling", _D.resampling, options=RESAMPLING),
+        Param("RESAMPLING", "enum", "Resampling", _D.resampling,
+              options=Ref("photo.ortho_options", "RESAMPLING")),
         Param("TRUE_ORTHO", "boolean", "True orthophoto (occluded ground = no data)",
               _D.true_ortho),
         Param("OCCLUSION_TOLERANCE", "number", "Occlusion tolerance along the ray",
@@ -108,6 +106,8 @@ class OrthoFile:
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Check every input, then orthorectify the images one after the other."""
+    import numpy as np
+
     from ..errors import CrsError, InputError
     from ..geometry.frames import LocalFrame, MappingFrame, check_area_of_use, parse_crs
     from ..geometry.raycast import DsmTracer
@@ -118,7 +118,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.orientation import read_eo_csv
     from ..io.raster import RasterReader
     from ..io.raster_write import GeoTiffWriter
-    from ..photo.orthophoto import OrthoProjector, _lens_lattice, auto_gsd
+    from ..photo.orthophoto import OrthoOptions, OrthoProjector, _lens_lattice, auto_gsd
     from .common import compression_args
 
     mapping = parse_crs(v.crs, what="mapping CRS")
@@ -143,8 +143,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             raise InputError(f"the image is {info.width} x {info.height} px, the camera "
                              f"{camera.name!r} {camera.width_px} x {camera.height_px} px",
                              path=str(f))  # fmt: skip
-    options = OrthoOptions(gsd=v.gsd, resampling=v.resampling, true_ortho=v.true_ortho,
-                           occlusion_tol_m=v.occlusion_tolerance)  # fmt: skip
+    options = options_from(OrthoOptions, SPEC, v)
     folder = Path(v.output_folder)
     targets = {f.stem: folder / ORTHO_NAME.format(f.stem) for f in images}
     inputs = {"IMAGES": [str(f) for f in images], "DSM": v.dsm, "EO": v.eo, "CAMERA": v.camera}
@@ -282,6 +281,8 @@ def _grids(boxes: dict, extent, gsd: float, infos: dict, folder: Path) -> dict:
     grids that GDAL cannot write or the output folder cannot hold (uncompressed)."""
     import shutil
 
+    import numpy as np
+
     from ..errors import InputError
     from ..photo.orthophoto import ortho_grid
     from .checks import size_text
@@ -352,6 +353,7 @@ def _tiles(proj, grid, src, info, options, progress, should_stop):
 
 def _median_height(dsm, box) -> float:
     """Median surface height inside the box (a subsample of its cells)."""
+    import numpy as np
     if box is None:
         return math.nan
     g = dsm.grid
@@ -368,6 +370,7 @@ def _median_height(dsm, box) -> float:
 
 def _beyond_dsm(proj, ground_z: float) -> float:
     """Share of the image's border whose ground (at the median height) lies beyond the DSM."""
+    import numpy as np
     cam = proj.camera
     k = np.linspace(0.0, 1.0, 33)
     w, h = cam.width_px, cam.height_px

@@ -12,14 +12,12 @@ from __future__ import annotations
 import logging
 import math
 
-import numpy as np
-
-from ..photo.resection import MODELS, ResectionOptions
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
+_OPTIONS = Fields("photo.resection", "ResectionOptions")
 
 SPEC = AlgorithmSpec(
     name="resection",
@@ -86,11 +84,13 @@ lines parallel).""",
               unit="m, degrees", optional=True, advanced=True, minimum=1e-6, maximum=1e6,
               help="empty: start values only; given: weighted observations"),
         Param("IMAGES", "string", "Images (comma separated; empty: all)", "", optional=True),
-        Param("MODEL", "enum", "Line model", MODELS[0], options=MODELS,
+        Param("MODEL", "enum", "Line model", _OPTIONS.model,
+              options=Ref("photo.resection", "MODELS"),
               labels=("coplanarity (no parametrisation)",
                       "equivalent planes (Tommaselli & Tozzi 1996)")),
-        Param("ESTIMATE_INTERIOR", "boolean", "Refine focal length and principal point", False),
-        Param("SNOOPING", "boolean", "Data snooping (Baarda)", True),
+        Param("ESTIMATE_INTERIOR", "boolean", "Refine focal length and principal point",
+              _OPTIONS.estimate_interior),
+        Param("SNOOPING", "boolean", "Data snooping (Baarda)", _OPTIONS.snooping),
         Param("OUTPUT_EO", "file_out", "Exterior orientation with sigmas (CSV)",
               file_filter=CSV_OUT),
         Param("OUTPUT_RESIDUALS", "file_out", "Residuals (CSV)", optional=True,
@@ -118,6 +118,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the inputs, resect each image, write the outputs."""
     from pathlib import Path
 
+    import numpy as np
+
     from ..errors import Cancelled, InputError, LidarPhotoError, stop_if_asked
     from ..geometry.frames import LocalFrame, MappingFrame, check_area_of_use
     from ..io.atomic import write_text_atomic
@@ -125,6 +127,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.observations import read_observations_csv
     from ..io.orientation import read_eo_csv
     from ..io.resection import read_line_control_csv, read_point_control_csv
+    from ..photo.resection import ResectionOptions
     from ..photo.resection_map import image_inputs, resect_in_map
     from ..quality.resection_html import render_resection_html
 
@@ -170,8 +173,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         prior = (*s[:3], *(math.radians(a) for a in s[3:]))
     images = [s.strip() for s in (v.images or "").split(",") if s.strip()]
     inputs = image_inputs(obs, points, lines, images or None)
-    options = ResectionOptions(model=v.model, estimate_interior=v.estimate_interior,
-                               snooping=v.snooping, eo_prior_sigma=prior)  # fmt: skip
+    options = options_from(ResectionOptions, SPEC, v, eo_prior_sigma=prior)
     everything = [d.data for d in inputs]
     ctrl = np.vstack([np.vstack([d.xyz, d.line_p1, d.line_p2]) for d in everything])
     if not len(ctrl):
@@ -275,6 +277,8 @@ def run_eo_row(r: ImageRun) -> tuple:
 
 def residual_rows(r: ImageRun, obs, camera) -> list[tuple]:
     """Rows of the residual table of one image (see :mod:`core.io.resection`)."""
+    import numpy as np
+
     from ..geometry.collinearity import project
 
     item, res = r.image, r.result.result
@@ -306,6 +310,7 @@ def residual_rows(r: ImageRun, obs, camera) -> list[tuple]:
 
 def _settings(v, camera, obs, points, lines, frame) -> dict[str, str]:
     """The run's settings as text (the HTML summary shows them)."""
+    import numpy as np
     kinds, counts = np.unique(np.array(obs.type), return_counts=True)
     return {
         "camera": f"{camera.name} (f = {camera.focal_mm:g} mm, {camera.width_px} x "

@@ -3,8 +3,14 @@
 A job module (``core/jobs/<algorithm>.py``) declares ``SPEC``, an :class:`AlgorithmSpec` whose
 :class:`Param` entries carry the name (the QGIS key, ``CELL_SIZE``, and the command-line
 option, ``--cell-size``), the kind, label, default, unit, valid range and help. The QGIS
-algorithm (``processing_provider/spec_algorithm.py``), the command line (``core/cli.py``) and
-both help texts are generated from it, so a default or a help text is written in one place.
+algorithm (``processing_provider/base.py``), the command line (``core/cli.py``) and both help texts
+are generated from it, so a default or a help text is written in one place.
+
+Defaults, choices and ranges that belong to the science are not retyped: a :class:`Ref`
+names them (``Ref("photo.tie_points", "TiePointOptions", "ratio")``, or through
+:class:`Fields`), and they are read from the science the first time the spec's parameters are
+used (:attr:`AlgorithmSpec.params`). Listing the algorithms (``lidarphoto --help``, the
+registry of :mod:`core.jobs`) reads only names and summaries and imports no science.
 
 Kinds of inputs (the value a job receives):
 
@@ -35,6 +41,8 @@ Results (numbers and strings a job reports) are :class:`Result` entries.
 
 from __future__ import annotations
 
+import dataclasses
+import importlib
 import math
 import re
 from collections.abc import Callable, Mapping, Sequence
@@ -65,6 +73,70 @@ TR_CONTEXT = "AlgorithmHelp"
 
 
 @dataclass(frozen=True)
+class Ref:
+    """A value of the science, read when first needed: ``Ref("photo.resection", "MODELS")`` is
+    the constant ``MODELS`` of ``core/photo/resection.py``; with ``field``,
+    ``Ref("photo.bundle", "BundleOptions", "robust")`` is the default of that dataclass field;
+    ``convert`` turns the value into the spec's form (e.g. a label per choice).
+
+    >>> Ref("lidar.roof_planes", "RoofPlaneParams", "k_neighbours").value()
+    20
+    """
+
+    module: str  #: module below ``core`` ("photo.bundle")
+    name: str  #: a constant or a dataclass of that module
+    field: str = ""  #: a field of the dataclass ``name`` ("" for a constant)
+    convert: Callable[[Any], Any] | None = None
+
+    def value(self) -> Any:
+        value = self.science_value()
+        return value if self.convert is None else self.convert(value)
+
+    def science_value(self) -> Any:
+        """The value as the science holds it (before ``convert``)."""
+        # relative to the core package, which the plugin may install under another name
+        module = importlib.import_module(f"..{self.module}", __package__)
+        obj = getattr(module, self.name)
+        if not self.field:
+            return obj
+        for f in dataclasses.fields(obj):
+            if f.name == self.field:
+                if f.default is not dataclasses.MISSING:
+                    return f.default
+                if f.default_factory is not dataclasses.MISSING:
+                    return f.default_factory()
+                raise ValueError(f"{self}: the field has no default")
+        raise AttributeError(f"{self.name} has no field {self.field!r}")
+
+    def names(self, cls: type) -> bool:
+        """Whether this is a field of the class ``cls``."""
+        return bool(self.field) and cls.__name__ == self.name and (
+            cls.__module__.endswith(f".{self.module}")
+        )
+
+    def __str__(self) -> str:
+        return f"{self.module}.{self.name}" + (f".{self.field}" if self.field else "")
+
+
+class Fields:
+    """The fields of a science dataclass as :class:`Ref` s, without importing it:
+    ``BUNDLE = Fields("photo.bundle", "BundleOptions")``; ``BUNDLE.robust`` is
+    ``Ref("photo.bundle", "BundleOptions", "robust")``."""
+
+    def __init__(self, module: str, name: str) -> None:
+        self.module, self.name = module, name
+
+    def __getattr__(self, field_name: str) -> Ref:
+        if field_name.startswith("_"):
+            raise AttributeError(field_name)
+        return Ref(self.module, self.name, field_name)
+
+
+#: The fields of :class:`Param` a :class:`Ref` may stand for.
+_REF_FIELDS = ("default", "minimum", "maximum", "options", "labels")
+
+
+@dataclass(frozen=True)
 class Param:
     """One parameter of an algorithm (see the module docstring for the kinds).
 
@@ -75,7 +147,9 @@ class Param:
     ``aliases`` are extra command-line spellings of options; ``qgis_default`` overrides
     ``default`` in QGIS only (e.g. ``"ProjectCrs"``); ``suffixes`` are the file endings the job
     reads from a folder given to a ``files`` (or ``file``) input (empty: every file), which no
-    output may overwrite.
+    output may overwrite. ``default``, ``minimum``, ``maximum``, ``options`` and ``labels`` may
+    be a :class:`Ref`, resolved by :meth:`resolved`; a default read from a dataclass field
+    keeps that field in ``source`` (see :func:`options_from`).
     """
 
     name: str
@@ -100,18 +174,45 @@ class Param:
     numeric_field: bool = False
     qgis_default: Any = None
     suffixes: tuple[str, ...] = ()
+    source: Ref | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in INPUT_KINDS + OUTPUT_KINDS:
             raise ValueError(f"{self.name}: unknown kind {self.kind!r}")
         if not re.fullmatch(r"[A-Z][A-Z0-9_]*", self.name):
             raise ValueError(f"{self.name}: names are upper case with underscores")
+        if self.refs:
+            return  # checked once resolved
         if self.kind == "enum" and not self.options:
             raise ValueError(f"{self.name}: an enum needs options")
         if self.labels and len(self.labels) != len(self.options):
             raise ValueError(f"{self.name}: one label per option")
         if self.kind == "numbers" and self.count < 1:
             raise ValueError(f"{self.name}: numbers need a count")
+
+    @property
+    def refs(self) -> tuple[str, ...]:
+        """The fields that are still a :class:`Ref`."""
+        return tuple(f for f in _REF_FIELDS if isinstance(getattr(self, f), Ref))
+
+    def resolved(self) -> Param:
+        """This parameter with its :class:`Ref` s read from the science (a tuple default
+        stays a tuple, an enum's options a tuple of names).
+
+        >>> p = Param("K", "integer", "Neighbours", Ref("lidar.roof_planes", "RoofPlaneParams",
+        ...           "k_neighbours"))
+        >>> p.resolved().default, str(p.resolved().source)
+        (20, 'lidar.roof_planes.RoofPlaneParams.k_neighbours')
+        """
+        if not self.refs:
+            return self
+        values: dict[str, Any] = {}
+        for name in self.refs:
+            value = getattr(self, name).value()
+            values[name] = tuple(value) if isinstance(value, (list, tuple)) else value
+        if isinstance(self.default, Ref) and self.default.field:
+            values["source"] = self.default
+        return dataclasses.replace(self, **values)
 
     @property
     def option(self) -> str:
@@ -182,14 +283,28 @@ class AlgorithmSpec:
     references: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
-        names = [p.name for p in self.params] + [r.name for r in self.results]
+        params = self.__dict__.get("params", self.__dict__.get("_unresolved"))
+        names = [p.name for p in params] + [r.name for r in self.results]
         dupes = {n for n in names if names.count(n) > 1}
         if dupes:
             raise ValueError(f"{self.name}: duplicate names {sorted(dupes)}")
-        known = {p.name for p in self.params}
-        for p in self.params:
+        known = {p.name for p in params}
+        for p in params:
             if p.kind == "field" and p.parent not in known:
                 raise ValueError(f"{self.name}.{p.name}: unknown parent {p.parent!r}")
+        if any(p.refs for p in params):
+            # lazy: the science is imported when the parameters are first used (__getattr__)
+            object.__setattr__(self, "_unresolved", tuple(params))
+            object.__delattr__(self, "params")
+
+    def __getattr__(self, name: str) -> Any:
+        # only called for a missing attribute: ``params`` before its first use
+        unresolved = self.__dict__.get("_unresolved")
+        if name != "params" or unresolved is None:
+            raise AttributeError(name)
+        params = tuple(p.resolved() for p in unresolved)
+        object.__setattr__(self, "params", params)
+        return params
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -488,6 +603,28 @@ def check_value(p: Param, value: Any) -> None:
             raise InputError(f"{p.name}{which}: must be >= {p.minimum:g}{unit}, got {v:g}")
         if p.maximum is not None and v > p.maximum:
             raise InputError(f"{p.name}{which}: must be <= {p.maximum:g}{unit}, got {v:g}")
+
+
+def options_from(cls: type, spec: AlgorithmSpec, values: Mapping[str, Any], **extra: Any) -> Any:
+    """An instance of the science dataclass ``cls`` from the parameters whose default is one
+    of its fields (:attr:`Param.source`), with ``extra`` fields (what needs a conversion: a
+    parameter whose :class:`Ref` converts, e.g. arcseconds to radians, is given there); the
+    other fields keep their defaults.
+
+    >>> spec = AlgorithmSpec("x", "X", "G", "g", "s", "d", (Param("EPSILON", "number", "E",
+    ...     Ref("lidar.roof_planes", "RoofPlaneParams", "epsilon")),))
+    >>> from lidarphoto.core.lidar.roof_planes import RoofPlaneParams
+    >>> options_from(RoofPlaneParams, spec, {"EPSILON": 0.2}, seed=3).epsilon
+    0.2
+    """
+    fields = {
+        p.source.field: values[p.name]
+        for p in spec.params
+        if p.source is not None and p.source.convert is None and p.name in values
+        and p.source.names(cls)
+    }
+    fields.update(extra)
+    return cls(**fields)
 
 
 def parse_values(spec: AlgorithmSpec, raw: Mapping[str, Any]) -> Values:

@@ -6,15 +6,14 @@ from __future__ import annotations
 
 import logging
 
-from ..io.images import IMAGE_SUFFIXES
-from ..photo.tie_points import DETECTORS, PAIR_MODES, RANSAC_METHODS, TiePointOptions
+from ..io.suffixes import IMAGE_SUFFIXES
 from .common import CSV_FILTER, CSV_OUT
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
-_D = TiePointOptions()
+_D = Fields("photo.tie_points", "TiePointOptions")
 #: Columns of the pair table (OUTPUT_PAIRS).
 PAIR_COLUMNS = ("image_a", "image_b", "overlap", "features_a", "features_b", "ratio_matches",
                 "mutual_matches", "inliers", "epipolar_median_px", "status")  # fmt: skip
@@ -68,7 +67,8 @@ track's first-image measurement: the median of its track's refined sigmas.""",
               help="the EO is checked against its area of use"),
         Param("HEIGHT", "number", "Mean terrain height", 0.0, unit="m", minimum=-1000.0,
               maximum=9000.0, help="the plane the footprints are computed on (EO heights)"),
-        Param("DETECTOR", "enum", "Detector", _D.detector, options=DETECTORS,
+        Param("DETECTOR", "enum", "Detector", _D.detector,
+              options=Ref("photo.tie_points", "DETECTORS"),
               labels=("SIFT (Lowe 2004)", "ORB (fast)")),
         Param("MAX_FEATURES", "integer", "Features per image", _D.max_features, minimum=100,
               maximum=100000),
@@ -79,12 +79,14 @@ track's first-image measurement: the median of its track's refined sigmas.""",
         Param("RANSAC_THRESHOLD", "number", "RANSAC threshold (epipolar distance)",
               _D.ransac_px, unit="pixels", minimum=0.05, maximum=100.0),
         Param("RANSAC_METHOD", "enum", "RANSAC method", _D.ransac_method,
-              options=RANSAC_METHODS, labels=("MAGSAC++", "RANSAC"), advanced=True),
+              options=Ref("photo.tie_points", "RANSAC_METHODS"), labels=("MAGSAC++", "RANSAC"),
+              advanced=True),
         Param("MIN_INLIERS", "integer", "Minimum inliers per pair", _D.min_inliers, minimum=8,
               maximum=100000),
         Param("MIN_TRACK_LENGTH", "integer", "Minimum track length", _D.min_track_length,
               unit="images", minimum=2, maximum=1000),
-        Param("PAIR_MODE", "enum", "Pairs", _D.pair_mode, options=PAIR_MODES,
+        Param("PAIR_MODE", "enum", "Pairs", _D.pair_mode,
+              options=Ref("photo.tie_points", "PAIR_MODES"),
               labels=("footprints with EO, else sequential", "footprints (EO + camera)",
                       "all pairs", "sequential window")),
         Param("WINDOW", "integer", "Sequential window", _D.window, unit="images", minimum=1,
@@ -124,15 +126,15 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.observations import write_observations_csv
     from ..io.orientation import read_eo_csv
     from ..io.tables import write_csv_atomic
-    from ..photo.tie_points import detect_features, footprints, reduction_factor, tie_points
+    from ..photo.tie_points import (
+        TiePointOptions,
+        detect_features,
+        footprints,
+        reduction_factor,
+        tie_points,
+    )
 
-    options = TiePointOptions(
-        detector=v.detector, max_features=int(v.max_features),
-        max_dimension_px=int(v.max_dimension), ratio=v.ratio, ransac_px=v.ransac_threshold,
-        ransac_method=v.ransac_method, min_inliers=int(v.min_inliers),
-        min_track_length=int(v.min_track_length), pair_mode=v.pair_mode, window=int(v.window),
-        min_overlap=v.min_overlap, sigma_px=v.sigma, refine=bool(v.refine),
-    )  # fmt: skip
+    options = options_from(TiePointOptions, SPEC, v)
     files = list_image_files(v.images, ("IMAGES", "identical images have no parallax"))
     if len(files) < 2:
         raise InputError("tie points need at least two images")

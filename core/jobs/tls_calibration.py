@@ -1,7 +1,7 @@
 """``tlscalibration``: register terrestrial laser scanner stations and calibrate the scanner.
 
 Outputs: the adjusted station poses with sigmas, the additional parameters (APs) with sigmas
-and significance, the target coordinates, the residuals per component (docs/conventions.md,
+and significance, the target coordinates, the residuals per component (docs/formats.md,
 "TLS tables"), an HTML report with the correlation matrix and, optionally, the scans written
 into the common frame (:data:`REGISTERED_NAME` in OUTPUT_FOLDER).
 """
@@ -14,17 +14,23 @@ from pathlib import Path
 
 from ..i18n import joined as _joined
 from ..i18n import mark as _t
-from ..io.scans import SCAN_SUFFIXES
-from ..tls.aps import AP_SETS, ARCSEC
-from ..tls.options import CalibrationOptions
+from ..io.suffixes import SCAN_SUFFIXES
 from .common import CSV_FILTER, CSV_OUT, doubt_params, settle_doubts
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Result, Values
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 TR_CONTEXT = "Report"
 
-_D = CalibrationOptions()
+_D = Fields("tls.options", "CalibrationOptions")
+
+
+def _arcsec(radians: float) -> float:
+    from ..tls.aps import ARCSEC
+
+    return radians / ARCSEC
+
+
 ANGLE_UNITS = ("degrees", "gon", "radians")
 DATUMS = ("inner", "reference")
 #: A median disagreement of target-to-target distances between stations beyond this
@@ -100,7 +106,8 @@ beginning with #).""",
               (2.0, 10.0, 10.0), count=3, unit="mm, arcsec, arcsec", minimum=1e-6,
               maximum=1e6, help="for rows without s_range, s_hz, s_vt (or s_x, s_y, s_z: "
               "the range sigma)"),
-        Param("AP_SET", "enum", "Additional parameters", "paper", options=tuple(AP_SETS),
+        Param("AP_SET", "enum", "Additional parameters", _D.ap_set,
+              options=Ref("tls.aps", "AP_SETS", convert=tuple),
               labels=("none (registration only)", "paper: a0, b1, b2, c0",
                       "extended (Lichti 2007): a0-a3, b1-b6, c0-c3")),
         Param("AP_TERMS", "string", "AP terms (overrides the set)", "", optional=True,
@@ -109,7 +116,8 @@ beginning with #).""",
               _D.select_aps),
         Param("LEVELLED", "boolean", "Stations levelled by the compensator", _D.levelled,
               help="default for stations whose table does not say"),
-        Param("TILT_SIGMA", "number", "Compensator sigma", _D.tilt_sigma_rad / ARCSEC,
+        Param("TILT_SIGMA", "number", "Compensator sigma",
+              Ref("tls.options", "CalibrationOptions", "tilt_sigma_rad", convert=_arcsec),
               unit="arcsec", minimum=0.01, maximum=36000.0),
         Param("DATUM", "enum", "Datum without control", _D.datum, options=DATUMS,
               labels=("inner constraints on the targets (free network)",
@@ -172,8 +180,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     )
     from ..lsq.results import rejection_test
     from ..quality.tls_html import render_tls_html
+    from ..tls.aps import ARCSEC
     from ..tls.calibration import calibrate
     from ..tls.network import distance_consistency
+    from ..tls.options import CalibrationOptions
 
     scans = _check_scans(v)
     s_range_mm, s_hz, s_vt = v.default_sigmas
@@ -212,17 +222,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             path=v.observations,
         )
     aps = v.ap_terms.strip() if v.ap_terms else v.ap_set
-    options = CalibrationOptions(
-        ap_set=aps,
-        levelled=v.levelled,
-        tilt_sigma_rad=v.tilt_sigma * ARCSEC,
-        cyclic_wavelength_m=v.cyclic_wavelength,
-        datum=v.datum,
-        reference_station=v.reference_station or None,
-        snooping=v.snooping,
-        correlation_limit=v.correlation_limit,
-        select_aps=v.select_aps,
-    )
+    options = options_from(CalibrationOptions, SPEC, v, ap_set=aps,
+                           tilt_sigma_rad=v.tilt_sigma * ARCSEC,
+                           reference_station=v.reference_station or None)  # fmt: skip
     cal = calibrate(obs, control, stations, options, progress=progress,
                     should_stop=should_stop)  # fmt: skip
     settings = {

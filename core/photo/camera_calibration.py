@@ -55,6 +55,12 @@ from ..i18n import mark as _t
 from ..lsq.adjustment import adjust
 from ..lsq.model import AdjustmentOptions, GaussMarkovBlock
 from ..lsq.results import AdjustmentResult
+from .calibration_options import (
+    FIELD_MODES,
+    INTERIOR_NAMES,
+    LENS_NAMES,
+    CalibrationOptions,
+)
 from .calibration_targets import Detection, TargetField
 
 #: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
@@ -62,53 +68,8 @@ TR_CONTEXT = "Report"
 
 Array = NDArray[np.float64]
 
-INTERIOR_NAMES = ("focal_mm", "x0_mm", "y0_mm", "k1", "k2", "k3", "p1", "p2")
-LENS_NAMES = INTERIOR_NAMES[3:]
-FIELD_MODES = ("fixed", "free")
 # Points a view needs for its own pose (6 unknowns) with some redundancy.
 MIN_POINTS_PER_VIEW = 6
-
-
-@dataclass(frozen=True)
-class CalibrationOptions:
-    """Options of :func:`calibrate_camera`.
-
-    Attributes
-    ----------
-    projection : str
-        ``"perspective"`` or a fisheye projection (:data:`core.geometry.projection.PROJECTIONS`).
-    lens_parameters : tuple of str
-        Lens coefficients to estimate (the others are held at zero), of
-        ``k1 k2 k3 p1 p2``.
-    field : {"fixed", "free"}
-        Target coordinates as given (fixed) or estimated with a minimal datum (free).
-    sigma_px : float
-        A-priori standard deviation of a detected point, pixels (each coordinate).
-    alpha : float
-        Significance level of the t-tests of the lens coefficients.
-    max_iterations : int
-        Of the adjustment.
-    """
-
-    projection: str = "perspective"
-    lens_parameters: tuple[str, ...] = LENS_NAMES
-    field: str = "fixed"
-    sigma_px: float = 0.2
-    alpha: float = 0.05
-    max_iterations: int = 100
-
-    def __post_init__(self) -> None:
-        """Check the choices (raises :class:`InputError`)."""
-        if self.projection not in PROJECTIONS:
-            raise InputError(f"projection must be one of {', '.join(PROJECTIONS)}, "
-                             f"got {self.projection!r}")  # fmt: skip
-        bad = [p for p in self.lens_parameters if p not in LENS_NAMES]
-        if bad:
-            raise InputError(f"unknown lens parameter(s) {bad}: use some of {list(LENS_NAMES)}")
-        if self.field not in FIELD_MODES:
-            raise InputError(f"field must be fixed or free, got {self.field!r}")
-        if not self.sigma_px > 0:
-            raise InputError(f"sigma_px must be positive, got {self.sigma_px}")
 
 
 @dataclass

@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -55,10 +55,11 @@ from ..geometry.collinearity import project_with_status
 from ..geometry.frames import LocalFrame, MappingFrame
 from ..geometry.rotations import matrix_to_opk
 from ..i18n import mark as _t
-from .least_squares_matching import LsmOptions, affine_start, lsm_in_image
+from .least_squares_matching import affine_start, lsm_in_image
+from .matching_options import LocateOptions
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_map_to_local
-from .template_matching import TextureOptions, choose_template_size, ncc_search
+from .template_matching import choose_template_size, ncc_search
 
 #: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
 TR_CONTEXT = "Report"
@@ -110,21 +111,6 @@ class ControlChip:
         x = gt[0] + (cr[:, 0] + 0.5) * gt[1]
         y = gt[3] + (cr[:, 1] + 0.5) * gt[5]
         return np.column_stack([x, y, np.full(len(cr), self.xyz[2])])
-
-
-@dataclass(frozen=True)
-class LocateOptions:
-    """Options of :func:`locate_control_points` (module docstring for each)."""
-
-    search_sigmas: float = 3.0
-    default_search_px: float = 25.0
-    min_search_px: float = 5.0
-    max_search_px: float = 150.0
-    min_ncc: float = 0.6
-    transfer: bool = True
-    sigma_floor_px: float = 0.1
-    texture: TextureOptions = field(default_factory=TextureOptions)
-    lsm: LsmOptions = field(default_factory=LsmOptions)
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..i18n import mark as _t
 from . import least_squares_matching_numba as _numba
+from .matching_options import LsmOptions
 
 #: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
 TR_CONTEXT = "Report"
@@ -59,19 +60,6 @@ STATUS_TEXT = (
     _t("ok"), _t("no texture"), _t("left the search window"), _t("not converged"),
     _t("moved too far"), _t("low correlation"), _t("sigma too large"),
 )  # fmt: skip
-
-
-@dataclass(frozen=True)
-class LsmOptions:
-    """Convergence and acceptance thresholds (module docstring); pixels unless stated."""
-
-    max_iterations: int = 30
-    shift_tol_px: float = 0.001
-    max_shift_px: float = 3.0
-    min_correlation: float = 0.7
-    max_sigma_px: float = 0.2
-    interpolation: str = "bicubic"
-    backend: str = "auto"
 
 
 @dataclass(frozen=True)

@@ -53,6 +53,7 @@ from ..geometry.raycast import (
     intersect_dsm,
 )
 from ..geometry.surface import Dsm, reproject_dsm
+from .monoplot_options import DEFAULT_EO_SIGMAS, METHODS
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_map_to_local
 
@@ -70,10 +71,6 @@ STATUS_TEXT = {
     STATUS_PARALLEL: "parallel",  # the ray is parallel to the plane or meets it behind
     STATUS_UNKNOWN_PLANE: "unknown_plane",  # target_id is not in the plane table
 }
-METHODS = ("dal_poz", "makarovic")
-#: Exterior-orientation sigmas (X, Y, Z m; omega, phi, kappa degrees) of a survey-grade
-#: GNSS/INS after post-processing (POS AV 510 class), used when none is given.
-DEFAULT_EO_SIGMAS = (0.05, 0.05, 0.08, 0.005, 0.005, 0.008)
 _HIT = (STATUS_OK, STATUS_GRAZING)
 
 __all__ = [

@@ -34,9 +34,10 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..geometry.grid import Grid
+from .ortho_options import MOSAIC_METHODS as METHODS
+from .ortho_options import MosaicOptions
 from .orthophoto import ordered_map
 
-METHODS = ("nadir", "centre")
 #: read(k, (col0, row0, cols, rows)) -> (data (bands, rows, cols), valid (rows, cols)) of
 #: orthophoto k in its own pixels
 ReadSource = Callable[[int, tuple[int, int, int, int]], tuple[NDArray, NDArray[np.bool_]]]
@@ -67,32 +68,6 @@ class MosaicSource:
     centre: tuple[float, float, float] | None = None
     ground_z: float | None = None
     principal_ground: tuple[float, float] | None = None
-
-
-@dataclass(frozen=True)
-class MosaicOptions:
-    """How the mosaic is made (module docstring).
-
-    Attributes
-    ----------
-    method : {"nadir", "centre"}
-    feather_px : float
-        Width of the blend across seamlines, cells (0: none, a hard seam).
-    tile_px : int
-    workers : int
-        Threads (0: one per CPU, at most 4).
-    """
-
-    method: str = "nadir"
-    feather_px: float = 0.0
-    tile_px: int = 512
-    workers: int = 0
-
-    def __post_init__(self) -> None:
-        if self.method not in METHODS:
-            raise InputError(f"method must be one of {', '.join(METHODS)}, got {self.method!r}")
-        if not (self.feather_px >= 0 and math.isfinite(self.feather_px)):
-            raise InputError(f"feathering must be >= 0 cells, got {self.feather_px!r}")
 
 
 @dataclass(frozen=True)

@@ -57,6 +57,7 @@ from ..geometry.grid import Grid
 from ..geometry.raycast import STATUS_GRAZING, STATUS_OK, DsmTracer, intersect_dsm
 from ..geometry.surface import Dsm, triangle_height
 from .orientation import eo_map_to_local
+from .ortho_options import RESAMPLING, OrthoOptions
 from .orthophoto_numba import cell_stats, remap_maps, remap_maps_fixed, valid_bounds
 
 LOG = logging.getLogger(__name__)
@@ -66,7 +67,6 @@ Array = NDArray[np.float64]
 #: source image, each pixel the mean of f x f (f = 1: the pixels themselves)
 ReadWindow = Callable[[tuple[int, int, int, int], int], NDArray]
 
-RESAMPLING = ("nearest", "bilinear", "cubic")
 _PAD = {"nearest": 1, "bilinear": 1, "cubic": 2}
 
 __all__ = [
@@ -80,52 +80,6 @@ __all__ = [
     "ortho_grid",
     "orthorectify_tiles",
 ]
-
-
-@dataclass(frozen=True)
-class OrthoOptions:
-    """How orthophotos are made.
-
-    Attributes
-    ----------
-    gsd : float
-        Cell size of the output, CRS unit; 0: the image's nadir GSD at the median surface
-        height, to 2 significant digits (:func:`auto_gsd`).
-    resampling : {"nearest", "bilinear", "cubic"}
-    true_ortho : bool
-        Make occluded ground no data (module docstring, step 5).
-    occlusion_tol_m : float
-        A surface hit this much (CRS unit, along the ray) before the ground point occludes it.
-    tile_px : int
-        Side of the tiles processed at once, cells.
-    lattice_px : int
-        Spacing of the exact projection nodes within a tile, cells.
-    workers : int
-        Threads (0: one per CPU, at most 4).
-    antialias : bool
-        Where a cell spans f >= 2 image pixels, resample the image averaged over f x f
-        pixels (else the resampling aliases fine texture).
-    """
-
-    gsd: float = 0.0
-    resampling: str = "bilinear"
-    true_ortho: bool = False
-    occlusion_tol_m: float = 0.05
-    tile_px: int = 512
-    lattice_px: int = 64
-    workers: int = 0
-    antialias: bool = True
-
-    def __post_init__(self) -> None:
-        if self.resampling not in RESAMPLING:
-            raise InputError(f"resampling must be one of {', '.join(RESAMPLING)}, "
-                             f"got {self.resampling!r}")  # fmt: skip
-        if not (self.gsd >= 0 and math.isfinite(self.gsd)):
-            raise InputError(f"GSD must be >= 0 (0: automatic), got {self.gsd!r}")
-        if int(self.tile_px) < 16 or int(self.lattice_px) < 2:
-            raise InputError("tile_px must be >= 16 and lattice_px >= 2")
-        if not self.occlusion_tol_m >= 0:
-            raise InputError(f"occlusion tolerance must be >= 0, got {self.occlusion_tol_m!r}")
 
 
 @dataclass(frozen=True)

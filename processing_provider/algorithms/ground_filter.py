@@ -1,4 +1,4 @@
-"""lidarphoto:groundfilter - progressive morphological ground filter of a LAS/LAZ cloud."""
+"""lidarphoto:groundfilter - ground filter of a LAS/LAZ cloud (SMRF, PMF or cloth simulation)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from ..layer_styles import style_dtm
 
 
 class GroundFilterAlgorithm(BaseAlgorithm):
-    """Adapter of ``core.jobs.ground_filter`` (file outputs only)."""
+    """Adapter of ``core.jobs.ground_filter``: file outputs, the DTM styled when QGIS loads it."""
 
     JOB = ground_filter
     STYLES = (("OUTPUT_DTM", style_dtm),)

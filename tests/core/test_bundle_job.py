@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.errors import InputError
+from lidarphoto.core.geometry.ap_models import AP_FAMILIES
 from lidarphoto.core.io.camera import read_cameras_json
 from lidarphoto.core.io.checkpoints import read_checkpoint_table
 from lidarphoto.core.io.orientation import read_eo_csv_full
@@ -67,7 +68,8 @@ def test_all_models_compared_and_every_output_readable(files):
     assert res.results["CHECK_RMS"] < 0.2
     comp = _read(outs["OUTPUT_COMPARISON"])
     assert next(r["model"] for r in comp) == best and len(comp) == 7
-    assert {r["model"] for r in comp} == set(bundle_adjustment.AP_CHOICES) - {"all"}
+    families = set(bundle_adjustment.SPEC.param("AP_MODEL").options) - {"all"}
+    assert {r["model"] for r in comp} == families
     rms = [float(r["rmse_3d"]) for r in comp]
     assert rms == sorted(rms)
     # the orientations with sigmas read back as observed orientations
@@ -78,7 +80,7 @@ def test_all_models_compared_and_every_output_readable(files):
     assert np.all(np.degrees(eo.sigma[:, 3:]) < 0.05)
     assert np.abs(eo.eo.xyz - blk.eo_true.xyz).max() < 0.5
     cam = read_cameras_json(outs["OUTPUT_CAMERA"])[0]
-    assert cam.distortion.model == bundle_adjustment.AP_FAMILIES[best]
+    assert cam.distortion.model == AP_FAMILIES[best]
     data = json.loads(open(outs["OUTPUT_CAMERA"]).read())
     assert data["sigmas"]["focal_mm"] > 0 and data["_bundle"]["ap_model"] == best
     pts = _read(outs["OUTPUT_POINTS"])
