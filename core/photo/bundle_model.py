@@ -126,7 +126,8 @@ def _dopk_dm(m: Array) -> Array:
 
 class _ObservedEOModel:
     """Observed orientation (GNSS/INS with the nominal mount) against the adjusted one, in
-    the conventions of DESIGN.md (``X_pc = X_obs + R_c^m da``, ``R_c^m = R_obs dR``):
+    the conventions of docs/conventions.md, "Rotations" (``X_pc = X_obs + R_c^m da``,
+    ``R_c^m = R_obs dR``):
     ``X_obs = X0 - M' da``, ``M_obs = dR M`` with ``da`` the lever-arm correction in camera
     axes and ``dR`` the boresight correction about the camera axes (what a boresight
     calibration estimates). x_local = [eo(6), da(3), bore(3)]."""

@@ -138,7 +138,8 @@ class BundleOptions:
     estimate_mount : bool
         With observed orientations: estimate a common lever-arm correction (camera axes,
         metres) and boresight correction (about the camera axes) between the observed and
-        the adjusted orientations, signed as in DESIGN.md: ``X_pc = X_obs + R_c^m da``,
+        the adjusted orientations, signed as in docs/conventions.md, "Rotations":
+        ``X_pc = X_obs + R_c^m da``,
         ``R_c^m = R_obs dR`` (a boresight calibration's dR).
     max_iterations : int
         Iterations of each adjustment.

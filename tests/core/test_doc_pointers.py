@@ -9,10 +9,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 CODE = [p for d in ("core", "processing_provider", "plugin") for p in (ROOT / d).rglob("*.py")]
-#: Modules another change of the same wave is splitting (issue 38): their two DESIGN.md
-#: citations (the bundle's mount corrections, now docs/conventions.md "Rotations") go with
-#: the split.
-DESIGN_CITED_UNTIL_SPLIT = {"core/photo/bundle.py"}
+#: Modules still citing the design notes outside the repository (none: the bundle's mount
+#: corrections cite docs/conventions.md "Rotations" since its split).
+DESIGN_CITED_UNTIL_SPLIT: set[str] = set()
 
 
 def _text(path: Path) -> str:

@@ -19,7 +19,8 @@ HEAVY = ("scipy", "cv2", "laspy", "lazrs", "numba", "pyproj", "osgeo", "rasterio
 #: The core modules listing the algorithms may import: the registry and the spec language,
 #: the messages, and the output set the runner names in its types.
 LISTING = {"lidarphoto.core", "lidarphoto.core.errors", "lidarphoto.core.i18n",
-           "lidarphoto.core.io", "lidarphoto.core.io.atomic", "lidarphoto.core.cli"}  # fmt: skip
+           "lidarphoto.core.io", "lidarphoto.core.io.atomic", "lidarphoto.core.io.suffixes",
+           "lidarphoto.core.cli"}  # fmt: skip  (io.suffixes: the readers' endings, stdlib only)
 #: Algorithms whose defaults are read from a dataclass in a module that imports a heavy
 #: library at its top (its --help pays for it): photo/bundle.py, photo/resection.py and
 #: photo/boresight.py import lsq/adjustment.py (scipy). Each needs its options in a light
