@@ -67,6 +67,8 @@ OVERVIEW_MEMORY_BYTES = 256 << 20
 MIN_FREE_BYTES = 1 << 16
 #: Writer threads (GDAL compresses blocks in parallel; more than 4 brings nothing here).
 MAX_THREADS = 4
+
+
 def _threads() -> int:
     return max(1, min(MAX_THREADS, os.cpu_count() or 1))
 
