@@ -517,10 +517,11 @@ class GeoTiffWriter:
         elif self._ovr is not None:
             self._ovr.ok = False
         if self.backend == "gdal":
-            self._ds.WriteArray(a, xoff=int(col0), yoff=int(row0))
-            if self.mask and mask is not None:
-                m = _mask_bytes(mask)
-                self._ds.GetRasterBand(1).GetMaskBand().WriteArray(m, int(col0), int(row0))
+            with _gdal_write_errors(self.path):
+                self._ds.WriteArray(a, xoff=int(col0), yoff=int(row0))
+                if self.mask and mask is not None:
+                    m = _mask_bytes(mask)
+                    self._ds.GetRasterBand(1).GetMaskBand().WriteArray(m, int(col0), int(row0))
         else:
             from rasterio.windows import Window as RioWindow
 
@@ -554,13 +555,14 @@ class GeoTiffWriter:
 
                 def finish() -> None:
                     ds = held.pop()
-                    if factors and levels is not None:
-                        ds.BuildOverviews("NONE", factors)  # the levels made, not computed
-                        _write_levels_gdal(ds, levels)
-                    elif factors:
-                        ds.BuildOverviews("AVERAGE", factors)
-                    ds.FlushCache()
-                    del ds  # the last reference: the file is closed here
+                    with _gdal_write_errors(self.path):
+                        if factors and levels is not None:
+                            ds.BuildOverviews("NONE", factors)  # the levels made, not computed
+                            _write_levels_gdal(ds, levels)
+                        elif factors:
+                            ds.BuildOverviews("AVERAGE", factors)
+                        ds.FlushCache()
+                        del ds  # the last reference: the file is closed here
                     check_written(self.path)
 
                 if levels is not None:
@@ -610,6 +612,17 @@ def check_written(path: str) -> None:
     if free < MIN_FREE_BYTES:
         raise OSError(errno.ENOSPC, f"cannot write it whole: no space left on the device "
                       f"({free} bytes free)", path)  # fmt: skip
+
+
+@contextlib.contextmanager
+def _gdal_write_errors(path: str) -> Iterator[None]:
+    """osgeo's RuntimeError of a failed write ("Write error at scanline") as an OSError with
+    its likely cause (:func:`check_written`)."""
+    try:
+        yield
+    except RuntimeError as exc:
+        check_written(path)
+        raise OSError(errno.EIO, f"cannot write it: {exc}", path) from exc
 
 
 def _mask_bytes(valid: NDArray) -> NDArray[np.uint8]:
