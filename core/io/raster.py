@@ -517,7 +517,7 @@ class GeoTiffWriter:
         elif self._ovr is not None:
             self._ovr.ok = False
         if self.backend == "gdal":
-            with _gdal_write_errors(self.path):
+            with _gdal_write_errors(self.path, self._drop):
                 self._ds.WriteArray(a, xoff=int(col0), yoff=int(row0))
                 if self.mask and mask is not None:
                     m = _mask_bytes(mask)
@@ -529,6 +529,10 @@ class GeoTiffWriter:
             self._ds.write(a, window=win)
             if self.mask and mask is not None:
                 self._ds.write_mask(_mask_bytes(mask), window=win)
+
+    def _drop(self) -> None:
+        self._ds = None
+        self._closed = True
 
     def close(self, overviews: bool = True, finish_in: Executor | None = None) -> Future | None:
         """Build the overviews (unless ``overviews`` is False) and close the file.
@@ -553,17 +557,16 @@ class GeoTiffWriter:
             if self.backend == "gdal":
                 held, self._ds = [self._ds], None
 
-                def finish() -> None:
-                    ds = held.pop()
-                    with _gdal_write_errors(self.path):
+                def finish() -> None:  # (no local name for the dataset: see _drop)
+                    with _gdal_write_errors(self.path, held.clear):
                         if factors and levels is not None:
-                            ds.BuildOverviews("NONE", factors)  # the levels made, not computed
-                            _write_levels_gdal(ds, levels)
+                            held[0].BuildOverviews("NONE", factors)  # the levels made
+                            _write_levels_gdal(held[0], levels)
                         elif factors:
-                            ds.BuildOverviews("AVERAGE", factors)
-                        ds.FlushCache()
-                        del ds  # the last reference: the file is closed here
-                    check_written(self.path)
+                            held[0].BuildOverviews("AVERAGE", factors)
+                        held[0].FlushCache()
+                    _quietly(held.clear)  # the last reference: the file is closed here
+                    check_written(self.path)  # (what the closing could not write)
 
                 if levels is not None:
                     later = finish
@@ -614,13 +617,32 @@ def check_written(path: str) -> None:
                       f"({free} bytes free)", path)  # fmt: skip
 
 
+def _quietly(drop: Callable[[], None]) -> None:
+    """``drop()`` (releasing an osgeo dataset) without the "Exception ignored" its destructor
+    prints when closing a cut file fails again (:func:`check_written` tells the cause)."""
+    import sys
+
+    hook = sys.unraisablehook
+    sys.unraisablehook = lambda _: None
+    try:
+        drop()
+    finally:
+        sys.unraisablehook = hook
+
+
 @contextlib.contextmanager
-def _gdal_write_errors(path: str) -> Iterator[None]:
+def _gdal_write_errors(path: str, drop: Callable[[], None]) -> Iterator[None]:
     """osgeo's RuntimeError of a failed write ("Write error at scanline") as an OSError with
-    its likely cause (:func:`check_written`)."""
+    its likely cause (:func:`check_written`). ``drop()`` releases the last reference to the
+    dataset: it is closed here, quietly (its destructor fails again on the cut file and
+    would print "Exception ignored" whenever it is collected)."""
     try:
         yield
     except RuntimeError as exc:
+        import traceback
+
+        traceback.clear_frames(exc.__traceback__)  # the finished frames' references
+        _quietly(drop)
         check_written(path)
         raise OSError(errno.EIO, f"cannot write it: {exc}", path) from exc
 
