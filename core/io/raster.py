@@ -23,10 +23,8 @@ and is moved into place only when complete.
 from __future__ import annotations
 
 import contextlib
-import errno
 import math
 import os
-import shutil
 import threading
 import warnings
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -40,8 +38,9 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from .atomic import atomic_path
-from .gdal_binding import raster_backend
+from .gdal_binding import check_written, gdal_write_errors, quietly, raster_backend
 from .gdal_binding import rio_env as _rio_env
+from .jpeg import JPEG_SUFFIXES, check_jpeg_whole
 from .raster_polygons import polygonize
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -63,8 +62,6 @@ __all__ = [
 #: raster gets GDAL's overviews, read back from the file.
 OVERVIEW_MEMORY_BYTES = 256 << 20
 
-#: Free bytes below which a write that just ended is taken to have hit a full device.
-MIN_FREE_BYTES = 1 << 16
 #: Writer threads (GDAL compresses blocks in parallel; more than 4 brings nothing here).
 MAX_THREADS = 4
 
@@ -152,6 +149,8 @@ class RasterReader:
         ):
             raise InputError("file not found", path=self.path)
         self.info = self._describe(self._handle())
+        if Path(self.path).suffix.lower() in JPEG_SUFFIXES:
+            check_jpeg_whole(self.path)
 
     def __enter__(self) -> RasterReader:
         return self
@@ -517,7 +516,7 @@ class GeoTiffWriter:
         elif self._ovr is not None:
             self._ovr.ok = False
         if self.backend == "gdal":
-            with _gdal_write_errors(self.path, self._drop):
+            with gdal_write_errors(self.path, self._drop):
                 self._ds.WriteArray(a, xoff=int(col0), yoff=int(row0))
                 if self.mask and mask is not None:
                     m = _mask_bytes(mask)
@@ -558,14 +557,14 @@ class GeoTiffWriter:
                 held, self._ds = [self._ds], None
 
                 def finish() -> None:  # (no local name for the dataset: see _drop)
-                    with _gdal_write_errors(self.path, held.clear):
+                    with gdal_write_errors(self.path, held.clear):
                         if factors and levels is not None:
                             held[0].BuildOverviews("NONE", factors)  # the levels made
                             _write_levels_gdal(held[0], levels)
                         elif factors:
                             held[0].BuildOverviews("AVERAGE", factors)
                         held[0].FlushCache()
-                    _quietly(held.clear)  # the last reference: the file is closed here
+                    quietly(held.clear)  # the last reference: the file is closed here
                     check_written(self.path)  # (what the closing could not write)
 
                 if levels is not None:
@@ -595,56 +594,6 @@ class GeoTiffWriter:
             later()
             return None
         return finish_in.submit(later)
-
-
-def check_written(path: str) -> None:
-    """Raise OSError (ENOSPC, EFBIG) when a file just written cannot be whole: the device has
-    no space left, or the file reached the process's size limit (``ulimit -f``). GDAL's TIFF
-    writer reports neither through rasterio: it logs them and closes a cut file."""
-    size = os.path.getsize(path)
-    try:
-        import resource
-
-        limit, unlimited = resource.getrlimit(resource.RLIMIT_FSIZE)[0], resource.RLIM_INFINITY
-    except (ImportError, OSError, ValueError):  # not on Windows
-        limit = unlimited = -1
-    if 0 <= limit != unlimited and size >= limit:
-        raise OSError(errno.EFBIG, f"cannot write it whole: the file reached the process's "
-                      f"file size limit of {limit} bytes (ulimit -f)", path)  # fmt: skip
-    free = shutil.disk_usage(os.path.dirname(os.path.abspath(path))).free
-    if free < MIN_FREE_BYTES:
-        raise OSError(errno.ENOSPC, f"cannot write it whole: no space left on the device "
-                      f"({free} bytes free)", path)  # fmt: skip
-
-
-def _quietly(drop: Callable[[], None]) -> None:
-    """``drop()`` (releasing an osgeo dataset) without the "Exception ignored" its destructor
-    prints when closing a cut file fails again (:func:`check_written` tells the cause)."""
-    import sys
-
-    hook = sys.unraisablehook
-    sys.unraisablehook = lambda _: None
-    try:
-        drop()
-    finally:
-        sys.unraisablehook = hook
-
-
-@contextlib.contextmanager
-def _gdal_write_errors(path: str, drop: Callable[[], None]) -> Iterator[None]:
-    """osgeo's RuntimeError of a failed write ("Write error at scanline") as an OSError with
-    its likely cause (:func:`check_written`). ``drop()`` releases the last reference to the
-    dataset: it is closed here, quietly (its destructor fails again on the cut file and
-    would print "Exception ignored" whenever it is collected)."""
-    try:
-        yield
-    except RuntimeError as exc:
-        import traceback
-
-        traceback.clear_frames(exc.__traceback__)  # the finished frames' references
-        _quietly(drop)
-        check_written(path)
-        raise OSError(errno.EIO, f"cannot write it: {exc}", path) from exc
 
 
 def _mask_bytes(valid: NDArray) -> NDArray[np.uint8]:
