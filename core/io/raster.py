@@ -38,6 +38,7 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from .gdal_binding import raster_backend
 from .gdal_binding import rio_env as _rio_env
+from .jpeg import JPEG_SUFFIXES, check_jpeg_whole
 from .raster_polygons import polygonize
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -139,6 +140,8 @@ class RasterReader:
         ):
             raise InputError("file not found", path=self.path)
         self.info = self._describe(self._handle())
+        if Path(self.path).suffix.lower() in JPEG_SUFFIXES:
+            check_jpeg_whole(self.path)
 
     def __enter__(self) -> RasterReader:
         return self

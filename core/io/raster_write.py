@@ -5,9 +5,7 @@ writers of a whole array or an RGB image. Through GDAL: osgeo in QGIS, rasterio 
 
 from __future__ import annotations
 
-import errno
 import os
-import shutil
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import Executor, Future
@@ -18,7 +16,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from .atomic import atomic_path
-from .gdal_binding import raster_backend
+from .gdal_binding import check_written, gdal_write_errors, quietly, raster_backend
 from .gdal_binding import rio_env as _rio_env
 from .raster import _crs_text, _threads, overview_factors
 
@@ -31,8 +29,6 @@ __all__ = ["GeoTiffWriter", "write_geotiff", "write_rgb_tiff"]
 #: raster gets GDAL's overviews, read back from the file.
 OVERVIEW_MEMORY_BYTES = 256 << 20
 
-#: Free bytes below which a write that just ended is taken to have hit a full device.
-MIN_FREE_BYTES = 1 << 16
 
 _GDAL_TYPES = {
     "uint8": "Byte", "uint16": "UInt16", "int16": "Int16", "uint32": "UInt32",
@@ -216,10 +212,11 @@ class GeoTiffWriter:
         elif self._ovr is not None:
             self._ovr.ok = False
         if self.backend == "gdal":
-            self._ds.WriteArray(a, xoff=int(col0), yoff=int(row0))
-            if self.mask and mask is not None:
-                m = _mask_bytes(mask)
-                self._ds.GetRasterBand(1).GetMaskBand().WriteArray(m, int(col0), int(row0))
+            with gdal_write_errors(self.path, self._drop):
+                self._ds.WriteArray(a, xoff=int(col0), yoff=int(row0))
+                if self.mask and mask is not None:
+                    m = _mask_bytes(mask)
+                    self._ds.GetRasterBand(1).GetMaskBand().WriteArray(m, int(col0), int(row0))
         else:
             from rasterio.windows import Window as RioWindow
 
@@ -227,6 +224,10 @@ class GeoTiffWriter:
             self._ds.write(a, window=win)
             if self.mask and mask is not None:
                 self._ds.write_mask(_mask_bytes(mask), window=win)
+
+    def _drop(self) -> None:
+        self._ds = None
+        self._closed = True
 
     def close(self, overviews: bool = True, finish_in: Executor | None = None) -> Future | None:
         """Build the overviews (unless ``overviews`` is False) and close the file.
@@ -251,16 +252,16 @@ class GeoTiffWriter:
             if self.backend == "gdal":
                 held, self._ds = [self._ds], None
 
-                def finish() -> None:
-                    ds = held.pop()
-                    if factors and levels is not None:
-                        ds.BuildOverviews("NONE", factors)  # the levels made, not computed
-                        _write_levels_gdal(ds, levels)
-                    elif factors:
-                        ds.BuildOverviews("AVERAGE", factors)
-                    ds.FlushCache()
-                    del ds  # the last reference: the file is closed here
-                    check_written(self.path)
+                def finish() -> None:  # (no local name for the dataset: see _drop)
+                    with gdal_write_errors(self.path, held.clear):
+                        if factors and levels is not None:
+                            held[0].BuildOverviews("NONE", factors)  # the levels made
+                            _write_levels_gdal(held[0], levels)
+                        elif factors:
+                            held[0].BuildOverviews("AVERAGE", factors)
+                        held[0].FlushCache()
+                    quietly(held.clear)  # the last reference: the file is closed here
+                    check_written(self.path)  # (what the closing could not write)
 
                 if levels is not None:
                     later = finish
@@ -289,26 +290,6 @@ class GeoTiffWriter:
             later()
             return None
         return finish_in.submit(later)
-
-
-def check_written(path: str) -> None:
-    """Raise OSError (ENOSPC, EFBIG) when a file just written cannot be whole: the device has
-    no space left, or the file reached the process's size limit (``ulimit -f``). GDAL's TIFF
-    writer reports neither through rasterio: it logs them and closes a cut file."""
-    size = os.path.getsize(path)
-    try:
-        import resource
-
-        limit, unlimited = resource.getrlimit(resource.RLIMIT_FSIZE)[0], resource.RLIM_INFINITY
-    except (ImportError, OSError, ValueError):  # not on Windows
-        limit = unlimited = -1
-    if 0 <= limit != unlimited and size >= limit:
-        raise OSError(errno.EFBIG, f"cannot write it whole: the file reached the process's "
-                      f"file size limit of {limit} bytes (ulimit -f)", path)  # fmt: skip
-    free = shutil.disk_usage(os.path.dirname(os.path.abspath(path))).free
-    if free < MIN_FREE_BYTES:
-        raise OSError(errno.ENOSPC, f"cannot write it whole: no space left on the device "
-                      f"({free} bytes free)", path)  # fmt: skip
 
 
 def _mask_bytes(valid: NDArray) -> NDArray[np.uint8]:

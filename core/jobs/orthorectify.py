@@ -270,8 +270,8 @@ def _extent(values) -> tuple[float, float, float, float] | None:
         return None
     x0, y0, x1, y1 = (float(a) for a in values)
     if not (x1 > x0 and y1 > y0):
-        raise InputError(f"EXTENT {x0:g},{y0:g},{x1:g},{y1:g}: give xmin,ymin,xmax,ymax with "
-                         "xmin < xmax and ymin < ymax")  # fmt: skip
+        raise InputError(f"EXTENT {x0:.10g},{y0:.10g},{x1:.10g},{y1:.10g}: give xmin,ymin,"
+                         "xmax,ymax with xmin < xmax and ymin < ymax")  # fmt: skip
     return x0, y0, x1, y1
 
 
