@@ -17,8 +17,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
-from .suffixes import IMAGE_SUFFIXES
 from .jpeg import check_jpeg_whole
+from .suffixes import IMAGE_SUFFIXES
 
 __all__ = ["IMAGE_SUFFIXES", "check_distinct_files", "check_jpeg_whole", "decode_factor",
            "image_size",
