@@ -108,14 +108,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Check every input, then orthorectify the images one after the other."""
     import numpy as np
 
-    from ..errors import CrsError, InputError
-    from ..geometry.frames import LocalFrame, MappingFrame, check_area_of_use, parse_crs
+    from ..errors import InputError
+    from ..geometry.frames import LocalFrame, MappingFrame, parse_crs
     from ..geometry.raycast import DsmTracer
-    from ..geometry.surface import reproject_dsm
     from ..io.atomic import OutputSet
-    from ..io.camera import read_camera_json
-    from ..io.dsm import load_dsm
-    from ..io.orientation import read_eo_csv
     from ..io.raster import RasterReader
     from ..io.raster_write import GeoTiffWriter
     from ..photo.orthophoto import OrthoOptions, OrthoProjector, _lens_lattice, auto_gsd
@@ -123,44 +119,14 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
     mapping = parse_crs(v.crs, what="mapping CRS")
     extent = _extent(v.extent)
-    camera = read_camera_json(v.camera)
-    eo = read_eo_csv(v.eo)
-    check_area_of_use(mapping, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
-                      what="the perspective centres", path=v.eo)  # fmt: skip
-    from ..io.images import list_image_files
-
-    images = list_image_files(v.images)
-    row_of = {name: k for k, name in enumerate(eo.image_id)}
-    missing = [f.stem for f in images if f.stem not in row_of]
-    if missing:
-        raise InputError(f"no exterior orientation for image(s) {', '.join(missing[:10])}",
-                         path=v.eo)  # fmt: skip
-    infos = {}
-    for f in images:  # every image is checked before anything is computed
-        with RasterReader(f) as src:
-            info = infos[f.stem] = src.info
-        if (info.width, info.height) != (camera.width_px, camera.height_px):
-            raise InputError(f"the image is {info.width} x {info.height} px, the camera "
-                             f"{camera.name!r} {camera.width_px} x {camera.height_px} px",
-                             path=str(f))  # fmt: skip
+    camera, eo, images, row_of, infos = _read_inputs(v, mapping)
     options = options_from(OrthoOptions, SPEC, v)
     folder = Path(v.output_folder)
     targets = {f.stem: folder / ORTHO_NAME.format(f.stem) for f in images}
     inputs = {"IMAGES": [str(f) for f in images], "DSM": v.dsm, "EO": v.eo, "CAMERA": v.camera}
 
     load, work = stages(progress, 0.15, 0.85)
-    dsm = load_dsm(v.dsm, v.cell_size, v.dsm_crs, progress=load, should_stop=should_stop)
-    if dsm.crs is None:
-        log.warning("the DSM has no CRS: taken to be the mapping CRS %s", mapping.name)
-    elif not dsm.crs.equals(mapping, ignore_axis_order=True):
-        source = dsm.crs.name
-        try:
-            dsm = reproject_dsm(dsm, mapping, should_stop=should_stop)
-        except CrsError as exc:
-            raise CrsError(f"the DSM ({source}) cannot be brought into the mapping CRS "
-                           f"'{mapping.name}': {exc}", path=str(v.dsm)) from exc  # fmt: skip
-        log.warning("the DSM was in '%s': resampled into '%s' (cell %g)", source, mapping.name,
-                    dsm.cell)  # fmt: skip
+    dsm = _dsm_in(v, mapping, load, should_stop)
     # the skipping pyramid of the ray casting only for true orthophotos (built once)
     surface = DsmTracer.build(dsm) if options.true_ortho else dsm
     zmin = dsm.z_range[0]
@@ -260,6 +226,59 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         lines=lines,
         data=written,
     )
+
+
+def _read_inputs(v: Values, mapping):
+    """The camera, the EO (checked against the mapping CRS's area of use), the images with
+    their EO rows and their size against the camera: all checked before anything is computed."""
+    from ..errors import InputError
+    from ..geometry.frames import check_area_of_use
+    from ..io.camera import read_camera_json
+    from ..io.images import list_image_files
+    from ..io.orientation import read_eo_csv
+    from ..io.raster import RasterReader
+
+    camera = read_camera_json(v.camera)
+    eo = read_eo_csv(v.eo)
+    check_area_of_use(mapping, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
+                      what="the perspective centres", path=v.eo)  # fmt: skip
+    images = list_image_files(v.images)
+    row_of = {name: k for k, name in enumerate(eo.image_id)}
+    missing = [f.stem for f in images if f.stem not in row_of]
+    if missing:
+        raise InputError(f"no exterior orientation for image(s) {', '.join(missing[:10])}",
+                         path=v.eo)  # fmt: skip
+    infos = {}
+    for f in images:
+        with RasterReader(f) as src:
+            info = infos[f.stem] = src.info
+        if (info.width, info.height) != (camera.width_px, camera.height_px):
+            raise InputError(f"the image is {info.width} x {info.height} px, the camera "
+                             f"{camera.name!r} {camera.width_px} x {camera.height_px} px",
+                             path=str(f))  # fmt: skip
+    return camera, eo, images, row_of, infos
+
+
+def _dsm_in(v: Values, mapping, progress, should_stop):
+    """The DSM (raster, or LAS/LAZ rasterised) in the mapping CRS: resampled when it is in
+    another CRS, refused with PROJ's reason when it cannot be."""
+    from ..errors import CrsError
+    from ..geometry.surface import reproject_dsm
+    from ..io.dsm import load_dsm
+
+    dsm = load_dsm(v.dsm, v.cell_size, v.dsm_crs, progress=progress, should_stop=should_stop)
+    if dsm.crs is None:
+        log.warning("the DSM has no CRS: taken to be the mapping CRS %s", mapping.name)
+    elif not dsm.crs.equals(mapping, ignore_axis_order=True):
+        source = dsm.crs.name
+        try:
+            dsm = reproject_dsm(dsm, mapping, should_stop=should_stop)
+        except CrsError as exc:
+            raise CrsError(f"the DSM ({source}) cannot be brought into the mapping CRS "
+                           f"'{mapping.name}': {exc}", path=str(v.dsm)) from exc  # fmt: skip
+        log.warning("the DSM was in '%s': resampled into '%s' (cell %g)", source, mapping.name,
+                    dsm.cell)  # fmt: skip
+    return dsm
 
 
 def _extent(values) -> tuple[float, float, float, float] | None:

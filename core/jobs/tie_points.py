@@ -126,13 +126,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.observations import write_observations_csv
     from ..io.orientation import read_eo_csv
     from ..io.tables import write_csv_atomic
-    from ..photo.tie_points import (
-        TiePointOptions,
-        detect_features,
-        footprints,
-        reduction_factor,
-        tie_points,
-    )
+    from ..photo.tie_pairs import footprints
+    from ..photo.tie_points import TiePointOptions, detect_features, reduction_factor, tie_points
 
     options = options_from(TiePointOptions, SPEC, v)
     files = list_image_files(v.images, ("IMAGES", "identical images have no parallax"))

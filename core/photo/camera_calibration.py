@@ -346,6 +346,46 @@ def _flat(detections: Sequence[Detection], fld: TargetField):
     return np.concatenate(views), np.concatenate(pts), np.concatenate(pxs), names
 
 
+def _adjust_explained(x0v, pnames, blocks, constraints, aopts, progress, should_stop,
+                      perspective_views, size) -> AdjustmentResult:
+    """``adjust`` with its failures explained for a camera calibration: which views are
+    missing, and (``perspective_views`` given) whether the views look like a fisheye lens."""
+
+    def fisheye() -> str:  # why a perspective calibration may fail
+        text = fisheye_evidence(perspective_views, size) if perspective_views else ""
+        return f"; {text}" if text else ""
+
+    try:
+        res = adjust(x0v, pnames, blocks, constraints, aopts, progress=progress,
+                     should_stop=should_stop)  # fmt: skip
+    except NotObservableError as exc:
+        raise NotObservableError(
+            f"camera calibration: {exc}. The views cannot determine these parameters: use "
+            "more views, tilted in different directions (not all parallel to the target), "
+            "with the target filling the image corners, or estimate fewer lens parameters"
+            + fisheye(),
+            parameters=exc.parameters,
+        ) from exc
+    except AdjustmentError as exc:
+        raise type(exc)(f"camera calibration: {exc}{fisheye()}") from exc
+    if not res.converged:
+        raise ConvergenceError(f"camera calibration did not converge in {res.iterations} "
+                               f"iterations{fisheye()}")  # fmt: skip
+    return res
+
+
+def _residuals_by_point(res: AdjustmentResult, blocks, is_free: Array, px: Array):
+    """(v, w): the residuals (px) and w-tests of every measured point in the input order."""
+    v_all = np.zeros_like(px)
+    w_all = np.full_like(px, np.nan)
+    for b in blocks:
+        sel = ~is_free if b.name == "fixed points" else is_free
+        tab = res.residuals[b.name]
+        v_all[sel] = tab.v
+        w_all[sel] = tab.w
+    return v_all, w_all
+
+
 def calibrate_camera(
     fld: TargetField,
     detections: Sequence[Detection],
@@ -462,28 +502,9 @@ def calibrate_camera(
 
         constraints.append(Constraint("datum: third point in Z = 0", [[zc]], plane))
     aopts = AdjustmentOptions(max_iterations=opts.max_iterations)
-
-    def fisheye() -> str:  # why a perspective calibration may fail
-        text = fisheye_evidence(per_view, (width_px, height_px)) \
-            if opts.projection == "perspective" else ""  # fmt: skip
-        return f"; {text}" if text else ""
-
-    try:
-        res = adjust(x0v, pnames, blocks, constraints, aopts, progress=progress,
-                     should_stop=should_stop)  # fmt: skip
-    except NotObservableError as exc:
-        raise NotObservableError(
-            f"camera calibration: {exc}. The views cannot determine these parameters: use "
-            "more views, tilted in different directions (not all parallel to the target), "
-            "with the target filling the image corners, or estimate fewer lens parameters"
-            + fisheye(),
-            parameters=exc.parameters,
-        ) from exc
-    except AdjustmentError as exc:
-        raise type(exc)(f"camera calibration: {exc}{fisheye()}") from exc
-    if not res.converged:
-        raise ConvergenceError(f"camera calibration did not converge in {res.iterations} "
-                               f"iterations{fisheye()}")  # fmt: skip
+    res = _adjust_explained(x0v, pnames, blocks, constraints, aopts, progress, should_stop,
+                            per_view if opts.projection == "perspective" else None,
+                            (width_px, height_px))  # fmt: skip
     full = base.interior_params
     full[free_io] = res.x[:n_io]
     cam = base.with_interior(full)
@@ -494,14 +515,7 @@ def calibrate_camera(
     t_values = {n: abs(float(res.x[i])) / float(std[i]) for i, n in enumerate(io_names)
                 if n in LENS_NAMES}  # fmt: skip
     significant = {n: bool(t > tcrit) for n, t in t_values.items()}
-    # residuals by view
-    v_all = np.zeros_like(px)
-    w_all = np.full_like(px, np.nan)
-    for b in blocks:
-        sel = ~is_free if b.name == "fixed points" else is_free
-        tab = res.residuals[b.name]
-        v_all[sel] = tab.v
-        w_all[sel] = tab.w
+    v_all, w_all = _residuals_by_point(res, blocks, is_free, px)
     d2 = np.sum(v_all**2, axis=1)
     view_rms = np.array([math.sqrt(float(np.mean(d2[view == j]))) for j in range(n_views)])
     view_pts = np.bincount(view, minlength=n_views).astype(np.int64)

@@ -190,7 +190,7 @@ MAX_FUNCTION_LINES = 150
 #: file or function may not grow, and one that is back under the limit must leave the list.
 FILES_NOT_YET_SPLIT = {
     "core/lidar/roof_planes.py": 942,
-    "core/photo/tie_points.py": 1035,
+    "core/photo/tie_points.py": 899,
     "core/tls/calibration.py": 813,
     "core/tls/targets.py": 886,
 }
@@ -198,7 +198,7 @@ FUNCTIONS_NOT_YET_SPLIT = {
     "bench/bench_ortho.py:main": 174,
     "core/geometry/raycast_numba.py:_trace": 174,
     "core/lidar/roof_planes_numba.py:_local_planes_kernel": 233,
-    "core/photo/camera_calibration.py:calibrate_camera": 176,
+    "core/photo/camera_calibration.py:calibrate_camera": 157,
     "core/photo/least_squares_matching.py:lsm_batch": 159,
     "core/photo/monoplot.py:monoplot": 227,
     "core/photo/tie_points.py:refine_tracks": 157,

@@ -22,15 +22,14 @@ from lidarphoto.core.io.observations import read_observations_csv
 from lidarphoto.core.io.orientation import write_eo_csv
 from lidarphoto.core.jobs import tie_points as job
 from lidarphoto.core.jobs.runner import run_job
+from lidarphoto.core.photo.tie_pairs import footprints, select_pairs
 from lidarphoto.core.photo.tie_points import (
     ImageFeatures,
     PairMatch,
     TiePointOptions,
     build_tracks,
     detect_features,
-    footprints,
     match_pair,
-    select_pairs,
 )
 from lidarphoto.core.simulation.textured_block import (
     TexturedBlock,
