@@ -18,23 +18,24 @@ differ, each where the two DTMs differ by more than 1 mm; tests/core/test_lidar_
 CSF, whose cloth couples every cell, and a slope estimated from the cloud (SMRF slope 0) have
 no finite buffer and are refused for blocks.
 
-Roof planes (:func:`tile_planes`, :func:`merge_cut_planes`) are extracted on each tile's
-core plus a buffer of :func:`roof_buffer`, sized from the neighbourhood the extraction uses:
-a core point's label depends on its K neighbours' local RANSAC, on its G neighbours' local
-planes and on the reassignment, which reaches REASSIGN_PASSES + 1 rings of G neighbours; the
-buffer holds three times that, so the half next to the core (the overlap band) is labelled
-as in a whole-file run. The extraction itself does not depend on the points a tile
-holds (fixed RANSAC triplets, seeds on a voxel grid of map coordinates, ties by coordinates:
-:mod:`core.lidar.roof_planes`). Each tile keeps the planes of its core points (pieces) and
-reports the labels it gives to the points of the band on both sides of its border. A plane
-cut by a border is found by both tiles; two pieces are merged when the tiles' own region
-growing put the same points into them: at least half of the band points that either tile
-gives to its piece are given to the other piece by the other tile. That is the growing's own
-test (a tile grows its region across the border into its buffer exactly as the whole-file
-run does), neither looser nor tighter: two roofs that the growing keeps apart get different
-labels in the band and are not fused, whatever their normals. The merged plane is refitted
-with :func:`lidarphoto.core.geometry.planes.fit_plane` (covariance included) from the points
-its tiles fitted (the regions' interiors, the whole-file rule).
+Roof planes (:func:`tile_planes`, :func:`merge_cut_planes`) are extracted on each tile's core
+plus a buffer of :func:`roof_buffer`, sized from the neighbourhood the extraction uses: a core
+point's label depends on its K neighbours' local RANSAC, on its G neighbours' local planes and
+on the reassignment, which reaches REASSIGN_PASSES + 1 rings of G neighbours; the buffer holds
+three times that, so the half next to the core (the overlap band) is labelled as in a whole-file
+run. A point's local plane and seed do not depend on the points a tile holds beyond its
+neighbours (RANSAC triplet tables picked by its coordinates, seed voxels on map coordinates
+sized by the local spacing, ties by coordinates: :mod:`core.lidar.roof_planes`); what a tile
+cannot see is the rest of a region cut by its buffer (its refit), hence the band. Each tile
+keeps the planes of its core points (pieces) and reports the labels it gives to the points of
+the band on both sides of its border. A plane cut by a border is found by both tiles; two pieces
+are merged when the tiles' own region growing put the same points into them: at least half of
+the band points that either tile gives to its piece are given to the other piece by the other
+tile. That is the growing's own test (a tile grows its region across the border into its buffer
+exactly as the whole-file run does), neither looser nor tighter: two roofs that the growing
+keeps apart get different labels in the band and are not fused, whatever their normals. The
+merged plane is refitted with :func:`lidarphoto.core.geometry.planes.fit_plane` (covariance
+included) from the points its tiles fitted (the regions' interiors, the whole-file rule).
 """
 
 from __future__ import annotations
@@ -102,7 +103,7 @@ MIN_SHARED = 3
 @dataclass(frozen=True)
 class PlanePiece:
     """A plane found in one tile: the tile, the plane, its core points (N, 3), which of them
-    the tile fitted (N,) and their ids (N,), -1 when unknown."""
+    are its region's interior (N,: RoofPlaneResult.fit_mask) and their point ids (N,)."""
 
     tile: int
     plane: Plane
