@@ -181,11 +181,11 @@ def tile_planes(
     return pieces, BandLabels(tile, ids[inband], core[inband], piece_of[label[inband] + 1])
 
 
-def _shared(bands: Sequence[BandLabels], n: int) -> tuple[NDArray, NDArray, NDArray, int]:
+def _shared(bands: Sequence[BandLabels], n: int) -> tuple[NDArray, NDArray, Any]:
     """Band points two tiles both labelled: a tile's label of a point of its buffer against
     the label of the tile that owns it. Returns the pairs of pieces (i < j) labelled on the
-    same points, their counts, and per piece and other tile the points both tiles labelled
-    (``over[piece * n_tiles + tile]``, any label of the other tile), and n_tiles."""
+    same points, their counts, and ``over(piece, tile)``: the points of the piece that ``tile``
+    labelled too (with any label; arrays in, arrays out)."""
     ids = np.concatenate([b.ids for b in bands])
     core = np.concatenate([b.core for b in bands])
     piece = np.concatenate([b.piece for b in bands])
@@ -198,13 +198,21 @@ def _shared(bands: Sequence[BandLabels], n: int) -> tuple[NDArray, NDArray, NDAr
     ok[ok] = ids[o[at[ok]]] == ids[u[ok]]
     u, c = u[ok], o[at[ok]]  # the same point: in one tile's buffer, in another's core
     pu, pc = piece[u], piece[c]
-    over = np.bincount(np.concatenate([(pu * n_tiles + tile[c])[pu >= 0],
-                                       (pc * n_tiles + tile[u])[pc >= 0]]),
-                       minlength=n * n_tiles)  # fmt: skip
+    # sparse (piece, other tile) counts: a dense table would be pieces x tiles
+    seen, seen_count = np.unique(np.concatenate([(pu * n_tiles + tile[c])[pu >= 0],
+                                                 (pc * n_tiles + tile[u])[pc >= 0]]),
+                                 return_counts=True)  # fmt: skip
+
+    def over(p: NDArray, t: NDArray) -> NDArray:
+        key = p * n_tiles + t
+        at = np.minimum(np.searchsorted(seen, key), max(len(seen) - 1, 0))
+        hit = (seen[at] == key) if len(seen) else np.zeros(len(key), bool)
+        return np.where(hit, seen_count[at] if len(seen) else 0, 0)
+
     both = (pu >= 0) & (pc >= 0)
     lo, hi = np.minimum(pu[both], pc[both]), np.maximum(pu[both], pc[both])
     key, count = np.unique(lo * n + hi, return_counts=True)
-    return np.column_stack([key // n, key % n]), count, over, n_tiles
+    return np.column_stack([key // n, key % n]), count, over
 
 
 def _refit(pieces: Sequence[PlanePiece], members: Sequence[int], new_id: int) -> Plane:
@@ -256,9 +264,9 @@ def merge_cut_planes(
     tiles = np.array([p.tile for p in pieces], dtype=np.int64)
     groups: dict[int, list[int]] = {k: [k] for k in range(n)}
     if bands:
-        pairs, count, over, n_tiles = _shared(bands, n)
+        pairs, count, over = _shared(bands, n)
         a, b = pairs[:, 0], pairs[:, 1]
-        least = np.minimum(over[a * n_tiles + tiles[b]], over[b * n_tiles + tiles[a]])
+        least = np.minimum(over(a, tiles[b]), over(b, tiles[a]))
         join = (tiles[a] != tiles[b]) & (count >= MIN_SHARED) & (2 * count >= least)
         a, b, count = a[join], b[join], count[join]
         # strongest joins first; a join that would put two pieces of one tile into one plane
