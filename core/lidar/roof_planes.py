@@ -315,6 +315,7 @@ def extract_roof_planes(
         hi = min(n, lo + (1 << 20))
         interior[lo:hi] = (labels[knn[lo:hi]] == labels[lo:hi, None]).all(axis=1)
     fit_sorted = keep & ~ambiguous & interior
+    del q, knn, interior, ambiguous, spacing_of  # the fits need the points and labels only
     planes, pid_sorted = _final_planes(xyz, order, labels, fit_sorted, cell, progress,
                                        should_stop)  # fmt: skip
     # back to the input's order (the work ran on the sorted points)

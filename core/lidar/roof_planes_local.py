@@ -204,13 +204,16 @@ def triplets(k: int, t: int) -> NDArray[np.int64]:
 def table_of(xyz: Array) -> NDArray[np.uint8]:
     """The triplet table (0 .. TRIPLET_TABLES - 1) of each point (N,), from the bits of its map
     coordinates (N, 3) float64: the same for the point in any tile, order or run."""
-    bits = np.ascontiguousarray(xyz, dtype=np.float64).view(np.uint64)
-    with np.errstate(over="ignore"):
-        h = bits[:, 0] * np.uint64(0x9E3779B97F4A7C15)
-        h ^= bits[:, 1] * np.uint64(0xC2B2AE3D27D4EB4F)
-        h ^= bits[:, 2] * np.uint64(0x165667B19E3779F9)
-        h = _mix(h)
-    return (h % np.uint64(TRIPLET_TABLES)).astype(np.uint8)
+    out = np.empty(len(xyz), dtype=np.uint8)
+    for lo in range(0, len(xyz), 1 << 20):  # in slices: the uint64 temporaries stay small
+        bits = np.ascontiguousarray(xyz[lo : lo + (1 << 20)], dtype=np.float64).view(np.uint64)
+        with np.errstate(over="ignore"):
+            h = bits[:, 0] * np.uint64(0x9E3779B97F4A7C15)
+            h ^= bits[:, 1] * np.uint64(0xC2B2AE3D27D4EB4F)
+            h ^= bits[:, 2] * np.uint64(0x165667B19E3779F9)
+            h = _mix(h)
+        out[lo : lo + len(h)] = h % np.uint64(TRIPLET_TABLES)
+    return out
 
 
 def _knn_numpy(tree: Any, q: Array, lo: int, hi: int, k: int) -> tuple[Array, NDArray]:
