@@ -14,15 +14,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable, Union
+from typing import Any, Callable, Union
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import stop_if_asked, use_compiled
 
-if TYPE_CHECKING:
-    from .roof_planes import RoofPlaneParams
+#: core.lidar.roof_planes.RoofPlaneParams (not imported: roof_planes imports this module)
+RoofPlaneParams = Any
 
 Array = NDArray[np.float64]
 Progress = Union[Callable[[float], None], None]

@@ -10,7 +10,7 @@ points (cell, then coordinates: :mod:`core.lidar.roof_planes_local`), sums run i
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -19,8 +19,8 @@ from ..errors import stop_if_asked
 from ..geometry.planes import label_moments
 from .roof_planes_local import Array, ShouldStop, _eig_normals
 
-if TYPE_CHECKING:
-    from .roof_planes import RoofPlaneParams
+#: core.lidar.roof_planes.RoofPlaneParams (not imported: roof_planes imports this module)
+RoofPlaneParams = Any
 
 #: Seed voxel size, in point spacings (distance to the 4th neighbour, the median over the point
 #: and its GROW_NEIGHBOURS - 1 nearest), rounded to a power of two.
