@@ -18,23 +18,24 @@ differ, each where the two DTMs differ by more than 1 mm; tests/core/test_lidar_
 CSF, whose cloth couples every cell, and a slope estimated from the cloud (SMRF slope 0) have
 no finite buffer and are refused for blocks.
 
-Roof planes (:func:`tile_planes`, :func:`merge_cut_planes`) are extracted on each tile's
-core plus a buffer of :func:`roof_buffer`, sized from the neighbourhood the extraction uses:
-a core point's label depends on its K neighbours' local RANSAC, on its G neighbours' local
-planes and on the reassignment, which reaches REASSIGN_PASSES + 1 rings of G neighbours; the
-buffer holds three times that, so the half next to the core (the overlap band) is labelled
-as in a whole-file run. The extraction itself does not depend on the points a tile
-holds (fixed RANSAC triplets, seeds on a voxel grid of map coordinates, ties by coordinates:
-:mod:`core.lidar.roof_planes`). Each tile keeps the planes of its core points (pieces) and
-reports the labels it gives to the points of the band on both sides of its border. A plane
-cut by a border is found by both tiles; two pieces are merged when the tiles' own region
-growing put the same points into them: at least half of the band points that either tile
-gives to its piece are given to the other piece by the other tile. That is the growing's own
-test (a tile grows its region across the border into its buffer exactly as the whole-file
-run does), neither looser nor tighter: two roofs that the growing keeps apart get different
-labels in the band and are not fused, whatever their normals. The merged plane is refitted
-with :func:`lidarphoto.core.geometry.planes.fit_plane` (covariance included) from the points
-its tiles fitted (the regions' interiors, the whole-file rule).
+Roof planes (:func:`tile_planes`, :func:`merge_cut_planes`) are extracted on each tile's core
+plus a buffer of :func:`roof_buffer`, sized from the neighbourhood the extraction uses: a core
+point's label depends on its K neighbours' local RANSAC, on its G neighbours' local planes and
+on the reassignment, which reaches REASSIGN_PASSES + 1 rings of G neighbours; the buffer holds
+three times that, so the half next to the core (the overlap band) is labelled as in a whole-file
+run. A point's local plane and seed do not depend on the points a tile holds beyond its
+neighbours (RANSAC triplet tables picked by its coordinates, seed voxels on map coordinates
+sized by the local spacing, ties by coordinates: :mod:`core.lidar.roof_planes`); what a tile
+cannot see is the rest of a region cut by its buffer (its refit), hence the band. Each tile
+keeps the planes of its core points (pieces) and reports the labels it gives to the points of
+the band on both sides of its border. A plane cut by a border is found by both tiles; two pieces
+are merged when the tiles' own region growing put the same points into them: at least half of
+the band points that either tile gives to its piece are given to the other piece by the other
+tile. That is the growing's own test (a tile grows its region across the border into its buffer
+exactly as the whole-file run does), neither looser nor tighter: two roofs that the growing
+keeps apart get different labels in the band and are not fused, whatever their normals. The
+merged plane is refitted with :func:`lidarphoto.core.geometry.planes.fit_plane` (covariance
+included) from the points its tiles fitted (the regions' interiors, the whole-file rule).
 """
 
 from __future__ import annotations
@@ -102,7 +103,7 @@ MIN_SHARED = 3
 @dataclass(frozen=True)
 class PlanePiece:
     """A plane found in one tile: the tile, the plane, its core points (N, 3), which of them
-    the tile fitted (N,) and their ids (N,), -1 when unknown."""
+    are its region's interior (N,: RoofPlaneResult.fit_mask) and their point ids (N,)."""
 
     tile: int
     plane: Plane
@@ -180,11 +181,11 @@ def tile_planes(
     return pieces, BandLabels(tile, ids[inband], core[inband], piece_of[label[inband] + 1])
 
 
-def _shared(bands: Sequence[BandLabels], n: int) -> tuple[NDArray, NDArray, NDArray, int]:
+def _shared(bands: Sequence[BandLabels], n: int) -> tuple[NDArray, NDArray, Any]:
     """Band points two tiles both labelled: a tile's label of a point of its buffer against
     the label of the tile that owns it. Returns the pairs of pieces (i < j) labelled on the
-    same points, their counts, and per piece and other tile the points both tiles labelled
-    (``over[piece * n_tiles + tile]``, any label of the other tile), and n_tiles."""
+    same points, their counts, and ``over(piece, tile)``: the points of the piece that ``tile``
+    labelled too (with any label; arrays in, arrays out)."""
     ids = np.concatenate([b.ids for b in bands])
     core = np.concatenate([b.core for b in bands])
     piece = np.concatenate([b.piece for b in bands])
@@ -197,13 +198,21 @@ def _shared(bands: Sequence[BandLabels], n: int) -> tuple[NDArray, NDArray, NDAr
     ok[ok] = ids[o[at[ok]]] == ids[u[ok]]
     u, c = u[ok], o[at[ok]]  # the same point: in one tile's buffer, in another's core
     pu, pc = piece[u], piece[c]
-    over = np.bincount(np.concatenate([(pu * n_tiles + tile[c])[pu >= 0],
-                                       (pc * n_tiles + tile[u])[pc >= 0]]),
-                       minlength=n * n_tiles)  # fmt: skip
+    # sparse (piece, other tile) counts: a dense table would be pieces x tiles
+    seen, seen_count = np.unique(np.concatenate([(pu * n_tiles + tile[c])[pu >= 0],
+                                                 (pc * n_tiles + tile[u])[pc >= 0]]),
+                                 return_counts=True)  # fmt: skip
+
+    def over(p: NDArray, t: NDArray) -> NDArray:
+        key = p * n_tiles + t
+        at = np.minimum(np.searchsorted(seen, key), max(len(seen) - 1, 0))
+        hit = (seen[at] == key) if len(seen) else np.zeros(len(key), bool)
+        return np.where(hit, seen_count[at] if len(seen) else 0, 0)
+
     both = (pu >= 0) & (pc >= 0)
     lo, hi = np.minimum(pu[both], pc[both]), np.maximum(pu[both], pc[both])
     key, count = np.unique(lo * n + hi, return_counts=True)
-    return np.column_stack([key // n, key % n]), count, over, n_tiles
+    return np.column_stack([key // n, key % n]), count, over
 
 
 def _refit(pieces: Sequence[PlanePiece], members: Sequence[int], new_id: int) -> Plane:
@@ -255,9 +264,9 @@ def merge_cut_planes(
     tiles = np.array([p.tile for p in pieces], dtype=np.int64)
     groups: dict[int, list[int]] = {k: [k] for k in range(n)}
     if bands:
-        pairs, count, over, n_tiles = _shared(bands, n)
+        pairs, count, over = _shared(bands, n)
         a, b = pairs[:, 0], pairs[:, 1]
-        least = np.minimum(over[a * n_tiles + tiles[b]], over[b * n_tiles + tiles[a]])
+        least = np.minimum(over(a, tiles[b]), over(b, tiles[a]))
         join = (tiles[a] != tiles[b]) & (count >= MIN_SHARED) & (2 * count >= least)
         a, b, count = a[join], b[join], count[join]
         # strongest joins first; a join that would put two pieces of one tile into one plane

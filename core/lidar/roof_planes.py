@@ -10,11 +10,13 @@ unit):
    least squares on its inliers. The point is kept when the plane has at least
    ``min_support`` inliers, the point lies within ``epsilon`` of it and its slope is in
    ``[min_slope_deg, max_slope_deg]`` (vegetation has no supported plane; walls are too
-   steep). The triplets are a fixed set of neighbour ranks, the same for every point
-   (``roof_planes_local.triplets``), not random draws: a point's local plane depends on its
-   neighbours alone, whatever the seed, the batch, the thread count or the tile.
+   steep). The triplets are not random draws: one of 256 fixed tables of neighbour ranks
+   (``roof_planes_local.triplets``), picked by a hash of the point's coordinates, so a point's
+   local plane depends on its neighbours alone, whatever the seed, the batch, the thread count
+   or the tile.
 2. **Region growing** (:mod:`core.lidar.roof_planes_regions`) from seeds (the best-fitting
-   kept point of each voxel of a grid on the map coordinates) in waves over the
+   kept point of each voxel of a grid on the map coordinates, its size a power of two from
+   the local spacing) in waves over the
    ``GROW_NEIGHBOURS`` nearest neighbours: a kept neighbour joins when it lies within
    ``epsilon`` of the region's current plane and its local normal is within
    ``angle_tolerance_deg`` of the region's.
@@ -313,6 +315,7 @@ def extract_roof_planes(
         hi = min(n, lo + (1 << 20))
         interior[lo:hi] = (labels[knn[lo:hi]] == labels[lo:hi, None]).all(axis=1)
     fit_sorted = keep & ~ambiguous & interior
+    del q, knn, interior, ambiguous, spacing_of  # the fits need the points and labels only
     planes, pid_sorted = _final_planes(xyz, order, labels, fit_sorted, cell, progress,
                                        should_stop)  # fmt: skip
     # back to the input's order (the work ran on the sorted points)

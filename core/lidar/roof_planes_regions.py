@@ -10,7 +10,7 @@ points (cell, then coordinates: :mod:`core.lidar.roof_planes_local`), sums run i
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -19,8 +19,8 @@ from ..errors import stop_if_asked
 from ..geometry.planes import label_moments
 from .roof_planes_local import Array, ShouldStop, _eig_normals
 
-if TYPE_CHECKING:
-    from .roof_planes import RoofPlaneParams
+#: core.lidar.roof_planes.RoofPlaneParams (not imported: roof_planes imports this module)
+RoofPlaneParams = Any
 
 #: Seed voxel size, in point spacings (distance to the 4th neighbour, the median over the point
 #: and its GROW_NEIGHBOURS - 1 nearest), rounded to a power of two.
@@ -132,20 +132,20 @@ def _grow(
 
 def _voxel_level(
     spacing: NDArray[np.float32], knn: NDArray[np.int32], good: NDArray[np.bool_]
-) -> NDArray[np.int64]:
+) -> NDArray[np.int8]:
     """Per point (of ``good`` ones; 0 elsewhere): the seed voxel's size as a power of two,
     ``2 ** level`` = SEED_VOXEL x the local spacing (the lower median of the 4th-neighbour
     distances of the point and its nearest neighbours). Local, so that a tile and the whole
     file give a point the same voxel (a median over the cloud gave tiles of another density
     voxels twice as large, and other seeds, far from any border)."""
-    level = np.zeros(len(spacing), dtype=np.int64)
+    level = np.zeros(len(spacing), dtype=np.int8)
     idx = np.flatnonzero(good)
     g = knn.shape[1]
     for lo in range(0, len(idx), 1 << 20):  # (B, G) spacings in slices: bounded memory
         part = idx[lo : lo + (1 << 20)]
         local = np.partition(spacing[knn[part]], (g - 1) // 2, axis=1)[:, (g - 1) // 2]
         size = SEED_VOXEL * np.maximum(local.astype(np.float64), 1e-9)
-        level[part] = np.round(np.log2(size)).astype(np.int64)
+        level[part] = np.round(np.log2(size)).astype(np.int8)
     return level
 
 
