@@ -124,7 +124,8 @@ import json, sys
 import numpy as np
 pkg = sys.argv[1]
 module = __import__(pkg + ".core.lidar.roof_planes_numba", fromlist=["counting_order"])
-order, start = module.counting_order(np.array([3, 1, 2, 1, 0], np.int64), 4)
+xyz = np.column_stack([np.arange(5.0), np.zeros(5), np.zeros(5)])
+order, start = module.counting_order(np.array([3, 1, 2, 1, 0], np.int64), 4, xyz)
 stats = module._compiled("order").stats
 print(json.dumps({"file": module.__file__, "order": order.tolist(), "start": start.tolist(),
                   "cache": stats.cache_path, "hits": sum(stats.cache_hits.values())}))
