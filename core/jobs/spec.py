@@ -109,10 +109,12 @@ class Ref:
         raise AttributeError(f"{self.name} has no field {self.field!r}")
 
     def names(self, cls: type) -> bool:
-        """Whether this is a field of the class ``cls``."""
-        return bool(self.field) and cls.__name__ == self.name and (
-            cls.__module__.endswith(f".{self.module}")
-        )
+        """Whether this is a field of the class ``cls``: the name of this module resolves to
+        ``cls`` itself (a class moved to another module and imported back still is)."""
+        if not self.field or cls.__name__ != self.name:
+            return False
+        module = importlib.import_module(f"..{self.module}", __package__)
+        return getattr(module, self.name, None) is cls
 
     def __str__(self) -> str:
         return f"{self.module}.{self.name}" + (f".{self.field}" if self.field else "")
@@ -617,11 +619,15 @@ def options_from(cls: type, spec: AlgorithmSpec, values: Mapping[str, Any], **ex
     >>> options_from(RoofPlaneParams, spec, {"EPSILON": 0.2}, seed=3).epsilon
     0.2
     """
+    mapped = [p for p in spec.params if p.source is not None and p.source.name == cls.__name__]
+    stray = [f"{p.name} ({p.source})" for p in mapped if not p.source.names(cls)]
+    if stray:  # a field read from another class of that name would be silently left out
+        raise TypeError(f"{spec.name}: parameters {', '.join(stray)} do not name "
+                        f"{cls.__module__}.{cls.__name__}")  # fmt: skip
     fields = {
         p.source.field: values[p.name]
-        for p in spec.params
-        if p.source is not None and p.source.convert is None and p.name in values
-        and p.source.names(cls)
+        for p in mapped
+        if p.source.convert is None and p.name in values
     }
     fields.update(extra)
     return cls(**fields)
