@@ -210,7 +210,7 @@ def _names_in(folder: Path, cache: dict[Path, dict[str, str]]) -> dict[str, str]
     return cache[folder]
 
 
-def read_files(
+def files_read(
     inputs: Mapping[str, PathLike | Iterable[PathLike] | None],
     suffixes: Mapping[str, Iterable[str]] | None = None,
 ) -> list[tuple[str, Path, str]]:
@@ -225,7 +225,7 @@ def read_files(
     >>> d = pathlib.Path(tempfile.mkdtemp())
     >>> for name in ("a.tif", "a.tfw", "notes.txt"):
     ...     _ = (d / name).write_text("")
-    >>> for name, f, how in read_files({"IMAGES": [d]}, {"IMAGES": [".tif"]}):
+    >>> for name, f, how in files_read({"IMAGES": [d]}, {"IMAGES": [".tif"]}):
     ...     print(name, f.name, how.replace(str(d), "<d>"))
     IMAGES a.tif , read from the folder <d>
     IMAGES a.tfw , the world file of <d>/a.tif
@@ -282,11 +282,11 @@ def check_outputs(
 
     ``outputs``: name -> file the job writes (with the sidecars GDAL may write beside a
     raster); ``folders``: name -> a folder the job replaces as a whole (no input may lie in
-    it); ``inputs`` and ``suffixes`` as :func:`read_files`. Files are compared as files
+    it); ``inputs`` and ``suffixes`` as :func:`files_read`. Files are compared as files
     (device and inode), so a link, ``..``, a folder named instead of its files or another
     case of the name on a case-insensitive file system changes nothing. Nothing is written.
     """
-    reads = read_files(inputs, suffixes)
+    reads = files_read(inputs, suffixes)
     by_id = {}
     for name, f, how in reads:
         key = _identity(f)

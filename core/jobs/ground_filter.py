@@ -154,7 +154,7 @@ also the extra dimension height_above_ground (float32); optionally the DTM as Ge
 def method_params(v: Values):
     """The science parameters of the chosen method (SmrfParams, GroundFilterParams or
     CsfParams) from the job's values, lengths as given."""
-    from ..lidar import ground_filter as science
+    from ..lidar import ground_filter_params as science
 
     method = v.method
     cls = getattr(science, _CLASSES[method])

@@ -391,7 +391,7 @@ def test_located_control_feeds_the_resection_directly(block, tmp_path):
     "change, message",
     [
         ("unknown_chip", r"chips of unknown points \(not in the control table\): EXTRA"),
-        ("no_image", r"no image of the EO table among the images given"),
+        ("no_image", r"eo\.csv: no exterior orientation for image\(s\) X9 \(image_id = file name"),
     ],
 )
 def test_bad_job_inputs_are_refused_by_name(block, tmp_path, capsys, change, message):
