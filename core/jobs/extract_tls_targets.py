@@ -95,7 +95,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.tables import write_csv_atomic
     from ..io.tls import read_tls_control_csv
     from ..tls.aps import ARCSEC
-    from ..tls.targets import detect_checkerboards, detect_spheres, label_targets
+    from ..tls.correspondence import label_targets
+    from ..tls.targets import detect_checkerboards, detect_spheres
 
     files = _scan_files(v.scans)
     s_range, s_angle = v.scan_sigmas[0] / 1000.0, v.scan_sigmas[1] * ARCSEC

@@ -18,7 +18,8 @@ import numpy as np
 from .. import __version__
 from ..lsq.results import RejectionTest
 from ..tls.aps import ARCSEC
-from ..tls.calibration import TlsCalibration, explain_pair
+from ..tls.calibration import TlsCalibration
+from ..tls.diagnosis import explain_pair
 from .html_table import TR_CONTEXT, failed_checks, html_lang, t  # noqa: F401 - TR_CONTEXT: i18n
 from .html_table import escape as _e
 from .html_table import table as _table

@@ -10,13 +10,8 @@ import pytest
 from lidarphoto.core.errors import InputError
 from lidarphoto.core.geometry.rotations import opk_to_matrix
 from lidarphoto.core.simulation.tls import room_network, scene_from_network, simulate_scan
-from lidarphoto.core.tls.targets import (
-    detect_spheres,
-    fit_checkerboard,
-    fit_sphere,
-    label_targets,
-    match_targets,
-)
+from lidarphoto.core.tls.correspondence import label_targets, match_targets
+from lidarphoto.core.tls.targets import detect_spheres, fit_checkerboard, fit_sphere
 
 
 def _scene(kind, keep):
