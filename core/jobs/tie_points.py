@@ -13,7 +13,7 @@ from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_fro
 
 log = logging.getLogger(__name__)
 
-_D = Fields("photo.tie_points", "TiePointOptions")
+_D = Fields("photo.tie_options", "TiePointOptions")
 #: Columns of the pair table (OUTPUT_PAIRS).
 PAIR_COLUMNS = ("image_a", "image_b", "overlap", "features_a", "features_b", "ratio_matches",
                 "mutual_matches", "inliers", "epipolar_median_px", "status")  # fmt: skip
@@ -68,7 +68,7 @@ track's first-image measurement: the median of its track's refined sigmas.""",
         Param("HEIGHT", "number", "Mean terrain height", 0.0, unit="m", minimum=-1000.0,
               maximum=9000.0, help="the plane the footprints are computed on (EO heights)"),
         Param("DETECTOR", "enum", "Detector", _D.detector,
-              options=Ref("photo.tie_points", "DETECTORS"),
+              options=Ref("photo.tie_options", "DETECTORS"),
               labels=("SIFT (Lowe 2004)", "ORB (fast)")),
         Param("MAX_FEATURES", "integer", "Features per image", _D.max_features, minimum=100,
               maximum=100000),
@@ -79,14 +79,14 @@ track's first-image measurement: the median of its track's refined sigmas.""",
         Param("RANSAC_THRESHOLD", "number", "RANSAC threshold (epipolar distance)",
               _D.ransac_px, unit="pixels", minimum=0.05, maximum=100.0),
         Param("RANSAC_METHOD", "enum", "RANSAC method", _D.ransac_method,
-              options=Ref("photo.tie_points", "RANSAC_METHODS"), labels=("MAGSAC++", "RANSAC"),
+              options=Ref("photo.tie_options", "RANSAC_METHODS"), labels=("MAGSAC++", "RANSAC"),
               advanced=True),
         Param("MIN_INLIERS", "integer", "Minimum inliers per pair", _D.min_inliers, minimum=8,
               maximum=100000),
         Param("MIN_TRACK_LENGTH", "integer", "Minimum track length", _D.min_track_length,
               unit="images", minimum=2, maximum=1000),
         Param("PAIR_MODE", "enum", "Pairs", _D.pair_mode,
-              options=Ref("photo.tie_points", "PAIR_MODES"),
+              options=Ref("photo.tie_options", "PAIR_MODES"),
               labels=("footprints with EO, else sequential", "footprints (EO + camera)",
                       "all pairs", "sequential window")),
         Param("WINDOW", "integer", "Sequential window", _D.window, unit="images", minimum=1,
@@ -126,8 +126,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.observations import write_observations_csv
     from ..io.orientation import read_eo_csv
     from ..io.tables import write_csv_atomic
+    from ..photo.tie_options import TiePointOptions
     from ..photo.tie_pairs import footprints
-    from ..photo.tie_points import TiePointOptions, detect_features, reduction_factor, tie_points
+    from ..photo.tie_points import detect_features, reduction_factor, tie_points
 
     options = options_from(TiePointOptions, SPEC, v)
     files = list_image_files(v.images, ("IMAGES", "identical images have no parallax"))

@@ -1,0 +1,93 @@
+"""Settings of the tie-point chain (:func:`lidarphoto.core.photo.tie_points.tie_points`), apart
+from its OpenCV and SciPy code so that the algorithm's parameters are read without them."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import InputError
+
+__all__ = ["DETECTORS", "PAIR_MODES", "RANSAC_METHODS", "TiePointOptions"]
+
+DETECTORS = ("sift", "orb")
+#: ``auto``: footprints when an orientation is given, else the sequential window.
+PAIR_MODES = ("auto", "footprints", "all", "sequential")
+RANSAC_METHODS = ("magsac", "ransac")
+
+
+@dataclass(frozen=True)
+class TiePointOptions:
+    """Settings of :func:`tie_points` (units in the names).
+
+    detector : "sift" or "orb"
+    max_features : int
+        Strongest keypoints kept per image.
+    max_dimension_px : int
+        Features are detected on the image reduced by the smallest integer factor that
+        brings its longer side to at most this; 0 detects at full resolution.
+    ratio : float
+        Lowe's ratio: best distance / second best must be below it.
+    mutual : bool
+        Keep a match only if it is also the best in the other direction.
+    ransac_px : float
+        RANSAC threshold on the distance to the epipolar line, full-resolution pixels.
+    ransac_method : "magsac" (MAGSAC++) or "ransac"
+    min_inliers : int
+        Fewer inliers: the pair is dropped.
+    min_track_length : int
+        Images a track must span.
+    pair_mode : one of :data:`PAIR_MODES`
+    window : int
+        Sequential mode: each image is matched with the next ``window`` images.
+    min_overlap : float
+        Footprint mode: overlap / smaller footprint area at least this.
+    sigma_px : float
+        A-priori sigma written with every measurement, pixels; 0 = 0.5 px times the
+        detection reduction factor.
+    coherence : float
+        Motion coherence: an inlier whose displacement differs from the median displacement
+        of its 8 nearest inliers by more than this share of the image diagonal is dropped
+        (0: no test). It removes wrong matches that slide along the epipolar line, which
+        the fundamental matrix cannot see (aerial strips: all epipolar lines are parallel).
+    refine : bool
+        Least-squares refinement of the tracks (:func:`refine_tracks`).
+    refine_half_px : int
+        Half size of the LSM template, full-resolution pixels (template 2 h + 1 square).
+    refine_sigma_floor_px : float
+        Smallest sigma_px written for a refined measurement (the LSM sigma ignores the
+        model errors of the affine patch model, e.g. relief inside the patch).
+    """
+
+    detector: str = "sift"
+    max_features: int = 4000
+    max_dimension_px: int = 3000
+    ratio: float = 0.8
+    mutual: bool = True
+    ransac_px: float = 2.0
+    ransac_method: str = "magsac"
+    min_inliers: int = 15
+    min_track_length: int = 2
+    pair_mode: str = "auto"
+    window: int = 5
+    min_overlap: float = 0.05
+    sigma_px: float = 0.0
+    coherence: float = 0.03
+    refine: bool = False
+    refine_half_px: int = 10
+    refine_sigma_floor_px: float = 0.02
+
+    def __post_init__(self) -> None:
+        if self.detector not in DETECTORS:
+            raise InputError(f"detector must be one of {', '.join(DETECTORS)}")
+        if self.pair_mode not in PAIR_MODES:
+            raise InputError(f"pair mode must be one of {', '.join(PAIR_MODES)}")
+        if self.ransac_method not in RANSAC_METHODS:
+            raise InputError(f"RANSAC method must be one of {', '.join(RANSAC_METHODS)}")
+        if not 0.0 < self.ratio <= 1.0:
+            raise InputError(f"ratio must be in (0, 1], got {self.ratio:g}")
+        if self.min_track_length < 2:
+            raise InputError("a track needs at least 2 images")
+        if self.min_inliers < 8:
+            raise InputError("the fundamental matrix needs at least 8 inliers")
+        if self.refine_half_px < 3:
+            raise InputError("the refinement template needs a half size of at least 3 px")
