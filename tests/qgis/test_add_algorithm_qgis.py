@@ -48,14 +48,17 @@ def test_the_registered_algorithm_is_generated_and_runs(fitplane_provider, tmp_p
     assert eps.defaultValue() == RoofPlaneParams().epsilon  # read from the science
     normal = _points(tmp_path / "points.csv")
     out = tmp_path / "plane.csv"
-    result = processing.run("lidarphoto:fitplane",
-                            {"INPUT": str(tmp_path / "points.csv"), "OUTPUT": str(out)})
+    result = processing.run(
+        "lidarphoto:fitplane", {"INPUT": str(tmp_path / "points.csv"), "OUTPUT": str(out)}
+    )
     row = next(csv.DictReader(out.open()))
     fitted = np.array([float(row[k]) for k in "abc"])
     # 300 points over 30 m x 30 m, 1 cm noise: the normal is good to 7e-5 rad (1 sigma)
     assert np.degrees(np.arccos(min(1.0, abs(fitted @ normal)))) < 0.03
     assert result["INLIERS"] == 300 and 0.008 < result["RMS"] < 0.012
     with pytest.raises(QgsProcessingException):
-        processing.run("lidarphoto:fitplane", {"INPUT": str(tmp_path / "missing.csv"),
-                                               "OUTPUT": str(tmp_path / "x.csv")})
+        processing.run(
+            "lidarphoto:fitplane",
+            {"INPUT": str(tmp_path / "missing.csv"), "OUTPUT": str(tmp_path / "x.csv")},
+        )
     assert not (tmp_path / "x.csv").exists()
