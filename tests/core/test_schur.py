@@ -102,7 +102,8 @@ def small_block(seed: int = 1, blunders: int = 0, n_img: int = 8, n_pt: int = 12
 
 def _compare(full, red, tol=1e-8):
     assert_allclose(red.x, full.x, rtol=0, atol=tol * np.maximum(1.0, np.abs(full.x)).max())
-    assert_allclose(red.std, full.std, rtol=1e-6)
+    # (a held parameter's sigma is 0 in one and rounding noise, ~1e-11, in the other)
+    assert_allclose(red.std, full.std, rtol=1e-6, atol=1e-9 * full.std.max())
     assert red.redundancy == full.redundancy
     assert abs(red.sigma0 / full.sigma0 - 1) < 1e-9
     for name, t in full.residuals.items():
