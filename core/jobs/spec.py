@@ -110,14 +110,25 @@ class Ref:
 
     def names(self, cls: type) -> bool:
         """Whether this is a field of the class ``cls``: the name of this module resolves to
-        ``cls`` itself (a class moved to another module and imported back still is)."""
+        ``cls`` itself (a class moved to another module and imported back still is), or to
+        its twin when the core is imported under two package names (a checkout's folder
+        name and the plugin's): the same class and module path below ``core``."""
         if not self.field or cls.__name__ != self.name:
             return False
         module = importlib.import_module(f"..{self.module}", __package__)
-        return getattr(module, self.name, None) is cls
+        found = getattr(module, self.name, None)
+        if found is cls:
+            return True
+        return (isinstance(found, type) and found.__qualname__ == cls.__qualname__
+                and _below_core(found.__module__) == _below_core(cls.__module__))  # fmt: skip
 
     def __str__(self) -> str:
         return f"{self.module}.{self.name}" + (f".{self.field}" if self.field else "")
+
+
+def _below_core(module: str) -> str:
+    """``lidarphoto.core.lidar.roof_planes`` -> ``lidar.roof_planes`` (any package name)."""
+    return module.partition(".core.")[2] or module
 
 
 class Fields:

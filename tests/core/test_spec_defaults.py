@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import os
 
 import pytest
 from lidarphoto.core.errors import InputError
@@ -117,3 +118,41 @@ def test_a_value_given_reaches_the_options(name, key):
     except InputError as exc:  # the other value breaks a rule between fields (not dropped)
         pytest.skip(f"the science refuses it with the other defaults: {exc}")
     assert getattr(opts, p.source.field) == new
+
+
+_TWIN = """
+import dataclasses, sys
+from main.core.jobs.spec import AlgorithmSpec, Param, Ref, options_from
+from lidarphoto.core.lidar.roof_planes import RoofPlaneParams
+
+spec = AlgorithmSpec("x", "X", "G", "g", "s", "d", (Param("EPSILON", "number", "E",
+    Ref("lidar.roof_planes", "RoofPlaneParams", "epsilon")),))
+assert options_from(RoofPlaneParams, spec, {"EPSILON": 0.2}).epsilon == 0.2
+
+@dataclasses.dataclass
+class RoofPlaneParams:  # a class of that name elsewhere: refused
+    epsilon: float = 0.1
+try:
+    options_from(RoofPlaneParams, spec, {"EPSILON": 0.2})
+except TypeError as exc:
+    print(exc)
+"""
+
+
+def test_a_field_is_found_when_the_core_is_imported_under_two_names(tmp_path):
+    """The plugin folder imported as ``main`` too (pytest's --doctest-modules names it after
+    the checkout's folder): its specs take the dataclasses of ``lidarphoto.core``, the same
+    classes under the other name; a class of that name from another module is refused."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import lidarphoto
+
+    (tmp_path / "main").symlink_to(Path(lidarphoto.__file__).parent, target_is_directory=True)
+    env = {**os.environ, "PYTHONPATH": str(tmp_path)}
+    run = subprocess.run([sys.executable, "-c", _TWIN], cwd=tmp_path, env=env,
+                         capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.strip() == ("x: parameters EPSILON (lidar.roof_planes.RoofPlaneParams."
+                                  "epsilon) do not name __main__.RoofPlaneParams")  # fmt: skip
