@@ -63,25 +63,54 @@ def pip_requirements(modules: Sequence[str]) -> list[str]:
     return seen
 
 
-def qgis_python() -> str:
-    """Path of the Python interpreter QGIS embeds (``sys.executable`` is often QGIS itself)."""
-    exe = sys.executable or ""
-    if os.path.basename(exe).lower().startswith("python"):
-        return exe
-    prefix = sys.exec_prefix
+def _is_this_python(path: str) -> bool:
+    """Whether ``path`` is an interpreter of the Python that runs: a binary (not a launcher
+    script such as a pyenv shim) in this installation's binary folder, or in this venv's
+    (another venv's ``python3``, first on PATH, would install where QGIS does not look)."""
+    if not path or not os.path.isfile(path):
+        return False
+    try:
+        with open(path, "rb") as fh:
+            if fh.read(2) == b"#!":
+                return False
+    except OSError:
+        return False
+    here = os.path.realpath(os.path.dirname(os.path.abspath(path)))
+    homes = (sys.exec_prefix, sys.base_exec_prefix)
+    if sys.platform == "win32":
+        folders = {os.path.realpath(h) for h in homes}
+    else:
+        folders = {os.path.realpath(os.path.join(h, "bin")) for h in homes}
+    return here in folders
+
+
+def _interpreter_candidates() -> list[str]:
+    """Where this installation keeps its interpreter, most specific first."""
+    ver = f"{sys.version_info.major}.{sys.version_info.minor}"
+    prefixes = dict.fromkeys((sys.exec_prefix, sys.base_exec_prefix))  # a venv first
     if sys.platform == "win32":  # OSGeo4W / standalone installer: <prefix>/python.exe
-        candidates = [os.path.join(prefix, "python.exe"), os.path.join(prefix, "python3.exe")]
-    else:  # Linux packages (/usr), macOS QGIS.app (.../Contents/MacOS or Frameworks)
-        ver = f"{sys.version_info.major}.{sys.version_info.minor}"
-        candidates = [
-            os.path.join(prefix, "bin", f"python{ver}"),
-            os.path.join(prefix, "bin", "python3"),
-            os.path.join(prefix, "bin", "python"),
-        ]
+        return [os.path.join(p, n) for p in prefixes for n in ("python.exe", "python3.exe")]
+    # Linux packages (/usr), macOS QGIS.app (.../Contents/MacOS or Frameworks)
+    names = (f"python{ver}", "python3", "python")
+    return [os.path.join(p, "bin", n) for p in prefixes for n in names]
+
+
+def qgis_python() -> str:
+    """Path of the Python interpreter QGIS embeds.
+
+    Inside QGIS, ``sys.executable`` is QGIS itself, or what an embedded Python found first
+    on PATH under the name ``python3`` (a pyenv shim, another venv): it is trusted only when
+    it is an interpreter of the installation that runs (:func:`_is_this_python`); else the
+    interpreter is derived from ``sys.exec_prefix`` / ``sys.base_exec_prefix``.
+    """
+    exe = sys.executable or ""
+    if os.path.basename(exe).lower().startswith("python") and _is_this_python(exe):
+        return exe
+    candidates = _interpreter_candidates()
     for path in candidates:
-        if os.path.isfile(path):
+        if os.path.isfile(path) and (sys.platform == "win32" or _is_this_python(path)):
             return path
-    return candidates[0] if sys.platform == "win32" else "python3"
+    return candidates[0]
 
 
 def _externally_managed() -> bool:
@@ -90,15 +119,16 @@ def _externally_managed() -> bool:
     return bool(stdlib) and os.path.isfile(os.path.join(stdlib, "EXTERNALLY-MANAGED"))
 
 
-def pip_command(modules: Sequence[str]) -> str:
-    """The shell command that installs ``modules`` into QGIS's Python.
+def pip_argv(modules: Sequence[str]) -> list[str]:
+    """The pip call that installs ``modules`` into QGIS's Python, as a program and its
+    arguments (what the plugin's Install button runs).
 
     numpy is pinned to the version QGIS already uses, so pip cannot replace it by an
     ABI-incompatible one (numpy 2 breaks GDAL's and QGIS's compiled numpy bindings).
     """
     python = qgis_python()
     args = [python, "-m", "pip", "install"]
-    if sys.platform != "win32":
+    if sys.platform != "win32" and sys.prefix == sys.base_prefix:  # a venv takes no --user
         args.append("--user")
         if _externally_managed():
             args.append("--break-system-packages")
@@ -109,6 +139,12 @@ def pip_command(modules: Sequence[str]) -> str:
         args.append(f"numpy=={numpy.__version__}")
     except Exception:
         pass
+    return args
+
+
+def pip_command(modules: Sequence[str]) -> str:
+    """:func:`pip_argv` as one shell command, quoted for this platform's shell."""
+    args = pip_argv(modules)
     if sys.platform == "win32":
         return " ".join(f'"{a}"' if " " in a else a for a in args)
     return " ".join(shlex.quote(a) for a in args)

@@ -83,6 +83,14 @@
             <translation>intervalo válido</translation>
         </message>
         <message>
+            <source>POINTS = the surveyed control, PHOTOS = ground photos of each point with and without the control plate, CAMERA = the ground camera; OUTPUT_FOLDER = one chip per point at the GSD of the aerial images</source>
+            <translation>POINTS = o controle levantado, PHOTOS = fotos terrestres de cada ponto com e sem a placa de controle, CAMERA = a câmera terrestre; OUTPUT_FOLDER = um recorte (chip) por ponto no GSD das imagens aéreas</translation>
+        </message>
+        <message>
+            <source>CHIPS = one GeoTIFF chip per control point, CONTROL_POINTS, CAMERA, approximate EO, IMAGES; OUTPUT = the control points' image observations, without clicking them</source>
+            <translation>CHIPS = um recorte (chip) GeoTIFF por ponto de controle, CONTROL_POINTS, CAMERA, EO aproximada, IMAGES; OUTPUT = as observações de imagem dos pontos de controle, sem clicar neles</translation>
+        </message>
+        <message>
             <source>Boresight calibration with LiDAR control (Pedrosa &amp; dos Santos 2020)</source>
             <translation>Calibração de boresight com controle LiDAR (Pedrosa &amp; dos Santos 2020)</translation>
         </message>
@@ -157,14 +165,6 @@
         <message>
             <source>IMAGES (and the approximate EO + CAMERA to pair images by their footprints); OUTPUT_OBSERVATIONS = tie points for the bundle</source>
             <translation>IMAGES (e a EO aproximada + CAMERA para formar pares de imagens pelas suas projeções no terreno); OUTPUT_OBSERVATIONS = pontos de enlace para o ajustamento por feixes de raios</translation>
-        </message>
-        <message>
-            <source>POINTS = the surveyed control, PHOTOS = ground photos of each point with and without the control plate, CAMERA = the ground camera; OUTPUT_FOLDER = one chip per point at the GSD of the aerial images</source>
-            <translation>POINTS = o controle levantado, PHOTOS = fotos terrestres de cada ponto com e sem a placa de controle, CAMERA = a câmera terrestre; OUTPUT_FOLDER = um recorte (chip) por ponto no GSD das imagens aéreas</translation>
-        </message>
-        <message>
-            <source>CHIPS = one GeoTIFF chip per control point, CONTROL_POINTS, CAMERA, approximate EO, IMAGES; OUTPUT = the control points' image observations, without clicking them</source>
-            <translation>CHIPS = um recorte (chip) GeoTIFF por ponto de controle, CONTROL_POINTS, CAMERA, EO aproximada, IMAGES; OUTPUT = as observações de imagem dos pontos de controle, sem clicar neles</translation>
         </message>
         <message>
             <source>CAMERA, OBSERVATIONS, GROUND_POINTS, EO (approximate); OUTPUT_EO = adjusted orientation, OUTPUT_CAMERA = calibrated camera</source>
@@ -440,6 +440,53 @@
         <message>
             <source>{} residuals: RMS {:.2f} px, max {:.2f} px</source>
             <translation>{} resíduos: RMS {:.2f} px, máx. {:.2f} px</translation>
+        </message>
+    </context>
+    <context>
+        <name>DependencyDialog</name>
+        <message>
+            <source>Missing Python packages: {names}.</source>
+            <translation>Pacotes Python ausentes: {names}.</translation>
+        </message>
+        <message>
+            <source>Install...</source>
+            <translation>Instalar...</translation>
+        </message>
+        <message>
+            <source>LiDAR Photogrammetry: missing Python packages</source>
+            <translation>Fotogrametria LiDAR: pacotes Python ausentes</translation>
+        </message>
+        <message>
+            <source>The algorithms need these Python packages in the Python QGIS runs: {names}. Install them with this command, or press Install.</source>
+            <translation>Os algoritmos precisam destes pacotes Python no Python que o QGIS executa: {names}. Instale-os com este comando ou clique em Instalar.</translation>
+        </message>
+        <message>
+            <source>Copy command</source>
+            <translation>Copiar comando</translation>
+        </message>
+        <message>
+            <source>Install</source>
+            <translation>Instalar</translation>
+        </message>
+        <message>
+            <source>The command is on the clipboard.</source>
+            <translation>O comando foi copiado para a área de transferência.</translation>
+        </message>
+        <message>
+            <source>Installing...</source>
+            <translation>Instalando...</translation>
+        </message>
+        <message>
+            <source>Installed. The algorithms can run now.</source>
+            <translation>Instalado. Os algoritmos já podem ser executados.</translation>
+        </message>
+        <message>
+            <source>pip finished, but {names} still cannot be imported: restart QGIS, or see pip's output below.</source>
+            <translation>O pip terminou, mas {names} ainda não pode ser importado: reinicie o QGIS ou veja a saída do pip abaixo.</translation>
+        </message>
+        <message>
+            <source>pip failed (exit code {code}); its message is below.</source>
+            <translation>O pip falhou (código de saída {code}); a mensagem dele está abaixo.</translation>
         </message>
     </context>
     <context>
@@ -847,6 +894,13 @@
         </message>
     </context>
     <context>
+        <name>PipTask</name>
+        <message>
+            <source>Installing Python packages for LiDAR Photogrammetry</source>
+            <translation>Instalando pacotes Python para a Fotogrametria LiDAR</translation>
+        </message>
+    </context>
+    <context>
         <name>ProjectLoader</name>
         <message>
             <source>Orientation not loaded: {}</source>
@@ -1011,6 +1065,10 @@
             <translation>{summary} (detalhes: lidarphoto -vv; QGIS: opções do Processamento, nível de log Verbose)</translation>
         </message>
         <message>
+            <source>the global test failed with sigma0 = {sigma0:.3g} &gt; MAX_SIGMA0 {maximum:g}: the observations are {sigma0:.3g} times less precise than their sigmas say (wrong sigmas, a model that does not fit, or undetected blunders)</source>
+            <translation>o teste global falhou com sigma0 = {sigma0:.3g} &gt; MAX_SIGMA0 {maximum:g}: as observações são {sigma0:.3g} vezes menos precisas do que os seus desvios-padrão dizem (desvios-padrão errados, um modelo que não se ajusta, ou erros grosseiros não detectados)</translation>
+        </message>
+        <message>
             <source>normals nearly parallel</source>
             <translation>normais quase paralelas</translation>
         </message>
@@ -1059,20 +1117,8 @@
             <translation>data snooping de Baarda (alfa = {alpha:g} por observação, |w| crítico = {critical:.2f}, rejeição iterativa de grupos inteiros)</translation>
         </message>
         <message>
-            <source>{method} reweighting (k = {k:g} robust scale units, {rounds} rounds, robust scale {scale:.3g}), groups with a standardised misfit above {critical:.2f} set aside</source>
-            <translation>reponderação {method} (k = {k:g} unidades da escala robusta, {rounds} rodadas, escala robusta {scale:.3g}), grupos com desajuste padronizado acima de {critical:.2f} afastados</translation>
-        </message>
-        <message>
             <source>{robust}, then {snooping}</source>
             <translation>{robust}, depois {snooping}</translation>
-        </message>
-        <message>
-            <source>no convergence within {n} iterations</source>
-            <translation>sem convergência em {n} iterações</translation>
-        </message>
-        <message>
-            <source>no redundancy: sigma0 and the global test are undefined</source>
-            <translation>sem redundância: sigma0 e o teste global ficam indefinidos</translation>
         </message>
         <message>
             <source>{robust}; no data snooping</source>
@@ -1083,16 +1129,16 @@
             <translation>nenhuma (data snooping desativado)</translation>
         </message>
         <message>
+            <source>{method} reweighting (k = {k:g} robust scale units, {rounds} rounds, robust scale {scale:.3g}), groups with a standardised misfit above {critical:.2f} set aside</source>
+            <translation>reponderação {method} (k = {k:g} unidades da escala robusta, {rounds} rodadas, escala robusta {scale:.3g}), grupos com desajuste padronizado acima de {critical:.2f} afastados</translation>
+        </message>
+        <message>
             <source>data snooping skipped: the adjustment did not converge</source>
             <translation>data snooping não executado: o ajustamento não convergiu</translation>
         </message>
         <message>
             <source>{n} observation rows have a redundancy number of about zero and cannot be tested by data snooping</source>
             <translation>{n} linhas de observação têm número de redundância próximo de zero e não podem ser testadas pelo data snooping</translation>
-        </message>
-        <message>
-            <source>the cost could not be reduced further at iteration {iteration} (step {step:.3g} sigma): stopped without convergence</source>
-            <translation>o custo não pôde ser reduzido mais na iteração {iteration} (passo de {step:.3g} sigma): interrompido sem convergência</translation>
         </message>
         <message>
             <source>robust estimation: setting aside the {n} groups it flagged would leave the adjustment not observable; they are kept</source>
@@ -1109,6 +1155,22 @@
         <message>
             <source>data snooping stopped: rejecting {block} / {label} (|w| = {w:.2f}) would make the adjustment not observable; it is kept</source>
             <translation>data snooping interrompido: rejeitar {block} / {label} (|w| = {w:.2f}) tornaria o ajustamento não observável; a observação foi mantida</translation>
+        </message>
+        <message>
+            <source>data snooping rejected {k} of {n} observations ({share:.1f} %); its false alarms at alpha = {alpha:g} explain at most {bound} ({expected:.2g} expected, P({k} or more) = {p:.2g}): a model that does not fit the data (parameters missing?) or many blunders, and the global test of the rest does not show it</source>
+            <translation>o data snooping rejeitou {k} de {n} observações ({share:.1f} %); os seus falsos alarmes com alfa = {alpha:g} explicam no máximo {bound} ({expected:.2g} esperadas, P({k} ou mais) = {p:.2g}): um modelo que não se ajusta aos dados (parâmetros em falta?) ou muitos erros grosseiros, e o teste global das restantes não o mostra</translation>
+        </message>
+        <message>
+            <source>no convergence within {n} iterations</source>
+            <translation>sem convergência em {n} iterações</translation>
+        </message>
+        <message>
+            <source>the cost could not be reduced further at iteration {iteration} (step {step:.3g} sigma): stopped without convergence</source>
+            <translation>o custo não pôde ser reduzido mais na iteração {iteration} (passo de {step:.3g} sigma): interrompido sem convergência</translation>
+        </message>
+        <message>
+            <source>no redundancy: sigma0 and the global test are undefined</source>
+            <translation>sem redundância: sigma0 e o teste global ficam indefinidos</translation>
         </message>
         <message>
             <source>the lever arm cannot be separated from the INS position: it turns with the aircraft while a position error does not, so fly lines in opposite directions (horizontal components) and add height control (LCPs); its vertical component cannot be told from a vertical GNSS bias at all: measure it (total station) and keep it fixed.</source>
@@ -1151,16 +1213,16 @@
             <translation>{angles} do grupo '{group}' não podem ser separados: os pontos estão perto do centro da imagem ou em planos de uma só orientação; distribua pontos pela imagem em telhados de inclinação e orientação diferentes, ou acrescente LCPs ou linhas.</translation>
         </message>
         <message>
-            <source>{n} ground point(s) are not measured in any image and were not used: {ids}</source>
-            <translation>{n} ponto(s) de terreno não foram medidos em nenhuma imagem e não foram usados: {ids}</translation>
-        </message>
-        <message>
             <source>insignificant (t = {t:.2f} &lt;= {critical:.2f}, alpha {alpha:g})</source>
             <translation>não significativo (t = {t:.2f} &lt;= {critical:.2f}, alfa {alpha:g})</translation>
         </message>
         <message>
             <source>|correlation| {r:.3f} &gt; {limit:g} with {other}</source>
             <translation>|correlação| {r:.3f} &gt; {limit:g} com {other}</translation>
+        </message>
+        <message>
+            <source>{n} ground point(s) are not measured in any image and were not used: {ids}</source>
+            <translation>{n} ponto(s) de terreno não foram medidos em nenhuma imagem e não foram usados: {ids}</translation>
         </message>
         <message>
             <source>view {view!r} left out: fewer than {minimum} target points</source>
@@ -1399,6 +1461,14 @@
             <translation>{}, usado (m)</translation>
         </message>
         <message>
+            <source>Plots</source>
+            <translation>Gráficos</translation>
+        </message>
+        <message>
+            <source>Histogram of {}</source>
+            <translation>Histograma de {}</translation>
+        </message>
+        <message>
             <source>item</source>
             <translation>item</translation>
         </message>
@@ -1421,14 +1491,6 @@
         <message>
             <source>Outliers</source>
             <translation>Outliers</translation>
-        </message>
-        <message>
-            <source>Plots</source>
-            <translation>Gráficos</translation>
-        </message>
-        <message>
-            <source>Histogram of {}</source>
-            <translation>Histograma de {}</translation>
         </message>
         <message>
             <source>Check points</source>
@@ -1543,6 +1605,10 @@
             <translation>Fonte: {}. {} pontos de verificação.</translation>
         </message>
         <message>
+            <source>Normal Q-Q plot of {}</source>
+            <translation>Gráfico Q-Q normal de {}</translation>
+        </message>
+        <message>
             <source>{} ({} in the statistics)</source>
             <translation>{} ({} nas estatísticas)</translation>
         </message>
@@ -1567,10 +1633,6 @@
             <translation>; mantidos nas estatísticas (não excluídos).</translation>
         </message>
         <message>
-            <source>Normal Q-Q plot of {}</source>
-            <translation>Gráfico Q-Q normal de {}</translation>
-        </message>
-        <message>
             <source>accepted</source>
             <translation>aceito</translation>
         </message>
@@ -1585,10 +1647,6 @@
         <message>
             <source>{} point(s) flagged: </source>
             <translation>{} ponto(s) marcado(s): </translation>
-        </message>
-        <message>
-            <source>These results FAILED their checks and were written only because the user asked for them (ACCEPT_DOUBTFUL): do not use them without review.</source>
-            <translation>Estes resultados FALHARAM nas verificações e foram gravados apenas porque o usuário os pediu (ACCEPT_DOUBTFUL): não os use sem revisão.</translation>
         </message>
         <message>
             <source>The calibration FAILED its checks: no table and no exterior orientation were written. The numbers below show the failed adjustment, for diagnosis only.</source>
@@ -2111,6 +2169,10 @@
             <translation>{} em {}: {}</translation>
         </message>
         <message>
+            <source>These results FAILED their checks and were written only because the user asked for them (ACCEPT_DOUBTFUL): do not use them without review.</source>
+            <translation>Estes resultados FALHARAM nas verificações e foram gravados apenas porque o usuário os pediu (ACCEPT_DOUBTFUL): não os use sem revisão.</translation>
+        </message>
+        <message>
             <source>control points: RMS |v| (px)</source>
             <translation>pontos de controle: RMS |v| (px)</translation>
         </message>
@@ -2219,10 +2281,6 @@
             <translation>Início: {}; modelo de linha: {}; {} iterações; {} pontos de controle, {} linhas, {} pontos de verificação, {} linhas sem controle ignoradas.</translation>
         </message>
         <message>
-            <source>none</source>
-            <translation>nenhuma</translation>
-        </message>
-        <message>
             <source>; only {n} of {minimum} check points</source>
             <translation>; apenas {n} de {minimum} pontos de verificação</translation>
         </message>
@@ -2233,26 +2291,6 @@
         <message>
             <source>Check-point survey error included: RMSE_HORIZONTAL_SURVEY (ASPRS RMSE_H2) = {horizontal:.2f} cm, RMSE_U_SURVEY (ASPRS RMSE_V2) = {vertical:.2f} cm (0 when not given: then the totals are RMSE_HORIZONTAL and RMSE_U of the check points alone).</source>
             <translation>Erro do levantamento dos pontos de verificação incluído: RMSE_HORIZONTAL_SURVEY (ASPRS RMSE_H2) = {horizontal:.2f} cm, RMSE_U_SURVEY (ASPRS RMSE_V2) = {vertical:.2f} cm (0 quando não informado: então os totais são o RMSE_HORIZONTAL e o RMSE_U apenas dos pontos de verificação).</translation>
-        </message>
-        <message>
-            <source> (only {n} of {minimum} check points)</source>
-            <translation> (apenas {n} de {minimum} pontos de verificação)</translation>
-        </message>
-        <message>
-            <source>Scale 1:{scale:,.0f}; equidistance {equidistance}. Best class met: planimetric {planimetric}, altimetric {altimetric}.</source>
-            <translation>Escala 1:{scale:,.0f}; equidistância {equidistance}. Melhor classe atendida: planimétrica {planimetric}, altimétrica {altimetric}.</translation>
-        </message>
-        <message>
-            <source>PEC-PCD limits: planimetric A-D 0.28/0.5/0.8/1.0 mm (EP 0.17/0.3/0.5/0.6 mm) at the map scale; altimetric A-D 0.27/0.50/0.60/0.75 of the equidistance (EP 1/6, 1/3, 2/5, 1/2).</source>
-            <translation>Limites do PEC-PCD: planimétrico A-D 0,28/0,5/0,8/1,0 mm (EP 0,17/0,3/0,5/0,6 mm) na escala da carta; altimétrico A-D 0,27/0,50/0,60/0,75 da equidistância (EP 1/6, 1/3, 2/5, 1/2).</translation>
-        </message>
-        <message>
-            <source>given</source>
-            <translation>informado</translation>
-        </message>
-        <message>
-            <source>Eq. 18 with H {height:g} m, B {base:g} m, f {focal:g} mm, sigma_pix {pixel:g} um</source>
-            <translation>Eq. 18 com H {height:g} m, B {base:g} m, f {focal:g} mm, sigma_pix {pixel:g} µm</translation>
         </message>
         <message>
             <source>Check-point count</source>
@@ -2291,6 +2329,10 @@
             <translation>RMSE_3D_TOTAL = sqrt(RMSE_HORIZONTAL_TOTAL^2 + RMSE_U_TOTAL^2) = {value:.2f} cm (informado, sem classe)</translation>
         </message>
         <message>
+            <source>ASPRS Positional Accuracy Standards, Edition 2 (2023)</source>
+            <translation>Padrões de Acurácia Posicional da ASPRS, Edição 2 (2023)</translation>
+        </message>
+        <message>
             <source>horizontal</source>
             <translation>horizontal</translation>
         </message>
@@ -2299,8 +2341,24 @@
             <translation>vertical</translation>
         </message>
         <message>
-            <source>ASPRS Positional Accuracy Standards, Edition 2 (2023)</source>
-            <translation>Padrões de Acurácia Posicional da ASPRS, Edição 2 (2023)</translation>
+            <source>The {axis} check-point survey ({survey:.2f} cm) is not at least twice as accurate as the {target:g}-cm class (uncertain reading of Ed. 2).</source>
+            <translation>O levantamento {axis} dos pontos de verificação ({survey:.2f} cm) não é pelo menos duas vezes mais acurado que a classe de {target:g} cm (leitura incerta da Ed. 2).</translation>
+        </message>
+        <message>
+            <source>The {axis} mean error ({mean:.2f} cm) exceeds 25 % of the {target:g}-cm class: investigate a systematic error (Ed. 1 section 7.4; kept as guidance in Ed. 2, uncertain).</source>
+            <translation>O erro médio {axis} ({mean:.2f} cm) excede 25 % da classe de {target:g} cm: investigue um erro sistemático (Ed. 1, seção 7.4; mantido como orientação na Ed. 2, incerto).</translation>
+        </message>
+        <message>
+            <source>{axis} class</source>
+            <translation>Classe {axis}</translation>
+        </message>
+        <message>
+            <source>; tightest example class met: {best:g}-cm</source>
+            <translation>; classe de exemplo mais restrita atendida: {best:g} cm</translation>
+        </message>
+        <message>
+            <source> (only {n} of {minimum} check points)</source>
+            <translation> (apenas {n} de {minimum} pontos de verificação)</translation>
         </message>
         <message>
             <source>{n} check points; NSSDA requires at least {minimum}</source>
@@ -2309,18 +2367,6 @@
         <message>
             <source>Horizontal approximation condition</source>
             <translation>Condição da aproximação horizontal</translation>
-        </message>
-        <message>
-            <source>Assumption: normal distribution (Shapiro-Wilk)</source>
-            <translation>Hipótese: distribuição normal (Shapiro-Wilk)</translation>
-        </message>
-        <message>
-            <source>Assumption: no systematic error (Student t)</source>
-            <translation>Hipótese: ausência de erro sistemático (t de Student)</translation>
-        </message>
-        <message>
-            <source>rejected for {components}</source>
-            <translation>rejeitada para {components}</translation>
         </message>
         <message>
             <source>Horizontal accuracy (95 %)</source>
@@ -2339,6 +2385,50 @@
             <translation>Acurácia vertical testada de {value:.3f} m ao nível de confiança de 95 %{few}</translation>
         </message>
         <message>
+            <source>Assumption: normal distribution (Shapiro-Wilk)</source>
+            <translation>Hipótese: distribuição normal (Shapiro-Wilk)</translation>
+        </message>
+        <message>
+            <source>Assumption: no systematic error (Student t)</source>
+            <translation>Hipótese: ausência de erro sistemático (t de Student)</translation>
+        </message>
+        <message>
+            <source>rejected for {components}</source>
+            <translation>rejeitada para {components}</translation>
+        </message>
+        <message>
+            <source>RMSE_min/RMSE_max = {ratio:.3f} &gt;= 0.6: Accuracy_r = 2.4477 x 0.5 (RMSE_x + RMSE_y)</source>
+            <translation>RMSE_min/RMSE_max = {ratio:.3f} &gt;= 0,6: Accuracy_r = 2,4477 x 0,5 (RMSE_x + RMSE_y)</translation>
+        </message>
+        <message>
+            <source>RMSE_min/RMSE_max = {ratio:.3f} &lt; 0.6: the NSSDA approximation does not hold; exact 95 % radius used</source>
+            <translation>RMSE_min/RMSE_max = {ratio:.3f} &lt; 0,6: a aproximação do NSSDA não vale; usado o raio exato de 95 %</translation>
+        </message>
+        <message>
+            <source>Accuracy_r = 1.7308 RMSE_r holds for RMSE_x = RMSE_y; the Case 2 formula 2.4477 x 0.5 (RMSE_x + RMSE_y) is used for 0.6 &lt;= ratio &lt;= 1; the exact 95 % radius of the bivariate normal is also given.</source>
+            <translation>Accuracy_r = 1,7308 RMSE_r vale para RMSE_x = RMSE_y; a fórmula do Caso 2, 2,4477 x 0,5 (RMSE_x + RMSE_y), é usada para 0,6 &lt;= razão &lt;= 1; o raio exato de 95 % da normal bivariada também é apresentado.</translation>
+        </message>
+        <message>
+            <source>not testable for {components}</source>
+            <translation>não testável para {components}</translation>
+        </message>
+        <message>
+            <source>accepted for E, N, H</source>
+            <translation>aceita para E, N, H</translation>
+        </message>
+        <message>
+            <source>none</source>
+            <translation>nenhuma</translation>
+        </message>
+        <message>
+            <source>Scale 1:{scale:,.0f}; equidistance {equidistance}. Best class met: planimetric {planimetric}, altimetric {altimetric}.</source>
+            <translation>Escala 1:{scale:,.0f}; equidistância {equidistance}. Melhor classe atendida: planimétrica {planimetric}, altimétrica {altimetric}.</translation>
+        </message>
+        <message>
+            <source>PEC-PCD limits: planimetric A-D 0.28/0.5/0.8/1.0 mm (EP 0.17/0.3/0.5/0.6 mm) at the map scale; altimetric A-D 0.27/0.50/0.60/0.75 of the equidistance (EP 1/6, 1/3, 2/5, 1/2).</source>
+            <translation>Limites do PEC-PCD: planimétrico A-D 0,28/0,5/0,8/1,0 mm (EP 0,17/0,3/0,5/0,6 mm) na escala da carta; altimétrico A-D 0,27/0,50/0,60/0,75 da equidistância (EP 1/6, 1/3, 2/5, 1/2).</translation>
+        </message>
+        <message>
             <source>{n} check points; fewer than {minimum} makes the 90 % rule weak (common practice, not in the Decreto)</source>
             <translation>{n} pontos de verificação; menos de {minimum} torna fraca a regra dos 90 % (prática usual, não consta do Decreto)</translation>
         </message>
@@ -2349,6 +2439,42 @@
         <message>
             <source>PEC-PCD (Decreto 89.817 / ET-CQDG), 1:{scale:,.0f}</source>
             <translation>PEC-PCD (Decreto 89.817 / ET-CQDG), 1:{scale:,.0f}</translation>
+        </message>
+        <message>
+            <source>Class {cls} planimetric</source>
+            <translation>Classe {cls} planimétrica</translation>
+        </message>
+        <message>
+            <source>Class {cls} altimetric</source>
+            <translation>Classe {cls} altimétrica</translation>
+        </message>
+        <message>
+            <source>{value:g} m</source>
+            <translation>{value:g} m</translation>
+        </message>
+        <message>
+            <source>not given</source>
+            <translation>não informada</translation>
+        </message>
+        <message>
+            <source>Declared class {cls} (planimetric)</source>
+            <translation>Classe declarada {cls} (planimétrica)</translation>
+        </message>
+        <message>
+            <source>Declared class {cls} (altimetric)</source>
+            <translation>Classe declarada {cls} (altimétrica)</translation>
+        </message>
+        <message>
+            <source>no equidistance given for this scale</source>
+            <translation>nenhuma equidistância informada para esta escala</translation>
+        </message>
+        <message>
+            <source>given</source>
+            <translation>informado</translation>
+        </message>
+        <message>
+            <source>Eq. 18 with H {height:g} m, B {base:g} m, f {focal:g} mm, sigma_pix {pixel:g} um</source>
+            <translation>Eq. 18 com H {height:g} m, B {base:g} m, f {focal:g} mm, sigma_pix {pixel:g} µm</translation>
         </message>
         <message>
             <source>Planimetric RMSE</source>
@@ -2371,72 +2497,8 @@
             <translation>Limiar do projeto (Pedrosa &amp; dos Santos 2020, seção 3)</translation>
         </message>
         <message>
-            <source>The {axis} check-point survey ({survey:.2f} cm) is not at least twice as accurate as the {target:g}-cm class (uncertain reading of Ed. 2).</source>
-            <translation>O levantamento {axis} dos pontos de verificação ({survey:.2f} cm) não é pelo menos duas vezes mais acurado que a classe de {target:g} cm (leitura incerta da Ed. 2).</translation>
-        </message>
-        <message>
-            <source>The {axis} mean error ({mean:.2f} cm) exceeds 25 % of the {target:g}-cm class: investigate a systematic error (Ed. 1 section 7.4; kept as guidance in Ed. 2, uncertain).</source>
-            <translation>O erro médio {axis} ({mean:.2f} cm) excede 25 % da classe de {target:g} cm: investigue um erro sistemático (Ed. 1, seção 7.4; mantido como orientação na Ed. 2, incerto).</translation>
-        </message>
-        <message>
-            <source>RMSE_min/RMSE_max = {ratio:.3f} &gt;= 0.6: Accuracy_r = 2.4477 x 0.5 (RMSE_x + RMSE_y)</source>
-            <translation>RMSE_min/RMSE_max = {ratio:.3f} &gt;= 0,6: Accuracy_r = 2,4477 x 0,5 (RMSE_x + RMSE_y)</translation>
-        </message>
-        <message>
-            <source>RMSE_min/RMSE_max = {ratio:.3f} &lt; 0.6: the NSSDA approximation does not hold; exact 95 % radius used</source>
-            <translation>RMSE_min/RMSE_max = {ratio:.3f} &lt; 0,6: a aproximação do NSSDA não vale; usado o raio exato de 95 %</translation>
-        </message>
-        <message>
-            <source>not testable for {components}</source>
-            <translation>não testável para {components}</translation>
-        </message>
-        <message>
-            <source>accepted for E, N, H</source>
-            <translation>aceita para E, N, H</translation>
-        </message>
-        <message>
-            <source>Accuracy_r = 1.7308 RMSE_r holds for RMSE_x = RMSE_y; the Case 2 formula 2.4477 x 0.5 (RMSE_x + RMSE_y) is used for 0.6 &lt;= ratio &lt;= 1; the exact 95 % radius of the bivariate normal is also given.</source>
-            <translation>Accuracy_r = 1,7308 RMSE_r vale para RMSE_x = RMSE_y; a fórmula do Caso 2, 2,4477 x 0,5 (RMSE_x + RMSE_y), é usada para 0,6 &lt;= razão &lt;= 1; o raio exato de 95 % da normal bivariada também é apresentado.</translation>
-        </message>
-        <message>
-            <source>Class {cls} planimetric</source>
-            <translation>Classe {cls} planimétrica</translation>
-        </message>
-        <message>
-            <source>Class {cls} altimetric</source>
-            <translation>Classe {cls} altimétrica</translation>
-        </message>
-        <message>
             <source>The paper compares the RMSE of the check-point discrepancies with 0.40 m (twice the LiDAR standard deviation) and with dz of Eq. 18.</source>
             <translation>O artigo compara o RMSE das discrepâncias nos pontos de verificação com 0,40 m (o dobro do desvio-padrão do LiDAR) e com o dz da Eq. 18.</translation>
-        </message>
-        <message>
-            <source>{axis} class</source>
-            <translation>Classe {axis}</translation>
-        </message>
-        <message>
-            <source>{value:g} m</source>
-            <translation>{value:g} m</translation>
-        </message>
-        <message>
-            <source>not given</source>
-            <translation>não informada</translation>
-        </message>
-        <message>
-            <source>Declared class {cls} (planimetric)</source>
-            <translation>Classe declarada {cls} (planimétrica)</translation>
-        </message>
-        <message>
-            <source>Declared class {cls} (altimetric)</source>
-            <translation>Classe declarada {cls} (altimétrica)</translation>
-        </message>
-        <message>
-            <source>; tightest example class met: {best:g}-cm</source>
-            <translation>; classe de exemplo mais restrita atendida: {best:g} cm</translation>
-        </message>
-        <message>
-            <source>no equidistance given for this scale</source>
-            <translation>nenhuma equidistância informada para esta escala</translation>
         </message>
         <message>
             <source>Horizontal discrepancy vectors</source>
@@ -2471,6 +2533,22 @@
             <translation>As correlações entre os PAs e os parâmetros das estações (Lichti 2010) vêm da geometria da rede, não do instrumento: o deslocamento do distanciômetro a0 com as posições das estações quando os alvos estão de um só lado ou em uma faixa vertical estreita; o erro de colimação b1 com kappa quando os alvos estão próximos do horizonte (sec(alfa) é então cerca de 1); o erro do eixo secundário b2 e o índice vertical c0 com omega e phi. Elas são quebradas por alvos em toda a volta do escâner e em toda a faixa vertical (piso e teto), por observações nas duas posições da luneta e por estações cujo escâner está inclinado de cerca de 90 graus (o que transforma elevações em direções horizontais). O compensador de um escâner nivelado observa omega e phi e ajuda b2 e c0.</translation>
         </message>
         <message>
+            <source>The calibration FAILED its checks: no table and no registered scan were written. The numbers below show the failed adjustment, for diagnosis only.</source>
+            <translation>A calibração FALHOU nas verificações: nenhuma tabela e nenhuma varredura registrada foram gravadas. Os números abaixo mostram o ajustamento que falhou, apenas para diagnóstico.</translation>
+        </message>
+        <message>
+            <source>passed, but only after more rejections than false alarms explain</source>
+            <translation>aprovado, mas só depois de mais rejeições do que os falsos alarmes explicam</translation>
+        </message>
+        <message>
+            <source>station / target</source>
+            <translation>estação / alvo</translation>
+        </message>
+        <message>
+            <source>v range mm</source>
+            <translation>v distância mm</translation>
+        </message>
+        <message>
             <source>TLS self-calibration</source>
             <translation>Autocalibração TLS</translation>
         </message>
@@ -2495,12 +2573,20 @@
             <translation>nivelada</translation>
         </message>
         <message>
-            <source>station / target</source>
-            <translation>estação / alvo</translation>
+            <source>range</source>
+            <translation>distância</translation>
         </message>
         <message>
-            <source>v range mm</source>
-            <translation>v distância mm</translation>
+            <source>horizontal direction</source>
+            <translation>direção horizontal</translation>
+        </message>
+        <message>
+            <source>arc-seconds</source>
+            <translation>segundos de arco</translation>
+        </message>
+        <message>
+            <source>vertical angle</source>
+            <translation>ângulo vertical</translation>
         </message>
         <message>
             <source>observations (station-target-face)</source>
@@ -2559,22 +2645,6 @@
             <translation>restantes</translation>
         </message>
         <message>
-            <source>range</source>
-            <translation>distância</translation>
-        </message>
-        <message>
-            <source>horizontal direction</source>
-            <translation>direção horizontal</translation>
-        </message>
-        <message>
-            <source>arc-seconds</source>
-            <translation>segundos de arco</translation>
-        </message>
-        <message>
-            <source>vertical angle</source>
-            <translation>ângulo vertical</translation>
-        </message>
-        <message>
             <source>control</source>
             <translation>controle</translation>
         </message>
@@ -2599,6 +2669,14 @@
             <translation>NÃO</translation>
         </message>
         <message>
+            <source>rejections explained by false alarms</source>
+            <translation>rejeições explicadas por falsos alarmes</translation>
+        </message>
+        <message>
+            <source>at most {bound} ({expected} expected); {k} rejected: P = {p}</source>
+            <translation>no máximo {bound} ({expected} esperadas); {k} rejeitadas: P = {p}</translation>
+        </message>
+        <message>
             <source>mean planimetric (m)</source>
             <translation type="vanished">média planimétrica (m)</translation>
         </message>
@@ -2621,30 +2699,6 @@
         <message>
             <source>Planimetric discrepancy: mean {} m, standard deviation {} m, RMS {} m; RMS E/N/H {} / {} / {} m; 3D {} m. Intersected with the adjusted orientations; their sigmas carry the image noise only.</source>
             <translation type="vanished">Discrepância planimétrica: média {} m, desvio-padrão {} m, RMS {} m; RMS E/N/H {} / {} / {} m; 3D {} m. Intersectados com as orientações ajustadas; os seus desvios-padrão trazem apenas o ruído das imagens.</translation>
-        </message>
-        <message>
-            <source>The calibration FAILED its checks: no table and no registered scan were written. The numbers below show the failed adjustment, for diagnosis only.</source>
-            <translation>A calibração FALHOU nas verificações: nenhuma tabela e nenhuma varredura registrada foram gravadas. Os números abaixo mostram o ajustamento que falhou, apenas para diagnóstico.</translation>
-        </message>
-        <message>
-            <source>passed, but only after more rejections than false alarms explain</source>
-            <translation>aprovado, mas só depois de mais rejeições do que os falsos alarmes explicam</translation>
-        </message>
-        <message>
-            <source>rejections explained by false alarms</source>
-            <translation>rejeições explicadas por falsos alarmes</translation>
-        </message>
-        <message>
-            <source>at most {bound} ({expected} expected); {k} rejected: P = {p}</source>
-            <translation>no máximo {bound} ({expected} esperadas); {k} rejeitadas: P = {p}</translation>
-        </message>
-        <message>
-            <source>the global test failed with sigma0 = {sigma0:.3g} &gt; MAX_SIGMA0 {maximum:g}: the observations are {sigma0:.3g} times less precise than their sigmas say (wrong sigmas, a model that does not fit, or undetected blunders)</source>
-            <translation>o teste global falhou com sigma0 = {sigma0:.3g} &gt; MAX_SIGMA0 {maximum:g}: as observações são {sigma0:.3g} vezes menos precisas do que os seus desvios-padrão dizem (desvios-padrão errados, um modelo que não se ajusta, ou erros grosseiros não detectados)</translation>
-        </message>
-        <message>
-            <source>data snooping rejected {k} of {n} observations ({share:.1f} %); its false alarms at alpha = {alpha:g} explain at most {bound} ({expected:.2g} expected, P({k} or more) = {p:.2g}): a model that does not fit the data (parameters missing?) or many blunders, and the global test of the rest does not show it</source>
-            <translation>o data snooping rejeitou {k} de {n} observações ({share:.1f} %); os seus falsos alarmes com alfa = {alpha:g} explicam no máximo {bound} ({expected:.2g} esperadas, P({k} ou mais) = {p:.2g}): um modelo que não se ajusta aos dados (parâmetros em falta?) ou muitos erros grosseiros, e o teste global das restantes não o mostra</translation>
         </message>
     </context>
     <context>
@@ -6336,6 +6390,24 @@ dimensões e VLRs mantidas); as varreduras PLY/E57 são lidas inteiras. Todos os
 aparecem juntos ou nenhum (uma varredura ruim: nenhum).</translation>
         </message>
         <message>
+            <source>## Checks of the result
+The run fails (nothing is written but the HTML report, which says why) when the adjustment
+did not converge, when its global test fails with sigma0 above MAX SIGMA0, or when data
+snooping rejected more observations than its false alarms explain (the upper tail of their
+binomial count below 0.001: a model that does not fit the data, e.g. APs missing, or many
+blunders; the global test of the observations left then proves nothing). With ACCEPT
+DOUBTFUL the outputs are written and each table starts with a warning (comment lines
+beginning with #).</source>
+            <translation>## Verificações do resultado
+A execução falha (nada é gravado além do relatório HTML, que diz o motivo) quando o ajustamento
+não convergiu, quando o seu teste global falha com sigma0 acima de MAX SIGMA0, ou quando o
+data snooping rejeitou mais observações do que os seus falsos alarmes explicam (a cauda
+superior da sua contagem binomial abaixo de 0,001: um modelo que não se ajusta aos dados, por
+exemplo APs em falta, ou muitos erros grosseiros; o teste global das observações restantes
+então nada prova). Com ACCEPT DOUBTFUL as saídas são gravadas e cada tabela começa com um aviso
+(linhas de comentário iniciadas por #).</translation>
+        </message>
+        <message>
             <source>Observations (CSV)</source>
             <translation>Observações (CSV)</translation>
         </message>
@@ -6444,6 +6516,22 @@ aparecem juntos ou nenhum (uma varredura ruim: nenhum).</translation>
             <translation>Correlação forte para |r| &gt;=</translation>
         </message>
         <message>
+            <source>Largest sigma0 when the global test fails</source>
+            <translation>Maior sigma0 quando o teste global falha</translation>
+        </message>
+        <message>
+            <source>a failed global test with sigma0 above this fails the run (wrong sigmas, a model that does not fit, or blunders data snooping did not catch)</source>
+            <translation>um teste global que falha com sigma0 acima deste valor faz a execução falhar (desvios-padrão errados, um modelo que não se ajusta, ou erros grosseiros que o data snooping não detectou)</translation>
+        </message>
+        <message>
+            <source>Write the results even when the checks fail</source>
+            <translation>Gravar os resultados mesmo quando as verificações falham</translation>
+        </message>
+        <message>
+            <source>no convergence, global test beyond MAX_SIGMA0 or more rejections than data snooping's false alarms explain: write the outputs anyway, each table with a warning at its top</source>
+            <translation>sem convergência, teste global além de MAX_SIGMA0 ou mais rejeições do que os falsos alarmes do data snooping explicam: grava as saídas mesmo assim, cada tabela com um aviso no início</translation>
+        </message>
+        <message>
             <source>Scans to register (LAS/LAZ, PLY, E57; one station per file)</source>
             <translation>Varreduras a registrar (LAS/LAZ, PLY, E57; uma estação por arquivo)</translation>
         </message>
@@ -6510,40 +6598,6 @@ aparecem juntos ou nenhum (uma varredura ruim: nenhum).</translation>
         <message>
             <source>Additional parameters estimated</source>
             <translation>Parâmetros adicionais estimados</translation>
-        </message>
-        <message>
-            <source>## Checks of the result
-The run fails (nothing is written but the HTML report, which says why) when the adjustment
-did not converge, when its global test fails with sigma0 above MAX SIGMA0, or when data
-snooping rejected more observations than its false alarms explain (the upper tail of their
-binomial count below 0.001: a model that does not fit the data, e.g. APs missing, or many
-blunders; the global test of the observations left then proves nothing). With ACCEPT
-DOUBTFUL the outputs are written and each table starts with a warning (comment lines
-beginning with #).</source>
-            <translation>## Verificações do resultado
-A execução falha (nada é gravado além do relatório HTML, que diz o motivo) quando o ajustamento
-não convergiu, quando o seu teste global falha com sigma0 acima de MAX SIGMA0, ou quando o
-data snooping rejeitou mais observações do que os seus falsos alarmes explicam (a cauda
-superior da sua contagem binomial abaixo de 0,001: um modelo que não se ajusta aos dados, por
-exemplo APs em falta, ou muitos erros grosseiros; o teste global das observações restantes
-então nada prova). Com ACCEPT DOUBTFUL as saídas são gravadas e cada tabela começa com um aviso
-(linhas de comentário iniciadas por #).</translation>
-        </message>
-        <message>
-            <source>Largest sigma0 when the global test fails</source>
-            <translation>Maior sigma0 quando o teste global falha</translation>
-        </message>
-        <message>
-            <source>a failed global test with sigma0 above this fails the run (wrong sigmas, a model that does not fit, or blunders data snooping did not catch)</source>
-            <translation>um teste global que falha com sigma0 acima deste valor faz a execução falhar (desvios-padrão errados, um modelo que não se ajusta, ou erros grosseiros que o data snooping não detectou)</translation>
-        </message>
-        <message>
-            <source>Write the results even when the checks fail</source>
-            <translation>Gravar os resultados mesmo quando as verificações falham</translation>
-        </message>
-        <message>
-            <source>no convergence, global test beyond MAX_SIGMA0 or more rejections than data snooping's false alarms explain: write the outputs anyway, each table with a warning at its top</source>
-            <translation>sem convergência, teste global além de MAX_SIGMA0 ou mais rejeições do que os falsos alarmes do data snooping explicam: grava as saídas mesmo assim, cada tabela com um aviso no início</translation>
         </message>
     </context>
     <context>

@@ -3,11 +3,9 @@ and the bridge from core calls to QGIS feedback (progress, cancel, log, errors).
 
 from __future__ import annotations
 
-import configparser
 import logging
 import math
 from contextlib import contextmanager
-from pathlib import Path
 from types import ModuleType
 from typing import Any, Callable
 
@@ -32,15 +30,8 @@ from .compat import FIELD_INT, FIELD_STRING, SINK_FAST_INSERT
 from .i18n import spec_help_html, spec_translator
 from .parameters import make_output, make_parameter, read_parameter
 
-_PLUGIN_DIR = Path(__file__).resolve().parents[1]
 #: Logger of the whole package ("lidarphoto"); the core logs below it ("lidarphoto.core.*").
 PACKAGE_LOGGER = __name__.split(".")[0]
-
-
-def _homepage() -> str:
-    meta = configparser.ConfigParser()
-    meta.read(_PLUGIN_DIR / "metadata.txt", encoding="utf-8")
-    return meta.get("general", "homepage", fallback="")
 
 
 class _FeedbackLogHandler(logging.Handler):
@@ -178,8 +169,9 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
         return spec_help_html(self.spec)
 
     def helpUrl(self) -> str:
-        home = _homepage()
-        return f"{home.rstrip('/')}/algorithms/{self.name()}" if home else ""
+        from .help_docs import help_url  # the pages are written on the first Help asked
+
+        return help_url(self.name())
 
     def initAlgorithm(self, config=None):
         for p in self.spec.params:

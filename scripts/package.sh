@@ -51,6 +51,11 @@ for required in ("metadata.txt", "__init__.py", "LICENSE"):
 meta = configparser.ConfigParser()
 meta.read("metadata.txt", encoding="utf-8")
 version = meta.get("general", "version")
+unset = [k for k in ("email", "homepage", "repository", "tracker")
+         if not meta.get("general", k, fallback="").strip()]
+if unset:  # the zip installs; plugins.qgis.org refuses an upload without them
+    print(f"package.sh: warning: metadata.txt has no {', '.join(unset)} yet "
+          "(needed before an upload to plugins.qgis.org)", file=sys.stderr)
 
 # the compiled translations (lrelease): QGIS loads the .qm, the core reads the .ts
 qm_dir = tempfile.mkdtemp(prefix="lidarphoto-qm-")

@@ -74,7 +74,7 @@ ensure_core_env() {
 
 # ------------------------------------------------------------------------------ .venv-qgis
 ensure_qgis_env() {
-  apt_install qgis python3-qgis qgis-providers python3-venv python3-pip
+  apt_install qgis python3-qgis qgis-providers python3-venv python3-pip xvfb xauth
   # pylupdate5 and lrelease: tests/qgis/test_i18n.py extracts the strings and builds the .qm
   apt_install pyqt5-dev-tools qttools5-dev-tools
   local venv=$ROOT/.venv-qgis

@@ -90,3 +90,28 @@ def test_qgis_process_runs_extractroofplanes_without_the_layer(qp_env, tmp_path)
     assert len(read_planes_csv(csv_path)) == results["PLANE_COUNT"]
     assert cloud.stat().st_size > 1000
     assert not results.get("OUTPUT")  # no layer was made
+
+
+def test_every_help_button_opens_a_local_page_of_its_algorithm(provider, tmp_path, monkeypatch):
+    """helpUrl() of every algorithm is a file URL of an existing page (written from the spec
+    into the profile, so it works offline) naming the algorithm and every parameter; the
+    pages link to an index of all algorithms. Nothing points to a placeholder address."""
+    from lidarphoto.processing_provider import help_docs
+    from qgis.PyQt.QtCore import QUrl
+
+    monkeypatch.setattr(help_docs, "help_folder", lambda lang: tmp_path / "help" / lang)
+    monkeypatch.setattr(help_docs, "_written", {})
+    algs = provider.algorithms()
+    assert sorted(a.name() for a in algs) == sorted(SPECS)
+    for alg in algs:
+        url = QUrl(alg.helpUrl())
+        assert url.isLocalFile(), alg.helpUrl()
+        page = Path(url.toLocalFile())
+        assert page.is_file() and page.parent == tmp_path / "help" / "en", page
+        text = page.read_text(encoding="utf-8")
+        assert f"lidarphoto:{alg.name()}" in text and alg.displayName() in text
+        for p in SPECS[alg.name()].params:
+            assert f"<b>{p.name}</b>" in text, (alg.name(), p.name)
+    assert (tmp_path / "help" / "en" / "index.html").is_file()
+    meta = (Path(ROOT) / "metadata.txt").read_text(encoding="utf-8")
+    assert "example.org" not in meta and "example.com" not in meta

@@ -97,21 +97,25 @@ def test_installed_zip_loads_in_qgis(package, tmp_path, qgis_plugin_paths, qgis_
 
 
 def test_metadata_is_complete(package):
-    """What plugins.qgis.org asks for, filled in, in the zip's metadata.txt."""
+    """What plugins.qgis.org asks for, in the zip's metadata.txt (addresses: empty, not fake)."""
     meta = configparser.ConfigParser()
     meta.read_string(zipfile.ZipFile(package).read("lidarphoto/metadata.txt").decode("utf-8"))
     general = meta["general"]
     for key in (
         "name", "qgisMinimumVersion", "qgisMaximumVersion", "description", "about", "version",
-        "author", "email", "homepage", "repository", "tracker", "tags", "changelog", "icon",
-        "category", "experimental", "hasProcessingProvider", "supportsQt6",
+        "author", "tags", "changelog", "icon", "category", "experimental",
+        "hasProcessingProvider", "supportsQt6",
     ):  # fmt: skip
         assert general.get(key, "").strip(), key
     assert (
         general["icon"] and f"lidarphoto/{general['icon']}" in zipfile.ZipFile(package).namelist()
     )
+    # not published yet: empty until the project has real addresses, never a placeholder
     for url in ("homepage", "repository", "tracker"):
-        assert general[url].startswith("https://"), url
+        assert general[url] == "" or general[url].startswith("https://"), url
+        assert "example." not in general[url], url
+    email = general["email"]
+    assert email == "" or ("@" in email and "example." not in email)
     assert general["experimental"] in ("True", "False")
     assert general["version"] in general["changelog"]
     about = general["about"].lower()
