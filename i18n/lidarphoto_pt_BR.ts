@@ -2854,6 +2854,26 @@
             <translation>Ajusta o ponto selecionado à correspondência por mínimos quadrados (6 parâmetros afins + 2 radiométricos) do mesmo ponto medido em outra imagem</translation>
         </message>
         <message>
+            <source>planes</source>
+            <translation>planos</translation>
+        </message>
+        <message>
+            <source>lcps</source>
+            <translation>LCPs</translation>
+        </message>
+        <message>
+            <source>residuals</source>
+            <translation>resíduos</translation>
+        </message>
+        <message>
+            <source>observations</source>
+            <translation>observações</translation>
+        </message>
+        <message>
+            <source>predictions</source>
+            <translation>previsões</translation>
+        </message>
+        <message>
             <source>Scale of the residual vectors</source>
             <translation>Escala dos vetores de resíduos</translation>
         </message>
@@ -3563,7 +3583,7 @@ points are resected and the rest of the block grows by intersection and resectio
 OE ou de observações), observações de imagem (image_id, point_id, col, row, sigma_px; uma linha
 do tipo control, como Localizar pontos de controle a escreve, deve nomear um ponto de apoio),
 pontos de apoio (point_id, X, Y, Z, sx, sy, sz, role = control | check) e, opcionalmente,
-orientações exteriores: aproximadas (por exemplo, da georreferenciação direta, com alguns graus e
+orientações exteriores: aproximadas (por exemplo, do georreferenciamento direto, com alguns graus e
 metros de erro) ou observadas quando a tabela tem colunas de desvio-padrão (GNSS/INS com
 desvios-padrão; correções do braço de alavanca e do boresight podem ser estimadas). Sem
 orientações, as imagens que veem quatro ou mais pontos de controle passam por resseção e o
@@ -3769,7 +3789,7 @@ points are resected and the rest of the block grows by intersection and resectio
             <translation type="vanished">Entradas: JSON da câmera (uma câmera, ou {"cameras": [...]} com uma coluna camera na tabela de
 OE ou de observações), observações de imagem (image_id, point_id, col, row, sigma_px), pontos
 de apoio (point_id, X, Y, Z, sx, sy, sz, role = control | check) e, opcionalmente, orientações
-exteriores: aproximadas (por exemplo, da georreferenciação direta, com alguns graus e metros de
+exteriores: aproximadas (por exemplo, do georreferenciamento direto, com alguns graus e metros de
 erro) ou observadas quando a tabela tem colunas de desvio-padrão (GNSS/INS com desvios-padrão;
 correções do braço de alavanca e do boresight podem ser estimadas). Sem orientações, as imagens
 que veem quatro ou mais pontos de controle passam por resseção e o restante do bloco cresce por
@@ -6608,7 +6628,7 @@ então nada prova). Com ACCEPT DOUBTFUL as saídas são gravadas e cada tabela c
         </message>
         <message>
             <source>Direct georeferencing</source>
-            <translation>Georreferenciação direta</translation>
+            <translation>Georreferenciamento direto</translation>
         </message>
         <message>
             <source>INS/GNSS trajectory + camera mount -&gt; exterior orientation per image</source>
@@ -6620,7 +6640,7 @@ from the INS/GNSS solution at its exposure time (direct georeferencing: X_pc = X
 R_b^m a_b, R_c^m = R_b^m R_c^b, composed rigorously through the Earth-centred frame, so grid
 convergence and Earth curvature are accounted for).</source>
             <translation>Calcula a orientação exterior (centro perspectivo e omega, phi, kappa) de cada imagem a partir
-da solução INS/GNSS no seu instante de exposição (georreferenciação direta: X_pc = X_ins +
+da solução INS/GNSS no seu instante de exposição (georreferenciamento direto: X_pc = X_ins +
 R_b^m a_b, R_c^m = R_b^m R_c^b, composta rigorosamente através do referencial geocêntrico, de
 modo que a convergência meridiana e a curvatura da Terra são levadas em conta).</translation>
         </message>

@@ -116,8 +116,16 @@ class ViewerPanel(QWidget):
         vl.addLayout(row)
         toggles = QHBoxLayout()
         self.overlay_checks: dict[str, QCheckBox] = {}
+        labels = {  # literal strings: pylupdate cannot collect tr() of a variable
+            "planes": self.tr("planes"),
+            "lines": self.tr("lines"),
+            "lcps": self.tr("lcps"),
+            "residuals": self.tr("residuals"),
+            "observations": self.tr("observations"),
+            "predictions": self.tr("predictions"),
+        }
         for name in GROUPS:
-            box = QCheckBox(self.tr(name))
+            box = QCheckBox(labels[name])
             box.setChecked(True)
             self.overlay_checks[name] = box
             toggles.addWidget(box)

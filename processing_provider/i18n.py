@@ -54,12 +54,30 @@ def install_translator(lang: str | None = None) -> str:
     qm = core_i18n.I18N_DIR / f"{core_i18n.PREFIX}{name}.qm"
     translator = QTranslator()
     if not qm.is_file() or not translator.load(str(qm)):
-        return "en"
+        # a checkout linked into QGIS has no .qm (built by `make package`): read the .ts
+        translator = CatalogueTranslator(name)
+        if not core_i18n.catalogue(name):
+            return "en"
     for other in list(_installed):  # one language at a time
         QCoreApplication.removeTranslator(_installed.pop(other))
     QCoreApplication.installTranslator(translator)
     _installed[name] = translator  # the translator must outlive this call
     return name
+
+
+class CatalogueTranslator(QTranslator):
+    """The translations of ``i18n/lidarphoto_<lang>.ts`` read directly (the core's parser of
+    the catalogue), for a plugin folder whose .qm has not been compiled."""
+
+    def __init__(self, lang: str) -> None:
+        super().__init__()
+        self.table = core_i18n.catalogue(lang)
+
+    def translate(self, context, source, disambiguation=None, n=-1):
+        return self.table.get((context, source), "")  # "" : Qt keeps the source text
+
+    def isEmpty(self) -> bool:
+        return not self.table
 
 
 def remove_translator() -> None:

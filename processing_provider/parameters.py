@@ -69,6 +69,8 @@ def make_parameter(
             p.name, title, behavior=FILE_BEHAVIOR_FILE, fileFilter=flt, optional=p.optional
         )
     elif k == "crs":
+        if default is None and not p.optional:  # the project's CRS, not "invalid projection"
+            default = "ProjectCrs"
         q = QgsProcessingParameterCrs(p.name, title, default, p.optional)
     elif k in ("number", "integer"):
         q = QgsProcessingParameterNumber(

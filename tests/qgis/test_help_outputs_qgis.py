@@ -115,3 +115,27 @@ def test_every_help_button_opens_a_local_page_of_its_algorithm(provider, tmp_pat
     assert (tmp_path / "help" / "en" / "index.html").is_file()
     meta = (Path(ROOT) / "metadata.txt").read_text(encoding="utf-8")
     assert "example.org" not in meta and "example.com" not in meta
+
+
+def test_a_required_crs_defaults_to_the_project_s(provider):
+    """Orthorectify and the others open with the project's CRS, not "invalid projection"."""
+    from qgis.core import (
+        QgsCoordinateReferenceSystem,
+        QgsProcessingContext,
+        QgsProcessingParameterCrs,
+        QgsProject,
+    )
+
+    project = QgsProject()
+    project.setCrs(QgsCoordinateReferenceSystem("EPSG:28992"))
+    context = QgsProcessingContext()
+    context.setProject(project)
+    required = 0
+    for alg in provider.algorithms():
+        for d in alg.parameterDefinitions():
+            if isinstance(d, QgsProcessingParameterCrs) and not d.flags() & d.FlagOptional:
+                required += 1
+                assert d.defaultValue() == "ProjectCrs", (alg.name(), d.name())
+                crs = alg.parameterAsCrs({}, d.name(), context)
+                assert crs.authid() == "EPSG:28992", (alg.name(), d.name())
+    assert required >= 5

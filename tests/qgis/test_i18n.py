@@ -257,3 +257,36 @@ def test_logged_messages_reach_the_feedback_in_portuguese(compiled_qm):
         ("warning", "point P7: outside every image"),
         ("info", "2 candidates rejected: 2 intersection far from a plane's points"),
     ]
+
+
+def test_a_checkout_without_the_compiled_catalogue_still_speaks_portuguese(
+    qgis_iface, tmp_path, monkeypatch
+):
+    """A plugin folder linked from a checkout has only the .ts (the .qm is built by `make
+    package`): the translator reads the .ts; the dock's overlay toggles are translated."""
+    import shutil
+
+    from lidarphoto.core import i18n as core_i18n
+    from lidarphoto.plugin.image_dock import ImagePickingDock
+    from lidarphoto.processing_provider import i18n as qt_i18n
+    from qgis.PyQt.QtCore import QCoreApplication
+
+    folder = tmp_path / "i18n"
+    folder.mkdir()
+    shutil.copy2(ROOT / "i18n" / "lidarphoto_pt_BR.ts", folder)
+    monkeypatch.setattr(core_i18n, "I18N_DIR", folder)
+    core_i18n.catalogue.cache_clear()
+    try:
+        assert qt_i18n.install_translator("pt_BR") == "pt_BR"
+        text = QCoreApplication.translate("OverviewTask", "{path}: overview build cancelled")
+        assert text.format(path="a.tif") == "a.tif: construção das visões gerais cancelada"
+        dock = ImagePickingDock(qgis_iface, None)
+        try:
+            toggles = [box.text() for box in dock.viewer.overlay_checks.values()]
+            assert toggles == ["planos", "linhas", "LCPs", "resíduos", "observações", "previsões"]
+        finally:
+            dock.view.shutdown()
+            dock.deleteLater()
+    finally:
+        qt_i18n.remove_translator()
+        core_i18n.catalogue.cache_clear()
