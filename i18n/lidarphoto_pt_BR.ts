@@ -2925,8 +2925,8 @@
             <translation>Relatório de acurácia posicional</translation>
         </message>
         <message>
-            <source>Quality</source>
-            <translation>Qualidade</translation>
+            <source>Accuracy</source>
+            <translation>Acurácia</translation>
         </message>
         <message>
             <source>check points against ASPRS Ed. 2, NSSDA, PEC-PCD and the project threshold</source>
@@ -3209,6 +3209,10 @@ por uma versão).</translation>
         <message>
             <source>RMSE_HORIZ (m; deprecated: use RMSE_HORIZONTAL)</source>
             <translation>RMSE_HORIZ (m; obsoleto: use RMSE_HORIZONTAL)</translation>
+        </message>
+        <message>
+            <source>Quality</source>
+            <translation type="vanished">Qualidade</translation>
         </message>
         <message>
             <source>## Outputs
@@ -3803,8 +3807,8 @@ interseção e resseção.</translation>
             <translation>Calibrar uma câmera a partir de imagens de um alvo</translation>
         </message>
         <message>
-            <source>Photogrammetry</source>
-            <translation>Fotogrametria</translation>
+            <source>Calibration</source>
+            <translation>Calibração</translation>
         </message>
         <message>
             <source>Interior orientation and lens distortion (perspective or fisheye) from views of a planar target</source>
@@ -3999,6 +4003,10 @@ os valores em milímetros do arquivo da câmera: a calibração em si é em pixe
         <message>
             <source>Focal length (px)</source>
             <translation>Distância focal (px)</translation>
+        </message>
+        <message>
+            <source>Photogrammetry</source>
+            <translation type="vanished">Fotogrametria</translation>
         </message>
     </context>
     <context>
@@ -4380,8 +4388,8 @@ sem telhados dá zero planos e uma mensagem, não um erro.</translation>
             <translation>Extrair alvos TLS das varreduras</translation>
         </message>
         <message>
-            <source>Calibration</source>
-            <translation>Calibração</translation>
+            <source>Laser scanning</source>
+            <translation>Varredura a laser</translation>
         </message>
         <message>
             <source>sphere or checkerboard target centres with covariance from laser scans</source>
@@ -4465,6 +4473,10 @@ informados (associados da mesma maneira).</translation>
         <message>
             <source>Target centres found (all scans)</source>
             <translation>Centros de alvos encontrados (todas as varreduras)</translation>
+        </message>
+        <message>
+            <source>Calibration</source>
+            <translation type="vanished">Calibração</translation>
         </message>
     </context>
     <context>
@@ -4738,8 +4750,8 @@ opcionalmente, o MDT em GeoTIFF.</translation>
             <translation>Bloco LiDAR: terreno, planos de telhado e controle, tile por tile (dask)</translation>
         </message>
         <message>
-            <source>LiDAR</source>
-            <translation>LiDAR</translation>
+            <source>Blocks</source>
+            <translation>Blocos</translation>
         </message>
         <message>
             <source>a whole LiDAR block tile by tile on dask.distributed: ground filter, roof planes, LiDAR control points and lines</source>
@@ -4974,6 +4986,10 @@ DISTANCE_UNIT seja metros.</translation>
             <translation>Linhas de controle LiDAR</translation>
         </message>
         <message>
+            <source>LiDAR</source>
+            <translation type="vanished">LiDAR</translation>
+        </message>
+        <message>
             <source>Input: a folder of LAS/LAZ tiles, a virtual point cloud (.vpc, as made by PDAL or QGIS), or
 one large LAS/LAZ file cut into square tiles of TILE_SIZE read in chunks. Tiles in different
 CRSs are refused. Neighbours are found from the headers' bounding boxes.</source>
@@ -5164,8 +5180,8 @@ uma linha por ponto e imagem com o status e o motivo; o relatório HTML mostra o
             <translation>Criar recortes (chips) de controle a partir de fotos terrestres</translation>
         </message>
         <message>
-            <source>Image matching</source>
-            <translation>Correspondência de imagens</translation>
+            <source>Aerotriangulation</source>
+            <translation>Aerotriangulação</translation>
         </message>
         <message>
             <source>Control chips: ground photos of surveyed points rectified at the aerial GSD</source>
@@ -5359,6 +5375,10 @@ os demais são gravados.</translation>
             <source>Points without a chip</source>
             <translation>Pontos sem recorte</translation>
         </message>
+        <message>
+            <source>Image matching</source>
+            <translation type="vanished">Correspondência de imagens</translation>
+        </message>
     </context>
     <context>
         <name>lidarphoto:monoplot</name>
@@ -5367,8 +5387,8 @@ os demais são gravados.</translation>
             <translation>Monorrestituir pontos e linhas da imagem sobre um MDS LiDAR</translation>
         </message>
         <message>
-            <source>Monoplotting</source>
-            <translation>Monorrestituição</translation>
+            <source>Orthophotos</source>
+            <translation>Ortofotos</translation>
         </message>
         <message>
             <source>3D points and lines from one oriented image and a LiDAR DSM</source>
@@ -5535,6 +5555,10 @@ not_converged (Makarovic), parallel / unknown_plane (planos).</translation>
         <message>
             <source>Rays with a 3D point</source>
             <translation>Raios com um ponto 3D</translation>
+        </message>
+        <message>
+            <source>Monoplotting</source>
+            <translation type="vanished">Monorrestituição</translation>
         </message>
     </context>
     <context>
@@ -5856,8 +5880,8 @@ juntos quando todos estão prontos.</translation>
             <translation>Resseção espacial a partir de pontos e linhas</translation>
         </message>
         <message>
-            <source>Orientation</source>
-            <translation>Orientação</translation>
+            <source>Aerotriangulation</source>
+            <translation>Aerotriangulação</translation>
         </message>
         <message>
             <source>exterior orientation of single images from control points and straight lines</source>
@@ -6055,6 +6079,10 @@ linhas paralelas).</translation>
             <translation>Maior sigma0 a posteriori</translation>
         </message>
         <message>
+            <source>Orientation</source>
+            <translation type="vanished">Orientação</translation>
+        </message>
+        <message>
             <source>Observations: the image-observation CSV (image_id, point_id, col, row, sigma_px, type,
 target_id). Rows of type line with the same image and target_id are one image line (two or
 more points: its ends); lcp rows are control points and check rows check points (target_id:
@@ -6075,8 +6103,8 @@ conter as linhas do tipo line em um segundo arquivo.</translation>
             <translation>Pontos de enlace automáticos</translation>
         </message>
         <message>
-            <source>Orientation</source>
-            <translation>Orientação</translation>
+            <source>Aerotriangulation</source>
+            <translation>Aerotriangulação</translation>
         </message>
         <message>
             <source>tie points of overlapping images by feature matching, for the bundle adjustment</source>
@@ -6309,6 +6337,10 @@ medida da primeira imagem da trilha: a mediana dos sigmas refinados da sua trilh
             <translation>Pares de imagens mantidos</translation>
         </message>
         <message>
+            <source>Orientation</source>
+            <translation type="vanished">Orientação</translation>
+        </message>
+        <message>
             <source>Output: the image-observation CSV (type tie, point ids tp000001 ..., target_id empty), read
 directly by Bundle adjustment. sigma_px: the value given, or 0.5 px times the detection
 reduction factor. No least-squares refinement of the points yet.</source>
@@ -6324,8 +6356,8 @@ redução da detecção. Ainda sem refinamento dos pontos por mínimos quadrados
             <translation>Registro e autocalibração TLS</translation>
         </message>
         <message>
-            <source>Calibration</source>
-            <translation>Calibração</translation>
+            <source>Laser scanning</source>
+            <translation>Varredura a laser</translation>
         </message>
         <message>
             <source>register laser scanner stations on targets and estimate the scanner's systematic errors</source>
@@ -6619,6 +6651,10 @@ então nada prova). Com ACCEPT DOUBTFUL as saídas são gravadas e cada tabela c
             <source>Additional parameters estimated</source>
             <translation>Parâmetros adicionais estimados</translation>
         </message>
+        <message>
+            <source>Calibration</source>
+            <translation type="vanished">Calibração</translation>
+        </message>
     </context>
     <context>
         <name>lidarphoto:trajectorytoeo</name>
@@ -6627,8 +6663,8 @@ então nada prova). Com ACCEPT DOUBTFUL as saídas são gravadas e cada tabela c
             <translation>Trajetória para orientação exterior</translation>
         </message>
         <message>
-            <source>Direct georeferencing</source>
-            <translation>Georreferenciamento direto</translation>
+            <source>Aerotriangulation</source>
+            <translation>Aerotriangulação</translation>
         </message>
         <message>
             <source>INS/GNSS trajectory + camera mount -&gt; exterior orientation per image</source>
@@ -6768,6 +6804,10 @@ número de imagens.</translation>
         <message>
             <source>Number of images</source>
             <translation>Número de imagens</translation>
+        </message>
+        <message>
+            <source>Direct georeferencing</source>
+            <translation type="vanished">Georreferenciamento direto</translation>
         </message>
     </context>
 </TS>

@@ -12,6 +12,7 @@ from qgis.PyQt.QtWidgets import QAction, QMenu
 from .dependency_check import LOG_TAG, report_missing
 
 ICON_PATH = Path(__file__).resolve().parents[1] / "icon.svg"
+ICONS = ICON_PATH.parent / "icons"
 PROVIDER_ID = "lidarphoto"
 TRAJECTORY_ALG = "lidarphoto:trajectorytoeo"
 MENU_OBJECT_NAME = "lidarphotoMenu"
@@ -63,7 +64,6 @@ class LidarPhotoPlugin:
         if self.iface is None:
             return
         window = self.iface.mainWindow()
-        icon = QIcon(str(ICON_PATH))
 
         self.menu = QMenu(self.tr("&LiDAR Photogrammetry"), window)
         self.menu.setObjectName(MENU_OBJECT_NAME)
@@ -77,7 +77,11 @@ class LidarPhotoPlugin:
         self.toolbar = self.iface.addToolBar(self.tr("LiDAR Photogrammetry"))
         self.toolbar.setObjectName(TOOLBAR_OBJECT_NAME)
 
-        trajectory = QAction(icon, self.tr("Trajectory to Exterior Orientation…"), window)
+        trajectory = QAction(
+            QIcon(str(ICONS / "trajectory.svg")),
+            self.tr("Trajectory to Exterior Orientation…"),
+            window,
+        )
         trajectory.setObjectName("lidarphotoTrajectoryToEo")
         trajectory.setToolTip(
             self.tr("Exterior orientation of each image from an INS/GNSS trajectory")
@@ -92,7 +96,7 @@ class LidarPhotoPlugin:
         toolbox.setObjectName("lidarphotoShowToolbox")
         toolbox.triggered.connect(self.show_toolbox)
 
-        picking = QAction(icon, self.tr("Image Point Picking"), window)
+        picking = QAction(QIcon(str(ICONS / "picking.svg")), self.tr("Image Point Picking"), window)
         picking.setObjectName("lidarphotoImagePicking")
         picking.setToolTip(self.tr("Measure image points on LiDAR roof planes, lines and LCPs"))
         picking.setCheckable(True)

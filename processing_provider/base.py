@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 import math
 from contextlib import contextmanager
+from pathlib import Path
 from types import ModuleType
 from typing import Any, Callable
 
@@ -20,6 +21,7 @@ from qgis.core import (
     QgsProcessingFeedback,
 )
 from qgis.PyQt.QtCore import QCoreApplication
+from qgis.PyQt.QtGui import QIcon
 
 from ..core.dependencies import missing_message, missing_modules
 from ..core.errors import Cancelled, LidarPhotoError
@@ -30,6 +32,8 @@ from .compat import FIELD_INT, FIELD_STRING, SINK_FAST_INSERT
 from .i18n import spec_help_html, spec_translator
 from .parameters import make_output, make_parameter, read_parameter
 
+ICONS = Path(__file__).resolve().parents[1] / "icons"
+PLUGIN_ICON = ICONS.parent / "icon.svg"
 #: Logger of the whole package ("lidarphoto"); the core logs below it ("lidarphoto.core.*").
 PACKAGE_LOGGER = __name__.split(".")[0]
 
@@ -152,6 +156,15 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
 
     def name(self) -> str:
         return self.spec.name
+
+    def svgIconPath(self) -> str:
+        """The icon of the algorithm's family (``icons/<group id>.svg``, drawn for the plugin);
+        the plugin's own icon for a group that has none."""
+        path = ICONS / f"{self.spec.group_id}.svg"
+        return str(path if path.is_file() else PLUGIN_ICON)
+
+    def icon(self) -> QIcon:
+        return QIcon(self.svgIconPath())
 
     def displayName(self) -> str:
         return self.spec_tr(self.spec.title)

@@ -76,8 +76,8 @@ def _point_params(what: str) -> tuple[Param, ...]:
 SPEC = AlgorithmSpec(
     name="accuracyreport",
     title="Positional accuracy report",
-    group="Quality",
-    group_id="quality",
+    group="Accuracy",
+    group_id="accuracy",
     summary="check points against ASPRS Ed. 2, NSSDA, PEC-PCD and the project threshold",
     description="""\
 Compares measured check points with reference coordinates and reports their positional

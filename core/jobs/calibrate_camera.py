@@ -13,8 +13,8 @@ JSON_FILTER = "JSON files (*.json)"
 SPEC = AlgorithmSpec(
     name="calibratecamera",
     title="Calibrate a camera from target images",
-    group="Photogrammetry",
-    group_id="photogrammetry",
+    group="Calibration",
+    group_id="calibration",
     summary="Interior orientation and lens distortion (perspective or fisheye) from views of "
     "a planar target",
     description="""\

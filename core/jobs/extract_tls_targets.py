@@ -24,8 +24,8 @@ COLUMNS = (
 SPEC = AlgorithmSpec(
     name="extracttlstargets",
     title="Extract TLS targets from scans",
-    group="Calibration",
-    group_id="calibration",
+    group="Laser scanning",
+    group_id="laserscanning",
     summary="sphere or checkerboard target centres with covariance from laser scans",
     description="""\
 Finds the targets in each scan and writes their centres in the scanner frame with their

@@ -49,8 +49,8 @@ TILE_BYTES_PER_POINT = 48
 SPEC = AlgorithmSpec(
     name="lidarblock",
     title="LiDAR block: ground, roof planes and control, tile by tile (dask)",
-    group="LiDAR",
-    group_id="lidar",
+    group="Blocks",
+    group_id="blocks",
     summary="a whole LiDAR block tile by tile on dask.distributed: ground filter, roof planes, "
             "LiDAR control points and lines",
     description="""\

@@ -22,8 +22,8 @@ REPORT_JSON = "control_chips.json"
 SPEC = AlgorithmSpec(
     name="makecontrolchips",
     title="Make control chips from ground photos",
-    group="Image matching",
-    group_id="imagematching",
+    group="Aerotriangulation",
+    group_id="aerotriangulation",
     summary="Control chips: ground photos of surveyed points rectified at the aerial GSD",
     description="""\
 Control chips for the automatic location of control points in aerial images (Berveglieri &

@@ -18,8 +18,8 @@ BYTES_PER_RAY = 1000
 SPEC = AlgorithmSpec(
     name="monoplot",
     title="Monoplot image points and lines on a LiDAR DSM",
-    group="Monoplotting",
-    group_id="monoplotting",
+    group="Orthophotos",
+    group_id="orthophotos",
     summary="3D points and lines from one oriented image and a LiDAR DSM",
     description="""\
 Monoplotting (dos Santos, Dal Poz & Dalmolin 2010): the ray of each image point is

@@ -22,8 +22,8 @@ _OPTIONS = Fields("photo.resection", "ResectionOptions")
 SPEC = AlgorithmSpec(
     name="resection",
     title="Space resection from points and lines",
-    group="Orientation",
-    group_id="orientation",
+    group="Aerotriangulation",
+    group_id="aerotriangulation",
     summary="exterior orientation of single images from control points and straight lines",
     description="""\
 Orients each image on its own from control points (collinearity) and straight lines: image

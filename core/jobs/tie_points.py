@@ -21,8 +21,8 @@ PAIR_COLUMNS = ("image_a", "image_b", "overlap", "features_a", "features_b", "ra
 SPEC = AlgorithmSpec(
     name="tiepoints",
     title="Automatic tie points",
-    group="Orientation",
-    group_id="orientation",
+    group="Aerotriangulation",
+    group_id="aerotriangulation",
     summary="tie points of overlapping images by feature matching, for the bundle adjustment",
     description="""\
 Finds tie points in a block of images without an operator. Features: SIFT (Lowe 2004) or

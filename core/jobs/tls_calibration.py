@@ -43,8 +43,8 @@ REGISTERED_NAME = "{}_registered{}"
 SPEC = AlgorithmSpec(
     name="tlscalibration",
     title="TLS registration and self-calibration",
-    group="Calibration",
-    group_id="calibration",
+    group="Laser scanning",
+    group_id="laserscanning",
     summary="register laser scanner stations on targets and estimate the scanner's "
     "systematic errors",
     description="""\

@@ -13,8 +13,8 @@ log = logging.getLogger(__name__)
 SPEC = AlgorithmSpec(
     name="trajectorytoeo",
     title="Trajectory to exterior orientation",
-    group="Direct georeferencing",
-    group_id="georeferencing",
+    group="Aerotriangulation",
+    group_id="aerotriangulation",
     summary="INS/GNSS trajectory + camera mount -> exterior orientation per image",
     description="""\
 Computes the exterior orientation (perspective centre and omega, phi, kappa) of every image

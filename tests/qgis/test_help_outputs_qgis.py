@@ -61,8 +61,11 @@ def test_layer_outputs_are_optional(provider, name):
 @pytest.mark.parametrize("name", sorted(SPECS))
 def test_html_reports_are_html_outputs(provider, name):
     alg = provider.algorithm(name)
-    html = [p.name for p in SPECS[name].params if p.kind == "file_out" and "html" in
-            p.file_filter.lower()]  # fmt: skip
+    html = [
+        p.name
+        for p in SPECS[name].params
+        if p.kind == "file_out" and "html" in p.file_filter.lower()
+    ]
     for key in html:
         assert isinstance(alg.outputDefinition(key), QgsProcessingOutputHtml), key
 
@@ -139,3 +142,31 @@ def test_a_required_crs_defaults_to_the_project_s(provider):
                 crs = alg.parameterAsCrs({}, d.name(), context)
                 assert crs.authid() == "EPSG:28992", (alg.name(), d.name())
     assert required >= 5
+
+
+def test_the_toolbox_groups_follow_the_user_s_work_with_an_icon_each(provider):
+    """Seven families (LiDAR, Calibration, Aerotriangulation, Orthophotos, Accuracy, Laser
+    scanning, Blocks); each algorithm shows its family's icon, not the generic gear."""
+    from qgis.core import QgsApplication
+
+    families = {
+        "lidar",
+        "calibration",
+        "aerotriangulation",
+        "orthophotos",
+        "accuracy",
+        "laserscanning",
+        "blocks",
+    }
+    gear = QgsApplication.getThemeIcon("/processingAlgorithm.svg").pixmap(32, 32).toImage()
+    seen = {}
+    for alg in provider.algorithms():
+        assert alg.groupId() in families, (alg.name(), alg.groupId())
+        path = Path(alg.svgIconPath())
+        assert path.is_file() and path.name == f"{alg.groupId()}.svg", (alg.name(), path)
+        image = alg.icon().pixmap(32, 32).toImage()
+        assert not image.isNull() and image != gear, alg.name()
+        seen.setdefault(alg.groupId(), image)
+    images = list(seen.values())
+    assert all(images[i] != images[j] for i in range(len(images)) for j in range(i))
+    assert len(seen) == len(families)

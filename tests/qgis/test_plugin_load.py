@@ -60,8 +60,8 @@ def test_processing_start_and_unload(qgis_plugin_paths, plugin_dir, qgis_process
     names = [alg.name() for alg in provider.algorithms()]
     assert "trajectorytoeo" in names
     alg = registry.algorithmById("lidarphoto:trajectorytoeo")
-    assert alg is not None and alg.groupId() == "georeferencing"
-    assert alg.group() == "Direct georeferencing"
+    assert alg is not None and alg.groupId() == "aerotriangulation"
+    assert alg.group() == "Aerotriangulation"
 
     assert qgis.utils.unloadPlugin(PLUGIN)
     assert registry.providerById("lidarphoto") is None
@@ -93,6 +93,8 @@ def test_gui_start_adds_menu_toolbar_and_unload_removes_them(
     assert {a.objectName() for a in toolbars[0].actions()} == names
     actions = list(plugin.actions)
     assert all(not a.icon().isNull() for a in actions)
+    images = [a.icon().pixmap(32, 32).toImage() for a in actions]
+    assert all(images[i] != images[j] for i in range(len(images)) for j in range(i))  # distinct
 
     assert qgis.utils.unloadPlugin(PLUGIN)
     _flush_deletes()
