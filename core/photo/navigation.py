@@ -162,7 +162,7 @@ def _segments(nav: NavSolution, events: CameraEvents, t: Array, max_gap_s: float
         raise InputError(
             f"image '{events.image_id[j]}' at trajectory time {t[j]:.6f} s (event + offset) "
             f"is outside the trajectory {nav.source} ({tt[0]:.6f} to {tt[-1]:.6f} s); "
-            f"{outside.size} event(s) are (wrong file, time offset or clock?)",
+            f"{outside.size} of {len(t)} events are outside: wrong file, time offset or clock?",
             path=events.source, row=events.rows[j],
         )  # fmt: skip
     k = np.clip(np.searchsorted(tt, t, side="right") - 1, 0, len(tt) - 2)
@@ -175,7 +175,7 @@ def _segments(nav: NavSolution, events: CameraEvents, t: Array, max_gap_s: float
             f"image '{events.image_id[j]}' at trajectory time {t[j]:.6f} s falls in a gap of "
             f"{gap[j]:.6g} s of the trajectory {nav.source} (between {nav.record}s {a} and "
             f"{b}, {tt[k[j]]:.6f} to {tt[k[j] + 1]:.6f} s), longer than the limit MAX_GAP = "
-            f"{max_gap_s:g} s; {wide.size} event(s) are",
+            f"{max_gap_s:g} s ({wide.size} of {len(t)} events are in such gaps)",
             path=events.source, row=events.rows[j],
         )  # fmt: skip
     return k
