@@ -56,8 +56,8 @@ class SimulatedFlight:
         return np.stack([roll, pitch, np.mod(heading, 2 * np.pi)], axis=1)
 
     def wander(self, t: Array) -> Array:
-        """The wander angle of the solution (radians): a slow drift through zero."""
-        return -0.2 + 0.01 * (np.asarray(t, dtype=np.float64) - self.t0)
+        """The wander angle of the solution (radians): a slow swing through zero."""
+        return -0.2 + 0.5 * np.sin(0.02 * (np.asarray(t, dtype=np.float64) - self.t0))
 
     def records(self, t: Array) -> dict[str, Array]:
         """What a navigation file holds at ``t``: llh (deg, m), NED velocity, rph."""

@@ -255,3 +255,16 @@ def test_job_refuses_an_event_outside_and_writes_nothing(tmp_path, records):
         _run(tmp_path, records, text)
     assert not (tmp_path / "traj.csv").exists() and not (tmp_path / "eo.csv").exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["events.csv", "job.out"]
+
+
+def test_hermite_positions_equal_scipys_cubic_hermite_spline():
+    from lidarphoto.core.photo.navigation import _interpolate
+    from scipy.interpolate import CubicHermiteSpline
+
+    rng = np.random.default_rng(5)
+    tk = np.cumsum(rng.uniform(0.002, 0.01, 40))
+    xyz, vel = rng.normal(0, 100, (40, 3)), rng.normal(0, 60, (40, 3))
+    rot = Rotation.random(40, random_state=3).as_matrix()
+    t = rng.uniform(tk[0], tk[-1], 500)
+    got, _ = _interpolate(tk, xyz, vel, rot, t)
+    np.testing.assert_allclose(got, CubicHermiteSpline(tk, xyz, vel, axis=0)(t), atol=1e-9)
