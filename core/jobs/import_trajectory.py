@@ -34,9 +34,10 @@ and interpolates the pose of every image at its exposure:
 - trajectory time = event time + TIME_OFFSET (the camera's timing offset, seconds);
 - position: cubic Hermite in the Earth-centred frame, with the records' velocities when the
   file has them (they are checked against the positions);
-- attitude: spherical interpolation of the body-to-Earth-centred rotation (quaternions), so a
-  heading through north and the SBET's wander angle (true heading = platform heading - wander)
-  need no special case;
+- attitude: spherical interpolation of the body-to-Earth-centred rotation (quaternions; a
+  cubic on the rotation group with the angular velocities of the neighbouring records, or
+  SLERP with ATTITUDE slerp), so a heading through north and the SBET's wander angle (true
+  heading = platform heading - wander) need no special case;
 - an event outside the trajectory, or in an interval between records longer than MAX_GAP,
   is refused by name, and nothing is written.
 
@@ -100,6 +101,16 @@ trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""
             minimum=1e-6,
             maximum=60.0,
             help="an event between two records further apart than this is refused",
+        ),
+        Param(
+            "ATTITUDE",
+            "enum",
+            "Attitude interpolation",
+            _OPTIONS.attitude,
+            options=Ref("photo.trajectory_options", "ATTITUDE_METHODS"),
+            advanced=True,
+            help="cubic: Hermite cubic on the rotation group with the neighbours' angular "
+            "velocities; slerp: constant angular velocity between two records",
         ),
         Param(
             "CRS",

@@ -13,11 +13,15 @@ inside a record interval ``[t_k, t_k+1]`` no longer than ``max_gap_s``:
   north-east-down into e) when the file has them, else velocities from the positions of
   the neighbouring records (three-point differences, second order in the interval);
 - attitude: the body-to-ECEF rotation ``R_b^e = R_n^e(lat, lon) R_b^n(roll, pitch,
-  heading)`` of both records, spherically interpolated (SLERP of the unit quaternions,
-  Shoemake 1985). The frame e does not turn with the aircraft, so a heading through north
-  (359 -> 1 degree), the meridian convergence between the records and a wander-azimuth
-  solution need no special case: roll, pitch and true heading are read back from
-  ``R_n^e(interpolated position)^T R_b^e`` at the interpolated position.
+  heading)`` of both records, interpolated on the sphere of unit quaternions: by default a
+  cubic Hermite on the rotation group, ``R(s) = exp(phi(s)) R_k`` with ``phi`` a cubic in the
+  rotation vector whose end slopes are the angular velocities at the two records (three-point
+  differences of the neighbouring rotations); or SLERP (Shoemake 1985: constant angular
+  velocity, exact for it, off by alpha h^2 / 8 under an angular acceleration alpha). The frame
+  e does not turn with the aircraft, so a heading through north (359 -> 1 degree), the
+  meridian convergence between the records and a wander-azimuth solution need no special
+  case: roll, pitch and true heading are read back from ``R_n^e(interpolated position)^T
+  R_b^e`` at the interpolated position.
 
 Events outside the trajectory, or in an interval longer than ``max_gap_s``, are refused by
 name (file, row, image). Event times in seconds of week are moved by one week when that
@@ -115,25 +119,33 @@ def interpolate_trajectory(
     """The pose of every event (module docstring), as the trajectory table of
     :mod:`.georeference`: easting, northing, height in the mapping CRS, roll, pitch and true
     heading (radians, heading in [0, 2 pi)), time = the trajectory time (event + offset)."""
+    from scipy.spatial.transform import Rotation
+
     if len(nav) < 2:
         raise InputError(f"the trajectory has {len(nav)} record(s); at least 2 are needed",
                          path=nav.source)  # fmt: skip
     t = _align_week(events.time + options.time_offset_s, nav.time)
     k = _segments(nav, events, t, options.max_gap_s)
-    knots = np.unique(np.concatenate([k, k + 1]))
-    # positions and velocities in ECEF for the records used (and their neighbours)
-    near = np.unique(np.clip(np.concatenate([knots - 1, knots, knots + 1]), 0, len(nav) - 1))
+    # the records of the events' intervals and their neighbours (for the rates), in ECEF
+    near = np.unique(np.clip(np.concatenate([k - 1, k, k + 1, k + 2]), 0, len(nav) - 1))
+    j = np.searchsorted(near, k)  # interval [near[j], near[j + 1]] of each event
+    tn = nav.time[near]
     llh = _geodetic(nav, frame, near)
     xyz = frame.geodetic_to_ecef(llh)
     r_n_e = ned_to_ecef_rotation(llh[:, 0], llh[:, 1])
-    at = np.searchsorted(near, knots)
+    lo, hi = _neighbours(near, tn, options.max_gap_s)
     if nav.velocity_ned is not None:
-        vel = np.einsum("kij,kj->ki", r_n_e[at], nav.velocity_ned[knots])
-        _check_velocities(nav, knots, xyz[at], vel, options.velocity_tolerance_mps)
+        vel = np.einsum("kij,kj->ki", r_n_e, nav.velocity_ned[near])
+        _check_velocities(nav, near, np.unique(j), xyz, vel, options.velocity_tolerance_mps)
     else:
-        vel = _three_point_velocity(nav.time[near], xyz, near, len(nav))[at]
-    r_b_e = r_n_e[at] @ rph_to_matrix(*nav.rph[knots].T)
-    xyz_t, r_b_e_t = _interpolate(nav.time[knots], xyz[at], vel, r_b_e, t)
+        vel = _rates(tn, lambda i: xyz[i] - xyz, lo, hi)
+    rot = Rotation.from_matrix(r_n_e @ rph_to_matrix(*nav.rph[near].T))  # R_b^e
+    xyz_t = _hermite(tn, xyz, vel, j, t)
+    if options.attitude == "slerp":
+        r_b_e_t = _slerp(tn, rot, j, t)
+    else:
+        omega = _rates(tn, lambda i: (rot[i] * rot.inv()).as_rotvec(), lo, hi)
+        r_b_e_t = _rotation_hermite(tn, rot, omega, j, t)
     llh_t = frame.ecef_to_geodetic(xyz_t)
     r_b_n = np.swapaxes(ned_to_ecef_rotation(llh_t[:, 0], llh_t[:, 1]), -1, -2) @ r_b_e_t
     roll, pitch, heading = matrix_to_rph(r_b_n)
@@ -186,64 +198,103 @@ def _geodetic(nav: NavSolution, frame: MappingFrame, index: NDArray[np.int64]) -
     return p if nav.geodetic else frame.map_to_geodetic(p)
 
 
-def _three_point_velocity(t: Array, xyz: Array, index: NDArray[np.int64], n: int) -> Array:
-    """d xyz / dt at each record of ``index`` (sorted) from its neighbours (second-order
-    differences on unequal intervals), one-sided at the trajectory's ends. ``t`` and ``xyz``
-    hold the records of ``index``; a record's neighbours are in it (the caller adds them)."""
-    out = np.empty_like(xyz)
-    pos = {int(r): i for i, r in enumerate(index)}
-    for i, r in enumerate(index):
-        lo, hi = pos.get(int(r) - 1), pos.get(int(r) + 1)
-        if lo is not None and hi is not None:
-            h1, h2 = t[i] - t[lo], t[hi] - t[i]
-            out[i] = (h1 * h1 * xyz[hi] - h2 * h2 * xyz[lo] + (h2 * h2 - h1 * h1) * xyz[i]) / (
-                h1 * h2 * (h1 + h2)
-            )
-        else:  # an end of the trajectory
-            j = hi if hi is not None else lo
-            out[i] = (xyz[j] - xyz[i]) / (t[j] - t[i])
-    return out
+def _neighbours(
+    index: NDArray[np.int64], t: Array, max_gap_s: float
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """For each record of ``index`` (sorted record numbers; ``t`` their times), the positions
+    in ``index`` of the records before and after it; a missing neighbour (an end of the
+    trajectory, or beyond a gap longer than ``max_gap_s``) is the record itself."""
+    n = len(index)
+    pos = np.arange(n)
+    prev, nxt = np.maximum(pos - 1, 0), np.minimum(pos + 1, n - 1)
+    ok_lo = (pos > 0) & (index[prev] == index - 1) & (t - t[prev] <= max_gap_s)
+    ok_hi = (pos < n - 1) & (index[nxt] == index + 1) & (t[nxt] - t <= max_gap_s)
+    return np.where(ok_lo, prev, pos), np.where(ok_hi, nxt, pos)
+
+
+def _rates(t: Array, diff, lo: NDArray[np.int64], hi: NDArray[np.int64]) -> Array:
+    """Time derivative at each record from its neighbours: ``diff(i)`` is the value at the
+    records ``i`` minus the value at each record (a vector difference, or the rotation vector
+    of a relative rotation). Three-point, second order on unequal intervals: central where
+    both neighbours exist, one-sided (the next two records) at the trajectory's ends and gaps."""
+    h1, h2 = (t - t[lo])[:, None], (t[hi] - t)[:, None]
+    lo2, hi2 = lo[lo], hi[hi]
+    g1, g2 = (t[lo] - t[lo2])[:, None], (t[hi2] - t[hi])[:, None]
+    d_lo, d_hi, d_lo2, d_hi2 = diff(lo), diff(hi), diff(lo2), diff(hi2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        central = (h1 * h1 * d_hi - h2 * h2 * d_lo) / (h1 * h2 * (h1 + h2))
+        # one-sided on 0, a, a + b: (d_a (a + b)^2 - d_ab a^2) / (a b (a + b))
+        start = (d_hi * (h2 + g2) ** 2 - d_hi2 * h2 * h2) / (h2 * g2 * (h2 + g2))
+        end = -(d_lo * (h1 + g1) ** 2 - d_lo2 * h1 * h1) / (h1 * g1 * (h1 + g1))
+        start = np.where(g2 > 0, start, d_hi / h2)
+        end = np.where(g1 > 0, end, -d_lo / h1)
+    return np.where((h1 > 0) & (h2 > 0), central, np.where(h2 > 0, start, end))
 
 
 def _check_velocities(
-    nav: NavSolution, knots: NDArray[np.int64], xyz: Array, vel: Array, tol: float
+    nav: NavSolution,
+    near: NDArray[np.int64],
+    j: NDArray[np.int64],
+    xyz: Array,
+    vel: Array,
+    tol: float,
 ) -> None:
     """Record velocities against the chord of each interval used (a velocity in another frame
     or sign convention would bend the interpolation by centimetres: refuse it)."""
-    adjacent = np.flatnonzero(np.diff(knots) == 1)
-    if not adjacent.size:
-        return
-    a, b = adjacent, adjacent + 1
-    dt = nav.time[knots[b]] - nav.time[knots[a]]
-    chord = (xyz[b] - xyz[a]) / dt[:, None]
-    mean = 0.5 * (vel[a] + vel[b])
-    off = np.linalg.norm(mean - chord, axis=1)
+    dt = nav.time[near[j + 1]] - nav.time[near[j]]
+    chord = (xyz[j + 1] - xyz[j]) / dt[:, None]
+    off = np.linalg.norm(0.5 * (vel[j] + vel[j + 1]) - chord, axis=1)
     bad = np.flatnonzero(off > tol + 5.0 * dt)
     if bad.size:
-        j = bad[np.argmax(off[bad])]
+        i = bad[np.argmax(off[bad])]
         raise InputError(
-            f"the velocities of {nav.record}s {int(nav.numbers[knots[a[j]]])} and "
-            f"{int(nav.numbers[knots[b[j]]])} differ by {off[j]:.3g} m/s from the motion of "
-            f"their positions (chord {np.linalg.norm(chord[j]):.3g} m/s): velocities in another "
+            f"the velocities of {nav.record}s {int(nav.numbers[near[j[i]]])} and "
+            f"{int(nav.numbers[near[j[i] + 1]])} differ by {off[i]:.3g} m/s from the motion of "
+            f"their positions (chord {np.linalg.norm(chord[i]):.3g} m/s): velocities in another "
             "frame or sign convention?",
             path=nav.source,
-        )
+        )  # fmt: skip
 
 
-def _interpolate(tk: Array, xyz: Array, vel: Array, r_b_e: Array, t: Array) -> tuple[Array, Array]:
-    """Cubic Hermite positions and SLERP rotations at ``t`` between the knots ``tk``
-    (increasing; the interval of each ``t`` holds two consecutive records).
+def _basis(t_knots: Array, j: NDArray[np.int64], t: Array):
+    """Interval lengths h and the cubic Hermite basis h00, h10, h01, h11 at ``t``."""
+    h = (t_knots[j + 1] - t_knots[j])[:, None]
+    s = (t - t_knots[j])[:, None] / h
+    s2, s3 = s * s, s * s * s
+    return h, 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, 3 * s2 - 2 * s3, s3 - s2
 
-    The Hermite basis is written out (the same numbers as SciPy's CubicHermiteSpline, tested):
+
+def _hermite(tk: Array, xyz: Array, vel: Array, j: NDArray[np.int64], t: Array) -> Array:
+    """Cubic Hermite positions at ``t`` in the intervals ``[tk[j], tk[j + 1]]``.
+
+    The basis is written out (the same numbers as SciPy's CubicHermiteSpline, tested):
     importing scipy.interpolate alone takes about 1 s, half of a whole hour-long SBET run.
     """
-    from scipy.spatial.transform import Rotation, Slerp
+    h, h00, h10, h01, h11 = _basis(tk, j, t)
+    return h00 * xyz[j] + h10 * h * vel[j] + h01 * xyz[j + 1] + h11 * h * vel[j + 1]
 
-    j = np.clip(np.searchsorted(tk, t, side="right") - 1, 0, len(tk) - 2)
-    h = (tk[j + 1] - tk[j])[:, None]
-    s = (t - tk[j])[:, None] / h
-    s2, s3 = s * s, s * s * s
-    h00, h10, h01, h11 = 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, 3 * s2 - 2 * s3, s3 - s2
-    xyz_t = h00 * xyz[j] + h10 * h * vel[j] + h01 * xyz[j + 1] + h11 * h * vel[j + 1]
-    rot = Slerp(tk, Rotation.from_matrix(r_b_e))(t)
-    return xyz_t, rot.as_matrix()
+
+def _slerp(tk: Array, rot, j: NDArray[np.int64], t: Array) -> Array:
+    """Spherical linear interpolation (constant angular velocity over each interval)."""
+    from scipy.spatial.transform import Rotation
+
+    s = (t - tk[j]) / (tk[j + 1] - tk[j])
+    delta = (rot[j + 1] * rot[j].inv()).as_rotvec()
+    return (Rotation.from_rotvec(s[:, None] * delta) * rot[j]).as_matrix()
+
+
+def _rotation_hermite(tk: Array, rot, omega: Array, j: NDArray[np.int64], t: Array) -> Array:
+    """Cubic Hermite on the rotation group: ``R(s) = exp(phi(s)) R_j`` with ``phi`` the cubic
+    in the rotation vector through 0 and ``log(R_j+1 R_j^T)`` whose slopes are the angular
+    velocities ``omega`` (ECEF, rad/s) at both records (the one at the end mapped through the
+    inverse left Jacobian of the rotation vector to first order). With constant angular
+    velocity it is SLERP; an angular acceleration (a roll manoeuvre) costs SLERP alpha h^2 / 8
+    and this a term of third order in h."""
+    from scipy.spatial.transform import Rotation
+
+    h, _, h10, h01, h11 = _basis(tk, j, t)
+    delta = (rot[j + 1] * rot[j].inv()).as_rotvec()
+    w0, w1 = h * omega[j], h * omega[j + 1]
+    w1 = w1 - 0.5 * np.cross(delta, w1)
+    phi = h10 * w0 + h01 * delta + h11 * w1
+    return (Rotation.from_rotvec(phi) * rot[j]).as_matrix()

@@ -18,6 +18,9 @@ TRAJECTORY_FORMATS = ("auto", "sbet", "ascii", "csv")
 EVENT_TIMES = ("gps", "utc")
 #: GPS - UTC in seconds since 2017-01-01 (IERS Bulletin C: no leap second announced since).
 LEAP_SECONDS_SINCE_2017 = 18
+#: Attitude between two records: ``cubic`` (a Hermite cubic on the rotation group with the
+#: angular velocities of the neighbouring records) or ``slerp`` (constant angular velocity).
+ATTITUDE_METHODS = ("cubic", "slerp")
 #: Seconds in a GPS week.
 WEEK_S = 604800.0
 
@@ -37,6 +40,8 @@ class TrajectoryImportOptions:
         Clock of the event times (:data:`EVENT_TIMES`).
     leap_seconds : int
         GPS - UTC, seconds, at the events' date (18 since 2017-01-01); used for ``utc``.
+    attitude : {"cubic", "slerp"}
+        Interpolation of the body-to-ECEF rotation (:data:`ATTITUDE_METHODS`).
     velocity_tolerance_mps : float
         The records' velocities may differ from the chord velocity of their positions by
         this much plus 5 m/s^2 times the record interval (a velocity in another frame or
@@ -47,6 +52,7 @@ class TrajectoryImportOptions:
     max_gap_s: float = 0.1
     event_time: str = "gps"
     leap_seconds: int = LEAP_SECONDS_SINCE_2017
+    attitude: str = "cubic"
     velocity_tolerance_mps: float = 0.1
 
     def __post_init__(self) -> None:
@@ -60,5 +66,9 @@ class TrajectoryImportOptions:
             )
         if not (0 <= self.leap_seconds <= 100 and float(self.leap_seconds).is_integer()):
             raise InputError(f"LEAP_SECONDS must be a whole number 0..100, got {self.leap_seconds}")
+        if self.attitude not in ATTITUDE_METHODS:
+            raise InputError(
+                f"ATTITUDE '{self.attitude}' is unknown: use {', '.join(ATTITUDE_METHODS)}"
+            )
         if not (self.velocity_tolerance_mps > 0.0):
             raise InputError("the velocity tolerance must be > 0 m/s")
