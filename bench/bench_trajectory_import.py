@@ -7,11 +7,13 @@
     python bench/bench_trajectory_import.py naive DIR     # the yardstick (below)
 
 The flight is core/simulation/navigation.py's (60 m/s, turning, a roll manoeuvre every 15 s,
-heading through north every 3 minutes, drifting wander angle), sampled at 200 Hz for 3,600 s;
-the events fall between records (0.4 ms past a record plus a ramp). The yardstick ``naive``
-is what a user writes by hand: numpy reads the file, and every field is interpolated
-linearly (np.interp), angles included, heading taken as platform heading - wander but not
-unwrapped: it is as fast as a reader can be and shows the error the rigorous method avoids.
+heading through north every 3 minutes, a wander angle swinging through zero), sampled at
+200 Hz for 3,600 s; the events fall between records (0.4 ms past a record plus a ramp), and
+20 more in the intervals where the file's heading wraps. No peer tool was available on this
+machine, so the yardstick ``naive`` is what a user writes by hand: numpy reads the file and
+every field is interpolated linearly (np.interp), angles included, the heading taken as
+platform heading - wander but not unwrapped: as fast as a reader can be, and it shows the
+error the rigorous method avoids.
 """
 
 from __future__ import annotations
