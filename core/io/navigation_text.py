@@ -33,7 +33,7 @@ from ..photo.navigation import NavSolution
 from .tables import Table, find_column, float_column, read_table
 from .trajectory import HEIGHT_RANGE_M, MAX_TIME_S
 
-_TIME = ("time", "gps_time", "gpstime", "sow", "gps_sow", "t", "time_sow", "utctime")
+_TIME = ("time", "gps_time", "gpstime", "sow", "gps_sow", "t", "time_sow")
 _LAT, _LON = ("latitude", "lat"), ("longitude", "lon", "long")
 _EAST, _NORTH = ("easting", "east", "e"), ("northing", "north", "n")
 _HEIGHT = ("height", "h_ell", "hell", "ellipsoid_height", "ellipsoidal_height", "h",
@@ -69,7 +69,7 @@ def read_nav_ascii(path: Union[str, Path]) -> NavSolution:
         raise InputError("no line of numbers: not a navigation export", path=str(p))
     width = len(_numbers(lines[first]) or ())
     header_at, unit_cells = _header_above(lines, first, width, str(p))
-    names, units = _split_units(_cells(lines[header_at].lstrip("#"), width))
+    names, units = _split_units(_cells(lines[header_at].lstrip("#")))
     if unit_cells is not None:
         units = tuple(u or _bare(c) for u, c in zip(units, unit_cells))
     rows, numbers = [], []
@@ -77,7 +77,7 @@ def read_nav_ascii(path: Union[str, Path]) -> NavSolution:
         line = lines[i]
         if not line.strip() or line.lstrip().startswith("#"):
             continue
-        cells = _cells(line, None)
+        cells = _cells(line)
         if len(cells) != width:
             raise InputError(f"has {len(cells)} values but the header has {width} columns",
                              path=str(p), row=i + 1)  # fmt: skip
@@ -86,21 +86,27 @@ def read_nav_ascii(path: Union[str, Path]) -> NavSolution:
     return _solution(Table(str(p), names, tuple(rows), tuple(numbers)), units)
 
 
-def _cells(line: str, width: int | None) -> tuple[str, ...]:
+def _cells(line: str) -> tuple[str, ...]:
     """Comma-separated if the line has commas, else whitespace-separated."""
     if "," in line:
         return tuple(c.strip() for c in line.split(","))
     return tuple(line.split())
 
 
-def _numbers(line: str) -> tuple[float, ...] | None:
-    cells = _cells(line, None)
+def _numbers(line: str) -> tuple[str, ...] | None:
+    """The cells of a data line: at least 4, three quarters of them numbers (an export may
+    carry a date or a clock time as text in columns this reader does not use)."""
+    cells = _cells(line)
     if len(cells) < 4:
         return None
-    try:
-        return tuple(float(c) for c in cells)
-    except ValueError:
-        return None
+    numeric = 0
+    for c in cells:
+        try:
+            float(c)
+            numeric += 1
+        except ValueError:
+            pass
+    return cells if numeric * 4 >= 3 * len(cells) else None
 
 
 def _bare(cell: str) -> str:
@@ -113,12 +119,12 @@ def _header_above(lines: list[str], first: int, width: int, path: str):
         i for i in range(first) if lines[i].strip() and not set(lines[i].strip()) <= set("-=_ ")
     ]
     units = None
-    if above and all(c.startswith(("(", "[")) for c in _cells(lines[above[-1]], None)):
-        cells = _cells(lines[above[-1]], None)
+    if above and all(c.startswith(("(", "[")) for c in _cells(lines[above[-1]])):
+        cells = _cells(lines[above[-1]])
         if len(cells) == width:
             units = cells
             above = above[:-1]
-    if not above or len(_cells(lines[above[-1]].lstrip("#"), None)) != width:
+    if not above or len(_cells(lines[above[-1]].lstrip("#"))) != width:
         raise InputError(
             f"no header line with {width} column names above the first data line "
             f"(names joined by _ or -, or separated by commas)",

@@ -104,6 +104,8 @@ def _ascii_export(path, rec, comma=False):
              "VEast", "VUp"]  # fmt: skip
     units = ["(sec)", "(deg)", "(deg)", "(m)", "(deg)", "(deg)", "(deg)", "(m/s)", "(m/s)",
              "(m/s)"]  # fmt: skip
+    if not comma:  # Inertial Explorer style: a date and a clock time as text, not used
+        names, units = ["Date", "UTCTime", *names], ["(YMD)", "(HMS)", *units]
     sep = ", " if comma else "  "
     lines = ["Project: simulated flight", "Datum: SIRGAS 2000", "-" * 40, sep.join(names),
              sep.join(units)]  # fmt: skip
@@ -111,7 +113,8 @@ def _ascii_export(path, rec, comma=False):
     for k in range(len(rec["time"])):
         v = rec["v_ned"][k]
         row = (rec["time"][k], *rec["llh"][k], *deg[k], v[0], v[1], -v[2])
-        lines.append(sep.join(repr(float(x)) for x in row))
+        text = [repr(float(x)) for x in row]
+        lines.append(sep.join(text if comma else ["1997/01/15", "06:13:13.00", *text]))
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
 
