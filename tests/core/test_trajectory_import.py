@@ -285,3 +285,23 @@ def test_hermite_positions_equal_scipys_cubic_hermite_spline():
     j = np.clip(np.searchsorted(tk, t, side="right") - 1, 0, len(tk) - 2)
     got = _hermite(tk, xyz, vel, j, t)
     np.testing.assert_allclose(got, CubicHermiteSpline(tk, xyz, vel, axis=0)(t), atol=1e-9)
+
+
+def test_command_line_utc_events_and_a_truncated_sbet(tmp_path, records, capsys):
+    from lidarphoto.core.cli import main as cli_main
+
+    sbet = _sbet(tmp_path / "cli.out", records)
+    # the same instants as UTC date-times: GPS second of week 345600.55 on Thursday
+    # 2026-12-03 (week 2447 began on Sunday 2026-11-29) is 00:00:00.55 GPS = 23:59:42.55 UTC
+    events = tmp_path / "utc.csv"
+    events.write_text("image_id,time\nA,2026-12-02T23:59:42.55Z\n", encoding="utf-8")
+    rc = cli_main(["importtrajectory", "--input", str(sbet), "--events", str(events),
+                   "--event-time", "utc", "--crs", CRS])  # fmt: skip
+    out = capsys.readouterr().out.splitlines()
+    assert rc == 0 and out[0].startswith("image_id,time") and out[1].startswith("A,345600.55")
+    sbet.write_bytes(sbet.read_bytes()[:-1])
+    rc = cli_main(["importtrajectory", "--input", str(sbet), "--events", str(events),
+                   "--event-time", "utc", "--crs", CRS,
+                   "--output-trajectory", str(tmp_path / "t.csv")])  # fmt: skip
+    assert rc == 2 and "cli.out: " in capsys.readouterr().err
+    assert not (tmp_path / "t.csv").exists()
