@@ -16,6 +16,7 @@ from types import ModuleType
 #: Every algorithm's job module, in the order of the toolbox and of ``lidarphoto --help``.
 NAMES = (
     "trajectory_to_eo",
+    "import_trajectory",
     "ground_filter",
     "create_lcps",
     "accuracy_report",

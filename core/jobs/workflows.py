@@ -111,6 +111,16 @@ WORKFLOWS: tuple[Workflow, ...] = (
         ),
     ),
     Workflow(
+        _t("Boresight calibration from an SBET (or ASCII export) and the camera events"),
+        (
+            ("importtrajectory", _t("INPUT = the SBET, POSPac / Inertial Explorer export or "
+             "CSV; EVENTS = image_id, time; OUTPUT_TRAJECTORY = the trajectory table at the "
+             "events, OUTPUT_EO = the exterior orientation")),
+            ("boresightcalibration", _t("TRAJECTORY = that trajectory table, OBSERVATIONS = "
+             "image measurements of the control; OUTPUT_TABLE = boresight per group")),
+        ),
+    ),
+    Workflow(
         _t("Boresight calibration with surveyed ground control located automatically"),
         (
             ("trajectorytoeo", _t("INPUT = the GNSS/INS trajectory CSV; OUTPUT_CSV = the "

@@ -84,10 +84,10 @@ _NEEDS_MORE_THAN_THE_FILE = {"control_chips.read_grey_photo", "control_chips.rea
 
 def test_every_table_reader_of_core_io_has_an_example():
     named = {tags["reader"] for _, _, tags, _ in EXAMPLES if "reader" in tags}
-    # no text example possible: LAS/LAZ, GeoTIFF, BAL, E57 (chips: GeoTIFF; tiles: LAS/LAZ;
+    # no text example possible: LAS/LAZ, GeoTIFF, BAL, E57, SBET (chips: GeoTIFF; tiles: LAS/LAZ;
     # calibration, images: photographs)
-    binary = {"bal", "calibration", "chips", "dsm", "images", "pointcloud", "raster", "scans",
-              "tiles"}  # fmt: skip
+    binary = {"bal", "calibration", "chips", "dsm", "images", "pointcloud", "raster", "sbet",
+              "scans", "tiles"}  # fmt: skip
     for module in sorted((ROOT / "core" / "io").glob("*.py")):
         if module.stem in binary:
             continue
