@@ -103,6 +103,10 @@
             <translation>Aerotriangulação e ortofotos</translation>
         </message>
         <message>
+            <source>Boresight calibration from an SBET (or ASCII export) and the camera events</source>
+            <translation>Calibração de boresight a partir de um SBET (ou exportação ASCII) e dos eventos da câmera</translation>
+        </message>
+        <message>
             <source>Boresight calibration with surveyed ground control located automatically</source>
             <translation>Calibração de boresight com pontos de apoio levantados e localizados automaticamente</translation>
         </message>
@@ -187,6 +191,14 @@
             <translation>INPUT = pontos de verificação medidos no mosaico</translation>
         </message>
         <message>
+            <source>INPUT = the SBET, POSPac / Inertial Explorer export or CSV; EVENTS = image_id, time; OUTPUT_TRAJECTORY = the trajectory table at the events, OUTPUT_EO = the exterior orientation</source>
+            <translation>INPUT = o SBET, a exportação do POSPac / Inertial Explorer ou o CSV; EVENTS = image_id, time; OUTPUT_TRAJECTORY = a tabela de trajetória nos eventos, OUTPUT_EO = a orientação exterior</translation>
+        </message>
+        <message>
+            <source>TRAJECTORY = that trajectory table, OBSERVATIONS = image measurements of the control; OUTPUT_TABLE = boresight per group</source>
+            <translation>TRAJECTORY = essa tabela de trajetória, OBSERVATIONS = medições do controle nas imagens; OUTPUT_TABLE = boresight por grupo</translation>
+        </message>
+        <message>
             <source>OBSERVATIONS = those control rows, GROUND_POINTS = the surveyed points (role control or check), TRAJECTORY; OUTPUT_TABLE = boresight per group, OUTPUT_EO = corrected orientation</source>
             <translation>OBSERVATIONS = essas linhas control, GROUND_POINTS = os pontos levantados (role control ou check), TRAJECTORY; OUTPUT_TABLE = boresight por grupo, OUTPUT_EO = orientação corrigida</translation>
         </message>
@@ -213,18 +225,6 @@
         <message>
             <source>unit, range</source>
             <translation type="vanished">unidade, intervalo</translation>
-        </message>
-        <message>
-            <source>Boresight calibration from an SBET (or ASCII export) and the camera events</source>
-            <translation>Calibração de boresight a partir de um SBET (ou exportação ASCII) e dos eventos da câmera</translation>
-        </message>
-        <message>
-            <source>INPUT = the SBET, POSPac / Inertial Explorer export or CSV; EVENTS = image_id, time; OUTPUT_TRAJECTORY = the trajectory table at the events, OUTPUT_EO = the exterior orientation</source>
-            <translation>INPUT = o SBET, a exportação do POSPac / Inertial Explorer ou o CSV; EVENTS = image_id, time; OUTPUT_TRAJECTORY = a tabela de trajetória nos eventos, OUTPUT_EO = a orientação exterior</translation>
-        </message>
-        <message>
-            <source>TRAJECTORY = that trajectory table, OBSERVATIONS = image measurements of the control; OUTPUT_TABLE = boresight per group</source>
-            <translation>TRAJECTORY = essa tabela de trajetória, OBSERVATIONS = medições do controle nas imagens; OUTPUT_TABLE = boresight por grupo</translation>
         </message>
     </context>
     <context>
@@ -4756,6 +4756,227 @@ opcionalmente, o MDT em GeoTIFF.</translation>
         </message>
     </context>
     <context>
+        <name>lidarphoto:importtrajectory</name>
+        <message>
+            <source>Import trajectory at camera events</source>
+            <translation>Importar trajetória nos eventos da câmera</translation>
+        </message>
+        <message>
+            <source>Aerotriangulation</source>
+            <translation>Aerotriangulação</translation>
+        </message>
+        <message>
+            <source>SBET / POSPac / Inertial Explorer / CSV trajectory + camera events -&gt; pose per image</source>
+            <translation>trajetória SBET / POSPac / Inertial Explorer / CSV + eventos da câmera -&gt; pose por imagem</translation>
+        </message>
+        <message>
+            <source>Reads the INS/GNSS solution as delivered (an Applanix SBET, a POSPac or Inertial Explorer
+ASCII export, or a generic CSV at any rate) and the camera's event file (image_id, time),
+and interpolates the pose of every image at its exposure:</source>
+            <translation>Lê a solução INS/GNSS como é entregue (um SBET da Applanix, uma exportação ASCII do POSPac
+ou do Inertial Explorer, ou um CSV genérico com qualquer frequência) e o arquivo de eventos da
+câmera (image_id, time), e interpola a pose de cada imagem no instante da sua exposição:</translation>
+        </message>
+        <message>
+            <source>- trajectory time = event time + TIME_OFFSET (the camera's timing offset, seconds);
+- position: cubic Hermite in the Earth-centred frame, with the records' velocities when the
+  file has them (they are checked against the positions);
+- attitude: spherical interpolation of the body-to-Earth-centred rotation (quaternions; a
+  cubic on the rotation group with the angular velocities of the neighbouring records, or
+  SLERP with ATTITUDE slerp), so a heading through north and the SBET's wander angle (true
+  heading = platform heading - wander) need no special case;
+- an event outside the trajectory, or in an interval between records longer than MAX_GAP,
+  is refused by name, and nothing is written.</source>
+            <translation>- tempo da trajetória = tempo do evento + TIME_OFFSET (o atraso de tempo da câmera, segundos);
+- posição: Hermite cúbica no referencial geocêntrico, com as velocidades dos registros quando
+  o arquivo as tem (elas são verificadas contra as posições);
+- atitude: interpolação esférica da rotação do corpo para o referencial geocêntrico
+  (quatérnios; uma cúbica no grupo das rotações com as velocidades angulares dos registros
+  vizinhos, ou SLERP com ATTITUDE slerp), de modo que um rumo passando pelo norte e o ângulo
+  wander do SBET (rumo verdadeiro = rumo da plataforma - wander) não precisam de caso especial;
+- um evento fora da trajetória, ou num intervalo entre registros maior que MAX_GAP, é recusado
+  pelo nome, e nada é escrito.</translation>
+        </message>
+        <message>
+            <source>## Inputs
+INPUT: the trajectory; FORMAT auto picks SBET for .out/.sbet, the generic CSV for .csv and
+an ASCII export otherwise (docs/formats.md). Latitude and longitude are on the datum of the
+mapping CRS. EVENTS: CSV with image_id, time and optionally group; EVENT_TIME gps (seconds of
+the GPS week, the SBET's clock) or utc (ISO 8601 date-times, with LEAP_SECONDS = GPS - UTC,
+18 s since 2017).</source>
+            <translation>## Entradas
+INPUT: a trajetória; FORMAT auto escolhe SBET para .out/.sbet, o CSV genérico para .csv e uma
+exportação ASCII nos outros casos (docs/formats.md). Latitude e longitude estão no datum do
+SRC de mapeamento. EVENTS: CSV com image_id, time e opcionalmente group; EVENT_TIME gps
+(segundos da semana GPS, o relógio do SBET) ou utc (data-hora ISO 8601, com LEAP_SECONDS =
+GPS - UTC, 18 s desde 2017).</translation>
+        </message>
+        <message>
+            <source>## Outputs
+OUTPUT_TRAJECTORY: the trajectory table that trajectorytoeo and boresightcalibration read
+(easting, northing, height in the mapping CRS; roll, pitch, true heading in degrees; time =
+the trajectory time). OUTPUT_EO: the exterior orientation with the mount applied, as
+trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.</source>
+            <translation>## Saídas
+OUTPUT_TRAJECTORY: a tabela de trajetória que trajectorytoeo e boresightcalibration leem
+(E, N, altura no SRC de mapeamento; rolamento, arfagem e rumo verdadeiro em graus; time = o
+tempo da trajetória). OUTPUT_EO: a orientação exterior com a montagem aplicada, como
+trajectorytoeo a calcula. OUTPUT: os centros perspectivos como camada PointZ.</translation>
+        </message>
+        <message>
+            <source>Trajectory (SBET, ASCII export or CSV)</source>
+            <translation>Trajetória (SBET, exportação ASCII ou CSV)</translation>
+        </message>
+        <message>
+            <source>Trajectories (*.out *.sbet *.txt *.asc *.csv *.OUT);;All files (*)</source>
+            <translation>Trajetórias (*.out *.sbet *.txt *.asc *.csv *.OUT);;Todos os arquivos (*)</translation>
+        </message>
+        <message>
+            <source>Trajectory format</source>
+            <translation>Formato da trajetória</translation>
+        </message>
+        <message>
+            <source>auto: by the file's ending (.out/.sbet SBET, .csv CSV, else ASCII)</source>
+            <translation>auto: pela extensão do arquivo (.out/.sbet SBET, .csv CSV, senão ASCII)</translation>
+        </message>
+        <message>
+            <source>Camera events (CSV: image_id, time)</source>
+            <translation>Eventos da câmera (CSV: image_id, time)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Clock of the event times</source>
+            <translation>Relógio dos tempos dos eventos</translation>
+        </message>
+        <message>
+            <source>gps: GPS seconds of week; utc: ISO 8601 date-times in UTC</source>
+            <translation>gps: segundos da semana GPS; utc: data-hora ISO 8601 em UTC</translation>
+        </message>
+        <message>
+            <source>Leap seconds GPS - UTC</source>
+            <translation>Segundos intercalares GPS - UTC</translation>
+        </message>
+        <message>
+            <source>GPS - UTC at the events' date (18 since 2017-01-01); used for utc times</source>
+            <translation>GPS - UTC na data dos eventos (18 desde 2017-01-01); usado para tempos utc</translation>
+        </message>
+        <message>
+            <source>Camera timing offset</source>
+            <translation>Atraso de tempo da câmera</translation>
+        </message>
+        <message>
+            <source>trajectory time = event time + offset</source>
+            <translation>tempo da trajetória = tempo do evento + atraso</translation>
+        </message>
+        <message>
+            <source>Longest record interval</source>
+            <translation>Maior intervalo entre registros</translation>
+        </message>
+        <message>
+            <source>an event between two records further apart than this is refused</source>
+            <translation>um evento entre dois registros mais afastados do que isto é recusado</translation>
+        </message>
+        <message>
+            <source>Attitude interpolation</source>
+            <translation>Interpolação da atitude</translation>
+        </message>
+        <message>
+            <source>cubic: Hermite cubic on the rotation group with the neighbours' angular velocities; slerp: constant angular velocity between two records</source>
+            <translation>cubic: Hermite cúbica no grupo das rotações com as velocidades angulares dos vizinhos; slerp: velocidade angular constante entre dois registros</translation>
+        </message>
+        <message>
+            <source>Mapping CRS (projected)</source>
+            <translation>SRC de mapeamento (projetado)</translation>
+        </message>
+        <message>
+            <source>projected CRS of the outputs (and of a CSV's eastings/northings)</source>
+            <translation>SRC projetado das saídas (e das coordenadas E/N de um CSV)</translation>
+        </message>
+        <message>
+            <source>Lever arm x,y,z</source>
+            <translation>Braço de alavanca x,y,z</translation>
+        </message>
+        <message>
+            <source>camera perspective centre in the INS body frame (x forward, y right, z down)</source>
+            <translation>centro perspectivo da câmera no referencial do corpo do INS (x para a frente, y para a direita, z para baixo)</translation>
+        </message>
+        <message>
+            <source>Camera mount</source>
+            <translation>Montagem da câmera</translation>
+        </message>
+        <message>
+            <source>nominal camera-to-body rotation; custom uses MOUNT_MATRIX</source>
+            <translation>rotação nominal da câmera para o corpo; custom usa MOUNT_MATRIX</translation>
+        </message>
+        <message>
+            <source>image_top_forward: image top towards the flight direction (nose)</source>
+            <translation>image_top_forward: topo da imagem no sentido do voo (nariz)</translation>
+        </message>
+        <message>
+            <source>image_right_forward: image right side towards the flight direction</source>
+            <translation>image_right_forward: lado direito da imagem no sentido do voo</translation>
+        </message>
+        <message>
+            <source>image_bottom_forward: image bottom towards the flight direction</source>
+            <translation>image_bottom_forward: base da imagem no sentido do voo</translation>
+        </message>
+        <message>
+            <source>image_left_forward: image left side towards the flight direction</source>
+            <translation>image_left_forward: lado esquerdo da imagem no sentido do voo</translation>
+        </message>
+        <message>
+            <source>custom: custom matrix (MOUNT_MATRIX)</source>
+            <translation>custom: matriz definida pelo usuário (MOUNT_MATRIX)</translation>
+        </message>
+        <message>
+            <source>Mount matrix R_c^b (9 numbers, row-major)</source>
+            <translation>Matriz de montagem R_c^b (9 números, por linhas)</translation>
+        </message>
+        <message>
+            <source>the nominal mount R_c^b when MOUNT is custom</source>
+            <translation>a montagem nominal R_c^b quando MOUNT é custom</translation>
+        </message>
+        <message>
+            <source>Boresight domega,dphi,dkappa</source>
+            <translation>Boresight domega,dphi,dkappa</translation>
+        </message>
+        <message>
+            <source>small misalignment about the camera axes x, y, z (a larger rotation belongs in MOUNT)</source>
+            <translation>pequeno desalinhamento em torno dos eixos x, y, z da câmera (uma rotação maior pertence a MOUNT)</translation>
+        </message>
+        <message>
+            <source>Perspective centres</source>
+            <translation>Centros perspectivos</translation>
+        </message>
+        <message>
+            <source>Trajectory table at the events (CSV)</source>
+            <translation>Tabela de trajetória nos eventos (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Exterior orientation table (CSV)</source>
+            <translation>Tabela de orientação exterior (CSV)</translation>
+        </message>
+        <message>
+            <source>Number of images</source>
+            <translation>Número de imagens</translation>
+        </message>
+        <message>
+            <source>Number of trajectory records</source>
+            <translation>Número de registros da trajetória</translation>
+        </message>
+        <message>
+            <source>Direct georeferencing</source>
+            <translation type="vanished">Georreferenciação direta</translation>
+        </message>
+    </context>
+    <context>
         <name>lidarphoto:lidarblock</name>
         <message>
             <source>LiDAR block: ground, roof planes and control, tile by tile (dask)</source>
@@ -6666,223 +6887,6 @@ então nada prova). Com ACCEPT DOUBTFUL as saídas são gravadas e cada tabela c
         <message>
             <source>Calibration</source>
             <translation type="vanished">Calibração</translation>
-        </message>
-    </context>
-    <context>
-        <name>lidarphoto:importtrajectory</name>
-        <message>
-            <source>Import trajectory at camera events</source>
-            <translation>Importar trajetória nos eventos da câmera</translation>
-        </message>
-        <message>
-            <source>Direct georeferencing</source>
-            <translation>Georreferenciação direta</translation>
-        </message>
-        <message>
-            <source>SBET / POSPac / Inertial Explorer / CSV trajectory + camera events -&gt; pose per image</source>
-            <translation>trajetória SBET / POSPac / Inertial Explorer / CSV + eventos da câmera -&gt; pose por imagem</translation>
-        </message>
-        <message>
-            <source>Reads the INS/GNSS solution as delivered (an Applanix SBET, a POSPac or Inertial Explorer
-ASCII export, or a generic CSV at any rate) and the camera's event file (image_id, time),
-and interpolates the pose of every image at its exposure:</source>
-            <translation>Lê a solução INS/GNSS como é entregue (um SBET da Applanix, uma exportação ASCII do POSPac
-ou do Inertial Explorer, ou um CSV genérico com qualquer frequência) e o arquivo de eventos da
-câmera (image_id, time), e interpola a pose de cada imagem no instante da sua exposição:</translation>
-        </message>
-        <message>
-            <source>- trajectory time = event time + TIME_OFFSET (the camera's timing offset, seconds);
-- position: cubic Hermite in the Earth-centred frame, with the records' velocities when the
-  file has them (they are checked against the positions);
-- attitude: spherical interpolation of the body-to-Earth-centred rotation (quaternions; a
-  cubic on the rotation group with the angular velocities of the neighbouring records, or
-  SLERP with ATTITUDE slerp), so a heading through north and the SBET's wander angle (true
-  heading = platform heading - wander) need no special case;
-- an event outside the trajectory, or in an interval between records longer than MAX_GAP,
-  is refused by name, and nothing is written.</source>
-            <translation>- tempo da trajetória = tempo do evento + TIME_OFFSET (o atraso de tempo da câmera, segundos);
-- posição: Hermite cúbica no referencial geocêntrico, com as velocidades dos registros quando
-  o arquivo as tem (elas são verificadas contra as posições);
-- atitude: interpolação esférica da rotação do corpo para o referencial geocêntrico
-  (quatérnios; uma cúbica no grupo das rotações com as velocidades angulares dos registros
-  vizinhos, ou SLERP com ATTITUDE slerp), de modo que um rumo passando pelo norte e o ângulo
-  wander do SBET (rumo verdadeiro = rumo da plataforma - wander) não precisam de caso especial;
-- um evento fora da trajetória, ou num intervalo entre registros maior que MAX_GAP, é recusado
-  pelo nome, e nada é escrito.</translation>
-        </message>
-        <message>
-            <source>## Inputs
-INPUT: the trajectory; FORMAT auto picks SBET for .out/.sbet, the generic CSV for .csv and
-an ASCII export otherwise (docs/formats.md). Latitude and longitude are on the datum of the
-mapping CRS. EVENTS: CSV with image_id, time and optionally group; EVENT_TIME gps (seconds of
-the GPS week, the SBET's clock) or utc (ISO 8601 date-times, with LEAP_SECONDS = GPS - UTC,
-18 s since 2017).</source>
-            <translation>## Entradas
-INPUT: a trajetória; FORMAT auto escolhe SBET para .out/.sbet, o CSV genérico para .csv e uma
-exportação ASCII nos outros casos (docs/formats.md). Latitude e longitude estão no datum do
-SRC de mapeamento. EVENTS: CSV com image_id, time e opcionalmente group; EVENT_TIME gps
-(segundos da semana GPS, o relógio do SBET) ou utc (data-hora ISO 8601, com LEAP_SECONDS =
-GPS - UTC, 18 s desde 2017).</translation>
-        </message>
-        <message>
-            <source>## Outputs
-OUTPUT_TRAJECTORY: the trajectory table that trajectorytoeo and boresightcalibration read
-(easting, northing, height in the mapping CRS; roll, pitch, true heading in degrees; time =
-the trajectory time). OUTPUT_EO: the exterior orientation with the mount applied, as
-trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.</source>
-            <translation>## Saídas
-OUTPUT_TRAJECTORY: a tabela de trajetória que trajectorytoeo e boresightcalibration leem
-(E, N, altura no SRC de mapeamento; rolamento, arfagem e rumo verdadeiro em graus; time = o
-tempo da trajetória). OUTPUT_EO: a orientação exterior com a montagem aplicada, como
-trajectorytoeo a calcula. OUTPUT: os centros perspectivos como camada PointZ.</translation>
-        </message>
-        <message>
-            <source>Trajectory (SBET, ASCII export or CSV)</source>
-            <translation>Trajetória (SBET, exportação ASCII ou CSV)</translation>
-        </message>
-        <message>
-            <source>Trajectories (*.out *.sbet *.txt *.asc *.csv *.OUT);;All files (*)</source>
-            <translation>Trajetórias (*.out *.sbet *.txt *.asc *.csv *.OUT);;Todos os arquivos (*)</translation>
-        </message>
-        <message>
-            <source>Trajectory format</source>
-            <translation>Formato da trajetória</translation>
-        </message>
-        <message>
-            <source>auto: by the file's ending (.out/.sbet SBET, .csv CSV, else ASCII)</source>
-            <translation>auto: pela extensão do arquivo (.out/.sbet SBET, .csv CSV, senão ASCII)</translation>
-        </message>
-        <message>
-            <source>Camera events (CSV: image_id, time)</source>
-            <translation>Eventos da câmera (CSV: image_id, time)</translation>
-        </message>
-        <message>
-            <source>CSV files (*.csv *.txt)</source>
-            <translation>Arquivos CSV (*.csv *.txt)</translation>
-        </message>
-        <message>
-            <source>Clock of the event times</source>
-            <translation>Relógio dos tempos dos eventos</translation>
-        </message>
-        <message>
-            <source>gps: GPS seconds of week; utc: ISO 8601 date-times in UTC</source>
-            <translation>gps: segundos da semana GPS; utc: data-hora ISO 8601 em UTC</translation>
-        </message>
-        <message>
-            <source>Leap seconds GPS - UTC</source>
-            <translation>Segundos intercalares GPS - UTC</translation>
-        </message>
-        <message>
-            <source>GPS - UTC at the events' date (18 since 2017-01-01); used for utc times</source>
-            <translation>GPS - UTC na data dos eventos (18 desde 2017-01-01); usado para tempos utc</translation>
-        </message>
-        <message>
-            <source>Camera timing offset</source>
-            <translation>Atraso de tempo da câmera</translation>
-        </message>
-        <message>
-            <source>trajectory time = event time + offset</source>
-            <translation>tempo da trajetória = tempo do evento + atraso</translation>
-        </message>
-        <message>
-            <source>Longest record interval</source>
-            <translation>Maior intervalo entre registros</translation>
-        </message>
-        <message>
-            <source>an event between two records further apart than this is refused</source>
-            <translation>um evento entre dois registros mais afastados do que isto é recusado</translation>
-        </message>
-        <message>
-            <source>Attitude interpolation</source>
-            <translation>Interpolação da atitude</translation>
-        </message>
-        <message>
-            <source>cubic: Hermite cubic on the rotation group with the neighbours' angular velocities; slerp: constant angular velocity between two records</source>
-            <translation>cubic: Hermite cúbica no grupo das rotações com as velocidades angulares dos vizinhos; slerp: velocidade angular constante entre dois registros</translation>
-        </message>
-        <message>
-            <source>Mapping CRS (projected)</source>
-            <translation>SRC de mapeamento (projetado)</translation>
-        </message>
-        <message>
-            <source>projected CRS of the outputs (and of a CSV's eastings/northings)</source>
-            <translation>SRC projetado das saídas (e das coordenadas E/N de um CSV)</translation>
-        </message>
-        <message>
-            <source>Lever arm x,y,z</source>
-            <translation>Braço de alavanca x,y,z</translation>
-        </message>
-        <message>
-            <source>camera perspective centre in the INS body frame (x forward, y right, z down)</source>
-            <translation>centro perspectivo da câmera no referencial do corpo do INS (x para a frente, y para a direita, z para baixo)</translation>
-        </message>
-        <message>
-            <source>Camera mount</source>
-            <translation>Montagem da câmera</translation>
-        </message>
-        <message>
-            <source>nominal camera-to-body rotation; custom uses MOUNT_MATRIX</source>
-            <translation>rotação nominal da câmera para o corpo; custom usa MOUNT_MATRIX</translation>
-        </message>
-        <message>
-            <source>image_top_forward: image top towards the flight direction (nose)</source>
-            <translation>image_top_forward: topo da imagem no sentido do voo (nariz)</translation>
-        </message>
-        <message>
-            <source>image_right_forward: image right side towards the flight direction</source>
-            <translation>image_right_forward: lado direito da imagem no sentido do voo</translation>
-        </message>
-        <message>
-            <source>image_bottom_forward: image bottom towards the flight direction</source>
-            <translation>image_bottom_forward: base da imagem no sentido do voo</translation>
-        </message>
-        <message>
-            <source>image_left_forward: image left side towards the flight direction</source>
-            <translation>image_left_forward: lado esquerdo da imagem no sentido do voo</translation>
-        </message>
-        <message>
-            <source>custom: custom matrix (MOUNT_MATRIX)</source>
-            <translation>custom: matriz definida pelo usuário (MOUNT_MATRIX)</translation>
-        </message>
-        <message>
-            <source>Mount matrix R_c^b (9 numbers, row-major)</source>
-            <translation>Matriz de montagem R_c^b (9 números, por linhas)</translation>
-        </message>
-        <message>
-            <source>the nominal mount R_c^b when MOUNT is custom</source>
-            <translation>a montagem nominal R_c^b quando MOUNT é custom</translation>
-        </message>
-        <message>
-            <source>Boresight domega,dphi,dkappa</source>
-            <translation>Boresight domega,dphi,dkappa</translation>
-        </message>
-        <message>
-            <source>small misalignment about the camera axes x, y, z (a larger rotation belongs in MOUNT)</source>
-            <translation>pequeno desalinhamento em torno dos eixos x, y, z da câmera (uma rotação maior pertence a MOUNT)</translation>
-        </message>
-        <message>
-            <source>Perspective centres</source>
-            <translation>Centros perspectivos</translation>
-        </message>
-        <message>
-            <source>Trajectory table at the events (CSV)</source>
-            <translation>Tabela de trajetória nos eventos (CSV)</translation>
-        </message>
-        <message>
-            <source>CSV files (*.csv)</source>
-            <translation>Arquivos CSV (*.csv)</translation>
-        </message>
-        <message>
-            <source>Exterior orientation table (CSV)</source>
-            <translation>Tabela de orientação exterior (CSV)</translation>
-        </message>
-        <message>
-            <source>Number of images</source>
-            <translation>Número de imagens</translation>
-        </message>
-        <message>
-            <source>Number of trajectory records</source>
-            <translation>Número de registros da trajetória</translation>
         </message>
     </context>
     <context>

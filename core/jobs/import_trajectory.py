@@ -23,8 +23,8 @@ NAV_FILTER = "Trajectories (*.out *.sbet *.txt *.asc *.csv *.OUT);;All files (*)
 SPEC = AlgorithmSpec(
     name="importtrajectory",
     title="Import trajectory at camera events",
-    group="Direct georeferencing",
-    group_id="georeferencing",
+    group="Aerotriangulation",
+    group_id="aerotriangulation",
     summary="SBET / POSPac / Inertial Explorer / CSV trajectory + camera events -> pose per image",
     description="""\
 Reads the INS/GNSS solution as delivered (an Applanix SBET, a POSPac or Inertial Explorer
