@@ -27,7 +27,15 @@ from qgis.core import QgsCoordinateReferenceSystem, QgsProject
 from qgis.gui import QgsDockWidget
 from qgis.PyQt.QtCore import QT_TRANSLATE_NOOP, QCoreApplication, Qt, pyqtSignal
 from qgis.PyQt.QtGui import QKeySequence
-from qgis.PyQt.QtWidgets import QLabel, QSplitter, QTabWidget, QVBoxLayout, QWidget
+from qgis.PyQt.QtWidgets import (
+    QLabel,
+    QSizePolicy,
+    QSplitter,
+    QStackedWidget,
+    QTabWidget,
+    QVBoxLayout,
+    QWidget,
+)
 
 from ..core.photo.picking import PickingScene
 from ..core.photo.picking_session import PICK_TYPES, PickingSession
@@ -129,11 +137,62 @@ class ImagePickingDock(QgsDockWidget):
         self.tabs.addTab(help_label, self.tr("Help"))
         self.viewer = ViewerPanel(dock_help())
         self.table = ObservationTable()
+        rows = 4  # the table shows a few rows at least, the image the rest
+        self.table.setMinimumHeight(
+            rows * self.table.verticalHeader().defaultSectionSize()
+            + self.table.horizontalHeader().sizeHint().height()
+            + 4
+        )
         for w in (self.tabs, self.viewer, self.table):
             split.addWidget(w)
-        split.setStretchFactor(1, 4)
-        split.setSizes([230, 560, 140])
+        for k, stretch in enumerate((0, 1, 0)):
+            split.setStretchFactor(k, stretch)
+            split.setCollapsible(k, False)
+        self.split = split
+        #: the tab pages are hidden (only the tab bar shows) to give the image the room; a
+        #: click on the current tab toggles them, on another tab opens that one
+        self.tabs_collapsed = False
+        self._tabs_chosen = False
+        self.tabs.currentChanged.connect(self._size_tabs_to_page)
+        self.tabs.tabBarClicked.connect(self._tab_clicked)
+        self._size_tabs_to_page(self.tabs.currentIndex())
+        # first layout (scaled to the dock): the tab page, the table's few rows, the image the rest
+        split.setSizes([self.tabs.maximumHeight(), 10_000, self.table.minimumHeight()])
         self.setWidget(root)
+
+    # -- the tab panel: as high as its current page, collapsible -----------------------------
+    def _size_tabs_to_page(self, index: int) -> None:
+        """The tab widget as high as the page shown (a QTabWidget is otherwise as high as its
+        highest page, the Project tab, even on the Resection tab's one button)."""
+        for i in range(self.tabs.count()):
+            page = self.tabs.widget(i)
+            vertical = QSizePolicy.Policy.Preferred if i == index else QSizePolicy.Policy.Ignored
+            page.setSizePolicy(QSizePolicy.Policy.Preferred, vertical)
+        self.set_tabs_collapsed(self.tabs_collapsed)
+
+    def _tab_clicked(self, index: int) -> None:
+        self._tabs_chosen = True
+        if index == self.tabs.currentIndex():
+            self.set_tabs_collapsed(not self.tabs_collapsed)
+        else:
+            self.set_tabs_collapsed(False)
+
+    def set_tabs_collapsed(self, collapsed: bool) -> None:
+        """Hide (or show) the tab pages: the tab bar stays, the image takes the height."""
+        self.tabs_collapsed = bool(collapsed)
+        stack = self.tabs.findChild(QStackedWidget)
+        if stack is not None:
+            stack.setVisible(not collapsed)
+        bar = self.tabs.tabBar().sizeHint().height()
+        page = self.tabs.currentWidget()
+        height = bar + (0 if collapsed or page is None else page.sizeHint().height() + 8)
+        self.tabs.setMaximumHeight(height)
+        sizes = self.split.sizes()
+        if len(sizes) == 3 and sum(sizes) > 0:
+            free = sum(sizes) - height - sizes[2]
+            self.split.setSizes(
+                [height, max(free, self.viewer.minimumSizeHint().height()), sizes[2]]
+            )
 
     def _connect(self) -> None:
         p, c, v = self.project_panel, self.calibration_panel, self.viewer
@@ -280,6 +339,8 @@ class ImagePickingDock(QgsDockWidget):
         path = self.image_paths.get(image_id)
         ok, text, warning = self.viewer.open(image_id, path, oriented, self.camera)
         self.message(text, warning=warning)
+        if ok and not self._tabs_chosen:  # set up: the image gets the room
+            self.set_tabs_collapsed(True)
         self.picking.refresh()
         self.update_footprint()
         self.imageChanged.emit(image_id)

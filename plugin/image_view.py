@@ -196,6 +196,8 @@ class ImageView(QGraphicsView):
         self._drag_key = None
         self._drag_item = None
         self._space = False
+        #: the whole image is in view as fit() put it (a resize refits it)
+        self.fitted = False
         self.tiles_loaded = 0
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
@@ -578,9 +580,11 @@ class ImageView(QGraphicsView):
         vp = self.viewport().rect()
         z = min(vp.width() / self.source.width, vp.height() / self.source.height) * 0.98
         self.set_zoom(z, QPointF(self.source.width / 2, self.source.height / 2))
+        self.fitted = True  # refitted on a resize until the user zooms or pans
 
     def set_zoom(self, zoom: float, centre: QPointF | None = None) -> None:
         """Set the zoom (screen px per image px) and optionally centre on a scene point."""
+        self.fitted = False  # fit() sets it again
         c = centre if centre is not None else self.visible_rect().center()
         zoom = float(min(_MAX_ZOOM, max(1e-4, zoom)))
         self.setTransform(QTransform.fromScale(zoom, zoom))
@@ -590,6 +594,7 @@ class ImageView(QGraphicsView):
 
     def zoom_about(self, factor: float, view_pos: QPointF) -> None:
         """Zoom by ``factor`` keeping the scene point under ``view_pos`` (viewport px) fixed."""
+        self.fitted = False
         before = self._scene_f(view_pos)
         z = float(min(_MAX_ZOOM, max(1e-4, self.zoom * factor)))
         self.setTransform(QTransform.fromScale(z, z))
@@ -606,6 +611,7 @@ class ImageView(QGraphicsView):
 
     def pan(self, dx: float, dy: float) -> None:
         """Move the image by (dx, dy) screen pixels."""
+        self.fitted = False
         self._scroll_by(-dx, -dy)
 
     def scrollContentsBy(self, dx: int, dy: int) -> None:
@@ -614,6 +620,8 @@ class ImageView(QGraphicsView):
 
     def resizeEvent(self, event) -> None:
         super().resizeEvent(event)
+        if self.fitted:  # docked, floated, maximised: the whole image stays in view
+            self.fit()
         if self.status_label.isVisible():  # keep it in the bottom-left corner
             self._status(self.status_label.text())
         self._schedule()

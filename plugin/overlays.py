@@ -19,7 +19,8 @@ import math
 from collections.abc import Callable, Hashable, Sequence
 
 import numpy as np
-from qgis.PyQt.QtCore import QPointF, Qt
+from qgis.PyQt import sip
+from qgis.PyQt.QtCore import QPointF, Qt, QTimer
 from qgis.PyQt.QtGui import QBrush, QColor, QFont, QPainterPath, QPen, QPolygonF
 from qgis.PyQt.QtWidgets import QGraphicsItem, QGraphicsPathItem, QGraphicsSimpleTextItem
 
@@ -39,6 +40,23 @@ COLOURS = {
     "predictions": QColor(255, 255, 0),
 }
 _IGNORES_TRANSFORMATIONS = QGraphicsItem.GraphicsItemFlag.ItemIgnoresTransformations
+#: Screen area of one label (a point id of 3-5 characters, 8 pt bold), px^2.
+LABEL_SCREEN_PX2 = 400.0
+#: Labels are drawn while, spread over the image, they would cover at most this share of it
+#: on screen (at fit zoom a block's thousand labels would hide the image they name).
+LABEL_COVER = 0.15
+
+
+def labels_fit(count: int, image_px2: float, zoom: float) -> bool:
+    """Whether ``count`` labels over an image of ``image_px2`` image pixels, seen at ``zoom``
+    (screen px per image px), cover at most :data:`LABEL_COVER` of it on screen.
+
+    >>> labels_fit(1336, 6000 * 4000, 0.13), labels_fit(1336, 6000 * 4000, 0.5)
+    (False, True)
+    """
+    if count <= 0 or image_px2 <= 0:
+        return True
+    return count * LABEL_SCREEN_PX2 <= LABEL_COVER * image_px2 * zoom * zoom
 
 
 def _pen(colour: QColor, width: float = 1.5, style=Qt.PenStyle.SolidLine) -> QPen:
@@ -94,8 +112,31 @@ class Overlays:
         self._selected: tuple | None = None
         #: planes and LCPs by id: [(items..., hot)] for restyling the highlight
         self._by_id: dict[str, dict[str, list[list]]] = {"planes": {}, "lcps": {}}
+        #: the labels (but the selected one's), drawn only while :func:`labels_fit`
+        self._labels: list[QGraphicsSimpleTextItem] = []
+        self.labels_shown = True
+        self._zoom = 1.0
+        self._recount = QTimer()
+        self._recount.setSingleShot(True)
+        self._recount.timeout.connect(self.update_labels)
         for name in GROUPS:
             self._new_group(name)
+
+    def set_zoom(self, zoom: float) -> None:
+        """The view's zoom changed (screen px per image px): labels follow :func:`labels_fit`."""
+        self._zoom = float(zoom)
+        self.update_labels()
+
+    def update_labels(self) -> None:
+        """Show or hide the labels by how many there are at this zoom (the image is the middle
+        quarter of the scene rectangle, see ImageView)."""
+        self._labels = [i for i in self._labels if not sip.isdeleted(i) and i.scene() is not None]
+        rect = self.scene.sceneRect()
+        shown = labels_fit(len(self._labels), rect.width() * rect.height() / 4, self._zoom)
+        if shown != self.labels_shown:
+            self.labels_shown = shown
+            for item in self._labels:
+                item.setVisible(shown)
 
     def _new_group(self, name: str) -> QGraphicsPathItem:
         group = QGraphicsPathItem()  # a parent without contents of its own
@@ -117,6 +158,7 @@ class Overlays:
         if old is not None:
             self.scene.removeItem(old)
         self.counts[name] = 0
+        self._recount.start(0)
         return self._new_group(name)
 
     def clear_all(self) -> None:
@@ -148,6 +190,10 @@ class Overlays:
         item.setFont(self._font)
         item.setFlag(_IGNORES_TRANSFORMATIONS, True)
         item.setPos(x, y)
+        if colour != "selected":  # the selected point keeps its label at every zoom
+            item.setVisible(self.labels_shown)
+            self._labels.append(item)
+            self._recount.start(0)  # once after this batch of items
         item.setParentItem(parent)
         return item
 
@@ -187,6 +233,7 @@ class Overlays:
             for item in bundle[1:]:
                 scene.removeItem(item)
         self._synced[name] = new
+        self._recount.start(0)  # fewer labels may fit again
         self.counts[name] = len(keys)
 
     # -- the control --------------------------------------------------------------------------

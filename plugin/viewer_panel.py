@@ -145,6 +145,7 @@ class ViewerPanel(QWidget):
         self.status.setObjectName("lidarphotoPickingStatus")
         vl.addWidget(self.status)
         self.overlays = Overlays(self.view.scene())
+        self.view.zoomChanged.connect(self.overlays.set_zoom)
         self.source: ImageSource | None = None
 
         self.image_combo.currentIndexChanged.connect(self._combo_changed)
