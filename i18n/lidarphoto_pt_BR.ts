@@ -502,6 +502,21 @@
         </message>
     </context>
     <context>
+        <name>GroundFilterMethodAlgorithm</name>
+        <message>
+            <source>Ground filter: SMRF (Pingel et al. 2013)</source>
+            <translation>Filtro de terreno: SMRF (Pingel et al. 2013)</translation>
+        </message>
+        <message>
+            <source>Ground filter: progressive morphological (Zhang et al. 2003)</source>
+            <translation>Filtro de terreno: morfológico progressivo (Zhang et al. 2003)</translation>
+        </message>
+        <message>
+            <source>Ground filter: cloth simulation (Zhang et al. 2016)</source>
+            <translation>Filtro de terreno: simulação de tecido (Zhang et al. 2016)</translation>
+        </message>
+    </context>
+    <context>
         <name>ImageLoader</name>
         <message>
             <source>{path}: read failed ({error})</source>

@@ -198,12 +198,16 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
             return False, missing_message(missing)
         return True, ""
 
-    def processAlgorithm(self, parameters, context, feedback):
-        raw = {
+    def read_raw(self, parameters, context) -> dict:
+        """The values of the spec's parameters as the job takes them (before :meth:`prepare`)."""
+        return {
             p.name: read_parameter(self, p, parameters, context)
             for p in self.spec.params
             if p.kind != "sink"
         }
+
+    def processAlgorithm(self, parameters, context, feedback):
+        raw = self.read_raw(parameters, context)
         raw = self.prepare(raw, parameters, context, feedback)
         self._verbose = verbose_log(context)
         result = self.run_core(run_job, self.JOB, raw, feedback=feedback)

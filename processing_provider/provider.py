@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import sys
 from pathlib import Path
 from types import ModuleType
 
@@ -39,8 +40,10 @@ def algorithm_class(job: ModuleType) -> type[BaseAlgorithm]:
     adapter = f"{__package__}.algorithms.{module}"
     if importlib.util.find_spec(adapter) is not None:
         for value in vars(importlib.import_module(adapter)).values():
-            if isinstance(value, type) and issubclass(value, BaseAlgorithm) and (
-                value.__dict__.get("JOB") is job
+            if (
+                isinstance(value, type)
+                and issubclass(value, BaseAlgorithm)
+                and (value.__dict__.get("JOB") is job)
             ):
                 return value
         raise TypeError(f"{adapter} has no BaseAlgorithm subclass with JOB = {job.__name__}")
@@ -75,4 +78,7 @@ class LidarPhotoProvider(QgsProcessingProvider):
 
     def loadAlgorithms(self) -> None:
         for job in algorithms():
-            self.addAlgorithm(algorithm_class(job)())
+            cls = algorithm_class(job)
+            self.addAlgorithm(cls())
+            for extra in getattr(sys.modules[cls.__module__], "EXTRA_ALGORITHMS", ()):
+                self.addAlgorithm(extra())

@@ -69,6 +69,8 @@ _CHOICES = (
      "boolean", (), False),
 )  # fmt: skip
 _FIELDS = tuple(row[:3] for row in _NUMBERS) + tuple(row[:3] for row in _CHOICES)
+#: parameter -> the method it belongs to ("" = every method): the one-method forms in QGIS
+PARAM_METHODS = {key: method for key, method, _ in _FIELDS}
 HORIZONTAL_LENGTHS = {m: tuple(f for _, pm, f, _, _, u, *_ in _NUMBERS if u == H and pm in (m, ""))
                       for m in _CLASSES}  # fmt: skip
 VERTICAL_LENGTHS = {m: tuple(f for _, pm, f, _, _, u, *_ in _NUMBERS if u == V and pm in (m, ""))

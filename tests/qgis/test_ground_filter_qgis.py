@@ -21,11 +21,28 @@ def test_parameters_and_outputs(provider):
     alg = provider.algorithm("groundfilter")
     assert alg.id() == ALG and alg.groupId() == "lidar"
     names = [p.name() for p in alg.parameterDefinitions()]
-    for name in ("INPUT", "CRS", "DISTANCE_UNIT", "METHOD", "SMRF_CELL_SIZE", "SMRF_SLOPE",
-                 "SMRF_WINDOW", "SMRF_THRESHOLD", "CELL_SIZE", "MAX_WINDOW", "SLOPE",
-                 "INITIAL_DISTANCE", "MAX_DISTANCE", "GROUND_THRESHOLD", "CSF_RESOLUTION",
-                 "CSF_RIGIDNESS", "CSF_THRESHOLD", "HEIGHT_ABOVE_GROUND", "OUTPUT_CLOUD",
-                 "OUTPUT_DTM"):  # fmt: skip
+    for name in (
+        "INPUT",
+        "CRS",
+        "DISTANCE_UNIT",
+        "METHOD",
+        "SMRF_CELL_SIZE",
+        "SMRF_SLOPE",
+        "SMRF_WINDOW",
+        "SMRF_THRESHOLD",
+        "CELL_SIZE",
+        "MAX_WINDOW",
+        "SLOPE",
+        "INITIAL_DISTANCE",
+        "MAX_DISTANCE",
+        "GROUND_THRESHOLD",
+        "CSF_RESOLUTION",
+        "CSF_RIGIDNESS",
+        "CSF_THRESHOLD",
+        "HEIGHT_ABOVE_GROUND",
+        "OUTPUT_CLOUD",
+        "OUTPUT_DTM",
+    ):
         assert name in names
     outputs = {o.name() for o in alg.outputDefinitions()}
     assert {"OUTPUT_CLOUD", "OUTPUT_DTM", "GROUND_COUNT", "POINT_COUNT", "UNIT"} <= outputs
@@ -38,9 +55,13 @@ def test_processing_run_writes_cloud_and_dtm(provider, tmp_path):
     cloud, dtm = tmp_path / "ground.laz", tmp_path / "dtm.tif"
     result = processing.run(
         ALG,
-        {"INPUT": str(AHN3), "OUTPUT_CLOUD": str(cloud), "OUTPUT_DTM": str(dtm),
-         "HEIGHT_ABOVE_GROUND": True},
-    )  # fmt: skip
+        {
+            "INPUT": str(AHN3),
+            "OUTPUT_CLOUD": str(cloud),
+            "OUTPUT_DTM": str(dtm),
+            "HEIGHT_ABOVE_GROUND": True,
+        },
+    )
     src, out = laspy.read(AHN3), laspy.read(cloud)
     assert result["POINT_COUNT"] == len(src.points)
     assert result["UNIT"] == "metre"
@@ -98,11 +119,58 @@ def test_point_cloud_layer_input_on_this_qgis():
 def test_qgis_process_runs_the_algorithm(qp_env, tmp_path):
     cloud = tmp_path / "qp.laz"
     r = subprocess.run(
-        [QGIS_PROCESS, "--json", "run", ALG, "--", f"INPUT={AHN3}", f"OUTPUT_CLOUD={cloud}",
-         "DISTANCE_UNIT=0", "CELL_SIZE=1"],
-        env=qp_env, capture_output=True, text=True, timeout=300,
-    )  # fmt: skip
+        [
+            QGIS_PROCESS,
+            "--json",
+            "run",
+            ALG,
+            "--",
+            f"INPUT={AHN3}",
+            f"OUTPUT_CLOUD={cloud}",
+            "DISTANCE_UNIT=0",
+            "CELL_SIZE=1",
+        ],
+        env=qp_env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
     results = json.loads(r.stdout[r.stdout.index("{") :])["results"]
     assert results["UNIT"] == "metre"
     assert int(results["GROUND_COUNT"]) == (laspy.read(cloud).classification == 2).sum()
+
+
+@pytest.mark.parametrize("method", ["smrf", "pmf", "csf"])
+def test_one_algorithm_per_method_shows_its_fields_only(provider, method):
+    """groundfiltersmrf / pmf / csf: the common fields and their method's, no METHOD; the
+    all-methods groundfilter is out of the toolbox but runs in models and qgis_process."""
+    from lidarphoto.core.jobs.ground_filter import PARAM_METHODS
+    from qgis.core import QgsProcessingAlgorithm
+
+    alg = provider.algorithm(f"groundfilter{method}")
+    assert alg is not None and alg.groupId() == "lidar"
+    names = {p.name() for p in alg.parameterDefinitions()}
+    assert "METHOD" not in names
+    own = {k for k, m in PARAM_METHODS.items() if m == method}
+    others = {k for k, m in PARAM_METHODS.items() if m not in ("", method)}
+    assert own and own <= names and not names & others
+    visible = [
+        p
+        for p in alg.parameterDefinitions()
+        if not p.flags() & p.FlagAdvanced and not p.flags() & p.FlagHidden
+    ]
+    assert len(visible) <= 14, [p.name() for p in visible]  # 22 in the all-methods form
+    generic = provider.algorithm("groundfilter")
+    assert generic.flags() & QgsProcessingAlgorithm.Flag.FlagHideFromToolbox
+    assert not alg.flags() & QgsProcessingAlgorithm.Flag.FlagHideFromToolbox
+    assert alg.helpUrl() == generic.helpUrl() != ""
+
+
+def test_the_one_method_algorithm_gives_the_all_methods_result(provider, tmp_path):
+    """groundfilterpmf equals groundfilter with METHOD pmf, point for point."""
+    a, b = tmp_path / "a.laz", tmp_path / "b.laz"
+    ra = processing.run("lidarphoto:groundfilterpmf", {"INPUT": str(AHN3), "OUTPUT_CLOUD": str(a)})
+    rb = processing.run(ALG, {"INPUT": str(AHN3), "METHOD": 1, "OUTPUT_CLOUD": str(b)})
+    assert ra["GROUND_COUNT"] == rb["GROUND_COUNT"] > 0
+    assert np.array_equal(laspy.read(a).classification, laspy.read(b).classification)
