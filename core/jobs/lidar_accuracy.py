@@ -1,0 +1,220 @@
+"""``lidaraccuracy``: a LiDAR survey's swath-to-swath, within-swath and absolute vertical
+accuracy (ASPRS Positional Accuracy Standards, Ed. 2, 2023)."""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+from ..errors import InputError
+from .common import CSV_FILTER
+from .runner import JobResult, stages
+from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
+
+log = logging.getLogger(__name__)
+
+_D = Fields("quality.lidar_accuracy_options", "LidarAccuracyOptions")
+_LAS_SUFFIXES = (".las", ".laz")
+#: (parameter, LidarAccuracyOptions field, label, kind, unit, minimum, maximum, advanced)
+_NUMBERS = (
+    ("CELL_SIZE", "cell_size", "Cell size (about 2 x point spacing or more)", "number", "m",
+     0.01, 1000.0, False),
+    ("MIN_POINTS", "min_points", "Least returns of one swath in a cell", "integer", "", 4,
+     100000, False),
+    ("MAX_SLOPE", "max_slope_deg", "Largest slope of a smooth cell", "number", "degrees", 0.0,
+     89.0, False),
+    ("MAX_RESIDUAL", "max_residual", "Largest plane-fit rms of a smooth cell", "number", "m",
+     0.0, 100.0, False),
+    ("GPS_GAP", "gps_gap_s", "GPS-time gap that starts a new swath", "number", "s", 0.0,
+     1e9, True),
+    ("MIN_PAIR_CELLS", "min_pair_cells", "Least smooth cells of an assessed swath pair",
+     "integer", "", 1, 1e9, True),
+    ("V_CLASS_CM", "v_class_cm", "ASPRS vertical class (0 = report the class met)", "number",
+     "cm", 0.0, 10000.0, False),
+    ("SURVEY_SIGMA_V", "survey_sigma_v", "Check-point survey sigma in height", "number", "m",
+     0.0, 100.0, False),
+    ("TIN_RADIUS", "tin_radius", "Ground returns within this distance make the TIN", "number",
+     "m", 0.1, 10000.0, True),
+)  # fmt: skip
+
+SPEC = AlgorithmSpec(
+    name="lidaraccuracy",
+    title="LiDAR swath and vertical accuracy (ASPRS 2023)",
+    group="Quality",
+    group_id="quality",
+    summary="swath overlap difference, within-swath precision and NVA/VVA of a LiDAR survey",
+    description="""\
+Tells how good a LiDAR survey itself is, under the ASPRS Positional Accuracy Standards,
+Edition 2 (2023): relative accuracy between overlapping swaths, within-swath precision and
+absolute vertical accuracy at surveyed check points.
+
+## Swaths
+From the LAS point source id (flight line) when the cloud holds more than one, else from gaps
+in GPS time longer than GPS gap (the report says which).
+
+## Smooth hard cells
+On a north-up grid of Cell size (corners on multiples of it), a cell of a swath is smooth
+when it holds at least the least returns of that swath, no vegetation class (3-5), only single
+returns, and the least-squares plane through them has a slope at most Max slope and a residual
+rms at most Max residual (edges, walls and rough ground fail).
+
+## Figures
+Swath overlap difference dz = h_a - h_b (plane heights at the cell centre) per swath pair and
+overall: count, mean, RMSDz, max |dz|, surface-normal RMSD, the share beyond 0.8 and 1.6 times
+the class, and the tilt of dz across the overlap (a roll error shows as a cross-track slope).
+Within-swath precision per swath: pooled plane residual rms and the cells' Max Diff (range).
+Check points (CSV id, e, n, h, group = land cover): dz = LiDAR - check, the LiDAR height
+interpolated in a TIN of the ground returns (class 2); NVA (non-vegetated): RMSE_V with the
+survey sigma, 1.96 RMSE_V for comparison; VVA (groups such as vegetated, forest, brush, crops):
+RMSE and the 95th percentile of |dz|, reported only. Verdicts against a vertical class #-cm:
+within-swath Max Diff <= 0.6 #, swath RMSDz <= 0.8 #, swath max <= 1.6 #, NVA RMSE_V <= #
+with at least 30 check points (docs/formats.md "LiDAR accuracy").
+
+## Outputs
+HTML report, JSON of every figure, a GeoTIFF of dz with one band per swath pair, and the check
+points with the LiDAR heights as a check-point table (id, e, n, h, e_ref, n_ref, h_ref, group)
+that accuracyreport reads for the NSSDA and PEC-PCD sections.""",
+    params=(
+        Param("INPUT", "files", "Point clouds (LAS/LAZ files or folders)",
+              suffixes=_LAS_SUFFIXES, help="LAS/LAZ files of one survey, or folders of them"),
+        Param("CHECKPOINTS", "file", "Check points (CSV: id, e, n, h, group)", optional=True,
+              file_filter=CSV_FILTER, help="surveyed check points; group = land cover"),
+        Param("SWATH_SOURCE", "enum", "Swaths from", _D.swath_source,
+              options=Ref("quality.lidar_accuracy_options", "SWATH_SOURCES"),
+              labels=("point source id, else GPS time", "point source id", "GPS time gaps")),
+        *(
+            Param(key, kind, label, getattr(_D, field), unit=unit, minimum=minimum,
+                  maximum=maximum, advanced=advanced)
+            for key, field, label, kind, unit, minimum, maximum, advanced in _NUMBERS
+        ),
+        Param("OUTPUT_HTML", "file_out", "LiDAR accuracy report (HTML)",
+              file_filter="HTML files (*.html)"),
+        Param("OUTPUT_JSON", "file_out", "LiDAR accuracy figures (JSON)", optional=True,
+              create_by_default=False, file_filter="JSON files (*.json)"),
+        Param("OUTPUT_RASTER", "raster_out", "Swath overlap dz (GeoTIFF, a band per pair)",
+              optional=True, create_by_default=False),
+        Param("OUTPUT_CHECKPOINTS", "file_out", "Check points with LiDAR heights (CSV)",
+              optional=True, create_by_default=False, file_filter=CSV_FILTER),
+    ),  # fmt: skip
+    results=(
+        Result("RMSDZ", "number", "Swath-to-swath RMSDz, all pairs (m)"),
+        Result("SMOOTH_CELLS", "number", "Smooth cells compared"),
+        Result("NVA_RMSE", "number", "NVA RMSE_V (m; NaN without check points)"),
+    ),
+    tags=("lidar", "swath", "overlap", "accuracy", "asprs", "nva", "vva", "quality"),
+    references=("ASPRS (2023)",),
+)
+
+
+def _cloud_files(paths) -> list[str]:
+    files: list[str] = []
+    for p in paths or ():
+        path = Path(p)
+        if path.is_dir():
+            files += sorted(str(f) for f in path.iterdir() if f.suffix.lower() in _LAS_SUFFIXES)
+        else:
+            files.append(str(path))
+    if not files:
+        raise InputError("INPUT holds no LAS/LAZ file")
+    return files
+
+
+def _read(files: list[str], progress, should_stop):
+    """Every file's returns with the fields the check uses (those a file lacks: None)."""
+    import numpy as np
+
+    from ..io.pointcloud import read_info, read_points
+    from ..quality.lidar_accuracy import LidarCloud
+
+    parts: dict[str, list] = {}
+    crs = None
+    optional = ("classification", "number_of_returns", "point_source_id", "gps_time")
+    for k, f in enumerate(files):
+        info = read_info(f, require_crs=False)
+        crs = crs or info.crs
+        fields = ["x", "y", "z"] + [n for n in optional if n in info.dimensions]
+        arrays, _ = read_points(f, fields, require_crs=False, should_stop=should_stop)
+        for n in ("x", "y", "z", *optional):
+            parts.setdefault(n, []).append(arrays.get(n))
+        if progress is not None:
+            progress((k + 1) / len(files))
+    joined = {}
+    for n, arrs in parts.items():
+        joined[n] = None if any(a is None for a in arrs) else np.concatenate(arrs)
+    if joined["gps_time"] is not None and not np.any(joined["gps_time"]):
+        joined["gps_time"] = None
+    return LidarCloud(source=", ".join(files), **joined), crs
+
+
+def _checkpoints(path: str | None):
+    if not path:
+        return None
+    from ..io.checkpoints import read_point_table
+    from ..quality.lidar_accuracy import CheckPointSet
+
+    pts = read_point_table(path)
+    return CheckPointSet(tuple(pts.ids), pts.xyz, tuple(pts.groups), str(path))
+
+
+def _write_checkpoint_table(path: str, report) -> None:
+    import csv
+    import io
+
+    from ..io.atomic import write_text_atomic
+
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["id", "e", "n", "h", "e_ref", "n_ref", "h_ref", "group"])
+    cp, f = report.checkpoints, report.vertical
+    for i, p, g, dz in zip(cp.ids, cp.xyz, cp.groups, f.dz):
+        if dz == dz:  # outside the TIN: no LiDAR height
+            w.writerow([i, repr(float(p[0])), repr(float(p[1])), repr(float(p[2] + dz)),
+                        repr(float(p[0])), repr(float(p[1])), repr(float(p[2])), g])  # fmt: skip
+    write_text_atomic(path, buf.getvalue())
+
+
+def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
+    """Read the clouds (and check points), assess them, write the report and rasters."""
+    import json
+    import math
+
+    from ..errors import stop_if_asked
+    from ..io.atomic import write_text_atomic
+    from ..io.raster_write import GeoTiffWriter
+    from ..quality.lidar_accuracy import assess_lidar, report_dict
+    from ..quality.lidar_accuracy_html import render_html
+    from ..quality.lidar_accuracy_options import LidarAccuracyOptions
+    from ..quality.lidar_swaths import pair_rasters
+
+    options = options_from(LidarAccuracyOptions, SPEC, v)
+    read_p, assess_p = stages(progress, 1, 2)
+    cloud, crs = _read(_cloud_files(v.input), read_p, should_stop)
+    log.info("%d returns from %s", cloud.x.size, cloud.source)
+    report = assess_lidar(cloud, options, _checkpoints(v.checkpoints), assess_p, should_stop)
+    stop_if_asked(should_stop, "writing the report")
+    bands = [f"{p.swath_a}-{p.swath_b}" for p in report.pairs]
+    if out.requested("OUTPUT_RASTER"):
+        from ..io.atomic import atomic_path
+
+        g = report.grid
+        data = pair_rasters(report.pairs, g)
+        with atomic_path(out.path("OUTPUT_RASTER")) as tmp:
+            with GeoTiffWriter(tmp, g.cols, g.rows, data.shape[0], data.dtype,
+                               g.geotransform(), crs, nodata=float("nan"),
+                               metadata={"BANDS": ",".join(bands)}) as w:  # fmt: skip
+                w.write(data)
+    if out.requested("OUTPUT_CHECKPOINTS") and report.vertical is not None:
+        _write_checkpoint_table(out.path("OUTPUT_CHECKPOINTS"), report)
+    if out.requested("OUTPUT_JSON"):
+        text = json.dumps(report_dict(report, bands), indent=1, allow_nan=False)
+        write_text_atomic(out.path("OUTPUT_JSON"), text)
+    if out.requested("OUTPUT_HTML"):
+        write_text_atomic(out.path("OUTPUT_HTML"), render_html(report))
+    nva = report.vertical.nva_rmse_v if report.vertical is not None else math.nan
+    lines = [f"swaths from {report.swath_method}: {len(report.swath_counts)}"]
+    lines += [f"swaths {p.swath_a}-{p.swath_b}: {p.n} cells, RMSDz {p.stats()['rmsdz']:.4f} m"
+              for p in report.pairs]  # fmt: skip
+    lines += [f"{x.name}: {x.status} ({x.reason})" for x in report.verdicts]
+    results = {"RMSDZ": report.overall["rmsdz"], "SMOOTH_CELLS": report.overall["n"],
+               "NVA_RMSE": nva}  # fmt: skip
+    return JobResult(results=results, lines=lines, data=report)
