@@ -50,8 +50,7 @@ def ground_tin_heights(
     >>> ground_tin_heights(g, np.array([[2.5, 5.0]]), radius=20).lidar_h.round(12).tolist()
     [2.25]
     """
-    from scipy.interpolate import LinearNDInterpolator
-    from scipy.spatial import cKDTree
+    from scipy.spatial import Delaunay, cKDTree
 
     g = np.asarray(ground_xyz, dtype=np.float64)
     q = np.asarray(check_xy, dtype=np.float64).reshape(-1, 2)
@@ -72,10 +71,59 @@ def ground_tin_heights(
     if sub.shape[0] < 3:
         return CheckHeights(np.full(len(q), np.nan), nearest, int(sub.shape[0]))
     try:
-        tin = LinearNDInterpolator(sub[:, :2], sub[:, 2])
+        tri = Delaunay(sub[:, :2])
     except Exception as exc:  # qhull: all returns on one line
         raise InputError(f"the ground returns near the check points make no TIN: {exc}") from exc
-    return CheckHeights(np.asarray(tin(q), dtype=np.float64), nearest, int(sub.shape[0]))
+    return CheckHeights(_interpolate(tri, sub[:, 2], q), nearest, int(sub.shape[0]))
+
+
+def _barycentric(tri, simplex: NDArray[np.int64], q: NDArray) -> NDArray[np.float64]:
+    """(M, 3) barycentric coordinates of q[m] in triangle simplex[m]."""
+    v = tri.points[tri.simplices[simplex]]  # (M, 3, 2)
+    t = np.stack([v[:, 0] - v[:, 2], v[:, 1] - v[:, 2]], axis=-1)  # columns: edges to v2
+    rhs = q - v[:, 2]
+    det = t[:, 0, 0] * t[:, 1, 1] - t[:, 0, 1] * t[:, 1, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        b0 = (rhs[:, 0] * t[:, 1, 1] - rhs[:, 1] * t[:, 0, 1]) / det
+        b1 = (t[:, 0, 0] * rhs[:, 1] - t[:, 1, 0] * rhs[:, 0]) / det
+    return np.column_stack([b0, b1, 1.0 - b0 - b1])
+
+
+def _interpolate(tri, z: NDArray, q: NDArray, k: int = 12) -> NDArray[np.float64]:
+    """Linear interpolation in the TIN at q (NaN outside it).
+
+    scipy's find_simplex first builds the barycentric transform of every triangle (seconds
+    for 10^5 triangles), so the containing triangle is searched among those incident to the
+    k returns nearest to each point, and only points not found there (rare) go to
+    find_simplex. The result is the same triangle either way (ties on a shared edge give
+    the same height).
+    """
+    from scipy.spatial import cKDTree
+
+    flat = tri.simplices.ravel()
+    by_vertex = np.argsort(flat, kind="stable")
+    owner = by_vertex // 3
+    first = np.searchsorted(flat[by_vertex], np.arange(tri.npoints + 1))
+    near = cKDTree(tri.points).query(q, k=min(k, tri.npoints))[1].reshape(len(q), -1)
+    out = np.full(len(q), np.nan)
+    missing = []
+    for m in range(len(q)):
+        cand = np.unique(np.concatenate([owner[first[v] : first[v + 1]] for v in near[m]]))
+        b = _barycentric(tri, cand, np.broadcast_to(q[m], (cand.size, 2)))
+        inside = np.flatnonzero(np.all(b >= -1e-12, axis=1))
+        if inside.size:
+            j = inside[0]
+            out[m] = float(b[j] @ z[tri.simplices[cand[j]]])
+        else:
+            missing.append(m)
+    if missing:
+        rest = q[missing]
+        simplex = tri.find_simplex(rest)
+        ok = simplex >= 0
+        if ok.any():
+            b = _barycentric(tri, simplex[ok], rest[ok])
+            out[np.asarray(missing)[ok]] = np.sum(b * z[tri.simplices[simplex[ok]]], axis=1)
+    return out
 
 
 @dataclass(frozen=True)

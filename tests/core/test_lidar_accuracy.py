@@ -268,3 +268,16 @@ def test_heights_outside_the_tin_are_listed():
     g = np.array([[0, 0, 0.0], [1, 0, 1.0], [0, 1, 0.0]])
     h = ground_tin_heights(g, np.array([[5.0, 5.0]]), radius=100)
     assert np.isnan(h.lidar_h[0]) and isinstance(h, CheckHeights)
+
+
+def test_tin_heights_match_scipy_linear_interpolation():
+    from scipy.interpolate import LinearNDInterpolator
+
+    rng = np.random.default_rng(10)
+    g = np.column_stack([rng.uniform(0, 30, 2000), rng.uniform(0, 30, 2000),
+                         rng.normal(0, 1, 2000)])  # fmt: skip
+    q = np.vstack([rng.uniform(2, 28, (40, 2)), [[-5.0, -5.0]]])
+    h = ground_tin_heights(g, q, radius=100.0)
+    ref = LinearNDInterpolator(g[:, :2], g[:, 2])(q)
+    np.testing.assert_allclose(h.lidar_h[:-1], ref[:-1], atol=1e-9)
+    assert np.isnan(h.lidar_h[-1]) and np.isnan(ref[-1])
