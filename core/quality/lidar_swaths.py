@@ -4,7 +4,8 @@ pair of swaths and the within-swath precision (smooth-surface repeatability).
 
 Frames: x, y, z in one projected CRS (the cloud's units, metres for the standard's classes);
 the grid is north-up, its corner on multiples of the cell size so that a cell is the same
-cell whatever the extent read. A cell of one swath is *smooth* when it holds at least
+cell whatever the extent read; a cell holds the returns on its west and north edges (columns
+counted from the west, rows from the north). A cell of one swath is *smooth* when it holds at least
 ``min_points`` returns of that swath, none of a vegetation class, only single returns, and the
 least-squares plane ``z = h + gx (x - xc) + gy (y - yc)`` through them (xc, yc: the cell
 centre) has a slope at most ``max_slope_deg`` and residual rms at most ``max_residual``. Its
