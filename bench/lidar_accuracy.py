@@ -32,8 +32,9 @@ def independent_rmsdz(cloud, pair, swath, cell: float) -> tuple[float, float]:
     for k in range(pair.n):
         lo, hi = np.searchsorted(xs, [pair.x[k] - half, pair.x[k] + half])
         idx = order[lo:hi]
-        idx = idx[(cloud.y[idx] > pair.y[k] - half) & (cloud.y[idx] <= pair.y[k] + half)
-                  & (cloud.x[idx] < pair.x[k] + half) & ~np.isin(cloud.classification[idx], (7, 18))]  # fmt: skip
+        keep = (cloud.y[idx] > pair.y[k] - half) & (cloud.y[idx] <= pair.y[k] + half)
+        keep &= (cloud.x[idx] < pair.x[k] + half) & ~np.isin(cloud.classification[idx], (7, 18))
+        idx = idx[keep]
         h = []
         for s in (pair.swath_a, pair.swath_b):
             m = idx[swath[idx] == s]
@@ -49,18 +50,22 @@ def main() -> int:
         return 1
     cloud, _ = _read(FILES, None, None)
     swath = cloud.point_source_id.astype(np.int64)
+    counts = zip(*np.unique(swath, return_counts=True))
     print(f"{cloud.x.size} returns; swaths (point source id): "
-          + ", ".join(f"{s} ({n})" for s, n in zip(*np.unique(swath, return_counts=True))))  # fmt: skip
-    for cell in (1.0, 1.5, 2.0):
-        o = LidarAccuracyOptions(cell_size=cell, v_class_cm=10.0)
+          + ", ".join(f"{s} ({n})" for s, n in counts))  # fmt: skip
+    for cell, hard in ((1.0, ()), (1.0, (2, 6)), (1.5, ()), (2.0, ())):
+        o = LidarAccuracyOptions(cell_size=cell, v_class_cm=10.0, hard_classes=hard)
         t0 = time.perf_counter()
         rep = assess_lidar(cloud, o)
         dt = time.perf_counter() - t0
         c = rep.cells
-        print(f"\n### cell {cell:g} m ({dt:.1f} s): {c.n.size} swath cells fitted, "
+        print(f"\n### cell {cell:g} m, hard classes {hard or 'any'} ({dt:.1f} s): "
+              f"{c.n.size} swath cells fitted, "
               f"{int(c.smooth.sum())} smooth; rejected {c.rejected}")  # fmt: skip
-        print("| swaths | cells | mean dz (m) | RMSDz (m) | max abs dz (m) | > 8 cm | > 16 cm "
-              "| tilt across a (mm/m) | independent RMSDz (m) | independent max (m) |")
+        print(
+            "| swaths | cells | mean dz (m) | RMSDz (m) | max abs dz (m) | > 8 cm | > 16 cm "
+            "| tilt across a (mm/m) | independent RMSDz (m) | independent max (m) |"
+        )
         print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
         for p in rep.pairs:
             st = p.stats()
@@ -74,11 +79,15 @@ def main() -> int:
         print(f"| all | {o_['n']} | {o_['mean']:.4f} | {o_['rmsdz']:.4f} | {o_['max_abs']:.4f} "
               f"| {o_.get('share_over_rmsdz_limit', 0):.2%} | "
               f"{o_.get('share_over_max_limit', 0):.2%} | | | |")  # fmt: skip
-        print("\n| swath | smooth cells | residual rms (m) | median Max Diff (m) | "
-              "95th pct (m) | max (m) |\n| --- | --- | --- | --- | --- | --- |")
+        print(
+            "\n| swath | smooth cells | residual rms (m) | median Max Diff (m) | "
+            "95th pct (m) | max (m) |\n| --- | --- | --- | --- | --- | --- |"
+        )
         for w in rep.precision:
-            print(f"| {w.swath} | {w.cells} | {w.rms:.4f} | {w.range_median:.4f} | "
-                  f"{w.range_p95:.4f} | {w.range_max:.4f} |")
+            print(
+                f"| {w.swath} | {w.cells} | {w.rms:.4f} | {w.range_median:.4f} | "
+                f"{w.range_p95:.4f} | {w.range_max:.4f} |"
+            )
     return 0
 
 

@@ -75,27 +75,81 @@ HTML report, JSON of every figure, a GeoTIFF of dz with one band per swath pair,
 points with the LiDAR heights as a check-point table (id, e, n, h, e_ref, n_ref, h_ref, group)
 that accuracyreport reads for the NSSDA and PEC-PCD sections.""",
     params=(
-        Param("INPUT", "files", "Point clouds (LAS/LAZ files or folders)",
-              suffixes=_LAS_SUFFIXES, help="LAS/LAZ files of one survey, or folders of them"),
-        Param("CHECKPOINTS", "file", "Check points (CSV: id, e, n, h, group)", optional=True,
-              file_filter=CSV_FILTER, help="surveyed check points; group = land cover"),
-        Param("SWATH_SOURCE", "enum", "Swaths from", _D.swath_source,
-              options=Ref("quality.lidar_accuracy_options", "SWATH_SOURCES"),
-              labels=("point source id, else GPS time", "point source id", "GPS time gaps")),
+        Param(
+            "INPUT",
+            "files",
+            "Point clouds (LAS/LAZ files or folders)",
+            suffixes=_LAS_SUFFIXES,
+            help="LAS/LAZ files of one survey, or folders of them",
+        ),
+        Param(
+            "CHECKPOINTS",
+            "file",
+            "Check points (CSV: id, e, n, h, group)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            help="surveyed check points; group = land cover",
+        ),
+        Param(
+            "SWATH_SOURCE",
+            "enum",
+            "Swaths from",
+            _D.swath_source,
+            options=Ref("quality.lidar_accuracy_options", "SWATH_SOURCES"),
+            labels=("point source id, else GPS time", "point source id", "GPS time gaps"),
+        ),
+        Param(
+            "HARD_CLASSES",
+            "string",
+            "Hard classes only (e.g. 2,6; empty: any but vegetation)",
+            "",
+            optional=True,
+            help="LAS classes of hard surfaces; a cell holding another "
+            "class is not compared (class 1 holds cars that move between flights)",
+        ),
         *(
-            Param(key, kind, label, getattr(_D, field), unit=unit, minimum=minimum,
-                  maximum=maximum, advanced=advanced)
+            Param(
+                key,
+                kind,
+                label,
+                getattr(_D, field),
+                unit=unit,
+                minimum=minimum,
+                maximum=maximum,
+                advanced=advanced,
+            )
             for key, field, label, kind, unit, minimum, maximum, advanced in _NUMBERS
         ),
-        Param("OUTPUT_HTML", "file_out", "LiDAR accuracy report (HTML)",
-              file_filter="HTML files (*.html)"),
-        Param("OUTPUT_JSON", "file_out", "LiDAR accuracy figures (JSON)", optional=True,
-              create_by_default=False, file_filter="JSON files (*.json)"),
-        Param("OUTPUT_RASTER", "raster_out", "Swath overlap dz (GeoTIFF, a band per pair)",
-              optional=True, create_by_default=False),
-        Param("OUTPUT_CHECKPOINTS", "file_out", "Check points with LiDAR heights (CSV)",
-              optional=True, create_by_default=False, file_filter=CSV_FILTER),
-    ),  # fmt: skip
+        Param(
+            "OUTPUT_HTML",
+            "file_out",
+            "LiDAR accuracy report (HTML)",
+            file_filter="HTML files (*.html)",
+        ),
+        Param(
+            "OUTPUT_JSON",
+            "file_out",
+            "LiDAR accuracy figures (JSON)",
+            optional=True,
+            create_by_default=False,
+            file_filter="JSON files (*.json)",
+        ),
+        Param(
+            "OUTPUT_RASTER",
+            "raster_out",
+            "Swath overlap dz (GeoTIFF, a band per pair)",
+            optional=True,
+            create_by_default=False,
+        ),
+        Param(
+            "OUTPUT_CHECKPOINTS",
+            "file_out",
+            "Check points with LiDAR heights (CSV)",
+            optional=True,
+            create_by_default=False,
+            file_filter=CSV_FILTER,
+        ),
+    ),
     results=(
         Result("RMSDZ", "number", "Swath-to-swath RMSDz, all pairs (m)"),
         Result("SMOOTH_CELLS", "number", "Smooth cells compared"),
@@ -104,6 +158,24 @@ that accuracyreport reads for the NSSDA and PEC-PCD sections.""",
     tags=("lidar", "swath", "overlap", "accuracy", "asprs", "nva", "vva", "quality"),
     references=("ASPRS (2023)",),
 )
+
+
+def _classes(text: str) -> tuple[int, ...]:
+    """LAS classes from "2,6" or "2 6" (empty: none).
+
+    >>> _classes("2, 6")
+    (2, 6)
+    """
+    parts = text.replace(",", " ").replace(";", " ").split()
+    try:
+        classes = tuple(int(p) for p in parts)
+    except ValueError:
+        raise InputError(
+            f"HARD_CLASSES must be integers separated by commas, got {text!r}"
+        ) from None
+    if any(not 0 <= c <= 255 for c in classes):
+        raise InputError(f"HARD_CLASSES: classes are 0-255, got {text!r}")
+    return classes
 
 
 def _cloud_files(paths) -> list[str]:
@@ -186,7 +258,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..quality.lidar_accuracy_options import LidarAccuracyOptions
     from ..quality.lidar_swaths import pair_rasters
 
-    options = options_from(LidarAccuracyOptions, SPEC, v)
+    options = options_from(LidarAccuracyOptions, SPEC, v,
+                           hard_classes=_classes(v.hard_classes or ""))  # fmt: skip
     read_p, assess_p = stages(progress, 1, 2)
     cloud, crs = _read(_cloud_files(v.input), read_p, should_stop)
     log.info("%d returns from %s", cloud.x.size, cloud.source)

@@ -39,7 +39,15 @@ from .lidar_swaths import (
 from .lidar_vertical import VerticalFigures, ground_tin_heights, vertical_figures
 from .standards import _TOL, Verdict
 
-__all__ = ["LidarAccuracyReport", "LidarCloud", "assess_lidar"]
+__all__ = ["LIDAR_JSON_TOP_KEYS", "LidarAccuracyReport", "LidarCloud", "assess_lidar"]
+
+#: The top-level keys of the JSON (docs/formats.md "LiDAR accuracy"); the last two only when
+#: check points were given.
+LIDAR_JSON_TOP_KEYS = (
+    "standard", "source", "swath_method", "swaths", "grid", "cells", "pairs", "overall",
+    "within_swath", "limits", "raster_bands", "verdicts", "notes", "options", "vertical",
+    "check_points",
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -134,10 +142,24 @@ def _relative_verdicts(
                                    f"{what} = {_cm(v)} on {st['n']} cells: "
                                    f"{_class_met(v, factor)}{few}", v, None))  # fmt: skip
             continue
-        out.append(_limit_verdict(f"{name}: swath-to-swath RMSDz", st["rmsdz"],
-                                  lim["swath_rmsdz"], enough, f"RMSDz on {st['n']} cells"))
-        out.append(_limit_verdict(f"{name}: swath-to-swath max difference", st["max_abs"],
-                                  lim["swath_max"], enough, f"max |dz| on {st['n']} cells"))
+        out.append(
+            _limit_verdict(
+                f"{name}: swath-to-swath RMSDz",
+                st["rmsdz"],
+                lim["swath_rmsdz"],
+                enough,
+                f"RMSDz on {st['n']} cells",
+            )
+        )
+        out.append(
+            _limit_verdict(
+                f"{name}: swath-to-swath max difference",
+                st["max_abs"],
+                lim["swath_max"],
+                enough,
+                f"max |dz| on {st['n']} cells",
+            )
+        )
     for p in precision:
         name = f"swath {p.swath}: within-swath precision (Max Diff)"
         enough = p.cells >= o.min_pair_cells
@@ -274,11 +296,18 @@ def report_dict(report: LidarAccuracyReport, raster_bands: Sequence[str] = ()) -
         "source": report.source,
         "swath_method": report.swath_method,
         "swaths": {str(k): v for k, v in report.swath_counts.items()},
-        "grid": {"x0": report.grid.x0, "y_top": report.grid.y_top, "cell": report.grid.cell,
-                 "cols": report.grid.cols, "rows": report.grid.rows},  # fmt: skip
-        "cells": {"fitted": int(report.cells.n.size),
-                  "smooth": int(np.count_nonzero(report.cells.smooth)),
-                  "rejected": dict(rejected)},  # fmt: skip
+        "grid": {
+            "x0": report.grid.x0,
+            "y_top": report.grid.y_top,
+            "cell": report.grid.cell,
+            "cols": report.grid.cols,
+            "rows": report.grid.rows,
+        },
+        "cells": {
+            "fitted": int(report.cells.n.size),
+            "smooth": int(np.count_nonzero(report.cells.smooth)),
+            "rejected": dict(rejected),
+        },
         "pairs": pair_rows(report),
         "overall": report.overall,
         "within_swath": [p.__dict__ for p in report.precision],

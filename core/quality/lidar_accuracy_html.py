@@ -59,7 +59,7 @@ def _map(report: LidarAccuracyReport, limit: float) -> str:
     g = report.grid
     w = 480
     scale = w / max(g.cols, 1)
-    h = int(math.ceil(g.rows * scale))
+    h = math.ceil(g.rows * scale)
     rects = []
     for p in report.pairs:
         row, col = np.divmod(p.cells, g.cols)
@@ -70,9 +70,11 @@ def _map(report: LidarAccuracyReport, limit: float) -> str:
             green = int(255 * (1 - abs(v)))
             rects.append(f'<rect x="{c * scale:.2f}" y="{r * scale:.2f}" width="{scale:.2f}" '
                          f'height="{scale:.2f}" fill="rgb({red},{green},{blue})"/>')  # fmt: skip
-    return (f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" '
-            f'style="border:1px solid #ccc;background:#f4f4f4">{"".join(rects)}</svg>'
-            f"<p>dz of every pair (red: a above b), colour limit &plusmn;{limit:.3f} m</p>")  # fmt: skip
+    return (
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" '
+        f'style="border:1px solid #ccc;background:#f4f4f4">{"".join(rects)}</svg>'
+        f"<p>dz of every pair (red: a above b), colour limit &plusmn;{limit:.3f} m</p>"
+    )
 
 
 def render_html(report: LidarAccuracyReport) -> str:
@@ -140,7 +142,7 @@ def render_html(report: LidarAccuracyReport) -> str:
         parts += [f"<li>{escape(n)}</li>" for n in report.notes]
         parts.append("</ul>")
     parts.append(
-        "<p>Limits (our reading of ASPRS Ed. 2 section 7, docs/formats.md \"LiDAR accuracy\"): "
+        '<p>Limits (our reading of ASPRS Ed. 2 section 7, docs/formats.md "LiDAR accuracy"): '
         "within-swath Max Diff &le; 0.6, swath-to-swath RMSDz &le; 0.8 and max difference "
         "&le; 1.6 times the vertical class; NVA RMSE_V &le; the class with at least 30 check "
         "points; VVA reported only.</p></body></html>"

@@ -54,6 +54,9 @@ class LidarAccuracyOptions:
     max_step: float = 0.30
     #: A cell holding any return of these classes is not hard (vegetation, LAS 3-5).
     vegetation_classes: tuple[int, ...] = (3, 4, 5)
+    #: When given, a cell holding any return of another class is not hard (e.g. (2, 6):
+    #: ground and building; class 1 "unclassified" holds cars that move between flights).
+    hard_classes: tuple[int, ...] = ()
     #: Returns of these classes are ignored (noise 7, high noise 18).
     ignore_classes: tuple[int, ...] = (7, 18)
     #: Only cells whose returns are all single returns (number of returns 1) are smooth.

@@ -44,7 +44,15 @@ __all__ = [
 ]
 
 #: Why a cell of a swath is not smooth (the counts the report shows), in the order tested.
-REJECTIONS = ("few returns", "vegetation class", "multiple returns", "slope", "rough", "step")
+REJECTIONS = (
+    "few returns",
+    "vegetation class",
+    "not a hard class",
+    "multiple returns",
+    "slope",
+    "rough",
+    "step",
+)
 
 
 def identify_swaths(
@@ -106,8 +114,8 @@ class CellGrid:
             raise InputError(f"CELL_SIZE must be > 0, got {cell}")
         x0 = math.floor(float(np.min(x)) / cell) * cell
         y_top = (math.floor(float(np.max(y)) / cell) + 1) * cell
-        cols = int(math.floor((float(np.max(x)) - x0) / cell)) + 1
-        rows = int(math.floor((y_top - float(np.min(y))) / cell)) + 1
+        cols = math.floor((float(np.max(x)) - x0) / cell) + 1
+        rows = math.floor((y_top - float(np.min(y))) / cell) + 1
         return cls(x0, y_top, float(cell), cols, rows)
 
     def geotransform(self) -> tuple[float, float, float, float, float, float]:
@@ -223,6 +231,11 @@ def swath_cells(
     if cls is not None and options.vegetation_classes:
         veg = np.isin(cls[keep][order], options.vegetation_classes)
         tests.append(np.add.reduceat(veg.astype(np.int64), starts) == 0)
+    else:
+        tests.append(np.ones(n.size, dtype=bool))
+    if cls is not None and options.hard_classes:
+        soft = ~np.isin(cls[keep][order], options.hard_classes)
+        tests.append(np.add.reduceat(soft.astype(np.int64), starts) == 0)
     else:
         tests.append(np.ones(n.size, dtype=bool))
     if number_of_returns is not None and options.single_returns:

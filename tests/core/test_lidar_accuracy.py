@@ -96,9 +96,9 @@ def test_vegetation_and_building_edges_are_not_smooth():
     in_tree = ((cx + half > VEG[0]) & (cx - half < VEG[1]) & (cy + half > VEG[2])
                & (cy - half < VEG[3]))  # fmt: skip
     x0, x1, y0, y1 = BUILDING
-    on_edge = (
-        ((np.abs(cx - x0) < half) | (np.abs(cx - x1) < half)) & (cy > y0) & (cy < y1)
-    ) | (((np.abs(cy - y0) < half) | (np.abs(cy - y1) < half)) & (cx > x0) & (cx < x1))
+    on_edge = (((np.abs(cx - x0) < half) | (np.abs(cx - x1) < half)) & (cy > y0) & (cy < y1)) | (
+        ((np.abs(cy - y0) < half) | (np.abs(cy - y1) < half)) & (cx > x0) & (cx < x1)
+    )
     assert in_tree.sum() > 100 and on_edge.sum() > 50  # the planted features are there
     assert not np.any(cells.smooth & in_tree)
     assert not np.any(cells.smooth & on_edge)
@@ -232,13 +232,16 @@ def test_job_writes_report_json_raster_and_checkpoint_table(tmp_path):
     }, progress=seen.append)  # fmt: skip
     assert seen[-1] == pytest.approx(1.0)
     d = json.loads((tmp_path / "r.json").read_text())
+    from lidarphoto.core.quality.lidar_accuracy import LIDAR_JSON_TOP_KEYS
+
+    assert tuple(d) == LIDAR_JSON_TOP_KEYS
     assert d["swath_method"] == "point_source_id" and d["raster_bands"] == ["11-12"]
     assert d["pairs"][0]["rmsdz"] == res.results["RMSDZ"]
     # the millimetre LAS scale leaves the ground within 0.5 mm: the check points' planted errors
     assert d["vertical"]["nva_n"] == 30 and d["vertical"]["vva_n"] == 5
     from lidarphoto.core.io.raster import read_geotiff
 
-    dz, gt, _ = read_geotiff(tmp_path / "dz.tif")
+    dz, _gt, _ = read_geotiff(tmp_path / "dz.tif")
     assert np.count_nonzero(np.isfinite(dz)) == d["pairs"][0]["n"]
     assert "swath-to-swath RMSDz" in (tmp_path / "r.html").read_text()
     text = (tmp_path / "cp_lidar.csv").read_text().splitlines()
