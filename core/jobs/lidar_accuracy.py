@@ -25,6 +25,8 @@ _NUMBERS = (
      89.0, False),
     ("MAX_RESIDUAL", "max_residual", "Largest plane-fit rms of a smooth cell", "number", "m",
      0.0, 100.0, False),
+    ("MAX_STEP", "max_step", "Largest step to a neighbour cell's plane", "number", "m", 0.0,
+     1000.0, True),
     ("GPS_GAP", "gps_gap_s", "GPS-time gap that starts a new swath", "number", "s", 0.0,
      1e9, True),
     ("MIN_PAIR_CELLS", "min_pair_cells", "Least smooth cells of an assessed swath pair",
@@ -55,8 +57,9 @@ in GPS time longer than GPS gap (the report says which).
 ## Smooth hard cells
 On a north-up grid of Cell size (corners on multiples of it), a cell of a swath is smooth
 when it holds at least the least returns of that swath, no vegetation class (3-5), only single
-returns, and the least-squares plane through them has a slope at most Max slope and a residual
-rms at most Max residual (edges, walls and rough ground fail).
+returns (and, with Hard classes, only those classes), the least-squares plane through them has
+a slope at most Max slope and a residual rms at most Max residual, and the planes of its
+neighbour cells continue it within Max step (edges, walls and rough ground fail).
 
 ## Figures
 Swath overlap difference dz = h_a - h_b (plane heights at the cell centre) per swath pair and
