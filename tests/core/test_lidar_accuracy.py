@@ -318,3 +318,25 @@ def test_ahn3_overlap_difference_matches_an_independent_computation():
         assert st["rmsdz"] == pytest.approx(float(np.sqrt(np.mean(dz**2))), abs=1e-9)
         assert st["max_abs"] == pytest.approx(float(np.max(np.abs(dz))), abs=1e-9)
         assert st["rmsdz"] < 0.05  # AHN3's stated systematic and stochastic errors: 5 cm each
+
+
+def test_checkpoint_table_feeds_the_accuracy_report(tmp_path):
+    """OUTPUT_CHECKPOINTS read by accuracyreport: its ASPRS RMSE_U is our NVA RMSE (all points
+    non-vegetated), its horizontal discrepancies zero."""
+    from lidarphoto.core.jobs import accuracy_report
+
+    cloud = _survey(seed=8)
+    _write_las(tmp_path / "survey.las", cloud)
+    cps, _ = _checkpoints(30, 0, seed=12)
+    rows = [f"{i},{float(p[0])!r},{float(p[1])!r},{float(p[2])!r},open"
+            for i, p in zip(cps.ids, cps.xyz)]  # fmt: skip
+    (tmp_path / "cp.csv").write_text("id,e,n,h,group\n" + "\n".join(rows) + "\n")
+    ours = run_job(lidar_accuracy, {
+        "INPUT": [str(tmp_path / "survey.las")], "CHECKPOINTS": str(tmp_path / "cp.csv"),
+        "OUTPUT_HTML": str(tmp_path / "r.html"), "OUTPUT_CHECKPOINTS": str(tmp_path / "t.csv"),
+    })  # fmt: skip
+    theirs = run_job(accuracy_report, {"INPUT": str(tmp_path / "t.csv"),
+                                       "OUTPUT_HTML": str(tmp_path / "a.html")})  # fmt: skip
+    assert ours.data.vertical.nva_n == 30
+    assert theirs.results["RMSE_U"] == pytest.approx(ours.results["NVA_RMSE"], abs=1e-9)
+    assert theirs.results["RMSE_HORIZONTAL"] == 0.0
