@@ -7,6 +7,7 @@ import logging
 from pathlib import Path
 
 from ..errors import InputError
+from .checks import check_memory
 from .common import CSV_FILTER
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
@@ -15,6 +16,9 @@ log = logging.getLogger(__name__)
 
 _D = Fields("quality.lidar_accuracy_options", "LidarAccuracyOptions")
 _LAS_SUFFIXES = (".las", ".laz")
+#: Memory per return: the arrays read (36 B) and the cell fit's sorted copies, offsets,
+#: products and residuals (about 20 float64 arrays); rounded up.
+BYTES_PER_RETURN = 200
 #: (parameter, LidarAccuracyOptions field, label, kind, unit, minimum, maximum, advanced)
 _NUMBERS = (
     ("CELL_SIZE", "cell_size", "Cell size (about 2 x point spacing or more)", "number", "m",
@@ -204,8 +208,13 @@ def _read(files: list[str], progress, should_stop):
     parts: dict[str, list] = {}
     crs = None
     optional = ("classification", "number_of_returns", "point_source_id", "gps_time")
-    for k, f in enumerate(files):
-        info = read_info(f, require_crs=False)
+    infos = [read_info(f, require_crs=False) for f in files]
+    total = sum(i.point_count for i in infos)
+    check_memory(total * BYTES_PER_RETURN, f"INPUT: {total} returns",
+                 "assess the survey in parts (a tiled run is not implemented yet)")  # fmt: skip
+    for k, (f, info) in enumerate(zip(files, infos)):
+        if crs is not None and info.crs is not None and not info.crs.equals(crs):
+            raise InputError(f"its CRS differs from {files[0]}'s: one survey, one CRS", path=f)
         crs = crs or info.crs
         fields = ["x", "y", "z"] + [n for n in optional if n in info.dimensions]
         arrays, _ = read_points(f, fields, require_crs=False, should_stop=should_stop)
@@ -273,6 +282,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         from ..io.atomic import atomic_path
 
         g = report.grid
+        check_memory(4.0 * max(len(bands), 1) * g.rows * g.cols,
+                     f"OUTPUT_RASTER: {len(bands)} band(s) of {g.cols} x {g.rows} cells",
+                     "use a larger CELL_SIZE")  # fmt: skip
         data = pair_rasters(report.pairs, g)
         with atomic_path(out.path("OUTPUT_RASTER")) as tmp:
             with GeoTiffWriter(tmp, g.cols, g.rows, data.shape[0], data.dtype,

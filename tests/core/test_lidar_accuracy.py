@@ -340,3 +340,17 @@ def test_checkpoint_table_feeds_the_accuracy_report(tmp_path):
     assert ours.data.vertical.nva_n == 30
     assert theirs.results["RMSE_U"] == pytest.approx(ours.results["NVA_RMSE"], abs=1e-9)
     assert theirs.results["RMSE_HORIZONTAL"] == 0.0
+
+
+def test_bad_inputs_are_named(tmp_path):
+    from lidarphoto.core.errors import InputError
+
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(InputError, match="INPUT holds no LAS/LAZ"):
+        run_job(lidar_accuracy, {"INPUT": [str(tmp_path / "empty")],
+                                 "OUTPUT_HTML": str(tmp_path / "r.html")})  # fmt: skip
+    _write_las(tmp_path / "s.las", _survey(seed=2))
+    with pytest.raises(InputError, match="HARD_CLASSES"):
+        run_job(lidar_accuracy, {"INPUT": [str(tmp_path / "s.las")], "HARD_CLASSES": "2,x",
+                                 "OUTPUT_HTML": str(tmp_path / "r.html")})  # fmt: skip
+    assert not (tmp_path / "r.html").exists()
