@@ -17,6 +17,7 @@ range (max - min) of its plane residuals.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -35,6 +36,8 @@ __all__ = [
     "PairDifference",
     "SwathCells",
     "SwathPrecision",
+    "finish_cells",
+    "fit_cells",
     "identify_swaths",
     "overlap_differences",
     "pair_rasters",
@@ -156,6 +159,25 @@ def _group_sums(values: list[NDArray], starts: NDArray) -> list[NDArray]:
     return [np.add.reduceat(v, starts) for v in values]
 
 
+@dataclass(frozen=True)
+class CellFits:
+    """The plane fits of the (swath, cell) groups of one set of points (a tile or the whole
+    cloud) and the per-cell tests passed (``passed[:, k]``: REJECTIONS[k], the neighbour step
+    excepted: it needs the neighbours, :func:`finish_cells`)."""
+
+    swath: NDArray[np.int64]
+    cell: NDArray[np.int64]
+    n: NDArray[np.int64]
+    height: NDArray[np.float64]
+    gx: NDArray[np.float64]
+    gy: NDArray[np.float64]
+    rms: NDArray[np.float64]
+    ssr: NDArray[np.float64]
+    range: NDArray[np.float64]
+    solvable: NDArray[np.bool_]
+    passed: NDArray[np.bool_]
+
+
 def swath_cells(
     x: NDArray,
     y: NDArray,
@@ -178,6 +200,24 @@ def swath_cells(
     >>> c.n.tolist(), np.round(c.gx, 12).tolist(), c.smooth.tolist()
     ([25, 25, 25, 25], [0.1, 0.1, 0.1, 0.1], [True, True, True, True])
     """
+    fits = fit_cells(x, y, z, swath, grid, options, classification, number_of_returns)
+    return finish_cells([fits], grid, options)
+
+
+def fit_cells(
+    x: NDArray,
+    y: NDArray,
+    z: NDArray,
+    swath: NDArray,
+    grid: CellGrid,
+    options: LidarAccuracyOptions,
+    classification: NDArray | None = None,
+    number_of_returns: NDArray | None = None,
+    own: tuple[float, float, float, float] | None = None,
+) -> CellFits:
+    """The plane fits and per-cell tests of :func:`swath_cells`; with ``own`` (xmin, ymin,
+    xmax, ymax, half-open) only the cells whose centre lies in it (a tile's cells: the points
+    given must hold every return of those cells)."""
     x, y, z = (np.asarray(a, dtype=np.float64) for a in (x, y, z))
     keep = np.ones(x.size, dtype=bool)
     cls = None if classification is None else np.asarray(classification)
@@ -195,7 +235,11 @@ def swath_cells(
     order = np.lexsort((z, y, x, key))
     key = key[order]
     if key.size == 0:
-        raise InputError("no returns inside the grid")
+        if own is None:
+            raise InputError("no returns inside the grid")
+        e, b = np.zeros(0), np.zeros(0, bool)
+        i = np.zeros(0, np.int64)
+        return CellFits(i, i, i, e, e, e, e, e, e, b, np.zeros((0, len(REJECTIONS) - 1), bool))
     starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
     n = np.diff(np.r_[starts, key.size])
     gkey = key[starts]
@@ -245,33 +289,59 @@ def swath_cells(
         tests.append(np.ones(n.size, dtype=bool))
     tests.append(slope <= options.max_slope_deg)
     tests.append(rms <= options.max_residual)
-    height = zmean + p[:, 0]
-    tests.append(_continuous(gkey, gcell, height, p, solvable, grid, options.max_step))
-    smooth = np.ones(n.size, dtype=bool)
+    keep_g = np.ones(n.size, dtype=bool)
+    if own is not None:
+        keep_g = (cx >= own[0]) & (cx < own[2]) & (cy >= own[1]) & (cy < own[3])
+    k = keep_g
+    return CellFits(
+        swath=names[gkey // ncell][k],
+        cell=gcell[k],
+        n=n.astype(np.int64)[k],
+        height=(zmean + p[:, 0])[k],
+        gx=p[:, 1][k],
+        gy=p[:, 2][k],
+        rms=np.where(solvable, rms, np.nan)[k],
+        ssr=ssr[k],
+        range=rng[k],
+        solvable=solvable[k],
+        passed=np.column_stack(tests)[k],
+    )
+
+
+def finish_cells(fits: Sequence[CellFits], grid: CellGrid, options: LidarAccuracyOptions):
+    """Join the fits of tiles (each cell in one of them), test each cell against its
+    neighbours' planes and flag the smooth ones: a :class:`SwathCells` sorted by swath, cell
+    (the same whatever the tiling)."""
+    parts = list(fits)
+    cat = {f: np.concatenate([getattr(p, f) for p in parts]) for f in CellFits.__dataclass_fields__}
+    order = np.lexsort((cat["cell"], cat["swath"]))
+    c = {f: v[order] for f, v in cat.items()}
+    sidx = np.unique(c["swath"], return_inverse=True)[1]
+    ncell = grid.rows * grid.cols
+    gkey = sidx.astype(np.int64) * ncell + c["cell"]
+    if np.any(np.diff(gkey) == 0):
+        raise ValueError("a cell was fitted in two tiles")
+    step = _continuous(gkey, c["cell"], c["height"], c["gx"], c["gy"], c["solvable"], grid,
+                       options.max_step)  # fmt: skip
+    tests = [*c["passed"].T, step]
+    smooth = np.ones(gkey.size, dtype=bool)
     rejected: dict[str, int] = {}
     for name, ok in zip(REJECTIONS, tests):
         rejected[name] = int(np.count_nonzero(smooth & ~ok))
         smooth &= ok
     return SwathCells(
-        swath=names[gkey // ncell],
-        cell=gcell,
-        n=n.astype(np.int64),
-        height=height,
-        gx=p[:, 1],
-        gy=p[:, 2],
-        rms=np.where(solvable, rms, np.nan),
-        ssr=ssr,
-        range=rng,
-        smooth=smooth,
+        swath=c["swath"], cell=c["cell"], n=c["n"], height=c["height"], gx=c["gx"],
+        gy=c["gy"], rms=c["rms"], ssr=c["ssr"], range=c["range"], smooth=smooth,
         rejected=rejected,
-    )
+    )  # fmt: skip
 
 
 def _continuous(
     gkey: NDArray[np.int64],
     gcell: NDArray[np.int64],
     height: NDArray[np.float64],
-    p: NDArray[np.float64],
+    gx: NDArray[np.float64],
+    gy: NDArray[np.float64],
     solvable: NDArray[np.bool_],
     grid: CellGrid,
     max_step: float,
@@ -288,7 +358,7 @@ def _continuous(
         j = np.clip(np.searchsorted(gkey, want), 0, gkey.size - 1)
         found = inside & (gkey[j] == want) & solvable[j]
         # rows grow southwards: one row down is -c in y
-        predicted = height + p[:, 1] * (dcol * c) - p[:, 2] * (drow * c)
+        predicted = height + gx * (dcol * c) - gy * (drow * c)
         ok &= ~found | (np.abs(height[j] - predicted) <= max_step)
     return ok
 
