@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from lidarphoto.core.jobs.lidar_accuracy import _read
+from lidarphoto.core.jobs.lidar_accuracy import _infos, _read
 from lidarphoto.core.quality.lidar_accuracy import assess_lidar
 from lidarphoto.core.quality.lidar_accuracy_options import LidarAccuracyOptions
 
@@ -48,7 +48,7 @@ def main() -> int:
     if not all(Path(f).exists() for f in FILES):
         print(f"AHN3 crops not found in {DATA}")
         return 1
-    cloud, _ = _read(FILES, None, None)
+    cloud = _read(FILES, _infos(FILES)[0], None, None)
     swath = cloud.point_source_id.astype(np.int64)
     counts = zip(*np.unique(swath, return_counts=True))
     print(f"{cloud.x.size} returns; swaths (point source id): "

@@ -4,7 +4,9 @@ accuracy (ASPRS Positional Accuracy Standards, Ed. 2, 2023)."""
 from __future__ import annotations
 
 import logging
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from ..errors import InputError
 from .checks import check_memory
@@ -128,6 +130,58 @@ that accuracyreport reads for the NSSDA and PEC-PCD sections.""",
             for key, field, label, kind, unit, minimum, maximum, advanced in _NUMBERS
         ),
         Param(
+            "TILE_SIZE",
+            "number",
+            "Tile size (0 = one process)",
+            0.0,
+            unit="m",
+            minimum=0.0,
+            maximum=1e6,
+            help="tiles of this side (rounded up to whole cells) on a dask "
+            "cluster, as lidarblock; needs point source ids",
+        ),
+        Param(
+            "CLUSTER",
+            "string",
+            "dask scheduler address (empty: a local cluster)",
+            "",
+            optional=True,
+            advanced=True,
+            help="e.g. tcp://10.0.0.5:8786",
+        ),
+        Param(
+            "WORKERS",
+            "integer",
+            "Local cluster: workers (0 = one per core)",
+            0,
+            minimum=0,
+            maximum=1024,
+            advanced=True,
+        ),
+        Param(
+            "MEMORY_LIMIT",
+            "number",
+            "Local cluster: memory limit per worker (0 = RAM / workers)",
+            0.0,
+            unit="GB",
+            minimum=0.0,
+            maximum=4096.0,
+            advanced=True,
+        ),
+        Param(
+            "LOCAL_CLUSTER",
+            "enum",
+            "Local cluster workers",
+            "auto",
+            options=("auto", "processes", "threads"),
+            labels=(
+                "auto (processes on the command line, threads inside QGIS)",
+                "processes (one per worker)",
+                "threads of this process",
+            ),
+            advanced=True,
+        ),
+        Param(
             "OUTPUT_HTML",
             "file_out",
             "LiDAR accuracy report (HTML)",
@@ -198,24 +252,43 @@ def _cloud_files(paths) -> list[str]:
     return files
 
 
-def _read(files: list[str], progress, should_stop):
-    """Every file's returns with the fields the check uses (those a file lacks: None)."""
-    import numpy as np
+def _infos(files: list[str]):
+    """The files' headers and their CRS (one CRS for the survey)."""
+    from ..io.pointcloud import read_info
 
-    from ..io.pointcloud import read_info, read_points
-    from ..quality.lidar_accuracy import LidarCloud
-
-    parts: dict[str, list] = {}
-    crs = None
-    optional = ("classification", "number_of_returns", "point_source_id", "gps_time")
     infos = [read_info(f, require_crs=False) for f in files]
-    total = sum(i.point_count for i in infos)
-    check_memory(total * BYTES_PER_RETURN, f"INPUT: {total} returns",
-                 "assess the survey in parts (a tiled run is not implemented yet)")  # fmt: skip
-    for k, (f, info) in enumerate(zip(files, infos)):
+    crs = None
+    for f, info in zip(files, infos):
         if crs is not None and info.crs is not None and not info.crs.equals(crs):
             raise InputError(f"its CRS differs from {files[0]}'s: one survey, one CRS", path=f)
         crs = crs or info.crs
+    return infos, crs
+
+
+def _header_grid(infos, cell: float):
+    """The cells covering the files' header boxes (the same for one process and tiles)."""
+    import numpy as np
+
+    from ..quality.lidar_swaths import CellGrid
+
+    lo = np.min([i.mins[:2] for i in infos], axis=0)
+    hi = np.max([i.maxs[:2] for i in infos], axis=0)
+    return CellGrid.covering(np.array([lo[0], hi[0]]), np.array([lo[1], hi[1]]), cell)
+
+
+def _read(files: list[str], infos, progress, should_stop):
+    """Every file's returns with the fields the check uses (those a file lacks: None)."""
+    import numpy as np
+
+    from ..io.pointcloud import read_points
+    from ..quality.lidar_accuracy import LidarCloud
+
+    parts: dict[str, list] = {}
+    optional = ("classification", "number_of_returns", "point_source_id", "gps_time")
+    total = sum(i.point_count for i in infos)
+    check_memory(total * BYTES_PER_RETURN, f"INPUT: {total} returns",
+                 "use TILE_SIZE (tiles on a dask cluster)")  # fmt: skip
+    for k, (f, info) in enumerate(zip(files, infos)):
         fields = ["x", "y", "z"] + [n for n in optional if n in info.dimensions]
         arrays, _ = read_points(f, fields, require_crs=False, should_stop=should_stop)
         for n in ("x", "y", "z", *optional):
@@ -227,7 +300,7 @@ def _read(files: list[str], progress, should_stop):
         joined[n] = None if any(a is None for a in arrs) else np.concatenate(arrs)
     if joined["gps_time"] is not None and not np.any(joined["gps_time"]):
         joined["gps_time"] = None
-    return LidarCloud(source=", ".join(files), **joined), crs
+    return LidarCloud(source=", ".join(files), **joined)
 
 
 def _checkpoints(path: str | None):
@@ -257,6 +330,164 @@ def _write_checkpoint_table(path: str, report) -> None:
     write_text_atomic(path, buf.getvalue())
 
 
+@dataclass(frozen=True)
+class TilePart:
+    """What one tile task returns: its cells' fits, its core returns per swath, the motion
+    sums of each swath (n, mean t, x, y; sums of dt dt, dt dx, dt dy) and its ground returns
+    within TIN_RADIUS of a check point."""
+
+    fits: Any
+    swaths: dict[int, int]
+    motion: dict[int, tuple[float, ...]]
+    ground: Any
+
+
+_FIELDS = ("x", "y", "z", "classification", "number_of_returns", "point_source_id", "gps_time")
+
+
+def accuracy_tile(files, boxes, own, grid, options, check_xy) -> TilePart:
+    """One dask task: the returns of ``own`` (half-open box on whole cells) and one cell
+    around it from the files whose header box meets it; the fits of the cells centred in it."""
+    import numpy as np
+    from scipy.spatial import cKDTree
+
+    from ..io.pointcloud import read_info, read_points
+    from ..quality.lidar_swaths import fit_cells
+
+    pad = grid.cell
+    outer = (own[0] - pad, own[1] - pad, own[2] + pad, own[3] + pad)
+    parts: dict[str, list] = {k: [] for k in _FIELDS}
+    for f, b in zip(files, boxes):
+        if b[0] > outer[2] or b[2] < outer[0] or b[1] > outer[3] or b[3] < outer[1]:
+            continue
+        info = read_info(f, require_crs=False)
+        fields = [k for k in _FIELDS if k in ("x", "y", "z") or k in info.dimensions]
+        if "point_source_id" not in fields:
+            raise InputError("a tiled run needs the point source ids (TILE_SIZE 0 for GPS "
+                             "time)", path=f)  # fmt: skip
+        a, _ = read_points(f, fields, require_crs=False)
+        m = (a["x"] >= outer[0]) & (a["x"] <= outer[2]) & (a["y"] >= outer[1])
+        m &= a["y"] <= outer[3]
+        for k in _FIELDS:
+            if k in a:
+                parts[k].append(a[k][m])
+    a = {k: np.concatenate(v) for k, v in parts.items() if v}
+    if "x" not in a or a["x"].size == 0:
+        return TilePart(None, {}, {}, np.zeros((0, 3)))
+    fits = fit_cells(a["x"], a["y"], a["z"], a["point_source_id"], grid, options,
+                     a.get("classification"), a.get("number_of_returns"), own)  # fmt: skip
+    core = (a["x"] >= own[0]) & (a["x"] < own[2]) & (a["y"] >= own[1]) & (a["y"] < own[3])
+    ids = a["point_source_id"][core].astype(np.int64)
+    swaths = {int(s): int(n) for s, n in zip(*np.unique(ids, return_counts=True))}
+    motion = {}
+    if "gps_time" in a:
+        t, x, y = a["gps_time"][core], a["x"][core], a["y"][core]
+        for s in swaths:
+            k = ids == s
+            tc, xc, yc = t[k] - t[k].mean(), x[k] - x[k].mean(), y[k] - y[k].mean()
+            means = (float(t[k].mean()), float(x[k].mean()), float(y[k].mean()))
+            motion[s] = (float(k.sum()), *means, float(tc @ tc), float(tc @ xc), float(tc @ yc))
+    ground = np.zeros((0, 3))
+    if check_xy is not None and len(check_xy) and "classification" in a:
+        g = core & np.isin(a["classification"], options.ground_classes)
+        xyz = np.column_stack([a["x"][g], a["y"][g], a["z"][g]])
+        if len(xyz):
+            d = cKDTree(check_xy).query(xyz[:, :2], distance_upper_bound=options.tin_radius)[0]
+            ground = xyz[np.isfinite(d)]
+    return TilePart(fits, swaths, motion, ground)
+
+
+def _merge_motion(parts) -> dict[int, float]:
+    """Each swath's flight direction (rad from grid east) from the tiles' motion sums
+    (pairwise-combined centred sums: no loss of digits to the GPS time's size)."""
+    import math
+
+    acc: dict[int, list[float]] = {}
+    for part in parts:
+        for s, (n, mt, mx, my, stt, stx, sty) in part.motion.items():
+            if s not in acc:
+                acc[s] = [n, mt, mx, my, stt, stx, sty]
+                continue
+            na, ta, xa, ya, sa_tt, sa_tx, sa_ty = acc[s]
+            tot = na + n
+            dt, dx, dy = mt - ta, mx - xa, my - ya
+            w = na * n / tot
+            acc[s] = [tot, ta + dt * n / tot, xa + dx * n / tot, ya + dy * n / tot,
+                      sa_tt + stt + dt * dt * w, sa_tx + stx + dt * dx * w,
+                      sa_ty + sty + dt * dy * w]  # fmt: skip
+    return {s: math.atan2(v[6], v[5]) for s, v in acc.items() if v[4] > 0 and (v[5] or v[6])}
+
+
+def _tiles(grid, tile_size: float) -> list[tuple[float, float, float, float]]:
+    """Boxes of whole cells covering the grid, about ``tile_size`` on a side."""
+    import math
+
+    k = max(1, math.ceil(tile_size / grid.cell))
+    side = k * grid.cell
+    out = []
+    for j in range(math.ceil(grid.rows / k)):
+        for i in range(math.ceil(grid.cols / k)):
+            x0 = grid.x0 + i * side
+            y1 = grid.y_top - j * side
+            out.append((x0, y1 - side, x0 + side, y1))
+    return out
+
+
+def _run_tiled(v: Values, files, infos, grid, options, checkpoints, progress, should_stop):
+    """The cells of every tile on a dask cluster (lidarblock's), joined into one report."""
+    import os
+    import time
+
+    import numpy as np
+
+    from ..quality.lidar_accuracy import report_from_cells
+    from ..quality.lidar_swaths import finish_cells
+    from .lidar_block import _stop_workers, gather, open_client
+
+    if options.swath_source == "gps_time":
+        raise InputError("SWATH_SOURCE gps_time needs the whole survey at once: TILE_SIZE 0")
+    boxes = [(float(i.mins[0]), float(i.mins[1]), float(i.maxs[0]), float(i.maxs[1]))
+             for i in infos]  # fmt: skip
+    tiles = _tiles(grid, v.tile_size)
+    check_xy = None if checkpoints is None else checkpoints.xyz[:, :2]
+    client, cluster = open_client(v)
+    try:
+        futures = [client.submit(accuracy_tile, files, boxes, own, grid, options, check_xy,
+                                 pure=False, key=f"lidaraccuracy-{k}-{os.getpid()}-"
+                                 f"{time.time_ns()}") for k, own in enumerate(tiles)]  # fmt: skip
+        try:
+            parts = [p for p in gather(client, futures, progress, should_stop, 0.0, 0.9)
+                     if p.fits is not None]  # fmt: skip
+        except BaseException:
+            if cluster is not None:
+                _stop_workers(cluster)
+            raise
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    if not parts:
+        raise InputError("the survey has no points in its header's box")
+    cells = finish_cells([p.fits for p in parts], grid, options)
+    counts: dict[int, int] = {}
+    for p in parts:
+        for s, n in p.swaths.items():
+            counts[s] = counts.get(s, 0) + n
+    ground = np.concatenate([p.ground for p in parts]) if checkpoints is not None else None
+    counts = dict(sorted(counts.items()))
+    return report_from_cells(
+        cells,
+        grid,
+        options,
+        "point_source_id",
+        counts,
+        _merge_motion(parts),
+        checkpoints,
+        ground,
+        ", ".join(files),
+    )
+
+
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the clouds (and check points), assess them, write the report and rasters."""
     import json
@@ -272,10 +503,17 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
     options = options_from(LidarAccuracyOptions, SPEC, v,
                            hard_classes=_classes(v.hard_classes or ""))  # fmt: skip
-    read_p, assess_p = stages(progress, 1, 2)
-    cloud, crs = _read(_cloud_files(v.input), read_p, should_stop)
-    log.info("%d returns from %s", cloud.x.size, cloud.source)
-    report = assess_lidar(cloud, options, _checkpoints(v.checkpoints), assess_p, should_stop)
+    files = _cloud_files(v.input)
+    infos, crs = _infos(files)
+    grid = _header_grid(infos, options.cell_size)
+    checkpoints = _checkpoints(v.checkpoints)
+    if v.tile_size > 0:
+        report = _run_tiled(v, files, infos, grid, options, checkpoints, progress, should_stop)
+    else:
+        read_p, assess_p = stages(progress, 1, 2)
+        cloud = _read(files, infos, read_p, should_stop)
+        log.info("%d returns from %s", cloud.x.size, cloud.source)
+        report = assess_lidar(cloud, options, checkpoints, assess_p, should_stop, grid)
     stop_if_asked(should_stop, "writing the report")
     bands = [f"{p.swath_a}-{p.swath_b}" for p in report.pairs]
     if out.requested("OUTPUT_RASTER"):

@@ -210,17 +210,19 @@ def assess_lidar(
     checkpoints: CheckPointSet | None = None,
     progress: Callable[[float], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
+    grid: CellGrid | None = None,
 ) -> LidarAccuracyReport:
     """Swath overlap differences, within-swath precision and (with check points) NVA/VVA.
 
-    Raises InputError for an empty cloud or a cell size that is not positive.
+    ``grid``: the cells (default: covering the points). Raises InputError for an empty cloud
+    or a cell size that is not positive.
     """
     o = options
     if cloud.x.size == 0:
         raise InputError("the cloud has no points", path=cloud.source or None)
     swath, method = _swaths(cloud, o)
     names, counts = np.unique(swath, return_counts=True)
-    grid = CellGrid.covering(cloud.x, cloud.y, o.cell_size)
+    grid = grid or CellGrid.covering(cloud.x, cloud.y, o.cell_size)
     stop_if_asked(should_stop, "fitting the cells")
     cells = swath_cells(cloud.x, cloud.y, cloud.z, swath, grid, o,
                         cloud.classification, cloud.number_of_returns)  # fmt: skip
@@ -228,6 +230,35 @@ def assess_lidar(
         progress(0.6)
     headings = (swath_headings(swath, cloud.x, cloud.y, cloud.gps_time)
                 if cloud.gps_time is not None else {})  # fmt: skip
+    ground = None
+    if checkpoints is not None and len(checkpoints.ids):
+        cls = cloud.classification
+        keep = np.ones(cloud.x.size, bool) if cls is None else np.isin(cls, o.ground_classes)
+        ground = np.column_stack([cloud.x[keep], cloud.y[keep], cloud.z[keep]])
+    stop_if_asked(should_stop, "comparing the swaths")
+    report = report_from_cells(
+        cells, grid, o, method, {int(s): int(n) for s, n in zip(names, counts)}, headings,
+        checkpoints, ground, cloud.source,
+    )  # fmt: skip
+    if progress is not None:
+        progress(1.0)
+    return report
+
+
+def report_from_cells(
+    cells: SwathCells,
+    grid: CellGrid,
+    options: LidarAccuracyOptions,
+    method: str,
+    swath_counts: dict[int, int],
+    headings: dict[int, float],
+    checkpoints: CheckPointSet | None = None,
+    ground_xyz: NDArray | None = None,
+    source: str = "",
+) -> LidarAccuracyReport:
+    """The report from the swaths' cells (one process or joined tiles) and, with check
+    points, the ground returns near them (N, 3)."""
+    o = options
     pairs = overlap_differences(cells, grid, headings)
     precision = within_swath_precision(cells)
     all_dz = np.concatenate([p.dz for p in pairs]) if pairs else np.zeros(0)
@@ -236,29 +267,22 @@ def assess_lidar(
     if o.v_class_cm > 0:
         overall.update(_shares(all_dz, relative_limits(o.v_class_cm)))
     verdicts = _relative_verdicts(pairs, overall, precision, o)
-    notes = [f"swaths from {method.replace('_', ' ')}: {len(names)} swaths"]
-    if len(names) < 2:
+    notes = [f"swaths from {method.replace('_', ' ')}: {len(swath_counts)} swaths"]
+    if len(swath_counts) < 2:
         notes.append("one swath only: no overlap difference")
     vertical = None
-    if checkpoints is not None and len(checkpoints.ids):
-        stop_if_asked(should_stop, "interpolating the TIN at the check points")
-        cls = cloud.classification
-        ground = np.ones(cloud.x.size, bool) if cls is None else np.isin(cls, o.ground_classes)
-        g = np.column_stack([cloud.x[ground], cloud.y[ground], cloud.z[ground]])
-        heights = ground_tin_heights(g, checkpoints.xyz[:, :2], o.tin_radius)
+    if checkpoints is not None and len(checkpoints.ids) and ground_xyz is not None:
+        heights = ground_tin_heights(ground_xyz, checkpoints.xyz[:, :2], o.tin_radius)
         vertical = vertical_figures(checkpoints.ids, checkpoints.xyz[:, 2],
                                     checkpoints.groups, heights, o)  # fmt: skip
         verdicts += _vertical_verdicts(vertical, o)
         if vertical.outside:
             notes.append(f"{len(vertical.outside)} check point(s) outside the ground TIN, not "
                          f"assessed: {', '.join(vertical.outside)}")  # fmt: skip
-    if progress is not None:
-        progress(1.0)
     return LidarAccuracyReport(
-        options=o, swath_method=method,
-        swath_counts={int(s): int(n) for s, n in zip(names, counts)}, grid=grid, cells=cells,
+        options=o, swath_method=method, swath_counts=swath_counts, grid=grid, cells=cells,
         pairs=pairs, precision=precision, overall=overall, verdicts=tuple(verdicts),
-        vertical=vertical, checkpoints=checkpoints, notes=tuple(notes), source=cloud.source,
+        vertical=vertical, checkpoints=checkpoints, notes=tuple(notes), source=source,
     )  # fmt: skip
 
 
