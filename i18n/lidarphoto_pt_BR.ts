@@ -4834,6 +4834,46 @@ e_ref, n_ref, h_ref, group) que o accuracyreport lê para as seções NSSDA e PE
             <translation>Retornos de solo dentro desta distância formam a TIN</translation>
         </message>
         <message>
+            <source>Tile size (0 = one process)</source>
+            <translation>Tamanho do tile (0 = um processo)</translation>
+        </message>
+        <message>
+            <source>tiles of this side (rounded up to whole cells) on a dask cluster, as lidarblock; needs point source ids</source>
+            <translation>tiles deste lado (arredondado para células inteiras) num cluster dask, como o lidarblock; requer os point source ids</translation>
+        </message>
+        <message>
+            <source>dask scheduler address (empty: a local cluster)</source>
+            <translation>endereço do scheduler dask (vazio: um cluster local)</translation>
+        </message>
+        <message>
+            <source>e.g. tcp://10.0.0.5:8786</source>
+            <translation>por exemplo, tcp://10.0.0.5:8786</translation>
+        </message>
+        <message>
+            <source>Local cluster: workers (0 = one per core)</source>
+            <translation>Cluster local: trabalhadores (workers) (0 = um por núcleo)</translation>
+        </message>
+        <message>
+            <source>Local cluster: memory limit per worker (0 = RAM / workers)</source>
+            <translation>Cluster local: limite de memória por trabalhador (worker) (0 = RAM / trabalhadores)</translation>
+        </message>
+        <message>
+            <source>Local cluster workers</source>
+            <translation>Trabalhadores (workers) do cluster local</translation>
+        </message>
+        <message>
+            <source>auto (processes on the command line, threads inside QGIS)</source>
+            <translation>auto (processos na linha de comando, threads dentro do QGIS)</translation>
+        </message>
+        <message>
+            <source>processes (one per worker)</source>
+            <translation>processos (um por trabalhador)</translation>
+        </message>
+        <message>
+            <source>threads of this process</source>
+            <translation>threads deste processo</translation>
+        </message>
+        <message>
             <source>LiDAR accuracy report (HTML)</source>
             <translation>Relatório de acurácia LiDAR (HTML)</translation>
         </message>
