@@ -88,7 +88,26 @@ def main() -> int:
                 f"| {w.swath} | {w.cells} | {w.rms:.4f} | {w.range_median:.4f} | "
                 f"{w.range_p95:.4f} | {w.range_max:.4f} |"
             )
+    tiled_check()
     return 0
+
+
+def tiled_check() -> None:
+    """The job in one process and tiled (100 m tiles, 2 thread workers): the same cells/dz."""
+    from lidarphoto.core.jobs import lidar_accuracy
+    from lidarphoto.core.jobs.runner import run_job
+
+    times, reports = {}, {}
+    for name, extra in (("one process", {}),
+                        ("tiled 100 m", {"TILE_SIZE": 100.0, "WORKERS": 2,
+                                         "LOCAL_CLUSTER": "threads"})):  # fmt: skip
+        t0 = time.perf_counter()
+        reports[name] = run_job(lidar_accuracy, {"INPUT": FILES, **extra}).data
+        times[name] = time.perf_counter() - t0
+    a, b = reports.values()
+    same = all(np.array_equal(p.dz, q.dz) for p, q in zip(a.pairs, b.pairs, strict=True))
+    print(f"\n### tiled run: dz identical to one process: {same}; "
+          + ", ".join(f"{k} {t:.1f} s" for k, t in times.items()))  # fmt: skip
 
 
 if __name__ == "__main__":
