@@ -54,26 +54,42 @@ def _pairs_table(report: LidarAccuracyReport) -> str:
     return table(head, rows)
 
 
+#: Most cells the map draws (one SVG rectangle each); more are averaged in square blocks.
+MAP_MAX_CELLS = 20000
+
+
 def _map(report: LidarAccuracyReport, limit: float) -> str:
-    """Cells of every pair coloured by dz (diverging, +-limit), north up."""
+    """Cells of every pair coloured by dz (diverging, +-limit), north up; on a large survey
+    the mean dz of blocks of f x f cells (f chosen to draw at most MAP_MAX_CELLS)."""
     g = report.grid
+    rows = np.concatenate([p.cells // g.cols for p in report.pairs])
+    cols = np.concatenate([p.cells % g.cols for p in report.pairs])
+    dz = np.concatenate([p.dz for p in report.pairs])
+    f = max(1, math.ceil(math.sqrt(dz.size / MAP_MAX_CELLS)))
+    while True:  # sparse cells: grow the blocks until few enough are drawn
+        bcols = -(-g.cols // f)
+        blocks, inv = np.unique((rows // f) * bcols + cols // f, return_inverse=True)
+        if blocks.size <= MAP_MAX_CELLS:
+            break
+        f += 1
+    mean = np.bincount(inv, weights=dz) / np.bincount(inv)
     w = 480
-    scale = w / max(g.cols, 1)
-    h = math.ceil(g.rows * scale)
+    scale = w * f / max(g.cols, 1)
+    h = math.ceil(g.rows * w / max(g.cols, 1))
+    t = np.clip(mean / limit, -1, 1) if limit > 0 else np.zeros_like(mean)
     rects = []
-    for p in report.pairs:
-        row, col = np.divmod(p.cells, g.cols)
-        t = np.clip(p.dz / limit, -1, 1) if limit > 0 else np.zeros_like(p.dz)
-        for r, c, v in zip(row, col, t):
-            red = 255 if v > 0 else int(255 * (1 + v))
-            blue = 255 if v < 0 else int(255 * (1 - v))
-            green = int(255 * (1 - abs(v)))
-            rects.append(f'<rect x="{c * scale:.2f}" y="{r * scale:.2f}" width="{scale:.2f}" '
-                         f'height="{scale:.2f}" fill="rgb({red},{green},{blue})"/>')  # fmt: skip
+    for b, v in zip(blocks, t):
+        r, c = divmod(int(b), bcols)
+        red = 255 if v > 0 else int(255 * (1 + v))
+        blue = 255 if v < 0 else int(255 * (1 - v))
+        green = int(255 * (1 - abs(v)))
+        rects.append(f'<rect x="{c * scale:.2f}" y="{r * scale:.2f}" width="{scale:.2f}" '
+                     f'height="{scale:.2f}" fill="rgb({red},{green},{blue})"/>')  # fmt: skip
+    what = "dz of every pair" if f == 1 else f"mean dz of {f} x {f} cells, every pair"
     return (
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" '
         f'style="border:1px solid #ccc;background:#f4f4f4">{"".join(rects)}</svg>'
-        f"<p>dz of every pair (red: a above b), colour limit &plusmn;{limit:.3f} m</p>"
+        f"<p>{what} (red: a above b), colour limit &plusmn;{limit:.3f} m</p>"
     )
 
 

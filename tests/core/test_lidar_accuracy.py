@@ -388,3 +388,13 @@ def test_tiled_run_equals_the_single_process(tmp_path):
     assert one.overall == tiled.overall
     assert tiled.vertical.nva_rmse_v == pytest.approx(one.vertical.nva_rmse_v, abs=1e-12)
     assert tiled.vertical.nva_n == one.vertical.nva_n
+
+
+def test_html_map_is_bounded_on_large_surveys(monkeypatch):
+    from lidarphoto.core.quality import lidar_accuracy_html
+
+    rep = assess_lidar(_survey(), LidarAccuracyOptions())
+    full = lidar_accuracy_html.render_html(rep).count("<rect")
+    monkeypatch.setattr(lidar_accuracy_html, "MAP_MAX_CELLS", 100)
+    small = lidar_accuracy_html.render_html(rep).count("<rect")
+    assert small < full and small - (full - rep.pairs[0].n) <= 100
