@@ -295,6 +295,10 @@ def test_ahn3_overlap_difference_matches_an_independent_computation():
     las = laspy.read(str(path))
     x, y, z = (np.asarray(las[k], dtype=float) for k in ("x", "y", "z"))
     ids = np.asarray(las.point_source_id)
+    # the GPS-time gaps find the same three flight lines (one label per id, one id per label)
+    labels, method = identify_swaths(None, np.asarray(las.gps_time), "gps_time", 10.0)
+    pairs = set(zip(labels.tolist(), ids.tolist()))
+    assert method == "gps_time" and len(pairs) == 3 == len({a for a, _ in pairs})
     res = run_job(lidar_accuracy, {"INPUT": [str(path)]})
     rep = res.data
     assert rep.swath_method == "point_source_id"
