@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -125,6 +125,7 @@ def _relative_verdicts(
     overall: dict[str, float],
     precision: list[SwathPrecision],
     o: LidarAccuracyOptions,
+    cells: SwathCells,
 ) -> list[Verdict]:
     out: list[Verdict] = []
     c = o.v_class_cm
@@ -170,8 +171,14 @@ def _relative_verdicts(
                                f"{_class_met(p.range_max, WITHIN_SWATH_FACTOR)}",
                                p.range_max, None))  # fmt: skip
         else:
-            out.append(_limit_verdict(name, p.range_max, lim["within_swath_max"], enough,
-                                      f"largest cell range on {p.cells} cells"))  # fmt: skip
+            v = _limit_verdict(name, p.range_max, lim["within_swath_max"], enough,
+                               f"largest cell range on {p.cells} cells")  # fmt: skip
+            m = (cells.swath == p.swath) & cells.smooth
+            share = (
+                float(np.mean(cells.range[m] <= lim["within_swath_max"] + _TOL)) if p.cells else 0.0
+            )
+            out.append(replace(v, reason=f"{v.reason}; {share:.1%} of the cells within it, 95th "
+                               f"percentile {_cm(p.range_p95)}"))  # fmt: skip
     return out
 
 
@@ -266,7 +273,7 @@ def report_from_cells(
     overall = difference_stats(all_dz, all_dn)
     if o.v_class_cm > 0:
         overall.update(_shares(all_dz, relative_limits(o.v_class_cm)))
-    verdicts = _relative_verdicts(pairs, overall, precision, o)
+    verdicts = _relative_verdicts(pairs, overall, precision, o, cells)
     notes = [f"swaths from {method.replace('_', ' ')}: {len(swath_counts)} swaths"]
     if len(swath_counts) < 2:
         notes.append("one swath only: no overlap difference")
