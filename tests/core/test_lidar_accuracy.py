@@ -402,3 +402,15 @@ def test_html_map_is_bounded_on_large_surveys(monkeypatch):
     monkeypatch.setattr(lidar_accuracy_html, "MAP_MAX_CELLS", 100)
     small = lidar_accuracy_html.render_html(rep).count("<rect")
     assert small < full and small - (full - rep.pairs[0].n) <= 100
+
+
+def test_tiled_run_stops_when_asked(tmp_path):
+    from lidarphoto.core.errors import Cancelled
+
+    _write_las(tmp_path / "s.las", _survey(seed=2))
+    with pytest.raises(Cancelled):
+        run_job(lidar_accuracy, {"INPUT": [str(tmp_path / "s.las")], "TILE_SIZE": 20.0,
+                                 "WORKERS": 1, "LOCAL_CLUSTER": "threads",
+                                 "OUTPUT_HTML": str(tmp_path / "r.html")},
+                should_stop=lambda: True)  # fmt: skip
+    assert not (tmp_path / "r.html").exists()
