@@ -433,6 +433,15 @@ def _tiles(grid, tile_size: float) -> list[tuple[float, float, float, float]]:
     return out
 
 
+def _tile_points(own, pad: float, boxes, infos) -> int:
+    """Returns of the files whose header box meets the tile and its one-cell margin."""
+    return sum(
+        i.point_count for b, i in zip(boxes, infos)
+        if not (b[0] > own[2] + pad or b[2] < own[0] - pad or b[1] > own[3] + pad
+                or b[3] < own[1] - pad)
+    )  # fmt: skip
+
+
 def _run_tiled(v: Values, files, infos, grid, options, checkpoints, progress, should_stop):
     """The cells of every tile on a dask cluster (lidarblock's), joined into one report."""
     import os
@@ -449,6 +458,13 @@ def _run_tiled(v: Values, files, infos, grid, options, checkpoints, progress, sh
     boxes = [(float(i.mins[0]), float(i.mins[1]), float(i.maxs[0]), float(i.maxs[1]))
              for i in infos]  # fmt: skip
     tiles = _tiles(grid, v.tile_size)
+    if not v.cluster:  # a local cluster: every worker holds the files its tile meets
+        most = max(_tile_points(own, grid.cell, boxes, infos) for own in tiles)
+        workers = min(v.workers or os.cpu_count() or 1, len(tiles))
+        check_memory(most * BYTES_PER_RETURN * workers,
+                     f"TILE_SIZE {v.tile_size:g}: {workers} worker(s), up to {most} returns "
+                     "each (every file a tile meets is decoded whole)",
+                     "use smaller files (e.g. lidarblock's tiles) or fewer WORKERS")  # fmt: skip
     check_xy = None if checkpoints is None else checkpoints.xyz[:, :2]
     client, cluster = open_client(v)
     try:
@@ -503,6 +519,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
     options = options_from(LidarAccuracyOptions, SPEC, v,
                            hard_classes=_classes(v.hard_classes or ""))  # fmt: skip
+    if v.output_checkpoints and not v.checkpoints:
+        raise InputError("OUTPUT_CHECKPOINTS needs the CHECKPOINTS table")
     files = _cloud_files(v.input)
     infos, crs = _infos(files)
     grid = _header_grid(infos, options.cell_size)

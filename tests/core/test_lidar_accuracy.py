@@ -354,6 +354,10 @@ def test_bad_inputs_are_named(tmp_path):
         run_job(lidar_accuracy, {"INPUT": [str(tmp_path / "empty")],
                                  "OUTPUT_HTML": str(tmp_path / "r.html")})  # fmt: skip
     _write_las(tmp_path / "s.las", _survey(seed=2))
+    with pytest.raises(InputError, match="OUTPUT_CHECKPOINTS needs"):
+        run_job(lidar_accuracy, {"INPUT": [str(tmp_path / "s.las")],
+                                 "OUTPUT_CHECKPOINTS": str(tmp_path / "c.csv"),
+                                 "OUTPUT_HTML": str(tmp_path / "r.html")})  # fmt: skip
     with pytest.raises(InputError, match="HARD_CLASSES"):
         run_job(lidar_accuracy, {"INPUT": [str(tmp_path / "s.las")], "HARD_CLASSES": "2,x",
                                  "OUTPUT_HTML": str(tmp_path / "r.html")})  # fmt: skip
