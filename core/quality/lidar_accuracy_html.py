@@ -49,7 +49,7 @@ def _pairs_table(report: LidarAccuracyReport) -> str:
                  _m(o["max_abs"]), _m(o["rmsd_normal"]), _pct(o.get("share_over_rmsdz_limit")),
                  _pct(o.get("share_over_max_limit")), "", "", ""])  # fmt: skip
     head = ["swaths a - b", "cells", "mean dz (m)", "std (m)", "RMSDz (m)", "max |dz| (m)",
-            "normal RMSD (m)", "beyond 0.8 class", "beyond 1.6 class", "tilt dz/dx (mm/m)",
+            "normal RMSD (m)", "share > 0.8 x class", "share > 1.6 x class", "tilt dz/dx (mm/m)",
             "tilt dz/dy (mm/m)", "cross-track (mm/m)"]  # fmt: skip
     return table(head, rows)
 
@@ -112,7 +112,7 @@ def render_html(report: LidarAccuracyReport) -> str:
             ["cells rejected", escape(", ".join(f"{k} {v}" for k, v in c.rejected.items()))],
             ["smooth cell", escape(f">= {o.min_points} single returns of one swath, no class "
                                    f"{o.vegetation_classes}, slope <= {o.max_slope_deg:g} deg, "
-                                   f"plane rms <= {o.max_residual:g}")],
+                                   f"plane rms <= {o.max_residual:g} m, step to a neighbour <= {o.max_step:g} m")],
             ["sign convention", "dz = swath a &minus; swath b; dz = LiDAR &minus; check point"],
             ["created", escape(f"lidarphoto {__version__}")],
         ]),
