@@ -112,7 +112,8 @@ def render_html(report: LidarAccuracyReport) -> str:
             ["cells rejected", escape(", ".join(f"{k} {v}" for k, v in c.rejected.items()))],
             ["smooth cell", escape(f">= {o.min_points} single returns of one swath, no class "
                                    f"{o.vegetation_classes}, slope <= {o.max_slope_deg:g} deg, "
-                                   f"plane rms <= {o.max_residual:g} m, step to a neighbour <= {o.max_step:g} m")],
+                                   f"plane rms <= {o.max_residual:g} m, step to a "
+                                   f"neighbour <= {o.max_step:g} m")],
             ["sign convention", "dz = swath a &minus; swath b; dz = LiDAR &minus; check point"],
             ["created", escape(f"lidarphoto {__version__}")],
         ]),
