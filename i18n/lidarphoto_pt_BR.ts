@@ -115,6 +115,10 @@
             <translation>Controle LiDAR para um bloco inteiro de tiles (dask.distributed)</translation>
         </message>
         <message>
+            <source>Accepting a LiDAR survey (ASPRS Ed. 2: swath and vertical accuracy)</source>
+            <translation>Aceitação de um levantamento LiDAR (ASPRS Ed. 2: acurácia entre faixas e vertical)</translation>
+        </message>
+        <message>
             <source>Terrestrial laser scanner calibration (Lichti 2007)</source>
             <translation>Calibração de laser scanner terrestre (Lichti 2007)</translation>
         </message>
@@ -209,6 +213,14 @@
         <message>
             <source>PLANES / LINES / LCPS = the block's tables, TRAJECTORY and OBSERVATIONS as above</source>
             <translation>PLANES / LINES / LCPS = as tabelas do bloco, TRAJECTORY e OBSERVATIONS como acima</translation>
+        </message>
+        <message>
+            <source>INPUT = the survey's LAS/LAZ (ground classified), CHECKPOINTS = surveyed points with land cover; OUTPUT_HTML = swath overlap, within-swath and NVA/VVA verdicts, OUTPUT_CHECKPOINTS = the check points with LiDAR heights</source>
+            <translation>INPUT = os LAS/LAZ do levantamento (solo classificado), CHECKPOINTS = pontos levantados com a cobertura do solo; OUTPUT_HTML = os veredictos de sobreposição entre faixas, dentro da faixa e NVA/VVA, OUTPUT_CHECKPOINTS = os pontos de verificação com as alturas LiDAR</translation>
+        </message>
+        <message>
+            <source>INPUT = that check-point table; OUTPUT_HTML = the NSSDA and PEC-PCD sections of the LiDAR's vertical accuracy</source>
+            <translation>INPUT = essa tabela de pontos de verificação; OUTPUT_HTML = as seções NSSDA e PEC-PCD da acurácia vertical do LiDAR</translation>
         </message>
         <message>
             <source>SCANS = the station clouds, CONTROL = target ids; OUTPUT = target observations</source>
@@ -4989,6 +5001,251 @@ trajectorytoeo a calcula. OUTPUT: os centros perspectivos como camada PointZ.</t
         <message>
             <source>Direct georeferencing</source>
             <translation type="vanished">Georreferenciação direta</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:lidaraccuracy</name>
+        <message>
+            <source>LiDAR swath and vertical accuracy (ASPRS 2023)</source>
+            <translation>Acurácia LiDAR entre faixas e vertical (ASPRS 2023)</translation>
+        </message>
+        <message>
+            <source>Accuracy</source>
+            <translation>Acurácia</translation>
+        </message>
+        <message>
+            <source>swath overlap difference, within-swath precision and NVA/VVA of a LiDAR survey</source>
+            <translation>diferença na sobreposição de faixas, precisão dentro da faixa e NVA/VVA de um levantamento LiDAR</translation>
+        </message>
+        <message>
+            <source>Tells how good a LiDAR survey itself is, under the ASPRS Positional Accuracy Standards,
+Edition 2 (2023): relative accuracy between overlapping swaths, within-swath precision and
+absolute vertical accuracy at surveyed check points.</source>
+            <translation>Diz quão bom é o próprio levantamento LiDAR, segundo os ASPRS Positional Accuracy Standards,
+Edição 2 (2023): acurácia relativa entre faixas sobrepostas, precisão dentro da faixa e
+acurácia vertical absoluta em pontos de verificação levantados.</translation>
+        </message>
+        <message>
+            <source>## Swaths
+From the LAS point source id (flight line) when the cloud holds more than one, else from gaps
+in GPS time longer than GPS gap (the report says which).</source>
+            <translation>## Faixas
+Do point source id do LAS (linha de voo) quando a nuvem tem mais de um, senão das lacunas
+no tempo GPS maiores que a lacuna GPS (o relatório diz qual).</translation>
+        </message>
+        <message>
+            <source>## Smooth hard cells
+On a north-up grid of Cell size (corners on multiples of it), a cell of a swath is smooth
+when it holds at least the least returns of that swath, no vegetation class (3-5), only single
+returns (and, with Hard classes, only those classes), the least-squares plane through them has
+a slope at most Max slope and a residual rms at most Max residual, and the planes of its
+neighbour cells continue it within Max step (edges, walls and rough ground fail).</source>
+            <translation>## Células lisas e rígidas
+Numa grade orientada ao norte com o tamanho de célula (cantos em múltiplos dele), a célula de uma
+faixa é lisa quando tem pelo menos o mínimo de retornos dessa faixa, nenhuma classe de vegetação
+(3-5), só retornos únicos (e, com Classes rígidas, só essas classes), o plano de mínimos
+quadrados por eles tem declividade no máximo a declividade máxima e rms dos resíduos no máximo o
+resíduo máximo, e os planos das células vizinhas o continuam dentro do degrau máximo (bordas,
+paredes e terreno rugoso falham).</translation>
+        </message>
+        <message>
+            <source>## Figures
+Swath overlap difference dz = h_a - h_b (plane heights at the cell centre) per swath pair and
+overall: count, mean, RMSDz, max |dz|, surface-normal RMSD, the share beyond 0.8 and 1.6 times
+the class, and the tilt of dz across the overlap (a roll error shows as a cross-track slope).
+Within-swath precision per swath: pooled plane residual rms and the cells' Max Diff (range).
+Check points (CSV id, e, n, h, group = land cover): dz = LiDAR - check, the LiDAR height
+interpolated in a TIN of the ground returns (class 2); NVA (non-vegetated): RMSE_V with the
+survey sigma, 1.96 RMSE_V for comparison; VVA (groups such as vegetated, forest, brush, crops):
+RMSE and the 95th percentile of |dz|, reported only. Verdicts against a vertical class #-cm:
+within-swath Max Diff &lt;= 0.6 #, swath RMSDz &lt;= 0.8 #, swath max &lt;= 1.6 #, NVA RMSE_V &lt;= #
+with at least 30 check points (docs/formats.md "LiDAR accuracy").</source>
+            <translation>## Figuras
+Diferença na sobreposição dz = h_a - h_b (alturas dos planos no centro da célula) por par de
+faixas e no total: contagem, média, RMSDz, máximo de |dz|, RMSD na normal da superfície, a
+parcela além de 0,8 e 1,6 vezes a classe, e a inclinação de dz na sobreposição (um erro de
+rolamento aparece como declividade transversal). Precisão dentro da faixa por faixa: rms
+conjunto dos resíduos dos planos e a Max Diff (amplitude) das células. Pontos de verificação (CSV
+id, e, n, h, group = cobertura do solo): dz = LiDAR - ponto, a altura LiDAR interpolada numa TIN
+dos retornos de solo (classe 2); NVA (não vegetado): RMSE_V com o sigma do levantamento, 1,96
+RMSE_V para comparação; VVA (grupos como vegetated, forest, brush, crops): RMSE e o percentil
+95 de |dz|, só informados. Veredictos para uma classe vertical #-cm: Max Diff dentro da faixa
+&lt;= 0,6 #, RMSDz entre faixas &lt;= 0,8 #, máximo entre faixas &lt;= 1,6 #, NVA RMSE_V &lt;= # com pelo
+menos 30 pontos de verificação (docs/formats.md "LiDAR accuracy").</translation>
+        </message>
+        <message>
+            <source>## Outputs
+HTML report, JSON of every figure, a GeoTIFF of dz with one band per swath pair, and the check
+points with the LiDAR heights as a check-point table (id, e, n, h, e_ref, n_ref, h_ref, group)
+that accuracyreport reads for the NSSDA and PEC-PCD sections.</source>
+            <translation>## Saídas
+Relatório HTML, JSON com todas as figuras, um GeoTIFF de dz com uma banda por par de faixas, e
+os pontos de verificação com as alturas LiDAR como tabela de pontos de verificação (id, e, n, h,
+e_ref, n_ref, h_ref, group) que o accuracyreport lê para as seções NSSDA e PEC-PCD.</translation>
+        </message>
+        <message>
+            <source>Point clouds (LAS/LAZ files or folders)</source>
+            <translation>Nuvens de pontos (arquivos LAS/LAZ ou pastas)</translation>
+        </message>
+        <message>
+            <source>LAS/LAZ files of one survey, or folders of them</source>
+            <translation>arquivos LAS/LAZ de um levantamento, ou pastas deles</translation>
+        </message>
+        <message>
+            <source>Check points (CSV: id, e, n, h, group)</source>
+            <translation>Pontos de verificação (CSV: id, e, n, h, group)</translation>
+        </message>
+        <message>
+            <source>surveyed check points; group = land cover</source>
+            <translation>pontos de verificação levantados; group = cobertura do solo</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Swaths from</source>
+            <translation>Faixas a partir de</translation>
+        </message>
+        <message>
+            <source>point source id, else GPS time</source>
+            <translation>point source id, senão tempo GPS</translation>
+        </message>
+        <message>
+            <source>point source id</source>
+            <translation>point source id</translation>
+        </message>
+        <message>
+            <source>GPS time gaps</source>
+            <translation>lacunas no tempo GPS</translation>
+        </message>
+        <message>
+            <source>Hard classes only (e.g. 2,6; empty: any but vegetation)</source>
+            <translation>Só classes rígidas (p. ex. 2,6; vazio: todas menos vegetação)</translation>
+        </message>
+        <message>
+            <source>LAS classes of hard surfaces; a cell holding another class is not compared (class 1 holds cars that move between flights)</source>
+            <translation>classes LAS de superfícies rígidas; uma célula com outra classe não é comparada (a classe 1 tem carros que se movem entre voos)</translation>
+        </message>
+        <message>
+            <source>Cell size (about 2 x point spacing or more)</source>
+            <translation>Tamanho da célula (cerca de 2 x o espaçamento dos pontos ou mais)</translation>
+        </message>
+        <message>
+            <source>Least returns of one swath in a cell</source>
+            <translation>Mínimo de retornos de uma faixa numa célula</translation>
+        </message>
+        <message>
+            <source>Largest slope of a smooth cell</source>
+            <translation>Maior declividade de uma célula lisa</translation>
+        </message>
+        <message>
+            <source>Largest plane-fit rms of a smooth cell</source>
+            <translation>Maior rms do ajuste do plano de uma célula lisa</translation>
+        </message>
+        <message>
+            <source>Largest step to a neighbour cell's plane</source>
+            <translation>Maior degrau até o plano de uma célula vizinha</translation>
+        </message>
+        <message>
+            <source>GPS-time gap that starts a new swath</source>
+            <translation>Lacuna no tempo GPS que inicia uma nova faixa</translation>
+        </message>
+        <message>
+            <source>Least smooth cells of an assessed swath pair</source>
+            <translation>Mínimo de células lisas de um par de faixas avaliado</translation>
+        </message>
+        <message>
+            <source>ASPRS vertical class (0 = report the class met)</source>
+            <translation>Classe vertical ASPRS (0 = informar a classe atendida)</translation>
+        </message>
+        <message>
+            <source>Check-point survey sigma in height</source>
+            <translation>Sigma do levantamento dos pontos de verificação em altura</translation>
+        </message>
+        <message>
+            <source>Ground returns within this distance make the TIN</source>
+            <translation>Retornos de solo dentro desta distância formam a TIN</translation>
+        </message>
+        <message>
+            <source>Tile size (0 = one process)</source>
+            <translation>Tamanho do tile (0 = um processo)</translation>
+        </message>
+        <message>
+            <source>tiles of this side (rounded up to whole cells) on a dask cluster, as lidarblock; needs point source ids</source>
+            <translation>tiles deste lado (arredondado para células inteiras) num cluster dask, como o lidarblock; requer os point source ids</translation>
+        </message>
+        <message>
+            <source>dask scheduler address (empty: a local cluster)</source>
+            <translation>endereço do scheduler dask (vazio: um cluster local)</translation>
+        </message>
+        <message>
+            <source>e.g. tcp://10.0.0.5:8786</source>
+            <translation>por exemplo, tcp://10.0.0.5:8786</translation>
+        </message>
+        <message>
+            <source>Local cluster: workers (0 = one per core)</source>
+            <translation>Cluster local: trabalhadores (workers) (0 = um por núcleo)</translation>
+        </message>
+        <message>
+            <source>Local cluster: memory limit per worker (0 = RAM / workers)</source>
+            <translation>Cluster local: limite de memória por trabalhador (worker) (0 = RAM / trabalhadores)</translation>
+        </message>
+        <message>
+            <source>Local cluster workers</source>
+            <translation>Trabalhadores (workers) do cluster local</translation>
+        </message>
+        <message>
+            <source>auto (processes on the command line, threads inside QGIS)</source>
+            <translation>auto (processos na linha de comando, threads dentro do QGIS)</translation>
+        </message>
+        <message>
+            <source>processes (one per worker)</source>
+            <translation>processos (um por trabalhador)</translation>
+        </message>
+        <message>
+            <source>threads of this process</source>
+            <translation>threads deste processo</translation>
+        </message>
+        <message>
+            <source>LiDAR accuracy report (HTML)</source>
+            <translation>Relatório de acurácia LiDAR (HTML)</translation>
+        </message>
+        <message>
+            <source>HTML files (*.html)</source>
+            <translation>Arquivos HTML (*.html)</translation>
+        </message>
+        <message>
+            <source>LiDAR accuracy figures (JSON)</source>
+            <translation>Figuras de acurácia LiDAR (JSON)</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>Swath overlap dz (GeoTIFF, a band per pair)</source>
+            <translation>dz na sobreposição de faixas (GeoTIFF, uma banda por par)</translation>
+        </message>
+        <message>
+            <source>Check points with LiDAR heights (CSV)</source>
+            <translation>Pontos de verificação com alturas LiDAR (CSV)</translation>
+        </message>
+        <message>
+            <source>Swath-to-swath RMSDz, all pairs (m)</source>
+            <translation>RMSDz entre faixas, todos os pares (m)</translation>
+        </message>
+        <message>
+            <source>Smooth cells compared</source>
+            <translation>Células lisas comparadas</translation>
+        </message>
+        <message>
+            <source>NVA RMSE_V (m; NaN without check points)</source>
+            <translation>NVA RMSE_V (m; NaN sem pontos de verificação)</translation>
+        </message>
+        <message>
+            <source>Quality</source>
+            <translation type="vanished">Qualidade</translation>
         </message>
     </context>
     <context>

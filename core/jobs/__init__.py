@@ -31,6 +31,7 @@ NAMES = (
     "extract_tls_targets",
     "locate_control_points",
     "lidar_block",
+    "lidar_accuracy",
     "calibrate_camera",
     "tie_points",
     "make_control_chips",

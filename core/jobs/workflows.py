@@ -142,6 +142,17 @@ WORKFLOWS: tuple[Workflow, ...] = (
         ),
     ),
     Workflow(
+        _t("Accepting a LiDAR survey (ASPRS Ed. 2: swath and vertical accuracy)"),
+        (
+            ("lidaraccuracy", _t("INPUT = the survey's LAS/LAZ (ground classified), "
+             "CHECKPOINTS = surveyed points with land cover; OUTPUT_HTML = swath overlap, "
+             "within-swath and NVA/VVA verdicts, OUTPUT_CHECKPOINTS = the check points with "
+             "LiDAR heights")),
+            ("accuracyreport", _t("INPUT = that check-point table; OUTPUT_HTML = the NSSDA and "
+             "PEC-PCD sections of the LiDAR's vertical accuracy")),
+        ),
+    ),
+    Workflow(
         _t("Terrestrial laser scanner calibration (Lichti 2007)"),
         (
             ("extracttlstargets", _t("SCANS = the station clouds, CONTROL = target ids; OUTPUT = "
