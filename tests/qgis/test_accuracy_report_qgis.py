@@ -103,7 +103,7 @@ def _run(params: dict) -> dict:
 
 def test_algorithm_is_registered_with_the_documented_api(provider):
     alg = provider.algorithm("accuracyreport")
-    assert alg.id() == ALG and alg.groupId() == "quality"
+    assert alg.id() == ALG and alg.groupId() == "accuracy"
     names = {p.name() for p in alg.parameterDefinitions()}
     assert {"INPUT", "MEASURED", "REFERENCE", "MEASURED_ID", "REFERENCE_ID", "GROUP_FIELD"} <= names
     assert {"OUTPUT", "OUTPUT_HTML", "OUTPUT_JSON", "STANDARDS", "REPROJECT"} <= names

@@ -19,7 +19,7 @@ def test_processing_run_matches_the_core(provider, tmp_path):
     from lidarphoto.core.jobs.runner import run_job
 
     alg = provider.algorithm("lidaraccuracy")
-    assert alg.id() == ALG and alg.groupId() == "quality"
+    assert alg.id() == ALG and alg.groupId() == "accuracy"
     result = processing.run(ALG, {"INPUT": [str(CROP)], "OUTPUT_HTML": str(tmp_path / "r.html"),
                                   "OUTPUT_JSON": str(tmp_path / "r.json")})  # fmt: skip
     core = run_job(lidar_accuracy, {"INPUT": [str(CROP)]})
