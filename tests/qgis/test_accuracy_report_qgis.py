@@ -301,3 +301,21 @@ def test_report_of_simulated_checkpoints(provider, tmp_path):
     print("\n".join(lines))
     assert re.search(r"RMSE_HORIZONTAL = \d", "\n".join(lines))
     assert r["RMSE_HORIZONTAL"] == pytest.approx(data["rmse"]["RMSE_HORIZONTAL"])
+
+
+def test_a_first_run_form_shows_what_it_needs(provider):
+    """The inputs, the standards and the outputs; the thresholds, sigmas, outlier rules and
+    field names under Advanced (28 basic fields before)."""
+    alg = provider.algorithm("accuracyreport")
+    basic = [d.name() for d in alg.parameterDefinitions() if not d.flags() & d.FlagAdvanced]
+    assert basic == [
+        "INPUT",
+        "MEASURED",
+        "REFERENCE",
+        "GROUP_FIELD",
+        "CRS",
+        "STANDARDS",
+        "OUTPUT",
+        "OUTPUT_HTML",
+        "OUTPUT_JSON",
+    ]
