@@ -698,6 +698,10 @@
             <translation>Todos os arquivos (*.*)</translation>
         </message>
         <message>
+            <source>{name}: the layer {layer} is not a raster or LAS/LAZ file ({source}); save it as a GeoTIFF first</source>
+            <translation>{name}: a camada {layer} não é um arquivo raster nem LAS/LAZ ({source}); salve-a primeiro como GeoTIFF</translation>
+        </message>
+        <message>
             <source>LiDAR Photogrammetry</source>
             <translation>Fotogrametria LiDAR</translation>
         </message>

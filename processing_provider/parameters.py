@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import os
 from typing import Any, Callable
 
 from qgis.core import (
+    QgsProcessingException,
     QgsProcessingOutputNumber,
     QgsProcessingOutputString,
     QgsProcessingParameterBoolean,
@@ -17,6 +19,7 @@ from qgis.core import (
     QgsProcessingParameterFile,
     QgsProcessingParameterFileDestination,
     QgsProcessingParameterFolderDestination,
+    QgsProcessingParameterMapLayer,
     QgsProcessingParameterMultipleLayers,
     QgsProcessingParameterNumber,
     QgsProcessingParameterRasterDestination,
@@ -33,6 +36,8 @@ from .compat import (
     NUMBER_DOUBLE,
     NUMBER_INTEGER,
     SOURCE_FILE,
+    SOURCE_POINT_CLOUD,
+    SOURCE_RASTER,
     SOURCE_VECTOR_LINE,
     SOURCE_VECTOR_POINT,
     SOURCE_VECTOR_POLYGON,
@@ -43,6 +48,19 @@ from .i18n import help_tr
 
 def _all_files() -> str:
     return QCoreApplication.translate("LidarPhotoProvider", "All files (*.*)")
+
+
+def point_cloud_layers() -> bool:
+    """Whether this QGIS reads LAS/LAZ as point-cloud layers (the PDAL provider: QGIS 3.26+
+    builds with PDAL; Debian's 3.22 has none)."""
+    from qgis.core import QgsProviderRegistry
+
+    return "pdal" in QgsProviderRegistry.instance().providerList()
+
+
+def layer_input(p: Param) -> bool:
+    """A DSM file parameter (a raster, or a LAS/LAZ): a layer of the project or a file."""
+    return p.kind == "file" and (p.file_filter or "").startswith("DSM")
 
 
 _SINK_TYPES = {
@@ -63,7 +81,10 @@ def make_parameter(
     title = tr(p.label) + (f" ({p.unit})" if p.unit else "")
     k = p.kind
     default = p.qgis_default if p.qgis_default is not None else p.default
-    if k == "file":
+    if layer_input(p):  # the layer list (rasters, and clouds where QGIS reads them) or a file
+        types = [SOURCE_RASTER] + ([SOURCE_POINT_CLOUD] if point_cloud_layers() else [])
+        q = LayerOrFileParameter(p.name, title, None, p.optional, types)
+    elif k == "file":
         flt = f"{tr(p.file_filter)};;{_all_files()}" if p.file_filter else _all_files()
         q = QgsProcessingParameterFile(
             p.name, title, behavior=FILE_BEHAVIOR_FILE, fileFilter=flt, optional=p.optional
@@ -97,9 +118,13 @@ def make_parameter(
         )
     elif k == "field":
         q = QgsProcessingParameterField(
-            p.name, title, None, p.parent, FIELD_TYPE_NUMERIC if p.numeric_field
-            else FIELD_TYPE_ANY, optional=True,
-        )  # fmt: skip
+            p.name,
+            title,
+            None,
+            p.parent,
+            FIELD_TYPE_NUMERIC if p.numeric_field else FIELD_TYPE_ANY,
+            optional=True,
+        )
     elif k == "files":
         q = QgsProcessingParameterMultipleLayers(p.name, title, SOURCE_FILE, None, p.optional)
     elif k == "folder_out":
@@ -108,18 +133,24 @@ def make_parameter(
         )
     elif k == "file_out":
         q = QgsProcessingParameterFileDestination(
-            p.name, title, tr(p.file_filter), optional=p.optional,
+            p.name,
+            title,
+            tr(p.file_filter),
+            optional=p.optional,
             createByDefault=p.create_by_default,
-        )  # fmt: skip
+        )
     elif k == "raster_out":
         q = QgsProcessingParameterRasterDestination(
             p.name, title, optional=p.optional, createByDefault=p.create_by_default
         )
     elif k == "sink":
         q = QgsProcessingParameterFeatureSink(
-            p.name, title, _SINK_TYPES[p.geometry], optional=p.optional,
+            p.name,
+            title,
+            _SINK_TYPES[p.geometry],
+            optional=p.optional,
             createByDefault=p.create_by_default,
-        )  # fmt: skip
+        )
     else:  # pragma: no cover - the spec refuses unknown kinds
         raise ValueError(k)
     if p.advanced:
@@ -142,6 +173,8 @@ def read_parameter(alg, p: Param, parameters: dict, context) -> Any:
     feature source (the algorithm turns it into a core object); ``field`` a field name or "".
     """
     k = p.kind
+    if layer_input(p):
+        return layer_file(alg, p, parameters, context)
     if k == "file":
         return alg.parameterAsFile(parameters, p.name, context) or None
     if k == "crs":
@@ -170,3 +203,43 @@ def read_parameter(alg, p: Param, parameters: dict, context) -> Any:
     if k == "raster_out":
         return alg.parameterAsOutputLayer(parameters, p.name, context) or None
     raise ValueError(f"{p.name}: no value for kind {k}")
+
+
+class LayerOrFileParameter(QgsProcessingParameterMapLayer):
+    """A map-layer parameter that also takes a file path QGIS cannot open as a layer (a
+    LAS/LAZ DSM without a point-cloud provider): the job reads the file itself."""
+
+    def clone(self):
+        copy = LayerOrFileParameter(
+            self.name(), self.description(), self.defaultValue(), False, self.dataTypes()
+        )
+        copy.setFlags(self.flags())
+        copy.setHelp(self.help())
+        return copy
+
+    def checkValueIsAcceptable(self, value, context=None) -> bool:
+        if isinstance(value, str) and os.path.isfile(value):
+            return True
+        return super().checkValueIsAcceptable(value, context)
+
+
+def layer_file(alg, p: Param, parameters: dict, context) -> str | None:
+    """The file behind a layer parameter: a path given as text is taken as it is (a LAS/LAZ
+    where QGIS has no point-cloud provider, qgis_process's arguments); a layer of the project
+    gives its source, which must be a file GDAL (or PDAL) reads as a whole."""
+    value = parameters.get(p.name)
+    if isinstance(value, str) and os.path.isfile(value):
+        return value
+    layer = alg.parameterAsLayer(parameters, p.name, context)
+    if layer is None:  # not a layer: the text as a path (the job names a missing file)
+        return value if isinstance(value, str) and value else None
+    path = layer.source().split("|")[0]
+    if layer.providerType() not in ("gdal", "pdal") or not os.path.isfile(path):
+        raise QgsProcessingException(
+            QCoreApplication.translate(
+                "LidarPhotoProvider",
+                "{name}: the layer {layer} is not a raster or LAS/LAZ file ({source}); "
+                "save it as a GeoTIFF first",
+            ).format(name=p.name, layer=layer.name(), source=layer.source())
+        )
+    return path

@@ -197,3 +197,44 @@ def test_monoplot_tool_in_the_picking_dock(qgis_parent, qgis_app, qgis_new_proje
     before = layer.featureCount()
     dock.view.pointPicked.emit(*map(float, pixels[visible[0]]))  # the dock's again
     assert layer.featureCount() == before
+
+
+def test_a_dsm_layer_of_the_project_gives_the_file_s_result(provider, scene, tmp_path):
+    """The DSM chosen among the project's layers (a raster layer loaded from the GeoTIFF, given
+    as the layer or its id) gives the same points as the file path; a layer that is not a
+    file (a memory layer) is refused by name."""
+    from qgis.core import (
+        QgsProcessingContext,
+        QgsProcessingFeedback,
+        QgsProcessingParameterMapLayer,
+        QgsProject,
+    )
+
+    folder, _ = scene
+    alg = provider.algorithm("monoplot")
+    assert isinstance(alg.parameterDefinition("DSM"), QgsProcessingParameterMapLayer)
+    layer = QgsRasterLayer(str(folder / "dsm.tif"), "the DSM")
+    assert layer.isValid()
+    QgsProject.instance().addMapLayer(layer)
+    try:
+        base = _params(folder, OUTPUT_CSV=str(tmp_path / "a.csv"), DSM=str(folder / "dsm.tif"))
+        by_file = processing.run(ALG, base)["OUTPUT_POINTS"]
+        got = {}
+        for key, value in (("layer", layer), ("id", layer.id())):
+            out = processing.run(
+                ALG, {**base, "DSM": value, "OUTPUT_CSV": str(tmp_path / f"{key}.csv")}
+            )
+            got[key] = out["OUTPUT_POINTS"]
+        want = [f.geometry().asWkt(6) for f in by_file.getFeatures()]
+        for key, points in got.items():
+            assert [f.geometry().asWkt(6) for f in points.getFeatures()] == want, key
+        memory = QgsVectorLayer("Point?crs=EPSG:28992", "scratch", "memory")
+        QgsProject.instance().addMapLayer(memory)
+        context = QgsProcessingContext()
+        context.setProject(QgsProject.instance())
+        with pytest.raises(QgsProcessingException, match="DSM: the layer scratch is not a raster"):
+            processing.run(
+                ALG, {**base, "DSM": memory.id()}, context=context, feedback=QgsProcessingFeedback()
+            )
+    finally:
+        QgsProject.instance().removeAllMapLayers()
