@@ -33,10 +33,14 @@ GROW_NEIGHBOURS = 10
 
 
 def _eig_normals(cov: NDArray) -> NDArray:
-    """Upward unit normals (smallest eigenvectors) of a batch of 3x3 scatter matrices (B,3,3)."""
-    _, vec = np.linalg.eigh(cov)
-    n = vec[:, :, 0]
-    return n * np.where(n[:, 2:3] < 0, -1.0, 1.0)
+    """Upward unit normals (smallest eigenvectors) of a batch of 3x3 scatter matrices (B,3,3).
+
+    By the fixed Jacobi rotations of :func:`_jacobi_normals`, not LAPACK: with Debian's numpy
+    1.24 (the system OpenBLAS) ``eigh`` of a 3 x 3 gave other last bits on 1 and 2 BLAS
+    threads, and some points another plane (the region growing compares with these normals)."""
+    nx, ny, nz = _jacobi_normals(cov[:, 0, 0], cov[:, 0, 1], cov[:, 0, 2], cov[:, 1, 1],
+                                 cov[:, 1, 2], cov[:, 2, 2])  # fmt: skip
+    return np.column_stack([nx, ny, nz])
 
 
 def _jacobi_normals(
