@@ -137,13 +137,14 @@ def _model_inputs(demo, tmp_path) -> dict:
 
 #: The demo's flight takes the LiDAR control as the truth (core/simulation/flight_over.py) while
 #: the resection weights it with its covariance: every image's sigma0 is below 1 (0.23-0.95),
-#: and an image with little control estimates it from few degrees of freedom. Demo image 6
-#: (L2_006: 2 LCPs and 4 lines, redundancy 6) got sigma0 0.226 (chi-square 0.31 on 6 degrees
-#: of freedom, p = 0.0005 were the weights the errors'): its a-posteriori sigmas are 0.226 of
-#: its a-priori ones, and it lay 7.35 of them from the truth, 1.66 a-priori sigmas (the other
-#: nine within 1.8). The demo's images are held to the a-priori sigmas; the other tests of this
-#: file keep the a-posteriori ones (their scene draws the control with the noise of its
-#: covariance, so the weights are the errors').
+#: and an image with little control estimates it from few degrees of freedom. With the planes
+#: of seed voxels of 8 spacings, demo image 6 (L2_006: 2 LCPs and 4 lines, redundancy 6) got
+#: sigma0 0.226 (chi-square 0.31 on 6 degrees of freedom, p = 0.0005 were the weights the
+#: errors'): its a-posteriori sigmas were 0.226 of its a-priori ones, and it lay 7.35 of them
+#: from the truth, 1.66 a-priori sigmas (the other nine within 1.8); with 16 spacings, sigma0
+#: 0.53 and 1.59 a-posteriori sigmas. The demo's images are held to the a-priori sigmas; the
+#: other tests of this file keep the a-posteriori ones (their scene draws the control with the
+#: noise of its covariance, so the weights are the errors').
 
 
 def test_model_createlcps_to_resection(provider, demo, tmp_path):
