@@ -301,6 +301,15 @@ def _jacobi_normal(a00, a01, a02, a11, a12, a22):
     return nx_, ny_, nz_
 
 
+def _normals_kernel(cov, out):
+    """Upward normals (B, 3) of the 3 x 3 matrices ``cov`` (B, 3, 3) by :func:`_jacobi_normal`
+    (roof_planes_local._eig_normals' compiled path; the same bits as its numpy path)."""
+    for b in range(cov.shape[0]):
+        out[b, 0], out[b, 1], out[b, 2] = _jacobi_normal(cov[b, 0, 0], cov[b, 0, 1],
+                                                         cov[b, 0, 2], cov[b, 1, 1],
+                                                         cov[b, 1, 2], cov[b, 2, 2])
+
+
 def _local_planes_kernel(
     qs, cell_of, start, nx, ny, x0, y0, h, offs, bound2, lo, hi, k, g, tri, table, eps,
     min_support, cos_lo, cos_hi, keep, normals, quality, knn, spacing,
@@ -527,7 +536,7 @@ def _compiled(name: str) -> Callable[..., Any]:
     if name not in _COMPILED:
         func = {"local_planes": _local_planes_kernel, "claims": _claims_kernel,
                 "reassign": _reassign_kernel, "pairs": _pairs_kernel, "order": _order_kernel,
-                "moments": _moments_kernel}[name]  # fmt: skip
+                "moments": _moments_kernel, "normals": _normals_kernel}[name]  # fmt: skip
         _COMPILED[name] = cached_njit(func, nogil=True)
     return _COMPILED[name]
 
@@ -600,6 +609,13 @@ def counting_order(
     _compiled("order")(key.astype(np.int64, copy=False), int(nbins),
                        np.ascontiguousarray(xyz, dtype=np.float64), start, order)  # fmt: skip
     return order, start
+
+
+def normals(cov: np.ndarray) -> np.ndarray:
+    """Upward unit normals (B, 3) of symmetric 3 x 3 matrices (B, 3, 3), Jacobi rotations."""
+    out = np.empty((cov.shape[0], 3))
+    _compiled("normals")(np.ascontiguousarray(cov, dtype=np.float64), out)
+    return out
 
 
 def moments(q: np.ndarray, labels: np.ndarray, nl: int) -> tuple[np.ndarray, ...]:

@@ -130,7 +130,7 @@ def _grow(
             cov = s2[grown] / cnt[grown, None, None] - mean[:, :, None] * mean[:, None, :]
             iu = np.triu_indices(3, 1)
             cov[:, iu[1], iu[0]] = cov[:, iu[0], iu[1]]
-            reg_n[base + grown] = _eig_normals(cov)
+            reg_n[base + grown] = _eig_normals(cov, compiled)
             reg_c[base + grown] = origin[grown] + mean
     return labels
 
@@ -226,7 +226,7 @@ def _fit_labels(
     else:
         m = labels >= 0
         counts, centroid, cov = label_moments(q[m], labels[m], nl)
-    return _eig_normals(cov), centroid, counts
+    return _eig_normals(cov, compiled), centroid, counts
 
 
 _UPPER = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
