@@ -22,10 +22,11 @@ Roof planes (:func:`tile_planes`, :func:`merge_cut_planes`) are extracted on eac
 plus a buffer of :func:`roof_buffer`, sized from the neighbourhood the extraction uses: a core
 point's label depends on its K neighbours' local RANSAC, on its G neighbours' local planes and
 on the reassignment, which reaches REASSIGN_PASSES + 1 rings of G neighbours; the buffer holds
-three times that, so the half next to the core (the overlap band) is labelled as in a whole-file
-run. A point's local plane and seed do not depend on the points a tile holds beyond its
-neighbours (RANSAC triplet tables picked by its coordinates, seed voxels on map coordinates
-sized by the local spacing, ties by coordinates: :mod:`core.lidar.roof_planes`); what a tile
+three times that, and at least the band plus a seed voxel plus a K patch, so the half next to
+the core (the overlap band) is labelled as in a whole-file run. A point's local plane does not
+depend on the points a tile holds beyond its neighbours, nor a seed on those beyond its voxel
+(RANSAC triplet tables picked by its coordinates, seed voxels on map coordinates sized by the
+local spacing, ties by coordinates: :mod:`core.lidar.roof_planes`); what a tile
 cannot see is the rest of a region cut by its buffer (its refit), hence the band. Each tile
 keeps the planes of its core points (pieces) and reports the labels it gives to the points of
 the band on both sides of its border. A plane cut by a border is found by both tiles; two pieces
@@ -80,20 +81,25 @@ def roof_buffer(k_neighbours: int, spacing: float) -> float:
     that many points): the label of a point of the band (half the buffer) has all it depends
     on, and the region's plane half a buffer more of its points. With twice the reach, one
     plane of the AHN3 crop 2 in 2 x 2 tiles came 0.61 degrees off (its fit at the border
-    differed by 29 of 740 points); with 1.5x more buffer every plane matched.
+    differed by 29 of 740 points); with 1.5x more buffer every plane matched. At least the band
+    plus a seed voxel (SEED_VOXEL spacings, up to sqrt(2) more by its rounding to a power of
+    two) plus a K patch: a voxel that reaches into the band has all its points, and their
+    local planes, in the tile, so the band's seeds are the whole file's.
 
     >>> round(roof_buffer(20, 0.5), 3)
-    14.489
+    19.82
     """
     from .roof_planes import REASSIGN_PASSES
     from .roof_planes_local import GROW_NEIGHBOURS
+    from .roof_planes_regions import SEED_VOXEL
 
     def radius(n: int) -> float:
         return math.sqrt(n / math.pi) * spacing
 
     reach = radius(k_neighbours) + (REASSIGN_PASSES + 1) * radius(min(GROW_NEIGHBOURS,
                                                                       k_neighbours))
-    return float(3.0 * reach)
+    seeds = 1.5 * reach + math.sqrt(2.0) * SEED_VOXEL * spacing + radius(k_neighbours)
+    return float(max(3.0 * reach, seeds))
 
 
 #: Least band points two pieces share to be merged (fewer: a corner or a ridge touch).

@@ -37,7 +37,9 @@ unit):
    It is a concave hull for display, not a measured building outline.
 
 **Repeatable**: the points are sorted by grid cell and, within a cell, by their coordinates;
-every tie goes to the lower sorted index and every sum runs in that order. The same point set
+every tie goes to the lower sorted index and every sum runs in that order; the local and the
+region normals come from fixed Jacobi rotations (IEEE +, -, *, /, sqrt), not LAPACK, so the
+assignments do not depend on the BLAS/LAPACK build or its threads. The same point set
 gives the same planes bit for bit whatever the order of the points, the seed or the number of
 threads (tests/core/test_roof_planes_repeatable.py), and a tile holding a buffer of
 :func:`core.lidar.block.roof_buffer` the whole file's local planes and seeds on its core.

@@ -32,11 +32,20 @@ ShouldStop = Union[Callable[[], bool], None]
 GROW_NEIGHBOURS = 10
 
 
-def _eig_normals(cov: NDArray) -> NDArray:
-    """Upward unit normals (smallest eigenvectors) of a batch of 3x3 scatter matrices (B,3,3)."""
-    _, vec = np.linalg.eigh(cov)
-    n = vec[:, :, 0]
-    return n * np.where(n[:, 2:3] < 0, -1.0, 1.0)
+def _eig_normals(cov: NDArray, compiled: bool = False) -> NDArray:
+    """Upward unit normals (smallest eigenvectors) of a batch of 3x3 scatter matrices (B,3,3).
+
+    By the fixed Jacobi rotations of :func:`_jacobi_normals` (compiled: the same rotations in
+    numba, the same bits), not LAPACK: the region growing compares with these normals, so
+    they must not depend on the LAPACK build or its threads (Debian's numpy 1.24 links the
+    system OpenBLAS). The numpy path costs about 4 % of an extraction (AHN3 crop 1)."""
+    if compiled:
+        from . import roof_planes_numba
+
+        return roof_planes_numba.normals(cov)
+    nx, ny, nz = _jacobi_normals(cov[:, 0, 0], cov[:, 0, 1], cov[:, 0, 2], cov[:, 1, 1],
+                                 cov[:, 1, 2], cov[:, 2, 2])  # fmt: skip
+    return np.column_stack([nx, ny, nz])
 
 
 def _jacobi_normals(

@@ -94,95 +94,244 @@ def _plane_dist(q, i, centre, normal, c):
                + (q[i, 2] - centre[c, 2]) * normal[c, 2])  # fmt: skip
 
 
+@_jit_helper
+def _first_cut(qs, last_r, last_i, px, py, pz):
+    """Squared bound on the k-th distance of (px, py, pz): a point's k-th distance is at most
+    a previous point's plus their distance (the search's first cut; inf for none)."""
+    cut = np.inf
+    for u in range(LAST):
+        if last_r[u] < np.inf:
+            rr = last_r[u] + np.sqrt(_sq_dist(qs, last_i[u], px, py, pz))
+            rr = rr * rr * (1.0 + 1e-9)  # above any rounding of the squares below
+            if rr < cut:
+                cut = rr
+    return cut
+
+
+@_jit_helper
+def _nearest(qs, cell_of, start, nx, ny, x0, y0, h, offs, bound2, i, k, cut, bd, bi):
+    """The k nearest neighbours of point i of ``qs`` into (bd, bi), ascending (d^2, index):
+    the points of the cells in the offsets' order, then, if fewer than k were within the
+    offsets' reach, every point (one pass, from an empty list). The insertion stays inline in
+    the loop (as a helper of its own the local planes took 5 % longer)."""
+    no = offs.shape[0]
+    px = qs[i, 0]
+    py = qs[i, 1]
+    pz = qs[i, 2]
+    c = cell_of[i]
+    cy = c // nx
+    cx = c - cy * nx
+    m = 0
+    o = 0
+    every = False
+    while True:
+        # the cell bounds carry rounding of about 1e-16 of the coordinates: prune with a
+        # margin, so that a tie at the k-th distance is never cut off
+        if o < no and not bound2[o] > cut * SLACK:
+            gx = cx + offs[o, 0]
+            gy = cy + offs[o, 1]
+            o += 1
+            if gx < 0 or gy < 0 or gx >= nx or gy >= ny:
+                continue
+            cc = gy * nx + gx
+            a = start[cc]
+            b = start[cc + 1]
+            if a == b:
+                continue
+            if cut < np.inf:
+                lx = x0 + gx * h
+                ly = y0 + gy * h
+                ex = max(lx - px, 0.0, px - lx - h)
+                ey = max(ly - py, 0.0, py - ly - h)
+                if ex * ex + ey * ey > cut * SLACK:
+                    continue
+        elif m < k and not every:
+            every = True
+            o = no
+            m = 0
+            cut = np.inf
+            a = 0
+            b = qs.shape[0]
+        else:
+            break
+        for s in range(a, b):
+            d2 = _sq_dist(qs, s, px, py, pz)
+            if d2 > cut:
+                continue
+            if m < k:
+                t = m
+                m += 1
+            elif d2 < bd[k - 1] or (d2 == bd[k - 1] and s < bi[k - 1]):
+                t = k - 1
+            else:
+                continue
+            while t > 0 and (bd[t - 1] > d2 or (bd[t - 1] == d2 and bi[t - 1] > s)):
+                bd[t] = bd[t - 1]
+                bi[t] = bi[t - 1]
+                t -= 1
+            bd[t] = d2
+            bi[t] = s
+            if m == k and bd[k - 1] < cut:
+                cut = bd[k - 1]
+
+
+@_jit_helper
+def _best_triplet(px32, py32, pz32, k, tri, tab, eps32, tiny32):
+    """RANSAC over the triplets of table ``tab`` (float32, relative to the point): the most
+    supported plane (support, nx, ny, nz, offset); the first of equal supports wins."""
+    best_support = -1
+    bnx = np.float32(0.0)
+    bny = np.float32(0.0)
+    bnz = np.float32(0.0)
+    boff = np.float32(0.0)
+    for t in range(tri.shape[1]):
+        a0 = tri[tab, t, 0]
+        a1 = tri[tab, t, 1]
+        a2 = tri[tab, t, 2]
+        ax, ay, az = px32[a0], py32[a0], pz32[a0]
+        ux = px32[a1] - ax
+        uy = py32[a1] - ay
+        uz = pz32[a1] - az
+        vx = px32[a2] - ax
+        vy = py32[a2] - ay
+        vz = pz32[a2] - az
+        nx_ = uy * vz - uz * vy
+        ny_ = uz * vx - ux * vz
+        nz_ = ux * vy - uy * vx
+        length = np.sqrt(nx_ * nx_ + ny_ * ny_ + nz_ * nz_)
+        valid = length > tiny32
+        if not valid:
+            length = np.float32(1.0)
+        nx_ = nx_ / length
+        ny_ = ny_ / length
+        nz_ = nz_ / length
+        off = -(nx_ * ax + ny_ * ay + nz_ * az)
+        support = 0
+        if valid:
+            for j in range(k):
+                d = abs(nx_ * px32[j] + ny_ * py32[j] + nz_ * pz32[j] + off)
+                if d < eps32:
+                    support += 1
+        if support > best_support:
+            best_support = support
+            bnx, bny, bnz, boff = nx_, ny_, nz_, off
+    return best_support, bnx, bny, bnz, boff
+
+
+@_jit_helper
+def _inlier_moments(px32, py32, pz32, inl, k, cnt):
+    """Mean (float64) of the inliers and the upper triangle of their scatter about it, summed
+    in neighbour order."""
+    sx = 0.0
+    sy = 0.0
+    sz = 0.0
+    for j in range(k):
+        w = 1.0 if inl[j] else 0.0
+        sx += w * np.float64(px32[j])
+        sy += w * np.float64(py32[j])
+        sz += w * np.float64(pz32[j])
+    mx = sx / cnt
+    my = sy / cnt
+    mz = sz / cnt
+    a00 = 0.0
+    a01 = 0.0
+    a02 = 0.0
+    a11 = 0.0
+    a12 = 0.0
+    a22 = 0.0
+    for j in range(k):
+        ex, ey, ez = _deviation(px32, py32, pz32, inl, j, mx, my, mz)
+        a00 += ex * ex
+        a01 += ex * ey
+        a02 += ex * ez
+        a11 += ey * ey
+        a12 += ey * ez
+        a22 += ez * ez
+    return mx, my, mz, a00, a01, a02, a11, a12, a22
+
+
+@_jit_helper
+def _jacobi_normal(a00, a01, a02, a11, a12, a22):
+    """Upward unit normal (smallest eigenvector) of a symmetric 3 x 3 by JACOBI_SWEEPS sweeps
+    of rotations (the numpy back end's _jacobi_normals, scalar)."""
+    v00, v01, v02 = 1.0, 0.0, 0.0
+    v10, v11, v12 = 0.0, 1.0, 0.0
+    v20, v21, v22 = 0.0, 0.0, 1.0
+    for _ in range(JACOBI_SWEEPS):
+        for rot in range(3):
+            if rot == 0:
+                app, aqq, apq = a00, a11, a01
+            elif rot == 1:
+                app, aqq, apq = a00, a22, a02
+            else:
+                app, aqq, apq = a11, a22, a12
+            if apq == 0.0:
+                continue
+            theta = (aqq - app) / (2.0 * apq)
+            tt = 1.0 / (abs(theta) + np.sqrt(theta * theta + 1.0))
+            if theta < 0.0:
+                tt = -tt
+            cc_ = 1.0 / np.sqrt(tt * tt + 1.0)
+            ss = tt * cc_
+            napp = app - tt * apq
+            naqq = aqq + tt * apq
+            if rot == 0:  # p = 0, q = 1, r = 2
+                a00, a11, a01 = napp, naqq, 0.0
+                a02, a12 = _rotate(cc_, ss, a02, a12)
+                v00, v01, v10, v11, v20, v21 = _rotate_columns(
+                    cc_, ss, v00, v01, v10, v11, v20, v21)
+            elif rot == 1:  # p = 0, q = 2, r = 1
+                a00, a22, a02 = napp, naqq, 0.0
+                a01, a12 = _rotate(cc_, ss, a01, a12)
+                v00, v02, v10, v12, v20, v22 = _rotate_columns(
+                    cc_, ss, v00, v02, v10, v12, v20, v22)
+            else:  # p = 1, q = 2, r = 0
+                a11, a22, a12 = napp, naqq, 0.0
+                a01, a02 = _rotate(cc_, ss, a01, a02)
+                v01, v02, v11, v12, v21, v22 = _rotate_columns(
+                    cc_, ss, v01, v02, v11, v12, v21, v22)
+    if a00 <= a11 and a00 <= a22:
+        nx_, ny_, nz_ = v00, v10, v20
+    elif a11 <= a22:
+        nx_, ny_, nz_ = v01, v11, v21
+    else:
+        nx_, ny_, nz_ = v02, v12, v22
+    if nz_ < 0.0:
+        nx_, ny_, nz_ = -nx_, -ny_, -nz_
+    return nx_, ny_, nz_
+
+
+def _normals_kernel(cov, out):
+    """Upward normals (B, 3) of the 3 x 3 matrices ``cov`` (B, 3, 3) by :func:`_jacobi_normal`
+    (roof_planes_local._eig_normals' compiled path; the same bits as its numpy path)."""
+    for b in range(cov.shape[0]):
+        out[b, 0], out[b, 1], out[b, 2] = _jacobi_normal(cov[b, 0, 0], cov[b, 0, 1],
+                                                         cov[b, 0, 2], cov[b, 1, 1],
+                                                         cov[b, 1, 2], cov[b, 2, 2])
+
+
 def _local_planes_kernel(
     qs, cell_of, start, nx, ny, x0, y0, h, offs, bound2, lo, hi, k, g, tri, table, eps,
     min_support, cos_lo, cos_hi, keep, normals, quality, knn, spacing,
 ):  # fmt: skip
     """Points lo .. hi-1 of ``qs`` (sorted by grid cell): K nearest neighbours and the local
     RANSAC; outputs at [i - lo] (keep, normals, quality, knn (first g), spacing)."""
-    no = offs.shape[0]
     bd = np.empty(k)
     bi = np.empty(k, np.int64)
     px32 = np.empty(k, np.float32)
     py32 = np.empty(k, np.float32)
     pz32 = np.empty(k, np.float32)
     inl = np.empty(k, np.bool_)
-    nt = tri.shape[1]
     eps32 = np.float32(eps)
     tiny32 = np.float32(1e-12)
-    # the k-th distance of the last points: a point's k-th distance is at most another's
-    # plus their distance, a bound that prunes cells and candidates from the start
     last_r = np.full(max(LAST, 1), np.inf)
     last_i = np.zeros(max(LAST, 1), np.int64)
     for i in range(lo, hi):
         px = qs[i, 0]
         py = qs[i, 1]
         pz = qs[i, 2]
-        c = cell_of[i]
-        cy = c // nx
-        cx = c - cy * nx
-        cut = np.inf
-        for u in range(LAST):
-            if last_r[u] < np.inf:
-                rr = last_r[u] + np.sqrt(_sq_dist(qs, last_i[u], px, py, pz))
-                rr = rr * rr * (1.0 + 1e-9)  # above any rounding of the squares below
-                if rr < cut:
-                    cut = rr
-        # candidates: the points of the cells in the offsets' order, then, if fewer than k
-        # were within the offsets' reach, every point (one pass, from an empty list); the
-        # insertion is written once, inline (as an njit helper the local planes took 5 % longer)
-        m = 0
-        o = 0
-        every = False
-        while True:
-            # the cell bounds carry rounding of about 1e-16 of the coordinates: prune with a
-            # margin, so that a tie at the k-th distance is never cut off
-            if o < no and not bound2[o] > cut * SLACK:
-                gx = cx + offs[o, 0]
-                gy = cy + offs[o, 1]
-                o += 1
-                if gx < 0 or gy < 0 or gx >= nx or gy >= ny:
-                    continue
-                cc = gy * nx + gx
-                a = start[cc]
-                b = start[cc + 1]
-                if a == b:
-                    continue
-                if cut < np.inf:
-                    lx = x0 + gx * h
-                    ly = y0 + gy * h
-                    ex = max(lx - px, 0.0, px - lx - h)
-                    ey = max(ly - py, 0.0, py - ly - h)
-                    if ex * ex + ey * ey > cut * SLACK:
-                        continue
-            elif m < k and not every:
-                every = True
-                o = no
-                m = 0
-                cut = np.inf
-                a = 0
-                b = qs.shape[0]
-            else:
-                break
-            for s in range(a, b):
-                d2 = _sq_dist(qs, s, px, py, pz)
-                if d2 > cut:
-                    continue
-                if m < k:
-                    t = m
-                    m += 1
-                elif d2 < bd[k - 1] or (d2 == bd[k - 1] and s < bi[k - 1]):
-                    t = k - 1
-                else:
-                    continue
-                while t > 0 and (bd[t - 1] > d2 or (bd[t - 1] == d2 and bi[t - 1] > s)):
-                    bd[t] = bd[t - 1]
-                    bi[t] = bi[t - 1]
-                    t -= 1
-                bd[t] = d2
-                bi[t] = s
-                if m == k and bd[k - 1] < cut:
-                    cut = bd[k - 1]
+        cut = _first_cut(qs, last_r, last_i, px, py, pz)
+        _nearest(qs, cell_of, start, nx, ny, x0, y0, h, offs, bound2, i, k, cut, bd, bi)
         slot = i % max(LAST, 1)
         last_r[slot] = np.sqrt(bd[k - 1])
         last_i[slot] = i
@@ -196,42 +345,8 @@ def _local_planes_kernel(
             px32[j] = np.float32(qs[s, 0] - px)
             py32[j] = np.float32(qs[s, 1] - py)
             pz32[j] = np.float32(qs[s, 2] - pz)
-        best_support = -1
-        bnx = np.float32(0.0)
-        bny = np.float32(0.0)
-        bnz = np.float32(0.0)
-        boff = np.float32(0.0)
-        for t in range(nt):
-            a0 = tri[table[i], t, 0]
-            a1 = tri[table[i], t, 1]
-            a2 = tri[table[i], t, 2]
-            ax, ay, az = px32[a0], py32[a0], pz32[a0]
-            ux = px32[a1] - ax
-            uy = py32[a1] - ay
-            uz = pz32[a1] - az
-            vx = px32[a2] - ax
-            vy = py32[a2] - ay
-            vz = pz32[a2] - az
-            nx_ = uy * vz - uz * vy
-            ny_ = uz * vx - ux * vz
-            nz_ = ux * vy - uy * vx
-            length = np.sqrt(nx_ * nx_ + ny_ * ny_ + nz_ * nz_)
-            valid = length > tiny32
-            if not valid:
-                length = np.float32(1.0)
-            nx_ = nx_ / length
-            ny_ = ny_ / length
-            nz_ = nz_ / length
-            off = -(nx_ * ax + ny_ * ay + nz_ * az)
-            support = 0
-            if valid:
-                for j in range(k):
-                    d = abs(nx_ * px32[j] + ny_ * py32[j] + nz_ * pz32[j] + off)
-                    if d < eps32:
-                        support += 1
-            if support > best_support:
-                best_support = support
-                bnx, bny, bnz, boff = nx_, ny_, nz_, off
+        best_support, bnx, bny, bnz, boff = _best_triplet(px32, py32, pz32, k, tri, table[i],
+                                                          eps32, tiny32)  # fmt: skip
         cnt = 0
         for j in range(k):
             d = abs(bnx * px32[j] + bny * py32[j] + bnz * pz32[j] + boff)
@@ -240,76 +355,9 @@ def _local_planes_kernel(
                 cnt += 1
         cnt = max(cnt, 1)
         # refit on the inliers (float64, sums in neighbour order)
-        sx = 0.0
-        sy = 0.0
-        sz = 0.0
-        for j in range(k):
-            w = 1.0 if inl[j] else 0.0
-            sx += w * np.float64(px32[j])
-            sy += w * np.float64(py32[j])
-            sz += w * np.float64(pz32[j])
-        mx = sx / cnt
-        my = sy / cnt
-        mz = sz / cnt
-        a00 = 0.0
-        a01 = 0.0
-        a02 = 0.0
-        a11 = 0.0
-        a12 = 0.0
-        a22 = 0.0
-        for j in range(k):
-            ex, ey, ez = _deviation(px32, py32, pz32, inl, j, mx, my, mz)
-            a00 += ex * ex
-            a01 += ex * ey
-            a02 += ex * ez
-            a11 += ey * ey
-            a12 += ey * ez
-            a22 += ez * ez
-        # Jacobi rotations (the numpy back end's _jacobi_normals, scalar)
-        v00, v01, v02 = 1.0, 0.0, 0.0
-        v10, v11, v12 = 0.0, 1.0, 0.0
-        v20, v21, v22 = 0.0, 0.0, 1.0
-        for _ in range(JACOBI_SWEEPS):
-            for rot in range(3):
-                if rot == 0:
-                    app, aqq, apq = a00, a11, a01
-                elif rot == 1:
-                    app, aqq, apq = a00, a22, a02
-                else:
-                    app, aqq, apq = a11, a22, a12
-                if apq == 0.0:
-                    continue
-                theta = (aqq - app) / (2.0 * apq)
-                tt = 1.0 / (abs(theta) + np.sqrt(theta * theta + 1.0))
-                if theta < 0.0:
-                    tt = -tt
-                cc_ = 1.0 / np.sqrt(tt * tt + 1.0)
-                ss = tt * cc_
-                napp = app - tt * apq
-                naqq = aqq + tt * apq
-                if rot == 0:  # p = 0, q = 1, r = 2
-                    a00, a11, a01 = napp, naqq, 0.0
-                    a02, a12 = _rotate(cc_, ss, a02, a12)
-                    v00, v01, v10, v11, v20, v21 = _rotate_columns(
-                        cc_, ss, v00, v01, v10, v11, v20, v21)
-                elif rot == 1:  # p = 0, q = 2, r = 1
-                    a00, a22, a02 = napp, naqq, 0.0
-                    a01, a12 = _rotate(cc_, ss, a01, a12)
-                    v00, v02, v10, v12, v20, v22 = _rotate_columns(
-                        cc_, ss, v00, v02, v10, v12, v20, v22)
-                else:  # p = 1, q = 2, r = 0
-                    a11, a22, a12 = napp, naqq, 0.0
-                    a01, a02 = _rotate(cc_, ss, a01, a02)
-                    v01, v02, v11, v12, v21, v22 = _rotate_columns(
-                        cc_, ss, v01, v02, v11, v12, v21, v22)
-        if a00 <= a11 and a00 <= a22:
-            nx_, ny_, nz_ = v00, v10, v20
-        elif a11 <= a22:
-            nx_, ny_, nz_ = v01, v11, v21
-        else:
-            nx_, ny_, nz_ = v02, v12, v22
-        if nz_ < 0.0:
-            nx_, ny_, nz_ = -nx_, -ny_, -nz_
+        mx, my, mz, a00, a01, a02, a11, a12, a22 = _inlier_moments(px32, py32, pz32, inl, k,
+                                                                   cnt)  # fmt: skip
+        nx_, ny_, nz_ = _jacobi_normal(a00, a01, a02, a11, a12, a22)
         dist_point = abs(nx_ * mx + ny_ * my + nz_ * mz)
         rr = 0.0
         for j in range(k):
@@ -488,7 +536,7 @@ def _compiled(name: str) -> Callable[..., Any]:
     if name not in _COMPILED:
         func = {"local_planes": _local_planes_kernel, "claims": _claims_kernel,
                 "reassign": _reassign_kernel, "pairs": _pairs_kernel, "order": _order_kernel,
-                "moments": _moments_kernel}[name]  # fmt: skip
+                "moments": _moments_kernel, "normals": _normals_kernel}[name]  # fmt: skip
         _COMPILED[name] = cached_njit(func, nogil=True)
     return _COMPILED[name]
 
@@ -561,6 +609,13 @@ def counting_order(
     _compiled("order")(key.astype(np.int64, copy=False), int(nbins),
                        np.ascontiguousarray(xyz, dtype=np.float64), start, order)  # fmt: skip
     return order, start
+
+
+def normals(cov: np.ndarray) -> np.ndarray:
+    """Upward unit normals (B, 3) of symmetric 3 x 3 matrices (B, 3, 3), Jacobi rotations."""
+    out = np.empty((cov.shape[0], 3))
+    _compiled("normals")(np.ascontiguousarray(cov, dtype=np.float64), out)
+    return out
 
 
 def moments(q: np.ndarray, labels: np.ndarray, nl: int) -> tuple[np.ndarray, ...]:

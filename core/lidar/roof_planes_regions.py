@@ -23,8 +23,13 @@ from .roof_planes_local import Array, ShouldStop, _eig_normals
 RoofPlaneParams = Any
 
 #: Seed voxel size, in point spacings (distance to the 4th neighbour, the median over the point
-#: and its GROW_NEIGHBOURS - 1 nearest), rounded to a power of two.
-SEED_VOXEL = 8.0
+#: and its GROW_NEIGHBOURS - 1 nearest), rounded to a power of two. With 8 (2 m voxels on AHN3)
+#: a dormer or a small hip face of 35-90 points got 3-6 seeds, grew into regions of 13-35
+#: points each that the coplanar merge did not join (their fits too rough) and that were all
+#: dropped below min_plane_points: AHN3 crop 1 lost those faces and 13 of the 82 LCPs of the
+#: former seeded run at their corners (77 LCPs); with 16: 806 planes, 82 LCPs, the town's
+#: accuracy unchanged (bench/roof_planes.md).
+SEED_VOXEL = 16.0
 #: Seeding rounds of the region growing.
 SEED_ROUNDS = 4
 
@@ -125,7 +130,7 @@ def _grow(
             cov = s2[grown] / cnt[grown, None, None] - mean[:, :, None] * mean[:, None, :]
             iu = np.triu_indices(3, 1)
             cov[:, iu[1], iu[0]] = cov[:, iu[0], iu[1]]
-            reg_n[base + grown] = _eig_normals(cov)
+            reg_n[base + grown] = _eig_normals(cov, compiled)
             reg_c[base + grown] = origin[grown] + mean
     return labels
 
@@ -221,7 +226,7 @@ def _fit_labels(
     else:
         m = labels >= 0
         counts, centroid, cov = label_moments(q[m], labels[m], nl)
-    return _eig_normals(cov), centroid, counts
+    return _eig_normals(cov, compiled), centroid, counts
 
 
 _UPPER = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))

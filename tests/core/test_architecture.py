@@ -192,7 +192,6 @@ FILES_NOT_YET_SPLIT: dict[str, int] = {}
 FUNCTIONS_NOT_YET_SPLIT = {
     "bench/bench_ortho.py:main": 174,
     "core/geometry/raycast_numba.py:_trace": 174,
-    "core/lidar/roof_planes_numba.py:_local_planes_kernel": 233,
     "core/photo/camera_calibration.py:calibrate_camera": 157,
     "core/photo/least_squares_matching.py:lsm_batch": 159,
     "core/photo/monoplot.py:monoplot": 227,

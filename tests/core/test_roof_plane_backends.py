@@ -23,6 +23,7 @@ from lidarphoto.core.lidar.roof_planes import (
     _spatial_order,
     extract_roof_planes,
 )
+from lidarphoto.core.lidar.roof_planes_local import _eig_normals
 from lidarphoto.core.simulation.town import CLASS_GROUND, simulate_town
 
 AHN3 = Path(__file__).resolve().parents[1] / "data" / "ahn3" / "ahn3_delft_crop60.laz"
@@ -131,6 +132,12 @@ def test_jacobi_normals_against_lapack():
     ref = vec[:, :, 0] * np.where(vec[:, 2:3, 0] < 0, -1.0, 1.0)
     np.testing.assert_allclose(normal, ref, atol=1e-9)
     np.testing.assert_allclose(np.linalg.norm(normal, axis=1), 1.0, atol=1e-12)
+    # the region normals' two paths (numpy and numba) give the same bits, zero and huge or
+    # tiny matrices included
+    cov[50:60] = 0.0
+    cov[60:70] *= 1e-300
+    cov[70:80] *= 1e150
+    np.testing.assert_array_equal(_eig_normals(cov), _eig_normals(cov, True))
 
 
 def test_counting_order_is_the_coordinate_lexsort_and_backend_names():

@@ -35,8 +35,10 @@ def _rows(path):
         return list(csv.DictReader(f))
 
 
-def _errors_in_sigma(eo_csv, truth_csv) -> np.ndarray:
-    """(images, 6) differences from the truth in units of the file's own sigmas."""
+def _errors_in_sigma(eo_csv, truth_csv, prior: bool = False) -> np.ndarray:
+    """(images, 6) differences from the truth in units of the file's own sigmas (a-posteriori,
+    ``sigma0 sqrt(Qxx)``), or of the a-priori ones (``sqrt(Qxx)``: the file's divided by its
+    sigma0) with ``prior``."""
     got, truth = read_eo_csv(eo_csv), read_eo_csv(truth_csv)
     rows = {r["image_id"]: r for r in _rows(eo_csv)}
     out = []
@@ -44,7 +46,8 @@ def _errors_in_sigma(eo_csv, truth_csv) -> np.ndarray:
         t = truth.image_id.index(i)
         d_ang = (np.degrees(got.opk[k] - truth.opk[t]) + 180.0) % 360.0 - 180.0
         d = np.r_[got.xyz[k] - truth.xyz[t], d_ang]
-        out.append(d / np.array([float(rows[i][c]) for c in SIGMAS]))
+        scale = float(rows[i]["sigma0"]) if prior else 1.0
+        out.append(d / (scale * np.array([float(rows[i][c]) for c in SIGMAS])))
     return np.array(out)
 
 
@@ -132,20 +135,22 @@ def _model_inputs(demo, tmp_path) -> dict:
             "resect:eo": str(tmp_path / "eo.csv")}  # fmt: skip
 
 
-#: Seen after the merges of 2026-12-02 (issue 33's repeatable roof planes change the demo tile's
-#: planes and lines: 59 planes, 3 LCPs, 30 lines): image 6 of the flight resects 7.35 sigma from
-#: the truth (the other nine within 2.7 sigma). Not yet explained: issue 33 stays open for it.
-_IMAGE_6 = pytest.mark.xfail(
-    strict=False,
-    reason="demo image 6 resected 7.35 sigma from the "
-    "truth since the repeatable roof planes (issue 33, open)",
-)
+#: The demo's flight takes the LiDAR control as the truth (core/simulation/flight_over.py) while
+#: the resection weights it with its covariance: every image's sigma0 is below 1 (0.23-0.95),
+#: and an image with little control estimates it from few degrees of freedom. With the planes
+#: of seed voxels of 8 spacings, demo image 6 (L2_006: 2 LCPs and 4 lines, redundancy 6) got
+#: sigma0 0.226 (chi-square 0.31 on 6 degrees of freedom, p = 0.0005 were the weights the
+#: errors'): its a-posteriori sigmas were 0.226 of its a-priori ones, and it lay 7.35 of them
+#: from the truth, 1.66 a-priori sigmas (the other nine within 1.8); with 16 spacings, sigma0
+#: 0.53 and 1.59 a-posteriori sigmas. The demo's images are held to the a-priori sigmas; the
+#: other tests of this file keep the a-posteriori ones (their scene draws the control with the
+#: noise of its covariance, so the weights are the errors').
 
 
-@_IMAGE_6
 def test_model_createlcps_to_resection(provider, demo, tmp_path):
     """The model's LCPs and lines are the demo's (the same createlcps); every image of the
-    flight is resected from them without approximate values, within 4 sigma of the truth."""
+    flight is resected from them without approximate values, within 4 a-priori sigma of the
+    truth."""
     model = QgsProcessingModelAlgorithm()
     assert model.fromFile(str(MODEL))
     ok, errors = model.validate()
@@ -154,15 +159,15 @@ def test_model_createlcps_to_resection(provider, demo, tmp_path):
         "lidarphoto:createlcps", "lidarphoto:resection"]  # fmt: skip
     processing.run(model, _model_inputs(demo, tmp_path))
     assert (tmp_path / "lines.csv").read_text() == (demo["lidar"] / "lines.csv").read_text()
-    z = _errors_in_sigma(tmp_path / "eo.csv", demo["paths"]["eo_true"])
+    z = _errors_in_sigma(tmp_path / "eo.csv", demo["paths"]["eo_true"], prior=True)
     assert len(z) == len(read_eo_csv(demo["paths"]["eo_true"]).image_id)
     assert np.all(np.abs(z) < 4.0), z
 
 
-@_IMAGE_6
 def test_model_in_qgis_process(qp_env, demo, tmp_path):
     args = [f"{k}={v}" for k, v in _model_inputs(demo, tmp_path).items()]
     r = subprocess.run([QGIS_PROCESS, "--json", "run", str(MODEL), "--", *args], env=qp_env,
                        capture_output=True, text=True, timeout=600)  # fmt: skip
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
-    assert np.all(np.abs(_errors_in_sigma(tmp_path / "eo.csv", demo["paths"]["eo_true"])) < 4)
+    z = _errors_in_sigma(tmp_path / "eo.csv", demo["paths"]["eo_true"], prior=True)
+    assert np.all(np.abs(z) < 4.0), z
