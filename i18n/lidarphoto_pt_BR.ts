@@ -694,6 +694,10 @@
     <context>
         <name>LidarPhotoProvider</name>
         <message>
+            <source>Orthophotos ({})</source>
+            <translation>Ortofotos ({})</translation>
+        </message>
+        <message>
             <source>All files (*.*)</source>
             <translation>Todos os arquivos (*.*)</translation>
         </message>

@@ -206,3 +206,32 @@ class LayerStyle(QgsProcessingLayerPostProcessorInterface):
         style = cls(func)
         cls._alive.append(style)
         return style
+
+
+class LayerInGroup(LayerStyle):
+    """A style function, then the layer moved into the layer-tree group ``group`` (made at
+    the top of the tree on first use): one run's orthophotos side by side in one group."""
+
+    def __init__(self, func: Callable[[object], None], group: str) -> None:
+        super().__init__(func)
+        self.group = group
+
+    def postProcessLayer(self, layer, context, feedback):
+        super().postProcessLayer(layer, context, feedback)
+        project = context.project()
+        if project is None:
+            return
+        root = project.layerTreeRoot()
+        node = root.findLayer(layer.id())
+        if node is None:
+            return
+        group = root.findGroup(self.group) or root.insertGroup(0, self.group)
+        if node.parent() is not group:
+            group.addChildNode(node.clone())
+            node.parent().removeChildNode(node)
+
+    @classmethod
+    def create_in(cls, func: Callable[[object], None], group: str) -> LayerInGroup:
+        style = cls(func, group)
+        cls._alive.append(style)
+        return style

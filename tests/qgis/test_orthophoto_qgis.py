@@ -106,11 +106,24 @@ def test_processing_run_and_layers_to_load(provider, demo, tmp_path):
         assert qi.geotransform == ci.geotransform
         np.testing.assert_array_equal(qm, cm)
         np.testing.assert_array_equal(qa, ca)
-    # the style: 8-bit RGB shown as is, without QGIS's 2-98 % stretch
-    layer = QgsRasterLayer(str(tmp_path / "q" / written[0]), "o")
-    details.postProcessor().postProcessLayer(layer, context, None)
-    assert layer.renderer().type() == "multibandcolor"
-    assert layer.renderer().redContrastEnhancement() is None
+    # the style: 8-bit RGB shown as is, without QGIS's 2-98 % stretch; every orthophoto of
+    # the run in one group named after the folder, as QGIS loads them after the run
+    project = QgsProject.instance()
+    try:
+        for path in loads:
+            layer = QgsRasterLayer(path, Path(path).stem)
+            project.addMapLayer(layer)
+            context.layerToLoadOnCompletionDetails(path).postProcessor().postProcessLayer(
+                layer, context, None
+            )
+            assert layer.renderer().type() == "multibandcolor"
+            assert layer.renderer().redContrastEnhancement() is None
+        group = project.layerTreeRoot().findGroup("Orthophotos (q)")
+        assert group is not None and len(group.findLayers()) == 4
+        assert project.layerTreeRoot().findLayers() == group.findLayers()
+    finally:
+        project.removeAllMapLayers()
+        project.layerTreeRoot().removeAllChildren()
 
 
 def test_processing_run_mosaic_from_laz_dsm(provider, demo, tmp_path):
