@@ -13,6 +13,7 @@ from qgis.core import (
     QgsProcessingParameterCrs,
     QgsProcessingParameterDefinition,
     QgsProcessingParameterEnum,
+    QgsProcessingParameterExtent,
     QgsProcessingParameterFeatureSink,
     QgsProcessingParameterFeatureSource,
     QgsProcessingParameterField,
@@ -20,6 +21,7 @@ from qgis.core import (
     QgsProcessingParameterFileDestination,
     QgsProcessingParameterFolderDestination,
     QgsProcessingParameterMapLayer,
+    QgsProcessingParameterMatrix,
     QgsProcessingParameterMultipleLayers,
     QgsProcessingParameterNumber,
     QgsProcessingParameterRasterDestination,
@@ -56,6 +58,49 @@ def point_cloud_layers() -> bool:
     from qgis.core import QgsProviderRegistry
 
     return "pdal" in QgsProviderRegistry.instance().providerList()
+
+
+def is_extent(p: Param) -> bool:
+    """A four-number extent (xmin, ymin, xmax, ymax in the algorithm's CRS): QGIS's extent
+    widget (drawn on the map, taken from a layer, or typed)."""
+    return p.kind == "numbers" and p.count == 4 and p.name.endswith("EXTENT")
+
+
+def matrix_shape(p: Param) -> tuple[int, list[str]]:
+    """(rows, column headers) of the table widget of a list of numbers: one row headed by the
+    names the label lists after its colon or as its last word ("Lever arm x,y,z"), or a 3 x 3
+    matrix for nine numbers."""
+    if p.count == 9:
+        return 3, ["1", "2", "3"]
+    text = p.label.split(":", 1)[1] if ":" in p.label else p.label.rsplit(" ", 1)[-1]
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if len(names) != p.count:
+        names = [str(k + 1) for k in range(p.count)]
+    return 1, names
+
+
+def read_numbers(alg, p: Param, parameters: dict, context):
+    """A list of numbers from its widget: the extent in the CRS of the algorithm's CRS
+    parameter (when it has one), the table's cells in order; "" when left empty."""
+    value = parameters.get(p.name)
+    if value in (None, "", []):
+        return ""
+    if is_extent(p):
+        crs = (
+            alg.parameterAsCrs(parameters, "CRS", context)
+            if alg.parameterDefinition("CRS")
+            else None
+        )
+        rect = (
+            alg.parameterAsExtent(parameters, p.name, context, crs)
+            if crs is not None and crs.isValid()
+            else alg.parameterAsExtent(parameters, p.name, context)
+        )
+        if rect.isNull():
+            return ""
+        return (rect.xMinimum(), rect.yMinimum(), rect.xMaximum(), rect.yMaximum())
+    cells = alg.parameterAsMatrix(parameters, p.name, context)
+    return tuple(cells) if cells else ""
 
 
 def layer_input(p: Param) -> bool:
@@ -110,7 +155,15 @@ def make_parameter(
         else:
             index = p.options.index(default) if default is not None else None
         q = QgsProcessingParameterEnum(p.name, title, labels, p.multiple, index, p.optional)
-    elif k in ("string", "numbers"):
+    elif k == "numbers" and is_extent(p):
+        q = QgsProcessingParameterExtent(p.name, title, None, p.optional)
+    elif k == "numbers":
+        rows, headers = matrix_shape(p)
+        default = list(p.default) if p.default else None
+        # QGIS refuses a matrix left out even with a default: the job's default then applies
+        optional = p.optional or default is not None
+        q = QgsProcessingParameterMatrix(p.name, title, rows, True, headers, default, optional)
+    elif k == "string":
         q = QgsProcessingParameterString(p.name, title, p.default_text(), False, p.optional)
     elif k == "points":
         q = QgsProcessingParameterFeatureSource(
@@ -190,7 +243,9 @@ def read_parameter(alg, p: Param, parameters: dict, context) -> Any:
         if p.multiple:
             return tuple(p.options[i] for i in alg.parameterAsEnums(parameters, p.name, context))
         return p.options[alg.parameterAsEnum(parameters, p.name, context)]
-    if k in ("string", "numbers"):
+    if k == "numbers":
+        return read_numbers(alg, p, parameters, context)
+    if k == "string":
         return alg.parameterAsString(parameters, p.name, context)
     if k == "points":
         return alg.parameterAsSource(parameters, p.name, context)

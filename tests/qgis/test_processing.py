@@ -66,8 +66,8 @@ def test_algorithm_parameters_are_the_documented_api(provider):
     mount = alg.parameterDefinition("MOUNT")
     assert [o.split(":")[0] for o in mount.options()] == list(MOUNT_CHOICES)
     assert mount.defaultValue() == 0
-    assert alg.parameterDefinition("LEVER_ARM").defaultValue() == "0,0,0"
-    assert alg.parameterDefinition("BORESIGHT").defaultValue() == "0,0,0"
+    assert alg.parameterDefinition("LEVER_ARM").defaultValue() == [0.0, 0.0, 0.0]
+    assert alg.parameterDefinition("BORESIGHT").defaultValue() == [0.0, 0.0, 0.0]
     assert (
         alg.parameterDefinition("OUTPUT_CSV").flags()
         & alg.parameterDefinition("OUTPUT_CSV").Flag.FlagOptional

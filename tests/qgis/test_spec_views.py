@@ -75,7 +75,16 @@ def test_names_and_kinds_agree(provider, name):
     qgis = [(d.name(), d.type()) for d in alg.parameterDefinitions()]
     from lidarphoto.processing_provider.parameters import layer_input
 
-    kinds = ["layer" if layer_input(p) else QGIS_TYPE[p.kind] for p in spec.params]
+    from lidarphoto.processing_provider.parameters import is_extent
+
+    def kind(p):
+        if layer_input(p):
+            return "layer"
+        if p.kind == "numbers":
+            return "extent" if is_extent(p) else "matrix"
+        return QGIS_TYPE[p.kind]
+
+    kinds = [kind(p) for p in spec.params]
     assert qgis == list(zip([p.name for p in spec.params], kinds))
     for p in spec.params:
         d = alg.parameterDefinition(p.name)
@@ -84,7 +93,8 @@ def test_names_and_kinds_agree(provider, name):
         if p.kind == "enum":
             assert d.allowMultiple() == p.multiple and len(d.options()) == len(p.options)
         optional = bool(d.flags() & d.Flag.FlagOptional)
-        assert optional == (p.optional or (p.kind == "field")), p.name
+        matrix = p.kind == "numbers" and p.default is not None  # see make_parameter
+        assert optional == (p.optional or (p.kind == "field") or matrix), p.name
     assert {o.name() for o in alg.outputDefinitions()} >= {r.name for r in spec.results}
     cli = [a.dest for a in _subparser(name)._actions if a.option_strings and a.dest != "help"]
     assert cli == [p.name for p in spec.params if p.kind != "sink"]
