@@ -73,9 +73,7 @@ def test_names_and_kinds_agree(provider, name):
     spec = SPECS[name]
     alg = provider.algorithm(name)
     qgis = [(d.name(), d.type()) for d in alg.parameterDefinitions()]
-    from lidarphoto.processing_provider.parameters import layer_input
-
-    from lidarphoto.processing_provider.parameters import is_extent
+    from lidarphoto.processing_provider.parameters import is_extent, layer_input
 
     def kind(p):
         if layer_input(p):
