@@ -197,7 +197,6 @@ FUNCTIONS_NOT_YET_SPLIT = {
     "core/photo/least_squares_matching.py:lsm_batch": 159,
     "core/photo/monoplot.py:monoplot": 227,
     "core/photo/tie_refine.py:refine_tracks": 157,
-    "core/simulation/uav_block.py:simulate_uav_block": 180,
     "scripts/make_demo_project.py:build_project": 163,
 }
 
