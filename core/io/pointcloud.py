@@ -124,21 +124,6 @@ class CloudInfo:
         return 1.0 / h, 1.0 / v
 
 
-def parse_crs(crs: CrsLike) -> pyproj.CRS | None:
-    """A user's CRS (``"EPSG:7415"``, ``7415``, WKT, PROJ string or pyproj.CRS) as pyproj.CRS.
-
-    Empty strings and None give None.
-
-    Examples
-    --------
-    >>> parse_crs("EPSG:28992").to_epsg()
-    28992
-    """
-    if crs is None or (isinstance(crs, str) and not crs.strip()):
-        return None
-    return frames.parse_crs(crs)
-
-
 def _horizontal_crs(crs: pyproj.CRS) -> pyproj.CRS:
     if crs.is_compound and crs.sub_crs_list:
         return crs.sub_crs_list[0]
@@ -233,7 +218,7 @@ def _info_from_header(path: str, header: Any, crs: CrsLike, require_crs: bool) -
             f"{', '.join(f'{v:g}' for v in offsets)}: a corrupt header",
             path=path,
         )
-    user_crs = parse_crs(crs)
+    user_crs = frames.parse_crs(crs, optional=True)
     file_crs = None
     if user_crs is None:
         try:
