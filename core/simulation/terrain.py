@@ -302,13 +302,14 @@ def _layout_cliffs(rng: np.random.Generator, L: float) -> _Layout:
 def _layout_terraces(rng: np.random.Generator, L: float) -> _Layout:
     """Steps across a hillside with vines in rows on the treads."""
     full = (0.0, 0.0, L, L)
-    boxes: list[_Box] = []
+
     # 2.2 m steps every 16 m across a hillside (risers 1:1), vines in rows on the treads
     def ground(x, y):
         k = x / 16.0
         step = np.floor(k) + 1.0 / (1.0 + np.exp(-((k - np.floor(k)) - 0.93) * 40.0))
         return 2.2 * step + 0.02 * x + 1.5 * np.sin(y / 40.0)
 
+    boxes: list[_Box] = []
     for i in range(int(L / 16)):
         for j in range(3):
             boxes.append(_Box(16.0 * i + 4.0 + 3.5 * j, L / 2, 1.0, 0.8 * L, 0.0, 1.6,
@@ -381,25 +382,25 @@ def _layout_gaps(rng: np.random.Generator, L: float) -> _Layout:
 
 def _layout_outliers(rng: np.random.Generator, L: float) -> _Layout:
     """Gentle ground with houses and trees (the outliers are added after sampling)."""
-    full = (0.0, 0.0, L, L)
 
     def ground(x, y):
         return 2.0 * np.sin(x / 45.0) * np.cos(y / 35.0) + 0.05 * y
 
     boxes = _houses(rng, 10, (0.05 * L, 0.05 * L, 0.95 * L, 0.95 * L))
-    trees = _scatter_trees(rng, int(L * L / 700), full)
-    boxes += _scatter_small(rng, 12, full)
+    trees = _scatter_trees(rng, int(L * L / 700), (0.0, 0.0, L, L))
+    boxes += _scatter_small(rng, 12, (0.0, 0.0, L, L))
     return _Layout(ground, boxes, trees, None)
 
 
 def _layout_dense_buildings(rng: np.random.Generator, L: float) -> _Layout:
     """A city block of large buildings with courtyards along narrow streets."""
     full = (0.0, 0.0, L, L)
-    boxes: list[_Box] = []
+
     # a city block: large buildings with courtyards along narrow streets, 2 % slope
     def ground(x, y):
         return 0.02 * x + 0.01 * y
 
+    boxes: list[_Box] = []
     street = 10.0
     x = street
     while x < L - 20:
