@@ -193,7 +193,6 @@ FUNCTIONS_NOT_YET_SPLIT = {
     "bench/bench_ortho.py:main": 174,
     "core/geometry/raycast_numba.py:_trace": 174,
     "core/lidar/roof_planes_numba.py:_local_planes_kernel": 233,
-    "core/photo/camera_calibration.py:calibrate_camera": 157,
     "scripts/make_demo_project.py:build_project": 163,
 }
 
