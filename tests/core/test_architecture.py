@@ -192,7 +192,6 @@ FILES_NOT_YET_SPLIT: dict[str, int] = {}
 FUNCTIONS_NOT_YET_SPLIT = {
     "core/geometry/raycast_numba.py:_trace": 174,
     "core/lidar/roof_planes_numba.py:_local_planes_kernel": 233,
-    "scripts/make_demo_project.py:build_project": 163,
 }
 
 
