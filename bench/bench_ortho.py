@@ -433,6 +433,143 @@ def large_frame(work: Path) -> dict:
     return res
 
 
+class _Peers:
+    """The two tools on one image of the demo, in RD New ("rd") or in a local transverse
+    Mercator ("tm"): ``frames[frame]`` is (CRS, EO file, EO table, DSM file, DSM)."""
+
+    def __init__(self, args: argparse.Namespace, cam, frames: dict, images: list[Path]):
+        self.args, self.cam, self.frames, self.images = args, cam, frames, images
+
+    def camera_points(self, frame: str, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """400 DSM points seen by image k and their pixels by our rigorous chain."""
+        from lidarphoto.core.geometry.collinearity import project
+        from lidarphoto.core.geometry.rotations import matrix_to_opk
+        from lidarphoto.core.photo.orientation import eo_map_to_local
+        from lidarphoto.core.photo.orthophoto import OrthoProjector
+
+        crs, _, eo, _, dsm = self.frames[frame]
+        proj = OrthoProjector.build(self.cam, eo.xyz[k], eo.opk[k], dsm, crs)
+        box = proj.footprint()
+        rng = np.random.default_rng(k)
+        xy = np.column_stack([rng.uniform(box[0], box[2], 400), rng.uniform(box[1], box[3], 400)])
+        pts = np.column_stack([xy, dsm.height_at(xy[:, 0], xy[:, 1])])
+        pts = pts[np.isfinite(pts[:, 2])]
+        c_loc, m_loc = eo_map_to_local(eo.xyz[k : k + 1], eo.opk[k : k + 1], proj.local)
+        px = project(proj.local.map_to_enu(pts), np.r_[c_loc[0], matrix_to_opk(m_loc[0])],
+                     self.cam)  # fmt: skip
+        return pts, px
+
+    def peer(self, frame: str, k: int, out: Path, own_defaults: bool = False) -> dict:
+        """orthority on image k; with our creation options, or with its own lossless default
+        (DEFLATE at GDAL's level 6, no predictor, tiled 512)."""
+        crs, _, eo, dsm_path, _ = self.frames[frame]
+        pts, px = self.camera_points(frame, k)
+        arg = {**_peer_camera(self.cam, eo, k), "image": str(self.images[k]),
+               "dem": str(dsm_path), "crs": crs, "gsd": GSD,
+               "creation": None if own_defaults else CREATION,
+               "compress": "deflate" if own_defaults else None, "points": pts.tolist(),
+               "out": str(out)}  # fmt: skip
+        res = _run(self.args.orthority_python, ORTHORITY, arg)
+        # orthority's pixels have their centres at integers (OpenCV's): ours at + 0.5
+        diff = np.abs(np.array(res["pixels"]) + 0.5 - px)
+        res["camera_max_px"] = float(diff.max())
+        return res
+
+    def ours(self, frame: str, k: int, ref: Path, out: Path, true_ortho: bool) -> dict:
+        """Our job on the extent of orthority's output ``ref`` (the same cells)."""
+        from lidarphoto.core.io.raster import RasterReader
+
+        crs, eo_csv, _, dsm_path, _ = self.frames[frame]
+        with RasterReader(ref) as src:
+            gt, w, h = src.info.geotransform, src.info.width, src.info.height
+        extent = (gt[0], gt[3] - h * GSD + GSD / 2, gt[0] + w * GSD - GSD / 2, gt[3] - GSD / 2)
+        values = {"CAMERA": str(self.args.demo / "flight" / "camera.json"), "EO": str(eo_csv),
+                  "IMAGES": [str(self.images[k])], "DSM": str(dsm_path), "CRS": crs, "GSD": GSD,
+                  "EXTENT": ",".join(repr(v) for v in extent), "RESAMPLING": "bilinear",
+                  "TRUE_ORTHO": true_ortho, "OUTPUT_FOLDER": str(out)}  # fmt: skip
+        res = _run(sys.executable, OURS, {"values": values})
+        res["cells"] = w * h
+        return res
+
+
+def _image_row(p: _Peers, k: int, work: Path) -> dict:
+    """Image k: best times of ``--repeats`` alternating runs of each tool, peak memories, the
+    camera comparison and the agreement of the outputs, in RD New and in the local TM."""
+    name = p.frames["rd"][2].image_id[k]
+    best = {"peer": math.inf, "ours": math.inf, "true": math.inf, "own": math.inf}
+    cpu = {"peer": math.inf, "ours": math.inf, "true": math.inf, "own": math.inf}
+    mem = {"peer": 0.0, "ours": 0.0, "true": 0.0, "own": 0.0}
+    ref = work / "rd" / f"{name}_orthority.tif"
+    ref.parent.mkdir(exist_ok=True)
+    for _ in range(p.args.repeats):  # alternating, in RD New: what the user runs
+        res = p.peer("rd", k, ref)
+        best["peer"], mem["peer"] = min(best["peer"], res["seconds"]), max(
+            mem["peer"], res["maxrss_mb"])  # fmt: skip
+        cpu["peer"] = min(cpu["peer"], res["cpu"])
+        cam_rd = res["camera_max_px"]
+        res = p.peer("rd", k, work / "rd" / f"{name}_orthority_own.tif", own_defaults=True)
+        best["own"], cpu["own"] = min(best["own"], res["seconds"]), min(cpu["own"],
+                                                                        res["cpu"])  # fmt: skip
+        for mode in ("ours", "true"):
+            got = p.ours("rd", k, ref, work / "rd" / mode, mode == "true")
+            best[mode], mem[mode] = min(best[mode], got["seconds"]), max(
+                mem[mode], got["maxrss_mb"])  # fmt: skip
+            cpu[mode] = min(cpu[mode], got["cpu"])
+            cells = got["cells"]
+    agree_rd = _agreement(ref, work / "rd" / "ours" / f"{name}_ortho.tif", p.frames["rd"][4])
+    ref_tm = work / "tm" / f"{name}_orthority.tif"
+    ref_tm.parent.mkdir(exist_ok=True)
+    cam_tm = p.peer("tm", k, ref_tm)["camera_max_px"]
+    p.ours("tm", k, ref_tm, work / "tm" / "ours", False)
+    agree_tm = _agreement(ref_tm, work / "tm" / "ours" / f"{name}_ortho.tif",
+                          p.frames["tm"][4])  # fmt: skip
+    row = {"image": name, "cells": cells, "orthority_s": best["peer"],
+           "ours_s": best["ours"], "ours_true_s": best["true"],
+           "orthority_cpu": cpu["peer"], "ours_cpu": cpu["ours"], "ours_true_cpu": cpu["true"],
+           "orthority_own_s": best["own"], "orthority_own_cpu": cpu["own"],
+           "orthority_mb": mem["peer"], "ours_mb": mem["ours"], "ours_true_mb": mem["true"],
+           "camera_max_px_rd": cam_rd, "camera_max_px_tm": cam_tm,
+           **{f"{key}_rd": v for key, v in agree_rd.items()},
+           **{f"{key}_tm": v for key, v in agree_tm.items()}}  # fmt: skip
+    print(f"{name}: {cells / 1e6:.1f} Mcells; orthority {best['peer']:.2f} s "
+          f"({cpu['peer']:.2f} CPU s), ours {best['ours']:.2f} s ({cpu['ours']:.2f}; "
+          f"{best['peer'] / best['ours']:.2f}x), true {best['true']:.2f}"
+          f" s; cameras differ by {cam_rd:.3f} px (RD) / {cam_tm:.3f} px (TM); shift median "
+          f"{np.median(agree_rd['shift_px']):.3f} (RD) / {np.median(agree_tm['shift_px']):.3f}"
+          f" (TM) px; RMS {agree_tm['rms_dn']:.2f} DN (TM)", flush=True)  # fmt: skip
+    return row
+
+
+def _summary(rows: list[dict]) -> dict:
+    """The figures over all images: throughputs and their ratios, shifts, RMS, memory."""
+    cells = sum(r["cells"] for r in rows)
+    kinds = ("orthority", "orthority_own", "ours", "ours_true")
+    tp = {k: cells / sum(r[f"{k}_s"] for r in rows) / 1e6 for k in kinds}
+
+    def stats(key: str) -> dict:
+        v = np.concatenate([r[key] for r in rows])
+        return {"median": float(np.median(v)), "p95": float(np.percentile(v, 95)),
+                "max": float(v.max()), "windows": int(v.size)}  # fmt: skip
+
+    tp_cpu = {k: cells / sum(r[f"{k}_cpu"] for r in rows) / 1e6 for k in kinds}
+    return dict(
+        images=len(rows), cells=cells, throughput_mcells_s=tp,
+        throughput_mcells_per_cpu_s=tp_cpu, cpu_ratio=tp_cpu["ours"] / tp_cpu["orthority"],
+        speed_ratio=tp["ours"] / tp["orthority"], true_ratio=tp["ours_true"] / tp["orthority"],
+        speed_ratio_own_defaults=tp["ours"] / tp["orthority_own"],
+        shift_px_rd=stats("shift_px_rd"), shift_px_tm=stats("shift_px_tm"),
+        shift_whitened_px_tm=stats("shift_whitened_px_tm"),
+        rms_dn_rd=float(np.sqrt(np.mean([r["rms_dn_rd"] ** 2 for r in rows]))),
+        rms_dn_tm=float(np.sqrt(np.mean([r["rms_dn_tm"] ** 2 for r in rows]))),
+        rms_dn_ground_tm=float(np.sqrt(np.mean([r["rms_dn_ground_tm"] ** 2 for r in rows]))),
+        camera_max_px_rd=max(r["camera_max_px_rd"] for r in rows),
+        camera_max_px_tm=max(r["camera_max_px_tm"] for r in rows),
+        memory_mb={k: max(r[f"{k}_mb"] for r in rows) for k in ("orthority", "ours",
+                                                               "ours_true")},
+        load_end=os.getloadavg()[0], rows=rows,
+    )  # fmt: skip
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--orthority-python", default=os.environ.get("ORTHORITY_PYTHON", ""),
@@ -452,13 +589,9 @@ def main() -> int:
         res = large_frame(Path(tempfile.mkdtemp(prefix="bench_ortho_large_")))
         return _emit(res, args.json)
 
-    from lidarphoto.core.geometry.collinearity import project
-    from lidarphoto.core.geometry.rotations import matrix_to_opk
     from lidarphoto.core.io.camera import read_camera_json
     from lidarphoto.core.io.dsm import read_dsm_raster
     from lidarphoto.core.io.orientation import read_eo_csv
-    from lidarphoto.core.photo.orientation import eo_map_to_local
-    from lidarphoto.core.photo.orthophoto import OrthoProjector
 
     figures: dict = {"date": datetime.date.today().isoformat(), "machine": platform.node(),
                      "cpus": os.cpu_count(), "load_start": os.getloadavg()[0]}  # fmt: skip
@@ -480,123 +613,10 @@ def main() -> int:
         "tm": (tm_wkt, tm_eo_csv, read_eo_csv(tm_eo_csv), tm_dsm_path,
                read_dsm_raster(tm_dsm_path)),
     }  # fmt: skip
-
-    def camera_points(frame: str, k: int) -> tuple[np.ndarray, np.ndarray]:
-        """400 DSM points seen by image k and their pixels by our rigorous chain."""
-        crs, _, eo, _, dsm = frames[frame]
-        proj = OrthoProjector.build(cam, eo.xyz[k], eo.opk[k], dsm, crs)
-        box = proj.footprint()
-        rng = np.random.default_rng(k)
-        xy = np.column_stack([rng.uniform(box[0], box[2], 400), rng.uniform(box[1], box[3], 400)])
-        pts = np.column_stack([xy, dsm.height_at(xy[:, 0], xy[:, 1])])
-        pts = pts[np.isfinite(pts[:, 2])]
-        c_loc, m_loc = eo_map_to_local(eo.xyz[k : k + 1], eo.opk[k : k + 1], proj.local)
-        px = project(proj.local.map_to_enu(pts), np.r_[c_loc[0], matrix_to_opk(m_loc[0])], cam)
-        return pts, px
-
-    def peer(frame: str, k: int, out: Path, own_defaults: bool = False) -> dict:
-        """orthority on image k; with our creation options, or with its own lossless default
-        (DEFLATE at GDAL's level 6, no predictor, tiled 512)."""
-        crs, _, eo, dsm_path, _ = frames[frame]
-        pts, px = camera_points(frame, k)
-        arg = {**_peer_camera(cam, eo, k), "image": str(images[k]), "dem": str(dsm_path),
-               "crs": crs, "gsd": GSD, "creation": None if own_defaults else CREATION,
-               "compress": "deflate" if own_defaults else None, "points": pts.tolist(),
-               "out": str(out)}  # fmt: skip
-        res = _run(args.orthority_python, ORTHORITY, arg)
-        # orthority's pixels have their centres at integers (OpenCV's): ours at + 0.5
-        diff = np.abs(np.array(res["pixels"]) + 0.5 - px)
-        res["camera_max_px"] = float(diff.max())
-        return res
-
-    def ours(frame: str, k: int, ref: Path, out: Path, true_ortho: bool) -> dict:
-        """Our job on the extent of orthority's output ``ref`` (the same cells)."""
-        from lidarphoto.core.io.raster import RasterReader
-
-        crs, eo_csv, _, dsm_path, _ = frames[frame]
-        with RasterReader(ref) as src:
-            gt, w, h = src.info.geotransform, src.info.width, src.info.height
-        extent = (gt[0], gt[3] - h * GSD + GSD / 2, gt[0] + w * GSD - GSD / 2, gt[3] - GSD / 2)
-        values = {"CAMERA": str(args.demo / "flight" / "camera.json"), "EO": str(eo_csv),
-                  "IMAGES": [str(images[k])], "DSM": str(dsm_path), "CRS": crs, "GSD": GSD,
-                  "EXTENT": ",".join(repr(v) for v in extent), "RESAMPLING": "bilinear",
-                  "TRUE_ORTHO": true_ortho, "OUTPUT_FOLDER": str(out)}  # fmt: skip
-        res = _run(sys.executable, OURS, {"values": values})
-        res["cells"] = w * h
-        return res
-
     images = [args.demo / "flight" / "images" / f"{i}.tif" for i in eo_rd.image_id]
-    rows = []
-    for k in range(min(args.images, len(eo_rd))):
-        name = eo_rd.image_id[k]
-        best = {"peer": math.inf, "ours": math.inf, "true": math.inf, "own": math.inf}
-        cpu = {"peer": math.inf, "ours": math.inf, "true": math.inf, "own": math.inf}
-        mem = {"peer": 0.0, "ours": 0.0, "true": 0.0, "own": 0.0}
-        ref = work / "rd" / f"{name}_orthority.tif"
-        ref.parent.mkdir(exist_ok=True)
-        for _ in range(args.repeats):  # alternating, in RD New: what the user runs
-            res = peer("rd", k, ref)
-            best["peer"], mem["peer"] = min(best["peer"], res["seconds"]), max(
-                mem["peer"], res["maxrss_mb"])  # fmt: skip
-            cpu["peer"] = min(cpu["peer"], res["cpu"])
-            cam_rd = res["camera_max_px"]
-            res = peer("rd", k, work / "rd" / f"{name}_orthority_own.tif", own_defaults=True)
-            best["own"], cpu["own"] = min(best["own"], res["seconds"]), min(cpu["own"],
-                                                                            res["cpu"])  # fmt: skip
-            for mode in ("ours", "true"):
-                got = ours("rd", k, ref, work / "rd" / mode, mode == "true")
-                best[mode], mem[mode] = min(best[mode], got["seconds"]), max(
-                    mem[mode], got["maxrss_mb"])  # fmt: skip
-                cpu[mode] = min(cpu[mode], got["cpu"])
-                cells = got["cells"]
-        agree_rd = _agreement(ref, work / "rd" / "ours" / f"{name}_ortho.tif", frames["rd"][4])
-        ref_tm = work / "tm" / f"{name}_orthority.tif"
-        ref_tm.parent.mkdir(exist_ok=True)
-        cam_tm = peer("tm", k, ref_tm)["camera_max_px"]
-        ours("tm", k, ref_tm, work / "tm" / "ours", False)
-        agree_tm = _agreement(ref_tm, work / "tm" / "ours" / f"{name}_ortho.tif",
-                              frames["tm"][4])  # fmt: skip
-        row = {"image": name, "cells": cells, "orthority_s": best["peer"],
-               "ours_s": best["ours"], "ours_true_s": best["true"],
-               "orthority_cpu": cpu["peer"], "ours_cpu": cpu["ours"], "ours_true_cpu": cpu["true"],
-               "orthority_own_s": best["own"], "orthority_own_cpu": cpu["own"],
-               "orthority_mb": mem["peer"], "ours_mb": mem["ours"], "ours_true_mb": mem["true"],
-               "camera_max_px_rd": cam_rd, "camera_max_px_tm": cam_tm,
-               **{f"{key}_rd": v for key, v in agree_rd.items()},
-               **{f"{key}_tm": v for key, v in agree_tm.items()}}  # fmt: skip
-        rows.append(row)
-        print(f"{name}: {cells / 1e6:.1f} Mcells; orthority {best['peer']:.2f} s "
-              f"({cpu['peer']:.2f} CPU s), ours {best['ours']:.2f} s ({cpu['ours']:.2f}; "
-              f"{best['peer'] / best['ours']:.2f}x), true {best['true']:.2f}"
-              f" s; cameras differ by {cam_rd:.3f} px (RD) / {cam_tm:.3f} px (TM); shift median "
-              f"{np.median(agree_rd['shift_px']):.3f} (RD) / {np.median(agree_tm['shift_px']):.3f}"
-              f" (TM) px; RMS {agree_tm['rms_dn']:.2f} DN (TM)", flush=True)  # fmt: skip
-    cells = sum(r["cells"] for r in rows)
-    kinds = ("orthority", "orthority_own", "ours", "ours_true")
-    tp = {k: cells / sum(r[f"{k}_s"] for r in rows) / 1e6 for k in kinds}
-
-    def stats(key: str) -> dict:
-        v = np.concatenate([r[key] for r in rows])
-        return {"median": float(np.median(v)), "p95": float(np.percentile(v, 95)),
-                "max": float(v.max()), "windows": int(v.size)}  # fmt: skip
-
-    tp_cpu = {k: cells / sum(r[f"{k}_cpu"] for r in rows) / 1e6 for k in kinds}
-    figures.update(
-        images=len(rows), cells=cells, throughput_mcells_s=tp,
-        throughput_mcells_per_cpu_s=tp_cpu, cpu_ratio=tp_cpu["ours"] / tp_cpu["orthority"],
-        speed_ratio=tp["ours"] / tp["orthority"], true_ratio=tp["ours_true"] / tp["orthority"],
-        speed_ratio_own_defaults=tp["ours"] / tp["orthority_own"],
-        shift_px_rd=stats("shift_px_rd"), shift_px_tm=stats("shift_px_tm"),
-        shift_whitened_px_tm=stats("shift_whitened_px_tm"),
-        rms_dn_rd=float(np.sqrt(np.mean([r["rms_dn_rd"] ** 2 for r in rows]))),
-        rms_dn_tm=float(np.sqrt(np.mean([r["rms_dn_tm"] ** 2 for r in rows]))),
-        rms_dn_ground_tm=float(np.sqrt(np.mean([r["rms_dn_ground_tm"] ** 2 for r in rows]))),
-        camera_max_px_rd=max(r["camera_max_px_rd"] for r in rows),
-        camera_max_px_tm=max(r["camera_max_px_tm"] for r in rows),
-        memory_mb={k: max(r[f"{k}_mb"] for r in rows) for k in ("orthority", "ours",
-                                                               "ours_true")},
-        load_end=os.getloadavg()[0], rows=rows,
-    )  # fmt: skip
+    peers = _Peers(args, cam, frames, images)
+    rows = [_image_row(peers, k, work) for k in range(min(args.images, len(eo_rd)))]
+    figures.update(_summary(rows))
     print(json.dumps({k: v for k, v in figures.items() if k != "rows"}, indent=1))
     if args.json:
         args.json.write_text(json.dumps(figures, indent=1), encoding="utf-8")

@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 from ..core.errors import Cancelled
 from ..core.i18n import mark as _t
 from ..core.i18n import render
+from ..core.io.raster import overview_factors
 
 #: catalogue context of this module's ``_t("...")`` messages (``make i18n``)
 TR_CONTEXT = "ImageSource"
@@ -47,7 +48,8 @@ __all__ = [
 
 #: images at least this large (pixels, either side) get an overview pyramid when they lack one
 OVERVIEW_MIN_SIDE = 2048
-#: side of the smallest overview level GDAL is asked to build
+#: side of the smallest overview level GDAL is asked to build (the in-memory pyramid of a
+#: small image also stops there); the same rule as core.io.raster.overview_factors
 _SMALLEST_LEVEL = 256
 #: side of the decimated whole-image sample the contrast stretch is computed from
 STRETCH_SAMPLE_SIDE = 1024
@@ -91,15 +93,6 @@ def _stretch_limits(sample: NDArray, low_pct: float, high_pct: float) -> tuple[N
         v = valid[::step].astype(np.float64)
         lo, hi = np.percentile(v, low_pct, axis=0), np.percentile(v, high_pct, axis=0)
     return lo, np.where(hi > lo, hi, lo + 1.0)
-
-
-def overview_factors(width: int, height: int) -> list[int]:
-    """Decimation factors 2, 4, ... down to a level of about ``_SMALLEST_LEVEL`` px."""
-    levels, f = [], 2
-    while max(width, height) / f >= _SMALLEST_LEVEL:
-        levels.append(f)
-        f *= 2
-    return levels
 
 
 def _gdal():
@@ -202,7 +195,7 @@ def build_overview_file(
         try:
             src = gdal.Open(str(image), gdal.GA_ReadOnly)
             if factors is None:
-                factors = overview_factors(src.RasterXSize, src.RasterYSize)
+                factors = overview_factors(src.RasterXSize, src.RasterYSize, _SMALLEST_LEVEL)
             vrt = gdal.Translate(str(tmp_vrt), src, format="VRT")
             src = None
             vrt = None  # flush the VRT file

@@ -159,19 +159,9 @@ def _style(layer, kind: str) -> None:
     layer.setRenderer(qgc.QgsSingleSymbolRenderer(sym))
 
 
-def build_project(
-    demo: Path,
-    output: Path | None = None,
-    *,
-    observations: str = "simulated",
-    eo: str = "initial",
-) -> Path:
-    """Write ``demo/demo_layers.gpkg``, ``demo/picking/observations.csv`` and the project;
-    returns the project's path. Needs a running QgsApplication."""
-
-    save_session = _import_plugin()
-    demo = Path(demo).resolve()
-    output = Path(output) if output else demo / PROJECT_NAME
+def _inputs(demo: Path, eo: str) -> tuple[Path, list[Path]]:
+    """The EO file given to the dock (``eo``: initial, calibrated or true) and the rendered
+    images; FileNotFoundError naming what ``make demo`` did not write."""
     lidar, flight, cal = demo / "lidar", demo / "flight", demo / "calibration"
     eo_files = {
         "initial": cal / "eo_initial.csv",
@@ -192,9 +182,13 @@ def build_project(
     missing = [str(p) for p in needed if not p.is_file()]
     if missing:
         raise FileNotFoundError("run `make demo` first; missing: " + ", ".join(missing))
-    images = sorted((flight / "images").glob("*.tif"))
+    return eo_csv, sorted((flight / "images").glob("*.tif"))
 
-    # ---- vector layers -> GeoPackage
+
+def _vector_tables(demo: Path, eo_csv: Path) -> list:
+    """The demo's vector layers as memory layers (planes, lines, LCPs, image centres, and
+    the check points and seamlines where the demo has them)."""
+    lidar, flight = demo / "lidar", demo / "flight"
     planes = _memory_layer("PolygonZ", "roof_planes", [
         ("id", "integer"), ("a", "double"), ("b", "double"), ("c", "double"), ("d", "double"),
         ("slope_deg", "double"), ("aspect_deg", "double"), ("n_points", "integer"),
@@ -229,13 +223,13 @@ def build_project(
         ])  # fmt: skip
         _fill(seams, _rows(ortho / "seamlines.csv"), lambda r: qgc.QgsGeometry.fromWkt(r["wkt"]))
         tables.append(seams)
-    gpkg = demo / LAYERS_NAME
-    _write_gpkg(tables, gpkg)
+    return tables
 
-    # ---- the project
-    project = qgc.QgsProject()
-    project.setCrs(qgc.QgsCoordinateReferenceSystem(CRS))
-    project.setTitle("LiDAR Photogrammetry Toolkit: demo (AHN3 Delft, simulated flight)")
+
+def _add_layers(project, tables: list, gpkg: Path, demo: Path, eo_csv: Path) -> tuple[dict, object]:
+    """The GeoPackage's tables (styled), the hillshaded DSM and the orthomosaic in the project;
+    returns the vector layers by table name and the DSM layer."""
+    lidar, ortho = demo / "lidar", demo / "ortho"
     titles = {
         "roof_planes": ("Roof planes", "planes"),
         "lidar_lines": ("LiDAR lines", "lines"),
@@ -276,9 +270,13 @@ def build_project(
     project.viewSettings().setDefaultViewExtent(
         qgc.QgsReferencedRectangle(extent, qgc.QgsCoordinateReferenceSystem(CRS))
     )
+    return layers, dsm
 
-    # ---- the picking dock's session
-    picking = demo / "picking"
+
+def _observation_file(demo: Path, observations: str) -> Path:
+    """The dock's new observation file: the simulated tie, line and LCP measurements, or
+    only the header (``observations``: simulated or empty)."""
+    flight, picking = demo / "flight", demo / "picking"
     picking.mkdir(exist_ok=True)
     obs_csv = picking / "observations.csv"
     if observations == "simulated":
@@ -292,6 +290,13 @@ def build_project(
         obs_csv.write_text(OBSERVATION_HEADER, encoding="utf-8")
     else:
         raise ValueError("observations must be 'simulated' or 'empty'")
+    return obs_csv
+
+
+def _session(demo: Path, eo_csv: Path, obs_csv: Path, images: list[Path], layers: dict,
+             dsm) -> dict:
+    """The picking dock's session (plugin.observation_store.save_session)."""
+    lidar, flight = demo / "lidar", demo / "flight"
     truth = json.loads((flight / "truth.json").read_text(encoding="utf-8"))
     session = {
         "camera": str(flight / "camera.json"),
@@ -314,6 +319,32 @@ def build_project(
         "dsm_file": "",
         "dsm_cell": "0.5",
     }
+    return session
+
+
+def build_project(
+    demo: Path,
+    output: Path | None = None,
+    *,
+    observations: str = "simulated",
+    eo: str = "initial",
+) -> Path:
+    """Write ``demo/demo_layers.gpkg``, ``demo/picking/observations.csv`` and the project;
+    returns the project's path. Needs a running QgsApplication."""
+
+    save_session = _import_plugin()
+    demo = Path(demo).resolve()
+    output = Path(output) if output else demo / PROJECT_NAME
+    eo_csv, images = _inputs(demo, eo)
+    tables = _vector_tables(demo, eo_csv)
+    gpkg = demo / LAYERS_NAME
+    _write_gpkg(tables, gpkg)
+    project = qgc.QgsProject()
+    project.setCrs(qgc.QgsCoordinateReferenceSystem(CRS))
+    project.setTitle("LiDAR Photogrammetry Toolkit: demo (AHN3 Delft, simulated flight)")
+    layers, dsm = _add_layers(project, tables, gpkg, demo, eo_csv)
+    obs_csv = _observation_file(demo, observations)
+    session = _session(demo, eo_csv, obs_csv, images, layers, dsm)
     save_session(project, session)
     project.writeEntry("lidarphoto_picking", "crs", CRS)
     output.parent.mkdir(parents=True, exist_ok=True)

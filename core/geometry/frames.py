@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
+from typing import Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -38,11 +39,27 @@ Array = NDArray[np.float64]
 NED_TO_ENU = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 
 
-def parse_crs(crs: CRS | str | int, *, what: str = "CRS") -> CRS:
-    """Read a CRS given as EPSG code, ``"EPSG:xxxx"``, WKT or PROJ string; clear error if not."""
+@overload
+def parse_crs(crs: CRS | str | int, *, what: str = ..., optional: Literal[False] = ...) -> CRS: ...
+@overload
+def parse_crs(
+    crs: CRS | str | int | None, *, what: str = ..., optional: Literal[True]
+) -> CRS | None: ...
+def parse_crs(
+    crs: CRS | str | int | None, *, what: str = "CRS", optional: bool = False
+) -> CRS | None:
+    """Read a CRS given as EPSG code, ``"EPSG:xxxx"``, WKT or PROJ string; clear error if not.
+
+    A missing CRS (None or an empty string) is an error, unless ``optional``: then None.
+
+    >>> parse_crs("EPSG:28992").to_epsg(), parse_crs(" ", optional=True)
+    (28992, None)
+    """
     if isinstance(crs, CRS):
         return crs
     if crs is None or (isinstance(crs, str) and not crs.strip()):
+        if optional:
+            return None
         raise CrsError(f"{what} is missing: give an EPSG code (e.g. EPSG:32632) or WKT")
     if isinstance(crs, str) and crs.strip().isdigit():
         crs = int(crs)  # a bare EPSG code typed as text

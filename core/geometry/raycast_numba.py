@@ -25,11 +25,16 @@ from ..compiled import cached_njit
 
 try:  # pragma: no cover - depends on the environment
     import numba
+    from numba.extending import register_jitable
 
     AVAILABLE = True
 except Exception:  # ImportError, or a numba built against another numpy
     numba = None
     AVAILABLE = False
+
+    def register_jitable(func: Callable[..., Any]) -> Callable[..., Any]:
+        """Without numba the kernels' helpers stay plain Python (never called then)."""
+        return func
 
 __all__ = ["AVAILABLE", "trace_rays"]
 
@@ -65,6 +70,49 @@ def _spatial_order(o, d, x_c, y_c, cell, zmax, rows, cols):
         order[start[key[r]]] = r
         start[key[r]] += 1
     return order
+
+
+@register_jitable
+def _slabs(u0, du, v0, dv, oz, dz, rows, cols, z_lo, z_hi):
+    """(t_lo, t_hi) of the ray inside the grid's footprint (lattice u, v) and the height range
+    ``z_lo..z_hi``, from t = 0; empty when t_lo > t_hi."""
+    t_lo = 0.0
+    t_hi = np.inf
+    for axis in range(3):
+        if axis == 0:
+            p0, dp, lo, hi = u0, du, 0.0, cols - 1.0
+        elif axis == 1:
+            p0, dp, lo, hi = v0, dv, 0.0, rows - 1.0
+        else:
+            p0, dp, lo, hi = oz, dz, z_lo, z_hi
+        if dp != 0.0:
+            ta = (lo - p0) / dp
+            tb = (hi - p0) / dp
+            near, far = min(ta, tb), max(ta, tb)
+        elif lo <= p0 <= hi:
+            near, far = -np.inf, np.inf
+        else:
+            near, far = np.inf, -np.inf
+        t_lo = max(t_lo, near)
+        t_hi = min(t_hi, far)
+    return t_lo, t_hi
+
+
+@register_jitable
+def _triangle(a, b, rhs, ul, vl, du, dv, dz, tc, lower):
+    """Dal Poz's Eq. 9 on one triangle of a quad, z = z00 + a u + b v (u, v in the quad's unit
+    square, ray from (ul, vl) along (du, dv, dz), ``rhs`` = z00 - oz): (hit, t); ``lower``:
+    the triangle (r, c), (r+1, c), (r+1, c+1), else (r, c), (r, c+1), (r+1, c+1). A hit
+    before ``tc`` does not count."""
+    den = dz - a * du - b * dv
+    if den == 0.0:
+        return False, np.nan
+    t = (rhs + a * ul + b * vl) / den
+    u = ul + du * t
+    v = vl + dv * t
+    if lower:
+        return u >= -_EPS and v <= 1 + _EPS and v - u >= -_EPS and t >= tc, t
+    return v >= -_EPS and u <= 1 + _EPS and u - v >= -_EPS and t >= tc, t
 
 
 def _trace(
@@ -103,25 +151,7 @@ def _trace(
         du = dx * inv
         dv = -dy * inv
         # slab test: the grid's footprint and the height range
-        t_lo = 0.0
-        t_hi = np.inf
-        for axis in range(3):
-            if axis == 0:
-                p0, dp, lo, hi = u0, du, 0.0, cols - 1.0
-            elif axis == 1:
-                p0, dp, lo, hi = v0, dv, 0.0, rows - 1.0
-            else:
-                p0, dp, lo, hi = oz, dz, zmin - margin, zmax + margin
-            if dp != 0.0:
-                ta = (lo - p0) / dp
-                tb = (hi - p0) / dp
-                near, far = min(ta, tb), max(ta, tb)
-            elif lo <= p0 <= hi:
-                near, far = -np.inf, np.inf
-            else:
-                near, far = np.inf, -np.inf
-            t_lo = max(t_lo, near)
-            t_hi = min(t_hi, far)
+        t_lo, t_hi = _slabs(u0, du, v0, dv, oz, dz, rows, cols, zmin - margin, zmax + margin)
         if not t_lo <= t_hi:
             continue
         su = 1.0 if du >= 0 else 0.0
@@ -178,27 +208,9 @@ def _trace(
                     tc = t - _TOL_T
                     rhs = z00 - oz
                     # triangle 0: (r, c), (r, c+1), (r+1, c+1); z = z00 + a u + b v
-                    a = z01 - z00
-                    b = z11 - z01
-                    den = dz - a * du - b * dv
-                    ok_a = False
-                    ta = np.nan
-                    if den != 0.0:
-                        ta = (rhs + a * ul + b * vl) / den
-                        ua = ul + du * ta
-                        va = vl + dv * ta
-                        ok_a = va >= -_EPS and ua <= 1 + _EPS and ua - va >= -_EPS and ta >= tc
+                    ok_a, ta = _triangle(z01 - z00, z11 - z01, rhs, ul, vl, du, dv, dz, tc, False)
                     # triangle 1: (r, c), (r+1, c), (r+1, c+1)
-                    a = z11 - z10
-                    b = z10 - z00
-                    den = dz - a * du - b * dv
-                    ok_b = False
-                    tb = np.nan
-                    if den != 0.0:
-                        tb = (rhs + a * ul + b * vl) / den
-                        ub = ul + du * tb
-                        vb = vl + dv * tb
-                        ok_b = ub >= -_EPS and vb <= 1 + _EPS and vb - ub >= -_EPS and tb >= tc
+                    ok_b, tb = _triangle(z11 - z10, z10 - z00, rhs, ul, vl, du, dv, dz, tc, True)
                     if ok_a or ok_b:
                         first_b = ok_b and not (ok_a and ta <= tb)
                         th = tb if first_b else ta

@@ -12,11 +12,11 @@ import numpy as np
 import pyproj
 
 from ..errors import InputError, stop_if_asked
-from ..geometry.frames import check_area_of_use
+from ..geometry.frames import check_area_of_use, parse_crs
 from ..geometry.grid import Grid
 from ..geometry.surface import Dsm
 from ..lidar.dsm import NOISE_CLASSES, dsm_from_points
-from .pointcloud import parse_crs, read_points
+from .pointcloud import read_points
 from .raster import read_geotiff
 from .raster_write import write_geotiff
 

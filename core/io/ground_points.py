@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..photo.bundle_setup import DEFAULT_CONTROL_SIGMA_M, ROLES, GroundPoints
+from . import tables
 from .tables import find_column, float_column, read_table, text_column, write_csv_atomic
 
 __all__ = ["GROUND_POINT_COLUMNS", "read_ground_points_csv", "write_ground_points_csv"]
@@ -64,15 +65,7 @@ def read_ground_points_csv(path: Union[str, Path]) -> GroundPoints:
             )
         sig[:, k] = np.where(np.isnan(v), DEFAULT_CONTROL_SIGMA_M, v)
     r_col = find_column(table, ("role", "type", "use"))
-    roles = tuple(v.strip().lower() for v in text_column(table, r_col))
-    for role, number in zip(roles, table.line_numbers):
-        if role not in ROLES:
-            raise InputError(
-                f"'{role}' is not a role ({', '.join(ROLES)})",
-                path=table.path,
-                row=number,
-                column=table.columns[r_col],
-            )
+    roles = tables.choice_column(table, r_col, ROLES, "a role")
     return GroundPoints(ids, xyz, sig, roles, table.line_numbers, table.path)
 
 

@@ -50,7 +50,14 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from ..geometry.camera import Camera
 from ..photo.observations import DEFAULT_SIGMA_PX, OBSERVATION_TYPES, ImageObservations
-from .tables import find_column, float_column, read_table, text_column, write_csv_atomic
+from .tables import (
+    choice_column,
+    find_column,
+    float_column,
+    read_table,
+    text_column,
+    write_csv_atomic,
+)
 
 __all__ = [
     "OBSERVATION_COLUMNS",
@@ -106,15 +113,7 @@ def read_observations_csv(
     if t_col is None:
         kinds = ("tie",) * len(table)
     else:
-        kinds = tuple(v.strip().lower() for v in text_column(table, t_col))
-        for k, number in zip(kinds, table.line_numbers):
-            if k not in OBSERVATION_TYPES:
-                raise InputError(
-                    f"'{k}' is not an observation type ({', '.join(OBSERVATION_TYPES)})",
-                    path=table.path,
-                    row=number,
-                    column=table.columns[t_col],
-                )
+        kinds = choice_column(table, t_col, OBSERVATION_TYPES, "an observation type")
     g_col = find_column(
         table, ("target_id", "target", "plane_id", "line_id", "lcp_id"), required=False
     )

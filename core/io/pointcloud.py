@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import logging
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from copy import deepcopy
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -124,21 +124,6 @@ class CloudInfo:
         return 1.0 / h, 1.0 / v
 
 
-def parse_crs(crs: CrsLike) -> pyproj.CRS | None:
-    """A user's CRS (``"EPSG:7415"``, ``7415``, WKT, PROJ string or pyproj.CRS) as pyproj.CRS.
-
-    Empty strings and None give None.
-
-    Examples
-    --------
-    >>> parse_crs("EPSG:28992").to_epsg()
-    28992
-    """
-    if crs is None or (isinstance(crs, str) and not crs.strip()):
-        return None
-    return frames.parse_crs(crs)
-
-
 def _horizontal_crs(crs: pyproj.CRS) -> pyproj.CRS:
     if crs.is_compound and crs.sub_crs_list:
         return crs.sub_crs_list[0]
@@ -233,7 +218,7 @@ def _info_from_header(path: str, header: Any, crs: CrsLike, require_crs: bool) -
             f"{', '.join(f'{v:g}' for v in offsets)}: a corrupt header",
             path=path,
         )
-    user_crs = parse_crs(crs)
+    user_crs = frames.parse_crs(crs, optional=True)
     file_crs = None
     if user_crs is None:
         try:
@@ -357,6 +342,32 @@ def _check_fields(info: CloudInfo, fields: Sequence[str]) -> list[str]:
 
 
 
+def _read_chunks(
+    chunks: Iterator[Any], n: int, path: str, take: Callable[[Any, int], None],
+    progress: Callable[[float], None] | None, should_stop: Callable[[], bool] | None,
+) -> None:
+    """Hand every chunk of a LAS reader to ``take(chunk, points_before_it)`` until ``n``
+    points; decoding errors (a corrupt or truncated file) and a short count become
+    InputError naming the file."""
+    done = 0
+    try:
+        for chunk in chunks:
+            stop_if_asked(should_stop, "processing the point cloud")
+            m = len(chunk)
+            take(chunk, done)
+            done += m
+            if progress is not None:
+                progress(done / n)
+    except (InputError, Cancelled):
+        raise
+    except Exception as exc:  # lazrs/laspy decoding errors: corrupt or truncated file
+        raise InputError(
+            f"corrupt or truncated point data after {done} of {n} points: {exc}", path=path
+        ) from exc
+    if done != n:
+        raise InputError(f"truncated: {done} points read, the header says {n}", path=path)
+
+
 def read_points(
     path: PathLike,
     fields: Sequence[str] = ("x", "y", "z"),
@@ -410,30 +421,20 @@ def read_points(
         names = _check_fields(info, fields)
         n = info.point_count
         out: dict[str, NDArray[Any]] = {}
-        done = 0
-        try:
-            for chunk in reader.chunk_iterator(max(int(chunk_size), 1)):
-                stop_if_asked(should_stop, "processing the point cloud")
-                m = len(chunk)
-                if done + m > n:
-                    raise InputError(f"more points than the header's {n}", path=path)
-                for key, name in zip(fields, names):
-                    values = np.asarray(chunk[name])
-                    if key not in out:
-                        dtype = np.float64 if name in _SCALED else values.dtype
-                        out[key] = np.empty(n, dtype=dtype)
-                    out[key][done : done + m] = values
-                done += m
-                if progress is not None:
-                    progress(done / n)
-        except (InputError, Cancelled):
-            raise
-        except Exception as exc:  # lazrs/laspy decoding errors: corrupt or truncated file
-            raise InputError(
-                f"corrupt or truncated point data after {done} of {n} points: {exc}", path=path
-            ) from exc
-    if done != n:
-        raise InputError(f"truncated: {done} points read, the header says {n}", path=path)
+
+        def take(chunk: Any, done: int) -> None:
+            m = len(chunk)
+            if done + m > n:
+                raise InputError(f"more points than the header's {n}", path=path)
+            for key, name in zip(fields, names):
+                values = np.asarray(chunk[name])
+                if key not in out:
+                    dtype = np.float64 if name in _SCALED else values.dtype
+                    out[key] = np.empty(n, dtype=dtype)
+                out[key][done : done + m] = values
+
+        chunks = reader.chunk_iterator(max(int(chunk_size), 1))
+        _read_chunks(chunks, n, path, take, progress, should_stop)
     if "return_number" in names:
         rn = out[fields[names.index("return_number")]]
         info = replace(info, has_return_numbers=bool(np.any(rn > 0)))
@@ -554,29 +555,24 @@ def read_cloud(
         header = deepcopy(reader.header)
         n = info.point_count
         chunks = []
-        done = 0
         returns = False
-        try:
-            while done < n:
-                stop_if_asked(should_stop, "processing the point cloud")
-                chunk = reader.read_points(min(max(int(chunk_size), 1), n - done))
-                m = len(chunk)
-                if m == 0:
-                    break
-                chunks.append(chunk.array)
-                returns = returns or bool(np.any(np.asarray(chunk.return_number) > 0))
-                done += m
-                if progress is not None:
-                    progress(done / n)
-        except (InputError, Cancelled):
-            raise
-        except Exception as exc:  # lazrs/laspy decoding errors: corrupt or truncated file
-            raise InputError(
-                f"corrupt or truncated point data after {done} of {n} points: {exc}", path=path
-            ) from exc
+
+        def take(chunk: Any, done: int) -> None:
+            nonlocal returns
+            chunks.append(chunk.array)
+            returns = returns or bool(np.any(np.asarray(chunk.return_number) > 0))
+
+        def read() -> Iterator[Any]:
+            got = 0
+            while got < n:
+                chunk = reader.read_points(min(max(int(chunk_size), 1), n - got))
+                if len(chunk) == 0:  # the file ends early: reported as truncated
+                    return
+                got += len(chunk)
+                yield chunk
+
+        _read_chunks(read(), n, path, take, progress, should_stop)
         evlrs = list(reader.header.evlrs or [])
-    if done != n:
-        raise InputError(f"truncated: {done} points read, the header says {n}", path=path)
     info = replace(info, has_return_numbers=returns)
     return LasPoints(info=info, header=header, chunks=chunks, evlrs=evlrs)
 
@@ -722,40 +718,28 @@ def _write_records(
             fmt = writer.header.point_format
             # laspy's header growth per chunk in one compiled pass (same header; None: laspy's)
             stats = HeaderStats.for_writer(writer) if same_format else None
-            done = 0
-            try:
-                for raw in chunks:
-                    stop_if_asked(should_stop, "processing the point cloud")
-                    m = len(raw)
-                    if done + m > n:
-                        raise InputError(f"more points than the header's {n}", path=src)
-                    if same_format:  # the chunk itself: no copy
-                        out = laspy.PackedPointRecord(raw, fmt)
-                    else:
-                        out = laspy.PackedPointRecord.zeros(m, fmt)
-                        for name in raw.dtype.names:
-                            out.array[name] = raw[name]
-                    if cls is not None:
-                        out.classification = cls[done : done + m]
-                    for name, arr in arrays.items():
-                        out[name] = arr[done : done + m]
-                    if stats is not None:
-                        stats.add(out)
-                        writer.point_writer.write_points(out)
-                    else:
-                        writer.write_points(out)
-                    done += m
-                    if progress is not None:
-                        progress(done / n)
-            except (InputError, Cancelled):
-                raise
-            except Exception as exc:
-                raise InputError(
-                    f"corrupt or truncated point data after {done} of {n} points: {exc}",
-                    path=src,
-                ) from exc
-            if done != n:
-                raise InputError(f"truncated: {done} points read, the header says {n}", path=src)
+
+            def take(raw: NDArray[Any], done: int) -> None:
+                m = len(raw)
+                if done + m > n:
+                    raise InputError(f"more points than the header's {n}", path=src)
+                if same_format:  # the chunk itself: no copy
+                    out = laspy.PackedPointRecord(raw, fmt)
+                else:
+                    out = laspy.PackedPointRecord.zeros(m, fmt)
+                    for name in raw.dtype.names:
+                        out.array[name] = raw[name]
+                if cls is not None:
+                    out.classification = cls[done : done + m]
+                for name, arr in arrays.items():
+                    out[name] = arr[done : done + m]
+                if stats is not None:
+                    stats.add(out)
+                    writer.point_writer.write_points(out)
+                else:
+                    writer.write_points(out)
+
+            _read_chunks(iter(chunks), n, src, take, progress, should_stop)
             if stats is not None:
                 stats.apply(writer.header)
             if evlrs:  # (laspy has no top-level VLRList)

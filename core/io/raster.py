@@ -79,9 +79,9 @@ def _crs_text(crs: Any) -> str:
     horizontal and vertical GeoTIFF keys of a compound CRS by code), else its WKT."""
     if crs is None or crs == "":
         return ""
-    from .pointcloud import parse_crs
+    from ..geometry.frames import parse_crs
 
-    parsed = parse_crs(crs)
+    parsed = parse_crs(crs, optional=True)
     if parsed is None:
         return ""
     auth = parsed.to_authority(min_confidence=100)

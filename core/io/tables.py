@@ -157,6 +157,23 @@ def unique_ids(table: Table, index: int) -> tuple[str, ...]:
     return values
 
 
+def choice_column(
+    table: Table, index: int, allowed: Sequence[str], what: str
+) -> tuple[str, ...]:
+    """A text column whose values (stripped, lower case) must be among ``allowed``; ``what``
+    names such a value in the error ("a role": "'x' is not a role (control, check)")."""
+    values = tuple(v.strip().lower() for v in text_column(table, index))
+    for value, number in zip(values, table.line_numbers):
+        if value not in allowed:
+            raise InputError(
+                f"'{value}' is not {what} ({', '.join(allowed)})",
+                path=table.path,
+                row=number,
+                column=table.columns[index],
+            )
+    return values
+
+
 def check_covariance(cov: NDArray[np.float64], table: Table, k: int, what: str) -> None:
     """Refuse (naming the file and row) a covariance matrix that is not positive
     semi-definite: a negative variance or an impossible correlation.

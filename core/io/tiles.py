@@ -40,8 +40,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import Cancelled, CrsError, InputError, stop_if_asked
+from ..geometry.frames import parse_crs
 from .atomic import PathLike, write_text_atomic
-from .pointcloud import CloudInfo, LasPoints, parse_crs, read_info
+from .pointcloud import CloudInfo, LasPoints, read_info
 
 #: Suffixes of the point-cloud files of a folder block.
 CLOUD_SUFFIXES = (".las", ".laz")

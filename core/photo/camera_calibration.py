@@ -386,6 +386,119 @@ def _residuals_by_point(res: AdjustmentResult, blocks, is_free: Array, px: Array
     return v_all, w_all
 
 
+def _initial_camera(
+    per_view: list[tuple[Array, Array]], opts: CalibrationOptions, name: str, width_px: int,
+    height_px: int, pixel_size_mm: float,
+) -> tuple[Camera, Array, dict]:
+    """The start camera (no distortion), the start orientations (V, 6) and how they were
+    found (focal length and principal point in pixels, the method)."""
+    if opts.projection == "perspective":
+        f_px, pp, eo0 = _init_perspective(per_view, (width_px, height_px))
+        how = "OpenCV calibrateCamera (Zhang)"
+    else:
+        f_px, pp, eo0 = _init_fisheye(per_view, (width_px, height_px), opts.projection)
+        how = "focal-length search: plane DLT of the back-projected rays (Z = 0 target)"
+    ps = float(pixel_size_mm)
+    base = Camera(
+        name, f_px * ps, ps, width_px, height_px,
+        x0_mm=(pp[0] - 0.5 * width_px) * ps, y0_mm=(0.5 * height_px - pp[1]) * ps,
+        distortion=BrownConrady(), projection=opts.projection,
+    )  # fmt: skip
+    initial = {"focal_px": float(f_px), "ppx_px": float(pp[0]), "ppy_px": float(pp[1]),
+               "method": how}  # fmt: skip
+    return base, eo0, initial
+
+
+@dataclass(frozen=True)
+class _Unknowns:
+    """The parameter vector: [interior (n_io), eo (6 per view), free points (3 each)]."""
+
+    free_io: NDArray[np.intp]  # the interior parameters adjusted (indices into the camera's)
+    io_names: list[str]
+    names: list[str]  # of every parameter
+    x0: Array  # start values
+    point_index: dict[int, int]  # field point -> index of its X among the parameters
+    datum: list[int]  # the free field's datum points (empty for a fixed field)
+
+    @property
+    def n_io(self) -> int:
+        return int(self.free_io.size)
+
+
+def _unknowns(
+    fld: TargetField, pt: NDArray[np.intp], view_names: list[str], base: Camera, eo0: Array,
+    opts: CalibrationOptions,
+) -> _Unknowns:
+    """The parameters adjusted and their start values (a free field: its points but two of
+    the datum)."""
+    free_io = np.array([0, 1, 2] + [3 + LENS_NAMES.index(p) for p in LENS_NAMES
+                                    if p in opts.lens_parameters], dtype=np.intp)  # fmt: skip
+    io_names = [INTERIOR_NAMES[i] for i in free_io]
+    n_io, n_views = free_io.size, len(view_names)
+    x0 = [base.interior_params[free_io], eo0.ravel()]
+    pnames = list(io_names)
+    pnames += [f"{n}:{p}" for n in view_names for p in ("X0", "Y0", "Z0", "omega", "phi", "kappa")]
+    seen = np.unique(pt)
+    datum: list[int] = []
+    if opts.field == "free":
+        datum = [int(np.flatnonzero(fld.ids == d)[0]) for d in fld.datum]
+        if not np.isin(datum, seen).all():
+            raise InputError("a free target field needs its datum points (origin, end of the "
+                             "first row, start of the last row) seen in some view")  # fmt: skip
+        fixed_pts = set(datum[:2])
+        free_pts = [int(k) for k in seen if int(k) not in fixed_pts]
+    else:
+        free_pts = []
+    point_index = {k: n_io + 6 * n_views + 3 * i for i, k in enumerate(free_pts)}
+    for k in free_pts:
+        x0.append(fld.xyz[k])
+        pnames += [f"point {int(fld.ids[k])}:{c}" for c in "XYZ"]
+    x0v = np.concatenate([np.asarray(a, dtype=np.float64).ravel() for a in x0])
+    return _Unknowns(free_io, io_names, pnames, x0v, point_index, datum)
+
+
+def _blocks(
+    fld: TargetField, view: NDArray[np.intp], pt: NDArray[np.intp], px: Array,
+    view_names: list[str], base: Camera, unk: _Unknowns, sigma: float,
+) -> tuple[list[GaussMarkovBlock], NDArray[np.bool_]]:
+    """The observation blocks (points of a fixed field, free points) and which observations
+    are of free points."""
+    n_io, point_index = unk.n_io, unk.point_index
+    eo_idx = n_io + 6 * view[:, None] + np.arange(6)[None, :]
+    io_idx = np.broadcast_to(np.arange(n_io), (view.size, n_io))
+    is_free = np.array([int(k) in point_index for k in pt], dtype=bool)
+    blocks = []
+    labels = [f"{view_names[v]} / {int(fld.ids[k])}" for v, k in zip(view, pt)]
+    for sel, free in ((~is_free, False), (is_free, True)):
+        if not sel.any():
+            continue
+        idx = [eo_idx[sel], io_idx[sel]]
+        if free:
+            idx.append(np.array([point_index[int(k)] for k in pt[sel]])[:, None]
+                       + np.arange(3)[None, :])  # fmt: skip
+        blocks.append(GaussMarkovBlock(
+            name="free points" if free else "fixed points",
+            observed=px[sel], sigma=sigma, param_index=np.concatenate(idx, axis=1),
+            model=_ViewModel(base, unk.free_io, view[sel], None if free else fld.xyz[pt[sel]]),
+            labels=[labels[i] for i in np.flatnonzero(sel)], row_names=("col", "row"),
+        ))  # fmt: skip
+    return blocks, is_free
+
+
+def _datum_constraints(unk: _Unknowns, free_field: bool) -> list:
+    """A free field's third datum point held in Z = 0 (none for a fixed field)."""
+    if not free_field:
+        return []
+    from ..lsq.model import Constraint
+
+    zc = unk.point_index[unk.datum[2]] + 2
+
+    def plane(xl: Array) -> tuple[Array, Array]:
+        return xl.copy(), np.ones((xl.shape[0], 1, 1))
+
+    return [Constraint("datum: third point in Z = 0", [[zc]], plane)]
+
+
 def calibrate_camera(
     fld: TargetField,
     detections: Sequence[Detection],
@@ -435,78 +548,20 @@ def calibrate_camera(
             parameters=["focal_mm", "x0_mm", "y0_mm"],
         )
     per_view = [(fld.xyz[pt[view == j]], px[view == j]) for j in range(n_views)]
-    if opts.projection == "perspective":
-        f_px, pp, eo0 = _init_perspective(per_view, (width_px, height_px))
-        how = "OpenCV calibrateCamera (Zhang)"
-    else:
-        f_px, pp, eo0 = _init_fisheye(per_view, (width_px, height_px), opts.projection)
-        how = "focal-length search: plane DLT of the back-projected rays (Z = 0 target)"
-    ps = float(pixel_size_mm)
-    base = Camera(
-        name, f_px * ps, ps, width_px, height_px,
-        x0_mm=(pp[0] - 0.5 * width_px) * ps, y0_mm=(0.5 * height_px - pp[1]) * ps,
-        distortion=BrownConrady(), projection=opts.projection,
-    )  # fmt: skip
-    initial = {"focal_px": float(f_px), "ppx_px": float(pp[0]), "ppy_px": float(pp[1]),
-               "method": how}  # fmt: skip
-    free_io = np.array([0, 1, 2] + [3 + LENS_NAMES.index(p) for p in LENS_NAMES
-                                    if p in opts.lens_parameters], dtype=np.intp)  # fmt: skip
-    io_names = [INTERIOR_NAMES[i] for i in free_io]
-    n_io = free_io.size
-    # parameter vector: [interior (n_io), eo (6 V), free points (3 each)]
-    x0 = [base.interior_params[free_io], eo0.ravel()]
-    pnames = list(io_names)
-    pnames += [f"{n}:{p}" for n in names for p in ("X0", "Y0", "Z0", "omega", "phi", "kappa")]
-    seen = np.unique(pt)
-    if opts.field == "free":
-        datum = [int(np.flatnonzero(fld.ids == d)[0]) for d in fld.datum]
-        if not np.isin(datum, seen).all():
-            raise InputError("a free target field needs its datum points (origin, end of the "
-                             "first row, start of the last row) seen in some view")  # fmt: skip
-        fixed_pts = set(datum[:2])
-        free_pts = [int(k) for k in seen if int(k) not in fixed_pts]
-    else:
-        free_pts = []
-    point_index = {k: n_io + 6 * n_views + 3 * i for i, k in enumerate(free_pts)}
-    for k in free_pts:
-        x0.append(fld.xyz[k])
-        pnames += [f"point {int(fld.ids[k])}:{c}" for c in "XYZ"]
-    x0v = np.concatenate([np.asarray(a, dtype=np.float64).ravel() for a in x0])
-    eo_idx = n_io + 6 * view[:, None] + np.arange(6)[None, :]
-    io_idx = np.broadcast_to(np.arange(n_io), (view.size, n_io))
-    is_free = np.array([int(k) in point_index for k in pt], dtype=bool)
-    blocks = []
+    base, eo0, initial = _initial_camera(per_view, opts, name, width_px, height_px,
+                                         pixel_size_mm)  # fmt: skip
+    unk = _unknowns(fld, pt, names, base, eo0, opts)
+    io_names, n_io, point_index = unk.io_names, unk.n_io, unk.point_index
     sigma = opts.sigma_px
-    labels = [f"{names[v]} / {int(fld.ids[k])}" for v, k in zip(view, pt)]
-    for sel, free in ((~is_free, False), (is_free, True)):
-        if not sel.any():
-            continue
-        idx = [eo_idx[sel], io_idx[sel]]
-        if free:
-            idx.append(np.array([point_index[int(k)] for k in pt[sel]])[:, None]
-                       + np.arange(3)[None, :])  # fmt: skip
-        blocks.append(GaussMarkovBlock(
-            name="free points" if free else "fixed points",
-            observed=px[sel], sigma=sigma, param_index=np.concatenate(idx, axis=1),
-            model=_ViewModel(base, free_io, view[sel], None if free else fld.xyz[pt[sel]]),
-            labels=[labels[i] for i in np.flatnonzero(sel)], row_names=("col", "row"),
-        ))  # fmt: skip
-    constraints = []
-    if opts.field == "free":
-        from ..lsq.model import Constraint
-
-        zc = point_index[datum[2]] + 2
-
-        def plane(xl: Array) -> tuple[Array, Array]:
-            return xl.copy(), np.ones((xl.shape[0], 1, 1))
-
-        constraints.append(Constraint("datum: third point in Z = 0", [[zc]], plane))
+    blocks, is_free = _blocks(fld, view, pt, px, names, base, unk, sigma)
     aopts = AdjustmentOptions(max_iterations=opts.max_iterations)
-    res = _adjust_explained(x0v, pnames, blocks, constraints, aopts, progress, should_stop,
+    constraints = _datum_constraints(unk, opts.field == "free")
+    res = _adjust_explained(unk.x0, unk.names, blocks, constraints, aopts,
+                            progress, should_stop,
                             per_view if opts.projection == "perspective" else None,
                             (width_px, height_px))  # fmt: skip
     full = base.interior_params
-    full[free_io] = res.x[:n_io]
+    full[unk.free_io] = res.x[:n_io]
     cam = base.with_interior(full)
     std = res.std
     sigmas = {n: float(std[i]) for i, n in enumerate(io_names)}

@@ -184,6 +184,76 @@ def _sample(
     return out[0], out[1], out[2]
 
 
+def _search_coords(a: Array, x: Array, y: Array) -> tuple[Array, Array]:
+    """(K, p) search (col, row) of the template points (x, y) under the affines ``a``."""
+    cs = a[:, 0, 0:1] + a[:, 0, 1:2] * x + a[:, 0, 2:3] * y
+    rs = a[:, 1, 0:1] + a[:, 1, 1:2] * x + a[:, 1, 2:3] * y
+    return cs, rs
+
+
+def _outside(cs: Array, rs: Array, box: tuple[float, float, float]) -> NDArray[np.bool_]:
+    """(K,) patches with a point outside the usable interior ``(lo, hi_col, hi_row)``."""
+    lo, hi_c, hi_r = box
+    return ((cs < lo) | (rs < lo) | (cs > hi_c) | (rs > hi_r)).any(axis=1)
+
+
+def _numpy_normals(
+    g: Array, idx: NDArray[np.intp], a: Array, rad: Array, fv: Array, x: Array, y: Array,
+    cubic: bool, grads: tuple[Array, Array] | None, box: tuple[float, float, float],
+) -> tuple[Array, Array, NDArray[np.bool_]]:
+    """Normal equations (n, 8, 8), right-hand sides (n, 8) and the outside flags of the
+    patches ``idx``: six affine and two radiometric parameters (the numba kernel's twin)."""
+    cs, rs = _search_coords(a[idx], x, y)
+    outside = _outside(cs, rs, box)
+    gv, gxv, gyv = _sample(g, idx[:, None], cs, rs, cubic, grads)
+    r0 = rad[idx, 0:1]
+    r1 = rad[idx, 1:2]
+    resid = fv[idx] - (r0 + r1 * gv)
+    ux = r1 * gxv
+    uy = r1 * gyv
+    jac = np.stack([ux, ux * x, ux * y, uy, uy * x, uy * y, np.ones_like(gv), gv],
+                   axis=1)  # fmt: skip
+    nn = jac @ jac.transpose(0, 2, 1)
+    rhs = np.einsum("kip,kp->ki", jac, resid)
+    return nn, rhs, outside
+
+
+def _solve_normals(nn: Array, rhs: Array, first: bool) -> tuple[Array, NDArray[np.bool_]]:
+    """(n, 8) corrections and the (n,) patches whose normal equations could be solved.
+
+    Singular normal equations (a template without texture: zero gain, no gradient) are
+    tested on the first iteration (an SVD per patch); later a failed solve is caught.
+    """
+    if first:
+        det_ok = np.linalg.cond(nn) < 1e12
+    else:
+        det_ok = np.isfinite(nn).all(axis=(1, 2))
+    sol = np.zeros((nn.shape[0], 8))
+    if det_ok.any():
+        try:
+            sol[det_ok] = np.linalg.solve(nn[det_ok], rhs[det_ok][:, :, None])[:, :, 0]
+        except np.linalg.LinAlgError:
+            for q in np.flatnonzero(det_ok):
+                try:
+                    sol[q] = np.linalg.solve(nn[q], rhs[q])
+                except np.linalg.LinAlgError:
+                    det_ok[q] = False
+    return sol, det_ok
+
+
+def _position_covariance(nmat: Array, s0: Array, good: NDArray[np.bool_]) -> Array:
+    """(K, 2, 2) covariance of the matched position (pixels^2; NaN where not ``good``)."""
+    cov = np.full((nmat.shape[0], 2, 2), np.nan)
+    if good.any():
+        try:
+            q = np.linalg.inv(nmat[good])
+        except np.linalg.LinAlgError:
+            q = np.linalg.pinv(nmat[good])
+        sub = q[:, [0, 3]][:, :, [0, 3]]
+        cov[good] = s0[good, None, None] ** 2 * sub
+    return cov
+
+
 def lsm_batch(
     templates: ArrayLike,
     searches: ArrayLike,
@@ -234,7 +304,7 @@ def lsm_batch(
     h, w = g.shape[1:]
     cubic = opt.interpolation == "bicubic"
     grads = None if cubic else tuple(np.gradient(g, axis=(1, 2))[::-1])
-    lo, hi_c, hi_r = (1.0, w - 3.0, h - 3.0) if cubic else (0.0, w - 1.0, h - 1.0)
+    box = (1.0, w - 3.0, h - 3.0) if cubic else (0.0, w - 1.0, h - 1.0)
     rc, rr = reference if reference is not None else ((n - 1) / 2.0, (m - 1) / 2.0)
     yy, xx = np.mgrid[0:m, 0:n]
     x = (xx.ravel() - rc).astype(np.float64)
@@ -251,13 +321,16 @@ def lsm_batch(
     if fast:
         g = np.ascontiguousarray(g)
         fv = np.ascontiguousarray(fv)
+
+    def samples() -> Array:
+        """(K, p) g resampled at the template points under the current affines."""
+        if fast:
+            return _numba.samples(g, a, x, y)
+        cs, rs = _search_coords(a, x, y)
+        return _sample(g, np.arange(k_n)[:, None], cs, rs, cubic, grads)[0]
+
     # Radiometric start: the gain and offset that map g's statistics at the start onto f's.
-    if fast:
-        gv0 = _numba.samples(g, a, x, y)
-    else:
-        cs = a[:, 0, 0:1] + a[:, 0, 1:2] * x + a[:, 0, 2:3] * y
-        rs = a[:, 1, 0:1] + a[:, 1, 1:2] * x + a[:, 1, 2:3] * y
-        gv0 = _sample(g, np.arange(k_n)[:, None], cs, rs, cubic, grads)[0]
+    gv0 = samples()
     sg = gv0.std(axis=1)
     rad[:, 1] = np.where(sg > 0, fv.std(axis=1) / np.where(sg > 0, sg, 1.0), 1.0)
     rad[:, 0] = fv.mean(axis=1) - rad[:, 1] * gv0.mean(axis=1)
@@ -268,36 +341,8 @@ def lsm_batch(
         if fast:
             nn, rhs, outside = _numba.normals(g, idx, a, rad, fv, x, y)
         else:
-            aa = a[idx]
-            cs = aa[:, 0, 0:1] + aa[:, 0, 1:2] * x + aa[:, 0, 2:3] * y
-            rs = aa[:, 1, 0:1] + aa[:, 1, 1:2] * x + aa[:, 1, 2:3] * y
-            outside = ((cs < lo) | (rs < lo) | (cs > hi_c) | (rs > hi_r)).any(axis=1)
-            gv, gxv, gyv = _sample(g, idx[:, None], cs, rs, cubic, grads)
-            r0 = rad[idx, 0:1]
-            r1 = rad[idx, 1:2]
-            resid = fv[idx] - (r0 + r1 * gv)
-            ux = r1 * gxv
-            uy = r1 * gyv
-            jac = np.stack([ux, ux * x, ux * y, uy, uy * x, uy * y, np.ones_like(gv), gv],
-                           axis=1)  # fmt: skip
-            nn = jac @ jac.transpose(0, 2, 1)
-            rhs = np.einsum("kip,kp->ki", jac, resid)
-        # Singular normal equations (a template without texture: zero gain, no gradient):
-        # tested on the first iteration (an SVD per patch); later a failed solve is caught.
-        if it == 1:
-            det_ok = np.linalg.cond(nn) < 1e12
-        else:
-            det_ok = np.isfinite(nn).all(axis=(1, 2))
-        sol = np.zeros((idx.size, 8))
-        if det_ok.any():
-            try:
-                sol[det_ok] = np.linalg.solve(nn[det_ok], rhs[det_ok][:, :, None])[:, :, 0]
-            except np.linalg.LinAlgError:
-                for q in np.flatnonzero(det_ok):
-                    try:
-                        sol[q] = np.linalg.solve(nn[q], rhs[q])
-                    except np.linalg.LinAlgError:
-                        det_ok[q] = False
+            nn, rhs, outside = _numpy_normals(g, idx, a, rad, fv, x, y, cubic, grads, box)
+        sol, det_ok = _solve_normals(nn, rhs, it == 1)
         a[idx, 0, :] += sol[:, 0:3]
         a[idx, 1, :] += sol[:, 3:6]
         rad[idx] += sol[:, 6:8]
@@ -312,25 +357,11 @@ def lsm_batch(
         active[idx[done | bad_tex | outside | moved]] = False
     status[active] = NOT_CONVERGED
     # Final residuals, sigma0, covariance and correlation at the solution.
-    cs = a[:, 0, 0:1] + a[:, 0, 1:2] * x + a[:, 0, 2:3] * y
-    rs = a[:, 1, 0:1] + a[:, 1, 1:2] * x + a[:, 1, 2:3] * y
-    outside = ((cs < lo) | (rs < lo) | (cs > hi_c) | (rs > hi_r)).any(axis=1)
-    status[(status == OK) & outside] = LEFT_WINDOW
-    if fast:
-        gv = _numba.samples(g, a, x, y)
-    else:
-        gv = _sample(g, np.arange(k_n)[:, None], cs, rs, cubic, grads)[0]
+    status[(status == OK) & _outside(*_search_coords(a, x, y), box)] = LEFT_WINDOW
+    gv = samples()
     resid = fv - (rad[:, 0:1] + rad[:, 1:2] * gv)
     s0 = np.sqrt((resid**2).sum(axis=1) / max(p - 8, 1))
-    cov = np.full((k_n, 2, 2), np.nan)
-    good = status != NO_TEXTURE
-    if good.any():
-        try:
-            q = np.linalg.inv(nmat[good])
-        except np.linalg.LinAlgError:
-            q = np.linalg.pinv(nmat[good])
-        sub = q[:, [0, 3]][:, :, [0, 3]]
-        cov[good] = s0[good, None, None] ** 2 * sub
+    cov = _position_covariance(nmat, s0, status != NO_TEXTURE)
     sig = np.sqrt(np.stack([cov[:, 0, 0], cov[:, 1, 1]], axis=1))
     fc = fv - fv.mean(axis=1, keepdims=True)
     gc = gv - gv.mean(axis=1, keepdims=True)
@@ -392,8 +423,7 @@ def lsm_in_image(
         y = yy.ravel() - rr
         k = np.arange(k_n)[:, None]
         for aff_w in (local, res.affine):
-            cs = aff_w[:, 0, 0:1] + aff_w[:, 0, 1:2] * x + aff_w[:, 0, 2:3] * y
-            rs = aff_w[:, 1, 0:1] + aff_w[:, 1, 1:2] * x + aff_w[:, 1, 2:3] * y
+            cs, rs = _search_coords(aff_w, x, y)
             ci = np.clip(np.floor(cs).astype(np.intp), 0, size - 2)
             ri = np.clip(np.floor(rs).astype(np.intp), 0, size - 2)
             touch = (nan[k, ri, ci] | nan[k, ri + 1, ci + 1] | nan[k, ri, ci + 1]

@@ -332,6 +332,160 @@ def _crs_equal(a: pyproj.CRS, b: pyproj.CRS) -> bool:
     return bool(a.equals(b, ignore_axis_order=True))
 
 
+def _ray_table(
+    obs: ImageObservations, step_px: float
+) -> tuple[NDArray[np.int64], Array, NDArray[np.int64], NDArray[np.int64], list[tuple[str, str]]]:
+    """The rays to cast: points, then line vertices (with densified points, ``step_px`` > 0).
+
+    Returns (source row of each ray, its pixel, its line index or -1, its vertex index or -1,
+    the (image, target) key of each line).
+    """
+    line_rays, line_keys = _line_rays(obs, step_px if step_px > 0 else 0.0)
+    in_lines = {r[0] for r in line_rays}
+    point_rows = [k for k in range(len(obs)) if k not in in_lines]
+    src = np.array(point_rows + [r[0] for r in line_rays], dtype=np.int64)
+    frac = np.array([0.0] * len(point_rows) + [r[3] for r in line_rays])
+    nxt = np.array(point_rows + [r[0] + 0 for r in line_rays], dtype=np.int64)
+    # densified points interpolate towards the next vertex of their line
+    for n_i, r in enumerate(line_rays):
+        if r[3] > 0:
+            later = [q for q in line_rays[n_i:] if q[1] == r[1] and q[3] == 0.0]
+            nxt[len(point_rows) + n_i] = later[0][0]
+    pixels = obs.pixels[src] * (1 - frac[:, None]) + obs.pixels[nxt] * frac[:, None]
+    line_of = np.array([-1] * len(point_rows) + [r[1] for r in line_rays], dtype=np.int64)
+    vertex_of = np.array([-1] * len(point_rows) + [r[2] for r in line_rays], dtype=np.int64)
+    return src, pixels, line_of, vertex_of, line_keys
+
+
+def _dsm_in_crs(
+    dsm: Dsm, mapping_crs: pyproj.CRS, should_stop: Callable[[], bool] | None
+) -> Dsm:
+    """The DSM in the mapping CRS: as is when it has no CRS or the same, else resampled
+    (heights transformed); CrsError when the heights cannot be brought over."""
+    if dsm.crs is None:
+        LOG.warning("the DSM has no CRS: taken to be the mapping CRS %s", mapping_crs.name)
+    elif not _crs_equal(dsm.crs, mapping_crs):
+        source_crs = dsm.crs.name
+        try:
+            dsm = reproject_dsm(dsm, mapping_crs, should_stop=should_stop)
+        except CrsError as exc:  # docs/conventions.md: never a height without its datum
+            raise CrsError(
+                f"the DSM in '{source_crs}' cannot be brought into the mapping CRS "
+                f"'{mapping_crs.name}': {exc}",
+                path=dsm.source or None,
+            ) from exc
+        LOG.warning("the DSM was in '%s': resampled into the mapping CRS '%s' (cell %g)",
+                    source_crs, mapping_crs.name, dsm.cell)  # fmt: skip
+    return dsm
+
+
+@dataclass(frozen=True)
+class _Chords:
+    """Rays in the local ENU frame at the DSM's centre, and how far to look along them."""
+
+    local: LocalFrame
+    c_map: Array  # (n, 3) perspective centres, mapping frame
+    c_loc: Array  # (n, 3) the same, local frame
+    d_loc: Array  # (n, 3) unit ray directions, local frame
+    s_far: Array  # (n,) distance to below the DSM's lowest point, metres
+
+    def take(self, k: NDArray[np.intp]) -> tuple[LocalFrame, Array, Array, Array, Array]:
+        """The arguments of _two_pass for the rays ``k``."""
+        return self.local, self.c_map[k], self.c_loc[k], self.d_loc[k], self.s_far[k]
+
+
+def _chords(
+    mapping_crs: pyproj.CRS, dsm: Dsm, table: ExteriorOrientationTable, cam: Camera,
+    pixels: Array, img: NDArray[np.int64],
+) -> _Chords:
+    """The rays of ``pixels`` seen from the images ``img`` (rows of ``table``)."""
+    from ..geometry.frames import MappingFrame
+
+    mapping = MappingFrame(mapping_crs)
+    zmin = dsm.z_range[0]
+    xc, yc = (
+        dsm.grid.x0 + dsm.grid.cols * dsm.cell / 2,
+        dsm.grid.y_top - dsm.grid.rows * dsm.cell / 2,
+    )
+    local = LocalFrame.at_map_point(mapping, [xc, yc, zmin])
+    c_loc_img, m_loc_img = eo_map_to_local(table.xyz, table.opk, local)
+    ideal = cam.ideal_from_pixel(pixels)
+    ray_c = np.column_stack([ideal, np.full(img.size, -cam.focal_mm)])
+    d_loc = np.einsum("nji,nj->ni", m_loc_img[img], ray_c)
+    d_loc /= np.linalg.norm(d_loc, axis=1, keepdims=True)
+    c_loc = c_loc_img[img]
+    c_map = table.xyz[img]
+    z_low = local.map_to_enu(np.array([[xc, yc, zmin - 10.0]]))[0, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s_far = np.where(d_loc[:, 2] < -1e-6, (c_loc[:, 2] - z_low) / -d_loc[:, 2], 1e3)
+    return _Chords(local, c_map, c_loc, d_loc, np.maximum(s_far, 1.0))
+
+
+#: (points (n, 3), status (n,), incidence (n,) degrees, surface gradient (n, 3), variance of
+#: the surface height (n,) m^2) of the rays solved on one kind of surface
+_Solved = tuple[Array, NDArray[np.int8], Array, Array, Array]
+
+
+def _on_dsm(
+    dsm: Dsm, tracer: DsmTracer, method: str, args: tuple, min_incidence_deg: float,
+    sigma_dsm: float, should_stop: Callable[[], bool] | None,
+) -> _Solved:
+    """Intersect the rays ``args`` (of _two_pass) with the DSM by ``method``."""
+    last: dict[str, DsmHits] = {}
+
+    def solve_dsm(o: Array, d: Array) -> tuple[Array, NDArray[np.int8]]:
+        if method == "makarovic":
+            return makarovic(dsm, o, d)[:2]
+        hits = intersect_dsm(tracer, o, d, min_incidence_deg=min_incidence_deg,
+                             should_stop=should_stop)  # fmt: skip
+        last["hits"] = hits
+        return hits.points, hits.status
+
+    pts, st, dirs = _two_pass(solve_dsm, *args)
+    if method == "dal_poz":
+        hits = last["hits"]
+    else:
+        # the face under the converged point gives the gradient for the precision
+        hits = intersect_dsm(tracer, args[1], dirs, min_incidence_deg=0.0)
+        st = np.where((st == STATUS_OK) & (hits.status == STATUS_GRAZING),
+                      STATUS_GRAZING, st).astype(np.int8)  # fmt: skip
+    grad = np.column_stack([-hits.gradient, np.ones(len(pts))])
+    var_h = sigma_dsm**2 * np.sum(hits.weights**2, axis=1)
+    return pts, st, hits.incidence_deg, grad, var_h
+
+
+def _on_planes(planes: list[Plane], args: tuple) -> _Solved:
+    """Intersect the rays ``args`` (of _two_pass) with one plane each."""
+    normal = np.array([p.normal for p in planes])
+    offset = np.array([p.d for p in planes])
+    pcov = np.array([p.covariance for p in planes])
+
+    def solve_plane(o: Array, d: Array) -> tuple[Array, NDArray[np.int8]]:
+        return intersect_planes(o, d, normal, offset)
+
+    pts, st, _ = _two_pass(solve_plane, *args)
+    inc = 90.0 - np.degrees(np.arccos(np.clip(np.abs(
+        np.einsum("ij,ij->i", normal, args[3])), 0, 1)))  # fmt: skip
+    g1 = np.column_stack([np.nan_to_num(pts), np.ones(len(pts))])
+    var_h = np.einsum("ni,nij,nj->n", g1, pcov, g1)
+    return pts, st, inc, normal, var_h
+
+
+def _result_lines(
+    line_keys: list[tuple[str, str]], line_of: NDArray[np.int64], vertex_of: NDArray[np.int64],
+    points: Array, cov: Array, status: NDArray[np.int8],
+) -> list[MonoplotLine]:
+    """The 3D lines (vertices in order), each with its worst status and end-point sigmas."""
+    lines = []
+    for li, (img, tgt) in enumerate(line_keys):
+        sel = np.flatnonzero(line_of == li)
+        sel = sel[np.argsort(vertex_of[sel])]
+        ends = [float(np.sqrt(np.trace(cov[sel[e]]))) for e in (0, -1)]
+        worst = int(max(status[sel], key=lambda s: (s not in _HIT, s)))
+        lines.append(MonoplotLine(img, tgt, points[sel], worst, (ends[0], ends[1])))
+    return lines
+
+
 def monoplot(
     observations: ImageObservations,
     camera: Camera,
@@ -384,7 +538,7 @@ def monoplot(
         With ``dsm`` the surface actually used (in ``crs``).
     """
     camera.require_perspective("monoplotting")
-    from ..geometry.frames import MappingFrame, parse_crs
+    from ..geometry.frames import parse_crs
 
     if method not in METHODS:
         raise InputError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
@@ -399,23 +553,8 @@ def monoplot(
         dsm = tracer.dsm
     plane_map: dict[str, Plane] = {str(p.id): p for p in planes}
 
-    # --- the rays: points, then line vertices (with densified points)
-    step = float(line_step_px)
-    line_rays, line_keys = _line_rays(obs, step if step > 0 else 0.0)
-    in_lines = {r[0] for r in line_rays}
-    point_rows = [k for k in range(len(obs)) if k not in in_lines]
-    src = np.array(point_rows + [r[0] for r in line_rays], dtype=np.int64)
-    frac = np.array([0.0] * len(point_rows) + [r[3] for r in line_rays])
-    nxt = np.array(point_rows + [r[0] + 0 for r in line_rays], dtype=np.int64)
-    # densified points interpolate towards the next vertex of their line
-    for n_i, r in enumerate(line_rays):
-        if r[3] > 0:
-            later = [q for q in line_rays[n_i:] if q[1] == r[1] and q[3] == 0.0]
-            nxt[len(point_rows) + n_i] = later[0][0]
-    pixels = obs.pixels[src] * (1 - frac[:, None]) + obs.pixels[nxt] * frac[:, None]
+    src, pixels, line_of, vertex_of, line_keys = _ray_table(obs, float(line_step_px))
     sigma_px = obs.sigma_px[src]
-    line_of = np.array([-1] * len(point_rows) + [r[1] for r in line_rays], dtype=np.int64)
-    vertex_of = np.array([-1] * len(point_rows) + [r[2] for r in line_rays], dtype=np.int64)
     n = src.size
     points = np.full((n, 3), np.nan)
     cov = np.full((n, 3, 3), np.nan)
@@ -430,20 +569,7 @@ def monoplot(
         missing = sorted({obs.image_id[k] for k in src[img_idx < 0]})
         LOG.warning("no exterior orientation for image(s) %s", ", ".join(missing[:10]))
 
-    if dsm.crs is None:
-        LOG.warning("the DSM has no CRS: taken to be the mapping CRS %s", mapping_crs.name)
-    elif not _crs_equal(dsm.crs, mapping_crs):
-        source_crs = dsm.crs.name
-        try:
-            dsm = reproject_dsm(dsm, mapping_crs, should_stop=should_stop)
-        except CrsError as exc:  # docs/conventions.md: never a height without its datum
-            raise CrsError(
-                f"the DSM in '{source_crs}' cannot be brought into the mapping CRS "
-                f"'{mapping_crs.name}': {exc}",
-                path=dsm.source or None,
-            ) from exc
-        LOG.warning("the DSM was in '%s': resampled into the mapping CRS '%s' (cell %g)",
-                    source_crs, mapping_crs.name, dsm.cell)  # fmt: skip
+    dsm = _dsm_in_crs(dsm, mapping_crs, should_stop)
     kinds = [obs.type[k] for k in src]
     targets = [obs.target_id[k] for k in src]
     on_plane = np.array(
@@ -457,24 +583,7 @@ def monoplot(
     if todo.size:
         if should_stop is not None and should_stop():
             raise Cancelled("cancelled before monoplotting")
-        mapping = MappingFrame(mapping_crs)
-        zmin = dsm.z_range[0]
-        xc, yc = (
-            dsm.grid.x0 + dsm.grid.cols * dsm.cell / 2,
-            dsm.grid.y_top - dsm.grid.rows * dsm.cell / 2,
-        )
-        local = LocalFrame.at_map_point(mapping, [xc, yc, zmin])
-        c_loc_img, m_loc_img = eo_map_to_local(table.xyz, table.opk, local)
-        ideal = cam.ideal_from_pixel(pixels[todo])
-        ray_c = np.column_stack([ideal, np.full(todo.size, -cam.focal_mm)])
-        d_loc = np.einsum("nji,nj->ni", m_loc_img[img_idx[todo]], ray_c)
-        d_loc /= np.linalg.norm(d_loc, axis=1, keepdims=True)
-        c_loc = c_loc_img[img_idx[todo]]
-        c_map = table.xyz[img_idx[todo]]
-        z_low = local.map_to_enu(np.array([[xc, yc, zmin - 10.0]]))[0, 2]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            s_far = np.where(d_loc[:, 2] < -1e-6, (c_loc[:, 2] - z_low) / -d_loc[:, 2], 1e3)
-        s_far = np.maximum(s_far, 1.0)
+        chords = _chords(mapping_crs, dsm, table, cam, pixels[todo], img_idx[todo])
         eo_rows = np.hstack([table.xyz, table.opk])[img_idx[todo]]
         grad = np.full((todo.size, 3), np.nan)
         var_h = np.full(todo.size, np.nan)
@@ -487,45 +596,13 @@ def monoplot(
             k = np.flatnonzero(dsm_sel)
             if tracer is None or tracer.dsm is not dsm:
                 tracer = DsmTracer.build(dsm)
-            last: dict[str, DsmHits] = {}
-
-            def solve_dsm(o: Array, d: Array) -> tuple[Array, NDArray[np.int8]]:
-                if method == "makarovic":
-                    return makarovic(dsm, o, d)[:2]
-                hits = intersect_dsm(tracer, o, d, min_incidence_deg=min_incidence_deg,
-                                     should_stop=should_stop)  # fmt: skip
-                last["hits"] = hits
-                return hits.points, hits.status
-
-            args = (local, c_map[k], c_loc[k], d_loc[k], s_far[k])
-            pts, st, dirs = _two_pass(solve_dsm, *args)
-            if method == "dal_poz":
-                hits = last["hits"]
-            else:
-                # the face under the converged point gives the gradient for the precision
-                hits = intersect_dsm(tracer, c_map[k], dirs, min_incidence_deg=0.0)
-                st = np.where((st == STATUS_OK) & (hits.status == STATUS_GRAZING),
-                              STATUS_GRAZING, st).astype(np.int8)  # fmt: skip
-            res_pts[k], res_st[k], res_inc[k] = pts, st, hits.incidence_deg
-            grad[k] = np.column_stack([-hits.gradient, np.ones(k.size)])
-            var_h[k] = sigma_dsm**2 * np.sum(hits.weights**2, axis=1)
+            res_pts[k], res_st[k], res_inc[k], grad[k], var_h[k] = _on_dsm(
+                dsm, tracer, method, chords.take(k), min_incidence_deg, sigma_dsm, should_stop
+            )
         if plane_sel.any():
             k = np.flatnonzero(plane_sel)
             pl = [plane_map[targets[todo[q]]] for q in k]
-            normal = np.array([p.normal for p in pl])
-            offset = np.array([p.d for p in pl])
-            pcov = np.array([p.covariance for p in pl])
-
-            def solve_plane(o: Array, d: Array) -> tuple[Array, NDArray[np.int8]]:
-                return intersect_planes(o, d, normal, offset)
-
-            pts, st, _ = _two_pass(solve_plane, local, c_map[k], c_loc[k], d_loc[k], s_far[k])
-            res_pts[k], res_st[k] = pts, st
-            res_inc[k] = 90.0 - np.degrees(np.arccos(np.clip(np.abs(
-                np.einsum("ij,ij->i", normal, d_loc[k])), 0, 1)))  # fmt: skip
-            grad[k] = normal
-            g1 = np.column_stack([np.nan_to_num(pts), np.ones(k.size)])
-            var_h[k] = np.einsum("ni,nij,nj->n", g1, pcov, g1)
+            res_pts[k], res_st[k], res_inc[k], grad[k], var_h[k] = _on_planes(pl, chords.take(k))
             for q in k:
                 used[todo[q]] = "plane"
         if method == "makarovic":
@@ -546,13 +623,7 @@ def monoplot(
          used[r])
         for r, (s, li, vi) in enumerate(zip(src, line_of, vertex_of))
     ]  # fmt: skip
-    lines = []
-    for li, (img, tgt) in enumerate(line_keys):
-        sel = np.flatnonzero(line_of == li)
-        sel = sel[np.argsort(vertex_of[sel])]
-        ends = [float(np.sqrt(np.trace(cov[sel[e]]))) for e in (0, -1)]
-        worst = int(max(status[sel], key=lambda s: (s not in _HIT, s)))
-        lines.append(MonoplotLine(img, tgt, points[sel], worst, (ends[0], ends[1])))
+    lines = _result_lines(line_keys, line_of, vertex_of, points, cov, status)
     result = MonoplotResult(rows, pixels, points, cov, status, incidence, lines,
                             mapping_crs.to_wkt(), dsm)  # fmt: skip
     LOG.info("monoplotted %d rays: %s", n, result.status_counts())

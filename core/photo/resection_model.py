@@ -269,6 +269,28 @@ def point_block(
     )
 
 
+def _lines_block(
+    name: str, conditions: LineConditions, s: Array, observed: Array, rows: list[str],
+    cov: Array | None, param_index: Array, labels: list[str],
+) -> GaussHelmertBlock:
+    """The Gauss-Helmert block of image lines (``observed``, their covariance in ``s``); with
+    ``cov`` (G, 6, 6) the 3D line's end points P1, P2 are observations too, after them."""
+    if cov is not None:
+        n = observed.shape[1]
+        s[:, n:, n:] = cov
+        observed = np.column_stack([observed, conditions.p1, conditions.p2])
+        rows = [*rows, "X1", "Y1", "Z1", "X2", "Y2", "Z2"]
+    return GaussHelmertBlock(
+        name=name,
+        observed=observed,
+        sigma=s,
+        param_index=param_index,
+        condition=conditions.condition,
+        labels=labels,
+        row_names=tuple(rows),
+    )
+
+
 def equivalent_planes_block(
     name: str,
     conditions: EquivalentPlanes,
@@ -286,19 +308,7 @@ def equivalent_planes_block(
     s[:, :2, :2] = ab_cov
     observed = ab
     rows = ["a", "b"]
-    if cov is not None:
-        s[:, 2:, 2:] = cov
-        observed = np.column_stack([ab, conditions.p1, conditions.p2])
-        rows += ["X1", "Y1", "Z1", "X2", "Y2", "Z2"]
-    return GaussHelmertBlock(
-        name=name,
-        observed=observed,
-        sigma=s,
-        param_index=param_index,
-        condition=conditions.condition,
-        labels=labels,
-        row_names=tuple(rows),
-    )
+    return _lines_block(name, conditions, s, observed, rows, cov, param_index, labels)
 
 
 def line_block(
@@ -319,16 +329,4 @@ def line_block(
     s[:, idx, idx] = np.repeat(sigma_px, 2, axis=1) ** 2
     observed = pixels.reshape(g, 2 * k)
     rows = [f"{axis}{j + 1}" for j in range(k) for axis in ("col", "row")]
-    if cov is not None:
-        s[:, 2 * k :, 2 * k :] = cov
-        observed = np.column_stack([observed, conditions.p1, conditions.p2])
-        rows += ["X1", "Y1", "Z1", "X2", "Y2", "Z2"]
-    return GaussHelmertBlock(
-        name=name,
-        observed=observed,
-        sigma=s,
-        param_index=param_index,
-        condition=conditions.condition,
-        labels=labels,
-        row_names=tuple(rows),
-    )
+    return _lines_block(name, conditions, s, observed, rows, cov, param_index, labels)

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import __version__
-from .html_table import TR_CONTEXT, html_lang, t  # noqa: F401 - TR_CONTEXT: make i18n
+from .html_table import TR_CONTEXT, html_lang, report_css, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 from .svg_plots import histogram, qq_plot, vector_map
@@ -25,17 +25,11 @@ if TYPE_CHECKING:
 __all__ = ["render_html"]
 
 
-_CSS = """
-body{font-family:sans-serif;margin:24px;color:#222;max-width:1200px}
-h1{font-size:22px}h2{font-size:18px;border-bottom:1px solid #aaa;margin-top:28px}
-h3{font-size:15px}
-table{border-collapse:collapse;margin:8px 0 16px 0;font-size:13px}
-th,td{border:1px solid #bbb;padding:3px 7px;text-align:right}
-th{background:#eee}td.t,th.t{text-align:left}
-.pass{background:#d8f0d8}.fail{background:#f7d4d4}.insufficient{background:#fbecc4}
-.info{background:#e6eef8}.plots svg{margin:4px;border:1px solid #ddd}
-.note{font-size:12px;color:#444}
-"""
+_CSS = report_css(1200, (
+    ".insufficient{background:#fbecc4}\n"
+    ".info{background:#e6eef8}.plots svg{margin:4px;border:1px solid #ddd}\n"
+    ".note{font-size:12px;color:#444}"
+), h2_top_px=28, h3="h3{font-size:15px}")
 
 
 def _m(x: float | None, digits: int = 3) -> str:

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import __version__
-from .html_table import TR_CONTEXT, failed_checks, html_lang, t  # noqa: F401 - TR_CONTEXT: i18n
+from .html_table import TR_CONTEXT, failed_checks, html_lang, report_css, t  # noqa: F401 - TR_CONTEXT: i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 from .svg_plots import histogram
@@ -29,16 +29,11 @@ __all__ = ["render_boresight_html"]
 ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
 _ANGLES = ("omega", "phi", "kappa")
 
-_CSS = """
-body{font-family:sans-serif;margin:24px;color:#222;max-width:1100px}
-h1{font-size:22px}h2{font-size:18px;border-bottom:1px solid #aaa;margin-top:26px}
-table{border-collapse:collapse;margin:8px 0 16px 0;font-size:13px}
-th,td{border:1px solid #bbb;padding:3px 7px;text-align:right}
-th{background:#eee}td.t,th.t{text-align:left}
-.pass{background:#d8f0d8}.fail{background:#f7d4d4}.diag{background:#fbecc4;padding:8px}
-.plots svg{margin:4px;border:1px solid #ddd}.note{font-size:12px;color:#444}
-.alarm{background:#c62828;color:#fff;padding:8px 14px;font-size:15px}
-"""
+_CSS = report_css(1100, (
+    ".diag{background:#fbecc4;padding:8px}\n"
+    ".plots svg{margin:4px;border:1px solid #ddd}.note{font-size:12px;color:#444}\n"
+    ".alarm{background:#c62828;color:#fff;padding:8px 14px;font-size:15px}"
+))
 
 
 def _n(x: float | None, digits: int = 2) -> str:

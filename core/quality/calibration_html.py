@@ -14,20 +14,13 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
-from .html_table import TR_CONTEXT, html_lang, t  # noqa: F401 - TR_CONTEXT: make i18n
+from .html_table import TR_CONTEXT, html_lang, report_css, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 
 __all__ = ["render_calibration_html"]
 
-_CSS = """
-body{font-family:sans-serif;margin:24px;color:#222;max-width:1100px}
-h1{font-size:22px}h2{font-size:18px;border-bottom:1px solid #aaa;margin-top:26px}
-table{border-collapse:collapse;margin:8px 0 16px 0;font-size:13px}
-th,td{border:1px solid #bbb;padding:3px 7px;text-align:right}
-th{background:#eee}td.t,th.t{text-align:left}
-.pass{background:#d8f0d8}.fail{background:#f7d4d4}.note{font-size:12px;color:#444}
-"""
+_CSS = report_css(1100, ".note{font-size:12px;color:#444}")
 
 
 def _n(x: float | None, fmt: str = ".4g") -> str:

@@ -17,22 +17,17 @@ import numpy as np
 
 from .. import __version__
 from ..photo.control_location import LocatedPair
-from .html_table import TR_CONTEXT, html_lang, t  # noqa: F401 - TR_CONTEXT: make i18n
+from .html_table import TR_CONTEXT, html_lang, report_css, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 
 __all__ = ["png_data_uri", "render_location_html"]
 
-_CSS = """
-body{font-family:sans-serif;margin:24px;color:#222;max-width:1200px}
-h1{font-size:22px}h2{font-size:18px;border-bottom:1px solid #aaa;margin-top:26px}
-table{border-collapse:collapse;margin:8px 0 16px 0;font-size:13px}
-th,td{border:1px solid #bbb;padding:3px 7px;text-align:right}
-th{background:#eee}td.t,th.t{text-align:left}
-.pass{background:#d8f0d8}.fail{background:#f7d4d4}.note{font-size:12px;color:#444}
-figure{display:inline-block;margin:6px;padding:4px;border:1px solid #ccc;font-size:12px}
-figure.fail{border-color:#c33}img{image-rendering:pixelated;margin:2px}
-"""
+_CSS = report_css(1200, (
+    ".note{font-size:12px;color:#444}\n"
+    "figure{display:inline-block;margin:6px;padding:4px;border:1px solid #ccc;font-size:12px}\n"
+    "figure.fail{border-color:#c33}img{image-rendering:pixelated;margin:2px}"
+))
 
 
 def png_data_uri(grey: np.ndarray | None, zoom: int = 4) -> str:

@@ -8,7 +8,7 @@ from collections.abc import Sequence
 
 from ..i18n import html_lang, render
 
-__all__ = ["TR_CONTEXT", "escape", "failed_checks", "html_lang", "t", "table"]
+__all__ = ["TR_CONTEXT", "escape", "failed_checks", "html_lang", "report_css", "t", "table"]
 #: translation context of the reports' texts (``make i18n`` collects the ``t("...")`` calls of
 #: every module that defines or imports TR_CONTEXT)
 TR_CONTEXT = "Report"
@@ -18,6 +18,25 @@ def t(text: str) -> str:
     """``text`` in the language of the reports (:func:`core.i18n.set_language`); a
     :class:`core.i18n.Message` through its translated template and its values."""
     return render(text, TR_CONTEXT)
+
+
+def report_css(max_width_px: int, rest: str, *, h2_top_px: int = 26, h3: str = "") -> str:
+    """The reports' style sheet: page, headings, tables and the pass/fail row colours they
+    all share, then ``rest`` (the report's own classes, straight after ``.fail``); ``h3``
+    the style of third-level headings where a report has them.
+
+    >>> report_css(1100, ".note{color:#444}").splitlines()[-1]
+    '.pass{background:#d8f0d8}.fail{background:#f7d4d4}.note{color:#444}'
+    """
+    return (
+        f"\nbody{{font-family:sans-serif;margin:24px;color:#222;max-width:{max_width_px}px}}\n"
+        f"h1{{font-size:22px}}h2{{font-size:18px;border-bottom:1px solid #aaa;"
+        f"margin-top:{h2_top_px}px}}\n" + (f"{h3}\n" if h3 else "")
+        + "table{border-collapse:collapse;margin:8px 0 16px 0;font-size:13px}\n"
+        "th,td{border:1px solid #bbb;padding:3px 7px;text-align:right}\n"
+        "th{background:#eee}td.t,th.t{text-align:left}\n"
+        ".pass{background:#d8f0d8}.fail{background:#f7d4d4}" + rest + "\n"
+    )  # fmt: skip
 
 
 def escape(text: object) -> str:

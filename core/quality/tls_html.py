@@ -20,22 +20,17 @@ from ..lsq.results import RejectionTest
 from ..tls.aps import ARCSEC
 from ..tls.calibration import TlsCalibration
 from ..tls.diagnosis import explain_pair
-from .html_table import TR_CONTEXT, failed_checks, html_lang, t  # noqa: F401 - TR_CONTEXT: i18n
+from .html_table import TR_CONTEXT, failed_checks, html_lang, report_css, t  # noqa: F401 - TR_CONTEXT: i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 
 __all__ = ["render_tls_html"]
 
-_CSS = """
-body{font-family:sans-serif;margin:24px;color:#222;max-width:1200px}
-h1{font-size:22px}h2{font-size:18px;border-bottom:1px solid #aaa;margin-top:26px}
-table{border-collapse:collapse;margin:8px 0 16px 0;font-size:13px}
-th,td{border:1px solid #bbb;padding:3px 7px;text-align:right}
-th{background:#eee}td.t,th.t{text-align:left}
-.pass{background:#d8f0d8}.fail{background:#f7d4d4}.diag{background:#fbecc4;padding:8px}
-table.corr td{padding:2px 4px;font-size:11px}table.corr th{font-size:11px;padding:2px 4px}
-.note{font-size:12px;color:#444}.alarm{background:#f7d4d4;border:2px solid #c33;padding:8px}
-"""
+_CSS = report_css(1200, (
+    ".diag{background:#fbecc4;padding:8px}\n"
+    "table.corr td{padding:2px 4px;font-size:11px}table.corr th{font-size:11px;padding:2px 4px}\n"
+    ".note{font-size:12px;color:#444}.alarm{background:#f7d4d4;border:2px solid #c33;padding:8px}"
+))
 
 def _design() -> str:
     """How the network design breaks the correlations (Lichti 2010), translated."""

@@ -16,11 +16,11 @@ import pyproj
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import CrsError, InputError
+from ..geometry.frames import parse_crs
 from ..geometry.grid import Grid
 from ..geometry.planes import Plane
 from ..geometry.raycast import DsmTracer
 from ..geometry.surface import Dsm
-from ..io.pointcloud import parse_crs
 
 LOG = logging.getLogger(__name__)
 
@@ -328,7 +328,7 @@ class RenderScene:
         -------
         RenderScene
         """
-        crs_ = parse_crs(crs) if crs is not None else dsm.crs
+        crs_ = parse_crs(crs, optional=True) if crs is not None else dsm.crs
         if crs_ is None:
             raise CrsError("the scene needs a mapping CRS (the DSM has none)")
         pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)

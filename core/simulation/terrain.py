@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -249,6 +250,223 @@ def _houses(
     ]  # fmt: skip
 
 
+class _Layout(NamedTuple):
+    """One terrain class's scene before sampling: the ground height function (x, y arrays ->
+    z, metres), the boxes and trees standing on it, and where no return comes back (None:
+    everywhere)."""
+
+    ground: Callable[[Array, Array], Array]
+    boxes: list[_Box]
+    trees: list[_Tree]
+    void: Callable[[Array, Array], Array] | None
+
+
+def _layout_slopes(rng: np.random.Generator, L: float) -> _Layout:
+    """A hillside steepening from 24 to 50 degrees under a closed forest, with houses."""
+    full = (0.0, 0.0, L, L)
+
+    # a hillside steepening from 24 to 50 degrees, with spurs; closed forest on the upper
+    # part, shrubs (1-2.5 m) everywhere, houses low down and on the steep part
+    def ground(x, y):
+        return 0.45 * x + 0.25 * L * np.tanh((x - 0.6 * L) / (0.25 * L)) * 0.8 + (
+            6.0 * np.sin(y / 23.0) * np.cos(x / 31.0)
+        )
+
+    # a closed canopy: a crown every 25 m^2 (the ground seen only through it)
+    trees = _scatter_trees(rng, int(0.55 * L * L / 25), (0.45 * L, 0, L, L))
+    trees += _scatter_trees(rng, int(L * L / 150), full, big=False)
+    boxes = _houses(rng, 6, (0.08 * L, 0.1 * L, 0.4 * L, 0.9 * L))
+    boxes += _houses(rng, 3, (0.5 * L, 0.1 * L, 0.9 * L, 0.9 * L))
+    boxes += _scatter_small(rng, 10, (0, 0, 0.4 * L, L))
+    return _Layout(ground, boxes, trees, None)
+
+
+def _layout_cliffs(rng: np.random.Generator, L: float) -> _Layout:
+    """A plateau behind a curved cliff and a quarry pit."""
+    full = (0.0, 0.0, L, L)
+
+    # a plateau 12 m above the plain behind a curved cliff, a quarry pit 9 m deep
+    def ground(x, y):
+        edge = 0.55 * L + 10.0 * np.sin(y / 19.0)
+        plateau = 12.0 / (1.0 + np.exp(-(x - edge) / 0.6))
+        r = np.hypot(x - 0.25 * L, y - 0.3 * L)
+        pit = -9.0 / (1.0 + np.exp(-(0.12 * L - r) / 0.5))
+        return 0.02 * y + plateau + pit
+
+    trees = _scatter_trees(rng, int(L * L / 600), full)
+    boxes = _houses(rng, 4, (0.6 * L, 0.5 * L, 0.95 * L, 0.95 * L))
+    boxes += _scatter_small(rng, 8, full)
+    return _Layout(ground, boxes, trees, None)
+
+
+def _layout_terraces(rng: np.random.Generator, L: float) -> _Layout:
+    """Steps across a hillside with vines in rows on the treads."""
+    full = (0.0, 0.0, L, L)
+
+    # 2.2 m steps every 16 m across a hillside (risers 1:1), vines in rows on the treads
+    def ground(x, y):
+        k = x / 16.0
+        step = np.floor(k) + 1.0 / (1.0 + np.exp(-((k - np.floor(k)) - 0.93) * 40.0))
+        return 2.2 * step + 0.02 * x + 1.5 * np.sin(y / 40.0)
+
+    boxes: list[_Box] = []
+    for i in range(int(L / 16)):
+        for j in range(3):
+            boxes.append(_Box(16.0 * i + 4.0 + 3.5 * j, L / 2, 1.0, 0.8 * L, 0.0, 1.6,
+                              VEGETATION))  # fmt: skip
+    trees = _scatter_trees(rng, int(L * L / 1500), full)
+    boxes += _houses(rng, 3, (0.1 * L, 0.05 * L, 0.9 * L, 0.2 * L))
+    return _Layout(ground, boxes, trees, None)
+
+
+def _layout_bridges(rng: np.random.Generator, L: float) -> _Layout:
+    """A river with a bridge on embankment ramps, a highway over a road."""
+    full = (0.0, 0.0, L, L)
+
+    # a river (no returns) in a floodplain, embankment ramps up to a bridge deck 7 m over
+    # the plain; a highway on an embankment crossing a road on an overpass
+    river_y = 0.35 * L
+
+    def ramp(x, y):
+        # an embankment along y at x = 0.5 L: 12 m wide on top, side slopes 1:1.5,
+        # rising at 12 % to 7 m at the bridge abutments, 14 m from the river's axis
+        dist = np.abs(y - river_y)
+        crest = np.where(dist > 14.0, np.clip(7.0 - (dist - 14.0) * 0.12, 0.0, 7.0), 0.0)
+        return np.clip(crest - (np.abs(x - 0.5 * L) - 6.0) / 1.5, 0.0, crest)
+
+    def highway(x, y):
+        # an embankment 5 m high along x at y = 0.75 L, cut by a road (x near 0.3 L)
+        across = np.abs(y - 0.75 * L) < 8.0
+        cut = np.abs(x - 0.3 * L) < 7.0
+        side = np.clip(5.0 - (np.abs(y - 0.75 * L) - 8.0) * 0.5, 0.0, 5.0)
+        return np.where(cut, 0.0, np.where(across, 5.0, side))
+
+    def ground(x, y):
+        bank = -2.0 / (1.0 + np.exp(-(12.0 - np.abs(y - river_y)) / 1.0))
+        return 0.01 * x + bank + np.maximum(ramp(x, y), highway(x, y))
+
+    def void(x, y):
+        return np.abs(y - river_y) < 10.0
+
+    boxes = [
+        _Box(0.5 * L, river_y, 12.0, 28.0, 0.0, 0.0, DECK, top=7.0 + 0.005 * L),
+        _Box(0.3 * L, 0.75 * L, 14.0, 16.0, 0.0, 0.0, DECK, top=5.0 + 0.003 * L),
+    ]
+    boxes += _scatter_small(rng, 12, full)
+    trees = _scatter_trees(rng, int(L * L / 900), (0, 0.45 * L, L, 0.65 * L))
+    boxes += _houses(rng, 3, (0.65 * L, 0.05 * L, 0.95 * L, 0.2 * L))
+    return _Layout(ground, boxes, trees, void)
+
+
+def _layout_gaps(rng: np.random.Generator, L: float) -> _Layout:
+    """Rolling ground with two lakes and an occluded strip."""
+    full = (0.0, 0.0, L, L)
+
+    # rolling ground with two lakes (no returns), an occluded strip, buildings at the shore
+    def ground(x, y):
+        return 4.0 * np.sin(x / 37.0) + 3.0 * np.cos(y / 29.0) + 0.03 * x
+
+    def void(x, y):
+        lake1 = np.hypot((x - 0.3 * L) / 0.2, (y - 0.35 * L) / 0.15) < L
+        lake2 = np.hypot((x - 0.75 * L) / 0.12, (y - 0.7 * L) / 0.2) < L
+        strip = np.abs(x + 0.4 * y - 0.9 * L) < 4.0
+        return lake1 | lake2 | strip
+
+    boxes = [_Box(0.3 * L + 0.23 * L, 0.35 * L, 18.0, 12.0, 0.3, 9.0),
+             _Box(0.75 * L - 0.17 * L, 0.7 * L + 0.1 * L, 24.0, 14.0, 1.2, 14.0)]  # fmt: skip
+    boxes += _houses(rng, 5, (0.05 * L, 0.65 * L, 0.45 * L, 0.95 * L))
+    trees = _scatter_trees(rng, int(L * L / 800), full)
+    boxes += _scatter_small(rng, 8, full)
+    return _Layout(ground, boxes, trees, void)
+
+
+def _layout_outliers(rng: np.random.Generator, L: float) -> _Layout:
+    """Gentle ground with houses and trees (the outliers are added after sampling)."""
+
+    def ground(x, y):
+        return 2.0 * np.sin(x / 45.0) * np.cos(y / 35.0) + 0.05 * y
+
+    boxes = _houses(rng, 10, (0.05 * L, 0.05 * L, 0.95 * L, 0.95 * L))
+    trees = _scatter_trees(rng, int(L * L / 700), (0.0, 0.0, L, L))
+    boxes += _scatter_small(rng, 12, (0.0, 0.0, L, L))
+    return _Layout(ground, boxes, trees, None)
+
+
+def _layout_dense_buildings(rng: np.random.Generator, L: float) -> _Layout:
+    """A city block of large buildings with courtyards along narrow streets."""
+    full = (0.0, 0.0, L, L)
+
+    # a city block: large buildings with courtyards along narrow streets, 2 % slope
+    def ground(x, y):
+        return 0.02 * x + 0.01 * y
+
+    boxes: list[_Box] = []
+    street = 10.0
+    x = street
+    while x < L - 20:
+        wx = rng.uniform(30.0, 80.0)
+        y = street
+        while y < L - 20:
+            wy = rng.uniform(25.0, 70.0)
+            ww, hh = min(wx, L - x - 2), min(wy, L - y - 2)
+            hole = rng.uniform(0.35, 0.6) if min(ww, hh) > 40 else 0.0
+            boxes.append(_Box(x + ww / 2, y + hh / 2, ww, hh, 0.0, rng.uniform(6.0, 30.0),
+                              hole=hole))  # fmt: skip
+            y += wy + street
+        x += wx + street
+    boxes += _scatter_small(rng, 25, full)
+    trees = _scatter_trees(rng, int(L * L / 2500), full)
+    return _Layout(ground, boxes, trees, None)
+
+
+#: the layout builder of each class (the two outlier classes share one layout)
+_LAYOUTS: dict[str, Callable[[np.random.Generator, float], _Layout]] = {
+    "slopes": _layout_slopes,
+    "cliffs": _layout_cliffs,
+    "terraces": _layout_terraces,
+    "bridges": _layout_bridges,
+    "gaps": _layout_gaps,
+    "low_outliers": _layout_outliers,
+    "high_outliers": _layout_outliers,
+    "dense_buildings": _layout_dense_buildings,
+}
+
+
+def _add_low_outliers(
+    rng: np.random.Generator, xyz: Array, kind: NDArray[np.int8], L: float
+) -> tuple[Array, NDArray[np.int8]]:
+    """Append multipath points below the ground: singles and clusters (kind LOW)."""
+    # single multipath points, one per 150 m^2, 1.5-25 m down
+    singles = rng.choice(np.flatnonzero(kind == TERRAIN), int(L * L / 150), replace=False)
+    low = xyz[singles].copy()
+    low[:, 2] -= rng.uniform(1.5, 25.0, len(low))
+    # clusters of multipath points, one per 1000 m^2: 12 points within about 1.5 m,
+    # 3-8 m down
+    centres = xyz[rng.choice(np.flatnonzero(kind == TERRAIN), max(int(L * L / 1000), 1))]
+    cl = np.repeat(centres, 12, axis=0)
+    cl[:, :2] += rng.normal(0.0, 0.5, (len(cl), 2))
+    cl[:, 2] -= np.repeat(rng.uniform(3.0, 8.0, len(centres)), 12)
+    cl[:, 2] += rng.normal(0.0, 0.3, len(cl))
+    xyz = np.concatenate([xyz, low, cl])
+    kind = np.concatenate([kind, np.full(len(low) + len(cl), LOW, dtype=np.int8)])
+    return xyz, kind
+
+
+def _add_high_outliers(
+    rng: np.random.Generator, xyz: Array, kind: NDArray[np.int8], n: int
+) -> tuple[Array, NDArray[np.int8]]:
+    """Append points above the scene (kind HIGH): birds and clouds, 0.5 % of the ``n``
+    sampled points; 30 % of them wires 3-12 m up."""
+    m = int(0.005 * n)
+    src = rng.choice(n, m, replace=False)
+    high = xyz[src].copy()
+    high[:, 2] += np.where(rng.random(m) < 0.3, rng.uniform(3.0, 12.0, m),
+                           rng.uniform(20.0, 250.0, m))  # fmt: skip
+    xyz = np.concatenate([xyz, high])
+    kind = np.concatenate([kind, np.full(m, HIGH, dtype=np.int8)])
+    return xyz, kind
+
+
 def make_terrain(
     name: str,
     *,
@@ -288,158 +506,15 @@ def make_terrain(
         raise InputError("size must be >= 100 m, density > 0 and noise_sigma >= 0")
     rng = np.random.default_rng([seed, TERRAIN_CLASSES.index(name)])
     L = float(size)
-    full = (0.0, 0.0, L, L)
-    void = None
-    boxes: list[_Box] = []
-    trees: list[_Tree] = []
-    extra_low = extra_high = False
-
-    if name == "slopes":
-        # a hillside steepening from 24 to 50 degrees, with spurs; closed forest on the upper
-        # part, shrubs (1-2.5 m) everywhere, houses low down and on the steep part
-        def ground(x, y):
-            return 0.45 * x + 0.25 * L * np.tanh((x - 0.6 * L) / (0.25 * L)) * 0.8 + (
-                6.0 * np.sin(y / 23.0) * np.cos(x / 31.0)
-            )
-
-        # a closed canopy: a crown every 25 m^2 (the ground seen only through it)
-        trees = _scatter_trees(rng, int(0.55 * L * L / 25), (0.45 * L, 0, L, L))
-        trees += _scatter_trees(rng, int(L * L / 150), full, big=False)
-        boxes = _houses(rng, 6, (0.08 * L, 0.1 * L, 0.4 * L, 0.9 * L))
-        boxes += _houses(rng, 3, (0.5 * L, 0.1 * L, 0.9 * L, 0.9 * L))
-        boxes += _scatter_small(rng, 10, (0, 0, 0.4 * L, L))
-    elif name == "cliffs":
-        # a plateau 12 m above the plain behind a curved cliff, a quarry pit 9 m deep
-        def ground(x, y):
-            edge = 0.55 * L + 10.0 * np.sin(y / 19.0)
-            plateau = 12.0 / (1.0 + np.exp(-(x - edge) / 0.6))
-            r = np.hypot(x - 0.25 * L, y - 0.3 * L)
-            pit = -9.0 / (1.0 + np.exp(-(0.12 * L - r) / 0.5))
-            return 0.02 * y + plateau + pit
-
-        trees = _scatter_trees(rng, int(L * L / 600), full)
-        boxes = _houses(rng, 4, (0.6 * L, 0.5 * L, 0.95 * L, 0.95 * L))
-        boxes += _scatter_small(rng, 8, full)
-    elif name == "terraces":
-        # 2.2 m steps every 16 m across a hillside (risers 1:1), vines in rows on the treads
-        def ground(x, y):
-            k = x / 16.0
-            step = np.floor(k) + 1.0 / (1.0 + np.exp(-((k - np.floor(k)) - 0.93) * 40.0))
-            return 2.2 * step + 0.02 * x + 1.5 * np.sin(y / 40.0)
-
-        for i in range(int(L / 16)):
-            for j in range(3):
-                boxes.append(_Box(16.0 * i + 4.0 + 3.5 * j, L / 2, 1.0, 0.8 * L, 0.0, 1.6,
-                                  VEGETATION))  # fmt: skip
-        trees = _scatter_trees(rng, int(L * L / 1500), full)
-        boxes += _houses(rng, 3, (0.1 * L, 0.05 * L, 0.9 * L, 0.2 * L))
-    elif name == "bridges":
-        # a river (no returns) in a floodplain, embankment ramps up to a bridge deck 7 m over
-        # the plain; a highway on an embankment crossing a road on an overpass
-        river_y = 0.35 * L
-
-        def ramp(x, y):
-            # an embankment along y at x = 0.5 L: 12 m wide on top, side slopes 1:1.5,
-            # rising at 12 % to 7 m at the bridge abutments, 14 m from the river's axis
-            dist = np.abs(y - river_y)
-            crest = np.where(dist > 14.0, np.clip(7.0 - (dist - 14.0) * 0.12, 0.0, 7.0), 0.0)
-            return np.clip(crest - (np.abs(x - 0.5 * L) - 6.0) / 1.5, 0.0, crest)
-
-        def highway(x, y):
-            # an embankment 5 m high along x at y = 0.75 L, cut by a road (x near 0.3 L)
-            across = np.abs(y - 0.75 * L) < 8.0
-            cut = np.abs(x - 0.3 * L) < 7.0
-            side = np.clip(5.0 - (np.abs(y - 0.75 * L) - 8.0) * 0.5, 0.0, 5.0)
-            return np.where(cut, 0.0, np.where(across, 5.0, side))
-
-        def ground(x, y):
-            bank = -2.0 / (1.0 + np.exp(-(12.0 - np.abs(y - river_y)) / 1.0))
-            return 0.01 * x + bank + np.maximum(ramp(x, y), highway(x, y))
-
-        def void(x, y):
-            return np.abs(y - river_y) < 10.0
-
-        boxes = [
-            _Box(0.5 * L, river_y, 12.0, 28.0, 0.0, 0.0, DECK, top=7.0 + 0.005 * L),
-            _Box(0.3 * L, 0.75 * L, 14.0, 16.0, 0.0, 0.0, DECK, top=5.0 + 0.003 * L),
-        ]
-        boxes += _scatter_small(rng, 12, full)
-        trees = _scatter_trees(rng, int(L * L / 900), (0, 0.45 * L, L, 0.65 * L))
-        boxes += _houses(rng, 3, (0.65 * L, 0.05 * L, 0.95 * L, 0.2 * L))
-    elif name == "gaps":
-        # rolling ground with two lakes (no returns), an occluded strip, buildings at the shore
-        def ground(x, y):
-            return 4.0 * np.sin(x / 37.0) + 3.0 * np.cos(y / 29.0) + 0.03 * x
-
-        def void(x, y):
-            lake1 = np.hypot((x - 0.3 * L) / 0.2, (y - 0.35 * L) / 0.15) < L
-            lake2 = np.hypot((x - 0.75 * L) / 0.12, (y - 0.7 * L) / 0.2) < L
-            strip = np.abs(x + 0.4 * y - 0.9 * L) < 4.0
-            return lake1 | lake2 | strip
-
-        boxes = [_Box(0.3 * L + 0.23 * L, 0.35 * L, 18.0, 12.0, 0.3, 9.0),
-                 _Box(0.75 * L - 0.17 * L, 0.7 * L + 0.1 * L, 24.0, 14.0, 1.2, 14.0)]  # fmt: skip
-        boxes += _houses(rng, 5, (0.05 * L, 0.65 * L, 0.45 * L, 0.95 * L))
-        trees = _scatter_trees(rng, int(L * L / 800), full)
-        boxes += _scatter_small(rng, 8, full)
-    elif name in ("low_outliers", "high_outliers"):
-        def ground(x, y):
-            return 2.0 * np.sin(x / 45.0) * np.cos(y / 35.0) + 0.05 * y
-
-        boxes = _houses(rng, 10, (0.05 * L, 0.05 * L, 0.95 * L, 0.95 * L))
-        trees = _scatter_trees(rng, int(L * L / 700), full)
-        boxes += _scatter_small(rng, 12, full)
-        if name == "low_outliers":
-            extra_low = True
-        else:
-            extra_high = True
-    else:  # dense_buildings
-        # a city block: large buildings with courtyards along narrow streets, 2 % slope
-        def ground(x, y):
-            return 0.02 * x + 0.01 * y
-
-        street = 10.0
-        x = street
-        while x < L - 20:
-            wx = rng.uniform(30.0, 80.0)
-            y = street
-            while y < L - 20:
-                wy = rng.uniform(25.0, 70.0)
-                ww, hh = min(wx, L - x - 2), min(wy, L - y - 2)
-                hole = rng.uniform(0.35, 0.6) if min(ww, hh) > 40 else 0.0
-                boxes.append(_Box(x + ww / 2, y + hh / 2, ww, hh, 0.0, rng.uniform(6.0, 30.0),
-                                  hole=hole))  # fmt: skip
-                y += wy + street
-            x += wx + street
-        boxes += _scatter_small(rng, 25, full)
-        trees = _scatter_trees(rng, int(L * L / 2500), full)
-
+    ground, boxes, trees, void = _LAYOUTS[name](rng, L)
     pts, kinds = _sample(name, (L, L), density, ground, boxes, trees, rng, noise_sigma, void)
     xyz = np.concatenate(pts)
     kind = np.concatenate(kinds)
     n = len(xyz)
-    if extra_low:
-        # single multipath points, one per 150 m^2, 1.5-25 m down
-        singles = rng.choice(np.flatnonzero(kind == TERRAIN), int(L * L / 150), replace=False)
-        low = xyz[singles].copy()
-        low[:, 2] -= rng.uniform(1.5, 25.0, len(low))
-        # clusters of multipath points, one per 1000 m^2: 12 points within about 1.5 m,
-        # 3-8 m down
-        centres = xyz[rng.choice(np.flatnonzero(kind == TERRAIN), max(int(L * L / 1000), 1))]
-        cl = np.repeat(centres, 12, axis=0)
-        cl[:, :2] += rng.normal(0.0, 0.5, (len(cl), 2))
-        cl[:, 2] -= np.repeat(rng.uniform(3.0, 8.0, len(centres)), 12)
-        cl[:, 2] += rng.normal(0.0, 0.3, len(cl))
-        xyz = np.concatenate([xyz, low, cl])
-        kind = np.concatenate([kind, np.full(len(low) + len(cl), LOW, dtype=np.int8)])
-    if extra_high:  # birds and clouds, 0.5 % of the points; 30 % of them wires 3-12 m up
-        m = int(0.005 * n)
-        src = rng.choice(n, m, replace=False)
-        high = xyz[src].copy()
-        high[:, 2] += np.where(rng.random(m) < 0.3, rng.uniform(3.0, 12.0, m),
-                               rng.uniform(20.0, 250.0, m))  # fmt: skip
-        xyz = np.concatenate([xyz, high])
-        kind = np.concatenate([kind, np.full(m, HIGH, dtype=np.int8)])
+    if name == "low_outliers":
+        xyz, kind = _add_low_outliers(rng, xyz, kind, L)
+    if name == "high_outliers":
+        xyz, kind = _add_high_outliers(rng, xyz, kind, n)
     order = rng.permutation(len(xyz))
     xyz, kind = xyz[order], kind[order]
     return TerrainScene(name, xyz, kind == TERRAIN, kind, float(density))

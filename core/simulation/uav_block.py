@@ -241,6 +241,189 @@ def _true_ap(family: str, cam: Camera, scale_px: float, rng) -> dict[str, float]
     return dict(zip(model.param_names, coef.tolist()))
 
 
+def _true_camera(
+    cfg: UavBlockConfig, ap_model: str, ap_scale_px: float, rng: np.random.Generator
+) -> tuple[dict[str, float], Camera]:
+    """The inserted AP coefficients and the true camera (interior orientation and lens)."""
+    nominal = cfg.camera
+    true_ap = {} if ap_model == "none" else _true_ap(ap_model, nominal, ap_scale_px, rng)
+    w_mm = nominal.width_px * nominal.pixel_size_mm
+    h_mm = nominal.height_px * nominal.pixel_size_mm
+    if ap_model == "real":
+        lens = BrownConrady(**true_ap)
+    elif ap_model == "none":
+        lens = nominal.distortion
+    else:
+        lens = make_ap_model(ap_model, w_mm, h_mm, nominal.focal_mm, **true_ap)
+    true_cam = replace(nominal, focal_mm=cfg.true_focal_mm, x0_mm=cfg.true_x0_mm,
+                       y0_mm=cfg.true_y0_mm, distortion=lens)  # fmt: skip
+    return true_ap, true_cam
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """The flight plan on the map: strips across the heading, images along it (metres)."""
+
+    fwd: Array  # unit vector of the heading (east, north)
+    right: Array  # unit vector to the right of it
+    centre: Array  # the block's centre (easting, northing)
+    along: float  # an image's ground footprint along the heading (the image top)
+    across: float  # and across it
+    base: float  # distance between exposures in a strip
+    spacing: float  # distance between strips
+    xy: Array  # (M, 2) planned exposure positions
+    headings: list[float]  # radians, clockwise from north
+    names: list[str]
+    strips: list[str]
+
+
+def _flight_plan(cfg: UavBlockConfig) -> _Plan:
+    """Exposures of the strips (alternating direction) from the overlaps and the GSD."""
+    nominal = cfg.camera
+    gsd = cfg.flying_height_m * nominal.pixel_size_mm / nominal.focal_mm
+    along = nominal.height_px * gsd  # the image top looks forward
+    across = nominal.width_px * gsd
+    base = (1.0 - cfg.forward_overlap) * along
+    spacing = (1.0 - cfg.side_overlap) * across
+    hd = math.radians(cfg.heading_deg)
+    fwd = np.array([math.sin(hd), math.cos(hd)])
+    right = np.array([fwd[1], -fwd[0]])
+    centre = np.array(cfg.centre)
+    n_strips = len(cfg.strips)
+    plan_xy, headings, names, strips = [], [], [], []
+    for s, count in enumerate(cfg.strips):
+        offset = (s - (n_strips - 1) / 2) * spacing
+        sign = 1.0 if s % 2 == 0 else -1.0
+        for k in range(count):
+            t = (k - (count - 1) / 2) * base * sign
+            plan_xy.append(centre + offset * right + t * fwd)
+            headings.append(hd if sign > 0 else hd + math.pi)
+            names.append(f"IMG_{s + 1:02d}{k + 1:02d}")
+            strips.append(f"strip {s + 1}")
+    return _Plan(fwd, right, centre, along, across, base, spacing, np.array(plan_xy), headings,
+                 names, strips)  # fmt: skip
+
+
+def _true_poses(
+    cfg: UavBlockConfig, plan: _Plan, mapping: MappingFrame, local: LocalFrame,
+    rng: np.random.Generator,
+) -> tuple[Array, Array, ExteriorOrientationTable]:
+    """The plan plus jitter, camera looking down with the image top forward: (centres in the
+    local frame (M, 3), local EO rows (M, 6), the true EO table on the map)."""
+    M = plan.xy.shape[0]
+    z_plan = float(_terrain(cfg, plan.centre[:1], plan.centre[1:])[0])
+    xyz_map = np.column_stack([
+        plan.xy + rng.normal(0, cfg.position_jitter_m, (M, 2)),
+        np.full(M, z_plan + cfg.flying_height_m) + rng.normal(0, cfg.position_jitter_m, M),
+    ])  # fmt: skip
+    centres = local.map_to_enu(xyz_map)
+    jitter = np.radians(rng.normal(0, cfg.attitude_jitter_deg, (M, 3)))
+    # camera -> local: kappa turns the image top to the heading (heading clockwise from north)
+    kappa = -np.array(plan.headings) + jitter[:, 2]
+    M_true = opk_to_matrix(jitter[:, 0], jitter[:, 1], kappa)
+    eo_local = np.column_stack([centres, *matrix_to_opk(M_true)])
+    eo_xyz, eo_opk = eo_local_to_map(centres, M_true, local)
+    times = np.arange(M, dtype=float) * 3.0
+    eo_true = ExteriorOrientationTable(
+        tuple(plan.names), times, tuple(plan.strips), eo_xyz, eo_opk, mapping.crs.to_wkt()
+    )
+    return centres, eo_local, eo_true
+
+
+def _direct_georeferencing(
+    cfg: UavBlockConfig, eo_true: ExteriorOrientationTable, nrng: np.random.Generator
+) -> tuple[ExteriorOrientationTable, Array]:
+    """The truth with GNSS/INS errors, and the sigmas (M, 6; m and rad)."""
+    M = len(eo_true)
+    dg_xyz = eo_true.xyz + nrng.normal(0, cfg.dg_position_sigma_m, (M, 3))
+    dg_opk = eo_true.opk + np.radians(nrng.normal(0, cfg.dg_attitude_sigma_deg, (M, 3)))
+    eo_dg = replace(eo_true, xyz=dg_xyz, opk=dg_opk)
+    eo_sigma = np.tile([cfg.dg_position_sigma_m] * 3 + [math.radians(cfg.dg_attitude_sigma_deg)]
+                       * 3, (M, 1))  # fmt: skip
+    return eo_dg, eo_sigma
+
+
+def _surveyed_points(
+    cfg: UavBlockConfig, plan: _Plan, ext: tuple[float, float], rng: np.random.Generator,
+    nrng: np.random.Generator,
+) -> tuple[Array, GroundPoints]:
+    """A jittered grid of control points over the block's extent (along, across; metres),
+    check points spread among them: (true coordinates, the surveyed points with noise)."""
+    ext_along, ext_across = ext
+    n_gcp = cfg.n_control + cfg.n_check
+    cols = math.ceil(math.sqrt(n_gcp * ext_along / ext_across))
+    rows_ = math.ceil(n_gcp / cols)
+    gu, gv = np.meshgrid(np.linspace(-0.42, 0.42, cols), np.linspace(-0.42, 0.42, rows_))
+    cells = np.column_stack([gu.ravel(), gv.ravel()])[:n_gcp]
+    cells = cells + rng.uniform(-0.04, 0.04, cells.shape)
+    gxy = plan.centre + (cells[:, :1] * ext_along) * plan.fwd + (cells[:, 1:] * ext_across) * (
+        plan.right
+    )  # fmt: skip
+    gcp_true = np.column_stack([gxy, _terrain(cfg, gxy[:, 0], gxy[:, 1])])
+    order = rng.permutation(n_gcp)
+    check_set = set(order[: cfg.n_check].tolist())
+    gids = tuple(f"GCP{k + 1:02d}" for k in range(n_gcp))
+    roles = tuple("check" if k in check_set else "control" for k in range(n_gcp))
+    sig = np.array([cfg.control_sigma_m[0]] * 2 + [cfg.control_sigma_m[1]])
+    gcp_meas = gcp_true + nrng.normal(0, 1, gcp_true.shape) * sig
+    return gcp_true, GroundPoints(gids, gcp_meas, np.tile(sig, (n_gcp, 1)), roles)
+
+
+def _project_all(
+    cfg: UavBlockConfig, plan: _Plan, true_cam: Camera, centres: Array, eo_local: Array,
+    pts_local: Array,
+) -> tuple[NDArray[np.intp], NDArray[np.intp], Array]:
+    """(image, point, pixel) of every point in front of a camera and inside its frame; only
+    the points near each image's footprint are projected (large blocks)."""
+    rec_img, rec_pt, rec_px = [], [], []
+    reach = 0.75 * math.hypot(plan.along, plan.across) + 3.0 * cfg.position_jitter_m + (
+        cfg.flying_height_m * math.tan(math.radians(4.0 * cfg.attitude_jitter_deg))
+    )  # fmt: skip
+    order = np.argsort(pts_local[:, 0])
+    xs = pts_local[order, 0]
+    for k in range(len(centres)):
+        lo, hi = np.searchsorted(xs, [centres[k, 0] - reach, centres[k, 0] + reach])
+        cand = order[lo:hi]
+        cand = cand[np.abs(pts_local[cand, 1] - centres[k, 1]) <= reach]
+        px, front, conv = project_with_status(pts_local[cand], eo_local[k], true_cam)
+        ok = front & conv & true_cam.in_frame(px, cfg.margin_px)
+        idx = np.flatnonzero(ok)
+        rec_img += [k] * idx.size
+        rec_pt.append(cand[idx])
+        rec_px.append(px[idx])
+    return np.array(rec_img, dtype=np.intp), np.concatenate(rec_pt), np.vstack(rec_px)
+
+
+def _measurements(
+    cfg: UavBlockConfig, names: list[str], all_ids: list[str], ground: GroundPoints,
+    img: NDArray[np.intp], pt: NDArray[np.intp], px: Array, nrng: np.random.Generator,
+) -> tuple[ImageObservations, NDArray[np.intp]]:
+    """The image observations (points seen twice or more, targets also once but for a check
+    point), with pixel noise; and the indices of the tie points kept (into the tie list)."""
+    n_gcp, roles = len(ground), ground.role
+    counts = np.bincount(pt, minlength=len(all_ids))
+    keep = counts[pt] >= 2
+    keep |= pt < n_gcp  # targets are kept even when seen once (a control point may be)
+    img, pt, px = img[keep], pt[keep], px[keep]
+    # a check point seen once cannot be intersected: drop its single measurement
+    once = (np.bincount(pt, minlength=len(all_ids)) < 2)[pt] & np.isin(
+        pt, [k for k in range(n_gcp) if roles[k] == "check"]
+    )
+    img, pt, px = img[~once], pt[~once], px[~once]
+    px = px + nrng.normal(0, cfg.sigma_px, px.shape)
+    n = img.size
+    obs = ImageObservations(
+        tuple(names[i] for i in img),
+        tuple(all_ids[p] for p in pt),
+        px,
+        np.full(n, cfg.sigma_px),
+        tuple("check" if p < n_gcp and roles[p] == "check" else "tie" for p in pt),
+        ("",) * n,
+    )
+    seen = np.bincount(pt, minlength=len(all_ids)) >= 2
+    return obs, np.flatnonzero(seen[n_gcp:])
+
+
 def simulate_uav_block(
     ap_model: str = "none",
     seed: int = 0,
@@ -284,139 +467,26 @@ def simulate_uav_block(
     rng = np.random.default_rng(seed)
     nrng = np.random.default_rng(seed if noise_seed is None else noise_seed)
     mapping = MappingFrame.from_user_input(cfg.crs)
-    nominal = cfg.camera
-    gsd = cfg.flying_height_m * nominal.pixel_size_mm / nominal.focal_mm
-    along = nominal.height_px * gsd  # the image top looks forward
-    across = nominal.width_px * gsd
-    base = (1.0 - cfg.forward_overlap) * along
-    spacing = (1.0 - cfg.side_overlap) * across
-    # true camera
-    true_ap = {} if ap_model == "none" else _true_ap(ap_model, nominal, ap_scale_px, rng)
-    w_mm = nominal.width_px * nominal.pixel_size_mm
-    h_mm = nominal.height_px * nominal.pixel_size_mm
-    if ap_model == "real":
-        lens = BrownConrady(**true_ap)
-    elif ap_model == "none":
-        lens = nominal.distortion
-    else:
-        lens = make_ap_model(ap_model, w_mm, h_mm, nominal.focal_mm, **true_ap)
-    true_cam = replace(nominal, focal_mm=cfg.true_focal_mm, x0_mm=cfg.true_x0_mm,
-                       y0_mm=cfg.true_y0_mm, distortion=lens)  # fmt: skip
-    # flight plan in grid coordinates: strips across, images along the heading
-    hd = math.radians(cfg.heading_deg)
-    fwd = np.array([math.sin(hd), math.cos(hd)])
-    right = np.array([fwd[1], -fwd[0]])
-    centre = np.array(cfg.centre)
-    n_strips = len(cfg.strips)
-    plan_xy, headings, names, strips = [], [], [], []
-    for s, count in enumerate(cfg.strips):
-        offset = (s - (n_strips - 1) / 2) * spacing
-        sign = 1.0 if s % 2 == 0 else -1.0
-        for k in range(count):
-            t = (k - (count - 1) / 2) * base * sign
-            plan_xy.append(centre + offset * right + t * fwd)
-            headings.append(hd if sign > 0 else hd + math.pi)
-            names.append(f"IMG_{s + 1:02d}{k + 1:02d}")
-            strips.append(f"strip {s + 1}")
-    plan_xy = np.array(plan_xy)
-    M = plan_xy.shape[0]
-    z_plan = float(_terrain(cfg, np.array([centre[0]]), np.array([centre[1]]))[0])
-    local = LocalFrame.at_map_point(mapping, np.array([*centre, cfg.ground_height_m]))
-    # true poses: the plan plus jitter; camera looking down, image top forward
-    xyz_map = np.column_stack([
-        plan_xy + rng.normal(0, cfg.position_jitter_m, (M, 2)),
-        np.full(M, z_plan + cfg.flying_height_m) + rng.normal(0, cfg.position_jitter_m, M),
-    ])  # fmt: skip
-    centres = local.map_to_enu(xyz_map)
-    jitter = np.radians(rng.normal(0, cfg.attitude_jitter_deg, (M, 3)))
-    # camera -> local: kappa turns the image top to the heading (heading clockwise from north)
-    kappa = -np.array(headings) + jitter[:, 2]
-    M_true = opk_to_matrix(jitter[:, 0], jitter[:, 1], kappa)
-    eo_local = np.column_stack([centres, *matrix_to_opk(M_true)])
-    eo_xyz, eo_opk = eo_local_to_map(centres, M_true, local)
-    times = np.arange(M, dtype=float) * 3.0
-    eo_true = ExteriorOrientationTable(
-        tuple(names), times, tuple(strips), eo_xyz, eo_opk, mapping.crs.to_wkt()
-    )
-    # direct georeferencing: the truth with GNSS/INS errors
-    dg_xyz = eo_xyz + nrng.normal(0, cfg.dg_position_sigma_m, (M, 3))
-    dg_opk = eo_opk + np.radians(nrng.normal(0, cfg.dg_attitude_sigma_deg, (M, 3)))
-    eo_dg = replace(eo_true, xyz=dg_xyz, opk=dg_opk)
-    eo_sigma = np.tile([cfg.dg_position_sigma_m] * 3 + [math.radians(cfg.dg_attitude_sigma_deg)]
-                       * 3, (M, 1))  # fmt: skip
+    # the random draws come in a fixed order (rng: geometry, nrng: noise): keep it
+    true_ap, true_cam = _true_camera(cfg, ap_model, ap_scale_px, rng)
+    plan = _flight_plan(cfg)
+    local = LocalFrame.at_map_point(mapping, np.array([*plan.centre, cfg.ground_height_m]))
+    centres, eo_local, eo_true = _true_poses(cfg, plan, mapping, local, rng)
+    eo_dg, eo_sigma = _direct_georeferencing(cfg, eo_true, nrng)
     # the block's ground extent (the union of the footprints, shrunk a little)
-    ext_along = (max(cfg.strips) - 1) * base + 0.8 * along
-    ext_across = (n_strips - 1) * spacing + 0.8 * across
-
-    def draw(n: int) -> Array:
-        u = rng.uniform(-0.5, 0.5, (n, 2)) * [ext_along, ext_across]
-        xy = centre + u[:, :1] * fwd + u[:, 1:] * right
-        return np.column_stack([xy, _terrain(cfg, xy[:, 0], xy[:, 1])])
-
-    # surveyed points: a jittered grid over the block, check points spread among them
-    n_gcp = cfg.n_control + cfg.n_check
-    cols = math.ceil(math.sqrt(n_gcp * ext_along / ext_across))
-    rows_ = math.ceil(n_gcp / cols)
-    gu, gv = np.meshgrid(np.linspace(-0.42, 0.42, cols), np.linspace(-0.42, 0.42, rows_))
-    cells = np.column_stack([gu.ravel(), gv.ravel()])[:n_gcp]
-    cells = cells + rng.uniform(-0.04, 0.04, cells.shape)
-    gxy = centre + (cells[:, :1] * ext_along) * fwd + (cells[:, 1:] * ext_across) * right
-    gcp_true = np.column_stack([gxy, _terrain(cfg, gxy[:, 0], gxy[:, 1])])
-    order = rng.permutation(n_gcp)
-    check_set = set(order[: cfg.n_check].tolist())
-    gids = tuple(f"GCP{k + 1:02d}" for k in range(n_gcp))
-    roles = tuple("check" if k in check_set else "control" for k in range(n_gcp))
-    sig = np.array([cfg.control_sigma_m[0]] * 2 + [cfg.control_sigma_m[1]])
-    gcp_meas = gcp_true + nrng.normal(0, 1, gcp_true.shape) * sig
-    ground = GroundPoints(gids, gcp_meas, np.tile(sig, (n_gcp, 1)), roles)
-    tie_map = draw(cfg.n_tie)
+    ext_along = (max(cfg.strips) - 1) * plan.base + 0.8 * plan.along
+    ext_across = (len(cfg.strips) - 1) * plan.spacing + 0.8 * plan.across
+    gcp_true, ground = _surveyed_points(cfg, plan, (ext_along, ext_across), rng, nrng)
+    u = rng.uniform(-0.5, 0.5, (cfg.n_tie, 2)) * [ext_along, ext_across]
+    xy = plan.centre + u[:, :1] * plan.fwd + u[:, 1:] * plan.right
+    tie_map = np.column_stack([xy, _terrain(cfg, xy[:, 0], xy[:, 1])])
     tie_ids = [f"T{k + 1:05d}" for k in range(cfg.n_tie)]
-    all_ids = list(gids) + tie_ids
-    all_map = np.vstack([gcp_true, tie_map])
-    pts_local = local.map_to_enu(all_map)
-    rec_img, rec_pt, rec_px = [], [], []
-    # only the points near each image's footprint are projected (large blocks)
-    reach = 0.75 * math.hypot(along, across) + 3.0 * cfg.position_jitter_m + cfg.flying_height_m * (
-        math.tan(math.radians(4.0 * cfg.attitude_jitter_deg))
-    )  # fmt: skip
-    order = np.argsort(pts_local[:, 0])
-    xs = pts_local[order, 0]
-    for k in range(M):
-        lo, hi = np.searchsorted(xs, [centres[k, 0] - reach, centres[k, 0] + reach])
-        cand = order[lo:hi]
-        cand = cand[np.abs(pts_local[cand, 1] - centres[k, 1]) <= reach]
-        px, front, conv = project_with_status(pts_local[cand], eo_local[k], true_cam)
-        ok = front & conv & true_cam.in_frame(px, cfg.margin_px)
-        idx = np.flatnonzero(ok)
-        rec_img += [k] * idx.size
-        rec_pt.append(cand[idx])
-        rec_px.append(px[idx])
-    pt = np.concatenate(rec_pt)
-    img = np.array(rec_img, dtype=np.intp)
-    px = np.vstack(rec_px)
-    counts = np.bincount(pt, minlength=len(all_ids))
-    keep = counts[pt] >= 2
-    keep |= pt < n_gcp  # targets are kept even when seen once (a control point may be)
-    img, pt, px = img[keep], pt[keep], px[keep]
-    # a check point seen once cannot be intersected: drop its single measurement
-    once = (np.bincount(pt, minlength=len(all_ids)) < 2)[pt] & np.isin(
-        pt, [k for k in range(n_gcp) if roles[k] == "check"]
-    )
-    img, pt, px = img[~once], pt[~once], px[~once]
-    px = px + nrng.normal(0, cfg.sigma_px, px.shape)
-    n = img.size
-    obs = ImageObservations(
-        tuple(names[i] for i in img),
-        tuple(all_ids[p] for p in pt),
-        px,
-        np.full(n, cfg.sigma_px),
-        tuple("check" if p < n_gcp and roles[p] == "check" else "tie" for p in pt),
-        ("",) * n,
-    )
-    seen = np.bincount(pt, minlength=len(all_ids)) >= 2
-    tie_keep = np.flatnonzero(seen[n_gcp:])
+    all_ids = list(ground.point_id) + tie_ids
+    pts_local = local.map_to_enu(np.vstack([gcp_true, tie_map]))
+    img, pt, px = _project_all(cfg, plan, true_cam, centres, eo_local, pts_local)
+    obs, tie_keep = _measurements(cfg, plan.names, all_ids, ground, img, pt, px, nrng)
     return UavBlock(
-        config=cfg, mapping=mapping, camera=nominal, true_camera=true_cam, ap_model=ap_model,
+        config=cfg, mapping=mapping, camera=cfg.camera, true_camera=true_cam, ap_model=ap_model,
         true_ap=true_ap, eo_true=eo_true, eo_dg=eo_dg, eo_sigma=eo_sigma, observations=obs,
         ground=ground, ground_true=gcp_true, tie_id=tuple(tie_ids[k] for k in tie_keep),
         tie_true=tie_map[tie_keep],
