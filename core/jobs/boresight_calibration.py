@@ -41,7 +41,7 @@ log = logging.getLogger(__name__)
 GROUPINGS = ("single", "group", "direction")
 #: Control types the adjustment can use.
 CONTROL_TYPES = ("tie", "line", "lcp", "paper", "control")
-_OPTIONS = Fields("photo.boresight", "BoresightOptions")
+_OPTIONS = Fields("photo.boresight_options", "BoresightOptions")
 _GRADES = Ref("photo.ins", "INS_GRADES", convert=lambda grades: (*grades, "custom"))
 _GRADE_LABELS = Ref("photo.ins", "INS_GRADES",
                     convert=lambda grades: (*(g.name for g in grades.values()),

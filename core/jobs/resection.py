@@ -17,7 +17,7 @@ from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
-_OPTIONS = Fields("photo.resection", "ResectionOptions")
+_OPTIONS = Fields("photo.resection_options", "ResectionOptions")
 
 SPEC = AlgorithmSpec(
     name="resection",
@@ -85,7 +85,7 @@ lines parallel).""",
               help="empty: start values only; given: weighted observations"),
         Param("IMAGES", "string", "Images (comma separated; empty: all)", "", optional=True),
         Param("MODEL", "enum", "Line model", _OPTIONS.model,
-              options=Ref("photo.resection", "MODELS"),
+              options=Ref("photo.resection_options", "MODELS"),
               labels=("coplanarity (no parametrisation)",
                       "equivalent planes (Tommaselli & Tozzi 1996)")),
         Param("ESTIMATE_INTERIOR", "boolean", "Refine focal length and principal point",
