@@ -42,8 +42,8 @@ GROUPINGS = ("single", "group", "direction")
 #: Control types the adjustment can use.
 CONTROL_TYPES = ("tie", "line", "lcp", "paper", "control")
 _OPTIONS = Fields("photo.boresight_options", "BoresightOptions")
-_GRADES = Ref("photo.ins", "INS_GRADES", convert=lambda grades: (*grades, "custom"))
-_GRADE_LABELS = Ref("photo.ins", "INS_GRADES",
+_GRADES = Ref("photo.ins_grades", "INS_GRADES", convert=lambda grades: (*grades, "custom"))
+_GRADE_LABELS = Ref("photo.ins_grades", "INS_GRADES",
                     convert=lambda grades: (*(g.name for g in grades.values()),
                                             "custom (INS sigmas)"))  # fmt: skip
 TABLE_COLUMNS = (

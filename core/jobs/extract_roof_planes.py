@@ -18,7 +18,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-_D = Fields("lidar.roof_planes", "RoofPlaneParams")
+_D = Fields("lidar.roof_plane_params", "RoofPlaneParams")
 #: (parameter, RoofPlaneParams field, label, kind, unit, minimum, maximum, advanced)
 _NUMBERS = (
     ("K_NEIGHBOURS", "k_neighbours", "Neighbours K of the local RANSAC", "integer", "", 6, 500,
@@ -86,7 +86,7 @@ error.""",
     params=(
         *cloud_params("INPUT"),
         Param("POINTS", "enum", "Points", "non_ground",
-              options=Ref("lidar.roof_planes", "SELECTION_CHOICES"),
+              options=Ref("lidar.roof_plane_params", "SELECTION_CHOICES"),
               labels=("non-ground (class != 2)", "the classes below", "all"),
               aliases={"non-ground": "non_ground"}),
         Param("CLASSES", "string", "Classes (e.g. 6)", "6", optional=True,

@@ -27,8 +27,8 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 _S = Fields("lidar.ground_filter_params", "SmrfParams")
-_R = Fields("lidar.roof_planes", "RoofPlaneParams")
-_C = Fields("lidar.control", "ControlOptions")
+_R = Fields("lidar.roof_plane_params", "RoofPlaneParams")
+_C = Fields("lidar.control_options", "ControlOptions")
 #: Exit status of the command line when the block is incomplete (a tile failed).
 INCOMPLETE_EXIT = 3
 #: The command line shows a progress bar for this job.
