@@ -204,14 +204,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                             failed_page, "HTML summary")  # fmt: skip
     positions = ground_positions(result, obs, cam, plane_list, line_list, lcp_list, ground)
     image_group = dict(zip(traj.image_id, group_labels(traj, options.groups)))
-    run = BoresightRun(
-        result,
-        obs,
-        positions,
-        tuple(image_group.get(i, "") for i in obs.image_id),
-        settings,
-        frame.crs.to_wkt(),
-    )
+    run = BoresightRun(result, obs, positions, tuple(image_group.get(i, "") for i in obs.image_id),
+                       settings, frame.crs.to_wkt())  # fmt: skip
     _write_outputs(out, run, settings, doubts, warning)
     return JobResult(results={"SIGMA0": result.sigma0}, lines=_summary_lines(result, warning),
                      data=run)  # fmt: skip
