@@ -13,8 +13,8 @@ from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
-_C = Fields("photo.control_chips", "ChipOptions")
-_P = Fields("photo.control_plate", "PlateGeometry")
+_C = Fields("photo.chip_options", "ChipOptions")
+_P = Fields("photo.chip_options", "PlateGeometry")
 #: File names of the report in the output folder.
 REPORT_CSV = "control_chips.csv"
 REPORT_JSON = "control_chips.json"
