@@ -18,7 +18,7 @@ from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_fro
 log = logging.getLogger(__name__)
 
 _OPTIONS = Fields("photo.bundle_options", "BundleOptions")
-_AP_CHOICES = Ref("geometry.ap_models", "AP_FAMILIES", convert=lambda f: (*f, "all"))
+_AP_CHOICES = Ref("geometry.ap_families", "AP_FAMILIES", convert=lambda f: (*f, "all"))
 ROBUST_CHOICES = ("none", "huber", "cauchy")
 DATUM_CHOICES = ("control", "inner", "minimal")
 

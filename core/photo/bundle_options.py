@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import InputError
-from ..geometry.ap_models import AP_FAMILIES
+from ..geometry.ap_families import AP_FAMILIES
 
 #: Datum definitions of :class:`BundleOptions` (``datum``).
 DATUMS = ("control", "inner", "minimal")
