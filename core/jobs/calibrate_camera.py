@@ -7,7 +7,7 @@ from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 _D = Fields("photo.calibration_options", "CalibrationOptions")
-_T = Fields("photo.calibration_targets", "TargetSpec")
+_T = Fields("photo.calibration_options", "TargetSpec")
 JSON_FILTER = "JSON files (*.json)"
 
 SPEC = AlgorithmSpec(
@@ -42,7 +42,7 @@ the millimetre values of the camera file: the calibration itself is in pixels.""
         Param("IMAGES", "files", "Target images (files or folders)", suffixes=IMAGE_SUFFIXES,
               help="image files, or folders whose images are all taken"),
         Param("TARGET", "enum", "Target", _T.kind,
-              options=Ref("photo.calibration_targets", "TARGET_KINDS"),
+              options=Ref("photo.calibration_options", "TARGET_KINDS"),
               labels=("chessboard", "ChArUco board", "ArUco grid board")),
         Param("COLUMNS", "integer", "Columns (inner corners / squares / markers)", _T.cols,
               minimum=2, maximum=200),
@@ -53,9 +53,9 @@ the millimetre values of the camera file: the calibration itself is in pixels.""
         Param("MARKER", "number", "ChArUco marker side / ArUco gap", _T.marker_m, unit="m",
               minimum=0.0, maximum=10.0),
         Param("DICTIONARY", "enum", "ArUco dictionary", _T.dictionary,
-              options=Ref("photo.calibration_targets", "DICTIONARIES")),
+              options=Ref("photo.calibration_options", "DICTIONARIES")),
         Param("PROJECTION", "enum", "Projection", _D.projection,
-              options=Ref("geometry.projection", "PROJECTIONS"),
+              options=Ref("geometry.projection_names", "PROJECTIONS"),
               labels=("perspective (central)", "fisheye: equidistant",
                       "fisheye: equisolid-angle", "fisheye: orthographic",
                       "fisheye: stereographic")),
