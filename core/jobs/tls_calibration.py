@@ -26,7 +26,7 @@ _D = Fields("tls.options", "CalibrationOptions")
 
 
 def _arcsec(radians: float) -> float:
-    from ..tls.aps import ARCSEC
+    from ..tls.ap_table import ARCSEC
 
     return radians / ARCSEC
 
@@ -104,7 +104,7 @@ beginning with #).""",
               maximum=1e6, help="for rows without s_range, s_hz, s_vt (or s_x, s_y, s_z: "
               "the range sigma)"),
         Param("AP_SET", "enum", "Additional parameters", _D.ap_set,
-              options=Ref("tls.aps", "AP_SETS", convert=tuple),
+              options=Ref("tls.ap_table", "AP_SETS", convert=tuple),
               labels=("none (registration only)", "paper: a0, b1, b2, c0",
                       "extended (Lichti 2007): a0-a3, b1-b6, c0-c3")),
         Param("AP_TERMS", "string", "AP terms (overrides the set)", "", optional=True,
