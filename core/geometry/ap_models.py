@@ -33,6 +33,7 @@ from typing import ClassVar, Dict, List, Tuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .ap_families import AP_FAMILIES
 from .distortion import DistortionModel, as_points, register_model
 
 Array = NDArray[np.float64]
@@ -285,19 +286,6 @@ class Brown14(PolynomialAP):
             (12, 0, ic, 3, 2), (12, 1, ic, 2, 3),
             (13, 0, 1.0, 3, 0), (13, 0, 1.0, 1, 2), (13, 1, 1.0, 2, 1), (13, 1, 1.0, 0, 3),
         ]  # fmt: skip
-
-
-#: The AP families of the bundle adjustment: option name -> lens model name. ``none`` keeps
-#: the camera's own lens model fixed; ``conrady_brown`` is the physical Brown-Conrady model.
-AP_FAMILIES: Dict[str, str] = {
-    "none": "none",
-    "lens_k1k2": "lens_k1k2",
-    "bauer": "bauer",
-    "jacobsen": "jacobsen",
-    "ebner": "ebner",
-    "brown": "brown",
-    "conrady_brown": "brown_conrady",
-}
 
 
 def ap_constants(width_mm: float, height_mm: float, focal_mm: float) -> Dict[str, float]:

@@ -34,17 +34,10 @@ from typing import Tuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .projection_names import FISHEYE_PROJECTIONS, PROJECTIONS
+
 Array = NDArray[np.float64]
 
-#: The projections, by the name used in camera files (key ``"projection"``).
-PROJECTIONS: Tuple[str, ...] = (
-    "perspective",
-    "equidistant",
-    "equisolid",
-    "orthographic",
-    "stereographic",
-)
-FISHEYE_PROJECTIONS: Tuple[str, ...] = PROJECTIONS[1:]
 
 # Largest off-axis angle of each projection, radians (exclusive except orthographic).
 _THETA_MAX = {

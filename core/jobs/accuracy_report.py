@@ -11,7 +11,7 @@ from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_fro
 
 log = logging.getLogger(__name__)
 
-_D = Fields("quality.accuracy", "AccuracySettings")
+_D = Fields("quality.accuracy_options", "AccuracySettings")
 _STANDARD_LABELS = (
     "ASPRS Positional Accuracy Standards, Edition 2 (2023)",
     "NSSDA (FGDC-STD-007.3-1998)",
@@ -124,16 +124,16 @@ for one release).""",
               False, help="QGIS only: point tables carry no CRS", advanced=True),
         *_numbers(_NUMBERS),
         Param("OUTLIER_RULE", "enum", "Outlier screening", _D.outlier_rule,
-              options=Ref("quality.accuracy_statistics", "OUTLIER_RULES"), labels=_OUTLIER_LABELS,
+              options=Ref("quality.accuracy_options", "OUTLIER_RULES"), labels=_OUTLIER_LABELS,
               advanced=True),
         Param("EXCLUDE_OUTLIERS", "boolean", "Exclude flagged outliers from the statistics",
               _D.exclude_outliers, advanced=True),
         Param("STANDARDS", "enum", "Standards", _D.standards,
-              options=Ref("quality.accuracy", "STANDARD_KEYS"), labels=_STANDARD_LABELS,
+              options=Ref("quality.accuracy_options", "STANDARD_KEYS"), labels=_STANDARD_LABELS,
               multiple=True),
         *_numbers(_STANDARD_NUMBERS),
         Param("PEC_CLASS", "enum", "PEC-PCD declared class", _D.pec_class,
-              options=Ref("quality.standards_pec", "PEC_CLASSES"), advanced=True),
+              options=Ref("quality.accuracy_options", "PEC_CLASSES"), advanced=True),
         *_numbers(_PROJECT_NUMBERS),
         Param("FLIGHT_GEOMETRY", "numbers", "Flight geometry for Eq. 18: H, B, f, pixel",
               _D.flight_geometry, count=4, unit="m, m, mm, um", advanced=True, minimum=0.001,

@@ -41,9 +41,9 @@ log = logging.getLogger(__name__)
 GROUPINGS = ("single", "group", "direction")
 #: Control types the adjustment can use.
 CONTROL_TYPES = ("tie", "line", "lcp", "paper", "control")
-_OPTIONS = Fields("photo.boresight", "BoresightOptions")
-_GRADES = Ref("photo.ins", "INS_GRADES", convert=lambda grades: (*grades, "custom"))
-_GRADE_LABELS = Ref("photo.ins", "INS_GRADES",
+_OPTIONS = Fields("photo.boresight_options", "BoresightOptions")
+_GRADES = Ref("photo.ins_grades", "INS_GRADES", convert=lambda grades: (*grades, "custom"))
+_GRADE_LABELS = Ref("photo.ins_grades", "INS_GRADES",
                     convert=lambda grades: (*(g.name for g in grades.values()),
                                             "custom (INS sigmas)"))  # fmt: skip
 TABLE_COLUMNS = (
@@ -161,17 +161,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     import numpy as np
 
     from ..errors import InputError, stop_if_asked
-    from ..geometry.frames import MappingFrame, check_area_of_use
+    from ..geometry.frames import MappingFrame
     from ..io.atomic import write_text_atomic
-    from ..io.camera import read_camera_json
-    from ..io.control import read_lcps_csv, read_lines_csv
-    from ..io.ground_points import read_ground_points_csv
-    from ..io.observations import read_observations_csv
-    from ..io.orientation import write_eo_csv
-    from ..io.planes import read_planes_csv
-    from ..io.pointcloud import read_points
-    from ..io.tables import write_csv_atomic
-    from ..io.trajectory import read_trajectory_csv
     from ..photo.boresight import calibrate
     from ..photo.boresight_result import BoresightNotObservable, BoresightRun
     from ..photo.boresight_setup import BoresightOptions, group_labels
@@ -185,34 +176,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     types = tuple(v.control_types)
     if not types:
         raise InputError(f"CONTROL_TYPES: choose at least one of {', '.join(CONTROL_TYPES)}")
-    cam = read_camera_json(v.camera)
-    traj = read_trajectory_csv(v.trajectory)
-    if not traj.geodetic:
-        check_area_of_use(frame.crs, traj.position.min(axis=0), traj.position.max(axis=0),
-                          what="the trajectory", path=v.trajectory)  # fmt: skip
-    obs = read_observations_csv(v.observations, camera=cam)
-    plane_list = read_planes_csv(v.planes) if v.planes else []
-    line_list = read_lines_csv(v.lines) if v.lines else []
-    lcp_list = read_lcps_csv(v.lcps) if v.lcps else []
-    ground = read_ground_points_csv(v.ground_points) if v.ground_points else None
-    for name, path, xyz in (
-        ("planes", v.planes, [p.centroid for p in plane_list]),
-        ("lines", v.lines, [ln.point for ln in line_list]),
-        ("LCPs", v.lcps, [p.xyz for p in lcp_list]),
-        ("ground points", v.ground_points, [] if ground is None else list(ground.xyz)),
-    ):
-        if xyz:
-            check_area_of_use(frame.crs, np.min(xyz, axis=0), np.max(xyz, axis=0),
-                              what=f"the {name}", path=path)  # fmt: skip
-    lidar_xyz = lidar_ids = None
-    if "paper" in types and "paper" in obs.type:
-        if not v.cloud:
-            raise InputError("paper-mode observations need CLOUD (LAS/LAZ with plane_id)")
-        arrays, _ = read_points(
-            v.cloud, ("x", "y", "z", "plane_id"), require_crs=False, should_stop=should_stop
-        )
-        lidar_xyz = np.column_stack([arrays["x"], arrays["y"], arrays["z"]])
-        lidar_ids = np.asarray(arrays["plane_id"]).astype(np.int64)
+    cam, traj, obs, plane_list, line_list, lcp_list, ground = _read_inputs(v, frame)
+    lidar_xyz, lidar_ids = _paper_cloud(v, types, obs, should_stop)
     stop_if_asked(should_stop, "starting the adjustment")
     options = options_from(BoresightOptions, SPEC, v, ins_grade=grade, use_types=types)
     settings = _settings(v, cam, traj, obs, plane_list, line_list, lcp_list, frame, mount, grade,
@@ -239,24 +204,88 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                             failed_page, "HTML summary")  # fmt: skip
     positions = ground_positions(result, obs, cam, plane_list, line_list, lcp_list, ground)
     image_group = dict(zip(traj.image_id, group_labels(traj, options.groups)))
-    run = BoresightRun(
-        result,
-        obs,
-        positions,
-        tuple(image_group.get(i, "") for i in obs.image_id),
-        settings,
-        frame.crs.to_wkt(),
+    run = BoresightRun(result, obs, positions, tuple(image_group.get(i, "") for i in obs.image_id),
+                       settings, frame.crs.to_wkt())  # fmt: skip
+    _write_outputs(out, run, settings, doubts, warning)
+    return JobResult(results={"SIGMA0": result.sigma0}, lines=_summary_lines(result, warning),
+                     data=run)  # fmt: skip
+
+
+def _read_inputs(v: Values, frame) -> tuple:
+    """The camera, trajectory, observations and the control (planes, lines, LCPs, ground
+    points), each checked against the mapping CRS's area of use."""
+    import numpy as np
+
+    from ..geometry.frames import check_area_of_use
+    from ..io.camera import read_camera_json
+    from ..io.control import read_lcps_csv, read_lines_csv
+    from ..io.ground_points import read_ground_points_csv
+    from ..io.observations import read_observations_csv
+    from ..io.planes import read_planes_csv
+    from ..io.trajectory import read_trajectory_csv
+
+    cam = read_camera_json(v.camera)
+    traj = read_trajectory_csv(v.trajectory)
+    if not traj.geodetic:
+        check_area_of_use(frame.crs, traj.position.min(axis=0), traj.position.max(axis=0),
+                          what="the trajectory", path=v.trajectory)  # fmt: skip
+    obs = read_observations_csv(v.observations, camera=cam)
+    plane_list = read_planes_csv(v.planes) if v.planes else []
+    line_list = read_lines_csv(v.lines) if v.lines else []
+    lcp_list = read_lcps_csv(v.lcps) if v.lcps else []
+    ground = read_ground_points_csv(v.ground_points) if v.ground_points else None
+    for name, path, xyz in (
+        ("planes", v.planes, [p.centroid for p in plane_list]),
+        ("lines", v.lines, [ln.point for ln in line_list]),
+        ("LCPs", v.lcps, [p.xyz for p in lcp_list]),
+        ("ground points", v.ground_points, [] if ground is None else list(ground.xyz)),
+    ):
+        if xyz:
+            check_area_of_use(frame.crs, np.min(xyz, axis=0), np.max(xyz, axis=0),
+                              what=f"the {name}", path=path)  # fmt: skip
+    return cam, traj, obs, plane_list, line_list, lcp_list, ground
+
+
+def _paper_cloud(v: Values, types: tuple, obs, should_stop) -> tuple:
+    """The LiDAR points (N, 3) and their plane ids of paper-mode observations, or (None,
+    None) when none is used."""
+    import numpy as np
+
+    from ..errors import InputError
+    from ..io.pointcloud import read_points
+
+    if not ("paper" in types and "paper" in obs.type):
+        return None, None
+    if not v.cloud:
+        raise InputError("paper-mode observations need CLOUD (LAS/LAZ with plane_id)")
+    arrays, _ = read_points(
+        v.cloud, ("x", "y", "z", "plane_id"), require_crs=False, should_stop=should_stop
     )
+    lidar_xyz = np.column_stack([arrays["x"], arrays["y"], arrays["z"]])
+    return lidar_xyz, np.asarray(arrays["plane_id"]).astype(np.int64)
+
+
+def _write_outputs(out, run, settings, doubts: list, warning: list) -> None:
+    """The requested outputs of the accepted calibration ``run``."""
+    from ..io.atomic import write_text_atomic
+    from ..io.orientation import write_eo_csv
+    from ..io.tables import write_csv_atomic
+    from ..quality.boresight_html import render_boresight_html
+
     if out.requested("OUTPUT_TABLE"):
         write_csv_atomic(out.path("OUTPUT_TABLE"), TABLE_COLUMNS, _table_rows(run), warning)
     if out.requested("OUTPUT_EO"):
-        write_eo_csv(out.path("OUTPUT_EO"), result.eo, warning)
+        write_eo_csv(out.path("OUTPUT_EO"), run.result.eo, warning)
     if out.requested("RESIDUALS_CSV"):
         rows = [_text(r) for r in run.residual_rows()]
         write_csv_atomic(out.path("RESIDUALS_CSV"), RESIDUAL_COLUMNS, rows, warning)
     if out.requested("OUTPUT_HTML"):
         page = render_boresight_html(run, settings, problems=doubts, accepted=True)
         write_text_atomic(out.path("OUTPUT_HTML"), page)
+
+
+def _summary_lines(result, warning: list) -> list[str]:
+    """The log's summary: the angles of every group and the adjustment's figures."""
     lines = [*warning, f"{'group':8} {'angle':8} {'deg':>12} {'arcsec':>10} {'sigma':>8}"]
     for row in result.table_rows():
         lines.append(
@@ -268,7 +297,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         f"sigma0 {result.sigma0:.3f}, redundancy {result.redundancy}, global test {test}, "
         f"{int(result.residuals.rejected.sum())} observations rejected"
     )
-    return JobResult(results={"SIGMA0": result.sigma0}, lines=lines, data=run)
+    return lines
 
 
 def doubts_about(result, max_boresight_deg: float, max_sigma0: float) -> list[str]:

@@ -17,8 +17,8 @@ from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_fro
 
 log = logging.getLogger(__name__)
 
-_OPTIONS = Fields("photo.bundle", "BundleOptions")
-_AP_CHOICES = Ref("geometry.ap_models", "AP_FAMILIES", convert=lambda f: (*f, "all"))
+_OPTIONS = Fields("photo.bundle_options", "BundleOptions")
+_AP_CHOICES = Ref("geometry.ap_families", "AP_FAMILIES", convert=lambda f: (*f, "all"))
 ROBUST_CHOICES = ("none", "huber", "cauchy")
 DATUM_CHOICES = ("control", "inner", "minimal")
 
@@ -229,26 +229,71 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the inputs, adjust (each AP family for ``all``), write the outputs."""
-    import numpy as np
+    import math
 
     from ..errors import AdjustmentError, InputError
     from ..geometry.ap_models import AP_FAMILIES
-    from ..geometry.frames import MappingFrame, check_area_of_use
-    from ..io.atomic import write_text_atomic
-    from ..io.bundle import (
-        write_bundle_points,
-        write_bundle_residuals,
-        write_check_points,
-        write_comparison,
+    from ..photo.bundle import bundle_adjust, compare_ap_models
+    from ..photo.bundle_setup import BundleOptions
+    from .runner import stages
+
+    frame, cams, obs, ground, eo, sigma, eo_rows, eo_source, image_camera = _read_inputs(v)
+    models = tuple(m for m in AP_FAMILIES) if v.ap_model == "all" else (v.ap_model,)
+    parts = stages(progress, *([1.0] * len(models)))
+    stage = dict(zip(models, parts))
+
+    def one(model: str):
+        opts = options_from(BundleOptions, SPEC, v, ap_model=model)
+        log.info("bundle adjustment with AP model %s", model)
+        try:
+            return bundle_adjust(cams, obs, ground, frame, eo, sigma, image_camera, opts,
+                                 eo_rows, eo_source, stage[model], should_stop)  # fmt: skip
+        except AdjustmentError as exc:
+            if eo is not None:  # an approximate orientation far off is the usual cause
+                _blame_eo(exc, cams, obs, ground, eo, image_camera, eo_rows, eo_source)
+            raise
+
+    if len(models) == 1:
+        res = one(models[0])
+        rows = [{**res.summary_row(), "rank": 1}]
+        results = {models[0]: res}
+    else:
+        rows, results = compare_ap_models(models, one)
+        if not results:
+            raise InputError(
+                "no AP model could be adjusted: " + "; ".join(str(r.get("error")) for r in rows)
+            )
+    best = str(next(r["model"] for r in rows if r["model"] in results))
+    res = results[best]
+    settings = _settings(v, cams, obs, ground, eo, sigma, frame)
+    _write_outputs(out, results, best, rows, settings, multi=len(cams) > 1,
+                   compared=len(models) > 1)  # fmt: skip
+    st = res.check.statistics()
+    return JobResult(
+        results={
+            "SIGMA0": float(res.adjustment.sigma0),
+            "CHECK_RMS": float(st["rms_3d"]) if math.isfinite(st["rms_3d"]) else float("nan"),
+            "MODEL": best,
+        },
+        lines=_summary_lines(res, best, rows if len(models) > 1 else ()),
+        data=res,
     )
-    from ..io.camera import read_cameras_json, write_cameras_json
+
+
+def _read_inputs(v: Values) -> tuple:
+    """The frame, cameras, observations and ground points, and the approximate orientations
+    with their sigmas (EO_SIGMAS when the file has none) and the camera of every image, all
+    checked: (frame, cameras, observations, ground, eo, sigma, eo_rows, eo_source,
+    image_camera)."""
+    import numpy as np
+
+    from ..errors import InputError
+    from ..geometry.frames import MappingFrame, check_area_of_use
+    from ..io.camera import read_cameras_json
     from ..io.ground_points import read_ground_points_csv
     from ..io.observations import read_observations_csv
-    from ..io.orientation import read_eo_csv_full, write_eo_csv_with_sigmas
-    from ..photo.bundle import bundle_adjust, compare_ap_models
-    from ..photo.bundle_setup import BundleOptions, GroundPoints
-    from ..quality.bundle_html import render_bundle_html
-    from .runner import stages
+    from ..io.orientation import read_eo_csv_full
+    from ..photo.bundle_setup import GroundPoints
 
     frame = MappingFrame.from_user_input(v.crs)
     cams = read_cameras_json(v.camera)
@@ -283,36 +328,26 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             )
     if len(cams) > 1:
         _check_on_image(obs, image_camera, cams)
-    models = tuple(m for m in AP_FAMILIES) if v.ap_model == "all" else (v.ap_model,)
-    parts = stages(progress, *([1.0] * len(models)))
-    stage = dict(zip(models, parts))
+    return frame, cams, obs, ground, eo, sigma, eo_rows, eo_source, image_camera
 
-    def one(model: str):
-        opts = options_from(BundleOptions, SPEC, v, ap_model=model)
-        log.info("bundle adjustment with AP model %s", model)
-        try:
-            return bundle_adjust(cams, obs, ground, frame, eo, sigma, image_camera, opts,
-                                 eo_rows, eo_source, stage[model], should_stop)  # fmt: skip
-        except AdjustmentError as exc:
-            if eo is not None:  # an approximate orientation far off is the usual cause
-                _blame_eo(exc, cams, obs, ground, eo, image_camera, eo_rows, eo_source)
-            raise
 
-    if len(models) == 1:
-        res = one(models[0])
-        rows = [{**res.summary_row(), "rank": 1}]
-        results = {models[0]: res}
-    else:
-        rows, results = compare_ap_models(models, one)
-        if not results:
-            raise InputError(
-                "no AP model could be adjusted: " + "; ".join(str(r.get("error")) for r in rows)
-            )
-    best = str(next(r["model"] for r in rows if r["model"] in results))
+def _write_outputs(out, results: dict, best: str, rows: list, settings, *, multi: bool,
+                   compared: bool) -> None:  # fmt: skip
+    """The requested outputs of the adjustment of AP model ``best`` (of ``results``, ranked
+    in ``rows``); ``multi``: several cameras, ``compared``: several AP models."""
+    from ..io.atomic import write_text_atomic
+    from ..io.bundle import (
+        write_bundle_points,
+        write_bundle_residuals,
+        write_check_points,
+        write_comparison,
+    )
+    from ..io.camera import write_cameras_json
+    from ..io.orientation import write_eo_csv_with_sigmas
+    from ..quality.bundle_html import render_bundle_html
+
     res = results[best]
-    settings = _settings(v, cams, obs, ground, eo, sigma, frame)
     if out.requested("OUTPUT_EO"):
-        multi = len(cams) > 1
         write_eo_csv_with_sigmas(out.path("OUTPUT_EO"), res.eo, res.eo_sigma,
                                  res.image_camera if multi else None)  # fmt: skip
     if out.requested("OUTPUT_CAMERA"):
@@ -332,11 +367,16 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if out.requested("OUTPUT_COMPARISON"):
         write_comparison(out.path("OUTPUT_COMPARISON"), rows)
     if out.requested("OUTPUT_HTML"):
-        page = render_bundle_html(results, best, settings, rows if len(models) > 1 else ())
+        page = render_bundle_html(results, best, settings, rows if compared else ())
         write_text_atomic(out.path("OUTPUT_HTML"), page)
+
+
+def _summary_lines(res, best: str, rows) -> list[str]:
+    """The log's summary: the ranking of the AP models (``rows``, when several), then the
+    adjustment of ``best`` and its check points."""
     st = res.check.statistics()
     lines = []
-    if len(models) > 1:
+    if rows:
         lines.append(f"{'rank':>4} {'model':14} {'check RMS 3D m':>14} {'planimetric m':>13} "
                      f"{'sigma0':>7} {'sig. APs':>8}")  # fmt: skip
         for r in rows:
@@ -357,15 +397,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             f"check points ({int(st['n'])}): RMS E/N/H {st['rms_e']:.3f} / {st['rms_n']:.3f} / "
             f"{st['rms_h']:.3f} m, 3D {st['rms_3d']:.3f} m"
         )
-    return JobResult(
-        results={
-            "SIGMA0": float(a.sigma0),
-            "CHECK_RMS": float(st["rms_3d"]) if np.isfinite(st["rms_3d"]) else float("nan"),
-            "MODEL": best,
-        },
-        lines=lines,
-        data=res,
-    )
+    return lines
 
 
 def _misfit(xyz, px, eo6, cam) -> float:

@@ -7,7 +7,7 @@ from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 _D = Fields("photo.calibration_options", "CalibrationOptions")
-_T = Fields("photo.calibration_targets", "TargetSpec")
+_T = Fields("photo.calibration_options", "TargetSpec")
 JSON_FILTER = "JSON files (*.json)"
 
 SPEC = AlgorithmSpec(
@@ -42,7 +42,7 @@ the millimetre values of the camera file: the calibration itself is in pixels.""
         Param("IMAGES", "files", "Target images (files or folders)", suffixes=IMAGE_SUFFIXES,
               help="image files, or folders whose images are all taken"),
         Param("TARGET", "enum", "Target", _T.kind,
-              options=Ref("photo.calibration_targets", "TARGET_KINDS"),
+              options=Ref("photo.calibration_options", "TARGET_KINDS"),
               labels=("chessboard", "ChArUco board", "ArUco grid board")),
         Param("COLUMNS", "integer", "Columns (inner corners / squares / markers)", _T.cols,
               minimum=2, maximum=200),
@@ -53,9 +53,9 @@ the millimetre values of the camera file: the calibration itself is in pixels.""
         Param("MARKER", "number", "ChArUco marker side / ArUco gap", _T.marker_m, unit="m",
               minimum=0.0, maximum=10.0),
         Param("DICTIONARY", "enum", "ArUco dictionary", _T.dictionary,
-              options=Ref("photo.calibration_targets", "DICTIONARIES")),
+              options=Ref("photo.calibration_options", "DICTIONARIES")),
         Param("PROJECTION", "enum", "Projection", _D.projection,
-              options=Ref("geometry.projection", "PROJECTIONS"),
+              options=Ref("geometry.projection_names", "PROJECTIONS"),
               labels=("perspective (central)", "fisheye: equidistant",
                       "fisheye: equisolid-angle", "fisheye: orthographic",
                       "fisheye: stereographic")),
@@ -94,11 +94,9 @@ the millimetre values of the camera file: the calibration itself is in pixels.""
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the images, detect the target, calibrate, write the camera, report and residuals."""
-    from ..errors import InputError, stop_if_asked
-    from ..io.calibration import read_image_grey, write_report_json, write_residuals_csv
-    from ..io.camera import write_cameras_json
+    from ..errors import InputError
     from ..io.images import list_image_files
-    from ..photo.calibration_targets import TargetSpec, detect_target, target_field
+    from ..photo.calibration_targets import TargetSpec, target_field
     from ..photo.camera_calibration import CalibrationOptions, calibrate_camera
     from .runner import stages
 
@@ -107,20 +105,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     fld = target_field(spec)
     images = list_image_files(v.images)
     detect, adjust = stages(progress, 0.7, 0.3)
-    detections, size = [], None
-    for i, path in enumerate(images):
-        stop_if_asked(should_stop, "detecting the target")
-        img = read_image_grey(path)
-        shape = (img.shape[1], img.shape[0])
-        if size is None:
-            size = shape
-        elif shape != size:
-            raise InputError(f"image size {shape[0]} x {shape[1]} differs from that of the "
-                             f"first image ({size[0]} x {size[1]}): one camera, one size",
-                             path=str(path))  # fmt: skip
-        detections.append(detect_target(img, spec, path.name))
-        if detect:
-            detect((i + 1) / len(images))
+    detections, size = _detect(images, spec, detect, should_stop)
     found = sum(d.ids.size > 0 for d in detections)
     if found == 0:
         raise InputError(f"the {v.target} target ({v.columns} x {v.rows}) was found in none "
@@ -132,28 +117,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if missing:
         result.warnings.insert(0, f"target not found in {len(missing)} image(s): "
                                + ", ".join(missing))  # fmt: skip
-    extra = {"target": {"kind": spec.kind, "columns": spec.cols, "rows": spec.rows,
-                        "spacing_m": spec.spacing_m, "marker_m": spec.marker_m,
-                        "dictionary": spec.dictionary if spec.kind != "chessboard" else None},
-             "field": opts.field, "images": len(images), "images_with_target": found}
-    write_cameras_json(out.path("OUTPUT_CAMERA"), [result.camera], sigmas=[result.sigmas],
-                       extra={"calibration": {"rms_px": result.rms_px, "sigma0": result.sigma0,
-                                              "views": len(result.view_names),
-                                              "points": result.n_points}})  # fmt: skip
-    if out.requested("OUTPUT_REPORT"):
-        write_report_json(out.path("OUTPUT_REPORT"), result, extra)
-    if out.requested("OUTPUT_HTML"):
-        from ..io.atomic import write_text_atomic
-        from ..quality.calibration_html import render_calibration_html
-
-        settings = {"images": f"{len(images)} ({found} with the target)",
-                    "target": f"{spec.kind} {spec.cols} x {spec.rows}, spacing "
-                              f"{spec.spacing_m:g} m", "field": opts.field,
-                    "lens coefficients": ", ".join(opts.lens_parameters) or "none",
-                    "initial values": result.initial["method"]}  # fmt: skip
-        write_text_atomic(out.path("OUTPUT_HTML"), render_calibration_html(result, settings))
-    if out.requested("OUTPUT_RESIDUALS"):
-        write_residuals_csv(out.path("OUTPUT_RESIDUALS"), result)
+    _write_outputs(out, result, spec, opts, len(images), found)
     cam = result.camera
     ppx, ppy = cam.principal_point_px
     s = result.sigmas
@@ -169,3 +133,56 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                  "RMS_PX": result.rms_px, "SIGMA0": result.sigma0, "FOCAL_PX": cam.focal_px},
         lines=lines, data=result,
     )  # fmt: skip
+
+
+def _detect(images: list, spec, progress, should_stop) -> tuple:
+    """(the target's detection in each image, the images' common (width, height) in pixels),
+    refused when an image's size differs from the first's."""
+    from ..errors import InputError, stop_if_asked
+    from ..io.calibration import read_image_grey
+    from ..photo.calibration_targets import detect_target
+
+    detections, size = [], None
+    for i, path in enumerate(images):
+        stop_if_asked(should_stop, "detecting the target")
+        img = read_image_grey(path)
+        shape = (img.shape[1], img.shape[0])
+        if size is None:
+            size = shape
+        elif shape != size:
+            raise InputError(f"image size {shape[0]} x {shape[1]} differs from that of the "
+                             f"first image ({size[0]} x {size[1]}): one camera, one size",
+                             path=str(path))  # fmt: skip
+        detections.append(detect_target(img, spec, path.name))
+        if progress:
+            progress((i + 1) / len(images))
+    return detections, size
+
+
+def _write_outputs(out, result, spec, opts, n_images: int, found: int) -> None:
+    """The camera file and the requested report, HTML page and residuals."""
+    from ..io.calibration import write_report_json, write_residuals_csv
+    from ..io.camera import write_cameras_json
+
+    extra = {"target": {"kind": spec.kind, "columns": spec.cols, "rows": spec.rows,
+                        "spacing_m": spec.spacing_m, "marker_m": spec.marker_m,
+                        "dictionary": spec.dictionary if spec.kind != "chessboard" else None},
+             "field": opts.field, "images": n_images, "images_with_target": found}
+    write_cameras_json(out.path("OUTPUT_CAMERA"), [result.camera], sigmas=[result.sigmas],
+                       extra={"calibration": {"rms_px": result.rms_px, "sigma0": result.sigma0,
+                                              "views": len(result.view_names),
+                                              "points": result.n_points}})  # fmt: skip
+    if out.requested("OUTPUT_REPORT"):
+        write_report_json(out.path("OUTPUT_REPORT"), result, extra)
+    if out.requested("OUTPUT_HTML"):
+        from ..io.atomic import write_text_atomic
+        from ..quality.calibration_html import render_calibration_html
+
+        settings = {"images": f"{n_images} ({found} with the target)",
+                    "target": f"{spec.kind} {spec.cols} x {spec.rows}, spacing "
+                              f"{spec.spacing_m:g} m", "field": opts.field,
+                    "lens coefficients": ", ".join(opts.lens_parameters) or "none",
+                    "initial values": result.initial["method"]}  # fmt: skip
+        write_text_atomic(out.path("OUTPUT_HTML"), render_calibration_html(result, settings))
+    if out.requested("OUTPUT_RESIDUALS"):
+        write_residuals_csv(out.path("OUTPUT_RESIDUALS"), result)

@@ -32,9 +32,9 @@ def mount_params() -> tuple[Param, ...]:
               unit="m, body frame", minimum=-MAX_LEVER_ARM_M, maximum=MAX_LEVER_ARM_M,
               help="camera perspective centre in the INS body frame (x forward, y right, "
               "z down)"),
-        Param("MOUNT", "enum", "Camera mount", Ref("photo.mount", "MOUNT_CHOICES", convert=_first),
-              options=Ref("photo.mount", "MOUNT_CHOICES"),
-              labels=Ref("photo.mount", "MOUNT_LABELS", convert=_mount_labels),
+        Param("MOUNT", "enum", "Camera mount", Ref("photo.mount_choices", "MOUNT_CHOICES",
+              convert=_first), options=Ref("photo.mount_choices", "MOUNT_CHOICES"),
+              labels=Ref("photo.mount_choices", "MOUNT_LABELS", convert=_mount_labels),
               help="nominal camera-to-body rotation; custom uses MOUNT_MATRIX"),
         Param("MOUNT_MATRIX", "numbers", "Mount matrix R_c^b (9 numbers, row-major)",
               count=9, optional=True, advanced=True, minimum=-1.0, maximum=1.0,
@@ -51,7 +51,7 @@ def _first(choices: tuple[str, ...]) -> str:
 
 
 def _mount_labels(labels: Mapping[str, str]) -> tuple[str, ...]:
-    from ..photo.mount import MOUNT_CHOICES
+    from ..photo.mount_choices import MOUNT_CHOICES
 
     return tuple(f"{m}: {labels[m]}" for m in MOUNT_CHOICES)
 

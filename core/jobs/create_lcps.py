@@ -16,7 +16,7 @@ log = logging.getLogger(__name__)
 #: catalogue context of this module's ``_t("...")`` log sentences
 TR_CONTEXT = "Report"
 
-_D = Fields("lidar.control", "ControlOptions")
+_D = Fields("lidar.control_options", "ControlOptions")
 _LENGTHS = ("delta", "min_boundary", "max_support_distance")
 
 SPEC = AlgorithmSpec(

@@ -18,7 +18,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-_D = Fields("lidar.roof_planes", "RoofPlaneParams")
+_D = Fields("lidar.roof_plane_params", "RoofPlaneParams")
 #: (parameter, RoofPlaneParams field, label, kind, unit, minimum, maximum, advanced)
 _NUMBERS = (
     ("K_NEIGHBOURS", "k_neighbours", "Neighbours K of the local RANSAC", "integer", "", 6, 500,
@@ -86,7 +86,7 @@ error.""",
     params=(
         *cloud_params("INPUT"),
         Param("POINTS", "enum", "Points", "non_ground",
-              options=Ref("lidar.roof_planes", "SELECTION_CHOICES"),
+              options=Ref("lidar.roof_plane_params", "SELECTION_CHOICES"),
               labels=("non-ground (class != 2)", "the classes below", "all"),
               aliases={"non-ground": "non_ground"}),
         Param("CLASSES", "string", "Classes (e.g. 6)", "6", optional=True,
@@ -146,63 +146,22 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     import numpy as np
 
     from ..io.planes import write_planes_csv
-    from ..io.pointcloud import read_cloud, read_points, write_cloud
-    from ..lidar.roof_planes import RoofPlaneParams, extract_roof_planes
+    from ..io.pointcloud import write_cloud
+    from ..lidar.roof_planes import extract_roof_planes
 
-    if v.min_support > v.k_neighbours:
-        raise InputError(
-            f"MIN_SUPPORT ({v.min_support}) must not exceed K_NEIGHBOURS ({v.k_neighbours})"
-        )
-    if v.min_slope > v.max_slope:
-        raise InputError(
-            f"MIN_SLOPE ({v.min_slope:g}) must not exceed MAX_SLOPE ({v.max_slope:g} degrees)"
-        )
-    params = options_from(RoofPlaneParams, SPEC, v)
-    # RANSAC works on batches of points: each holds batch x iterations x K samples
-    check_memory(
-        float(params.batch_size) * params.ransac_iterations * params.k_neighbours
-        * RANSAC_BYTES_PER_SAMPLE,
-        f"K_NEIGHBOURS {params.k_neighbours} with RANSAC_ITERATIONS "
-        f"{params.ransac_iterations}: one batch of {params.batch_size} points",
-        "give fewer neighbours or iterations",
-    )  # fmt: skip
-    selection = v.points
-    wanted = parse_classes(v.classes) if selection == "classes" else ()
+    params = _params(v)
+    wanted = parse_classes(v.classes) if v.points == "classes" else ()
     weights = (0.15, 0.7, 0.15) if out.requested("OUTPUT_CLOUD") else (0.2, 0.8, 0.0)
     read, compute, write = stages(progress, *weights)
-    fields = ("x", "y", "z") if selection == "all" else ("x", "y", "z", "classification")
-    cloud = None
-    if out.requested("OUTPUT_CLOUD"):  # decoded once: the copy is written from memory
-        cloud = read_cloud(v.input, v.crs or None, progress=read, should_stop=should_stop)
-        arrays, info = {f: cloud.values(f) for f in fields}, cloud.info
-    else:
-        arrays, info = read_points(
-            v.input, fields, crs=v.crs or None, progress=read, should_stop=should_stop
-        )
-    ratio = info.vertical_unit_to_metre / info.unit_to_metre
-    if not math.isfinite(ratio) or abs(ratio - 1.0) > 1e-9:
-        raise InputError(
-            f"horizontal unit ({info.horizontal_unit}) and vertical unit "
-            f"({info.vertical_unit_to_metre} m) differ: planes need x, y and z in one unit; "
-            "convert the heights first",
-            path=str(v.input),
-        )
+    cloud, arrays, info = _read(v, out, read, should_stop)
     params = lengths_in_cloud_units(params, info, v.distance_unit, _LENGTHS)
     messages = [
         f"lengths in {info.horizontal_unit} (1 unit = {info.unit_to_metre:g} m): "
         f"epsilon = {params.epsilon:g}, outline cell = {params.outline_cell:g} (0 = auto)"
     ]
     n = info.point_count
-    if selection == "all":
-        sel = np.ones(n, dtype=bool)
-    elif selection == "classes":
-        sel = np.isin(arrays["classification"], wanted)
-    else:
-        sel = arrays["classification"] != 2
+    sel = _selected(v, arrays, n, wanted)
     n_sel = int(sel.sum())
-    if n_sel == 0:
-        what = {"classes": f"of class {v.classes}", "non_ground": "that is not ground (class 2)"}
-        raise InputError(f"no point {what.get(selection, '')} in the cloud", path=str(v.input))
     xyz = np.column_stack([arrays["x"][sel], arrays["y"][sel], arrays["z"][sel]])
     del arrays
     result = extract_roof_planes(xyz, params, progress=compute, should_stop=should_stop)
@@ -241,3 +200,71 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         ],
         data=run_info,
     )
+
+
+def _params(v: Values):
+    """The :class:`RoofPlaneParams` of the parameters, checked against each other and against
+    the memory a RANSAC batch needs."""
+    from ..lidar.roof_planes import RoofPlaneParams
+
+    if v.min_support > v.k_neighbours:
+        raise InputError(
+            f"MIN_SUPPORT ({v.min_support}) must not exceed K_NEIGHBOURS ({v.k_neighbours})"
+        )
+    if v.min_slope > v.max_slope:
+        raise InputError(
+            f"MIN_SLOPE ({v.min_slope:g}) must not exceed MAX_SLOPE ({v.max_slope:g} degrees)"
+        )
+    params = options_from(RoofPlaneParams, SPEC, v)
+    # RANSAC works on batches of points: each holds batch x iterations x K samples
+    check_memory(
+        float(params.batch_size) * params.ransac_iterations * params.k_neighbours
+        * RANSAC_BYTES_PER_SAMPLE,
+        f"K_NEIGHBOURS {params.k_neighbours} with RANSAC_ITERATIONS "
+        f"{params.ransac_iterations}: one batch of {params.batch_size} points",
+        "give fewer neighbours or iterations",
+    )  # fmt: skip
+    return params
+
+
+def _read(v: Values, out, progress, should_stop) -> tuple:
+    """(the whole cloud when OUTPUT_CLOUD is written from it else None, the x, y, z (and
+    classification) arrays, the cloud's info), refused when x, y and z are in two units."""
+    from ..io.pointcloud import read_cloud, read_points
+
+    fields = ("x", "y", "z") if v.points == "all" else ("x", "y", "z", "classification")
+    cloud = None
+    if out.requested("OUTPUT_CLOUD"):  # decoded once: the copy is written from memory
+        cloud = read_cloud(v.input, v.crs or None, progress=progress, should_stop=should_stop)
+        arrays, info = {f: cloud.values(f) for f in fields}, cloud.info
+    else:
+        arrays, info = read_points(
+            v.input, fields, crs=v.crs or None, progress=progress, should_stop=should_stop
+        )
+    ratio = info.vertical_unit_to_metre / info.unit_to_metre
+    if not math.isfinite(ratio) or abs(ratio - 1.0) > 1e-9:
+        raise InputError(
+            f"horizontal unit ({info.horizontal_unit}) and vertical unit "
+            f"({info.vertical_unit_to_metre} m) differ: planes need x, y and z in one unit; "
+            "convert the heights first",
+            path=str(v.input),
+        )
+    return cloud, arrays, info
+
+
+def _selected(v: Values, arrays: dict, n: int, wanted: tuple):
+    """The mask (n,) of the points POINTS selects (``wanted``: the classes of CLASSES),
+    refused when it selects none."""
+    import numpy as np
+
+    selection = v.points
+    if selection == "all":
+        sel = np.ones(n, dtype=bool)
+    elif selection == "classes":
+        sel = np.isin(arrays["classification"], wanted)
+    else:
+        sel = arrays["classification"] != 2
+    if not sel.any():
+        what = {"classes": f"of class {v.classes}", "non_ground": "that is not ground (class 2)"}
+        raise InputError(f"no point {what.get(selection, '')} in the cloud", path=str(v.input))
+    return sel

@@ -168,13 +168,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the cloud, filter its ground, write the classified copy (and the DTM)."""
     from ..io.pointcloud import read_cloud, read_info, write_cloud
     from ..io.raster_write import write_geotiff
-    from ..lidar.ground_filter import (
-        GROUND_CLASS,
-        HEIGHT_FIELD,
-        LOW_NOISE_CLASS,
-        UNCLASSIFIED_CLASS,
-        ground_filter,
-    )
+    from ..lidar.ground_filter import HEIGHT_FIELD, ground_filter
 
     _check_together(v)
     params = method_params(v)
@@ -187,16 +181,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     cloud = read_cloud(v.input, v.crs, progress=read, should_stop=should_stop)
     info = cloud.info
     returns = info.has_return_numbers and params.last_returns_only
-    converted = v.distance_unit == "metre"
-    log.info(
-        "%s: %d points, CRS %s, distances in %s (%s), method %s",
-        v.input,
-        info.point_count,
-        info.crs.name if info.crs is not None else "?",
-        "metres" if converted else info.horizontal_unit,
-        "converted from metres" if converted else "the cloud's CRS unit",
-        v.method,
-    )
+    _log_start(v, info)
     result = ground_filter(
         cloud.scaled_xyz(),  # the records' integers: no float64 x, y, z of every point
         params=params,
@@ -210,12 +195,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         should_stop=should_stop,
     )
     cls = cloud.values("classification")
-    if v.non_ground_class == "unclassified":
-        cls[:] = UNCLASSIFIED_CLASS
-    else:  # a point the file had as ground but the filter rejects becomes unclassified
-        cls[cls == GROUND_CLASS] = UNCLASSIFIED_CLASS  # (those it keeps get 2 again below)
-    cls[result.ground] = GROUND_CLASS
-    cls[result.low_outlier] = LOW_NOISE_CLASS
+    result.classify(cls, reset_non_ground=v.non_ground_class == "unclassified")
     write_cloud(
         v.input,
         out.path("OUTPUT_CLOUD"),
@@ -230,6 +210,11 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         write_geotiff(
             out.path("OUTPUT_DTM"), result.dtm, result.geotransform, result.nodata, crs_wkt or None
         )
+    return _job_result(v, info, result, out)
+
+
+def _job_result(v: Values, info, result, out) -> JobResult:
+    """The figures and the summary line of the run."""
     unit = unit_text(info, v.distance_unit)
     ground, low = result.stats["ground_count"], result.stats["low_outlier_count"]
     slope = result.stats.get("slope_estimated")
@@ -246,6 +231,20 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             f"{estimated}); distances in {unit} -> {out.target('OUTPUT_CLOUD')}"
         ],
         data=result,
+    )
+
+
+def _log_start(v: Values, info) -> None:
+    """Log the cloud, its CRS, the unit of the distances and the method."""
+    converted = v.distance_unit == "metre"
+    log.info(
+        "%s: %d points, CRS %s, distances in %s (%s), method %s",
+        v.input,
+        info.point_count,
+        info.crs.name if info.crs is not None else "?",
+        "metres" if converted else info.horizontal_unit,
+        "converted from metres" if converted else "the cloud's CRS unit",
+        v.method,
     )
 
 

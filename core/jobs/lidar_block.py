@@ -27,8 +27,8 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 _S = Fields("lidar.ground_filter_params", "SmrfParams")
-_R = Fields("lidar.roof_planes", "RoofPlaneParams")
-_C = Fields("lidar.control", "ControlOptions")
+_R = Fields("lidar.roof_plane_params", "RoofPlaneParams")
+_C = Fields("lidar.control_options", "ControlOptions")
 #: Exit status of the command line when the block is incomplete (a tile failed).
 INCOMPLETE_EXIT = 3
 #: The command line shows a progress bar for this job.
@@ -552,10 +552,10 @@ def _check_output(folder: Path) -> None:
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Index the block, run it on the cluster, write the outputs together."""
+    import shutil
+
     from ..io.atomic import check_outputs
-    from ..io.control import write_lcps_csv, write_lines_csv
-    from ..io.planes import write_planes_csv
-    from ..io.tiles import commit_folder, index_block, staging_folder, write_json, write_vpc
+    from ..io.tiles import commit_folder, index_block, staging_folder, write_json
 
     target = Path(v.output_folder)
     _check_output(target)
@@ -571,57 +571,14 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
              len(index.tiles), index.kind, index.point_count, settings.ground_buffer,
              settings.roof_buffer, info.horizontal_unit)  # fmt: skip
     staging = staging_folder(target)
-    import shutil
-
     try:
-        client, cluster = open_client(v)
-        try:
-            block = run_block(index, settings, str(staging), client, progress, should_stop)
-        except BaseException:
-            if cluster is not None:
-                _stop_workers(cluster)
-            raise
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+        block = _on_cluster(v, index, settings, str(staging), progress, should_stop)
         outcomes = block["outcomes"]
         failed = [(o.name, o.error) for o in outcomes if not o.ok] + index.bad
         good = [o for o in outcomes if o.ok and o.n_core > 0]
-        crs_wkt = info.crs.to_wkt() if info.crs is not None else ""
-        write_vpc(staging / "block.vpc",
-                  [{"name": o.name, "href": o.href, "count": o.n_core, "bbox": o.bbox}
-                   for o in good], crs_wkt)  # fmt: skip
-        write_planes_csv(staging / "planes.csv", block["planes"])
-        write_lcps_csv(staging / "lcps.csv", block["lcps"])
-        write_lines_csv(staging / "lines.csv", block["lines"])
+        _write_tables(staging, block, good, info)
         complete = not failed
-        report = {
-            "complete": complete,
-            "source": str(v.input),
-            "kind": index.kind,
-            "copc_tiles": sum(t.copc for t in index.tiles),
-            "crs": info.crs.name if info.crs is not None else "",
-            "unit": info.horizontal_unit,
-            "ground_buffer": settings.ground_buffer,
-            "roof_buffer": settings.roof_buffer,
-            "failed_tiles": [{"name": n, "error": e} for n, e in failed],
-            "point_count": sum(o.n_core for o in good),
-            "ground_count": sum(o.n_ground for o in good),
-            "plane_count": len(block["planes"]),
-            "lcp_count": len(block["lcps"]),
-            "line_count": len(block["lines"]),
-            "seconds": round(block["seconds"], 3),
-            "tasks_s": round(block["seconds_tiles"], 3),
-            "tiles": [{"name": o.name, "ok": o.ok, "error": o.error, "points": o.n_core,
-                       "points_read": o.n_read, "points_decoded": o.n_decoded,
-                       "ground": o.n_ground, "low_outliers": o.n_low,
-                       "plane_pieces": len(o.pieces), "seconds": round(o.seconds, 3),
-                       "peak_rss_mb": round(o.peak_rss_mb, 1), "stage_seconds": o.stages,
-                       "buffer_incomplete": o.missing,
-                       "href": o.href}
-                      for o in outcomes],
-        }  # fmt: skip
+        report = _report(v, index, settings, block, failed, good)
         write_json(staging / REPORT_NAME, report)
         commit_folder(staging, target)
     except BaseException:
@@ -647,3 +604,65 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         exit_code=0 if complete else INCOMPLETE_EXIT,
     )  # fmt: skip
 
+
+def _on_cluster(v: Values, index, settings, staging: str, progress, should_stop) -> dict:
+    """:func:`run_block` on the client of the parameters; its workers stopped when the block
+    fails or is cancelled, the client and cluster closed in every case."""
+    client, cluster = open_client(v)
+    try:
+        return run_block(index, settings, staging, client, progress, should_stop)
+    except BaseException:
+        if cluster is not None:
+            _stop_workers(cluster)
+        raise
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _write_tables(staging: Path, block: dict, good: list, info) -> None:
+    """The block's virtual point cloud (its good tiles) and its planes, LCPs and lines."""
+    from ..io.control import write_lcps_csv, write_lines_csv
+    from ..io.planes import write_planes_csv
+    from ..io.tiles import write_vpc
+
+    crs_wkt = info.crs.to_wkt() if info.crs is not None else ""
+    write_vpc(staging / "block.vpc",
+              [{"name": o.name, "href": o.href, "count": o.n_core, "bbox": o.bbox}
+               for o in good], crs_wkt)  # fmt: skip
+    write_planes_csv(staging / "planes.csv", block["planes"])
+    write_lcps_csv(staging / "lcps.csv", block["lcps"])
+    write_lines_csv(staging / "lines.csv", block["lines"])
+
+
+def _report(v: Values, index, settings, block: dict, failed: list, good: list) -> dict:
+    """The block's report (REPORT_NAME): the source, buffers, counts, times and every tile."""
+    info = index.info
+    outcomes = block["outcomes"]
+    return {
+        "complete": not failed,
+        "source": str(v.input),
+        "kind": index.kind,
+        "copc_tiles": sum(t.copc for t in index.tiles),
+        "crs": info.crs.name if info.crs is not None else "",
+        "unit": info.horizontal_unit,
+        "ground_buffer": settings.ground_buffer,
+        "roof_buffer": settings.roof_buffer,
+        "failed_tiles": [{"name": n, "error": e} for n, e in failed],
+        "point_count": sum(o.n_core for o in good),
+        "ground_count": sum(o.n_ground for o in good),
+        "plane_count": len(block["planes"]),
+        "lcp_count": len(block["lcps"]),
+        "line_count": len(block["lines"]),
+        "seconds": round(block["seconds"], 3),
+        "tasks_s": round(block["seconds_tiles"], 3),
+        "tiles": [{"name": o.name, "ok": o.ok, "error": o.error, "points": o.n_core,
+                   "points_read": o.n_read, "points_decoded": o.n_decoded,
+                   "ground": o.n_ground, "low_outliers": o.n_low,
+                   "plane_pieces": len(o.pieces), "seconds": round(o.seconds, 3),
+                   "peak_rss_mb": round(o.peak_rss_mb, 1), "stage_seconds": o.stages,
+                   "buffer_incomplete": o.missing,
+                   "href": o.href}
+                  for o in outcomes],
+    }  # fmt: skip

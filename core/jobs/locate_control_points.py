@@ -168,20 +168,57 @@ class _Images:
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read chips, control, camera, EO and images; locate; write the outputs."""
+    from ..io.atomic import write_text_atomic
+    from ..io.chips import write_location_report
+    from ..io.observations import write_observations_csv
+    from ..photo.control_location import LocateOptions, locate_control_points
+    from ..photo.least_squares_matching import LsmOptions
+    from ..quality.control_location_html import render_location_html
+
+    camera, chips, images, sub, sig = _read_inputs(v)
+    opt = options_from(LocateOptions, SPEC, v, lsm=options_from(LsmOptions, SPEC, v))
+    reader = _Images(images)
+    compute, _ = stages(progress, 0.95, 0.05)
+    try:
+        res = locate_control_points(chips, sub, camera, reader, sig, opt, progress=compute,
+                                    should_stop=should_stop)  # fmt: skip
+    finally:
+        reader.close()
+    write_observations_csv(out.path("OUTPUT"), res.observations)
+    if out.requested("OUTPUT_REPORT"):
+        write_location_report(out.path("OUTPUT_REPORT"), res.pairs)
+    if out.requested("OUTPUT_HTML"):
+        settings = {
+            "chips": str(len(chips)),
+            "images": str(len(sub)),
+            "search window": "EO sigmas x 3" if sig is not None else f"+-{v.search_px:g} px",
+            "transfer": "yes" if v.transfer else "no",
+        }
+        write_text_atomic(out.path("OUTPUT_HTML"), render_location_html(res.pairs, settings))
+    counts = res.counts()
+    rejected = counts.get("rejected", 0) + counts.get("outside", 0)
+    lines = [f"{len(res.observations)} observations of {len(chips)} points in {len(sub)} images;"
+             f" {rejected} rejected"]  # fmt: skip
+    for p in res.pairs:
+        if p.status != "ok":
+            where = f" in {p.image_id}" if p.image_id else ""
+            lines.append(f"  {p.point_id}{where}: {p.reason}")
+    return JobResult(results={"LOCATED": len(res.observations), "REJECTED": rejected},
+                     lines=lines, data=res)  # fmt: skip
+
+
+def _read_inputs(v: Values) -> tuple:
+    """(camera, the chips of the control points, the image files by id, the EO of those
+    images, their EO sigmas or None), every input checked before any work."""
     from dataclasses import replace
 
     from ..errors import InputError
     from ..geometry.frames import check_area_of_use, parse_crs
-    from ..io.atomic import write_text_atomic
     from ..io.camera import read_camera_json
-    from ..io.chips import list_chips, read_control_chip, write_location_report
+    from ..io.chips import list_chips, read_control_chip
     from ..io.images import image_size, list_image_files
-    from ..io.observations import write_observations_csv
     from ..io.orientation import read_eo_csv_full
     from ..io.resection import read_point_control_csv
-    from ..photo.control_location import LocateOptions, locate_control_points
-    from ..photo.least_squares_matching import LsmOptions
-    from ..quality.control_location_html import render_location_html
 
     crs = parse_crs(v.crs, what="CRS")
     camera = read_camera_json(v.camera)
@@ -222,32 +259,4 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         opk=eo.opk[keep],
     )
     sig = eo_file.sigma[keep] if eo_file.sigma is not None else None
-    opt = options_from(LocateOptions, SPEC, v, lsm=options_from(LsmOptions, SPEC, v))
-    reader = _Images(images)
-    compute, _ = stages(progress, 0.95, 0.05)
-    try:
-        res = locate_control_points(chips, sub, camera, reader, sig, opt, progress=compute,
-                                    should_stop=should_stop)  # fmt: skip
-    finally:
-        reader.close()
-    write_observations_csv(out.path("OUTPUT"), res.observations)
-    if out.requested("OUTPUT_REPORT"):
-        write_location_report(out.path("OUTPUT_REPORT"), res.pairs)
-    if out.requested("OUTPUT_HTML"):
-        settings = {
-            "chips": str(len(chips)),
-            "images": str(len(sub)),
-            "search window": "EO sigmas x 3" if sig is not None else f"+-{v.search_px:g} px",
-            "transfer": "yes" if v.transfer else "no",
-        }
-        write_text_atomic(out.path("OUTPUT_HTML"), render_location_html(res.pairs, settings))
-    counts = res.counts()
-    rejected = counts.get("rejected", 0) + counts.get("outside", 0)
-    lines = [f"{len(res.observations)} observations of {len(chips)} points in {len(sub)} images;"
-             f" {rejected} rejected"]  # fmt: skip
-    for p in res.pairs:
-        if p.status != "ok":
-            where = f" in {p.image_id}" if p.image_id else ""
-            lines.append(f"  {p.point_id}{where}: {p.reason}")
-    return JobResult(results={"LOCATED": len(res.observations), "REJECTED": rejected},
-                     lines=lines, data=res)  # fmt: skip
+    return camera, chips, images, sub, sig

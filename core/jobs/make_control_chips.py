@@ -13,8 +13,8 @@ from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
-_C = Fields("photo.control_chips", "ChipOptions")
-_P = Fields("photo.control_plate", "PlateGeometry")
+_C = Fields("photo.chip_options", "ChipOptions")
+_P = Fields("photo.chip_options", "PlateGeometry")
 #: File names of the report in the output folder.
 REPORT_CSV = "control_chips.csv"
 REPORT_JSON = "control_chips.json"
@@ -151,23 +151,60 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the points, camera and photos, make each point's chip, write chips and report."""
     from pathlib import Path
 
-    from ..errors import InputError, stop_if_asked
+    from ..errors import stop_if_asked
+    from ..io.atomic import OutputSet
+    from ..io.control_chips import write_report_csv, write_report_json
+    from ..photo.control_chips import ChipOptions
+
+    points, crs, camera, pairs = _read_inputs(v)
+    options = options_from(ChipOptions, SPEC, v)
+    _check_photos(pairs, camera)  # every photo checked before anything is computed
+    folder = Path(v.output_folder)
+    ids = [p for p in points.point_id if p in pairs]
+    targets = {pid: folder / f"{pid}.tif" for pid in ids}
+    targets["__csv"] = folder / REPORT_CSV
+    targets["__json"] = folder / REPORT_JSON
+    inputs = {"POINTS": v.points, "CAMERA": v.camera, "PHOTO_TABLE": v.photo_table,
+              "PHOTOS": [x for p in pairs.values() for x in (p.plate_photo, p.free_photo)
+                         if x]}  # fmt: skip
+    xyz_of = dict(zip(points.point_id, points.xyz))
+    rows = []
+    written = 0
+    with OutputSet({k: str(p) for k, p in targets.items()}, inputs) as files:
+        for k, pid in enumerate(ids):
+            stop_if_asked(should_stop, "making control chips")
+            row = _chip(v, pid, xyz_of[pid], pairs[pid], camera, options, crs, files)
+            if row["status"] == "ok":
+                row["chip"] = str(targets[pid])
+                written += 1
+            rows.append(row)
+            if progress is not None:
+                progress((k + 1) / len(ids))
+        missing = [p for p in points.point_id if p not in pairs]
+        for pid in missing:
+            rows.append({"point_id": pid, "status": "failed", "reason": "no plate photo",
+                         "X": float(xyz_of[pid][0]), "Y": float(xyz_of[pid][1]),
+                         "Z": float(xyz_of[pid][2])})  # fmt: skip
+        write_report_csv(files.path("__csv"), rows)
+        write_report_json(files.path("__json"), rows)
+        files.commit()
+    failed = len(rows) - written
+    lines = [f"{written} chip(s) of {v.chip_size} x {v.chip_size} px at {v.gsd:g} m in "
+             f"{folder}; {failed} point(s) without a chip"]  # fmt: skip
+    lines += [f"  {r['point_id']}: {r['reason']}" for r in rows if r["status"] != "ok"]
+    return JobResult(results={"CHIP_COUNT": written, "FAILED_COUNT": failed}, lines=lines,
+                     data=rows)  # fmt: skip
+
+
+def _read_inputs(v: Values) -> tuple:
+    """The ground points (checked against the CRS's area of use), the CRS, the camera and the
+    plate and free photos of each point, with the plate's sides checked."""
+    from ..errors import InputError
     from ..geometry.frames import check_area_of_use, parse_crs
     from ..geometry.projection import PROJECTIONS
-    from ..io.atomic import OutputSet
     from ..io.camera import read_camera_json
-    from ..io.control_chips import (
-        find_photo_pairs,
-        read_grey_photo,
-        read_photo_table,
-        write_chip,
-        write_report_csv,
-        write_report_json,
-    )
+    from ..io.control_chips import find_photo_pairs, read_photo_table
     from ..io.ground_points import read_ground_points_csv
-    from ..io.raster import RasterReader
-    from ..photo.control_chips import ChipOptions, ChipResult, make_chip
-    from ..photo.control_plate import PlateGeometry
 
     points = read_ground_points_csv(v.points)
     crs = parse_crs(v.crs, what="mapping CRS")
@@ -193,8 +230,15 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if not v.inner_side < v.outer_side:
         raise InputError(f"INNER_SIDE ({v.inner_side:g} m) must be smaller than OUTER_SIDE "
                          f"({v.outer_side:g} m)")  # fmt: skip
-    options = options_from(ChipOptions, SPEC, v)
-    for pair in pairs.values():  # every photo checked before anything is computed
+    return points, crs, camera, pairs
+
+
+def _check_photos(pairs: dict, camera) -> None:
+    """Every photo has the camera's size."""
+    from ..errors import InputError
+    from ..io.raster import RasterReader
+
+    for pair in pairs.values():
         for path in (pair.plate_photo, pair.free_photo):
             if path:
                 with RasterReader(path) as src:
@@ -203,59 +247,35 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                     raise InputError(f"the photo is {w} x {h} px, the camera {camera.name!r} "
                                      f"{camera.width_px} x {camera.height_px} px",
                                      path=path)  # fmt: skip
-    folder = Path(v.output_folder)
-    ids = [p for p in points.point_id if p in pairs]
-    targets = {pid: folder / f"{pid}.tif" for pid in ids}
-    targets["__csv"] = folder / REPORT_CSV
-    targets["__json"] = folder / REPORT_JSON
-    inputs = {"POINTS": v.points, "CAMERA": v.camera, "PHOTO_TABLE": v.photo_table,
-              "PHOTOS": [x for p in pairs.values() for x in (p.plate_photo, p.free_photo)
-                         if x]}  # fmt: skip
-    xyz_of = dict(zip(points.point_id, points.xyz))
-    rows = []
-    written = 0
-    with OutputSet({k: str(p) for k, p in targets.items()}, inputs) as files:
-        for k, pid in enumerate(ids):
-            stop_if_asked(should_stop, "making control chips")
-            pair = pairs[pid]
-            xyz = xyz_of[pid]
-            plate = PlateGeometry(
-                v.outer_side, v.inner_side, v.plate_height,
-                v.plate_azimuth if math.isnan(pair.plate_azimuth_deg) else pair.plate_azimuth_deg,
-            )  # fmt: skip
-            az = v.photo_azimuth if math.isnan(pair.photo_azimuth_deg) else pair.photo_azimuth_deg
-            ref = read_grey_photo(pair.plate_photo, camera.width_px, camera.height_px)
-            free = (read_grey_photo(pair.free_photo, camera.width_px, camera.height_px)
-                    if pair.free_photo else None)  # fmt: skip
-            res: ChipResult = make_chip(pid, xyz, ref, free, camera, plate, options, az)
-            row = _report_row(pid, xyz, pair, res)
-            if res.status == "ok":
-                meta = {
-                    "LIDARPHOTO_POINT_ID": pid,
-                    "LIDARPHOTO_POINT": ",".join(repr(float(c)) for c in xyz),
-                    "LIDARPHOTO_PLANE_Z": repr(float(xyz[2])),
-                    "LIDARPHOTO_SOURCE": res.source,
-                    "LIDARPHOTO_GSD": repr(v.gsd),
-                }
-                write_chip(files.path(pid), res.chip, res.geotransform, crs, meta)
-                row["chip"] = str(targets[pid])
-                written += 1
-            else:
-                log.warning("point %s: %s", pid, res.reason)
-            rows.append(row)
-            if progress is not None:
-                progress((k + 1) / len(ids))
-        missing = [p for p in points.point_id if p not in pairs]
-        for pid in missing:
-            rows.append({"point_id": pid, "status": "failed", "reason": "no plate photo",
-                         "X": float(xyz_of[pid][0]), "Y": float(xyz_of[pid][1]),
-                         "Z": float(xyz_of[pid][2])})  # fmt: skip
-        write_report_csv(files.path("__csv"), rows)
-        write_report_json(files.path("__json"), rows)
-        files.commit()
-    failed = len(rows) - written
-    lines = [f"{written} chip(s) of {v.chip_size} x {v.chip_size} px at {v.gsd:g} m in "
-             f"{folder}; {failed} point(s) without a chip"]  # fmt: skip
-    lines += [f"  {r['point_id']}: {r['reason']}" for r in rows if r["status"] != "ok"]
-    return JobResult(results={"CHIP_COUNT": written, "FAILED_COUNT": failed}, lines=lines,
-                     data=rows)  # fmt: skip
+
+
+def _chip(v: Values, pid: str, xyz, pair, camera, options, crs, files) -> dict:
+    """Make point ``pid``'s chip and write it into its temporary of ``files`` when it could
+    be made: its report row (the plate's and the photo's azimuths from the pair's row, else
+    the parameters)."""
+    from ..io.control_chips import read_grey_photo, write_chip
+    from ..photo.control_chips import ChipResult, make_chip
+    from ..photo.control_plate import PlateGeometry
+
+    plate = PlateGeometry(
+        v.outer_side, v.inner_side, v.plate_height,
+        v.plate_azimuth if math.isnan(pair.plate_azimuth_deg) else pair.plate_azimuth_deg,
+    )  # fmt: skip
+    az = v.photo_azimuth if math.isnan(pair.photo_azimuth_deg) else pair.photo_azimuth_deg
+    ref = read_grey_photo(pair.plate_photo, camera.width_px, camera.height_px)
+    free = (read_grey_photo(pair.free_photo, camera.width_px, camera.height_px)
+            if pair.free_photo else None)  # fmt: skip
+    res: ChipResult = make_chip(pid, xyz, ref, free, camera, plate, options, az)
+    row = _report_row(pid, xyz, pair, res)
+    if res.status == "ok":
+        meta = {
+            "LIDARPHOTO_POINT_ID": pid,
+            "LIDARPHOTO_POINT": ",".join(repr(float(c)) for c in xyz),
+            "LIDARPHOTO_PLANE_Z": repr(float(xyz[2])),
+            "LIDARPHOTO_SOURCE": res.source,
+            "LIDARPHOTO_GSD": repr(v.gsd),
+        }
+        write_chip(files.path(pid), res.chip, res.geotransform, crs, meta)
+    else:
+        log.warning("point %s: %s", pid, res.reason)
+    return row

@@ -99,78 +99,27 @@ def _floats(text: str | None, n: int) -> tuple[float, ...] | None:
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the orthophotos' grids and metadata, mosaic tile by tile, trace the seamlines."""
     import numpy as np
-    import pyproj
 
-    from ..errors import InputError
-    from ..geometry.grid import Grid
     from ..io.images import list_image_files
     from ..io.raster import RasterReader, polygonize
-    from ..io.raster_write import GeoTiffWriter
     from ..io.tables import write_csv_atomic
-    from ..photo.mosaic import MosaicOptions, MosaicSource, mosaic_grid, mosaic_tiles
-    from .common import compression_args
-    from .orthorectify import failures_named
+    from ..photo.mosaic import MosaicOptions, mosaic_grid, mosaic_method
 
     files = list_image_files(v.orthophotos, ("ORTHOPHOTOS", "one image would count twice"))
     readers = [RasterReader(f) for f in files]
     try:
-        first = readers[0].info
-        crs = pyproj.CRS.from_wkt(first.crs_wkt) if first.crs_wkt else None
-        sources = []
-        for f, r in zip(files, readers):
-            info = r.info
-            gt = info.geotransform
-            if gt is None or gt[2] or gt[4] or not math.isclose(gt[1], -gt[5], rel_tol=1e-9):
-                raise InputError("not a north-up raster with square cells", path=str(f))
-            if (info.bands, info.dtype) != (first.bands, first.dtype):
-                raise InputError(f"{info.bands} band(s) of {info.dtype}, the first orthophoto "
-                                 f"{first.bands} of {first.dtype}", path=str(f))  # fmt: skip
-            other = pyproj.CRS.from_wkt(info.crs_wkt) if info.crs_wkt else None
-            if (other is None) != (crs is None) or (
-                other is not None and not other.equals(crs, ignore_axis_order=True)
-            ):
-                raise InputError(f"CRS '{other.name if other else 'none'}' differs from the "
-                                 f"first orthophoto's '{crs.name if crs else 'none'}'",
-                                 path=str(f))  # fmt: skip
-            meta = info.metadata
-            centre = _floats(meta.get("LIDARPHOTO_CENTRE"), 3)
-            ground = _floats(meta.get("LIDARPHOTO_GROUND_Z"), 1)
-            pg = _floats(meta.get("LIDARPHOTO_PRINCIPAL_GROUND"), 2)
-            name = meta.get("LIDARPHOTO_IMAGE_ID") or f.stem
-            sources.append(MosaicSource(name, Grid(gt[0], gt[3], gt[1], info.height, info.width),
-                                        centre, ground[0] if ground else None, pg))  # fmt: skip
-        method = v.method
-        if method == "nadir" and any(s.centre is None for s in sources):
-            # a nadir angle and a distance are not comparable scores: one rule for all
+        crs, sources = _sources(files, readers)
+        method = mosaic_method(v.method, sources)
+        if method != v.method:
             log.warning("some orthophotos have no perspective centre in their metadata (not "
                         "made by orthorectify): every cell takes the nearest image centre")
-            method = "centre"
         grid = mosaic_grid(sources)
         options = options_from(MosaicOptions, SPEC, v, method=method)
-
-        def read(k: int, win: tuple[int, int, int, int]):
-            return readers[k].read(win), readers[k].read_mask(win)
-
         # seamlines are traced on a raster of the chosen image (coarser for huge mosaics)
         step = max(1, math.ceil(math.sqrt(grid.rows * grid.cols / MAX_LABEL_CELLS)))
-        labels = np.full((-(-grid.rows // step), -(-grid.cols // step)), -1, np.int16)
-        photometric = "RGB" if first.bands == 3 and first.dtype == np.uint8 else None
         mosaic, seams = stages(progress, 0.9, 0.1)
-        covered = 0
-        meta_out = {"LIDARPHOTO_SOURCES": ",".join(s.name for s in sources)}
-        with failures_named(out.target("OUTPUT")), GeoTiffWriter(
-                out.path("OUTPUT"), grid.cols, grid.rows, first.bands, first.dtype,
-                grid.geotransform, crs, mask=True, tile=512, photometric=photometric,
-                metadata=meta_out, **compression_args(v.compression)) as writer:  # fmt: skip
-            for tile in mosaic_tiles(sources, grid, read, first.bands, first.dtype, options,
-                                     progress=mosaic, should_stop=should_stop):  # fmt: skip
-                writer.write(tile.data, tile.col0, tile.row0, tile.valid)
-                covered += int(np.count_nonzero(tile.valid))
-                r_first = (-tile.row0) % step
-                c_first = (-tile.col0) % step
-                sub = tile.label[r_first::step, c_first::step]
-                lr, lc = (tile.row0 + r_first) // step, (tile.col0 + c_first) // step
-                labels[lr : lr + sub.shape[0], lc : lc + sub.shape[1]] = sub
+        covered, labels = _write_mosaic(v, out, readers, sources, grid, crs, options, step,
+                                        mosaic, should_stop)  # fmt: skip
     finally:
         for r in readers:
             r.close()
@@ -193,3 +142,75 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         data=MosaicResult(seamlines, crs.to_wkt() if crs else "", str(out.target("OUTPUT"))),
     )  # fmt: skip
 
+
+def _sources(files: list, readers: list) -> tuple:
+    """(the CRS, one :class:`MosaicSource` per orthophoto from its grid and metadata), each
+    checked: north-up with square cells, the bands, type and CRS of the first."""
+    import pyproj
+
+    from ..errors import InputError
+    from ..geometry.grid import Grid
+    from ..photo.mosaic import MosaicSource
+
+    first = readers[0].info
+    crs = pyproj.CRS.from_wkt(first.crs_wkt) if first.crs_wkt else None
+    sources = []
+    for f, r in zip(files, readers):
+        info = r.info
+        gt = info.geotransform
+        if gt is None or gt[2] or gt[4] or not math.isclose(gt[1], -gt[5], rel_tol=1e-9):
+            raise InputError("not a north-up raster with square cells", path=str(f))
+        if (info.bands, info.dtype) != (first.bands, first.dtype):
+            raise InputError(f"{info.bands} band(s) of {info.dtype}, the first orthophoto "
+                             f"{first.bands} of {first.dtype}", path=str(f))  # fmt: skip
+        other = pyproj.CRS.from_wkt(info.crs_wkt) if info.crs_wkt else None
+        if (other is None) != (crs is None) or (
+            other is not None and not other.equals(crs, ignore_axis_order=True)
+        ):
+            raise InputError(f"CRS '{other.name if other else 'none'}' differs from the "
+                             f"first orthophoto's '{crs.name if crs else 'none'}'",
+                             path=str(f))  # fmt: skip
+        meta = info.metadata
+        centre = _floats(meta.get("LIDARPHOTO_CENTRE"), 3)
+        ground = _floats(meta.get("LIDARPHOTO_GROUND_Z"), 1)
+        pg = _floats(meta.get("LIDARPHOTO_PRINCIPAL_GROUND"), 2)
+        name = meta.get("LIDARPHOTO_IMAGE_ID") or f.stem
+        sources.append(MosaicSource(name, Grid(gt[0], gt[3], gt[1], info.height, info.width),
+                                    centre, ground[0] if ground else None, pg))  # fmt: skip
+    return crs, sources
+
+
+def _write_mosaic(v: Values, out, readers, sources, grid, crs, options, step: int, progress,
+                  should_stop) -> tuple:  # fmt: skip
+    """Write OUTPUT tile by tile: (the cells with data, the raster of the chosen image's index
+    every ``step`` cells, -1 where none)."""
+    import numpy as np
+
+    from ..io.raster_write import GeoTiffWriter
+    from ..photo.mosaic import mosaic_tiles
+    from .common import compression_args
+    from .orthorectify import failures_named
+
+    first = readers[0].info
+
+    def read(k: int, win: tuple[int, int, int, int]):
+        return readers[k].read(win), readers[k].read_mask(win)
+
+    labels = np.full((-(-grid.rows // step), -(-grid.cols // step)), -1, np.int16)
+    photometric = "RGB" if first.bands == 3 and first.dtype == np.uint8 else None
+    covered = 0
+    meta_out = {"LIDARPHOTO_SOURCES": ",".join(s.name for s in sources)}
+    with failures_named(out.target("OUTPUT")), GeoTiffWriter(
+            out.path("OUTPUT"), grid.cols, grid.rows, first.bands, first.dtype,
+            grid.geotransform, crs, mask=True, tile=512, photometric=photometric,
+            metadata=meta_out, **compression_args(v.compression)) as writer:  # fmt: skip
+        for tile in mosaic_tiles(sources, grid, read, first.bands, first.dtype, options,
+                                 progress=progress, should_stop=should_stop):  # fmt: skip
+            writer.write(tile.data, tile.col0, tile.row0, tile.valid)
+            covered += int(np.count_nonzero(tile.valid))
+            r_first = (-tile.row0) % step
+            c_first = (-tile.col0) % step
+            sub = tile.label[r_first::step, c_first::step]
+            lr, lc = (tile.row0 + r_first) // step, (tile.col0 + c_first) // step
+            labels[lr : lr + sub.shape[0], lc : lc + sub.shape[1]] = sub
+    return covered, labels

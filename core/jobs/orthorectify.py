@@ -106,16 +106,11 @@ class OrthoFile:
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Check every input, then orthorectify the images one after the other."""
-    import numpy as np
-
-    from ..errors import InputError
-    from ..geometry.frames import LocalFrame, MappingFrame, parse_crs
+    from ..geometry.frames import parse_crs
     from ..geometry.raycast import DsmTracer
     from ..io.atomic import OutputSet
-    from ..io.raster import RasterReader
-    from ..io.raster_write import GeoTiffWriter
-    from ..photo.orthophoto import OrthoOptions, OrthoProjector, _lens_lattice, auto_gsd
-    from .common import compression_args
+    from ..photo.ortho_block import block_gsd, block_projectors, median_height
+    from ..photo.orthophoto import OrthoOptions
 
     mapping = parse_crs(v.crs, what="mapping CRS")
     extent = _extent(v.extent)
@@ -129,103 +124,101 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     dsm = _dsm_in(v, mapping, load, should_stop)
     # the skipping pyramid of the ray casting only for true orthophotos (built once)
     surface = DsmTracer.build(dsm) if options.true_ortho else dsm
-    zmin = dsm.z_range[0]
-    lens = _lens_lattice(camera)
-    g = dsm.grid  # one ENU frame (at the DSM's centre) and one lens lattice for every image
-    local = LocalFrame.at_map_point(MappingFrame(mapping), [g.x0 + g.cols * g.cell / 2,
-                                                           g.y_top - g.rows * g.cell / 2,
-                                                           zmin])  # fmt: skip
-    projectors = {f.stem: OrthoProjector.build(camera, eo.xyz[row_of[f.stem]],
-                                               eo.opk[row_of[f.stem]], surface, mapping,
-                                               local=local, lens=lens) for f in images}  # fmt: skip
+    poses = {f.stem: (eo.xyz[row_of[f.stem]], eo.opk[row_of[f.stem]]) for f in images}
+    projectors = block_projectors(camera, poses, dsm, surface, mapping)
     boxes = {k: p.footprint() for k, p in projectors.items()}
-    ground_z = {k: _median_height(dsm, b) for k, b in boxes.items()}
-    gsd = float(v.gsd)
-    if gsd == 0:
-        gsds = [auto_gsd(camera, p.xyz[2], ground_z[k]) for k, p in projectors.items()
-                if np.isfinite(ground_z[k])]  # fmt: skip
-        if not gsds:
-            raise InputError("no image sees the DSM", path=str(v.dsm))
-        gsd = float(np.median(gsds))
+    ground_z = {k: median_height(dsm, b) for k, b in boxes.items()}
+    gsd = block_gsd(options, camera, projectors, ground_z, path=str(v.dsm))
     grids = _grids(boxes, extent, gsd, infos, folder)
+    _warn_beyond(projectors, boxes, ground_z)
+    # an image's overview levels are written (GDAL compressing them) while the next image's
+    # tiles are computed; the files are renamed into place once all are whole
     written: list[OrthoFile] = []
-    total_valid = total_occluded = 0
-    beyond = {k: _beyond_dsm(p, ground_z[k]) for k, p in projectors.items()
+    finishing: list[tuple[Future, str]] = []  # and the image of each
+    with OutputSet({k: str(p) for k, p in targets.items()}, inputs) as files, \
+            ThreadPoolExecutor(max_workers=1) as finisher:  # fmt: skip
+        try:
+            for m, f in enumerate(images):
+                if f.stem not in grids:
+                    continue
+                sub = None if work is None else (
+                    lambda fr, m=m: work((m + fr) / len(images)))  # fmt: skip
+                done, job = _write_image(v, f, projectors[f.stem], grids[f.stem],
+                                         ground_z[f.stem], options, files, finisher, mapping,
+                                         targets[f.stem], sub, should_stop)  # fmt: skip
+                written.append(done)
+                if job is not None:
+                    finishing.append((job, f.stem))
+        finally:
+            wait([job for job, _ in finishing])  # nothing is being written when set discarded
+        for job, name in finishing:
+            # a failure to write an image's levels fails the job: nothing renamed
+            with failures_named(targets[name]):
+                job.result()
+        files.commit()
+    occluded = sum(w.occluded_cells for w in written)
+    frac = occluded / max(sum(w.valid_cells for w in written) + occluded, 1)
+    lines = [f"{len(written)} orthophoto(s) of {gsd:g} in {folder}"
+             + (f"; {100 * frac:.1f} % of the cells occluded" if options.true_ortho else "")]
+    return JobResult(results={"IMAGE_COUNT": len(written), "GSD_USED": gsd,
+                              "OCCLUDED_FRACTION": frac}, lines=lines, data=written)  # fmt: skip
+
+
+def _write_image(v: Values, f: Path, proj, grid, ground_z: float, options, files, finisher,
+                 mapping, target: Path, progress, should_stop):  # fmt: skip
+    """Orthorectify image ``f`` into its temporary of ``files``: (its :class:`OrthoFile`, the
+    future writing its overview levels, or None)."""
+    import numpy as np
+
+    from ..io.raster import RasterReader
+    from ..io.raster_write import GeoTiffWriter
+    from .common import compression_args
+
+    name = f.stem
+    nadir = proj.ground_points([proj.camera.principal_point_px], ground_z)[0]
+    meta = {
+        "LIDARPHOTO_IMAGE_ID": name,
+        "LIDARPHOTO_SOURCE": os.path.basename(str(f)),
+        "LIDARPHOTO_CENTRE": ",".join(repr(float(c)) for c in proj.xyz),
+        "LIDARPHOTO_GROUND_Z": repr(float(ground_z)),
+        "LIDARPHOTO_PRINCIPAL_GROUND": ",".join(repr(float(c)) for c in nadir),
+        "LIDARPHOTO_TRUE_ORTHO": "yes" if options.true_ortho else "no",
+    }
+    valid = occluded = 0
+    with RasterReader(f) as src:
+        info = src.info
+        photometric = "RGB" if info.bands == 3 and info.dtype == np.uint8 else None
+        writer = GeoTiffWriter(files.path(name), grid.cols, grid.rows, info.bands, info.dtype,
+                               grid.geotransform, mapping, mask=True, tile=512,
+                               photometric=photometric, metadata=meta,
+                               **compression_args(v.compression))  # fmt: skip
+        try:
+            for tile in _tiles(proj, grid, src, info, options, progress, should_stop):
+                writer.write(tile.data, tile.col0, tile.row0, tile.valid)
+                valid += int(np.count_nonzero(tile.valid))
+                occluded += tile.occluded
+        except BaseException:
+            with contextlib.suppress(OSError):  # the first error is the one told
+                writer.close(overviews=False)
+            raise
+        with failures_named(target):
+            job = writer.close(finish_in=finisher)
+    log.info("%s: %d x %d cells of %g, %d with data%s", name, grid.cols, grid.rows, grid.cell,
+             valid, f", {occluded} occluded" if options.true_ortho else "")  # fmt: skip
+    return OrthoFile(name, str(target), grid.cols, grid.rows, valid, occluded), job
+
+
+def _warn_beyond(projectors: dict, boxes: dict, ground_z: dict) -> None:
+    """Warn of the images whose border reaches beyond the DSM (no data there)."""
+    from ..photo.ortho_block import share_beyond_dsm
+
+    beyond = {k: share_beyond_dsm(p, ground_z[k]) for k, p in projectors.items()
               if boxes[k] is not None}  # fmt: skip
     beyond = {k: v for k, v in beyond.items() if v > 0}
     if beyond:
         log.warning("the DSM does not cover all of %d image(s) (share of the image's border "
                     "beyond it: %s): no data there", len(beyond),
                     ", ".join(f"{k} {round(100 * v)} %" for k, v in beyond.items()))  # fmt: skip
-    # an image's overview levels are written (GDAL compressing them) while the next image's
-    # tiles are computed; the files are renamed into place once all are whole
-    finishing: list[Future] = []
-    finished: list[str] = []  # the image of each of them
-    with OutputSet({k: str(p) for k, p in targets.items()}, inputs) as files, \
-            ThreadPoolExecutor(max_workers=1) as finisher:  # fmt: skip
-        try:
-            for m, f in enumerate(images):
-                name = f.stem
-                proj = projectors[name]
-                grid = grids.get(name)
-                if grid is None:
-                    continue
-                sub = None if work is None else (
-                    lambda fr, m=m: work((m + fr) / len(images)))  # fmt: skip
-                centre_px = camera.principal_point_px
-                nadir = proj.ground_points([centre_px], ground_z[name])[0]
-                meta = {
-                    "LIDARPHOTO_IMAGE_ID": name,
-                    "LIDARPHOTO_SOURCE": os.path.basename(str(f)),
-                    "LIDARPHOTO_CENTRE": ",".join(repr(float(c)) for c in proj.xyz),
-                    "LIDARPHOTO_GROUND_Z": repr(float(ground_z[name])),
-                    "LIDARPHOTO_PRINCIPAL_GROUND": ",".join(repr(float(c)) for c in nadir),
-                    "LIDARPHOTO_TRUE_ORTHO": "yes" if options.true_ortho else "no",
-                }
-                valid = occluded = 0
-                with RasterReader(f) as src:
-                    info = src.info
-                    photometric = "RGB" if info.bands == 3 and info.dtype == np.uint8 else None
-                    writer = GeoTiffWriter(files.path(name), grid.cols, grid.rows, info.bands,
-                                           info.dtype, grid.geotransform, mapping, mask=True,
-                                           tile=512, photometric=photometric, metadata=meta,
-                                           **compression_args(v.compression))  # fmt: skip
-                    try:
-                        for tile in _tiles(proj, grid, src, info, options, sub, should_stop):
-                            writer.write(tile.data, tile.col0, tile.row0, tile.valid)
-                            valid += int(np.count_nonzero(tile.valid))
-                            occluded += tile.occluded
-                    except BaseException:
-                        with contextlib.suppress(OSError):  # the first error is the one told
-                            writer.close(overviews=False)
-                        raise
-                    with failures_named(targets[name]):
-                        job = writer.close(finish_in=finisher)
-                    if job is not None:
-                        finishing.append(job)
-                        finished.append(name)
-                total_valid += valid
-                total_occluded += occluded
-                written.append(OrthoFile(name, str(targets[name]), grid.cols, grid.rows, valid,
-                                         occluded))  # fmt: skip
-                log.info("%s: %d x %d cells of %g, %d with data%s", name, grid.cols, grid.rows,
-                         gsd, valid,
-                         f", {occluded} occluded" if options.true_ortho else "")  # fmt: skip
-        finally:
-            wait(finishing)  # no file is still being written when the set is discarded
-        for job, name in zip(finishing, finished):
-            # a failure to write an image's levels fails the job: nothing renamed
-            with failures_named(targets[name]):
-                job.result()
-        files.commit()
-    frac = total_occluded / max(total_valid + total_occluded, 1)
-    lines = [f"{len(written)} orthophoto(s) of {gsd:g} in {folder}"
-             + (f"; {100 * frac:.1f} % of the cells occluded" if options.true_ortho else "")]
-    return JobResult(
-        results={"IMAGE_COUNT": len(written), "GSD_USED": gsd, "OCCLUDED_FRACTION": frac},
-        lines=lines,
-        data=written,
-    )
 
 
 def _read_inputs(v: Values, mapping):
@@ -368,38 +361,3 @@ def _tiles(proj, grid, src, info, options, progress, should_stop):
 
     return orthorectify_tiles(proj, grid, read, info.bands, info.dtype, options,
                               progress=progress, should_stop=should_stop)  # fmt: skip
-
-
-def _median_height(dsm, box) -> float:
-    """Median surface height inside the box (a subsample of its cells)."""
-    import numpy as np
-    if box is None:
-        return math.nan
-    g = dsm.grid
-    c0 = max(int((box[0] - g.x0) / g.cell), 0)
-    c1 = min(math.ceil((box[2] - g.x0) / g.cell), g.cols)
-    r0 = max(int((g.y_top - box[3]) / g.cell), 0)
-    r1 = min(math.ceil((g.y_top - box[1]) / g.cell), g.rows)
-    sub = dsm.heights[r0:r1, c0:c1]
-    step = max(1, int(math.sqrt(sub.size / 250000)))
-    vals = sub[::step, ::step]
-    vals = vals[np.isfinite(vals)]
-    return float(np.median(vals)) if vals.size else math.nan
-
-
-def _beyond_dsm(proj, ground_z: float) -> float:
-    """Share of the image's border whose ground (at the median height) lies beyond the DSM."""
-    import numpy as np
-    cam = proj.camera
-    k = np.linspace(0.0, 1.0, 33)
-    w, h = cam.width_px, cam.height_px
-    border = np.vstack([np.column_stack([k * w, np.zeros_like(k)]),
-                        np.column_stack([k * w, np.full_like(k, h)]),
-                        np.column_stack([np.zeros_like(k), k * h]),
-                        np.column_stack([np.full_like(k, w), k * h])])  # fmt: skip
-    xy = proj.ground_points(border, ground_z)
-    g = proj.dsm.grid
-    xc, yc = proj.dsm.centre_origin
-    inside = ((xy[:, 0] >= xc) & (xy[:, 0] <= xc + (g.cols - 1) * g.cell)
-              & (xy[:, 1] <= yc) & (xy[:, 1] >= yc - (g.rows - 1) * g.cell))  # fmt: skip
-    return float(1.0 - inside.mean())

@@ -17,7 +17,7 @@ from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
-_OPTIONS = Fields("photo.resection", "ResectionOptions")
+_OPTIONS = Fields("photo.resection_options", "ResectionOptions")
 
 SPEC = AlgorithmSpec(
     name="resection",
@@ -85,7 +85,7 @@ lines parallel).""",
               help="empty: start values only; given: weighted observations"),
         Param("IMAGES", "string", "Images (comma separated; empty: all)", "", optional=True),
         Param("MODEL", "enum", "Line model", _OPTIONS.model,
-              options=Ref("photo.resection", "MODELS"),
+              options=Ref("photo.resection_options", "MODELS"),
               labels=("coplanarity (no parametrisation)",
                       "equivalent planes (Tommaselli & Tozzi 1996)")),
         Param("ESTIMATE_INTERIOR", "boolean", "Refine focal length and principal point",
@@ -116,25 +116,55 @@ lines parallel).""",
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the inputs, resect each image, write the outputs."""
-    from pathlib import Path
-
     import numpy as np
 
     from ..errors import Cancelled, InputError, LidarPhotoError, stop_if_asked
-    from ..geometry.frames import LocalFrame, MappingFrame, check_area_of_use
-    from ..io.atomic import write_text_atomic
-    from ..io.camera import read_camera_json
-    from ..io.observations import read_observations_csv
-    from ..io.orientation import read_eo_csv
-    from ..io.resection import read_line_control_csv, read_point_control_csv
     from ..photo.resection import ResectionOptions
-    from ..photo.resection_map import image_inputs, resect_in_map
-    from ..quality.resection_html import render_resection_html
+    from ..photo.resection_map import control_frame, image_inputs, resect_in_map
 
     if not v.observations and not v.line_observations:
         raise InputError("give OBSERVATIONS or LINE_OBSERVATIONS (the measured image points)")
     if not v.control_points and not v.control_lines:
         raise InputError("give CONTROL_POINTS or CONTROL_LINES (the object coordinates)")
+    frame, camera, obs, points, lines = _read_inputs(v)
+    approx, prior = _approximations(v, frame)
+    images = [s.strip() for s in (v.images or "").split(",") if s.strip()]
+    inputs = image_inputs(obs, points, lines, images or None)
+    options = options_from(ResectionOptions, SPEC, v, eo_prior_sigma=prior)
+    local = control_frame(inputs, frame)
+    runs = []
+    for n, item in enumerate(inputs):
+        stop_if_asked(should_stop, "resecting")
+        sub = None if progress is None else (
+            lambda f, n=n: progress((n + f) / len(inputs)))  # fmt: skip
+        start = approx.get(item.image_id)
+        eo0 = None if start is None else np.concatenate([start[0], start[1]])
+        try:
+            res = resect_in_map(item.image_id, item.data, camera, frame, options, eo0, local,
+                                progress=sub, should_stop=should_stop)  # fmt: skip
+        except LidarPhotoError as exc:
+            if isinstance(exc, Cancelled):
+                raise
+            raise _prefixed(exc, item.image_id) from None
+        runs.append(ImageRun(item, res, start))
+    _write_outputs(v, out, runs, camera, obs, points, lines, frame)
+    sigma0 = max((r.result.result.sigma0 for r in runs), default=math.nan)
+    return JobResult(results={"IMAGE_COUNT": len(runs), "SIGMA0": sigma0},
+                     lines=_summary_lines(runs), data=runs)  # fmt: skip
+
+
+def _read_inputs(v: Values) -> tuple:
+    """The frame, the camera, the image observations (points and lines, a file given twice
+    read once) and the control points and lines, checked against the CRS's area of use."""
+    from pathlib import Path
+
+    import numpy as np
+
+    from ..geometry.frames import MappingFrame, check_area_of_use
+    from ..io.camera import read_camera_json
+    from ..io.observations import read_observations_csv
+    from ..io.resection import read_line_control_csv, read_point_control_csv
+
     frame = MappingFrame.from_user_input(v.crs)
     camera = read_camera_json(v.camera)
     points = read_point_control_csv(v.control_points) if v.control_points else None
@@ -158,6 +188,16 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         if xyz is not None and len(xyz):
             check_area_of_use(frame.crs, xyz.min(axis=0), xyz.max(axis=0), what=f"the {what}",
                               path=path)  # fmt: skip
+    return frame, camera, obs, points, lines
+
+
+def _approximations(v: Values, frame) -> tuple[dict, tuple | None]:
+    """The approximate orientations by image id ((xyz, opk, time, group)) and the sigmas of
+    their prior (m, m, m, rad x 3; None without APPROX_EO_SIGMAS)."""
+    from ..errors import InputError
+    from ..geometry.frames import check_area_of_use
+    from ..io.orientation import read_eo_csv
+
     approx = {}
     if v.approx_eo:
         table = read_eo_csv(v.approx_eo)
@@ -171,29 +211,14 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             raise InputError("APPROX_EO_SIGMAS needs APPROX_EO")
         s = v.approx_eo_sigmas
         prior = (*s[:3], *(math.radians(a) for a in s[3:]))
-    images = [s.strip() for s in (v.images or "").split(",") if s.strip()]
-    inputs = image_inputs(obs, points, lines, images or None)
-    options = options_from(ResectionOptions, SPEC, v, eo_prior_sigma=prior)
-    everything = [d.data for d in inputs]
-    ctrl = np.vstack([np.vstack([d.xyz, d.line_p1, d.line_p2]) for d in everything])
-    if not len(ctrl):
-        raise InputError("no observation matches the control: check the point and line ids")
-    local = LocalFrame.at_map_point(frame, ctrl.mean(axis=0))
-    runs = []
-    for n, item in enumerate(inputs):
-        stop_if_asked(should_stop, "resecting")
-        sub = None if progress is None else (
-            lambda f, n=n: progress((n + f) / len(inputs)))  # fmt: skip
-        start = approx.get(item.image_id)
-        eo0 = None if start is None else np.concatenate([start[0], start[1]])
-        try:
-            res = resect_in_map(item.image_id, item.data, camera, frame, options, eo0, local,
-                                progress=sub, should_stop=should_stop)  # fmt: skip
-        except LidarPhotoError as exc:
-            if isinstance(exc, Cancelled):
-                raise
-            raise _prefixed(exc, item.image_id) from None
-        runs.append(ImageRun(item, res, start))
+    return approx, prior
+
+
+def _write_outputs(v: Values, out, runs: list, camera, obs, points, lines, frame) -> None:
+    """The requested EO table, residuals and report."""
+    from ..io.atomic import write_text_atomic
+    from ..quality.resection_html import render_resection_html
+
     rows = [run_eo_row(r) for r in runs]
     if out.requested("OUTPUT_EO"):
         from ..io.resection import write_eo_sigma_csv
@@ -208,6 +233,12 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if out.requested("OUTPUT_HTML"):
         write_text_atomic(out.path("OUTPUT_HTML"),
                           render_resection_html(runs, residuals, settings))  # fmt: skip
+
+
+def _summary_lines(runs: list) -> list[str]:
+    """The log's table: one line per image."""
+    import numpy as np
+
     lines_out = [
         f"{'image':16} {'X':>12} {'Y':>13} {'Z':>9} {'omega':>9} {'phi':>9} {'kappa':>10} "
         f"{'sigma0':>7} {'pts':>4} {'lns':>4} test"
@@ -221,9 +252,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             f"{res.sigma0:7.3f} {r.image.data.n_points:4d} {r.image.data.n_lines:4d} "
             f"{'passed' if res.chi2_passed else 'FAILED'}"
         )
-    sigma0 = max((r.result.result.sigma0 for r in runs), default=math.nan)
-    return JobResult(results={"IMAGE_COUNT": len(runs), "SIGMA0": sigma0}, lines=lines_out,
-                     data=runs)  # fmt: skip
+    return lines_out
 
 
 def _check_control_rows(obs, points) -> None:

@@ -121,13 +121,9 @@ track's first-image measurement: the median of its track's refined sigmas.""",
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the images one by one (features only are kept), match, write the tables."""
     from ..errors import InputError
-    from ..io.camera import read_camera_json
     from ..io.images import decode_factor, image_size, list_image_files, read_gray
     from ..io.observations import write_observations_csv
-    from ..io.orientation import read_eo_csv
-    from ..io.tables import write_csv_atomic
     from ..photo.tie_options import TiePointOptions
-    from ..photo.tie_pairs import footprints
     from ..photo.tie_points import detect_features, reduction_factor, tie_points
 
     options = options_from(TiePointOptions, SPEC, v)
@@ -135,27 +131,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if len(files) < 2:
         raise InputError("tie points need at least two images")
     ids = [f.stem for f in files]
-    if bool(v.eo) != bool(v.camera):
-        raise InputError("give both the exterior orientation and the camera (footprint pairs) "
-                         "or neither")  # fmt: skip
-    footprint = None
-    camera = None
-    if v.eo:
-        camera = read_camera_json(v.camera)
-        eo = read_eo_csv(v.eo)
-        _check_eo_coordinates(eo, v.crs, v.eo, v.height)
-        row = {name: k for k, name in enumerate(eo.image_id)}
-        fps = footprints(camera, eo.xyz, eo.opk, v.height)
-        footprint = [fps[row[i]] if i in row else None for i in ids]
-        missing = [i for i in ids if i not in row]
-        if len(missing) == len(ids):
-            raise InputError("no image has a row in the exterior orientation (image_id = "
-                             "file name without extension)", path=v.eo)  # fmt: skip
-        if missing:
-            log.warning("%d image(s) without exterior orientation, paired with every image: "
-                        "%s", len(missing), ", ".join(missing[:10]))  # fmt: skip
-    elif options.pair_mode == "footprints":
-        raise InputError("footprint pairs need EO and CAMERA")
+    camera, footprint = _footprints(v, ids, options)
     sizes = [image_size(f) for f in files]  # every header read before any work
     if camera is not None:
         for f, (w, h) in zip(files, sizes):
@@ -185,11 +161,63 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                          f"matched; dropped pairs: {s['dropped_pairs'] or 'none'}")  # fmt: skip
     write_observations_csv(out.path("OUTPUT_OBSERVATIONS"), res.observations())
     if out.requested("OUTPUT_PAIRS"):
-        rows = ((ids[p.i], ids[p.j], f"{p.overlap:.4g}", res.features[p.i], res.features[p.j],
-                 p.n_ratio, p.n_mutual, p.n_inliers,
-                 f"{np_median(p.residual_px):.4g}" if p.residual_px.size else "", p.status)
-                for p in res.pairs)  # fmt: skip
-        write_csv_atomic(out.path("OUTPUT_PAIRS"), PAIR_COLUMNS, rows)
+        _write_pairs(out.path("OUTPUT_PAIRS"), res, ids)
+    lines = _summary_lines(res, s)
+    for line in lines:
+        log.info("%s", line)
+    return JobResult(
+        results={"TRACK_COUNT": s["tracks"], "MEASUREMENT_COUNT": s["measurements"],
+                 "PAIRS_TRIED": s["pairs_tried"], "PAIRS_KEPT": s["pairs_kept"]},
+        lines=lines,
+        data=res,
+    )  # fmt: skip
+
+
+def _footprints(v: Values, ids: list[str], options) -> tuple:
+    """(camera, the ground footprint of each image or None) with EO and CAMERA, else (None,
+    None); refused when only one is given or footprint pairs lack them."""
+    from ..errors import InputError
+    from ..io.camera import read_camera_json
+    from ..io.orientation import read_eo_csv
+    from ..photo.tie_pairs import footprints
+
+    if bool(v.eo) != bool(v.camera):
+        raise InputError("give both the exterior orientation and the camera (footprint pairs) "
+                         "or neither")  # fmt: skip
+    if not v.eo:
+        if options.pair_mode == "footprints":
+            raise InputError("footprint pairs need EO and CAMERA")
+        return None, None
+    camera = read_camera_json(v.camera)
+    eo = read_eo_csv(v.eo)
+    _check_eo_coordinates(eo, v.crs, v.eo, v.height)
+    row = {name: k for k, name in enumerate(eo.image_id)}
+    fps = footprints(camera, eo.xyz, eo.opk, v.height)
+    footprint = [fps[row[i]] if i in row else None for i in ids]
+    missing = [i for i in ids if i not in row]
+    if len(missing) == len(ids):
+        raise InputError("no image has a row in the exterior orientation (image_id = "
+                         "file name without extension)", path=v.eo)  # fmt: skip
+    if missing:
+        log.warning("%d image(s) without exterior orientation, paired with every image: "
+                    "%s", len(missing), ", ".join(missing[:10]))  # fmt: skip
+    return camera, footprint
+
+
+def _write_pairs(path: str, res, ids: list[str]) -> None:
+    """OUTPUT_PAIRS: one row per image pair tried."""
+    from ..io.tables import write_csv_atomic
+
+    rows = ((ids[p.i], ids[p.j], f"{p.overlap:.4g}", res.features[p.i], res.features[p.j],
+             p.n_ratio, p.n_mutual, p.n_inliers,
+             f"{np_median(p.residual_px):.4g}" if p.residual_px.size else "", p.status)
+            for p in res.pairs)  # fmt: skip
+    write_csv_atomic(path, PAIR_COLUMNS, rows)
+
+
+def _summary_lines(res, s: dict) -> list[str]:
+    """The log's summary of the matching (``s``: its summary), the refinement and what was
+    dropped."""
     lines = [
         f"{s['images']} images, {sum(res.features)} features; pairs: {s['pairs_kept']} of "
         f"{s['pairs_tried']} kept (inliers per pair: median {s['inliers_median']:g}, min "
@@ -214,14 +242,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if s["images_without_tie"]:
         lines.append(f"{len(s['images_without_tie'])} image(s) without tie points (no "
                      f"overlap matched): {', '.join(s['images_without_tie'][:20])}")  # fmt: skip
-    for line in lines:
-        log.info("%s", line)
-    return JobResult(
-        results={"TRACK_COUNT": s["tracks"], "MEASUREMENT_COUNT": s["measurements"],
-                 "PAIRS_TRIED": s["pairs_tried"], "PAIRS_KEPT": s["pairs_kept"]},
-        lines=lines,
-        data=res,
-    )  # fmt: skip
+    return lines
 
 
 def _check_eo_coordinates(eo, crs: str | None, path: str, height: float) -> None:

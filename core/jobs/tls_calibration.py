@@ -26,16 +26,13 @@ _D = Fields("tls.options", "CalibrationOptions")
 
 
 def _arcsec(radians: float) -> float:
-    from ..tls.aps import ARCSEC
+    from ..tls.ap_table import ARCSEC
 
     return radians / ARCSEC
 
 
 ANGLE_UNITS = ("degrees", "gon", "radians")
 DATUMS = ("inner", "reference")
-#: A median disagreement of target-to-target distances between stations beyond this
-#: (relative) is not a scanner error but a wrong angle unit or convention.
-MAX_DISTANCE_DISAGREEMENT = 0.005
 #: Name of station ``<station_id>``'s registered scan in OUTPUT_FOLDER (its suffix: .laz for
 #: a LAZ scan, .las for the others).
 REGISTERED_NAME = "{}_registered{}"
@@ -107,7 +104,7 @@ beginning with #).""",
               maximum=1e6, help="for rows without s_range, s_hz, s_vt (or s_x, s_y, s_z: "
               "the range sigma)"),
         Param("AP_SET", "enum", "Additional parameters", _D.ap_set,
-              options=Ref("tls.aps", "AP_SETS", convert=tuple),
+              options=Ref("tls.ap_table", "AP_SETS", convert=tuple),
               labels=("none (registration only)", "paper: a0, b1, b2, c0",
                       "extended (Lichti 2007): a0-a3, b1-b6, c0-c3")),
         Param("AP_TERMS", "string", "AP terms (overrides the set)", "", optional=True,
@@ -167,25 +164,45 @@ beginning with #).""",
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the tables, adjust, check the result, write the outputs."""
-    from ..errors import InputError
-    from ..io.atomic import write_text_atomic
-    from ..io.tls import (
-        read_tls_control_csv,
-        read_tls_observations_csv,
-        read_tls_stations_csv,
-        write_tls_aps_csv,
-        write_tls_residuals_csv,
-        write_tls_stations_csv,
-        write_tls_targets_csv,
-    )
     from ..lsq.results import rejection_test
     from ..quality.tls_html import render_tls_html
     from ..tls.aps import ARCSEC
     from ..tls.calibration import calibrate
-    from ..tls.network import distance_consistency
+    from ..tls.network import check_distance_consistency
     from ..tls.options import CalibrationOptions
 
     scans = _check_scans(v)
+    obs, control, stations = _read_inputs(v, scans)
+    median = check_distance_consistency(obs, path=v.observations)
+    aps = v.ap_terms.strip() if v.ap_terms else v.ap_set
+    options = options_from(CalibrationOptions, SPEC, v, ap_set=aps,
+                           tilt_sigma_rad=v.tilt_sigma * ARCSEC,
+                           reference_station=v.reference_station or None)  # fmt: skip
+    cal = calibrate(obs, control, stations, options, progress=progress,
+                    should_stop=should_stop)  # fmt: skip
+    settings = _settings(v, obs, control, aps, options, median)
+    rejections = rejection_test(cal.adjustment, options.snooping_alpha) if v.snooping else None
+    doubts = doubts_about(cal, v.max_sigma0, rejections)
+    warning = settle_doubts(
+        "TLS calibration", doubts, v.accept_doubtful, out,
+        lambda: render_tls_html(cal, settings, doubts, accepted=False, rejections=rejections),
+    )  # fmt: skip
+    _write_outputs(out, cal, settings, doubts, rejections, warning)
+    registered = _write_registered(v, scans, cal, out, should_stop) if scans else []
+    return JobResult(
+        results={"SIGMA0": cal.sigma0, "REJECTED": int(cal.rejected.sum()),
+                 "APS": ",".join(cal.ap_names), "REGISTERED": len(registered)},
+        lines=_summary_lines(cal, rejections, registered, warning),
+        data=cal,
+    )  # fmt: skip
+
+
+def _read_inputs(v: Values, scans: list) -> tuple:
+    """The observations, control and stations tables, checked against each other (every
+    scan, and every listed station, has observations; every observed station is listed)."""
+    from ..errors import InputError
+    from ..io.tls import read_tls_control_csv, read_tls_observations_csv, read_tls_stations_csv
+
     s_range_mm, s_hz, s_vt = v.default_sigmas
     obs = read_tls_observations_csv(v.observations, v.angle_unit,
                                     (s_range_mm / 1000.0, s_hz, s_vt))  # fmt: skip
@@ -212,22 +229,12 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         if c.id not in set(obs.target):
             log.warning("control target '%s' (%s, row %d) is not observed", c.id, v.control,
                         c.row)  # fmt: skip
-    median, pair = distance_consistency(obs)
-    if math.isfinite(median) and median > MAX_DISTANCE_DISAGREEMENT:
-        raise InputError(
-            f"the distances between targets disagree by {100 * median:.2g} % (median) between "
-            f"stations (worst: {pair}); a scanner error is a few 0.01 %: the angles are in "
-            "another unit (gon read as degrees?) or another convention (zenith angle instead "
-            "of elevation?)",
-            path=v.observations,
-        )
-    aps = v.ap_terms.strip() if v.ap_terms else v.ap_set
-    options = options_from(CalibrationOptions, SPEC, v, ap_set=aps,
-                           tilt_sigma_rad=v.tilt_sigma * ARCSEC,
-                           reference_station=v.reference_station or None)  # fmt: skip
-    cal = calibrate(obs, control, stations, options, progress=progress,
-                    should_stop=should_stop)  # fmt: skip
-    settings = {
+    return obs, control, stations
+
+
+def _settings(v: Values, obs, control, aps: str, options, median: float) -> dict:
+    """The settings shown in the report."""
+    return {
         "observations": f"{v.observations} ({len(obs)} rows, {len(obs.stations())} stations, "
         f"{len(obs.targets())} targets, {int(obs.face_two.sum())} in face II)",
         "control": f"{v.control} ({len(control)} targets)" if v.control else "none",
@@ -241,12 +248,19 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         "distance consistency between stations": "n/a" if not math.isfinite(median)
         else f"{median * 1e6:.0f} ppm (median)",
     }  # fmt: skip
-    rejections = rejection_test(cal.adjustment, options.snooping_alpha) if v.snooping else None
-    doubts = doubts_about(cal, v.max_sigma0, rejections)
-    warning = settle_doubts(
-        "TLS calibration", doubts, v.accept_doubtful, out,
-        lambda: render_tls_html(cal, settings, doubts, accepted=False, rejections=rejections),
-    )  # fmt: skip
+
+
+def _write_outputs(out, cal, settings: dict, doubts: list, rejections, warning: list) -> None:
+    """The requested tables and report of the accepted calibration."""
+    from ..io.atomic import write_text_atomic
+    from ..io.tls import (
+        write_tls_aps_csv,
+        write_tls_residuals_csv,
+        write_tls_stations_csv,
+        write_tls_targets_csv,
+    )
+    from ..quality.tls_html import render_tls_html
+
     if out.requested("OUTPUT_STATIONS"):
         write_tls_stations_csv(out.path("OUTPUT_STATIONS"), cal, warning)
     if out.requested("OUTPUT_APS"):
@@ -258,7 +272,11 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     if out.requested("OUTPUT_HTML"):
         page = render_tls_html(cal, settings, doubts, accepted=True, rejections=rejections)
         write_text_atomic(out.path("OUTPUT_HTML"), page)
-    registered = _write_registered(v, scans, cal, out, should_stop) if scans else []
+
+
+def _summary_lines(cal, rejections, registered: list, warning: list) -> list[str]:
+    """The log's summary: the APs, the selection, strong correlations, the registered scans
+    and the adjustment's figures."""
     lines = [*warning, f"{'AP':4} {'value':>10} {'sigma':>9} unit    t"]
     for a in cal.ap_report():
         lines.append(f"{a['name']:4} {a['value']:10.3f} {a['std']:9.3f} {a['unit']:7} "
@@ -275,12 +293,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                  f"{rejections.bound})")  # fmt: skip
     lines.append(f"sigma0 {cal.sigma0:.3f}, redundancy {cal.adjustment.redundancy}, global "
                  f"test {test}, {int(cal.rejected.sum())} observations rejected")  # fmt: skip
-    return JobResult(
-        results={"SIGMA0": cal.sigma0, "REJECTED": int(cal.rejected.sum()),
-                 "APS": ",".join(cal.ap_names), "REGISTERED": len(registered)},
-        lines=lines,
-        data=cal,
-    )  # fmt: skip
+    return lines
 
 
 def doubts_about(cal, max_sigma0: float, rejections) -> list:

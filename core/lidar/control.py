@@ -29,6 +29,7 @@ from ..errors import InputError, stop_if_asked
 from ..geometry.rotations import skew
 from ..i18n import Message, joined
 from ..i18n import mark as _t
+from .control_options import ControlOptions
 
 log = logging.getLogger(__name__)
 
@@ -316,26 +317,6 @@ class Rejection:
 
 
 @dataclass(frozen=True)
-class ControlOptions:
-    """Thresholds, in the cloud's units and degrees.
-
-    delta: adjacency distance between points of two planes; min_boundary: minimum common
-    boundary length; min_angle_deg: every pair of normals of a triple (or of a line) must
-    differ by at least this; max_condition: condition number limit of the 3 x 3 system;
-    max_support_distance: an LCP must lie within this distance of the points of each plane.
-    length_unit: the symbol of the cloud's length unit, for the messages ("m", "ft").
-    """
-
-    delta: float = 1.0
-    min_boundary: float = 2.0
-    min_angle_deg: float = 10.0
-    max_condition: float = 50.0
-    max_support_distance: float = 2.0
-    neighbours: int = 12
-    length_unit: str = "m"
-
-
-@dataclass(frozen=True)
 class LidarControl:
     points: list[ControlPoint]
     lines: list[ControlLine]
@@ -391,7 +372,7 @@ def lidar_control(
     planes: Sequence,
     points: Array,
     plane_ids: NDArray[np.integer],
-    options: ControlOptions = ControlOptions(),
+    options: ControlOptions = ControlOptions(),  # noqa: B008 - frozen, shared safely
     triples: Sequence[Sequence[int]] | None = None,
     pairs: Sequence[Sequence[int]] | None = None,
     progress: Callable[[float], None] | None = None,

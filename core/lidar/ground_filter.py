@@ -198,6 +198,26 @@ class GroundFilterResult:
     unit: str = "unknown"
     stats: dict[str, Any] = field(default_factory=dict)
 
+    def classify(self, classification: NDArray[Any], reset_non_ground: bool = False) -> None:
+        """Write the filter's classes into the cloud's LAS ``classification`` (N,), in place:
+        ground 2, low outliers 7; the other points keep their class (``reset_non_ground``:
+        all become 1, unclassified), except that a point the file had as ground which the
+        filter rejects becomes 1.
+
+        >>> r = GroundFilterResult(np.array([True, False, False]), np.array([False, False, True]),
+        ...     None, np.zeros((1, 1), np.float32), (0.0, 1.0, 0.0, 0.0, 0.0, -1.0), NODATA, (), (),
+        ...     None)
+        >>> cls = np.array([6, 2, 6], np.uint8); r.classify(cls); cls.tolist()
+        [2, 1, 7]
+        """
+        cls = classification
+        if reset_non_ground:
+            cls[:] = UNCLASSIFIED_CLASS
+        else:  # a point the file had as ground but the filter rejects becomes unclassified
+            cls[cls == GROUND_CLASS] = UNCLASSIFIED_CLASS  # (those it keeps get 2 again below)
+        cls[self.ground] = GROUND_CLASS
+        cls[self.low_outlier] = LOW_NOISE_CLASS
+
 
 def _min_grid(grid: Grid, flat: NDArray[np.int32], z: NDArray[Any]) -> NDArray[np.float32]:
     out = np.full(grid.rows * grid.cols, np.inf, dtype=np.float32)

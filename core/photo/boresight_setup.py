@@ -19,6 +19,7 @@ from ..geometry.frames import LocalFrame, MappingFrame
 from .boresight_models import (
     PoseSpec,
 )
+from .boresight_options import BoresightOptions
 from .georeference import Trajectory
 from .ins import INS_GRADES, InsGrade
 from .mount import Mount
@@ -39,55 +40,6 @@ Array = NDArray[np.float64]
 ARCSEC = math.pi / (180.0 * 3600.0)
 ANGLES = ("d_omega", "d_phi", "d_kappa")
 INS_NAMES = ("E", "N", "U", "roll", "pitch", "heading")
-
-
-@dataclass(frozen=True)
-class BoresightOptions:
-    """Options of :func:`calibrate`.
-
-    Attributes
-    ----------
-    groups : str or mapping
-        ``"single"`` one boresight for all images; ``"group"`` one per value of the
-        trajectory's group column (flight line, direction or session, as the user filled it);
-        ``"direction"`` one per compass octant of the heading (N, NE, ...); or a mapping
-        image_id -> group name.
-    estimate_lever_arm, estimate_interior : bool
-        Add the lever arm (3) / the focal length and principal point (3) as unknowns.
-    ins_grade : str or InsGrade
-        Key of :data:`INS_GRADES` or a custom grade: sigmas of the INS prior observations.
-    ins_as_parameters : bool
-        True: INS positions and attitudes are nuisance parameters with their priors. False: held at
-        the INS values (weighted with 1e-6 times the grade's sigmas), as Pedrosa & dos Santos
-        (2020).
-    roof_roughness_m : float
-        Standard deviation of a roof point about its plane (tiles, sag), metres (> 0).
-    use_types : tuple of str
-        Observation types used (``tie``, ``line``, ``lcp``, ``paper``, ``control``).
-    paper_sigma : {"eq17", "propagated"}
-        Standard deviation of d in paper mode (module docstring).
-    lidar_sigma_m : float
-        Nominal LiDAR coordinate sigma of Eq. 17, metres.
-    paper_z_neighbours : int
-        LiDAR points of the plane whose mean height is the paper's z.
-    snooping, snooping_alpha : bool, float
-        Baarda data snooping and its significance per observation.
-    max_iterations : int
-    """
-
-    groups: Union[str, Mapping[str, str]] = "group"
-    estimate_lever_arm: bool = False
-    estimate_interior: bool = False
-    ins_grade: Union[str, InsGrade] = "pos_av_310"
-    ins_as_parameters: bool = True
-    roof_roughness_m: float = 0.01
-    use_types: tuple[str, ...] = ("tie", "line", "lcp", "paper", "control")
-    paper_sigma: str = "eq17"
-    lidar_sigma_m: float = 0.05
-    paper_z_neighbours: int = 4
-    snooping: bool = True
-    snooping_alpha: float = 0.001
-    max_iterations: int = 50
 
 
 class SurveyedPoints(Protocol):

@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import InputError
-from ..geometry.projection import PROJECTIONS
+from ..geometry.projection_names import PROJECTIONS
 
 INTERIOR_NAMES = ("focal_mm", "x0_mm", "y0_mm", "k1", "k2", "k3", "p1", "p2")
 LENS_NAMES = INTERIOR_NAMES[3:]
@@ -54,3 +54,60 @@ class CalibrationOptions:
             raise InputError(f"field must be fixed or free, got {self.field!r}")
         if not self.sigma_px > 0:
             raise InputError(f"sigma_px must be positive, got {self.sigma_px}")
+
+
+#: Kinds of planar calibration target (:mod:`.calibration_targets` detects them).
+TARGET_KINDS: tuple[str, ...] = ("chessboard", "charuco", "aruco")
+#: OpenCV's predefined ArUco dictionaries accepted by name.
+DICTIONARIES: tuple[str, ...] = (
+    "DICT_4X4_50", "DICT_4X4_100", "DICT_4X4_250", "DICT_4X4_1000",
+    "DICT_5X5_50", "DICT_5X5_100", "DICT_5X5_250", "DICT_5X5_1000",
+    "DICT_6X6_50", "DICT_6X6_100", "DICT_6X6_250", "DICT_6X6_1000",
+    "DICT_7X7_50", "DICT_7X7_100", "DICT_7X7_250", "DICT_7X7_1000",
+    "DICT_ARUCO_ORIGINAL", "DICT_APRILTAG_16h5", "DICT_APRILTAG_25h9",
+    "DICT_APRILTAG_36h10", "DICT_APRILTAG_36h11",
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class TargetSpec:
+    """Geometry of a planar calibration target.
+
+    Parameters
+    ----------
+    kind : {"chessboard", "charuco", "aruco"}
+    cols, rows : int
+        chessboard: inner corners per row and per column; charuco: squares in x and y;
+        aruco: markers in x and y.
+    spacing_m : float
+        chessboard and charuco: the square side; aruco: the marker side; metres.
+    marker_m : float
+        charuco: the marker side; aruco: the gap between markers; metres (unused for a
+        chessboard).
+    dictionary : str
+        ArUco dictionary (charuco, aruco), one of :data:`DICTIONARIES`.
+    """
+
+    kind: str = "chessboard"
+    cols: int = 9
+    rows: int = 6
+    spacing_m: float = 0.025
+    marker_m: float = 0.0
+    dictionary: str = "DICT_6X6_250"
+
+    def __post_init__(self) -> None:
+        """Check the kind, the counts and the sizes (raises :class:`InputError`)."""
+        if self.kind not in TARGET_KINDS:
+            raise InputError(f"target kind must be one of {', '.join(TARGET_KINDS)}")
+        if self.cols < 2 or self.rows < 2:
+            raise InputError(f"a {self.kind} target needs at least 2 x 2 (got "
+                             f"{self.cols} x {self.rows})")  # fmt: skip
+        if not self.spacing_m > 0:
+            raise InputError(f"the target spacing must be positive, got {self.spacing_m}")
+        if self.kind == "charuco" and not 0 < self.marker_m < self.spacing_m:
+            raise InputError("a ChArUco marker must be smaller than the square "
+                             f"({self.marker_m} m vs {self.spacing_m} m)")  # fmt: skip
+        if self.kind == "aruco" and not self.marker_m > 0:
+            raise InputError("an ArUco grid board needs the gap between markers (marker_m > 0)")
+        if self.kind != "chessboard" and self.dictionary not in DICTIONARIES:
+            raise InputError(f"unknown ArUco dictionary {self.dictionary!r}")

@@ -31,66 +31,12 @@ from typing import Any, Tuple
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError
+from .calibration_options import DICTIONARIES, TARGET_KINDS, TargetSpec  # noqa: F401 - the old address
 
 Array = NDArray[np.float64]
 
-TARGET_KINDS: Tuple[str, ...] = ("chessboard", "charuco", "aruco")
-#: OpenCV's predefined ArUco dictionaries accepted by name.
-DICTIONARIES: Tuple[str, ...] = (
-    "DICT_4X4_50", "DICT_4X4_100", "DICT_4X4_250", "DICT_4X4_1000",
-    "DICT_5X5_50", "DICT_5X5_100", "DICT_5X5_250", "DICT_5X5_1000",
-    "DICT_6X6_50", "DICT_6X6_100", "DICT_6X6_250", "DICT_6X6_1000",
-    "DICT_7X7_50", "DICT_7X7_100", "DICT_7X7_250", "DICT_7X7_1000",
-    "DICT_ARUCO_ORIGINAL", "DICT_APRILTAG_16h5", "DICT_APRILTAG_25h9",
-    "DICT_APRILTAG_36h10", "DICT_APRILTAG_36h11",
-)  # fmt: skip
 # OpenCV pixel centres are integers; the project's are at +0.5.
 _CV_TO_PROJECT_PX = 0.5
-
-
-@dataclass(frozen=True)
-class TargetSpec:
-    """Geometry of a planar calibration target.
-
-    Parameters
-    ----------
-    kind : {"chessboard", "charuco", "aruco"}
-    cols, rows : int
-        chessboard: inner corners per row and per column; charuco: squares in x and y;
-        aruco: markers in x and y.
-    spacing_m : float
-        chessboard and charuco: the square side; aruco: the marker side; metres.
-    marker_m : float
-        charuco: the marker side; aruco: the gap between markers; metres (unused for a
-        chessboard).
-    dictionary : str
-        ArUco dictionary (charuco, aruco), one of :data:`DICTIONARIES`.
-    """
-
-    kind: str = "chessboard"
-    cols: int = 9
-    rows: int = 6
-    spacing_m: float = 0.025
-    marker_m: float = 0.0
-    dictionary: str = "DICT_6X6_250"
-
-    def __post_init__(self) -> None:
-        """Check the kind, the counts and the sizes (raises :class:`InputError`)."""
-        if self.kind not in TARGET_KINDS:
-            raise InputError(f"target kind must be one of {', '.join(TARGET_KINDS)}")
-        if self.cols < 2 or self.rows < 2:
-            raise InputError(f"a {self.kind} target needs at least 2 x 2 (got "
-                             f"{self.cols} x {self.rows})")  # fmt: skip
-        if not self.spacing_m > 0:
-            raise InputError(f"the target spacing must be positive, got {self.spacing_m}")
-        if self.kind == "charuco" and not 0 < self.marker_m < self.spacing_m:
-            raise InputError("a ChArUco marker must be smaller than the square "
-                             f"({self.marker_m} m vs {self.spacing_m} m)")  # fmt: skip
-        if self.kind == "aruco" and not self.marker_m > 0:
-            raise InputError("an ArUco grid board needs the gap between markers (marker_m > 0)")
-        if self.kind != "chessboard" and self.dictionary not in DICTIONARIES:
-            raise InputError(f"unknown ArUco dictionary {self.dictionary!r}")
 
 
 @dataclass(frozen=True)

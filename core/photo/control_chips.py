@@ -53,6 +53,7 @@ from ..errors import ConvergenceError, InputError, NotObservableError
 from ..geometry.camera import Camera
 from ..geometry.collinearity import image_rays, project_with_status
 from ..i18n import mark as _t
+from .chip_options import ChipOptions
 from .control_plate import (
     PlateDetection,
     PlateGeometry,
@@ -79,33 +80,6 @@ __all__ = [
 
 #: Most sub-samples per chip cell side.
 MAX_SUBSAMPLES = 8
-
-
-@dataclass(frozen=True)
-class ChipOptions:
-    """Options of :func:`make_chip` (units in the names)."""
-
-    gsd_m: float = 0.15
-    size_px: int = 41
-    corner_sigma_px: float = 0.0
-    max_sigma0: float = 3.0
-    sift_ratio: float = 0.75
-    ransac_px: float = 2.0
-    min_matches: int = 30
-    sift_features: int = 8000
-    match_sigma_px: float = 0.5
-    min_valid: float = 1.0
-    from_plate_photo: bool = False
-
-    def __post_init__(self) -> None:
-        if not (math.isfinite(self.gsd_m) and self.gsd_m > 0):
-            raise InputError(f"GSD must be > 0 m, got {self.gsd_m!r}")
-        if int(self.size_px) != self.size_px or self.size_px < 3:
-            raise InputError(f"chip size must be a whole number >= 3 px, got {self.size_px!r}")
-        if not 0.0 < self.sift_ratio < 1.0:
-            raise InputError(f"SIFT ratio must be in (0, 1), got {self.sift_ratio!r}")
-        if not 0.0 < self.min_valid <= 1.0:
-            raise InputError(f"min_valid must be in (0, 1], got {self.min_valid!r}")
 
 
 @dataclass(frozen=True)

@@ -77,6 +77,7 @@ from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians, image_rays, project_with_status
 from ..geometry.rotations import opk_to_matrix
 from ..i18n import mark as _t
+from .chip_options import PlateGeometry
 
 #: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
 TR_CONTEXT = "Report"
@@ -106,46 +107,6 @@ EDGE_WINDOW_PX = 1.5
 MIN_FRAME_PX = 5.0
 #: Fraction of each side (its middle) sampled for edge points.
 SIDE_FRACTION = 0.8
-
-
-@dataclass(frozen=True)
-class PlateGeometry:
-    """The control plate (module docstring): sides in metres, height above the surveyed
-    point in metres, grid azimuth of a side in degrees.
-
-    >>> PlateGeometry(0.6, 0.3).corners().round(3)[:2].tolist()
-    [[-0.3, 0.3, 0.0], [-0.3, -0.3, 0.0]]
-    """
-
-    outer_m: float = 0.6
-    inner_m: float = 0.3
-    height_m: float = 0.0
-    azimuth_deg: float = 0.0
-
-    def __post_init__(self) -> None:
-        for name in ("outer_m", "inner_m", "height_m", "azimuth_deg"):
-            value = getattr(self, name)
-            if not math.isfinite(float(value)):
-                raise InputError(f"plate {name} must be finite, got {value!r}")
-        if not 0.0 < self.inner_m < self.outer_m:
-            raise InputError(f"plate: need 0 < inner side ({self.inner_m:g} m) < outer side "
-                             f"({self.outer_m:g} m)")  # fmt: skip
-
-    def corners(self) -> Array:
-        """(8, 3) corners relative to the surveyed point (east, north, up; metres)."""
-        a = math.radians(self.azimuth_deg)
-        e1 = np.array([math.sin(a), math.cos(a)])  # along the azimuth
-        e2 = np.array([-math.cos(a), math.sin(a)])  # a quarter turn counter-clockwise
-        signs = np.array([[1, 1], [-1, 1], [-1, -1], [1, -1]], dtype=float)
-        out = np.zeros((8, 3))
-        for k, side in enumerate((self.outer_m, self.inner_m)):
-            h = side / 2.0
-            # rotate so that the first corner lies in the direction azimuth - 45 degrees...
-            xy = h * (signs[:, :1] * e1 + signs[:, 1:] * e2)
-            # ...which with signs (1, 1) is e1 + e2: azimuth - 45 degrees
-            out[4 * k : 4 * k + 4, :2] = xy
-        out[:, 2] = self.height_m
-        return out
 
 
 @dataclass(frozen=True)

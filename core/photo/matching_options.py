@@ -7,7 +7,18 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .template_matching import TextureOptions
+
+@dataclass(frozen=True)
+class TextureOptions:
+    """Parameters of the adaptive template size (:mod:`.template_matching`'s docstring)."""
+
+    min_size: int = 15
+    max_size: int = 51
+    step: int = 6
+    target_sigma_px: float = 0.02
+    min_isotropy: float = 0.05
+    noise_floor: float = 0.02
+    min_contrast: float = 1e-6
 
 
 @dataclass(frozen=True)

@@ -93,6 +93,20 @@ def _offset(src: Grid, grid: Grid) -> tuple[int, int]:
     return round(fc), round(fr)
 
 
+def mosaic_method(method: str, sources: Sequence[MosaicSource]) -> str:
+    """The method of :data:`METHODS` the mosaic can use: ``nadir`` needs every orthophoto's
+    perspective centre, else every cell takes the nearest image centre (``centre``): a nadir
+    angle and a distance are not comparable scores, so one rule holds for all cells.
+
+    >>> g = Grid(0.0, 1.0, 1.0, 1, 1)
+    >>> mosaic_method("nadir", [MosaicSource("a", g, None, None, None)])
+    'centre'
+    """
+    if method == "nadir" and any(s.centre is None for s in sources):
+        return "centre"
+    return method
+
+
 def mosaic_grid(sources: Sequence[MosaicSource]) -> Grid:
     """The grid covering every orthophoto (they must share the cell and be aligned)."""
     if not sources:

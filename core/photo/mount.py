@@ -15,6 +15,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..geometry.rotations import boresight_matrix, is_rotation
+from .mount_choices import MOUNT_CHOICES, MOUNT_LABELS  # noqa: F401 - MOUNT_LABELS: the old address
 
 Array = NDArray[np.float64]
 
@@ -31,7 +32,8 @@ MOUNT_PRESETS: dict[str, Array] = {
     "image_left_forward": np.array([[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]]),
 }
 
-MOUNT_CHOICES = (*MOUNT_PRESETS.keys(), "custom")
+if (*MOUNT_PRESETS, "custom") != MOUNT_CHOICES:  # the names the help lists without numpy
+    raise ImportError("photo/mount_choices.py MOUNT_CHOICES differs from MOUNT_PRESETS")
 
 
 @dataclass(frozen=True)
@@ -88,11 +90,3 @@ class Mount:
         )
 
 
-#: What each nominal mount means, as the toolbox and the dock show it.
-MOUNT_LABELS = {
-    "image_top_forward": "image top towards the flight direction (nose)",
-    "image_right_forward": "image right side towards the flight direction",
-    "image_bottom_forward": "image bottom towards the flight direction",
-    "image_left_forward": "image left side towards the flight direction",
-    "custom": "custom matrix (MOUNT_MATRIX)",
-}

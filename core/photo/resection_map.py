@@ -322,3 +322,19 @@ def image_inputs(
         out.append(ImageInput(img, data, tuple(p_rows), tuple(tuple(groups[t]) for t in lids),
                               tuple(c_rows), cxyz.reshape(-1, 3), ignored))  # fmt: skip
     return out
+
+
+def control_frame(inputs: Sequence[ImageInput], frame: MappingFrame) -> LocalFrame:
+    """The ENU frame the images of ``inputs`` are resected in: tangent at the mean of all
+    their control (points and line end points, mapping CRS), one frame for the block.
+
+    Raises
+    ------
+    InputError
+        No observation matched the control.
+    """
+    everything = [d.data for d in inputs]
+    ctrl = np.vstack([np.vstack([d.xyz, d.line_p1, d.line_p2]) for d in everything])
+    if not len(ctrl):
+        raise InputError("no observation matches the control: check the point and line ids")
+    return LocalFrame.at_map_point(frame, ctrl.mean(axis=0))

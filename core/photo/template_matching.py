@@ -35,6 +35,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..i18n import mark as _t
+from .matching_options import TextureOptions
 
 #: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
 TR_CONTEXT = "Report"
@@ -92,19 +93,6 @@ def texture_measure(template: ArrayLike) -> tuple[float, float]:
     half_trace = 0.5 * (sxx + syy)
     root = float(np.hypot(0.5 * (sxx - syy), sxy))
     return max(half_trace - root, 0.0), half_trace + root
-
-
-@dataclass(frozen=True)
-class TextureOptions:
-    """Parameters of the adaptive template size (module docstring)."""
-
-    min_size: int = 15
-    max_size: int = 51
-    step: int = 6
-    target_sigma_px: float = 0.02
-    min_isotropy: float = 0.05
-    noise_floor: float = 0.02
-    min_contrast: float = 1e-6
 
 
 @dataclass(frozen=True)

@@ -27,15 +27,15 @@ from __future__ import annotations
 
 import datetime
 import logging
-import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import CrsError, InputError, stop_if_asked
+from .accuracy_options import STANDARD_KEYS, AccuracySettings
 from .accuracy_statistics import (
     COMPONENTS,
     HORIZONTAL,
@@ -51,7 +51,7 @@ from .standards import StandardResult, _t
 from .standards_asprs import asprs_2023
 from .standards_nssda import nssda
 from .standards_pec import pec_pcd
-from .standards_project import PAPER_FLIGHT_GEOMETRY, PAPER_H_THRESHOLD_M, project_threshold
+from .standards_project import project_threshold
 
 __all__ = [
     "OUTLIER_RULES",
@@ -70,7 +70,6 @@ log = logging.getLogger(__name__)
 
 #: The coordinates as the point tables name them (columns e, n, h), for error messages.
 _COORDINATES = ("E", "N", "H")
-STANDARD_KEYS = ("asprs", "nssda", "pec", "project")
 
 
 
@@ -269,58 +268,6 @@ def join_points(measured: PointSet, reference: PointSet) -> CheckPoints:
 
 
 # ----------------------------------------------------------------------------- the report
-
-
-@dataclass(frozen=True)
-class AccuracySettings:
-    """Everything the report depends on besides the points. Lengths in metres.
-
-    ``declared_sigma_h`` / ``survey_sigma_h`` are per horizontal axis (E and N);
-    ``flight_geometry`` is (H m, B m, f mm, sigma_pix um) for Eq. 18 of Pedrosa & dos Santos (2020).
-    """
-
-    alpha: float = 0.05
-    declared_sigma_h: float = 0.0
-    declared_sigma_v: float = 0.0
-    survey_sigma_h: float = 0.0
-    survey_sigma_v: float = 0.0
-    outlier_rule: str = "robust"
-    exclude_outliers: bool = False
-    standards: tuple[str, ...] = STANDARD_KEYS
-    asprs_h_class_cm: float = 0.0
-    asprs_v_class_cm: float = 0.0
-    pec_scale: float = 1000.0
-    pec_equidistance: float = 0.0
-    pec_class: str = "A"
-    project_h_threshold: float = PAPER_H_THRESHOLD_M
-    project_v_threshold: float = 0.0
-    flight_geometry: tuple[float, float, float, float] = PAPER_FLIGHT_GEOMETRY
-    title: str = _t("Positional accuracy report")
-
-    def validated(self) -> AccuracySettings:
-        if not (0.0 < self.alpha < 0.5):
-            raise InputError(f"the significance level must be in (0, 0.5), got {self.alpha}")
-        for name in (
-            "declared_sigma_h",
-            "declared_sigma_v",
-            "survey_sigma_h",
-            "survey_sigma_v",
-            "asprs_h_class_cm",
-            "asprs_v_class_cm",
-            "pec_equidistance",
-            "project_v_threshold",
-        ):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0):
-                raise InputError(f"{name} must be zero or positive, got {value}")
-        keys = tuple(k.strip().lower() for k in self.standards if k.strip())
-        unknown = [k for k in keys if k not in STANDARD_KEYS]
-        if unknown:
-            raise InputError(f"unknown standard(s) {unknown} ({', '.join(STANDARD_KEYS)})")
-        rule = self.outlier_rule.strip().lower().replace("-", "_")
-        if rule not in OUTLIER_RULES:
-            raise InputError(f"unknown outlier rule '{self.outlier_rule}'")
-        return replace(self, standards=keys, outlier_rule=rule)
 
 
 @dataclass(frozen=True)

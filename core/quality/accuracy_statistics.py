@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from .accuracy_options import OUTLIER_RULES
 
 __all__ = [
     "BiasTest",
@@ -34,7 +35,6 @@ __all__ = [
 #: (the height, column h of the tables), then the derived horizontal and 3D lengths.
 COMPONENTS = ("E", "N", "U")
 HORIZONTAL, THREE_D = "HORIZONTAL", "3D"
-OUTLIER_RULES = ("robust", "three_sigma", "none")
 
 _ROBUST_THRESHOLD = 3.5  # Iglewicz & Hoaglin (1993)
 _SIGMA_THRESHOLD = 3.0

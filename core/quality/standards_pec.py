@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from .accuracy_options import PEC_CLASSES
 from .html_table import TR_CONTEXT  # noqa: F401 - make i18n collects the _t("...") marks
 from .standards import _TOL, StandardResult, Verdict, _check_d, _rmse, _t
 
@@ -21,7 +22,6 @@ __all__ = [
 
 #: PEC-PCD (ET-ADGV/ET-CQDG): planimetric PEC and EP in millimetres at the map scale and
 #: altimetric PEC and EP as fractions of the equidistance (contour interval), classes A-D.
-PEC_CLASSES = ("A", "B", "C", "D")
 _PEC_PLANIMETRIC_MM = {"A": (0.28, 0.17), "B": (0.5, 0.3), "C": (0.8, 0.5), "D": (1.0, 0.6)}
 _PEC_ALTIMETRIC_EQ = {
     "A": (0.27, 1.0 / 6.0),

@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError
+from .accuracy_options import PAPER_FLIGHT_GEOMETRY, PAPER_H_THRESHOLD_M
 from .html_table import TR_CONTEXT  # noqa: F401 - make i18n collects the _t("...") marks
 from .standards import _TOL, StandardResult, Verdict, _check_d, _rmse, _t
 
@@ -19,9 +20,6 @@ __all__ = [
     "stereo_height_precision",
 ]
 
-#: Paper 000 (Pedrosa & dos Santos 2020), section 3.
-PAPER_H_THRESHOLD_M = 0.40
-PAPER_FLIGHT_GEOMETRY = (1600.0, 452.0, 100.4, 6.0)  # H (m), B (m), f (mm), sigma_pix (um)
 
 
 def stereo_height_precision(

@@ -303,6 +303,27 @@ def distance_consistency(obs: TlsObservations) -> tuple[float, str]:
     return float(np.median(meds)), names[worst]
 
 
+#: A median disagreement of target-to-target distances between stations beyond this
+#: (relative) is not a scanner error but a wrong angle unit or convention.
+MAX_DISTANCE_DISAGREEMENT = 0.005
+
+
+def check_distance_consistency(obs: TlsObservations, *, path: str | None = None) -> float:
+    """:func:`distance_consistency`'s median (NaN without two stations sharing two targets),
+    refused when it exceeds :data:`MAX_DISTANCE_DISAGREEMENT`: the angles are then in another
+    unit or convention (``path``, the observations' file, names the error)."""
+    median, pair = distance_consistency(obs)
+    if math.isfinite(median) and median > MAX_DISTANCE_DISAGREEMENT:
+        raise InputError(
+            f"the distances between targets disagree by {100 * median:.2g} % (median) between "
+            f"stations (worst: {pair}); a scanner error is a few 0.01 %: the angles are in "
+            "another unit (gon read as degrees?) or another convention (zenith angle instead "
+            "of elevation?)",
+            path=path,
+        )
+    return median
+
+
 def kabsch(src: ArrayLike, dst: ArrayLike) -> tuple[Array, Array, float]:
     """Rigid motion ``dst ~ R src + t`` by least squares (Kabsch's SVD solution).
 

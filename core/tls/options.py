@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .aps import ARCSEC
+from .ap_table import ARCSEC
 
 __all__ = ["CalibrationOptions"]
 

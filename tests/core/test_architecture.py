@@ -259,3 +259,49 @@ def test_the_size_checker_sees_a_long_file_and_function(tmp_path):
     assert _size_violations({}, {"core/gone.py": 900}, MAX_FILE_LINES) == [
         f"core/gone.py: now within {MAX_FILE_LINES} lines: remove it from the list"
     ]
+
+
+# ------------------------------------------------------------------ job run() functions
+
+#: A job's run() orchestrates: it reads, calls the science, writes and reports. Geometry and
+#: rules live in the science (e.g. the automatic GSD of orthophotos, photo/ortho_block.py),
+#: reading and writing in helpers beside run(); no job is exempt.
+MAX_RUN_LINES = 60
+
+
+def _run_lengths(root: Path = ROOT) -> dict[str, int]:
+    """{job file: lines of its top-level ``run``} of every module of core/jobs with one."""
+    lengths = {}
+    for path in sorted((root / "core" / "jobs").glob("*.py")):
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            if isinstance(node, ast.FunctionDef) and node.name == "run":
+                lengths[path.relative_to(root).as_posix()] = node.end_lineno - node.lineno + 1
+    return lengths
+
+
+RUN_LENGTHS = _run_lengths()
+
+
+def test_every_registered_job_has_a_run():
+    from lidarphoto.core.jobs import NAMES
+
+    files = {f"core/jobs/{name}.py" for name in NAMES if "." not in name}
+    assert files <= set(RUN_LENGTHS), sorted(files - set(RUN_LENGTHS))
+
+
+@pytest.mark.parametrize("job", sorted(RUN_LENGTHS))
+def test_a_jobs_run_is_orchestration_only(job):
+    """Each job's run() length, listed one test per job."""
+    assert RUN_LENGTHS[job] <= MAX_RUN_LINES, (
+        f"{job}: run() is {RUN_LENGTHS[job]} lines > {MAX_RUN_LINES}: move geometry and rules "
+        "into the science, reading and writing into helpers"
+    )
+
+
+def test_the_run_checker_sees_a_long_run(tmp_path):
+    (tmp_path / "core" / "jobs").mkdir(parents=True)
+    body = "".join(f"    x{i} = {i}\n" for i in range(MAX_RUN_LINES))
+    (tmp_path / "core" / "jobs" / "long.py").write_text(f"def run():\n{body}", encoding="utf-8")
+    (tmp_path / "core" / "jobs" / "short.py").write_text("def run():\n    pass\n")
+    assert _run_lengths(tmp_path) == {"core/jobs/long.py": MAX_RUN_LINES + 1,
+                                      "core/jobs/short.py": 2}  # fmt: skip

@@ -21,12 +21,6 @@ HEAVY = ("scipy", "cv2", "laspy", "lazrs", "numba", "pyproj", "osgeo", "rasterio
 LISTING = {"lidarphoto.core", "lidarphoto.core.errors", "lidarphoto.core.i18n",
            "lidarphoto.core.io", "lidarphoto.core.io.atomic", "lidarphoto.core.io.suffixes",
            "lidarphoto.core.cli"}  # fmt: skip  (io.suffixes: the readers' endings, stdlib only)
-#: Algorithms whose defaults are read from a dataclass in a module that imports a heavy
-#: library at its top (its --help pays for it): photo/bundle.py, photo/resection.py and
-#: photo/boresight.py import lsq/adjustment.py (scipy). Each needs its options in a light
-#: module, as photo/ortho_options.py, calibration_options.py, matching_options.py and
-#: monoplot_options.py are.
-HEAVY_DEFAULTS = {"bundleadjustment", "resection", "boresightcalibration"}
 
 
 def _imported_by(code: str) -> dict:
@@ -78,7 +72,8 @@ def test_the_top_level_help_reads_no_parameter():
 @pytest.mark.parametrize("name", sorted(j.SPEC.name for j in ALGORITHMS))
 def test_an_algorithms_help_imports_no_heavy_library(name):
     """``lidarphoto <alg> --help``: the parser of that algorithm with every option, default,
-    unit and range; the science behind the defaults only where it is light."""
+    unit and range; the science behind the defaults is light, without numpy
+    (its options live in modules such as photo/bundle_options.py)."""
     modules = _imported_by(
         "from lidarphoto.core.cli import build_parser\n"
         f"parser = build_parser(with_options={{{name!r}}})\n"
@@ -87,10 +82,8 @@ def test_an_algorithms_help_imports_no_heavy_library(name):
         "except SystemExit:\n"
         "    pass"
     )
-    if name in HEAVY_DEFAULTS:
-        assert _heavy(modules), f"{name}: its defaults are light now; drop it from the list"
-    else:
-        assert _heavy(modules) == []
+    assert _heavy(modules) == []
+    assert "numpy" not in modules  # 0.1-0.3 s: the defaults and choices live in light modules
 
 
 def test_the_runner_and_the_science_are_imported_when_a_job_runs():
