@@ -214,6 +214,37 @@ def _block(inp: Path, out: Path, *extra: str) -> list[str]:
             *extra]  # fmt: skip
 
 
+def test_a_killed_lidarblock_s_staging_folders_go_with_the_next_run(tmp_path, capsys):
+    """SIGKILL during a block leaves its staging folder ``.b.p<pid>h<host>r<random>.part``
+    (tiles half written) and, during the commit, the old output set aside the same way; the
+    next run in the folder removes both (their process is gone), leaves a living process's
+    staging folder, and writes the block in full."""
+    import json
+
+    from lidarphoto.core.io.atomic import _HOST
+
+    inp, out = tmp_path / "in", tmp_path / "out"
+    inp.mkdir()
+    out.mkdir()
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True).stdout.strip()  # fmt: skip
+    killed = [out / f".b.p{dead}h{_HOST}r{r}.part" for r in ("k3x9q1zz", "q8m2a7bb")]
+    for k, folder in enumerate(killed):
+        (folder / "tiles").mkdir(parents=True)
+        (folder / "tiles" / f"t{k}.laz").write_bytes(b"LASF half a tile")
+        (folder / "tiles" / f".t{k}.p{dead}h{_HOST}rzz.part.laz").write_bytes(b"LASF")
+    living = out / f".b.p{os.getppid()}h{_HOST}rlive01.part"  # a running process's: kept
+    living.mkdir()
+    argv = _block(inp, out)
+    before = _snapshot(inp)
+    assert main(argv) == 0, capsys.readouterr().err
+    assert sorted(p.name for p in out.iterdir()) == sorted([living.name, "b"])
+    report = json.loads((out / "b" / "block_report.json").read_text(encoding="utf-8"))
+    assert report["complete"] and not report["failed_tiles"]
+    assert report["point_count"] == 35231  # every point of the file, once
+    assert _snapshot(inp) == before
+
+
 def test_lidarblock_memory_limit_below_a_tile_is_refused_before_the_cluster(tmp_path, capsys):
     inp, out = tmp_path / "in", tmp_path / "out"
     inp.mkdir()
