@@ -214,11 +214,7 @@ def rejection_doubts(adjustment: Any, alpha: float) -> list[Any]:
     """``[test]`` when the rejections of ``adjustment`` (robust stage and data snooping at
     ``alpha`` per row) fail :func:`~core.lsq.results.rejection_test` (its ``message()`` is
     the doubt :func:`settle_doubts` takes), else ``[]``."""
-    import numpy as np
+    from ..lsq.results import unexplained_rejections
 
-    from ..lsq.results import rejection_test
-
-    if not any(bool(np.any(t.rejected)) for t in adjustment.residuals.values()):
-        return []  # nothing rejected: nothing to explain (and no scipy import)
-    test = rejection_test(adjustment, alpha)
-    return [] if test.passed else [test]
+    test = unexplained_rejections(adjustment, alpha)
+    return [] if test is None else [test]

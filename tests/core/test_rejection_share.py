@@ -54,12 +54,17 @@ def uav(tmp_path_factory):
     return paths, folder
 
 
-def _bundle(paths, observations) -> list[str]:
-    return run_job(bundle_adjustment, {
+LATE = "passed, but only after more rejections than false alarms explain"
+
+
+def _bundle(paths, observations) -> tuple[list[str], str]:
+    html = observations.parent / f"{observations.stem}.html"
+    lines = run_job(bundle_adjustment, {
         "CAMERA": str(paths["camera"]), "OBSERVATIONS": str(observations),
         "GROUND_POINTS": str(paths["ground_points"]), "EO": str(paths["eo"]),
-        "CRS": "EPSG:31983", "AP_MODEL": "none",
+        "CRS": "EPSG:31983", "AP_MODEL": "none", "OUTPUT_HTML": str(html),
     }).lines  # fmt: skip
+    return lines, html.read_text(encoding="utf-8")
 
 
 def test_bundle_with_a_tenth_of_its_ties_blundered_says_its_test_is_not_plainly_passed(uav):
@@ -68,14 +73,17 @@ def test_bundle_with_a_tenth_of_its_ties_blundered_says_its_test_is_not_plainly_
     false alarms at alpha = 0.001 among ~700 groups); the clean block passes plainly. (With
     a fifth blundered the global test of the rest fails: "failed".)"""
     paths, folder = uav
-    clean = _test_line(_bundle(paths, paths["observations"]))
-    assert "global test passed," in clean, clean
+    lines, page = _bundle(paths, paths["observations"])
+    assert "global test passed," in _test_line(lines), lines
+    assert LATE not in page and "rejections explained by false alarms" not in page
     n = _blunder(paths["observations"], folder / "dirty.csv", 0.1, ("T",), seed=3)
-    line = _test_line(_bundle(paths, folder / "dirty.csv"))
+    lines, page = _bundle(paths, folder / "dirty.csv")
+    line = _test_line(lines)
     assert FLAGGED in line and "global test passed," not in line, line
+    assert LATE in page and "at most 6 (1.5 expected); 79 rejected" in page
     rejected = int(line.split(" of ")[0].rsplit(" ", 1)[1])
     assert rejected >= n, (rejected, n)
-    assert "(false alarms explain at most 6)" in line, line
+    assert "rejecting 79 of 698 observations (false alarms explain at most 6)" in line, line
 
 
 @pytest.fixture(scope="module")
@@ -86,13 +94,15 @@ def scene(tmp_path_factory):
     return write_scene_files(folder, sc, data, "EPSG:32632"), folder
 
 
-def _resect(files, observations) -> str:
+def _resect(files, observations) -> tuple[str, str]:
+    html = observations.parent / f"{observations.stem}.html"
     lines = run_job(resection, {
         "CAMERA": str(files["camera"]), "OBSERVATIONS": str(observations),
         "CONTROL_POINTS": str(files["control_points"]),
         "CONTROL_LINES": str(files["control_lines"]), "CRS": "EPSG:32632",
+        "OUTPUT_HTML": str(html),
     }).lines  # fmt: skip
-    return lines[1]
+    return lines[1], html.read_text(encoding="utf-8")
 
 
 def test_resection_with_a_sixth_of_its_measurements_blundered_is_not_plainly_passed(scene):
@@ -100,12 +110,13 @@ def test_resection_with_a_sixth_of_its_measurements_blundered_is_not_plainly_pas
     point and line groups, the rest passes, and the image's row says at what price (more
     blunders and the resection no longer converges: a named error). Clean: passed."""
     files, folder = scene
-    clean = _resect(files, files["observations"])
-    assert clean.endswith(" passed"), clean
+    clean, page = _resect(files, files["observations"])
+    assert clean.endswith(" passed") and LATE not in page, clean
     assert _blunder(files["observations"], folder / "dirty.csv", 0.15, ("lcp", "line"), 4) == 9
-    row = _resect(files, folder / "dirty.csv")
+    row, page = _resect(files, folder / "dirty.csv")
     assert row.endswith(" passed only after rejecting 9 of 36 observations (false alarms "
                         "explain at most 3)"), row  # fmt: skip
+    assert page.count(LATE) == 2  # the images' table and the image's global test
 
 
 SMALL = FlightConfig(n_buildings=6, n_planes=12, town_size_m=700.0, n_check=3,
