@@ -84,6 +84,29 @@ def stop_signals_raise() -> Iterator[None]:
             signal.signal(s, old)
 
 
+def _exit_now(code: int) -> None:
+    """End the process with ``code`` now, after a stop signal: the run has cleaned up (its
+    temporaries removed, its cluster's workers ended), and what the interpreter's exit would
+    still do takes seconds a stopping service does not wait for (distributed's exit hook
+    gracefully closes a cluster that was still starting; the teardown of numba, dask and
+    GDAL). Child processes still running (workers of a cluster being started) are killed
+    first; any started after that end with this process (distributed's workers watch a pipe
+    from their parent)."""
+    import multiprocessing
+    import os
+
+    children = multiprocessing.active_children()
+    for child in children:
+        child.kill()
+    for child in children:
+        child.join(1.0)
+    logging.shutdown()
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    os._exit(code)
+
+
 def _option_help(
     p: Param, spec: AlgorithmSpec | None = None, t: Callable[[str], str] | None = None
 ) -> str:
@@ -228,8 +251,12 @@ def _progress_bar(job):
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """The command line: ``argv`` (default ``sys.argv[1:]``) run, its exit status returned.
+    Called without ``argv`` (the ``lidarphoto`` command, ``python -m lidarphoto``), a run
+    stopped by a signal ends the process at once after its message (:func:`_exit_now`)."""
     import os
 
+    entry = argv is None
     argv = sys.argv[1:] if argv is None else list(argv)
     lang = i18n.set_language(_language(argv))
     args = build_parser(lang, with_options={_algorithm(argv)}).parse_args(argv)
@@ -252,6 +279,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Terminated as exc:
         print(f"lidarphoto {args.algorithm}: stopped by {exc.name}; nothing was written",
               file=sys.stderr)  # fmt: skip
+        if entry:
+            _exit_now(128 + exc.signum)
         return 128 + exc.signum
     except Cancelled as exc:
         print(f"lidarphoto {args.algorithm}: {exc}", file=sys.stderr)

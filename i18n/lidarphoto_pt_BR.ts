@@ -3356,14 +3356,17 @@ parâmetros e o motivo (o HTML traz então o diagnóstico).</translation>
             <source>## Checks of the result
 The run fails (nothing but the HTML summary, which says why, is written) when the
 adjustment did not converge, when its global test fails with sigma0 above the largest sigma0
-(the observations do not fit their sigmas), or when an estimated angle exceeds the largest
-plausible boresight. With Write the results even when the checks fail, the outputs are
-written and each starts with a warning (CSV: comment lines beginning with #).</source>
+(the observations do not fit their sigmas), when the robust stage and data snooping rejected
+more observations than their false alarms explain (the global test of the rest then says
+nothing), or when an estimated angle exceeds the largest plausible boresight. With Write the
+results even when the checks fail, the outputs are written and each starts with a warning (CSV:
+comment lines beginning with #).</source>
             <translation>## Verificações do resultado
 A execução falha (nada é gravado além do resumo HTML, que diz o motivo) quando o ajustamento
 não convergiu, quando o seu teste global falha com sigma0 acima do maior sigma0 (as observações
-não se ajustam aos seus desvios-padrão), ou quando um ângulo estimado excede o maior boresight
-plausível. Com Gravar os resultados mesmo quando as verificações falham, as saídas são gravadas
+não se ajustam aos seus desvios-padrão), quando o estágio robusto e o data snooping rejeitaram
+mais observações do que os seus falsos alarmes explicam (o teste global do restante então nada
+diz), ou quando um ângulo estimado excede o maior boresight plausível. Com Gravar os resultados mesmo quando as verificações falham, as saídas são gravadas
 e cada uma começa com um aviso (CSV: linhas de comentário iniciadas por #).</translation>
         </message>
         <message>
@@ -3543,8 +3546,8 @@ e cada uma começa com um aviso (CSV: linhas de comentário iniciadas por #).</t
             <translation>Gravar os resultados mesmo quando as verificações falham</translation>
         </message>
         <message>
-            <source>no convergence, global test beyond MAX_SIGMA0 or boresight beyond MAX_BORESIGHT: write the outputs anyway, each with a warning at its top</source>
-            <translation>sem convergência, teste global além de MAX_SIGMA0 ou boresight além de MAX_BORESIGHT: grava as saídas mesmo assim, cada uma com um aviso no início</translation>
+            <source>no convergence, global test beyond MAX_SIGMA0, more rejections than false alarms explain or boresight beyond MAX_BORESIGHT: write the outputs anyway, each with a warning at its top</source>
+            <translation>sem convergência, teste global além de MAX_SIGMA0, mais rejeições do que os falsos alarmes explicam ou boresight além de MAX_BORESIGHT: grava as saídas mesmo assim, cada uma com um aviso no início</translation>
         </message>
         <message>
             <source>Boresight per group (CSV)</source>

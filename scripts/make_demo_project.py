@@ -64,9 +64,15 @@ def _rows(path: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(fh))
 
 
+#: Memory-layer field types as declared: a bare "double" gets length 20 and precision 5 in
+#: QGIS 3.22, which the GeoPackage writer then rounds every value to (0.12345678901234566 ->
+#: 0.12346); "double(0,0)" leaves the precision unset: full doubles in the layer and the file.
+_FIELD_TYPES = {"double": "double(0,0)"}
+
+
 def _memory_layer(geometry: str, name: str, fields: list[tuple[str, str]]):
 
-    spec = "&".join(f"field={n}:{t}" for n, t in fields)
+    spec = "&".join(f"field={n}:{_FIELD_TYPES.get(t, t)}" for n, t in fields)
     layer = qgc.QgsVectorLayer(f"{geometry}?crs={CRS}&{spec}", name, "memory")
     if not layer.isValid():
         raise RuntimeError(f"cannot make the memory layer {name}")

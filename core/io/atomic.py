@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+import shutil
 import socket
 import tempfile
 import time
@@ -73,6 +74,17 @@ def _temp_name(target: Path) -> str:
     os.close(fd)
     _LIVE.add(os.path.abspath(tmp))
     return tmp
+
+
+def temp_folder(target: Path) -> Path:
+    """A new hidden folder next to ``target`` (a folder to be) with the name of a temporary,
+    ``.name.p<pid>h<host>r<random>.part``: :func:`remove_dead_temporaries` removes it once its
+    process is gone; :func:`_forget` it when it is moved into place or removed."""
+    tmp = tempfile.mkdtemp(
+        prefix=f".{target.name}.p{os.getpid()}h{_HOST}r", suffix=TEMP_SUFFIX, dir=target.parent
+    )
+    _LIVE.add(os.path.abspath(tmp))
+    return Path(tmp)
 
 
 def _forget(tmp: str) -> None:
@@ -530,7 +542,8 @@ def remove_dead_temporaries(folder: PathLike) -> list[str]:
     A temporary's name carries the id of the process that made it and a hash of its host
     (:func:`_temp_name`); one made on this machine by a process that no longer runs (killed:
     SIGKILL, a crash, a power cut) is removed whatever its file's name or age, also the
-    temporary of a temporary (``..g.<t1>.part.<t2>.part.laz``) and a writer's sidecar of it.
+    temporary of a temporary (``..g.<t1>.part.<t2>.part.laz``), a writer's sidecar of it and a
+    staging folder of tiles (:func:`temp_folder`) with everything in it.
     Temporaries of running processes, of this process, of other hosts (a shared folder) and
     names without a process id are left alone (:func:`remove_stale_temporaries` removes
     those of a job's outputs by age). Errors are ignored.
@@ -570,7 +583,10 @@ def remove_dead_temporaries(folder: PathLike) -> list[str]:
             continue
         full = os.path.join(folder, name)
         try:
-            if os.path.isfile(full):
+            if os.path.isdir(full) and not os.path.islink(full):  # a staging folder
+                shutil.rmtree(full)
+                removed.append(full)
+            elif os.path.isfile(full):
                 os.unlink(full)
                 removed.append(full)
         except OSError:

@@ -34,7 +34,7 @@ from typing import Union
 import numpy as np
 
 from ..photo.bundle_result import BundleResult
-from .tables import write_csv_atomic
+from .tables import number, write_csv_atomic
 
 __all__ = [
     "CHECK_COLUMNS",
@@ -65,19 +65,11 @@ _COMPARISON_KEYS = {
 }  # fmt: skip
 
 
-def _num(v: float, digits: int = 4) -> str:
-    return f"{v:.{digits}f}" if np.isfinite(v) else ""
-
-
-def _g(v: float) -> str:
-    return f"{v:.6g}" if np.isfinite(v) else ""
-
-
 def write_bundle_points(path: Union[str, Path], res: BundleResult) -> None:
     """The object points with their sigmas (format in the module docstring)."""
     parts = zip(res.point_id, res.point_role, res.point_xyz, res.point_sigma, res.point_images)
     rows = (
-        (p, r, *(_num(v) for v in x), *(_num(v, 5) for v in s), int(n)) for p, r, x, s, n in parts
+        (p, r, *(number(v) for v in x), *(number(v) for v in s), int(n)) for p, r, x, s, n in parts
     )
     write_csv_atomic(path, POINT_COLUMNS, rows)
 
@@ -87,8 +79,8 @@ def write_bundle_residuals(path: Union[str, Path], res: BundleResult) -> None:
     obs = res.observations
     vlen = np.hypot(res.v_px[:, 0], res.v_px[:, 1])
     rows = (
-        (i, p, role, repr(float(px[0])), repr(float(px[1])), _g(s), _num(v[0]), _num(v[1]),
-         _num(vl), _num(w[0], 3), _num(w[1], 3), _num(r[0], 3), _num(r[1], 3), int(rej), int(u))
+        (i, p, role, number(px[0]), number(px[1]), number(s), number(v[0]), number(v[1]),
+         number(vl), number(w[0]), number(w[1]), number(r[0]), number(r[1]), int(rej), int(u))
         for i, p, role, px, s, v, vl, w, r, rej, u in zip(
             obs.image_id, obs.point_id, res.obs_role, obs.pixels, obs.sigma_px, res.v_px, vlen,
             res.w, res.redundancy, res.rejected, res.used,
@@ -102,9 +94,9 @@ def check_rows(res: BundleResult, tag: bool = False) -> list[tuple[str, ...]]:
     the model too, ``GCP02 [bauer]``, so that several models' rows stay unique)."""
     c = res.check
     return [
-        (f"{p} [{res.ap_model}]" if tag else p, *(_num(v) for v in m), *(_num(v) for v in r),
+        (f"{p} [{res.ap_model}]" if tag else p, *(number(v) for v in m), *(number(v) for v in r),
          res.ap_model,
-         *(_num(v, 5) for v in s), str(int(n)))
+         *(number(v) for v in s), str(int(n)))
         for p, m, r, s, n in zip(c.point_id, c.measured, c.reference, c.sigma, c.n_images)
     ]  # fmt: skip
 
@@ -123,7 +115,7 @@ def write_comparison(path: Union[str, Path], rows: Sequence[dict]) -> None:
     def cell(r: dict, k: str) -> str:
         v = r.get(_COMPARISON_KEYS.get(k, k), "")
         if isinstance(v, float):
-            return _g(v)
+            return number(v)
         return "" if v is None else str(v)
 
     write_csv_atomic(path, COMPARISON_COLUMNS, ([cell(r, k) for k in COMPARISON_COLUMNS]

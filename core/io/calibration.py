@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from .atomic import write_text_atomic
-from .tables import write_csv_atomic
+from .tables import number, write_csv_atomic
 
 RESIDUAL_COLUMNS = ("image", "point_id", "col", "row", "v_col", "v_row", "w_col", "w_row")
 
@@ -44,13 +44,9 @@ def read_image_grey(path: Union[str, Path]) -> NDArray[np.uint8]:
     return img
 
 
-def _num(x: float, digits: int = 4) -> str:
-    return "" if not math.isfinite(x) else f"{x:.{digits}f}"
-
-
 def write_residuals_csv(path: Union[str, Path], result: Any) -> None:
     """Write the residual table of a :class:`core.photo.camera_calibration.CalibrationResult`."""
-    rows = ((img, pid, _num(c), _num(r), _num(vc), _num(vr), _num(wc, 2), _num(wr, 2))
+    rows = ((img, pid, number(c), number(r), number(vc), number(vr), number(wc), number(wr))
             for img, pid, c, r, vc, vr, wc, wr in result.residuals)  # fmt: skip
     write_csv_atomic(path, RESIDUAL_COLUMNS, rows)
 

@@ -36,6 +36,7 @@ from .tables import (
     check_covariance,
     find_column,
     float_column,
+    number,
     read_table,
     text_column,
     unique_integer_ids,
@@ -64,17 +65,13 @@ GRAPH_COLUMNS = (
 PathLike = Union[str, Path]
 
 
-def _f(v: float) -> str:
-    return repr(float(v))
-
-
 def write_lcps_csv(path: PathLike, points: Sequence[ControlPoint]) -> None:
     rows = []
     for p in points:
         axes, _ = error_ellipsoid(p.covariance)
         rows.append(
-            [p.id, *map(_f, p.xyz), *map(_f, p.sigma), *map(_f, p.covariance[_IU3]),
-             *map(_f, axes), *p.plane_ids, _f(p.min_angle_deg), _f(p.condition)]
+            [p.id, *map(number, p.xyz), *map(number, p.sigma), *map(number, p.covariance[_IU3]),
+             *map(number, axes), *p.plane_ids, number(p.min_angle_deg), number(p.condition)]
         )  # fmt: skip
     write_csv_atomic(path, LCP_COLUMNS, rows)
 
@@ -108,9 +105,10 @@ def read_lcps_csv(path: PathLike) -> list[ControlPoint]:
 
 def write_lines_csv(path: PathLike, lines: Sequence[ControlLine]) -> None:
     rows = [
-        [ln.id, *ln.plane_ids, ln.kind, *map(_f, ln.start), *map(_f, ln.end), _f(ln.length),
-         *map(_f, ln.point), *map(_f, ln.direction), _f(ln.sigma_perpendicular),
-         *map(_f, ln.sigma_ends), _f(ln.dihedral_deg), *map(_f, ln.covariance[_IU6])]
+        [ln.id, *ln.plane_ids, ln.kind, *map(number, ln.start), *map(number, ln.end),
+         number(ln.length), *map(number, ln.point), *map(number, ln.direction),
+         number(ln.sigma_perpendicular), *map(number, ln.sigma_ends), number(ln.dihedral_deg),
+         *map(number, ln.covariance[_IU6])]
         for ln in lines
     ]  # fmt: skip
     write_csv_atomic(path, LINE_COLUMNS, rows)
@@ -161,7 +159,7 @@ def read_lines_csv(path: PathLike) -> list[ControlLine]:
 
 def write_graph_csv(path: PathLike, adjacency: Adjacency) -> None:
     rows = [
-        [int(a), int(b), int(adj), _f(length), int(count), *map(_f, centre)]
+        [int(a), int(b), int(adj), number(length), int(count), *map(number, centre)]
         for (a, b), adj, length, count, centre in zip(
             adjacency.pairs.tolist(), adjacency.adjacent, adjacency.boundary_length,
             adjacency.contact_count, adjacency.contact_centre,

@@ -186,9 +186,7 @@ def write_report_csv(path: PathLike, rows: Sequence[dict]) -> None:
     def cell(v: object) -> object:
         if v is None:
             return ""
-        if isinstance(v, float):
-            return "" if not math.isfinite(v) else repr(v)
-        return v
+        return v  # floats: write_csv_atomic writes them in full (tables.number)
 
     write_csv_atomic(path, REPORT_COLUMNS, ([cell(r.get(c)) for c in REPORT_COLUMNS]
                                             for r in rows))  # fmt: skip

@@ -9,7 +9,7 @@ from typing import Union
 import numpy as np
 
 from ..photo.monoplot import STATUS_TEXT, MonoplotResult
-from .tables import write_csv_atomic
+from .tables import number, write_csv_atomic
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -23,10 +23,6 @@ LINE_COLUMNS = ("line", "image_id", "target_id", "n_vertices", "status", "status
                 "length", "sigma_start", "sigma_end", "wkt")  # fmt: skip
 
 
-def _f(v: float, fmt: str = ".4f") -> str:
-    return format(float(v), fmt) if np.isfinite(v) else ""
-
-
 def write_monoplot_points_csv(path: PathLike, r: MonoplotResult) -> None:
     """The point table: one row per ray (observation point or line vertex), atomically."""
     sig = r.sigmas
@@ -34,10 +30,10 @@ def write_monoplot_points_csv(path: PathLike, r: MonoplotResult) -> None:
     for k, (img, pid, kind, tgt, li, vi, how) in enumerate(r.rows):
         c = r.covariance[k]
         out.append((
-            img, pid, kind, tgt, li, vi, _f(r.pixels[k, 0], ".3f"), _f(r.pixels[k, 1], ".3f"),
-            *(_f(v) for v in r.points[k]), *(_f(v, ".5f") for v in sig[k]),
-            *(_f(v, ".3e") for v in (c[0, 1], c[0, 2], c[1, 2])), int(r.status[k]),
-            STATUS_TEXT[int(r.status[k])], how, _f(r.incidence_deg[k], ".2f"),
+            img, pid, kind, tgt, li, vi, number(r.pixels[k, 0]), number(r.pixels[k, 1]),
+            *(number(v) for v in r.points[k]), *(number(v) for v in sig[k]),
+            *(number(v) for v in (c[0, 1], c[0, 2], c[1, 2])), int(r.status[k]),
+            STATUS_TEXT[int(r.status[k])], how, number(r.incidence_deg[k]),
         ))  # fmt: skip
     write_csv_atomic(path, POINT_COLUMNS, out)
 
@@ -48,8 +44,9 @@ def write_monoplot_lines_csv(path: PathLike, r: MonoplotResult) -> None:
     for li, ln in enumerate(r.lines):
         v = ln.vertices[np.isfinite(ln.vertices).all(axis=1)]
         length = float(np.linalg.norm(np.diff(v, axis=0), axis=1).sum()) if len(v) > 1 else 0.0
-        wkt = "LINESTRING Z (" + ", ".join(f"{x:.4f} {y:.4f} {z:.4f}" for x, y, z in v) + ")"
+        xyz = ", ".join(f"{number(x)} {number(y)} {number(z)}" for x, y, z in v)
+        wkt = f"LINESTRING Z ({xyz})"
         out.append((li, ln.image_id, ln.target_id, len(ln.vertices), ln.status,
-                    STATUS_TEXT[ln.status], _f(length), _f(ln.sigma_ends[0], ".5f"),
-                    _f(ln.sigma_ends[1], ".5f"), wkt if len(v) > 1 else ""))  # fmt: skip
+                    STATUS_TEXT[ln.status], number(length), number(ln.sigma_ends[0]),
+                    number(ln.sigma_ends[1]), wkt if len(v) > 1 else ""))  # fmt: skip
     write_csv_atomic(path, LINE_COLUMNS, out)

@@ -38,6 +38,7 @@ from .tables import (
     Table,
     find_column,
     float_column,
+    number,
     read_table,
     text_column,
     unique_ids,
@@ -77,14 +78,14 @@ def _eo_rows(eo: ExteriorOrientationTable) -> Iterator[tuple[str, ...]]:
     ):
         yield (
             image,
-            "" if not np.isfinite(t) else f"{t:.6f}",
+            number(t),
             group,
-            f"{x:.4f}",
-            f"{y:.4f}",
-            f"{z:.4f}",
-            f"{w:.10f}",
-            f"{p:.10f}",
-            f"{k:.10f}",
+            number(x),
+            number(y),
+            number(z),
+            number(w),
+            number(p),
+            number(k),
         )
 
 
@@ -185,7 +186,7 @@ def write_eo_csv_with_sigmas(
 
     def rows() -> Iterator[tuple[str, ...]]:
         for k, base in enumerate(_eo_rows(eo)):
-            s = tuple("" if not np.isfinite(v) else f"{v:.6g}" for v in sig[k])
+            s = tuple(number(v) for v in sig[k])
             yield base + s + ((camera[k],) if camera is not None else ())
 
     write_csv_atomic(path, cols, rows())

@@ -23,7 +23,14 @@ import numpy as np
 
 from ..errors import InputError
 from ..geometry.planes import Plane
-from .tables import check_covariance, find_column, float_column, read_table, write_csv_atomic
+from .tables import (
+    check_covariance,
+    find_column,
+    float_column,
+    number,
+    read_table,
+    write_csv_atomic,
+)
 
 _PARAMS = "abcd"
 
@@ -53,10 +60,6 @@ PLANE_COLUMNS: tuple[str, ...] = (
 _IU = np.triu_indices(4)
 
 
-def _fmt(value: float) -> str:
-    return repr(float(value))
-
-
 def write_planes_csv(path: Union[str, Path], planes: Sequence[Plane]) -> None:
     """Write the plane table (header ``PLANE_COLUMNS``, see the module docstring) atomically.
 
@@ -72,15 +75,15 @@ def write_planes_csv(path: Union[str, Path], planes: Sequence[Plane]) -> None:
         rows.append(
             [
                 str(int(p.id)),
-                *(_fmt(v) for v in p.normal),
-                _fmt(p.d),
-                *(_fmt(v) for v in p.centroid),
+                *(number(v) for v in p.normal),
+                number(p.d),
+                *(number(v) for v in p.centroid),
                 str(int(p.n_points)),
-                _fmt(p.rms),
-                _fmt(p.sigma_d),
-                _fmt(p.slope_deg),
-                _fmt(p.aspect_deg),
-                *(_fmt(v) for v in p.covariance[_IU]),
+                number(p.rms),
+                number(p.sigma_d),
+                number(p.slope_deg),
+                number(p.aspect_deg),
+                *(number(v) for v in p.covariance[_IU]),
             ]
         )
     write_csv_atomic(path, PLANE_COLUMNS, rows)

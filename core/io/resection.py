@@ -65,6 +65,7 @@ from .tables import (
     find_column,
     float_column,
     normalise,
+    number,
     read_table,
     text_column,
     unique_ids,
@@ -197,14 +198,14 @@ def read_line_control_csv(path: PathLike) -> LineControl:
 
 def _unique(ids: Sequence[str], rows: Sequence[int], table, col: int) -> tuple[str, ...]:
     first: dict[str, int] = {}
-    for value, number in zip(ids, rows):
+    for value, line_no in zip(ids, rows):
         if not value:
-            raise InputError("empty id", path=table.path, row=number,
+            raise InputError("empty id", path=table.path, row=line_no,
                              column=table.columns[col])  # fmt: skip
         if value in first:
             raise InputError(f"line id '{value}' already appears in row {first[value]}",
-                             path=table.path, row=number, column=table.columns[col])
-        first[value] = number
+                             path=table.path, row=line_no, column=table.columns[col])
+        first[value] = line_no
     return tuple(ids)
 
 
@@ -225,10 +226,6 @@ def _wkt_ends(text: str, path: str, row: int) -> tuple[list[float], list[float]]
     return vertices[0], vertices[-1]
 
 
-def _num(v: float, fmt: str) -> str:
-    return format(float(v), fmt) if math.isfinite(float(v)) else ""
-
-
 def write_eo_sigma_csv(path: PathLike, rows: Iterable[Sequence[object]]) -> None:
     """Write the EO table with precision; ``rows`` hold the values of
     :data:`EO_SIGMA_COLUMNS` (angles in radians, converted here), in that order."""
@@ -237,11 +234,11 @@ def write_eo_sigma_csv(path: PathLike, rows: Iterable[Sequence[object]]) -> None
         (image, time, group, x, y, z, w, p, k, sx, sy, sz, sw, sp, sk, s0, red, chi2, crit,
          passed, npt, nln, rej, model, start) = r  # fmt: skip
         out.append((
-            image, _num(time, ".6f"), group, _num(x, ".4f"), _num(y, ".4f"), _num(z, ".4f"),
-            *(_num(math.degrees(a), ".10f") for a in (w, p, k)),
-            *(_num(s, ".5f") for s in (sx, sy, sz)),
-            *(_num(math.degrees(s), ".8f") for s in (sw, sp, sk)),
-            _num(s0, ".5f"), int(red), _num(chi2, ".5f"), _num(crit, ".5f"), int(bool(passed)),
+            image, number(time), group, number(x), number(y), number(z),
+            *(number(math.degrees(a)) for a in (w, p, k)),
+            *(number(s) for s in (sx, sy, sz)),
+            *(number(math.degrees(s)) for s in (sw, sp, sk)),
+            number(s0), int(red), number(chi2), number(crit), int(bool(passed)),
             int(npt), int(nln), int(rej), model, start,
         ))  # fmt: skip
     write_csv_atomic(path, EO_SIGMA_COLUMNS, out)
@@ -252,7 +249,7 @@ def write_residuals_csv(path: PathLike, rows: Iterable[Sequence[object]]) -> Non
     out = []
     for r in rows:
         image, point, kind, target, vertex, col, row, vx, vy, dist, w, rej, used = r
-        out.append((image, point, kind, target, int(vertex), _num(col, ".3f"), _num(row, ".3f"),
-                    _num(vx, ".4f"), _num(vy, ".4f"), _num(dist, ".4f"), _num(w, ".3f"),
+        out.append((image, point, kind, target, int(vertex), number(col), number(row),
+                    number(vx), number(vy), number(dist), number(w),
                     int(bool(rej)), int(bool(used))))  # fmt: skip
     write_csv_atomic(path, RESIDUAL_COLUMNS, out)

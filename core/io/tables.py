@@ -13,7 +13,7 @@ import os
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Union
+from typing import Any, Union
 
 import numpy as np
 from numpy.typing import NDArray
@@ -213,6 +213,23 @@ def unique_integer_ids(table: Table, values: NDArray[np.float64], index: int) ->
     return out
 
 
+def number(value: Any) -> str:
+    """A number as the core writes it in every table: the shortest text that reads back to the
+    same double (``repr``: full precision, no rounding, whatever the unit), empty when it is not
+    finite (no value).
+
+    >>> number(0.1 + 0.2), number(1.5e-6), number(float("nan")), number(np.float32(0.1))
+    ('0.30000000000000004', '1.5e-06', '', '0.10000000149011612')
+    """
+    v = float(value)
+    return repr(v) if math.isfinite(v) else ""
+
+
+def _cell(value: object) -> object:
+    """A float cell through :func:`number`; anything else as it is."""
+    return number(value) if isinstance(value, (float, np.floating)) else value
+
+
 def write_csv_atomic(
     path: PathLike,
     columns: Sequence[str],
@@ -222,6 +239,7 @@ def write_csv_atomic(
     """Write a CSV through :func:`~lidarphoto.core.io.atomic.atomic_write`: a temporary file in
     the same folder moved into place, so a crash never leaves a half-written file at ``path``.
 
+    Float cells are written with :func:`number` (full precision; empty when not finite).
     ``comments`` are written before the header as ``# text`` lines (the readers of this
     package skip them), e.g. a warning the user must not miss.
     """
@@ -230,7 +248,7 @@ def write_csv_atomic(
             fh.write("# " + " ".join(str(line).split()) + "\n")
         writer = csv.writer(fh, lineterminator="\n")
         writer.writerow(columns)
-        writer.writerows(rows)
+        writer.writerows([_cell(v) for v in row] for row in rows)
 
 
 def _detect_delimiter(header: str) -> str | None:

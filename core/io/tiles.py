@@ -41,7 +41,7 @@ from numpy.typing import NDArray
 
 from ..errors import Cancelled, CrsError, InputError, stop_if_asked
 from ..geometry.frames import parse_crs
-from .atomic import PathLike, write_text_atomic
+from .atomic import PathLike, _forget, remove_dead_temporaries, temp_folder, write_text_atomic
 from .pointcloud import CloudInfo, LasPoints, read_info
 
 #: Suffixes of the point-cloud files of a folder block.
@@ -576,12 +576,13 @@ def read_buffered(
 # ----------------------------------------------------------------------------- outputs
 def staging_folder(target: PathLike) -> Path:
     """A new hidden folder next to ``target`` (a folder to be) where the tiles are written
-    before :func:`commit_folder` moves it into place."""
-    import tempfile
-
+    before :func:`commit_folder` moves it into place; its name carries this process's id
+    (:func:`~core.io.atomic.temp_folder`), and the staging folders and temporaries a killed
+    run left next to ``target`` are removed first (only those whose process is gone)."""
     dest = Path(target)
     dest.parent.mkdir(parents=True, exist_ok=True)
-    return Path(tempfile.mkdtemp(prefix=f".{dest.name}.", suffix=".part", dir=dest.parent))
+    remove_dead_temporaries(dest.parent)
+    return temp_folder(dest)
 
 
 def commit_folder(staging: PathLike, target: PathLike) -> None:
@@ -600,9 +601,12 @@ def commit_folder(staging: PathLike, target: PathLike) -> None:
     except OSError:
         if old is not None:
             os.replace(old, dest)
+            _forget(str(old))
         raise
+    _forget(str(staging))
     if old is not None:
         shutil.rmtree(old, ignore_errors=True)
+        _forget(str(old))
 
 
 def write_vpc(path: PathLike, tiles: Sequence[dict[str, Any]], crs_wkt: str) -> None:

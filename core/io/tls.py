@@ -45,6 +45,7 @@ from .tables import (
     Table,
     find_column,
     float_column,
+    number,
     read_table,
     text_column,
     unique_ids,
@@ -263,10 +264,6 @@ def read_tls_stations_csv(path: PathLike) -> list[StationInfo]:
     return out
 
 
-def _num(x: float) -> str:
-    return repr(float(x)) if np.isfinite(x) else ""
-
-
 def write_tls_stations_csv(
     path: PathLike, cal: TlsCalibration, comments: Sequence[str] = ()
 ) -> None:
@@ -278,8 +275,8 @@ def write_tls_stations_csv(
     for k, s in enumerate(cal.stations):
         p, sd = cal.pose[k], cal.pose_std[k]
         rows.append(
-            (s, *map(_num, p[:3]), *map(_num, np.degrees(p[3:])), *map(_num, sd[:3]),
-             *map(_num, sd[3:] / ARCSEC), int(cal.levelled[k]), counts[s])
+            (s, *map(number, p[:3]), *map(number, np.degrees(p[3:])), *map(number, sd[:3]),
+             *map(number, sd[3:] / ARCSEC), int(cal.levelled[k]), counts[s])
         )  # fmt: skip
     write_csv_atomic(path, STATION_COLUMNS, rows, comments)
 
@@ -287,8 +284,8 @@ def write_tls_stations_csv(
 def write_tls_aps_csv(path: PathLike, cal: TlsCalibration, comments: Sequence[str] = ()) -> None:
     """The additional parameters in report units (:data:`AP_COLUMNS`)."""
     rows = [
-        (a["name"], a["formula"], a["cause"], a["unit"], _num(a["value"]), _num(a["std"]),
-         _num(a["std_prior"]), _num(a["t"]), int(a["significant"]))
+        (a["name"], a["formula"], a["cause"], a["unit"], number(a["value"]), number(a["std"]),
+         number(a["std_prior"]), number(a["t"]), int(a["significant"]))
         for a in cal.ap_report()
     ]  # fmt: skip
     write_csv_atomic(path, AP_COLUMNS, rows, comments)
@@ -303,7 +300,7 @@ def write_tls_targets_csv(
     for s, t in zip(obs.station, obs.target):
         seen.setdefault(t, set()).add(s)
     rows = [
-        (t, *map(_num, cal.target_xyz[k]), *map(_num, cal.target_std[k]), cal.target_kind[k],
+        (t, *map(number, cal.target_xyz[k]), *map(number, cal.target_std[k]), cal.target_kind[k],
          len(seen.get(t, ())))
         for k, t in enumerate(cal.targets)
     ]  # fmt: skip
@@ -319,8 +316,8 @@ def write_tls_residuals_csv(
     face = obs.face_two
     v, w = cal.residuals, cal.w
     rows = [
-        (obs.station[k], obs.target[k], "II" if face[k] else "I", _num(v[k, 0] * 1000.0),
-         _num(v[k, 1] / ARCSEC), _num(v[k, 2] / ARCSEC), *map(_num, w[k]),
+        (obs.station[k], obs.target[k], "II" if face[k] else "I", number(v[k, 0] * 1000.0),
+         number(v[k, 1] / ARCSEC), number(v[k, 2] / ARCSEC), *map(number, w[k]),
          int(cal.rejected[k]), int(obs.rows[k]))
         for k in range(len(obs))
     ]  # fmt: skip
@@ -336,9 +333,9 @@ def write_tls_observations_csv(
     scale = 1.0 / ANGLE_UNITS[angle_unit]
     sig = np.sqrt(np.einsum("nii->ni", obs.cov))
     rows = [
-        (obs.station[k], obs.target[k], _num(obs.polar[k, 0]), _num(obs.polar[k, 1] * scale),
-         _num(obs.polar[k, 2] * scale), _num(sig[k, 0]), _num(sig[k, 1] / ARCSEC),
-         _num(sig[k, 2] / ARCSEC))
+        (obs.station[k], obs.target[k], number(obs.polar[k, 0]), number(obs.polar[k, 1] * scale),
+         number(obs.polar[k, 2] * scale), number(sig[k, 0]), number(sig[k, 1] / ARCSEC),
+         number(sig[k, 2] / ARCSEC))
         for k in range(len(obs))
     ]  # fmt: skip
     columns = ("station_id", "target_id", "range", f"hz_{suffix}", f"vt_{suffix}", "s_range",
@@ -348,5 +345,5 @@ def write_tls_observations_csv(
 
 def write_tls_control_csv(path: PathLike, control: Sequence[ControlTarget]) -> None:
     """A control table ``target_id,X,Y,Z,s_X,s_Y,s_Z`` (m)."""
-    rows = [(c.id, *map(_num, c.xyz), *map(_num, c.sigma)) for c in control]
+    rows = [(c.id, *map(number, c.xyz), *map(number, c.sigma)) for c in control]
     write_csv_atomic(path, ("target_id", "X", "Y", "Z", "s_X", "s_Y", "s_Z"), rows)

@@ -21,8 +21,10 @@ from .common import (
     CSV_OUT,
     LAS_FILTER,
     doubt_params,
+    global_test_verdict,
     mount_from,
     mount_params,
+    rejection_doubts,
     settle_doubts,
 )
 from .runner import JobResult
@@ -95,9 +97,11 @@ parameters and why (the HTML then carries the diagnosis).
 ## Checks of the result
 The run fails (nothing but the HTML summary, which says why, is written) when the
 adjustment did not converge, when its global test fails with sigma0 above the largest sigma0
-(the observations do not fit their sigmas), or when an estimated angle exceeds the largest
-plausible boresight. With Write the results even when the checks fail, the outputs are
-written and each starts with a warning (CSV: comment lines beginning with #).""",
+(the observations do not fit their sigmas), when the robust stage and data snooping rejected
+more observations than their false alarms explain (the global test of the rest then says
+nothing), or when an estimated angle exceeds the largest plausible boresight. With Write the
+results even when the checks fail, the outputs are written and each starts with a warning (CSV:
+comment lines beginning with #).""",
     params=(
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
         Param("TRAJECTORY", "file", "Trajectory table (CSV)", file_filter=CSV_FILTER),
@@ -139,7 +143,8 @@ written and each starts with a warning (CSV: comment lines beginning with #)."""
         *doubt_params(
             "a failed global test with sigma0 above this fails the run (wrong sigma_px or INS "
             "grade, or blunders data snooping did not catch)",
-            "no convergence, global test beyond MAX_SIGMA0 or boresight beyond MAX_BORESIGHT: "
+            "no convergence, global test beyond MAX_SIGMA0, more rejections than false alarms "
+            "explain or boresight beyond MAX_BORESIGHT: "
             "write the outputs anyway, each with a warning at its top",
         ),
         Param("OUTPUT_TABLE", "file_out", "Boresight per group (CSV)", file_filter=CSV_OUT),
@@ -193,7 +198,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             write_text_atomic(out.path("OUTPUT_HTML"), page)
             out.commit(["OUTPUT_HTML"])
         raise
-    doubts = doubts_about(result, v.max_boresight, v.max_sigma0)
+    doubts = doubts_about(result, v.max_boresight, v.max_sigma0, options.snooping_alpha)
 
     def failed_page() -> str:  # the failed adjustment, without the positions it would give
         failed = BoresightRun(result, obs, np.full((len(obs), 3), np.nan), ("",) * len(obs),
@@ -292,7 +297,7 @@ def _summary_lines(result, warning: list) -> list[str]:
             f"{row['group']:8} {row['parameter']:8} {row['value_deg']:12.6f} "
             f"{row['value_arcsec']:10.1f} {row['std_arcsec']:8.1f}"
         )
-    test = "passed" if result.chi2_passed else "failed"
+    test = global_test_verdict(result.chi2_passed, result.adjustment, options.snooping_alpha)
     lines.append(
         f"sigma0 {result.sigma0:.3f}, redundancy {result.redundancy}, global test {test}, "
         f"{int(result.residuals.rejected.sum())} observations rejected"
@@ -300,9 +305,11 @@ def _summary_lines(result, warning: list) -> list[str]:
     return lines
 
 
-def doubts_about(result, max_boresight_deg: float, max_sigma0: float) -> list[str]:
+def doubts_about(result, max_boresight_deg: float, max_sigma0: float,
+                 snooping_alpha: float = 0.001) -> list[str]:  # fmt: skip
     """Why the calibration's numbers cannot be trusted (empty when they can): no convergence,
-    a global test failed with sigma0 above ``max_sigma0``, an angle beyond
+    a global test failed with sigma0 above ``max_sigma0``, more rejections than data
+    snooping's false alarms at ``snooping_alpha`` explain, an angle beyond
     ``max_boresight_deg``, numbers that are not finite."""
     import numpy as np
     out = []
@@ -325,6 +332,7 @@ def doubts_about(result, max_boresight_deg: float, max_sigma0: float) -> list[st
                 maximum=max_sigma0,
             )
         )
+    out.extend(t.message() for t in rejection_doubts(adj, snooping_alpha))
     deg = result.boresight_deg
     large, nonfinite = [], []
     for g, name in enumerate(result.groups):

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_FILTER, CSV_OUT
+from .common import CSV_FILTER, CSV_OUT, global_test_verdict
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -389,7 +389,8 @@ def _summary_lines(res, best: str, rows) -> list[str]:
     a = res.adjustment
     lines.append(
         f"{best}: sigma0 {a.sigma0:.3f}, redundancy {a.redundancy}, global test "
-        f"{'passed' if a.global_test.passed else 'failed'}, {int(res.rejected.sum())} "
+        f"{global_test_verdict(a.global_test.passed, a, BundleOptions.snooping_alpha)}, "
+        f"{int(res.rejected.sum())} "
         f"measurements rejected, {len(res.dropped)} APs dropped"
     )
     if len(res.check.point_id):

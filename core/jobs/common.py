@@ -181,3 +181,40 @@ def settle_doubts(
         for line in warning:
             logging.getLogger(__name__).warning(line.removeprefix("WARNING: "))
     return warning
+
+
+def global_test_verdict(passed: bool, adjustment: Any, alpha: float, failed: str = "failed"
+                        ) -> str:  # fmt: skip
+    """The global test's word for a summary line: ``failed``, ``passed``, or, when the
+    robust stage and data snooping (per-row significance ``alpha``) rejected more
+    observations than their false alarms explain (:func:`~core.lsq.results.rejection_test`
+    on ``adjustment``), "passed only after rejecting ...": the test of the rest then says
+    nothing about the model (the message is logged as a warning too).
+
+    >>> from types import SimpleNamespace as NS
+    >>> import numpy as np
+    >>> table = lambda n, k: NS(v=np.zeros((n, 2)), rejected=np.arange(n) < k)
+    >>> global_test_verdict(True, NS(residuals={"image": table(100, 1)}), 0.001)
+    'passed'
+    >>> global_test_verdict(True, NS(residuals={"image": table(100, 30)}), 0.001)
+    'passed only after rejecting 30 of 100 observations (false alarms explain at most 3)'
+    """
+    if not passed:
+        return failed
+    rejections = rejection_doubts(adjustment, alpha)
+    if not rejections:
+        return "passed"
+    test = rejections[0]
+    logging.getLogger(__name__).warning(str(test.message()))
+    return (f"passed only after rejecting {test.rejected} of {test.groups} observations (false "
+            f"alarms explain at most {test.bound})")  # fmt: skip
+
+
+def rejection_doubts(adjustment: Any, alpha: float) -> list[Any]:
+    """``[test]`` when the rejections of ``adjustment`` (robust stage and data snooping at
+    ``alpha`` per row) fail :func:`~core.lsq.results.rejection_test` (its ``message()`` is
+    the doubt :func:`settle_doubts` takes), else ``[]``."""
+    from ..lsq.results import unexplained_rejections
+
+    test = unexplained_rejections(adjustment, alpha)
+    return [] if test is None else [test]

@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 import math
 
-from .common import CSV_FILTER, CSV_OUT
+from .common import CSV_FILTER, CSV_OUT, global_test_verdict
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -250,7 +250,7 @@ def _summary_lines(runs: list) -> list[str]:
             f"{r.image.image_id:16} {r.result.xyz[0]:12.3f} {r.result.xyz[1]:13.3f} "
             f"{r.result.xyz[2]:9.3f} {deg[0]:9.5f} {deg[1]:9.5f} {deg[2]:10.5f} "
             f"{res.sigma0:7.3f} {r.image.data.n_points:4d} {r.image.data.n_lines:4d} "
-            f"{'passed' if res.chi2_passed else 'FAILED'}"
+            + global_test_verdict(res.chi2_passed, res.adjustment, options.snooping_alpha, "FAILED")
         )
     return lines_out
 

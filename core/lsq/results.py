@@ -370,3 +370,15 @@ def rejection_test(
     bound = int(np.argmax(upper < level)) if (upper < level).any() else top
     p_value = 1.0 if k == 0 else float(upper[k - 1])
     return RejectionTest(groups, k, float(alpha), float(level), float(expected), bound, p_value)
+
+
+def unexplained_rejections(
+    result: AdjustmentResult, alpha: float, level: float = 0.001
+) -> RejectionTest | None:
+    """The :func:`rejection_test` of ``result`` when it fails (more rejections than the false
+    alarms of snooping at ``alpha`` per row explain), else None (also when nothing was
+    rejected: then scipy is not imported)."""
+    if not any(bool(np.any(t.rejected)) for t in result.residuals.values()):
+        return None
+    test = rejection_test(result, alpha, level)
+    return None if test.passed else test

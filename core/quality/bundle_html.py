@@ -64,8 +64,17 @@ def _comparison(rows: Sequence[Mapping[str, object]], best: str) -> str:
 
 
 def _adjustment(res: BundleResult) -> str:
+    from ..lsq.results import unexplained_rejections
+    from ..photo.bundle_setup import BundleOptions
+
     a = res.adjustment
     gt = a.global_test
+    # the robust stage and snooping set aside more than their false alarms explain: the test
+    # of the rest says nothing about the model
+    doubt = unexplained_rejections(a, BundleOptions.snooping_alpha) if gt.passed else None
+    verdict = t("passed") if gt.passed else t("FAILED")
+    if doubt is not None:
+        verdict = t("passed, but only after more rejections than false alarms explain")
     rows = [
         [t("converged"), t("yes") if a.converged else t("NO"),
          t("after {} iterations").format(a.iterations)],
@@ -74,16 +83,20 @@ def _adjustment(res: BundleResult) -> str:
         [t("redundancy"), _e(a.redundancy),
          t("{} observation rows, {} parameters, {} constraint rows").format(
              a.n_observations, len(a.x), a.n_constraints)],
-        [t("global chi-square test"), t("passed") if gt.passed else t("FAILED"),
+        [t("global chi-square test"), verdict,
          t("statistic {}, accepted [{}, {}], p = {}").format(
              f"{gt.statistic:.1f}", f"{gt.lower:.1f}", f"{gt.upper:.1f}", f"{gt.p_value:.3g}")
          if gt.dof > 0 else t("no redundancy")],
         [t("outliers"), _e(int(res.rejected.sum())), _e(t(a.outlier_method))],
+        *([[t("rejections explained by false alarms"), _e(doubt.rejected),
+            t("at most {bound} ({expected} expected); {k} rejected: P = {p}").format(
+                bound=doubt.bound, expected=f"{doubt.expected:.2g}", k=doubt.rejected,
+                p=f"{doubt.p_value:.2g}")]] if doubt is not None else []),
         [t("condition number (reduced system)"), _n(a.condition_number, ".3g"), ""],
     ]  # fmt: skip
-    return _table(
-        ["", t("value"), t("details")], rows, ["", "", "", "pass" if gt.passed else "fail"]
-    )
+    good = gt.passed and doubt is None
+    return _table(["", t("value"), t("details")], rows,
+                  ["", "", "", "pass" if good else "fail", "", "" if doubt is None else "fail"])
 
 
 def _interior(res: BundleResult, alpha_text: str) -> str:

@@ -82,8 +82,8 @@ def render_resection_html(
         rows.append([_e(r.image_id), *(_n(x, 3) for x in r.result.xyz),
                      *(_n(a, 5) for a in deg), str(r.image.data.n_points),
                      str(r.image.data.n_lines), _n(res.sigma0, 3),
-                     t("passed") if res.chi2_passed else t("FAILED")])  # fmt: skip
-        css.append("pass" if res.chi2_passed else "fail")
+                     _verdict(res)])  # fmt: skip
+        css.append("pass" if res.chi2_passed and _doubt(res) is None else "fail")
     parts.append(_table([t("image"), "X (m)", "Y (m)", "Z (m)", "omega (deg)", "phi (deg)",
                          "kappa (deg)", t("points"), t("lines"), "sigma0", t("test")], rows,
                         css))  # fmt: skip
@@ -128,7 +128,7 @@ def _image(r, residuals: list) -> list[str]:
             [n, _n(v, 5), _n(s, 5)] for n, v, s in zip(
                 ("focal", "x0", "y0"), res.interior, res.interior_std)]))  # fmt: skip
     gt = res.chi2
-    verdict = t("passed") if res.chi2_passed else t("FAILED")
+    verdict = _verdict(res)
     out.append(f"<h3>{t('Global test')}</h3>")
     out.append(_table([t("quantity"), t("value")], [
         [t("observations (condition rows)"), str(res.adjustment.n_observations)],
@@ -140,7 +140,8 @@ def _image(r, residuals: list) -> list[str]:
         [t("verdict (one-sided)"), verdict],
         [t("condition number (scaled normal matrix)"),
          f"{res.adjustment.condition_number:.3g}"],
-    ], ["", "", "", "", "", "pass" if res.chi2_passed else "fail"]))  # fmt: skip
+    ], ["", "", "", "", "", "pass" if res.chi2_passed and _doubt(res) is None else "fail"]
+    ))  # fmt: skip
     out.append(f"<h3>{t('Correlation of the six parameters')}</h3>")
     corr = res.correlation
     out.append(_table(["", *_NAMES], [
@@ -176,3 +177,23 @@ def _prior_std(r) -> np.ndarray:
     if not (math.isfinite(s0) and s0 > 0):
         return np.full(6, math.nan)
     return r.result.std / s0 * res.adjustment.sigma0_prior
+
+
+def _doubt(res):
+    """The failed rejection test of a resection (:func:`core.lsq.results.unexplained_rejections`
+    at the snooping alpha of the job's options), None when it passed or was not needed."""
+    from ..lsq.results import unexplained_rejections
+    from ..photo.resection import ResectionOptions
+
+    if not res.chi2_passed:
+        return None
+    return unexplained_rejections(res.adjustment, ResectionOptions.snooping_alpha)
+
+
+def _verdict(res) -> str:
+    """The image's global test: passed, FAILED, or passed only after unexplained rejections."""
+    if not res.chi2_passed:
+        return t("FAILED")
+    if _doubt(res) is not None:
+        return t("passed, but only after more rejections than false alarms explain")
+    return t("passed")

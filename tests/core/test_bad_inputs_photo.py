@@ -439,3 +439,36 @@ def test_fisheye_images_taken_as_perspective_say_so(tmp_path, capsys):
              r"equisolid|stereographic) projection \(f \d+ px\) .* field of view of about "
              r"[12]\d\d degrees\): try PROJECTION (equidistant|equisolid|"
              r"stereographic)$")
+
+
+def test_simulated_fisheye_views_taken_as_perspective_say_so(tmp_path, capsys, monkeypatch):
+    """The same case in CI, where the BoofCV views are absent: 4 views of a chessboard
+    simulated through an equidistant fisheye (f = 300 px; the first of
+    tests/core/test_camera_calibration.py's set) are what the target detector finds in 4 image
+    files; calibratecamera taken as perspective names the projection to try, writes nothing
+    and leaves the images (7 s of CPU: the failing adjustment and its diagnosis)."""
+    from lidarphoto.core.photo import calibration_targets
+    from test_camera_calibration import _camera, _views
+
+    inp, out = tmp_path / "in", tmp_path / "out"
+    inp.mkdir()
+    out.mkdir()
+    spec = TargetSpec("chessboard", 9, 6, 0.05)
+    projection = "equidistant"
+    cam = _camera(projection)
+    det = simulate_views(cam, target_field(spec), _views(projection)[:4], noise_px=0.2, seed=2)
+    blank = np.zeros((cam.height_px, cam.width_px), np.uint8)
+    for k in range(len(det)):
+        cv2.imwrite(str(inp / f"view{k:02d}.png"), blank)
+    by_name = {f"view{k:02d}.png": d for k, d in enumerate(det)}
+    monkeypatch.setattr(calibration_targets, "detect_target", lambda img, s, name: by_name[name])
+    argv = ["calibratecamera", "--images", str(inp), "--target", "chessboard", "--columns",
+            "9", "--rows", "6", "--spacing", "0.05", "--pixel-size", str(cam.pixel_size_mm),
+            "--output-camera", str(out / "cam.json")]  # fmt: skip
+    _refused(argv, inp, out, capsys,
+             rf"camera calibration did not converge in \d+ iterations; the views look like a "
+             rf"fisheye lens: the target's straight lines fit the {projection} projection \(f "
+             rf"(29[5-9]|30[0-5]) px\) [\d.]+ times better than the perspective one \(RMS "
+             rf"misfit .* % of the rays' spread\) and the target is seen up to about \d+ "
+             rf"degrees off the axis \(a field of view of about 1[5-9]\d degrees\): try "
+             rf"PROJECTION {projection}$")

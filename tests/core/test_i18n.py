@@ -356,7 +356,8 @@ def test_boresight_doubts_in_portuguese():
     from lidarphoto.core.jobs.boresight_calibration import doubts_about
     from lidarphoto.core.quality.boresight_html import render_boresight_html
 
-    result = S(adjustment=S(converged=True, iterations=4, warnings=[]), chi2_passed=False,
+    result = S(adjustment=S(converged=True, iterations=4, warnings=[], residuals={}),
+               chi2_passed=False,
                sigma0=3.5, groups=("g1",), boresight_deg=np.array([[0.01, 2.5, 0.0]]),
                std=np.full((1, 3), 1e-3))  # fmt: skip
     doubts = doubts_about(result, 1.0, 2.0)
