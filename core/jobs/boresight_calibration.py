@@ -212,8 +212,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     run = BoresightRun(result, obs, positions, tuple(image_group.get(i, "") for i in obs.image_id),
                        settings, frame.crs.to_wkt())  # fmt: skip
     _write_outputs(out, run, settings, doubts, warning)
-    return JobResult(results={"SIGMA0": result.sigma0}, lines=_summary_lines(result, warning),
-                     data=run)  # fmt: skip
+    lines = _summary_lines(result, warning, options.snooping_alpha)
+    return JobResult(results={"SIGMA0": result.sigma0}, lines=lines, data=run)
 
 
 def _read_inputs(v: Values, frame) -> tuple:
@@ -289,7 +289,7 @@ def _write_outputs(out, run, settings, doubts: list, warning: list) -> None:
         write_text_atomic(out.path("OUTPUT_HTML"), page)
 
 
-def _summary_lines(result, warning: list) -> list[str]:
+def _summary_lines(result, warning: list, snooping_alpha: float) -> list[str]:
     """The log's summary: the angles of every group and the adjustment's figures."""
     lines = [*warning, f"{'group':8} {'angle':8} {'deg':>12} {'arcsec':>10} {'sigma':>8}"]
     for row in result.table_rows():
@@ -297,7 +297,7 @@ def _summary_lines(result, warning: list) -> list[str]:
             f"{row['group']:8} {row['parameter']:8} {row['value_deg']:12.6f} "
             f"{row['value_arcsec']:10.1f} {row['std_arcsec']:8.1f}"
         )
-    test = global_test_verdict(result.chi2_passed, result.adjustment, options.snooping_alpha)
+    test = global_test_verdict(result.chi2_passed, result.adjustment, snooping_alpha)
     lines.append(
         f"sigma0 {result.sigma0:.3f}, redundancy {result.redundancy}, global test {test}, "
         f"{int(result.residuals.rejected.sum())} observations rejected"

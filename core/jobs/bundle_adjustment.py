@@ -374,6 +374,8 @@ def _write_outputs(out, results: dict, best: str, rows: list, settings, *, multi
 def _summary_lines(res, best: str, rows) -> list[str]:
     """The log's summary: the ranking of the AP models (``rows``, when several), then the
     adjustment of ``best`` and its check points."""
+    from ..photo.bundle_options import BundleOptions
+
     st = res.check.statistics()
     lines = []
     if rows:

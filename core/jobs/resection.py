@@ -150,7 +150,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     _write_outputs(v, out, runs, camera, obs, points, lines, frame)
     sigma0 = max((r.result.result.sigma0 for r in runs), default=math.nan)
     return JobResult(results={"IMAGE_COUNT": len(runs), "SIGMA0": sigma0},
-                     lines=_summary_lines(runs), data=runs)  # fmt: skip
+                     lines=_summary_lines(runs, options.snooping_alpha), data=runs)  # fmt: skip
 
 
 def _read_inputs(v: Values) -> tuple:
@@ -235,7 +235,7 @@ def _write_outputs(v: Values, out, runs: list, camera, obs, points, lines, frame
                           render_resection_html(runs, residuals, settings))  # fmt: skip
 
 
-def _summary_lines(runs: list) -> list[str]:
+def _summary_lines(runs: list, snooping_alpha: float) -> list[str]:
     """The log's table: one line per image."""
     import numpy as np
 
@@ -250,7 +250,7 @@ def _summary_lines(runs: list) -> list[str]:
             f"{r.image.image_id:16} {r.result.xyz[0]:12.3f} {r.result.xyz[1]:13.3f} "
             f"{r.result.xyz[2]:9.3f} {deg[0]:9.5f} {deg[1]:9.5f} {deg[2]:10.5f} "
             f"{res.sigma0:7.3f} {r.image.data.n_points:4d} {r.image.data.n_lines:4d} "
-            + global_test_verdict(res.chi2_passed, res.adjustment, options.snooping_alpha, "FAILED")
+            + global_test_verdict(res.chi2_passed, res.adjustment, snooping_alpha, "FAILED")
         )
     return lines_out
 
