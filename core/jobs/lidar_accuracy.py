@@ -451,7 +451,7 @@ def _run_tiled(v: Values, files, infos, grid, options, checkpoints, progress, sh
 
     from ..quality.lidar_accuracy import report_from_cells
     from ..quality.lidar_swaths import finish_cells
-    from .lidar_block import _stop_workers, gather, open_client
+    from .lidar_block import cluster_session, gather
 
     if options.swath_source == "gps_time":
         raise InputError("SWATH_SOURCE gps_time needs the whole survey at once: TILE_SIZE 0")
@@ -466,22 +466,12 @@ def _run_tiled(v: Values, files, infos, grid, options, checkpoints, progress, sh
                      "each (every file a tile meets is decoded whole)",
                      "use smaller files (e.g. lidarblock's tiles) or fewer WORKERS")  # fmt: skip
     check_xy = None if checkpoints is None else checkpoints.xyz[:, :2]
-    client, cluster = open_client(v)
-    try:
+    with cluster_session(v) as client:
         futures = [client.submit(accuracy_tile, files, boxes, own, grid, options, check_xy,
                                  pure=False, key=f"lidaraccuracy-{k}-{os.getpid()}-"
                                  f"{time.time_ns()}") for k, own in enumerate(tiles)]  # fmt: skip
-        try:
-            parts = [p for p in gather(client, futures, progress, should_stop, 0.0, 0.9)
-                     if p.fits is not None]  # fmt: skip
-        except BaseException:
-            if cluster is not None:
-                _stop_workers(cluster)
-            raise
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        parts = [p for p in gather(client, futures, progress, should_stop, 0.0, 0.9)
+                 if p.fits is not None]  # fmt: skip
     if not parts:
         raise InputError("the survey has no points in its header's box")
     cells = finish_cells([p.fits for p in parts], grid, options)

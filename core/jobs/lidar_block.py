@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import os
@@ -605,12 +606,14 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     )  # fmt: skip
 
 
-def _on_cluster(v: Values, index, settings, staging: str, progress, should_stop) -> dict:
-    """:func:`run_block` on the client of the parameters; its workers stopped when the block
-    fails or is cancelled, the client and cluster closed in every case."""
+@contextlib.contextmanager
+def cluster_session(v: Values):
+    """The dask client of the parameters (:func:`open_client`) for the block inside; a local
+    cluster's workers stopped at once when it fails or is cancelled, the client and cluster
+    closed in every case."""
     client, cluster = open_client(v)
     try:
-        return run_block(index, settings, staging, client, progress, should_stop)
+        yield client
     except BaseException:
         if cluster is not None:
             _stop_workers(cluster)
@@ -619,6 +622,12 @@ def _on_cluster(v: Values, index, settings, staging: str, progress, should_stop)
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _on_cluster(v: Values, index, settings, staging: str, progress, should_stop) -> dict:
+    """:func:`run_block` on the client of the parameters (:func:`cluster_session`)."""
+    with cluster_session(v) as client:
+        return run_block(index, settings, staging, client, progress, should_stop)
 
 
 def _write_tables(staging: Path, block: dict, good: list, info) -> None:
