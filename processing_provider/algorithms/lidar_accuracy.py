@@ -28,7 +28,7 @@ def style_swath_dz(layer) -> None:
     if not math.isfinite(limit) or limit <= 0:
         limit = 0.1
     shader = QgsColorRampShader(-limit, limit)
-    shader.setColorRampType(QgsColorRampShader.Interpolated)
+    shader.setColorRampType(QgsColorRampShader.Type.Interpolated)
     shader.setColorRampItemList([
         QgsColorRampShader.ColorRampItem(-limit, QColor(33, 102, 172), f"{-limit:.3f}"),
         QgsColorRampShader.ColorRampItem(0.0, QColor(247, 247, 247), "0"),
