@@ -141,6 +141,8 @@ def _problem(
         raise InputError("x0 contains NaN or inf")
     if opts.max_iterations < 1 or not opts.tolerance > 0 or not opts.sigma0_prior > 0:
         raise InputError("max_iterations >= 1, tolerance > 0 and sigma0_prior > 0 are required")
+    if not (opts.function_tolerance >= 0 and opts.gradient_tolerance >= 0):
+        raise InputError("function_tolerance and gradient_tolerance must be >= 0")
     obs = [_prepare_block(b, n, name_list) for b in blocks]
     bnames = [b.name for b in obs]
     if len(set(bnames)) != len(bnames):
