@@ -304,6 +304,25 @@ def test_snavely_jacobians_against_finite_differences():
         assert np.abs(num - jp[:, :, j]).max() < 1e-7 * np.abs(jp[:, :, j]).max()
 
 
+def test_snavely_compiled_kernel_equals_numpy():
+    """The numba kernel (core/geometry/snavely_numba.py) and the numpy code: the same
+    projections and Jacobians to rounding, also for rotations below the series threshold."""
+    pytest.importorskip("numba")
+    rng = np.random.default_rng(3)
+    n = 200
+    cam = np.column_stack([rng.normal(0, 0.5, (n, 3)), rng.normal(0, 1, (n, 2)),
+                           rng.normal(-8, 1, n), rng.uniform(400, 600, n),
+                           rng.normal(0, 0.1, n), rng.normal(0, 0.01, n)])  # fmt: skip
+    cam[:20, :3] *= 1e-6  # |r| < 1e-4: the series branch
+    X = rng.normal(0, 1, (n, 3))
+    ref = snavely_project(cam, X, compiled=False)
+    got = snavely_project(cam, X, compiled=True)
+    for a, b in zip(ref, got):
+        np.testing.assert_allclose(b, a, rtol=1e-12, atol=1e-12 * np.abs(a).max())
+    u = snavely_project(cam, X, jacobian=False, compiled=True)
+    np.testing.assert_allclose(u, ref[0], rtol=1e-12, atol=1e-9)
+
+
 @pytest.mark.skipif(not (BAL / "dubrovnik-3-7-pre.txt").is_file(), reason="BAL data not here")
 def test_bal_reader_and_projection_on_dubrovnik():
     from lidarphoto.core.io.bal import read_bal
