@@ -13,8 +13,6 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from ..compiled import AVAILABLE, cached_njit
-
 Array = NDArray[np.float64]
 
 __all__ = ["project"]
@@ -101,17 +99,28 @@ def _kernel(c, X, u, jc, jp, want_jac):  # pragma: no cover - compiled
 _COMPILED: list = []
 
 
-def project(cameras: Array, points: Array, jacobian: bool) -> tuple | Array | None:
-    """``snavely_project`` compiled (None without numba)."""
+def _compile(*kernels):
+    """The kernels compiled (numba imports only here: importing this module stays light),
+    or None without numba."""
+    from ..compiled import AVAILABLE, cached_njit
+
     if not AVAILABLE:
         return None
-    if not _COMPILED:
-        _COMPILED.append(cached_njit(_kernel, nogil=True))
+    while len(_COMPILED) < len(kernels):
+        _COMPILED.append(cached_njit(kernels[len(_COMPILED)], nogil=True))
+    return _COMPILED
+
+
+def project(cameras: Array, points: Array, jacobian: bool) -> tuple | Array | None:
+    """``snavely_project`` compiled (None without numba)."""
+    compiled = _compile(_kernel)
+    if compiled is None:
+        return None
     c = np.ascontiguousarray(cameras, dtype=np.float64)
     X = np.ascontiguousarray(points, dtype=np.float64)
     n = c.shape[0]
     u = np.empty((n, 2))
     jc = np.empty((n, 2, 9) if jacobian else (0, 2, 9))
     jp = np.empty((n, 2, 3) if jacobian else (0, 2, 3))
-    _COMPILED[0](c, X, u, jc, jp, bool(jacobian))
+    compiled[0](c, X, u, jc, jp, bool(jacobian))
     return (u, jc, jp) if jacobian else u

@@ -42,10 +42,15 @@ quadratic model predicted the decrease well), and Gauss-Newton is tried again on
 below 1e-7 (lowered a hundredfold after each rejected Gauss-Newton step, so that nearly
 singular directions keep a little damping). With constraints the merit function is
 ``Omega + nu ||h||_1`` (an exact penalty, ``nu`` above the multipliers). Convergence is
-declared when the Gauss-Newton step is below ``tolerance`` in units of parameter precision,
-or at the rounding floor of parameters with large values (such as map coordinates): the
-relative change of the cost is below ``tolerance``, the step is below ``sqrt(tolerance)`` and
-has stopped shrinking (more than half the previous one).
+declared (:attr:`AdjustmentResult.termination` says which rule) when an accepted step lowers
+the merit by at most ``function_tolerance`` of it (Ceres' rule and default, 1e-6; one
+Gauss-Newton step follows, kept when it does not raise the cost, so that the estimates gain
+the digits a relative cost cannot show), when the Jacobi-scaled gradient is below
+``gradient_tolerance`` of the misclosure norm (no constraints), when the Gauss-Newton step is
+below ``tolerance`` in units of parameter precision, or at the rounding floor of parameters
+with large values (such as map coordinates): the relative change of the cost is below
+``tolerance``, the step is below ``sqrt(tolerance)`` and has stopped shrinking (more than
+half the previous one).
 
 Observability: before trusting a solve, the Jacobi-scaled ``N + C'C`` (``C`` the constraint rows
 normalised in the scaled space) is checked with a dense symmetric eigen-decomposition (up to a

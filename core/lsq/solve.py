@@ -302,6 +302,29 @@ def _trial(
         return None
 
 
+def _normal(
+    problem: _Problem,
+    lin: _Lin,
+    active: list[NDArray[np.bool_]],
+    rowscale: Array | None,
+    use_sparse: bool | None,
+    opts: AdjustmentOptions,
+    check: bool,
+) -> tuple[_Normal, Array | None, bool | None]:
+    """The normal equations at ``lin``, the solver choice, and (``check``) the observability
+    analysis of the first iteration."""
+    nrm, rowscale = problem.normal(lin, active, rowscale)
+    if isinstance(nrm, ReducedNormal):
+        use_sparse = nrm.use_sparse
+    elif use_sparse is None:
+        n = problem.n
+        use_sparse = n > _SPARSE_AUTO_MIN_N and nrm.Ns.nnz <= _SPARSE_AUTO_MAX_DENSITY * n * n
+    if check:
+        _check_observability(nrm, problem.names, opts.condition_limit,
+                             problem.constraint_labels())  # fmt: skip
+    return nrm, rowscale, use_sparse
+
+
 def _gradient_small(nrm: _Normal, lin: _Lin, opts: AdjustmentOptions) -> bool:
     """The gradient test of :attr:`AdjustmentOptions.gradient_tolerance` (no constraints)."""
     if lin.h.size or opts.gradient_tolerance <= 0 or not nrm.ns.size:
@@ -344,16 +367,8 @@ def _run(
     for it in range(1, opts.max_iterations + 1):
         stop_if_asked(should_stop, "adjusting")
         progress((it - 1) / opts.max_iterations)
-        nrm, rowscale = problem.normal(lin, active, rowscale)
-        if isinstance(nrm, ReducedNormal):
-            use_sparse = nrm.use_sparse
-        elif use_sparse is None:
-            n = problem.n
-            use_sparse = n > _SPARSE_AUTO_MIN_N and nrm.Ns.nnz <= _SPARSE_AUTO_MAX_DENSITY * n * n
-        if it == 1:
-            _check_observability(
-                nrm, problem.names, opts.condition_limit, problem.constraint_labels()
-            )
+        nrm, rowscale, use_sparse = _normal(problem, lin, active, rowscale, use_sparse,
+                                            opts, it == 1)  # fmt: skip
         if _gradient_small(nrm, lin, opts):
             converged, why, final = True, GRADIENT_TOLERANCE, nrm
             it -= 1  # no step taken
@@ -438,7 +453,8 @@ def _run(
         m_new = _merit(new, rowscale, nu)
         lin = new
         trace.append((it, lin.phi, time.perf_counter() - t0))
-        if m_new <= m_old * (1 + 1e-13) and m_old - m_new <= opts.function_tolerance * m_old:
+        ftol = opts.function_tolerance
+        if ftol > 0 and m_new <= m_old * (1 + 1e-13) and m_old - m_new <= ftol * m_old:
             # Ceres' function tolerance: the accepted step changed the cost too little to
             # be worth another damped iteration; one Gauss-Newton step follows
             finishing = True
