@@ -336,3 +336,45 @@ def test_bal_reader_and_projection_on_dubrovnik():
     # cost the shared MANIFEST states (2.764220e3)
     cost = 0.5 * np.sum((u - p.observations) ** 2)
     assert abs(cost / 2.764220e3 - 1) < 1e-6
+
+
+def test_compiled_reduced_system_equals_numpy(monkeypatch):
+    """A BAL-like block (Snavely's model, every camera with its own 9 parameters, so the
+    compiled per-block sums and the pair sums both run): the same adjustment with the numba
+    kernels and with the numpy code of core/lsq/schur.py, to rounding."""
+    pytest.importorskip("numba")
+    from lidarphoto.core.lsq import schur
+
+    rng = np.random.default_rng(4)
+    nc, npt = 6, 80
+    cams = np.column_stack([rng.normal(0, 0.1, (nc, 3)), rng.normal(0, 0.5, (nc, 2)),
+                            np.full(nc, -10.0), np.full(nc, 500.0), np.zeros((nc, 2))])  # fmt: skip
+    pts = rng.normal(0, 1.5, (npt, 3))
+    ci = np.repeat(np.arange(nc), npt)
+    pi = np.tile(np.arange(npt), nc)
+    keep = rng.random(ci.size) < 0.8
+    ci, pi = ci[keep], pi[keep]
+    obs = snavely_project(cams[ci], pts[pi], jacobian=False) + rng.normal(0, 0.5, (ci.size, 2))
+    x_true = np.concatenate([cams.ravel(), pts.ravel()])
+    x0 = x_true + np.concatenate([rng.normal(0, 1e-3, 9 * nc), rng.normal(0, 0.05, 3 * npt)])
+    names = [f"c{c} {k}" for c in range(nc) for k in range(9)]
+    names += [f"p{p} {a}" for p in range(npt) for a in "XYZ"]
+    idx = np.concatenate([ci[:, None] * 9 + np.arange(9), 9 * nc + pi[:, None] * 3 + np.arange(3)],
+                         axis=1)  # fmt: skip
+
+    def model(xl):
+        u, jc, jp = snavely_project(xl[:, :9], xl[:, 9:])
+        return u, np.concatenate([jc, jp], axis=2)
+
+    block = GaussMarkovBlock("obs", obs, 0.5, idx, model)
+    sig = np.tile([1e-3] * 6 + [1.0, 1e-3, 1e-3], nc)
+    prior = prior_block("cams", np.arange(9 * nc), cams.ravel(), sig)
+    elim = 9 * nc + np.arange(3 * npt).reshape(npt, 3)
+    opts = AdjustmentOptions(eliminate=elim)
+    fast = adjust(x0, names, [block, prior], options=opts)
+    monkeypatch.setattr(schur, "_COMPILED", False)
+    slow = adjust(x0, names, [block, prior], options=opts)
+    assert fast.converged and slow.converged and fast.iterations == slow.iterations
+    assert_allclose(fast.x, slow.x, rtol=1e-10, atol=1e-10)
+    assert_allclose(fast.std, slow.std, rtol=1e-8)
+    assert fast.omega == pytest.approx(slow.omega, rel=1e-10)
