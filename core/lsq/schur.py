@@ -59,8 +59,11 @@ __all__ = ["BlockCofactor", "ReducedNormal", "SingularSystem"]
 # the reduced matrix is sparse enough.
 _DENSE_MAX = 2500
 _SPARSE_MAX_DENSITY = 0.1
-# The compiled pair sums of the reduced matrix (numba, when it imports); False: numpy only.
+# The compiled sums of the reduced system (numba, when it imports); False: numpy only. They
+# run from _COMPILED_MIN items (pairs, or groups of a block) on: below, numpy is as fast and
+# numba's import and cache load (about a second) would not pay.
 _COMPILED = True
+_COMPILED_MIN = 20000
 
 
 class SingularSystem(Exception):
@@ -149,7 +152,8 @@ class ReducedNormal:
             kk1, kk2 = a.rows.shape[1], b.rows.shape[1]
 
             kr = pl.key_reducer
-            blocks = pair_sums(Za, Zb, o1, o2, kr.item_keys, kr.n_keys) if _COMPILED else None
+            big = _COMPILED and o1.size >= _COMPILED_MIN
+            blocks = pair_sums(Za, Zb, o1, o2, kr.item_keys, kr.n_keys) if big else None
             if blocks is None:
                 blocks = kr.sum_outer(
                     lambda it, Za=Za, o1=o1: Za[o1[it]], lambda it, Zb=Zb, o2=o2: Zb[o2[it]],
@@ -470,7 +474,7 @@ def build_reduced_normal(
         if not every:
             scale = a[:, None] * scale
         w = bl.wbar if every else bl.wbar * a[:, None]
-        if _plain(bp, g, b) and _COMPILED:
+        if _COMPILED and g >= _COMPILED_MIN and _plain(bp, g, b):
             sums = normal_sums(bl.abar, w, scale, bp.rc, bp.ec, bp.sig, bp.sig_rows.shape[0],
                                bp.point, P)  # fmt: skip
             if sums is not None:

@@ -25,15 +25,24 @@ def _kernel(Za, Zb, o1, o2, key, out):  # pragma: no cover - compiled
     b = Za.shape[1]
     k1 = Za.shape[2]
     k2 = Zb.shape[2]
+    acc = np.zeros((k1, k2))
+    last = -1
     for q in range(o1.size):
+        k = key[q]
+        if k != last:  # pairs come sorted by key: one block in the accumulator at a time
+            if last >= 0:
+                out[last] += acc
+                acc[:, :] = 0.0
+            last = k
         a = o1[q]
         c = o2[q]
-        k = key[q]
         for m in range(b):
             for i in range(k1):
                 z = Za[a, m, i]
                 for j in range(k2):
-                    out[k, i, j] += z * Zb[c, m, j]
+                    acc[i, j] += z * Zb[c, m, j]
+    if last >= 0:
+        out[last] += acc
 
 
 _COMPILED: list = []
@@ -63,27 +72,28 @@ def pair_sums(Za: Array, Zb: Array, o1: Index, o2: Index, key: Index, n_keys: in
 
 
 def _normal_kernel(abar, wbar, scale, rc, ec, sig, point, U, V, g_e, T):  # pragma: no cover
-    g_n, c_n, _ = abar.shape
+    g_n, c_n, k_n = abar.shape
     kr = rc.size
     b = ec.size
+    row = np.empty(k_n)
     for g in range(g_n):
         s = sig[g]
         p = point[g]
         for c in range(c_n):
             w = wbar[g, c]
+            for i in range(k_n):
+                row[i] = abar[g, c, i] * scale[g, i]
             for i in range(kr):
-                ri = abar[g, c, rc[i]] * scale[g, rc[i]]
-                if ri == 0.0:
-                    continue
+                ri = row[rc[i]]
                 for j in range(kr):
-                    U[s, i, j] += ri * abar[g, c, rc[j]] * scale[g, rc[j]]
+                    U[s, i, j] += ri * row[rc[j]]
                 for j in range(b):
-                    T[g, i, j] += ri * abar[g, c, ec[j]] * scale[g, ec[j]]
+                    T[g, i, j] += ri * row[ec[j]]
             for i in range(b):
-                ei = abar[g, c, ec[i]] * scale[g, ec[i]]
+                ei = row[ec[i]]
                 g_e[p, i] += w * ei
                 for j in range(b):
-                    V[p, i, j] += ei * abar[g, c, ec[j]] * scale[g, ec[j]]
+                    V[p, i, j] += ei * row[ec[j]]
 
 
 def normal_sums(abar: Array, wbar: Array, scale: Array, rc: Index, ec: Index, sig: Index,

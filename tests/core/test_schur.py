@@ -371,6 +371,7 @@ def test_compiled_reduced_system_equals_numpy(monkeypatch):
     prior = prior_block("cams", np.arange(9 * nc), cams.ravel(), sig)
     elim = 9 * nc + np.arange(3 * npt).reshape(npt, 3)
     opts = AdjustmentOptions(eliminate=elim)
+    monkeypatch.setattr(schur, "_COMPILED_MIN", 0)  # compiled at any size
     fast = adjust(x0, names, [block, prior], options=opts)
     monkeypatch.setattr(schur, "_COMPILED", False)
     slow = adjust(x0, names, [block, prior], options=opts)
