@@ -224,6 +224,7 @@ class _Damping:
     # Gauss-Newton step (nearly singular directions, e.g. points far away, need a little
     # damping all the way).
     floor: float = _LAMBDA_MIN
+    last: float = 0.0  # the damping of the step accepted last
 
 
 def _damped_step(
@@ -264,6 +265,7 @@ def _damped_step(
             # Ties at rounding level are accepted: the cost cannot go lower.
             m_try = _merit(cand, rowscale, nu) if cand is not None else math.inf
             if m_try <= m_old * (1 + 1e-13):
+                damp.last = lam
                 factor = 0.1
                 if lam > 0:
                     damp.good = lam
@@ -454,9 +456,12 @@ def _run(
         lin = new
         trace.append((it, lin.phi, time.perf_counter() - t0))
         ftol = opts.function_tolerance
-        if ftol > 0 and m_new <= m_old * (1 + 1e-13) and m_old - m_new <= ftol * m_old:
+        if (ftol > 0 and m_new <= m_old * (1 + 1e-13) and m_old - m_new <= ftol * m_old
+                and (not opts.damping or damp.last <= _LAMBDA_START)):  # fmt: skip
             # Ceres' function tolerance: the accepted step changed the cost too little to
-            # be worth another damped iteration; one Gauss-Newton step follows
+            # be worth another damped iteration; one Gauss-Newton step follows. Not after
+            # a heavily damped step: a small decrease there is a stall (e.g. a model that
+            # cannot fit), not the minimum
             finishing = True
             damp.memory = 0.0
             continue
