@@ -327,6 +327,18 @@ def _normal(
     return nrm, rowscale, use_sparse
 
 
+def _function_tolerance_met(opts: AdjustmentOptions, damp: _Damping, m_old: float,
+                            m_new: float) -> bool:  # fmt: skip
+    """Ceres' function tolerance: the accepted step changed the cost too little to be worth
+    another damped iteration (one Gauss-Newton step follows). Not after a heavily damped
+    step: a small decrease there is a stall (e.g. a model that cannot fit), not the minimum."""
+    ftol = opts.function_tolerance
+    return bool(
+        ftol > 0 and m_new <= m_old * (1 + 1e-13) and m_old - m_new <= ftol * m_old
+        and (not opts.damping or damp.last <= _LAMBDA_START)
+    )  # fmt: skip
+
+
 def _gradient_small(nrm: _Normal, lin: _Lin, opts: AdjustmentOptions) -> bool:
     """The gradient test of :attr:`AdjustmentOptions.gradient_tolerance` (no constraints)."""
     if lin.h.size or opts.gradient_tolerance <= 0 or not nrm.ns.size:
@@ -455,13 +467,7 @@ def _run(
         m_new = _merit(new, rowscale, nu)
         lin = new
         trace.append((it, lin.phi, time.perf_counter() - t0))
-        ftol = opts.function_tolerance
-        if (ftol > 0 and m_new <= m_old * (1 + 1e-13) and m_old - m_new <= ftol * m_old
-                and (not opts.damping or damp.last <= _LAMBDA_START)):  # fmt: skip
-            # Ceres' function tolerance: the accepted step changed the cost too little to
-            # be worth another damped iteration; one Gauss-Newton step follows. Not after
-            # a heavily damped step: a small decrease there is a stall (e.g. a model that
-            # cannot fit), not the minimum
+        if _function_tolerance_met(opts, damp, m_old, m_new):
             finishing = True
             damp.memory = 0.0
             continue
