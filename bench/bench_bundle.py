@@ -1,11 +1,16 @@
 """Bundle adjustment speed: our engine (analytic Jacobians, reduced camera system, Levenberg-
-Marquardt) against SciPy's ``least_squares`` with a sparse finite-difference Jacobian (the
-SciPy cookbook's bundle adjustment) on the BAL problems, from the same start; and a synthetic
-1,000-image block with 200,000 points (time and peak memory of the whole process).
+Marquardt) against Ceres Solver (its BAL example: Levenberg-Marquardt, DENSE_SCHUR, one
+thread; the peer in ``../shared/peers/ceres-bal``) on the BAL problems, from the same start,
+in interleaved runs; SciPy's ``least_squares`` with a sparse finite-difference Jacobian (the
+SciPy cookbook's bundle adjustment) as a second yardstick; and a synthetic 1,000-image block
+with 200,000 points (time and peak memory of the whole process).
 
-Run: ``.venv/bin/python bench/bench_bundle.py [bal|large|all]``; writes its section of
+Run: ``.venv/bin/python bench/bench_bundle.py [ceres|bal|large|all]``; writes its section of
 bench/bundle.md (bench/bundle_ap_models.py writes the accuracy section). The BAL files are read
-from ``../shared/data/bal`` (not in the repository).
+from ``../shared/data/bal`` (not in the repository); the Ceres program from ``$CERES_BAL``
+(default ``~/.cache/ceres-bal/ceres_bal``, what ``../shared/peers/ceres-bal/build.sh`` builds).
+``bench_bundle.py ours FILE`` runs our engine alone on one BAL file and prints one JSON line
+(for timing the whole process from outside).
 """
 
 from __future__ import annotations
@@ -84,7 +89,8 @@ class _SnavelyModel:
         return u, np.concatenate([jc, jp], axis=2)
 
 
-def engine(problem: BalProblem, tolerance: float = 1e-10) -> dict:
+def engine(problem: BalProblem, tolerance: float = 1e-10, max_iterations: int = 40,
+           function_tolerance: float = 1e-6) -> dict:  # fmt: skip
     """Our adjustment of the same cost ``0.5 sum r^2`` (unit sigmas), points eliminated.
 
     BAL problems have no datum: the seven similarity parameters are held by minimal
@@ -92,7 +98,9 @@ def engine(problem: BalProblem, tolerance: float = 1e-10) -> dict:
     of the second camera that a change of scale moves most), which changes no projection and
     hence not the minimum of the cost. A few points of these problems are seen along nearly
     parallel rays and drift away as the cost keeps falling by tiny amounts; the run stops after
-    40 iterations (the condition limit is raised to 1e16 so that they are accepted).
+    40 iterations (the condition limit is raised to 1e16 so that they are accepted), or when
+    an accepted step lowers the cost by less than ``function_tolerance`` (Ceres' rule and
+    default).
     """
     nc, npt = problem.cameras.shape[0], problem.points.shape[0]
     ci, pi = problem.camera_index, problem.point_index
@@ -117,8 +125,9 @@ def engine(problem: BalProblem, tolerance: float = 1e-10) -> dict:
         return (xl[0] - vals)[None], np.eye(7)[None]
 
     opts = AdjustmentOptions(eliminate=nc * 9 + np.arange(3 * npt).reshape(npt, 3),
-                             compute_covariance=False, tolerance=tolerance, max_iterations=40,
-                             condition_limit=1e16)  # fmt: skip
+                             compute_covariance=False, tolerance=tolerance,
+                             max_iterations=max_iterations, condition_limit=1e16,
+                             function_tolerance=function_tolerance)  # fmt: skip
     t = time.perf_counter()
     res = adjust(x0, names, [block], [Constraint("gauge", held[None], gauge)], opts)
     elapsed = time.perf_counter() - t
@@ -132,30 +141,86 @@ def engine(problem: BalProblem, tolerance: float = 1e-10) -> dict:
         "iterations": res.iterations,
         "converged": res.converged,
         "rms": float(np.sqrt(np.mean(v**2))),
+        "termination": res.termination,
+        "trace": [(i, 0.5 * c, t) for i, c, t in res.trace],
         "result": res,
     }
 
 
-def engine_to_cost(problem: BalProblem, target: float) -> dict:
-    """Time of our engine until its cost first reaches ``target`` (the cookbook's)."""
-    from lidarphoto.core.lsq import adjustment as adj
+def seconds_to_cost(run: dict, target: float) -> float:
+    """Seconds of a run of :func:`engine` until its cost first fell to ``target``: the whole
+    run less what followed the first iteration at or below it (conservative: the set-up and
+    the final statistics count in full). NaN when it never got there."""
+    trace = run["trace"]
+    hit = [t for _, c, t in trace if c <= target]
+    if not hit:
+        return float("nan")
+    return run["seconds"] - (trace[-1][2] - hit[0])
 
-    seen: dict = {}
-    orig = adj._merit
+
+def warm_up() -> None:
+    """Load the compiled kernels (numba's cache) on the 3-camera BAL file, as a program loads
+    its code before it runs: the timed runs then measure the adjustment alone."""
+    path = BAL / "dubrovnik-3-7-pre.txt"
+    if path.is_file():
+        try:
+            engine(read_bal(path), max_iterations=2)
+        except Exception:  # a gauge-deficient toy: only the kernels matter
+            pass
+
+
+def ours_json(path: Path) -> str:
+    """One run of our engine on a BAL file as a JSON line (after :func:`warm_up`)."""
+    import json
+
+    warm_up()
+    r = engine(read_bal(path), max_iterations=100)
+    return json.dumps({k: v for k, v in r.items() if k != "result"})
+
+
+def ceres_program() -> Path:
+    return Path(os.environ.get("CERES_BAL", "~/.cache/ceres-bal/ceres_bal")).expanduser()
+
+
+def ceres(path: Path, max_iterations: int = 100) -> dict:
+    """Ceres' BAL run (DENSE_SCHUR, one thread) as its JSON, with the whole process's
+    wall time."""
+    import json
+
     t = time.perf_counter()
+    out = subprocess.run([str(ceres_program()), str(path), "DENSE_SCHUR", "1",
+                          str(max_iterations)], capture_output=True, text=True,
+                         check=True)  # fmt: skip
+    d = json.loads(out.stdout.strip().splitlines()[-1])
+    d["process_s"] = time.perf_counter() - t
+    return d
 
-    def spy(lin, rowscale, nu):
-        m = orig(lin, rowscale, nu)
-        if "t" not in seen and 0.5 * lin.phi <= target:
-            seen["t"] = time.perf_counter() - t
-        return m
 
-    adj._merit = spy
-    try:
-        engine(problem)
-    finally:
-        adj._merit = orig
-    return {"seconds_to_target": seen.get("t", float("nan"))}
+def ours_process(path: Path) -> dict:
+    """:func:`ours_json` in a fresh process, with the whole process's wall time."""
+    import json
+
+    t = time.perf_counter()
+    out = subprocess.run([sys.executable, __file__, "ours", str(path)], capture_output=True,
+                         text=True, check=True, env=dict(os.environ))  # fmt: skip
+    d = json.loads(out.stdout.strip().splitlines()[-1])
+    d["process_s"] = time.perf_counter() - t
+    return d
+
+
+def against_ceres(path: Path, repeats: int = 3) -> dict:
+    """Interleaved runs (ours, Ceres, ours, Ceres, ...): per pair the ratios of the time to
+    Ceres' final cost and of the whole solve; medians over the pairs."""
+    pairs = []
+    for _ in range(repeats):
+        o = ours_process(path)
+        c = ceres(path)
+        to = seconds_to_cost(o, c["final_cost"])
+        pairs.append({"ours": o, "ceres": c, "to_cost": to / c["solve_wall_s"],
+                      "whole": o["seconds"] / c["solve_wall_s"],
+                      "process": o["process_s"] / c["process_s"]})  # fmt: skip
+    med = {k: float(np.median([p[k] for p in pairs])) for k in ("to_cost", "whole", "process")}
+    return {"pairs": pairs, **med}
 
 
 # ----------------------------------------------------------------------------- large block
@@ -199,17 +264,18 @@ def large(covariance: bool) -> dict:
 
 
 def main(what: str = "all") -> None:
-    lines = [
-        "## Speed",
-        "",
+    head = [
         f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()} ({os.cpu_count()} cores, "
         f"shared), Python {platform.python_version()}, numpy {np.__version__}, scipy "
         f"{scipy.__version__}; one BLAS thread. Wall times carry the noise of a shared machine "
         f"(about +/-30 %; load average {os.getloadavg()[0]:.1f} when the run started).",
         "",
     ]
+    if what in ("ceres", "all"):
+        write_section(HERE / "bundle.md", "ceres", "\n".join(head + ceres_section()))
     if what in ("bal", "all"):
-        lines += [
+        lines = [
+            *head,
             "### BAL problems: our engine against SciPy's cookbook, same start, same cost",
             "",
             "Cost = 0.5 sum r^2 (pixels). SciPy: `least_squares(method='trf', x_scale='jac', "
@@ -230,9 +296,9 @@ def main(what: str = "all") -> None:
                 lines.append(f"| {name} | missing | | | | | | | | |")
                 continue
             prob = read_bal(path)
-            ours = engine(prob)
+            ours = engine(prob, function_tolerance=0.0)
             sc = cookbook(prob)
-            to = engine_to_cost(prob, sc["final"])
+            to = {"seconds_to_target": seconds_to_cost(ours, sc["final"])}
             lines.append(
                 f"| {name} | {2 * prob.camera_index.size} | {ours['initial']:.6e} | "
                 f"{sc['final']:.6e} | {sc['seconds']:.1f} ({sc['nfev']}) | {ours['final']:.6e} | "
@@ -242,8 +308,10 @@ def main(what: str = "all") -> None:
             )
             print(lines[-1], flush=True)
         lines.append("")
+        write_section(HERE / "bundle.md", "speed", "\n".join(lines))
     if what in ("large", "all"):
-        lines += [
+        lines = [
+            *head,
             "### Synthetic 1,000-image block, 200,000 points",
             "",
             "`simulate_uav_block` with 25 strips of 40 images (60 %/30 % overlap), 200,000 "
@@ -265,7 +333,47 @@ def main(what: str = "all") -> None:
             )
             print(lines[-1], flush=True)
         lines.append("")
-    write_section(HERE / "bundle.md", "speed", "\n".join(lines))
+        write_section(HERE / "bundle.md", "large", "\n".join(lines))
+
+
+def ceres_section() -> list[str]:
+    """The comparison with Ceres (see :func:`against_ceres`), as Markdown lines."""
+    lines = [
+        "### BAL problems: our engine against Ceres Solver, same start, interleaved runs",
+        "",
+        "Cost = 0.5 sum r^2 (pixels). Ceres: its BAL example (`../shared/peers/ceres-bal`: "
+        "Levenberg-Marquardt, DENSE_SCHUR, one thread, its defaults: function tolerance 1e-6, "
+        "gradient 1e-10, parameter 1e-8). Ours: analytic Jacobians, points eliminated (reduced "
+        "camera system), Levenberg-Marquardt, the default stopping rules (function tolerance "
+        "1e-6, then one Gauss-Newton step), at most 100 iterations, the compiled kernels "
+        "loaded before the run (numba's cache: about 1.5 s once per process, in the "
+        "whole-process column). Runs alternate ours / Ceres, three pairs; the ratios are "
+        "taken pair by pair, medians. 'to Ceres' cost' is our time until our cost first "
+        "fell to Ceres' final cost, over Ceres' whole solve.",
+        "",
+        "| problem | Ceres final cost (iterations) | ours final cost (iterations, stopped by) | "
+        "Ceres solve s | ours s | ours / Ceres to Ceres' cost | ours / Ceres whole solve | "
+        "ours / Ceres whole process |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    if not ceres_program().is_file():
+        return [*lines, "| (no Ceres program at $CERES_BAL) | | | | | | | |", ""]
+    for name in PROBLEMS:
+        path = BAL / name
+        if not path.is_file():
+            lines.append(f"| {name} | missing | | | | | | |")
+            continue
+        r = against_ceres(path)
+        o, c = r["pairs"][0]["ours"], r["pairs"][0]["ceres"]
+        cs = float(np.median([p["ceres"]["solve_wall_s"] for p in r["pairs"]]))
+        os_ = float(np.median([p["ours"]["seconds"] for p in r["pairs"]]))
+        lines.append(
+            f"| {name} | {c['final_cost']:.2f} ({c['iterations']}) | {o['final']:.2f} "
+            f"({o['iterations']}, {o['termination']}) | {cs:.2f} | {os_:.2f} | "
+            f"{r['to_cost']:.2f} | {r['whole']:.2f} | {r['process']:.2f} |"
+        )
+        print(lines[-1], flush=True)
+    return [*lines, ""]
 
 
 def write_section(path: Path, name: str, text: str) -> None:
@@ -281,4 +389,7 @@ def write_section(path: Path, name: str, text: str) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "all")
+    if len(sys.argv) > 2 and sys.argv[1] == "ours":
+        print(ours_json(Path(sys.argv[2])), flush=True)
+    else:
+        main(sys.argv[1] if len(sys.argv) > 1 else "all")

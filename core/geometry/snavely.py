@@ -43,9 +43,12 @@ def rodrigues(r: Array) -> Array:
     return np.eye(3) + s1[:, None, None] * K + s2[:, None, None] * (K @ K)
 
 
-def snavely_project(cameras: Array, points: Array, jacobian: bool = True):
+def snavely_project(cameras: Array, points: Array, jacobian: bool = True,
+                    compiled: bool = True):  # fmt: skip
     """Projections (N, 2) of points (N, 3) by cameras (N, 9), and optionally the Jacobians
-    ``d u / d camera`` (N, 2, 9) and ``d u / d point`` (N, 2, 3).
+    ``d u / d camera`` (N, 2, 9) and ``d u / d point`` (N, 2, 3). ``compiled``: the numba
+    kernel of :mod:`.snavely_numba` when numba is there (the same formulas in one loop),
+    else numpy.
 
     >>> cam = np.array([[0, 0, 0, 0, 0, -10.0, 100.0, 0, 0]])
     >>> snavely_project(cam, np.array([[1.0, 2.0, 0.0]]), jacobian=False).tolist()
@@ -53,6 +56,12 @@ def snavely_project(cameras: Array, points: Array, jacobian: bool = True):
     """
     c = np.asarray(cameras, dtype=np.float64)
     X = np.asarray(points, dtype=np.float64)
+    if compiled and c.shape[0] > 0:
+        from .snavely_numba import project
+
+        out = project(c, X, jacobian)
+        if out is not None:
+            return out
     r, t, f, k1, k2 = c[:, :3], c[:, 3:6], c[:, 6], c[:, 7], c[:, 8]
     R = rodrigues(r)
     P = np.einsum("nij,nj->ni", R, X) + t

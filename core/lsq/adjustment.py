@@ -42,10 +42,15 @@ quadratic model predicted the decrease well), and Gauss-Newton is tried again on
 below 1e-7 (lowered a hundredfold after each rejected Gauss-Newton step, so that nearly
 singular directions keep a little damping). With constraints the merit function is
 ``Omega + nu ||h||_1`` (an exact penalty, ``nu`` above the multipliers). Convergence is
-declared when the Gauss-Newton step is below ``tolerance`` in units of parameter precision,
-or at the rounding floor of parameters with large values (such as map coordinates): the
-relative change of the cost is below ``tolerance``, the step is below ``sqrt(tolerance)`` and
-has stopped shrinking (more than half the previous one).
+declared (:attr:`AdjustmentResult.termination` says which rule) when an accepted step lowers
+the merit by at most ``function_tolerance`` of it (Ceres' rule and default, 1e-6; one
+Gauss-Newton step follows, kept when it does not raise the cost, so that the estimates gain
+the digits a relative cost cannot show), when the Jacobi-scaled gradient is below
+``gradient_tolerance`` of the misclosure norm (no constraints), when the Gauss-Newton step is
+below ``tolerance`` in units of parameter precision, or at the rounding floor of parameters
+with large values (such as map coordinates): the relative change of the cost is below
+``tolerance``, the step is below ``sqrt(tolerance)`` and has stopped shrinking (more than
+half the previous one).
 
 Observability: before trusting a solve, the Jacobi-scaled ``N + C'C`` (``C`` the constraint rows
 normalised in the scaled space) is checked with a dense symmetric eigen-decomposition (up to a
@@ -141,6 +146,8 @@ def _problem(
         raise InputError("x0 contains NaN or inf")
     if opts.max_iterations < 1 or not opts.tolerance > 0 or not opts.sigma0_prior > 0:
         raise InputError("max_iterations >= 1, tolerance > 0 and sigma0_prior > 0 are required")
+    if not (opts.function_tolerance >= 0 and opts.gradient_tolerance >= 0):
+        raise InputError("function_tolerance and gradient_tolerance must be >= 0")
     obs = [_prepare_block(b, n, name_list) for b in blocks]
     bnames = [b.name for b in obs]
     if len(set(bnames)) != len(bnames):

@@ -164,8 +164,22 @@ class AdjustmentOptions:
     max_iterations : int
         Maximum number of linearisations of one adjustment (each snooping round has its own).
     tolerance : float
-        Convergence threshold on the Gauss-Newton step in units of parameter precision
-        (``|dx_i| sqrt(N_ii)``) and on the relative change of ``v'Pv``.
+        Step tolerance: converged when the Gauss-Newton step is below this in units of
+        parameter precision (``max_i |dx_i| sqrt(N_ii)``; Ceres' ``parameter_tolerance`` is
+        relative to ``|x|`` instead, which map coordinates would make meaningless). Also the
+        rounding floor: the relative change of ``v'Pv`` below it with a step below
+        ``sqrt(tolerance)`` that no longer shrinks. Default 1e-10.
+    function_tolerance : float
+        Converged when an accepted step lowers the cost (``v'Pv``, with constraints the merit
+        function) by at most this fraction of it, as Ceres' ``function_tolerance``
+        (``|dcost| / cost``); default 1e-6, Ceres' default. 0 turns the rule off (then only
+        the step tolerance ends the iteration, as before).
+    gradient_tolerance : float
+        Converged when the Jacobi-scaled gradient is below this fraction of the norm of the
+        whitened misclosures (``max_i |a_i' w| / (|a_i| |w|)``: the largest cosine between a
+        column of the design matrix and the misclosure vector; scale-free, unlike Ceres'
+        ``gradient_tolerance``, whose default 1e-10 it shares). Not used with hard
+        constraints (the gradient there is balanced by the multipliers, not zero).
     damping : bool
         Levenberg-Marquardt (Marquardt's diagonal scaling) on top of Gauss-Newton; plain
         Gauss-Newton when False.
@@ -215,6 +229,8 @@ class AdjustmentOptions:
 
     max_iterations: int = 50
     tolerance: float = 1e-10
+    function_tolerance: float = 1e-6
+    gradient_tolerance: float = 1e-10
     damping: bool = True
     sparse: bool | None = None
     sigma0_prior: float = 1.0

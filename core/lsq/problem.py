@@ -49,6 +49,7 @@ class _Obs:
     labels: list[str]
     row_names: list[str]
     c: int | None  # condition rows per group (known after the first evaluation)
+    inv_sigma: Array | None = None  # (G, o) 1/sigma when every cov is diagonal, else None
 
     @property
     def groups(self) -> int:
@@ -168,6 +169,9 @@ def _prepare_block(block: Block, n: int, names: list[str]) -> _Obs:
             "positive definite"
         ) from None
     chol_inv = np.linalg.inv(chol) if g else chol
+    off = cov.copy()
+    off[:, np.arange(o), np.arange(o)] = 0.0
+    inv_sigma = None if off.any() else np.ascontiguousarray(np.einsum("gii->gi", chol_inv))
     weight = np.swapaxes(chol_inv, 1, 2) @ chol_inv
     func = block.model if gm else block.condition
     if isinstance(func, _PriorModel) and block.labels is None:
@@ -188,11 +192,14 @@ def _prepare_block(block: Block, n: int, names: list[str]) -> _Obs:
         labels=labels,
         row_names=row_names,
         c=o if gm else None,
+        inv_sigma=inv_sigma,
     )
 
 
 def _check_finite(block: str, labels: list[str], *arrays: Array) -> None:
     for a in arrays:
+        if np.isfinite(a.sum()):  # one pass; NaN or inf anywhere makes the sum non-finite
+            continue
         ok = np.isfinite(a.reshape(a.shape[0], -1)).all(axis=1)
         if not ok.all():
             raise _NonFiniteError(block, labels[int(np.flatnonzero(~ok)[0])])
@@ -238,8 +245,12 @@ class _Problem:
                 raise _shape_error(where, "model Jacobian J", J.shape, (g, o, k))
             _check_finite(b.name, b.labels, f, J)
             # B = -I: w = f - l does not depend on v^, and L is the Cholesky factor of S.
-            abar = b.chol_inv @ J
-            wbar = np.einsum("gij,gj->gi", b.chol_inv, f - b.observed)
+            if b.inv_sigma is not None:  # uncorrelated observations: L^-1 is diagonal
+                abar = J * b.inv_sigma[:, :, None]
+                wbar = (f - b.observed) * b.inv_sigma
+            else:
+                abar = b.chol_inv @ J
+                wbar = np.einsum("gij,gj->gi", b.chol_inv, f - b.observed)
             K = -b.chol
             return _BlockLin(abar=abar, wbar=wbar, K=K)
         gv, A, B = b.func(xl, b.observed + vhat)

@@ -123,6 +123,14 @@ class AdjustmentResult:
     iterations : int
         Linearisations of the last adjustment run.
     converged : bool
+    termination : str
+        Why the last run stopped: ``"step tolerance"``, ``"function tolerance"``,
+        ``"gradient tolerance"``, ``"rounding floor"`` (converged; see
+        :class:`AdjustmentOptions`), ``"iteration limit"`` or ``"no decrease"`` (not
+        converged).
+    trace : list of (int, float, float)
+        Per iteration of the last run (0: the start): the iteration, ``v'Pv`` (over the
+        groups kept, robust weights included) and the seconds since the run started.
     omega : float
         ``v'Pv`` over the groups kept.
     redundancy : int
@@ -181,6 +189,8 @@ class AdjustmentResult:
     n_constraints: int = 0
     outlier_method: str = "none"
     cofactor_blocks: BlockCofactor | None = None
+    termination: str = ""
+    trace: list[tuple[int, float, float]] = field(default_factory=list)
 
     def covariance_of(self, index: ArrayLike, prior: bool = False) -> Array:
         """Covariance matrix (k, k) of the parameters ``index`` (a posteriori sigma0, or the
@@ -221,7 +231,7 @@ class AdjustmentResult:
         lines = [
             "Least-squares adjustment",
             f"  converged: {'yes' if self.converged else 'NO'} after {self.iterations} "
-            f"iterations ({self.solver} solver)",
+            f"iterations ({self.solver} solver; stopped by: {self.termination or '-'})",
             f"  observations (condition rows): {self.n_observations}, parameters: "
             f"{len(self.x)}, hard constraints: {self.n_constraints}, redundancy: "
             f"{self.redundancy}",

@@ -47,6 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from .scaling import jacobi_scale, scale_constraints
+from .schur_numba import normal_sums, pair_sums
 from .schur_plan import EliminationPlan
 
 Array = NDArray[np.float64]
@@ -58,6 +59,11 @@ __all__ = ["BlockCofactor", "ReducedNormal", "SingularSystem"]
 # the reduced matrix is sparse enough.
 _DENSE_MAX = 2500
 _SPARSE_MAX_DENSITY = 0.1
+# The compiled sums of the reduced system (numba, when it imports); False: numpy only. They
+# run from _COMPILED_MIN items (pairs, or groups of a block) on: below, numpy is as fast and
+# numba's import and cache load (about a second) would not pay.
+_COMPILED = True
+_COMPILED_MIN = 20000
 
 
 class SingularSystem(Exception):
@@ -145,9 +151,14 @@ class ReducedNormal:
             o1, o2 = pl.o1, pl.o2
             kk1, kk2 = a.rows.shape[1], b.rows.shape[1]
 
-            blocks = pl.key_reducer.sum_outer(
-                lambda it, Za=Za, o1=o1: Za[o1[it]], lambda it, Zb=Zb, o2=o2: Zb[o2[it]], kk1, kk2
-            )
+            kr = pl.key_reducer
+            big = _COMPILED and o1.size >= _COMPILED_MIN
+            blocks = pair_sums(Za, Zb, o1, o2, kr.item_keys, kr.n_keys) if big else None
+            if blocks is None:
+                blocks = kr.sum_outer(
+                    lambda it, Za=Za, o1=o1: Za[o1[it]], lambda it, Zb=Zb, o2=o2: Zb[o2[it]],
+                    kk1, kk2,
+                )  # fmt: skip
             r1 = a.rows[pl.key_sig1]
             r2 = b.rows[pl.key_sig2]
             rr = np.broadcast_to(r1[:, :, None], blocks.shape).ravel()
@@ -398,6 +409,23 @@ class BlockCofactor:
         return Q / (dk[:, :, None] * dk[:, None, :])
 
 
+def _plain(bp, g: int, b: int) -> bool:
+    """A block plan the compiled sums cover: every group sees one eliminated block, its
+    columns in slot order, and every reduced column varies between groups."""
+    return bool(
+        bp.ec.size == b and bp.eslot_identity and bp.rc.size and bp.vc.size == bp.rc.size
+        and bp.cset < 0 and bp.vset >= 0 and bp.u_reducer is not None
+        and bp.v_reducer is not None and bp.with_point.size == g
+    )  # fmt: skip
+
+
+def _columns(A: Array, cols: Index) -> Array:
+    """``A[:, :, cols]``, a view when the columns are a contiguous run."""
+    if cols.size and (np.diff(cols) == 1).all():
+        return A[:, :, int(cols[0]) : int(cols[-1]) + 1]
+    return A[:, :, cols]
+
+
 def build_reduced_normal(
     plan: EliminationPlan,
     blocks: Sequence,
@@ -419,12 +447,13 @@ def build_reduced_normal(
     for bk, bl, a in zip(blocks, lins, active):
         if bk.groups == 0:
             continue
-        A = bl.abar * a[:, None, None]
-        w = bl.wbar * a[:, None]
-        diag += np.bincount(bk.param_index.ravel(), weights=(A * A).sum(axis=1).ravel(),
+        every = bool(a.all())
+        A = bl.abar if every else bl.abar * a[:, None, None]
+        w = bl.wbar if every else bl.wbar * a[:, None]
+        diag += np.bincount(bk.param_index.ravel(), weights=np.einsum("gck,gck->gk", A, A).ravel(),
                             minlength=n)  # fmt: skip
         grad += np.bincount(bk.param_index.ravel(),
-                            weights=(w[:, None, :] @ A)[:, 0, :].ravel(), minlength=n)  # fmt: skip
+                            weights=np.einsum("gc,gck->gk", w, A).ravel(), minlength=n)  # fmt: skip
     d = jacobi_scale(np.sqrt(np.clip(diag, 0.0, None)), C)
     dinv = 1.0 / d
     mc = 0 if C is None else C.shape[0]
@@ -440,12 +469,28 @@ def build_reduced_normal(
         g = bk.groups
         if g == 0:
             continue
-        As = bl.abar * (a[:, None, None] * dinv[bk.param_index][:, None, :])
-        w = bl.wbar * a[:, None]
-        R = As[:, :, bp.rc]
+        every = bool(a.all())
+        scale = dinv[bk.param_index]
+        if not every:
+            scale = a[:, None] * scale
+        w = bl.wbar if every else bl.wbar * a[:, None]
+        if _COMPILED and g >= _COMPILED_MIN and _plain(bp, g, b):
+            sums = normal_sums(bl.abar, w, scale, bp.rc, bp.ec, bp.sig, bp.sig_rows.shape[0],
+                               bp.point, P)  # fmt: skip
+            if sums is not None:
+                UR, Vb, gb, T[bp.vset] = sums
+                rs = bp.sig_rows
+                urows.append(np.broadcast_to(rs[:, :, None], UR.shape).ravel())
+                ucols.append(np.broadcast_to(rs[:, None, :], UR.shape).ravel())
+                uvals.append(UR.ravel())
+                V += Vb
+                g_e += gb
+                continue
+        As = bl.abar * scale[:, None, :]
+        R = _columns(As, bp.rc)
         ke = bp.ec.size
         if ke and bp.eslot_identity:
-            E = As[:, :, bp.ec]
+            E = _columns(As, bp.ec)
         elif ke:
             E = np.zeros((g, As.shape[1], b))
             for j in range(ke):

@@ -31,6 +31,7 @@ class _Reducer:
 
     def __init__(self, keys: Index, n_keys: int, chunk: int = _CHUNK) -> None:
         keys = np.asarray(keys, dtype=np.intp)
+        self.item_keys = keys  # the key of every item (for the compiled sums)
         # already sorted (pairs are stored in key order): the items are taken as slices
         self.identity = bool(keys.size < 2 or (keys[1:] >= keys[:-1]).all())
         self.order = (np.arange(keys.size, dtype=np.intp) if self.identity

@@ -6,7 +6,8 @@ scaled cofactor matrix at the solution (see :mod:`.adjustment` for the method).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+import time
+from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
@@ -156,6 +157,15 @@ class _Progress:
             self.callback(self.last)
 
 
+#: Why an iteration ended (:attr:`AdjustmentResult.termination`).
+STEP_TOLERANCE = "step tolerance"
+FUNCTION_TOLERANCE = "function tolerance"
+GRADIENT_TOLERANCE = "gradient tolerance"
+ROUNDING_FLOOR = "rounding floor"
+ITERATION_LIMIT = "iteration limit"
+NO_DECREASE = "no decrease"
+
+
 @dataclass
 class _Run:
     lin: _Lin
@@ -164,6 +174,9 @@ class _Run:
     converged: bool
     use_sparse: bool
     warnings: list[str]
+    termination: str = ""
+    # (iteration, cost v'Pv after it, seconds since the start of the run)
+    trace: list[tuple[int, float, float]] = field(default_factory=list)
 
 
 def _apply(problem: _Problem, lin: _Lin, nrm: _Normal, z: Array) -> tuple[Array, list[Array]]:
@@ -211,6 +224,7 @@ class _Damping:
     # Gauss-Newton step (nearly singular directions, e.g. points far away, need a little
     # damping all the way).
     floor: float = _LAMBDA_MIN
+    last: float = 0.0  # the damping of the step accepted last
 
 
 def _damped_step(
@@ -251,6 +265,7 @@ def _damped_step(
             # Ties at rounding level are accepted: the cost cannot go lower.
             m_try = _merit(cand, rowscale, nu) if cand is not None else math.inf
             if m_try <= m_old * (1 + 1e-13):
+                damp.last = lam
                 factor = 0.1
                 if lam > 0:
                     damp.good = lam
@@ -278,6 +293,60 @@ def _damped_step(
             return None
 
 
+def _trial(
+    problem: _Problem, lin: _Lin, nrm: _Normal, z: Array, active: list[NDArray[np.bool_]]
+) -> _Lin | None:
+    """The linearisation after the scaled step ``z`` (None on non-finite values)."""
+    x, vhat = _apply(problem, lin, nrm, z)
+    try:
+        return problem.linearize(x, vhat, active)
+    except _NonFiniteError:
+        return None
+
+
+def _normal(
+    problem: _Problem,
+    lin: _Lin,
+    active: list[NDArray[np.bool_]],
+    rowscale: Array | None,
+    use_sparse: bool | None,
+    opts: AdjustmentOptions,
+    check: bool,
+) -> tuple[_Normal, Array | None, bool | None]:
+    """The normal equations at ``lin``, the solver choice, and (``check``) the observability
+    analysis of the first iteration."""
+    nrm, rowscale = problem.normal(lin, active, rowscale)
+    if isinstance(nrm, ReducedNormal):
+        use_sparse = nrm.use_sparse
+    elif use_sparse is None:
+        n = problem.n
+        use_sparse = n > _SPARSE_AUTO_MIN_N and nrm.Ns.nnz <= _SPARSE_AUTO_MAX_DENSITY * n * n
+    if check:
+        _check_observability(nrm, problem.names, opts.condition_limit,
+                             problem.constraint_labels())  # fmt: skip
+    return nrm, rowscale, use_sparse
+
+
+def _function_tolerance_met(opts: AdjustmentOptions, damp: _Damping, m_old: float,
+                            m_new: float) -> bool:  # fmt: skip
+    """Ceres' function tolerance: the accepted step changed the cost too little to be worth
+    another damped iteration (one Gauss-Newton step follows). Not after a heavily damped
+    step: a small decrease there is a stall (e.g. a model that cannot fit), not the minimum."""
+    ftol = opts.function_tolerance
+    return bool(
+        ftol > 0 and m_new <= m_old * (1 + 1e-13) and m_old - m_new <= ftol * m_old
+        and (not opts.damping or damp.last <= _LAMBDA_START)
+    )  # fmt: skip
+
+
+def _gradient_small(nrm: _Normal, lin: _Lin, opts: AdjustmentOptions) -> bool:
+    """The gradient test of :attr:`AdjustmentOptions.gradient_tolerance` (no constraints)."""
+    if lin.h.size or opts.gradient_tolerance <= 0 or not nrm.ns.size:
+        return False
+    g = float(np.abs(nrm.ns).max())
+    return g <= opts.gradient_tolerance * math.sqrt(max(lin.phi, 0.0))
+
+
 def _run(
     problem: _Problem,
     x0: Array,
@@ -289,6 +358,7 @@ def _run(
     initial: bool,
 ) -> _Run:
     """One adjustment from ``x0`` with the given groups active."""
+    t0 = time.perf_counter()
     try:
         lin = problem.linearize(x0.copy(), vhat0, active)
     except _NonFiniteError as exc:
@@ -301,22 +371,23 @@ def _run(
     nu = 0.0
     prev_step = math.inf
     converged = False
+    why = ITERATION_LIMIT
     warnings: list[str] = []
+    trace = [(0, lin.phi, time.perf_counter() - t0)]
     it = 0
     nrm: _Normal | None = None
+    final: _Normal | None = None  # the normal equations at the final lin, when built
+    finishing = False  # the function tolerance was met: one last Gauss-Newton step
     for it in range(1, opts.max_iterations + 1):
         stop_if_asked(should_stop, "adjusting")
         progress((it - 1) / opts.max_iterations)
-        nrm, rowscale = problem.normal(lin, active, rowscale)
-        if isinstance(nrm, ReducedNormal):
-            use_sparse = nrm.use_sparse
-        elif use_sparse is None:
-            n = problem.n
-            use_sparse = n > _SPARSE_AUTO_MIN_N and nrm.Ns.nnz <= _SPARSE_AUTO_MAX_DENSITY * n * n
-        if it == 1:
-            _check_observability(
-                nrm, problem.names, opts.condition_limit, problem.constraint_labels()
-            )
+        nrm, rowscale, use_sparse = _normal(problem, lin, active, rowscale, use_sparse,
+                                            opts, it == 1)  # fmt: skip
+        if _gradient_small(nrm, lin, opts):
+            converged, why, final = True, GRADIENT_TOLERANCE, nrm
+            it -= 1  # no step taken
+            break
+
         def gauss_newton(nrm=nrm, use_sparse=use_sparse) -> tuple[Array, Array]:
             try:
                 return _solve(nrm, 0.0, use_sparse)
@@ -344,9 +415,21 @@ def _run(
                 lin = problem.linearize(x, vhat, active)
             except _NonFiniteError as exc:
                 raise ConvergenceError(f"{exc} after the final step") from None
-            converged = True
+            trace.append((it, lin.phi, time.perf_counter() - t0))
+            converged, why = True, STEP_TOLERANCE
             break
         m_old = _merit(lin, rowscale, nu)
+        if finishing:
+            # after the function tolerance: one Gauss-Newton step, kept if it does not
+            # raise the cost (near the minimum it gains the digits the cost cannot show)
+            new = _trial(problem, lin, nrm, z, active)
+            if new is not None and _merit(new, rowscale, nu) <= m_old * (1 + 1e-13):
+                lin = new
+                trace.append((it, lin.phi, time.perf_counter() - t0))
+            else:
+                final = nrm
+            converged, why = True, FUNCTION_TOLERANCE
+            break
         if not opts.damping:
             x, vhat = _apply(problem, lin, nrm, z)
             try:
@@ -363,7 +446,7 @@ def _run(
                 step = float(np.abs(z).max()) if z.size else 0.0
             if new is None:
                 if step <= math.sqrt(tol):
-                    converged = True
+                    converged, why, final = True, ROUNDING_FLOOR, nrm
                     break
                 fresh = _refreshed(problem, lin, active)
                 if fresh is not None and _merit(fresh, rowscale, nu) > m_old * (1 + 1e-12):
@@ -379,9 +462,15 @@ def _run(
                         step=step,
                     )
                 )
+                why, final = NO_DECREASE, nrm
                 break
         m_new = _merit(new, rowscale, nu)
         lin = new
+        trace.append((it, lin.phi, time.perf_counter() - t0))
+        if _function_tolerance_met(opts, damp, m_old, m_new):
+            finishing = True
+            damp.memory = 0.0
+            continue
         # Rounding floor (large parameter values): the cost no longer changes and the step
         # has stopped shrinking although it is above tolerance.
         if (
@@ -389,15 +478,18 @@ def _run(
             and step <= math.sqrt(tol)
             and step >= 0.5 * prev_step
         ):
-            converged = True
+            converged, why = True, ROUNDING_FLOOR
             break
         prev_step = step
-    if not converged and it >= opts.max_iterations:
+    if finishing and not converged:  # met at the last iteration: no room for the last step
+        converged, why = True, FUNCTION_TOLERANCE
+    if not converged and it >= opts.max_iterations and why == ITERATION_LIMIT:
         warnings.append(
             _t("no convergence within {n} iterations", n=opts.max_iterations)
         )
     # Final normal equations at the final linearisation point, checked before use.
-    nrm, _ = problem.normal(lin, active, rowscale)
+    if final is None:
+        final, _ = problem.normal(lin, active, rowscale)
     if use_sparse is None:
         use_sparse = False
-    return _Run(lin, nrm, it, converged, bool(use_sparse), warnings)
+    return _Run(lin, final, it, converged, bool(use_sparse), warnings, why, trace)

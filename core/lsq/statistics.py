@@ -173,4 +173,6 @@ def _finish(
         n_observations=int(m),
         n_constraints=int(mc),
         cofactor_blocks=blocks,
+        termination=run.termination,
+        trace=list(run.trace),
     )

@@ -38,11 +38,13 @@ Statistics and selection: sigma0, the global chi-square test, standard deviation
 correlations; for every AP its t-test (value over its a-posteriori standard deviation against
 Student's t with the redundancy as degrees of freedom) and correlations above a limit with the
 other interior parameters. Automatic selection drops, one at a time, the least significant
-insignificant AP, or the less significant AP of a too-correlated pair, re-adjusts, and reports
-what it dropped and why. Outliers: robust reweighting (Huber or Cauchy) before Baarda's data
-snooping, both on the image measurements only (control points and observed orientations are
-tested, their w reported, but never removed: their misfits mostly reflect an imperfect
-model); a tie point left with one ray by a rejection is set aside with it.
+AP among those insignificant alone and, tested jointly with the other insignificant APs they
+correlate with, as a group (a correlation alone never drops a significant parameter:
+:mod:`.bundle_selection`), re-adjusts, and reports every decision with its statistic.
+Outliers: robust reweighting (Huber or Cauchy) before Baarda's data snooping, both on the
+image measurements only (control points and observed orientations are tested, their w
+reported, but never removed: their misfits mostly reflect an imperfect model); a tie point
+left with one ray by a rejection is set aside with it.
 """
 
 
@@ -54,14 +56,13 @@ from typing import Callable
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import stats
 
 from ..errors import InputError, NotObservableError, stop_if_asked
 from ..geometry.camera import Camera
 from ..geometry.frames import MappingFrame
-from ..i18n import mark as _t
 from .bundle_model import _cams_from, _Run, _run
 from .bundle_result import BundleResult, _finish
+from .bundle_selection import ap_decisions, drop_candidate
 from .bundle_setup import BundleOptions, GroundPoints, _prepare
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable
@@ -74,48 +75,13 @@ Array = NDArray[np.float64]
 
 def _drop_candidate(run: _Run, options: BundleOptions) -> tuple[int, int, str] | None:
     """(camera, interior position, reason) of the AP to drop next, or None: the least
-    significant insignificant AP of any camera first; only when every AP is significant, the
-    AP of the most correlated pair (a t-value and a correlation are never compared)."""
-    res = run.result
-    r = max(res.redundancy, 1)
-    tcrit = float(stats.t.ppf(1 - options.ap_alpha / 2, r))
-    per_camera = []
-    for c, cam in enumerate(run.cams):
-        idx = run.lay.interior[c]
-        if idx.size:
-            with np.errstate(divide="ignore", invalid="ignore"):
-                t = np.abs(res.x[idx]) / res.std[idx]
-            per_camera.append((c, cam, idx, run.lay.free[c], t))
-    insignificant = [
-        (float(t[k]), c, int(free[k]),
-         _t("insignificant (t = {t:.2f} <= {critical:.2f}, alpha {alpha:g})", t=t[k],
-            critical=tcrit, alpha=options.ap_alpha))
-        for c, _cam, idx, free, t in per_camera
-        for k in range(idx.size)
-        if free[k] >= 3 and t[k] <= tcrit
-    ]  # fmt: skip
-    if insignificant:
-        _, c, k, why = min(insignificant, key=lambda q: q[0])
-        return c, k, why
-    correlated = []
-    for c, cam, idx, free, t in per_camera:
-        corr = res.correlation_of(idx)
-        names = cam.interior_names
-        for a in range(idx.size):
-            for b in range(a + 1, idx.size):
-                pick = [k for k in (a, b) if free[k] >= 3]
-                if not abs(corr[a, b]) > options.max_correlation or not pick:
-                    continue
-                # drop the AP of the pair (the less significant one when both are APs)
-                k = min(pick, key=lambda q: t[q])
-                other = b if k == a else a
-                why = _t("|correlation| {r:.3f} > {limit:g} with {other}", r=abs(corr[a, b]),
-                         limit=options.max_correlation, other=names[free[other]])  # fmt: skip
-                correlated.append((abs(float(corr[a, b])), c, int(free[k]), why))
-    if correlated:
-        _, c, k, why = max(correlated, key=lambda q: q[0])
-        return c, k, why
-    return None
+    significant of the APs that are insignificant alone and, with the other insignificant APs
+    they correlate with, jointly (:mod:`.bundle_selection`); a correlation alone never drops
+    a parameter."""
+    decisions = ap_decisions(run.result, run.lay.interior, run.lay.free, run.cams,
+                             options.ap_alpha, options.max_correlation)  # fmt: skip
+    d = drop_candidate(decisions)
+    return None if d is None else (d.camera, d.position, d.reason)
 
 
 def bundle_adjust(

@@ -18,6 +18,7 @@ from ..geometry.frames import LocalFrame
 from ..geometry.rotations import opk_to_matrix
 from ..lsq.results import AdjustmentResult
 from .bundle_model import _cams_from, _Run
+from .bundle_selection import ap_decisions
 from .bundle_setup import BundleOptions, _cov_local_to_map, _rays, _Setup
 from .intersection import meet_rays
 from .observations import ImageObservations
@@ -34,7 +35,8 @@ class InteriorEstimate:
     """One interior parameter of one camera (a row of the AP table).
 
     ``status``: ``estimated``, ``dropped`` (by the selection, ``reason`` says why) or
-    ``fixed`` (not estimated in this run).
+    ``fixed`` (not estimated in this run); an estimated AP's ``reason`` is its significance
+    decision with its statistic (:mod:`.bundle_selection`).
     """
 
     camera: str
@@ -202,6 +204,9 @@ def _interior_table(run: _Run, options: BundleOptions, dropped: dict) -> tuple[
     corr_out: dict[str, tuple[list[str], Array]] = {}
     flagged: list[tuple[str, str, str, float]] = []
     cams = _cams_from(run)
+    decided = {(d.camera, d.position): d.reason for d in ap_decisions(
+        res, run.lay.interior, run.lay.free, run.cams, options.ap_alpha,
+        options.max_correlation)}  # fmt: skip
     for c, cam in enumerate(cams):
         names = cam.interior_names
         idx = run.lay.interior[c]
@@ -213,7 +218,8 @@ def _interior_table(run: _Run, options: BundleOptions, dropped: dict) -> tuple[
                 val, sd = float(res.x[idx[k]]), float(res.std[idx[k]])
                 t = abs(val) / sd if sd > 0 else math.inf
                 table.append(InteriorEstimate(cam.name, nm, val, sd, t, bool(t > tcrit),
-                                              "estimated", "", is_ap))  # fmt: skip
+                                              "estimated", decided.get((c, j), ""),
+                                              is_ap))  # fmt: skip
             elif is_ap and (cam.name, nm) in dropped:
                 why = dropped[(cam.name, nm)]
                 table.append(InteriorEstimate(cam.name, nm, 0.0, math.nan, math.nan, False,

@@ -304,6 +304,25 @@ def test_snavely_jacobians_against_finite_differences():
         assert np.abs(num - jp[:, :, j]).max() < 1e-7 * np.abs(jp[:, :, j]).max()
 
 
+def test_snavely_compiled_kernel_equals_numpy():
+    """The numba kernel (core/geometry/snavely_numba.py) and the numpy code: the same
+    projections and Jacobians to rounding, also for rotations below the series threshold."""
+    pytest.importorskip("numba")
+    rng = np.random.default_rng(3)
+    n = 200
+    cam = np.column_stack([rng.normal(0, 0.5, (n, 3)), rng.normal(0, 1, (n, 2)),
+                           rng.normal(-8, 1, n), rng.uniform(400, 600, n),
+                           rng.normal(0, 0.1, n), rng.normal(0, 0.01, n)])  # fmt: skip
+    cam[:20, :3] *= 1e-6  # |r| < 1e-4: the series branch
+    X = rng.normal(0, 1, (n, 3))
+    ref = snavely_project(cam, X, compiled=False)
+    got = snavely_project(cam, X, compiled=True)
+    for a, b in zip(ref, got):
+        np.testing.assert_allclose(b, a, rtol=1e-12, atol=1e-12 * np.abs(a).max())
+    u = snavely_project(cam, X, jacobian=False, compiled=True)
+    np.testing.assert_allclose(u, ref[0], rtol=1e-12, atol=1e-9)
+
+
 @pytest.mark.skipif(not (BAL / "dubrovnik-3-7-pre.txt").is_file(), reason="BAL data not here")
 def test_bal_reader_and_projection_on_dubrovnik():
     from lidarphoto.core.io.bal import read_bal
@@ -317,3 +336,46 @@ def test_bal_reader_and_projection_on_dubrovnik():
     # cost the shared MANIFEST states (2.764220e3)
     cost = 0.5 * np.sum((u - p.observations) ** 2)
     assert abs(cost / 2.764220e3 - 1) < 1e-6
+
+
+def test_compiled_reduced_system_equals_numpy(monkeypatch):
+    """A BAL-like block (Snavely's model, every camera with its own 9 parameters, so the
+    compiled per-block sums and the pair sums both run): the same adjustment with the numba
+    kernels and with the numpy code of core/lsq/schur.py, to rounding."""
+    pytest.importorskip("numba")
+    from lidarphoto.core.lsq import schur
+
+    rng = np.random.default_rng(4)
+    nc, npt = 6, 80
+    cams = np.column_stack([rng.normal(0, 0.1, (nc, 3)), rng.normal(0, 0.5, (nc, 2)),
+                            np.full(nc, -10.0), np.full(nc, 500.0), np.zeros((nc, 2))])  # fmt: skip
+    pts = rng.normal(0, 1.5, (npt, 3))
+    ci = np.repeat(np.arange(nc), npt)
+    pi = np.tile(np.arange(npt), nc)
+    keep = rng.random(ci.size) < 0.8
+    ci, pi = ci[keep], pi[keep]
+    obs = snavely_project(cams[ci], pts[pi], jacobian=False) + rng.normal(0, 0.5, (ci.size, 2))
+    x_true = np.concatenate([cams.ravel(), pts.ravel()])
+    x0 = x_true + np.concatenate([rng.normal(0, 1e-3, 9 * nc), rng.normal(0, 0.05, 3 * npt)])
+    names = [f"c{c} {k}" for c in range(nc) for k in range(9)]
+    names += [f"p{p} {a}" for p in range(npt) for a in "XYZ"]
+    idx = np.concatenate([ci[:, None] * 9 + np.arange(9), 9 * nc + pi[:, None] * 3 + np.arange(3)],
+                         axis=1)  # fmt: skip
+
+    def model(xl):
+        u, jc, jp = snavely_project(xl[:, :9], xl[:, 9:])
+        return u, np.concatenate([jc, jp], axis=2)
+
+    block = GaussMarkovBlock("obs", obs, 0.5, idx, model)
+    sig = np.tile([1e-3] * 6 + [1.0, 1e-3, 1e-3], nc)
+    prior = prior_block("cams", np.arange(9 * nc), cams.ravel(), sig)
+    elim = 9 * nc + np.arange(3 * npt).reshape(npt, 3)
+    opts = AdjustmentOptions(eliminate=elim)
+    monkeypatch.setattr(schur, "_COMPILED_MIN", 0)  # compiled at any size
+    fast = adjust(x0, names, [block, prior], options=opts)
+    monkeypatch.setattr(schur, "_COMPILED", False)
+    slow = adjust(x0, names, [block, prior], options=opts)
+    assert fast.converged and slow.converged and fast.iterations == slow.iterations
+    assert_allclose(fast.x, slow.x, rtol=1e-10, atol=1e-10)
+    assert_allclose(fast.std, slow.std, rtol=1e-8)
+    assert fast.omega == pytest.approx(slow.omega, rel=1e-10)
