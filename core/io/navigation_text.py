@@ -183,7 +183,11 @@ def _velocity(table: Table) -> np.ndarray | None:
     if vn is None or ve is None or (vu is None and vd is None):
         raise InputError("give all three velocity columns (v_north, v_east and v_up or v_down) "
                          "or none", path=table.path)  # fmt: skip
-    down = -float_column(table, vu) if vu is not None else float_column(table, vd)
+    if vu is not None:
+        down = -float_column(table, vu)
+    else:
+        assert vd is not None  # refused above
+        down = float_column(table, vd)
     return np.stack([float_column(table, vn), float_column(table, ve), down], axis=1)
 
 

@@ -13,7 +13,7 @@ import os
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Union
+from typing import Any, Literal, Union, overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -83,6 +83,18 @@ def read_table(path: PathLike) -> Table:
 
 def normalise(name: str) -> str:
     return name.strip().lower().replace(" ", "_").replace("-", "_")
+
+
+@overload
+def find_column(
+    table: Table, aliases: Sequence[str], *, required: Literal[True] = ..., what: str | None = ...
+) -> int: ...
+
+
+@overload
+def find_column(
+    table: Table, aliases: Sequence[str], *, required: bool, what: str | None = ...
+) -> int | None: ...
 
 
 def find_column(

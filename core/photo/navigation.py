@@ -164,7 +164,9 @@ def _align_week(t: Array, nav_time: Array) -> Array:
     return out
 
 
-def _segments(nav: NavSolution, events: CameraEvents, t: Array, max_gap_s: float) -> Array:
+def _segments(
+    nav: NavSolution, events: CameraEvents, t: Array, max_gap_s: float
+) -> NDArray[np.intp]:
     """Index k of the record interval [t_k, t_k+1] of every event; refuses events outside
     the trajectory or in a gap longer than ``max_gap_s``."""
     tt = nav.time

@@ -270,7 +270,8 @@ def point_block(
 
 
 def _lines_block(
-    name: str, conditions: LineConditions, s: Array, observed: Array, rows: list[str],
+    name: str, conditions: LineConditions | EquivalentPlanes, s: Array, observed: Array,
+    rows: list[str],
     cov: Array | None, param_index: Array, labels: list[str],
 ) -> GaussHelmertBlock:
     """The Gauss-Helmert block of image lines (``observed``, their covariance in ``s``); with

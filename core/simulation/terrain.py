@@ -129,7 +129,7 @@ def _sample(
     trees: list[_Tree],
     rng: np.random.Generator,
     noise: float,
-    void: Callable[[Array, Array], NDArray[np.bool_]] | None = None,
+    void: Callable[[Array, Array], np.ndarray] | None = None,
 ) -> tuple[list[Array], list[NDArray[np.int8]]]:
     """Top-surface sampling of a scene: (points, kinds) lists."""
     w, h = size
