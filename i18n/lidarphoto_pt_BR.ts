@@ -1264,8 +1264,20 @@
             <translation>não significativo (t = {t:.2f} &lt;= {critical:.2f}, alfa {alpha:g})</translation>
         </message>
         <message>
-            <source>|correlation| {r:.3f} &gt; {limit:g} with {other}</source>
-            <translation>|correlação| {r:.3f} &gt; {limit:g} com {other}</translation>
+            <source>insignificant (t = {t:.2f} &lt;= {critical:.2f}, alpha {alpha:g}), also jointly with {others} (F = {f:.2f} &lt;= {fcritical:.2f})</source>
+            <translation>não significativo (t = {t:.2f} &lt;= {critical:.2f}, alfa {alpha:g}), também em conjunto com {others} (F = {f:.2f} &lt;= {fcritical:.2f})</translation>
+        </message>
+        <message>
+            <source>kept: insignificant alone (t = {t:.2f} &lt;= {critical:.2f}) but jointly significant with {others} (F = {f:.2f} &gt; {fcritical:.2f})</source>
+            <translation>mantido: não significativo sozinho (t = {t:.2f} &lt;= {critical:.2f}), mas significativo em conjunto com {others} (F = {f:.2f} &gt; {fcritical:.2f})</translation>
+        </message>
+        <message>
+            <source>significant (t = {t:.2f} &gt; {critical:.2f})</source>
+            <translation>significativo (t = {t:.2f} &gt; {critical:.2f})</translation>
+        </message>
+        <message>
+            <source>not tested (no standard deviation)</source>
+            <translation>não testado (sem desvio-padrão)</translation>
         </message>
         <message>
             <source>{n} ground point(s) are not measured in any image and were not used: {ids}</source>
@@ -1414,10 +1426,6 @@
         <message>
             <source>weak texture</source>
             <translation>textura fraca</translation>
-        </message>
-        <message>
-            <source>Positional accuracy report</source>
-            <translation>Relatório de acurácia posicional</translation>
         </message>
         <message>
             <source>without the {n} flagged point(s)</source>
@@ -1696,6 +1704,10 @@
             <translation>{} ponto(s) marcado(s): </translation>
         </message>
         <message>
+            <source>Positional accuracy report</source>
+            <translation>Relatório de acurácia posicional</translation>
+        </message>
+        <message>
             <source>The calibration FAILED its checks: no table and no exterior orientation were written. The numbers below show the failed adjustment, for diagnosis only.</source>
             <translation>A calibração FALHOU nas verificações: nenhuma tabela e nenhuma orientação exterior foram gravadas. Os números abaixo mostram o ajustamento que falhou, apenas para diagnóstico.</translation>
         </message>
@@ -1920,6 +1932,14 @@
             <translation>significativo</translation>
         </message>
         <message>
+            <source>FAILED</source>
+            <translation>REPROVADO</translation>
+        </message>
+        <message>
+            <source>passed, but only after more rejections than false alarms explain</source>
+            <translation>aprovado, mas só depois de mais rejeições do que os falsos alarmes explicam</translation>
+        </message>
+        <message>
             <source>estimated</source>
             <translation>estimado</translation>
         </message>
@@ -1966,10 +1986,6 @@
         <message>
             <source>NO</source>
             <translation>NÃO</translation>
-        </message>
-        <message>
-            <source>FAILED</source>
-            <translation>REPROVADO</translation>
         </message>
         <message>
             <source>no redundancy</source>
@@ -2068,6 +2084,10 @@
             <translation>estatística {}, aceita em [{}, {}], p = {}</translation>
         </message>
         <message>
+            <source>rejections explained by false alarms</source>
+            <translation>rejeições explicadas por falsos alarmes</translation>
+        </message>
+        <message>
             <source>Bundle adjustment: {}</source>
             <translation>Ajustamento por feixes de raios: {}</translation>
         </message>
@@ -2110,6 +2130,10 @@
         <message>
             <source>not observable: {}</source>
             <translation>não observável: {}</translation>
+        </message>
+        <message>
+            <source>at most {bound} ({expected} expected); {k} rejected: P = {p}</source>
+            <translation>no máximo {bound} ({expected} esperadas); {k} rejeitadas: P = {p}</translation>
         </message>
         <message>
             <source>|correlation| above {} in the final adjustment: </source>
@@ -2584,10 +2608,6 @@
             <translation>A calibração FALHOU nas verificações: nenhuma tabela e nenhuma varredura registrada foram gravadas. Os números abaixo mostram o ajustamento que falhou, apenas para diagnóstico.</translation>
         </message>
         <message>
-            <source>passed, but only after more rejections than false alarms explain</source>
-            <translation>aprovado, mas só depois de mais rejeições do que os falsos alarmes explicam</translation>
-        </message>
-        <message>
             <source>station / target</source>
             <translation>estação / alvo</translation>
         </message>
@@ -2716,12 +2736,8 @@
             <translation>NÃO</translation>
         </message>
         <message>
-            <source>rejections explained by false alarms</source>
-            <translation>rejeições explicadas por falsos alarmes</translation>
-        </message>
-        <message>
-            <source>at most {bound} ({expected} expected); {k} rejected: P = {p}</source>
-            <translation>no máximo {bound} ({expected} esperadas); {k} rejeitadas: P = {p}</translation>
+            <source>|correlation| {r:.3f} &gt; {limit:g} with {other}</source>
+            <translation type="vanished">|correlação| {r:.3f} &gt; {limit:g} com {other}</translation>
         </message>
         <message>
             <source>mean planimetric (m)</source>
@@ -3645,15 +3661,19 @@ restante do bloco cresce por interseção e resseção.</translation>
         </message>
         <message>
             <source>Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
-and |correlation| above 0.9 flagged; automatic selection drops insignificant or too
-correlated APs one at a time and says which and why. Outliers: robust reweighting (Huber or
-Cauchy) then Baarda's data snooping. Datum: control points and/or observed orientations, or a
+and |correlation| above 0.9 flagged; automatic selection drops insignificant APs one at a
+time (an AP correlated with others is dropped only when a joint F-test finds them
+insignificant together; a correlation alone never drops one) and says which and why.
+Outliers: robust reweighting (Huber or Cauchy) then Baarda's data snooping.
+Datum: control points and/or observed orientations, or a
 free network (inner or minimal constraints). Tables that cannot make a block (an image
 without observations, a tie point seen once, duplicated rows, unknown images, ground points
 in another CRS, unconnected parts) are refused with the file and row named.</source>
             <translation>Estatísticas: sigma0, o teste global qui-quadrado, desvios-padrão e correlações; teste t de
 cada PA e |correlação| acima de 0,9 marcada; a seleção automática descarta, um por vez, os PAs
-não significativos ou correlacionados demais e diz quais e por quê. Outliers: reponderação
+não significativos (um PA correlacionado com outros só é descartado quando um teste F conjunto
+os considera não significativos juntos; uma correlação sozinha nunca descarta um PA) e diz
+quais e por quê. Outliers: reponderação
 robusta (Huber ou Cauchy) seguida do data snooping de Baarda. Referencial (datum): pontos de
 controle e/ou orientações observadas, ou uma rede livre (injunções internas ou mínimas).
 Tabelas que não formam um bloco (uma imagem sem observações, um ponto de enlace visto uma só
@@ -3745,8 +3765,8 @@ são recusadas, com o arquivo e a linha indicados.</translation>
             <translation>Estimar a distância principal e o ponto principal</translation>
         </message>
         <message>
-            <source>Drop insignificant or correlated APs</source>
-            <translation>Descartar PAs não significativos ou correlacionados</translation>
+            <source>Drop insignificant APs</source>
+            <translation>Descartar PAs não significativos</translation>
         </message>
         <message>
             <source>Robust reweighting before data snooping</source>
@@ -3831,6 +3851,47 @@ são recusadas, com o arquivo e a linha indicados.</translation>
         <message>
             <source>AP model of the outputs</source>
             <translation>Modelo de PAs das saídas</translation>
+        </message>
+        <message>
+            <source>Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
+and |correlation| above 0.9 flagged; automatic selection drops insignificant APs one at a
+time (an AP correlated with others is dropped only when a joint F-test finds them
+insignificant together; a correlation alone never drops one) and says which and why.
+Outliers: robust reweighting (Huber or Cauchy) then Baarda's data snooping. Datum: control points and/or observed orientations, or a
+free network (inner or minimal constraints). Tables that cannot make a block (an image
+without observations, a tie point seen once, duplicated rows, unknown images, ground points
+in another CRS, unconnected parts) are refused with the file and row named.</source>
+            <translation type="vanished">Estatísticas: sigma0, o teste global qui-quadrado, desvios-padrão e correlações; teste t de
+cada PA e |correlação| acima de 0,9 marcada; a seleção automática descarta, um por vez, os PAs
+não significativos (um PA correlacionado com outros só é descartado quando um teste F conjunto
+os considera não significativos juntos; uma correlação sozinha nunca descarta um PA) e diz
+quais e por quê. Outliers: reponderação
+robusta (Huber ou Cauchy) seguida do data snooping de Baarda. Referencial (datum): pontos de
+controle e/ou orientações observadas, ou uma rede livre (injunções internas ou mínimas).
+Tabelas que não formam um bloco (uma imagem sem observações, um ponto de enlace visto uma só
+vez, linhas repetidas, imagens desconhecidas, pontos de apoio em outro SRC, partes desconexas)
+são recusadas, com o arquivo e a linha indicados.</translation>
+        </message>
+        <message>
+            <source>Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
+and |correlation| above 0.9 flagged; automatic selection drops insignificant or too
+correlated APs one at a time and says which and why. Outliers: robust reweighting (Huber or
+Cauchy) then Baarda's data snooping. Datum: control points and/or observed orientations, or a
+free network (inner or minimal constraints). Tables that cannot make a block (an image
+without observations, a tie point seen once, duplicated rows, unknown images, ground points
+in another CRS, unconnected parts) are refused with the file and row named.</source>
+            <translation type="vanished">Estatísticas: sigma0, o teste global qui-quadrado, desvios-padrão e correlações; teste t de
+cada PA e |correlação| acima de 0,9 marcada; a seleção automática descarta, um por vez, os PAs
+não significativos ou correlacionados demais e diz quais e por quê. Outliers: reponderação
+robusta (Huber ou Cauchy) seguida do data snooping de Baarda. Referencial (datum): pontos de
+controle e/ou orientações observadas, ou uma rede livre (injunções internas ou mínimas).
+Tabelas que não formam um bloco (uma imagem sem observações, um ponto de enlace visto uma só
+vez, linhas repetidas, imagens desconhecidas, pontos de apoio em outro SRC, partes desconexas)
+são recusadas, com o arquivo e a linha indicados.</translation>
+        </message>
+        <message>
+            <source>Drop insignificant or correlated APs</source>
+            <translation type="vanished">Descartar PAs não significativos ou correlacionados</translation>
         </message>
         <message>
             <source>Inputs: camera JSON (one camera, or {"cameras": [...]} with a camera column in the EO or

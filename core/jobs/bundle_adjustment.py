@@ -52,9 +52,11 @@ corrections can be estimated). Without orientations the images that see four or 
 points are resected and the rest of the block grows by intersection and resection.
 
 Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
-and |correlation| above 0.9 flagged; automatic selection drops insignificant or too
-correlated APs one at a time and says which and why. Outliers: robust reweighting (Huber or
-Cauchy) then Baarda's data snooping. Datum: control points and/or observed orientations, or a
+and |correlation| above 0.9 flagged; automatic selection drops insignificant APs one at a
+time (an AP correlated with others is dropped only when a joint F-test finds them
+insignificant together; a correlation alone never drops one) and says which and why.
+Outliers: robust reweighting (Huber or Cauchy) then Baarda's data snooping.
+Datum: control points and/or observed orientations, or a
 free network (inner or minimal constraints). Tables that cannot make a block (an image
 without observations, a tie point seen once, duplicated rows, unknown images, ground points
 in another CRS, unconnected parts) are refused with the file and row named.""",
@@ -124,7 +126,7 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
             _OPTIONS.estimate_interior,
         ),
         Param(
-            "AP_SELECTION", "boolean", "Drop insignificant or correlated APs", _OPTIONS.ap_selection
+            "AP_SELECTION", "boolean", "Drop insignificant APs", _OPTIONS.ap_selection
         ),
         Param(
             "ROBUST",

@@ -26,12 +26,14 @@ class BundleOptions:
     estimate_interior : bool
         Estimate the principal distance and the principal point of every camera.
     ap_selection : bool
-        Drop insignificant or too-correlated APs one at a time and re-adjust.
+        Drop insignificant APs one at a time and re-adjust: an AP goes only when its own
+        t-test and, with the insignificant APs it correlates with above ``max_correlation``,
+        a joint F-test find it insignificant (a correlation alone never drops one).
     ap_alpha : float
         Two-sided significance level of the AP t-test.
     max_correlation : float
         |correlation| above which a pair of interior parameters is flagged (and, with
-        selection, the less significant AP of the pair dropped).
+        selection, the correlated insignificant APs are tested jointly).
     robust : str
         ``none``, ``huber`` or ``cauchy``: reweighting before data snooping.
     snooping : bool
