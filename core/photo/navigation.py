@@ -63,8 +63,9 @@ class NavSolution:
     and ellipsoidal height (m) on the mapping CRS's datum when ``geodetic``, else easting,
     northing, height in the mapping CRS. rph: (N, 3) roll, pitch, true heading, radians
     (body x forward, y right, z down; docs/conventions.md, "Frames"). velocity_ned: (N, 3)
-    north, east, down m/s, or None. source: the file (for messages); record: what a record is called there
-    (``record`` for SBET, ``row`` for tables) and ``numbers`` its 1-based number.
+    north, east, down m/s, or None. source: the file (for messages); record: what a record
+    is called there (``record`` for SBET, ``row`` for tables) and ``numbers`` its 1-based
+    number.
     """
 
     time: Array
