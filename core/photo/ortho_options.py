@@ -26,7 +26,8 @@ class OrthoOptions:
         height, to 2 significant digits (:func:`auto_gsd`).
     resampling : {"nearest", "bilinear", "cubic"}
     true_ortho : bool
-        Make occluded ground no data (module docstring, step 5).
+        Make occluded ground no data (module docstring, step 5); on by default, as the
+        algorithm's title says (off: a plain orthophoto, cheaper on a bare-earth DTM).
     occlusion_tol_m : float
         A surface hit this much (CRS unit, along the ray) before the ground point occludes it.
     tile_px : int
@@ -42,7 +43,7 @@ class OrthoOptions:
 
     gsd: float = 0.0
     resampling: str = "bilinear"
-    true_ortho: bool = False
+    true_ortho: bool = True
     occlusion_tol_m: float = 0.05
     tile_px: int = 512
     lattice_px: int = 64

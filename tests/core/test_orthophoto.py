@@ -99,7 +99,7 @@ def exact_case() -> dict:
             valid[t.row0 : t.row0 + h, t.col0 : t.col0 + w] = t.valid
         return data, valid
 
-    plain, plain_valid = ortho()
+    plain, plain_valid = ortho(true_ortho=False)
     true_, true_valid = ortho(true_ortho=True)
     col, row, z = proj.pixels(grid, 0, 0, grid.rows, grid.cols)
     xs = grid.x0 + (np.arange(grid.cols) + 0.5) * GSD
