@@ -31,7 +31,7 @@ except Exception:  # ImportError, or a numba built against another numpy
 
 log = logging.getLogger(__name__)
 
-__all__ = ["AVAILABLE", "cache_folder", "cached_njit"]
+__all__ = ["AVAILABLE", "cache_folder", "cached_njit", "compiled_kernel"]
 
 #: The package folder (the plugin's root, whatever it is named) and its import name.
 _ROOT = Path(__file__).resolve().parents[1]
@@ -121,3 +121,17 @@ def cached_njit(func: Callable[..., Any], **options: Any) -> Callable[..., Any]:
         except Exception as exc:  # no writable cache folder, another numba's internals
             log.debug("no compiled cache for %s: %s", func.__qualname__, exc)
     return dispatcher
+
+
+_KERNELS: dict[Callable[..., Any], Callable[..., Any]] = {}
+
+
+def compiled_kernel(func: Callable[..., Any]) -> Callable[..., Any] | None:
+    """``func`` compiled once per process (:func:`cached_njit`, ``nogil``), or None without
+    numba: for modules that stay light until a kernel is first asked for (they import this
+    function inside theirs)."""
+    if not AVAILABLE:
+        return None
+    if func not in _KERNELS:
+        _KERNELS[func] = cached_njit(func, nogil=True)
+    return _KERNELS[func]

@@ -96,25 +96,12 @@ def _kernel(c, X, u, jc, jp, want_jac):  # pragma: no cover - compiled
         jc[i, 1, 8] = f * rr * rr * py
 
 
-_COMPILED: list = []
-
-
-def _compile(*kernels):
-    """The kernels compiled (numba imports only here: importing this module stays light),
-    or None without numba."""
-    from ..compiled import AVAILABLE, cached_njit
-
-    if not AVAILABLE:
-        return None
-    while len(_COMPILED) < len(kernels):
-        _COMPILED.append(cached_njit(kernels[len(_COMPILED)], nogil=True))
-    return _COMPILED
-
-
 def project(cameras: Array, points: Array, jacobian: bool) -> tuple | Array | None:
     """``snavely_project`` compiled (None without numba)."""
-    compiled = _compile(_kernel)
-    if compiled is None:
+    from ..compiled import compiled_kernel  # numba imported here: this module stays light
+
+    kernel = compiled_kernel(_kernel)
+    if kernel is None:
         return None
     c = np.ascontiguousarray(cameras, dtype=np.float64)
     X = np.ascontiguousarray(points, dtype=np.float64)
@@ -122,5 +109,5 @@ def project(cameras: Array, points: Array, jacobian: bool) -> tuple | Array | No
     u = np.empty((n, 2))
     jc = np.empty((n, 2, 9) if jacobian else (0, 2, 9))
     jp = np.empty((n, 2, 3) if jacobian else (0, 2, 3))
-    compiled[0](c, X, u, jc, jp, bool(jacobian))
+    kernel(c, X, u, jc, jp, bool(jacobian))
     return (u, jc, jp) if jacobian else u

@@ -45,29 +45,16 @@ def _kernel(Za, Zb, o1, o2, key, out):  # pragma: no cover - compiled
         out[last] += acc
 
 
-_COMPILED: list = []
-
-
-def _compile(*kernels):
-    """The kernels compiled (numba imports only here: importing this module stays light),
-    or None without numba."""
-    from ..compiled import AVAILABLE, cached_njit
-
-    if not AVAILABLE:
-        return None
-    while len(_COMPILED) < len(kernels):
-        _COMPILED.append(cached_njit(kernels[len(_COMPILED)], nogil=True))
-    return _COMPILED
-
-
 def pair_sums(Za: Array, Zb: Array, o1: Index, o2: Index, key: Index, n_keys: int
               ) -> Array | None:  # fmt: skip
     """Per key ``sum_q Za[o1[q]]' Zb[o2[q]]`` (n_keys, kk1, kk2), or None without numba."""
-    compiled = _compile(_kernel)
-    if compiled is None:
+    from ..compiled import compiled_kernel  # numba imported here: this module stays light
+
+    kernel = compiled_kernel(_kernel)
+    if kernel is None:
         return None
     out = np.zeros((n_keys, Za.shape[2], Zb.shape[2]))
-    compiled[0](np.ascontiguousarray(Za), np.ascontiguousarray(Zb), o1, o2, key, out)
+    kernel(np.ascontiguousarray(Za), np.ascontiguousarray(Zb), o1, o2, key, out)
     return out
 
 
@@ -102,14 +89,16 @@ def normal_sums(abar: Array, wbar: Array, scale: Array, rc: Index, ec: Index, si
     reduced columns all vary between groups: ``U`` per signature (n_sig, kr, kr), ``V`` and
     ``g_e`` per eliminated block, ``T = R' E`` per group, from the whitened rows ``abar``
     scaled by ``scale`` (G, k) and the misclosures ``wbar`` (G, c); None without numba."""
-    compiled = _compile(_kernel, _normal_kernel)
-    if compiled is None:
+    from ..compiled import compiled_kernel  # numba imported here: this module stays light
+
+    kernel = compiled_kernel(_normal_kernel)
+    if kernel is None:
         return None
     g, kr, b = abar.shape[0], rc.size, ec.size
     U = np.zeros((n_sig, kr, kr))
     V = np.zeros((n_points, b, b))
     g_e = np.zeros((n_points, b))
     T = np.zeros((g, kr, b))
-    compiled[1](np.ascontiguousarray(abar), np.ascontiguousarray(wbar),
+    kernel(np.ascontiguousarray(abar), np.ascontiguousarray(wbar),
                  np.ascontiguousarray(scale), rc, ec, sig, point, U, V, g_e, T)  # fmt: skip
     return U, V, g_e, T
