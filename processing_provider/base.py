@@ -186,9 +186,15 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
 
         return help_url(self.name())
 
+    def shown(self, name: str) -> bool:
+        """Whether the spec's parameter ``name`` is in this algorithm's form (all are; a
+        variant of a job may leave some at their defaults)."""
+        return True
+
     def initAlgorithm(self, config=None):
         for p in self.spec.params:
-            self.addParameter(make_parameter(p, self.spec_tr, self.spec))
+            if self.shown(p.name):
+                self.addParameter(make_parameter(p, self.spec_tr, self.spec))
         for r in self.spec.results:
             self.addOutput(make_output(r, self.spec_tr))
 
@@ -203,7 +209,7 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
         return {
             p.name: read_parameter(self, p, parameters, context)
             for p in self.spec.params
-            if p.kind != "sink"
+            if p.kind != "sink" and self.shown(p.name)
         }
 
     def processAlgorithm(self, parameters, context, feedback):

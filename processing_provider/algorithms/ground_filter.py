@@ -67,25 +67,8 @@ class GroundFilterMethodAlgorithm(GroundFilterAlgorithm):
             return False
         return ground_filter.PARAM_METHODS.get(name, "") in ("", self.METHOD)
 
-    def initAlgorithm(self, config=None):
-        from ..parameters import make_output, make_parameter
-
-        for p in self.spec.params:
-            if self.shown(p.name):
-                self.addParameter(make_parameter(p, self.spec_tr, self.spec))
-        for r in self.spec.results:
-            self.addOutput(make_output(r, self.spec_tr))
-
-    def read_raw(self, parameters, context) -> dict:
-        from ..parameters import read_parameter
-
-        raw = {
-            p.name: read_parameter(self, p, parameters, context)
-            for p in self.spec.params
-            if p.kind != "sink" and self.shown(p.name)
-        }
-        raw["METHOD"] = self.METHOD
-        return raw
+    def prepare(self, raw: dict, parameters, context, feedback) -> dict:
+        return {**raw, "METHOD": self.METHOD}
 
 
 class GroundFilterSmrfAlgorithm(GroundFilterMethodAlgorithm):
