@@ -21,6 +21,7 @@ from .. import __version__
 from .html_table import TR_CONTEXT, html_lang, report_css, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
+from .lens_plots import lens_distortion_field, lens_radial_profile
 from .svg_plots import correlation_heatmap, histogram, image_vector_field
 
 if TYPE_CHECKING:
@@ -117,6 +118,18 @@ def _interior(res: BundleResult, alpha_text: str) -> str:
     return _table(head, rows, css)
 
 
+def _lens_plots(res: BundleResult) -> list[str]:
+    """The adjusted lens correction of every camera with a lens model, as plots."""
+    plots = []
+    for name, cam in res.cameras.items():
+        if cam.distortion.n_params:
+            plots.append(lens_distortion_field(cam, title=t("Lens correction: {}").format(name)))
+            plots.append(lens_radial_profile(cam, title=t("Radial profile: {}").format(name)))
+    if not plots:
+        return []
+    return [f"<h2>{t('Lens distortion')}</h2>", '<div class="plots">', *plots, "</div>"]
+
+
 def render_bundle_html(
     results: Mapping[str, BundleResult],
     best: str,
@@ -179,6 +192,7 @@ def render_bundle_html(
                                              flag=max_correlation))  # fmt: skip
     if plots:
         parts += ['<div class="plots">', *plots, "</div>"]
+    parts += _lens_plots(res)
     if res.mount is not None:
         m = res.mount
         rows = [[_e(n), _n(v, ".4f"), _n(s, ".4f")] for n, v, s in zip(

@@ -17,10 +17,13 @@ from .. import __version__
 from .html_table import TR_CONTEXT, html_lang, report_css, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
+from .lens_plots import lens_distortion_field, lens_radial_profile
 
 __all__ = ["render_calibration_html"]
 
-_CSS = report_css(1100, ".note{font-size:12px;color:#444}")
+_CSS = report_css(
+    1100, ".note{font-size:12px;color:#444}.plots svg{margin:4px;border:1px solid #ddd}"
+)
 
 
 def _n(x: float | None, fmt: str = ".4g") -> str:
@@ -98,6 +101,14 @@ def render_calibration_html(result: Any, settings: Mapping[str, str]) -> str:
         off = np.abs(np.delete(corr[i], i))
         ccss.append("fail" if off.size and np.nanmax(off) > 0.9 else "")
     parts += [f"<h2>{t('Correlations')}</h2>", _table(["", *map(_e, names)], crow, ccss)]
+    if getattr(cam, "distortion", None) is not None and cam.distortion.n_params:
+        parts += [
+            f"<h2>{t('Lens distortion')}</h2>",
+            '<div class="plots">',
+            lens_distortion_field(cam, title=t("Lens correction: {}").format(cam.name)),
+            lens_radial_profile(cam, title=t("Radial profile: {}").format(cam.name)),
+            "</div>",
+        ]
     vrows = [[_e(v), str(int(p)), _n(r, ".3f"), *(_n(x, ".4f") for x in e[:3]),
               *(_n(math.degrees(a), ".3f") for a in e[3:])]
              for v, p, r, e in zip(result.view_names, result.view_points, result.view_rms_px,

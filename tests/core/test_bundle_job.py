@@ -72,6 +72,9 @@ def test_all_models_compared_and_every_output_readable(files):
     assert {r["model"] for r in comp} == families
     rms = [float(r["rmse_3d"]) for r in comp]
     assert rms == sorted(rms)
+    # the report draws the winner's adjusted lens: its field and radial profile
+    page = open(outs["OUTPUT_HTML"], encoding="utf-8").read()
+    assert page.count('class="lens-field"') == 1 and page.count('class="lens-profile"') == 1
     # the orientations with sigmas read back as observed orientations
     eo = read_eo_csv_full(outs["OUTPUT_EO"], "")
     assert eo.sigma is not None and len(eo.eo) == 15
