@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import __version__
+from .block_map import BlockMap, block_map_svg, footprints
 from .html_table import TR_CONTEXT, html_lang, report_css, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
@@ -118,6 +119,25 @@ def _interior(res: BundleResult, alpha_text: str) -> str:
     return _table(head, rows, css)
 
 
+def _block_map(res: BundleResult) -> list[str]:
+    """The plan map of the block: overlap, footprints, centres, control, check and tie points."""
+    xyz = np.asarray(res.point_xyz, dtype=np.float64)
+    role = np.asarray(res.point_role)
+    if len(res.eo) == 0 or xyz.shape[0] == 0:
+        return []
+    ground = xyz[role != "check"] if np.any(role != "check") else xyz
+    cams = [res.cameras[c] for c in res.image_camera]
+    eo = np.column_stack([res.eo.xyz, res.eo.opk])
+    prints = [p for p in footprints(cams, eo, float(np.median(ground[:, 2]))) if p is not None]
+    tie = xyz[role == "tie", :2]
+    # a deterministic thinning: every k-th tie point, at most about 3,000 dots
+    tie = tie[:: max(1, len(tie) // 3000)]
+    bm = BlockMap(np.asarray(res.eo.xyz)[:, :2], prints, xyz[role == "control", :2],
+                  xyz[role == "check", :2], tie)  # fmt: skip
+    svg = block_map_svg(bm, title=t("Image overlap, control and check points"))
+    return [f"<h2>{t('Block map')}</h2>", '<div class="plots">', svg, "</div>"]
+
+
 def _lens_plots(res: BundleResult) -> list[str]:
     """The adjusted lens correction of every camera with a lens model, as plots."""
     plots = []
@@ -168,6 +188,7 @@ def render_bundle_html(
             _comparison(comparison, best),
         ]
     parts += [f"<h2>{t('Adjustment')}</h2>", _adjustment(res)]
+    parts += _block_map(res)
     parts += [f"<h2>{t('Interior orientation and additional parameters')}</h2>",
               _interior(res, alpha_text)]  # fmt: skip
     if res.dropped:

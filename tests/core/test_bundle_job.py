@@ -75,6 +75,7 @@ def test_all_models_compared_and_every_output_readable(files):
     # the report draws the winner's adjusted lens: its field and radial profile
     page = open(outs["OUTPUT_HTML"], encoding="utf-8").read()
     assert page.count('class="lens-field"') == 1 and page.count('class="lens-profile"') == 1
+    assert page.count('class="block-map"') == 1
     # the orientations with sigmas read back as observed orientations
     eo = read_eo_csv_full(outs["OUTPUT_EO"], "")
     assert eo.sigma is not None and len(eo.eo) == 15
