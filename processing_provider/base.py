@@ -223,7 +223,31 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
         outputs.update(result.results)
         outputs.update(self.write_layers(result, parameters, context, feedback))
         self.attach_styles(outputs, context)
+        self._html_reports = [
+            str(outputs[p.name]) for p in self.spec.outputs
+            if p.kind == "file_out" and str(outputs.get(p.name) or "").lower().endswith(".html")
+        ]  # fmt: skip
         return outputs
+
+    def postProcessAlgorithm(self, context, feedback):
+        """Every HTML report the run wrote also as PDF beside it (printing needs the main
+        thread, where QGIS calls this)."""
+        from .report_pdf import can_print, write_pdf
+
+        for html in getattr(self, "_html_reports", []):
+            if not Path(html).is_file():
+                continue
+            why = can_print()
+            if why:
+                feedback.pushInfo(self.tr("No PDF of {}: {}").format(html, why))
+                continue
+            try:
+                pdf = write_pdf(html)
+            except RuntimeError as exc:
+                feedback.reportError(str(exc))
+                continue
+            feedback.pushInfo(self.tr("Report as PDF: {}").format(pdf))
+        return {}
 
     #: (output name, style function of processing_provider/layer_styles.py) pairs: how each
     #: output layer looks when QGIS loads it after the run.
