@@ -153,11 +153,10 @@ def test_bundle_adjustment_with_a_forward_lens_recovers_the_interior() -> None:
     test: the forward model works through the bundle's interface."""
     from dataclasses import replace
 
-    from scipy import stats
-
     from lidarphoto.core.photo.bundle import bundle_adjust
     from lidarphoto.core.photo.bundle_setup import BundleOptions
     from lidarphoto.core.simulation.uav_block import UavBlockConfig, simulate_uav_block
+    from scipy import stats
 
     nominal = UavBlockConfig().camera
     lens = OpenCVLens(k1=-0.09, k2=0.02, p1=4e-4, p2=-3e-4, scale_mm=nominal.focal_mm,
@@ -165,9 +164,9 @@ def test_bundle_adjustment_with_a_forward_lens_recovers_the_interior() -> None:
     blk = simulate_uav_block("none", seed=2, n_tie=300, camera=replace(nominal, distortion=lens))
     corner = np.array([[0.5 * nominal.width_px, 0.5 * nominal.height_px]]) * nominal.pixel_size_mm
     assert np.hypot(*(lens.distort(corner) - corner)[0]) / nominal.pixel_size_mm > 20  # px
+    opts = BundleOptions(ap_model="none", robust="none", snooping=False, ap_selection=False)
     res = bundle_adjust([blk.camera], blk.observations, blk.ground, blk.mapping, blk.eo_dg,
-                        blk.eo_sigma, options=BundleOptions(ap_model="none", robust="none",
-                                                            snooping=False, ap_selection=False))  # fmt: skip
+                        blk.eo_sigma, options=opts)  # fmt: skip
     assert res.adjustment.converged
     r = res.adjustment.redundancy
     lo, hi = stats.chi2.ppf([0.0005, 0.9995], r) / r
