@@ -76,11 +76,12 @@ def _random_rotation(rng: np.random.Generator) -> np.ndarray:
 
 
 def build_model(models: list[str], n_images: int = 6, n_points: int = 80, seed: int = 1,
-                offset: np.ndarray | None = None, in_front: float = 0.7) -> dict:
+                offset: np.ndarray | None = None, in_front: float = 0.7,
+                half_width_m: float = 20.0) -> dict:
     """Cameras, images looking at a cloud of points, and COLMAP's projections of them."""
     rng = np.random.default_rng(seed)
     off = np.zeros(3) if offset is None else offset
-    pts = rng.uniform(-20, 20, size=(n_points, 3)) * np.array([1, 1, 0.2]) + off
+    pts = rng.uniform(-1, 1, size=(n_points, 3)) * np.array([1, 1, 0.04]) * half_width_m + off
     cams = {k + 1: (m, PARAMS[m]) for k, m in enumerate(models)}
     images = {}
     for i in range(n_images):
@@ -174,7 +175,8 @@ def _residuals(block, m: dict) -> np.ndarray:
 @pytest.mark.parametrize("fmt", ["txt", "bin"])
 @pytest.mark.parametrize("model", list(PARAMS))
 def test_imported_block_projects_like_colmap(tmp_path: Path, fmt: str, model: str) -> None:
-    m = build_model([model])
+    # fisheyes: points up to about 70 degrees off the axis (60 m below, 160 m across)
+    m = build_model([model], n_points=160, half_width_m=160.0 if model in FISHEYE else 20.0)
     (write_text if fmt == "txt" else write_bin)(tmp_path / "sparse", m)
     colmap = read_colmap_model(tmp_path / "sparse")
     block = block_from_colmap(colmap, frame_from_text("LOCAL"), pixel_size_mm=0.004)
@@ -184,6 +186,15 @@ def test_imported_block_projects_like_colmap(tmp_path: Path, fmt: str, model: st
     assert np.median(res) <= 0.01 and np.max(res) <= 0.05
     assert np.max(res) < 1e-6  # exact in fact
     assert block.cameras[0].projection == ("equidistant" if model in FISHEYE else "perspective")
+    if model in FISHEYE:  # the wide field is covered, not only its centre
+        cam, pts = block.cameras[0], block.points.xyz
+        k = 0
+        eo = np.concatenate([block.eo.xyz[k], block.eo.opk[k]])
+        px = project(pts, eo, cam)
+        ok = cam.in_frame(px)
+        off_axis = np.degrees(np.arctan2(np.hypot(*(pts[ok, :2] - block.eo.xyz[k, :2]).T),
+                                         block.eo.xyz[k, 2] - pts[ok, 2]))  # fmt: skip
+        assert off_axis.max() > 60.0
 
 
 def test_several_cameras_and_a_similarity(tmp_path: Path) -> None:
