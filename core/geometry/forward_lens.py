@@ -56,6 +56,7 @@ __all__ = [
     "OpenCVFisheyeLens",
     "OpenCVFullLens",
     "OpenCVLens",
+    "ThinPrismFisheyeLens",
     "opencv_coefficients",
 ]
 
@@ -313,6 +314,47 @@ class OpenCVFisheyeLens(_NormalisedLens):
         return a * g, b * g, j, dp
 
 
+@register_model
+class ThinPrismFisheyeLens(_NormalisedLens):
+    """COLMAP's THIN_PRISM_FISHEYE, forward, for a camera with the ``equidistant`` projection.
+
+    On the equidistant normalised coordinates ``(a, b)`` (length ``theta``, y down),
+    ``r2 = a^2 + b^2`` and ``c = k1 r2 + k2 r2^2 + k3 r2^3 + k4 r2^4``::
+
+        x_d = a (1 + c) + 2 p1 a b + p2 (r2 + 2 a^2) + sx1 r2
+        y_d = b (1 + c) + p1 (r2 + 2 b^2) + 2 p2 a b + sy1 r2
+
+    >>> lens = ThinPrismFisheyeLens(sx1=0.01, scale_mm=10.0, aspect=1.0)
+    >>> (lens.distort([[0.0, 5.0]]).round(12) + 0.0).tolist()    # x: 10 * 0.01 * 0.25
+    [[0.025, 5.0]]
+    """
+
+    model: ClassVar[str] = "thin_prism_fisheye"
+    param_names: ClassVar[Tuple[str, ...]] = ("k1", "k2", "p1", "p2", "k3", "k4", "sx1", "sy1")
+
+    def _distort_normalised(self, a: Array, b: Array) -> Tuple[Array, Array, Array, Array]:
+        k1, k2, p1, p2, k3, k4, sx1, sy1 = self._params.tolist()
+        r2 = a * a + b * b
+        c = r2 * (k1 + r2 * (k2 + r2 * (k3 + r2 * k4)))
+        dc = k1 + r2 * (2.0 * k2 + r2 * (3.0 * k3 + 4.0 * k4 * r2))  # d c / d r2
+        xd = a * (1.0 + c) + 2.0 * p1 * a * b + p2 * (r2 + 2.0 * a * a) + sx1 * r2
+        yd = b * (1.0 + c) + p1 * (r2 + 2.0 * b * b) + 2.0 * p2 * a * b + sy1 * r2
+        j = np.empty((a.shape[0], 2, 2))
+        j[:, 0, 0] = 1.0 + c + 2.0 * a * a * dc + 2.0 * p1 * b + 6.0 * p2 * a + 2.0 * sx1 * a
+        j[:, 0, 1] = 2.0 * a * b * dc + 2.0 * p1 * a + 2.0 * p2 * b + 2.0 * sx1 * b
+        j[:, 1, 0] = 2.0 * a * b * dc + 2.0 * p1 * a + 2.0 * p2 * b + 2.0 * sy1 * a
+        j[:, 1, 1] = 1.0 + c + 2.0 * b * b * dc + 6.0 * p1 * b + 2.0 * p2 * a + 2.0 * sy1 * b
+        dp = np.zeros((a.shape[0], 2, 8))
+        for col, n in ((0, 1), (1, 2), (4, 3), (5, 4)):
+            rn = r2**n
+            dp[:, 0, col], dp[:, 1, col] = a * rn, b * rn
+        dp[:, 0, 2], dp[:, 1, 2] = 2.0 * a * b, r2 + 2.0 * b * b
+        dp[:, 0, 3], dp[:, 1, 3] = r2 + 2.0 * a * a, 2.0 * a * b
+        dp[:, 0, 6] = r2
+        dp[:, 1, 7] = r2
+        return xd, yd, j, dp
+
+
 def opencv_coefficients(lens: DistortionModel, focal_mm: float) -> dict[str, float]:
     """The lens's coefficients normalised by ``focal_mm`` (OpenCV's and COLMAP's), exactly.
 
@@ -326,6 +368,8 @@ def opencv_coefficients(lens: DistortionModel, focal_mm: float) -> dict[str, flo
     power = {"k1": 2, "k2": 4, "k3": 6, "k4": 2, "k5": 4, "k6": 6, "p1": 1, "p2": 1}
     if isinstance(lens, OpenCVFisheyeLens):
         power = {"k1": 2, "k2": 4, "k3": 6, "k4": 8}
+    elif isinstance(lens, ThinPrismFisheyeLens):
+        power = {"k1": 2, "k2": 4, "k3": 6, "k4": 8, "p1": 1, "p2": 1, "sx1": 1, "sy1": 1}
     return {
         n: float(v) * ratio ** power[n]
         for n, v in zip(lens.param_names, lens.params.tolist())

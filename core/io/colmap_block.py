@@ -21,9 +21,11 @@ FULL_OPENCV                  ``opencv_full`` (k1, k2, p1, p2, k3..k6)       pers
 OPENCV_FISHEYE               ``opencv_fisheye`` (k1..k4)                    equidistant
 SIMPLE_RADIAL_FISHEYE,       ``opencv_fisheye`` (k1 = k; k1, k2)            equidistant
 RADIAL_FISHEYE
+THIN_PRISM_FISHEYE           ``thin_prism_fisheye`` (k1 k2 p1 p2 k3 k4      equidistant
+                             sx1 sy1)
 ===========================  =============================================  ===============
 
-FOV, THIN_PRISM_FISHEYE and RAD_TAN_THIN_PRISM_FISHEYE are refused by name. Every mapping
+FOV and RAD_TAN_THIN_PRISM_FISHEYE are refused by name. Every mapping
 is exact (the formulas are the same, not fitted).
 
 Orientations
@@ -51,6 +53,7 @@ from ..geometry.forward_lens import (
     OpenCVFisheyeLens,
     OpenCVFullLens,
     OpenCVLens,
+    ThinPrismFisheyeLens,
     opencv_coefficients,
 )
 from ..geometry.rotations import matrix_to_opk, opk_to_matrix
@@ -74,7 +77,7 @@ __all__ = [
 
 #: The project's camera frame from COLMAP's (y and z flipped).
 _FLIP = np.diag([1.0, -1.0, -1.0])
-_REFUSED = ("FOV", "THIN_PRISM_FISHEYE", "RAD_TAN_THIN_PRISM_FISHEYE")
+_REFUSED = ("FOV", "RAD_TAN_THIN_PRISM_FISHEYE")
 
 
 @dataclass(frozen=True)
@@ -200,6 +203,10 @@ def camera_from_colmap(cam: ColmapCamera, pixel_size_mm: float, name: str) -> Ca
         lens = OpenCVLens(**{k: p.get(k, 0.0) for k in ("k1", "k2", "p1", "p2")}, **common)
     elif cam.model == "FULL_OPENCV":
         lens = OpenCVFullLens(**{k: p[k] for k in OpenCVFullLens.param_names}, **common)
+    elif cam.model == "THIN_PRISM_FISHEYE":
+        projection = "equidistant"
+        lens = ThinPrismFisheyeLens(**{k: p[k] for k in ThinPrismFisheyeLens.param_names},
+                                    **common)  # fmt: skip
     else:  # the fisheyes: OPENCV_FISHEYE, SIMPLE_RADIAL_FISHEYE, RADIAL_FISHEYE
         projection = "equidistant"
         coef = {"k1": p.get("k", 0.0)} if "k" in p else {}
@@ -232,8 +239,9 @@ def camera_to_colmap(camera: Camera, camera_id: int) -> ColmapCamera:
                                 (f_px, f_px, cx, cy, 0.0, 0.0, 0.0, 0.0))  # fmt: skip
         return ColmapCamera(camera_id, "SIMPLE_PINHOLE", camera.width_px, camera.height_px,
                             (f_px, cx, cy))  # fmt: skip
-    if isinstance(lens, OpenCVFisheyeLens) != fisheye or not isinstance(
-        lens, (OpenCVLens, OpenCVFullLens, OpenCVFisheyeLens)
+    fisheye_lens = isinstance(lens, (OpenCVFisheyeLens, ThinPrismFisheyeLens))
+    if fisheye_lens != fisheye or not isinstance(
+        lens, (OpenCVLens, OpenCVFullLens, OpenCVFisheyeLens, ThinPrismFisheyeLens)
     ):
         raise InputError(
             f"camera {camera.name!r}: lens model {lens.model!r} with the {camera.projection} "
@@ -245,6 +253,8 @@ def camera_to_colmap(camera: Camera, camera_id: int) -> ColmapCamera:
     names: Tuple[str, ...]
     if isinstance(lens, OpenCVFisheyeLens):
         model, names = "OPENCV_FISHEYE", ("k1", "k2", "k3", "k4")
+    elif isinstance(lens, ThinPrismFisheyeLens):
+        model, names = "THIN_PRISM_FISHEYE", ThinPrismFisheyeLens.param_names
     elif type(lens) is OpenCVLens and c["k3"] == 0.0:
         model, names = "OPENCV", ("k1", "k2", "p1", "p2")
     else:

@@ -25,8 +25,8 @@ writes the project's camera JSON, exterior orientation, observation table and po
 the lens models converted exactly: COLMAP's distortion maps ideal to measured coordinates,
 and each camera gets the forward lens model with COLMAP's own coefficients (docs/formats.md,
 COLMAP). SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV,
-OPENCV_FISHEYE, SIMPLE_RADIAL_FISHEYE and RADIAL_FISHEYE are supported; FOV and the thin-prism
-fisheyes are refused by name.
+OPENCV_FISHEYE, SIMPLE_RADIAL_FISHEYE, RADIAL_FISHEYE and THIN_PRISM_FISHEYE are supported;
+FOV and RAD_TAN_THIN_PRISM_FISHEYE are refused by name.
 
 ## Frame
 A COLMAP model has no coordinate reference system: FRAME states it, and a model without one

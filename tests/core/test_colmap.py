@@ -21,7 +21,7 @@ from lidarphoto.core.io.colmap_block import (
 W, H = 1600, 1200
 MODEL_IDS = {"SIMPLE_PINHOLE": 0, "PINHOLE": 1, "SIMPLE_RADIAL": 2, "RADIAL": 3, "OPENCV": 4,
              "OPENCV_FISHEYE": 5, "FULL_OPENCV": 6, "FOV": 7, "SIMPLE_RADIAL_FISHEYE": 8,
-             "RADIAL_FISHEYE": 9}  # fmt: skip
+             "RADIAL_FISHEYE": 9, "THIN_PRISM_FISHEYE": 10}  # fmt: skip
 PARAMS = {
     "SIMPLE_PINHOLE": [1180.0, 801.3, 597.2],
     "PINHOLE": [1180.0, 1187.5, 801.3, 597.2],
@@ -33,8 +33,10 @@ PARAMS = {
     "OPENCV_FISHEYE": [640.0, 641.5, 801.3, 597.2, 0.04, -0.012, 0.003, -4e-4],
     "SIMPLE_RADIAL_FISHEYE": [640.0, 801.3, 597.2, 0.05],
     "RADIAL_FISHEYE": [640.0, 801.3, 597.2, 0.05, -0.01],
+    "THIN_PRISM_FISHEYE": [640.0, 642.0, 801.3, 597.2, 0.03, -0.01, 6e-4, -4e-4, 0.002, -3e-4,
+                           5e-4, -3e-4],
 }  # fmt: skip
-FISHEYE = ("OPENCV_FISHEYE", "SIMPLE_RADIAL_FISHEYE", "RADIAL_FISHEYE")
+FISHEYE = ("OPENCV_FISHEYE", "SIMPLE_RADIAL_FISHEYE", "RADIAL_FISHEYE", "THIN_PRISM_FISHEYE")
 
 
 def colmap_pixel(model: str, p: list[float], xc: np.ndarray) -> np.ndarray:
@@ -58,6 +60,16 @@ def colmap_pixel(model: str, p: list[float], xc: np.ndarray) -> np.ndarray:
         radial = (1 + k1 * r2 + k2 * r2**2 + k3 * r2**3) / (1 + k4 * r2 + k5 * r2**2 + k6 * r2**3)
         du = u * radial + 2 * p1 * u * v + p2 * (r2 + 2 * u * u) - u
         dv = v * radial + 2 * p2 * u * v + p1 * (r2 + 2 * v * v) - v
+    elif model == "THIN_PRISM_FISHEYE":
+        # on the equidistant normalised point (length theta): radial, tangential, thin prism
+        k1, k2, p1, p2, k3, k4, sx1, sy1 = extra
+        r = np.sqrt(r2)
+        uu, vv = u * np.arctan(r) / r, v * np.arctan(r) / r
+        t2 = uu * uu + vv * vv
+        rad = k1 * t2 + k2 * t2**2 + k3 * t2**3 + k4 * t2**4
+        xu = uu + uu * rad + 2 * p1 * uu * vv + p2 * (t2 + 2 * uu * uu) + sx1 * t2
+        yv = vv + vv * rad + 2 * p2 * uu * vv + p1 * (t2 + 2 * vv * vv) + sy1 * t2
+        du, dv = xu - u, yv - v
     elif model in FISHEYE:
         k = (extra + [0.0] * 4)[:4]
         r = np.sqrt(r2)
@@ -256,14 +268,15 @@ def test_ecef_frame_projects_in_the_local_frame(tmp_path: Path) -> None:
 
 
 def test_export_then_import_is_exact(tmp_path: Path) -> None:
-    m = build_model(["FULL_OPENCV", "OPENCV_FISHEYE"], n_images=6)
+    m = build_model(["FULL_OPENCV", "OPENCV_FISHEYE", "THIN_PRISM_FISHEYE"], n_images=6)
     write_text(tmp_path / "a", m)
     block = block_from_colmap(read_colmap_model(tmp_path / "a"), frame_from_text("LOCAL"), 0.004)
     out = colmap_from_block(block.cameras, block.eo, block.camera, block.observations,
                             block.points)  # fmt: skip
     write_colmap_text(tmp_path / "b", out)
     again = read_colmap_model(tmp_path / "b")
-    assert [c.model for c in again.cameras.values()] == ["FULL_OPENCV", "OPENCV_FISHEYE"]
+    assert [c.model for c in again.cameras.values()] == ["FULL_OPENCV", "OPENCV_FISHEYE",
+                                                         "THIN_PRISM_FISHEYE"]  # fmt: skip
     for c_in, c_out in zip(read_colmap_model(tmp_path / "a").cameras.values(),
                            again.cameras.values()):  # fmt: skip
         np.testing.assert_allclose(c_out.params, c_in.params, rtol=1e-12, atol=1e-15)

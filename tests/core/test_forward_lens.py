@@ -10,6 +10,7 @@ from lidarphoto.core.geometry.forward_lens import (
     OpenCVFisheyeLens,
     OpenCVFullLens,
     OpenCVLens,
+    ThinPrismFisheyeLens,
     opencv_coefficients,
 )
 from lidarphoto.core.geometry.projection import ideal_from_camera
@@ -24,6 +25,9 @@ LENSES = {
                                   k4=0.35, k5=-0.02, k6=0.004, scale_mm=F_MM, aspect=0.998),
     "opencv_fisheye": OpenCVFisheyeLens(k1=0.03, k2=-0.01, k3=0.002, k4=-3e-4,
                                         scale_mm=F_MM, aspect=1.0),
+    "thin_prism_fisheye": ThinPrismFisheyeLens(k1=0.03, k2=-0.01, p1=6e-4, p2=-4e-4, k3=0.002,
+                                               k4=-3e-4, sx1=5e-4, sy1=-3e-4, scale_mm=F_MM,
+                                               aspect=1.003),
 }  # fmt: skip
 
 
@@ -43,7 +47,7 @@ def test_registered_and_round_trip_through_files() -> None:
 @pytest.mark.parametrize("name", list(LENSES))
 def test_forward_then_correction_round_trips(name: str) -> None:
     lens = LENSES[name]
-    ideal = _ideal_grid(name == "opencv_fisheye")
+    ideal = _ideal_grid(name.endswith("fisheye"))
     measured = lens.distort(ideal)
     back = measured + lens.correction(measured)
     assert np.max(np.abs(back - ideal)) < 1e-9
@@ -54,7 +58,7 @@ def test_forward_then_correction_round_trips(name: str) -> None:
 @pytest.mark.parametrize("name", list(LENSES))
 def test_jacobians_against_finite_differences(name: str) -> None:
     lens = LENSES[name]
-    m = lens.distort(_ideal_grid(name == "opencv_fisheye")[:40])
+    m = lens.distort(_ideal_grid(name.endswith("fisheye"))[:40])
     h = 1e-6
     jx = lens.jacobian_xy(m)
     for j in range(2):
@@ -140,6 +144,10 @@ def test_rescaled_coefficients_keep_the_map() -> None:
     fish = LENSES["opencv_fisheye"]
     same_f = OpenCVFisheyeLens(**opencv_coefficients(fish, f_new), scale_mm=f_new, aspect=1.0)
     np.testing.assert_allclose(same_f.distort(ideal), fish.distort(ideal), atol=1e-12)
+    prism = LENSES["thin_prism_fisheye"]
+    same_p = ThinPrismFisheyeLens(**opencv_coefficients(prism, f_new), scale_mm=f_new,
+                                  aspect=prism.constants["aspect"])  # fmt: skip
+    np.testing.assert_allclose(same_p.distort(ideal), prism.distort(ideal), atol=1e-12)
 
 
 def test_camera_json_reads_a_forward_model() -> None:
