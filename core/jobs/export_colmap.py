@@ -18,9 +18,10 @@ Writes cameras.txt, images.txt and points3D.txt in OUTPUT_FOLDER, so a block ori
 calibrated here continues in COLMAP (or the tools that read its models: OpenMVS, Gaussian
 splatting). Cameras are written exactly: no lens (SIMPLE_PINHOLE), the forward models opencv
 (OPENCV, or FULL_OPENCV with k3), opencv_full (FULL_OPENCV), and with the equidistant
-projection opencv_fisheye (OPENCV_FISHEYE) and thin_prism_fisheye (THIN_PRISM_FISHEYE), their coefficients renormalised exactly to the
-current focal length; a correction lens model (brown_conrady and the other photogrammetric
-ones) has no exact COLMAP model and is refused by name.
+projection opencv_fisheye (OPENCV_FISHEYE) and thin_prism_fisheye (THIN_PRISM_FISHEYE),
+their coefficients renormalised exactly to the current focal length; a correction lens model
+(brown_conrady and the other photogrammetric ones) has no exact COLMAP model and is refused
+by name.
 
 Orientations are written as COLMAP's world-to-camera quaternion and translation in the EO's
 own coordinates (the mapping CRS; COLMAP stores no CRS: import it back with FRAME = that
