@@ -33,6 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from . import ap_models as _ap_models  # noqa: F401  (registers the AP families' lens models)
+from . import forward_lens as _forward_lens  # noqa: F401  (registers the forward models)
 from .distortion import (
     DEFAULT_MAX_ITER,
     DistortionModel,

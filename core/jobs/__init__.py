@@ -17,6 +17,8 @@ from types import ModuleType
 NAMES = (
     "trajectory_to_eo",
     "import_trajectory",
+    "import_colmap",
+    "export_colmap",
     "ground_filter",
     "create_lcps",
     "accuracy_report",

@@ -111,6 +111,18 @@ WORKFLOWS: tuple[Workflow, ...] = (
         ),
     ),
     Workflow(
+        _t("A COLMAP block: orthophotos on the LiDAR DSM, and back to COLMAP"),
+        (
+            ("importcolmap", _t("INPUT = the model's cameras.txt or cameras.bin; FRAME = the "
+             "frame of its coordinates (LOCAL, ECEF with CRS, or a CRS); OUTPUT_CAMERA, "
+             "OUTPUT_EO, OUTPUT_OBSERVATIONS, OUTPUT_POINTS")),
+            ("orthorectify", _t("CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
+             "OUTPUT_FOLDER = one orthophoto per image")),
+            ("exportcolmap", _t("CAMERA, EO (e.g. adjusted by bundleadjustment), OBSERVATIONS "
+             "and POINTS; OUTPUT_FOLDER = the COLMAP text model")),
+        ),
+    ),
+    Workflow(
         _t("Boresight calibration from an SBET (or ASCII export) and the camera events"),
         (
             ("importtrajectory", _t("INPUT = the SBET, POSPac / Inertial Explorer export or "

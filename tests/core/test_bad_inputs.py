@@ -171,6 +171,25 @@ def _one_iteration(mp: pytest.MonkeyPatch) -> None:
     mp.setattr(bs, "calibrate", calibrate)
 
 
+def _colmap(inp: Path, model: str = "OPENCV 1600 1200 1180 1180 800 600 -0.1 0 0 0",
+            frame: tuple[str, ...] = ("--frame", "LOCAL"), binary: bool = False) -> list[str]:
+    """A two-image COLMAP model in ``inp`` (text, or binary cut short) and its import argv."""
+    if binary:
+        cams = struct.pack("<QiiQQ", 1, 1, 0, 1600, 1200) + struct.pack("<3d", 1180, 800, 600)
+        (inp / "cameras.bin").write_bytes(cams[:-4])
+        (inp / "images.bin").write_bytes(struct.pack("<Q", 0))
+        cameras = inp / "cameras.bin"
+    else:
+        cameras = inp / "cameras.txt"
+        cameras.write_text(f"1 {model}\n", encoding="utf-8")
+        (inp / "images.txt").write_text(
+            "1 1 0 0 0 0 0 5 1 a.jpg\n800 600 -1\n2 1 0 0 0 1 0 5 1 b.jpg\n\n",
+            encoding="utf-8",
+        )  # fmt: skip
+    return ["importcolmap", "--input", str(cameras), *frame,
+            "--output-eo", str(inp.parent / "out" / "eo.csv")]  # fmt: skip
+
+
 def _traj(inp: Path, rows: list[str], crs: str = RD) -> list[str]:
     path = inp / "traj.csv"
     path.write_text(
@@ -327,6 +346,15 @@ CASES = [
          r"failed its checks: the adjustment did not converge after 1 iterations \(no "
          r"convergence within 1 iterations\)", written=("summary.html",), patch=_one_iteration,
          needs_flight=True),
+    # -- COLMAP: no frame, an unknown camera model, a truncated binary file
+    Case("COLMAP model without a frame", lambda i, o, f: _colmap(i, frame=()),
+         r"FRAME: a COLMAP model has no coordinate reference system; state its frame"),
+    Case("COLMAP unknown camera model", lambda i, o, f: _colmap(i, "KANNALA 1600 1200 1 2 3"),
+         r"cameras\.txt, row 1: camera 1: unknown COLMAP camera model 'KANNALA'"),
+    Case("COLMAP FOV camera", lambda i, o, f: _colmap(i, "FOV 1600 1200 900 900 800 600 0.9"),
+         r"camera 1: COLMAP camera model FOV is not supported"),
+    Case("COLMAP truncated binary", lambda i, o, f: _colmap(i, binary=True),
+         r"cameras\.bin: the file ends at byte \d+ inside a record \(truncated\?\)"),
 ]  # fmt: skip
 
 
