@@ -223,7 +223,15 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
         outputs.update(result.results)
         outputs.update(self.write_layers(result, parameters, context, feedback))
         self.attach_styles(outputs, context)
+        self.load_outputs(raw, result, context)
         return outputs
+
+    def load_outputs(self, raw: dict, result: JobResult, context) -> list[str]:
+        """Tables with coordinates and point clouds among the file outputs load as layers
+        (``processing_provider/output_layers.py``); returns their paths."""
+        from .output_layers import load_outputs
+
+        return load_outputs(self, raw, result.data, context)
 
     #: (output name, style function of processing_provider/layer_styles.py) pairs: how each
     #: output layer looks when QGIS loads it after the run.
