@@ -132,3 +132,16 @@ def test_a_classified_laz_loads_as_a_point_cloud_where_qgis_can(provider, tmp_pa
 
     has_pdal = "pdal" in QgsProviderRegistry.instance().providerList()
     assert (cloud_layer(str(cloud), "c") is not None) == has_pdal
+
+
+def test_html_reports_go_to_the_results_viewer(provider):
+    """Every HTML report is a QgsProcessingOutputHtml: QGIS's algorithm dialog adds those to
+    the Processing results viewer after the run and opens it (one click to the report)."""
+    from lidarphoto.core.jobs import ALGORITHMS
+
+    html = {(job.SPEC.name, p.name) for job in ALGORITHMS for p in job.SPEC.outputs
+            if p.kind == "file_out" and "htm" in p.file_filter.lower()}  # fmt: skip
+    assert len(html) >= 8  # accuracy, boresight, bundle, camera, LiDAR, control, resection, TLS
+    for name, key in sorted(html):
+        alg = provider.algorithm(name)
+        assert alg.outputDefinition(key).type() == "outputHtml", (name, key)
