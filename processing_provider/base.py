@@ -227,7 +227,17 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
             str(outputs[p.name]) for p in self.spec.outputs
             if p.kind == "file_out" and str(outputs.get(p.name) or "").lower().endswith(".html")
         ]  # fmt: skip
+        sinks = {p.name: outputs.get(p.name) for p in self.spec.outputs if p.kind == "sink"}
+        self.load_outputs(raw, result, context, sinks)
         return outputs
+
+    def load_outputs(self, raw: dict, result: JobResult, context, sinks=None) -> list[str]:
+        """Tables with coordinates and point clouds among the file outputs load as layers
+        (``processing_provider/output_layers.py``), except a table whose layer twin the run
+        wrote (``sinks``: sink name -> layer id); returns their paths."""
+        from .output_layers import load_outputs
+
+        return load_outputs(self, raw, result.data, context, sinks)
 
     def postProcessAlgorithm(self, context, feedback):
         """Every HTML report the run wrote also as PDF beside it (printing needs the main

@@ -25,8 +25,10 @@ MAX_LEVER_ARM_M = 50.0
 MAX_BORESIGHT_DEG = 10.0
 
 
-def mount_params() -> tuple[Param, ...]:
-    """LEVER_ARM, MOUNT, MOUNT_MATRIX and BORESIGHT (``core.photo.mount``)."""
+def mount_params(initial_boresight: bool = False) -> tuple[Param, ...]:
+    """LEVER_ARM, MOUNT, MOUNT_MATRIX and BORESIGHT (``core.photo.mount``);
+    ``initial_boresight``: BORESIGHT is only the start of an estimate (under Advanced: 0 is
+    a fine first value)."""
     return (
         Param("LEVER_ARM", "numbers", "Lever arm x,y,z", (0.0, 0.0, 0.0), count=3,
               unit="m, body frame", minimum=-MAX_LEVER_ARM_M, maximum=MAX_LEVER_ARM_M,
@@ -41,6 +43,7 @@ def mount_params() -> tuple[Param, ...]:
               help="the nominal mount R_c^b when MOUNT is custom"),
         Param("BORESIGHT", "numbers", "Boresight domega,dphi,dkappa", (0.0, 0.0, 0.0),
               count=3, unit="degrees", minimum=-MAX_BORESIGHT_DEG, maximum=MAX_BORESIGHT_DEG,
+              advanced=initial_boresight,
               help="small misalignment about the camera axes x, y, z (a larger rotation "
               "belongs in MOUNT)"),
     )  # fmt: skip
@@ -141,7 +144,7 @@ def doubt_params(sigma0_help: str, accept_help: str) -> tuple[Param, Param]:
         Param("MAX_SIGMA0", "number", "Largest sigma0 when the global test fails", 3.0,
               minimum=1.0, maximum=1000.0, advanced=True, help=sigma0_help),
         Param("ACCEPT_DOUBTFUL", "boolean", "Write the results even when the checks fail",
-              False, help=accept_help),
+              False, advanced=True, help=accept_help),
     )  # fmt: skip
 
 

@@ -91,6 +91,7 @@ trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""
             minimum=-60.0,
             maximum=60.0,
             help="trajectory time = event time + offset",
+            advanced=True,
         ),
         Param(
             "MAX_GAP",
@@ -101,6 +102,7 @@ trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""
             minimum=1e-6,
             maximum=60.0,
             help="an event between two records further apart than this is refused",
+            advanced=True,
         ),
         Param(
             "ATTITUDE",
@@ -127,6 +129,7 @@ trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""
             "Trajectory table at the events (CSV)",
             optional=True,
             file_filter=CSV_OUT,
+            advanced=True,
         ),
         Param(
             "OUTPUT_EO",
