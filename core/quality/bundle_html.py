@@ -273,7 +273,7 @@ def _in_unit(page: str, unit: str) -> str:
     if unit == "m":
         return page
     page = re.sub(r"(?<!lever d[xyz] )\(m\)", f"({unit})", page)
-    return re.sub(r"(\d) m(?=[;,.]| RMSE|<)", rf"\1 {unit}", page)
+    return re.sub(r"(\d|&ndash;|\u2013) m(?=[;,.]| RMSE|<)", rf"\1 {unit}", page)
 
 
 def _scale_bars(res: BundleResult) -> list[str]:

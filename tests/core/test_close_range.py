@@ -281,3 +281,21 @@ def test_command_line_local_millimetre_frame_with_scale_bars(net, tmp_path, caps
     page = (tmp_path / "summary.html").read_text()
     assert "local engineering frame (mm)" in page and "RMS col (px)" in page
     assert "sigma X (mm)" in page and "Scale bars" in page
+
+
+def test_the_job_needs_a_crs_or_a_local_frame_and_bars_for_their_output(net, tmp_path, capsys):
+    from lidarphoto.core.cli import main
+    from lidarphoto.core.io.camera import write_camera_json
+    from lidarphoto.core.io.observations import write_observations_csv
+
+    cam, _, _, obs, _ = net
+    write_camera_json(tmp_path / "cam.json", cam)
+    write_observations_csv(tmp_path / "obs.csv", obs)
+    base = ["bundleadjustment", "--camera", str(tmp_path / "cam.json"), "--observations",
+            str(tmp_path / "obs.csv"), "--output-eo", str(tmp_path / "eo_out.csv")]  # fmt: skip
+    assert main(base) == 2
+    assert "CRS: give the mapping CRS" in capsys.readouterr().err
+    assert main([*base, "--frame", "local_mm", "--output-scale-bars",
+                 str(tmp_path / "bars.csv")]) == 2  # fmt: skip
+    assert "OUTPUT_SCALE_BARS needs the scale bars" in capsys.readouterr().err
+    assert not (tmp_path / "eo_out.csv").exists() and not (tmp_path / "bars.csv").exists()
