@@ -59,9 +59,12 @@ time (an AP correlated with others is dropped only when a joint F-test finds the
 insignificant together; a correlation alone never drops one) and says which and why.
 Outliers: robust reweighting (Huber or Cauchy) then Baarda's data snooping.
 Datum: control points and/or observed orientations, or a
-free network (inner or minimal constraints). Tables that cannot make a block (an image
-without observations, a tie point seen once, duplicated rows, unknown images, ground points
-in another CRS, unconnected parts) are refused with the file and row named.""",
+free network (inner or minimal constraints); scale bars (measured distances with sigmas) are
+observations, and with a free network they give its scale. Close-range networks: FRAME
+local_m or local_mm takes the coordinates in a local engineering frame with no CRS.
+Tables that cannot make a block (an image without observations, a tie point seen once,
+duplicated rows, unknown images, ground points in another CRS, unconnected parts) are refused
+with the file and row named.""",
     params=(
         Param(
             "CAMERA",
