@@ -161,6 +161,11 @@ class MappingFrame:
     def from_user_input(cls, crs: CRS | str | int) -> MappingFrame:
         return cls(parse_crs(crs, what="mapping CRS"))
 
+    @property
+    def name(self) -> str:
+        """The CRS's name (the reports'; an engineering frame has one too)."""
+        return str(self.crs.name)
+
     # -- positions -----------------------------------------------------------------------
     def map_to_geodetic(self, enh: ArrayLike) -> Array:
         """(N, 3) easting, northing, height -> (N, 3) latitude, longitude (deg), ellipsoidal h."""

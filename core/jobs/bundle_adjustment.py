@@ -21,6 +21,8 @@ _OPTIONS = Fields("photo.bundle_options", "BundleOptions")
 _AP_CHOICES = Ref("geometry.ap_families", "AP_FAMILIES", convert=lambda f: (*f, "all"))
 ROBUST_CHOICES = ("none", "huber", "cauchy")
 DATUM_CHOICES = ("control", "inner", "minimal")
+#: the frame of the coordinates: the mapping CRS, or a local engineering frame (no CRS)
+FRAME_CHOICES = ("crs", "local_m", "local_mm")
 
 SPEC = AlgorithmSpec(
     name="bundleadjustment",
@@ -57,9 +59,12 @@ time (an AP correlated with others is dropped only when a joint F-test finds the
 insignificant together; a correlation alone never drops one) and says which and why.
 Outliers: robust reweighting (Huber or Cauchy) then Baarda's data snooping.
 Datum: control points and/or observed orientations, or a
-free network (inner or minimal constraints). Tables that cannot make a block (an image
-without observations, a tie point seen once, duplicated rows, unknown images, ground points
-in another CRS, unconnected parts) are refused with the file and row named.""",
+free network (inner or minimal constraints); scale bars (measured distances with sigmas) are
+observations, and with a free network they give its scale. Close-range networks: FRAME
+local_m or local_mm takes the coordinates in a local engineering frame with no CRS.
+Tables that cannot make a block (an image without observations, a tie point seen once,
+duplicated rows, unknown images, ground points in another CRS, unconnected parts) are refused
+with the file and row named.""",
     params=(
         Param(
             "CAMERA",
@@ -88,7 +93,7 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
             "numbers",
             "EO sigmas when the table has none: X, Y, Z, omega, phi, kappa",
             count=6,
-            unit="m, degrees",
+            unit="frame unit (m, or mm in a local frame), degrees",
             optional=True,
             minimum=0.0001,
             maximum=100.0,
@@ -100,8 +105,26 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
             "CRS",
             "crs",
             "Mapping CRS",
+            optional=True,
             qgis_default="ProjectCrs",
-            help="projected CRS of the ground points and exterior orientations",
+            help="projected CRS of the ground points and exterior orientations (needed "
+            "unless FRAME is a local frame, which ignores it)",
+        ),
+        Param(
+            "FRAME",
+            "enum",
+            "Coordinate frame",
+            "crs",
+            options=FRAME_CHOICES,
+            labels=(
+                "mapping CRS (projected, metres)",
+                "local engineering frame, metres (no CRS)",
+                "local engineering frame, millimetres (no CRS)",
+            ),
+            help="a local frame takes X, Y, Z and omega-phi-kappa as they are (close-range "
+            "networks, calibration fields): no projection, no earth curvature; every length "
+            "of the inputs (coordinates, sigmas, EO_SIGMAS, scale bars) and of the outputs is "
+            "in its unit",
         ),
         Param(
             "AP_MODEL",
@@ -153,6 +176,16 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
             advanced=True,
         ),
         Param(
+            "SCALE_BARS",
+            "file",
+            "Scale bars / measured distances (CSV: point_a,point_b,distance,sigma)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            help="distances between adjusted points, observations with their sigmas (frame "
+            "units); with a free-network datum they give its scale (inner constraints "
+            "without the scale row, or six parameters held)",
+        ),
+        Param(
             "ESTIMATE_MOUNT",
             "boolean",
             "Estimate lever arm and boresight corrections",
@@ -198,6 +231,14 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
             advanced=True,
         ),
         Param(
+            "OUTPUT_SCALE_BARS",
+            "file_out",
+            "Adjusted scale bars with w-tests (CSV)",
+            optional=True,
+            create_by_default=False,
+            file_filter=CSV_OUT,
+        ),
+        Param(
             "OUTPUT_HTML",
             "file_out",
             "Summary (HTML)",
@@ -207,7 +248,7 @@ in another CRS, unconnected parts) are refused with the file and row named.""",
     ),
     results=(
         Result("SIGMA0", "number", "Sigma0 a-posteriori"),
-        Result("CHECK_RMS", "number", "Check-point RMS 3D (m)"),
+        Result("CHECK_RMS", "number", "Check-point RMS 3D (frame unit)"),
         Result("MODEL", "string", "AP model of the outputs"),
     ),
     tags=(
@@ -246,7 +287,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..photo.bundle_setup import BundleOptions
     from .runner import stages
 
-    frame, cams, obs, ground, eo, sigma, eo_rows, eo_source, image_camera = _read_inputs(v)
+    frame, cams, obs, ground, eo, sigma, eo_rows, eo_source, image_camera, bars = _read_inputs(v)
     models = tuple(m for m in AP_FAMILIES) if v.ap_model == "all" else (v.ap_model,)
     parts = stages(progress, *([1.0] * len(models)))
     stage = dict(zip(models, parts))
@@ -256,7 +297,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         log.info("bundle adjustment with AP model %s", model)
         try:
             return bundle_adjust(cams, obs, ground, frame, eo, sigma, image_camera, opts,
-                                 eo_rows, eo_source, stage[model], should_stop)  # fmt: skip
+                                 eo_rows, eo_source, stage[model], should_stop,
+                                 scale_bars=bars)  # fmt: skip
         except AdjustmentError as exc:
             if eo is not None:  # an approximate orientation far off is the usual cause
                 _blame_eo(exc, cams, obs, ground, eo, image_camera, eo_rows, eo_source)
@@ -292,35 +334,38 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 def _read_inputs(v: Values) -> tuple:
     """The frame, cameras, observations and ground points, and the approximate orientations
     with their sigmas (EO_SIGMAS when the file has none) and the camera of every image, all
-    checked: (frame, cameras, observations, ground, eo, sigma, eo_rows, eo_source,
-    image_camera)."""
+    checked, and the scale bars: (frame, cameras, observations, ground, eo, sigma, eo_rows,
+    eo_source, image_camera, bars)."""
     import numpy as np
 
     from ..errors import InputError
-    from ..geometry.frames import MappingFrame, check_area_of_use
+    from ..geometry.frames import check_area_of_use
     from ..io.camera import read_cameras_json
     from ..io.ground_points import read_ground_points_csv
     from ..io.observations import read_observations_csv
     from ..io.orientation import read_eo_csv_full
+    from ..io.scale_bars import read_scale_bars_csv
     from ..photo.bundle_setup import GroundPoints
 
-    frame = MappingFrame.from_user_input(v.crs)
+    frame = _frame(v)
+    crs = getattr(frame, "crs", None)  # None: a local engineering frame
     cams = read_cameras_json(v.camera)
     # one camera: its image size bounds every pixel as the table is read (several: below)
     obs = read_observations_csv(v.observations, camera=cams[0] if len(cams) == 1 else None)
     ground = read_ground_points_csv(v.ground_points) if v.ground_points else GroundPoints.empty()
-    if len(ground):
-        check_area_of_use(frame.crs, ground.xyz.min(axis=0), ground.xyz.max(axis=0),
+    if len(ground) and crs is not None:
+        check_area_of_use(crs, ground.xyz.min(axis=0), ground.xyz.max(axis=0),
                           what="the ground points", path=v.ground_points)  # fmt: skip
     eo = sigma = None
     eo_rows: tuple[int, ...] = ()
     eo_source = ""
     image_camera: dict[str, str] = {}
     if v.eo:
-        f = read_eo_csv_full(v.eo, frame.crs.to_wkt())
+        f = read_eo_csv_full(v.eo, crs.to_wkt() if crs is not None else "")
         eo, sigma, eo_rows, eo_source = f.eo, f.sigma, f.rows, f.path
-        check_area_of_use(frame.crs, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
-                          what="the perspective centres", path=v.eo)  # fmt: skip
+        if crs is not None:
+            check_area_of_use(crs, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
+                              what="the perspective centres", path=v.eo)  # fmt: skip
         if sigma is None and v.eo_sigmas:
             s6 = np.array(v.eo_sigmas, dtype=float)
             if not (s6 > 0).all():
@@ -337,7 +382,24 @@ def _read_inputs(v: Values) -> tuple:
             )
     if len(cams) > 1:
         _check_on_image(obs, image_camera, cams)
-    return frame, cams, obs, ground, eo, sigma, eo_rows, eo_source, image_camera
+    bars = read_scale_bars_csv(v.scale_bars) if v.scale_bars else None
+    if bars is None and v.output_scale_bars:
+        raise InputError("OUTPUT_SCALE_BARS needs the scale bars (SCALE_BARS)")
+    return frame, cams, obs, ground, eo, sigma, eo_rows, eo_source, image_camera, bars
+
+
+def _frame(v: Values):
+    """The frame of the coordinates: the mapping CRS, or a local engineering frame."""
+    from ..errors import InputError
+    from ..geometry.engineering import EngineeringFrame
+    from ..geometry.frames import MappingFrame
+
+    if v.frame == "crs":
+        if not v.crs:
+            raise InputError("CRS: give the mapping CRS of the coordinates, or a local "
+                             "engineering frame (FRAME local_m or local_mm)")  # fmt: skip
+        return MappingFrame.from_user_input(v.crs)
+    return EngineeringFrame(v.frame.split("_")[1])
 
 
 def _write_outputs(out, results: dict, best: str, rows: list, settings, *, multi: bool,
@@ -353,6 +415,7 @@ def _write_outputs(out, results: dict, best: str, rows: list, settings, *, multi
     )
     from ..io.camera import write_cameras_json
     from ..io.orientation import write_eo_csv_with_sigmas
+    from ..io.scale_bars import write_scale_bars_csv
     from ..quality.bundle_html import render_bundle_html
 
     res = results[best]
@@ -366,6 +429,7 @@ def _write_outputs(out, results: dict, best: str, rows: list, settings, *, multi
         ]
         write_cameras_json(out.path("OUTPUT_CAMERA"), list(res.cameras.values()), sig,
                            {"_bundle": {"ap_model": best, "sigma0": res.sigma0,
+                                        "frame": res.local.mapping.name,
                                         "dropped": [list(d) for d in res.dropped]}})  # fmt: skip
     if out.requested("OUTPUT_POINTS"):
         write_bundle_points(out.path("OUTPUT_POINTS"), res)
@@ -375,6 +439,8 @@ def _write_outputs(out, results: dict, best: str, rows: list, settings, *, multi
         write_check_points(out.path("OUTPUT_CHECK_CSV"), results.values())
     if out.requested("OUTPUT_COMPARISON"):
         write_comparison(out.path("OUTPUT_COMPARISON"), rows)
+    if out.requested("OUTPUT_SCALE_BARS") and res.scale_bars is not None:
+        write_scale_bars_csv(out.path("OUTPUT_SCALE_BARS"), res.scale_bars, _unit(res))
     if out.requested("OUTPUT_HTML"):
         page = render_bundle_html(results, best, settings, rows if compared else ())
         write_text_atomic(out.path("OUTPUT_HTML"), page)
@@ -383,12 +449,17 @@ def _write_outputs(out, results: dict, best: str, rows: list, settings, *, multi
 def _summary_lines(res, best: str, rows) -> list[str]:
     """The log's summary: the ranking of the AP models (``rows``, when several), then the
     adjustment of ``best`` and its check points."""
+    import math
+
+    import numpy as np
+
     from ..photo.bundle_options import BundleOptions
 
     st = res.check.statistics()
-    lines = []
+    u = _unit(res)
+    lines = [f"frame: {res.local.mapping.name}"] if u != "m" or _local(res) else []
     if rows:
-        lines.append(f"{'rank':>4} {'model':14} {'check RMS 3D m':>14} {'planimetric m':>13} "
+        lines.append(f"{'rank':>4} {'model':14} {'check RMS 3D ' + u:>14} {'planimetric ' + u:>13} "
                      f"{'sigma0':>7} {'sig. APs':>8}")  # fmt: skip
         for r in rows:
             if r.get("error"):
@@ -406,10 +477,27 @@ def _summary_lines(res, best: str, rows) -> list[str]:
     )
     if len(res.check.point_id):
         lines.append(
-            f"check points ({int(st['n'])}): RMS E/N/H {st['rms_e']:.3f} / {st['rms_n']:.3f} / "
-            f"{st['rms_h']:.3f} m, 3D {st['rms_3d']:.3f} m"
+            f"check points ({int(st['n'])}): RMS E/N/H {st['rms_e']:.4g} / {st['rms_n']:.4g} / "
+            f"{st['rms_h']:.4g} {u}, 3D {st['rms_3d']:.4g} {u}"
+        )
+    b = res.scale_bars
+    if b is not None:
+        lines.append(
+            f"scale bars ({len(b.v)}): RMS residual {math.sqrt(float(np.mean(b.v**2))):.4g} {u}, "
+            f"max |w| {float(np.nanmax(np.abs(b.w), initial=0.0)):.2f}, "
+            f"{int(b.rejected.sum())} rejected"
         )
     return lines
+
+
+def _local(res) -> bool:
+    """Whether a bundle result is in a local engineering frame."""
+    return bool(getattr(res.local, "engineering", False))
+
+
+def _unit(res) -> str:
+    """The length unit of the frame of a bundle result: m, or an engineering frame's."""
+    return str(getattr(res.local.mapping, "unit", "m"))
 
 
 def _misfit(xyz, px, eo6, cam) -> float:
@@ -502,11 +590,11 @@ def _settings(v, cams, obs, ground, eo, sigma, frame) -> dict[str, str]:
         "ground points": f"{roles.count('control')} control, {roles.count('check')} check",
         "exterior orientation": "none (resection and growth)" if eo is None else (
             "observed (with sigmas)" if sigma is not None else "approximate values"),
-        "mapping CRS": frame.crs.name,
+        ("mapping CRS" if hasattr(frame, "crs") else "frame"): frame.name,
         "AP model": v.ap_model,
         "interior orientation": "estimated" if v.estimate_interior else "fixed",
         "AP selection": "on" if v.ap_selection else "off",
         "outliers": f"robust {v.robust}, data snooping {'on' if v.snooping else 'off'}",
-        "datum": v.datum,
+        "datum": v.datum + (" + scale bars" if v.scale_bars else ""),
         "lever arm / boresight": "estimated" if v.estimate_mount else "held",
     }  # fmt: skip

@@ -59,6 +59,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError, NotObservableError, stop_if_asked
 from ..geometry.camera import Camera
+from ..geometry.engineering import EngineeringFrame, EngineeringLocal
 from ..geometry.frames import MappingFrame
 from .bundle_model import _cams_from, _Run, _run
 from .bundle_result import BundleResult, _finish
@@ -66,6 +67,7 @@ from .bundle_selection import ap_decisions, drop_candidate
 from .bundle_setup import BundleOptions, GroundPoints, _prepare
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable
+from .scale_bars import ScaleBars, setup_bars
 
 #: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
 TR_CONTEXT = "Report"
@@ -88,7 +90,7 @@ def bundle_adjust(
     cameras: Sequence[Camera],
     observations: ImageObservations,
     ground: GroundPoints,
-    mapping: MappingFrame,
+    mapping: MappingFrame | EngineeringFrame,
     eo: ExteriorOrientationTable | None = None,
     eo_sigma: Array | None = None,
     image_camera: Mapping[str, str] | None = None,
@@ -97,6 +99,7 @@ def bundle_adjust(
     eo_source: str = "",
     progress: Callable[[float], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
+    scale_bars: ScaleBars | None = None,
 ) -> BundleResult:
     """Bundle adjustment with self-calibration (see the module docstring).
 
@@ -109,8 +112,9 @@ def bundle_adjust(
         of type ``control`` must name a ground point).
     ground : GroundPoints
         Control and check points in the mapping CRS.
-    mapping : MappingFrame
-        The mapping CRS of the ground points and orientations.
+    mapping : MappingFrame or EngineeringFrame
+        The mapping CRS of the ground points and orientations, or a local engineering
+        frame (no CRS, m or mm).
     eo : ExteriorOrientationTable, optional
         Approximate or observed orientations (mapping CRS, omega-phi-kappa of the grid
         frame); without it the images are oriented by resection from control and growth.
@@ -121,6 +125,9 @@ def bundle_adjust(
         Camera name of each image (needed with several cameras).
     options : BundleOptions, optional
     eo_rows, eo_source : for error messages naming rows of the EO file.
+    scale_bars : ScaleBars, optional
+        Measured distances between adjusted points (frame units), observations with their
+        sigmas; with a free-network datum they give its scale (:mod:`.scale_bars`).
 
     Returns
     -------
@@ -152,6 +159,9 @@ def bundle_adjust(
                          "(EO with sigma columns)")  # fmt: skip
     setup = _prepare(cameras, dict(image_camera or {}), observations, ground, mapping, eo,
                      eo_sigma, opts, eo_rows, eo_source, should_stop, warnings)  # fmt: skip
+    if scale_bars is not None and len(scale_bars):
+        metres = setup.local.mapping.metres if isinstance(setup.local, EngineeringLocal) else 1.0
+        setup.bars = setup_bars(scale_bars, setup.points, setup.check_ids, metres)
     cams = list(setup.cameras)
     free = []
     for cam in cams:

@@ -18,6 +18,8 @@ from ..lsq.model import AdjustmentOptions, Constraint, GaussMarkovBlock
 from ..lsq.results import AdjustmentResult
 from .bundle_setup import EO_PARAM_NAMES, BundleOptions, _Setup
 from .observations import ImageObservations
+from .scale_bars import BLOCK_NAME as BARS
+from .scale_bars import bar_block
 
 #: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
 TR_CONTEXT = "Report"
@@ -177,8 +179,13 @@ def _blocks(setup: _Setup, lay: _Layout, cams: list[Camera], obs: ImageObservati
     blocks = []
     rows_of = []
     names = []
-    for c, cam in enumerate(cams):
-        rows = np.flatnonzero(keep & (setup.obs_pt >= 0) & (setup.image_cam[setup.obs_img] == c))
+    elim = _eliminated(setup)
+    # a scale bar's ends stay in the reduced system: their measurements form blocks of their
+    # own (a block's point columns are eliminated in every group or in none)
+    parts = [(c, cam, e) for c, cam in enumerate(cams) for e in (True, False)]
+    for c, cam, e in parts:
+        rows = np.flatnonzero(keep & (setup.obs_pt >= 0) & (setup.image_cam[setup.obs_img] == c)
+                              & (elim[np.maximum(setup.obs_pt, 0)] == e))  # fmt: skip
         if rows.size == 0:
             continue
         img, pt = setup.obs_img[rows], setup.obs_pt[rows]
@@ -190,7 +197,7 @@ def _blocks(setup: _Setup, lay: _Layout, cams: list[Camera], obs: ImageObservati
         labels = [f"{obs.image_id[r]} / {obs.point_id[r]}" for r in rows]
         blocks.append(
             GaussMarkovBlock(
-                name=f"image points {cam.name}",
+                name=f"image points {cam.name}" + ("" if e else " (scale bar ends)"),
                 observed=obs.pixels[rows],
                 sigma=np.repeat(obs.sigma_px[rows, None], 2, axis=1),
                 param_index=idx,
@@ -233,6 +240,8 @@ def _blocks(setup: _Setup, lay: _Layout, cams: list[Camera], obs: ImageObservati
                 row_names=EO_PARAM_NAMES,
             )
         )
+    if setup.bars is not None:
+        blocks.append(bar_block(setup.bars, lay.points))
     return blocks, rows_of, names
 
 
@@ -252,7 +261,9 @@ def _datum_constraints(setup: _Setup, lay: _Layout, datum: str, xyz0: Array, eo0
         G[4, :, 0], G[4, :, 2] = q[:, 2] / scale, -q[:, 0] / scale
         G[5, :, 0], G[5, :, 1] = -q[:, 1] / scale, q[:, 0] / scale
         G[6] = q / scale
-        Gm = G.reshape(7, -1)
+        if setup.bars is not None:  # the scale bars carry the scale: no scale row
+            G = G[:6]
+        Gm = G.reshape(len(G), -1)
         base = P0.ravel()
 
         def inner(xl: Array, Gm=Gm, base=base) -> tuple[Array, Array]:
@@ -265,9 +276,11 @@ def _datum_constraints(setup: _Setup, lay: _Layout, datum: str, xyz0: Array, eo0
     axis = int(np.argmax(np.abs(eo0[far, :3] - eo0[0, :3])))
     held = np.concatenate([lay.eo[0], [lay.eo[far, axis]]])
     vals = np.concatenate([eo0[0], [eo0[far, axis]]])
+    if setup.bars is not None:  # the scale bars carry the scale: the first image alone
+        held, vals = held[:6], vals[:6]
 
     def minimal(xl: Array, vals=vals) -> tuple[Array, Array]:
-        return (xl[0] - vals)[None], np.eye(7)[None]
+        return (xl[0] - vals)[None], np.eye(vals.size)[None]
 
     return [Constraint("minimal constraints", held[None], minimal)]
 
@@ -290,12 +303,12 @@ def _run(setup: _Setup, obs: ImageObservations, cams: list[Camera], free: list,
     cons = _datum_constraints(setup, lay, options.datum, setup.xyz0, setup.eo0)
     opts = AdjustmentOptions(
         robust_blocks=bnames,
-        snooping_blocks=bnames,
+        snooping_blocks=bnames + ([BARS] if setup.bars is not None else []),
         max_iterations=options.max_iterations,
         snooping=snooping,
         snooping_alpha=options.snooping_alpha,
         robust=robust,
-        eliminate=lay.points,
+        eliminate=lay.points[_eliminated(setup)] if _eliminated(setup).any() else None,
         max_rejections=max(50, len(obs) // 20),
         # a millionth of each parameter's precision: far below anything reported, and the
         # linear convergence of large-residual blocks reaches it in a few iterations
@@ -305,6 +318,15 @@ def _run(setup: _Setup, obs: ImageObservations, cams: list[Camera], free: list,
     result = adjust(lay.x0, lay.names, blocks, cons, opts, progress=progress,
                     should_stop=should_stop)  # fmt: skip
     return _Run(result, lay, cams, rows_of, bnames, keep)
+
+
+def _eliminated(setup: _Setup) -> NDArray[np.bool_]:
+    """The points eliminated by the Schur complement: all but the scale bars' ends (a group
+    may see one eliminated block only; a bar sees two points)."""
+    out = np.ones(len(setup.points), dtype=bool)
+    if setup.bars is not None:
+        out[setup.bars.a] = out[setup.bars.b] = False
+    return out
 
 
 def _cams_from(run: _Run) -> list[Camera]:

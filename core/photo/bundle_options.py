@@ -43,7 +43,7 @@ class BundleOptions:
     datum : str
         ``control`` (control points and/or observed orientations), ``inner`` (free network,
         inner constraints on the tie points) or ``minimal`` (free network, seven parameters
-        held).
+        held); with scale bars a free network keeps six (the bars give the scale).
     estimate_mount : bool
         With observed orientations: estimate a common lever-arm correction (camera axes,
         metres) and boresight correction (about the camera axes) between the observed and

@@ -14,15 +14,16 @@ from scipy import stats
 
 from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians
-from ..geometry.frames import LocalFrame
+from ..geometry.engineering import EngineeringLocal
 from ..geometry.rotations import opk_to_matrix
 from ..lsq.results import AdjustmentResult
-from .bundle_model import _cams_from, _Run
+from .bundle_model import _cams_from, _eliminated, _Run
 from .bundle_selection import ap_decisions
-from .bundle_setup import BundleOptions, _cov_local_to_map, _rays, _Setup
+from .bundle_setup import BundleOptions, Local, _cov_local_to_map, _rays, _Setup
 from .intersection import meet_rays
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_local_to_map
+from .scale_bars import BarResult, bar_result
 
 #: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
 TR_CONTEXT = "Report"
@@ -132,8 +133,10 @@ class BundleResult:
         Estimated lever arm (m, camera axes) and boresight (rad) with sigmas.
     adjustment : AdjustmentResult
         The final adjustment (sigma0, global test, warnings, rejections ...).
-    local : LocalFrame
+    local : LocalFrame or EngineeringLocal
     warnings : list of str
+    scale_bars : BarResult or None
+        The scale bars' adjusted distances, residuals and tests (frame units).
     """
 
     ap_model: str
@@ -161,8 +164,9 @@ class BundleResult:
     check: CheckPointResult
     mount: dict | None
     adjustment: AdjustmentResult
-    local: LocalFrame
+    local: Local
     warnings: list[str] = field(default_factory=list)
+    scale_bars: BarResult | None = None
 
     @property
     def sigma0(self) -> float:
@@ -285,7 +289,7 @@ def _check_points(setup: _Setup, obs: ImageObservations, cams: list[Camera], eo:
     return CheckPointResult(setup.check_ids, meas, ref, sig, counts.astype(np.int64))
 
 
-def _eo_map_sigma(eo_local: Array, cov: Array, local: LocalFrame) -> tuple[Array, Array, Array]:
+def _eo_map_sigma(eo_local: Array, cov: Array, local: Local) -> tuple[Array, Array, Array]:
     """Mapping-frame EO (xyz, opk) and their sigmas (M, 6) by numerical propagation."""
 
     def to_map(e: Array) -> Array:
@@ -320,14 +324,18 @@ def _finish(setup: _Setup, obs: ImageObservations, run: _Run, options: BundleOpt
     time = eo_table.time if eo_table is not None else np.full(M, np.nan)
     group = eo_table.group if eo_table is not None else ("",) * M
     eo_out = ExteriorOrientationTable(setup.images, time, group, xyz_map, opk_map,
-                                      setup.local.mapping.crs.to_wkt())  # fmt: skip
+                                      _wkt(setup.local))  # fmt: skip
     pts_local = x[lay.points]
     blocks_q = res.cofactor_blocks
     P = len(setup.points)
+    pcov = np.full((P, 3, 3), np.nan)
     if blocks_q is not None:
-        pcov = blocks_q.Q_eliminated * res.sigma0**2
-    else:
-        pcov = np.full((P, 3, 3), np.nan)
+        elim = _eliminated(setup)
+        pcov[elim] = blocks_q.Q_eliminated * res.sigma0**2
+        for i in np.flatnonzero(~elim):  # the scale bars' ends, in the reduced system
+            pcov[i] = res.covariance_of(lay.points[i])
+    elif res.cofactor is not None:  # nothing eliminated
+        pcov = np.stack([res.covariance_of(lay.points[i]) for i in range(P)]) if P else pcov
     pcov_map = _cov_local_to_map(pts_local, pcov, setup.local) if P else np.zeros((0, 3, 3))
     check = _check_points(setup, obs, cams, eo_local, res.sigma0)
     n_obs = len(obs)
@@ -407,4 +415,10 @@ def _finish(setup: _Setup, obs: ImageObservations, run: _Run, options: BundleOpt
         adjustment=res,
         local=setup.local,
         warnings=warnings + list(res.warnings),
+        scale_bars=bar_result(setup.bars, res, lay.points) if setup.bars is not None else None,
     )
+
+
+def _wkt(local: Local) -> str:
+    """The WKT of the tables written in the frame of ``local`` (empty: no CRS)."""
+    return "" if isinstance(local, EngineeringLocal) else local.mapping.crs.to_wkt()

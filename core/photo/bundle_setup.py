@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import Callable
+from typing import Callable, Union
 
 import numpy as np
 from numpy.typing import NDArray
@@ -17,6 +17,7 @@ from ..errors import AdjustmentError, InputError, stop_if_asked
 from ..geometry.ap_models import AP_FAMILIES, make_ap_model
 from ..geometry.camera import Camera
 from ..geometry.collinearity import image_rays
+from ..geometry.engineering import EngineeringFrame, EngineeringLocal
 from ..geometry.frames import LocalFrame, MappingFrame
 from ..geometry.rotations import matrix_to_opk
 from ..i18n import mark as _t
@@ -25,11 +26,16 @@ from .bundle_options import DATUMS, BundleOptions  # noqa: F401 - DATUMS: the ol
 from .intersection import meet_rays
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_map_to_local
+from .scale_bars import BarSetup
 
 #: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
 TR_CONTEXT = "Report"
 
 Array = NDArray[np.float64]
+#: the frame of the user's coordinates (a mapping CRS, or a local engineering frame) and the
+#: adjustment frame it gives
+Frame = Union[MappingFrame, EngineeringFrame]
+Local = Union[LocalFrame, EngineeringLocal]
 
 ROLES = ("control", "check")
 EO_PARAM_NAMES = ("X0", "Y0", "Z0", "omega", "phi", "kappa")
@@ -196,7 +202,7 @@ def _components(img: NDArray[np.intp], pts: NDArray[np.intp], n_img: int, n_pts:
 class _Setup:
     """Everything fixed for a block: indices, approximations, frames."""
 
-    local: LocalFrame
+    local: Local
     images: tuple[str, ...]
     image_cam: NDArray[np.intp]  # (M,) camera number
     cam_names: tuple[str, ...]
@@ -215,23 +221,27 @@ class _Setup:
     control_local: Array  # (C, 3)
     eo_obs: Array | None  # (M, 6) local observed orientations
     eo_obs_cov: Array | None  # (M, 6, 6)
+    bars: BarSetup | None = None  # scale bars (set after the setup, bundle.py)
 
 
-def _local_frame(mapping: MappingFrame, ground: GroundPoints, eo: ExteriorOrientationTable | None):
+def _local_frame(mapping: Frame, ground: GroundPoints,
+                 eo: ExteriorOrientationTable | None) -> Local:  # fmt: skip
     if len(ground):
         centre = ground.xyz.mean(axis=0)
     else:
         centre = eo.xyz.mean(axis=0)  # type: ignore[union-attr]
+    if isinstance(mapping, EngineeringFrame):
+        return EngineeringLocal(mapping, (float(centre[0]), float(centre[1]), float(centre[2])))
     return LocalFrame.at_map_point(mapping, centre)
 
 
-def _eo_to_local(eo: ExteriorOrientationTable, local: LocalFrame) -> Array:
+def _eo_to_local(eo: ExteriorOrientationTable, local: Local) -> Array:
     centres, m = eo_map_to_local(eo.xyz, eo.opk, local)
     om, ph, ka = matrix_to_opk(m)
     return np.column_stack([centres, om, ph, ka])
 
 
-def _eo_cov_to_local(eo: ExteriorOrientationTable, sigma: Array, local: LocalFrame) -> Array:
+def _eo_cov_to_local(eo: ExteriorOrientationTable, sigma: Array, local: Local) -> Array:
     """Covariance (M, 6, 6) in the local frame of orientations with map-frame sigmas (M, 6)."""
     jac = np.zeros((len(eo), 6, 6))
     steps = np.array([0.01, 0.01, 0.01, 1e-6, 1e-6, 1e-6])
@@ -262,11 +272,11 @@ def _camera_for_family(cam: Camera, family: str) -> Camera:
 
 
 def _check_ground_crs(
-    ground: GroundPoints, eo: ExteriorOrientationTable | None, mapping: MappingFrame
+    ground: GroundPoints, eo: ExteriorOrientationTable | None, mapping: Frame
 ) -> None:
     """Refuse control points in another CRS: coordinates like degrees, or far from every
-    image."""
-    if not len(ground):
+    image (a local engineering frame has no CRS to confuse)."""
+    if not len(ground) or isinstance(mapping, EngineeringFrame):
         return
     g = ground.xyz
     if (np.abs(g[:, 0]) <= 180).all() and (np.abs(g[:, 1]) <= 90).all():
@@ -299,7 +309,7 @@ def _prepare(
     image_camera: Mapping[str, str],
     obs: ImageObservations,
     ground: GroundPoints,
-    mapping: MappingFrame,
+    mapping: Frame,
     eo: ExteriorOrientationTable | None,
     eo_sigma: Array | None,
     options: BundleOptions,
@@ -434,13 +444,13 @@ def _prepare(
     )  # fmt: skip
 
 
-def _cov_map_to_local(xyz: Array, sigma: Array, local: LocalFrame) -> Array:
+def _cov_map_to_local(xyz: Array, sigma: Array, local: Local) -> Array:
     """(N, 3, 3) covariance in the local frame of map coordinates with sigmas (N, 3)."""
     jac = local.map_to_enu_jacobian(xyz)[1]
     return jac @ (sigma[:, :, None] ** 2 * np.eye(3)) @ np.swapaxes(jac, 1, 2)
 
 
-def _cov_local_to_map(xyz_local: Array, cov: Array, local: LocalFrame) -> Array:
+def _cov_local_to_map(xyz_local: Array, cov: Array, local: Local) -> Array:
     jac = local.enu_to_map_jacobian(xyz_local)[1]
     return jac @ cov @ np.swapaxes(jac, 1, 2)
 

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from ..geometry.engineering import EngineeringLocal
 from ..geometry.frames import LocalFrame
 from ..geometry.rotations import matrix_to_opk, opk_to_matrix
 
@@ -40,13 +41,15 @@ class ExteriorOrientationTable:
 
 
 def eo_map_to_local(
-    xyz: NDArray[np.float64], opk: NDArray[np.float64], local: LocalFrame
+    xyz: NDArray[np.float64], opk: NDArray[np.float64], local: LocalFrame | EngineeringLocal
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Mapping-frame EO -> (centres (N, 3) in the ENU frame, world-to-camera M (N, 3, 3) there).
 
     ``opk`` is relative to the grid frame at each centre (as in the EO CSV); the rotation into
     the ENU frame includes grid convergence and the tilt of the local vertical.
     """
+    if isinstance(local, EngineeringLocal):  # an engineering frame: no grid, same axes
+        return local.map_to_enu(xyz), opk_to_matrix(opk[:, 0], opk[:, 1], opk[:, 2])
     llh = local.mapping.map_to_geodetic(xyz)
     r_c_m = np.swapaxes(opk_to_matrix(opk[:, 0], opk[:, 1], opk[:, 2]), -1, -2)
     r_c_l = local.grid_to_local(llh) @ r_c_m
@@ -54,9 +57,12 @@ def eo_map_to_local(
 
 
 def eo_local_to_map(
-    centres: NDArray[np.float64], m_local: NDArray[np.float64], local: LocalFrame
+    centres: NDArray[np.float64], m_local: NDArray[np.float64], local: LocalFrame | EngineeringLocal
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Inverse of :func:`eo_map_to_local`: -> (xyz (N, 3) mapping CRS, opk (N, 3) radians)."""
+    if isinstance(local, EngineeringLocal):
+        omega, phi, kappa = matrix_to_opk(m_local)
+        return local.enu_to_map(centres), np.stack([omega, phi, kappa], axis=-1)
     llh = local.mapping.ecef_to_geodetic(local.enu_to_ecef(centres))
     r_c_l = np.swapaxes(m_local, -1, -2)
     r_c_m = np.swapaxes(local.grid_to_local(llh), -1, -2) @ r_c_l

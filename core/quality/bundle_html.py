@@ -12,6 +12,7 @@ systematic patterns) and the residual histograms; warnings.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
 
@@ -288,8 +289,39 @@ def render_bundle_html(
         parts += [f"<h2>{title}</h2>",
                   _table([t("image"), t("point"), t("v col"), t("v row"), t("w col"),
                           t("w row")], rows)]  # fmt: skip
+    parts += _scale_bars(res)
     if res.warnings:
         parts += [f"<h2>{t('Warnings')}</h2><ul>",
                   *(f"<li>{_e(t(w))}</li>" for w in res.warnings), "</ul>"]  # fmt: skip
     parts.append("</body></html>")
-    return "\n".join(parts)
+    return _in_unit("\n".join(parts), _unit(res))
+
+
+def _unit(res: BundleResult) -> str:
+    """The length unit of the frame of ``res``: ``m``, or the unit of an engineering frame."""
+    return str(getattr(res.local.mapping, "unit", "m"))
+
+
+def _in_unit(page: str, unit: str) -> str:
+    """The page with its lengths labelled in ``unit`` (every length of the report but the
+    lever arm, which the core keeps in metres, is in the frame's unit)."""
+    if unit == "m":
+        return page
+    page = re.sub(r"(?<!lever d[xyz] )\(m\)", f"({unit})", page)
+    return re.sub(r"(\d|&ndash;|\u2013) m(?=[;,.]| RMSE|<)", rf"\1 {unit}", page)
+
+
+def _scale_bars(res: BundleResult) -> list[str]:
+    """The scale bars' section: measured and adjusted distances, residuals, w-tests."""
+    b = res.scale_bars
+    if b is None:
+        return []
+    rows = [[_e(f"{pa} - {pb}"), _n(d, ".6g"), _n(s, ".3g"), _n(a, ".6g"), _n(sa, ".3g"),
+             _n(v, ".3g"), _n(w, ".2f"), _n(r, ".2f"), _e(t("rejected") if rej else "")]
+            for pa, pb, d, s, a, sa, v, w, r, rej in zip(
+                b.bars.point_a, b.bars.point_b, b.bars.distance, b.bars.sigma, b.adjusted,
+                b.sigma, b.v, b.w, b.redundancy, b.rejected)]  # fmt: skip
+    return [f"<h2>{t('Scale bars')}</h2>",
+            _table([t("bar"), t("distance (m)"), t("sigma (m)"), t("adjusted (m)"),
+                    t("adjusted sigma (m)"), t("v (m)"), "w", t("redundancy"), t("status")],
+                   rows)]  # fmt: skip
