@@ -125,6 +125,7 @@ with the file and row named.""",
             "networks, calibration fields): no projection, no earth curvature; every length "
             "of the inputs (coordinates, sigmas, EO_SIGMAS, scale bars) and of the outputs is "
             "in its unit",
+            advanced=True,
         ),
         Param(
             "AP_MODEL",
@@ -184,6 +185,7 @@ with the file and row named.""",
             help="distances between adjusted points, observations with their sigmas (frame "
             "units); with a free-network datum they give its scale (inner constraints "
             "without the scale row, or six parameters held)",
+            advanced=True,
         ),
         Param(
             "ESTIMATE_MOUNT",
@@ -237,6 +239,7 @@ with the file and row named.""",
             optional=True,
             create_by_default=False,
             file_filter=CSV_OUT,
+            advanced=True,
         ),
         Param(
             "OUTPUT_HTML",
