@@ -103,6 +103,10 @@
             <translation>Aerotriangulação e ortofotos</translation>
         </message>
         <message>
+            <source>A COLMAP block: orthophotos on the LiDAR DSM, and back to COLMAP</source>
+            <translation>Um bloco COLMAP: ortofotos sobre o MDS LiDAR, e de volta ao COLMAP</translation>
+        </message>
+        <message>
             <source>Boresight calibration from an SBET (or ASCII export) and the camera events</source>
             <translation>Calibração de boresight a partir de um SBET (ou exportação ASCII) e dos eventos da câmera</translation>
         </message>
@@ -195,6 +199,18 @@
             <translation>INPUT = pontos de verificação medidos no mosaico</translation>
         </message>
         <message>
+            <source>INPUT = the model's cameras.txt or cameras.bin; FRAME = the frame of its coordinates (LOCAL, ECEF with CRS, or a CRS); OUTPUT_CAMERA, OUTPUT_EO, OUTPUT_OBSERVATIONS, OUTPUT_POINTS</source>
+            <translation>INPUT = o cameras.txt ou cameras.bin do modelo; FRAME = o referencial de suas coordenadas (LOCAL, ECEF com CRS, ou um CRS); OUTPUT_CAMERA, OUTPUT_EO, OUTPUT_OBSERVATIONS, OUTPUT_POINTS</translation>
+        </message>
+        <message>
+            <source>CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; OUTPUT_FOLDER = one orthophoto per image</source>
+            <translation>CAMERA e EO da importação, IMAGES, DSM = o MDS LiDAR; OUTPUT_FOLDER = uma ortofoto por imagem</translation>
+        </message>
+        <message>
+            <source>CAMERA, EO (e.g. adjusted by bundleadjustment), OBSERVATIONS and POINTS; OUTPUT_FOLDER = the COLMAP text model</source>
+            <translation>CAMERA, EO (p. ex. ajustada pelo bundleadjustment), OBSERVATIONS e POINTS; OUTPUT_FOLDER = o modelo COLMAP em texto</translation>
+        </message>
+        <message>
             <source>INPUT = the SBET, POSPac / Inertial Explorer export or CSV; EVENTS = image_id, time; OUTPUT_TRAJECTORY = the trajectory table at the events, OUTPUT_EO = the exterior orientation</source>
             <translation>INPUT = o SBET, a exportação do POSPac / Inertial Explorer ou o CSV; EVENTS = image_id, time; OUTPUT_TRAJECTORY = a tabela de trajetória nos eventos, OUTPUT_EO = a orientação exterior</translation>
         </message>
@@ -244,6 +260,14 @@
         <message>
             <source>out of memory; nothing was written (use a coarser cell or a smaller input)</source>
             <translation>memória insuficiente; nada foi gravado (use uma célula maior ou uma entrada menor)</translation>
+        </message>
+        <message>
+            <source>No PDF of {}: {}</source>
+            <translation>Sem PDF de {}: {}</translation>
+        </message>
+        <message>
+            <source>Report as PDF: {}</source>
+            <translation>Relatório em PDF: {}</translation>
         </message>
         <message>
             <source>Cancelled by the user</source>
@@ -1708,6 +1732,30 @@
             <translation>Relatório de acurácia posicional</translation>
         </message>
         <message>
+            <source>perspective centre</source>
+            <translation>centro perspectivo</translation>
+        </message>
+        <message>
+            <source>control point</source>
+            <translation>ponto de controle</translation>
+        </message>
+        <message>
+            <source>check point</source>
+            <translation>ponto de verificação</translation>
+        </message>
+        <message>
+            <source>tie point</source>
+            <translation>ponto de ligação</translation>
+        </message>
+        <message>
+            <source>images covering</source>
+            <translation>imagens que cobrem</translation>
+        </message>
+        <message>
+            <source>{} m on the ground</source>
+            <translation>{} m no terreno</translation>
+        </message>
+        <message>
             <source>The calibration FAILED its checks: no table and no exterior orientation were written. The numbers below show the failed adjustment, for diagnosis only.</source>
             <translation>A calibração FALHOU nas verificações: nenhuma tabela e nenhuma orientação exterior foram gravadas. Os números abaixo mostram o ajustamento que falhou, apenas para diagnóstico.</translation>
         </message>
@@ -1984,6 +2032,10 @@
             <translation>detalhes</translation>
         </message>
         <message>
+            <source>Image overlap, control and check points</source>
+            <translation>Sobreposição das imagens, pontos de controle e de verificação</translation>
+        </message>
+        <message>
             <source>NO</source>
             <translation>NÃO</translation>
         </message>
@@ -1994,6 +2046,14 @@
         <message>
             <source>significant ({})</source>
             <translation>significativo ({})</translation>
+        </message>
+        <message>
+            <source>Block map</source>
+            <translation>Mapa do bloco</translation>
+        </message>
+        <message>
+            <source>Lens distortion</source>
+            <translation>Distorção da lente</translation>
         </message>
         <message>
             <source>mapping CRS and units in the settings; image residuals in pixels (adjusted minus measured).</source>
@@ -2022,6 +2082,30 @@
         <message>
             <source>Rejected measurements ({})</source>
             <translation>Medições rejeitadas ({})</translation>
+        </message>
+        <message>
+            <source>Scale bars</source>
+            <translation>Barras de escala</translation>
+        </message>
+        <message>
+            <source>bar</source>
+            <translation>barra</translation>
+        </message>
+        <message>
+            <source>distance (m)</source>
+            <translation>distância (m)</translation>
+        </message>
+        <message>
+            <source>adjusted (m)</source>
+            <translation>ajustada (m)</translation>
+        </message>
+        <message>
+            <source>adjusted sigma (m)</source>
+            <translation>sigma ajustado (m)</translation>
+        </message>
+        <message>
+            <source>v (m)</source>
+            <translation>v (m)</translation>
         </message>
         <message>
             <source>after {} iterations</source>
@@ -2136,6 +2220,14 @@
             <translation>no máximo {bound} ({expected} esperadas); {k} rejeitadas: P = {p}</translation>
         </message>
         <message>
+            <source>Lens correction: {}</source>
+            <translation>Correção da lente: {}</translation>
+        </message>
+        <message>
+            <source>Radial profile: {}</source>
+            <translation>Perfil radial: {}</translation>
+        </message>
+        <message>
             <source>|correlation| above {} in the final adjustment: </source>
             <translation>|correlação| acima de {} no ajustamento final: </translation>
         </message>
@@ -2242,6 +2334,26 @@
         <message>
             <source>These results FAILED their checks and were written only because the user asked for them (ACCEPT_DOUBTFUL): do not use them without review.</source>
             <translation>Estes resultados FALHARAM nas verificações e foram gravados apenas porque o usuário os pediu (ACCEPT_DOUBTFUL): não os use sem revisão.</translation>
+        </message>
+        <message>
+            <source>distance from the principal point (px)</source>
+            <translation>distância ao ponto principal (px)</translation>
+        </message>
+        <message>
+            <source>correction (px)</source>
+            <translation>correção (px)</translation>
+        </message>
+        <message>
+            <source>tangential</source>
+            <translation>tangencial</translation>
+        </message>
+        <message>
+            <source>correction (measured to ideal); {} px = {} px on screen; {} px at the corners</source>
+            <translation>correção (medida para ideal); {} px = {} px na tela; {} px nos cantos</translation>
+        </message>
+        <message>
+            <source>radial</source>
+            <translation>radial</translation>
         </message>
         <message>
             <source>control points: RMS |v| (px)</source>
@@ -2586,10 +2698,6 @@
         <message>
             <source>(vectors x {})</source>
             <translation>(vetores x {})</translation>
-        </message>
-        <message>
-            <source>{} m on the ground</source>
-            <translation>{} m no terreno</translation>
         </message>
         <message>
             <source>mean residual per cell; {} px = {} px on screen; largest {} px</source>
@@ -3666,19 +3774,24 @@ time (an AP correlated with others is dropped only when a joint F-test finds the
 insignificant together; a correlation alone never drops one) and says which and why.
 Outliers: robust reweighting (Huber or Cauchy) then Baarda's data snooping.
 Datum: control points and/or observed orientations, or a
-free network (inner or minimal constraints). Tables that cannot make a block (an image
-without observations, a tie point seen once, duplicated rows, unknown images, ground points
-in another CRS, unconnected parts) are refused with the file and row named.</source>
-            <translation>Estatísticas: sigma0, o teste global qui-quadrado, desvios-padrão e correlações; teste t de
-cada PA e |correlação| acima de 0,9 marcada; a seleção automática descarta, um por vez, os PAs
-não significativos (um PA correlacionado com outros só é descartado quando um teste F conjunto
-os considera não significativos juntos; uma correlação sozinha nunca descarta um PA) e diz
-quais e por quê. Outliers: reponderação
-robusta (Huber ou Cauchy) seguida do data snooping de Baarda. Referencial (datum): pontos de
-controle e/ou orientações observadas, ou uma rede livre (injunções internas ou mínimas).
-Tabelas que não formam um bloco (uma imagem sem observações, um ponto de enlace visto uma só
-vez, linhas repetidas, imagens desconhecidas, pontos de apoio em outro SRC, partes desconexas)
-são recusadas, com o arquivo e a linha indicados.</translation>
+free network (inner or minimal constraints); scale bars (measured distances with sigmas) are
+observations, and with a free network they give its scale. Close-range networks: FRAME
+local_m or local_mm takes the coordinates in a local engineering frame with no CRS.
+Tables that cannot make a block (an image without observations, a tie point seen once,
+duplicated rows, unknown images, ground points in another CRS, unconnected parts) are refused
+with the file and row named.</source>
+            <translation>Estatística: sigma0, o teste global qui-quadrado, sigmas e correlações; o teste t de cada PA
+e |correlação| acima de 0,9 sinalizados; a seleção automática remove PAs não significativos um
+por vez (um PA correlacionado com outros só é removido quando um teste F conjunto os considera
+não significativos juntos; uma correlação sozinha nunca remove um) e diz qual e por quê.
+Outliers: reponderação robusta (Huber ou Cauchy) seguida do data snooping de Baarda.
+Datum: pontos de controle e/ou orientações observadas, ou uma
+rede livre (injunções internas ou mínimas); barras de escala (distâncias medidas com sigmas) são
+observações e, numa rede livre, dão a sua escala. Redes a curta distância: FRAME
+local_m ou local_mm toma as coordenadas num referencial local de engenharia sem CRS.
+Tabelas que não formam um bloco (uma imagem sem observações, um ponto de ligação visto uma vez,
+linhas duplicadas, imagens desconhecidas, pontos de apoio em outro CRS, partes desconexas) são recusadas
+com o arquivo e a linha indicados.</translation>
         </message>
         <message>
             <source>Camera (JSON; several as {"cameras": [...]})</source>
@@ -3721,8 +3834,28 @@ são recusadas, com o arquivo e a linha indicados.</translation>
             <translation>SRC de mapeamento</translation>
         </message>
         <message>
-            <source>projected CRS of the ground points and exterior orientations</source>
-            <translation>SRC projetado dos pontos de apoio e das orientações exteriores</translation>
+            <source>projected CRS of the ground points and exterior orientations (needed unless FRAME is a local frame, which ignores it)</source>
+            <translation>CRS projetado dos pontos de apoio e das orientações exteriores (necessário, a menos que FRAME seja um referencial local, que o ignora)</translation>
+        </message>
+        <message>
+            <source>Coordinate frame</source>
+            <translation>Referencial de coordenadas</translation>
+        </message>
+        <message>
+            <source>a local frame takes X, Y, Z and omega-phi-kappa as they are (close-range networks, calibration fields): no projection, no earth curvature; every length of the inputs (coordinates, sigmas, EO_SIGMAS, scale bars) and of the outputs is in its unit</source>
+            <translation>um referencial local toma X, Y, Z e ômega-fi-capa como estão (redes a curta distância, campos de calibração): sem projeção, sem curvatura terrestre; todo comprimento das entradas (coordenadas, sigmas, EO_SIGMAS, barras de escala) e das saídas está na sua unidade</translation>
+        </message>
+        <message>
+            <source>mapping CRS (projected, metres)</source>
+            <translation>CRS de mapeamento (projetado, metros)</translation>
+        </message>
+        <message>
+            <source>local engineering frame, metres (no CRS)</source>
+            <translation>referencial local de engenharia, metros (sem CRS)</translation>
+        </message>
+        <message>
+            <source>local engineering frame, millimetres (no CRS)</source>
+            <translation>referencial local de engenharia, milímetros (sem CRS)</translation>
         </message>
         <message>
             <source>Additional parameters</source>
@@ -3793,6 +3926,14 @@ são recusadas, com o arquivo e a linha indicados.</translation>
             <translation>rede livre: injunções mínimas</translation>
         </message>
         <message>
+            <source>Scale bars / measured distances (CSV: point_a,point_b,distance,sigma)</source>
+            <translation>Barras de escala / distâncias medidas (CSV: point_a,point_b,distance,sigma)</translation>
+        </message>
+        <message>
+            <source>distances between adjusted points, observations with their sigmas (frame units); with a free-network datum they give its scale (inner constraints without the scale row, or six parameters held)</source>
+            <translation>distâncias entre pontos ajustados, observações com seus sigmas (unidades do referencial); com um datum de rede livre dão a sua escala (injunções internas sem a linha de escala, ou seis parâmetros fixados)</translation>
+        </message>
+        <message>
             <source>Estimate lever arm and boresight corrections</source>
             <translation>Estimar correções do braço de alavanca e do boresight</translation>
         </message>
@@ -3833,6 +3974,10 @@ são recusadas, com o arquivo e a linha indicados.</translation>
             <translation>Comparação dos modelos de PAs (CSV)</translation>
         </message>
         <message>
+            <source>Adjusted scale bars with w-tests (CSV)</source>
+            <translation>Barras de escala ajustadas com testes w (CSV)</translation>
+        </message>
+        <message>
             <source>Summary (HTML)</source>
             <translation>Resumo (HTML)</translation>
         </message>
@@ -3845,12 +3990,41 @@ são recusadas, com o arquivo e a linha indicados.</translation>
             <translation>Sigma0 a posteriori</translation>
         </message>
         <message>
-            <source>Check-point RMS 3D (m)</source>
-            <translation>RMS 3D nos pontos de verificação (m)</translation>
+            <source>Check-point RMS 3D (frame unit)</source>
+            <translation>RMS 3D dos pontos de verificação (unidade do referencial)</translation>
         </message>
         <message>
             <source>AP model of the outputs</source>
             <translation>Modelo de PAs das saídas</translation>
+        </message>
+        <message>
+            <source>Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
+and |correlation| above 0.9 flagged; automatic selection drops insignificant APs one at a
+time (an AP correlated with others is dropped only when a joint F-test finds them
+insignificant together; a correlation alone never drops one) and says which and why.
+Outliers: robust reweighting (Huber or Cauchy) then Baarda's data snooping.
+Datum: control points and/or observed orientations, or a
+free network (inner or minimal constraints). Tables that cannot make a block (an image
+without observations, a tie point seen once, duplicated rows, unknown images, ground points
+in another CRS, unconnected parts) are refused with the file and row named.</source>
+            <translation type="vanished">Estatísticas: sigma0, o teste global qui-quadrado, desvios-padrão e correlações; teste t de
+cada PA e |correlação| acima de 0,9 marcada; a seleção automática descarta, um por vez, os PAs
+não significativos (um PA correlacionado com outros só é descartado quando um teste F conjunto
+os considera não significativos juntos; uma correlação sozinha nunca descarta um PA) e diz
+quais e por quê. Outliers: reponderação
+robusta (Huber ou Cauchy) seguida do data snooping de Baarda. Referencial (datum): pontos de
+controle e/ou orientações observadas, ou uma rede livre (injunções internas ou mínimas).
+Tabelas que não formam um bloco (uma imagem sem observações, um ponto de enlace visto uma só
+vez, linhas repetidas, imagens desconhecidas, pontos de apoio em outro SRC, partes desconexas)
+são recusadas, com o arquivo e a linha indicados.</translation>
+        </message>
+        <message>
+            <source>projected CRS of the ground points and exterior orientations</source>
+            <translation type="vanished">SRC projetado dos pontos de apoio e das orientações exteriores</translation>
+        </message>
+        <message>
+            <source>Check-point RMS 3D (m)</source>
+            <translation type="vanished">RMS 3D nos pontos de verificação (m)</translation>
         </message>
         <message>
             <source>Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
@@ -4289,6 +4463,85 @@ are listed in the log with the reason.</source>
 que a unidade de distância seja metros; as saídas estão na unidade do SRC. Opcionalmente,
 informe suas próprias triplas ("1,2,3; 4,5,6") ou pares ("1,2; 2,3") de identificadores de
 plano em vez dos automáticos. Os candidatos rejeitados são listados no log com o motivo.</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:exportcolmap</name>
+        <message>
+            <source>Export COLMAP model</source>
+            <translation>Exportar modelo COLMAP</translation>
+        </message>
+        <message>
+            <source>Aerotriangulation</source>
+            <translation>Aerotriangulação</translation>
+        </message>
+        <message>
+            <source>Cameras + exterior orientation (+ observations, points) -&gt; COLMAP text model</source>
+            <translation>Câmeras + orientação exterior (+ observações, pontos) -&gt; modelo COLMAP em texto</translation>
+        </message>
+        <message>
+            <source>Writes cameras.txt, images.txt and points3D.txt in OUTPUT_FOLDER, so a block oriented or
+calibrated here continues in COLMAP (or the tools that read its models: OpenMVS, Gaussian
+splatting). Cameras are written exactly: no lens (SIMPLE_PINHOLE), the forward models opencv
+(OPENCV, or FULL_OPENCV with k3), opencv_full (FULL_OPENCV), and with the equidistant
+projection opencv_fisheye (OPENCV_FISHEYE) and thin_prism_fisheye (THIN_PRISM_FISHEYE),
+their coefficients renormalised exactly to the current focal length; a correction lens model
+(brown_conrady and the other photogrammetric ones) has no exact COLMAP model and is refused
+by name.</source>
+            <translation>Escreve cameras.txt, images.txt e points3D.txt em OUTPUT_FOLDER, para que um bloco orientado ou
+calibrado aqui continue no COLMAP (ou nas ferramentas que leem seus modelos: OpenMVS, Gaussian
+splatting). As câmeras são escritas exatamente: sem lente (SIMPLE_PINHOLE), os modelos diretos opencv
+(OPENCV, ou FULL_OPENCV com k3), opencv_full (FULL_OPENCV) e, com a projeção
+equidistante, opencv_fisheye (OPENCV_FISHEYE) e thin_prism_fisheye (THIN_PRISM_FISHEYE),
+com os coeficientes renormalizados exatamente para a distância focal atual; um modelo de lente de correção
+(brown_conrady e os outros fotogramétricos) não tem modelo COLMAP exato e é recusado
+pelo nome.</translation>
+        </message>
+        <message>
+            <source>Orientations are written as COLMAP's world-to-camera quaternion and translation in the EO's
+own coordinates (the mapping CRS; COLMAP stores no CRS: import it back with FRAME = that
+CRS). OBSERVATIONS become each image's keypoints, tracked to the POINTS (a ground point table,
+e.g. importcolmap's OUTPUT_POINTS) that share their point_id; the others are untracked.</source>
+            <translation>As orientações são escritas como o quatérnio e a translação mundo-câmera do COLMAP, nas coordenadas
+da própria EO (o CRS de mapeamento; o COLMAP não guarda CRS: importe de volta com FRAME = esse
+CRS). As OBSERVATIONS tornam-se os pontos-chave de cada imagem, rastreados até os POINTS (uma tabela de pontos de apoio,
+p. ex. a OUTPUT_POINTS do importcolmap) que compartilham o seu point_id; os demais ficam sem rastro.</translation>
+        </message>
+        <message>
+            <source>Camera(s) (JSON)</source>
+            <translation>Câmera(s) (JSON)</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>Exterior orientation table (CSV)</source>
+            <translation>Tabela de orientação exterior (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Observations (CSV)</source>
+            <translation>Observações (CSV)</translation>
+        </message>
+        <message>
+            <source>3D points (ground point table, CSV)</source>
+            <translation>Pontos 3D (tabela de pontos de apoio, CSV)</translation>
+        </message>
+        <message>
+            <source>Output folder (the COLMAP model)</source>
+            <translation>Pasta de saída (o modelo COLMAP)</translation>
+        </message>
+        <message>
+            <source>Number of images</source>
+            <translation>Número de imagens</translation>
+        </message>
+        <message>
+            <source>Number of 3D points</source>
+            <translation>Número de pontos 3D</translation>
         </message>
     </context>
     <context>
@@ -4852,6 +5105,147 @@ opcionalmente, o MDT em GeoTIFF.</translation>
         <message>
             <source>Unit of the distances</source>
             <translation>Unidade das distâncias</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:importcolmap</name>
+        <message>
+            <source>Import COLMAP model</source>
+            <translation>Importar modelo COLMAP</translation>
+        </message>
+        <message>
+            <source>Aerotriangulation</source>
+            <translation>Aerotriangulação</translation>
+        </message>
+        <message>
+            <source>COLMAP sparse model (text or binary) -&gt; cameras, orientations, tie points</source>
+            <translation>Modelo esparso COLMAP (texto ou binário) -&gt; câmeras, orientações, pontos de ligação</translation>
+        </message>
+        <message>
+            <source>Reads a COLMAP sparse model (cameras, images and points3D, as text or binary files) and
+writes the project's camera JSON, exterior orientation, observation table and points, with
+the lens models converted exactly: COLMAP's distortion maps ideal to measured coordinates,
+and each camera gets the forward lens model with COLMAP's own coefficients (docs/formats.md,
+COLMAP). SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV,
+OPENCV_FISHEYE, SIMPLE_RADIAL_FISHEYE, RADIAL_FISHEYE and THIN_PRISM_FISHEYE are supported;
+FOV and RAD_TAN_THIN_PRISM_FISHEYE are refused by name.</source>
+            <translation>Lê um modelo esparso COLMAP (cameras, images e points3D, como arquivos de texto ou binários) e
+escreve o JSON de câmera do projeto, a orientação exterior, a tabela de observações e os pontos, com
+os modelos de lente convertidos exatamente: a distorção do COLMAP leva coordenadas ideais a medidas,
+e cada câmera recebe o modelo de lente direto com os próprios coeficientes do COLMAP (docs/formats.md,
+COLMAP). SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV,
+OPENCV_FISHEYE, SIMPLE_RADIAL_FISHEYE, RADIAL_FISHEYE e THIN_PRISM_FISHEYE são aceitos;
+FOV e RAD_TAN_THIN_PRISM_FISHEYE são recusados pelo nome.</translation>
+        </message>
+        <message>
+            <source>## Frame
+A COLMAP model has no coordinate reference system: FRAME states it, and a model without one
+is refused. LOCAL: the coordinates as they are (no CRS); ECEF (as COLMAP's model aligner
+writes it): converted into the mapping CRS given as CRS; or the CRS the coordinates are in
+(e.g. EPSG:32723: easting, northing, height). SIMILARITY (s qw qx qy qz tx ty tz) is applied
+first, model -&gt; frame (X' = s R(q) X + t).</source>
+            <translation>## Referencial
+Um modelo COLMAP não tem sistema de referência de coordenadas: FRAME o declara, e um modelo sem ele
+é recusado. LOCAL: as coordenadas como estão (sem CRS); ECEF (como o alinhador de modelos do COLMAP
+o escreve): convertidas para o CRS de mapeamento dado em CRS; ou o CRS em que as coordenadas estão
+(p. ex. EPSG:32723: este, norte, altitude). SIMILARITY (s qw qx qy qz tx ty tz) é aplicada
+primeiro, modelo -&gt; referencial (X' = s R(q) X + t).</translation>
+        </message>
+        <message>
+            <source>## Inputs
+INPUT: the model's cameras.txt or cameras.bin (or its folder); images and points3D are read
+beside it. PIXEL_SIZE: COLMAP has none; it scales the millimetres, never the projection.</source>
+            <translation>## Entradas
+INPUT: o cameras.txt ou cameras.bin do modelo (ou a sua pasta); images e points3D são lidos
+ao lado. PIXEL_SIZE: o COLMAP não tem; ele escala os milímetros, nunca a projeção.</translation>
+        </message>
+        <message>
+            <source>## Outputs
+OUTPUT_CAMERA: the cameras (colmap_&lt;id&gt;); OUTPUT_EO: one row per registered image (image_id =
+COLMAP's image name, with a camera column when there are several); OUTPUT_OBSERVATIONS: the
+tracked keypoints as tie rows (point_id = COLMAP's 3D point id); OUTPUT_POINTS: the 3D points
+as a ground point table with role check (triangulated tie points, never control).</source>
+            <translation>## Saídas
+OUTPUT_CAMERA: as câmeras (colmap_&lt;id&gt;); OUTPUT_EO: uma linha por imagem registrada (image_id =
+o nome da imagem no COLMAP, com uma coluna de câmera quando há várias); OUTPUT_OBSERVATIONS: os
+pontos-chave rastreados como linhas tie (point_id = o id do ponto 3D no COLMAP); OUTPUT_POINTS: os pontos 3D
+como tabela de pontos de apoio com papel check (pontos de ligação triangulados, nunca controle).</translation>
+        </message>
+        <message>
+            <source>COLMAP model (cameras.txt or cameras.bin)</source>
+            <translation>Modelo COLMAP (cameras.txt ou cameras.bin)</translation>
+        </message>
+        <message>
+            <source>COLMAP cameras (cameras.txt cameras.bin);;All files (*)</source>
+            <translation>Câmeras COLMAP (cameras.txt cameras.bin);;Todos os arquivos (*)</translation>
+        </message>
+        <message>
+            <source>Frame of the model's coordinates</source>
+            <translation>Referencial das coordenadas do modelo</translation>
+        </message>
+        <message>
+            <source>LOCAL, ECEF (with CRS) or a CRS (EPSG code or WKT); required</source>
+            <translation>LOCAL, ECEF (com CRS) ou um CRS (código EPSG ou WKT); obrigatório</translation>
+        </message>
+        <message>
+            <source>Mapping CRS (for ECEF)</source>
+            <translation>CRS de mapeamento (para ECEF)</translation>
+        </message>
+        <message>
+            <source>the projected CRS an ECEF model is converted to</source>
+            <translation>o CRS projetado para o qual um modelo ECEF é convertido</translation>
+        </message>
+        <message>
+            <source>Similarity model -&gt; frame</source>
+            <translation>Semelhança modelo -&gt; referencial</translation>
+        </message>
+        <message>
+            <source>s qw qx qy qz tx ty tz (X' = s R(q) X + t); empty: none</source>
+            <translation>s qw qx qy qz tx ty tz (X' = s R(q) X + t); vazio: nenhuma</translation>
+        </message>
+        <message>
+            <source>Pixel size</source>
+            <translation>Tamanho do pixel</translation>
+        </message>
+        <message>
+            <source>COLMAP stores none: it sets the millimetres of the camera</source>
+            <translation>o COLMAP não guarda: define os milímetros da câmera</translation>
+        </message>
+        <message>
+            <source>Cameras (JSON)</source>
+            <translation>Câmeras (JSON)</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>Exterior orientation table (CSV)</source>
+            <translation>Tabela de orientação exterior (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Observations (tie points, CSV)</source>
+            <translation>Observações (pontos de ligação, CSV)</translation>
+        </message>
+        <message>
+            <source>3D points (ground point table, CSV)</source>
+            <translation>Pontos 3D (tabela de pontos de apoio, CSV)</translation>
+        </message>
+        <message>
+            <source>Number of registered images</source>
+            <translation>Número de imagens registradas</translation>
+        </message>
+        <message>
+            <source>Number of cameras</source>
+            <translation>Número de câmeras</translation>
+        </message>
+        <message>
+            <source>Number of 3D points</source>
+            <translation>Número de pontos 3D</translation>
         </message>
     </context>
     <context>
