@@ -138,8 +138,11 @@ class MappingFrame:
                     f"the mapping CRS '{crs.name}' has {axis.unit_name} units; the core works in "
                     "metres: reproject to a metric CRS first"
                 )
-        geodetic = horizontal.geodetic_crs.to_3d()
-        ellipsoid = geodetic.ellipsoid
+        base = horizontal.geodetic_crs
+        geodetic = base.to_3d() if base is not None else None
+        ellipsoid = geodetic.ellipsoid if geodetic is not None else None
+        if geodetic is None or ellipsoid is None:  # pyproj's types allow it, a projected CRS not
+            raise CrsError(f"the mapping CRS '{crs.name}' names no geodetic CRS or ellipsoid")
         a, rf = ellipsoid.semi_major_metre, ellipsoid.inverse_flattening
         ell = f"+a={a!r} +rf={rf!r}" if rf else f"+a={a!r} +b={a!r}"  # rf 0: a sphere
         geocentric = CRS.from_proj4(f"+proj=geocent {ell} +units=m +no_defs")
@@ -169,25 +172,17 @@ class MappingFrame:
     # -- positions -----------------------------------------------------------------------
     def map_to_geodetic(self, enh: ArrayLike) -> Array:
         """(N, 3) easting, northing, height -> (N, 3) latitude, longitude (deg), ellipsoidal h."""
-        e, n, h = _columns(enh)
-        lon, lat, hh = self._to_geod.transform(e, n, h)
-        return np.stack([lat, lon, hh], axis=-1)
+        return _transform(self._to_geod, enh, latlon_in=False, latlon_out=True)
 
     def geodetic_to_map(self, llh: ArrayLike) -> Array:
         """(N, 3) latitude, longitude (deg), ellipsoidal h -> (N, 3) easting, northing, height."""
-        lat, lon, h = _columns(llh)
-        e, n, hh = self._from_geod.transform(lon, lat, h)
-        return np.stack([e, n, hh], axis=-1)
+        return _transform(self._from_geod, llh, latlon_in=True, latlon_out=False)
 
     def geodetic_to_ecef(self, llh: ArrayLike) -> Array:
-        lat, lon, h = _columns(llh)
-        x, y, z = self._geod_to_ecef.transform(lon, lat, h)
-        return np.stack([x, y, z], axis=-1)
+        return _transform(self._geod_to_ecef, llh, latlon_in=True, latlon_out=False)
 
     def ecef_to_geodetic(self, xyz: ArrayLike) -> Array:
-        x, y, z = _columns(xyz)
-        lon, lat, h = self._ecef_to_geod.transform(x, y, z)
-        return np.stack([lat, lon, h], axis=-1)
+        return _transform(self._ecef_to_geod, xyz, latlon_in=False, latlon_out=True)
 
     def map_to_ecef(self, enh: ArrayLike) -> Array:
         return self.geodetic_to_ecef(self.map_to_geodetic(enh))
@@ -212,6 +207,14 @@ class MappingFrame:
     def ned_to_grid(self, llh: ArrayLike) -> Array:
         """``R_n^m`` per point: NED at the point -> grid frame (grid E, grid N, up)."""
         return grid_rotation(self.grid_north_azimuth(llh)) @ NED_TO_ENU
+
+
+def _transform(tr: Transformer, pts: ArrayLike, *, latlon_in: bool, latlon_out: bool) -> Array:
+    """(N, 3) points through ``tr``, whose geodetic side is (longitude, latitude, h): the
+    core's geodetic triples are (latitude, longitude, h), swapped on the way in or out."""
+    a, b, c = _columns(pts)
+    u, v, w = tr.transform(b, a, c) if latlon_in else tr.transform(a, b, c)
+    return np.stack([v, u, w] if latlon_out else [u, v, w], axis=-1)
 
 
 def _jacobian(f, xyz: ArrayLike, step: float) -> tuple[Array, Array]:

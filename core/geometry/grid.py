@@ -128,7 +128,7 @@ def fill_holes(surface: NDArray[np.float32], valid: NDArray[np.bool_]) -> NDArra
             axis=(1, 3)
         )
     values, weights = levels[-1]
-    est = values / np.maximum(weights, 1e-30)
+    est: NDArray[np.floating] = values / np.maximum(weights, 1e-30)
     if weights.min() <= 0:  # a 1-cell-wide top level with holes: nearest fill
         est = fill_nearest(est.astype(np.float32), weights > 0)
     for values, weights in reversed(levels[:-1]):

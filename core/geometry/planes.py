@@ -247,7 +247,10 @@ def label_moments(
     ([2.0, 1.0], [1.0, 0.0, 0.0], 2.0, 0.0)
     """
     counts = np.bincount(lab, minlength=nl).astype(np.float64)
-    mean = np.column_stack([np.bincount(lab, q[:, c], minlength=nl) for c in range(3)])
+    # weighted bincounts are float64 already (copy=False: no copy; the stubs say integers)
+    mean = np.column_stack([np.bincount(lab, q[:, c], minlength=nl) for c in range(3)]).astype(
+        np.float64, copy=False
+    )
     mean /= np.maximum(counts, 1.0)[:, None]
     dev = q - mean[lab]
     scatter = np.empty((nl, 3, 3))

@@ -299,7 +299,7 @@ def check_outputs(
     case of the name on a case-insensitive file system changes nothing. Nothing is written.
     """
     reads = files_read(inputs, suffixes)
-    by_id = {}
+    by_id: dict[tuple[int, int] | None, tuple[str, Path, str]] = {}
     for name, f, how in reads:
         key = _identity(f)
         if key is not None:
@@ -570,7 +570,7 @@ def remove_dead_temporaries(folder: PathLike) -> list[str]:
     for name in names:
         match = _ANY_TEMP.fullmatch(name)
         token = _TOKEN.fullmatch(match.group(2)) if match else None
-        if token is None or token.group(2) != _HOST:
+        if match is None or token is None or token.group(2) != _HOST:
             continue
         pid = int(token.group(1))
         if pid == os.getpid():  # ours while this process knows it, else an earlier process's

@@ -21,7 +21,7 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from typing import Any, Union
+from typing import Any, Union, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -41,7 +41,7 @@ def read_image_grey(path: Union[str, Path]) -> NDArray[np.uint8]:
     if img is None:
         raise InputError("cannot read this image (not an image format OpenCV reads)",
                          path=str(path))  # fmt: skip
-    return img
+    return cast(NDArray[np.uint8], img)  # IMREAD_GRAYSCALE: always 8 bit
 
 
 def write_residuals_csv(path: Union[str, Path], result: Any) -> None:

@@ -53,6 +53,7 @@ def _table_ids(table: Table) -> tuple[str, ...]:
 
 
 def _table_groups(table: Table, column: str | None) -> tuple[str, ...]:
+    index: int | None
     if column:
         index = find_column(table, (normalise(column),), what=f"the group ({column})")
     else:
@@ -110,6 +111,7 @@ def read_point_table(
     else:
         ids = _table_ids(table)
     cols = []
+    aliases: tuple[str, ...]
     for k, aliases in enumerate(_MEASURED):
         if k == 2 and z_column:
             aliases = (normalise(z_column),)

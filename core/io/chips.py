@@ -30,7 +30,7 @@ import math
 import os
 from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import Union
+from typing import TYPE_CHECKING, Union
 
 import numpy as np
 
@@ -39,6 +39,9 @@ from ..photo.control_location import ControlChip, LocatedPair
 from .raster import RasterReader
 from .suffixes import CHIP_SUFFIXES
 from .tables import write_csv_atomic
+
+if TYPE_CHECKING:
+    import pyproj
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -71,7 +74,7 @@ def list_chips(paths: Iterable[PathLike]) -> dict[str, Path]:
 
 
 def read_control_chip(
-    path: PathLike, point_id: str, xyz: Sequence[float], crs: object = None
+    path: PathLike, point_id: str, xyz: Sequence[float], crs: pyproj.CRS | None = None
 ) -> ControlChip:
     """Read a chip (module docstring) as a :class:`ControlChip` of the point at ``xyz``;
     with ``crs`` (the control's, a pyproj CRS), a chip tagged with another CRS is refused."""

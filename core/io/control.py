@@ -94,7 +94,7 @@ def read_lcps_csv(path: PathLike) -> list[ControlPoint]:
                 id=ids[k],
                 xyz=np.array([num["X"][k], num["Y"][k], num["Z"][k]]),
                 covariance=cov,
-                plane_ids=tuple(int(num[f"plane_{i}"][k]) for i in (1, 2, 3)),
+                plane_ids=(int(num["plane_1"][k]), int(num["plane_2"][k]), int(num["plane_3"][k])),
                 min_angle_deg=float(num["min_angle_deg"][k]),
                 condition=float(num["condition"][k]),
                 support_distance=np.full(3, np.nan),

@@ -151,7 +151,8 @@ def read_eo_csv_full(path: Union[str, Path], crs_wkt: str = "") -> EoFile:
             path=table.path,
         )
     if given:
-        values = np.column_stack([float_column(table, c, allow_empty=True) for c in cols])
+        # all six given: ``given`` is ``cols``, in order
+        values = np.column_stack([float_column(table, c, allow_empty=True) for c in given])
         empty = np.isnan(values)
         if empty.all():
             sigma = None
@@ -164,7 +165,7 @@ def read_eo_csv_full(path: Union[str, Path], crs_wkt: str = "") -> EoFile:
                     "every sigma must be a number > 0 (or leave all of them empty)",
                     path=table.path,
                     row=table.line_numbers[k],
-                    column=table.columns[cols[j]],
+                    column=table.columns[given[j]],
                 )
             sigma = values.copy()
             sigma[:, 3:] = np.radians(sigma[:, 3:])

@@ -15,7 +15,7 @@ point count) is the first nine columns. Numbers are written with full round-trip
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Hashable, Sequence
 from pathlib import Path
 from typing import Union
 
@@ -27,6 +27,7 @@ from .tables import (
     check_covariance,
     find_column,
     float_column,
+    note_unique,
     number,
     read_table,
     write_csv_atomic,
@@ -125,7 +126,7 @@ def read_planes_csv(path: Union[str, Path]) -> list[Plane]:
     id_col = find_column(table, ("id",))
     np_col = find_column(table, ("n_points",))
     planes = []
-    seen: dict[int, int] = {}
+    seen: dict[Hashable, int] = {}
     for k, row_no in enumerate(table.line_numbers):
         for name, col in (("id", id_col), ("n_points", np_col)):
             value = cols[name][k]
@@ -137,14 +138,7 @@ def read_planes_csv(path: Union[str, Path]) -> list[Plane]:
                     column=table.columns[col],
                 )
         pid = int(cols["id"][k])
-        if pid in seen:
-            raise InputError(
-                f"id {pid} already appears in row {seen[pid]}",
-                path=table.path,
-                row=row_no,
-                column=table.columns[id_col],
-            )
-        seen[pid] = row_no
+        note_unique(seen, pid, f"id {pid}", table, row_no, id_col)
         normal = np.array([cols["a"][k], cols["b"][k], cols["c"][k]])
         if abs(np.linalg.norm(normal) - 1.0) > 1e-6 or normal[2] < 0:
             raise InputError(

@@ -473,10 +473,12 @@ class LasPoints:
         of every point."""
         from ..geometry.scaled_xyz import ScaledXYZ
 
+        sx, sy, sz = (float(v) for v in self.header.scales)
+        ox, oy, oz = (float(v) for v in self.header.offsets)
         return ScaledXYZ(
             chunks=tuple((c["X"], c["Y"], c["Z"]) for c in self.chunks),
-            scales=tuple(float(v) for v in self.header.scales),
-            offsets=tuple(float(v) for v in self.header.offsets),
+            scales=(sx, sy, sz),
+            offsets=(ox, oy, oz),
         )
 
     def values(self, name: str) -> NDArray[Any]:
@@ -727,7 +729,7 @@ def _write_records(
                     out = laspy.PackedPointRecord(raw, fmt)
                 else:
                     out = laspy.PackedPointRecord.zeros(m, fmt)
-                    for name in raw.dtype.names:
+                    for name in raw.dtype.names or ():
                         out.array[name] = raw[name]
                 if cls is not None:
                     out.classification = cls[done : done + m]

@@ -10,7 +10,7 @@ from __future__ import annotations
 import csv
 import math
 import os
-from collections.abc import Iterable, Sequence
+from collections.abc import Hashable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal, Union, overload
@@ -156,17 +156,26 @@ def text_column(table: Table, index: int, *, nonempty: bool = True) -> tuple[str
 def unique_ids(table: Table, index: int) -> tuple[str, ...]:
     """A text column whose values must be unique (e.g. image ids)."""
     values = text_column(table, index)
-    first: dict[str, int] = {}
+    first: dict[Hashable, int] = {}
     for value, number in zip(values, table.line_numbers):
-        if value in first:
-            raise InputError(
-                f"'{value}' already appears in row {first[value]}",
-                path=table.path,
-                row=number,
-                column=table.columns[index],
-            )
-        first[value] = number
+        note_unique(first, value, f"'{value}'", table, number, index)
     return values
+
+
+def note_unique(
+    first: dict[Hashable, int], value: Hashable, label: str, table: Table, row: int, index: int
+) -> None:
+    """Record that ``value`` stands in file row ``row`` of column ``index``; InputError naming
+    ``label`` and the row it first stood in when it was seen before (``first`` maps value to row).
+    """
+    if value in first:
+        raise InputError(
+            f"{label} already appears in row {first[value]}",
+            path=table.path,
+            row=row,
+            column=table.columns[index],
+        )
+    first[value] = row
 
 
 def choice_column(

@@ -228,7 +228,8 @@ def _index_vpc(path: Path, crs: Any) -> BlockIndex:
     features = doc.get("features") if isinstance(doc, dict) else None
     if doc.get("type") != "FeatureCollection" or not isinstance(features, list):
         raise InputError("not a virtual point cloud (a STAC FeatureCollection)", path=str(path))
-    entries, bad, crs_seen = [], [], {}
+    entries, bad = [], []
+    crs_seen: dict[str, str] = {}
     for k, feat in enumerate(features):
         assets = feat.get("assets") or {}
         asset = assets.get("data") or next(iter(assets.values()), None)
@@ -353,7 +354,7 @@ def _copc_layout(fh: Any, path: str) -> CopcLayout:
         raise InputError(f"corrupt COPC: its nodes hold {int(entries['count'].sum())} points, "
                          f"the header says {int(header.point_count)}", path=path)  # fmt: skip
     out = np.zeros(len(entries), _ENTRY.descr + [("start", "<i8")])
-    for name in _ENTRY.names:
+    for name in _ENTRY.names or ():
         out[name] = entries[name]
     out["start"] = np.concatenate([[0], np.cumsum(entries["count"], dtype=np.int64)[:-1]])
     return CopcLayout(out, center, halfsize, bytes(laz.record_data), header)

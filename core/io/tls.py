@@ -250,7 +250,8 @@ def read_tls_stations_csv(path: PathLike) -> list[StationInfo]:
             return None
         if any(c is None for c in cols):
             raise InputError(f"give all of {', '.join(names)} or none", path=t.path)
-        return np.column_stack([float_column(t, c, allow_empty=True) for c in cols]) * scale
+        given = [c for c in cols if c is not None]  # all of them
+        return np.column_stack([float_column(t, c, allow_empty=True) for c in given]) * scale
 
     xyz = group(("x", "y", "z"), 1.0)
     opk = group(("omega_deg", "phi_deg", "kappa_deg"), math.pi / 180.0)

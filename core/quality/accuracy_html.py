@@ -63,6 +63,16 @@ def _stats_table(g: GroupStatistics) -> str:
     return _table(head, rows)
 
 
+def _figures(test: object | None, *fields: tuple[str, int]) -> list[str]:
+    """The figures ``(attribute, decimals)`` of a test's result; dashes for a test not run."""
+    return [_m(getattr(test, name) if test else None, digits) for name, digits in fields]
+
+
+def _decision(flag: bool | None, yes: str, no: str) -> str:
+    """A test's decision: ``yes`` when ``flag`` holds, ``no`` when it is False, else not tested."""
+    return _e(yes if flag else (no if flag is False else t("not tested")))
+
+
 def _tests_table(g: GroupStatistics) -> str:
     rows, css = [], []
     for key in ("E", "N", "U"):
@@ -71,23 +81,11 @@ def _tests_table(g: GroupStatistics) -> str:
         rows.append(
             [
                 f"d{key}",
-                _m(sw.statistic, 4) if sw else "&ndash;",
-                _m(sw.p_value, 4) if sw else "&ndash;",
-                _e(
-                    t("normal")
-                    if sw and sw.normal
-                    else (t("not normal") if sw and sw.normal is False else t("not tested"))
-                ),
-                _m(bt.t, 3) if bt else "&ndash;",
-                _m(bt.critical, 3) if bt else "&ndash;",
-                _m(bt.p_value, 4) if bt else "&ndash;",
-                _e(
-                    t("bias")
-                    if bt and bt.biased
-                    else (t("no bias") if bt and bt.biased is False else t("not tested"))
-                ),
-                _m(pt.chi2, 3) if pt else "&ndash;",
-                _m(pt.critical, 3) if pt else "&ndash;",
+                *_figures(sw, ("statistic", 4), ("p_value", 4)),
+                _decision(sw.normal if sw else None, t("normal"), t("not normal")),
+                *_figures(bt, ("t", 3), ("critical", 3), ("p_value", 4)),
+                _decision(bt.biased if bt else None, t("bias"), t("no bias")),
+                *_figures(pt, ("chi2", 3), ("critical", 3)),
                 _e(
                     (t("accepted") if pt.accepted else t("rejected")) + f" (sigma0 {pt.sigma0:g} m)"
                     if pt and pt.accepted is not None

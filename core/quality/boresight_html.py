@@ -42,6 +42,18 @@ def _n(x: float | None, digits: int = 2) -> str:
     return f"{float(x):.{digits}f}"
 
 
+def _value_table(
+    head: list[str],
+    names: Sequence[str],
+    values: Sequence[float],
+    sigmas: Sequence[float],
+    digits: int,
+) -> str:
+    """A table of estimated parameters: one row a parameter, its value and sigma."""
+    rows = [[a, _n(v, digits), _n(s, digits)] for a, v, s in zip(names, values, sigmas)]
+    return _table(head, rows)
+
+
 def _dms(rad: float) -> str:
     """Signed degrees, arc-minutes and arc-seconds, e.g. -0&deg;07'48.0"."""
     s = rad * ARCSEC_PER_RAD
@@ -154,26 +166,12 @@ def _results(run: BoresightRun) -> list[str]:
     )
     if res.lever_arm is not None:
         out.append(f"<h3>{t('Lever arm (body frame)')}</h3>")
-        out.append(
-            _table(
-                [t("axis"), t("value (m)"), t("sigma (m)")],
-                [
-                    [a, _n(v, 4), _n(s, 4)]
-                    for a, v, s in zip("xyz", res.lever_arm, res.lever_arm_std)
-                ],
-            )
-        )
+        head = [t("axis"), t("value (m)"), t("sigma (m)")]
+        out.append(_value_table(head, "xyz", res.lever_arm, res.lever_arm_std, 4))
     if res.interior is not None:
         out.append(f"<h3>{t('Interior orientation')}</h3>")
-        out.append(
-            _table(
-                [t("parameter"), t("value (mm)"), t("sigma (mm)")],
-                [
-                    [a, _n(v, 5), _n(s, 5)]
-                    for a, v, s in zip(("f", "x0", "y0"), res.interior, res.interior_std)
-                ],
-            )
-        )
+        head = [t("parameter"), t("value (mm)"), t("sigma (mm)")]
+        out.append(_value_table(head, ("f", "x0", "y0"), res.interior, res.interior_std, 5))
     gt = res.adjustment.global_test
     out.append(f"<h2>{t('Adjustment')}</h2>")
     out.append(

@@ -132,11 +132,9 @@ class CellGrid:
 
 
 @dataclass(frozen=True)
-class SwathCells:
-    """The plane fit of every (swath, cell) holding returns, sorted by swath then cell.
-
-    Heights, residuals and ranges in the cloud's z unit; ``gx``, ``gy`` dimensionless.
-    """
+class _CellPlanes:
+    """The plane fit ``z = height + gx dx + gy dy`` of (swath, cell) groups about the cell
+    centres; heights, residuals and ranges in the cloud's z unit, ``gx``, ``gy`` dimensionless."""
 
     swath: NDArray[np.int64]
     cell: NDArray[np.int64]
@@ -147,6 +145,15 @@ class SwathCells:
     rms: NDArray[np.float64]
     ssr: NDArray[np.float64]
     range: NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class SwathCells(_CellPlanes):
+    """The plane fit of every (swath, cell) holding returns, sorted by swath then cell.
+
+    Heights, residuals and ranges in the cloud's z unit; ``gx``, ``gy`` dimensionless.
+    """
+
     smooth: NDArray[np.bool_]
     rejected: dict[str, int] = field(default_factory=dict)
 
@@ -160,20 +167,11 @@ def _group_sums(values: list[NDArray], starts: NDArray) -> list[NDArray]:
 
 
 @dataclass(frozen=True)
-class CellFits:
+class CellFits(_CellPlanes):
     """The plane fits of the (swath, cell) groups of one set of points (a tile or the whole
     cloud) and the per-cell tests passed (``passed[:, k]``: REJECTIONS[k], the neighbour step
     excepted: it needs the neighbours, :func:`finish_cells`)."""
 
-    swath: NDArray[np.int64]
-    cell: NDArray[np.int64]
-    n: NDArray[np.int64]
-    height: NDArray[np.float64]
-    gx: NDArray[np.float64]
-    gy: NDArray[np.float64]
-    rms: NDArray[np.float64]
-    ssr: NDArray[np.float64]
-    range: NDArray[np.float64]
     solvable: NDArray[np.bool_]
     passed: NDArray[np.bool_]
 
@@ -329,11 +327,8 @@ def finish_cells(fits: Sequence[CellFits], grid: CellGrid, options: LidarAccurac
     for name, ok in zip(REJECTIONS, tests):
         rejected[name] = int(np.count_nonzero(smooth & ~ok))
         smooth &= ok
-    return SwathCells(
-        swath=c["swath"], cell=c["cell"], n=c["n"], height=c["height"], gx=c["gx"],
-        gy=c["gy"], rms=c["rms"], ssr=c["ssr"], range=c["range"], smooth=smooth,
-        rejected=rejected,
-    )  # fmt: skip
+    planes = {f: c[f] for f in _CellPlanes.__dataclass_fields__}
+    return SwathCells(**planes, smooth=smooth, rejected=rejected)
 
 
 def _continuous(

@@ -104,6 +104,13 @@ def _rmse(x: NDArray[np.float64]) -> float:
     return float(np.sqrt(np.mean(np.square(x)))) if x.size else math.nan
 
 
+def _count_verdict(n: int, minimum: int, reason: str) -> Verdict:
+    """The check-point count condition of a standard: ``n`` points, at least ``minimum``
+    wanted (``reason`` says the standard's rule); short of it, "insufficient"."""
+    status = "pass" if n >= minimum else "insufficient"
+    return Verdict(_t("Check-point count"), status, reason, float(n), float(minimum), unit="points")
+
+
 def _status(ok: bool, enough: bool) -> str:
     if not enough:
         return "insufficient"

@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 
 from ..i18n import Message
 from .html_table import TR_CONTEXT  # noqa: F401 - make i18n collects the _t("...") marks
-from .standards import _TOL, StandardResult, Verdict, _check_d, _rmse, _status, _t
+from .standards import _TOL, StandardResult, Verdict, _check_d, _count_verdict, _rmse, _status, _t
 
 __all__ = [
     "ASPRS_MIN_CHECKPOINTS",
@@ -75,9 +75,9 @@ def asprs_2023(
     rmse_3d = math.hypot(rmse_h, rmse_v)
     enough = n >= ASPRS_MIN_CHECKPOINTS
     verdicts = [
-        Verdict(
-            _t("Check-point count"),
-            "pass" if enough else "insufficient",
+        _count_verdict(
+            n,
+            ASPRS_MIN_CHECKPOINTS,
             _t(
                 "{n} check points; Edition 2 requires at least {minimum} (and up to {maximum} "
                 "for large projects)",
@@ -85,9 +85,6 @@ def asprs_2023(
                 minimum=ASPRS_MIN_CHECKPOINTS,
                 maximum=ASPRS_MAX_CHECKPOINTS,
             ),
-            float(n),
-            float(ASPRS_MIN_CHECKPOINTS),
-            unit="points",
         )
     ]
     few = (

@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .html_table import TR_CONTEXT  # noqa: F401 - make i18n collects the _t("...") marks
-from .standards import StandardResult, Verdict, _check_d, _rmse, _t
+from .standards import StandardResult, Verdict, _check_d, _count_verdict, _rmse, _t
 
 __all__ = [
     "NSSDA_HORIZONTAL_FACTOR",
@@ -136,17 +136,14 @@ def nssda(
     acc_z = NSSDA_VERTICAL_FACTOR * rmse_z
     enough = n >= NSSDA_MIN_CHECKPOINTS
     verdicts = [
-        Verdict(
-            _t("Check-point count"),
-            "pass" if enough else "insufficient",
+        _count_verdict(
+            n,
+            NSSDA_MIN_CHECKPOINTS,
             _t(
                 "{n} check points; NSSDA requires at least {minimum}",
                 n=n,
                 minimum=NSSDA_MIN_CHECKPOINTS,
             ),
-            float(n),
-            float(NSSDA_MIN_CHECKPOINTS),
-            unit="points",
         ),
         Verdict(
             _t("Horizontal approximation condition"),

@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from .accuracy_options import PEC_CLASSES
 from .html_table import TR_CONTEXT  # noqa: F401 - make i18n collects the _t("...") marks
-from .standards import _TOL, StandardResult, Verdict, _check_d, _rmse, _t
+from .standards import _TOL, StandardResult, Verdict, _check_d, _count_verdict, _rmse, _t
 
 __all__ = [
     "PEC_CLASSES",
@@ -131,20 +131,16 @@ def pec_pcd(
     horiz = np.hypot(d[:, 0], d[:, 1])
     vert = np.abs(d[:, 2])
     rms_h, rms_v = _rmse(horiz), _rmse(vert)
-    enough = n >= PEC_RECOMMENDED_MIN_POINTS
     verdicts = [
-        Verdict(
-            _t("Check-point count"),
-            "pass" if enough else "insufficient",
+        _count_verdict(
+            n,
+            PEC_RECOMMENDED_MIN_POINTS,
             _t(
                 "{n} check points; fewer than {minimum} makes the 90 % rule weak (common "
                 "practice, not in the Decreto)",
                 n=n,
                 minimum=PEC_RECOMMENDED_MIN_POINTS,
             ),
-            float(n),
-            float(PEC_RECOMMENDED_MIN_POINTS),
-            unit="points",
         )
     ]
     figures: dict[str, float] = {"RMSE_HORIZONTAL": rms_h, "RMSE_U": rms_v}

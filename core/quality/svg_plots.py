@@ -68,6 +68,16 @@ def _esc(text: str) -> str:
     return html.escape(str(text), quote=True)
 
 
+def _tick(
+    x1: float, y1: float, x2: float, y2: float, tx: float, ty: float, anchor: str, label: str
+) -> str:
+    """A grid line from (x1, y1) to (x2, y2) and its tick label anchored at (tx, ty) (px)."""
+    return (
+        f'<line x1="{x1:.1f}" y1="{y1:.1f}" x2="{x2:.1f}" y2="{y2:.1f}" stroke="#ddd"/>'
+        f'<text x="{tx:.1f}" y="{ty:.1f}" text-anchor="{anchor}" {_FONT}>{label}</text>'
+    )
+
+
 class _Frame:
     """Linear mapping of a data window onto a pixel box (y up)."""
 
@@ -96,21 +106,11 @@ class _Frame:
                 if axis == "x":
                     x = float(self.px(t))
                     b = self.top + self.height
-                    out.append(
-                        f'<line x1="{x:.1f}" y1="{self.top:.1f}" x2="{x:.1f}" y2="{b:.1f}" '
-                        'stroke="#ddd"/>'
-                        f'<text x="{x:.1f}" y="{b + 14:.1f}" text-anchor="middle" {_FONT}>'
-                        f"{_fmt(t)}</text>"
-                    )
+                    out.append(_tick(x, self.top, x, b, x, b + 14, "middle", _fmt(t)))
                 else:
                     y = float(self.py(t))
                     r = self.left + self.width
-                    out.append(
-                        f'<line x1="{self.left:.1f}" y1="{y:.1f}" x2="{r:.1f}" y2="{y:.1f}" '
-                        'stroke="#ddd"/>'
-                        f'<text x="{self.left - 4:.1f}" y="{y + 4:.1f}" text-anchor="end" '
-                        f"{_FONT}>{_fmt(t)}</text>"
-                    )
+                    out.append(_tick(self.left, y, r, y, self.left - 4, y + 4, "end", _fmt(t)))
         cx = self.left + self.width / 2
         cy = self.top + self.height / 2
         out.append(
