@@ -50,7 +50,8 @@ class TiePointOptions:
         (0: no test). It removes wrong matches that slide along the epipolar line, which
         the fundamental matrix cannot see (aerial strips: all epipolar lines are parallel).
     refine : bool
-        Least-squares refinement of the tracks (:func:`refine_tracks`).
+        Least-squares refinement of the tracks (:func:`refine_tracks`); on by default: it
+        cuts the median error 1.2-3.6x for +25 to +40 % CPU (bench/matching.md, "Tie points").
     refine_half_px : int
         Half size of the LSM template, full-resolution pixels (template 2 h + 1 square).
     refine_sigma_floor_px : float
@@ -72,7 +73,7 @@ class TiePointOptions:
     min_overlap: float = 0.05
     sigma_px: float = 0.0
     coherence: float = 0.03
-    refine: bool = False
+    refine: bool = True
     refine_half_px: int = 10
     refine_sigma_floor_px: float = 0.02
 

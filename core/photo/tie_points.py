@@ -26,12 +26,12 @@ The chain (one image's features are computed once and kept; the images themselve
    tracks. A track holding two different keypoints of the same image is inconsistent and is
    dropped whole; tracks shorter than ``min_track_length`` images are dropped.
 
-5. **Refinement** (optional, :func:`refine_tracks`): least-squares matching (Gruen 1985) of
-   every measurement of a track against a template cut around the track's reference
-   measurement (its first image), in the full-resolution grey images (read again, one at a
-   time, in image order: each image once).
+5. **Refinement** (on by default, ``refine``; :func:`refine_tracks`): least-squares matching
+   (Gruen 1985) of every measurement of a track against a template cut around the track's
+   reference measurement (its first image), in the full-resolution grey images (read again,
+   one at a time, in image order: each image once).
 
-Without step 5 the tie points are measured at the keypoint positions.
+Without step 5 (``refine=False``) the tie points are measured at the keypoint positions.
 """
 
 from __future__ import annotations
@@ -179,9 +179,13 @@ def _knn(a: NDArray, b: NDArray, binary: bool, k: int):
 
     SIFT: FLANN's randomised k-d trees (Muja & Lowe 2009; 4 trees, 64 checks), an
     approximate search several times faster than brute force at a few thousand features;
-    ORB: brute force on the Hamming distance.
+    ORB: brute force on the Hamming distance. The trees are drawn from OpenCV's global
+    random state, seeded here: otherwise they depend on whatever OpenCV drew before (an
+    earlier pair's RANSAC, an earlier run in the process) and a repeated run differs.
     """
     import cv2
+
+    cv2.setRNGSeed(12345)
 
     if binary:
         matcher = cv2.BFMatcher(cv2.NORM_HAMMING)

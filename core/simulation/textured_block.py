@@ -70,10 +70,29 @@ def make_texture(extent: tuple[float, float, float, float], cell_m: float, seed:
                         interpolation=cv2.INTER_CUBIC)  # fmt: skip
         acc += (size**0.6) * up[:rows, :cols]
         size *= 2
-    acc -= acc.mean()
-    acc *= 45.0 / acc.std()
-    vals = np.clip(acc + 128.0, 0, 255).astype(np.uint8)
+    # mean and spread from exact integer sums: numpy's float32 sums (and, before NEP 50,
+    # the float64 scalar 45 / std) differ between numpy 1.24 and 2, which changed about half
+    # of the rendered test images by one grey level here and there (and so their tie points)
+    mean = _exact_mean(acc)
+    dev = acc - np.float32(mean)
+    scale = np.float32(45.0 / math.sqrt(_exact_mean(dev.astype(np.float64) ** 2)))
+    vals = np.clip(dev * scale + np.float32(128.0), 0, 255).astype(np.uint8)
     return GroundTexture(vals, float(extent[0]), float(extent[3]), float(cell_m))
+
+
+def _exact_mean(x: NDArray) -> float:
+    """Mean of ``x`` from its values rounded to 2^-20 and summed as int64: integer sums are
+    exact, so the order numpy adds in (its version, SIMD width, blocking) cannot change it.
+
+    >>> a = np.array([0.1, 0.2, 0.3, 1e3], np.float32)
+    >>> _exact_mean(a) == _exact_mean(a[::-1].copy()), round(_exact_mean(a), 4)
+    (True, 250.15)
+    """
+    v = np.asarray(x, np.float64)
+    if v.size and float(np.abs(v).max()) * v.size >= 2.0**42:
+        raise ValueError("values too large for an exact int64 sum at 2^-20")
+    q = np.rint(v * 2.0**20).astype(np.int64)
+    return int(q.sum(dtype=np.int64)) / 2.0**20 / max(q.size, 1)
 
 
 @dataclass(frozen=True)
