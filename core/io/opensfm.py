@@ -31,8 +31,8 @@ fisheye_opencv  ``opencv_fisheye`` (k1..k4, aspect_ratio)     equidistant
 ==============  ============================================  ===========
 
 OpenSfM's Brown tangential terms are OpenCV's (``x += 2 p1 x y + p2 (r2 + 2 x^2)``, ``y +=
-p1 (r2 + 2 y^2) + 2 p2 x y``). Spherical (equirectangular), dual, fisheye62/624 are refused
-by name.
+p1 (r2 + 2 y^2) + 2 p2 x y``, as in OpenSfM's ``camera_distortions_functions.h``).
+Spherical (equirectangular), dual, fisheye62/624 are refused by name.
 
 Orientations and frame
 ----------------------
