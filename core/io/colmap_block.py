@@ -73,6 +73,7 @@ __all__ = [
     "colmap_from_block",
     "frame_from_text",
     "quaternion_to_matrix",
+    "to_frame",
 ]
 
 #: The project's camera frame from COLMAP's (y and z flipped).
@@ -281,10 +282,12 @@ class ColmapBlock:
     points: GroundPoints
 
 
-def _to_frame(
+def to_frame(
     frame: ColmapFrame, xyz: Array, m: Array
 ) -> Tuple[Array, Array, str]:
     """Model-frame centres/points (N, 3) and rotations M (K, 3, 3) -> the frame's (and its WKT).
+
+    Shared with the OpenSfM import (its topocentric frame is an ECEF similarity).
 
     ``m`` applies to the first K rows of ``xyz`` (the image centres)."""
     x = frame.scale * xyz @ frame.rotation.T + frame.translation
@@ -322,7 +325,7 @@ def block_from_colmap(
     centres = -np.einsum("nji,nj->ni", r, t)
     pts: List[ColmapPoint] = sorted(model.points.values(), key=lambda p: p.point_id)
     xyz = np.array([p.xyz for p in pts], dtype=np.float64).reshape(-1, 3)
-    allx, m, wkt = _to_frame(frame, np.vstack([centres, xyz]), _FLIP @ r)
+    allx, m, wkt = to_frame(frame, np.vstack([centres, xyz]), _FLIP @ r)
     w, ph, k = matrix_to_opk(m)
     n = len(images)
     eo = ExteriorOrientationTable(tuple(names), np.full(n, np.nan), ("",) * n, allx[:n],

@@ -19,6 +19,7 @@ NAMES = (
     "import_trajectory",
     "import_colmap",
     "export_colmap",
+    "import_opensfm",
     "ground_filter",
     "create_lcps",
     "accuracy_report",

@@ -123,6 +123,16 @@ WORKFLOWS: tuple[Workflow, ...] = (
         ),
     ),
     Workflow(
+        _t("An OpenSfM / ODM block: orthophotos on the LiDAR DSM"),
+        (
+            ("importopensfm", _t("INPUT = the reconstruction.json (ODM: opensfm/); CRS = the "
+             "mapping CRS (empty: topocentric, LOCAL); OUTPUT_CAMERA, OUTPUT_EO, "
+             "OUTPUT_OBSERVATIONS, OUTPUT_POINTS")),
+            ("orthorectify", _t("CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
+             "OUTPUT_FOLDER = one orthophoto per image")),
+        ),
+    ),
+    Workflow(
         _t("Boresight calibration from an SBET (or ASCII export) and the camera events"),
         (
             ("importtrajectory", _t("INPUT = the SBET, POSPac / Inertial Explorer export or "
