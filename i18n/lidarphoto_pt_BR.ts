@@ -107,6 +107,10 @@
             <translation>Um bloco COLMAP: ortofotos sobre o MDS LiDAR, e de volta ao COLMAP</translation>
         </message>
         <message>
+            <source>An OpenSfM / ODM block: orthophotos on the LiDAR DSM</source>
+            <translation>Um bloco OpenSfM / ODM: ortofotos sobre o MDS LiDAR</translation>
+        </message>
+        <message>
             <source>Boresight calibration from an SBET (or ASCII export) and the camera events</source>
             <translation>Calibração de boresight a partir de um SBET (ou exportação ASCII) e dos eventos da câmera</translation>
         </message>
@@ -209,6 +213,10 @@
         <message>
             <source>CAMERA, EO (e.g. adjusted by bundleadjustment), OBSERVATIONS and POINTS; OUTPUT_FOLDER = the COLMAP text model</source>
             <translation>CAMERA, EO (p. ex. ajustada pelo bundleadjustment), OBSERVATIONS e POINTS; OUTPUT_FOLDER = o modelo COLMAP em texto</translation>
+        </message>
+        <message>
+            <source>INPUT = the reconstruction.json (ODM: opensfm/); CRS = the mapping CRS (empty: topocentric, LOCAL); OUTPUT_CAMERA, OUTPUT_EO, OUTPUT_OBSERVATIONS, OUTPUT_POINTS</source>
+            <translation>INPUT = o reconstruction.json (ODM: opensfm/); CRS = o CRS de mapeamento (vazio: topocêntrico, LOCAL); OUTPUT_CAMERA, OUTPUT_EO, OUTPUT_OBSERVATIONS, OUTPUT_POINTS</translation>
         </message>
         <message>
             <source>INPUT = the SBET, POSPac / Inertial Explorer export or CSV; EVENTS = image_id, time; OUTPUT_TRAJECTORY = the trajectory table at the events, OUTPUT_EO = the exterior orientation</source>
@@ -5238,6 +5246,137 @@ como tabela de pontos de apoio com papel check (pontos de ligação triangulados
         <message>
             <source>Number of registered images</source>
             <translation>Número de imagens registradas</translation>
+        </message>
+        <message>
+            <source>Number of cameras</source>
+            <translation>Número de câmeras</translation>
+        </message>
+        <message>
+            <source>Number of 3D points</source>
+            <translation>Número de pontos 3D</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:importopensfm</name>
+        <message>
+            <source>Import OpenSfM / ODM reconstruction</source>
+            <translation>Importar reconstrução OpenSfM / ODM</translation>
+        </message>
+        <message>
+            <source>Aerotriangulation</source>
+            <translation>Aerotriangulação</translation>
+        </message>
+        <message>
+            <source>OpenSfM or ODM reconstruction.json -&gt; cameras, orientations, tie points</source>
+            <translation>reconstruction.json do OpenSfM ou do ODM -&gt; câmeras, orientações, pontos de ligação</translation>
+        </message>
+        <message>
+            <source>Reads an OpenSfM reconstruction (reconstruction.json, as OpenSfM and OpenDroneMap write it,
+with tracks.csv beside it when present) and writes the project's camera JSON, exterior
+orientation, observation table and points, with the lens models converted exactly: OpenSfM's
+distortion maps ideal to measured coordinates, and each camera gets the forward lens model
+with OpenSfM's own coefficients (docs/formats.md, OpenSfM). The perspective, simple_radial,
+radial, brown, fisheye and fisheye_opencv projection types are supported; spherical, dual and
+fisheye62/624 are refused by name.</source>
+            <translation>Lê uma reconstrução OpenSfM (reconstruction.json, como o OpenSfM e o OpenDroneMap a escrevem,
+com o tracks.csv ao lado quando existe) e escreve o JSON de câmera do projeto, a orientação
+exterior, a tabela de observações e os pontos, com os modelos de lente convertidos exatamente: a
+distorção do OpenSfM leva coordenadas ideais a medidas, e cada câmera recebe o modelo de lente direto
+com os próprios coeficientes do OpenSfM (docs/formats.md, OpenSfM). Os tipos de projeção perspective, simple_radial,
+radial, brown, fisheye e fisheye_opencv são aceitos; spherical, dual e
+fisheye62/624 são recusados pelo nome.</translation>
+        </message>
+        <message>
+            <source>## Frame
+OpenSfM's coordinates are topocentric (east, north, up) at reference_lla. CRS empty: they
+are kept as they are (LOCAL, no CRS); a projected CRS (e.g. EPSG:32723): they are converted
+into it through ECEF, with each orientation turned to the grid frame at its centre.</source>
+            <translation>## Referencial
+As coordenadas do OpenSfM são topocêntricas (leste, norte, acima) em reference_lla. CRS vazio:
+ficam como estão (LOCAL, sem CRS); um CRS projetado (p. ex. EPSG:32723): são convertidas
+para ele via ECEF, com cada orientação girada para o referencial da quadrícula em seu centro.</translation>
+        </message>
+        <message>
+            <source>## Inputs
+INPUT: reconstruction.json (or its folder); RECONSTRUCTION: which of its reconstructions (0:
+the first, the largest). PIXEL_SIZE: OpenSfM has none; it scales the millimetres, never the
+projection.</source>
+            <translation>## Entradas
+INPUT: reconstruction.json (ou a sua pasta); RECONSTRUCTION: qual das suas reconstruções (0:
+a primeira, a maior). PIXEL_SIZE: o OpenSfM não tem; ele escala os milímetros, nunca a
+projeção.</translation>
+        </message>
+        <message>
+            <source>## Outputs
+OUTPUT_CAMERA: the cameras (opensfm_&lt;id&gt;); OUTPUT_EO: one row per shot (image_id = the shot's
+image name, with a camera column when there are several); OUTPUT_OBSERVATIONS: the tracks of
+tracks.csv as tie rows (point_id = the track id); OUTPUT_POINTS: the 3D points as a ground
+point table with role check (triangulated tie points, never control).</source>
+            <translation>## Saídas
+OUTPUT_CAMERA: as câmeras (opensfm_&lt;id&gt;); OUTPUT_EO: uma linha por tomada (image_id = o nome da
+imagem da tomada, com uma coluna de câmera quando há várias); OUTPUT_OBSERVATIONS: os rastros do
+tracks.csv como linhas tie (point_id = o id do rastro); OUTPUT_POINTS: os pontos 3D como tabela de
+pontos de apoio com papel check (pontos de ligação triangulados, nunca controle).</translation>
+        </message>
+        <message>
+            <source>OpenSfM reconstruction (reconstruction.json)</source>
+            <translation>Reconstrução OpenSfM (reconstruction.json)</translation>
+        </message>
+        <message>
+            <source>OpenSfM reconstruction (*.json);;All files (*)</source>
+            <translation>Reconstrução OpenSfM (*.json);;Todos os arquivos (*)</translation>
+        </message>
+        <message>
+            <source>Mapping CRS</source>
+            <translation>CRS de mapeamento</translation>
+        </message>
+        <message>
+            <source>the projected CRS to convert to; empty: the topocentric frame (LOCAL)</source>
+            <translation>o CRS projetado para o qual converter; vazio: o referencial topocêntrico (LOCAL)</translation>
+        </message>
+        <message>
+            <source>Reconstruction index</source>
+            <translation>Índice da reconstrução</translation>
+        </message>
+        <message>
+            <source>which reconstruction of the file (0: the first)</source>
+            <translation>qual reconstrução do arquivo (0: a primeira)</translation>
+        </message>
+        <message>
+            <source>Pixel size</source>
+            <translation>Tamanho do pixel</translation>
+        </message>
+        <message>
+            <source>OpenSfM stores none: it sets the millimetres of the camera</source>
+            <translation>o OpenSfM não guarda: define os milímetros da câmera</translation>
+        </message>
+        <message>
+            <source>Cameras (JSON)</source>
+            <translation>Câmeras (JSON)</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>Exterior orientation table (CSV)</source>
+            <translation>Tabela de orientação exterior (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Observations (tie points, CSV)</source>
+            <translation>Observações (pontos de ligação, CSV)</translation>
+        </message>
+        <message>
+            <source>3D points (ground point table, CSV)</source>
+            <translation>Pontos 3D (tabela de pontos de apoio, CSV)</translation>
+        </message>
+        <message>
+            <source>Number of shots</source>
+            <translation>Número de tomadas</translation>
         </message>
         <message>
             <source>Number of cameras</source>

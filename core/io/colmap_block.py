@@ -307,6 +307,22 @@ def to_frame(
     return mapping.ecef_to_map(x), mm @ np.swapaxes(r_eg, -1, -2), mapping.crs.to_wkt()
 
 
+def oriented(
+    frame: ColmapFrame, names: Sequence[str], r: NDArray[np.float64], t: NDArray[np.float64],
+    xyz: NDArray[np.float64],
+) -> Tuple[ExteriorOrientationTable, NDArray[np.float64]]:
+    """The EO table of images given as world -> camera rotations ``r`` (N, 3, 3) and
+    translations ``t`` (N, 3) in the camera frame x right, y down, z forward (COLMAP's and
+    OpenSfM's), and the points ``xyz`` (M, 3), both converted into ``frame``."""
+    centres = -np.einsum("nji,nj->ni", r, t)
+    allx, m, wkt = to_frame(frame, np.vstack([centres, xyz]), _FLIP @ r)
+    w, ph, k = matrix_to_opk(m)
+    n = len(names)
+    eo = ExteriorOrientationTable(tuple(names), np.full(n, np.nan), ("",) * n, allx[:n],
+                                  np.column_stack([w, ph, k]), wkt)  # fmt: skip
+    return eo, allx[n:]
+
+
 def block_from_colmap(
     model: ColmapModel, frame: ColmapFrame, pixel_size_mm: float
 ) -> ColmapBlock:
@@ -322,14 +338,9 @@ def block_from_colmap(
         raise InputError("two images have the same name", path=model.source)
     r = np.array([quaternion_to_matrix(im.qvec) for im in images])
     t = np.array([im.tvec for im in images], dtype=np.float64)
-    centres = -np.einsum("nji,nj->ni", r, t)
     pts: List[ColmapPoint] = sorted(model.points.values(), key=lambda p: p.point_id)
     xyz = np.array([p.xyz for p in pts], dtype=np.float64).reshape(-1, 3)
-    allx, m, wkt = to_frame(frame, np.vstack([centres, xyz]), _FLIP @ r)
-    w, ph, k = matrix_to_opk(m)
-    n = len(images)
-    eo = ExteriorOrientationTable(tuple(names), np.full(n, np.nan), ("",) * n, allx[:n],
-                                  np.column_stack([w, ph, k]), wkt)  # fmt: skip
+    eo, point_xyz = oriented(frame, names, r, t, xyz)
     known = set(model.points)
     rows: Dict[str, list] = {"image": [], "point": [], "px": []}
     for im in images:
@@ -347,7 +358,7 @@ def block_from_colmap(
                             np.array(rows["px"], dtype=np.float64).reshape(-1, 2),
                             np.full(n_obs, DEFAULT_SIGMA_PX), ("tie",) * n_obs,
                             ("",) * n_obs)  # fmt: skip
-    ground = GroundPoints(tuple(str(p.point_id) for p in pts), allx[n:],
+    ground = GroundPoints(tuple(str(p.point_id) for p in pts), point_xyz,
                           np.full((len(pts), 3), DEFAULT_CONTROL_SIGMA_M),
                           ("check",) * len(pts))  # fmt: skip
     per_image = tuple(cam_names[im.camera_id] for im in images)

@@ -57,11 +57,9 @@ from ..errors import InputError
 from ..geometry.camera import Camera
 from ..geometry.distortion import DistortionModel
 from ..geometry.forward_lens import OpenCVFisheyeLens, OpenCVLens
-from ..geometry.rotations import matrix_to_opk
 from ..photo.bundle_setup import DEFAULT_CONTROL_SIGMA_M, GroundPoints
 from ..photo.observations import DEFAULT_SIGMA_PX, ImageObservations
-from ..photo.orientation import ExteriorOrientationTable
-from .colmap_block import ColmapBlock, ColmapFrame, to_frame
+from .colmap_block import ColmapBlock, ColmapFrame, oriented
 
 Array = NDArray[np.float64]
 
@@ -86,7 +84,6 @@ OPENSFM_MODELS: Dict[str, Tuple[str, ...]] = {
     "fisheye_opencv": ("focal", "aspect_ratio", "c_x", "c_y", "k1", "k2", "k3", "k4"),
 }
 _REFUSED = ("spherical", "equirectangular", "dual", "fisheye62", "fisheye624")
-_FLIP = np.diag([1.0, -1.0, -1.0])
 
 
 @dataclass(frozen=True)
@@ -318,15 +315,9 @@ def block_from_opensfm(
         raise InputError("the reconstruction has no shot", path=rec.source)
     r = np.array([rotation_from_axis_angle(s.rotation) for s in shots])
     t = np.array([s.translation for s in shots], dtype=np.float64)
-    centres = -np.einsum("nji,nj->ni", r, t)
     pids = sorted(rec.points)
     xyz = np.array([rec.points[k] for k in pids], dtype=np.float64).reshape(-1, 3)
-    allx, m, wkt = to_frame(frame, np.vstack([centres, xyz]), _FLIP @ r)
-    w, ph, k = matrix_to_opk(m)
-    n = len(shots)
-    names = tuple(s.name for s in shots)
-    eo = ExteriorOrientationTable(names, np.full(n, np.nan), ("",) * n, allx[:n],
-                                  np.column_stack([w, ph, k]), wkt)  # fmt: skip
+    eo, point_xyz = oriented(frame, [s.name for s in shots], r, t, xyz)
     px = np.empty((len(rec.tracks), 2))
     for j, (img, _, xn, yn) in enumerate(rec.tracks):
         c = rec.cameras[rec.shots[img].camera]
@@ -336,6 +327,6 @@ def block_from_opensfm(
     obs = ImageObservations(tuple(r_[0] for r_ in rec.tracks), tuple(r_[1] for r_ in rec.tracks),
                             px, np.full(n_obs, DEFAULT_SIGMA_PX), ("tie",) * n_obs,
                             ("",) * n_obs)  # fmt: skip
-    ground = GroundPoints(tuple(pids), allx[n:], np.full((len(pids), 3), DEFAULT_CONTROL_SIGMA_M),
+    ground = GroundPoints(tuple(pids), point_xyz, np.full((len(pids), 3), DEFAULT_CONTROL_SIGMA_M),
                           ("check",) * len(pids))  # fmt: skip
     return ColmapBlock(cams, eo, tuple(cam_names[s.camera] for s in shots), obs, ground)

@@ -13,6 +13,28 @@ log = logging.getLogger(__name__)
 
 COLMAP_FILTER = "COLMAP cameras (cameras.txt cameras.bin);;All files (*)"
 
+#: The tables every block import writes (importcolmap, importopensfm).
+BLOCK_OUTPUTS = (
+    Param("OUTPUT_CAMERA", "file_out", "Cameras (JSON)", optional=True,
+          file_filter="JSON files (*.json)"),
+    Param("OUTPUT_EO", "file_out", "Exterior orientation table (CSV)", optional=True,
+          file_filter=CSV_OUT),
+    Param("OUTPUT_OBSERVATIONS", "file_out", "Observations (tie points, CSV)",
+          optional=True, file_filter=CSV_OUT),
+    Param("OUTPUT_POINTS", "file_out", "3D points (ground point table, CSV)",
+          optional=True, create_by_default=False, file_filter=CSV_OUT),
+)  # fmt: skip
+
+
+def block_results(images: str) -> tuple[Result, ...]:
+    """The counts a block import reports; ``images`` names the image count."""
+    return (
+        Result("IMAGE_COUNT", "number", images),
+        Result("CAMERA_COUNT", "number", "Number of cameras"),
+        Result("POINT_COUNT", "number", "Number of 3D points"),
+    )
+
+
 SPEC = AlgorithmSpec(
     name="importcolmap",
     title="Import COLMAP model",
@@ -56,20 +78,9 @@ as a ground point table with role check (triangulated tie points, never control)
         Param("PIXEL_SIZE", "number", "Pixel size",
               Ref("io.colmap_names", "DEFAULT_PIXEL_SIZE_MM"), unit="mm", minimum=0.0005,
               maximum=0.5, help="COLMAP stores none: it sets the millimetres of the camera"),
-        Param("OUTPUT_CAMERA", "file_out", "Cameras (JSON)", optional=True,
-              file_filter="JSON files (*.json)"),
-        Param("OUTPUT_EO", "file_out", "Exterior orientation table (CSV)", optional=True,
-              file_filter=CSV_OUT),
-        Param("OUTPUT_OBSERVATIONS", "file_out", "Observations (tie points, CSV)",
-              optional=True, file_filter=CSV_OUT),
-        Param("OUTPUT_POINTS", "file_out", "3D points (ground point table, CSV)",
-              optional=True, create_by_default=False, file_filter=CSV_OUT),
+        *BLOCK_OUTPUTS,
     ),
-    results=(
-        Result("IMAGE_COUNT", "number", "Number of registered images"),
-        Result("CAMERA_COUNT", "number", "Number of cameras"),
-        Result("POINT_COUNT", "number", "Number of 3D points"),
-    ),
+    results=block_results("Number of registered images"),
     tags=("colmap", "structure from motion", "sfm", "import", "opencv", "lens"),
     references=("Schönberger & Frahm (2016)",),
 )
@@ -81,13 +92,19 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
     from ..io.colmap import read_colmap_model
     from ..io.colmap_block import block_from_colmap, frame_from_text
-    from ..io.orientation import eo_csv_text
 
     frame = frame_from_text(v.frame, v.crs or "", v.similarity or "")
     folder = Path(v.input)
     model = read_colmap_model(folder if folder.is_dir() else folder.parent)
     block = block_from_colmap(model, frame, v.pixel_size)
-    log.info("%d images, %d cameras, %d points", len(block.eo), len(block.cameras),
+    return finish_import(block, out, progress, "images")
+
+
+def finish_import(block, out, progress, images: str) -> JobResult:
+    """Log the counts, write the requested tables (the EO to stdout when none is), report."""
+    from ..io.orientation import eo_csv_text
+
+    log.info("%d %s, %d cameras, %d points", len(block.eo), images, len(block.cameras),
              len(block.points.point_id))
     result = JobResult(results={"IMAGE_COUNT": len(block.eo), "CAMERA_COUNT": len(block.cameras),
                                 "POINT_COUNT": len(block.points.point_id)}, data=block)

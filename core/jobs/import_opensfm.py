@@ -5,10 +5,9 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_OUT
-from .import_colmap import _write_outputs
+from .import_colmap import BLOCK_OUTPUTS, block_results, finish_import
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Ref, Result, Values
+from .spec import AlgorithmSpec, Param, Ref, Values
 
 log = logging.getLogger(__name__)
 
@@ -52,20 +51,9 @@ point table with role check (triangulated tie points, never control).""",
         Param("PIXEL_SIZE", "number", "Pixel size",
               Ref("io.colmap_names", "DEFAULT_PIXEL_SIZE_MM"), unit="mm", minimum=0.0005,
               maximum=0.5, help="OpenSfM stores none: it sets the millimetres of the camera"),
-        Param("OUTPUT_CAMERA", "file_out", "Cameras (JSON)", optional=True,
-              file_filter="JSON files (*.json)"),
-        Param("OUTPUT_EO", "file_out", "Exterior orientation table (CSV)", optional=True,
-              file_filter=CSV_OUT),
-        Param("OUTPUT_OBSERVATIONS", "file_out", "Observations (tie points, CSV)",
-              optional=True, file_filter=CSV_OUT),
-        Param("OUTPUT_POINTS", "file_out", "3D points (ground point table, CSV)",
-              optional=True, create_by_default=False, file_filter=CSV_OUT),
+        *BLOCK_OUTPUTS,
     ),
-    results=(
-        Result("IMAGE_COUNT", "number", "Number of shots"),
-        Result("CAMERA_COUNT", "number", "Number of cameras"),
-        Result("POINT_COUNT", "number", "Number of 3D points"),
-    ),
+    results=block_results("Number of shots"),
     tags=("opensfm", "odm", "opendronemap", "structure from motion", "sfm", "import", "lens"),
     references=("Mapillary (n. d.)",),
 )
@@ -74,17 +62,7 @@ point table with role check (triangulated tie points, never control).""",
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the reconstruction, convert it (LOCAL or into CRS), write the requested tables."""
     from ..io.opensfm import block_from_opensfm, read_opensfm
-    from ..io.orientation import eo_csv_text
 
     rec = read_opensfm(v.input, int(v.reconstruction))
     block = block_from_opensfm(rec, v.crs or "", v.pixel_size)
-    log.info("%d shots, %d cameras, %d points", len(block.eo), len(block.cameras),
-             len(block.points.point_id))
-    result = JobResult(results={"IMAGE_COUNT": len(block.eo), "CAMERA_COUNT": len(block.cameras),
-                                "POINT_COUNT": len(block.points.point_id)}, data=block)
-    _write_outputs(block, out, result.lines)
-    if not result.lines:
-        result.stdout = eo_csv_text(block.eo)
-    if progress is not None:
-        progress(1.0)
-    return result
+    return finish_import(block, out, progress, "shots")

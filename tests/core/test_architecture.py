@@ -316,10 +316,12 @@ DUPLICATE_FOLDERS = ("core", "processing_provider", "plugin")
 #: only shrinks: most of what is left is parallel structure, not shared logic (dataclass
 #: fields with defaults, typed signatures, job parameter tables, the compat shims of QGIS
 #: versions), see docs/architecture.md.
-#: 80 after the clean-up; +2 with this wave's merges, both parallel structure: the forward
-#: lens models' override of ``distort_with_status`` (the interface's signature) and two job
-#: parameter tables that now carry the same ``advanced=True`` runs.
-MAX_DUPLICATE_PAIRS = 82
+#: 80 after the clean-up; +4 with this wave's merges, all parallel structure: the forward
+#: lens models' override of ``distort_with_status`` (the interface's signature), two job
+#: parameter tables that now carry the same ``advanced=True`` runs, and the COLMAP and
+#: OpenSfM importers' opening lines (their shared logic is ``colmap_block.oriented`` and
+#: ``import_colmap.finish_import``).
+MAX_DUPLICATE_PAIRS = 84
 _PAIR_ROW = re.compile(r"^D\d+ (\S+):\d+-\d+ ~ (\S+):\d+-\d+")
 
 
