@@ -2,9 +2,9 @@
 
 The HTML reports are self-contained (inline CSS and SVG), so WebKit lays them out as a browser
 would, and QPrinter writes them to an A4 PDF beside the HTML (``report.html`` ->
-``report.pdf``). Printing needs a GUI application and its main thread: QGIS desktop, or a
-QgsApplication created with the GUI (offscreen is fine); under ``qgis_process`` or without
-QtWebKit the PDF is skipped with a message, the HTML stays.
+``report.pdf``). Printing needs a GUI application and its main thread: QGIS desktop,
+``qgis_process`` (it runs on Qt's offscreen platform) or a QgsApplication created with the GUI;
+where there is none, or no QtWebKit, the PDF is skipped with a message and the HTML stays.
 """
 
 from __future__ import annotations
