@@ -5,7 +5,7 @@ The frame stands where a :class:`~.frames.MappingFrame` and its
 :class:`~.frames.LocalFrame` stand in an adjustment: the user's X, Y, Z (and omega-phi-kappa
 relative to the frame's own axes) are taken as they are, with no projection, no datum and no
 earth curvature; only the unit is converted, so that the core still works in metres
-(DESIGN.md, "Units") and a millimetre network gives the same numbers as the metre network
+(docs/conventions.md, "Units") and a millimetre network gives the same numbers as the metre network
 scaled by 1000. The adjustment frame is the user's frame shifted to an origin near the
 network (the centre of its points), metres.
 """

@@ -31,7 +31,7 @@ is exact (the formulas are the same, not fitted).
 Orientations
 ------------
 COLMAP stores world-to-camera ``R(q), t`` with its camera frame x right, y down, z forward;
-the project's camera frame is x right, y up, z backward (DESIGN.md), so
+the project's camera frame is x right, y up, z backward (docs/conventions.md, "Images"), so
 ``M = diag(1, -1, -1) R(q)`` and the centre is ``C = -R(q)^T t``. A similarity ``X' = s R X +
 T`` (the model's frame to the stated one) gives ``C' = s R C + T`` and ``M' = M R^T``. In
 ECEF, ``M`` is turned to the grid frame at each centre (grid east, grid north, up) and the
