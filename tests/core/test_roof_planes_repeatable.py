@@ -120,8 +120,18 @@ def test_one_and_two_threads_give_the_same_planes(ahn3_small, tmp_path):
                            capture_output=True, text=True, check=True)  # fmt: skip
         out.append(json.loads(r.stdout.strip().splitlines()[-1]))
     assert [o["threads"] for o in out] == [1, 2]
-    assert out[0]["pid"] == out[1]["pid"] and out[0]["params"] == out[1]["params"]
+    # the same regions, point for point, on every BLAS
+    assert out[0]["pid"] == out[1]["pid"]
     assert len(out[0]["params"]) > 30
+    if np.lib.NumpyVersion(np.__version__) >= "2.0.0":
+        assert out[0]["params"] == out[1]["params"]  # numpy 2's OpenBLAS: bit for bit
+    else:
+        # Debian's system OpenBLAS (numpy 1.24) on 2 threads moves some plane parameters and
+        # covariances by up to 1.8e-14 of their value on some hosts (measured 2026-12-02: 267
+        # of 1,180 numbers; numba's thread count changes nothing): rounding, not another plane.
+        # Left to issue 33: final fits without threaded BLAS or LAPACK.
+        a, b = np.array(out[0]["params"]), np.array(out[1]["params"])
+        assert np.all(np.abs(a - b) <= 1e-13 * np.maximum(np.abs(a), np.abs(b)))
 
 
 # ----------------------------------------------------------------------------- blocks
