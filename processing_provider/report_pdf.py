@@ -43,6 +43,7 @@ def write_pdf(html: str, pdf: str | None = None) -> str:
     """Print the HTML report ``html`` to ``pdf`` (default: :func:`pdf_path_of`); returns the
     PDF's path. Written to a temporary file beside it and renamed, so a failed print leaves no
     half-written PDF. Raises RuntimeError naming the file when it cannot print."""
+    from qgis.PyQt.QtGui import QPageSize
     from qgis.PyQt.QtPrintSupport import QPrinter
     from qgis.PyQt.QtWebKitWidgets import QWebPage
 
@@ -58,16 +59,16 @@ def write_pdf(html: str, pdf: str | None = None) -> str:
     QTimer.singleShot(LOAD_TIMEOUT_MS, loop.quit)
     page.mainFrame().setHtml(text, QUrl.fromLocalFile(str(Path(html).resolve())))
     if not done:
-        loop.exec_()
+        loop.exec()
     if not done or not done[0]:
         raise RuntimeError(f"{html}: no PDF: the page did not load")
-    printer = QPrinter(QPrinter.HighResolution)
-    printer.setOutputFormat(QPrinter.PdfFormat)
-    printer.setPaperSize(QPrinter.A4)
+    printer = QPrinter(QPrinter.PrinterMode.HighResolution)
+    printer.setOutputFormat(QPrinter.OutputFormat.PdfFormat)
+    printer.setPageSize(QPageSize(QPageSize.PageSizeId.A4))
     part = f"{pdf}.{os.getpid()}.part"
     printer.setOutputFileName(part)
     try:
-        page.mainFrame().print_(printer)
+        page.mainFrame().print(printer)
         del printer  # closes the file
         if not Path(part).is_file() or Path(part).stat().st_size == 0:
             raise RuntimeError(f"{html}: no PDF: the printer wrote nothing")
