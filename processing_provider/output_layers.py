@@ -136,17 +136,6 @@ def run_crs(raw: dict, data: Any) -> QgsCoordinateReferenceSystem:
     return QgsCoordinateReferenceSystem()
 
 
-#: CSV outputs that carry the same points as a layer output of the same algorithm: loaded
-#: only when that layer was not asked for, so a run never adds the same points twice.
-LAYER_TWINS = {
-    "bundleadjustment": {"OUTPUT_POINTS": "OUTPUT_POINTS_LAYER"},
-    "boresightcalibration": {"RESIDUALS_CSV": "OUTPUT_RESIDUALS"},
-    "monoplot": {"OUTPUT_CSV": "OUTPUT_POINTS"},
-    "createlcps": {"POINTS_CSV": "OUTPUT_POINTS"},
-    "trajectorytoeo": {"OUTPUT_CSV": "OUTPUT"},
-}
-
-
 def load_outputs(alg, raw: dict, data: Any, context, sinks: dict | None = None) -> list[str]:
     """Register every coordinate table and point cloud among ``alg``'s file outputs to load
     when the run completes; returns the paths registered. A table whose CRS the run does not
@@ -157,8 +146,8 @@ def load_outputs(alg, raw: dict, data: Any, context, sinks: dict | None = None) 
         path = raw.get(p.name)
         if p.kind != "file_out" or not isinstance(path, str) or not Path(path).is_file():
             continue
-        if (sinks or {}).get(LAYER_TWINS.get(alg.name(), {}).get(p.name, "")):
-            continue  # its layer twin is loaded already
+        if p.layer_twin and (sinks or {}).get(p.layer_twin):
+            continue  # the run wrote its layer twin: the same rows load once
         suffix = Path(path).suffix.lower()
         name = alg.spec_tr(p.label)
         layer = None

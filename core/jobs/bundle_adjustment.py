@@ -204,7 +204,8 @@ with the file and row named.""",
             file_filter="JSON files (*.json)",
         ),
         Param(
-            "OUTPUT_POINTS", "file_out", "Object points (CSV)", optional=True, file_filter=CSV_OUT
+            "OUTPUT_POINTS", "file_out", "Object points (CSV)", optional=True,
+            file_filter=CSV_OUT, layer_twin="OUTPUT_POINTS_LAYER",
         ),
         Param("OUTPUT_POINTS_LAYER", "sink", "Object points", geometry="point", optional=True),
         Param(

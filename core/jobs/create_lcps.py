@@ -63,7 +63,7 @@ verbose mode (command line: -vv; QGIS: Processing options, logging level Verbose
         Param("OUTPUT_POINTS", "sink", "LiDAR control points", geometry="point", optional=True),
         Param("OUTPUT_LINES", "sink", "LiDAR control lines", geometry="line", optional=True),
         Param("POINTS_CSV", "file_out", "Control point table (CSV)", optional=True,
-              create_by_default=False, file_filter=CSV_OUT),
+              create_by_default=False, file_filter=CSV_OUT, layer_twin="OUTPUT_POINTS"),
         Param("LINES_CSV", "file_out", "Control line table (CSV)", optional=True,
               create_by_default=False, file_filter=CSV_OUT),
         Param("GRAPH_CSV", "file_out", "Plane adjacency graph (CSV)", optional=True,

@@ -162,7 +162,9 @@ class Param:
     reads from a folder given to a ``files`` (or ``file``) input (empty: every file), which no
     output may overwrite. ``default``, ``minimum``, ``maximum``, ``options`` and ``labels`` may
     be a :class:`Ref`, resolved by :meth:`resolved`; a default read from a dataclass field
-    keeps that field in ``source`` (see :func:`options_from`).
+    keeps that field in ``source`` (see :func:`options_from`). ``layer_twin`` names, on a table
+    output, the layer output (``sink``) that carries the same rows: QGIS loads the table as a
+    layer only when that layer was not written.
     """
 
     name: str
@@ -188,6 +190,7 @@ class Param:
     qgis_default: Any = None
     suffixes: tuple[str, ...] = ()
     source: Ref | None = None
+    layer_twin: str = ""
 
     def __post_init__(self) -> None:
         if self.kind not in INPUT_KINDS + OUTPUT_KINDS:

@@ -47,7 +47,7 @@ CSV (on the command line, printed when no file is given), and the number of imag
         *mount_params(),
         Param("OUTPUT", "sink", "Exterior orientation", geometry="point", optional=True),
         Param("OUTPUT_CSV", "file_out", "Exterior orientation table (CSV)", optional=True,
-              create_by_default=False, file_filter=CSV_OUT),
+              create_by_default=False, file_filter=CSV_OUT, layer_twin="OUTPUT"),
     ),
     results=(Result("IMAGE_COUNT", "number", "Number of images"),),
     tags=("trajectory", "ins", "gnss", "imu", "exterior orientation", "omega phi kappa"),

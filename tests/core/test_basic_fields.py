@@ -52,3 +52,14 @@ def test_the_one_method_forms_are_the_ground_filters_fields():
     leaving the all-methods form out of the count), METHOD excepted."""
     shown = {p.name for m in ("smrf", "pmf", "csf") for p in FORMS[f"groundfilter{m}"]}
     assert shown == set(SPECS["groundfilter"].names) - {"METHOD"}
+
+
+def test_a_layer_twin_names_a_layer_output_of_its_algorithm():
+    twins = 0
+    for spec in SPECS.values():
+        sinks = {p.name for p in spec.outputs if p.kind == "sink"}
+        for p in spec.params:
+            if p.layer_twin:
+                twins += 1
+                assert p.kind == "file_out" and p.layer_twin in sinks, (spec.name, p.name)
+    assert twins == 5  # bundle points, boresight residuals, monoplot, LCPs, trajectory EO
