@@ -48,6 +48,13 @@ The adjustment is :func:`core.lsq.adjustment.adjust` (Gauss-Markov/Gauss-Helmert
 Marquardt, Baarda data snooping). When a parameter is not observable, :func:`calibrate`
 raises :class:`BoresightNotObservable` whose ``diagnosis`` says which flight pattern or
 control would fix it.
+
+Timing offset (``BoresightOptions.estimate_timing``): a constant dt (s) between the recorded
+exposure time and the true one, one more calibration unknown entering the INS position priors
+(:class:`.boresight_blocks._TimedPosition`). It is separable from the lever arm only when the
+along-track velocity varies in the body frame (lines at different speeds): a single line, or
+lines flown at one speed (either direction), leave ``dt * speed`` = along-track lever arm, which
+the observability check names (the diagnosis says so).
 """
 
 
@@ -85,6 +92,7 @@ from .boresight_setup import (
     _parameters,
     _surveyed_points,
     _trajectory_llh,
+    exposure_velocity,
     group_labels,
     local_frame_for,
     transform_planes,
@@ -195,7 +203,9 @@ def calibrate(
     )
     st = _Stage(observations, kinds, used, img, par.pose_idx, r_nl, spec, local, par.names,
                 np.array(par.x0))  # fmt: skip
-    st.blocks += _ins_blocks(trajectory, grade, opts, r_nl, ins_pos, par.ins_at)
+    velocity = exposure_velocity(trajectory, ins_pos) if opts.estimate_timing else None
+    st.blocks += _ins_blocks(trajectory, grade, opts, r_nl, ins_pos, par.ins_at, par.timing_at,
+                             velocity)  # fmt: skip
     plane_by_id = {str(p.id): k for k, p in enumerate(planes)}
     p_params, p_cov, _ = transform_planes(list(planes), local)
     _tie_blocks(st, planes, plane_by_id, p_params, p_cov, opts.roof_roughness_m)

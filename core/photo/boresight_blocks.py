@@ -38,6 +38,22 @@ class _Identity:
         return x_local.copy(), np.broadcast_to(np.eye(c), (g, c, c)).copy()
 
 
+class _TimedPosition:
+    """Gauss-Markov model of the INS position at the recorded time with a timing offset:
+    ``p_ins = p - v dt`` (p the position at exposure, v (G, 3) m/s, dt s; first order)."""
+
+    def __init__(self, velocity: Array) -> None:
+        self.velocity = velocity
+
+    def __call__(self, x_local: Array) -> tuple[Array, Array]:
+        g = x_local.shape[0]
+        f = x_local[:, :3] - self.velocity * x_local[:, 3:4]
+        jac = np.zeros((g, 3, 4))
+        jac[:, :, :3] = np.eye(3)
+        jac[:, :, 3] = -self.velocity
+        return f, jac
+
+
 def _regular(cov: Array) -> Array:
     """Covariances made positive definite: a plane's (a, b, c, d) has rank 3 (unit normal), a
     line's (X0, u) rank 4 or 5; the engine factors them, so their null directions (and rounding
@@ -95,6 +111,8 @@ def _ins_blocks(
     r_nl: Array,
     ins_pos: Array,
     ins_at: int,
+    timing_at: int = -1,
+    velocity: Array | None = None,
 ) -> list[GaussMarkovBlock]:
     """The INS positions and attitudes as priors with the grade's sigmas (tiny ones unless
     ``ins_as_parameters``: then the poses are held at the INS)."""
@@ -102,12 +120,17 @@ def _ins_blocks(
     scale = 1.0 if opts.ins_as_parameters else 1e-6
     enu_i = r_nl @ NED_TO_ENU.T  # ENU at each image -> the adjustment frame
     cov_pos = enu_i @ np.diag((scale * grade.sigma_position) ** 2) @ np.swapaxes(enu_i, 1, 2)
+    pos_idx = ins_at + 6 * np.arange(n_img)[:, None] + np.arange(3)
+    model: _Identity | _TimedPosition = _Identity()
+    if timing_at >= 0 and velocity is not None:
+        pos_idx = np.hstack([pos_idx, np.full((n_img, 1), timing_at)])
+        model = _TimedPosition(velocity)
     position = GaussMarkovBlock(
         "ins position",
         ins_pos,
         0.5 * (cov_pos + np.swapaxes(cov_pos, 1, 2)),
-        ins_at + 6 * np.arange(n_img)[:, None] + np.arange(3),
-        _Identity(),
+        pos_idx,
+        model,
         labels=[f"ins[{i}] position" for i in trajectory.image_id],
         row_names=("E", "N", "U"),
     )

@@ -41,6 +41,11 @@ class BoresightOptions:
         Nominal LiDAR coordinate sigma of Eq. 17, metres.
     paper_z_neighbours : int
         LiDAR points of the plane whose mean height is the paper's z.
+    estimate_timing : bool
+        Add a constant camera timing offset dt (seconds, exposure = recorded time + dt) as an
+        unknown: the INS position prior becomes ``p_ins(t) = p(t + dt) - v(t) dt`` with v the
+        velocity from finite differences of neighbouring exposures of the same flight line
+        (:func:`.boresight_setup.exposure_velocity`). Needs >= 2 images per line.
     snooping, snooping_alpha : bool, float
         Baarda data snooping and its significance per observation.
     max_iterations : int
@@ -56,6 +61,7 @@ class BoresightOptions:
     paper_sigma: str = "eq17"
     lidar_sigma_m: float = 0.05
     paper_z_neighbours: int = 4
+    estimate_timing: bool = False
     snooping: bool = True
     snooping_alpha: float = 0.001
     max_iterations: int = 50

@@ -94,6 +94,9 @@ class BoresightResult:
     adjustment : AdjustmentResult
     local : LocalFrame
     warnings : list of str
+    timing_offset, timing_offset_std : float or None
+        Camera timing offset dt (exposure = recorded time + dt), seconds, and its a-posteriori
+        standard deviation (None when not estimated).
     """
 
     groups: tuple[str, ...]
@@ -114,6 +117,8 @@ class BoresightResult:
     adjustment: AdjustmentResult
     local: LocalFrame
     warnings: list[str] = field(default_factory=list)
+    timing_offset: float | None = None
+    timing_offset_std: float | None = None
 
     @property
     def boresight_deg(self) -> Array:
@@ -229,6 +234,8 @@ def _result(
         adjustment=res,
         local=local,
         warnings=list(res.warnings),
+        timing_offset=float(x[par.timing_at]) if par.timing_at >= 0 else None,
+        timing_offset_std=float(res.std[par.timing_at]) if par.timing_at >= 0 else None,
     )
 
 
@@ -299,6 +306,15 @@ def diagnose(parameters: Sequence[str], groups: Sequence[str] = ()) -> list[str]
                 "flying height (needs control at clearly different heights or two flying "
                 "heights), the principal point with the boresight omega/phi (both shift the "
                 "whole image); fix them from the lab calibration."
+            )
+        )
+    if "timing" in kinds:
+        out.append(
+            _t(
+                "the camera timing offset cannot be separated: on one line, or on lines flown "
+                "at one speed (in either direction), dt times the speed equals an along-track "
+                "lever arm (and, over flat ground, a pitch boresight); fly lines at clearly "
+                "different speeds, or keep the lever arm fixed, or do not estimate the timing."
             )
         )
     if "tie" in kinds:

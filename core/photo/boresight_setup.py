@@ -212,6 +212,7 @@ class _Parameters:
     interior_at: int
     ins_at: int
     pose_idx: NDArray[np.intp]  # (N, spec.size)
+    timing_at: int = -1
 
 
 def _parameters(
@@ -241,6 +242,11 @@ def _parameters(
         interior_at = len(names)
         names += ["interior.f", "interior.x0", "interior.y0"]
         x0 += [camera.focal_mm, camera.x0_mm, camera.y0_mm]
+    timing_at = -1
+    if opts.estimate_timing:
+        timing_at = len(names)
+        names += ["timing.dt"]
+        x0 += [0.0]
     n_cal = len(names)
     ins_at = len(names)
     for i in trajectory.image_id:
@@ -255,4 +261,30 @@ def _parameters(
         col += 3
     if opts.estimate_interior:
         pose_idx[:, col : col + 3] = interior_at + np.arange(3)
-    return _Parameters(names, x0, n_cal, lever_at, interior_at, ins_at, pose_idx)
+    return _Parameters(names, x0, n_cal, lever_at, interior_at, ins_at, pose_idx, timing_at)
+
+
+def exposure_velocity(trajectory: Trajectory, ins_pos: Array) -> Array:
+    """(N, 3) velocity of each exposure in the adjustment frame (ENU), m/s.
+
+    Finite differences of the neighbouring exposures of the same flight line (trajectory group
+    column; empty = one line), in time order: central inside, one-sided at the ends. Why not a
+    high-rate trajectory: the trajectory table holds the exposures only; over the few seconds
+    between exposures a straight line is flown at near constant speed, so the difference is the
+    velocity to well below what dt resolves. The attitude's rate is not differenced (random
+    attitude changes between exposures are not a rate): the dt term of the attitude is
+    neglected, which is second order for straight lines.
+    """
+    t = np.asarray(trajectory.time, dtype=np.float64)
+    vel = np.zeros_like(ins_pos)
+    lines = np.array([g if g else "" for g in trajectory.group])
+    for g in dict.fromkeys(lines.tolist()):
+        sel = np.flatnonzero(lines == g)
+        sel = sel[np.argsort(t[sel], kind="stable")]
+        if sel.size < 2 or np.any(np.diff(t[sel]) <= 0):
+            raise InputError(
+                f"estimate_timing: flight line '{g}' needs >= 2 images with distinct times "
+                "(the velocity is differenced from neighbouring exposures)"
+            )
+        vel[sel] = np.gradient(ins_pos[sel], t[sel], axis=0)
+    return vel
