@@ -1,0 +1,253 @@
+"""Automatic line observations: image edges found along projected LiDAR ridge, hip and valley
+lines (issue 32, step 3).
+
+Each LiDAR line (:class:`core.lidar.control.ControlLine`, mapping CRS) is sampled in 3D and
+projected into the image through the project's collinearity chain with the lens model
+(:class:`core.photo.picking.PickingScene`), so a curved image of a straight line under
+distortion is followed exactly; samples behind the camera or outside the frame are dropped.
+At every ``spacing_px`` along the projection, the dock's sub-pixel routine
+:func:`core.photo.line_edge.refine_edge_point` moves the sample across the line to the
+strongest edge within ``search_px`` (derived from the pose uncertainty by the caller). A
+sample is refused when the edge is weak (grey step across it below ``min_contrast``) or
+ambiguous (a second gradient peak, away from the chosen one, stronger than ``ambiguity`` of
+it). Per line, the signed offsets from the prediction are fitted by a straight function of
+the position along the line (a small pose error shifts and turns the projection); samples
+more than ``outlier_sigmas`` robust sigmas off the fit are refused and the fit's residual
+RMS is each kept point's ``sigma_px``. Lines with fewer than ``min_points`` kept points give
+nothing. Pixels follow docs/conventions.md ("Images"): (col, row), first pixel centre
+(0.5, 0.5).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.ndimage import map_coordinates
+
+from ..errors import InputError
+from ..geometry.camera import Camera
+from ..lidar.control import ControlLine
+from .line_edge import refine_edge_point
+from .observations import ImageObservations
+from .orientation import ExteriorOrientationTable
+from .picking import PickingScene
+
+__all__ = ["AutoLineOptions", "line_observations", "line_observations_block"]
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class AutoLineOptions:
+    """Parameters of :func:`line_observations` (pixels unless said).
+
+    spacing_px: distance between samples along a projected line.
+    search_px: half width of the search across the line (>= the projection's uncertainty
+        from the pose's, e.g. 3 sigma).
+    along_px: half length of the stretch of edge averaged per sample.
+    min_contrast: smallest grey step across an accepted edge (grey units of the image).
+    ambiguity: a second gradient peak above this fraction of the first refuses the sample.
+    min_points: fewest accepted samples a line must keep.
+    margin_px: samples nearer the frame border than this are dropped.
+    outlier_sigmas: refusal threshold on the per-line fit's robust residual sigma.
+    min_sigma_px: floor of the reported sigma (the fit's RMS can be tiny on few points).
+    """
+
+    spacing_px: float = 4.0
+    search_px: float = 4.0
+    along_px: float = 2.0
+    min_contrast: float = 4.0
+    ambiguity: float = 0.6
+    min_points: int = 5
+    margin_px: float = 2.0
+    outlier_sigmas: float = 3.0
+    min_sigma_px: float = 0.05
+
+    def __post_init__(self) -> None:
+        for name in ("spacing_px", "search_px", "min_sigma_px", "outlier_sigmas"):
+            if not float(getattr(self, name)) > 0:
+                raise InputError(f"{name} must be > 0, got {getattr(self, name)!r}")
+        for name in ("along_px", "min_contrast", "margin_px"):
+            if not float(getattr(self, name)) >= 0:
+                raise InputError(f"{name} must be >= 0, got {getattr(self, name)!r}")
+        if not 0 < float(self.ambiguity) <= 1:
+            raise InputError(f"ambiguity must be in (0, 1], got {self.ambiguity!r}")
+        if int(self.min_points) < 3:
+            raise InputError(f"min_points must be >= 3, got {self.min_points!r}")
+
+
+def _grey(image: ArrayLike) -> Array:
+    a = np.asarray(image, dtype=np.float64)
+    if a.ndim == 3:  # RGB(A): luminance of the first three bands
+        a = a[..., :3] @ np.array([0.299, 0.587, 0.114])
+    if a.ndim != 2:
+        raise InputError(f"image must be (H, W) or (H, W, 3), got shape {a.shape}")
+    return a
+
+
+def _samples(
+    scene: PickingScene, image_id: str, line: ControlLine, camera: Camera, opt: AutoLineOptions
+) -> tuple[Array, Array, Array]:
+    """(pixels (K, 2), unit directions (K, 2), along-line parameter (K,) in 0..1) of the
+    in-frame samples of one line, ``spacing_px`` apart in the image (approximately)."""
+    a, b = np.asarray(line.start, float), np.asarray(line.end, float)
+    coarse = scene.project(image_id, a + np.linspace(0, 1, 9)[:, None] * (b - a))
+    ok = np.isfinite(coarse).all(axis=1)
+    if ok.sum() < 2:
+        return np.empty((0, 2)), np.empty((0, 2)), np.empty(0)
+    span = np.nansum(np.linalg.norm(np.diff(coarse[ok], axis=0), axis=1))
+    n = int(np.clip(np.ceil(span / opt.spacing_px), 2, 100000))
+    t = (np.arange(n) + 0.5) / n
+    eps = 0.5 / n
+    pts = scene.project(image_id, a + np.concatenate([t, t - eps, t + eps])[:, None] * (b - a))
+    px, lo, hi = pts[:n], pts[n : 2 * n], pts[2 * n :]
+    d = hi - lo
+    norm = np.linalg.norm(d, axis=1)
+    good = np.isfinite(px).all(axis=1) & np.isfinite(norm) & (norm > 0)
+    good[good] &= camera.in_frame(px[good], opt.margin_px + opt.search_px + opt.along_px)
+    return px[good], d[good] / norm[good, None], t[good]
+
+
+def _edge_checks(
+    grey: Array, pix: Array, refined: Array, dirs: Array, opt: AutoLineOptions
+) -> NDArray[np.bool_]:
+    """Contrast and uniqueness of the edge at each refined point (vectorised profiles)."""
+    normal = np.column_stack([-dirs[:, 1], dirs[:, 0]])
+    step = 0.25
+    t = np.arange(-opt.search_px, opt.search_px + step / 2, step)
+    s = np.arange(-opt.along_px, opt.along_px + 0.5, 1.0)
+    pts = (pix[:, None, None] + s[None, :, None, None] * dirs[:, None, None]
+           + t[None, None, :, None] * normal[:, None, None])  # fmt: skip
+    idx = pts - 0.5
+    g = map_coordinates(grey, [idx[..., 1].ravel(), idx[..., 0].ravel()], order=1, mode="nearest")
+    prof = g.reshape(pts.shape[:3]).mean(axis=1)  # (K, T)
+    grad = np.abs(np.gradient(prof, step, axis=1))
+    # the refined point's position on the profile
+    off = np.einsum("ij,ij->i", refined - pix, normal)
+    k = np.clip(np.rint((off + opt.search_px) / step).astype(int), 0, len(t) - 1)
+    # grey step: 1.5 px either side of the edge (past a 1 px blur)
+    side = np.rint(1.5 / step).astype(int)
+    lo = np.clip(k - side, 0, len(t) - 1)
+    hi = np.clip(k + side, 0, len(t) - 1)
+    rows = np.arange(len(k))
+    contrast = np.abs(prof[rows, hi] - prof[rows, lo])
+    # a second peak: the largest gradient more than 2 px from the chosen edge
+    far = np.abs(t[None, :] - off[:, None]) > 2.0
+    peak = grad[rows[:, None], np.clip(k[:, None] + np.arange(-2, 3), 0, len(t) - 1)].max(axis=1)
+    second = np.where(far, grad, 0.0).max(axis=1)
+    return (contrast >= opt.min_contrast) & (second <= opt.ambiguity * peak)
+
+
+def _fit_line(t: Array, off: Array, opt: AutoLineOptions) -> tuple[NDArray[np.bool_], float]:
+    """Keep mask and residual RMS (px) of the offsets fitted by ``c0 + c1 t``."""
+    keep = np.ones(t.size, bool)
+    rms = 0.0
+    for _ in range(5):  # refit until no sample leaves
+        if keep.sum() < max(3, opt.min_points):
+            return np.zeros(t.size, bool), 0.0
+        coef = np.polyfit(t[keep], off[keep], 1)
+        res = off - np.polyval(coef, t)
+        mad = 1.4826 * np.median(np.abs(res[keep]))
+        rms = float(np.sqrt(np.sum(res[keep] ** 2) / max(keep.sum() - 2, 1)))
+        new = np.abs(res) <= opt.outlier_sigmas * max(mad, opt.min_sigma_px)
+        if (new == keep).all():
+            break
+        keep = new
+    return keep, rms
+
+
+def line_observations(
+    image: ArrayLike,
+    image_id: str,
+    camera: Camera,
+    eo: ExteriorOrientationTable,
+    lines: Sequence[ControlLine],
+    options: AutoLineOptions | None = None,
+    *,
+    scene: PickingScene | None = None,
+) -> ImageObservations:
+    """Line observations of one image (module docstring).
+
+    Parameters
+    ----------
+    image : (H, W) or (H, W, 3) array_like
+        Grey or RGB values of the whole image (the camera's size).
+    image_id : str
+        The image's row in ``eo``.
+    camera : Camera
+    eo : ExteriorOrientationTable
+        Exterior orientation (mapping CRS) holding ``image_id``: the current estimate.
+    lines : sequence of ControlLine
+        LiDAR lines, mapping CRS (:mod:`core.lidar.control`).
+    options : AutoLineOptions, optional
+    scene : PickingScene, optional
+        The projection chain, when the caller has built it for the block (else built here).
+
+    Returns
+    -------
+    ImageObservations
+        Rows of type ``line``, ``target_id`` the line id, ``point_id``
+        ``"<image_id>:L<line id>:<k>"``, pixels (col, row), ``sigma_px`` from the per-line fit.
+    """
+    opt = options or AutoLineOptions()
+    grey = _grey(image)
+    if grey.shape != (camera.height_px, camera.width_px):
+        raise InputError(
+            f"image '{image_id}' is {grey.shape[1]} x {grey.shape[0]} px, the camera "
+            f"'{camera.name}' {camera.width_px} x {camera.height_px}"
+        )
+    sc = scene or PickingScene(eo, camera)
+    cols: dict[str, list] = {"pid": [], "tid": [], "px": [], "sig": []}
+    for line in lines:
+        pix, dirs, t = _samples(sc, image_id, line, camera, opt)
+        if len(pix) < opt.min_points:
+            continue
+        found = [refine_edge_point(grey, (0, 0), p, d, opt.search_px, opt.along_px)
+                 for p, d in zip(pix, dirs)]  # fmt: skip
+        hit = np.array([f is not None for f in found], bool)
+        if hit.sum() < opt.min_points:
+            continue
+        refined = np.array([f for f in found if f is not None])
+        pix, dirs, t = pix[hit], dirs[hit], t[hit]
+        ok = _edge_checks(grey, pix, refined, dirs, opt)
+        normal = np.column_stack([-dirs[:, 1], dirs[:, 0]])
+        off = np.einsum("ij,ij->i", refined - pix, normal)
+        ok &= np.abs(off) < opt.search_px
+        if ok.sum() < opt.min_points:
+            continue
+        keep, rms = _fit_line(t[ok], off[ok], opt)
+        if keep.sum() < opt.min_points:
+            continue
+        good = refined[ok][keep]
+        for k, p in enumerate(good):
+            cols["pid"].append(f"{image_id}:L{line.id}:{k}")
+            cols["tid"].append(str(line.id))
+            cols["px"].append(p)
+        cols["sig"].extend([max(rms, opt.min_sigma_px)] * len(good))
+    n = len(cols["pid"])
+    return ImageObservations.from_arrays(
+        [image_id] * n, cols["pid"], np.reshape(cols["px"], (n, 2)), np.asarray(cols["sig"]),
+        ["line"] * n, cols["tid"],
+    )  # fmt: skip
+
+
+def line_observations_block(
+    images: Sequence[tuple[str, ArrayLike]],
+    camera: Camera,
+    eo: ExteriorOrientationTable,
+    lines: Sequence[ControlLine],
+    options: AutoLineOptions | None = None,
+) -> ImageObservations:
+    """:func:`line_observations` of many images ((image_id, array) pairs, e.g. a generator
+    reading them one at a time), with one projection chain for the block; rows concatenated."""
+    scene = PickingScene(eo, camera)
+    out = ImageObservations.from_arrays([], [], np.empty((0, 2)), [], [], [])
+    for image_id, image in images:
+        if not scene.has_image(image_id):
+            raise InputError(f"image '{image_id}' has no exterior orientation")
+        out = out.concat(line_observations(image, image_id, camera, eo, lines, options,
+                                           scene=scene))  # fmt: skip
+    return out

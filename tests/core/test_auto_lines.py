@@ -1,0 +1,77 @@
+"""Automatic line observations (core.photo.auto_lines) on images rendered with the project's
+renderer, whose ridges and hips are the projections of the LiDAR lines to a fraction of a px."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from lidarphoto.core.geometry.camera import camera_from_dict
+from lidarphoto.core.geometry.frames import MappingFrame
+from lidarphoto.core.geometry.surface import Dsm
+from lidarphoto.core.lidar.dsm import dsm_from_points
+from lidarphoto.core.photo.auto_lines import AutoLineOptions, line_observations
+from lidarphoto.core.photo.orientation import ExteriorOrientationTable
+from lidarphoto.core.photo.picking import PickingScene
+from lidarphoto.core.simulation.render import render_image
+from lidarphoto.core.simulation.render_scene import RenderOptions, RenderScene
+from test_render import CRS, X0, Y0, _hip_house
+
+
+def _table(xyz, opk_deg):
+    return ExteriorOrientationTable(("img",), np.array([0.0]), ("",), np.array([xyz], float),
+                                    np.radians([opk_deg]), CRS)  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def house():
+    rng = np.random.default_rng(3)
+    centre = (X0 + 20.0, Y0 + 20.0)
+    pts, cls, pid, planes, lines, _ = _hip_house(rng, centre)
+    heights, grid = dsm_from_points(pts[:, 0], pts[:, 1], pts[:, 2], 0.5)
+    dsm = Dsm(heights, grid, MappingFrame.from_user_input(CRS).crs)
+    scene = RenderScene.build(dsm, pts, cls, pid, planes, lines, crs=CRS)
+    cam = camera_from_dict({"name": "k1", "focal_mm": 35.0, "pixel_size_mm": 0.0045,
+                            "width_px": 1600, "height_px": 1200,
+                            "distortion": {"model": "brown_conrady", "k1": 8e-5}})  # fmt: skip
+    table = _table([centre[0] + 4.0, centre[1] - 3.0, 120.0], [1.5, -2.5, 35.0])
+    img = render_image(scene, cam, table.xyz[0], table.opk[0], RenderOptions(step_px=4))
+    return cam, table, img, lines
+
+
+def _distance_to_truth(obs, table, cam, lines):
+    """Perpendicular distance (px) of each observation from its line's TRUE projection."""
+    sc = PickingScene(table, cam)
+    by_id = {str(ln.id): ln for ln in lines}
+    out = []
+    for tid, p in zip(obs.target_id, obs.pixels):
+        ln = by_id[tid]
+        t = np.linspace(0, 1, 2001)[:, None]
+        proj = sc.project("img", ln.start + t * (ln.end - ln.start))
+        out.append(np.min(np.linalg.norm(proj - p, axis=1)))
+    return np.array(out)
+
+
+def test_exact_orientation_points_on_the_projected_lines(house):
+    cam, table, img, lines = house
+    obs = line_observations(img.rgb, "img", cam, table, lines)
+    assert set(obs.type) == {"line"} and len(set(obs.point_id)) == len(obs)
+    assert set(obs.target_id) == {str(ln.id) for ln in lines}
+    d = _distance_to_truth(obs, table, cam, lines)
+    assert len(obs) >= 50
+    assert np.median(d) < 0.25, np.median(d)
+    assert np.percentile(d, 95) < 3 * np.median(obs.sigma_px) + 0.25
+
+
+def test_perturbed_orientation_still_finds_the_true_edges(house):
+    cam, table, img, lines = house
+    wrong = _table(table.xyz[0], np.degrees(table.opk[0]) + [0.3, -0.3, 0.2])
+    obs = line_observations(img.rgb, "img", cam, wrong, lines, AutoLineOptions(search_px=8.0))
+    assert len(obs) >= 30
+    d = _distance_to_truth(obs, table, cam, lines)  # distance to the TRUE projection
+    assert np.median(d) < 0.5, np.median(d)
+
+
+def test_absent_line_gives_nothing(house):
+    cam, table, img, lines = house
+    flat = np.full(img.rgb.shape[:2], 100.0)  # no edge anywhere
+    assert len(line_observations(flat, "img", cam, table, lines)) == 0
