@@ -55,6 +55,7 @@ __all__ = [
     "ForwardDistortionModel",
     "OpenCVFisheyeLens",
     "OpenCVFullLens",
+    "MetashapeLens",
     "OpenCVLens",
     "ThinPrismFisheyeLens",
     "opencv_coefficients",
@@ -355,6 +356,60 @@ class ThinPrismFisheyeLens(_NormalisedLens):
         return xd, yd, j, dp
 
 
+@register_model
+class MetashapeLens(_NormalisedLens):
+    """Agisoft Metashape's frame / fisheye model, forward (Metashape Professional manual,
+    appendix "Camera models"); with the ``equidistant`` projection for its fisheye.
+
+    On the normalised ideal coordinates ``(a, b)`` (y down; the fisheye's have length theta),
+    ``r2 = a^2 + b^2`` and ``c = 1 + k1 r2 + k2 r2^2 + k3 r2^3 + k4 r2^4``::
+
+        x' = a c + p1 (r2 + 2 a^2) + 2 p2 a b      (p1, p2 swapped w.r.t. OpenCV)
+        y' = b c + p2 (r2 + 2 b^2) + 2 p1 a b
+        u - w/2 - cx = x' (f + b1) + y' b2,   v - h/2 - cy = y' f   (px)
+
+    b1 (affinity) and b2 (non-orthogonality) are Metashape's pixels; the constant
+    ``focal_px`` is f (px) when the model was made, ``scale_mm`` the same f in mm, so the
+    measured point is ``(s (x' (1 + b1/F) + y' b2/F), -s y')`` mm (``aspect`` stays 1).
+
+    >>> lens = MetashapeLens(p1=0.01, scale_mm=10.0, aspect=1.0, focal_px=2000.0)
+    >>> (lens.distort([[5.0, 0.0]]).round(12) + 0.0).tolist()   # x: 5 + 10 * 0.01 * 0.75
+    [[5.075, 0.0]]
+    """
+
+    model: ClassVar[str] = "metashape"
+    param_names: ClassVar[Tuple[str, ...]] = ("k1", "k2", "k3", "k4", "p1", "p2", "b1", "b2")
+    constant_names: ClassVar[Tuple[str, ...]] = ("scale_mm", "aspect", "focal_px")
+
+    def _distort_normalised(self, a: Array, b: Array) -> Tuple[Array, Array, Array, Array]:
+        k1, k2, k3, k4, p1, p2, b1, b2 = self._params.tolist()
+        big_f = self._constants["focal_px"]
+        r2 = a * a + b * b
+        c = 1.0 + r2 * (k1 + r2 * (k2 + r2 * (k3 + r2 * k4)))
+        dc = k1 + r2 * (2.0 * k2 + r2 * (3.0 * k3 + 4.0 * k4 * r2))  # d c / d r2
+        xp = a * c + p1 * (r2 + 2.0 * a * a) + 2.0 * p2 * a * b
+        yp = b * c + p2 * (r2 + 2.0 * b * b) + 2.0 * p1 * a * b
+        jb = np.empty((a.shape[0], 2, 2))  # d(x', y') / d(a, b)
+        jb[:, 0, 0] = c + 2.0 * a * a * dc + 6.0 * p1 * a + 2.0 * p2 * b
+        jb[:, 0, 1] = 2.0 * a * b * dc + 2.0 * p1 * b + 2.0 * p2 * a
+        jb[:, 1, 0] = 2.0 * a * b * dc + 2.0 * p2 * a + 2.0 * p1 * b
+        jb[:, 1, 1] = c + 2.0 * b * b * dc + 6.0 * p2 * b + 2.0 * p1 * a
+        dp = np.zeros((a.shape[0], 2, 8))
+        for col in range(4):
+            rn = r2 ** (col + 1)
+            dp[:, 0, col], dp[:, 1, col] = a * rn, b * rn
+        dp[:, 0, 4], dp[:, 1, 4] = r2 + 2.0 * a * a, 2.0 * a * b
+        dp[:, 0, 5], dp[:, 1, 5] = 2.0 * a * b, r2 + 2.0 * b * b
+        # the affine part: x_d = (1 + b1/F) x' + (b2/F) y', y_d = y' (y down, in units of s)
+        ex, ey = 1.0 + b1 / big_f, b2 / big_f
+        xd = ex * xp + ey * yp
+        j = jb.copy()
+        j[:, 0, :] = ex * jb[:, 0, :] + ey * jb[:, 1, :]
+        dp[:, 0, :6] = ex * dp[:, 0, :6] + ey * dp[:, 1, :6]
+        dp[:, 0, 6], dp[:, 0, 7] = xp / big_f, yp / big_f
+        return xd, yp, j, dp
+
+
 def opencv_coefficients(lens: DistortionModel, focal_mm: float) -> dict[str, float]:
     """The lens's coefficients normalised by ``focal_mm`` (OpenCV's and COLMAP's), exactly.
 
@@ -362,7 +417,7 @@ def opencv_coefficients(lens: DistortionModel, focal_mm: float) -> dict[str, flo
     ``k_n (f/s)^(2n)`` (radial, also the fisheye's and the rational denominator's) and
     ``p (f/s)`` (tangential).
     """
-    if not isinstance(lens, _NormalisedLens):
+    if not isinstance(lens, _NormalisedLens) or isinstance(lens, MetashapeLens):
         raise TypeError(f"{lens.model} is not an OpenCV forward model")
     ratio = focal_mm / lens.constants["scale_mm"]
     power = {"k1": 2, "k2": 4, "k3": 6, "k4": 2, "k5": 4, "k6": 6, "p1": 1, "p2": 1}

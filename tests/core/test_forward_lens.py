@@ -7,6 +7,7 @@ import pytest
 from lidarphoto.core.geometry.camera import Camera, camera_from_dict
 from lidarphoto.core.geometry.distortion import DISTORTION_MODELS, distortion_from_dict
 from lidarphoto.core.geometry.forward_lens import (
+    MetashapeLens,
     OpenCVFisheyeLens,
     OpenCVFullLens,
     OpenCVLens,
@@ -28,6 +29,8 @@ LENSES = {
     "thin_prism_fisheye": ThinPrismFisheyeLens(k1=0.03, k2=-0.01, p1=6e-4, p2=-4e-4, k3=0.002,
                                                k4=-3e-4, sx1=5e-4, sy1=-3e-4, scale_mm=F_MM,
                                                aspect=1.003),
+    "metashape": MetashapeLens(k1=-0.2, k2=0.06, k3=-0.01, k4=0.002, p1=-8e-4, p2=1.2e-3,
+                               b1=0.8, b2=-0.3, scale_mm=F_MM, aspect=1.0, focal_px=1000.0),
 }  # fmt: skip
 
 
