@@ -1260,6 +1260,10 @@
             <translation>a orientação interior não é separável: a distância focal se confunde com a altura de voo (requer controle em alturas claramente diferentes ou duas alturas de voo), o ponto principal com omega/phi do boresight (ambos deslocam a imagem inteira); fixe-os pela calibração de laboratório.</translation>
         </message>
         <message>
+            <source>the camera timing offset cannot be separated: on one line, or on lines flown at one speed (in either direction), dt times the speed equals an along-track lever arm (and, over flat ground, a pitch boresight); fly lines at clearly different speeds, or keep the lever arm fixed, or do not estimate the timing.</source>
+            <translation>o atraso de disparo da câmera não pode ser separado: em uma faixa, ou em faixas voadas a uma mesma velocidade (em qualquer sentido), dt vezes a velocidade equivale a um braço de alavanca ao longo da trajetória (e, sobre terreno plano, a um boresight em arfagem); voe faixas a velocidades claramente diferentes, ou mantenha o braço de alavanca fixo, ou não estime o atraso.</translation>
+        </message>
+        <message>
             <source>some tie points are not determined: measure each in at least two images, on a plane that is not seen edge-on.</source>
             <translation>alguns pontos de enlace não são determinados: meça cada um em pelo menos duas imagens, em um plano que não seja visto de perfil.</translation>
         </message>

