@@ -5,36 +5,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from lidarphoto.core.geometry.camera import camera_from_dict
-from lidarphoto.core.geometry.frames import MappingFrame
-from lidarphoto.core.geometry.surface import Dsm
-from lidarphoto.core.lidar.dsm import dsm_from_points
 from lidarphoto.core.photo.auto_lines import AutoLineOptions, line_observations
-from lidarphoto.core.photo.orientation import ExteriorOrientationTable
 from lidarphoto.core.photo.picking import PickingScene
-from lidarphoto.core.simulation.render import render_image
-from lidarphoto.core.simulation.render_scene import RenderOptions, RenderScene
-from test_render import CRS, X0, Y0, _hip_house
-
-
-def _table(xyz, opk_deg):
-    return ExteriorOrientationTable(("img",), np.array([0.0]), ("",), np.array([xyz], float),
-                                    np.radians([opk_deg]), CRS)  # fmt: skip
+from test_render import _table, hip  # noqa: F401  (hip: the rendered hip-roof fixture)
 
 
 @pytest.fixture(scope="module")
-def house():
-    rng = np.random.default_rng(3)
-    centre = (X0 + 20.0, Y0 + 20.0)
-    pts, cls, pid, planes, lines, _ = _hip_house(rng, centre)
-    heights, grid = dsm_from_points(pts[:, 0], pts[:, 1], pts[:, 2], 0.5)
-    dsm = Dsm(heights, grid, MappingFrame.from_user_input(CRS).crs)
-    scene = RenderScene.build(dsm, pts, cls, pid, planes, lines, crs=CRS)
-    cam = camera_from_dict({"name": "k1", "focal_mm": 35.0, "pixel_size_mm": 0.0045,
-                            "width_px": 1600, "height_px": 1200,
-                            "distortion": {"model": "brown_conrady", "k1": 8e-5}})  # fmt: skip
-    table = _table([centre[0] + 4.0, centre[1] - 3.0, 120.0], [1.5, -2.5, 35.0])
-    img = render_image(scene, cam, table.xyz[0], table.opk[0], RenderOptions(step_px=4))
+def house(hip):  # noqa: F811
+    """The rendered hip roof of test_render: camera, EO, image, LiDAR lines."""
+    _, cam, table, img, _, lines, _ = hip
     return cam, table, img, lines
 
 
