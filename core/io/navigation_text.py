@@ -31,7 +31,7 @@ import numpy as np
 from ..errors import InputError
 from ..photo.navigation import NavSolution
 from .tables import Table, find_column, float_column, read_table
-from .trajectory import HEIGHT_RANGE_M, MAX_TIME_S
+from .trajectory import HEIGHT_RANGE_M, MAX_TIME_S, velocity_columns
 
 _TIME = ("time", "gps_time", "gpstime", "sow", "gps_sow", "t", "time_sow")
 _LAT, _LON = ("latitude", "lat"), ("longitude", "lon", "long")
@@ -40,9 +40,6 @@ _HEIGHT = ("height", "h_ell", "hell", "ellipsoid_height", "ellipsoidal_height", 
            "alt", "altitude", "z")  # fmt: skip
 _ROLL, _PITCH = ("roll",), ("pitch",)
 _HEADING = ("heading", "yaw", "true_heading", "azimuth")
-_VN, _VE = ("v_north", "vnorth", "vn", "north_vel", "vel_north"), (
-    "v_east", "veast", "ve", "east_vel", "vel_east")  # fmt: skip
-_VU, _VD = ("v_up", "vup", "vu", "up_vel", "vel_up"), ("v_down", "vdown", "vd", "down_vel")
 _WANDER = ("wander", "wander_angle")
 _UNIT = re.compile(r"^(.*?)\s*[(\[]([^)\]]*)[)\]]\s*$")
 
@@ -171,24 +168,8 @@ def _solution(table: Table, units: tuple[str, ...]) -> NavSolution:
         rph[:, 2] -= float_column(table, w_col) * _angle_factor(units, w_col)
     for col, values, limit in zip(cols, rph.T, (np.pi, np.pi / 2, 4 * np.pi)):
         _check_abs(table, col, values, limit, "radians (degrees expected unless the unit is rad)")
-    return NavSolution(time, pos, lat_col is not None, rph, _velocity(table), table.path,
+    return NavSolution(time, pos, lat_col is not None, rph, velocity_columns(table), table.path,
                        "row", np.asarray(table.line_numbers))  # fmt: skip
-
-
-def _velocity(table: Table) -> np.ndarray | None:
-    vn, ve = (find_column(table, names, required=False) for names in (_VN, _VE))
-    vu, vd = (find_column(table, names, required=False) for names in (_VU, _VD))
-    if vn is None and ve is None and vu is None and vd is None:
-        return None
-    if vn is None or ve is None or (vu is None and vd is None):
-        raise InputError("give all three velocity columns (v_north, v_east and v_up or v_down) "
-                         "or none", path=table.path)  # fmt: skip
-    if vu is not None:
-        down = -float_column(table, vu)
-    else:
-        assert vd is not None  # refused above
-        down = float_column(table, vd)
-    return np.stack([float_column(table, vn), float_column(table, ve), down], axis=1)
 
 
 def _check_abs(table: Table, col: int, values, limit: float, unit: str) -> None:

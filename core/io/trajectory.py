@@ -10,6 +10,11 @@ CSV with a header row (names are case-insensitive, aliases in parentheses)::
     latitude (lat), longitude (lon, long), height (h, z, alt)   degrees on the CRS's datum
     roll, pitch, heading (yaw)             degrees; body x forward, y right, z down;
                                            heading clockwise from true north
+    v_north (vnorth, vn, north_vel, vel_north), v_east (veast, ve, east_vel, vel_east) and
+    v_up (vup, vu, up_vel, vel_up) or v_down (vdown, vd, down_vel)
+                                           optional, all three or none: velocity at the
+                                           exposure, m/s, local level at the image (true
+                                           north); the boresight's timing offset uses it
 
 Values outside their physical range are refused with the row: a time beyond
 :data:`MAX_TIME_S` (another unit, or garbage), a time earlier than the row before it in the
@@ -28,6 +33,7 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from ..photo.georeference import Trajectory
 from .tables import (
+    Table,
     find_column,
     float_column,
     read_table,
@@ -42,6 +48,11 @@ MAX_TIME_S = 1e10
 #: Plausible heights of a sensor (m): below the Dead Sea's shore with the geoid's
 #: undulation, above any survey aircraft.
 HEIGHT_RANGE_M = (-1000.0, 30000.0)
+_VN = ("v_north", "vnorth", "vn", "north_vel", "vel_north")
+_VE = ("v_east", "veast", "ve", "east_vel", "vel_east")
+_VU, _VD = ("v_up", "vup", "vu", "up_vel", "vel_up"), ("v_down", "vdown", "vd", "down_vel")
+#: Largest plausible |velocity| of a sensor, m/s (a jet at Mach 1; beyond it another unit).
+MAX_SPEED_MPS = 340.0
 
 
 def read_trajectory_csv(path: Union[str, Path]) -> Trajectory:
@@ -78,7 +89,35 @@ def read_trajectory_csv(path: Union[str, Path]) -> Trajectory:
     _check_range(table, cols[0], rph_deg[:, 0], 180.0)
     _check_range(table, cols[1], rph_deg[:, 1], 90.0)
     _check_range(table, cols[2], rph_deg[:, 2], 360.0)
-    return Trajectory(ids, time, group, position, lat_col is not None, np.radians(rph_deg))
+    vel = velocity_columns(table)
+    return Trajectory(ids, time, group, position, lat_col is not None, np.radians(rph_deg), vel)
+
+
+def velocity_columns(table: Table) -> Array | None:
+    """North, east, down velocities (N, 3) m/s from the v_north, v_east and v_up or v_down
+    columns (aliases in the module docstring), or None without any; some but not all, or a
+    speed beyond :data:`MAX_SPEED_MPS`, is refused with the row."""
+    vn, ve = (find_column(table, names, required=False) for names in (_VN, _VE))
+    vu, vd = (find_column(table, names, required=False) for names in (_VU, _VD))
+    if vn is None and ve is None and vu is None and vd is None:
+        return None
+    if vn is None or ve is None or (vu is None and vd is None):
+        raise InputError("give all three velocity columns (v_north, v_east and v_up or v_down) "
+                         "or none", path=table.path)  # fmt: skip
+    if vu is not None:
+        down = -float_column(table, vu)
+    else:
+        assert vd is not None  # refused above
+        down = float_column(table, vd)
+    vel = np.stack([float_column(table, vn), float_column(table, ve), down], axis=1)
+    fast = np.flatnonzero(np.linalg.norm(vel, axis=1) > MAX_SPEED_MPS)
+    if fast.size:
+        raise InputError(
+            f"a speed of {np.linalg.norm(vel[fast[0]]):.4g} m/s is beyond the plausible "
+            f"{MAX_SPEED_MPS:g} m/s of a sensor (velocities in another unit?)",
+            path=table.path, row=table.line_numbers[fast[0]], column=table.columns[vn],
+        )  # fmt: skip
+    return vel
 
 
 def _check_range(table, column: int, values: Array, limit: float) -> None:
@@ -130,22 +169,40 @@ def _check_heights(table, column: int, height: Array) -> None:
 
 
 TRAJECTORY_COLUMNS = (
-    "image_id", "time", "group", "easting", "northing", "height", "roll", "pitch", "heading",
+    "image_id",
+    "time",
+    "group",
+    "easting",
+    "northing",
+    "height",
+    "roll",
+    "pitch",
+    "heading",
 )
 
 
+#: The velocity columns written when the trajectory has velocities (m/s, up positive).
+VELOCITY_COLUMNS = ("v_north", "v_east", "v_up")
+
+
 def write_trajectory_csv(path: Union[str, Path], trajectory: Trajectory) -> None:
-    """Write a projected trajectory (easting, northing, height; angles in degrees), atomically;
-    numbers with full round-trip precision."""
+    """Write a projected trajectory (easting, northing, height; angles in degrees; the
+    velocities as v_north, v_east, v_up when it has them), atomically; numbers with full
+    round-trip precision."""
     if trajectory.geodetic:
         raise InputError("only a trajectory in map coordinates can be written")
     deg = np.degrees(trajectory.rph)
     t = trajectory
+    columns = TRAJECTORY_COLUMNS
+    extra: Array = np.empty((len(t), 0))
+    if t.velocity_ned is not None:
+        columns = (*columns, *VELOCITY_COLUMNS)
+        extra = np.asarray(t.velocity_ned, dtype=np.float64) * [1.0, 1.0, -1.0]
     write_csv_atomic(
         path,
-        TRAJECTORY_COLUMNS,
+        columns,
         [
-            (i, repr(float(tt)), g, *(repr(float(v)) for v in p), *(repr(float(v)) for v in a))
-            for i, tt, g, p, a in zip(t.image_id, t.time, t.group, t.position, deg)
+            (i, repr(float(tt)), g, *(repr(float(v)) for v in (*p, *a, *e)))
+            for i, tt, g, p, a, e in zip(t.image_id, t.time, t.group, t.position, deg, extra)
         ],
     )

@@ -54,11 +54,13 @@ exposure time and the true one, one more calibration unknown entering the INS po
 (:class:`.boresight_blocks._TimedPosition`). It is separable from the lever arm only when the
 along-track velocity varies in the body frame (lines at different speeds): a single line, or
 lines flown at one speed (either direction), leave ``dt * speed`` = along-track lever arm. The
-diagnosis explains it when the observability check finds that null space; with attitude noise
-the trade-off is only nearly singular and is not yet caught (tests/core/test_timing_offset.py
-holds that gap as a strict xfail).
+set-up is refused before the adjustment when the lever arm is estimated with dt and the
+body-frame velocity varies by less than :data:`.boresight_result.TIMING_SEPARABILITY_MIN` of
+the speed (:func:`.boresight_setup.timing_separability`): attitude noise makes that trade-off
+only nearly singular, below what the observability check's condition limit catches. The
+velocity is the trajectory's own (``Trajectory.velocity_ned``) when it has one, else
+differenced from neighbouring exposures.
 """
-
 
 from __future__ import annotations
 
@@ -71,6 +73,7 @@ from numpy.typing import NDArray
 from ..errors import InputError, NotObservableError
 from ..geometry.camera import Camera
 from ..geometry.frames import MappingFrame
+from ..geometry.rotations import rph_to_matrix
 from ..lsq.adjustment import adjust
 from ..lsq.model import AdjustmentOptions
 from .boresight_blocks import (
@@ -84,7 +87,13 @@ from .boresight_blocks import (
 from .boresight_models import (
     PoseSpec,
 )
-from .boresight_result import BoresightNotObservable, BoresightResult, _result, diagnose
+from .boresight_result import (
+    BoresightNotObservable,
+    BoresightResult,
+    _result,
+    diagnose,
+    require_timing_separable,
+)
 from .boresight_setup import (
     BoresightOptions,
     SurveyedPoints,
@@ -97,6 +106,7 @@ from .boresight_setup import (
     exposure_velocity,
     group_labels,
     local_frame_for,
+    timing_separability,
     transform_planes,
 )
 from .georeference import Trajectory
@@ -205,7 +215,12 @@ def calibrate(
     )
     st = _Stage(observations, kinds, used, img, par.pose_idx, r_nl, spec, local, par.names,
                 np.array(par.x0))  # fmt: skip
-    velocity = exposure_velocity(trajectory, ins_pos) if opts.estimate_timing else None
+    velocity = None
+    if opts.estimate_timing:
+        velocity = exposure_velocity(trajectory, ins_pos, r_nl)
+        if opts.estimate_lever_arm:
+            r_bl = r_nl @ rph_to_matrix(*trajectory.rph.T)
+            require_timing_separable(*timing_separability(velocity, r_bl))
     st.blocks += _ins_blocks(trajectory, grade, opts, r_nl, ins_pos, par.ins_at, par.timing_at,
                              velocity)  # fmt: skip
     plane_by_id = {str(p.id): k for k, p in enumerate(planes)}
@@ -219,8 +234,21 @@ def calibrate(
     if paper_rows.size:
         st.blocks.append(
             _paper_block(
-                paper_rows, observations, img, par.pose_idx, r_nl, spec, planes, plane_by_id,
-                p_params, p_cov, local, lidar_points, lidar_plane_ids, opts, st.x_init,
+                paper_rows,
+                observations,
+                img,
+                par.pose_idx,
+                r_nl,
+                spec,
+                planes,
+                plane_by_id,
+                p_params,
+                p_cov,
+                local,
+                lidar_points,
+                lidar_plane_ids,
+                opts,
+                st.x_init,
             )
         )
         st.maps.append(("paper planes", paper_rows[:, None], "paper"))

@@ -44,8 +44,11 @@ class BoresightOptions:
     estimate_timing : bool
         Add a constant camera timing offset dt (seconds, exposure = recorded time + dt) as an
         unknown: the INS position prior becomes ``p_ins(t) = p(t + dt) - v(t) dt`` with v the
-        velocity from finite differences of neighbouring exposures of the same flight line
-        (:func:`.boresight_setup.exposure_velocity`). Needs >= 2 images per line.
+        trajectory's velocity at the exposure (its v_north, v_east, v_up columns, as
+        ``importtrajectory`` writes them) or, without them, finite differences of neighbouring
+        exposures of the same flight line (:func:`.boresight_setup.exposure_velocity`; then >=
+        2 images per line). With the lever arm also estimated, lines at clearly different
+        speeds are needed (else refused as not observable).
     snooping, snooping_alpha : bool, float
         Baarda data snooping and its significance per observation.
     max_iterations : int

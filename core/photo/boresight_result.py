@@ -5,13 +5,14 @@ determined, and what a run of the job computed.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import DiagnosedNotObservable
+from ..errors import DiagnosedNotObservable, NotObservableError
 from ..geometry.frames import LocalFrame, MappingFrame
 from ..i18n import mark as _t
 from ..lsq.results import AdjustmentResult
@@ -33,6 +34,7 @@ __all__ = [
     "BoresightRun",
     "ObservationResiduals",
     "diagnose",
+    "require_timing_separable",
 ]
 
 Array = NDArray[np.float64]
@@ -338,6 +340,48 @@ def diagnose(parameters: Sequence[str], groups: Sequence[str] = ()) -> list[str]
             )
         )
     return out
+
+
+#: Smallest share of the body-frame velocity that a lever arm cannot mimic
+#: (:func:`.boresight_setup.timing_separability`) with which the timing offset and the lever
+#: arm are estimated together: below it dt's sigma would be more than 20 times the one with
+#: the lever arm known (speeds differing by less than about 10 %, or one line).
+TIMING_SEPARABILITY_MIN = 0.05
+
+
+def require_timing_separable(share: float, body_velocity: Array) -> None:
+    """Refuse a timing offset estimated with the lever arm when the body-frame velocity is
+    (nearly) the same at every image (``share`` below :data:`TIMING_SEPARABILITY_MIN`):
+    dt times that velocity is then a lever arm. Names dt and the lever-arm component along
+    the velocity (``body_velocity``, the mean body-frame velocity, m/s)."""
+    if share >= TIMING_SEPARABILITY_MIN:
+        return
+    k = int(np.argmax(np.abs(body_velocity)))
+    axis = "xyz"[k]
+    speed = float(np.linalg.norm(body_velocity))
+    names = ["timing.dt", f"lever_arm.{axis}"]
+    cause = NotObservableError(
+        f"Not observable: timing.dt and lever_arm.{axis} cannot be separated (the body-frame "
+        f"velocity varies by {share:.1%} of the speed at the images, less than the "
+        f"{TIMING_SEPARABILITY_MIN:.0%} needed)",
+        parameters=names,
+        condition_number=math.inf if share == 0 else 1.0 / share**2,
+    )
+    diagnosis: list[str] = [
+        _t(
+            "the camera timing offset dt cannot be separated from the lever arm's {axis} "
+            "component: the velocity in the aircraft's body frame is the same at every image "
+            "to {share:.1%} ({speed:.1f} m/s along body {axis}; at least {minimum:.0%} is "
+            "needed), so dt times the speed equals a lever arm along {axis} (one line, or lines "
+            "flown at one speed in either direction); fly lines at clearly different speeds, "
+            "or keep the lever arm fixed, or do not estimate the timing.",
+            axis=axis,
+            share=share,
+            speed=speed,
+            minimum=TIMING_SEPARABILITY_MIN,
+        )
+    ]
+    raise BoresightNotObservable(cause, diagnosis)
 
 
 @dataclass

@@ -39,6 +39,8 @@ class Trajectory:
     position: (N, 3) easting, northing, height in the mapping CRS when ``geodetic`` is False;
     latitude, longitude (degrees) and ellipsoidal height otherwise.
     rph: (N, 3) roll, pitch, heading in radians.
+    velocity_ned: (N, 3) north, east, down velocity at each exposure, m/s (local level at the
+    image, true north), or None when the table has none.
     """
 
     image_id: tuple[str, ...]
@@ -47,6 +49,7 @@ class Trajectory:
     position: Array
     geodetic: bool
     rph: Array
+    velocity_ned: Array | None = None
 
     def __len__(self) -> int:
         return len(self.image_id)

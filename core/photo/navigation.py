@@ -119,7 +119,8 @@ def interpolate_trajectory(
 ) -> Trajectory:
     """The pose of every event (module docstring), as the trajectory table of
     :mod:`.georeference`: easting, northing, height in the mapping CRS, roll, pitch and true
-    heading (radians, heading in [0, 2 pi)), time = the trajectory time (event + offset)."""
+    heading (radians, heading in [0, 2 pi)), the north-east-down velocity (m/s: the
+    derivative of the position's Hermite cubic), time = the trajectory time (event + offset)."""
     from scipy.spatial.transform import Rotation
 
     if len(nav) < 2:
@@ -142,16 +143,19 @@ def interpolate_trajectory(
         vel = _rates(tn, lambda i: xyz[i] - xyz, lo, hi)
     rot = Rotation.from_matrix(r_n_e @ rph_to_matrix(*nav.rph[near].T))  # R_b^e
     xyz_t = _hermite(tn, xyz, vel, j, t)
+    vel_t = _hermite_rate(tn, xyz, vel, j, t)
     if options.attitude == "slerp":
         r_b_e_t = _slerp(tn, rot, j, t)
     else:
         omega = _rates(tn, lambda i: (rot[i] * rot.inv()).as_rotvec(), lo, hi)
         r_b_e_t = _rotation_hermite(tn, rot, omega, j, t)
     llh_t = frame.ecef_to_geodetic(xyz_t)
-    r_b_n = np.swapaxes(ned_to_ecef_rotation(llh_t[:, 0], llh_t[:, 1]), -1, -2) @ r_b_e_t
-    roll, pitch, heading = matrix_to_rph(r_b_n)
+    r_e_n = np.swapaxes(ned_to_ecef_rotation(llh_t[:, 0], llh_t[:, 1]), -1, -2)
+    roll, pitch, heading = matrix_to_rph(r_e_n @ r_b_e_t)
     rph = np.stack([roll, pitch, np.mod(heading, 2.0 * np.pi)], axis=1)
-    return Trajectory(events.image_id, t, events.group, frame.geodetic_to_map(llh_t), False, rph)
+    v_ned = np.einsum("kij,kj->ki", r_e_n, vel_t)
+    return Trajectory(events.image_id, t, events.group, frame.geodetic_to_map(llh_t), False, rph,
+                      v_ned)  # fmt: skip
 
 
 def _align_week(t: Array, nav_time: Array) -> Array:
@@ -275,6 +279,15 @@ def _hermite(tk: Array, xyz: Array, vel: Array, j: NDArray[np.int64], t: Array) 
     """
     h, h00, h10, h01, h11 = _basis(tk, j, t)
     return h00 * xyz[j] + h10 * h * vel[j] + h01 * xyz[j + 1] + h11 * h * vel[j + 1]
+
+
+def _hermite_rate(tk: Array, xyz: Array, vel: Array, j: NDArray[np.int64], t: Array) -> Array:
+    """Velocity (m/s) of the cubic Hermite of :func:`_hermite` at ``t``: its derivative."""
+    h = (tk[j + 1] - tk[j])[:, None]
+    s = (t - tk[j])[:, None] / h
+    d00, d01 = 6 * s * s - 6 * s, 6 * s - 6 * s * s
+    d10, d11 = 3 * s * s - 4 * s + 1, 3 * s * s - 2 * s
+    return (d00 * xyz[j] + d01 * xyz[j + 1]) / h + d10 * vel[j] + d11 * vel[j + 1]
 
 
 def _slerp(tk: Array, rot, j: NDArray[np.int64], t: Array) -> Array:
