@@ -2,7 +2,8 @@
 and surveyed ground control points.
 
 Outputs: the results table (one row per boresight group: the angles in degrees and
-arc-seconds and their a-posteriori standard deviations in arc-seconds); the updated exterior
+arc-seconds and their a-posteriori standard deviations in arc-seconds; with ESTIMATE_TIMING
+the timing offset in ms, its sigma and correlations, :data:`TIMING_COLUMNS`); the updated exterior
 orientations (the EO CSV of ``trajectorytoeo``); a residual table (every image observation
 placed at its ground position, the adjusted ray cut with its plane or line, or the LCP, with
 its pixel residual, Baarda w and rejection flag); the HTML summary, written also when the
@@ -48,10 +49,18 @@ _GRADES = Ref("photo.ins_grades", "INS_GRADES", convert=lambda grades: (*grades,
 _GRADE_LABELS = Ref("photo.ins_grades", "INS_GRADES",
                     convert=lambda grades: (*(g.name for g in grades.values()),
                                             "custom (INS sigmas)"))  # fmt: skip
+#: The timing offset's columns of the results table (empty when it is not estimated): dt in
+#: milliseconds (exposure = recorded time + dt), its a-posteriori sigma, and its correlations
+#: with the group's boresight angles and with the lever arm (empty when that is fixed).
+TIMING_COLUMNS = (
+    "dt_ms", "std_dt_ms", "corr_dt_d_omega", "corr_dt_d_phi", "corr_dt_d_kappa",
+    "corr_dt_lever_arm_x", "corr_dt_lever_arm_y", "corr_dt_lever_arm_z",
+)  # fmt: skip
 TABLE_COLUMNS = (
     "group", "images", "observations", "d_omega_deg", "d_phi_deg", "d_kappa_deg",
     "d_omega_arcsec", "d_phi_arcsec", "d_kappa_arcsec", "std_d_omega_arcsec",
     "std_d_phi_arcsec", "std_d_kappa_arcsec", "sigma0", "chi2_passed",
+    *TIMING_COLUMNS,
 )  # fmt: skip
 RESIDUAL_COLUMNS = (
     "image_id", "point_id", "type", "target_id", "group", "X", "Y", "Z", "col", "row", "vx_px",
@@ -89,6 +98,13 @@ point is an error.
 Grouping: one boresight for all images, one per value of the trajectory's group column
 (flight line, direction or session) or one per heading octant.
 
+Timing offset (ESTIMATE_TIMING): a constant camera timing offset dt (exposure = recorded
+time + dt) as one more unknown, from the trajectory's velocities when the table has them
+(v_north, v_east, v_up, as Import trajectory writes them), else from the neighbouring
+exposures of each flight line. Estimated with the lever arm it needs lines flown at clearly
+different speeds: with one speed dt times the speed is an along-track lever arm, and the run
+is refused as not observable, naming both.
+
 Outputs: the boresight per group (CSV), the updated exterior orientation (CSV), the image
 residuals (a layer at each observation's ground position, and optionally CSV) and an HTML
 summary; a set-up that cannot determine the boresight is an error that names the
@@ -105,41 +121,119 @@ comment lines beginning with #).""",
     params=(
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
         Param("TRAJECTORY", "file", "Trajectory table (CSV)", file_filter=CSV_FILTER),
-        Param("CRS", "crs", "Mapping CRS", qgis_default="ProjectCrs",
-              help="projected CRS of the trajectory and of the LiDAR tables"),
+        Param(
+            "CRS",
+            "crs",
+            "Mapping CRS",
+            qgis_default="ProjectCrs",
+            help="projected CRS of the trajectory and of the LiDAR tables",
+        ),
         *mount_params(initial_boresight=True),
         Param("OBSERVATIONS", "file", "Image observations (CSV)", file_filter=CSV_FILTER),
         Param("PLANES", "file", "Plane table (CSV)", optional=True, file_filter=CSV_FILTER),
         Param("LINES", "file", "Line table (CSV)", optional=True, file_filter=CSV_FILTER),
-        Param("LCPS", "file", "LiDAR control point table (CSV)", optional=True,
-              file_filter=CSV_FILTER),
-        Param("GROUND_POINTS", "file", "Ground points (CSV)", optional=True,
-              file_filter=CSV_FILTER,
-              help="surveyed points of the control rows: point_id, X, Y, Z, sx, sy, sz, role "
-              "(control or check), in the mapping CRS", advanced=True),
-        Param("CLOUD", "file", "Cloud with plane ids (LAS/LAZ, paper mode only)",
-              optional=True, file_filter=LAS_FILTER, advanced=True),
-        Param("GROUPING", "enum", "Boresight groups", _OPTIONS.groups, options=GROUPINGS,
-              labels=("one boresight for all images",
-                      "one per trajectory group (flight line, direction, session)",
-                      "one per heading direction (octant)"), advanced=True),
-        Param("CONTROL_TYPES", "enum", "Control types", _OPTIONS.use_types,
-              options=CONTROL_TYPES, multiple=True, advanced=True),
-        Param("ESTIMATE_LEVER_ARM", "boolean", "Estimate the lever arm",
-              _OPTIONS.estimate_lever_arm, advanced=True),
-        Param("ESTIMATE_INTERIOR", "boolean", "Estimate focal length and principal point",
-              _OPTIONS.estimate_interior, advanced=True),
-        Param("INS_GRADE", "enum", "INS grade", _OPTIONS.ins_grade, options=_GRADES,
-              labels=_GRADE_LABELS, advanced=True),
-        Param("INS_SIGMAS", "numbers",
-              "Custom INS sigmas: horizontal, vertical, roll/pitch, heading",
-              (0.02, 0.05, 0.015, 0.035), count=4, unit="m, m, deg, deg", optional=True,
-              advanced=True, minimum=0.0001, maximum=100.0),
+        Param(
+            "LCPS", "file", "LiDAR control point table (CSV)", optional=True, file_filter=CSV_FILTER
+        ),
+        Param(
+            "GROUND_POINTS",
+            "file",
+            "Ground points (CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            help="surveyed points of the control rows: point_id, X, Y, Z, sx, sy, sz, role "
+            "(control or check), in the mapping CRS",
+            advanced=True,
+        ),
+        Param(
+            "CLOUD",
+            "file",
+            "Cloud with plane ids (LAS/LAZ, paper mode only)",
+            optional=True,
+            file_filter=LAS_FILTER,
+            advanced=True,
+        ),
+        Param(
+            "GROUPING",
+            "enum",
+            "Boresight groups",
+            _OPTIONS.groups,
+            options=GROUPINGS,
+            labels=(
+                "one boresight for all images",
+                "one per trajectory group (flight line, direction, session)",
+                "one per heading direction (octant)",
+            ),
+            advanced=True,
+        ),
+        Param(
+            "CONTROL_TYPES",
+            "enum",
+            "Control types",
+            _OPTIONS.use_types,
+            options=CONTROL_TYPES,
+            multiple=True,
+            advanced=True,
+        ),
+        Param(
+            "ESTIMATE_LEVER_ARM",
+            "boolean",
+            "Estimate the lever arm",
+            _OPTIONS.estimate_lever_arm,
+            advanced=True,
+        ),
+        Param(
+            "ESTIMATE_INTERIOR",
+            "boolean",
+            "Estimate focal length and principal point",
+            _OPTIONS.estimate_interior,
+            advanced=True,
+        ),
+        Param(
+            "ESTIMATE_TIMING",
+            "boolean",
+            "Estimate the camera timing offset",
+            _OPTIONS.estimate_timing,
+            advanced=True,
+            help="a constant dt (exposure = recorded time + dt) from the trajectory's "
+            "velocities (v_north, v_east, v_up columns, as Import trajectory writes them) or "
+            "from neighbouring exposures of each line; with the lever arm it needs lines at "
+            "clearly different speeds",
+        ),
+        Param(
+            "INS_GRADE",
+            "enum",
+            "INS grade",
+            _OPTIONS.ins_grade,
+            options=_GRADES,
+            labels=_GRADE_LABELS,
+            advanced=True,
+        ),
+        Param(
+            "INS_SIGMAS",
+            "numbers",
+            "Custom INS sigmas: horizontal, vertical, roll/pitch, heading",
+            (0.02, 0.05, 0.015, 0.035),
+            count=4,
+            unit="m, m, deg, deg",
+            optional=True,
+            advanced=True,
+            minimum=0.0001,
+            maximum=100.0,
+        ),
         Param("SNOOPING", "boolean", "Data snooping (Baarda)", _OPTIONS.snooping, advanced=True),
-        Param("MAX_BORESIGHT", "number", "Largest plausible boresight angle", 2.0,
-              unit="degrees", minimum=0.001, maximum=45.0, advanced=True,
-              help="an estimated angle beyond this fails the run (wrong MOUNT, image ids or "
-              "observations)"),
+        Param(
+            "MAX_BORESIGHT",
+            "number",
+            "Largest plausible boresight angle",
+            2.0,
+            unit="degrees",
+            minimum=0.001,
+            maximum=45.0,
+            advanced=True,
+            help="an estimated angle beyond this fails the run (wrong MOUNT, image ids or "
+            "observations)",
+        ),
         *doubt_params(
             "a failed global test with sigma0 above this fails the run (wrong sigma_px or INS "
             "grade, or blunders data snooping did not catch)",
@@ -148,16 +242,32 @@ comment lines beginning with #).""",
             "write the outputs anyway, each with a warning at its top",
         ),
         Param("OUTPUT_TABLE", "file_out", "Boresight per group (CSV)", file_filter=CSV_OUT),
-        Param("OUTPUT_RESIDUALS", "sink", "Image residuals", geometry="point", optional=True,
-              advanced=True),
-        Param("RESIDUALS_CSV", "file_out", "Image residuals (CSV)", optional=True,
-              create_by_default=False, file_filter=CSV_OUT, advanced=True,
-              layer_twin="OUTPUT_RESIDUALS"),
-        Param("OUTPUT_EO", "file_out", "Updated exterior orientation (CSV)",
-              file_filter=CSV_OUT),
+        Param(
+            "OUTPUT_RESIDUALS",
+            "sink",
+            "Image residuals",
+            geometry="point",
+            optional=True,
+            advanced=True,
+        ),
+        Param(
+            "RESIDUALS_CSV",
+            "file_out",
+            "Image residuals (CSV)",
+            optional=True,
+            create_by_default=False,
+            file_filter=CSV_OUT,
+            advanced=True,
+            layer_twin="OUTPUT_RESIDUALS",
+        ),
+        Param("OUTPUT_EO", "file_out", "Updated exterior orientation (CSV)", file_filter=CSV_OUT),
         Param("OUTPUT_HTML", "file_out", "Summary (HTML)", file_filter="HTML files (*.html)"),
     ),
-    results=(Result("SIGMA0", "number", "Sigma0 a-posteriori"),),
+    results=(
+        Result("SIGMA0", "number", "Sigma0 a-posteriori"),
+        Result("TIMING_OFFSET_MS", "number", "Camera timing offset dt (ms, NaN if not estimated)"),
+        Result("TIMING_OFFSET_STD_MS", "number", "Sigma of the timing offset (ms)"),
+    ),
     tags=("boresight", "misalignment", "ins", "imu", "calibration", "roof planes", "lever arm"),
     references=("Pedrosa & dos Santos (2020)", "Baarda (1968)"),
 )
@@ -215,7 +325,18 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                        settings, frame.crs.to_wkt())  # fmt: skip
     _write_outputs(out, run, settings, doubts, warning)
     lines = _summary_lines(result, warning, options.snooping_alpha)
-    return JobResult(results={"SIGMA0": result.sigma0}, lines=lines, data=run)
+    return JobResult(results=_results(result), lines=lines, data=run)
+
+
+def _results(result) -> dict[str, float]:
+    """The job's numeric results: sigma0 and the timing offset in ms (NaN when fixed)."""
+    dt, std = result.timing_offset, result.timing_offset_std
+    nan = float("nan")
+    return {
+        "SIGMA0": result.sigma0,
+        "TIMING_OFFSET_MS": nan if dt is None else 1e3 * dt,
+        "TIMING_OFFSET_STD_MS": nan if std is None else 1e3 * std,
+    }
 
 
 def _read_inputs(v: Values, frame) -> tuple:
@@ -299,6 +420,11 @@ def _summary_lines(result, warning: list, snooping_alpha: float) -> list[str]:
             f"{row['group']:8} {row['parameter']:8} {row['value_deg']:12.6f} "
             f"{row['value_arcsec']:10.1f} {row['std_arcsec']:8.1f}"
         )
+    if result.timing_offset is not None:
+        lines.append(
+            f"timing offset dt {1e3 * result.timing_offset:.2f} ms, sigma "
+            f"{1e3 * result.timing_offset_std:.2f} ms (exposure = recorded time + dt)"
+        )
     test = global_test_verdict(result.chi2_passed, result.adjustment, snooping_alpha)
     lines.append(
         f"sigma0 {result.sigma0:.3f}, redundancy {result.redundancy}, global test {test}, "
@@ -314,6 +440,7 @@ def doubts_about(result, max_boresight_deg: float, max_sigma0: float,
     snooping's false alarms at ``snooping_alpha`` explain, an angle beyond
     ``max_boresight_deg``, numbers that are not finite."""
     import numpy as np
+
     out = []
     adj = result.adjustment
     if not adj.converged:
@@ -365,6 +492,7 @@ def _settings(v, cam, traj, obs, planes, lines, lcps, frame, mount, grade, groun
               ) -> dict[str, str]:  # fmt: skip
     """The run's settings as text (the HTML summary shows them)."""
     import numpy as np
+
     types = tuple(v.control_types)
     return {
         "camera": f"{cam.name} (f = {cam.focal_mm:g} mm, {cam.width_px} x {cam.height_px} px "
@@ -374,8 +502,15 @@ def _settings(v, cam, traj, obs, planes, lines, lcps, frame, mount, grade, groun
             f"{t} {n}" for t, n in zip(*np.unique(np.array(obs.type), return_counts=True))
         ),
         "planes / lines / LCPs": f"{len(planes)} / {len(lines)} / {len(lcps)}",
-        **({} if ground is None else {"ground points (control / check)": (
-            f"{ground.role.count('control')} / {ground.role.count('check')}")}),
+        **(
+            {}
+            if ground is None
+            else {
+                "ground points (control / check)": (
+                    f"{ground.role.count('control')} / {ground.role.count('check')}"
+                )
+            }
+        ),
         "mapping CRS": frame.crs.name,
         "grouping": v.grouping,
         "control types used": ", ".join(types),
@@ -383,6 +518,13 @@ def _settings(v, cam, traj, obs, planes, lines, lcps, frame, mount, grade, groun
         "lever arm (m, body)": ", ".join(f"{a:.3f}" for a in mount.lever_arm)
         + (" (estimated)" if v.estimate_lever_arm else " (fixed)"),
         "interior orientation": "estimated" if v.estimate_interior else "fixed",
+        "camera timing offset": (
+            "fixed (0)"
+            if not v.estimate_timing
+            else "estimated, velocities from the trajectory"
+            if traj.velocity_ned is not None
+            else "estimated, velocities from neighbouring exposures"
+        ),
         "INS grade": f"{grade.name}: position {grade.sigma_horizontal_m:g} m horizontal, "
         f"{grade.sigma_vertical_m:g} m vertical; roll/pitch {grade.sigma_roll_pitch_deg:g} deg, "
         f"heading {grade.sigma_heading_deg:g} deg",
@@ -411,14 +553,28 @@ def _table_rows(run: BoresightRun) -> list[tuple[str, ...]]:
                     *res.std_arcsec[k],
                     res.sigma0,
                     int(res.chi2_passed),
+                    *_timing_cells(res, g),
                 )
             )
         )
     return rows
 
 
+def _timing_cells(res, group: str) -> tuple:
+    """The :data:`TIMING_COLUMNS` of one group's row ("" where not estimated)."""
+    if res.timing_offset is None:
+        return ("",) * len(TIMING_COLUMNS)
+    names = res.parameter_names
+    at = names.index("timing.dt")
+    others = [f"bore[{group}].{a}" for a in ("d_omega", "d_phi", "d_kappa")]
+    others += [f"lever_arm.{a}" for a in "xyz"]
+    corr = [float(res.correlation[at, names.index(n)]) if n in names else "" for n in others]
+    return (1e3 * res.timing_offset, 1e3 * res.timing_offset_std, *corr)
+
+
 def _text(row) -> tuple[str, ...]:
     import numpy as np
+
     out = []
     for v in row:
         if isinstance(v, (float, np.floating)):

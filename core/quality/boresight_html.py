@@ -1,7 +1,8 @@
 """Short self-contained HTML summary of a boresight calibration (inline CSS and SVG).
 
 Sections: settings; the boresight per group in degrees and arc-seconds with a-posteriori and
-a-priori standard deviations; lever arm and interior orientation when estimated; sigma0,
+a-priori standard deviations; lever arm, interior orientation and the camera timing offset
+(ms, with its correlations) when estimated; sigma0,
 redundancy and the global chi-square test; the correlation matrix of the calibration
 parameters; rejected observations (Baarda data snooping); residual histograms in pixels.
 When the set-up is not observable the page carries the diagnosis instead of numbers.
@@ -29,11 +30,14 @@ __all__ = ["render_boresight_html"]
 ARCSEC_PER_RAD = 180.0 * 3600.0 / math.pi
 _ANGLES = ("omega", "phi", "kappa")
 
-_CSS = report_css(1100, (
-    ".diag{background:#fbecc4;padding:8px}\n"
-    ".plots svg{margin:4px;border:1px solid #ddd}.note{font-size:12px;color:#444}\n"
-    ".alarm{background:#c62828;color:#fff;padding:8px 14px;font-size:15px}"
-))
+_CSS = report_css(
+    1100,
+    (
+        ".diag{background:#fbecc4;padding:8px}\n"
+        ".plots svg{margin:4px;border:1px solid #ddd}.note{font-size:12px;color:#444}\n"
+        ".alarm{background:#c62828;color:#fff;padding:8px 14px;font-size:15px}"
+    ),
+)
 
 
 def _n(x: float | None, digits: int = 2) -> str:
@@ -125,6 +129,27 @@ def render_boresight_html(
     return "\n".join(parts)
 
 
+def _timing(res) -> list[str]:
+    """The timing offset dt in milliseconds with its sigma and its correlations with the
+    other calibration parameters (boresight angles, lever arm, interior)."""
+    head = [t("parameter"), t("value (ms)"), t("sigma (ms)")]
+    rows = [["dt", _n(1e3 * res.timing_offset, 2), _n(1e3 * res.timing_offset_std, 2)]]
+    names = res.parameter_names
+    at = names.index("timing.dt")
+    corr = np.asarray(res.correlation)[at]
+    others = [
+        [_e(n.replace("bore[", "").replace("].", " ")), _n(corr[k], 3)]
+        for k, n in enumerate(names)
+        if k != at
+    ]
+    return [
+        f"<h3>{t('Camera timing offset')}</h3>",
+        f'<p class="note">{t("exposure = recorded time + dt")}</p>',
+        _table(head, rows),
+        _table([t("parameter"), t("correlation with dt")], others),
+    ]
+
+
 def _problems(problems: Sequence[str], accepted: bool) -> list[str]:
     return failed_checks(problems, accepted, t(
         "The calibration FAILED its checks: no table and no exterior orientation were "
@@ -172,6 +197,8 @@ def _results(run: BoresightRun) -> list[str]:
         out.append(f"<h3>{t('Interior orientation')}</h3>")
         head = [t("parameter"), t("value (mm)"), t("sigma (mm)")]
         out.append(_value_table(head, ("f", "x0", "y0"), res.interior, res.interior_std, 5))
+    if res.timing_offset is not None:
+        out += _timing(res)
     gt = res.adjustment.global_test
     out.append(f"<h2>{t('Adjustment')}</h2>")
     out.append(
