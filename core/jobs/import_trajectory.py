@@ -50,7 +50,8 @@ the GPS week, the SBET's clock) or utc (ISO 8601 date-times, with LEAP_SECONDS =
 
 ## Outputs
 OUTPUT_TRAJECTORY: the trajectory table that trajectorytoeo and boresightcalibration read
-(easting, northing, height in the mapping CRS; roll, pitch, true heading in degrees; time =
+(easting, northing, height in the mapping CRS; roll, pitch, true heading in degrees; the
+velocity v_north, v_east, v_up in m/s, which boresightcalibration's timing offset uses; time =
 the trajectory time). OUTPUT_EO: the exterior orientation with the mount applied, as
 trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""",
     params=(
