@@ -16,6 +16,7 @@ from lidarphoto.core.io.trajectory import read_trajectory_csv, write_trajectory_
 from lidarphoto.core.jobs import boresight_calibration
 from lidarphoto.core.jobs.boresight_calibration import TABLE_COLUMNS, TIMING_COLUMNS
 from lidarphoto.core.jobs.runner import run_job
+from lidarphoto.core.photo.boresight_result import BoresightNotObservable
 from lidarphoto.core.photo.boresight_setup import BoresightOptions
 from lidarphoto.core.simulation.flight import FlightConfig, simulate_flight
 
@@ -136,3 +137,15 @@ def test_some_velocity_columns_or_another_unit_are_refused(tmp_path):
     path.write_text("\n".join(cut) + "\n", encoding="utf-8")
     with pytest.raises(InputError, match="all three velocity columns"):
         read_trajectory_csv(path)
+
+
+def test_job_refuses_one_line_with_the_lever_arm_and_writes_the_diagnosis(tmp_path):
+    """A single straight line at constant speed: dt times the speed is an along-track lever
+    arm. The run fails naming both, and the HTML summary says why."""
+    sim, _ = _recorded(simulate_flight(replace(CFG, n_lines=1, images_per_line=4), seed=3), DT)
+    with pytest.raises(BoresightNotObservable) as info:
+        _job(sim, tmp_path, estimate_timing=True, estimate_lever_arm=True)
+    assert info.value.parameters == ["timing.dt", "lever_arm.x"]
+    page = (tmp_path / "summary.html").read_text(encoding="utf-8")
+    assert "Not observable" in page and "timing offset dt cannot be separated" in page
+    assert not (tmp_path / "table.csv").exists()
