@@ -1,0 +1,445 @@
+"""Agisoft Metashape camera XML (*Export Cameras > Agisoft XML*) -> the project's cameras and EO.
+
+The file
+--------
+``document/chunk`` (or a ``chunk`` root, as in a project's ``chunk.zip``) holds ``sensors``
+(one ``sensor`` per camera model: ``type`` frame or fisheye, its ``resolution`` and
+``calibration`` elements, the ``adjusted`` one taken first, with ``f cx cy k1..k4 p1 p2 b1
+b2`` in pixels / unitless), ``components`` (Metashape 2: one ``transform`` per component and
+a ``partition`` of camera ids), ``cameras`` (``camera`` elements, possibly inside ``group``
+elements, with ``sensor_id``, ``component_id``, ``label`` and a ``transform``: 16 numbers,
+the 4 x 4 camera -> internal matrix, row by row), a chunk ``transform`` (``rotation`` 3 x 3
+row by row, ``translation``, ``scale``: internal -> world, ``X = s R x + t``) and the
+``reference`` (the chunk's CRS as WKT: world coordinates are geocentric (ECEF) for a
+geographic or projected CRS, the local coordinates themselves for ``LOCAL_CS``).
+
+A camera's internal frame is its component's (the component's ``transform`` maps it to the
+world; in Metashape 2 the chunk's ``transform`` is the active component's), else the chunk's.
+A camera with no ``transform`` (not aligned), whose sensor is missing or has no
+calibration, or whose component has no transform in a georeferenced chunk is skipped and
+reported by label; so are the cameras of other components than the active one in a local
+chunk (their frames differ).
+
+Cameras (Metashape Professional manual, appendix "Camera models")
+----------------------------------------------------------------
+Camera frame x right, y down, z forward (the camera looks along +z); ``x = X/Z, y = Y/Z``
+(fisheye: scaled to the length ``atan(r)``), ``x' = x (1 + k1 r^2 + .. + k4 r^8) + p1 (r^2 +
+2 x^2) + 2 p2 x y``, ``y' = y (..) + p2 (r^2 + 2 y^2) + 2 p1 x y``, ``u = w/2 + cx + x' (f +
+b1) + y' b2``, ``v = h/2 + cy + y' f`` with ``(u, v)`` from the image's top-left corner (the
+image centre at ``w/2, h/2``: the project's pixel convention). That is
+:class:`~core.geometry.forward_lens.MetashapeLens` with Metashape's own coefficients
+(``scale_mm = focal_mm = f * pixel size``, ``focal_px = f``), the ``perspective`` projection
+for frame sensors and ``equidistant`` for fisheye ones, ``x0 = cx * ps``, ``y0 = -cy * ps``.
+Nonzero ``p3``, ``p4`` (no model of ours holds them), other sensor types (spherical,
+cylindrical, RPC) and PhotoScan's ``fx fy`` calibrations are refused by name. The pixel
+size is the sensor's ``pixel_width`` property when given (else PIXEL_SIZE); it scales the
+millimetres, never the projection.
+
+Orientations
+------------
+``R_wc = R_world R_cam`` (camera -> world; the transform's scale does not rotate) and the
+centre ``C = s R_world t_cam + t_world``; world -> camera ``R = R_wc^T`` and ``t = -R C``
+give the project's orientation as COLMAP's do (:func:`core.io.colmap_block.oriented`:
+``M = diag(1, -1, -1) R``), in ECEF turned to the grid frame at each centre.
+"""
+
+from __future__ import annotations
+
+import logging
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Dict, List, Mapping, Tuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import CrsError, InputError
+from ..geometry.camera import Camera
+from ..geometry.forward_lens import MetashapeLens
+from ..photo.bundle_setup import GroundPoints
+from ..photo.observations import ImageObservations
+from .colmap_block import ColmapBlock, ColmapFrame, oriented
+
+Array = NDArray[np.float64]
+log = logging.getLogger(__name__)
+
+__all__ = [
+    "MetashapeCamera",
+    "MetashapeChunk",
+    "MetashapeSensor",
+    "Similarity",
+    "block_from_metashape",
+    "camera_from_metashape",
+    "read_metashape",
+]
+
+#: Calibration coefficients read (absent ones are 0).
+COEFFICIENTS = ("k1", "k2", "k3", "k4", "p1", "p2", "b1", "b2")
+_SENSOR_TYPES = {"frame": "perspective", "fisheye": "equidistant"}
+#: Rotation matrices are orthonormalised when within this of a rotation (the files' digits).
+_ROTATION_TOL = 1e-6
+
+
+@dataclass(frozen=True)
+class Similarity:
+    """``X = scale * rotation @ x + translation`` (internal -> world; metres, unitless)."""
+
+    rotation: Array
+    translation: Array
+    scale: float = 1.0
+
+    def apply(self, x: Array) -> Array:
+        """(N, 3) internal -> (N, 3) world."""
+        return self.scale * x @ self.rotation.T + self.translation
+
+
+@dataclass(frozen=True)
+class MetashapeSensor:
+    """One sensor: id, label, type (frame, fisheye), size (px), calibration (f, cx, cy px and
+    :data:`COEFFICIENTS`), pixel size (mm, 0 when the file has none); ``calibration`` is None
+    for a sensor without one (its cameras are skipped)."""
+
+    sensor_id: str
+    label: str
+    kind: str
+    width: int
+    height: int
+    calibration: Mapping[str, float] | None
+    pixel_size_mm: float = 0.0
+
+
+@dataclass(frozen=True)
+class MetashapeCamera:
+    """One aligned camera: label, sensor id, component id ("" for none) and its 4 x 4
+    camera -> internal transform (the camera frame x right, y down, z forward)."""
+
+    camera_id: str
+    label: str
+    sensor_id: str
+    component_id: str
+    transform: Array
+
+
+@dataclass(frozen=True)
+class MetashapeChunk:
+    """A chunk of a camera XML: sensors, aligned cameras, component and chunk transforms,
+    the reference CRS (WKT, "" for none), the active component and the skipped cameras
+    (label, reason)."""
+
+    sensors: Dict[str, MetashapeSensor]
+    cameras: Tuple[MetashapeCamera, ...]
+    components: Dict[str, Similarity | None]
+    chunk_transform: Similarity | None
+    reference_wkt: str
+    active_component: str
+    skipped: Tuple[Tuple[str, str], ...]
+    source: str
+
+
+# ---------------------------------------------------------------------- reading
+def _numbers(el: ET.Element | None, n: int, what: str, src: str) -> Array:
+    text = (el.text or "") if el is not None else ""
+    try:
+        vals = np.array([float(v) for v in text.split()], dtype=np.float64)
+    except ValueError:
+        vals = np.zeros(0)
+    if vals.shape != (n,) or not np.all(np.isfinite(vals)):
+        raise InputError(f"{what}: expected {n} numbers, got {text.strip()[:60]!r}", path=src)
+    return vals
+
+
+def _rotation(m: Array, what: str, src: str) -> Array:
+    """The rotation nearest ``m`` (3, 3), refused unless within :data:`_ROTATION_TOL`."""
+    u, s, vt = np.linalg.svd(m)
+    r = u @ vt
+    if (
+        np.linalg.det(r) < 0
+        or np.max(np.abs(s - 1.0)) > _ROTATION_TOL * 10
+        or np.max(np.abs(r - m)) > _ROTATION_TOL * 10
+    ):
+        raise InputError(f"{what}: not a rotation matrix (singular values {s.round(6)})", path=src)
+    return r
+
+
+def _similarity(el: ET.Element | None, what: str, src: str) -> Similarity | None:
+    if el is None:
+        return None
+    rot = el.find("rotation")
+    r = (
+        np.eye(3)
+        if rot is None
+        else _rotation(
+            _numbers(rot, 9, f"{what} rotation", src).reshape(3, 3), f"{what} rotation", src
+        )
+    )
+    tr = el.find("translation")
+    t = np.zeros(3) if tr is None else _numbers(tr, 3, f"{what} translation", src)
+    sc = el.find("scale")
+    s = 1.0 if sc is None else float(_numbers(sc, 1, f"{what} scale", src)[0])
+    if not s > 0:
+        raise InputError(f"{what} scale must be positive, got {s}", path=src)
+    return Similarity(r, t, s)
+
+
+def _calibration(sensor: ET.Element, what: str, src: str) -> Dict[str, float] | None:
+    cals = sensor.findall("calibration")
+    if not cals:
+        return None
+    cal = next((c for c in cals if c.get("class") == "adjusted"), cals[0])
+    if cal.find("f") is None:
+        if cal.find("fx") is not None:
+            raise InputError(
+                f"{what}: a PhotoScan calibration (fx, fy) is not supported; "
+                "export the cameras again from Metashape 1.4 or later",
+                path=src,
+            )
+        raise InputError(f"{what}: the calibration has no focal length <f>", path=src)
+    out: Dict[str, float] = {}
+    for key in ("f", "cx", "cy", *COEFFICIENTS, "p3", "p4"):
+        el = cal.find(key)
+        out[key] = 0.0 if el is None else float(_numbers(el, 1, f"{what} {key}", src)[0])
+    for key in ("p3", "p4"):
+        if out.pop(key) != 0.0:
+            raise InputError(
+                f"{what}: calibration coefficient {key} is not supported (no lens "
+                "model of the project holds Metashape's p3, p4)",
+                path=src,
+            )
+    if not out["f"] > 0:
+        raise InputError(f"{what}: the focal length f must be positive, got {out['f']}", path=src)
+    res = cal.find("resolution")
+    if res is not None:
+        out["width"], out["height"] = float(res.get("width", 0)), float(res.get("height", 0))
+    return out
+
+
+def _read_sensor(el: ET.Element, src: str) -> MetashapeSensor:
+    sid = el.get("id", "")
+    what = f"sensor {sid} ({el.get('label', '')})"
+    kind = el.get("type", "frame")
+    cal = _calibration(el, what, src)
+    if kind not in _SENSOR_TYPES:
+        raise InputError(
+            f"{what}: Metashape sensor type '{kind}' is not supported (frame and fisheye are)",
+            path=src,
+        )
+    res = el.find("resolution")
+    w = float(res.get("width", 0)) if res is not None else 0.0
+    h = float(res.get("height", 0)) if res is not None else 0.0
+    if cal is not None and "width" in cal:
+        w, h = cal.pop("width"), cal.pop("height")
+    if not (w >= 1 and h >= 1 and w == int(w) and h == int(h)):
+        raise InputError(f"{what}: the resolution must be positive integers", path=src)
+    ps = 0.0
+    for prop in el.findall("property"):
+        if prop.get("name") == "pixel_width":
+            ps = float(prop.get("value", 0) or 0)
+    return MetashapeSensor(
+        sid,
+        el.get("label", ""),
+        kind,
+        int(w),
+        int(h),
+        cal,
+        ps if np.isfinite(ps) and ps > 0 else 0.0,
+    )
+
+
+def _chunk_of(root: ET.Element, src: str) -> ET.Element:
+    if root.tag == "chunk":
+        return root
+    chunks = root.findall("chunk")
+    if root.tag != "document" or not chunks:
+        raise InputError("not a Metashape camera file (expected <document><chunk>)", path=src)
+    if len(chunks) > 1:
+        log.warning("%s: %d chunks, the first is read", src, len(chunks))
+    return chunks[0]
+
+
+def read_metashape(path: str | Path) -> MetashapeChunk:
+    """Read a Metashape camera XML (see the module docstring).
+
+    Raises
+    ------
+    InputError
+        Naming the file and the sensor, camera or element at fault.
+    """
+    src = str(path)
+    try:
+        root = ET.parse(src).getroot()
+    except OSError as exc:
+        raise InputError(f"cannot read the camera file: {exc.strerror or exc}", path=src) from exc
+    except ET.ParseError as exc:
+        raise InputError(f"not an XML file: {exc}", path=src) from exc
+    chunk = _chunk_of(root, src)
+    sensors_el = chunk.find("sensors")
+    sensors = {
+        s.sensor_id: s
+        for s in (
+            _read_sensor(e, src)
+            for e in (sensors_el.findall("sensor") if sensors_el is not None else [])
+        )
+    }
+    components: Dict[str, Similarity | None] = {}
+    member: Dict[str, str] = {}
+    comps = chunk.find("components")
+    active = comps.get("active_id", "") if comps is not None else ""
+    for comp in comps.findall("component") if comps is not None else []:
+        cid = comp.get("id", "")
+        components[cid] = _similarity(comp.find("transform"), f"component {cid} transform", src)
+        for cam_id in (comp.findtext("partition/camera_ids") or "").split():
+            member[cam_id] = cid
+    cams_el = chunk.find("cameras")
+    cameras: List[MetashapeCamera] = []
+    skipped: List[Tuple[str, str]] = []
+    labels: Dict[str, str] = {}
+    for el in cams_el.iter("camera") if cams_el is not None else []:
+        cam_id, label = el.get("id", ""), el.get("label", el.get("id", ""))
+        sid = el.get("sensor_id", "")
+        tr = el.find("transform")
+        if tr is None or not (tr.text or "").strip():
+            skipped.append((label, "not aligned (no transform)"))
+            continue
+        if sid not in sensors:
+            skipped.append((label, f"sensor {sid!r} is not in the file"))
+            continue
+        if sensors[sid].calibration is None:
+            skipped.append((label, f"sensor {sid!r} has no calibration"))
+            continue
+        if label in labels:
+            raise InputError(
+                f"cameras {labels[label]} and {cam_id} have the same label {label!r}", path=src
+            )
+        labels[label] = cam_id
+        m = _numbers(tr, 16, f"camera {label!r} transform", src).reshape(4, 4)
+        if not np.allclose(m[3], [0, 0, 0, 1]):
+            raise InputError(f"camera {label!r} transform: the last row must be 0 0 0 1", path=src)
+        m[:3, :3] = _rotation(m[:3, :3], f"camera {label!r} transform", src)
+        comp_id = el.get("component_id", member.get(cam_id, ""))
+        cameras.append(MetashapeCamera(cam_id, label, sid, comp_id, m))
+    chunk_tr = _similarity(chunk.find("transform"), "chunk transform", src)
+    ref = (chunk.findtext("reference") or "").strip()
+    return MetashapeChunk(
+        sensors, tuple(cameras), components, chunk_tr, ref, active, tuple(skipped), src
+    )
+
+
+# ---------------------------------------------------------------------- conversion
+def camera_from_metashape(sensor: MetashapeSensor, pixel_size_mm: float, name: str) -> Camera:
+    """The project's camera of a calibrated Metashape sensor (exact; see the module docstring).
+    ``pixel_size_mm`` is used when the sensor states none."""
+    cal = dict(sensor.calibration or {})
+    ps = sensor.pixel_size_mm or float(pixel_size_mm)
+    f_px = cal["f"]
+    f_mm = f_px * ps
+    lens = MetashapeLens(
+        **{k: cal[k] for k in COEFFICIENTS}, scale_mm=f_mm, aspect=1.0, focal_px=f_px
+    )
+    return Camera(
+        name,
+        f_mm,
+        ps,
+        sensor.width,
+        sensor.height,
+        cal["cx"] * ps,
+        -cal["cy"] * ps,
+        lens,
+        _SENSOR_TYPES[sensor.kind],
+    )
+
+
+def chunk_frame(reference_wkt: str, crs: str) -> Tuple[ColmapFrame, bool]:
+    """The frame of the chunk's world coordinates and whether they are geocentric: LOCAL for
+    ``LOCAL_CS`` (or no reference), else ECEF converted into ``crs`` (default: the chunk's
+    CRS when it is projected).
+
+    Raises
+    ------
+    CrsError
+        A geographic chunk without a projected ``crs``, or a ``crs`` for a local chunk.
+    """
+    ref = reference_wkt.strip()
+    if not ref or ref.upper().startswith("LOCAL_CS"):
+        if crs.strip():
+            raise CrsError(
+                "CRS: the chunk is in local coordinates (LOCAL_CS), which no CRS "
+                "describes; leave CRS empty"
+            )
+        return ColmapFrame("local"), False
+    from pyproj import CRS
+
+    try:
+        chunk_crs = CRS.from_wkt(ref)
+    except Exception as exc:
+        raise CrsError(f"the chunk's reference is not a CRS pyproj reads: {exc}") from exc
+    target = crs.strip()
+    if not target:
+        horizontal = chunk_crs.sub_crs_list[0] if chunk_crs.is_compound else chunk_crs
+        if not horizontal.is_projected:
+            raise CrsError(
+                f"CRS: the chunk is in {chunk_crs.name} ({horizontal.type_name}); "
+                "give the projected CRS to convert it to (e.g. its UTM zone)"
+            )
+        target = chunk_crs.to_wkt()
+    return ColmapFrame("ecef", target), True
+
+
+def _world(
+    chunk: MetashapeChunk, cam: MetashapeCamera, geocentric: bool
+) -> Tuple[Similarity | None, str]:
+    """The internal -> world similarity of a camera, or None and the reason it is skipped."""
+    sim = chunk.components.get(cam.component_id)
+    if sim is None and cam.component_id in ("", chunk.active_component):
+        sim = chunk.chunk_transform  # Metashape 1: the chunk's; 2: the active component's
+    if not geocentric:
+        several = len({c.component_id for c in chunk.cameras}) > 1
+        active = chunk.active_component or (chunk.cameras[0].component_id if chunk.cameras else "")
+        if several and cam.component_id != active:
+            return None, (
+                f"component {cam.component_id} is not the active one ({active}): a "
+                "local chunk's components have no common frame"
+            )
+        return sim or Similarity(np.eye(3), np.zeros(3)), ""
+    if sim is None:
+        return None, f"component {cam.component_id or '-'} has no transform (not georeferenced)"
+    return sim, ""
+
+
+def block_from_metashape(
+    chunk: MetashapeChunk, crs: str, pixel_size_mm: float
+) -> Tuple[ColmapBlock, Tuple[Tuple[str, str], ...]]:
+    """Convert a chunk (see the module docstring): LOCAL or into ``crs``; returns the block
+    (cameras ``metashape_<sensor id>``, one EO row per imported camera, image_id = its label;
+    no observations or points: the camera XML has none) and every skipped camera (label,
+    reason)."""
+    frame, geocentric = chunk_frame(chunk.reference_wkt, crs)
+    skipped = list(chunk.skipped)
+    rows: List[Tuple[MetashapeCamera, Array, Array]] = []
+    for cam in chunk.cameras:
+        sim, why = _world(chunk, cam, geocentric)
+        if sim is None:
+            skipped.append((cam.label, why))
+            continue
+        r_wc = sim.rotation @ cam.transform[:3, :3]
+        centre = sim.apply(cam.transform[:3, 3].reshape(1, 3))[0]
+        rows.append((cam, r_wc.T, -r_wc.T @ centre))
+    for label, why in skipped:
+        log.warning("camera %r skipped: %s", label, why)
+    if not rows:
+        raise InputError(
+            "no camera to import (every camera was skipped: "
+            f"{'; '.join(f'{lab}: {why}' for lab, why in skipped[:5])})",
+            path=chunk.source,
+        )
+    rows.sort(key=lambda row: row[0].label)
+    used = sorted({row[0].sensor_id for row in rows})
+    names = {s: f"metashape_{s}" for s in used}
+    cams = tuple(camera_from_metashape(chunk.sensors[s], pixel_size_mm, names[s]) for s in used)
+    r = np.array([row[1] for row in rows])
+    t = np.array([row[2] for row in rows])
+    eo, _ = oriented(frame, [row[0].label for row in rows], r, t, np.zeros((0, 3)))
+    obs = ImageObservations((), (), np.zeros((0, 2)), np.zeros(0), (), ())
+    ground = GroundPoints((), np.zeros((0, 3)), np.zeros((0, 3)), ())
+    block = ColmapBlock(cams, eo, tuple(names[row[0].sensor_id] for row in rows), obs, ground)
+    return block, tuple(skipped)
