@@ -57,16 +57,18 @@ from numpy.typing import NDArray
 from ..errors import CrsError, InputError
 from ..geometry.camera import Camera
 from ..geometry.forward_lens import MetashapeLens
-from ..photo.bundle_setup import GroundPoints
-from ..photo.observations import ImageObservations
+from ..photo.bundle_setup import DEFAULT_CONTROL_SIGMA_M, GroundPoints
+from ..photo.observations import DEFAULT_SIGMA_PX, ImageObservations
 from .colmap_block import ColmapBlock, ColmapFrame, oriented
 
 Array = NDArray[np.float64]
 log = logging.getLogger(__name__)
 
 __all__ = [
+    "MarkerProjection",
     "MetashapeCamera",
     "MetashapeChunk",
+    "MetashapeMarker",
     "MetashapeSensor",
     "Similarity",
     "block_from_metashape",
@@ -122,10 +124,35 @@ class MetashapeCamera:
 
 
 @dataclass(frozen=True)
+class MetashapeMarker:
+    """One marker: id, label, its reference (x, y, z in the marker CRS; None without one),
+    whether the reference is enabled (control) or not (check), its sigmas (m; None: the
+    chunk's marker accuracy)."""
+
+    marker_id: str
+    label: str
+    xyz: Tuple[float, float, float] | None
+    enabled: bool
+    sigma: Tuple[float, float, float] | None
+
+
+@dataclass(frozen=True)
+class MarkerProjection:
+    """A marker's location on a camera: pixels (u, v) from the image's top-left corner;
+    ``pinned`` for a location placed by the user (Metashape's green flag)."""
+
+    marker_id: str
+    camera_id: str
+    uv: Tuple[float, float]
+    pinned: bool
+
+
+@dataclass(frozen=True)
 class MetashapeChunk:
     """A chunk of a camera XML: sensors, aligned cameras, component and chunk transforms,
     the reference CRS (WKT, "" for none), the active component and the skipped cameras
-    (label, reason)."""
+    (label, reason); its markers, their locations on the cameras, their CRS (WKT, "" for
+    the chunk's) and the chunk's marker accuracy (m)."""
 
     sensors: Dict[str, MetashapeSensor]
     cameras: Tuple[MetashapeCamera, ...]
@@ -135,6 +162,10 @@ class MetashapeChunk:
     active_component: str
     skipped: Tuple[Tuple[str, str], ...]
     source: str
+    markers: Tuple[MetashapeMarker, ...] = ()
+    projections: Tuple[MarkerProjection, ...] = ()
+    marker_reference_wkt: str = ""
+    marker_sigma_m: float = DEFAULT_CONTROL_SIGMA_M
 
 
 # ---------------------------------------------------------------------- reading
@@ -257,6 +288,63 @@ def _chunk_of(root: ET.Element, src: str) -> ET.Element:
     return chunks[0]
 
 
+def _attr(el: ET.Element, key: str, what: str, src: str) -> float | None:
+    val = el.get(key)
+    if val is None:
+        return None
+    try:
+        out = float(val)
+    except ValueError:
+        out = float("nan")
+    if not np.isfinite(out):
+        raise InputError(f"{what}: attribute {key} is not a finite number: {val!r}", path=src)
+    return out
+
+
+def _read_markers(
+    chunk: ET.Element, src: str
+) -> Tuple[Tuple[MetashapeMarker, ...], Tuple[MarkerProjection, ...], float]:
+    """The chunk's markers (``markers/marker`` with their ``reference``), their locations
+    (``frames/frame/markers/marker/location``) and the marker accuracy of its settings."""
+    markers = []
+    for el in chunk.iterfind("markers//marker"):
+        mid = el.get("id", "")
+        what = f"marker {el.get('label', mid)!r}"
+        ref = el.find("reference")
+        xyz = sig = None
+        enabled = False
+        if ref is not None:
+            vals = [_attr(ref, k, what, src) for k in ("x", "y", "z")]
+            if all(v is not None for v in vals):
+                xyz = (float(vals[0]), float(vals[1]), float(vals[2]))  # type: ignore[arg-type]
+            enabled = ref.get("enabled", "false").lower() in ("true", "1")
+            s3 = [_attr(ref, k, what, src) for k in ("sx", "sy", "sz")]
+            sxyz = _attr(ref, "sxyz", what, src)
+            if all(v is not None for v in s3):
+                sig = (float(s3[0]), float(s3[1]), float(s3[2]))  # type: ignore[arg-type]
+            elif sxyz is not None:
+                sig = (sxyz, sxyz, sxyz)
+            if sig is not None and not min(sig) > 0:
+                raise InputError(f"{what}: its reference accuracy must be positive", path=src)
+        markers.append(MetashapeMarker(mid, el.get("label", mid), xyz, enabled, sig))
+    projections = []
+    for mk in chunk.iterfind("frames/frame/markers/marker"):
+        mid = mk.get("marker_id", "")
+        for loc in mk.iterfind("location"):
+            what = f"marker {mid} on camera {loc.get('camera_id', '')}"
+            u, v = _attr(loc, "x", what, src), _attr(loc, "y", what, src)
+            if u is None or v is None:
+                raise InputError(f"{what}: the location needs x and y", path=src)
+            pinned = loc.get("pinned", "true").lower() in ("true", "1")
+            projections.append(MarkerProjection(mid, loc.get("camera_id", ""), (u, v), pinned))
+    sigma = DEFAULT_CONTROL_SIGMA_M
+    for prop in chunk.iterfind("settings/property"):
+        if prop.get("name") == "accuracy_markers":
+            val = _attr(prop, "value", "settings accuracy_markers", src)
+            sigma = val if val is not None and val > 0 else sigma
+    return tuple(markers), tuple(projections), sigma
+
+
 def read_metashape(path: str | Path) -> MetashapeChunk:
     """Read a Metashape camera XML (see the module docstring).
 
@@ -320,8 +408,20 @@ def read_metashape(path: str | Path) -> MetashapeChunk:
         cameras.append(MetashapeCamera(cam_id, label, sid, comp_id, m))
     chunk_tr = _similarity(chunk.find("transform"), "chunk transform", src)
     ref = (chunk.findtext("reference") or "").strip()
+    markers, projections, sigma = _read_markers(chunk, src)
     return MetashapeChunk(
-        sensors, tuple(cameras), components, chunk_tr, ref, active, tuple(skipped), src
+        sensors,
+        tuple(cameras),
+        components,
+        chunk_tr,
+        ref,
+        active,
+        tuple(skipped),
+        src,
+        markers,
+        projections,
+        (chunk.findtext("marker_reference") or "").strip(),
+        sigma,
     )
 
 
@@ -406,6 +506,51 @@ def _world(
     return sim, ""
 
 
+def marker_tables(
+    chunk: MetashapeChunk, imported: Mapping[str, str], frame: ColmapFrame
+) -> Tuple[ImageObservations, GroundPoints]:
+    """The markers as the observation table and ground points.
+
+    Observations: the pinned locations (Metashape's green flags; its automatic, unpinned
+    projections are left out) on the imported cameras (``imported``: camera id -> label),
+    type ``control`` for a marker with reference coordinates, ``tie`` without (point_id =
+    the marker's label), sigma 0.5 px. Ground points: the markers with reference
+    coordinates, role ``control`` when the reference is enabled, else ``check``, their
+    sigmas (else the chunk's marker accuracy), converted from the marker CRS (else the
+    chunk's) into the frame's CRS (LOCAL: as they are).
+    """
+    by_id = {m.marker_id: m for m in chunk.markers}
+    known = [m for m in chunk.markers if m.xyz is not None]
+    xyz = np.array([m.xyz for m in known], dtype=np.float64).reshape(-1, 3)
+    if known and frame.kind != "local":
+        from pyproj import CRS
+
+        from ..geometry.frames import parse_crs, transformer_3d
+
+        wkt = chunk.marker_reference_wkt or chunk.reference_wkt
+        try:
+            src = CRS.from_wkt(wkt)
+        except Exception as exc:
+            raise CrsError(f"the markers' reference is not a CRS pyproj reads: {exc}") from exc
+        tr = transformer_3d(src, parse_crs(frame.crs, what="CRS"))
+        xyz = np.column_stack(tr.transform(xyz[:, 0], xyz[:, 1], xyz[:, 2]))
+    sigma = np.array([m.sigma or (chunk.marker_sigma_m,) * 3 for m in known]).reshape(-1, 3)
+    ground = GroundPoints(tuple(m.label for m in known), xyz, sigma,
+                          tuple("control" if m.enabled else "check" for m in known))  # fmt: skip
+    sel = [p for p in chunk.projections if p.pinned and p.camera_id in imported
+           and p.marker_id in by_id]  # fmt: skip
+    n = len(sel)
+    obs = ImageObservations(
+        tuple(imported[p.camera_id] for p in sel),
+        tuple(by_id[p.marker_id].label for p in sel),
+        np.array([p.uv for p in sel], dtype=np.float64).reshape(-1, 2),
+        np.full(n, DEFAULT_SIGMA_PX),
+        tuple("control" if by_id[p.marker_id].xyz is not None else "tie" for p in sel),
+        ("",) * n,
+    )
+    return obs, ground
+
+
 def block_from_metashape(
     chunk: MetashapeChunk, crs: str, pixel_size_mm: float
 ) -> Tuple[ColmapBlock, Tuple[Tuple[str, str], ...]]:
@@ -439,7 +584,7 @@ def block_from_metashape(
     r = np.array([row[1] for row in rows])
     t = np.array([row[2] for row in rows])
     eo, _ = oriented(frame, [row[0].label for row in rows], r, t, np.zeros((0, 3)))
-    obs = ImageObservations((), (), np.zeros((0, 2)), np.zeros(0), (), ())
-    ground = GroundPoints((), np.zeros((0, 3)), np.zeros((0, 3)), ())
+    imported = {row[0].camera_id: row[0].label for row in rows}
+    obs, ground = marker_tables(chunk, imported, frame)
     block = ColmapBlock(cams, eo, tuple(names[row[0].sensor_id] for row in rows), obs, ground)
     return block, tuple(skipped)

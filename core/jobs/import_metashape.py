@@ -1,5 +1,5 @@
 """``importmetashape``: an Agisoft Metashape camera XML (Export Cameras > Agisoft XML) as the
-project's camera JSON and EO."""
+project's camera JSON, EO, marker observations and ground points."""
 
 from __future__ import annotations
 
@@ -16,10 +16,10 @@ SPEC = AlgorithmSpec(
     title="Import Agisoft Metashape cameras (XML)",
     group="Aerotriangulation",
     group_id="aerotriangulation",
-    summary="Metashape camera XML -> cameras (exact lens model), orientations",
+    summary="Metashape camera XML -> cameras (exact lens model), orientations, markers",
     description="""\
 Reads the camera file Agisoft Metashape writes with File > Export > Export Cameras (Agisoft
-XML) and writes the project's camera JSON and exterior orientation, with the lens model
+XML) and writes the project's camera JSON, exterior orientation and markers, with the lens model
 converted exactly: each calibrated sensor gets the forward lens model of Metashape's own
 equations and coefficients (f, cx, cy, k1-k4, p1, p2, b1, b2; docs/formats.md, Metashape).
 Frame and fisheye sensors are supported; spherical, cylindrical and RPC sensors and nonzero
@@ -38,8 +38,12 @@ components other than the active one of a local chunk (their frames differ).
 
 ## Outputs
 OUTPUT_CAMERA: the cameras (metashape_<sensor id>); OUTPUT_EO: one row per imported camera
-(image_id = the camera's label, with a camera column when there are several sensors). The
-camera XML has no tie points.""",
+(image_id = the camera's label, with a camera column when there are several sensors);
+OUTPUT_OBSERVATIONS: the markers' pinned locations on the imported cameras (type control for a
+marker with reference coordinates, tie without; point_id = the marker's label);
+OUTPUT_POINTS: the markers' reference coordinates in CRS as a ground point table (role
+control when the reference is enabled in Metashape, check when not; the marker accuracy as
+sigma). The camera XML has no tie points.""",
     params=(
         Param(
             "INPUT",
@@ -65,7 +69,7 @@ camera XML has no tie points.""",
             help="used when a sensor states no pixel_width: it sets the "
             "millimetres of the camera, never the projection",
         ),
-        *BLOCK_OUTPUTS[:2],
+        *BLOCK_OUTPUTS,
     ),
     results=(
         *block_results("Number of imported cameras"),

@@ -128,6 +128,7 @@ def build(
     seed: int = 3,
     extra_cameras: str = "",
     sensors: str = "",
+    markers: bool = False,
 ) -> dict:
     """A camera XML of shots 120 m above a field of points, with known poses; ``style`` v2
     (a component transform), v1 (the chunk's transform only) or local (LOCAL_CS). Returns
@@ -184,12 +185,45 @@ def build(
     chunk_tr = _transform(sim)
     ref = LOCAL_WKT if local else WGS84_WKT
     sensors = sensors or _sensor("0", "frame", FRAME) + _sensor("1", "fisheye", FISHEYE, None)
+    marker_xml = frames_xml = ""
+    if markers:  # the first four points as markers, references in WGS84 (lon, lat, h)
+        lon, lat, h = Transformer.from_crs("EPSG:4978", "EPSG:4979", always_xy=True).transform(
+            *pts[:4].T
+        )
+        lon, lat, h = lon.tolist(), lat.tolist(), h.tolist()
+        refs = [
+            f'<reference x="{lon[0]!r}" y="{lat[0]!r}" z="{h[0]!r}" enabled="true"/>',
+            f'<reference x="{lon[1]!r}" y="{lat[1]!r}" z="{h[1]!r}" sxyz="0.05" enabled="false"/>',
+            f'<reference x="{lon[2]!r}" y="{lat[2]!r}" z="{h[2]!r}" sx="0.01" sy="0.02" '
+            'sz="0.03" enabled="true"/>',
+            "",
+        ]
+        marker_xml = (
+            '<markers next_id="4" next_group_id="0">'
+            + "".join(f'<marker id="{j}" label="GCP{j}">{refs[j]}</marker>' for j in range(4))
+            + "</markers>"
+        )
+        locs = {j: [] for j in range(4)}
+        for (label, j), px in expected.items():
+            if j < 4:
+                cid = str(int(label.split("_")[1]))
+                u, v = px.tolist()
+                locs[j].append(f'<location camera_id="{cid}" pinned="true" x="{u!r}" y="{v!r}"/>')
+        locs[0].append('<location camera_id="0" pinned="false" x="10.5" y="20.5"/>')
+        frames_xml = (
+            '<frames next_id="1"><frame id="0"><markers>'
+            + "".join(f'<marker marker_id="{j}">{"".join(v)}</marker>' for j, v in locs.items())
+            + "</markers></frame></frames>"
+        )
+    settings = (
+        '<settings><property name="accuracy_markers" value="0.004"/></settings>' if markers else ""
+    )
     text = (
         f'<?xml version="1.0" encoding="UTF-8"?>\n<document version="2.0.0"><chunk '
         f'label="Chunk 1" enabled="true"><sensors next_id="2">{sensors}</sensors>{comps}'
         f'<cameras next_id="{n_shots}" next_group_id="1"><group id="0" label="g" '
-        f'type="folder">{"".join(cams)}</group>{extra_cameras}</cameras>{chunk_tr}'
-        f"<reference>{ref}</reference></chunk></document>\n"
+        f'type="folder">{"".join(cams)}</group>{extra_cameras}</cameras>{marker_xml}{chunk_tr}'
+        f"<reference>{ref}</reference>{frames_xml}{settings}</chunk></document>\n"
     )
     path.write_text(text, encoding="utf-8")
     return {"points": pts, "expected": expected}
@@ -454,3 +488,37 @@ def test_command_line(tmp_path: Path, capsys) -> None:
     np.testing.assert_allclose(eo.eo.opk, block.eo.opk, atol=1e-9)
     [cam] = read_cameras_json(out["camera"])
     assert cam.distortion.model == "metashape" and cam.width_px == 4864
+
+
+def test_markers_become_observations_and_ground_points(tmp_path: Path, capsys) -> None:
+    """Pinned locations -> control rows (where the imported camera projects the marker's
+    reference within 1e-6 px), unpinned ones left out; references from WGS84 into UTM as
+    PROJ gives them, roles from the reference's enabled flag, sigmas from sx sy sz, sxyz or
+    the chunk's marker accuracy; a marker without a reference -> tie rows."""
+    path = tmp_path / "cameras.xml"
+    m = build(path, markers=True)
+    block, _ = block_from_metashape(read_metashape(path), UTM, 0.004)
+    gp = block.points
+    assert gp.point_id == ("GCP0", "GCP1", "GCP2") and gp.role == ("control", "check", "control")
+    np.testing.assert_allclose(gp.xyz, to_map(m["points"][:3]), atol=1e-6)
+    np.testing.assert_allclose(gp.sigma, [[0.004] * 3, [0.05] * 3, [0.01, 0.02, 0.03]])
+    obs = block.observations
+    want = {k: v for k, v in m["expected"].items() if k[1] < 4}
+    assert len(obs.image_id) == len(want) > 8  # the unpinned location left out
+    for i, (img, pid) in enumerate(zip(obs.image_id, obs.point_id)):
+        j = int(pid[3:])
+        np.testing.assert_allclose(obs.pixels[i], want[(img, j)], atol=1e-9)
+        assert obs.type[i] == ("tie" if j == 3 else "control")
+        k = block.eo.image_id.index(img)
+        got = project_enu(block, k, m["points"][j : j + 1])
+        assert np.max(np.abs(got - obs.pixels[i])) < 1e-6
+    from lidarphoto.core.cli import main as cli_main
+    from lidarphoto.core.io.ground_points import read_ground_points_csv
+    from lidarphoto.core.io.observations import read_observations_csv
+
+    out = {k: tmp_path / f"{k}.csv" for k in ("eo", "observations", "points")}
+    args = ["importmetashape", "--input", str(path), "--crs", UTM]
+    rc = cli_main([*args, *(a for k, p in out.items() for a in (f"--output-{k}", str(p)))])
+    assert rc == 0, capsys.readouterr().err
+    assert len(read_observations_csv(out["observations"]).image_id) == len(want)
+    assert read_ground_points_csv(out["points"]).role == gp.role
