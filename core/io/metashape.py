@@ -80,7 +80,7 @@ __all__ = [
 COEFFICIENTS = ("k1", "k2", "k3", "k4", "p1", "p2", "b1", "b2")
 _SENSOR_TYPES = {"frame": "perspective", "fisheye": "equidistant"}
 #: Rotation matrices are orthonormalised when within this of a rotation (the files' digits).
-_ROTATION_TOL = 1e-6
+_ROTATION_TOL = 1e-5
 
 
 @dataclass(frozen=True)
@@ -169,6 +169,19 @@ class MetashapeChunk:
 
 
 # ---------------------------------------------------------------------- reading
+def _attr(el: ET.Element, key: str, what: str, src: str) -> float | None:
+    val = el.get(key)
+    if val is None:
+        return None
+    try:
+        out = float(val)
+    except ValueError:
+        out = float("nan")
+    if not np.isfinite(out):
+        raise InputError(f"{what}: attribute {key} is not a finite number: {val!r}", path=src)
+    return out
+
+
 def _numbers(el: ET.Element | None, n: int, what: str, src: str) -> Array:
     text = (el.text or "") if el is not None else ""
     try:
@@ -186,8 +199,8 @@ def _rotation(m: Array, what: str, src: str) -> Array:
     r = u @ vt
     if (
         np.linalg.det(r) < 0
-        or np.max(np.abs(s - 1.0)) > _ROTATION_TOL * 10
-        or np.max(np.abs(r - m)) > _ROTATION_TOL * 10
+        or np.max(np.abs(s - 1.0)) > _ROTATION_TOL
+        or np.max(np.abs(r - m)) > _ROTATION_TOL
     ):
         raise InputError(f"{what}: not a rotation matrix (singular values {s.round(6)})", path=src)
     return r
@@ -241,7 +254,8 @@ def _calibration(sensor: ET.Element, what: str, src: str) -> Dict[str, float] | 
         raise InputError(f"{what}: the focal length f must be positive, got {out['f']}", path=src)
     res = cal.find("resolution")
     if res is not None:
-        out["width"], out["height"] = float(res.get("width", 0)), float(res.get("height", 0))
+        out["width"] = _attr(res, "width", f"{what} calibration resolution", src) or 0.0
+        out["height"] = _attr(res, "height", f"{what} calibration resolution", src) or 0.0
     return out
 
 
@@ -256,8 +270,8 @@ def _read_sensor(el: ET.Element, src: str) -> MetashapeSensor:
             path=src,
         )
     res = el.find("resolution")
-    w = float(res.get("width", 0)) if res is not None else 0.0
-    h = float(res.get("height", 0)) if res is not None else 0.0
+    w = (_attr(res, "width", what, src) or 0.0) if res is not None else 0.0
+    h = (_attr(res, "height", what, src) or 0.0) if res is not None else 0.0
     if cal is not None and "width" in cal:
         w, h = cal.pop("width"), cal.pop("height")
     if not (w >= 1 and h >= 1 and w == int(w) and h == int(h)):
@@ -265,7 +279,7 @@ def _read_sensor(el: ET.Element, src: str) -> MetashapeSensor:
     ps = 0.0
     for prop in el.findall("property"):
         if prop.get("name") == "pixel_width":
-            ps = float(prop.get("value", 0) or 0)
+            ps = _attr(prop, "value", f"{what} pixel_width", src) or 0.0
     return MetashapeSensor(
         sid,
         el.get("label", ""),
@@ -286,19 +300,6 @@ def _chunk_of(root: ET.Element, src: str) -> ET.Element:
     if len(chunks) > 1:
         log.warning("%s: %d chunks, the first is read", src, len(chunks))
     return chunks[0]
-
-
-def _attr(el: ET.Element, key: str, what: str, src: str) -> float | None:
-    val = el.get(key)
-    if val is None:
-        return None
-    try:
-        out = float(val)
-    except ValueError:
-        out = float("nan")
-    if not np.isfinite(out):
-        raise InputError(f"{what}: attribute {key} is not a finite number: {val!r}", path=src)
-    return out
 
 
 def _read_markers(
