@@ -60,11 +60,13 @@ from ..geometry.forward_lens import MetashapeLens
 from ..photo.bundle_setup import DEFAULT_CONTROL_SIGMA_M, GroundPoints
 from ..photo.observations import DEFAULT_SIGMA_PX, ImageObservations
 from .colmap_block import ColmapBlock, ColmapFrame, oriented
+from .colmap_names import METASHAPE_IMAGE_NAMES
 
 Array = NDArray[np.float64]
 log = logging.getLogger(__name__)
 
 __all__ = [
+    "IMAGE_NAMES",
     "MarkerProjection",
     "MetashapeCamera",
     "MetashapeChunk",
@@ -73,9 +75,12 @@ __all__ = [
     "Similarity",
     "block_from_metashape",
     "camera_from_metashape",
+    "marker_tables",
     "read_metashape",
 ]
 
+#: The EO's image names: the camera labels, or their file names (see colmap_names).
+IMAGE_NAMES = METASHAPE_IMAGE_NAMES
 #: Calibration coefficients read (absent ones are 0).
 COEFFICIENTS = ("k1", "k2", "k3", "k4", "p1", "p2", "b1", "b2")
 _SENSOR_TYPES = {"frame": "perspective", "fisheye": "equidistant"}
@@ -536,10 +541,17 @@ def marker_tables(
         tr = transformer_3d(src, parse_crs(frame.crs, what="CRS"))
         xyz = np.column_stack(tr.transform(xyz[:, 0], xyz[:, 1], xyz[:, 2]))
     sigma = np.array([m.sigma or (chunk.marker_sigma_m,) * 3 for m in known]).reshape(-1, 3)
-    ground = GroundPoints(tuple(m.label for m in known), xyz, sigma,
-                          tuple("control" if m.enabled else "check" for m in known))  # fmt: skip
-    sel = [p for p in chunk.projections if p.pinned and p.camera_id in imported
-           and p.marker_id in by_id]  # fmt: skip
+    ground = GroundPoints(
+        tuple(m.label for m in known),
+        xyz,
+        sigma,
+        tuple("control" if m.enabled else "check" for m in known),
+    )
+    sel = [
+        p
+        for p in chunk.projections
+        if p.pinned and p.camera_id in imported and p.marker_id in by_id
+    ]
     n = len(sel)
     obs = ImageObservations(
         tuple(imported[p.camera_id] for p in sel),
@@ -552,13 +564,32 @@ def marker_tables(
     return obs, ground
 
 
+def _image_name(label: str, image_names: str) -> str:
+    """The image_id of a camera label (``file``: its file name without folder and extension;
+    Metashape's labels may carry either separator)."""
+    if image_names == "label":
+        return label
+    return Path(label.replace("\\", "/").rsplit("/", 1)[-1]).stem
+
+
 def block_from_metashape(
-    chunk: MetashapeChunk, crs: str, pixel_size_mm: float
+    chunk: MetashapeChunk, crs: str, pixel_size_mm: float, image_names: str = IMAGE_NAMES[0]
 ) -> Tuple[ColmapBlock, Tuple[Tuple[str, str], ...]]:
     """Convert a chunk (see the module docstring): LOCAL or into ``crs``; returns the block
-    (cameras ``metashape_<sensor id>``, one EO row per imported camera, image_id = its label;
-    no observations or points: the camera XML has none) and every skipped camera (label,
-    reason)."""
+    (cameras ``metashape_<sensor id>``, one EO row per imported camera, image_id its label or,
+    ``image_names`` ``file``, the label's file name without folder and extension; the
+    markers as observations and ground points, :func:`marker_tables`) and every skipped
+    camera (label, reason).
+
+    Raises
+    ------
+    InputError
+        No camera to import, an unknown ``image_names``, or two cameras of one image name.
+    """
+    if image_names not in IMAGE_NAMES:
+        raise InputError(
+            f"IMAGE_NAMES: expected one of {', '.join(IMAGE_NAMES)}, got {image_names!r}"
+        )
     frame, geocentric = chunk_frame(chunk.reference_wkt, crs)
     skipped = list(chunk.skipped)
     rows: List[Tuple[MetashapeCamera, Array, Array]] = []
@@ -584,8 +615,18 @@ def block_from_metashape(
     cams = tuple(camera_from_metashape(chunk.sensors[s], pixel_size_mm, names[s]) for s in used)
     r = np.array([row[1] for row in rows])
     t = np.array([row[2] for row in rows])
-    eo, _ = oriented(frame, [row[0].label for row in rows], r, t, np.zeros((0, 3)))
-    imported = {row[0].camera_id: row[0].label for row in rows}
+    image_id = {row[0].camera_id: _image_name(row[0].label, image_names) for row in rows}
+    first: Dict[str, str] = {}
+    for row in rows:
+        name = image_id[row[0].camera_id]
+        if first.setdefault(name, row[0].label) != row[0].label:
+            raise InputError(
+                f"cameras {first[name]!r} and {row[0].label!r} are both image "
+                f"{name!r}: use IMAGE_NAMES label",
+                path=chunk.source,
+            )
+    eo, _ = oriented(frame, [image_id[row[0].camera_id] for row in rows], r, t, np.zeros((0, 3)))
+    imported = image_id
     obs, ground = marker_tables(chunk, imported, frame)
     block = ColmapBlock(cams, eo, tuple(names[row[0].sensor_id] for row in rows), obs, ground)
     return block, tuple(skipped)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import logging
 
+from .common import _first
 from .import_colmap import BLOCK_OUTPUTS, block_results, finish_import
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Ref, Result, Values
@@ -38,7 +39,8 @@ components other than the active one of a local chunk (their frames differ).
 
 ## Outputs
 OUTPUT_CAMERA: the cameras (metashape_<sensor id>); OUTPUT_EO: one row per imported camera
-(image_id = the camera's label, with a camera column when there are several sensors);
+(image_id = the camera's label, or its file name with IMAGE_NAMES file; with a camera column
+when there are several sensors);
 OUTPUT_OBSERVATIONS: the markers' pinned locations on the imported cameras (type control for a
 marker with reference coordinates, tie without; point_id = the marker's label);
 OUTPUT_POINTS: the markers' reference coordinates in CRS as a ground point table (role
@@ -69,6 +71,15 @@ sigma). The camera XML has no tie points.""",
             help="used when a sensor states no pixel_width: it sets the "
             "millimetres of the camera, never the projection",
         ),
+        Param(
+            "IMAGE_NAMES",
+            "enum",
+            "Image names in the EO",
+            Ref("io.colmap_names", "METASHAPE_IMAGE_NAMES", convert=_first),
+            options=Ref("io.colmap_names", "METASHAPE_IMAGE_NAMES"),  # type: ignore[arg-type]
+            help="label: the camera labels as Metashape shows them; file: their file names "
+            "without folder and extension (how orthorectify and the picking dock find images)",
+        ),
         *BLOCK_OUTPUTS,
     ),
     results=(
@@ -84,7 +95,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the camera XML, convert it (LOCAL or into CRS), write the requested tables."""
     from ..io.metashape import block_from_metashape, read_metashape
 
-    block, skipped = block_from_metashape(read_metashape(v.input), v.crs or "", v.pixel_size)
+    chunk = read_metashape(v.input)
+    block, skipped = block_from_metashape(chunk, v.crs or "", v.pixel_size, v.image_names)
     result = finish_import(block, out, progress, "cameras")
     result.results["SKIPPED_COUNT"] = len(skipped)
     if skipped:

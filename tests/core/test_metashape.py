@@ -129,6 +129,7 @@ def build(
     extra_cameras: str = "",
     sensors: str = "",
     markers: bool = False,
+    frame_only: bool = False,
 ) -> dict:
     """A camera XML of shots 120 m above a field of points, with known poses; ``style`` v2
     (a component transform), v1 (the chunk's transform only) or local (LOCAL_CS). Returns
@@ -151,7 +152,7 @@ def build(
     cams, expected = [], {}
     kinds = {"0": ("frame", FRAME), "1": ("fisheye", FISHEYE)}
     for i in range(n_shots):
-        sid = "0" if i % 3 else "1"
+        sid = "0" if i % 3 or frame_only else "1"
         kind, cal = kinds[sid]
         tilt = rng.normal(scale=0.1, size=3) + ([0.0, 0.45, 0.0] if i == 2 else 0.0)
         r_enu = Rotation.from_rotvec(tilt).as_matrix() @ np.diag([1.0, -1.0, -1.0])
@@ -522,3 +523,92 @@ def test_markers_become_observations_and_ground_points(tmp_path: Path, capsys) -
     assert rc == 0, capsys.readouterr().err
     assert len(read_observations_csv(out["observations"]).image_id) == len(want)
     assert read_ground_points_csv(out["points"]).role == gp.role
+
+
+def test_metashape_block_to_orthophoto_on_a_dsm(tmp_path: Path, capsys) -> None:
+    """The issue's path end to end: a Metashape camera XML -> importmetashape (IMAGE_NAMES
+    file) -> orthorectify on a flat DSM. A bright spot drawn where Metashape's equations put
+    a ground point lands on the orthophoto at that point's UTM position (PROJ)."""
+    from lidarphoto.core.cli import main as cli_main
+    from lidarphoto.core.geometry.grid import Grid
+    from lidarphoto.core.geometry.surface import Dsm
+    from lidarphoto.core.io.dsm import write_dsm
+    from lidarphoto.core.io.raster import RasterReader
+    from lidarphoto.core.io.raster_write import write_rgb_tiff
+
+    xml = tmp_path / "cameras.xml"
+    build(xml, n_shots=2, frame_only=True)
+    root = ET.parse(xml).getroot()
+    for res in root.iter("resolution"):  # a quarter of the size: the same camera, binned
+        res.set("width", str(W // 4))
+        res.set("height", str(H // 4))
+    cal_el = root.find(".//calibration[@class='adjusted']")
+    for key in ("f", "cx", "cy", "b1", "b2"):
+        cal_el.find(key).text = repr(float(cal_el.findtext(key)) / 4)
+    label = "sub/folder/DJI_0001.JPG"
+    cam = next(c for c in root.iter("camera") if c.get("label") == "DJI_0001")
+    cam.set("label", label)
+    xml.write_text(ET.tostring(root, encoding="unicode"))
+    cal = {k: float(cal_el.findtext(k) or 0.0) for k in FRAME}
+    comp = root.find(".//component/transform")
+    r_c = np.array(comp.findtext("rotation").split(), dtype=float).reshape(3, 3)
+    t_c = np.array(comp.findtext("translation").split(), dtype=float)
+    s_c = float(comp.findtext("scale"))
+    m = np.array(cam.findtext("transform").split(), dtype=float).reshape(4, 4)
+    centre = s_c * r_c @ m[:3, 3] + t_c
+    # the ground point 120 m below the camera, a little off its nadir
+    lon, lat, h = Transformer.from_crs("EPSG:4978", "EPSG:4979", always_xy=True).transform(*centre)
+    target = np.array(
+        Transformer.from_crs("EPSG:4979", "EPSG:4978", always_xy=True).transform(
+            lon + 4e-5, lat - 3e-5, h - 120.0
+        )
+    )
+    xc = ((target - t_c) @ r_c / s_c - m[:3, 3]) @ m[:3, :3]
+    u, v = metashape_pixels(cal, "frame", xc.reshape(1, 3), (W // 4, H // 4))[0]
+    img = np.zeros((H // 4, W // 4, 3), np.uint8)
+    yy, xx = np.mgrid[0 : H // 4, 0 : W // 4] + 0.5  # pixel centres
+    img[(xx - u) ** 2 + (yy - v) ** 2 <= 4.0**2] = 255
+    images = tmp_path / "images"
+    write_rgb_tiff(images / "DJI_0001.tif", img)
+    want = to_map(target.reshape(1, 3))[0]
+    grid = Grid(want[0] - 60.0, want[1] + 60.0, 0.5, 240, 240)
+    write_dsm(
+        tmp_path / "dsm.tif", Dsm(np.full((240, 240), want[2], np.float32), grid, pyproj_crs(UTM))
+    )
+    out = {k: tmp_path / f for k, f in (("camera", "cam.json"), ("eo", "eo.csv"))}
+    args = ["importmetashape", "--input", str(xml), "--crs", UTM, "--image-names", "file"]
+    rc = cli_main([*args, *(a for k, p in out.items() for a in (f"--output-{k}", str(p)))])
+    assert rc == 0, capsys.readouterr().err
+    assert "DJI_0001" in out["eo"].read_text()
+    rc = cli_main(
+        [
+            "orthorectify",
+            "--camera",
+            str(out["camera"]),
+            "--eo",
+            str(out["eo"]),
+            "--images",
+            str(images),
+            "--dsm",
+            str(tmp_path / "dsm.tif"),
+            "--crs",
+            UTM,
+            "--gsd",
+            "0.05",
+            "--output-folder",
+            str(tmp_path / "ortho"),
+        ]
+    )
+    assert rc == 0, capsys.readouterr().err
+    with RasterReader(tmp_path / "ortho" / "DJI_0001_ortho.tif") as src:
+        gt, band = src.info.geotransform, src.read()[0].astype(float)
+    rows, cols = np.nonzero(band > 127)
+    e = gt[0] + (cols.mean() + 0.5) * gt[1]
+    n = gt[3] + (rows.mean() + 0.5) * gt[5]
+    assert np.hypot(e - want[0], n - want[1]) < 0.05, (e - want[0], n - want[1])
+
+
+def pyproj_crs(text: str):
+    from pyproj import CRS
+
+    return CRS.from_user_input(text)
