@@ -307,6 +307,14 @@ def _chunk_of(root: ET.Element, src: str) -> ET.Element:
     return chunks[0]
 
 
+def _triple(
+    el: ET.Element, keys: Tuple[str, str, str], what: str, src: str
+) -> Tuple[float, float, float] | None:
+    """Three numeric attributes, or None when any is absent."""
+    a, b, c = (_attr(el, k, what, src) for k in keys)
+    return (a, b, c) if a is not None and b is not None and c is not None else None
+
+
 def _read_markers(
     chunk: ET.Element, src: str
 ) -> Tuple[Tuple[MetashapeMarker, ...], Tuple[MarkerProjection, ...], float]:
@@ -317,18 +325,15 @@ def _read_markers(
         mid = el.get("id", "")
         what = f"marker {el.get('label', mid)!r}"
         ref = el.find("reference")
-        xyz = sig = None
+        xyz: Tuple[float, float, float] | None = None
+        sig: Tuple[float, float, float] | None = None
         enabled = False
         if ref is not None:
-            vals = [_attr(ref, k, what, src) for k in ("x", "y", "z")]
-            if all(v is not None for v in vals):
-                xyz = (float(vals[0]), float(vals[1]), float(vals[2]))  # type: ignore[arg-type]
+            xyz = _triple(ref, ("x", "y", "z"), what, src)
             enabled = ref.get("enabled", "false").lower() in ("true", "1")
-            s3 = [_attr(ref, k, what, src) for k in ("sx", "sy", "sz")]
+            sig = _triple(ref, ("sx", "sy", "sz"), what, src)
             sxyz = _attr(ref, "sxyz", what, src)
-            if all(v is not None for v in s3):
-                sig = (float(s3[0]), float(s3[1]), float(s3[2]))  # type: ignore[arg-type]
-            elif sxyz is not None:
+            if sig is None and sxyz is not None:
                 sig = (sxyz, sxyz, sxyz)
             if sig is not None and not min(sig) > 0:
                 raise InputError(f"{what}: its reference accuracy must be positive", path=src)
