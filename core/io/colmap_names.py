@@ -1,5 +1,6 @@
-"""COLMAP's camera models and the import's default pixel size, in a module that imports no
-numerical library (the help lists them without numpy: tests/core/test_startup.py)."""
+"""COLMAP's camera models, the block imports' default pixel size and the Metashape import's
+image-name choices, in a module that imports no numerical library (the help lists them
+without numpy: tests/core/test_startup.py)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,11 @@ from typing import Dict, Tuple
 #: Pixel size given to an imported COLMAP camera when none is stated, mm (COLMAP stores none;
 #: it scales the millimetres of the camera, never its projection).
 DEFAULT_PIXEL_SIZE_MM = 0.004
+
+#: How the Metashape import names the images in the EO: ``label`` (the camera's label as
+#: Metashape shows it) or ``file`` (the label's file name without folder and extension: how
+#: orthorectify and the picking dock match image files).
+METASHAPE_IMAGE_NAMES = ("label", "file")
 
 #: COLMAP's camera models: id -> (name, parameter names), as in its format documentation.
 COLMAP_MODELS: Dict[int, Tuple[str, Tuple[str, ...]]] = {

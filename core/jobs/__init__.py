@@ -20,6 +20,7 @@ NAMES = (
     "import_colmap",
     "export_colmap",
     "import_opensfm",
+    "import_metashape",
     "ground_filter",
     "create_lcps",
     "accuracy_report",

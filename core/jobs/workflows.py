@@ -133,6 +133,16 @@ WORKFLOWS: tuple[Workflow, ...] = (
         ),
     ),
     Workflow(
+        _t("A Metashape block: orthophotos on the LiDAR DSM"),
+        (
+            ("importmetashape", _t("INPUT = the camera XML (Export Cameras, Agisoft XML); "
+             "CRS = the mapping CRS (empty: the chunk's projected CRS); OUTPUT_CAMERA, "
+             "OUTPUT_EO")),
+            ("orthorectify", _t("CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
+             "OUTPUT_FOLDER = one orthophoto per image")),
+        ),
+    ),
+    Workflow(
         _t("Boresight calibration from an SBET (or ASCII export) and the camera events"),
         (
             ("importtrajectory", _t("INPUT = the SBET, POSPac / Inertial Explorer export or "
