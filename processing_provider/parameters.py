@@ -331,13 +331,24 @@ def layer_parameter(p: Param, title: str) -> QgsProcessingParameterDefinition:
     return LayerOrFileParameter(p.name, title, None, p.optional, types)
 
 
-#: What each layer kind's file must be: (providers, file endings or () for any, its name).
+#: What each layer kind's file must be: (providers, file endings or () for any).
 _LAYER_FILES = {
-    "raster": (("gdal",), (), "raster"),
-    "pointcloud": (("pdal", "copc"), (".las", ".laz"), "LAS/LAZ"),
-    "surface": (("gdal", "pdal", "copc"), (), "raster or LAS/LAZ"),
-    "table": (("delimitedtext", "ogr"), (".csv", ".txt"), "CSV"),
+    "raster": (("gdal",), ()),
+    "pointcloud": (("pdal", "copc"), (".las", ".laz")),
+    "surface": (("gdal", "pdal", "copc"), ()),
+    "table": (("delimitedtext", "ogr"), (".csv", ".txt")),
 }
+
+
+def _file_format(kind: str) -> str:
+    """The name of a layer kind's file format, translated (the refusal's ``{what}``)."""
+    names = {
+        "raster": QCoreApplication.translate("LidarPhotoProvider", "raster"),
+        "pointcloud": QCoreApplication.translate("LidarPhotoProvider", "LAS/LAZ"),
+        "surface": QCoreApplication.translate("LidarPhotoProvider", "raster or LAS/LAZ"),
+        "table": QCoreApplication.translate("LidarPhotoProvider", "CSV"),
+    }
+    return names[kind]
 
 
 def layer_source_file(layer) -> str:
@@ -367,7 +378,7 @@ def layer_file(alg, p: Param, parameters: dict, context) -> str | None:
     layer = alg.parameterAsLayer(parameters, p.name, context)
     if layer is None:  # not a layer: the text as a path (the job names a missing file)
         return value if isinstance(value, str) and value else None
-    providers, endings, what = _LAYER_FILES[p.kind]
+    providers, endings = _LAYER_FILES[p.kind]
     path = layer_source_file(layer)
     if (
         not path
@@ -379,6 +390,8 @@ def layer_file(alg, p: Param, parameters: dict, context) -> str | None:
                 "LidarPhotoProvider",
                 "{name}: the layer {layer} is not backed by a {what} file ({source}); "
                 "save it as one first",
-            ).format(name=p.name, layer=layer.name(), what=what, source=layer.source())
+            ).format(
+                name=p.name, layer=layer.name(), what=_file_format(p.kind), source=layer.source()
+            )
         )
     return path
