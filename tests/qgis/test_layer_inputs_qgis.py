@@ -218,3 +218,48 @@ def test_without_pdal_a_cloud_is_a_file_and_a_dsm_takes_a_laz_path(provider, tmp
     ortho = provider.algorithm("orthorectify")
     p = next(q for q in ortho.JOB.SPEC.params if q.name == "DSM")
     assert layer_file(ortho, p, {"DSM": str(AHN3)}, _context(QgsProject.instance())) == str(AHN3)
+
+
+def test_an_output_table_layer_is_read_back_as_its_file(provider, project, tmp_path):
+    """A table as the runs load it (output_layers.table_layer: delimited text with points, its
+    ``#`` warning lines skipped) given to a ``table`` parameter is its CSV file again, warning
+    lines included: the output of one run is the input of the next."""
+    from lidarphoto.processing_provider.output_layers import table_layer
+    from qgis.core import QgsCoordinateReferenceSystem
+
+    csv = tmp_path / "ground points.csv"
+    csv.write_text("# doubtful: 2 images only\npoint_id,X,Y,Z\nA,500000.5,7450000.25,781.0\n",
+                   encoding="utf-8")  # fmt: skip
+    layer = table_layer(str(csv), QgsCoordinateReferenceSystem(CRS), "ground points")
+    assert layer is not None and layer.featureCount() == 1
+    project.addMapLayer(layer)
+    alg = provider.algorithm("bundleadjustment")
+    p = next(q for q in alg.JOB.SPEC.params if q.name == "GROUND_POINTS")
+    assert p.kind == "table"
+    for value in (layer, layer.id()):
+        assert layer_file(alg, p, {"GROUND_POINTS": value}, _context(project)) == str(csv)
+
+
+def test_the_form_offers_the_csv_layer_and_runs_from_it(provider, project, monkeypatch, tmp_path):
+    """The algorithm dialog (Processing's own, headless): the table parameter's widget takes a
+    CSV layer of the project; the parameters the form hands over run to the file's figures."""
+    from processing.gui import ParametersPanel
+
+    monkeypatch.setattr(
+        ParametersPanel, "iface", None
+    )  # no main window: the form without map canvas
+    table = _checkpoints(tmp_path / "cp.csv")
+    layer = QgsVectorLayer(f"{table.as_uri()}?type=csv&geomType=none", "cp", "delimitedtext")
+    project.addMapLayers([QgsVectorLayer("Point?crs=EPSG:31983", "scratch", "memory"), layer])
+    dialog = processing.createAlgorithmDialog(ACCURACY, {})
+    try:
+        widget = dialog.mainWidget().wrappers["INPUT"]
+        widget.setParameterValue(layer.id(), QgsProcessingContext())
+        assert widget.parameterValue() == layer.id()
+        params = dialog.createProcessingParameters()
+    finally:
+        dialog.deleteLater()
+    assert params["INPUT"] == layer.id()
+    from_form = processing.run(ACCURACY, {**params, "CRS": CRS}, context=_context(project))
+    from_file = processing.run(ACCURACY, {"INPUT": str(table), "CRS": CRS})
+    assert from_form["RMSE_3D"] == from_file["RMSE_3D"] > 0.1
