@@ -20,9 +20,9 @@ kind       QGIS parameter                      value
 file       QgsProcessingParameterFile          path (str) or None
 raster     QgsProcessingParameterRasterLayer   path (str) or None: a raster layer's file,
                                                or a file
-pointcloud QgsProcessingParameterPointCloudLayer path (str) or None: a point-cloud layer's
-           where QGIS reads LAS/LAZ (PDAL),    file, or a file
-           else QgsProcessingParameterFile
+pointcloud …ParameterPointCloudLayer where     path (str) or None: a point-cloud layer's
+           QGIS reads LAS/LAZ (PDAL), else     file, or a file
+           QgsProcessingParameterFile
 surface    QgsProcessingParameterMapLayer      path (str) or None: a DSM, raster or LAS/LAZ
            (rasters; clouds with PDAL)         (a layer's file, or a file)
 table      QgsProcessingParameterVectorLayer   path (str) or None: the CSV file of a layer
