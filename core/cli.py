@@ -27,6 +27,10 @@ from .jobs.translate import context_of, translate_spec
 
 _METAVAR = {
     "file": "FILE",
+    "raster": "FILE",
+    "pointcloud": "FILE",
+    "surface": "FILE",
+    "table": "CSV",
     "points": "CSV",
     "crs": "CRS",
     "number": "NUMBER",

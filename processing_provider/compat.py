@@ -32,10 +32,12 @@ if hasattr(Qgis, "ProcessingSourceType"):  # QGIS >= 3.36
     SOURCE_FILE = Qgis.ProcessingSourceType.File
     SOURCE_RASTER = Qgis.ProcessingSourceType.Raster
     SOURCE_POINT_CLOUD = Qgis.ProcessingSourceType.PointCloud
+    SOURCE_TABLE = Qgis.ProcessingSourceType.Vector  # any geometry or none
 else:  # QGIS 3.22-3.34
     SOURCE_FILE = QgsProcessing.SourceType.TypeFile
     SOURCE_RASTER = QgsProcessing.SourceType.TypeRaster
     SOURCE_POINT_CLOUD = QgsProcessing.SourceType.TypePointCloud
+    SOURCE_TABLE = QgsProcessing.SourceType.TypeVector
 
 if hasattr(Qgis, "ProcessingParameterFlag"):  # QGIS >= 3.36
     FLAG_ADVANCED = Qgis.ProcessingParameterFlag.Advanced

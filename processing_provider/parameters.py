@@ -24,12 +24,15 @@ from qgis.core import (
     QgsProcessingParameterMatrix,
     QgsProcessingParameterMultipleLayers,
     QgsProcessingParameterNumber,
+    QgsProcessingParameterPointCloudLayer,
     QgsProcessingParameterRasterDestination,
+    QgsProcessingParameterRasterLayer,
     QgsProcessingParameterString,
+    QgsProcessingParameterVectorLayer,
 )
-from qgis.PyQt.QtCore import QCoreApplication
+from qgis.PyQt.QtCore import QCoreApplication, QUrl
 
-from ..core.jobs.spec import AlgorithmSpec, Param, Result, facts_line
+from ..core.jobs.spec import FILE_KINDS, AlgorithmSpec, Param, Result, facts_line
 from .compat import (
     FIELD_TYPE_ANY,
     FIELD_TYPE_NUMERIC,
@@ -40,6 +43,7 @@ from .compat import (
     SOURCE_FILE,
     SOURCE_POINT_CLOUD,
     SOURCE_RASTER,
+    SOURCE_TABLE,
     SOURCE_VECTOR_LINE,
     SOURCE_VECTOR_POINT,
     SOURCE_VECTOR_POLYGON,
@@ -104,8 +108,12 @@ def read_numbers(alg, p: Param, parameters: dict, context):
 
 
 def layer_input(p: Param) -> bool:
-    """A DSM file parameter (a raster, or a LAS/LAZ): a layer of the project or a file."""
-    return p.kind == "file" and (p.file_filter or "").startswith("DSM")
+    """Whether QGIS offers the project's layers for ``p`` (a file is accepted too): the layer
+    kinds of core/jobs/spec.py, except a point cloud where this QGIS reads no LAS/LAZ (a file
+    parameter there, so one spec works on QGIS with and without PDAL)."""
+    if p.kind == "pointcloud":
+        return point_cloud_layers()
+    return p.kind in ("raster", "surface", "table")
 
 
 _SINK_TYPES = {
@@ -126,10 +134,9 @@ def make_parameter(
     title = tr(p.label) + (f" ({p.unit})" if p.unit else "")
     k = p.kind
     default = p.qgis_default if p.qgis_default is not None else p.default
-    if layer_input(p):  # the layer list (rasters, and clouds where QGIS reads them) or a file
-        types = [SOURCE_RASTER] + ([SOURCE_POINT_CLOUD] if point_cloud_layers() else [])
-        q = LayerOrFileParameter(p.name, title, None, p.optional, types)
-    elif k == "file":
+    if layer_input(p):  # the project's layers, or a file
+        q = layer_parameter(p, title)
+    elif k in FILE_KINDS:  # a file (and a cloud where QGIS reads no LAS/LAZ)
         flt = f"{tr(p.file_filter)};;{_all_files()}" if p.file_filter else _all_files()
         q = QgsProcessingParameterFile(
             p.name, title, behavior=FILE_BEHAVIOR_FILE, fileFilter=flt, optional=p.optional
@@ -228,7 +235,7 @@ def read_parameter(alg, p: Param, parameters: dict, context) -> Any:
     k = p.kind
     if layer_input(p):
         return layer_file(alg, p, parameters, context)
-    if k == "file":
+    if k in FILE_KINDS:
         return alg.parameterAsFile(parameters, p.name, context) or None
     if k == "crs":
         crs = alg.parameterAsCrs(parameters, p.name, context)
@@ -260,41 +267,131 @@ def read_parameter(alg, p: Param, parameters: dict, context) -> Any:
     raise ValueError(f"{p.name}: no value for kind {k}")
 
 
-class LayerOrFileParameter(QgsProcessingParameterMapLayer):
-    """A map-layer parameter that also takes a file path QGIS cannot open as a layer (a
-    LAS/LAZ DSM without a point-cloud provider): the job reads the file itself."""
-
-    def clone(self):
-        copy = LayerOrFileParameter(
-            self.name(), self.description(), self.defaultValue(), False, self.dataTypes()
-        )
-        copy.setFlags(self.flags())
-        copy.setHelp(self.help())
-        return copy
+class _FileAccepted:
+    """Mixin of the layer parameters: a path of an existing file is accepted as it is (a
+    LAS/LAZ where QGIS has no point-cloud provider, a CSV with comment lines, qgis_process's
+    arguments, a model input of type file): the job reads the file itself."""
 
     def checkValueIsAcceptable(self, value, context=None) -> bool:
         if isinstance(value, str) and os.path.isfile(value):
             return True
-        return super().checkValueIsAcceptable(value, context)
+        return super().checkValueIsAcceptable(value, context)  # type: ignore[misc]
+
+    def _copied(self, copy):
+        copy.setFlags(self.flags())
+        copy.setHelp(self.help())
+        return copy
+
+
+class LayerOrFileParameter(_FileAccepted, QgsProcessingParameterMapLayer):
+    """A DSM: a raster layer, a point-cloud layer (where QGIS has PDAL) or a file."""
+
+    def clone(self):
+        return self._copied(LayerOrFileParameter(
+            self.name(), self.description(), self.defaultValue(), False, self.dataTypes()
+        ))  # fmt: skip
+
+
+class RasterOrFileParameter(_FileAccepted, QgsProcessingParameterRasterLayer):
+    """A raster layer of the project or a raster file."""
+
+    def clone(self):
+        return self._copied(
+            RasterOrFileParameter(self.name(), self.description(), self.defaultValue())
+        )
+
+
+class PointCloudOrFileParameter(_FileAccepted, QgsProcessingParameterPointCloudLayer):
+    """A point-cloud layer of the project or a LAS/LAZ file."""
+
+    def clone(self):
+        return self._copied(
+            PointCloudOrFileParameter(self.name(), self.description(), self.defaultValue())
+        )
+
+
+class TableOrFileParameter(_FileAccepted, QgsProcessingParameterVectorLayer):
+    """A vector layer of the project (with or without geometry) backed by a CSV, or a CSV."""
+
+    def clone(self):
+        return self._copied(TableOrFileParameter(
+            self.name(), self.description(), self.dataTypes(), self.defaultValue()
+        ))  # fmt: skip
+
+
+def layer_parameter(p: Param, title: str) -> QgsProcessingParameterDefinition:
+    """The layer parameter of a layer kind (see :func:`layer_input`)."""
+    if p.kind == "raster":
+        return RasterOrFileParameter(p.name, title, None, p.optional)
+    if p.kind == "pointcloud":
+        return PointCloudOrFileParameter(p.name, title, None, p.optional)
+    if p.kind == "table":
+        return TableOrFileParameter(p.name, title, [SOURCE_TABLE], None, p.optional)
+    types = [SOURCE_RASTER] + ([SOURCE_POINT_CLOUD] if point_cloud_layers() else [])
+    return LayerOrFileParameter(p.name, title, None, p.optional, types)
+
+
+#: What each layer kind's file must be: (providers, file endings or () for any).
+_LAYER_FILES = {
+    "raster": (("gdal",), ()),
+    "pointcloud": (("pdal", "copc"), (".las", ".laz")),
+    "surface": (("gdal", "pdal", "copc"), ()),
+    "table": (("delimitedtext", "ogr"), (".csv", ".txt")),
+}
+
+
+def _file_format(kind: str) -> str:
+    """The name of a layer kind's file format, translated (the refusal's ``{what}``)."""
+    names = {
+        "raster": QCoreApplication.translate("LidarPhotoProvider", "raster"),
+        "pointcloud": QCoreApplication.translate("LidarPhotoProvider", "LAS/LAZ"),
+        "surface": QCoreApplication.translate("LidarPhotoProvider", "raster or LAS/LAZ"),
+        "table": QCoreApplication.translate("LidarPhotoProvider", "CSV"),
+    }
+    return names[kind]
+
+
+def layer_source_file(layer) -> str:
+    """The file behind ``layer`` ("" when it has none): a delimited-text layer's file from its
+    URI, an OGR or GDAL source without its ``|layername=`` / ``|option`` suffixes, a
+    point-cloud layer's source."""
+    provider, source = layer.providerType(), layer.source()
+    if provider == "delimitedtext":
+        path = QUrl(source).toLocalFile()
+    elif provider in ("ogr", "gdal"):
+        path = source.split("|")[0]
+    elif provider in ("pdal", "copc"):
+        path = source
+    else:  # memory, database, web service, ...
+        path = ""
+    return path if path and os.path.isfile(path) else ""
 
 
 def layer_file(alg, p: Param, parameters: dict, context) -> str | None:
     """The file behind a layer parameter: a path given as text is taken as it is (a LAS/LAZ
     where QGIS has no point-cloud provider, qgis_process's arguments); a layer of the project
-    gives its source, which must be a file GDAL (or PDAL) reads as a whole."""
+    gives its file (:func:`layer_source_file`), which must be of the kind's format; a layer
+    not backed by such a file (memory, database, another format) is refused by name."""
     value = parameters.get(p.name)
     if isinstance(value, str) and os.path.isfile(value):
         return value
     layer = alg.parameterAsLayer(parameters, p.name, context)
     if layer is None:  # not a layer: the text as a path (the job names a missing file)
         return value if isinstance(value, str) and value else None
-    path = layer.source().split("|")[0]
-    if layer.providerType() not in ("gdal", "pdal") or not os.path.isfile(path):
+    providers, endings = _LAYER_FILES[p.kind]
+    path = layer_source_file(layer)
+    if (
+        not path
+        or layer.providerType() not in providers
+        or (endings and not path.lower().endswith(endings))
+    ):
         raise QgsProcessingException(
             QCoreApplication.translate(
                 "LidarPhotoProvider",
-                "{name}: the layer {layer} is not a raster or LAS/LAZ file ({source}); "
-                "save it as a GeoTIFF first",
-            ).format(name=p.name, layer=layer.name(), source=layer.source())
+                "{name}: the layer {layer} is not backed by a {what} file ({source}); "
+                "save it as one first",
+            ).format(
+                name=p.name, layer=layer.name(), what=_file_format(p.kind), source=layer.source()
+            )
         )
     return path

@@ -112,7 +112,7 @@ the RMSE values as numeric outputs RMSE_E, RMSE_N, RMSE_U (height), RMSE_HORIZON
 (docs/formats.md, "Accuracy figures"; RMSE_H and RMSE_HORIZ, their former names, are kept
 for one release).""",
     params=(
-        Param("INPUT", "file", "Check-point table (CSV: id, e, n, h, e_ref, n_ref, h_ref, group)",
+        Param("INPUT", "table", "Check-point table (CSV: id, e, n, h, e_ref, n_ref, h_ref, group)",
               optional=True, file_filter=CSV_FILTER),
         *_point_params("measured"),
         *_point_params("reference"),

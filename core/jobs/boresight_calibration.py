@@ -130,14 +130,14 @@ comment lines beginning with #).""",
         ),
         *mount_params(initial_boresight=True),
         Param("OBSERVATIONS", "file", "Image observations (CSV)", file_filter=CSV_FILTER),
-        Param("PLANES", "file", "Plane table (CSV)", optional=True, file_filter=CSV_FILTER),
-        Param("LINES", "file", "Line table (CSV)", optional=True, file_filter=CSV_FILTER),
+        Param("PLANES", "table", "Plane table (CSV)", optional=True, file_filter=CSV_FILTER),
+        Param("LINES", "table", "Line table (CSV)", optional=True, file_filter=CSV_FILTER),
         Param(
-            "LCPS", "file", "LiDAR control point table (CSV)", optional=True, file_filter=CSV_FILTER
+            "LCPS", "table", "LiDAR control point table (CSV)", optional=True, file_filter=CSV_FILTER
         ),
         Param(
             "GROUND_POINTS",
-            "file",
+            "table",
             "Ground points (CSV)",
             optional=True,
             file_filter=CSV_FILTER,
@@ -147,7 +147,7 @@ comment lines beginning with #).""",
         ),
         Param(
             "CLOUD",
-            "file",
+            "pointcloud",
             "Cloud with plane ids (LAS/LAZ, paper mode only)",
             optional=True,
             file_filter=LAS_FILTER,

@@ -71,7 +71,7 @@ def mount_from(values: Mapping[str, Any]):
 def cloud_params(key: str = "INPUT", label: str = "Point cloud (LAS/LAZ)") -> tuple[Param, ...]:
     """The cloud file, ``CRS`` (overrides or supplies the file's) and ``DISTANCE_UNIT``."""
     return (
-        Param(key, "file", label, file_filter=LAS_FILTER),
+        Param(key, "pointcloud", label, file_filter=LAS_FILTER),
         Param("CRS", "crs", "CRS (overrides the file's)", optional=True,
               help="the cloud's CRS when the file has none or a wrong one (EPSG:xxxx or WKT)"),
         Param("DISTANCE_UNIT", "enum", "Distance unit", "crs", options=DISTANCE_UNITS,

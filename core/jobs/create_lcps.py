@@ -44,7 +44,7 @@ metres; the outputs are in the CRS unit. Optionally give your own plane-id tripl
 rejected candidates per reason; each one, with its numbers and units, is listed only in
 verbose mode (command line: -vv; QGIS: Processing options, logging level Verbose).""",
     params=(
-        Param("PLANES", "file", "Plane table (CSV)", file_filter=CSV_FILTER),
+        Param("PLANES", "table", "Plane table (CSV)", file_filter=CSV_FILTER),
         *cloud_params("CLOUD", "Cloud with plane ids (LAS/LAZ)"),
         Param("DELTA", "number", "Adjacency distance delta", _D.delta, unit="length",
               minimum=0.001, maximum=1000.0),

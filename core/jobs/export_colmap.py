@@ -29,10 +29,10 @@ CRS). OBSERVATIONS become each image's keypoints, tracked to the POINTS (a groun
 e.g. importcolmap's OUTPUT_POINTS) that share their point_id; the others are untracked.""",
     params=(
         Param("CAMERA", "file", "Camera(s) (JSON)", file_filter="JSON files (*.json)"),
-        Param("EO", "file", "Exterior orientation table (CSV)", file_filter=CSV_FILTER),
+        Param("EO", "table", "Exterior orientation table (CSV)", file_filter=CSV_FILTER),
         Param("OBSERVATIONS", "file", "Observations (CSV)", optional=True,
               file_filter=CSV_FILTER),
-        Param("POINTS", "file", "3D points (ground point table, CSV)", optional=True,
+        Param("POINTS", "table", "3D points (ground point table, CSV)", optional=True,
               file_filter=CSV_FILTER),
         Param("OUTPUT_FOLDER", "folder_out", "Output folder (the COLMAP model)"),
     ),

@@ -93,7 +93,7 @@ that accuracyreport reads for the NSSDA and PEC-PCD sections.""",
         ),
         Param(
             "CHECKPOINTS",
-            "file",
+            "table",
             "Check points (CSV: id, e, n, h, group)",
             optional=True,
             file_filter=CSV_FILTER,

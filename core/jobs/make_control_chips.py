@@ -60,7 +60,7 @@ inliers). A point that fails (plate not found, only one square, ambiguous, resec
 too large, too few SIFT matches, chip partly outside the photo) gets its reason and no chip;
 the others are written.""",
     params=(
-        Param("POINTS", "file", "Ground points (CSV)", file_filter=CSV_FILTER,
+        Param("POINTS", "table", "Ground points (CSV)", file_filter=CSV_FILTER,
               help="point_id, X, Y, Z, role (the bundle adjustment's table)"),
         Param("CRS", "crs", "Mapping CRS of the points", help="e.g. EPSG:31983"),
         Param("CAMERA", "file", "Ground camera (JSON)", file_filter="JSON files (*.json)",

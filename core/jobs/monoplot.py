@@ -48,10 +48,10 @@ parallel / unknown_plane (planes).""",
     params=(
         Param("OBSERVATIONS", "file", "Image observations (CSV)", file_filter=CSV_FILTER),
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
-        Param("EO", "file", "Exterior orientation (CSV)", file_filter=CSV_FILTER),
-        Param("DSM", "file", "DSM (raster, or LAS/LAZ)",
+        Param("EO", "table", "Exterior orientation (CSV)", file_filter=CSV_FILTER),
+        Param("DSM", "surface", "DSM (raster, or LAS/LAZ)",
               file_filter="DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"),
-        Param("PLANES", "file", "Roof plane table (CSV)", optional=True, file_filter=CSV_FILTER),
+        Param("PLANES", "table", "Roof plane table (CSV)", optional=True, file_filter=CSV_FILTER),
         Param("CRS", "crs", "Mapping CRS of the EO", help="e.g. EPSG:28992"),
         Param("DSM_CRS", "crs", "DSM CRS (overrides the file's)", optional=True,
               help="the DSM's CRS when the file has none or a wrong one; a 2D CRS takes the "

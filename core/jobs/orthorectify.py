@@ -59,10 +59,10 @@ extent is each image's footprint on the DSM, or the extent given (xmin, ymin, xm
 Nothing is written when an input is wrong; the files appear together when all are done.""",
     params=(
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
-        Param("EO", "file", "Exterior orientation (CSV)", file_filter=CSV_FILTER),
+        Param("EO", "table", "Exterior orientation (CSV)", file_filter=CSV_FILTER),
         Param("IMAGES", "files", "Images (files or folders)", suffixes=IMAGE_SUFFIXES,
               help="image files, or folders whose images are all taken"),
-        Param("DSM", "file", "DSM or DTM (raster, or LAS/LAZ)", file_filter=DSM_FILTER,
+        Param("DSM", "surface", "DSM or DTM (raster, or LAS/LAZ)", file_filter=DSM_FILTER,
               help="a raster (the file of a raster layer) or a LAS/LAZ cloud"),
         Param("CRS", "crs", "Mapping CRS of the EO", help="e.g. EPSG:28992"),
         Param("DSM_CRS", "crs", "DSM CRS (if the file has none)", optional=True),

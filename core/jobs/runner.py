@@ -16,7 +16,7 @@ from types import ModuleType
 from typing import Any
 
 from ..io.atomic import OutputSet
-from .spec import AlgorithmSpec, Values, parse_values
+from .spec import FILE_KINDS, AlgorithmSpec, Values, parse_values
 
 Progress = Callable[[float], None]
 ShouldStop = Callable[[], bool]
@@ -45,7 +45,7 @@ def input_files(spec: AlgorithmSpec, values: Mapping[str, Any]) -> dict[str, Any
     return {
         p.name: values[p.name]
         for p in spec.inputs
-        if (p.kind in ("file", "points") and isinstance(values.get(p.name), str))
+        if (p.kind in (*FILE_KINDS, "points") and isinstance(values.get(p.name), str))
         or (p.kind == "files" and values.get(p.name))
     }
 

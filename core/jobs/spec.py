@@ -18,6 +18,15 @@ Kinds of inputs (the value a job receives):
 kind       QGIS parameter                      value
 ========== =================================== ==========================================
 file       QgsProcessingParameterFile          path (str) or None
+raster     QgsProcessingParameterRasterLayer   path (str) or None: a raster layer's file,
+                                               or a file
+pointcloud …ParameterPointCloudLayer where     path (str) or None: a point-cloud layer's
+           QGIS reads LAS/LAZ (PDAL), else     file, or a file
+           QgsProcessingParameterFile
+surface    QgsProcessingParameterMapLayer      path (str) or None: a DSM, raster or LAS/LAZ
+           (rasters; clouds with PDAL)         (a layer's file, or a file)
+table      QgsProcessingParameterVectorLayer   path (str) or None: the CSV file of a layer
+           (any geometry or none)              (delimited text or OGR), or a CSV file
 crs        QgsProcessingParameterCrs           authority id or WKT (str) or None
 number     QgsProcessingParameterNumber        float
 integer    QgsProcessingParameterNumber (int)  int
@@ -31,6 +40,11 @@ field      QgsProcessingParameterField         column / field name (str), "" whe
 files      QgsProcessingParameterMultipleLayers tuple of paths (files or folders) or None
            (files)
 ========== =================================== ==========================================
+
+The layer kinds (``raster``, ``pointcloud``, ``surface``, ``table``) reach the job as the path
+of the file behind the layer, exactly as ``file`` does; on the command line they are paths.
+The QGIS adapter refuses, naming the parameter, a layer that is not backed by such a file (a
+memory layer, a database table, a web service).
 
 Outputs: ``file_out`` (QgsProcessingParameterFileDestination), ``raster_out``
 (…RasterDestination), both a path or None; ``folder_out`` (…FolderDestination): a folder
@@ -51,8 +65,10 @@ from typing import Any
 
 from ..errors import InputError
 
+#: Input kinds whose value is the path of one file (a layer's file in QGIS).
+FILE_KINDS = ("file", "raster", "pointcloud", "surface", "table")
 INPUT_KINDS = (
-    "file",
+    *FILE_KINDS,
     "crs",
     "number",
     "integer",

@@ -60,7 +60,7 @@ track's first-image measurement: the median of its track's refined sigmas.""",
         Param("IMAGES", "files", "Images (files or folders)", suffixes=IMAGE_SUFFIXES,
               help="image files, or folders whose images are all taken; the image id is the "
               "file name without extension"),
-        Param("EO", "file", "Exterior orientation (CSV) for pair selection", optional=True,
+        Param("EO", "table", "Exterior orientation (CSV) for pair selection", optional=True,
               file_filter=CSV_FILTER, help="with CAMERA: pairs from ground footprints"),
         Param("CAMERA", "file", "Camera (JSON)", optional=True,
               file_filter="JSON files (*.json)"),

@@ -92,7 +92,7 @@ DOUBTFUL the outputs are written and each table starts with a warning (comment l
 beginning with #).""",
     params=(
         Param("OBSERVATIONS", "file", "Observations (CSV)", file_filter=CSV_FILTER),
-        Param("CONTROL", "file", "Control targets (CSV)", optional=True, file_filter=CSV_FILTER),
+        Param("CONTROL", "table", "Control targets (CSV)", optional=True, file_filter=CSV_FILTER),
         Param("STATIONS", "file", "Stations (CSV)", optional=True, file_filter=CSV_FILTER,
               help="approximate poses, compensator tilts, levelled flags; when given, every "
               "observed station must be in it"),

@@ -232,7 +232,10 @@ def test_a_dsm_layer_of_the_project_gives_the_file_s_result(provider, scene, tmp
         QgsProject.instance().addMapLayer(memory)
         context = QgsProcessingContext()
         context.setProject(QgsProject.instance())
-        with pytest.raises(QgsProcessingException, match="DSM: the layer scratch is not a raster"):
+        with pytest.raises(
+            QgsProcessingException,
+            match="DSM: the layer scratch is not backed by a raster or LAS/LAZ file",
+        ):
             processing.run(
                 ALG, {**base, "DSM": memory.id()}, context=context, feedback=QgsProcessingFeedback()
             )

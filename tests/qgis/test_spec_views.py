@@ -18,6 +18,10 @@ from qgis.core import QgsProcessingContext, QgsProject
 #: QGIS parameter type() of each spec kind
 QGIS_TYPE = {
     "file": "file",
+    "raster": "raster",
+    "pointcloud": "pointcloud",
+    "surface": "layer",
+    "table": "vector",
     "crs": "crs",
     "number": "number",
     "integer": "number",
@@ -76,8 +80,8 @@ def test_names_and_kinds_agree(provider, name):
     from lidarphoto.processing_provider.parameters import is_extent, layer_input
 
     def kind(p):
-        if layer_input(p):
-            return "layer"
+        if p.kind == "pointcloud" and not layer_input(p):
+            return "file"  # QGIS without a point-cloud provider (PDAL)
         if p.kind == "numbers":
             return "extent" if is_extent(p) else "matrix"
         return QGIS_TYPE[p.kind]
