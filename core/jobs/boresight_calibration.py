@@ -133,7 +133,11 @@ comment lines beginning with #).""",
         Param("PLANES", "table", "Plane table (CSV)", optional=True, file_filter=CSV_FILTER),
         Param("LINES", "table", "Line table (CSV)", optional=True, file_filter=CSV_FILTER),
         Param(
-            "LCPS", "table", "LiDAR control point table (CSV)", optional=True, file_filter=CSV_FILTER
+            "LCPS",
+            "table",
+            "LiDAR control point table (CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
         ),
         Param(
             "GROUND_POINTS",
