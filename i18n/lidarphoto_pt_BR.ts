@@ -111,6 +111,10 @@
             <translation>Um bloco OpenSfM / ODM: ortofotos sobre o MDS LiDAR</translation>
         </message>
         <message>
+            <source>A Metashape block: orthophotos on the LiDAR DSM</source>
+            <translation>Um bloco do Metashape: ortofotos sobre o MDS LiDAR</translation>
+        </message>
+        <message>
             <source>Boresight calibration from an SBET (or ASCII export) and the camera events</source>
             <translation>Calibração de boresight a partir de um SBET (ou exportação ASCII) e dos eventos da câmera</translation>
         </message>
@@ -217,6 +221,10 @@
         <message>
             <source>INPUT = the reconstruction.json (ODM: opensfm/); CRS = the mapping CRS (empty: topocentric, LOCAL); OUTPUT_CAMERA, OUTPUT_EO, OUTPUT_OBSERVATIONS, OUTPUT_POINTS</source>
             <translation>INPUT = o reconstruction.json (ODM: opensfm/); CRS = o CRS de mapeamento (vazio: topocêntrico, LOCAL); OUTPUT_CAMERA, OUTPUT_EO, OUTPUT_OBSERVATIONS, OUTPUT_POINTS</translation>
+        </message>
+        <message>
+            <source>INPUT = the camera XML (Export Cameras, Agisoft XML); CRS = the mapping CRS (empty: the chunk's projected CRS); OUTPUT_CAMERA, OUTPUT_EO</source>
+            <translation>INPUT = o XML de câmeras (Export Cameras, Agisoft XML); CRS = o SRC de mapeamento (vazio: o SRC projetado do chunk); OUTPUT_CAMERA, OUTPUT_EO</translation>
         </message>
         <message>
             <source>INPUT = the SBET, POSPac / Inertial Explorer export or CSV; EVENTS = image_id, time; OUTPUT_TRAJECTORY = the trajectory table at the events, OUTPUT_EO = the exterior orientation</source>
@@ -734,8 +742,24 @@
             <translation>Todos os arquivos (*.*)</translation>
         </message>
         <message>
-            <source>{name}: the layer {layer} is not a raster or LAS/LAZ file ({source}); save it as a GeoTIFF first</source>
-            <translation>{name}: a camada {layer} não é um arquivo raster nem LAS/LAZ ({source}); salve-a primeiro como GeoTIFF</translation>
+            <source>raster</source>
+            <translation>raster</translation>
+        </message>
+        <message>
+            <source>LAS/LAZ</source>
+            <translation>LAS/LAZ</translation>
+        </message>
+        <message>
+            <source>raster or LAS/LAZ</source>
+            <translation>raster ou LAS/LAZ</translation>
+        </message>
+        <message>
+            <source>CSV</source>
+            <translation>CSV</translation>
+        </message>
+        <message>
+            <source>{name}: the layer {layer} is not backed by a {what} file ({source}); save it as one first</source>
+            <translation>{name}: a camada {layer} não está gravada em um arquivo {what} ({source}); salve-a primeiro como tal</translation>
         </message>
         <message>
             <source>LiDAR Photogrammetry</source>
@@ -744,6 +768,10 @@
         <message>
             <source>LiDAR Photogrammetry Toolkit</source>
             <translation>Kit de Ferramentas de Fotogrametria LiDAR</translation>
+        </message>
+        <message>
+            <source>{name}: the layer {layer} is not a raster or LAS/LAZ file ({source}); save it as a GeoTIFF first</source>
+            <translation type="vanished">{name}: a camada {layer} não é um arquivo raster nem LAS/LAZ ({source}); salve-a primeiro como GeoTIFF</translation>
         </message>
     </context>
     <context>
@@ -1250,6 +1278,10 @@
         <message>
             <source>no redundancy: sigma0 and the global test are undefined</source>
             <translation>sem redundância: sigma0 e o teste global ficam indefinidos</translation>
+        </message>
+        <message>
+            <source>the camera timing offset dt cannot be separated from the lever arm's {axis} component: the velocity in the aircraft's body frame is the same at every image to {share:.1%} ({speed:.1f} m/s along body {axis}; at least {minimum:.0%} is needed), so dt times the speed equals a lever arm along {axis} (one line, or lines flown at one speed in either direction); fly lines at clearly different speeds, or keep the lever arm fixed, or do not estimate the timing.</source>
+            <translation>o atraso de disparo da câmera dt não pode ser separado da componente {axis} do braço de alavanca: a velocidade no referencial do corpo da aeronave é a mesma em todas as imagens a menos de {share:.1%} ({speed:.1f} m/s ao longo de {axis} do corpo; é preciso pelo menos {minimum:.0%}), de modo que dt vezes a velocidade equivale a um braço de alavanca ao longo de {axis} (uma faixa, ou faixas voadas a uma só velocidade em qualquer sentido); voe faixas a velocidades claramente diferentes, ou mantenha o braço de alavanca fixo, ou não estime o atraso de disparo.</translation>
         </message>
         <message>
             <source>the lever arm cannot be separated from the INS position: it turns with the aircraft while a position error does not, so fly lines in opposite directions (horizontal components) and add height control (LCPs); its vertical component cannot be told from a vertical GNSS bias at all: measure it (total station) and keep it fixed.</source>
@@ -1768,6 +1800,18 @@
             <translation>{} m no terreno</translation>
         </message>
         <message>
+            <source>parameter</source>
+            <translation>parâmetro</translation>
+        </message>
+        <message>
+            <source>value (ms)</source>
+            <translation>valor (ms)</translation>
+        </message>
+        <message>
+            <source>sigma (ms)</source>
+            <translation>desvio-padrão (ms)</translation>
+        </message>
+        <message>
             <source>The calibration FAILED its checks: no table and no exterior orientation were written. The numbers below show the failed adjustment, for diagnosis only.</source>
             <translation>A calibração FALHOU nas verificações: nenhuma tabela e nenhuma orientação exterior foram gravadas. Os números abaixo mostram o ajustamento que falhou, apenas para diagnóstico.</translation>
         </message>
@@ -1778,10 +1822,6 @@
         <message>
             <source>sigma (m)</source>
             <translation>sigma (m)</translation>
-        </message>
-        <message>
-            <source>parameter</source>
-            <translation>parâmetro</translation>
         </message>
         <message>
             <source>value (mm)</source>
@@ -1806,6 +1846,18 @@
         <message>
             <source>setting</source>
             <translation>configuração</translation>
+        </message>
+        <message>
+            <source>Camera timing offset</source>
+            <translation>Atraso de disparo da câmera</translation>
+        </message>
+        <message>
+            <source>exposure = recorded time + dt</source>
+            <translation>exposição = tempo registrado + dt</translation>
+        </message>
+        <message>
+            <source>correlation with dt</source>
+            <translation>correlação com dt</translation>
         </message>
         <message>
             <source>Boresight</source>
@@ -3479,6 +3531,20 @@ nenhum ponto de apoio é um erro.</translation>
 (faixa de voo, direção ou sessão) ou um por octante de rumo.</translation>
         </message>
         <message>
+            <source>Timing offset (ESTIMATE_TIMING): a constant camera timing offset dt (exposure = recorded
+time + dt) as one more unknown, from the trajectory's velocities when the table has them
+(v_north, v_east, v_up, as Import trajectory writes them), else from the neighbouring
+exposures of each flight line. Estimated with the lever arm it needs lines flown at clearly
+different speeds: with one speed dt times the speed is an along-track lever arm, and the run
+is refused as not observable, naming both.</source>
+            <translation>Atraso de disparo (ESTIMATE_TIMING): um atraso constante dt da câmera (exposição = tempo
+registrado + dt) como mais uma incógnita, a partir das velocidades da trajetória quando a tabela
+as tem (v_north, v_east, v_up, como Importar trajetória as escreve), senão das exposições
+vizinhas de cada faixa de voo. Estimado junto com o braço de alavanca, exige faixas voadas a
+velocidades claramente diferentes: com uma só velocidade, dt vezes a velocidade é um braço de
+alavanca ao longo da faixa, e a execução é recusada como não observável, nomeando ambos.</translation>
+        </message>
+        <message>
             <source>Outputs: the boresight per group (CSV), the updated exterior orientation (CSV), the image
 residuals (a layer at each observation's ground position, and optionally CSV) and an HTML
 summary; a set-up that cannot determine the boresight is an error that names the
@@ -3642,6 +3708,14 @@ e cada uma começa com um aviso (CSV: linhas de comentário iniciadas por #).</t
             <translation>Estimar a distância focal e o ponto principal</translation>
         </message>
         <message>
+            <source>Estimate the camera timing offset</source>
+            <translation>Estimar o atraso de disparo da câmera</translation>
+        </message>
+        <message>
+            <source>a constant dt (exposure = recorded time + dt) from the trajectory's velocities (v_north, v_east, v_up columns, as Import trajectory writes them) or from neighbouring exposures of each line; with the lever arm it needs lines at clearly different speeds</source>
+            <translation>um dt constante (exposição = tempo registrado + dt) a partir das velocidades da trajetória (colunas v_north, v_east, v_up, como Importar trajetória as escreve) ou das exposições vizinhas de cada faixa; com o braço de alavanca exige faixas a velocidades claramente diferentes</translation>
+        </message>
+        <message>
             <source>INS grade</source>
             <translation>Classe do INS</translation>
         </message>
@@ -3716,6 +3790,14 @@ e cada uma começa com um aviso (CSV: linhas de comentário iniciadas por #).</t
         <message>
             <source>Sigma0 a-posteriori</source>
             <translation>Sigma0 a posteriori</translation>
+        </message>
+        <message>
+            <source>Camera timing offset dt (ms, NaN if not estimated)</source>
+            <translation>Atraso de disparo da câmera dt (ms, NaN se não estimado)</translation>
+        </message>
+        <message>
+            <source>Sigma of the timing offset (ms)</source>
+            <translation>Desvio-padrão do atraso de disparo (ms)</translation>
         </message>
     </context>
     <context>
@@ -5261,6 +5343,149 @@ como tabela de pontos de apoio com papel check (pontos de ligação triangulados
         </message>
     </context>
     <context>
+        <name>lidarphoto:importmetashape</name>
+        <message>
+            <source>Import Agisoft Metashape cameras (XML)</source>
+            <translation>Importar câmeras do Agisoft Metashape (XML)</translation>
+        </message>
+        <message>
+            <source>Aerotriangulation</source>
+            <translation>Aerotriangulação</translation>
+        </message>
+        <message>
+            <source>Metashape camera XML -&gt; cameras (exact lens model), orientations, markers</source>
+            <translation>XML de câmeras do Metashape -&gt; câmeras (modelo de lente exato), orientações, marcadores</translation>
+        </message>
+        <message>
+            <source>Reads the camera file Agisoft Metashape writes with File &gt; Export &gt; Export Cameras (Agisoft
+XML) and writes the project's camera JSON, exterior orientation and markers, with the lens model
+converted exactly: each calibrated sensor gets the forward lens model of Metashape's own
+equations and coefficients (f, cx, cy, k1-k4, p1, p2, b1, b2; docs/formats.md, Metashape).
+Frame and fisheye sensors are supported; spherical, cylindrical and RPC sensors and nonzero
+p3, p4 are refused by name.</source>
+            <translation>Lê o arquivo de câmeras que o Agisoft Metashape escreve com File &gt; Export &gt; Export Cameras
+(Agisoft XML) e escreve o JSON de câmera, a orientação exterior e os marcadores do projeto, com o
+modelo de lente convertido exatamente: cada sensor calibrado recebe o modelo de lente direto das
+equações e coeficientes do próprio Metashape (f, cx, cy, k1-k4, p1, p2, b1, b2; docs/formats.md,
+Metashape). Sensores de quadro e olho de peixe são aceitos; sensores esféricos, cilíndricos e RPC
+e p3, p4 não nulos são recusados pelo nome.</translation>
+        </message>
+        <message>
+            <source>## Frame
+The chunk's transform (Metashape 2: each component's) takes the cameras to the chunk's
+CRS: geocentric (ECEF) for a geographic or projected CRS, converted into CRS (empty: the
+chunk's CRS when it is projected; a geographic chunk needs one, e.g. its UTM zone); local
+coordinates (LOCAL_CS) stay as they are (LOCAL, no CRS; CRS must be empty).</source>
+            <translation>## Referencial
+A transformação do chunk (Metashape 2: a de cada componente) leva as câmeras ao SRC do
+chunk: geocêntrico (ECEF) para um SRC geográfico ou projetado, convertido para CRS (vazio: o
+SRC do chunk quando é projetado; um chunk geográfico precisa de um, p. ex. seu fuso UTM);
+coordenadas locais (LOCAL_CS) ficam como estão (LOCAL, sem SRC; CRS deve ficar vazio).</translation>
+        </message>
+        <message>
+            <source>## Skipped cameras
+A camera without a transform (not aligned), whose sensor is missing or uncalibrated, or in a
+component without a transform, is skipped and named in the log; so are the cameras of the
+components other than the active one of a local chunk (their frames differ).</source>
+            <translation>## Câmeras ignoradas
+Uma câmera sem transformação (não alinhada), cujo sensor falta ou não está calibrado, ou em um
+componente sem transformação, é ignorada e nomeada no log; assim também as câmeras dos
+componentes que não o ativo de um chunk local (seus referenciais diferem).</translation>
+        </message>
+        <message>
+            <source>## Outputs
+OUTPUT_CAMERA: the cameras (metashape_&lt;sensor id&gt;); OUTPUT_EO: one row per imported camera
+(image_id = the camera's label, or its file name with IMAGE_NAMES file; with a camera column
+when there are several sensors);
+OUTPUT_OBSERVATIONS: the markers' pinned locations on the imported cameras (type control for a
+marker with reference coordinates, tie without; point_id = the marker's label);
+OUTPUT_POINTS: the markers' reference coordinates in CRS as a ground point table (role
+control when the reference is enabled in Metashape, check when not; the marker accuracy as
+sigma). The camera XML has no tie points.</source>
+            <translation>## Saídas
+OUTPUT_CAMERA: as câmeras (metashape_&lt;id do sensor&gt;); OUTPUT_EO: uma linha por câmera importada
+(image_id = o rótulo da câmera, ou seu nome de arquivo com IMAGE_NAMES file; com uma coluna camera
+quando há vários sensores);
+OUTPUT_OBSERVATIONS: as posições fixadas dos marcadores nas câmeras importadas (tipo control para
+um marcador com coordenadas de referência, tie sem elas; point_id = o rótulo do marcador);
+OUTPUT_POINTS: as coordenadas de referência dos marcadores em CRS como tabela de pontos de apoio
+(papel control quando a referência está habilitada no Metashape, check quando não; a precisão do
+marcador como desvio-padrão). O XML de câmeras não tem pontos de ligação.</translation>
+        </message>
+        <message>
+            <source>Metashape camera file (XML)</source>
+            <translation>Arquivo de câmeras do Metashape (XML)</translation>
+        </message>
+        <message>
+            <source>Metashape cameras (*.xml);;All files (*)</source>
+            <translation>Câmeras do Metashape (*.xml);;Todos os arquivos (*)</translation>
+        </message>
+        <message>
+            <source>Mapping CRS</source>
+            <translation>SRC de mapeamento</translation>
+        </message>
+        <message>
+            <source>the projected CRS to convert to; empty: the chunk's own (projected) CRS</source>
+            <translation>o SRC projetado de destino; vazio: o SRC (projetado) do próprio chunk</translation>
+        </message>
+        <message>
+            <source>Pixel size</source>
+            <translation>Tamanho do pixel</translation>
+        </message>
+        <message>
+            <source>used when a sensor states no pixel_width: it sets the millimetres of the camera, never the projection</source>
+            <translation>usado quando um sensor não declara pixel_width: define os milímetros da câmera, nunca a projeção</translation>
+        </message>
+        <message>
+            <source>Image names in the EO</source>
+            <translation>Nomes das imagens na OE</translation>
+        </message>
+        <message>
+            <source>label: the camera labels as Metashape shows them; file: their file names without folder and extension (how orthorectify and the picking dock find images)</source>
+            <translation>label: os rótulos das câmeras como o Metashape os mostra; file: seus nomes de arquivo sem pasta nem extensão (como orthorectify e o painel de medição encontram as imagens)</translation>
+        </message>
+        <message>
+            <source>Cameras (JSON)</source>
+            <translation>Câmeras (JSON)</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>Exterior orientation table (CSV)</source>
+            <translation>Tabela de orientação exterior (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Observations (tie points, CSV)</source>
+            <translation>Observações (pontos de ligação, CSV)</translation>
+        </message>
+        <message>
+            <source>3D points (ground point table, CSV)</source>
+            <translation>Pontos 3D (tabela de pontos de apoio, CSV)</translation>
+        </message>
+        <message>
+            <source>Number of imported cameras</source>
+            <translation>Número de câmeras importadas</translation>
+        </message>
+        <message>
+            <source>Number of cameras</source>
+            <translation>Número de câmeras</translation>
+        </message>
+        <message>
+            <source>Number of 3D points</source>
+            <translation>Número de pontos 3D</translation>
+        </message>
+        <message>
+            <source>Number of skipped cameras</source>
+            <translation>Número de câmeras ignoradas</translation>
+        </message>
+    </context>
+    <context>
         <name>lidarphoto:importopensfm</name>
         <message>
             <source>Import OpenSfM / ODM reconstruction</source>
@@ -5450,14 +5675,16 @@ GPS - UTC, 18 s desde 2017).</translation>
         <message>
             <source>## Outputs
 OUTPUT_TRAJECTORY: the trajectory table that trajectorytoeo and boresightcalibration read
-(easting, northing, height in the mapping CRS; roll, pitch, true heading in degrees; time =
+(easting, northing, height in the mapping CRS; roll, pitch, true heading in degrees; the
+velocity v_north, v_east, v_up in m/s, which boresightcalibration's timing offset uses; time =
 the trajectory time). OUTPUT_EO: the exterior orientation with the mount applied, as
 trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.</source>
             <translation>## Saídas
 OUTPUT_TRAJECTORY: a tabela de trajetória que trajectorytoeo e boresightcalibration leem
-(E, N, altura no SRC de mapeamento; rolamento, arfagem e rumo verdadeiro em graus; time = o
-tempo da trajetória). OUTPUT_EO: a orientação exterior com a montagem aplicada, como
-trajectorytoeo a calcula. OUTPUT: os centros perspectivos como camada PointZ.</translation>
+(E, N, altura no SRC de mapeamento; rolamento, arfagem e rumo verdadeiro em graus; a
+velocidade v_north, v_east, v_up em m/s, que o atraso de disparo de boresightcalibration
+usa; time = o tempo da trajetória). OUTPUT_EO: a orientação exterior com a montagem aplicada,
+como trajectorytoeo a calcula. OUTPUT: os centros perspectivos como camada PointZ.</translation>
         </message>
         <message>
             <source>Trajectory (SBET, ASCII export or CSV)</source>
@@ -5606,6 +5833,18 @@ trajectorytoeo a calcula. OUTPUT: os centros perspectivos como camada PointZ.</t
         <message>
             <source>Number of trajectory records</source>
             <translation>Número de registros da trajetória</translation>
+        </message>
+        <message>
+            <source>## Outputs
+OUTPUT_TRAJECTORY: the trajectory table that trajectorytoeo and boresightcalibration read
+(easting, northing, height in the mapping CRS; roll, pitch, true heading in degrees; time =
+the trajectory time). OUTPUT_EO: the exterior orientation with the mount applied, as
+trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.</source>
+            <translation type="vanished">## Saídas
+OUTPUT_TRAJECTORY: a tabela de trajetória que trajectorytoeo e boresightcalibration leem
+(E, N, altura no SRC de mapeamento; rolamento, arfagem e rumo verdadeiro em graus; time = o
+tempo da trajetória). OUTPUT_EO: a orientação exterior com a montagem aplicada, como
+trajectorytoeo a calcula. OUTPUT: os centros perspectivos como camada PointZ.</translation>
         </message>
         <message>
             <source>Direct georeferencing</source>
