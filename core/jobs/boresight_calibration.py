@@ -120,7 +120,7 @@ results even when the checks fail, the outputs are written and each starts with 
 comment lines beginning with #).""",
     params=(
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
-        Param("TRAJECTORY", "file", "Trajectory table (CSV)", file_filter=CSV_FILTER),
+        Param("TRAJECTORY", "table", "Trajectory table (CSV)", file_filter=CSV_FILTER),
         Param(
             "CRS",
             "crs",
@@ -129,7 +129,7 @@ comment lines beginning with #).""",
             help="projected CRS of the trajectory and of the LiDAR tables",
         ),
         *mount_params(initial_boresight=True),
-        Param("OBSERVATIONS", "file", "Image observations (CSV)", file_filter=CSV_FILTER),
+        Param("OBSERVATIONS", "table", "Image observations (CSV)", file_filter=CSV_FILTER),
         Param("PLANES", "table", "Plane table (CSV)", optional=True, file_filter=CSV_FILTER),
         Param("LINES", "table", "Line table (CSV)", optional=True, file_filter=CSV_FILTER),
         Param(

@@ -30,7 +30,7 @@ e.g. importcolmap's OUTPUT_POINTS) that share their point_id; the others are unt
     params=(
         Param("CAMERA", "file", "Camera(s) (JSON)", file_filter="JSON files (*.json)"),
         Param("EO", "table", "Exterior orientation table (CSV)", file_filter=CSV_FILTER),
-        Param("OBSERVATIONS", "file", "Observations (CSV)", optional=True,
+        Param("OBSERVATIONS", "table", "Observations (CSV)", optional=True,
               file_filter=CSV_FILTER),
         Param("POINTS", "table", "3D points (ground point table, CSV)", optional=True,
               file_filter=CSV_FILTER),

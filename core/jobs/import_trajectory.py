@@ -64,7 +64,7 @@ trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""
             options=Ref("photo.trajectory_options", "TRAJECTORY_FORMATS"),
             help="auto: by the file's ending (.out/.sbet SBET, .csv CSV, else ASCII)",
         ),
-        Param("EVENTS", "file", "Camera events (CSV: image_id, time)", file_filter=CSV_FILTER),
+        Param("EVENTS", "table", "Camera events (CSV: image_id, time)", file_filter=CSV_FILTER),
         Param(
             "EVENT_TIME",
             "enum",

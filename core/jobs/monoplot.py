@@ -46,7 +46,7 @@ the face at less than the minimum angle), outside (the ray leaves the DSM), noda
 a hole first), no_orientation (image not in the EO table), not_converged (Makarovic),
 parallel / unknown_plane (planes).""",
     params=(
-        Param("OBSERVATIONS", "file", "Image observations (CSV)", file_filter=CSV_FILTER),
+        Param("OBSERVATIONS", "table", "Image observations (CSV)", file_filter=CSV_FILTER),
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
         Param("EO", "table", "Exterior orientation (CSV)", file_filter=CSV_FILTER),
         Param("DSM", "surface", "DSM (raster, or LAS/LAZ)",

@@ -62,10 +62,10 @@ and whole lines, and a diagnosis naming what the observations cannot determine (
 lines parallel).""",
     params=(
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
-        Param("OBSERVATIONS", "file", "Image observations (CSV)", optional=True,
+        Param("OBSERVATIONS", "table", "Image observations (CSV)", optional=True,
               file_filter=CSV_FILTER,
               help="points (and line points) measured in the images"),
-        Param("LINE_OBSERVATIONS", "file", "Image line observations (CSV)", optional=True,
+        Param("LINE_OBSERVATIONS", "table", "Image line observations (CSV)", optional=True,
               file_filter=CSV_FILTER,
               help="rows of type line in a second observation file"),
         Param("CONTROL_POINTS", "table", "Control points (CSV)", optional=True,

@@ -91,9 +91,9 @@ blunders; the global test of the observations left then proves nothing). With AC
 DOUBTFUL the outputs are written and each table starts with a warning (comment lines
 beginning with #).""",
     params=(
-        Param("OBSERVATIONS", "file", "Observations (CSV)", file_filter=CSV_FILTER),
+        Param("OBSERVATIONS", "table", "Observations (CSV)", file_filter=CSV_FILTER),
         Param("CONTROL", "table", "Control targets (CSV)", optional=True, file_filter=CSV_FILTER),
-        Param("STATIONS", "file", "Stations (CSV)", optional=True, file_filter=CSV_FILTER,
+        Param("STATIONS", "table", "Stations (CSV)", optional=True, file_filter=CSV_FILTER,
               help="approximate poses, compensator tilts, levelled flags; when given, every "
               "observed station must be in it"),
         Param("ANGLE_UNIT", "enum", "Angle unit of hz/vt columns", "degrees",

@@ -41,7 +41,7 @@ A PointZ layer in the mapping CRS with image_id, time, group, X, Y, Z, omega_deg
 kappa_deg (angles relative to the grid frame at each image), optionally the same table as
 CSV (on the command line, printed when no file is given), and the number of images.""",
     params=(
-        Param("INPUT", "file", "Trajectory table (CSV)", file_filter=CSV_FILTER),
+        Param("INPUT", "table", "Trajectory table (CSV)", file_filter=CSV_FILTER),
         Param("CRS", "crs", "Mapping CRS (projected)", qgis_default="ProjectCrs",
               help="projected CRS of the trajectory's eastings/northings and of the output"),
         *mount_params(),
