@@ -114,7 +114,7 @@ class _Rays:
         jj, ii = np.meshgrid(np.arange(nx) * float(spacing), np.arange(ny) * float(spacing))
         pix = np.column_stack([jj.ravel(), ii.ravel()])
         ideal = camera.ideal_from_pixel(pix)
-        ray_c = np.column_stack([ideal, np.full(len(pix), -camera.focal_mm)])
+        ray_c = camera.ray_from_ideal(ideal)  # perspective or fisheye (NaN: beyond its field)
         d_loc = ray_c @ m_loc[0]  # M^T r for every row: camera -> local ENU
         d_loc /= np.linalg.norm(d_loc, axis=1, keepdims=True)
         z_low = local.map_to_enu(np.array([[xc, yc, zmin - 10.0]]))[0, 2]
