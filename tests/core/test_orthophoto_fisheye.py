@@ -28,8 +28,12 @@ from lidarphoto.core.geometry.frames import LocalFrame, MappingFrame
 from lidarphoto.core.geometry.raycast import chord_rays, intersect_dsm
 from lidarphoto.core.geometry.rotations import matrix_to_opk
 from lidarphoto.core.photo.orientation import eo_map_to_local
-from lidarphoto.core.photo.orthophoto import OrthoOptions, OrthoProjector, ortho_grid
-from lidarphoto.core.photo.orthophoto import orthorectify_tiles
+from lidarphoto.core.photo.orthophoto import (
+    OrthoOptions,
+    OrthoProjector,
+    ortho_grid,
+    orthorectify_tiles,
+)
 from lidarphoto.core.quality.registration import phase_correlation
 from lidarphoto.core.simulation.render import render_image
 from lidarphoto.core.simulation.render_scene import RenderOptions, lambert, sun_vector
