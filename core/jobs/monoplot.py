@@ -94,6 +94,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from pathlib import Path
 
     from ..geometry.frames import check_area_of_use, parse_crs
+    from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.dsm import CLOUD_SUFFIXES, load_dsm, write_dsm
     from ..io.monoplot import write_monoplot_lines_csv, write_monoplot_points_csv
@@ -103,7 +104,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.pointcloud import read_info
     from ..photo.monoplot import monoplot
 
-    camera = read_camera_json(v.camera)
+    camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     obs = read_observations_csv(v.observations, camera=camera)
     eo = read_eo_csv(v.eo)
     check_area_of_use(parse_crs(v.crs, what="CRS"), eo.xyz.min(axis=0), eo.xyz.max(axis=0),

@@ -226,12 +226,13 @@ def _read_inputs(v: Values, mapping):
     their EO rows and their size against the camera: all checked before anything is computed."""
     from ..errors import InputError
     from ..geometry.frames import check_area_of_use
+    from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.images import list_image_files
     from ..io.orientation import read_eo_csv
     from ..io.raster import RasterReader
 
-    camera = read_camera_json(v.camera)
+    camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     eo = read_eo_csv(v.eo)
     check_area_of_use(mapping, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
                       what="the perspective centres", path=v.eo)  # fmt: skip

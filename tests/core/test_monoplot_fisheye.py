@@ -90,3 +90,40 @@ def test_pixel_beyond_the_orthographic_field_is_reported(dsm):  # noqa: F811
     assert [STATUS_TEXT[int(s)] for s in res.status] == ["out_of_field"] * 2 + ["ok"]
     assert np.isnan(res.points[:2]).all() and np.isnan(res.covariance[:2]).all()
     assert np.isfinite(res.covariance[2]).all()
+
+
+def test_monoplot_job_takes_a_fisheye_camera_file(tmp_path, dsm):  # noqa: F811
+    """The ``monoplot`` algorithm with a fisheye camera JSON (as calibratecamera writes it):
+    the point table carries the truth."""
+    import csv
+
+    from lidarphoto.core.io.camera import write_camera_json
+    from lidarphoto.core.io.dsm import write_dsm
+    from lidarphoto.core.io.observations import write_observations_csv
+    from lidarphoto.core.io.orientation import write_eo_csv
+    from lidarphoto.core.jobs import monoplot as monoplot_job
+    from lidarphoto.core.jobs.runner import run_job
+
+    cam = _camera("equisolid")
+    table = _table(dsm)
+    truth = _surface_points(dsm, 200, 23)
+    pixels, foot, _ = _truth_pixels(truth, table, cam)
+    keep = np.isfinite(pixels).all(axis=1) & cam.in_frame(pixels)
+    keep &= _clearance(dsm, table.xyz[0], truth) > 2e-3
+    truth, pixels, foot = truth[keep], pixels[keep], foot[keep]
+    write_camera_json(tmp_path / "fisheye.json", cam)
+    write_eo_csv(tmp_path / "eo.csv", table)
+    write_dsm(tmp_path / "dsm.tif", dsm)
+    write_observations_csv(tmp_path / "obs.csv", _observations(pixels))
+    v = {"OBSERVATIONS": str(tmp_path / "obs.csv"), "CAMERA": str(tmp_path / "fisheye.json"),
+         "EO": str(tmp_path / "eo.csv"), "DSM": str(tmp_path / "dsm.tif"), "CRS": CRS,
+         "OUTPUT_CSV": str(tmp_path / "points.csv")}  # fmt: skip
+    run_job(monoplot_job, v)
+    with open(tmp_path / "points.csv", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == len(truth) > 100
+    ok = np.array([r["status_text"] == "ok" for r in rows])
+    assert ok.mean() > 0.9
+    got = np.array([[float(r[k]) for k in "XYZ"] for r in np.array(rows)[ok]])
+    rel = np.linalg.norm(got - truth[ok], axis=1) / foot[ok]
+    assert rel.max() < 1e-3, rel.max()

@@ -74,6 +74,18 @@ def exact_rays(scene, cam: Camera, xyz, opk, pixels: np.ndarray) -> np.ndarray:
                       np.maximum(s, 1.0))  # fmt: skip
 
 
+def texture(scene, x: np.ndarray, y: np.ndarray, opt: RenderOptions) -> np.ndarray:
+    """(N, 3) colour the renderer gives the ground points (x, y): class albedo x Lambert
+    shading of the DSM face under them."""
+    above = np.column_stack([x, y, np.full(x.size, 100.0)])
+    down = intersect_dsm(scene.dsm, above, np.tile([0.0, 0.0, -1.0], (x.size, 1)),
+                         min_incidence_deg=0.0)  # fmt: skip
+    normal = np.column_stack([-down.gradient, np.ones(x.size)])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    sun = sun_vector(opt.sun_azimuth_deg, opt.sun_elevation_deg)
+    return 255 * scene.albedo_at(x, y) * lambert(normal, sun, opt.ambient)[:, None]
+
+
 def fisheye_case(projection: str) -> dict:
     """The rendered fisheye image, its orthophotos (plain and true) and the truths."""
     scene, dsm = _scene()
@@ -112,14 +124,8 @@ def fisheye_case(projection: str) -> dict:
     gap = np.linalg.norm(land - ground, axis=2)
     hidden = ok & (np.linalg.norm(land - XYZ, axis=2) < np.linalg.norm(ground - XYZ, axis=2)
                    - 0.05)  # fmt: skip
-    above = np.column_stack([gx[ok], gy[ok], np.full(ok.sum(), 100.0)])
-    down = intersect_dsm(dsm, above, np.tile([0.0, 0.0, -1.0], (above.shape[0], 1)),
-                         min_incidence_deg=0.0)  # fmt: skip
-    normal = np.column_stack([-down.gradient, np.ones(above.shape[0])])
-    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
-    sun = sun_vector(opt.sun_azimuth_deg, opt.sun_elevation_deg)
     truth = np.full((grid.rows, grid.cols, 3), np.nan)
-    truth[ok] = 255 * scene.albedo_at(gx[ok], gy[ok]) * lambert(normal, sun, opt.ambient)[:, None]
+    truth[ok] = texture(scene, gx[ok], gy[ok], opt)
     return {"cam": cam, "dsm": dsm, "proj": proj, "grid": grid, "plain": plain,
             "plain_valid": plain_valid, "true_valid": true_valid, "true": true_, "col": col,
             "row": row, "z": z, "gap": gap, "hidden": hidden, "truth": truth, "gx": gx,
@@ -172,25 +178,23 @@ def test_cells_project_as_the_forward_model(case):
     assert np.median(off) > 10.0, np.median(off)
 
 
+def _square(keep: np.ndarray) -> tuple[int, int, int]:
+    """(row, col, size) of the first large square of cells all in ``keep``."""
+    for size in (192, 128, 96):
+        for rr in range(0, keep.shape[0] - size, 8):
+            for cc in range(0, keep.shape[1] - size, 8):
+                if keep[rr : rr + size, cc : cc + size].all():
+                    return rr, cc, size
+    raise AssertionError("no square of 96 cells in the region")
+
+
 def test_texture_reproduced_without_shift(case):
     e = case
     gray = lambda a: a.astype(np.float64) @ np.array([0.299, 0.587, 0.114])  # noqa: E731
     ortho = gray(np.moveaxis(e["plain"], 0, 2))
     truth = gray(np.nan_to_num(e["truth"]))
     keep = _interior(e["plain_valid"] & (e["z"] < 3.0) & ~e["hidden"], 4)
-    best = None
-    for size in (192, 128, 96):
-        for rr in range(0, keep.shape[0] - size, 8):
-            for cc in range(0, keep.shape[1] - size, 8):
-                if keep[rr : rr + size, cc : cc + size].all():
-                    best = (rr, cc, size)
-                    break
-            if best:
-                break
-        if best:
-            break
-    assert best is not None
-    rr, cc, size = best
+    rr, cc, size = _square(keep)
     dx, dy, peak = phase_correlation(truth[rr : rr + size, cc : cc + size],
                                      ortho[rr : rr + size, cc : cc + size])  # fmt: skip
     assert math.hypot(dx, dy) < 0.05 and peak > 0.8, (e["cam"].projection, dx, dy, peak)
@@ -232,3 +236,66 @@ def test_beyond_the_field_is_no_data_and_a_wide_fisheye_sees_past_90_degrees():
         theta_of[projection] = theta[np.isfinite(col.ravel())]
     assert theta_of["equidistant"].max() > 95.0
     assert theta_of["orthographic"].max() < 90.0 and theta_of["orthographic"].size > 1000
+
+
+def test_fisheye_block_through_the_orthorectify_and_orthomosaic_jobs(tmp_path):
+    """Two equisolid fisheye images of the house from opposite sides, through the command
+    line: true orthophotos, then their mosaic; the mosaic's ground is the renderer's texture
+    (no shift) and ground hidden in one view is filled from the other."""
+    import pyproj
+    from lidarphoto.core.cli import main as cli_main
+    from lidarphoto.core.io.camera import write_camera_json
+    from lidarphoto.core.io.dsm import write_dsm
+    from lidarphoto.core.io.orientation import write_eo_csv
+    from lidarphoto.core.io.raster import RasterReader
+    from lidarphoto.core.io.raster_write import write_rgb_tiff
+    from lidarphoto.core.photo.orientation import ExteriorOrientationTable
+
+    scene, dsm = _scene()
+    cam = fisheye("equisolid")
+    xyz = np.array([[X0 + 12.0, Y0 + 11.0, 24.0], [X0 + 28.0, Y0 + 29.0, 25.0]])
+    opk = np.radians([[6.0, -10.0, 20.0], [-5.0, 8.0, 200.0]])
+    eo = ExteriorOrientationTable(("sw", "ne"), np.array([0.0, 1.0]), ("a", "a"), xyz, opk,
+                                  pyproj.CRS.from_user_input(CRS).to_wkt())  # fmt: skip
+    opt = RenderOptions(step_px=1, noise_dn=0.0, direction_grid_px=2)
+    for k, name in enumerate(eo.image_id):
+        write_rgb_tiff(tmp_path / "images" / f"{name}.tif",
+                       render_image(scene, cam, xyz[k], opk[k], opt).rgb)  # fmt: skip
+    write_camera_json(tmp_path / "fisheye.json", cam)
+    write_eo_csv(tmp_path / "eo.csv", eo)
+    write_dsm(tmp_path / "dsm.tif", dsm)
+    out = tmp_path / "orthos"
+    assert cli_main(["orthorectify", "--camera", str(tmp_path / "fisheye.json"), "--eo",
+                     str(tmp_path / "eo.csv"), "--images", str(tmp_path / "images"), "--dsm",
+                     str(tmp_path / "dsm.tif"), "--crs", CRS, "--gsd", str(GSD),
+                     "--true-ortho", "true", "--output-folder", str(out)]) == 0  # fmt: skip
+    assert sorted(p.name for p in out.iterdir()) == ["ne_ortho.tif", "sw_ortho.tif"]
+    mosaic = tmp_path / "m.tif"
+    assert cli_main(["orthomosaic", "--orthophotos", str(out), "--output", str(mosaic)]) == 0
+    with RasterReader(mosaic) as src:
+        info, data, mask = src.info, src.read(), src.read_mask()
+    have = []
+    for name in ("sw", "ne"):
+        with RasterReader(out / f"{name}_ortho.tif") as src:
+            gt, m = src.info.geotransform, src.read_mask()
+        c0 = round((gt[0] - info.geotransform[0]) / GSD)
+        r0 = round((info.geotransform[3] - gt[3]) / GSD)
+        full = np.zeros(mask.shape, bool)
+        full[r0 : r0 + m.shape[0], c0 : c0 + m.shape[1]] = m
+        have.append(full)
+    assert np.array_equal(mask, have[0] | have[1])
+    assert (have[1] & ~have[0]).sum() > 500 and (have[0] & ~have[1]).sum() > 500
+    gt = info.geotransform
+    xs = gt[0] + (np.arange(mask.shape[1]) + 0.5) * GSD
+    ys = gt[3] - (np.arange(mask.shape[0]) + 0.5) * GSD
+    gx, gy = np.meshgrid(xs, ys)
+    z = dsm.height_at(gx.ravel(), gy.ravel()).reshape(gx.shape)
+    keep = _interior(mask & (z < 3.0), 4)
+    gray = np.array([0.299, 0.587, 0.114])
+    truth = np.zeros(mask.shape)
+    truth[keep] = texture(scene, gx[keep], gy[keep], opt) @ gray
+    mos = np.moveaxis(data, 0, 2).astype(np.float64) @ gray
+    rr, cc, size = _square(keep)
+    dx, dy, peak = phase_correlation(truth[rr : rr + size, cc : cc + size],
+                                     mos[rr : rr + size, cc : cc + size])  # fmt: skip
+    assert math.hypot(dx, dy) < 0.05 and peak > 0.8, (dx, dy, peak)
