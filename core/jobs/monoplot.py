@@ -23,7 +23,9 @@ SPEC = AlgorithmSpec(
     summary="3D points and lines from one oriented image and a LiDAR DSM",
     description="""\
 Monoplotting (dos Santos, Dal Poz & Dalmolin 2010): the ray of each image point is
-intersected with the LiDAR surface. Direct (Dal Poz 1991): the ray walks the DSM's cells in
+intersected with the LiDAR surface. The camera may be perspective or fisheye (equidistant,
+equisolid-angle, orthographic, stereographic, with its Brown correction): the ray is the
+one of the camera's own projection. Direct (Dal Poz 1991): the ray walks the DSM's cells in
 order from the camera and meets the two triangles of each cell in the determinant form of
 Eqs. 6-10; the first face hit is the visible point (occlusion). Makarovic: the classical
 iteration height -> position -> height.
@@ -44,7 +46,8 @@ Each point carries a 3x3 covariance from the image sigma, the EO sigmas (X, Y, Z
 omega, phi, kappa in degrees) and the DSM height sigma, and a status: ok, grazing (ray meets
 the face at less than the minimum angle), outside (the ray leaves the DSM), nodata (it crosses
 a hole first), no_orientation (image not in the EO table), not_converged (Makarovic),
-parallel / unknown_plane (planes).""",
+parallel / unknown_plane (planes), out_of_field (the point lies beyond a fisheye
+projection's field: no ray).""",
     params=(
         Param("OBSERVATIONS", "file", "Image observations (CSV)", file_filter=CSV_FILTER),
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),

@@ -35,7 +35,9 @@ Each image is resampled onto a north-up grid of the mapping CRS through the surf
 height of every output cell comes from the DSM (or DTM) and its image position from the
 camera (lens model included) and the exterior orientation, by the rigorous chain of the
 toolbox (local ENU frame reached through ECEF, so the map projection's scale and the Earth's
-curvature are not neglected).
+curvature are not neglected). The camera may be perspective or fisheye (equidistant,
+equisolid-angle, orthographic, stereographic, with its Brown correction, as Calibrate camera
+writes it): a fisheye maps the angle off its axis, and ground beyond its field is no data.
 
 With True orthophoto, ground hidden from the camera (behind buildings, under trees and
 overhangs) is found by tracing the ray from the camera to every cell through the DSM (as
