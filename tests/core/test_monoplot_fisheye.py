@@ -13,12 +13,15 @@ import dataclasses
 import numpy as np
 import pytest
 from lidarphoto.core.geometry.camera import Camera
-from lidarphoto.core.geometry.collinearity import project
+from lidarphoto.core.geometry.collinearity import image_rays, project
 from lidarphoto.core.geometry.distortion import distortion_from_dict
 from lidarphoto.core.geometry.frames import LocalFrame, MappingFrame
+from lidarphoto.core.geometry.grid import Grid
 from lidarphoto.core.geometry.projection import radius_derivative, radius_factor
+from lidarphoto.core.geometry.raycast import DsmTracer, intersect_dsm
 from lidarphoto.core.geometry.rotations import matrix_to_opk, opk_to_matrix
-from lidarphoto.core.photo.monoplot import STATUS_TEXT, monoplot
+from lidarphoto.core.geometry.surface import Dsm
+from lidarphoto.core.photo.monoplot import STATUS_TEXT, monoplot, propagate_covariance
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable, eo_map_to_local
 from test_monoplot import CRS, _clearance, _observations, _surface_points, dsm  # noqa: F401
 
@@ -127,3 +130,45 @@ def test_monoplot_job_takes_a_fisheye_camera_file(tmp_path, dsm):  # noqa: F811
     got = np.array([[float(r[k]) for k in "XYZ"] for r in np.array(rows)[ok]])
     rel = np.linalg.norm(got - truth[ok], axis=1) / foot[ok]
     assert rel.max() < 1e-3, rel.max()
+
+
+@pytest.mark.parametrize("projection", FISHEYES)
+def test_fisheye_covariance_matches_monte_carlo(projection):
+    """The propagated 3 x 3 covariance (the projection's own Jacobian) against the scatter of
+    300 noisy draws (pixels, EO, DSM heights) for points 20-60 degrees off the axis, as
+    tests/core/test_monoplot.py does for a perspective camera."""
+    rng = np.random.default_rng(34)
+    rows, cols, cell = 240, 240, 0.5
+    grid = Grid(1000.0, 2120.0, cell, rows, cols)
+    yy, xx = np.mgrid[0:rows, 0:cols] * cell
+    base = (20.0 + 0.15 * xx - 0.1 * yy).astype(np.float32)
+    surface = Dsm(base, grid)
+    cam = _camera(projection)
+    xc, yc = surface.centre_origin
+    eo = np.array([xc + 60.0, yc - 60.0, 60.0, *np.radians([4.0, -3.0, 30.0])])
+    off = np.radians(rng.uniform(20.0, 60.0, 30))
+    az = rng.uniform(0.0, 2 * np.pi, 30)
+    rad = (eo[2] - 38.0) * np.tan(off)
+    truth_xy = np.column_stack([eo[0] + rad * np.cos(az), eo[1] + rad * np.sin(az)])
+    truth = np.column_stack([truth_xy, surface.height_at(*truth_xy.T)])
+    pix = project(truth, eo, cam)
+    assert cam.in_frame(pix).all()
+    s_px, s_h = 0.5, 0.05
+    s_eo = np.array([0.03, 0.03, 0.05, *np.radians([0.01, 0.01, 0.015])])
+    o, d = image_rays(pix, eo, cam)
+    hits = intersect_dsm(surface, o, d)
+    grad = np.column_stack([-hits.gradient, np.ones(30)])
+    cov = propagate_covariance(truth, eo, cam, np.full(30, s_px), np.diag(s_eo**2), grad,
+                               s_h**2 * np.sum(hits.weights**2, axis=1))  # fmt: skip
+    draws = 300
+    errs = np.empty((draws, 30, 3))
+    for k in range(draws):
+        noisy = Dsm((base + rng.normal(0, s_h, base.shape)).astype(np.float32), grid)
+        o, d = image_rays(pix + rng.normal(0, s_px, pix.shape), eo + rng.normal(0, s_eo), cam)
+        errs[k] = intersect_dsm(DsmTracer.build(noisy), o, d).points - truth
+    d2 = np.einsum("kni,nij,knj->kn", errs, np.linalg.inv(cov), errs)
+    # chi-square with 3 degrees of freedom: mean 3 (the EO noise is shared by a draw's 30
+    # points: an effective sample of about 300, sd of the mean about sqrt(6 / 300) = 0.14)
+    assert abs(d2.mean() - 3.0) < 0.4, (projection, d2.mean())
+    ratio = errs.var(axis=0) / np.diagonal(cov, axis1=1, axis2=2)
+    assert 0.75 < np.median(ratio) < 1.25, (projection, np.median(ratio))
