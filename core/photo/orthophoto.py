@@ -354,11 +354,15 @@ class OrthoProjector:
     ) -> tuple[Array, Array, Array]:  # fmt: skip
         """Image pixels of the cells ``[row0, row0 + rows) x [col0, col0 + cols)`` of ``grid``.
 
+        ``backend`` ("auto", "numba", "numpy") chooses the perspective projection's loop; a
+        fisheye camera always takes the vectorised numpy one.
+
         Returns
         -------
         col, row : (rows, cols) float64
             Measured pixel (col, row) of each cell centre (docs/conventions.md), NaN where the
-            cell has no height, lies behind the camera or off the image.
+            cell has no height, lies behind the camera (beyond a fisheye's field) or off the
+            image.
         z : (rows, cols) float64
             Surface height at the cell centre (NaN: none).
         """
