@@ -23,7 +23,9 @@ SPEC = AlgorithmSpec(
     summary="3D points and lines from one oriented image and a LiDAR DSM",
     description="""\
 Monoplotting (dos Santos, Dal Poz & Dalmolin 2010): the ray of each image point is
-intersected with the LiDAR surface. Direct (Dal Poz 1991): the ray walks the DSM's cells in
+intersected with the LiDAR surface. The camera may be perspective or fisheye (equidistant,
+equisolid-angle, orthographic, stereographic, with its Brown correction): the ray is the
+one of the camera's own projection. Direct (Dal Poz 1991): the ray walks the DSM's cells in
 order from the camera and meets the two triangles of each cell in the determinant form of
 Eqs. 6-10; the first face hit is the visible point (occlusion). Makarovic: the classical
 iteration height -> position -> height.
@@ -44,7 +46,8 @@ Each point carries a 3x3 covariance from the image sigma, the EO sigmas (X, Y, Z
 omega, phi, kappa in degrees) and the DSM height sigma, and a status: ok, grazing (ray meets
 the face at less than the minimum angle), outside (the ray leaves the DSM), nodata (it crosses
 a hole first), no_orientation (image not in the EO table), not_converged (Makarovic),
-parallel / unknown_plane (planes).""",
+parallel / unknown_plane (planes), out_of_field (the point lies beyond a fisheye
+projection's field: no ray).""",
     params=(
         Param("OBSERVATIONS", "table", "Image observations (CSV)", file_filter=CSV_FILTER),
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
@@ -94,6 +97,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from pathlib import Path
 
     from ..geometry.frames import check_area_of_use, parse_crs
+    from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.dsm import CLOUD_SUFFIXES, load_dsm, write_dsm
     from ..io.monoplot import write_monoplot_lines_csv, write_monoplot_points_csv
@@ -103,7 +107,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..io.pointcloud import read_info
     from ..photo.monoplot import monoplot
 
-    camera = read_camera_json(v.camera)
+    camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     obs = read_observations_csv(v.observations, camera=camera)
     eo = read_eo_csv(v.eo)
     check_area_of_use(parse_crs(v.crs, what="CRS"), eo.xyz.min(axis=0), eo.xyz.max(axis=0),

@@ -38,7 +38,7 @@ centred on the seamline; 0 leaves hard seams.
 
 ## Inputs
 Orthophotos: GeoTIFFs of one CRS and cell size, aligned on multiples of it (Orthorectify
-with one GSD makes them so), or folders of them.
+with one GSD makes them so, from perspective or fisheye images alike), or folders of them.
 
 ## Outputs
 The mosaic (GeoTIFF: tiled, compressed, overviews, internal mask), and the seamline polygons:

@@ -35,7 +35,9 @@ Each image is resampled onto a north-up grid of the mapping CRS through the surf
 height of every output cell comes from the DSM (or DTM) and its image position from the
 camera (lens model included) and the exterior orientation, by the rigorous chain of the
 toolbox (local ENU frame reached through ECEF, so the map projection's scale and the Earth's
-curvature are not neglected).
+curvature are not neglected). The camera may be perspective or fisheye (equidistant,
+equisolid-angle, orthographic, stereographic, with its Brown correction, as Calibrate camera
+writes it): a fisheye maps the angle off its axis, and ground beyond its field is no data.
 
 With True orthophoto, ground hidden from the camera (behind buildings, under trees and
 overhangs) is found by tracing the ray from the camera to every cell through the DSM (as
@@ -226,12 +228,13 @@ def _read_inputs(v: Values, mapping):
     their EO rows and their size against the camera: all checked before anything is computed."""
     from ..errors import InputError
     from ..geometry.frames import check_area_of_use
+    from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.images import list_image_files
     from ..io.orientation import read_eo_csv
     from ..io.raster import RasterReader
 
-    camera = read_camera_json(v.camera)
+    camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     eo = read_eo_csv(v.eo)
     check_area_of_use(mapping, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
                       what="the perspective centres", path=v.eo)  # fmt: skip

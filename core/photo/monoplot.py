@@ -9,6 +9,13 @@ LiDAR roof planes are intersected with their plane (Eqs. 7-10 with the fitted pl
 image-point sigma, the exterior-orientation covariance and the DSM (or plane) uncertainty are
 propagated into a 3 x 3 covariance per point.
 
+For a fisheye camera (equidistant, equisolid, orthographic, stereographic, with its lens
+correction; :mod:`core.geometry.projection`) the camera-frame ray ``(x - x0, y - y0, -f)``
+above is replaced by the projection's own ray of the ideal point, at the angle ``theta(r)``
+off the axis (:meth:`core.geometry.camera.Camera.ray_from_ideal`); the ray casting is the same.
+A pixel beyond the projection's field (``r > f`` for the orthographic one) has no ray: status
+``out_of_field``.
+
 Each ray gets a status code (:data:`STATUS_TEXT`): a ray that leaves the DSM, crosses a
 nodata hole before hitting the surface, or belongs to an image without orientation is
 reported, never raised. A DSM in another CRS is resampled into the mapping CRS first
@@ -64,12 +71,14 @@ Array = NDArray[np.float64]
 STATUS_NO_ORIENTATION = 4
 STATUS_PARALLEL = 6
 STATUS_UNKNOWN_PLANE = 7
+STATUS_OUT_OF_FIELD = 8
 #: Meaning of each status code (the outputs carry both).
 STATUS_TEXT = {
     **RAY_STATUS_TEXT,
     STATUS_NO_ORIENTATION: "no_orientation",  # the image is not in the EO table
     STATUS_PARALLEL: "parallel",  # the ray is parallel to the plane or meets it behind
     STATUS_UNKNOWN_PLANE: "unknown_plane",  # target_id is not in the plane table
+    STATUS_OUT_OF_FIELD: "out_of_field",  # the pixel lies beyond the fisheye projection's field
 }
 _HIT = (STATUS_OK, STATUS_GRAZING)
 
@@ -410,7 +419,8 @@ def _chords(
     local = LocalFrame.at_map_point(mapping, [xc, yc, zmin])
     c_loc_img, m_loc_img = eo_map_to_local(table.xyz, table.opk, local)
     ideal = cam.ideal_from_pixel(pixels)
-    ray_c = np.column_stack([ideal, np.full(img.size, -cam.focal_mm)])
+    # the camera's own projection (perspective or fisheye); NaN outside a fisheye's field
+    ray_c = cam.ray_from_ideal(ideal)
     d_loc = np.einsum("nji,nj->ni", m_loc_img[img], ray_c)
     d_loc /= np.linalg.norm(d_loc, axis=1, keepdims=True)
     c_loc = c_loc_img[img]
@@ -537,7 +547,6 @@ def monoplot(
     MonoplotResult
         With ``dsm`` the surface actually used (in ``crs``).
     """
-    camera.require_perspective("monoplotting")
     from ..geometry.frames import parse_crs
 
     if method not in METHODS:
@@ -608,6 +617,8 @@ def monoplot(
         if method == "makarovic":
             for q in np.flatnonzero(dsm_sel):
                 used[todo[q]] = "makarovic"
+        no_ray = ~np.isfinite(chords.d_loc).all(axis=1)
+        res_st[no_ray] = STATUS_OUT_OF_FIELD
         points[todo], status[todo], incidence[todo] = res_pts, res_st, res_inc
         hit = np.isin(res_st, _HIT)
         if hit.any():

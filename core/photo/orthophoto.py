@@ -13,7 +13,10 @@ For the centre (X, Y) of every cell of the output grid (mapping CRS):
    ``a = M (A - C)`` and ``b = M B``. ``a`` and ``b`` are exact at the nodes of a lattice
    (every ``lattice_px`` cells) and bilinear between them: they vary with the Earth's curvature
    and the projection's scale, far below 1e-4 px over a lattice cell (tested). Collinearity
-   ``x = -f q_x / q_z``, ``y = -f q_y / q_z`` is then exact per cell.
+   ``x = -f q_x / q_z``, ``y = -f q_y / q_z`` is then exact per cell. A fisheye camera maps
+   ``q`` by its own projection instead (``r = f g(theta)``, :mod:`core.geometry.projection`;
+   vectorised numpy, the compiled loop being the perspective one's); a cell beyond its field
+   (``theta`` past the projection's limit) has no pixel.
 3. **Lens**: the camera's own model (any of the registry, :mod:`core.geometry.distortion`) maps
    ideal to measured coordinates by Newton iteration at the nodes of a lattice in the image
    (refined until bilinear interpolation is within 1e-3 px of Newton at the cell midpoints).
@@ -54,6 +57,7 @@ from ..geometry.camera import Camera
 from ..geometry.distortion import NoDistortion
 from ..geometry.frames import LocalFrame, MappingFrame, parse_crs
 from ..geometry.grid import Grid
+from ..geometry.projection import ideal_from_camera
 from ..geometry.raycast import STATUS_GRAZING, STATUS_OK, DsmTracer, intersect_dsm
 from ..geometry.surface import Dsm, triangle_height
 from .orientation import eo_map_to_local
@@ -140,7 +144,7 @@ def _lens_lattice(camera: Camera, tol_px: float = 1e-3) -> tuple[Array, float, f
 def cell_pixels_numpy(
     x0: float, y0: float, g: float, h: int, w: int, z: NDArray[np.float32], xc: float,
     yc: float, inv_cell: float, lat: Array, step: float, focal: float, lens: Array,
-    lx0: float, ly0: float, inv_ls: float, nolens: Array,
+    lx0: float, ly0: float, inv_ls: float, nolens: Array, projection: str = "perspective",
 ) -> tuple[Array, Array, Array]:  # fmt: skip
     """Image pixels of an h x w block of cells (numpy; the compiled version is
     :mod:`core.photo.orthophoto_numba`).
@@ -160,6 +164,9 @@ def cell_pixels_numpy(
         means none.
     nolens : (5,)
         Without lens: principal point column and row (pixels), pixel size (mm), W, H.
+    projection
+        The camera's projection (:mod:`core.geometry.projection`): a fisheye maps the angle
+        off the axis, and a cell outside its field has no pixel.
 
     Returns
     -------
@@ -188,10 +195,16 @@ def cell_pixels_numpy(
                  + w01 * (a[ki][:, kj + 1] + zz * b[ki][:, kj + 1])
                  + w10 * (a[ki + 1][:, kj] + zz * b[ki + 1][:, kj])
                  + w11 * (a[ki + 1][:, kj + 1] + zz * b[ki + 1][:, kj + 1]))  # fmt: skip
-    front = q[2] < 0.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        xi = -focal * q[0] / q[2]
-        yi = -focal * q[1] / q[2]
+    if projection == "perspective":
+        front = q[2] < 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xi = -focal * q[0] / q[2]
+            yi = -focal * q[1] / q[2]
+    else:
+        qs = np.stack(np.broadcast_arrays(*q), axis=-1).reshape(-1, 3)
+        ideal, inside = ideal_from_camera(qs, focal, projection)
+        front = inside.reshape(h, w)
+        xi, yi = ideal[:, 0].reshape(h, w), ideal[:, 1].reshape(h, w)
     if lens.shape[0] > 1:
         my, mx = lens.shape[:2]
         lu, lv = (xi - lx0) * inv_ls, (yi - ly0) * inv_ls
@@ -286,7 +299,6 @@ class OrthoProjector:
         lens : optional
             A lens lattice of the same camera (:func:`_lens_lattice`), to share between images.
         """
-        camera.require_perspective("orthorectification")
         tracer = dsm if isinstance(dsm, DsmTracer) else None
         surface = tracer.dsm if tracer is not None else dsm
         zr = (tracer.zmin, tracer.zmax) if tracer is not None else surface.z_range
@@ -342,11 +354,15 @@ class OrthoProjector:
     ) -> tuple[Array, Array, Array]:  # fmt: skip
         """Image pixels of the cells ``[row0, row0 + rows) x [col0, col0 + cols)`` of ``grid``.
 
+        ``backend`` ("auto", "numba", "numpy") chooses the perspective projection's loop; a
+        fisheye camera always takes the vectorised numpy one.
+
         Returns
         -------
         col, row : (rows, cols) float64
             Measured pixel (col, row) of each cell centre (docs/conventions.md), NaN where the
-            cell has no height, lies behind the camera or off the image.
+            cell has no height, lies behind the camera (beyond a fisheye's field) or off the
+            image.
         z : (rows, cols) float64
             Surface height at the cell centre (NaN: none).
         """
@@ -368,10 +384,12 @@ class OrthoProjector:
                 nolens)  # fmt: skip
         if backend not in ("auto", "numba", "numpy"):
             raise ValueError(f"backend must be 'auto', 'numba' or 'numpy', got {backend!r}")
-        if backend == "numpy" or not AVAILABLE:
-            if backend == "numba":
+        if backend == "numpy" or not AVAILABLE or not cam.is_perspective:
+            if backend == "numba" and not AVAILABLE:
                 raise InputError("backend 'numba' asked for, but numba is not installed")
-            return cell_pixels_numpy(*args)
+            # a fisheye camera: the vectorised numpy version (the compiled loop is the
+            # perspective projection's)
+            return cell_pixels_numpy(*args, projection=cam.projection)
         out = [np.empty((rows, cols)) for _ in range(3)]
         cell_pixels(*args, *out)
         return out[0], out[1], out[2]
@@ -400,7 +418,7 @@ class OrthoProjector:
         that do not descend."""
         cam = self.camera
         ideal = cam.ideal_from_pixel(np.asarray(pixels, float).reshape(-1, 2))
-        d = np.column_stack([ideal, np.full(len(ideal), -cam.focal_mm)]) @ self.m_local
+        d = cam.ray_from_ideal(ideal) @ self.m_local
         g = self.dsm.grid
         mid = np.array([[g.x0 + g.cols * g.cell / 2, g.y_top - g.rows * g.cell / 2, z]])
         up = self.local.map_to_enu(mid)[0, 2]
@@ -422,7 +440,7 @@ class OrthoProjector:
                             np.column_stack([np.zeros_like(k), k * h]),
                             np.column_stack([np.full_like(k, w), k * h])])  # fmt: skip
         ideal = cam.ideal_from_pixel(border)
-        ray_c = np.column_stack([ideal, np.full(len(border), -cam.focal_mm)])
+        ray_c = cam.ray_from_ideal(ideal)  # NaN beyond a fisheye's field: the whole surface
         d = ray_c @ self.m_local  # M^T r: camera -> local ENU
         gx0, gy0 = dsm.centre_origin
         gx1 = gx0 + (dsm.grid.cols - 1) * dsm.cell
