@@ -97,11 +97,16 @@ import json, sys
 import numpy as np
 import numba
 from lidarphoto.core.geometry.planes import fit_plane
+from lidarphoto.core.io.control import write_lcps_csv, write_lines_csv
 from lidarphoto.core.io.planes import write_planes_csv
+from lidarphoto.core.lidar.control import lidar_control
 from lidarphoto.core.lidar.roof_planes import extract_roof_planes
 xyz = np.load(sys.argv[1])
 res = extract_roof_planes(xyz)
-write_planes_csv(sys.argv[2], res.planes)
+write_planes_csv(sys.argv[2] + "planes.csv", res.planes)
+control = lidar_control(res.planes, xyz, res.plane_id)
+write_lcps_csv(sys.argv[2] + "lcps.csv", control.points)
+write_lines_csv(sys.argv[2] + "lines.csv", control.lines)
 refit = fit_plane(xyz[res.plane_id >= 0])  # one fit of 1e5 points, as a block's refit
 print(json.dumps({"threads": numba.get_num_threads(), "pid": res.plane_id.tolist(),
                   "params": [p.params.tolist() + p.covariance.ravel().tolist()
@@ -112,11 +117,12 @@ print(json.dumps({"threads": numba.get_num_threads(), "pid": res.plane_id.tolist
 
 def test_one_and_two_threads_give_the_same_planes(ahn3_small, tmp_path):
     """Whole processes with numba, OpenMP and BLAS on 1 and on 2 threads: the same plane of
-    every point and the same plane table, byte for byte (numbers with repr precision), with
-    numpy 2 and with Debian's numpy 1.24 (the system OpenBLAS). Every plane parameter comes
-    from sums in point order and fixed Jacobi rotations (core/geometry/sym3.py), not from a
-    BLAS product or LAPACK's eigh, whose sums depend on the thread count (before issue 33:
-    up to 1.8e-14 of a value on numpy 1.24 and 2 threads)."""
+    every point and the same plane, LCP and line tables, byte for byte (numbers with repr
+    precision), with numpy 2 and with Debian's numpy 1.24 (the system OpenBLAS). Every plane
+    parameter comes from sums in point order and fixed Jacobi rotations
+    (core/geometry/sym3.py), not from a BLAS product or LAPACK's eigh, whose sums depend on
+    the thread count (before issue 33, numpy 1.24 on 2 threads: 314 of the 806 planes of
+    AHN3 crop 1 had parameters moved in the last bits, and the LCPs' error ellipsoids)."""
     pytest.importorskip("numba")
     path = tmp_path / "xyz.npy"
     np.save(path, ahn3_small)
@@ -124,17 +130,20 @@ def test_one_and_two_threads_give_the_same_planes(ahn3_small, tmp_path):
     for n in ("1", "2"):
         env = {**os.environ, "NUMBA_NUM_THREADS": n, "OMP_NUM_THREADS": n,
                "OPENBLAS_NUM_THREADS": n, "MKL_NUM_THREADS": n}  # fmt: skip
-        table = tmp_path / f"planes_{n}.csv"
-        r = subprocess.run([sys.executable, "-c", _THREADS_CHILD, str(path), str(table)],
+        prefix = str(tmp_path / f"threads_{n}_")
+        r = subprocess.run([sys.executable, "-c", _THREADS_CHILD, str(path), prefix],
                            env=env, capture_output=True, text=True, check=True)  # fmt: skip
         out.append(json.loads(r.stdout.strip().splitlines()[-1]))
-        tables.append(table.read_bytes())
+        tables.append([Path(prefix + t).read_bytes() for t in ("planes.csv", "lcps.csv",
+                                                               "lines.csv")])  # fmt: skip
     assert [o["threads"] for o in out] == [1, 2]
     assert out[0]["pid"] == out[1]["pid"]  # the same regions, point for point
     assert len(out[0]["params"]) > 30
     assert out[0]["params"] == out[1]["params"]  # bit for bit, on every numpy and BLAS
     assert out[0]["refit"] == out[1]["refit"]
-    assert tables[0] == tables[1] and tables[0].count(b"\n") == len(out[0]["params"]) + 1
+    assert tables[0][0].count(b"\n") == len(out[0]["params"]) + 1
+    assert [t.count(b"\n") > 3 for t in tables[0][1:]] == [True, True]  # LCPs and lines
+    assert tables[0] == tables[1]
 
 
 # ----------------------------------------------------------------------------- blocks
