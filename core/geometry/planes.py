@@ -40,10 +40,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from .sym3 import eigh_sym3
 
 __all__ = ["Plane", "fit_plane", "fit_planes", "label_moments", "orient_up", "slope_aspect_deg"]
 
 Array = NDArray[np.float64]
+
 
 @dataclass(frozen=True)
 class Plane:
@@ -140,6 +142,11 @@ def slope_aspect_deg(normal: Array) -> tuple[float, float]:
 def fit_plane(points: ArrayLike, weights: ArrayLike | None = None, *, plane_id: int = -1) -> Plane:
     """Weighted least-squares plane (Pathak et al. 2010) with its covariance.
 
+    The same arithmetic as :func:`fit_planes` (sums in point order by ``np.bincount``, the
+    3 x 3 eigen-problem by :func:`core.geometry.sym3.eigh_sym3`, no BLAS or LAPACK): the same
+    bits on any thread count or numpy; with unit weights, those of :func:`fit_planes` given
+    the same points as one label.
+
     Parameters
     ----------
     points : array_like, shape (N, 3)
@@ -178,85 +185,54 @@ def fit_plane(points: ArrayLike, weights: ArrayLike | None = None, *, plane_id: 
         raise InputError(f"a plane needs at least 3 points, got {n}")
     if not np.isfinite(pts).all():
         raise InputError("points contain NaN or infinite coordinates")
-    if weights is None:
-        w = np.ones(n)
-    else:
+    w = None
+    if weights is not None:
         w = np.asarray(weights, dtype=np.float64).reshape(-1)
         if w.shape != (n,):
             raise InputError(f"weights must have shape ({n},), got {w.shape}")
         if not (np.isfinite(w).all() and (w > 0).all()):
             raise InputError("weights must be finite and > 0")
-    w_sum = float(w.sum())
-    # Centre in two steps (first point, then the weighted mean) so that large map coordinates
-    # never meet in one product.
-    ref = pts[0]
-    q = pts - ref
-    centroid = ref + (w @ q) / w_sum
-    q = pts - centroid
-    scatter = (q * w[:, None]).T @ q
-    lam, vec = np.linalg.eigh(scatter)  # ascending
-    extent = lam[2]
-    if not extent > 0 or lam[1] <= 1e-12 * extent:
+    plane = _fit_labels(pts, np.zeros(n, dtype=np.int64), 1, w)[0]
+    if plane is None:
         raise InputError("the points are collinear or coincident: no unique plane")
-    normal = orient_up(vec[:, 0].copy())
-    d = -float(normal @ centroid)
-    r = q @ normal
-    wrr = float(w @ (r * r))
-    rms = math.sqrt(wrr / w_sum)
-    sigma0_sq = wrr / (n - 3) if n > 3 else 0.0
-    # Eigen-structure of the scatter matrix: tilts of the normal towards v_k are resisted by the
-    # spread along v_k (l_k - l3); the offset along n by the total weight.
-    c_nn = sigma0_sq * (
-        np.outer(vec[:, 2], vec[:, 2]) / (lam[2] - lam[0])
-        + np.outer(vec[:, 1], vec[:, 1]) / (lam[1] - lam[0])
-    )
-    var_s = sigma0_sq / w_sum
-    cov = np.empty((4, 4))
-    cov[:3, :3] = c_nn
-    c_nd = -c_nn @ centroid
-    cov[:3, 3] = c_nd
-    cov[3, :3] = c_nd
-    cov[3, 3] = float(centroid @ c_nn @ centroid) + var_s
-    slope, aspect = slope_aspect_deg(normal)
-    return Plane(
-        id=int(plane_id),
-        normal=normal,
-        d=d,
-        centroid=centroid,
-        n_points=n,
-        rms=rms,
-        sigma_d=math.sqrt(max(cov[3, 3], 0.0)),
-        covariance=cov,
-        slope_deg=slope,
-        aspect_deg=aspect,
-    )
-
-
+    return plane.with_id(plane_id)
 
 
 def label_moments(
-    q: NDArray[np.float64], lab: NDArray[np.int64], nl: int
+    q: NDArray[np.float64],
+    lab: NDArray[np.int64],
+    nl: int,
+    weights: NDArray[np.float64] | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Point counts (L,), centroids (L, 3) and scatter matrices (L, 3, 3) of the points ``q``
     (N, 3) of each label ``lab`` (N,) in 0..L-1, in two passes (centroid first: no
-    cancellation), summed in point order.
+    cancellation), summed in point order (``np.bincount``: no BLAS). With ``weights`` (N,):
+    the weight sums, weighted centroids and weighted scatter matrices (unit weights give the
+    unweighted moments bit for bit).
 
     >>> c, m, s = label_moments(np.array([[0., 0, 0], [2, 0, 0], [5, 5, 5]]),
     ...                         np.array([0, 0, 1]), 2)
     >>> c.tolist(), m[0].tolist(), float(s[0, 0, 0]), float(s[1].sum())
     ([2.0, 1.0], [1.0, 0.0, 0.0], 2.0, 0.0)
     """
-    counts = np.bincount(lab, minlength=nl).astype(np.float64)
+
+    def weighted(values: NDArray[np.float64]) -> NDArray[np.float64]:
+        return values if weights is None else weights * values
+
+    if weights is None:
+        counts = np.bincount(lab, minlength=nl).astype(np.float64)
+    else:
+        counts = np.bincount(lab, weights, minlength=nl).astype(np.float64, copy=False)
     # weighted bincounts are float64 already (copy=False: no copy; the stubs say integers)
-    mean = np.column_stack([np.bincount(lab, q[:, c], minlength=nl) for c in range(3)]).astype(
-        np.float64, copy=False
-    )
-    mean /= np.maximum(counts, 1.0)[:, None]
+    mean = np.column_stack(
+        [np.bincount(lab, weighted(q[:, c]), minlength=nl) for c in range(3)]
+    ).astype(np.float64, copy=False)
+    mean /= np.where(counts > 0, counts, 1.0)[:, None]
     dev = q - mean[lab]
     scatter = np.empty((nl, 3, 3))
     for a in range(3):
         for b in range(a, 3):
-            scatter[:, a, b] = scatter[:, b, a] = np.bincount(lab, dev[:, a] * dev[:, b],
+            scatter[:, a, b] = scatter[:, b, a] = np.bincount(lab, weighted(dev[:, a] * dev[:, b]),
                                                               minlength=nl)  # fmt: skip
     return counts, mean, scatter
 
@@ -269,8 +245,11 @@ def fit_planes(
 
     The same estimator and covariance as :func:`fit_plane`, with the moments of all planes
     summed in one pass over the points (coordinates centred on the first point's floor, so
-    map coordinates keep their digits): the planes agree with per-plane fits to rounding.
-    A label with fewer than 3 points, or collinear ones, gives None.
+    map coordinates keep their digits). Repeatable: every sum runs in point order
+    (``np.bincount``), the eigen-problems by fixed Jacobi rotations
+    (:func:`core.geometry.sym3.eigh_sym3`) and every small product written out, so no BLAS
+    or LAPACK call is made and the planes are the same bits for any thread count, BLAS build
+    or numpy version. A label with fewer than 3 points, or collinear ones, gives None.
 
     Parameters
     ----------
@@ -301,46 +280,71 @@ def fit_planes(
     m = (lab >= 0) & (lab < nl)
     if not m.any():
         return [None] * nl
-    lab = lab[m]
-    origin = np.floor(pts[m][0])
-    q = pts[m] - origin
-    counts, mean, scatter = label_moments(q, lab, nl)
-    dev = q - mean[lab]
-    ok = counts >= 3
-    lam = np.zeros((nl, 3))
-    vec = np.tile(np.eye(3), (nl, 1, 1))
-    if ok.any():
-        lam[ok], vec[ok] = np.linalg.eigh(scatter[ok])
+    return _fit_labels(pts[m], lab[m], nl, None)
+
+
+def _dot3(u: Array, v: Array) -> Array:
+    """Row-wise dot products of (..., 3) arrays, summed in the order 0, 1, 2 (no BLAS)."""
+    return u[..., 0] * v[..., 0] + u[..., 1] * v[..., 1] + u[..., 2] * v[..., 2]
+
+
+def _fit_labels(pts: Array, lab: NDArray[np.int64], nl: int, w: Array | None) -> list[Plane | None]:
+    """The planes of labels 0..nl-1 (``lab`` (N,) all in range) of ``pts`` (N, 3) with
+    relative weights ``w`` (N,) or unit weights (None); None for a label with fewer than 3
+    points or collinear ones. Fixed-order sums and Jacobi eigen-problems only."""
+    origin = np.floor(pts[0])
+    q = pts - origin
+    counts = np.bincount(lab, minlength=nl)
+    wsum, mean, scatter = label_moments(q, lab, nl, w)
+    lam, vec = eigh_sym3(scatter)  # ascending
     extent = lam[:, 2]
-    ok &= (extent > 0) & (lam[:, 1] > 1e-12 * extent)
+    ok = (counts >= 3) & (extent > 0) & (lam[:, 1] > 1e-12 * extent)
     normal = vec[:, :, 0].copy()
     # orient_up, vectorised: the last non-zero component positive
-    sign = np.where(normal[:, 2] != 0, np.sign(normal[:, 2]),
-                    np.where(normal[:, 1] != 0, np.sign(normal[:, 1]), np.sign(normal[:, 0])))
+    sign = np.where(
+        normal[:, 2] != 0,
+        np.sign(normal[:, 2]),
+        np.where(normal[:, 1] != 0, np.sign(normal[:, 1]), np.sign(normal[:, 0])),
+    )
     normal *= np.where(sign < 0, -1.0, 1.0)[:, None]  # fmt: skip
-    r = (dev * normal[lab]).sum(axis=1)
-    wrr = np.bincount(lab, r * r, minlength=nl)
+    r = _dot3(q - mean[lab], normal[lab])
+    wrr = np.bincount(lab, r * r if w is None else w * (r * r), minlength=nl)
+    centroid = origin + mean
+    with np.errstate(divide="ignore", invalid="ignore"):  # labels not ok are dropped below
+        sigma0_sq = np.where(counts > 3, wrr / np.maximum(counts - 3, 1), 0.0)
+        cov = _covariances(lam, vec, centroid, sigma0_sq, wsum)
+        rms = np.sqrt(wrr / wsum)
+    d = -_dot3(normal, centroid)
     out: list[Plane | None] = []
     for pid in range(nl):
         if not ok[pid]:
             out.append(None)
             continue
-        n = int(counts[pid])
-        nrm = normal[pid]
-        centroid = origin + mean[pid]
-        sigma0_sq = wrr[pid] / (n - 3) if n > 3 else 0.0
-        l0, l1, l2 = lam[pid]
-        v1, v2 = vec[pid][:, 1], vec[pid][:, 2]
-        c_nn = sigma0_sq * (np.outer(v2, v2) / (l2 - l0) + np.outer(v1, v1) / (l1 - l0))
-        cov = np.empty((4, 4))
-        cov[:3, :3] = c_nn
-        c_nd = -c_nn @ centroid
-        cov[:3, 3] = c_nd
-        cov[3, :3] = c_nd
-        cov[3, 3] = float(centroid @ c_nn @ centroid) + sigma0_sq / n
-        slope, aspect = slope_aspect_deg(nrm)
-        out.append(Plane(id=pid, normal=nrm, d=-float(nrm @ centroid), centroid=centroid,
-                         n_points=n, rms=math.sqrt(wrr[pid] / n),
-                         sigma_d=math.sqrt(max(cov[3, 3], 0.0)), covariance=cov,
-                         slope_deg=slope, aspect_deg=aspect))  # fmt: skip
+        slope, aspect = slope_aspect_deg(normal[pid])
+        out.append(Plane(id=pid, normal=normal[pid].copy(), d=float(d[pid]),
+                         centroid=centroid[pid].copy(), n_points=int(counts[pid]),
+                         rms=float(rms[pid]), sigma_d=math.sqrt(max(cov[pid, 3, 3], 0.0)),
+                         covariance=cov[pid].copy(), slope_deg=slope,
+                         aspect_deg=aspect))  # fmt: skip
     return out
+
+
+def _covariances(lam: Array, vec: Array, centroid: Array, sigma0_sq: Array, wsum: Array) -> Array:
+    """Covariances (L, 4, 4) of (a, b, c, d) from the eigenpairs (``lam`` (L, 3) ascending,
+    ``vec`` (L, 3, 3) in columns) of the scatter matrices, the centroids (L, 3, CRS unit),
+    the variance factors (L,) and the weight sums (L,): tilts of the normal towards v_k are
+    resisted by the spread along v_k (l_k - l3); the offset along n by the total weight. Every
+    product written out (no BLAS)."""
+    v1, v2 = vec[:, :, 1], vec[:, :, 2]
+    g1 = (lam[:, 1] - lam[:, 0])[:, None, None]
+    g2 = (lam[:, 2] - lam[:, 0])[:, None, None]
+    c_nn = sigma0_sq[:, None, None] * (
+        v2[:, :, None] * v2[:, None, :] / g2 + v1[:, :, None] * v1[:, None, :] / g1
+    )
+    t = _dot3(c_nn, centroid[:, None, :])  # (L, 3): C_nn m
+    cov = np.empty((len(lam), 4, 4))
+    cov[:, :3, :3] = c_nn
+    cov[:, :3, 3] = -t
+    cov[:, 3, :3] = -t
+    cov[:, 3, 3] = _dot3(centroid, t) + sigma0_sq / wsum
+    return cov

@@ -18,6 +18,7 @@ nearest to a reference point ``c`` (the centre of the contact zone) solve
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Callable
@@ -27,6 +28,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError, stop_if_asked
 from ..geometry.rotations import skew
+from ..geometry.sym3 import eigh_sym3
 from ..i18n import Message, joined
 from ..i18n import mark as _t
 from .control_options import ControlOptions
@@ -126,10 +128,14 @@ def intersect_two_planes(
 
 
 def error_ellipsoid(cov: Array, confidence_scale: float = 1.0) -> tuple[Array, Array]:
-    """Semi-axes (..., 3) in decreasing order and their directions (..., 3, 3) as columns."""
-    w, v = np.linalg.eigh(np.asarray(cov, dtype=float))
-    w = np.clip(w[..., ::-1], 0.0, None)
-    return confidence_scale * np.sqrt(w), v[..., ::-1]
+    """Semi-axes (..., 3) in decreasing order and their directions (..., 3, 3) as columns, of
+    covariances (..., 3, 3) (CRS unit^2). By the fixed Jacobi rotations of
+    :func:`core.geometry.sym3.eigh_sym3`, not LAPACK: the same bits on any thread count or
+    numpy (LAPACK's eigh on Debian's OpenBLAS moved the axes with the thread count)."""
+    c = np.asarray(cov, dtype=float)
+    w, v = eigh_sym3(c.reshape(-1, 3, 3))
+    w = np.clip(w[:, ::-1], 0.0, None).reshape(c.shape[:-1])
+    return confidence_scale * np.sqrt(w), v[:, :, ::-1].reshape(c.shape)
 
 
 # ----------------------------------------------------------------------------- adjacency
@@ -328,8 +334,15 @@ class LidarControl:
 def _pair_angles(n: Array) -> Array:
     """Angles (degrees) between every pair of normals of each triple (T, 3)."""
     pairs = [(0, 1), (0, 2), (1, 2)]
-    cosines = np.stack([np.abs(np.einsum("ti,ti->t", n[:, i], n[:, j])) for i, j in pairs], 1)
-    return np.degrees(np.arccos(np.clip(cosines, -1.0, 1.0)))
+    return np.stack([_angles_deg(n[:, i], n[:, j]) for i, j in pairs], 1)
+
+
+def _angles_deg(u: Array, v: Array) -> Array:
+    """Angles (degrees, 0-90) between the lines of unit normals u and v (E, 3): products
+    written out and ``math.acos`` (numpy 2's vectorised arccos rounds differently from
+    numpy 1's in the last bit; libm is the same for both)."""
+    cos = np.abs(u[:, 0] * v[:, 0] + u[:, 1] * v[:, 1] + u[:, 2] * v[:, 2])
+    return np.array([math.degrees(math.acos(c)) for c in np.clip(cos, 0.0, 1.0).tolist()])
 
 
 def corner_candidates(adjacency: Adjacency) -> NDArray[np.int64]:
@@ -522,7 +535,7 @@ def _two_plane_lines(cand, by_id, pts, ids, adjacency, options, rejected) -> lis
     x0, u, cov = intersect_two_planes(
         n[:, 0], d[:, 0], c[:, 0], n[:, 1], d[:, 1], c[:, 1], np.array(refs)
     )
-    dihedral = np.degrees(np.arccos(np.clip(np.abs(np.einsum("ei,ei->e", n[:, 0], n[:, 1])), 0, 1)))
+    dihedral = _angles_deg(n[:, 0], n[:, 1])
     out = []
     for e, (a, b) in enumerate(cand.tolist()):
         pair = (int(a), int(b))

@@ -38,16 +38,19 @@ unit):
 
 **Repeatable**: the points are sorted by grid cell and, within a cell, by their coordinates;
 every tie goes to the lower sorted index and every sum runs in that order; the local and the
-region normals come from fixed Jacobi rotations (IEEE +, -, *, /, sqrt), not LAPACK, so the
-assignments do not depend on the BLAS/LAPACK build or its threads. The same point set
-gives the same planes bit for bit whatever the order of the points, the seed or the number of
-threads (tests/core/test_roof_planes_repeatable.py), and a tile holding a buffer of
+region normals and the final fits (:func:`core.geometry.planes.fit_planes`: sums in point
+order, :mod:`core.geometry.sym3`) come from fixed Jacobi rotations (IEEE +, -, *, /, sqrt), not
+BLAS or LAPACK, so neither the assignments nor the plane parameters depend on the BLAS/LAPACK
+build, its threads or the numpy version. The same point set gives the same planes bit for
+bit whatever the order of the points, the seed or the number of threads
+(tests/core/test_roof_planes_repeatable.py), and a tile holding a buffer of
 :func:`core.lidar.block.roof_buffer` the whole file's local planes and seeds on its core.
 """
 
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -115,7 +118,6 @@ class RoofPlaneResult:
     fit_mask: NDArray[np.bool_] | None = None
 
 
-
 def _outline(xyz: Array, plane: Plane, cell: float) -> Array:
     """Concave outline (M, 3) of a plane's points: raster mask, closing, outer contour."""
     import cv2
@@ -139,7 +141,8 @@ def _outline(xyz: Array, plane: Plane, cell: float) -> Array:
     # cell (i, j) covers [i, i + 1) * cell from lo - 2 cells: its centre is at i + 0.5
     pxy = lo + (poly - 2 + 0.5) * cell
     x, y = pxy[:, 0], pxy[:, 1]
-    if np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y) < 0:  # shoelace: clockwise
+    # shoelace (fsum: exactly rounded, no BLAS dot): clockwise
+    if math.fsum((x * np.roll(y, -1) - np.roll(x, -1) * y).tolist()) < 0:
         pxy = pxy[::-1]
     a, b, c = plane.normal
     z = (
@@ -221,8 +224,9 @@ def extract_roof_planes(
     del grid
     n_cand = int(keep.sum())
     log.info("local RANSAC kept %d of %d points (%.1f %%)", n_cand, n, 100.0 * n_cand / n)
-    labels = _grow(q, keep, normals, quality, knn, spacing_of, params, should_stop, compiled,
-                   origin)
+    labels = _grow(
+        q, keep, normals, quality, knn, spacing_of, params, should_stop, compiled, origin
+    )
     del normals, quality
     if progress is not None:
         progress(0.8)

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import stop_if_asked, use_compiled
+from ..geometry.sym3 import jacobi_sym3
 
 #: core.lidar.roof_planes.RoofPlaneParams (not imported: roof_planes imports this module)
 RoofPlaneParams = Any
@@ -52,36 +53,11 @@ def _jacobi_normals(
     a00: Array, a01: Array, a02: Array, a11: Array, a12: Array, a22: Array
 ) -> tuple[Array, Array, Array]:
     """Upward unit normals (smallest eigenvectors) of symmetric 3 x 3 matrices given by their
-    upper triangles (each (B,)), by ``JACOBI_SWEEPS`` sweeps of Jacobi rotations: only +, -,
-    *, / and sqrt in a fixed order, so the compiled back end (one matrix at a time) gives the
-    same bits. Six sweeps converge any 3 x 3 matrix to machine precision."""
-    from .roof_planes_numba import JACOBI_SWEEPS
-
-    one, zero = np.ones_like(a00), np.zeros_like(a00)
-    v = [[one, zero, zero], [zero.copy(), one.copy(), zero.copy()],
-         [zero.copy(), zero.copy(), one.copy()]]  # fmt: skip
-    a = {(0, 0): a00, (0, 1): a01, (0, 2): a02, (1, 1): a11, (1, 2): a12, (2, 2): a22}
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        for _ in range(JACOBI_SWEEPS):
-            for p_, q_, r_ in ((0, 1, 2), (0, 2, 1), (1, 2, 0)):
-                app, aqq, apq = a[p_, p_], a[q_, q_], a[p_, q_]
-                rot = apq != 0.0
-                theta = (aqq - app) / (2.0 * apq)
-                tt = 1.0 / (np.abs(theta) + np.sqrt(theta * theta + 1.0))
-                tt = np.where(theta < 0.0, -tt, tt)
-                cc = 1.0 / np.sqrt(tt * tt + 1.0)
-                ss = tt * cc
-                arp, arq = a[min(r_, p_), max(r_, p_)], a[min(r_, q_), max(r_, q_)]
-                a[p_, p_] = np.where(rot, app - tt * apq, app)
-                a[q_, q_] = np.where(rot, aqq + tt * apq, aqq)
-                a[p_, q_] = np.where(rot, 0.0, apq)
-                a[min(r_, p_), max(r_, p_)] = np.where(rot, cc * arp - ss * arq, arp)
-                a[min(r_, q_), max(r_, q_)] = np.where(rot, ss * arp + cc * arq, arq)
-                for row in range(3):
-                    vp, vq = v[row][p_], v[row][q_]
-                    v[row][p_] = np.where(rot, cc * vp - ss * vq, vp)
-                    v[row][q_] = np.where(rot, ss * vp + cc * vq, vq)
-    d0, d1, d2 = a[0, 0], a[1, 1], a[2, 2]
+    upper triangles (each (B,)), by the fixed Jacobi rotations of
+    :func:`core.geometry.sym3.jacobi_sym3`: only +, -, *, / and sqrt in a fixed order, so the
+    compiled back end (one matrix at a time) gives the same bits. Ties in the eigenvalues go
+    to the lower column."""
+    (d0, d1, d2), v = jacobi_sym3(a00, a01, a02, a11, a12, a22)
     first = (d0 <= d1) & (d0 <= d2)
     second = ~first & (d1 <= d2)
     col = np.where(first, 0, np.where(second, 1, 2))
@@ -365,7 +341,9 @@ def _local_planes(
             pts = (q[idx] - q[lo:hi, None, :]).astype(np.float32)
             keep, normals, quality = _ransac_numpy(pts, tri[grid.table[lo:hi]], params)
             out["keep"][lo:hi], out["normals"][lo:hi], out["quality"][lo:hi] = (
-                keep, normals, quality
+                keep,
+                normals,
+                quality,
             )
         if progress is not None:
             progress(0.7 * (bi + 1) / n_batches)
@@ -377,5 +355,3 @@ def _use_numba(backend: str) -> bool:
     from .roof_planes_numba import AVAILABLE
 
     return use_compiled(backend, AVAILABLE)
-
-

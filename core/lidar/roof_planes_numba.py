@@ -25,6 +25,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..compiled import cached_njit
+from ..geometry.sym3 import JACOBI_SWEEPS  # the numpy back end's sweeps
 
 try:  # pragma: no cover - depends on the environment
     import numba
@@ -36,9 +37,6 @@ except Exception:  # ImportError, or a numba built against another numpy
 
 __all__ = ["AVAILABLE", "local_planes"]
 
-#: Jacobi sweeps of the 3 x 3 eigen-decomposition (3 rotations each); the same number as the
-#: numpy back end's.
-JACOBI_SWEEPS = 6
 #: Previous points whose k-th distance bounds the next point's (the search's first cut).
 LAST = 4
 #: Relative margin of the cell pruning.
@@ -279,17 +277,20 @@ def _jacobi_normal(a00, a01, a02, a11, a12, a22):
                 a00, a11, a01 = napp, naqq, 0.0
                 a02, a12 = _rotate(cc_, ss, a02, a12)
                 v00, v01, v10, v11, v20, v21 = _rotate_columns(
-                    cc_, ss, v00, v01, v10, v11, v20, v21)
+                    cc_, ss, v00, v01, v10, v11, v20, v21
+                )
             elif rot == 1:  # p = 0, q = 2, r = 1
                 a00, a22, a02 = napp, naqq, 0.0
                 a01, a12 = _rotate(cc_, ss, a01, a12)
                 v00, v02, v10, v12, v20, v22 = _rotate_columns(
-                    cc_, ss, v00, v02, v10, v12, v20, v22)
+                    cc_, ss, v00, v02, v10, v12, v20, v22
+                )
             else:  # p = 1, q = 2, r = 0
                 a11, a22, a12 = napp, naqq, 0.0
                 a01, a02 = _rotate(cc_, ss, a01, a02)
                 v01, v02, v11, v12, v21, v22 = _rotate_columns(
-                    cc_, ss, v01, v02, v11, v12, v21, v22)
+                    cc_, ss, v01, v02, v11, v12, v21, v22
+                )
     if a00 <= a11 and a00 <= a22:
         nx_, ny_, nz_ = v00, v10, v20
     elif a11 <= a22:
@@ -305,9 +306,9 @@ def _normals_kernel(cov, out):
     """Upward normals (B, 3) of the 3 x 3 matrices ``cov`` (B, 3, 3) by :func:`_jacobi_normal`
     (roof_planes_local._eig_normals' compiled path; the same bits as its numpy path)."""
     for b in range(cov.shape[0]):
-        out[b, 0], out[b, 1], out[b, 2] = _jacobi_normal(cov[b, 0, 0], cov[b, 0, 1],
-                                                         cov[b, 0, 2], cov[b, 1, 1],
-                                                         cov[b, 1, 2], cov[b, 2, 2])
+        out[b, 0], out[b, 1], out[b, 2] = _jacobi_normal(
+            cov[b, 0, 0], cov[b, 0, 1], cov[b, 0, 2], cov[b, 1, 1], cov[b, 1, 2], cov[b, 2, 2]
+        )
 
 
 def _local_planes_kernel(
@@ -487,9 +488,12 @@ def _order_kernel(key, nbins, xyz, start, order):
             t = u
             while t > start[b]:
                 j = order[t - 1]
-                if xyz[j, 0] < xyz[i, 0] or (xyz[j, 0] == xyz[i, 0] and (
-                        xyz[j, 1] < xyz[i, 1] or (xyz[j, 1] == xyz[i, 1]
-                                                  and xyz[j, 2] <= xyz[i, 2]))):
+                if xyz[j, 0] < xyz[i, 0] or (
+                    xyz[j, 0] == xyz[i, 0]
+                    and (
+                        xyz[j, 1] < xyz[i, 1] or (xyz[j, 1] == xyz[i, 1] and xyz[j, 2] <= xyz[i, 2])
+                    )
+                ):
                     break
                 order[t] = j
                 t -= 1
@@ -599,9 +603,7 @@ def label_pairs(labels: np.ndarray, knn: np.ndarray, nl: int) -> np.ndarray:
     return np.unique(out[:m])
 
 
-def counting_order(
-    key: np.ndarray, nbins: int, xyz: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
+def counting_order(key: np.ndarray, nbins: int, xyz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(order, start) of a counting sort of ``key`` in [0, nbins), each key's points by their
     coordinates ``xyz`` (N, 3): numpy's lexsort of (z, y, x, key)."""
     start = np.zeros(nbins + 1, dtype=np.int64)

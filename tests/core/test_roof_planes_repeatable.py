@@ -96,42 +96,54 @@ _THREADS_CHILD = """
 import json, sys
 import numpy as np
 import numba
+from lidarphoto.core.geometry.planes import fit_plane
+from lidarphoto.core.io.control import write_lcps_csv, write_lines_csv
+from lidarphoto.core.io.planes import write_planes_csv
+from lidarphoto.core.lidar.control import lidar_control
 from lidarphoto.core.lidar.roof_planes import extract_roof_planes
 xyz = np.load(sys.argv[1])
 res = extract_roof_planes(xyz)
+write_planes_csv(sys.argv[2] + "planes.csv", res.planes)
+control = lidar_control(res.planes, xyz, res.plane_id)
+write_lcps_csv(sys.argv[2] + "lcps.csv", control.points)
+write_lines_csv(sys.argv[2] + "lines.csv", control.lines)
+refit = fit_plane(xyz[res.plane_id >= 0])  # one fit of 1e5 points, as a block's refit
 print(json.dumps({"threads": numba.get_num_threads(), "pid": res.plane_id.tolist(),
                   "params": [p.params.tolist() + p.covariance.ravel().tolist()
-                             for p in res.planes]}))
+                             for p in res.planes],
+                  "refit": refit.params.tolist() + refit.covariance.ravel().tolist()}))
 """
 
 
 def test_one_and_two_threads_give_the_same_planes(ahn3_small, tmp_path):
-    """Whole processes with numba, OpenMP and BLAS on 1 and on 2 threads: the same numbers
-    (printed with repr precision, so bit for bit), with numpy 2 and Debian's numpy 1.24 (the
-    system OpenBLAS). The region normals come from fixed Jacobi rotations, not LAPACK."""
+    """Whole processes with numba, OpenMP and BLAS on 1 and on 2 threads: the same plane of
+    every point and the same plane, LCP and line tables, byte for byte (numbers with repr
+    precision), with numpy 2 and with Debian's numpy 1.24 (the system OpenBLAS). Every plane
+    parameter comes from sums in point order and fixed Jacobi rotations
+    (core/geometry/sym3.py), not from a BLAS product or LAPACK's eigh, whose sums depend on
+    the thread count (before issue 33, numpy 1.24 on 2 threads: 314 of the 806 planes of
+    AHN3 crop 1 had parameters moved in the last bits, and the LCPs' error ellipsoids)."""
     pytest.importorskip("numba")
     path = tmp_path / "xyz.npy"
     np.save(path, ahn3_small)
-    out = []
+    out, tables = [], []
     for n in ("1", "2"):
         env = {**os.environ, "NUMBA_NUM_THREADS": n, "OMP_NUM_THREADS": n,
                "OPENBLAS_NUM_THREADS": n, "MKL_NUM_THREADS": n}  # fmt: skip
-        r = subprocess.run([sys.executable, "-c", _THREADS_CHILD, str(path)], env=env,
-                           capture_output=True, text=True, check=True)  # fmt: skip
+        prefix = str(tmp_path / f"threads_{n}_")
+        r = subprocess.run([sys.executable, "-c", _THREADS_CHILD, str(path), prefix],
+                           env=env, capture_output=True, text=True, check=True)  # fmt: skip
         out.append(json.loads(r.stdout.strip().splitlines()[-1]))
+        tables.append([Path(prefix + t).read_bytes() for t in ("planes.csv", "lcps.csv",
+                                                               "lines.csv")])  # fmt: skip
     assert [o["threads"] for o in out] == [1, 2]
-    # the same regions, point for point, on every BLAS
-    assert out[0]["pid"] == out[1]["pid"]
+    assert out[0]["pid"] == out[1]["pid"]  # the same regions, point for point
     assert len(out[0]["params"]) > 30
-    if np.lib.NumpyVersion(np.__version__) >= "2.0.0":
-        assert out[0]["params"] == out[1]["params"]  # numpy 2's OpenBLAS: bit for bit
-    else:
-        # Debian's system OpenBLAS (numpy 1.24) on 2 threads moves some plane parameters and
-        # covariances by up to 1.8e-14 of their value on some hosts (measured 2026-12-02: 267
-        # of 1,180 numbers; numba's thread count changes nothing): rounding, not another plane.
-        # Left to issue 33: final fits without threaded BLAS or LAPACK.
-        a, b = np.array(out[0]["params"]), np.array(out[1]["params"])
-        assert np.all(np.abs(a - b) <= 1e-13 * np.maximum(np.abs(a), np.abs(b)))
+    assert out[0]["params"] == out[1]["params"]  # bit for bit, on every numpy and BLAS
+    assert out[0]["refit"] == out[1]["refit"]
+    assert tables[0][0].count(b"\n") == len(out[0]["params"]) + 1
+    assert [t.count(b"\n") > 3 for t in tables[0][1:]] == [True, True]  # LCPs and lines
+    assert tables[0] == tables[1]
 
 
 # ----------------------------------------------------------------------------- blocks
@@ -186,14 +198,20 @@ def assert_block_reproduces(xyz, ref, merged, pid, n_pieces) -> dict:
         if not (angle < 0.5 and off < 0.02 and share >= 0.8):
             bad.append((int(p), round(angle, 3), round(off, 4), round(share, 3)))
     assert len(bad) <= 0.01 * len(big), (len(bad), len(big), bad[:10])
-    assert abs(len(merged) - len(ref.planes)) <= 0.01 * len(ref.planes), (len(merged),
-                                                                          len(ref.planes))
+    assert abs(len(merged) - len(ref.planes)) <= 0.01 * len(ref.planes), (
+        len(merged),
+        len(ref.planes),
+    )
     whole = lidar_control(ref.planes, xyz, ref.plane_id)
     block = lidar_control([m.plane for m in merged], xyz, pid)
     assert abs(len(block.points) - len(whole.points)) <= 0.01 * len(whole.points) + 0.5
     assert abs(len(block.lines) - len(whole.lines)) <= 0.01 * len(whole.lines) + 0.5
-    return {"planes": (len(ref.planes), len(merged)), "matched": len(big) - len(bad),
-            "big": len(big), "lcps": (len(whole.points), len(block.points))}
+    return {
+        "planes": (len(ref.planes), len(merged)),
+        "matched": len(big) - len(bad),
+        "big": len(big),
+        "lcps": (len(whole.points), len(block.points)),
+    }
 
 
 @pytest.mark.parametrize("cuts", [((45.0,), (45.0,)), ((40.0, 80.0), (40.0, 80.0))],
