@@ -1,0 +1,427 @@
+"""Automatic (click-free) boresight calibration from LiDAR roof lines and planes (issue 32).
+
+From the images, the camera, the trajectory (INS/GNSS), the mount with an approximate
+boresight and the LiDAR roof planes and lines (mapping CRS), without any hand-picked point:
+
+1. Observability: a scene with no roof plane sloping more than ``min_slope_deg`` and fewer
+   than ``min_line_directions`` distinct LiDAR line directions (flat ground, flat roofs) is
+   refused with that reason (:class:`SceneNotObservable`): the angles are not observable.
+2. Angle search (coarse to fine): the LiDAR lines, sampled in 3D, are projected into every
+   image for boresight candidates on a grid of ``coarse_step_px`` (in the image) over
+   +-``search_deg`` about the initial boresight (omega and phi together, then kappa), and the
+   candidate whose projections lie on the strongest image edges (the sum of the gradient
+   magnitude of the image blurred by about half a step) wins; the grid is then halved around
+   it down to ``fine_step_px``. This is what lets a 1-degree initial error converge: the
+   edge refinement of step 3 only looks a few pixels across a line.
+3. Rounds: with the exterior orientation of the current estimate, line observations are
+   found along the projected lines (:func:`.auto_lines.line_observations_block`, searched
+   within 3 sigma of the projection's uncertainty, the pose's and the boresight's), tie
+   tracks (optional input) are associated with roof planes within a gate of 3 sigma
+   (:func:`.auto_ties.associate_ties`), and :func:`.boresight.calibrate` (robust stage and
+   data snooping) adjusts them. The next round starts from the adjusted orientation; the
+   rounds stop when every boresight angle changed by less than its standard deviation (after
+   at least two rounds) or after ``max_rounds``.
+
+Angles are radians inside, pixel quantities (col, row) per docs/conventions.md.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Union
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InputError, stop_if_asked
+from ..geometry.camera import Camera
+from ..geometry.frames import LocalFrame, MappingFrame
+from ..geometry.planes import Plane
+from ..geometry.projection import ideal_from_camera
+from ..geometry.rotations import boresight_matrix
+from ..geometry.surface import Dsm
+from ..lidar.control import ControlLine
+from .auto_lines import AutoLineOptions, _grey, line_observations_block
+from .auto_ties import REASONS, associate_ties
+from .boresight import calibrate
+from .boresight_options import BoresightOptions
+from .boresight_result import BoresightResult
+from .georeference import Trajectory, direct_georeference
+from .ins import ins_grade
+from .mount import Mount
+from .observations import ImageObservations
+from .orientation import ExteriorOrientationTable, eo_map_to_local
+
+__all__ = [
+    "AutoBoresightOptions",
+    "AutoBoresightResult",
+    "RoundRecord",
+    "SceneNotObservable",
+    "auto_calibrate",
+    "scene_refusal",
+    "search_boresight",
+]
+
+Array = NDArray[np.float64]
+Images = Sequence[tuple[str, ArrayLike]]
+
+
+class SceneNotObservable(InputError):
+    """The LiDAR scene cannot determine the boresight angles (the message says why)."""
+
+
+@dataclass(frozen=True)
+class AutoBoresightOptions:
+    """Parameters of :func:`auto_calibrate`.
+
+    search_deg: half width of the angle search about the initial boresight, degrees (0: no
+        search, the initial boresight must be within a few pixels).
+    coarse_step_px, fine_step_px: first and last grid step of the search, pixels in the image.
+    min_search_px: smallest half width of the edge search across a projected line, pixels.
+    sigmas: width of the edge search and of the tie gate in standard deviations.
+    min_gate_m: smallest tie gate, metres.
+    border_m: smallest distance of a tie from its plane's outline, metres.
+    max_roof_slope_deg: steeper planes are walls (no tie), degrees.
+    min_slope_deg: a plane sloping less is flat (does not make the angles observable), degrees.
+    min_line_directions: fewest distinct line directions (15 degrees apart in plan) that make
+        the angles observable without sloped planes.
+    max_rounds: most association-adjustment rounds.
+    lines: options of the edge search (its ``search_px`` is set per round).
+    """
+
+    search_deg: float = 1.0
+    coarse_step_px: float = 4.0
+    fine_step_px: float = 0.5
+    min_search_px: float = 2.5
+    sigmas: float = 3.0
+    min_gate_m: float = 0.05
+    border_m: float = 0.3
+    max_roof_slope_deg: float = 65.0
+    min_slope_deg: float = 5.0
+    min_line_directions: int = 2
+    max_rounds: int = 6
+    lines: AutoLineOptions = field(default_factory=AutoLineOptions)
+
+    def __post_init__(self) -> None:
+        for name in ("coarse_step_px", "fine_step_px", "min_search_px", "sigmas", "min_gate_m"):
+            if not float(getattr(self, name)) > 0:
+                raise InputError(f"{name} must be > 0, got {getattr(self, name)!r}")
+        if not 0 <= float(self.search_deg) <= 10:
+            raise InputError(f"search_deg must be in [0, 10] degrees, got {self.search_deg!r}")
+        if self.fine_step_px > self.coarse_step_px:
+            raise InputError("fine_step_px must not exceed coarse_step_px")
+        if int(self.max_rounds) < 1 or int(self.min_line_directions) < 1:
+            raise InputError("max_rounds and min_line_directions must be >= 1")
+
+
+@dataclass(frozen=True)
+class RoundRecord:
+    """One association-adjustment round: the search width (px) and tie gate (m) used, the
+    observation counts, the boresight after it (G, 3, radians), its sigmas and its change."""
+
+    round: int
+    search_px: float
+    gate_m: float
+    line_points: int
+    lines_seen: int
+    tie_tracks: int
+    ties_associated: int
+    ties_refused: dict[str, int]
+    boresight: Array
+    std: Array
+    change: Array
+    rejected: int
+
+
+@dataclass(frozen=True)
+class AutoBoresightResult:
+    """Result of :func:`auto_calibrate`: the last calibration, the boresight the angle search
+    gave (3,) radians, the rounds, the observations of the last round, and the images'
+    line-point counts and tie counts per plane of the last round."""
+
+    result: BoresightResult
+    searched: Array
+    rounds: list[RoundRecord]
+    observations: ImageObservations
+    converged: bool
+    per_image: dict[str, int]
+    per_plane: dict[str, int]
+
+
+# ------------------------------------------------------------------ observability
+def _directions(lines: Sequence[ControlLine], min_length: float = 1.0) -> int:
+    """Number of distinct plan directions (15 degrees apart) among the lines."""
+    az = sorted(
+        float(np.degrees(np.arctan2(ln.direction[1], ln.direction[0]))) % 180.0
+        for ln in lines
+        if ln.length >= min_length and np.hypot(*ln.direction[:2]) > 0.2
+    )
+    count, last = 0, -1e9
+    for a in az:
+        if a - last >= 15.0:
+            count, last = count + 1, a
+    if count > 1 and az[0] + 180.0 - last < 15.0:  # the first and last wrap round
+        count -= 1
+    return count
+
+
+def scene_refusal(planes: Sequence[Plane], lines: Sequence[ControlLine],
+                  options: AutoBoresightOptions | None = None) -> str:  # fmt: skip
+    """Why the scene cannot determine the boresight ("" when it can; module docstring)."""
+    opt = options or AutoBoresightOptions()
+    sloped = [p for p in planes if opt.min_slope_deg <= p.slope_deg <= opt.max_roof_slope_deg]
+    normals = np.array([p.normal for p in sloped]).reshape(-1, 3)
+    distinct = normals.shape[0] > 1 and float(np.min(normals @ normals[0])) < np.cos(
+        np.radians(10.0)
+    )
+    n_dir = _directions(lines)
+    if distinct or n_dir >= opt.min_line_directions:
+        return ""
+    return (
+        f"the LiDAR scene cannot determine the boresight angles: {len(sloped)} roof plane(s) "
+        f"sloping {opt.min_slope_deg:g} to {opt.max_roof_slope_deg:g} degrees "
+        f"({'one normal' if len(sloped) else 'none'}: flat ground or flat roofs only) and "
+        f"{n_dir} LiDAR line direction(s) (at least {opt.min_line_directions} needed)"
+    )
+
+
+# ------------------------------------------------------------------ angle search
+@dataclass
+class _SearchImage:
+    u: Array  # (K, 3) line samples in the camera frame of the zero boresight
+    grey: Array
+
+
+def _nominal_camera_vectors(traj: Trajectory, camera: Camera, mount: Mount,
+                            frame: MappingFrame, lines: Sequence[ControlLine], step_px: float
+                            ) -> tuple[list[Array], LocalFrame]:  # fmt: skip
+    """Per image, LiDAR line samples (about ``step_px`` / 2 apart at the image scale) as
+    vectors in the camera frame of a zero boresight: ``u = M0 (X - C)``."""
+    zero = replace(mount, boresight=np.zeros(3))
+    eo = direct_georeference(traj, zero, frame)
+    local = LocalFrame.at_map_point(frame, eo.xyz.mean(axis=0))
+    centres, m0 = eo_map_to_local(eo.xyz, eo.opk, local)
+    pts = []
+    for ln in lines:
+        a, b = np.asarray(ln.start, float), np.asarray(ln.end, float)
+        rng = float(np.min(np.abs(eo.xyz[:, 2] - (a[2] + b[2]) / 2)))
+        gsd = max(rng, 1.0) / camera.focal_px
+        n = int(np.clip(np.ceil(np.linalg.norm(b - a) / (gsd * step_px / 2)), 2, 2000))
+        t = (np.arange(n) + 0.5) / n
+        pts.append(a + t[:, None] * (b - a))
+    xyz = local.map_to_enu(np.vstack(pts)) if pts else np.empty((0, 3))
+    return [(xyz - centres[i]) @ m0[i].T for i in range(len(traj))], local
+
+
+def _pixels(u: Array, bore: Array, camera: Camera) -> Array:
+    """Pixels (K, 2) of the camera-frame vectors ``u`` turned by the boresight (NaN: not seen)."""
+    q = u @ boresight_matrix(*bore)  # v = dR^T u, in rows
+    ideal, valid = ideal_from_camera(q, camera.focal_mm, camera.projection)[:2]
+    px, ok = camera.pixel_from_ideal_with_status(np.where(valid[:, None], ideal, 0.0))
+    px[~(valid & ok)] = np.nan
+    return px
+
+
+def _score(images: list[_SearchImage], grads: list[Array], bore: Array, camera: Camera) -> float:
+    """Mean edge strength under the projected lines (out-of-frame samples count 0)."""
+    from scipy.ndimage import map_coordinates
+
+    total, count = 0.0, 0
+    for im, g in zip(images, grads):
+        px = _pixels(im.u, bore, camera)
+        inside = np.isfinite(px).all(axis=1) & camera.in_frame(np.nan_to_num(px, nan=-1e9), 2.0)
+        count += len(px)
+        if inside.any():
+            p = px[inside] - 0.5
+            total += float(map_coordinates(g, [p[:, 1], p[:, 0]], order=1).sum())
+    return total / max(count, 1)
+
+
+def _grid_best(images, grads, camera, centre: Array, steps: Array, half: int, axes) -> Array:
+    """The best candidate of a (2 half + 1)^len(axes) grid about ``centre``."""
+    offsets = np.arange(-half, half + 1)
+    grids = np.meshgrid(*[offsets * steps[a] for a in axes], indexing="ij")
+    best, best_score = centre, -np.inf
+    for combo in zip(*[g.ravel() for g in grids]):
+        cand = centre.copy()
+        for a, d in zip(axes, combo):
+            cand[a] += d
+        s = _score(images, grads, cand, camera)
+        if s > best_score:
+            best, best_score = cand, s
+    return best
+
+
+def search_boresight(
+    traj: Trajectory,
+    camera: Camera,
+    mount: Mount,
+    frame: MappingFrame,
+    images: Images,
+    lines: Sequence[ControlLine],
+    options: AutoBoresightOptions | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> Array:
+    """Coarse-to-fine boresight (3,) radians whose projected LiDAR lines lie on the strongest
+    image edges (module docstring, step 2)."""
+    from scipy.ndimage import gaussian_gradient_magnitude
+
+    opt = options or AutoBoresightOptions()
+    if opt.search_deg == 0 or not lines:
+        return np.asarray(mount.boresight, float).copy()
+    us, _ = _nominal_camera_vectors(traj, camera, mount, frame, lines, opt.fine_step_px * 4)
+    row = {iid: k for k, iid in enumerate(traj.image_id)}
+    ims = []
+    for iid, img in images:
+        if iid not in row:
+            raise InputError(f"image '{iid}' is not in the trajectory")
+        ims.append(_SearchImage(us[row[iid]], _grey(img)))
+    f = camera.focal_px
+    half_diag = 0.5 * float(np.hypot(camera.width_px, camera.height_px))
+    step_px = float(opt.coarse_step_px)
+    bore = np.asarray(mount.boresight, float).copy()
+    first = True
+    while True:
+        stop_if_asked(should_stop, "the boresight search")
+        grads = [gaussian_gradient_magnitude(im.grey, max(0.7, 0.6 * step_px)) for im in ims]
+        steps = np.array([step_px / f, step_px / f, step_px / half_diag])
+        if first:  # the whole range: omega and phi together, then kappa
+            n_op = int(np.ceil(np.radians(opt.search_deg) / steps[0]))
+            n_k = int(np.ceil(np.radians(opt.search_deg) / steps[2]))
+            bore = _grid_best(ims, grads, camera, bore, steps, n_op, (0, 1))
+            bore = _grid_best(ims, grads, camera, bore, steps, n_k, (2,))
+            first = False
+        for _ in range(2):
+            bore = _grid_best(ims, grads, camera, bore, steps, 2, (0, 1))
+            bore = _grid_best(ims, grads, camera, bore, steps, 2, (2,))
+        if step_px <= opt.fine_step_px * 1.0001:
+            return bore
+        step_px = max(step_px / 2.0, opt.fine_step_px)
+
+
+# ------------------------------------------------------------------ rounds
+def _counts(obs: ImageObservations, kind: str, key: str) -> dict[str, int]:
+    out: dict[str, int] = {}
+    for t, i, tid in zip(obs.type, obs.image_id, obs.target_id):
+        if t == kind:
+            k = i if key == "image" else tid
+            out[k] = out.get(k, 0) + 1
+    return out
+
+
+def auto_calibrate(
+    trajectory: Trajectory,
+    camera: Camera,
+    mount: Mount,
+    crs: Union[str, MappingFrame],
+    images: Images,
+    planes: Sequence[Plane] = (),
+    lines: Sequence[ControlLine] = (),
+    ties: ImageObservations | None = None,
+    dsm: Dsm | None = None,
+    options: AutoBoresightOptions | None = None,
+    calibration: BoresightOptions | None = None,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> AutoBoresightResult:
+    """Calibrate the boresight without hand picks (module docstring).
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        INS/GNSS poses of the images (the approximate EO with ``mount``).
+    camera : Camera
+    mount : Mount
+        Lever arm, nominal mount and the approximate boresight (radians).
+    crs : str or MappingFrame
+        Mapping CRS of the trajectory, planes, lines and DSM.
+    images : sequence of (image_id, array)
+        Grey or RGB images of the camera's size (a list: it is read in every round).
+    planes, lines : sequences
+        LiDAR roof planes (with outlines for ties) and ridge/hip/valley lines.
+    ties : ImageObservations, optional
+        Tie tracks (rows of type ``tie``, e.g. from ``tiepoints``); associated with planes.
+    dsm : Dsm, optional
+        LiDAR DSM: ties off it are refused.
+    options : AutoBoresightOptions, optional
+    calibration : BoresightOptions, optional
+        Options of the adjustment (``use_types`` is set to tie and line).
+    progress, should_stop : callables, optional
+        Fraction done (0..1); cancellation.
+
+    Raises
+    ------
+    SceneNotObservable
+        A flat scene (module docstring, step 1), or no observation found.
+    """
+    opt = options or AutoBoresightOptions()
+    frame = crs if isinstance(crs, MappingFrame) else MappingFrame.from_user_input(crs)
+    why = scene_refusal(planes, lines, opt)
+    if why:
+        raise SceneNotObservable(why)
+    images = list(images)
+    base = calibration or BoresightOptions()
+    cal = replace(base, use_types=("tie", "line"))
+    grade = ins_grade(base.ins_grade) if isinstance(base.ins_grade, str) else base.ins_grade
+    att_sigma = np.radians(max(grade.sigma_roll_pitch_deg, grade.sigma_heading_deg))
+    searched = search_boresight(trajectory, camera, mount, frame, images, lines, opt, should_stop)
+    if progress:
+        progress(0.3)
+    current = replace(mount, boresight=searched)
+    eo: ExteriorOrientationTable = direct_georeference(trajectory, current, frame)
+    bore_sigma = opt.fine_step_px / camera.focal_px if opt.search_deg > 0 else 0.0
+    height = float(np.median(eo.xyz[:, 2]) - np.median([p.centroid[2] for p in planes])) \
+        if planes else float(np.median(eo.xyz[:, 2]))  # fmt: skip
+    rounds: list[RoundRecord] = []
+    last = np.asarray(searched, float)[None, :]
+    result, obs, converged = None, None, False
+    for r in range(int(opt.max_rounds)):
+        stop_if_asked(should_stop, "the automatic calibration")
+        spread = float(np.hypot(bore_sigma, att_sigma))
+        search_px = max(opt.min_search_px, opt.sigmas * camera.focal_px * spread)
+        gate = max(opt.min_gate_m, opt.sigmas * abs(height) * spread)
+        line_obs = line_observations_block(images, camera, eo, lines,
+                                           replace(opt.lines, search_px=search_px))  # fmt: skip
+        refused = dict.fromkeys(REASONS, 0)
+        n_tracks = 0
+        obs = line_obs
+        if ties is not None and len(ties):
+            assoc = associate_ties(ties, eo, camera, planes, gate, border_m=opt.border_m,
+                                   max_roof_slope_deg=opt.max_roof_slope_deg, dsm=dsm)  # fmt: skip
+            refused, n_tracks = assoc.reasons, assoc.tracks
+            obs = obs.concat(assoc.observations)
+        if len(obs) == 0:
+            raise SceneNotObservable(
+                "no image edge was found along the projected LiDAR lines and no tie track lies "
+                f"on a roof plane (round {r + 1}, search {search_px:.1f} px): the approximate "
+                "boresight or the mount is too far off, or the lines are not in the images"
+            )
+        result = calibrate(trajectory, camera, current, frame, obs, planes, lines, options=cal,
+                           should_stop=should_stop)  # fmt: skip
+        change = result.boresight - last
+        n_ties = sum(1 for t in obs.type if t == "tie")
+        rounds.append(RoundRecord(
+            r + 1, search_px, gate, len(line_obs), len(set(line_obs.target_id)), n_tracks,
+            len(set(p for p, t in zip(obs.point_id, obs.type) if t == "tie")) if n_ties else 0,
+            refused, result.boresight.copy(), result.std.copy(), change,
+            int(result.residuals.rejected.sum())))  # fmt: skip
+        if progress:
+            progress(0.3 + 0.7 * (r + 1) / opt.max_rounds)
+        if r >= 1 and bool(np.all(np.abs(change) < result.std)):
+            converged = True
+            break
+        last = result.boresight.copy()
+        bore_sigma = float(np.max(result.std))
+        eo = result.eo
+        current = replace(mount, boresight=result.boresight.mean(axis=0))
+    assert result is not None and obs is not None
+    return AutoBoresightResult(
+        result,
+        np.asarray(searched, float),
+        rounds,
+        obs,
+        converged,
+        _counts(obs, "line", "image"),
+        _counts(obs, "tie", "plane"),
+    )

@@ -1,0 +1,255 @@
+"""Automatic boresight calibration (core.photo.auto_boresight, auto_ties) on a block of four
+images rendered by the project's renderer over three hip-roof houses, with a known boresight,
+INS noise of the POS AV 310 grade and an initial boresight that is 0.3 and 1 degree off."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from lidarphoto.core.geometry.camera import Camera
+from lidarphoto.core.geometry.frames import MappingFrame
+from lidarphoto.core.geometry.planes import fit_plane
+from lidarphoto.core.geometry.surface import Dsm
+from lidarphoto.core.lidar.control import ControlLine
+from lidarphoto.core.lidar.dsm import dsm_from_points
+from lidarphoto.core.photo.auto_boresight import (
+    AutoBoresightOptions,
+    SceneNotObservable,
+    auto_calibrate,
+    scene_refusal,
+)
+from lidarphoto.core.photo.auto_ties import associate_ties
+from lidarphoto.core.photo.boresight_options import BoresightOptions
+from lidarphoto.core.photo.georeference import Trajectory, direct_georeference
+from lidarphoto.core.photo.ins import ins_grade
+from lidarphoto.core.photo.mount import Mount
+from lidarphoto.core.photo.observations import ImageObservations
+from lidarphoto.core.photo.picking import PickingScene
+from lidarphoto.core.simulation.render import render_image
+from lidarphoto.core.simulation.render_scene import RenderOptions, RenderScene
+
+CRS = "EPSG:28992"
+X0, Y0 = 85000.0, 447000.0
+TRUTH_DEG = np.array([0.3, -0.2, 0.25])
+HOUSES = (((-8.0, 7.0), 25.0), ((7.0, 9.0), -40.0), ((0.0, -8.0), 70.0))
+LENGTH, WIDTH, EAVE, SLOPE = 10.0, 7.0, 5.0, 0.8
+
+
+def _house(k: int, centre, turn_deg: float):
+    """Roof points (N, 3) and face labels of one hip roof, its four planes' outlines (house
+    frame u along, v across) and its ridge and hip lines (end points), mapping CRS."""
+    c, s = math.cos(math.radians(turn_deg)), math.sin(math.radians(turn_deg))
+    rot = np.array([[c, -s], [s, c]])
+    r = LENGTH / 2 - WIDTH / 2
+    top = EAVE + SLOPE * WIDTH / 2
+
+    def m(u, v, h):
+        return np.r_[np.asarray(centre) + rot @ [u, v], h]
+
+    L2, W2 = LENGTH / 2, WIDTH / 2
+    outlines = [
+        [m(-L2, W2, EAVE), m(L2, W2, EAVE), m(r, 0, top), m(-r, 0, top)],
+        [m(-L2, -W2, EAVE), m(L2, -W2, EAVE), m(r, 0, top), m(-r, 0, top)],
+        [m(L2, W2, EAVE), m(L2, -W2, EAVE), m(r, 0, top)],
+        [m(-L2, W2, EAVE), m(-L2, -W2, EAVE), m(-r, 0, top)],
+    ]
+    segs = {(0, 1): (m(-r, 0, top), m(r, 0, top)), (0, 2): (m(r, 0, top), m(L2, W2, EAVE)),
+            (1, 2): (m(r, 0, top), m(L2, -W2, EAVE)), (0, 3): (m(-r, 0, top), m(-L2, W2, EAVE)),
+            (1, 3): (m(-r, 0, top), m(-L2, -W2, EAVE))}  # fmt: skip
+    lines = []
+    for j, ((a, b), (p, q)) in enumerate(segs.items()):
+        u = (q - p) / np.linalg.norm(q - p)
+        lines.append(ControlLine(10 * k + j + 1, (10 * k + a, 10 * k + b), "hip" if j else "ridge",
+                                 p, q, p, u, np.eye(6) * 1e-6, 90.0))  # fmt: skip
+    return rot, outlines, lines
+
+
+def _scene():
+    rng = np.random.default_rng(7)
+    n = 12 * 50 * 50
+    xy = rng.uniform(-25, 25, (n, 2))
+    z = np.zeros(n)
+    cls = np.full(n, 2)
+    pid = np.full(n, -1)
+    lines, outlines = [], {}
+    for k, (centre, turn) in enumerate(HOUSES):
+        rot, rings, house_lines = _house(k, centre, turn)
+        lines += house_lines
+        uv = (xy - centre) @ rot  # house frame
+        on = (np.abs(uv[:, 0]) < LENGTH / 2) & (np.abs(uv[:, 1]) < WIDTH / 2)
+        a = WIDTH / 2 - np.abs(uv[:, 1])
+        b = LENGTH / 2 - np.abs(uv[:, 0])
+        face = np.where(a <= b, np.where(uv[:, 1] >= 0, 0, 1), np.where(uv[:, 0] >= 0, 2, 3))
+        z = np.where(on, EAVE + SLOPE * np.minimum(a, b), z)
+        cls = np.where(on, 6, cls)
+        pid = np.where(on, 10 * k + face, pid)
+        for j, ring in enumerate(rings):
+            outlines[10 * k + j] = np.array(ring)
+    pts = np.column_stack([xy + [X0, Y0], z])
+    for ln in lines:
+        for name in ("start", "end", "point"):
+            object.__setattr__(ln, name, getattr(ln, name) + [X0, Y0, 0.0])
+    planes = [fit_plane(pts[pid == i], plane_id=i).with_outline(outlines[i] + [X0, Y0, 0.0])
+              for i in sorted(outlines)]  # fmt: skip
+    heights, grid = dsm_from_points(pts[:, 0], pts[:, 1], pts[:, 2], 0.5)
+    dsm = Dsm(heights, grid, MappingFrame.from_user_input(CRS).crs)
+    scene = RenderScene.build(dsm, pts, cls, pid, planes, lines, crs=CRS)
+    return scene, dsm, planes, lines
+
+
+def _trajectory(rng, noise: bool) -> Trajectory:
+    pos = np.array([[-4, 2, 150], [4, 2, 150], [4, -2, 150], [-4, -2, 150.0]]) + [X0, Y0, 0]
+    rph = np.radians([[0.4, -0.3, 90], [-0.2, 0.5, 90], [0.3, 0.2, 270], [-0.5, -0.1, 270.0]])
+    if noise:  # POS AV 310: 0.02 m, 0.05 m, 0.015 deg, 0.035 deg
+        pos = pos + rng.normal(0, 1, (4, 3)) * [0.02, 0.02, 0.05]
+        rph = rph + np.radians(rng.normal(0, 1, (4, 3)) * [0.015, 0.015, 0.035])
+    return Trajectory(("a", "b", "c", "d"), np.arange(4.0), ("E", "E", "W", "W"), pos, False, rph)
+
+
+@pytest.fixture(scope="module")
+def block():
+    scene, dsm, planes, lines = _scene()
+    cam = Camera("c", focal_mm=35.0, pixel_size_mm=0.012, width_px=800, height_px=600)
+    frame = MappingFrame.from_user_input(CRS)
+    rng = np.random.default_rng(11)
+    true_mount = Mount.from_parameters(boresight_deg=TRUTH_DEG)
+    true_eo = direct_georeference(_trajectory(rng, False), true_mount, frame)
+    images = [(iid, render_image(scene, cam, true_eo.xyz[k], true_eo.opk[k],
+                                 RenderOptions(step_px=4, seed=k)).rgb)
+              for k, iid in enumerate(true_eo.image_id)]  # fmt: skip
+    return cam, frame, true_eo, _trajectory(rng, True), images, planes, lines, dsm
+
+
+def _ties(cam, true_eo, planes, rng):
+    """Tie tracks as a matcher gives them (0.3 px noise) on roof points inside the faces, and
+    planted wrong tracks: ground, a tree crown over a roof, a wall, a wrong match."""
+    sc = PickingScene(true_eo, cam)
+    good, xyz = [], []
+    for p in planes:
+        ring = p.outline
+        centre = ring.mean(axis=0)
+        for _ in range(6):
+            w = rng.dirichlet(np.ones(len(ring)))
+            q = 0.5 * centre + 0.5 * (w @ ring)  # well inside the face
+            q[2] = -(p.normal[:2] @ (q[:2] - p.centroid[:2])) / p.normal[2] + p.centroid[2]
+            good.append(p.id)
+            xyz.append(q)
+    a = planes[0]
+    planted = {
+        "ground": np.array([X0 + 14.0, Y0 - 2.0, 0.0]),
+        "tree": np.r_[a.outline.mean(axis=0)[:2], a.outline.mean(axis=0)[2] + 2.0],
+        "wall": np.r_[0.5 * (a.outline[0][:2] + a.outline[1][:2]), 2.5],
+    }
+    rows = {"img": [], "pid": [], "px": []}
+
+    def add(name, points):
+        for k, iid in enumerate(true_eo.image_id):
+            px = sc.project(iid, points[k % len(points)][None])[0]
+            if np.isfinite(px).all() and cam.in_frame(px[None], 5.0)[0]:
+                rows["img"].append(iid)
+                rows["pid"].append(name)
+                rows["px"].append(px + rng.normal(0, 0.3, 2))
+
+    for k, q in enumerate(xyz):
+        add(f"t{k}", [q])
+    for name, q in planted.items():
+        add(name, [q])
+    add("mismatch", [planes[1].outline.mean(axis=0), planes[5].outline.mean(axis=0)])
+    n = len(rows["img"])
+    obs = ImageObservations.from_arrays(rows["img"], rows["pid"], np.array(rows["px"]),
+                                        np.full(n, 0.3), ["tie"] * n, [""] * n)  # fmt: skip
+    return obs, {f"t{k}": g for k, g in enumerate(good)}
+
+
+def test_ties_on_roofs_associated_and_planted_ones_refused(block):
+    cam, _frame, true_eo, _traj, _images, planes, _lines, dsm = block
+    ties, truth = _ties(cam, true_eo, planes, np.random.default_rng(2))
+    got = associate_ties(ties, true_eo, cam, planes, 0.15, dsm=dsm)
+    assert got.tracks == len(truth) + 4
+    for name in ("ground", "tree", "wall", "mismatch"):
+        assert name not in got.plane_of, name
+    assert got.reasons["no roof plane"] >= 1 and got.reasons["off the plane"] >= 1
+    assert got.reasons["rays apart"] >= 1
+    assert sum(got.reasons.values()) + got.associated == got.tracks
+    wrong = [p for p, g in got.plane_of.items() if truth[p] != g]
+    assert not wrong and got.associated >= 0.9 * len(truth), got.reasons
+    assert set(got.observations.target_id) <= {str(p.id) for p in planes}
+
+
+def _check_recovered(out, label):
+    res = out.result
+    err = np.degrees(res.boresight[0]) - TRUTH_DEG
+    std = np.degrees(res.std[0])
+    print(
+        label,
+        "err arcsec",
+        np.round(err * 3600, 1),
+        "std arcsec",
+        np.round(std * 3600, 1),
+        "rounds",
+        len(out.rounds),
+        [r.line_points for r in out.rounds],
+    )
+    assert out.converged and len(out.rounds) >= 2
+    assert np.all(np.abs(err) < 3 * std), (err * 3600, std * 3600)
+    # the bound: the boresight is the mean camera-INS attitude difference, so the INS attitude
+    # priors alone (POS AV 310: 0.015 deg roll/pitch, 0.035 deg heading, 4 images) bound it
+    # even with errorless image measurements
+    bound = np.array([0.015, 0.015, 0.035]) / np.sqrt(4)
+    assert np.all(std >= 0.99 * bound) and np.all(std <= 1.5 * bound), std / bound
+    return err, std
+
+
+def test_point_three_degrees_off_recovered_without_hand_picks(block):
+    cam, frame, true_eo, traj, images, planes, lines, dsm = block
+    ties, _ = _ties(cam, true_eo, planes, np.random.default_rng(3))
+    start = Mount.from_parameters()  # nominal mount, zero boresight: 0.3 degree off
+    out = auto_calibrate(traj, cam, start, frame, images, planes, lines, ties, dsm,
+                         AutoBoresightOptions(search_deg=0.6),
+                         BoresightOptions(groups="single"))  # fmt: skip
+    _check_recovered(out, "0.3 deg")
+    last = out.rounds[-1]
+    assert last.line_points >= 200 and last.ties_associated >= 40
+    assert last.ties_refused["no roof plane"] >= 1 and last.ties_refused["rays apart"] >= 1
+
+
+def test_one_degree_off_converges_from_lines_alone(block):
+    cam, frame, _true_eo, traj, images, planes, lines, _dsm = block
+    start = Mount.from_parameters(boresight_deg=TRUTH_DEG + [-0.9, 0.8, -0.6])
+    out = auto_calibrate(traj, cam, start, frame, images, planes, lines,
+                         options=AutoBoresightOptions(search_deg=1.2),
+                         calibration=BoresightOptions(groups="single"))  # fmt: skip
+    _check_recovered(out, "1 deg")
+
+
+def test_exact_ins_gives_the_image_limited_precision(block):
+    """Without INS noise (and with tight priors) the boresight error is the automatic line
+    measurements' own: a few arc-seconds, within 3 of its sigmas."""
+    cam, frame, _true_eo, _traj, images, planes, lines, _dsm = block
+    exact = _trajectory(np.random.default_rng(0), False)
+    tight = ins_grade("custom", (0.002, 0.002, 0.0002, 0.0002))
+    out = auto_calibrate(exact, cam, Mount.from_parameters(), frame, images, planes, lines,
+                         options=AutoBoresightOptions(search_deg=0.6),
+                         calibration=BoresightOptions(groups="single",
+                                                      ins_grade=tight))  # fmt: skip
+    err = np.degrees(out.result.boresight[0]) - TRUTH_DEG
+    std = np.degrees(out.result.std[0])
+    print("exact INS err arcsec", np.round(err * 3600, 2), "std", np.round(std * 3600, 2))
+    assert out.converged and np.all(np.abs(err) < 3 * std), (err * 3600, std * 3600)
+    # omega, phi from the image shifts; kappa only from the small turn of lines off the centre
+    assert np.all(std * 3600 < [5.0, 5.0, 30.0])
+
+
+def test_flat_scene_is_refused_with_the_reason(block):
+    *_, planes, lines, _dsm = block
+    flat = [replace(p, normal=np.array([0.0, 0.0, 1.0]), slope_deg=0.0) for p in planes]
+    why = scene_refusal(flat, [])
+    assert "not" in why and "flat" in why and "0 LiDAR line direction" in why
+    with pytest.raises(SceneNotObservable, match="cannot determine the boresight"):
+        cam, frame, _t, traj, images, *_ = block
+        auto_calibrate(traj, cam, Mount.from_parameters(), frame, images, flat, [])
+    assert scene_refusal(planes, []) == "" and scene_refusal(flat, lines) == ""
+    assert "1 LiDAR line direction" in scene_refusal(flat, lines[:1])
