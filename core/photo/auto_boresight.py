@@ -28,7 +28,7 @@ Angles are radians inside, pixel quantities (col, row) per docs/conventions.md.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Union
 
 import numpy as np
@@ -42,7 +42,8 @@ from ..geometry.projection import ideal_from_camera
 from ..geometry.rotations import boresight_matrix
 from ..geometry.surface import Dsm
 from ..lidar.control import ControlLine
-from .auto_lines import AutoLineOptions, _grey, line_observations_block
+from .auto_boresight_options import AutoBoresightOptions
+from .auto_lines import _grey, line_observations_block
 from .auto_ties import REASONS, associate_ties
 from .boresight import calibrate
 from .boresight_options import BoresightOptions
@@ -69,50 +70,6 @@ Images = Sequence[tuple[str, ArrayLike]]
 
 class SceneNotObservable(InputError):
     """The LiDAR scene cannot determine the boresight angles (the message says why)."""
-
-
-@dataclass(frozen=True)
-class AutoBoresightOptions:
-    """Parameters of :func:`auto_calibrate`.
-
-    search_deg: half width of the angle search about the initial boresight, degrees (0: no
-        search, the initial boresight must be within a few pixels).
-    coarse_step_px, fine_step_px: first and last grid step of the search, pixels in the image.
-    min_search_px: smallest half width of the edge search across a projected line, pixels.
-    sigmas: width of the edge search and of the tie gate in standard deviations.
-    min_gate_m: smallest tie gate, metres.
-    border_m: smallest distance of a tie from its plane's outline, metres.
-    max_roof_slope_deg: steeper planes are walls (no tie), degrees.
-    min_slope_deg: a plane sloping less is flat (does not make the angles observable), degrees.
-    min_line_directions: fewest distinct line directions (15 degrees apart in plan) that make
-        the angles observable without sloped planes.
-    max_rounds: most association-adjustment rounds.
-    lines: options of the edge search (its ``search_px`` is set per round).
-    """
-
-    search_deg: float = 1.0
-    coarse_step_px: float = 4.0
-    fine_step_px: float = 0.5
-    min_search_px: float = 2.5
-    sigmas: float = 3.0
-    min_gate_m: float = 0.05
-    border_m: float = 0.3
-    max_roof_slope_deg: float = 65.0
-    min_slope_deg: float = 5.0
-    min_line_directions: int = 2
-    max_rounds: int = 6
-    lines: AutoLineOptions = field(default_factory=AutoLineOptions)
-
-    def __post_init__(self) -> None:
-        for name in ("coarse_step_px", "fine_step_px", "min_search_px", "sigmas", "min_gate_m"):
-            if not float(getattr(self, name)) > 0:
-                raise InputError(f"{name} must be > 0, got {getattr(self, name)!r}")
-        if not 0 <= float(self.search_deg) <= 10:
-            raise InputError(f"search_deg must be in [0, 10] degrees, got {self.search_deg!r}")
-        if self.fine_step_px > self.coarse_step_px:
-            raise InputError("fine_step_px must not exceed coarse_step_px")
-        if int(self.max_rounds) < 1 or int(self.min_line_directions) < 1:
-            raise InputError("max_rounds and min_line_directions must be >= 1")
 
 
 @dataclass(frozen=True)

@@ -31,7 +31,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from ..geometry.camera import Camera
@@ -42,7 +42,7 @@ from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable
 from .picking import PickingScene, points_in_polygons
 
-__all__ = ["REASONS", "TieAssociation", "associate_ties"]
+__all__ = ["REASONS", "TieAssociation", "associate_ties", "outlines_from_points"]
 
 Array = NDArray[np.float64]
 
@@ -71,6 +71,33 @@ class TieAssociation:
     @property
     def associated(self) -> int:
         return len(self.plane_of)
+
+
+def outlines_from_points(planes: Sequence[Plane], xyz: ArrayLike, plane_ids: ArrayLike
+                         ) -> list[Plane]:  # fmt: skip
+    """The planes with an outline: the convex hull (x, y) of their LiDAR points (mapping CRS),
+    its heights on the plane; planes with fewer than 3 points (or an outline already) are
+    returned unchanged."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    pts = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+    ids = np.asarray(plane_ids).reshape(-1)
+    if ids.shape[0] != pts.shape[0]:
+        raise InputError(f"{pts.shape[0]} points but {ids.shape[0]} plane ids")
+    out = []
+    for p in planes:
+        own = pts[ids == p.id]
+        if len(p.outline) >= 3 or len(own) < 3 or abs(p.normal[2]) < 1e-6:
+            out.append(p)
+            continue
+        try:
+            ring = own[ConvexHull(own[:, :2]).vertices, :2]
+        except QhullError:  # collinear points: no area
+            out.append(p)
+            continue
+        z = p.centroid[2] - ((ring - p.centroid[:2]) @ p.normal[:2]) / p.normal[2]
+        out.append(p.with_outline(np.column_stack([ring, z])))
+    return out
 
 
 def _segment_distance(xy: Array, ring: Array) -> float:

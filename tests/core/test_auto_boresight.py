@@ -4,6 +4,7 @@ INS noise of the POS AV 310 grade and an initial boresight that is 0.3 and 1 deg
 
 from __future__ import annotations
 
+import csv
 import math
 from dataclasses import replace
 
@@ -97,7 +98,7 @@ def _scene():
     heights, grid = dsm_from_points(pts[:, 0], pts[:, 1], pts[:, 2], 0.5)
     dsm = Dsm(heights, grid, MappingFrame.from_user_input(CRS).crs)
     scene = RenderScene.build(dsm, pts, cls, pid, planes, lines, crs=CRS)
-    return scene, dsm, planes, lines
+    return scene, dsm, planes, lines, pts, pid
 
 
 def _trajectory(rng, noise: bool) -> Trajectory:
@@ -110,8 +111,14 @@ def _trajectory(rng, noise: bool) -> Trajectory:
 
 
 @pytest.fixture(scope="module")
-def block():
-    scene, dsm, planes, lines = _scene()
+def lidar():
+    """The scene: render scene, DSM, planes (with outlines), lines, points and plane ids."""
+    return _scene()
+
+
+@pytest.fixture(scope="module")
+def block(lidar):
+    scene, dsm, planes, lines, _pts, _pid = lidar
     cam = Camera("c", focal_mm=35.0, pixel_size_mm=0.012, width_px=800, height_px=600)
     frame = MappingFrame.from_user_input(CRS)
     rng = np.random.default_rng(11)
@@ -253,3 +260,58 @@ def test_flat_scene_is_refused_with_the_reason(block):
         auto_calibrate(traj, cam, Mount.from_parameters(), frame, images, flat, [])
     assert scene_refusal(planes, []) == "" and scene_refusal(flat, lines) == ""
     assert "1 LiDAR line direction" in scene_refusal(flat, lines[:1])
+
+
+def test_the_job_runs_from_files(block, lidar, tmp_path):
+    """``autoboresight`` from image files, the camera JSON, the trajectory CSV, the line and
+    plane tables, a LAS with plane_id (the outlines) and a tie-point CSV."""
+    import cv2
+    import laspy
+    from lidarphoto.core.io.camera import write_camera_json
+    from lidarphoto.core.io.control import write_lines_csv
+    from lidarphoto.core.io.observations import read_observations_csv, write_observations_csv
+    from lidarphoto.core.io.planes import write_planes_csv
+    from lidarphoto.core.io.trajectory import write_trajectory_csv
+    from lidarphoto.core.jobs import auto_boresight as job
+    from lidarphoto.core.jobs.runner import run_job
+
+    cam, _frame, true_eo, traj, images, planes, lines, _dsm = block
+    *_, pts, pid = lidar
+    folder = tmp_path / "images"
+    folder.mkdir()
+    for iid, rgb in images:
+        cv2.imwrite(str(folder / f"{iid}.png"), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+    write_camera_json(tmp_path / "camera.json", cam)
+    write_trajectory_csv(tmp_path / "traj.csv", traj)
+    write_lines_csv(tmp_path / "lines.csv", lines)
+    write_planes_csv(tmp_path / "planes.csv", planes)
+    header = laspy.LasHeader(point_format=3, version="1.2")
+    header.offsets, header.scales = pts.min(axis=0), np.full(3, 0.001)
+    header.add_extra_dim(laspy.ExtraBytesParams(name="plane_id", type=np.int32))
+    las = laspy.LasData(header)
+    las.x, las.y, las.z = pts.T
+    las.plane_id = pid.astype(np.int32)
+    las.write(tmp_path / "cloud.las")
+    ties, _ = _ties(cam, true_eo, planes, np.random.default_rng(3))
+    write_observations_csv(tmp_path / "ties.csv", ties)
+    out = {k: str(tmp_path / f) for k, f in (("OUTPUT_TABLE", "bore.csv"), ("OUTPUT_EO", "eo.csv"),
+           ("OUTPUT_OBSERVATIONS", "obs.csv"), ("OUTPUT_ROUNDS", "rounds.csv"),
+           ("OUTPUT_HTML", "report.html"))}  # fmt: skip
+    res = run_job(job, {
+        "IMAGES": [str(folder)], "CAMERA": str(tmp_path / "camera.json"),
+        "TRAJECTORY": str(tmp_path / "traj.csv"), "CRS": CRS, "LINES": str(tmp_path / "lines.csv"),
+        "PLANES": str(tmp_path / "planes.csv"), "CLOUD": str(tmp_path / "cloud.las"),
+        "TIE_POINTS": str(tmp_path / "ties.csv"), "SEARCH": 0.6, "GROUPING": "single", **out,
+    })  # fmt: skip
+    assert res.results["ROUNDS"] >= 2 and res.results["TIES_ASSOCIATED"] >= 40
+    assert res.results["LINE_POINTS"] >= 200
+    row = next(csv.DictReader((tmp_path / "bore.csv").open()))
+    got = np.array([float(row[f"d_{a}_deg"]) for a in ("omega", "phi", "kappa")])
+    std = np.array([float(row[f"std_d_{a}_arcsec"]) for a in ("omega", "phi", "kappa")]) / 3600
+    assert np.all(np.abs(got - TRUTH_DEG) < 3 * std), ((got - TRUTH_DEG) * 3600, std * 3600)
+    found = read_observations_csv(tmp_path / "obs.csv", camera=cam)
+    assert set(found.type) == {"line", "tie"}
+    rounds = list(csv.DictReader((tmp_path / "rounds.csv").open()))
+    assert len(rounds) == res.results["ROUNDS"] and "no roof plane" in rounds[-1]["ties_refused"]
+    page = (tmp_path / "report.html").read_text()
+    assert "round 1" in page and "tie measurements per plane" in page
