@@ -144,17 +144,11 @@ def scene_refusal(planes: Sequence[Plane], lines: Sequence[ControlLine],
 
 
 # ------------------------------------------------------------------ angle search
-@dataclass
-class _SearchImage:
-    u: Array  # (K, 3) line samples in the camera frame of the zero boresight
-    grey: Array
-
-
 def _nominal_camera_vectors(traj: Trajectory, camera: Camera, mount: Mount,
-                            frame: MappingFrame, lines: Sequence[ControlLine], step_px: float
-                            ) -> tuple[list[Array], LocalFrame]:  # fmt: skip
-    """Per image, LiDAR line samples (about ``step_px`` / 2 apart at the image scale) as
-    vectors in the camera frame of a zero boresight: ``u = M0 (X - C)``."""
+                            frame: MappingFrame, lines: Sequence[ControlLine], spacing_px: float
+                            ) -> list[Array]:  # fmt: skip
+    """Per image, LiDAR line samples (about ``spacing_px`` apart at the image scale) as vectors
+    in the camera frame of a zero boresight: ``u = M0 (X - C)`` (local ENU, metres)."""
     zero = replace(mount, boresight=np.zeros(3))
     eo = direct_georeference(traj, zero, frame)
     local = LocalFrame.at_map_point(frame, eo.xyz.mean(axis=0))
@@ -164,50 +158,63 @@ def _nominal_camera_vectors(traj: Trajectory, camera: Camera, mount: Mount,
         a, b = np.asarray(ln.start, float), np.asarray(ln.end, float)
         rng = float(np.min(np.abs(eo.xyz[:, 2] - (a[2] + b[2]) / 2)))
         gsd = max(rng, 1.0) / camera.focal_px
-        n = int(np.clip(np.ceil(np.linalg.norm(b - a) / (gsd * step_px / 2)), 2, 2000))
+        n = int(np.clip(np.ceil(np.linalg.norm(b - a) / (gsd * spacing_px)), 2, 2000))
         t = (np.arange(n) + 0.5) / n
         pts.append(a + t[:, None] * (b - a))
     xyz = local.map_to_enu(np.vstack(pts)) if pts else np.empty((0, 3))
-    return [(xyz - centres[i]) @ m0[i].T for i in range(len(traj))], local
+    return [(xyz - centres[i]) @ m0[i].T for i in range(len(traj))]
 
 
-def _pixels(u: Array, bore: Array, camera: Camera) -> Array:
-    """Pixels (K, 2) of the camera-frame vectors ``u`` turned by the boresight (NaN: not seen)."""
-    q = u @ boresight_matrix(*bore)  # v = dR^T u, in rows
-    ideal, valid = ideal_from_camera(q, camera.focal_mm, camera.projection)[:2]
-    px, ok = camera.pixel_from_ideal_with_status(np.where(valid[:, None], ideal, 0.0))
-    px[~(valid & ok)] = np.nan
-    return px
+class _Search:
+    """The line samples of all images (stacked) and the images' edge strength at one blur."""
 
+    def __init__(self, camera: Camera, us: list[Array], greys: list[Array]) -> None:
+        self.camera = camera
+        self.us = us
+        self.greys = greys
+        self.grads: list[Array] = []
+        self.stride = 1
 
-def _score(images: list[_SearchImage], grads: list[Array], bore: Array, camera: Camera) -> float:
-    """Mean edge strength under the projected lines (out-of-frame samples count 0)."""
-    from scipy.ndimage import map_coordinates
+    def blur(self, sigma_px: float, stride: int) -> None:
+        """Gradient magnitude of the images blurred by ``sigma_px``; every ``stride``-th sample."""
+        from scipy.ndimage import gaussian_gradient_magnitude
 
-    total, count = 0.0, 0
-    for im, g in zip(images, grads):
-        px = _pixels(im.u, bore, camera)
-        inside = np.isfinite(px).all(axis=1) & camera.in_frame(np.nan_to_num(px, nan=-1e9), 2.0)
-        count += len(px)
-        if inside.any():
-            p = px[inside] - 0.5
-            total += float(map_coordinates(g, [p[:, 1], p[:, 0]], order=1).sum())
-    return total / max(count, 1)
+        self.grads = [gaussian_gradient_magnitude(g, sigma_px) for g in self.greys]
+        self.stride = max(1, int(stride))
+        parts = [u[:: self.stride] for u in self.us]
+        self.owner = np.repeat(np.arange(len(parts)), [len(p) for p in parts])
+        self.u = np.vstack(parts) if parts else np.empty((0, 3))
 
+    def score(self, bore: Array) -> float:
+        """Mean edge strength under the projected lines (out-of-frame samples count 0)."""
+        from scipy.ndimage import map_coordinates
 
-def _grid_best(images, grads, camera, centre: Array, steps: Array, half: int, axes) -> Array:
-    """The best candidate of a (2 half + 1)^len(axes) grid about ``centre``."""
-    offsets = np.arange(-half, half + 1)
-    grids = np.meshgrid(*[offsets * steps[a] for a in axes], indexing="ij")
-    best, best_score = centre, -np.inf
-    for combo in zip(*[g.ravel() for g in grids]):
-        cand = centre.copy()
-        for a, d in zip(axes, combo):
-            cand[a] += d
-        s = _score(images, grads, cand, camera)
-        if s > best_score:
-            best, best_score = cand, s
-    return best
+        cam = self.camera
+        q = self.u @ boresight_matrix(*bore)  # v = dR^T u, in rows
+        ideal, valid = ideal_from_camera(q, cam.focal_mm, cam.projection)[:2]
+        px, ok = cam.pixel_from_ideal_with_status(np.where(valid[:, None], ideal, 0.0))
+        good = valid & ok & np.isfinite(px).all(axis=1)
+        good[good] &= cam.in_frame(px[good], 2.0)
+        total = 0.0
+        for k, g in enumerate(self.grads):
+            p = px[good & (self.owner == k)] - 0.5
+            if len(p):
+                total += float(map_coordinates(g, [p[:, 1], p[:, 0]], order=1).sum())
+        return total / max(len(px), 1)
+
+    def grid_best(self, centre: Array, steps: Array, half: int, axes: tuple[int, ...]) -> Array:
+        """The best candidate of a (2 half + 1)^len(axes) grid about ``centre``."""
+        offsets = np.arange(-half, half + 1)
+        grids = np.meshgrid(*[offsets * steps[a] for a in axes], indexing="ij")
+        best, best_score = centre, -np.inf
+        for combo in zip(*[g.ravel() for g in grids]):
+            cand = centre.copy()
+            for a, d in zip(axes, combo):
+                cand[a] += d
+            s = self.score(cand)
+            if s > best_score:
+                best, best_score = cand, s
+        return best
 
 
 def search_boresight(
@@ -222,18 +229,19 @@ def search_boresight(
 ) -> Array:
     """Coarse-to-fine boresight (3,) radians whose projected LiDAR lines lie on the strongest
     image edges (module docstring, step 2)."""
-    from scipy.ndimage import gaussian_gradient_magnitude
-
     opt = options or AutoBoresightOptions()
     if opt.search_deg == 0 or not lines:
         return np.asarray(mount.boresight, float).copy()
-    us, _ = _nominal_camera_vectors(traj, camera, mount, frame, lines, opt.fine_step_px * 4)
+    spacing = max(opt.fine_step_px, 0.5)  # samples this far apart at the finest step
+    us = _nominal_camera_vectors(traj, camera, mount, frame, lines, spacing)
     row = {iid: k for k, iid in enumerate(traj.image_id)}
-    ims = []
+    chosen, greys = [], []
     for iid, img in images:
         if iid not in row:
             raise InputError(f"image '{iid}' is not in the trajectory")
-        ims.append(_SearchImage(us[row[iid]], _grey(img)))
+        chosen.append(us[row[iid]])
+        greys.append(_grey(img))
+    search = _Search(camera, chosen, greys)
     f = camera.focal_px
     half_diag = 0.5 * float(np.hypot(camera.width_px, camera.height_px))
     step_px = float(opt.coarse_step_px)
@@ -241,17 +249,17 @@ def search_boresight(
     first = True
     while True:
         stop_if_asked(should_stop, "the boresight search")
-        grads = [gaussian_gradient_magnitude(im.grey, max(0.7, 0.6 * step_px)) for im in ims]
+        search.blur(max(0.7, 0.6 * step_px), int(step_px / (2 * spacing)))
         steps = np.array([step_px / f, step_px / f, step_px / half_diag])
         if first:  # the whole range: omega and phi together, then kappa
             n_op = int(np.ceil(np.radians(opt.search_deg) / steps[0]))
             n_k = int(np.ceil(np.radians(opt.search_deg) / steps[2]))
-            bore = _grid_best(ims, grads, camera, bore, steps, n_op, (0, 1))
-            bore = _grid_best(ims, grads, camera, bore, steps, n_k, (2,))
+            bore = search.grid_best(bore, steps, n_op, (0, 1))
+            bore = search.grid_best(bore, steps, n_k, (2,))
             first = False
         for _ in range(2):
-            bore = _grid_best(ims, grads, camera, bore, steps, 2, (0, 1))
-            bore = _grid_best(ims, grads, camera, bore, steps, 2, (2,))
+            bore = search.grid_best(bore, steps, 2, (0, 1))
+            bore = search.grid_best(bore, steps, 2, (2,))
         if step_px <= opt.fine_step_px * 1.0001:
             return bore
         step_px = max(step_px / 2.0, opt.fine_step_px)

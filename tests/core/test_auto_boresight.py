@@ -23,6 +23,7 @@ from lidarphoto.core.photo.auto_boresight import (
     scene_refusal,
 )
 from lidarphoto.core.photo.auto_ties import associate_ties
+from lidarphoto.core.photo.boresight import calibrate
 from lidarphoto.core.photo.boresight_options import BoresightOptions
 from lidarphoto.core.photo.georeference import Trajectory, direct_georeference
 from lidarphoto.core.photo.ins import ins_grade
@@ -36,12 +37,13 @@ CRS = "EPSG:28992"
 X0, Y0 = 85000.0, 447000.0
 TRUTH_DEG = np.array([0.3, -0.2, 0.25])
 HOUSES = (((-8.0, 7.0), 25.0), ((7.0, 9.0), -40.0), ((0.0, -8.0), 70.0))
-LENGTH, WIDTH, EAVE, SLOPE = 10.0, 7.0, 5.0, 0.8
+DIMS = (10.0, 7.0, 5.0, 0.8)  # length, width, eave height (m), roof slope (rise / run)
 
 
-def _house(k: int, centre, turn_deg: float):
+def _house(k: int, centre, turn_deg: float, dims=DIMS):
     """Roof points (N, 3) and face labels of one hip roof, its four planes' outlines (house
     frame u along, v across) and its ridge and hip lines (end points), mapping CRS."""
+    LENGTH, WIDTH, EAVE, SLOPE = dims
     c, s = math.cos(math.radians(turn_deg)), math.sin(math.radians(turn_deg))
     rot = np.array([[c, -s], [s, c]])
     r = LENGTH / 2 - WIDTH / 2
@@ -68,16 +70,17 @@ def _house(k: int, centre, turn_deg: float):
     return rot, outlines, lines
 
 
-def _scene():
-    rng = np.random.default_rng(7)
+def _scene(houses=HOUSES, dims=DIMS, seed=7):
+    LENGTH, WIDTH, EAVE, SLOPE = dims
+    rng = np.random.default_rng(seed)
     n = 12 * 50 * 50
     xy = rng.uniform(-25, 25, (n, 2))
     z = np.zeros(n)
     cls = np.full(n, 2)
     pid = np.full(n, -1)
     lines, outlines = [], {}
-    for k, (centre, turn) in enumerate(HOUSES):
-        rot, rings, house_lines = _house(k, centre, turn)
+    for k, (centre, turn) in enumerate(houses):
+        rot, rings, house_lines = _house(k, centre, turn, dims)
         lines += house_lines
         uv = (xy - centre) @ rot  # house frame
         on = (np.abs(uv[:, 0]) < LENGTH / 2) & (np.abs(uv[:, 1]) < WIDTH / 2)
@@ -232,9 +235,31 @@ def test_one_degree_off_converges_from_lines_alone(block):
     _check_recovered(out, "1 deg")
 
 
+def _hand_picks(cam, eo, lines, rng, per_image=30, sigma_px=0.5):
+    """What an operator clicks in the dock: ``per_image`` points on the LiDAR lines of each
+    image, at their true projections + ``sigma_px`` of noise (type line)."""
+    sc = PickingScene(eo, cam)
+    rows = {"img": [], "pid": [], "px": [], "tid": []}
+    for iid in eo.image_id:
+        k = 0
+        while k < per_image:
+            ln = lines[rng.integers(len(lines))]
+            px = sc.project(iid, (ln.start + rng.uniform(0.1, 0.9) * (ln.end - ln.start))[None])
+            if np.isfinite(px).all() and cam.in_frame(px, 10.0)[0]:
+                rows["img"].append(iid)
+                rows["pid"].append(f"{iid}:{k}")
+                rows["px"].append(px[0] + rng.normal(0, sigma_px, 2))
+                rows["tid"].append(ln.id)
+                k += 1
+    n = len(rows["img"])
+    return ImageObservations.from_arrays(rows["img"], rows["pid"], np.array(rows["px"]),
+                                         np.full(n, sigma_px), ["line"] * n, rows["tid"])  # fmt: skip
+
+
 def test_exact_ins_gives_the_image_limited_precision(block):
     """Without INS noise (and with tight priors) the boresight error is the automatic line
-    measurements' own: a few arc-seconds, within 3 of its sigmas."""
+    measurements' own: a few arc-seconds, within 3 of its sigmas, and its sigmas no larger
+    than those of 30 hand picks per image (0.5 px) on the same lines."""
     cam, frame, _true_eo, _traj, images, planes, lines, _dsm = block
     exact = _trajectory(np.random.default_rng(0), False)
     tight = ins_grade("custom", (0.002, 0.002, 0.0002, 0.0002))
@@ -248,6 +273,52 @@ def test_exact_ins_gives_the_image_limited_precision(block):
     assert out.converged and np.all(np.abs(err) < 3 * std), (err * 3600, std * 3600)
     # omega, phi from the image shifts; kappa only from the small turn of lines off the centre
     assert np.all(std * 3600 < [5.0, 5.0, 30.0])
+    picks = _hand_picks(cam, _true_eo, lines, np.random.default_rng(5))
+    hand = calibrate(exact, cam, Mount.from_parameters(), frame, picks, planes, lines,
+                     options=BoresightOptions(groups="single", ins_grade=tight))  # fmt: skip
+    hand_std = np.degrees(hand.std[0])
+    print("hand picks std arcsec", np.round(hand_std * 3600, 2))
+    assert np.all(std <= hand_std), (std * 3600, hand_std * 3600)
+
+
+def test_a_second_scene_and_camera_one_degree_off():
+    """Four larger, flatter roofs, a 40 mm camera with radial distortion at 250 m, six images
+    on two north-south lines, another boresight; 1 degree off; INS noise."""
+    from lidarphoto.core.geometry.camera import camera_from_dict
+
+    houses = (((-12.0, 8.0), 10.0), ((11.0, 6.0), 55.0), ((-6.0, -9.0), -30.0),
+              ((10.0, -10.0), 85.0))  # fmt: skip
+    scene, dsm, planes, lines, _pts, _pid = _scene(houses, (14.0, 9.0, 7.0, 0.6), seed=3)
+    cam = camera_from_dict({"name": "k1", "focal_mm": 40.0, "pixel_size_mm": 0.0075,
+                            "width_px": 1000, "height_px": 750,
+                            "distortion": {"model": "brown_conrady", "k1": 8e-5}})  # fmt: skip
+    frame = MappingFrame.from_user_input(CRS)
+    truth = np.array([-0.25, 0.4, -0.15])
+    pos = np.array([[-3, -6], [-3, 0], [-3, 6], [3, 6], [3, 0], [3, -6.0]])
+    pos = np.column_stack([pos + [X0, Y0], np.full(6, 250.0)])
+    rng = np.random.default_rng(21)
+    rph = np.radians(np.column_stack([rng.normal(0, 0.5, (6, 2)), [0, 0, 0, 180, 180, 180]]))
+    ids = tuple(f"p{k}" for k in range(6))
+    groups = ("N",) * 3 + ("S",) * 3
+    true_traj = Trajectory(ids, np.arange(6.0), groups, pos, False, rph)
+    eo = direct_georeference(true_traj, Mount.from_parameters(boresight_deg=truth), frame)
+    images = [(iid, render_image(scene, cam, eo.xyz[k], eo.opk[k],
+                                 RenderOptions(step_px=4, seed=10 + k)).rgb)
+              for k, iid in enumerate(ids)]  # fmt: skip
+    noisy = Trajectory(ids, np.arange(6.0), groups,
+                       pos + rng.normal(0, 1, (6, 3)) * [0.02, 0.02, 0.05], False,
+                       rph + np.radians(rng.normal(0, 1, (6, 3)) * [0.015, 0.015, 0.035]))  # fmt: skip
+    start = Mount.from_parameters(boresight_deg=truth + [0.8, -0.7, 0.5])
+    out = auto_calibrate(noisy, cam, start, frame, images, planes, lines,
+                         options=AutoBoresightOptions(search_deg=1.2),
+                         calibration=BoresightOptions(groups="single"))  # fmt: skip
+    err = np.degrees(out.result.boresight[0]) - truth
+    std = np.degrees(out.result.std[0])
+    print("second scene err arcsec", np.round(err * 3600, 1), "std", np.round(std * 3600, 1),
+          "line points", [r.line_points for r in out.rounds])  # fmt: skip
+    assert out.converged and np.all(np.abs(err) < 3 * std), (err * 3600, std * 3600)
+    bound = np.array([0.015, 0.015, 0.035]) / np.sqrt(6)
+    assert np.all(std >= 0.99 * bound) and np.all(std <= 1.5 * bound), std / bound
 
 
 def test_flat_scene_is_refused_with_the_reason(block):
