@@ -67,9 +67,7 @@ class AutoBoresightOptions:
     min_line_directions: fewest distinct line directions (15 degrees apart in plan) that make
         the angles observable without sloped planes.
     max_rounds: most association-adjustment rounds.
-    lines: options of the edge search (its ``search_px`` is set per round; samples 8 px
-        apart: neighbouring edge samples share pixels, and the adjustment's time grows
-        with their number).
+    lines: options of the edge search (its ``search_px`` is set per round).
     """
 
     search_deg: float = 1.0
@@ -83,7 +81,7 @@ class AutoBoresightOptions:
     min_slope_deg: float = 5.0
     min_line_directions: int = 2
     max_rounds: int = 6
-    lines: AutoLineOptions = field(default_factory=lambda: AutoLineOptions(spacing_px=8.0))
+    lines: AutoLineOptions = field(default_factory=AutoLineOptions)
 
     def __post_init__(self) -> None:
         for name in ("coarse_step_px", "fine_step_px", "min_search_px", "sigmas", "min_gate_m"):
