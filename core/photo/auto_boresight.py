@@ -202,12 +202,15 @@ class _Search:
                 total += float(map_coordinates(g, [p[:, 1], p[:, 0]], order=1).sum())
         return total / max(len(px), 1)
 
-    def grid_best(self, centre: Array, steps: Array, half: int, axes: tuple[int, ...]) -> Array:
+    def grid_best(self, centre: Array, steps: Array, half: int, axes: tuple[int, ...],
+                  should_stop: Callable[[], bool] | None = None) -> Array:  # fmt: skip
         """The best candidate of a (2 half + 1)^len(axes) grid about ``centre``."""
         offsets = np.arange(-half, half + 1)
         grids = np.meshgrid(*[offsets * steps[a] for a in axes], indexing="ij")
         best, best_score = centre, -np.inf
-        for combo in zip(*[g.ravel() for g in grids]):
+        for n, combo in enumerate(zip(*[g.ravel() for g in grids])):
+            if n % 64 == 0:
+                stop_if_asked(should_stop, "the boresight search")
             cand = centre.copy()
             for a, d in zip(axes, combo):
                 cand[a] += d
@@ -254,8 +257,8 @@ def search_boresight(
         if first:  # the whole range: omega and phi together, then kappa
             n_op = int(np.ceil(np.radians(opt.search_deg) / steps[0]))
             n_k = int(np.ceil(np.radians(opt.search_deg) / steps[2]))
-            bore = search.grid_best(bore, steps, n_op, (0, 1))
-            bore = search.grid_best(bore, steps, n_k, (2,))
+            bore = search.grid_best(bore, steps, n_op, (0, 1), should_stop)
+            bore = search.grid_best(bore, steps, n_k, (2,), should_stop)
             first = False
         for _ in range(2):
             bore = search.grid_best(bore, steps, 2, (0, 1))

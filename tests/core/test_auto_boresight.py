@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -337,19 +338,19 @@ def test_flat_scene_is_refused_with_the_reason(block):
     assert "1 LiDAR line direction" in scene_refusal(flat, lines[:1])
 
 
-def test_the_job_runs_from_files(block, lidar, tmp_path):
-    """``autoboresight`` from image files, the camera JSON, the trajectory CSV, the line and
-    plane tables, a LAS with plane_id (the outlines) and a tie-point CSV."""
+@pytest.fixture(scope="module")
+def files(block, lidar, tmp_path_factory):
+    """The block as files: images (PNG), camera JSON, trajectory CSV, line and plane tables,
+    a LAS with plane_id (the outlines) and a tie-point CSV."""
     import cv2
     import laspy
     from lidarphoto.core.io.camera import write_camera_json
     from lidarphoto.core.io.control import write_lines_csv
-    from lidarphoto.core.io.observations import read_observations_csv, write_observations_csv
+    from lidarphoto.core.io.observations import write_observations_csv
     from lidarphoto.core.io.planes import write_planes_csv
     from lidarphoto.core.io.trajectory import write_trajectory_csv
-    from lidarphoto.core.jobs import auto_boresight as job
-    from lidarphoto.core.jobs.runner import run_job
 
+    tmp_path = tmp_path_factory.mktemp("autoboresight")
     cam, _frame, true_eo, traj, images, planes, lines, _dsm = block
     *_, pts, pid = lidar
     folder = tmp_path / "images"
@@ -369,15 +370,26 @@ def test_the_job_runs_from_files(block, lidar, tmp_path):
     las.write(tmp_path / "cloud.las")
     ties, _ = _ties(cam, true_eo, planes, np.random.default_rng(3))
     write_observations_csv(tmp_path / "ties.csv", ties)
-    out = {k: str(tmp_path / f) for k, f in (("OUTPUT_TABLE", "bore.csv"), ("OUTPUT_EO", "eo.csv"),
-           ("OUTPUT_OBSERVATIONS", "obs.csv"), ("OUTPUT_ROUNDS", "rounds.csv"),
-           ("OUTPUT_HTML", "report.html"))}  # fmt: skip
-    res = run_job(job, {
+    return tmp_path, {
         "IMAGES": [str(folder)], "CAMERA": str(tmp_path / "camera.json"),
         "TRAJECTORY": str(tmp_path / "traj.csv"), "CRS": CRS, "LINES": str(tmp_path / "lines.csv"),
         "PLANES": str(tmp_path / "planes.csv"), "CLOUD": str(tmp_path / "cloud.las"),
-        "TIE_POINTS": str(tmp_path / "ties.csv"), "SEARCH": 0.6, "GROUPING": "single", **out,
-    })  # fmt: skip
+        "TIE_POINTS": str(tmp_path / "ties.csv"), "SEARCH": 0.6, "GROUPING": "single",
+    }  # fmt: skip
+
+
+def test_the_job_runs_from_files(block, files):
+    """``autoboresight`` from the files: outputs, counts and the boresight within 3 sigma."""
+    from lidarphoto.core.io.observations import read_observations_csv
+    from lidarphoto.core.jobs import auto_boresight as job
+    from lidarphoto.core.jobs.runner import run_job
+
+    cam = block[0]
+    tmp_path, inputs = files
+    out = {k: str(tmp_path / f) for k, f in (("OUTPUT_TABLE", "bore.csv"), ("OUTPUT_EO", "eo.csv"),
+           ("OUTPUT_OBSERVATIONS", "obs.csv"), ("OUTPUT_ROUNDS", "rounds.csv"),
+           ("OUTPUT_HTML", "report.html"))}  # fmt: skip
+    res = run_job(job, {**inputs, **out})
     assert res.results["ROUNDS"] >= 2 and res.results["TIES_ASSOCIATED"] >= 40
     assert res.results["LINE_POINTS"] >= 200
     row = next(csv.DictReader((tmp_path / "bore.csv").open()))
@@ -390,3 +402,22 @@ def test_the_job_runs_from_files(block, lidar, tmp_path):
     assert len(rounds) == res.results["ROUNDS"] and "no roof plane" in rounds[-1]["ties_refused"]
     page = (tmp_path / "report.html").read_text()
     assert "round 1" in page and "tie measurements per plane" in page
+
+
+def test_the_job_refuses_bad_inputs_by_name(files, tmp_path):
+    from lidarphoto.core.errors import InputError
+    from lidarphoto.core.jobs import auto_boresight as job
+    from lidarphoto.core.jobs.runner import run_job
+
+    _, inputs = files
+    out = {"OUTPUT_TABLE": str(tmp_path / "b.csv"), "OUTPUT_EO": str(tmp_path / "e.csv"),
+           "OUTPUT_OBSERVATIONS": str(tmp_path / "o.csv"),
+           "OUTPUT_HTML": str(tmp_path / "r.html")}  # fmt: skip
+    with pytest.raises(InputError, match="TIE_POINTS need PLANES and CLOUD"):
+        run_job(job, {**inputs, "CLOUD": None, **out})
+    empty = tmp_path / "none"
+    empty.mkdir()
+    (empty / "x.png").write_bytes((Path(inputs["IMAGES"][0]) / "a.png").read_bytes())
+    with pytest.raises(InputError, match="no image is named in the trajectory"):
+        run_job(job, {**inputs, "IMAGES": [str(empty)], **out})
+    assert not any(tmp_path.glob("*.csv")) and not any(tmp_path.glob("*.html"))
