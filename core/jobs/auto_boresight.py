@@ -80,6 +80,10 @@ give the counts per round and the ties refused per reason.""",
               help="the planes' outlines (convex hull of their points): needed by tie points"),
         Param("TIE_POINTS", "file", "Tie points (observation CSV)", optional=True,
               file_filter=CSV_FILTER, advanced=True, help="the output of Automatic tie points"),
+        Param("HAND_PICKS", "file", "Hand picks to compare with (observation CSV)",
+              optional=True, file_filter=CSV_FILTER, advanced=True,
+              help="observations picked in the dock: their tie and line rows are calibrated "
+              "alone and the summary compares the two boresights"),
         Param("SEARCH", "number", "Search range of the boresight", _AUTO.search_deg,
               unit="degrees", minimum=0.0, maximum=10.0, advanced=True,
               help="half width of the angle search about BORESIGHT (0: none)"),
@@ -154,6 +158,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     doubts = doubts_about(result, v.max_boresight, v.max_sigma0, cal.snooping_alpha)
     run_ = _boresight_run(found, cam, traj, planes, lines, frame, cal)
     settings = _settings(v, cam, traj, found, frame, grade)
+    if v.hand_picks:
+        settings.update(_compare_hand_picks(v, cam, traj, mount, frame, planes, lines, cal,
+                                            result, should_stop))  # fmt: skip
 
     def failed_page() -> str:
         from ..quality.boresight_html import render_boresight_html
@@ -251,6 +258,39 @@ def _settings(v, cam, traj, found, frame, grade) -> dict[str, str]:
         ", ".join(f"{k} {n}" for k, n in found.per_plane.items()) or "none"
     )
     return s
+
+
+def _compare_hand_picks(v, cam, traj, mount, frame, planes, lines, cal, result, should_stop
+                        ) -> dict[str, str]:  # fmt: skip
+    """The calibration from the hand picks' tie and line rows, and its difference from the
+    automatic one per group (arc-seconds, and in sigmas of the difference, the two taken as
+    independent: an upper bound, both share the INS priors)."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    from ..io.observations import read_observations_csv
+    from ..photo.boresight import calibrate
+
+    picks = read_observations_csv(v.hand_picks, camera=cam)
+    hand = calibrate(traj, cam, mount, frame, picks, planes, lines,
+                     options=replace(cal, use_types=("tie", "line")),
+                     should_stop=should_stop)  # fmt: skip
+    out = {}
+    arcsec = 3600.0 * 180.0 / np.pi
+    for g, name in enumerate(result.groups):
+        if name not in hand.groups:
+            continue
+        h = hand.groups.index(name)
+        diff = (result.boresight[g] - hand.boresight[h]) * arcsec
+        both = np.hypot(result.std[g], hand.std[h]) * arcsec
+        out[f"hand picks, group {name}"] = (
+            f"{sum(t in ('tie', 'line') for t in picks.type)} rows; boresight "
+            + ", ".join(f"{np.degrees(a):.5f}" for a in hand.boresight[h]) + " deg, sigmas "
+            + ", ".join(f"{a * arcsec:.1f}" for a in hand.std[h]) + " arcsec; automatic minus "
+            "hand " + ", ".join(f"{d:.1f}" for d in diff) + " arcsec ("
+            + ", ".join(f"{d / b:.1f}" for d, b in zip(diff, both)) + " sigma)")  # fmt: skip
+    return out
 
 
 def _round_rows(found) -> list[tuple[str, ...]]:

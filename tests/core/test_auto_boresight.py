@@ -370,6 +370,8 @@ def files(block, lidar, tmp_path_factory):
     las.write(tmp_path / "cloud.las")
     ties, _ = _ties(cam, true_eo, planes, np.random.default_rng(3))
     write_observations_csv(tmp_path / "ties.csv", ties)
+    write_observations_csv(tmp_path / "picks.csv",
+                           _hand_picks(cam, true_eo, lines, np.random.default_rng(8)))  # fmt: skip
     return tmp_path, {
         "IMAGES": [str(folder)], "CAMERA": str(tmp_path / "camera.json"),
         "TRAJECTORY": str(tmp_path / "traj.csv"), "CRS": CRS, "LINES": str(tmp_path / "lines.csv"),
@@ -389,7 +391,7 @@ def test_the_job_runs_from_files(block, files):
     out = {k: str(tmp_path / f) for k, f in (("OUTPUT_TABLE", "bore.csv"), ("OUTPUT_EO", "eo.csv"),
            ("OUTPUT_OBSERVATIONS", "obs.csv"), ("OUTPUT_ROUNDS", "rounds.csv"),
            ("OUTPUT_HTML", "report.html"))}  # fmt: skip
-    res = run_job(job, {**inputs, **out})
+    res = run_job(job, {**inputs, "HAND_PICKS": str(tmp_path / "picks.csv"), **out})
     assert res.results["ROUNDS"] >= 2 and res.results["TIES_ASSOCIATED"] >= 40
     assert res.results["LINE_POINTS"] >= 200
     row = next(csv.DictReader((tmp_path / "bore.csv").open()))
@@ -402,6 +404,7 @@ def test_the_job_runs_from_files(block, files):
     assert len(rounds) == res.results["ROUNDS"] and "no roof plane" in rounds[-1]["ties_refused"]
     page = (tmp_path / "report.html").read_text()
     assert "round 1" in page and "tie measurements per plane" in page
+    assert "hand picks, group all" in page and "automatic minus hand" in page
 
 
 def test_the_job_refuses_bad_inputs_by_name(files, tmp_path):
