@@ -405,6 +405,8 @@ def test_the_job_runs_from_files(block, files):
     page = (tmp_path / "report.html").read_text()
     assert "round 1" in page and "tie measurements per plane" in page
     assert "hand picks, group all" in page and "automatic minus hand" in page
+    at = page.index("automatic minus hand")
+    print(page[at - 200 : at + 80])
 
 
 def test_the_job_refuses_bad_inputs_by_name(files, tmp_path):
