@@ -26,6 +26,7 @@ NAMES = (
     "accuracy_report",
     "extract_roof_planes",
     "boresight_calibration",
+    "auto_boresight",
     "monoplot",
     "bundle_adjustment",
     "resection",

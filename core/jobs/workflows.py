@@ -143,6 +143,20 @@ WORKFLOWS: tuple[Workflow, ...] = (
         ),
     ),
     Workflow(
+        _t("Boresight calibration without hand picks (automatic)"),
+        (
+            ("extractroofplanes", _t("INPUT = the classified cloud; OUTPUT_CSV = the plane table, "
+             "OUTPUT_CLOUD = the cloud with plane_id")),
+            ("createlcps", _t("PLANES and CLOUD = the two outputs of extractroofplanes; "
+             "LINES_CSV = the LiDAR ridge, hip and valley lines")),
+            ("tiepoints", _t("IMAGES (and the approximate EO + CAMERA to pair images by their "
+             "footprints); OUTPUT_OBSERVATIONS = tie points (optional for the next step)")),
+            ("autoboresight", _t("IMAGES, CAMERA, TRAJECTORY, LINES, PLANES and CLOUD, "
+             "TIE_POINTS; OUTPUT_TABLE = boresight per group, OUTPUT_OBSERVATIONS = the "
+             "observations found")),
+        ),
+    ),
+    Workflow(
         _t("Boresight calibration from an SBET (or ASCII export) and the camera events"),
         (
             ("importtrajectory", _t("INPUT = the SBET, POSPac / Inertial Explorer export or "

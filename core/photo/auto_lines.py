@@ -21,7 +21,6 @@ nothing. Pixels follow docs/conventions.md ("Images"): (col, row), first pixel c
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -30,6 +29,7 @@ from scipy.ndimage import map_coordinates
 from ..errors import InputError
 from ..geometry.camera import Camera
 from ..lidar.control import ControlLine
+from .auto_boresight_options import AutoLineOptions
 from .line_edge import refine_edge_point
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable
@@ -38,45 +38,6 @@ from .picking import PickingScene
 __all__ = ["AutoLineOptions", "line_observations", "line_observations_block"]
 
 Array = NDArray[np.float64]
-
-
-@dataclass(frozen=True)
-class AutoLineOptions:
-    """Parameters of :func:`line_observations` (pixels unless said).
-
-    spacing_px: distance between samples along a projected line.
-    search_px: half width of the search across the line (>= the projection's uncertainty
-        from the pose's, e.g. 3 sigma).
-    along_px: half length of the stretch of edge averaged per sample.
-    min_contrast: smallest grey step across an accepted edge (grey units of the image).
-    ambiguity: a second gradient peak above this fraction of the first refuses the sample.
-    min_points: fewest accepted samples a line must keep.
-    margin_px: samples nearer the frame border than this are dropped.
-    outlier_sigmas: refusal threshold on the per-line fit's robust residual sigma.
-    min_sigma_px: floor of the reported sigma (the fit's RMS can be tiny on few points).
-    """
-
-    spacing_px: float = 4.0
-    search_px: float = 4.0
-    along_px: float = 2.0
-    min_contrast: float = 4.0
-    ambiguity: float = 0.6
-    min_points: int = 5
-    margin_px: float = 2.0
-    outlier_sigmas: float = 3.0
-    min_sigma_px: float = 0.05
-
-    def __post_init__(self) -> None:
-        for name in ("spacing_px", "search_px", "min_sigma_px", "outlier_sigmas"):
-            if not float(getattr(self, name)) > 0:
-                raise InputError(f"{name} must be > 0, got {getattr(self, name)!r}")
-        for name in ("along_px", "min_contrast", "margin_px"):
-            if not float(getattr(self, name)) >= 0:
-                raise InputError(f"{name} must be >= 0, got {getattr(self, name)!r}")
-        if not 0 < float(self.ambiguity) <= 1:
-            raise InputError(f"ambiguity must be in (0, 1], got {self.ambiguity!r}")
-        if int(self.min_points) < 3:
-            raise InputError(f"min_points must be >= 3, got {self.min_points!r}")
 
 
 def _grey(image: ArrayLike) -> Array:

@@ -1,0 +1,395 @@
+"""Automatic (click-free) boresight calibration from LiDAR roof lines and planes (issue 32).
+
+From the images, the camera, the trajectory (INS/GNSS), the mount with an approximate
+boresight and the LiDAR roof planes and lines (mapping CRS), without any hand-picked point:
+
+1. Observability: a scene with no roof plane sloping more than ``min_slope_deg`` and fewer
+   than ``min_line_directions`` distinct LiDAR line directions (flat ground, flat roofs) is
+   refused with that reason (:class:`SceneNotObservable`): the angles are not observable.
+2. Angle search (coarse to fine): the LiDAR lines, sampled in 3D, are projected into every
+   image for boresight candidates on a grid of ``coarse_step_px`` (in the image) over
+   +-``search_deg`` about the initial boresight (omega and phi together, then kappa), and the
+   candidate whose projections lie on the strongest image edges (the sum of the gradient
+   magnitude of the image blurred by about half a step) wins; the grid is then halved around
+   it down to ``fine_step_px``. This is what lets a 1-degree initial error converge: the
+   edge refinement of step 3 only looks a few pixels across a line.
+3. Rounds: with the exterior orientation of the current estimate, line observations are
+   found along the projected lines (:func:`.auto_lines.line_observations_block`, searched
+   within 3 sigma of the projection's uncertainty, the pose's and the boresight's), tie
+   tracks (optional input) are associated with roof planes within a gate of 3 sigma
+   (:func:`.auto_ties.associate_ties`), and :func:`.boresight.calibrate` (robust stage and
+   data snooping) adjusts them. The next round starts from the adjusted orientation; the
+   rounds stop when every boresight angle changed by less than its standard deviation (after
+   at least two rounds) or after ``max_rounds``.
+
+Angles are radians inside, pixel quantities (col, row) per docs/conventions.md.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+from typing import Union
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InputError, stop_if_asked
+from ..geometry.camera import Camera
+from ..geometry.frames import LocalFrame, MappingFrame
+from ..geometry.planes import Plane
+from ..geometry.projection import ideal_from_camera
+from ..geometry.rotations import boresight_matrix
+from ..geometry.surface import Dsm
+from ..lidar.control import ControlLine
+from .auto_boresight_options import AutoBoresightOptions
+from .auto_lines import _grey, line_observations_block
+from .auto_ties import REASONS, associate_ties
+from .boresight import calibrate
+from .boresight_options import BoresightOptions
+from .boresight_result import BoresightResult
+from .georeference import Trajectory, direct_georeference
+from .ins import ins_grade
+from .mount import Mount
+from .observations import ImageObservations
+from .orientation import ExteriorOrientationTable, eo_map_to_local
+
+__all__ = [
+    "AutoBoresightOptions",
+    "AutoBoresightResult",
+    "RoundRecord",
+    "SceneNotObservable",
+    "auto_calibrate",
+    "scene_refusal",
+    "search_boresight",
+]
+
+Array = NDArray[np.float64]
+Images = Sequence[tuple[str, ArrayLike]]
+
+
+class SceneNotObservable(InputError):
+    """The LiDAR scene cannot determine the boresight angles (the message says why)."""
+
+
+@dataclass(frozen=True)
+class RoundRecord:
+    """One association-adjustment round: the search width (px) and tie gate (m) used, the
+    observation counts, the boresight after it (G, 3, radians), its sigmas and its change."""
+
+    round: int
+    search_px: float
+    gate_m: float
+    line_points: int
+    lines_seen: int
+    tie_tracks: int
+    ties_associated: int
+    ties_refused: dict[str, int]
+    boresight: Array
+    std: Array
+    change: Array
+    rejected: int
+
+
+@dataclass(frozen=True)
+class AutoBoresightResult:
+    """Result of :func:`auto_calibrate`: the last calibration, the boresight the angle search
+    gave (3,) radians, the rounds, the observations of the last round, and the images'
+    line-point counts and tie counts per plane of the last round."""
+
+    result: BoresightResult
+    searched: Array
+    rounds: list[RoundRecord]
+    observations: ImageObservations
+    converged: bool
+    per_image: dict[str, int]
+    per_plane: dict[str, int]
+
+
+# ------------------------------------------------------------------ observability
+def _directions(lines: Sequence[ControlLine], min_length: float = 1.0) -> int:
+    """Number of distinct plan directions (15 degrees apart) among the lines."""
+    az = sorted(
+        float(np.degrees(np.arctan2(ln.direction[1], ln.direction[0]))) % 180.0
+        for ln in lines
+        if ln.length >= min_length and np.hypot(*ln.direction[:2]) > 0.2
+    )
+    count, last = 0, -1e9
+    for a in az:
+        if a - last >= 15.0:
+            count, last = count + 1, a
+    if count > 1 and az[0] + 180.0 - last < 15.0:  # the first and last wrap round
+        count -= 1
+    return count
+
+
+def scene_refusal(planes: Sequence[Plane], lines: Sequence[ControlLine],
+                  options: AutoBoresightOptions | None = None) -> str:  # fmt: skip
+    """Why the scene cannot determine the boresight ("" when it can; module docstring)."""
+    opt = options or AutoBoresightOptions()
+    sloped = [p for p in planes if opt.min_slope_deg <= p.slope_deg <= opt.max_roof_slope_deg]
+    normals = np.array([p.normal for p in sloped]).reshape(-1, 3)
+    distinct = normals.shape[0] > 1 and float(np.min(normals @ normals[0])) < np.cos(
+        np.radians(10.0)
+    )
+    n_dir = _directions(lines)
+    if distinct or n_dir >= opt.min_line_directions:
+        return ""
+    return (
+        f"the LiDAR scene cannot determine the boresight angles: {len(sloped)} roof plane(s) "
+        f"sloping {opt.min_slope_deg:g} to {opt.max_roof_slope_deg:g} degrees "
+        f"({'one normal' if len(sloped) else 'none'}: flat ground or flat roofs only) and "
+        f"{n_dir} LiDAR line direction(s) (at least {opt.min_line_directions} needed)"
+    )
+
+
+# ------------------------------------------------------------------ angle search
+def _nominal_camera_vectors(traj: Trajectory, camera: Camera, mount: Mount,
+                            frame: MappingFrame, lines: Sequence[ControlLine], spacing_px: float
+                            ) -> list[Array]:  # fmt: skip
+    """Per image, LiDAR line samples (about ``spacing_px`` apart at the image scale) as vectors
+    in the camera frame of a zero boresight: ``u = M0 (X - C)`` (local ENU, metres)."""
+    zero = replace(mount, boresight=np.zeros(3))
+    eo = direct_georeference(traj, zero, frame)
+    local = LocalFrame.at_map_point(frame, eo.xyz.mean(axis=0))
+    centres, m0 = eo_map_to_local(eo.xyz, eo.opk, local)
+    pts = []
+    for ln in lines:
+        a, b = np.asarray(ln.start, float), np.asarray(ln.end, float)
+        rng = float(np.min(np.abs(eo.xyz[:, 2] - (a[2] + b[2]) / 2)))
+        gsd = max(rng, 1.0) / camera.focal_px
+        n = int(np.clip(np.ceil(np.linalg.norm(b - a) / (gsd * spacing_px)), 2, 2000))
+        t = (np.arange(n) + 0.5) / n
+        pts.append(a + t[:, None] * (b - a))
+    xyz = local.map_to_enu(np.vstack(pts)) if pts else np.empty((0, 3))
+    return [(xyz - centres[i]) @ m0[i].T for i in range(len(traj))]
+
+
+class _Search:
+    """The line samples of all images (stacked) and the images' edge strength at one blur."""
+
+    def __init__(self, camera: Camera, us: list[Array], greys: list[Array]) -> None:
+        self.camera = camera
+        self.us = us
+        self.greys = greys
+        self.grads: list[Array] = []
+        self.stride = 1
+
+    def blur(self, sigma_px: float, stride: int) -> None:
+        """Gradient magnitude of the images blurred by ``sigma_px``; every ``stride``-th sample."""
+        from scipy.ndimage import gaussian_gradient_magnitude
+
+        self.grads = [gaussian_gradient_magnitude(g, sigma_px) for g in self.greys]
+        self.stride = max(1, int(stride))
+        parts = [u[:: self.stride] for u in self.us]
+        self.owner = np.repeat(np.arange(len(parts)), [len(p) for p in parts])
+        self.u = np.vstack(parts) if parts else np.empty((0, 3))
+
+    def score(self, bore: Array) -> float:
+        """Mean edge strength under the projected lines (out-of-frame samples count 0)."""
+        from scipy.ndimage import map_coordinates
+
+        cam = self.camera
+        q = self.u @ boresight_matrix(*bore)  # v = dR^T u, in rows
+        ideal, valid = ideal_from_camera(q, cam.focal_mm, cam.projection)[:2]
+        px, ok = cam.pixel_from_ideal_with_status(np.where(valid[:, None], ideal, 0.0))
+        good = valid & ok & np.isfinite(px).all(axis=1)
+        good[good] &= cam.in_frame(px[good], 2.0)
+        total = 0.0
+        for k, g in enumerate(self.grads):
+            p = px[good & (self.owner == k)] - 0.5
+            if len(p):
+                total += float(map_coordinates(g, [p[:, 1], p[:, 0]], order=1).sum())
+        return total / max(len(px), 1)
+
+    def grid_best(self, centre: Array, steps: Array, half: int, axes: tuple[int, ...],
+                  should_stop: Callable[[], bool] | None = None) -> Array:  # fmt: skip
+        """The best candidate of a (2 half + 1)^len(axes) grid about ``centre``."""
+        offsets = np.arange(-half, half + 1)
+        grids = np.meshgrid(*[offsets * steps[a] for a in axes], indexing="ij")
+        best, best_score = centre, -np.inf
+        for n, combo in enumerate(zip(*[g.ravel() for g in grids])):
+            if n % 64 == 0:
+                stop_if_asked(should_stop, "the boresight search")
+            cand = centre.copy()
+            for a, d in zip(axes, combo):
+                cand[a] += d
+            s = self.score(cand)
+            if s > best_score:
+                best, best_score = cand, s
+        return best
+
+
+def search_boresight(
+    traj: Trajectory,
+    camera: Camera,
+    mount: Mount,
+    frame: MappingFrame,
+    images: Images,
+    lines: Sequence[ControlLine],
+    options: AutoBoresightOptions | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> Array:
+    """Coarse-to-fine boresight (3,) radians whose projected LiDAR lines lie on the strongest
+    image edges (module docstring, step 2)."""
+    opt = options or AutoBoresightOptions()
+    if opt.search_deg == 0 or not lines:
+        return np.asarray(mount.boresight, float).copy()
+    spacing = max(opt.fine_step_px, 0.5)  # samples this far apart at the finest step
+    us = _nominal_camera_vectors(traj, camera, mount, frame, lines, spacing)
+    row = {iid: k for k, iid in enumerate(traj.image_id)}
+    chosen, greys = [], []
+    for iid, img in images:
+        if iid not in row:
+            raise InputError(f"image '{iid}' is not in the trajectory")
+        chosen.append(us[row[iid]])
+        greys.append(_grey(img))
+    search = _Search(camera, chosen, greys)
+    f = camera.focal_px
+    half_diag = 0.5 * float(np.hypot(camera.width_px, camera.height_px))
+    step_px = float(opt.coarse_step_px)
+    bore = np.asarray(mount.boresight, float).copy()
+    first = True
+    while True:
+        stop_if_asked(should_stop, "the boresight search")
+        search.blur(max(0.7, 0.6 * step_px), int(step_px / (2 * spacing)))
+        steps = np.array([step_px / f, step_px / f, step_px / half_diag])
+        if first:  # the whole range: omega and phi together, then kappa
+            n_op = int(np.ceil(np.radians(opt.search_deg) / steps[0]))
+            n_k = int(np.ceil(np.radians(opt.search_deg) / steps[2]))
+            bore = search.grid_best(bore, steps, n_op, (0, 1), should_stop)
+            bore = search.grid_best(bore, steps, n_k, (2,), should_stop)
+            first = False
+        for _ in range(2):
+            bore = search.grid_best(bore, steps, 2, (0, 1))
+            bore = search.grid_best(bore, steps, 2, (2,))
+        if step_px <= opt.fine_step_px * 1.0001:
+            return bore
+        step_px = max(step_px / 2.0, opt.fine_step_px)
+
+
+# ------------------------------------------------------------------ rounds
+def _counts(obs: ImageObservations, kind: str, key: str) -> dict[str, int]:
+    out: dict[str, int] = {}
+    for t, i, tid in zip(obs.type, obs.image_id, obs.target_id):
+        if t == kind:
+            k = i if key == "image" else tid
+            out[k] = out.get(k, 0) + 1
+    return out
+
+
+def auto_calibrate(
+    trajectory: Trajectory,
+    camera: Camera,
+    mount: Mount,
+    crs: Union[str, MappingFrame],
+    images: Images,
+    planes: Sequence[Plane] = (),
+    lines: Sequence[ControlLine] = (),
+    ties: ImageObservations | None = None,
+    dsm: Dsm | None = None,
+    options: AutoBoresightOptions | None = None,
+    calibration: BoresightOptions | None = None,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> AutoBoresightResult:
+    """Calibrate the boresight without hand picks (module docstring).
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        INS/GNSS poses of the images (the approximate EO with ``mount``).
+    camera : Camera
+    mount : Mount
+        Lever arm, nominal mount and the approximate boresight (radians).
+    crs : str or MappingFrame
+        Mapping CRS of the trajectory, planes, lines and DSM.
+    images : sequence of (image_id, array)
+        Grey or RGB images of the camera's size (a list: it is read in every round).
+    planes, lines : sequences
+        LiDAR roof planes (with outlines for ties) and ridge/hip/valley lines.
+    ties : ImageObservations, optional
+        Tie tracks (rows of type ``tie``, e.g. from ``tiepoints``); associated with planes.
+    dsm : Dsm, optional
+        LiDAR DSM: ties off it are refused.
+    options : AutoBoresightOptions, optional
+    calibration : BoresightOptions, optional
+        Options of the adjustment (``use_types`` is set to tie and line).
+    progress, should_stop : callables, optional
+        Fraction done (0..1); cancellation.
+
+    Raises
+    ------
+    SceneNotObservable
+        A flat scene (module docstring, step 1), or no observation found.
+    """
+    opt = options or AutoBoresightOptions()
+    frame = crs if isinstance(crs, MappingFrame) else MappingFrame.from_user_input(crs)
+    why = scene_refusal(planes, lines, opt)
+    if why:
+        raise SceneNotObservable(why)
+    images = list(images)
+    base = calibration or BoresightOptions()
+    cal = replace(base, use_types=("tie", "line"))
+    grade = ins_grade(base.ins_grade) if isinstance(base.ins_grade, str) else base.ins_grade
+    att_sigma = np.radians(max(grade.sigma_roll_pitch_deg, grade.sigma_heading_deg))
+    searched = search_boresight(trajectory, camera, mount, frame, images, lines, opt, should_stop)
+    if progress:
+        progress(0.3)
+    current = replace(mount, boresight=searched)
+    eo: ExteriorOrientationTable = direct_georeference(trajectory, current, frame)
+    bore_sigma = opt.fine_step_px / camera.focal_px if opt.search_deg > 0 else 0.0
+    height = float(np.median(eo.xyz[:, 2]) - np.median([p.centroid[2] for p in planes])) \
+        if planes else float(np.median(eo.xyz[:, 2]))  # fmt: skip
+    rounds: list[RoundRecord] = []
+    last = np.asarray(searched, float)[None, :]
+    result, obs, converged = None, None, False
+    for r in range(int(opt.max_rounds)):
+        stop_if_asked(should_stop, "the automatic calibration")
+        spread = float(np.hypot(bore_sigma, att_sigma))
+        search_px = max(opt.min_search_px, opt.sigmas * camera.focal_px * spread)
+        gate = max(opt.min_gate_m, opt.sigmas * abs(height) * spread)
+        line_obs = line_observations_block(images, camera, eo, lines,
+                                           replace(opt.lines, search_px=search_px))  # fmt: skip
+        refused = dict.fromkeys(REASONS, 0)
+        n_tracks = 0
+        obs = line_obs
+        if ties is not None and len(ties):
+            assoc = associate_ties(ties, eo, camera, planes, gate, border_m=opt.border_m,
+                                   max_roof_slope_deg=opt.max_roof_slope_deg, dsm=dsm)  # fmt: skip
+            refused, n_tracks = assoc.reasons, assoc.tracks
+            obs = obs.concat(assoc.observations)
+        if len(obs) == 0:
+            raise SceneNotObservable(
+                "no image edge was found along the projected LiDAR lines and no tie track lies "
+                f"on a roof plane (round {r + 1}, search {search_px:.1f} px): the approximate "
+                "boresight or the mount is too far off, or the lines are not in the images"
+            )
+        result = calibrate(trajectory, camera, current, frame, obs, planes, lines, options=cal,
+                           should_stop=should_stop)  # fmt: skip
+        change = result.boresight - last
+        n_ties = sum(1 for t in obs.type if t == "tie")
+        rounds.append(RoundRecord(
+            r + 1, search_px, gate, len(line_obs), len(set(line_obs.target_id)), n_tracks,
+            len(set(p for p, t in zip(obs.point_id, obs.type) if t == "tie")) if n_ties else 0,
+            refused, result.boresight.copy(), result.std.copy(), change,
+            int(result.residuals.rejected.sum())))  # fmt: skip
+        if progress:
+            progress(0.3 + 0.7 * (r + 1) / opt.max_rounds)
+        if r >= 1 and bool(np.all(np.abs(change) < result.std)):
+            converged = True
+            break
+        last = result.boresight.copy()
+        bore_sigma = float(np.max(result.std))
+        eo = result.eo
+        current = replace(mount, boresight=result.boresight.mean(axis=0))
+    assert result is not None and obs is not None
+    return AutoBoresightResult(
+        result,
+        np.asarray(searched, float),
+        rounds,
+        obs,
+        converged,
+        _counts(obs, "line", "image"),
+        _counts(obs, "tie", "plane"),
+    )

@@ -1,0 +1,95 @@
+"""The options of the automatic boresight calibration (:mod:`.auto_boresight`) and of its
+line observations (:mod:`.auto_lines`), in a module that imports no numerical library, so that
+the command line's help reads their defaults without the science (tests/core/test_startup.py).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..errors import InputError
+
+__all__ = ["AutoBoresightOptions", "AutoLineOptions"]
+
+
+@dataclass(frozen=True)
+class AutoLineOptions:
+    """Parameters of :func:`line_observations` (pixels unless said).
+
+    spacing_px: distance between samples along a projected line.
+    search_px: half width of the search across the line (>= the projection's uncertainty
+        from the pose's, e.g. 3 sigma).
+    along_px: half length of the stretch of edge averaged per sample.
+    min_contrast: smallest grey step across an accepted edge (grey units of the image).
+    ambiguity: a second gradient peak above this fraction of the first refuses the sample.
+    min_points: fewest accepted samples a line must keep.
+    margin_px: samples nearer the frame border than this are dropped.
+    outlier_sigmas: refusal threshold on the per-line fit's robust residual sigma.
+    min_sigma_px: floor of the reported sigma (the fit's RMS can be tiny on few points).
+    """
+
+    spacing_px: float = 4.0
+    search_px: float = 4.0
+    along_px: float = 2.0
+    min_contrast: float = 4.0
+    ambiguity: float = 0.6
+    min_points: int = 5
+    margin_px: float = 2.0
+    outlier_sigmas: float = 3.0
+    min_sigma_px: float = 0.05
+
+    def __post_init__(self) -> None:
+        for name in ("spacing_px", "search_px", "min_sigma_px", "outlier_sigmas"):
+            if not float(getattr(self, name)) > 0:
+                raise InputError(f"{name} must be > 0, got {getattr(self, name)!r}")
+        for name in ("along_px", "min_contrast", "margin_px"):
+            if not float(getattr(self, name)) >= 0:
+                raise InputError(f"{name} must be >= 0, got {getattr(self, name)!r}")
+        if not 0 < float(self.ambiguity) <= 1:
+            raise InputError(f"ambiguity must be in (0, 1], got {self.ambiguity!r}")
+        if int(self.min_points) < 3:
+            raise InputError(f"min_points must be >= 3, got {self.min_points!r}")
+
+
+@dataclass(frozen=True)
+class AutoBoresightOptions:
+    """Parameters of :func:`auto_calibrate`.
+
+    search_deg: half width of the angle search about the initial boresight, degrees (0: no
+        search, the initial boresight must be within a few pixels).
+    coarse_step_px, fine_step_px: first and last grid step of the search, pixels in the image.
+    min_search_px: smallest half width of the edge search across a projected line, pixels.
+    sigmas: width of the edge search and of the tie gate in standard deviations.
+    min_gate_m: smallest tie gate, metres.
+    border_m: smallest distance of a tie from its plane's outline, metres.
+    max_roof_slope_deg: steeper planes are walls (no tie), degrees.
+    min_slope_deg: a plane sloping less is flat (does not make the angles observable), degrees.
+    min_line_directions: fewest distinct line directions (15 degrees apart in plan) that make
+        the angles observable without sloped planes.
+    max_rounds: most association-adjustment rounds.
+    lines: options of the edge search (its ``search_px`` is set per round).
+    """
+
+    search_deg: float = 1.0
+    coarse_step_px: float = 8.0
+    fine_step_px: float = 0.5
+    min_search_px: float = 2.5
+    sigmas: float = 3.0
+    min_gate_m: float = 0.05
+    border_m: float = 0.3
+    max_roof_slope_deg: float = 65.0
+    min_slope_deg: float = 5.0
+    min_line_directions: int = 2
+    max_rounds: int = 6
+    lines: AutoLineOptions = field(default_factory=AutoLineOptions)
+
+    def __post_init__(self) -> None:
+        for name in ("coarse_step_px", "fine_step_px", "min_search_px", "sigmas", "min_gate_m"):
+            if not float(getattr(self, name)) > 0:
+                raise InputError(f"{name} must be > 0, got {getattr(self, name)!r}")
+        if not 0 <= float(self.search_deg) <= 10:
+            raise InputError(f"search_deg must be in [0, 10] degrees, got {self.search_deg!r}")
+        if self.fine_step_px > self.coarse_step_px:
+            raise InputError("fine_step_px must not exceed coarse_step_px")
+        if int(self.max_rounds) < 1 or int(self.min_line_directions) < 1:
+            raise InputError("max_rounds and min_line_directions must be >= 1")
