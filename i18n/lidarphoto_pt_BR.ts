@@ -115,6 +115,10 @@
             <translation>Um bloco do Metashape: ortofotos sobre o MDS LiDAR</translation>
         </message>
         <message>
+            <source>Boresight calibration without hand picks (automatic)</source>
+            <translation>Calibração de boresight sem medições manuais (automática)</translation>
+        </message>
+        <message>
             <source>Boresight calibration from an SBET (or ASCII export) and the camera events</source>
             <translation>Calibração de boresight a partir de um SBET (ou exportação ASCII) e dos eventos da câmera</translation>
         </message>
@@ -225,6 +229,18 @@
         <message>
             <source>INPUT = the camera XML (Export Cameras, Agisoft XML); CRS = the mapping CRS (empty: the chunk's projected CRS); OUTPUT_CAMERA, OUTPUT_EO</source>
             <translation>INPUT = o XML de câmeras (Export Cameras, Agisoft XML); CRS = o SRC de mapeamento (vazio: o SRC projetado do chunk); OUTPUT_CAMERA, OUTPUT_EO</translation>
+        </message>
+        <message>
+            <source>PLANES and CLOUD = the two outputs of extractroofplanes; LINES_CSV = the LiDAR ridge, hip and valley lines</source>
+            <translation>PLANES e CLOUD = as duas saídas de extractroofplanes; LINES_CSV = as linhas LiDAR de cumeeira, espigão e rincão</translation>
+        </message>
+        <message>
+            <source>IMAGES (and the approximate EO + CAMERA to pair images by their footprints); OUTPUT_OBSERVATIONS = tie points (optional for the next step)</source>
+            <translation>IMAGES (e a OE aproximada + CAMERA para parear as imagens por suas áreas de cobertura); OUTPUT_OBSERVATIONS = pontos de enlace (opcionais para a próxima etapa)</translation>
+        </message>
+        <message>
+            <source>IMAGES, CAMERA, TRAJECTORY, LINES, PLANES and CLOUD, TIE_POINTS; OUTPUT_TABLE = boresight per group, OUTPUT_OBSERVATIONS = the observations found</source>
+            <translation>IMAGES, CAMERA, TRAJECTORY, LINES, PLANES e CLOUD, TIE_POINTS; OUTPUT_TABLE = boresight por grupo, OUTPUT_OBSERVATIONS = as observações encontradas</translation>
         </message>
         <message>
             <source>INPUT = the SBET, POSPac / Inertial Explorer export or CSV; EVENTS = image_id, time; OUTPUT_TRAJECTORY = the trajectory table at the events, OUTPUT_EO = the exterior orientation</source>
@@ -3469,6 +3485,301 @@ os valores de RMSE como saídas numéricas.</translation>
         </message>
     </context>
     <context>
+        <name>lidarphoto:autoboresight</name>
+        <message>
+            <source>Automatic boresight calibration</source>
+            <translation>Calibração de boresight automática</translation>
+        </message>
+        <message>
+            <source>Calibration</source>
+            <translation>Calibração</translation>
+        </message>
+        <message>
+            <source>boresight without hand picks: image edges along LiDAR lines, ties on roof planes</source>
+            <translation>boresight sem medições manuais: bordas da imagem ao longo das linhas LiDAR, pontos de enlace nos planos de telhado</translation>
+        </message>
+        <message>
+            <source>Calibrates the camera-INS boresight from the images themselves, with no picked point. The
+LiDAR ridge, hip and valley lines (the line table of Create LiDAR control points and lines)
+are projected into every image with the trajectory, the mount and the approximate boresight.
+First an angle search (coarse to fine, within Search range of the approximate boresight)
+finds the boresight whose projected lines lie on the strongest image edges; then, in rounds,
+sub-pixel image edges are found along every projected line (the dock's edge refinement, within
+3 sigma of the projection's uncertainty) and, when tie points are given (the observation CSV
+of Automatic tie points), each tie track is intersected and kept as a point-to-plane tie of
+the roof plane it lies on (inside the plane's outline, from the cloud's plane ids; off the
+borders; within a gate of 3 sigma of the pose and intersection uncertainty; not on a wall).
+Each round runs the rigorous calibration of Boresight calibration (line and tie models,
+INS priors, data snooping) and starts the next from its result, until every angle changes
+by less than its standard deviation.</source>
+            <translation>Calibra o boresight câmera-INS a partir das próprias imagens, sem nenhum ponto medido. As
+linhas LiDAR de cumeeira, espigão e rincão (a tabela de linhas de Criar pontos e linhas de
+controle LiDAR) são projetadas em cada imagem com a trajetória, a montagem e o boresight
+aproximado. Primeiro uma busca angular (do grosseiro ao fino, dentro do Intervalo de busca em
+torno do boresight aproximado) encontra o boresight cujas linhas projetadas caem sobre as bordas
+mais fortes da imagem; depois, em rodadas, bordas subpixel são encontradas ao longo de cada
+linha projetada (o refinamento de bordas do painel, dentro de 3 sigma da incerteza da projeção)
+e, quando pontos de enlace são dados (o CSV de observações de Pontos de enlace automáticos), cada
+trilha é intersectada e mantida como vínculo ponto-plano do plano de telhado onde está (dentro do
+contorno do plano, pelos ids de plano da nuvem; longe das bordas; dentro de uma janela de 3 sigma
+da incerteza da pose e da interseção; fora de paredes). Cada rodada executa a calibração rigorosa
+de Calibração de boresight (modelos de linha e de enlace, injunções do INS, data snooping) e
+inicia a seguinte a partir do seu resultado, até que cada ângulo mude menos que seu desvio-padrão.</translation>
+        </message>
+        <message>
+            <source>A scene with no sloped roof plane and fewer than two LiDAR line directions (flat ground,
+flat roofs) is refused: the angles are not observable there.</source>
+            <translation>Uma cena sem plano de telhado inclinado e com menos de duas direções de linhas LiDAR (terreno
+plano, telhados planos) é recusada: ali os ângulos não são observáveis.</translation>
+        </message>
+        <message>
+            <source>Outputs: the boresight per group and the updated exterior orientation (as Boresight
+calibration), the observations found (image-observation CSV: Boresight calibration reads it
+again, e.g. to compare with hand picks), the rounds (CSV) and the HTML summary, whose settings
+give the counts per round and the ties refused per reason.</source>
+            <translation>Saídas: o boresight por grupo e a orientação exterior atualizada (como em Calibração de
+boresight), as observações encontradas (CSV de observações de imagem: Calibração de boresight o
+lê de novo, p. ex. para comparar com medições manuais), as rodadas (CSV) e o resumo HTML, cujas
+configurações dão as contagens por rodada e os pontos de enlace recusados por motivo.</translation>
+        </message>
+        <message>
+            <source>Images (files or folders)</source>
+            <translation>Imagens (arquivos ou pastas)</translation>
+        </message>
+        <message>
+            <source>the image id is the file name without extension, as in the trajectory</source>
+            <translation>o id da imagem é o nome do arquivo sem extensão, como na trajetória</translation>
+        </message>
+        <message>
+            <source>Camera (JSON)</source>
+            <translation>Câmera (JSON)</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>Trajectory table (CSV)</source>
+            <translation>Tabela da trajetória (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Mapping CRS</source>
+            <translation>SRC de mapeamento</translation>
+        </message>
+        <message>
+            <source>projected CRS of the trajectory and of the LiDAR tables</source>
+            <translation>SRC projetado da trajetória e das tabelas LiDAR</translation>
+        </message>
+        <message>
+            <source>Lever arm x,y,z</source>
+            <translation>Braço de alavanca x,y,z</translation>
+        </message>
+        <message>
+            <source>camera perspective centre in the INS body frame (x forward, y right, z down)</source>
+            <translation>centro perspectivo da câmera no referencial do corpo do INS (x para a frente, y para a direita, z para baixo)</translation>
+        </message>
+        <message>
+            <source>Camera mount</source>
+            <translation>Montagem da câmera</translation>
+        </message>
+        <message>
+            <source>nominal camera-to-body rotation; custom uses MOUNT_MATRIX</source>
+            <translation>rotação nominal da câmera para o corpo; custom usa MOUNT_MATRIX</translation>
+        </message>
+        <message>
+            <source>image_top_forward: image top towards the flight direction (nose)</source>
+            <translation>image_top_forward: topo da imagem no sentido do voo (nariz)</translation>
+        </message>
+        <message>
+            <source>image_right_forward: image right side towards the flight direction</source>
+            <translation>image_right_forward: lado direito da imagem no sentido do voo</translation>
+        </message>
+        <message>
+            <source>image_bottom_forward: image bottom towards the flight direction</source>
+            <translation>image_bottom_forward: base da imagem no sentido do voo</translation>
+        </message>
+        <message>
+            <source>image_left_forward: image left side towards the flight direction</source>
+            <translation>image_left_forward: lado esquerdo da imagem no sentido do voo</translation>
+        </message>
+        <message>
+            <source>custom: custom matrix (MOUNT_MATRIX)</source>
+            <translation>custom: matriz definida pelo usuário (MOUNT_MATRIX)</translation>
+        </message>
+        <message>
+            <source>Mount matrix R_c^b (9 numbers, row-major)</source>
+            <translation>Matriz de montagem R_c^b (9 números, por linhas)</translation>
+        </message>
+        <message>
+            <source>the nominal mount R_c^b when MOUNT is custom</source>
+            <translation>a montagem nominal R_c^b quando MOUNT é custom</translation>
+        </message>
+        <message>
+            <source>Boresight domega,dphi,dkappa</source>
+            <translation>Boresight domega,dphi,dkappa</translation>
+        </message>
+        <message>
+            <source>small misalignment about the camera axes x, y, z (a larger rotation belongs in MOUNT)</source>
+            <translation>pequeno desalinhamento em torno dos eixos x, y, z da câmera (uma rotação maior pertence a MOUNT)</translation>
+        </message>
+        <message>
+            <source>Line table (CSV)</source>
+            <translation>Tabela de linhas (CSV)</translation>
+        </message>
+        <message>
+            <source>Plane table (CSV)</source>
+            <translation>Tabela de planos (CSV)</translation>
+        </message>
+        <message>
+            <source>the roof planes of the tie points and of the observability check</source>
+            <translation>os planos de telhado dos pontos de enlace e da verificação de observabilidade</translation>
+        </message>
+        <message>
+            <source>Cloud with plane ids (LAS/LAZ)</source>
+            <translation>Nuvem com identificadores de plano (LAS/LAZ)</translation>
+        </message>
+        <message>
+            <source>the planes' outlines (convex hull of their points): needed by tie points</source>
+            <translation>os contornos dos planos (envoltória convexa de seus pontos): necessários aos pontos de enlace</translation>
+        </message>
+        <message>
+            <source>LAS/LAZ files (*.las *.laz *.LAS *.LAZ)</source>
+            <translation>Arquivos LAS/LAZ (*.las *.laz *.LAS *.LAZ)</translation>
+        </message>
+        <message>
+            <source>Tie points (observation CSV)</source>
+            <translation>Pontos de enlace (CSV de observações)</translation>
+        </message>
+        <message>
+            <source>the output of Automatic tie points</source>
+            <translation>a saída de Pontos de enlace automáticos</translation>
+        </message>
+        <message>
+            <source>Hand picks to compare with (observation CSV)</source>
+            <translation>Medições manuais para comparar (CSV de observações)</translation>
+        </message>
+        <message>
+            <source>observations picked in the dock: their tie and line rows are calibrated alone and the summary compares the two boresights</source>
+            <translation>observações medidas no painel: suas linhas de enlace e de linha são calibradas sozinhas e o resumo compara os dois boresights</translation>
+        </message>
+        <message>
+            <source>Search range of the boresight</source>
+            <translation>Intervalo de busca do boresight</translation>
+        </message>
+        <message>
+            <source>half width of the angle search about BORESIGHT (0: none)</source>
+            <translation>meia largura da busca angular em torno de BORESIGHT (0: nenhuma)</translation>
+        </message>
+        <message>
+            <source>Most rounds</source>
+            <translation>Máximo de rodadas</translation>
+        </message>
+        <message>
+            <source>Boresight groups</source>
+            <translation>Grupos de boresight</translation>
+        </message>
+        <message>
+            <source>one boresight for all images</source>
+            <translation>um boresight para todas as imagens</translation>
+        </message>
+        <message>
+            <source>one per trajectory group (flight line, direction, session)</source>
+            <translation>um por grupo da trajetória (faixa de voo, direção, sessão)</translation>
+        </message>
+        <message>
+            <source>one per heading direction (octant)</source>
+            <translation>um por direção de rumo (octante)</translation>
+        </message>
+        <message>
+            <source>INS grade</source>
+            <translation>Classe do INS</translation>
+        </message>
+        <message>
+            <source>Applanix POS AV 310</source>
+            <translation>Applanix POS AV 310</translation>
+        </message>
+        <message>
+            <source>custom (INS sigmas)</source>
+            <translation>personalizada (sigmas do INS)</translation>
+        </message>
+        <message>
+            <source>Custom INS sigmas: horizontal, vertical, roll/pitch, heading</source>
+            <translation>Sigmas do INS personalizados: horizontal, vertical, rolagem/arfagem, rumo</translation>
+        </message>
+        <message>
+            <source>Largest plausible boresight angle</source>
+            <translation>Maior ângulo de boresight plausível</translation>
+        </message>
+        <message>
+            <source>an estimated angle beyond this fails the run</source>
+            <translation>um ângulo estimado além deste faz a execução falhar</translation>
+        </message>
+        <message>
+            <source>Largest sigma0 when the global test fails</source>
+            <translation>Maior sigma0 quando o teste global falha</translation>
+        </message>
+        <message>
+            <source>a failed global test with sigma0 above this fails the run</source>
+            <translation>um teste global reprovado com sigma0 acima deste faz a execução falhar</translation>
+        </message>
+        <message>
+            <source>Write the results even when the checks fail</source>
+            <translation>Gravar os resultados mesmo quando as verificações falham</translation>
+        </message>
+        <message>
+            <source>no convergence, global test beyond MAX_SIGMA0, more rejections than false alarms explain or boresight beyond MAX_BORESIGHT: write the outputs anyway, each with a warning at its top</source>
+            <translation>sem convergência, teste global além de MAX_SIGMA0, mais rejeições do que os falsos alarmes explicam ou boresight além de MAX_BORESIGHT: grava as saídas mesmo assim, cada uma com um aviso no início</translation>
+        </message>
+        <message>
+            <source>Boresight per group (CSV)</source>
+            <translation>Boresight por grupo (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Updated exterior orientation (CSV)</source>
+            <translation>Orientação exterior atualizada (CSV)</translation>
+        </message>
+        <message>
+            <source>Observations found (CSV)</source>
+            <translation>Observações encontradas (CSV)</translation>
+        </message>
+        <message>
+            <source>Rounds (CSV)</source>
+            <translation>Rodadas (CSV)</translation>
+        </message>
+        <message>
+            <source>Summary (HTML)</source>
+            <translation>Resumo (HTML)</translation>
+        </message>
+        <message>
+            <source>HTML files (*.html)</source>
+            <translation>Arquivos HTML (*.html)</translation>
+        </message>
+        <message>
+            <source>Sigma0 a-posteriori</source>
+            <translation>Sigma0 a posteriori</translation>
+        </message>
+        <message>
+            <source>Rounds</source>
+            <translation>Rodadas</translation>
+        </message>
+        <message>
+            <source>Line observations</source>
+            <translation>Observações de linha</translation>
+        </message>
+        <message>
+            <source>Tie points on roof planes</source>
+            <translation>Pontos de enlace nos planos de telhado</translation>
+        </message>
+    </context>
+    <context>
         <name>lidarphoto:boresightcalibration</name>
         <message>
             <source>Boresight calibration</source>
@@ -4224,16 +4535,20 @@ mantidos nas suas coordenadas nominais, o que define a escala a partir do tamanh
 última linha mantido no plano Z = 0).</translation>
         </message>
         <message>
-            <source>Outputs: the camera JSON (usable by every algorithm; a fisheye camera is refused by those whose
-kernels are perspective-only), a report JSON (sigmas, correlations, sigma0, the t-test of every
-lens coefficient, per-view RMS and poses), the same as an HTML page, and the residual table
-(CSV). PIXEL_SIZE only scales
-the millimetre values of the camera file: the calibration itself is in pixels.</source>
-            <translation>Saídas: o JSON da câmera (utilizável por todos os algoritmos; uma câmera olho de peixe é recusada por aqueles cujos
-núcleos são apenas perspectivos), um JSON de relatório (sigmas, correlações, sigma0, o teste t de cada
-coeficiente da lente, RMS e poses por vista), o mesmo como página HTML, e a tabela de resíduos
-(CSV). PIXEL_SIZE apenas escala
-os valores em milímetros do arquivo da câmera: a calibração em si é em pixels.</translation>
+            <source>Outputs: the camera JSON (a fisheye camera is taken by control chips, orthorectify (and so
+the orthomosaic) and monoplot, the equidistant one by the COLMAP export; the algorithms still
+perspective-only refuse it by name: resection, bundle adjustment, boresight calibration, tie
+points, control point location), a report JSON (sigmas, correlations, sigma0, the t-test of
+every lens coefficient, per-view RMS and poses), the same as an HTML page, and the residual
+table (CSV). PIXEL_SIZE only scales the millimetre values of the camera file: the calibration
+itself is in pixels.</source>
+            <translation>Saídas: o JSON da câmera (uma câmera olho de peixe é aceita pelos chips de controle, por
+orthorectify (e assim pelo ortomosaico) e por monoplot, a equidistante pela exportação COLMAP; os
+algoritmos ainda apenas perspectivos a recusam pelo nome: resseção, ajustamento por feixes,
+calibração de boresight, pontos de enlace, localização de pontos de controle), um JSON de
+relatório (sigmas, correlações, sigma0, o teste t de cada coeficiente da lente, RMS e poses por
+vista), o mesmo como página HTML, e a tabela de resíduos (CSV). PIXEL_SIZE apenas escala os
+valores em milímetros do arquivo da câmera: a calibração em si é em pixels.</translation>
         </message>
         <message>
             <source>Target images (files or folders)</source>
@@ -4382,6 +4697,18 @@ os valores em milímetros do arquivo da câmera: a calibração em si é em pixe
         <message>
             <source>Focal length (px)</source>
             <translation>Distância focal (px)</translation>
+        </message>
+        <message>
+            <source>Outputs: the camera JSON (usable by every algorithm; a fisheye camera is refused by those whose
+kernels are perspective-only), a report JSON (sigmas, correlations, sigma0, the t-test of every
+lens coefficient, per-view RMS and poses), the same as an HTML page, and the residual table
+(CSV). PIXEL_SIZE only scales
+the millimetre values of the camera file: the calibration itself is in pixels.</source>
+            <translation type="vanished">Saídas: o JSON da câmera (utilizável por todos os algoritmos; uma câmera olho de peixe é recusada por aqueles cujos
+núcleos são apenas perspectivos), um JSON de relatório (sigmas, correlações, sigma0, o teste t de cada
+coeficiente da lente, RMS e poses por vista), o mesmo como página HTML, e a tabela de resíduos
+(CSV). PIXEL_SIZE apenas escala
+os valores em milímetros do arquivo da câmera: a calibração em si é em pixels.</translation>
         </message>
         <message>
             <source>Photogrammetry</source>
@@ -6749,15 +7076,19 @@ os demais são gravados.</translation>
         </message>
         <message>
             <source>Monoplotting (dos Santos, Dal Poz &amp; Dalmolin 2010): the ray of each image point is
-intersected with the LiDAR surface. Direct (Dal Poz 1991): the ray walks the DSM's cells in
+intersected with the LiDAR surface. The camera may be perspective or fisheye (equidistant,
+equisolid-angle, orthographic, stereographic, with its Brown correction): the ray is the
+one of the camera's own projection. Direct (Dal Poz 1991): the ray walks the DSM's cells in
 order from the camera and meets the two triangles of each cell in the determinant form of
 Eqs. 6-10; the first face hit is the visible point (occlusion). Makarovic: the classical
 iteration height -&gt; position -&gt; height.</source>
             <translation>Monorrestituição (dos Santos, Dal Poz &amp; Dalmolin 2010): o raio de cada ponto da imagem é
-intersectado com a superfície LiDAR. Direto (Dal Poz 1991): o raio percorre as células do MDS
-em ordem a partir da câmera e encontra os dois triângulos de cada célula na forma de
-determinantes das Eqs. 6-10; a primeira face atingida é o ponto visível (oclusão). Makarovic: a
-iteração clássica altura -&gt; posição -&gt; altura.</translation>
+intersectado com a superfície LiDAR. A câmera pode ser perspectiva ou olho de peixe
+(equidistante, equissólida, ortográfica, estereográfica, com sua correção de Brown): o raio é o
+da própria projeção da câmera. Direto (Dal Poz 1991): o raio percorre as células do MDS em ordem
+a partir da câmera e encontra os dois triângulos de cada célula na forma de determinantes das
+Eqs. 6-10; a primeira face atingida é o ponto visível (oclusão). Makarovic: a iteração clássica
+altura -&gt; posição -&gt; altura.</translation>
         </message>
         <message>
             <source>Observations: the image-observation CSV of the picking dock (image_id, point_id, col, row,
@@ -6790,12 +7121,14 @@ MDS o SRC do MDS com alturas elipsoidais.</translation>
 omega, phi, kappa in degrees) and the DSM height sigma, and a status: ok, grazing (ray meets
 the face at less than the minimum angle), outside (the ray leaves the DSM), nodata (it crosses
 a hole first), no_orientation (image not in the EO table), not_converged (Makarovic),
-parallel / unknown_plane (planes).</source>
+parallel / unknown_plane (planes), out_of_field (the point lies beyond a fisheye
+projection's field: no ray).</source>
             <translation>Cada ponto traz uma covariância 3x3 a partir do desvio-padrão da imagem, dos desvios-padrão da
 OE (X, Y, Z em m; omega, phi, kappa em graus) e do desvio-padrão da altura do MDS, e um estado:
 ok, grazing (o raio encontra a face com ângulo menor que o mínimo), outside (o raio sai do
 MDS), nodata (ele cruza primeiro um buraco), no_orientation (imagem ausente da tabela de OE),
-not_converged (Makarovic), parallel / unknown_plane (planos).</translation>
+not_converged (Makarovic), parallel / unknown_plane (planos), out_of_field (o ponto está além do
+campo de uma projeção olho de peixe: sem raio).</translation>
         </message>
         <message>
             <source>Image observations (CSV)</source>
@@ -6910,6 +7243,30 @@ not_converged (Makarovic), parallel / unknown_plane (planos).</translation>
             <translation>Raios com um ponto 3D</translation>
         </message>
         <message>
+            <source>Monoplotting (dos Santos, Dal Poz &amp; Dalmolin 2010): the ray of each image point is
+intersected with the LiDAR surface. Direct (Dal Poz 1991): the ray walks the DSM's cells in
+order from the camera and meets the two triangles of each cell in the determinant form of
+Eqs. 6-10; the first face hit is the visible point (occlusion). Makarovic: the classical
+iteration height -&gt; position -&gt; height.</source>
+            <translation type="vanished">Monorrestituição (dos Santos, Dal Poz &amp; Dalmolin 2010): o raio de cada ponto da imagem é
+intersectado com a superfície LiDAR. Direto (Dal Poz 1991): o raio percorre as células do MDS
+em ordem a partir da câmera e encontra os dois triângulos de cada célula na forma de
+determinantes das Eqs. 6-10; a primeira face atingida é o ponto visível (oclusão). Makarovic: a
+iteração clássica altura -&gt; posição -&gt; altura.</translation>
+        </message>
+        <message>
+            <source>Each point carries a 3x3 covariance from the image sigma, the EO sigmas (X, Y, Z in m;
+omega, phi, kappa in degrees) and the DSM height sigma, and a status: ok, grazing (ray meets
+the face at less than the minimum angle), outside (the ray leaves the DSM), nodata (it crosses
+a hole first), no_orientation (image not in the EO table), not_converged (Makarovic),
+parallel / unknown_plane (planes).</source>
+            <translation type="vanished">Cada ponto traz uma covariância 3x3 a partir do desvio-padrão da imagem, dos desvios-padrão da
+OE (X, Y, Z em m; omega, phi, kappa em graus) e do desvio-padrão da altura do MDS, e um estado:
+ok, grazing (o raio encontra a face com ângulo menor que o mínimo), outside (o raio sai do
+MDS), nodata (ele cruza primeiro um buraco), no_orientation (imagem ausente da tabela de OE),
+not_converged (Makarovic), parallel / unknown_plane (planos).</translation>
+        </message>
+        <message>
             <source>Monoplotting</source>
             <translation type="vanished">Monorrestituição</translation>
         </message>
@@ -6950,10 +7307,11 @@ abruptas.</translation>
         <message>
             <source>## Inputs
 Orthophotos: GeoTIFFs of one CRS and cell size, aligned on multiples of it (Orthorectify
-with one GSD makes them so), or folders of them.</source>
+with one GSD makes them so, from perspective or fisheye images alike), or folders of them.</source>
             <translation>## Entradas
 Ortofotos: GeoTIFFs de um mesmo SRC e tamanho de célula, alinhados em múltiplos dele
-(Ortorretificar com um único GSD os produz assim), ou pastas com eles.</translation>
+(Ortorretificar com um único GSD os produz assim, de imagens perspectivas ou olho de peixe), ou
+pastas com eles.</translation>
         </message>
         <message>
             <source>## Outputs
@@ -7037,6 +7395,14 @@ cells, area, WKT MultiPolygon no SRC do mosaico).</translation>
             <source>Share of the mosaic's cells with data</source>
             <translation>Fração das células do mosaico com dados</translation>
         </message>
+        <message>
+            <source>## Inputs
+Orthophotos: GeoTIFFs of one CRS and cell size, aligned on multiples of it (Orthorectify
+with one GSD makes them so), or folders of them.</source>
+            <translation type="vanished">## Entradas
+Ortofotos: GeoTIFFs de um mesmo SRC e tamanho de célula, alinhados em múltiplos dele
+(Ortorretificar com um único GSD os produz assim), ou pastas com eles.</translation>
+        </message>
     </context>
     <context>
         <name>lidarphoto:orthorectify</name>
@@ -7057,12 +7423,17 @@ cells, area, WKT MultiPolygon no SRC do mosaico).</translation>
 height of every output cell comes from the DSM (or DTM) and its image position from the
 camera (lens model included) and the exterior orientation, by the rigorous chain of the
 toolbox (local ENU frame reached through ECEF, so the map projection's scale and the Earth's
-curvature are not neglected).</source>
+curvature are not neglected). The camera may be perspective or fisheye (equidistant,
+equisolid-angle, orthographic, stereographic, with its Brown correction, as Calibrate camera
+writes it): a fisheye maps the angle off its axis, and ground beyond its field is no data.</source>
             <translation>Cada imagem é reamostrada em uma grade orientada ao norte do SRC de mapeamento através da
 superfície: a altura de cada célula de saída vem do MDS (ou MDT) e a sua posição na imagem vem
 da câmera (modelo de lente incluído) e da orientação exterior, pela cadeia rigorosa do kit de
 ferramentas (referencial local ENU alcançado através do ECEF, de modo que a escala da projeção
-cartográfica e a curvatura da Terra não são desprezadas).</translation>
+cartográfica e a curvatura da Terra não são desprezadas). A câmera pode ser perspectiva ou olho
+de peixe (equidistante, equissólida, ortográfica, estereográfica, com sua correção de Brown, como
+Calibrar câmera a escreve): uma olho de peixe mapeia o ângulo fora do seu eixo, e o terreno além
+do seu campo fica sem dado.</translation>
         </message>
         <message>
             <source>With True orthophoto, ground hidden from the camera (behind buildings, under trees and
@@ -7224,6 +7595,18 @@ juntos quando todos estão prontos.</translation>
         <message>
             <source>Share of cells occluded (true orthophotos)</source>
             <translation>Fração das células oclusas (ortofotos verdadeiras)</translation>
+        </message>
+        <message>
+            <source>Each image is resampled onto a north-up grid of the mapping CRS through the surface: the
+height of every output cell comes from the DSM (or DTM) and its image position from the
+camera (lens model included) and the exterior orientation, by the rigorous chain of the
+toolbox (local ENU frame reached through ECEF, so the map projection's scale and the Earth's
+curvature are not neglected).</source>
+            <translation type="vanished">Cada imagem é reamostrada em uma grade orientada ao norte do SRC de mapeamento através da
+superfície: a altura de cada célula de saída vem do MDS (ou MDT) e a sua posição na imagem vem
+da câmera (modelo de lente incluído) e da orientação exterior, pela cadeia rigorosa do kit de
+ferramentas (referencial local ENU alcançado através do ECEF, de modo que a escala da projeção
+cartográfica e a curvatura da Terra não são desprezadas).</translation>
         </message>
     </context>
     <context>
