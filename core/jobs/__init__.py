@@ -21,6 +21,7 @@ NAMES = (
     "export_colmap",
     "import_opensfm",
     "import_metashape",
+    "import_pix4d",
     "ground_filter",
     "create_lcps",
     "accuracy_report",

@@ -143,6 +143,16 @@ WORKFLOWS: tuple[Workflow, ...] = (
         ),
     ),
     Workflow(
+        _t("A Pix4D block: orthophotos on the LiDAR DSM"),
+        (
+            ("importpix4d", _t("INPUT = <project>_calibrated_camera_parameters.txt (Pix4D's "
+             "1_initial/params, its offset beside it); CRS = the project's output CRS (empty: "
+             "its _wkt.prj); OUTPUT_CAMERA, OUTPUT_EO")),
+            ("orthorectify", _t("CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
+             "OUTPUT_FOLDER = one orthophoto per image")),
+        ),
+    ),
+    Workflow(
         _t("Boresight calibration from an SBET (or ASCII export) and the camera events"),
         (
             ("importtrajectory", _t("INPUT = the SBET, POSPac / Inertial Explorer export or "
