@@ -20,6 +20,7 @@ NAMES = (
     "import_colmap",
     "export_colmap",
     "import_opensfm",
+    "export_opensfm",
     "import_metashape",
     "import_pix4d",
     "ground_filter",

@@ -130,6 +130,8 @@ WORKFLOWS: tuple[Workflow, ...] = (
              "OUTPUT_OBSERVATIONS, OUTPUT_POINTS")),
             ("orthorectify", _t("CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
              "OUTPUT_FOLDER = one orthophoto per image")),
+            ("exportopensfm", _t("CAMERA, EO (e.g. adjusted by bundleadjustment), "
+             "OBSERVATIONS and POINTS; OUTPUT_FOLDER = the reconstruction.json for OpenSfM / ODM")),
         ),
     ),
     Workflow(
