@@ -114,6 +114,15 @@ def _is_name_line(tokens: List[str]) -> bool:
     return False
 
 
+def _numeric(tokens: List[str]) -> bool:
+    """Every token a number (a line of an image block, never of the header)."""
+    try:
+        [float(t) for t in tokens]
+    except ValueError:
+        return False
+    return True
+
+
 def _rotation(m: Array, name: str, src: str, row: int) -> Array:
     err = float(np.max(np.abs(m @ m.T - np.eye(3))))
     if err > _ROTATION_TOL or np.linalg.det(m) <= 0:
@@ -145,7 +154,7 @@ def read_pix4d(path: str | Path) -> Tuple[Pix4dImage, ...]:
     while j < len(lines):
         row, tokens = lines[j]
         if not _is_name_line(tokens):
-            if images:  # after the header, every line belongs to an image's block
+            if images or _numeric(tokens):  # the header is text; then only image blocks
                 raise InputError(f"expected 'name width height', got {' '.join(tokens)!r}",
                                  path=src, row=row)  # fmt: skip
             j += 1

@@ -187,6 +187,9 @@ def test_bad_input_is_named(tmp_path: Path) -> None:
     images = read_pix4d(path)
     with pytest.raises(InputError, match="PIXEL_ORIGIN"):
         block_from_pix4d(images, np.zeros(3), "", 0.004, "middle")
+    # a first image whose name is a number is not taken for the header
+    msg = broken(lambda ls: ls.__setitem__(first, "0000 5472 3648"))
+    assert f"row {first + 1}" in msg and "expected 'name width height'" in msg
     path.write_text("hello\nworld\n", encoding="utf-8")
     with pytest.raises(InputError, match="no image block"):
         read_pix4d(path)
