@@ -33,3 +33,9 @@ COLMAP_MODELS: Dict[int, Tuple[str, Tuple[str, ...]]] = {
          ("fx", "fy", "cx", "cy", "k0", "k1", "k2", "k3", "k4", "k5", "p0", "p1", "s0", "s1",
           "s2", "s3")),
 }  # fmt: skip
+
+#: Where the Pix4D import puts the centre of the top-left pixel in Pix4D's K: ``corner``
+#: (the pixel coordinates start at the image's top-left corner, the first pixel's centre at
+#: (0.5, 0.5): the project's convention) or ``centre`` (the first pixel's centre at (0, 0),
+#: OpenCV's). Pix4D's documentation found does not state it (docs/formats.md, Pix4D).
+PIX4D_PIXEL_ORIGINS = ("corner", "centre")

@@ -130,6 +130,8 @@ WORKFLOWS: tuple[Workflow, ...] = (
              "OUTPUT_OBSERVATIONS, OUTPUT_POINTS")),
             ("orthorectify", _t("CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
              "OUTPUT_FOLDER = one orthophoto per image")),
+            ("exportopensfm", _t("CAMERA, EO (e.g. adjusted by bundleadjustment), "
+             "OBSERVATIONS and POINTS; OUTPUT_FOLDER = the reconstruction.json for OpenSfM / ODM")),
         ),
     ),
     Workflow(
@@ -154,6 +156,16 @@ WORKFLOWS: tuple[Workflow, ...] = (
             ("autoboresight", _t("IMAGES, CAMERA, TRAJECTORY, LINES, PLANES and CLOUD, "
              "TIE_POINTS; OUTPUT_TABLE = boresight per group, OUTPUT_OBSERVATIONS = the "
              "observations found")),
+        ),
+    ),
+    Workflow(
+        _t("A Pix4D block: orthophotos on the LiDAR DSM"),
+        (
+            ("importpix4d", _t("INPUT = <project>_calibrated_camera_parameters.txt (Pix4D's "
+             "1_initial/params, its offset beside it); CRS = the project's output CRS (empty: "
+             "its _wkt.prj); OUTPUT_CAMERA, OUTPUT_EO")),
+            ("orthorectify", _t("CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
+             "OUTPUT_FOLDER = one orthophoto per image")),
         ),
     ),
     Workflow(

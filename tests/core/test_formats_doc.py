@@ -58,8 +58,8 @@ def test_every_section_has_an_example_or_says_why_not():
 @pytest.mark.parametrize("example", EXAMPLES, ids=_id)
 def test_example_is_read_by_its_reader_and_matches_its_columns(example, tmp_path):
     title, lang, tags, content = example
-    assert lang in ("csv", "json", "xml"), title
-    path = tmp_path / f"example.{lang}"
+    assert lang in ("csv", "json", "xml", "text"), title
+    path = tmp_path / f"example.{'txt' if lang == 'text' else lang}"
     path.write_text(content, encoding="utf-8")
     if "columns" in tags:
         expected = tuple(_resolve(tags["columns"]))
