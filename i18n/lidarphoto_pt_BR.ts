@@ -119,6 +119,10 @@
             <translation>Calibração de boresight sem medições manuais (automática)</translation>
         </message>
         <message>
+            <source>A Pix4D block: orthophotos on the LiDAR DSM</source>
+            <translation>Um bloco do Pix4D: ortofotos sobre o MDS LiDAR</translation>
+        </message>
+        <message>
             <source>Boresight calibration from an SBET (or ASCII export) and the camera events</source>
             <translation>Calibração de boresight a partir de um SBET (ou exportação ASCII) e dos eventos da câmera</translation>
         </message>
@@ -227,6 +231,10 @@
             <translation>INPUT = o reconstruction.json (ODM: opensfm/); CRS = o CRS de mapeamento (vazio: topocêntrico, LOCAL); OUTPUT_CAMERA, OUTPUT_EO, OUTPUT_OBSERVATIONS, OUTPUT_POINTS</translation>
         </message>
         <message>
+            <source>CAMERA, EO (e.g. adjusted by bundleadjustment), OBSERVATIONS and POINTS; OUTPUT_FOLDER = the reconstruction.json for OpenSfM / ODM</source>
+            <translation>CAMERA, EO (p. ex. ajustada por bundleadjustment), OBSERVATIONS e POINTS; OUTPUT_FOLDER = o reconstruction.json para OpenSfM / ODM</translation>
+        </message>
+        <message>
             <source>INPUT = the camera XML (Export Cameras, Agisoft XML); CRS = the mapping CRS (empty: the chunk's projected CRS); OUTPUT_CAMERA, OUTPUT_EO</source>
             <translation>INPUT = o XML de câmeras (Export Cameras, Agisoft XML); CRS = o SRC de mapeamento (vazio: o SRC projetado do chunk); OUTPUT_CAMERA, OUTPUT_EO</translation>
         </message>
@@ -241,6 +249,10 @@
         <message>
             <source>IMAGES, CAMERA, TRAJECTORY, LINES, PLANES and CLOUD, TIE_POINTS; OUTPUT_TABLE = boresight per group, OUTPUT_OBSERVATIONS = the observations found</source>
             <translation>IMAGES, CAMERA, TRAJECTORY, LINES, PLANES e CLOUD, TIE_POINTS; OUTPUT_TABLE = boresight por grupo, OUTPUT_OBSERVATIONS = as observações encontradas</translation>
+        </message>
+        <message>
+            <source>INPUT = &lt;project&gt;_calibrated_camera_parameters.txt (Pix4D's 1_initial/params, its offset beside it); CRS = the project's output CRS (empty: its _wkt.prj); OUTPUT_CAMERA, OUTPUT_EO</source>
+            <translation>INPUT = &lt;project&gt;_calibrated_camera_parameters.txt (1_initial/params do Pix4D, com seu offset ao lado); CRS = o SRC de saída do projeto (vazio: seu _wkt.prj); OUTPUT_CAMERA, OUTPUT_EO</translation>
         </message>
         <message>
             <source>INPUT = the SBET, POSPac / Inertial Explorer export or CSV; EVENTS = image_id, time; OUTPUT_TRAJECTORY = the trajectory table at the events, OUTPUT_EO = the exterior orientation</source>
@@ -4966,6 +4978,95 @@ p. ex. a OUTPUT_POINTS do importcolmap) que compartilham o seu point_id; os dema
         </message>
     </context>
     <context>
+        <name>lidarphoto:exportopensfm</name>
+        <message>
+            <source>Export OpenSfM reconstruction</source>
+            <translation>Exportar reconstrução OpenSfM</translation>
+        </message>
+        <message>
+            <source>Aerotriangulation</source>
+            <translation>Aerotriangulação</translation>
+        </message>
+        <message>
+            <source>Cameras + exterior orientation (+ observations, points) -&gt; OpenSfM reconstruction</source>
+            <translation>Câmeras + orientação exterior (+ observações, pontos) -&gt; reconstrução OpenSfM</translation>
+        </message>
+        <message>
+            <source>Writes reconstruction.json (and tracks.csv with OBSERVATIONS and POINTS) in OUTPUT_FOLDER, so
+a block oriented or calibrated here continues in OpenSfM or ODM. Cameras are written exactly,
+with the simplest OpenSfM type that holds them: perspective (centred, square, k1 k2), brown
+(k1 k2 k3 p1 p2, focal_x/y, c_x/y) for the opencv lenses, fisheye or fisheye_opencv for the
+equidistant projection with opencv_fisheye; their coefficients renormalised exactly to the
+current focal length. A correction lens model (brown_conrady and the other photogrammetric
+ones), metashape, thin_prism_fisheye and a rational opencv_full have no exact OpenSfM camera
+and are refused by name (docs/formats.md, OpenSfM export).</source>
+            <translation>Escreve reconstruction.json (e tracks.csv com OBSERVATIONS e POINTS) em OUTPUT_FOLDER, para que
+um bloco orientado ou calibrado aqui continue no OpenSfM ou no ODM. As câmeras são escritas
+exatamente, com o tipo OpenSfM mais simples que as representa: perspective (centrada, quadrada,
+k1 k2), brown (k1 k2 k3 p1 p2, focal_x/y, c_x/y) para as lentes opencv, fisheye ou fisheye_opencv
+para a projeção equidistante com opencv_fisheye; seus coeficientes renormalizados exatamente para
+a distância focal atual. Um modelo de lente de correção (brown_conrady e os demais
+fotogramétricos), metashape, thin_prism_fisheye e um opencv_full racional não têm câmera OpenSfM
+exata e são recusados pelo nome (docs/formats.md, exportação OpenSfM).</translation>
+        </message>
+        <message>
+            <source>Shots are OpenSfM's world-to-camera axis-angle rotation and translation. With CRS (the
+EO's and the points' projected CRS) they are written in OpenSfM's topocentric frame (east,
+north, up at reference_lla, the mean of the centres), the rotations turned from the grid
+frame through ECEF; without CRS as they are (LOCAL, no reference_lla).
+OBSERVATIONS of the POINTS (same point_id) become tracks.csv.</source>
+            <translation>As tomadas (shots) são a rotação eixo-ângulo mundo-câmera e a translação do OpenSfM. Com CRS (o
+SRC projetado da OE e dos pontos) são escritas no referencial topocêntrico do OpenSfM (leste,
+norte, acima em reference_lla, a média dos centros), as rotações levadas do referencial da
+quadrícula através do ECEF; sem CRS, como estão (LOCAL, sem reference_lla).
+As OBSERVATIONS dos POINTS (mesmo point_id) tornam-se tracks.csv.</translation>
+        </message>
+        <message>
+            <source>Camera(s) (JSON)</source>
+            <translation>Câmera(s) (JSON)</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>Exterior orientation table (CSV)</source>
+            <translation>Tabela de orientação exterior (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv *.txt)</source>
+            <translation>Arquivos CSV (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <source>Observations (CSV)</source>
+            <translation>Observações (CSV)</translation>
+        </message>
+        <message>
+            <source>3D points (ground point table, CSV)</source>
+            <translation>Pontos 3D (tabela de pontos de apoio, CSV)</translation>
+        </message>
+        <message>
+            <source>CRS of the EO</source>
+            <translation>SRC da OE</translation>
+        </message>
+        <message>
+            <source>the projected CRS of the EO and points (written topocentric with reference_lla); empty: LOCAL, written as they are</source>
+            <translation>o SRC projetado da OE e dos pontos (escritos topocêntricos com reference_lla); vazio: LOCAL, escritos como estão</translation>
+        </message>
+        <message>
+            <source>Output folder (reconstruction.json)</source>
+            <translation>Pasta de saída (reconstruction.json)</translation>
+        </message>
+        <message>
+            <source>Number of images</source>
+            <translation>Número de imagens</translation>
+        </message>
+        <message>
+            <source>Number of 3D points</source>
+            <translation>Número de pontos 3D</translation>
+        </message>
+    </context>
+    <context>
         <name>lidarphoto:extractroofplanes</name>
         <message>
             <source>Extract roof planes</source>
@@ -5933,6 +6034,147 @@ pontos de apoio com papel check (pontos de ligação triangulados, nunca control
         <message>
             <source>Number of shots</source>
             <translation>Número de tomadas</translation>
+        </message>
+        <message>
+            <source>Number of cameras</source>
+            <translation>Número de câmeras</translation>
+        </message>
+        <message>
+            <source>Number of 3D points</source>
+            <translation>Número de pontos 3D</translation>
+        </message>
+    </context>
+    <context>
+        <name>lidarphoto:importpix4d</name>
+        <message>
+            <source>Import Pix4D calibrated cameras</source>
+            <translation>Importar câmeras calibradas do Pix4D</translation>
+        </message>
+        <message>
+            <source>Aerotriangulation</source>
+            <translation>Aerotriangulação</translation>
+        </message>
+        <message>
+            <source>Pix4D calibrated_camera_parameters.txt -&gt; cameras (exact lens model), orientations</source>
+            <translation>calibrated_camera_parameters.txt do Pix4D -&gt; câmeras (modelo de lente exato), orientações</translation>
+        </message>
+        <message>
+            <source>Reads the file PIX4Dmapper writes in 1_initial/params, &lt;project&gt;_calibrated_camera_parameters.txt
+(per image: K, radial R1 R2 R3, tangential T1 T2, position t and rotation R, with
+m = K [R | -R t] X on the coordinates minus &lt;project&gt;_offset.xyz), and writes the project's
+camera JSON and exterior orientation with the lens converted exactly: the forward OpenCV
+model with Pix4D's coefficients (k1..k3 = R1..R3, p1 = T1, p2 = T2; docs/formats.md, Pix4D).
+Images with the same K and coefficients share a camera. A K with skew is refused by name.</source>
+            <translation>Lê o arquivo que o PIX4Dmapper escreve em 1_initial/params, &lt;project&gt;_calibrated_camera_parameters.txt
+(por imagem: K, radiais R1 R2 R3, tangenciais T1 T2, posição t e rotação R, com
+m = K [R | -R t] X sobre as coordenadas menos &lt;project&gt;_offset.xyz), e escreve o JSON de câmera e
+a orientação exterior do projeto com a lente convertida exatamente: o modelo OpenCV direto com os
+coeficientes do Pix4D (k1..k3 = R1..R3, p1 = T1, p2 = T2; docs/formats.md, Pix4D).
+Imagens com o mesmo K e coeficientes compartilham uma câmera. Um K com cisalhamento é recusado pelo nome.</translation>
+        </message>
+        <message>
+            <source>## Assumptions
+Pix4D's documentation found does not state the pixel origin of K nor show the distortion
+formula in the y-down frame of this file: the tangential terms are read as OpenCV's in that
+frame, and PIXEL_ORIGIN says whether K's pixels start at the image's corner (default) or at
+the centre of the first pixel.</source>
+            <translation>## Suposições
+A documentação do Pix4D encontrada não declara a origem dos pixels de K nem mostra a fórmula de
+distorção no referencial com y para baixo deste arquivo: os termos tangenciais são lidos como os
+do OpenCV nesse referencial, e PIXEL_ORIGIN diz se os pixels de K começam no canto da imagem
+(padrão) ou no centro do primeiro pixel.</translation>
+        </message>
+        <message>
+            <source>## Frame
+OFFSET: the &lt;project&gt;_offset.xyz (empty: the one beside INPUT; none found: no offset, said in
+the log). CRS: the output CRS Pix4D used (empty: the &lt;project&gt;_wkt.prj beside INPUT when there
+is one, else LOCAL); the coordinates are its easting, northing and height.</source>
+            <translation>## Referencial
+OFFSET: o &lt;project&gt;_offset.xyz (vazio: o que está ao lado de INPUT; nenhum encontrado: sem
+offset, dito no log). CRS: o SRC de saída que o Pix4D usou (vazio: o &lt;project&gt;_wkt.prj ao lado
+de INPUT quando existe, senão LOCAL); as coordenadas são seus E, N e altura.</translation>
+        </message>
+        <message>
+            <source>## Outputs
+OUTPUT_CAMERA: the cameras (pix4d_1, pix4d_2, ...); OUTPUT_EO: one row per image (image_id =
+the image's file name as Pix4D writes it; with a camera column when there are several). The
+file has no tie points.</source>
+            <translation>## Saídas
+OUTPUT_CAMERA: as câmeras (pix4d_1, pix4d_2, ...); OUTPUT_EO: uma linha por imagem (image_id =
+o nome de arquivo da imagem como o Pix4D o escreve; com uma coluna camera quando há várias). O
+arquivo não tem pontos de enlace.</translation>
+        </message>
+        <message>
+            <source>Pix4D calibrated camera parameters (TXT)</source>
+            <translation>Parâmetros calibrados de câmera do Pix4D (TXT)</translation>
+        </message>
+        <message>
+            <source>Pix4D calibrated cameras (*_calibrated_camera_parameters.txt);;All files (*)</source>
+            <translation>Câmeras calibradas do Pix4D (*_calibrated_camera_parameters.txt);;Todos os arquivos (*)</translation>
+        </message>
+        <message>
+            <source>Pix4D offset (XYZ)</source>
+            <translation>Offset do Pix4D (XYZ)</translation>
+        </message>
+        <message>
+            <source>empty: &lt;project&gt;_offset.xyz beside INPUT</source>
+            <translation>vazio: &lt;project&gt;_offset.xyz ao lado de INPUT</translation>
+        </message>
+        <message>
+            <source>Pix4D offset (*_offset.xyz);;All files (*)</source>
+            <translation>Offset do Pix4D (*_offset.xyz);;Todos os arquivos (*)</translation>
+        </message>
+        <message>
+            <source>Output CRS of the Pix4D project</source>
+            <translation>SRC de saída do projeto Pix4D</translation>
+        </message>
+        <message>
+            <source>empty: &lt;project&gt;_wkt.prj beside INPUT, else LOCAL</source>
+            <translation>vazio: &lt;project&gt;_wkt.prj ao lado de INPUT, senão LOCAL</translation>
+        </message>
+        <message>
+            <source>Pixel size</source>
+            <translation>Tamanho do pixel</translation>
+        </message>
+        <message>
+            <source>the file states none: it sets the millimetres of the camera, never the projection</source>
+            <translation>o arquivo não declara nenhum: define os milímetros da câmera, nunca a projeção</translation>
+        </message>
+        <message>
+            <source>Pixel origin of K</source>
+            <translation>Origem dos pixels de K</translation>
+        </message>
+        <message>
+            <source>corner: K's pixel coordinates start at the image's top-left corner; centre: the first pixel's centre is (0, 0)</source>
+            <translation>corner: as coordenadas de pixel de K começam no canto superior esquerdo da imagem; centre: o centro do primeiro pixel é (0, 0)</translation>
+        </message>
+        <message>
+            <source>Cameras (JSON)</source>
+            <translation>Câmeras (JSON)</translation>
+        </message>
+        <message>
+            <source>JSON files (*.json)</source>
+            <translation>Arquivos JSON (*.json)</translation>
+        </message>
+        <message>
+            <source>Exterior orientation table (CSV)</source>
+            <translation>Tabela de orientação exterior (CSV)</translation>
+        </message>
+        <message>
+            <source>CSV files (*.csv)</source>
+            <translation>Arquivos CSV (*.csv)</translation>
+        </message>
+        <message>
+            <source>Observations (tie points, CSV)</source>
+            <translation>Observações (pontos de ligação, CSV)</translation>
+        </message>
+        <message>
+            <source>3D points (ground point table, CSV)</source>
+            <translation>Pontos 3D (tabela de pontos de apoio, CSV)</translation>
+        </message>
+        <message>
+            <source>Number of imported images</source>
+            <translation>Número de imagens importadas</translation>
         </message>
         <message>
             <source>Number of cameras</source>

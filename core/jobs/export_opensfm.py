@@ -31,7 +31,7 @@ OBSERVATIONS of the POINTS (same point_id) become tracks.csv.""",
     params=(
         Param("CAMERA", "file", "Camera(s) (JSON)", file_filter="JSON files (*.json)"),
         Param("EO", "table", "Exterior orientation table (CSV)", file_filter=CSV_FILTER),
-        Param("OBSERVATIONS", "file", "Observations (CSV)", optional=True, file_filter=CSV_FILTER),
+        Param("OBSERVATIONS", "table", "Observations (CSV)", optional=True, file_filter=CSV_FILTER),
         Param(
             "POINTS",
             "table",

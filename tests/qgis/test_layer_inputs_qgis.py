@@ -85,7 +85,7 @@ def test_every_layer_kind_is_a_layer_parameter(provider, tmp_path):
                 assert d.dataTypes() == [SOURCE_TABLE], p.name
     # the DSMs, the clouds of the LiDAR algorithms and every CSV table (points, planes, lines, EO,
     # image observations, trajectories, events, scale bars, stations, ground photos)
-    assert seen == {"raster": 0, "pointcloud": 5, "surface": 2, "table": 41}, seen
+    assert seen == {"raster": 0, "pointcloud": 5, "surface": 2, "table": 44}, seen
 
 
 def _checkpoints(path: Path) -> Path:
