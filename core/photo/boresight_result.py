@@ -343,8 +343,6 @@ def diagnose(parameters: Sequence[str], groups: Sequence[str] = ()) -> list[str]
     return out
 
 
-
-
 def require_timing_separable(share: float, body_velocity: Array) -> None:
     """Refuse a timing offset estimated with the lever arm when the body-frame velocity is
     (nearly) the same at every image (``share`` below :data:`TIMING_SEPARABILITY_MIN`):

@@ -181,14 +181,8 @@ def bundle_adjust(
         metres = setup.local.mapping.metres if isinstance(setup.local, EngineeringLocal) else 1.0
         setup.bars = setup_bars(scale_bars, setup.points, setup.check_ids, metres)
     if opts.estimate_timing:
-        assert eo is not None and setup.eo_obs is not None  # observed orientations: above
-        setup.velocity = _exposure_velocity(setup, eo, velocity, eo_source)
-        if opts.estimate_mount:
-            r_cl = np.swapaxes(opk_to_matrix(*setup.eo_obs[:, 3:].T), 1, 2)
-            trade = timing_trade(*timing_separability(setup.velocity, r_cl), TIMING_NAME,
-                                 LEVER_NAMES, "camera")  # fmt: skip
-            if trade is not None:
-                raise trade
+        assert eo is not None  # observed orientations: above
+        setup.velocity = _exposure_velocity(setup, eo, velocity, eo_source, opts.estimate_mount)
     dt0 = 0.0 if opts.estimate_timing else None
     cams = list(setup.cameras)
     free = []
@@ -258,10 +252,23 @@ def _carried(run: _Run) -> tuple[Array | None, float | None]:
     return mnt, (float(x[run.lay.timing]) if run.lay.timing >= 0 else None)
 
 
-def _exposure_velocity(setup, eo: ExteriorOrientationTable,
-                       velocity: ExposureVelocities | None, source: str) -> Array:  # fmt: skip
+def _exposure_velocity(setup, eo: ExteriorOrientationTable, velocity: ExposureVelocities | None,
+                       source: str, with_lever_arm: bool) -> Array:  # fmt: skip
     """(M, 3) velocities of the exposures in the adjustment frame, m/s: the EO table's, or
-    differenced from the observed centres of each group by the EO's time."""
+    differenced from the observed centres of each group by the EO's time; with the lever arm
+    estimated, a camera-frame velocity that is one at every image is refused, naming dt and
+    the lever-arm component it trades with."""
+    vel = _velocity_local(setup, eo, velocity, source)
+    if with_lever_arm:
+        r_cl = np.swapaxes(opk_to_matrix(*setup.eo_obs[:, 3:].T), 1, 2)
+        trade = timing_trade(*timing_separability(vel, r_cl), TIMING_NAME, LEVER_NAMES, "camera")
+        if trade is not None:
+            raise trade
+    return vel
+
+
+def _velocity_local(setup, eo: ExteriorOrientationTable, velocity: ExposureVelocities | None,
+                    source: str) -> Array:  # fmt: skip
     if velocity is not None:
         if velocity.values.shape != (len(eo), 3) or not np.isfinite(velocity.values).all():
             raise InputError("the exposure velocities must be finite, three per image",

@@ -5,8 +5,8 @@ of Lima, Debiasi & Menezes, with sigma0 and the AP counts); the adjustment (sigm
 global chi-square test, outlier method and rejections); the interior orientation and APs of
 every camera with sigmas, t-tests and the selection's decisions; the correlation heat map of
 the interior parameters (|r| above the limit framed); the lever arm and boresight corrections
-and the camera timing offset (ms, with its correlations) when estimated; per-image RMS of the residuals; the
-check points; the image-space residual vectors per camera (averaged per cell, to show
+and the camera timing offset (ms, with its correlations) when estimated; per-image RMS of the
+residuals; the check points; the image-space residual vectors per camera (averaged per cell, to show
 systematic patterns) and the residual histograms; warnings.
 """
 

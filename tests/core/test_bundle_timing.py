@@ -69,7 +69,7 @@ def _adjust(blk, observed, sigma, vel=None, ground=None, **kw):
 
 def _along_track(blk, res_xyz) -> float:
     """Mean (adjusted - true) centre along each image's flight direction, metres."""
-    observed, _, vel = _recorded(blk, (60.0,), 0)
+    vel = _recorded(blk, (60.0,), 0)[2]
     u = vel[:, :2] / np.linalg.norm(vel[:, :2], axis=1)[:, None]
     return float(np.mean(np.sum((res_xyz[:, :2] - blk.eo_true.xyz[:, :2]) * u, axis=1)))
 
