@@ -16,6 +16,7 @@ from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians
 from ..geometry.engineering import EngineeringLocal
 from ..geometry.rotations import opk_to_matrix
+from ..i18n import mark as _t
 from ..lsq.results import AdjustmentResult
 from .bundle_model import _cams_from, _eliminated, _Run
 from .bundle_selection import ap_decisions
@@ -393,6 +394,9 @@ def _finish(setup: _Setup, obs: ImageObservations, run: _Run, options: BundleOpt
     ]).astype(np.int64)  # fmt: skip
     role_arr = np.array(setup.roles + ("check",), dtype=object)
     obs_role = tuple(role_arr[np.where(setup.obs_check >= 0, len(setup.roles), setup.obs_pt)])
+    timing = _timing(run)
+    if timing is not None:
+        warnings = warnings + _timing_warnings(timing, options.max_correlation)
     return BundleResult(
         ap_model=options.ap_model,
         cameras={c.name: c for c in cams},
@@ -422,8 +426,24 @@ def _finish(setup: _Setup, obs: ImageObservations, run: _Run, options: BundleOpt
         local=setup.local,
         warnings=warnings + list(res.warnings),
         scale_bars=bar_result(setup.bars, res, lay.points) if setup.bars is not None else None,
-        timing=_timing(run),
+        timing=timing,
     )
+
+
+def _timing_warnings(timing: dict, limit: float) -> list[str]:
+    """A warning naming the parameters whose |correlation| with dt is above ``limit``."""
+    high = [(n, r) for n, r in timing["correlation"].items() if abs(r) > limit]
+    if not high:
+        return []
+    return [
+        _t(
+            "the camera timing offset dt is correlated with {names}: its sigma ({sigma:.2f} ms) "
+            "carries that trade-off (strips at different speeds, or held interior orientation "
+            "and lever arm, separate them better)",
+            names=", ".join(f"{n} ({r:+.3f})" for n, r in high),
+            sigma=1e3 * timing["dt_std_s"],
+        )
+    ]
 
 
 def _timing(run: _Run) -> dict | None:

@@ -170,3 +170,20 @@ def test_job_estimates_dt_and_reports_it(block, tmp_path):
     assert any("timing offset dt" in line for line in job.lines)
     plain = run_job(bundle_adjustment, base)
     assert np.isnan(plain.results["TIMING_OFFSET_MS"])
+
+
+def test_with_the_interior_estimated_dt_trades_with_the_principal_point_and_says_so(block):
+    """Strips of alternating direction at one speed: dt shifts the GNSS centres along track
+    in the camera frame, as a principal point off in y does; dt is still recovered within 3
+    sigma, its sigma grows, and the warning names y0."""
+    observed, sigma, vel = _recorded(block, (60.0,), seed=5)
+    res = bundle_adjust(
+        [block.camera], block.observations, block.ground, block.mapping, observed, sigma,
+        options=BundleOptions(**{**PLAIN, "estimate_interior": True, "estimate_timing": True}),
+        velocity=ExposureVelocities(vel, "map"),
+    )  # fmt: skip
+    t = res.timing
+    assert abs(t["dt_s"] - DT) < 3 * t["dt_std_s"], t
+    name = f"{block.camera.name} y0_mm"
+    assert abs(t["correlation"][name]) > 0.9
+    assert any("timing offset dt is correlated with" in w and name in w for w in res.warnings)
