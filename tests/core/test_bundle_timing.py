@@ -187,3 +187,48 @@ def test_with_the_interior_estimated_dt_trades_with_the_principal_point_and_says
     name = f"{block.camera.name} y0_mm"
     assert abs(t["correlation"][name]) > 0.9
     assert any("timing offset dt is correlated with" in w and name in w for w in res.warnings)
+
+
+def test_eo_velocity_columns_read_and_refused_by_name(tmp_path):
+    from lidarphoto.core.errors import InputError
+    from lidarphoto.core.io.orientation import read_eo_csv_full
+
+    head = "image_id,time,group,X,Y,Z,omega_deg,phi_deg,kappa_deg"
+    row = "I1,1.0,L1,500000,7450000,300,0,0,0"
+
+    def eo(cols: str, vals: str):
+        path = tmp_path / "eo.csv"
+        path.write_text(f"{head},{cols}\n{row},{vals}\n", encoding="utf-8")
+        return read_eo_csv_full(path)
+
+    v = eo("v_north,v_east,v_up", "10,50,2").velocity
+    assert v.frame == "ned" and np.allclose(v.values, [[10, 50, -2]])
+    v = eo("vx,vy,vz", "50,10,2").velocity
+    assert v.frame == "map" and np.allclose(v.values, [[50, 10, 2]])
+    assert _plain_eo(tmp_path, head, row).velocity is None
+    with pytest.raises(InputError, match="all three"):
+        eo("vx,vy", "50,10")
+    with pytest.raises(InputError, match="all three"):
+        eo("vx,vy,vz,v_north,v_east,v_up", "1,2,3,4,5,6")
+    with pytest.raises(InputError, match="m/s") as info:
+        eo("vx,vy,vz", "500,10,2")
+    assert info.value.row == 2
+
+
+def _plain_eo(folder, head: str, row: str):
+    from lidarphoto.core.io.orientation import read_eo_csv_full
+
+    path = folder / "plain.csv"
+    path.write_text(f"{head}\n{row}\n", encoding="utf-8")
+    return read_eo_csv_full(path)
+
+
+def test_timing_needs_observed_orientations_and_velocities_or_times(block):
+    from lidarphoto.core.errors import InputError
+
+    observed, sigma, _ = _recorded(block, (60.0,), seed=3)
+    with pytest.raises(InputError, match="needs observed orientations"):
+        _adjust(block, observed, None, estimate_timing=True)
+    untimed = replace(observed, time=np.full(len(observed), np.nan))
+    with pytest.raises(InputError, match="velocity columns"):
+        _adjust(block, untimed, sigma, estimate_timing=True)
