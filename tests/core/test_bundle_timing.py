@@ -232,3 +232,30 @@ def test_timing_needs_observed_orientations_and_velocities_or_times(block):
     untimed = replace(observed, time=np.full(len(observed), np.nan))
     with pytest.raises(InputError, match="velocity columns"):
         _adjust(block, untimed, sigma, estimate_timing=True)
+
+
+@pytest.mark.parametrize("mount", [True, False])
+def test_observed_orientation_model_with_dt_jacobian(mount):
+    """The analytic Jacobian of the observed-orientation model with dt (with and without the
+    lever arm and boresight) against central differences; dt moves the centre by -v dt."""
+    from lidarphoto.core.photo.bundle_model import _ObservedEOModel
+
+    rng = np.random.default_rng(1)
+    g = 5
+    cols = [rng.normal(0, 10, (g, 3)), rng.normal(0, 0.05, (g, 2)), rng.uniform(-3, 3, (g, 1))]
+    if mount:
+        cols += [rng.normal(0, 0.3, (g, 3)), rng.normal(0, 0.01, (g, 3))]
+    xl = np.column_stack([*cols, np.full(g, 0.02)])
+    vel = rng.normal(0, 50, (g, 3))
+    model = _ObservedEOModel(np.zeros((g, 6)), mount, vel)
+    f, J = model(xl)
+    assert J.shape == (g, 6, xl.shape[1])
+    for j in range(xl.shape[1]):
+        p, q = xl.copy(), xl.copy()
+        p[:, j] += 1e-7
+        q[:, j] -= 1e-7
+        num = (model(p)[0] - model(q)[0]) / 2e-7
+        assert np.abs(num - J[:, :, j]).max() < 1e-5, j
+    still = xl.copy()
+    still[:, -1] = 0.0
+    assert np.allclose(model(still)[0][:, :3] - f[:, :3], 0.02 * vel)
