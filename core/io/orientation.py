@@ -192,7 +192,7 @@ _MAP_VELOCITY = (("vx", "v_x"), ("vy", "v_y"), ("vz", "v_z"))
 def _velocity(table: Table) -> ExposureVelocities | None:
     """The exposures' velocities of the module docstring, or None; a partial set, both sets
     or an implausible speed refused with the file (and row)."""
-    from .trajectory import MAX_SPEED_MPS, velocity_columns
+    from .trajectory import check_speeds, velocity_columns
 
     ned = velocity_columns(table)
     cols = [find_column(table, a, required=False) for a in _MAP_VELOCITY]
@@ -203,13 +203,7 @@ def _velocity(table: Table) -> ExposureVelocities | None:
         raise InputError("give the velocities as v_north, v_east, v_up or as vx, vy, vz (all "
                          "three of one set)", path=table.path)  # fmt: skip
     vel = np.column_stack([float_column(table, c) for c in given])
-    fast = np.flatnonzero(np.linalg.norm(vel, axis=1) > MAX_SPEED_MPS)
-    if fast.size:
-        raise InputError(
-            f"a speed of {np.linalg.norm(vel[fast[0]]):.4g} m/s is beyond the plausible "
-            f"{MAX_SPEED_MPS:g} m/s of a sensor (velocities in another unit?)",
-            path=table.path, row=table.line_numbers[fast[0]], column=table.columns[given[0]],
-        )  # fmt: skip
+    check_speeds(table, vel, given[0])
     return ExposureVelocities(vel, "map")
 
 
