@@ -200,12 +200,12 @@ with the file and row named.""",
             "boolean",
             "Estimate the camera timing offset",
             _OPTIONS.estimate_timing,
+            help="observed orientations taken at the recorded time, the exposure at recorded "
+            "time + dt: one constant dt from the EO table's velocities (v_north, v_east, v_up "
+            "or vx, vy, vz) or differenced from neighbouring exposures of each group by time; "
+            "needs strips in different directions or at different speeds (or ground control); "
+            "with the lever arm, different speeds",
             advanced=True,
-            help="a constant dt (exposure = recorded time + dt) between the observed "
-            "orientations and the exposures, from the EO table's velocities (v_north, v_east, "
-            "v_up or vx, vy, vz) or differenced from neighbouring exposures of each group by "
-            "time; needs observed orientations and strips in different directions or at "
-            "different speeds (or ground control); with the lever arm, different speeds",
         ),
         Param("OUTPUT_EO", "file_out", "Adjusted exterior orientation (CSV)", file_filter=CSV_OUT),
         Param(
