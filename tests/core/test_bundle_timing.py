@@ -259,3 +259,17 @@ def test_observed_orientation_model_with_dt_jacobian(mount):
     still = xl.copy()
     still[:, -1] = 0.0
     assert np.allclose(model(still)[0][:, :3] - f[:, :3], 0.02 * vel)
+
+
+def test_default_pipeline_carries_dt_through_the_ap_selection(block):
+    """Robust reweighting, data snooping and the AP selection (Brown's 14 terms on a lens
+    without distortion: most are dropped, each drop a new adjustment) keep dt."""
+    observed, sigma, vel = _recorded(block, (60.0, 45.0), seed=4)
+    res = bundle_adjust(
+        [block.true_camera], block.observations, block.ground, block.mapping, observed, sigma,
+        options=BundleOptions(ap_model="brown", estimate_interior=False, estimate_timing=True),
+        velocity=ExposureVelocities(vel, "map"),
+    )  # fmt: skip
+    assert res.dropped  # the selection re-adjusted
+    t = res.timing
+    assert abs(t["dt_s"] - DT) < 3 * t["dt_std_s"], t
