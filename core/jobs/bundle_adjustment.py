@@ -53,6 +53,14 @@ observed when the table has sigma columns (GNSS/INS with sigmas; lever arm and b
 corrections can be estimated). Without orientations the images that see four or more control
 points are resected and the rest of the block grows by intersection and resection.
 
+Camera timing offset (ESTIMATE_TIMING): with observed orientations, a constant dt (exposure =
+recorded time + dt) as one more unknown, the observed centres being the GNSS/INS positions at
+the recorded times; the velocity of each exposure from the EO table (v_north, v_east, v_up or
+vx, vy, vz) or differenced from the neighbouring exposures of its group. It needs strips in
+different directions or at different speeds, or ground control; estimated with the lever arm,
+strips at one speed are refused as not observable, naming both. dt in ms with its sigma and
+correlations: the results TIMING_OFFSET_MS and TIMING_OFFSET_STD_MS, the log and the summary.
+
 Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
 and |correlation| above 0.9 flagged; automatic selection drops insignificant APs one at a
 time (an AP correlated with others is dropped only when a joint F-test finds them
