@@ -17,7 +17,17 @@ all six or none (the bundle adjustment writes them for its adjusted orientations
     sigma_omega_deg,sigma_phi_deg,sigma_kappa_deg    degrees (aliases s_omega_deg, ...)
 
 and an optional ``camera`` column names the camera of each image (blocks with several
-cameras). Tables without these columns are read as before.
+cameras). The velocity of each exposure (m/s; the bundle adjustment's camera timing offset)
+may be given, three columns or none, either local level at the image (true north, as the
+trajectory table and ``importtrajectory`` write it)::
+
+    v_north, v_east, v_up (or v_down)      aliases as in :mod:`.trajectory`
+
+or along the mapping CRS's axes (d easting / dt, d northing / dt, d height / dt)::
+
+    vx, vy, vz                             aliases v_x, v_y, v_z
+
+Tables without these columns are read as before.
 """
 
 from __future__ import annotations
@@ -34,6 +44,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..photo.orientation import ExteriorOrientationTable
+from ..photo.timing import ExposureVelocities
 from .tables import (
     Table,
     find_column,
@@ -69,6 +80,7 @@ class EoFile:
     camera: tuple[str, ...] | None
     rows: tuple[int, ...]
     path: str
+    velocity: ExposureVelocities | None = None
 
 
 def _eo_rows(eo: ExteriorOrientationTable) -> Iterator[tuple[str, ...]]:
@@ -171,7 +183,28 @@ def read_eo_csv_full(path: Union[str, Path], crs_wkt: str = "") -> EoFile:
             sigma[:, 3:] = np.radians(sigma[:, 3:])
     c_col = find_column(table, ("camera", "camera_id", "camera_name"), required=False)
     camera = None if c_col is None else text_column(table, c_col)
-    return EoFile(eo, sigma, camera, table.line_numbers, table.path)
+    return EoFile(eo, sigma, camera, table.line_numbers, table.path, _velocity(table))
+
+
+_MAP_VELOCITY = (("vx", "v_x"), ("vy", "v_y"), ("vz", "v_z"))
+
+
+def _velocity(table: Table) -> ExposureVelocities | None:
+    """The exposures' velocities of the module docstring, or None; a partial set, both sets
+    or an implausible speed refused with the file (and row)."""
+    from .trajectory import check_speeds, velocity_columns
+
+    ned = velocity_columns(table)
+    cols = [find_column(table, a, required=False) for a in _MAP_VELOCITY]
+    given = [c for c in cols if c is not None]
+    if not given:
+        return None if ned is None else ExposureVelocities(ned, "ned")
+    if ned is not None or len(given) < 3:
+        raise InputError("give the velocities as v_north, v_east, v_up or as vx, vy, vz (all "
+                         "three of one set)", path=table.path)  # fmt: skip
+    vel = np.column_stack([float_column(table, c) for c in given])
+    check_speeds(table, vel, given[0])
+    return ExposureVelocities(vel, "map")
 
 
 def write_eo_csv_with_sigmas(

@@ -110,14 +110,20 @@ def velocity_columns(table: Table) -> Array | None:
         assert vd is not None  # refused above
         down = float_column(table, vd)
     vel = np.stack([float_column(table, vn), float_column(table, ve), down], axis=1)
+    check_speeds(table, vel, vn)
+    return vel
+
+
+def check_speeds(table: Table, vel: Array, column: int) -> None:
+    """Refuse a speed (|vel| of a row, m/s) beyond :data:`MAX_SPEED_MPS`, naming the row and
+    ``column`` (the first velocity column)."""
     fast = np.flatnonzero(np.linalg.norm(vel, axis=1) > MAX_SPEED_MPS)
     if fast.size:
         raise InputError(
             f"a speed of {np.linalg.norm(vel[fast[0]]):.4g} m/s is beyond the plausible "
             f"{MAX_SPEED_MPS:g} m/s of a sensor (velocities in another unit?)",
-            path=table.path, row=table.line_numbers[fast[0]], column=table.columns[vn],
+            path=table.path, row=table.line_numbers[fast[0]], column=table.columns[column],
         )  # fmt: skip
-    return vel
 
 
 def _check_range(table, column: int, values: Array, limit: float) -> None:

@@ -53,6 +53,14 @@ observed when the table has sigma columns (GNSS/INS with sigmas; lever arm and b
 corrections can be estimated). Without orientations the images that see four or more control
 points are resected and the rest of the block grows by intersection and resection.
 
+Camera timing offset (ESTIMATE_TIMING): with observed orientations, a constant dt (exposure =
+recorded time + dt) as one more unknown, the observed centres being the GNSS/INS positions at
+the recorded times; the velocity of each exposure from the EO table (v_north, v_east, v_up or
+vx, vy, vz) or differenced from the neighbouring exposures of its group. It needs strips in
+different directions or at different speeds, or ground control; estimated with the lever arm,
+strips at one speed are refused as not observable, naming both. dt in ms with its sigma and
+correlations: the results TIMING_OFFSET_MS and TIMING_OFFSET_STD_MS, the log and the summary.
+
 Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
 and |correlation| above 0.9 flagged; automatic selection drops insignificant APs one at a
 time (an AP correlated with others is dropped only when a joint F-test finds them
@@ -195,6 +203,18 @@ with the file and row named.""",
             advanced=True,
             help="needs observed exterior orientations",
         ),
+        Param(
+            "ESTIMATE_TIMING",
+            "boolean",
+            "Estimate the camera timing offset",
+            _OPTIONS.estimate_timing,
+            help="observed orientations taken at the recorded time, the exposure at recorded "
+            "time + dt: one constant dt from the EO table's velocities (v_north, v_east, v_up "
+            "or vx, vy, vz) or differenced from neighbouring exposures of each group by time; "
+            "needs strips in different directions or at different speeds (or ground control); "
+            "with the lever arm, different speeds",
+            advanced=True,
+        ),
         Param("OUTPUT_EO", "file_out", "Adjusted exterior orientation (CSV)", file_filter=CSV_OUT),
         Param(
             "OUTPUT_CAMERA",
@@ -254,6 +274,8 @@ with the file and row named.""",
         Result("SIGMA0", "number", "Sigma0 a-posteriori"),
         Result("CHECK_RMS", "number", "Check-point RMS 3D (frame unit)"),
         Result("MODEL", "string", "AP model of the outputs"),
+        Result("TIMING_OFFSET_MS", "number", "Camera timing offset dt (ms, NaN if not estimated)"),
+        Result("TIMING_OFFSET_STD_MS", "number", "Sigma of the timing offset (ms)"),
     ),
     tags=(
         "bundle adjustment",
@@ -291,7 +313,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..photo.bundle_setup import BundleOptions
     from .runner import stages
 
-    frame, cams, obs, ground, eo, sigma, eo_rows, eo_source, image_camera, bars = _read_inputs(v)
+    frame, cams, obs, ground, eo, sigma, eo_rows, eo_source, image_camera, bars, velocity = (
+        _read_inputs(v)
+    )
     models = tuple(m for m in AP_FAMILIES) if v.ap_model == "all" else (v.ap_model,)
     parts = stages(progress, *([1.0] * len(models)))
     stage = dict(zip(models, parts))
@@ -302,7 +326,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         try:
             return bundle_adjust(cams, obs, ground, frame, eo, sigma, image_camera, opts,
                                  eo_rows, eo_source, stage[model], should_stop,
-                                 scale_bars=bars)  # fmt: skip
+                                 scale_bars=bars, velocity=velocity)  # fmt: skip
         except AdjustmentError as exc:
             if eo is not None:  # an approximate orientation far off is the usual cause
                 _blame_eo(exc, cams, obs, ground, eo, image_camera, eo_rows, eo_source)
@@ -320,7 +344,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             )
     best = str(next(r["model"] for r in rows if r["model"] in results))
     res = results[best]
-    settings = _settings(v, cams, obs, ground, eo, sigma, frame)
+    settings = _settings(v, cams, obs, ground, eo, sigma, frame, velocity)
     _write_outputs(out, results, best, rows, settings, multi=len(cams) > 1,
                    compared=len(models) > 1)  # fmt: skip
     st = res.check.statistics()
@@ -329,17 +353,28 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             "SIGMA0": float(res.adjustment.sigma0),
             "CHECK_RMS": float(st["rms_3d"]) if math.isfinite(st["rms_3d"]) else float("nan"),
             "MODEL": best,
+            **_timing_results(res),
         },
         lines=_summary_lines(res, best, rows if len(models) > 1 else ()),
         data=res,
     )
 
 
+def _timing_results(res) -> dict[str, float]:
+    """TIMING_OFFSET_MS and TIMING_OFFSET_STD_MS (NaN when the offset is not estimated)."""
+    t = res.timing
+    nan = float("nan")
+    return {
+        "TIMING_OFFSET_MS": nan if t is None else 1e3 * t["dt_s"],
+        "TIMING_OFFSET_STD_MS": nan if t is None else 1e3 * t["dt_std_s"],
+    }
+
+
 def _read_inputs(v: Values) -> tuple:
     """The frame, cameras, observations and ground points, and the approximate orientations
     with their sigmas (EO_SIGMAS when the file has none) and the camera of every image, all
-    checked, and the scale bars: (frame, cameras, observations, ground, eo, sigma, eo_rows,
-    eo_source, image_camera, bars)."""
+    checked, the scale bars and the EO's velocities: (frame, cameras, observations, ground,
+    eo, sigma, eo_rows, eo_source, image_camera, bars, velocity)."""
     import numpy as np
 
     from ..errors import InputError
@@ -360,13 +395,13 @@ def _read_inputs(v: Values) -> tuple:
     if len(ground) and crs is not None:
         check_area_of_use(crs, ground.xyz.min(axis=0), ground.xyz.max(axis=0),
                           what="the ground points", path=v.ground_points)  # fmt: skip
-    eo = sigma = None
+    eo = sigma = velocity = None
     eo_rows: tuple[int, ...] = ()
     eo_source = ""
     image_camera: dict[str, str] = {}
     if v.eo:
         f = read_eo_csv_full(v.eo, crs.to_wkt() if crs is not None else "")
-        eo, sigma, eo_rows, eo_source = f.eo, f.sigma, f.rows, f.path
+        eo, sigma, eo_rows, eo_source, velocity = f.eo, f.sigma, f.rows, f.path, f.velocity
         if crs is not None:
             check_area_of_use(crs, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
                               what="the perspective centres", path=v.eo)  # fmt: skip
@@ -389,7 +424,7 @@ def _read_inputs(v: Values) -> tuple:
     bars = read_scale_bars_csv(v.scale_bars) if v.scale_bars else None
     if bars is None and v.output_scale_bars:
         raise InputError("OUTPUT_SCALE_BARS needs the scale bars (SCALE_BARS)")
-    return frame, cams, obs, ground, eo, sigma, eo_rows, eo_source, image_camera, bars
+    return frame, cams, obs, ground, eo, sigma, eo_rows, eo_source, image_camera, bars, velocity
 
 
 def _frame(v: Values):
@@ -479,6 +514,11 @@ def _summary_lines(res, best: str, rows) -> list[str]:
         f"{int(res.rejected.sum())} "
         f"measurements rejected, {len(res.dropped)} APs dropped"
     )
+    if res.timing is not None:
+        lines.append(
+            f"timing offset dt {1e3 * res.timing['dt_s']:.2f} ms, sigma "
+            f"{1e3 * res.timing['dt_std_s']:.2f} ms (exposure = recorded time + dt)"
+        )
     if len(res.check.point_id):
         lines.append(
             f"check points ({int(st['n'])}): RMS E/N/H {st['rms_e']:.4g} / {st['rms_n']:.4g} / "
@@ -583,7 +623,7 @@ def _check_on_image(obs, image_camera: dict[str, str], cams) -> None:
         )
 
 
-def _settings(v, cams, obs, ground, eo, sigma, frame) -> dict[str, str]:
+def _settings(v, cams, obs, ground, eo, sigma, frame, velocity=None) -> dict[str, str]:
     roles = list(ground.role)
     return {
         "cameras": "; ".join(
@@ -601,4 +641,7 @@ def _settings(v, cams, obs, ground, eo, sigma, frame) -> dict[str, str]:
         "outliers": f"robust {v.robust}, data snooping {'on' if v.snooping else 'off'}",
         "datum": v.datum + (" + scale bars" if v.scale_bars else ""),
         "lever arm / boresight": "estimated" if v.estimate_mount else "held",
+        "camera timing offset": ("estimated" if v.estimate_timing else "held (0)") + (
+            "" if not v.estimate_timing else ", velocities from the EO table"
+            if velocity is not None else ", velocities from neighbouring exposures"),
     }  # fmt: skip

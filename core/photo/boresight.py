@@ -55,8 +55,8 @@ exposure time and the true one, one more calibration unknown entering the INS po
 along-track velocity varies in the body frame (lines at different speeds): a single line, or
 lines flown at one speed (either direction), leave ``dt * speed`` = along-track lever arm. The
 set-up is refused before the adjustment when the lever arm is estimated with dt and the
-body-frame velocity varies by less than :data:`.boresight_result.TIMING_SEPARABILITY_MIN` of
-the speed (:func:`.boresight_setup.timing_separability`): attitude noise makes that trade-off
+body-frame velocity varies by less than :data:`.timing.TIMING_SEPARABILITY_MIN` of
+the speed (:func:`.timing.timing_separability`): attitude noise makes that trade-off
 only nearly singular, below what the observability check's condition limit catches. The
 velocity is the trajectory's own (``Trajectory.velocity_ned``) when it has one, else
 differenced from neighbouring exposures.

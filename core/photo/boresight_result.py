@@ -24,6 +24,7 @@ from .boresight_setup import ANGLES, ARCSEC, BoresightOptions, _Parameters
 from .georeference import Trajectory
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_local_to_map
+from .timing import TIMING_SEPARABILITY_MIN
 
 #: catalogue context of this module's ``_t("...")`` sentences (the diagnosis the report shows)
 TR_CONTEXT = "Report"
@@ -340,13 +341,6 @@ def diagnose(parameters: Sequence[str], groups: Sequence[str] = ()) -> list[str]
             )
         )
     return out
-
-
-#: Smallest share of the body-frame velocity that a lever arm cannot mimic
-#: (:func:`.boresight_setup.timing_separability`) with which the timing offset and the lever
-#: arm are estimated together: below it dt's sigma would be more than 20 times the one with
-#: the lever arm known (speeds differing by less than about 10 %, or one line).
-TIMING_SEPARABILITY_MIN = 0.05
 
 
 def require_timing_separable(share: float, body_velocity: Array) -> None:

@@ -24,6 +24,7 @@ from .georeference import Trajectory
 from .ins import INS_GRADES, InsGrade
 from .mount import Mount
 from .observations import ImageObservations
+from .timing import difference_velocity, timing_separability
 
 __all__ = [
     "ARCSEC",
@@ -272,46 +273,9 @@ def exposure_velocity(trajectory: Trajectory, ins_pos: Array, r_nl: Array) -> Ar
     down at each image, as ``importtrajectory`` interpolates them from the high-rate solution),
     rotated by ``r_nl`` (N, 3, 3: NED at each image -> the adjustment frame). Otherwise finite
     differences of the neighbouring exposures of the same flight line (trajectory group
-    column; empty = one line), in time order: central inside, one-sided at the ends; over the
-    few seconds between exposures a straight line is flown at near constant speed, so the
-    difference is the velocity to well below what dt resolves, but INS position noise enters
-    it. The attitude's rate is not used: the dt term of the attitude is neglected, which is
-    second order for straight lines.
+    column; empty = one line; :func:`.timing.difference_velocity`). The attitude's rate is not
+    used: the dt term of the attitude is neglected, which is second order for straight lines.
     """
     if trajectory.velocity_ned is not None:
         return np.einsum("nij,nj->ni", r_nl, np.asarray(trajectory.velocity_ned, dtype=float))
-    t = np.asarray(trajectory.time, dtype=np.float64)
-    vel = np.zeros_like(ins_pos)
-    lines = np.array([g if g else "" for g in trajectory.group])
-    for g in dict.fromkeys(lines.tolist()):
-        sel = np.flatnonzero(lines == g)
-        sel = sel[np.argsort(t[sel], kind="stable")]
-        if sel.size < 2 or np.any(np.diff(t[sel]) <= 0):
-            raise InputError(
-                f"estimate_timing: flight line '{g}' needs >= 2 images with distinct times "
-                "(the velocity is differenced from neighbouring exposures; or give the "
-                "trajectory's velocities: v_north, v_east, v_up)"
-            )
-        vel[sel] = np.gradient(ins_pos[sel], t[sel], axis=0)
-    return vel
-
-
-def timing_separability(velocity: Array, r_bl: Array) -> tuple[float, Array]:
-    """How far the timing offset dt is separable from the lever arm, from the geometry alone.
-
-    dt shifts every camera centre by ``v_i dt`` (adjustment frame); a lever arm ``a`` by
-    ``R_b^l(i) a``. The lever arm best mimicking dt is ``a = u dt`` with ``u`` the mean of the
-    body-frame velocities ``b_i = R_b^l(i)' v_i`` (the rotations are orthonormal), and what
-    it leaves is ``b_i - u``. Returns the share ``rms|b - u| / rms|b|`` (0: dt and the lever
-    arm are one unknown; dt's variance grows by about 1 / share^2 when the lever arm is
-    estimated) and ``u`` (3,), m/s in the body frame.
-
-    >>> r = np.broadcast_to(np.eye(3), (4, 3, 3))
-    >>> round(timing_separability(np.array([[60.0, 0, 0]] * 2 + [[30.0, 0, 0]] * 2), r)[0], 3)
-    0.316
-    """
-    b = np.einsum("nji,nj->ni", r_bl, velocity)
-    u = b.mean(axis=0)
-    rms_b = float(np.sqrt(np.mean(np.sum(b * b, axis=1))))
-    share = float(np.sqrt(np.mean(np.sum((b - u) ** 2, axis=1)))) / rms_b if rms_b > 0 else 0.0
-    return share, u
+    return difference_velocity(trajectory.time, trajectory.group, ins_pos)

@@ -16,7 +16,9 @@ docs/conventions.md:
 - per object point: ``X, Y, Z`` (eliminated from the normal equations by the Schur complement:
   the reduced camera system, :mod:`core.lsq.schur`);
 - optionally a common lever-arm and boresight correction between the observed (GNSS/INS) and
-  the photogrammetric orientation.
+  the photogrammetric orientation, and a camera timing offset dt (s; exposure = recorded time
+  + dt): the observed centre is the GNSS/INS position at the recorded time,
+  ``X_obs = X_pc - R_c^m da - v dt``, with the exposure's velocity v (:mod:`.timing`).
 
 Observations besides the image points: control points (their coordinates with sigmas, carried
 into the adjustment frame with their full covariance), observed exterior orientations
@@ -61,13 +63,21 @@ from ..errors import InputError, NotObservableError, stop_if_asked
 from ..geometry.camera import Camera
 from ..geometry.engineering import EngineeringFrame, EngineeringLocal
 from ..geometry.frames import MappingFrame
-from .bundle_model import _cams_from, _Run, _run
+from ..geometry.rotations import opk_to_matrix
+from .bundle_model import LEVER_NAMES, TIMING_NAME, _cams_from, _Run, _run
 from .bundle_result import BundleResult, _finish
 from .bundle_selection import ap_decisions, drop_candidate
 from .bundle_setup import BundleOptions, GroundPoints, _prepare
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable
 from .scale_bars import ScaleBars, setup_bars
+from .timing import (
+    ExposureVelocities,
+    difference_velocity,
+    local_velocity,
+    timing_separability,
+    timing_trade,
+)
 
 #: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
 TR_CONTEXT = "Report"
@@ -100,6 +110,7 @@ def bundle_adjust(
     progress: Callable[[float], None] | None = None,
     should_stop: Callable[[], bool] | None = None,
     scale_bars: ScaleBars | None = None,
+    velocity: ExposureVelocities | None = None,
 ) -> BundleResult:
     """Bundle adjustment with self-calibration (see the module docstring).
 
@@ -128,6 +139,10 @@ def bundle_adjust(
     scale_bars : ScaleBars, optional
         Measured distances between adjusted points (frame units), observations with their
         sigmas; with a free-network datum they give its scale (:mod:`.scale_bars`).
+    velocity : ExposureVelocities, optional
+        The velocity of every exposure of ``eo`` (m/s) for the timing offset
+        (``options.estimate_timing``); without it the velocities are differenced from the
+        observed centres of each group of ``eo`` by its time column.
 
     Returns
     -------
@@ -157,11 +172,18 @@ def bundle_adjust(
     if opts.estimate_mount and eo_sigma is None:
         raise InputError("estimating the lever arm and boresight needs observed orientations "
                          "(EO with sigma columns)")  # fmt: skip
+    if opts.estimate_timing and eo_sigma is None:
+        raise InputError("estimating the camera timing offset needs observed orientations "
+                         "(EO with sigma columns, or EO_SIGMAS)")  # fmt: skip
     setup = _prepare(cameras, dict(image_camera or {}), observations, ground, mapping, eo,
                      eo_sigma, opts, eo_rows, eo_source, should_stop, warnings)  # fmt: skip
     if scale_bars is not None and len(scale_bars):
         metres = setup.local.mapping.metres if isinstance(setup.local, EngineeringLocal) else 1.0
         setup.bars = setup_bars(scale_bars, setup.points, setup.check_ids, metres)
+    if opts.estimate_timing:
+        assert eo is not None  # observed orientations: above
+        setup.velocity = _exposure_velocity(setup, eo, velocity, eo_source, opts.estimate_mount)
+    dt0 = 0.0 if opts.estimate_timing else None
     cams = list(setup.cameras)
     free = []
     for cam in cams:
@@ -176,7 +198,7 @@ def bundle_adjust(
     report = progress if progress is not None else (lambda f: None)
     # 1. the full model, robust + snooping, from the approximate values
     run = _run(setup, observations, cams, free, opts, keep, opts.robust, opts.snooping,
-               setup.eo0, setup.xyz0, mount, should_stop, None)  # fmt: skip
+               setup.eo0, setup.xyz0, mount, should_stop, None, dt0)  # fmt: skip
     report(0.4)
     dropped: dict[tuple[str, str], str] = {}
     dropped_list: list[tuple[str, str, str]] = []
@@ -203,23 +225,61 @@ def bundle_adjust(
             new_cams[c] = new_cams[c].with_interior(full)
             free = [f if k != c else f[f != pos] for k, f in enumerate(free)]
             x = current.result.x
-            mnt = x[current.lay.mount] if current.lay.mount is not None else None
+            mnt, dt = _carried(current)
             current = _run(setup, observations, new_cams, free, opts, keep, "none", False,
                            x[current.lay.eo], x[current.lay.points], mnt, should_stop,
-                           None)  # fmt: skip
+                           None, dt)  # fmt: skip
             cams = new_cams
             changed = True
         if changed:
             x = current.result.x
-            mnt = x[current.lay.mount] if current.lay.mount is not None else None
+            mnt, dt = _carried(current)
             keep = np.ones(len(observations), dtype=bool)
             run = _run(setup, observations, cams, free, opts, keep, opts.robust, opts.snooping,
                        x[current.lay.eo], x[current.lay.points], mnt, should_stop,
-                       None)  # fmt: skip
+                       None, dt)  # fmt: skip
     report(0.9)
     out = _finish(setup, observations, run, opts, dropped, dropped_list, eo, warnings)
     report(1.0)
     return out
+
+
+def _carried(run: _Run) -> tuple[Array | None, float | None]:
+    """The mount corrections and the timing offset of ``run`` (None where not estimated),
+    the starting values of the next run."""
+    x = run.result.x
+    mnt = x[run.lay.mount] if run.lay.mount is not None else None
+    return mnt, (float(x[run.lay.timing]) if run.lay.timing >= 0 else None)
+
+
+def _exposure_velocity(setup, eo: ExteriorOrientationTable, velocity: ExposureVelocities | None,
+                       source: str, with_lever_arm: bool) -> Array:  # fmt: skip
+    """(M, 3) velocities of the exposures in the adjustment frame, m/s: the EO table's, or
+    differenced from the observed centres of each group by the EO's time; with the lever arm
+    estimated, a camera-frame velocity that is one at every image is refused, naming dt and
+    the lever-arm component it trades with."""
+    vel = _velocity_local(setup, eo, velocity, source)
+    if with_lever_arm:
+        r_cl = np.swapaxes(opk_to_matrix(*setup.eo_obs[:, 3:].T), 1, 2)
+        trade = timing_trade(*timing_separability(vel, r_cl), TIMING_NAME, LEVER_NAMES, "camera")
+        if trade is not None:
+            raise trade
+    return vel
+
+
+def _velocity_local(setup, eo: ExteriorOrientationTable, velocity: ExposureVelocities | None,
+                    source: str) -> Array:  # fmt: skip
+    if velocity is not None:
+        if velocity.values.shape != (len(eo), 3) or not np.isfinite(velocity.values).all():
+            raise InputError("the exposure velocities must be finite, three per image",
+                             path=source or None)  # fmt: skip
+        return local_velocity(velocity, eo.xyz, setup.local)
+    if not np.isfinite(eo.time).all():
+        raise InputError("estimating the camera timing offset needs the velocity of every "
+                         "exposure: velocity columns (v_north, v_east, v_up or vx, vy, vz) or "
+                         "a time for every image (differenced within each group)",
+                         path=source or None)  # fmt: skip
+    return difference_velocity(eo.time, eo.group, setup.eo_obs[:, :3], "the timing offset")
 
 
 def compare_ap_models(

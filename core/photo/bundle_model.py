@@ -25,6 +25,10 @@ from .scale_bars import bar_block
 TR_CONTEXT = "Report"
 
 Array = NDArray[np.float64]
+#: The name of the camera timing offset (seconds) among the adjustment's parameters.
+TIMING_NAME = "timing dt"
+#: The names of the lever-arm correction (camera axes) among the adjustment's parameters.
+LEVER_NAMES = ("lever dx_c", "lever dy_c", "lever dz_c")
 
 
 @dataclass
@@ -38,10 +42,11 @@ class _Layout:
     free: list[NDArray[np.intp]]  # per camera, positions within Camera.interior_params
     mount: NDArray[np.intp] | None  # (6,)
     points: NDArray[np.intp]  # (P, 3)
+    timing: int = -1  # index of the timing offset dt (s), -1 when not estimated
 
 
 def _layout(setup: _Setup, free: list[NDArray[np.intp]], cams: list[Camera], eo: Array,
-            xyz: Array, mount: Array | None) -> _Layout:  # fmt: skip
+            xyz: Array, mount: Array | None, timing: float | None = None) -> _Layout:  # fmt: skip
     names: list[str] = []
     values: list[Array] = []
     M = len(setup.images)
@@ -60,16 +65,22 @@ def _layout(setup: _Setup, free: list[NDArray[np.intp]], cams: list[Camera], eo:
         start += f.size
     idx_mount = None
     if mount is not None:
-        names += ["lever dx_c", "lever dy_c", "lever dz_c", "boresight d_omega",
-                  "boresight d_phi", "boresight d_kappa"]  # fmt: skip
+        names += [*LEVER_NAMES, "boresight d_omega", "boresight d_phi", "boresight d_kappa"]
         values.append(mount)
         idx_mount = np.arange(start, start + 6)
         start += 6
+    idx_dt = -1
+    if timing is not None:
+        names.append(TIMING_NAME)
+        values.append(np.array([timing], dtype=np.float64))
+        idx_dt = start
+        start += 1
     P = len(setup.points)
     names += [f"{p} {c}" for p in setup.points for c in "XYZ"]
     values.append(xyz.ravel())
     idx_pts = np.arange(start, start + 3 * P).reshape(P, 3)
-    return _Layout(names, np.concatenate(values), idx_eo, interior, free, idx_mount, idx_pts)
+    return _Layout(names, np.concatenate(values), idx_eo, interior, free, idx_mount, idx_pts,
+                   idx_dt)  # fmt: skip
 
 
 class _ImageModel:
@@ -132,23 +143,41 @@ class _ObservedEOModel:
     ``R_c^m = R_obs dR``):
     ``X_obs = X0 - M' da``, ``M_obs = dR M`` with ``da`` the lever-arm correction in camera
     axes and ``dR`` the boresight correction about the camera axes (what a boresight
-    calibration estimates). x_local = [eo(6), da(3), bore(3)]."""
+    calibration estimates). x_local = [eo(6), da(3), bore(3)] with ``mount``, then dt (s)
+    with ``velocity`` (G, 3; m/s in the adjustment frame): the centre observed at the
+    recorded time is ``X_obs = X0 - M' da - v dt`` (exposure = recorded time + dt; the
+    attitude's change over dt is neglected, second order on straight lines)."""
 
-    def __init__(self, observed: Array) -> None:
+    def __init__(self, observed: Array, mount: bool = True, velocity: Array | None = None) -> None:
         self.observed = observed
+        self.mount = mount
+        self.velocity = velocity
 
     def __call__(self, xl: Array) -> tuple[Array, Array]:
+        f, J = self._full(xl)
+        cols = list(range(6)) + (list(range(6, 12)) if self.mount else [])
+        if self.velocity is not None:
+            cols.append(12)
+        return f, J[:, :, cols]
+
+    def _full(self, xl: Array) -> tuple[Array, Array]:
+        """The prediction and its Jacobian with respect to [eo(6), da(3), bore(3), dt]."""
         from ..geometry.rotations import boresight_matrix, rx, ry, rz, skew
 
         g = xl.shape[0]
-        eo, da, bo = xl[:, :6], xl[:, 6:9], xl[:, 9:12]
+        eo = xl[:, :6]
+        da, bo = (xl[:, 6:9], xl[:, 9:12]) if self.mount else (np.zeros((g, 3)),) * 2
+        dt = xl[:, -1] if self.velocity is not None else np.zeros(g)
         M = opk_to_matrix(eo[:, 3], eo[:, 4], eo[:, 5])
         dM = opk_derivatives(eo[:, 3], eo[:, 4], eo[:, 5])  # (g, 3, 3, 3)
         dR = boresight_matrix(bo[:, 0], bo[:, 1], bo[:, 2])
         Mobs = dR @ M
         f = np.zeros((g, 6))
-        J = np.zeros((g, 6, 12))
+        J = np.zeros((g, 6, 13))
         f[:, :3] = eo[:, :3] - np.einsum("gji,gj->gi", M, da)
+        if self.velocity is not None:
+            f[:, :3] -= self.velocity * dt[:, None]
+            J[:, :3, 12] = -self.velocity
         J[:, :3, :3] = np.eye(3)
         J[:, :3, 3:6] = -np.einsum("gkji,gj->gik", dM, da)
         J[:, :3, 6:9] = -np.swapaxes(M, 1, 2)
@@ -221,11 +250,16 @@ def _blocks(setup: _Setup, lay: _Layout, cams: list[Camera], obs: ImageObservati
             )
         )
     if setup.eo_obs is not None:
-        if lay.mount is not None:
-            idx = np.concatenate(
-                [lay.eo, np.broadcast_to(lay.mount, (len(setup.images), 6))], axis=1
-            )
-            model = _ObservedEOModel(setup.eo_obs)
+        M = len(setup.images)
+        if lay.mount is not None or lay.timing >= 0:
+            parts = [lay.eo]
+            if lay.mount is not None:
+                parts.append(np.broadcast_to(lay.mount, (M, 6)))
+            if lay.timing >= 0:
+                parts.append(np.full((M, 1), lay.timing, dtype=np.intp))
+            idx = np.concatenate(parts, axis=1)
+            velocity = setup.velocity if lay.timing >= 0 else None
+            model = _ObservedEOModel(setup.eo_obs, lay.mount is not None, velocity)
         else:
             idx = lay.eo
             model = _IdentityModel()
@@ -297,8 +331,9 @@ class _Run:
 
 def _run(setup: _Setup, obs: ImageObservations, cams: list[Camera], free: list,
          options: BundleOptions, keep: NDArray[np.bool_], robust: str, snooping: bool,
-         eo: Array, xyz: Array, mount: Array | None, should_stop, progress) -> _Run:  # fmt: skip
-    lay = _layout(setup, free, cams, eo, xyz, mount)
+         eo: Array, xyz: Array, mount: Array | None, should_stop, progress,
+         timing: float | None = None) -> _Run:  # fmt: skip
+    lay = _layout(setup, free, cams, eo, xyz, mount, timing)
     blocks, rows_of, bnames = _blocks(setup, lay, cams, obs, keep)
     cons = _datum_constraints(setup, lay, options.datum, setup.xyz0, setup.eo0)
     opts = AdjustmentOptions(

@@ -50,6 +50,14 @@ class BundleOptions:
         the adjusted orientations, signed as in docs/conventions.md, "Rotations":
         ``X_pc = X_obs + R_c^m da``,
         ``R_c^m = R_obs dR`` (a boresight calibration's dR).
+    estimate_timing : bool
+        With observed orientations: estimate a constant camera timing offset dt (seconds,
+        exposure = recorded time + dt), the observed centre being the GNSS/INS position at
+        the recorded time, ``X_obs = X_pc - R_c^m da - v dt``, with each exposure's velocity
+        ``v`` from the EO table (v_north, v_east, v_up or vx, vy, vz) or differenced from the
+        neighbouring exposures of its group (:mod:`.timing`). It needs velocities that vary
+        across the block (strips in different directions or at different speeds) or ground
+        control; with the lever arm, camera-frame velocities that vary (different speeds).
     max_iterations : int
         Iterations of each adjustment.
     covariance : bool
@@ -67,6 +75,7 @@ class BundleOptions:
     snooping_alpha: float = 0.001
     datum: str = "control"
     estimate_mount: bool = False
+    estimate_timing: bool = False
     max_iterations: int = 60
     covariance: bool = True
 

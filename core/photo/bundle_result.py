@@ -16,6 +16,7 @@ from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians
 from ..geometry.engineering import EngineeringLocal
 from ..geometry.rotations import opk_to_matrix
+from ..i18n import mark as _t
 from ..lsq.results import AdjustmentResult
 from .bundle_model import _cams_from, _eliminated, _Run
 from .bundle_selection import ap_decisions
@@ -137,6 +138,11 @@ class BundleResult:
     warnings : list of str
     scale_bars : BarResult or None
         The scale bars' adjusted distances, residuals and tests (frame units).
+    timing : dict or None
+        The camera timing offset when estimated: ``dt_s`` and ``dt_std_s`` (seconds, exposure
+        = recorded time + dt) and ``correlation`` (parameter name -> its correlation with dt:
+        the lever arm and boresight corrections, the interior orientation and APs, and the
+        exterior-orientation parameter most correlated with dt).
     """
 
     ap_model: str
@@ -167,6 +173,7 @@ class BundleResult:
     local: Local
     warnings: list[str] = field(default_factory=list)
     scale_bars: BarResult | None = None
+    timing: dict | None = None
 
     @property
     def sigma0(self) -> float:
@@ -387,6 +394,9 @@ def _finish(setup: _Setup, obs: ImageObservations, run: _Run, options: BundleOpt
     ]).astype(np.int64)  # fmt: skip
     role_arr = np.array(setup.roles + ("check",), dtype=object)
     obs_role = tuple(role_arr[np.where(setup.obs_check >= 0, len(setup.roles), setup.obs_pt)])
+    timing = _timing(run)
+    if timing is not None:
+        warnings = warnings + _timing_warnings(timing, options.max_correlation)
     return BundleResult(
         ap_model=options.ap_model,
         cameras={c.name: c for c in cams},
@@ -416,7 +426,44 @@ def _finish(setup: _Setup, obs: ImageObservations, run: _Run, options: BundleOpt
         local=setup.local,
         warnings=warnings + list(res.warnings),
         scale_bars=bar_result(setup.bars, res, lay.points) if setup.bars is not None else None,
+        timing=timing,
     )
+
+
+def _timing_warnings(timing: dict, limit: float) -> list[str]:
+    """A warning naming the parameters whose |correlation| with dt is above ``limit``."""
+    high = [(n, r) for n, r in timing["correlation"].items() if abs(r) > limit]
+    if not high:
+        return []
+    return [
+        _t(
+            "the camera timing offset dt is correlated with {names}: its sigma ({sigma:.2f} ms) "
+            "carries that trade-off (strips at different speeds, or held interior orientation "
+            "and lever arm, separate them better)",
+            names=", ".join(f"{n} ({r:+.3f})" for n, r in high),
+            sigma=1e3 * timing["dt_std_s"],
+        )
+    ]
+
+
+def _timing(run: _Run) -> dict | None:
+    """dt (s), its sigma and its correlations (see :class:`BundleResult`), or None."""
+    lay, res = run.lay, run.result
+    if lay.timing < 0:
+        return None
+    others = [*(lay.mount if lay.mount is not None else ()), *np.concatenate(
+        [np.asarray(i, dtype=np.intp) for i in lay.interior] or [np.zeros(0, np.intp)])]
+    corr: dict[str, float] = {}
+    if res.cofactor is not None or res.cofactor_blocks is not None:
+        eo = lay.eo.ravel()
+        r_eo = res.correlation_of(np.r_[lay.timing, eo])[0, 1:]
+        k = int(np.argmax(np.abs(r_eo)))
+        idx = np.r_[lay.timing, np.asarray(others, dtype=np.intp)]
+        r = res.correlation_of(idx)[0, 1:]
+        corr = {lay.names[i]: float(v) for i, v in zip(others, r)}
+        corr[lay.names[eo[k]]] = float(r_eo[k])
+    return {"dt_s": float(res.x[lay.timing]), "dt_std_s": float(res.std[lay.timing]),
+            "correlation": corr}  # fmt: skip
 
 
 def _wkt(local: Local) -> str:

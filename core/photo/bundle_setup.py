@@ -222,6 +222,7 @@ class _Setup:
     eo_obs: Array | None  # (M, 6) local observed orientations
     eo_obs_cov: Array | None  # (M, 6, 6)
     bars: BarSetup | None = None  # scale bars (set after the setup, bundle.py)
+    velocity: Array | None = None  # (M, 3) local, m/s: the exposures' (timing offset)
 
 
 def _local_frame(mapping: Frame, ground: GroundPoints,

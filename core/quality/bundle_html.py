@@ -4,8 +4,9 @@ Sections: settings; the model comparison (when several AP families ran: the layo
 of Lima, Debiasi & Menezes, with sigma0 and the AP counts); the adjustment (sigma0, redundancy,
 global chi-square test, outlier method and rejections); the interior orientation and APs of
 every camera with sigmas, t-tests and the selection's decisions; the correlation heat map of
-the interior parameters (|r| above the limit framed); per-image RMS of the residuals; the
-check points; the image-space residual vectors per camera (averaged per cell, to show
+the interior parameters (|r| above the limit framed); the lever arm and boresight corrections
+and the camera timing offset (ms, with its correlations) when estimated; per-image RMS of the
+residuals; the check points; the image-space residual vectors per camera (averaged per cell, to show
 systematic patterns) and the residual histograms; warnings.
 """
 
@@ -35,6 +36,21 @@ _CSS = report_css(1150, (
     ".best{background:#d8e8f8}\n"
     ".drop{color:#777}.plots svg{margin:4px;border:1px solid #ddd}.note{font-size:12px;color:#444}"
 ))
+
+
+def _timing(res: BundleResult) -> list[str]:
+    """The camera timing offset dt in ms with its sigma and its correlations (none when it
+    was not estimated)."""
+    tm = res.timing
+    if tm is None:
+        return []
+    rows = [["dt", _n(1e3 * tm["dt_s"], ".2f"), _n(1e3 * tm["dt_std_s"], ".2f")]]
+    corr = [[_e(n), _n(r, "+.3f")] for n, r in tm["correlation"].items()]
+    return [
+        f"<h2>{t('Camera timing offset (exposure = recorded time + dt)')}</h2>",
+        _table([t("parameter"), t("value (ms)"), t("sigma (ms)")], rows),
+        *([_table([t("correlated with dt"), "r"], corr)] if corr else []),
+    ]
 
 
 def _n(x: object, fmt: str = ".3f") -> str:
@@ -226,6 +242,7 @@ def render_bundle_html(
             m["boresight_rad"], m["boresight_std_rad"])]  # fmt: skip
         parts += [f"<h2>{t('Lever arm and boresight corrections (camera axes)')}</h2>",
                   _table([t("parameter"), t("value"), t("std")], rows)]  # fmt: skip
+    parts += _timing(res)
     # per image
     rows = []
     for k, im in enumerate(res.eo.image_id):
