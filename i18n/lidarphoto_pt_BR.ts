@@ -1356,6 +1356,10 @@
             <translation>{angles} do grupo '{group}' não podem ser separados: os pontos estão perto do centro da imagem ou em planos de uma só orientação; distribua pontos pela imagem em telhados de inclinação e orientação diferentes, ou acrescente LCPs ou linhas.</translation>
         </message>
         <message>
+            <source>the camera timing offset dt is correlated with {names}: its sigma ({sigma:.2f} ms) carries that trade-off (strips at different speeds, or held interior orientation and lever arm, separate them better)</source>
+            <translation>o atraso de disparo da câmera dt está correlacionado com {names}: seu desvio-padrão ({sigma:.2f} ms) carrega essa troca (faixas a velocidades diferentes, ou orientação interior e braço de alavanca fixos, os separam melhor)</translation>
+        </message>
+        <message>
             <source>insignificant (t = {t:.2f} &lt;= {critical:.2f}, alpha {alpha:g})</source>
             <translation>não significativo (t = {t:.2f} &lt;= {critical:.2f}, alfa {alpha:g})</translation>
         </message>
@@ -2128,6 +2132,10 @@
             <translation>Sobreposição das imagens, pontos de controle e de verificação</translation>
         </message>
         <message>
+            <source>Camera timing offset (exposure = recorded time + dt)</source>
+            <translation>Atraso de disparo da câmera (exposição = tempo registrado + dt)</translation>
+        </message>
+        <message>
             <source>NO</source>
             <translation>NÃO</translation>
         </message>
@@ -2298,6 +2306,10 @@
         <message>
             <source>boresight d_kappa (deg)</source>
             <translation>boresight d_kappa (graus)</translation>
+        </message>
+        <message>
+            <source>correlated with dt</source>
+            <translation>correlacionado com dt</translation>
         </message>
         <message>
             <source>Horizontal discrepancy: mean {} m, standard deviation {} m, RMSE_HORIZONTAL {} m; RMSE_E / RMSE_N / RMSE_U {} / {} / {} m; RMSE_3D {} m. Intersected with the adjusted orientations; their sigmas carry the image noise only.</source>
@@ -4185,6 +4197,23 @@ orientações, as imagens que veem quatro ou mais pontos de controle passam por 
 restante do bloco cresce por interseção e resseção.</translation>
         </message>
         <message>
+            <source>Camera timing offset (ESTIMATE_TIMING): with observed orientations, a constant dt (exposure =
+recorded time + dt) as one more unknown, the observed centres being the GNSS/INS positions at
+the recorded times; the velocity of each exposure from the EO table (v_north, v_east, v_up or
+vx, vy, vz) or differenced from the neighbouring exposures of its group. It needs strips in
+different directions or at different speeds, or ground control; estimated with the lever arm,
+strips at one speed are refused as not observable, naming both. dt in ms with its sigma and
+correlations: the results TIMING_OFFSET_MS and TIMING_OFFSET_STD_MS, the log and the summary.</source>
+            <translation>Atraso de disparo da câmera (ESTIMATE_TIMING): com orientações observadas, um dt constante
+(exposição = tempo registrado + dt) como mais uma incógnita, sendo os centros observados as
+posições GNSS/INS nos tempos registrados; a velocidade de cada exposição vem da tabela de OE
+(v_north, v_east, v_up ou vx, vy, vz) ou é diferenciada das exposições vizinhas do seu grupo.
+Exige faixas em direções diferentes ou a velocidades diferentes, ou pontos de apoio; estimado com
+o braço de alavanca, faixas a uma só velocidade são recusadas como não observáveis, nomeando
+ambos. dt em ms com seu desvio-padrão e correlações: os resultados TIMING_OFFSET_MS e
+TIMING_OFFSET_STD_MS, o log e o resumo.</translation>
+        </message>
+        <message>
             <source>Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
 and |correlation| above 0.9 flagged; automatic selection drops insignificant APs one at a
 time (an AP correlated with others is dropped only when a joint F-test finds them
@@ -4359,6 +4388,14 @@ com o arquivo e a linha indicados.</translation>
             <translation>requer orientações exteriores observadas</translation>
         </message>
         <message>
+            <source>Estimate the camera timing offset</source>
+            <translation>Estimar o atraso de disparo da câmera</translation>
+        </message>
+        <message>
+            <source>observed orientations taken at the recorded time, the exposure at recorded time + dt: one constant dt from the EO table's velocities (v_north, v_east, v_up or vx, vy, vz) or differenced from neighbouring exposures of each group by time; needs strips in different directions or at different speeds (or ground control); with the lever arm, different speeds</source>
+            <translation>orientações observadas tomadas no tempo registrado, a exposição em tempo registrado + dt: um dt constante a partir das velocidades da tabela de OE (v_north, v_east, v_up ou vx, vy, vz) ou diferenciado das exposições vizinhas de cada grupo pelo tempo; exige faixas em direções diferentes ou a velocidades diferentes (ou pontos de apoio); com o braço de alavanca, velocidades diferentes</translation>
+        </message>
+        <message>
             <source>Adjusted exterior orientation (CSV)</source>
             <translation>Orientação exterior ajustada (CSV)</translation>
         </message>
@@ -4413,6 +4450,14 @@ com o arquivo e a linha indicados.</translation>
         <message>
             <source>AP model of the outputs</source>
             <translation>Modelo de PAs das saídas</translation>
+        </message>
+        <message>
+            <source>Camera timing offset dt (ms, NaN if not estimated)</source>
+            <translation>Atraso de disparo da câmera dt (ms, NaN se não estimado)</translation>
+        </message>
+        <message>
+            <source>Sigma of the timing offset (ms)</source>
+            <translation>Desvio-padrão do atraso de disparo (ms)</translation>
         </message>
         <message>
             <source>Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
