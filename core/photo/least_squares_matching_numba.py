@@ -8,13 +8,14 @@ compare them); numba is optional: :data:`AVAILABLE` tells whether it imports.
 
 from __future__ import annotations
 
+from types import ModuleType
 from typing import Any, Callable
 
 import numpy as np
 
 from ..compiled import cached_njit
 
-numba: Any  # the module, or None without it
+numba: ModuleType | None  # None without numba
 try:  # pragma: no cover - depends on the environment
     import numba
 
