@@ -262,13 +262,13 @@ def collinearity_jacobians(
             out["eo"] = np.concatenate([-dpx_dpoint, dpx_dq @ dq_dangles], axis=2)
 
     if "interior" in wanted:
-        p = camera.distortion.n_params
-        jac = np.empty((n, 2, 3 + p))
+        n_ap = camera.distortion.n_params
+        jac = np.empty((n, 2, 3 + n_ap))
         # every projection's ideal point (r = f g(theta)) is linear in f, so di/df = i / f.
         jac[:, :, 0] = np.einsum("nij,nj->ni", sg, ideal / f)
         jac[:, 0, 1], jac[:, 1, 1] = 1.0 / ps, 0.0
         jac[:, 0, 2], jac[:, 1, 2] = 0.0, -1.0 / ps
-        if p:
+        if n_ap:
             jac[:, :, 3:] = -sg @ camera.distortion.jacobian_params(measured)
         out["interior"] = jac
         out["interior_names"] = camera.interior_names

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -35,7 +36,12 @@ class Grid:
         return (self.x0, self.cell, 0.0, self.y_top, 0.0, -self.cell)
 
     @classmethod
-    def covering(cls, mins: Sequence[float], maxs: Sequence[float], cell: float) -> Grid:
+    def covering(
+        cls,
+        mins: Sequence[float] | NDArray[np.float64],
+        maxs: Sequence[float] | NDArray[np.float64],
+        cell: float,
+    ) -> Grid:
         """The grid of ``cell`` aligned on multiples of ``cell`` that covers the box."""
         x0 = math.floor(mins[0] / cell) * cell
         y_top = (math.floor(maxs[1] / cell) + 1) * cell
@@ -74,7 +80,10 @@ class Grid:
         return top * (1 - fr) + bottom * fr
 
 
-def fill_nearest(surface: NDArray[np.float32], valid: NDArray[np.bool_]) -> NDArray[np.float32]:
+_Float = TypeVar("_Float", np.float32, np.float64)
+
+
+def fill_nearest(surface: NDArray[_Float], valid: NDArray[np.bool_]) -> NDArray[_Float]:
     from scipy import ndimage
 
     if valid.all():

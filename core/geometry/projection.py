@@ -29,7 +29,7 @@ the ideal point is computed as ``-f (u, v) / w``, exactly as before this module 
 
 from __future__ import annotations
 
-from typing import Tuple
+from typing import Literal, Tuple, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -113,6 +113,18 @@ def theta_from_radius(r_over_f: ArrayLike, projection: str) -> Array:
     return t
 
 
+@overload
+def ideal_from_camera(
+    q: ArrayLike, focal_mm: float, projection: str, jacobian: Literal[False] = False
+) -> Tuple[Array, NDArray[np.bool_]]: ...
+
+
+@overload
+def ideal_from_camera(
+    q: ArrayLike, focal_mm: float, projection: str, jacobian: Literal[True]
+) -> Tuple[Array, NDArray[np.bool_], Array]: ...
+
+
 def ideal_from_camera(
     q: ArrayLike, focal_mm: float, projection: str, jacobian: bool = False
 ) -> Tuple[Array, NDArray[np.bool_]] | Tuple[Array, NDArray[np.bool_], Array]:
@@ -159,9 +171,7 @@ def ideal_from_camera(
                 ds_dw = gp * (rho / n2) / rho
                 for i, c in enumerate((u, v)):
                     for j, d in enumerate((u, v)):
-                        jac[:, i, j] = f * (
-                            (scale if i == j else 0.0) + c * ds_drho * d / rho
-                        )
+                        jac[:, i, j] = f * ((scale if i == j else 0.0) + c * ds_drho * d / rho)
                     jac[:, i, 2] = f * c * ds_dw
             # on the axis: the perspective Jacobian (the fisheye one tends to it)
             if axis.any():

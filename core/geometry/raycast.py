@@ -213,15 +213,15 @@ class DsmTracer:
             )
             dil = cv2.dilate(
                 block, np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT,
-                borderValue=-np.inf,
+                borderValue=(-np.inf,),
             )  # fmt: skip
             out.append((lev, np.ascontiguousarray(dil, dtype=np.float32)))
         zmin, zmax = dsm.z_range
         # (z[r, c], z[r + 1, c]) side by side, 8 bytes per entry: the two corners of a quad
         # column come in one gather (the last row repeats itself; it is never a quad's top)
         below = np.vstack([z[1:], z[-1:]])
-        pairs = np.ascontiguousarray(np.stack([z, below], axis=-1), np.float32)
-        pairs = pairs.view(np.float64).reshape(-1)
+        packed = np.ascontiguousarray(np.stack([z, below], axis=-1), np.float32)
+        pairs = packed.view(np.float64).reshape(-1)
         qflat = np.ascontiguousarray(qmax).ravel()
         mstack = np.concatenate([m.ravel() for _, m in out] or [np.zeros(0, np.float32)])
         offsets = np.cumsum([0] + [m.size for _, m in out])[:-1].astype(np.int64)
@@ -296,6 +296,7 @@ def _trace_chunk(
     n_lev = len(tr.levels) if accelerate else 0
     lv = np.zeros(queue.size, np.int64)
     ou, ov = 3.0 * su - 1.0, 3.0 * sv - 1.0
+    state: list[NDArray[Any]]  # the per-ray arrays, in the order unpacked below
     state = [u0, v0, z0, du, dv, dz, su, sv, iu, iv, iz, nudge, t_lo, t_hi, ou, ov, lv]
     pairs = tr.pairs
     t_q = np.full(queue.size, np.nan)
@@ -443,7 +444,7 @@ def intersect_dsm(
     if _use_numba(backend):
         from . import raycast_numba as dda_compiled
 
-        out = {
+        out: dict[str, NDArray[Any]] = {
             "t": np.empty(n), "status": np.empty(n, np.int8), "qi": np.empty(n, np.int64),
             "qj": np.empty(n, np.int64), "tri": np.empty(n, np.int8),
             "points": np.empty((n, 3)), "weights": np.empty((n, 3)),

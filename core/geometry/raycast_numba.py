@@ -23,6 +23,8 @@ import numpy as np
 
 from ..compiled import cached_njit
 
+numba: Any  # the module, or None without it
+register_jitable: Callable[[Callable[..., Any]], Callable[..., Any]]
 try:  # pragma: no cover - depends on the environment
     import numba
     from numba.extending import register_jitable
@@ -32,9 +34,11 @@ except Exception:  # ImportError, or a numba built against another numpy
     numba = None
     AVAILABLE = False
 
-    def register_jitable(func: Callable[..., Any]) -> Callable[..., Any]:
+    def _plain(func: Callable[..., Any]) -> Callable[..., Any]:
         """Without numba the kernels' helpers stay plain Python (never called then)."""
         return func
+
+    register_jitable = _plain
 
 __all__ = ["AVAILABLE", "trace_rays"]
 
@@ -264,8 +268,8 @@ def _compiled(name: str) -> Callable[..., Any]:
     next session: about 3 s). The cache is keyed by the module's import name: imported under
     another package name, the functions compile again."""
     if name not in _COMPILED:
-        func = {"order": _spatial_order, "trace": _trace}[name]
-        _COMPILED[name] = cached_njit(func, nogil=True)
+        kernels: dict[str, Callable[..., Any]] = {"order": _spatial_order, "trace": _trace}
+        _COMPILED[name] = cached_njit(kernels[name], nogil=True)
     return _COMPILED[name]
 
 
@@ -290,6 +294,7 @@ def trace_rays(
     r_, c_ = z.shape
     qmax = tracer.qmax.reshape(r_ - 1, c_ - 1)
     if accelerate and tracer.levels:
+        pyramid: tuple[Any, ...]  # the stacked levels, offsets, columns, shifts
         pyramid = (tracer.mstack, tracer.level_offsets, tracer.level_cols, tracer.level_shifts)
         n_lev = len(tracer.levels)
     else:

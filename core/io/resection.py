@@ -53,7 +53,7 @@ import math
 import os
 import re
 from collections.abc import Iterable, Sequence
-from typing import Union
+from typing import Any, Union
 
 import numpy as np
 
@@ -146,7 +146,7 @@ def read_line_control_csv(path: PathLike) -> LineControl:
     table = read_table(path)
     names = [normalise(c) for c in table.columns]
     if "cov_00" in names and "ux" in names:
-        return line_control_from_lines(read_lines_csv(path))
+        return line_control_from_lines(read_lines_csv(os.fspath(path)))
     if "wkt" in names:
         id_col = find_column(table, ("target_id", "line_id", "id"))
         wkt = text_column(table, names.index("wkt"), nonempty=False)
@@ -226,7 +226,7 @@ def _wkt_ends(text: str, path: str, row: int) -> tuple[list[float], list[float]]
     return vertices[0], vertices[-1]
 
 
-def write_eo_sigma_csv(path: PathLike, rows: Iterable[Sequence[object]]) -> None:
+def write_eo_sigma_csv(path: PathLike, rows: Iterable[Sequence[Any]]) -> None:
     """Write the EO table with precision; ``rows`` hold the values of
     :data:`EO_SIGMA_COLUMNS` (angles in radians, converted here), in that order."""
     out = []
@@ -244,7 +244,7 @@ def write_eo_sigma_csv(path: PathLike, rows: Iterable[Sequence[object]]) -> None
     write_csv_atomic(path, EO_SIGMA_COLUMNS, out)
 
 
-def write_residuals_csv(path: PathLike, rows: Iterable[Sequence[object]]) -> None:
+def write_residuals_csv(path: PathLike, rows: Iterable[Sequence[Any]]) -> None:
     """Write the residual table; ``rows`` hold the values of :data:`RESIDUAL_COLUMNS`."""
     out = []
     for r in rows:

@@ -165,7 +165,7 @@ def tile_planes(
 
     xyz = np.asarray(xyz, dtype=np.float64)
     label = np.full(len(xyz), -1, dtype=np.int64)
-    fit = np.zeros(len(xyz), dtype=bool)
+    fit: NDArray[np.bool_] | None = np.zeros(len(xyz), dtype=bool)
     pieces: list[PlanePiece] = []
     planes: tuple[Plane, ...] = ()
     if len(xyz) >= params.min_plane_points:
@@ -177,6 +177,7 @@ def tile_planes(
     for pid in np.flatnonzero(sizes > 0):  # a plane only in the buffer: the neighbour's
         m = core_label == pid
         piece_of[pid + 1] = len(pieces)
+        assert fit is not None  # the fit mask comes with every plane found
         pieces.append(PlanePiece(tile, planes[pid], xyz[m], fit[m], ids[m]))
     x, y = xyz[:, 0], xyz[:, 1]
     inner = np.minimum(np.minimum(x - box[0], box[2] - x), np.minimum(y - box[1], box[3] - y))
@@ -225,8 +226,8 @@ def _refit(pieces: Sequence[PlanePiece], members: Sequence[int], new_id: int) ->
     """The plane of merged pieces from the points their tiles fitted (all of them when fewer
     than half were: the rule of a single run, roof_planes._final_planes)."""
     pts = np.concatenate([pieces[k].points for k in members])
-    fit = [pieces[k].fit for k in members]
-    if all(f is not None for f in fit):
+    fit = [f for f in (pieces[k].fit for k in members) if f is not None]
+    if len(fit) == len(members):  # every piece has its fit mask
         mask = np.concatenate(fit)
         if mask.sum() >= max(3, len(pts) // 2):
             pts = pts[mask]
@@ -294,9 +295,9 @@ def merge_cut_planes(
     out = []
     for new_id, (members, _) in enumerate(merged):
         pts = np.concatenate([pieces[k].points for k in members])
-        ids = [pieces[k].ids for k in members]
+        ids = [i for i in (pieces[k].ids for k in members) if i is not None]
         out.append(MergedPlane(_refit(pieces, members, new_id), tuple(members), pts,
-                               None if any(i is None for i in ids) else np.concatenate(ids)))
+                               None if len(ids) < len(members) else np.concatenate(ids)))
     return out
 
 

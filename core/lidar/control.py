@@ -460,9 +460,9 @@ def _three_plane_points(cand, by_id, pts, ids, options, rejected) -> list[Contro
     x, cov, cond = intersect_three_planes(n, d, c)
     angles = _pair_angles(n)
     trees = {}
-    out = []
+    out: list[ControlPoint] = []
     for t, triple in enumerate(cand.tolist()):
-        tri = tuple(int(i) for i in triple)
+        tri = (int(triple[0]), int(triple[1]), int(triple[2]))
         u = options.length_unit
         min_angle = float(angles[t].min())
         if min_angle < options.min_angle_deg:
@@ -536,7 +536,7 @@ def _two_plane_lines(cand, by_id, pts, ids, adjacency, options, rejected) -> lis
         n[:, 0], d[:, 0], c[:, 0], n[:, 1], d[:, 1], c[:, 1], np.array(refs)
     )
     dihedral = _angles_deg(n[:, 0], n[:, 1])
-    out = []
+    out: list[ControlLine] = []
     for e, (a, b) in enumerate(cand.tolist()):
         pair = (int(a), int(b))
         if contact[e].shape[0] < 2:

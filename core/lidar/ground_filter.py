@@ -62,7 +62,7 @@ import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -78,7 +78,7 @@ from .ground_filter_morphology import (
     pmf_windows,
     smrf_windows,
 )
-from .ground_filter_params import CsfParams, FilterParams, SmrfParams
+from .ground_filter_params import CsfParams, FilterParams, GroundFilterParams, SmrfParams
 
 LOG = logging.getLogger(__name__)
 
@@ -231,7 +231,8 @@ def _neighbour_min(surface: NDArray[np.float32], radius: int) -> NDArray[np.floa
 
     kernel = np.ones((2 * radius + 1, 2 * radius + 1), np.uint8)
     kernel[radius, radius] = 0
-    return cv2.erode(surface, kernel, borderType=cv2.BORDER_CONSTANT, borderValue=np.inf)
+    out = cv2.erode(surface, kernel, borderType=cv2.BORDER_CONSTANT, borderValue=(np.inf,))
+    return cast(NDArray[np.float32], out)  # OpenCV keeps the float32 depth
 
 
 def _low_references(
@@ -256,14 +257,17 @@ def _low_references(
     inner = math.ceil(LOW_RING * radius)
     around = None
     if radius - inner >= 1:
-        ring = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))
-        hole = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * inner + 1, 2 * inner + 1))
+        ellipse = cv2.MORPH_ELLIPSE  # structuring elements are uint8
+        ring = cast(NDArray[np.uint8], cv2.getStructuringElement(ellipse, (2 * radius + 1,) * 2))
+        hole = cast(NDArray[np.uint8], cv2.getStructuringElement(ellipse, (2 * inner + 1,) * 2))
         ring[radius - inner : radius + inner + 1, radius - inner : radius + inner + 1] &= 1 - hole
-        ring_min = cv2.erode(zmin, ring, borderType=cv2.BORDER_CONSTANT, borderValue=np.inf)
+        eroded = cv2.erode(zmin, ring, borderType=cv2.BORDER_CONSTANT, borderValue=(np.inf,))
+        ring_min = cast(NDArray[np.float32], eroded)
         ring_min -= depth
         pit = (zmin < ring_min) & np.isfinite(ring_min)
         if pit.any():
-            _, labels, stats, _ = cv2.connectedComponentsWithStats(pit.astype(np.uint8), 8)
+            blobs = pit.astype(np.uint8)
+            _, labels, stats, _ = cv2.connectedComponentsWithStats(blobs, connectivity=8)
             small = stats[:, cv2.CC_STAT_AREA] <= int(hole.sum())
             small[0] = False
             blob = small[labels].ravel()
@@ -442,6 +446,7 @@ def _opened_surface(
     stats: dict[str, Any] = {}
     filled = fill_nearest(zmin, valid)
     if p.method == "smrf":
+        assert isinstance(p, SmrfParams) and isinstance(params, SmrfParams)
         if params.slope == 0:  # estimated from the cloud
             estimate = _estimate_slope(zmin, valid, p, xy_per_z, should_stop, compiled)
             p = replace(p, slope=estimate * xy_per_z)
@@ -450,6 +455,7 @@ def _opened_surface(
         windows, thresholds = smrf_windows(p)
         shape, final, scalar = "disk", p.threshold, p.scalar
     else:
+        assert isinstance(p, GroundFilterParams)
         windows, thresholds = pmf_windows(p)
         shape, final, scalar = p.window_shape, p.ground_threshold, p.slope_scalar
     objects = _progressive_opening(filled, windows, thresholds, shape, should_stop,
@@ -573,7 +579,9 @@ def ground_filter(
     xy_per_z = 1.0
     if unit_to_metre > 0 and vertical_unit_to_metre > 0:
         xy_per_z = unit_to_metre / vertical_unit_to_metre
-    p = replace(params, slope=params.slope * xy_per_z) if hasattr(params, "slope") else params
+    p: FilterParams = params
+    if isinstance(params, (GroundFilterParams, SmrfParams)):  # CSF has no slope
+        p = replace(params, slope=params.slope * xy_per_z)
     points = _Points(x, y, z)
     n = points.n
     if n == 0:
@@ -604,6 +612,7 @@ def ground_filter(
     report(0.45)
 
     if p.method == "csf":
+        assert isinstance(p, CsfParams)
         surf = _cloth_surface(cells, grid, points, low, candidate, p, vertical_unit_to_metre,
                               should_stop)  # fmt: skip
     else:

@@ -53,7 +53,7 @@ def _csf_cloth(
     nearest = np.full(rows * cols, np.inf)
     np.minimum.at(nearest, f, d2)
     pick = d2 == nearest[f]
-    ihv = np.full(rows * cols, np.nan, dtype=np.float64)
+    ihv: NDArray[np.float64] = np.full(rows * cols, np.nan, dtype=np.float64)
     ihv[f[pick]] = -zc[usable][pick].astype(np.float64)
     has = np.isfinite(ihv).reshape(rows, cols)
     ihv = fill_nearest(ihv.reshape(rows, cols), has)  # particles without a point: nearest one

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import replace
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -76,7 +77,8 @@ def _kernel(w: int, shape: str) -> NDArray[np.uint8]:
     import cv2
 
     if shape == "disk":
-        return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (w, w))
+        disk = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (w, w))
+        return cast(NDArray[np.uint8], disk)  # structuring elements are uint8
     return np.ones((w, w), np.uint8)
 
 
@@ -103,7 +105,7 @@ def _opening(
         if opened is not None:
             return opened
     # cv2's default border for erode/dilate is neutral (ignored), as the filter needs.
-    return cv2.morphologyEx(surface, cv2.MORPH_OPEN, kernel)
+    return cast(NDArray[np.float32], cv2.morphologyEx(surface, cv2.MORPH_OPEN, kernel))
 
 
 def _estimate_slope(

@@ -27,12 +27,14 @@ them array by array.
 from __future__ import annotations
 
 import threading
+from functools import partial
 from typing import Any, Callable
 
 import numpy as np
 
 from ..compiled import cached_njit
 
+numba: Any  # the module, or None without it
 try:  # pragma: no cover - depends on the environment
     import numba
 
@@ -284,10 +286,11 @@ def _compiled(name: str) -> Callable[..., Any]:
     """The jitted function (compiled at its first call for each argument type, cached next to
     this module, keyed by the module's import name)."""
     if name not in _COMPILED:
-        func = {"cells": _cells_kernel, "low_pass": _low_pass_kernel,
+        kernels: dict[str, Callable[..., Any]]
+        kernels = {"cells": _cells_kernel, "low_pass": _low_pass_kernel,
                 "classify": _classify_kernel, "bounds": _bounds_kernel,
-                "rect_union": _rect_union_kernel}[name]  # fmt: skip
-        _COMPILED[name] = cached_njit(func, nogil=True)
+                "rect_union": _rect_union_kernel}  # fmt: skip
+        _COMPILED[name] = cached_njit(kernels[name], nogil=True)
     return _COMPILED[name]
 
 
@@ -356,7 +359,7 @@ def rectangles(kernel: Any) -> tuple[Any, Any] | None:
     if rows % 2 == 0 or cols % 2 == 0 or not k[rows // 2, cols // 2]:
         return None
     ry, rx = rows // 2, cols // 2
-    half = []
+    half: list[int] = []
     for dy in range(ry + 1):
         row = k[ry + dy]
         if not np.array_equal(row, k[ry - dy]):
@@ -491,7 +494,7 @@ def cells_all(parts: Any, grid: Any, z0: float, candidate: Any, flat: Any, zr: A
             cells(part, grid, z0, candidate, lo, flat, zr, zmin)
         return zmin
 
-    grids = _run([lambda s=s: task(s) for s in _shares(len(pieces))])
+    grids = _run([partial(task, s) for s in _shares(len(pieces))])
     for other in grids[1:]:
         np.minimum(grids[0], other, out=grids[0])
     return grids[0]
@@ -508,7 +511,7 @@ def low_pass_all(flat: Any, zr: Any, candidate: Any, low: Any, reference: Any, a
         cand = None if candidate is None else candidate[a:b]
         return low_pass(flat[a:b], zr[a:b], cand, low[a:b], reference, around, zmin), zmin
 
-    results = _run([lambda r=r: task(r) for r in _shares(len(flat))])
+    results = _run([partial(task, r) for r in _shares(len(flat))])
     zmin = results[0][1]
     for _, other in results[1:]:
         np.minimum(zmin, other, out=zmin)
@@ -525,4 +528,4 @@ def classify_all(parts: Any, grid: Any, flat: Any, zr: Any, dtm: Any, thr: Any, 
         for lo, part in pieces[share[0] : share[1]]:
             classify(part, grid, lo, flat, zr, dtm, thr, low, candidate, nodata, ground, hag)
 
-    _run([lambda s=s: task(s) for s in _shares(len(pieces))])
+    _run([partial(task, s) for s in _shares(len(pieces))])

@@ -100,7 +100,8 @@ def target_field(spec: TargetSpec) -> TargetField:
     """
     if spec.kind == "chessboard":
         c, r = np.meshgrid(np.arange(spec.cols), np.arange(spec.rows))
-        xyz = np.column_stack([c.ravel(), r.ravel(), np.zeros(c.size)]) * spec.spacing_m
+        grid = np.column_stack([c.ravel(), r.ravel(), np.zeros(c.size)])
+        xyz = np.asarray(grid * spec.spacing_m, dtype=np.float64)  # float64 already: no copy
         ids = np.arange(spec.cols * spec.rows, dtype=np.int64)
         return TargetField(ids, xyz, (0, spec.cols - 1, (spec.rows - 1) * spec.cols),
                            spec.spacing_m)  # fmt: skip
@@ -170,13 +171,13 @@ def detect_target(image: NDArray[Any], spec: TargetSpec, name: str = "") -> Dete
     params = cv2.aruco.DetectorParameters()
     params.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
     board = _grid_board(spec)
-    det = cv2.aruco.ArucoDetector(_dictionary(spec.dictionary), params)
-    corners, ids, _ = det.detectMarkers(grey)
+    aruco = cv2.aruco.ArucoDetector(_dictionary(spec.dictionary), params)
+    marker_corners, ids, _ = aruco.detectMarkers(grey)
     if ids is None or len(ids) == 0:
         return Detection(name, np.zeros(0, np.int64), np.zeros((0, 2)))
     mids = np.asarray(ids, dtype=np.int64).ravel()
     on_board = np.isin(mids, np.asarray(board.getIds()).ravel())
-    c = np.asarray(corners, dtype=np.float64).reshape(-1, 4, 2)[on_board]
+    c = np.asarray(marker_corners, dtype=np.float64).reshape(-1, 4, 2)[on_board]
     mids = mids[on_board]
     # a marker id seen twice in one image is ambiguous: drop it
     uniq, counts = np.unique(mids, return_counts=True)

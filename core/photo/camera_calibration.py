@@ -296,7 +296,8 @@ def _init_perspective(views: list[tuple[Array, Array]], size: tuple[int, int]):
 
     obj = [xyz.astype(np.float32) for xyz, _ in views]
     img = [(px - 0.5).astype(np.float32) for _, px in views]  # OpenCV pixel centres
-    _, k, _, rvecs, tvecs = cv2.calibrateCamera(obj, img, size, None, None)
+    # OpenCV takes None for the camera matrix and distortion to estimate; its stubs do not
+    _, k, _, rvecs, tvecs = cv2.calibrateCamera(obj, img, size, None, None)  # type: ignore[call-overload]
     f_px = 0.5 * (k[0, 0] + k[1, 1])
     pp = np.array([k[0, 2] + 0.5, k[1, 2] + 0.5])
     eos = np.array([_cv_pose_to_eo(r, t) for r, t in zip(rvecs, tvecs)])
@@ -374,7 +375,7 @@ def _adjust_explained(x0v, pnames, blocks, constraints, aopts, progress, should_
     return res
 
 
-def _residuals_by_point(res: AdjustmentResult, blocks, is_free: Array, px: Array):
+def _residuals_by_point(res: AdjustmentResult, blocks, is_free: NDArray[np.bool_], px: Array):
     """(v, w): the residuals (px) and w-tests of every measured point in the input order."""
     v_all = np.zeros_like(px)
     w_all = np.full_like(px, np.nan)
@@ -538,6 +539,7 @@ def calibrate_camera(
     opts = options or CalibrationOptions()
     view, pt, px, names = _flat(detections, fld)
     skipped = [d.image for d in detections if d.image not in names]
+    warnings: list[str]  # Messages: English text that keeps its template for translation
     warnings = [_t("view {view!r} left out: fewer than {minimum} target points", view=s,
                    minimum=MIN_POINTS_PER_VIEW) for s in skipped]  # fmt: skip
     n_views = len(names)

@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -154,7 +155,8 @@ def register_sift(
         lo, hi = np.nanpercentile(a, [0.5, 99.5])
         return np.clip((a - lo) * (255.0 / max(float(hi - lo), 1e-6)), 0, 255).astype(np.uint8)
 
-    sift = cv2.SIFT_create(nfeatures=int(features))
+    # cv2.SIFT_create (OpenCV >= 4.4) is missing from OpenCV's stubs
+    sift = cv2.SIFT_create(nfeatures=int(features))  # type: ignore[attr-defined]
     ka, da = sift.detectAndCompute(u8(_grey_f32(reference)), None)
     kb, db = sift.detectAndCompute(u8(_grey_f32(moved)), None)
     empty = SiftRegistration(np.empty((0, 2)), np.empty((0, 2)), 0, np.full((3, 3), np.nan))
@@ -176,7 +178,7 @@ def register_sift(
     if h is None:
         return SiftRegistration(np.empty((0, 2)), np.empty((0, 2)), len(good), empty.homography)
     inl = mask.ravel().astype(bool)
-    return SiftRegistration(pa[inl], pb[inl], len(good), h)
+    return SiftRegistration(pa[inl], pb[inl], len(good), cast(Array, h))  # 3 x 3 float64
 
 
 def _on_plane(pixels: Array, eo: Array, camera: Camera, z: float) -> Array:
@@ -248,7 +250,7 @@ def rectify_to_plane(
         mx = np.where(good, px[:, 0] - 0.5, -1e6).astype(np.float32).reshape(shape)
         my = np.where(good, px[:, 1] - 0.5, -1e6).astype(np.float32).reshape(shape)
         sub = cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
-                        borderValue=np.nan)  # fmt: skip
+                        borderValue=(np.nan,))  # fmt: skip
         # a cell with any sub-sample outside the photo is NaN (no partial cells)
         chip[r0:r1] = sub.reshape(r1 - r0, s, n, s).mean(axis=(1, 3))
     return chip, s
@@ -333,6 +335,7 @@ def make_chip(
             notes.append(_t("{n} SIFT matches rejected by data snooping", n=len(fr.rejected)))
     chip, s = rectify_to_plane(source_img, camera, eo, gt, opt.size_px, origin_xy=p[:2], z=0.0)
     valid = float(np.isfinite(chip).mean())
+    kw: dict[str, Any]  # ChipResult's fields
     kw = dict(detection=det, plate=pr, sift=reg, free_eo=np.asarray(eo).copy(),
               free_std=np.asarray(std).copy(), free_sigma0=float(s0), source=source,
               chip=chip, valid_fraction=valid, subsamples=s, notes=tuple(notes))  # fmt: skip

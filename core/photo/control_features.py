@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -261,7 +262,7 @@ class ControlSet:
     ) -> ControlSet:
         """Core objects of layer features (:func:`~.picking.plane_from_feature` and the line
         and LCP ones); features without a usable geometry are counted in ``skipped``."""
-        out: dict[str, tuple] = {}
+        out: dict[str, tuple[tuple[Any, ...], tuple[str, ...]]] = {}  # kind: (objects, ids)
         skipped: dict[str, int] = {}
         for kind, feats, make in (
             ("planes", planes, plane_from_feature),
@@ -307,7 +308,10 @@ class ControlSet:
                     new_ids.append(str(t.id))
                     continue
                 used.add(k)
-                new_objs.append(t.with_outline(objs[k].outline) if kind == "planes" else t)
+                if kind == "planes":
+                    assert isinstance(t, Plane)  # the plane table's rows
+                    t = t.with_outline(objs[k].outline)
+                new_objs.append(t)
                 new_ids.append(ids[k])
             for k, (o, i) in enumerate(zip(objs, ids)):
                 if k not in used:

@@ -45,6 +45,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -263,9 +264,10 @@ def locate_control_points(
                                      template_px=size.size))  # fmt: skip
             continue
         results: dict[int, LocatedPair] = {}
-        for i in np.flatnonzero(inside):
+        for i in np.flatnonzero(inside).tolist():
             iid = eo.image_id[i]
             pred = pix[i, 0]
+            base: dict[str, Any]  # LocatedPair's fields
             base = {"template_px": size.size, "predicted_col": float(pred[0]),
                     "predicted_row": float(pred[1])}  # fmt: skip
             if not inside_margin[i]:
@@ -285,7 +287,7 @@ def locate_control_points(
             cov_search = cov_search + np.diag(np.full(2, opt.min_search_px**2))
             base["search_px"] = (float(half_f[0]), float(half_f[1]))
             jac = jac_chip[i]
-            r = _match(
+            m = _match(
                 chip_template=template,
                 ref=ref,
                 jac=jac,
@@ -296,7 +298,7 @@ def locate_control_points(
                 opt=opt,
                 cv2=cv2,
             )
-            results[i] = _finish(pid, iid, r, pred, cov_search, base, "chip")
+            results[i] = _finish(pid, iid, m, pred, cov_search, base, "chip")
         # transfer
         if opt.transfer:
             good = [i for i, r in results.items() if r.status == "ok"]
@@ -320,8 +322,8 @@ def locate_control_points(
     if progress is not None:
         progress(1.0)
     if obs_rows:
-        img, pid_, c, rr, s = zip(*obs_rows)
-        obs = ImageObservations.from_arrays(img, pid_, np.column_stack([c, rr]), s,
+        img, pid_, c, rr, sig = zip(*obs_rows)
+        obs = ImageObservations.from_arrays(img, pid_, np.column_stack([c, rr]), sig,
                                             ["control"] * len(img), [""] * len(img))  # fmt: skip
     else:
         obs = ImageObservations.from_arrays([], [], np.zeros((0, 2)), np.zeros(0), [], [])

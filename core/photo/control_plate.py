@@ -68,6 +68,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -405,7 +406,7 @@ def _edge_points(
     mx = (pts[..., 0] - 0.5).astype(np.float32)
     my = (pts[..., 1] - 0.5).astype(np.float32)
     prof = cv2.remap(smooth, mx, my, cv2.INTER_CUBIC, borderMode=cv2.BORDER_CONSTANT,
-                     borderValue=np.nan).astype(np.float64)  # fmt: skip
+                     borderValue=(np.nan,)).astype(np.float64)  # fmt: skip
     grad = np.abs(np.gradient(prof, PROFILE_STEP_PX, axis=1))
     ok = np.isfinite(grad).all(axis=1)
     grad = np.nan_to_num(grad)
@@ -476,7 +477,7 @@ def detect_plate(
                                         n=len(pairs)),
                               candidates=len(pairs))  # fmt: skip
     outer, inner = pairs[0]
-    smooth = cv2.GaussianBlur(img, (0, 0), 1.0)
+    smooth = cast(NDArray[np.float32], cv2.GaussianBlur(img, (0, 0), 1.0))  # depth kept
     lines = []
     rms = np.full(8, np.nan)
     count = np.zeros(8, np.int64)

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -194,7 +195,8 @@ def _search_coords(a: Array, x: Array, y: Array) -> tuple[Array, Array]:
 def _outside(cs: Array, rs: Array, box: tuple[float, float, float]) -> NDArray[np.bool_]:
     """(K,) patches with a point outside the usable interior ``(lo, hi_col, hi_row)``."""
     lo, hi_c, hi_r = box
-    return ((cs < lo) | (rs < lo) | (cs > hi_c) | (rs > hi_r)).any(axis=1)
+    outside = (cs < lo) | (rs < lo) | (cs > hi_c) | (rs > hi_r)
+    return cast(NDArray[np.bool_], outside.any(axis=1))  # an array along an axis
 
 
 def _numpy_normals(

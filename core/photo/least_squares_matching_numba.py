@@ -8,12 +8,14 @@ compare them); numba is optional: :data:`AVAILABLE` tells whether it imports.
 
 from __future__ import annotations
 
+from types import ModuleType
 from typing import Any, Callable
 
 import numpy as np
 
 from ..compiled import cached_njit
 
+numba: ModuleType | None  # None without numba
 try:  # pragma: no cover - depends on the environment
     import numba
 
@@ -131,8 +133,8 @@ _COMPILED: dict[str, Callable[..., Any]] = {}
 def _compiled(name: str) -> Callable[..., Any]:
     """The jitted function (compiled at its first call; cached next to this module)."""
     if name not in _COMPILED:
-        func = {"normals": _normals, "samples": _samples}[name]
-        _COMPILED[name] = cached_njit(func, nogil=True)
+        kernels: dict[str, Callable[..., Any]] = {"normals": _normals, "samples": _samples}
+        _COMPILED[name] = cached_njit(kernels[name], nogil=True)
     return _COMPILED[name]
 
 

@@ -23,6 +23,9 @@ is an upper bound of the median match error: a wrong model only inflates it.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import cv2
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -134,7 +137,7 @@ def _monomials(p: Array, centre: Array, scale: float, degree: int) -> Array:
 
 def fit_smooth_map(
     src: ArrayLike, dst: ArrayLike, degree: int = 0, k: float = 3.0
-) -> tuple[object, NDArray[np.bool_]]:
+) -> tuple[Callable[[ArrayLike], NDArray[np.float64]], NDArray[np.bool_]]:
     """A homography plus, when ``degree >= 2``, a polynomial correction in image 2 of the
     terms of degree 2..``degree`` (a smooth departure from one plane seen by two pinhole
     cameras: lens distortion that differs between the images, a gently curved scene). Robust
@@ -159,7 +162,7 @@ def fit_smooth_map(
     centre = p.mean(axis=0)
     scale = float(np.abs(p - centre).max()) or 1.0
     mono_all = _monomials(p, centre, scale, degree)
-    coef = np.zeros((mono_all.shape[1], 2))
+    coef: NDArray[np.floating[Any]] = np.zeros((mono_all.shape[1], 2))
     # alternate: the correction given H, H given the correction, then the kept set
     for _ in range(20):
         for _ in range(3):

@@ -558,8 +558,8 @@ def monoplot(
     obs, cam, table = observations, camera, eo
     mapping_crs = parse_crs(crs)
     tracer = dsm if isinstance(dsm, DsmTracer) else None
-    if tracer is not None:  # a prepared DSM (interactive use: one click after another)
-        dsm = tracer.dsm
+    if isinstance(dsm, DsmTracer):  # a prepared DSM (interactive use: one click after another)
+        dsm = dsm.dsm
     plane_map: dict[str, Plane] = {str(p.id): p for p in planes}
 
     src, pixels, line_of, vertex_of, line_keys = _ray_table(obs, float(line_step_px))

@@ -300,7 +300,7 @@ class OrthoProjector:
             A lens lattice of the same camera (:func:`_lens_lattice`), to share between images.
         """
         tracer = dsm if isinstance(dsm, DsmTracer) else None
-        surface = tracer.dsm if tracer is not None else dsm
+        surface = dsm.dsm if isinstance(dsm, DsmTracer) else dsm
         zr = (tracer.zmin, tracer.zmax) if tracer is not None else surface.z_range
         if local is None:
             mapping = MappingFrame(parse_crs(crs))
@@ -502,8 +502,9 @@ def _occlusion(
     square whose four corners agree take their value, the others get their own ray."""
     h, w = z.shape
     s = int(max(1, min(8, math.floor(proj.dsm.cell / (2 * grid.cell)))))
-    ys = grid.y_top - (row0 + np.arange(h) + 0.5) * grid.cell
-    xs = grid.x0 + (col0 + np.arange(w) + 0.5) * grid.cell
+    # float64 already: asarray makes no copy
+    ys = np.asarray(grid.y_top - (row0 + np.arange(h) + 0.5) * grid.cell, dtype=np.float64)
+    xs = np.asarray(grid.x0 + (col0 + np.arange(w) + 0.5) * grid.cell, dtype=np.float64)
     occ = np.zeros((h, w), bool)
     if s == 1 or h < 2 or w < 2:
         r, c = np.nonzero(valid)

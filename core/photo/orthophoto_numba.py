@@ -212,11 +212,12 @@ _COMPILED: dict[str, Callable[..., Any]] = {}
 
 def _compiled(name: str) -> Callable[..., Any]:
     if name not in _COMPILED:
-        func = {"cells": _cell_pixels, "maps": _remap_maps, "fixed": _remap_maps_fixed,
-                "stats": _cell_stats}[name]  # fmt: skip
+        kernels: dict[str, Callable[..., Any]]
+        kernels = {"cells": _cell_pixels, "maps": _remap_maps, "fixed": _remap_maps_fixed,
+                   "stats": _cell_stats}  # fmt: skip
         # numpy's error model: a float division by zero gives inf (checked after), with no
         # test per division that would keep the cell loop from being vectorised
-        _COMPILED[name] = cached_njit(func, nogil=True, error_model="numpy")
+        _COMPILED[name] = cached_njit(kernels[name], nogil=True, error_model="numpy")
     return _COMPILED[name]
 
 
@@ -261,8 +262,8 @@ def remap_maps_fixed(
 
 def valid_bounds(col: np.ndarray, row: np.ndarray) -> tuple[int, float, float, float, float]:
     """(count, col min, col max, row min, row max) over the cells whose col is finite."""
-    _, n, _, *bounds = cell_stats(col, row, col)
-    return (n, *bounds)
+    _, n, _, c_lo, c_hi, r_lo, r_hi = cell_stats(col, row, col)
+    return (n, c_lo, c_hi, r_lo, r_hi)
 
 
 def cell_stats(

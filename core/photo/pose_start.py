@@ -108,10 +108,11 @@ def initial_pose_pnp(pixels: ArrayLike, points: ArrayLike, camera: Camera) -> Ar
     centre = pts.mean(axis=0)  # keeps OpenCV's float arithmetic away from large coordinates
     obj = np.ascontiguousarray(pts - centre)
     img = np.ascontiguousarray(cv_px)
-    ok, rvec, tvec = cv2.solvePnP(obj, img, k, None, flags=cv2.SOLVEPNP_SQPNP)
+    # OpenCV takes None for no distortion; its stubs do not
+    ok, rvec, tvec = cv2.solvePnP(obj, img, k, None, flags=cv2.SOLVEPNP_SQPNP)  # type: ignore[call-overload]
     if not ok:
         raise InputError("OpenCV could not find an initial pose for the resection")
-    ok, rvec, tvec = cv2.solvePnP(obj, img, k, None, rvec, tvec, True, cv2.SOLVEPNP_ITERATIVE)
+    ok, rvec, tvec = cv2.solvePnP(obj, img, k, None, rvec, tvec, True, cv2.SOLVEPNP_ITERATIVE)  # type: ignore[call-overload]
     r_cv = cv2.Rodrigues(rvec)[0]
     m = _CV_FLIP @ r_cv
     x0 = -r_cv.T @ tvec.ravel() + centre

@@ -436,6 +436,7 @@ class _Problem:
         return np.tile(np.arange(self.n), (g, 1))
 
     def x0(self, eo: Array) -> Array:
+        io: Array | list[float]  # the interior orientation's start, when estimated
         io = self.camera.interior_params[:3] if self.options.estimate_interior else []
         return np.concatenate([eo, io])
 

@@ -263,7 +263,11 @@ def image_inputs(
     l_index = lines.index() if lines is not None else {}
     out = []
     for img in wanted:
-        p_rows, p_ctrl, c_rows, c_ctrl = [], [], [], []
+        # observation rows and control indices of the points used, and of the check points
+        p_rows: list[int] = []
+        p_ctrl: list[int] = []
+        c_rows: list[int] = []
+        c_ctrl: list[int] = []
         groups: dict[str, list[int]] = {}
         ignored = 0
         for k in by_image[img]:

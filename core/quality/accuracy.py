@@ -394,10 +394,12 @@ def assess_accuracy(
     if len(names) > 1 or (names and names[0]):
         for g in names:
             mask = (garr == g) & used
-            label = g or "(no group)"
-            groups[label] = group_statistics(d[mask], label, alpha=s.alpha, declared_sigma=sig)
+            group_label = g or "(no group)"
+            groups[group_label] = group_statistics(
+                d[mask], group_label, alpha=s.alpha, declared_sigma=sig
+            )
             if "project" in s.standards and mask.any():
-                thresholds[label] = project_threshold(
+                thresholds[group_label] = project_threshold(
                     d[mask],
                     h_threshold=s.project_h_threshold,
                     v_threshold=s.project_v_threshold or None,
@@ -418,11 +420,15 @@ def assess_accuracy(
                 )
             )
         elif key == "nssda":
+            normality = [comps[c].normality for c in COMPONENTS]
+            bias = [comps[c].bias for c in COMPONENTS]
+            # E, N and H of a non-empty set are always tested
+            assert all(x is not None for x in normality) and all(x is not None for x in bias)
             results.append(
                 nssda(
                     du,
-                    normal=[comps[c].normality.normal for c in COMPONENTS],
-                    biased=[comps[c].bias.biased for c in COMPONENTS],
+                    normal=[x.normal for x in normality if x is not None],
+                    biased=[x.biased for x in bias if x is not None],
                 )
             )
         elif key == "pec":

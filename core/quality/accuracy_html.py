@@ -245,10 +245,10 @@ def render_html(report: AccuracyReport) -> str:
         parts.append('<h3 class="group">' + t("For comparison: {} ({})").format(
             _e(t(report.contrast.name)), report.contrast.n) + "</h3>")  # fmt: skip
         parts.append(_stats_table(report.contrast))
-    for name, g in report.groups.items():
-        parts.append('<h3 class="group">' + t("Group {} ({})").format(_e(name), g.n) + "</h3>")
-        parts.append(_stats_table(g))
-        parts.append(_tests_table(g))
+    for name, stats in report.groups.items():
+        parts.append('<h3 class="group">' + t("Group {} ({})").format(_e(name), stats.n) + "</h3>")
+        parts.append(_stats_table(stats))
+        parts.append(_tests_table(stats))
     parts.append(f"<h2>{t('Outliers')}</h2>")
     parts.append(
         "<p>"

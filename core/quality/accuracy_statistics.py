@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -301,7 +302,7 @@ class OutlierScreen:
 
     @property
     def any(self) -> NDArray[np.bool_]:
-        return self.flags.any(axis=1)
+        return cast(NDArray[np.bool_], self.flags.any(axis=1))  # an array along an axis
 
 
 def screen_outliers(d: NDArray[np.float64], rule: str = "robust") -> OutlierScreen:

@@ -15,6 +15,7 @@ from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .. import __version__
 from .html_table import TR_CONTEXT, failed_checks, html_lang, report_css, t  # noqa: F401 - TR_CONTEXT: i18n
@@ -49,8 +50,8 @@ def _n(x: float | None, digits: int = 2) -> str:
 def _value_table(
     head: list[str],
     names: Sequence[str],
-    values: Sequence[float],
-    sigmas: Sequence[float],
+    values: Sequence[float] | NDArray[np.float64],
+    sigmas: Sequence[float] | NDArray[np.float64],
     digits: int,
 ) -> str:
     """A table of estimated parameters: one row a parameter, its value and sigma."""
@@ -192,10 +193,12 @@ def _results(run: BoresightRun) -> list[str]:
     if res.lever_arm is not None:
         out.append(f"<h3>{t('Lever arm (body frame)')}</h3>")
         head = [t("axis"), t("value (m)"), t("sigma (m)")]
+        assert res.lever_arm_std is not None  # estimated with the lever arm
         out.append(_value_table(head, "xyz", res.lever_arm, res.lever_arm_std, 4))
     if res.interior is not None:
         out.append(f"<h3>{t('Interior orientation')}</h3>")
         head = [t("parameter"), t("value (mm)"), t("sigma (mm)")]
+        assert res.interior_std is not None  # estimated with the interior orientation
         out.append(_value_table(head, ("f", "x0", "y0"), res.interior, res.interior_std, 5))
     if res.timing_offset is not None:
         out += _timing(res)

@@ -284,12 +284,12 @@ def render_bundle_html(
     cams = np.array(res.image_camera)
     img_index = {im: k for k, im in enumerate(res.eo.image_id)}
     cam_of_obs = cams[[img_index[i] for i in obs.image_id]] if len(obs) else np.array([])
-    for name, cam in res.cameras.items():
+    for name, camera in res.cameras.items():
         sel = res.used & (cam_of_obs == name)
         if sel.any():
             plots.append(image_vector_field(
                 obs.pixels[sel, 0], obs.pixels[sel, 1], res.v_px[sel, 0], res.v_px[sel, 1],
-                cam.width_px, cam.height_px,
+                camera.width_px, camera.height_px,
                 title=t("Image residuals: {}").format(name)))  # fmt: skip
     used_v = res.v_px[res.used]
     if used_v.size:

@@ -14,7 +14,7 @@ __all__ = ["TR_CONTEXT", "escape", "failed_checks", "html_lang", "report_css", "
 TR_CONTEXT = "Report"
 
 
-def t(text: str) -> str:
+def t(text: object) -> str:
     """``text`` in the language of the reports (:func:`core.i18n.set_language`); a
     :class:`core.i18n.Message` through its translated template and its values."""
     return render(text, TR_CONTEXT)

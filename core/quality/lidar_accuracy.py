@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -171,14 +172,14 @@ def _relative_verdicts(
                                f"{_class_met(p.range_max, WITHIN_SWATH_FACTOR)}",
                                p.range_max, None))  # fmt: skip
         else:
-            v = _limit_verdict(name, p.range_max, lim["within_swath_max"], enough,
-                               f"largest cell range on {p.cells} cells")  # fmt: skip
+            verdict = _limit_verdict(name, p.range_max, lim["within_swath_max"], enough,
+                                     f"largest cell range on {p.cells} cells")  # fmt: skip
             m = (cells.swath == p.swath) & cells.smooth
             share = (
                 float(np.mean(cells.range[m] <= lim["within_swath_max"] + _TOL)) if p.cells else 0.0
             )
-            out.append(replace(v, reason=f"{v.reason}; {share:.1%} of the cells within it, 95th "
-                               f"percentile {_cm(p.range_p95)}"))  # fmt: skip
+            out.append(replace(verdict, reason=f"{verdict.reason}; {share:.1%} of the cells "
+                               f"within it, 95th percentile {_cm(p.range_p95)}"))  # fmt: skip
     return out
 
 
@@ -293,9 +294,9 @@ def report_from_cells(
     )  # fmt: skip
 
 
-def pair_rows(report: LidarAccuracyReport) -> list[dict[str, object]]:
+def pair_rows(report: LidarAccuracyReport) -> list[dict[str, Any]]:
     """One dict per swath pair (and one for all pairs) of the figures the report prints."""
-    rows: list[dict[str, object]] = []
+    rows: list[dict[str, Any]] = []
     lim = relative_limits(report.options.v_class_cm) if report.options.v_class_cm > 0 else None
     for p in report.pairs:
         st: dict[str, object] = {"swath_a": p.swath_a, "swath_b": p.swath_b, **p.stats()}
@@ -360,4 +361,4 @@ def report_dict(report: LidarAccuracyReport, raster_bands: Sequence[str] = ()) -
             for i, p, g, v, dz in zip(report.checkpoints.ids, report.checkpoints.xyz,
                                       report.checkpoints.groups, f.vegetated, f.dz)
         ]  # fmt: skip
-    return _finite(d)
+    return {k: _finite(x) for k, x in d.items()}  # _finite(d), keeping the dict type

@@ -5,6 +5,7 @@ points, histograms and a map of the overlap differences (SVG)."""
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -22,13 +23,13 @@ tr.fail td{background:#f8dede}tr.insufficient td{background:#fff3cd}
 """
 
 
-def _m(v: object, digits: int = 4) -> str:
+def _m(v: Any, digits: int = 4) -> str:
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "&ndash;"
     return f"{float(v):.{digits}f}"
 
 
-def _pct(v: object) -> str:
+def _pct(v: Any) -> str:
     return "&ndash;" if v is None else f"{100 * float(v):.2f} %"
 
 

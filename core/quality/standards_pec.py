@@ -144,7 +144,7 @@ def pec_pcd(
         )
     ]
     figures: dict[str, float] = {"RMSE_HORIZONTAL": rms_h, "RMSE_U": rms_v}
-    best = {"planimetric": None, "altimetric": None}
+    best: dict[str, str | None] = {"planimetric": None, "altimetric": None}
     for kind, values, rms, pk, ek in (
         ("planimetric", horiz, rms_h, "pec_h", "ep_h"),
         ("altimetric", vert, rms_v, "pec_v", "ep_v"),

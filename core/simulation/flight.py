@@ -360,7 +360,8 @@ def _true_flight(cfg, cam, h0: float, frame, rng, seconds_per_image: float):
     fwd = np.array([math.sin(az), math.cos(az)])
     right = np.array([math.cos(az), -math.sin(az)])
     names = _direction_names(cfg)
-    pos, head, groups, ids = [], [], [], []
+    pos, head, groups = [], [], []
+    ids: list[str] = []
     m = cfg.images_per_line
     for line in range(cfg.n_lines):
         back = cfg.opposite and line % 2 == 1
@@ -454,9 +455,8 @@ def _control(
         if not np.isfinite(x).all():
             continue
         xyz = p.copy() if exact else x[0]
-        all_lcps.append(
-            ControlPoint(k, xyz, c[0], tuple(int(f) for f in tri), 0.0, float(cond[0]), np.zeros(3))
-        )
+        plane_ids = (int(tri[0]), int(tri[1]), int(tri[2]))
+        all_lcps.append(ControlPoint(k, xyz, c[0], plane_ids, 0.0, float(cond[0]), np.zeros(3)))
         lcp_truth.append(p)
     return planes, lines, line_truth, all_lcps, lcp_truth
 

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -65,8 +66,8 @@ class GroundPatch:
 
         xa = np.asarray(x, dtype=np.float64)
         ya = np.asarray(y, dtype=np.float64)
-        mx = ((xa - self.x0) / self.cell_m - 0.5).astype(np.float32).ravel()
-        my = ((self.y_top - ya) / self.cell_m - 0.5).astype(np.float32).ravel()
+        mx: NDArray[np.float32] = ((xa - self.x0) / self.cell_m - 0.5).astype(np.float32).ravel()
+        my: NDArray[np.float32] = ((self.y_top - ya) / self.cell_m - 0.5).astype(np.float32).ravel()
         # cv2.remap wants sides below 32767: rows of 4096 points, padded
         width = 4096
         pad = (-len(mx)) % width
@@ -76,7 +77,7 @@ class GroundPatch:
         for s in range(0, len(mx), 16384):
             out[s : s + 16384] = cv2.remap(self.grey, mx[s : s + 16384], my[s : s + 16384],
                                            cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
-                                           borderValue=0.0)  # fmt: skip
+                                           borderValue=(0.0,))  # fmt: skip
         out = out.ravel()[: xa.size]
         return out.reshape(xa.shape)
 
@@ -90,7 +91,7 @@ def make_ground_patch(
     n = math.ceil(size_m / cell_m)
     rng = np.random.default_rng(seed)
     g = rng.standard_normal((n, n)).astype(np.float32)
-    g = cv2.GaussianBlur(g, (0, 0), feature_m / cell_m)
+    g = cast(NDArray[np.float32], cv2.GaussianBlur(g, (0, 0), feature_m / cell_m))
     g = (g - g.mean()) / max(float(g.std()), 1e-12)
     grey = np.clip(125.0 + 30.0 * g, 40.0, 210.0).astype(np.float32)
     half = n * cell_m / 2.0
@@ -159,8 +160,8 @@ def render_ground_photo(
         hi[r0 : r0 + n] = lab.max(axis=(1, 3))
     # a pixel on an edge: its rays see two things, or a neighbour sees something else (with
     # few rays per pixel an edge can pass between them)
-    lo = cv2.erode(lo, np.ones((3, 3), np.uint8))
-    hi = cv2.dilate(hi, np.ones((3, 3), np.uint8))
+    lo = cast(NDArray[np.uint8], cv2.erode(lo, np.ones((3, 3), np.uint8)))  # depth kept
+    hi = cast(NDArray[np.uint8], cv2.dilate(hi, np.ones((3, 3), np.uint8)))
     mixed = lo != hi
     # pixels on the plate's edges again with EDGE_SUPERSAMPLE^2 rays: the edge's position in
     # the grey level is then exact to 1/EDGE_SUPERSAMPLE^2 of a pixel's area
@@ -224,4 +225,5 @@ def corner_errors(found: ArrayLike, truth: ArrayLike) -> NDArray[np.float64]:
         err = np.linalg.norm(found - truth[order], axis=1)
         if best is None or err.max() < best.max():
             best = err
+    assert best is not None  # set at the first turn
     return best

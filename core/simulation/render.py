@@ -404,7 +404,8 @@ def render_image(
         # a 24-Mpx LZW TIFF near 16 MB instead of 30 MB with independent channels
         noise = np.empty(base.shape[:2], np.int16)
         cv2.setRNGSeed(int(opt.seed))
-        cv2.randn(noise, 0.0, float(opt.noise_dn))
+        # OpenCV's stubs want arrays for the mean and deviation; it takes numbers
+        cv2.randn(noise, 0.0, float(opt.noise_dn))  # type: ignore[call-overload]
         base = cv2.add(base, cv2.merge([noise, noise, noise]), dtype=cv2.CV_8U)
     ids = np.append(scene.plane_ids, -1).astype(np.int32)
     plane_id = ids[label]  # -1 indexes the appended "no plane"

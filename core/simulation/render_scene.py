@@ -182,8 +182,8 @@ def _nearest_label_raster(
     order = np.lexsort((z, flat))
     fs = flat[order]
     last = np.flatnonzero(np.r_[fs[1:] != fs[:-1], True])
-    out = np.full(grid.rows * grid.cols, fill, dtype=np.int32)
-    occupied = np.zeros(grid.rows * grid.cols, dtype=bool)
+    out: NDArray[np.int32] = np.full(grid.rows * grid.cols, fill, dtype=np.int32)
+    occupied: NDArray[np.bool_] = np.zeros(grid.rows * grid.cols, dtype=bool)
     out[fs[last]] = labels[order[last]]
     occupied[fs[last]] = True
     out = out.reshape(grid.rows, grid.cols)
@@ -363,7 +363,7 @@ class RenderScene:
         centroids = np.array([p.centroid for p in planes], dtype=np.float64).reshape(n_p, 3)
         edge = np.zeros((n_p, n_p), dtype=np.int8)
         line_of = np.full((n_p, n_p), -1, dtype=np.int32)
-        segments = []
+        segments: list[list[Array]] = []
         for line in lines:
             a, b = (by_id.get(int(i), -1) for i in line.plane_ids)
             if a >= 0 and b >= 0 and a != b:

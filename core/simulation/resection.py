@@ -11,6 +11,7 @@ line share only the line), and the control with the noise of its covariance.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -119,6 +120,7 @@ def write_scene_files(
                                             "eo_true")}  # fmt: skip
     paths["camera"] = out / "camera.json"
     write_camera_json(paths["camera"], scene.camera)
+    rows: dict[str, list[Any]]  # the observation table's columns
     rows = {"image_id": [], "point_id": [], "pixels": [], "sigma_px": [], "type": [],
             "target_id": []}  # fmt: skip
 

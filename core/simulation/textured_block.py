@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -172,11 +173,12 @@ def render_view(tb: TexturedBlock, texture: GroundTexture, k: int, *, step_px: i
     map_u = (ar @ u.astype(np.float32)) @ ac.T
     map_v = (ar @ v.astype(np.float32)) @ ac.T
     img = cv2.remap(texture.values, map_u, map_v, cv2.INTER_LINEAR,
-                    borderMode=cv2.BORDER_CONSTANT, borderValue=0)  # fmt: skip
+                    borderMode=cv2.BORDER_CONSTANT, borderValue=(0,))  # fmt: skip
     del map_u, map_v
     if noise_dn > 0:
         noise = np.empty(img.shape, np.int16)
         cv2.setRNGSeed(int(seed) + k)
-        cv2.randn(noise, 0.0, float(noise_dn))
+        # OpenCV's stubs want arrays for the mean and deviation; it takes numbers
+        cv2.randn(noise, 0.0, float(noise_dn))  # type: ignore[call-overload]
         img = cv2.add(img, noise, dtype=cv2.CV_8U)
-    return img
+    return cast(NDArray[np.uint8], img)  # the texture's 8 bits, kept by remap and add

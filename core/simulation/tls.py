@@ -417,7 +417,9 @@ def scene_from_network(
     return scene, replace(truth, target_xyz=centres)
 
 
-def _hits(scene: ScanScene, m: Array, x0: Array, u: Array) -> tuple[Array, Array, Array]:
+def _hits(
+    scene: ScanScene, m: Array, x0: Array, u: Array
+) -> tuple[Array, Array, NDArray[np.int64]]:
     """Nearest hit along unit rays ``u`` (N, 3) of the scanner frame: range, intensity and
     label (the target index, -1 for a wall); the scene is moved into the scanner frame."""
     n = u.shape[0]

@@ -299,7 +299,7 @@ def _build(
             RoofFace(first_face + k, building_id, roof_type, normal, d, np.column_stack([xy, z]))
         )
     # ridges: polygon edges that are not on the footprint boundary
-    ridges = []
+    ridges: list[Array] = []
     for face, poly in zip(faces, polys_local):
         m = len(poly)
         for i in range(m):
@@ -395,7 +395,9 @@ def make_town(
         a, b, c, d = terrain
         return float(-(a * xy[0] + b * xy[1] + d) / c)
 
-    buildings, faces, trees = [], [], []
+    buildings: list[Building] = []
+    faces: list[RoofFace] = []
+    trees: list[Tree] = []
     for i in range(n_cells):
         centre = np.array([ox + (i % cols + 0.5) * cell, oy + (i // cols + 0.5) * cell])
         centre = centre + rng.uniform(-1.5, 1.5, 2)

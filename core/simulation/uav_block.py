@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 from ..geometry.ap_models import AP_FAMILIES, make_ap_model
 from ..geometry.camera import Camera
 from ..geometry.collinearity import project_with_status
-from ..geometry.distortion import BrownConrady
+from ..geometry.distortion import BrownConrady, DistortionModel
 from ..geometry.frames import LocalFrame, MappingFrame
 from ..geometry.rotations import matrix_to_opk, opk_to_matrix
 from ..io.atomic import write_text_atomic
@@ -249,6 +249,7 @@ def _true_camera(
     true_ap = {} if ap_model == "none" else _true_ap(ap_model, nominal, ap_scale_px, rng)
     w_mm = nominal.width_px * nominal.pixel_size_mm
     h_mm = nominal.height_px * nominal.pixel_size_mm
+    lens: DistortionModel
     if ap_model == "real":
         lens = BrownConrady(**true_ap)
     elif ap_model == "none":

@@ -420,20 +420,21 @@ def _build(
             val += list(np.asarray(c.xyz, dtype=np.float64))
             sig += list(np.asarray(c.sigma, dtype=np.float64))
         blocks.append(prior_block("control", idx, val, sig, labels=[names[i] for i in idx]))
-    constraints, datum_fixed = [], []
+    constraints: list[Constraint] = []
+    datum_fixed: list[str] = []
     if reference is not None and opts.datum == "inner" and free:
-        idx = np.array([t_at[t] + q for t in free for q in range(3)], dtype=np.intp)
+        d_idx = np.array([t_at[t] + q for t in free for q in range(3)], dtype=np.intp)
         rotations = (2,) if levelled.any() else (0, 1, 2)
-        constraints.append(Constraint("datum (inner constraints)", idx[None, :],
-                                      _InnerConstraint(x0a[idx], rotations)))  # fmt: skip
+        constraints.append(Constraint("datum (inner constraints)", d_idx[None, :],
+                                      _InnerConstraint(x0a[d_idx], rotations)))  # fmt: skip
         datum_fixed = []
     elif reference is not None:
         base = s_at[reference]
         comps = [0, 1, 2, 5] if levelled[stations.index(reference)] else [0, 1, 2, 3, 4, 5]
-        idx = np.array([base + c for c in comps], dtype=np.intp)
-        values = x0a[idx].copy()
-        constraints.append(Constraint("datum", idx[None, :], _DatumConstraint(values)))
-        datum_fixed = [names[i] for i in idx]
+        d_idx = np.array([base + c for c in comps], dtype=np.intp)
+        values = x0a[d_idx].copy()
+        constraints.append(Constraint("datum", d_idx[None, :], _DatumConstraint(values)))
+        datum_fixed = [names[i] for i in d_idx]
     return _Layout(aps, stations, free, fixed, names, x0a, blocks, constraints, obs_of_block,
                    levelled, datum_fixed)  # fmt: skip
 

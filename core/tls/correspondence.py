@@ -178,9 +178,10 @@ def label_targets(
     placed_id: list[str] = []
     for k in range(len(cs[0])):
         counter += 1
-        ids[0][k] = f"{prefix}{counter}"
+        name = f"{prefix}{counter}"
+        ids[0][k] = name
         placed_xyz.append(cs[0][k])
-        placed_id.append(ids[0][k])
+        placed_id.append(name)
     done = {0}
     while len(done) < len(cs):
         best = None
@@ -206,9 +207,10 @@ def label_targets(
         for k in range(len(cs[s])):
             if ids[s][k] is None:
                 counter += 1
-                ids[s][k] = f"{prefix}{counter}"
+                name = f"{prefix}{counter}"
+                ids[s][k] = name
                 placed_xyz.append(moved[k])
-                placed_id.append(ids[s][k])
+                placed_id.append(name)
         done.add(s)
     if control_xyz is not None and len(control_ids):
         ctrl = np.asarray(control_xyz, dtype=np.float64)

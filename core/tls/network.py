@@ -402,10 +402,10 @@ def register_stations(
             common = [t for t in points[s] if t in ctrl]
             if len(common) >= 3:
                 try:
-                    r, t, _ = kabsch([points[s][c] for c in common], [ctrl[c] for c in common])
+                    r, shift, _ = kabsch([points[s][c] for c in common], [ctrl[c] for c in common])
                 except InputError:
                     continue
-                place(s, r, t)
+                place(s, r, shift)
         for tid, p in ctrl.items():
             known.setdefault(tid, []).insert(0, p)
     if not poses:
@@ -418,7 +418,8 @@ def register_stations(
         opk = st.opk if st is not None and st.opk is not None else np.zeros(3)
         place(ref_id, opk_to_matrix(*opk).T, np.asarray(x0, dtype=np.float64))
     while len(poses) < len(points):
-        best, best_common = None, []
+        best: str | None = None
+        best_common: list[str] = []
         for s in order:
             if s in poses:
                 continue
@@ -437,14 +438,14 @@ def register_stations(
         src = [points[best][c] for c in best_common]
         dst = [np.mean(known[c], axis=0) for c in best_common]
         try:
-            r, t, _ = kabsch(src, dst)
+            r, shift, _ = kabsch(src, dst)
         except InputError:
             k = obs.station.index(best)
             raise InputError(
                 f"station '{best}': its targets in common with the network are collinear",
                 **obs.where(k),
             ) from None
-        place(best, r, t)
+        place(best, r, shift)
     targets = {tid: np.mean(v, axis=0) for tid, v in known.items()}
     for tid, p in ctrl.items():
         targets[tid] = p

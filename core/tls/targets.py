@@ -206,6 +206,7 @@ def _sphere_lsq(
     if not res.converged:
         raise AdjustmentError("the sphere fit did not converge")
     r = float(res.x[3]) if free_radius else radius
+    assert res.covariance is not None  # computed: no parameter block is eliminated
     return res.x[:3].copy(), res.covariance[:3, :3].copy(), r, float(res.sigma0)
 
 
@@ -277,7 +278,7 @@ def fit_sphere(
             break
         inl = new
     rms = float(np.sqrt(np.mean(d[fitted] ** 2)))
-    towards = -c / max(np.linalg.norm(c), 1e-12)
+    towards = -c / max(float(np.linalg.norm(c)), 1e-12)
     return TargetFit("sphere", c, ccov, p.shape[0], int(fitted.sum()), rms, s0, r, towards)
 
 
@@ -450,6 +451,7 @@ def fit_checkerboard(
         u0, v0 = u_new, v_new
         if moved < 0.05 * s_blur:
             break
+    assert res.covariance is not None  # computed: no parameter block is eliminated
     c2 = res.covariance[:2, :2]
     centre = centroid + u0 * e1 + v0 * e2
     plane_var = float(np.var(dist) / max(len(dist) - 3, 1))
