@@ -47,7 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from .scaling import jacobi_scale, scale_constraints
-from .schur_numba import normal_sums, pair_sums
+from .schur_numba import back_substitute, dense_reduced, normal_sums, pair_sums
 from .schur_plan import EliminationPlan
 
 Array = NDArray[np.float64]
@@ -189,8 +189,43 @@ class ReducedNormal:
             rhs += np.bincount(rows.ravel(), weights=contrib.ravel(), minlength=rhs.size)
         return rhs
 
+    def _fused(self) -> bool:
+        """Whether :meth:`solve` runs the compiled dense path (:meth:`_dense_system`): one
+        occurrence set (e.g. one image block, every camera with its own parameters), a dense
+        reduced system, and enough pairs for the compiled code to pay."""
+        plan = self.plan
+        return bool(
+            _COMPILED and not self.use_sparse and len(plan.sets) == 1
+            and sum(pl.o1.size for pl in plan.pairs) >= _COMPILED_MIN
+        )  # fmt: skip
+
+    def _dense_system(self, lam: float) -> tuple[Array, Array, Array] | None:
+        """(K, rhs, Li): the dense reduced matrix and right-hand side of :meth:`reduced_matrix`
+        and :meth:`reduced_rhs`, built point by point in one compiled pass, and the inverse
+        Cholesky factors of ``V_p + lam I``; None without numba."""
+        plan = self.plan
+        s = plan.sets[0]
+        order, start = s.by_point(plan.P)
+        n = self.n_red
+        K = np.zeros((n, n))
+        rhs = np.concatenate([-self.g_r, -self.hs])
+        try:
+            out = dense_reduced(self.V, lam, self.g_e, self.T[0], order, start, s.sig, s.rows,
+                                K, rhs)  # fmt: skip
+        except ValueError:
+            raise SingularSystem("an eliminated block is singular") from None
+        if out is None:
+            return None
+        K += K.T
+        np.add.at(K, (self.u_rows, self.u_cols), self.u_vals)
+        K[np.arange(plan.n_r), np.arange(plan.n_r)] += lam
+        return K, rhs, out[0]
+
     def solve(self, lam: float) -> tuple[Array, Array]:
         """Scaled step ``z`` (n,) and multipliers ``k`` (mc,) of the damped system."""
+        dense = self._dense_system(lam) if self._fused() else None
+        if dense is not None:
+            return self._solve_dense(*dense)
         plan = self.plan
         K = self.reduced_matrix(lam)
         rhs = self.reduced_rhs(lam)
@@ -224,12 +259,35 @@ class ReducedNormal:
             for j in range(plan.b):
                 acc[:, j] -= np.bincount(s.point, weights=contrib[:, j], minlength=plan.P)
         ze = np.einsum("pij,pj->pi", Vinv, acc)
+        return self._step(zr, ze, k)
+
+    def _step(self, zr: Array, ze: Array, k: Array) -> tuple[Array, Array]:
+        """The scaled step of all ``n`` parameters from its reduced and eliminated parts."""
+        plan = self.plan
         z = np.empty(plan.n)
         z[plan.reduced] = zr
         z[plan.elim.ravel()] = ze.ravel()
         if not np.isfinite(z).all():
             raise SingularSystem("non-finite solution")
         return z, k
+
+    def _solve_dense(self, K: Array, rhs: Array, Li: Array) -> tuple[Array, Array]:
+        """:meth:`solve` on the system of :meth:`_dense_system`."""
+        plan = self.plan
+        try:
+            if self.mc == 0:
+                cf = sla.cho_factor(K, lower=True, check_finite=False)
+                sol = sla.cho_solve(cf, rhs, check_finite=False)
+            else:
+                sol = sla.solve(K, rhs, assume_a="sym", check_finite=False)
+        except (np.linalg.LinAlgError, ValueError) as exc:
+            raise SingularSystem(str(exc)) from None
+        if not np.isfinite(sol).all():
+            raise SingularSystem("non-finite solution")
+        s = plan.sets[0]
+        ze = back_substitute(self.g_e, self.T[0], s.point, s.sig, s.rows, sol, Li)
+        assert ze is not None  # numba imported for _dense_system
+        return self._step(sol[: plan.n_r], ze, sol[plan.n_r :])
 
     def observability_parts(self) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """(S, C~) at lam = 0: the reduced matrix and the reduced constraint rows."""
