@@ -104,7 +104,8 @@ def normal_sums(abar: Array, wbar: Array, scale: Array, rc: Index, ec: Index, si
     return U, V, g_e, T
 
 
-def _dense_kernel(V, lam, g_e, T, order, start, osig, srows, K, rhs, Li, y):  # pragma: no cover
+def _dense_kernel(V, lam, g_e, T, order, start, osig, srows, base, K, rhs, Li,
+                  y):  # pragma: no cover - compiled  # fmt: skip
     P, b = V.shape[0], V.shape[1]
     kk = T.shape[1]
     most = 0
@@ -166,20 +167,30 @@ def _dense_kernel(V, lam, g_e, T, order, start, osig, srows, K, rhs, Li, y):  # 
         # the pair products -Z_i' Z_j at (rows_i, rows_j) for i <= j, the pairs i == j at
         # half weight: K + K' is then the full sum
         for qi in range(n_o):
-            ri = srows[osig[order[start[p] + qi]]]
+            si = osig[order[start[p] + qi]]
             for qj in range(qi, n_o):
-                rj = srows[osig[order[start[p] + qj]]]
+                sj = osig[order[start[p] + qj]]
+                w = -0.5 if qi == qj else -1.0
+                if b == 3 and base[si] >= 0 and base[sj] >= 0:
+                    # points with contiguous rows: one row of K at a time
+                    bj = base[sj]
+                    for a in range(kk):
+                        z0, z1, z2 = w * Z[qi, 0, a], w * Z[qi, 1, a], w * Z[qi, 2, a]
+                        row = K[base[si] + a]
+                        for c in range(kk):
+                            row[bj + c] += z0 * Z[qj, 0, c] + z1 * Z[qj, 1, c] + z2 * Z[qj, 2, c]
+                    continue
+                ri, rj = srows[si], srows[sj]
                 acc[:, :] = 0.0
                 for m in range(b):
                     for a in range(kk):
                         z = Z[qi, m, a]
                         for c in range(kk):
                             acc[a, c] += z * Z[qj, m, c]
-                w = 0.5 if qi == qj else 1.0
                 for a in range(kk):
                     r = ri[a]
                     for c in range(kk):
-                        K[r, rj[c]] -= w * acc[a, c]
+                        K[r, rj[c]] += w * acc[a, c]
     return 0
 
 
@@ -200,8 +211,13 @@ def dense_reduced(V: Array, lam: float, g_e: Array, T: Array, order: Index, star
     P, b = V.shape[0], V.shape[1]
     Li = np.empty((P, b, b))
     y = np.empty((P, b))
+    # the first row of every signature whose rows are one contiguous run, else -1
+    kk = srows.shape[1]
+    run = (srows == srows[:, :1] + np.arange(kk)).all(axis=1)
+    base = np.where(run, srows[:, 0], -1).astype(np.intp)
     bad = kernel(np.ascontiguousarray(V), float(lam), np.ascontiguousarray(g_e),
-                 np.ascontiguousarray(T), order, start, osig, srows, K, rhs, Li, y)  # fmt: skip
+                 np.ascontiguousarray(T), order, start, osig, srows, base, K, rhs, Li,
+                 y)  # fmt: skip
     if bad:
         raise ValueError("an eliminated block is singular")
     return Li, y
