@@ -274,12 +274,22 @@ class ReducedNormal:
     def _solve_dense(self, K: Array, rhs: Array, Li: Array) -> tuple[Array, Array]:
         """:meth:`solve` on the system of :meth:`_dense_system`."""
         plan = self.plan
+        n_r = plan.n_r
         try:
             if self.mc == 0:
                 cf = sla.cho_factor(K, lower=True, check_finite=False)
                 sol = sla.cho_solve(cf, rhs, check_finite=False)
             else:
-                sol = sla.solve(K, rhs, assume_a="sym", check_finite=False)
+                # the border C (no constraint on eliminated blocks here): (S + C'C) is
+                # positive definite when the constrained problem is determined, and the
+                # multipliers follow from the small Schur complement C (S + C'C)^-1 C'
+                S, C = K[:n_r, :n_r], K[n_r:, :n_r]
+                r1, r2 = rhs[:n_r], rhs[n_r:]
+                cf = sla.cho_factor(S + C.T @ C, lower=True, check_finite=False)
+                Y = sla.cho_solve(cf, C.T, check_finite=False)
+                zr = sla.cho_solve(cf, r1 + C.T @ r2, check_finite=False)
+                k = sla.solve(C @ Y, C @ zr - r2, assume_a="pos", check_finite=False)
+                sol = np.concatenate([zr - Y @ k, k])
         except (np.linalg.LinAlgError, ValueError) as exc:
             raise SingularSystem(str(exc)) from None
         if not np.isfinite(sol).all():
@@ -287,7 +297,7 @@ class ReducedNormal:
         s = plan.sets[0]
         ze = back_substitute(self.g_e, self.T[0], s.point, s.sig, s.rows, sol, Li)
         assert ze is not None  # numba imported for _dense_system
-        return self._step(sol[: plan.n_r], ze, sol[plan.n_r :])
+        return self._step(sol[:n_r], ze, sol[n_r:])
 
     def observability_parts(self) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """(S, C~) at lam = 0: the reduced matrix and the reduced constraint rows."""
