@@ -72,14 +72,14 @@ def _normal_kernel(abar, wbar, scale, rc, ec, sig, point, U, V, g_e, T):  # prag
                 row[i] = abar[g, c, i] * scale[g, i]
             for i in range(kr):
                 ri = row[rc[i]]
-                for j in range(kr):
+                for j in range(i, kr):  # the upper triangle (mirrored afterwards)
                     U[s, i, j] += ri * row[rc[j]]
                 for j in range(b):
                     T[g, i, j] += ri * row[ec[j]]
             for i in range(b):
                 ei = row[ec[i]]
                 g_e[p, i] += w * ei
-                for j in range(b):
+                for j in range(i, b):
                     V[p, i, j] += ei * row[ec[j]]
 
 
@@ -101,6 +101,8 @@ def normal_sums(abar: Array, wbar: Array, scale: Array, rc: Index, ec: Index, si
     T = np.zeros((g, kr, b))
     kernel(np.ascontiguousarray(abar), np.ascontiguousarray(wbar),
                  np.ascontiguousarray(scale), rc, ec, sig, point, U, V, g_e, T)  # fmt: skip
+    U += np.swapaxes(np.triu(U, 1), 1, 2)
+    V += np.swapaxes(np.triu(V, 1), 1, 2)
     return U, V, g_e, T
 
 
