@@ -321,6 +321,12 @@ def test_snavely_compiled_kernel_equals_numpy():
         np.testing.assert_allclose(b, a, rtol=1e-12, atol=1e-12 * np.abs(a).max())
     u = snavely_project(cam, X, jacobian=False, compiled=True)
     np.testing.assert_allclose(u, ref[0], rtol=1e-12, atol=1e-9)
+    # the joint Jacobian (camera columns, then point columns), compiled and numpy
+    J_ref = np.concatenate(ref[1:], axis=2)
+    for compiled in (True, False):
+        uj, J = snavely_project(cam, X, compiled=compiled, joint=True)
+        np.testing.assert_allclose(uj, ref[0], rtol=1e-12, atol=1e-9)
+        np.testing.assert_allclose(J, J_ref, rtol=1e-12, atol=1e-12 * np.abs(J_ref).max())
 
 
 @pytest.mark.skipif(not (BAL / "dubrovnik-3-7-pre.txt").is_file(), reason="BAL data not here")
