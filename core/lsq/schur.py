@@ -203,6 +203,9 @@ class ReducedNormal:
         """(K, rhs, Li): the dense reduced matrix and right-hand side of :meth:`reduced_matrix`
         and :meth:`reduced_rhs`, built point by point in one compiled pass, and the inverse
         Cholesky factors of ``V_p + lam I``; None without numba."""
+        key = ("D", lam)
+        if key in self._cache:
+            return self._cache[key]
         plan = self.plan
         s = plan.sets[0]
         order, start = s.by_point(plan.P)
@@ -219,6 +222,9 @@ class ReducedNormal:
         K += K.T
         np.add.at(K, (self.u_rows, self.u_cols), self.u_vals)
         K[np.arange(plan.n_r), np.arange(plan.n_r)] += lam
+        if lam == 0.0:
+            # kept: the observability check and the Gauss-Newton step share it
+            self._cache[key] = (K, rhs, out[0])
         return K, rhs, out[0]
 
     def solve(self, lam: float) -> tuple[Array, Array]:
@@ -301,8 +307,12 @@ class ReducedNormal:
 
     def observability_parts(self) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """(S, C~) at lam = 0: the reduced matrix and the reduced constraint rows."""
-        K = self.reduced_matrix(0.0)
         n_r = self.plan.n_r
+        dense = self._dense_system(0.0) if self._fused() else None
+        if dense is not None:
+            Kd = dense[0]
+            return sp.csr_matrix(Kd[:n_r, :n_r]), sp.csr_matrix(Kd[n_r:, :n_r]) if self.mc else None
+        K = self.reduced_matrix(0.0)
         S = K[:n_r, :n_r].tocsr()
         C = K[n_r:, :n_r].tocsr() if self.mc else None
         return S, C
