@@ -59,28 +59,31 @@ def pair_sums(Za: Array, Zb: Array, o1: Index, o2: Index, key: Index, n_keys: in
 
 
 def _normal_kernel(abar, wbar, scale, rc, ec, sig, point, U, V, g_e, T):  # pragma: no cover
-    g_n, c_n, k_n = abar.shape
+    g_n, c_n = abar.shape[0], abar.shape[1]
     kr = rc.size
     b = ec.size
-    row = np.empty(k_n)
+    rr = np.empty(kr)  # the scaled row's reduced and eliminated parts, contiguous
+    er = np.empty(b)
     for g in range(g_n):
         s = sig[g]
         p = point[g]
         for c in range(c_n):
             w = wbar[g, c]
-            for i in range(k_n):
-                row[i] = abar[g, c, i] * scale[g, i]
             for i in range(kr):
-                ri = row[rc[i]]
-                for j in range(i, kr):  # the upper triangle (mirrored afterwards)
-                    U[s, i, j] += ri * row[rc[j]]
-                for j in range(b):
-                    T[g, i, j] += ri * row[ec[j]]
+                rr[i] = abar[g, c, rc[i]] * scale[g, rc[i]]
             for i in range(b):
-                ei = row[ec[i]]
+                er[i] = abar[g, c, ec[i]] * scale[g, ec[i]]
+            for i in range(kr):
+                ri = rr[i]
+                for j in range(i, kr):  # the upper triangle (mirrored afterwards)
+                    U[s, i, j] += ri * rr[j]
+                for j in range(b):
+                    T[g, i, j] += ri * er[j]
+            for i in range(b):
+                ei = er[i]
                 g_e[p, i] += w * ei
                 for j in range(i, b):
-                    V[p, i, j] += ei * row[ec[j]]
+                    V[p, i, j] += ei * er[j]
 
 
 def normal_sums(abar: Array, wbar: Array, scale: Array, rc: Index, ec: Index, sig: Index,
@@ -179,6 +182,15 @@ def _dense_kernel(V, lam, g_e, T, order, start, osig, srows, base, K, rhs, Li,
                     for a in range(kk):
                         z0, z1, z2 = w * Z[qi, 0, a], w * Z[qi, 1, a], w * Z[qi, 2, a]
                         row = K[base[si] + a]
+                        if qi == qj:  # a symmetric block: its upper triangle, doubled
+                            z0, z1, z2 = 2.0 * z0, 2.0 * z1, 2.0 * z2
+                            row[bj + a] += 0.5 * (
+                                z0 * Z[qj, 0, a] + z1 * Z[qj, 1, a] + z2 * Z[qj, 2, a]
+                            )
+                            for c in range(a + 1, kk):
+                                row[bj + c] += (z0 * Z[qj, 0, c] + z1 * Z[qj, 1, c]
+                                                + z2 * Z[qj, 2, c])  # fmt: skip
+                            continue
                         for c in range(kk):
                             row[bj + c] += z0 * Z[qj, 0, c] + z1 * Z[qj, 1, c] + z2 * Z[qj, 2, c]
                     continue
