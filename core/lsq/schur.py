@@ -47,7 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from .scaling import jacobi_scale, scale_constraints
-from .schur_numba import back_substitute, dense_reduced, normal_sums, pair_sums
+from .schur_numba import back_substitute, dense_reduced, diag_grad, normal_sums, pair_sums
 from .schur_plan import EliminationPlan
 
 Array = NDArray[np.float64]
@@ -524,6 +524,10 @@ def build_reduced_normal(
     grad = np.zeros(n)
     for bk, bl, a in zip(blocks, lins, active):
         if bk.groups == 0:
+            continue
+        if _COMPILED and bk.groups >= _COMPILED_MIN and diag_grad(
+            bl.abar, bl.wbar, a, bk.param_index, diag, grad
+        ):
             continue
         every = bool(a.all())
         A = bl.abar if every else bl.abar * a[:, None, None]

@@ -279,3 +279,34 @@ def back_substitute(g_e: Array, T: Array, point: Index, osig: Index, srows: Inde
     kernel(np.ascontiguousarray(g_e), np.ascontiguousarray(T), point, osig, srows,
            np.ascontiguousarray(z), Li, ze)  # fmt: skip
     return ze
+
+
+def _diag_grad_kernel(abar, wbar, active, index, diag, grad):  # pragma: no cover - compiled
+    g_n, c_n, k_n = abar.shape
+    for g in range(g_n):
+        if not active[g]:
+            continue
+        for k in range(k_n):
+            d = 0.0
+            s = 0.0
+            for c in range(c_n):
+                a = abar[g, c, k]
+                d += a * a
+                s += wbar[g, c] * a
+            diag[index[g, k]] += d
+            grad[index[g, k]] += s
+
+
+def diag_grad(abar: Array, wbar: Array, active: NDArray[np.bool_], index: Index, diag: Array,
+              grad: Array) -> bool:  # fmt: skip
+    """Add the diagonal ``sum a^2`` and the gradient ``sum w a`` of the normal equations of
+    one block's active groups (``abar`` (G, c, k) at the parameters ``index`` (G, k)) to
+    ``diag`` and ``grad`` in place; False without numba (nothing added)."""
+    from ..compiled import compiled_kernel
+
+    kernel = compiled_kernel(_diag_grad_kernel)
+    if kernel is None:
+        return False
+    kernel(np.ascontiguousarray(abar), np.ascontiguousarray(wbar), np.ascontiguousarray(active),
+           np.ascontiguousarray(index), diag, grad)  # fmt: skip
+    return True
