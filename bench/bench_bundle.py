@@ -85,8 +85,7 @@ def cookbook(problem: BalProblem) -> dict:
 
 class _SnavelyModel:
     def __call__(self, xl: np.ndarray):
-        u, jc, jp = snavely_project(xl[:, :9], xl[:, 9:12])
-        return u, np.concatenate([jc, jp], axis=2)
+        return snavely_project(xl[:, :9], xl[:, 9:12], joint=True)
 
 
 def engine(problem: BalProblem, tolerance: float = 1e-10, max_iterations: int = 40,

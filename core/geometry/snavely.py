@@ -44,11 +44,12 @@ def rodrigues(r: Array) -> Array:
 
 
 def snavely_project(cameras: Array, points: Array, jacobian: bool = True,
-                    compiled: bool = True):  # fmt: skip
+                    compiled: bool = True, joint: bool = False):  # fmt: skip
     """Projections (N, 2) of points (N, 3) by cameras (N, 9), and optionally the Jacobians
-    ``d u / d camera`` (N, 2, 9) and ``d u / d point`` (N, 2, 3). ``compiled``: the numba
-    kernel of :mod:`.snavely_numba` when numba is there (the same formulas in one loop),
-    else numpy.
+    ``d u / d camera`` (N, 2, 9) and ``d u / d point`` (N, 2, 3), or with ``joint`` both as
+    one (N, 2, 12), camera columns first (the Jacobian of a group (camera, point)).
+    ``compiled``: the numba kernel of :mod:`.snavely_numba` when numba is there (the same
+    formulas in one loop), else numpy.
 
     >>> cam = np.array([[0, 0, 0, 0, 0, -10.0, 100.0, 0, 0]])
     >>> snavely_project(cam, np.array([[1.0, 2.0, 0.0]]), jacobian=False).tolist()
@@ -59,7 +60,7 @@ def snavely_project(cameras: Array, points: Array, jacobian: bool = True,
     if compiled and c.shape[0] > 0:
         from .snavely_numba import project
 
-        out = project(c, X, jacobian)
+        out = project(c, X, jacobian, joint)
         if out is not None:
             return out
     r, t, f, k1, k2 = c[:, :3], c[:, 3:6], c[:, 6], c[:, 7], c[:, 8]
@@ -93,4 +94,6 @@ def snavely_project(cameras: Array, points: Array, jacobian: bool = True,
     J_cam[:, :, 7] = (f * r2)[:, None] * p
     J_cam[:, :, 8] = (f * r2 * r2)[:, None] * p
     J_pt = du_dP @ R
+    if joint:
+        return u, np.concatenate([J_cam, J_pt], axis=2)
     return u, J_cam, J_pt

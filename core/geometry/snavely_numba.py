@@ -96,8 +96,10 @@ def _kernel(c, X, u, jc, jp, want_jac):  # pragma: no cover - compiled
         jc[i, 1, 8] = f * rr * rr * py
 
 
-def project(cameras: Array, points: Array, jacobian: bool) -> tuple | Array | None:
-    """``snavely_project`` compiled (None without numba)."""
+def project(cameras: Array, points: Array, jacobian: bool, joint: bool = False
+            ) -> tuple | Array | None:  # fmt: skip
+    """``snavely_project`` compiled (None without numba); ``joint``: the Jacobians as one
+    array (n, 2, 12), camera columns first, written in place (no concatenation)."""
     from ..compiled import compiled_kernel  # numba imported here: this module stays light
 
     kernel = compiled_kernel(_kernel)
@@ -107,6 +109,10 @@ def project(cameras: Array, points: Array, jacobian: bool) -> tuple | Array | No
     X = np.ascontiguousarray(points, dtype=np.float64)
     n = c.shape[0]
     u = np.empty((n, 2))
+    if jacobian and joint:
+        J = np.empty((n, 2, 12))
+        kernel(c, X, u, J[:, :, :9], J[:, :, 9:], True)
+        return u, J
     jc = np.empty((n, 2, 9) if jacobian else (0, 2, 9))
     jp = np.empty((n, 2, 3) if jacobian else (0, 2, 3))
     kernel(c, X, u, jc, jp, bool(jacobian))

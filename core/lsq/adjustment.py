@@ -104,7 +104,7 @@ from typing import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import stats
+from scipy import special
 
 from ..errors import InputError
 from ..i18n import mark as _t
@@ -221,7 +221,7 @@ def adjust(
     want_cov = opts.compute_covariance or opts.snooping
     active = [np.ones(b.groups, dtype=bool) for b in obs]
     vhat = [np.zeros((b.groups, b.o)) for b in obs]
-    crit = float(stats.norm.ppf(1 - opts.snooping_alpha / 2))
+    crit = float(special.ndtri(1 - opts.snooping_alpha / 2))  # the normal quantile
     rejected: list[RejectedObservation] = []
     extra_warnings: list[str] = []
     robust_text = ""

@@ -12,7 +12,6 @@ from typing import Callable
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import stats
 
 from ..errors import InputError, NotObservableError
 from ..i18n import mark as _t
@@ -20,7 +19,7 @@ from .model import AdjustmentOptions, _PriorModel
 from .problem import _Problem
 from .results import AdjustmentResult, RejectedObservation
 from .solve import _Progress, _Run, _run
-from .statistics import _finish
+from .statistics import _finish, chi2_ppf
 
 #: catalogue context of this module's ``_t("...")`` sentences (``make i18n``): the reports'
 TR_CONTEXT = "Report"
@@ -123,7 +122,7 @@ def _robust(
             # multiplied by sqrt(weight)).
             u_rows = [bl.wbar / np.sqrt(w)[:, None] for bl, w in zip(run.lin.blocks, weights)]
             u = [np.sqrt(np.sum(r * r, axis=1) / r.shape[1]) for r in u_rows]
-            ref = [math.sqrt(stats.chi2.ppf(0.5, b.c) / b.c) for b in blocks]
+            ref = [math.sqrt(chi2_ppf(0.5, int(b.c or 1)) / int(b.c or 1)) for b in blocks]
             pool = np.concatenate(
                 [u[i][active[i]] / ref[i] for i in scale_blocks] or [np.zeros(0)]
             )

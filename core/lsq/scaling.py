@@ -23,7 +23,8 @@ def jacobi_scale(d: Array, C: sp.csr_matrix | None) -> Array:
     [2.0, 3.0, 1.0]
     """
     if C is not None:
-        cn = np.sqrt(np.asarray(C.multiply(C).sum(axis=0)).ravel())
+        Cc = sp.csr_matrix(C)
+        cn = np.sqrt(np.bincount(Cc.indices, weights=Cc.data**2, minlength=Cc.shape[1]))
         d = np.where(d > 0, d, cn)
     return np.where(d > 0, d, 1.0)
 
@@ -40,9 +41,13 @@ def scale_constraints(
     >>> np.round(Cs.toarray(), 12).tolist(), hs.tolist(), r.tolist()
     ([[0.6, 0.8]], [2.0], [0.2])
     """
-    Cd = sp.csr_matrix(C @ sp.diags(dinv))
+    # the products with the diagonal matrices on the stored entries (no sparse products)
+    Cd = sp.csr_matrix(C, copy=True)
+    Cd.eliminate_zeros()
+    Cd.data *= dinv[Cd.indices]
+    rows = np.repeat(np.arange(Cd.shape[0]), np.diff(Cd.indptr))
     if rowscale is None:
-        rn = np.sqrt(np.asarray(Cd.multiply(Cd).sum(axis=1)).ravel())
+        rn = np.sqrt(np.bincount(rows, weights=Cd.data**2, minlength=Cd.shape[0]))
         rowscale = np.where(rn > 0, 1.0 / np.where(rn > 0, rn, 1.0), 1.0)
-    Cs = sp.csr_matrix(sp.diags(rowscale) @ Cd)
-    return Cs, rowscale * h, rowscale
+    Cd.data *= rowscale[rows]
+    return Cd, rowscale * h, rowscale

@@ -47,7 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
 from .scaling import jacobi_scale, scale_constraints
-from .schur_numba import normal_sums, pair_sums
+from .schur_numba import back_substitute, dense_reduced, diag_grad, normal_sums, pair_sums
 from .schur_plan import EliminationPlan
 
 Array = NDArray[np.float64]
@@ -189,8 +189,49 @@ class ReducedNormal:
             rhs += np.bincount(rows.ravel(), weights=contrib.ravel(), minlength=rhs.size)
         return rhs
 
+    def _fused(self) -> bool:
+        """Whether :meth:`solve` runs the compiled dense path (:meth:`_dense_system`): one
+        occurrence set (e.g. one image block, every camera with its own parameters), a dense
+        reduced system, and enough pairs for the compiled code to pay."""
+        plan = self.plan
+        return bool(
+            _COMPILED and not self.use_sparse and len(plan.sets) == 1
+            and sum(pl.o1.size for pl in plan.pairs) >= _COMPILED_MIN
+        )  # fmt: skip
+
+    def _dense_system(self, lam: float) -> tuple[Array, Array, Array] | None:
+        """(K, rhs, Li): the dense reduced matrix and right-hand side of :meth:`reduced_matrix`
+        and :meth:`reduced_rhs`, built point by point in one compiled pass, and the inverse
+        Cholesky factors of ``V_p + lam I``; None without numba."""
+        key = ("D", lam)
+        if key in self._cache:
+            return self._cache[key]
+        plan = self.plan
+        s = plan.sets[0]
+        order, start = s.by_point(plan.P)
+        n = self.n_red
+        K = np.zeros((n, n))
+        rhs = np.concatenate([-self.g_r, -self.hs])
+        try:
+            out = dense_reduced(self.V, lam, self.g_e, self.T[0], order, start, s.sig, s.rows,
+                                K, rhs)  # fmt: skip
+        except ValueError:
+            raise SingularSystem("an eliminated block is singular") from None
+        if out is None:
+            return None
+        K += K.T
+        np.add.at(K, (self.u_rows, self.u_cols), self.u_vals)
+        K[np.arange(plan.n_r), np.arange(plan.n_r)] += lam
+        if lam == 0.0:
+            # kept: the observability check and the Gauss-Newton step share it
+            self._cache[key] = (K, rhs, out[0])
+        return K, rhs, out[0]
+
     def solve(self, lam: float) -> tuple[Array, Array]:
         """Scaled step ``z`` (n,) and multipliers ``k`` (mc,) of the damped system."""
+        dense = self._dense_system(lam) if self._fused() else None
+        if dense is not None:
+            return self._solve_dense(*dense)
         plan = self.plan
         K = self.reduced_matrix(lam)
         rhs = self.reduced_rhs(lam)
@@ -224,6 +265,11 @@ class ReducedNormal:
             for j in range(plan.b):
                 acc[:, j] -= np.bincount(s.point, weights=contrib[:, j], minlength=plan.P)
         ze = np.einsum("pij,pj->pi", Vinv, acc)
+        return self._step(zr, ze, k)
+
+    def _step(self, zr: Array, ze: Array, k: Array) -> tuple[Array, Array]:
+        """The scaled step of all ``n`` parameters from its reduced and eliminated parts."""
+        plan = self.plan
         z = np.empty(plan.n)
         z[plan.reduced] = zr
         z[plan.elim.ravel()] = ze.ravel()
@@ -231,10 +277,42 @@ class ReducedNormal:
             raise SingularSystem("non-finite solution")
         return z, k
 
+    def _solve_dense(self, K: Array, rhs: Array, Li: Array) -> tuple[Array, Array]:
+        """:meth:`solve` on the system of :meth:`_dense_system`."""
+        plan = self.plan
+        n_r = plan.n_r
+        try:
+            if self.mc == 0:
+                cf = sla.cho_factor(K, lower=True, check_finite=False)
+                sol = sla.cho_solve(cf, rhs, check_finite=False)
+            else:
+                # the border C (no constraint on eliminated blocks here): (S + C'C) is
+                # positive definite when the constrained problem is determined, and the
+                # multipliers follow from the small Schur complement C (S + C'C)^-1 C'
+                S, C = K[:n_r, :n_r], K[n_r:, :n_r]
+                r1, r2 = rhs[:n_r], rhs[n_r:]
+                cf = sla.cho_factor(S + C.T @ C, lower=True, check_finite=False)
+                Y = sla.cho_solve(cf, C.T, check_finite=False)
+                zr = sla.cho_solve(cf, r1 + C.T @ r2, check_finite=False)
+                k = sla.solve(C @ Y, C @ zr - r2, assume_a="pos", check_finite=False)
+                sol = np.concatenate([zr - Y @ k, k])
+        except (np.linalg.LinAlgError, ValueError) as exc:
+            raise SingularSystem(str(exc)) from None
+        if not np.isfinite(sol).all():
+            raise SingularSystem("non-finite solution")
+        s = plan.sets[0]
+        ze = back_substitute(self.g_e, self.T[0], s.point, s.sig, s.rows, sol, Li)
+        assert ze is not None  # numba imported for _dense_system
+        return self._step(sol[:n_r], ze, sol[n_r:])
+
     def observability_parts(self) -> tuple[sp.csr_matrix, sp.csr_matrix | None]:
         """(S, C~) at lam = 0: the reduced matrix and the reduced constraint rows."""
-        K = self.reduced_matrix(0.0)
         n_r = self.plan.n_r
+        dense = self._dense_system(0.0) if self._fused() else None
+        if dense is not None:
+            Kd = dense[0]
+            return sp.csr_matrix(Kd[:n_r, :n_r]), sp.csr_matrix(Kd[n_r:, :n_r]) if self.mc else None
+        K = self.reduced_matrix(0.0)
         S = K[:n_r, :n_r].tocsr()
         C = K[n_r:, :n_r].tocsr() if self.mc else None
         return S, C
@@ -446,6 +524,10 @@ def build_reduced_normal(
     grad = np.zeros(n)
     for bk, bl, a in zip(blocks, lins, active):
         if bk.groups == 0:
+            continue
+        if _COMPILED and bk.groups >= _COMPILED_MIN and diag_grad(
+            bl.abar, bl.wbar, a, bk.param_index, diag, grad
+        ):
             continue
         every = bool(a.all())
         A = bl.abar if every else bl.abar * a[:, None, None]

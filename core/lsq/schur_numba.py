@@ -59,28 +59,31 @@ def pair_sums(Za: Array, Zb: Array, o1: Index, o2: Index, key: Index, n_keys: in
 
 
 def _normal_kernel(abar, wbar, scale, rc, ec, sig, point, U, V, g_e, T):  # pragma: no cover
-    g_n, c_n, k_n = abar.shape
+    g_n, c_n = abar.shape[0], abar.shape[1]
     kr = rc.size
     b = ec.size
-    row = np.empty(k_n)
+    rr = np.empty(kr)  # the scaled row's reduced and eliminated parts, contiguous
+    er = np.empty(b)
     for g in range(g_n):
         s = sig[g]
         p = point[g]
         for c in range(c_n):
             w = wbar[g, c]
-            for i in range(k_n):
-                row[i] = abar[g, c, i] * scale[g, i]
             for i in range(kr):
-                ri = row[rc[i]]
-                for j in range(kr):
-                    U[s, i, j] += ri * row[rc[j]]
-                for j in range(b):
-                    T[g, i, j] += ri * row[ec[j]]
+                rr[i] = abar[g, c, rc[i]] * scale[g, rc[i]]
             for i in range(b):
-                ei = row[ec[i]]
-                g_e[p, i] += w * ei
+                er[i] = abar[g, c, ec[i]] * scale[g, ec[i]]
+            for i in range(kr):
+                ri = rr[i]
+                for j in range(i, kr):  # the upper triangle (mirrored afterwards)
+                    U[s, i, j] += ri * rr[j]
                 for j in range(b):
-                    V[p, i, j] += ei * row[ec[j]]
+                    T[g, i, j] += ri * er[j]
+            for i in range(b):
+                ei = er[i]
+                g_e[p, i] += w * ei
+                for j in range(i, b):
+                    V[p, i, j] += ei * er[j]
 
 
 def normal_sums(abar: Array, wbar: Array, scale: Array, rc: Index, ec: Index, sig: Index,
@@ -101,4 +104,209 @@ def normal_sums(abar: Array, wbar: Array, scale: Array, rc: Index, ec: Index, si
     T = np.zeros((g, kr, b))
     kernel(np.ascontiguousarray(abar), np.ascontiguousarray(wbar),
                  np.ascontiguousarray(scale), rc, ec, sig, point, U, V, g_e, T)  # fmt: skip
+    U += np.swapaxes(np.triu(U, 1), 1, 2)
+    V += np.swapaxes(np.triu(V, 1), 1, 2)
     return U, V, g_e, T
+
+
+def _dense_kernel(V, lam, g_e, T, order, start, osig, srows, base, K, rhs, Li,
+                  y):  # pragma: no cover - compiled  # fmt: skip
+    P, b = V.shape[0], V.shape[1]
+    kk = T.shape[1]
+    most = 0
+    for p in range(P):
+        most = max(most, start[p + 1] - start[p])
+    Z = np.empty((most, b, kk))
+    acc = np.empty((kk, kk))
+    L = np.empty((b, b))
+    t = np.empty(b)
+    for p in range(P):
+        # Cholesky factor of V_p + lam I and its inverse (lower triangular)
+        for i in range(b):
+            for j in range(i + 1):
+                s = V[p, i, j] + (lam if i == j else 0.0)
+                for m in range(j):
+                    s -= L[i, m] * L[j, m]
+                if i == j:
+                    if not s > 0.0:
+                        return 1
+                    L[i, i] = np.sqrt(s)
+                else:
+                    L[i, j] = s / L[j, j]
+        for j in range(b):
+            for i in range(b):
+                if i < j:
+                    Li[p, i, j] = 0.0
+                    continue
+                s = 1.0 if i == j else 0.0
+                for m in range(j, i):
+                    s -= L[i, m] * Li[p, m, j]
+                Li[p, i, j] = s / L[i, i]
+        # y_p = (V_p + lam I)^-1 g_e,p = Li' Li g_e,p
+        for i in range(b):
+            s = 0.0
+            for m in range(i + 1):
+                s += Li[p, i, m] * g_e[p, m]
+            t[i] = s
+        for i in range(b):
+            s = 0.0
+            for m in range(i, b):
+                s += Li[p, m, i] * t[m]
+            y[p, i] = s
+        n_o = start[p + 1] - start[p]
+        for q in range(n_o):
+            o = order[start[p] + q]
+            rows = srows[osig[o]]
+            for a in range(kk):
+                s = 0.0
+                for m in range(b):
+                    s += T[o, a, m] * y[p, m]
+                rhs[rows[a]] += s
+            # Z = Li T' (b x kk)
+            for m in range(b):
+                for a in range(kk):
+                    s = 0.0
+                    for c in range(m + 1):
+                        s += Li[p, m, c] * T[o, a, c]
+                    Z[q, m, a] = s
+        # the pair products -Z_i' Z_j at (rows_i, rows_j) for i <= j, the pairs i == j at
+        # half weight: K + K' is then the full sum
+        for qi in range(n_o):
+            si = osig[order[start[p] + qi]]
+            for qj in range(qi, n_o):
+                sj = osig[order[start[p] + qj]]
+                w = -0.5 if qi == qj else -1.0
+                if b == 3 and base[si] >= 0 and base[sj] >= 0:
+                    # points with contiguous rows: one row of K at a time
+                    bj = base[sj]
+                    for a in range(kk):
+                        z0, z1, z2 = w * Z[qi, 0, a], w * Z[qi, 1, a], w * Z[qi, 2, a]
+                        row = K[base[si] + a]
+                        if qi == qj:  # a symmetric block: its upper triangle, doubled
+                            z0, z1, z2 = 2.0 * z0, 2.0 * z1, 2.0 * z2
+                            row[bj + a] += 0.5 * (
+                                z0 * Z[qj, 0, a] + z1 * Z[qj, 1, a] + z2 * Z[qj, 2, a]
+                            )
+                            for c in range(a + 1, kk):
+                                row[bj + c] += (z0 * Z[qj, 0, c] + z1 * Z[qj, 1, c]
+                                                + z2 * Z[qj, 2, c])  # fmt: skip
+                            continue
+                        for c in range(kk):
+                            row[bj + c] += z0 * Z[qj, 0, c] + z1 * Z[qj, 1, c] + z2 * Z[qj, 2, c]
+                    continue
+                ri, rj = srows[si], srows[sj]
+                acc[:, :] = 0.0
+                for m in range(b):
+                    for a in range(kk):
+                        z = Z[qi, m, a]
+                        for c in range(kk):
+                            acc[a, c] += z * Z[qj, m, c]
+                for a in range(kk):
+                    r = ri[a]
+                    for c in range(kk):
+                        K[r, rj[c]] += w * acc[a, c]
+    return 0
+
+
+def dense_reduced(V: Array, lam: float, g_e: Array, T: Array, order: Index, start: Index,
+                  osig: Index, srows: Index, K: Array, rhs: Array) -> tuple | None:  # fmt: skip
+    """For one occurrence set, in place and point by point (``order``/``start``: the
+    occurrences sorted by point, CSR-like): afterwards ``K + K'`` is
+    ``-sum_p W_p (V_p + lam I)^-1 W_p'`` (``K`` dense, zero on entry), and
+    ``sum_p W_p (V_p + lam I)^-1 g_e,p`` is added to ``rhs``.
+    Returns (Li, y): the inverse Cholesky factors of ``V_p + lam I`` (P, b, b) and
+    ``(V_p + lam I)^-1 g_e,p`` (P, b); raises SingularSystem's cause as ValueError when a
+    point block is not positive definite; None without numba."""
+    from ..compiled import compiled_kernel
+
+    kernel = compiled_kernel(_dense_kernel)
+    if kernel is None:
+        return None
+    P, b = V.shape[0], V.shape[1]
+    Li = np.empty((P, b, b))
+    y = np.empty((P, b))
+    # the first row of every signature whose rows are one contiguous run, else -1
+    kk = srows.shape[1]
+    run = (srows == srows[:, :1] + np.arange(kk)).all(axis=1)
+    base = np.where(run, srows[:, 0], -1).astype(np.intp)
+    bad = kernel(np.ascontiguousarray(V), float(lam), np.ascontiguousarray(g_e),
+                 np.ascontiguousarray(T), order, start, osig, srows, base, K, rhs, Li,
+                 y)  # fmt: skip
+    if bad:
+        raise ValueError("an eliminated block is singular")
+    return Li, y
+
+
+def _back_kernel(g_e, T, point, osig, srows, z, Li, ze):  # pragma: no cover - compiled
+    P, b = g_e.shape
+    kk = T.shape[1]
+    acc = np.empty((P, b))
+    for p in range(P):
+        for m in range(b):
+            acc[p, m] = -g_e[p, m]
+    for o in range(point.size):
+        p = point[o]
+        rows = srows[osig[o]]
+        for m in range(b):
+            s = 0.0
+            for a in range(kk):
+                s += T[o, a, m] * z[rows[a]]
+            acc[p, m] -= s
+    t = np.empty(b)
+    for p in range(P):
+        for i in range(b):
+            s = 0.0
+            for m in range(i + 1):
+                s += Li[p, i, m] * acc[p, m]
+            t[i] = s
+        for i in range(b):
+            s = 0.0
+            for m in range(i, b):
+                s += Li[p, m, i] * t[m]
+            ze[p, i] = s
+
+
+def back_substitute(g_e: Array, T: Array, point: Index, osig: Index, srows: Index, z: Array,
+                    Li: Array) -> Array | None:  # fmt: skip
+    """``z_e,p = (V_p + lam I)^-1 (-g_e,p - W_p' z_r)`` for one occurrence set, with ``Li`` of
+    :func:`dense_reduced`; (P, b), or None without numba."""
+    from ..compiled import compiled_kernel
+
+    kernel = compiled_kernel(_back_kernel)
+    if kernel is None:
+        return None
+    ze = np.empty(g_e.shape)
+    kernel(np.ascontiguousarray(g_e), np.ascontiguousarray(T), point, osig, srows,
+           np.ascontiguousarray(z), Li, ze)  # fmt: skip
+    return ze
+
+
+def _diag_grad_kernel(abar, wbar, active, index, diag, grad):  # pragma: no cover - compiled
+    g_n, c_n, k_n = abar.shape
+    for g in range(g_n):
+        if not active[g]:
+            continue
+        for k in range(k_n):
+            d = 0.0
+            s = 0.0
+            for c in range(c_n):
+                a = abar[g, c, k]
+                d += a * a
+                s += wbar[g, c] * a
+            diag[index[g, k]] += d
+            grad[index[g, k]] += s
+
+
+def diag_grad(abar: Array, wbar: Array, active: NDArray[np.bool_], index: Index, diag: Array,
+              grad: Array) -> bool:  # fmt: skip
+    """Add the diagonal ``sum a^2`` and the gradient ``sum w a`` of the normal equations of
+    one block's active groups (``abar`` (G, c, k) at the parameters ``index`` (G, k)) to
+    ``diag`` and ``grad`` in place; False without numba (nothing added)."""
+    from ..compiled import compiled_kernel
+
+    kernel = compiled_kernel(_diag_grad_kernel)
+    if kernel is None:
+        return False
+    kernel(np.ascontiguousarray(abar), np.ascontiguousarray(wbar), np.ascontiguousarray(active),
+           np.ascontiguousarray(index), diag, grad)  # fmt: skip
+    return True

@@ -124,6 +124,17 @@ class _OccSet:
     sig: Index  # (O,)
     rows: Index  # (n_sig, kk) rows of the reduced (bordered) system
     source: tuple[str, int]  # ("v" | "c" | "k", block number)
+    _by_point: tuple[Index, Index] | None = None
+
+    def by_point(self, n_points: int) -> tuple[Index, Index]:
+        """(order, start): the occurrences sorted by their block, and where each block's
+        run starts (n_points + 1,); made on first use."""
+        if self._by_point is None:
+            order = np.argsort(self.point, kind="stable").astype(np.intp)
+            counts = np.bincount(self.point, minlength=n_points)
+            start = np.concatenate([[0], np.cumsum(counts)]).astype(np.intp)
+            self._by_point = (order, start)
+        return self._by_point
 
 
 @dataclass

@@ -321,6 +321,12 @@ def test_snavely_compiled_kernel_equals_numpy():
         np.testing.assert_allclose(b, a, rtol=1e-12, atol=1e-12 * np.abs(a).max())
     u = snavely_project(cam, X, jacobian=False, compiled=True)
     np.testing.assert_allclose(u, ref[0], rtol=1e-12, atol=1e-9)
+    # the joint Jacobian (camera columns, then point columns), compiled and numpy
+    J_ref = np.concatenate(ref[1:], axis=2)
+    for compiled in (True, False):
+        uj, J = snavely_project(cam, X, compiled=compiled, joint=True)
+        np.testing.assert_allclose(uj, ref[0], rtol=1e-12, atol=1e-9)
+        np.testing.assert_allclose(J, J_ref, rtol=1e-12, atol=1e-12 * np.abs(J_ref).max())
 
 
 @pytest.mark.skipif(not (BAL / "dubrovnik-3-7-pre.txt").is_file(), reason="BAL data not here")
@@ -338,10 +344,13 @@ def test_bal_reader_and_projection_on_dubrovnik():
     assert abs(cost / 2.764220e3 - 1) < 1e-6
 
 
-def test_compiled_reduced_system_equals_numpy(monkeypatch):
+@pytest.mark.parametrize("datum", ["priors", "constraints"])
+def test_compiled_reduced_system_equals_numpy(monkeypatch, datum):
     """A BAL-like block (Snavely's model, every camera with its own 9 parameters, so the
-    compiled per-block sums and the pair sums both run): the same adjustment with the numba
-    kernels and with the numpy code of core/lsq/schur.py, to rounding."""
+    compiled per-block sums and the compiled dense reduced system both run): the same
+    adjustment with the numba kernels and with the numpy code of core/lsq/schur.py, to
+    rounding; the datum by priors on the cameras, or by hard constraints (the dense system's
+    bordered solve)."""
     pytest.importorskip("numba")
     from lidarphoto.core.lsq import schur
 
@@ -371,11 +380,65 @@ def test_compiled_reduced_system_equals_numpy(monkeypatch):
     prior = prior_block("cams", np.arange(9 * nc), cams.ravel(), sig)
     elim = 9 * nc + np.arange(3 * npt).reshape(npt, 3)
     opts = AdjustmentOptions(eliminate=elim)
+    blocks, cons = [block, prior], []
+    if datum == "constraints":
+        # camera 0's rotation and translation and camera 1's first translation held; the
+        # focal lengths and distortions of all cameras observed
+        held = np.array([0, 1, 2, 3, 4, 5, 12])
+        vals = x0[held]
+        cons = [Constraint("gauge", held[None], lambda xl: ((xl[0] - vals)[None], np.eye(7)[None]))]
+        keep_f = np.flatnonzero(np.tile(np.arange(9) >= 6, nc))
+        blocks = [block, prior_block("interior", keep_f, cams.ravel()[keep_f], sig[keep_f])]
     monkeypatch.setattr(schur, "_COMPILED_MIN", 0)  # compiled at any size
-    fast = adjust(x0, names, [block, prior], options=opts)
+    fast = adjust(x0, names, blocks, cons, options=opts)
     monkeypatch.setattr(schur, "_COMPILED", False)
-    slow = adjust(x0, names, [block, prior], options=opts)
+    slow = adjust(x0, names, blocks, cons, options=opts)
     assert fast.converged and slow.converged and fast.iterations == slow.iterations
     assert_allclose(fast.x, slow.x, rtol=1e-10, atol=1e-10)
-    assert_allclose(fast.std, slow.std, rtol=1e-8)
+    # (held parameters: sigma 0, to rounding of the bordered inverse)
+    assert_allclose(fast.std, slow.std, rtol=1e-8, atol=1e-9)
     assert fast.omega == pytest.approx(slow.omega, rel=1e-10)
+
+
+def test_compiled_dense_reduced_system_with_scattered_rows():
+    """The compiled dense reduced system (core/lsq/schur_numba.py) on occurrences whose
+    reduced rows are not contiguous runs and blocks of 2 parameters (its general loop),
+    against the sums written out in numpy."""
+    pytest.importorskip("numba")
+    from lidarphoto.core.lsq.schur_numba import back_substitute, dense_reduced
+
+    rng = np.random.default_rng(7)
+    P, b, kk, n_sig, n = 30, 2, 4, 6, 24
+    srows = np.array([rng.permutation(n)[:kk] for _ in range(n_sig)], dtype=np.intp)
+    point = np.repeat(np.arange(P), rng.integers(1, 5, P)).astype(np.intp)
+    rng.shuffle(point)
+    osig = rng.integers(0, n_sig, point.size).astype(np.intp)
+    T = rng.normal(size=(point.size, kk, b))
+    A = rng.normal(size=(P, b, b))
+    V = A @ np.swapaxes(A, 1, 2) + np.eye(b)
+    g_e = rng.normal(size=(P, b))
+    lam = 0.3
+    order = np.argsort(point, kind="stable").astype(np.intp)
+    start = np.concatenate([[0], np.cumsum(np.bincount(point, minlength=P))]).astype(np.intp)
+    K = np.zeros((n, n))
+    rhs = np.zeros(n)
+    Li, y = dense_reduced(V, lam, g_e, T, order, start, osig, srows, K, rhs)
+    Vinv = np.linalg.inv(V + lam * np.eye(b))
+    K_ref = np.zeros((n, n))
+    rhs_ref = np.zeros(n)
+    for o1 in range(point.size):
+        p = point[o1]
+        r1 = srows[osig[o1]]
+        rhs_ref[r1] += T[o1] @ Vinv[p] @ g_e[p]
+        for o2 in np.flatnonzero(point == p):
+            K_ref[np.ix_(r1, srows[osig[o2]])] -= T[o1] @ Vinv[p] @ T[o2].T
+    assert_allclose(K + K.T, K_ref, rtol=1e-12, atol=1e-12)
+    assert_allclose(rhs, rhs_ref, rtol=1e-12, atol=1e-12)
+    assert_allclose(np.swapaxes(Li, 1, 2) @ Li, Vinv, rtol=1e-12, atol=1e-12)
+    assert_allclose(y, np.einsum("pij,pj->pi", Vinv, g_e), rtol=1e-12, atol=1e-12)
+    z = rng.normal(size=n)
+    ze = back_substitute(g_e, T, point, osig, srows, z, Li)
+    acc = -g_e.copy()
+    for o in range(point.size):
+        acc[point[o]] -= T[o].T @ z[srows[osig[o]]]
+    assert_allclose(ze, np.einsum("pij,pj->pi", Vinv, acc), rtol=1e-12, atol=1e-12)
