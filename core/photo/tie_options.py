@@ -22,16 +22,29 @@ class TiePointOptions:
     detector : "sift" or "orb"
     max_features : int
         Strongest keypoints kept per image.
+    contrast : float
+        SIFT's contrast threshold (OpenCV's ``contrastThreshold``, divided by the 3 layers
+        per octave: grey levels / 255). Lower finds weaker extrema; the ``max_features``
+        strongest are kept either way, so a low threshold fills the budget on low-contrast
+        images instead of stopping short of it.
     max_dimension_px : int
         Features are detected on the image reduced by the smallest integer factor that
         brings its longer side to at most this; 0 detects at full resolution.
     ratio : float
         Lowe's ratio: best distance / second best must be below it.
+    root_sift : bool
+        SIFT: match RootSIFT descriptors (L1-normalised, square-rooted; Arandjelovic &
+        Zisserman 2012) rather than OpenCV's raw ones.
     mutual : bool
         Keep a match only if it is also the best in the other direction.
     ransac_px : float
         RANSAC threshold on the distance to the epipolar line, full-resolution pixels.
     ransac_method : "magsac" (MAGSAC++) or "ransac"
+    guided : bool
+        SIFT: after the fundamental matrix, every keypoint is matched again among its
+        nearest descriptors that lie within ``ransac_px`` of its epipolar line (ratio test
+        among those): the matches the global ratio test lost to look-alikes elsewhere in the
+        image.
     min_inliers : int
         Fewer inliers: the pair is dropped.
     min_track_length : int
@@ -45,8 +58,9 @@ class TiePointOptions:
         A-priori sigma written with every measurement, pixels; 0 = 0.5 px times the
         detection reduction factor.
     coherence : float
-        Motion coherence: an inlier whose displacement differs from the median displacement
-        of its 8 nearest inliers by more than this share of the image diagonal is dropped
+        Motion coherence: an inlier whose displacement (what a homography fitted robustly
+        to the pair leaves of it) differs from the median displacement of its 8 nearest
+        inliers by more than this share of the image diagonal is dropped
         (0: no test). It removes wrong matches that slide along the epipolar line, which
         the fundamental matrix cannot see (aerial strips: all epipolar lines are parallel).
     refine : bool
@@ -61,11 +75,14 @@ class TiePointOptions:
 
     detector: str = "sift"
     max_features: int = 4000
+    contrast: float = 0.04
     max_dimension_px: int = 3000
     ratio: float = 0.8
+    root_sift: bool = False
     mutual: bool = True
     ransac_px: float = 2.0
     ransac_method: str = "magsac"
+    guided: bool = False
     min_inliers: int = 15
     min_track_length: int = 2
     pair_mode: str = "auto"
@@ -90,5 +107,7 @@ class TiePointOptions:
             raise InputError("a track needs at least 2 images")
         if self.min_inliers < 8:
             raise InputError("the fundamental matrix needs at least 8 inliers")
+        if not 0.0 < self.contrast < 1.0:
+            raise InputError(f"SIFT contrast threshold must be in (0, 1), got {self.contrast:g}")
         if self.refine_half_px < 3:
             raise InputError("the refinement template needs a half size of at least 3 px")

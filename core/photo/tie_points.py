@@ -69,6 +69,7 @@ __all__ = [
     "tie_points",
 ]
 
+
 def reduction_factor(width_px: int, height_px: int, max_dimension_px: int) -> int:
     """Smallest integer factor bringing the longer side to at most ``max_dimension_px``.
 
@@ -94,9 +95,12 @@ def _detector(options: TiePointOptions):
     if options.detector == "sift":
         try:
             return cv2.SIFT_create(nfeatures=int(options.max_features),
+                                   contrastThreshold=float(options.contrast),
                                    enable_precise_upscale=True), 0.0  # fmt: skip
         except TypeError:  # OpenCV < 4.8
-            return cv2.SIFT_create(nfeatures=int(options.max_features)), -0.25
+            return cv2.SIFT_create(
+                nfeatures=int(options.max_features), contrastThreshold=float(options.contrast)
+            ), -0.25
     return cv2.ORB_create(nfeatures=int(options.max_features), scaleFactor=1.2, nlevels=8,
                           fastThreshold=10), 0.0  # fmt: skip
 
@@ -209,6 +213,34 @@ def _knn(a: NDArray, b: NDArray, binary: bool, k: int):
     return idx, d1, d2
 
 
+def root_sift(d: NDArray) -> NDArray[np.float32]:
+    """RootSIFT (Arandjelovic & Zisserman 2012): each descriptor divided by its L1 norm and
+    square-rooted, so that the Euclidean distance compares them by the Hellinger kernel,
+    which separates true from false neighbours better than the Euclidean one (unit length).
+
+    >>> root_sift(np.array([[4, 0, 0, 12]], np.uint8)).round(3).tolist()
+    [[0.5, 0.0, 0.0, 0.866]]
+    """
+    x = np.asarray(d, np.float32)
+    return np.sqrt(x / np.maximum(x.sum(axis=1, keepdims=True), 1e-12))
+
+
+def _knn_k(a: NDArray, b: NDArray, k: int) -> tuple[NDArray[np.intp], Array]:
+    """The ``k`` nearest rows of ``b`` of every row of ``a`` (FLANN, as :func:`_knn`):
+    indices (-1 where fewer were found) and distances, each (len(a), k)."""
+    import cv2
+
+    cv2.setRNGSeed(12345)
+    matcher = cv2.FlannBasedMatcher({"algorithm": 1, "trees": 4}, {"checks": 64})
+    res = matcher.knnMatch(a.astype(np.float32), b.astype(np.float32), k=k)
+    idx = np.full((len(res), k), -1, np.intp)
+    dist = np.full((len(res), k), np.inf)
+    for r, m in enumerate(res):
+        idx[r, : len(m)] = [x.trainIdx for x in m]
+        dist[r, : len(m)] = [x.distance for x in m]
+    return idx, dist
+
+
 def epipolar_distances(f: Array, pa: Array, pb: Array) -> Array:
     """Mean of the distances of b to the epipolar line F a and of a to F^T b, pixels.
 
@@ -250,13 +282,21 @@ def match_pair(
     if len(fa) < 2 or len(fb) < 2:
         return drop("too few features")
     binary = options.detector == "orb"
-    best, d1, d2 = _knn(fa.descriptors, fb.descriptors, binary, 2)
+    da, db = fa.descriptors, fb.descriptors
+    if not binary and options.root_sift:
+        da, db = root_sift(da), root_sift(db)
+    guided = options.guided and not binary
+    if guided:  # one search serves the ratio test and the guided matching
+        near, dist = _knn_k(da, db, min(_GUIDED_K, len(db)))
+        best, d1, d2 = near[:, 0], dist[:, 0], dist[:, 1]
+    else:
+        best, d1, d2 = _knn(da, db, binary, 2)
     ok = (best >= 0) & (d1 < options.ratio * d2)
     ia = np.flatnonzero(ok)
     ib = best[ia]
     n_ratio = int(ia.size)
     if options.mutual and ia.size:
-        back, _, _ = _knn(fb.descriptors[ib], fa.descriptors, binary, 1)
+        back, _, _ = _knn(db[ib], da, binary, 1)
         keep = back == ia
         ia, ib = ia[keep], ib[keep]
     # a keypoint of b chosen by two of a (possible without the mutual check): drop both
@@ -281,28 +321,93 @@ def match_pair(
     if f is None or mask is None or f.shape != (3, 3):
         return drop("no fundamental matrix found (RANSAC failed)", n_ratio, n_mutual)
     inl = mask.ravel().astype(bool)
-    res = epipolar_distances(f, pa[inl], pb[inl])
+    ka, kb = ia[inl], ib[inl]
+    if guided and ka.size >= options.min_inliers:
+        ka, kb = _guided(near, dist, fa.pixels, fb.pixels, f, options, ka, kb)
+    pa, pb = fa.pixels[ka], fb.pixels[kb]
+    res = epipolar_distances(f, pa, pb)
     # MAGSAC's mask is its own weighting: keep the hard threshold as well
-    good = np.isfinite(res) & (res <= options.ransac_px)
-    sel = np.flatnonzero(inl)[good]
+    sel = np.flatnonzero(np.isfinite(res) & (res <= options.ransac_px))
     if options.coherence > 0 and sel.size > _NEIGHBOURS:
         diag = math.hypot(*fa.size_px)
-        coherent = _coherent(pa[sel], pb[sel] - pa[sel], options.coherence * diag)
-        sel, res = sel[coherent], res[good][coherent]
-    else:
-        res = res[good]
+        tol = options.coherence * diag
+        sel = sel[_coherent(pa[sel], pb[sel] - _global_map(pa[sel], pb[sel], tol), tol)]
     n_in = int(sel.size)
     if n_in < options.min_inliers:
         return PairMatch(i, j, empty, empty, n_ratio, n_mutual, n_in, np.zeros(0),
                          f"too few RANSAC inliers ({n_in} < {options.min_inliers})",
                          overlap)  # fmt: skip
-    return PairMatch(i, j, ia[sel], ib[sel], n_ratio, n_mutual, n_in, res, "ok", overlap)
+    return PairMatch(i, j, ka[sel], kb[sel], n_ratio, n_mutual, n_in, res[sel], "ok", overlap)
+
+
+#: Descriptor neighbours searched per keypoint by the guided matching.
+_GUIDED_K = 8
+
+
+def _guided(idx: NDArray[np.intp], dist: Array, xa: Array, xb: Array, f: Array,
+            options: TiePointOptions, ka: NDArray[np.intp],
+            kb: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:  # fmt: skip
+    """Guided matching along the epipolar lines of ``f`` (pixels ``xa``, ``xb``; ``idx``,
+    ``dist``: the descriptor neighbours in b of every keypoint of a, from :func:`_knn_k`):
+    each keypoint of a takes its nearest descriptor among the ``_GUIDED_K`` nearest of b that lie
+    within ``ransac_px`` of its epipolar line, if that one is below ``ratio`` times the next
+    such neighbour (or, when it is the only one, the ``_GUIDED_K``-th neighbour's distance: a
+    bound, so the test is stricter than with the true second). Keypoints of b taken twice
+    are dropped; the matches ``ka``, ``kb`` already verified are kept. Returns the keypoint
+    indices of all the matches (a one-to-one map)."""
+    n, k = idx.shape
+    ra = np.repeat(np.arange(n), k)
+    valid = idx.ravel() >= 0
+    e = np.full(n * k, np.inf)
+    e[valid] = epipolar_distances(f, xa[ra[valid]], xb[idx.ravel()[valid]])
+    near = (e <= options.ransac_px).reshape(n, k)
+    d = np.where(near, dist, np.inf)
+    order = np.argsort(d, axis=1, kind="stable")[:, :2]
+    first = np.take_along_axis(d, order[:, :1], 1)[:, 0]
+    second = np.take_along_axis(d, order[:, 1:2], 1)[:, 0]
+    second = np.where(np.isfinite(second), second, dist[:, -1])
+    ok = np.isfinite(first) & (first < options.ratio * second)
+    ga = np.flatnonzero(ok)
+    gb = np.take_along_axis(idx, order[:, :1], 1)[ga, 0]
+    prior = np.full(n, -1, np.intp)
+    prior[ka] = kb  # the verified match of a keypoint wins over its guided one
+    ga, gb = ga[prior[ga] < 0], gb[prior[ga] < 0]
+    ga, gb = np.concatenate([ka, ga]), np.concatenate([kb, gb])
+    uniq, counts = np.unique(gb, return_counts=True)
+    single = np.isin(gb, uniq[counts == 1])
+    return ga[single], gb[single]
 
 
 _NEIGHBOURS = 8
 #: Median shift of the matches (full-resolution pixels) below which a pair is the same view
 #: twice (a copy, or a camera that did not move): no parallax, no tie points.
 NO_PARALLAX_PX = 0.5
+
+
+def _global_map(pa: Array, pb: Array, tol_px: float) -> Array:
+    """``pa`` carried into image b by a homography fitted robustly (RANSAC, ``tol_px``) to
+    the matches; ``pa`` itself when none is found. The coherence test compares what is left
+    of each displacement: between images turned against each other the displacement itself
+    changes by twice the distance between neighbours (180 degrees), which the test must not
+    take for incoherence (measured: a quarter of the right matches of such a pair dropped).
+
+    >>> pa = np.random.default_rng(2).random((30, 2)) * 500
+    >>> bool(np.allclose(_global_map(pa, 600.0 - pa, 5.0), 600.0 - pa, atol=1e-6))
+    True
+    """
+    import cv2
+
+    cv2.setRNGSeed(12345)
+    try:
+        h, _ = cv2.findHomography(pa, pb, cv2.RANSAC, float(tol_px))
+    except cv2.error:
+        h = None
+    if h is None or h.shape != (3, 3):
+        return pa
+    q = np.column_stack([pa, np.ones(len(pa))]) @ h.T
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = q[:, :2] / q[:, 2:]
+    return np.where(np.isfinite(out), out, pa)
 
 
 def _coherent(p: Array, d: Array, tol_px: float) -> NDArray[np.bool_]:
