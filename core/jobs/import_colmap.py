@@ -26,6 +26,21 @@ BLOCK_OUTPUTS = (
 )  # fmt: skip
 
 
+def pixel_size_param(help: str) -> Param:
+    """The importers' PIXEL_SIZE (mm): the file states none (or, for Metashape, may not), so
+    it only sets the camera's millimetres, never the projection."""
+    return Param(
+        "PIXEL_SIZE",
+        "number",
+        "Pixel size",
+        Ref("io.colmap_names", "DEFAULT_PIXEL_SIZE_MM"),
+        unit="mm",
+        minimum=0.0005,
+        maximum=0.5,
+        help=help,
+    )
+
+
 def block_results(images: str) -> tuple[Result, ...]:
     """The counts a block import reports; ``images`` names the image count."""
     return (
@@ -75,9 +90,7 @@ as a ground point table with role check (triangulated tie points, never control)
               help="the projected CRS an ECEF model is converted to"),
         Param("SIMILARITY", "string", "Similarity model -> frame", "", optional=True,
               help="s qw qx qy qz tx ty tz (X' = s R(q) X + t); empty: none"),
-        Param("PIXEL_SIZE", "number", "Pixel size",
-              Ref("io.colmap_names", "DEFAULT_PIXEL_SIZE_MM"), unit="mm", minimum=0.0005,
-              maximum=0.5, help="COLMAP stores none: it sets the millimetres of the camera"),
+        pixel_size_param("COLMAP stores none: it sets the millimetres of the camera"),
         *BLOCK_OUTPUTS,
     ),
     results=block_results("Number of registered images"),

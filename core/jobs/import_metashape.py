@@ -6,7 +6,7 @@ from __future__ import annotations
 import logging
 
 from .common import _first
-from .import_colmap import BLOCK_OUTPUTS, block_results, finish_import
+from .import_colmap import BLOCK_OUTPUTS, block_results, finish_import, pixel_size_param
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Ref, Result, Values
 
@@ -60,16 +60,9 @@ sigma). The camera XML has no tie points.""",
             optional=True,
             help="the projected CRS to convert to; empty: the chunk's own (projected) CRS",
         ),
-        Param(
-            "PIXEL_SIZE",
-            "number",
-            "Pixel size",
-            Ref("io.colmap_names", "DEFAULT_PIXEL_SIZE_MM"),
-            unit="mm",
-            minimum=0.0005,
-            maximum=0.5,
-            help="used when a sensor states no pixel_width: it sets the "
-            "millimetres of the camera, never the projection",
+        pixel_size_param(
+            "used when a sensor states no pixel_width: it sets the "
+            "millimetres of the camera, never the projection"
         ),
         Param(
             "IMAGE_NAMES",

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import logging
 
-from .import_colmap import BLOCK_OUTPUTS, block_results, finish_import
+from .import_colmap import BLOCK_OUTPUTS, block_results, finish_import, pixel_size_param
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Ref, Values
+from .spec import AlgorithmSpec, Param, Values
 
 log = logging.getLogger(__name__)
 
@@ -48,9 +48,7 @@ point table with role check (triangulated tie points, never control).""",
               help="the projected CRS to convert to; empty: the topocentric frame (LOCAL)"),
         Param("RECONSTRUCTION", "integer", "Reconstruction index", 0, minimum=0,
               help="which reconstruction of the file (0: the first)"),
-        Param("PIXEL_SIZE", "number", "Pixel size",
-              Ref("io.colmap_names", "DEFAULT_PIXEL_SIZE_MM"), unit="mm", minimum=0.0005,
-              maximum=0.5, help="OpenSfM stores none: it sets the millimetres of the camera"),
+        pixel_size_param("OpenSfM stores none: it sets the millimetres of the camera"),
         *BLOCK_OUTPUTS,
     ),
     results=block_results("Number of shots"),

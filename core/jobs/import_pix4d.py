@@ -6,7 +6,7 @@ from __future__ import annotations
 import logging
 
 from .common import _first
-from .import_colmap import BLOCK_OUTPUTS, block_results, finish_import
+from .import_colmap import BLOCK_OUTPUTS, block_results, finish_import, pixel_size_param
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Ref, Values
 
@@ -66,16 +66,8 @@ file has no tie points.""",
             optional=True,
             help="empty: <project>_wkt.prj beside INPUT, else LOCAL",
         ),
-        Param(
-            "PIXEL_SIZE",
-            "number",
-            "Pixel size",
-            Ref("io.colmap_names", "DEFAULT_PIXEL_SIZE_MM"),
-            unit="mm",
-            minimum=0.0005,
-            maximum=0.5,
-            help="the file states none: it sets the millimetres of the camera, "
-            "never the projection",
+        pixel_size_param(
+            "the file states none: it sets the millimetres of the camera, never the projection"
         ),
         Param(
             "PIXEL_ORIGIN",
