@@ -225,8 +225,9 @@ WORKFLOWS: tuple[Workflow, ...] = (
 def workflows_of(name: str) -> tuple[Workflow, ...]:
     """The workflows algorithm ``name`` is a step of.
 
-    >>> [w.title.split()[0] for w in workflows_of("createlcps")]
-    ['Boresight']
+    >>> [w.title for w in workflows_of("createlcps")]  # doctest: +NORMALIZE_WHITESPACE
+    ['Boresight calibration with LiDAR control (Pedrosa & dos Santos 2020)',
+     'Boresight calibration without hand picks (automatic)']
     """
     return tuple(w for w in WORKFLOWS if name in w.ids)
 

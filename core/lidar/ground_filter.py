@@ -563,7 +563,6 @@ def ground_filter(
 
     Examples
     --------
-    >>> from lidarphoto.core.lidar.ground_filter_params import GroundFilterParams
     >>> xx, yy = np.meshgrid(np.arange(0, 30, 0.5), np.arange(0, 30, 0.5))
     >>> x, y = xx.ravel(), yy.ravel()
     >>> z = np.where((abs(x - 15) < 4) & (abs(y - 15) < 4), 6.0, 0.0)

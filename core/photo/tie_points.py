@@ -218,7 +218,7 @@ def root_sift(d: NDArray) -> NDArray[np.float32]:
     square-rooted, so that the Euclidean distance compares them by the Hellinger kernel,
     which separates true from false neighbours better than the Euclidean one (unit length).
 
-    >>> root_sift(np.array([[4, 0, 0, 12]], np.uint8)).round(3).tolist()
+    >>> root_sift(np.array([[4, 0, 0, 12]], np.uint8)).astype(float).round(3).tolist()
     [[0.5, 0.0, 0.0, 0.866]]
     """
     x = np.asarray(d, np.float32)
