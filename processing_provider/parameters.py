@@ -32,12 +32,14 @@ from qgis.core import (
 )
 from qgis.PyQt.QtCore import QCoreApplication, QUrl
 
+from ..core.io.suffixes import IMAGE_SUFFIXES
 from ..core.jobs.spec import FILE_KINDS, AlgorithmSpec, Param, Result, facts_line
 from .compat import (
     FIELD_TYPE_ANY,
     FIELD_TYPE_NUMERIC,
     FILE_BEHAVIOR_FILE,
     FLAG_ADVANCED,
+    FLAG_OPTIONAL,
     NUMBER_DOUBLE,
     NUMBER_INTEGER,
     SOURCE_FILE,
@@ -116,6 +118,12 @@ def layer_input(p: Param) -> bool:
     return p.kind in ("raster", "surface", "table")
 
 
+def raster_files(p: Param) -> bool:
+    """Whether a list of files is a list of images (every ending one GDAL reads as a raster):
+    QGIS then offers the project's raster layers, and files and folders as well."""
+    return p.kind == "files" and bool(p.suffixes) and set(p.suffixes) <= set(IMAGE_SUFFIXES)
+
+
 _SINK_TYPES = {
     "point": SOURCE_VECTOR_POINT,
     "line": SOURCE_VECTOR_LINE,
@@ -185,6 +193,8 @@ def make_parameter(
             FIELD_TYPE_NUMERIC if p.numeric_field else FIELD_TYPE_ANY,
             optional=True,
         )
+    elif raster_files(p):
+        q = RasterFilesParameter(p.name, title, SOURCE_RASTER, None, p.optional)
     elif k == "files":
         q = QgsProcessingParameterMultipleLayers(p.name, title, SOURCE_FILE, None, p.optional)
     elif k == "folder_out":
@@ -258,6 +268,8 @@ def read_parameter(alg, p: Param, parameters: dict, context) -> Any:
         return alg.parameterAsSource(parameters, p.name, context)
     if k == "field":
         return (alg.parameterAsFields(parameters, p.name, context) or [""])[0]
+    if raster_files(p):
+        return raster_file_list(p, parameters.get(p.name), context) or None
     if k == "files":
         return tuple(alg.parameterAsFileList(parameters, p.name, context)) or None
     if k in ("file_out", "folder_out"):
@@ -317,6 +329,67 @@ class TableOrFileParameter(_FileAccepted, QgsProcessingParameterVectorLayer):
         return self._copied(TableOrFileParameter(
             self.name(), self.description(), self.dataTypes(), self.defaultValue()
         ))  # fmt: skip
+
+
+class RasterFilesParameter(QgsProcessingParameterMultipleLayers):
+    """Images: raster layers of the project, image files and folders of images (the job
+    expands a folder with its endings), in any mix."""
+
+    def checkValueIsAcceptable(self, value, context=None) -> bool:
+        items = value if isinstance(value, (list, tuple)) else [value]
+        if items and all(isinstance(i, str) and os.path.exists(i) for i in items):
+            return True
+        return super().checkValueIsAcceptable(value, context)
+
+    def clone(self):
+        copy = RasterFilesParameter(
+            self.name(),
+            self.description(),
+            self.layerType(),
+            self.defaultValue(),
+            bool(self.flags() & FLAG_OPTIONAL),
+        )
+        copy.setFlags(self.flags())
+        copy.setHelp(self.help())
+        return copy
+
+
+def raster_file_list(p: Param, value, context) -> tuple[str, ...]:
+    """The files of an image list (:class:`RasterFilesParameter`): a path (file or folder)
+    as it is, a raster layer (the object or its id) its GDAL file, other text as a path (the
+    job names a missing file); a layer not backed by a raster file refused by name."""
+    from qgis.core import QgsMapLayer, QgsProcessingUtils
+
+    if value in (None, ""):
+        return ()
+    items = value if isinstance(value, (list, tuple)) else [value]
+    files: list[str] = []
+    for item in items:
+        if isinstance(item, str) and (not item or os.path.exists(item)):
+            files += [item] if item else []
+            continue
+        layer = item if isinstance(item, QgsMapLayer) else (
+            QgsProcessingUtils.mapLayerFromString(str(item), context)
+        )  # fmt: skip
+        if layer is None:
+            files.append(str(item))
+            continue
+        path = layer_source_file(layer)
+        if not path or layer.providerType() != "gdal":
+            raise QgsProcessingException(
+                QCoreApplication.translate(
+                    "LidarPhotoProvider",
+                    "{name}: the layer {layer} is not backed by a {what} file ({source}); "
+                    "save it as one first",
+                ).format(
+                    name=p.name,
+                    layer=layer.name(),
+                    what=_file_format("raster"),
+                    source=layer.source(),
+                )
+            )
+        files.append(path)
+    return tuple(files)
 
 
 def layer_parameter(p: Param, title: str) -> QgsProcessingParameterDefinition:

@@ -20,6 +20,7 @@ from lidarphoto.processing_provider.compat import SOURCE_TABLE
 from lidarphoto.processing_provider.parameters import (
     LayerOrFileParameter,
     PointCloudOrFileParameter,
+    RasterFilesParameter,
     RasterOrFileParameter,
     TableOrFileParameter,
     layer_file,
@@ -30,6 +31,7 @@ from qgis.core import (
     QgsProcessingException,
     QgsProcessingFeedback,
     QgsProcessingParameterFile,
+    QgsProcessingParameterMultipleLayers,
     QgsProject,
     QgsRasterLayer,
     QgsVectorLayer,
@@ -86,6 +88,41 @@ def test_every_layer_kind_is_a_layer_parameter(provider, tmp_path):
     # the DSMs, the clouds of the LiDAR algorithms and every CSV table (points, planes, lines, EO,
     # image observations, trajectories, events, scale bars, stations, ground photos)
     assert seen == {"raster": 0, "pointcloud": 5, "surface": 2, "table": 44}, seen
+
+
+def test_image_lists_take_raster_layers_files_and_folders(provider, tmp_path):
+    """Every list of images (images, orthophotos, ground photos, control chips) offers the
+    project's raster layers and accepts files and folders as they are; other lists of files
+    (scans, swaths) stay file lists; each keeps its class when cloned."""
+    from lidarphoto.processing_provider.compat import SOURCE_FILE, SOURCE_RASTER
+
+    image = tmp_path / "a.tif"
+    image.write_bytes(b"")
+    context = _context(QgsProject.instance())
+    names = []
+    for job in ALGORITHMS:
+        alg = provider.algorithm(job.SPEC.name)
+        for p in job.SPEC.params:
+            if p.kind != "files":
+                continue
+            d = alg.parameterDefinition(p.name)
+            assert isinstance(d, QgsProcessingParameterMultipleLayers), p.name
+            if not isinstance(d, RasterFilesParameter):
+                assert d.layerType() == SOURCE_FILE, (job.SPEC.name, p.name)
+                continue
+            names.append(f"{job.SPEC.name}.{p.name}")
+            assert d.layerType() == SOURCE_RASTER
+            clone = d.clone()
+            assert type(clone) is RasterFilesParameter and clone.flags() == d.flags()
+            assert clone.help() == d.help()
+            for value in (str(tmp_path), [str(tmp_path), str(image)], str(image)):
+                assert d.checkValueIsAcceptable(value, context), (p.name, value)
+            assert not d.checkValueIsAcceptable(str(tmp_path / "missing.tif"), context)
+    assert sorted(names) == [
+        "autoboresight.IMAGES", "calibratecamera.IMAGES", "locatecontrolpoints.CHIPS",
+        "locatecontrolpoints.IMAGES", "makecontrolchips.PHOTOS", "orthomosaic.ORTHOPHOTOS",
+        "orthorectify.IMAGES", "tiepoints.IMAGES",
+    ], names
 
 
 def _checkpoints(path: Path) -> Path:

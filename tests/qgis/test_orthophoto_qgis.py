@@ -157,6 +157,47 @@ def test_processing_run_mosaic_from_laz_dsm(provider, demo, tmp_path):
         f["image_id"] for f in seams.getFeatures())  # fmt: skip
 
 
+def test_images_and_orthophotos_from_raster_layers(provider, demo, tmp_path):
+    """Issue 31, layers in: the images as raster layers of the project (objects and ids, in a
+    mix with a file) give the orthophotos the folder gives, bit for bit; the orthophotos loaded
+    as layers give the mosaic their folder gives; a layer not backed by a raster file is
+    refused naming the parameter, nothing written."""
+    project = QgsProject.instance()
+    context = QgsProcessingContext()
+    context.setProject(project)
+    files = sorted(Path(demo["images"]).iterdir())
+    layers = [QgsRasterLayer(str(f), f.stem) for f in files]
+    assert all(layer.isValid() for layer in layers) and len(layers) == 4
+    project.addMapLayers(layers)
+    try:
+        mixed = [layers[0], layers[1].id(), layers[2].id(), str(files[3])]
+        processing.run("lidarphoto:orthorectify", _params(demo, tmp_path / "f"), context=context)
+        processing.run("lidarphoto:orthorectify",
+                       _params(demo, tmp_path / "l", IMAGES=mixed), context=context)  # fmt: skip
+        written = sorted(p.name for p in (tmp_path / "f").iterdir())
+        assert len(written) == 4 and sorted(p.name for p in (tmp_path / "l").iterdir()) == written
+        for name in written:
+            np.testing.assert_array_equal(_read(tmp_path / "f" / name)[1],
+                                          _read(tmp_path / "l" / name)[1])  # fmt: skip
+        orthos = [QgsRasterLayer(str(tmp_path / "l" / n), n) for n in written]
+        project.addMapLayers(orthos)
+        outs = {}
+        for key, value in (("folder", [str(tmp_path / "l")]), ("layers", [o.id() for o in orthos])):
+            outs[key] = processing.run("lidarphoto:orthomosaic", {
+                "ORTHOPHOTOS": value, "OUTPUT": str(tmp_path / f"{key}.tif"),
+            }, context=context)["OUTPUT"]  # fmt: skip
+        np.testing.assert_array_equal(_read(outs["folder"])[1], _read(outs["layers"])[1])
+        memory = QgsVectorLayer("Point?crs=EPSG:28992", "scratch", "memory")
+        project.addMapLayer(memory)
+        refused = "IMAGES: the layer scratch is not backed by a raster file"
+        with pytest.raises(QgsProcessingException, match=refused):
+            processing.run("lidarphoto:orthorectify", _params(
+                demo, tmp_path / "m", IMAGES=[layers[0].id(), memory.id()]), context=context)
+        assert not (tmp_path / "m").exists() or not any((tmp_path / "m").iterdir())
+    finally:
+        project.removeAllMapLayers()
+
+
 def test_errors_name_the_image(provider, demo, tmp_path):
     eo = tmp_path / "eo.csv"
     lines = Path(demo["paths"]["eo_true"]).read_text(encoding="utf-8").splitlines()
