@@ -458,7 +458,8 @@ def param_facts(
 
 
 def facts_line(p: Param, spec: AlgorithmSpec | None = None, t: Callable[[str], str] = _same) -> str:
-    """"default: 0.15; unit: m; range: 0.001 to 100" (the parts that apply).
+    """The facts of a parameter, e.g. "default: 0.15; unit: m; range: 0.001 to 100" (the parts
+    that apply).
 
     >>> facts_line(Param("E", "number", "Epsilon", 0.15, unit="m", minimum=0.001))
     'default: 0.15; unit: m; range: >= 0.001'
