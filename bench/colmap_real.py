@@ -205,9 +205,12 @@ def make(args: argparse.Namespace) -> None:
         record["image_size"] = downscale(Path(args.images), small)
         for model in args.models:
             rec = reconstruct(small, Path(tmp), model)
-            full = {"images": rec.num_reg_images(), "points": rec.num_points3D(),
-                    "observations": rec.compute_num_observations(),
-                    "mean_reprojection_error_px": rec.compute_mean_reprojection_error()}
+            full = {
+                "images": rec.num_reg_images(),
+                "points": rec.num_points3D(),
+                "observations": rec.compute_num_observations(),
+                "mean_reprojection_error_px": rec.compute_mean_reprojection_error(),
+            }
             new = trimmed(rec, np.random.default_rng(0))
             folder = OUT / model
             writers = [("txt", new.write_text)]
