@@ -35,7 +35,9 @@ the camera parameters and the file sizes.
 
 ``check-export``: reads a model written by the project's ``exportcolmap`` (text) with
 pycolmap and projects the recorded pairs through it, against COLMAP's recorded projections
-(matched by image name and 3D point position), e.g.::
+(matched by image name; the points are the original's), lets COLMAP recompute the points'
+errors on it (the export writes 0) and records the result under ``export_checks`` in
+record.json, e.g.::
 
     lidarphoto importcolmap --input tests/data/colmap/OPENCV/txt --frame LOCAL \
         --output-camera c.json --output-eo eo.csv --output-observations o.csv \
@@ -240,7 +242,8 @@ def make(args: argparse.Namespace) -> None:
 
 
 def check_export(args: argparse.Namespace) -> None:
-    """pycolmap reads our exported model; its projections against COLMAP's recorded ones."""
+    """pycolmap reads our exported model: its projections against COLMAP's recorded ones, and
+    COLMAP's errors recomputed on it against the original's; recorded in record.json."""
     orig = pycolmap.Reconstruction(str(OUT / args.model / "txt"))
     ours = pycolmap.Reconstruction(str(args.folder))
     by_name = {img.name: iid for iid, img in ours.images.items()}
@@ -252,11 +255,24 @@ def check_export(args: argparse.Namespace) -> None:
             px = project(ours, by_name[orig.image(iid).name], xyz)
             diffs.append(np.hypot(px[0] - float(row["x_px"]), px[1] - float(row["y_px"])))
     d = np.array(diffs)
-    out = {"model": args.model, "read_by": f"pycolmap {pycolmap.__version__}",
-           "cameras": [c.model_name for c in ours.cameras.values()], "pairs": len(d),
-           "median_px": float(np.median(d)), "max_px": float(np.max(d)),
-           "mean_reprojection_error_px": ours.compute_mean_reprojection_error()}  # fmt: skip
-    print(json.dumps(out))
+    ours.update_point_3d_errors()  # the export writes ERROR 0: COLMAP recomputes them
+    out = {
+        "read_by": f"pycolmap {pycolmap.__version__}",
+        "cameras": [c.model_name for c in ours.cameras.values()],
+        "images": ours.num_reg_images(),
+        "points": ours.num_points3D(),
+        "observations": ours.compute_num_observations(),
+        "pairs": len(d),
+        "median_px": float(np.median(d)),
+        "max_px": float(np.max(d)),
+        "mean_reprojection_error_px": ours.compute_mean_reprojection_error(),
+        "original_mean_reprojection_error_px": orig.compute_mean_reprojection_error(),
+    }
+    print(args.model, json.dumps(out))
+    path = OUT / "record.json"
+    record = json.loads(path.read_text())
+    record.setdefault("export_checks", {})[args.model] = out
+    path.write_text(json.dumps(record, indent=1) + "\n")
 
 
 def main() -> None:
