@@ -45,7 +45,9 @@ family on the same block, writes the comparison table (mean, standard deviation 
 check-point discrepancies, sigma0, significant APs) and the outputs of the best model.
 
 Inputs: camera JSON (one camera, or {"cameras": [...]} with a camera column in the EO or
-observation table), image observations (image_id, point_id, col, row, sigma_px; a row of
+observation table; perspective or fisheye: equidistant, equisolid-angle, orthographic or
+stereographic with Brown added, as Calibrate camera writes it, each through its own
+projection), image observations (image_id, point_id, col, row, sigma_px; a row of
 type control, as Locate control points writes it, must name a ground point), ground points
 (point_id, X, Y, Z, sx, sy, sz, role = control | check), optionally exterior
 orientations: approximate (e.g. direct georeferencing, a few degrees and metres off), or

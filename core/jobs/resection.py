@@ -32,7 +32,10 @@ points and lines, or lines monoplotted on another image (dos Santos, Dal Poz & D
 No approximate orientation is needed: a global search over the rotation with the position
 eliminated in closed form (Hesch & Roumeliotis 2011; Mirzaei & Roumeliotis 2011) gives the
 start, OpenCV's solvePnP another when there are four or more points, and the one that fits
-best starts the rigorous adjustment.
+best starts the rigorous adjustment. The camera may be perspective or, for control points,
+fisheye (equidistant, equisolid-angle, orthographic, stereographic, Brown added: its own
+projection and rays); straight lines need a perspective camera (line rows with a fisheye
+camera are refused).
 
 Line models: coplanarity (every point measured on an image line lies on the projected 3D
 line; no parametrisation, the default) or the equivalent-planes model of Tommaselli & Tozzi
