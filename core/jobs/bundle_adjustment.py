@@ -45,7 +45,9 @@ family on the same block, writes the comparison table (mean, standard deviation 
 check-point discrepancies, sigma0, significant APs) and the outputs of the best model.
 
 Inputs: camera JSON (one camera, or {"cameras": [...]} with a camera column in the EO or
-observation table), image observations (image_id, point_id, col, row, sigma_px; a row of
+observation table; perspective or fisheye: equidistant, equisolid-angle, orthographic or
+stereographic with Brown added, as Calibrate camera writes it, each through its own
+projection), image observations (image_id, point_id, col, row, sigma_px; a row of
 type control, as Locate control points writes it, must name a ground point), ground points
 (point_id, X, Y, Z, sx, sy, sz, role = control | check), optionally exterior
 orientations: approximate (e.g. direct georeferencing, a few degrees and metres off), or
@@ -379,6 +381,7 @@ def _read_inputs(v: Values) -> tuple:
 
     from ..errors import InputError
     from ..geometry.frames import check_area_of_use
+    from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_cameras_json
     from ..io.ground_points import read_ground_points_csv
     from ..io.observations import read_observations_csv
@@ -388,7 +391,7 @@ def _read_inputs(v: Values) -> tuple:
 
     frame = _frame(v)
     crs = getattr(frame, "crs", None)  # None: a local engineering frame
-    cams = read_cameras_json(v.camera)
+    cams = read_cameras_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     # one camera: its image size bounds every pixel as the table is read (several: below)
     obs = read_observations_csv(v.observations, camera=cams[0] if len(cams) == 1 else None)
     ground = read_ground_points_csv(v.ground_points) if v.ground_points else GroundPoints.empty()
@@ -628,7 +631,8 @@ def _settings(v, cams, obs, ground, eo, sigma, frame, velocity=None) -> dict[str
     return {
         "cameras": "; ".join(
             f"{c.name} (f = {c.focal_mm:g} mm, {c.width_px} x {c.height_px} px of "
-            f"{c.pixel_size_mm * 1000:g} um, lens {c.distortion.model})" for c in cams
+            f"{c.pixel_size_mm * 1000:g} um, {c.projection} projection, lens "
+            f"{c.distortion.model})" for c in cams
         ),
         "images / measurements": f"{len(set(obs.image_id))} / {len(obs)}",
         "ground points": f"{roles.count('control')} control, {roles.count('check')} check",

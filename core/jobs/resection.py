@@ -32,7 +32,10 @@ points and lines, or lines monoplotted on another image (dos Santos, Dal Poz & D
 No approximate orientation is needed: a global search over the rotation with the position
 eliminated in closed form (Hesch & Roumeliotis 2011; Mirzaei & Roumeliotis 2011) gives the
 start, OpenCV's solvePnP another when there are four or more points, and the one that fits
-best starts the rigorous adjustment.
+best starts the rigorous adjustment. The camera may be perspective or, for control points,
+fisheye (equidistant, equisolid-angle, orthographic, stereographic, Brown added: its own
+projection and rays); straight lines need a perspective camera (line rows with a fisheye
+camera are refused).
 
 Line models: coplanarity (every point measured on an image line lies on the projected 3D
 line; no parametrisation, the default) or the equivalent-planes model of Tommaselli & Tozzi
@@ -161,13 +164,15 @@ def _read_inputs(v: Values) -> tuple:
 
     import numpy as np
 
+    from ..errors import InputError
     from ..geometry.frames import MappingFrame, check_area_of_use
+    from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.observations import read_observations_csv
     from ..io.resection import read_line_control_csv, read_point_control_csv
 
     frame = MappingFrame.from_user_input(v.crs)
-    camera = read_camera_json(v.camera)
+    camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     points = read_point_control_csv(v.control_points) if v.control_points else None
     obs = None
     for path in (v.observations, v.line_observations):
@@ -178,6 +183,15 @@ def _read_inputs(v: Values) -> tuple:
         o = read_observations_csv(path, camera=camera)
         if path == v.line_observations and path != v.observations:
             o = o.subset(o.mask("line"))
+        if not camera.is_perspective and o.mask("line").any():
+            # a straight object line images as a curve through a fisheye lens: the line
+            # models (coplanarity, equivalent planes) hold for the perspective projection only
+            row = int(np.flatnonzero(o.mask("line"))[0])
+            raise InputError(
+                f"camera {camera.name!r} ({v.camera}) has the {camera.projection} (fisheye) "
+                "projection; the resection from straight lines handles perspective cameras "
+                "only: leave the rows of type line out (use control points)",
+                **o.where(row))
         _check_control_rows(o, points)
         obs = o if obs is None else obs.concat(o)
     lines = read_line_control_csv(v.control_lines) if v.control_lines else None
@@ -344,7 +358,8 @@ def _settings(v, camera, obs, points, lines, frame) -> dict[str, str]:
     kinds, counts = np.unique(np.array(obs.type), return_counts=True)
     return {
         "camera": f"{camera.name} (f = {camera.focal_mm:g} mm, {camera.width_px} x "
-        f"{camera.height_px} px of {camera.pixel_size_mm * 1000:g} um)",
+        f"{camera.height_px} px of {camera.pixel_size_mm * 1000:g} um, {camera.projection} "
+        "projection)",
         "observations": ", ".join(f"{t} {n}" for t, n in zip(kinds, counts)),
         "control points / lines": f"{0 if points is None else len(points.ids)} / "
         f"{0 if lines is None else len(lines.ids)}",

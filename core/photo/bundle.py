@@ -157,8 +157,6 @@ def bundle_adjust(
     NotObservableError
         Naming the parameters the block cannot determine.
     """
-    for cam in cameras:
-        cam.require_perspective("the bundle adjustment")
     opts = options if options is not None else BundleOptions()
     if opts.robust not in ("none", "huber", "cauchy"):
         raise InputError(f"robust must be none, huber or cauchy, got {opts.robust!r}")

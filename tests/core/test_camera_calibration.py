@@ -325,14 +325,13 @@ def test_perspective_only_algorithms_refuse_a_fisheye_camera():
     import inspect
 
     from lidarphoto.core.photo.boresight import calibrate
-    from lidarphoto.core.photo.bundle import bundle_adjust
 
     # the resection takes fisheye control points (its lines stay perspective-only, refused by
-    # name): tests/core/test_resection_fisheye.py; monoplotting and orthophotos take fisheye
-    # cameras: tests/core/test_monoplot_fisheye.py, tests/core/test_orthophoto_fisheye.py
+    # name): tests/core/test_resection_fisheye.py; the bundle adjustment, monoplotting and
+    # orthophotos take fisheye cameras: tests/core/test_bundle_fisheye.py,
+    # tests/core/test_monoplot_fisheye.py, tests/core/test_orthophoto_fisheye.py
     cam = _camera("equisolid")
-    for func, who in ((calibrate, "the boresight calibration"),
-                      (bundle_adjust, "the bundle adjustment")):  # fmt: skip
+    for func, who in ((calibrate, "the boresight calibration"),):
         params = inspect.signature(func).parameters
         kwargs = {n: None for n, p in params.items()
                   if p.default is inspect.Parameter.empty and n not in ("self", "cls")}  # fmt: skip

@@ -5,8 +5,8 @@ Truth: control points projected through each fisheye projection of core/geometry
 above a nadir camera: the model must be the projection itself, not an undistorted perspective
 image); Gaussian noise of known sigma on the pixels. The recovered pose must be exact without
 noise, within 4 of its reported sigmas with noise, and the reported sigmas must agree with the
-scatter of a Monte Carlo run. The algorithms that stay perspective-only must still refuse a
-fisheye camera, naming it.
+scatter of a Monte Carlo run. Straight lines stay perspective-only: with a fisheye camera
+they must be refused, naming it.
 """
 
 from __future__ import annotations
@@ -117,9 +117,10 @@ def test_lines_with_a_fisheye_camera_are_refused_by_name():
         resect(data, cam)
 
 
-def test_resection_algorithm_still_refuses_a_fisheye_camera(tmp_path):
-    """The ``resection`` algorithm (points and lines, HTML report in the image plane) stays
-    perspective-only: a fisheye camera file is refused, naming it."""
+def test_resection_algorithm_refuses_lines_with_a_fisheye_camera(tmp_path):
+    """The ``resection`` algorithm takes a fisheye camera for control points
+    (tests/core/test_bundle_fisheye.py) but not its line rows: the observation file holds
+    lines, so the camera is refused, naming its file."""
     scene = make_scene(51, point_sigma_m=0.03)
     data = scene.observe(np.random.default_rng(7))
     files = write_scene_files(tmp_path, scene, data, "EPSG:32632")
