@@ -109,13 +109,16 @@ MIN_SHARED = 3
 @dataclass(frozen=True)
 class PlanePiece:
     """A plane found in one tile: the tile, the plane, its core points (N, 3), which of them
-    are its region's interior (N,: RoofPlaneResult.fit_mask) and their point ids (N,)."""
+    are its region's interior (N,: RoofPlaneResult.fit_mask), their point ids (N,) and
+    ``edge``: the tile's region came within a quarter buffer of the outer edge of the tile's
+    points (the tile saw part of it only: :func:`core.lidar.block_cut.second_pass`)."""
 
     tile: int
     plane: Plane
     points: NDArray[np.float64]
     fit: NDArray[np.bool_] | None = None
     ids: NDArray[np.int64] | None = None
+    edge: bool = False
 
 
 @dataclass(frozen=True)
@@ -174,16 +177,21 @@ def tile_planes(
     piece_of = np.full(len(planes) + 1, -1, dtype=np.int64)  # plane id + 1 -> piece
     core_label = np.where(core, label, -1)
     sizes = np.bincount(core_label + 1, minlength=len(piece_of))[1:]
+    x, y = xyz[:, 0], xyz[:, 1]
+    inner = np.minimum(np.minimum(x - box[0], box[2] - x), np.minimum(y - box[1], box[3] - y))
+    # distance outside the box (the buffer side), 0 inside; the buffer is two bands: a plane
+    # with points in its outer quarter may reach beyond the tile's points
+    far = np.maximum(np.maximum(box[0] - x, x - box[2]), np.maximum(box[1] - y, y - box[3]))
+    outer = np.hypot(np.maximum(np.maximum(box[0] - x, x - box[2]), 0.0),
+                     np.maximum(np.maximum(box[1] - y, y - box[3]), 0.0))  # fmt: skip
+    at_edge = np.zeros(len(planes) + 1, dtype=bool)
+    at_edge[np.unique(label[far >= 1.5 * band]) + 1] = True
     for pid in np.flatnonzero(sizes > 0):  # a plane only in the buffer: the neighbour's
         m = core_label == pid
         piece_of[pid + 1] = len(pieces)
         assert fit is not None  # the fit mask comes with every plane found
-        pieces.append(PlanePiece(tile, planes[pid], xyz[m], fit[m], ids[m]))
-    x, y = xyz[:, 0], xyz[:, 1]
-    inner = np.minimum(np.minimum(x - box[0], box[2] - x), np.minimum(y - box[1], box[3] - y))
-    # distance outside the box (the buffer side), 0 inside
-    outer = np.hypot(np.maximum(np.maximum(box[0] - x, x - box[2]), 0.0),
-                     np.maximum(np.maximum(box[1] - y, y - box[3]), 0.0))  # fmt: skip
+        pieces.append(PlanePiece(tile, planes[pid], xyz[m], fit[m], ids[m],
+                                 bool(at_edge[pid + 1])))  # fmt: skip
     inband = np.where(core, inner < band, outer < band)
     return pieces, BandLabels(tile, ids[inband], core[inband], piece_of[label[inband] + 1])
 

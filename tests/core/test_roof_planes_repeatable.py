@@ -178,8 +178,9 @@ def block_planes(xyz, cuts_x, cuts_y, params, n_all):
     return merged, pid, pieces
 
 
-def assert_block_reproduces(xyz, ref, merged, pid, n_pieces) -> dict:
-    """The criteria of the module docstring; returns the figures."""
+def assert_block_reproduces(xyz, ref, merged, pid, n_pieces, metre: float = 1.0) -> dict:
+    """The criteria of the module docstring (``metre``: the CRS unit in metres, for the 2 cm);
+    returns the figures."""
     assert n_pieces > len(merged)  # some planes were cut by a border and merged
     sizes = np.bincount(ref.plane_id[ref.plane_id >= 0], minlength=len(ref.planes))
     big = np.flatnonzero(sizes >= 50)
@@ -194,7 +195,7 @@ def assert_block_reproduces(xyz, ref, merged, pid, n_pieces) -> dict:
         share = float(np.mean(lab == k))
         a, b = ref.planes[p], merged[k].plane
         angle = float(np.degrees(np.arccos(min(1.0, abs(float(a.normal @ b.normal))))))
-        off = abs(float(b.distance(a.centroid)[0]))
+        off = abs(float(b.distance(a.centroid)[0])) * metre
         if not (angle < 0.5 and off < 0.02 and share >= 0.8):
             bad.append((int(p), round(angle, 3), round(off, 4), round(share, 3)))
     assert len(bad) <= 0.01 * len(big), (len(bad), len(big), bad[:10])
