@@ -102,6 +102,10 @@ def roof_buffer(k_neighbours: int, spacing: float) -> float:
     return float(max(3.0 * reach, seeds))
 
 
+#: A piece is ``edge`` when its tile's region has points this many bands (half buffers)
+#: outside the tile's box: in the buffer's outer eighth, where it may go on beyond the tile.
+EDGE = 1.75
+
 #: Least band points two pieces share to be merged (fewer: a corner or a ridge touch).
 MIN_SHARED = 3
 
@@ -110,7 +114,7 @@ MIN_SHARED = 3
 class PlanePiece:
     """A plane found in one tile: the tile, the plane, its core points (N, 3), which of them
     are its region's interior (N,: RoofPlaneResult.fit_mask), their point ids (N,) and
-    ``edge``: the tile's region came within a quarter buffer of the outer edge of the tile's
+    ``edge``: the tile's region came within an eighth of a buffer of the outer edge of the tile's
     points (the tile saw part of it only: :func:`core.lidar.block_cut.second_pass`)."""
 
     tile: int
@@ -180,12 +184,12 @@ def tile_planes(
     x, y = xyz[:, 0], xyz[:, 1]
     inner = np.minimum(np.minimum(x - box[0], box[2] - x), np.minimum(y - box[1], box[3] - y))
     # distance outside the box (the buffer side), 0 inside; the buffer is two bands: a plane
-    # with points in its outer quarter may reach beyond the tile's points
+    # with points in its outer eighth may reach beyond the tile's points
     far = np.maximum(np.maximum(box[0] - x, x - box[2]), np.maximum(box[1] - y, y - box[3]))
     outer = np.hypot(np.maximum(np.maximum(box[0] - x, x - box[2]), 0.0),
                      np.maximum(np.maximum(box[1] - y, y - box[3]), 0.0))  # fmt: skip
     at_edge = np.zeros(len(planes) + 1, dtype=bool)
-    at_edge[np.unique(label[far >= 1.5 * band]) + 1] = True
+    at_edge[np.unique(label[far >= EDGE * band]) + 1] = True
     for pid in np.flatnonzero(sizes > 0):  # a plane only in the buffer: the neighbour's
         m = core_label == pid
         piece_of[pid + 1] = len(pieces)

@@ -8,15 +8,18 @@ left moved its neighbours' planes too. No finite buffer makes that the single ru
 after the tiles and :func:`core.lidar.block.merge_cut_planes`:
 
 1. the block planes with a piece flagged ``edge`` (:class:`core.lidar.block.PlanePiece`:
-   the tile's region came within a quarter buffer of the edge of the tile's points) mark the
-   cells, on a grid of half a buffer aligned on the map coordinates, that hold their points;
-2. the marked cells, dilated by one buffer, are the window's **core**; the core dilated by one
-   more buffer is the **window**; each connected window is one pass;
+   the tile's region came within an eighth of a buffer of the edge of the tile's points,
+   :data:`core.lidar.block.EDGE`) mark the
+   cells, on a grid of a quarter buffer aligned on the map coordinates, that hold their
+   points;
+2. the marked cells, dilated by half a buffer, are the window's **core**; the core dilated by
+   one buffer is the **window**; each connected core is one pass;
 3. the extraction (:func:`core.lidar.roof_planes.extract_roof_planes`, the same parameters,
    so the same seeds, triplet tables and ties as the single run) runs once on all the
    non-ground points of the window (from the tiles' point sets, ``fetch``); a plane of that
-   run that reaches the window's outer half buffer marks its cells too and the window is
-   re-run larger (at most ``MAX_ROUNDS`` times);
+   run on marked cells that reaches the window's outer quarter buffer marks its cells too
+   and the window is re-run larger (at most ``MAX_ROUNDS`` times); the other planes the
+   window's border cuts are joined as a tile's are (step 4);
 4. the window run's labels replace the block's on the core's points; across the core's
    border the window planes are joined to the block planes by the merge's own test on the
    points within half a buffer of that border (both sides): the two runs put the same points
@@ -135,12 +138,14 @@ def _state(merged: Sequence[MergedPlane], pieces: Sequence[PlanePiece]) -> dict[
 def _window_run(
     grid: _Grid, marked: NDArray[np.bool_], buffer_cells: int, params: Any, fetch: Fetch
 ) -> tuple[dict[str, Any], NDArray[np.bool_]]:
-    """The extraction on one window (its core: ``marked`` dilated by a buffer); returns the
-    window's points, labels, fit mask, core and band flags, and the cells of its planes that
-    reach the window's outer half buffer (empty when none: the window saw them whole)."""
+    """The extraction on one window (its core: ``marked`` dilated by half a buffer, the window
+    one buffer more; ``buffer_cells`` cells a buffer); returns the window's points, labels, fit
+    mask, core and band flags, and the cells of its planes on ``marked`` that reach the
+    window's outer quarter buffer (none: the window saw them whole)."""
     from .roof_planes import extract_roof_planes
 
-    core_m = _dilate(marked, buffer_cells)
+    half = max(1, buffer_cells // 2)
+    core_m = _dilate(marked, half)
     win_m = _dilate(core_m, buffer_cells)
     xyz, ids = fetch(grid.box(win_m))
     xy = xyz[:, :2]
@@ -152,14 +157,13 @@ def _window_run(
     lab = res.plane_id.astype(np.int64)
     fit = res.fit_mask if res.fit_mask is not None else np.ones(len(xyz), bool)
     core = grid.look(core_m, xy)
-    half = max(1, buffer_cells // 2)
     # band: within half a buffer of the core's border, both sides
     band = grid.look(_dilate(core_m, half) & ~core_m | core_m & _dilate(~core_m, half), xy)
-    # the outer half buffer of the window: a plane with points there and in the core was
-    # cut by the window
-    outer = ~grid.look(_dilate(core_m, buffer_cells - half), xy)
-    with_core = np.unique(lab[core & (lab >= 0)])
-    cut = np.intersect1d(with_core, np.unique(lab[outer & (lab >= 0)]))
+    # the outer quarter of the window's buffer: a cut region (points in the marked cells)
+    # that reaches it may go on beyond the window, which grows by its extent
+    outer = ~grid.look(_dilate(core_m, buffer_cells - max(1, buffer_cells // 4)), xy)
+    inner = np.unique(lab[grid.look(marked, xy) & (lab >= 0)])
+    cut = np.intersect1d(inner, np.unique(lab[outer & (lab >= 0)]))
     grow = grid.mask(grid.of(xy[np.isin(lab, cut)])) if len(cut) else np.zeros_like(marked)
     return {"ids": ids, "xyz": xyz, "label": lab, "fit": fit, "core": core,
             "band": band}, grow  # fmt: skip
@@ -227,16 +231,16 @@ def second_pass(
     if not edge:
         return list(merged)
     state = _state(merged, pieces)
-    cells_per_buffer = 2
+    cells_per_buffer = 4
     size = buffer / cells_per_buffer
     seed_xy = state["xyz"][np.isin(state["label"], edge), :2]
     seed_cells = np.unique(np.floor(seed_xy / size).astype(np.int64), axis=0)
     next_label = len(merged)
-    # one window per connected core (cut regions closer than two buffers share one)
+    # one window per connected core (cut regions closer than a buffer share one)
     base = _Grid(seed_cells, size, cells_per_buffer + 1)
     seeds_m = base.mask(seed_cells)
     windows = []
-    for comp in _components(_dilate(seeds_m, cells_per_buffer)):
+    for comp in _components(_dilate(seeds_m, cells_per_buffer // 2)):
         i, j = np.nonzero(comp & seeds_m)
         cells = np.column_stack([i, j]) + base.lo
         for _ in range(MAX_ROUNDS):
