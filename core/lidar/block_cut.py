@@ -308,12 +308,12 @@ def tiled_planes(
     :func:`core.lidar.block.merge_cut_planes` and, when ``whole``, :func:`second_pass`: what
     lidarblock does, without files (tests, benchmarks). Returns the planes and the number of
     pieces."""
-    from .block import merge_cut_planes, tile_planes
+    from .block import BandLabels, merge_cut_planes, tile_planes
 
     ids = np.arange(len(xyz))
     x, y = xyz[:, 0], xyz[:, 1]
     pieces: list[PlanePiece] = []
-    bands = []
+    bands: list[BandLabels] = []
     for i in range(len(xs) - 1):
         for j in range(len(ys) - 1):
             box = (xs[i], ys[j], xs[i + 1], ys[j + 1])
