@@ -94,3 +94,25 @@ def test_tiled_autzen_reproduces_the_single_run(n):
     merged, n_pieces = tiled_planes(xyz[ng], [v[0] for v in e], [v[1] for v in e], params, buf)
     pid = _pid(merged, int(ng.sum()))
     assert_block_reproduces(xyz[ng], ref, merged, pid, n_pieces, metre=FT)
+
+
+def test_no_piece_at_a_buffer_edge_leaves_the_block_as_it_was():
+    """Without an ``edge`` piece no window is read or run: the merged planes come back."""
+    from lidarphoto.core.geometry.planes import fit_plane
+    from lidarphoto.core.lidar.block import PlanePiece, merge_cut_planes
+    from lidarphoto.core.lidar.block_cut import _dilate, second_pass
+
+    rng = np.random.default_rng(0)
+    pts = np.column_stack([rng.uniform(0, 5, (200, 2)), rng.normal(0, 0.01, 200)])
+    piece = PlanePiece(0, fit_plane(pts), pts, np.ones(200, bool), np.arange(200))
+    merged = merge_cut_planes([piece], [])
+
+    def fetch(box):
+        raise AssertionError(f"no window expected, asked for {box}")
+
+    out = second_pass(merged, [piece], 10.0, RoofPlaneParams(), fetch)
+    assert len(out) == len(merged) == 1 and out[0] is merged[0]
+    one = np.zeros((7, 7), bool)
+    one[3, 3] = True
+    grown = _dilate(one, 2)
+    assert grown.sum() == 25 and grown[1:6, 1:6].all()  # a square of 2 cells each side
