@@ -404,8 +404,15 @@ def run_block(
         pieces += o.pieces if o.ok else []
     merged = merge_cut_planes(pieces, bands)
     t1 = time.perf_counter()
+
+    def on_cluster(f: Callable[..., Any], args: list[tuple[Any, ...]]) -> list[Any]:
+        # one task a window: its points are read and its planes found on a worker
+        return gather(client, [client.submit(f, *a, pure=False) for a in args], None,
+                      should_stop, 0.85, 0.85)  # fmt: skip
+
     merged = second_pass(merged, pieces, settings.roof_buffer, settings.roof,
-                         _scratch_fetch(os.path.join(staging, ROOF_SCRATCH)))  # fmt: skip
+                         _scratch_fetch(os.path.join(staging, ROOF_SCRATCH)),
+                         on_cluster)  # fmt: skip
     t_second = time.perf_counter() - t1
     shutil.rmtree(os.path.join(staging, ROOF_SCRATCH), ignore_errors=True)
     planes = [m.plane for m in merged]

@@ -28,8 +28,10 @@ after the tiles and :func:`core.lidar.block.merge_cut_planes`:
    points; all of them when fewer than half are) and the block's ids are re-ranked by
    decreasing point count.
 
-Memory: a window holds the cut regions and two buffers around them, small against a tile in
-a block of roofs; on a block whose planes are mostly large fields it can reach a tile or more.
+Memory: a window holds the cut regions, half a buffer and one buffer around them, small
+against a tile in a block of roofs; where a field or a car park spans the block, the block.
+lidarblock (core/jobs/lidar_block.py) runs each window as one dask task (``map_windows``),
+which reads the window's points from the tiles' saved non-ground points, one tile at a time.
 """
 
 from __future__ import annotations
@@ -215,43 +217,60 @@ def _apply(state: dict[str, Any], win: dict[str, Any], next_label: int) -> int:
     return next_label + len(used)
 
 
+#: ``map(function, list of argument tuples) -> list of results``: how the windows run (in
+#: turn by default; lidarblock gives one dask task to each).
+MapWindows = Callable[[Callable[..., Any], list[tuple[Any, ...]]], list[Any]]
+
+#: Grid cells per buffer (the cells of the windows' masks).
+CELLS_PER_BUFFER = 4
+
+
+def run_window(cells: NDArray[np.int64], size: float, params: Any,
+               fetch: Fetch) -> dict[str, Any]:  # fmt: skip
+    """One window of the second pass from its marked ``cells`` (K, 2; global indices of
+    cells of ``size``), re-run larger while a cut region reaches its edge (at most
+    MAX_ROUNDS runs): its points, labels, fit mask, core and band flags (``_window_run``)."""
+    for _ in range(MAX_ROUNDS):
+        grid = _Grid(cells, size, 2 * CELLS_PER_BUFFER + 1)
+        marked = grid.mask(cells)
+        win, grow = _window_run(grid, marked, CELLS_PER_BUFFER, params, fetch)
+        if not grow.any() or (grow <= marked).all():
+            break
+        i, j = np.nonzero(marked | grow)
+        cells = np.column_stack([i, j]) + grid.lo
+    return win
+
+
 def second_pass(
     merged: Sequence[MergedPlane],
     pieces: Sequence[PlanePiece],
     buffer: float,
     params: Any,
     fetch: Fetch,
+    map_windows: MapWindows | None = None,
 ) -> list[MergedPlane]:
     """The block planes with the regions cut by a tile's buffer re-run whole (module
     docstring). ``merged``: :func:`core.lidar.block.merge_cut_planes` of ``pieces``;
     ``buffer``: the tiles' roof buffer (CRS unit); ``params``: the tiles'
-    :class:`RoofPlaneParams`; ``fetch``: the block's non-ground points in a box. Planes no
+    :class:`RoofPlaneParams`; ``fetch``: the block's non-ground points in a box;
+    ``map_windows``: runs :func:`run_window` on each window (default: in turn). Planes no
     window touched are returned as they were (their ids re-ranked with the rest)."""
     edge = [k for k, m in enumerate(merged) if any(pieces[p].edge for p in m.pieces)]
     if not edge:
         return list(merged)
     state = _state(merged, pieces)
-    cells_per_buffer = 4
-    size = buffer / cells_per_buffer
+    size = buffer / CELLS_PER_BUFFER
     seed_xy = state["xyz"][np.isin(state["label"], edge), :2]
     seed_cells = np.unique(np.floor(seed_xy / size).astype(np.int64), axis=0)
-    next_label = len(merged)
     # one window per connected core (cut regions closer than a buffer share one)
-    base = _Grid(seed_cells, size, cells_per_buffer + 1)
+    base = _Grid(seed_cells, size, CELLS_PER_BUFFER + 1)
     seeds_m = base.mask(seed_cells)
-    windows = []
-    for comp in _components(_dilate(seeds_m, cells_per_buffer // 2)):
+    jobs = []
+    for comp in _components(_dilate(seeds_m, CELLS_PER_BUFFER // 2)):
         i, j = np.nonzero(comp & seeds_m)
-        cells = np.column_stack([i, j]) + base.lo
-        for _ in range(MAX_ROUNDS):
-            grid = _Grid(cells, size, 2 * cells_per_buffer + 1)
-            marked = grid.mask(cells)
-            win, grow = _window_run(grid, marked, cells_per_buffer, params, fetch)
-            if not grow.any() or (grow <= marked).all():
-                break
-            i, j = np.nonzero(marked | grow)
-            cells = np.column_stack([i, j]) + grid.lo
-        windows.append(win)
+        jobs.append((np.column_stack([i, j]) + base.lo, size, params, fetch))
+    windows = (map_windows or (lambda f, args: [f(*a) for a in args]))(run_window, jobs)
+    next_label = len(merged)
     for win in windows:
         next_label = _apply(state, win, next_label)
     return _planes(merged, state, params.min_plane_points)
