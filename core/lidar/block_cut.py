@@ -208,7 +208,9 @@ def _apply(state: dict[str, Any], win: dict[str, Any], next_label: int) -> int:
     used = np.unique(wl[core & (wl >= 0)])
     new = {int(w): joins.get(int(w), next_label + i) for i, w in enumerate(used)}
     add = core & (wl >= 0)
-    lab_add = np.array([new[int(w)] for w in wl[add]], dtype=np.int64)
+    lut = np.full(int(wl.max()) + 1 if len(wl) else 0, -1, dtype=np.int64)
+    lut[used] = [new[int(w)] for w in used]
+    lab_add = lut[wl[add]]
     touched = set(int(b) for b in np.unique(state["label"][~keep])) | set(new.values())
     for key in ("ids", "xyz", "fit"):
         state[key] = np.concatenate([state[key][keep], win[key][add]])
