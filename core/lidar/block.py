@@ -37,6 +37,8 @@ exactly as the whole-file run does), neither looser nor tighter: two roofs that 
 keeps apart get different labels in the band and are not fused, whatever their normals. The
 merged plane is refitted with :func:`lidarphoto.core.geometry.planes.fit_plane` (covariance
 included) from the points its tiles fitted (the regions' interiors, the whole-file rule).
+A region that reaches the outer edge of a tile's buffer (a piece flagged ``edge``) was seen in
+part only; :func:`core.lidar.block_cut.second_pass` re-runs it whole after the merge.
 """
 
 from __future__ import annotations
