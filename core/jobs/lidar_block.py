@@ -7,6 +7,7 @@ import contextlib
 import logging
 import math
 import os
+import shutil
 import signal
 import sys
 import time
@@ -38,6 +39,9 @@ REPORT_NAME = "block_report.json"
 #: Most tiles one block may have (each is a task carrying the block's index; a small
 #: TILE_SIZE over a large file would give millions).
 MAX_TILES = 20000
+#: Folder of the staging area for the tiles' non-ground points (the roof planes' second pass;
+#: removed before the block is committed).
+ROOF_SCRATCH = ".roof_points"
 #: Memory of one worker besides its tile: Python, numpy, dask, laspy and the compiled
 #: kernels loaded (a process worker: 200 MB idle, 285.6 MB peak on the 35 231-point AHN3 tile
 #: by the block report's peak_rss_mb; rounded).
@@ -261,6 +265,10 @@ def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOu
     # the band next to the border, where the tile labels as a whole-file run would
     pieces, band = tile_planes(xyz[near], core[near], a["id"][near], own, r / 2.0,
                                settings.roof, i)  # fmt: skip
+    # the tile's non-ground points, for the second pass of the regions cut by a buffer
+    mine = near & core
+    np.savez(os.path.join(staging, ROOF_SCRATCH, f"{i}.npz"), xyz=xyz[mine], id=a["id"][mine],
+             box=np.asarray(own, dtype=np.float64))  # fmt: skip
     stages["roof_planes"] = time.perf_counter() - t0 - sum(stages.values())
     stages["cpu"] = time.process_time() - c0
     ids = a["id"][:n_core]
@@ -377,8 +385,10 @@ def run_block(
     import numpy as np
 
     from ..lidar.block import dedupe_lines, dedupe_points, merge_cut_planes
+    from ..lidar.block_cut import second_pass
 
     os.makedirs(os.path.join(staging, "tiles"), exist_ok=True)
+    os.makedirs(os.path.join(staging, ROOF_SCRATCH), exist_ok=True)
     t0 = time.perf_counter()
     # the index travels with each task (a few hundred bytes per tile): nothing is lost
     # with a worker
@@ -393,6 +403,18 @@ def run_block(
             bands.append(o.band.shifted(len(pieces)))
         pieces += o.pieces if o.ok else []
     merged = merge_cut_planes(pieces, bands)
+    t1 = time.perf_counter()
+
+    def on_cluster(f: Callable[..., Any], args: list[tuple[Any, ...]]) -> list[Any]:
+        # one task a window: its points are read and its planes found on a worker
+        return gather(client, [client.submit(f, *a, pure=False) for a in args], None,
+                      should_stop, 0.85, 0.85)  # fmt: skip
+
+    merged = second_pass(merged, pieces, settings.roof_buffer, settings.roof,
+                         _scratch_fetch(os.path.join(staging, ROOF_SCRATCH)),
+                         on_cluster)  # fmt: skip
+    t_second = time.perf_counter() - t1
+    shutil.rmtree(os.path.join(staging, ROOF_SCRATCH), ignore_errors=True)
     planes = [m.plane for m in merged]
     # control around each tile: planes whose points come within the control reach of it
     reach = settings.control.delta + settings.control.max_support_distance
@@ -419,7 +441,33 @@ def run_block(
     lcps = dedupe_points([p for f in found for p in f[0]], settings.control.delta)
     lines = dedupe_lines([ln for f in found for ln in f[1]])
     return {"outcomes": outcomes, "planes": planes, "lcps": lcps, "lines": lines,
-            "seconds_tiles": t_tiles, "seconds": time.perf_counter() - t0}  # fmt: skip
+            "seconds_tiles": t_tiles, "seconds_second_pass": t_second,
+            "seconds": time.perf_counter() - t0}  # fmt: skip
+
+
+def _scratch_fetch(folder: str) -> Callable[[tuple[float, float, float, float]], Any]:
+    """``fetch(box)`` for :func:`core.lidar.block_cut.second_pass`: the non-ground points in
+    ``box`` from the tiles' scratch files (``process_tile``), read one tile at a time (those
+    whose box meets ``box``), each point from the tile that owns it."""
+    import numpy as np
+
+    names = sorted(os.listdir(folder), key=lambda f: int(f.split(".")[0]))
+
+    def fetch(box: tuple[float, float, float, float]) -> tuple[Any, Any]:
+        xyz, ids = [np.zeros((0, 3))], [np.zeros(0, np.int64)]
+        for name in names:
+            with np.load(os.path.join(folder, name)) as f:
+                own = f["box"]
+                if own[0] > box[2] or own[2] < box[0] or own[1] > box[3] or own[3] < box[1]:
+                    continue
+                x, i = f["xyz"], f["id"]
+            m = ((x[:, 0] >= box[0]) & (x[:, 0] < box[2]) & (x[:, 1] >= box[1])
+                 & (x[:, 1] < box[3]))  # fmt: skip
+            xyz.append(x[m])
+            ids.append(i[m])
+        return np.concatenate(xyz), np.concatenate(ids)
+
+    return fetch
 
 
 def settings_from(v: Values, info) -> BlockSettings:
@@ -666,6 +714,7 @@ def _report(v: Values, index, settings, block: dict, failed: list, good: list) -
         "line_count": len(block["lines"]),
         "seconds": round(block["seconds"], 3),
         "tasks_s": round(block["seconds_tiles"], 3),
+        "second_pass_s": round(block.get("seconds_second_pass", 0.0), 3),
         "tiles": [{"name": o.name, "ok": o.ok, "error": o.error, "points": o.n_core,
                    "points_read": o.n_read, "points_decoded": o.n_decoded,
                    "ground": o.n_ground, "low_outliers": o.n_low,

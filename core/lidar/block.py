@@ -37,6 +37,8 @@ exactly as the whole-file run does), neither looser nor tighter: two roofs that 
 keeps apart get different labels in the band and are not fused, whatever their normals. The
 merged plane is refitted with :func:`lidarphoto.core.geometry.planes.fit_plane` (covariance
 included) from the points its tiles fitted (the regions' interiors, the whole-file rule).
+A region that reaches the outer edge of a tile's buffer (a piece flagged ``edge``) was seen in
+part only; :func:`core.lidar.block_cut.second_pass` re-runs it whole after the merge.
 """
 
 from __future__ import annotations
@@ -102,6 +104,10 @@ def roof_buffer(k_neighbours: int, spacing: float) -> float:
     return float(max(3.0 * reach, seeds))
 
 
+#: A piece is ``edge`` when its tile's region has points this many bands (half buffers)
+#: outside the tile's box: in the buffer's outer eighth, where it may go on beyond the tile.
+EDGE = 1.75
+
 #: Least band points two pieces share to be merged (fewer: a corner or a ridge touch).
 MIN_SHARED = 3
 
@@ -109,13 +115,16 @@ MIN_SHARED = 3
 @dataclass(frozen=True)
 class PlanePiece:
     """A plane found in one tile: the tile, the plane, its core points (N, 3), which of them
-    are its region's interior (N,: RoofPlaneResult.fit_mask) and their point ids (N,)."""
+    are its region's interior (N,: RoofPlaneResult.fit_mask), their point ids (N,) and
+    ``edge``: the tile's region came within an eighth of a buffer of the outer edge of the tile's
+    points (the tile saw part of it only: :func:`core.lidar.block_cut.second_pass`)."""
 
     tile: int
     plane: Plane
     points: NDArray[np.float64]
     fit: NDArray[np.bool_] | None = None
     ids: NDArray[np.int64] | None = None
+    edge: bool = False
 
 
 @dataclass(frozen=True)
@@ -174,16 +183,21 @@ def tile_planes(
     piece_of = np.full(len(planes) + 1, -1, dtype=np.int64)  # plane id + 1 -> piece
     core_label = np.where(core, label, -1)
     sizes = np.bincount(core_label + 1, minlength=len(piece_of))[1:]
+    x, y = xyz[:, 0], xyz[:, 1]
+    inner = np.minimum(np.minimum(x - box[0], box[2] - x), np.minimum(y - box[1], box[3] - y))
+    # distance outside the box (the buffer side), 0 inside; the buffer is two bands: a plane
+    # with points in its outer eighth may reach beyond the tile's points
+    far = np.maximum(np.maximum(box[0] - x, x - box[2]), np.maximum(box[1] - y, y - box[3]))
+    outer = np.hypot(np.maximum(np.maximum(box[0] - x, x - box[2]), 0.0),
+                     np.maximum(np.maximum(box[1] - y, y - box[3]), 0.0))  # fmt: skip
+    at_edge = np.zeros(len(planes) + 1, dtype=bool)
+    at_edge[np.unique(label[far >= EDGE * band]) + 1] = True
     for pid in np.flatnonzero(sizes > 0):  # a plane only in the buffer: the neighbour's
         m = core_label == pid
         piece_of[pid + 1] = len(pieces)
         assert fit is not None  # the fit mask comes with every plane found
-        pieces.append(PlanePiece(tile, planes[pid], xyz[m], fit[m], ids[m]))
-    x, y = xyz[:, 0], xyz[:, 1]
-    inner = np.minimum(np.minimum(x - box[0], box[2] - x), np.minimum(y - box[1], box[3] - y))
-    # distance outside the box (the buffer side), 0 inside
-    outer = np.hypot(np.maximum(np.maximum(box[0] - x, x - box[2]), 0.0),
-                     np.maximum(np.maximum(box[1] - y, y - box[3]), 0.0))  # fmt: skip
+        pieces.append(PlanePiece(tile, planes[pid], xyz[m], fit[m], ids[m],
+                                 bool(at_edge[pid + 1])))  # fmt: skip
     inband = np.where(core, inner < band, outer < band)
     return pieces, BandLabels(tile, ids[inband], core[inband], piece_of[label[inband] + 1])
 

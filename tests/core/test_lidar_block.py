@@ -67,6 +67,9 @@ def test_every_point_once_with_its_id(block):
     report = json.loads((block["out"] / "block_report.json").read_text())
     assert report["complete"] is True and block["result"].exit_code == 0
     assert report["ground_buffer"] == 44.0  # 2 x 18 m + 5 m + 3 x 1 m
+    # the roof planes' second pass ran on the client and left no scratch points behind
+    assert report["second_pass_s"] >= 0.0
+    assert sorted(p.name for p in block["out"].iterdir() if p.name.startswith(".")) == []
     vpc = json.loads((block["out"] / "block.vpc").read_text())
     assert len(vpc["features"]) == len(block["files"])
     assert sum(f["properties"]["pc:count"] for f in vpc["features"]) == len(ids)

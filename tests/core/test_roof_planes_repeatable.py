@@ -19,7 +19,8 @@ from pathlib import Path
 import laspy
 import numpy as np
 import pytest
-from lidarphoto.core.lidar.block import merge_cut_planes, roof_buffer, tile_planes
+from lidarphoto.core.lidar.block import roof_buffer
+from lidarphoto.core.lidar.block_cut import tiled_planes
 from lidarphoto.core.lidar.control import lidar_control
 from lidarphoto.core.lidar.roof_planes import RoofPlaneParams, extract_roof_planes
 from lidarphoto.core.simulation.town import CLASS_GROUND, make_town, sample_town
@@ -149,37 +150,26 @@ def test_one_and_two_threads_give_the_same_planes(ahn3_small, tmp_path):
 # ----------------------------------------------------------------------------- blocks
 def block_planes(xyz, cuts_x, cuts_y, params, n_all):
     """The block's roof planes of an in-memory cloud cut at ``cuts_x`` x ``cuts_y`` (inner
-    borders): per tile :func:`tile_planes` on its core and its buffer (roof_buffer from the
-    mean spacing of the ``n_all`` points, ground included, as lidarblock sizes it), then
-    :func:`merge_cut_planes`. Returns the merged planes and the block plane of every point."""
+    borders), as lidarblock finds them (:func:`core.lidar.block_cut.tiled_planes`: per tile
+    :func:`tile_planes` on its core and its buffer, roof_buffer from the mean spacing of the
+    ``n_all`` points, ground included, :func:`merge_cut_planes`, the second pass). Returns
+    the merged planes, the block plane of every point and the number of pieces."""
     lo, hi = xyz[:, :2].min(axis=0), xyz[:, :2].max(axis=0)
     spacing = float(np.sqrt(np.prod(hi - lo) / n_all))
     buf = roof_buffer(params.k_neighbours, spacing)
     xs = [lo[0], *cuts_x, np.nextafter(hi[0], np.inf)]
     ys = [lo[1], *cuts_y, np.nextafter(hi[1], np.inf)]
-    ids = np.arange(len(xyz))
-    x, y = xyz[:, 0], xyz[:, 1]
-    pieces, bands = [], []
-    for i in range(len(xs) - 1):
-        for j in range(len(ys) - 1):
-            box = (xs[i], ys[j], xs[i + 1], ys[j + 1])
-            core = (x >= box[0]) & (x < box[2]) & (y >= box[1]) & (y < box[3])
-            near = ((x >= box[0] - buf) & (x <= box[2] + buf) & (y >= box[1] - buf)
-                    & (y <= box[3] + buf))  # fmt: skip
-            got, band = tile_planes(xyz[near], core[near], ids[near], box, buf / 2.0, params,
-                                    len(bands))  # fmt: skip
-            bands.append(band.shifted(len(pieces)))
-            pieces += got
-    merged = merge_cut_planes(pieces, bands)
+    merged, n_pieces = tiled_planes(xyz, xs, ys, params, buf)
     pid = np.full(len(xyz), -1)
     for k, m in enumerate(merged):
         assert (pid[m.ids] == -1).all()  # a point in one block plane only
         pid[m.ids] = k
-    return merged, pid, pieces
+    return merged, pid, n_pieces
 
 
-def assert_block_reproduces(xyz, ref, merged, pid, n_pieces) -> dict:
-    """The criteria of the module docstring; returns the figures."""
+def assert_block_reproduces(xyz, ref, merged, pid, n_pieces, metre: float = 1.0) -> dict:
+    """The criteria of the module docstring (``metre``: the CRS unit in metres, for the 2 cm);
+    returns the figures."""
     assert n_pieces > len(merged)  # some planes were cut by a border and merged
     sizes = np.bincount(ref.plane_id[ref.plane_id >= 0], minlength=len(ref.planes))
     big = np.flatnonzero(sizes >= 50)
@@ -194,7 +184,7 @@ def assert_block_reproduces(xyz, ref, merged, pid, n_pieces) -> dict:
         share = float(np.mean(lab == k))
         a, b = ref.planes[p], merged[k].plane
         angle = float(np.degrees(np.arccos(min(1.0, abs(float(a.normal @ b.normal))))))
-        off = abs(float(b.distance(a.centroid)[0]))
+        off = abs(float(b.distance(a.centroid)[0])) * metre
         if not (angle < 0.5 and off < 0.02 and share >= 0.8):
             bad.append((int(p), round(angle, 3), round(off, 4), round(share, 3)))
     assert len(bad) <= 0.01 * len(big), (len(bad), len(big), bad[:10])
@@ -225,7 +215,7 @@ def test_a_tiled_town_reproduces_the_single_run(town, town_planes, cuts):
     ox, oy = t.extent[0], t.extent[1]
     merged, pid, pieces = block_planes(xyz, [ox + c for c in cuts[0]], [oy + c for c in cuts[1]],
                                        RoofPlaneParams(), len(pts.xyz))  # fmt: skip
-    fig = assert_block_reproduces(xyz, ref, merged, pid, len(pieces))
+    fig = assert_block_reproduces(xyz, ref, merged, pid, pieces)
     assert fig["matched"] == fig["big"] and len(merged) == len(ref.planes) == len(t.faces)
 
 
@@ -254,4 +244,4 @@ def test_tiled_ahn3_crops_reproduce_the_single_run(ahn3_crops, n):
     cuts = [lo + (hi - lo) * k / n for k in range(1, n)]
     merged, pid, pieces = block_planes(xyz, [c[0] for c in cuts], [c[1] for c in cuts],
                                        RoofPlaneParams(), n_all)  # fmt: skip
-    assert_block_reproduces(xyz, ref, merged, pid, len(pieces))
+    assert_block_reproduces(xyz, ref, merged, pid, pieces)
