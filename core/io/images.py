@@ -126,11 +126,13 @@ def read_gray(path: PathLike, factor: int = 1) -> NDArray[np.uint8]:
              4: cv2.IMREAD_REDUCED_GRAYSCALE_4, 8: cv2.IMREAD_REDUCED_GRAYSCALE_8}  # fmt: skip
     if factor not in flags:
         raise ValueError(f"decoding reduces by 1, 2, 4 or 8, not {factor}")
-    img = cv2.imread(p, flags[factor] | cv2.IMREAD_IGNORE_ORIENTATION)
+    # ANYDEPTH: without it OpenCV divides 16-bit values by 256, and a 12-bit frame keeps
+    # 4 of its bits (edges of 150 DN in 16 bits become 0.6 DN)
+    img = cv2.imread(p, flags[factor] | cv2.IMREAD_ANYDEPTH | cv2.IMREAD_IGNORE_ORIENTATION)
     if img is None:
         raise InputError("cannot read the image (not an image file, or damaged)", path=p)
     if Path(p).suffix.lower() in (".jpg", ".jpeg"):  # OpenCV greys out a cut JPEG's rest
         check_jpeg_whole(p)
-    if img.dtype != np.uint8:  # 16-bit: stretched to 8 bits (features need contrast only)
+    if img.dtype != np.uint8:  # 16-bit or float: stretched to 8 bits (features need contrast)
         img = cv2.normalize(img, None, 0, 255, cv2.NORM_MINMAX).astype(np.uint8)
     return img
