@@ -300,6 +300,53 @@
         </message>
     </context>
     <context>
+        <name>AutoCalibrationController</name>
+        <message>
+            <source>An automatic calibration is already running.</source>
+            <translation>Uma calibração automática já está em execução.</translation>
+        </message>
+        <message>
+            <source>images</source>
+            <translation>imagens</translation>
+        </message>
+        <message>
+            <source>a camera</source>
+            <translation>uma câmera</translation>
+        </message>
+        <message>
+            <source>a trajectory</source>
+            <translation>uma trajetória</translation>
+        </message>
+        <message>
+            <source>LiDAR lines</source>
+            <translation>linhas LiDAR</translation>
+        </message>
+        <message>
+            <source>The automatic calibration needs {}.</source>
+            <translation>A calibração automática precisa de {}.</translation>
+        </message>
+        <message>
+            <source>Automatic boresight calibration</source>
+            <translation>Calibração de boresight automática</translation>
+        </message>
+        <message>
+            <source>Calibration cancelled.</source>
+            <translation>Calibração cancelada.</translation>
+        </message>
+        <message>
+            <source>Automatic calibration failed. {}</source>
+            <translation>A calibração automática falhou. {}</translation>
+        </message>
+        <message>
+            <source>{} line points, {} tie points on roof planes, {} rounds</source>
+            <translation>{} pontos em linhas, {} pontos de enlace em planos de telhado, {} rodadas</translation>
+        </message>
+        <message>
+            <source>Automatic calibration done: {}</source>
+            <translation>Calibração automática concluída: {}</translation>
+        </message>
+    </context>
+    <context>
         <name>BaseAlgorithm</name>
         <message>
             <source>out of memory; nothing was written (use a coarser cell or a smaller input)</source>
@@ -488,6 +535,14 @@
         <message>
             <source>Runs {} in the background with the current observations</source>
             <translation>Executa {} em segundo plano com as observações atuais</translation>
+        </message>
+        <message>
+            <source>Calibrate automatically</source>
+            <translation>Calibrar automaticamente</translation>
+        </message>
+        <message>
+            <source>Runs {} in the background on the open images: no picked observation needed (image edges along the LiDAR lines of the line layer or table)</source>
+            <translation>Executa {} em segundo plano nas imagens abertas: nenhuma observação medida à mão é necessária (bordas da imagem ao longo das linhas LiDAR da camada ou tabela de linhas)</translation>
         </message>
         <message>
             <source>Show with the calibrated orientation</source>
@@ -770,6 +825,10 @@
             <translation>Todos os arquivos (*.*)</translation>
         </message>
         <message>
+            <source>{name}: the layer {layer} is not backed by a {what} file ({source}); save it as one first</source>
+            <translation>{name}: a camada {layer} não está gravada em um arquivo {what} ({source}); salve-a primeiro como tal</translation>
+        </message>
+        <message>
             <source>raster</source>
             <translation>raster</translation>
         </message>
@@ -784,10 +843,6 @@
         <message>
             <source>CSV</source>
             <translation>CSV</translation>
-        </message>
-        <message>
-            <source>{name}: the layer {layer} is not backed by a {what} file ({source}); save it as one first</source>
-            <translation>{name}: a camada {layer} não está gravada em um arquivo {what} ({source}); salve-a primeiro como tal</translation>
         </message>
         <message>
             <source>LiDAR Photogrammetry</source>
@@ -4179,7 +4234,9 @@ significativos) e as saídas do melhor modelo.</translation>
         </message>
         <message>
             <source>Inputs: camera JSON (one camera, or {"cameras": [...]} with a camera column in the EO or
-observation table), image observations (image_id, point_id, col, row, sigma_px; a row of
+observation table; perspective or fisheye: equidistant, equisolid-angle, orthographic or
+stereographic with Brown added, as Calibrate camera writes it, each through its own
+projection), image observations (image_id, point_id, col, row, sigma_px; a row of
 type control, as Locate control points writes it, must name a ground point), ground points
 (point_id, X, Y, Z, sx, sy, sz, role = control | check), optionally exterior
 orientations: approximate (e.g. direct georeferencing, a few degrees and metres off), or
@@ -4187,7 +4244,9 @@ observed when the table has sigma columns (GNSS/INS with sigmas; lever arm and b
 corrections can be estimated). Without orientations the images that see four or more control
 points are resected and the rest of the block grows by intersection and resection.</source>
             <translation>Entradas: JSON da câmera (uma câmera, ou {"cameras": [...]} com uma coluna camera na tabela de
-OE ou de observações), observações de imagem (image_id, point_id, col, row, sigma_px; uma linha
+OE ou de observações; perspectiva ou olho de peixe: equidistante, equissólida, ortográfica ou
+estereográfica com Brown somado, como Calibrar câmera a escreve, cada uma pela sua própria
+projeção), observações de imagem (image_id, point_id, col, row, sigma_px; uma linha
 do tipo control, como Localizar pontos de controle a escreve, deve nomear um ponto de apoio),
 pontos de apoio (point_id, X, Y, Z, sx, sy, sz, role = control | check) e, opcionalmente,
 orientações exteriores: aproximadas (por exemplo, do georreferenciamento direto, com alguns graus e
@@ -4460,6 +4519,25 @@ com o arquivo e a linha indicados.</translation>
             <translation>Desvio-padrão do atraso de disparo (ms)</translation>
         </message>
         <message>
+            <source>Inputs: camera JSON (one camera, or {"cameras": [...]} with a camera column in the EO or
+observation table), image observations (image_id, point_id, col, row, sigma_px; a row of
+type control, as Locate control points writes it, must name a ground point), ground points
+(point_id, X, Y, Z, sx, sy, sz, role = control | check), optionally exterior
+orientations: approximate (e.g. direct georeferencing, a few degrees and metres off), or
+observed when the table has sigma columns (GNSS/INS with sigmas; lever arm and boresight
+corrections can be estimated). Without orientations the images that see four or more control
+points are resected and the rest of the block grows by intersection and resection.</source>
+            <translation type="vanished">Entradas: JSON da câmera (uma câmera, ou {"cameras": [...]} com uma coluna camera na tabela de
+OE ou de observações), observações de imagem (image_id, point_id, col, row, sigma_px; uma linha
+do tipo control, como Localizar pontos de controle a escreve, deve nomear um ponto de apoio),
+pontos de apoio (point_id, X, Y, Z, sx, sy, sz, role = control | check) e, opcionalmente,
+orientações exteriores: aproximadas (por exemplo, do georreferenciamento direto, com alguns graus e
+metros de erro) ou observadas quando a tabela tem colunas de desvio-padrão (GNSS/INS com
+desvios-padrão; correções do braço de alavanca e do boresight podem ser estimadas). Sem
+orientações, as imagens que veem quatro ou mais pontos de controle passam por resseção e o
+restante do bloco cresce por interseção e resseção.</translation>
+        </message>
+        <message>
             <source>Statistics: sigma0, the global chi-square test, sigmas and correlations; each AP's t-test
 and |correlation| above 0.9 flagged; automatic selection drops insignificant APs one at a
 time (an AP correlated with others is dropped only when a joint F-test finds them
@@ -4593,19 +4671,22 @@ mantidos nas suas coordenadas nominais, o que define a escala a partir do tamanh
         </message>
         <message>
             <source>Outputs: the camera JSON (a fisheye camera is taken by control chips, orthorectify (and so
-the orthomosaic) and monoplot, the equidistant one by the COLMAP export; the algorithms still
-perspective-only refuse it by name: resection, bundle adjustment, boresight calibration, tie
-points, control point location), a report JSON (sigmas, correlations, sigma0, the t-test of
-every lens coefficient, per-view RMS and poses), the same as an HTML page, and the residual
-table (CSV). PIXEL_SIZE only scales the millimetre values of the camera file: the calibration
-itself is in pixels.</source>
+the orthomosaic), monoplot, the bundle adjustment (self-calibrating its lens) and the
+resection (from control points; its straight lines stay perspective-only), the equidistant
+one by the COLMAP export; the algorithms still perspective-only refuse it by name: boresight
+calibration, tie points, control point location), a report JSON (sigmas, correlations,
+sigma0, the t-test of every lens coefficient, per-view RMS and poses), the same as an HTML
+page, and the residual table (CSV). PIXEL_SIZE only scales the millimetre values of the
+camera file: the calibration itself is in pixels.</source>
             <translation>Saídas: o JSON da câmera (uma câmera olho de peixe é aceita pelos chips de controle, por
-orthorectify (e assim pelo ortomosaico) e por monoplot, a equidistante pela exportação COLMAP; os
-algoritmos ainda apenas perspectivos a recusam pelo nome: resseção, ajustamento por feixes,
-calibração de boresight, pontos de enlace, localização de pontos de controle), um JSON de
-relatório (sigmas, correlações, sigma0, o teste t de cada coeficiente da lente, RMS e poses por
-vista), o mesmo como página HTML, e a tabela de resíduos (CSV). PIXEL_SIZE apenas escala os
-valores em milímetros do arquivo da câmera: a calibração em si é em pixels.</translation>
+orthorectify (e assim pelo ortomosaico), por monoplot, pelo ajustamento por feixes
+(autocalibrando a sua lente) e pela resseção (a partir de pontos de controle; as suas retas
+continuam apenas perspectivas), a equidistante pela exportação COLMAP; os algoritmos ainda
+apenas perspectivos a recusam pelo nome: calibração de boresight, pontos de enlace, localização
+de pontos de controle), um JSON de relatório (sigmas, correlações, sigma0, o teste t de cada
+coeficiente da lente, RMS e poses por vista), o mesmo como página HTML, e a tabela de resíduos
+(CSV). PIXEL_SIZE apenas escala os valores em milímetros do arquivo da câmera: a calibração em
+si é em pixels.</translation>
         </message>
         <message>
             <source>Target images (files or folders)</source>
@@ -4754,6 +4835,22 @@ valores em milímetros do arquivo da câmera: a calibração em si é em pixels.
         <message>
             <source>Focal length (px)</source>
             <translation>Distância focal (px)</translation>
+        </message>
+        <message>
+            <source>Outputs: the camera JSON (a fisheye camera is taken by control chips, orthorectify (and so
+the orthomosaic) and monoplot, the equidistant one by the COLMAP export; the algorithms still
+perspective-only refuse it by name: resection, bundle adjustment, boresight calibration, tie
+points, control point location), a report JSON (sigmas, correlations, sigma0, the t-test of
+every lens coefficient, per-view RMS and poses), the same as an HTML page, and the residual
+table (CSV). PIXEL_SIZE only scales the millimetre values of the camera file: the calibration
+itself is in pixels.</source>
+            <translation type="vanished">Saídas: o JSON da câmera (uma câmera olho de peixe é aceita pelos chips de controle, por
+orthorectify (e assim pelo ortomosaico) e por monoplot, a equidistante pela exportação COLMAP; os
+algoritmos ainda apenas perspectivos a recusam pelo nome: resseção, ajustamento por feixes,
+calibração de boresight, pontos de enlace, localização de pontos de controle), um JSON de
+relatório (sigmas, correlações, sigma0, o teste t de cada coeficiente da lente, RMS e poses por
+vista), o mesmo como página HTML, e a tabela de resíduos (CSV). PIXEL_SIZE apenas escala os
+valores em milímetros do arquivo da câmera: a calibração em si é em pixels.</translation>
         </message>
         <message>
             <source>Outputs: the camera JSON (usable by every algorithm; a fisheye camera is refused by those whose
@@ -7917,14 +8014,20 @@ points and lines, or lines monoplotted on another image (dos Santos, Dal Poz &am
 No approximate orientation is needed: a global search over the rotation with the position
 eliminated in closed form (Hesch &amp; Roumeliotis 2011; Mirzaei &amp; Roumeliotis 2011) gives the
 start, OpenCV's solvePnP another when there are four or more points, and the one that fits
-best starts the rigorous adjustment.</source>
+best starts the rigorous adjustment. The camera may be perspective or, for control points,
+fisheye (equidistant, equisolid-angle, orthographic, stereographic, Brown added: its own
+projection and rays); straight lines need a perspective camera (line rows with a fisheye
+camera are refused).</source>
             <translation>Orienta cada imagem isoladamente a partir de pontos de controle (colinearidade) e de retas:
 linhas da imagem associadas a linhas 3D, como as linhas de cumeeira, espigão e rincão de Criar
 pontos e linhas de controle LiDAR, ou linhas monorrestituídas em outra imagem (dos Santos, Dal
 Poz &amp; Dalmolin 2010). Nenhuma orientação aproximada é necessária: uma busca global sobre a
 rotação, com a posição eliminada em forma fechada (Hesch &amp; Roumeliotis 2011; Mirzaei &amp;
 Roumeliotis 2011), dá o ponto de partida, o solvePnP do OpenCV dá outro quando há quatro ou
-mais pontos, e o que melhor se ajusta inicia o ajustamento rigoroso.</translation>
+mais pontos, e o que melhor se ajusta inicia o ajustamento rigoroso. A câmera pode ser
+perspectiva ou, para pontos de controle, olho de peixe (equidistante, equissólida, ortográfica,
+estereográfica, com Brown somado: a sua própria projeção e os seus raios); as retas precisam
+de uma câmera perspectiva (linhas do tipo line com uma câmera olho de peixe são recusadas).</translation>
         </message>
         <message>
             <source>Line models: coplanarity (every point measured on an image line lies on the projected 3D
@@ -8100,6 +8203,22 @@ linhas paralelas).</translation>
         <message>
             <source>Largest sigma0 a-posteriori</source>
             <translation>Maior sigma0 a posteriori</translation>
+        </message>
+        <message>
+            <source>Orients each image on its own from control points (collinearity) and straight lines: image
+lines matched to 3D lines, such as the ridge, hip and valley lines of Create LiDAR control
+points and lines, or lines monoplotted on another image (dos Santos, Dal Poz &amp; Dalmolin 2010).
+No approximate orientation is needed: a global search over the rotation with the position
+eliminated in closed form (Hesch &amp; Roumeliotis 2011; Mirzaei &amp; Roumeliotis 2011) gives the
+start, OpenCV's solvePnP another when there are four or more points, and the one that fits
+best starts the rigorous adjustment.</source>
+            <translation type="vanished">Orienta cada imagem isoladamente a partir de pontos de controle (colinearidade) e de retas:
+linhas da imagem associadas a linhas 3D, como as linhas de cumeeira, espigão e rincão de Criar
+pontos e linhas de controle LiDAR, ou linhas monorrestituídas em outra imagem (dos Santos, Dal
+Poz &amp; Dalmolin 2010). Nenhuma orientação aproximada é necessária: uma busca global sobre a
+rotação, com a posição eliminada em forma fechada (Hesch &amp; Roumeliotis 2011; Mirzaei &amp;
+Roumeliotis 2011), dá o ponto de partida, o solvePnP do OpenCV dá outro quando há quatro ou
+mais pontos, e o que melhor se ajusta inicia o ajustamento rigoroso.</translation>
         </message>
         <message>
             <source>Orientation</source>

@@ -11,10 +11,12 @@ from qgis.PyQt.QtWidgets import QComboBox, QFormLayout, QLabel, QLineEdit, QPush
 
 from ..core.photo.mount import MOUNT_CHOICES
 
-__all__ = ["CALIBRATION_ALG", "CalibrationPanel"]
+__all__ = ["AUTO_CALIBRATION_ALG", "CALIBRATION_ALG", "CalibrationPanel"]
 
 #: the algorithm (core job) the Run button runs
 CALIBRATION_ALG = "lidarphoto:boresightcalibration"
+#: the algorithm of the *Calibrate automatically* button
+AUTO_CALIBRATION_ALG = "lidarphoto:autoboresight"
 _TABLE_KEYS = ("planes_csv", "lines_csv", "lcps_csv")
 
 
@@ -60,6 +62,14 @@ class CalibrationPanel(QWidget):
                 CALIBRATION_ALG
             )
         )
+        self.auto_button = QPushButton(self.tr("Calibrate automatically"))
+        self.auto_button.setObjectName("lidarphotoRunAutoCalibration")
+        self.auto_button.setToolTip(
+            self.tr(
+                "Runs {} in the background on the open images: no picked observation needed "
+                "(image edges along the LiDAR lines of the line layer or table)"
+            ).format(AUTO_CALIBRATION_ALG)
+        )
         self.use_eo_button = QPushButton(self.tr("Show with the calibrated orientation"))
         self.use_eo_button.setObjectName("lidarphotoUseCalibratedEo")
         self.use_eo_button.setToolTip(
@@ -80,6 +90,7 @@ class CalibrationPanel(QWidget):
         form.addRow(self.tr("Line table"), self.lines_csv_edit)
         form.addRow(self.tr("LCP table"), self.lcps_csv_edit)
         form.addRow(self.run_button)
+        form.addRow(self.auto_button)
         form.addRow(self.result_label)
         form.addRow(self.use_eo_button)
 
@@ -120,6 +131,7 @@ class CalibrationPanel(QWidget):
     # -- running and result -------------------------------------------------------------------
     def set_running(self, running: bool) -> None:
         self.run_button.setEnabled(not running)
+        self.auto_button.setEnabled(not running)
         self.use_eo_button.setEnabled(False)
         if running:
             self.result_label.setText(self.tr("Calibration running…"))

@@ -39,6 +39,7 @@ from qgis.PyQt.QtWidgets import (
 
 from ..core.photo.picking import PickingScene
 from ..core.photo.picking_session import PICK_TYPES, PickingSession
+from .auto_calibration_task import AutoCalibrationController
 from .bundle_task import BundleController, BundlePanel
 from .calibration_panel import CALIBRATION_ALG, CalibrationPanel
 from .calibration_task import CalibrationController
@@ -90,6 +91,7 @@ class ImagePickingDock(QgsDockWidget):
 
     imageChanged = pyqtSignal(str)  # noqa: N815 - Qt signal naming
     calibrationFinished = pyqtSignal(bool)  # noqa: N815 - Qt signal naming
+    autoCalibrationFinished = pyqtSignal(bool)  # noqa: N815
     resectionFinished = pyqtSignal(bool)  # noqa: N815 - Qt signal naming
     bundleFinished = pyqtSignal(bool)  # noqa: N815 - Qt signal naming
 
@@ -111,6 +113,7 @@ class ImagePickingDock(QgsDockWidget):
         self.monoplot_tool = MonoplotTool(self, self.project)
         self.monoplot = MonoplotController(self, self.monoplot_tool)
         self.calibration = CalibrationController(self)
+        self.auto_calibration = AutoCalibrationController(self)
         self.resection = ResectionController(self)
         self.bundle = BundleController(self)
         self.canvas_footprint = CanvasFootprint(iface, self.project)
@@ -204,6 +207,7 @@ class ImagePickingDock(QgsDockWidget):
         c.tablesChanged.connect(self.loader.reload_control)
         c.settingsChanged.connect(self.save_session)
         self.calibration.finished.connect(self.calibrationFinished)
+        self.auto_calibration.finished.connect(self.autoCalibrationFinished)
         self.resection.finished.connect(self.resectionFinished)
         self.bundle.finished.connect(self.bundleFinished)
         v.imageSelected.connect(self.show_image)
