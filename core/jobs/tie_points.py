@@ -73,6 +73,32 @@ track's first-image measurement: the median of its track's refined sigmas.""",
               labels=("SIFT (Lowe 2004)", "ORB (fast)")),
         Param("MAX_FEATURES", "integer", "Features per image", _D.max_features, minimum=100,
               maximum=100000, advanced=True),
+        Param("KEEP", "enum", "Keypoints kept (SIFT)", _D.keep,
+              options=Ref("photo.tie_options", "KEEP_MODES"),
+              labels=("largest scales (COLMAP's rule)", "strongest response (OpenCV's)"),
+              advanced=True,
+              help="which Features per image SIFT keeps when it finds more: the largest "
+              "scales (COLMAP's rule) or the strongest response (OpenCV's). Two kite "
+              "images, 8,192 features: 3,313 verified matches against 2,436 (+36 %); "
+              "simulated block, 1,500 features: 3-6 % fewer matches, keypoints 0.15 against "
+              "0.12 px from the truth before the refinement (bench/matching.md)"),
+        Param("CONTRAST", "number", "SIFT contrast threshold", _D.contrast, minimum=0.001,
+              maximum=0.5, advanced=True,
+              help="OpenCV's contrastThreshold (grey levels / 255 over 3 layers per "
+              "octave): lower finds weaker extrema, so that low-contrast images fill "
+              "Features per image; 6 kite images at 8,192 features: 0.04 finds "
+              "5,116 per image, 0.01 fills the budget (verified matches 5,954 -> 9,836)"),
+        Param("ROOT_SIFT", "boolean", "RootSIFT descriptors (Arandjelovic & Zisserman 2012)",
+              _D.root_sift, advanced=True,
+              help="SIFT descriptors L1-normalised and square-rooted before matching (the "
+              "Hellinger kernel); 6 kite images at 8,192 features: 5,954 -> 6,118 verified "
+              "matches (+3 %) for +7 % CPU"),
+        Param("GUIDED", "boolean", "Guided matching along the epipolar lines", _D.guided,
+              advanced=True,
+              help="after the fundamental matrix, every keypoint is matched again among "
+              "its 8 nearest descriptors within the RANSAC threshold of its epipolar "
+              "line; 6 kite images at 8,192 features: 5,954 -> 6,639 verified "
+              "matches (+12 %), 3-image tracks 714 -> 839, for +46 % CPU"),
         Param("MAX_DIMENSION", "integer", "Detection size (longer side, 0 = full resolution)",
               _D.max_dimension_px, unit="pixels", minimum=0, maximum=100000, advanced=True),
         Param("RATIO", "number", "Ratio test (best / second best)", _D.ratio, minimum=0.3,
@@ -118,7 +144,8 @@ track's first-image measurement: the median of its track's refined sigmas.""",
     tags=("tie points", "sift", "orb", "matching", "ransac", "fundamental matrix", "tracks",
           "least-squares matching"),
     references=("Lowe (2004)", "Fischler & Bolles (1981)", "Rublee et al. (2011)",
-                "Muja & Lowe (2009)", "Barath et al. (2020)", "Gruen (1985)"),
+                "Muja & Lowe (2009)", "Barath et al. (2020)", "Gruen (1985)",
+                "Arandjelovic & Zisserman (2012)"),
 )  # fmt: skip
 
 

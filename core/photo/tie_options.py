@@ -7,9 +7,11 @@ from dataclasses import dataclass
 
 from ..errors import InputError
 
-__all__ = ["DETECTORS", "PAIR_MODES", "RANSAC_METHODS", "TiePointOptions"]
+__all__ = ["DETECTORS", "KEEP_MODES", "PAIR_MODES", "RANSAC_METHODS", "TiePointOptions"]
 
 DETECTORS = ("sift", "orb")
+#: Which ``max_features`` keypoints SIFT keeps: the largest scales, or the strongest.
+KEEP_MODES = ("scale", "response")
 #: ``auto``: footprints when an orientation is given, else the sequential window.
 PAIR_MODES = ("auto", "footprints", "all", "sequential")
 RANSAC_METHODS = ("magsac", "ransac")
@@ -27,6 +29,10 @@ class TiePointOptions:
         per octave: grey levels / 255). Lower finds weaker extrema; the ``max_features``
         strongest are kept either way, so a low threshold fills the budget on low-contrast
         images instead of stopping short of it.
+    keep : one of :data:`KEEP_MODES`
+        SIFT: which ``max_features`` keypoints are kept when more are found: ``"scale"``
+        those of the largest scale (COLMAP's rule; fine-scale extrema are many and repeat
+        less between views), ``"response"`` the strongest (OpenCV's). ORB: the strongest.
     max_dimension_px : int
         Features are detected on the image reduced by the smallest integer factor that
         brings its longer side to at most this; 0 detects at full resolution.
@@ -76,6 +82,7 @@ class TiePointOptions:
     detector: str = "sift"
     max_features: int = 4000
     contrast: float = 0.04
+    keep: str = "scale"
     max_dimension_px: int = 3000
     ratio: float = 0.8
     root_sift: bool = False
@@ -97,6 +104,8 @@ class TiePointOptions:
     def __post_init__(self) -> None:
         if self.detector not in DETECTORS:
             raise InputError(f"detector must be one of {', '.join(DETECTORS)}")
+        if self.keep not in KEEP_MODES:
+            raise InputError(f"keep must be one of {', '.join(KEEP_MODES)}")
         if self.pair_mode not in PAIR_MODES:
             raise InputError(f"pair mode must be one of {', '.join(PAIR_MODES)}")
         if self.ransac_method not in RANSAC_METHODS:
