@@ -22,8 +22,9 @@ The chain (one image's features are computed once and kept; the images themselve
    2020 by default), threshold in full-resolution pixels. A pair with fewer than
    ``min_inliers`` inliers is dropped, with its reason.
 4. **Tracks** (:func:`build_tracks`): the pairwise matches are the edges of a graph whose
-   nodes are the keypoints of all images; its connected components (union-find) are the
-   tracks. A track holding two different keypoints of the same image is inconsistent and is
+   nodes are the keypoints of all images (keypoints of one image at one position, SIFT's
+   orientations of one extremum, are one node); its connected components (union-find) are
+   the tracks. A track holding two different keypoints of the same image is inconsistent and is
    dropped whole; tracks shorter than ``min_track_length`` images are dropped.
 
 5. **Refinement** (on by default, ``refine``; :func:`refine_tracks`): least-squares matching

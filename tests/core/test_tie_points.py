@@ -260,7 +260,7 @@ def test_bad_inputs_are_named(block, tmp_path):
 
 
 def test_tracks_reject_two_points_of_one_image():
-    z = np.zeros((3, 2))
+    z = np.array([[1.0, 1.0], [5.0, 5.0], [9.0, 9.0]])  # distinct positions
     d = np.zeros((3, 128), np.uint8)
     s = np.ones(3, np.float32)
     fs = [ImageFeatures(n, (10, 10), 1, z, s, d) for n in "abcd"]
