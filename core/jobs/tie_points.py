@@ -87,13 +87,14 @@ track's first-image measurement: the median of its track's refined sigmas.""",
               maximum=0.5, advanced=True,
               help="OpenCV's contrastThreshold (grey levels / 255 over 3 layers per "
               "octave): lower finds weaker extrema, so that low-contrast images fill "
-              "Features per image; 6 kite images at 8,192 features: 0.04 finds "
-              "5,116 per image, 0.01 fills the budget (verified matches 5,954 -> 9,836)"),
+              "Features per image; 6 kite images at 8,192 features (strongest kept): "
+              "OpenCV's 0.04 finds 5,116 per image, 0.02 (default) fills the budget, "
+              "verified matches 5,954 -> 9,874; 0.01 gives the same within 0.4 %"),
         Param("ROOT_SIFT", "boolean", "RootSIFT descriptors (Arandjelovic & Zisserman 2012)",
               _D.root_sift, advanced=True,
               help="SIFT descriptors L1-normalised and square-rooted before matching (the "
-              "Hellinger kernel); 6 kite images at 8,192 features: 5,954 -> 6,118 verified "
-              "matches (+3 %) for +7 % CPU"),
+              "Hellinger kernel; on by default, as in COLMAP); 6 kite images at 8,192 "
+              "features: 5,954 -> 6,118 verified matches (+3 %) for +7 % CPU"),
         Param("GUIDED", "boolean", "Guided matching along the epipolar lines", _D.guided,
               advanced=True,
               help="after the fundamental matrix, every keypoint is matched again among "
