@@ -90,7 +90,7 @@ class TiePointOptions:
     mutual: bool = True
     ransac_px: float = 2.0
     ransac_method: str = "magsac"
-    guided: bool = False
+    guided: bool = True
     min_inliers: int = 15
     min_track_length: int = 2
     pair_mode: str = "auto"
