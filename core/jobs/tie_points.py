@@ -29,7 +29,8 @@ Finds tie points in a block of images without an operator. Features: SIFT (Lowe 
 ORB (Rublee et al. 2011, faster, less precise), detected once per image, on the image reduced
 by the smallest integer factor that brings its longer side to at most Detection size (0: full
 resolution; reductions by 2, 4 and 8 are made while decoding JPEGs); the keypoints are
-scaled back to full-resolution pixels.
+scaled back to full-resolution pixels. SIFT keeps the Features per image of the largest
+scales (Keypoints kept) among the extrema above its Contrast threshold.
 
 Pairs: with an exterior orientation and a camera, the pairs whose ground footprints (image
 corners met with the plane at Mean terrain height) overlap by at least Minimum overlap of the
@@ -39,10 +40,13 @@ smaller footprint; without them, each image with the next Window images in file-
 Matching: nearest neighbours in descriptor space (FLANN k-d trees for SIFT, Muja & Lowe 2009;
 brute force for ORB), Lowe's ratio test, a mutual check, then RANSAC on the fundamental
 matrix (Fischler & Bolles 1981; MAGSAC++ by default) with a threshold on the distance to the
-epipolar line in full-resolution pixels. Pairs with fewer than Minimum inliers are dropped
-(the pair table gives the reason). Tracks: the matches of all pairs are merged (connected
-components); a track holding two different points of one image is dropped, as are tracks
-seen in fewer than Minimum track length images.
+epipolar line in full-resolution pixels. SIFT descriptors are compared as RootSIFT
+(Arandjelovic & Zisserman 2012) and, after the fundamental matrix, matched again along the
+epipolar lines (guided matching); both are on by default. Pairs with fewer than Minimum
+inliers are dropped (the pair table gives the reason). Tracks: the matches of all pairs are
+merged (connected components; keypoints of one image at one position, SIFT's orientations of
+one extremum, count as one); a track holding two different points of one image is dropped,
+as are tracks seen in fewer than Minimum track length images.
 
 Refinement (on by default; unticked, the keypoints are written as detected): least-squares
 matching (Gruen 1985, 6 affine + 2 radiometric parameters) of every measurement of a track
@@ -73,6 +77,36 @@ track's first-image measurement: the median of its track's refined sigmas.""",
               labels=("SIFT (Lowe 2004)", "ORB (fast)")),
         Param("MAX_FEATURES", "integer", "Features per image", _D.max_features, minimum=100,
               maximum=100000, advanced=True),
+        Param("KEEP", "enum", "Keypoints kept (SIFT)", _D.keep,
+              options=Ref("photo.tie_options", "KEEP_MODES"),
+              labels=("largest scales (COLMAP's rule)", "strongest response (OpenCV's)"),
+              advanced=True,
+              help="which Features per image SIFT keeps when it finds more: the largest "
+              "scales (COLMAP's rule) or the strongest response (OpenCV's). Two kite "
+              "images, 8,192 features: 3,313 verified matches against 2,436 (+36 %); "
+              "simulated block, 1,500 features: 3-6 % fewer matches, keypoints 0.15 against "
+              "0.12 px from the truth before the refinement, the same 0.021 px after it: with "
+              "REFINE off, the strongest response is the precise choice (bench/matching.md)"),
+        Param("CONTRAST", "number", "SIFT contrast threshold", _D.contrast, minimum=0.001,
+              maximum=0.5, advanced=True,
+              help="OpenCV's contrastThreshold (grey levels / 255 over 3 layers per "
+              "octave): lower finds weaker extrema, so that low-contrast images fill "
+              "Features per image; 6 kite images at 8,192 features (strongest kept): "
+              "OpenCV's 0.04 finds 5,116 per image, 0.02 (default) fills the budget, "
+              "verified matches 5,954 -> 9,874; 0.01 gives the same within 0.4 %"),
+        Param("ROOT_SIFT", "boolean", "RootSIFT descriptors (Arandjelovic & Zisserman 2012)",
+              _D.root_sift, advanced=True,
+              help="SIFT descriptors L1-normalised and square-rooted before matching (the "
+              "Hellinger kernel; on by default, as in COLMAP); 6 kite images at 8,192 "
+              "features: 5,954 -> 6,118 verified matches (+3 %) for +7 % CPU"),
+        Param("GUIDED", "boolean", "Guided matching along the epipolar lines", _D.guided,
+              advanced=True,
+              help="after the fundamental matrix, every keypoint is matched again among "
+              "its 8 nearest descriptors within the RANSAC threshold of its epipolar "
+              "line (on by default); 6 kite images, 16,384 features: 27,075 -> 28,427 "
+              "verified matches (+5 %), 3-image tracks 3,582 -> 3,876 (+8 %), CPU +6 %; "
+              "simulated block: +1.7 % matches, refined 0.0212 -> 0.0213 px median, the same "
+              "2 wrong tracks of 4,400"),
         Param("MAX_DIMENSION", "integer", "Detection size (longer side, 0 = full resolution)",
               _D.max_dimension_px, unit="pixels", minimum=0, maximum=100000, advanced=True),
         Param("RATIO", "number", "Ratio test (best / second best)", _D.ratio, minimum=0.3,
@@ -118,7 +152,8 @@ track's first-image measurement: the median of its track's refined sigmas.""",
     tags=("tie points", "sift", "orb", "matching", "ransac", "fundamental matrix", "tracks",
           "least-squares matching"),
     references=("Lowe (2004)", "Fischler & Bolles (1981)", "Rublee et al. (2011)",
-                "Muja & Lowe (2009)", "Barath et al. (2020)", "Gruen (1985)"),
+                "Muja & Lowe (2009)", "Barath et al. (2020)", "Gruen (1985)",
+                "Arandjelovic & Zisserman (2012)"),
 )  # fmt: skip
 
 

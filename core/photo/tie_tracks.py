@@ -41,14 +41,31 @@ class Tracks:
         return np.bincount(self.track, minlength=self.n_tracks)
 
 
+def _same_point(features: Sequence[ImageFeatures], offset: NDArray[np.intp]) -> NDArray[np.intp]:
+    """For every keypoint (global index), the first keypoint of its image at the same pixel
+    position: SIFT describes an extremum once per dominant orientation (about 1.2 keypoints
+    per position), and one orientation may match in one pair, another in the next; taken as
+    one node, their matches join into one track instead of two shorter ones."""
+    out = np.arange(offset[-1], dtype=np.intp)
+    for k, f in enumerate(features):
+        if len(f) < 2:
+            continue
+        _, first, inv = np.unique(f.pixels, axis=0, return_index=True, return_inverse=True)
+        out[offset[k] : offset[k + 1]] = offset[k] + first[inv.ravel()]
+    return out
+
+
 def build_tracks(
     features: Sequence[ImageFeatures], matches: Sequence[PairMatch], min_track_length: int = 2
 ) -> Tracks:
-    """Merge the kept pairwise matches into tracks (connected components, union-find).
+    """Merge the kept pairwise matches into tracks (connected components, union-find);
+    keypoints of one image at the same position (SIFT's orientations of one extremum) are
+    one node.
 
     Examples
     --------
-    >>> z = np.zeros((3, 2)); d = np.zeros((3, 128), np.uint8); s = np.ones(3, np.float32)
+    >>> z = np.array([[1.0, 1], [5, 5], [1, 1]])  # keypoints 0 and 2: one extremum twice
+    >>> d = np.zeros((3, 128), np.uint8); s = np.ones(3, np.float32)
     >>> fs = [ImageFeatures(n, (10, 10), 1, z, s, d) for n in "abc"]
     >>> e = np.array([0, 1]); r = np.zeros(2)
     >>> m = [PairMatch(0, 1, e, e, 2, 2, 2, r, "ok"), PairMatch(1, 2, e, e[::-1], 2, 2, 2, r, "ok")]
@@ -58,6 +75,11 @@ def build_tracks(
     >>> m.append(PairMatch(0, 2, e[:1], e[:1], 1, 1, 1, r[:1], "ok"))  # a0-c0: joins both
     >>> t = build_tracks(fs, m); t.n_tracks, t.rejected_inconsistent
     (0, 1)
+    >>> e2 = np.array([2]); r1 = r[:1]  # a2 (= a0's position) with b0: joins a0's track
+    >>> m = [PairMatch(0, 1, e[:1], e[:1], 1, 1, 1, r1, "ok"),
+    ...      PairMatch(0, 2, e2, e[1:], 1, 1, 1, r1, "ok")]
+    >>> t = build_tracks(fs, m); t.lengths().tolist(), t.feature.tolist()
+    ([3], [0, 0, 1])
     """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -68,8 +90,9 @@ def build_tracks(
     empty = np.zeros(0, np.intp)
     if not kept:
         return Tracks(empty, empty, empty, np.zeros((0, 2)), 0, 0)
-    a = np.concatenate([offset[m.i] + m.idx_i for m in kept])
-    b = np.concatenate([offset[m.j] + m.idx_j for m in kept])
+    same = _same_point(features, offset)
+    a = same[np.concatenate([offset[m.i] + m.idx_i for m in kept])]
+    b = same[np.concatenate([offset[m.j] + m.idx_j for m in kept])]
     nodes, inv = np.unique(np.concatenate([a, b]), return_inverse=True)
     n = nodes.size
     ea, eb = inv[: a.size], inv[a.size :]
