@@ -8257,12 +8257,14 @@ conter as linhas do tipo line em um segundo arquivo.</translation>
 ORB (Rublee et al. 2011, faster, less precise), detected once per image, on the image reduced
 by the smallest integer factor that brings its longer side to at most Detection size (0: full
 resolution; reductions by 2, 4 and 8 are made while decoding JPEGs); the keypoints are
-scaled back to full-resolution pixels.</source>
+scaled back to full-resolution pixels. SIFT keeps the Features per image of the largest
+scales (Keypoints kept) among the extrema above its Contrast threshold.</source>
             <translation>Encontra pontos de enlace em um bloco de imagens sem operador. Feições: SIFT (Lowe 2004) ou
 ORB (Rublee et al. 2011, mais rápido, menos preciso), detectadas uma vez por imagem, na imagem reduzida
 pelo menor fator inteiro que leva o seu lado maior a no máximo Tamanho de detecção (0: resolução
 completa; reduções por 2, 4 e 8 são feitas durante a decodificação de JPEGs); os pontos-chave são
-reescalados para pixels da resolução completa.</translation>
+reescalados para pixels da resolução completa. O SIFT mantém as Feições por imagem das maiores
+escalas (Pontos-chave mantidos) entre os extremos acima do seu Limiar de contraste.</translation>
         </message>
         <message>
             <source>Pairs: with an exterior orientation and a camera, the pairs whose ground footprints (image
@@ -8278,17 +8280,24 @@ menor projeção; sem elas, cada imagem com as próximas Janela imagens na ordem
             <source>Matching: nearest neighbours in descriptor space (FLANN k-d trees for SIFT, Muja &amp; Lowe 2009;
 brute force for ORB), Lowe's ratio test, a mutual check, then RANSAC on the fundamental
 matrix (Fischler &amp; Bolles 1981; MAGSAC++ by default) with a threshold on the distance to the
-epipolar line in full-resolution pixels. Pairs with fewer than Minimum inliers are dropped
-(the pair table gives the reason). Tracks: the matches of all pairs are merged (connected
-components); a track holding two different points of one image is dropped, as are tracks
-seen in fewer than Minimum track length images.</source>
+epipolar line in full-resolution pixels. SIFT descriptors are compared as RootSIFT
+(Arandjelovic &amp; Zisserman 2012) and, after the fundamental matrix, matched again along the
+epipolar lines (guided matching); both are on by default. Pairs with fewer than Minimum
+inliers are dropped (the pair table gives the reason). Tracks: the matches of all pairs are
+merged (connected components; keypoints of one image at one position, SIFT's orientations of
+one extremum, count as one); a track holding two different points of one image is dropped,
+as are tracks seen in fewer than Minimum track length images.</source>
             <translation>Correspondência: vizinhos mais próximos no espaço dos descritores (árvores k-d do FLANN para SIFT, Muja &amp; Lowe 2009;
 força bruta para ORB), teste de razão de Lowe, uma verificação mútua, e então RANSAC sobre a matriz
 fundamental (Fischler &amp; Bolles 1981; MAGSAC++ por padrão) com um limiar sobre a distância à
-linha epipolar em pixels da resolução completa. Pares com menos que Mínimo de inliers são descartados
-(a tabela de pares dá o motivo). Trilhas: as correspondências de todos os pares são unidas (componentes
-conexas); uma trilha que contém dois pontos diferentes de uma mesma imagem é descartada, assim como as trilhas
-vistas em menos imagens que Comprimento mínimo da trilha.</translation>
+linha epipolar em pixels da resolução completa. Os descritores SIFT são comparados como RootSIFT
+(Arandjelovic &amp; Zisserman 2012) e, depois da matriz fundamental, associados de novo ao longo das
+linhas epipolares (correspondência guiada); ambos estão ativos por padrão. Pares com menos que
+Mínimo de inliers são descartados (a tabela de pares dá o motivo). Trilhas: as correspondências
+de todos os pares são unidas (componentes conexas; pontos-chave de uma imagem na mesma posição,
+as orientações SIFT de um mesmo extremo, contam como um só); uma trilha que contém dois pontos
+diferentes de uma mesma imagem é descartada, assim como as trilhas vistas em menos imagens que
+Comprimento mínimo da trilha.</translation>
         </message>
         <message>
             <source>Refinement (on by default; unticked, the keypoints are written as detected): least-squares
@@ -8375,6 +8384,46 @@ medida da primeira imagem da trilha: a mediana dos sigmas refinados da sua trilh
         <message>
             <source>Features per image</source>
             <translation>Feições por imagem</translation>
+        </message>
+        <message>
+            <source>Keypoints kept (SIFT)</source>
+            <translation>Pontos-chave mantidos (SIFT)</translation>
+        </message>
+        <message>
+            <source>which Features per image SIFT keeps when it finds more: the largest scales (COLMAP's rule) or the strongest response (OpenCV's). Two kite images, 8,192 features: 3,313 verified matches against 2,436 (+36 %); simulated block, 1,500 features: 3-6 % fewer matches, keypoints 0.15 against 0.12 px from the truth before the refinement, the same 0.021 px after it: with REFINE off, the strongest response is the precise choice (bench/matching.md)</source>
+            <translation>quais Feições por imagem o SIFT mantém quando encontra mais: as das maiores escalas (a regra do COLMAP) ou as de resposta mais forte (a do OpenCV). Duas imagens de pipa, 8.192 feições: 3.313 correspondências verificadas contra 2.436 (+36 %); bloco simulado, 1.500 feições: 3-6 % menos correspondências, pontos-chave a 0,15 contra 0,12 px da verdade antes do refinamento, os mesmos 0,021 px depois dele: com REFINE desligado, a resposta mais forte é a escolha precisa (bench/matching.md)</translation>
+        </message>
+        <message>
+            <source>largest scales (COLMAP's rule)</source>
+            <translation>maiores escalas (a regra do COLMAP)</translation>
+        </message>
+        <message>
+            <source>strongest response (OpenCV's)</source>
+            <translation>resposta mais forte (a do OpenCV)</translation>
+        </message>
+        <message>
+            <source>SIFT contrast threshold</source>
+            <translation>Limiar de contraste do SIFT</translation>
+        </message>
+        <message>
+            <source>OpenCV's contrastThreshold (grey levels / 255 over 3 layers per octave): lower finds weaker extrema, so that low-contrast images fill Features per image; 6 kite images at 8,192 features (strongest kept): OpenCV's 0.04 finds 5,116 per image, 0.02 (default) fills the budget, verified matches 5,954 -&gt; 9,874; 0.01 gives the same within 0.4 %</source>
+            <translation>o contrastThreshold do OpenCV (níveis de cinza / 255 em 3 camadas por oitava): um valor menor encontra extremos mais fracos, para que imagens de baixo contraste preencham as Feições por imagem; 6 imagens de pipa com 8.192 feições (as mais fortes mantidas): o 0,04 do OpenCV encontra 5.116 por imagem, 0,02 (padrão) preenche o orçamento, correspondências verificadas 5.954 -&gt; 9.874; 0,01 dá o mesmo a 0,4 %</translation>
+        </message>
+        <message>
+            <source>RootSIFT descriptors (Arandjelovic &amp; Zisserman 2012)</source>
+            <translation>Descritores RootSIFT (Arandjelovic &amp; Zisserman 2012)</translation>
+        </message>
+        <message>
+            <source>SIFT descriptors L1-normalised and square-rooted before matching (the Hellinger kernel; on by default, as in COLMAP); 6 kite images at 8,192 features: 5,954 -&gt; 6,118 verified matches (+3 %) for +7 % CPU</source>
+            <translation>descritores SIFT normalizados em L1 e com raiz quadrada antes da correspondência (o núcleo de Hellinger; ativo por padrão, como no COLMAP); 6 imagens de pipa com 8.192 feições: 5.954 -&gt; 6.118 correspondências verificadas (+3 %) por +7 % de CPU</translation>
+        </message>
+        <message>
+            <source>Guided matching along the epipolar lines</source>
+            <translation>Correspondência guiada ao longo das linhas epipolares</translation>
+        </message>
+        <message>
+            <source>after the fundamental matrix, every keypoint is matched again among its 8 nearest descriptors within the RANSAC threshold of its epipolar line (on by default); 6 kite images, 16,384 features: 27,075 -&gt; 28,427 verified matches (+5 %), 3-image tracks 3,582 -&gt; 3,876 (+8 %), CPU +6 %; simulated block: +1.7 % matches, refined 0.0212 -&gt; 0.0213 px median, the same 2 wrong tracks of 4,400</source>
+            <translation>depois da matriz fundamental, cada ponto-chave é associado de novo entre os seus 8 descritores mais próximos dentro do limiar do RANSAC da sua linha epipolar (ativo por padrão); 6 imagens de pipa, 16.384 feições: 27.075 -&gt; 28.427 correspondências verificadas (+5 %), trilhas de 3 imagens 3.582 -&gt; 3.876 (+8 %), CPU +6 %; bloco simulado: +1,7 % de correspondências, refinado 0,0212 -&gt; 0,0213 px de mediana, as mesmas 2 trilhas erradas em 4.400</translation>
         </message>
         <message>
             <source>Detection size (longer side, 0 = full resolution)</source>
@@ -8479,6 +8528,34 @@ medida da primeira imagem da trilha: a mediana dos sigmas refinados da sua trilh
         <message>
             <source>Image pairs kept</source>
             <translation>Pares de imagens mantidos</translation>
+        </message>
+        <message>
+            <source>Finds tie points in a block of images without an operator. Features: SIFT (Lowe 2004) or
+ORB (Rublee et al. 2011, faster, less precise), detected once per image, on the image reduced
+by the smallest integer factor that brings its longer side to at most Detection size (0: full
+resolution; reductions by 2, 4 and 8 are made while decoding JPEGs); the keypoints are
+scaled back to full-resolution pixels.</source>
+            <translation type="vanished">Encontra pontos de enlace em um bloco de imagens sem operador. Feições: SIFT (Lowe 2004) ou
+ORB (Rublee et al. 2011, mais rápido, menos preciso), detectadas uma vez por imagem, na imagem reduzida
+pelo menor fator inteiro que leva o seu lado maior a no máximo Tamanho de detecção (0: resolução
+completa; reduções por 2, 4 e 8 são feitas durante a decodificação de JPEGs); os pontos-chave são
+reescalados para pixels da resolução completa.</translation>
+        </message>
+        <message>
+            <source>Matching: nearest neighbours in descriptor space (FLANN k-d trees for SIFT, Muja &amp; Lowe 2009;
+brute force for ORB), Lowe's ratio test, a mutual check, then RANSAC on the fundamental
+matrix (Fischler &amp; Bolles 1981; MAGSAC++ by default) with a threshold on the distance to the
+epipolar line in full-resolution pixels. Pairs with fewer than Minimum inliers are dropped
+(the pair table gives the reason). Tracks: the matches of all pairs are merged (connected
+components); a track holding two different points of one image is dropped, as are tracks
+seen in fewer than Minimum track length images.</source>
+            <translation type="vanished">Correspondência: vizinhos mais próximos no espaço dos descritores (árvores k-d do FLANN para SIFT, Muja &amp; Lowe 2009;
+força bruta para ORB), teste de razão de Lowe, uma verificação mútua, e então RANSAC sobre a matriz
+fundamental (Fischler &amp; Bolles 1981; MAGSAC++ por padrão) com um limiar sobre a distância à
+linha epipolar em pixels da resolução completa. Pares com menos que Mínimo de inliers são descartados
+(a tabela de pares dá o motivo). Trilhas: as correspondências de todos os pares são unidas (componentes
+conexas); uma trilha que contém dois pontos diferentes de uma mesma imagem é descartada, assim como as trilhas
+vistas em menos imagens que Comprimento mínimo da trilha.</translation>
         </message>
         <message>
             <source>Refinement (optional): least-squares matching (Gruen 1985, 6 affine + 2 radiometric
