@@ -259,8 +259,8 @@ FISHEYE_OFF_AXIS_DEG = 55.0
 
 def fisheye_evidence(views: list[tuple[Array, Array]], size: tuple[int, int]) -> str:
     """The sentence saying that views taken as perspective look like a fisheye lens ("" when
-    they do not): the target's straight lines fit the best fisheye projection better than a perspective
-    one (:func:`_best_focal`'s relative misfit, principal point at the centre) by
+    they do not): the target's straight lines fit the best fisheye projection better than a
+    perspective one (:func:`_best_focal`'s relative misfit, principal point at the centre) by
     :data:`FISHEYE_FIT_RATIO`, the target seen :data:`FISHEYE_OFF_AXIS_DEG` or more off the
     axis through it; names the projection to try."""
     import warnings
