@@ -55,23 +55,29 @@ _CHUNK = 256
 
 def _takahashi_kernel(Lt, Zt):  # pragma: no cover - compiled
     """Band of ``A^-1`` from the band Cholesky factor: ``Lt[j, d] = L[j + d, j]``,
-    ``Zt[j, d] = Z[j + d, j]`` (both (n, w + 1)); Zt is written."""
+    ``Zt[j, d] = Z[j + d, j]`` (both (n, w + 1)); Zt is written. For each column j the
+    sums over k are one symmetric product of the window ``Z[j+1:j+w+1, j+1:j+w+1]`` (read
+    row by row from its lower triangle, contiguously) with ``L[j+1:j+w+1, j]``."""
     n, w1 = Lt.shape
     w = w1 - 1
+    z = np.zeros(w1)
     for j in range(n - 1, -1, -1):
         ljj = Lt[j, 0]
         m = min(w, n - 1 - j)
-        for a in range(1, m + 1):
-            ia = j + a
-            s = 0.0
-            for c in range(1, a):  # k = j + c < i: Z[i, k] = Zt[k, a - c]
-                s += Lt[j, c] * Zt[j + c, a - c]
-            for c in range(a, m + 1):  # k >= i: Z[k, i] = Zt[i, c - a]
-                s += Lt[j, c] * Zt[ia, c - a]
-            Zt[j, a] = -s / ljj
+        z[: m + 1] = 0.0
+        for c in range(1, m + 1):  # row k = j + c of the window: Z[k + e, k] = Zt[k, e]
+            k = j + c
+            lc = Lt[j, c]
+            zc = lc * Zt[k, 0]
+            for e in range(1, m - c + 1):
+                zz = Zt[k, e]
+                z[c + e] += lc * zz
+                zc += Lt[j, c + e] * zz
+            z[c] += zc
         s = 0.0
-        for c in range(1, m + 1):
-            s += Lt[j, c] * Zt[j, c]
+        for a in range(1, m + 1):
+            Zt[j, a] = -z[a] / ljj
+            s += Lt[j, a] * Zt[j, a]
         Zt[j, 0] = (1.0 / ljj - s) / ljj
 
 
@@ -117,10 +123,14 @@ class BandedInverse:
 
     def take(self, rows: NDArray[np.integer], cols: NDArray[np.integer]) -> Array:
         """``S^-1[rows, cols]`` elementwise (broadcast index arrays, original order)."""
-        r, c = np.broadcast_arrays(np.asarray(rows, dtype=np.intp),
-                                   np.asarray(cols, dtype=np.intp))  # fmt: skip
-        q = self.pos[r].ravel()
-        p = self.pos[c].ravel()
+        qq = self.pos[np.asarray(rows, dtype=np.intp)]
+        pp = self.pos[np.asarray(cols, dtype=np.intp)]
+        lo = np.minimum(qq, pp)
+        dd = np.abs(qq - pp)
+        if not self.n_dense and (dd.size == 0 or dd.max() <= self.bandwidth):
+            return self._Zt[lo, dd]  # the common case: all within the band
+        r, c = np.broadcast_arrays(qq, pp)
+        q, p = r.ravel(), c.ravel()
         out = np.empty(q.size)
         nb, w = self.n_band, self.bandwidth
         qb, pb = q < nb, p < nb
