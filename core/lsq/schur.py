@@ -69,6 +69,8 @@ _COMPILED_MIN = 20000
 # the entries of the inverse reduced matrix it needs from a band Cholesky factor
 # (:mod:`.selected_inverse`) instead of the whole dense inverse.
 _SELECTED_MIN = _DENSE_MAX
+# Occurrences per chunk of the point-factor products of :meth:`ReducedNormal.reduced_matrix`.
+_CHUNK = 65536
 
 
 class SingularSystem(Exception):
@@ -146,7 +148,7 @@ class ReducedNormal:
         plan = self.plan
         Li, _ = self.point_factors(lam)
         # Z' = Li T' per occurrence, (O, b, kk): rows stack without copies in sum_outer
-        Z = [Li[s.point] @ np.swapaxes(T, 1, 2) for T, s in zip(self.T, plan.sets)]
+        Z = [_point_products(Li, s.point, T) for T, s in zip(self.T, plan.sets)]
         rows = [self.u_rows, np.arange(plan.n_r)]
         cols = [self.u_cols, np.arange(plan.n_r)]
         vals = [self.u_vals, np.full(plan.n_r, lam)]
@@ -518,6 +520,16 @@ class BlockCofactor:
         dk = np.empty((g, k))
         dk[:, order] = dl
         return Q / (dk[:, :, None] * dk[:, None, :])
+
+
+def _point_products(Li: Array, point: Index, T: Array) -> Array:
+    """``Li[point] @ T'`` (O, b, kk), in chunks of occurrences (the gathered factors are
+    not held for all occurrences at once)."""
+    out = np.empty((T.shape[0], Li.shape[1], T.shape[1]))
+    for s in range(0, T.shape[0], _CHUNK):
+        sl = slice(s, s + _CHUNK)
+        out[sl] = Li[point[sl]] @ np.swapaxes(T[sl], 1, 2)
+    return out
 
 
 def _plain(bp, g: int, b: int) -> bool:
