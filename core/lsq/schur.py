@@ -36,7 +36,7 @@ columns (``M`` the inverse of the reduced bordered matrix).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -49,6 +49,7 @@ from ..errors import InputError
 from .scaling import jacobi_scale, scale_constraints
 from .schur_numba import back_substitute, dense_reduced, diag_grad, normal_sums, pair_sums
 from .schur_plan import EliminationPlan
+from .selected_inverse import banded_inverse
 
 Array = NDArray[np.float64]
 Index = NDArray[np.intp]
@@ -64,6 +65,12 @@ _SPARSE_MAX_DENSITY = 0.1
 # numba's import and cache load (about a second) would not pay.
 _COMPILED = True
 _COMPILED_MIN = 20000
+# From this many reduced parameters on (and without constraints), the cofactor matrix takes
+# the entries of the inverse reduced matrix it needs from a band Cholesky factor
+# (:mod:`.selected_inverse`) instead of the whole dense inverse.
+_SELECTED_MIN = _DENSE_MAX
+# Occurrences per chunk of the point-factor products of :meth:`ReducedNormal.reduced_matrix`.
+_CHUNK = 65536
 
 
 class SingularSystem(Exception):
@@ -141,7 +148,7 @@ class ReducedNormal:
         plan = self.plan
         Li, _ = self.point_factors(lam)
         # Z' = Li T' per occurrence, (O, b, kk): rows stack without copies in sum_outer
-        Z = [Li[s.point] @ np.swapaxes(T, 1, 2) for T, s in zip(self.T, plan.sets)]
+        Z = [_point_products(Li, s.point, T) for T, s in zip(self.T, plan.sets)]
         rows = [self.u_rows, np.arange(plan.n_r)]
         cols = [self.u_cols, np.arange(plan.n_r)]
         vals = [self.u_vals, np.full(plan.n_r, lam)]
@@ -320,19 +327,41 @@ class ReducedNormal:
     # -- cofactor ----------------------------------------------------------------------------
 
     def cofactor(self) -> BlockCofactor:
-        """Blocks of ``Qxx`` in the original units (see :class:`BlockCofactor`)."""
+        """Blocks of ``Qxx`` in the original units (see :class:`BlockCofactor`).
+
+        ``M``, the inverse of the reduced (bordered) matrix, is needed only where the reduced
+        matrix is non-zero (pairs of parameters that share an eliminated block) and on the
+        diagonal blocks: without constraints and from :data:`_SELECTED_MIN` reduced parameters
+        on, these entries come from a band Cholesky factor (:mod:`.selected_inverse`), never
+        from the whole dense inverse; below, or with constraints, ``M`` is inverted densely.
+        """
         plan = self.plan
-        K = self.reduced_matrix(0.0).toarray()
+        Ks = self.reduced_matrix(0.0)
         n_r = plan.n_r
-        try:
-            if self.mc == 0:
-                cf = sla.cho_factor(K, lower=True, check_finite=False)
-                M = sla.cho_solve(cf, np.eye(K.shape[0]), check_finite=False)
-            else:
-                M = sla.inv(K, check_finite=False)
-        except (np.linalg.LinAlgError, ValueError) as exc:
-            raise SingularSystem(str(exc)) from None
-        M = 0.5 * (M + M.T)
+        sel = None
+        M = None
+        if self.mc == 0 and n_r >= _SELECTED_MIN:
+            try:
+                sel = banded_inverse(Ks)
+            except (np.linalg.LinAlgError, ValueError) as exc:
+                raise SingularSystem(str(exc)) from None
+        if sel is None:
+            K = Ks.toarray()
+            try:
+                if self.mc == 0:
+                    cf = sla.cho_factor(K, lower=True, check_finite=False)
+                    M = sla.cho_solve(cf, np.eye(K.shape[0]), check_finite=False)
+                else:
+                    M = sla.inv(K, check_finite=False)
+            except (np.linalg.LinAlgError, ValueError) as exc:
+                raise SingularSystem(str(exc)) from None
+            del K
+            M = 0.5 * (M + M.T)
+
+            def take(i: Index, j: Index, M: Array = M) -> Array:
+                return M[i, j]
+        else:
+            take = sel.take
         _, Vinv = self.point_factors(0.0)
         acc = [np.zeros_like(T) for T in self.T]
         for pl in plan.pairs:
@@ -343,14 +372,14 @@ class ReducedNormal:
 
             def fwd(items: Index, a=a, b=b, Tb=Tb, o1=pl.o1, o2=pl.o2) -> Array:
                 ra, rb = a.rows[a.sig[o1[items]]], b.rows[b.sig[o2[items]]]
-                return M[ra[:, :, None], rb[:, None, :]] @ Tb[o2[items]]
+                return take(ra[:, :, None], rb[:, None, :]) @ Tb[o2[items]]
 
             acc[pl.s1] += pl.o1_reducer.sum(fwd, (ka[0], kb[1]))
             if pl.o2_reducer is not None:
 
                 def bwd(items: Index, a=a, b=b, Ta=Ta, o1=pl.o1, o2=pl.o2) -> Array:
                     ra, rb = a.rows[a.sig[o1[items]]], b.rows[b.sig[o2[items]]]
-                    return M[rb[:, :, None], ra[:, None, :]] @ Ta[o1[items]]
+                    return take(rb[:, :, None], ra[:, None, :]) @ Ta[o1[items]]
 
                 acc[pl.s2] += pl.o2_reducer.sum(bwd, (kb[0], ka[1]))
         inner = np.zeros((plan.P, plan.b, plan.b))
@@ -367,18 +396,17 @@ class ReducedNormal:
             Qpp[self.dead] = np.nan  # not adjusted: no precision
         cross = [-(A @ Vinv[s.point]) for A, s in zip(acc, plan.sets)]
         d = self.d
-        dr = d[plan.reduced]
         de = d[plan.elim]  # (P, b)
         live = np.ones(plan.P, dtype=bool) if self.dead is None else ~self.dead
-        if not (np.isfinite(M).all() and np.isfinite(Qpp[live]).all()):
+        finite = np.isfinite(M).all() if M is not None else sel is not None and sel.finite()
+        if not (finite and np.isfinite(Qpp[live]).all()):
             raise SingularSystem("non-finite cofactor matrix")
         return BlockCofactor(
             reduced_index=plan.reduced.copy(),
-            Q_reduced=M[:n_r, :n_r] / np.outer(dr, dr),
             eliminated_index=plan.elim.copy(),
             Q_eliminated=Qpp / (de[:, :, None] * de[:, None, :]),
             _plan=plan,
-            _M=M,
+            _take=take,
             _Qpp_s=Qpp,
             _cross=cross,
             _d=d,
@@ -392,9 +420,7 @@ class BlockCofactor:
     Attributes
     ----------
     reduced_index : ndarray of int, shape (n_r,)
-        Parameters that were not eliminated, in the order of ``Q_reduced``.
-    Q_reduced : ndarray, shape (n_r, n_r)
-        Their cofactor matrix (full).
+        Parameters that were not eliminated, in the order of :attr:`Q_reduced`.
     eliminated_index : ndarray of int, shape (P, b)
         The eliminated blocks.
     Q_eliminated : ndarray, shape (P, b, b)
@@ -402,19 +428,27 @@ class BlockCofactor:
     """
 
     reduced_index: Index
-    Q_reduced: Array
     eliminated_index: Index
     Q_eliminated: Array
     _plan: EliminationPlan = field(repr=False)
-    _M: Array = field(repr=False)
+    _take: Callable[[Index, Index], Array] = field(repr=False)  # entries of the scaled M
     _Qpp_s: Array = field(repr=False)
     _cross: list[Array] = field(repr=False)
     _d: Array = field(repr=False)
 
+    @property
+    def Q_reduced(self) -> Array:
+        """The cofactor matrix (n_r, n_r) of the reduced parameters in full (formed on each
+        call: for a large reduced system of a large block, from its band factor column by
+        column; :meth:`block` forms only what it is asked for)."""
+        return self.block(self.reduced_index)
+
     def diagonal(self) -> Array:
         """``diag(Qxx)`` of all ``n`` parameters."""
         out = np.empty(self._plan.n)
-        out[self.reduced_index] = np.diag(self.Q_reduced)
+        r = np.arange(self.reduced_index.size)
+        dr = self._d[self.reduced_index]
+        out[self.reduced_index] = self._take(r, r) / dr**2
         out[self.eliminated_index.ravel()] = np.einsum("pii->pi", self.Q_eliminated).ravel()
         return out
 
@@ -431,7 +465,8 @@ class BlockCofactor:
         pts = plan.point_of[idx]
         if (pts < 0).all():
             r = plan.rmap[idx]
-            return self.Q_reduced[np.ix_(r, r)]
+            dr = self._d[idx]
+            return self._take(r[:, None], r[None, :]) / np.outer(dr, dr)
         if (pts >= 0).all() and np.unique(pts).size == 1:
             p = int(pts[0])
             slots = np.array([int(np.flatnonzero(plan.elim[p] == i)[0]) for i in idx])
@@ -452,7 +487,7 @@ class BlockCofactor:
         Q = np.zeros((g, k, k))
         rr = bp.rrows[sel]
         if kr:
-            Q[:, bp.rc[:, None], bp.rc[None, :]] = self._M[rr[:, :, None], rr[:, None, :]]
+            Q[:, bp.rc[:, None], bp.rc[None, :]] = self._take(rr[:, :, None], rr[:, None, :])
         if ke:
             pt = bp.point[sel]
             es = bp.eslot[sel]
@@ -485,6 +520,16 @@ class BlockCofactor:
         dk = np.empty((g, k))
         dk[:, order] = dl
         return Q / (dk[:, :, None] * dk[:, None, :])
+
+
+def _point_products(Li: Array, point: Index, T: Array) -> Array:
+    """``Li[point] @ T'`` (O, b, kk), in chunks of occurrences (the gathered factors are
+    not held for all occurrences at once)."""
+    out = np.empty((T.shape[0], Li.shape[1], T.shape[1]))
+    for s in range(0, T.shape[0], _CHUNK):
+        sl = slice(s, s + _CHUNK)
+        out[sl] = Li[point[sl]] @ np.swapaxes(T[sl], 1, 2)
+    return out
 
 
 def _plain(bp, g: int, b: int) -> bool:

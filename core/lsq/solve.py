@@ -258,6 +258,7 @@ def _damped_step(
             z_try = z
         if z_try is not None:
             x, vhat = _apply(problem, lin, nrm, z_try)
+            cand = None  # a rejected candidate is not held while the next one is evaluated
             try:
                 cand = problem.linearize(x, vhat, active)
             except _NonFiniteError:
@@ -381,6 +382,9 @@ def _run(
     for it in range(1, opts.max_iterations + 1):
         stop_if_asked(should_stop, "adjusting")
         progress((it - 1) / opts.max_iterations)
+        # the previous point's normal equations are not needed any more: not held while the
+        # new ones are built (on a large block they are hundreds of MB)
+        nrm = None
         nrm, rowscale, use_sparse = _normal(problem, lin, active, rowscale, use_sparse,
                                             opts, it == 1)  # fmt: skip
         if _gradient_small(nrm, lin, opts):
@@ -388,7 +392,7 @@ def _run(
             it -= 1  # no step taken
             break
 
-        def gauss_newton(nrm=nrm, use_sparse=use_sparse) -> tuple[Array, Array]:
+        def gauss_newton(nrm: _Normal, use_sparse=use_sparse) -> tuple[Array, Array]:
             try:
                 return _solve(nrm, 0.0, use_sparse)
             except SingularSystem:
@@ -404,7 +408,7 @@ def _run(
             z = None
             step = math.inf
         else:
-            z, k = gauss_newton()
+            z, k = gauss_newton(nrm)
             step = float(np.abs(z).max()) if z.size else 0.0
             if k.size:
                 # Exact-penalty weight above the Lagrange multipliers of min ||.||^2 (= 2 k).
@@ -442,7 +446,7 @@ def _run(
             new = _damped_step(problem, lin, nrm, z, active, rowscale, nu, m_old, use_sparse,
                                tol, damp)  # fmt: skip
             if new is None and z is None:
-                z, k = gauss_newton()
+                z, k = gauss_newton(nrm)
                 step = float(np.abs(z).max()) if z.size else 0.0
             if new is None:
                 if step <= math.sqrt(tol):

@@ -29,6 +29,8 @@ Array = NDArray[np.float64]
 TIMING_NAME = "timing dt"
 #: The names of the lever-arm correction (camera axes) among the adjustment's parameters.
 LEVER_NAMES = ("lever dx_c", "lever dy_c", "lever dz_c")
+# Image measurements projected at once by the collinearity model (bounds its temporaries).
+_CHUNK = 65536
 
 
 @dataclass
@@ -102,12 +104,22 @@ class _ImageModel:
             full = cam.interior_params
             full[self.free] = xl[0, 9:]
             cam = cam.with_interior(full)
-        out = collinearity_jacobians(xl[:, 6:9], xl[self.first, :6], cam, wrt=wrt,
-                                     image_index=self.inv)  # fmt: skip
-        parts = [out["eo"], out["point"]]
-        if self.free.size:
-            parts.append(out["interior"][:, :, self.free])
-        return out["pixels"], np.concatenate(parts, axis=2)
+        n = xl.shape[0]
+        eo = xl[self.first, :6]
+        pixels = np.empty((n, 2))
+        jac = np.empty((n, 2, 9 + self.free.size))
+        # in chunks of groups: the projection's per-ray temporaries (rotations, partial
+        # derivatives: some 700 bytes a ray) stay bounded; every row is computed alone
+        for s in range(0, n, _CHUNK):
+            sl = slice(s, min(n, s + _CHUNK))
+            out = collinearity_jacobians(xl[sl, 6:9], eo, cam, wrt=wrt,
+                                         image_index=self.inv[sl])  # fmt: skip
+            pixels[sl] = out["pixels"]
+            jac[sl, :, :6] = out["eo"]
+            jac[sl, :, 6:9] = out["point"]
+            if self.free.size:
+                jac[sl, :, 9:] = out["interior"][:, :, self.free]
+        return pixels, jac
 
 
 class _IdentityModel:

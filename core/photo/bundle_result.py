@@ -456,7 +456,9 @@ def _timing(run: _Run) -> dict | None:
     corr: dict[str, float] = {}
     if res.cofactor is not None or res.cofactor_blocks is not None:
         eo = lay.eo.ravel()
-        r_eo = res.correlation_of(np.r_[lay.timing, eo])[0, 1:]
+        # pair by pair: the whole (1 + 6M)-square block is not needed (for a large block
+        # it would be solved from the band factor column by column)
+        r_eo = np.array([res.correlation_of([lay.timing, e])[0, 1] for e in eo])
         k = int(np.argmax(np.abs(r_eo)))
         idx = np.r_[lay.timing, np.asarray(others, dtype=np.intp)]
         r = res.correlation_of(idx)[0, 1:]

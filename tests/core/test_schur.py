@@ -442,3 +442,73 @@ def test_compiled_dense_reduced_system_with_scattered_rows():
     for o in range(point.size):
         acc[point[o]] -= T[o].T @ z[srows[osig[o]]]
     assert_allclose(ze, np.einsum("pij,pj->pi", Vinv, acc), rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("dense_min", [0, 10**9])
+def test_banded_selected_inverse_equals_the_dense_inverse(monkeypatch, dense_min):
+    """The cofactor blocks from the band factor (Takahashi's recurrence, the interior
+    orientation as the dense part or inside the band) equal those of the dense inverse of the
+    reduced system to 1e-10 relative: Q_rr (in the band and, solved column by column,
+    outside it), the point blocks, the sigmas, the w-tests and the redundancy numbers."""
+    from lidarphoto.core.lsq import selected_inverse
+
+    x_true, x0, names, block, n_eo, ni, elim, extra = small_block(seed=6, n_img=16, n_pt=300)
+    ctrl = np.arange(0, elim.shape[0], 9)
+    priors = [
+        prior_block("control", elim[ctrl].ravel(), extra["pts"][ctrl].ravel(), 0.02),
+        prior_block("eo", np.arange(n_eo), x_true[:n_eo], np.tile([0.5] * 3 + [1e-3] * 3, 16)),
+    ]
+    opts = AdjustmentOptions(snooping=True, eliminate=elim)
+    dense = adjust(x0, names, [block, *priors], options=opts)
+    monkeypatch.setattr(schur, "_SELECTED_MIN", 0)
+    monkeypatch.setattr(selected_inverse, "_DENSE_MIN_DEGREE", dense_min)
+    monkeypatch.setattr(selected_inverse, "_DENSE_SHARE", 0.99)  # the interior (all images)
+    seen = []
+    real = selected_inverse.banded_inverse
+
+    def spy(S):
+        out = real(S)
+        seen.append(out)
+        return out
+
+    monkeypatch.setattr(schur, "banded_inverse", spy)
+    band = adjust(x0, names, [block, *priors], options=opts)
+    assert seen and seen[-1] is not None  # the band path ran
+    b = seen[-1]
+    assert (ni <= b.n_dense < b.n) if dense_min == 0 else b.n_dense == 0
+    qd, qb = dense.cofactor_blocks, band.cofactor_blocks
+    ref = qd.Q_reduced
+    rel = np.abs(qb.Q_reduced - ref).max() / np.abs(ref).max()
+    assert rel < 1e-10
+    ref = qd.Q_eliminated
+    assert np.abs(qb.Q_eliminated - ref).max() / np.abs(ref).max() < 1e-10
+    assert_allclose(band.std, dense.std, rtol=1e-10)
+    assert_allclose(band.x, dense.x, rtol=0, atol=0)  # the solve is untouched
+    t1, t2 = dense.residuals["img"], band.residuals["img"]
+    assert_allclose(t2.w, t1.w, rtol=1e-10, atol=1e-12)
+    assert_allclose(t2.redundancy_numbers, t1.redundancy_numbers, rtol=1e-10, atol=1e-12)
+
+
+def test_banded_inverse_of_a_random_sparse_matrix():
+    """Every entry of the inverse of a random sparse SPD matrix with five dense rows, in the
+    band and outside it, against numpy's dense inverse (1e-10 relative)."""
+    import scipy.sparse as sp
+    from lidarphoto.core.lsq import selected_inverse
+
+    rng = np.random.default_rng(3)
+    n = 300
+    A = sp.random(n, n, density=0.01, random_state=4).toarray()
+    A[-5:, :] = rng.normal(0, 0.1, (5, n))
+    A = A + A.T
+    A += np.eye(n) * (np.abs(A).sum(axis=1).max() + 1.0)
+    old = selected_inverse._DENSE_MIN_DEGREE
+    selected_inverse._DENSE_MIN_DEGREE = 10
+    try:
+        b = selected_inverse.banded_inverse(sp.csr_matrix(A))
+    finally:
+        selected_inverse._DENSE_MIN_DEGREE = old
+    assert b is not None and b.n_dense == 5 and b.bandwidth < n - 6
+    ref = np.linalg.inv(A)
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    assert np.abs(b.take(i, j) - ref).max() / np.abs(ref).max() < 1e-10
+    assert np.abs(b.diagonal() - np.diag(ref)).max() / np.abs(ref).max() < 1e-10

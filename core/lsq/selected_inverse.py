@@ -1,0 +1,235 @@
+"""Selected entries of the inverse of a sparse symmetric positive definite matrix, without
+forming the inverse: a band Cholesky factor and Takahashi's recurrence.
+
+Used for the cofactor matrix of a large reduced camera system (:mod:`.schur`): its statistics
+need the blocks of ``S^-1`` where ``S`` itself is non-zero (each image with itself and with
+the images it shares points with) and a few small dense blocks (interior orientation), never
+the whole inverse (288 MB for 1,000 images, and ``n^3`` operations).
+
+Method
+------
+The parameters are ordered (permutation ``perm``, positions ``pos``) so that the sparse part
+``A`` of ``S`` has a small bandwidth ``w`` (reverse Cuthill-McKee of its graph), with the few
+dense rows and columns (parameters coupled to a large share of all others, such as a
+camera's interior orientation) last::
+
+    P S P' = [[A, E], [E', F]]         A banded (n_B x n_B, bandwidth w), F small (g x g)
+
+``A = L L'`` (LAPACK's band Cholesky); Takahashi, Fagan & Chen (1973): ``Z = A^-1`` satisfies
+``L' Z = L^-1`` whose right side is lower triangular with diagonal ``1 / L_jj``, so, from the
+last column on::
+
+    Z_ij = -(1 / L_jj) sum_{k > j} L_kj Z_ki      (i > j, i - j <= w)
+    Z_jj = 1 / L_jj^2 - (1 / L_jj) sum_{k > j} L_kj Z_kj
+
+and every ``Z_ki`` it reads lies within the band (``j < k, i <= j + w``): the band of the
+inverse, and only it, in ``n_B w^2`` operations. The dense part by its Schur complement
+``H = F - E' A^-1 E`` with ``Y = A^-1 E`` (``g`` band solves)::
+
+    S^-1 = [[Z + Y H^-1 Y', -Y H^-1], [-H^-1 Y', H^-1]]      (in the order of perm)
+
+An entry outside the band is found by solving for its column (:meth:`BandedInverse.take`
+gathers any entries; columns are solved in chunks).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+from numpy.typing import NDArray
+from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+Array = NDArray[np.float64]
+Index = NDArray[np.intp]
+
+__all__ = ["BandedInverse", "banded_inverse"]
+
+# A parameter is "dense" (ordered last, outside the band) when it is coupled to more than
+# this share of all parameters, and to more than _DENSE_MIN_DEGREE of them.
+_DENSE_SHARE = 0.1
+_DENSE_MIN_DEGREE = 200
+# Columns solved at once for entries outside the band (bounds the n x k work array).
+_CHUNK = 256
+
+
+def _takahashi_kernel(Lt, Zt):  # pragma: no cover - compiled
+    """Band of ``A^-1`` from the band Cholesky factor: ``Lt[j, d] = L[j + d, j]``,
+    ``Zt[j, d] = Z[j + d, j]`` (both (n, w + 1)); Zt is written. For each column j the
+    sums over k are one symmetric product of the window ``Z[j+1:j+w+1, j+1:j+w+1]`` (read
+    row by row from its lower triangle, contiguously) with ``L[j+1:j+w+1, j]``."""
+    n, w1 = Lt.shape
+    w = w1 - 1
+    z = np.zeros(w1)
+    for j in range(n - 1, -1, -1):
+        ljj = Lt[j, 0]
+        m = min(w, n - 1 - j)
+        z[: m + 1] = 0.0
+        for c in range(1, m + 1):  # row k = j + c of the window: Z[k + e, k] = Zt[k, e]
+            k = j + c
+            lc = Lt[j, c]
+            zc = lc * Zt[k, 0]
+            for e in range(1, m - c + 1):
+                zz = Zt[k, e]
+                z[c + e] += lc * zz
+                zc += Lt[j, c + e] * zz
+            z[c] += zc
+        s = 0.0
+        for a in range(1, m + 1):
+            Zt[j, a] = -z[a] / ljj
+            s += Lt[j, a] * Zt[j, a]
+        Zt[j, 0] = (1.0 / ljj - s) / ljj
+
+
+class BandedInverse:
+    """Entries of ``S^-1`` on demand (see the module docstring); built by
+    :func:`banded_inverse`.
+
+    Attributes
+    ----------
+    n : int
+        Order of ``S``.
+    bandwidth : int
+        ``w`` of the sparse part in the chosen order.
+    n_dense : int
+        ``g``, the parameters ordered last and treated densely.
+    """
+
+    def __init__(self, perm: Index, n_band: int, Lb: Array, Zt: Array, Y: Array, Hinv: Array,
+                 E: Array) -> None:  # fmt: skip
+        self.perm = perm
+        self.pos = np.empty_like(perm)
+        self.pos[perm] = np.arange(perm.size)
+        self.n = int(perm.size)
+        self.n_band = n_band
+        self.n_dense = self.n - n_band
+        self._Lb = Lb  # LAPACK lower band form, (w + 1, n_B)
+        self._Zt = Zt  # (n_B, w + 1)
+        self.bandwidth = Zt.shape[1] - 1
+        self._Y = Y  # (n_B, g) A^-1 E
+        self._YH = Y @ Hinv  # (n_B, g)
+        self._Hinv = Hinv
+        self._E = E  # (n_B, g)
+
+    def finite(self) -> bool:
+        """Whether every stored number is finite."""
+        return bool(np.isfinite(self._Zt).all() and np.isfinite(self._YH).all()
+                    and np.isfinite(self._Hinv).all())  # fmt: skip
+
+    def diagonal(self) -> Array:
+        """``diag(S^-1)`` (n,)."""
+        i = np.arange(self.n)
+        return self.take(i, i)
+
+    def take(self, rows: NDArray[np.integer], cols: NDArray[np.integer]) -> Array:
+        """``S^-1[rows, cols]`` elementwise (broadcast index arrays, original order)."""
+        qq = self.pos[np.asarray(rows, dtype=np.intp)]
+        pp = self.pos[np.asarray(cols, dtype=np.intp)]
+        lo = np.minimum(qq, pp)
+        dd = np.abs(qq - pp)
+        if not self.n_dense and (dd.size == 0 or dd.max() <= self.bandwidth):
+            return self._Zt[lo, dd]  # the common case: all within the band
+        r, c = np.broadcast_arrays(qq, pp)
+        q, p = r.ravel(), c.ravel()
+        out = np.empty(q.size)
+        nb, w = self.n_band, self.bandwidth
+        qb, pb = q < nb, p < nb
+        bb = qb & pb
+        lo, hi = np.minimum(q, p), np.maximum(q, p)
+        inband = bb & (hi - lo <= w)
+        out[inband] = self._Zt[lo[inband], hi[inband] - lo[inband]]
+        far = bb & ~inband
+        if far.any():
+            out[far] = self._far(q[far], p[far])
+        if self.n_dense:
+            if bb.any():
+                out[inband] += np.einsum("ij,ij->i", self._YH[q[inband]], self._Y[p[inband]])
+            s = qb & ~pb
+            out[s] = -self._YH[q[s], p[s] - nb]
+            s = ~qb & pb
+            out[s] = -self._YH[p[s], q[s] - nb]
+            s = ~qb & ~pb
+            out[s] = self._Hinv[q[s] - nb, p[s] - nb]
+        return out.reshape(r.shape)
+
+    def _far(self, q: Index, p: Index) -> Array:
+        """Entries (permuted positions, both in the band part, outside the band) by solving
+        for their columns (the dense part's term included)."""
+        cols, where = np.unique(p, return_inverse=True)
+        out = np.empty(q.size)
+        for start in range(0, cols.size, _CHUNK):
+            cc = cols[start:start + _CHUNK]
+            X = self._columns(cc)  # (n, k), permuted rows
+            sel = (where >= start) & (where < start + cc.size)
+            out[sel] = X[q[sel], where[sel] - start]
+        return out
+
+    def _columns(self, cc: Index) -> Array:
+        """Columns ``cc`` (permuted positions in the band part) of ``P S^-1 P'``, (n, k)."""
+        nb = self.n_band
+        rhs = np.zeros((nb, cc.size))
+        rhs[cc, np.arange(cc.size)] = 1.0
+        yb = sla.cho_solve_banded((self._Lb, True), rhs, check_finite=False)
+        if not self.n_dense:
+            return yb
+        xg = -self._Hinv @ (self._E.T @ yb)
+        return np.vstack([yb - self._Y @ xg, xg])
+
+
+def _order(S: sp.csr_matrix) -> tuple[Index, int]:
+    """(perm, n_B): the sparse parameters in reverse Cuthill-McKee order, then the dense."""
+    n = S.shape[0]
+    deg = np.diff(S.indptr)
+    dense = (deg > _DENSE_SHARE * n) & (deg > _DENSE_MIN_DEGREE)
+    sparse_idx = np.flatnonzero(~dense)
+    sub = S[sparse_idx][:, sparse_idx].tocsr()
+    rcm = reverse_cuthill_mckee(sub, symmetric_mode=True) if sparse_idx.size else sparse_idx
+    perm = np.concatenate([sparse_idx[rcm], np.flatnonzero(dense)]).astype(np.intp)
+    return perm, int(sparse_idx.size)
+
+
+def banded_inverse(S: sp.spmatrix) -> BandedInverse | None:
+    """The :class:`BandedInverse` of the symmetric positive definite ``S`` (n x n, sparse;
+    both triangles stored), or None without numba (the recurrence is compiled).
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        When ``S`` (or its dense part's Schur complement) is not positive definite.
+    """
+    from ..compiled import compiled_kernel  # numba imported here: this module stays light
+
+    kernel = compiled_kernel(_takahashi_kernel)
+    if kernel is None:
+        return None
+    S = sp.csr_matrix(S)
+    S.eliminate_zeros()
+    perm, nb = _order(S)
+    P = S[perm][:, perm].tocoo()
+    i, j, v = P.row, P.col, P.data
+    low = (i >= j) & (i < nb)
+    w = int((i[low] - j[low]).max()) if low.any() else 0
+    ab = np.zeros((w + 1, nb))
+    ab[i[low] - j[low], j[low]] = v[low]
+    Lb = sla.cholesky_banded(ab, lower=True, check_finite=False) if nb else ab
+    del ab
+    g = S.shape[0] - nb
+    E = np.zeros((nb, g))
+    F = np.zeros((g, g))
+    eb = (i < nb) & (j >= nb)
+    E[i[eb], j[eb] - nb] = v[eb]
+    fg = (i >= nb) & (j >= nb)
+    F[i[fg] - nb, j[fg] - nb] = v[fg]
+    if g:
+        Y = sla.cho_solve_banded((Lb, True), E, check_finite=False) if nb else E
+        H = F - E.T @ Y
+        cf = sla.cho_factor(0.5 * (H + H.T), lower=True, check_finite=False)
+        Hinv = sla.cho_solve(cf, np.eye(g), check_finite=False)
+        Hinv = 0.5 * (Hinv + Hinv.T)
+    else:
+        Y, Hinv = np.zeros((nb, 0)), np.zeros((0, 0))
+    Lt = np.ascontiguousarray(Lb.T)
+    Zt = np.zeros_like(Lt)
+    kernel(Lt, Zt)
+    del Lt
+    return BandedInverse(perm, nb, Lb, Zt, Y, Hinv, E)
