@@ -209,3 +209,55 @@ def test_fisheye_camera_in_the_dock(qgis_parent, qgis_app, fisheye_block, fishey
     targets = dock.session.targets_at(image, on_line, "line", 0.5, proj)
     assert targets and targets[0].target_id == lid
     dock.close()
+
+
+def test_fisheye_resection_from_the_dock_leaves_the_lines_out(
+    qgis_parent, qgis_app, fisheye_block, fisheye_layers, tmp_path
+):
+    """An observation file with line rows of the image (the simulation's, exact), then the
+    control points clicked in the dock (real clicks at 100 %: the centres of the pixels
+    holding their projections, at most 0.5 px off) and Resect: the dock says the line rows
+    are left out (fisheye), and the job recovers the true pose from the points within 4 of
+    its reported sigmas."""
+    from lidarphoto.core.io.observations import write_observations_csv
+    from lidarphoto.core.io.orientation import read_eo_csv
+    from test_dock_lines import _click
+    from test_image_dock import _wait
+
+    b = fisheye_block
+    sim = b["sim"]
+    image = sim.trajectory.image_id[4]
+    obs = sim.observations
+    lines_here = obs.mask("line") & (np.asarray(obs.image_id) == image)
+    assert lines_here.sum() >= 4
+    write_observations_csv(tmp_path / "lines.csv", obs.subset(lines_here))
+    dock = _dock(qgis_parent, qgis_app, b, fisheye_layers, tmp_path, obs_name="lines.csv")
+    assert len(dock.store.rows) == int(lines_here.sum())
+    dock.show_image(image)
+    dock.viewer.type_combo.setCurrentText("lcp")
+    lcp_px = b["scene"].project(image, np.array([c.xyz for c in sim.lcps]))
+    seen = [k for k, p in enumerate(lcp_px)
+            if np.isfinite(p).all() and FISHEYE.in_frame(p[None], 40.0)[0]]  # fmt: skip
+    assert len(seen) >= 4, seen
+    for k in seen:
+        _click(dock, lcp_px[k])
+    assert sum(o.type == "lcp" for o in dock.store.rows) == len(seen), dock.messages[-3:]
+    finished = []
+    dock.resectionFinished.connect(finished.append)
+    assert dock.run_resection()
+    assert any("left out" in m and "fisheye" in m for m in dock.messages), dock.messages[-3:]
+    assert _wait(qgis_app, lambda: bool(finished), 120.0)
+    assert finished == [True], dock.resection.error
+    run = dock.resection.run
+    assert run.image_id == image and run.image.data.n_lines == 0
+    truth = read_eo_csv(b["eo"])
+    k = list(truth.image_id).index(image)
+    std = run.result.std
+    dxyz = run.result.xyz - truth.xyz[k]
+    dopk = (run.result.opk - truth.opk[k] + np.pi) % (2 * np.pi) - np.pi
+    assert np.all(np.abs(dxyz) < 4 * std[:3]), (dxyz, std[:3])
+    assert np.all(np.abs(dopk) < 4 * std[3:]), (dopk, std[3:])
+    print(f"\nfisheye resection of {image} from {len(seen)} LCPs: dxyz {np.round(dxyz, 3)} m "
+          f"(sigma {np.round(std[:3], 3)}), dopk {np.round(np.degrees(dopk), 4)} deg "
+          f"(sigma {np.round(np.degrees(std[3:]), 4)})")
+    dock.close()
