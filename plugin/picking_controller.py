@@ -10,6 +10,11 @@ new, moved or removed ones are redrawn), the table is a model reset (Qt reads on
 screen), and the map selection it makes restyles only the highlighted plane or control point.
 The control is projected again only when the image, the orientation or the control change
 (:meth:`PickingController.refresh`).
+
+With a fisheye camera the LiDAR lines are drawn and hit as the curves they image as (the
+session's polylines), but no image line is measured (the resection and the calibrations
+model image lines for perspective cameras only: the click is refused by name), and so no
+line end is refined on a curved image edge (the refinement assumes a straight edge).
 """
 
 from __future__ import annotations
