@@ -202,10 +202,13 @@ def _densify(
 
     Each segment is cut into pieces of at most :data:`_MAX_PIECE_RAD` seen from the centre,
     then a piece is halved while its projected midpoint lies more than ``tol_px / 2`` from
-    its chord (unless the piece is wholly off the image ``frame`` = (width, height) px: it
-    is kept as it is); a piece with one end outside the field is first cut at the field's
-    edge (found by bisection to 2**-40 of the piece). Pieces outside the field are left
-    out: a NaN row separates the visible runs; a segment not seen at all gives two NaN rows.
+    its chord, or one of its halves holds over 90 % of the chord's length (unless the piece
+    is wholly off the image ``frame`` = (width, height) px: it is kept as it is). A piece
+    still so after :data:`_MAX_DEPTH` halvings spans a jump of the image (the segment passes
+    exactly through the backward axis or the centre) and is left out. A piece with one end
+    outside the field is first cut at the field's edge (bisection to 2**-40 of the piece).
+    Pieces outside the field are left out: a NaN row separates the visible runs; a segment
+    not seen at all gives two NaN rows.
     """
     n = len(a)
     if n == 0:
@@ -256,8 +259,15 @@ def _densify(
         hi = np.maximum(np.maximum(p0, p1), pm) + grow
         off = (hi[:, 0] < 0) | (lo[:, 0] > w) | (hi[:, 1] < 0) | (lo[:, 1] > h)
         both = v0 & v1
-        split = both & (~vm | ((dev > 0.5 * tol_px) & ~off)) & (depth < _MAX_DEPTH)
-        done = ~split & both & vm
+        # bent: the midpoint off the chord; uneven: nearly all of the chord in one half (a
+        # jump of the image hides there even when the points are in a row)
+        half = np.maximum(np.hypot(*(pm - p0).T), np.hypot(*(p1 - pm).T))
+        uneven = (half > 0.9 * np.sqrt(len2)) & (len2 > (0.5 * tol_px) ** 2)
+        bent = ((dev > 0.5 * tol_px) | uneven) & ~off
+        split = both & (~vm | bent) & (depth < _MAX_DEPTH)
+        # still bent after every halving: a jump of the image (the segment passes exactly
+        # through the backward axis, or the centre), not a curve: a gap, not a chord
+        done = ~split & both & vm & ~bent
         kept.append((owner[done], t0[done], t1[done], p0[done], p1[done]))
         o, d = owner[split], depth[split] + 1
         owner = np.concatenate([o, o])

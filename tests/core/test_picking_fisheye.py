@@ -198,3 +198,52 @@ def test_session_hits_the_curved_line_and_refuses_line_measurement():
     persp = PickingSession()
     persp.set_orientation(Camera("p", 8.0, 0.003, 2000, 1500), session.eo, CRS)
     assert persp.lines_refused() == ""
+
+
+@pytest.mark.parametrize("projection", ("equidistant", "equisolid", "stereographic"))
+def test_segment_past_the_backward_axis(projection):
+    """A segment passing just behind the camera, next to its backward axis (theta near 180
+    deg, inside the field of these projections): its image swings around the image circle
+    (in part inside the frame for the equisolid). In the frame, the exact image within the
+    tolerance of the polyline and the polyline's vertices and edge midpoints within the
+    tolerance of the exact image (no chord across the image)."""
+    from lidarphoto.core.geometry.rotations import opk_to_matrix
+
+    scene = _scene(projection)
+    cam = scene.camera
+    local = scene.local_eo[0]
+    r = opk_to_matrix(*local[3:])
+    axis, side, c = -r[:, 2], r[:, 0], local[:3]
+    to_map = scene.local.enu_to_map
+    a, b = to_map((c - 30 * axis - 40 * side)[None]), to_map((c - 30 * axis + 40 * side)[None])
+    poly = scene.project_segments("img1", a, b)[0]
+    exact = _truth(scene, a, b, 20001)[0]
+    seen = exact[np.isfinite(exact).all(axis=1) & cam.in_frame(exact, 0.0)]
+    if len(seen):
+        assert _distance_to_polyline(seen, poly).max() <= CHORD_TOL_PX
+    fin = np.vstack([poly, 0.5 * (poly[1:] + poly[:-1])])
+    fin = fin[np.isfinite(fin).all(axis=1) & cam.in_frame(fin, 0.0)]
+    if len(fin):
+        assert _distance_to_polyline(fin, exact).max() <= CHORD_TOL_PX
+    assert len(seen) > 0 or len(fin) == 0
+    if projection == "equisolid":
+        assert len(seen) > 100  # the case is not vacuous
+
+
+def test_a_jump_of_the_image_is_a_gap_not_a_chord():
+    """Where the image of a segment jumps (a line exactly through the backward axis or the
+    centre: points on either side map to opposite sides of the image), the piece across the
+    jump stays bent after every halving and is left out: a NaN gap, not a chord."""
+    from lidarphoto.core.photo.picking import _densify
+
+    def jumping(p):  # x in [0, 1] -> a straight image with a 500 px jump at x = 0.6
+        x = p[:, 0]
+        return np.column_stack([100.0 * x + np.where(x < 0.6, 0.0, 500.0), 50.0 + 0 * x])
+
+    a, b = np.array([[0.0, 0.0, -1.0]]), np.array([[1.0, 0.0, -1.0]])
+    poly = _densify(jumping, np.zeros(3), a, b, (1000.0, 100.0), CHORD_TOL_PX)[0]
+    gap = np.flatnonzero(np.isnan(poly[:, 0]))
+    assert gap.size == 1
+    before, after = poly[: gap[0]], poly[gap[0] + 1 :]
+    assert before[0, 0] == 0.0 and after[-1, 0] == 600.0
+    assert abs(before[-1, 0] - 60.0) < 1e-6 and abs(after[0, 0] - 560.0) < 1e-6
