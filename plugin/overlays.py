@@ -99,6 +99,8 @@ class Overlays:
         self.groups: dict[str, QGraphicsPathItem] = {}
         self.visible = {name: True for name in GROUPS}
         self.counts = {name: 0 for name in GROUPS}
+        #: vertices of the LiDAR lines drawn (2 a line through a perspective camera)
+        self.line_vertices = 0
         #: (shape, size) -> marker path; (colour name, width, style) -> pen
         self._paths: dict[tuple[str, float], QPainterPath] = {}
         self._pens: dict[tuple[str, float, object], QPen] = {}
@@ -278,21 +280,37 @@ class Overlays:
             by_id.setdefault(str(pid), []).append([*items, hot])
             self.counts["planes"] += 1
 
-    def set_lines(self, starts: np.ndarray, ends: np.ndarray, ids: Sequence[str]) -> None:
-        """LiDAR lines as segments (L, 2) -> (L, 2) pixels."""
+    def set_lines(self, polylines: Sequence[np.ndarray], ids: Sequence[str]) -> None:
+        """LiDAR lines as polylines (each (K, 2) pixels: the two end points through a
+        perspective camera, the densified curve through a fisheye one); a NaN row breaks a
+        polyline (a stretch outside the projection's field), a line without two finite
+        vertices in a run is not drawn. ``line_vertices`` counts the vertices drawn."""
         group = self.clear("lines")
-        a, b = np.reshape(starts, (-1, 2)), np.reshape(ends, (-1, 2))
-        ok = _finite_rows(a) & _finite_rows(b)
+        self.line_vertices = 0
         pen = self._pen_of("lines", 2.0, Qt.PenStyle.DashLine)
-        ids = [i for i, good in zip(ids, ok.tolist()) if good]
-        for (ax, ay), (bx, by), lid in zip(a[ok].tolist(), b[ok].tolist(), ids):
-            path = QPainterPath(QPointF(ax, ay))
-            path.lineTo(bx, by)
+        for poly, lid in zip(polylines, ids):
+            p = np.reshape(poly, (-1, 2))
+            ok = _finite_rows(p)
+            # runs of finite vertices: a run starts where the vertex before it is not finite
+            starts = ok & ~np.r_[False, ok[:-1]]
+            path, drawn = QPainterPath(), []
+            for (x, y), good, first in zip(p.tolist(), ok.tolist(), starts.tolist()):
+                if not good:
+                    continue
+                if first:
+                    path.moveTo(x, y)
+                else:
+                    path.lineTo(x, y)
+                drawn.append((x, y))
+            if len(drawn) - int(starts.sum()) < 1:  # no segment at all
+                continue
             item = QGraphicsPathItem(path)
             item.setPen(pen)
             item.setParentItem(group)
-            self._label(group, f"L{lid}", (ax + bx) / 2, (ay + by) / 2, "lines")
+            mx, my = drawn[len(drawn) // 2] if len(drawn) > 2 else np.mean(drawn, axis=0)
+            self._label(group, f"L{lid}", float(mx), float(my), "lines")
             self.counts["lines"] += 1
+            self.line_vertices += len(drawn)
 
     def set_lcps(self, pixels: np.ndarray, ids: Sequence[str], highlighted=frozenset()) -> None:
         """LiDAR control points (P, 2) pixels."""

@@ -10,6 +10,11 @@ new, moved or removed ones are redrawn), the table is a model reset (Qt reads on
 screen), and the map selection it makes restyles only the highlighted plane or control point.
 The control is projected again only when the image, the orientation or the control change
 (:meth:`PickingController.refresh`).
+
+With a fisheye camera the LiDAR lines are drawn and hit as the curves they image as (the
+session's polylines), but no image line is measured (the resection and the calibrations
+model image lines for perspective cameras only: the click is refused by name), and so no
+line end is refined on a curved image edge (the refinement assumes a straight edge).
 """
 
 from __future__ import annotations
@@ -81,7 +86,7 @@ class PickingController(QObject):
         control = self.session.control
         hot_planes, hot_lcps = self.highlighted()
         overlays.set_planes(p.rings, control.plane_ids, hot_planes)
-        overlays.set_lines(p.line_starts, p.line_ends, control.line_ids)
+        overlays.set_lines(p.lines, control.line_ids)
         overlays.set_lcps(p.lcps, control.lcp_ids, hot_lcps)
         self.draw_observations()
         self.fill_table()
@@ -208,6 +213,18 @@ class PickingController(QObject):
         if kind == "line" and half is not None and half.image_id == img:
             return self._line_end(img, col, row)
         session.cancel_line()  # (another type or image since the first click)
+        camera = session.camera
+        if kind == "line" and session.lines_refused() and camera is not None:
+            dock.message(
+                self.tr(
+                    "No image lines with camera {} ({} fisheye projection): straight LiDAR "
+                    "lines image as curves through it, and the resection and the calibration "
+                    "from lines handle perspective cameras only. Measure control points "
+                    "(lcp) instead."
+                ).format(camera.name, camera.projection),
+                warning=True,
+            )
+            return -1
         tol = HIT_SCREEN_PX / max(self.viewer.view.zoom, 1e-9)
         targets = session.targets_at(img, (col, row), kind, tol, self.projected)
         if not targets:

@@ -12,6 +12,7 @@ from qgis.PyQt import sip
 from qgis.PyQt.QtCore import QCoreApplication, QObject, QTimer
 
 from ..core.errors import InputError
+from ..core.geometry.projection import PROJECTIONS
 from ..core.io.camera import read_camera_json
 from ..core.io.orientation import read_eo_csv
 from .control_layers import ControlLinks, read_control, read_tables
@@ -77,7 +78,10 @@ class ProjectLoader(QObject):
         crs = self.inputs.crs()
         self.session.set_orientation(None, None)
         try:
-            camera = read_camera_json(cam_path) if cam_path else None
+            # perspective or fisheye: a fisheye's lines and outlines are drawn as the curves
+            # they image as (core.photo.picking); image lines are measured with a
+            # perspective camera only (PickingSession.lines_refused)
+            camera = read_camera_json(cam_path, projections=PROJECTIONS) if cam_path else None
             eo = read_eo_csv(eo_path, crs.toWkt()) if eo_path else None
             # keeps the camera and the table when the scene cannot be made (e.g. no CRS)
             self.session.set_orientation(camera, eo, crs.authid() or crs.toWkt())

@@ -149,6 +149,8 @@ class ResectionController(JobController):
         super().__init__(dock, dock.resection_panel)
         self.run = None
         self.text = ""
+        #: the line rows left out of the last resection (fisheye camera), said after it
+        self.left_out = ""
         self.panel.resect_button.clicked.connect(self.start)
 
     def start(self, *_args) -> bool:
@@ -177,6 +179,32 @@ class ResectionController(JobController):
         snapshot = store.to_observations()
         # control rows name surveyed points, which the dock's LCP table does not hold
         snapshot = snapshot.subset(~snapshot.mask("control"))
+        cam = dock.session.camera
+        left_out = ""
+        if cam is not None and not cam.is_perspective and snapshot.mask("line").any():
+            # the resection from lines holds for the perspective projection only (the job
+            # refuses line rows with a fisheye camera): the image's points are used alone
+            lines_here = snapshot.mask("line") & (np.asarray(snapshot.image_id) == image)
+            n_lines = int(lines_here.sum())
+            snapshot = snapshot.subset(~snapshot.mask("line"))
+            control = (planes, [], lcps)
+            if not np.any(np.asarray(snapshot.image_id) == image):
+                dock.message(
+                    self.tr(
+                        "Image {} has only line rows: camera {} has the {} (fisheye) "
+                        "projection, and the resection from lines handles perspective "
+                        "cameras only. Measure control points (lcp)."
+                    ).format(image, cam.name, cam.projection),
+                    warning=True,
+                )
+                return False
+            if n_lines:
+                left_out = self.tr(
+                    "{} line row(s) of image {} left out: the resection from lines handles "
+                    "perspective cameras only (camera {}: {} fisheye projection)."
+                ).format(n_lines, image, cam.name, cam.projection)
+                dock.message(left_out, warning=True)
+        self.left_out = left_out
         params = resection_parameters(
             out_dir, image, out_dir / "observations.csv", camera, crs.authid() or crs.toWkt(),
             control,
@@ -199,12 +227,13 @@ class ResectionController(JobController):
         return bool(result.data)
 
     def _show(self, result) -> None:
+        from ..core.geometry.projection import PROJECTIONS
         from ..core.io.camera import read_camera_json
         from ..core.io.observations import read_observations_csv
 
         dock = self.dock
         run = self.run = result.data[0]
-        camera = read_camera_json(self.params["CAMERA"])
+        camera = read_camera_json(self.params["CAMERA"], projections=PROJECTIONS)
         obs = read_observations_csv(self.params["OBSERVATIONS"], camera=camera)
         rows = residual_rows(run, obs, camera)
         dock.session.set_resection(rows)
@@ -214,4 +243,5 @@ class ResectionController(JobController):
             self.tr("Resection of {} done: sigma0 {}; {}").format(
                 run.image_id, f"{s0:.3f}" if math.isfinite(s0) else "-", self.params["OUTPUT_HTML"]
             )
+            + (" " + self.left_out if self.left_out else "")
         )

@@ -10,11 +10,24 @@ frame tangent at the block centre (:func:`core.orientation.eo_map_to_local`), be
 projected frame is not Cartesian: over a 2 km block the earth curvature alone moves a point
 by about 0.3 m, a few pixels at a 10 cm ground sample distance. Pixels follow
 :mod:`core.camera`: origin at the top-left corner of the top-left pixel, rows downwards.
+
+Fisheye cameras
+---------------
+Through a perspective camera a straight 3-D segment images as the straight segment between
+its projected end points, so lines and outline edges are projected as their end points
+(2 points a line). Through a fisheye projection (:mod:`core.geometry.projection`) it images
+as a curve: :meth:`PickingScene.project_segments` and :meth:`PickingScene.project_rings`
+then subdivide each segment adaptively in object space (bisection in its parameter, first
+into pieces of at most :data:`_MAX_PIECE_RAD` seen from the perspective centre) until the
+projected midpoint of every piece lies within half of :data:`CHORD_TOL_PX` of its chord:
+the polyline stays within :data:`CHORD_TOL_PX` of the exact image of the line (measured in
+tests/core/test_picking_fisheye.py). Parts beyond the projection's field are left out,
+with a NaN row between the visible runs.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,14 +41,24 @@ from ..geometry.rotations import matrix_to_opk
 from .orientation import ExteriorOrientationTable, eo_map_to_local
 
 __all__ = [
+    "CHORD_TOL_PX",
     "PickingScene",
     "PlaneCandidate",
     "nearest_point",
+    "nearest_polyline",
     "nearest_segment",
     "points_in_polygons",
 ]
 
 Array = NDArray[np.float64]
+
+#: largest distance of a fisheye polyline from the exact image of its 3-D segment, pixels
+CHORD_TOL_PX = 0.25
+#: longest piece of a segment before the chord test, radians seen from the centre (so that a
+#: curve cannot enter the image between three samples that all lie outside it)
+_MAX_PIECE_RAD = np.radians(3.0)
+#: most halvings of a piece, and bisection steps to the edge of the field (2**-40 of a piece)
+_MAX_DEPTH = 40
 
 
 def points_in_polygons(pixel: ArrayLike, polygons: Sequence[ArrayLike]) -> NDArray[np.intp]:
@@ -131,6 +154,141 @@ def nearest_segment(
     dist = np.where(np.isfinite(dist), dist, np.inf)
     k = int(np.argmin(dist))
     return (k, float(dist[k])) if dist[k] <= tol_px else (-1, float("inf"))
+
+
+def nearest_polyline(
+    pixel: ArrayLike, polylines: Sequence[ArrayLike], tol_px: float
+) -> tuple[int, float]:
+    """The polyline nearest to ``pixel`` within ``tol_px`` (the hit test of projected lines).
+
+    Parameters
+    ----------
+    pixel : (2,) array_like
+    polylines : sequence of (K_i, 2) array_like
+        Pixels; an edge to or from a NaN row is no edge (a gap). Two-point polylines give
+        what :func:`nearest_segment` gives for their end points.
+    tol_px : float
+
+    Returns
+    -------
+    index, distance : int, float
+        Index into ``polylines``; ``(-1, inf)`` when none is within the tolerance.
+
+    >>> nearest_polyline((7.0, 1.0), [[[0, 0], [4, 0]], [[0, 3], [4, 3], [9, 3]]], 2.5)
+    (1, 2.0)
+    """
+    lines = [np.asarray(p, dtype=np.float64).reshape(-1, 2) for p in polylines]
+    edges = np.array([max(len(p) - 1, 0) for p in lines], dtype=np.intp)
+    if edges.sum() == 0:
+        return -1, float("inf")
+    a = np.vstack([p[:-1] for p in lines if len(p) > 1])
+    b = np.vstack([p[1:] for p in lines if len(p) > 1])
+    k, dist = nearest_segment(pixel, a, b, tol_px)
+    if k < 0:
+        return -1, float("inf")
+    return int(np.repeat(np.arange(len(lines)), edges)[k]), dist
+
+
+def _densify(
+    project: Callable[[Array], Array],
+    centre: Array,
+    a: Array,
+    b: Array,
+    frame: tuple[float, float],
+    tol_px: float,
+) -> list[Array]:
+    """Polylines (K_i, 2) pixels of the straight segments ``a[i] -> b[i]`` ((L, 3), the
+    frame ``project`` takes: points -> pixels, NaN outside the field) seen from ``centre``.
+
+    Each segment is cut into pieces of at most :data:`_MAX_PIECE_RAD` seen from the centre,
+    then a piece is halved while its projected midpoint lies more than ``tol_px / 2`` from
+    its chord, or one of its halves holds over 90 % of the chord's length (unless the piece
+    is wholly off the image ``frame`` = (width, height) px: it is kept as it is). A piece
+    still so after :data:`_MAX_DEPTH` halvings spans a jump of the image (the segment passes
+    exactly through the backward axis or the centre) and is left out. A piece with one end
+    outside the field is first cut at the field's edge (bisection to 2**-40 of the piece).
+    Pieces outside the field are left out: a NaN row separates the visible runs; a segment
+    not seen at all gives two NaN rows.
+    """
+    n = len(a)
+    if n == 0:
+        return []
+    da, db = a - centre, b - centre
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cos = np.einsum("ij,ij->i", da, db) / (np.linalg.norm(da, axis=1)
+                                                * np.linalg.norm(db, axis=1))  # fmt: skip
+        ang = np.arccos(np.clip(cos, -1.0, 1.0))
+    m = np.ones(n, dtype=np.intp)
+    good = np.isfinite(ang)
+    m[good] = np.clip(np.ceil(ang[good] / _MAX_PIECE_RAD), 1, 4096).astype(np.intp)
+    owner = np.repeat(np.arange(n), m)
+    k = np.arange(owner.size) - np.repeat(np.cumsum(m) - m, m)
+    t0, t1 = k / m[owner], (k + 1) / m[owner]
+
+    def at(o: NDArray[np.intp], t: Array) -> Array:
+        return project(a[o] + t[:, None] * (b[o] - a[o]))
+
+    p0, p1 = at(owner, t0), at(owner, t1)
+    depth = np.zeros(owner.size, dtype=np.intp)
+    w, h = frame
+    kept: list[tuple[NDArray[np.intp], Array, Array, Array, Array]] = []
+    while owner.size:
+        v0, v1 = np.isfinite(p0).all(axis=1), np.isfinite(p1).all(axis=1)
+        edge = np.flatnonzero(v0 != v1)
+        if edge.size:  # one end outside the field: keep the part inside (bisection)
+            good_t = np.where(v0, t0, t1)[edge]
+            in_t, out_t = good_t.copy(), np.where(v0, t1, t0)[edge]
+            for _ in range(_MAX_DEPTH):
+                mid = 0.5 * (in_t + out_t)
+                inside = np.isfinite(at(owner[edge], mid)).all(axis=1)
+                in_t, out_t = np.where(inside, mid, in_t), np.where(inside, out_t, mid)
+            t0[edge], t1[edge] = np.minimum(good_t, in_t), np.maximum(good_t, in_t)
+            p0[edge], p1[edge] = at(owner[edge], t0[edge]), at(owner[edge], t1[edge])
+            v0[edge] = v1[edge] = True
+        tm = 0.5 * (t0 + t1)
+        pm = at(owner, tm)
+        vm = np.isfinite(pm).all(axis=1)
+        chord = p1 - p0
+        len2 = np.einsum("ij,ij->i", chord, chord)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            s = np.clip(np.einsum("ij,ij->i", pm - p0, chord) / len2, 0.0, 1.0)
+        s = np.where(len2 > 0, s, 0.0)
+        dev = np.hypot(*(p0 + s[:, None] * chord - pm).T)
+        grow = (np.sqrt(len2) + dev)[:, None]
+        lo = np.minimum(np.minimum(p0, p1), pm) - grow
+        hi = np.maximum(np.maximum(p0, p1), pm) + grow
+        off = (hi[:, 0] < 0) | (lo[:, 0] > w) | (hi[:, 1] < 0) | (lo[:, 1] > h)
+        both = v0 & v1
+        # bent: the midpoint off the chord; uneven: nearly all of the chord in one half (a
+        # jump of the image hides there even when the points are in a row)
+        half = np.maximum(np.hypot(*(pm - p0).T), np.hypot(*(p1 - pm).T))
+        uneven = (half > 0.9 * np.sqrt(len2)) & (len2 > (0.5 * tol_px) ** 2)
+        bent = ((dev > 0.5 * tol_px) | uneven) & ~off
+        split = both & (~vm | bent) & (depth < _MAX_DEPTH)
+        # still bent after every halving: a jump of the image (the segment passes exactly
+        # through the backward axis, or the centre), not a curve: a gap, not a chord
+        done = ~split & both & vm & ~bent
+        kept.append((owner[done], t0[done], t1[done], p0[done], p1[done]))
+        o, d = owner[split], depth[split] + 1
+        owner = np.concatenate([o, o])
+        depth = np.concatenate([d, d])
+        t0, t1 = np.concatenate([t0[split], tm[split]]), np.concatenate([tm[split], t1[split]])
+        p0 = np.concatenate([p0[split], pm[split]])
+        p1 = np.concatenate([pm[split], p1[split]])
+    own, s0, s1, q0, q1 = (np.concatenate(x) for x in zip(*kept))
+    order = np.lexsort((s0, own))
+    own, s0, s1, q0, q1 = own[order], s0[order], s1[order], q0[order], q1[order]
+    new_run = np.ones(own.size, dtype=bool)
+    new_run[1:] = (own[1:] != own[:-1]) | (s0[1:] != s1[:-1])
+    starts = np.flatnonzero(new_run)
+    parts: list[list[Array]] = [[] for _ in range(n)]
+    gap = np.full((1, 2), np.nan)
+    for i, j in zip(starts.tolist(), [*starts[1:].tolist(), own.size]):
+        out = parts[int(own[i])]
+        if out:
+            out.append(gap)
+        out += [q0[i:j], q1[j - 1 : j]]
+    return [np.vstack(p) if p else np.full((2, 2), np.nan) for p in parts]
 
 
 @dataclass(frozen=True)
@@ -261,12 +419,61 @@ class PickingScene:
 
     # -- picking ------------------------------------------------------------------------------
     def project_rings(self, image_id: str, rings: Sequence[ArrayLike]) -> list[Array]:
-        """Project outline rings (each (M_i, 3), mapping CRS) in one call: (M_i, 2) pixels."""
-        sizes = [len(np.asarray(r).reshape(-1, 3)) for r in rings]
+        """Project outline rings (each (M_i, 3), mapping CRS) in one call: pixels.
+
+        Perspective camera: the projected vertices, (M_i, 2). Fisheye camera: each edge
+        (the closing one included) densified as :meth:`project_segments` does, the ring
+        closed implicitly as before; a ring with a vertex or a stretch of edge outside the
+        projection's field holds a NaN row (it then contains no pixel,
+        :func:`points_in_polygons`).
+        """
+        verts = [np.asarray(r, dtype=np.float64).reshape(-1, 3) for r in rings]
+        sizes = [len(v) for v in verts]
         if sum(sizes) == 0:
             return [np.empty((0, 2)) for _ in rings]
-        px = self.project(image_id, np.vstack([np.asarray(r).reshape(-1, 3) for r in rings]))
-        return np.split(px, np.cumsum(sizes)[:-1])
+        if self.camera.is_perspective:
+            px = self.project(image_id, np.vstack(verts))
+            return np.split(px, np.cumsum(sizes)[:-1])
+        starts = np.vstack([v for v in verts if len(v)])
+        ends = np.vstack([np.roll(v, -1, axis=0) for v in verts if len(v)])
+        edges = self.project_segments(image_id, starts, ends)
+        out, k = [], 0
+        for size in sizes:
+            parts = []
+            for e in edges[k : k + size]:
+                whole = np.isfinite(e).all()
+                parts.append(e[:-1] if whole else np.vstack([e, np.full((1, 2), np.nan)]))
+            out.append(np.vstack(parts) if parts else np.empty((0, 2)))
+            k += size
+        return out
+
+    def project_segments(
+        self, image_id: str, starts: ArrayLike, ends: ArrayLike, tol_px: float = CHORD_TOL_PX
+    ) -> list[Array]:
+        """Project straight 3-D segments (``starts`` -> ``ends``, (L, 3) mapping CRS) into an
+        image: one polyline (K_i, 2) pixels each.
+
+        Perspective camera: the two projected end points (K_i = 2; NaN behind the camera), as
+        :meth:`project` gives them. Fisheye camera: the segment (straight in the local frame)
+        subdivided until the polyline lies within ``tol_px`` of its exact curved image (see
+        the module docstring); runs beyond the projection's field are left out, a NaN row
+        between the visible runs (two NaN rows: not seen at all).
+        """
+        a = np.asarray(starts, dtype=np.float64).reshape(-1, 3)
+        b = np.asarray(ends, dtype=np.float64).reshape(-1, 3)
+        if a.shape[0] == 0:
+            return []
+        if self.camera.is_perspective:
+            return list(np.stack([self.project(image_id, a), self.project(image_id, b)], 1))
+        eo = self._eo(image_id)
+
+        def to_pixels(pts: Array) -> Array:
+            px, front, ok = project_with_status(pts, eo, self.camera)
+            px[~(front & ok)] = np.nan
+            return px
+
+        frame = (float(self.camera.width_px), float(self.camera.height_px))
+        return _densify(to_pixels, eo[:3], self.to_local(a), self.to_local(b), frame, tol_px)
 
     def planes_under_pixel(
         self,

@@ -30,11 +30,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..errors import InputError
 from ..geometry.camera import Camera
 from .control_features import ControlSet
 from .observation_list import Observation, ObservationList
 from .orientation import ExteriorOrientationTable
-from .picking import PickingScene, nearest_point, nearest_segment
+from .picking import PickingScene, nearest_point, nearest_polyline
 
 if TYPE_CHECKING:
     from .boresight_result import BoresightRun
@@ -61,13 +62,20 @@ _CONTROL_OF = {"tie": "planes", "paper": "planes", "line": "lines", "lcp": "lcps
 # ----------------------------------------------------------------------------- picking
 @dataclass(frozen=True)
 class ProjectedControl:
-    """The control projected into one image, pixels (NaN behind the camera)."""
+    """The control projected into one image, pixels (NaN behind the camera).
+
+    ``line_starts`` and ``line_ends`` are the LiDAR lines' projected end points; ``lines``
+    the lines as drawn and hit: one polyline (K_i, 2) each, the two end points for a
+    perspective camera, densified along the curved image for a fisheye one
+    (:meth:`~.picking.PickingScene.project_segments`; ``rings`` likewise).
+    """
 
     image_id: str
     rings: list[Array]
     line_starts: Array
     line_ends: Array
     lcps: Array
+    lines: list[Array]
 
 
 @dataclass(frozen=True, eq=False)
@@ -192,6 +200,24 @@ class PickingSession:
             sg.project(image_id, c.line_starts),
             sg.project(image_id, c.line_ends),
             sg.project(image_id, c.lcp_xyz),
+            sg.project_segments(image_id, c.line_starts, c.line_ends),
+        )
+
+    def lines_refused(self) -> str:
+        """Why image lines cannot be measured with the current camera ("" when they can).
+
+        A straight LiDAR line images as a curve through a fisheye lens, and the models that
+        use image lines (the resection's coplanarity and equivalent planes, the boresight
+        calibration) hold for the perspective projection only: with a fisheye camera the
+        dock measures no lines (and so refines no line end on an image edge).
+        """
+        cam = self.camera
+        if cam is None or cam.is_perspective:
+            return ""
+        return (
+            f"camera {cam.name!r} has the {cam.projection} (fisheye) projection: straight "
+            "LiDAR lines image as curves through it, and the resection and the calibration "
+            "from image lines handle perspective cameras only; measure control points (lcp)"
         )
 
     def footprint(self, image_id: str) -> Array | None:
@@ -214,7 +240,8 @@ class PickingSession:
         tie, paper: every plane whose outline holds the pixel, nearest to the camera first;
         line: the nearest line within ``tol_px``; lcp, check: the nearest control point within
         ``tol_px``. Empty when there is nothing. ``projected``: the control already projected
-        into that image (:meth:`project`), so that it is not projected again.
+        into that image (:meth:`project`), so that it is not projected again. Lines are hit
+        along their drawn polylines (the curved images of a fisheye camera).
         """
         c = self.control
         if projected is not None and projected.image_id != image_id:
@@ -227,7 +254,7 @@ class PickingSession:
             return [PickTarget(kind, p.index, c.plane_ids[p.index], p.range_m) for p in cands]
         proj = projected if projected is not None else self.project(image_id)
         if kind == "line":
-            k, _d = nearest_segment(pixel, proj.line_starts, proj.line_ends, tol_px)
+            k, _d = nearest_polyline(pixel, proj.lines, tol_px)
             return [PickTarget(kind, k, c.line_ids[k])] if k >= 0 else []
         k, _d = nearest_point(pixel, proj.lcps, tol_px)
         return [PickTarget(kind, k, c.lcp_ids[k])] if k >= 0 else []
@@ -263,9 +290,18 @@ class PickingSession:
         projected: ProjectedControl | None = None,
     ) -> HalfLine:
         """The first click of an image line on the LiDAR line ``target`` (kind ``line``): kept
-        as :attr:`half_line` until :meth:`finish_line` or :meth:`cancel_line`."""
+        as :attr:`half_line` until :meth:`finish_line` or :meth:`cancel_line`.
+
+        Raises
+        ------
+        InputError
+            A fisheye camera (:meth:`lines_refused`).
+        """
         if target.kind != "line":
             raise ValueError(f"an image line is linked to a LiDAR line, not a {target.kind}")
+        refused = self.lines_refused()
+        if refused:
+            raise InputError(refused)
         if projected is None or projected.image_id != image_id:
             projected = self.project(image_id)
         k = target.index
