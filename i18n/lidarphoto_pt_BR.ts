@@ -1035,6 +1035,10 @@
             <translation>A imagem {} não tem orientação: a medição precisa da câmera e da orientação exterior.</translation>
         </message>
         <message>
+            <source>No image lines with camera {} ({} fisheye projection): straight LiDAR lines image as curves through it, and the resection and the calibration from lines handle perspective cameras only. Measure control points (lcp) instead.</source>
+            <translation>Sem linhas de imagem com a câmera {} (projeção olho de peixe {}): através dela, linhas LiDAR retas aparecem como curvas na imagem, e a resseção e a calibração a partir de linhas tratam apenas câmeras perspectivas. Meça pontos de controle (lcp) em vez disso.</translation>
+        </message>
+        <message>
             <source>No roof plane under the cursor.</source>
             <translation>Nenhum plano de telhado sob o cursor.</translation>
         </message>
@@ -3048,6 +3052,14 @@
         <message>
             <source>Choose the line or LCP layer.</source>
             <translation>Escolha a camada de linhas ou de LCPs.</translation>
+        </message>
+        <message>
+            <source>Image {} has only line rows: camera {} has the {} (fisheye) projection, and the resection from lines handles perspective cameras only. Measure control points (lcp).</source>
+            <translation>A imagem {} tem apenas linhas do tipo line: a câmera {} tem a projeção {} (olho de peixe), e a resseção a partir de linhas trata apenas câmeras perspectivas. Meça pontos de controle (lcp).</translation>
+        </message>
+        <message>
+            <source>{} line row(s) of image {} left out: the resection from lines handles perspective cameras only (camera {}: {} fisheye projection).</source>
+            <translation>{} linha(s) do tipo line da imagem {} deixada(s) de fora: a resseção a partir de linhas trata apenas câmeras perspectivas (câmera {}: projeção olho de peixe {}).</translation>
         </message>
         <message>
             <source>Resection of {}</source>
