@@ -80,6 +80,10 @@ give the counts per round and the ties refused per reason.""",
               help="the planes' outlines (convex hull of their points): needed by tie points"),
         Param("TIE_POINTS", "table", "Tie points (observation CSV)", optional=True,
               file_filter=CSV_FILTER, advanced=True, help="the output of Automatic tie points"),
+        Param("FIND_TIES", "boolean", "Find tie points when none are given",
+              _AUTO.find_ties, advanced=True,
+              help="without TIE_POINTS, and with PLANES and CLOUD, run Automatic tie points "
+              "on the images (pairs from the footprints, least-squares refinement on)"),
         Param("HAND_PICKS", "table", "Hand picks to compare with (observation CSV)",
               optional=True, file_filter=CSV_FILTER, advanced=True,
               help="observations picked in the dock: their tie and line rows are calibrated "
@@ -93,6 +97,16 @@ give the counts per round and the ties refused per reason.""",
               labels=("one boresight for all images",
                       "one per trajectory group (flight line, direction, session)",
                       "one per heading direction (octant)"), advanced=True),
+        Param("ESTIMATE_LEVER_ARM", "boolean", "Estimate the lever arm",
+              _OPTIONS.estimate_lever_arm, advanced=True),
+        Param("ESTIMATE_INTERIOR", "boolean", "Estimate focal length and principal point",
+              _OPTIONS.estimate_interior, advanced=True),
+        Param("ESTIMATE_TIMING", "boolean", "Estimate the camera timing offset",
+              _OPTIONS.estimate_timing, advanced=True,
+              help="a constant dt (exposure = recorded time + dt) from the trajectory's "
+              "velocities (v_north, v_east, v_up columns, as Import trajectory writes them) or "
+              "from neighbouring exposures of each line; with the lever arm it needs lines at "
+              "clearly different speeds"),
         Param("INS_GRADE", "enum", "INS grade", _OPTIONS.ins_grade,
               options=_GRADES, labels=_GRADE_LABELS,  # type: ignore[arg-type]  # Refs
               advanced=True),
@@ -152,12 +166,21 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                          "without extension)", path=v.trajectory)  # fmt: skip
     auto = options_from(AutoBoresightOptions, SPEC, v)
     cal = options_from(BoresightOptions, SPEC, v, ins_grade=grade)
+    share = 0.0
+    detected = None
+    if ties is None and auto.find_ties and v.cloud and any(len(p.outline) >= 3 for p in planes):
+        share = 0.4
+        ties, detected = _find_ties(images, cam, traj, mount, frame, planes, progress,
+                                    should_stop)  # fmt: skip
+    rest = None if progress is None else (lambda x: progress(share + (1.0 - share) * x))
     found = auto_calibrate(traj, cam, mount, frame, images, planes, lines, ties, None, auto, cal,
-                           progress=progress, should_stop=should_stop)  # fmt: skip
+                           progress=rest, should_stop=should_stop)  # fmt: skip
     result = found.result
     doubts = doubts_about(result, v.max_boresight, v.max_sigma0, cal.snooping_alpha)
     run_ = _boresight_run(found, cam, traj, planes, lines, frame, cal)
     settings = _settings(v, cam, traj, found, frame, grade)
+    if detected is not None:
+        settings["tie points found"] = detected
     if v.hand_picks:
         settings.update(_compare_hand_picks(v, cam, traj, mount, frame, planes, lines, cal,
                                             result, should_stop))  # fmt: skip
@@ -216,6 +239,30 @@ def _read_inputs(v: Values) -> tuple:
             raise InputError("TIE_POINTS need PLANES and CLOUD (the planes' outlines)")
         ties = read_observations_csv(v.tie_points, camera=cam)
     return cam, traj, planes, lines, ties
+
+
+def _find_ties(images, cam, traj, mount, frame, planes, progress, should_stop) -> tuple:
+    """Tie tracks found between the images read (FIND_TIES): the observations and a line of
+    counts for the summary. Pairs from the footprints of the approximate orientation at the
+    planes' median height."""
+    import numpy as np
+
+    from ..errors import InputError
+    from ..photo.auto_ties import find_ties
+    from ..photo.georeference import direct_georeference
+
+    if len(images) < 2:
+        raise InputError("IMAGES: finding tie points needs at least two images (or give "
+                         "TIE_POINTS)")  # fmt: skip
+    eo = direct_georeference(traj, mount, frame)
+    height = float(np.median([p.centroid[2] for p in planes]))
+    sub = None if progress is None else (lambda x: progress(0.4 * x))
+    res = find_ties(images, cam, eo, height, progress=sub, should_stop=should_stop)
+    s = res.summary()
+    text = (f"{s['tracks']} tracks, {s['measurements']} measurements; pairs "
+            f"{s['pairs_kept']} of {s['pairs_tried']} kept")  # fmt: skip
+    log.info("tie points found: %s", text)
+    return res.observations(), text
 
 
 def _boresight_run(found, cam, traj, planes, lines, frame, cal):

@@ -342,6 +342,7 @@ def auto_calibrate(
     height = float(np.median(eo.xyz[:, 2]) - np.median([p.centroid[2] for p in planes])) \
         if planes else float(np.median(eo.xyz[:, 2]))  # fmt: skip
     rounds: list[RoundRecord] = []
+    cam = camera  # with the interior estimated, the last round's (and the lever arm's)
     last = np.asarray(searched, float)[None, :]
     result, obs, converged = None, None, False
     for r in range(int(opt.max_rounds)):
@@ -349,13 +350,13 @@ def auto_calibrate(
         spread = float(np.hypot(bore_sigma, att_sigma))
         search_px = max(opt.min_search_px, opt.sigmas * camera.focal_px * spread)
         gate = max(opt.min_gate_m, opt.sigmas * abs(height) * spread)
-        line_obs = line_observations_block(images, camera, eo, lines,
+        line_obs = line_observations_block(images, cam, eo, lines,
                                            replace(opt.lines, search_px=search_px))  # fmt: skip
         refused = dict.fromkeys(REASONS, 0)
         n_tracks = 0
         obs = line_obs
         if ties is not None and len(ties):
-            assoc = associate_ties(ties, eo, camera, planes, gate, border_m=opt.border_m,
+            assoc = associate_ties(ties, eo, cam, planes, gate, border_m=opt.border_m,
                                    max_roof_slope_deg=opt.max_roof_slope_deg, dsm=dsm)  # fmt: skip
             refused, n_tracks = assoc.reasons, assoc.tracks
             obs = obs.concat(assoc.observations)
@@ -365,7 +366,7 @@ def auto_calibrate(
                 f"on a roof plane (round {r + 1}, search {search_px:.1f} px): the approximate "
                 "boresight or the mount is too far off, or the lines are not in the images"
             )
-        result = calibrate(trajectory, camera, current, frame, obs, planes, lines, options=cal,
+        result = calibrate(trajectory, cam, current, frame, obs, planes, lines, options=cal,
                            should_stop=should_stop)  # fmt: skip
         change = result.boresight - last
         n_ties = sum(1 for t in obs.type if t == "tie")
@@ -383,6 +384,11 @@ def auto_calibrate(
         bore_sigma = float(np.max(result.std))
         eo = result.eo
         current = replace(mount, boresight=result.boresight.mean(axis=0))
+        if result.lever_arm is not None:
+            current = replace(current, lever_arm=np.asarray(result.lever_arm, float).copy())
+        if result.interior is not None:
+            f, x0, y0 = (float(a) for a in result.interior)
+            cam = replace(cam, focal_mm=f, x0_mm=x0, y0_mm=y0)
     assert result is not None and obs is not None
     return AutoBoresightResult(
         result,

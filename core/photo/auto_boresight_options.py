@@ -67,6 +67,9 @@ class AutoBoresightOptions:
     min_line_directions: fewest distinct line directions (15 degrees apart in plan) that make
         the angles observable without sloped planes.
     max_rounds: most association-adjustment rounds.
+    find_ties: without tie points given, find them between the images (the ``tiepoints``
+        chain with its defaults: pairs from the footprints, least-squares refinement) when
+        the planes have outlines.
     lines: options of the edge search (its ``search_px`` is set per round).
     """
 
@@ -81,6 +84,7 @@ class AutoBoresightOptions:
     min_slope_deg: float = 5.0
     min_line_directions: int = 2
     max_rounds: int = 6
+    find_ties: bool = True
     lines: AutoLineOptions = field(default_factory=AutoLineOptions)
 
     def __post_init__(self) -> None:
