@@ -390,6 +390,8 @@ def auto_calibrate(
             f, x0, y0 = (float(a) for a in result.interior)
             cam = replace(cam, focal_mm=f, x0_mm=x0, y0_mm=y0)
     assert result is not None and obs is not None
+    if progress:
+        progress(1.0)
     return AutoBoresightResult(
         result,
         np.asarray(searched, float),

@@ -479,6 +479,37 @@ def test_the_job_estimates_the_lever_arm_when_asked(block, files, tmp_path):
                                                                    res.lever_arm_std)
 
 
+def test_the_job_finds_the_tie_points_itself(files, tmp_path):
+    """No TIE_POINTS: the job runs the tie-point chain on the images (pairs from the
+    footprints, least-squares refinement), associates the tracks with the roof planes and
+    calibrates; FIND_TIES off leaves the lines alone. Progress reaches 1 and only rises."""
+    from lidarphoto.core.jobs import auto_boresight as job
+    from lidarphoto.core.jobs.runner import run_job
+
+    _, inputs = files
+    inputs = {**inputs, "TIE_POINTS": None}
+    out = {"OUTPUT_TABLE": str(tmp_path / "b.csv"), "OUTPUT_EO": str(tmp_path / "e.csv"),
+           "OUTPUT_OBSERVATIONS": str(tmp_path / "o.csv"),
+           "OUTPUT_HTML": str(tmp_path / "r.html")}  # fmt: skip
+    seen = []
+    got = run_job(job, {**inputs, **out}, progress=seen.append)
+    found = got.data
+    res = found.result
+    err = np.degrees(res.boresight[0]) - TRUTH_DEG
+    std = np.degrees(res.std[0])
+    last = found.rounds[-1]
+    print("ties found: tracks", last.tie_tracks, "associated", last.ties_associated,
+          "refused", last.ties_refused, "err arcsec", np.round(err * 3600, 1), "std",
+          np.round(std * 3600, 1))  # fmt: skip
+    assert last.tie_tracks > 0 and last.ties_associated > 0
+    assert got.results["TIES_ASSOCIATED"] == last.ties_associated
+    assert found.converged and np.all(np.abs(err) < 3 * std), (err * 3600, std * 3600)
+    assert "tie points found" in (tmp_path / "r.html").read_text()
+    assert seen and seen[-1] == pytest.approx(1.0) and np.all(np.diff(seen) >= -1e-12)
+    alone = run_job(job, {**inputs, "FIND_TIES": False, **out}).data
+    assert alone.rounds[-1].tie_tracks == 0 and alone.rounds[-1].ties_associated == 0
+
+
 def test_the_job_refuses_bad_inputs_by_name(files, tmp_path):
     from lidarphoto.core.errors import InputError
     from lidarphoto.core.jobs import auto_boresight as job
