@@ -57,7 +57,9 @@ class AutoBoresightOptions:
 
     search_deg: half width of the angle search about the initial boresight, degrees (0: no
         search, the initial boresight must be within a few pixels).
-    coarse_step_px, fine_step_px: first and last grid step of the search, pixels in the image.
+    coarse_step_px, fine_step_px: first and last grid step of the search, pixels in the image
+        (the first is widened to an eighth of the search range when that is larger: large
+        images take as many candidates as small ones).
     min_search_px: smallest half width of the edge search across a projected line, pixels.
     sigmas: width of the edge search and of the tie gate in standard deviations.
     min_gate_m: smallest tie gate, metres.
