@@ -195,7 +195,8 @@ class _Search:
         r = max(1, int(sigma_px // 2.0))
         if self._blurred != (sigma_px, r):
             grads = []
-            for g in self.greys:
+            for full in self.greys:
+                g: NDArray = full
                 if r > 1:
                     h, w = (g.shape[0] // r) * r, (g.shape[1] // r) * r
                     g = cv2.resize(g[:h, :w], (w // r, h // r), interpolation=cv2.INTER_AREA)
