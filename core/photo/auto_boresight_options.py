@@ -26,6 +26,9 @@ class AutoLineOptions:
     margin_px: samples nearer the frame border than this are dropped.
     outlier_sigmas: refusal threshold on the per-line fit's robust residual sigma.
     min_sigma_px: floor of the reported sigma (the fit's RMS can be tiny on few points).
+    max_samples: most samples of one line in one image (a long line's samples are spread
+        wider than ``spacing_px``): the boresight is bound by the INS priors long before, and
+        the adjustment's time (data snooping) grows with the observations (a 24-Mpx flight).
     """
 
     spacing_px: float = 4.0
@@ -37,6 +40,7 @@ class AutoLineOptions:
     margin_px: float = 2.0
     outlier_sigmas: float = 3.0
     min_sigma_px: float = 0.05
+    max_samples: int = 100
 
     def __post_init__(self) -> None:
         for name in ("spacing_px", "search_px", "min_sigma_px", "outlier_sigmas"):
@@ -47,6 +51,8 @@ class AutoLineOptions:
                 raise InputError(f"{name} must be >= 0, got {getattr(self, name)!r}")
         if not 0 < float(self.ambiguity) <= 1:
             raise InputError(f"ambiguity must be in (0, 1], got {self.ambiguity!r}")
+        if int(self.max_samples) < int(self.min_points):
+            raise InputError(f"max_samples must be >= min_points, got {self.max_samples!r}")
         if int(self.min_points) < 3:
             raise InputError(f"min_points must be >= 3, got {self.min_points!r}")
 
