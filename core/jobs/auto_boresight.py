@@ -22,7 +22,7 @@ from .common import (
     mount_params,
     settle_doubts,
 )
-from .runner import JobResult
+from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
@@ -49,8 +49,9 @@ are projected into every image with the trajectory, the mount and the approximat
 First an angle search (coarse to fine, within Search range of the approximate boresight)
 finds the boresight whose projected lines lie on the strongest image edges; then, in rounds,
 sub-pixel image edges are found along every projected line (the dock's edge refinement, within
-3 sigma of the projection's uncertainty) and, when tie points are given (the observation CSV
-of Automatic tie points), each tie track is intersected and kept as a point-to-plane tie of
+3 sigma of the projection's uncertainty) and each tie track (found between the images by
+the chain of Automatic tie points, pairs from the footprints and least-squares refinement on,
+or its observation CSV given as Tie points) is intersected and kept as a point-to-plane tie of
 the roof plane it lies on (inside the plane's outline, from the cloud's plane ids; off the
 borders; within a gate of 3 sigma of the pose and intersection uncertainty; not on a wall).
 Each round runs the rigorous calibration of Boresight calibration (line and tie models,
@@ -80,6 +81,10 @@ give the counts per round and the ties refused per reason.""",
               help="the planes' outlines (convex hull of their points): needed by tie points"),
         Param("TIE_POINTS", "table", "Tie points (observation CSV)", optional=True,
               file_filter=CSV_FILTER, advanced=True, help="the output of Automatic tie points"),
+        Param("FIND_TIES", "boolean", "Find tie points when none are given",
+              _AUTO.find_ties, advanced=True,
+              help="without TIE_POINTS, and with PLANES and CLOUD, run Automatic tie points "
+              "on the images (pairs from the footprints, least-squares refinement on)"),
         Param("HAND_PICKS", "table", "Hand picks to compare with (observation CSV)",
               optional=True, file_filter=CSV_FILTER, advanced=True,
               help="observations picked in the dock: their tie and line rows are calibrated "
@@ -93,6 +98,16 @@ give the counts per round and the ties refused per reason.""",
               labels=("one boresight for all images",
                       "one per trajectory group (flight line, direction, session)",
                       "one per heading direction (octant)"), advanced=True),
+        Param("ESTIMATE_LEVER_ARM", "boolean", "Estimate the lever arm",
+              _OPTIONS.estimate_lever_arm, advanced=True),
+        Param("ESTIMATE_INTERIOR", "boolean", "Estimate focal length and principal point",
+              _OPTIONS.estimate_interior, advanced=True),
+        Param("ESTIMATE_TIMING", "boolean", "Estimate the camera timing offset",
+              _OPTIONS.estimate_timing, advanced=True,
+              help="a constant dt (exposure = recorded time + dt) from the trajectory's "
+              "velocities (v_north, v_east, v_up columns, as Import trajectory writes them) or "
+              "from neighbouring exposures of each line; with the lever arm it needs lines at "
+              "clearly different speeds"),
         Param("INS_GRADE", "enum", "INS grade", _OPTIONS.ins_grade,
               options=_GRADES, labels=_GRADE_LABELS,  # type: ignore[arg-type]  # Refs
               advanced=True),
@@ -131,9 +146,7 @@ give the counts per round and the ties refused per reason.""",
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the inputs, calibrate automatically, write the outputs."""
-    from ..errors import InputError
     from ..geometry.frames import MappingFrame
-    from ..io.images import list_image_files, read_gray
     from ..photo.auto_boresight import auto_calibrate
     from ..photo.auto_boresight_options import AutoBoresightOptions
     from ..photo.boresight_setup import BoresightOptions
@@ -144,20 +157,17 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     mount = mount_from(v)
     grade = ins_grade(v.ins_grade, v.ins_sigmas)
     cam, traj, planes, lines, ties = _read_inputs(v)
-    files = list_image_files(v.images, ("IMAGES", "identical images have no parallax"))
-    known = set(traj.image_id)
-    images = [(f.stem, read_gray(f)) for f in files if f.stem in known]
-    if not images:
-        raise InputError("IMAGES: no image is named in the trajectory (image id = file name "
-                         "without extension)", path=v.trajectory)  # fmt: skip
+    images = _read_images(v, traj)
     auto = options_from(AutoBoresightOptions, SPEC, v)
     cal = options_from(BoresightOptions, SPEC, v, ins_grade=grade)
+    ties, detected, rest = _tie_stage(v, auto, ties, images, cam, traj, mount, frame, planes,
+                                      progress, should_stop)  # fmt: skip
     found = auto_calibrate(traj, cam, mount, frame, images, planes, lines, ties, None, auto, cal,
-                           progress=progress, should_stop=should_stop)  # fmt: skip
+                           progress=rest, should_stop=should_stop)  # fmt: skip
     result = found.result
     doubts = doubts_about(result, v.max_boresight, v.max_sigma0, cal.snooping_alpha)
     run_ = _boresight_run(found, cam, traj, planes, lines, frame, cal)
-    settings = _settings(v, cam, traj, found, frame, grade)
+    settings = _settings(v, cam, traj, found, frame, grade, detected)
     if v.hand_picks:
         settings.update(_compare_hand_picks(v, cam, traj, mount, frame, planes, lines, cal,
                                             result, should_stop))  # fmt: skip
@@ -218,6 +228,58 @@ def _read_inputs(v: Values) -> tuple:
     return cam, traj, planes, lines, ties
 
 
+def _read_images(v: Values, traj) -> list:
+    """(image id, 8-bit grey image) of the IMAGES named in the trajectory."""
+    from ..errors import InputError
+    from ..io.images import list_image_files, read_gray
+
+    files = list_image_files(v.images, ("IMAGES", "identical images have no parallax"))
+    known = set(traj.image_id)
+    images = [(f.stem, read_gray(f)) for f in files if f.stem in known]
+    if not images:
+        raise InputError("IMAGES: no image is named in the trajectory (image id = file name "
+                         "without extension)", path=v.trajectory)  # fmt: skip
+    return images
+
+
+def _tie_stage(v, auto, ties, images, cam, traj, mount, frame, planes, progress, should_stop
+               ) -> tuple:  # fmt: skip
+    """(the tie points, the summary's line on those found or None, the calibration's share
+    of the progress): TIE_POINTS when given, else those found between the images (FIND_TIES,
+    with CLOUD: the planes' outlines), else None."""
+    find = ties is None and auto.find_ties and bool(v.cloud) and any(
+        len(p.outline) >= 3 for p in planes)  # fmt: skip
+    tie_progress, rest = stages(progress, 0.4 if find else 0.0, 1.0)
+    detected = None
+    if find:
+        ties, detected = _find_ties(images, cam, traj, mount, frame, planes, tie_progress,
+                                    should_stop)  # fmt: skip
+    return ties, detected, rest
+
+
+def _find_ties(images, cam, traj, mount, frame, planes, progress, should_stop) -> tuple:
+    """Tie tracks found between the images read (FIND_TIES): the observations and a line of
+    counts for the summary. Pairs from the footprints of the approximate orientation at the
+    planes' median height."""
+    import numpy as np
+
+    from ..errors import InputError
+    from ..photo.auto_ties import find_ties
+    from ..photo.georeference import direct_georeference
+
+    if len(images) < 2:
+        raise InputError("IMAGES: finding tie points needs at least two images (or give "
+                         "TIE_POINTS)")  # fmt: skip
+    eo = direct_georeference(traj, mount, frame)
+    height = float(np.median([p.centroid[2] for p in planes]))
+    res = find_ties(images, cam, eo, height, progress=progress, should_stop=should_stop)
+    s = res.summary()
+    text = (f"{s['tracks']} tracks, {s['measurements']} measurements; pairs "
+            f"{s['pairs_kept']} of {s['pairs_tried']} kept")  # fmt: skip
+    log.info("tie points found: %s", text)
+    return res.observations(), text
+
+
 def _boresight_run(found, cam, traj, planes, lines, frame, cal):
     """The :class:`BoresightRun` of the last round (residuals at their ground positions)."""
     from ..photo.boresight_result import BoresightRun
@@ -232,7 +294,7 @@ def _boresight_run(found, cam, traj, planes, lines, frame, cal):
                         frame.crs.to_wkt())  # fmt: skip
 
 
-def _settings(v, cam, traj, found, frame, grade) -> dict[str, str]:
+def _settings(v, cam, traj, found, frame, grade, detected) -> dict[str, str]:
     """The run's settings and counts as text (the HTML summary shows them)."""
     import numpy as np
 
@@ -253,6 +315,8 @@ def _settings(v, cam, traj, found, frame, grade) -> dict[str, str]:
             f"on {r.lines_seen} lines; tie tracks {r.tie_tracks}, on planes {r.ties_associated}"
             f", refused: {refused}; rejected by the adjustment {r.rejected}"
         )
+    if detected is not None:
+        s["tie points found"] = detected
     s["line points per image"] = ", ".join(f"{k} {n}" for k, n in found.per_image.items())
     s["tie measurements per plane"] = (
         ", ".join(f"{k} {n}" for k, n in found.per_plane.items()) or "none"

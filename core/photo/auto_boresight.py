@@ -7,10 +7,11 @@ boresight and the LiDAR roof planes and lines (mapping CRS), without any hand-pi
    than ``min_line_directions`` distinct LiDAR line directions (flat ground, flat roofs) is
    refused with that reason (:class:`SceneNotObservable`): the angles are not observable.
 2. Angle search (coarse to fine): the LiDAR lines, sampled in 3D, are projected into every
-   image for boresight candidates on a grid of ``coarse_step_px`` (in the image) over
-   +-``search_deg`` about the initial boresight (omega and phi together, then kappa), and the
-   candidate whose projections lie on the strongest image edges (the sum of the gradient
-   magnitude of the image blurred by about half a step) wins; the grid is then halved around
+   image for boresight candidates on a grid of ``coarse_step_px`` (in the image; widened to
+   an eighth of the range when larger) over +-``search_deg`` about the initial boresight
+   (omega and phi together, then kappa), and the candidate whose projections lie on the
+   strongest image edges (the sum of the gradient magnitude of the image blurred by about
+   half a step) wins; the grid is then halved around
    it down to ``fine_step_px``. This is what lets a 1-degree initial error converge: the
    edge refinement of step 3 only looks a few pixels across a line.
 3. Rounds: with the exterior orientation of the current estimate, line observations are
@@ -165,21 +166,42 @@ def _nominal_camera_vectors(traj: Trajectory, camera: Camera, mount: Mount,
     return [(xyz - centres[i]) @ m0[i].T for i in range(len(traj))]
 
 
+#: Most grid steps each side of the initial boresight at the search's first level.
+_FIRST_STEPS = 8.0
+
+
 class _Search:
     """The line samples of all images (stacked) and the images' edge strength at one blur."""
 
-    def __init__(self, camera: Camera, us: list[Array], greys: list[Array]) -> None:
+    def __init__(self, camera: Camera, us: list[Array], greys: list[NDArray[np.float32]]
+                 ) -> None:  # fmt: skip
         self.camera = camera
         self.us = us
         self.greys = greys
-        self.grads: list[Array] = []
+        self.grads: list[NDArray[np.float32]] = []
         self.stride = 1
+        self.reduce = 1
+        self._blurred: tuple[float, int] = (-1.0, 0)
 
     def blur(self, sigma_px: float, stride: int) -> None:
-        """Gradient magnitude of the images blurred by ``sigma_px``; every ``stride``-th sample."""
+        """Gradient magnitude of the images blurred by ``sigma_px`` (full-resolution pixels);
+        every ``stride``-th sample. A wide blur is computed on the image reduced by an integer
+        factor (box average) that keeps at least 2 reduced pixels of sigma: the search needs
+        the edges' position at the blur's scale only, and a 24-Mpx image blurred by 30 px
+        would otherwise cost seconds per candidate level."""
+        import cv2
         from scipy.ndimage import gaussian_gradient_magnitude
 
-        self.grads = [gaussian_gradient_magnitude(g, sigma_px) for g in self.greys]
+        r = max(1, int(sigma_px // 2.0))
+        if self._blurred != (sigma_px, r):
+            grads = []
+            for full in self.greys:
+                g: NDArray = full
+                if r > 1:
+                    h, w = (g.shape[0] // r) * r, (g.shape[1] // r) * r
+                    g = cv2.resize(g[:h, :w], (w // r, h // r), interpolation=cv2.INTER_AREA)
+                grads.append(gaussian_gradient_magnitude(g, sigma_px / r))
+            self.grads, self.reduce, self._blurred = grads, r, (sigma_px, r)
         self.stride = max(1, int(stride))
         parts = [u[:: self.stride] for u in self.us]
         self.owner = np.repeat(np.arange(len(parts)), [len(p) for p in parts])
@@ -197,7 +219,9 @@ class _Search:
         good[good] &= cam.in_frame(px[good], 2.0)
         total = 0.0
         for k, g in enumerate(self.grads):
-            p = px[good & (self.owner == k)] - 0.5
+            # reduced pixel j covers full-resolution [j r, (j + 1) r): its centre is at
+            # (j + 1/2) r in the project's pixel convention (first pixel's centre at 0.5)
+            p = px[good & (self.owner == k)] / self.reduce - 0.5
             if len(p):
                 total += float(map_coordinates(g, [p[:, 1], p[:, 0]], order=1).sum())
         return total / max(len(px), 1)
@@ -243,11 +267,14 @@ def search_boresight(
         if iid not in row:
             raise InputError(f"image '{iid}' is not in the trajectory")
         chosen.append(us[row[iid]])
-        greys.append(_grey(img))
+        greys.append(_grey(img).astype(np.float32))
     search = _Search(camera, chosen, greys)
     f = camera.focal_px
     half_diag = 0.5 * float(np.hypot(camera.width_px, camera.height_px))
-    step_px = float(opt.coarse_step_px)
+    # the first grid spans the range in at most _FIRST_STEPS steps each side (and at least
+    # coarse_step_px): the search costs the same number of candidates at any image size
+    range_px = f * np.radians(opt.search_deg)
+    step_px = max(float(opt.coarse_step_px), range_px / _FIRST_STEPS)
     bore = np.asarray(mount.boresight, float).copy()
     first = True
     while True:
@@ -342,6 +369,7 @@ def auto_calibrate(
     height = float(np.median(eo.xyz[:, 2]) - np.median([p.centroid[2] for p in planes])) \
         if planes else float(np.median(eo.xyz[:, 2]))  # fmt: skip
     rounds: list[RoundRecord] = []
+    cam = camera  # with the interior estimated, the last round's (and the lever arm's)
     last = np.asarray(searched, float)[None, :]
     result, obs, converged = None, None, False
     for r in range(int(opt.max_rounds)):
@@ -349,13 +377,13 @@ def auto_calibrate(
         spread = float(np.hypot(bore_sigma, att_sigma))
         search_px = max(opt.min_search_px, opt.sigmas * camera.focal_px * spread)
         gate = max(opt.min_gate_m, opt.sigmas * abs(height) * spread)
-        line_obs = line_observations_block(images, camera, eo, lines,
+        line_obs = line_observations_block(images, cam, eo, lines,
                                            replace(opt.lines, search_px=search_px))  # fmt: skip
         refused = dict.fromkeys(REASONS, 0)
         n_tracks = 0
         obs = line_obs
         if ties is not None and len(ties):
-            assoc = associate_ties(ties, eo, camera, planes, gate, border_m=opt.border_m,
+            assoc = associate_ties(ties, eo, cam, planes, gate, border_m=opt.border_m,
                                    max_roof_slope_deg=opt.max_roof_slope_deg, dsm=dsm)  # fmt: skip
             refused, n_tracks = assoc.reasons, assoc.tracks
             obs = obs.concat(assoc.observations)
@@ -365,7 +393,7 @@ def auto_calibrate(
                 f"on a roof plane (round {r + 1}, search {search_px:.1f} px): the approximate "
                 "boresight or the mount is too far off, or the lines are not in the images"
             )
-        result = calibrate(trajectory, camera, current, frame, obs, planes, lines, options=cal,
+        result = calibrate(trajectory, cam, current, frame, obs, planes, lines, options=cal,
                            should_stop=should_stop)  # fmt: skip
         change = result.boresight - last
         n_ties = sum(1 for t in obs.type if t == "tie")
@@ -383,7 +411,14 @@ def auto_calibrate(
         bore_sigma = float(np.max(result.std))
         eo = result.eo
         current = replace(mount, boresight=result.boresight.mean(axis=0))
+        if result.lever_arm is not None:
+            current = replace(current, lever_arm=np.asarray(result.lever_arm, float).copy())
+        if result.interior is not None:
+            f, x0, y0 = (float(a) for a in result.interior)
+            cam = replace(cam, focal_mm=f, x0_mm=x0, y0_mm=y0)
     assert result is not None and obs is not None
+    if progress:
+        progress(1.0)
     return AutoBoresightResult(
         result,
         np.asarray(searched, float),

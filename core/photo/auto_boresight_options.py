@@ -26,6 +26,9 @@ class AutoLineOptions:
     margin_px: samples nearer the frame border than this are dropped.
     outlier_sigmas: refusal threshold on the per-line fit's robust residual sigma.
     min_sigma_px: floor of the reported sigma (the fit's RMS can be tiny on few points).
+    max_samples: most samples of one line in one image (a long line's samples are spread
+        wider than ``spacing_px``): the boresight is bound by the INS priors long before, and
+        the adjustment's time (data snooping) grows with the observations (a 24-Mpx flight).
     """
 
     spacing_px: float = 4.0
@@ -37,6 +40,7 @@ class AutoLineOptions:
     margin_px: float = 2.0
     outlier_sigmas: float = 3.0
     min_sigma_px: float = 0.05
+    max_samples: int = 100
 
     def __post_init__(self) -> None:
         for name in ("spacing_px", "search_px", "min_sigma_px", "outlier_sigmas"):
@@ -47,6 +51,8 @@ class AutoLineOptions:
                 raise InputError(f"{name} must be >= 0, got {getattr(self, name)!r}")
         if not 0 < float(self.ambiguity) <= 1:
             raise InputError(f"ambiguity must be in (0, 1], got {self.ambiguity!r}")
+        if int(self.max_samples) < int(self.min_points):
+            raise InputError(f"max_samples must be >= min_points, got {self.max_samples!r}")
         if int(self.min_points) < 3:
             raise InputError(f"min_points must be >= 3, got {self.min_points!r}")
 
@@ -57,7 +63,9 @@ class AutoBoresightOptions:
 
     search_deg: half width of the angle search about the initial boresight, degrees (0: no
         search, the initial boresight must be within a few pixels).
-    coarse_step_px, fine_step_px: first and last grid step of the search, pixels in the image.
+    coarse_step_px, fine_step_px: first and last grid step of the search, pixels in the image
+        (the first is widened to an eighth of the search range when that is larger: large
+        images take as many candidates as small ones).
     min_search_px: smallest half width of the edge search across a projected line, pixels.
     sigmas: width of the edge search and of the tie gate in standard deviations.
     min_gate_m: smallest tie gate, metres.
@@ -67,6 +75,9 @@ class AutoBoresightOptions:
     min_line_directions: fewest distinct line directions (15 degrees apart in plan) that make
         the angles observable without sloped planes.
     max_rounds: most association-adjustment rounds.
+    find_ties: without tie points given, find them between the images (the ``tiepoints``
+        chain with its defaults: pairs from the footprints, least-squares refinement) when
+        the planes have outlines.
     lines: options of the edge search (its ``search_px`` is set per round).
     """
 
@@ -81,6 +92,7 @@ class AutoBoresightOptions:
     min_slope_deg: float = 5.0
     min_line_directions: int = 2
     max_rounds: int = 6
+    find_ties: bool = True
     lines: AutoLineOptions = field(default_factory=AutoLineOptions)
 
     def __post_init__(self) -> None:

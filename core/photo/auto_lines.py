@@ -53,14 +53,15 @@ def _samples(
     scene: PickingScene, image_id: str, line: ControlLine, camera: Camera, opt: AutoLineOptions
 ) -> tuple[Array, Array, Array]:
     """(pixels (K, 2), unit directions (K, 2), along-line parameter (K,) in 0..1) of the
-    in-frame samples of one line, ``spacing_px`` apart in the image (approximately)."""
+    in-frame samples of one line, ``spacing_px`` apart in the image (approximately; at most
+    ``max_samples`` over the line)."""
     a, b = np.asarray(line.start, float), np.asarray(line.end, float)
     coarse = scene.project(image_id, a + np.linspace(0, 1, 9)[:, None] * (b - a))
     ok = np.isfinite(coarse).all(axis=1)
     if ok.sum() < 2:
         return np.empty((0, 2)), np.empty((0, 2)), np.empty(0)
     span = np.nansum(np.linalg.norm(np.diff(coarse[ok], axis=0), axis=1))
-    n = int(np.clip(np.ceil(span / opt.spacing_px), 2, 100000))
+    n = int(np.clip(np.ceil(span / opt.spacing_px), 2, max(2, int(opt.max_samples))))
     t = (np.arange(n) + 0.5) / n
     eps = 0.5 / n
     pts = scene.project(image_id, a + np.concatenate([t, t - eps, t + eps])[:, None] * (b - a))

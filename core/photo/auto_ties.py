@@ -27,7 +27,7 @@ point-to-plane model does.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,7 +42,7 @@ from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable
 from .picking import PickingScene, points_in_polygons
 
-__all__ = ["REASONS", "TieAssociation", "associate_ties", "outlines_from_points"]
+__all__ = ["REASONS", "TieAssociation", "associate_ties", "find_ties", "outlines_from_points"]
 
 Array = NDArray[np.float64]
 
@@ -98,6 +98,68 @@ def outlines_from_points(planes: Sequence[Plane], xyz: ArrayLike, plane_ids: Arr
         z = p.centroid[2] - ((ring - p.centroid[:2]) @ p.normal[:2]) / p.normal[2]
         out.append(p.with_outline(np.column_stack([ring, z])))
     return out
+
+
+def find_ties(
+    images: Sequence[tuple[str, ArrayLike]],
+    camera: Camera,
+    eo: ExteriorOrientationTable,
+    height_m: float,
+    options=None,
+    progress: Callable[[float], None] | None = None,
+    should_stop: Callable[[], bool] | None = None,
+):
+    """Tie tracks between the images already in memory (issue 32, step 1): the chain of
+    :func:`.tie_points.tie_points` (features, pairs from the ground footprints of the
+    approximate orientation ``eo`` at ``height_m`` (mapping CRS, metres), matching, tracks,
+    least-squares refinement), each image converted to 8-bit grey once.
+
+    Returns the :class:`.tie_points.TiePointResult`; its ``observations()`` are rows of type
+    ``tie`` (pixels, per docs/conventions.md), ready for :func:`associate_ties`.
+    ``options`` is a :class:`.tie_options.TiePointOptions` (default: its defaults, refinement
+    on, pairs from the footprints). Images without a row in ``eo`` are refused by name.
+    """
+    from .tie_options import TiePointOptions
+    from .tie_pairs import footprints
+    from .tie_points import detect_features, tie_points
+
+    opt = options or TiePointOptions()
+    row = {iid: k for k, iid in enumerate(eo.image_id)}
+    missing = [iid for iid, _ in images if iid not in row]
+    if missing:
+        raise InputError(f"image(s) without an exterior orientation: {', '.join(missing[:5])}")
+    ids = [iid for iid, _ in images]
+    fps = footprints(camera, eo.xyz, eo.opk, float(height_m))
+    footprint = [fps[row[iid]] for iid in ids]
+    greys = [_grey8(img) for _, img in images]
+    for iid, g in zip(ids, greys):
+        if g.shape != (camera.height_px, camera.width_px):
+            raise InputError(f"image {iid} is {g.shape[1]} x {g.shape[0]} px, the camera "
+                             f"{camera.width_px} x {camera.height_px} px")  # fmt: skip
+
+    def load(k: int):
+        return detect_features(greys[k], ids[k], opt)
+
+    return tie_points(ids, load, opt, footprint, progress=progress, should_stop=should_stop,
+                      load_image=lambda k: greys[k])  # fmt: skip
+
+
+def _grey8(image: ArrayLike) -> NDArray[np.uint8]:
+    """8-bit grey of a grey or RGB(A) image (luminance of the first three bands); other than
+    8-bit images are stretched from their minimum to their maximum (features need contrast
+    only)."""
+    a = np.asarray(image)
+    eight = a.dtype == np.uint8
+    if a.ndim == 3:
+        a = a[..., :3].astype(np.float32) @ np.array([0.299, 0.587, 0.114], np.float32)
+    if a.ndim != 2:
+        raise InputError(f"image must be (H, W) or (H, W, 3), got shape {a.shape}")
+    if a.dtype == np.uint8:
+        return a
+    if not eight:
+        lo, hi = float(np.min(a)), float(np.max(a))
+        a = (a - lo) * (255.0 / (hi - lo if hi > lo else 1.0))
+    return np.clip(np.rint(a), 0, 255).astype(np.uint8)
 
 
 def _segment_distance(xy: Array, ring: Array) -> float:

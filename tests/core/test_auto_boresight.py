@@ -247,6 +247,37 @@ def test_point_three_degrees_off_recovered_without_hand_picks(block):
     assert len(errors) >= 30 and rms < 1.5 * gsd
 
 
+@pytest.mark.parametrize("extra", ["estimate_interior", "estimate_lever_arm", "estimate_timing"])
+def test_interior_lever_arm_or_timing_estimated_with_the_boresight(block, extra):
+    """The rendered flight with one more group of unknowns (the truth: the camera as rendered,
+    a zero lever arm, no timing offset; the trajectory has no velocities: they are differenced
+    from the two exposures of each line): the rounds converge, the boresight and the extra
+    unknowns lie within 3 of their sigmas of the truth, and the sigmas are finite."""
+    cam, frame, true_eo, traj, images, planes, lines, dsm = block
+    ties, _ = _ties(cam, true_eo, planes, np.random.default_rng(3))
+    out = auto_calibrate(traj, cam, Mount.from_parameters(), frame, images, planes, lines, ties,
+                         dsm, AutoBoresightOptions(search_deg=0.6),
+                         BoresightOptions(groups="single", **{extra: True}))  # fmt: skip
+    res = out.result
+    err = np.degrees(res.boresight[0]) - TRUTH_DEG
+    std = np.degrees(res.std[0])
+    assert out.converged and np.all(np.abs(err) < 3 * std), (err * 3600, std * 3600)
+    if extra == "estimate_interior":
+        got, sig = res.interior, res.interior_std
+        truth = np.array([cam.focal_mm, cam.x0_mm, cam.y0_mm])
+        assert res.lever_arm is None and res.timing_offset is None
+    elif extra == "estimate_lever_arm":
+        got, sig, truth = res.lever_arm, res.lever_arm_std, np.zeros(3)
+        assert res.interior is None and res.timing_offset is None
+    else:
+        got, sig, truth = np.array([res.timing_offset]), np.array([res.timing_offset_std]), 0.0
+        assert res.interior is None and res.lever_arm is None
+    print(extra, "error", got - truth, "sigma", sig, "boresight err arcsec",
+          np.round(err * 3600, 1), "std", np.round(std * 3600, 1))  # fmt: skip
+    assert np.all(np.isfinite(sig)) and np.all(sig > 0)
+    assert np.all(np.abs(got - truth) < 3 * sig), (got - truth, sig)
+
+
 def test_one_degree_off_converges_from_lines_alone(block):
     cam, frame, _true_eo, traj, images, planes, lines, _dsm = block
     start = Mount.from_parameters(boresight_deg=TRUTH_DEG + [-0.9, 0.8, -0.6])
@@ -426,6 +457,57 @@ def test_the_job_runs_from_files(block, files):
     assert "hand picks, group all" in page and "automatic minus hand" in page
     at = page.index("automatic minus hand")
     print(page[at - 200 : at + 80])
+
+
+def test_the_job_estimates_the_lever_arm_when_asked(block, files, tmp_path):
+    """ESTIMATE_LEVER_ARM (and the other two flags) reach the adjustment through the spec:
+    the lever arm is estimated and within 3 sigma of the truth (zero)."""
+    from lidarphoto.core.jobs import auto_boresight as job
+    from lidarphoto.core.jobs.runner import run_job
+    from lidarphoto.core.jobs.spec import options_from, parse_values
+
+    _, inputs = files
+    v = parse_values(job.SPEC, {**inputs, "ESTIMATE_INTERIOR": True, "ESTIMATE_TIMING": True})
+    opts = options_from(BoresightOptions, job.SPEC, v)
+    assert opts.estimate_interior and opts.estimate_timing and not opts.estimate_lever_arm
+    out = {"OUTPUT_TABLE": str(tmp_path / "b.csv"), "OUTPUT_EO": str(tmp_path / "e.csv"),
+           "OUTPUT_OBSERVATIONS": str(tmp_path / "o.csv"),
+           "OUTPUT_HTML": str(tmp_path / "r.html")}  # fmt: skip
+    res = run_job(job, {**inputs, "ESTIMATE_LEVER_ARM": True, **out}).data.result
+    assert res.lever_arm is not None and res.interior is None
+    assert np.all(np.abs(res.lever_arm) < 3 * res.lever_arm_std), (res.lever_arm,
+                                                                   res.lever_arm_std)
+
+
+def test_the_job_finds_the_tie_points_itself(files, tmp_path):
+    """No TIE_POINTS: the job runs the tie-point chain on the images (pairs from the
+    footprints, least-squares refinement), associates the tracks with the roof planes and
+    calibrates; FIND_TIES off leaves the lines alone. Progress reaches 1 and only rises."""
+    from lidarphoto.core.jobs import auto_boresight as job
+    from lidarphoto.core.jobs.runner import run_job
+
+    _, inputs = files
+    inputs = {**inputs, "TIE_POINTS": None}
+    out = {"OUTPUT_TABLE": str(tmp_path / "b.csv"), "OUTPUT_EO": str(tmp_path / "e.csv"),
+           "OUTPUT_OBSERVATIONS": str(tmp_path / "o.csv"),
+           "OUTPUT_HTML": str(tmp_path / "r.html")}  # fmt: skip
+    seen = []
+    got = run_job(job, {**inputs, **out}, progress=seen.append)
+    found = got.data
+    res = found.result
+    err = np.degrees(res.boresight[0]) - TRUTH_DEG
+    std = np.degrees(res.std[0])
+    last = found.rounds[-1]
+    print("ties found: tracks", last.tie_tracks, "associated", last.ties_associated,
+          "refused", last.ties_refused, "err arcsec", np.round(err * 3600, 1), "std",
+          np.round(std * 3600, 1))  # fmt: skip
+    assert last.tie_tracks > 0 and last.ties_associated > 0
+    assert got.results["TIES_ASSOCIATED"] == last.ties_associated
+    assert found.converged and np.all(np.abs(err) < 3 * std), (err * 3600, std * 3600)
+    assert "tie points found" in (tmp_path / "r.html").read_text()
+    assert seen and seen[-1] == pytest.approx(1.0) and np.all(np.diff(seen) >= -1e-12)
+    alone = run_job(job, {**inputs, "FIND_TIES": False, **out}).data
+    assert alone.rounds[-1].tie_tracks == 0 and alone.rounds[-1].ties_associated == 0
 
 
 def test_the_job_refuses_bad_inputs_by_name(files, tmp_path):
