@@ -3596,8 +3596,9 @@ are projected into every image with the trajectory, the mount and the approximat
 First an angle search (coarse to fine, within Search range of the approximate boresight)
 finds the boresight whose projected lines lie on the strongest image edges; then, in rounds,
 sub-pixel image edges are found along every projected line (the dock's edge refinement, within
-3 sigma of the projection's uncertainty) and, when tie points are given (the observation CSV
-of Automatic tie points), each tie track is intersected and kept as a point-to-plane tie of
+3 sigma of the projection's uncertainty) and each tie track (found between the images by
+the chain of Automatic tie points, pairs from the footprints and least-squares refinement on,
+or its observation CSV given as Tie points) is intersected and kept as a point-to-plane tie of
 the roof plane it lies on (inside the plane's outline, from the cloud's plane ids; off the
 borders; within a gate of 3 sigma of the pose and intersection uncertainty; not on a wall).
 Each round runs the rigorous calibration of Boresight calibration (line and tie models,
@@ -3610,12 +3611,14 @@ aproximado. Primeiro uma busca angular (do grosseiro ao fino, dentro do Interval
 torno do boresight aproximado) encontra o boresight cujas linhas projetadas caem sobre as bordas
 mais fortes da imagem; depois, em rodadas, bordas subpixel são encontradas ao longo de cada
 linha projetada (o refinamento de bordas do painel, dentro de 3 sigma da incerteza da projeção)
-e, quando pontos de enlace são dados (o CSV de observações de Pontos de enlace automáticos), cada
-trilha é intersectada e mantida como vínculo ponto-plano do plano de telhado onde está (dentro do
-contorno do plano, pelos ids de plano da nuvem; longe das bordas; dentro de uma janela de 3 sigma
-da incerteza da pose e da interseção; fora de paredes). Cada rodada executa a calibração rigorosa
-de Calibração de boresight (modelos de linha e de enlace, injunções do INS, data snooping) e
-inicia a seguinte a partir do seu resultado, até que cada ângulo mude menos que seu desvio-padrão.</translation>
+e cada trilha de pontos de enlace (encontrada entre as imagens pela cadeia de Pontos de enlace
+automáticos, pares pelas áreas de cobertura e refinamento por mínimos quadrados ativo, ou o seu
+CSV de observações dado como Pontos de enlace) é intersectada e mantida como vínculo ponto-plano
+do plano de telhado onde está (dentro do contorno do plano, pelos ids de plano da nuvem; longe
+das bordas; dentro de uma janela de 3 sigma da incerteza da pose e da interseção; fora de
+paredes). Cada rodada executa a calibração rigorosa de Calibração de boresight (modelos de linha
+e de enlace, injunções do INS, data snooping) e inicia a seguinte a partir do seu resultado, até
+que cada ângulo mude menos que seu desvio-padrão.</translation>
         </message>
         <message>
             <source>A scene with no sloped roof plane and fewer than two LiDAR line directions (flat ground,
@@ -3750,6 +3753,14 @@ configurações dão as contagens por rodada e os pontos de enlace recusados por
             <translation>a saída de Pontos de enlace automáticos</translation>
         </message>
         <message>
+            <source>Find tie points when none are given</source>
+            <translation>Encontrar pontos de enlace quando nenhum é dado</translation>
+        </message>
+        <message>
+            <source>without TIE_POINTS, and with PLANES and CLOUD, run Automatic tie points on the images (pairs from the footprints, least-squares refinement on)</source>
+            <translation>sem TIE_POINTS, e com PLANES e CLOUD, executa Pontos de enlace automáticos nas imagens (pares pelas áreas de cobertura, refinamento por mínimos quadrados ativo)</translation>
+        </message>
+        <message>
             <source>Hand picks to compare with (observation CSV)</source>
             <translation>Medições manuais para comparar (CSV de observações)</translation>
         </message>
@@ -3784,6 +3795,22 @@ configurações dão as contagens por rodada e os pontos de enlace recusados por
         <message>
             <source>one per heading direction (octant)</source>
             <translation>um por direção de rumo (octante)</translation>
+        </message>
+        <message>
+            <source>Estimate the lever arm</source>
+            <translation>Estimar o braço de alavanca</translation>
+        </message>
+        <message>
+            <source>Estimate focal length and principal point</source>
+            <translation>Estimar a distância focal e o ponto principal</translation>
+        </message>
+        <message>
+            <source>Estimate the camera timing offset</source>
+            <translation>Estimar o atraso de disparo da câmera</translation>
+        </message>
+        <message>
+            <source>a constant dt (exposure = recorded time + dt) from the trajectory's velocities (v_north, v_east, v_up columns, as Import trajectory writes them) or from neighbouring exposures of each line; with the lever arm it needs lines at clearly different speeds</source>
+            <translation>um dt constante (exposição = tempo registrado + dt) a partir das velocidades da trajetória (colunas v_north, v_east, v_up, como Importar trajetória as escreve) ou das exposições vizinhas de cada faixa; com o braço de alavanca exige faixas a velocidades claramente diferentes</translation>
         </message>
         <message>
             <source>INS grade</source>
@@ -3868,6 +3895,34 @@ configurações dão as contagens por rodada e os pontos de enlace recusados por
         <message>
             <source>Tie points on roof planes</source>
             <translation>Pontos de enlace nos planos de telhado</translation>
+        </message>
+        <message>
+            <source>Calibrates the camera-INS boresight from the images themselves, with no picked point. The
+LiDAR ridge, hip and valley lines (the line table of Create LiDAR control points and lines)
+are projected into every image with the trajectory, the mount and the approximate boresight.
+First an angle search (coarse to fine, within Search range of the approximate boresight)
+finds the boresight whose projected lines lie on the strongest image edges; then, in rounds,
+sub-pixel image edges are found along every projected line (the dock's edge refinement, within
+3 sigma of the projection's uncertainty) and, when tie points are given (the observation CSV
+of Automatic tie points), each tie track is intersected and kept as a point-to-plane tie of
+the roof plane it lies on (inside the plane's outline, from the cloud's plane ids; off the
+borders; within a gate of 3 sigma of the pose and intersection uncertainty; not on a wall).
+Each round runs the rigorous calibration of Boresight calibration (line and tie models,
+INS priors, data snooping) and starts the next from its result, until every angle changes
+by less than its standard deviation.</source>
+            <translation type="vanished">Calibra o boresight câmera-INS a partir das próprias imagens, sem nenhum ponto medido. As
+linhas LiDAR de cumeeira, espigão e rincão (a tabela de linhas de Criar pontos e linhas de
+controle LiDAR) são projetadas em cada imagem com a trajetória, a montagem e o boresight
+aproximado. Primeiro uma busca angular (do grosseiro ao fino, dentro do Intervalo de busca em
+torno do boresight aproximado) encontra o boresight cujas linhas projetadas caem sobre as bordas
+mais fortes da imagem; depois, em rodadas, bordas subpixel são encontradas ao longo de cada
+linha projetada (o refinamento de bordas do painel, dentro de 3 sigma da incerteza da projeção)
+e, quando pontos de enlace são dados (o CSV de observações de Pontos de enlace automáticos), cada
+trilha é intersectada e mantida como vínculo ponto-plano do plano de telhado onde está (dentro do
+contorno do plano, pelos ids de plano da nuvem; longe das bordas; dentro de uma janela de 3 sigma
+da incerteza da pose e da interseção; fora de paredes). Cada rodada executa a calibração rigorosa
+de Calibração de boresight (modelos de linha e de enlace, injunções do INS, data snooping) e
+inicia a seguinte a partir do seu resultado, até que cada ângulo mude menos que seu desvio-padrão.</translation>
         </message>
     </context>
     <context>
