@@ -18,6 +18,7 @@ from ..core.io.control import write_lines_csv
 from ..core.io.planes import write_planes_csv
 from ..core.jobs import auto_boresight
 from ..core.jobs.runner import JobResult
+from .calibration_task import flight_parameters
 from .job_task import JobController
 
 __all__ = ["AutoCalibrationController", "auto_calibration_parameters"]
@@ -31,12 +32,7 @@ def auto_calibration_parameters(
     the lines (and, with ``has_planes``, the planes) are written into ``out_dir``."""
     return {
         "IMAGES": list(images),
-        "CAMERA": settings["camera"],
-        "TRAJECTORY": settings["trajectory"],
-        "CRS": crs,
-        "LEVER_ARM": settings["lever_arm"],
-        "MOUNT": settings["mount"],
-        "BORESIGHT": settings["boresight"],
+        **flight_parameters(settings, crs),
         "LINES": str(out_dir / "control_lines.csv"),
         "PLANES": str(out_dir / "control_planes.csv") if has_planes else None,
         "OUTPUT_TABLE": str(out_dir / "boresight.csv"),

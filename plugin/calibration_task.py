@@ -19,10 +19,23 @@ from ..core.jobs import boresight_calibration
 from ..core.jobs.runner import JobResult
 from .job_task import JobController
 
-__all__ = ["CalibrationController", "calibration_parameters"]
+__all__ = ["CalibrationController", "calibration_parameters", "flight_parameters"]
 
 #: observation type -> the control list it needs ("paper" needs the cloud: not from the dock)
 _NEEDS = {"tie": 0, "line": 1, "lcp": 2}
+
+
+def flight_parameters(settings: dict, crs: str) -> dict:
+    """The parameters both calibrations of the dock share: the camera file, the Calibration
+    tab's trajectory, lever arm, mount and approximate boresight, the mapping CRS."""
+    return {
+        "CAMERA": settings["camera"],
+        "TRAJECTORY": settings["trajectory"],
+        "CRS": crs,
+        "LEVER_ARM": settings["lever_arm"],
+        "MOUNT": settings["mount"],
+        "BORESIGHT": settings["boresight"],
+    }
 
 
 def calibration_parameters(
@@ -49,12 +62,7 @@ def calibration_parameters(
     names = ("control_planes.csv", "control_lines.csv", "control_lcps.csv")
     tables = [str(out_dir / n) if items else None for n, items in zip(names, control)]
     return {
-        "CAMERA": settings["camera"],
-        "TRAJECTORY": settings["trajectory"],
-        "CRS": crs,
-        "LEVER_ARM": settings["lever_arm"],
-        "MOUNT": settings["mount"],
-        "BORESIGHT": settings["boresight"],
+        **flight_parameters(settings, crs),
         "OBSERVATIONS": str(observations),
         "PLANES": tables[0],
         "LINES": tables[1],

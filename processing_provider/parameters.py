@@ -374,21 +374,7 @@ def raster_file_list(p: Param, value, context) -> tuple[str, ...]:
         if layer is None:
             files.append(str(item))
             continue
-        path = layer_source_file(layer)
-        if not path or layer.providerType() != "gdal":
-            raise QgsProcessingException(
-                QCoreApplication.translate(
-                    "LidarPhotoProvider",
-                    "{name}: the layer {layer} is not backed by a {what} file ({source}); "
-                    "save it as one first",
-                ).format(
-                    name=p.name,
-                    layer=layer.name(),
-                    what=_file_format("raster"),
-                    source=layer.source(),
-                )
-            )
-        files.append(path)
+        files.append(kind_file(p.name, layer, "raster"))
     return tuple(files)
 
 
@@ -451,7 +437,13 @@ def layer_file(alg, p: Param, parameters: dict, context) -> str | None:
     layer = alg.parameterAsLayer(parameters, p.name, context)
     if layer is None:  # not a layer: the text as a path (the job names a missing file)
         return value if isinstance(value, str) and value else None
-    providers, endings = _LAYER_FILES[p.kind]
+    return kind_file(p.name, layer, p.kind)
+
+
+def kind_file(name: str, layer, kind: str) -> str:
+    """The file behind ``layer`` (:func:`layer_source_file`) when it is of the layer kind's
+    format; else QgsProcessingException naming the parameter ``name`` and the layer."""
+    providers, endings = _LAYER_FILES[kind]
     path = layer_source_file(layer)
     if (
         not path
@@ -463,8 +455,6 @@ def layer_file(alg, p: Param, parameters: dict, context) -> str | None:
                 "LidarPhotoProvider",
                 "{name}: the layer {layer} is not backed by a {what} file ({source}); "
                 "save it as one first",
-            ).format(
-                name=p.name, layer=layer.name(), what=_file_format(p.kind), source=layer.source()
-            )
+            ).format(name=name, layer=layer.name(), what=_file_format(kind), source=layer.source())
         )
     return path
