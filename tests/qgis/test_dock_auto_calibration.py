@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 from lidarphoto.core.geometry.frames import MappingFrame
 from lidarphoto.core.io.observations import read_observations_csv
 from lidarphoto.core.io.orientation import read_eo_csv, write_eo_csv
@@ -27,6 +28,14 @@ from qgis.PyQt.QtTest import QTest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "core"))
 from test_auto_boresight import CRS, TRUTH_DEG, block, files, lidar  # noqa: F401
+
+
+@pytest.fixture(autouse=True)
+def _clean_project(qgis_new_project):
+    """The line layer the dock reads is removed afterwards (later tests count the layers)."""
+    yield
+    QgsProject.instance().removeAllMapLayers()
+    QgsProject.instance().layerTreeRoot().removeAllChildren()
 
 
 def _wait(app, cond, timeout_s: float) -> bool:
