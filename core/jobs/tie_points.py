@@ -67,7 +67,10 @@ track's first-image measurement: the median of its track's refined sigmas.""",
         Param("EO", "table", "Exterior orientation (CSV) for pair selection", optional=True,
               file_filter=CSV_FILTER, help="with CAMERA: pairs from ground footprints"),
         Param("CAMERA", "file", "Camera (JSON)", optional=True,
-              file_filter="JSON files (*.json)"),
+              file_filter="JSON files (*.json)",
+              help="perspective or fisheye; with EO: pairs from ground footprints; a "
+              "fisheye camera is needed for fisheye images (their matches are verified on "
+              "the camera's rays)"),
         Param("CRS", "crs", "Mapping CRS of the EO", optional=True,
               help="the EO is checked against its area of use"),
         Param("HEIGHT", "number", "Mean terrain height", 0.0, unit="m", minimum=-1000.0,
@@ -188,7 +191,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         return detect_features(gray, ids[k], options, factor=dec, size_px=sizes[k])
 
     res = tie_points(ids, load, options, footprint, progress=progress, should_stop=should_stop,
-                     load_image=lambda k: read_gray(files[k], 1))  # fmt: skip
+                     load_image=lambda k: read_gray(files[k], 1), camera=camera)  # fmt: skip
     flat = [p for p in res.pairs if p.status.startswith("no parallax")]
     if flat:
         raise InputError("IMAGES: " + "; ".join(f"{ids[p.i]} and {ids[p.j]} show {p.status}"
@@ -213,21 +216,23 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
 
 def _footprints(v: Values, ids: list[str], options) -> tuple:
-    """(camera, the ground footprint of each image or None) with EO and CAMERA, else (None,
-    None); refused when only one is given or footprint pairs lack them."""
+    """(camera or None, the ground footprint of each image or None): the footprints with EO
+    and CAMERA; refused for EO without CAMERA or footprint pairs without both. The camera
+    may be perspective or fisheye (any projection of the registry)."""
     from ..errors import InputError
+    from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.orientation import read_eo_csv
     from ..photo.tie_pairs import footprints
 
-    if bool(v.eo) != bool(v.camera):
+    if v.eo and not v.camera:
         raise InputError("give both the exterior orientation and the camera (footprint pairs) "
                          "or neither")  # fmt: skip
+    camera = read_camera_json(v.camera, projections=PROJECTIONS) if v.camera else None
     if not v.eo:
         if options.pair_mode == "footprints":
             raise InputError("footprint pairs need EO and CAMERA")
-        return None, None
-    camera = read_camera_json(v.camera)
+        return camera, None
     eo = read_eo_csv(v.eo)
     _check_eo_coordinates(eo, v.crs, v.eo, v.height)
     row = {name: k for k, name in enumerate(eo.image_id)}
