@@ -21,9 +21,10 @@ def footprints(
     camera: Camera, xyz: Array, opk: Array, height_m: float, max_range_factor: float = 10.0
 ) -> list[Array]:
     """Ground footprint of each image: its four corners' rays met with Z = ``height_m``
-    (a fisheye camera: the convex hull of 16 points per image side, its border being
-    curved on the ground; a ray that cannot reach the plane, e.g. beyond 90 degrees off a
-    nadir axis, is cut as below).
+    (a fisheye camera: the convex hull of 64 points per image side, its border being
+    curved on the ground, a point outside the projection's field moved in to its edge; a
+    ray that cannot reach the plane, e.g. beyond 90 degrees off a nadir axis, is cut as
+    below).
 
     The mapping frame is taken as Cartesian over one image (good enough to choose pairs:
     the footprints are compared with a tolerance, ``min_overlap``). A corner ray that does
@@ -52,7 +53,7 @@ def footprints(
     w, h = camera.width_px, camera.height_px
     corners = np.array([[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]])
     if not camera.is_perspective:
-        corners = _border(w, h)
+        corners = _within_field(camera, _border(w, h))
     out = []
     for x, a in zip(np.asarray(xyz, float), np.asarray(opk, float)):
         o, d = image_rays(corners, np.concatenate([x, a]), camera)
@@ -67,7 +68,7 @@ def footprints(
 
 
 #: Points per image side of a fisheye footprint (its border is curved on the ground).
-FISHEYE_BORDER_POINTS = 16
+FISHEYE_BORDER_POINTS = 64
 
 
 def _border(w: int, h: int, n: int = FISHEYE_BORDER_POINTS) -> Array:
@@ -77,6 +78,27 @@ def _border(w: int, h: int, n: int = FISHEYE_BORDER_POINTS) -> Array:
                       np.column_stack([np.full(n, float(w)), s * h]),
                       np.column_stack([(1 - s) * w, np.full(n, float(h))]),
                       np.column_stack([np.zeros(n), (1 - s) * h])])  # fmt: skip
+
+
+def _within_field(camera: Camera, px: Array, steps: int = 64) -> Array:
+    """Pixels ``px`` of the border, each one outside the projection's field (a circular
+    fisheye image's corners) moved towards the principal point until it has a ray (the
+    largest of ``steps`` equal fractions of its distance that does)."""
+    pp = np.asarray(camera.principal_point_px, np.float64)
+    out = np.array(px, np.float64)
+
+    def valid(p: Array) -> NDArray[np.bool_]:
+        return np.all(np.isfinite(camera.ray_from_ideal(camera.ideal_from_pixel(p))), axis=1)
+
+    bad = np.flatnonzero(~valid(out))
+    for s in np.arange(steps - 1, 0, -1) / steps:
+        if bad.size == 0:
+            break
+        trial = pp + s * (px[bad] - pp)
+        ok = valid(trial)
+        out[bad[ok]] = trial[ok]
+        bad = bad[~ok]
+    return out
 
 
 def _hull(p: Array) -> Array:

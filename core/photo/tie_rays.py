@@ -43,8 +43,15 @@ from ..geometry.rotations import opk_to_matrix, skew
 
 Array = NDArray[np.float64]
 
-__all__ = ["MAX_RANSAC_ANGLE_DEG", "KeypointRays", "essential_from_rays", "keypoint_rays",
-           "fit_essential", "ray_epipolar_px", "refine_essential"]  # fmt: skip
+__all__ = [
+    "MAX_RANSAC_ANGLE_DEG",
+    "KeypointRays",
+    "essential_from_rays",
+    "fit_essential",
+    "keypoint_rays",
+    "ray_epipolar_px",
+    "refine_essential",
+]  # fmt: skip
 
 #: Rays further off the axis (degrees) take no part in the essential-matrix hypothesis: their
 #: normalised coordinates grow without bound towards 90 degrees.
