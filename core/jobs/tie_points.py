@@ -33,8 +33,9 @@ scaled back to full-resolution pixels. SIFT keeps the Features per image of the 
 scales (Keypoints kept) among the extrema above its Contrast threshold.
 
 Pairs: with an exterior orientation and a camera, the pairs whose ground footprints (image
-corners met with the plane at Mean terrain height) overlap by at least Minimum overlap of the
-smaller footprint; without them, each image with the next Window images in file-name order
+corners met with the plane at Mean terrain height; a fisheye image: the convex hull of 64
+points a side of its border, a ray that misses the plane cut at 10 flying heights) overlap
+by at least Minimum overlap of the smaller footprint; without them, each image with the next Window images in file-name order
 (sequential), or all pairs. An image the EO table lacks is paired with every image.
 
 Matching: nearest neighbours in descriptor space (FLANN k-d trees for SIFT, Muja & Lowe 2009;
@@ -47,6 +48,15 @@ inliers are dropped (the pair table gives the reason). Tracks: the matches of al
 merged (connected components; keypoints of one image at one position, SIFT's orientations of
 one extremum, count as one); a track holding two different points of one image is dropped,
 as are tracks seen in fewer than Minimum track length images.
+
+Fisheye images (a CAMERA with a fisheye projection, Brown correction included; needed for
+them, with or without EO): the fundamental matrix holds between perspective images only, so
+the keypoints become the camera's rays and the RANSAC (the threshold in the same pixels) runs
+on the essential matrix of the rays within 75 degrees of the axis (Nister 2004), refined by
+least squares on the distances to the epipolar curves in pixels; the guided matching follows
+those curves. Simulated fisheye blocks (corners 62 degrees off the axis): refined
+measurements 0.025-0.028 px from the truth in the median; the fundamental matrix on the raw
+pixels keeps 77-80 % of the matches, under half of those beyond 400 px from the centre.
 
 Refinement (on by default; unticked, the keypoints are written as detected): least-squares
 matching (Gruen 1985, 6 affine + 2 radiometric parameters) of every measurement of a track
@@ -156,7 +166,7 @@ track's first-image measurement: the median of its track's refined sigmas.""",
           "least-squares matching"),
     references=("Lowe (2004)", "Fischler & Bolles (1981)", "Rublee et al. (2011)",
                 "Muja & Lowe (2009)", "Barath et al. (2020)", "Gruen (1985)",
-                "Arandjelovic & Zisserman (2012)"),
+                "Arandjelovic & Zisserman (2012)", "Nister (2004)"),
 )  # fmt: skip
 
 

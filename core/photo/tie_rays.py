@@ -6,7 +6,7 @@ of :mod:`core.geometry.projection`, with its lens correction) the epipolar "line
 The keypoints of a fisheye image are therefore turned into unit rays of the camera frame
 (x right, y up, the camera looks along -z) with the camera's own inverse projection
 (:meth:`Camera.ideal_from_pixel`, :meth:`Camera.ray_from_ideal`); two rays of one ground point
-satisfy ``b^T E a = 0`` with the essential matrix ``E`` (Hartley & Zisserman 2004, 9.6).
+satisfy ``b^T E a = 0`` with the essential matrix ``E``.
 
 - **Hypothesis**: OpenCV's essential-matrix RANSAC (MAGSAC++ or RANSAC, the five-point
   solver; Nister 2004) on the normalised coordinates ``(u, v) / -w`` of the rays less than
@@ -187,7 +187,7 @@ def refine_essential(e: Array, ra: KeypointRays, ia: NDArray[np.intp], rb: Keypo
                      ib: NDArray[np.intp]) -> Array:  # fmt: skip
     """``e`` refined by least squares on the epipolar distances (pixels) of the matches
     ``ia``, ``ib`` (its inliers): ``E = [t]x R``, R turned by three small angles, the unit
-    baseline t by two (Hartley & Zisserman 2004, 9.6.2); ``e`` itself when fewer than 8
+    baseline t by two; ``e`` itself when fewer than 8
     finite matches are given or the fit does not lower the sum of squares.
 
     >>> from lidarphoto.core.geometry.projection import ideal_from_camera
