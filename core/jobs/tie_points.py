@@ -35,8 +35,9 @@ scales (Keypoints kept) among the extrema above its Contrast threshold.
 Pairs: with an exterior orientation and a camera, the pairs whose ground footprints (image
 corners met with the plane at Mean terrain height; a fisheye image: the convex hull of 64
 points a side of its border, a ray that misses the plane cut at 10 flying heights) overlap
-by at least Minimum overlap of the smaller footprint; without them, each image with the next Window images in file-name order
-(sequential), or all pairs. An image the EO table lacks is paired with every image.
+by at least Minimum overlap of the smaller footprint; without them, each image with the
+next Window images in file-name order (sequential), or all pairs. An image the EO table
+lacks is paired with every image.
 
 Matching: nearest neighbours in descriptor space (FLANN k-d trees for SIFT, Muja & Lowe 2009;
 brute force for ORB), Lowe's ratio test, a mutual check, then RANSAC on the fundamental
