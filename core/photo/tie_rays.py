@@ -130,16 +130,7 @@ def ray_epipolar_px(e: Array, ra: KeypointRays, ia: NDArray[np.intp], rb: Keypoi
     >>> float(ray_epipolar_px(e, ka, i, kb, i)[0].round(4))  # and 0.5076 px off its curve in a
     0.5038
     """
-    a, b = ra.rays[ia], rb.rays[ib]
-    ea = a @ e.T  # E a: the epipolar plane's normal in b
-    eb = b @ e  # E^T b: in a
-    c = np.sum(b * ea, axis=1)
-    ga = np.einsum("nk,nkj->nj", eb, ra.jac[ia])
-    gb = np.einsum("nk,nkj->nj", ea, rb.jac[ib])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        da = np.abs(c) / np.hypot(ga[:, 0], ga[:, 1])
-        db = np.abs(c) / np.hypot(gb[:, 0], gb[:, 1])
-    return 0.5 * (da + db)
+    return np.abs(_signed_px(e, ra.rays[ia], ra.jac[ia], rb.rays[ib], rb.jac[ib]))
 
 
 def essential_from_rays(ra: KeypointRays, ia: NDArray[np.intp], rb: KeypointRays,
@@ -173,9 +164,10 @@ def essential_from_rays(ra: KeypointRays, ia: NDArray[np.intp], rb: KeypointRays
 
 
 def _signed_px(e: Array, a: Array, ja: Array, b: Array, jb: Array) -> Array:
-    """Signed first-order epipolar distance (pixels, mean of the two images) of rays."""
-    ea = a @ e.T
-    eb = b @ e
+    """Signed first-order epipolar distance (pixels, mean of the two images) of rays ``a``,
+    ``b`` (N, 3) whose Jacobians by the pixel are ``ja``, ``jb`` (N, 3, 2)."""
+    ea = a @ e.T  # E a: the epipolar plane's normal in b
+    eb = b @ e  # E^T b: in a
     c = np.sum(b * ea, axis=1)
     ga = np.einsum("nk,nkj->nj", eb, ja)
     gb = np.einsum("nk,nkj->nj", ea, jb)
