@@ -36,7 +36,7 @@ the last row held in the plane Z = 0).
 Outputs: the camera JSON (a fisheye camera is taken by control chips, orthorectify (and so
 the orthomosaic), monoplot, the bundle adjustment (self-calibrating its lens), the resection
 (from control points; its straight lines stay perspective-only) and the tie points (verified
-on the camera's rays: 0.025-0.028 px from the truth, refined, on simulated fisheye blocks),
+on the camera's rays: 0.021-0.033 px from the truth, refined, on simulated fisheye blocks),
 the equidistant one by the COLMAP export; the algorithms still perspective-only refuse it by
 name: boresight calibration, control point location), a report JSON (sigmas, correlations,
 sigma0, the t-test of every lens coefficient, per-view RMS and poses), the same as an HTML
