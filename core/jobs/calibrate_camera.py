@@ -34,10 +34,11 @@ held at their nominal coordinates, which sets the scale from the square size, an
 the last row held in the plane Z = 0).
 
 Outputs: the camera JSON (a fisheye camera is taken by control chips, orthorectify (and so
-the orthomosaic), monoplot, the bundle adjustment (self-calibrating its lens) and the
-resection (from control points; its straight lines stay perspective-only), the equidistant
-one by the COLMAP export; the algorithms still perspective-only refuse it by name: boresight
-calibration, tie points, control point location), a report JSON (sigmas, correlations,
+the orthomosaic), monoplot, the bundle adjustment (self-calibrating its lens), the resection
+(from control points; its straight lines stay perspective-only) and the tie points (verified
+on the camera's rays: 0.021-0.033 px from the truth, refined, on simulated fisheye blocks),
+the equidistant one by the COLMAP export; the algorithms still perspective-only refuse it by
+name: boresight calibration, control point location), a report JSON (sigmas, correlations,
 sigma0, the t-test of every lens coefficient, per-view RMS and poses), the same as an HTML
 page, and the residual table (CSV). PIXEL_SIZE only scales the millimetre values of the
 camera file: the calibration itself is in pixels.""",

@@ -33,9 +33,11 @@ scaled back to full-resolution pixels. SIFT keeps the Features per image of the 
 scales (Keypoints kept) among the extrema above its Contrast threshold.
 
 Pairs: with an exterior orientation and a camera, the pairs whose ground footprints (image
-corners met with the plane at Mean terrain height) overlap by at least Minimum overlap of the
-smaller footprint; without them, each image with the next Window images in file-name order
-(sequential), or all pairs. An image the EO table lacks is paired with every image.
+corners met with the plane at Mean terrain height; a fisheye image: the convex hull of 64
+points a side of its border, a ray that misses the plane cut at 10 flying heights) overlap
+by at least Minimum overlap of the smaller footprint; without them, each image with the
+next Window images in file-name order (sequential), or all pairs. An image the EO table
+lacks is paired with every image.
 
 Matching: nearest neighbours in descriptor space (FLANN k-d trees for SIFT, Muja & Lowe 2009;
 brute force for ORB), Lowe's ratio test, a mutual check, then RANSAC on the fundamental
@@ -47,6 +49,16 @@ inliers are dropped (the pair table gives the reason). Tracks: the matches of al
 merged (connected components; keypoints of one image at one position, SIFT's orientations of
 one extremum, count as one); a track holding two different points of one image is dropped,
 as are tracks seen in fewer than Minimum track length images.
+
+Fisheye images (a CAMERA with a fisheye projection, Brown correction included; needed for
+them, with or without EO): the fundamental matrix holds between perspective images only, so
+the keypoints become the camera's rays and the RANSAC (the threshold in the same pixels) runs
+on the essential matrix of the rays within 75 degrees of the axis (Nister 2004), refined by
+least squares on the distances to the epipolar curves in pixels; the guided matching follows
+those curves. Simulated blocks of the four fisheye projections (corners 62-65 degrees off
+the axis): refined measurements 0.021-0.033 px from the truth in the median; the fundamental
+matrix on the raw pixels keeps 77-85 % of the matches, 37-52 % of those beyond 400 px from
+the centre.
 
 Refinement (on by default; unticked, the keypoints are written as detected): least-squares
 matching (Gruen 1985, 6 affine + 2 radiometric parameters) of every measurement of a track
@@ -67,7 +79,10 @@ track's first-image measurement: the median of its track's refined sigmas.""",
         Param("EO", "table", "Exterior orientation (CSV) for pair selection", optional=True,
               file_filter=CSV_FILTER, help="with CAMERA: pairs from ground footprints"),
         Param("CAMERA", "file", "Camera (JSON)", optional=True,
-              file_filter="JSON files (*.json)"),
+              file_filter="JSON files (*.json)",
+              help="perspective or fisheye; with EO: pairs from ground footprints; a "
+              "fisheye camera is needed for fisheye images (their matches are verified on "
+              "the camera's rays)"),
         Param("CRS", "crs", "Mapping CRS of the EO", optional=True,
               help="the EO is checked against its area of use"),
         Param("HEIGHT", "number", "Mean terrain height", 0.0, unit="m", minimum=-1000.0,
@@ -153,7 +168,7 @@ track's first-image measurement: the median of its track's refined sigmas.""",
           "least-squares matching"),
     references=("Lowe (2004)", "Fischler & Bolles (1981)", "Rublee et al. (2011)",
                 "Muja & Lowe (2009)", "Barath et al. (2020)", "Gruen (1985)",
-                "Arandjelovic & Zisserman (2012)"),
+                "Arandjelovic & Zisserman (2012)", "Nister (2004)"),
 )  # fmt: skip
 
 
@@ -188,7 +203,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         return detect_features(gray, ids[k], options, factor=dec, size_px=sizes[k])
 
     res = tie_points(ids, load, options, footprint, progress=progress, should_stop=should_stop,
-                     load_image=lambda k: read_gray(files[k], 1))  # fmt: skip
+                     load_image=lambda k: read_gray(files[k], 1), camera=camera)  # fmt: skip
     flat = [p for p in res.pairs if p.status.startswith("no parallax")]
     if flat:
         raise InputError("IMAGES: " + "; ".join(f"{ids[p.i]} and {ids[p.j]} show {p.status}"
@@ -213,21 +228,23 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
 
 def _footprints(v: Values, ids: list[str], options) -> tuple:
-    """(camera, the ground footprint of each image or None) with EO and CAMERA, else (None,
-    None); refused when only one is given or footprint pairs lack them."""
+    """(camera or None, the ground footprint of each image or None): the footprints with EO
+    and CAMERA; refused for EO without CAMERA or footprint pairs without both. The camera
+    may be perspective or fisheye (any projection of the registry)."""
     from ..errors import InputError
+    from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.orientation import read_eo_csv
     from ..photo.tie_pairs import footprints
 
-    if bool(v.eo) != bool(v.camera):
+    if v.eo and not v.camera:
         raise InputError("give both the exterior orientation and the camera (footprint pairs) "
                          "or neither")  # fmt: skip
+    camera = read_camera_json(v.camera, projections=PROJECTIONS) if v.camera else None
     if not v.eo:
         if options.pair_mode == "footprints":
             raise InputError("footprint pairs need EO and CAMERA")
-        return None, None
-    camera = read_camera_json(v.camera)
+        return camera, None
     eo = read_eo_csv(v.eo)
     _check_eo_coordinates(eo, v.crs, v.eo, v.height)
     row = {name: k for k, name in enumerate(eo.image_id)}

@@ -20,7 +20,11 @@ Array = NDArray[np.float64]
 def footprints(
     camera: Camera, xyz: Array, opk: Array, height_m: float, max_range_factor: float = 10.0
 ) -> list[Array]:
-    """Ground footprint of each image: its four corners' rays met with Z = ``height_m``.
+    """Ground footprint of each image: its four corners' rays met with Z = ``height_m``
+    (a fisheye camera: the convex hull of 64 points per image side, its border being
+    curved on the ground, a point outside the projection's field moved in to its edge; a
+    ray that cannot reach the plane, e.g. beyond 90 degrees off a nadir axis, is cut as
+    below).
 
     The mapping frame is taken as Cartesian over one image (good enough to choose pairs:
     the footprints are compared with a tolerance, ``min_overlap``). A corner ray that does
@@ -37,7 +41,7 @@ def footprints(
     -------
     list of (4, 2) arrays
         Easting, northing of the corners (image order: top-left, top-right, bottom-right,
-        bottom-left).
+        bottom-left); a fisheye camera's: (K, 2), its convex hull counter-clockwise.
 
     Examples
     --------
@@ -48,6 +52,8 @@ def footprints(
     """
     w, h = camera.width_px, camera.height_px
     corners = np.array([[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]])
+    if not camera.is_perspective:
+        corners = _within_field(camera, _border(w, h))
     out = []
     for x, a in zip(np.asarray(xyz, float), np.asarray(opk, float)):
         o, d = image_rays(corners, np.concatenate([x, a]), camera)
@@ -56,8 +62,70 @@ def footprints(
             t = (height_m - o[:, 2]) / d[:, 2]
         t = np.where((t > 0) & np.isfinite(t), t, np.inf)
         t = np.minimum(t, max_range_factor * abs(depth))
-        out.append(o[:, :2] + t[:, None] * d[:, :2])
+        ground = o[:, :2] + t[:, None] * d[:, :2]
+        out.append(ground if camera.is_perspective else _hull(ground))
     return out
+
+
+#: Points per image side of a fisheye footprint (its border is curved on the ground).
+FISHEYE_BORDER_POINTS = 64
+
+
+def _border(w: int, h: int, n: int = FISHEYE_BORDER_POINTS) -> Array:
+    """``4 n`` pixels along the image border, clockwise from the top-left corner."""
+    s = np.arange(n) / n
+    return np.vstack([np.column_stack([s * w, np.zeros(n)]),
+                      np.column_stack([np.full(n, float(w)), s * h]),
+                      np.column_stack([(1 - s) * w, np.full(n, float(h))]),
+                      np.column_stack([np.zeros(n), (1 - s) * h])])  # fmt: skip
+
+
+def _within_field(camera: Camera, px: Array, steps: int = 64) -> Array:
+    """Pixels ``px`` of the border, each one outside the projection's field (a circular
+    fisheye image's corners) moved towards the principal point until it has a ray (the
+    largest of ``steps`` equal fractions of its distance that does)."""
+    pp = np.asarray(camera.principal_point_px, np.float64)
+    out = np.array(px, np.float64)
+
+    def valid(p: Array) -> NDArray[np.bool_]:
+        return np.all(np.isfinite(camera.ray_from_ideal(camera.ideal_from_pixel(p))), axis=1)
+
+    bad = np.flatnonzero(~valid(out))
+    for s in np.arange(steps - 1, 0, -1) / steps:
+        if bad.size == 0:
+            break
+        trial = pp + s * (px[bad] - pp)
+        ok = valid(trial)
+        out[bad[ok]] = trial[ok]
+        bad = bad[~ok]
+    return out
+
+
+def _hull(p: Array) -> Array:
+    """Convex hull (counter-clockwise, Andrew's monotone chain) of the finite points: the
+    footprint of a fisheye image, whose border bulges out towards the corners on the ground
+    (a hull slightly larger than the footprint chooses a pair more, never one less).
+
+    >>> _hull(np.array([[0, 0], [2, 0], [1, 0.5], [2, 2], [0, 2], [np.nan, 1]])).tolist()
+    [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]
+    """
+    q = p[np.all(np.isfinite(p), axis=1)]
+    q = q[np.lexsort((q[:, 1], q[:, 0]))]
+    if len(q) < 3:
+        return q
+
+    def half(points: Array) -> list:
+        chain: list = []
+        for pt in points:
+            while len(chain) >= 2 and ((chain[-1][0] - chain[-2][0]) * (pt[1] - chain[-2][1])
+                                       - (chain[-1][1] - chain[-2][1]) * (pt[0] - chain[-2][0])
+                                       ) <= 0:  # fmt: skip
+                chain.pop()
+            chain.append(pt)
+        return chain
+
+    lower, upper = half(q), half(q[::-1])
+    return np.array(lower[:-1] + upper[:-1], dtype=np.float64)
 
 
 def _clip(subject: Array, clip: Array) -> Array:

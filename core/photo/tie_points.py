@@ -46,9 +46,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import InputError, stop_if_asked
+from ..geometry.camera import Camera
 from .tie_data import ImageFeatures, PairMatch
 from .tie_options import DETECTORS, PAIR_MODES, RANSAC_METHODS, TiePointOptions
 from .tie_pairs import select_pairs
+from .tie_rays import KeypointRays, fit_essential, keypoint_rays, ray_epipolar_px
 from .tie_refine import RefineStats, refine_tracks
 from .tie_tracks import Tracks, build_tracks
 
@@ -293,11 +295,14 @@ def match_pair(
     i: int = 0,
     j: int = 1,
     overlap: float = math.nan,
+    rays: tuple[KeypointRays, KeypointRays] | None = None,
 ) -> PairMatch:
     """Ratio test, mutual check and fundamental-matrix RANSAC between two images.
 
     The RANSAC works on the project pixel coordinates (full resolution) with a fixed seed
-    (OpenCV's), so a run is repeatable.
+    (OpenCV's), so a run is repeatable. ``rays``: the keypoints' camera rays of a fisheye
+    camera (:func:`~core.photo.tie_rays.keypoint_rays`): the essential matrix on the rays
+    instead, distances in pixels along the epipolar curves (:mod:`core.photo.tie_rays`).
     """
     import cv2
 
@@ -339,20 +344,36 @@ def match_pair(
     if shift < NO_PARALLAX_PX:  # the same view twice: no geometry to find
         return drop(f"no parallax (median shift {shift:.2f} px over {n_mutual} matches)",
                     n_ratio, n_mutual)  # fmt: skip
-    method = cv2.USAC_MAGSAC if options.ransac_method == "magsac" else cv2.FM_RANSAC
-    cv2.setRNGSeed(12345)
-    try:
-        f, mask = cv2.findFundamentalMat(pa, pb, method, float(options.ransac_px), 0.999, 10000)
-    except cv2.error:
-        f, mask = None, None
-    if f is None or mask is None or f.shape != (3, 3):
-        return drop("no fundamental matrix found (RANSAC failed)", n_ratio, n_mutual)
-    inl = mask.ravel().astype(bool)
+    if rays is None:
+        method = cv2.USAC_MAGSAC if options.ransac_method == "magsac" else cv2.FM_RANSAC
+        cv2.setRNGSeed(12345)
+        try:
+            f, mask = cv2.findFundamentalMat(pa, pb, method, float(options.ransac_px), 0.999,
+                                             10000)  # fmt: skip
+        except cv2.error:
+            f, mask = None, None
+        if f is None or mask is None or f.shape != (3, 3):
+            return drop("no fundamental matrix found (RANSAC failed)", n_ratio, n_mutual)
+        inl = mask.ravel().astype(bool)
+
+        def distance(ka: NDArray[np.intp], kb: NDArray[np.intp]) -> Array:
+            return epipolar_distances(f, fa.pixels[ka], fb.pixels[kb])
+    else:
+        ra, rb = rays
+        e = fit_essential(ra, ia, rb, ib, options.ransac_px, options.ransac_method)
+        if e is None:
+            return drop("no essential matrix found (RANSAC failed)", n_ratio, n_mutual)
+
+        def distance(ka: NDArray[np.intp], kb: NDArray[np.intp]) -> Array:
+            return ray_epipolar_px(e, ra, ka, rb, kb)
+
+        with np.errstate(invalid="ignore"):
+            inl = distance(ia, ib) <= options.ransac_px
     ka, kb = ia[inl], ib[inl]
     if guided and ka.size >= options.min_inliers:
-        ka, kb = _guided(near, dist, fa.pixels, fb.pixels, f, options, ka, kb)
+        ka, kb = _guided(near, dist, distance, options, ka, kb)
     pa, pb = fa.pixels[ka], fb.pixels[kb]
-    res = epipolar_distances(f, pa, pb)
+    res = distance(ka, kb)
     # MAGSAC's mask is its own weighting: keep the hard threshold as well
     sel = np.flatnonzero(np.isfinite(res) & (res <= options.ransac_px))
     if options.coherence > 0 and sel.size > _NEIGHBOURS:
@@ -371,10 +392,12 @@ def match_pair(
 _GUIDED_K = 8
 
 
-def _guided(idx: NDArray[np.intp], dist: Array, xa: Array, xb: Array, f: Array,
+def _guided(idx: NDArray[np.intp], dist: Array,
+            distance: Callable[[NDArray[np.intp], NDArray[np.intp]], Array],
             options: TiePointOptions, ka: NDArray[np.intp],
             kb: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:  # fmt: skip
-    """Guided matching along the epipolar lines of ``f`` (pixels ``xa``, ``xb``; ``idx``,
+    """Guided matching along the epipolar lines (``distance(ka, kb)``: the epipolar distance
+    of keypoints ``ka`` of a and ``kb`` of b, pixels; ``idx``,
     ``dist``: the descriptor neighbours in b of every keypoint of a, from :func:`_knn_k`):
     each keypoint of a takes its nearest descriptor among the ``_GUIDED_K`` nearest of b that lie
     within ``ransac_px`` of its epipolar line, if that one is below ``ratio`` times the next
@@ -386,8 +409,9 @@ def _guided(idx: NDArray[np.intp], dist: Array, xa: Array, xb: Array, f: Array,
     ra = np.repeat(np.arange(n), k)
     valid = idx.ravel() >= 0
     e = np.full(n * k, np.inf)
-    e[valid] = epipolar_distances(f, xa[ra[valid]], xb[idx.ravel()[valid]])
-    near = (e <= options.ransac_px).reshape(n, k)
+    e[valid] = distance(ra[valid], idx.ravel()[valid])
+    with np.errstate(invalid="ignore"):
+        near = (e <= options.ransac_px).reshape(n, k)
     d = np.where(near, dist, np.inf)
     order = np.argsort(d, axis=1, kind="stable")[:, :2]
     first = np.take_along_axis(d, order[:, :1], 1)[:, 0]
@@ -542,6 +566,7 @@ def tie_points(
     should_stop: Callable[[], bool] | None = None,
     on_features: Callable[[ImageFeatures], None] | None = None,
     load_image: Callable[[int], NDArray] | None = None,
+    camera: Camera | None = None,
 ) -> TiePointResult:
     """The whole chain (module docstring).
 
@@ -559,16 +584,25 @@ def tie_points(
         0.4..0.8, refinement 0.8..1); cancellation per image and pair.
     load_image : callable, optional
         ``load_image(k)``: the full-resolution grey image ``k``, for ``options.refine``.
+    camera : Camera, optional
+        The camera of every image (full-resolution pixels). A fisheye one (any projection
+        but ``perspective``) is verified on its rays (:mod:`core.photo.tie_rays`); without a
+        camera, or with a perspective one, by the fundamental matrix on the pixels.
     """
     if options.refine and load_image is None:
         raise InputError("the least-squares refinement needs the images (load_image)")
     share = (0.4, 0.8) if options.refine else (0.5, 1.0)
     n = len(image_ids)
     feats: list[ImageFeatures] = []
+    fisheye = camera is not None and not camera.is_perspective
+    rays: list[KeypointRays] = []
     for k in range(n):
         stop_if_asked(should_stop, f"detecting features ({image_ids[k]})")
         f = load(k)
         feats.append(f)
+        if fisheye:
+            assert camera is not None
+            rays.append(keypoint_rays(camera, f.pixels))
         if on_features is not None:
             on_features(f)
         if progress is not None:
@@ -581,7 +615,8 @@ def tie_points(
     for m, (i, j) in enumerate(pairs):
         stop_if_asked(should_stop, f"matching {image_ids[i]} with {image_ids[j]}")
         results.append(match_pair(feats[i], feats[j], options, i, j,
-                                  overlap.get((i, j), math.nan)))  # fmt: skip
+                                  overlap.get((i, j), math.nan),
+                                  (rays[i], rays[j]) if fisheye else None))  # fmt: skip
         if progress is not None:
             progress(share[0] + (share[1] - share[0]) * (m + 1) / max(len(pairs), 1))
     tracks = build_tracks(feats, results, options.min_track_length)
@@ -593,7 +628,8 @@ def tie_points(
         sigma = 0.5 * np.asarray(factors, float)[tracks.image] if tracks.track.size else np.zeros(0)
     stats = None
     if options.refine:
-        del feats[:]  # the descriptors are not needed any more: free them before the images
+        # the descriptors are not needed any more: free them before the images
+        del feats[:], rays[:]
         sub = None if progress is None else (lambda x: progress(share[1] + (1 - share[1]) * x))
         tracks, sigma, stats = refine_tracks(tracks, sigma, n, load_image, options,
                                              progress=sub, should_stop=should_stop)  # fmt: skip
