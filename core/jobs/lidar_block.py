@@ -306,8 +306,6 @@ def run_block(
             "seconds": time.perf_counter() - t0}  # fmt: skip
 
 
-
-
 def settings_from(v: Values, info) -> BlockSettings:
     """Science parameters in the cloud's units, the buffers from their rule."""
     import numpy as np

@@ -22,7 +22,6 @@ if TYPE_CHECKING:
 ROOF_SCRATCH = ".roof_points"
 
 
-
 @dataclass(frozen=True)
 class BlockSettings:
     """What every tile task needs (picklable; lengths in the cloud's units)."""
@@ -159,7 +158,6 @@ def control_tile(box, planes, points, plane_ids, options: ControlOptions):
     lcps = [p for p in res.points
             if box[0] <= p.xyz[0] < box[2] and box[1] <= p.xyz[1] < box[3]]  # fmt: skip
     return lcps, res.lines
-
 
 
 def _scratch_fetch(folder: str) -> Callable[[tuple[float, float, float, float]], Any]:
