@@ -38,6 +38,7 @@ from ..errors import InputError, stop_if_asked, use_compiled
 from .surface import Dsm
 
 Array = NDArray[np.float64]
+Bools = NDArray[np.bool_]
 
 STATUS_OK = 0
 STATUS_GRAZING = 1
@@ -240,6 +241,42 @@ def _slab(p0: Array, dp: Array, lo: float, hi: float) -> tuple[Array, Array]:
     return near, far
 
 
+def _slabs(tr: DsmTracer, start: tuple, step: tuple, rows: int, cols: int) -> tuple[Array, Array]:
+    """(t_lo, t_hi) of the rays ``start + t step`` (lattice u, v and height z) inside the
+    grid's footprint and its height range (empty where t_lo > t_hi)."""
+    (u0, v0, z0), (du, dv, dz) = start, step
+    n = u0.shape[0]
+    t_lo, t_hi = np.zeros(n), np.full(n, np.inf)
+    margin = 1e-6 * max(1.0, abs(tr.zmax), abs(tr.zmin))
+    for p0, dp, lo, hi in (
+        (u0, du, 0.0, cols - 1.0),
+        (v0, dv, 0.0, rows - 1.0),
+        (z0, dz, tr.zmin - margin, tr.zmax + margin),
+    ):
+        near, far = _slab(p0, dp, lo, hi)
+        np.maximum(t_lo, near, out=t_lo)
+        np.minimum(t_hi, far, out=t_hi)
+    return t_lo, t_hi
+
+
+def _quad_triangles(corners: tuple, ul: Array, vl: Array, du: Array, dv: Array, dz: Array,
+                    rhs: Array, tc: Array, eps: float) -> tuple[Array, Bools, Array, Bools]:
+    """Dal Poz's Eq. 9 for the two triangles of each ray's quad (corner heights z00, z01,
+    z10, z11; the ray at (ul, vl) in the quad, ``rhs`` = z00 - z0): (ta, hits triangle 0,
+    tb, hits triangle 1), a hit at t >= ``tc`` within ``eps`` of the triangle."""
+    z00, z01, z10, z11 = corners
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a, b = z01 - z00, z11 - z01  # triangle 0: z = z00 + a u + b v
+        ta = (rhs + a * ul + b * vl) / (dz - a * du - b * dv)
+        ua, va = ul + du * ta, vl + dv * ta
+        ok_a = (va >= -eps) & (ua <= 1 + eps) & (ua - va >= -eps) & (ta >= tc)
+        a, b = z11 - z10, z10 - z00  # triangle 1
+        tb = (rhs + a * ul + b * vl) / (dz - a * du - b * dv)
+        ub, vb = ul + du * tb, vl + dv * tb
+        ok_b = (ub >= -eps) & (vb <= 1 + eps) & (vb - ub >= -eps) & (tb >= tc)
+    return ta, ok_a, tb, ok_b
+
+
 def _trace_chunk(
     tr: DsmTracer, o: Array, d: Array, accelerate: bool, pool: int = 8192
 ) -> tuple[Array, NDArray[np.int8], NDArray[np.int64], NDArray[np.int64], NDArray[np.int8]]:
@@ -257,16 +294,7 @@ def _trace_chunk(
     # map is affine, so t (and Eq. 9) is the same in both systems.
     u0, v0, z0 = (o[:, 0] - xc) * inv, (yc - o[:, 1]) * inv, o[:, 2].copy()
     du, dv, dz = d[:, 0] * inv, -d[:, 1] * inv, d[:, 2].copy()
-    t_lo, t_hi = np.zeros(n), np.full(n, np.inf)
-    margin = 1e-6 * max(1.0, abs(tr.zmax), abs(tr.zmin))
-    for p0, dp, lo, hi in (
-        (u0, du, 0.0, cols - 1.0),
-        (v0, dv, 0.0, rows - 1.0),
-        (z0, dz, tr.zmin - margin, tr.zmax + margin),
-    ):
-        near, far = _slab(p0, dp, lo, hi)
-        np.maximum(t_lo, near, out=t_lo)
-        np.minimum(t_hi, far, out=t_hi)
+    t_lo, t_hi = _slabs(tr, (u0, v0, z0), (du, dv, dz), rows, cols)
     t_out = np.full(n, np.nan)
     st_out = np.full(n, STATUS_OUTSIDE, np.int8)
     qi_out = np.full(n, -1, np.int64)
@@ -331,15 +359,7 @@ def _trace_chunk(
         ul, vl = u0 - j, v0 - i
         tc = t - tol_t
         rhs = z00 - z0
-        with np.errstate(divide="ignore", invalid="ignore"):
-            a, b = z01 - z00, z11 - z01  # triangle 0: z = z00 + a u + b v
-            ta = (rhs + a * ul + b * vl) / (dz - a * du - b * dv)
-            ua, va = ul + du * ta, vl + dv * ta
-            ok_a = (va >= -eps) & (ua <= 1 + eps) & (ua - va >= -eps) & (ta >= tc)
-            a, b = z11 - z10, z10 - z00  # triangle 1
-            tb = (rhs + a * ul + b * vl) / (dz - a * du - b * dv)
-            ub, vb = ul + du * tb, vl + dv * tb
-            ok_b = (ub >= -eps) & (vb <= 1 + eps) & (vb - ub >= -eps) & (tb >= tc)
+        ta, ok_a, tb, ok_b = _quad_triangles((z00, z01, z10, z11), ul, vl, du, dv, dz, rhs, tc, eps)
         nodata = np.isnan(z00 + z01 + z10 + z11)
         first_b = ok_b & ~(ok_a & (ta <= tb))
         hit = (ok_a | ok_b) & ~nodata

@@ -119,6 +119,60 @@ def _triangle(a, b, rhs, ul, vl, du, dv, dz, tc, lower):
     return v >= -_EPS and u <= 1 + _EPS and u - v >= -_EPS and t >= tc, t
 
 
+@register_jitable
+def _clear(r, t_out, st_out, qi_out, qj_out, tri_out, pts_out, w_out, grad_out, inc_out):
+    """Row ``r`` of the *_out arrays set to "no hit" (outside, NaN, -1)."""
+    t_out[r] = np.nan
+    st_out[r] = _OUTSIDE
+    qi_out[r] = -1
+    qj_out[r] = -1
+    tri_out[r] = -1
+    for c in range(3):
+        pts_out[r, c] = np.nan
+        w_out[r, c] = np.nan
+    grad_out[r, 0] = np.nan
+    grad_out[r, 1] = np.nan
+    inc_out[r] = np.nan
+
+
+@register_jitable
+def _describe_hit(r, th, k, i, j, o, d, z, x_c, y_c, cell, pts_out, w_out, grad_out, inc_out):
+    """Row ``r`` of the hit arrays: the point of ray ``r`` at parameter ``th`` on triangle ``k``
+    of quad (i, j) of the heights ``z``, its barycentric weights, the face gradient and the
+    incidence angle (degrees)."""
+    ox, oy, oz = o[r, 0], o[r, 1], o[r, 2]
+    dx, dy, dz = d[r, 0], d[r, 1], d[r, 2]
+    z00 = np.float64(z[i, j])
+    z01 = np.float64(z[i, j + 1])
+    z10 = np.float64(z[i + 1, j])
+    z11 = np.float64(z[i + 1, j + 1])
+    inv = 1.0 / cell
+    px, py, pz = ox + th * dx, oy + th * dy, oz + th * dz
+    pts_out[r, 0] = px
+    pts_out[r, 1] = py
+    pts_out[r, 2] = pz
+    u = (px - x_c) * inv - j
+    v = (y_c - py) * inv - i
+    if k == 1:
+        gx = (z11 - z10) / cell
+        gy = (z10 - z00) / -cell
+        w_out[r, 0] = 1 - v
+        w_out[r, 1] = v - u
+        w_out[r, 2] = u
+    else:
+        gx = (z01 - z00) / cell
+        gy = (z11 - z01) / -cell
+        w_out[r, 0] = 1 - u
+        w_out[r, 1] = u - v
+        w_out[r, 2] = v
+    grad_out[r, 0] = gx
+    grad_out[r, 1] = gy
+    cosang = abs(dz - gx * dx - gy * dy) / math.sqrt(
+        (gx * gx + gy * gy + 1.0) * (dx * dx + dy * dy + dz * dz)
+    )
+    inc_out[r] = math.degrees(math.asin(min(cosang, 1.0)))
+
+
 def _trace(
     o, d, order, z, qmax, mstack, offsets, bcols, shifts, x_c, y_c, cell, zmin, zmax, n_lev,
     min_inc_deg, t_out, st_out, qi_out, qj_out, tri_out, pts_out, w_out, grad_out, inc_out,
@@ -130,17 +184,7 @@ def _trace(
     margin = 1e-6 * max(1.0, abs(zmax), abs(zmin))
     budget = 4 * (rows + cols) + 16
     for r in order:
-        t_out[r] = np.nan
-        st_out[r] = _OUTSIDE
-        qi_out[r] = -1
-        qj_out[r] = -1
-        tri_out[r] = -1
-        for c in range(3):
-            pts_out[r, c] = np.nan
-            w_out[r, c] = np.nan
-        grad_out[r, 0] = np.nan
-        grad_out[r, 1] = np.nan
-        inc_out[r] = np.nan
+        _clear(r, t_out, st_out, qi_out, qj_out, tri_out, pts_out, w_out, grad_out, inc_out)
         ox, oy, oz = o[r, 0], o[r, 1], o[r, 2]
         dx, dy, dz = d[r, 0], d[r, 1], d[r, 2]
         finite = True
@@ -170,6 +214,8 @@ def _trace(
         t = t_lo
         lv = 0
         status = _NOT_CONVERGED
+        i = j = k = 0  # the quad and triangle of the hit
+        th = t_lo
         for _ in range(budget):
             tp = t + nudge
             j = min(max(math.floor(u0 + du * tp), 0), cols - 2)
@@ -220,42 +266,21 @@ def _trace(
                         th = tb if first_b else ta
                         k = 1 if first_b else 0
                         status = _OK
-                        t_out[r] = th
-                        qi_out[r] = i
-                        qj_out[r] = j
-                        tri_out[r] = k
-                        px, py, pz = ox + th * dx, oy + th * dy, oz + th * dz
-                        pts_out[r, 0] = px
-                        pts_out[r, 1] = py
-                        pts_out[r, 2] = pz
-                        u = (px - x_c) * inv - j
-                        v = (y_c - py) * inv - i
-                        if k == 1:
-                            gx = (z11 - z10) / cell
-                            gy = (z10 - z00) / -cell
-                            w_out[r, 0] = 1 - v
-                            w_out[r, 1] = v - u
-                            w_out[r, 2] = u
-                        else:
-                            gx = (z01 - z00) / cell
-                            gy = (z11 - z01) / -cell
-                            w_out[r, 0] = 1 - u
-                            w_out[r, 1] = u - v
-                            w_out[r, 2] = v
-                        grad_out[r, 0] = gx
-                        grad_out[r, 1] = gy
-                        cosang = abs(dz - gx * dx - gy * dy) / math.sqrt(
-                            (gx * gx + gy * gy + 1.0) * (dx * dx + dy * dy + dz * dz)
-                        )
-                        inc_out[r] = math.degrees(math.asin(min(cosang, 1.0)))
-                        if inc_out[r] < min_inc_deg:
-                            status = _GRAZING
                         break
             # the quad index was clipped (t_exit <= t): the ray is past the grid's edge
             if t_new >= t_hi or t_exit <= t:
                 status = _OUTSIDE
                 break
             t = t_new
+        if status == _OK:
+            t_out[r] = th
+            qi_out[r] = i
+            qj_out[r] = j
+            tri_out[r] = k
+            _describe_hit(r, th, k, i, j, o, d, z, x_c, y_c, cell, pts_out, w_out, grad_out,
+                          inc_out)  # fmt: skip
+            if inc_out[r] < min_inc_deg:
+                status = _GRAZING
         st_out[r] = status
 
 

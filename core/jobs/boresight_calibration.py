@@ -279,17 +279,10 @@ comment lines beginning with #).""",
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the inputs, calibrate, write the outputs."""
-    import numpy as np
-
     from ..errors import InputError, stop_if_asked
     from ..geometry.frames import MappingFrame
-    from ..io.atomic import write_text_atomic
-    from ..photo.boresight import calibrate
-    from ..photo.boresight_result import BoresightNotObservable, BoresightRun
-    from ..photo.boresight_setup import BoresightOptions, group_labels
+    from ..photo.boresight_setup import BoresightOptions
     from ..photo.ins import ins_grade
-    from ..photo.intersection import ground_positions
-    from ..quality.boresight_html import render_boresight_html
 
     frame = MappingFrame.from_user_input(v.crs)
     mount = mount_from(v)
@@ -303,18 +296,46 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     options = options_from(BoresightOptions, SPEC, v, ins_grade=grade, use_types=types)
     settings = _settings(v, cam, traj, obs, plane_list, line_list, lcp_list, frame, mount, grade,
                          ground)  # fmt: skip
+    args = (traj, cam, mount, frame, obs, plane_list, line_list, lcp_list, lidar_xyz, lidar_ids,
+            options)  # fmt: skip
+    result = _calibrate(out, settings, args, progress=progress, should_stop=should_stop,
+                        ground_points=ground)  # fmt: skip
+    doubts, warning = _settle(v, out, result, obs, settings, frame, options.snooping_alpha)
+    run = _run_record(result, obs, cam, traj, options, (plane_list, line_list, lcp_list, ground),
+                      settings, frame)  # fmt: skip
+    _write_outputs(out, run, settings, doubts, warning)
+    lines = _summary_lines(result, warning, options.snooping_alpha)
+    return JobResult(results=_results(result), lines=lines, data=run)
+
+
+def _calibrate(out, settings: dict, args: tuple, **kwargs):
+    """:func:`core.photo.boresight.calibrate` of ``args`` and ``kwargs``; when the boresight is
+    not observable, the HTML page of its diagnosis (the user's answer) is written before the
+    error goes on."""
+    from ..io.atomic import write_text_atomic
+    from ..photo.boresight import calibrate
+    from ..photo.boresight_result import BoresightNotObservable
+    from ..quality.boresight_html import render_boresight_html
+
     try:
-        result = calibrate(
-            traj, cam, mount, frame, obs, plane_list, line_list, lcp_list, lidar_xyz,
-            lidar_ids, options, progress=progress, should_stop=should_stop, ground_points=ground,
-        )  # fmt: skip
+        return calibrate(*args, **kwargs)
     except BoresightNotObservable as exc:
         if out.requested("OUTPUT_HTML"):  # the diagnosis is the user's answer: keep it
             page = render_boresight_html(None, settings, exc.diagnosis)
             write_text_atomic(out.path("OUTPUT_HTML"), page)
             out.commit(["OUTPUT_HTML"])
         raise
-    doubts = doubts_about(result, v.max_boresight, v.max_sigma0, options.snooping_alpha)
+
+
+def _settle(v: Values, out, result, obs, settings: dict, frame, snooping_alpha: float) -> tuple:
+    """The doubts about ``result`` (:func:`doubts_about`) and the warning lines when they are
+    accepted; refused (the failed adjustment's page written) unless ACCEPT_DOUBTFUL."""
+    import numpy as np
+
+    from ..photo.boresight_result import BoresightRun
+    from ..quality.boresight_html import render_boresight_html
+
+    doubts = doubts_about(result, v.max_boresight, v.max_sigma0, snooping_alpha)
 
     def failed_page() -> str:  # the failed adjustment, without the positions it would give
         failed = BoresightRun(result, obs, np.full((len(obs), 3), np.nan), ("",) * len(obs),
@@ -323,13 +344,20 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
     warning = settle_doubts("boresight calibration", doubts, v.accept_doubtful, out,
                             failed_page, "HTML summary")  # fmt: skip
-    positions = ground_positions(result, obs, cam, plane_list, line_list, lcp_list, ground)
+    return doubts, warning
+
+
+def _run_record(result, obs, cam, traj, options, control: tuple, settings: dict, frame):
+    """The calibration's record for the outputs: the result, the observations' ground
+    positions (``control``: planes, lines, LCPs, ground points) and the images' groups."""
+    from ..photo.boresight_result import BoresightRun
+    from ..photo.boresight_setup import group_labels
+    from ..photo.intersection import ground_positions
+
+    positions = ground_positions(result, obs, cam, *control)
     image_group = dict(zip(traj.image_id, group_labels(traj, options.groups)))
-    run = BoresightRun(result, obs, positions, tuple(image_group.get(i, "") for i in obs.image_id),
-                       settings, frame.crs.to_wkt())  # fmt: skip
-    _write_outputs(out, run, settings, doubts, warning)
-    lines = _summary_lines(result, warning, options.snooping_alpha)
-    return JobResult(results=_results(result), lines=lines, data=run)
+    return BoresightRun(result, obs, positions, tuple(image_group.get(i, "") for i in obs.image_id),
+                        settings, frame.crs.to_wkt())  # fmt: skip
 
 
 def _results(result) -> dict[str, float]:

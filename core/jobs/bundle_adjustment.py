@@ -307,11 +307,9 @@ with the file and row named.""",
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the inputs, adjust (each AP family for ``all``), write the outputs."""
-    import math
-
-    from ..errors import AdjustmentError, InputError
+    from ..errors import AdjustmentError
     from ..geometry.ap_models import AP_FAMILIES
-    from ..photo.bundle import bundle_adjust, compare_ap_models
+    from ..photo.bundle import bundle_adjust
     from ..photo.bundle_setup import BundleOptions
     from .runner import stages
 
@@ -334,32 +332,46 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                 _blame_eo(exc, cams, obs, ground, eo, image_camera, eo_rows, eo_source)
             raise
 
-    if len(models) == 1:
-        res = one(models[0])
-        rows = [{**res.summary_row(), "rank": 1}]
-        results = {models[0]: res}
-    else:
-        rows, results = compare_ap_models(models, one)
-        if not results:
-            raise InputError(
-                "no AP model could be adjusted: " + "; ".join(str(r.get("error")) for r in rows)
-            )
+    rows, results = _adjust_models(models, one)
     best = str(next(r["model"] for r in rows if r["model"] in results))
     res = results[best]
     settings = _settings(v, cams, obs, ground, eo, sigma, frame, velocity)
     _write_outputs(out, results, best, rows, settings, multi=len(cams) > 1,
                    compared=len(models) > 1)  # fmt: skip
+    return JobResult(results=_results(res, best),
+                     lines=_summary_lines(res, best, rows if len(models) > 1 else ()),
+                     data=res)  # fmt: skip
+
+
+def _adjust_models(models: tuple, one) -> tuple[list, dict]:
+    """``one(model)`` for each AP model: (the comparison rows ranked, {model: result}); with
+    several models those that fail are rows with their error (InputError when all do)."""
+    from ..errors import InputError
+    from ..photo.bundle import compare_ap_models
+
+    if len(models) == 1:
+        res = one(models[0])
+        return [{**res.summary_row(), "rank": 1}], {models[0]: res}
+    rows, results = compare_ap_models(models, one)
+    if not results:
+        raise InputError(
+            "no AP model could be adjusted: " + "; ".join(str(r.get("error")) for r in rows)
+        )
+    return rows, results
+
+
+def _results(res, best: str) -> dict:
+    """The job's results: sigma0, the check points' 3D RMS (NaN without), the model chosen
+    and the timing offset."""
+    import math
+
     st = res.check.statistics()
-    return JobResult(
-        results={
-            "SIGMA0": float(res.adjustment.sigma0),
-            "CHECK_RMS": float(st["rms_3d"]) if math.isfinite(st["rms_3d"]) else float("nan"),
-            "MODEL": best,
-            **_timing_results(res),
-        },
-        lines=_summary_lines(res, best, rows if len(models) > 1 else ()),
-        data=res,
-    )
+    return {
+        "SIGMA0": float(res.adjustment.sigma0),
+        "CHECK_RMS": float(st["rms_3d"]) if math.isfinite(st["rms_3d"]) else float("nan"),
+        "MODEL": best,
+        **_timing_results(res),
+    }
 
 
 def _timing_results(res) -> dict[str, float]:

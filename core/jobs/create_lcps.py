@@ -105,10 +105,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the planes and the cloud, intersect the planes, write the tables."""
     import numpy as np
 
-    from ..io.control import write_graph_csv, write_lcps_csv, write_lines_csv
     from ..io.planes import read_planes_csv
     from ..io.pointcloud import read_info, read_points
-    from ..lidar.control import ControlOptions, lidar_control, rejection_summary
+    from ..lidar.control import ControlOptions, lidar_control
 
     user_triples = parse_id_groups(v.triples, 3, "TRIPLES")
     user_pairs = parse_id_groups(v.pairs, 2, "PAIRS")
@@ -134,18 +133,8 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         planes, xyz, arrays["plane_id"], options, user_triples, user_pairs,
         progress=compute, should_stop=should_stop,
     )  # fmt: skip
-    if out.requested("POINTS_CSV"):
-        write_lcps_csv(out.path("POINTS_CSV"), result.points)
-    if out.requested("LINES_CSV"):
-        write_lines_csv(out.path("LINES_CSV"), result.lines)
-    if out.requested("GRAPH_CSV"):
-        write_graph_csv(out.path("GRAPH_CSV"), result.adjacency)
-    # the counts always; each candidate only in verbose mode (CLI -vv, QGIS debug info)
-    if result.rejected:
-        log.info(_t("{summary} (details: lidarphoto -vv; QGIS: Processing logging level "
-                    "Verbose)", summary=rejection_summary(result.rejected)))  # fmt: skip
-    for r in result.rejected:
-        log.debug("planes %s: %s", ",".join(map(str, r.plane_ids)), r.reason)
+    _write_tables(out, result)
+    _log_rejected(result)
     pairs = int(result.adjacency.adjacent.sum())
     return JobResult(
         results={"LCP_COUNT": len(result.points), "LINE_COUNT": len(result.lines)},
@@ -155,3 +144,27 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         ],
         data=(result, info),
     )
+
+
+def _write_tables(out, result) -> None:
+    """The requested tables of ``result``: LCPs, lines and the plane adjacency graph."""
+    from ..io.control import write_graph_csv, write_lcps_csv, write_lines_csv
+
+    if out.requested("POINTS_CSV"):
+        write_lcps_csv(out.path("POINTS_CSV"), result.points)
+    if out.requested("LINES_CSV"):
+        write_lines_csv(out.path("LINES_CSV"), result.lines)
+    if out.requested("GRAPH_CSV"):
+        write_graph_csv(out.path("GRAPH_CSV"), result.adjacency)
+
+
+def _log_rejected(result) -> None:
+    """The rejected candidates: their counts always, each one in verbose mode only (CLI -vv,
+    QGIS debug info)."""
+    from ..lidar.control import rejection_summary
+
+    if result.rejected:
+        log.info(_t("{summary} (details: lidarphoto -vv; QGIS: Processing logging level "
+                    "Verbose)", summary=rejection_summary(result.rejected)))  # fmt: skip
+    for r in result.rejected:
+        log.debug("planes %s: %s", ",".join(map(str, r.plane_ids)), r.reason)

@@ -146,7 +146,6 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     import numpy as np
 
     from ..io.planes import write_planes_csv
-    from ..io.pointcloud import write_cloud
     from ..lidar.roof_planes import extract_roof_planes
 
     params = _params(v)
@@ -170,14 +169,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     plane_id = np.full(n, -1, dtype=np.int32)
     plane_id[sel] = result.plane_id
     if out.requested("OUTPUT_CLOUD"):
-        write_cloud(
-            v.input,
-            out.path("OUTPUT_CLOUD"),
-            extra={"plane_id": plane_id},
-            points=cloud,
-            progress=write,
-            should_stop=should_stop,
-        )
+        _write_cloud(v.input, out.path("OUTPUT_CLOUD"), plane_id, cloud, write, should_stop)
     write_planes_csv(out.path("OUTPUT_CSV"), result.planes)
     if progress is not None:
         progress(1.0)
@@ -200,6 +192,14 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         ],
         data=run_info,
     )
+
+
+def _write_cloud(source, target, plane_id, cloud, progress, should_stop) -> None:
+    """The input cloud's points with their ``plane_id`` (-1: none) as an extra dimension."""
+    from ..io.pointcloud import write_cloud
+
+    write_cloud(source, target, extra={"plane_id": plane_id}, points=cloud, progress=progress,
+                should_stop=should_stop)  # fmt: skip
 
 
 def _params(v: Values):

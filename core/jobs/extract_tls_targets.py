@@ -90,13 +90,11 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read each scan, find its targets, label them across scans, write the table."""
     import numpy as np
 
-    from ..errors import InputError, stop_if_asked
-    from ..io.scans import read_scan
+    from ..errors import stop_if_asked
     from ..io.tables import write_csv_atomic
     from ..io.tls import read_tls_control_csv
     from ..tls.aps import ARCSEC
     from ..tls.correspondence import label_targets
-    from ..tls.targets import detect_checkerboards, detect_spheres
 
     files = _scan_files(v.scans)
     s_range, s_angle = v.scan_sigmas[0] / 1000.0, v.scan_sigmas[1] * ARCSEC
@@ -105,27 +103,48 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     fits = []
     for f, part in zip(files, parts):
         stop_if_asked(should_stop, f"reading {f.name}")
-        xyz, intensity = read_scan(f)
-        if v.kind == "sphere":
-            found = detect_spheres(xyz, v.radius, s_range, s_angle, progress=part,
-                                   should_stop=should_stop)  # fmt: skip
-        else:
-            if not np.isfinite(intensity).any():
-                raise InputError("checkerboards need the intensity of the points; the scan "
-                                 "has none", path=str(f))  # fmt: skip
-            found = detect_checkerboards(xyz, intensity, v.half_size, s_range, s_angle,
-                                         progress=part, should_stop=should_stop)  # fmt: skip
-        log.info("%s: %d %s targets", f.name, len(found), v.kind)
-        if len(found) < 3:
-            raise InputError(f"found {len(found)} {v.kind} target(s) in the scan: at least "
-                             "three are needed to register it (check RADIUS / HALF_SIZE, "
-                             "SCAN_SIGMAS and that the points are in the scanner frame)",
-                             path=str(f))  # fmt: skip
-        fits.append(found)
+        fits.append(_targets_in(f, v, s_range, s_angle, part, should_stop))
     ctrl_ids = [c.id for c in control]
     ctrl_xyz = np.array([c.xyz for c in control]) if control else None
     ids = label_targets([np.array([t.centre for t in fs]) for fs in fits], v.match_tolerance,
                         ctrl_ids, ctrl_xyz)  # fmt: skip
+    rows = _rows(files, fits, ids)
+    if out.requested("OUTPUT"):
+        write_csv_atomic(out.path("OUTPUT"), COLUMNS, rows)
+    lines = [f"{f.name}: {len(fs)} {v.kind} targets" for f, fs in zip(files, fits)]
+    return JobResult(results={"TARGETS": len(rows)}, lines=lines, data=(files, fits, ids))
+
+
+def _targets_in(f: Path, v: Values, s_range: float, s_angle: float, progress, should_stop) -> list:
+    """The targets of kind KIND found in scan ``f`` (scanner frame; range sigma in m, angle
+    sigma in rad); InputError naming the scan when fewer than three are found."""
+    import numpy as np
+
+    from ..errors import InputError
+    from ..io.scans import read_scan
+    from ..tls.targets import detect_checkerboards, detect_spheres
+
+    xyz, intensity = read_scan(f)
+    if v.kind == "sphere":
+        found = detect_spheres(xyz, v.radius, s_range, s_angle, progress=progress,
+                               should_stop=should_stop)  # fmt: skip
+    else:
+        if not np.isfinite(intensity).any():
+            raise InputError("checkerboards need the intensity of the points; the scan "
+                             "has none", path=str(f))  # fmt: skip
+        found = detect_checkerboards(xyz, intensity, v.half_size, s_range, s_angle,
+                                     progress=progress, should_stop=should_stop)  # fmt: skip
+    log.info("%s: %d %s targets", f.name, len(found), v.kind)
+    if len(found) < 3:
+        raise InputError(f"found {len(found)} {v.kind} target(s) in the scan: at least "
+                         "three are needed to register it (check RADIUS / HALF_SIZE, "
+                         "SCAN_SIGMAS and that the points are in the scanner frame)",
+                         path=str(f))  # fmt: skip
+    return found
+
+
+def _rows(files: list[Path], fits: list, ids: list) -> list[tuple]:
+    """The output table's rows (COLUMNS): every target of every scan with its label."""
     rows = []
     for f, fs, names in zip(files, fits, ids):
         for t, name in zip(fs, names):
@@ -134,7 +153,4 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
                          *(repr(float(x)) for x in t.sigma), repr(float(c[0, 1])),
                          repr(float(c[0, 2])), repr(float(c[1, 2])), t.kind, t.n_points,
                          t.n_inliers, repr(float(t.rms * 1000.0))))  # fmt: skip
-    if out.requested("OUTPUT"):
-        write_csv_atomic(out.path("OUTPUT"), COLUMNS, rows)
-    lines = [f"{f.name}: {len(fs)} {v.kind} targets" for f, fs in zip(files, fits)]
-    return JobResult(results={"TARGETS": len(rows)}, lines=lines, data=(files, fits, ids))
+    return rows

@@ -497,16 +497,11 @@ def _run_tiled(v: Values, files, infos, grid, options, checkpoints, progress, sh
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the clouds (and check points), assess them, write the report and rasters."""
-    import json
     import math
 
     from ..errors import stop_if_asked
-    from ..io.atomic import write_text_atomic
-    from ..io.raster_write import GeoTiffWriter
-    from ..quality.lidar_accuracy import assess_lidar, report_dict
-    from ..quality.lidar_accuracy_html import render_html
+    from ..quality.lidar_accuracy import assess_lidar
     from ..quality.lidar_accuracy_options import LidarAccuracyOptions
-    from ..quality.lidar_swaths import pair_rasters
 
     options = options_from(LidarAccuracyOptions, SPEC, v,
                            hard_classes=_classes(v.hard_classes or ""))  # fmt: skip
@@ -525,6 +520,28 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         report = assess_lidar(cloud, options, checkpoints, assess_p, should_stop, grid)
     stop_if_asked(should_stop, "writing the report")
     bands = [f"{p.swath_a}-{p.swath_b}" for p in report.pairs]
+    _write_outputs(out, report, bands, crs)
+    nva = report.vertical.nva_rmse_v if report.vertical is not None else math.nan
+    lines = [f"swaths from {report.swath_method}: {len(report.swath_counts)}"]
+    lines += [f"swaths {p.swath_a}-{p.swath_b}: {p.n} cells, RMSDz {p.stats()['rmsdz']:.4f} m"
+              for p in report.pairs]  # fmt: skip
+    lines += [f"{x.name}: {x.status} ({x.reason})" for x in report.verdicts]
+    results = {"RMSDZ": report.overall["rmsdz"], "SMOOTH_CELLS": report.overall["n"],
+               "NVA_RMSE": nva}  # fmt: skip
+    return JobResult(results=results, lines=lines, data=report)
+
+
+def _write_outputs(out, report, bands: list[str], crs) -> None:
+    """The requested outputs: the swath-pair rasters (one band per pair, ``bands`` their
+    names), the check point table, the JSON and the HTML report."""
+    import json
+
+    from ..io.atomic import write_text_atomic
+    from ..io.raster_write import GeoTiffWriter
+    from ..quality.lidar_accuracy import report_dict
+    from ..quality.lidar_accuracy_html import render_html
+    from ..quality.lidar_swaths import pair_rasters
+
     if out.requested("OUTPUT_RASTER"):
         from ..io.atomic import atomic_path
 
@@ -545,11 +562,3 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         write_text_atomic(out.path("OUTPUT_JSON"), text)
     if out.requested("OUTPUT_HTML"):
         write_text_atomic(out.path("OUTPUT_HTML"), render_html(report))
-    nva = report.vertical.nva_rmse_v if report.vertical is not None else math.nan
-    lines = [f"swaths from {report.swath_method}: {len(report.swath_counts)}"]
-    lines += [f"swaths {p.swath_a}-{p.swath_b}: {p.n} cells, RMSDz {p.stats()['rmsdz']:.4f} m"
-              for p in report.pairs]  # fmt: skip
-    lines += [f"{x.name}: {x.status} ({x.reason})" for x in report.verdicts]
-    results = {"RMSDZ": report.overall["rmsdz"], "SMOOTH_CELLS": report.overall["n"],
-               "NVA_RMSE": nva}  # fmt: skip
-    return JobResult(results=results, lines=lines, data=report)

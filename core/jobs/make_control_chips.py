@@ -180,11 +180,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             rows.append(row)
             if progress is not None:
                 progress((k + 1) / len(ids))
-        missing = [p for p in points.point_id if p not in pairs]
-        for pid in missing:
-            rows.append({"point_id": pid, "status": "failed", "reason": "no plate photo",
-                         "X": float(xyz_of[pid][0]), "Y": float(xyz_of[pid][1]),
-                         "Z": float(xyz_of[pid][2])})  # fmt: skip
+        rows += _without_photo(points.point_id, pairs, xyz_of)
         write_report_csv(files.path("__csv"), rows)
         write_report_json(files.path("__json"), rows)
         files.commit()
@@ -194,6 +190,13 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     lines += [f"  {r['point_id']}: {r['reason']}" for r in rows if r["status"] != "ok"]
     return JobResult(results={"CHIP_COUNT": written, "FAILED_COUNT": failed}, lines=lines,
                      data=rows)  # fmt: skip
+
+
+def _without_photo(point_ids, pairs: dict, xyz_of: dict) -> list[dict]:
+    """The report's rows of the points without a plate photo (no chip)."""
+    return [{"point_id": pid, "status": "failed", "reason": "no plate photo",
+             "X": float(xyz_of[pid][0]), "Y": float(xyz_of[pid][1]), "Z": float(xyz_of[pid][2])}
+            for pid in point_ids if pid not in pairs]  # fmt: skip
 
 
 def _read_inputs(v: Values) -> tuple:

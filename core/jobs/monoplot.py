@@ -94,18 +94,34 @@ projection's field: no ray).""",
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the observations, camera, EO, DSM (and planes), monoplot, write the tables."""
-    from pathlib import Path
+    from ..photo.monoplot import monoplot
 
+    camera, obs, eo, planes = _read_inputs(v)
+    load, compute = stages(progress, 0.4, 0.6)
+    dsm = _load_dsm(v, load, should_stop)
+    result = monoplot(
+        obs, camera, eo, dsm, v.crs, method=v.method, sigma_dsm=v.sigma_dsm,
+        eo_sigmas=v.eo_sigmas, planes=planes, line_step_px=v.line_step,
+        min_incidence_deg=v.min_incidence, progress=compute, should_stop=should_stop,
+    )  # fmt: skip
+    _write_tables(out, result)
+    hits = int(sum(int(s) in (0, 1) for s in result.status))
+    return JobResult(
+        results={"POINT_COUNT": len(result.rows), "HIT_COUNT": hits},
+        lines=[f"{len(result.rows)} rays, {len(result.lines)} lines: {result.status_counts()}"],
+        data=result,
+    )
+
+
+def _read_inputs(v: Values) -> tuple:
+    """(camera, observations, EO, planes), the perspective centres checked against the CRS's
+    area of use and the rays' memory against what is free."""
     from ..geometry.frames import check_area_of_use, parse_crs
     from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
-    from ..io.dsm import CLOUD_SUFFIXES, load_dsm, write_dsm
-    from ..io.monoplot import write_monoplot_lines_csv, write_monoplot_points_csv
     from ..io.observations import read_observations_csv
     from ..io.orientation import read_eo_csv
     from ..io.planes import read_planes_csv
-    from ..io.pointcloud import read_info
-    from ..photo.monoplot import monoplot
 
     camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     obs = read_observations_csv(v.observations, camera=camera)
@@ -116,33 +132,40 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     rays = ray_count(obs, v.line_step)
     check_memory(rays * BYTES_PER_RAY, f"LINE_STEP {v.line_step:g} px: {rays} rays",
                  "give a larger step (or 0: the end points only)")  # fmt: skip
+    return camera, obs, eo, planes
+
+
+def _load_dsm(v: Values, progress, should_stop):
+    """The DSM of the DSM parameter (a raster, or a cloud gridded at CELL_SIZE), its size
+    checked against the memory that is free (before and after reading)."""
+    from pathlib import Path
+
+    from ..io.dsm import CLOUD_SUFFIXES, load_dsm
+    from ..io.pointcloud import read_info
+
     if Path(v.dsm).suffix.lower() in CLOUD_SUFFIXES:
         info = read_info(v.dsm, v.dsm_crs, require_crs=False)
         unit = info.horizontal_unit if info.crs is not None else "CRS unit"
         check_cell_size("CELL_SIZE", v.cell_size, unit, info.mins[:2], info.maxs[:2],
                         DSM_BYTES_PER_CELL, extra_bytes=40.0 * info.point_count)  # fmt: skip
-    load, compute = stages(progress, 0.4, 0.6)
-    dsm = load_dsm(v.dsm, v.cell_size, v.dsm_crs, progress=load, should_stop=should_stop)
+    dsm = load_dsm(v.dsm, v.cell_size, v.dsm_crs, progress=progress, should_stop=should_stop)
     rows, cols = dsm.heights.shape
     check_memory(float(rows) * cols * DSM_BYTES_PER_CELL,
                  f"the DSM of {rows} x {cols} cells ({v.dsm})", "give a coarser DSM")  # fmt: skip
-    result = monoplot(
-        obs, camera, eo, dsm, v.crs, method=v.method, sigma_dsm=v.sigma_dsm,
-        eo_sigmas=v.eo_sigmas, planes=planes, line_step_px=v.line_step,
-        min_incidence_deg=v.min_incidence, progress=compute, should_stop=should_stop,
-    )  # fmt: skip
+    return dsm
+
+
+def _write_tables(out, result) -> None:
+    """The requested outputs: the DSM used, the points and the lines."""
+    from ..io.dsm import write_dsm
+    from ..io.monoplot import write_monoplot_lines_csv, write_monoplot_points_csv
+
     if out.requested("OUTPUT_DSM"):
         write_dsm(out.path("OUTPUT_DSM"), result.dsm)
     if out.requested("OUTPUT_CSV"):
         write_monoplot_points_csv(out.path("OUTPUT_CSV"), result)
     if out.requested("LINES_CSV"):
         write_monoplot_lines_csv(out.path("LINES_CSV"), result)
-    hits = int(sum(int(s) in (0, 1) for s in result.status))
-    return JobResult(
-        results={"POINT_COUNT": len(result.rows), "HIT_COUNT": hits},
-        lines=[f"{len(result.rows)} rays, {len(result.lines)} lines: {result.status_counts()}"],
-        data=result,
-    )
 
 
 def ray_count(obs, line_step_px: float) -> int:

@@ -109,9 +109,7 @@ class OrthoFile:
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Check every input, then orthorectify the images one after the other."""
     from ..geometry.frames import parse_crs
-    from ..geometry.raycast import DsmTracer
     from ..io.atomic import OutputSet
-    from ..photo.ortho_block import block_gsd, block_projectors, median_height
     from ..photo.orthophoto import OrthoOptions
 
     mapping = parse_crs(v.crs, what="mapping CRS")
@@ -124,15 +122,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
     load, work = stages(progress, 0.15, 0.85)
     dsm = _dsm_in(v, mapping, load, should_stop)
-    # the skipping pyramid of the ray casting only for true orthophotos (built once)
-    surface = DsmTracer.build(dsm) if options.true_ortho else dsm
     poses = {f.stem: (eo.xyz[row_of[f.stem]], eo.opk[row_of[f.stem]]) for f in images}
-    projectors = block_projectors(camera, poses, dsm, surface, mapping)
-    boxes = {k: p.footprint() for k, p in projectors.items()}
-    ground_z = {k: median_height(dsm, b) for k, b in boxes.items()}
-    gsd = block_gsd(options, camera, projectors, ground_z, path=str(v.dsm))
-    grids = _grids(boxes, extent, gsd, infos, folder)
-    _warn_beyond(projectors, boxes, ground_z)
+    projectors, ground_z, gsd = _block_geometry(v, options, camera, poses, dsm, mapping)
+    grids = _grids({k: p.footprint() for k, p in projectors.items()}, extent, gsd, infos, folder)
     # an image's overview levels are written (GDAL compressing them) while the next image's
     # tiles are computed; the files are renamed into place once all are whole
     written: list[OrthoFile] = []
@@ -158,10 +150,32 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
             with failures_named(targets[name]):
                 job.result()
         files.commit()
+    return _result(written, gsd, folder, options.true_ortho)
+
+
+def _block_geometry(v: Values, options, camera, poses: dict, dsm, mapping) -> tuple:
+    """(the images' projectors on the DSM, their ground heights, the GSD used): the ground
+    height of an image is the DSM's median in its footprint, the GSD GSD's or the block's
+    rule (:func:`core.photo.ortho_block.block_gsd`); images reaching beyond the DSM warned."""
+    from ..geometry.raycast import DsmTracer
+    from ..photo.ortho_block import block_gsd, block_projectors, median_height
+
+    # the skipping pyramid of the ray casting only for true orthophotos (built once)
+    surface = DsmTracer.build(dsm) if options.true_ortho else dsm
+    projectors = block_projectors(camera, poses, dsm, surface, mapping)
+    boxes = {k: p.footprint() for k, p in projectors.items()}
+    ground_z = {k: median_height(dsm, b) for k, b in boxes.items()}
+    gsd = block_gsd(options, camera, projectors, ground_z, path=str(v.dsm))
+    _warn_beyond(projectors, boxes, ground_z)
+    return projectors, ground_z, gsd
+
+
+def _result(written: list, gsd: float, folder: Path, true_ortho: bool) -> JobResult:
+    """The job's result: the images written, the GSD and the share of occluded cells."""
     occluded = sum(w.occluded_cells for w in written)
     frac = occluded / max(sum(w.valid_cells for w in written) + occluded, 1)
     lines = [f"{len(written)} orthophoto(s) of {gsd:g} in {folder}"
-             + (f"; {100 * frac:.1f} % of the cells occluded" if options.true_ortho else "")]
+             + (f"; {100 * frac:.1f} % of the cells occluded" if true_ortho else "")]
     return JobResult(results={"IMAGE_COUNT": len(written), "GSD_USED": gsd,
                               "OCCLUDED_FRACTION": frac}, lines=lines, data=written)  # fmt: skip
 

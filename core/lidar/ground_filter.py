@@ -515,6 +515,34 @@ def _classify(
     return ground, hag
 
 
+def _last_returns(params: FilterParams, returns, n_returns) -> NDArray[np.bool_] | None:
+    """The ground candidates with ``last_returns_only``: the last returns (``returns`` the
+    return numbers, ``n_returns`` the numbers of returns; records of return 0 as single
+    returns), or None (every point) without it or without return numbers."""
+    candidate: NDArray[np.bool_] | None = None
+    if params.last_returns_only and returns is not None and n_returns is not None:
+        if np.any(returns > 0):
+            candidate = np.asarray(returns) >= np.asarray(n_returns)
+            # malformed records (return 0) are treated as single returns
+            candidate |= np.asarray(returns) == 0
+    return candidate
+
+
+def _grid(mins, maxs, p: FilterParams, unit: str) -> Grid:
+    """The grid of ``p.cell_size`` covering the points' bounds (``mins``, ``maxs``: (3,) arrays,
+    ``unit`` their unit's name); InputError naming the parameter beyond 400 million cells."""
+    cell = p.cell_size
+    grid = Grid.covering(mins[:2], maxs[:2], cell)
+    if grid.rows * grid.cols > 400_000_000:
+        name = "resolution" if p.method == "csf" else "cell_size"
+        raise InputError(
+            f"{name} {cell:g} {unit} gives a {grid.rows} x {grid.cols} grid: too fine "
+            "for this extent (check the distance unit)",
+            column=name,
+        )
+    return grid
+
+
 def ground_filter(
     x: NDArray[np.float64] | ScaledXYZ,
     y: NDArray[np.float64] | None = None,
@@ -587,22 +615,10 @@ def ground_filter(
         raise InputError("x, y and z must be non-empty arrays of equal length")
     report = progress or (lambda _f: None)
 
-    candidate: NDArray[np.bool_] | None = None
-    if params.last_returns_only and return_number is not None and number_of_returns is not None:
-        if np.any(return_number > 0):
-            candidate = np.asarray(return_number) >= np.asarray(number_of_returns)
-            # malformed records (return 0) are treated as single returns
-            candidate |= np.asarray(return_number) == 0
+    candidate = _last_returns(params, return_number, number_of_returns)
     cell = p.cell_size
     mins, maxs = points.bounds(compiled)
-    grid = Grid.covering(mins[:2], maxs[:2], cell)
-    if grid.rows * grid.cols > 400_000_000:
-        name = "resolution" if p.method == "csf" else "cell_size"
-        raise InputError(
-            f"{name} {cell:g} {unit} gives a {grid.rows} x {grid.cols} grid: too fine "
-            "for this extent (check the distance unit)",
-            column=name,
-        )
+    grid = _grid(mins, maxs, p, unit)
     z0 = float(mins[2])  # float32 grid values relative to the lowest point keep 0.1 mm
     cells = _minimum_grid(points, grid, z0, candidate, compiled, should_stop)
     report(0.3)

@@ -549,22 +549,10 @@ def _columns(A: Array, cols: Index) -> Array:
     return A[:, :, cols]
 
 
-def build_reduced_normal(
-    plan: EliminationPlan,
-    blocks: Sequence,
-    lins: Sequence,
-    active: Sequence[NDArray[np.bool_]],
-    C: sp.csr_matrix | None,
-    h: Array,
-    rowscale: Array | None,
-) -> tuple[ReducedNormal, Array | None]:
-    """Assemble the reduced system of one linearisation (see the module docstring).
-
-    ``lins`` are the whitened linearisations of the blocks (``abar`` (G, c, k), ``wbar``
-    (G, c)); ``C`` the constraint Jacobian (mc, n) and ``h`` its values. Returns the system
-    and the constraint row scale (computed on the first call, then reused).
-    """
-    n = plan.n
+def _diag_grad(blocks: Sequence, lins: Sequence, active: Sequence[NDArray[np.bool_]],
+               n: int) -> tuple[Array, Array]:  # fmt: skip
+    """The diagonal of the normal matrix and the gradient ``A^T w`` (n,) of the whitened
+    linearisations, the active groups only (the Jacobi scale is computed from the diagonal)."""
     diag = np.zeros(n)
     grad = np.zeros(n)
     for bk, bl, a in zip(blocks, lins, active):
@@ -581,6 +569,25 @@ def build_reduced_normal(
                             minlength=n)  # fmt: skip
         grad += np.bincount(bk.param_index.ravel(),
                             weights=np.einsum("gc,gck->gk", w, A).ravel(), minlength=n)  # fmt: skip
+    return diag, grad
+
+
+def build_reduced_normal(
+    plan: EliminationPlan,
+    blocks: Sequence,
+    lins: Sequence,
+    active: Sequence[NDArray[np.bool_]],
+    C: sp.csr_matrix | None,
+    h: Array,
+    rowscale: Array | None,
+) -> tuple[ReducedNormal, Array | None]:
+    """Assemble the reduced system of one linearisation (see the module docstring).
+
+    ``lins`` are the whitened linearisations of the blocks (``abar`` (G, c, k), ``wbar``
+    (G, c)); ``C`` the constraint Jacobian (mc, n) and ``h`` its values. Returns the system
+    and the constraint row scale (computed on the first call, then reused).
+    """
+    diag, grad = _diag_grad(blocks, lins, active, plan.n)
     d = jacobi_scale(np.sqrt(np.clip(diag, 0.0, None)), C)
     dinv = 1.0 / d
     mc = 0 if C is None else C.shape[0]

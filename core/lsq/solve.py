@@ -348,6 +348,18 @@ def _gradient_small(nrm: _Normal, lin: _Lin, opts: AdjustmentOptions) -> bool:
     return g <= opts.gradient_tolerance * math.sqrt(max(lin.phi, 0.0))
 
 
+def _gauss_newton(problem: _Problem, nrm: _Normal, opts: AdjustmentOptions,
+                  use_sparse: bool) -> tuple[Array, Array]:  # fmt: skip
+    """The Gauss-Newton step of the normal equations ``nrm`` (undamped) and the constraints'
+    multipliers; a singular system is diagnosed (NotObservableError naming the parameters)
+    or AdjustmentError."""
+    try:
+        return _solve(nrm, 0.0, use_sparse)
+    except SingularSystem:
+        _check_observability(nrm, problem.names, opts.condition_limit, problem.constraint_labels())
+        raise AdjustmentError("the normal equations could not be solved") from None
+
+
 def _run(
     problem: _Problem,
     x0: Array,
@@ -392,15 +404,6 @@ def _run(
             it -= 1  # no step taken
             break
 
-        def gauss_newton(nrm: _Normal, use_sparse=use_sparse) -> tuple[Array, Array]:
-            try:
-                return _solve(nrm, 0.0, use_sparse)
-            except SingularSystem:
-                _check_observability(
-                    nrm, problem.names, opts.condition_limit, problem.constraint_labels()
-                )
-                raise AdjustmentError("the normal equations could not be solved") from None
-
         # While damping is still needed the Gauss-Newton step is not solved for (it would be
         # rejected); it is solved again once the damping has shrunk back to zero, or when no
         # damped step reduces the cost (to tell convergence from a stall).
@@ -408,7 +411,7 @@ def _run(
             z = None
             step = math.inf
         else:
-            z, k = gauss_newton(nrm)
+            z, k = _gauss_newton(problem, nrm, opts, use_sparse)
             step = float(np.abs(z).max()) if z.size else 0.0
             if k.size:
                 # Exact-penalty weight above the Lagrange multipliers of min ||.||^2 (= 2 k).
@@ -446,7 +449,7 @@ def _run(
             new = _damped_step(problem, lin, nrm, z, active, rowscale, nu, m_old, use_sparse,
                                tol, damp)  # fmt: skip
             if new is None and z is None:
-                z, k = gauss_newton(nrm)
+                z, k = _gauss_newton(problem, nrm, opts, use_sparse)
                 step = float(np.abs(z).max()) if z.size else 0.0
             if new is None:
                 if step <= math.sqrt(tol):

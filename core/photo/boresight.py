@@ -201,26 +201,10 @@ def calibrate(
     par = _parameters(trajectory, camera, mount, opts, group_names, gidx, ins_pos, spec)
 
     # ---- observations in use
-    kinds = np.array(observations.type)
-    used = np.isin(kinds, [t for t in opts.use_types if t != "check"])
-    surveyed: list[_KnownPoint] = []
-    if "control" in opts.use_types and (kinds == "control").any():
-        surveyed, check = _surveyed_points(observations, ground_points)
-        used &= ~check
-    image_of = {iid: k for k, iid in enumerate(trajectory.image_id)}
-    rows_all = np.arange(len(observations))
-    img = np.full(len(observations), -1, dtype=np.intp)
-    img[used] = _index(
-        [observations.image_id[r] for r in rows_all[used]], image_of, "image", rows_all[used]
-    )
+    kinds, used, img, surveyed = _rows_in_use(observations, trajectory, opts, ground_points)
     st = _Stage(observations, kinds, used, img, par.pose_idx, r_nl, spec, local, par.names,
                 np.array(par.x0))  # fmt: skip
-    velocity = None
-    if opts.estimate_timing:
-        velocity = exposure_velocity(trajectory, ins_pos, r_nl)
-        if opts.estimate_lever_arm:
-            r_bl = r_nl @ rph_to_matrix(*trajectory.rph.T)
-            require_timing_separable(*timing_separability(velocity, r_bl))
+    velocity = _velocity(trajectory, ins_pos, r_nl, opts)
     st.blocks += _ins_blocks(trajectory, grade, opts, r_nl, ins_pos, par.ins_at, par.timing_at,
                              velocity)  # fmt: skip
     plane_by_id = {str(p.id): k for k, p in enumerate(planes)}
@@ -269,3 +253,35 @@ def calibrate(
     except NotObservableError as exc:
         raise BoresightNotObservable(exc, diagnose(exc.parameters, group_names)) from exc
     return _result(res, trajectory, frame, local, group_names, par, st, opts)
+
+
+def _rows_in_use(observations: ImageObservations, trajectory: Trajectory, opts: BoresightOptions,
+                 ground_points: SurveyedPoints | None):  # fmt: skip
+    """The observations in use: (types, used mask, image index per row (-1 where unused),
+    the surveyed points of ``control`` rows); the rows of check points are not used."""
+    kinds = np.array(observations.type)
+    used = np.isin(kinds, [t for t in opts.use_types if t != "check"])
+    surveyed: list[_KnownPoint] = []
+    if "control" in opts.use_types and (kinds == "control").any():
+        surveyed, check = _surveyed_points(observations, ground_points)
+        used &= ~check
+    image_of = {iid: k for k, iid in enumerate(trajectory.image_id)}
+    rows_all = np.arange(len(observations))
+    img = np.full(len(observations), -1, dtype=np.intp)
+    img[used] = _index(
+        [observations.image_id[r] for r in rows_all[used]], image_of, "image", rows_all[used]
+    )
+    return kinds, used, img, surveyed
+
+
+def _velocity(trajectory: Trajectory, ins_pos: Array, r_nl: Array,
+              opts: BoresightOptions) -> Array | None:  # fmt: skip
+    """The exposures' velocities (local frame, m/s) for the timing offset, None without it;
+    with the lever arm estimated too, refused where the two cannot be separated."""
+    velocity = None
+    if opts.estimate_timing:
+        velocity = exposure_velocity(trajectory, ins_pos, r_nl)
+        if opts.estimate_lever_arm:
+            r_bl = r_nl @ rph_to_matrix(*trajectory.rph.T)
+            require_timing_separable(*timing_separability(velocity, r_bl))
+    return velocity

@@ -158,9 +158,43 @@ def bundle_adjust(
         Naming the parameters the block cannot determine.
     """
     opts = options if options is not None else BundleOptions()
+    eo_sigma = _check_options(opts, eo, eo_sigma, eo_source)
+    warnings: list[str] = []
+    setup = _prepare(cameras, dict(image_camera or {}), observations, ground, mapping, eo,
+                     eo_sigma, opts, eo_rows, eo_source, should_stop, warnings)  # fmt: skip
+    if scale_bars is not None and len(scale_bars):
+        metres = setup.local.mapping.metres if isinstance(setup.local, EngineeringLocal) else 1.0
+        setup.bars = setup_bars(scale_bars, setup.points, setup.check_ids, metres)
+    if opts.estimate_timing:
+        assert eo is not None  # observed orientations: above
+        setup.velocity = _exposure_velocity(setup, eo, velocity, eo_source, opts.estimate_mount)
+    dt0 = 0.0 if opts.estimate_timing else None
+    cams = list(setup.cameras)
+    free = _free_interior(cams, opts)
+    mount = np.zeros(6) if opts.estimate_mount else None
+    keep = np.ones(len(observations), dtype=bool)
+    report = progress if progress is not None else (lambda f: None)
+    # 1. the full model, robust + snooping, from the approximate values
+    run = _run(setup, observations, cams, free, opts, keep, opts.robust, opts.snooping,
+               setup.eo0, setup.xyz0, mount, should_stop, None, dt0)  # fmt: skip
+    report(0.4)
+    dropped: dict[tuple[str, str], str] = {}
+    dropped_list: list[tuple[str, str, str]] = []
+    if opts.ap_selection and opts.ap_model != "none":
+        run = _select_aps(setup, observations, run, cams, free, opts, keep, should_stop,
+                          dropped, dropped_list)  # fmt: skip
+    report(0.9)
+    out = _finish(setup, observations, run, opts, dropped, dropped_list, eo, warnings)
+    report(1.0)
+    return out
+
+
+def _check_options(opts: BundleOptions, eo: ExteriorOrientationTable | None,
+                   eo_sigma: Array | None, eo_source: str) -> Array | None:  # fmt: skip
+    """The options and the EO sigmas checked against each other (InputError naming what is
+    wrong); the sigmas as a float64 array (m, m, m, rad, rad, rad) or None."""
     if opts.robust not in ("none", "huber", "cauchy"):
         raise InputError(f"robust must be none, huber or cauchy, got {opts.robust!r}")
-    warnings: list[str] = []
     if eo is not None and eo_sigma is not None:
         eo_sigma = np.asarray(eo_sigma, dtype=np.float64)
         if eo_sigma.shape != (len(eo), 6) or not (np.isfinite(eo_sigma).all() and
@@ -173,16 +207,13 @@ def bundle_adjust(
     if opts.estimate_timing and eo_sigma is None:
         raise InputError("estimating the camera timing offset needs observed orientations "
                          "(EO with sigma columns, or EO_SIGMAS)")  # fmt: skip
-    setup = _prepare(cameras, dict(image_camera or {}), observations, ground, mapping, eo,
-                     eo_sigma, opts, eo_rows, eo_source, should_stop, warnings)  # fmt: skip
-    if scale_bars is not None and len(scale_bars):
-        metres = setup.local.mapping.metres if isinstance(setup.local, EngineeringLocal) else 1.0
-        setup.bars = setup_bars(scale_bars, setup.points, setup.check_ids, metres)
-    if opts.estimate_timing:
-        assert eo is not None  # observed orientations: above
-        setup.velocity = _exposure_velocity(setup, eo, velocity, eo_source, opts.estimate_mount)
-    dt0 = 0.0 if opts.estimate_timing else None
-    cams = list(setup.cameras)
+    return eo_sigma
+
+
+def _free_interior(cams: Sequence[Camera], opts: BundleOptions) -> list[NDArray[np.intp]]:
+    """Per camera, the indices of its interior parameters the adjustment estimates (the
+    principal distance and point with ``estimate_interior``, the APs unless ``ap_model`` is
+    none)."""
     free = []
     for cam in cams:
         f = []
@@ -191,55 +222,53 @@ def bundle_adjust(
         if opts.ap_model != "none":
             f += list(range(3, 3 + cam.distortion.n_params))
         free.append(np.array(f, dtype=np.intp))
-    mount = np.zeros(6) if opts.estimate_mount else None
-    keep = np.ones(len(observations), dtype=bool)
-    report = progress if progress is not None else (lambda f: None)
-    # 1. the full model, robust + snooping, from the approximate values
-    run = _run(setup, observations, cams, free, opts, keep, opts.robust, opts.snooping,
-               setup.eo0, setup.xyz0, mount, should_stop, None, dt0)  # fmt: skip
-    report(0.4)
-    dropped: dict[tuple[str, str], str] = {}
-    dropped_list: list[tuple[str, str, str]] = []
-    if opts.ap_selection and opts.ap_model != "none":
-        # observations rejected by the first run stay out while APs are selected
-        keep = keep.copy()
-        for rows, name in zip(run.blocks_rows, run.block_names):
-            keep[rows[run.result.residuals[name].rejected]] = False
-        current = run
-        changed = False
-        for _ in range(sum(f.size for f in free)):
-            stop_if_asked(should_stop, "selecting additional parameters")
-            cand = _drop_candidate(current, opts)
-            if cand is None:
-                break
-            c, pos, reason = cand
-            name = cams[c].interior_names[pos]
-            dropped[(cams[c].name, name)] = reason
-            dropped_list.append((cams[c].name, name, reason))
-            # a dropped AP is held at zero
-            full = _cams_from(current)[c].interior_params
-            full[pos] = 0.0
-            new_cams = _cams_from(current)
-            new_cams[c] = new_cams[c].with_interior(full)
-            free = [f if k != c else f[f != pos] for k, f in enumerate(free)]
-            x = current.result.x
-            mnt, dt = _carried(current)
-            current = _run(setup, observations, new_cams, free, opts, keep, "none", False,
-                           x[current.lay.eo], x[current.lay.points], mnt, should_stop,
-                           None, dt)  # fmt: skip
-            cams = new_cams
-            changed = True
-        if changed:
-            x = current.result.x
-            mnt, dt = _carried(current)
-            keep = np.ones(len(observations), dtype=bool)
-            run = _run(setup, observations, cams, free, opts, keep, opts.robust, opts.snooping,
+    return free
+
+
+def _select_aps(setup, observations: ImageObservations, run: _Run, cams: list[Camera],
+                free: list[NDArray[np.intp]], opts: BundleOptions, keep: NDArray[np.bool_],
+                should_stop: Callable[[], bool] | None, dropped: dict[tuple[str, str], str],
+                dropped_list: list[tuple[str, str, str]]) -> _Run:  # fmt: skip
+    """The AP selection loop (:mod:`.bundle_selection`): from the first run, drop one AP at a
+    time (held at zero; the observations that run rejected stay out) while one is not
+    significant, then the full model, robust + snooping, again with what is left; ``dropped``
+    and ``dropped_list`` filled with each dropped AP and its reason. The run to report."""
+    # observations rejected by the first run stay out while APs are selected
+    keep = keep.copy()
+    for rows, name in zip(run.blocks_rows, run.block_names):
+        keep[rows[run.result.residuals[name].rejected]] = False
+    current = run
+    changed = False
+    for _ in range(sum(f.size for f in free)):
+        stop_if_asked(should_stop, "selecting additional parameters")
+        cand = _drop_candidate(current, opts)
+        if cand is None:
+            break
+        c, pos, reason = cand
+        name = cams[c].interior_names[pos]
+        dropped[(cams[c].name, name)] = reason
+        dropped_list.append((cams[c].name, name, reason))
+        # a dropped AP is held at zero
+        full = _cams_from(current)[c].interior_params
+        full[pos] = 0.0
+        new_cams = _cams_from(current)
+        new_cams[c] = new_cams[c].with_interior(full)
+        free = [f if k != c else f[f != pos] for k, f in enumerate(free)]
+        x = current.result.x
+        mnt, dt = _carried(current)
+        current = _run(setup, observations, new_cams, free, opts, keep, "none", False,
                        x[current.lay.eo], x[current.lay.points], mnt, should_stop,
                        None, dt)  # fmt: skip
-    report(0.9)
-    out = _finish(setup, observations, run, opts, dropped, dropped_list, eo, warnings)
-    report(1.0)
-    return out
+        cams = new_cams
+        changed = True
+    if changed:
+        x = current.result.x
+        mnt, dt = _carried(current)
+        keep = np.ones(len(observations), dtype=bool)
+        run = _run(setup, observations, cams, free, opts, keep, opts.robust, opts.snooping,
+                   x[current.lay.eo], x[current.lay.points], mnt, should_stop,
+                   None, dt)  # fmt: skip
+    return run
 
 
 def _carried(run: _Run) -> tuple[Array | None, float | None]:

@@ -324,33 +324,10 @@ def _prepare(
         raise InputError(f"two cameras share the name(s) {sorted(set(cam_names))}")
     images = tuple(eo.image_id) if eo is not None else tuple(dict.fromkeys(obs.image_id))
     _check_observations(obs, images, eo_rows, eo_source, ground, options.datum != "control")
-    image_cam = np.zeros(len(images), dtype=np.intp)
-    for k, im in enumerate(images):
-        name = image_camera.get(im)
-        if name is None:
-            if len(cameras) == 1:
-                continue
-            raise InputError(
-                f"image '{im}' has no camera: with several cameras give a camera column in "
-                "the exterior orientation or observation table"
-            )
-        if name not in cam_names:
-            raise InputError(
-                f"image '{im}' names camera '{name}', which is not one of {', '.join(cam_names)}"
-            )
-        image_cam[k] = cam_names.index(name)
+    image_cam = _image_cameras(cameras, cam_names, images, image_camera)
     roles = dict(zip(ground.point_id, ground.role))
     gidx = {p: i for i, p in enumerate(ground.point_id)}
-    observed = set(obs.point_id)
-    unobserved = [p for p in ground.point_id if p not in observed]
-    if unobserved:
-        warnings.append(
-            _t(
-                "{n} ground point(s) are not measured in any image and were not used: {ids}",
-                n=len(unobserved),
-                ids=", ".join(unobserved[:20]) + (" ..." if len(unobserved) > 20 else ""),
-            )
-        )
+    _warn_unobserved(ground, obs, warnings)
     free = options.datum != "control"
     adjusted: list[str] = []
     check_ids: list[str] = []
@@ -368,20 +345,7 @@ def _prepare(
     point_roles = tuple(
         "control" if (roles.get(p) == "control" and not free) else "tie" for p in adjusted
     )
-    # the block must hang together through its adjusted points
-    used = obs_pt >= 0
-    ncomp, label = _components(obs_img[used], obs_pt[used], len(images), len(adjusted))
-    if ncomp > 1:
-        img_label = label[: len(images)]
-        main = np.bincount(img_label).argmax()
-        apart = [images[k] for k in np.flatnonzero(img_label != main)]
-        raise InputError(
-            f"the block falls into {ncomp} unconnected parts (no tie or control point links "
-            f"them): images {', '.join(apart[:30])}{' ...' if len(apart) > 30 else ''} are "
-            "not connected to the rest; adjust the parts separately or measure tie points "
-            "between them",
-            path=obs.source or None,
-        )
+    _check_connected(obs, obs_img, obs_pt, images, len(adjusted))
     if eo is None and len(ground) == 0:
         raise InputError(
             "without approximate exterior orientations the bundle needs control points to "
@@ -413,17 +377,7 @@ def _prepare(
             "sigmas (or choose a free-network datum: inner or minimal)"
         )
     if eo_obs is None:
-        # without observed orientations an image needs three points (six equations for its
-        # six unknowns) to be oriented at all
-        per_image = np.bincount(obs_img[obs_pt >= 0], minlength=len(images))
-        few = np.flatnonzero(per_image < 3)
-        if few.size:
-            names = ", ".join(f"{images[k]} ({per_image[k]})" for k in few[:20])
-            raise InputError(
-                f"{few.size} image(s) have fewer than three measured points and cannot be "
-                f"oriented without observed exterior orientations: {names}",
-                path=obs.source or None,
-            )
+        _check_orientable(obs, obs_img, obs_pt, images)
     xyz0 = _approximate_points(cams, image_cam, eo0, obs, obs_img, obs_pt, len(adjusted))
     if control_pt.size:
         xyz0[control_pt] = control_local
@@ -443,6 +397,79 @@ def _prepare(
         check_ref_local=check_local, control_pt=control_pt, control_cov=control_cov,
         control_local=control_local, eo_obs=eo_obs, eo_obs_cov=eo_obs_cov,
     )  # fmt: skip
+
+
+def _image_cameras(cameras: Sequence[Camera], cam_names: tuple[str, ...], images: tuple[str, ...],
+                   image_camera: Mapping[str, str]) -> NDArray[np.intp]:  # fmt: skip
+    """The camera (index into ``cameras``) of every image; InputError for an image without
+    one among several cameras or naming an unknown camera."""
+    image_cam = np.zeros(len(images), dtype=np.intp)
+    for k, im in enumerate(images):
+        name = image_camera.get(im)
+        if name is None:
+            if len(cameras) == 1:
+                continue
+            raise InputError(
+                f"image '{im}' has no camera: with several cameras give a camera column in "
+                "the exterior orientation or observation table"
+            )
+        if name not in cam_names:
+            raise InputError(
+                f"image '{im}' names camera '{name}', which is not one of {', '.join(cam_names)}"
+            )
+        image_cam[k] = cam_names.index(name)
+    return image_cam
+
+
+def _warn_unobserved(ground: GroundPoints, obs: ImageObservations, warnings: list[str]) -> None:
+    """A warning (appended to ``warnings``) naming the ground points no image measures."""
+    observed = set(obs.point_id)
+    unobserved = [p for p in ground.point_id if p not in observed]
+    if unobserved:
+        warnings.append(
+            _t(
+                "{n} ground point(s) are not measured in any image and were not used: {ids}",
+                n=len(unobserved),
+                ids=", ".join(unobserved[:20]) + (" ..." if len(unobserved) > 20 else ""),
+            )
+        )
+
+
+def _check_connected(obs: ImageObservations, obs_img: NDArray[np.intp], obs_pt: NDArray[np.intp],
+                     images: tuple[str, ...], n_points: int) -> None:  # fmt: skip
+    """InputError naming the images apart when the block falls into unconnected parts
+    (through its adjusted points)."""
+    # the block must hang together through its adjusted points
+    used = obs_pt >= 0
+    ncomp, label = _components(obs_img[used], obs_pt[used], len(images), n_points)
+    if ncomp > 1:
+        img_label = label[: len(images)]
+        main = np.bincount(img_label).argmax()
+        apart = [images[k] for k in np.flatnonzero(img_label != main)]
+        raise InputError(
+            f"the block falls into {ncomp} unconnected parts (no tie or control point links "
+            f"them): images {', '.join(apart[:30])}{' ...' if len(apart) > 30 else ''} are "
+            "not connected to the rest; adjust the parts separately or measure tie points "
+            "between them",
+            path=obs.source or None,
+        )
+
+
+def _check_orientable(obs: ImageObservations, obs_img: NDArray[np.intp], obs_pt: NDArray[np.intp],
+                      images: tuple[str, ...]) -> None:  # fmt: skip
+    """Without observed orientations: InputError naming the images with fewer than three
+    measured points (six equations for their six unknowns)."""
+    # without observed orientations an image needs three points (six equations for its
+    # six unknowns) to be oriented at all
+    per_image = np.bincount(obs_img[obs_pt >= 0], minlength=len(images))
+    few = np.flatnonzero(per_image < 3)
+    if few.size:
+        names = ", ".join(f"{images[k]} ({per_image[k]})" for k in few[:20])
+        raise InputError(
+            f"{few.size} image(s) have fewer than three measured points and cannot be "
+            f"oriented without observed exterior orientations: {names}",
+            path=obs.source or None,
+        )
 
 
 def _cov_map_to_local(xyz: Array, sigma: Array, local: Local) -> Array:

@@ -224,7 +224,6 @@ def locate_control_points(
     eo_local = np.column_stack([centres, om, ph, ka])
     pairs: list[LocatedPair] = []
     obs_rows: list[tuple[str, str, float, float, float]] = []
-    n_img = len(eo)
     for p_n, chip in enumerate(chips):
         stop_if_asked(should_stop, "locating control points")
         if progress is not None:
@@ -241,24 +240,8 @@ def locate_control_points(
         ci, ri = int(np.rint(pc[0])), int(np.rint(pc[1]))
         template = chip.grey[ri - h : ri + h + 1, ci - h : ci + h + 1]
         ref = (pc[0] - (ci - h), pc[1] - (ri - h))
-        # The point and 4 chip pixels +-5 px around it, in every image at once.
-        offsets = np.array([[0, 0], [5, 0], [-5, 0], [0, 5], [0, -5]], dtype=float)
-        pts_local = local.map_to_enu(chip.array_to_map(np.asarray(pc) + offsets))
-        pix = np.full((n_img, 5, 2), np.nan)
-        front = np.zeros(n_img, dtype=bool)
-        for i in range(n_img):
-            px, inf, conv = project_with_status(pts_local, eo_local[i], camera)
-            pix[i] = px
-            front[i] = bool(inf.all() and conv.all())
-        jac_chip = np.stack(
-            [(pix[:, 1] - pix[:, 2]) / 10.0, (pix[:, 3] - pix[:, 4]) / 10.0], axis=2
-        )  # fmt: skip  (n_img, 2 image, 2 chip)
-        reach = np.abs(jac_chip).sum(axis=2).max(axis=1) * h if n_img else np.zeros(0)
-        inside = front & camera.in_frame(pix[:, 0], margin_px=0.0)
-        inside &= np.isfinite(reach)
-        inside_margin = inside & (pix[:, 0, 0] - reach >= 0) & (pix[:, 0, 1] - reach >= 0)
-        inside_margin &= pix[:, 0, 0] + reach <= camera.width_px
-        inside_margin &= pix[:, 0, 1] + reach <= camera.height_px
+        pts_local, pix, jac_chip, inside, inside_margin = _chip_in_images(
+            chip, pc, h, local, eo_local, camera)  # fmt: skip
         if not inside.any():
             pairs.append(LocatedPair(pid, "", "outside", _t("outside every image"),
                                      template_px=size.size))  # fmt: skip
@@ -274,17 +257,8 @@ def locate_control_points(
                 results[i] = LocatedPair(pid, iid, "rejected", _t("template partly outside "
                                          "the image"), **base)  # fmt: skip
                 continue
-            # search ellipse
-            if eo_sigmas is not None:
-                jeo = _pixel_jacobian(pts_local[:1], eo_local[i], camera)[0]
-                cov = jeo @ np.diag(np.asarray(eo_sigmas[i], float) ** 2) @ jeo.T
-                half_f = opt.search_sigmas * np.sqrt(np.diag(cov))
-                cov_search = cov * opt.search_sigmas**2
-            else:
-                half_f = np.full(2, opt.default_search_px)
-                cov_search = np.diag(half_f**2)
-            half_f = np.clip(half_f, opt.min_search_px, opt.max_search_px)
-            cov_search = cov_search + np.diag(np.full(2, opt.min_search_px**2))
+            half_f, cov_search = _search_ellipse(opt, eo_sigmas, i, pts_local, eo_local,
+                                                 camera)  # fmt: skip
             base["search_px"] = (float(half_f[0]), float(half_f[1]))
             jac = jac_chip[i]
             m = _match(
@@ -299,20 +273,9 @@ def locate_control_points(
                 cv2=cv2,
             )
             results[i] = _finish(pid, iid, m, pred, cov_search, base, "chip")
-        # transfer
         if opt.transfer:
-            good = [i for i, r in results.items() if r.status == "ok"]
-            if good:
-                master = min(good, key=lambda i: max(results[i].sigma_col, results[i].sigma_row))
-                mres = results[master]
-                for i, r in list(results.items()):
-                    if r.status == "ok" or "outside the image" in r.reason:
-                        continue
-                    t = _transfer(mres, master, i, jac_chip, pix, eo.image_id, read_window,
-                                  size.size, opt, cv2, eo_sigmas, eo_local, pts_local, camera,
-                                  r)  # fmt: skip
-                    if t is not None:
-                        results[i] = t
+            _transfer_failed(results, jac_chip, pix, eo, read_window, size.size, opt, cv2,
+                             eo_sigmas, eo_local, pts_local, camera)  # fmt: skip
         for i in sorted(results):
             r = results[i]
             pairs.append(r)
@@ -328,6 +291,70 @@ def locate_control_points(
     else:
         obs = ImageObservations.from_arrays([], [], np.zeros((0, 2)), np.zeros(0), [], [])
     return LocationResult(tuple(pairs), obs)
+
+
+def _chip_in_images(chip: ControlChip, pc, h: int, local: LocalFrame, eo_local: Array,
+                    camera: Camera):  # fmt: skip
+    """The chip's point and 4 chip pixels +-5 px around it in every image at once: (their
+    local coordinates (5, 3), their pixels (n_img, 5, 2), the image-per-chip-pixel Jacobians
+    (n_img, 2, 2), the images the point falls in, those that also hold the whole template of
+    half-size ``h`` chip pixels)."""
+    offsets = np.array([[0, 0], [5, 0], [-5, 0], [0, 5], [0, -5]], dtype=float)
+    pts_local = local.map_to_enu(chip.array_to_map(np.asarray(pc) + offsets))
+    n_img = len(eo_local)
+    pix = np.full((n_img, 5, 2), np.nan)
+    front = np.zeros(n_img, dtype=bool)
+    for i in range(n_img):
+        px, inf, conv = project_with_status(pts_local, eo_local[i], camera)
+        pix[i] = px
+        front[i] = bool(inf.all() and conv.all())
+    jac_chip = np.stack(
+        [(pix[:, 1] - pix[:, 2]) / 10.0, (pix[:, 3] - pix[:, 4]) / 10.0], axis=2
+    )  # fmt: skip  (n_img, 2 image, 2 chip)
+    reach = np.abs(jac_chip).sum(axis=2).max(axis=1) * h if n_img else np.zeros(0)
+    inside = front & camera.in_frame(pix[:, 0], margin_px=0.0)
+    inside &= np.isfinite(reach)
+    inside_margin = inside & (pix[:, 0, 0] - reach >= 0) & (pix[:, 0, 1] - reach >= 0)
+    inside_margin &= pix[:, 0, 0] + reach <= camera.width_px
+    inside_margin &= pix[:, 0, 1] + reach <= camera.height_px
+    return pts_local, pix, jac_chip, inside, inside_margin
+
+
+def _search_ellipse(opt: LocateOptions, eo_sigmas: Array | None, i: int, pts_local: Array,
+                    eo_local: Array, camera: Camera) -> tuple[Array, Array]:  # fmt: skip
+    """The search half-sizes (col, row pixels) in image ``i`` and the search covariance
+    (pixels^2): from the EO sigmas propagated to the image when given, else the defaults."""
+    if eo_sigmas is not None:
+        jeo = _pixel_jacobian(pts_local[:1], eo_local[i], camera)[0]
+        cov = jeo @ np.diag(np.asarray(eo_sigmas[i], float) ** 2) @ jeo.T
+        half_f = opt.search_sigmas * np.sqrt(np.diag(cov))
+        cov_search = cov * opt.search_sigmas**2
+    else:
+        half_f = np.full(2, opt.default_search_px)
+        cov_search = np.diag(half_f**2)
+    half_f = np.clip(half_f, opt.min_search_px, opt.max_search_px)
+    cov_search = cov_search + np.diag(np.full(2, opt.min_search_px**2))
+    return half_f, cov_search
+
+
+def _transfer_failed(results: dict, jac_chip: Array, pix: Array, eo: ExteriorOrientationTable,
+                     read_window: WindowReader, size_px: int, opt: LocateOptions, cv2,
+                     eo_sigmas: Array | None, eo_local: Array, pts_local: Array,
+                     camera: Camera) -> None:  # fmt: skip
+    """Transfer: the images where the chip failed (not for being outside the image) matched
+    again from the best located image (smallest sigma); ``results`` updated in place."""
+    good = [i for i, r in results.items() if r.status == "ok"]
+    if good:
+        master = min(good, key=lambda i: max(results[i].sigma_col, results[i].sigma_row))
+        mres = results[master]
+        for i, r in list(results.items()):
+            if r.status == "ok" or "outside the image" in r.reason:
+                continue
+            t = _transfer(mres, master, i, jac_chip, pix, eo.image_id, read_window,
+                          size_px, opt, cv2, eo_sigmas, eo_local, pts_local, camera,
+                          r)  # fmt: skip
+            if t is not None:
+                results[i] = t
 
 
 @dataclass

@@ -496,6 +496,37 @@ def _result_lines(
     return lines
 
 
+def _eo_covariance(eo_sigmas) -> Array:
+    """(6, 6) covariance of the exterior orientation (m, rad) from its 6 sigmas: X, Y, Z (m),
+    omega, phi, kappa (deg); InputError unless 6 finite numbers >= 0."""
+    sig6 = np.asarray(eo_sigmas, dtype=np.float64).ravel()
+    if sig6.size != 6 or not np.isfinite(sig6).all() or (sig6 < 0).any():
+        raise InputError("EO sigmas: give 6 numbers >= 0: X, Y, Z (m), omega, phi, kappa (deg)")
+    return np.diag(np.r_[sig6[:3], np.radians(sig6[3:])] ** 2)
+
+
+def _plane_rays(obs: ImageObservations, src: NDArray[np.int64], line_of: NDArray[np.int64],
+                plane_map: dict) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:  # fmt: skip
+    """(rays cut with a plane: tie and paper points, not on lines, when planes are given;
+    those among them whose plane is not in ``plane_map``)."""
+    kinds = [obs.type[k] for k in src]
+    on_plane = np.array(
+        [bool(plane_map) and kd in ("tie", "paper") and line_of[r] < 0
+         for r, kd in enumerate(kinds)]
+    )  # fmt: skip
+    unknown = on_plane & np.array([obs.target_id[k] not in plane_map for k in src])
+    return on_plane, unknown
+
+
+def _rows(obs: ImageObservations, src, line_of, vertex_of, used: list[str]) -> list[tuple]:
+    """The result's row per ray: image, point, type, target, line, vertex, surface used."""
+    return [
+        (obs.image_id[s], obs.point_id[s], obs.type[s], obs.target_id[s], int(li), int(vi),
+         used[r])
+        for r, (s, li, vi) in enumerate(zip(src, line_of, vertex_of))
+    ]  # fmt: skip
+
+
 def monoplot(
     observations: ImageObservations,
     camera: Camera,
@@ -551,10 +582,7 @@ def monoplot(
 
     if method not in METHODS:
         raise InputError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
-    sig6 = np.asarray(eo_sigmas, dtype=np.float64).ravel()
-    if sig6.size != 6 or not np.isfinite(sig6).all() or (sig6 < 0).any():
-        raise InputError("EO sigmas: give 6 numbers >= 0: X, Y, Z (m), omega, phi, kappa (deg)")
-    eo_cov = np.diag(np.r_[sig6[:3], np.radians(sig6[3:])] ** 2)
+    eo_cov = _eo_covariance(eo_sigmas)
     obs, cam, table = observations, camera, eo
     mapping_crs = parse_crs(crs)
     tracer = dsm if isinstance(dsm, DsmTracer) else None
@@ -579,12 +607,8 @@ def monoplot(
         LOG.warning("no exterior orientation for image(s) %s", ", ".join(missing[:10]))
 
     dsm = _dsm_in_crs(dsm, mapping_crs, should_stop)
-    kinds = [obs.type[k] for k in src]
     targets = [obs.target_id[k] for k in src]
-    on_plane = np.array(
-        [bool(planes) and kd in ("tie", "paper") and line_of[r] < 0 for r, kd in enumerate(kinds)]
-    )
-    unknown = on_plane & np.array([t not in plane_map for t in targets])
+    on_plane, unknown = _plane_rays(obs, src, line_of, plane_map)
     status[unknown & (img_idx >= 0)] = STATUS_UNKNOWN_PLANE
     on_plane &= ~unknown
 
@@ -629,11 +653,7 @@ def monoplot(
     if progress is not None:
         progress(0.95)
 
-    rows = [
-        (obs.image_id[s], obs.point_id[s], obs.type[s], obs.target_id[s], int(li), int(vi),
-         used[r])
-        for r, (s, li, vi) in enumerate(zip(src, line_of, vertex_of))
-    ]  # fmt: skip
+    rows = _rows(obs, src, line_of, vertex_of, used)
     lines = _result_lines(line_keys, line_of, vertex_of, points, cov, status)
     result = MonoplotResult(rows, pixels, points, cov, status, incidence, lines,
                             mapping_crs.to_wkt(), dsm)  # fmt: skip

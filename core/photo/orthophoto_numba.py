@@ -27,7 +27,7 @@ def _cell_pixels(
 ):  # fmt: skip
     """Fill out_col, out_row (image pixels, NaN: none) and out_z (surface height) of an h x w
     block of cells whose first centre is (x0, y0) and spacing g (see
-    :func:`core.photo.orthophoto.cell_pixels_numpy` for the arguments).
+    :func:`core.photo.orthophoto_cells.cell_pixels_numpy` for the arguments).
 
     Written for speed: the lattice is interpolated to each row once, then along the row one
     lattice interval after the other (no per-cell division or clamping); in each interval the

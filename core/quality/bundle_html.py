@@ -208,6 +208,25 @@ def render_bundle_html(
     parts += _block_map(res)
     parts += [f"<h2>{t('Interior orientation and additional parameters')}</h2>",
               _interior(res, alpha_text)]  # fmt: skip
+    parts += _selection(res, max_correlation)
+    parts += _lens_plots(res)
+    parts += _mount(res)
+    parts += _timing(res)
+    parts += _images(res)
+    parts += _check_points(res)
+    parts += _residuals(res)
+    parts += _scale_bars(res)
+    if res.warnings:
+        parts += [f"<h2>{t('Warnings')}</h2><ul>",
+                  *(f"<li>{_e(t(w))}</li>" for w in res.warnings), "</ul>"]  # fmt: skip
+    parts.append("</body></html>")
+    return _in_unit("\n".join(parts), _unit(res))
+
+
+def _selection(res: BundleResult, max_correlation: float) -> list[str]:
+    """The APs the selection dropped, the correlations flagged and the interior
+    correlation heat maps."""
+    parts: list[str] = []
     if res.dropped:
         parts.append(
             "<p>"
@@ -230,7 +249,12 @@ def render_bundle_html(
                                              flag=max_correlation))  # fmt: skip
     if plots:
         parts += ['<div class="plots">', *plots, "</div>"]
-    parts += _lens_plots(res)
+    return parts
+
+
+def _mount(res: BundleResult) -> list[str]:
+    """The lever arm and boresight corrections' section (when estimated)."""
+    parts: list[str] = []
     if res.mount is not None:
         m = res.mount
         rows = [[_e(n), _n(v, ".4f"), _n(s, ".4f")] for n, v, s in zip(
@@ -242,7 +266,12 @@ def render_bundle_html(
             m["boresight_rad"], m["boresight_std_rad"])]  # fmt: skip
         parts += [f"<h2>{t('Lever arm and boresight corrections (camera axes)')}</h2>",
                   _table([t("parameter"), t("value"), t("std")], rows)]  # fmt: skip
-    parts += _timing(res)
+    return parts
+
+
+def _images(res: BundleResult) -> list[str]:
+    """The images' section: points used, residual RMS and orientation sigmas."""
+    parts: list[str] = []
     # per image
     rows = []
     for k, im in enumerate(res.eo.image_id):
@@ -257,6 +286,12 @@ def render_bundle_html(
                 "sigma X (m)", "sigma Y (m)", "sigma Z (m)", 'sigma omega (")', 'sigma phi (")',
                 'sigma kappa (")'], rows),
     ]
+    return parts
+
+
+def _check_points(res: BundleResult) -> list[str]:
+    """The check points' section: discrepancies, their statistics and sigmas."""
+    parts: list[str] = []
     c = res.check
     if len(c.point_id):
         st = c.statistics()
@@ -279,6 +314,13 @@ def render_bundle_html(
             _table([t("point"), "dE (m)", "dN (m)", "dU (m)", "dHorizontal (m)", "sigma E (m)",
                     "sigma N (m)", "sigma H (m)", t("images")], rows),
         ]
+    return parts
+
+
+def _residuals(res: BundleResult) -> list[str]:
+    """The residuals' section (vector fields per camera, histograms) and the rejected
+    measurements."""
+    parts: list[str] = []
     plots = []
     obs = res.observations
     cams = np.array(res.image_camera)
@@ -306,12 +348,7 @@ def render_bundle_html(
         parts += [f"<h2>{title}</h2>",
                   _table([t("image"), t("point"), t("v col"), t("v row"), t("w col"),
                           t("w row")], rows)]  # fmt: skip
-    parts += _scale_bars(res)
-    if res.warnings:
-        parts += [f"<h2>{t('Warnings')}</h2><ul>",
-                  *(f"<li>{_e(t(w))}</li>" for w in res.warnings), "</ul>"]  # fmt: skip
-    parts.append("</body></html>")
-    return _in_unit("\n".join(parts), _unit(res))
+    return parts
 
 
 def _unit(res: BundleResult) -> str:

@@ -84,6 +84,47 @@ def pec_pcd_limits(scale: float, equidistance: float | None = None) -> dict[str,
     return out
 
 
+def _class_verdict(name: str, share: float, n: int, rms: float, pec: float, ep: float) -> Verdict:
+    """One class: met when ``share`` (of the n discrepancies) within its PEC is >= 90 % and
+    the RMS (m) within its EP (m). The Decreto sets no minimum sample: the class verdict
+    stands, the count verdict warns when the sample is small."""
+    ok90 = share >= PEC_FRACTION
+    ok_ep = rms <= ep + _TOL
+    reason = _t(
+        "{share:.1f} % of {n} points within PEC {pec:.3f} m ({share_relation} 90 %); "
+        "RMS {rms:.3f} m {rms_relation} EP {ep:.3f} m",
+        share=100 * share,
+        n=n,
+        pec=pec,
+        share_relation=">=" if ok90 else "<",
+        rms=rms,
+        rms_relation="<=" if ok_ep else ">",
+        ep=ep,
+    )
+    return Verdict(name, "pass" if ok90 and ok_ep else "fail", reason, rms, ep)
+
+
+def _declared(verdicts: list[Verdict], target: str) -> list[Verdict]:
+    """The declared class's verdicts (planimetric, altimetric): those of class ``target``."""
+    out = []
+    for kind in ("planimetric", "altimetric"):
+        v = next(x for x in verdicts if x.name == f"Class {target} {kind}")
+        out.append(
+            Verdict(
+                (
+                    _t("Declared class {cls} (planimetric)", cls=target)
+                    if kind == "planimetric"
+                    else _t("Declared class {cls} (altimetric)", cls=target)
+                ),
+                v.status,
+                v.reason,
+                v.measured,
+                v.limit,
+            )
+        )
+    return out
+
+
 def pec_pcd(
     d: NDArray[np.float64],
     *,
@@ -162,25 +203,10 @@ def pec_pcd(
                 )
                 continue
             share = float(np.mean(values <= pec + _TOL))
-            ok90 = share >= PEC_FRACTION
-            ok_ep = rms <= ep + _TOL
-            reason = _t(
-                "{share:.1f} % of {n} points within PEC {pec:.3f} m ({share_relation} 90 %); "
-                "RMS {rms:.3f} m {rms_relation} EP {ep:.3f} m",
-                share=100 * share,
-                n=n,
-                pec=pec,
-                share_relation=">=" if ok90 else "<",
-                rms=rms,
-                rms_relation="<=" if ok_ep else ">",
-                ep=ep,
-            )
-            # The Decreto sets no minimum sample: the class verdict stands, the count verdict
-            # above warns when the sample is small.
-            status = "pass" if ok90 and ok_ep else "fail"
-            if ok90 and ok_ep and best[kind] is None:
+            verdict = _class_verdict(name, share, n, rms, pec, ep)
+            if verdict.status == "pass" and best[kind] is None:
                 best[kind] = c
-            verdicts.append(Verdict(name, status, reason, rms, ep))
+            verdicts.append(verdict)
             figures[f"{kind}_{c}_share_within_pec"] = share
     eq = _equidistance(scale, equidistance)
     figures["equidistance"] = eq if eq else math.nan
@@ -200,21 +226,7 @@ def pec_pcd(
             "1/3, 2/5, 1/2)."
         ),
     ]
-    for kind in ("planimetric", "altimetric"):
-        v = next(x for x in verdicts if x.name == f"Class {target} {kind}")
-        verdicts.append(
-            Verdict(
-                (
-                    _t("Declared class {cls} (planimetric)", cls=target)
-                    if kind == "planimetric"
-                    else _t("Declared class {cls} (altimetric)", cls=target)
-                ),
-                v.status,
-                v.reason,
-                v.measured,
-                v.limit,
-            )
-        )
+    verdicts += _declared(verdicts, target)
     return StandardResult(
         key="pec",
         title=_t("PEC-PCD (Decreto 89.817 / ET-CQDG), 1:{scale:,.0f}", scale=float(scale)),

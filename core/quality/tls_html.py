@@ -173,33 +173,9 @@ def _adjustment_parts(cal: TlsCalibration, rejections: RejectionTest | None) -> 
     ]
 
 
-def render_tls_html(
-    cal: TlsCalibration,
-    settings: Mapping[str, str],
-    problems: Sequence[object] = (),
-    accepted: bool = True,
-    rejections: RejectionTest | None = None,
-) -> str:
-    """The report page of a calibration (str, UTF-8 HTML); ``problems``: why it failed its
-    checks (written anyway when ``accepted``), ``rejections``: the test of the number of
-    rejected observations against snooping's false alarms."""
-    adj = cal.adjustment
-    out = [
-        f"<!DOCTYPE html><html lang='{html_lang()}'><head><meta charset='utf-8'>",
-        f"<title>{t('TLS self-calibration')}</title>",
-        f"<style>{_CSS}</style></head><body>",
-        f"<h1>{t('Terrestrial laser scanner: registration and self-calibration')}</h1>",
-        f"<p class='note'>lidarphoto {_e(__version__)}. "
-        + t(
-            "Model: Carvalho, Correa &amp; dos Santos (Eqs. 1-5), additional parameters after "
-            "Lichti (2007), correlation analysis after Lichti (2010)."
-        )
-        + "</p>",
-        *failed_checks(problems, accepted, _refused()),
-        f"<h2>{t('Settings')}</h2>",
-        _table([t("setting"), t("value")], [(_e(k), _e(v)) for k, v in settings.items()]),
-    ]
-    out += _adjustment_parts(cal, rejections)
+def _ap_parts(cal: TlsCalibration) -> list[str]:
+    """The additional parameters' section: values, sigmas, t-tests (none without APs)."""
+    out: list[str] = []
     if cal.ap_names:
         rows, css = [], []
         for a in cal.ap_report():
@@ -233,6 +209,12 @@ def render_tls_html(
             ).format(_n(cal.t_critical, 2), f"{cal.options.significance_alpha:g}")
             + "</p>",
         ]
+    return out
+
+
+def _station_parts(cal: TlsCalibration) -> list[str]:
+    """The stations' section: poses (m, deg) and their sigmas (mm, arc seconds)."""
+    out: list[str] = []
     srows = []
     for k, s in enumerate(cal.stations):
         p, sd = cal.pose[k], cal.pose_std[k]
@@ -261,6 +243,38 @@ def render_tls_html(
             srows,
         ),
     ]
+    return out
+
+
+def render_tls_html(
+    cal: TlsCalibration,
+    settings: Mapping[str, str],
+    problems: Sequence[object] = (),
+    accepted: bool = True,
+    rejections: RejectionTest | None = None,
+) -> str:
+    """The report page of a calibration (str, UTF-8 HTML); ``problems``: why it failed its
+    checks (written anyway when ``accepted``), ``rejections``: the test of the number of
+    rejected observations against snooping's false alarms."""
+    adj = cal.adjustment
+    out = [
+        f"<!DOCTYPE html><html lang='{html_lang()}'><head><meta charset='utf-8'>",
+        f"<title>{t('TLS self-calibration')}</title>",
+        f"<style>{_CSS}</style></head><body>",
+        f"<h1>{t('Terrestrial laser scanner: registration and self-calibration')}</h1>",
+        f"<p class='note'>lidarphoto {_e(__version__)}. "
+        + t(
+            "Model: Carvalho, Correa &amp; dos Santos (Eqs. 1-5), additional parameters after "
+            "Lichti (2007), correlation analysis after Lichti (2010)."
+        )
+        + "</p>",
+        *failed_checks(problems, accepted, _refused()),
+        f"<h2>{t('Settings')}</h2>",
+        _table([t("setting"), t("value")], [(_e(k), _e(v)) for k, v in settings.items()]),
+    ]
+    out += _adjustment_parts(cal, rejections)
+    out += _ap_parts(cal)
+    out += _station_parts(cal)
     out.append(f"<h2>{t('Correlations')}</h2>")
     if cal.strong_pairs:
         prow = [(_e(a), _e(b), _n(r, 3), _e(explain_pair(a, b) or "")) for a, b, r in

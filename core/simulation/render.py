@@ -285,6 +285,30 @@ class RenderedImage:
 
 
 
+def _paint_planes(base: NDArray, label: NDArray, scene: RenderScene, sun: Array,
+                  ambient: float) -> None:  # fmt: skip
+    """The pixels of ``base`` (H, W, 3) whose ``label`` is a plane painted with its tint,
+    shaded by the sun (in place)."""
+    shade = lambert(scene.normals, sun, ambient)
+    tint = np.array(PLANE_TINTS)[scene.tint]
+    plane_rgb = np.clip(np.rint(255.0 * tint * shade[:, None]), 0, 255).astype(np.uint8)
+    on = label >= 0
+    base[on] = plane_rgb[label[on]]
+
+
+def _with_noise(base: NDArray, opt: RenderOptions) -> NDArray:
+    """``base`` with luminance noise of ``opt.noise_dn`` (DN, seeded by ``opt.seed``): the same
+    on the three channels, as after demosaicing; also keeps a 24-Mpx LZW TIFF near 16 MB
+    instead of 30 MB with independent channels."""
+    import cv2
+
+    noise = np.empty(base.shape[:2], np.int16)
+    cv2.setRNGSeed(int(opt.seed))
+    # OpenCV's stubs want arrays for the mean and deviation; it takes numbers
+    cv2.randn(noise, 0.0, float(opt.noise_dn))  # type: ignore[call-overload]
+    return cv2.add(base, cv2.merge([noise, noise, noise]), dtype=cv2.CV_8U)
+
+
 def render_image(
     scene: RenderScene,
     camera: Camera,
@@ -394,19 +418,9 @@ def render_image(
                 progress(0.7 + 0.2 * min(1.0, (s + chunk) / max(br.size, 1)))
     base = cv2.resize(rgb_c, (w * k, h * k), interpolation=cv2.INTER_LINEAR)[:height, :width]
     if n_planes:
-        shade = lambert(scene.normals, sun, opt.ambient)
-        tint = np.array(PLANE_TINTS)[scene.tint]
-        plane_rgb = np.clip(np.rint(255.0 * tint * shade[:, None]), 0, 255).astype(np.uint8)
-        on = label >= 0
-        base[on] = plane_rgb[label[on]]
+        _paint_planes(base, label, scene, sun, opt.ambient)
     if opt.noise_dn > 0:
-        # luminance noise (the same on the three channels, as after demosaicing): also keeps
-        # a 24-Mpx LZW TIFF near 16 MB instead of 30 MB with independent channels
-        noise = np.empty(base.shape[:2], np.int16)
-        cv2.setRNGSeed(int(opt.seed))
-        # OpenCV's stubs want arrays for the mean and deviation; it takes numbers
-        cv2.randn(noise, 0.0, float(opt.noise_dn))  # type: ignore[call-overload]
-        base = cv2.add(base, cv2.merge([noise, noise, noise]), dtype=cv2.CV_8U)
+        base = _with_noise(base, opt)
     ids = np.append(scene.plane_ids, -1).astype(np.int32)
     plane_id = ids[label]  # -1 indexes the appended "no plane"
     if progress is not None:
