@@ -23,11 +23,11 @@ i18n:
 lint:
 	bash scripts/test.sh --core-env
 	.venv/bin/ruff check .
-	.venv/bin/ruff format --check plugin processing_provider tests/qgis __init__.py
+	.venv/bin/ruff format --check core plugin processing_provider tests/qgis __init__.py
 
 format:
 	bash scripts/test.sh --core-env
-	.venv/bin/ruff format plugin processing_provider tests/qgis __init__.py
+	.venv/bin/ruff format core plugin processing_provider tests/qgis __init__.py
 
 ## model: regenerate tests/qgis/data/trajectory_model.model3 (needs .venv-qgis from `make test`)
 model:

@@ -186,9 +186,12 @@ def build_parser(
     parser = argparse.ArgumentParser(prog="lidarphoto", description=__doc__.split("\n\n")[0])
     parser.add_argument("--version", action="version", version=f"lidarphoto {__version__}")
     parser.add_argument(
-        "-v", "--verbose", action="count", default=0,
+        "-v",
+        "--verbose",
+        action="count",
+        default=0,
         help="log progress to stderr; -vv also the details (e.g. every rejected candidate)",
-    )  # fmt: skip
+    )
     parser.add_argument(
         "--lang",
         metavar="LANG",
@@ -281,8 +284,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         with stop_signals_raise():
             result = run_job(args.job, raw, progress=_progress_bar(args.job))
     except Terminated as exc:
-        print(f"lidarphoto {args.algorithm}: stopped by {exc.name}; nothing was written",
-              file=sys.stderr)  # fmt: skip
+        print(
+            f"lidarphoto {args.algorithm}: stopped by {exc.name}; nothing was written",
+            file=sys.stderr,
+        )
         if entry:
             _exit_now(128 + exc.signum)
         return 128 + exc.signum
@@ -300,8 +305,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"lidarphoto {args.algorithm}: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
     except MemoryError:
-        print(f"lidarphoto {args.algorithm}: error: out of memory; nothing was written (use a "
-              "coarser cell or a smaller input)", file=sys.stderr)  # fmt: skip
+        print(
+            f"lidarphoto {args.algorithm}: error: out of memory; nothing was written (use a "
+            "coarser cell or a smaller input)",
+            file=sys.stderr,
+        )
         return 2
     if result.stdout:
         sys.stdout.write(result.stdout)

@@ -23,6 +23,7 @@ def t(text: str) -> str:
     """``text`` in the language set by :func:`core.i18n.set_language`."""
     return translator(TR_CONTEXT)(text)
 
+
 #: import name -> pip requirement, in the order they are reported.
 REQUIRED_MODULES: dict[str, str] = {
     "laspy": "laspy",
@@ -34,10 +35,15 @@ REQUIRED_MODULES: dict[str, str] = {
 
 #: optional packages: import name -> (pip requirement, what is slower or missing without it).
 OPTIONAL_MODULES: dict[str, tuple[str, str]] = {
-    "numba": ("numba", "ray casting on the DSM (monoplotting) runs 2-3x slower, orthophotos "
-              "about 2.5x, roof planes about 3.5x"),
-    "distributed": ("distributed", "the LiDAR block algorithm (lidarblock, tiles on dask) "
-                    "cannot run"),
+    "numba": (
+        "numba",
+        "ray casting on the DSM (monoplotting) runs 2-3x slower, orthophotos "
+        "about 2.5x, roof planes about 3.5x",
+    ),
+    "distributed": (
+        "distributed",
+        "the LiDAR block algorithm (lidarblock, tiles on dask) cannot run",
+    ),
 }
 
 

@@ -57,8 +57,9 @@ def use_compiled(backend: str, available: bool) -> bool:
     if backend not in ("auto", "numba", "numpy"):
         raise InputError(f"backend must be 'auto', 'numba' or 'numpy', got {backend!r}")
     if backend == "numba" and not available:
-        raise InputError("backend 'numba' asked for, but numba is not installed "
-                         "(pip install numba)")  # fmt: skip
+        raise InputError(
+            "backend 'numba' asked for, but numba is not installed (pip install numba)"
+        )
     return available and backend != "numpy"
 
 

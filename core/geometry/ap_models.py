@@ -65,8 +65,9 @@ class PolynomialAP(DistortionModel):
         """The basis functions as a list of :data:`Term` (constants already applied)."""
         raise NotImplementedError
 
-    def _tables(self) -> tuple[NDArray[np.intp], NDArray[np.intp], Array, NDArray[np.intp],
-                               NDArray[np.intp]]:  # fmt: skip
+    def _tables(
+        self,
+    ) -> tuple[NDArray[np.intp], NDArray[np.intp], Array, NDArray[np.intp], NDArray[np.intp]]:
         cached = getattr(self, "_term_table", None)
         if cached is None:
             t = self.terms()
@@ -123,9 +124,13 @@ class PolynomialAP(DistortionModel):
 def _radial(par: int, c0: float) -> List[Term]:
     """``a (x, y) (r^2 - c0)``: x^3 + x y^2 - c0 x and x^2 y + y^3 - c0 y."""
     return [
-        (par, 0, 1.0, 3, 0), (par, 0, 1.0, 1, 2), (par, 0, -c0, 1, 0),
-        (par, 1, 1.0, 2, 1), (par, 1, 1.0, 0, 3), (par, 1, -c0, 0, 1),
-    ]  # fmt: skip
+        (par, 0, 1.0, 3, 0),
+        (par, 0, 1.0, 1, 2),
+        (par, 0, -c0, 1, 0),
+        (par, 1, 1.0, 2, 1),
+        (par, 1, 1.0, 0, 3),
+        (par, 1, -c0, 0, 1),
+    ]
 
 
 @register_model
@@ -150,8 +155,10 @@ class LensK1K2(PolynomialAP):
         # r^4 = x^4 + 2 x^2 y^2 + y^4
         for axis, (a, b) in ((0, (1, 0)), (1, (0, 1))):
             out += [
-                (1, axis, 1.0, 4 + a, b), (1, axis, 2.0, 2 + a, 2 + b), (1, axis, 1.0, a, 4 + b),
-            ]  # fmt: skip
+                (1, axis, 1.0, 4 + a, b),
+                (1, axis, 2.0, 2 + a, 2 + b),
+                (1, axis, 1.0, a, 4 + b),
+            ]
         return out
 
 
@@ -194,19 +201,26 @@ class Jacobsen(PolynomialAP):
     constant_names: ClassVar[Tuple[str, ...]] = ("r0_mm",)
 
     def __init__(
-        self, a1: float = 0.0, a2: float = 0.0, a3: float = 0.0, a4: float = 0.0, *,
+        self,
+        a1: float = 0.0,
+        a2: float = 0.0,
+        a3: float = 0.0,
+        a4: float = 0.0,
+        *,
         r0_mm: float,
-    ) -> None:  # fmt: skip
+    ) -> None:
         super().__init__(a1=a1, a2=a2, a3=a3, a4=a4, r0_mm=r0_mm)
 
     def terms(self) -> List[Term]:
         """The four basis functions, expanded."""
         r02 = self._constants["r0_mm"] ** 2
         return _radial(0, r02) + [
-            (1, 0, 1.0, 1, 0), (1, 1, -1.0, 0, 1),
-            (2, 0, 1.0, 0, 1), (2, 1, 1.0, 1, 0),
+            (1, 0, 1.0, 1, 0),
+            (1, 1, -1.0, 0, 1),
+            (2, 0, 1.0, 0, 1),
+            (2, 1, 1.0, 1, 0),
             (3, 1, 1.0, 2, 0),
-        ]  # fmt: skip
+        ]
 
 
 @register_model
@@ -235,21 +249,37 @@ class Ebner(PolynomialAP):
         """The twelve basis functions, expanded with ``q(u) = u^2 - 2 b^2 / 3``."""
         c = 2.0 * self._constants["b_mm"] ** 2 / 3.0
         t: List[Term] = [
-            (0, 0, 1.0, 1, 0), (0, 1, -1.0, 0, 1),  # b1
-            (1, 0, 1.0, 0, 1), (1, 1, 1.0, 1, 0),  # b2
-            (2, 0, -2.0, 2, 0), (2, 0, 2.0 * c, 0, 0), (2, 1, 1.0, 1, 1),  # b3
-            (3, 0, 1.0, 1, 1), (3, 1, -2.0, 0, 2), (3, 1, 2.0 * c, 0, 0),  # b4
-            (4, 0, 1.0, 0, 2), (4, 0, -c, 0, 0),  # b5: q(y)
-            (5, 1, 1.0, 2, 0), (5, 1, -c, 0, 0),  # b6: q(x)
-            (6, 0, 1.0, 1, 2), (6, 0, -c, 1, 0),  # b7: x q(y)
-            (7, 1, 1.0, 2, 1), (7, 1, -c, 0, 1),  # b8: y q(x)
-            (8, 0, 1.0, 2, 1), (8, 0, -c, 0, 1),  # b9: y q(x)
-            (9, 1, 1.0, 1, 2), (9, 1, -c, 1, 0),  # b10: x q(y)
-        ]  # fmt: skip
+            (0, 0, 1.0, 1, 0),
+            (0, 1, -1.0, 0, 1),  # b1
+            (1, 0, 1.0, 0, 1),
+            (1, 1, 1.0, 1, 0),  # b2
+            (2, 0, -2.0, 2, 0),
+            (2, 0, 2.0 * c, 0, 0),
+            (2, 1, 1.0, 1, 1),  # b3
+            (3, 0, 1.0, 1, 1),
+            (3, 1, -2.0, 0, 2),
+            (3, 1, 2.0 * c, 0, 0),  # b4
+            (4, 0, 1.0, 0, 2),
+            (4, 0, -c, 0, 0),  # b5: q(y)
+            (5, 1, 1.0, 2, 0),
+            (5, 1, -c, 0, 0),  # b6: q(x)
+            (6, 0, 1.0, 1, 2),
+            (6, 0, -c, 1, 0),  # b7: x q(y)
+            (7, 1, 1.0, 2, 1),
+            (7, 1, -c, 0, 1),  # b8: y q(x)
+            (8, 0, 1.0, 2, 1),
+            (8, 0, -c, 0, 1),  # b9: y q(x)
+            (9, 1, 1.0, 1, 2),
+            (9, 1, -c, 1, 0),  # b10: x q(y)
+        ]
         # b11 (dx), b12 (dy): q(x) q(y) = x^2 y^2 - c x^2 - c y^2 + c^2
         for par, axis in ((10, 0), (11, 1)):
-            t += [(par, axis, 1.0, 2, 2), (par, axis, -c, 2, 0), (par, axis, -c, 0, 2),
-                  (par, axis, c * c, 0, 0)]  # fmt: skip
+            t += [
+                (par, axis, 1.0, 2, 2),
+                (par, axis, -c, 2, 0),
+                (par, axis, -c, 0, 2),
+                (par, axis, c * c, 0, 0),
+            ]
         return t
 
 
@@ -279,13 +309,25 @@ class Brown14(PolynomialAP):
         """The fourteen basis functions, expanded."""
         ic = 1.0 / self._constants["c_mm"]
         return [
-            (0, 0, 1.0, 1, 0), (1, 0, 1.0, 0, 1), (2, 0, 1.0, 1, 1), (3, 0, 1.0, 0, 2),
-            (4, 0, 1.0, 2, 1), (5, 0, 1.0, 1, 2), (6, 0, 1.0, 2, 2),
-            (7, 1, 1.0, 1, 1), (8, 1, 1.0, 2, 0), (9, 1, 1.0, 2, 1), (10, 1, 1.0, 1, 2),
+            (0, 0, 1.0, 1, 0),
+            (1, 0, 1.0, 0, 1),
+            (2, 0, 1.0, 1, 1),
+            (3, 0, 1.0, 0, 2),
+            (4, 0, 1.0, 2, 1),
+            (5, 0, 1.0, 1, 2),
+            (6, 0, 1.0, 2, 2),
+            (7, 1, 1.0, 1, 1),
+            (8, 1, 1.0, 2, 0),
+            (9, 1, 1.0, 2, 1),
+            (10, 1, 1.0, 1, 2),
             (11, 1, 1.0, 2, 2),
-            (12, 0, ic, 3, 2), (12, 1, ic, 2, 3),
-            (13, 0, 1.0, 3, 0), (13, 0, 1.0, 1, 2), (13, 1, 1.0, 2, 1), (13, 1, 1.0, 0, 3),
-        ]  # fmt: skip
+            (12, 0, ic, 3, 2),
+            (12, 1, ic, 2, 3),
+            (13, 0, 1.0, 3, 0),
+            (13, 0, 1.0, 1, 2),
+            (13, 1, 1.0, 2, 1),
+            (13, 1, 1.0, 0, 3),
+        ]
 
 
 def ap_constants(width_mm: float, height_mm: float, focal_mm: float) -> Dict[str, float]:

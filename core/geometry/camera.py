@@ -145,8 +145,7 @@ class Camera:
         set_(self, "y0_mm", _check_finite(self.y0_mm, who + "y0_mm"))
         if self.projection not in PROJECTIONS:
             raise InputError(
-                who + f"projection must be one of {', '.join(PROJECTIONS)}, "
-                f"got {self.projection!r}"
+                who + f"projection must be one of {', '.join(PROJECTIONS)}, got {self.projection!r}"
             )
         if not isinstance(self.distortion, DistortionModel):
             raise InputError(
@@ -342,8 +341,14 @@ MAX_IMAGE_SIDE_PX = 200_000
 _MM_KEYS = ("focal_mm", "x0_mm", "y0_mm")
 _PX_KEYS = ("focal_px", "ppx_px", "ppy_px")
 _KNOWN_KEYS = {
-    "name", "pixel_size_mm", "width_px", "height_px", "distortion", "sigmas", "projection",
-}  # fmt: skip
+    "name",
+    "pixel_size_mm",
+    "width_px",
+    "height_px",
+    "distortion",
+    "sigmas",
+    "projection",
+}
 _KNOWN_KEYS.update(_MM_KEYS, _PX_KEYS)
 
 
@@ -436,18 +441,23 @@ def camera_from_dict(data: Any, source: str | None = None, default_name: str = "
     ):
         if not lo <= value <= hi:
             shown = "focal_px" if key == "focal_mm" and "focal_px" in data else key
-            raise fail(shown, f"{value:g} {unit} is outside the physical range {lo:g} to {hi:g} "
-                       f"{unit} (a value in another unit?)")  # fmt: skip
+            raise fail(
+                shown,
+                f"{value:g} {unit} is outside the physical range {lo:g} to {hi:g} "
+                f"{unit} (a value in another unit?)",
+            )
     for key, value, half in (("x0_mm", x0, 0.5 * width), ("y0_mm", y0, 0.5 * height)):
         if abs(value) > half * pixel_size:
             shown = key if key in data else ("ppx_px" if key == "x0_mm" else "ppy_px")
-            raise fail(shown, f"the principal point ({value:g} mm from the image centre) lies "
-                       f"outside the image ({half * pixel_size:g} mm to its edge)")  # fmt: skip
+            raise fail(
+                shown,
+                f"the principal point ({value:g} mm from the image centre) lies "
+                f"outside the image ({half * pixel_size:g} mm to its edge)",
+            )
     distortion = distortion_from_dict(data.get("distortion", {}), source, "distortion")
     projection = data.get("projection", "perspective")
     if projection not in PROJECTIONS:
-        raise fail("projection", f"unknown projection {projection!r} "
-                   f"(known: {', '.join(PROJECTIONS)})")  # fmt: skip
+        raise fail(
+            "projection", f"unknown projection {projection!r} (known: {', '.join(PROJECTIONS)})"
+        )
     return Camera(name, focal, pixel_size, width, height, x0, y0, distortion, projection)
-
-

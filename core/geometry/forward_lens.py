@@ -425,7 +425,4 @@ def opencv_coefficients(lens: DistortionModel, focal_mm: float) -> dict[str, flo
         power = {"k1": 2, "k2": 4, "k3": 6, "k4": 8}
     elif isinstance(lens, ThinPrismFisheyeLens):
         power = {"k1": 2, "k2": 4, "k3": 6, "k4": 8, "p1": 1, "p2": 1, "sx1": 1, "sy1": 1}
-    return {
-        n: float(v) * ratio ** power[n]
-        for n, v in zip(lens.param_names, lens.params.tolist())
-    }
+    return {n: float(v) * ratio ** power[n] for n, v in zip(lens.param_names, lens.params.tolist())}

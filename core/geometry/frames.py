@@ -153,10 +153,13 @@ class MappingFrame:
         object.__setattr__(self, "_from_geod", _exact_transformer(geodetic, src))
         # on one ellipsoid these are conversions: PROJ's pipelines directly (the same numbers
         # as TransformerGroup's, tested, without its 40 ms search of the database)
-        to_ecef = ("+proj=pipeline +step +proj=unitconvert +xy_in=deg +xy_out=rad "
-                   f"+step +proj=cart {ell}")  # fmt: skip
-        from_ecef = (f"+proj=pipeline +step +inv +proj=cart {ell} "
-                     "+step +proj=unitconvert +xy_in=rad +xy_out=deg")  # fmt: skip
+        to_ecef = (
+            f"+proj=pipeline +step +proj=unitconvert +xy_in=deg +xy_out=rad +step +proj=cart {ell}"
+        )
+        from_ecef = (
+            f"+proj=pipeline +step +inv +proj=cart {ell} "
+            "+step +proj=unitconvert +xy_in=rad +xy_out=deg"
+        )
         object.__setattr__(self, "_geod_to_ecef", Transformer.from_pipeline(to_ecef))
         object.__setattr__(self, "_ecef_to_geod", Transformer.from_pipeline(from_ecef))
 
@@ -416,9 +419,13 @@ def check_area_of_use(
         lon = np.where(lon < west, lon + 360.0, lon)
     m = float(margin_deg)
     inside = (
-        np.isfinite(lon) & np.isfinite(lat)
-        & (lon >= west - m) & (lon <= east + m) & (lat >= south - m) & (lat <= north + m)
-    )  # fmt: skip
+        np.isfinite(lon)
+        & np.isfinite(lat)
+        & (lon >= west - m)
+        & (lon <= east + m)
+        & (lat >= south - m)
+        & (lat <= north + m)
+    )
     if not inside.all():
         k = int(np.argmin(inside))
         where = (
@@ -434,4 +441,3 @@ def check_area_of_use(
             "axis order",
             path=path,
         )
-

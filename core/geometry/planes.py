@@ -232,8 +232,9 @@ def label_moments(
     scatter = np.empty((nl, 3, 3))
     for a in range(3):
         for b in range(a, 3):
-            scatter[:, a, b] = scatter[:, b, a] = np.bincount(lab, weighted(dev[:, a] * dev[:, b]),
-                                                              minlength=nl)  # fmt: skip
+            scatter[:, a, b] = scatter[:, b, a] = np.bincount(
+                lab, weighted(dev[:, a] * dev[:, b]), minlength=nl
+            )
     return counts, mean, scatter
 
 
@@ -306,7 +307,7 @@ def _fit_labels(pts: Array, lab: NDArray[np.int64], nl: int, w: Array | None) ->
         np.sign(normal[:, 2]),
         np.where(normal[:, 1] != 0, np.sign(normal[:, 1]), np.sign(normal[:, 0])),
     )
-    normal *= np.where(sign < 0, -1.0, 1.0)[:, None]  # fmt: skip
+    normal *= np.where(sign < 0, -1.0, 1.0)[:, None]
     r = _dot3(q - mean[lab], normal[lab])
     wrr = np.bincount(lab, r * r if w is None else w * (r * r), minlength=nl)
     centroid = origin + mean
@@ -321,11 +322,20 @@ def _fit_labels(pts: Array, lab: NDArray[np.int64], nl: int, w: Array | None) ->
             out.append(None)
             continue
         slope, aspect = slope_aspect_deg(normal[pid])
-        out.append(Plane(id=pid, normal=normal[pid].copy(), d=float(d[pid]),
-                         centroid=centroid[pid].copy(), n_points=int(counts[pid]),
-                         rms=float(rms[pid]), sigma_d=math.sqrt(max(cov[pid, 3, 3], 0.0)),
-                         covariance=cov[pid].copy(), slope_deg=slope,
-                         aspect_deg=aspect))  # fmt: skip
+        out.append(
+            Plane(
+                id=pid,
+                normal=normal[pid].copy(),
+                d=float(d[pid]),
+                centroid=centroid[pid].copy(),
+                n_points=int(counts[pid]),
+                rms=float(rms[pid]),
+                sigma_d=math.sqrt(max(cov[pid, 3, 3], 0.0)),
+                covariance=cov[pid].copy(),
+                slope_deg=slope,
+                aspect_deg=aspect,
+            )
+        )
     return out
 
 

@@ -213,9 +213,11 @@ class DsmTracer:
                 axis=(1, 3)
             )
             dil = cv2.dilate(
-                block, np.ones((3, 3), np.uint8), borderType=cv2.BORDER_CONSTANT,
+                block,
+                np.ones((3, 3), np.uint8),
+                borderType=cv2.BORDER_CONSTANT,
                 borderValue=(-np.inf,),
-            )  # fmt: skip
+            )
             out.append((lev, np.ascontiguousarray(dil, dtype=np.float32)))
         zmin, zmax = dsm.z_range
         # (z[r, c], z[r + 1, c]) side by side, 8 bytes per entry: the two corners of a quad
@@ -259,8 +261,17 @@ def _slabs(tr: DsmTracer, start: tuple, step: tuple, rows: int, cols: int) -> tu
     return t_lo, t_hi
 
 
-def _quad_triangles(corners: tuple, ul: Array, vl: Array, du: Array, dv: Array, dz: Array,
-                    rhs: Array, tc: Array, eps: float) -> tuple[Array, Bools, Array, Bools]:
+def _quad_triangles(
+    corners: tuple,
+    ul: Array,
+    vl: Array,
+    du: Array,
+    dv: Array,
+    dz: Array,
+    rhs: Array,
+    tc: Array,
+    eps: float,
+) -> tuple[Array, Bools, Array, Bools]:
     """Dal Poz's Eq. 9 for the two triangles of each ray's quad (corner heights z00, z01,
     z10, z11; the ray at (ul, vl) in the quad, ``rhs`` = z00 - z0): (ta, hits triangle 0,
     tb, hits triangle 1), a hit at t >= ``tc`` within ``eps`` of the triangle."""
@@ -465,20 +476,32 @@ def intersect_dsm(
         from . import raycast_numba as dda_compiled
 
         out: dict[str, NDArray[Any]] = {
-            "t": np.empty(n), "status": np.empty(n, np.int8), "qi": np.empty(n, np.int64),
-            "qj": np.empty(n, np.int64), "tri": np.empty(n, np.int8),
-            "points": np.empty((n, 3)), "weights": np.empty((n, 3)),
-            "gradient": np.empty((n, 2)), "incidence": np.empty(n),
-        }  # fmt: skip
+            "t": np.empty(n),
+            "status": np.empty(n, np.int8),
+            "qi": np.empty(n, np.int64),
+            "qj": np.empty(n, np.int64),
+            "tri": np.empty(n, np.int8),
+            "points": np.empty((n, 3)),
+            "weights": np.empty((n, 3)),
+            "gradient": np.empty((n, 2)),
+            "incidence": np.empty(n),
+        }
         for start in range(0, n, step):
             stop_if_asked(should_stop, "intersecting rays with the DSM")
             sl = slice(start, min(start + step, n))
             dda_compiled.trace_rays(tr, o, d, accelerate, min_incidence_deg, out, sl)
             if progress is not None:
                 progress(sl.stop / n)
-        return DsmHits(out["points"], out["t"], out["status"],
-                       np.stack([out["qi"], out["qj"]], 1), out["tri"], out["weights"],
-                       out["gradient"], out["incidence"])  # fmt: skip
+        return DsmHits(
+            out["points"],
+            out["t"],
+            out["status"],
+            np.stack([out["qi"], out["qj"]], 1),
+            out["tri"],
+            out["weights"],
+            out["gradient"],
+            out["incidence"],
+        )
     t = np.full(n, np.nan)
     status = np.full(n, STATUS_OUTSIDE, np.int8)
     qi = np.full(n, -1, np.int64)

@@ -174,9 +174,32 @@ def _describe_hit(r, th, k, i, j, o, d, z, x_c, y_c, cell, pts_out, w_out, grad_
 
 
 def _trace(
-    o, d, order, z, qmax, mstack, offsets, bcols, shifts, x_c, y_c, cell, zmin, zmax, n_lev,
-    min_inc_deg, t_out, st_out, qi_out, qj_out, tri_out, pts_out, w_out, grad_out, inc_out,
-):  # fmt: skip
+    o,
+    d,
+    order,
+    z,
+    qmax,
+    mstack,
+    offsets,
+    bcols,
+    shifts,
+    x_c,
+    y_c,
+    cell,
+    zmin,
+    zmax,
+    n_lev,
+    min_inc_deg,
+    t_out,
+    st_out,
+    qi_out,
+    qj_out,
+    tri_out,
+    pts_out,
+    w_out,
+    grad_out,
+    inc_out,
+):
     """Trace rays o + t d (CRS units) through the DSM heights z, in the given order; fills
     the *_out arrays."""
     rows, cols = z.shape
@@ -247,8 +270,12 @@ def _trace(
                     z01 = np.float64(z[i, j + 1])
                     z10 = np.float64(z[i + 1, j])
                     z11 = np.float64(z[i + 1, j + 1])
-                    if not (math.isfinite(z00) and math.isfinite(z01)
-                            and math.isfinite(z10) and math.isfinite(z11)):  # fmt: skip
+                    if not (
+                        math.isfinite(z00)
+                        and math.isfinite(z01)
+                        and math.isfinite(z10)
+                        and math.isfinite(z11)
+                    ):
                         status = _NODATA
                         qi_out[r] = i
                         qj_out[r] = j
@@ -277,8 +304,9 @@ def _trace(
             qi_out[r] = i
             qj_out[r] = j
             tri_out[r] = k
-            _describe_hit(r, th, k, i, j, o, d, z, x_c, y_c, cell, pts_out, w_out, grad_out,
-                          inc_out)  # fmt: skip
+            _describe_hit(
+                r, th, k, i, j, o, d, z, x_c, y_c, cell, pts_out, w_out, grad_out, inc_out
+            )
             if inc_out[r] < min_inc_deg:
                 status = _GRAZING
         st_out[r] = status
@@ -328,12 +356,30 @@ def trace_rays(
     xc, yc = dsm.centre_origin
     o = np.ascontiguousarray(origins[rows], np.float64)
     d = np.ascontiguousarray(directions[rows], np.float64)
-    order = _compiled("order")(o, d, float(xc), float(yc), float(dsm.cell),
-                               float(tracer.zmax), r_, c_)  # fmt: skip
+    order = _compiled("order")(
+        o, d, float(xc), float(yc), float(dsm.cell), float(tracer.zmax), r_, c_
+    )
     _compiled("trace")(
-        o, d, order, z, qmax, *pyramid, float(xc), float(yc), float(dsm.cell),
-        float(tracer.zmin), float(tracer.zmax), n_lev, float(min_incidence_deg),
-        out["t"][rows], out["status"][rows], out["qi"][rows], out["qj"][rows],
-        out["tri"][rows], out["points"][rows], out["weights"][rows], out["gradient"][rows],
+        o,
+        d,
+        order,
+        z,
+        qmax,
+        *pyramid,
+        float(xc),
+        float(yc),
+        float(dsm.cell),
+        float(tracer.zmin),
+        float(tracer.zmax),
+        n_lev,
+        float(min_incidence_deg),
+        out["t"][rows],
+        out["status"][rows],
+        out["qi"][rows],
+        out["qj"][rows],
+        out["tri"][rows],
+        out["points"][rows],
+        out["weights"][rows],
+        out["gradient"][rows],
         out["incidence"][rows],
-    )  # fmt: skip
+    )

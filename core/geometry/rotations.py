@@ -158,5 +158,3 @@ def is_rotation(r: ArrayLike, atol: float = 1e-9) -> bool:
         np.allclose(np.swapaxes(r, -1, -2) @ r, eye, atol=atol)
         and np.allclose(np.linalg.det(r), 1.0, atol=atol)
     )
-
-

@@ -53,9 +53,13 @@ class ScaledXYZ:
         ``integers``: the (3, 2) extreme integers when already known."""
         if integers is None:
             nonempty = [c for c in self.chunks if len(c[0])]
-            integers = np.array([[min(int(c[k].min()) for c in nonempty),
-                                  max(int(c[k].max()) for c in nonempty)]
-                                 for k in range(3)], dtype=np.int64)  # fmt: skip
+            integers = np.array(
+                [
+                    [min(int(c[k].min()) for c in nonempty), max(int(c[k].max()) for c in nonempty)]
+                    for k in range(3)
+                ],
+                dtype=np.int64,
+            )
         ends = integers.astype(np.float64)
         ends *= np.asarray(self.scales, dtype=np.float64)[:, None]
         ends += np.asarray(self.offsets, dtype=np.float64)[:, None]

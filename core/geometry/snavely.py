@@ -43,8 +43,9 @@ def rodrigues(r: Array) -> Array:
     return np.eye(3) + s1[:, None, None] * K + s2[:, None, None] * (K @ K)
 
 
-def snavely_project(cameras: Array, points: Array, jacobian: bool = True,
-                    compiled: bool = True, joint: bool = False):  # fmt: skip
+def snavely_project(
+    cameras: Array, points: Array, jacobian: bool = True, compiled: bool = True, joint: bool = False
+):
     """Projections (N, 2) of points (N, 3) by cameras (N, 9), and optionally the Jacobians
     ``d u / d camera`` (N, 2, 9) and ``d u / d point`` (N, 2, 3), or with ``joint`` both as
     one (N, 2, 12), camera columns first (the Jacobian of a group (camera, point)).

@@ -96,8 +96,9 @@ def _kernel(c, X, u, jc, jp, want_jac):  # pragma: no cover - compiled
         jc[i, 1, 8] = f * rr * rr * py
 
 
-def project(cameras: Array, points: Array, jacobian: bool, joint: bool = False
-            ) -> tuple | Array | None:  # fmt: skip
+def project(
+    cameras: Array, points: Array, jacobian: bool, joint: bool = False
+) -> tuple | Array | None:
     """``snavely_project`` compiled (None without numba); ``joint``: the Jacobians as one
     array (n, 2, 12), camera columns first, written in place (no concatenation)."""
     from ..compiled import compiled_kernel  # numba imported here: this module stays light

@@ -95,7 +95,6 @@ class Dsm:
         return triangle_height(self.heights, np.atleast_1d(u), np.atleast_1d(v))
 
 
-
 def triangle_height(z: NDArray, u: ArrayLike, v: ArrayLike) -> Array:
     """Height of the surface triangulated on the grid ``z`` at grid coordinates ``(u, v)``.
 
@@ -170,19 +169,22 @@ def reproject_dsm(
     zmid = float(np.nanmedian(dsm.heights)) if np.isfinite(dsm.heights).any() else 0.0
     bx, by, _ = fwd.transform(xs, ys, np.full(xs.size, zmid))
     if not (np.isfinite(bx).all() and np.isfinite(by).all()):
-        raise CrsError(f"the DSM's footprint cannot be transformed to '{dst.name}'",
-                       path=dsm.source or None)  # fmt: skip
+        raise CrsError(
+            f"the DSM's footprint cannot be transformed to '{dst.name}'", path=dsm.source or None
+        )
     if cell is None:
         cx, cy = xc + (cols - 1) * g.cell / 2, yc - (rows - 1) * g.cell / 2
-        px, py, _ = fwd.transform(
-            [cx, cx + g.cell, cx], [cy, cy, cy + g.cell], [zmid] * 3
-        )  # fmt: skip
-        scale = 0.5 * (math.hypot(px[1] - px[0], py[1] - py[0])
-                       + math.hypot(px[2] - px[0], py[2] - py[0])) / g.cell  # fmt: skip
+        px, py, _ = fwd.transform([cx, cx + g.cell, cx], [cy, cy, cy + g.cell], [zmid] * 3)
+        scale = (
+            0.5
+            * (math.hypot(px[1] - px[0], py[1] - py[0]) + math.hypot(px[2] - px[0], py[2] - py[0]))
+            / g.cell
+        )
         cell = max(round(g.cell * scale, 3), 1e-3)
     cell = float(cell)
-    out = Grid.covering((bx.min() - cell / 2, by.min() - cell / 2),
-                        (bx.max() + cell / 2, by.max() + cell / 2), cell)  # fmt: skip
+    out = Grid.covering(
+        (bx.min() - cell / 2, by.min() - cell / 2), (bx.max() + cell / 2, by.max() + cell / 2), cell
+    )
     heights = np.full((out.rows, out.cols), np.nan, np.float32)
     cols_x = out.x0 + (np.arange(out.cols) + 0.5) * cell
     for r0 in range(0, out.rows, max(int(block_rows), 1)):
@@ -198,6 +200,12 @@ def reproject_dsm(
             block = np.full(tx.size, np.nan)
             block[ok] = th
             heights[r0:r1] = block.reshape(tx.shape)
-    LOG.info("DSM reprojected from '%s' to '%s': %d x %d cells of %g", dsm.crs.name, dst.name,
-             out.rows, out.cols, cell)  # fmt: skip
+    LOG.info(
+        "DSM reprojected from '%s' to '%s': %d x %d cells of %g",
+        dsm.crs.name,
+        dst.name,
+        out.rows,
+        out.cols,
+        cell,
+    )
     return Dsm(heights, out, dst, dsm.source)

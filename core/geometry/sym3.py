@@ -40,8 +40,11 @@ def jacobi_sym3(
     (u) and ``v[row][k]`` (B,) the row-th component of its unit eigenvector (the k-th column
     of the rotations' product). The inputs are not modified."""
     one, zero = np.ones_like(a00), np.zeros_like(a00)
-    v = [[one, zero, zero], [zero.copy(), one.copy(), zero.copy()],
-         [zero.copy(), zero.copy(), one.copy()]]  # fmt: skip
+    v = [
+        [one, zero, zero],
+        [zero.copy(), one.copy(), zero.copy()],
+        [zero.copy(), zero.copy(), one.copy()],
+    ]
     a = {(0, 0): a00, (0, 1): a01, (0, 2): a02, (1, 1): a11, (1, 2): a12, (2, 2): a22}
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         for _ in range(JACOBI_SWEEPS):

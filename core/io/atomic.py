@@ -197,19 +197,33 @@ def _check_writable(name: str, target: Path) -> None:
 
 # ----------------------------------------------------------------------------- the guard
 #: Endings of the files read as rasters through GDAL, which reads the files beside them too.
-RASTER_SUFFIXES = (".tif", ".tiff", ".jpg", ".jpeg", ".png", ".jp2", ".img", ".bmp", ".gif",
-                   ".vrt", ".asc")  # fmt: skip
+RASTER_SUFFIXES = (
+    ".tif",
+    ".tiff",
+    ".jpg",
+    ".jpeg",
+    ".png",
+    ".jp2",
+    ".img",
+    ".bmp",
+    ".gif",
+    ".vrt",
+    ".asc",
+)
 #: What GDAL reads beside a raster ``x.tif``: ``x.tif`` + these.
-_RASTER_SIDECARS = ((".aux.xml", "its metadata"), (".ovr", "its overviews"),
-                    (".msk", "its mask"))  # fmt: skip
+_RASTER_SIDECARS = ((".aux.xml", "its metadata"), (".ovr", "its overviews"), (".msk", "its mask"))
 
 
 def _world_files(path: Path) -> tuple[str, ...]:
     """Names of the georeferencing files GDAL takes for ``path``: ``x.tfw``, ``x.tifw``,
     ``x.wld`` (world files) and ``x.tab`` (MapInfo)."""
     ext = path.suffix
-    return (f"{path.stem}.{ext[1]}{ext[-1]}w", f"{path.stem}{ext}w", f"{path.stem}.wld",
-            f"{path.stem}.tab")  # fmt: skip
+    return (
+        f"{path.stem}.{ext[1]}{ext[-1]}w",
+        f"{path.stem}{ext}w",
+        f"{path.stem}.wld",
+        f"{path.stem}.tab",
+    )
 
 
 def _names_in(folder: Path, cache: dict[Path, dict[str, str]]) -> dict[str, str]:
@@ -254,8 +268,11 @@ def files_read(
                 continue  # an object the QGIS adapter made from a layer
             p = Path(raw)
             if p.is_dir():
-                files = [(p / f, f", read from the folder {p}") for f in sorted(os.listdir(p))
-                         if (p / f).is_file() and (not ends or Path(f).suffix.lower() in ends)]
+                files = [
+                    (p / f, f", read from the folder {p}")
+                    for f in sorted(os.listdir(p))
+                    if (p / f).is_file() and (not ends or Path(f).suffix.lower() in ends)
+                ]
             elif p.is_file():
                 files = [(p, "")]
             else:
@@ -308,8 +325,10 @@ def check_outputs(
         target = Path(target)
         written = [(target, "")]
         if target.suffix.lower() in RASTER_SUFFIXES:
-            written += [(Path(str(target) + ext), f" (with {target.name + ext}, {what})")
-                        for ext, what in _RASTER_SIDECARS]  # fmt: skip
+            written += [
+                (Path(str(target) + ext), f" (with {target.name + ext}, {what})")
+                for ext, what in _RASTER_SIDECARS
+            ]
         for path, what in written:
             # folders of the path still missing are made before writing: "new/../x" is "x"
             hit = by_id.get(_identity(Path(os.path.realpath(path))))
@@ -331,7 +350,6 @@ def check_outputs(
                     f"{out_name} ({folder}) holds the input {in_name} ({f}{how}): the folder "
                     "is replaced as a whole when the job is done; choose another folder"
                 )
-
 
 
 class OutputSet:

@@ -49,20 +49,60 @@ __all__ = [
 
 POINT_COLUMNS = ("point_id", "role", "X", "Y", "Z", "sigma_X", "sigma_Y", "sigma_Z", "n_images")
 RESIDUAL_COLUMNS = (
-    "image_id", "point_id", "role", "col", "row", "sigma_px", "v_col", "v_row", "v_px",
-    "w_col", "w_row", "redundancy_col", "redundancy_row", "rejected", "used",
-)  # fmt: skip
-CHECK_COLUMNS = ("id", "e", "n", "h", "e_ref", "n_ref", "h_ref", "group", "sigma_e", "sigma_n",
-                 "sigma_h", "n_images")  # fmt: skip
+    "image_id",
+    "point_id",
+    "role",
+    "col",
+    "row",
+    "sigma_px",
+    "v_col",
+    "v_row",
+    "v_px",
+    "w_col",
+    "w_row",
+    "redundancy_col",
+    "redundancy_row",
+    "rejected",
+    "used",
+)
+CHECK_COLUMNS = (
+    "id",
+    "e",
+    "n",
+    "h",
+    "e_ref",
+    "n_ref",
+    "h_ref",
+    "group",
+    "sigma_e",
+    "sigma_n",
+    "sigma_h",
+    "n_images",
+)
 COMPARISON_COLUMNS = (
-    "rank", "model", "n_check", "mean_horizontal", "std_horizontal", "rmse_horizontal",
-    "rmse_u", "rmse_3d", "sigma0", "n_ap", "n_ap_kept", "n_significant", "rejected", "error",
-)  # fmt: skip
+    "rank",
+    "model",
+    "n_check",
+    "mean_horizontal",
+    "std_horizontal",
+    "rmse_horizontal",
+    "rmse_u",
+    "rmse_3d",
+    "sigma0",
+    "n_ap",
+    "n_ap_kept",
+    "n_significant",
+    "rejected",
+    "error",
+)
 #: The key of :func:`core.photo.bundle.compare_ap_models`'s rows each column is written from.
 _COMPARISON_KEYS = {
-    "mean_horizontal": "mean_planimetric", "std_horizontal": "std_planimetric",
-    "rmse_horizontal": "rms_planimetric", "rmse_u": "rms_h", "rmse_3d": "rms_3d",
-}  # fmt: skip
+    "mean_horizontal": "mean_planimetric",
+    "std_horizontal": "std_planimetric",
+    "rmse_horizontal": "rms_planimetric",
+    "rmse_u": "rms_h",
+    "rmse_3d": "rms_3d",
+}
 
 
 def write_bundle_points(path: Union[str, Path], res: BundleResult) -> None:
@@ -79,13 +119,37 @@ def write_bundle_residuals(path: Union[str, Path], res: BundleResult) -> None:
     obs = res.observations
     vlen = np.hypot(res.v_px[:, 0], res.v_px[:, 1])
     rows = (
-        (i, p, role, number(px[0]), number(px[1]), number(s), number(v[0]), number(v[1]),
-         number(vl), number(w[0]), number(w[1]), number(r[0]), number(r[1]), int(rej), int(u))
-        for i, p, role, px, s, v, vl, w, r, rej, u in zip(
-            obs.image_id, obs.point_id, res.obs_role, obs.pixels, obs.sigma_px, res.v_px, vlen,
-            res.w, res.redundancy, res.rejected, res.used,
+        (
+            i,
+            p,
+            role,
+            number(px[0]),
+            number(px[1]),
+            number(s),
+            number(v[0]),
+            number(v[1]),
+            number(vl),
+            number(w[0]),
+            number(w[1]),
+            number(r[0]),
+            number(r[1]),
+            int(rej),
+            int(u),
         )
-    )  # fmt: skip
+        for i, p, role, px, s, v, vl, w, r, rej, u in zip(
+            obs.image_id,
+            obs.point_id,
+            res.obs_role,
+            obs.pixels,
+            obs.sigma_px,
+            res.v_px,
+            vlen,
+            res.w,
+            res.redundancy,
+            res.rejected,
+            res.used,
+        )
+    )
     write_csv_atomic(path, RESIDUAL_COLUMNS, rows)
 
 
@@ -94,11 +158,16 @@ def check_rows(res: BundleResult, tag: bool = False) -> list[tuple[str, ...]]:
     the model too, ``GCP02 [bauer]``, so that several models' rows stay unique)."""
     c = res.check
     return [
-        (f"{p} [{res.ap_model}]" if tag else p, *(number(v) for v in m), *(number(v) for v in r),
-         res.ap_model,
-         *(number(v) for v in s), str(int(n)))
+        (
+            f"{p} [{res.ap_model}]" if tag else p,
+            *(number(v) for v in m),
+            *(number(v) for v in r),
+            res.ap_model,
+            *(number(v) for v in s),
+            str(int(n)),
+        )
         for p, m, r, s, n in zip(c.point_id, c.measured, c.reference, c.sigma, c.n_images)
-    ]  # fmt: skip
+    ]
 
 
 def write_check_points(path: Union[str, Path], results: Iterable[BundleResult]) -> None:
@@ -118,5 +187,6 @@ def write_comparison(path: Union[str, Path], rows: Sequence[dict]) -> None:
             return number(v)
         return "" if v is None else str(v)
 
-    write_csv_atomic(path, COMPARISON_COLUMNS, ([cell(r, k) for k in COMPARISON_COLUMNS]
-                                                for r in rows))  # fmt: skip
+    write_csv_atomic(
+        path, COMPARISON_COLUMNS, ([cell(r, k) for k in COMPARISON_COLUMNS] for r in rows)
+    )

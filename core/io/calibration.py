@@ -39,15 +39,18 @@ def read_image_grey(path: Union[str, Path]) -> NDArray[np.uint8]:
 
     img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
     if img is None:
-        raise InputError("cannot read this image (not an image format OpenCV reads)",
-                         path=str(path))  # fmt: skip
+        raise InputError(
+            "cannot read this image (not an image format OpenCV reads)", path=str(path)
+        )
     return cast(NDArray[np.uint8], img)  # IMREAD_GRAYSCALE: always 8 bit
 
 
 def write_residuals_csv(path: Union[str, Path], result: Any) -> None:
     """Write the residual table of a :class:`core.photo.camera_calibration.CalibrationResult`."""
-    rows = ((img, pid, number(c), number(r), number(vc), number(vr), number(wc), number(wr))
-            for img, pid, c, r, vc, vr, wc, wr in result.residuals)  # fmt: skip
+    rows = (
+        (img, pid, number(c), number(r), number(vc), number(vr), number(wc), number(wr))
+        for img, pid, c, r, vc, vr, wc, wr in result.residuals
+    )
     write_csv_atomic(path, RESIDUAL_COLUMNS, rows)
 
 
@@ -60,20 +63,28 @@ def report_dict(result: Any, extra: dict | None = None) -> dict[str, Any]:
     names = result.parameter_names
     corr = [[_finite(c) for c in row] for row in np.asarray(result.correlation)]
     views = [
-        {"image": n, "points": int(p), "rms_px": float(r),
-         "eo": dict(zip(("X0", "Y0", "Z0", "omega", "phi", "kappa"), map(float, e))),
-         "eo_sigma": dict(zip(("X0", "Y0", "Z0", "omega", "phi", "kappa"), map(_finite, s)))}
-        for n, p, r, e, s in zip(result.view_names, result.view_points, result.view_rms_px,
-                                 result.eo, result.eo_sigma)
-    ]  # fmt: skip
+        {
+            "image": n,
+            "points": int(p),
+            "rms_px": float(r),
+            "eo": dict(zip(("X0", "Y0", "Z0", "omega", "phi", "kappa"), map(float, e))),
+            "eo_sigma": dict(zip(("X0", "Y0", "Z0", "omega", "phi", "kappa"), map(_finite, s))),
+        }
+        for n, p, r, e, s in zip(
+            result.view_names, result.view_points, result.view_rms_px, result.eo, result.eo_sigma
+        )
+    ]
     cam = result.camera
     out = {
         "camera": cam.to_dict(),
         "focal_px": cam.focal_px,
         "principal_point_px": list(cam.principal_point_px),
         "sigmas": {k: _finite(v) for k, v in result.sigmas.items()},
-        "sigmas_px": {k: _finite(result.sigmas[k] / cam.pixel_size_mm)
-                      for k in ("focal_mm", "x0_mm", "y0_mm") if k in result.sigmas},
+        "sigmas_px": {
+            k: _finite(result.sigmas[k] / cam.pixel_size_mm)
+            for k in ("focal_mm", "x0_mm", "y0_mm")
+            if k in result.sigmas
+        },
         "parameters": names,
         "correlation": corr,
         "t_values": result.t_values,
@@ -99,5 +110,6 @@ def report_dict(result: Any, extra: dict | None = None) -> dict[str, Any]:
 
 def write_report_json(path: Union[str, Path], result: Any, extra: dict | None = None) -> None:
     """Write :func:`report_dict` to ``path`` (atomically)."""
-    write_text_atomic(path, json.dumps(report_dict(result, extra), indent=2,
-                                       allow_nan=False) + "\n")  # fmt: skip
+    write_text_atomic(
+        path, json.dumps(report_dict(result, extra), indent=2, allow_nan=False) + "\n"
+    )

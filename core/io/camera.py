@@ -103,12 +103,14 @@ def read_cameras_json(
             raise InputError("key 'cameras': must be a non-empty list", path=str(path))
         cams = [
             camera_from_dict(
-                {k: v for k, v in item.items() if k != "sigmas"} if isinstance(item, Mapping)
+                {k: v for k, v in item.items() if k != "sigmas"}
+                if isinstance(item, Mapping)
                 else item,
-                source=str(path), default_name=f"{path.stem}_{i + 1}",
+                source=str(path),
+                default_name=f"{path.stem}_{i + 1}",
             )
             for i, item in enumerate(items)
-        ]  # fmt: skip
+        ]
         for cam in cams:
             _check_projection(cam, path, projections)
         names = [c.name for c in cams]

@@ -49,14 +49,18 @@ def read_camera_events(
         if bad.size:
             raise InputError(
                 f"{time[bad[0]]:g} s is not a GPS second of week (0 to 604800; a UTC "
-                "date-time needs EVENT_TIME utc)", row=table.line_numbers[bad[0]], **where,
-            )  # fmt: skip
+                "date-time needs EVENT_TIME utc)",
+                row=table.line_numbers[bad[0]],
+                **where,
+            )
     else:
         cells = text_column(table, t_col)
-        time = np.array([
-            gps_seconds_of_week(_utc(c, table.line_numbers[k], where), leap_seconds)
-            for k, c in enumerate(cells)
-        ])  # fmt: skip
+        time = np.array(
+            [
+                gps_seconds_of_week(_utc(c, table.line_numbers[k], where), leap_seconds)
+                for k, c in enumerate(cells)
+            ]
+        )
     return CameraEvents(ids, time, group, table.line_numbers, table.path)
 
 
@@ -69,8 +73,11 @@ def _utc(cell: str, row: int, where: dict) -> _dt.datetime:
     try:
         value = _dt.datetime.fromisoformat(text)
     except ValueError:
-        raise InputError(f"'{cell}' is not an ISO 8601 date-time (e.g. "
-                         "2026-12-02T06:13:13.25Z)", row=row, **where) from None  # fmt: skip
+        raise InputError(
+            f"'{cell}' is not an ISO 8601 date-time (e.g. 2026-12-02T06:13:13.25Z)",
+            row=row,
+            **where,
+        ) from None
     if value.tzinfo is None:
         raise InputError(f"'{cell}' has no time zone: add Z for UTC", row=row, **where)
     return value.astimezone(_dt.timezone.utc)

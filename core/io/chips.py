@@ -48,10 +48,25 @@ PathLike = Union[str, "os.PathLike[str]"]
 __all__ = ["REPORT_COLUMNS", "list_chips", "read_control_chip", "write_location_report"]
 
 REPORT_COLUMNS = (
-    "point_id", "image_id", "status", "reason", "source", "col", "row", "sigma_col",
-    "sigma_row", "sigma0", "ncc", "lsm_correlation", "template_px", "predicted_col",
-    "predicted_row", "search_col_px", "search_row_px", "iterations",
-)  # fmt: skip
+    "point_id",
+    "image_id",
+    "status",
+    "reason",
+    "source",
+    "col",
+    "row",
+    "sigma_col",
+    "sigma_row",
+    "sigma0",
+    "ncc",
+    "lsm_correlation",
+    "template_px",
+    "predicted_col",
+    "predicted_row",
+    "search_col_px",
+    "search_row_px",
+    "iterations",
+)
 
 
 def list_chips(paths: Iterable[PathLike]) -> dict[str, Path]:
@@ -87,9 +102,11 @@ def read_control_chip(
 
             own = pyproj.CRS.from_wkt(info.crs_wkt)
             if not _horizontal(own).equals(_horizontal(crs), ignore_axis_order=True):
-                raise InputError(f"the chip is in '{own.name}', the control points in "
-                                 f"'{crs.name}' (CRS): make the chips in the control's CRS",
-                                 path=str(path))  # fmt: skip
+                raise InputError(
+                    f"the chip is in '{own.name}', the control points in "
+                    f"'{crs.name}' (CRS): make the chips in the control's CRS",
+                    path=str(path),
+                )
         data = src.read().astype(np.float64)
         valid = src.read_mask()
     if data.shape[0] >= 3:
@@ -117,11 +134,26 @@ def _f(v: float, digits: int = 4) -> str:
 def write_location_report(path: PathLike, pairs: Sequence[LocatedPair]) -> None:
     """Write the location report (module docstring)."""
     rows = [
-        (p.point_id, p.image_id, p.status, p.reason, p.source if p.image_id else "",
-         _f(p.col), _f(p.row), _f(p.sigma_col), _f(p.sigma_row), _f(p.sigma0, 3), _f(p.ncc, 3),
-         _f(p.lsm_correlation, 3), p.template_px or "", _f(p.predicted_col, 2),
-         _f(p.predicted_row, 2), _f(p.search_px[0], 1), _f(p.search_px[1], 1),
-         p.iterations or "")
+        (
+            p.point_id,
+            p.image_id,
+            p.status,
+            p.reason,
+            p.source if p.image_id else "",
+            _f(p.col),
+            _f(p.row),
+            _f(p.sigma_col),
+            _f(p.sigma_row),
+            _f(p.sigma0, 3),
+            _f(p.ncc, 3),
+            _f(p.lsm_correlation, 3),
+            p.template_px or "",
+            _f(p.predicted_col, 2),
+            _f(p.predicted_row, 2),
+            _f(p.search_px[0], 1),
+            _f(p.search_px[1], 1),
+            p.iterations or "",
+        )
         for p in pairs
-    ]  # fmt: skip
+    ]
     write_csv_atomic(path, REPORT_COLUMNS, rows)

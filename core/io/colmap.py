@@ -111,14 +111,16 @@ def _check_camera(cam_id: int, model: str, params: Tuple[float, ...], path: str,
         raise InputError(
             f"camera {cam_id}: unknown COLMAP camera model {model!r} "
             f"(known: {', '.join(_MODEL_IDS)})",
-            path=path, row=row,
-        )  # fmt: skip
+            path=path,
+            row=row,
+        )
     want = len(COLMAP_MODELS[_MODEL_IDS[model]][1])
     if len(params) != want:
         raise InputError(
             f"camera {cam_id}: model {model} has {want} parameters, got {len(params)}",
-            path=path, row=row,
-        )  # fmt: skip
+            path=path,
+            row=row,
+        )
     if not all(np.isfinite(params)):
         raise InputError(f"camera {cam_id}: a parameter is not finite", path=path, row=row)
 
@@ -172,8 +174,9 @@ def _read_images_txt(path: Path) -> Dict[int, ColmapImage]:
             raise InputError(
                 "expected IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME, then a line of "
                 "X Y POINT3D_ID triples",
-                path=str(path), row=row,
-            ) from None  # fmt: skip
+                path=str(path),
+                row=row,
+            ) from None
         out[image_id] = ColmapImage(image_id, q, t, cam_id, name, xy, pid)
     return out
 
@@ -195,8 +198,9 @@ def _read_points_txt(path: Path) -> Dict[int, ColmapPoint]:
         except (ValueError, IndexError):
             raise InputError(
                 "expected POINT3D_ID X Y Z R G B ERROR (IMAGE_ID POINT2D_IDX)...",
-                path=str(path), row=row,
-            ) from None  # fmt: skip
+                path=str(path),
+                row=row,
+            ) from None
         track = tuple(zip(rest[0::2], rest[1::2]))
         out[pid] = ColmapPoint(pid, xyz, rgb, err, track)
     return out
@@ -227,7 +231,7 @@ class _Reader:
         end = self.data.find(b"\0", self.pos)
         if end < 0:
             raise InputError("an image name has no end (truncated?)", path=str(self.path))
-        text = self.data[self.pos:end].decode("utf-8", errors="replace")
+        text = self.data[self.pos : end].decode("utf-8", errors="replace")
         self.pos = end + 1
         return text
 
@@ -251,9 +255,7 @@ def _read_cameras_bin(path: Path) -> Dict[int, ColmapCamera]:
         name, names = COLMAP_MODELS[model_id]
         params = tuple(float(v) for v in r.take("d" * len(names)))
         _check_camera(int(cam_id), name, params, str(path), 0)
-        out[int(cam_id)] = ColmapCamera(
-            int(cam_id), name, int(width), int(height), params
-        )
+        out[int(cam_id)] = ColmapCamera(int(cam_id), name, int(width), int(height), params)
     r.done()
     return out
 
@@ -272,9 +274,7 @@ def _read_images_bin(path: Path) -> Dict[int, ColmapImage]:
         image_id = int(vals[0])
         q = tuple(float(v) for v in vals[1:5])
         t = tuple(float(v) for v in vals[5:8])
-        out[image_id] = ColmapImage(
-            image_id, q, t, int(vals[8]), name, arr[:, :2].copy(), pid
-        )
+        out[image_id] = ColmapImage(image_id, q, t, int(vals[8]), name, arr[:, :2].copy(), pid)
     r.done()
     return out
 
@@ -287,9 +287,7 @@ def _read_points_bin(path: Path) -> Dict[int, ColmapPoint]:
         pid, x, y, z, cr, cg, cb, err, n = r.take("Q3d3BdQ")
         flat = r.take("ii" * int(n))
         track = tuple(zip(flat[0::2], flat[1::2]))
-        out[int(pid)] = ColmapPoint(
-            int(pid), (x, y, z), (cr, cg, cb), float(err), track
-        )
+        out[int(pid)] = ColmapPoint(int(pid), (x, y, z), (cr, cg, cb), float(err), track)
     r.done()
     return out
 
@@ -307,8 +305,9 @@ def read_colmap_model(folder: Union[str, Path]) -> ColmapModel:
     """
     folder = Path(folder)
     if not folder.is_dir():
-        raise InputError("not a folder (give the COLMAP model folder, e.g. sparse/0)",
-                         path=str(folder))  # fmt: skip
+        raise InputError(
+            "not a folder (give the COLMAP model folder, e.g. sparse/0)", path=str(folder)
+        )
     if (folder / "cameras.txt").is_file():
         readers = (_read_cameras_txt, _read_images_txt, _read_points_txt)
         ext = ".txt"
@@ -325,8 +324,10 @@ def read_colmap_model(folder: Union[str, Path]) -> ColmapModel:
     points = readers[2](pts_path) if pts_path.is_file() else {}
     for img in images.values():
         if img.camera_id not in cameras:
-            raise InputError(f"image {img.name!r}: camera {img.camera_id} is not in cameras{ext}",
-                             path=str(folder / f"images{ext}"))  # fmt: skip
+            raise InputError(
+                f"image {img.name!r}: camera {img.camera_id} is not in cameras{ext}",
+                path=str(folder / f"images{ext}"),
+            )
     return ColmapModel(cameras, images, points, str(folder))
 
 
@@ -336,21 +337,47 @@ def write_colmap_text(folder: Union[str, Path], model: ColmapModel) -> None:
     folder = Path(folder)
     cams = ["# CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]"]
     for c in model.cameras.values():
-        cams.append(" ".join([str(c.camera_id), c.model, str(c.width), str(c.height),
-                              *(repr(float(v)) for v in c.params)]))  # fmt: skip
-    imgs = ["# IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME",
-            "# POINTS2D[] as (X, Y, POINT3D_ID)"]  # fmt: skip
+        cams.append(
+            " ".join(
+                [
+                    str(c.camera_id),
+                    c.model,
+                    str(c.width),
+                    str(c.height),
+                    *(repr(float(v)) for v in c.params),
+                ]
+            )
+        )
+    imgs = [
+        "# IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME",
+        "# POINTS2D[] as (X, Y, POINT3D_ID)",
+    ]
     for im in model.images.values():
-        imgs.append(" ".join([str(im.image_id), *(repr(float(v)) for v in (*im.qvec, *im.tvec)),
-                              str(im.camera_id), im.name]))  # fmt: skip
+        imgs.append(
+            " ".join(
+                [
+                    str(im.image_id),
+                    *(repr(float(v)) for v in (*im.qvec, *im.tvec)),
+                    str(im.camera_id),
+                    im.name,
+                ]
+            )
+        )
         pairs = zip(im.xy.tolist(), im.point3d_id.tolist())
         imgs.append(" ".join(f"{x!r} {y!r} {int(p)}" for (x, y), p in pairs))
     pts = ["# POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)"]
     for p in model.points.values():
-        pts.append(" ".join([str(p.point_id), *(repr(float(v)) for v in p.xyz),
-                             *(str(int(v)) for v in p.rgb), repr(float(p.error)),
-                             *(f"{i} {j}" for i, j in p.track)]))  # fmt: skip
+        pts.append(
+            " ".join(
+                [
+                    str(p.point_id),
+                    *(repr(float(v)) for v in p.xyz),
+                    *(str(int(v)) for v in p.rgb),
+                    repr(float(p.error)),
+                    *(f"{i} {j}" for i, j in p.track),
+                ]
+            )
+        )
     folder.mkdir(parents=True, exist_ok=True)
     for name, lines in (("cameras.txt", cams), ("images.txt", imgs), ("points3D.txt", pts)):
         write_text_atomic(folder / name, "\n".join(lines) + "\n")
-

@@ -104,11 +104,13 @@ def quaternion_to_matrix(q: Sequence[float]) -> Array:
     [-1.0, 0.0, 0.0]
     """
     w, x, y, z = np.asarray(q, dtype=np.float64) / np.linalg.norm(q)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-    ])  # fmt: skip
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def matrix_to_quaternion(r: Array) -> Tuple[float, float, float, float]:
@@ -206,8 +208,7 @@ def camera_from_colmap(cam: ColmapCamera, pixel_size_mm: float, name: str) -> Ca
         lens = OpenCVFullLens(**{k: p[k] for k in OpenCVFullLens.param_names}, **common)
     elif cam.model == "THIN_PRISM_FISHEYE":
         projection = "equidistant"
-        lens = ThinPrismFisheyeLens(**{k: p[k] for k in ThinPrismFisheyeLens.param_names},
-                                    **common)  # fmt: skip
+        lens = ThinPrismFisheyeLens(**{k: p[k] for k in ThinPrismFisheyeLens.param_names}, **common)
     else:  # the fisheyes: OPENCV_FISHEYE, SIMPLE_RADIAL_FISHEYE, RADIAL_FISHEYE
         projection = "equidistant"
         coef = {"k1": p.get("k", 0.0)} if "k" in p else {}
@@ -232,14 +233,21 @@ def camera_to_colmap(camera: Camera, camera_id: int) -> ColmapCamera:
     cx, cy = camera.principal_point_px
     fisheye = camera.projection == "equidistant"
     if camera.projection not in ("perspective", "equidistant"):
-        raise InputError(f"camera {camera.name!r}: the {camera.projection} projection has no "
-                         "COLMAP camera model")  # fmt: skip
+        raise InputError(
+            f"camera {camera.name!r}: the {camera.projection} projection has no COLMAP camera model"
+        )
     if isinstance(lens, NoDistortion):
         if fisheye:
-            return ColmapCamera(camera_id, "OPENCV_FISHEYE", camera.width_px, camera.height_px,
-                                (f_px, f_px, cx, cy, 0.0, 0.0, 0.0, 0.0))  # fmt: skip
-        return ColmapCamera(camera_id, "SIMPLE_PINHOLE", camera.width_px, camera.height_px,
-                            (f_px, cx, cy))  # fmt: skip
+            return ColmapCamera(
+                camera_id,
+                "OPENCV_FISHEYE",
+                camera.width_px,
+                camera.height_px,
+                (f_px, f_px, cx, cy, 0.0, 0.0, 0.0, 0.0),
+            )
+        return ColmapCamera(
+            camera_id, "SIMPLE_PINHOLE", camera.width_px, camera.height_px, (f_px, cx, cy)
+        )
     fisheye_lens = isinstance(lens, (OpenCVFisheyeLens, ThinPrismFisheyeLens))
     if fisheye_lens != fisheye or not isinstance(
         lens, (OpenCVLens, OpenCVFullLens, OpenCVFisheyeLens, ThinPrismFisheyeLens)
@@ -282,9 +290,7 @@ class ColmapBlock:
     points: GroundPoints
 
 
-def to_frame(
-    frame: ColmapFrame, xyz: Array, m: Array
-) -> Tuple[Array, Array, str]:
+def to_frame(frame: ColmapFrame, xyz: Array, m: Array) -> Tuple[Array, Array, str]:
     """Model-frame centres/points (N, 3) and rotations M (K, 3, 3) -> the frame's (and its WKT).
 
     Shared with the OpenSfM import (its topocentric frame is an ECEF similarity).
@@ -308,7 +314,10 @@ def to_frame(
 
 
 def oriented(
-    frame: ColmapFrame, names: Sequence[str], r: NDArray[np.float64], t: NDArray[np.float64],
+    frame: ColmapFrame,
+    names: Sequence[str],
+    r: NDArray[np.float64],
+    t: NDArray[np.float64],
     xyz: NDArray[np.float64],
 ) -> Tuple[ExteriorOrientationTable, NDArray[np.float64]]:
     """The EO table of images given as world -> camera rotations ``r`` (N, 3, 3) and
@@ -318,18 +327,18 @@ def oriented(
     allx, m, wkt = to_frame(frame, np.vstack([centres, xyz]), _FLIP @ r)
     w, ph, k = matrix_to_opk(m)
     n = len(names)
-    eo = ExteriorOrientationTable(tuple(names), np.full(n, np.nan), ("",) * n, allx[:n],
-                                  np.column_stack([w, ph, k]), wkt)  # fmt: skip
+    eo = ExteriorOrientationTable(
+        tuple(names), np.full(n, np.nan), ("",) * n, allx[:n], np.column_stack([w, ph, k]), wkt
+    )
     return eo, allx[n:]
 
 
-def block_from_colmap(
-    model: ColmapModel, frame: ColmapFrame, pixel_size_mm: float
-) -> ColmapBlock:
+def block_from_colmap(model: ColmapModel, frame: ColmapFrame, pixel_size_mm: float) -> ColmapBlock:
     """Convert a COLMAP model (see the module docstring for the rules)."""
     cam_names = {k: f"colmap_{k}" for k in model.cameras}
-    cams = tuple(camera_from_colmap(c, pixel_size_mm, cam_names[k])
-                 for k, c in model.cameras.items())  # fmt: skip
+    cams = tuple(
+        camera_from_colmap(c, pixel_size_mm, cam_names[k]) for k, c in model.cameras.items()
+    )
     images: List[ColmapImage] = sorted(model.images.values(), key=lambda im: im.image_id)
     if not images:
         raise InputError("the model has no registered image", path=model.source)
@@ -347,20 +356,29 @@ def block_from_colmap(
         keep = np.flatnonzero(im.point3d_id >= 0)
         for j in keep:
             if int(im.point3d_id[j]) not in known and known:
-                raise InputError(f"image {im.name!r}: keypoint {j} names 3D point "
-                                 f"{int(im.point3d_id[j])}, not in points3D",
-                                 path=model.source)  # fmt: skip
+                raise InputError(
+                    f"image {im.name!r}: keypoint {j} names 3D point "
+                    f"{int(im.point3d_id[j])}, not in points3D",
+                    path=model.source,
+                )
             rows["image"].append(im.name)
             rows["point"].append(str(int(im.point3d_id[j])))
             rows["px"].append(im.xy[j])
     n_obs = len(rows["image"])
-    obs = ImageObservations(tuple(rows["image"]), tuple(rows["point"]),
-                            np.array(rows["px"], dtype=np.float64).reshape(-1, 2),
-                            np.full(n_obs, DEFAULT_SIGMA_PX), ("tie",) * n_obs,
-                            ("",) * n_obs)  # fmt: skip
-    ground = GroundPoints(tuple(str(p.point_id) for p in pts), point_xyz,
-                          np.full((len(pts), 3), DEFAULT_CONTROL_SIGMA_M),
-                          ("check",) * len(pts))  # fmt: skip
+    obs = ImageObservations(
+        tuple(rows["image"]),
+        tuple(rows["point"]),
+        np.array(rows["px"], dtype=np.float64).reshape(-1, 2),
+        np.full(n_obs, DEFAULT_SIGMA_PX),
+        ("tie",) * n_obs,
+        ("",) * n_obs,
+    )
+    ground = GroundPoints(
+        tuple(str(p.point_id) for p in pts),
+        point_xyz,
+        np.full((len(pts), 3), DEFAULT_CONTROL_SIGMA_M),
+        ("check",) * len(pts),
+    )
     per_image = tuple(cam_names[im.camera_id] for im in images)
     return ColmapBlock(cams, eo, per_image, obs, ground)
 
@@ -401,13 +419,22 @@ def colmap_from_block(
             for idx, p in enumerate(pid):
                 if p > 0:
                     tracks[p].append((k + 1, idx))
-        images[k + 1] = ColmapImage(k + 1, matrix_to_quaternion(r[k]), tuple(t[k].tolist()),
-                                    by_name[camera[k]], name, xy,
-                                    np.array(pid, dtype=np.int64))  # fmt: skip
+        images[k + 1] = ColmapImage(
+            k + 1,
+            matrix_to_quaternion(r[k]),
+            tuple(t[k].tolist()),
+            by_name[camera[k]],
+            name,
+            xy,
+            np.array(pid, dtype=np.int64),
+        )
     pts: Dict[int, ColmapPoint] = {}
     if points is not None:
         for v in point_ids.values():
-            xyz = (float(points.xyz[v - 1, 0]), float(points.xyz[v - 1, 1]),
-                   float(points.xyz[v - 1, 2]))  # fmt: skip
+            xyz = (
+                float(points.xyz[v - 1, 0]),
+                float(points.xyz[v - 1, 1]),
+                float(points.xyz[v - 1, 2]),
+            )
             pts[v] = ColmapPoint(v, xyz, (128, 128, 128), 0.0, tuple(tracks[v]))
     return ColmapModel(cols, images, pts)

@@ -27,12 +27,32 @@ COLMAP_MODELS: Dict[int, Tuple[str, Tuple[str, ...]]] = {
     7: ("FOV", ("fx", "fy", "cx", "cy", "omega")),
     8: ("SIMPLE_RADIAL_FISHEYE", ("f", "cx", "cy", "k")),
     9: ("RADIAL_FISHEYE", ("f", "cx", "cy", "k1", "k2")),
-    10: ("THIN_PRISM_FISHEYE",
-         ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3", "k4", "sx1", "sy1")),
-    11: ("RAD_TAN_THIN_PRISM_FISHEYE",
-         ("fx", "fy", "cx", "cy", "k0", "k1", "k2", "k3", "k4", "k5", "p0", "p1", "s0", "s1",
-          "s2", "s3")),
-}  # fmt: skip
+    10: (
+        "THIN_PRISM_FISHEYE",
+        ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3", "k4", "sx1", "sy1"),
+    ),
+    11: (
+        "RAD_TAN_THIN_PRISM_FISHEYE",
+        (
+            "fx",
+            "fy",
+            "cx",
+            "cy",
+            "k0",
+            "k1",
+            "k2",
+            "k3",
+            "k4",
+            "k5",
+            "p0",
+            "p1",
+            "s0",
+            "s1",
+            "s2",
+            "s3",
+        ),
+    ),
+}
 
 #: Where the Pix4D import puts the centre of the top-left pixel in Pix4D's K: ``corner``
 #: (the pixel coordinates start at the image's top-left corner, the first pixel's centre at

@@ -47,20 +47,58 @@ _IU3 = np.triu_indices(3)
 _IU6 = np.triu_indices(6)
 LCP_COV = tuple(f"cov_{'xyz'[i]}{'xyz'[j]}" for i, j in zip(*_IU3))
 LCP_COLUMNS = (
-    "id", "X", "Y", "Z", "sigma_x", "sigma_y", "sigma_z", *LCP_COV,
-    "ellipsoid_a", "ellipsoid_b", "ellipsoid_c", "plane_1", "plane_2", "plane_3",
-    "min_angle_deg", "condition",
-)  # fmt: skip
+    "id",
+    "X",
+    "Y",
+    "Z",
+    "sigma_x",
+    "sigma_y",
+    "sigma_z",
+    *LCP_COV,
+    "ellipsoid_a",
+    "ellipsoid_b",
+    "ellipsoid_c",
+    "plane_1",
+    "plane_2",
+    "plane_3",
+    "min_angle_deg",
+    "condition",
+)
 LINE_COV = tuple(f"cov_{i}{j}" for i, j in zip(*_IU6))
 LINE_COLUMNS = (
-    "id", "plane_1", "plane_2", "kind", "x1", "y1", "z1", "x2", "y2", "z2", "length",
-    "x0", "y0", "z0", "ux", "uy", "uz", "sigma_perpendicular", "sigma_start", "sigma_end",
-    "dihedral_deg", *LINE_COV,
-)  # fmt: skip
+    "id",
+    "plane_1",
+    "plane_2",
+    "kind",
+    "x1",
+    "y1",
+    "z1",
+    "x2",
+    "y2",
+    "z2",
+    "length",
+    "x0",
+    "y0",
+    "z0",
+    "ux",
+    "uy",
+    "uz",
+    "sigma_perpendicular",
+    "sigma_start",
+    "sigma_end",
+    "dihedral_deg",
+    *LINE_COV,
+)
 GRAPH_COLUMNS = (
-    "plane_1", "plane_2", "adjacent", "boundary_length", "contact_points",
-    "contact_x", "contact_y", "contact_z",
-)  # fmt: skip
+    "plane_1",
+    "plane_2",
+    "adjacent",
+    "boundary_length",
+    "contact_points",
+    "contact_x",
+    "contact_y",
+    "contact_z",
+)
 
 PathLike = Union[str, Path]
 
@@ -70,9 +108,17 @@ def write_lcps_csv(path: PathLike, points: Sequence[ControlPoint]) -> None:
     for p in points:
         axes, _ = error_ellipsoid(p.covariance)
         rows.append(
-            [p.id, *map(number, p.xyz), *map(number, p.sigma), *map(number, p.covariance[_IU3]),
-             *map(number, axes), *p.plane_ids, number(p.min_angle_deg), number(p.condition)]
-        )  # fmt: skip
+            [
+                p.id,
+                *map(number, p.xyz),
+                *map(number, p.sigma),
+                *map(number, p.covariance[_IU3]),
+                *map(number, axes),
+                *p.plane_ids,
+                number(p.min_angle_deg),
+                number(p.condition),
+            ]
+        )
     write_csv_atomic(path, LCP_COLUMNS, rows)
 
 
@@ -105,12 +151,22 @@ def read_lcps_csv(path: PathLike) -> list[ControlPoint]:
 
 def write_lines_csv(path: PathLike, lines: Sequence[ControlLine]) -> None:
     rows = [
-        [ln.id, *ln.plane_ids, ln.kind, *map(number, ln.start), *map(number, ln.end),
-         number(ln.length), *map(number, ln.point), *map(number, ln.direction),
-         number(ln.sigma_perpendicular), *map(number, ln.sigma_ends), number(ln.dihedral_deg),
-         *map(number, ln.covariance[_IU6])]
+        [
+            ln.id,
+            *ln.plane_ids,
+            ln.kind,
+            *map(number, ln.start),
+            *map(number, ln.end),
+            number(ln.length),
+            *map(number, ln.point),
+            *map(number, ln.direction),
+            number(ln.sigma_perpendicular),
+            *map(number, ln.sigma_ends),
+            number(ln.dihedral_deg),
+            *map(number, ln.covariance[_IU6]),
+        ]
         for ln in lines
-    ]  # fmt: skip
+    ]
     write_csv_atomic(path, LINE_COLUMNS, rows)
 
 
@@ -161,8 +217,11 @@ def write_graph_csv(path: PathLike, adjacency: Adjacency) -> None:
     rows = [
         [int(a), int(b), int(adj), number(length), int(count), *map(number, centre)]
         for (a, b), adj, length, count, centre in zip(
-            adjacency.pairs.tolist(), adjacency.adjacent, adjacency.boundary_length,
-            adjacency.contact_count, adjacency.contact_centre,
+            adjacency.pairs.tolist(),
+            adjacency.adjacent,
+            adjacency.boundary_length,
+            adjacency.contact_count,
+            adjacency.contact_centre,
         )
-    ]  # fmt: skip
+    ]
     write_csv_atomic(path, GRAPH_COLUMNS, rows)

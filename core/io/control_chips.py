@@ -60,12 +60,32 @@ __all__ = [
 
 CHIP_NODATA = -9999.0
 REPORT_COLUMNS = (
-    "point_id", "status", "reason", "X", "Y", "Z", "plate_photo", "free_photo", "source",
-    "corners_found", "corner_sigma_max_px", "edge_rms_max_px", "resection_sigma0",
-    "sigma_X0", "sigma_Y0", "sigma_Z0", "sigma_omega_deg", "sigma_phi_deg", "sigma_kappa_deg",
-    "azimuth_misfit_deg", "sift_matches", "sift_inliers", "free_sigma0", "valid_fraction",
+    "point_id",
+    "status",
+    "reason",
+    "X",
+    "Y",
+    "Z",
+    "plate_photo",
+    "free_photo",
+    "source",
+    "corners_found",
+    "corner_sigma_max_px",
+    "edge_rms_max_px",
+    "resection_sigma0",
+    "sigma_X0",
+    "sigma_Y0",
+    "sigma_Z0",
+    "sigma_omega_deg",
+    "sigma_phi_deg",
+    "sigma_kappa_deg",
+    "azimuth_misfit_deg",
+    "sift_matches",
+    "sift_inliers",
+    "free_sigma0",
+    "valid_fraction",
     "chip",
-)  # fmt: skip
+)
 
 
 @dataclass(frozen=True)
@@ -103,14 +123,19 @@ def read_photo_table(path: PathLike) -> dict[str, PhotoPair]:
             raise InputError(f"point {pid} twice", path=str(path), row=row)
         pp = (base / plate[k]).resolve()
         if not pp.is_file():
-            raise InputError(f"plate photo not found: {pp}", path=str(path), row=row,
-                             column="plate_photo")  # fmt: skip
+            raise InputError(
+                f"plate photo not found: {pp}", path=str(path), row=row, column="plate_photo"
+            )
         fp = None
         if free[k]:
             fpath = (base / free[k]).resolve()
             if not fpath.is_file():
-                raise InputError(f"plate-free photo not found: {fpath}", path=str(path),
-                                 row=row, column="free_photo")  # fmt: skip
+                raise InputError(
+                    f"plate-free photo not found: {fpath}",
+                    path=str(path),
+                    row=row,
+                    column="free_photo",
+                )
             fp = str(fpath)
         out[pid] = PhotoPair(pid, str(pp), fp, float(pa[k]), float(qa[k]))
     return out
@@ -122,14 +147,17 @@ def find_photo_pairs(
     """Photos by name among files and folders: ``<id><plate_suffix>.<ext>`` and
     ``<id><free_suffix>.<ext>``; points without a plate photo are left out."""
     if not plate_suffix or plate_suffix == free_suffix:
-        raise InputError("the plate and plate-free suffixes must differ and the plate suffix "
-                         f"cannot be empty (got {plate_suffix!r}, {free_suffix!r})")  # fmt: skip
+        raise InputError(
+            "the plate and plate-free suffixes must differ and the plate suffix "
+            f"cannot be empty (got {plate_suffix!r}, {free_suffix!r})"
+        )
     files: dict[str, Path] = {}
     for raw in paths:
         p = Path(raw)
         if p.is_dir():
-            found = [f for f in sorted(p.iterdir()) if f.is_file()
-                     and f.suffix.lower() in PHOTO_SUFFIXES]  # fmt: skip
+            found = [
+                f for f in sorted(p.iterdir()) if f.is_file() and f.suffix.lower() in PHOTO_SUFFIXES
+            ]
         elif p.is_file():
             found = [p]
         else:
@@ -155,8 +183,10 @@ def read_grey_photo(path: PathLike, width: int, height: int) -> NDArray[np.float
     with RasterReader(path) as src:
         info = src.info
         if (info.width, info.height) != (width, height):
-            raise InputError(f"the photo is {info.width} x {info.height} px, the camera "
-                             f"{width} x {height} px", path=str(path))  # fmt: skip
+            raise InputError(
+                f"the photo is {info.width} x {info.height} px, the camera {width} x {height} px",
+                path=str(path),
+            )
         data = src.read().astype(np.float32)
     if data.shape[0] >= 3:
         return (0.299 * data[0] + 0.587 * data[1] + 0.114 * data[2]).astype(np.float32)
@@ -175,8 +205,17 @@ def write_chip(
 
     data = np.where(np.isfinite(chip), chip, CHIP_NODATA).astype(np.float32)
     rows, cols = data.shape
-    with GeoTiffWriter(os.fspath(path), cols, rows, 1, np.float32, tuple(geotransform), crs,
-                       nodata=CHIP_NODATA, metadata=metadata) as w:  # fmt: skip
+    with GeoTiffWriter(
+        os.fspath(path),
+        cols,
+        rows,
+        1,
+        np.float32,
+        tuple(geotransform),
+        crs,
+        nodata=CHIP_NODATA,
+        metadata=metadata,
+    ) as w:
         w.write(data[None] if data.ndim == 2 else data)
 
 
@@ -188,8 +227,7 @@ def write_report_csv(path: PathLike, rows: Sequence[dict]) -> None:
             return ""
         return v  # floats: write_csv_atomic writes them in full (tables.number)
 
-    write_csv_atomic(path, REPORT_COLUMNS, ([cell(r.get(c)) for c in REPORT_COLUMNS]
-                                            for r in rows))  # fmt: skip
+    write_csv_atomic(path, REPORT_COLUMNS, ([cell(r.get(c)) for c in REPORT_COLUMNS] for r in rows))
 
 
 def write_report_json(path: PathLike, rows: Sequence[dict]) -> None:

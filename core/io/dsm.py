@@ -122,7 +122,11 @@ def load_dsm(
     """A DSM from a LAS/LAZ file (rasterised at ``cell``) or from a raster file."""
     if Path(os.fspath(path)).suffix.lower() in CLOUD_SUFFIXES:
         return dsm_from_las(
-            path, cell, crs, distance_unit=distance_unit, progress=progress,
+            path,
+            cell,
+            crs,
+            distance_unit=distance_unit,
+            progress=progress,
             should_stop=should_stop,
-        )  # fmt: skip
+        )
     return read_dsm_raster(path, crs)

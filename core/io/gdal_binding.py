@@ -66,12 +66,19 @@ def check_written(path: str) -> None:
     except (ImportError, OSError, ValueError):  # not on Windows
         limit = unlimited = -1
     if 0 <= limit != unlimited and size >= limit:
-        raise OSError(errno.EFBIG, f"cannot write it whole: the file reached the process's "
-                      f"file size limit of {limit} bytes (ulimit -f)", path)  # fmt: skip
+        raise OSError(
+            errno.EFBIG,
+            f"cannot write it whole: the file reached the process's "
+            f"file size limit of {limit} bytes (ulimit -f)",
+            path,
+        )
     free = shutil.disk_usage(os.path.dirname(os.path.abspath(path))).free
     if free < MIN_FREE_BYTES:
-        raise OSError(errno.ENOSPC, f"cannot write it whole: no space left on the device "
-                      f"({free} bytes free)", path)  # fmt: skip
+        raise OSError(
+            errno.ENOSPC,
+            f"cannot write it whole: no space left on the device ({free} bytes free)",
+            path,
+        )
 
 
 def quietly(drop: Callable[[], None]) -> None:

@@ -33,8 +33,11 @@ __all__ = ["GROUND_POINT_COLUMNS", "read_ground_points_csv", "write_ground_point
 GROUND_POINT_COLUMNS = ("point_id", "X", "Y", "Z", "sx", "sy", "sz", "role")
 
 _XYZ = (("x", "e", "easting"), ("y", "n", "northing"), ("z", "h", "height"))
-_SIG = (("sx", "sigma_x", "sigma_e", "s_x"), ("sy", "sigma_y", "sigma_n", "s_y"),
-        ("sz", "sigma_z", "sigma_h", "s_z"))  # fmt: skip
+_SIG = (
+    ("sx", "sigma_x", "sigma_e", "s_x"),
+    ("sy", "sigma_y", "sigma_n", "s_y"),
+    ("sz", "sigma_z", "sigma_h", "s_z"),
+)
 
 
 def read_ground_points_csv(path: Union[str, Path]) -> GroundPoints:

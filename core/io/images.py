@@ -20,9 +20,15 @@ from ..errors import InputError
 from .jpeg import check_jpeg_whole
 from .suffixes import IMAGE_SUFFIXES
 
-__all__ = ["IMAGE_SUFFIXES", "check_distinct_files", "check_jpeg_whole", "decode_factor",
-           "image_size",
-           "list_image_files", "read_gray"]  # fmt: skip
+__all__ = [
+    "IMAGE_SUFFIXES",
+    "check_distinct_files",
+    "check_jpeg_whole",
+    "decode_factor",
+    "image_size",
+    "list_image_files",
+    "read_gray",
+]
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -37,12 +43,15 @@ def list_image_files(paths, twice: tuple[str, str] | None = None) -> list[Path]:
     for raw in paths:
         p = Path(raw)
         if p.is_dir():
-            found = sorted(f for f in p.iterdir()
-                           if f.is_file() and f.suffix.lower() in IMAGE_SUFFIXES
-                           and not f.name.startswith("."))  # fmt: skip
+            found = sorted(
+                f
+                for f in p.iterdir()
+                if f.is_file() and f.suffix.lower() in IMAGE_SUFFIXES and not f.name.startswith(".")
+            )
             if not found:
-                raise InputError("no image in this folder (" + ", ".join(IMAGE_SUFFIXES) + ")",
-                                 path=str(p))  # fmt: skip
+                raise InputError(
+                    "no image in this folder (" + ", ".join(IMAGE_SUFFIXES) + ")", path=str(p)
+                )
             out += found
         elif p.is_file():
             out.append(p)
@@ -86,8 +95,9 @@ def check_distinct_files(files, param: str, why: str) -> None:
         for f in same:
             first = seen.setdefault(digest(f), f)
             if first is not f:
-                raise InputError(f"{param}: {f} has the same content as {first} (a copy): "
-                                 f"{why}; give it once")  # fmt: skip
+                raise InputError(
+                    f"{param}: {f} has the same content as {first} (a copy): {why}; give it once"
+                )
 
 
 def image_size(path: PathLike) -> tuple[int, int]:
@@ -122,8 +132,12 @@ def read_gray(path: PathLike, factor: int = 1) -> NDArray[np.uint8]:
     p = os.fspath(path)
     if not Path(p).is_file():
         raise InputError("image file not found", path=p)
-    flags = {1: cv2.IMREAD_GRAYSCALE, 2: cv2.IMREAD_REDUCED_GRAYSCALE_2,
-             4: cv2.IMREAD_REDUCED_GRAYSCALE_4, 8: cv2.IMREAD_REDUCED_GRAYSCALE_8}  # fmt: skip
+    flags = {
+        1: cv2.IMREAD_GRAYSCALE,
+        2: cv2.IMREAD_REDUCED_GRAYSCALE_2,
+        4: cv2.IMREAD_REDUCED_GRAYSCALE_4,
+        8: cv2.IMREAD_REDUCED_GRAYSCALE_8,
+    }
     if factor not in flags:
         raise ValueError(f"decoding reduces by 1, 2, 4 or 8, not {factor}")
     # ANYDEPTH: without it OpenCV divides 16-bit values by 256, and a 12-bit frame keeps

@@ -36,6 +36,8 @@ def check_jpeg_whole(path: PathLike) -> None:
     tail = raw[k:]
     end = np.flatnonzero((tail[:-1] == 0xFF) & (tail[1:] == 0xD9)) if tail.size > 1 else ()
     if k + 4 > raw.size or len(end) == 0:
-        raise InputError(f"truncated JPEG: its image data stop at byte {raw.size} without the "
-                         "end-of-image marker (a copy or a download cut short?)",
-                         path=os.fspath(path))  # fmt: skip
+        raise InputError(
+            f"truncated JPEG: its image data stop at byte {raw.size} without the "
+            "end-of-image marker (a copy or a download cut short?)",
+            path=os.fspath(path),
+        )

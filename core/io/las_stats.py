@@ -97,13 +97,16 @@ class HeaderStats:
         a = points.array
         rn = points.return_number  # laspy's bit-field view: its byte array, mask, shift
         ints = np.zeros(6, np.int64)
-        _COMPILED["stats"](a["X"], a["Y"], a["Z"], rn.array, int(rn.bit_mask), int(rn.lsb),
-                           ints, self._counts)  # fmt: skip
+        _COMPILED["stats"](
+            a["X"], a["Y"], a["Z"], rn.array, int(rn.bit_mask), int(rn.lsb), ints, self._counts
+        )
         for k in range(3):  # laspy's arithmetic: max(header, chunk's max * scale + offset)
-            self._maxs[k] = max(self._maxs[k], np.int64(ints[2 * k + 1]) * self._scales[k]
-                                + self._offsets[k])  # fmt: skip
-            self._mins[k] = min(self._mins[k], np.int64(ints[2 * k]) * self._scales[k]
-                                + self._offsets[k])  # fmt: skip
+            self._maxs[k] = max(
+                self._maxs[k], np.int64(ints[2 * k + 1]) * self._scales[k] + self._offsets[k]
+            )
+            self._mins[k] = min(
+                self._mins[k], np.int64(ints[2 * k]) * self._scales[k] + self._offsets[k]
+            )
         self._n += m
 
     def apply(self, header: Any) -> None:

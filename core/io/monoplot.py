@@ -15,12 +15,40 @@ PathLike = Union[str, "os.PathLike[str]"]
 
 
 POINT_COLUMNS = (
-    "image_id", "point_id", "type", "target_id", "line", "vertex", "col", "row", "X", "Y",
-    "Z", "sigma_x", "sigma_y", "sigma_z", "cov_xy", "cov_xz", "cov_yz", "status",
-    "status_text", "method", "incidence_deg",
-)  # fmt: skip
-LINE_COLUMNS = ("line", "image_id", "target_id", "n_vertices", "status", "status_text",
-                "length", "sigma_start", "sigma_end", "wkt")  # fmt: skip
+    "image_id",
+    "point_id",
+    "type",
+    "target_id",
+    "line",
+    "vertex",
+    "col",
+    "row",
+    "X",
+    "Y",
+    "Z",
+    "sigma_x",
+    "sigma_y",
+    "sigma_z",
+    "cov_xy",
+    "cov_xz",
+    "cov_yz",
+    "status",
+    "status_text",
+    "method",
+    "incidence_deg",
+)
+LINE_COLUMNS = (
+    "line",
+    "image_id",
+    "target_id",
+    "n_vertices",
+    "status",
+    "status_text",
+    "length",
+    "sigma_start",
+    "sigma_end",
+    "wkt",
+)
 
 
 def write_monoplot_points_csv(path: PathLike, r: MonoplotResult) -> None:
@@ -29,12 +57,25 @@ def write_monoplot_points_csv(path: PathLike, r: MonoplotResult) -> None:
     out = []
     for k, (img, pid, kind, tgt, li, vi, how) in enumerate(r.rows):
         c = r.covariance[k]
-        out.append((
-            img, pid, kind, tgt, li, vi, number(r.pixels[k, 0]), number(r.pixels[k, 1]),
-            *(number(v) for v in r.points[k]), *(number(v) for v in sig[k]),
-            *(number(v) for v in (c[0, 1], c[0, 2], c[1, 2])), int(r.status[k]),
-            STATUS_TEXT[int(r.status[k])], how, number(r.incidence_deg[k]),
-        ))  # fmt: skip
+        out.append(
+            (
+                img,
+                pid,
+                kind,
+                tgt,
+                li,
+                vi,
+                number(r.pixels[k, 0]),
+                number(r.pixels[k, 1]),
+                *(number(v) for v in r.points[k]),
+                *(number(v) for v in sig[k]),
+                *(number(v) for v in (c[0, 1], c[0, 2], c[1, 2])),
+                int(r.status[k]),
+                STATUS_TEXT[int(r.status[k])],
+                how,
+                number(r.incidence_deg[k]),
+            )
+        )
     write_csv_atomic(path, POINT_COLUMNS, out)
 
 
@@ -46,7 +87,18 @@ def write_monoplot_lines_csv(path: PathLike, r: MonoplotResult) -> None:
         length = float(np.linalg.norm(np.diff(v, axis=0), axis=1).sum()) if len(v) > 1 else 0.0
         xyz = ", ".join(f"{number(x)} {number(y)} {number(z)}" for x, y, z in v)
         wkt = f"LINESTRING Z ({xyz})"
-        out.append((li, ln.image_id, ln.target_id, len(ln.vertices), ln.status,
-                    STATUS_TEXT[ln.status], number(length), number(ln.sigma_ends[0]),
-                    number(ln.sigma_ends[1]), wkt if len(v) > 1 else ""))  # fmt: skip
+        out.append(
+            (
+                li,
+                ln.image_id,
+                ln.target_id,
+                len(ln.vertices),
+                ln.status,
+                STATUS_TEXT[ln.status],
+                number(length),
+                number(ln.sigma_ends[0]),
+                number(ln.sigma_ends[1]),
+                wkt if len(v) > 1 else "",
+            )
+        )
     write_csv_atomic(path, LINE_COLUMNS, out)

@@ -36,8 +36,17 @@ from .trajectory import HEIGHT_RANGE_M, MAX_TIME_S, velocity_columns
 _TIME = ("time", "gps_time", "gpstime", "sow", "gps_sow", "t", "time_sow")
 _LAT, _LON = ("latitude", "lat"), ("longitude", "lon", "long")
 _EAST, _NORTH = ("easting", "east", "e"), ("northing", "north", "n")
-_HEIGHT = ("height", "h_ell", "hell", "ellipsoid_height", "ellipsoidal_height", "h",
-           "alt", "altitude", "z")  # fmt: skip
+_HEIGHT = (
+    "height",
+    "h_ell",
+    "hell",
+    "ellipsoid_height",
+    "ellipsoidal_height",
+    "h",
+    "alt",
+    "altitude",
+    "z",
+)
 _ROLL, _PITCH = ("roll",), ("pitch",)
 _HEADING = ("heading", "yaw", "true_heading", "azimuth")
 _WANDER = ("wander", "wander_angle")
@@ -59,8 +68,9 @@ def read_nav_ascii(path: Union[str, Path]) -> NavSolution:
     try:
         lines = p.read_text(encoding="utf-8-sig", errors="strict").splitlines()
     except UnicodeDecodeError as exc:
-        raise InputError(f"not a text file ({exc.reason}): an SBET? use FORMAT sbet",
-                         path=str(p)) from exc  # fmt: skip
+        raise InputError(
+            f"not a text file ({exc.reason}): an SBET? use FORMAT sbet", path=str(p)
+        ) from exc
     first = next((i for i, line in enumerate(lines) if _numbers(line)), None)
     if first is None:
         raise InputError("no line of numbers: not a navigation export", path=str(p))
@@ -76,8 +86,11 @@ def read_nav_ascii(path: Union[str, Path]) -> NavSolution:
             continue
         cells = _cells(line)
         if len(cells) != width:
-            raise InputError(f"has {len(cells)} values but the header has {width} columns",
-                             path=str(p), row=i + 1)  # fmt: skip
+            raise InputError(
+                f"has {len(cells)} values but the header has {width} columns",
+                path=str(p),
+                row=i + 1,
+            )
         rows.append(tuple(cells))
         numbers.append(i + 1)
     return _solution(Table(str(p), names, tuple(rows), tuple(numbers)), units)
@@ -125,8 +138,9 @@ def _header_above(lines: list[str], first: int, width: int, path: str):
         raise InputError(
             f"no header line with {width} column names above the first data line "
             f"(names joined by _ or -, or separated by commas)",
-            path=path, row=first + 1,
-        )  # fmt: skip
+            path=path,
+            row=first + 1,
+        )
     return above[-1], units
 
 
@@ -159,8 +173,9 @@ def _solution(table: Table, units: tuple[str, ...]) -> NavSolution:
         cols = [find_column(table, names, what=names[0]) for names in (_EAST, _NORTH)]
         pos = np.stack([float_column(table, c) for c in (*cols, h_col)], axis=1)
     lo, hi = HEIGHT_RANGE_M
-    _check_abs(table, h_col, pos[:, 2] - 0.5 * (lo + hi), 0.5 * (hi - lo), "m (a height in "
-               "another unit?)")  # fmt: skip
+    _check_abs(
+        table, h_col, pos[:, 2] - 0.5 * (lo + hi), 0.5 * (hi - lo), "m (a height in another unit?)"
+    )
     cols = [find_column(table, names, what=names[0]) for names in (_ROLL, _PITCH, _HEADING)]
     rph = np.stack([float_column(table, c) * _angle_factor(units, c) for c in cols], axis=1)
     w_col = find_column(table, _WANDER, required=False)
@@ -168,16 +183,27 @@ def _solution(table: Table, units: tuple[str, ...]) -> NavSolution:
         rph[:, 2] -= float_column(table, w_col) * _angle_factor(units, w_col)
     for col, values, limit in zip(cols, rph.T, (np.pi, np.pi / 2, 4 * np.pi)):
         _check_abs(table, col, values, limit, "radians (degrees expected unless the unit is rad)")
-    return NavSolution(time, pos, lat_col is not None, rph, velocity_columns(table), table.path,
-                       "row", np.asarray(table.line_numbers))  # fmt: skip
+    return NavSolution(
+        time,
+        pos,
+        lat_col is not None,
+        rph,
+        velocity_columns(table),
+        table.path,
+        "row",
+        np.asarray(table.line_numbers),
+    )
 
 
 def _check_abs(table: Table, col: int, values, limit: float, unit: str) -> None:
     bad = np.flatnonzero(np.abs(values) > limit)
     if bad.size:
-        raise InputError(f"'{table.rows[bad[0]][col]}' is out of range ({unit})",
-                         path=table.path, row=table.line_numbers[bad[0]],
-                         column=table.columns[col])  # fmt: skip
+        raise InputError(
+            f"'{table.rows[bad[0]][col]}' is out of range ({unit})",
+            path=table.path,
+            row=table.line_numbers[bad[0]],
+            column=table.columns[col],
+        )
 
 
 def _check_time(table: Table, col: int, time: np.ndarray) -> None:
@@ -188,5 +214,7 @@ def _check_time(table: Table, col: int, time: np.ndarray) -> None:
         raise InputError(
             f"time {time[k]:.6f} s is not later than {time[k - 1]:.6f} s in row "
             f"{table.line_numbers[k - 1]}: the records must rise strictly in time",
-            path=table.path, row=table.line_numbers[k], column=table.columns[col],
-        )  # fmt: skip
+            path=table.path,
+            row=table.line_numbers[k],
+            column=table.columns[col],
+        )

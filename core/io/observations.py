@@ -149,9 +149,16 @@ def read_observations_csv(
                     column=table.columns[index],
                 )
     return ImageObservations(
-        image, point, np.column_stack([col, row]), sigma, kinds, target,
-        table.line_numbers, table.path, cameras,
-    )  # fmt: skip
+        image,
+        point,
+        np.column_stack([col, row]),
+        sigma,
+        kinds,
+        target,
+        table.line_numbers,
+        table.path,
+        cameras,
+    )
 
 
 def observation_cells(

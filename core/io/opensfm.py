@@ -164,8 +164,11 @@ def _read_camera(cid: str, obj: Any, path: str) -> OpenSfmCamera:
         raise InputError(f"{what}: expected an object", path=path)
     kind = str(obj.get("projection_type", "perspective"))
     if kind in _REFUSED:
-        raise InputError(f"{what}: OpenSfM projection type '{kind}' is not supported (no "
-                         "camera model of the project represents it)", path=path)  # fmt: skip
+        raise InputError(
+            f"{what}: OpenSfM projection type '{kind}' is not supported (no "
+            "camera model of the project represents it)",
+            path=path,
+        )
     if kind not in OPENSFM_MODELS:
         raise InputError(f"{what}: unknown OpenSfM projection type '{kind}'", path=path)
     w, h = (_number(obj, k, what, path) for k in ("width", "height"))
@@ -184,8 +187,9 @@ def _read_tracks(path: Path, shots: Mapping[str, Any], points: Mapping[str, Any]
         try:
             x, y = float(f[3]), float(f[4])
         except (IndexError, ValueError):
-            raise InputError("expected image, track, feature, x, y separated by tabs",
-                             path=str(path), row=n) from None  # fmt: skip
+            raise InputError(
+                "expected image, track, feature, x, y separated by tabs", path=str(path), row=n
+            ) from None
         if f[0] in shots and f[1] in points:
             rows.append((f[0], f[1], x, y))
     return rows
@@ -214,8 +218,9 @@ def read_opensfm(path: str | Path, index: int = 0) -> OpenSfmReconstruction:
     if not isinstance(data, list) or not data:
         raise InputError("expected a list of reconstructions", path=src)
     if not 0 <= index < len(data) or not isinstance(data[index], dict):
-        raise InputError(f"reconstruction {index} does not exist (the file has {len(data)})",
-                         path=src)  # fmt: skip
+        raise InputError(
+            f"reconstruction {index} does not exist (the file has {len(data)})", path=src
+        )
     rec = data[index]
     for key in ("cameras", "shots"):
         if not isinstance(rec.get(key), dict):
@@ -228,11 +233,16 @@ def read_opensfm(path: str | Path, index: int = 0) -> OpenSfmReconstruction:
             raise InputError(f"{what}: key 'camera' is missing", path=src)
         if str(s["camera"]) not in cams:
             raise InputError(f"{what}: camera {s['camera']!r} is not in cameras", path=src)
-        shots[str(name)] = OpenSfmShot(str(name), str(s["camera"]),
-                                       _vector(s, "rotation", what, src),
-                                       _vector(s, "translation", what, src))  # fmt: skip
-    points = {str(k): _vector(v if isinstance(v, dict) else {}, "coordinates", f"point {k!r}",
-                              src) for k, v in (rec.get("points") or {}).items()}  # fmt: skip
+        shots[str(name)] = OpenSfmShot(
+            str(name),
+            str(s["camera"]),
+            _vector(s, "rotation", what, src),
+            _vector(s, "translation", what, src),
+        )
+    points = {
+        str(k): _vector(v if isinstance(v, dict) else {}, "coordinates", f"point {k!r}", src)
+        for k, v in (rec.get("points") or {}).items()
+    }
     ref = rec.get("reference_lla")
     ref_file = p.parent / "reference_lla.json"
     if ref is None and ref_file.is_file():
@@ -246,8 +256,9 @@ def read_opensfm(path: str | Path, index: int = 0) -> OpenSfmReconstruction:
     lla: Tuple[float, float, float] | None = None
     if ref is not None:
         obj = ref if isinstance(ref, dict) else {}
-        lat, lon, alt = (_number(obj, k, "reference_lla", src_ref)
-                         for k in ("latitude", "longitude", "altitude"))  # fmt: skip
+        lat, lon, alt = (
+            _number(obj, k, "reference_lla", src_ref) for k in ("latitude", "longitude", "altitude")
+        )
         lla = (lat, lon, alt)
     tracks_file = p.parent / "tracks.csv"
     tracks = _read_tracks(tracks_file, shots, points) if tracks_file.is_file() else []
@@ -277,17 +288,17 @@ def camera_from_opensfm(cam: OpenSfmCamera, pixel_size_mm: float, name: str) -> 
     return Camera(name, f_mm, ps, cam.width, cam.height, x0, y0, lens, projection)
 
 
-def topocentric_frame(
-    reference_lla: Tuple[float, float, float] | None, crs: str
-) -> ColmapFrame:
+def topocentric_frame(reference_lla: Tuple[float, float, float] | None, crs: str) -> ColmapFrame:
     """The frame of OpenSfM's coordinates: LOCAL (``crs`` empty) or topocentric at
     ``reference_lla`` as an ECEF similarity, converted to the mapping ``crs``."""
     if not crs.strip():
         return ColmapFrame("local")
     if reference_lla is None:
-        raise InputError("CRS given but the reconstruction has no reference_lla (nor a "
-                         "reference_lla.json beside it): its frame is unknown; leave CRS empty "
-                         "for LOCAL")  # fmt: skip
+        raise InputError(
+            "CRS given but the reconstruction has no reference_lla (nor a "
+            "reference_lla.json beside it): its frame is unknown; leave CRS empty "
+            "for LOCAL"
+        )
     from ..geometry.frames import MappingFrame, enu_rotation
 
     try:
@@ -302,14 +313,13 @@ def topocentric_frame(
     return ColmapFrame("ecef", crs.strip(), 1.0, enu_rotation(lat, lon).T, x0)
 
 
-def block_from_opensfm(
-    rec: OpenSfmReconstruction, crs: str, pixel_size_mm: float
-) -> ColmapBlock:
+def block_from_opensfm(rec: OpenSfmReconstruction, crs: str, pixel_size_mm: float) -> ColmapBlock:
     """Convert one reconstruction (see the module docstring): LOCAL, or into ``crs``."""
     frame = topocentric_frame(rec.reference_lla, crs)
     cam_names = {k: f"opensfm_{k}" for k in rec.cameras}
-    cams = tuple(camera_from_opensfm(c, pixel_size_mm, cam_names[k])
-                 for k, c in rec.cameras.items())  # fmt: skip
+    cams = tuple(
+        camera_from_opensfm(c, pixel_size_mm, cam_names[k]) for k, c in rec.cameras.items()
+    )
     shots: List[OpenSfmShot] = sorted(rec.shots.values(), key=lambda s: s.name)
     if not shots:
         raise InputError("the reconstruction has no shot", path=rec.source)
@@ -324,9 +334,18 @@ def block_from_opensfm(
         size = max(c.width, c.height)
         px[j] = (xn * size + 0.5 * c.width, yn * size + 0.5 * c.height)
     n_obs = len(rec.tracks)
-    obs = ImageObservations(tuple(r_[0] for r_ in rec.tracks), tuple(r_[1] for r_ in rec.tracks),
-                            px, np.full(n_obs, DEFAULT_SIGMA_PX), ("tie",) * n_obs,
-                            ("",) * n_obs)  # fmt: skip
-    ground = GroundPoints(tuple(pids), point_xyz, np.full((len(pids), 3), DEFAULT_CONTROL_SIGMA_M),
-                          ("check",) * len(pids))  # fmt: skip
+    obs = ImageObservations(
+        tuple(r_[0] for r_ in rec.tracks),
+        tuple(r_[1] for r_ in rec.tracks),
+        px,
+        np.full(n_obs, DEFAULT_SIGMA_PX),
+        ("tie",) * n_obs,
+        ("",) * n_obs,
+    )
+    ground = GroundPoints(
+        tuple(pids),
+        point_xyz,
+        np.full((len(pids), 3), DEFAULT_CONTROL_SIGMA_M),
+        ("check",) * len(pids),
+    )
     return ColmapBlock(cams, eo, tuple(cam_names[s.camera] for s in shots), obs, ground)

@@ -92,8 +92,9 @@ def camera_to_opensfm(camera: Camera) -> Dict[str, Any]:
     c_x, c_y = (cx - 0.5 * w) / size, (cy - 0.5 * h) / size
     fisheye = camera.projection == "equidistant"
     if camera.projection not in ("perspective", "equidistant"):
-        raise InputError(f"camera {camera.name!r}: the {camera.projection} projection has no "
-                         "OpenSfM camera type")  # fmt: skip
+        raise InputError(
+            f"camera {camera.name!r}: the {camera.projection} projection has no OpenSfM camera type"
+        )
     if isinstance(lens, NoDistortion):
         coef: Dict[str, float] = {}
         aspect = 1.0
@@ -102,8 +103,10 @@ def camera_to_opensfm(camera: Camera) -> Dict[str, Any]:
     elif not fisheye and type(lens) in (OpenCVLens, OpenCVFullLens):
         coef, aspect = opencv_coefficients(lens, camera.focal_mm), lens.constants["aspect"]
         if any(coef.get(k, 0.0) != 0.0 for k in ("k4", "k5", "k6")):
-            raise InputError(f"camera {camera.name!r}: lens model 'opencv_full' with k4..k6 "
-                             "(a rational radial term) has no OpenSfM camera type")  # fmt: skip
+            raise InputError(
+                f"camera {camera.name!r}: lens model 'opencv_full' with k4..k6 "
+                "(a rational radial term) has no OpenSfM camera type"
+            )
     else:
         raise InputError(
             f"camera {camera.name!r}: lens model {lens.model!r} with the {camera.projection} "
@@ -117,15 +120,26 @@ def camera_to_opensfm(camera: Camera) -> Dict[str, Any]:
         if centred and k["k3"] == 0.0 and k["k4"] == 0.0:
             out.update(projection_type="fisheye", focal=f_px / size, k1=k["k1"], k2=k["k2"])
         else:
-            out.update(projection_type="fisheye_opencv", focal=f_px / size,
-                       aspect_ratio=aspect, c_x=c_x, c_y=c_y,
-                       **{n: k[n] for n in ("k1", "k2", "k3", "k4")})  # fmt: skip
+            out.update(
+                projection_type="fisheye_opencv",
+                focal=f_px / size,
+                aspect_ratio=aspect,
+                c_x=c_x,
+                c_y=c_y,
+                **{n: k[n] for n in ("k1", "k2", "k3", "k4")},
+            )
     elif centred and k["k3"] == 0.0 and k["p1"] == 0.0 and k["p2"] == 0.0:
         out.update(projection_type="perspective", focal=f_px / size, k1=k["k1"], k2=k["k2"])
     else:
         brown = {n: k[n] for n in ("k1", "k2", "k3", "p1", "p2")}
-        out.update(projection_type="brown", focal_x=f_px / size, focal_y=aspect * f_px / size,
-                   c_x=c_x, c_y=c_y, **brown)  # fmt: skip
+        out.update(
+            projection_type="brown",
+            focal_x=f_px / size,
+            focal_y=aspect * f_px / size,
+            c_x=c_x,
+            c_y=c_y,
+            **brown,
+        )
     return out
 
 
@@ -183,12 +197,17 @@ def opensfm_from_block(
     shots = {}
     for k, name in enumerate(eo.image_id):
         r = _FLIP @ m_out[k]
-        shots[name] = {"camera": camera[k], "rotation": list(axis_angle(r)),
-                       "translation": (-r @ centres[k]).tolist()}  # fmt: skip
+        shots[name] = {
+            "camera": camera[k],
+            "rotation": list(axis_angle(r)),
+            "translation": (-r @ centres[k]).tolist(),
+        }
     rec: Dict[str, Any] = {"cameras": cams, "shots": shots, "points": {}}
     if points is not None:
-        rec["points"] = {pid: {"coordinates": pts[j].tolist(), "color": [128, 128, 128]}
-                         for j, pid in enumerate(points.point_id)}  # fmt: skip
+        rec["points"] = {
+            pid: {"coordinates": pts[j].tolist(), "color": [128, 128, 128]}
+            for j, pid in enumerate(points.point_id)
+        }
     if ref is not None:
         rec["reference_lla"] = ref
     tracks = ""

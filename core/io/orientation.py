@@ -58,13 +58,21 @@ from .tables import (
 
 EO_COLUMNS = ("image_id", "time", "group", "X", "Y", "Z", "omega_deg", "phi_deg", "kappa_deg")
 EO_SIGMA_COLUMNS = (
-    "sigma_X", "sigma_Y", "sigma_Z", "sigma_omega_deg", "sigma_phi_deg", "sigma_kappa_deg",
-)  # fmt: skip
+    "sigma_X",
+    "sigma_Y",
+    "sigma_Z",
+    "sigma_omega_deg",
+    "sigma_phi_deg",
+    "sigma_kappa_deg",
+)
 _SIGMA_ALIASES = (
-    ("sigma_x", "sx", "s_x"), ("sigma_y", "sy", "s_y"), ("sigma_z", "sz", "s_z"),
-    ("sigma_omega_deg", "s_omega_deg", "sigma_omega"), ("sigma_phi_deg", "s_phi_deg", "sigma_phi"),
+    ("sigma_x", "sx", "s_x"),
+    ("sigma_y", "sy", "s_y"),
+    ("sigma_z", "sz", "s_z"),
+    ("sigma_omega_deg", "s_omega_deg", "sigma_omega"),
+    ("sigma_phi_deg", "s_phi_deg", "sigma_phi"),
     ("sigma_kappa_deg", "s_kappa_deg", "sigma_kappa"),
-)  # fmt: skip
+)
 
 
 @dataclass(frozen=True)
@@ -85,9 +93,7 @@ class EoFile:
 
 def _eo_rows(eo: ExteriorOrientationTable) -> Iterator[tuple[str, ...]]:
     deg = np.degrees(eo.opk)
-    for image, t, group, (x, y, z), (w, p, k) in zip(
-        eo.image_id, eo.time, eo.group, eo.xyz, deg
-    ):
+    for image, t, group, (x, y, z), (w, p, k) in zip(eo.image_id, eo.time, eo.group, eo.xyz, deg):
         yield (
             image,
             number(t),
@@ -200,8 +206,10 @@ def _velocity(table: Table) -> ExposureVelocities | None:
     if not given:
         return None if ned is None else ExposureVelocities(ned, "ned")
     if ned is not None or len(given) < 3:
-        raise InputError("give the velocities as v_north, v_east, v_up or as vx, vy, vz (all "
-                         "three of one set)", path=table.path)  # fmt: skip
+        raise InputError(
+            "give the velocities as v_north, v_east, v_up or as vx, vy, vz (all three of one set)",
+            path=table.path,
+        )
     vel = np.column_stack([float_column(table, c) for c in given])
     check_speeds(table, vel, given[0])
     return ExposureVelocities(vel, "map")

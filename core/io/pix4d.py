@@ -70,8 +70,17 @@ PIXEL_ORIGINS = PIX4D_PIXEL_ORIGINS
 _ROTATION_TOL = 1e-5
 #: The numbers of an image's block after its name line: K (9), radial (3), tangential (2),
 #: position (3), rotation (9), on 1 + 3 + 1 + 1 + 1 + 3 lines.
-_LINES = ((3, "K"), (3, "K"), (3, "K"), (3, "radial distortion"), (2, "tangential distortion"),
-          (3, "camera position t"), (3, "R"), (3, "R"), (3, "R"))  # fmt: skip
+_LINES = (
+    (3, "K"),
+    (3, "K"),
+    (3, "K"),
+    (3, "radial distortion"),
+    (2, "tangential distortion"),
+    (3, "camera position t"),
+    (3, "R"),
+    (3, "R"),
+    (3, "R"),
+)
 
 
 @dataclass(frozen=True)
@@ -96,8 +105,9 @@ def _floats(tokens: List[str], n: int, what: str, src: str, row: int) -> List[fl
     try:
         vals = [float(t) for t in tokens]
     except ValueError:
-        raise InputError(f"{what}: not a number in {' '.join(tokens)!r}", path=src,
-                         row=row) from None  # fmt: skip
+        raise InputError(
+            f"{what}: not a number in {' '.join(tokens)!r}", path=src, row=row
+        ) from None
     if not all(np.isfinite(vals)):
         raise InputError(f"{what}: not finite", path=src, row=row)
     return vals
@@ -126,8 +136,12 @@ def _numeric(tokens: List[str]) -> bool:
 def _rotation(m: Array, name: str, src: str, row: int) -> Array:
     err = float(np.max(np.abs(m @ m.T - np.eye(3))))
     if err > _ROTATION_TOL or np.linalg.det(m) <= 0:
-        raise InputError(f"image {name!r}: R is not a rotation (|R R^T - I| = {err:.2e}, "
-                         f"det {np.linalg.det(m):.6f})", path=src, row=row)  # fmt: skip
+        raise InputError(
+            f"image {name!r}: R is not a rotation (|R R^T - I| = {err:.2e}, "
+            f"det {np.linalg.det(m):.6f})",
+            path=src,
+            row=row,
+        )
     u, _, vt = np.linalg.svd(m)
     return u @ vt
 
@@ -155,18 +169,24 @@ def read_pix4d(path: str | Path) -> Tuple[Pix4dImage, ...]:
         row, tokens = lines[j]
         if not _is_name_line(tokens):
             if images or _numeric(tokens):  # the header is text; then only image blocks
-                raise InputError(f"expected 'name width height', got {' '.join(tokens)!r}",
-                                 path=src, row=row)  # fmt: skip
+                raise InputError(
+                    f"expected 'name width height', got {' '.join(tokens)!r}", path=src, row=row
+                )
             j += 1
             continue
         name, width, height = " ".join(tokens[:-2]), int(tokens[-2]), int(tokens[-1])
         if name in seen:
-            raise InputError(f"image {name!r} repeated (first at row {seen[name]})",
-                             path=src, row=row)  # fmt: skip
+            raise InputError(
+                f"image {name!r} repeated (first at row {seen[name]})", path=src, row=row
+            )
         seen[name] = row
         if j + len(_LINES) >= len(lines):
-            raise InputError(f"image {name!r}: the block is truncated (expected {len(_LINES)} "
-                             "lines of numbers after its name)", path=src, row=row)  # fmt: skip
+            raise InputError(
+                f"image {name!r}: the block is truncated (expected {len(_LINES)} "
+                "lines of numbers after its name)",
+                path=src,
+                row=row,
+            )
         vals: List[float] = []
         for (n, what), (r, tok) in zip(_LINES, lines[j + 1 : j + 1 + len(_LINES)]):
             vals += _floats(tok, n, f"image {name!r}, {what}", src, r)
@@ -178,19 +198,38 @@ def read_pix4d(path: str | Path) -> Tuple[Pix4dImage, ...]:
             or np.any(k[[1, 2, 2], [0, 0, 1]] != 0)
             or k[2, 2] != 1
         ):
-            raise InputError(f"image {name!r}: K must be [fx 0 cx; 0 fy cy; 0 0 1] with fx, "
-                             f"fy > 0, got {k.ravel().tolist()}", path=src,
-                             row=row + 1)  # fmt: skip
+            raise InputError(
+                f"image {name!r}: K must be [fx 0 cx; 0 fy cy; 0 0 1] with fx, "
+                f"fy > 0, got {k.ravel().tolist()}",
+                path=src,
+                row=row + 1,
+            )
         if k[0, 1] != 0:
-            raise InputError(f"image {name!r}: K has a skew ({k[0, 1]}): no camera of the "
-                             "project represents it", path=src, row=row + 1)  # fmt: skip
+            raise InputError(
+                f"image {name!r}: K has a skew ({k[0, 1]}): no camera of the project represents it",
+                path=src,
+                row=row + 1,
+            )
         rot = _rotation(np.array(vals[17:26]).reshape(3, 3), name, src, lines[j + 7][0])
-        images.append(Pix4dImage(name, width, height, k, (vals[9], vals[10], vals[11]),
-                                 (vals[12], vals[13]), np.array(vals[14:17]), rot))  # fmt: skip
+        images.append(
+            Pix4dImage(
+                name,
+                width,
+                height,
+                k,
+                (vals[9], vals[10], vals[11]),
+                (vals[12], vals[13]),
+                np.array(vals[14:17]),
+                rot,
+            )
+        )
         j += 1 + len(_LINES)
     if not images:
-        raise InputError("no image block ('name width height' and its numbers) in the file: "
-                         "is it a Pix4D calibrated_camera_parameters.txt?", path=src)  # fmt: skip
+        raise InputError(
+            "no image block ('name width height' and its numbers) in the file: "
+            "is it a Pix4D calibrated_camera_parameters.txt?",
+            path=src,
+        )
     return tuple(images)
 
 
@@ -209,8 +248,9 @@ def camera_from_pix4d(
 ) -> Camera:
     """The project's camera of an image's K and coefficients (see the module docstring)."""
     if pixel_origin not in PIXEL_ORIGINS:
-        raise InputError(f"PIXEL_ORIGIN: expected one of {', '.join(PIXEL_ORIGINS)}, "
-                         f"got {pixel_origin!r}")  # fmt: skip
+        raise InputError(
+            f"PIXEL_ORIGIN: expected one of {', '.join(PIXEL_ORIGINS)}, got {pixel_origin!r}"
+        )
     ps = float(pixel_size_mm)
     fx, fy = float(img.k[0, 0]), float(img.k[1, 1])
     shift = 0.5 if pixel_origin == "centre" else 0.0  # K's pixel -> the project's
@@ -242,13 +282,17 @@ def block_from_pix4d(
     """Convert the images (see the module docstring): the offset added, in ``crs`` (the
     output CRS Pix4D wrote them in: easting, northing, height) or LOCAL (``crs`` empty)."""
     if pixel_origin not in PIXEL_ORIGINS:
-        raise InputError(f"PIXEL_ORIGIN: expected one of {', '.join(PIXEL_ORIGINS)}, "
-                         f"got {pixel_origin!r}")  # fmt: skip
+        raise InputError(
+            f"PIXEL_ORIGIN: expected one of {', '.join(PIXEL_ORIGINS)}, got {pixel_origin!r}"
+        )
     if not images:
         raise InputError("no image to import")
     off = np.asarray(offset, dtype=np.float64).reshape(3)
-    frame = ColmapFrame("crs", crs.strip(), translation=off) if crs.strip() else ColmapFrame(
-        "local", translation=off)  # fmt: skip
+    frame = (
+        ColmapFrame("crs", crs.strip(), translation=off)
+        if crs.strip()
+        else ColmapFrame("local", translation=off)
+    )
     names: Dict[Tuple[float, ...], str] = {}
     cams: List[Camera] = []
     for img in images:

@@ -149,11 +149,16 @@ def read_planes_csv(path: Union[str, Path]) -> list[Plane]:
             )
         for name in ("rms", "sigma_d"):
             if not cols[name][k] >= 0:
-                raise InputError(f"{name} must be >= 0, got {cols[name][k]:g}",
-                                 path=table.path, row=row_no, column=name)  # fmt: skip
+                raise InputError(
+                    f"{name} must be >= 0, got {cols[name][k]:g}",
+                    path=table.path,
+                    row=row_no,
+                    column=name,
+                )
         if cols["n_points"][k] < 3:
-            raise InputError("a plane needs at least 3 points", path=table.path, row=row_no,
-                             column="n_points")  # fmt: skip
+            raise InputError(
+                "a plane needs at least 3 points", path=table.path, row=row_no, column="n_points"
+            )
         cov = np.empty((4, 4))
         cov[_IU] = [cols[name][k] for name in COV_COLUMNS]
         cov.T[_IU] = cov[_IU]

@@ -185,8 +185,9 @@ def _info_from_header(path: str, header: Any, crs: CrsLike, require_crs: bool) -
     mins = np.asarray(header.mins, dtype=np.float64).copy()
     maxs = np.asarray(header.maxs, dtype=np.float64).copy()
     if use is not None:  # a CRS that cannot hold these coordinates (or a unit mix-up)
-        frames.check_area_of_use(use, mins[:2], maxs[:2], what="the cloud (header extent)",
-                                 path=path)  # fmt: skip
+        frames.check_area_of_use(
+            use, mins[:2], maxs[:2], what="the cloud (header extent)", path=path
+        )
     by_return = np.asarray(header.number_of_points_by_return)
     return CloudInfo(
         path=path,
@@ -230,8 +231,9 @@ def _check_record_count(path: str, header: Any) -> None:
             path=path,
         )
     if held < n:
-        raise InputError(f"truncated: the file holds {held} point records, the header says {n}",
-                         path=path)  # fmt: skip
+        raise InputError(
+            f"truncated: the file holds {held} point records, the header says {n}", path=path
+        )
     if held == n and rest:
         LOG.warning("%s: %d stray bytes after the last point record", path, rest)
 
@@ -283,8 +285,12 @@ def _check_fields(info: CloudInfo, fields: Sequence[str]) -> list[str]:
 
 
 def _read_chunks(
-    chunks: Iterator[Any], n: int, path: str, take: Callable[[Any, int], None],
-    progress: Callable[[float], None] | None, should_stop: Callable[[], bool] | None,
+    chunks: Iterator[Any],
+    n: int,
+    path: str,
+    take: Callable[[Any, int], None],
+    progress: Callable[[float], None] | None,
+    should_stop: Callable[[], bool] | None,
 ) -> None:
     """Hand every chunk of a LAS reader to ``take(chunk, points_before_it)`` until ``n``
     points; decoding errors (a corrupt or truncated file) and a short count become
@@ -602,8 +608,18 @@ def write_cloud(
     if points is not None:
         n = len(points)
         chunks = iter(points.chunks)
-        _write_records(src, dst, points.header, points.evlrs, n, chunks, classification,
-                       extra, progress, should_stop)  # fmt: skip
+        _write_records(
+            src,
+            dst,
+            points.header,
+            points.evlrs,
+            n,
+            chunks,
+            classification,
+            extra,
+            progress,
+            should_stop,
+        )
         return
     with _open(src) as reader:
         _check_record_count(src, reader.header)
@@ -611,8 +627,18 @@ def write_cloud(
         if n == 0:
             raise InputError("the file holds no points", path=src)
         chunks = (chunk.array for chunk in reader.chunk_iterator(step))
-        _write_records(src, dst, reader.header, list(reader.header.evlrs or []), n, chunks,
-                       classification, extra, progress, should_stop)  # fmt: skip
+        _write_records(
+            src,
+            dst,
+            reader.header,
+            list(reader.header.evlrs or []),
+            n,
+            chunks,
+            classification,
+            extra,
+            progress,
+            should_stop,
+        )
 
 
 def _write_records(
@@ -655,8 +681,13 @@ def _write_records(
         header.add_extra_dims(new_params)
     same_format = not new_params
     with atomic_path(dst) as tmp:
-        with laspy.open(tmp, mode="w", header=header, do_compress=dst.lower().endswith(".laz"),
-                        laz_backend=_laz_backend()) as writer:  # fmt: skip
+        with laspy.open(
+            tmp,
+            mode="w",
+            header=header,
+            do_compress=dst.lower().endswith(".laz"),
+            laz_backend=_laz_backend(),
+        ) as writer:
             fmt = writer.header.point_format
             # laspy's header growth per chunk in one compiled pass (same header; None: laspy's)
             stats = HeaderStats.for_writer(writer) if same_format else None

@@ -135,8 +135,10 @@ class RasterReader:
         self.backend = raster_backend()
         self._ds: Any = None
         self._lock = threading.RLock()
-        if "://" not in self.path and ":" not in Path(self.path).name and not (
-            Path(self.path).exists()
+        if (
+            "://" not in self.path
+            and ":" not in Path(self.path).name
+            and not (Path(self.path).exists())
         ):
             raise InputError("file not found", path=self.path)
         self.info = self._describe(self._handle())
@@ -189,22 +191,45 @@ class RasterReader:
             band = h.GetRasterBand(1)
             gt = tuple(h.GetGeoTransform(can_return_null=True) or ()) or None
             dtype = np.dtype(gdal_array.GDALTypeCodeToNumericTypeCode(band.DataType))
-            return RasterInfo(self.path, h.RasterXSize, h.RasterYSize, h.RasterCount, dtype,
-                              gt, h.GetProjection() or "", band.GetNoDataValue(),
-                              dict(h.GetMetadata() or {}))  # fmt: skip
+            return RasterInfo(
+                self.path,
+                h.RasterXSize,
+                h.RasterYSize,
+                h.RasterCount,
+                dtype,
+                gt,
+                h.GetProjection() or "",
+                band.GetNoDataValue(),
+                dict(h.GetMetadata() or {}),
+            )
         gt = None if h.transform.is_identity and h.crs is None else tuple(h.transform.to_gdal())
-        return RasterInfo(self.path, h.width, h.height, h.count, np.dtype(h.dtypes[0]), gt,
-                          h.crs.to_wkt() if h.crs else "", h.nodata, dict(h.tags()))  # fmt: skip
+        return RasterInfo(
+            self.path,
+            h.width,
+            h.height,
+            h.count,
+            np.dtype(h.dtypes[0]),
+            gt,
+            h.crs.to_wkt() if h.crs else "",
+            h.nodata,
+            dict(h.tags()),
+        )
 
     def _window(self, window: Window | None) -> Window:
         if window is None:
             return 0, 0, self.info.width, self.info.height
         c0, r0, w, h = (int(v) for v in window)
-        if c0 < 0 or r0 < 0 or w < 0 or h < 0 or c0 + w > self.info.width or (
-            r0 + h > self.info.height
+        if (
+            c0 < 0
+            or r0 < 0
+            or w < 0
+            or h < 0
+            or c0 + w > self.info.width
+            or (r0 + h > self.info.height)
         ):
-            raise ValueError(f"window {window} outside the raster {self.info.width} x "
-                             f"{self.info.height}")  # fmt: skip
+            raise ValueError(
+                f"window {window} outside the raster {self.info.width} x {self.info.height}"
+            )
         return c0, r0, w, h
 
     def read(
@@ -240,12 +265,23 @@ class RasterReader:
         except (RuntimeError, OSError) as exc:
             cause = exc.__cause__ or exc
             detail = getattr(cause, "errmsg", None) or str(cause)
-            raise InputError(f"cannot read the pixels: the file is truncated or corrupt "
-                             f"({detail})", path=self.path) from exc  # fmt: skip
+            raise InputError(
+                f"cannot read the pixels: the file is truncated or corrupt ({detail})",
+                path=self.path,
+            ) from exc
 
-
-    def _read(self, c0: int, r0: int, w: int, h: int, which: list[int], f: int, bw: int,
-              bh: int, out: NDArray | None = None) -> NDArray:  # fmt: skip
+    def _read(
+        self,
+        c0: int,
+        r0: int,
+        w: int,
+        h: int,
+        which: list[int],
+        f: int,
+        bw: int,
+        bh: int,
+        out: NDArray | None = None,
+    ) -> NDArray:
         ds = self._handle()
         if self.backend == "gdal":
             if f == 1:
@@ -253,8 +289,16 @@ class RasterReader:
             else:
                 from osgeo import gdal
 
-                got = ds.ReadAsArray(c0, r0, w, h, buf_xsize=bw, buf_ysize=bh, band_list=which,
-                                     resample_alg=gdal.GRIORA_Average)  # fmt: skip
+                got = ds.ReadAsArray(
+                    c0,
+                    r0,
+                    w,
+                    h,
+                    buf_xsize=bw,
+                    buf_ysize=bh,
+                    band_list=which,
+                    resample_alg=gdal.GRIORA_Average,
+                )
             got = got.reshape(len(which), bh, bw)
             if out is None:
                 return got
@@ -268,10 +312,15 @@ class RasterReader:
         from rasterio.enums import Resampling
 
         if out is not None:  # the shape of ``out`` is the decimated one
-            return ds.read(which, window=RioWindow(c0, r0, w, h), out=out,
-                           resampling=Resampling.average)  # fmt: skip
-        return ds.read(which, window=RioWindow(c0, r0, w, h), out_shape=(len(which), bh, bw),
-                       resampling=Resampling.average)  # fmt: skip
+            return ds.read(
+                which, window=RioWindow(c0, r0, w, h), out=out, resampling=Resampling.average
+            )
+        return ds.read(
+            which,
+            window=RioWindow(c0, r0, w, h),
+            out_shape=(len(which), bh, bw),
+            resampling=Resampling.average,
+        )
 
     def read_mask(self, window: Window | None = None) -> NDArray[np.bool_]:
         """(rows, cols) True where band 1 holds data: GDAL's mask band (an internal or

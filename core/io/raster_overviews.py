@@ -51,7 +51,7 @@ def level_windows(n_src: int, n_dst: int) -> Windows:
     return a, b, wl, wr
 
 
-def _average_rows(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask):  # fmt: skip
+def _average_rows(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask):
     """Cells (rows ya.size, cols xa.size) of a level from the source rows of ``src`` (rows,
     cols, bands: pixel-interleaved) and ``mask`` (rows, cols) into ``out`` (rows, cols, bands);
     ya, yb relative to src's first row; windows of at most 3 pixels per axis (r <= 2). Each
@@ -93,9 +93,11 @@ def _average_rows(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask):
                 wline[k, j] = (wl if m0 else 0.0) + (1.0 if m1 else 0.0) + (wr if m2 else 0.0)
                 cline[k, j] = int(m0) + int(m1) + int(m2)
                 for bb in range(nb):
-                    line[k, j, bb] = ((src[y, x0, bb] * wl if m0 else 0.0)
-                                      + (src[y, x0 + 1, bb] if m1 else 0.0)
-                                      + (src[y, x2, bb] * wr if m2 else 0.0))  # fmt: skip
+                    line[k, j, bb] = (
+                        (src[y, x0, bb] * wl if m0 else 0.0)
+                        + (src[y, x0 + 1, bb] if m1 else 0.0)
+                        + (src[y, x2, bb] * wr if m2 else 0.0)
+                    )
         for i in range(i0, i1):  # then over the rows
             k0 = ya[i] - s0
             ny = yb[i] - ya[i]
@@ -148,7 +150,7 @@ def _average_rows_2x2(src, mask, out, out_mask):
                 out[i, j, bb] = (tot + half) // cnt if cnt else 0
 
 
-def _average_rows_numpy(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask):  # fmt: skip
+def _average_rows_numpy(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask):
     """The same as :func:`_average_rows`, vectorised (numba not installed): windows span at
     most 3 pixels per axis (r <= 2), so each sum has at most three terms, added in GDAL's
     order (masked terms are exact zeros)."""
@@ -170,8 +172,9 @@ def _average_rows_numpy(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_
 
     mi = m.astype(np.int64)
     c = mi[:, xa] + np.where(nx >= 2, mi[:, xb - 1], 0) + np.where(nx == 3, mi[:, xm], 0)
-    cnt = c[ya] + np.where((ny >= 2)[:, None], c[yb - 1], 0) + np.where(
-        (ny == 3)[:, None], c[ym], 0)  # fmt: skip
+    cnt = (
+        c[ya] + np.where((ny >= 2)[:, None], c[yb - 1], 0) + np.where((ny == 3)[:, None], c[ym], 0)
+    )
     tot = rows(lines(np.where(m, src, 0).astype(np.float64)))
     wt = rows(lines(m.astype(np.float64)))
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -183,8 +186,7 @@ def _average_rows_numpy(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_
 _COMPILED: dict[str, Callable[..., Any]] = {}
 
 
-def _run_kernel(backend: str, src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out,
-                out_mask) -> None:  # fmt: skip
+def _run_kernel(backend: str, src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask) -> None:
     """The level's cells from the source rows (:func:`_average_rows` arguments), compiled
     when numba is there (the 2 x 2 kernel when every window is 2 x 2 whole pixels)."""
     if backend == "numpy" or (backend == "auto" and not AVAILABLE):
@@ -193,10 +195,20 @@ def _run_kernel(backend: str, src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out
     if not _COMPILED:
         _COMPILED["rows"] = cached_njit(_average_rows, nogil=True)
         _COMPILED["2x2"] = cached_njit(_average_rows_2x2, nogil=True)
-    two = (ya.size == 0 or (np.all(yb - ya == 2) and ya[0] == 0 and np.all(np.diff(ya) == 2)
-                            and np.all(ywl == 1.0) and np.all(ywr == 1.0)))
-    two = two and (np.all(xb - xa == 2) and xa[0] == 0 and np.all(np.diff(xa) == 2)
-                   and np.all(xwl == 1.0) and np.all(xwr == 1.0))  # fmt: skip
+    two = ya.size == 0 or (
+        np.all(yb - ya == 2)
+        and ya[0] == 0
+        and np.all(np.diff(ya) == 2)
+        and np.all(ywl == 1.0)
+        and np.all(ywr == 1.0)
+    )
+    two = two and (
+        np.all(xb - xa == 2)
+        and xa[0] == 0
+        and np.all(np.diff(xa) == 2)
+        and np.all(xwl == 1.0)
+        and np.all(xwr == 1.0)
+    )
     if two:
         _COMPILED["2x2"](src, mask, out, out_mask)
     else:
@@ -223,9 +235,21 @@ def average_level(
     out_mask = np.empty((oh, ow), np.bool_)
     ya, yb, ywl, ywr = level_windows(h, oh)
     xa, xb, xwl, xwr = level_windows(w, ow)
-    _run_kernel(backend, np.ascontiguousarray(np.moveaxis(data, 0, -1)),
-                np.asarray(mask, np.uint8), ya, yb, ywl, ywr, xa, xb, xwl, xwr, out,
-                out_mask)  # fmt: skip
+    _run_kernel(
+        backend,
+        np.ascontiguousarray(np.moveaxis(data, 0, -1)),
+        np.asarray(mask, np.uint8),
+        ya,
+        yb,
+        ywl,
+        ywr,
+        xa,
+        xb,
+        xwl,
+        xwr,
+        out,
+        out_mask,
+    )
     return np.moveaxis(out, 2, 0), out_mask
 
 
@@ -240,8 +264,9 @@ class OverviewBuilder:
     consumed makes :meth:`add` return False: the caller then lets GDAL build the overviews.
     """
 
-    def __init__(self, bands: int, height: int, width: int, dtype: Any, levels: int,
-                 backend: str = "auto") -> None:  # fmt: skip
+    def __init__(
+        self, bands: int, height: int, width: int, dtype: Any, levels: int, backend: str = "auto"
+    ) -> None:
         self.bands, self.height, self.width = int(bands), int(height), int(width)
         self.dtype = np.dtype(dtype)
         self.n_levels = int(levels)
@@ -260,8 +285,11 @@ class OverviewBuilder:
         self.ok = True
         # the next level grown from level 1's rows as they are made (GDAL makes each level
         # from the previous), so that none is left for the end
-        self._child = (OverviewBuilder(self.bands, oh, ow, self.dtype, self.n_levels - 1,
-                                       backend) if self.n_levels > 1 else None)  # fmt: skip
+        self._child = (
+            OverviewBuilder(self.bands, oh, ow, self.dtype, self.n_levels - 1, backend)
+            if self.n_levels > 1
+            else None
+        )
 
     def _room(self, rows: int) -> None:
         """Make the buffer hold rows [base, base + rows)."""
@@ -309,10 +337,18 @@ class OverviewBuilder:
             return
         i0 = self._next
         s0 = int(ya[i0]) - self._base
-        _run_kernel(self.backend, np.moveaxis(self._buf, 0, -1)[s0:complete],
-                    self._mbuf[s0:complete], ya[i0:end] - ya[i0], yb[i0:end] - ya[i0],
-                    ywl[i0:end], ywr[i0:end], *self._x, self._lv1[i0:end],
-                    self.lv1_mask[i0:end])  # fmt: skip
+        _run_kernel(
+            self.backend,
+            np.moveaxis(self._buf, 0, -1)[s0:complete],
+            self._mbuf[s0:complete],
+            ya[i0:end] - ya[i0],
+            yb[i0:end] - ya[i0],
+            ywl[i0:end],
+            ywr[i0:end],
+            *self._x,
+            self._lv1[i0:end],
+            self.lv1_mask[i0:end],
+        )
         self._next = end
         if self._child is not None:
             self._child.add(self.lv1[:, i0:end], self.lv1_mask[i0:end], 0, i0)

@@ -31,9 +31,14 @@ OVERVIEW_MEMORY_BYTES = 256 << 20
 
 
 _GDAL_TYPES = {
-    "uint8": "Byte", "uint16": "UInt16", "int16": "Int16", "uint32": "UInt32",
-    "int32": "Int32", "float32": "Float32", "float64": "Float64",
-}  # fmt: skip
+    "uint8": "Byte",
+    "uint16": "UInt16",
+    "int16": "Int16",
+    "uint32": "UInt32",
+    "int32": "Int32",
+    "float32": "Float32",
+    "float64": "Float64",
+}
 
 
 class GeoTiffWriter:
@@ -106,22 +111,34 @@ class GeoTiffWriter:
         if overviews_in_memory is None:
             # the levels held until the file is closed: level 1, a quarter of the raster and
             # its mask, and the deeper ones (a third more)
-            held = (-(-self.height // 2) * -(-self.width // 2)
-                    * (self.bands * self.dtype.itemsize + 1) * 4 // 3)  # fmt: skip
-            overviews_in_memory = (self.mask and self.dtype in (np.uint8, np.uint16)
-                                   and held <= OVERVIEW_MEMORY_BYTES
-                                   and os.environ.get("LIDARPHOTO_OVERVIEWS", "").lower()
-                                   != "gdal")  # fmt: skip
+            held = (
+                -(-self.height // 2)
+                * -(-self.width // 2)
+                * (self.bands * self.dtype.itemsize + 1)
+                * 4
+                // 3
+            )
+            overviews_in_memory = (
+                self.mask
+                and self.dtype in (np.uint8, np.uint16)
+                and held <= OVERVIEW_MEMORY_BYTES
+                and os.environ.get("LIDARPHOTO_OVERVIEWS", "").lower() != "gdal"
+            )
         self._ovr = None
         if overviews_in_memory and factors:
             from .raster_overviews import OverviewBuilder
 
-            self._ovr = OverviewBuilder(self.bands, self.height, self.width, self.dtype,
-                                        len(factors))  # fmt: skip
+            self._ovr = OverviewBuilder(
+                self.bands, self.height, self.width, self.dtype, len(factors)
+            )
         compress = compress.upper()
         integer = self.dtype.kind in "ui"
-        opts: dict[str, str] = {"COMPRESS": compress, "BIGTIFF": "IF_SAFER",
-                                "NUM_THREADS": str(_threads()), "INTERLEAVE": "PIXEL"}  # fmt: skip
+        opts: dict[str, str] = {
+            "COMPRESS": compress,
+            "BIGTIFF": "IF_SAFER",
+            "NUM_THREADS": str(_threads()),
+            "INTERLEAVE": "PIXEL",
+        }
         if tile:
             opts.update(TILED="YES", BLOCKXSIZE=str(int(tile)), BLOCKYSIZE=str(int(tile)))
         if predictor and compress in ("DEFLATE", "LZW", "ZSTD"):
@@ -143,9 +160,14 @@ class GeoTiffWriter:
 
             gdal.UseExceptions()
             drv = gdal.GetDriverByName("GTiff")
-            self._ds = drv.Create(self.path, self.width, self.height, self.bands,
-                                  getattr(gdal, "GDT_" + _GDAL_TYPES[self.dtype.name]),
-                                  [f"{k}={v}" for k, v in opts.items()])  # fmt: skip
+            self._ds = drv.Create(
+                self.path,
+                self.width,
+                self.height,
+                self.bands,
+                getattr(gdal, "GDT_" + _GDAL_TYPES[self.dtype.name]),
+                [f"{k}={v}" for k, v in opts.items()],
+            )
             if gt is not None:
                 self._ds.SetGeoTransform(gt)
             if crs_text:
@@ -178,12 +200,19 @@ class GeoTiffWriter:
             with warnings.catch_warnings():  # an image without georeferencing is fine here
                 warnings.simplefilter("ignore", NotGeoreferencedWarning)
                 self._ds = rasterio.open(
-                    self.path, "w", driver="GTiff", width=self.width, height=self.height,
-                    count=self.bands, dtype=self.dtype.name, nodata=nodata,
+                    self.path,
+                    "w",
+                    driver="GTiff",
+                    width=self.width,
+                    height=self.height,
+                    count=self.bands,
+                    dtype=self.dtype.name,
+                    nodata=nodata,
                     crs=RIO_CRS.from_user_input(crs_text) if crs_text else None,
                     transform=Affine.from_gdal(*gt) if gt is not None else None,
-                    tiled=bool(tile), **kwargs,
-                )  # fmt: skip
+                    tiled=bool(tile),
+                    **kwargs,
+                )
             if metadata:
                 self._ds.update_tags(**{str(k): str(v) for k, v in metadata.items()})
 
@@ -313,10 +342,19 @@ def _write_levels_gdal(ds: Any, levels: list) -> None:
         for r0 in range(0, rows, _LEVEL_ROWS):  # as in _write_levels_rasterio
             part = np.ascontiguousarray(np.moveaxis(data[:, r0 : r0 + _LEVEL_ROWS], 0, -1))
             n = part.shape[0]
-            level.WriteRaster(0, r0, cols, n, part.data, cols, n,
-                              band_list=list(range(1, nb + 1)),
-                              buf_pixel_space=part.strides[1], buf_line_space=part.strides[0],
-                              buf_band_space=part.strides[2])  # fmt: skip
+            level.WriteRaster(
+                0,
+                r0,
+                cols,
+                n,
+                part.data,
+                cols,
+                n,
+                band_list=list(range(1, nb + 1)),
+                buf_pixel_space=part.strides[1],
+                buf_line_space=part.strides[0],
+                buf_band_space=part.strides[2],
+            )
             mask.WriteArray(m[r0 : r0 + _LEVEL_ROWS], 0, r0)
 
 
@@ -333,8 +371,16 @@ def _rasterio_gdal() -> Any:
         lib.GDALOpenEx.restype = vp
         lib.GDALOpenEx.argtypes = [ctypes.c_char_p, ctypes.c_uint, vp, vp, vp]
         lib.GDALBuildOverviews.restype = ci
-        lib.GDALBuildOverviews.argtypes = [vp, ctypes.c_char_p, ci, ctypes.POINTER(ci), ci,
-                                           ctypes.POINTER(ci), vp, vp]  # fmt: skip
+        lib.GDALBuildOverviews.argtypes = [
+            vp,
+            ctypes.c_char_p,
+            ci,
+            ctypes.POINTER(ci),
+            ci,
+            ctypes.POINTER(ci),
+            vp,
+            vp,
+        ]
         lib.GDALGetRasterBand.restype = vp
         lib.GDALGetRasterBand.argtypes = [vp, ci]
         lib.GDALGetOverview.restype = vp
@@ -348,8 +394,23 @@ def _rasterio_gdal() -> Any:
         lib.GDALGetBandDataset.restype = vp
         lib.GDALGetBandDataset.argtypes = [vp]
         lib.GDALDatasetRasterIO.restype = ci
-        lib.GDALDatasetRasterIO.argtypes = [vp, ci, ci, ci, ci, ci, vp, ci, ci, ci, ci,
-                                            ctypes.POINTER(ci), ci, ci, ci]  # fmt: skip
+        lib.GDALDatasetRasterIO.argtypes = [
+            vp,
+            ci,
+            ci,
+            ci,
+            ci,
+            ci,
+            vp,
+            ci,
+            ci,
+            ci,
+            ci,
+            ctypes.POINTER(ci),
+            ci,
+            ci,
+            ci,
+        ]
     except (OSError, AttributeError):
         return None
     return lib
@@ -399,14 +460,45 @@ def _write_levels_rasterio(path: str, factors: list[int], levels: list, zlevel: 
                 for r0 in range(0, rows, _LEVEL_ROWS):
                     n = min(_LEVEL_ROWS, rows - r0)
                     part = data[:, r0 : r0 + n]
-                    if lib.GDALDatasetRasterIO(level, 1, 0, r0, cols, n, part.ctypes.data, cols,
-                                               n, _GDT[data.dtype.name], nb, band_map,
-                                               part.strides[2], part.strides[1],
-                                               part.strides[0]) != 0:  # fmt: skip
+                    if (
+                        lib.GDALDatasetRasterIO(
+                            level,
+                            1,
+                            0,
+                            r0,
+                            cols,
+                            n,
+                            part.ctypes.data,
+                            cols,
+                            n,
+                            _GDT[data.dtype.name],
+                            nb,
+                            band_map,
+                            part.strides[2],
+                            part.strides[1],
+                            part.strides[0],
+                        )
+                        != 0
+                    ):
                         raise OSError(f"cannot write the overviews of {path}")
                     mp = m[r0 : r0 + n]
-                    if lib.GDALRasterIO(mask, 1, 0, r0, cols, n, mp.ctypes.data, cols, n, 1,
-                                        mp.strides[1], mp.strides[0]) != 0:  # fmt: skip
+                    if (
+                        lib.GDALRasterIO(
+                            mask,
+                            1,
+                            0,
+                            r0,
+                            cols,
+                            n,
+                            mp.ctypes.data,
+                            cols,
+                            n,
+                            1,
+                            mp.strides[1],
+                            mp.strides[0],
+                        )
+                        != 0
+                    ):
                         raise OSError(f"cannot write the overviews of {path}")
         finally:
             lib.GDALClose(h)
@@ -434,8 +526,7 @@ def write_geotiff(
     data = np.asarray(array, dtype=np.float32)
     rows, cols = data.shape
     with atomic_path(path) as tmp:
-        with GeoTiffWriter(tmp, cols, rows, 1, np.float32, geotransform, crs,
-                           nodata=nodata) as w:  # fmt: skip
+        with GeoTiffWriter(tmp, cols, rows, 1, np.float32, geotransform, crs, nodata=nodata) as w:
             w.write(data)
 
 
@@ -446,7 +537,17 @@ def write_rgb_tiff(path: PathLike, rgb: NDArray[np.uint8]) -> None:
         raise ValueError(f"expected an (H, W, 3) uint8 image, got {a.shape} {a.dtype}")
     h, w, _ = a.shape
     with atomic_path(path) as tmp:
-        with GeoTiffWriter(tmp, w, h, 3, np.uint8, None, compress="LZW", predictor=True,
-                           tile=512, photometric="RGB") as out:  # fmt: skip
+        with GeoTiffWriter(
+            tmp,
+            w,
+            h,
+            3,
+            np.uint8,
+            None,
+            compress="LZW",
+            predictor=True,
+            tile=512,
+            photometric="RGB",
+        ) as out:
             out.write(np.moveaxis(a, 2, 0))
             out.close(overviews=False)

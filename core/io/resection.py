@@ -75,15 +75,47 @@ from .tables import (
 PathLike = Union[str, "os.PathLike[str]"]
 
 EO_SIGMA_COLUMNS = (
-    "image_id", "time", "group", "X", "Y", "Z", "omega_deg", "phi_deg", "kappa_deg",
-    "sigma_X", "sigma_Y", "sigma_Z", "sigma_omega_deg", "sigma_phi_deg", "sigma_kappa_deg",
-    "sigma0", "redundancy", "chi2", "chi2_critical", "chi2_passed", "points", "lines",
-    "rejected", "model", "start",
-)  # fmt: skip
+    "image_id",
+    "time",
+    "group",
+    "X",
+    "Y",
+    "Z",
+    "omega_deg",
+    "phi_deg",
+    "kappa_deg",
+    "sigma_X",
+    "sigma_Y",
+    "sigma_Z",
+    "sigma_omega_deg",
+    "sigma_phi_deg",
+    "sigma_kappa_deg",
+    "sigma0",
+    "redundancy",
+    "chi2",
+    "chi2_critical",
+    "chi2_passed",
+    "points",
+    "lines",
+    "rejected",
+    "model",
+    "start",
+)
 RESIDUAL_COLUMNS = (
-    "image_id", "point_id", "type", "target_id", "vertex", "col", "row", "vx_px", "vy_px",
-    "distance_px", "w", "rejected", "used",
-)  # fmt: skip
+    "image_id",
+    "point_id",
+    "type",
+    "target_id",
+    "vertex",
+    "col",
+    "row",
+    "vx_px",
+    "vy_px",
+    "distance_px",
+    "w",
+    "rejected",
+    "used",
+)
 _IU3 = np.triu_indices(3)
 _LCP_COV = tuple(f"cov_{'xyz'[i]}{'xyz'[j]}" for i, j in zip(*_IU3))
 _WKT = re.compile(r"^\s*LINESTRING\s*Z?\s*\((.*)\)\s*$", re.IGNORECASE)
@@ -101,10 +133,12 @@ def read_point_control_csv(path: PathLike) -> PointControl:
     table = read_table(path)
     names = [normalise(c) for c in table.columns]
     ids = unique_ids(table, find_column(table, ("point_id", "id", "name", "point")))
-    xyz = np.column_stack([
-        float_column(table, find_column(table, aliases))
-        for aliases in (("x", "easting"), ("y", "northing"), ("z", "h", "height"))
-    ])  # fmt: skip
+    xyz = np.column_stack(
+        [
+            float_column(table, find_column(table, aliases))
+            for aliases in (("x", "easting"), ("y", "northing"), ("z", "h", "height"))
+        ]
+    )
     n = len(ids)
     cov = np.zeros((n, 3, 3))
     if all(c in names for c in _LCP_COV):
@@ -126,9 +160,12 @@ def read_point_control_csv(path: PathLike) -> PointControl:
         s = np.where(np.isnan(s), 0.0, s)
         bad = np.flatnonzero(s < 0)
         if bad.size:
-            raise InputError(f"a standard deviation cannot be negative ({s[bad[0]]:g})",
-                             path=table.path, row=table.line_numbers[bad[0]],
-                             column=table.columns[col])  # fmt: skip
+            raise InputError(
+                f"a standard deviation cannot be negative ({s[bad[0]]:g})",
+                path=table.path,
+                row=table.line_numbers[bad[0]],
+                column=table.columns[col],
+            )
         cov[:, axis, axis] = s**2
     return PointControl(ids, xyz, cov)
 
@@ -167,10 +204,9 @@ def read_line_control_csv(path: PathLike) -> LineControl:
         keep = list(range(len(table)))
         ids = _unique(text_column(table, id_col), rows, table, id_col)
         p1, p2 = (
-            np.column_stack([float_column(table, find_column(table, (f"{a}{i}",)))
-                             for a in "xyz"])
+            np.column_stack([float_column(table, find_column(table, (f"{a}{i}",))) for a in "xyz"])
             for i in (1, 2)
-        )  # fmt: skip
+        )
     sig = []
     for aliases in (("sigma_start", "sigma_1", "sigma1"), ("sigma_end", "sigma_2", "sigma2")):
         col = find_column(table, aliases, required=False)
@@ -181,14 +217,22 @@ def read_line_control_csv(path: PathLike) -> LineControl:
         s = np.where(np.isnan(s), 0.0, s)
         bad = np.flatnonzero(s < 0)
         if bad.size:
-            raise InputError(f"a standard deviation cannot be negative ({s[bad[0]]:g})",
-                             path=table.path, row=rows[bad[0]], column=table.columns[col])
+            raise InputError(
+                f"a standard deviation cannot be negative ({s[bad[0]]:g})",
+                path=table.path,
+                row=rows[bad[0]],
+                column=table.columns[col],
+            )
         sig.append(s)
     length = np.linalg.norm(p2 - p1, axis=1)
     short = np.flatnonzero(~(length > 1e-3))
     if short.size:
-        raise InputError(f"line '{ids[short[0]]}' has zero length ({length[short[0]]:.3g}): its "
-                         "two end points coincide", path=table.path, row=rows[short[0]])
+        raise InputError(
+            f"line '{ids[short[0]]}' has zero length ({length[short[0]]:.3g}): its "
+            "two end points coincide",
+            path=table.path,
+            row=rows[short[0]],
+        )
     cov = np.zeros((len(ids), 6, 6))
     eye = np.eye(3)
     cov[:, :3, :3] = (sig[0] ** 2 / 3.0)[:, None, None] * eye
@@ -200,19 +244,26 @@ def _unique(ids: Sequence[str], rows: Sequence[int], table, col: int) -> tuple[s
     first: dict[str, int] = {}
     for value, line_no in zip(ids, rows):
         if not value:
-            raise InputError("empty id", path=table.path, row=line_no,
-                             column=table.columns[col])  # fmt: skip
+            raise InputError("empty id", path=table.path, row=line_no, column=table.columns[col])
         if value in first:
-            raise InputError(f"line id '{value}' already appears in row {first[value]}",
-                             path=table.path, row=line_no, column=table.columns[col])
+            raise InputError(
+                f"line id '{value}' already appears in row {first[value]}",
+                path=table.path,
+                row=line_no,
+                column=table.columns[col],
+            )
         first[value] = line_no
     return tuple(ids)
 
 
 def _wkt_ends(text: str, path: str, row: int) -> tuple[list[float], list[float]]:
     m = _WKT.match(text)
-    bad = InputError("the geometry is not a LINESTRING Z of two or more 3D vertices",
-                     path=path, row=row, column="wkt")  # fmt: skip
+    bad = InputError(
+        "the geometry is not a LINESTRING Z of two or more 3D vertices",
+        path=path,
+        row=row,
+        column="wkt",
+    )
     if not m:
         raise bad
     try:
@@ -231,16 +282,56 @@ def write_eo_sigma_csv(path: PathLike, rows: Iterable[Sequence[Any]]) -> None:
     :data:`EO_SIGMA_COLUMNS` (angles in radians, converted here), in that order."""
     out = []
     for r in rows:
-        (image, time, group, x, y, z, w, p, k, sx, sy, sz, sw, sp, sk, s0, red, chi2, crit,
-         passed, npt, nln, rej, model, start) = r  # fmt: skip
-        out.append((
-            image, number(time), group, number(x), number(y), number(z),
-            *(number(math.degrees(a)) for a in (w, p, k)),
-            *(number(s) for s in (sx, sy, sz)),
-            *(number(math.degrees(s)) for s in (sw, sp, sk)),
-            number(s0), int(red), number(chi2), number(crit), int(bool(passed)),
-            int(npt), int(nln), int(rej), model, start,
-        ))  # fmt: skip
+        (
+            image,
+            time,
+            group,
+            x,
+            y,
+            z,
+            w,
+            p,
+            k,
+            sx,
+            sy,
+            sz,
+            sw,
+            sp,
+            sk,
+            s0,
+            red,
+            chi2,
+            crit,
+            passed,
+            npt,
+            nln,
+            rej,
+            model,
+            start,
+        ) = r
+        out.append(
+            (
+                image,
+                number(time),
+                group,
+                number(x),
+                number(y),
+                number(z),
+                *(number(math.degrees(a)) for a in (w, p, k)),
+                *(number(s) for s in (sx, sy, sz)),
+                *(number(math.degrees(s)) for s in (sw, sp, sk)),
+                number(s0),
+                int(red),
+                number(chi2),
+                number(crit),
+                int(bool(passed)),
+                int(npt),
+                int(nln),
+                int(rej),
+                model,
+                start,
+            )
+        )
     write_csv_atomic(path, EO_SIGMA_COLUMNS, out)
 
 
@@ -249,7 +340,21 @@ def write_residuals_csv(path: PathLike, rows: Iterable[Sequence[Any]]) -> None:
     out = []
     for r in rows:
         image, point, kind, target, vertex, col, row, vx, vy, dist, w, rej, used = r
-        out.append((image, point, kind, target, int(vertex), number(col), number(row),
-                    number(vx), number(vy), number(dist), number(w),
-                    int(bool(rej)), int(bool(used))))  # fmt: skip
+        out.append(
+            (
+                image,
+                point,
+                kind,
+                target,
+                int(vertex),
+                number(col),
+                number(row),
+                number(vx),
+                number(vy),
+                number(dist),
+                number(w),
+                int(bool(rej)),
+                int(bool(used)),
+            )
+        )
     write_csv_atomic(path, RESIDUAL_COLUMNS, out)

@@ -40,9 +40,24 @@ Array = NDArray[np.float64]
 #: Bytes per SBET record: 17 float64.
 RECORD_BYTES = 136
 SBET_FIELDS = (
-    "time", "latitude", "longitude", "height", "vx", "vy", "vz", "roll", "pitch",
-    "platform_heading", "wander", "ax", "ay", "az", "wx", "wy", "wz",
-)  # fmt: skip
+    "time",
+    "latitude",
+    "longitude",
+    "height",
+    "vx",
+    "vy",
+    "vz",
+    "roll",
+    "pitch",
+    "platform_heading",
+    "wander",
+    "ax",
+    "ay",
+    "az",
+    "wx",
+    "wy",
+    "wz",
+)
 
 
 def read_sbet(path: Union[str, Path]) -> NavSolution:
@@ -84,14 +99,23 @@ def _check(data: Array, path: str) -> None:
     bad = np.flatnonzero(~np.isfinite(data).all(axis=1))
     if bad.size:
         refuse(int(bad[0]), "a value is not finite")
-    limits = ((0, MAX_TIME_S, "time"), (1, np.pi / 2, "latitude"), (2, 2 * np.pi, "longitude"),
-              (7, np.pi, "roll"), (8, np.pi / 2, "pitch"), (9, 4 * np.pi, "heading"),
-              (10, 4 * np.pi, "wander angle"))  # fmt: skip
+    limits = (
+        (0, MAX_TIME_S, "time"),
+        (1, np.pi / 2, "latitude"),
+        (2, 2 * np.pi, "longitude"),
+        (7, np.pi, "roll"),
+        (8, np.pi / 2, "pitch"),
+        (9, 4 * np.pi, "heading"),
+        (10, 4 * np.pi, "wander angle"),
+    )
     for col, limit, name in limits:
         bad = np.flatnonzero(np.abs(data[:, col]) > limit)
         if bad.size:
-            refuse(int(bad[0]), f"{name} {data[bad[0], col]:.9g} is beyond +-{limit:.9g} "
-                   "(radians and seconds expected: not an SBET?)")  # fmt: skip
+            refuse(
+                int(bad[0]),
+                f"{name} {data[bad[0], col]:.9g} is beyond +-{limit:.9g} "
+                "(radians and seconds expected: not an SBET?)",
+            )
     lo, hi = HEIGHT_RANGE_M
     bad = np.flatnonzero((data[:, 3] < lo) | (data[:, 3] > hi))
     if bad.size:
@@ -99,8 +123,11 @@ def _check(data: Array, path: str) -> None:
     step = np.flatnonzero(np.diff(data[:, 0]) <= 0)
     if step.size:
         k = int(step[0]) + 1
-        refuse(k, f"time {data[k, 0]:.6f} s is not later than {data[k - 1, 0]:.6f} s of the "
-               "record before (records out of order or repeated)")  # fmt: skip
+        refuse(
+            k,
+            f"time {data[k, 0]:.6f} s is not later than {data[k - 1, 0]:.6f} s of the "
+            "record before (records out of order or repeated)",
+        )
 
 
 def sbet_records(

@@ -37,10 +37,23 @@ log = logging.getLogger(__name__)
 #: (N, 3) scanner-frame points (m) -> (N, 3) object-frame points (m).
 Transform = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 _PLY_TYPES = {
-    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",
-    "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
-    "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
-}  # fmt: skip
+    "char": "i1",
+    "int8": "i1",
+    "uchar": "u1",
+    "uint8": "u1",
+    "short": "i2",
+    "int16": "i2",
+    "ushort": "u2",
+    "uint16": "u2",
+    "int": "i4",
+    "int32": "i4",
+    "uint": "u4",
+    "uint32": "u4",
+    "float": "f4",
+    "float32": "f4",
+    "double": "f8",
+    "float64": "f8",
+}
 
 
 #: A scan whose points lie farther than this from its origin (m) is not in the scanner's own
@@ -80,18 +93,23 @@ def _ply_header(fh, path: Path) -> tuple[str, int, list[tuple[str, str]]]:
                 except ValueError:
                     count = -1
                 if count < 0:
-                    raise InputError(f"header line {number}: the vertex count {words[2]!r} is "
-                                     "not a whole number", path=where)  # fmt: skip
+                    raise InputError(
+                        f"header line {number}: the vertex count {words[2]!r} is "
+                        "not a whole number",
+                        path=where,
+                    )
                 seen = True
             elif not seen:
                 other_before.append(words[1])
         elif words[0] == "property" and in_vertex:
             if words[1] == "list":
-                raise InputError("list properties in the PLY vertex element are not "
-                                 "supported", path=where)  # fmt: skip
+                raise InputError(
+                    "list properties in the PLY vertex element are not supported", path=where
+                )
             if len(words) != 3:
-                raise InputError(f"header line {number}: a property needs a type and a name",
-                                 path=where)  # fmt: skip
+                raise InputError(
+                    f"header line {number}: a property needs a type and a name", path=where
+                )
             props.append((words[2], _PLY_TYPES.get(words[1], "")))
         elif words[0] == "end_header":
             break
@@ -100,8 +118,10 @@ def _ply_header(fh, path: Path) -> tuple[str, int, list[tuple[str, str]]]:
     if fmt is None:
         raise InputError("the PLY header has no format line", path=where)
     if fmt not in ("ascii", "binary_little_endian", "binary_big_endian"):
-        raise InputError(f"unknown PLY format {fmt!r} (ascii, binary_little_endian or "
-                         "binary_big_endian)", path=where)  # fmt: skip
+        raise InputError(
+            f"unknown PLY format {fmt!r} (ascii, binary_little_endian or binary_big_endian)",
+            path=where,
+        )
     if count is None:
         raise InputError("the PLY file has no vertex element", path=where)
     if other_before:
@@ -140,13 +160,18 @@ def _ply_ascii(fh, path: Path, count: int, names: list[str]) -> dict[str, NDArra
             except ValueError:
                 good = False
             if not good:
-                raise InputError(f"vertex {held + 1}: {len(words)} value(s) "
-                                 f"({line.decode('ascii', 'replace').strip()[:40]!r}), the "
-                                 f"header declares {len(names)} numbers ({', '.join(names)})",
-                                 path=str(path), row=head + held + 1)  # fmt: skip
+                raise InputError(
+                    f"vertex {held + 1}: {len(words)} value(s) "
+                    f"({line.decode('ascii', 'replace').strip()[:40]!r}), the "
+                    f"header declares {len(names)} numbers ({', '.join(names)})",
+                    path=str(path),
+                    row=head + held + 1,
+                )
             held += 1
-        raise InputError(f"truncated: the file holds {held} of the {count} vertices its header "
-                         "declares", path=str(path))  # fmt: skip
+        raise InputError(
+            f"truncated: the file holds {held} of the {count} vertices its header declares",
+            path=str(path),
+        )
     return {n: data[:, i] for i, n in enumerate(names)}
 
 
@@ -161,9 +186,11 @@ def _read_ply(path: Path) -> tuple[NDArray[np.float64], NDArray | None]:
             dtype = np.dtype([(n, end + t) for n, t in props])
             held = (os.fstat(fh.fileno()).st_size - fh.tell()) // dtype.itemsize
             if held < count:
-                raise InputError(f"truncated: the file holds {held} of the {count} vertices "
-                                 f"its header declares ({dtype.itemsize} bytes each)",
-                                 path=str(path))  # fmt: skip
+                raise InputError(
+                    f"truncated: the file holds {held} of the {count} vertices "
+                    f"its header declares ({dtype.itemsize} bytes each)",
+                    path=str(path),
+                )
             data = np.fromfile(fh, dtype=dtype, count=count)
             cols = {n: data[n].astype(np.float64) for n in names}
     xyz = np.column_stack([cols["x"], cols["y"], cols["z"]])
@@ -190,8 +217,9 @@ def _read_e57(path: Path) -> tuple[NDArray[np.float64], NDArray | None]:
     try:
         e57 = pye57.E57(str(path))
     except Exception as exc:  # libE57Format raises its own types for bad bytes
-        raise InputError(f"cannot read as E57 (truncated or corrupt file?): {_first_line(exc)}",
-                         path=str(path)) from exc  # fmt: skip
+        raise InputError(
+            f"cannot read as E57 (truncated or corrupt file?): {_first_line(exc)}", path=str(path)
+        ) from exc
     try:
         scans = int(e57.scan_count)
         if scans == 0:
@@ -201,23 +229,29 @@ def _read_e57(path: Path) -> tuple[NDArray[np.float64], NDArray | None]:
         try:
             data = e57.read_scan_raw(0, ignore_unsupported_fields=True)
         except Exception as exc:
-            raise InputError(f"cannot read the points of its first scan (truncated or "
-                             f"corrupt E57?): {_first_line(exc)}",
-                             path=str(path)) from exc  # fmt: skip
+            raise InputError(
+                f"cannot read the points of its first scan (truncated or "
+                f"corrupt E57?): {_first_line(exc)}",
+                path=str(path),
+            ) from exc
     finally:
         e57.close()
     if "cartesianX" in data:
         xyz = np.column_stack([data["cartesianX"], data["cartesianY"], data["cartesianZ"]])
         state = data.get("cartesianInvalidState")
     elif "sphericalRange" in data:
-        r, az, el = (np.asarray(data[k], dtype=np.float64) for k in
-                     ("sphericalRange", "sphericalAzimuth", "sphericalElevation"))  # fmt: skip
-        xyz = np.column_stack([r * np.cos(el) * np.cos(az), r * np.cos(el) * np.sin(az),
-                               r * np.sin(el)])  # fmt: skip
+        r, az, el = (
+            np.asarray(data[k], dtype=np.float64)
+            for k in ("sphericalRange", "sphericalAzimuth", "sphericalElevation")
+        )
+        xyz = np.column_stack(
+            [r * np.cos(el) * np.cos(az), r * np.cos(el) * np.sin(az), r * np.sin(el)]
+        )
         state = data.get("sphericalInvalidState")
     else:
-        raise InputError("the first scan has neither Cartesian nor spherical coordinates",
-                         path=str(path))  # fmt: skip
+        raise InputError(
+            "the first scan has neither Cartesian nor spherical coordinates", path=str(path)
+        )
     intensity = data.get("intensity")
     if state is not None:  # E57: 0 a point, 1 a direction only, 2 no return
         keep = np.asarray(state) == 0
@@ -235,23 +269,31 @@ def _checked(path: Path, xyz: NDArray[np.float64], intensity: NDArray | None) ->
     bad = ~np.isfinite(xyz).all(axis=1)
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
-        raise InputError(f"point {k + 1} of {len(xyz)} has coordinates that are not finite "
-                         f"({', '.join(f'{v:g}' for v in xyz[k])}); {int(bad.sum())} point(s) "
-                         "affected: remove the points without a return", path=where)  # fmt: skip
+        raise InputError(
+            f"point {k + 1} of {len(xyz)} has coordinates that are not finite "
+            f"({', '.join(f'{v:g}' for v in xyz[k])}); {int(bad.sum())} point(s) "
+            "affected: remove the points without a return",
+            path=where,
+        )
     if intensity is not None:
         it = np.asarray(intensity, dtype=np.float64)
         bad = ~np.isfinite(it)
         if bad.any():
             k = int(np.flatnonzero(bad)[0])
-            raise InputError(f"point {k + 1} of {len(xyz)} has an intensity that is not "
-                             f"finite ({it[k]:g}); {int(bad.sum())} point(s) affected",
-                             path=where)  # fmt: skip
+            raise InputError(
+                f"point {k + 1} of {len(xyz)} has an intensity that is not "
+                f"finite ({it[k]:g}); {int(bad.sum())} point(s) affected",
+                path=where,
+            )
     far = float(np.max(np.hypot(np.hypot(xyz[:, 0], xyz[:, 1]), xyz[:, 2])))  # no overflow
     if far > MAX_SCANNER_RANGE_M:
-        raise InputError(f"points lie up to {far / 1000:.4g} km from the scanner's origin; a "
-                         f"scan in its scanner's own frame stays within "
-                         f"{MAX_SCANNER_RANGE_M / 1000:g} km: this one is registered or "
-                         "georeferenced (export the station unregistered)", path=where)  # fmt: skip
+        raise InputError(
+            f"points lie up to {far / 1000:.4g} km from the scanner's origin; a "
+            f"scan in its scanner's own frame stays within "
+            f"{MAX_SCANNER_RANGE_M / 1000:g} km: this one is registered or "
+            "georeferenced (export the station unregistered)",
+            path=where,
+        )
 
 
 def read_scan(path: PathLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -342,12 +384,18 @@ def write_registered_scan(
         try:
             for chunk in reader.chunk_iterator(max(int(chunk_size), 1)):
                 stop_if_asked(should_stop, f"registering {p.name}")
-                xyz = np.column_stack([np.asarray(chunk.x), np.asarray(chunk.y),
-                                       np.asarray(chunk.z)]).astype(np.float64)  # fmt: skip
+                xyz = np.column_stack(
+                    [np.asarray(chunk.x), np.asarray(chunk.y), np.asarray(chunk.z)]
+                ).astype(np.float64)
                 reg = np.asarray(transform(xyz), dtype=np.float64)
                 if writer is None:
-                    writer = laspy.open(out, mode="w", header=header, do_compress=compress,
-                                        laz_backend=_laz_backend())  # fmt: skip
+                    writer = laspy.open(
+                        out,
+                        mode="w",
+                        header=header,
+                        do_compress=compress,
+                        laz_backend=_laz_backend(),
+                    )
                 rec = laspy.ScaleAwarePointRecord.zeros(len(reg), header=writer.header)
                 for name in chunk.point_format.dimension_names:
                     if name not in ("X", "Y", "Z"):

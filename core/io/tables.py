@@ -178,9 +178,7 @@ def note_unique(
     first[value] = row
 
 
-def choice_column(
-    table: Table, index: int, allowed: Sequence[str], what: str
-) -> tuple[str, ...]:
+def choice_column(table: Table, index: int, allowed: Sequence[str], what: str) -> tuple[str, ...]:
     """A text column whose values (stripped, lower case) must be among ``allowed``; ``what``
     names such a value in the error ("a role": "'x' is not a role (control, check)")."""
     values = tuple(v.strip().lower() for v in text_column(table, index))
@@ -223,12 +221,20 @@ def unique_integer_ids(table: Table, values: NDArray[np.float64], index: int) ->
     out = []
     for k, (value, number) in enumerate(zip(values, table.line_numbers)):
         if value != round(value):
-            raise InputError(f"'{table.rows[k][index]}' is not an integer id", path=table.path,
-                             row=number, column=table.columns[index])  # fmt: skip
+            raise InputError(
+                f"'{table.rows[k][index]}' is not an integer id",
+                path=table.path,
+                row=number,
+                column=table.columns[index],
+            )
         key = int(value)
         if key in seen:
-            raise InputError(f"id {key} already appears in row {seen[key]}", path=table.path,
-                             row=number, column=table.columns[index])  # fmt: skip
+            raise InputError(
+                f"id {key} already appears in row {seen[key]}",
+                path=table.path,
+                row=number,
+                column=table.columns[index],
+            )
         seen[key] = number
         out.append(key)
     return out

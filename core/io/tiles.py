@@ -104,9 +104,8 @@ class BlockIndex:
 
 def _boxes_touch(a: Sequence[float], b: Sequence[float], margin: float) -> bool:
     return not (
-        a[0] - margin > b[2] or b[0] > a[2] + margin or a[1] - margin > b[3]
-        or b[1] > a[3] + margin
-    )  # fmt: skip
+        a[0] - margin > b[2] or b[0] > a[2] + margin or a[1] - margin > b[3] or b[1] > a[3] + margin
+    )
 
 
 def neighbours(index: BlockIndex, i: int, buffer: float) -> list[int]:
@@ -118,9 +117,10 @@ def neighbours(index: BlockIndex, i: int, buffer: float) -> list[int]:
     """
     own = index.tiles[i].cell or index.tiles[i].box
     return [
-        k for k, t in enumerate(index.tiles)
+        k
+        for k, t in enumerate(index.tiles)
         if k != i and _boxes_touch(own, t.cell or t.box, buffer)
-    ]  # fmt: skip
+    ]
 
 
 def _same_crs(a: CloudInfo, b: CloudInfo) -> bool:
@@ -140,9 +140,7 @@ def _check_crs(infos: list[tuple[str, CloudInfo]]) -> None:
             )
 
 
-def index_block(
-    source: PathLike, crs: Any = None, tile_size: float = 0.0
-) -> BlockIndex:
+def index_block(source: PathLike, crs: Any = None, tile_size: float = 0.0) -> BlockIndex:
     """Index a block: a folder of LAS/LAZ tiles, a ``.vpc``, or one LAS/LAZ file.
 
     Parameters
@@ -164,9 +162,10 @@ def index_block(
     path = Path(source)
     if path.is_dir():
         files = sorted(
-            p for p in path.iterdir()
+            p
+            for p in path.iterdir()
             if p.suffix.lower() in CLOUD_SUFFIXES and not p.name.startswith(".")
-        )  # fmt: skip
+        )
         if not files:
             raise InputError("no .las or .laz file in the folder", path=str(path))
         return _index_files(str(path), "folder", [(p.stem, str(p), None) for p in files], crs)
@@ -200,8 +199,7 @@ def _index_files(
             bad.append((name, str(exc)))
             continue
         infos.append((name, info))
-        box = (float(info.mins[0]), float(info.mins[1]), float(info.maxs[0]),
-               float(info.maxs[1]))  # fmt: skip
+        box = (float(info.mins[0]), float(info.mins[1]), float(info.maxs[0]), float(info.maxs[1]))
         tiles.append(Tile(name, file, box, info.point_count, offset, None, copc))
         offset += info.point_count
     if not tiles:
@@ -261,8 +259,12 @@ def _index_one_file(path: Path, crs: Any, tile_size: float) -> BlockIndex:
     if copc:  # a truncated COPC fails here, by name, not in every tile task
         with open(path, "rb") as fh:
             _copc_layout(fh, str(path))
-    xmin, ymin, xmax, ymax = (float(info.mins[0]), float(info.mins[1]), float(info.maxs[0]),
-                              float(info.maxs[1]))  # fmt: skip
+    xmin, ymin, xmax, ymax = (
+        float(info.mins[0]),
+        float(info.mins[1]),
+        float(info.maxs[0]),
+        float(info.maxs[1]),
+    )
     size = tile_size if tile_size > 0 else max(xmax - xmin, ymax - ymin, 1.0) * 1.000001
     # cells on multiples of the tile size: the same grid whatever the file's extent
     x0, y0 = math.floor(xmin / size) * size, math.floor(ymin / size) * size
@@ -273,8 +275,9 @@ def _index_one_file(path: Path, crs: Any, tile_size: float) -> BlockIndex:
         for c in range(cols):
             cell = (x0 + c * size, y0 + r * size, x0 + (c + 1) * size, y0 + (r + 1) * size)
             box = (max(cell[0], xmin), max(cell[1], ymin), min(cell[2], xmax), min(cell[3], ymax))
-            tiles.append(Tile(f"{path.stem}_{c}_{r}", str(path), box, info.point_count, 0, cell,
-                              copc))  # fmt: skip
+            tiles.append(
+                Tile(f"{path.stem}_{c}_{r}", str(path), box, info.point_count, 0, cell, copc)
+            )
     return BlockIndex(str(path), "file", tiles, info)
 
 
@@ -282,8 +285,17 @@ def _index_one_file(path: Path, crs: Any, tile_size: float) -> BlockIndex:
 #: A COPC hierarchy entry (COPC 1.0 specification): voxel key (level, x, y, z), then the byte
 #: offset and size of the node's LAZ chunk (or of a child hierarchy page when the point count
 #: is -1) and its point count.
-_ENTRY = np.dtype([("level", "<i4"), ("x", "<i4"), ("y", "<i4"), ("z", "<i4"),
-                   ("offset", "<u8"), ("size", "<i4"), ("count", "<i4")])  # fmt: skip
+_ENTRY = np.dtype(
+    [
+        ("level", "<i4"),
+        ("x", "<i4"),
+        ("y", "<i4"),
+        ("z", "<i4"),
+        ("offset", "<u8"),
+        ("size", "<i4"),
+        ("count", "<i4"),
+    ]
+)
 
 
 def is_copc(path: PathLike) -> bool:
@@ -337,9 +349,11 @@ def _copc_layout(fh: Any, path: str) -> CopcLayout:
             raise InputError(f"corrupt COPC: hierarchy page at byte {at} listed twice", path=path)
         seen.add(at)
         if at + nbytes > size or nbytes % _ENTRY.itemsize:
-            raise InputError(f"corrupt or truncated COPC: a hierarchy page (bytes {at} to "
-                             f"{at + nbytes}) lies past the end of the file ({size} bytes)",
-                             path=path)  # fmt: skip
+            raise InputError(
+                f"corrupt or truncated COPC: a hierarchy page (bytes {at} to "
+                f"{at + nbytes}) lies past the end of the file ({size} bytes)",
+                path=path,
+            )
         fh.seek(at)
         page = np.frombuffer(fh.read(nbytes), dtype=_ENTRY)
         pages += [(int(e["offset"]), int(e["size"])) for e in page[page["count"] == -1]]
@@ -348,11 +362,17 @@ def _copc_layout(fh: Any, path: str) -> CopcLayout:
     entries = np.sort(entries, order="offset")
     end = entries["offset"].astype(np.int64) + entries["size"]
     if len(entries) and int(end.max()) > size:
-        raise InputError(f"corrupt or truncated COPC: its last node ends at byte {int(end.max())}"
-                         f", the file has {size}", path=path)  # fmt: skip
+        raise InputError(
+            f"corrupt or truncated COPC: its last node ends at byte {int(end.max())}"
+            f", the file has {size}",
+            path=path,
+        )
     if int(entries["count"].sum()) != int(header.point_count):
-        raise InputError(f"corrupt COPC: its nodes hold {int(entries['count'].sum())} points, "
-                         f"the header says {int(header.point_count)}", path=path)  # fmt: skip
+        raise InputError(
+            f"corrupt COPC: its nodes hold {int(entries['count'].sum())} points, "
+            f"the header says {int(header.point_count)}",
+            path=path,
+        )
     out = np.zeros(len(entries), _ENTRY.descr + [("start", "<i8")])
     for name in _ENTRY.names or ():
         out[name] = entries[name]
@@ -371,8 +391,12 @@ def copc_nodes(layout: CopcLayout, box: Sequence[float]) -> NDArray[Any]:
     pad = 2.0 * float(np.max(layout.header.scales[:2]))
     lo_x = layout.center[0] - layout.halfsize + n["x"] * side
     lo_y = layout.center[1] - layout.halfsize + n["y"] * side
-    hit = ((lo_x - pad <= box[2]) & (lo_x + side + pad >= box[0]) & (lo_y - pad <= box[3])
-           & (lo_y + side + pad >= box[1]))  # fmt: skip
+    hit = (
+        (lo_x - pad <= box[2])
+        & (lo_x + side + pad >= box[0])
+        & (lo_y - pad <= box[3])
+        & (lo_y + side + pad >= box[1])
+    )
     return n[hit]
 
 
@@ -411,20 +435,21 @@ def _copc_read(path: str, box: Sequence[float]):
                 nbytes = int(nodes["size"][k:last].sum())
                 fh.seek(int(at[k]))
                 if fh.readinto(view[pos : pos + nbytes]) != nbytes:
-                    raise InputError("truncated COPC: a node's chunk ends past the end of the "
-                                     "file", path=path)  # fmt: skip
+                    raise InputError(
+                        "truncated COPC: a node's chunk ends past the end of the file", path=path
+                    )
                 pos += nbytes
             table = [(int(c), int(b)) for c, b in zip(nodes["count"], nodes["size"])]
             try:
                 lazrs.decompress_points_with_chunk_table(
-                    data, layout.laz_vlr, raw, table,
-                    laspy.DecompressionSelection.all().to_lazrs())  # fmt: skip
+                    data, layout.laz_vlr, raw, table, laspy.DecompressionSelection.all().to_lazrs()
+                )
             except Exception as exc:  # lazrs: corrupt chunk bytes
                 raise InputError(f"corrupt COPC point data: {exc}", path=path) from exc
-    points = laspy.ScaleAwarePointRecord(raw.view(fmt.dtype()), fmt, header.scales,
-                                         header.offsets)  # fmt: skip
-    ids = np.repeat(nodes["start"] - np.cumsum(nodes["count"]) + nodes["count"],
-                    nodes["count"]) + np.arange(total, dtype=np.int64)  # fmt: skip
+    points = laspy.ScaleAwarePointRecord(raw.view(fmt.dtype()), fmt, header.scales, header.offsets)
+    ids = np.repeat(
+        nodes["start"] - np.cumsum(nodes["count"]) + nodes["count"], nodes["count"]
+    ) + np.arange(total, dtype=np.int64)
     return header, points, ids, total
 
 
@@ -530,8 +555,9 @@ def read_buffered(
     missing: list[str] = []
     decoded = 0
     for path, offset, is_own, by_query in files:
-        reads = _query(path, crs, outer, should_stop) if by_query else _stream(
-            path, crs, should_stop)  # fmt: skip
+        reads = (
+            _query(path, crs, outer, should_stop) if by_query else _stream(path, crs, should_stop)
+        )
         try:
             for head, inf, chunk, ids in reads:
                 decoded += len(chunk)
@@ -563,8 +589,13 @@ def read_buffered(
     if header is None or info is None:
         raise InputError("no point read", path=tile.path)
     if not parts:  # an empty cell of a large file's grid
-        parts = [{"core": np.zeros(0, bool), "id": np.zeros(0, np.int64),
-                  **{k: np.zeros(0) for k in BUFFER_FIELDS}}]  # fmt: skip
+        parts = [
+            {
+                "core": np.zeros(0, bool),
+                "id": np.zeros(0, np.int64),
+                **{k: np.zeros(0) for k in BUFFER_FIELDS},
+            }
+        ]
     arrays = {k: np.concatenate([p[k] for p in parts]) for k in ("core", "id", *BUFFER_FIELDS)}
     # core points first overall (their order: file order, as in the output tile)
     first = np.argsort(~arrays["core"], kind="stable")
@@ -632,27 +663,29 @@ def write_vpc(path: PathLike, tiles: Sequence[dict[str, Any]], crs_wkt: str) -> 
         else:
             ll = ring
         lon, lat = [p[0] for p in ll], [p[1] for p in ll]
-        features.append({
-            "type": "Feature",
-            "stac_version": "1.0.0",
-            "stac_extensions": [
-                "https://stac-extensions.github.io/pointcloud/v1.0.0/schema.json",
-                "https://stac-extensions.github.io/projection/v1.1.0/schema.json",
-            ],
-            "id": t["name"],
-            "geometry": {"type": "Polygon", "coordinates": [[list(p) for p in ll]]},
-            "bbox": [min(lon), min(lat), b[2], max(lon), max(lat), b[5]],
-            "properties": {
-                "datetime": "0001-01-01T00:00:00Z",
-                "pc:count": int(t["count"]),
-                "pc:encoding": "?",
-                "pc:type": "lidar",
-                "proj:bbox": b,
-                "proj:wkt2": crs_wkt,
-            },
-            "links": [],
-            "assets": {"data": {"href": t["href"], "roles": ["data"]}},
-        })  # fmt: skip
+        features.append(
+            {
+                "type": "Feature",
+                "stac_version": "1.0.0",
+                "stac_extensions": [
+                    "https://stac-extensions.github.io/pointcloud/v1.0.0/schema.json",
+                    "https://stac-extensions.github.io/projection/v1.1.0/schema.json",
+                ],
+                "id": t["name"],
+                "geometry": {"type": "Polygon", "coordinates": [[list(p) for p in ll]]},
+                "bbox": [min(lon), min(lat), b[2], max(lon), max(lat), b[5]],
+                "properties": {
+                    "datetime": "0001-01-01T00:00:00Z",
+                    "pc:count": int(t["count"]),
+                    "pc:encoding": "?",
+                    "pc:type": "lidar",
+                    "proj:bbox": b,
+                    "proj:wkt2": crs_wkt,
+                },
+                "links": [],
+                "assets": {"data": {"href": t["href"], "roles": ["data"]}},
+            }
+        )
     text = json.dumps({"type": "FeatureCollection", "features": features}, indent=1)
     write_text_atomic(path, text + "\n")
 

@@ -74,17 +74,47 @@ ANGLE_UNITS = {"degrees": math.pi / 180.0, "gon": math.pi / 200.0, "radians": 1.
 _FULL_CIRCLE = {"degrees": 360.0, "gon": 400.0, "radians": 2 * math.pi}
 
 STATION_COLUMNS = (
-    "station_id", "X", "Y", "Z", "omega_deg", "phi_deg", "kappa_deg", "s_X", "s_Y", "s_Z",
-    "s_omega_arcsec", "s_phi_arcsec", "s_kappa_arcsec", "levelled", "targets",
-)  # fmt: skip
+    "station_id",
+    "X",
+    "Y",
+    "Z",
+    "omega_deg",
+    "phi_deg",
+    "kappa_deg",
+    "s_X",
+    "s_Y",
+    "s_Z",
+    "s_omega_arcsec",
+    "s_phi_arcsec",
+    "s_kappa_arcsec",
+    "levelled",
+    "targets",
+)
 AP_COLUMNS = (
-    "name", "formula", "cause", "unit", "value", "std", "std_prior", "t", "significant",
-)  # fmt: skip
+    "name",
+    "formula",
+    "cause",
+    "unit",
+    "value",
+    "std",
+    "std_prior",
+    "t",
+    "significant",
+)
 TARGET_COLUMNS = ("target_id", "X", "Y", "Z", "s_X", "s_Y", "s_Z", "kind", "stations")
 RESIDUAL_COLUMNS = (
-    "station_id", "target_id", "face", "v_range_mm", "v_hz_arcsec", "v_vt_arcsec", "w_range",
-    "w_hz", "w_vt", "rejected", "row",
-)  # fmt: skip
+    "station_id",
+    "target_id",
+    "face",
+    "v_range_mm",
+    "v_hz_arcsec",
+    "v_vt_arcsec",
+    "w_range",
+    "w_hz",
+    "w_vt",
+    "rejected",
+    "row",
+)
 
 
 def _ids(table: Table, aliases: Sequence[str], what: str) -> tuple[str, ...]:
@@ -99,8 +129,12 @@ def _optional(table: Table, aliases: Sequence[str], default: float) -> np.ndarra
     values[np.isnan(values)] = default
     if (values < 0).any():
         k = int(np.flatnonzero(values < 0)[0])
-        raise InputError("a standard deviation cannot be negative", path=table.path,
-                         row=table.line_numbers[k], column=table.columns[col])  # fmt: skip
+        raise InputError(
+            "a standard deviation cannot be negative",
+            path=table.path,
+            row=table.line_numbers[k],
+            column=table.columns[col],
+        )
     return values
 
 
@@ -122,8 +156,10 @@ def _angle(table: Table, stem: str, unit: str) -> tuple[np.ndarray, str]:
                 f"{values[k]:g} is beyond {limit:g} {u}: the angles are not in {u} (gon read "
                 "as degrees?). Name the column hz_deg/vt_deg or hz_gon/vt_gon, or choose the "
                 "angle unit",
-                path=table.path, row=table.line_numbers[k], column=table.columns[col],
-            )  # fmt: skip
+                path=table.path,
+                row=table.line_numbers[k],
+                column=table.columns[col],
+            )
         return values * ANGLE_UNITS[u], u
     raise InputError(
         f"no column for the {'horizontal direction' if stem == 'hz' else 'vertical angle'} "
@@ -139,8 +175,11 @@ def _check_ranges(t: Table, rho: np.ndarray, what: str, col: int | None) -> None
     bad = np.flatnonzero(rho <= 0)
     if bad.size:
         k = int(bad[0])
-        raise InputError(f"{what} is {rho[k]:g} m from the scanner: it must be > 0",
-                         row=t.line_numbers[k], **where)  # fmt: skip
+        raise InputError(
+            f"{what} is {rho[k]:g} m from the scanner: it must be > 0",
+            row=t.line_numbers[k],
+            **where,
+        )
     bad = np.flatnonzero(rho > MAX_SCANNER_RANGE_M)
     if bad.size:
         k = int(bad[0])
@@ -148,8 +187,9 @@ def _check_ranges(t: Table, rho: np.ndarray, what: str, col: int | None) -> None
             f"{what} is {rho[k]:g} m from the scanner, beyond the {MAX_SCANNER_RANGE_M:g} m a "
             "terrestrial scanner reaches: another unit, or coordinates that are not in the "
             "scanner's frame",
-            row=t.line_numbers[k], **where,
-        )  # fmt: skip
+            row=t.line_numbers[k],
+            **where,
+        )
 
 
 def read_tls_observations_csv(
@@ -189,8 +229,11 @@ def read_tls_observations_csv(
                 cov[:, i, j] = cov[:, j, i] = np.nan_to_num(c)
         for k in range(len(t)):
             if np.linalg.eigvalsh(cov[k])[0] <= 0:
-                raise InputError("the covariance of (x, y, z) is not positive definite",
-                                 path=t.path, row=int(rows[k]))  # fmt: skip
+                raise InputError(
+                    "the covariance of (x, y, z) is not positive definite",
+                    path=t.path,
+                    row=int(rows[k]),
+                )
         # hypot: no overflow for a coordinate of 1e300
         _check_ranges(t, np.hypot(np.hypot(xyz[:, 0], xyz[:, 1]), xyz[:, 2]), "the point", None)
         polar, pcov = polar_covariance(xyz, cov)
@@ -216,8 +259,9 @@ def read_tls_observations_csv(
 def read_tls_control_csv(path: PathLike) -> list[ControlTarget]:
     """Read control targets ``target_id,X,Y,Z[,s_X,s_Y,s_Z]`` (m; sigma 0 or absent: fixed)."""
     t = read_table(path)
-    ids = unique_ids(t, find_column(t, ("target_id", "target", "id", "point_id"),
-                                    what="the target id"))  # fmt: skip
+    ids = unique_ids(
+        t, find_column(t, ("target_id", "target", "id", "point_id"), what="the target id")
+    )
     xyz = np.column_stack(
         [float_column(t, find_column(t, (c.lower(),), what=c)) for c in ("X", "Y", "Z")]
     )
@@ -233,16 +277,21 @@ def _flag(cell: str, t: Table, k: int, col: int) -> bool | None:
         return True
     if c in ("0", "false", "no", "n"):
         return False
-    raise InputError(f"'{cell}' is not a yes/no value (1/0, true/false)", path=t.path,
-                     row=t.line_numbers[k], column=t.columns[col])  # fmt: skip
+    raise InputError(
+        f"'{cell}' is not a yes/no value (1/0, true/false)",
+        path=t.path,
+        row=t.line_numbers[k],
+        column=t.columns[col],
+    )
 
 
 def read_tls_stations_csv(path: PathLike) -> list[StationInfo]:
     """Read the stations table (see the module text); every column but the id is optional,
     and an empty cell means unknown."""
     t = read_table(path)
-    ids = unique_ids(t, find_column(t, ("station_id", "station", "scan", "setup", "id"),
-                                    what="the station id"))  # fmt: skip
+    ids = unique_ids(
+        t, find_column(t, ("station_id", "station", "scan", "setup", "id"), what="the station id")
+    )
 
     def group(names: Sequence[str], scale: float) -> np.ndarray | None:
         cols = [find_column(t, (n,), required=False) for n in names]
@@ -270,25 +319,42 @@ def write_tls_stations_csv(
 ) -> None:
     """Adjusted station poses with a-posteriori sigmas (:data:`STATION_COLUMNS`)."""
     obs = cal.observations
-    counts = {s: len({t for st, t in zip(obs.station, obs.target) if st == s})
-              for s in cal.stations}  # fmt: skip
+    counts = {
+        s: len({t for st, t in zip(obs.station, obs.target) if st == s}) for s in cal.stations
+    }
     rows = []
     for k, s in enumerate(cal.stations):
         p, sd = cal.pose[k], cal.pose_std[k]
         rows.append(
-            (s, *map(number, p[:3]), *map(number, np.degrees(p[3:])), *map(number, sd[:3]),
-             *map(number, sd[3:] / ARCSEC), int(cal.levelled[k]), counts[s])
-        )  # fmt: skip
+            (
+                s,
+                *map(number, p[:3]),
+                *map(number, np.degrees(p[3:])),
+                *map(number, sd[:3]),
+                *map(number, sd[3:] / ARCSEC),
+                int(cal.levelled[k]),
+                counts[s],
+            )
+        )
     write_csv_atomic(path, STATION_COLUMNS, rows, comments)
 
 
 def write_tls_aps_csv(path: PathLike, cal: TlsCalibration, comments: Sequence[str] = ()) -> None:
     """The additional parameters in report units (:data:`AP_COLUMNS`)."""
     rows = [
-        (a["name"], a["formula"], a["cause"], a["unit"], number(a["value"]), number(a["std"]),
-         number(a["std_prior"]), number(a["t"]), int(a["significant"]))
+        (
+            a["name"],
+            a["formula"],
+            a["cause"],
+            a["unit"],
+            number(a["value"]),
+            number(a["std"]),
+            number(a["std_prior"]),
+            number(a["t"]),
+            int(a["significant"]),
+        )
         for a in cal.ap_report()
-    ]  # fmt: skip
+    ]
     write_csv_atomic(path, AP_COLUMNS, rows, comments)
 
 
@@ -301,10 +367,15 @@ def write_tls_targets_csv(
     for s, t in zip(obs.station, obs.target):
         seen.setdefault(t, set()).add(s)
     rows = [
-        (t, *map(number, cal.target_xyz[k]), *map(number, cal.target_std[k]), cal.target_kind[k],
-         len(seen.get(t, ())))
+        (
+            t,
+            *map(number, cal.target_xyz[k]),
+            *map(number, cal.target_std[k]),
+            cal.target_kind[k],
+            len(seen.get(t, ())),
+        )
         for k, t in enumerate(cal.targets)
-    ]  # fmt: skip
+    ]
     write_csv_atomic(path, TARGET_COLUMNS, rows, comments)
 
 
@@ -317,11 +388,19 @@ def write_tls_residuals_csv(
     face = obs.face_two
     v, w = cal.residuals, cal.w
     rows = [
-        (obs.station[k], obs.target[k], "II" if face[k] else "I", number(v[k, 0] * 1000.0),
-         number(v[k, 1] / ARCSEC), number(v[k, 2] / ARCSEC), *map(number, w[k]),
-         int(cal.rejected[k]), int(obs.rows[k]))
+        (
+            obs.station[k],
+            obs.target[k],
+            "II" if face[k] else "I",
+            number(v[k, 0] * 1000.0),
+            number(v[k, 1] / ARCSEC),
+            number(v[k, 2] / ARCSEC),
+            *map(number, w[k]),
+            int(cal.rejected[k]),
+            int(obs.rows[k]),
+        )
         for k in range(len(obs))
-    ]  # fmt: skip
+    ]
     write_csv_atomic(path, RESIDUAL_COLUMNS, rows, comments)
 
 
@@ -334,13 +413,28 @@ def write_tls_observations_csv(
     scale = 1.0 / ANGLE_UNITS[angle_unit]
     sig = np.sqrt(np.einsum("nii->ni", obs.cov))
     rows = [
-        (obs.station[k], obs.target[k], number(obs.polar[k, 0]), number(obs.polar[k, 1] * scale),
-         number(obs.polar[k, 2] * scale), number(sig[k, 0]), number(sig[k, 1] / ARCSEC),
-         number(sig[k, 2] / ARCSEC))
+        (
+            obs.station[k],
+            obs.target[k],
+            number(obs.polar[k, 0]),
+            number(obs.polar[k, 1] * scale),
+            number(obs.polar[k, 2] * scale),
+            number(sig[k, 0]),
+            number(sig[k, 1] / ARCSEC),
+            number(sig[k, 2] / ARCSEC),
+        )
         for k in range(len(obs))
-    ]  # fmt: skip
-    columns = ("station_id", "target_id", "range", f"hz_{suffix}", f"vt_{suffix}", "s_range",
-               "s_hz", "s_vt")  # fmt: skip
+    ]
+    columns = (
+        "station_id",
+        "target_id",
+        "range",
+        f"hz_{suffix}",
+        f"vt_{suffix}",
+        "s_range",
+        "s_hz",
+        "s_vt",
+    )
     write_csv_atomic(path, columns, rows)
 
 

@@ -102,8 +102,10 @@ def velocity_columns(table: Table) -> Array | None:
     if vn is None and ve is None and vu is None and vd is None:
         return None
     if vn is None or ve is None or (vu is None and vd is None):
-        raise InputError("give all three velocity columns (v_north, v_east and v_up or v_down) "
-                         "or none", path=table.path)  # fmt: skip
+        raise InputError(
+            "give all three velocity columns (v_north, v_east and v_up or v_down) or none",
+            path=table.path,
+        )
     if vu is not None:
         down = -float_column(table, vu)
     else:
@@ -122,8 +124,10 @@ def check_speeds(table: Table, vel: Array, column: int) -> None:
         raise InputError(
             f"a speed of {np.linalg.norm(vel[fast[0]]):.4g} m/s is beyond the plausible "
             f"{MAX_SPEED_MPS:g} m/s of a sensor (velocities in another unit?)",
-            path=table.path, row=table.line_numbers[fast[0]], column=table.columns[column],
-        )  # fmt: skip
+            path=table.path,
+            row=table.line_numbers[fast[0]],
+            column=table.columns[column],
+        )
 
 
 def _check_range(table, column: int, values: Array, limit: float) -> None:
@@ -145,8 +149,9 @@ def _check_times(table, column: int, time: Array, group: tuple[str, ...]) -> Non
         raise InputError(
             f"{time[bad[0]]:g} s is beyond the plausible +-{MAX_TIME_S:g} s of a time in "
             "seconds (GPS week or standard time, UNIX time): another unit, or not a time",
-            row=table.line_numbers[bad[0]], **where,
-        )  # fmt: skip
+            row=table.line_numbers[bad[0]],
+            **where,
+        )
     last: dict[str, int] = {}
     for k, (t, g) in enumerate(zip(time, group)):
         if np.isnan(t):
@@ -158,8 +163,9 @@ def _check_times(table, column: int, time: Array, group: tuple[str, ...]) -> Non
                 f"time {t:.12g} s is earlier than {time[j]:.12g} s in row "
                 f"{table.line_numbers[j]}{in_group}: the rows are not in time order (rows "
                 "mixed up? sort the table by time)",
-                row=table.line_numbers[k], **where,
-            )  # fmt: skip
+                row=table.line_numbers[k],
+                **where,
+            )
         last[g] = k
 
 
@@ -170,8 +176,10 @@ def _check_heights(table, column: int, height: Array) -> None:
         raise InputError(
             f"{height[bad[0]]:g} m is outside the plausible heights {lo:g} to {hi:g} m of a "
             "sensor (a height in another unit?)",
-            path=table.path, row=table.line_numbers[bad[0]], column=table.columns[column],
-        )  # fmt: skip
+            path=table.path,
+            row=table.line_numbers[bad[0]],
+            column=table.columns[column],
+        )
 
 
 TRAJECTORY_COLUMNS = (

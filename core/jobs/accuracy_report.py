@@ -26,51 +26,135 @@ _OUTLIER_LABELS = (
 #: (parameter, AccuracySettings field, label, unit, minimum, maximum, advanced)
 _NUMBERS = (
     ("ALPHA", "alpha", "Significance level of the tests", "", 0.0001, 0.25, True),
-    ("DECLARED_SIGMA_H", "declared_sigma_h", "Declared precision per horizontal axis", "m",
-     0.0, 100.0, True),
-    ("DECLARED_SIGMA_V", "declared_sigma_v", "Declared precision in height", "m", 0.0, 100.0,
-     True),
-    ("SURVEY_SIGMA_H", "survey_sigma_h", "Check-point survey sigma per horizontal axis", "m",
-     0.0, 100.0, True),
-    ("SURVEY_SIGMA_V", "survey_sigma_v", "Check-point survey sigma in height", "m", 0.0, 100.0,
-     True),
-)  # fmt: skip
+    (
+        "DECLARED_SIGMA_H",
+        "declared_sigma_h",
+        "Declared precision per horizontal axis",
+        "m",
+        0.0,
+        100.0,
+        True,
+    ),
+    ("DECLARED_SIGMA_V", "declared_sigma_v", "Declared precision in height", "m", 0.0, 100.0, True),
+    (
+        "SURVEY_SIGMA_H",
+        "survey_sigma_h",
+        "Check-point survey sigma per horizontal axis",
+        "m",
+        0.0,
+        100.0,
+        True,
+    ),
+    (
+        "SURVEY_SIGMA_V",
+        "survey_sigma_v",
+        "Check-point survey sigma in height",
+        "m",
+        0.0,
+        100.0,
+        True,
+    ),
+)
 _STANDARD_NUMBERS = (
-    ("ASPRS_H_CLASS_CM", "asprs_h_class_cm", "ASPRS horizontal class (0 = tightest met)", "cm",
-     0.0, 10000.0, True),
-    ("ASPRS_V_CLASS_CM", "asprs_v_class_cm", "ASPRS vertical class (0 = tightest met)", "cm",
-     0.0, 10000.0, True),
+    (
+        "ASPRS_H_CLASS_CM",
+        "asprs_h_class_cm",
+        "ASPRS horizontal class (0 = tightest met)",
+        "cm",
+        0.0,
+        10000.0,
+        True,
+    ),
+    (
+        "ASPRS_V_CLASS_CM",
+        "asprs_v_class_cm",
+        "ASPRS vertical class (0 = tightest met)",
+        "cm",
+        0.0,
+        10000.0,
+        True,
+    ),
     ("PEC_SCALE", "pec_scale", "PEC-PCD scale denominator (1:N)", "", 1.0, 1e8, True),
-    ("PEC_EQUIDISTANCE", "pec_equidistance", "PEC-PCD equidistance (0 = series value)", "m",
-     0.0, 1000.0, True),
-)  # fmt: skip
+    (
+        "PEC_EQUIDISTANCE",
+        "pec_equidistance",
+        "PEC-PCD equidistance (0 = series value)",
+        "m",
+        0.0,
+        1000.0,
+        True,
+    ),
+)
 _PROJECT_NUMBERS = (
-    ("PROJECT_H_THRESHOLD", "project_h_threshold", "Project planimetric threshold", "m", 0.0,
-     1000.0, True),
-    ("PROJECT_V_THRESHOLD", "project_v_threshold", "Project vertical threshold (0 = Eq. 18)",
-     "m", 0.0, 1000.0, True),
-)  # fmt: skip
+    (
+        "PROJECT_H_THRESHOLD",
+        "project_h_threshold",
+        "Project planimetric threshold",
+        "m",
+        0.0,
+        1000.0,
+        True,
+    ),
+    (
+        "PROJECT_V_THRESHOLD",
+        "project_v_threshold",
+        "Project vertical threshold (0 = Eq. 18)",
+        "m",
+        0.0,
+        1000.0,
+        True,
+    ),
+)
 
 
 def _numbers(rows) -> tuple[Param, ...]:
     return tuple(
-        Param(key, "number", label, getattr(_D, field), unit=unit, minimum=minimum,
-              maximum=maximum, advanced=advanced)
+        Param(
+            key,
+            "number",
+            label,
+            getattr(_D, field),
+            unit=unit,
+            minimum=minimum,
+            maximum=maximum,
+            advanced=advanced,
+        )
         for key, field, label, unit, minimum, maximum, advanced in rows
-    )  # fmt: skip
+    )
 
 
 def _point_params(what: str) -> tuple[Param, ...]:
     key = what.upper()
     return (
-        Param(key, "points", f"{what.capitalize()} points", optional=True,
-              help=f"{what} point table (CSV: id, e, n, h [, group]) or point layer"),
-        Param(f"{key}_ID", "field", f"{what.capitalize()} id field", "", parent=key,
-              optional=True, help="id column (default: id)", advanced=True),
-        Param(f"{key}_Z_FIELD", "field", f"{what.capitalize()} height field (empty: geometry Z)",
-              "", parent=key, optional=True, numeric_field=True, advanced=True,
-              help="height column (default: h; in QGIS empty takes the geometry's Z)"),
-    )  # fmt: skip
+        Param(
+            key,
+            "points",
+            f"{what.capitalize()} points",
+            optional=True,
+            help=f"{what} point table (CSV: id, e, n, h [, group]) or point layer",
+        ),
+        Param(
+            f"{key}_ID",
+            "field",
+            f"{what.capitalize()} id field",
+            "",
+            parent=key,
+            optional=True,
+            help="id column (default: id)",
+            advanced=True,
+        ),
+        Param(
+            f"{key}_Z_FIELD",
+            "field",
+            f"{what.capitalize()} height field (empty: geometry Z)",
+            "",
+            parent=key,
+            optional=True,
+            numeric_field=True,
+            advanced=True,
+            help="height column (default: h; in QGIS empty takes the geometry's Z)",
+        ),
+    )
 
 
 SPEC = AlgorithmSpec(
@@ -112,37 +196,102 @@ the RMSE values as numeric outputs RMSE_E, RMSE_N, RMSE_U (height), RMSE_HORIZON
 (docs/formats.md, "Accuracy figures"; RMSE_H and RMSE_HORIZ, their former names, are kept
 for one release).""",
     params=(
-        Param("INPUT", "table", "Check-point table (CSV: id, e, n, h, e_ref, n_ref, h_ref, group)",
-              optional=True, file_filter=CSV_FILTER),
+        Param(
+            "INPUT",
+            "table",
+            "Check-point table (CSV: id, e, n, h, e_ref, n_ref, h_ref, group)",
+            optional=True,
+            file_filter=CSV_FILTER,
+        ),
         *_point_params("measured"),
         *_point_params("reference"),
-        Param("GROUP_FIELD", "field", "Group field (flight direction, model, block)", "",
-              parent="MEASURED", optional=True, help="group column (default: group)"),
-        Param("CRS", "crs", "CRS of the check-point table", optional=True,
-              help="CRS of the coordinates (reported only)"),
-        Param("REPROJECT", "boolean", "Reproject the reference layer to the measured CRS",
-              False, help="QGIS only: point tables carry no CRS", advanced=True),
+        Param(
+            "GROUP_FIELD",
+            "field",
+            "Group field (flight direction, model, block)",
+            "",
+            parent="MEASURED",
+            optional=True,
+            help="group column (default: group)",
+        ),
+        Param(
+            "CRS",
+            "crs",
+            "CRS of the check-point table",
+            optional=True,
+            help="CRS of the coordinates (reported only)",
+        ),
+        Param(
+            "REPROJECT",
+            "boolean",
+            "Reproject the reference layer to the measured CRS",
+            False,
+            help="QGIS only: point tables carry no CRS",
+            advanced=True,
+        ),
         *_numbers(_NUMBERS),
-        Param("OUTLIER_RULE", "enum", "Outlier screening", _D.outlier_rule,
-              options=Ref("quality.accuracy_options", "OUTLIER_RULES"), labels=_OUTLIER_LABELS,
-              advanced=True),
-        Param("EXCLUDE_OUTLIERS", "boolean", "Exclude flagged outliers from the statistics",
-              _D.exclude_outliers, advanced=True),
-        Param("STANDARDS", "enum", "Standards", _D.standards,
-              options=Ref("quality.accuracy_options", "STANDARD_KEYS"), labels=_STANDARD_LABELS,
-              multiple=True),
+        Param(
+            "OUTLIER_RULE",
+            "enum",
+            "Outlier screening",
+            _D.outlier_rule,
+            options=Ref("quality.accuracy_options", "OUTLIER_RULES"),
+            labels=_OUTLIER_LABELS,
+            advanced=True,
+        ),
+        Param(
+            "EXCLUDE_OUTLIERS",
+            "boolean",
+            "Exclude flagged outliers from the statistics",
+            _D.exclude_outliers,
+            advanced=True,
+        ),
+        Param(
+            "STANDARDS",
+            "enum",
+            "Standards",
+            _D.standards,
+            options=Ref("quality.accuracy_options", "STANDARD_KEYS"),
+            labels=_STANDARD_LABELS,
+            multiple=True,
+        ),
         *_numbers(_STANDARD_NUMBERS),
-        Param("PEC_CLASS", "enum", "PEC-PCD declared class", _D.pec_class,
-              options=Ref("quality.accuracy_options", "PEC_CLASSES"), advanced=True),
+        Param(
+            "PEC_CLASS",
+            "enum",
+            "PEC-PCD declared class",
+            _D.pec_class,
+            options=Ref("quality.accuracy_options", "PEC_CLASSES"),
+            advanced=True,
+        ),
         *_numbers(_PROJECT_NUMBERS),
-        Param("FLIGHT_GEOMETRY", "numbers", "Flight geometry for Eq. 18: H, B, f, pixel",
-              _D.flight_geometry, count=4, unit="m, m, mm, um", advanced=True, minimum=0.001,
-              maximum=100000.0),
+        Param(
+            "FLIGHT_GEOMETRY",
+            "numbers",
+            "Flight geometry for Eq. 18: H, B, f, pixel",
+            _D.flight_geometry,
+            count=4,
+            unit="m, m, mm, um",
+            advanced=True,
+            minimum=0.001,
+            maximum=100000.0,
+        ),
         Param("OUTPUT", "sink", "Check points with discrepancies", geometry="point", optional=True),
-        Param("OUTPUT_HTML", "file_out", "Accuracy report (HTML)", optional=True,
-              file_filter="HTML files (*.html)"),
-        Param("OUTPUT_JSON", "file_out", "Accuracy figures (JSON)", optional=True,
-              create_by_default=False, file_filter="JSON files (*.json)"),
+        Param(
+            "OUTPUT_HTML",
+            "file_out",
+            "Accuracy report (HTML)",
+            optional=True,
+            file_filter="HTML files (*.html)",
+        ),
+        Param(
+            "OUTPUT_JSON",
+            "file_out",
+            "Accuracy figures (JSON)",
+            optional=True,
+            create_by_default=False,
+            file_filter="JSON files (*.json)",
+        ),
     ),
     results=(
         *(
@@ -184,13 +333,18 @@ def _points(v: Values):
     if v.reproject:
         raise InputError("REPROJECT needs QGIS (point tables carry no CRS)")
     measured = read_point_table(
-        v.measured, id_column=v.measured_id or None, z_column=v.measured_z_field or None,
-        group_column=v.group_field or None, crs=v.crs,
-    )  # fmt: skip
-    reference = read_point_table(
-        v.reference, id_column=v.reference_id or None, z_column=v.reference_z_field or None,
+        v.measured,
+        id_column=v.measured_id or None,
+        z_column=v.measured_z_field or None,
+        group_column=v.group_field or None,
         crs=v.crs,
-    )  # fmt: skip
+    )
+    reference = read_point_table(
+        v.reference,
+        id_column=v.reference_id or None,
+        z_column=v.reference_z_field or None,
+        crs=v.crs,
+    )
     return join_points(measured, reference)
 
 
@@ -212,8 +366,13 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     log.info("%d check points from %s", len(points), points.source)
     if points.crs:  # coordinates that cannot be in the stated CRS are refused
         xyz = np.vstack([points.measured, points.reference])
-        check_area_of_use(parse_crs(points.crs), xyz.min(axis=0), xyz.max(axis=0),
-                          what="the check points", path=points.source or None)  # fmt: skip
+        check_area_of_use(
+            parse_crs(points.crs),
+            xyz.min(axis=0),
+            xyz.max(axis=0),
+            what="the check points",
+            path=points.source or None,
+        )
     report = assess_accuracy(points, settings, progress=progress, should_stop=should_stop)
     stop_if_asked(should_stop, "writing the report")
     if out.requested("OUTPUT_HTML"):

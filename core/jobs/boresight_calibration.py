@@ -46,26 +46,60 @@ GROUPINGS = ("single", "group", "direction")
 CONTROL_TYPES = ("tie", "line", "lcp", "paper", "control")
 _OPTIONS = Fields("photo.boresight_options", "BoresightOptions")
 _GRADES = Ref("photo.ins_grades", "INS_GRADES", convert=lambda grades: (*grades, "custom"))
-_GRADE_LABELS = Ref("photo.ins_grades", "INS_GRADES",
-                    convert=lambda grades: (*(g.name for g in grades.values()),
-                                            "custom (INS sigmas)"))  # fmt: skip
+_GRADE_LABELS = Ref(
+    "photo.ins_grades",
+    "INS_GRADES",
+    convert=lambda grades: (*(g.name for g in grades.values()), "custom (INS sigmas)"),
+)
 #: The timing offset's columns of the results table (empty when it is not estimated): dt in
 #: milliseconds (exposure = recorded time + dt), its a-posteriori sigma, and its correlations
 #: with the group's boresight angles and with the lever arm (empty when that is fixed).
 TIMING_COLUMNS = (
-    "dt_ms", "std_dt_ms", "corr_dt_d_omega", "corr_dt_d_phi", "corr_dt_d_kappa",
-    "corr_dt_lever_arm_x", "corr_dt_lever_arm_y", "corr_dt_lever_arm_z",
-)  # fmt: skip
+    "dt_ms",
+    "std_dt_ms",
+    "corr_dt_d_omega",
+    "corr_dt_d_phi",
+    "corr_dt_d_kappa",
+    "corr_dt_lever_arm_x",
+    "corr_dt_lever_arm_y",
+    "corr_dt_lever_arm_z",
+)
 TABLE_COLUMNS = (
-    "group", "images", "observations", "d_omega_deg", "d_phi_deg", "d_kappa_deg",
-    "d_omega_arcsec", "d_phi_arcsec", "d_kappa_arcsec", "std_d_omega_arcsec",
-    "std_d_phi_arcsec", "std_d_kappa_arcsec", "sigma0", "chi2_passed",
+    "group",
+    "images",
+    "observations",
+    "d_omega_deg",
+    "d_phi_deg",
+    "d_kappa_deg",
+    "d_omega_arcsec",
+    "d_phi_arcsec",
+    "d_kappa_arcsec",
+    "std_d_omega_arcsec",
+    "std_d_phi_arcsec",
+    "std_d_kappa_arcsec",
+    "sigma0",
+    "chi2_passed",
     *TIMING_COLUMNS,
-)  # fmt: skip
+)
 RESIDUAL_COLUMNS = (
-    "image_id", "point_id", "type", "target_id", "group", "X", "Y", "Z", "col", "row", "vx_px",
-    "vy_px", "v_px", "v_d_m", "w", "rejected", "used",
-)  # fmt: skip
+    "image_id",
+    "point_id",
+    "type",
+    "target_id",
+    "group",
+    "X",
+    "Y",
+    "Z",
+    "col",
+    "row",
+    "vx_px",
+    "vy_px",
+    "v_px",
+    "v_d_m",
+    "w",
+    "rejected",
+    "used",
+)
 
 SPEC = AlgorithmSpec(
     name="boresightcalibration",
@@ -294,15 +328,29 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     lidar_xyz, lidar_ids = _paper_cloud(v, types, obs, should_stop)
     stop_if_asked(should_stop, "starting the adjustment")
     options = options_from(BoresightOptions, SPEC, v, ins_grade=grade, use_types=types)
-    settings = _settings(v, cam, traj, obs, plane_list, line_list, lcp_list, frame, mount, grade,
-                         ground)  # fmt: skip
-    args = (traj, cam, mount, frame, obs, plane_list, line_list, lcp_list, lidar_xyz, lidar_ids,
-            options)  # fmt: skip
-    result = _calibrate(out, settings, args, progress=progress, should_stop=should_stop,
-                        ground_points=ground)  # fmt: skip
+    settings = _settings(
+        v, cam, traj, obs, plane_list, line_list, lcp_list, frame, mount, grade, ground
+    )
+    args = (
+        traj,
+        cam,
+        mount,
+        frame,
+        obs,
+        plane_list,
+        line_list,
+        lcp_list,
+        lidar_xyz,
+        lidar_ids,
+        options,
+    )
+    result = _calibrate(
+        out, settings, args, progress=progress, should_stop=should_stop, ground_points=ground
+    )
     doubts, warning = _settle(v, out, result, obs, settings, frame, options.snooping_alpha)
-    run = _run_record(result, obs, cam, traj, options, (plane_list, line_list, lcp_list, ground),
-                      settings, frame)  # fmt: skip
+    run = _run_record(
+        result, obs, cam, traj, options, (plane_list, line_list, lcp_list, ground), settings, frame
+    )
     _write_outputs(out, run, settings, doubts, warning)
     lines = _summary_lines(result, warning, options.snooping_alpha)
     return JobResult(results=_results(result), lines=lines, data=run)
@@ -338,12 +386,19 @@ def _settle(v: Values, out, result, obs, settings: dict, frame, snooping_alpha: 
     doubts = doubts_about(result, v.max_boresight, v.max_sigma0, snooping_alpha)
 
     def failed_page() -> str:  # the failed adjustment, without the positions it would give
-        failed = BoresightRun(result, obs, np.full((len(obs), 3), np.nan), ("",) * len(obs),
-                              settings, frame.crs.to_wkt())  # fmt: skip
+        failed = BoresightRun(
+            result,
+            obs,
+            np.full((len(obs), 3), np.nan),
+            ("",) * len(obs),
+            settings,
+            frame.crs.to_wkt(),
+        )
         return render_boresight_html(failed, settings, problems=doubts, accepted=False)
 
-    warning = settle_doubts("boresight calibration", doubts, v.accept_doubtful, out,
-                            failed_page, "HTML summary")  # fmt: skip
+    warning = settle_doubts(
+        "boresight calibration", doubts, v.accept_doubtful, out, failed_page, "HTML summary"
+    )
     return doubts, warning
 
 
@@ -356,8 +411,14 @@ def _run_record(result, obs, cam, traj, options, control: tuple, settings: dict,
 
     positions = ground_positions(result, obs, cam, *control)
     image_group = dict(zip(traj.image_id, group_labels(traj, options.groups)))
-    return BoresightRun(result, obs, positions, tuple(image_group.get(i, "") for i in obs.image_id),
-                        settings, frame.crs.to_wkt())  # fmt: skip
+    return BoresightRun(
+        result,
+        obs,
+        positions,
+        tuple(image_group.get(i, "") for i in obs.image_id),
+        settings,
+        frame.crs.to_wkt(),
+    )
 
 
 def _results(result) -> dict[str, float]:
@@ -387,8 +448,13 @@ def _read_inputs(v: Values, frame) -> tuple:
     cam = read_camera_json(v.camera)
     traj = read_trajectory_csv(v.trajectory)
     if not traj.geodetic:
-        check_area_of_use(frame.crs, traj.position.min(axis=0), traj.position.max(axis=0),
-                          what="the trajectory", path=v.trajectory)  # fmt: skip
+        check_area_of_use(
+            frame.crs,
+            traj.position.min(axis=0),
+            traj.position.max(axis=0),
+            what="the trajectory",
+            path=v.trajectory,
+        )
     obs = read_observations_csv(v.observations, camera=cam)
     plane_list = read_planes_csv(v.planes) if v.planes else []
     line_list = read_lines_csv(v.lines) if v.lines else []
@@ -401,8 +467,9 @@ def _read_inputs(v: Values, frame) -> tuple:
         ("ground points", v.ground_points, [] if ground is None else list(ground.xyz)),
     ):
         if xyz:
-            check_area_of_use(frame.crs, np.min(xyz, axis=0), np.max(xyz, axis=0),
-                              what=f"the {name}", path=path)  # fmt: skip
+            check_area_of_use(
+                frame.crs, np.min(xyz, axis=0), np.max(xyz, axis=0), what=f"the {name}", path=path
+            )
     return cam, traj, obs, plane_list, line_list, lcp_list, ground
 
 
@@ -465,8 +532,9 @@ def _summary_lines(result, warning: list, snooping_alpha: float) -> list[str]:
     return lines
 
 
-def doubts_about(result, max_boresight_deg: float, max_sigma0: float,
-                 snooping_alpha: float = 0.001) -> list[str]:  # fmt: skip
+def doubts_about(
+    result, max_boresight_deg: float, max_sigma0: float, snooping_alpha: float = 0.001
+) -> list[str]:
     """Why the calibration's numbers cannot be trusted (empty when they can): no convergence,
     a global test failed with sigma0 above ``max_sigma0``, more rejections than data
     snooping's false alarms at ``snooping_alpha`` explain, an angle beyond
@@ -478,11 +546,14 @@ def doubts_about(result, max_boresight_deg: float, max_sigma0: float,
     if not adj.converged:
         why = _joined([w for w in adj.warnings if "converg" in w or "reduced" in w], "; ")
         out.append(
-            _t("the adjustment did not converge after {n} iterations ({why})",
-               n=adj.iterations, why=why)
+            _t(
+                "the adjustment did not converge after {n} iterations ({why})",
+                n=adj.iterations,
+                why=why,
+            )
             if why
             else _t("the adjustment did not converge after {n} iterations", n=adj.iterations)
-        )  # fmt: skip
+        )
     if not result.chi2_passed and result.sigma0 > max_sigma0:
         out.append(
             _t(
@@ -503,9 +574,13 @@ def doubts_about(result, max_boresight_deg: float, max_sigma0: float,
                 nonfinite.append(_t("{angle} of group {group}", angle=angle, group=name))
             elif abs(value) > max_boresight_deg:
                 large.append(
-                    _t("{angle} = {value:.4f} deg in group {group}", angle=angle, value=value,
-                       group=name)
-                )  # fmt: skip
+                    _t(
+                        "{angle} = {value:.4f} deg in group {group}",
+                        angle=angle,
+                        value=value,
+                        group=name,
+                    )
+                )
     if nonfinite:
         out.append(_t("not a finite number: {items}", items=_joined(nonfinite)))
     if large:
@@ -520,8 +595,9 @@ def doubts_about(result, max_boresight_deg: float, max_sigma0: float,
     return out
 
 
-def _settings(v, cam, traj, obs, planes, lines, lcps, frame, mount, grade, ground=None
-              ) -> dict[str, str]:  # fmt: skip
+def _settings(
+    v, cam, traj, obs, planes, lines, lcps, frame, mount, grade, ground=None
+) -> dict[str, str]:
     """The run's settings as text (the HTML summary shows them)."""
     import numpy as np
 

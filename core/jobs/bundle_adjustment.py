@@ -161,7 +161,10 @@ with the file and row named.""",
             _OPTIONS.estimate_interior,
         ),
         Param(
-            "AP_SELECTION", "boolean", "Drop insignificant APs", _OPTIONS.ap_selection,
+            "AP_SELECTION",
+            "boolean",
+            "Drop insignificant APs",
+            _OPTIONS.ap_selection,
             advanced=True,
         ),
         Param(
@@ -226,8 +229,12 @@ with the file and row named.""",
             file_filter="JSON files (*.json)",
         ),
         Param(
-            "OUTPUT_POINTS", "file_out", "Object points (CSV)", optional=True,
-            file_filter=CSV_OUT, layer_twin="OUTPUT_POINTS_LAYER",
+            "OUTPUT_POINTS",
+            "file_out",
+            "Object points (CSV)",
+            optional=True,
+            file_filter=CSV_OUT,
+            layer_twin="OUTPUT_POINTS_LAYER",
         ),
         Param("OUTPUT_POINTS_LAYER", "sink", "Object points", geometry="point", optional=True),
         Param(
@@ -324,9 +331,22 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         opts = options_from(BundleOptions, SPEC, v, ap_model=model)
         log.info("bundle adjustment with AP model %s", model)
         try:
-            return bundle_adjust(cams, obs, ground, frame, eo, sigma, image_camera, opts,
-                                 eo_rows, eo_source, stage[model], should_stop,
-                                 scale_bars=bars, velocity=velocity)  # fmt: skip
+            return bundle_adjust(
+                cams,
+                obs,
+                ground,
+                frame,
+                eo,
+                sigma,
+                image_camera,
+                opts,
+                eo_rows,
+                eo_source,
+                stage[model],
+                should_stop,
+                scale_bars=bars,
+                velocity=velocity,
+            )
         except AdjustmentError as exc:
             if eo is not None:  # an approximate orientation far off is the usual cause
                 _blame_eo(exc, cams, obs, ground, eo, image_camera, eo_rows, eo_source)
@@ -336,11 +356,14 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     best = str(next(r["model"] for r in rows if r["model"] in results))
     res = results[best]
     settings = _settings(v, cams, obs, ground, eo, sigma, frame, velocity)
-    _write_outputs(out, results, best, rows, settings, multi=len(cams) > 1,
-                   compared=len(models) > 1)  # fmt: skip
-    return JobResult(results=_results(res, best),
-                     lines=_summary_lines(res, best, rows if len(models) > 1 else ()),
-                     data=res)  # fmt: skip
+    _write_outputs(
+        out, results, best, rows, settings, multi=len(cams) > 1, compared=len(models) > 1
+    )
+    return JobResult(
+        results=_results(res, best),
+        lines=_summary_lines(res, best, rows if len(models) > 1 else ()),
+        data=res,
+    )
 
 
 def _adjust_models(models: tuple, one) -> tuple[list, dict]:
@@ -408,8 +431,13 @@ def _read_inputs(v: Values) -> tuple:
     obs = read_observations_csv(v.observations, camera=cams[0] if len(cams) == 1 else None)
     ground = read_ground_points_csv(v.ground_points) if v.ground_points else GroundPoints.empty()
     if len(ground) and crs is not None:
-        check_area_of_use(crs, ground.xyz.min(axis=0), ground.xyz.max(axis=0),
-                          what="the ground points", path=v.ground_points)  # fmt: skip
+        check_area_of_use(
+            crs,
+            ground.xyz.min(axis=0),
+            ground.xyz.max(axis=0),
+            what="the ground points",
+            path=v.ground_points,
+        )
     eo = sigma = velocity = None
     eo_rows: tuple[int, ...] = ()
     eo_source = ""
@@ -418,8 +446,13 @@ def _read_inputs(v: Values) -> tuple:
         f = read_eo_csv_full(v.eo, crs.to_wkt() if crs is not None else "")
         eo, sigma, eo_rows, eo_source, velocity = f.eo, f.sigma, f.rows, f.path, f.velocity
         if crs is not None:
-            check_area_of_use(crs, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
-                              what="the perspective centres", path=v.eo)  # fmt: skip
+            check_area_of_use(
+                crs,
+                eo.xyz.min(axis=0),
+                eo.xyz.max(axis=0),
+                what="the perspective centres",
+                path=v.eo,
+            )
         if sigma is None and v.eo_sigmas:
             s6 = np.array(v.eo_sigmas, dtype=float)
             if not (s6 > 0).all():
@@ -450,14 +483,17 @@ def _frame(v: Values):
 
     if v.frame == "crs":
         if not v.crs:
-            raise InputError("CRS: give the mapping CRS of the coordinates, or a local "
-                             "engineering frame (FRAME local_m or local_mm)")  # fmt: skip
+            raise InputError(
+                "CRS: give the mapping CRS of the coordinates, or a local "
+                "engineering frame (FRAME local_m or local_mm)"
+            )
         return MappingFrame.from_user_input(v.crs)
     return EngineeringFrame(v.frame.split("_")[1])
 
 
-def _write_outputs(out, results: dict, best: str, rows: list, settings, *, multi: bool,
-                   compared: bool) -> None:  # fmt: skip
+def _write_outputs(
+    out, results: dict, best: str, rows: list, settings, *, multi: bool, compared: bool
+) -> None:
     """The requested outputs of the adjustment of AP model ``best`` (of ``results``, ranked
     in ``rows``); ``multi``: several cameras, ``compared``: several AP models."""
     from ..io.atomic import write_text_atomic
@@ -474,17 +510,27 @@ def _write_outputs(out, results: dict, best: str, rows: list, settings, *, multi
 
     res = results[best]
     if out.requested("OUTPUT_EO"):
-        write_eo_csv_with_sigmas(out.path("OUTPUT_EO"), res.eo, res.eo_sigma,
-                                 res.image_camera if multi else None)  # fmt: skip
+        write_eo_csv_with_sigmas(
+            out.path("OUTPUT_EO"), res.eo, res.eo_sigma, res.image_camera if multi else None
+        )
     if out.requested("OUTPUT_CAMERA"):
         sig = [
             {p.name: p.std for p in res.interior if p.camera == c.name and p.status == "estimated"}
             for c in res.cameras.values()
         ]
-        write_cameras_json(out.path("OUTPUT_CAMERA"), list(res.cameras.values()), sig,
-                           {"_bundle": {"ap_model": best, "sigma0": res.sigma0,
-                                        "frame": res.local.mapping.name,
-                                        "dropped": [list(d) for d in res.dropped]}})  # fmt: skip
+        write_cameras_json(
+            out.path("OUTPUT_CAMERA"),
+            list(res.cameras.values()),
+            sig,
+            {
+                "_bundle": {
+                    "ap_model": best,
+                    "sigma0": res.sigma0,
+                    "frame": res.local.mapping.name,
+                    "dropped": [list(d) for d in res.dropped],
+                }
+            },
+        )
     if out.requested("OUTPUT_POINTS"):
         write_bundle_points(out.path("OUTPUT_POINTS"), res)
     if out.requested("OUTPUT_RESIDUALS"):
@@ -513,15 +559,19 @@ def _summary_lines(res, best: str, rows) -> list[str]:
     u = _unit(res)
     lines = [f"frame: {res.local.mapping.name}"] if u != "m" or _local(res) else []
     if rows:
-        lines.append(f"{'rank':>4} {'model':14} {'check RMS 3D ' + u:>14} {'planimetric ' + u:>13} "
-                     f"{'sigma0':>7} {'sig. APs':>8}")  # fmt: skip
+        lines.append(
+            f"{'rank':>4} {'model':14} {'check RMS 3D ' + u:>14} {'planimetric ' + u:>13} "
+            f"{'sigma0':>7} {'sig. APs':>8}"
+        )
         for r in rows:
             if r.get("error"):
                 lines.append(f"{'-':>4} {r['model']:14} not observable")
                 continue
-            lines.append(f"{r['rank']:>4} {r['model']:14} {r['rms_3d']:14.3f} "
-                         f"{r['rms_planimetric']:13.3f} {r['sigma0']:7.3f} "
-                         f"{r['n_significant']:8d}")  # fmt: skip
+            lines.append(
+                f"{r['rank']:>4} {r['model']:14} {r['rms_3d']:14.3f} "
+                f"{r['rms_planimetric']:13.3f} {r['sigma0']:7.3f} "
+                f"{r['n_significant']:8d}"
+            )
     a = res.adjustment
     lines.append(
         f"{best}: sigma0 {a.sigma0:.3f}, redundancy {a.redundancy}, global test "
@@ -590,8 +640,11 @@ def _blame_eo(exc, cams, obs, ground, eo, image_camera, rows, path) -> None:
     by_name = {c.name: c for c in cams}
     for k, image in enumerate(eo.image_id):
         cam = by_name.get(image_camera.get(image, ""), cams[0])
-        sel = [m for m, (im, p) in enumerate(zip(obs.image_id, obs.point_id))
-               if im == image and p in where]  # fmt: skip
+        sel = [
+            m
+            for m, (im, p) in enumerate(zip(obs.image_id, obs.point_id))
+            if im == image and p in where
+        ]
         if len(sel) < 3:
             continue
         xyz = ground.xyz[[where[obs.point_id[m]] for m in sel]]
@@ -601,17 +654,25 @@ def _blame_eo(exc, cams, obs, ground, eo, image_camera, rows, path) -> None:
         now = _misfit(xyz, px, eo6, cam)
         if now <= 0.25 * diag:
             continue
-        turns = {d: _misfit(xyz, px, eo6 + np.r_[0, 0, 0, 0, 0, math.radians(d)], cam)
-                 for d in (180, 90, -90)}  # fmt: skip
+        turns = {
+            d: _misfit(xyz, px, eo6 + np.r_[0, 0, 0, 0, 0, math.radians(d)], cam)
+            for d in (180, 90, -90)
+        }
         d = min(turns, key=turns.get)
-        cause = (f"kappa looks {abs(d)} degrees off (turned by {d:+d} degrees, the ground points "
-                 f"fit within {turns[d]:.0f} px)" if turns[d] <= min(0.1 * diag, now / 5) else
-                 "the position or the angles are far off (degrees, the order omega-phi-kappa, "
-                 "the axes' signs)")  # fmt: skip
-        raise InputError(f"the approximate orientation of image {image} cannot be right: its "
-                         f"{len(sel)} ground points project more than a quarter of the image "
-                         f"away from their measurements; {cause} (the adjustment: {exc})",
-                         path=path, row=rows[k] if rows else None) from exc  # fmt: skip
+        cause = (
+            f"kappa looks {abs(d)} degrees off (turned by {d:+d} degrees, the ground points "
+            f"fit within {turns[d]:.0f} px)"
+            if turns[d] <= min(0.1 * diag, now / 5)
+            else "the position or the angles are far off (degrees, the order omega-phi-kappa, "
+            "the axes' signs)"
+        )
+        raise InputError(
+            f"the approximate orientation of image {image} cannot be right: its "
+            f"{len(sel)} ground points project more than a quarter of the image "
+            f"away from their measurements; {cause} (the adjustment: {exc})",
+            path=path,
+            row=rows[k] if rows else None,
+        ) from exc
 
 
 def _check_on_image(obs, image_camera: dict[str, str], cams) -> None:
@@ -644,12 +705,14 @@ def _settings(v, cams, obs, ground, eo, sigma, frame, velocity=None) -> dict[str
         "cameras": "; ".join(
             f"{c.name} (f = {c.focal_mm:g} mm, {c.width_px} x {c.height_px} px of "
             f"{c.pixel_size_mm * 1000:g} um, {c.projection} projection, lens "
-            f"{c.distortion.model})" for c in cams
+            f"{c.distortion.model})"
+            for c in cams
         ),
         "images / measurements": f"{len(set(obs.image_id))} / {len(obs)}",
         "ground points": f"{roles.count('control')} control, {roles.count('check')} check",
-        "exterior orientation": "none (resection and growth)" if eo is None else (
-            "observed (with sigmas)" if sigma is not None else "approximate values"),
+        "exterior orientation": "none (resection and growth)"
+        if eo is None
+        else ("observed (with sigmas)" if sigma is not None else "approximate values"),
         ("mapping CRS" if hasattr(frame, "crs") else "frame"): frame.name,
         "AP model": v.ap_model,
         "interior orientation": "estimated" if v.estimate_interior else "fixed",
@@ -657,7 +720,12 @@ def _settings(v, cams, obs, ground, eo, sigma, frame, velocity=None) -> dict[str
         "outliers": f"robust {v.robust}, data snooping {'on' if v.snooping else 'off'}",
         "datum": v.datum + (" + scale bars" if v.scale_bars else ""),
         "lever arm / boresight": "estimated" if v.estimate_mount else "held",
-        "camera timing offset": ("estimated" if v.estimate_timing else "held (0)") + (
-            "" if not v.estimate_timing else ", velocities from the EO table"
-            if velocity is not None else ", velocities from neighbouring exposures"),
-    }  # fmt: skip
+        "camera timing offset": ("estimated" if v.estimate_timing else "held (0)")
+        + (
+            ""
+            if not v.estimate_timing
+            else ", velocities from the EO table"
+            if velocity is not None
+            else ", velocities from neighbouring exposures"
+        ),
+    }

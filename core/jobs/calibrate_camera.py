@@ -43,45 +43,133 @@ sigma0, the t-test of every lens coefficient, per-view RMS and poses), the same 
 page, and the residual table (CSV). PIXEL_SIZE only scales the millimetre values of the
 camera file: the calibration itself is in pixels.""",
     params=(
-        Param("IMAGES", "files", "Target images (files or folders)", suffixes=IMAGE_SUFFIXES,
-              help="image files, or folders whose images are all taken"),
-        Param("TARGET", "enum", "Target", _T.kind,
-              options=Ref("photo.calibration_options", "TARGET_KINDS"),
-              labels=("chessboard", "ChArUco board", "ArUco grid board")),
-        Param("COLUMNS", "integer", "Columns (inner corners / squares / markers)", _T.cols,
-              minimum=2, maximum=200),
-        Param("ROWS", "integer", "Rows (inner corners / squares / markers)", _T.rows, minimum=2,
-              maximum=200),
-        Param("SPACING", "number", "Square side (ArUco: marker side)", _T.spacing_m, unit="m",
-              minimum=1e-4, maximum=10.0),
-        Param("MARKER", "number", "ChArUco marker side / ArUco gap", _T.marker_m, unit="m",
-              minimum=0.0, maximum=10.0),
-        Param("DICTIONARY", "enum", "ArUco dictionary", _T.dictionary,
-              options=Ref("photo.calibration_options", "DICTIONARIES")),
-        Param("PROJECTION", "enum", "Projection", _D.projection,
-              options=Ref("geometry.projection_names", "PROJECTIONS"),
-              labels=("perspective (central)", "fisheye: equidistant",
-                      "fisheye: equisolid-angle", "fisheye: orthographic",
-                      "fisheye: stereographic")),
-        Param("LENS_PARAMETERS", "enum", "Lens coefficients estimated", _D.lens_parameters,
-              options=Ref("photo.calibration_options", "LENS_NAMES"), multiple=True,
-              help="Brown-Conrady coefficients; the others are held at zero"),
-        Param("FIELD", "enum", "Target field", _D.field,
-              options=Ref("photo.calibration_options", "FIELD_MODES"),
-              labels=("fixed (nominal coordinates)", "free (estimated, minimal datum)"),
-              advanced=True),
-        Param("PIXEL_SIZE", "number", "Pixel size", 0.003, unit="mm", minimum=0.0005,
-              maximum=0.5),
-        Param("SIGMA_PX", "number", "A-priori sigma of a detected point", _D.sigma_px,
-              unit="px", minimum=0.001, maximum=10.0, advanced=True),
+        Param(
+            "IMAGES",
+            "files",
+            "Target images (files or folders)",
+            suffixes=IMAGE_SUFFIXES,
+            help="image files, or folders whose images are all taken",
+        ),
+        Param(
+            "TARGET",
+            "enum",
+            "Target",
+            _T.kind,
+            options=Ref("photo.calibration_options", "TARGET_KINDS"),
+            labels=("chessboard", "ChArUco board", "ArUco grid board"),
+        ),
+        Param(
+            "COLUMNS",
+            "integer",
+            "Columns (inner corners / squares / markers)",
+            _T.cols,
+            minimum=2,
+            maximum=200,
+        ),
+        Param(
+            "ROWS",
+            "integer",
+            "Rows (inner corners / squares / markers)",
+            _T.rows,
+            minimum=2,
+            maximum=200,
+        ),
+        Param(
+            "SPACING",
+            "number",
+            "Square side (ArUco: marker side)",
+            _T.spacing_m,
+            unit="m",
+            minimum=1e-4,
+            maximum=10.0,
+        ),
+        Param(
+            "MARKER",
+            "number",
+            "ChArUco marker side / ArUco gap",
+            _T.marker_m,
+            unit="m",
+            minimum=0.0,
+            maximum=10.0,
+        ),
+        Param(
+            "DICTIONARY",
+            "enum",
+            "ArUco dictionary",
+            _T.dictionary,
+            options=Ref("photo.calibration_options", "DICTIONARIES"),
+        ),
+        Param(
+            "PROJECTION",
+            "enum",
+            "Projection",
+            _D.projection,
+            options=Ref("geometry.projection_names", "PROJECTIONS"),
+            labels=(
+                "perspective (central)",
+                "fisheye: equidistant",
+                "fisheye: equisolid-angle",
+                "fisheye: orthographic",
+                "fisheye: stereographic",
+            ),
+        ),
+        Param(
+            "LENS_PARAMETERS",
+            "enum",
+            "Lens coefficients estimated",
+            _D.lens_parameters,
+            options=Ref("photo.calibration_options", "LENS_NAMES"),
+            multiple=True,
+            help="Brown-Conrady coefficients; the others are held at zero",
+        ),
+        Param(
+            "FIELD",
+            "enum",
+            "Target field",
+            _D.field,
+            options=Ref("photo.calibration_options", "FIELD_MODES"),
+            labels=("fixed (nominal coordinates)", "free (estimated, minimal datum)"),
+            advanced=True,
+        ),
+        Param("PIXEL_SIZE", "number", "Pixel size", 0.003, unit="mm", minimum=0.0005, maximum=0.5),
+        Param(
+            "SIGMA_PX",
+            "number",
+            "A-priori sigma of a detected point",
+            _D.sigma_px,
+            unit="px",
+            minimum=0.001,
+            maximum=10.0,
+            advanced=True,
+        ),
         Param("CAMERA_NAME", "string", "Camera name", "camera", advanced=True),
         Param("OUTPUT_CAMERA", "file_out", "Calibrated camera (JSON)", file_filter=JSON_FILTER),
-        Param("OUTPUT_REPORT", "file_out", "Calibration report (JSON)", optional=True,
-              create_by_default=False, file_filter=JSON_FILTER, advanced=True),
-        Param("OUTPUT_HTML", "file_out", "Calibration report (HTML)", optional=True,
-              create_by_default=False, file_filter="HTML files (*.html)"),
-        Param("OUTPUT_RESIDUALS", "file_out", "Residuals per point (CSV)", optional=True,
-              create_by_default=False, file_filter="CSV files (*.csv)", advanced=True),
+        Param(
+            "OUTPUT_REPORT",
+            "file_out",
+            "Calibration report (JSON)",
+            optional=True,
+            create_by_default=False,
+            file_filter=JSON_FILTER,
+            advanced=True,
+        ),
+        Param(
+            "OUTPUT_HTML",
+            "file_out",
+            "Calibration report (HTML)",
+            optional=True,
+            create_by_default=False,
+            file_filter="HTML files (*.html)",
+        ),
+        Param(
+            "OUTPUT_RESIDUALS",
+            "file_out",
+            "Residuals per point (CSV)",
+            optional=True,
+            create_by_default=False,
+            file_filter="CSV files (*.csv)",
+            advanced=True,
+        ),
     ),
     results=(
         Result("VIEW_COUNT", "number", "Views used"),
@@ -90,11 +178,23 @@ camera file: the calibration itself is in pixels.""",
         Result("SIGMA0", "number", "Sigma0 (a-priori 1)"),
         Result("FOCAL_PX", "number", "Focal length (px)"),
     ),
-    tags=("camera calibration", "fisheye", "chessboard", "charuco", "aruco", "brown",
-          "self-calibration", "interior orientation"),
-    references=("Schneider, Schwalbe & Maas (2009)", "Brown (1971)", "Zhang (2000)",
-                "Garrido-Jurado et al. (2014)"),
-)  # fmt: skip
+    tags=(
+        "camera calibration",
+        "fisheye",
+        "chessboard",
+        "charuco",
+        "aruco",
+        "brown",
+        "self-calibration",
+        "interior orientation",
+    ),
+    references=(
+        "Schneider, Schwalbe & Maas (2009)",
+        "Brown (1971)",
+        "Zhang (2000)",
+        "Garrido-Jurado et al. (2014)",
+    ),
+)
 
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
@@ -113,15 +213,26 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     detections, size = _detect(images, spec, detect, should_stop)
     found = sum(d.ids.size > 0 for d in detections)
     if found == 0:
-        raise InputError(f"the {v.target} target ({v.columns} x {v.rows}) was found in none "
-                         f"of the {len(images)} images")  # fmt: skip
-    result = calibrate_camera(fld, detections, size[0], size[1], v.pixel_size, opts,
-                              name=v.camera_name, progress=adjust,
-                              should_stop=should_stop)  # fmt: skip
+        raise InputError(
+            f"the {v.target} target ({v.columns} x {v.rows}) was found in none "
+            f"of the {len(images)} images"
+        )
+    result = calibrate_camera(
+        fld,
+        detections,
+        size[0],
+        size[1],
+        v.pixel_size,
+        opts,
+        name=v.camera_name,
+        progress=adjust,
+        should_stop=should_stop,
+    )
     missing = [d.image for d in detections if d.ids.size == 0]
     if missing:
-        result.warnings.insert(0, f"target not found in {len(missing)} image(s): "
-                               + ", ".join(missing))  # fmt: skip
+        result.warnings.insert(
+            0, f"target not found in {len(missing)} image(s): " + ", ".join(missing)
+        )
     _write_outputs(out, result, spec, opts, len(images), found)
     cam = result.camera
     ppx, ppy = cam.principal_point_px
@@ -134,10 +245,16 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         *result.warnings,
     ]
     return JobResult(
-        results={"VIEW_COUNT": len(result.view_names), "POINT_COUNT": result.n_points,
-                 "RMS_PX": result.rms_px, "SIGMA0": result.sigma0, "FOCAL_PX": cam.focal_px},
-        lines=lines, data=result,
-    )  # fmt: skip
+        results={
+            "VIEW_COUNT": len(result.view_names),
+            "POINT_COUNT": result.n_points,
+            "RMS_PX": result.rms_px,
+            "SIGMA0": result.sigma0,
+            "FOCAL_PX": cam.focal_px,
+        },
+        lines=lines,
+        data=result,
+    )
 
 
 def _detect(images: list, spec, progress, should_stop) -> tuple:
@@ -155,9 +272,11 @@ def _detect(images: list, spec, progress, should_stop) -> tuple:
         if size is None:
             size = shape
         elif shape != size:
-            raise InputError(f"image size {shape[0]} x {shape[1]} differs from that of the "
-                             f"first image ({size[0]} x {size[1]}): one camera, one size",
-                             path=str(path))  # fmt: skip
+            raise InputError(
+                f"image size {shape[0]} x {shape[1]} differs from that of the "
+                f"first image ({size[0]} x {size[1]}): one camera, one size",
+                path=str(path),
+            )
         detections.append(detect_target(img, spec, path.name))
         if progress:
             progress((i + 1) / len(images))
@@ -169,25 +288,45 @@ def _write_outputs(out, result, spec, opts, n_images: int, found: int) -> None:
     from ..io.calibration import write_report_json, write_residuals_csv
     from ..io.camera import write_cameras_json
 
-    extra = {"target": {"kind": spec.kind, "columns": spec.cols, "rows": spec.rows,
-                        "spacing_m": spec.spacing_m, "marker_m": spec.marker_m,
-                        "dictionary": spec.dictionary if spec.kind != "chessboard" else None},
-             "field": opts.field, "images": n_images, "images_with_target": found}
-    write_cameras_json(out.path("OUTPUT_CAMERA"), [result.camera], sigmas=[result.sigmas],
-                       extra={"calibration": {"rms_px": result.rms_px, "sigma0": result.sigma0,
-                                              "views": len(result.view_names),
-                                              "points": result.n_points}})  # fmt: skip
+    extra = {
+        "target": {
+            "kind": spec.kind,
+            "columns": spec.cols,
+            "rows": spec.rows,
+            "spacing_m": spec.spacing_m,
+            "marker_m": spec.marker_m,
+            "dictionary": spec.dictionary if spec.kind != "chessboard" else None,
+        },
+        "field": opts.field,
+        "images": n_images,
+        "images_with_target": found,
+    }
+    write_cameras_json(
+        out.path("OUTPUT_CAMERA"),
+        [result.camera],
+        sigmas=[result.sigmas],
+        extra={
+            "calibration": {
+                "rms_px": result.rms_px,
+                "sigma0": result.sigma0,
+                "views": len(result.view_names),
+                "points": result.n_points,
+            }
+        },
+    )
     if out.requested("OUTPUT_REPORT"):
         write_report_json(out.path("OUTPUT_REPORT"), result, extra)
     if out.requested("OUTPUT_HTML"):
         from ..io.atomic import write_text_atomic
         from ..quality.calibration_html import render_calibration_html
 
-        settings = {"images": f"{n_images} ({found} with the target)",
-                    "target": f"{spec.kind} {spec.cols} x {spec.rows}, spacing "
-                              f"{spec.spacing_m:g} m", "field": opts.field,
-                    "lens coefficients": ", ".join(opts.lens_parameters) or "none",
-                    "initial values": result.initial["method"]}  # fmt: skip
+        settings = {
+            "images": f"{n_images} ({found} with the target)",
+            "target": f"{spec.kind} {spec.cols} x {spec.rows}, spacing {spec.spacing_m:g} m",
+            "field": opts.field,
+            "lens coefficients": ", ".join(opts.lens_parameters) or "none",
+            "initial values": result.initial["method"],
+        }
         write_text_atomic(out.path("OUTPUT_HTML"), render_calibration_html(result, settings))
     if out.requested("OUTPUT_RESIDUALS"):
         write_residuals_csv(out.path("OUTPUT_RESIDUALS"), result)

@@ -30,23 +30,51 @@ def mount_params(initial_boresight: bool = False) -> tuple[Param, ...]:
     ``initial_boresight``: BORESIGHT is only the start of an estimate (under Advanced: 0 is
     a fine first value)."""
     return (
-        Param("LEVER_ARM", "numbers", "Lever arm x,y,z", (0.0, 0.0, 0.0), count=3,
-              unit="m, body frame", minimum=-MAX_LEVER_ARM_M, maximum=MAX_LEVER_ARM_M,
-              help="camera perspective centre in the INS body frame (x forward, y right, "
-              "z down)"),
-        Param("MOUNT", "enum", "Camera mount", Ref("photo.mount_choices", "MOUNT_CHOICES",
-              convert=_first), options=Ref("photo.mount_choices", "MOUNT_CHOICES"),
-              labels=Ref("photo.mount_choices", "MOUNT_LABELS", convert=_mount_labels),
-              help="nominal camera-to-body rotation; custom uses MOUNT_MATRIX"),
-        Param("MOUNT_MATRIX", "numbers", "Mount matrix R_c^b (9 numbers, row-major)",
-              count=9, optional=True, advanced=True, minimum=-1.0, maximum=1.0,
-              help="the nominal mount R_c^b when MOUNT is custom"),
-        Param("BORESIGHT", "numbers", "Boresight domega,dphi,dkappa", (0.0, 0.0, 0.0),
-              count=3, unit="degrees", minimum=-MAX_BORESIGHT_DEG, maximum=MAX_BORESIGHT_DEG,
-              advanced=initial_boresight,
-              help="small misalignment about the camera axes x, y, z (a larger rotation "
-              "belongs in MOUNT)"),
-    )  # fmt: skip
+        Param(
+            "LEVER_ARM",
+            "numbers",
+            "Lever arm x,y,z",
+            (0.0, 0.0, 0.0),
+            count=3,
+            unit="m, body frame",
+            minimum=-MAX_LEVER_ARM_M,
+            maximum=MAX_LEVER_ARM_M,
+            help="camera perspective centre in the INS body frame (x forward, y right, z down)",
+        ),
+        Param(
+            "MOUNT",
+            "enum",
+            "Camera mount",
+            Ref("photo.mount_choices", "MOUNT_CHOICES", convert=_first),
+            options=Ref("photo.mount_choices", "MOUNT_CHOICES"),
+            labels=Ref("photo.mount_choices", "MOUNT_LABELS", convert=_mount_labels),
+            help="nominal camera-to-body rotation; custom uses MOUNT_MATRIX",
+        ),
+        Param(
+            "MOUNT_MATRIX",
+            "numbers",
+            "Mount matrix R_c^b (9 numbers, row-major)",
+            count=9,
+            optional=True,
+            advanced=True,
+            minimum=-1.0,
+            maximum=1.0,
+            help="the nominal mount R_c^b when MOUNT is custom",
+        ),
+        Param(
+            "BORESIGHT",
+            "numbers",
+            "Boresight domega,dphi,dkappa",
+            (0.0, 0.0, 0.0),
+            count=3,
+            unit="degrees",
+            minimum=-MAX_BORESIGHT_DEG,
+            maximum=MAX_BORESIGHT_DEG,
+            advanced=initial_boresight,
+            help="small misalignment about the camera axes x, y, z (a larger rotation "
+            "belongs in MOUNT)",
+        ),
+    )
 
 
 def _first(choices: tuple[str, ...]) -> str:
@@ -72,13 +100,25 @@ def cloud_params(key: str = "INPUT", label: str = "Point cloud (LAS/LAZ)") -> tu
     """The cloud file, ``CRS`` (overrides or supplies the file's) and ``DISTANCE_UNIT``."""
     return (
         Param(key, "pointcloud", label, file_filter=LAS_FILTER),
-        Param("CRS", "crs", "CRS (overrides the file's)", optional=True,
-              help="the cloud's CRS when the file has none or a wrong one (EPSG:xxxx or WKT)"),
-        Param("DISTANCE_UNIT", "enum", "Distance unit", "crs", options=DISTANCE_UNITS,
-              labels=("cloud CRS units", "metres"), aliases={"metres": "metre", "m": "metre"},
-              help="unit of the length parameters: the cloud's CRS unit (e.g. international "
-              "feet) or metres, converted"),
-    )  # fmt: skip
+        Param(
+            "CRS",
+            "crs",
+            "CRS (overrides the file's)",
+            optional=True,
+            help="the cloud's CRS when the file has none or a wrong one (EPSG:xxxx or WKT)",
+        ),
+        Param(
+            "DISTANCE_UNIT",
+            "enum",
+            "Distance unit",
+            "crs",
+            options=DISTANCE_UNITS,
+            labels=("cloud CRS units", "metres"),
+            aliases={"metres": "metre", "m": "metre"},
+            help="unit of the length parameters: the cloud's CRS unit (e.g. international "
+            "feet) or metres, converted",
+        ),
+    )
 
 
 def lengths_in_cloud_units(
@@ -124,12 +164,23 @@ COMPRESSIONS = ("deflate", "zstd", "lzw", "jpeg", "none")
 
 def compression_param() -> Param:
     """COMPRESSION of an image output (:class:`~lidarphoto.core.io.raster.GeoTiffWriter`)."""
-    return Param("COMPRESSION", "enum", "GeoTIFF compression", COMPRESSIONS[0],
-                 options=COMPRESSIONS, advanced=True,
-                 labels=("DEFLATE (lossless, level 1: fast)", "ZSTD (lossless, level 1)",
-                         "LZW (lossless)", "JPEG (lossy, quality 90; 8-bit images)", "none"),
-                 help="deflate and zstd at their fastest level (files about 15 % larger than "
-                 "at the default level); jpeg is lossy and only for 8-bit images")  # fmt: skip
+    return Param(
+        "COMPRESSION",
+        "enum",
+        "GeoTIFF compression",
+        COMPRESSIONS[0],
+        options=COMPRESSIONS,
+        advanced=True,
+        labels=(
+            "DEFLATE (lossless, level 1: fast)",
+            "ZSTD (lossless, level 1)",
+            "LZW (lossless)",
+            "JPEG (lossy, quality 90; 8-bit images)",
+            "none",
+        ),
+        help="deflate and zstd at their fastest level (files about 15 % larger than "
+        "at the default level); jpeg is lossy and only for 8-bit images",
+    )
 
 
 def compression_args(name: str) -> dict[str, Any]:
@@ -141,11 +192,25 @@ def doubt_params(sigma0_help: str, accept_help: str) -> tuple[Param, Param]:
     """MAX_SIGMA0 and ACCEPT_DOUBTFUL of an adjustment whose result is checked
     (:func:`settle_doubts`); the helps say which checks."""
     return (
-        Param("MAX_SIGMA0", "number", "Largest sigma0 when the global test fails", 3.0,
-              minimum=1.0, maximum=1000.0, advanced=True, help=sigma0_help),
-        Param("ACCEPT_DOUBTFUL", "boolean", "Write the results even when the checks fail",
-              False, advanced=True, help=accept_help),
-    )  # fmt: skip
+        Param(
+            "MAX_SIGMA0",
+            "number",
+            "Largest sigma0 when the global test fails",
+            3.0,
+            minimum=1.0,
+            maximum=1000.0,
+            advanced=True,
+            help=sigma0_help,
+        ),
+        Param(
+            "ACCEPT_DOUBTFUL",
+            "boolean",
+            "Write the results even when the checks fail",
+            False,
+            advanced=True,
+            help=accept_help,
+        ),
+    )
 
 
 def settle_doubts(
@@ -171,23 +236,29 @@ def settle_doubts(
             write_text_atomic(out.path("OUTPUT_HTML"), failed_page())
             out.commit(["OUTPUT_HTML"])
         raise AdjustmentError(
-            f"the {what} failed its checks: " + "; ".join(str(d) for d in doubts)
+            f"the {what} failed its checks: "
+            + "; ".join(str(d) for d in doubts)
             + ". No result was written"
-            + (f" (the {report} shows the failed adjustment)" if out.requested("OUTPUT_HTML")
-               else "")
+            + (
+                f" (the {report} shows the failed adjustment)"
+                if out.requested("OUTPUT_HTML")
+                else ""
+            )
             + "; ACCEPT_DOUBTFUL writes them with a warning"
-        )  # fmt: skip
+        )
     warning = [f"WARNING: {d}" for d in doubts]
     if doubts:
-        warning.insert(0, "WARNING: this calibration failed its checks and was written only "
-                       "because ACCEPT_DOUBTFUL was set; do not use it without review")  # fmt: skip
+        warning.insert(
+            0,
+            "WARNING: this calibration failed its checks and was written only "
+            "because ACCEPT_DOUBTFUL was set; do not use it without review",
+        )
         for line in warning:
             logging.getLogger(__name__).warning(line.removeprefix("WARNING: "))
     return warning
 
 
-def global_test_verdict(passed: bool, adjustment: Any, alpha: float, failed: str = "failed"
-                        ) -> str:  # fmt: skip
+def global_test_verdict(passed: bool, adjustment: Any, alpha: float, failed: str = "failed") -> str:
     """The global test's word for a summary line: ``failed``, ``passed``, or, when the
     robust stage and data snooping (per-row significance ``alpha``) rejected more
     observations than their false alarms explain (:func:`~core.lsq.results.rejection_test`
@@ -209,8 +280,10 @@ def global_test_verdict(passed: bool, adjustment: Any, alpha: float, failed: str
         return "passed"
     test = rejections[0]
     logging.getLogger(__name__).warning(str(test.message()))
-    return (f"passed only after rejecting {test.rejected} of {test.groups} observations (false "
-            f"alarms explain at most {test.bound})")  # fmt: skip
+    return (
+        f"passed only after rejecting {test.rejected} of {test.groups} observations (false "
+        f"alarms explain at most {test.bound})"
+    )
 
 
 def rejection_doubts(adjustment: Any, alpha: float) -> list[Any]:

@@ -46,28 +46,98 @@ verbose mode (command line: -vv; QGIS: Processing options, logging level Verbose
     params=(
         Param("PLANES", "table", "Plane table (CSV)", file_filter=CSV_FILTER),
         *cloud_params("CLOUD", "Cloud with plane ids (LAS/LAZ)"),
-        Param("DELTA", "number", "Adjacency distance delta", _D.delta, unit="length",
-              minimum=0.001, maximum=1000.0),
-        Param("MIN_BOUNDARY", "number", "Minimum common boundary", _D.min_boundary,
-              unit="length", minimum=0.0, maximum=10000.0),
-        Param("MAX_SUPPORT", "number", "Maximum distance of a corner from each plane's points",
-              _D.max_support_distance, unit="length", minimum=0.001, maximum=1000.0, advanced=True),
-        Param("MIN_ANGLE", "number", "Minimum angle between normals", _D.min_angle_deg,
-              unit="degrees", minimum=0.0, maximum=90.0),
-        Param("MAX_CONDITION", "number", "Maximum condition number", _D.max_condition,
-              minimum=1.0, maximum=1e12, advanced=True),
-        Param("TRIPLES", "string", "Plane triples", "", optional=True, advanced=True,
-              help='plane ids "1,2,3; 4,5,6" (default: automatic)'),
-        Param("PAIRS", "string", "Plane pairs", "", optional=True, advanced=True,
-              help='plane ids "1,2; 2,3" (default: automatic)'),
+        Param(
+            "DELTA",
+            "number",
+            "Adjacency distance delta",
+            _D.delta,
+            unit="length",
+            minimum=0.001,
+            maximum=1000.0,
+        ),
+        Param(
+            "MIN_BOUNDARY",
+            "number",
+            "Minimum common boundary",
+            _D.min_boundary,
+            unit="length",
+            minimum=0.0,
+            maximum=10000.0,
+        ),
+        Param(
+            "MAX_SUPPORT",
+            "number",
+            "Maximum distance of a corner from each plane's points",
+            _D.max_support_distance,
+            unit="length",
+            minimum=0.001,
+            maximum=1000.0,
+            advanced=True,
+        ),
+        Param(
+            "MIN_ANGLE",
+            "number",
+            "Minimum angle between normals",
+            _D.min_angle_deg,
+            unit="degrees",
+            minimum=0.0,
+            maximum=90.0,
+        ),
+        Param(
+            "MAX_CONDITION",
+            "number",
+            "Maximum condition number",
+            _D.max_condition,
+            minimum=1.0,
+            maximum=1e12,
+            advanced=True,
+        ),
+        Param(
+            "TRIPLES",
+            "string",
+            "Plane triples",
+            "",
+            optional=True,
+            advanced=True,
+            help='plane ids "1,2,3; 4,5,6" (default: automatic)',
+        ),
+        Param(
+            "PAIRS",
+            "string",
+            "Plane pairs",
+            "",
+            optional=True,
+            advanced=True,
+            help='plane ids "1,2; 2,3" (default: automatic)',
+        ),
         Param("OUTPUT_POINTS", "sink", "LiDAR control points", geometry="point", optional=True),
         Param("OUTPUT_LINES", "sink", "LiDAR control lines", geometry="line", optional=True),
-        Param("POINTS_CSV", "file_out", "Control point table (CSV)", optional=True,
-              create_by_default=False, file_filter=CSV_OUT, layer_twin="OUTPUT_POINTS"),
-        Param("LINES_CSV", "file_out", "Control line table (CSV)", optional=True,
-              create_by_default=False, file_filter=CSV_OUT),
-        Param("GRAPH_CSV", "file_out", "Plane adjacency graph (CSV)", optional=True,
-              create_by_default=False, file_filter=CSV_OUT, advanced=True),
+        Param(
+            "POINTS_CSV",
+            "file_out",
+            "Control point table (CSV)",
+            optional=True,
+            create_by_default=False,
+            file_filter=CSV_OUT,
+            layer_twin="OUTPUT_POINTS",
+        ),
+        Param(
+            "LINES_CSV",
+            "file_out",
+            "Control line table (CSV)",
+            optional=True,
+            create_by_default=False,
+            file_filter=CSV_OUT,
+        ),
+        Param(
+            "GRAPH_CSV",
+            "file_out",
+            "Plane adjacency graph (CSV)",
+            optional=True,
+            create_by_default=False,
+            file_filter=CSV_OUT,
+            advanced=True,
+        ),
     ),
     results=(
         Result("LCP_COUNT", "number", "Number of LCPs"),
@@ -130,9 +200,15 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     )
     xyz = np.column_stack([arrays["x"], arrays["y"], arrays["z"]])
     result = lidar_control(
-        planes, xyz, arrays["plane_id"], options, user_triples, user_pairs,
-        progress=compute, should_stop=should_stop,
-    )  # fmt: skip
+        planes,
+        xyz,
+        arrays["plane_id"],
+        options,
+        user_triples,
+        user_pairs,
+        progress=compute,
+        should_stop=should_stop,
+    )
     _write_tables(out, result)
     _log_rejected(result)
     pairs = int(result.adjacency.adjacent.sum())
@@ -164,7 +240,11 @@ def _log_rejected(result) -> None:
     from ..lidar.control import rejection_summary
 
     if result.rejected:
-        log.info(_t("{summary} (details: lidarphoto -vv; QGIS: Processing logging level "
-                    "Verbose)", summary=rejection_summary(result.rejected)))  # fmt: skip
+        log.info(
+            _t(
+                "{summary} (details: lidarphoto -vv; QGIS: Processing logging level Verbose)",
+                summary=rejection_summary(result.rejected),
+            )
+        )
     for r in result.rejected:
         log.debug("planes %s: %s", ",".join(map(str, r.plane_ids)), r.reason)

@@ -30,10 +30,14 @@ e.g. importcolmap's OUTPUT_POINTS) that share their point_id; the others are unt
     params=(
         Param("CAMERA", "file", "Camera(s) (JSON)", file_filter="JSON files (*.json)"),
         Param("EO", "table", "Exterior orientation table (CSV)", file_filter=CSV_FILTER),
-        Param("OBSERVATIONS", "table", "Observations (CSV)", optional=True,
-              file_filter=CSV_FILTER),
-        Param("POINTS", "table", "3D points (ground point table, CSV)", optional=True,
-              file_filter=CSV_FILTER),
+        Param("OBSERVATIONS", "table", "Observations (CSV)", optional=True, file_filter=CSV_FILTER),
+        Param(
+            "POINTS",
+            "table",
+            "3D points (ground point table, CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+        ),
         Param("OUTPUT_FOLDER", "folder_out", "Output folder (the COLMAP model)"),
     ),
     results=(
@@ -60,9 +64,12 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     points = read_ground_points_csv(v.points) if v.points else None
     model = colmap_from_block(cams, eo.eo, eo.camera, obs, points)
     write_colmap_text(v.output_folder, model)
-    lines = [f"{len(model.images)} images, {len(model.cameras)} camera(s), "
-             f"{len(model.points)} points -> {v.output_folder}"]  # fmt: skip
+    lines = [
+        f"{len(model.images)} images, {len(model.cameras)} camera(s), "
+        f"{len(model.points)} points -> {v.output_folder}"
+    ]
     if progress is not None:
         progress(1.0)
-    return JobResult(results={"IMAGE_COUNT": len(model.images),
-                              "POINT_COUNT": len(model.points)}, lines=lines)  # fmt: skip
+    return JobResult(
+        results={"IMAGE_COUNT": len(model.images), "POINT_COUNT": len(model.points)}, lines=lines
+    )

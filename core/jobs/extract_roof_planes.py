@@ -21,29 +21,85 @@ log = logging.getLogger(__name__)
 _D = Fields("lidar.roof_plane_params", "RoofPlaneParams")
 #: (parameter, RoofPlaneParams field, label, kind, unit, minimum, maximum, advanced)
 _NUMBERS = (
-    ("K_NEIGHBOURS", "k_neighbours", "Neighbours K of the local RANSAC", "integer", "", 6, 500,
-     True),
-    ("EPSILON", "epsilon", "Point-to-plane tolerance epsilon", "number", "length", 0.001,
-     100.0, False),
-    ("MIN_SUPPORT", "min_support", "Minimum support of a local plane", "integer", "points", 3,
-     500, True),
-    ("RANSAC_ITERATIONS", "ransac_iterations", "RANSAC triplets per point", "integer", "", 1,
-     1000, True),
-    ("MIN_SLOPE", "min_slope_deg", "Minimum slope alpha", "number", "degrees", 0.0, 90.0,
-     False),
-    ("MAX_SLOPE", "max_slope_deg", "Maximum slope beta", "number", "degrees", 0.0, 90.0,
-     True),
-    ("ANGLE_TOLERANCE", "angle_tolerance_deg", "Normal angle tolerance", "number", "degrees",
-     0.1, 89.9, True),
-    ("MIN_PLANE_POINTS", "min_plane_points", "Minimum points per plane", "integer", "", 3,
-     1e9, False),
-    ("OUTLINE_CELL", "outline_cell", "Outline raster cell (0 = auto)", "number", "length",
-     0.0, 1000.0, True),
+    (
+        "K_NEIGHBOURS",
+        "k_neighbours",
+        "Neighbours K of the local RANSAC",
+        "integer",
+        "",
+        6,
+        500,
+        True,
+    ),
+    (
+        "EPSILON",
+        "epsilon",
+        "Point-to-plane tolerance epsilon",
+        "number",
+        "length",
+        0.001,
+        100.0,
+        False,
+    ),
+    (
+        "MIN_SUPPORT",
+        "min_support",
+        "Minimum support of a local plane",
+        "integer",
+        "points",
+        3,
+        500,
+        True,
+    ),
+    (
+        "RANSAC_ITERATIONS",
+        "ransac_iterations",
+        "RANSAC triplets per point",
+        "integer",
+        "",
+        1,
+        1000,
+        True,
+    ),
+    ("MIN_SLOPE", "min_slope_deg", "Minimum slope alpha", "number", "degrees", 0.0, 90.0, False),
+    ("MAX_SLOPE", "max_slope_deg", "Maximum slope beta", "number", "degrees", 0.0, 90.0, True),
+    (
+        "ANGLE_TOLERANCE",
+        "angle_tolerance_deg",
+        "Normal angle tolerance",
+        "number",
+        "degrees",
+        0.1,
+        89.9,
+        True,
+    ),
+    (
+        "MIN_PLANE_POINTS",
+        "min_plane_points",
+        "Minimum points per plane",
+        "integer",
+        "",
+        3,
+        1e9,
+        False,
+    ),
+    (
+        "OUTLINE_CELL",
+        "outline_cell",
+        "Outline raster cell (0 = auto)",
+        "number",
+        "length",
+        0.0,
+        1000.0,
+        True,
+    ),
     ("SEED", "seed", "Random seed", "integer", "", 0, 2**32 - 1, True),
-)  # fmt: skip
+)
 #: Help of the parameters that need one.
-_HELP = {"SEED": "no effect, kept for scripts and models that give it: the RANSAC triplets "
-                 "are a fixed set, every seed gives the same planes"}
+_HELP = {
+    "SEED": "no effect, kept for scripts and models that give it: the RANSAC triplets "
+    "are a fixed set, every seed gives the same planes"
+}
 _LENGTHS = ("epsilon", "outline_cell")
 #: Bytes per RANSAC sample (point x triplet) of a batch: the float32 distances, their
 #: product and the inlier flags (about 10 B; rounded up).
@@ -85,21 +141,47 @@ dimension plane_id (-1 = none). A cloud without roofs gives zero planes and a me
 error.""",
     params=(
         *cloud_params("INPUT"),
-        Param("POINTS", "enum", "Points", "non_ground",
-              options=Ref("lidar.roof_plane_params", "SELECTION_CHOICES"),
-              labels=("non-ground (class != 2)", "the classes below", "all"),
-              aliases={"non-ground": "non_ground"}),
-        Param("CLASSES", "string", "Classes (e.g. 6)", "6", optional=True,
-              help="LAS classes searched when POINTS is classes, e.g. 6 or 1,6"),
+        Param(
+            "POINTS",
+            "enum",
+            "Points",
+            "non_ground",
+            options=Ref("lidar.roof_plane_params", "SELECTION_CHOICES"),
+            labels=("non-ground (class != 2)", "the classes below", "all"),
+            aliases={"non-ground": "non_ground"},
+        ),
+        Param(
+            "CLASSES",
+            "string",
+            "Classes (e.g. 6)",
+            "6",
+            optional=True,
+            help="LAS classes searched when POINTS is classes, e.g. 6 or 1,6",
+        ),
         *(
-            Param(key, kind, label, getattr(_D, field), unit=unit, minimum=minimum,
-                  maximum=maximum, advanced=advanced, help=_HELP.get(key, ""))
+            Param(
+                key,
+                kind,
+                label,
+                getattr(_D, field),
+                unit=unit,
+                minimum=minimum,
+                maximum=maximum,
+                advanced=advanced,
+                help=_HELP.get(key, ""),
+            )
             for key, field, label, kind, unit, minimum, maximum, advanced in _NUMBERS
         ),
         Param("OUTPUT", "sink", "Roof planes", geometry="polygon", optional=True),
         Param("OUTPUT_CSV", "file_out", "Plane table (CSV)", file_filter=CSV_OUT),
-        Param("OUTPUT_CLOUD", "file_out", "Point cloud with plane_id", optional=True,
-              create_by_default=False, file_filter="LAZ files (*.laz);;LAS files (*.las)"),
+        Param(
+            "OUTPUT_CLOUD",
+            "file_out",
+            "Point cloud with plane_id",
+            optional=True,
+            create_by_default=False,
+            file_filter="LAZ files (*.laz);;LAS files (*.las)",
+        ),
     ),
     results=(
         Result("PLANE_COUNT", "number", "Number of planes"),
@@ -198,8 +280,14 @@ def _write_cloud(source, target, plane_id, cloud, progress, should_stop) -> None
     """The input cloud's points with their ``plane_id`` (-1: none) as an extra dimension."""
     from ..io.pointcloud import write_cloud
 
-    write_cloud(source, target, extra={"plane_id": plane_id}, points=cloud, progress=progress,
-                should_stop=should_stop)  # fmt: skip
+    write_cloud(
+        source,
+        target,
+        extra={"plane_id": plane_id},
+        points=cloud,
+        progress=progress,
+        should_stop=should_stop,
+    )
 
 
 def _params(v: Values):
@@ -218,12 +306,14 @@ def _params(v: Values):
     params = options_from(RoofPlaneParams, SPEC, v)
     # RANSAC works on batches of points: each holds batch x iterations x K samples
     check_memory(
-        float(params.batch_size) * params.ransac_iterations * params.k_neighbours
+        float(params.batch_size)
+        * params.ransac_iterations
+        * params.k_neighbours
         * RANSAC_BYTES_PER_SAMPLE,
         f"K_NEIGHBOURS {params.k_neighbours} with RANSAC_ITERATIONS "
         f"{params.ransac_iterations}: one batch of {params.batch_size} points",
         "give fewer neighbours or iterations",
-    )  # fmt: skip
+    )
     return params
 
 

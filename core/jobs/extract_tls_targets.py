@@ -17,9 +17,22 @@ KINDS = ("sphere", "checkerboard")
 #: Columns of the table written (docs/formats.md, "TLS tables"): the x, y, z form of the
 #: observation table with the full covariance and the fit's figures.
 COLUMNS = (
-    "station_id", "target_id", "x", "y", "z", "s_x", "s_y", "s_z", "cov_xy", "cov_xz", "cov_yz",
-    "kind", "n_points", "n_inliers", "rms_mm",
-)  # fmt: skip
+    "station_id",
+    "target_id",
+    "x",
+    "y",
+    "z",
+    "s_x",
+    "s_y",
+    "s_z",
+    "cov_xy",
+    "cov_xz",
+    "cov_yz",
+    "kind",
+    "n_points",
+    "n_inliers",
+    "rms_mm",
+)
 
 SPEC = AlgorithmSpec(
     name="extracttlstargets",
@@ -44,25 +57,56 @@ sigma is 2-3 times optimistic on simulations (the centre itself within 0.5 mm).
 Ids: targets are matched between scans by their mutual distances (a rigid motion keeps them),
 and take the ids of CONTROL points when given (matched the same way).""",
     params=(
-        Param("SCANS", "files", "Scans (LAS/LAZ, PLY, E57; one station per file)",
-              suffixes=SCAN_SUFFIXES),
+        Param(
+            "SCANS",
+            "files",
+            "Scans (LAS/LAZ, PLY, E57; one station per file)",
+            suffixes=SCAN_SUFFIXES,
+        ),
         Param("KIND", "enum", "Target kind", "sphere", options=KINDS),
-        Param("RADIUS", "number", "Sphere radius", 0.0725, unit="m", minimum=0.005,
-              maximum=2.0),
-        Param("HALF_SIZE", "number", "Checkerboard half size", 0.1, unit="m", minimum=0.01,
-              maximum=2.0),
-        Param("SCAN_SIGMAS", "numbers", "Scan point noise: range, angle", (1.0, 4.0), count=2,
-              unit="mm, arcsec", minimum=0.001, maximum=1e4),
-        Param("MATCH_TOLERANCE", "number", "Distance tolerance of the matching", 0.02,
-              unit="m", minimum=0.0001, maximum=10.0, advanced=True),
-        Param("CONTROL", "table", "Control targets (CSV, for their ids)", optional=True,
-              file_filter=CSV_FILTER),
+        Param("RADIUS", "number", "Sphere radius", 0.0725, unit="m", minimum=0.005, maximum=2.0),
+        Param(
+            "HALF_SIZE",
+            "number",
+            "Checkerboard half size",
+            0.1,
+            unit="m",
+            minimum=0.01,
+            maximum=2.0,
+        ),
+        Param(
+            "SCAN_SIGMAS",
+            "numbers",
+            "Scan point noise: range, angle",
+            (1.0, 4.0),
+            count=2,
+            unit="mm, arcsec",
+            minimum=0.001,
+            maximum=1e4,
+        ),
+        Param(
+            "MATCH_TOLERANCE",
+            "number",
+            "Distance tolerance of the matching",
+            0.02,
+            unit="m",
+            minimum=0.0001,
+            maximum=10.0,
+            advanced=True,
+        ),
+        Param(
+            "CONTROL",
+            "table",
+            "Control targets (CSV, for their ids)",
+            optional=True,
+            file_filter=CSV_FILTER,
+        ),
         Param("OUTPUT", "file_out", "Target observations (CSV)", file_filter=CSV_OUT),
     ),
     results=(Result("TARGETS", "number", "Target centres found (all scans)"),),
     tags=("tls", "terrestrial laser scanner", "targets", "spheres", "checkerboards", "ransac"),
     references=("Fischler & Bolles (1981)",),
-)  # fmt: skip
+)
 
 
 def _scan_files(paths) -> list[Path]:
@@ -81,8 +125,10 @@ def _scan_files(paths) -> list[Path]:
     stems = [f.stem for f in out]
     for s in stems:
         if stems.count(s) > 1:
-            raise InputError(f"SCANS: two scans are named '{s}': the file name is the station "
-                             "id and must be unique")  # fmt: skip
+            raise InputError(
+                f"SCANS: two scans are named '{s}': the file name is the station "
+                "id and must be unique"
+            )
     return out
 
 
@@ -106,8 +152,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         fits.append(_targets_in(f, v, s_range, s_angle, part, should_stop))
     ctrl_ids = [c.id for c in control]
     ctrl_xyz = np.array([c.xyz for c in control]) if control else None
-    ids = label_targets([np.array([t.centre for t in fs]) for fs in fits], v.match_tolerance,
-                        ctrl_ids, ctrl_xyz)  # fmt: skip
+    ids = label_targets(
+        [np.array([t.centre for t in fs]) for fs in fits], v.match_tolerance, ctrl_ids, ctrl_xyz
+    )
     rows = _rows(files, fits, ids)
     if out.requested("OUTPUT"):
         write_csv_atomic(out.path("OUTPUT"), COLUMNS, rows)
@@ -126,20 +173,31 @@ def _targets_in(f: Path, v: Values, s_range: float, s_angle: float, progress, sh
 
     xyz, intensity = read_scan(f)
     if v.kind == "sphere":
-        found = detect_spheres(xyz, v.radius, s_range, s_angle, progress=progress,
-                               should_stop=should_stop)  # fmt: skip
+        found = detect_spheres(
+            xyz, v.radius, s_range, s_angle, progress=progress, should_stop=should_stop
+        )
     else:
         if not np.isfinite(intensity).any():
-            raise InputError("checkerboards need the intensity of the points; the scan "
-                             "has none", path=str(f))  # fmt: skip
-        found = detect_checkerboards(xyz, intensity, v.half_size, s_range, s_angle,
-                                     progress=progress, should_stop=should_stop)  # fmt: skip
+            raise InputError(
+                "checkerboards need the intensity of the points; the scan has none", path=str(f)
+            )
+        found = detect_checkerboards(
+            xyz,
+            intensity,
+            v.half_size,
+            s_range,
+            s_angle,
+            progress=progress,
+            should_stop=should_stop,
+        )
     log.info("%s: %d %s targets", f.name, len(found), v.kind)
     if len(found) < 3:
-        raise InputError(f"found {len(found)} {v.kind} target(s) in the scan: at least "
-                         "three are needed to register it (check RADIUS / HALF_SIZE, "
-                         "SCAN_SIGMAS and that the points are in the scanner frame)",
-                         path=str(f))  # fmt: skip
+        raise InputError(
+            f"found {len(found)} {v.kind} target(s) in the scan: at least "
+            "three are needed to register it (check RADIUS / HALF_SIZE, "
+            "SCAN_SIGMAS and that the points are in the scanner frame)",
+            path=str(f),
+        )
     return found
 
 
@@ -149,8 +207,19 @@ def _rows(files: list[Path], fits: list, ids: list) -> list[tuple]:
     for f, fs, names in zip(files, fits, ids):
         for t, name in zip(fs, names):
             c = t.cov
-            rows.append((f.stem, name, *(repr(float(x)) for x in t.centre),
-                         *(repr(float(x)) for x in t.sigma), repr(float(c[0, 1])),
-                         repr(float(c[0, 2])), repr(float(c[1, 2])), t.kind, t.n_points,
-                         t.n_inliers, repr(float(t.rms * 1000.0))))  # fmt: skip
+            rows.append(
+                (
+                    f.stem,
+                    name,
+                    *(repr(float(x)) for x in t.centre),
+                    *(repr(float(x)) for x in t.sigma),
+                    repr(float(c[0, 1])),
+                    repr(float(c[0, 2])),
+                    repr(float(c[1, 2])),
+                    t.kind,
+                    t.n_points,
+                    t.n_inliers,
+                    repr(float(t.rms * 1000.0)),
+                )
+            )
     return rows

@@ -20,61 +20,219 @@ _SCIENCE = "lidar.ground_filter_params"
 #: (parameter, method, field, label, kind, unit, advanced, minimum, maximum): the ranges are
 #: physical (a cell of 1 cm to 1 km, a slope up to 10:1) and hold in feet as in metres.
 _NUMBERS = (
-    ("SMRF_CELL_SIZE", "smrf", "cell_size", "SMRF cell size", "number", H, False, 0.01,
-     1000.0),
-    ("SMRF_SLOPE", "smrf", "slope", "SMRF terrain slope (0 = estimated from the cloud)",
-     "number", "rise/run", False, 0.0, 10.0),
-    ("SMRF_WINDOW", "smrf", "max_window", "SMRF largest window radius", "number", H, False,
-     0.01, 10000.0),
-    ("SMRF_THRESHOLD", "smrf", "threshold", "SMRF final height tolerance", "number", V, False,
-     0.0, 1000.0),
-    ("SMRF_SCALAR", "smrf", "scalar", "SMRF tolerance added per unit of slope", "number", V,
-     True, 0.0, 1000.0),
+    ("SMRF_CELL_SIZE", "smrf", "cell_size", "SMRF cell size", "number", H, False, 0.01, 1000.0),
+    (
+        "SMRF_SLOPE",
+        "smrf",
+        "slope",
+        "SMRF terrain slope (0 = estimated from the cloud)",
+        "number",
+        "rise/run",
+        False,
+        0.0,
+        10.0,
+    ),
+    (
+        "SMRF_WINDOW",
+        "smrf",
+        "max_window",
+        "SMRF largest window radius",
+        "number",
+        H,
+        False,
+        0.01,
+        10000.0,
+    ),
+    (
+        "SMRF_THRESHOLD",
+        "smrf",
+        "threshold",
+        "SMRF final height tolerance",
+        "number",
+        V,
+        False,
+        0.0,
+        1000.0,
+    ),
+    (
+        "SMRF_SCALAR",
+        "smrf",
+        "scalar",
+        "SMRF tolerance added per unit of slope",
+        "number",
+        V,
+        True,
+        0.0,
+        1000.0,
+    ),
     ("CELL_SIZE", "pmf", "cell_size", "PMF cell size", "number", H, False, 0.01, 1000.0),
-    ("MAX_WINDOW", "pmf", "max_window", "PMF maximum window size", "number", H, False, 0.01,
-     10000.0),
+    (
+        "MAX_WINDOW",
+        "pmf",
+        "max_window",
+        "PMF maximum window size",
+        "number",
+        H,
+        False,
+        0.01,
+        10000.0,
+    ),
     ("SLOPE", "pmf", "slope", "PMF terrain slope", "number", "rise/run", False, 0.0, 10.0),
-    ("INITIAL_DISTANCE", "pmf", "initial_distance", "PMF initial elevation threshold", "number",
-     V, True, 0.0, 1000.0),
-    ("MAX_DISTANCE", "pmf", "max_distance", "PMF maximum elevation threshold", "number", V,
-     False, 0.0, 1000.0),
-    ("WINDOW_BASE", "pmf", "window_base", "PMF window growth base b", "number", "cells", True,
-     0.5, 100.0),
-    ("GROUND_THRESHOLD", "pmf", "ground_threshold", "PMF final height tolerance", "number", V,
-     True, 0.0, 1000.0),
-    ("SLOPE_SCALAR", "pmf", "slope_scalar", "PMF tolerance added per unit of slope", "number",
-     V, True, 0.0, 1000.0),
-    ("CSF_RESOLUTION", "csf", "resolution", "CSF cloth resolution", "number", H, False, 0.01,
-     1000.0),
-    ("CSF_RIGIDNESS", "csf", "rigidness", "CSF rigidness (1 steep, 2 terraces, 3 flat)",
-     "integer", "", False, 1, 3),
-    ("CSF_THRESHOLD", "csf", "threshold", "CSF distance to the cloth", "number", V, False, 0.0,
-     1000.0),
+    (
+        "INITIAL_DISTANCE",
+        "pmf",
+        "initial_distance",
+        "PMF initial elevation threshold",
+        "number",
+        V,
+        True,
+        0.0,
+        1000.0,
+    ),
+    (
+        "MAX_DISTANCE",
+        "pmf",
+        "max_distance",
+        "PMF maximum elevation threshold",
+        "number",
+        V,
+        False,
+        0.0,
+        1000.0,
+    ),
+    (
+        "WINDOW_BASE",
+        "pmf",
+        "window_base",
+        "PMF window growth base b",
+        "number",
+        "cells",
+        True,
+        0.5,
+        100.0,
+    ),
+    (
+        "GROUND_THRESHOLD",
+        "pmf",
+        "ground_threshold",
+        "PMF final height tolerance",
+        "number",
+        V,
+        True,
+        0.0,
+        1000.0,
+    ),
+    (
+        "SLOPE_SCALAR",
+        "pmf",
+        "slope_scalar",
+        "PMF tolerance added per unit of slope",
+        "number",
+        V,
+        True,
+        0.0,
+        1000.0,
+    ),
+    (
+        "CSF_RESOLUTION",
+        "csf",
+        "resolution",
+        "CSF cloth resolution",
+        "number",
+        H,
+        False,
+        0.01,
+        1000.0,
+    ),
+    (
+        "CSF_RIGIDNESS",
+        "csf",
+        "rigidness",
+        "CSF rigidness (1 steep, 2 terraces, 3 flat)",
+        "integer",
+        "",
+        False,
+        1,
+        3,
+    ),
+    (
+        "CSF_THRESHOLD",
+        "csf",
+        "threshold",
+        "CSF distance to the cloth",
+        "number",
+        V,
+        False,
+        0.0,
+        1000.0,
+    ),
     ("CSF_TIME_STEP", "csf", "time_step", "CSF time step", "number", "", True, 0.01, 10.0),
-    ("CSF_ITERATIONS", "csf", "iterations", "CSF largest number of steps", "integer", "", True,
-     1, 100000),
-    ("LOW_OUTLIER_HEIGHT", "", "low_outlier_height", "Low outlier depth (0 = off)", "number",
-     V, True, 0.0, 1000.0),
-    ("LOW_OUTLIER_RADIUS", "", "low_outlier_radius", "Low outlier radius", "number", H, True,
-     0.0, 10000.0),
-)  # fmt: skip
+    (
+        "CSF_ITERATIONS",
+        "csf",
+        "iterations",
+        "CSF largest number of steps",
+        "integer",
+        "",
+        True,
+        1,
+        100000,
+    ),
+    (
+        "LOW_OUTLIER_HEIGHT",
+        "",
+        "low_outlier_height",
+        "Low outlier depth (0 = off)",
+        "number",
+        V,
+        True,
+        0.0,
+        1000.0,
+    ),
+    (
+        "LOW_OUTLIER_RADIUS",
+        "",
+        "low_outlier_radius",
+        "Low outlier radius",
+        "number",
+        H,
+        True,
+        0.0,
+        10000.0,
+    ),
+)
 #: (parameter, method, field, label, kind, options, advanced)
 _CHOICES = (
-    ("GROWTH", "pmf", "growth", "PMF window growth", "enum",
-     Ref(_SCIENCE, "GROWTH_CHOICES"), True),
-    ("WINDOW_SHAPE", "pmf", "window_shape", "PMF window shape", "enum",
-     Ref(_SCIENCE, "WINDOW_SHAPES"), True),
+    ("GROWTH", "pmf", "growth", "PMF window growth", "enum", Ref(_SCIENCE, "GROWTH_CHOICES"), True),
+    (
+        "WINDOW_SHAPE",
+        "pmf",
+        "window_shape",
+        "PMF window shape",
+        "enum",
+        Ref(_SCIENCE, "WINDOW_SHAPES"),
+        True,
+    ),
     ("CSF_SLOPE_SMOOTH", "csf", "slope_smooth", "CSF slope smoothing", "boolean", (), True),
-    ("LAST_RETURNS_ONLY", "", "last_returns_only", "Only last returns can be ground",
-     "boolean", (), False),
-)  # fmt: skip
+    (
+        "LAST_RETURNS_ONLY",
+        "",
+        "last_returns_only",
+        "Only last returns can be ground",
+        "boolean",
+        (),
+        False,
+    ),
+)
 _FIELDS = tuple(row[:3] for row in _NUMBERS) + tuple(row[:3] for row in _CHOICES)
 #: parameter -> the method it belongs to ("" = every method): the one-method forms in QGIS
 PARAM_METHODS = {key: method for key, method, _ in _FIELDS}
-HORIZONTAL_LENGTHS = {m: tuple(f for _, pm, f, _, _, u, *_ in _NUMBERS if u == H and pm in (m, ""))
-                      for m in _CLASSES}  # fmt: skip
-VERTICAL_LENGTHS = {m: tuple(f for _, pm, f, _, _, u, *_ in _NUMBERS if u == V and pm in (m, ""))
-                    for m in _CLASSES}  # fmt: skip
+HORIZONTAL_LENGTHS = {
+    m: tuple(f for _, pm, f, _, _, u, *_ in _NUMBERS if u == H and pm in (m, "")) for m in _CLASSES
+}
+VERTICAL_LENGTHS = {
+    m: tuple(f for _, pm, f, _, _, u, *_ in _NUMBERS if u == V and pm in (m, "")) for m in _CLASSES
+}
 
 
 def _default(method: str, field: str) -> Ref:
@@ -176,8 +334,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     read, compute, write = stages(progress, 0.3, 0.3, 0.4)
     info = read_info(v.input, v.crs)
     _check_against_data(v, info)
-    params = lengths_in_cloud_units(params, info, v.distance_unit,
-                                    HORIZONTAL_LENGTHS[v.method], VERTICAL_LENGTHS[v.method])
+    params = lengths_in_cloud_units(
+        params, info, v.distance_unit, HORIZONTAL_LENGTHS[v.method], VERTICAL_LENGTHS[v.method]
+    )
     cloud = read_cloud(v.input, v.crs, progress=read, should_stop=should_stop)
     info = cloud.info
     returns = info.has_return_numbers and params.last_returns_only
@@ -250,8 +409,11 @@ def _log_start(v: Values, info) -> None:
 
 def _check_together(v: Values) -> None:
     """Parameters that are only meaningful together, and none of another method."""
-    others = [key for key, method, _ in _FIELDS
-              if method not in ("", v.method) and v[key] != SPEC.param(key).default]  # fmt: skip
+    others = [
+        key
+        for key, method, _ in _FIELDS
+        if method not in ("", v.method) and v[key] != SPEC.param(key).default
+    ]
     if others:
         raise InputError(
             f"{', '.join(others)}: parameter{'s' if len(others) > 1 else ''} of another method "
@@ -260,8 +422,10 @@ def _check_together(v: Values) -> None:
         )
     if v.method == "pmf":
         if v.max_window < v.cell_size:
-            raise InputError(f"MAX_WINDOW ({v.max_window:g}) must be at least one cell "
-                             f"(CELL_SIZE {v.cell_size:g})")  # fmt: skip
+            raise InputError(
+                f"MAX_WINDOW ({v.max_window:g}) must be at least one cell "
+                f"(CELL_SIZE {v.cell_size:g})"
+            )
         if v.initial_distance > v.max_distance:
             raise InputError(
                 f"INITIAL_DISTANCE ({v.initial_distance:g}) must not exceed MAX_DISTANCE "
@@ -272,13 +436,18 @@ def _check_together(v: Values) -> None:
                 f"WINDOW_BASE must be > 1 for exponential growth, got {v.window_base:g}"
             )
     elif v.method == "smrf" and v.smrf_window < v.smrf_cell_size:
-        raise InputError(f"SMRF_WINDOW ({v.smrf_window:g}) must be at least one cell "
-                         f"(SMRF_CELL_SIZE {v.smrf_cell_size:g})")  # fmt: skip
+        raise InputError(
+            f"SMRF_WINDOW ({v.smrf_window:g}) must be at least one cell "
+            f"(SMRF_CELL_SIZE {v.smrf_cell_size:g})"
+        )
 
 
 #: The cell and window parameters of each method (the window is a radius in SMRF).
-_GRID = {"pmf": ("CELL_SIZE", "MAX_WINDOW"), "smrf": ("SMRF_CELL_SIZE", "SMRF_WINDOW"),
-         "csf": ("CSF_RESOLUTION", None)}  # fmt: skip
+_GRID = {
+    "pmf": ("CELL_SIZE", "MAX_WINDOW"),
+    "smrf": ("SMRF_CELL_SIZE", "SMRF_WINDOW"),
+    "csf": ("CSF_RESOLUTION", None),
+}
 
 
 def _check_against_data(v: Values, info) -> None:
@@ -292,8 +461,15 @@ def _check_against_data(v: Values, info) -> None:
     # the records a block at a time)
     per_point = GROUND_FILTER_BYTES_PER_POINT + 3 + info.record_size
     cell_key, window_key = _GRID[v.method]
-    check_cell_size(cell_key, v[cell_key], unit, mins, maxs, GROUND_FILTER_BYTES_PER_CELL,
-                    extra_bytes=info.point_count * per_point)  # fmt: skip
+    check_cell_size(
+        cell_key,
+        v[cell_key],
+        unit,
+        mins,
+        maxs,
+        GROUND_FILTER_BYTES_PER_CELL,
+        extra_bytes=info.point_count * per_point,
+    )
     width, height = maxs - mins
     # a window wider than the data opens it as one the data's size does: harmless up to a
     # point, a unit or typing mistake beyond twice the extent

@@ -15,15 +15,36 @@ COLMAP_FILTER = "COLMAP cameras (cameras.txt cameras.bin);;All files (*)"
 
 #: The tables every block import writes (importcolmap, importopensfm).
 BLOCK_OUTPUTS = (
-    Param("OUTPUT_CAMERA", "file_out", "Cameras (JSON)", optional=True,
-          file_filter="JSON files (*.json)"),
-    Param("OUTPUT_EO", "file_out", "Exterior orientation table (CSV)", optional=True,
-          file_filter=CSV_OUT),
-    Param("OUTPUT_OBSERVATIONS", "file_out", "Observations (tie points, CSV)",
-          optional=True, file_filter=CSV_OUT),
-    Param("OUTPUT_POINTS", "file_out", "3D points (ground point table, CSV)",
-          optional=True, create_by_default=False, file_filter=CSV_OUT),
-)  # fmt: skip
+    Param(
+        "OUTPUT_CAMERA",
+        "file_out",
+        "Cameras (JSON)",
+        optional=True,
+        file_filter="JSON files (*.json)",
+    ),
+    Param(
+        "OUTPUT_EO",
+        "file_out",
+        "Exterior orientation table (CSV)",
+        optional=True,
+        file_filter=CSV_OUT,
+    ),
+    Param(
+        "OUTPUT_OBSERVATIONS",
+        "file_out",
+        "Observations (tie points, CSV)",
+        optional=True,
+        file_filter=CSV_OUT,
+    ),
+    Param(
+        "OUTPUT_POINTS",
+        "file_out",
+        "3D points (ground point table, CSV)",
+        optional=True,
+        create_by_default=False,
+        file_filter=CSV_OUT,
+    ),
+)
 
 
 def pixel_size_param(help: str) -> Param:
@@ -82,14 +103,31 @@ COLMAP's image name, with a camera column when there are several); OUTPUT_OBSERV
 tracked keypoints as tie rows (point_id = COLMAP's 3D point id); OUTPUT_POINTS: the 3D points
 as a ground point table with role check (triangulated tie points, never control).""",
     params=(
-        Param("INPUT", "file", "COLMAP model (cameras.txt or cameras.bin)",
-              file_filter=COLMAP_FILTER),
-        Param("FRAME", "string", "Frame of the model's coordinates", "",
-              help="LOCAL, ECEF (with CRS) or a CRS (EPSG code or WKT); required"),
-        Param("CRS", "crs", "Mapping CRS (for ECEF)", optional=True,
-              help="the projected CRS an ECEF model is converted to"),
-        Param("SIMILARITY", "string", "Similarity model -> frame", "", optional=True,
-              help="s qw qx qy qz tx ty tz (X' = s R(q) X + t); empty: none"),
+        Param(
+            "INPUT", "file", "COLMAP model (cameras.txt or cameras.bin)", file_filter=COLMAP_FILTER
+        ),
+        Param(
+            "FRAME",
+            "string",
+            "Frame of the model's coordinates",
+            "",
+            help="LOCAL, ECEF (with CRS) or a CRS (EPSG code or WKT); required",
+        ),
+        Param(
+            "CRS",
+            "crs",
+            "Mapping CRS (for ECEF)",
+            optional=True,
+            help="the projected CRS an ECEF model is converted to",
+        ),
+        Param(
+            "SIMILARITY",
+            "string",
+            "Similarity model -> frame",
+            "",
+            optional=True,
+            help="s qw qx qy qz tx ty tz (X' = s R(q) X + t); empty: none",
+        ),
         pixel_size_param("COLMAP stores none: it sets the millimetres of the camera"),
         *BLOCK_OUTPUTS,
     ),
@@ -117,10 +155,21 @@ def finish_import(block, out, progress, images: str) -> JobResult:
     """Log the counts, write the requested tables (the EO to stdout when none is), report."""
     from ..io.orientation import eo_csv_text
 
-    log.info("%d %s, %d cameras, %d points", len(block.eo), images, len(block.cameras),
-             len(block.points.point_id))
-    result = JobResult(results={"IMAGE_COUNT": len(block.eo), "CAMERA_COUNT": len(block.cameras),
-                                "POINT_COUNT": len(block.points.point_id)}, data=block)
+    log.info(
+        "%d %s, %d cameras, %d points",
+        len(block.eo),
+        images,
+        len(block.cameras),
+        len(block.points.point_id),
+    )
+    result = JobResult(
+        results={
+            "IMAGE_COUNT": len(block.eo),
+            "CAMERA_COUNT": len(block.cameras),
+            "POINT_COUNT": len(block.points.point_id),
+        },
+        data=block,
+    )
     _write_outputs(block, out, result.lines)
     if not result.lines:
         result.stdout = eo_csv_text(block.eo)
@@ -145,11 +194,17 @@ def _write_outputs(block, out, lines: list) -> None:
     for name, write, count in (
         ("OUTPUT_CAMERA", lambda p, b: write_cameras_json(p, b.cameras), len(block.cameras)),
         ("OUTPUT_EO", eo, len(block.eo)),
-        ("OUTPUT_OBSERVATIONS", lambda p, b: write_observations_csv(p, b.observations),
-         len(block.observations.image_id)),
-        ("OUTPUT_POINTS", lambda p, b: write_ground_points_csv(p, b.points),
-         len(block.points.point_id)),
-    ):  # fmt: skip
+        (
+            "OUTPUT_OBSERVATIONS",
+            lambda p, b: write_observations_csv(p, b.observations),
+            len(block.observations.image_id),
+        ),
+        (
+            "OUTPUT_POINTS",
+            lambda p, b: write_ground_points_csv(p, b.points),
+            len(block.points.point_id),
+        ),
+    ):
         if out.requested(name):
             write(out.path(name), block)
             lines.append(f"{count} rows -> {out.target(name)}")

@@ -42,12 +42,27 @@ image name, with a camera column when there are several); OUTPUT_OBSERVATIONS: t
 tracks.csv as tie rows (point_id = the track id); OUTPUT_POINTS: the 3D points as a ground
 point table with role check (triangulated tie points, never control).""",
     params=(
-        Param("INPUT", "file", "OpenSfM reconstruction (reconstruction.json)",
-              file_filter="OpenSfM reconstruction (*.json);;All files (*)"),
-        Param("CRS", "crs", "Mapping CRS", optional=True,
-              help="the projected CRS to convert to; empty: the topocentric frame (LOCAL)"),
-        Param("RECONSTRUCTION", "integer", "Reconstruction index", 0, minimum=0,
-              help="which reconstruction of the file (0: the first)"),
+        Param(
+            "INPUT",
+            "file",
+            "OpenSfM reconstruction (reconstruction.json)",
+            file_filter="OpenSfM reconstruction (*.json);;All files (*)",
+        ),
+        Param(
+            "CRS",
+            "crs",
+            "Mapping CRS",
+            optional=True,
+            help="the projected CRS to convert to; empty: the topocentric frame (LOCAL)",
+        ),
+        Param(
+            "RECONSTRUCTION",
+            "integer",
+            "Reconstruction index",
+            0,
+            minimum=0,
+            help="which reconstruction of the file (0: the first)",
+        ),
         pixel_size_param("OpenSfM stores none: it sets the millimetres of the camera"),
         *BLOCK_OUTPUTS,
     ),

@@ -173,8 +173,10 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     traj = interpolate_trajectory(nav, events, frame, options)
     table = direct_georeference(traj, mount, frame)
     result = JobResult(results={"IMAGE_COUNT": len(traj), "RECORD_COUNT": len(nav)}, data=table)
-    for name, write, what in (("OUTPUT_TRAJECTORY", write_trajectory_csv, traj),
-                              ("OUTPUT_EO", write_eo_csv, table)):  # fmt: skip
+    for name, write, what in (
+        ("OUTPUT_TRAJECTORY", write_trajectory_csv, traj),
+        ("OUTPUT_EO", write_eo_csv, table),
+    ):
         if out.requested(name):
             write(out.path(name), what)
             result.lines.append(f"{len(traj)} images -> {out.target(name)}")
@@ -199,6 +201,11 @@ def _read_navigation(path: str, fmt: str, frame):
         fmt = "sbet" if suffix in (".out", ".sbet") else "csv" if suffix == ".csv" else "ascii"
     nav = {"sbet": read_sbet, "ascii": read_nav_ascii, "csv": read_nav_csv}[fmt](path)
     if not nav.geodetic:
-        check_area_of_use(frame.crs, nav.position.min(axis=0), nav.position.max(axis=0),
-                          what="the trajectory", path=path)  # fmt: skip
+        check_area_of_use(
+            frame.crs,
+            nav.position.min(axis=0),
+            nav.position.max(axis=0),
+            what="the trajectory",
+            path=path,
+        )
     return nav

@@ -23,27 +23,98 @@ _LAS_SUFFIXES = (".las", ".laz")
 BYTES_PER_RETURN = 200
 #: (parameter, LidarAccuracyOptions field, label, kind, unit, minimum, maximum, advanced)
 _NUMBERS = (
-    ("CELL_SIZE", "cell_size", "Cell size (about 2 x point spacing or more)", "number", "m",
-     0.01, 1000.0, False),
-    ("MIN_POINTS", "min_points", "Least returns of one swath in a cell", "integer", "", 4,
-     100000, True),
-    ("MAX_SLOPE", "max_slope_deg", "Largest slope of a smooth cell", "number", "degrees", 0.0,
-     89.0, True),
-    ("MAX_RESIDUAL", "max_residual", "Largest plane-fit rms of a smooth cell", "number", "m",
-     0.0, 100.0, True),
-    ("MAX_STEP", "max_step", "Largest step to a neighbour cell's plane", "number", "m", 0.0,
-     1000.0, True),
-    ("GPS_GAP", "gps_gap_s", "GPS-time gap that starts a new swath", "number", "s", 0.0,
-     1e9, True),
-    ("MIN_PAIR_CELLS", "min_pair_cells", "Least smooth cells of an assessed swath pair",
-     "integer", "", 1, 1e9, True),
-    ("V_CLASS_CM", "v_class_cm", "ASPRS vertical class (0 = report the class met)", "number",
-     "cm", 0.0, 10000.0, False),
-    ("SURVEY_SIGMA_V", "survey_sigma_v", "Check-point survey sigma in height", "number", "m",
-     0.0, 100.0, False),
-    ("TIN_RADIUS", "tin_radius", "Ground returns within this distance make the TIN", "number",
-     "m", 0.1, 10000.0, True),
-)  # fmt: skip
+    (
+        "CELL_SIZE",
+        "cell_size",
+        "Cell size (about 2 x point spacing or more)",
+        "number",
+        "m",
+        0.01,
+        1000.0,
+        False,
+    ),
+    (
+        "MIN_POINTS",
+        "min_points",
+        "Least returns of one swath in a cell",
+        "integer",
+        "",
+        4,
+        100000,
+        True,
+    ),
+    (
+        "MAX_SLOPE",
+        "max_slope_deg",
+        "Largest slope of a smooth cell",
+        "number",
+        "degrees",
+        0.0,
+        89.0,
+        True,
+    ),
+    (
+        "MAX_RESIDUAL",
+        "max_residual",
+        "Largest plane-fit rms of a smooth cell",
+        "number",
+        "m",
+        0.0,
+        100.0,
+        True,
+    ),
+    (
+        "MAX_STEP",
+        "max_step",
+        "Largest step to a neighbour cell's plane",
+        "number",
+        "m",
+        0.0,
+        1000.0,
+        True,
+    ),
+    ("GPS_GAP", "gps_gap_s", "GPS-time gap that starts a new swath", "number", "s", 0.0, 1e9, True),
+    (
+        "MIN_PAIR_CELLS",
+        "min_pair_cells",
+        "Least smooth cells of an assessed swath pair",
+        "integer",
+        "",
+        1,
+        1e9,
+        True,
+    ),
+    (
+        "V_CLASS_CM",
+        "v_class_cm",
+        "ASPRS vertical class (0 = report the class met)",
+        "number",
+        "cm",
+        0.0,
+        10000.0,
+        False,
+    ),
+    (
+        "SURVEY_SIGMA_V",
+        "survey_sigma_v",
+        "Check-point survey sigma in height",
+        "number",
+        "m",
+        0.0,
+        100.0,
+        False,
+    ),
+    (
+        "TIN_RADIUS",
+        "tin_radius",
+        "Ground returns within this distance make the TIN",
+        "number",
+        "m",
+        0.1,
+        10000.0,
+        True,
+    ),
+)
 
 SPEC = AlgorithmSpec(
     name="lidaraccuracy",
@@ -287,8 +358,11 @@ def _read(files: list[str], infos, progress, should_stop):
     parts: dict[str, list] = {}
     optional = ("classification", "number_of_returns", "point_source_id", "gps_time")
     total = sum(i.point_count for i in infos)
-    check_memory(total * BYTES_PER_RETURN, f"INPUT: {total} returns",
-                 "use TILE_SIZE (tiles on a dask cluster)")  # fmt: skip
+    check_memory(
+        total * BYTES_PER_RETURN,
+        f"INPUT: {total} returns",
+        "use TILE_SIZE (tiles on a dask cluster)",
+    )
     for k, (f, info) in enumerate(zip(files, infos)):
         fields = ["x", "y", "z"] + [n for n in optional if n in info.dimensions]
         arrays, _ = read_points(f, fields, require_crs=False, should_stop=should_stop)
@@ -326,8 +400,18 @@ def _write_checkpoint_table(path: str, report) -> None:
     cp, f = report.checkpoints, report.vertical
     for i, p, g, dz in zip(cp.ids, cp.xyz, cp.groups, f.dz):
         if dz == dz:  # outside the TIN: no LiDAR height
-            w.writerow([i, repr(float(p[0])), repr(float(p[1])), repr(float(p[2] + dz)),
-                        repr(float(p[0])), repr(float(p[1])), repr(float(p[2])), g])  # fmt: skip
+            w.writerow(
+                [
+                    i,
+                    repr(float(p[0])),
+                    repr(float(p[1])),
+                    repr(float(p[2] + dz)),
+                    repr(float(p[0])),
+                    repr(float(p[1])),
+                    repr(float(p[2])),
+                    g,
+                ]
+            )
     write_text_atomic(path, buf.getvalue())
 
 
@@ -364,8 +448,9 @@ def accuracy_tile(files, boxes, own, grid, options, check_xy) -> TilePart:
         info = read_info(f, require_crs=False)
         fields = [k for k in _FIELDS if k in ("x", "y", "z") or k in info.dimensions]
         if "point_source_id" not in fields:
-            raise InputError("a tiled run needs the point source ids (TILE_SIZE 0 for GPS "
-                             "time)", path=f)  # fmt: skip
+            raise InputError(
+                "a tiled run needs the point source ids (TILE_SIZE 0 for GPS time)", path=f
+            )
         a, _ = read_points(f, fields, require_crs=False)
         m = (a["x"] >= outer[0]) & (a["x"] <= outer[2]) & (a["y"] >= outer[1])
         m &= a["y"] <= outer[3]
@@ -375,8 +460,17 @@ def accuracy_tile(files, boxes, own, grid, options, check_xy) -> TilePart:
     a = {k: np.concatenate(v) for k, v in parts.items() if v}
     if "x" not in a or a["x"].size == 0:
         return TilePart(None, {}, {}, np.zeros((0, 3)))
-    fits = fit_cells(a["x"], a["y"], a["z"], a["point_source_id"], grid, options,
-                     a.get("classification"), a.get("number_of_returns"), own)  # fmt: skip
+    fits = fit_cells(
+        a["x"],
+        a["y"],
+        a["z"],
+        a["point_source_id"],
+        grid,
+        options,
+        a.get("classification"),
+        a.get("number_of_returns"),
+        own,
+    )
     core = (a["x"] >= own[0]) & (a["x"] < own[2]) & (a["y"] >= own[1]) & (a["y"] < own[3])
     ids = a["point_source_id"][core].astype(np.int64)
     swaths = {int(s): int(n) for s, n in zip(*np.unique(ids, return_counts=True))}
@@ -413,9 +507,15 @@ def _merge_motion(parts) -> dict[int, float]:
             tot = na + n
             dt, dx, dy = mt - ta, mx - xa, my - ya
             w = na * n / tot
-            acc[s] = [tot, ta + dt * n / tot, xa + dx * n / tot, ya + dy * n / tot,
-                      sa_tt + stt + dt * dt * w, sa_tx + stx + dt * dx * w,
-                      sa_ty + sty + dt * dy * w]  # fmt: skip
+            acc[s] = [
+                tot,
+                ta + dt * n / tot,
+                xa + dx * n / tot,
+                ya + dy * n / tot,
+                sa_tt + stt + dt * dt * w,
+                sa_tx + stx + dt * dx * w,
+                sa_ty + sty + dt * dy * w,
+            ]
     return {s: math.atan2(v[6], v[5]) for s, v in acc.items() if v[4] > 0 and (v[5] or v[6])}
 
 
@@ -437,10 +537,12 @@ def _tiles(grid, tile_size: float) -> list[tuple[float, float, float, float]]:
 def _tile_points(own, pad: float, boxes, infos) -> int:
     """Returns of the files whose header box meets the tile and its one-cell margin."""
     return sum(
-        i.point_count for b, i in zip(boxes, infos)
-        if not (b[0] > own[2] + pad or b[2] < own[0] - pad or b[1] > own[3] + pad
-                or b[3] < own[1] - pad)
-    )  # fmt: skip
+        i.point_count
+        for b, i in zip(boxes, infos)
+        if not (
+            b[0] > own[2] + pad or b[2] < own[0] - pad or b[1] > own[3] + pad or b[3] < own[1] - pad
+        )
+    )
 
 
 def _run_tiled(v: Values, files, infos, grid, options, checkpoints, progress, should_stop):
@@ -456,23 +558,40 @@ def _run_tiled(v: Values, files, infos, grid, options, checkpoints, progress, sh
 
     if options.swath_source == "gps_time":
         raise InputError("SWATH_SOURCE gps_time needs the whole survey at once: TILE_SIZE 0")
-    boxes = [(float(i.mins[0]), float(i.mins[1]), float(i.maxs[0]), float(i.maxs[1]))
-             for i in infos]  # fmt: skip
+    boxes = [
+        (float(i.mins[0]), float(i.mins[1]), float(i.maxs[0]), float(i.maxs[1])) for i in infos
+    ]
     tiles = _tiles(grid, v.tile_size)
     if not v.cluster:  # a local cluster: every worker holds the files its tile meets
         most = max(_tile_points(own, grid.cell, boxes, infos) for own in tiles)
         workers = min(v.workers or os.cpu_count() or 1, len(tiles))
-        check_memory(most * BYTES_PER_RETURN * workers,
-                     f"TILE_SIZE {v.tile_size:g}: {workers} worker(s), up to {most} returns "
-                     "each (every file a tile meets is decoded whole)",
-                     "use smaller files (e.g. lidarblock's tiles) or fewer WORKERS")  # fmt: skip
+        check_memory(
+            most * BYTES_PER_RETURN * workers,
+            f"TILE_SIZE {v.tile_size:g}: {workers} worker(s), up to {most} returns "
+            "each (every file a tile meets is decoded whole)",
+            "use smaller files (e.g. lidarblock's tiles) or fewer WORKERS",
+        )
     check_xy = None if checkpoints is None else checkpoints.xyz[:, :2]
     with cluster_session(v) as client:
-        futures = [client.submit(accuracy_tile, files, boxes, own, grid, options, check_xy,
-                                 pure=False, key=f"lidaraccuracy-{k}-{os.getpid()}-"
-                                 f"{time.time_ns()}") for k, own in enumerate(tiles)]  # fmt: skip
-        parts = [p for p in gather(client, futures, progress, should_stop, 0.0, 0.9)
-                 if p.fits is not None]  # fmt: skip
+        futures = [
+            client.submit(
+                accuracy_tile,
+                files,
+                boxes,
+                own,
+                grid,
+                options,
+                check_xy,
+                pure=False,
+                key=f"lidaraccuracy-{k}-{os.getpid()}-{time.time_ns()}",
+            )
+            for k, own in enumerate(tiles)
+        ]
+        parts = [
+            p
+            for p in gather(client, futures, progress, should_stop, 0.0, 0.9)
+            if p.fits is not None
+        ]
     if not parts:
         raise InputError("the survey has no points in its header's box")
     cells = finish_cells([p.fits for p in parts], grid, options)
@@ -503,8 +622,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     from ..quality.lidar_accuracy import assess_lidar
     from ..quality.lidar_accuracy_options import LidarAccuracyOptions
 
-    options = options_from(LidarAccuracyOptions, SPEC, v,
-                           hard_classes=_classes(v.hard_classes or ""))  # fmt: skip
+    options = options_from(
+        LidarAccuracyOptions, SPEC, v, hard_classes=_classes(v.hard_classes or "")
+    )
     if v.output_checkpoints and not v.checkpoints:
         raise InputError("OUTPUT_CHECKPOINTS needs the CHECKPOINTS table")
     files = _cloud_files(v.input)
@@ -523,11 +643,16 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     _write_outputs(out, report, bands, crs)
     nva = report.vertical.nva_rmse_v if report.vertical is not None else math.nan
     lines = [f"swaths from {report.swath_method}: {len(report.swath_counts)}"]
-    lines += [f"swaths {p.swath_a}-{p.swath_b}: {p.n} cells, RMSDz {p.stats()['rmsdz']:.4f} m"
-              for p in report.pairs]  # fmt: skip
+    lines += [
+        f"swaths {p.swath_a}-{p.swath_b}: {p.n} cells, RMSDz {p.stats()['rmsdz']:.4f} m"
+        for p in report.pairs
+    ]
     lines += [f"{x.name}: {x.status} ({x.reason})" for x in report.verdicts]
-    results = {"RMSDZ": report.overall["rmsdz"], "SMOOTH_CELLS": report.overall["n"],
-               "NVA_RMSE": nva}  # fmt: skip
+    results = {
+        "RMSDZ": report.overall["rmsdz"],
+        "SMOOTH_CELLS": report.overall["n"],
+        "NVA_RMSE": nva,
+    }
     return JobResult(results=results, lines=lines, data=report)
 
 
@@ -546,14 +671,24 @@ def _write_outputs(out, report, bands: list[str], crs) -> None:
         from ..io.atomic import atomic_path
 
         g = report.grid
-        check_memory(4.0 * max(len(bands), 1) * g.rows * g.cols,
-                     f"OUTPUT_RASTER: {len(bands)} band(s) of {g.cols} x {g.rows} cells",
-                     "use a larger CELL_SIZE")  # fmt: skip
+        check_memory(
+            4.0 * max(len(bands), 1) * g.rows * g.cols,
+            f"OUTPUT_RASTER: {len(bands)} band(s) of {g.cols} x {g.rows} cells",
+            "use a larger CELL_SIZE",
+        )
         data = pair_rasters(report.pairs, g)
         with atomic_path(out.path("OUTPUT_RASTER")) as tmp:
-            with GeoTiffWriter(tmp, g.cols, g.rows, data.shape[0], data.dtype,
-                               g.geotransform(), crs, nodata=float("nan"),
-                               metadata={"BANDS": ",".join(bands)}) as w:  # fmt: skip
+            with GeoTiffWriter(
+                tmp,
+                g.cols,
+                g.rows,
+                data.shape[0],
+                data.dtype,
+                g.geotransform(),
+                crs,
+                nodata=float("nan"),
+                metadata={"BANDS": ",".join(bands)},
+            ) as w:
                 w.write(data)
     if out.requested("OUTPUT_CHECKPOINTS") and report.vertical is not None:
         _write_checkpoint_table(out.path("OUTPUT_CHECKPOINTS"), report)

@@ -152,8 +152,7 @@ DISTANCE_UNIT is metres.""",
 )
 # fmt: on
 
-_H = ("cell_size", "max_window", "threshold", "scalar", "low_outlier_radius",
-      "low_outlier_height")  # fmt: skip
+_H = ("cell_size", "max_window", "threshold", "scalar", "low_outlier_radius", "low_outlier_height")
 
 
 # ----------------------------------------------------------------------------- the cluster
@@ -166,7 +165,8 @@ def _process_workers(v: Values) -> bool:
     # inside QGIS (or qgis_process) a worker process would be started with QGIS's own
     # executable: threads there
     return v.local_cluster == "processes" or (
-        v.local_cluster == "auto" and "qgis.core" not in sys.modules)
+        v.local_cluster == "auto" and "qgis.core" not in sys.modules
+    )
 
 
 def open_client(v: Values):
@@ -194,9 +194,14 @@ def open_client(v: Values):
         if hasattr(signal, "pthread_sigmask"):
             signal.pthread_sigmask(signal.SIG_BLOCK, _STOP_SIGNALS)
         try:
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, memory_limit=memory,
-                                   processes=processes, dashboard_address=None,
-                                   silence_logs=logging.ERROR)  # fmt: skip
+            cluster = LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,
+                memory_limit=memory,
+                processes=processes,
+                dashboard_address=None,
+                silence_logs=logging.ERROR,
+            )
             made.append((Client(cluster), cluster))
         except Exception as exc:
             made.append(exc)
@@ -253,9 +258,18 @@ def run_block(
     t0 = time.perf_counter()
     # the index travels with each task (a few hundred bytes per tile): nothing is lost
     # with a worker
-    futures = [client.submit(task, index, i, settings, staging, pure=False,
-                             key=f"lidarblock-tile-{i}-{os.getpid()}-{time.time_ns()}")
-               for i in range(len(index.tiles))]  # fmt: skip
+    futures = [
+        client.submit(
+            task,
+            index,
+            i,
+            settings,
+            staging,
+            pure=False,
+            key=f"lidarblock-tile-{i}-{os.getpid()}-{time.time_ns()}",
+        )
+        for i in range(len(index.tiles))
+    ]
     outcomes: list[TileOutcome] = gather(client, futures, progress, should_stop, 0.0, 0.85)
     t_tiles = time.perf_counter() - t0
     pieces, bands = [], []
@@ -268,12 +282,18 @@ def run_block(
 
     def on_cluster(f: Callable[..., Any], args: list[tuple[Any, ...]]) -> list[Any]:
         # one task a window: its points are read and its planes found on a worker
-        return gather(client, [client.submit(f, *a, pure=False) for a in args], None,
-                      should_stop, 0.85, 0.85)  # fmt: skip
+        return gather(
+            client, [client.submit(f, *a, pure=False) for a in args], None, should_stop, 0.85, 0.85
+        )
 
-    merged = second_pass(merged, pieces, settings.roof_buffer, settings.roof,
-                         _scratch_fetch(os.path.join(staging, ROOF_SCRATCH)),
-                         on_cluster)  # fmt: skip
+    merged = second_pass(
+        merged,
+        pieces,
+        settings.roof_buffer,
+        settings.roof,
+        _scratch_fetch(os.path.join(staging, ROOF_SCRATCH)),
+        on_cluster,
+    )
     t_second = time.perf_counter() - t1
     shutil.rmtree(os.path.join(staging, ROOF_SCRATCH), ignore_errors=True)
     planes = [m.plane for m in merged]
@@ -288,22 +308,43 @@ def run_block(
         box = tile.cell or tile.box
         if tile.cell is None:  # a file tile: the half-open box must hold its max corner
             box = (box[0], box[1], np.nextafter(box[2], np.inf), np.nextafter(box[3], np.inf))
-        near = np.flatnonzero(np.all(lo <= np.array(box[2:]) + reach, axis=1)
-                              & np.all(hi >= np.array(box[:2]) - reach, axis=1))  # fmt: skip
+        near = np.flatnonzero(
+            np.all(lo <= np.array(box[2:]) + reach, axis=1)
+            & np.all(hi >= np.array(box[:2]) - reach, axis=1)
+        )
         if len(near) < 2:
             continue
         pts = np.concatenate([merged[j].points for j in near])
         ids = np.concatenate([np.full(len(merged[j].points), j, np.int64) for j in near])
-        inside = ((pts[:, 0] >= box[0] - reach) & (pts[:, 0] <= box[2] + reach)
-                  & (pts[:, 1] >= box[1] - reach) & (pts[:, 1] <= box[3] + reach))  # fmt: skip
-        ctrl.append(client.submit(control_tile, box, [planes[j] for j in near], pts[inside],
-                                  ids[inside], settings.control, pure=False))  # fmt: skip
+        inside = (
+            (pts[:, 0] >= box[0] - reach)
+            & (pts[:, 0] <= box[2] + reach)
+            & (pts[:, 1] >= box[1] - reach)
+            & (pts[:, 1] <= box[3] + reach)
+        )
+        ctrl.append(
+            client.submit(
+                control_tile,
+                box,
+                [planes[j] for j in near],
+                pts[inside],
+                ids[inside],
+                settings.control,
+                pure=False,
+            )
+        )
     found = gather(client, ctrl, progress, should_stop, 0.85, 1.0)
     lcps = dedupe_points([p for f in found for p in f[0]], settings.control.delta)
     lines = dedupe_lines([ln for f in found for ln in f[1]])
-    return {"outcomes": outcomes, "planes": planes, "lcps": lcps, "lines": lines,
-            "seconds_tiles": t_tiles, "seconds_second_pass": t_second,
-            "seconds": time.perf_counter() - t0}  # fmt: skip
+    return {
+        "outcomes": outcomes,
+        "planes": planes,
+        "lcps": lcps,
+        "lines": lines,
+        "seconds_tiles": t_tiles,
+        "seconds_second_pass": t_second,
+        "seconds": time.perf_counter() - t0,
+    }
 
 
 def settings_from(v: Values, info) -> BlockSettings:
@@ -316,19 +357,31 @@ def settings_from(v: Values, info) -> BlockSettings:
     from ..lidar.roof_planes import RoofPlaneParams
 
     smrf = options_from(SmrfParams, SPEC, v)
-    smrf = lengths_in_cloud_units(smrf, info, v.distance_unit,
-                                  ("cell_size", "max_window", "low_outlier_radius"),
-                                  ("threshold", "scalar", "low_outlier_height"))  # fmt: skip
-    roof = options_from(RoofPlaneParams, SPEC, v,
-                        min_support=min(RoofPlaneParams().min_support, v.k_neighbours))
+    smrf = lengths_in_cloud_units(
+        smrf,
+        info,
+        v.distance_unit,
+        ("cell_size", "max_window", "low_outlier_radius"),
+        ("threshold", "scalar", "low_outlier_height"),
+    )
+    roof = options_from(
+        RoofPlaneParams, SPEC, v, min_support=min(RoofPlaneParams().min_support, v.k_neighbours)
+    )
     roof = lengths_in_cloud_units(roof, info, v.distance_unit, ("epsilon",))
     control = options_from(ControlOptions, SPEC, v)
-    control = lengths_in_cloud_units(control, info, v.distance_unit,
-                                     ("delta", "min_boundary", "max_support_distance"))  # fmt: skip
+    control = lengths_in_cloud_units(
+        control, info, v.distance_unit, ("delta", "min_boundary", "max_support_distance")
+    )
     area = float(np.prod(np.maximum(info.maxs[:2] - info.mins[:2], 1e-9)))
     spacing = math.sqrt(area / max(info.point_count, 1))
-    return BlockSettings(smrf, roof, control, ground_buffer(smrf),
-                         roof_buffer(roof.k_neighbours, spacing), v.crs or None)  # fmt: skip
+    return BlockSettings(
+        smrf,
+        roof,
+        control,
+        ground_buffer(smrf),
+        roof_buffer(roof.k_neighbours, spacing),
+        v.crs or None,
+    )
 
 
 def _check_tiling(v: Values) -> None:
@@ -346,20 +399,26 @@ def _check_tiling(v: Values) -> None:
     if size > max(width, height):
         return  # one tile
     # the grid of index_block: cells on multiples of the tile size
-    cols, rows = (math.floor((float(hi) - math.floor(float(lo) / size) * size) / size) + 1
-                  for lo, hi in zip(info.mins[:2], info.maxs[:2]))  # fmt: skip
+    cols, rows = (
+        math.floor((float(hi) - math.floor(float(lo) / size) * size) / size) + 1
+        for lo, hi in zip(info.mins[:2], info.maxs[:2])
+    )
     if cols * rows > MAX_TILES:
-        raise InputError(f"TILE_SIZE {size:g} {unit}: the file ({width:.4g} x {height:.4g} "
-                         f"{unit}) would be cut into {cols} x {rows} tiles, more than "
-                         f"{MAX_TILES}: give a larger TILE_SIZE")  # fmt: skip
+        raise InputError(
+            f"TILE_SIZE {size:g} {unit}: the file ({width:.4g} x {height:.4g} "
+            f"{unit}) would be cut into {cols} x {rows} tiles, more than "
+            f"{MAX_TILES}: give a larger TILE_SIZE"
+        )
     settings = settings_from(v, info)
     buffer = max(settings.ground_buffer, settings.roof_buffer)
     if size < buffer:
         ratio = ((size + 2 * buffer) / size) ** 2
-        raise InputError(f"TILE_SIZE {size:g} {unit} is smaller than the buffer each tile reads "
-                         f"around it ({buffer:.4g} {unit}, from SMRF_WINDOW, "
-                         f"LOW_OUTLIER_RADIUS and SMRF_CELL_SIZE): each tile would read "
-                         f"{ratio:.0f} times its own area; give at least {buffer:.4g} {unit}")
+        raise InputError(
+            f"TILE_SIZE {size:g} {unit} is smaller than the buffer each tile reads "
+            f"around it ({buffer:.4g} {unit}, from SMRF_WINDOW, "
+            f"LOW_OUTLIER_RADIUS and SMRF_CELL_SIZE): each tile would read "
+            f"{ratio:.0f} times its own area; give at least {buffer:.4g} {unit}"
+        )
 
 
 def _tile_need(index, settings: BlockSettings) -> tuple[float, str]:
@@ -387,7 +446,8 @@ def _tile_need(index, settings: BlockSettings) -> tuple[float, str]:
     need, points, cells, name = best
     return WORKER_BASE_BYTES + need, (
         f"the largest tile ({name}: about {points} points with its buffer, a grid of {cells} "
-        f"cells) and the worker itself ({size_text(WORKER_BASE_BYTES)})")
+        f"cells) and the worker itself ({size_text(WORKER_BASE_BYTES)})"
+    )
 
 
 def _check_cluster_memory(v: Values, index, settings: BlockSettings) -> None:
@@ -396,21 +456,28 @@ def _check_cluster_memory(v: Values, index, settings: BlockSettings) -> None:
     from .checks import check_memory, size_text
 
     if len(index.tiles) > MAX_TILES:
-        raise InputError(f"INPUT: the block has {len(index.tiles)} tiles, more than "
-                         f"{MAX_TILES}: split it into several blocks")  # fmt: skip
+        raise InputError(
+            f"INPUT: the block has {len(index.tiles)} tiles, more than "
+            f"{MAX_TILES}: split it into several blocks"
+        )
     if v.cluster or not index.tiles:
         return  # an existing cluster's workers have their own memory
     need, what = _tile_need(index, settings)
     if v.memory_limit > 0 and need > v.memory_limit * 1e9:
-        raise InputError(f"MEMORY_LIMIT {v.memory_limit:g} GB: a worker needs about "
-                         f"{size_text(need)} for {what}: give at least "
-                         f"{math.ceil(need / 1e8) / 10:g} GB, or 0 (the memory shared among "
-                         "the workers)")  # fmt: skip
+        raise InputError(
+            f"MEMORY_LIMIT {v.memory_limit:g} GB: a worker needs about "
+            f"{size_text(need)} for {what}: give at least "
+            f"{math.ceil(need / 1e8) / 10:g} GB, or 0 (the memory shared among "
+            "the workers)"
+        )
     n = v.workers or os.cpu_count() or 1
     # thread workers share this process (its own memory counted once)
     total = n * need if _process_workers(v) else need + (n - 1) * (need - WORKER_BASE_BYTES)
-    check_memory(total, f"WORKERS {n}: {n} tiles at once, each {what},",
-                 "give fewer WORKERS or a smaller TILE_SIZE")  # fmt: skip
+    check_memory(
+        total,
+        f"WORKERS {n}: {n} tiles at once, each {what},",
+        "give fewer WORKERS or a smaller TILE_SIZE",
+    )
 
 
 def _stop_workers(cluster) -> None:
@@ -429,10 +496,14 @@ def _stop_workers(cluster) -> None:
 
 
 def _check_output(folder: Path) -> None:
-    if folder.exists() and (not folder.is_dir() or (any(folder.iterdir())
-                                                    and not (folder / REPORT_NAME).exists())):
-        raise InputError("OUTPUT_FOLDER must be a new or empty folder, or a previous block "
-                         "output (with its block_report.json)", path=str(folder))  # fmt: skip
+    if folder.exists() and (
+        not folder.is_dir() or (any(folder.iterdir()) and not (folder / REPORT_NAME).exists())
+    ):
+        raise InputError(
+            "OUTPUT_FOLDER must be a new or empty folder, or a previous block "
+            "output (with its block_report.json)",
+            path=str(folder),
+        )
 
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
@@ -447,14 +518,21 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     _check_tiling(v)
     index = index_block(v.input, v.crs or None, v.tile_size)
     # the folder is replaced when the block is done: no tile it reads may lie in it
-    check_outputs({}, {"INPUT": [v.input, *(t.path for t in index.tiles)]},
-                  folders={"OUTPUT_FOLDER": target})  # fmt: skip
+    check_outputs(
+        {}, {"INPUT": [v.input, *(t.path for t in index.tiles)]}, folders={"OUTPUT_FOLDER": target}
+    )
     info = index.info
     settings = settings_from(v, info)
     _check_cluster_memory(v, index, settings)
-    log.info("%d tiles (%s), %d points; buffers: ground %.4g, roof planes %.4g %s",
-             len(index.tiles), index.kind, index.point_count, settings.ground_buffer,
-             settings.roof_buffer, info.horizontal_unit)  # fmt: skip
+    log.info(
+        "%d tiles (%s), %d points; buffers: ground %.4g, roof planes %.4g %s",
+        len(index.tiles),
+        index.kind,
+        index.point_count,
+        settings.ground_buffer,
+        settings.roof_buffer,
+        info.horizontal_unit,
+    )
     staging = staging_folder(target)
     try:
         block = _on_cluster(v, index, settings, str(staging), progress, should_stop)
@@ -477,22 +555,31 @@ def _result(target: Path, index, block: dict, report: dict, failed: list, good: 
     for name, error in failed:
         log.warning("tile %s failed: %s", name, error)
     n_tiles = len(index.tiles) + len(index.bad)
-    status = "complete" if complete else f"INCOMPLETE ({len(failed)} tile(s) failed: " + \
-        ", ".join(n for n, _ in failed) + ")"
+    status = (
+        "complete"
+        if complete
+        else f"INCOMPLETE ({len(failed)} tile(s) failed: " + ", ".join(n for n, _ in failed) + ")"
+    )
     return JobResult(
         results={
-            "TILE_COUNT": len(good), "FAILED_TILES": len(failed), "COMPLETE": int(complete),
-            "POINT_COUNT": report["point_count"], "GROUND_COUNT": report["ground_count"],
-            "PLANE_COUNT": len(block["planes"]), "LCP_COUNT": len(block["lcps"]),
+            "TILE_COUNT": len(good),
+            "FAILED_TILES": len(failed),
+            "COMPLETE": int(complete),
+            "POINT_COUNT": report["point_count"],
+            "GROUND_COUNT": report["ground_count"],
+            "PLANE_COUNT": len(block["planes"]),
+            "LCP_COUNT": len(block["lcps"]),
             "LINE_COUNT": len(block["lines"]),
         },
-        lines=[f"block {status}: {len(good)} of {n_tiles} tiles, {report['point_count']} "
-               f"points, {report['ground_count']} ground, {len(block['planes'])} planes, "
-               f"{len(block['lcps'])} LCPs, {len(block['lines'])} lines in "
-               f"{block['seconds']:.1f} s -> {target}"],
+        lines=[
+            f"block {status}: {len(good)} of {n_tiles} tiles, {report['point_count']} "
+            f"points, {report['ground_count']} ground, {len(block['planes'])} planes, "
+            f"{len(block['lcps'])} LCPs, {len(block['lines'])} lines in "
+            f"{block['seconds']:.1f} s -> {target}"
+        ],
         data=report,
         exit_code=0 if complete else INCOMPLETE_EXIT,
-    )  # fmt: skip
+    )
 
 
 @contextlib.contextmanager
@@ -526,9 +613,11 @@ def _write_tables(staging: Path, block: dict, good: list, info) -> None:
     from ..io.tiles import write_vpc
 
     crs_wkt = info.crs.to_wkt() if info.crs is not None else ""
-    write_vpc(staging / "block.vpc",
-              [{"name": o.name, "href": o.href, "count": o.n_core, "bbox": o.bbox}
-               for o in good], crs_wkt)  # fmt: skip
+    write_vpc(
+        staging / "block.vpc",
+        [{"name": o.name, "href": o.href, "count": o.n_core, "bbox": o.bbox} for o in good],
+        crs_wkt,
+    )
     write_planes_csv(staging / "planes.csv", block["planes"])
     write_lcps_csv(staging / "lcps.csv", block["lcps"])
     write_lines_csv(staging / "lines.csv", block["lines"])
@@ -556,12 +645,23 @@ def _report(v: Values, index, settings, block: dict, failed: list, good: list) -
         "seconds": round(block["seconds"], 3),
         "tasks_s": round(block["seconds_tiles"], 3),
         "second_pass_s": round(block.get("seconds_second_pass", 0.0), 3),
-        "tiles": [{"name": o.name, "ok": o.ok, "error": o.error, "points": o.n_core,
-                   "points_read": o.n_read, "points_decoded": o.n_decoded,
-                   "ground": o.n_ground, "low_outliers": o.n_low,
-                   "plane_pieces": len(o.pieces), "seconds": round(o.seconds, 3),
-                   "peak_rss_mb": round(o.peak_rss_mb, 1), "stage_seconds": o.stages,
-                   "buffer_incomplete": o.missing,
-                   "href": o.href}
-                  for o in outcomes],
-    }  # fmt: skip
+        "tiles": [
+            {
+                "name": o.name,
+                "ok": o.ok,
+                "error": o.error,
+                "points": o.n_core,
+                "points_read": o.n_read,
+                "points_decoded": o.n_decoded,
+                "ground": o.n_ground,
+                "low_outliers": o.n_low,
+                "plane_pieces": len(o.pieces),
+                "seconds": round(o.seconds, 3),
+                "peak_rss_mb": round(o.peak_rss_mb, 1),
+                "stage_seconds": o.stages,
+                "buffer_incomplete": o.missing,
+                "href": o.href,
+            }
+            for o in outcomes
+        ],
+    }

@@ -86,8 +86,9 @@ def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOu
     c0 = time.process_time()  # the worker's CPU (its decoder threads too): load-independent
     tile = index.tiles[i]
     try:
-        buf = read_buffered(index, i, max(settings.ground_buffer, settings.roof_buffer),
-                            settings.crs)  # fmt: skip
+        buf = read_buffered(
+            index, i, max(settings.ground_buffer, settings.roof_buffer), settings.crs
+        )
     except InputError as exc:
         return TileOutcome(i, tile.name, False, str(exc))
     stages = {"read": time.perf_counter() - t0}
@@ -95,20 +96,28 @@ def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOu
     core = a["core"]
     n_core = int(core.sum())
     if n_core == 0:  # an empty cell of a large file's grid
-        return TileOutcome(i, tile.name, True, n_read=len(core), seconds=0.0,
-                           n_decoded=buf.decoded)  # fmt: skip
+        return TileOutcome(i, tile.name, True, n_read=len(core), seconds=0.0, n_decoded=buf.decoded)
     own = tile.cell or tile.box
     g = settings.ground_buffer
-    inside = ((a["x"] >= own[0] - g) & (a["x"] <= own[2] + g) & (a["y"] >= own[1] - g)
-              & (a["y"] <= own[3] + g))  # fmt: skip
+    inside = (
+        (a["x"] >= own[0] - g)
+        & (a["x"] <= own[2] + g)
+        & (a["y"] >= own[1] - g)
+        & (a["y"] <= own[3] + g)
+    )
     info = buf.records.info
     sel = np.flatnonzero(inside)
     res = ground_filter(
-        a["x"][sel], a["y"][sel], a["z"][sel], settings.smrf,
-        return_number=a["return_number"][sel], number_of_returns=a["number_of_returns"][sel],
-        unit_to_metre=info.unit_to_metre, vertical_unit_to_metre=info.vertical_unit_to_metre,
+        a["x"][sel],
+        a["y"][sel],
+        a["z"][sel],
+        settings.smrf,
+        return_number=a["return_number"][sel],
+        number_of_returns=a["number_of_returns"][sel],
+        unit_to_metre=info.unit_to_metre,
+        vertical_unit_to_metre=info.vertical_unit_to_metre,
         unit=info.horizontal_unit,
-    )  # fmt: skip
+    )
     ground = np.zeros(len(core), bool)
     low = np.zeros(len(core), bool)
     ground[sel], low[sel] = res.ground, res.low_outlier
@@ -119,32 +128,56 @@ def process_tile(index, i: int, settings: BlockSettings, staging: str) -> TileOu
     cls[low] = LOW_NOISE_CLASS
     # core points come first in the buffered arrays, in the order of the tile's records
     name = f"{tile.name}.laz"
-    write_cloud(tile.path, os.path.join(staging, "tiles", name), classification=cls[:n_core],
-                points=buf.records)  # fmt: skip
+    write_cloud(
+        tile.path,
+        os.path.join(staging, "tiles", name),
+        classification=cls[:n_core],
+        points=buf.records,
+    )
     stages["write"] = time.perf_counter() - t0 - sum(stages.values())
     xyz = np.column_stack([a["x"], a["y"], a["z"]])
     r = settings.roof_buffer
-    near = ((a["x"] >= own[0] - r) & (a["x"] <= own[2] + r) & (a["y"] >= own[1] - r)
-            & (a["y"] <= own[3] + r))  # fmt: skip
+    near = (
+        (a["x"] >= own[0] - r)
+        & (a["x"] <= own[2] + r)
+        & (a["y"] >= own[1] - r)
+        & (a["y"] <= own[3] + r)
+    )
     near &= (cls != GROUND_CLASS) & (cls != LOW_NOISE_CLASS)
     # the band next to the border, where the tile labels as a whole-file run would
-    pieces, band = tile_planes(xyz[near], core[near], a["id"][near], own, r / 2.0,
-                               settings.roof, i)  # fmt: skip
+    pieces, band = tile_planes(xyz[near], core[near], a["id"][near], own, r / 2.0, settings.roof, i)
     # the tile's non-ground points, for the second pass of the regions cut by a buffer
     mine = near & core
-    np.savez(os.path.join(staging, ROOF_SCRATCH, f"{i}.npz"), xyz=xyz[mine], id=a["id"][mine],
-             box=np.asarray(own, dtype=np.float64))  # fmt: skip
+    np.savez(
+        os.path.join(staging, ROOF_SCRATCH, f"{i}.npz"),
+        xyz=xyz[mine],
+        id=a["id"][mine],
+        box=np.asarray(own, dtype=np.float64),
+    )
     stages["roof_planes"] = time.perf_counter() - t0 - sum(stages.values())
     stages["cpu"] = time.process_time() - c0
     ids = a["id"][:n_core]
     cx = xyz[:n_core]
     return TileOutcome(
-        i, tile.name, True, "", n_core, len(core), int(ground[:n_core].sum()),
-        int(low[:n_core].sum()), time.perf_counter() - t0, _peak_rss_mb(), buf.missing,
-        (*cx.min(axis=0).tolist(), *cx.max(axis=0).tolist()), f"tiles/{name}", pieces,
+        i,
+        tile.name,
+        True,
+        "",
+        n_core,
+        len(core),
+        int(ground[:n_core].sum()),
+        int(low[:n_core].sum()),
+        time.perf_counter() - t0,
+        _peak_rss_mb(),
+        buf.missing,
+        (*cx.min(axis=0).tolist(), *cx.max(axis=0).tolist()),
+        f"tiles/{name}",
+        pieces,
         (int(ids.min()), int(ids.max()), int(ids.sum())),
-        {k: round(t, 3) for k, t in stages.items()}, buf.decoded, band,
-    )  # fmt: skip
+        {k: round(t, 3) for k, t in stages.items()},
+        buf.decoded,
+        band,
+    )
 
 
 def control_tile(box, planes, points, plane_ids, options: ControlOptions):
@@ -155,8 +188,7 @@ def control_tile(box, planes, points, plane_ids, options: ControlOptions):
     if len(planes) < 2:
         return [], []
     res = lidar_control(planes, points, plane_ids, options)
-    lcps = [p for p in res.points
-            if box[0] <= p.xyz[0] < box[2] and box[1] <= p.xyz[1] < box[3]]  # fmt: skip
+    lcps = [p for p in res.points if box[0] <= p.xyz[0] < box[2] and box[1] <= p.xyz[1] < box[3]]
     return lcps, res.lines
 
 
@@ -176,8 +208,7 @@ def _scratch_fetch(folder: str) -> Callable[[tuple[float, float, float, float]],
                 if own[0] > box[2] or own[2] < box[0] or own[1] > box[3] or own[3] < box[1]:
                     continue
                 x, i = f["xyz"], f["id"]
-            m = ((x[:, 0] >= box[0]) & (x[:, 0] < box[2]) & (x[:, 1] >= box[1])
-                 & (x[:, 1] < box[3]))  # fmt: skip
+            m = (x[:, 0] >= box[0]) & (x[:, 0] < box[2]) & (x[:, 1] >= box[1]) & (x[:, 1] < box[3])
             xyz.append(x[m])
             ids.append(i[m])
         return np.concatenate(xyz), np.concatenate(ids)

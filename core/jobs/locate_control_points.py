@@ -82,8 +82,15 @@ shows the chips.""",
             minimum=1.0,
             maximum=1000.0,
         ),
-        Param("MIN_NCC", "number", "Smallest NCC peak", _D.min_ncc, minimum=0.0, maximum=1.0,
-              advanced=True),
+        Param(
+            "MIN_NCC",
+            "number",
+            "Smallest NCC peak",
+            _D.min_ncc,
+            minimum=0.0,
+            maximum=1.0,
+            advanced=True,
+        ),
         Param(
             "MIN_CORRELATION",
             "number",
@@ -160,8 +167,9 @@ class _Images:
         if ce <= cs or re <= rs:
             return out
         data = src.read((cs, rs, ce - cs, re - rs)).astype(np.float64)
-        grey = 0.299 * data[0] + 0.587 * data[1] + 0.114 * data[2] if data.shape[0] >= 3 \
-            else data[0]  # fmt: skip
+        grey = (
+            0.299 * data[0] + 0.587 * data[1] + 0.114 * data[2] if data.shape[0] >= 3 else data[0]
+        )
         out[rs - r0 : re - r0, cs - c0 : ce - c0] = grey
         return out
 
@@ -184,8 +192,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     reader = _Images(images)
     compute, _ = stages(progress, 0.95, 0.05)
     try:
-        res = locate_control_points(chips, sub, camera, reader, sig, opt, progress=compute,
-                                    should_stop=should_stop)  # fmt: skip
+        res = locate_control_points(
+            chips, sub, camera, reader, sig, opt, progress=compute, should_stop=should_stop
+        )
     finally:
         reader.close()
     write_observations_csv(out.path("OUTPUT"), res.observations)
@@ -201,14 +210,17 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         write_text_atomic(out.path("OUTPUT_HTML"), render_location_html(res.pairs, settings))
     counts = res.counts()
     rejected = counts.get("rejected", 0) + counts.get("outside", 0)
-    lines = [f"{len(res.observations)} observations of {len(chips)} points in {len(sub)} images;"
-             f" {rejected} rejected"]  # fmt: skip
+    lines = [
+        f"{len(res.observations)} observations of {len(chips)} points in {len(sub)} images;"
+        f" {rejected} rejected"
+    ]
     for p in res.pairs:
         if p.status != "ok":
             where = f" in {p.image_id}" if p.image_id else ""
             lines.append(f"  {p.point_id}{where}: {p.reason}")
-    return JobResult(results={"LOCATED": len(res.observations), "REJECTED": rejected},
-                     lines=lines, data=res)  # fmt: skip
+    return JobResult(
+        results={"LOCATED": len(res.observations), "REJECTED": rejected}, lines=lines, data=res
+    )
 
 
 def _read_inputs(v: Values) -> tuple:
@@ -228,29 +240,45 @@ def _read_inputs(v: Values) -> tuple:
     camera = read_camera_json(v.camera)
     eo_file = read_eo_csv_full(v.eo, crs.to_wkt())
     eo = eo_file.eo
-    check_area_of_use(crs, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
-                      what="the perspective centres", path=v.eo)  # fmt: skip
+    check_area_of_use(
+        crs, eo.xyz.min(axis=0), eo.xyz.max(axis=0), what="the perspective centres", path=v.eo
+    )
     control = read_point_control_csv(v.control_points)
-    check_area_of_use(crs, control.xyz.min(axis=0), control.xyz.max(axis=0),
-                      what="the control points", path=v.control_points)  # fmt: skip
+    check_area_of_use(
+        crs,
+        control.xyz.min(axis=0),
+        control.xyz.max(axis=0),
+        what="the control points",
+        path=v.control_points,
+    )
     chip_files = list_chips(v.chips)
     ids = list(control.ids)
     unknown = sorted(set(chip_files) - set(ids))
     if unknown:
-        raise InputError(f"chips of unknown points (not in the control table): "
-                         f"{', '.join(unknown[:10])}", path=v.control_points)  # fmt: skip
-    chips = [read_control_chip(chip_files[p], p, control.xyz[ids.index(p)], crs)
-             for p in sorted(chip_files)]  # fmt: skip
+        raise InputError(
+            f"chips of unknown points (not in the control table): {', '.join(unknown[:10])}",
+            path=v.control_points,
+        )
+    chips = [
+        read_control_chip(chip_files[p], p, control.xyz[ids.index(p)], crs)
+        for p in sorted(chip_files)
+    ]
     images = {f.stem: f for f in list_image_files(v.images)}
     lacking = sorted(set(images) - set(eo.image_id))
     if lacking:
-        raise InputError(f"no exterior orientation for image(s) {', '.join(lacking[:10])} "
-                         "(image_id = file name without extension)", path=v.eo)  # fmt: skip
+        raise InputError(
+            f"no exterior orientation for image(s) {', '.join(lacking[:10])} "
+            "(image_id = file name without extension)",
+            path=v.eo,
+        )
     for f in images.values():  # every header read before any work
         w, h = image_size(f)
         if (w, h) != (camera.width_px, camera.height_px):
-            raise InputError(f"the image is {w} x {h} px, the camera {camera.name!r} "
-                             f"{camera.width_px} x {camera.height_px} px", path=str(f))  # fmt: skip
+            raise InputError(
+                f"the image is {w} x {h} px, the camera {camera.name!r} "
+                f"{camera.width_px} x {camera.height_px} px",
+                path=str(f),
+            )
     keep = [k for k, i in enumerate(eo.image_id) if i in images]
     if not keep:
         raise InputError("no image of the EO table among the images given", path=v.eo)

@@ -60,90 +60,244 @@ inliers). A point that fails (plate not found, only one square, ambiguous, resec
 too large, too few SIFT matches, chip partly outside the photo) gets its reason and no chip;
 the others are written.""",
     params=(
-        Param("POINTS", "table", "Ground points (CSV)", file_filter=CSV_FILTER,
-              help="point_id, X, Y, Z, role (the bundle adjustment's table)"),
+        Param(
+            "POINTS",
+            "table",
+            "Ground points (CSV)",
+            file_filter=CSV_FILTER,
+            help="point_id, X, Y, Z, role (the bundle adjustment's table)",
+        ),
         Param("CRS", "crs", "Mapping CRS of the points", help="e.g. EPSG:31983"),
-        Param("CAMERA", "file", "Ground camera (JSON)", file_filter="JSON files (*.json)",
-              help="perspective or fisheye (as written by calibratecamera)"),
-        Param("PHOTO_TABLE", "table", "Ground-photo table (CSV)", optional=True,
-              file_filter=CSV_FILTER,
-              help="point_id, plate_photo, free_photo; else PHOTOS are searched by name"),
-        Param("PHOTOS", "files", "Ground photos (files or folders)", optional=True,
-              suffixes=PHOTO_SUFFIXES, help="searched by name when no table is given"),
+        Param(
+            "CAMERA",
+            "file",
+            "Ground camera (JSON)",
+            file_filter="JSON files (*.json)",
+            help="perspective or fisheye (as written by calibratecamera)",
+        ),
+        Param(
+            "PHOTO_TABLE",
+            "table",
+            "Ground-photo table (CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            help="point_id, plate_photo, free_photo; else PHOTOS are searched by name",
+        ),
+        Param(
+            "PHOTOS",
+            "files",
+            "Ground photos (files or folders)",
+            optional=True,
+            suffixes=PHOTO_SUFFIXES,
+            help="searched by name when no table is given",
+        ),
         Param("PLATE_SUFFIX", "string", "Plate photo name suffix", "_plate", advanced=True),
         Param("FREE_SUFFIX", "string", "Plate-free photo name suffix", "_free", advanced=True),
-        Param("OUTER_SIDE", "number", "Plate outer side", _P.outer_m, unit="m", minimum=0.01,
-              maximum=10.0),
-        Param("INNER_SIDE", "number", "Plate inner side", _P.inner_m, unit="m", minimum=0.005,
-              maximum=10.0),
-        Param("PLATE_HEIGHT", "number", "Plate height above the point", _P.height_m, unit="m",
-              minimum=-5.0, maximum=5.0, advanced=True),
-        Param("PLATE_AZIMUTH", "number", "Plate side azimuth (grid)", _P.azimuth_deg,
-              unit="degrees", minimum=-360.0, maximum=360.0),
-        Param("PHOTO_AZIMUTH", "number", "Photo up azimuth (grid, +-45)", 0.0, unit="degrees",
-              minimum=-360.0, maximum=360.0, advanced=True),
-        Param("GSD", "number", "Chip GSD (the aerial images')", _C.gsd_m, unit="m",
-              minimum=1e-4, maximum=100.0),
-        Param("CHIP_SIZE", "integer", "Chip size", _C.size_px, unit="pixels", minimum=3,
-              maximum=4001, advanced=True),
-        Param("MAX_SIGMA0", "number", "Largest resection sigma0", _C.max_sigma0, minimum=0.0,
-              maximum=1e6, advanced=True),
-        Param("CORNER_SIGMA", "number", "Corner sigma (0 = from the line fits)",
-              _C.corner_sigma_px, unit="pixels", minimum=0.0, maximum=100.0, advanced=True),
-        Param("SIFT_RATIO", "number", "SIFT ratio test", _C.sift_ratio, minimum=0.1,
-              maximum=0.99, advanced=True),
-        Param("RANSAC_THRESHOLD", "number", "RANSAC threshold", _C.ransac_px, unit="pixels",
-              minimum=0.1, maximum=100.0, advanced=True),
-        Param("MIN_MATCHES", "integer", "Fewest SIFT inliers", _C.min_matches, minimum=6,
-              maximum=100000, advanced=True),
-        Param("FROM_PLATE_PHOTO", "boolean", "Chip from the plate photo when no plate-free "
-              "photo", _C.from_plate_photo),
+        Param(
+            "OUTER_SIDE",
+            "number",
+            "Plate outer side",
+            _P.outer_m,
+            unit="m",
+            minimum=0.01,
+            maximum=10.0,
+        ),
+        Param(
+            "INNER_SIDE",
+            "number",
+            "Plate inner side",
+            _P.inner_m,
+            unit="m",
+            minimum=0.005,
+            maximum=10.0,
+        ),
+        Param(
+            "PLATE_HEIGHT",
+            "number",
+            "Plate height above the point",
+            _P.height_m,
+            unit="m",
+            minimum=-5.0,
+            maximum=5.0,
+            advanced=True,
+        ),
+        Param(
+            "PLATE_AZIMUTH",
+            "number",
+            "Plate side azimuth (grid)",
+            _P.azimuth_deg,
+            unit="degrees",
+            minimum=-360.0,
+            maximum=360.0,
+        ),
+        Param(
+            "PHOTO_AZIMUTH",
+            "number",
+            "Photo up azimuth (grid, +-45)",
+            0.0,
+            unit="degrees",
+            minimum=-360.0,
+            maximum=360.0,
+            advanced=True,
+        ),
+        Param(
+            "GSD",
+            "number",
+            "Chip GSD (the aerial images')",
+            _C.gsd_m,
+            unit="m",
+            minimum=1e-4,
+            maximum=100.0,
+        ),
+        Param(
+            "CHIP_SIZE",
+            "integer",
+            "Chip size",
+            _C.size_px,
+            unit="pixels",
+            minimum=3,
+            maximum=4001,
+            advanced=True,
+        ),
+        Param(
+            "MAX_SIGMA0",
+            "number",
+            "Largest resection sigma0",
+            _C.max_sigma0,
+            minimum=0.0,
+            maximum=1e6,
+            advanced=True,
+        ),
+        Param(
+            "CORNER_SIGMA",
+            "number",
+            "Corner sigma (0 = from the line fits)",
+            _C.corner_sigma_px,
+            unit="pixels",
+            minimum=0.0,
+            maximum=100.0,
+            advanced=True,
+        ),
+        Param(
+            "SIFT_RATIO",
+            "number",
+            "SIFT ratio test",
+            _C.sift_ratio,
+            minimum=0.1,
+            maximum=0.99,
+            advanced=True,
+        ),
+        Param(
+            "RANSAC_THRESHOLD",
+            "number",
+            "RANSAC threshold",
+            _C.ransac_px,
+            unit="pixels",
+            minimum=0.1,
+            maximum=100.0,
+            advanced=True,
+        ),
+        Param(
+            "MIN_MATCHES",
+            "integer",
+            "Fewest SIFT inliers",
+            _C.min_matches,
+            minimum=6,
+            maximum=100000,
+            advanced=True,
+        ),
+        Param(
+            "FROM_PLATE_PHOTO",
+            "boolean",
+            "Chip from the plate photo when no plate-free photo",
+            _C.from_plate_photo,
+        ),
         Param("OUTPUT_FOLDER", "folder_out", "Output folder"),
     ),
     results=(
         Result("CHIP_COUNT", "number", "Chips written"),
         Result("FAILED_COUNT", "number", "Points without a chip"),
     ),
-    tags=("control chip", "control plate", "ground photo", "sift", "rectification",
-          "control points", "resection"),
-    references=("Berveglieri & Tommaselli (2014)", "Tommaselli & Berveglieri (2014)",
-                "Lowe (2004)", "Garrido-Jurado et al. (2014)"),
-)  # fmt: skip
+    tags=(
+        "control chip",
+        "control plate",
+        "ground photo",
+        "sift",
+        "rectification",
+        "control points",
+        "resection",
+    ),
+    references=(
+        "Berveglieri & Tommaselli (2014)",
+        "Tommaselli & Berveglieri (2014)",
+        "Lowe (2004)",
+        "Garrido-Jurado et al. (2014)",
+    ),
+)
 
 
 def _report_row(pid, xyz, pair, res) -> dict:
     """The report's row (CSV columns, plus the JSON details under their own keys)."""
-    row = {"point_id": pid, "status": res.status, "reason": res.reason,
-           "X": float(xyz[0]), "Y": float(xyz[1]), "Z": float(xyz[2]),
-           "plate_photo": pair.plate_photo if pair else "",
-           "free_photo": (pair.free_photo or "") if pair else "", "source": res.source,
-           "corners_found": 0}  # fmt: skip
+    row = {
+        "point_id": pid,
+        "status": res.status,
+        "reason": res.reason,
+        "X": float(xyz[0]),
+        "Y": float(xyz[1]),
+        "Z": float(xyz[2]),
+        "plate_photo": pair.plate_photo if pair else "",
+        "free_photo": (pair.free_photo or "") if pair else "",
+        "source": res.source,
+        "corners_found": 0,
+    }
     det = res.detection
     if det is not None and det.found:
-        row.update(corners_found=8, corner_sigma_max_px=float(det.sigma_px.max()),
-                   edge_rms_max_px=float(det.edge_rms_px.max()),
-                   corners_px=det.corners_px.tolist(), corner_sigma_px=det.sigma_px.tolist(),
-                   edge_rms_px=det.edge_rms_px.tolist(),
-                   edge_points=det.edge_points.tolist())  # fmt: skip
+        row.update(
+            corners_found=8,
+            corner_sigma_max_px=float(det.sigma_px.max()),
+            edge_rms_max_px=float(det.edge_rms_px.max()),
+            corners_px=det.corners_px.tolist(),
+            corner_sigma_px=det.sigma_px.tolist(),
+            edge_rms_px=det.edge_rms_px.tolist(),
+            edge_points=det.edge_points.tolist(),
+        )
     pr = res.plate
     if pr is not None:
         std = pr.std
-        row.update(resection_sigma0=pr.sigma0, sigma_X0=float(std[0]), sigma_Y0=float(std[1]),
-                   sigma_Z0=float(std[2]), sigma_omega_deg=math.degrees(std[3]),
-                   sigma_phi_deg=math.degrees(std[4]), sigma_kappa_deg=math.degrees(std[5]),
-                   azimuth_misfit_deg=pr.azimuth_misfit_deg,
-                   plate_eo=[float(xyz[0] + pr.eo[0]), float(xyz[1] + pr.eo[1]),
-                             float(xyz[2] + pr.eo[2]), *map(math.degrees, pr.eo[3:])],
-                   corner_residuals_px=pr.residuals_px.tolist(),
-                   corner_rejected=pr.rejected.tolist())  # fmt: skip
+        row.update(
+            resection_sigma0=pr.sigma0,
+            sigma_X0=float(std[0]),
+            sigma_Y0=float(std[1]),
+            sigma_Z0=float(std[2]),
+            sigma_omega_deg=math.degrees(std[3]),
+            sigma_phi_deg=math.degrees(std[4]),
+            sigma_kappa_deg=math.degrees(std[5]),
+            azimuth_misfit_deg=pr.azimuth_misfit_deg,
+            plate_eo=[
+                float(xyz[0] + pr.eo[0]),
+                float(xyz[1] + pr.eo[1]),
+                float(xyz[2] + pr.eo[2]),
+                *map(math.degrees, pr.eo[3:]),
+            ],
+            corner_residuals_px=pr.residuals_px.tolist(),
+            corner_rejected=pr.rejected.tolist(),
+        )
     if res.sift is not None:
         row.update(sift_matches=res.sift.matches, sift_inliers=len(res.sift.ref_px))
     if res.free_eo is not None:
         e = res.free_eo
-        row.update(free_sigma0=res.free_sigma0, valid_fraction=res.valid_fraction,
-                   chip_eo=[float(xyz[0] + e[0]), float(xyz[1] + e[1]), float(xyz[2] + e[2]),
-                            *map(math.degrees, e[3:])],
-                   subsamples=res.subsamples, notes=list(res.notes))  # fmt: skip
+        row.update(
+            free_sigma0=res.free_sigma0,
+            valid_fraction=res.valid_fraction,
+            chip_eo=[
+                float(xyz[0] + e[0]),
+                float(xyz[1] + e[1]),
+                float(xyz[2] + e[2]),
+                *map(math.degrees, e[3:]),
+            ],
+            subsamples=res.subsamples,
+            notes=list(res.notes),
+        )
     return row
 
 
@@ -164,9 +318,12 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     targets = {pid: folder / f"{pid}.tif" for pid in ids}
     targets["__csv"] = folder / REPORT_CSV
     targets["__json"] = folder / REPORT_JSON
-    inputs = {"POINTS": v.points, "CAMERA": v.camera, "PHOTO_TABLE": v.photo_table,
-              "PHOTOS": [x for p in pairs.values() for x in (p.plate_photo, p.free_photo)
-                         if x]}  # fmt: skip
+    inputs = {
+        "POINTS": v.points,
+        "CAMERA": v.camera,
+        "PHOTO_TABLE": v.photo_table,
+        "PHOTOS": [x for p in pairs.values() for x in (p.plate_photo, p.free_photo) if x],
+    }
     xyz_of = dict(zip(points.point_id, points.xyz))
     rows = []
     written = 0
@@ -185,18 +342,30 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         write_report_json(files.path("__json"), rows)
         files.commit()
     failed = len(rows) - written
-    lines = [f"{written} chip(s) of {v.chip_size} x {v.chip_size} px at {v.gsd:g} m in "
-             f"{folder}; {failed} point(s) without a chip"]  # fmt: skip
+    lines = [
+        f"{written} chip(s) of {v.chip_size} x {v.chip_size} px at {v.gsd:g} m in "
+        f"{folder}; {failed} point(s) without a chip"
+    ]
     lines += [f"  {r['point_id']}: {r['reason']}" for r in rows if r["status"] != "ok"]
-    return JobResult(results={"CHIP_COUNT": written, "FAILED_COUNT": failed}, lines=lines,
-                     data=rows)  # fmt: skip
+    return JobResult(
+        results={"CHIP_COUNT": written, "FAILED_COUNT": failed}, lines=lines, data=rows
+    )
 
 
 def _without_photo(point_ids, pairs: dict, xyz_of: dict) -> list[dict]:
     """The report's rows of the points without a plate photo (no chip)."""
-    return [{"point_id": pid, "status": "failed", "reason": "no plate photo",
-             "X": float(xyz_of[pid][0]), "Y": float(xyz_of[pid][1]), "Z": float(xyz_of[pid][2])}
-            for pid in point_ids if pid not in pairs]  # fmt: skip
+    return [
+        {
+            "point_id": pid,
+            "status": "failed",
+            "reason": "no plate photo",
+            "X": float(xyz_of[pid][0]),
+            "Y": float(xyz_of[pid][1]),
+            "Z": float(xyz_of[pid][2]),
+        }
+        for pid in point_ids
+        if pid not in pairs
+    ]
 
 
 def _read_inputs(v: Values) -> tuple:
@@ -211,8 +380,9 @@ def _read_inputs(v: Values) -> tuple:
 
     points = read_ground_points_csv(v.points)
     crs = parse_crs(v.crs, what="mapping CRS")
-    check_area_of_use(crs, points.xyz.min(axis=0), points.xyz.max(axis=0),
-                      what="the ground points", path=v.points)  # fmt: skip
+    check_area_of_use(
+        crs, points.xyz.min(axis=0), points.xyz.max(axis=0), what="the ground points", path=v.points
+    )
     # any central projection: the plate's edges, the resection, the registration and the
     # rectification all go through the camera's own projection (a nadir fisheye, as in the
     # source)
@@ -221,18 +391,21 @@ def _read_inputs(v: Values) -> tuple:
         pairs = read_photo_table(v.photo_table)
         unknown = [p for p in pairs if p not in points.point_id]
         if unknown:
-            raise InputError(f"point(s) not in the ground points: {', '.join(unknown[:10])}",
-                             path=v.photo_table)  # fmt: skip
+            raise InputError(
+                f"point(s) not in the ground points: {', '.join(unknown[:10])}", path=v.photo_table
+            )
     elif v.photos:
         pairs = find_photo_pairs(v.photos, points.point_id, v.plate_suffix, v.free_suffix)
     else:
         raise InputError("give a ground-photo table (PHOTO_TABLE) or photos (PHOTOS)")
     if not pairs:
-        raise InputError(f"no plate photo found for any point (names <point_id>"
-                         f"{v.plate_suffix}.<ext>)")  # fmt: skip
+        raise InputError(
+            f"no plate photo found for any point (names <point_id>{v.plate_suffix}.<ext>)"
+        )
     if not v.inner_side < v.outer_side:
-        raise InputError(f"INNER_SIDE ({v.inner_side:g} m) must be smaller than OUTER_SIDE "
-                         f"({v.outer_side:g} m)")  # fmt: skip
+        raise InputError(
+            f"INNER_SIDE ({v.inner_side:g} m) must be smaller than OUTER_SIDE ({v.outer_side:g} m)"
+        )
     return points, crs, camera, pairs
 
 
@@ -247,9 +420,11 @@ def _check_photos(pairs: dict, camera) -> None:
                 with RasterReader(path) as src:
                     w, h = src.info.width, src.info.height
                 if (w, h) != (camera.width_px, camera.height_px):
-                    raise InputError(f"the photo is {w} x {h} px, the camera {camera.name!r} "
-                                     f"{camera.width_px} x {camera.height_px} px",
-                                     path=path)  # fmt: skip
+                    raise InputError(
+                        f"the photo is {w} x {h} px, the camera {camera.name!r} "
+                        f"{camera.width_px} x {camera.height_px} px",
+                        path=path,
+                    )
 
 
 def _chip(v: Values, pid: str, xyz, pair, camera, options, crs, files) -> dict:
@@ -261,13 +436,18 @@ def _chip(v: Values, pid: str, xyz, pair, camera, options, crs, files) -> dict:
     from ..photo.control_plate import PlateGeometry
 
     plate = PlateGeometry(
-        v.outer_side, v.inner_side, v.plate_height,
+        v.outer_side,
+        v.inner_side,
+        v.plate_height,
         v.plate_azimuth if math.isnan(pair.plate_azimuth_deg) else pair.plate_azimuth_deg,
-    )  # fmt: skip
+    )
     az = v.photo_azimuth if math.isnan(pair.photo_azimuth_deg) else pair.photo_azimuth_deg
     ref = read_grey_photo(pair.plate_photo, camera.width_px, camera.height_px)
-    free = (read_grey_photo(pair.free_photo, camera.width_px, camera.height_px)
-            if pair.free_photo else None)  # fmt: skip
+    free = (
+        read_grey_photo(pair.free_photo, camera.width_px, camera.height_px)
+        if pair.free_photo
+        else None
+    )
     res: ChipResult = make_chip(pid, xyz, ref, free, camera, plate, options, az)
     row = _report_row(pid, xyz, pair, res)
     if res.status == "ok":

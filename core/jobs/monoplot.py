@@ -52,36 +52,109 @@ projection's field: no ray).""",
         Param("OBSERVATIONS", "table", "Image observations (CSV)", file_filter=CSV_FILTER),
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
         Param("EO", "table", "Exterior orientation (CSV)", file_filter=CSV_FILTER),
-        Param("DSM", "surface", "DSM (raster, or LAS/LAZ)",
-              file_filter="DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"),
+        Param(
+            "DSM",
+            "surface",
+            "DSM (raster, or LAS/LAZ)",
+            file_filter="DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)",
+        ),
         Param("PLANES", "table", "Roof plane table (CSV)", optional=True, file_filter=CSV_FILTER),
         Param("CRS", "crs", "Mapping CRS of the EO", help="e.g. EPSG:28992"),
-        Param("DSM_CRS", "crs", "DSM CRS (overrides the file's)", optional=True,
-              help="the DSM's CRS when the file has none or a wrong one; a 2D CRS takes the "
-              "heights as ellipsoidal", advanced=True),
-        Param("METHOD", "enum", "Method",
-              Ref("photo.monoplot_options", "METHODS", convert=lambda methods: methods[0]),
-              options=Ref("photo.monoplot_options", "METHODS"),
-              labels=("direct (Dal Poz, DDA)", "Makarovic iteration")),
-        Param("CELL_SIZE", "number", "DSM cell size for LAS/LAZ", 0.5, unit="CRS unit",
-              minimum=0.01, maximum=1000.0, advanced=True),
-        Param("SIGMA_DSM", "number", "DSM height sigma", 0.10, unit="m", minimum=0.0,
-              maximum=100.0, advanced=True),
-        Param("LINE_STEP", "number", "Points along lines every (0 = end points)", 0.0,
-              unit="pixels", minimum=0.0, maximum=1e6, advanced=True),
-        Param("MIN_INCIDENCE", "number", "Minimum angle ray / face", 5.0, unit="degrees",
-              minimum=0.0, maximum=90.0, advanced=True),
-        Param("EO_SIGMAS", "numbers", "EO sigmas: X, Y, Z, omega, phi, kappa",
-              Ref("photo.monoplot_options", "DEFAULT_EO_SIGMAS"),
-              count=6, unit="m, degrees", minimum=0.0, maximum=100.0, advanced=True),
+        Param(
+            "DSM_CRS",
+            "crs",
+            "DSM CRS (overrides the file's)",
+            optional=True,
+            help="the DSM's CRS when the file has none or a wrong one; a 2D CRS takes the "
+            "heights as ellipsoidal",
+            advanced=True,
+        ),
+        Param(
+            "METHOD",
+            "enum",
+            "Method",
+            Ref("photo.monoplot_options", "METHODS", convert=lambda methods: methods[0]),
+            options=Ref("photo.monoplot_options", "METHODS"),
+            labels=("direct (Dal Poz, DDA)", "Makarovic iteration"),
+        ),
+        Param(
+            "CELL_SIZE",
+            "number",
+            "DSM cell size for LAS/LAZ",
+            0.5,
+            unit="CRS unit",
+            minimum=0.01,
+            maximum=1000.0,
+            advanced=True,
+        ),
+        Param(
+            "SIGMA_DSM",
+            "number",
+            "DSM height sigma",
+            0.10,
+            unit="m",
+            minimum=0.0,
+            maximum=100.0,
+            advanced=True,
+        ),
+        Param(
+            "LINE_STEP",
+            "number",
+            "Points along lines every (0 = end points)",
+            0.0,
+            unit="pixels",
+            minimum=0.0,
+            maximum=1e6,
+            advanced=True,
+        ),
+        Param(
+            "MIN_INCIDENCE",
+            "number",
+            "Minimum angle ray / face",
+            5.0,
+            unit="degrees",
+            minimum=0.0,
+            maximum=90.0,
+            advanced=True,
+        ),
+        Param(
+            "EO_SIGMAS",
+            "numbers",
+            "EO sigmas: X, Y, Z, omega, phi, kappa",
+            Ref("photo.monoplot_options", "DEFAULT_EO_SIGMAS"),
+            count=6,
+            unit="m, degrees",
+            minimum=0.0,
+            maximum=100.0,
+            advanced=True,
+        ),
         Param("OUTPUT_POINTS", "sink", "Monoplotted points", geometry="point", optional=True),
         Param("OUTPUT_LINES", "sink", "Monoplotted lines", geometry="line", optional=True),
-        Param("OUTPUT_CSV", "file_out", "Point table (CSV)", optional=True,
-              create_by_default=False, file_filter=CSV_OUT, layer_twin="OUTPUT_POINTS"),
-        Param("LINES_CSV", "file_out", "Line table", optional=True, create_by_default=False,
-              file_filter=CSV_OUT),
-        Param("OUTPUT_DSM", "raster_out", "DSM made from the LAS/LAZ", optional=True,
-              create_by_default=False, advanced=True),
+        Param(
+            "OUTPUT_CSV",
+            "file_out",
+            "Point table (CSV)",
+            optional=True,
+            create_by_default=False,
+            file_filter=CSV_OUT,
+            layer_twin="OUTPUT_POINTS",
+        ),
+        Param(
+            "LINES_CSV",
+            "file_out",
+            "Line table",
+            optional=True,
+            create_by_default=False,
+            file_filter=CSV_OUT,
+        ),
+        Param(
+            "OUTPUT_DSM",
+            "raster_out",
+            "DSM made from the LAS/LAZ",
+            optional=True,
+            create_by_default=False,
+            advanced=True,
+        ),
     ),
     results=(
         Result("POINT_COUNT", "number", "Rays monoplotted"),
@@ -100,10 +173,20 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     load, compute = stages(progress, 0.4, 0.6)
     dsm = _load_dsm(v, load, should_stop)
     result = monoplot(
-        obs, camera, eo, dsm, v.crs, method=v.method, sigma_dsm=v.sigma_dsm,
-        eo_sigmas=v.eo_sigmas, planes=planes, line_step_px=v.line_step,
-        min_incidence_deg=v.min_incidence, progress=compute, should_stop=should_stop,
-    )  # fmt: skip
+        obs,
+        camera,
+        eo,
+        dsm,
+        v.crs,
+        method=v.method,
+        sigma_dsm=v.sigma_dsm,
+        eo_sigmas=v.eo_sigmas,
+        planes=planes,
+        line_step_px=v.line_step,
+        min_incidence_deg=v.min_incidence,
+        progress=compute,
+        should_stop=should_stop,
+    )
     _write_tables(out, result)
     hits = int(sum(int(s) in (0, 1) for s in result.status))
     return JobResult(
@@ -126,12 +209,20 @@ def _read_inputs(v: Values) -> tuple:
     camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     obs = read_observations_csv(v.observations, camera=camera)
     eo = read_eo_csv(v.eo)
-    check_area_of_use(parse_crs(v.crs, what="CRS"), eo.xyz.min(axis=0), eo.xyz.max(axis=0),
-                      what="the perspective centres", path=v.eo)  # fmt: skip
+    check_area_of_use(
+        parse_crs(v.crs, what="CRS"),
+        eo.xyz.min(axis=0),
+        eo.xyz.max(axis=0),
+        what="the perspective centres",
+        path=v.eo,
+    )
     planes = read_planes_csv(v.planes) if v.planes else ()
     rays = ray_count(obs, v.line_step)
-    check_memory(rays * BYTES_PER_RAY, f"LINE_STEP {v.line_step:g} px: {rays} rays",
-                 "give a larger step (or 0: the end points only)")  # fmt: skip
+    check_memory(
+        rays * BYTES_PER_RAY,
+        f"LINE_STEP {v.line_step:g} px: {rays} rays",
+        "give a larger step (or 0: the end points only)",
+    )
     return camera, obs, eo, planes
 
 
@@ -146,12 +237,22 @@ def _load_dsm(v: Values, progress, should_stop):
     if Path(v.dsm).suffix.lower() in CLOUD_SUFFIXES:
         info = read_info(v.dsm, v.dsm_crs, require_crs=False)
         unit = info.horizontal_unit if info.crs is not None else "CRS unit"
-        check_cell_size("CELL_SIZE", v.cell_size, unit, info.mins[:2], info.maxs[:2],
-                        DSM_BYTES_PER_CELL, extra_bytes=40.0 * info.point_count)  # fmt: skip
+        check_cell_size(
+            "CELL_SIZE",
+            v.cell_size,
+            unit,
+            info.mins[:2],
+            info.maxs[:2],
+            DSM_BYTES_PER_CELL,
+            extra_bytes=40.0 * info.point_count,
+        )
     dsm = load_dsm(v.dsm, v.cell_size, v.dsm_crs, progress=progress, should_stop=should_stop)
     rows, cols = dsm.heights.shape
-    check_memory(float(rows) * cols * DSM_BYTES_PER_CELL,
-                 f"the DSM of {rows} x {cols} cells ({v.dsm})", "give a coarser DSM")  # fmt: skip
+    check_memory(
+        float(rows) * cols * DSM_BYTES_PER_CELL,
+        f"the DSM of {rows} x {cols} cells ({v.dsm})",
+        "give a coarser DSM",
+    )
     return dsm
 
 
@@ -172,6 +273,7 @@ def ray_count(obs, line_step_px: float) -> int:
     """How many rays :func:`~lidarphoto.core.photo.monoplot.monoplot` will cast: one per
     observation row plus, with ``line_step_px > 0``, the points added along each line."""
     import numpy as np
+
     total = len(obs)
     if line_step_px <= 0:
         return total
@@ -184,4 +286,3 @@ def ray_count(obs, line_step_px: float) -> int:
         length = np.linalg.norm(np.diff(px, axis=0), axis=1)
         total += int(np.sum(np.maximum(np.ceil(length / line_step_px) - 1, 0)))
     return total
-

@@ -46,17 +46,40 @@ the region each image fills, as a layer and as a CSV (image_id, cells, area, WKT
 MultiPolygon in the mosaic's CRS).""",
     params=(
         Param("ORTHOPHOTOS", "files", "Orthophotos (files or folders)", suffixes=IMAGE_SUFFIXES),
-        Param("METHOD", "enum", "Image chosen per cell", _D.method,
-              options=Ref("photo.ortho_options", "MOSAIC_METHODS"),
-              labels=("most nadir view", "nearest image centre")),
-        Param("FEATHER", "number", "Feathering width across seamlines (0 = none)",
-              _D.feather_px, unit="cells", minimum=0.0, maximum=1000.0),
+        Param(
+            "METHOD",
+            "enum",
+            "Image chosen per cell",
+            _D.method,
+            options=Ref("photo.ortho_options", "MOSAIC_METHODS"),
+            labels=("most nadir view", "nearest image centre"),
+        ),
+        Param(
+            "FEATHER",
+            "number",
+            "Feathering width across seamlines (0 = none)",
+            _D.feather_px,
+            unit="cells",
+            minimum=0.0,
+            maximum=1000.0,
+        ),
         compression_param(),
         Param("OUTPUT", "raster_out", "Orthomosaic"),
-        Param("OUTPUT_SEAMLINES", "sink", "Seamlines (region of each image)",
-              geometry="polygon", optional=True),
-        Param("SEAMLINES_CSV", "file_out", "Seamline table (CSV)", optional=True,
-              create_by_default=False, file_filter=CSV_OUT),
+        Param(
+            "OUTPUT_SEAMLINES",
+            "sink",
+            "Seamlines (region of each image)",
+            geometry="polygon",
+            optional=True,
+        ),
+        Param(
+            "SEAMLINES_CSV",
+            "file_out",
+            "Seamline table (CSV)",
+            optional=True,
+            create_by_default=False,
+            file_filter=CSV_OUT,
+        ),
     ),
     results=(
         Result("SOURCE_COUNT", "number", "Orthophotos mosaicked"),
@@ -64,7 +87,7 @@ MultiPolygon in the mosaic's CRS).""",
     ),
     tags=("orthomosaic", "mosaic", "seamline", "feathering", "true orthophoto"),
     references=("Amhar, Jansa & Ries (1998)",),
-)  # fmt: skip
+)
 
 
 @dataclass(frozen=True)
@@ -111,23 +134,28 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         crs, sources = _sources(files, readers)
         method = mosaic_method(v.method, sources)
         if method != v.method:
-            log.warning("some orthophotos have no perspective centre in their metadata (not "
-                        "made by orthorectify): every cell takes the nearest image centre")
+            log.warning(
+                "some orthophotos have no perspective centre in their metadata (not "
+                "made by orthorectify): every cell takes the nearest image centre"
+            )
         grid = mosaic_grid(sources)
         options = options_from(MosaicOptions, SPEC, v, method=method)
         # seamlines are traced on a raster of the chosen image (coarser for huge mosaics)
         step = max(1, math.ceil(math.sqrt(grid.rows * grid.cols / MAX_LABEL_CELLS)))
         mosaic, seams = stages(progress, 0.9, 0.1)
-        covered, labels = _write_mosaic(v, out, readers, sources, grid, crs, options, step,
-                                        mosaic, should_stop)  # fmt: skip
+        covered, labels = _write_mosaic(
+            v, out, readers, sources, grid, crs, options, step, mosaic, should_stop
+        )
     finally:
         for r in readers:
             r.close()
     gt_lab = (grid.x0, grid.cell * step, 0.0, grid.y_top, 0.0, -grid.cell * step)
     regions = polygonize(labels, gt_lab)
     counts = np.bincount(labels[labels >= 0].ravel(), minlength=len(sources)) * step * step
-    seamlines = [Seamline(sources[k].name, int(counts[k]), float(counts[k]) * grid.cell**2, wkt)
-                 for k, wkt in regions.items()]  # fmt: skip
+    seamlines = [
+        Seamline(sources[k].name, int(counts[k]), float(counts[k]) * grid.cell**2, wkt)
+        for k, wkt in regions.items()
+    ]
     if seams is not None:
         seams(1.0)
     if out.requested("SEAMLINES_CSV"):
@@ -136,11 +164,13 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     frac = covered / max(grid.rows * grid.cols, 1)
     return JobResult(
         results={"SOURCE_COUNT": len(sources), "COVERED_FRACTION": frac},
-        lines=[f"mosaic of {len(sources)} orthophoto(s): {grid.cols} x {grid.rows} cells of "
-               f"{grid.cell:g}, {100 * frac:.1f} % with data; {len(seamlines)} seamline "
-               f"region(s)" + (f" (traced every {step} cells)" if step > 1 else "")],
+        lines=[
+            f"mosaic of {len(sources)} orthophoto(s): {grid.cols} x {grid.rows} cells of "
+            f"{grid.cell:g}, {100 * frac:.1f} % with data; {len(seamlines)} seamline "
+            f"region(s)" + (f" (traced every {step} cells)" if step > 1 else "")
+        ],
         data=MosaicResult(seamlines, crs.to_wkt() if crs else "", str(out.target("OUTPUT"))),
-    )  # fmt: skip
+    )
 
 
 def _sources(files: list, readers: list) -> tuple:
@@ -161,27 +191,40 @@ def _sources(files: list, readers: list) -> tuple:
         if gt is None or gt[2] or gt[4] or not math.isclose(gt[1], -gt[5], rel_tol=1e-9):
             raise InputError("not a north-up raster with square cells", path=str(f))
         if (info.bands, info.dtype) != (first.bands, first.dtype):
-            raise InputError(f"{info.bands} band(s) of {info.dtype}, the first orthophoto "
-                             f"{first.bands} of {first.dtype}", path=str(f))  # fmt: skip
+            raise InputError(
+                f"{info.bands} band(s) of {info.dtype}, the first orthophoto "
+                f"{first.bands} of {first.dtype}",
+                path=str(f),
+            )
         other = pyproj.CRS.from_wkt(info.crs_wkt) if info.crs_wkt else None
         if (other is None) != (crs is None) or (
             other is not None and not other.equals(crs, ignore_axis_order=True)
         ):
-            raise InputError(f"CRS '{other.name if other else 'none'}' differs from the "
-                             f"first orthophoto's '{crs.name if crs else 'none'}'",
-                             path=str(f))  # fmt: skip
+            raise InputError(
+                f"CRS '{other.name if other else 'none'}' differs from the "
+                f"first orthophoto's '{crs.name if crs else 'none'}'",
+                path=str(f),
+            )
         meta = info.metadata
         centre = _floats(meta.get("LIDARPHOTO_CENTRE"), 3)
         ground = _floats(meta.get("LIDARPHOTO_GROUND_Z"), 1)
         pg = _floats(meta.get("LIDARPHOTO_PRINCIPAL_GROUND"), 2)
         name = meta.get("LIDARPHOTO_IMAGE_ID") or f.stem
-        sources.append(MosaicSource(name, Grid(gt[0], gt[3], gt[1], info.height, info.width),
-                                    centre, ground[0] if ground else None, pg))  # fmt: skip
+        sources.append(
+            MosaicSource(
+                name,
+                Grid(gt[0], gt[3], gt[1], info.height, info.width),
+                centre,
+                ground[0] if ground else None,
+                pg,
+            )
+        )
     return crs, sources
 
 
-def _write_mosaic(v: Values, out, readers, sources, grid, crs, options, step: int, progress,
-                  should_stop) -> tuple:  # fmt: skip
+def _write_mosaic(
+    v: Values, out, readers, sources, grid, crs, options, step: int, progress, should_stop
+) -> tuple:
     """Write OUTPUT tile by tile: (the cells with data, the raster of the chosen image's index
     every ``step`` cells, -1 where none)."""
     import numpy as np
@@ -200,12 +243,33 @@ def _write_mosaic(v: Values, out, readers, sources, grid, crs, options, step: in
     photometric = "RGB" if first.bands == 3 and first.dtype == np.uint8 else None
     covered = 0
     meta_out = {"LIDARPHOTO_SOURCES": ",".join(s.name for s in sources)}
-    with failures_named(out.target("OUTPUT")), GeoTiffWriter(
-            out.path("OUTPUT"), grid.cols, grid.rows, first.bands, first.dtype,
-            grid.geotransform, crs, mask=True, tile=512, photometric=photometric,
-            metadata=meta_out, **compression_args(v.compression)) as writer:  # fmt: skip
-        for tile in mosaic_tiles(sources, grid, read, first.bands, first.dtype, options,
-                                 progress=progress, should_stop=should_stop):  # fmt: skip
+    with (
+        failures_named(out.target("OUTPUT")),
+        GeoTiffWriter(
+            out.path("OUTPUT"),
+            grid.cols,
+            grid.rows,
+            first.bands,
+            first.dtype,
+            grid.geotransform,
+            crs,
+            mask=True,
+            tile=512,
+            photometric=photometric,
+            metadata=meta_out,
+            **compression_args(v.compression),
+        ) as writer,
+    ):
+        for tile in mosaic_tiles(
+            sources,
+            grid,
+            read,
+            first.bands,
+            first.dtype,
+            options,
+            progress=progress,
+            should_stop=should_stop,
+        ):
             writer.write(tile.data, tile.col0, tile.row0, tile.valid)
             covered += int(np.count_nonzero(tile.valid))
             r_first = (-tile.row0) % step

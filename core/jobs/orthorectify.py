@@ -62,24 +62,68 @@ Nothing is written when an input is wrong; the files appear together when all ar
     params=(
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
         Param("EO", "table", "Exterior orientation (CSV)", file_filter=CSV_FILTER),
-        Param("IMAGES", "files", "Images (files or folders)", suffixes=IMAGE_SUFFIXES,
-              help="image files, or folders whose images are all taken"),
-        Param("DSM", "surface", "DSM or DTM (raster, or LAS/LAZ)", file_filter=DSM_FILTER,
-              help="a raster (the file of a raster layer) or a LAS/LAZ cloud"),
+        Param(
+            "IMAGES",
+            "files",
+            "Images (files or folders)",
+            suffixes=IMAGE_SUFFIXES,
+            help="image files, or folders whose images are all taken",
+        ),
+        Param(
+            "DSM",
+            "surface",
+            "DSM or DTM (raster, or LAS/LAZ)",
+            file_filter=DSM_FILTER,
+            help="a raster (the file of a raster layer) or a LAS/LAZ cloud",
+        ),
         Param("CRS", "crs", "Mapping CRS of the EO", help="e.g. EPSG:28992"),
         Param("DSM_CRS", "crs", "DSM CRS (if the file has none)", optional=True),
-        Param("CELL_SIZE", "number", "DSM cell size for LAS/LAZ", 0.5, unit="CRS unit",
-              minimum=0.01, maximum=1000.0),
-        Param("GSD", "number", "Output cell size (0 = image GSD)", _D.gsd, unit="CRS unit",
-              minimum=0.0, maximum=1000.0),
-        Param("EXTENT", "numbers", "Extent xmin,ymin,xmax,ymax (empty = footprint)", count=4,
-              optional=True, unit="CRS unit"),
-        Param("RESAMPLING", "enum", "Resampling", _D.resampling,
-              options=Ref("photo.ortho_options", "RESAMPLING")),
-        Param("TRUE_ORTHO", "boolean", "True orthophoto (occluded ground = no data)",
-              _D.true_ortho),
-        Param("OCCLUSION_TOLERANCE", "number", "Occlusion tolerance along the ray",
-              _D.occlusion_tol_m, unit="CRS unit", minimum=0.0, maximum=100.0, advanced=True),
+        Param(
+            "CELL_SIZE",
+            "number",
+            "DSM cell size for LAS/LAZ",
+            0.5,
+            unit="CRS unit",
+            minimum=0.01,
+            maximum=1000.0,
+        ),
+        Param(
+            "GSD",
+            "number",
+            "Output cell size (0 = image GSD)",
+            _D.gsd,
+            unit="CRS unit",
+            minimum=0.0,
+            maximum=1000.0,
+        ),
+        Param(
+            "EXTENT",
+            "numbers",
+            "Extent xmin,ymin,xmax,ymax (empty = footprint)",
+            count=4,
+            optional=True,
+            unit="CRS unit",
+        ),
+        Param(
+            "RESAMPLING",
+            "enum",
+            "Resampling",
+            _D.resampling,
+            options=Ref("photo.ortho_options", "RESAMPLING"),
+        ),
+        Param(
+            "TRUE_ORTHO", "boolean", "True orthophoto (occluded ground = no data)", _D.true_ortho
+        ),
+        Param(
+            "OCCLUSION_TOLERANCE",
+            "number",
+            "Occlusion tolerance along the ray",
+            _D.occlusion_tol_m,
+            unit="CRS unit",
+            minimum=0.0,
+            maximum=100.0,
+            advanced=True,
+        ),
         compression_param(),
         Param("OUTPUT_FOLDER", "folder_out", "Output folder"),
     ),
@@ -89,9 +133,12 @@ Nothing is written when an input is wrong; the files appear together when all ar
         Result("OCCLUDED_FRACTION", "number", "Share of cells occluded (true orthophotos)"),
     ),
     tags=("orthophoto", "orthorectification", "true orthophoto", "occlusion", "dsm", "dtm"),
-    references=("dos Santos, Dal Poz & Dalmolin (2010)", "Amhar, Jansa & Ries (1998)",
-                "Habib, Kim & Kim (2007)"),
-)  # fmt: skip
+    references=(
+        "dos Santos, Dal Poz & Dalmolin (2010)",
+        "Amhar, Jansa & Ries (1998)",
+        "Habib, Kim & Kim (2007)",
+    ),
+)
 
 
 @dataclass(frozen=True)
@@ -129,17 +176,29 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     # tiles are computed; the files are renamed into place once all are whole
     written: list[OrthoFile] = []
     finishing: list[tuple[Future, str]] = []  # and the image of each
-    with OutputSet({k: str(p) for k, p in targets.items()}, inputs) as files, \
-            ThreadPoolExecutor(max_workers=1) as finisher:  # fmt: skip
+    with (
+        OutputSet({k: str(p) for k, p in targets.items()}, inputs) as files,
+        ThreadPoolExecutor(max_workers=1) as finisher,
+    ):
         try:
             for m, f in enumerate(images):
                 if f.stem not in grids:
                     continue
-                sub = None if work is None else (
-                    lambda fr, m=m: work((m + fr) / len(images)))  # fmt: skip
-                done, job = _write_image(v, f, projectors[f.stem], grids[f.stem],
-                                         ground_z[f.stem], options, files, finisher, mapping,
-                                         targets[f.stem], sub, should_stop)  # fmt: skip
+                sub = None if work is None else (lambda fr, m=m: work((m + fr) / len(images)))
+                done, job = _write_image(
+                    v,
+                    f,
+                    projectors[f.stem],
+                    grids[f.stem],
+                    ground_z[f.stem],
+                    options,
+                    files,
+                    finisher,
+                    mapping,
+                    targets[f.stem],
+                    sub,
+                    should_stop,
+                )
                 written.append(done)
                 if job is not None:
                     finishing.append((job, f.stem))
@@ -174,14 +233,31 @@ def _result(written: list, gsd: float, folder: Path, true_ortho: bool) -> JobRes
     """The job's result: the images written, the GSD and the share of occluded cells."""
     occluded = sum(w.occluded_cells for w in written)
     frac = occluded / max(sum(w.valid_cells for w in written) + occluded, 1)
-    lines = [f"{len(written)} orthophoto(s) of {gsd:g} in {folder}"
-             + (f"; {100 * frac:.1f} % of the cells occluded" if true_ortho else "")]
-    return JobResult(results={"IMAGE_COUNT": len(written), "GSD_USED": gsd,
-                              "OCCLUDED_FRACTION": frac}, lines=lines, data=written)  # fmt: skip
+    lines = [
+        f"{len(written)} orthophoto(s) of {gsd:g} in {folder}"
+        + (f"; {100 * frac:.1f} % of the cells occluded" if true_ortho else "")
+    ]
+    return JobResult(
+        results={"IMAGE_COUNT": len(written), "GSD_USED": gsd, "OCCLUDED_FRACTION": frac},
+        lines=lines,
+        data=written,
+    )
 
 
-def _write_image(v: Values, f: Path, proj, grid, ground_z: float, options, files, finisher,
-                 mapping, target: Path, progress, should_stop):  # fmt: skip
+def _write_image(
+    v: Values,
+    f: Path,
+    proj,
+    grid,
+    ground_z: float,
+    options,
+    files,
+    finisher,
+    mapping,
+    target: Path,
+    progress,
+    should_stop,
+):
     """Orthorectify image ``f`` into its temporary of ``files``: (its :class:`OrthoFile`, the
     future writing its overview levels, or None)."""
     import numpy as np
@@ -204,10 +280,20 @@ def _write_image(v: Values, f: Path, proj, grid, ground_z: float, options, files
     with RasterReader(f) as src:
         info = src.info
         photometric = "RGB" if info.bands == 3 and info.dtype == np.uint8 else None
-        writer = GeoTiffWriter(files.path(name), grid.cols, grid.rows, info.bands, info.dtype,
-                               grid.geotransform, mapping, mask=True, tile=512,
-                               photometric=photometric, metadata=meta,
-                               **compression_args(v.compression))  # fmt: skip
+        writer = GeoTiffWriter(
+            files.path(name),
+            grid.cols,
+            grid.rows,
+            info.bands,
+            info.dtype,
+            grid.geotransform,
+            mapping,
+            mask=True,
+            tile=512,
+            photometric=photometric,
+            metadata=meta,
+            **compression_args(v.compression),
+        )
         try:
             for tile in _tiles(proj, grid, src, info, options, progress, should_stop):
                 writer.write(tile.data, tile.col0, tile.row0, tile.valid)
@@ -219,8 +305,15 @@ def _write_image(v: Values, f: Path, proj, grid, ground_z: float, options, files
             raise
         with failures_named(target):
             job = writer.close(finish_in=finisher)
-    log.info("%s: %d x %d cells of %g, %d with data%s", name, grid.cols, grid.rows, grid.cell,
-             valid, f", {occluded} occluded" if options.true_ortho else "")  # fmt: skip
+    log.info(
+        "%s: %d x %d cells of %g, %d with data%s",
+        name,
+        grid.cols,
+        grid.rows,
+        grid.cell,
+        valid,
+        f", {occluded} occluded" if options.true_ortho else "",
+    )
     return OrthoFile(name, str(target), grid.cols, grid.rows, valid, occluded), job
 
 
@@ -228,13 +321,17 @@ def _warn_beyond(projectors: dict, boxes: dict, ground_z: dict) -> None:
     """Warn of the images whose border reaches beyond the DSM (no data there)."""
     from ..photo.ortho_block import share_beyond_dsm
 
-    beyond = {k: share_beyond_dsm(p, ground_z[k]) for k, p in projectors.items()
-              if boxes[k] is not None}  # fmt: skip
+    beyond = {
+        k: share_beyond_dsm(p, ground_z[k]) for k, p in projectors.items() if boxes[k] is not None
+    }
     beyond = {k: v for k, v in beyond.items() if v > 0}
     if beyond:
-        log.warning("the DSM does not cover all of %d image(s) (share of the image's border "
-                    "beyond it: %s): no data there", len(beyond),
-                    ", ".join(f"{k} {round(100 * v)} %" for k, v in beyond.items()))  # fmt: skip
+        log.warning(
+            "the DSM does not cover all of %d image(s) (share of the image's border "
+            "beyond it: %s): no data there",
+            len(beyond),
+            ", ".join(f"{k} {round(100 * v)} %" for k, v in beyond.items()),
+        )
 
 
 def _read_inputs(v: Values, mapping):
@@ -250,22 +347,26 @@ def _read_inputs(v: Values, mapping):
 
     camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     eo = read_eo_csv(v.eo)
-    check_area_of_use(mapping, eo.xyz.min(axis=0), eo.xyz.max(axis=0),
-                      what="the perspective centres", path=v.eo)  # fmt: skip
+    check_area_of_use(
+        mapping, eo.xyz.min(axis=0), eo.xyz.max(axis=0), what="the perspective centres", path=v.eo
+    )
     images = list_image_files(v.images)
     row_of = {name: k for k, name in enumerate(eo.image_id)}
     missing = [f.stem for f in images if f.stem not in row_of]
     if missing:
-        raise InputError(f"no exterior orientation for image(s) {', '.join(missing[:10])}",
-                         path=v.eo)  # fmt: skip
+        raise InputError(
+            f"no exterior orientation for image(s) {', '.join(missing[:10])}", path=v.eo
+        )
     infos = {}
     for f in images:
         with RasterReader(f) as src:
             info = infos[f.stem] = src.info
         if (info.width, info.height) != (camera.width_px, camera.height_px):
-            raise InputError(f"the image is {info.width} x {info.height} px, the camera "
-                             f"{camera.name!r} {camera.width_px} x {camera.height_px} px",
-                             path=str(f))  # fmt: skip
+            raise InputError(
+                f"the image is {info.width} x {info.height} px, the camera "
+                f"{camera.name!r} {camera.width_px} x {camera.height_px} px",
+                path=str(f),
+            )
     return camera, eo, images, row_of, infos
 
 
@@ -284,10 +385,14 @@ def _dsm_in(v: Values, mapping, progress, should_stop):
         try:
             dsm = reproject_dsm(dsm, mapping, should_stop=should_stop)
         except CrsError as exc:
-            raise CrsError(f"the DSM ({source}) cannot be brought into the mapping CRS "
-                           f"'{mapping.name}': {exc}", path=str(v.dsm)) from exc  # fmt: skip
-        log.warning("the DSM was in '%s': resampled into '%s' (cell %g)", source, mapping.name,
-                    dsm.cell)  # fmt: skip
+            raise CrsError(
+                f"the DSM ({source}) cannot be brought into the mapping CRS "
+                f"'{mapping.name}': {exc}",
+                path=str(v.dsm),
+            ) from exc
+        log.warning(
+            "the DSM was in '%s': resampled into '%s' (cell %g)", source, mapping.name, dsm.cell
+        )
     return dsm
 
 
@@ -299,8 +404,10 @@ def _extent(values) -> tuple[float, float, float, float] | None:
         return None
     x0, y0, x1, y1 = (float(a) for a in values)
     if not (x1 > x0 and y1 > y0):
-        raise InputError(f"EXTENT {x0:.10g},{y0:.10g},{x1:.10g},{y1:.10g}: give xmin,ymin,"
-                         "xmax,ymax with xmin < xmax and ymin < ymax")  # fmt: skip
+        raise InputError(
+            f"EXTENT {x0:.10g},{y0:.10g},{x1:.10g},{y1:.10g}: give xmin,ymin,"
+            "xmax,ymax with xmin < xmax and ymin < ymax"
+        )
     return x0, y0, x1, y1
 
 
@@ -321,8 +428,11 @@ def _grids(boxes: dict, extent, gsd: float, infos: dict, folder: Path) -> dict:
             log.warning("image %s does not overlap the DSM: no orthophoto", name)
     seen = {k: b for k, b in boxes.items() if b is not None}
     if extent is not None and seen:
-        inside = {k: b for k, b in seen.items() if b[0] < extent[2] and extent[0] < b[2]
-                  and b[1] < extent[3] and extent[1] < b[3]}  # fmt: skip
+        inside = {
+            k: b
+            for k, b in seen.items()
+            if b[0] < extent[2] and extent[0] < b[2] and b[1] < extent[3] and extent[1] < b[3]
+        }
         if not inside:
             lo = np.min([b[:2] for b in seen.values()], axis=0)
             hi = np.max([b[2:] for b in seen.values()], axis=0)
@@ -330,7 +440,9 @@ def _grids(boxes: dict, extent, gsd: float, infos: dict, folder: Path) -> dict:
                 "EXTENT {:.10g},{:.10g},{:.10g},{:.10g} lies outside every image's footprint "
                 "on the DSM (the footprints span x {:.10g} to {:.10g}, y {:.10g} to {:.10g}): "
                 "give the extent in the mapping CRS, within the footprints".format(
-                    *extent, lo[0], hi[0], lo[1], hi[1]))  # fmt: skip
+                    *extent, lo[0], hi[0], lo[1], hi[1]
+                )
+            )
         for k in sorted(set(seen) - set(inside)):
             log.warning("image %s does not see EXTENT: no orthophoto", k)
         seen = inside
@@ -341,9 +453,11 @@ def _grids(boxes: dict, extent, gsd: float, infos: dict, folder: Path) -> dict:
         per_cell = infos[k].bands * infos[k].dtype.itemsize + 1  # the bands and the mask
         # GDAL keeps a GeoTIFF's tile offsets in one array of at most 2 GB (8 bytes a tile)
         if math.ceil(g.cols / 512) * math.ceil(g.rows / 512) * (infos[k].bands + 1) > 2**28:
-            raise InputError(f"GSD {gsd:g}: the orthophoto of image {k} would be {g.cols} x "
-                             f"{g.rows} cells, beyond what a GeoTIFF can hold: give a larger "
-                             "GSD (0: the images' own)")  # fmt: skip
+            raise InputError(
+                f"GSD {gsd:g}: the orthophoto of image {k} would be {g.cols} x "
+                f"{g.rows} cells, beyond what a GeoTIFF can hold: give a larger "
+                "GSD (0: the images' own)"
+            )
         need += cells * per_cell * 4 / 3  # the overview levels add a third
     there = folder.absolute()
     while not there.is_dir() and there != there.parent:  # the folder is made when written
@@ -352,10 +466,12 @@ def _grids(boxes: dict, extent, gsd: float, infos: dict, folder: Path) -> dict:
     if need > free:
         big = max(shape, key=lambda k: shape[k].rows * shape[k].cols)
         g = shape[big]
-        raise InputError(f"GSD {gsd:g}: the {len(shape)} orthophoto(s) need up to "
-                         f"{size_text(need)} (uncompressed; image {big}: {g.cols} x {g.rows} "
-                         f"cells); the output folder has {size_text(free)} free: give a larger "
-                         "GSD (0: the images' own) or free some space")  # fmt: skip
+        raise InputError(
+            f"GSD {gsd:g}: the {len(shape)} orthophoto(s) need up to "
+            f"{size_text(need)} (uncompressed; image {big}: {g.cols} x {g.rows} "
+            f"cells); the output folder has {size_text(free)} free: give a larger "
+            "GSD (0: the images' own) or free some space"
+        )
     return shape
 
 
@@ -366,8 +482,9 @@ def failures_named(target) -> Iterator[None]:
     try:
         yield
     except OSError as exc:
-        raise OSError(exc.errno, f"{exc.strerror or exc}; nothing was written",
-                      str(target)) from exc  # fmt: skip
+        raise OSError(
+            exc.errno, f"{exc.strerror or exc}; nothing was written", str(target)
+        ) from exc
 
 
 def _tiles(proj, grid, src, info, options, progress, should_stop):
@@ -376,5 +493,13 @@ def _tiles(proj, grid, src, info, options, progress, should_stop):
     def read(window, f):  # pixel-interleaved: OpenCV's layout, read without a copy
         return src.read(window, decimation=f, pixel_interleaved=True)
 
-    return orthorectify_tiles(proj, grid, read, info.bands, info.dtype, options,
-                              progress=progress, should_stop=should_stop)  # fmt: skip
+    return orthorectify_tiles(
+        proj,
+        grid,
+        read,
+        info.bands,
+        info.dtype,
+        options,
+        progress=progress,
+        should_stop=should_stop,
+    )

@@ -65,49 +65,120 @@ and whole lines, and a diagnosis naming what the observations cannot determine (
 lines parallel).""",
     params=(
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
-        Param("OBSERVATIONS", "table", "Image observations (CSV)", optional=True,
-              file_filter=CSV_FILTER,
-              help="points (and line points) measured in the images"),
-        Param("LINE_OBSERVATIONS", "table", "Image line observations (CSV)", optional=True,
-              file_filter=CSV_FILTER,
-              help="rows of type line in a second observation file"),
-        Param("CONTROL_POINTS", "table", "Control points (CSV)", optional=True,
-              file_filter=CSV_FILTER, help="point_id,X,Y,Z[,sx,sy,sz] or the LCP table"),
-        Param("CONTROL_LINES", "table", "Control lines (CSV)", optional=True,
-              file_filter=CSV_FILTER,
-              help="LiDAR line table, 3D segments (id,x1..z2) or monoplotted lines"),
-        Param("CRS", "crs", "Mapping CRS of the control", qgis_default="ProjectCrs",
-              help="projected CRS of the control points and lines (and of APPROX_EO)"),
-        Param("APPROX_EO", "table", "Approximate exterior orientation (CSV)", optional=True,
-              file_filter=CSV_FILTER,
-              help="start values instead of the automatic start (images not in it start "
-              "automatically)"),
-        Param("APPROX_EO_SIGMAS", "numbers",
-              "Weights of the approximate EO: X, Y, Z, omega, phi, kappa", count=6,
-              unit="m, degrees", optional=True, advanced=True, minimum=1e-6, maximum=1e6,
-              help="empty: start values only; given: weighted observations"),
-        Param("IMAGES", "string", "Images (comma separated; empty: all)", "", optional=True,
-              advanced=True),
-        Param("MODEL", "enum", "Line model", _OPTIONS.model,
-              options=Ref("photo.resection_options", "MODELS"),
-              labels=("coplanarity (no parametrisation)",
-                      "equivalent planes (Tommaselli & Tozzi 1996)"), advanced=True),
-        Param("ESTIMATE_INTERIOR", "boolean", "Refine focal length and principal point",
-              _OPTIONS.estimate_interior),
+        Param(
+            "OBSERVATIONS",
+            "table",
+            "Image observations (CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            help="points (and line points) measured in the images",
+        ),
+        Param(
+            "LINE_OBSERVATIONS",
+            "table",
+            "Image line observations (CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            help="rows of type line in a second observation file",
+        ),
+        Param(
+            "CONTROL_POINTS",
+            "table",
+            "Control points (CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            help="point_id,X,Y,Z[,sx,sy,sz] or the LCP table",
+        ),
+        Param(
+            "CONTROL_LINES",
+            "table",
+            "Control lines (CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            help="LiDAR line table, 3D segments (id,x1..z2) or monoplotted lines",
+        ),
+        Param(
+            "CRS",
+            "crs",
+            "Mapping CRS of the control",
+            qgis_default="ProjectCrs",
+            help="projected CRS of the control points and lines (and of APPROX_EO)",
+        ),
+        Param(
+            "APPROX_EO",
+            "table",
+            "Approximate exterior orientation (CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            help="start values instead of the automatic start (images not in it start "
+            "automatically)",
+        ),
+        Param(
+            "APPROX_EO_SIGMAS",
+            "numbers",
+            "Weights of the approximate EO: X, Y, Z, omega, phi, kappa",
+            count=6,
+            unit="m, degrees",
+            optional=True,
+            advanced=True,
+            minimum=1e-6,
+            maximum=1e6,
+            help="empty: start values only; given: weighted observations",
+        ),
+        Param(
+            "IMAGES",
+            "string",
+            "Images (comma separated; empty: all)",
+            "",
+            optional=True,
+            advanced=True,
+        ),
+        Param(
+            "MODEL",
+            "enum",
+            "Line model",
+            _OPTIONS.model,
+            options=Ref("photo.resection_options", "MODELS"),
+            labels=(
+                "coplanarity (no parametrisation)",
+                "equivalent planes (Tommaselli & Tozzi 1996)",
+            ),
+            advanced=True,
+        ),
+        Param(
+            "ESTIMATE_INTERIOR",
+            "boolean",
+            "Refine focal length and principal point",
+            _OPTIONS.estimate_interior,
+        ),
         Param("SNOOPING", "boolean", "Data snooping (Baarda)", _OPTIONS.snooping, advanced=True),
-        Param("OUTPUT_EO", "file_out", "Exterior orientation with sigmas (CSV)",
-              file_filter=CSV_OUT),
-        Param("OUTPUT_RESIDUALS", "file_out", "Residuals (CSV)", optional=True,
-              file_filter=CSV_OUT),
-        Param("OUTPUT_HTML", "file_out", "Summary (HTML)", optional=True,
-              file_filter="HTML files (*.html)"),
+        Param(
+            "OUTPUT_EO", "file_out", "Exterior orientation with sigmas (CSV)", file_filter=CSV_OUT
+        ),
+        Param(
+            "OUTPUT_RESIDUALS", "file_out", "Residuals (CSV)", optional=True, file_filter=CSV_OUT
+        ),
+        Param(
+            "OUTPUT_HTML",
+            "file_out",
+            "Summary (HTML)",
+            optional=True,
+            file_filter="HTML files (*.html)",
+        ),
     ),
     results=(
         Result("IMAGE_COUNT", "number", "Images resected"),
         Result("SIGMA0", "number", "Largest sigma0 a-posteriori"),
     ),
-    tags=("resection", "orientation", "exterior orientation", "straight lines", "lidar lines",
-          "equivalent planes", "pnp"),
+    tags=(
+        "resection",
+        "orientation",
+        "exterior orientation",
+        "straight lines",
+        "lidar lines",
+        "equivalent planes",
+        "pnp",
+    ),
     references=(
         "dos Santos, Dal Poz & Dalmolin (2010)",
         "Tommaselli & Tozzi (1996)",
@@ -139,13 +210,21 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     runs = []
     for n, item in enumerate(inputs):
         stop_if_asked(should_stop, "resecting")
-        sub = None if progress is None else (
-            lambda f, n=n: progress((n + f) / len(inputs)))  # fmt: skip
+        sub = None if progress is None else (lambda f, n=n: progress((n + f) / len(inputs)))
         start = approx.get(item.image_id)
         eo0 = None if start is None else np.concatenate([start[0], start[1]])
         try:
-            res = resect_in_map(item.image_id, item.data, camera, frame, options, eo0, local,
-                                progress=sub, should_stop=should_stop)  # fmt: skip
+            res = resect_in_map(
+                item.image_id,
+                item.data,
+                camera,
+                frame,
+                options,
+                eo0,
+                local,
+                progress=sub,
+                should_stop=should_stop,
+            )
         except LidarPhotoError as exc:
             if isinstance(exc, Cancelled):
                 raise
@@ -153,8 +232,11 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
         runs.append(ImageRun(item, res, start))
     _write_outputs(v, out, runs, camera, obs, points, lines, frame)
     sigma0 = max((r.result.result.sigma0 for r in runs), default=math.nan)
-    return JobResult(results={"IMAGE_COUNT": len(runs), "SIGMA0": sigma0},
-                     lines=_summary_lines(runs, options.snooping_alpha), data=runs)  # fmt: skip
+    return JobResult(
+        results={"IMAGE_COUNT": len(runs), "SIGMA0": sigma0},
+        lines=_summary_lines(runs, options.snooping_alpha),
+        data=runs,
+    )
 
 
 def _read_inputs(v: Values) -> tuple:
@@ -191,18 +273,23 @@ def _read_inputs(v: Values) -> tuple:
                 f"camera {camera.name!r} ({v.camera}) has the {camera.projection} (fisheye) "
                 "projection; the resection from straight lines handles perspective cameras "
                 "only: leave the rows of type line out (use control points)",
-                **o.where(row))
+                **o.where(row),
+            )
         _check_control_rows(o, points)
         obs = o if obs is None else obs.concat(o)
     lines = read_line_control_csv(v.control_lines) if v.control_lines else None
     for what, path, xyz in (
         ("control points", v.control_points, None if points is None else points.xyz),
-        ("control lines", v.control_lines,
-         None if lines is None else np.vstack([lines.p1, lines.p2])),
-    ):  # fmt: skip
+        (
+            "control lines",
+            v.control_lines,
+            None if lines is None else np.vstack([lines.p1, lines.p2]),
+        ),
+    ):
         if xyz is not None and len(xyz):
-            check_area_of_use(frame.crs, xyz.min(axis=0), xyz.max(axis=0), what=f"the {what}",
-                              path=path)  # fmt: skip
+            check_area_of_use(
+                frame.crs, xyz.min(axis=0), xyz.max(axis=0), what=f"the {what}", path=path
+            )
     return frame, camera, obs, points, lines
 
 
@@ -216,10 +303,17 @@ def _approximations(v: Values, frame) -> tuple[dict, tuple | None]:
     approx = {}
     if v.approx_eo:
         table = read_eo_csv(v.approx_eo)
-        check_area_of_use(frame.crs, table.xyz.min(axis=0), table.xyz.max(axis=0),
-                          what="the approximate perspective centres", path=v.approx_eo)
-        approx = {i: (table.xyz[k], table.opk[k], table.time[k], table.group[k])
-                  for k, i in enumerate(table.image_id)}  # fmt: skip
+        check_area_of_use(
+            frame.crs,
+            table.xyz.min(axis=0),
+            table.xyz.max(axis=0),
+            what="the approximate perspective centres",
+            path=v.approx_eo,
+        )
+        approx = {
+            i: (table.xyz[k], table.opk[k], table.time[k], table.group[k])
+            for k, i in enumerate(table.image_id)
+        }
     prior = None
     if v.approx_eo_sigmas:
         if not v.approx_eo:
@@ -246,8 +340,7 @@ def _write_outputs(v: Values, out, runs: list, camera, obs, points, lines, frame
         write_residuals_csv(out.path("OUTPUT_RESIDUALS"), residuals)
     settings = _settings(v, camera, obs, points, lines, frame)
     if out.requested("OUTPUT_HTML"):
-        write_text_atomic(out.path("OUTPUT_HTML"),
-                          render_resection_html(runs, residuals, settings))  # fmt: skip
+        write_text_atomic(out.path("OUTPUT_HTML"), render_resection_html(runs, residuals, settings))
 
 
 def _summary_lines(runs: list, snooping_alpha: float) -> list[str]:
@@ -274,9 +367,10 @@ def _check_control_rows(obs, points) -> None:
     """A ``control`` row measures a surveyed point: its point_id must be a control point."""
     obs.require_control_known(
         points.index() if points is not None else {},
-        "CONTROL_POINTS" if points is not None
+        "CONTROL_POINTS"
+        if points is not None
         else "the control: give CONTROL_POINTS with that point_id",
-    )  # fmt: skip
+    )
 
 
 def _prefixed(exc, image_id: str):
@@ -284,8 +378,9 @@ def _prefixed(exc, image_id: str):
     from ..errors import NotObservableError
 
     if isinstance(exc, NotObservableError):
-        return NotObservableError(f"image {image_id}: {exc}", exc.parameters, exc.null_vectors,
-                                  exc.condition_number)  # fmt: skip
+        return NotObservableError(
+            f"image {image_id}: {exc}", exc.parameters, exc.null_vectors, exc.condition_number
+        )
     try:
         return type(exc)(f"image {image_id}: {exc}")
     except TypeError:
@@ -314,9 +409,24 @@ def run_eo_row(r: ImageRun) -> tuple:
     time = r.start[2] if r.start is not None else math.nan
     group = r.start[3] if r.start is not None else ""
     rejected = int(res.point_rejected.sum() + res.line_rejected.sum())
-    return (r.image_id, time, group, *r.result.xyz, *r.result.opk, *s, res.sigma0,
-            res.redundancy, res.chi2.statistic, res.chi2_critical, res.chi2_passed,
-            r.image.data.n_points, r.image.data.n_lines, rejected, res.model, res.start)
+    return (
+        r.image_id,
+        time,
+        group,
+        *r.result.xyz,
+        *r.result.opk,
+        *s,
+        res.sigma0,
+        res.redundancy,
+        res.chi2.statistic,
+        res.chi2_critical,
+        res.chi2_passed,
+        r.image.data.n_points,
+        r.image.data.n_lines,
+        rejected,
+        res.model,
+        res.start,
+    )
 
 
 def residual_rows(r: ImageRun, obs, camera) -> list[tuple]:
@@ -329,32 +439,72 @@ def residual_rows(r: ImageRun, obs, camera) -> list[tuple]:
     rows = []
     for j, k in enumerate(item.point_rows):
         v = res.point_v[j]
-        rows.append((item.image_id, obs.point_id[k], obs.type[k], obs.target_id[k], 0,
-                     *obs.pixels[k], *v, float(np.hypot(*v)), res.point_w[j],
-                     bool(res.point_rejected[j]), True))  # fmt: skip
+        rows.append(
+            (
+                item.image_id,
+                obs.point_id[k],
+                obs.type[k],
+                obs.target_id[k],
+                0,
+                *obs.pixels[k],
+                *v,
+                float(np.hypot(*v)),
+                res.point_w[j],
+                bool(res.point_rejected[j]),
+                True,
+            )
+        )
     for j, ks in enumerate(item.line_rows):
         for vi, k in enumerate(ks):
             v = res.line_v[j][vi]
-            rows.append((item.image_id, obs.point_id[k], "line", obs.target_id[k], vi + 1,
-                         *obs.pixels[k], *v, float(res.line_distance_px[j][vi]),
-                         res.line_w[j], bool(res.line_rejected[j]), True))  # fmt: skip
+            rows.append(
+                (
+                    item.image_id,
+                    obs.point_id[k],
+                    "line",
+                    obs.target_id[k],
+                    vi + 1,
+                    *obs.pixels[k],
+                    *v,
+                    float(res.line_distance_px[j][vi]),
+                    res.line_w[j],
+                    bool(res.line_rejected[j]),
+                    True,
+                )
+            )
     if item.check_rows:
         local = r.result.local
         xyz = local.map_to_enu(item.check_xyz)
-        cam = camera if res.interior is None else camera.with_interior(
-            np.concatenate([res.interior, camera.distortion.params]))  # fmt: skip
+        cam = (
+            camera
+            if res.interior is None
+            else camera.with_interior(np.concatenate([res.interior, camera.distortion.params]))
+        )
         pred = project(xyz, res.eo, cam)
         for j, k in enumerate(item.check_rows):
             v = pred[j] - obs.pixels[k]
-            rows.append((item.image_id, obs.point_id[k], "check", obs.target_id[k], 0,
-                         *obs.pixels[k], *v, float(np.hypot(*v)), math.nan, False,
-                         False))  # fmt: skip
+            rows.append(
+                (
+                    item.image_id,
+                    obs.point_id[k],
+                    "check",
+                    obs.target_id[k],
+                    0,
+                    *obs.pixels[k],
+                    *v,
+                    float(np.hypot(*v)),
+                    math.nan,
+                    False,
+                    False,
+                )
+            )
     return rows
 
 
 def _settings(v, camera, obs, points, lines, frame) -> dict[str, str]:
     """The run's settings as text (the HTML summary shows them)."""
     import numpy as np
+
     kinds, counts = np.unique(np.array(obs.type), return_counts=True)
     return {
         "camera": f"{camera.name} (f = {camera.focal_mm:g} mm, {camera.width_px} x "
@@ -367,6 +517,7 @@ def _settings(v, camera, obs, points, lines, frame) -> dict[str, str]:
         "line model": v.model,
         "interior orientation": "refined (f, x0, y0)" if v.estimate_interior else "fixed",
         "start": "approximate EO" + (" (weighted)" if v.approx_eo_sigmas else "")
-        if v.approx_eo else "automatic (no approximate values)",
+        if v.approx_eo
+        else "automatic (no approximate values)",
         "data snooping": "Baarda, alpha = 0.001 per observation" if v.snooping else "off",
     }

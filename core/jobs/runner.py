@@ -66,8 +66,9 @@ def run_job(
     spec: AlgorithmSpec = job.SPEC
     values: Values = parse_values(spec, raw)
     # a folder output holds files the job commits itself (core/jobs/<job>.py)
-    outputs = {p.name: values.get(p.name) for p in spec.outputs
-               if p.kind not in ("sink", "folder_out")}  # fmt: skip
+    outputs = {
+        p.name: values.get(p.name) for p in spec.outputs if p.kind not in ("sink", "folder_out")
+    }
     with OutputSet(outputs, input_files(spec, values), folder_suffixes(spec)) as out:
         result = job.run(values, out, progress=progress, should_stop=should_stop)
         out.commit()

@@ -135,8 +135,11 @@ class Ref:
         found = getattr(module, self.name, None)
         if found is cls:
             return True
-        return (isinstance(found, type) and found.__qualname__ == cls.__qualname__
-                and _below_core(found.__module__) == _below_core(cls.__module__))  # fmt: skip
+        return (
+            isinstance(found, type)
+            and found.__qualname__ == cls.__qualname__
+            and _below_core(found.__module__) == _below_core(cls.__module__)
+        )
 
     def __str__(self) -> str:
         return f"{self.module}.{self.name}" + (f".{self.field}" if self.field else "")
@@ -372,14 +375,16 @@ class AlgorithmSpec:
         for p in self.params:
             cells = (p.help or p.label, *param_facts(p, self, t))
             rows.append(
-                f"<tr><td><b>{p.name}</b></td>" + "".join(f"<td>{_esc(c)}</td>" for c in cells)
+                f"<tr><td><b>{p.name}</b></td>"
+                + "".join(f"<td>{_esc(c)}</td>" for c in cells)
                 + "</tr>"
-            )  # fmt: skip
+            )
         parts.append(
             f"<h3>{t('Parameters')}</h3><table><tr><th>{t('name')}</th><th>{t('meaning')}</th>"
             f"<th>{t('default')}</th><th>{t('unit')}</th><th>{t('valid range')}</th></tr>"
-            + "".join(rows) + "</table>"
-        )  # fmt: skip
+            + "".join(rows)
+            + "</table>"
+        )
         if self.references:
             items = "".join(f"<li>{_esc(r)}</li>" for r in self.references)
             parts.append(f"<h3>{t('References')}</h3><ul>{items}</ul>")
@@ -653,8 +658,10 @@ def options_from(cls: type, spec: AlgorithmSpec, values: Mapping[str, Any], **ex
     mapped = [p for p in spec.params if p.source is not None and p.source.name == cls.__name__]
     stray = [f"{p.name} ({p.source})" for p in mapped if not p.source.names(cls)]
     if stray:  # a field read from another class of that name would be silently left out
-        raise TypeError(f"{spec.name}: parameters {', '.join(stray)} do not name "
-                        f"{cls.__module__}.{cls.__name__}")  # fmt: skip
+        raise TypeError(
+            f"{spec.name}: parameters {', '.join(stray)} do not name "
+            f"{cls.__module__}.{cls.__name__}"
+        )
     fields = {
         p.source.field: values[p.name]
         for p in mapped

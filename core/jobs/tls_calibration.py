@@ -93,40 +93,122 @@ beginning with #).""",
     params=(
         Param("OBSERVATIONS", "table", "Observations (CSV)", file_filter=CSV_FILTER),
         Param("CONTROL", "table", "Control targets (CSV)", optional=True, file_filter=CSV_FILTER),
-        Param("STATIONS", "table", "Stations (CSV)", optional=True, file_filter=CSV_FILTER,
-              help="approximate poses, compensator tilts, levelled flags; when given, every "
-              "observed station must be in it"),
-        Param("ANGLE_UNIT", "enum", "Angle unit of hz/vt columns", "degrees",
-              options=ANGLE_UNITS,
-              help="only for columns named hz and vt; hz_deg/hz_gon say their own unit"),
-        Param("DEFAULT_SIGMAS", "numbers", "Default sigmas: range, horizontal, vertical",
-              (2.0, 10.0, 10.0), count=3, unit="mm, arcsec, arcsec", minimum=1e-6,
-              maximum=1e6, help="for rows without s_range, s_hz, s_vt (or s_x, s_y, s_z: "
-              "the range sigma)", advanced=True),
-        Param("AP_SET", "enum", "Additional parameters", _D.ap_set,
-              options=Ref("tls.ap_table", "AP_SETS", convert=tuple),
-              labels=("none (registration only)", "paper: a0, b1, b2, c0",
-                      "extended (Lichti 2007): a0-a3, b1-b6, c0-c3")),
-        Param("AP_TERMS", "string", "AP terms (overrides the set)", "", optional=True,
-              help="comma-separated, e.g. a0,b1,b2,c0,a1", advanced=True),
-        Param("SELECT_APS", "boolean", "Select the APs by significance and correlation",
-              _D.select_aps, advanced=True),
-        Param("LEVELLED", "boolean", "Stations levelled by the compensator", _D.levelled,
-              help="default for stations whose table does not say"),
-        Param("TILT_SIGMA", "number", "Compensator sigma",
-              Ref("tls.options", "CalibrationOptions", "tilt_sigma_rad", convert=_arcsec),
-              unit="arcsec", minimum=0.01, maximum=36000.0, advanced=True),
-        Param("DATUM", "enum", "Datum without control", _D.datum, options=DATUMS,
-              labels=("inner constraints on the targets (free network)",
-                      "reference station held at its pose"), advanced=True),
-        Param("REFERENCE_STATION", "string", "Reference station", "", optional=True,
-              advanced=True, help="default: the first station of the stations table with a "
-              "position, else the first observed"),
-        Param("CYCLIC_WAVELENGTH", "number", "Wavelength of the cyclic range terms",
-              _D.cyclic_wavelength_m, unit="m", minimum=0.01, maximum=1000.0, advanced=True),
+        Param(
+            "STATIONS",
+            "table",
+            "Stations (CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            help="approximate poses, compensator tilts, levelled flags; when given, every "
+            "observed station must be in it",
+        ),
+        Param(
+            "ANGLE_UNIT",
+            "enum",
+            "Angle unit of hz/vt columns",
+            "degrees",
+            options=ANGLE_UNITS,
+            help="only for columns named hz and vt; hz_deg/hz_gon say their own unit",
+        ),
+        Param(
+            "DEFAULT_SIGMAS",
+            "numbers",
+            "Default sigmas: range, horizontal, vertical",
+            (2.0, 10.0, 10.0),
+            count=3,
+            unit="mm, arcsec, arcsec",
+            minimum=1e-6,
+            maximum=1e6,
+            help="for rows without s_range, s_hz, s_vt (or s_x, s_y, s_z: the range sigma)",
+            advanced=True,
+        ),
+        Param(
+            "AP_SET",
+            "enum",
+            "Additional parameters",
+            _D.ap_set,
+            options=Ref("tls.ap_table", "AP_SETS", convert=tuple),
+            labels=(
+                "none (registration only)",
+                "paper: a0, b1, b2, c0",
+                "extended (Lichti 2007): a0-a3, b1-b6, c0-c3",
+            ),
+        ),
+        Param(
+            "AP_TERMS",
+            "string",
+            "AP terms (overrides the set)",
+            "",
+            optional=True,
+            help="comma-separated, e.g. a0,b1,b2,c0,a1",
+            advanced=True,
+        ),
+        Param(
+            "SELECT_APS",
+            "boolean",
+            "Select the APs by significance and correlation",
+            _D.select_aps,
+            advanced=True,
+        ),
+        Param(
+            "LEVELLED",
+            "boolean",
+            "Stations levelled by the compensator",
+            _D.levelled,
+            help="default for stations whose table does not say",
+        ),
+        Param(
+            "TILT_SIGMA",
+            "number",
+            "Compensator sigma",
+            Ref("tls.options", "CalibrationOptions", "tilt_sigma_rad", convert=_arcsec),
+            unit="arcsec",
+            minimum=0.01,
+            maximum=36000.0,
+            advanced=True,
+        ),
+        Param(
+            "DATUM",
+            "enum",
+            "Datum without control",
+            _D.datum,
+            options=DATUMS,
+            labels=(
+                "inner constraints on the targets (free network)",
+                "reference station held at its pose",
+            ),
+            advanced=True,
+        ),
+        Param(
+            "REFERENCE_STATION",
+            "string",
+            "Reference station",
+            "",
+            optional=True,
+            advanced=True,
+            help="default: the first station of the stations table with a "
+            "position, else the first observed",
+        ),
+        Param(
+            "CYCLIC_WAVELENGTH",
+            "number",
+            "Wavelength of the cyclic range terms",
+            _D.cyclic_wavelength_m,
+            unit="m",
+            minimum=0.01,
+            maximum=1000.0,
+            advanced=True,
+        ),
         Param("SNOOPING", "boolean", "Data snooping (Baarda)", _D.snooping, advanced=True),
-        Param("CORRELATION_LIMIT", "number", "Strong correlation at |r| >=",
-              _D.correlation_limit, minimum=0.1, maximum=1.0, advanced=True),
+        Param(
+            "CORRELATION_LIMIT",
+            "number",
+            "Strong correlation at |r| >=",
+            _D.correlation_limit,
+            minimum=0.1,
+            maximum=1.0,
+            advanced=True,
+        ),
         *doubt_params(
             "a failed global test with sigma0 above this fails the run (wrong sigmas, a model "
             "that does not fit, or blunders data snooping did not catch)",
@@ -134,20 +216,49 @@ beginning with #).""",
             "snooping's false alarms explain: write the outputs anyway, each table with a "
             "warning at its top",
         ),
-        Param("SCANS", "files", "Scans to register (LAS/LAZ, PLY, E57; one station per file)",
-              optional=True, suffixes=SCAN_SUFFIXES,
-              help="the file name without its suffix is the station id"),
-        Param("APPLY_APS", "boolean", "Correct the scan points by the estimated APs", True,
-              help="face-I readings; off: the rigid pose only", advanced=True),
+        Param(
+            "SCANS",
+            "files",
+            "Scans to register (LAS/LAZ, PLY, E57; one station per file)",
+            optional=True,
+            suffixes=SCAN_SUFFIXES,
+            help="the file name without its suffix is the station id",
+        ),
+        Param(
+            "APPLY_APS",
+            "boolean",
+            "Correct the scan points by the estimated APs",
+            True,
+            help="face-I readings; off: the rigid pose only",
+            advanced=True,
+        ),
         Param("OUTPUT_STATIONS", "file_out", "Station poses (CSV)", file_filter=CSV_OUT),
         Param("OUTPUT_APS", "file_out", "Additional parameters (CSV)", file_filter=CSV_OUT),
-        Param("OUTPUT_TARGETS", "file_out", "Target coordinates (CSV)", optional=True,
-              file_filter=CSV_OUT),
-        Param("OUTPUT_RESIDUALS", "file_out", "Residuals (CSV)", optional=True,
-              create_by_default=False, file_filter=CSV_OUT, advanced=True),
+        Param(
+            "OUTPUT_TARGETS",
+            "file_out",
+            "Target coordinates (CSV)",
+            optional=True,
+            file_filter=CSV_OUT,
+        ),
+        Param(
+            "OUTPUT_RESIDUALS",
+            "file_out",
+            "Residuals (CSV)",
+            optional=True,
+            create_by_default=False,
+            file_filter=CSV_OUT,
+            advanced=True,
+        ),
         Param("OUTPUT_HTML", "file_out", "Report (HTML)", file_filter="HTML files (*.html)"),
-        Param("OUTPUT_FOLDER", "folder_out", "Registered scans (folder)", optional=True,
-              create_by_default=False, help="needs SCANS"),
+        Param(
+            "OUTPUT_FOLDER",
+            "folder_out",
+            "Registered scans (folder)",
+            optional=True,
+            create_by_default=False,
+            help="needs SCANS",
+        ),
     ),
     results=(
         Result("SIGMA0", "number", "Sigma0 a-posteriori"),
@@ -155,11 +266,16 @@ beginning with #).""",
         Result("REJECTED", "number", "Observations rejected"),
         Result("APS", "string", "Additional parameters estimated"),
     ),
-    tags=("tls", "terrestrial laser scanner", "self-calibration", "registration",
-          "additional parameters", "targets"),
-    references=("Carvalho, Correa & dos Santos", "Lichti (2007)", "Lichti (2010)",
-                "Baarda (1968)"),
-)  # fmt: skip
+    tags=(
+        "tls",
+        "terrestrial laser scanner",
+        "self-calibration",
+        "registration",
+        "additional parameters",
+        "targets",
+    ),
+    references=("Carvalho, Correa & dos Santos", "Lichti (2007)", "Lichti (2010)", "Baarda (1968)"),
+)
 
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
@@ -175,26 +291,37 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     obs, control, stations = _read_inputs(v, scans)
     median = check_distance_consistency(obs, path=v.observations)
     aps = v.ap_terms.strip() if v.ap_terms else v.ap_set
-    options = options_from(CalibrationOptions, SPEC, v, ap_set=aps,
-                           tilt_sigma_rad=v.tilt_sigma * ARCSEC,
-                           reference_station=v.reference_station or None)  # fmt: skip
-    cal = calibrate(obs, control, stations, options, progress=progress,
-                    should_stop=should_stop)  # fmt: skip
+    options = options_from(
+        CalibrationOptions,
+        SPEC,
+        v,
+        ap_set=aps,
+        tilt_sigma_rad=v.tilt_sigma * ARCSEC,
+        reference_station=v.reference_station or None,
+    )
+    cal = calibrate(obs, control, stations, options, progress=progress, should_stop=should_stop)
     settings = _settings(v, obs, control, aps, options, median)
     rejections = rejection_test(cal.adjustment, options.snooping_alpha) if v.snooping else None
     doubts = doubts_about(cal, v.max_sigma0, rejections)
     warning = settle_doubts(
-        "TLS calibration", doubts, v.accept_doubtful, out,
+        "TLS calibration",
+        doubts,
+        v.accept_doubtful,
+        out,
         lambda: render_tls_html(cal, settings, doubts, accepted=False, rejections=rejections),
-    )  # fmt: skip
+    )
     _write_outputs(out, cal, settings, doubts, rejections, warning)
     registered = _write_registered(v, scans, cal, out, should_stop) if scans else []
     return JobResult(
-        results={"SIGMA0": cal.sigma0, "REJECTED": int(cal.rejected.sum()),
-                 "APS": ",".join(cal.ap_names), "REGISTERED": len(registered)},
+        results={
+            "SIGMA0": cal.sigma0,
+            "REJECTED": int(cal.rejected.sum()),
+            "APS": ",".join(cal.ap_names),
+            "REGISTERED": len(registered),
+        },
         lines=_summary_lines(cal, rejections, registered, warning),
         data=cal,
-    )  # fmt: skip
+    )
 
 
 def _read_inputs(v: Values, scans: list) -> tuple:
@@ -204,31 +331,36 @@ def _read_inputs(v: Values, scans: list) -> tuple:
     from ..io.tls import read_tls_control_csv, read_tls_observations_csv, read_tls_stations_csv
 
     s_range_mm, s_hz, s_vt = v.default_sigmas
-    obs = read_tls_observations_csv(v.observations, v.angle_unit,
-                                    (s_range_mm / 1000.0, s_hz, s_vt))  # fmt: skip
+    obs = read_tls_observations_csv(v.observations, v.angle_unit, (s_range_mm / 1000.0, s_hz, s_vt))
     control = read_tls_control_csv(v.control) if v.control else []
     stations = read_tls_stations_csv(v.stations) if v.stations else []
     if scans:
         observed = set(obs.station)
         for f in scans:
             if f.stem not in observed:
-                raise InputError(f"SCANS: the scan's station '{f.stem}' (its file name) has "
-                                 f"no observations in {v.observations}", path=str(f))  # fmt: skip
+                raise InputError(
+                    f"SCANS: the scan's station '{f.stem}' (its file name) has "
+                    f"no observations in {v.observations}",
+                    path=str(f),
+                )
     if stations:
         listed = {s.id for s in stations}
         for k, s in enumerate(obs.station):
             if s not in listed:
-                raise InputError(f"station '{s}' is not in the stations table {v.stations}",
-                                 **obs.where(k))  # fmt: skip
+                raise InputError(
+                    f"station '{s}' is not in the stations table {v.stations}", **obs.where(k)
+                )
         observed = set(obs.station)
         for s in stations:
             if s.id not in observed:
-                raise InputError(f"station '{s.id}' has no observations in {v.observations}",
-                                 path=v.stations, row=s.row or None)  # fmt: skip
+                raise InputError(
+                    f"station '{s.id}' has no observations in {v.observations}",
+                    path=v.stations,
+                    row=s.row or None,
+                )
     for c in control:
         if c.id not in set(obs.target):
-            log.warning("control target '%s' (%s, row %d) is not observed", c.id, v.control,
-                        c.row)  # fmt: skip
+            log.warning("control target '%s' (%s, row %d) is not observed", c.id, v.control, c.row)
     return obs, control, stations
 
 
@@ -239,15 +371,16 @@ def _settings(v: Values, obs, control, aps: str, options, median: float) -> dict
         f"{len(obs.targets())} targets, {int(obs.face_two.sum())} in face II)",
         "control": f"{v.control} ({len(control)} targets)" if v.control else "none",
         "stations table": v.stations or "none",
-        "additional parameters": f"{aps}" + (" with automatic selection" if v.select_aps
-                                             else ""),
-        "levelled by default": f"{v.levelled} (compensator sigma {v.tilt_sigma:g}\")",
+        "additional parameters": f"{aps}" + (" with automatic selection" if v.select_aps else ""),
+        "levelled by default": f'{v.levelled} (compensator sigma {v.tilt_sigma:g}")',
         "datum without control": v.datum,
         "data snooping": f"Baarda, alpha = {options.snooping_alpha:g} per observation"
-        if v.snooping else "off",
-        "distance consistency between stations": "n/a" if not math.isfinite(median)
+        if v.snooping
+        else "off",
+        "distance consistency between stations": "n/a"
+        if not math.isfinite(median)
         else f"{median * 1e6:.0f} ppm (median)",
-    }  # fmt: skip
+    }
 
 
 def _write_outputs(out, cal, settings: dict, doubts: list, rejections, warning: list) -> None:
@@ -279,8 +412,10 @@ def _summary_lines(cal, rejections, registered: list, warning: list) -> list[str
     and the adjustment's figures."""
     lines = [*warning, f"{'AP':4} {'value':>10} {'sigma':>9} unit    t"]
     for a in cal.ap_report():
-        lines.append(f"{a['name']:4} {a['value']:10.3f} {a['std']:9.3f} {a['unit']:7} "
-                     f"{a['t']:.1f}{'' if a['significant'] else ' (not significant)'}")  # fmt: skip
+        lines.append(
+            f"{a['name']:4} {a['value']:10.3f} {a['std']:9.3f} {a['unit']:7} "
+            f"{a['t']:.1f}{'' if a['significant'] else ' (not significant)'}"
+        )
     for s in cal.selection:
         lines.append(f"removed {s.removed}: {s.reason}")
     for a, b, r in cal.strong_pairs[:5]:
@@ -289,10 +424,14 @@ def _summary_lines(cal, rejections, registered: list, warning: list) -> list[str
         lines.append(f"registered scan {path}: {n} points")
     test = "passed" if cal.chi2_passed else "failed"
     if cal.chi2_passed and rejections is not None and not rejections.passed:
-        test += (f" only after rejecting more observations than false alarms explain (at most "
-                 f"{rejections.bound})")  # fmt: skip
-    lines.append(f"sigma0 {cal.sigma0:.3f}, redundancy {cal.adjustment.redundancy}, global "
-                 f"test {test}, {int(cal.rejected.sum())} observations rejected")  # fmt: skip
+        test += (
+            f" only after rejecting more observations than false alarms explain (at most "
+            f"{rejections.bound})"
+        )
+    lines.append(
+        f"sigma0 {cal.sigma0:.3f}, redundancy {cal.adjustment.redundancy}, global "
+        f"test {test}, {int(cal.rejected.sum())} observations rejected"
+    )
     return lines
 
 
@@ -356,20 +495,39 @@ def _write_registered(v: Values, scans, cal, out, should_stop) -> list[tuple[str
     for f in scans:
         suffix = ".laz" if f.suffix.lower() == ".laz" else ".las"
         targets[f.stem] = folder / REGISTERED_NAME.format(f.stem, suffix)
-    inputs = {"SCANS": [str(f) for f in scans], "OBSERVATIONS": v.observations,
-              "CONTROL": v.control, "STATIONS": v.stations}  # fmt: skip
+    inputs = {
+        "SCANS": [str(f) for f in scans],
+        "OBSERVATIONS": v.observations,
+        "CONTROL": v.control,
+        "STATIONS": v.stations,
+    }
     # outputs of this run are inputs too here: no scan may overwrite a table just written
-    inputs.update({k: str(out.target(k)) for k in ("OUTPUT_STATIONS", "OUTPUT_APS",
-                   "OUTPUT_TARGETS", "OUTPUT_RESIDUALS", "OUTPUT_HTML") if out.requested(k)})
+    inputs.update(
+        {
+            k: str(out.target(k))
+            for k in (
+                "OUTPUT_STATIONS",
+                "OUTPUT_APS",
+                "OUTPUT_TARGETS",
+                "OUTPUT_RESIDUALS",
+                "OUTPUT_HTML",
+            )
+            if out.requested(k)
+        }
+    )
     at = {s: k for k, s in enumerate(cal.stations)}
     names = cal.ap_names if v.apply_aps else ()
     written = []
     with OutputSet({k: str(p) for k, p in targets.items()}, inputs) as files:
         for f in scans:
-            transform = partial(scanner_to_object, pose=cal.pose[at[f.stem]], names=names,
-                                values=cal.ap, wavelength_m=cal.options.cyclic_wavelength_m)
-            n = write_registered_scan(f, files.path(f.stem), transform,
-                                      should_stop=should_stop)  # fmt: skip
+            transform = partial(
+                scanner_to_object,
+                pose=cal.pose[at[f.stem]],
+                names=names,
+                values=cal.ap,
+                wavelength_m=cal.options.cyclic_wavelength_m,
+            )
+            n = write_registered_scan(f, files.path(f.stem), transform, should_stop=should_stop)
             log.info("%s: %d points registered to %s", f.name, n, targets[f.stem])
             written.append((str(targets[f.stem]), n))
         files.commit()

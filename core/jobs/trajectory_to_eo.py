@@ -42,12 +42,24 @@ kappa_deg (angles relative to the grid frame at each image), optionally the same
 CSV (on the command line, printed when no file is given), and the number of images.""",
     params=(
         Param("INPUT", "table", "Trajectory table (CSV)", file_filter=CSV_FILTER),
-        Param("CRS", "crs", "Mapping CRS (projected)", qgis_default="ProjectCrs",
-              help="projected CRS of the trajectory's eastings/northings and of the output"),
+        Param(
+            "CRS",
+            "crs",
+            "Mapping CRS (projected)",
+            qgis_default="ProjectCrs",
+            help="projected CRS of the trajectory's eastings/northings and of the output",
+        ),
         *mount_params(),
         Param("OUTPUT", "sink", "Exterior orientation", geometry="point", optional=True),
-        Param("OUTPUT_CSV", "file_out", "Exterior orientation table (CSV)", optional=True,
-              create_by_default=False, file_filter=CSV_OUT, layer_twin="OUTPUT"),
+        Param(
+            "OUTPUT_CSV",
+            "file_out",
+            "Exterior orientation table (CSV)",
+            optional=True,
+            create_by_default=False,
+            file_filter=CSV_OUT,
+            layer_twin="OUTPUT",
+        ),
     ),
     results=(Result("IMAGE_COUNT", "number", "Number of images"),),
     tags=("trajectory", "ins", "gnss", "imu", "exterior orientation", "omega phi kappa"),
@@ -67,8 +79,13 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     mount = mount_from(v)
     traj = read_trajectory_csv(v.input)
     if not traj.geodetic:
-        check_area_of_use(frame.crs, traj.position.min(axis=0), traj.position.max(axis=0),
-                          what="the trajectory", path=v.input)  # fmt: skip
+        check_area_of_use(
+            frame.crs,
+            traj.position.min(axis=0),
+            traj.position.max(axis=0),
+            what="the trajectory",
+            path=v.input,
+        )
     log.info("read %d images from %s", len(traj), v.input)
     stop_if_asked(should_stop, "georeferencing")
     if progress is not None:

@@ -50,173 +50,375 @@ class Workflow:
 
 
 #: steps shared by two workflows (one message each in the catalogue)
-_CHIPS_STEP = ("makecontrolchips", _t(
-    "POINTS = the surveyed control, PHOTOS = ground photos of each point with and without the "
-    "control plate, CAMERA = the ground camera; OUTPUT_FOLDER = one chip per point at the GSD "
-    "of the aerial images"))  # fmt: skip
-_LOCATE_STEP = ("locatecontrolpoints", _t(
-    "CHIPS = one GeoTIFF chip per control point, CONTROL_POINTS, CAMERA, approximate EO, "
-    "IMAGES; OUTPUT = the control points' image observations, without clicking them"))  # fmt: skip
+_CHIPS_STEP = (
+    "makecontrolchips",
+    _t(
+        "POINTS = the surveyed control, PHOTOS = ground photos of each point with and without the "
+        "control plate, CAMERA = the ground camera; OUTPUT_FOLDER = one chip per point at the GSD "
+        "of the aerial images"
+    ),
+)
+_LOCATE_STEP = (
+    "locatecontrolpoints",
+    _t(
+        "CHIPS = one GeoTIFF chip per control point, CONTROL_POINTS, CAMERA, approximate EO, "
+        "IMAGES; OUTPUT = the control points' image observations, without clicking them"
+    ),
+)
 
 WORKFLOWS: tuple[Workflow, ...] = (
     Workflow(
         _t("Boresight calibration with LiDAR control (Pedrosa & dos Santos 2020)"),
         (
-            ("trajectorytoeo", _t("INPUT = the GNSS/INS trajectory CSV; OUTPUT_CSV = the "
-             "exterior orientation of every image")),
-            ("groundfilter", _t("INPUT = the LAS/LAZ; OUTPUT_CLOUD = the cloud classified into "
-             "ground (2) and non-ground")),
-            ("extractroofplanes", _t("INPUT = the classified cloud; OUTPUT_CSV = the plane table, "
-             "OUTPUT_CLOUD = the cloud with plane_id")),
-            ("createlcps", _t("PLANES and CLOUD = the two outputs of extractroofplanes; "
-             "POINTS_CSV and LINES_CSV = LiDAR control points and lines")),
-            ("boresightcalibration", _t("TRAJECTORY = the exterior orientation, PLANES / LINES / "
-             "LCPS = the control, OBSERVATIONS = image measurements made in the picking dock; "
-             "OUTPUT_TABLE = boresight per group, OUTPUT_EO = corrected orientation")),
-            ("accuracyreport", _t("INPUT = check points measured with the corrected orientation; "
-             "OUTPUT_HTML and OUTPUT_JSON = the accuracy figures against the standards")),
+            (
+                "trajectorytoeo",
+                _t(
+                    "INPUT = the GNSS/INS trajectory CSV; OUTPUT_CSV = the "
+                    "exterior orientation of every image"
+                ),
+            ),
+            (
+                "groundfilter",
+                _t(
+                    "INPUT = the LAS/LAZ; OUTPUT_CLOUD = the cloud classified into "
+                    "ground (2) and non-ground"
+                ),
+            ),
+            (
+                "extractroofplanes",
+                _t(
+                    "INPUT = the classified cloud; OUTPUT_CSV = the plane table, "
+                    "OUTPUT_CLOUD = the cloud with plane_id"
+                ),
+            ),
+            (
+                "createlcps",
+                _t(
+                    "PLANES and CLOUD = the two outputs of extractroofplanes; "
+                    "POINTS_CSV and LINES_CSV = LiDAR control points and lines"
+                ),
+            ),
+            (
+                "boresightcalibration",
+                _t(
+                    "TRAJECTORY = the exterior orientation, PLANES / LINES / "
+                    "LCPS = the control, OBSERVATIONS = image measurements made in the picking "
+                    "dock; "
+                    "OUTPUT_TABLE = boresight per group, OUTPUT_EO = corrected orientation"
+                ),
+            ),
+            (
+                "accuracyreport",
+                _t(
+                    "INPUT = check points measured with the corrected orientation; "
+                    "OUTPUT_HTML and OUTPUT_JSON = the accuracy figures against the standards"
+                ),
+            ),
         ),
     ),
     Workflow(
         _t("Monoplotting on a LiDAR surface (dos Santos, Dal Poz & Dalmolin 2010)"),
         (
-            ("groundfilter", _t("INPUT = the LAS/LAZ; OUTPUT_DTM = the terrain model (or use the "
-             "cloud itself as DSM)")),
-            ("extractroofplanes", _t("OUTPUT_CSV = roof planes, used by monoplot for points on "
-             "roofs")),
-            ("resection", _t("OBSERVATIONS + CONTROL_POINTS (or lines) of one image; OUTPUT_EO = "
-             "its exterior orientation")),
-            ("monoplot", _t("OBSERVATIONS of the image, EO, DSM (raster or LAS/LAZ), optional "
-             "PLANES; OUTPUT_CSV = 3D points")),
+            (
+                "groundfilter",
+                _t(
+                    "INPUT = the LAS/LAZ; OUTPUT_DTM = the terrain model (or use the "
+                    "cloud itself as DSM)"
+                ),
+            ),
+            (
+                "extractroofplanes",
+                _t("OUTPUT_CSV = roof planes, used by monoplot for points on roofs"),
+            ),
+            (
+                "resection",
+                _t(
+                    "OBSERVATIONS + CONTROL_POINTS (or lines) of one image; OUTPUT_EO = "
+                    "its exterior orientation"
+                ),
+            ),
+            (
+                "monoplot",
+                _t(
+                    "OBSERVATIONS of the image, EO, DSM (raster or LAS/LAZ), optional "
+                    "PLANES; OUTPUT_CSV = 3D points"
+                ),
+            ),
             ("accuracyreport", _t("INPUT = monoplotted check points against their reference")),
         ),
     ),
     Workflow(
         _t("Aerial triangulation and orthophotos"),
         (
-            ("calibratecamera", _t("IMAGES = views of a chessboard or ChArUco target; "
-             "OUTPUT_CAMERA = the camera JSON (start values for the block, or held fixed)")),
-            ("tiepoints", _t("IMAGES (and the approximate EO + CAMERA to pair images by their "
-             "footprints); OUTPUT_OBSERVATIONS = tie points for the bundle")),
+            (
+                "calibratecamera",
+                _t(
+                    "IMAGES = views of a chessboard or ChArUco target; "
+                    "OUTPUT_CAMERA = the camera JSON (start values for the block, or held fixed)"
+                ),
+            ),
+            (
+                "tiepoints",
+                _t(
+                    "IMAGES (and the approximate EO + CAMERA to pair images by their "
+                    "footprints); OUTPUT_OBSERVATIONS = tie points for the bundle"
+                ),
+            ),
             _CHIPS_STEP,
             _LOCATE_STEP,
-            ("bundleadjustment", _t("CAMERA, OBSERVATIONS, GROUND_POINTS, EO (approximate); "
-             "OUTPUT_EO = adjusted orientation, OUTPUT_CAMERA = calibrated camera")),
+            (
+                "bundleadjustment",
+                _t(
+                    "CAMERA, OBSERVATIONS, GROUND_POINTS, EO (approximate); "
+                    "OUTPUT_EO = adjusted orientation, OUTPUT_CAMERA = calibrated camera"
+                ),
+            ),
             ("groundfilter", _t("OUTPUT_DTM = the terrain for the orthophotos")),
-            ("orthorectify", _t("CAMERA and EO from the bundle, IMAGES, DSM = the DTM or DSM; "
-             "OUTPUT_FOLDER = one orthophoto per image")),
-            ("orthomosaic", _t("ORTHOPHOTOS = that folder; OUTPUT = the mosaic, SEAMLINES_CSV = "
-             "the region of each image")),
+            (
+                "orthorectify",
+                _t(
+                    "CAMERA and EO from the bundle, IMAGES, DSM = the DTM or DSM; "
+                    "OUTPUT_FOLDER = one orthophoto per image"
+                ),
+            ),
+            (
+                "orthomosaic",
+                _t(
+                    "ORTHOPHOTOS = that folder; OUTPUT = the mosaic, SEAMLINES_CSV = "
+                    "the region of each image"
+                ),
+            ),
             ("accuracyreport", _t("INPUT = check points measured on the mosaic")),
         ),
     ),
     Workflow(
         _t("A COLMAP block: orthophotos on the LiDAR DSM, and back to COLMAP"),
         (
-            ("importcolmap", _t("INPUT = the model's cameras.txt or cameras.bin; FRAME = the "
-             "frame of its coordinates (LOCAL, ECEF with CRS, or a CRS); OUTPUT_CAMERA, "
-             "OUTPUT_EO, OUTPUT_OBSERVATIONS, OUTPUT_POINTS")),
-            ("orthorectify", _t("CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
-             "OUTPUT_FOLDER = one orthophoto per image")),
-            ("exportcolmap", _t("CAMERA, EO (e.g. adjusted by bundleadjustment), OBSERVATIONS "
-             "and POINTS; OUTPUT_FOLDER = the COLMAP text model")),
+            (
+                "importcolmap",
+                _t(
+                    "INPUT = the model's cameras.txt or cameras.bin; FRAME = the "
+                    "frame of its coordinates (LOCAL, ECEF with CRS, or a CRS); OUTPUT_CAMERA, "
+                    "OUTPUT_EO, OUTPUT_OBSERVATIONS, OUTPUT_POINTS"
+                ),
+            ),
+            (
+                "orthorectify",
+                _t(
+                    "CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
+                    "OUTPUT_FOLDER = one orthophoto per image"
+                ),
+            ),
+            (
+                "exportcolmap",
+                _t(
+                    "CAMERA, EO (e.g. adjusted by bundleadjustment), OBSERVATIONS "
+                    "and POINTS; OUTPUT_FOLDER = the COLMAP text model"
+                ),
+            ),
         ),
     ),
     Workflow(
         _t("An OpenSfM / ODM block: orthophotos on the LiDAR DSM"),
         (
-            ("importopensfm", _t("INPUT = the reconstruction.json (ODM: opensfm/); CRS = the "
-             "mapping CRS (empty: topocentric, LOCAL); OUTPUT_CAMERA, OUTPUT_EO, "
-             "OUTPUT_OBSERVATIONS, OUTPUT_POINTS")),
-            ("orthorectify", _t("CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
-             "OUTPUT_FOLDER = one orthophoto per image")),
-            ("exportopensfm", _t("CAMERA, EO (e.g. adjusted by bundleadjustment), "
-             "OBSERVATIONS and POINTS; OUTPUT_FOLDER = the reconstruction.json for OpenSfM / ODM")),
+            (
+                "importopensfm",
+                _t(
+                    "INPUT = the reconstruction.json (ODM: opensfm/); CRS = the "
+                    "mapping CRS (empty: topocentric, LOCAL); OUTPUT_CAMERA, OUTPUT_EO, "
+                    "OUTPUT_OBSERVATIONS, OUTPUT_POINTS"
+                ),
+            ),
+            (
+                "orthorectify",
+                _t(
+                    "CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
+                    "OUTPUT_FOLDER = one orthophoto per image"
+                ),
+            ),
+            (
+                "exportopensfm",
+                _t(
+                    "CAMERA, EO (e.g. adjusted by bundleadjustment), "
+                    "OBSERVATIONS and POINTS; OUTPUT_FOLDER = the reconstruction.json for "
+                    "OpenSfM / ODM"
+                ),
+            ),
         ),
     ),
     Workflow(
         _t("A Metashape block: orthophotos on the LiDAR DSM"),
         (
-            ("importmetashape", _t("INPUT = the camera XML (Export Cameras, Agisoft XML); "
-             "CRS = the mapping CRS (empty: the chunk's projected CRS); OUTPUT_CAMERA, "
-             "OUTPUT_EO")),
-            ("orthorectify", _t("CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
-             "OUTPUT_FOLDER = one orthophoto per image")),
+            (
+                "importmetashape",
+                _t(
+                    "INPUT = the camera XML (Export Cameras, Agisoft XML); "
+                    "CRS = the mapping CRS (empty: the chunk's projected CRS); OUTPUT_CAMERA, "
+                    "OUTPUT_EO"
+                ),
+            ),
+            (
+                "orthorectify",
+                _t(
+                    "CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
+                    "OUTPUT_FOLDER = one orthophoto per image"
+                ),
+            ),
         ),
     ),
     Workflow(
         _t("Boresight calibration without hand picks (automatic)"),
         (
-            ("extractroofplanes", _t("INPUT = the classified cloud; OUTPUT_CSV = the plane table, "
-             "OUTPUT_CLOUD = the cloud with plane_id")),
-            ("createlcps", _t("PLANES and CLOUD = the two outputs of extractroofplanes; "
-             "LINES_CSV = the LiDAR ridge, hip and valley lines")),
-            ("tiepoints", _t("IMAGES (and the approximate EO + CAMERA to pair images by their "
-             "footprints); OUTPUT_OBSERVATIONS = tie points (optional for the next step)")),
-            ("autoboresight", _t("IMAGES, CAMERA, TRAJECTORY, LINES, PLANES and CLOUD, "
-             "TIE_POINTS; OUTPUT_TABLE = boresight per group, OUTPUT_OBSERVATIONS = the "
-             "observations found")),
+            (
+                "extractroofplanes",
+                _t(
+                    "INPUT = the classified cloud; OUTPUT_CSV = the plane table, "
+                    "OUTPUT_CLOUD = the cloud with plane_id"
+                ),
+            ),
+            (
+                "createlcps",
+                _t(
+                    "PLANES and CLOUD = the two outputs of extractroofplanes; "
+                    "LINES_CSV = the LiDAR ridge, hip and valley lines"
+                ),
+            ),
+            (
+                "tiepoints",
+                _t(
+                    "IMAGES (and the approximate EO + CAMERA to pair images by their "
+                    "footprints); OUTPUT_OBSERVATIONS = tie points (optional for the next step)"
+                ),
+            ),
+            (
+                "autoboresight",
+                _t(
+                    "IMAGES, CAMERA, TRAJECTORY, LINES, PLANES and CLOUD, "
+                    "TIE_POINTS; OUTPUT_TABLE = boresight per group, OUTPUT_OBSERVATIONS = the "
+                    "observations found"
+                ),
+            ),
         ),
     ),
     Workflow(
         _t("A Pix4D block: orthophotos on the LiDAR DSM"),
         (
-            ("importpix4d", _t("INPUT = <project>_calibrated_camera_parameters.txt (Pix4D's "
-             "1_initial/params, its offset beside it); CRS = the project's output CRS (empty: "
-             "its _wkt.prj); OUTPUT_CAMERA, OUTPUT_EO")),
-            ("orthorectify", _t("CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
-             "OUTPUT_FOLDER = one orthophoto per image")),
+            (
+                "importpix4d",
+                _t(
+                    "INPUT = <project>_calibrated_camera_parameters.txt (Pix4D's "
+                    "1_initial/params, its offset beside it); CRS = the project's output CRS "
+                    "(empty: "
+                    "its _wkt.prj); OUTPUT_CAMERA, OUTPUT_EO"
+                ),
+            ),
+            (
+                "orthorectify",
+                _t(
+                    "CAMERA and EO from the import, IMAGES, DSM = the LiDAR DSM; "
+                    "OUTPUT_FOLDER = one orthophoto per image"
+                ),
+            ),
         ),
     ),
     Workflow(
         _t("Boresight calibration from an SBET (or ASCII export) and the camera events"),
         (
-            ("importtrajectory", _t("INPUT = the SBET, POSPac / Inertial Explorer export or "
-             "CSV; EVENTS = image_id, time; OUTPUT_TRAJECTORY = the trajectory table at the "
-             "events, OUTPUT_EO = the exterior orientation")),
-            ("boresightcalibration", _t("TRAJECTORY = that trajectory table, OBSERVATIONS = "
-             "image measurements of the control; OUTPUT_TABLE = boresight per group")),
+            (
+                "importtrajectory",
+                _t(
+                    "INPUT = the SBET, POSPac / Inertial Explorer export or "
+                    "CSV; EVENTS = image_id, time; OUTPUT_TRAJECTORY = the trajectory table at the "
+                    "events, OUTPUT_EO = the exterior orientation"
+                ),
+            ),
+            (
+                "boresightcalibration",
+                _t(
+                    "TRAJECTORY = that trajectory table, OBSERVATIONS = "
+                    "image measurements of the control; OUTPUT_TABLE = boresight per group"
+                ),
+            ),
         ),
     ),
     Workflow(
         _t("Boresight calibration with surveyed ground control located automatically"),
         (
-            ("trajectorytoeo", _t("INPUT = the GNSS/INS trajectory CSV; OUTPUT_CSV = the "
-             "exterior orientation of every image")),
+            (
+                "trajectorytoeo",
+                _t(
+                    "INPUT = the GNSS/INS trajectory CSV; OUTPUT_CSV = the "
+                    "exterior orientation of every image"
+                ),
+            ),
             _CHIPS_STEP,
             _LOCATE_STEP,
-            ("boresightcalibration", _t("OBSERVATIONS = those control rows, GROUND_POINTS = the "
-             "surveyed points (role control or check), TRAJECTORY; OUTPUT_TABLE = boresight "
-             "per group, OUTPUT_EO = corrected orientation")),
+            (
+                "boresightcalibration",
+                _t(
+                    "OBSERVATIONS = those control rows, GROUND_POINTS = the "
+                    "surveyed points (role control or check), TRAJECTORY; OUTPUT_TABLE = boresight "
+                    "per group, OUTPUT_EO = corrected orientation"
+                ),
+            ),
         ),
     ),
     Workflow(
         _t("LiDAR control for a whole block of tiles (dask.distributed)"),
         (
-            ("lidarblock", _t("INPUT = a folder of LAS/LAZ tiles or a .vpc; OUTPUT_FOLDER = "
-             "classified tiles, block.vpc, planes.csv, lcps.csv and lines.csv")),
-            ("boresightcalibration", _t("PLANES / LINES / LCPS = the block's tables, TRAJECTORY "
-             "and OBSERVATIONS as above")),
+            (
+                "lidarblock",
+                _t(
+                    "INPUT = a folder of LAS/LAZ tiles or a .vpc; OUTPUT_FOLDER = "
+                    "classified tiles, block.vpc, planes.csv, lcps.csv and lines.csv"
+                ),
+            ),
+            (
+                "boresightcalibration",
+                _t(
+                    "PLANES / LINES / LCPS = the block's tables, TRAJECTORY "
+                    "and OBSERVATIONS as above"
+                ),
+            ),
         ),
     ),
     Workflow(
         _t("Accepting a LiDAR survey (ASPRS Ed. 2: swath and vertical accuracy)"),
         (
-            ("lidaraccuracy", _t("INPUT = the survey's LAS/LAZ (ground classified), "
-             "CHECKPOINTS = surveyed points with land cover; OUTPUT_HTML = swath overlap, "
-             "within-swath and NVA/VVA verdicts, OUTPUT_CHECKPOINTS = the check points with "
-             "LiDAR heights")),
-            ("accuracyreport", _t("INPUT = that check-point table; OUTPUT_HTML = the NSSDA and "
-             "PEC-PCD sections of the LiDAR's vertical accuracy")),
+            (
+                "lidaraccuracy",
+                _t(
+                    "INPUT = the survey's LAS/LAZ (ground classified), "
+                    "CHECKPOINTS = surveyed points with land cover; OUTPUT_HTML = swath overlap, "
+                    "within-swath and NVA/VVA verdicts, OUTPUT_CHECKPOINTS = the check points with "
+                    "LiDAR heights"
+                ),
+            ),
+            (
+                "accuracyreport",
+                _t(
+                    "INPUT = that check-point table; OUTPUT_HTML = the NSSDA and "
+                    "PEC-PCD sections of the LiDAR's vertical accuracy"
+                ),
+            ),
         ),
     ),
     Workflow(
         _t("Terrestrial laser scanner calibration (Lichti 2007)"),
         (
-            ("extracttlstargets", _t("SCANS = the station clouds, CONTROL = target ids; OUTPUT = "
-             "target observations")),
-            ("tlscalibration", _t("OBSERVATIONS = those targets, CONTROL and STATIONS; "
-             "OUTPUT_APS = the scanner's additional parameters, OUTPUT_HTML = the report")),
+            (
+                "extracttlstargets",
+                _t(
+                    "SCANS = the station clouds, CONTROL = target ids; OUTPUT = target observations"
+                ),
+            ),
+            (
+                "tlscalibration",
+                _t(
+                    "OBSERVATIONS = those targets, CONTROL and STATIONS; "
+                    "OUTPUT_APS = the scanner's additional parameters, OUTPUT_HTML = the report"
+                ),
+            ),
         ),
     ),
 )
@@ -243,8 +445,10 @@ def how_to_use(name: str, tr: Callable[[str], str] | None = None) -> str:
         for alg, note in w.steps:
             here = " " + t("(this algorithm)") if alg == name else ""
             lines += textwrap.wrap(
-                f"- {alg}{here}: {t(note)}", _WIDTH, subsequent_indent="  ",
+                f"- {alg}{here}: {t(note)}",
+                _WIDTH,
+                subsequent_indent="  ",
                 break_on_hyphens=False,
-            )  # fmt: skip
+            )
         blocks.append("\n".join(lines))
     return "\n\n".join(blocks)

@@ -65,11 +65,16 @@ def ground_buffer(params: Any) -> float:
     """
     method = getattr(params, "method", "")
     if method == "csf":
-        raise InputError("the cloth filter (CSF) couples the whole cloud: no tile buffer "
-                         "makes tiles agree; use SMRF or PMF for a block")  # fmt: skip
+        raise InputError(
+            "the cloth filter (CSF) couples the whole cloud: no tile buffer "
+            "makes tiles agree; use SMRF or PMF for a block"
+        )
     if method == "smrf" and params.slope == 0:
-        raise InputError("SMRF slope 0 (estimated from the cloud) differs from tile to tile: "
-                         "give the terrain slope for a block", column="slope")  # fmt: skip
+        raise InputError(
+            "SMRF slope 0 (estimated from the cloud) differs from tile to tile: "
+            "give the terrain slope for a block",
+            column="slope",
+        )
     # SMRF's max_window is a radius, PMF's a window width
     radius = params.max_window if method == "smrf" else params.max_window / 2.0
     low = params.low_outlier_radius if params.low_outlier_height > 0 else 0.0
@@ -98,8 +103,9 @@ def roof_buffer(k_neighbours: int, spacing: float) -> float:
     def radius(n: int) -> float:
         return math.sqrt(n / math.pi) * spacing
 
-    reach = radius(k_neighbours) + (REASSIGN_PASSES + 1) * radius(min(GROW_NEIGHBOURS,
-                                                                      k_neighbours))
+    reach = radius(k_neighbours) + (REASSIGN_PASSES + 1) * radius(
+        min(GROW_NEIGHBOURS, k_neighbours)
+    )
     seeds = 1.5 * reach + math.sqrt(2.0) * SEED_VOXEL * spacing + radius(k_neighbours)
     return float(max(3.0 * reach, seeds))
 
@@ -140,8 +146,9 @@ class BandLabels:
 
     def shifted(self, offset: int) -> BandLabels:
         """The same labels with piece indices counted from ``offset`` (the block's list)."""
-        return BandLabels(self.tile, self.ids, self.core,
-                          np.where(self.piece >= 0, self.piece + offset, -1))  # fmt: skip
+        return BandLabels(
+            self.tile, self.ids, self.core, np.where(self.piece >= 0, self.piece + offset, -1)
+        )
 
 
 @dataclass(frozen=True)
@@ -188,16 +195,17 @@ def tile_planes(
     # distance outside the box (the buffer side), 0 inside; the buffer is two bands: a plane
     # with points in its outer eighth may reach beyond the tile's points
     far = np.maximum(np.maximum(box[0] - x, x - box[2]), np.maximum(box[1] - y, y - box[3]))
-    outer = np.hypot(np.maximum(np.maximum(box[0] - x, x - box[2]), 0.0),
-                     np.maximum(np.maximum(box[1] - y, y - box[3]), 0.0))  # fmt: skip
+    outer = np.hypot(
+        np.maximum(np.maximum(box[0] - x, x - box[2]), 0.0),
+        np.maximum(np.maximum(box[1] - y, y - box[3]), 0.0),
+    )
     at_edge = np.zeros(len(planes) + 1, dtype=bool)
     at_edge[np.unique(label[far >= EDGE * band]) + 1] = True
     for pid in np.flatnonzero(sizes > 0):  # a plane only in the buffer: the neighbour's
         m = core_label == pid
         piece_of[pid + 1] = len(pieces)
         assert fit is not None  # the fit mask comes with every plane found
-        pieces.append(PlanePiece(tile, planes[pid], xyz[m], fit[m], ids[m],
-                                 bool(at_edge[pid + 1])))  # fmt: skip
+        pieces.append(PlanePiece(tile, planes[pid], xyz[m], fit[m], ids[m], bool(at_edge[pid + 1])))
     inband = np.where(core, inner < band, outer < band)
     return pieces, BandLabels(tile, ids[inband], core[inband], piece_of[label[inband] + 1])
 
@@ -220,9 +228,10 @@ def _shared(bands: Sequence[BandLabels], n: int) -> tuple[NDArray, NDArray, Any]
     u, c = u[ok], o[at[ok]]  # the same point: in one tile's buffer, in another's core
     pu, pc = piece[u], piece[c]
     # sparse (piece, other tile) counts: a dense table would be pieces x tiles
-    seen, seen_count = np.unique(np.concatenate([(pu * n_tiles + tile[c])[pu >= 0],
-                                                 (pc * n_tiles + tile[u])[pc >= 0]]),
-                                 return_counts=True)  # fmt: skip
+    seen, seen_count = np.unique(
+        np.concatenate([(pu * n_tiles + tile[c])[pu >= 0], (pc * n_tiles + tile[u])[pc >= 0]]),
+        return_counts=True,
+    )
 
     def over(p: NDArray, t: NDArray) -> NDArray:
         key = p * n_tiles + t
@@ -302,16 +311,24 @@ def merge_cut_planes(
             groups[ra] += groups.pop(rb)
             root[groups[ra]] = ra
     # a piece of fewer than 3 points that joined no other is no plane
-    merged = [(sorted(members), sum(len(pieces[k].points) for k in members))
-              for members in groups.values()]  # fmt: skip
+    merged = [
+        (sorted(members), sum(len(pieces[k].points) for k in members))
+        for members in groups.values()
+    ]
     merged = [m for m in merged if m[1] >= 3]
     merged.sort(key=lambda m: (-m[1], m[0][0]))
     out = []
     for new_id, (members, _) in enumerate(merged):
         pts = np.concatenate([pieces[k].points for k in members])
         ids = [i for i in (pieces[k].ids for k in members) if i is not None]
-        out.append(MergedPlane(_refit(pieces, members, new_id), tuple(members), pts,
-                               None if len(ids) < len(members) else np.concatenate(ids)))
+        out.append(
+            MergedPlane(
+                _refit(pieces, members, new_id),
+                tuple(members),
+                pts,
+                None if len(ids) < len(members) else np.concatenate(ids),
+            )
+        )
     return out
 
 

@@ -53,8 +53,7 @@ MAX_ROUNDS = 4
 
 #: ``fetch(box) -> (xyz (N, 3), ids (N,))``: the block's non-ground points in ``box`` (xmin,
 #: ymin, xmax, ymax; CRS unit), each once, with the ids the tiles gave them.
-Fetch = Callable[[tuple[float, float, float, float]], tuple[NDArray[np.float64],
-                                                            NDArray[np.int64]]]  # fmt: skip
+Fetch = Callable[[tuple[float, float, float, float]], tuple[NDArray[np.float64], NDArray[np.int64]]]
 
 
 def _dilate(mask: NDArray[np.bool_], r: int) -> NDArray[np.bool_]:
@@ -104,8 +103,12 @@ class _Grid:
         """Map box of the true cells of ``mask``."""
         i, j = np.nonzero(mask)
         s = self.size
-        return (float((self.lo[0] + i.min()) * s), float((self.lo[1] + j.min()) * s),
-                float((self.lo[0] + i.max() + 1) * s), float((self.lo[1] + j.max() + 1) * s))
+        return (
+            float((self.lo[0] + i.min()) * s),
+            float((self.lo[1] + j.min()) * s),
+            float((self.lo[0] + i.max() + 1) * s),
+            float((self.lo[1] + j.max() + 1) * s),
+        )
 
 
 def _components(mask: NDArray[np.bool_]) -> list[NDArray[np.bool_]]:
@@ -133,8 +136,12 @@ def _state(merged: Sequence[MergedPlane], pieces: Sequence[PlanePiece]) -> dict[
             fit.append(np.ones(len(pieces[p].points), bool) if f is None else f)
         if not m.pieces:
             fit.append(np.ones(len(m.ids), bool))
-    return {"ids": np.concatenate(ids), "xyz": np.concatenate(pts),
-            "label": np.concatenate(lab), "fit": np.concatenate(fit)}  # fmt: skip
+    return {
+        "ids": np.concatenate(ids),
+        "xyz": np.concatenate(pts),
+        "label": np.concatenate(lab),
+        "fit": np.concatenate(fit),
+    }
 
 
 def _window_run(
@@ -154,8 +161,12 @@ def _window_run(
     inwin = grid.look(win_m, xy)
     xyz, ids, xy = xyz[inwin], ids[inwin], xy[inwin]
     res = extract_roof_planes(xyz, params)
-    log.info("second pass: a window of %d points, %.0f x %.0f", len(xyz),
-             grid.box(win_m)[2] - grid.box(win_m)[0], grid.box(win_m)[3] - grid.box(win_m)[1])
+    log.info(
+        "second pass: a window of %d points, %.0f x %.0f",
+        len(xyz),
+        grid.box(win_m)[2] - grid.box(win_m)[0],
+        grid.box(win_m)[3] - grid.box(win_m)[1],
+    )
     lab = res.plane_id.astype(np.int64)
     fit = res.fit_mask if res.fit_mask is not None else np.ones(len(xyz), bool)
     core = grid.look(core_m, xy)
@@ -167,8 +178,7 @@ def _window_run(
     inner = np.unique(lab[grid.look(marked, xy) & (lab >= 0)])
     cut = np.intersect1d(inner, np.unique(lab[outer & (lab >= 0)]))
     grow = grid.mask(grid.of(xy[np.isin(lab, cut)])) if len(cut) else np.zeros_like(marked)
-    return {"ids": ids, "xyz": xyz, "label": lab, "fit": fit, "core": core,
-            "band": band}, grow  # fmt: skip
+    return {"ids": ids, "xyz": xyz, "label": lab, "fit": fit, "core": core, "band": band}, grow
 
 
 def _joins(blab: NDArray[np.int64], wlab: NDArray[np.int64]) -> dict[int, int]:
@@ -178,8 +188,7 @@ def _joins(blab: NDArray[np.int64], wlab: NDArray[np.int64]) -> dict[int, int]:
     both = (blab >= 0) & (wlab >= 0)
     if not both.any():
         return {}
-    pairs, count = np.unique(np.column_stack([wlab[both], blab[both]]), axis=0,
-                             return_counts=True)  # fmt: skip
+    pairs, count = np.unique(np.column_stack([wlab[both], blab[both]]), axis=0, return_counts=True)
     nw = dict(zip(*np.unique(wlab[wlab >= 0], return_counts=True)))
     nb = dict(zip(*np.unique(blab[blab >= 0], return_counts=True)))
     out: dict[int, int] = {}
@@ -227,8 +236,7 @@ MapWindows = Callable[[Callable[..., Any], list[tuple[Any, ...]]], list[Any]]
 CELLS_PER_BUFFER = 4
 
 
-def run_window(cells: NDArray[np.int64], size: float, params: Any,
-               fetch: Fetch) -> dict[str, Any]:  # fmt: skip
+def run_window(cells: NDArray[np.int64], size: float, params: Any, fetch: Fetch) -> dict[str, Any]:
     """One window of the second pass from its marked ``cells`` (K, 2; global indices of
     cells of ``size``), re-run larger while a cut region reaches its edge (at most
     MAX_ROUNDS runs): its points, labels, fit mask, core and band flags (``_window_run``)."""
@@ -278,8 +286,9 @@ def second_pass(
     return _planes(merged, state, params.min_plane_points)
 
 
-def _planes(merged: Sequence[MergedPlane], state: dict[str, Any],
-            min_points: int) -> list[MergedPlane]:  # fmt: skip
+def _planes(
+    merged: Sequence[MergedPlane], state: dict[str, Any], min_points: int
+) -> list[MergedPlane]:
     """The block planes from the state: untouched planes as they were, touched ones refitted
     (dropped below ``min_points``); ids by decreasing size (ties: lowest point id)."""
     lab, ids = state["label"], state["ids"]
@@ -339,10 +348,15 @@ def tiled_planes(
         for j in range(len(ys) - 1):
             box = (xs[i], ys[j], xs[i + 1], ys[j + 1])
             core = (x >= box[0]) & (x < box[2]) & (y >= box[1]) & (y < box[3])
-            near = ((x >= box[0] - buffer) & (x <= box[2] + buffer) & (y >= box[1] - buffer)
-                    & (y <= box[3] + buffer))  # fmt: skip
-            got, band = tile_planes(xyz[near], core[near], ids[near], box, buffer / 2.0,
-                                    params, len(bands))  # fmt: skip
+            near = (
+                (x >= box[0] - buffer)
+                & (x <= box[2] + buffer)
+                & (y >= box[1] - buffer)
+                & (y <= box[3] + buffer)
+            )
+            got, band = tile_planes(
+                xyz[near], core[near], ids[near], box, buffer / 2.0, params, len(bands)
+            )
             bands.append(band.shifted(len(pieces)))
             pieces += got
     merged = merge_cut_planes(pieces, bands)

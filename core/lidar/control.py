@@ -467,16 +467,23 @@ def _three_plane_points(cand, by_id, pts, ids, options, rejected) -> list[Contro
         min_angle = float(angles[t].min())
         if min_angle < options.min_angle_deg:
             rejected.append(
-                Rejection(tri, f"normals nearly parallel: {min_angle:.1f} deg between two planes "
-                          f"(< {options.min_angle_deg:g} deg)", REJECT_PARALLEL)
-            )  # fmt: skip
+                Rejection(
+                    tri,
+                    f"normals nearly parallel: {min_angle:.1f} deg between two planes "
+                    f"(< {options.min_angle_deg:g} deg)",
+                    REJECT_PARALLEL,
+                )
+            )
             continue
         if not np.isfinite(cond[t]) or cond[t] > options.max_condition:
             rejected.append(
-                Rejection(tri, f"the planes meet in a line rather than a point "
-                          f"(condition number {cond[t]:.3g} > {options.max_condition:g})",
-                          REJECT_CONDITION)
-            )  # fmt: skip
+                Rejection(
+                    tri,
+                    f"the planes meet in a line rather than a point "
+                    f"(condition number {cond[t]:.3g} > {options.max_condition:g})",
+                    REJECT_CONDITION,
+                )
+            )
             continue
         support = np.empty(3)
         for k, pid in enumerate(tri):
@@ -486,9 +493,13 @@ def _three_plane_points(cand, by_id, pts, ids, options, rejected) -> list[Contro
         if np.any(support > options.max_support_distance):
             far = tri[int(np.argmax(support))]
             rejected.append(
-                Rejection(tri, f"intersection {support.max():.2f} {u} from the points of plane "
-                          f"{far} (> {options.max_support_distance:g} {u})", REJECT_SUPPORT)
-            )  # fmt: skip
+                Rejection(
+                    tri,
+                    f"intersection {support.max():.2f} {u} from the points of plane "
+                    f"{far} (> {options.max_support_distance:g} {u})",
+                    REJECT_SUPPORT,
+                )
+            )
             continue
         out.append(
             ControlPoint(len(out) + 1, x[t], cov[t], tri, min_angle, float(cond[t]), support)
@@ -510,9 +521,13 @@ def _merge_duplicates(
             kept.append(p)
         else:
             rejected.append(
-                Rejection(p.plane_ids, f"same corner as planes {twin.plane_ids} (within "
-                          f"{radius:g} {unit}), which give a more precise point", REJECT_DUPLICATE)
-            )  # fmt: skip
+                Rejection(
+                    p.plane_ids,
+                    f"same corner as planes {twin.plane_ids} (within "
+                    f"{radius:g} {unit}), which give a more precise point",
+                    REJECT_DUPLICATE,
+                )
+            )
     kept.sort(key=lambda p: p.id)
     return [replace(p, id=i + 1) for i, p in enumerate(kept)]
 
@@ -546,9 +561,13 @@ def _two_plane_lines(cand, by_id, pts, ids, adjacency, options, rejected) -> lis
             continue
         if dihedral[e] < options.min_angle_deg or not np.all(np.isfinite(x0[e])):
             rejected.append(
-                Rejection(pair, f"planes nearly parallel ({dihedral[e]:.1f} deg "
-                          f"< {options.min_angle_deg:g} deg): no stable line", REJECT_LINE_PARALLEL)
-            )  # fmt: skip
+                Rejection(
+                    pair,
+                    f"planes nearly parallel ({dihedral[e]:.1f} deg "
+                    f"< {options.min_angle_deg:g} deg): no stable line",
+                    REJECT_LINE_PARALLEL,
+                )
+            )
             continue
         t = (contact[e] - x0[e]) @ u[e]
         start, end = x0[e] + t.min() * u[e], x0[e] + t.max() * u[e]

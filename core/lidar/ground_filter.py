@@ -122,8 +122,10 @@ class _Points:
 
                 return self.scaled.bounds(bounds(self.scaled.chunks))
             return self.scaled.bounds()
-        return (np.array([float(a.min()) for a in self.xyz]),
-                np.array([float(a.max()) for a in self.xyz]))  # fmt: skip
+        return (
+            np.array([float(a.min()) for a in self.xyz]),
+            np.array([float(a.max()) for a in self.xyz]),
+        )
 
     def axis(self, k: int) -> NDArray[np.float64]:
         return self.scaled.axis(k) if self.scaled is not None else self.xyz[k]
@@ -154,8 +156,12 @@ class _Points:
                         v = np.multiply(a[s], float(scales[k]))
                         v += float(offsets[k])
                         out.append(v)
-                yield (slice(lo + start, lo + start + len(out[0])), out[0], out[1],
-                       out[2] if z else None)  # fmt: skip
+                yield (
+                    slice(lo + start, lo + start + len(out[0])),
+                    out[0],
+                    out[1],
+                    out[2] if z else None,
+                )
 
 
 @dataclass(frozen=True)
@@ -370,8 +376,9 @@ def _remove_low_outliers(
         if compiled:
             from . import ground_filter_numba as nb
 
-            count, rebuilt = nb.low_pass_all(flat, zr, candidate, low, reference, around,
-                                             cells.zmin.size)  # fmt: skip
+            count, rebuilt = nb.low_pass_all(
+                flat, zr, candidate, low, reference, around, cells.zmin.size
+            )
             if not count:
                 break
             cells.zmin = rebuilt.reshape(cells.zmin.shape)
@@ -422,8 +429,9 @@ def _cloth_surface(
         if candidate is not None:
             zc[~candidate] = np.inf
     g_xy = 1.0 / vertical_unit_to_metre if vertical_unit_to_metre > 0 else 1.0
-    dtm, steps, moved = _csf_cloth(grid, cells.flat, points.axis(0), points.axis(1), zc, p, g_xy,
-                                   should_stop)  # fmt: skip
+    dtm, steps, moved = _csf_cloth(
+        grid, cells.flat, points.axis(0), points.axis(1), zc, p, g_xy, should_stop
+    )
     reach = np.ones(dtm.shape, dtype=bool)
     thr_cell = np.full(dtm.size, p.threshold, dtype=np.float32)
     stats = {"csf_steps": steps, "csf_last_move": moved}
@@ -458,8 +466,7 @@ def _opened_surface(
         assert isinstance(p, GroundFilterParams)
         windows, thresholds = pmf_windows(p)
         shape, final, scalar = p.window_shape, p.ground_threshold, p.slope_scalar
-    objects = _progressive_opening(filled, windows, thresholds, shape, should_stop,
-                                   compiled)  # fmt: skip
+    objects = _progressive_opening(filled, windows, thresholds, shape, should_stop, compiled)
     ground_cells = valid & ~objects
     if not ground_cells.any():
         ground_cells = valid
@@ -496,8 +503,19 @@ def _classify(
 
         dtm_flat = np.ascontiguousarray(dtm, dtype=np.float32).ravel()
         stop_if_asked(should_stop, "filtering the ground")
-        nb.classify_all(points.parts(), grid, flat, zr, dtm_flat, thr_cell, low, candidate,
-                        nodata_flat, ground, hag)  # fmt: skip
+        nb.classify_all(
+            points.parts(),
+            grid,
+            flat,
+            zr,
+            dtm_flat,
+            thr_cell,
+            low,
+            candidate,
+            nodata_flat,
+            ground,
+            hag,
+        )
         report(1.0)
     else:
         for s, bx, by, _ in points.blocks(should_stop, z=False):
@@ -628,15 +646,17 @@ def ground_filter(
 
     if p.method == "csf":
         assert isinstance(p, CsfParams)
-        surf = _cloth_surface(cells, grid, points, low, candidate, p, vertical_unit_to_metre,
-                              should_stop)  # fmt: skip
+        surf = _cloth_surface(
+            cells, grid, points, low, candidate, p, vertical_unit_to_metre, should_stop
+        )
     else:
         surf = _opened_surface(cells, params, p, xy_per_z, compiled, should_stop)
     p = surf.params
     report(0.6)
 
-    ground, hag = _classify(points, grid, cells, surf, low, candidate, heights, compiled,
-                            report, should_stop)  # fmt: skip
+    ground, hag = _classify(
+        points, grid, cells, surf, low, candidate, heights, compiled, report, should_stop
+    )
     dtm, reach, windows, thresholds = surf.dtm, surf.reach, surf.windows, surf.thresholds
     ground_count, low_count = int(np.count_nonzero(ground)), int(np.count_nonzero(low))
     dtm_out = (dtm.astype(np.float64) + z0).astype(np.float32)

@@ -151,8 +151,10 @@ def _csf_smooth(
     big = (sizes > CSF_SMOOTH_MIN_REGION)[labels] & movable
     index = np.arange(rows * cols).reshape(rows, cols)
     heads, tails = [], []
-    for sa, sb in (((slice(None), slice(0, -1)), (slice(None), slice(1, None))),
-                   ((slice(0, -1), slice(None)), (slice(1, None), slice(None)))):  # fmt: skip
+    for sa, sb in (
+        ((slice(None), slice(0, -1)), (slice(None), slice(1, None))),
+        ((slice(0, -1), slice(None)), (slice(1, None), slice(None))),
+    ):
         close = np.abs(ihv[sa] - ihv[sb]) < near
         heads.append(index[sa][close])
         tails.append(index[sb][close])

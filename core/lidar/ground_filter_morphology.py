@@ -128,8 +128,9 @@ def _estimate_slope(
         return SLOPE_RANGE[0]
     first = replace(p, cell_size=2 * p.cell_size, slope=SMRF_PUBLISHED.slope * xy_per_z)
     windows, thresholds = smrf_windows(first)
-    objects = _progressive_opening(fill_nearest(coarse, ok), windows, thresholds, "disk",
-                                   should_stop, compiled)  # fmt: skip
+    objects = _progressive_opening(
+        fill_nearest(coarse, ok), windows, thresholds, "disk", should_stop, compiled
+    )
     ground = ok & ~objects
     if not ground.any():
         return SLOPE_RANGE[0]

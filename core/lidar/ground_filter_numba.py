@@ -43,12 +43,43 @@ except Exception:  # ImportError, or a numba built against another numpy
     numba = None
     AVAILABLE = False
 
-__all__ = ["AVAILABLE", "bounds", "cells", "cells_all", "classify", "classify_all", "low_pass",
-           "low_pass_all", "opening", "rectangles"]  # fmt: skip
+__all__ = [
+    "AVAILABLE",
+    "bounds",
+    "cells",
+    "cells_all",
+    "classify",
+    "classify_all",
+    "low_pass",
+    "low_pass_all",
+    "opening",
+    "rectangles",
+]
 
 
-def _cells_kernel(X, Y, Z, sx, ox, sy, oy, sz, oz, x0, y_top, inv, cols, rows, z0, cand,
-                  use_cand, lo, flat, zr, zmin):  # fmt: skip
+def _cells_kernel(
+    X,
+    Y,
+    Z,
+    sx,
+    ox,
+    sy,
+    oy,
+    sz,
+    oz,
+    x0,
+    y_top,
+    inv,
+    cols,
+    rows,
+    z0,
+    cand,
+    use_cand,
+    lo,
+    flat,
+    zr,
+    zmin,
+):
     """Points lo .. lo + len(X) - 1: flat cell index, float32 z - z0, and the lowest candidate
     of each cell into ``zmin`` (flat, +inf where none)."""
     for i in range(X.shape[0]):
@@ -102,8 +133,31 @@ def _low_pass_kernel(flat, zr, cand, use_cand, low, reference, around, use_aroun
     return count
 
 
-def _classify_kernel(X, Y, sx, ox, sy, oy, x0, y_top, inv, cols, rows, lo, flat, zr, dtm, thr,
-                     low, cand, use_cand, nodata, ground, hag, want_hag):  # fmt: skip
+def _classify_kernel(
+    X,
+    Y,
+    sx,
+    ox,
+    sy,
+    oy,
+    x0,
+    y_top,
+    inv,
+    cols,
+    rows,
+    lo,
+    flat,
+    zr,
+    dtm,
+    thr,
+    low,
+    cand,
+    use_cand,
+    nodata,
+    ground,
+    hag,
+    want_hag,
+):
     """Points lo .. lo + len(X) - 1: ground when |z - DTM| <= the cell's tolerance (the DTM
     bilinear between cell centres, as Grid.bilinear computes it, in float32), never when low
     or not a candidate; the height (NaN where the DTM is nodata) when ``want_hag``."""
@@ -287,9 +341,13 @@ def _compiled(name: str) -> Callable[..., Any]:
     this module, keyed by the module's import name)."""
     if name not in _COMPILED:
         kernels: dict[str, Callable[..., Any]]
-        kernels = {"cells": _cells_kernel, "low_pass": _low_pass_kernel,
-                "classify": _classify_kernel, "bounds": _bounds_kernel,
-                "rect_union": _rect_union_kernel}  # fmt: skip
+        kernels = {
+            "cells": _cells_kernel,
+            "low_pass": _low_pass_kernel,
+            "classify": _classify_kernel,
+            "bounds": _bounds_kernel,
+            "rect_union": _rect_union_kernel,
+        }
         _COMPILED[name] = cached_njit(kernels[name], nogil=True)
     return _COMPILED[name]
 
@@ -298,37 +356,102 @@ _NO_BOOL = np.zeros(0, dtype=bool)
 _NO_FLOAT = np.zeros(0, dtype=np.float32)
 
 
-def cells(part: Any, grid: Any, z0: float, candidate: Any, lo: int, flat: Any, zr: Any,
-          zmin: Any) -> None:  # fmt: skip
+def cells(
+    part: Any, grid: Any, z0: float, candidate: Any, lo: int, flat: Any, zr: Any, zmin: Any
+) -> None:
     """:func:`_cells_kernel` on one part ``(X, Y, Z, scales, offsets)`` of the points."""
     X, Y, Z, (sx, sy, sz), (ox, oy, oz) = part
     use = candidate is not None
-    _compiled("cells")(X, Y, Z, float(sx), float(ox), float(sy), float(oy), float(sz), float(oz),
-                       float(grid.x0), float(grid.y_top), 1.0 / grid.cell, int(grid.cols),
-                       int(grid.rows), float(z0), candidate if use else _NO_BOOL, use, int(lo),
-                       flat, zr, zmin)  # fmt: skip
+    _compiled("cells")(
+        X,
+        Y,
+        Z,
+        float(sx),
+        float(ox),
+        float(sy),
+        float(oy),
+        float(sz),
+        float(oz),
+        float(grid.x0),
+        float(grid.y_top),
+        1.0 / grid.cell,
+        int(grid.cols),
+        int(grid.rows),
+        float(z0),
+        candidate if use else _NO_BOOL,
+        use,
+        int(lo),
+        flat,
+        zr,
+        zmin,
+    )
 
 
-def low_pass(flat: Any, zr: Any, candidate: Any, low: Any, reference: Any, around: Any,
-             zmin: Any) -> int:  # fmt: skip
+def low_pass(
+    flat: Any, zr: Any, candidate: Any, low: Any, reference: Any, around: Any, zmin: Any
+) -> int:
     """:func:`_low_pass_kernel` over every point; returns the number of new low outliers."""
     use = candidate is not None
     ring = around is not None
     kernel = _compiled("low_pass")
-    return int(kernel(flat, zr, candidate if use else _NO_BOOL, use, low, reference,
-                      around if ring else _NO_FLOAT, ring, zmin))  # fmt: skip
+    return int(
+        kernel(
+            flat,
+            zr,
+            candidate if use else _NO_BOOL,
+            use,
+            low,
+            reference,
+            around if ring else _NO_FLOAT,
+            ring,
+            zmin,
+        )
+    )
 
 
-def classify(part: Any, grid: Any, lo: int, flat: Any, zr: Any, dtm: Any, thr: Any, low: Any,
-             candidate: Any, nodata: Any, ground: Any, hag: Any) -> None:  # fmt: skip
+def classify(
+    part: Any,
+    grid: Any,
+    lo: int,
+    flat: Any,
+    zr: Any,
+    dtm: Any,
+    thr: Any,
+    low: Any,
+    candidate: Any,
+    nodata: Any,
+    ground: Any,
+    hag: Any,
+) -> None:
     """:func:`_classify_kernel` on one part ``(X, Y, Z, scales, offsets)`` of the points."""
     X, Y, _, (sx, sy, _), (ox, oy, _) = part
     use = candidate is not None
     want = hag is not None
-    _compiled("classify")(X, Y, float(sx), float(ox), float(sy), float(oy), float(grid.x0),
-                          float(grid.y_top), 1.0 / grid.cell, int(grid.cols), int(grid.rows),
-                          int(lo), flat, zr, dtm, thr, low, candidate if use else _NO_BOOL, use,
-                          nodata, ground, hag if want else _NO_FLOAT, want)  # fmt: skip
+    _compiled("classify")(
+        X,
+        Y,
+        float(sx),
+        float(ox),
+        float(sy),
+        float(oy),
+        float(grid.x0),
+        float(grid.y_top),
+        1.0 / grid.cell,
+        int(grid.cols),
+        int(grid.rows),
+        int(lo),
+        flat,
+        zr,
+        dtm,
+        thr,
+        low,
+        candidate if use else _NO_BOOL,
+        use,
+        nodata,
+        ground,
+        hag if want else _NO_FLOAT,
+        want,
+    )
 
 
 def bounds(chunks: Any) -> Any:
@@ -393,8 +516,11 @@ def _pool() -> Any:
         if not _POOL:
             from concurrent.futures import ThreadPoolExecutor
 
-            _POOL.append(ThreadPoolExecutor(_threads(), thread_name_prefix="lidarphoto-grid",
-                                            initializer=_block_signals))  # fmt: skip
+            _POOL.append(
+                ThreadPoolExecutor(
+                    _threads(), thread_name_prefix="lidarphoto-grid", initializer=_block_signals
+                )
+            )
     return _POOL[0]
 
 
@@ -435,8 +561,10 @@ def morph(src: Any, kernel: Any, dilate: bool) -> Any | None:
     if parts == 1:
         kernel_fn(src, out, rects[0], rects[1], sign, 0, rows)
         return out
-    jobs = [_pool().submit(kernel_fn, src, out, rects[0], rects[1], sign, lo, hi)
-            for lo, hi in zip(cuts[:-1], cuts[1:])]  # fmt: skip
+    jobs = [
+        _pool().submit(kernel_fn, src, out, rects[0], rects[1], sign, lo, hi)
+        for lo, hi in zip(cuts[:-1], cuts[1:])
+    ]
     for job in jobs:
         job.result()
     return out
@@ -500,8 +628,9 @@ def cells_all(parts: Any, grid: Any, z0: float, candidate: Any, flat: Any, zr: A
     return grids[0]
 
 
-def low_pass_all(flat: Any, zr: Any, candidate: Any, low: Any, reference: Any, around: Any,
-                 size: int) -> tuple[int, Any]:  # fmt: skip
+def low_pass_all(
+    flat: Any, zr: Any, candidate: Any, low: Any, reference: Any, around: Any, size: int
+) -> tuple[int, Any]:
     """:func:`low_pass` over every point, the threads each on a share with their own grid;
     returns the number of new low outliers and the new flat minimum grid."""
 
@@ -518,8 +647,19 @@ def low_pass_all(flat: Any, zr: Any, candidate: Any, low: Any, reference: Any, a
     return sum(c for c, _ in results), zmin
 
 
-def classify_all(parts: Any, grid: Any, flat: Any, zr: Any, dtm: Any, thr: Any, low: Any,
-                 candidate: Any, nodata: Any, ground: Any, hag: Any) -> None:  # fmt: skip
+def classify_all(
+    parts: Any,
+    grid: Any,
+    flat: Any,
+    zr: Any,
+    dtm: Any,
+    thr: Any,
+    low: Any,
+    candidate: Any,
+    nodata: Any,
+    ground: Any,
+    hag: Any,
+) -> None:
     """:func:`classify` over every part, pieces shared out among the threads (each point is
     written by one thread)."""
     pieces = _pieces(parts)

@@ -207,8 +207,7 @@ def extract_roof_planes(
     n = len(xyz)
     empty = np.full(n, -1, dtype=np.int32)
     if n < max(params.min_plane_points, params.k_neighbours):
-        msg = _t("no roof plane: only {n} candidate points (fewer than needed for one plane)",
-                 n=n)  # fmt: skip
+        msg = _t("no roof plane: only {n} candidate points (fewer than needed for one plane)", n=n)
         log.info(msg)
         return RoofPlaneResult((), empty, 0, params.outline_cell, msg)
     # centred once: map coordinates (1e5-1e6) would cost digits in every product below
@@ -219,8 +218,9 @@ def extract_roof_planes(
     compiled = _use_numba(backend)
     order, grid = _spatial_order(xyz, origin, params.k_neighbours, compiled)
     q = grid.q
-    keep, normals, quality, knn, spacing_of = _local_planes(grid, params, backend, progress,
-                                                         should_stop)  # fmt: skip
+    keep, normals, quality, knn, spacing_of = _local_planes(
+        grid, params, backend, progress, should_stop
+    )
     del grid
     n_cand = int(keep.sum())
     log.info("local RANSAC kept %d of %d points (%.1f %%)", n_cand, n, 100.0 * n_cand / n)
@@ -231,8 +231,7 @@ def extract_roof_planes(
     if progress is not None:
         progress(0.8)
     eps = params.epsilon
-    labels = _drop_small(_merge_coplanar(q, labels, knn, params, compiled),
-                         params.min_plane_points)  # fmt: skip
+    labels = _drop_small(_merge_coplanar(q, labels, knn, params, compiled), params.min_plane_points)
     for _ in range(2):
         labels = _drop_small(_release_far(q, labels, eps, compiled), params.min_plane_points)
     for _ in range(REASSIGN_PASSES):
@@ -241,8 +240,7 @@ def extract_roof_planes(
             params.min_plane_points,
         )
     labels = _merge_coplanar(q, labels, knn, params, compiled)
-    labels, ambiguous = _reassign(q, labels, knn, eps, params.batch_size * 8, should_stop,
-                                  compiled)  # fmt: skip
+    labels, ambiguous = _reassign(q, labels, knn, eps, params.batch_size * 8, should_stop, compiled)
     labels = _drop_small(labels, params.min_plane_points)
     if progress is not None:
         progress(0.9)
@@ -255,8 +253,7 @@ def extract_roof_planes(
         interior[lo:hi] = (labels[knn[lo:hi]] == labels[lo:hi, None]).all(axis=1)
     fit_sorted = keep & ~ambiguous & interior
     del q, knn, interior, ambiguous, spacing_of  # the fits need the points and labels only
-    planes, pid_sorted = _final_planes(xyz, order, labels, fit_sorted, cell, progress,
-                                       should_stop)  # fmt: skip
+    planes, pid_sorted = _final_planes(xyz, order, labels, fit_sorted, cell, progress, should_stop)
     # back to the input's order (the work ran on the sorted points)
     plane_id = np.empty(n, dtype=np.int32)
     plane_id[order] = pid_sorted

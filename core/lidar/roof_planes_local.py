@@ -45,8 +45,9 @@ def _eig_normals(cov: NDArray, compiled: bool = False) -> NDArray:
         from . import roof_planes_numba
 
         return roof_planes_numba.normals(cov)
-    nx, ny, nz = _jacobi_normals(cov[:, 0, 0], cov[:, 0, 1], cov[:, 0, 2], cov[:, 1, 1],
-                                 cov[:, 1, 2], cov[:, 2, 2])  # fmt: skip
+    nx, ny, nz = _jacobi_normals(
+        cov[:, 0, 0], cov[:, 0, 1], cov[:, 0, 2], cov[:, 1, 1], cov[:, 1, 2], cov[:, 2, 2]
+    )
     return np.column_stack([nx, ny, nz])
 
 
@@ -125,11 +126,9 @@ def _spatial_order(
     ny = int(span[1] / cell) + 1
     # cells of the centred coordinates, as the search computes their bounds
     x0, y0 = lo[0] - origin[0], lo[1] - origin[1]
-    key = np.minimum(np.maximum(((xyz[:, 1] - origin[1] - y0) / cell).astype(np.int64), 0),
-                     ny - 1)  # fmt: skip
+    key = np.minimum(np.maximum(((xyz[:, 1] - origin[1] - y0) / cell).astype(np.int64), 0), ny - 1)
     key *= nx
-    key += np.minimum(np.maximum(((xyz[:, 0] - origin[0] - x0) / cell).astype(np.int64), 0),
-                      nx - 1)  # fmt: skip
+    key += np.minimum(np.maximum(((xyz[:, 0] - origin[0] - x0) / cell).astype(np.int64), 0), nx - 1)
     if compiled:  # a counting sort, then each cell by coordinates: the lexsort's order
         from . import roof_planes_numba
 
@@ -148,9 +147,18 @@ def _spatial_order(
     table = table_all[order]
     q -= origin
     grid = PointGrid(
-        q, key[order], start, nx, ny, float(x0), float(y0),
-        cell, np.column_stack([gx[o], gy[o]]).astype(np.int64), bound[o] ** 2, table,
-    )  # fmt: skip
+        q,
+        key[order],
+        start,
+        nx,
+        ny,
+        float(x0),
+        float(y0),
+        cell,
+        np.column_stack([gx[o], gy[o]]).astype(np.int64),
+        bound[o] ** 2,
+        table,
+    )
     return order, grid
 
 
@@ -256,8 +264,12 @@ def _ransac_numpy(
     length = np.where(valid, length, np.float32(1.0))
     nx, ny, nz = nx / length, ny / length, nz / length
     off = -(nx * ax + ny * ay + nz * az)  # (B, T)
-    d = np.abs(nx[..., None] * px[:, None, :] + ny[..., None] * py[:, None, :]
-               + nz[..., None] * pz[:, None, :] + off[..., None])  # (B, T, K)  # fmt: skip
+    d = np.abs(
+        nx[..., None] * px[:, None, :]
+        + ny[..., None] * py[:, None, :]
+        + nz[..., None] * pz[:, None, :]
+        + off[..., None]
+    )  # (B, T, K)
     support = np.count_nonzero(d < eps, axis=2)
     support[~valid] = 0
     best = np.argmax(support, axis=1)
@@ -280,8 +292,7 @@ def _ransac_numpy(
         for j in range(k):
             acc += dev[u_][:, j] * dev[v_][:, j]
         cov[u_, v_] = acc
-    fx, fy, fz = _jacobi_normals(cov[0, 0], cov[0, 1], cov[0, 2], cov[1, 1], cov[1, 2],
-                                 cov[2, 2])  # fmt: skip
+    fx, fy, fz = _jacobi_normals(cov[0, 0], cov[0, 1], cov[0, 2], cov[1, 1], cov[1, 2], cov[2, 2])
     dist_point = np.abs(fx * m[0] + fy * m[1] + fz * m[2])  # the query point at the origin
     rr = np.zeros(b)
     for j in range(k):
@@ -306,8 +317,13 @@ def _local_planes(
     backend: str,
     progress: Progress,
     should_stop: ShouldStop,
-) -> tuple[NDArray[np.bool_], NDArray[np.float32], NDArray[np.float32], NDArray[np.int32],
-           NDArray[np.float32]]:  # fmt: skip
+) -> tuple[
+    NDArray[np.bool_],
+    NDArray[np.float32],
+    NDArray[np.float32],
+    NDArray[np.int32],
+    NDArray[np.float32],
+]:
     """Step 1 on the sorted points. Returns keep (N,), local normals (N,3), local rms of the
     refined plane's inliers (N,), the first GROW_NEIGHBOURS neighbours (N, G) and the
     distance of each point to its 4th neighbour (N,)."""
@@ -340,8 +356,9 @@ def _local_planes(
         if compiled:
             from . import roof_planes_numba
 
-            roof_planes_numba.local_planes(grid, lo, hi, k, g, tri, params.epsilon,
-                                           params.min_support, cos_lo, cos_hi, out)  # fmt: skip
+            roof_planes_numba.local_planes(
+                grid, lo, hi, k, g, tri, params.epsilon, params.min_support, cos_lo, cos_hi, out
+            )
         else:
             d2, idx = _knn_numpy(tree, q, lo, hi, k)
             out["knn"][lo:hi] = idx[:, :g]

@@ -87,9 +87,11 @@ def _rotate_columns(c, s, a0, b0, a1, b1, a2, b2):
 @_jit_helper
 def _plane_dist(q, i, centre, normal, c):
     """Distance of point i of q to plane c (row c of ``centre`` and ``normal``)."""
-    return abs((q[i, 0] - centre[c, 0]) * normal[c, 0]
-               + (q[i, 1] - centre[c, 1]) * normal[c, 1]
-               + (q[i, 2] - centre[c, 2]) * normal[c, 2])  # fmt: skip
+    return abs(
+        (q[i, 0] - centre[c, 0]) * normal[c, 0]
+        + (q[i, 1] - centre[c, 1]) * normal[c, 1]
+        + (q[i, 2] - centre[c, 2]) * normal[c, 2]
+    )
 
 
 @_jit_helper
@@ -312,9 +314,32 @@ def _normals_kernel(cov, out):
 
 
 def _local_planes_kernel(
-    qs, cell_of, start, nx, ny, x0, y0, h, offs, bound2, lo, hi, k, g, tri, table, eps,
-    min_support, cos_lo, cos_hi, keep, normals, quality, knn, spacing,
-):  # fmt: skip
+    qs,
+    cell_of,
+    start,
+    nx,
+    ny,
+    x0,
+    y0,
+    h,
+    offs,
+    bound2,
+    lo,
+    hi,
+    k,
+    g,
+    tri,
+    table,
+    eps,
+    min_support,
+    cos_lo,
+    cos_hi,
+    keep,
+    normals,
+    quality,
+    knn,
+    spacing,
+):
     """Points lo .. hi-1 of ``qs`` (sorted by grid cell): K nearest neighbours and the local
     RANSAC; outputs at [i - lo] (keep, normals, quality, knn (first g), spacing)."""
     bd = np.empty(k)
@@ -346,8 +371,9 @@ def _local_planes_kernel(
             px32[j] = np.float32(qs[s, 0] - px)
             py32[j] = np.float32(qs[s, 1] - py)
             pz32[j] = np.float32(qs[s, 2] - pz)
-        best_support, bnx, bny, bnz, boff = _best_triplet(px32, py32, pz32, k, tri, table[i],
-                                                          eps32, tiny32)  # fmt: skip
+        best_support, bnx, bny, bnz, boff = _best_triplet(
+            px32, py32, pz32, k, tri, table[i], eps32, tiny32
+        )
         cnt = 0
         for j in range(k):
             d = abs(bnx * px32[j] + bny * py32[j] + bnz * pz32[j] + boff)
@@ -356,8 +382,7 @@ def _local_planes_kernel(
                 cnt += 1
         cnt = max(cnt, 1)
         # refit on the inliers (float64, sums in neighbour order)
-        mx, my, mz, a00, a01, a02, a11, a12, a22 = _inlier_moments(px32, py32, pz32, inl, k,
-                                                                   cnt)  # fmt: skip
+        mx, my, mz, a00, a01, a02, a11, a12, a22 = _inlier_moments(px32, py32, pz32, inl, k, cnt)
         nx_, ny_, nz_ = _jacobi_normal(a00, a01, a02, a11, a12, a22)
         dist_point = abs(nx_ * mx + ny_ * my + nz_ * mz)
         rr = 0.0
@@ -378,8 +403,22 @@ def _local_planes_kernel(
         normals[r, 2] = nz_
 
 
-def _claims_kernel(q, keep, normals, labels, knn, frontier, reg_n, reg_c, cos_tol, eps, best_d,
-                   best_r, out_cand, out_reg):  # fmt: skip
+def _claims_kernel(
+    q,
+    keep,
+    normals,
+    labels,
+    knn,
+    frontier,
+    reg_n,
+    reg_c,
+    cos_tol,
+    eps,
+    best_d,
+    best_r,
+    out_cand,
+    out_reg,
+):
     """One wave of the region growing (roof_planes._claims): the unlabelled kept neighbours of
     the frontier that fit their region, each to the nearest region plane (ties: the lower
     region); returns their number m, out_cand[:m] sorted, out_reg[:m]. best_d / best_r are
@@ -396,9 +435,11 @@ def _claims_kernel(q, keep, normals, labels, knn, frontier, reg_n, reg_c, cos_to
             dist = _plane_dist(q, j, reg_c, reg_n, reg)
             if not dist < eps:
                 continue
-            cosang = (np.float64(normals[j, 0]) * reg_n[reg, 0]
-                      + np.float64(normals[j, 1]) * reg_n[reg, 1]
-                      + np.float64(normals[j, 2]) * reg_n[reg, 2])  # fmt: skip
+            cosang = (
+                np.float64(normals[j, 0]) * reg_n[reg, 0]
+                + np.float64(normals[j, 1]) * reg_n[reg, 1]
+                + np.float64(normals[j, 2]) * reg_n[reg, 2]
+            )
             if not cosang > cos_tol:
                 continue
             if best_r[j] < 0:
@@ -538,9 +579,15 @@ def _compiled(name: str) -> Callable[..., Any]:
     """The jitted function (compiled at its first call, cached next to this module, the
     helpers it calls compiled into its cache entry)."""
     if name not in _COMPILED:
-        func = {"local_planes": _local_planes_kernel, "claims": _claims_kernel,
-                "reassign": _reassign_kernel, "pairs": _pairs_kernel, "order": _order_kernel,
-                "moments": _moments_kernel, "normals": _normals_kernel}[name]  # fmt: skip
+        func = {
+            "local_planes": _local_planes_kernel,
+            "claims": _claims_kernel,
+            "reassign": _reassign_kernel,
+            "pairs": _pairs_kernel,
+            "order": _order_kernel,
+            "moments": _moments_kernel,
+            "normals": _normals_kernel,
+        }[name]
         _COMPILED[name] = cached_njit(func, nogil=True)
     return _COMPILED[name]
 
@@ -564,35 +611,84 @@ def local_planes(
     if not AVAILABLE:
         raise RuntimeError("numba is not installed")
     _compiled("local_planes")(
-        grid.q, grid.cell_of, grid.start, grid.nx, grid.ny, grid.x0, grid.y0, grid.cell,
-        grid.offsets, grid.bound2, lo, hi, k, g, tri, grid.table, float(eps), int(min_support),
-        float(cos_lo), float(cos_hi), out["keep"][lo:hi], out["normals"][lo:hi],
-        out["quality"][lo:hi], out["knn"][lo:hi], out["spacing"][lo:hi],
-    )  # fmt: skip
+        grid.q,
+        grid.cell_of,
+        grid.start,
+        grid.nx,
+        grid.ny,
+        grid.x0,
+        grid.y0,
+        grid.cell,
+        grid.offsets,
+        grid.bound2,
+        lo,
+        hi,
+        k,
+        g,
+        tri,
+        grid.table,
+        float(eps),
+        int(min_support),
+        float(cos_lo),
+        float(cos_hi),
+        out["keep"][lo:hi],
+        out["normals"][lo:hi],
+        out["quality"][lo:hi],
+        out["knn"][lo:hi],
+        out["spacing"][lo:hi],
+    )
 
 
 def claims(
-    q: np.ndarray, keep: np.ndarray, normals: np.ndarray, labels: np.ndarray, knn: np.ndarray,
-    frontier: np.ndarray, reg_n: np.ndarray, reg_c: np.ndarray, cos_tol: float, eps: float,
+    q: np.ndarray,
+    keep: np.ndarray,
+    normals: np.ndarray,
+    labels: np.ndarray,
+    knn: np.ndarray,
+    frontier: np.ndarray,
+    reg_n: np.ndarray,
+    reg_c: np.ndarray,
+    cos_tol: float,
+    eps: float,
     scratch: dict[str, np.ndarray],
-) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+) -> tuple[np.ndarray, np.ndarray]:
     """One wave of the region growing (see roof_planes._claims): (points, regions)."""
     size = min(len(frontier) * knn.shape[1], len(q))
     cand = np.empty(size, dtype=np.int64)
     reg = np.empty(size, dtype=np.int64)
-    m = _compiled("claims")(q, keep, normals, labels, knn, frontier.astype(np.int64), reg_n,
-                            reg_c, float(cos_tol), float(eps), scratch["best_d"],
-                            scratch["best_r"], cand, reg)  # fmt: skip
+    m = _compiled("claims")(
+        q,
+        keep,
+        normals,
+        labels,
+        knn,
+        frontier.astype(np.int64),
+        reg_n,
+        reg_c,
+        float(cos_tol),
+        float(eps),
+        scratch["best_d"],
+        scratch["best_r"],
+        cand,
+        reg,
+    )
     return cand[:m], reg[:m]
 
 
 def reassign(
-    q: np.ndarray, labels: np.ndarray, knn: np.ndarray, centroids: np.ndarray,
-    normals: np.ndarray, eps: float, lo: int, hi: int, out: np.ndarray, ambiguous: np.ndarray,
-) -> None:  # fmt: skip
+    q: np.ndarray,
+    labels: np.ndarray,
+    knn: np.ndarray,
+    centroids: np.ndarray,
+    normals: np.ndarray,
+    eps: float,
+    lo: int,
+    hi: int,
+    out: np.ndarray,
+    ambiguous: np.ndarray,
+) -> None:
     """Points lo .. hi-1 of roof_planes._reassign into out / ambiguous."""
-    _compiled("reassign")(q, labels, knn, centroids, normals, float(eps), lo, hi, out,
-                          ambiguous)  # fmt: skip
+    _compiled("reassign")(q, labels, knn, centroids, normals, float(eps), lo, hi, out, ambiguous)
 
 
 def label_pairs(labels: np.ndarray, knn: np.ndarray, nl: int) -> np.ndarray:
@@ -608,8 +704,13 @@ def counting_order(key: np.ndarray, nbins: int, xyz: np.ndarray) -> tuple[np.nda
     coordinates ``xyz`` (N, 3): numpy's lexsort of (z, y, x, key)."""
     start = np.zeros(nbins + 1, dtype=np.int64)
     order = np.empty(len(key), dtype=np.int64)
-    _compiled("order")(key.astype(np.int64, copy=False), int(nbins),
-                       np.ascontiguousarray(xyz, dtype=np.float64), start, order)  # fmt: skip
+    _compiled("order")(
+        key.astype(np.int64, copy=False),
+        int(nbins),
+        np.ascontiguousarray(xyz, dtype=np.float64),
+        start,
+        order,
+    )
     return order, start
 
 

@@ -78,8 +78,7 @@ def _grow(
             break
         lev = level[cand_seed]
         key3 = np.floor((q[cand_seed] + shift) / np.ldexp(1.0, lev)[:, None]).astype(np.int64)
-        order = np.lexsort((cand_seed, quality[cand_seed], key3[:, 2], key3[:, 1], key3[:, 0],
-                            lev))  # fmt: skip
+        order = np.lexsort((cand_seed, quality[cand_seed], key3[:, 2], key3[:, 1], key3[:, 0], lev))
         key = np.column_stack([lev, key3])[order]
         first = np.ones(len(order), dtype=bool)
         first[1:] = (key[1:] != key[:-1]).any(axis=1)
@@ -100,12 +99,23 @@ def _grow(
             if compiled:
                 from . import roof_planes_numba
 
-                cand, reg = roof_planes_numba.claims(q, keep, normals, labels, knn, frontier,
-                                                     reg_n, reg_c, cos_tol, params.epsilon,
-                                                     scratch)  # fmt: skip
+                cand, reg = roof_planes_numba.claims(
+                    q,
+                    keep,
+                    normals,
+                    labels,
+                    knn,
+                    frontier,
+                    reg_n,
+                    reg_c,
+                    cos_tol,
+                    params.epsilon,
+                    scratch,
+                )
             else:
-                cand, reg = _claims(q, keep, normals, labels, knn, frontier, reg_n, reg_c,
-                                    cos_tol, params.epsilon)  # fmt: skip
+                cand, reg = _claims(
+                    q, keep, normals, labels, knn, frontier, reg_n, reg_c, cos_tol, params.epsilon
+                )
             if not len(cand):
                 if retried:
                     break
@@ -272,16 +282,18 @@ def _reassign(
         if compiled:
             from . import roof_planes_numba
 
-            roof_planes_numba.reassign(q, labels, knn, centroids, normals, eps, lo, hi, out,
-                                       ambiguous)  # fmt: skip
+            roof_planes_numba.reassign(
+                q, labels, knn, centroids, normals, eps, lo, hi, out, ambiguous
+            )
             continue
         cand = np.concatenate([labels[lo:hi, None], labels[knn[lo:hi]]], axis=1)  # (B, G+1)
         valid = cand >= 0
         c = np.where(valid, cand, 0)
         rel = q[lo:hi, None, :] - centroids[c]
         nc = normals[c]
-        dist = np.abs(rel[..., 0] * nc[..., 0] + rel[..., 1] * nc[..., 1]
-                      + rel[..., 2] * nc[..., 2])  # fmt: skip
+        dist = np.abs(
+            rel[..., 0] * nc[..., 0] + rel[..., 1] * nc[..., 1] + rel[..., 2] * nc[..., 2]
+        )
         dist[~valid] = np.inf
         best = np.argmin(dist, axis=1)
         rows = np.arange(hi - lo)
@@ -341,5 +353,3 @@ def _merge_coplanar(
     out = labels.copy()
     out[m] = comp[labels[m]]
     return out
-
-

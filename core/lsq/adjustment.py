@@ -96,7 +96,6 @@ Sigmas define the weights ``P = S^-1``; ``sigma0_prior`` is the a-priori standar
 unit weight, so ``Omega / sigma0_prior^2`` is chi-square distributed when the sigmas are right.
 """
 
-
 from __future__ import annotations
 
 from collections.abc import Sequence
@@ -168,7 +167,6 @@ def _problem(
     return x, _Problem(name_list, obs, cons, plan)
 
 
-
 def adjust(
     x0: ArrayLike,
     names: Sequence[str],
@@ -236,8 +234,9 @@ def adjust(
     elif opts.robust != "none":
         reporter.span(0.3, 1.0)
     if run is None:  # else the robust stage's (same start, same active groups): not again
-        run = _run(problem, x, vhat, active, opts, reporter, should_stop,
-                   initial=opts.robust == "none")  # fmt: skip
+        run = _run(
+            problem, x, vhat, active, opts, reporter, should_stop, initial=opts.robust == "none"
+        )
     result = _finish(problem, run, active, opts, want_cov)
     if not opts.snooping:
         result.outlier_method = (
@@ -251,15 +250,24 @@ def adjust(
         reporter(1.0)
         return result
 
-    result = _snoop(problem, run, result, active, opts, crit, want_cov, rejected,
-                    extra_warnings, reporter, should_stop)  # fmt: skip
-    result.outlier_method = (
-        _t(
-            "Baarda data snooping (alpha = {alpha:g} per observation, critical |w| = "
-            "{critical:.2f}, iterative rejection of whole groups)",
-            alpha=opts.snooping_alpha,
-            critical=crit,
-        )
+    result = _snoop(
+        problem,
+        run,
+        result,
+        active,
+        opts,
+        crit,
+        want_cov,
+        rejected,
+        extra_warnings,
+        reporter,
+        should_stop,
+    )
+    result.outlier_method = _t(
+        "Baarda data snooping (alpha = {alpha:g} per observation, critical |w| = "
+        "{critical:.2f}, iterative rejection of whole groups)",
+        alpha=opts.snooping_alpha,
+        critical=crit,
     )
     if robust_text:
         result.outlier_method = _t(

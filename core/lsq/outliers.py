@@ -115,17 +115,14 @@ def _robust(
             # converge together).
             short = replace(opts, max_iterations=min(4, opts.max_iterations))
             inner = opts if rounds == 1 else short
-            run = _run(problem, x, vhat, active, inner, reporter, should_stop,
-                       initial=rounds == 1)  # fmt: skip
+            run = _run(problem, x, vhat, active, inner, reporter, should_stop, initial=rounds == 1)
             x, vhat = run.lin.x, run.lin.vhat
             # Unweighted whitened misclosures at the estimate (the linearisation holds them
             # multiplied by sqrt(weight)).
             u_rows = [bl.wbar / np.sqrt(w)[:, None] for bl, w in zip(run.lin.blocks, weights)]
             u = [np.sqrt(np.sum(r * r, axis=1) / r.shape[1]) for r in u_rows]
             ref = [math.sqrt(chi2_ppf(0.5, int(b.c or 1)) / int(b.c or 1)) for b in blocks]
-            pool = np.concatenate(
-                [u[i][active[i]] / ref[i] for i in scale_blocks] or [np.zeros(0)]
-            )
+            pool = np.concatenate([u[i][active[i]] / ref[i] for i in scale_blocks] or [np.zeros(0)])
             scale = float(np.median(pool)) if pool.size else 1.0
             # never below the a-priori unit weight: measurements that fit as well as their
             # stated sigmas (or better, when those are pessimistic) are not outliers, the same
@@ -140,8 +137,9 @@ def _robust(
                     new.append(np.where(t <= 1.0, 1.0, 1.0 / np.where(t > 0, t, 1.0)))
                 else:
                     new.append(1.0 / (1.0 + t * t))
-            change = max((float(np.max(np.abs(a - b))) for a, b in zip(new, weights) if a.size),
-                         default=0.0)  # fmt: skip
+            change = max(
+                (float(np.max(np.abs(a - b))) for a, b in zip(new, weights) if a.size), default=0.0
+            )
             weights = new
             if change < 1e-2:
                 break
@@ -183,8 +181,7 @@ def _robust_stage(
     obs = problem.blocks
     rejected: list[RejectedObservation] = []
     warnings: list[str] = []
-    x, vhat, flagged, rob = _robust(problem, x, vhat, active, opts, crit, reporter,
-                                    should_stop)  # fmt: skip
+    x, vhat, flagged, rob = _robust(problem, x, vhat, active, opts, crit, reporter, should_stop)
     text = _t(
         "{method} reweighting (k = {k:g} robust scale units, {rounds} rounds, robust scale "
         "{scale:.3g}), groups with a standardised misfit above {critical:.2f} set aside",
@@ -213,10 +210,14 @@ def _robust_stage(
         for g in np.flatnonzero(f):
             u = rob["u"][bi][g]
             rejected.append(
-                RejectedObservation(obs[bi].name, obs[bi].labels[g],
-                                    obs[bi].row_names[int(np.argmax(np.abs(u)))],
-                                    float(u[int(np.argmax(np.abs(u)))]), 0)
-            )  # fmt: skip
+                RejectedObservation(
+                    obs[bi].name,
+                    obs[bi].labels[g],
+                    obs[bi].row_names[int(np.argmax(np.abs(u)))],
+                    float(u[int(np.argmax(np.abs(u)))]),
+                    0,
+                )
+            )
     return _RobustStage(x, vhat, trial, run, rejected, text, warnings)
 
 
@@ -299,9 +300,7 @@ def _snoop(
             )
             break
         signed = float(result.residuals[b.name].w[g, i])
-        rejected.append(
-            RejectedObservation(b.name, b.labels[g], b.row_names[i], signed, round_no)
-        )
+        rejected.append(RejectedObservation(b.name, b.labels[g], b.row_names[i], signed, round_no))
         for bj, gj in gone:
             lab = obs[bj].labels[gj]
             rejected.append(

@@ -333,9 +333,14 @@ class RejectionTest:
             "at alpha = {alpha:g} explain at most {bound} ({expected:.2g} expected, P({k} or "
             "more) = {p:.2g}): a model that does not fit the data (parameters missing?) or "
             "many blunders, and the global test of the rest does not show it",
-            k=self.rejected, n=self.groups, share=share, alpha=self.alpha, bound=self.bound,
-            expected=self.expected, p=self.p_value,
-        )  # fmt: skip
+            k=self.rejected,
+            n=self.groups,
+            share=share,
+            alpha=self.alpha,
+            bound=self.bound,
+            expected=self.expected,
+            p=self.p_value,
+        )
 
 
 def rejection_test(

@@ -163,9 +163,11 @@ class ReducedNormal:
             blocks = pair_sums(Za, Zb, o1, o2, kr.item_keys, kr.n_keys) if big else None
             if blocks is None:
                 blocks = kr.sum_outer(
-                    lambda it, Za=Za, o1=o1: Za[o1[it]], lambda it, Zb=Zb, o2=o2: Zb[o2[it]],
-                    kk1, kk2,
-                )  # fmt: skip
+                    lambda it, Za=Za, o1=o1: Za[o1[it]],
+                    lambda it, Zb=Zb, o2=o2: Zb[o2[it]],
+                    kk1,
+                    kk2,
+                )
             r1 = a.rows[pl.key_sig1]
             r2 = b.rows[pl.key_sig2]
             rr = np.broadcast_to(r1[:, :, None], blocks.shape).ravel()
@@ -202,9 +204,11 @@ class ReducedNormal:
         reduced system, and enough pairs for the compiled code to pay."""
         plan = self.plan
         return bool(
-            _COMPILED and not self.use_sparse and len(plan.sets) == 1
+            _COMPILED
+            and not self.use_sparse
+            and len(plan.sets) == 1
             and sum(pl.o1.size for pl in plan.pairs) >= _COMPILED_MIN
-        )  # fmt: skip
+        )
 
     def _dense_system(self, lam: float) -> tuple[Array, Array, Array] | None:
         """(K, rhs, Li): the dense reduced matrix and right-hand side of :meth:`reduced_matrix`
@@ -220,8 +224,9 @@ class ReducedNormal:
         K = np.zeros((n, n))
         rhs = np.concatenate([-self.g_r, -self.hs])
         try:
-            out = dense_reduced(self.V, lam, self.g_e, self.T[0], order, start, s.sig, s.rows,
-                                K, rhs)  # fmt: skip
+            out = dense_reduced(
+                self.V, lam, self.g_e, self.T[0], order, start, s.sig, s.rows, K, rhs
+            )
         except ValueError:
             raise SingularSystem("an eliminated block is singular") from None
         if out is None:
@@ -536,10 +541,16 @@ def _plain(bp, g: int, b: int) -> bool:
     """A block plan the compiled sums cover: every group sees one eliminated block, its
     columns in slot order, and every reduced column varies between groups."""
     return bool(
-        bp.ec.size == b and bp.eslot_identity and bp.rc.size and bp.vc.size == bp.rc.size
-        and bp.cset < 0 and bp.vset >= 0 and bp.u_reducer is not None
-        and bp.v_reducer is not None and bp.with_point.size == g
-    )  # fmt: skip
+        bp.ec.size == b
+        and bp.eslot_identity
+        and bp.rc.size
+        and bp.vc.size == bp.rc.size
+        and bp.cset < 0
+        and bp.vset >= 0
+        and bp.u_reducer is not None
+        and bp.v_reducer is not None
+        and bp.with_point.size == g
+    )
 
 
 def _columns(A: Array, cols: Index) -> Array:
@@ -549,8 +560,9 @@ def _columns(A: Array, cols: Index) -> Array:
     return A[:, :, cols]
 
 
-def _diag_grad(blocks: Sequence, lins: Sequence, active: Sequence[NDArray[np.bool_]],
-               n: int) -> tuple[Array, Array]:  # fmt: skip
+def _diag_grad(
+    blocks: Sequence, lins: Sequence, active: Sequence[NDArray[np.bool_]], n: int
+) -> tuple[Array, Array]:
     """The diagonal of the normal matrix and the gradient ``A^T w`` (n,) of the whitened
     linearisations, the active groups only (the Jacobi scale is computed from the diagonal)."""
     diag = np.zeros(n)
@@ -558,17 +570,21 @@ def _diag_grad(blocks: Sequence, lins: Sequence, active: Sequence[NDArray[np.boo
     for bk, bl, a in zip(blocks, lins, active):
         if bk.groups == 0:
             continue
-        if _COMPILED and bk.groups >= _COMPILED_MIN and diag_grad(
-            bl.abar, bl.wbar, a, bk.param_index, diag, grad
+        if (
+            _COMPILED
+            and bk.groups >= _COMPILED_MIN
+            and diag_grad(bl.abar, bl.wbar, a, bk.param_index, diag, grad)
         ):
             continue
         every = bool(a.all())
         A = bl.abar if every else bl.abar * a[:, None, None]
         w = bl.wbar if every else bl.wbar * a[:, None]
-        diag += np.bincount(bk.param_index.ravel(), weights=np.einsum("gck,gck->gk", A, A).ravel(),
-                            minlength=n)  # fmt: skip
-        grad += np.bincount(bk.param_index.ravel(),
-                            weights=np.einsum("gc,gck->gk", w, A).ravel(), minlength=n)  # fmt: skip
+        diag += np.bincount(
+            bk.param_index.ravel(), weights=np.einsum("gck,gck->gk", A, A).ravel(), minlength=n
+        )
+        grad += np.bincount(
+            bk.param_index.ravel(), weights=np.einsum("gc,gck->gk", w, A).ravel(), minlength=n
+        )
     return diag, grad
 
 
@@ -609,8 +625,9 @@ def build_reduced_normal(
             scale = a[:, None] * scale
         w = bl.wbar if every else bl.wbar * a[:, None]
         if _COMPILED and g >= _COMPILED_MIN and _plain(bp, g, b):
-            sums = normal_sums(bl.abar, w, scale, bp.rc, bp.ec, bp.sig, bp.sig_rows.shape[0],
-                               bp.point, P)  # fmt: skip
+            sums = normal_sums(
+                bl.abar, w, scale, bp.rc, bp.ec, bp.sig, bp.sig_rows.shape[0], bp.point, P
+            )
             if sums is not None:
                 UR, Vb, gb, T[bp.vset] = sums
                 rs = bp.sig_rows
@@ -702,4 +719,3 @@ def build_reduced_normal(
             nnz = 0  # diagnosed by the observability check
         red.use_sparse = nnz <= _SPARSE_MAX_DENSITY * nred * nred
     return red, rowscale
-

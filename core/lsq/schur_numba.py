@@ -45,8 +45,7 @@ def _kernel(Za, Zb, o1, o2, key, out):  # pragma: no cover - compiled
         out[last] += acc
 
 
-def pair_sums(Za: Array, Zb: Array, o1: Index, o2: Index, key: Index, n_keys: int
-              ) -> Array | None:  # fmt: skip
+def pair_sums(Za: Array, Zb: Array, o1: Index, o2: Index, key: Index, n_keys: int) -> Array | None:
     """Per key ``sum_q Za[o1[q]]' Zb[o2[q]]`` (n_keys, kk1, kk2), or None without numba."""
     from ..compiled import compiled_kernel  # numba imported here: this module stays light
 
@@ -86,8 +85,17 @@ def _normal_kernel(abar, wbar, scale, rc, ec, sig, point, U, V, g_e, T):  # prag
                     V[p, i, j] += ei * er[j]
 
 
-def normal_sums(abar: Array, wbar: Array, scale: Array, rc: Index, ec: Index, sig: Index,
-                n_sig: int, point: Index, n_points: int) -> tuple | None:  # fmt: skip
+def normal_sums(
+    abar: Array,
+    wbar: Array,
+    scale: Array,
+    rc: Index,
+    ec: Index,
+    sig: Index,
+    n_sig: int,
+    point: Index,
+    n_points: int,
+) -> tuple | None:
     """For one block whose every group sees one eliminated block in slot order and whose
     reduced columns all vary between groups: ``U`` per signature (n_sig, kr, kr), ``V`` and
     ``g_e`` per eliminated block, ``T = R' E`` per group, from the whitened rows ``abar``
@@ -102,15 +110,27 @@ def normal_sums(abar: Array, wbar: Array, scale: Array, rc: Index, ec: Index, si
     V = np.zeros((n_points, b, b))
     g_e = np.zeros((n_points, b))
     T = np.zeros((g, kr, b))
-    kernel(np.ascontiguousarray(abar), np.ascontiguousarray(wbar),
-                 np.ascontiguousarray(scale), rc, ec, sig, point, U, V, g_e, T)  # fmt: skip
+    kernel(
+        np.ascontiguousarray(abar),
+        np.ascontiguousarray(wbar),
+        np.ascontiguousarray(scale),
+        rc,
+        ec,
+        sig,
+        point,
+        U,
+        V,
+        g_e,
+        T,
+    )
     U += np.swapaxes(np.triu(U, 1), 1, 2)
     V += np.swapaxes(np.triu(V, 1), 1, 2)
     return U, V, g_e, T
 
 
-def _dense_kernel(V, lam, g_e, T, order, start, osig, srows, base, K, rhs, Li,
-                  y):  # pragma: no cover - compiled  # fmt: skip
+def _dense_kernel(
+    V, lam, g_e, T, order, start, osig, srows, base, K, rhs, Li, y
+):  # pragma: no cover - compiled
     P, b = V.shape[0], V.shape[1]
     kk = T.shape[1]
     most = 0
@@ -188,8 +208,9 @@ def _dense_kernel(V, lam, g_e, T, order, start, osig, srows, base, K, rhs, Li,
                                 z0 * Z[qj, 0, a] + z1 * Z[qj, 1, a] + z2 * Z[qj, 2, a]
                             )
                             for c in range(a + 1, kk):
-                                row[bj + c] += (z0 * Z[qj, 0, c] + z1 * Z[qj, 1, c]
-                                                + z2 * Z[qj, 2, c])  # fmt: skip
+                                row[bj + c] += (
+                                    z0 * Z[qj, 0, c] + z1 * Z[qj, 1, c] + z2 * Z[qj, 2, c]
+                                )
                             continue
                         for c in range(kk):
                             row[bj + c] += z0 * Z[qj, 0, c] + z1 * Z[qj, 1, c] + z2 * Z[qj, 2, c]
@@ -208,8 +229,18 @@ def _dense_kernel(V, lam, g_e, T, order, start, osig, srows, base, K, rhs, Li,
     return 0
 
 
-def dense_reduced(V: Array, lam: float, g_e: Array, T: Array, order: Index, start: Index,
-                  osig: Index, srows: Index, K: Array, rhs: Array) -> tuple | None:  # fmt: skip
+def dense_reduced(
+    V: Array,
+    lam: float,
+    g_e: Array,
+    T: Array,
+    order: Index,
+    start: Index,
+    osig: Index,
+    srows: Index,
+    K: Array,
+    rhs: Array,
+) -> tuple | None:
     """For one occurrence set, in place and point by point (``order``/``start``: the
     occurrences sorted by point, CSR-like): afterwards ``K + K'`` is
     ``-sum_p W_p (V_p + lam I)^-1 W_p'`` (``K`` dense, zero on entry), and
@@ -229,9 +260,21 @@ def dense_reduced(V: Array, lam: float, g_e: Array, T: Array, order: Index, star
     kk = srows.shape[1]
     run = (srows == srows[:, :1] + np.arange(kk)).all(axis=1)
     base = np.where(run, srows[:, 0], -1).astype(np.intp)
-    bad = kernel(np.ascontiguousarray(V), float(lam), np.ascontiguousarray(g_e),
-                 np.ascontiguousarray(T), order, start, osig, srows, base, K, rhs, Li,
-                 y)  # fmt: skip
+    bad = kernel(
+        np.ascontiguousarray(V),
+        float(lam),
+        np.ascontiguousarray(g_e),
+        np.ascontiguousarray(T),
+        order,
+        start,
+        osig,
+        srows,
+        base,
+        K,
+        rhs,
+        Li,
+        y,
+    )
     if bad:
         raise ValueError("an eliminated block is singular")
     return Li, y
@@ -266,8 +309,9 @@ def _back_kernel(g_e, T, point, osig, srows, z, Li, ze):  # pragma: no cover - c
             ze[p, i] = s
 
 
-def back_substitute(g_e: Array, T: Array, point: Index, osig: Index, srows: Index, z: Array,
-                    Li: Array) -> Array | None:  # fmt: skip
+def back_substitute(
+    g_e: Array, T: Array, point: Index, osig: Index, srows: Index, z: Array, Li: Array
+) -> Array | None:
     """``z_e,p = (V_p + lam I)^-1 (-g_e,p - W_p' z_r)`` for one occurrence set, with ``Li`` of
     :func:`dense_reduced`; (P, b), or None without numba."""
     from ..compiled import compiled_kernel
@@ -276,8 +320,16 @@ def back_substitute(g_e: Array, T: Array, point: Index, osig: Index, srows: Inde
     if kernel is None:
         return None
     ze = np.empty(g_e.shape)
-    kernel(np.ascontiguousarray(g_e), np.ascontiguousarray(T), point, osig, srows,
-           np.ascontiguousarray(z), Li, ze)  # fmt: skip
+    kernel(
+        np.ascontiguousarray(g_e),
+        np.ascontiguousarray(T),
+        point,
+        osig,
+        srows,
+        np.ascontiguousarray(z),
+        Li,
+        ze,
+    )
     return ze
 
 
@@ -297,8 +349,9 @@ def _diag_grad_kernel(abar, wbar, active, index, diag, grad):  # pragma: no cove
             grad[index[g, k]] += s
 
 
-def diag_grad(abar: Array, wbar: Array, active: NDArray[np.bool_], index: Index, diag: Array,
-              grad: Array) -> bool:  # fmt: skip
+def diag_grad(
+    abar: Array, wbar: Array, active: NDArray[np.bool_], index: Index, diag: Array, grad: Array
+) -> bool:
     """Add the diagonal ``sum a^2`` and the gradient ``sum w a`` of the normal equations of
     one block's active groups (``abar`` (G, c, k) at the parameters ``index`` (G, k)) to
     ``diag`` and ``grad`` in place; False without numba (nothing added)."""
@@ -307,6 +360,12 @@ def diag_grad(abar: Array, wbar: Array, active: NDArray[np.bool_], index: Index,
     kernel = compiled_kernel(_diag_grad_kernel)
     if kernel is None:
         return False
-    kernel(np.ascontiguousarray(abar), np.ascontiguousarray(wbar), np.ascontiguousarray(active),
-           np.ascontiguousarray(index), diag, grad)  # fmt: skip
+    kernel(
+        np.ascontiguousarray(abar),
+        np.ascontiguousarray(wbar),
+        np.ascontiguousarray(active),
+        np.ascontiguousarray(index),
+        diag,
+        grad,
+    )
     return True

@@ -34,8 +34,11 @@ class _Reducer:
         self.item_keys = keys  # the key of every item (for the compiled sums)
         # already sorted (pairs are stored in key order): the items are taken as slices
         self.identity = bool(keys.size < 2 or (keys[1:] >= keys[:-1]).all())
-        self.order = (np.arange(keys.size, dtype=np.intp) if self.identity
-                      else np.argsort(keys, kind="stable"))  # fmt: skip
+        self.order = (
+            np.arange(keys.size, dtype=np.intp)
+            if self.identity
+            else np.argsort(keys, kind="stable")
+        )
         sk = keys[self.order]
         self.n_keys = int(n_keys)
         self.n_items = int(keys.size)
@@ -270,9 +273,7 @@ class EliminationPlan:
 
     # -- structure -------------------------------------------------------------------------
 
-    def _block_plan(
-        self, bi: int, bk, point_of: Index, slot_of: Index, rmap: Index
-    ) -> _BlockPlan:
+    def _block_plan(self, bi: int, bk, point_of: Index, slot_of: Index, rmap: Index) -> _BlockPlan:
         where = f"block '{bk.name}'"
         idx = bk.param_index
         g, k = idx.shape
@@ -316,9 +317,7 @@ class EliminationPlan:
         first, sig = _unique_rows(rrows[:, vc])
         sig_rows = rrows[first] if g else np.zeros((0, rc.size), dtype=np.intp)
         bp = _BlockPlan(rc, ec, rrows, eslot, point, vc, cc, sig, sig_rows)
-        bp.eslot_identity = bool(
-            ec.size == self.b and (eslot == np.arange(self.b)[None, :]).all()
-        )
+        bp.eslot_identity = bool(ec.size == self.b and (eslot == np.arange(self.b)[None, :]).all())
         if rc.size and g:
             bp.u_reducer = _Reducer(sig, sig_rows.shape[0])
         wp = np.flatnonzero(point >= 0)
@@ -404,8 +403,15 @@ class EliminationPlan:
                     kinv = np.asarray(kinv, dtype=np.intp).ravel()
                     self.pairs.append(
                         _PairList(
-                            s1, s2, p1, p2, _Reducer(kinv, ukey.size),
-                            (ukey // nsig2).astype(np.intp), (ukey % nsig2).astype(np.intp),
-                            a.point.size, b.point.size, mirror,
+                            s1,
+                            s2,
+                            p1,
+                            p2,
+                            _Reducer(kinv, ukey.size),
+                            (ukey // nsig2).astype(np.intp),
+                            (ukey % nsig2).astype(np.intp),
+                            a.point.size,
+                            b.point.size,
+                            mirror,
                         )
-                    )  # fmt: skip
+                    )

@@ -95,8 +95,9 @@ class BandedInverse:
         ``g``, the parameters ordered last and treated densely.
     """
 
-    def __init__(self, perm: Index, n_band: int, Lb: Array, Zt: Array, Y: Array, Hinv: Array,
-                 E: Array) -> None:  # fmt: skip
+    def __init__(
+        self, perm: Index, n_band: int, Lb: Array, Zt: Array, Y: Array, Hinv: Array, E: Array
+    ) -> None:
         self.perm = perm
         self.pos = np.empty_like(perm)
         self.pos[perm] = np.arange(perm.size)
@@ -113,8 +114,11 @@ class BandedInverse:
 
     def finite(self) -> bool:
         """Whether every stored number is finite."""
-        return bool(np.isfinite(self._Zt).all() and np.isfinite(self._YH).all()
-                    and np.isfinite(self._Hinv).all())  # fmt: skip
+        return bool(
+            np.isfinite(self._Zt).all()
+            and np.isfinite(self._YH).all()
+            and np.isfinite(self._Hinv).all()
+        )
 
     def diagonal(self) -> Array:
         """``diag(S^-1)`` (n,)."""
@@ -158,7 +162,7 @@ class BandedInverse:
         cols, where = np.unique(p, return_inverse=True)
         out = np.empty(q.size)
         for start in range(0, cols.size, _CHUNK):
-            cc = cols[start:start + _CHUNK]
+            cc = cols[start : start + _CHUNK]
             X = self._columns(cc)  # (n, k), permuted rows
             sel = (where >= start) & (where < start + cc.size)
             out[sel] = X[q[sel], where[sel] - start]

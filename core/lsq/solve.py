@@ -323,21 +323,23 @@ def _normal(
         n = problem.n
         use_sparse = n > _SPARSE_AUTO_MIN_N and nrm.Ns.nnz <= _SPARSE_AUTO_MAX_DENSITY * n * n
     if check:
-        _check_observability(nrm, problem.names, opts.condition_limit,
-                             problem.constraint_labels())  # fmt: skip
+        _check_observability(nrm, problem.names, opts.condition_limit, problem.constraint_labels())
     return nrm, rowscale, use_sparse
 
 
-def _function_tolerance_met(opts: AdjustmentOptions, damp: _Damping, m_old: float,
-                            m_new: float) -> bool:  # fmt: skip
+def _function_tolerance_met(
+    opts: AdjustmentOptions, damp: _Damping, m_old: float, m_new: float
+) -> bool:
     """Ceres' function tolerance: the accepted step changed the cost too little to be worth
     another damped iteration (one Gauss-Newton step follows). Not after a heavily damped
     step: a small decrease there is a stall (e.g. a model that cannot fit), not the minimum."""
     ftol = opts.function_tolerance
     return bool(
-        ftol > 0 and m_new <= m_old * (1 + 1e-13) and m_old - m_new <= ftol * m_old
+        ftol > 0
+        and m_new <= m_old * (1 + 1e-13)
+        and m_old - m_new <= ftol * m_old
         and (not opts.damping or damp.last <= _LAMBDA_START)
-    )  # fmt: skip
+    )
 
 
 def _gradient_small(nrm: _Normal, lin: _Lin, opts: AdjustmentOptions) -> bool:
@@ -348,8 +350,9 @@ def _gradient_small(nrm: _Normal, lin: _Lin, opts: AdjustmentOptions) -> bool:
     return g <= opts.gradient_tolerance * math.sqrt(max(lin.phi, 0.0))
 
 
-def _gauss_newton(problem: _Problem, nrm: _Normal, opts: AdjustmentOptions,
-                  use_sparse: bool) -> tuple[Array, Array]:  # fmt: skip
+def _gauss_newton(
+    problem: _Problem, nrm: _Normal, opts: AdjustmentOptions, use_sparse: bool
+) -> tuple[Array, Array]:
     """The Gauss-Newton step of the normal equations ``nrm`` (undamped) and the constraints'
     multipliers; a singular system is diagnosed (NotObservableError naming the parameters)
     or AdjustmentError."""
@@ -397,8 +400,9 @@ def _run(
         # the previous point's normal equations are not needed any more: not held while the
         # new ones are built (on a large block they are hundreds of MB)
         nrm = None
-        nrm, rowscale, use_sparse = _normal(problem, lin, active, rowscale, use_sparse,
-                                            opts, it == 1)  # fmt: skip
+        nrm, rowscale, use_sparse = _normal(
+            problem, lin, active, rowscale, use_sparse, opts, it == 1
+        )
         if _gradient_small(nrm, lin, opts):
             converged, why, final = True, GRADIENT_TOLERANCE, nrm
             it -= 1  # no step taken
@@ -446,8 +450,9 @@ def _run(
                     f"Gauss-Newton diverged: {exc} at iteration {it}; try damping=True"
                 ) from None
         else:
-            new = _damped_step(problem, lin, nrm, z, active, rowscale, nu, m_old, use_sparse,
-                               tol, damp)  # fmt: skip
+            new = _damped_step(
+                problem, lin, nrm, z, active, rowscale, nu, m_old, use_sparse, tol, damp
+            )
             if new is None and z is None:
                 z, k = _gauss_newton(problem, nrm, opts, use_sparse)
                 step = float(np.abs(z).max()) if z.size else 0.0
@@ -491,9 +496,7 @@ def _run(
     if finishing and not converged:  # met at the last iteration: no room for the last step
         converged, why = True, FUNCTION_TOLERANCE
     if not converged and it >= opts.max_iterations and why == ITERATION_LIMIT:
-        warnings.append(
-            _t("no convergence within {n} iterations", n=opts.max_iterations)
-        )
+        warnings.append(_t("no convergence within {n} iterations", n=opts.max_iterations))
     # Final normal equations at the final linearisation point, checked before use.
     if final is None:
         final, _ = problem.normal(lin, active, rowscale)

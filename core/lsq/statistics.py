@@ -130,6 +130,7 @@ def _finish(
         def qgg(bi: int, sel: NDArray[np.intp], Q: Array = Q) -> Array:
             idx = problem.blocks[bi].param_index[sel]
             return Q[idx[:, :, None], idx[:, None, :]]
+
     omega = run.lin.phi
     mc = problem.constraint_rows()
     m = problem.rows(active)

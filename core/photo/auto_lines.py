@@ -81,8 +81,11 @@ def _edge_checks(
     step = 0.25
     t = np.arange(-opt.search_px, opt.search_px + step / 2, step)
     s = np.arange(-opt.along_px, opt.along_px + 0.5, 1.0)
-    pts = (pix[:, None, None] + s[None, :, None, None] * dirs[:, None, None]
-           + t[None, None, :, None] * normal[:, None, None])  # fmt: skip
+    pts = (
+        pix[:, None, None]
+        + s[None, :, None, None] * dirs[:, None, None]
+        + t[None, None, :, None] * normal[:, None, None]
+    )
     idx = pts - 0.5
     g = map_coordinates(grey, [idx[..., 1].ravel(), idx[..., 0].ravel()], order=1, mode="nearest")
     prof = g.reshape(pts.shape[:3]).mean(axis=1)  # (K, T)
@@ -167,8 +170,10 @@ def line_observations(
         pix, dirs, t = _samples(sc, image_id, line, camera, opt)
         if len(pix) < opt.min_points:
             continue
-        found = [refine_edge_point(grey, (0, 0), p, d, opt.search_px, opt.along_px)
-                 for p, d in zip(pix, dirs)]  # fmt: skip
+        found = [
+            refine_edge_point(grey, (0, 0), p, d, opt.search_px, opt.along_px)
+            for p, d in zip(pix, dirs)
+        ]
         hit = np.array([f is not None for f in found], bool)
         if hit.sum() < opt.min_points:
             continue
@@ -191,9 +196,13 @@ def line_observations(
         cols["sig"].extend([max(rms, opt.min_sigma_px)] * len(good))
     n = len(cols["pid"])
     return ImageObservations.from_arrays(
-        [image_id] * n, cols["pid"], np.reshape(cols["px"], (n, 2)), np.asarray(cols["sig"]),
-        ["line"] * n, cols["tid"],
-    )  # fmt: skip
+        [image_id] * n,
+        cols["pid"],
+        np.reshape(cols["px"], (n, 2)),
+        np.asarray(cols["sig"]),
+        ["line"] * n,
+        cols["tid"],
+    )
 
 
 def line_observations_block(
@@ -210,6 +219,7 @@ def line_observations_block(
     for image_id, image in images:
         if not scene.has_image(image_id):
             raise InputError(f"image '{image_id}' has no exterior orientation")
-        out = out.concat(line_observations(image, image_id, camera, eo, lines, options,
-                                           scene=scene))  # fmt: skip
+        out = out.concat(
+            line_observations(image, image_id, camera, eo, lines, options, scene=scene)
+        )
     return out

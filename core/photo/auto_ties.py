@@ -47,8 +47,16 @@ __all__ = ["REASONS", "TieAssociation", "associate_ties", "find_ties", "outlines
 Array = NDArray[np.float64]
 
 #: Reasons for refusing a track, in the order they are checked.
-REASONS = ("one image", "rays apart", "no roof plane", "wall", "plane border", "off the plane",
-           "ambiguous", "not on the DSM")  # fmt: skip
+REASONS = (
+    "one image",
+    "rays apart",
+    "no roof plane",
+    "wall",
+    "plane border",
+    "off the plane",
+    "ambiguous",
+    "not on the DSM",
+)
 
 
 @dataclass(frozen=True)
@@ -73,8 +81,9 @@ class TieAssociation:
         return len(self.plane_of)
 
 
-def outlines_from_points(planes: Sequence[Plane], xyz: ArrayLike, plane_ids: ArrayLike
-                         ) -> list[Plane]:  # fmt: skip
+def outlines_from_points(
+    planes: Sequence[Plane], xyz: ArrayLike, plane_ids: ArrayLike
+) -> list[Plane]:
     """The planes with an outline: the convex hull (x, y) of their LiDAR points (mapping CRS),
     its heights on the plane; planes with fewer than 3 points (or an outline already) are
     returned unchanged."""
@@ -134,14 +143,23 @@ def find_ties(
     greys = [_grey8(img) for _, img in images]
     for iid, g in zip(ids, greys):
         if g.shape != (camera.height_px, camera.width_px):
-            raise InputError(f"image {iid} is {g.shape[1]} x {g.shape[0]} px, the camera "
-                             f"{camera.width_px} x {camera.height_px} px")  # fmt: skip
+            raise InputError(
+                f"image {iid} is {g.shape[1]} x {g.shape[0]} px, the camera "
+                f"{camera.width_px} x {camera.height_px} px"
+            )
 
     def load(k: int):
         return detect_features(greys[k], ids[k], opt)
 
-    return tie_points(ids, load, opt, footprint, progress=progress, should_stop=should_stop,
-                      load_image=lambda k: greys[k])  # fmt: skip
+    return tie_points(
+        ids,
+        load,
+        opt,
+        footprint,
+        progress=progress,
+        should_stop=should_stop,
+        load_image=lambda k: greys[k],
+    )
 
 
 def _grey8(image: ArrayLike) -> NDArray[np.uint8]:
@@ -166,13 +184,15 @@ def _segment_distance(xy: Array, ring: Array) -> float:
     """Smallest distance (CRS unit) from the point ``xy`` (2,) to the closed ring (M, 2)."""
     a, b = ring, np.roll(ring, -1, axis=0)
     d = b - a
-    t = np.clip(np.einsum("ij,ij->i", xy - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-12),
-                0.0, 1.0)  # fmt: skip
+    t = np.clip(
+        np.einsum("ij,ij->i", xy - a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-12), 0.0, 1.0
+    )
     return float(np.min(np.linalg.norm(a + t[:, None] * d - xy, axis=1)))
 
 
-def _meet(scene: PickingScene, ties: ImageObservations, names: list[str], sigmas: float
-          ) -> tuple[Array, NDArray[np.intp], Array, Array]:  # fmt: skip
+def _meet(
+    scene: PickingScene, ties: ImageObservations, names: list[str], sigmas: float
+) -> tuple[Array, NDArray[np.intp], Array, Array]:
     """Meeting points (T, 3, local frame), ray counts (T,), the largest ray miss beyond
     ``sigmas`` times its own precision (T,) m, and each point's covariance (T, 3, 3) m^2
     from the pixels' sigmas (the rays' perpendicular precision at their range)."""
@@ -188,8 +208,9 @@ def _meet(scene: PickingScene, ties: ImageObservations, names: list[str], sigmas
     rel = xyz[point_of] - origins
     miss = np.linalg.norm(rel - np.einsum("ij,ij->i", rel, dirs)[:, None] * dirs, axis=1)
     rng = np.linalg.norm(np.nan_to_num(rel), axis=1)
-    perp = np.maximum(ties.sigma_px * scene.camera.pixel_size_mm / scene.camera.focal_mm * rng,
-                      1e-6)  # fmt: skip
+    perp = np.maximum(
+        ties.sigma_px * scene.camera.pixel_size_mm / scene.camera.focal_mm * rng, 1e-6
+    )
     worst = np.zeros(len(names))
     np.maximum.at(worst, point_of, np.maximum(np.nan_to_num(miss, nan=np.inf) - sigmas * perp, 0))
     proj = np.eye(3) - dirs[:, :, None] * dirs[:, None, :]
@@ -263,17 +284,35 @@ def associate_ties(
             continue
         points[name] = xyz[k]
         # the point's own precision (local ENU ~ map axes within the convergence, enough here)
-        reason, pid = _judge(xyz[k], miss[k], cov[k], planes, rings, gate_m, border_m,
-                             max_roof_slope_deg, dsm, sigmas)  # fmt: skip
+        reason, pid = _judge(
+            xyz[k],
+            miss[k],
+            cov[k],
+            planes,
+            rings,
+            gate_m,
+            border_m,
+            max_roof_slope_deg,
+            dsm,
+            sigmas,
+        )
         if reason:
             reasons[reason] += 1
         else:
             plane_of[name] = pid
     keep = np.array([p in plane_of for p in ties.point_id], bool)
     kept = ties.subset(keep)
-    kept = ImageObservations(kept.image_id, kept.point_id, kept.pixels, kept.sigma_px, kept.type,
-                             tuple(str(plane_of[p]) for p in kept.point_id), kept.rows,
-                             kept.source, kept.camera)  # fmt: skip
+    kept = ImageObservations(
+        kept.image_id,
+        kept.point_id,
+        kept.pixels,
+        kept.sigma_px,
+        kept.type,
+        tuple(str(plane_of[p]) for p in kept.point_id),
+        kept.rows,
+        kept.source,
+        kept.camera,
+    )
     return TieAssociation(kept, reasons, len(names), plane_of, points)
 
 
@@ -300,8 +339,9 @@ def _judge(
     def gate(n: Array) -> float:
         return float(np.hypot(gate_m, sigmas * np.sqrt(max(float(n @ cov @ n), 0.0))))
 
-    near = [int(k) for k in inside
-            if abs(float(planes[k].distance(xyz)[0])) <= gate(planes[k].normal)]  # fmt: skip
+    near = [
+        int(k) for k in inside if abs(float(planes[k].distance(xyz)[0])) <= gate(planes[k].normal)
+    ]
     if len(near) > 1:
         return "ambiguous", -1
     pick = near[0] if near else int(inside[0])

@@ -202,11 +202,13 @@ def calibrate(
 
     # ---- observations in use
     kinds, used, img, surveyed = _rows_in_use(observations, trajectory, opts, ground_points)
-    st = _Stage(observations, kinds, used, img, par.pose_idx, r_nl, spec, local, par.names,
-                np.array(par.x0))  # fmt: skip
+    st = _Stage(
+        observations, kinds, used, img, par.pose_idx, r_nl, spec, local, par.names, np.array(par.x0)
+    )
     velocity = _velocity(trajectory, ins_pos, r_nl, opts)
-    st.blocks += _ins_blocks(trajectory, grade, opts, r_nl, ins_pos, par.ins_at, par.timing_at,
-                             velocity)  # fmt: skip
+    st.blocks += _ins_blocks(
+        trajectory, grade, opts, r_nl, ins_pos, par.ins_at, par.timing_at, velocity
+    )
     plane_by_id = {str(p.id): k for k, p in enumerate(planes)}
     p_params, p_cov, _ = transform_planes(list(planes), local)
     _tie_blocks(st, planes, plane_by_id, p_params, p_cov, opts.roof_roughness_m)
@@ -247,16 +249,24 @@ def calibrate(
     )
     try:
         res = adjust(
-            st.x_init, st.names, st.blocks, options=aopts, progress=progress,
+            st.x_init,
+            st.names,
+            st.blocks,
+            options=aopts,
+            progress=progress,
             should_stop=should_stop,
-        )  # fmt: skip
+        )
     except NotObservableError as exc:
         raise BoresightNotObservable(exc, diagnose(exc.parameters, group_names)) from exc
     return _result(res, trajectory, frame, local, group_names, par, st, opts)
 
 
-def _rows_in_use(observations: ImageObservations, trajectory: Trajectory, opts: BoresightOptions,
-                 ground_points: SurveyedPoints | None):  # fmt: skip
+def _rows_in_use(
+    observations: ImageObservations,
+    trajectory: Trajectory,
+    opts: BoresightOptions,
+    ground_points: SurveyedPoints | None,
+):
     """The observations in use: (types, used mask, image index per row (-1 where unused),
     the surveyed points of ``control`` rows); the rows of check points are not used."""
     kinds = np.array(observations.type)
@@ -274,8 +284,9 @@ def _rows_in_use(observations: ImageObservations, trajectory: Trajectory, opts: 
     return kinds, used, img, surveyed
 
 
-def _velocity(trajectory: Trajectory, ins_pos: Array, r_nl: Array,
-              opts: BoresightOptions) -> Array | None:  # fmt: skip
+def _velocity(
+    trajectory: Trajectory, ins_pos: Array, r_nl: Array, opts: BoresightOptions
+) -> Array | None:
     """The exposures' velocities (local frame, m/s) for the timing offset, None without it;
     with the lever arm estimated too, refused where the two cannot be separated."""
     velocity = None

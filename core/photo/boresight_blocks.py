@@ -171,8 +171,9 @@ def _tie_blocks(
     # initial coordinates: the first ray of each tie point cut with its plane
     first = np.unique(tk, return_index=True)[1]
     fr = tie_rows[first]
-    centre, ray, *_ = camera_ray(st.init_pose(fr), observations.pixels[fr], st.r_nl[st.img[fr]],
-                                 st.spec)  # fmt: skip
+    centre, ray, *_ = camera_ray(
+        st.init_pose(fr), observations.pixels[fr], st.r_nl[st.img[fr]], st.spec
+    )
     pl = p_params[plane_of_tie]
     t = -(np.einsum("ti,ti->t", pl[:, :3], centre) + pl[:, 3]) / np.einsum(
         "ti,ti->t", pl[:, :3], ray
@@ -184,10 +185,17 @@ def _tie_blocks(
     tie_idx = tie_at + 3 * np.arange(len(tie_names))[:, None] + np.arange(3)
     st.blocks.append(
         _collinearity_block(
-            "tie image points", tie_rows, tk, tie_idx, observations, st.img, st.pose_idx,
-            st.r_nl, st.spec,
+            "tie image points",
+            tie_rows,
+            tk,
+            tie_idx,
+            observations,
+            st.img,
+            st.pose_idx,
+            st.r_nl,
+            st.spec,
         )
-    )  # fmt: skip
+    )
     st.maps.append(("tie image points", tie_rows[:, None], "gm"))
     counts = np.bincount(plane_of_tie, minlength=len(planes))
     for k in np.unique(counts[counts > 0]):

@@ -49,7 +49,6 @@ reported, but never removed: their misfits mostly reflect an imperfect model); a
 left with one ray by a rejection is set aside with it.
 """
 
-
 from __future__ import annotations
 
 import math
@@ -90,8 +89,14 @@ def _drop_candidate(run: _Run, options: BundleOptions) -> tuple[int, int, str] |
     significant of the APs that are insignificant alone and, with the other insignificant APs
     they correlate with, jointly (:mod:`.bundle_selection`); a correlation alone never drops
     a parameter."""
-    decisions = ap_decisions(run.result, run.lay.interior, run.lay.free, run.cams,
-                             options.ap_alpha, options.max_correlation)  # fmt: skip
+    decisions = ap_decisions(
+        run.result,
+        run.lay.interior,
+        run.lay.free,
+        run.cams,
+        options.ap_alpha,
+        options.max_correlation,
+    )
     d = drop_candidate(decisions)
     return None if d is None else (d.camera, d.position, d.reason)
 
@@ -160,8 +165,20 @@ def bundle_adjust(
     opts = options if options is not None else BundleOptions()
     eo_sigma = _check_options(opts, eo, eo_sigma, eo_source)
     warnings: list[str] = []
-    setup = _prepare(cameras, dict(image_camera or {}), observations, ground, mapping, eo,
-                     eo_sigma, opts, eo_rows, eo_source, should_stop, warnings)  # fmt: skip
+    setup = _prepare(
+        cameras,
+        dict(image_camera or {}),
+        observations,
+        ground,
+        mapping,
+        eo,
+        eo_sigma,
+        opts,
+        eo_rows,
+        eo_source,
+        should_stop,
+        warnings,
+    )
     if scale_bars is not None and len(scale_bars):
         metres = setup.local.mapping.metres if isinstance(setup.local, EngineeringLocal) else 1.0
         setup.bars = setup_bars(scale_bars, setup.points, setup.check_ids, metres)
@@ -175,38 +192,60 @@ def bundle_adjust(
     keep = np.ones(len(observations), dtype=bool)
     report = progress if progress is not None else (lambda f: None)
     # 1. the full model, robust + snooping, from the approximate values
-    run = _run(setup, observations, cams, free, opts, keep, opts.robust, opts.snooping,
-               setup.eo0, setup.xyz0, mount, should_stop, None, dt0)  # fmt: skip
+    run = _run(
+        setup,
+        observations,
+        cams,
+        free,
+        opts,
+        keep,
+        opts.robust,
+        opts.snooping,
+        setup.eo0,
+        setup.xyz0,
+        mount,
+        should_stop,
+        None,
+        dt0,
+    )
     report(0.4)
     dropped: dict[tuple[str, str], str] = {}
     dropped_list: list[tuple[str, str, str]] = []
     if opts.ap_selection and opts.ap_model != "none":
-        run = _select_aps(setup, observations, run, cams, free, opts, keep, should_stop,
-                          dropped, dropped_list)  # fmt: skip
+        run = _select_aps(
+            setup, observations, run, cams, free, opts, keep, should_stop, dropped, dropped_list
+        )
     report(0.9)
     out = _finish(setup, observations, run, opts, dropped, dropped_list, eo, warnings)
     report(1.0)
     return out
 
 
-def _check_options(opts: BundleOptions, eo: ExteriorOrientationTable | None,
-                   eo_sigma: Array | None, eo_source: str) -> Array | None:  # fmt: skip
+def _check_options(
+    opts: BundleOptions, eo: ExteriorOrientationTable | None, eo_sigma: Array | None, eo_source: str
+) -> Array | None:
     """The options and the EO sigmas checked against each other (InputError naming what is
     wrong); the sigmas as a float64 array (m, m, m, rad, rad, rad) or None."""
     if opts.robust not in ("none", "huber", "cauchy"):
         raise InputError(f"robust must be none, huber or cauchy, got {opts.robust!r}")
     if eo is not None and eo_sigma is not None:
         eo_sigma = np.asarray(eo_sigma, dtype=np.float64)
-        if eo_sigma.shape != (len(eo), 6) or not (np.isfinite(eo_sigma).all() and
-                                                  (eo_sigma > 0).all()):  # fmt: skip
-            raise InputError("the EO sigmas must be finite and > 0 for every image",
-                             path=eo_source or None)  # fmt: skip
+        if eo_sigma.shape != (len(eo), 6) or not (
+            np.isfinite(eo_sigma).all() and (eo_sigma > 0).all()
+        ):
+            raise InputError(
+                "the EO sigmas must be finite and > 0 for every image", path=eo_source or None
+            )
     if opts.estimate_mount and eo_sigma is None:
-        raise InputError("estimating the lever arm and boresight needs observed orientations "
-                         "(EO with sigma columns)")  # fmt: skip
+        raise InputError(
+            "estimating the lever arm and boresight needs observed orientations "
+            "(EO with sigma columns)"
+        )
     if opts.estimate_timing and eo_sigma is None:
-        raise InputError("estimating the camera timing offset needs observed orientations "
-                         "(EO with sigma columns, or EO_SIGMAS)")  # fmt: skip
+        raise InputError(
+            "estimating the camera timing offset needs observed orientations "
+            "(EO with sigma columns, or EO_SIGMAS)"
+        )
     return eo_sigma
 
 
@@ -225,10 +264,18 @@ def _free_interior(cams: Sequence[Camera], opts: BundleOptions) -> list[NDArray[
     return free
 
 
-def _select_aps(setup, observations: ImageObservations, run: _Run, cams: list[Camera],
-                free: list[NDArray[np.intp]], opts: BundleOptions, keep: NDArray[np.bool_],
-                should_stop: Callable[[], bool] | None, dropped: dict[tuple[str, str], str],
-                dropped_list: list[tuple[str, str, str]]) -> _Run:  # fmt: skip
+def _select_aps(
+    setup,
+    observations: ImageObservations,
+    run: _Run,
+    cams: list[Camera],
+    free: list[NDArray[np.intp]],
+    opts: BundleOptions,
+    keep: NDArray[np.bool_],
+    should_stop: Callable[[], bool] | None,
+    dropped: dict[tuple[str, str], str],
+    dropped_list: list[tuple[str, str, str]],
+) -> _Run:
     """The AP selection loop (:mod:`.bundle_selection`): from the first run, drop one AP at a
     time (held at zero; the observations that run rejected stay out) while one is not
     significant, then the full model, robust + snooping, again with what is left; ``dropped``
@@ -256,18 +303,44 @@ def _select_aps(setup, observations: ImageObservations, run: _Run, cams: list[Ca
         free = [f if k != c else f[f != pos] for k, f in enumerate(free)]
         x = current.result.x
         mnt, dt = _carried(current)
-        current = _run(setup, observations, new_cams, free, opts, keep, "none", False,
-                       x[current.lay.eo], x[current.lay.points], mnt, should_stop,
-                       None, dt)  # fmt: skip
+        current = _run(
+            setup,
+            observations,
+            new_cams,
+            free,
+            opts,
+            keep,
+            "none",
+            False,
+            x[current.lay.eo],
+            x[current.lay.points],
+            mnt,
+            should_stop,
+            None,
+            dt,
+        )
         cams = new_cams
         changed = True
     if changed:
         x = current.result.x
         mnt, dt = _carried(current)
         keep = np.ones(len(observations), dtype=bool)
-        run = _run(setup, observations, cams, free, opts, keep, opts.robust, opts.snooping,
-                   x[current.lay.eo], x[current.lay.points], mnt, should_stop,
-                   None, dt)  # fmt: skip
+        run = _run(
+            setup,
+            observations,
+            cams,
+            free,
+            opts,
+            keep,
+            opts.robust,
+            opts.snooping,
+            x[current.lay.eo],
+            x[current.lay.points],
+            mnt,
+            should_stop,
+            None,
+            dt,
+        )
     return run
 
 
@@ -279,8 +352,13 @@ def _carried(run: _Run) -> tuple[Array | None, float | None]:
     return mnt, (float(x[run.lay.timing]) if run.lay.timing >= 0 else None)
 
 
-def _exposure_velocity(setup, eo: ExteriorOrientationTable, velocity: ExposureVelocities | None,
-                       source: str, with_lever_arm: bool) -> Array:  # fmt: skip
+def _exposure_velocity(
+    setup,
+    eo: ExteriorOrientationTable,
+    velocity: ExposureVelocities | None,
+    source: str,
+    with_lever_arm: bool,
+) -> Array:
     """(M, 3) velocities of the exposures in the adjustment frame, m/s: the EO table's, or
     differenced from the observed centres of each group by the EO's time; with the lever arm
     estimated, a camera-frame velocity that is one at every image is refused, naming dt and
@@ -294,18 +372,22 @@ def _exposure_velocity(setup, eo: ExteriorOrientationTable, velocity: ExposureVe
     return vel
 
 
-def _velocity_local(setup, eo: ExteriorOrientationTable, velocity: ExposureVelocities | None,
-                    source: str) -> Array:  # fmt: skip
+def _velocity_local(
+    setup, eo: ExteriorOrientationTable, velocity: ExposureVelocities | None, source: str
+) -> Array:
     if velocity is not None:
         if velocity.values.shape != (len(eo), 3) or not np.isfinite(velocity.values).all():
-            raise InputError("the exposure velocities must be finite, three per image",
-                             path=source or None)  # fmt: skip
+            raise InputError(
+                "the exposure velocities must be finite, three per image", path=source or None
+            )
         return local_velocity(velocity, eo.xyz, setup.local)
     if not np.isfinite(eo.time).all():
-        raise InputError("estimating the camera timing offset needs the velocity of every "
-                         "exposure: velocity columns (v_north, v_east, v_up or vx, vy, vz) or "
-                         "a time for every image (differenced within each group)",
-                         path=source or None)  # fmt: skip
+        raise InputError(
+            "estimating the camera timing offset needs the velocity of every "
+            "exposure: velocity columns (v_north, v_east, v_up or vx, vy, vz) or "
+            "a time for every image (differenced within each group)",
+            path=source or None,
+        )
     return difference_velocity(eo.time, eo.group, setup.eo_obs[:, :3], "the timing offset")
 
 
@@ -334,8 +416,11 @@ def compare_ap_models(
     def key(r: dict) -> tuple:
         v = r.get("rms_3d", math.nan)  # 3D: the check points are surveyed in 3D
         s = r.get("sigma0", math.nan)
-        return (0 if "error" not in r else 1, v if isinstance(v, float) and math.isfinite(v)
-                else math.inf, s if isinstance(s, float) else math.inf)  # fmt: skip
+        return (
+            0 if "error" not in r else 1,
+            v if isinstance(v, float) and math.isfinite(v) else math.inf,
+            s if isinstance(s, float) else math.inf,
+        )
 
     rows.sort(key=key)
     for rank, r in enumerate(rows, 1):

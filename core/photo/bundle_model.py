@@ -47,8 +47,15 @@ class _Layout:
     timing: int = -1  # index of the timing offset dt (s), -1 when not estimated
 
 
-def _layout(setup: _Setup, free: list[NDArray[np.intp]], cams: list[Camera], eo: Array,
-            xyz: Array, mount: Array | None, timing: float | None = None) -> _Layout:  # fmt: skip
+def _layout(
+    setup: _Setup,
+    free: list[NDArray[np.intp]],
+    cams: list[Camera],
+    eo: Array,
+    xyz: Array,
+    mount: Array | None,
+    timing: float | None = None,
+) -> _Layout:
     names: list[str] = []
     values: list[Array] = []
     M = len(setup.images)
@@ -81,8 +88,9 @@ def _layout(setup: _Setup, free: list[NDArray[np.intp]], cams: list[Camera], eo:
     names += [f"{p} {c}" for p in setup.points for c in "XYZ"]
     values.append(xyz.ravel())
     idx_pts = np.arange(start, start + 3 * P).reshape(P, 3)
-    return _Layout(names, np.concatenate(values), idx_eo, interior, free, idx_mount, idx_pts,
-                   idx_dt)  # fmt: skip
+    return _Layout(
+        names, np.concatenate(values), idx_eo, interior, free, idx_mount, idx_pts, idx_dt
+    )
 
 
 class _ImageModel:
@@ -112,8 +120,7 @@ class _ImageModel:
         # derivatives: some 700 bytes a ray) stay bounded; every row is computed alone
         for s in range(0, n, _CHUNK):
             sl = slice(s, min(n, s + _CHUNK))
-            out = collinearity_jacobians(xl[sl, 6:9], eo, cam, wrt=wrt,
-                                         image_index=self.inv[sl])  # fmt: skip
+            out = collinearity_jacobians(xl[sl, 6:9], eo, cam, wrt=wrt, image_index=self.inv[sl])
             pixels[sl] = out["pixels"]
             jac[sl, :, :6] = out["eo"]
             jac[sl, :, 6:9] = out["point"]
@@ -196,9 +203,9 @@ class _ObservedEOModel:
         om, ph, ka = matrix_to_opk(Mobs)
         f[:, 3:] = np.column_stack([om, ph, ka])
         # keep the predicted angles on the branch of the observed ones
-        f[:, 3:] = self.observed[:, 3:] + (f[:, 3:] - self.observed[:, 3:] + np.pi) % (
-            2 * np.pi
-        ) - np.pi
+        f[:, 3:] = (
+            self.observed[:, 3:] + (f[:, 3:] - self.observed[:, 3:] + np.pi) % (2 * np.pi) - np.pi
+        )
         dop = _dopk_dm(Mobs)  # (g, 3, 9)
         for k in range(3):
             dMobs = dR @ dM[:, k]
@@ -213,8 +220,9 @@ class _ObservedEOModel:
         return f, J
 
 
-def _blocks(setup: _Setup, lay: _Layout, cams: list[Camera], obs: ImageObservations,
-            keep: NDArray[np.bool_]) -> tuple[list, list, list[str]]:  # fmt: skip
+def _blocks(
+    setup: _Setup, lay: _Layout, cams: list[Camera], obs: ImageObservations, keep: NDArray[np.bool_]
+) -> tuple[list, list, list[str]]:
     """Observation blocks; returns them, the measurement rows and the names of the
     image-point blocks."""
     blocks = []
@@ -225,14 +233,21 @@ def _blocks(setup: _Setup, lay: _Layout, cams: list[Camera], obs: ImageObservati
     # own (a block's point columns are eliminated in every group or in none)
     parts = [(c, cam, e) for c, cam in enumerate(cams) for e in (True, False)]
     for c, cam, e in parts:
-        rows = np.flatnonzero(keep & (setup.obs_pt >= 0) & (setup.image_cam[setup.obs_img] == c)
-                              & (elim[np.maximum(setup.obs_pt, 0)] == e))  # fmt: skip
+        rows = np.flatnonzero(
+            keep
+            & (setup.obs_pt >= 0)
+            & (setup.image_cam[setup.obs_img] == c)
+            & (elim[np.maximum(setup.obs_pt, 0)] == e)
+        )
         if rows.size == 0:
             continue
         img, pt = setup.obs_img[rows], setup.obs_pt[rows]
         idx = np.concatenate(
-            [lay.eo[img], lay.points[pt], np.broadcast_to(lay.interior[c], (rows.size,
-                                                                             lay.interior[c].size))],
+            [
+                lay.eo[img],
+                lay.points[pt],
+                np.broadcast_to(lay.interior[c], (rows.size, lay.interior[c].size)),
+            ],
             axis=1,
         )
         labels = [f"{obs.image_id[r]} / {obs.point_id[r]}" for r in rows]
@@ -341,10 +356,22 @@ class _Run:
     keep: NDArray[np.bool_]
 
 
-def _run(setup: _Setup, obs: ImageObservations, cams: list[Camera], free: list,
-         options: BundleOptions, keep: NDArray[np.bool_], robust: str, snooping: bool,
-         eo: Array, xyz: Array, mount: Array | None, should_stop, progress,
-         timing: float | None = None) -> _Run:  # fmt: skip
+def _run(
+    setup: _Setup,
+    obs: ImageObservations,
+    cams: list[Camera],
+    free: list,
+    options: BundleOptions,
+    keep: NDArray[np.bool_],
+    robust: str,
+    snooping: bool,
+    eo: Array,
+    xyz: Array,
+    mount: Array | None,
+    should_stop,
+    progress,
+    timing: float | None = None,
+) -> _Run:
     lay = _layout(setup, free, cams, eo, xyz, mount, timing)
     blocks, rows_of, bnames = _blocks(setup, lay, cams, obs, keep)
     cons = _datum_constraints(setup, lay, options.datum, setup.xyz0, setup.eo0)
@@ -362,8 +389,9 @@ def _run(setup: _Setup, obs: ImageObservations, cams: list[Camera], free: list,
         tolerance=1e-6,
         compute_covariance=options.covariance,
     )
-    result = adjust(lay.x0, lay.names, blocks, cons, opts, progress=progress,
-                    should_stop=should_stop)  # fmt: skip
+    result = adjust(
+        lay.x0, lay.names, blocks, cons, opts, progress=progress, should_stop=should_stop
+    )
     return _Run(result, lay, cams, rows_of, bnames, keep)
 
 

@@ -78,9 +78,21 @@ class CheckPointResult:
         n = d.shape[0]
         out = {"n": float(n)}
         if n == 0:
-            return {**out, **{k: math.nan for k in (
-                "mean_planimetric", "std_planimetric", "rms_planimetric", "rms_e", "rms_n",
-                "rms_h", "rms_3d")}}  # fmt: skip
+            return {
+                **out,
+                **{
+                    k: math.nan
+                    for k in (
+                        "mean_planimetric",
+                        "std_planimetric",
+                        "rms_planimetric",
+                        "rms_e",
+                        "rms_n",
+                        "rms_h",
+                        "rms_3d",
+                    )
+                },
+            }
         hz = np.hypot(d[:, 0], d[:, 1])
         out["mean_planimetric"] = float(hz.mean())
         out["std_planimetric"] = float(hz.std(ddof=1)) if n > 1 else math.nan
@@ -182,8 +194,9 @@ class BundleResult:
     @property
     def n_significant(self) -> int:
         """APs kept and significant in the final adjustment."""
-        return sum(1 for p in self.interior if p.is_ap and p.status == "estimated" and
-                   p.significant)  # fmt: skip
+        return sum(
+            1 for p in self.interior if p.is_ap and p.status == "estimated" and p.significant
+        )
 
     def summary_row(self) -> dict[str, object]:
         """One row of the model comparison (the layout of Table 1 of Lima, Debiasi &
@@ -206,8 +219,9 @@ class BundleResult:
         }
 
 
-def _interior_table(run: _Run, options: BundleOptions, dropped: dict) -> tuple[
-        list[InteriorEstimate], dict, list]:  # fmt: skip
+def _interior_table(
+    run: _Run, options: BundleOptions, dropped: dict
+) -> tuple[list[InteriorEstimate], dict, list]:
     res = run.result
     r = max(res.redundancy, 1)
     tcrit = float(stats.t.ppf(1 - options.ap_alpha / 2, r))
@@ -215,9 +229,12 @@ def _interior_table(run: _Run, options: BundleOptions, dropped: dict) -> tuple[
     corr_out: dict[str, tuple[list[str], Array]] = {}
     flagged: list[tuple[str, str, str, float]] = []
     cams = _cams_from(run)
-    decided = {(d.camera, d.position): d.reason for d in ap_decisions(
-        res, run.lay.interior, run.lay.free, run.cams, options.ap_alpha,
-        options.max_correlation)}  # fmt: skip
+    decided = {
+        (d.camera, d.position): d.reason
+        for d in ap_decisions(
+            res, run.lay.interior, run.lay.free, run.cams, options.ap_alpha, options.max_correlation
+        )
+    }
     for c, cam in enumerate(cams):
         names = cam.interior_names
         idx = run.lay.interior[c]
@@ -228,19 +245,35 @@ def _interior_table(run: _Run, options: BundleOptions, dropped: dict) -> tuple[
                 k = free.index(j)
                 val, sd = float(res.x[idx[k]]), float(res.std[idx[k]])
                 t = abs(val) / sd if sd > 0 else math.inf
-                table.append(InteriorEstimate(cam.name, nm, val, sd, t, bool(t > tcrit),
-                                              "estimated", decided.get((c, j), ""),
-                                              is_ap))  # fmt: skip
+                table.append(
+                    InteriorEstimate(
+                        cam.name,
+                        nm,
+                        val,
+                        sd,
+                        t,
+                        bool(t > tcrit),
+                        "estimated",
+                        decided.get((c, j), ""),
+                        is_ap,
+                    )
+                )
             elif is_ap and (cam.name, nm) in dropped:
                 why = dropped[(cam.name, nm)]
-                table.append(InteriorEstimate(cam.name, nm, 0.0, math.nan, math.nan, False,
-                                              "dropped", why, is_ap))  # fmt: skip
+                table.append(
+                    InteriorEstimate(
+                        cam.name, nm, 0.0, math.nan, math.nan, False, "dropped", why, is_ap
+                    )
+                )
             elif is_ap and options.ap_model == "none":
                 continue
             else:
                 value = float(cam.interior_params[j])
-                table.append(InteriorEstimate(cam.name, nm, value, math.nan, math.nan, False,
-                                              "fixed", "", is_ap))  # fmt: skip
+                table.append(
+                    InteriorEstimate(
+                        cam.name, nm, value, math.nan, math.nan, False, "fixed", "", is_ap
+                    )
+                )
         if idx.size:
             corr = res.correlation_of(idx)
             nm = [names[j] for j in free]
@@ -252,8 +285,9 @@ def _interior_table(run: _Run, options: BundleOptions, dropped: dict) -> tuple[
     return table, corr_out, flagged
 
 
-def _check_points(setup: _Setup, obs: ImageObservations, cams: list[Camera], eo: Array,
-                  sigma0: float) -> CheckPointResult:  # fmt: skip
+def _check_points(
+    setup: _Setup, obs: ImageObservations, cams: list[Camera], eo: Array, sigma0: float
+) -> CheckPointResult:
     """Forward intersection of the check points (Gauss-Newton on the collinearity)."""
     n = len(setup.check_ids)
     rows = np.flatnonzero(setup.obs_check >= 0)
@@ -317,9 +351,16 @@ def _eo_map_sigma(eo_local: Array, cov: Array, local: Local) -> tuple[Array, Arr
     return base[:, :3], base[:, 3:], np.sqrt(np.clip(np.einsum("nii->ni", cm), 0, None))
 
 
-def _finish(setup: _Setup, obs: ImageObservations, run: _Run, options: BundleOptions,
-            dropped: dict, dropped_list: list, eo_table: ExteriorOrientationTable | None,
-            warnings: list[str]) -> BundleResult:  # fmt: skip
+def _finish(
+    setup: _Setup,
+    obs: ImageObservations,
+    run: _Run,
+    options: BundleOptions,
+    dropped: dict,
+    dropped_list: list,
+    eo_table: ExteriorOrientationTable | None,
+    warnings: list[str],
+) -> BundleResult:
     res = run.result
     lay = run.lay
     cams = _cams_from(run)
@@ -330,8 +371,9 @@ def _finish(setup: _Setup, obs: ImageObservations, run: _Run, options: BundleOpt
     xyz_map, opk_map, eo_sig = _eo_map_sigma(eo_local, eo_cov, setup.local)
     time = eo_table.time if eo_table is not None else np.full(M, np.nan)
     group = eo_table.group if eo_table is not None else ("",) * M
-    eo_out = ExteriorOrientationTable(setup.images, time, group, xyz_map, opk_map,
-                                      _wkt(setup.local))  # fmt: skip
+    eo_out = ExteriorOrientationTable(
+        setup.images, time, group, xyz_map, opk_map, _wkt(setup.local)
+    )
     pts_local = x[lay.points]
     blocks_q = res.cofactor_blocks
     P = len(setup.points)
@@ -366,8 +408,9 @@ def _finish(setup: _Setup, obs: ImageObservations, run: _Run, options: BundleOpt
         for c, cam in enumerate(cams):
             sel = chk[setup.image_cam[setup.obs_img[chk]] == c]
             if sel.size:
-                pred = collinearity_jacobians(xyz_chk[setup.obs_check[sel]],
-                                              eo_local[setup.obs_img[sel]], cam, wrt=())
+                pred = collinearity_jacobians(
+                    xyz_chk[setup.obs_check[sel]], eo_local[setup.obs_img[sel]], cam, wrt=()
+                )
                 v[sel] = pred["pixels"] - obs.pixels[sel]
     cnt = np.bincount(setup.obs_img[used], minlength=M)
     sq = [np.bincount(setup.obs_img[used], weights=v[used, j] ** 2, minlength=M) for j in (0, 1)]
@@ -385,13 +428,14 @@ def _finish(setup: _Setup, obs: ImageObservations, run: _Run, options: BundleOpt
         }
     roles = setup.roles + ("check",) * len(setup.check_ids)
     pid = setup.points + setup.check_ids
-    pxyz = np.vstack([setup.local.enu_to_map(pts_local) if P else np.zeros((0, 3)),
-                      check.measured])  # fmt: skip
+    pxyz = np.vstack([setup.local.enu_to_map(pts_local) if P else np.zeros((0, 3)), check.measured])
     psig = np.vstack([np.sqrt(np.clip(np.einsum("nii->ni", pcov_map), 0, None)), check.sigma])
-    nimg = np.concatenate([
-        np.bincount(setup.obs_pt[setup.obs_pt >= 0], minlength=P),
-        check.n_images,
-    ]).astype(np.int64)  # fmt: skip
+    nimg = np.concatenate(
+        [
+            np.bincount(setup.obs_pt[setup.obs_pt >= 0], minlength=P),
+            check.n_images,
+        ]
+    ).astype(np.int64)
     role_arr = np.array(setup.roles + ("check",), dtype=object)
     obs_role = tuple(role_arr[np.where(setup.obs_check >= 0, len(setup.roles), setup.obs_pt)])
     timing = _timing(run)
@@ -451,8 +495,12 @@ def _timing(run: _Run) -> dict | None:
     lay, res = run.lay, run.result
     if lay.timing < 0:
         return None
-    others = [*(lay.mount if lay.mount is not None else ()), *np.concatenate(
-        [np.asarray(i, dtype=np.intp) for i in lay.interior] or [np.zeros(0, np.intp)])]
+    others = [
+        *(lay.mount if lay.mount is not None else ()),
+        *np.concatenate(
+            [np.asarray(i, dtype=np.intp) for i in lay.interior] or [np.zeros(0, np.intp)]
+        ),
+    ]
     corr: dict[str, float] = {}
     if res.cofactor is not None or res.cofactor_blocks is not None:
         eo = lay.eo.ravel()
@@ -464,8 +512,11 @@ def _timing(run: _Run) -> dict | None:
         r = res.correlation_of(idx)[0, 1:]
         corr = {lay.names[i]: float(v) for i, v in zip(others, r)}
         corr[lay.names[eo[k]]] = float(r_eo[k])
-    return {"dt_s": float(res.x[lay.timing]), "dt_std_s": float(res.std[lay.timing]),
-            "correlation": corr}  # fmt: skip
+    return {
+        "dt_s": float(res.x[lay.timing]),
+        "dt_std_s": float(res.std[lay.timing]),
+        "correlation": corr,
+    }
 
 
 def _wkt(local: Local) -> str:

@@ -73,8 +73,9 @@ def _joint_f(x: np.ndarray, cov: np.ndarray) -> float:
         return math.nan
 
 
-def ap_decisions(result, interior, free, cameras, alpha: float, max_correlation: float
-                 ) -> list[ApDecision]:  # fmt: skip
+def ap_decisions(
+    result, interior, free, cameras, alpha: float, max_correlation: float
+) -> list[ApDecision]:
     """The decision for every free AP of every camera (see the module docstring).
 
     ``result`` is the :class:`~lidarphoto.core.lsq.results.AdjustmentResult`; ``interior[c]``
@@ -99,19 +100,40 @@ def ap_decisions(result, interior, free, cameras, alpha: float, max_correlation:
         for k in aps:
             nm = names[pos[k]]
             if not t[k] <= tcrit:
-                reason = (_t("significant (t = {t:.2f} > {critical:.2f})", t=t[k],
-                             critical=tcrit) if np.isfinite(t[k])
-                          else _t("not tested (no standard deviation)"))  # fmt: skip
-                out.append(ApDecision(c, int(pos[k]), nm, float(t[k]), tcrit, (), math.nan,
-                                      math.nan, False, reason))  # fmt: skip
+                reason = (
+                    _t("significant (t = {t:.2f} > {critical:.2f})", t=t[k], critical=tcrit)
+                    if np.isfinite(t[k])
+                    else _t("not tested (no standard deviation)")
+                )
+                out.append(
+                    ApDecision(
+                        c,
+                        int(pos[k]),
+                        nm,
+                        float(t[k]),
+                        tcrit,
+                        (),
+                        math.nan,
+                        math.nan,
+                        False,
+                        reason,
+                    )
+                )
                 continue
             group = [j for j in weak if j != k and abs(corr[k, j]) > max_correlation]
             gnames = tuple(names[pos[j]] for j in group)
             if not group:
-                reason = _t("insignificant (t = {t:.2f} <= {critical:.2f}, alpha {alpha:g})",
-                            t=t[k], critical=tcrit, alpha=alpha)  # fmt: skip
-                out.append(ApDecision(c, int(pos[k]), nm, float(t[k]), tcrit, (), math.nan,
-                                      math.nan, True, reason))  # fmt: skip
+                reason = _t(
+                    "insignificant (t = {t:.2f} <= {critical:.2f}, alpha {alpha:g})",
+                    t=t[k],
+                    critical=tcrit,
+                    alpha=alpha,
+                )
+                out.append(
+                    ApDecision(
+                        c, int(pos[k]), nm, float(t[k]), tcrit, (), math.nan, math.nan, True, reason
+                    )
+                )
                 continue
             sel = np.array([k, *group])
             f = _joint_f(x[sel], result.covariance_of(idx[sel]))
@@ -122,16 +144,26 @@ def ap_decisions(result, interior, free, cameras, alpha: float, max_correlation:
                 reason = _t(
                     "insignificant (t = {t:.2f} <= {critical:.2f}, alpha {alpha:g}), also "
                     "jointly with {others} (F = {f:.2f} <= {fcritical:.2f})",
-                    t=t[k], critical=tcrit, alpha=alpha, others=others, f=f, fcritical=fcrit,
-                )  # fmt: skip
+                    t=t[k],
+                    critical=tcrit,
+                    alpha=alpha,
+                    others=others,
+                    f=f,
+                    fcritical=fcrit,
+                )
             else:
                 reason = _t(
                     "kept: insignificant alone (t = {t:.2f} <= {critical:.2f}) but jointly "
                     "significant with {others} (F = {f:.2f} > {fcritical:.2f})",
-                    t=t[k], critical=tcrit, others=others, f=f, fcritical=fcrit,
-                )  # fmt: skip
-            out.append(ApDecision(c, int(pos[k]), nm, float(t[k]), tcrit, gnames, f, fcrit,
-                                  drop, reason))  # fmt: skip
+                    t=t[k],
+                    critical=tcrit,
+                    others=others,
+                    f=f,
+                    fcritical=fcrit,
+                )
+            out.append(
+                ApDecision(c, int(pos[k]), nm, float(t[k]), tcrit, gnames, f, fcrit, drop, reason)
+            )
     return out
 
 

@@ -146,8 +146,9 @@ def _check_observations(
         raise _fail(
             f"point '{obs.point_id[i]}' is measured twice in image '{obs.image_id[i]}' (also "
             f"row {row_j})",
-            obs, i,
-        )  # fmt: skip
+            obs,
+            i,
+        )
     seen = set(img_names.tolist())
     for k, im in enumerate(images):
         if im not in seen:
@@ -160,16 +161,18 @@ def _check_observations(
             )
     roles = dict(zip(ground.point_id, ground.role))
     obs.require_control_known(
-        roles, f"the ground point table{f' {ground.source}' if ground.source else ''} (give "
+        roles,
+        f"the ground point table{f' {ground.source}' if ground.source else ''} (give "
         "GROUND_POINTS with that point_id)",
-    )  # fmt: skip
+    )
     for i, (p, t) in enumerate(zip(obs.point_id, obs.type)):
         if t == "check" and roles.get(p) != "check":
             raise _fail(
                 f"row of type check names point '{p}', which is not a check point of the "
                 "ground point table",
-                obs, i,
-            )  # fmt: skip
+                obs,
+                i,
+            )
     counts = np.bincount(pt, minlength=pt_names.size)
     first_i = np.full(pt_names.size, n)
     np.minimum.at(first_i, pt, np.arange(n))
@@ -182,8 +185,9 @@ def _check_observations(
         raise _fail(
             f"{what} '{p}' is measured in one image only: it needs two or more (a control "
             "point may be measured once)",
-            obs, int(first_i[k]),
-        )  # fmt: skip
+            obs,
+            int(first_i[k]),
+        )
 
 
 def _components(img: NDArray[np.intp], pts: NDArray[np.intp], n_img: int, n_pts: int):
@@ -194,8 +198,6 @@ def _components(img: NDArray[np.intp], pts: NDArray[np.intp], n_img: int, n_pts:
         (np.ones(img.size), (img, n_img + pts)), shape=(n_img + n_pts, n_img + n_pts)
     )
     return connected_components(graph, directed=False)
-
-
 
 
 @dataclass
@@ -225,8 +227,9 @@ class _Setup:
     velocity: Array | None = None  # (M, 3) local, m/s: the exposures' (timing offset)
 
 
-def _local_frame(mapping: Frame, ground: GroundPoints,
-                 eo: ExteriorOrientationTable | None) -> Local:  # fmt: skip
+def _local_frame(
+    mapping: Frame, ground: GroundPoints, eo: ExteriorOrientationTable | None
+) -> Local:
     if len(ground):
         centre = ground.xyz.mean(axis=0)
     else:
@@ -368,8 +371,19 @@ def _prepare(
             eo_obs = eo0.copy()
             eo_obs_cov = _eo_cov_to_local(eo, eo_sigma, local)
     else:
-        eo0 = _grow(cams, image_cam, obs, obs_img, obs_pt, control_pt, control_local,
-                    len(images), len(adjusted), images, should_stop)  # fmt: skip
+        eo0 = _grow(
+            cams,
+            image_cam,
+            obs,
+            obs_img,
+            obs_pt,
+            control_pt,
+            control_local,
+            len(images),
+            len(adjusted),
+            images,
+            should_stop,
+        )
     if options.datum == "control" and control_pt.size < 3 and eo_obs is None:
         raise InputError(
             f"the datum needs three or more control points measured in the images or observed "
@@ -388,19 +402,38 @@ def _prepare(
         raise _fail(
             f"point '{p}' cannot be intersected from the approximate orientations (its rays "
             "are parallel or miss each other); check its measurements",
-            obs, i,
-        )  # fmt: skip
+            obs,
+            i,
+        )
     return _Setup(
-        local=local, images=images, image_cam=image_cam, cam_names=cam_names, cameras=cams,
-        eo0=eo0, points=tuple(adjusted), roles=point_roles, xyz0=xyz0, obs_img=obs_img,
-        obs_pt=obs_pt, obs_check=obs_check, check_ids=tuple(check_ids),
-        check_ref_local=check_local, control_pt=control_pt, control_cov=control_cov,
-        control_local=control_local, eo_obs=eo_obs, eo_obs_cov=eo_obs_cov,
-    )  # fmt: skip
+        local=local,
+        images=images,
+        image_cam=image_cam,
+        cam_names=cam_names,
+        cameras=cams,
+        eo0=eo0,
+        points=tuple(adjusted),
+        roles=point_roles,
+        xyz0=xyz0,
+        obs_img=obs_img,
+        obs_pt=obs_pt,
+        obs_check=obs_check,
+        check_ids=tuple(check_ids),
+        check_ref_local=check_local,
+        control_pt=control_pt,
+        control_cov=control_cov,
+        control_local=control_local,
+        eo_obs=eo_obs,
+        eo_obs_cov=eo_obs_cov,
+    )
 
 
-def _image_cameras(cameras: Sequence[Camera], cam_names: tuple[str, ...], images: tuple[str, ...],
-                   image_camera: Mapping[str, str]) -> NDArray[np.intp]:  # fmt: skip
+def _image_cameras(
+    cameras: Sequence[Camera],
+    cam_names: tuple[str, ...],
+    images: tuple[str, ...],
+    image_camera: Mapping[str, str],
+) -> NDArray[np.intp]:
     """The camera (index into ``cameras``) of every image; InputError for an image without
     one among several cameras or naming an unknown camera."""
     image_cam = np.zeros(len(images), dtype=np.intp)
@@ -435,8 +468,13 @@ def _warn_unobserved(ground: GroundPoints, obs: ImageObservations, warnings: lis
         )
 
 
-def _check_connected(obs: ImageObservations, obs_img: NDArray[np.intp], obs_pt: NDArray[np.intp],
-                     images: tuple[str, ...], n_points: int) -> None:  # fmt: skip
+def _check_connected(
+    obs: ImageObservations,
+    obs_img: NDArray[np.intp],
+    obs_pt: NDArray[np.intp],
+    images: tuple[str, ...],
+    n_points: int,
+) -> None:
     """InputError naming the images apart when the block falls into unconnected parts
     (through its adjusted points)."""
     # the block must hang together through its adjusted points
@@ -455,8 +493,12 @@ def _check_connected(obs: ImageObservations, obs_img: NDArray[np.intp], obs_pt: 
         )
 
 
-def _check_orientable(obs: ImageObservations, obs_img: NDArray[np.intp], obs_pt: NDArray[np.intp],
-                      images: tuple[str, ...]) -> None:  # fmt: skip
+def _check_orientable(
+    obs: ImageObservations,
+    obs_img: NDArray[np.intp],
+    obs_pt: NDArray[np.intp],
+    images: tuple[str, ...],
+) -> None:
     """Without observed orientations: InputError naming the images with fewer than three
     measured points (six equations for their six unknowns)."""
     # without observed orientations an image needs three points (six equations for its
@@ -500,8 +542,19 @@ def _approximate_points(cams, image_cam, eo, obs, obs_img, obs_pt, n_points) -> 
     return meet_rays(o, d, obs_pt[rows], n_points)[0]
 
 
-def _grow(cams, image_cam, obs, obs_img, obs_pt, control_pt, control_local, n_img, n_pts,
-          images, should_stop) -> Array:  # fmt: skip
+def _grow(
+    cams,
+    image_cam,
+    obs,
+    obs_img,
+    obs_pt,
+    control_pt,
+    control_local,
+    n_img,
+    n_pts,
+    images,
+    should_stop,
+) -> Array:
     """Orientations from resections of the images that see control, then growth."""
     import cv2
 
@@ -524,9 +577,12 @@ def _grow(cams, image_cam, obs, obs_img, obs_pt, control_pt, control_local, n_im
                 continue
             try:
                 res = space_resection(
-                    obs.pixels[rows], known[obs_pt[rows]], cams[image_cam[k]],
-                    sigma_px=1.0, options=AdjustmentOptions(snooping=True, max_iterations=30),
-                )  # fmt: skip
+                    obs.pixels[rows],
+                    known[obs_pt[rows]],
+                    cams[image_cam[k]],
+                    sigma_px=1.0,
+                    options=AdjustmentOptions(snooping=True, max_iterations=30),
+                )
             except (AdjustmentError, InputError, np.linalg.LinAlgError, cv2.error):
                 continue  # a failed start is retried when more points are known
             if np.all(np.abs(res.rms_px) < 50.0):

@@ -45,8 +45,9 @@ class CalibrationOptions:
     def __post_init__(self) -> None:
         """Check the choices (raises :class:`InputError`)."""
         if self.projection not in PROJECTIONS:
-            raise InputError(f"projection must be one of {', '.join(PROJECTIONS)}, "
-                             f"got {self.projection!r}")  # fmt: skip
+            raise InputError(
+                f"projection must be one of {', '.join(PROJECTIONS)}, got {self.projection!r}"
+            )
         bad = [p for p in self.lens_parameters if p not in LENS_NAMES]
         if bad:
             raise InputError(f"unknown lens parameter(s) {bad}: use some of {list(LENS_NAMES)}")
@@ -60,13 +61,28 @@ class CalibrationOptions:
 TARGET_KINDS: tuple[str, ...] = ("chessboard", "charuco", "aruco")
 #: OpenCV's predefined ArUco dictionaries accepted by name.
 DICTIONARIES: tuple[str, ...] = (
-    "DICT_4X4_50", "DICT_4X4_100", "DICT_4X4_250", "DICT_4X4_1000",
-    "DICT_5X5_50", "DICT_5X5_100", "DICT_5X5_250", "DICT_5X5_1000",
-    "DICT_6X6_50", "DICT_6X6_100", "DICT_6X6_250", "DICT_6X6_1000",
-    "DICT_7X7_50", "DICT_7X7_100", "DICT_7X7_250", "DICT_7X7_1000",
-    "DICT_ARUCO_ORIGINAL", "DICT_APRILTAG_16h5", "DICT_APRILTAG_25h9",
-    "DICT_APRILTAG_36h10", "DICT_APRILTAG_36h11",
-)  # fmt: skip
+    "DICT_4X4_50",
+    "DICT_4X4_100",
+    "DICT_4X4_250",
+    "DICT_4X4_1000",
+    "DICT_5X5_50",
+    "DICT_5X5_100",
+    "DICT_5X5_250",
+    "DICT_5X5_1000",
+    "DICT_6X6_50",
+    "DICT_6X6_100",
+    "DICT_6X6_250",
+    "DICT_6X6_1000",
+    "DICT_7X7_50",
+    "DICT_7X7_100",
+    "DICT_7X7_250",
+    "DICT_7X7_1000",
+    "DICT_ARUCO_ORIGINAL",
+    "DICT_APRILTAG_16h5",
+    "DICT_APRILTAG_25h9",
+    "DICT_APRILTAG_36h10",
+    "DICT_APRILTAG_36h11",
+)
 
 
 @dataclass(frozen=True)
@@ -100,13 +116,16 @@ class TargetSpec:
         if self.kind not in TARGET_KINDS:
             raise InputError(f"target kind must be one of {', '.join(TARGET_KINDS)}")
         if self.cols < 2 or self.rows < 2:
-            raise InputError(f"a {self.kind} target needs at least 2 x 2 (got "
-                             f"{self.cols} x {self.rows})")  # fmt: skip
+            raise InputError(
+                f"a {self.kind} target needs at least 2 x 2 (got {self.cols} x {self.rows})"
+            )
         if not self.spacing_m > 0:
             raise InputError(f"the target spacing must be positive, got {self.spacing_m}")
         if self.kind == "charuco" and not 0 < self.marker_m < self.spacing_m:
-            raise InputError("a ChArUco marker must be smaller than the square "
-                             f"({self.marker_m} m vs {self.spacing_m} m)")  # fmt: skip
+            raise InputError(
+                "a ChArUco marker must be smaller than the square "
+                f"({self.marker_m} m vs {self.spacing_m} m)"
+            )
         if self.kind == "aruco" and not self.marker_m > 0:
             raise InputError("an ArUco grid board needs the gap between markers (marker_m > 0)")
         if self.kind != "chessboard" and self.dictionary not in DICTIONARIES:

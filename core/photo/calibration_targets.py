@@ -103,8 +103,9 @@ def target_field(spec: TargetSpec) -> TargetField:
         grid = np.column_stack([c.ravel(), r.ravel(), np.zeros(c.size)])
         xyz = np.asarray(grid * spec.spacing_m, dtype=np.float64)  # float64 already: no copy
         ids = np.arange(spec.cols * spec.rows, dtype=np.int64)
-        return TargetField(ids, xyz, (0, spec.cols - 1, (spec.rows - 1) * spec.cols),
-                           spec.spacing_m)  # fmt: skip
+        return TargetField(
+            ids, xyz, (0, spec.cols - 1, (spec.rows - 1) * spec.cols), spec.spacing_m
+        )
     if spec.kind == "charuco":
         corners = np.asarray(_charuco_board(spec).getChessboardCorners(), dtype=np.float64)
         nc, nr = spec.cols - 1, spec.rows - 1
@@ -116,8 +117,9 @@ def target_field(spec: TargetSpec) -> TargetField:
     ids = (4 * mids[:, None] + np.arange(4)[None, :]).ravel()
     last_in_row = 4 * int(mids[spec.cols - 1]) + 1
     first_of_last = 4 * int(mids[(spec.rows - 1) * spec.cols]) + 3
-    return TargetField(ids, obj.reshape(-1, 3), (int(ids[0]), last_in_row, first_of_last),
-                       spec.spacing_m)  # fmt: skip
+    return TargetField(
+        ids, obj.reshape(-1, 3), (int(ids[0]), last_in_row, first_of_last), spec.spacing_m
+    )
 
 
 def _grey(image: NDArray[Any]) -> NDArray[np.uint8]:

@@ -195,8 +195,9 @@ def _plane_pose(xy: Array, rays: Array) -> tuple[Array, Array, float]:
     return rot, lam * h[:, 2], misfit
 
 
-def _best_focal(views: list[tuple[Array, Array]], size: tuple[int, int], projection: str,
-                relative: bool = False) -> tuple[float, float]:  # fmt: skip
+def _best_focal(
+    views: list[tuple[Array, Array]], size: tuple[int, int], projection: str, relative: bool = False
+) -> tuple[float, float]:
     """Focal length (px) whose back-projected rays make every view closest to a plane seen by
     a central camera (a wrong focal length bends the grid's lines), and the summed squares
     of the views' RMS misfit angles (rad^2) there; the principal point at the centre. With
@@ -223,8 +224,10 @@ def _best_focal(views: list[tuple[Array, Array]], size: tuple[int, int], project
     grid = np.geomspace(0.05 * diag, 2.0 * diag, 60)
     costs = np.array([misfit(f) for f in grid])
     if not np.isfinite(costs).any():
-        raise InputError(f"no focal length puts every target point inside the {projection} "
-                         "projection's image (a wider projection may fit)")  # fmt: skip
+        raise InputError(
+            f"no focal length puts every target point inside the {projection} "
+            "projection's image (a wider projection may fit)"
+        )
     k = int(np.argmin(costs))
     lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
     for _ in range(40):  # golden-section refinement within the bracket
@@ -279,16 +282,24 @@ def fisheye_evidence(views: list[tuple[Array, Array]], size: tuple[int, int]) ->
     best = min(PROJECTIONS[1:], key=lambda p: fits[p][1])
     f_px, mis = fits[best]
     pp = np.array([0.5 * size[0], 0.5 * size[1]])
-    off = max(float(np.nanmax(np.arccos(np.clip(_rays_cv(px, f_px, pp, best)[:, 2], -1, 1))))
-              for _, px in views) if math.isfinite(mis) else 0.0  # fmt: skip
+    off = (
+        max(
+            float(np.nanmax(np.arccos(np.clip(_rays_cv(px, f_px, pp, best)[:, 2], -1, 1))))
+            for _, px in views
+        )
+        if math.isfinite(mis)
+        else 0.0
+    )
     if not (mis * FISHEYE_FIT_RATIO < persp and off >= math.radians(FISHEYE_OFF_AXIS_DEG)):
         return ""
-    return (f"the views look like a fisheye lens: the target's straight lines fit the {best} "
-            f"projection (f {f_px:.0f} px) {persp / mis:.2g} times better than the perspective "
-            f"one (RMS misfit {100 * mis:.2g} % against {100 * persp:.2g} % of the rays' "
-            f"spread) and the target is seen up to about {math.degrees(off):.0f} degrees off the "
-            f"axis (a field of view of about {2 * math.degrees(off):.0f} degrees): try PROJECTION "
-            f"{best}")  # fmt: skip
+    return (
+        f"the views look like a fisheye lens: the target's straight lines fit the {best} "
+        f"projection (f {f_px:.0f} px) {persp / mis:.2g} times better than the perspective "
+        f"one (RMS misfit {100 * mis:.2g} % against {100 * persp:.2g} % of the rays' "
+        f"spread) and the target is seen up to about {math.degrees(off):.0f} degrees off the "
+        f"axis (a field of view of about {2 * math.degrees(off):.0f} degrees): try PROJECTION "
+        f"{best}"
+    )
 
 
 def _init_perspective(views: list[tuple[Array, Array]], size: tuple[int, int]):
@@ -308,8 +319,9 @@ def _init_perspective(views: list[tuple[Array, Array]], size: tuple[int, int]):
 class _ViewModel:
     """Collinearity of one block of observations: x_local = [eo (6), interior (p), point (3)?]."""
 
-    def __init__(self, base: Camera, free: NDArray[np.intp], view: NDArray[np.intp],
-                 const_xyz: Array | None) -> None:  # fmt: skip
+    def __init__(
+        self, base: Camera, free: NDArray[np.intp], view: NDArray[np.intp], const_xyz: Array | None
+    ) -> None:
         self.base = base
         self.free = free
         self.const_xyz = const_xyz
@@ -347,8 +359,9 @@ def _flat(detections: Sequence[Detection], fld: TargetField):
     return np.concatenate(views), np.concatenate(pts), np.concatenate(pxs), names
 
 
-def _adjust_explained(x0v, pnames, blocks, constraints, aopts, progress, should_stop,
-                      perspective_views, size) -> AdjustmentResult:
+def _adjust_explained(
+    x0v, pnames, blocks, constraints, aopts, progress, should_stop, perspective_views, size
+) -> AdjustmentResult:
     """``adjust`` with its failures explained for a camera calibration: which views are
     missing, and (``perspective_views`` given) whether the views look like a fisheye lens."""
 
@@ -357,8 +370,9 @@ def _adjust_explained(x0v, pnames, blocks, constraints, aopts, progress, should_
         return f"; {text}" if text else ""
 
     try:
-        res = adjust(x0v, pnames, blocks, constraints, aopts, progress=progress,
-                     should_stop=should_stop)  # fmt: skip
+        res = adjust(
+            x0v, pnames, blocks, constraints, aopts, progress=progress, should_stop=should_stop
+        )
     except NotObservableError as exc:
         raise NotObservableError(
             f"camera calibration: {exc}. The views cannot determine these parameters: use "
@@ -370,8 +384,9 @@ def _adjust_explained(x0v, pnames, blocks, constraints, aopts, progress, should_
     except AdjustmentError as exc:
         raise type(exc)(f"camera calibration: {exc}{fisheye()}") from exc
     if not res.converged:
-        raise ConvergenceError(f"camera calibration did not converge in {res.iterations} "
-                               f"iterations{fisheye()}")  # fmt: skip
+        raise ConvergenceError(
+            f"camera calibration did not converge in {res.iterations} iterations{fisheye()}"
+        )
     return res
 
 
@@ -388,8 +403,12 @@ def _residuals_by_point(res: AdjustmentResult, blocks, is_free: NDArray[np.bool_
 
 
 def _initial_camera(
-    per_view: list[tuple[Array, Array]], opts: CalibrationOptions, name: str, width_px: int,
-    height_px: int, pixel_size_mm: float,
+    per_view: list[tuple[Array, Array]],
+    opts: CalibrationOptions,
+    name: str,
+    width_px: int,
+    height_px: int,
+    pixel_size_mm: float,
 ) -> tuple[Camera, Array, dict]:
     """The start camera (no distortion), the start orientations (V, 6) and how they were
     found (focal length and principal point in pixels, the method)."""
@@ -401,12 +420,22 @@ def _initial_camera(
         how = "focal-length search: plane DLT of the back-projected rays (Z = 0 target)"
     ps = float(pixel_size_mm)
     base = Camera(
-        name, f_px * ps, ps, width_px, height_px,
-        x0_mm=(pp[0] - 0.5 * width_px) * ps, y0_mm=(0.5 * height_px - pp[1]) * ps,
-        distortion=BrownConrady(), projection=opts.projection,
-    )  # fmt: skip
-    initial = {"focal_px": float(f_px), "ppx_px": float(pp[0]), "ppy_px": float(pp[1]),
-               "method": how}  # fmt: skip
+        name,
+        f_px * ps,
+        ps,
+        width_px,
+        height_px,
+        x0_mm=(pp[0] - 0.5 * width_px) * ps,
+        y0_mm=(0.5 * height_px - pp[1]) * ps,
+        distortion=BrownConrady(),
+        projection=opts.projection,
+    )
+    initial = {
+        "focal_px": float(f_px),
+        "ppx_px": float(pp[0]),
+        "ppy_px": float(pp[1]),
+        "method": how,
+    }
     return base, eo0, initial
 
 
@@ -427,13 +456,19 @@ class _Unknowns:
 
 
 def _unknowns(
-    fld: TargetField, pt: NDArray[np.intp], view_names: list[str], base: Camera, eo0: Array,
+    fld: TargetField,
+    pt: NDArray[np.intp],
+    view_names: list[str],
+    base: Camera,
+    eo0: Array,
     opts: CalibrationOptions,
 ) -> _Unknowns:
     """The parameters adjusted and their start values (a free field: its points but two of
     the datum)."""
-    free_io = np.array([0, 1, 2] + [3 + LENS_NAMES.index(p) for p in LENS_NAMES
-                                    if p in opts.lens_parameters], dtype=np.intp)  # fmt: skip
+    free_io = np.array(
+        [0, 1, 2] + [3 + LENS_NAMES.index(p) for p in LENS_NAMES if p in opts.lens_parameters],
+        dtype=np.intp,
+    )
     io_names = [INTERIOR_NAMES[i] for i in free_io]
     n_io, n_views = free_io.size, len(view_names)
     x0 = [base.interior_params[free_io], eo0.ravel()]
@@ -444,8 +479,10 @@ def _unknowns(
     if opts.field == "free":
         datum = [int(np.flatnonzero(fld.ids == d)[0]) for d in fld.datum]
         if not np.isin(datum, seen).all():
-            raise InputError("a free target field needs its datum points (origin, end of the "
-                             "first row, start of the last row) seen in some view")  # fmt: skip
+            raise InputError(
+                "a free target field needs its datum points (origin, end of the "
+                "first row, start of the last row) seen in some view"
+            )
         fixed_pts = set(datum[:2])
         free_pts = [int(k) for k in seen if int(k) not in fixed_pts]
     else:
@@ -459,8 +496,14 @@ def _unknowns(
 
 
 def _blocks(
-    fld: TargetField, view: NDArray[np.intp], pt: NDArray[np.intp], px: Array,
-    view_names: list[str], base: Camera, unk: _Unknowns, sigma: float,
+    fld: TargetField,
+    view: NDArray[np.intp],
+    pt: NDArray[np.intp],
+    px: Array,
+    view_names: list[str],
+    base: Camera,
+    unk: _Unknowns,
+    sigma: float,
 ) -> tuple[list[GaussMarkovBlock], NDArray[np.bool_]]:
     """The observation blocks (points of a fixed field, free points) and which observations
     are of free points."""
@@ -475,14 +518,20 @@ def _blocks(
             continue
         idx = [eo_idx[sel], io_idx[sel]]
         if free:
-            idx.append(np.array([point_index[int(k)] for k in pt[sel]])[:, None]
-                       + np.arange(3)[None, :])  # fmt: skip
-        blocks.append(GaussMarkovBlock(
-            name="free points" if free else "fixed points",
-            observed=px[sel], sigma=sigma, param_index=np.concatenate(idx, axis=1),
-            model=_ViewModel(base, unk.free_io, view[sel], None if free else fld.xyz[pt[sel]]),
-            labels=[labels[i] for i in np.flatnonzero(sel)], row_names=("col", "row"),
-        ))  # fmt: skip
+            idx.append(
+                np.array([point_index[int(k)] for k in pt[sel]])[:, None] + np.arange(3)[None, :]
+            )
+        blocks.append(
+            GaussMarkovBlock(
+                name="free points" if free else "fixed points",
+                observed=px[sel],
+                sigma=sigma,
+                param_index=np.concatenate(idx, axis=1),
+                model=_ViewModel(base, unk.free_io, view[sel], None if free else fld.xyz[pt[sel]]),
+                labels=[labels[i] for i in np.flatnonzero(sel)],
+                row_names=("col", "row"),
+            )
+        )
     return blocks, is_free
 
 
@@ -540,8 +589,14 @@ def calibrate_camera(
     view, pt, px, names = _flat(detections, fld)
     skipped = [d.image for d in detections if d.image not in names]
     warnings: list[str]  # Messages: English text that keeps its template for translation
-    warnings = [_t("view {view!r} left out: fewer than {minimum} target points", view=s,
-                   minimum=MIN_POINTS_PER_VIEW) for s in skipped]  # fmt: skip
+    warnings = [
+        _t(
+            "view {view!r} left out: fewer than {minimum} target points",
+            view=s,
+            minimum=MIN_POINTS_PER_VIEW,
+        )
+        for s in skipped
+    ]
     n_views = len(names)
     if n_views < 2:
         raise NotObservableError(
@@ -550,18 +605,24 @@ def calibrate_camera(
             parameters=["focal_mm", "x0_mm", "y0_mm"],
         )
     per_view = [(fld.xyz[pt[view == j]], px[view == j]) for j in range(n_views)]
-    base, eo0, initial = _initial_camera(per_view, opts, name, width_px, height_px,
-                                         pixel_size_mm)  # fmt: skip
+    base, eo0, initial = _initial_camera(per_view, opts, name, width_px, height_px, pixel_size_mm)
     unk = _unknowns(fld, pt, names, base, eo0, opts)
     io_names, n_io, point_index = unk.io_names, unk.n_io, unk.point_index
     sigma = opts.sigma_px
     blocks, is_free = _blocks(fld, view, pt, px, names, base, unk, sigma)
     aopts = AdjustmentOptions(max_iterations=opts.max_iterations)
     constraints = _datum_constraints(unk, opts.field == "free")
-    res = _adjust_explained(unk.x0, unk.names, blocks, constraints, aopts,
-                            progress, should_stop,
-                            per_view if opts.projection == "perspective" else None,
-                            (width_px, height_px))  # fmt: skip
+    res = _adjust_explained(
+        unk.x0,
+        unk.names,
+        blocks,
+        constraints,
+        aopts,
+        progress,
+        should_stop,
+        per_view if opts.projection == "perspective" else None,
+        (width_px, height_px),
+    )
     full = base.interior_params
     full[unk.free_io] = res.x[:n_io]
     cam = base.with_interior(full)
@@ -569,8 +630,9 @@ def calibrate_camera(
     sigmas = {n: float(std[i]) for i, n in enumerate(io_names)}
     corr = res.correlation_of(np.arange(n_io))
     tcrit = float(stats.t.ppf(1 - opts.alpha / 2, max(res.redundancy, 1)))
-    t_values = {n: abs(float(res.x[i])) / float(std[i]) for i, n in enumerate(io_names)
-                if n in LENS_NAMES}  # fmt: skip
+    t_values = {
+        n: abs(float(res.x[i])) / float(std[i]) for i, n in enumerate(io_names) if n in LENS_NAMES
+    }
     significant = {n: bool(t > tcrit) for n, t in t_values.items()}
     v_all, w_all = _residuals_by_point(res, blocks, is_free, px)
     d2 = np.sum(v_all**2, axis=1)
@@ -581,25 +643,51 @@ def calibrate_camera(
     xyz = fld.xyz.copy()
     for k, i in point_index.items():
         xyz[k] = res.x[i : i + 3]
-    rows = [(names[v], int(fld.ids[k]), float(c), float(r), float(a), float(b), float(wc),
-             float(wr)) for v, k, (c, r), (a, b), (wc, wr)
-            in zip(view, pt, px, v_all, w_all)]  # fmt: skip
+    rows = [
+        (names[v], int(fld.ids[k]), float(c), float(r), float(a), float(b), float(wc), float(wr))
+        for v, k, (c, r), (a, b), (wc, wr) in zip(view, pt, px, v_all, w_all)
+    ]
     for n, sig in significant.items():
         if not sig:
-            warnings.append(_t("{parameter} is not significant (t = {t:.2f} < {critical:.2f}): "
-                               "consider holding it at zero", parameter=n, t=t_values[n],
-                               critical=tcrit))  # fmt: skip
+            warnings.append(
+                _t(
+                    "{parameter} is not significant (t = {t:.2f} < {critical:.2f}): "
+                    "consider holding it at zero",
+                    parameter=n,
+                    t=t_values[n],
+                    critical=tcrit,
+                )
+            )
     warnings += list(res.warnings)
     return CalibrationResult(
-        camera=cam, sigmas=sigmas, parameter_names=io_names, correlation=corr,
-        t_values=t_values, significant=significant, t_critical=tcrit, sigma0=res.sigma0,
-        sigma0_prior=1.0, redundancy=res.redundancy, n_points=int(view.size),
-        iterations=res.iterations, condition_number=res.condition_number,
-        rms_px=math.sqrt(float(np.mean(d2))), view_names=names, view_rms_px=view_rms,
-        view_points=view_pts, eo=eo, eo_sigma=eo_sigma, residuals=rows, field_xyz=xyz,
-        field_ids=fld.ids.copy(), initial=initial, adjustment=res, warnings=warnings,
-        sigma_px=sigma, projection=opts.projection,
-    )  # fmt: skip
+        camera=cam,
+        sigmas=sigmas,
+        parameter_names=io_names,
+        correlation=corr,
+        t_values=t_values,
+        significant=significant,
+        t_critical=tcrit,
+        sigma0=res.sigma0,
+        sigma0_prior=1.0,
+        redundancy=res.redundancy,
+        n_points=int(view.size),
+        iterations=res.iterations,
+        condition_number=res.condition_number,
+        rms_px=math.sqrt(float(np.mean(d2))),
+        view_names=names,
+        view_rms_px=view_rms,
+        view_points=view_pts,
+        eo=eo,
+        eo_sigma=eo_sigma,
+        residuals=rows,
+        field_xyz=xyz,
+        field_ids=fld.ids.copy(),
+        initial=initial,
+        adjustment=res,
+        warnings=warnings,
+        sigma_px=sigma,
+        projection=opts.projection,
+    )
 
 
 def simulate_views(

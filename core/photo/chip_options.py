@@ -65,8 +65,9 @@ class PlateGeometry:
             if not math.isfinite(float(value)):
                 raise InputError(f"plate {name} must be finite, got {value!r}")
         if not 0.0 < self.inner_m < self.outer_m:
-            raise InputError(f"plate: need 0 < inner side ({self.inner_m:g} m) < outer side "
-                             f"({self.outer_m:g} m)")  # fmt: skip
+            raise InputError(
+                f"plate: need 0 < inner side ({self.inner_m:g} m) < outer side ({self.outer_m:g} m)"
+            )
 
     def corners(self) -> Array:
         """(8, 3) corners relative to the surveyed point (east, north, up; metres)."""

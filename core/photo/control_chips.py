@@ -249,8 +249,9 @@ def rectify_to_plane(
         shape = gx.shape
         mx = np.where(good, px[:, 0] - 0.5, -1e6).astype(np.float32).reshape(shape)
         my = np.where(good, px[:, 1] - 0.5, -1e6).astype(np.float32).reshape(shape)
-        sub = cv2.remap(img, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
-                        borderValue=(np.nan,))  # fmt: skip
+        sub = cv2.remap(
+            img, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=(np.nan,)
+        )
         # a cell with any sub-sample outside the photo is NaN (no partial cells)
         chip[r0:r1] = sub.reshape(r1 - r0, s, n, s).mean(axis=(1, 3))
     return chip, s
@@ -295,19 +296,29 @@ def make_chip(
     if not det.found:
         return fail(det.reason, detection=det)
     try:
-        pr = resect_plate(det, camera, plate, photo_azimuth_deg,
-                          sigma_px=opt.corner_sigma_px or None)  # fmt: skip
+        pr = resect_plate(
+            det, camera, plate, photo_azimuth_deg, sigma_px=opt.corner_sigma_px or None
+        )
     except (ConvergenceError, NotObservableError, InputError) as exc:
         return fail(_t("plate resection failed: {error}", error=str(exc)), detection=det)
     if not (pr.sigma0 <= opt.max_sigma0):
-        return fail(_t("resection sigma0 {sigma0:.3g} > {maximum:g}", sigma0=pr.sigma0,
-                       maximum=opt.max_sigma0), detection=det,
-                    plate=pr)  # fmt: skip
+        return fail(
+            _t(
+                "resection sigma0 {sigma0:.3g} > {maximum:g}",
+                sigma0=pr.sigma0,
+                maximum=opt.max_sigma0,
+            ),
+            detection=det,
+            plate=pr,
+        )
     notes = []
     if free_photo is None:
         if not opt.from_plate_photo:
-            return fail(_t("no plate-free photo (allow the chip from the plate photo to make "
-                           "it anyway)"), detection=det, plate=pr)  # fmt: skip
+            return fail(
+                _t("no plate-free photo (allow the chip from the plate photo to make it anyway)"),
+                detection=det,
+                plate=pr,
+            )
         source_img, eo, std, s0, reg, source = ref, pr.eo, pr.std, pr.sigma0, None, "plate"
         notes.append(_t("chip from the plate photo: the plate hides the ground at the point"))
     else:
@@ -316,19 +327,31 @@ def make_chip(
         free = _grey_f32(free_photo)
         reg = register_sift(ref, free, camera, opt.sift_ratio, opt.ransac_px, opt.sift_features)
         if len(reg.ref_px) < opt.min_matches:
-            return fail(_t("too few SIFT matches: {inliers} RANSAC inliers of {matches} "
-                           "matches (< {minimum})", inliers=len(reg.ref_px),
-                           matches=reg.matches, minimum=opt.min_matches), detection=det,
-                        plate=pr, sift=reg)  # fmt: skip
+            return fail(
+                _t(
+                    "too few SIFT matches: {inliers} RANSAC inliers of {matches} "
+                    "matches (< {minimum})",
+                    inliers=len(reg.ref_px),
+                    matches=reg.matches,
+                    minimum=opt.min_matches,
+                ),
+                detection=det,
+                plate=pr,
+                sift=reg,
+            )
         ground = _on_plane(reg.ref_px, pr.eo, camera, 0.0)
         ok = np.isfinite(ground).all(axis=1)
         try:
-            fr = space_resection(reg.moved_px[ok], ground[ok], camera, eo0=pr.eo,
-                                 sigma_px=opt.match_sigma_px)  # fmt: skip
+            fr = space_resection(
+                reg.moved_px[ok], ground[ok], camera, eo0=pr.eo, sigma_px=opt.match_sigma_px
+            )
         except (ConvergenceError, NotObservableError, InputError) as exc:
-            return fail(_t("plate-free photo resection failed: {error}", error=str(exc)),
-                        detection=det, plate=pr,
-                        sift=reg)  # fmt: skip
+            return fail(
+                _t("plate-free photo resection failed: {error}", error=str(exc)),
+                detection=det,
+                plate=pr,
+                sift=reg,
+            )
         eo, std, s0, source = fr.eo, fr.std, float(fr.adjustment.sigma0), "free"
         source_img = free
         if len(fr.rejected):
@@ -336,12 +359,29 @@ def make_chip(
     chip, s = rectify_to_plane(source_img, camera, eo, gt, opt.size_px, origin_xy=p[:2], z=0.0)
     valid = float(np.isfinite(chip).mean())
     kw: dict[str, Any]  # ChipResult's fields
-    kw = dict(detection=det, plate=pr, sift=reg, free_eo=np.asarray(eo).copy(),
-              free_std=np.asarray(std).copy(), free_sigma0=float(s0), source=source,
-              chip=chip, valid_fraction=valid, subsamples=s, notes=tuple(notes))  # fmt: skip
+    kw = dict(
+        detection=det,
+        plate=pr,
+        sift=reg,
+        free_eo=np.asarray(eo).copy(),
+        free_std=np.asarray(std).copy(),
+        free_sigma0=float(s0),
+        source=source,
+        chip=chip,
+        valid_fraction=valid,
+        subsamples=s,
+        notes=tuple(notes),
+    )
     if valid < opt.min_valid:
-        return ChipResult(point_id, "failed", _t("the photo sees {valid:.1f} % of the chip "
-                                                 "(< {minimum:g} %)", valid=100 * valid,
-                                                 minimum=100 * opt.min_valid),
-                          geotransform=gt, **kw)  # fmt: skip
+        return ChipResult(
+            point_id,
+            "failed",
+            _t(
+                "the photo sees {valid:.1f} % of the chip (< {minimum:g} %)",
+                valid=100 * valid,
+                minimum=100 * opt.min_valid,
+            ),
+            geotransform=gt,
+            **kw,
+        )
     return ChipResult(point_id, "ok", "", geotransform=gt, **kw)

@@ -235,6 +235,7 @@ def lcp_from_feature(feature: ControlFeature) -> ControlPoint | None:
         support_distance=np.full(3, np.nan),
     )
 
+
 # ----------------------------------------------------------------------------- control
 @dataclass(frozen=True)
 class ControlSet:

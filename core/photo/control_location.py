@@ -233,32 +233,40 @@ def locate_control_points(
         size = choose_template_size(chip.grey, pc, opt.texture)
         if not size.ok or not np.isfinite(chip.grey).all():
             why = size.reason if not size.ok else _t("chip has no-data pixels")
-            pairs.append(LocatedPair(pid, "", "rejected", _t("chip refused: {why}", why=why),
-                                     template_px=size.size))  # fmt: skip
+            pairs.append(
+                LocatedPair(
+                    pid, "", "rejected", _t("chip refused: {why}", why=why), template_px=size.size
+                )
+            )
             continue
         h = size.size // 2
         ci, ri = int(np.rint(pc[0])), int(np.rint(pc[1]))
         template = chip.grey[ri - h : ri + h + 1, ci - h : ci + h + 1]
         ref = (pc[0] - (ci - h), pc[1] - (ri - h))
         pts_local, pix, jac_chip, inside, inside_margin = _chip_in_images(
-            chip, pc, h, local, eo_local, camera)  # fmt: skip
+            chip, pc, h, local, eo_local, camera
+        )
         if not inside.any():
-            pairs.append(LocatedPair(pid, "", "outside", _t("outside every image"),
-                                     template_px=size.size))  # fmt: skip
+            pairs.append(
+                LocatedPair(pid, "", "outside", _t("outside every image"), template_px=size.size)
+            )
             continue
         results: dict[int, LocatedPair] = {}
         for i in np.flatnonzero(inside).tolist():
             iid = eo.image_id[i]
             pred = pix[i, 0]
             base: dict[str, Any]  # LocatedPair's fields
-            base = {"template_px": size.size, "predicted_col": float(pred[0]),
-                    "predicted_row": float(pred[1])}  # fmt: skip
+            base = {
+                "template_px": size.size,
+                "predicted_col": float(pred[0]),
+                "predicted_row": float(pred[1]),
+            }
             if not inside_margin[i]:
-                results[i] = LocatedPair(pid, iid, "rejected", _t("template partly outside "
-                                         "the image"), **base)  # fmt: skip
+                results[i] = LocatedPair(
+                    pid, iid, "rejected", _t("template partly outside the image"), **base
+                )
                 continue
-            half_f, cov_search = _search_ellipse(opt, eo_sigmas, i, pts_local, eo_local,
-                                                 camera)  # fmt: skip
+            half_f, cov_search = _search_ellipse(opt, eo_sigmas, i, pts_local, eo_local, camera)
             base["search_px"] = (float(half_f[0]), float(half_f[1]))
             jac = jac_chip[i]
             m = _match(
@@ -274,8 +282,20 @@ def locate_control_points(
             )
             results[i] = _finish(pid, iid, m, pred, cov_search, base, "chip")
         if opt.transfer:
-            _transfer_failed(results, jac_chip, pix, eo, read_window, size.size, opt, cv2,
-                             eo_sigmas, eo_local, pts_local, camera)  # fmt: skip
+            _transfer_failed(
+                results,
+                jac_chip,
+                pix,
+                eo,
+                read_window,
+                size.size,
+                opt,
+                cv2,
+                eo_sigmas,
+                eo_local,
+                pts_local,
+                camera,
+            )
         for i in sorted(results):
             r = results[i]
             pairs.append(r)
@@ -286,15 +306,17 @@ def locate_control_points(
         progress(1.0)
     if obs_rows:
         img, pid_, c, rr, sig = zip(*obs_rows)
-        obs = ImageObservations.from_arrays(img, pid_, np.column_stack([c, rr]), sig,
-                                            ["control"] * len(img), [""] * len(img))  # fmt: skip
+        obs = ImageObservations.from_arrays(
+            img, pid_, np.column_stack([c, rr]), sig, ["control"] * len(img), [""] * len(img)
+        )
     else:
         obs = ImageObservations.from_arrays([], [], np.zeros((0, 2)), np.zeros(0), [], [])
     return LocationResult(tuple(pairs), obs)
 
 
-def _chip_in_images(chip: ControlChip, pc, h: int, local: LocalFrame, eo_local: Array,
-                    camera: Camera):  # fmt: skip
+def _chip_in_images(
+    chip: ControlChip, pc, h: int, local: LocalFrame, eo_local: Array, camera: Camera
+):
     """The chip's point and 4 chip pixels +-5 px around it in every image at once: (their
     local coordinates (5, 3), their pixels (n_img, 5, 2), the image-per-chip-pixel Jacobians
     (n_img, 2, 2), the images the point falls in, those that also hold the whole template of
@@ -310,7 +332,7 @@ def _chip_in_images(chip: ControlChip, pc, h: int, local: LocalFrame, eo_local: 
         front[i] = bool(inf.all() and conv.all())
     jac_chip = np.stack(
         [(pix[:, 1] - pix[:, 2]) / 10.0, (pix[:, 3] - pix[:, 4]) / 10.0], axis=2
-    )  # fmt: skip  (n_img, 2 image, 2 chip)
+    )  # (n_img, 2 image, 2 chip)
     reach = np.abs(jac_chip).sum(axis=2).max(axis=1) * h if n_img else np.zeros(0)
     inside = front & camera.in_frame(pix[:, 0], margin_px=0.0)
     inside &= np.isfinite(reach)
@@ -320,8 +342,14 @@ def _chip_in_images(chip: ControlChip, pc, h: int, local: LocalFrame, eo_local: 
     return pts_local, pix, jac_chip, inside, inside_margin
 
 
-def _search_ellipse(opt: LocateOptions, eo_sigmas: Array | None, i: int, pts_local: Array,
-                    eo_local: Array, camera: Camera) -> tuple[Array, Array]:  # fmt: skip
+def _search_ellipse(
+    opt: LocateOptions,
+    eo_sigmas: Array | None,
+    i: int,
+    pts_local: Array,
+    eo_local: Array,
+    camera: Camera,
+) -> tuple[Array, Array]:
     """The search half-sizes (col, row pixels) in image ``i`` and the search covariance
     (pixels^2): from the EO sigmas propagated to the image when given, else the defaults."""
     if eo_sigmas is not None:
@@ -337,10 +365,20 @@ def _search_ellipse(opt: LocateOptions, eo_sigmas: Array | None, i: int, pts_loc
     return half_f, cov_search
 
 
-def _transfer_failed(results: dict, jac_chip: Array, pix: Array, eo: ExteriorOrientationTable,
-                     read_window: WindowReader, size_px: int, opt: LocateOptions, cv2,
-                     eo_sigmas: Array | None, eo_local: Array, pts_local: Array,
-                     camera: Camera) -> None:  # fmt: skip
+def _transfer_failed(
+    results: dict,
+    jac_chip: Array,
+    pix: Array,
+    eo: ExteriorOrientationTable,
+    read_window: WindowReader,
+    size_px: int,
+    opt: LocateOptions,
+    cv2,
+    eo_sigmas: Array | None,
+    eo_local: Array,
+    pts_local: Array,
+    camera: Camera,
+) -> None:
     """Transfer: the images where the chip failed (not for being outside the image) matched
     again from the best located image (smallest sigma); ``results`` updated in place."""
     good = [i for i, r in results.items() if r.status == "ok"]
@@ -350,9 +388,23 @@ def _transfer_failed(results: dict, jac_chip: Array, pix: Array, eo: ExteriorOri
         for i, r in list(results.items()):
             if r.status == "ok" or "outside the image" in r.reason:
                 continue
-            t = _transfer(mres, master, i, jac_chip, pix, eo.image_id, read_window,
-                          size_px, opt, cv2, eo_sigmas, eo_local, pts_local, camera,
-                          r)  # fmt: skip
+            t = _transfer(
+                mres,
+                master,
+                i,
+                jac_chip,
+                pix,
+                eo.image_id,
+                read_window,
+                size_px,
+                opt,
+                cv2,
+                eo_sigmas,
+                eo_local,
+                pts_local,
+                camera,
+                r,
+            )
             if t is not None:
                 results[i] = t
 
@@ -371,8 +423,9 @@ class _Match:
     image_patch: Array | None = None
 
 
-def _match(chip_template, ref, jac, image_id, pred_corner, half_search, read, opt, cv2,
-           ncc_template=None) -> _Match:  # fmt: skip
+def _match(
+    chip_template, ref, jac, image_id, pred_corner, half_search, read, opt, cv2, ncc_template=None
+) -> _Match:
     """NCC (template warped into image geometry) then LSM of the template in the image."""
     m, n = chip_template.shape
     # image-geometry template of side s' centred on the point
@@ -383,18 +436,23 @@ def _match(chip_template, ref, jac, image_id, pred_corner, half_search, read, op
     jinv = np.linalg.inv(jac)
     # dst (x, y) in patch array coords -> template array coords: ref + Jinv ((x, y) - hs)
     warp = np.hstack([jinv, (np.asarray(ref) - jinv @ np.array([hs, hs]))[:, None]])
-    tmpl_img = cv2.warpAffine(np.ascontiguousarray(chip_template, dtype=np.float32),
-                              warp.astype(np.float64), (side, side),
-                              flags=cv2.INTER_CUBIC | cv2.WARP_INVERSE_MAP,
-                              borderMode=cv2.BORDER_REPLICATE)  # fmt: skip
+    tmpl_img = cv2.warpAffine(
+        np.ascontiguousarray(chip_template, dtype=np.float32),
+        warp.astype(np.float64),
+        (side, side),
+        flags=cv2.INTER_CUBIC | cv2.WARP_INVERSE_MAP,
+        borderMode=cv2.BORDER_REPLICATE,
+    )
     if ncc_template is not None:
         tmpl_img = ncc_template
         side = tmpl_img.shape[0]
         hs = side // 2
     pred = np.asarray(pred_corner, float) - 0.5  # array coordinates
     lsm_margin = int(np.ceil(np.abs(jac).sum(axis=1).max() * max(m, n) / 2 + 6))
-    half = (math.ceil(half_search[0]) + max(hs, lsm_margin) + 2,
-            math.ceil(half_search[1]) + max(hs, lsm_margin) + 2)  # fmt: skip
+    half = (
+        math.ceil(half_search[0]) + max(hs, lsm_margin) + 2,
+        math.ceil(half_search[1]) + max(hs, lsm_margin) + 2,
+    )
     win, origin = _window(read, image_id, pred, half)
     if np.isnan(win).any():
         # Only the part inside the image is searched; the NaNs are filled for NCC so that
@@ -416,8 +474,9 @@ def _match(chip_template, ref, jac, image_id, pred_corner, half_search, read, op
     nm = ncc_search(tmpl_img, sub)
     out = _Match(ncc=nm.peak)
     if nm.peak < opt.min_ncc:
-        out.reason = _t("low correlation (NCC {ncc:.2f} < {minimum:.2f})", ncc=nm.peak,
-                        minimum=opt.min_ncc)  # fmt: skip
+        out.reason = _t(
+            "low correlation (NCC {ncc:.2f} < {minimum:.2f})", ncc=nm.peak, minimum=opt.min_ncc
+        )
         return out
     if nm.on_border:
         out.reason = _t("NCC peak on the search border")
@@ -455,15 +514,42 @@ def _finish(pid, iid, r: _Match, pred, cov_search, base, source) -> LocatedPair:
             reason = _t("outside the search ellipse")
     sig = np.sqrt(np.diag(r.cov)) if r.cov is not None else np.full(2, np.nan)
     return LocatedPair(
-        pid, iid, "rejected" if reason else "ok", reason, source, col, row,
-        float(sig[0]), float(sig[1]), r.sigma0, r.ncc, r.corr,
-        iterations=r.iterations, chip_patch=r.chip_patch, image_patch=r.image_patch, **base,
-    )  # fmt: skip
+        pid,
+        iid,
+        "rejected" if reason else "ok",
+        reason,
+        source,
+        col,
+        row,
+        float(sig[0]),
+        float(sig[1]),
+        r.sigma0,
+        r.ncc,
+        r.corr,
+        iterations=r.iterations,
+        chip_patch=r.chip_patch,
+        image_patch=r.image_patch,
+        **base,
+    )
 
 
-def _transfer(mres: LocatedPair, master: int, i: int, jac_chip, pix, image_ids, read,
-              size: int, opt, cv2, eo_sigmas, eo_local, pts_local, camera,
-              old: LocatedPair) -> LocatedPair | None:  # fmt: skip
+def _transfer(
+    mres: LocatedPair,
+    master: int,
+    i: int,
+    jac_chip,
+    pix,
+    image_ids,
+    read,
+    size: int,
+    opt,
+    cv2,
+    eo_sigmas,
+    eo_local,
+    pts_local,
+    camera,
+    old: LocatedPair,
+) -> LocatedPair | None:
     """Image-to-image LSM from the master image's patch around its match into image i."""
     h = size // 2
     mc, mr = mres.col - 0.5, mres.row - 0.5
@@ -481,15 +567,30 @@ def _transfer(mres: LocatedPair, master: int, i: int, jac_chip, pix, image_ids, 
         half_f = np.full(2, opt.default_search_px)
     r = _match(win, ref, jac, image_ids[i], pred, half_f, read, opt, cv2)
     cov_search = np.diag(half_f**2) + np.diag(np.full(2, opt.min_search_px**2))
-    base = {"template_px": size, "predicted_col": old.predicted_col,
-            "predicted_row": old.predicted_row, "search_px": old.search_px}  # fmt: skip
+    base = {
+        "template_px": size,
+        "predicted_col": old.predicted_col,
+        "predicted_row": old.predicted_row,
+        "search_px": old.search_px,
+    }
     if r.cov is not None:
         m_cov = np.diag([mres.sigma_col**2, mres.sigma_row**2])
         r.cov = r.cov + jac @ m_cov @ jac.T
-    out = _finish(old.point_id, old.image_id, r, pred, cov_search * 4.0, base,
-                  _t("transfer from {image}", image=image_ids[master]))  # fmt: skip
+    out = _finish(
+        old.point_id,
+        old.image_id,
+        r,
+        pred,
+        cov_search * 4.0,
+        base,
+        _t("transfer from {image}", image=image_ids[master]),
+    )
     if out.status != "ok":
-        reason = _t("{reason}; transfer from {image}: {transfer_reason}", reason=old.reason,
-                    image=image_ids[master], transfer_reason=out.reason)  # fmt: skip
+        reason = _t(
+            "{reason}; transfer from {image}: {transfer_reason}",
+            reason=old.reason,
+            image=image_ids[master],
+            transfer_reason=out.reason,
+        )
         return LocatedPair(**{**out.__dict__, "reason": reason})
     return out

@@ -263,8 +263,9 @@ def _quads(grey_u8: NDArray[np.uint8], min_area_px: float) -> list[Array]:
     blur = cv2.GaussianBlur(grey_u8, (5, 5), 0)
     _, otsu = cv2.threshold(blur, 0, 255, cv2.THRESH_BINARY + cv2.THRESH_OTSU)
     block = max(15, (min(h, w) // 16) | 1)
-    adaptive = cv2.adaptiveThreshold(blur, 255, cv2.ADAPTIVE_THRESH_MEAN_C,
-                                     cv2.THRESH_BINARY, block, 0)  # fmt: skip
+    adaptive = cv2.adaptiveThreshold(
+        blur, 255, cv2.ADAPTIVE_THRESH_MEAN_C, cv2.THRESH_BINARY, block, 0
+    )
     # fixed levels too: a plate edge against a ground of similar mean grey is separated only
     # by a level between the plate's grey and the nearest ground grey
     levels = [cv2.threshold(blur, t, 255, cv2.THRESH_BINARY)[1] for t in range(32, 255, 32)]
@@ -405,8 +406,9 @@ def _edge_points(
     # our pixel centres are at +0.5, OpenCV's at 0
     mx = (pts[..., 0] - 0.5).astype(np.float32)
     my = (pts[..., 1] - 0.5).astype(np.float32)
-    prof = cv2.remap(smooth, mx, my, cv2.INTER_CUBIC, borderMode=cv2.BORDER_CONSTANT,
-                     borderValue=(np.nan,)).astype(np.float64)  # fmt: skip
+    prof = cv2.remap(
+        smooth, mx, my, cv2.INTER_CUBIC, borderMode=cv2.BORDER_CONSTANT, borderValue=(np.nan,)
+    ).astype(np.float64)
     grad = np.abs(np.gradient(prof, PROFILE_STEP_PX, axis=1))
     ok = np.isfinite(grad).all(axis=1)
     grad = np.nan_to_num(grad)
@@ -465,17 +467,26 @@ def detect_plate(
     quads = _quads(u8, min_area_px)
     if not quads:
         return PlateDetection(False, _t("plate not found: no quadrilateral in the photo"))
-    pairs = _pairs(quads, plate.inner_m / plate.outer_m,
-                   to_plane=None if camera.is_perspective else (
-                       lambda q: plane_from_pixels(q, camera)))  # fmt: skip
+    pairs = _pairs(
+        quads,
+        plate.inner_m / plate.outer_m,
+        to_plane=None if camera.is_perspective else (lambda q: plane_from_pixels(q, camera)),
+    )
     if not pairs:
-        return PlateDetection(False, _t("only one square: {n} quadrilateral(s), none with a "
-                                        "nested square of the plate's inner/outer ratio",
-                                        n=len(quads)))  # fmt: skip
+        return PlateDetection(
+            False,
+            _t(
+                "only one square: {n} quadrilateral(s), none with a "
+                "nested square of the plate's inner/outer ratio",
+                n=len(quads),
+            ),
+        )
     if len(pairs) > 1:
-        return PlateDetection(False, _t("ambiguous: {n} plate-like pairs of squares",
-                                        n=len(pairs)),
-                              candidates=len(pairs))  # fmt: skip
+        return PlateDetection(
+            False,
+            _t("ambiguous: {n} plate-like pairs of squares", n=len(pairs)),
+            candidates=len(pairs),
+        )
     outer, inner = pairs[0]
     smooth = cast(NDArray[np.float32], cv2.GaussianBlur(img, (0, 0), 1.0))  # depth kept
     lines = []
@@ -484,15 +495,22 @@ def detect_plate(
     f_px = camera.focal_px
     for k, quad in enumerate((outer, inner)):
         for i in range(4):
-            pts = _edge_points(smooth, quad[i], quad[(i + 1) % 4],
-                               None if camera.is_perspective else camera)  # fmt: skip
+            pts = _edge_points(
+                smooth, quad[i], quad[(i + 1) % 4], None if camera.is_perspective else camera
+            )
             uv = plane_from_pixels(pts, camera) if len(pts) else pts
             uv = uv[np.isfinite(uv).all(axis=1)] if len(uv) else uv
             fit = _fit_side(uv)
             if fit is None:
-                return PlateDetection(False, _t("edge fit failed: side {side} has {n} edge "
-                                                "points", side=4 * k + i, n=len(uv)),
-                                      candidates=1)  # fmt: skip
+                return PlateDetection(
+                    False,
+                    _t(
+                        "edge fit failed: side {side} has {n} edge points",
+                        side=4 * k + i,
+                        n=len(uv),
+                    ),
+                    candidates=1,
+                )
             lines.append(fit)
             if camera.is_perspective:
                 rms[4 * k + i] = fit[3] * f_px
@@ -517,8 +535,9 @@ def detect_plate(
                 sig[4 * k + i] = math.sqrt(max(var, 0.0))
     px = pixels_from_plane(corners_uv, camera)
     if not np.isfinite(px).all():
-        return PlateDetection(False, _t("edge fit failed: a corner falls outside the camera's "
-                                 "field"), candidates=1)  # fmt: skip
+        return PlateDetection(
+            False, _t("edge fit failed: a corner falls outside the camera's field"), candidates=1
+        )
     return PlateDetection(True, "", px, sig, rms, count, 1)
 
 
@@ -590,11 +609,19 @@ def resect_plate(
     if best is None:
         raise InputError("no pose fits the plate's corners")
     turn, eo0, mis, order = best
-    sig = (np.maximum(detection.sigma_px, 0.02) if sigma_px is None
-           else np.full(8, float(sigma_px)))  # fmt: skip
-    data = ResectionData(point_ids=tuple(f"corner{k}" for k in range(8)), pixels=px,
-                         sigma_px=sig, xyz=obj[order])  # fmt: skip
+    sig = np.maximum(detection.sigma_px, 0.02) if sigma_px is None else np.full(8, float(sigma_px))
+    data = ResectionData(
+        point_ids=tuple(f"corner{k}" for k in range(8)), pixels=px, sigma_px=sig, xyz=obj[order]
+    )
     res = resect(data, camera, ResectionOptions(snooping=True), eo0=eo0)
-    return PlateResection(res.eo.copy(), res.std.copy(), float(res.sigma0), int(res.redundancy),
-                          res.point_v.copy(), res.point_rejected.copy(), turn, float(mis),
-                          res)  # fmt: skip
+    return PlateResection(
+        res.eo.copy(),
+        res.std.copy(),
+        float(res.sigma0),
+        int(res.redundancy),
+        res.point_v.copy(),
+        res.point_rejected.copy(),
+        turn,
+        float(mis),
+        res,
+    )

@@ -141,9 +141,8 @@ def dock_bundle_inputs(
     point_id: list[str] = []
     ground: dict[str, tuple[Array, Array, str]] = {}
     for i, (im, pid, kind, tid) in enumerate(
-        zip(observations.image_id, observations.point_id, observations.type,
-            observations.target_id)
-    ):  # fmt: skip
+        zip(observations.image_id, observations.point_id, observations.type, observations.target_id)
+    ):
         if open_images is not None and im not in open_images:
             leave("row(s) of images not open")
         elif kind in ("line", "paper"):
@@ -161,8 +160,11 @@ def dock_bundle_inputs(
                 sig = np.sqrt(np.clip(np.diag(np.asarray(c.covariance, dtype=np.float64)), 0, None))
                 sig = np.where(np.isfinite(sig), sig, DEFAULT_CONTROL_SIGMA_M)
                 role = "control" if kind == "lcp" else "check"
-                ground[name] = (np.asarray(c.xyz, dtype=np.float64),
-                                np.maximum(sig, MIN_CONTROL_SIGMA_M), role)  # fmt: skip
+                ground[name] = (
+                    np.asarray(c.xyz, dtype=np.float64),
+                    np.maximum(sig, MIN_CONTROL_SIGMA_M),
+                    role,
+                )
             keep.append(i)
             point_id.append(name)
     # a tie point in one image only is one still being measured: no ray to intersect
@@ -180,9 +182,16 @@ def dock_bundle_inputs(
     # the bundle refuses a control row naming no ground point: here they are tie points
     kinds = tuple("tie" if t == "control" else t for t in sub.type)
     kept = ImageObservations(
-        sub.image_id, tuple(p for _, p in sel), sub.pixels, sub.sigma_px, kinds,
-        sub.target_id, sub.rows, sub.source, sub.camera,
-    )  # fmt: skip
+        sub.image_id,
+        tuple(p for _, p in sel),
+        sub.pixels,
+        sub.sigma_px,
+        kinds,
+        sub.target_id,
+        sub.rows,
+        sub.source,
+        sub.camera,
+    )
     names = tuple(ground)
     gp = GroundPoints(
         names,
@@ -193,9 +202,7 @@ def dock_bundle_inputs(
     return DockBundleInputs(kept, gp, tuple(dict.fromkeys(kept.image_id)), left)
 
 
-def residuals_by_row(
-    result: BundleResult, observations: ImageObservations
-) -> dict[int, Array]:
+def residuals_by_row(result: BundleResult, observations: ImageObservations) -> dict[int, Array]:
     """The bundle's residual (v_col, v_row; adjusted minus measured, pixels) of each row of the
     dock's ``observations`` it adjusted, by row index. A residual belongs to the row of the
     same image, type and point (``C<target>``/``K<target>`` for lcp and check rows; a
@@ -211,9 +218,8 @@ def residuals_by_row(
     }
     out: dict[int, Array] = {}
     for i, (im, pid, kind, tid) in enumerate(
-        zip(observations.image_id, observations.point_id, observations.type,
-            observations.target_id)
-    ):  # fmt: skip
+        zip(observations.image_id, observations.point_id, observations.type, observations.target_id)
+    ):
         name = pid if kind in _AS_TIE else ("C" if kind == "lcp" else "K") + str(tid)
         vk = by_key.get((im, "tie" if kind == "control" else kind, name))
         if vk is not None:

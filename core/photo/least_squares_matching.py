@@ -51,16 +51,27 @@ TR_CONTEXT = "Report"
 Array = NDArray[np.float64]
 
 __all__ = [
-    "STATUS_TEXT", "LsmOptions", "LsmResult", "PointMatch", "affine_start", "lsm_batch",
-    "lsm_in_image", "match_point",
-]  # fmt: skip
+    "STATUS_TEXT",
+    "LsmOptions",
+    "LsmResult",
+    "PointMatch",
+    "affine_start",
+    "lsm_batch",
+    "lsm_in_image",
+    "match_point",
+]
 
 OK, NO_TEXTURE, LEFT_WINDOW, NOT_CONVERGED, DRIFTED, LOW_CORRELATION, SIGMA_TOO_LARGE = range(7)
 #: Status code -> reason.
 STATUS_TEXT = (
-    _t("ok"), _t("no texture"), _t("left the search window"), _t("not converged"),
-    _t("moved too far"), _t("low correlation"), _t("sigma too large"),
-)  # fmt: skip
+    _t("ok"),
+    _t("no texture"),
+    _t("left the search window"),
+    _t("not converged"),
+    _t("moved too far"),
+    _t("low correlation"),
+    _t("sigma too large"),
+)
 
 
 @dataclass(frozen=True)
@@ -110,8 +121,9 @@ def affine_start(position: ArrayLike, linear: ArrayLike | None = None) -> Array:
     [[[5.0, 1.0, 0.0], [6.0, 0.0, 1.0]]]
     """
     p = np.asarray(position, dtype=np.float64).reshape(-1, 2)
-    lin = np.broadcast_to(np.eye(2) if linear is None else np.asarray(linear, float),
-                          (p.shape[0], 2, 2))  # fmt: skip
+    lin = np.broadcast_to(
+        np.eye(2) if linear is None else np.asarray(linear, float), (p.shape[0], 2, 2)
+    )
     return np.concatenate([p[:, :, None], lin], axis=2)
 
 
@@ -120,18 +132,24 @@ def _keys(t: Array) -> tuple[Array, Array]:
     for fraction ``t`` (any shape), and their derivatives d/dt; stacked on a last axis."""
     t2 = t * t
     t3 = t2 * t
-    w = np.stack([
-        -0.5 * t3 + t2 - 0.5 * t,
-        1.5 * t3 - 2.5 * t2 + 1.0,
-        -1.5 * t3 + 2.0 * t2 + 0.5 * t,
-        0.5 * t3 - 0.5 * t2,
-    ], axis=-1)  # fmt: skip
-    d = np.stack([
-        -1.5 * t2 + 2.0 * t - 0.5,
-        4.5 * t2 - 5.0 * t,
-        -4.5 * t2 + 4.0 * t + 0.5,
-        1.5 * t2 - t,
-    ], axis=-1)  # fmt: skip
+    w = np.stack(
+        [
+            -0.5 * t3 + t2 - 0.5 * t,
+            1.5 * t3 - 2.5 * t2 + 1.0,
+            -1.5 * t3 + 2.0 * t2 + 0.5 * t,
+            0.5 * t3 - 0.5 * t2,
+        ],
+        axis=-1,
+    )
+    d = np.stack(
+        [
+            -1.5 * t2 + 2.0 * t - 0.5,
+            4.5 * t2 - 5.0 * t,
+            -4.5 * t2 + 4.0 * t + 0.5,
+            1.5 * t2 - t,
+        ],
+        axis=-1,
+    )
     return w, d
 
 
@@ -180,8 +198,9 @@ def _sample(
     out = []
     for a in (g, *(grads or (g, g))):
         fl = a.reshape(-1)
-        out.append(w00 * fl[base] + w01 * fl[base + 1] + w10 * fl[base + w]
-                   + w11 * fl[base + w + 1])  # fmt: skip
+        out.append(
+            w00 * fl[base] + w01 * fl[base + 1] + w10 * fl[base + w] + w11 * fl[base + w + 1]
+        )
     return out[0], out[1], out[2]
 
 
@@ -200,8 +219,16 @@ def _outside(cs: Array, rs: Array, box: tuple[float, float, float]) -> NDArray[n
 
 
 def _numpy_normals(
-    g: Array, idx: NDArray[np.intp], a: Array, rad: Array, fv: Array, x: Array, y: Array,
-    cubic: bool, grads: tuple[Array, Array] | None, box: tuple[float, float, float],
+    g: Array,
+    idx: NDArray[np.intp],
+    a: Array,
+    rad: Array,
+    fv: Array,
+    x: Array,
+    y: Array,
+    cubic: bool,
+    grads: tuple[Array, Array] | None,
+    box: tuple[float, float, float],
 ) -> tuple[Array, Array, NDArray[np.bool_]]:
     """Normal equations (n, 8, 8), right-hand sides (n, 8) and the outside flags of the
     patches ``idx``: six affine and two radiometric parameters (the numba kernel's twin)."""
@@ -213,8 +240,7 @@ def _numpy_normals(
     resid = fv[idx] - (r0 + r1 * gv)
     ux = r1 * gxv
     uy = r1 * gyv
-    jac = np.stack([ux, ux * x, ux * y, uy, uy * x, uy * y, np.ones_like(gv), gv],
-                   axis=1)  # fmt: skip
+    jac = np.stack([ux, ux * x, ux * y, uy, uy * x, uy * y, np.ones_like(gv), gv], axis=1)
     nn = jac @ jac.transpose(0, 2, 1)
     rhs = np.einsum("kip,kp->ki", jac, resid)
     return nn, rhs, outside
@@ -428,11 +454,20 @@ def lsm_in_image(
             cs, rs = _search_coords(aff_w, x, y)
             ci = np.clip(np.floor(cs).astype(np.intp), 0, size - 2)
             ri = np.clip(np.floor(rs).astype(np.intp), 0, size - 2)
-            touch = (nan[k, ri, ci] | nan[k, ri + 1, ci + 1] | nan[k, ri, ci + 1]
-                     | nan[k, ri + 1, ci]).any(axis=1)  # fmt: skip
+            touch = (
+                nan[k, ri, ci] | nan[k, ri + 1, ci + 1] | nan[k, ri, ci + 1] | nan[k, ri + 1, ci]
+            ).any(axis=1)
             status[(status != NO_TEXTURE) & touch] = LEFT_WINDOW
-    return LsmResult(aff, res.radiometry, res.sigma_px, res.cov_px, res.sigma0,
-                     res.correlation, res.iterations, status)  # fmt: skip
+    return LsmResult(
+        aff,
+        res.radiometry,
+        res.sigma_px,
+        res.cov_px,
+        res.sigma0,
+        res.correlation,
+        res.iterations,
+        status,
+    )
 
 
 @dataclass(frozen=True)
@@ -485,24 +520,43 @@ def match_point(
     c, r = int(np.rint(template_xy[0])), int(np.rint(template_xy[1]))
     h = int(half_size)
     if c - h < 0 or r - h < 0 or c + h >= t.shape[1] or r + h >= t.shape[0]:
-        return PointMatch(math.nan, math.nan, (math.nan, math.nan), math.nan,
-                          "the template point is too close to its image's border")  # fmt: skip
+        return PointMatch(
+            math.nan,
+            math.nan,
+            (math.nan, math.nan),
+            math.nan,
+            "the template point is too close to its image's border",
+        )
     tmpl = t[r - h : r + h + 1, c - h : c + h + 1]
     ref = (template_xy[0] - (c - h), template_xy[1] - (r - h))
     sc, sr = int(np.rint(start_xy[0])), int(np.rint(start_xy[1]))
     reach = h + int(search_px)
     if sc - reach < 0 or sr - reach < 0 or sc + reach >= s.shape[1] or sr + reach >= s.shape[0]:
-        return PointMatch(math.nan, math.nan, (math.nan, math.nan), math.nan,
-                          "the point is too close to the image's border")  # fmt: skip
+        return PointMatch(
+            math.nan,
+            math.nan,
+            (math.nan, math.nan),
+            math.nan,
+            "the point is too close to the image's border",
+        )
     sub = s[sr - reach : sr + reach + 1, sc - reach : sc + reach + 1]
     m = ncc_search(tmpl, sub)
     if m.peak < min_ncc:
-        return PointMatch(math.nan, math.nan, (math.nan, math.nan), m.peak,
-                          f"low correlation (NCC {m.peak:.2f} < {min_ncc:.2f})")  # fmt: skip
+        return PointMatch(
+            math.nan,
+            math.nan,
+            (math.nan, math.nan),
+            m.peak,
+            f"low correlation (NCC {m.peak:.2f} < {min_ncc:.2f})",
+        )
     # the NCC centre is the template's centre pixel; the point is at ref from its corner
     start = np.array([sc - reach + m.col - h + ref[0], sr - reach + m.row - h + ref[1]])
     res = lsm_in_image(tmpl[None], s, affine_start(start[None]), reference=ref, options=options)
     reason = "" if res.ok[0] else f"LSM: {res.reasons()[0]}"
-    return PointMatch(float(res.position[0, 0]), float(res.position[0, 1]),
-                      (float(res.sigma_px[0, 0]), float(res.sigma_px[0, 1])),
-                      float(res.correlation[0]), reason)  # fmt: skip
+    return PointMatch(
+        float(res.position[0, 0]),
+        float(res.position[0, 1]),
+        (float(res.sigma_px[0, 0]), float(res.sigma_px[0, 1])),
+        float(res.correlation[0]),
+        reason,
+    )

@@ -32,10 +32,15 @@ def _keys(t):  # pragma: no cover - compiled
     the second one, and their derivatives in t."""
     t2 = t * t
     t3 = t2 * t
-    return ((-0.5 * t3 + t2 - 0.5 * t, 1.5 * t3 - 2.5 * t2 + 1.0,
-             -1.5 * t3 + 2.0 * t2 + 0.5 * t, 0.5 * t3 - 0.5 * t2),
-            (-1.5 * t2 + 2.0 * t - 0.5, 4.5 * t2 - 5.0 * t,
-             -4.5 * t2 + 4.0 * t + 0.5, 1.5 * t2 - t))  # fmt: skip
+    return (
+        (
+            -0.5 * t3 + t2 - 0.5 * t,
+            1.5 * t3 - 2.5 * t2 + 1.0,
+            -1.5 * t3 + 2.0 * t2 + 0.5 * t,
+            0.5 * t3 - 0.5 * t2,
+        ),
+        (-1.5 * t2 + 2.0 * t - 0.5, 4.5 * t2 - 5.0 * t, -4.5 * t2 + 4.0 * t + 0.5, 1.5 * t2 - t),
+    )
 
 
 if AVAILABLE:  # inlined into the kernels (a plain function cannot be called from them)

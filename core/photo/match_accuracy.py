@@ -104,8 +104,10 @@ def fit_homography(
     r = np.hypot(*(q - apply_homography(start, p)).T)
     kept = r <= (np.inf if np.isinf(k) else k * np.median(r) / 1.1774)
     if kept.sum() < 4:
-        raise ValueError(f"only {int(kept.sum())} of {len(p)} matches agree with the start: "
-                         "no homography fits them")  # fmt: skip
+        raise ValueError(
+            f"only {int(kept.sum())} of {len(p)} matches agree with the start: "
+            "no homography fits them"
+        )
     for _ in range(max(1, max_rounds)):
         h = _opencv_fit(p[kept], q[kept], 0)
         r = np.hypot(*(q - apply_homography(h, p)).T)
@@ -166,8 +168,9 @@ def fit_smooth_map(
     # alternate: the correction given H, H given the correction, then the kept set
     for _ in range(20):
         for _ in range(3):
-            coef = np.linalg.lstsq(mono_all[kept], (q - apply_homography(h, p))[kept],
-                                   rcond=None)[0]  # fmt: skip
+            coef = np.linalg.lstsq(mono_all[kept], (q - apply_homography(h, p))[kept], rcond=None)[
+                0
+            ]
             h, _ = fit_homography(p[kept], (q - mono_all @ coef)[kept], k=np.inf, start=h)
         r = np.hypot(*(q - apply_homography(h, p) - mono_all @ coef).T)
         new = r <= max(k * np.median(r[kept]) / 1.1774, 1e-4)
@@ -209,8 +212,9 @@ def split_sample_residuals(
     return out
 
 
-def homography_difference(h_a: ArrayLike, h_b: ArrayLike, shape: tuple[int, int],
-                          step: float = 10.0) -> tuple[Array, Array]:  # fmt: skip
+def homography_difference(
+    h_a: ArrayLike, h_b: ArrayLike, shape: tuple[int, int], step: float = 10.0
+) -> tuple[Array, Array]:
     """Grid of image-1 points (every ``step`` pixels over ``shape`` = (rows, cols)) and the
     (N, 2) differences ``h_a(p) - h_b(p)`` in image 2, pixels.
 

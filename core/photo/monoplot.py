@@ -232,8 +232,9 @@ def propagate_covariance(
     s[:, 1, 1] += sig**2
     s[:, 2, 2] = np.asarray(constraint_var, dtype=np.float64)
     out = np.full((n, 3, 3), np.nan)
-    ok = np.isfinite(a).all(axis=(1, 2)) & (np.abs(np.linalg.det(np.where(
-        np.isfinite(a), a, 0.0))) > 1e-300)  # fmt: skip
+    ok = np.isfinite(a).all(axis=(1, 2)) & (
+        np.abs(np.linalg.det(np.where(np.isfinite(a), a, 0.0))) > 1e-300
+    )
     if ok.any():
         ainv = np.linalg.inv(a[ok])
         out[ok] = ainv @ s[ok] @ np.swapaxes(ainv, 1, 2)
@@ -366,9 +367,7 @@ def _ray_table(
     return src, pixels, line_of, vertex_of, line_keys
 
 
-def _dsm_in_crs(
-    dsm: Dsm, mapping_crs: pyproj.CRS, should_stop: Callable[[], bool] | None
-) -> Dsm:
+def _dsm_in_crs(dsm: Dsm, mapping_crs: pyproj.CRS, should_stop: Callable[[], bool] | None) -> Dsm:
     """The DSM in the mapping CRS: as is when it has no CRS or the same, else resampled
     (heights transformed); CrsError when the heights cannot be brought over."""
     if dsm.crs is None:
@@ -383,8 +382,12 @@ def _dsm_in_crs(
                 f"'{mapping_crs.name}': {exc}",
                 path=dsm.source or None,
             ) from exc
-        LOG.warning("the DSM was in '%s': resampled into the mapping CRS '%s' (cell %g)",
-                    source_crs, mapping_crs.name, dsm.cell)  # fmt: skip
+        LOG.warning(
+            "the DSM was in '%s': resampled into the mapping CRS '%s' (cell %g)",
+            source_crs,
+            mapping_crs.name,
+            dsm.cell,
+        )
     return dsm
 
 
@@ -404,8 +407,12 @@ class _Chords:
 
 
 def _chords(
-    mapping_crs: pyproj.CRS, dsm: Dsm, table: ExteriorOrientationTable, cam: Camera,
-    pixels: Array, img: NDArray[np.int64],
+    mapping_crs: pyproj.CRS,
+    dsm: Dsm,
+    table: ExteriorOrientationTable,
+    cam: Camera,
+    pixels: Array,
+    img: NDArray[np.int64],
 ) -> _Chords:
     """The rays of ``pixels`` seen from the images ``img`` (rows of ``table``)."""
     from ..geometry.frames import MappingFrame
@@ -437,8 +444,13 @@ _Solved = tuple[Array, NDArray[np.int8], Array, Array, Array]
 
 
 def _on_dsm(
-    dsm: Dsm, tracer: DsmTracer, method: str, args: tuple, min_incidence_deg: float,
-    sigma_dsm: float, should_stop: Callable[[], bool] | None,
+    dsm: Dsm,
+    tracer: DsmTracer,
+    method: str,
+    args: tuple,
+    min_incidence_deg: float,
+    sigma_dsm: float,
+    should_stop: Callable[[], bool] | None,
 ) -> _Solved:
     """Intersect the rays ``args`` (of _two_pass) with the DSM by ``method``."""
     last: dict[str, DsmHits] = {}
@@ -446,8 +458,9 @@ def _on_dsm(
     def solve_dsm(o: Array, d: Array) -> tuple[Array, NDArray[np.int8]]:
         if method == "makarovic":
             return makarovic(dsm, o, d)[:2]
-        hits = intersect_dsm(tracer, o, d, min_incidence_deg=min_incidence_deg,
-                             should_stop=should_stop)  # fmt: skip
+        hits = intersect_dsm(
+            tracer, o, d, min_incidence_deg=min_incidence_deg, should_stop=should_stop
+        )
         last["hits"] = hits
         return hits.points, hits.status
 
@@ -457,8 +470,9 @@ def _on_dsm(
     else:
         # the face under the converged point gives the gradient for the precision
         hits = intersect_dsm(tracer, args[1], dirs, min_incidence_deg=0.0)
-        st = np.where((st == STATUS_OK) & (hits.status == STATUS_GRAZING),
-                      STATUS_GRAZING, st).astype(np.int8)  # fmt: skip
+        st = np.where(
+            (st == STATUS_OK) & (hits.status == STATUS_GRAZING), STATUS_GRAZING, st
+        ).astype(np.int8)
     grad = np.column_stack([-hits.gradient, np.ones(len(pts))])
     var_h = sigma_dsm**2 * np.sum(hits.weights**2, axis=1)
     return pts, st, hits.incidence_deg, grad, var_h
@@ -474,16 +488,21 @@ def _on_planes(planes: list[Plane], args: tuple) -> _Solved:
         return intersect_planes(o, d, normal, offset)
 
     pts, st, _ = _two_pass(solve_plane, *args)
-    inc = 90.0 - np.degrees(np.arccos(np.clip(np.abs(
-        np.einsum("ij,ij->i", normal, args[3])), 0, 1)))  # fmt: skip
+    inc = 90.0 - np.degrees(
+        np.arccos(np.clip(np.abs(np.einsum("ij,ij->i", normal, args[3])), 0, 1))
+    )
     g1 = np.column_stack([np.nan_to_num(pts), np.ones(len(pts))])
     var_h = np.einsum("ni,nij,nj->n", g1, pcov, g1)
     return pts, st, inc, normal, var_h
 
 
 def _result_lines(
-    line_keys: list[tuple[str, str]], line_of: NDArray[np.int64], vertex_of: NDArray[np.int64],
-    points: Array, cov: Array, status: NDArray[np.int8],
+    line_keys: list[tuple[str, str]],
+    line_of: NDArray[np.int64],
+    vertex_of: NDArray[np.int64],
+    points: Array,
+    cov: Array,
+    status: NDArray[np.int8],
 ) -> list[MonoplotLine]:
     """The 3D lines (vertices in order), each with its worst status and end-point sigmas."""
     lines = []
@@ -505,15 +524,18 @@ def _eo_covariance(eo_sigmas) -> Array:
     return np.diag(np.r_[sig6[:3], np.radians(sig6[3:])] ** 2)
 
 
-def _plane_rays(obs: ImageObservations, src: NDArray[np.int64], line_of: NDArray[np.int64],
-                plane_map: dict) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:  # fmt: skip
+def _plane_rays(
+    obs: ImageObservations, src: NDArray[np.int64], line_of: NDArray[np.int64], plane_map: dict
+) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
     """(rays cut with a plane: tie and paper points, not on lines, when planes are given;
     those among them whose plane is not in ``plane_map``)."""
     kinds = [obs.type[k] for k in src]
     on_plane = np.array(
-        [bool(plane_map) and kd in ("tie", "paper") and line_of[r] < 0
-         for r, kd in enumerate(kinds)]
-    )  # fmt: skip
+        [
+            bool(plane_map) and kd in ("tie", "paper") and line_of[r] < 0
+            for r, kd in enumerate(kinds)
+        ]
+    )
     unknown = on_plane & np.array([obs.target_id[k] not in plane_map for k in src])
     return on_plane, unknown
 
@@ -521,10 +543,9 @@ def _plane_rays(obs: ImageObservations, src: NDArray[np.int64], line_of: NDArray
 def _rows(obs: ImageObservations, src, line_of, vertex_of, used: list[str]) -> list[tuple]:
     """The result's row per ray: image, point, type, target, line, vertex, surface used."""
     return [
-        (obs.image_id[s], obs.point_id[s], obs.type[s], obs.target_id[s], int(li), int(vi),
-         used[r])
+        (obs.image_id[s], obs.point_id[s], obs.type[s], obs.target_id[s], int(li), int(vi), used[r])
         for r, (s, li, vi) in enumerate(zip(src, line_of, vertex_of))
-    ]  # fmt: skip
+    ]
 
 
 def monoplot(
@@ -647,16 +668,22 @@ def monoplot(
         hit = np.isin(res_st, _HIT)
         if hit.any():
             cov[todo[hit]] = propagate_covariance(
-                res_pts[hit], eo_rows[hit], cam, sigma_px[todo[hit]], eo_cov, grad[hit],
+                res_pts[hit],
+                eo_rows[hit],
+                cam,
+                sigma_px[todo[hit]],
+                eo_cov,
+                grad[hit],
                 var_h[hit],
-            )  # fmt: skip
+            )
     if progress is not None:
         progress(0.95)
 
     rows = _rows(obs, src, line_of, vertex_of, used)
     lines = _result_lines(line_keys, line_of, vertex_of, points, cov, status)
-    result = MonoplotResult(rows, pixels, points, cov, status, incidence, lines,
-                            mapping_crs.to_wkt(), dsm)  # fmt: skip
+    result = MonoplotResult(
+        rows, pixels, points, cov, status, incidence, lines, mapping_crs.to_wkt(), dsm
+    )
     LOG.info("monoplotted %d rays: %s", n, result.status_counts())
     if progress is not None:
         progress(1.0)

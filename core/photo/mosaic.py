@@ -42,8 +42,7 @@ from .orthophoto import ordered_map
 #: orthophoto k in its own pixels
 ReadSource = Callable[[int, tuple[int, int, int, int]], tuple[NDArray, NDArray[np.bool_]]]
 
-__all__ = ["METHODS", "MosaicOptions", "MosaicSource", "MosaicTile", "mosaic_grid",
-           "mosaic_tiles"]  # fmt: skip
+__all__ = ["METHODS", "MosaicOptions", "MosaicSource", "MosaicTile", "mosaic_grid", "mosaic_tiles"]
 
 
 @dataclass(frozen=True)
@@ -87,9 +86,11 @@ def _offset(src: Grid, grid: Grid) -> tuple[int, int]:
     fc = (src.x0 - grid.x0) / grid.cell
     fr = (grid.y_top - src.y_top) / grid.cell
     if abs(fc - round(fc)) > 1e-6 or abs(fr - round(fr)) > 1e-6:
-        raise InputError("the orthophotos are not aligned on one grid (cells shifted by "
-                         f"{fc - round(fc):.3f}, {fr - round(fr):.3f} of a cell): make them "
-                         "with the same GSD")  # fmt: skip
+        raise InputError(
+            "the orthophotos are not aligned on one grid (cells shifted by "
+            f"{fc - round(fc):.3f}, {fr - round(fr):.3f} of a cell): make them "
+            "with the same GSD"
+        )
     return round(fc), round(fr)
 
 
@@ -114,8 +115,10 @@ def mosaic_grid(sources: Sequence[MosaicSource]) -> Grid:
     cell = sources[0].grid.cell
     for s in sources:
         if not math.isclose(s.grid.cell, cell, rel_tol=1e-9):
-            raise InputError(f"orthophoto {s.name} has cells of {s.grid.cell:g}, "
-                             f"{sources[0].name} of {cell:g}: make them with one GSD")
+            raise InputError(
+                f"orthophoto {s.name} has cells of {s.grid.cell:g}, "
+                f"{sources[0].name} of {cell:g}: make them with one GSD"
+            )
     x0 = min(s.grid.x0 for s in sources)
     y_top = max(s.grid.y_top for s in sources)
     x1 = max(s.grid.x0 + s.grid.cols * cell for s in sources)
@@ -131,8 +134,9 @@ def _scores(src: MosaicSource, xs: NDArray, ys: NDArray, method: str, z_ref: flo
     needs every source's centre (a tangent and a distance do not compare)."""
     if method == "nadir":
         if src.centre is None:
-            raise InputError(f"orthophoto '{src.name}' has no perspective centre: "
-                             "use the method centre")  # fmt: skip
+            raise InputError(
+                f"orthophoto '{src.name}' has no perspective centre: use the method centre"
+            )
         cx, cy, cz = src.centre
         height = max(cz - z_ref, 1e-6)
         return np.hypot(xs[None, :] - cx, ys[:, None] - cy) / height
@@ -215,9 +219,13 @@ def _tile(
             sel = label == k
             out[:, sel] = d[:, sel]
     cr, cc = row0 - er0, col0 - ec0
-    return MosaicTile(row0, col0, np.ascontiguousarray(out[:, cr : cr + rows, cc : cc + cols]),
-                      valid[cr : cr + rows, cc : cc + cols],
-                      label[cr : cr + rows, cc : cc + cols])  # fmt: skip
+    return MosaicTile(
+        row0,
+        col0,
+        np.ascontiguousarray(out[:, cr : cr + rows, cc : cc + cols]),
+        valid[cr : cr + rows, cc : cc + cols],
+        label[cr : cr + rows, cc : cc + cols],
+    )
 
 
 def mosaic_tiles(
@@ -251,8 +259,11 @@ def mosaic_tiles(
     zs = [s.ground_z for s in sources if s.ground_z is not None and math.isfinite(s.ground_z)]
     z_ref = float(np.mean(zs)) if zs else 0.0
     size = int(opt.tile_px)
-    windows = [(r0, c0, min(size, grid.rows - r0), min(size, grid.cols - c0))
-               for r0 in range(0, grid.rows, size) for c0 in range(0, grid.cols, size)]  # fmt: skip
+    windows = [
+        (r0, c0, min(size, grid.rows - r0), min(size, grid.cols - c0))
+        for r0 in range(0, grid.rows, size)
+        for c0 in range(0, grid.cols, size)
+    ]
     kind = np.dtype(dtype)
 
     def one(win: tuple[int, int, int, int]) -> MosaicTile:

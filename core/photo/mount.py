@@ -88,5 +88,3 @@ class Mount:
         return cls(
             np.asarray(lever_arm, dtype=np.float64), nominal, np.radians(np.asarray(boresight_deg))
         )
-
-

@@ -124,8 +124,9 @@ def interpolate_trajectory(
     from scipy.spatial.transform import Rotation
 
     if len(nav) < 2:
-        raise InputError(f"the trajectory has {len(nav)} record(s); at least 2 are needed",
-                         path=nav.source)  # fmt: skip
+        raise InputError(
+            f"the trajectory has {len(nav)} record(s); at least 2 are needed", path=nav.source
+        )
     t = _align_week(events.time + options.time_offset_s, nav.time)
     k = _segments(nav, events, t, options.max_gap_s)
     # the records of the events' intervals and their neighbours (for the rates), in ECEF
@@ -154,8 +155,9 @@ def interpolate_trajectory(
     roll, pitch, heading = matrix_to_rph(r_e_n @ r_b_e_t)
     rph = np.stack([roll, pitch, np.mod(heading, 2.0 * np.pi)], axis=1)
     v_ned = np.einsum("kij,kj->ki", r_e_n, vel_t)
-    return Trajectory(events.image_id, t, events.group, frame.geodetic_to_map(llh_t), False, rph,
-                      v_ned)  # fmt: skip
+    return Trajectory(
+        events.image_id, t, events.group, frame.geodetic_to_map(llh_t), False, rph, v_ned
+    )
 
 
 def _align_week(t: Array, nav_time: Array) -> Array:
@@ -182,8 +184,9 @@ def _segments(
             f"image '{events.image_id[j]}' at trajectory time {t[j]:.6f} s (event + offset) "
             f"is outside the trajectory {nav.source} ({tt[0]:.6f} to {tt[-1]:.6f} s); "
             f"{outside.size} of {len(t)} events are outside: wrong file, time offset or clock?",
-            path=events.source, row=events.rows[j],
-        )  # fmt: skip
+            path=events.source,
+            row=events.rows[j],
+        )
     k = np.clip(np.searchsorted(tt, t, side="right") - 1, 0, len(tt) - 2)
     gap = tt[k + 1] - tt[k]
     wide = np.flatnonzero(gap > max_gap_s)
@@ -195,8 +198,9 @@ def _segments(
             f"{gap[j]:.6g} s of the trajectory {nav.source} (between {nav.record}s {a} and "
             f"{b}, {tt[k[j]]:.6f} to {tt[k[j] + 1]:.6f} s), longer than the limit MAX_GAP = "
             f"{max_gap_s:g} s ({wide.size} of {len(t)} events are in such gaps)",
-            path=events.source, row=events.rows[j],
-        )  # fmt: skip
+            path=events.source,
+            row=events.rows[j],
+        )
     return k
 
 
@@ -260,7 +264,7 @@ def _check_velocities(
             f"their positions (chord {np.linalg.norm(chord[i]):.3g} m/s): velocities in another "
             "frame or sign convention?",
             path=nav.source,
-        )  # fmt: skip
+        )
 
 
 def _basis(t_knots: Array, j: NDArray[np.int64], t: Array):

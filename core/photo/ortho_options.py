@@ -52,15 +52,15 @@ class OrthoOptions:
 
     def __post_init__(self) -> None:
         if self.resampling not in RESAMPLING:
-            raise InputError(f"resampling must be one of {', '.join(RESAMPLING)}, "
-                             f"got {self.resampling!r}")  # fmt: skip
+            raise InputError(
+                f"resampling must be one of {', '.join(RESAMPLING)}, got {self.resampling!r}"
+            )
         if not (self.gsd >= 0 and math.isfinite(self.gsd)):
             raise InputError(f"GSD must be >= 0 (0: automatic), got {self.gsd!r}")
         if int(self.tile_px) < 16 or int(self.lattice_px) < 2:
             raise InputError("tile_px must be >= 16 and lattice_px >= 2")
         if not self.occlusion_tol_m >= 0:
             raise InputError(f"occlusion tolerance must be >= 0, got {self.occlusion_tol_m!r}")
-
 
 
 @dataclass(frozen=True)
@@ -84,7 +84,8 @@ class MosaicOptions:
 
     def __post_init__(self) -> None:
         if self.method not in MOSAIC_METHODS:
-            raise InputError(f"method must be one of {', '.join(MOSAIC_METHODS)}, "
-                             f"got {self.method!r}")  # fmt: skip
+            raise InputError(
+                f"method must be one of {', '.join(MOSAIC_METHODS)}, got {self.method!r}"
+            )
         if not (self.feather_px >= 0 and math.isfinite(self.feather_px)):
             raise InputError(f"feathering must be >= 0 cells, got {self.feather_px!r}")

@@ -135,8 +135,9 @@ class OrthoProjector:
     z_range: tuple[float, float] = (0.0, 0.0)
     # the lattice of a whole grid, made once for its tiles (_lattice)
     _lattices: dict = field(default_factory=dict, init=False, compare=False, repr=False)
-    _lock: threading.Lock = field(default_factory=threading.Lock, init=False, compare=False,
-                                  repr=False)  # fmt: skip
+    _lock: threading.Lock = field(
+        default_factory=threading.Lock, init=False, compare=False, repr=False
+    )
 
     @classmethod
     def build(
@@ -178,9 +179,18 @@ class OrthoProjector:
         centre = np.asarray(xyz, dtype=np.float64).reshape(3)
         angles = np.asarray(opk, dtype=np.float64).reshape(3)
         c_loc, m_loc = eo_map_to_local(centre[None], angles[None], local)
-        return cls(camera, centre, angles, surface, tracer, local, c_loc[0], m_loc[0],
-                   lens if lens is not None else _lens_lattice(camera),
-                   (float(zr[0]), float(zr[1])))  # fmt: skip
+        return cls(
+            camera,
+            centre,
+            angles,
+            surface,
+            tracer,
+            local,
+            c_loc[0],
+            m_loc[0],
+            lens if lens is not None else _lens_lattice(camera),
+            (float(zr[0]), float(zr[1])),
+        )
 
     # ------------------------------------------------------------------ geometry
     def _lattice(self, grid: Grid, row0: int, col0: int, h: int, w: int, step: int) -> Array:
@@ -189,15 +199,27 @@ class OrthoProjector:
         grid that starts on a node (the tiles: one transformation instead of one per tile)."""
         ny = max(2, math.ceil((h - 1) / step) + 1)
         nx = max(2, math.ceil((w - 1) / step) + 1)
-        if (row0 % step or col0 % step or row0 < 0 or col0 < 0 or row0 + h > grid.rows
-                or col0 + w > grid.cols):  # fmt: skip
+        if (
+            row0 % step
+            or col0 % step
+            or row0 < 0
+            or col0 < 0
+            or row0 + h > grid.rows
+            or col0 + w > grid.cols
+        ):
             return self._nodes(grid, row0, col0, ny, nx, step)
         key = (grid, step)
         with self._lock:
             full = self._lattices.get(key)
             if full is None:
-                full = self._nodes(grid, 0, 0, math.ceil((grid.rows - 1) / step) + 2,
-                                   math.ceil((grid.cols - 1) / step) + 2, step)  # fmt: skip
+                full = self._nodes(
+                    grid,
+                    0,
+                    0,
+                    math.ceil((grid.rows - 1) / step) + 2,
+                    math.ceil((grid.cols - 1) / step) + 2,
+                    step,
+                )
                 self._lattices[key] = full
         k, m = row0 // step, col0 // step
         return full[k : k + ny, m : m + nx]
@@ -217,9 +239,16 @@ class OrthoProjector:
         return np.concatenate([a, b], axis=1).reshape(ny, nx, 6)
 
     def pixels(
-        self, grid: Grid, row0: int, col0: int, rows: int, cols: int, *, lattice_px: int = 64,
+        self,
+        grid: Grid,
+        row0: int,
+        col0: int,
+        rows: int,
+        cols: int,
+        *,
+        lattice_px: int = 64,
         backend: str = "auto",
-    ) -> tuple[Array, Array, Array]:  # fmt: skip
+    ) -> tuple[Array, Array, Array]:
         """Image pixels of the cells ``[row0, row0 + rows) x [col0, col0 + cols)`` of ``grid``.
 
         ``backend`` ("auto", "numba", "numpy") chooses the perspective projection's loop; a
@@ -245,11 +274,25 @@ class OrthoProjector:
         dsm = self.dsm
         xc, yc = dsm.centre_origin
         z = np.ascontiguousarray(dsm.heights, dtype=np.float32)
-        args = (grid.x0 + (col0 + 0.5) * grid.cell, grid.y_top - (row0 + 0.5) * grid.cell,
-                grid.cell, int(rows), int(cols), z, float(xc), float(yc), 1.0 / dsm.cell,
-                np.ascontiguousarray(lat), float(step), float(cam.focal_mm),
-                np.ascontiguousarray(lens, dtype=np.float64), lx0, ly0, 1.0 / ls,
-                nolens)  # fmt: skip
+        args = (
+            grid.x0 + (col0 + 0.5) * grid.cell,
+            grid.y_top - (row0 + 0.5) * grid.cell,
+            grid.cell,
+            int(rows),
+            int(cols),
+            z,
+            float(xc),
+            float(yc),
+            1.0 / dsm.cell,
+            np.ascontiguousarray(lat),
+            float(step),
+            float(cam.focal_mm),
+            np.ascontiguousarray(lens, dtype=np.float64),
+            lx0,
+            ly0,
+            1.0 / ls,
+            nolens,
+        )
         if backend not in ("auto", "numba", "numpy"):
             raise ValueError(f"backend must be 'auto', 'numba' or 'numpy', got {backend!r}")
         if backend == "numpy" or not AVAILABLE or not cam.is_perspective:
@@ -270,10 +313,17 @@ class OrthoProjector:
         if g.shape[0] == 0:
             return np.ones(0, bool)
         if self.tracer is None:
-            raise ValueError("no DsmTracer: build the projector with one (or through "
-                             "orthorectify_tiles) for the visibility test")  # fmt: skip
-        hits = intersect_dsm(self.tracer, np.broadcast_to(self.xyz, g.shape), d,
-                             min_incidence_deg=0.0, chunk_size=max(g.shape[0], 1))  # fmt: skip
+            raise ValueError(
+                "no DsmTracer: build the projector with one (or through "
+                "orthorectify_tiles) for the visibility test"
+            )
+        hits = intersect_dsm(
+            self.tracer,
+            np.broadcast_to(self.xyz, g.shape),
+            d,
+            min_incidence_deg=0.0,
+            chunk_size=max(g.shape[0], 1),
+        )
         dist = np.linalg.norm(d, axis=1)
         hit = np.isin(hits.status, (STATUS_OK, STATUS_GRAZING))
         with np.errstate(invalid="ignore"):
@@ -303,10 +353,14 @@ class OrthoProjector:
         cam, dsm = self.camera, self.dsm
         k = np.linspace(0.0, 1.0, samples + 1)
         w, h = cam.width_px, cam.height_px
-        border = np.vstack([np.column_stack([k * w, np.zeros_like(k)]),
-                            np.column_stack([k * w, np.full_like(k, h)]),
-                            np.column_stack([np.zeros_like(k), k * h]),
-                            np.column_stack([np.full_like(k, w), k * h])])  # fmt: skip
+        border = np.vstack(
+            [
+                np.column_stack([k * w, np.zeros_like(k)]),
+                np.column_stack([k * w, np.full_like(k, h)]),
+                np.column_stack([np.zeros_like(k), k * h]),
+                np.column_stack([np.full_like(k, w), k * h]),
+            ]
+        )
         ideal = cam.ideal_from_pixel(border)
         ray_c = cam.ray_from_ideal(ideal)  # NaN beyond a fisheye's field: the whole surface
         d = ray_c @ self.m_local  # M^T r: camera -> local ENU
@@ -362,9 +416,14 @@ def ortho_grid(box: Sequence[float], gsd: float) -> Grid:
 
 # --------------------------------------------------------------------------- the tiles
 def _occlusion(
-    proj: OrthoProjector, grid: Grid, row0: int, col0: int, z: Array, valid: NDArray[np.bool_],
+    proj: OrthoProjector,
+    grid: Grid,
+    row0: int,
+    col0: int,
+    z: Array,
+    valid: NDArray[np.bool_],
     tol: float,
-) -> NDArray[np.bool_]:  # fmt: skip
+) -> NDArray[np.bool_]:
     """(rows, cols) True where a valid cell is occluded (module docstring, step 5): rays on a
     lattice of spacing s (at most half a DSM cell, at most 8 cells); the cells of a lattice
     square whose four corners agree take their value, the others get their own ray."""
@@ -427,11 +486,15 @@ def _remap(src: NDArray, mapx: NDArray, mapy: NDArray, resampling: str) -> NDArr
     float32 maps, or the fixed-point pair of :func:`remap_maps_fixed`)."""
     import cv2
 
-    interp = {"nearest": cv2.INTER_NEAREST, "bilinear": cv2.INTER_LINEAR,
-              "cubic": cv2.INTER_CUBIC}[resampling]  # fmt: skip
+    interp = {"nearest": cv2.INTER_NEAREST, "bilinear": cv2.INTER_LINEAR, "cubic": cv2.INTER_CUBIC}[
+        resampling
+    ]
     kind = src.dtype
-    work = src if kind in (np.uint8, np.uint16, np.int16, np.float32, np.float64) else (
-        src.astype(np.float64))  # fmt: skip
+    work = (
+        src
+        if kind in (np.uint8, np.uint16, np.int16, np.float32, np.float64)
+        else (src.astype(np.float64))
+    )
     bands = work.shape[0]
     out = []
     for b0 in range(0, bands, 4):  # OpenCV remaps up to 4 interleaved channels at once
@@ -469,8 +532,9 @@ def _tile(
         col = np.where(valid, col, np.nan)
         n, c_min, c_max, r_min, r_max = valid_bounds(col, row)
     if n == 0:
-        return OrthoTile(row0, col0, np.zeros((bands, rows, cols), dtype), valid, occluded,
-                         no_surface)  # fmt: skip
+        return OrthoTile(
+            row0, col0, np.zeros((bands, rows, cols), dtype), valid, occluded, no_surface
+        )
     pad = _PAD[opt.resampling]
     cam = proj.camera
     c_lo = max(math.floor(c_min - 0.5) - pad * f, 0)
@@ -525,8 +589,11 @@ def orthorectify_tiles(
     """
     opt = options or OrthoOptions()
     size = int(opt.tile_px)
-    windows = [(r0, c0, min(size, grid.rows - r0), min(size, grid.cols - c0))
-               for r0 in range(0, grid.rows, size) for c0 in range(0, grid.cols, size)]  # fmt: skip
+    windows = [
+        (r0, c0, min(size, grid.rows - r0), min(size, grid.cols - c0))
+        for r0 in range(0, grid.rows, size)
+        for c0 in range(0, grid.cols, size)
+    ]
     kind = np.dtype(dtype)
     if opt.true_ortho and projector.tracer is None:
         from dataclasses import replace

@@ -29,10 +29,14 @@ def _lens_lattice(camera: Camera, tol_px: float = 1e-3) -> tuple[Array, float, f
         return np.zeros((1, 1, 2)), 0.0, 0.0, 1.0
     w, h = camera.width_px, camera.height_px
     k = np.linspace(0.0, 1.0, 257)
-    border = np.vstack([np.column_stack([k * w, np.zeros_like(k)]),
-                        np.column_stack([k * w, np.full_like(k, h)]),
-                        np.column_stack([np.zeros_like(k), k * h]),
-                        np.column_stack([np.full_like(k, w), k * h])])  # fmt: skip
+    border = np.vstack(
+        [
+            np.column_stack([k * w, np.zeros_like(k)]),
+            np.column_stack([k * w, np.full_like(k, h)]),
+            np.column_stack([np.zeros_like(k), k * h]),
+            np.column_stack([np.full_like(k, w), k * h]),
+        ]
+    )
     ideal = camera.ideal_from_pixel(border)
     lo, hi = ideal.min(axis=0), ideal.max(axis=0)
     margin = 0.02 * (hi - lo) + 2 * camera.pixel_size_mm
@@ -48,24 +52,43 @@ def _lens_lattice(camera: Camera, tol_px: float = 1e-3) -> tuple[Array, float, f
         lat = px.reshape(ny, nx, 2)
         # check at the lattice-cell centres (where bilinear interpolation is worst)
         mx, my = np.meshgrid(xs[:-1] + step / 2, ys[:-1] + step / 2)
-        exact, ok2 = camera.pixel_from_ideal_with_status(np.column_stack([mx.ravel(),
-                                                                         my.ravel()]))  # fmt: skip
+        exact, ok2 = camera.pixel_from_ideal_with_status(np.column_stack([mx.ravel(), my.ravel()]))
         interp = 0.25 * (lat[:-1, :-1] + lat[:-1, 1:] + lat[1:, :-1] + lat[1:, 1:]).reshape(-1, 2)
         # only where the cell lies on the image: elsewhere no cell of an orthophoto is kept
         on = ok2 & camera.in_frame(exact, -2.0) & np.isfinite(interp).all(axis=1)
         err = np.abs(interp[on] - exact[on]).max() if on.any() else 0.0
         if err <= tol_px or step <= 2 * camera.pixel_size_mm:
-            LOG.debug("lens lattice %d x %d nodes every %.1f px: %.2g px", nx, ny,
-                      step / camera.pixel_size_mm, err)  # fmt: skip
+            LOG.debug(
+                "lens lattice %d x %d nodes every %.1f px: %.2g px",
+                nx,
+                ny,
+                step / camera.pixel_size_mm,
+                err,
+            )
             return lat, float(lo[0]), float(lo[1]), float(step)
         step /= 2
 
 
 def cell_pixels_numpy(
-    x0: float, y0: float, g: float, h: int, w: int, z: NDArray[np.float32], xc: float,
-    yc: float, inv_cell: float, lat: Array, step: float, focal: float, lens: Array,
-    lx0: float, ly0: float, inv_ls: float, nolens: Array, projection: str = "perspective",
-) -> tuple[Array, Array, Array]:  # fmt: skip
+    x0: float,
+    y0: float,
+    g: float,
+    h: int,
+    w: int,
+    z: NDArray[np.float32],
+    xc: float,
+    yc: float,
+    inv_cell: float,
+    lat: Array,
+    step: float,
+    focal: float,
+    lens: Array,
+    lx0: float,
+    ly0: float,
+    inv_ls: float,
+    nolens: Array,
+    projection: str = "perspective",
+) -> tuple[Array, Array, Array]:
     """Image pixels of an h x w block of cells (numpy; the compiled version is
     :mod:`core.photo.orthophoto_numba`).
 
@@ -111,10 +134,12 @@ def cell_pixels_numpy(
     q = []
     for k in range(3):
         a, b = lat[:, :, k], lat[:, :, k + 3]
-        q.append(w00 * (a[ki][:, kj] + zz * b[ki][:, kj])
-                 + w01 * (a[ki][:, kj + 1] + zz * b[ki][:, kj + 1])
-                 + w10 * (a[ki + 1][:, kj] + zz * b[ki + 1][:, kj])
-                 + w11 * (a[ki + 1][:, kj + 1] + zz * b[ki + 1][:, kj + 1]))  # fmt: skip
+        q.append(
+            w00 * (a[ki][:, kj] + zz * b[ki][:, kj])
+            + w01 * (a[ki][:, kj + 1] + zz * b[ki][:, kj + 1])
+            + w10 * (a[ki + 1][:, kj] + zz * b[ki + 1][:, kj])
+            + w11 * (a[ki + 1][:, kj + 1] + zz * b[ki + 1][:, kj + 1])
+        )
     if projection == "perspective":
         front = q[2] < 0.0
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -135,16 +160,23 @@ def cell_pixels_numpy(
         out = []
         for k in range(2):
             m = lens[:, :, k]
-            out.append((m[li, lj] * (1 - su) + m[li, lj + 1] * su) * (1 - sv)
-                       + (m[li + 1, lj] * (1 - su) + m[li + 1, lj + 1] * su) * sv)  # fmt: skip
+            out.append(
+                (m[li, lj] * (1 - su) + m[li, lj + 1] * su) * (1 - sv)
+                + (m[li + 1, lj] * (1 - su) + m[li + 1, lj + 1] * su) * sv
+            )
         col, row = out
         front &= on
     else:
         col = nolens[0] + xi / nolens[1]
         row = nolens[2] - yi / nolens[1]
     with np.errstate(invalid="ignore"):
-        ok = front & np.isfinite(zz) & (col >= 0) & (row >= 0) & (col <= nolens[3]) & (
-            row <= nolens[4]
+        ok = (
+            front
+            & np.isfinite(zz)
+            & (col >= 0)
+            & (row >= 0)
+            & (col <= nolens[3])
+            & (row <= nolens[4])
         )
     col = np.where(ok, col, np.nan)
     row = np.where(ok, row, np.nan)

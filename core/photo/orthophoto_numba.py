@@ -17,14 +17,38 @@ import numpy as np
 from ..compiled import cached_njit
 from ..geometry.raycast_numba import AVAILABLE
 
-__all__ = ["AVAILABLE", "cell_pixels", "cell_stats", "remap_maps", "remap_maps_fixed",
-           "valid_bounds"]
+__all__ = [
+    "AVAILABLE",
+    "cell_pixels",
+    "cell_stats",
+    "remap_maps",
+    "remap_maps_fixed",
+    "valid_bounds",
+]
 
 
 def _cell_pixels(
-    x0, y0, g, h, w, z, xc, yc, inv_cell, lat, step, focal, lens, lx0, ly0, inv_ls, nolens,
-    out_col, out_row, out_z,
-):  # fmt: skip
+    x0,
+    y0,
+    g,
+    h,
+    w,
+    z,
+    xc,
+    yc,
+    inv_cell,
+    lat,
+    step,
+    focal,
+    lens,
+    lx0,
+    ly0,
+    inv_ls,
+    nolens,
+    out_col,
+    out_row,
+    out_z,
+):
     """Fill out_col, out_row (image pixels, NaN: none) and out_z (surface height) of an h x w
     block of cells whose first centre is (x0, y0) and spacing g (see
     :func:`core.photo.orthophoto_cells.cell_pixels_numpy` for the arguments).
@@ -128,12 +152,12 @@ def _cell_pixels(
                         lj = min(int(lu), mx - 2)
                         li = min(int(lv), my - 2)
                         su, sv = lu - lj, lv - li
-                        cc = ((lens[li, lj, 0] * (1 - su) + lens[li, lj + 1, 0] * su) * (1 - sv)
-                              + (lens[li + 1, lj, 0] * (1 - su) + lens[li + 1, lj + 1, 0] * su)
-                              * sv)  # fmt: skip
-                        rr = ((lens[li, lj, 1] * (1 - su) + lens[li, lj + 1, 1] * su) * (1 - sv)
-                              + (lens[li + 1, lj, 1] * (1 - su) + lens[li + 1, lj + 1, 1] * su)
-                              * sv)  # fmt: skip
+                        cc = (lens[li, lj, 0] * (1 - su) + lens[li, lj + 1, 0] * su) * (1 - sv) + (
+                            lens[li + 1, lj, 0] * (1 - su) + lens[li + 1, lj + 1, 0] * su
+                        ) * sv
+                        rr = (lens[li, lj, 1] * (1 - su) + lens[li, lj + 1, 1] * su) * (1 - sv) + (
+                            lens[li + 1, lj, 1] * (1 - su) + lens[li + 1, lj + 1, 1] * su
+                        ) * sv
                         if cc >= 0.0 and rr >= 0.0 and cc <= wpx and rr <= hpx:
                             col = cc
                             row = rr
@@ -213,8 +237,12 @@ _COMPILED: dict[str, Callable[..., Any]] = {}
 def _compiled(name: str) -> Callable[..., Any]:
     if name not in _COMPILED:
         kernels: dict[str, Callable[..., Any]]
-        kernels = {"cells": _cell_pixels, "maps": _remap_maps, "fixed": _remap_maps_fixed,
-                   "stats": _cell_stats}  # fmt: skip
+        kernels = {
+            "cells": _cell_pixels,
+            "maps": _remap_maps,
+            "fixed": _remap_maps_fixed,
+            "stats": _cell_stats,
+        }
         # numpy's error model: a float division by zero gives inf (checked after), with no
         # test per division that would keep the cell loop from being vectorised
         _COMPILED[name] = cached_njit(kernels[name], nogil=True, error_model="numpy")
@@ -228,9 +256,7 @@ def cell_pixels(*args: Any) -> None:
     _compiled("cells")(*args)
 
 
-def remap_maps(
-    col: np.ndarray, row: np.ndarray, c0: int, r0: int
-) -> tuple[np.ndarray, np.ndarray]:
+def remap_maps(col: np.ndarray, row: np.ndarray, c0: int, r0: int) -> tuple[np.ndarray, np.ndarray]:
     """float32 maps for cv2.remap of a window at (c0, r0) (see :func:`_remap_maps`)."""
     mapx = np.empty(col.shape, np.float32)
     mapy = np.empty(col.shape, np.float32)
@@ -280,5 +306,12 @@ def cell_stats(
     if not valid.any():
         return valid, 0, no_z, math.inf, -math.inf, math.inf, -math.inf
     cv, rv = col[valid], row[valid]
-    return (valid, int(valid.sum()), no_z, float(cv.min()), float(cv.max()), float(rv.min()),
-            float(rv.max()))  # fmt: skip
+    return (
+        valid,
+        int(valid.sum()),
+        no_z,
+        float(cv.min()),
+        float(cv.max()),
+        float(rv.min()),
+        float(rv.max()),
+    )

@@ -215,8 +215,9 @@ def _densify(
         return []
     da, db = a - centre, b - centre
     with np.errstate(invalid="ignore", divide="ignore"):
-        cos = np.einsum("ij,ij->i", da, db) / (np.linalg.norm(da, axis=1)
-                                                * np.linalg.norm(db, axis=1))  # fmt: skip
+        cos = np.einsum("ij,ij->i", da, db) / (
+            np.linalg.norm(da, axis=1) * np.linalg.norm(db, axis=1)
+        )
         ang = np.arccos(np.clip(cos, -1.0, 1.0))
     m = np.ones(n, dtype=np.intp)
     good = np.isfinite(ang)

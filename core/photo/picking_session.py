@@ -561,6 +561,14 @@ def residual_summary(rows: Iterable[tuple]) -> list[tuple[str, str, int, float, 
     out = []
     for (_img, kind, _pid), rs in groups.items():
         d = np.abs(np.array([float(r[9]) for r in rs]))
-        out.append((kind, str(rs[0][3]), len(rs), float(np.sqrt(np.mean(d**2))),
-                    float(d.max()), any(bool(r[11]) for r in rs)))  # fmt: skip
+        out.append(
+            (
+                kind,
+                str(rs[0][3]),
+                len(rs),
+                float(np.sqrt(np.mean(d**2))),
+                float(d.max()),
+                any(bool(r[11]) for r in rs),
+            )
+        )
     return out

@@ -210,8 +210,9 @@ def _refine(k_sqrt: Array, r0: Array, iterations: int = 40) -> tuple[Array, Arra
         jac = np.einsum("ij,skj->sik", k_sqrt, _vec(gens[None] @ r[:, None]))  # (S, 9, 3)
         n = np.swapaxes(jac, 1, 2) @ jac
         g = np.einsum("sik,si->sk", jac, res)
-        damp = lam[:, None, None] * (np.eye(3) * (np.diagonal(n, axis1=1, axis2=2)[:, None, :]
-                                                  + 1e-12))  # fmt: skip
+        damp = lam[:, None, None] * (
+            np.eye(3) * (np.diagonal(n, axis1=1, axis2=2)[:, None, :] + 1e-12)
+        )
         step = -np.linalg.solve(n + damp, g[:, :, None])[:, :, 0]
         trial = Rotation.from_rotvec(step).as_matrix() @ r
         c = np.sum((_vec(trial) @ k_sqrt.T) ** 2, axis=1)
@@ -316,8 +317,7 @@ def pose_candidates(
     for i in order:
         r = _ROTATIONS[i]
         if all(
-            np.arccos(np.clip((np.trace(r @ s.T) - 1) / 2, -1, 1)) > _SEED_SEPARATION
-            for s in seeds
+            np.arccos(np.clip((np.trace(r @ s.T) - 1) / 2, -1, 1)) > _SEED_SEPARATION for s in seeds
         ):
             seeds.append(r)
             if len(seeds) >= _SEEDS:
@@ -334,9 +334,9 @@ def pose_candidates(
             continue
         c = centre - r.T @ t
         dup = any(
-            np.arccos(np.clip((np.trace(r @ o_r.T) - 1) / 2, -1, 1)) < 1e-4 for o_r in
-            [_opk_matrix(o.eo) for o in out]
-        )  # fmt: skip
+            np.arccos(np.clip((np.trace(r @ o_r.T) - 1) / 2, -1, 1)) < 1e-4
+            for o_r in [_opk_matrix(o.eo) for o in out]
+        )
         if dup:
             continue
         omega, phi, kappa = matrix_to_opk(r)

@@ -116,12 +116,18 @@ class ResectionData:
         set_ = object.__setattr__
         set_(self, "point_ids", tuple(map(str, self.point_ids)))
         set_(self, "pixels", np.asarray(self.pixels, dtype=np.float64).reshape(n, 2))
-        set_(self, "sigma_px", np.broadcast_to(
-            np.asarray(self.sigma_px, dtype=np.float64), (n,)).copy())  # fmt: skip
+        set_(
+            self,
+            "sigma_px",
+            np.broadcast_to(np.asarray(self.sigma_px, dtype=np.float64), (n,)).copy(),
+        )
         set_(self, "xyz", np.asarray(self.xyz, dtype=np.float64).reshape(n, 3))
         cov = np.asarray(self.xyz_cov, dtype=np.float64)
-        set_(self, "xyz_cov", np.broadcast_to(cov, (n, 3, 3)).copy() if cov.size else
-             np.zeros((n, 3, 3)))  # fmt: skip
+        set_(
+            self,
+            "xyz_cov",
+            np.broadcast_to(cov, (n, 3, 3)).copy() if cov.size else np.zeros((n, 3, 3)),
+        )
         m = len(self.line_ids)
         set_(self, "line_ids", tuple(map(str, self.line_ids)))
         lp = tuple(np.asarray(v, dtype=np.float64).reshape(-1, 2) for v in self.line_pixels)
@@ -129,18 +135,31 @@ class ResectionData:
         sig = self.line_sigma_px
         if len(sig) != len(lp):
             raise InputError("line_sigma_px needs one entry per image line")
-        set_(self, "line_sigma_px", tuple(
-            np.broadcast_to(np.asarray(s, dtype=np.float64), (len(v),)).copy()
-            for s, v in zip(sig, lp)))  # fmt: skip
+        set_(
+            self,
+            "line_sigma_px",
+            tuple(
+                np.broadcast_to(np.asarray(s, dtype=np.float64), (len(v),)).copy()
+                for s, v in zip(sig, lp)
+            ),
+        )
         set_(self, "line_p1", np.asarray(self.line_p1, dtype=np.float64).reshape(m, 3))
         set_(self, "line_p2", np.asarray(self.line_p2, dtype=np.float64).reshape(m, 3))
         lc = np.asarray(self.line_cov, dtype=np.float64)
-        set_(self, "line_cov", np.broadcast_to(lc, (m, 6, 6)).copy() if lc.size else
-             np.zeros((m, 6, 6)))  # fmt: skip
+        set_(
+            self,
+            "line_cov",
+            np.broadcast_to(lc, (m, 6, 6)).copy() if lc.size else np.zeros((m, 6, 6)),
+        )
         if len(lp) != m:
             raise InputError(f"{len(lp)} image lines for {m} line ids")
-        for name, arr in (("pixels", self.pixels), ("xyz", self.xyz), ("sigma_px", self.sigma_px),
-                          ("line_p1", self.line_p1), ("line_p2", self.line_p2)):  # fmt: skip
+        for name, arr in (
+            ("pixels", self.pixels),
+            ("xyz", self.xyz),
+            ("sigma_px", self.sigma_px),
+            ("line_p1", self.line_p1),
+            ("line_p2", self.line_p2),
+        ):
             if not np.isfinite(arr).all():
                 raise InputError(f"resection: {name} must be finite")
         if (self.sigma_px <= 0).any() or any((s <= 0).any() for s in self.line_sigma_px):
@@ -157,8 +176,9 @@ class ResectionData:
         length = np.linalg.norm(self.line_p2 - self.line_p1, axis=1)
         for i, ln in zip(self.line_ids, length):
             if not ln >= MIN_LINE_LENGTH_M:
-                raise InputError(f"3D line {i} has zero length ({ln:.3g} m): its two points "
-                                 "coincide")  # fmt: skip
+                raise InputError(
+                    f"3D line {i} has zero length ({ln:.3g} m): its two points coincide"
+                )
 
     @property
     def n_points(self) -> int:
@@ -301,9 +321,7 @@ def _parallel_diagnosis(data: ResectionData) -> None:
 
 
 def _conditions_count(data: ResectionData, model: str) -> int:
-    lines = (
-        sum(len(v) for v in data.line_pixels) if model == "coplanarity" else 2 * data.n_lines
-    )
+    lines = sum(len(v) for v in data.line_pixels) if model == "coplanarity" else 2 * data.n_lines
     return 2 * data.n_points + lines
 
 
@@ -322,10 +340,18 @@ class _Problem:
             for flag, name in ((False, "control points"), (True, "control points (weighted)")):
                 idx = np.flatnonzero(has == flag)
                 if idx.size:
-                    self.blocks.append(point_block(
-                        name, camera, data.pixels[idx], data.sigma_px[idx], data.xyz[idx],
-                        data.xyz_cov[idx] if flag else None, self._index(idx.size),
-                        [data.point_ids[i] for i in idx]))  # fmt: skip
+                    self.blocks.append(
+                        point_block(
+                            name,
+                            camera,
+                            data.pixels[idx],
+                            data.sigma_px[idx],
+                            data.xyz[idx],
+                            data.xyz_cov[idx] if flag else None,
+                            self._index(idx.size),
+                            [data.point_ids[i] for i in idx],
+                        )
+                    )
                     self.members.append(("point", name, idx))
         if data.n_lines:
             cov, has = _line_cov(data)
@@ -341,19 +367,30 @@ class _Problem:
                     line_cov = cov[idx] if flag else None
                     name = f"lines ({k} points{', weighted' if flag else ''})"
                     if options.model == "coplanarity":
-                        cond = LineConditions(camera, "coplanarity", int(k), bool(flag),
-                                              data.line_p1[idx], data.line_p2[idx])  # fmt: skip
-                        self.blocks.append(line_block(name, cond, px, sig, line_cov,
-                                                      self._index(idx.size), labels))  # fmt: skip
+                        cond = LineConditions(
+                            camera,
+                            "coplanarity",
+                            int(k),
+                            bool(flag),
+                            data.line_p1[idx],
+                            data.line_p2[idx],
+                        )
+                        self.blocks.append(
+                            line_block(name, cond, px, sig, line_cov, self._index(idx.size), labels)
+                        )
                     else:
                         kind = parametrisation(image_vectors(px, camera)[0])
                         if options.parametrisation != "auto":
                             kind[:] = PARAMETRISATIONS.index(options.parametrisation) - 1
                         ab, ab_cov = observed_line_parameters(camera, px, sig, kind)
-                        eqp = EquivalentPlanes(camera, bool(flag), data.line_p1[idx],
-                                               data.line_p2[idx], kind)  # fmt: skip
-                        self.blocks.append(equivalent_planes_block(
-                            name, eqp, ab, ab_cov, line_cov, self._index(idx.size), labels))
+                        eqp = EquivalentPlanes(
+                            camera, bool(flag), data.line_p1[idx], data.line_p2[idx], kind
+                        )
+                        self.blocks.append(
+                            equivalent_planes_block(
+                                name, eqp, ab, ab_cov, line_cov, self._index(idx.size), labels
+                            )
+                        )
                     self.members.append(("line", name, idx))
 
     def _index(self, g: int) -> Array:
@@ -398,8 +435,9 @@ def _start_pose(
     :func:`.pose_start.pose_candidates` that fits the rigorous model best."""
     if eo0 is not None:
         return np.asarray(eo0, dtype=np.float64).reshape(6).copy(), "given"
-    cands = pose_candidates(camera, data.pixels, data.xyz, list(data.line_pixels),
-                            data.line_p1, data.line_p2)  # fmt: skip
+    cands = pose_candidates(
+        camera, data.pixels, data.xyz, list(data.line_pixels), data.line_p1, data.line_p2
+    )
     if not cands:
         raise ConvergenceError(
             "no start pose puts the control in front of the camera: check that the "
@@ -424,8 +462,11 @@ def _residuals(
     line_rej = np.zeros(data.n_lines, bool)
     for kind, name, idx in problem.members:
         table = adj.residuals[name]
-        wmax = np.nanmax(np.abs(table.w), axis=1) if np.isfinite(table.w).any() else (
-            np.full(len(idx), np.nan))  # fmt: skip
+        wmax = (
+            np.nanmax(np.abs(table.w), axis=1)
+            if np.isfinite(table.w).any()
+            else (np.full(len(idx), np.nan))
+        )
         if kind == "point":
             point_v[idx] = table.v[:, :2]
             point_w[idx] = wmax
@@ -534,26 +575,42 @@ def resect(
     stop_if_asked(should_stop, "starting the resection")
     blocks = list(problem.blocks)
     if opts.eo_prior_sigma is not None and eo0 is not None:
-        blocks.append(prior_block("approximate orientation", np.arange(6), start_eo,
-                                  opts.eo_prior_sigma))  # fmt: skip
+        blocks.append(
+            prior_block("approximate orientation", np.arange(6), start_eo, opts.eo_prior_sigma)
+        )
     aopts = AdjustmentOptions(
-        max_iterations=opts.max_iterations, tolerance=RESECTION_TOLERANCE,
-        damping=opts.damping, alpha=opts.alpha,
-        snooping=opts.snooping, snooping_alpha=opts.snooping_alpha,
+        max_iterations=opts.max_iterations,
+        tolerance=RESECTION_TOLERANCE,
+        damping=opts.damping,
+        alpha=opts.alpha,
+        snooping=opts.snooping,
+        snooping_alpha=opts.snooping_alpha,
         max_rejections=max(0, (m - n_unknown) // 2),
-    )  # fmt: skip
+    )
     adj = _adjust(problem, start_eo, blocks, aopts, opts, progress, should_stop)
     return _result(adj, problem, data, camera, opts, start, start_eo)
 
 
-def _adjust(problem: _Problem, start_eo: Array, blocks: list, aopts: AdjustmentOptions,
-            opts: ResectionOptions, progress: Callable[[float], None] | None,
-            should_stop: Callable[[], bool] | None):  # fmt: skip
+def _adjust(
+    problem: _Problem,
+    start_eo: Array,
+    blocks: list,
+    aopts: AdjustmentOptions,
+    opts: ResectionOptions,
+    progress: Callable[[float], None] | None,
+    should_stop: Callable[[], bool] | None,
+):
     """The resection's adjustment from ``start_eo``; a non-observable interior orientation
     named with what would determine it."""
     try:
-        return adjust(problem.x0(start_eo), problem.names, blocks, options=aopts,
-                      progress=progress, should_stop=should_stop)  # fmt: skip
+        return adjust(
+            problem.x0(start_eo),
+            problem.names,
+            blocks,
+            options=aopts,
+            progress=progress,
+            should_stop=should_stop,
+        )
     except NotObservableError as exc:
         if opts.estimate_interior and set(exc.parameters) & set(IO_NAMES):
             raise NotObservableError(
@@ -567,8 +624,15 @@ def _adjust(problem: _Problem, start_eo: Array, blocks: list, aopts: AdjustmentO
         raise
 
 
-def _result(adj, problem: _Problem, data: ResectionData, camera: Camera, opts: ResectionOptions,
-            start: str, start_eo: Array) -> SpaceResection:  # fmt: skip
+def _result(
+    adj,
+    problem: _Problem,
+    data: ResectionData,
+    camera: Camera,
+    opts: ResectionOptions,
+    start: str,
+    start_eo: Array,
+) -> SpaceResection:
     """The resection of a finished adjustment (ConvergenceError when it did not converge):
     the pose (angles wrapped to [-pi, pi)), its covariances, the residuals, the line
     distances and the global test."""
@@ -576,8 +640,10 @@ def _result(adj, problem: _Problem, data: ResectionData, camera: Camera, opts: R
 
     if not adj.converged:
         why = "; ".join(adj.warnings) or f"{adj.iterations} iterations"
-        raise ConvergenceError(f"the resection did not converge ({why}) from the start pose "
-                               f"({start}); no orientation was computed")  # fmt: skip
+        raise ConvergenceError(
+            f"the resection did not converge ({why}) from the start pose "
+            f"({start}); no orientation was computed"
+        )
     x = adj.x
     eo = x[:6].copy()
     eo[3:] = (eo[3:] + np.pi) % (2 * np.pi) - np.pi
@@ -591,8 +657,11 @@ def _result(adj, problem: _Problem, data: ResectionData, camera: Camera, opts: R
     if opts.estimate_interior:
         interior = x[6:9].copy()
         interior_std = adj.std[6:9].copy()
-    cam_final = camera.with_interior(np.concatenate([interior, camera.distortion.params])) if (
-        interior is not None) else camera  # fmt: skip
+    cam_final = (
+        camera.with_interior(np.concatenate([interior, camera.distortion.params]))
+        if (interior is not None)
+        else camera
+    )
     dist = line_distances(data, eo, cam_final)
     r = adj.redundancy
     crit = float(stats.chi2.ppf(1 - opts.alpha, r)) if r > 0 else math.nan
@@ -600,14 +669,31 @@ def _result(adj, problem: _Problem, data: ResectionData, camera: Camera, opts: R
     if start != "given" and r == 0:
         warnings.append(_t("no redundancy: the orientation cannot be checked"))
     return SpaceResection(
-        eo=eo, covariance=cov[:6, :6].copy(), covariance_prior=cov_p[:6, :6].copy(),
-        correlation=corr[:6, :6].copy(), interior=interior, interior_std=interior_std,
-        sigma0=float(adj.sigma0), redundancy=int(r), chi2=adj.global_test, chi2_critical=crit,
-        point_v=point_v, point_w=point_w, point_rejected=point_rej, line_v=tuple(line_v),
-        line_distance_px=dist, line_ab_v=line_ab_v, line_w=line_w, line_rejected=line_rej,
-        start=start, start_eo=start_eo, model=opts.model, iterations=adj.iterations,
-        adjustment=adj, warnings=tuple(warnings),
-    )  # fmt: skip
+        eo=eo,
+        covariance=cov[:6, :6].copy(),
+        covariance_prior=cov_p[:6, :6].copy(),
+        correlation=corr[:6, :6].copy(),
+        interior=interior,
+        interior_std=interior_std,
+        sigma0=float(adj.sigma0),
+        redundancy=int(r),
+        chi2=adj.global_test,
+        chi2_critical=crit,
+        point_v=point_v,
+        point_w=point_w,
+        point_rejected=point_rej,
+        line_v=tuple(line_v),
+        line_distance_px=dist,
+        line_ab_v=line_ab_v,
+        line_w=line_w,
+        line_rejected=line_rej,
+        start=start,
+        start_eo=start_eo,
+        model=opts.model,
+        iterations=adj.iterations,
+        adjustment=adj,
+        warnings=tuple(warnings),
+    )
 
 
 def line_distances(data: ResectionData, eo: ArrayLike, camera: Camera) -> tuple[Array, ...]:

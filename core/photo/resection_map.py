@@ -23,7 +23,6 @@ from .resection import ResectionData, ResectionOptions, SpaceResection, resect
 Array = NDArray[np.float64]
 
 
-
 @dataclass(frozen=True)
 class PointControl:
     """Control points: ids (N,), coordinates (N, 3) and covariances (N, 3, 3) (zero:
@@ -271,23 +270,30 @@ def image_inputs(
         groups: dict[str, list[int]] = {}
         ignored = 0
         for k in by_image[img]:
-            kind, target, pid = (observations.type[k], observations.target_id[k],
-                                 observations.point_id[k])  # fmt: skip
+            kind, target, pid = (
+                observations.type[k],
+                observations.target_id[k],
+                observations.point_id[k],
+            )
             if kind == "line":
                 if lines is None:
                     ignored += 1
                     continue
                 if target not in l_index:
-                    raise InputError(f"image {img}: line '{target}' (point {pid}) is not in the "
-                                     f"control lines ({len(l_index)} ids)")  # fmt: skip
+                    raise InputError(
+                        f"image {img}: line '{target}' (point {pid}) is not in the "
+                        f"control lines ({len(l_index)} ids)"
+                    )
                 groups.setdefault(target, []).append(k)
             elif kind in ("lcp", "check"):
                 if points is None:
                     ignored += 1
                     continue
                 if target not in p_index:
-                    raise InputError(f"image {img}: control point '{target}' ({kind} row, point "
-                                     f"{pid}) is not in the control points")  # fmt: skip
+                    raise InputError(
+                        f"image {img}: control point '{target}' ({kind} row, point "
+                        f"{pid}) is not in the control points"
+                    )
                 (c_rows if kind == "check" else p_rows).append(k)
                 (c_ctrl if kind == "check" else p_ctrl).append(p_index[target])
             elif pid in p_index:
@@ -321,10 +327,22 @@ def image_inputs(
             )
         except InputError as exc:  # the checks of ResectionData, with the image named
             raise InputError(f"image {img}: {exc}") from None
-        cxyz = points.xyz[np.array(c_ctrl, dtype=np.int64)] if points is not None else (
-            np.empty((0, 3)))  # fmt: skip
-        out.append(ImageInput(img, data, tuple(p_rows), tuple(tuple(groups[t]) for t in lids),
-                              tuple(c_rows), cxyz.reshape(-1, 3), ignored))  # fmt: skip
+        cxyz = (
+            points.xyz[np.array(c_ctrl, dtype=np.int64)]
+            if points is not None
+            else (np.empty((0, 3)))
+        )
+        out.append(
+            ImageInput(
+                img,
+                data,
+                tuple(p_rows),
+                tuple(tuple(groups[t]) for t in lids),
+                tuple(c_rows),
+                cxyz.reshape(-1, 3),
+                ignored,
+            )
+        )
     return out
 
 

@@ -60,9 +60,7 @@ def _camera_at(camera: Camera, x_local: Array) -> Camera:
     """The camera with the adjusted interior orientation (the same in every group)."""
     if x_local.shape[1] <= 6:
         return camera
-    return camera.with_interior(
-        np.concatenate([x_local[0, 6:9], camera.distortion.params])
-    )
+    return camera.with_interior(np.concatenate([x_local[0, 6:9], camera.distortion.params]))
 
 
 @dataclass
@@ -270,9 +268,14 @@ def point_block(
 
 
 def _lines_block(
-    name: str, conditions: LineConditions | EquivalentPlanes, s: Array, observed: Array,
+    name: str,
+    conditions: LineConditions | EquivalentPlanes,
+    s: Array,
+    observed: Array,
     rows: list[str],
-    cov: Array | None, param_index: Array, labels: list[str],
+    cov: Array | None,
+    param_index: Array,
+    labels: list[str],
 ) -> GaussHelmertBlock:
     """The Gauss-Helmert block of image lines (``observed``, their covariance in ``s``); with
     ``cov`` (G, 6, 6) the 3D line's end points P1, P2 are observations too, after them."""

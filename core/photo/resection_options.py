@@ -59,8 +59,10 @@ class ResectionOptions:
         if self.model not in MODELS:
             raise InputError(f"model '{self.model}' is not one of {', '.join(MODELS)}")
         if self.parametrisation not in PARAMETRISATIONS:
-            raise InputError(f"parametrisation '{self.parametrisation}' is not one of "
-                             f"{', '.join(PARAMETRISATIONS)}")  # fmt: skip
+            raise InputError(
+                f"parametrisation '{self.parametrisation}' is not one of "
+                f"{', '.join(PARAMETRISATIONS)}"
+            )
         if self.eo_prior_sigma is not None:
             s = tuple(float(v) for v in self.eo_prior_sigma)
             if len(s) != 6 or not all(v > 0 and math.isfinite(v) for v in s):

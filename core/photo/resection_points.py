@@ -85,9 +85,16 @@ def space_resection(
         raise InputError(f"a resection needs at least 4 points, got {px.shape[0]}")
     x0 = initial_pose_pnp(px, pts, camera) if eo0 is None else np.asarray(eo0, dtype=float)
     n = px.shape[0]
-    block = point_block("image points", camera, px, np.full(n, float(sigma_px)), pts, None,
-                        np.tile(np.arange(6), (n, 1)),
-                        labels if labels is not None else [str(i) for i in range(n)])  # fmt: skip
+    block = point_block(
+        "image points",
+        camera,
+        px,
+        np.full(n, float(sigma_px)),
+        pts,
+        None,
+        np.tile(np.arange(6), (n, 1)),
+        labels if labels is not None else [str(i) for i in range(n)],
+    )
     opts = options if options is not None else AdjustmentOptions(snooping=True)
     result = adjust(x0, list(EO_NAMES), [block], options=opts, should_stop=should_stop)
     table = result.residuals["image points"]

@@ -76,8 +76,9 @@ class BarSetup:
     metres: float  # length of one frame unit, metres
 
 
-def setup_bars(bars: ScaleBars, points: Sequence[str], check_ids: Sequence[str],
-               metres: float) -> BarSetup:  # fmt: skip
+def setup_bars(
+    bars: ScaleBars, points: Sequence[str], check_ids: Sequence[str], metres: float
+) -> BarSetup:
     """Number the bars' end points among the adjusted ``points``; refuse a bar on a point
     that is not adjusted (unknown, or a check point), naming its row.
 
@@ -104,8 +105,7 @@ def setup_bars(bars: ScaleBars, points: Sequence[str], check_ids: Sequence[str],
                 )
         ends.append((num[pair[0]], num[pair[1]]))
     ab = np.array(ends, dtype=np.intp).reshape(-1, 2)
-    return BarSetup(bars, ab[:, 0], ab[:, 1], bars.distance * metres, bars.sigma * metres,
-                    metres)  # fmt: skip
+    return BarSetup(bars, ab[:, 0], ab[:, 1], bars.distance * metres, bars.sigma * metres, metres)
 
 
 class DistanceModel:
@@ -173,6 +173,12 @@ def bar_result(bars: BarSetup, res: AdjustmentResult, point_index: NDArray[np.in
         sigma[k] = math.sqrt(max(float(u @ cov @ u), 0.0))
     table = res.residuals[BLOCK_NAME]
     s = bars.metres
-    return BarResult(bars.bars, adjusted / s, sigma / s, np.asarray(table.v)[:, 0] / s,
-                     np.asarray(table.w)[:, 0], np.asarray(table.redundancy_numbers)[:, 0],
-                     np.asarray(table.rejected, dtype=bool))  # fmt: skip
+    return BarResult(
+        bars.bars,
+        adjusted / s,
+        sigma / s,
+        np.asarray(table.v)[:, 0] / s,
+        np.asarray(table.w)[:, 0],
+        np.asarray(table.redundancy_numbers)[:, 0],
+        np.asarray(table.rejected, dtype=bool),
+    )

@@ -67,10 +67,16 @@ def immerkaer_noise(image: ArrayLike) -> float:
     if a.ndim != 2 or min(a.shape) < 3:
         return 0.0
     lap = (
-        a[:-2, :-2] - 2 * a[:-2, 1:-1] + a[:-2, 2:]
-        - 2 * a[1:-1, :-2] + 4 * a[1:-1, 1:-1] - 2 * a[1:-1, 2:]
-        + a[2:, :-2] - 2 * a[2:, 1:-1] + a[2:, 2:]
-    )  # fmt: skip
+        a[:-2, :-2]
+        - 2 * a[:-2, 1:-1]
+        + a[:-2, 2:]
+        - 2 * a[1:-1, :-2]
+        + 4 * a[1:-1, 1:-1]
+        - 2 * a[1:-1, 2:]
+        + a[2:, :-2]
+        - 2 * a[2:, 1:-1]
+        + a[2:, 2:]
+    )
     h, w = a.shape
     return float(np.sqrt(np.pi / 2.0) * np.abs(lap).sum() / (6.0 * (w - 2) * (h - 2)))
 

@@ -74,10 +74,14 @@ FISHEYE_BORDER_POINTS = 64
 def _border(w: int, h: int, n: int = FISHEYE_BORDER_POINTS) -> Array:
     """``4 n`` pixels along the image border, clockwise from the top-left corner."""
     s = np.arange(n) / n
-    return np.vstack([np.column_stack([s * w, np.zeros(n)]),
-                      np.column_stack([np.full(n, float(w)), s * h]),
-                      np.column_stack([(1 - s) * w, np.full(n, float(h))]),
-                      np.column_stack([np.zeros(n), (1 - s) * h])])  # fmt: skip
+    return np.vstack(
+        [
+            np.column_stack([s * w, np.zeros(n)]),
+            np.column_stack([np.full(n, float(w)), s * h]),
+            np.column_stack([(1 - s) * w, np.full(n, float(h))]),
+            np.column_stack([np.zeros(n), (1 - s) * h]),
+        ]
+    )
 
 
 def _within_field(camera: Camera, px: Array, steps: int = 64) -> Array:
@@ -117,9 +121,14 @@ def _hull(p: Array) -> Array:
     def half(points: Array) -> list:
         chain: list = []
         for pt in points:
-            while len(chain) >= 2 and ((chain[-1][0] - chain[-2][0]) * (pt[1] - chain[-2][1])
-                                       - (chain[-1][1] - chain[-2][1]) * (pt[0] - chain[-2][0])
-                                       ) <= 0:  # fmt: skip
+            while (
+                len(chain) >= 2
+                and (
+                    (chain[-1][0] - chain[-2][0]) * (pt[1] - chain[-2][1])
+                    - (chain[-1][1] - chain[-2][1]) * (pt[0] - chain[-2][0])
+                )
+                <= 0
+            ):
                 chain.pop()
             chain.append(pt)
         return chain
@@ -198,13 +207,15 @@ def select_pairs(
     if mode == "all":
         pairs = [(i, j) for i in range(n_images) for j in range(i + 1, n_images)]
     elif mode == "sequential":
-        pairs = [(i, j) for i in range(n_images)
-                 for j in range(i + 1, min(n_images, i + 1 + max(1, window)))]  # fmt: skip
+        pairs = [
+            (i, j)
+            for i in range(n_images)
+            for j in range(i + 1, min(n_images, i + 1 + max(1, window)))
+        ]
     elif mode == "footprints":
         if footprint is None or len(footprint) != n_images:
             raise InputError("footprint pairs need the orientation and camera of the images")
-        boxes = np.array([[np.nan] * 4 if f is None else [*f.min(0), *f.max(0)]
-                          for f in footprint])  # fmt: skip
+        boxes = np.array([[np.nan] * 4 if f is None else [*f.min(0), *f.max(0)] for f in footprint])
         for i in range(n_images):
             for j in range(i + 1, n_images):
                 if footprint[i] is None or footprint[j] is None:

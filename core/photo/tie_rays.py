@@ -51,7 +51,7 @@ __all__ = [
     "keypoint_rays",
     "ray_epipolar_px",
     "refine_essential",
-]  # fmt: skip
+]
 
 #: Rays further off the axis (degrees) take no part in the essential-matrix hypothesis: their
 #: normalised coordinates grow without bound towards 90 degrees.
@@ -115,8 +115,9 @@ def keypoint_rays(camera: Camera, pixels: Array) -> KeypointRays:
     return KeypointRays(allr[0], jac, scale)
 
 
-def ray_epipolar_px(e: Array, ra: KeypointRays, ia: NDArray[np.intp], rb: KeypointRays,
-                    ib: NDArray[np.intp]) -> Array:  # fmt: skip
+def ray_epipolar_px(
+    e: Array, ra: KeypointRays, ia: NDArray[np.intp], rb: KeypointRays, ib: NDArray[np.intp]
+) -> Array:
     """Distance of the matches ``ia``, ``ib`` to their epipolar curves (``b^T E a = 0``),
     full-resolution pixels, the mean of the two images (module docstring); NaN for a ray
     outside its projection.
@@ -133,9 +134,14 @@ def ray_epipolar_px(e: Array, ra: KeypointRays, ia: NDArray[np.intp], rb: Keypoi
     return np.abs(_signed_px(e, ra.rays[ia], ra.jac[ia], rb.rays[ib], rb.jac[ib]))
 
 
-def essential_from_rays(ra: KeypointRays, ia: NDArray[np.intp], rb: KeypointRays,
-                        ib: NDArray[np.intp], threshold_px: float,
-                        method: str) -> Array | None:  # fmt: skip
+def essential_from_rays(
+    ra: KeypointRays,
+    ia: NDArray[np.intp],
+    rb: KeypointRays,
+    ib: NDArray[np.intp],
+    threshold_px: float,
+    method: str,
+) -> Array | None:
     """The essential matrix (3, 3) of the rays' frame (``b^T E a = 0``) from the matches,
     or None when fewer than 8 lie within :data:`MAX_RANSAC_ANGLE_DEG` of both axes or the
     RANSAC fails. ``method``: ``"magsac"`` or ``"ransac"``; a fixed seed (OpenCV's)."""
@@ -151,8 +157,9 @@ def essential_from_rays(ra: KeypointRays, ia: NDArray[np.intp], rb: KeypointRays
     cv_method = cv2.USAC_MAGSAC if method == "magsac" else cv2.RANSAC
     cv2.setRNGSeed(12345)
     try:
-        em, _ = cv2.findEssentialMat(na, nb, np.eye(3), cv_method, 0.999,
-                                     float(threshold_px) * scale, 10000)  # fmt: skip
+        em, _ = cv2.findEssentialMat(
+            na, nb, np.eye(3), cv_method, 0.999, float(threshold_px) * scale, 10000
+        )
     except cv2.error:
         return None
     if em is None or em.ndim != 2 or em.shape[1] != 3 or em.shape[0] < 3:
@@ -175,8 +182,9 @@ def _signed_px(e: Array, a: Array, ja: Array, b: Array, jb: Array) -> Array:
         return 0.5 * c * (1.0 / np.hypot(ga[:, 0], ga[:, 1]) + 1.0 / np.hypot(gb[:, 0], gb[:, 1]))
 
 
-def refine_essential(e: Array, ra: KeypointRays, ia: NDArray[np.intp], rb: KeypointRays,
-                     ib: NDArray[np.intp]) -> Array:  # fmt: skip
+def refine_essential(
+    e: Array, ra: KeypointRays, ia: NDArray[np.intp], rb: KeypointRays, ib: NDArray[np.intp]
+) -> Array:
     """``e`` refined by least squares on the epipolar distances (pixels) of the matches
     ``ia``, ``ib`` (its inliers): ``E = [t]x R``, R turned by three small angles, the unit
     baseline t by two; ``e`` itself when fewer than 8
@@ -231,9 +239,14 @@ def refine_essential(e: Array, ra: KeypointRays, ia: NDArray[np.intp], rb: Keypo
     return np.asarray(model(fit.x), np.float64)
 
 
-def fit_essential(ra: KeypointRays, ia: NDArray[np.intp], rb: KeypointRays,
-                  ib: NDArray[np.intp], threshold_px: float,
-                  method: str) -> Array | None:  # fmt: skip
+def fit_essential(
+    ra: KeypointRays,
+    ia: NDArray[np.intp],
+    rb: KeypointRays,
+    ib: NDArray[np.intp],
+    threshold_px: float,
+    method: str,
+) -> Array | None:
     """The essential matrix of the matches ``ia``, ``ib`` (module docstring, "Refinement"):
     RANSAC, least squares on its inliers, RANSAC again on them, least squares; the matrix of
     the lowest truncated cost; None when the first RANSAC fails."""

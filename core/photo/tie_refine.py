@@ -116,8 +116,14 @@ class _Index:
         first = np.r_[True, t.track[1:] != t.track[:-1]]
         start = np.flatnonzero(first)
         by_image = np.argsort(t.image, kind="stable")
-        return cls(first, start, start[t.track], t.image[np.r_[start[1:] - 1, n - 1]], by_image,
-                   np.searchsorted(t.image[by_image], np.arange(n_images + 1)))  # fmt: skip
+        return cls(
+            first,
+            start,
+            start[t.track],
+            t.image[np.r_[start[1:] - 1, n - 1]],
+            by_image,
+            np.searchsorted(t.image[by_image], np.arange(n_images + 1)),
+        )
 
     def rows(self, k: int) -> NDArray[np.intp]:
         """Image ``k``'s rows, sorted by track."""
@@ -125,8 +131,13 @@ class _Index:
 
 
 def _starts(
-    t: Tracks, ix: _Index, rows_k: NDArray[np.intp], targets: NDArray[np.intp],
-    store: dict[int, _Templates], size: int, work: _Work,
+    t: Tracks,
+    ix: _Index,
+    rows_k: NDArray[np.intp],
+    targets: NDArray[np.intp],
+    store: dict[int, _Templates],
+    size: int,
+    work: _Work,
 ) -> tuple[NDArray[np.float32], Array, Array, NDArray[np.bool_]]:
     """For the ``targets`` rows of one image: their templates, start linear parts, template
     offsets and whether they can be matched (a start affine and a template inside)."""
@@ -138,8 +149,9 @@ def _starts(
     for r in np.unique(t.image[ix.ref_row[targets]]):
         sel = np.flatnonzero(t.image[ix.ref_row[targets]] == r)
         rows_r = ix.rows(r)
-        _, ir, ik = np.intersect1d(t.track[rows_r], tracks_k, assume_unique=True,
-                                   return_indices=True)  # fmt: skip
+        _, ir, ik = np.intersect1d(
+            t.track[rows_r], tracks_k, assume_unique=True, return_indices=True
+        )
         pr, pk = t.pixels[rows_r[ir]], t.pixels[rows_k[ik]]
         lin[sel], ok = _start_linear(pr, pk, t.pixels[ix.ref_row[targets[sel]]])
         ids, tp, off = store[int(r)]
@@ -154,8 +166,13 @@ def _starts(
 
 
 def _match(
-    rows: NDArray[np.intp], tmpl: NDArray[np.float32], lin: Array, d_off: Array, img: Array,
-    sigma_floor_px: float, work: _Work,
+    rows: NDArray[np.intp],
+    tmpl: NDArray[np.float32],
+    lin: Array,
+    d_off: Array,
+    img: Array,
+    sigma_floor_px: float,
+    work: _Work,
 ) -> None:
     """LSM of the measurements ``rows`` against their templates; moves, keeps or drops them."""
     from .least_squares_matching import STATUS_TEXT, LsmOptions, lsm_in_image
@@ -187,8 +204,12 @@ def _templates(t: Tracks, refs: NDArray[np.intp], img: Array, h: int) -> _Templa
     size = 2 * h + 1
     arr = t.pixels[refs] - 0.5
     c = np.rint(arr).astype(np.intp)
-    inside = ((c[:, 0] >= h) & (c[:, 1] >= h) & (c[:, 0] < img.shape[1] - h)
-              & (c[:, 1] < img.shape[0] - h))  # fmt: skip
+    inside = (
+        (c[:, 0] >= h)
+        & (c[:, 1] >= h)
+        & (c[:, 0] < img.shape[1] - h)
+        & (c[:, 1] < img.shape[0] - h)
+    )
     tp = np.zeros((refs.size, size, size), np.float32)
     if inside.any():
         ci = c[inside]
@@ -220,11 +241,21 @@ def _finish(
     had = np.bincount(t.track, minlength=t.n_tracks) > 0
     keep &= ok_track[t.track]
     new_id = np.cumsum(ok_track) - 1
-    out = Tracks(new_id[t.track[keep]].astype(np.intp), t.image[keep], t.feature[keep],
-                 work.pix[keep], t.rejected_inconsistent, t.rejected_short)  # fmt: skip
-    stats = RefineStats(int(np.sum(refined & keep)), work.kept, work.dropped,
-                        int(np.sum(had & ~ok_track)),
-                        float(np.median(shift)) if shift.size else math.nan)  # fmt: skip
+    out = Tracks(
+        new_id[t.track[keep]].astype(np.intp),
+        t.image[keep],
+        t.feature[keep],
+        work.pix[keep],
+        t.rejected_inconsistent,
+        t.rejected_short,
+    )
+    stats = RefineStats(
+        int(np.sum(refined & keep)),
+        work.kept,
+        work.dropped,
+        int(np.sum(had & ~ok_track)),
+        float(np.median(shift)) if shift.size else math.nan,
+    )
     return out, sigma[keep], stats
 
 
@@ -266,8 +297,9 @@ def refine_tracks(
     t = tracks
     n = t.track.size
     h = int(options.refine_half_px)
-    work = _Work(t.pixels.copy(), np.asarray(sigma_px, float).copy(), np.ones(n, bool),
-                 np.zeros(n, bool))  # fmt: skip
+    work = _Work(
+        t.pixels.copy(), np.asarray(sigma_px, float).copy(), np.ones(n, bool), np.zeros(n, bool)
+    )
     if n == 0:
         return t, work.sigma, RefineStats(0, work.kept, work.dropped, 0, math.nan)
     ix = _Index.of(t, n_images)
@@ -286,8 +318,15 @@ def refine_tracks(
         idx = np.flatnonzero(usable)
         for c0 in range(0, idx.size, _LSM_CHUNK):
             sel = idx[c0 : c0 + _LSM_CHUNK]
-            _match(targets[sel], tmpl[sel], lin[sel], d_off[sel], img,
-                   float(options.refine_sigma_floor_px), work)  # fmt: skip
+            _match(
+                targets[sel],
+                tmpl[sel],
+                lin[sel],
+                d_off[sel],
+                img,
+                float(options.refine_sigma_floor_px),
+                work,
+            )
         # this image's own templates (the tracks it is the reference of)
         store[k] = _templates(t, rows_k[ix.first[rows_k]], img, h)
         for r in [r for r, v in store.items() if v[0].size == 0 or ix.last_img[v[0]].max() <= k]:

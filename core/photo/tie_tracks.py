@@ -113,5 +113,11 @@ def build_tracks(
     new_id = np.cumsum(keep_comp) - 1
     track = new_id[comp[keep]]
     pix = np.vstack([f.pixels for f in features])[nodes[keep]]
-    return Tracks(track.astype(np.intp), img[keep].astype(np.intp), feat[keep].astype(np.intp),
-                  pix, int(bad.sum()), int(short.sum()))  # fmt: skip
+    return Tracks(
+        track.astype(np.intp),
+        img[keep].astype(np.intp),
+        feat[keep].astype(np.intp),
+        pix,
+        int(bad.sum()),
+        int(short.sum()),
+    )

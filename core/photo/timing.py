@@ -54,8 +54,10 @@ def local_velocity(vel: ExposureVelocities, xyz_map: Array, local) -> Array:
         jac = local.map_to_enu_jacobian(xyz_map)[1]
         return np.einsum("nij,nj->ni", jac, v)
     if not hasattr(local, "ned_to_local"):
-        raise InputError("velocities v_north, v_east, v_up need a mapping CRS; in a local "
-                         "engineering frame give vx, vy, vz along its axes")  # fmt: skip
+        raise InputError(
+            "velocities v_north, v_east, v_up need a mapping CRS; in a local "
+            "engineering frame give vx, vy, vz along its axes"
+        )
     llh = local.mapping.map_to_geodetic(xyz_map)
     return np.einsum("nij,nj->ni", local.ned_to_local(llh), v)
 

@@ -22,7 +22,6 @@ then also given the other way (without the flagged points, or with them), so tha
 blunder is seen for what it does to the figures.
 """
 
-
 from __future__ import annotations
 
 import datetime
@@ -70,7 +69,6 @@ log = logging.getLogger(__name__)
 
 #: The coordinates as the point tables name them (columns e, n, h), for error messages.
 _COORDINATES = ("E", "N", "H")
-
 
 
 # ----------------------------------------------------------------------------- inputs
@@ -380,11 +378,7 @@ def assess_accuracy(
     if n_flag:  # the user sees what the flagged points do to the figures, both ways
         other = np.ones(len(d), dtype=bool) if s.exclude_outliers else ~flagged
         if other.any():
-            other_label = (
-                _t("all points (flagged included)")
-                if s.exclude_outliers
-                else without
-            )
+            other_label = _t("all points (flagged included)") if s.exclude_outliers else without
             contrast = group_statistics(d[other], other_label, alpha=s.alpha, declared_sigma=sig)
     _tick(progress, should_stop, 0.3)
     groups: dict[str, GroupStatistics] = {}

@@ -25,11 +25,16 @@ if TYPE_CHECKING:
 __all__ = ["render_html"]
 
 
-_CSS = report_css(1200, (
-    ".insufficient{background:#fbecc4}\n"
-    ".info{background:#e6eef8}.plots svg{margin:4px;border:1px solid #ddd}\n"
-    ".note{font-size:12px;color:#444}"
-), h2_top_px=28, h3="h3{font-size:15px}")
+_CSS = report_css(
+    1200,
+    (
+        ".insufficient{background:#fbecc4}\n"
+        ".info{background:#e6eef8}.plots svg{margin:4px;border:1px solid #ddd}\n"
+        ".note{font-size:12px;color:#444}"
+    ),
+    h2_top_px=28,
+    h3="h3{font-size:15px}",
+)
 
 
 def _m(x: float | None, digits: int = 3) -> str:
@@ -237,13 +242,17 @@ def render_html(report: AccuracyReport) -> str:
                 css.append(v.status)
         parts.append(_table([t("group"), t("check"), t("status"), t("reason")], rows, css))
     parts.append(f"<h2>{t('Statistics')}</h2>")
-    parts.append(f'<h3 class="group">{_e(t(report.overall.name).capitalize())} '
-                 f"({report.overall.n})</h3>")  # fmt: skip
+    parts.append(
+        f'<h3 class="group">{_e(t(report.overall.name).capitalize())} ({report.overall.n})</h3>'
+    )
     parts.append(_stats_table(report.overall))
     parts.append(_tests_table(report.overall))
     if report.contrast is not None:
-        parts.append('<h3 class="group">' + t("For comparison: {} ({})").format(
-            _e(t(report.contrast.name)), report.contrast.n) + "</h3>")  # fmt: skip
+        parts.append(
+            '<h3 class="group">'
+            + t("For comparison: {} ({})").format(_e(t(report.contrast.name)), report.contrast.n)
+            + "</h3>"
+        )
         parts.append(_stats_table(report.contrast))
     for name, stats in report.groups.items():
         parts.append('<h3 class="group">' + t("Group {} ({})").format(_e(name), stats.n) + "</h3>")

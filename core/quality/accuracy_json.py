@@ -2,7 +2,6 @@
 numbers and lists, the keys of earlier versions kept for one release.
 """
 
-
 from __future__ import annotations
 
 import math
@@ -24,7 +23,6 @@ DEPRECATED_KEYS = {
     "rmse.RMSE_H": "rmse.RMSE_U (the height RMSE; RMSE_H was also ASPRS's horizontal RMSE)",
     "rmse.RMSE_HORIZ": "rmse.RMSE_HORIZONTAL",
 }
-
 
 
 # ----------------------------------------------------------------------------- JSON
@@ -56,10 +54,26 @@ def _obj(o: Any) -> Any:
 
 #: Top-level keys of the JSON report, in order (docs/formats.md, "Accuracy report JSON").
 JSON_TOP_KEYS = (
-    "title", "created", "source", "crs", "sign_convention", "n_points", "n_used", "settings",
-    "names", "rmse", "outliers", "overall", "contrast", "rmse_contrast", "deprecated_keys",
-    "groups", "standards", "group_thresholds", "points",
-)  # fmt: skip
+    "title",
+    "created",
+    "source",
+    "crs",
+    "sign_convention",
+    "n_points",
+    "n_used",
+    "settings",
+    "names",
+    "rmse",
+    "outliers",
+    "overall",
+    "contrast",
+    "rmse_contrast",
+    "deprecated_keys",
+    "groups",
+    "standards",
+    "group_thresholds",
+    "points",
+)
 
 
 def with_deprecated_keys(rmse: dict[str, float]) -> dict[str, float]:

@@ -3,7 +3,6 @@ Shapiro-Wilk normality test, Student's t test of a zero mean, the chi-square tes
 precision, and the screening of outliers (robust modified z-score or three sigma).
 """
 
-
 from __future__ import annotations
 
 import math
@@ -39,7 +38,6 @@ HORIZONTAL, THREE_D = "HORIZONTAL", "3D"
 
 _ROBUST_THRESHOLD = 3.5  # Iglewicz & Hoaglin (1993)
 _SIGMA_THRESHOLD = 3.0
-
 
 
 @dataclass(frozen=True)
@@ -283,9 +281,7 @@ def group_statistics(
         c: component_statistics(d[:, k], c, alpha=alpha, sigma0=declared_sigma[k] or None)
         for k, c in enumerate(COMPONENTS)
     }
-    comps[HORIZONTAL] = component_statistics(
-        np.hypot(d[:, 0], d[:, 1]), HORIZONTAL, tests=False
-    )
+    comps[HORIZONTAL] = component_statistics(np.hypot(d[:, 0], d[:, 1]), HORIZONTAL, tests=False)
     comps[THREE_D] = component_statistics(np.linalg.norm(d, axis=1), THREE_D, tests=False)
     return GroupStatistics(name, len(d), comps)
 

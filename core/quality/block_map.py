@@ -149,8 +149,12 @@ def block_map_svg(
             body.append(
                 f'<polygon points="{ring}" fill="none" stroke="#6b6b6b" stroke-width="0.6"/>'
             )
-    for p, shape in ((block.tie, "tie"), (block.centres, "centre"), (block.control, "control"),
-                     (block.check, "check")):  # fmt: skip
+    for p, shape in (
+        (block.tie, "tie"),
+        (block.centres, "centre"),
+        (block.control, "control"),
+        (block.check, "check"),
+    ):
         if not len(p):
             continue
         px, py = xy(p)
@@ -158,8 +162,12 @@ def block_map_svg(
             body.append(_marker(shape, float(x), float(y)))
     lx = width - right + 14
     ly = top + 20
-    entries = [("centre", _tr("perspective centre")), ("control", _tr("control point")),
-               ("check", _tr("check point")), ("tie", _tr("tie point"))]  # fmt: skip
+    entries = [
+        ("centre", _tr("perspective centre")),
+        ("control", _tr("control point")),
+        ("check", _tr("check point")),
+        ("tie", _tr("tie point")),
+    ]
     for j, (shape, text) in enumerate(entries):
         y = ly + 16 * j
         body.append(

@@ -152,10 +152,14 @@ def _timing(res) -> list[str]:
 
 
 def _problems(problems: Sequence[str], accepted: bool) -> list[str]:
-    return failed_checks(problems, accepted, t(
-        "The calibration FAILED its checks: no table and no exterior orientation were "
-        "written. The numbers below show the failed adjustment, for diagnosis only."
-    ))  # fmt: skip
+    return failed_checks(
+        problems,
+        accepted,
+        t(
+            "The calibration FAILED its checks: no table and no exterior orientation were "
+            "written. The numbers below show the failed adjustment, for diagnosis only."
+        ),
+    )
 
 
 def _results(run: BoresightRun) -> list[str]:

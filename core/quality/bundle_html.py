@@ -32,10 +32,14 @@ if TYPE_CHECKING:
 
 __all__ = ["render_bundle_html"]
 
-_CSS = report_css(1150, (
-    ".best{background:#d8e8f8}\n"
-    ".drop{color:#777}.plots svg{margin:4px;border:1px solid #ddd}.note{font-size:12px;color:#444}"
-))
+_CSS = report_css(
+    1150,
+    (
+        ".best{background:#d8e8f8}\n"
+        ".drop{color:#777}.plots svg{margin:4px;border:1px solid #ddd}"
+        ".note{font-size:12px;color:#444}"
+    ),
+)
 
 
 def _timing(res: BundleResult) -> list[str]:
@@ -62,22 +66,47 @@ def _n(x: object, fmt: str = ".3f") -> str:
 
 
 def _comparison(rows: Sequence[Mapping[str, object]], best: str) -> str:
-    head = [t("rank"), t("AP model"), t("check points"), t("mean horizontal (m)"),
-            t("std horizontal (m)"), "RMSE_HORIZONTAL (m)", "RMSE_U (m)", "RMSE_3D (m)",
-            "sigma0", t("APs"), t("APs kept"), t("significant"), t("rejected")]  # fmt: skip
+    head = [
+        t("rank"),
+        t("AP model"),
+        t("check points"),
+        t("mean horizontal (m)"),
+        t("std horizontal (m)"),
+        "RMSE_HORIZONTAL (m)",
+        "RMSE_U (m)",
+        "RMSE_3D (m)",
+        "sigma0",
+        t("APs"),
+        t("APs kept"),
+        t("significant"),
+        t("rejected"),
+    ]
     out, css = [], []
     for r in rows:
         if "error" in r and r.get("error"):
-            out.append(["&ndash;", _e(r["model"]), t("not observable: {}").format(_e(r["error"]))] +
-                       [""] * 10)  # fmt: skip
+            out.append(
+                ["&ndash;", _e(r["model"]), t("not observable: {}").format(_e(r["error"]))]
+                + [""] * 10
+            )
             css.append("fail")
             continue
-        out.append([
-            _e(r.get("rank")), _e(r["model"]), _e(r["n_check"]), _n(r["mean_planimetric"]),
-            _n(r["std_planimetric"]), _n(r["rms_planimetric"]), _n(r["rms_h"]),
-            _n(r["rms_3d"]), _n(r["sigma0"]), _e(r["n_ap"]), _e(r["n_ap_kept"]),
-            _e(r["n_significant"]), _e(r["rejected"]),
-        ])  # fmt: skip
+        out.append(
+            [
+                _e(r.get("rank")),
+                _e(r["model"]),
+                _e(r["n_check"]),
+                _n(r["mean_planimetric"]),
+                _n(r["std_planimetric"]),
+                _n(r["rms_planimetric"]),
+                _n(r["rms_h"]),
+                _n(r["rms_3d"]),
+                _n(r["sigma0"]),
+                _e(r["n_ap"]),
+                _e(r["n_ap_kept"]),
+                _e(r["n_significant"]),
+                _e(r["rejected"]),
+            ]
+        )
         css.append("best" if r["model"] == best else "")
     return _table(head, out, css)
 
@@ -95,27 +124,57 @@ def _adjustment(res: BundleResult) -> str:
     if doubt is not None:
         verdict = t("passed, but only after more rejections than false alarms explain")
     rows = [
-        [t("converged"), t("yes") if a.converged else t("NO"),
-         t("after {} iterations").format(a.iterations)],
-        [t("sigma0 a posteriori"), _n(a.sigma0, ".4f"),
-         t("a priori {}").format(f"{a.sigma0_prior:g}")],
-        [t("redundancy"), _e(a.redundancy),
-         t("{} observation rows, {} parameters, {} constraint rows").format(
-             a.n_observations, len(a.x), a.n_constraints)],
-        [t("global chi-square test"), verdict,
-         t("statistic {}, accepted [{}, {}], p = {}").format(
-             f"{gt.statistic:.1f}", f"{gt.lower:.1f}", f"{gt.upper:.1f}", f"{gt.p_value:.3g}")
-         if gt.dof > 0 else t("no redundancy")],
+        [
+            t("converged"),
+            t("yes") if a.converged else t("NO"),
+            t("after {} iterations").format(a.iterations),
+        ],
+        [
+            t("sigma0 a posteriori"),
+            _n(a.sigma0, ".4f"),
+            t("a priori {}").format(f"{a.sigma0_prior:g}"),
+        ],
+        [
+            t("redundancy"),
+            _e(a.redundancy),
+            t("{} observation rows, {} parameters, {} constraint rows").format(
+                a.n_observations, len(a.x), a.n_constraints
+            ),
+        ],
+        [
+            t("global chi-square test"),
+            verdict,
+            t("statistic {}, accepted [{}, {}], p = {}").format(
+                f"{gt.statistic:.1f}", f"{gt.lower:.1f}", f"{gt.upper:.1f}", f"{gt.p_value:.3g}"
+            )
+            if gt.dof > 0
+            else t("no redundancy"),
+        ],
         [t("outliers"), _e(int(res.rejected.sum())), _e(t(a.outlier_method))],
-        *([[t("rejections explained by false alarms"), _e(doubt.rejected),
-            t("at most {bound} ({expected} expected); {k} rejected: P = {p}").format(
-                bound=doubt.bound, expected=f"{doubt.expected:.2g}", k=doubt.rejected,
-                p=f"{doubt.p_value:.2g}")]] if doubt is not None else []),
+        *(
+            [
+                [
+                    t("rejections explained by false alarms"),
+                    _e(doubt.rejected),
+                    t("at most {bound} ({expected} expected); {k} rejected: P = {p}").format(
+                        bound=doubt.bound,
+                        expected=f"{doubt.expected:.2g}",
+                        k=doubt.rejected,
+                        p=f"{doubt.p_value:.2g}",
+                    ),
+                ]
+            ]
+            if doubt is not None
+            else []
+        ),
         [t("condition number (reduced system)"), _n(a.condition_number, ".3g"), ""],
-    ]  # fmt: skip
+    ]
     good = gt.passed and doubt is None
-    return _table(["", t("value"), t("details")], rows,
-                  ["", "", "", "pass" if good else "fail", "", "" if doubt is None else "fail"])
+    return _table(
+        ["", t("value"), t("details")],
+        rows,
+        ["", "", "", "pass" if good else "fail", "", "" if doubt is None else "fail"],
+    )
 
 
 def _interior(res: BundleResult, alpha_text: str) -> str:
@@ -126,13 +185,29 @@ def _interior(res: BundleResult, alpha_text: str) -> str:
             sig = t("yes") if p.significant else t("no")
         else:
             sig = "&ndash;"
-        rows.append([
-            _e(p.camera), _e(p.name), _n(p.value, ".6g"), _n(p.std, ".3g"), _n(p.t, ".2f"),
-            sig, _e(words.get(p.status, p.status)), _e(t(p.reason)),
-        ])  # fmt: skip
+        rows.append(
+            [
+                _e(p.camera),
+                _e(p.name),
+                _n(p.value, ".6g"),
+                _n(p.std, ".3g"),
+                _n(p.t, ".2f"),
+                sig,
+                _e(words.get(p.status, p.status)),
+                _e(t(p.reason)),
+            ]
+        )
         css.append("drop" if p.status == "dropped" else "")
-    head = [t("camera"), t("parameter"), t("value"), t("std"), "t",
-            t("significant ({})").format(alpha_text), t("status"), t("reason")]  # fmt: skip
+    head = [
+        t("camera"),
+        t("parameter"),
+        t("value"),
+        t("std"),
+        "t",
+        t("significant ({})").format(alpha_text),
+        t("status"),
+        t("reason"),
+    ]
     return _table(head, rows, css)
 
 
@@ -149,8 +224,13 @@ def _block_map(res: BundleResult) -> list[str]:
     tie = xyz[role == "tie", :2]
     # a deterministic thinning: every k-th tie point, at most about 3,000 dots
     tie = tie[:: max(1, len(tie) // 3000)]
-    bm = BlockMap(np.asarray(res.eo.xyz)[:, :2], prints, xyz[role == "control", :2],
-                  xyz[role == "check", :2], tie)  # fmt: skip
+    bm = BlockMap(
+        np.asarray(res.eo.xyz)[:, :2],
+        prints,
+        xyz[role == "control", :2],
+        xyz[role == "check", :2],
+        tie,
+    )
     svg = block_map_svg(bm, title=t("Image overlap, control and check points"))
     return [f"<h2>{t('Block map')}</h2>", '<div class="plots">', svg, "</div>"]
 
@@ -206,8 +286,10 @@ def render_bundle_html(
         ]
     parts += [f"<h2>{t('Adjustment')}</h2>", _adjustment(res)]
     parts += _block_map(res)
-    parts += [f"<h2>{t('Interior orientation and additional parameters')}</h2>",
-              _interior(res, alpha_text)]  # fmt: skip
+    parts += [
+        f"<h2>{t('Interior orientation and additional parameters')}</h2>",
+        _interior(res, alpha_text),
+    ]
     parts += _selection(res, max_correlation)
     parts += _lens_plots(res)
     parts += _mount(res)
@@ -217,8 +299,11 @@ def render_bundle_html(
     parts += _residuals(res)
     parts += _scale_bars(res)
     if res.warnings:
-        parts += [f"<h2>{t('Warnings')}</h2><ul>",
-                  *(f"<li>{_e(t(w))}</li>" for w in res.warnings), "</ul>"]  # fmt: skip
+        parts += [
+            f"<h2>{t('Warnings')}</h2><ul>",
+            *(f"<li>{_e(t(w))}</li>" for w in res.warnings),
+            "</ul>",
+        ]
     parts.append("</body></html>")
     return _in_unit("\n".join(parts), _unit(res))
 
@@ -238,15 +323,19 @@ def _selection(res: BundleResult, max_correlation: float) -> list[str]:
         parts.append(
             "<p>"
             + t("|correlation| above {} in the final adjustment: ").format(f"{max_correlation:g}")
-            + "; ".join(f"{_e(c)} {_e(a)} / {_e(b)}: {r:+.3f}"
-                        for c, a, b, r in res.flagged_correlations)
+            + "; ".join(
+                f"{_e(c)} {_e(a)} / {_e(b)}: {r:+.3f}" for c, a, b, r in res.flagged_correlations
+            )
             + "</p>"
         )
     plots = []
     for cam, (names, corr) in res.interior_correlation.items():
         if len(names) > 1:
-            plots.append(correlation_heatmap(names, corr, title=t("Correlations: {}").format(cam),
-                                             flag=max_correlation))  # fmt: skip
+            plots.append(
+                correlation_heatmap(
+                    names, corr, title=t("Correlations: {}").format(cam), flag=max_correlation
+                )
+            )
     if plots:
         parts += ['<div class="plots">', *plots, "</div>"]
     return parts
@@ -257,15 +346,30 @@ def _mount(res: BundleResult) -> list[str]:
     parts: list[str] = []
     if res.mount is not None:
         m = res.mount
-        rows = [[_e(n), _n(v, ".4f"), _n(s, ".4f")] for n, v, s in zip(
-            (t("lever dx (m)"), t("lever dy (m)"), t("lever dz (m)")), m["lever_arm_m"],
-            m["lever_arm_std_m"])]  # fmt: skip
-        rows += [[_e(n), _n(np.degrees(v), ".5f"), _n(np.degrees(s), ".5f")] for n, v, s in zip(
-            (t("boresight d_omega (deg)"), t("boresight d_phi (deg)"),
-             t("boresight d_kappa (deg)")),
-            m["boresight_rad"], m["boresight_std_rad"])]  # fmt: skip
-        parts += [f"<h2>{t('Lever arm and boresight corrections (camera axes)')}</h2>",
-                  _table([t("parameter"), t("value"), t("std")], rows)]  # fmt: skip
+        rows = [
+            [_e(n), _n(v, ".4f"), _n(s, ".4f")]
+            for n, v, s in zip(
+                (t("lever dx (m)"), t("lever dy (m)"), t("lever dz (m)")),
+                m["lever_arm_m"],
+                m["lever_arm_std_m"],
+            )
+        ]
+        rows += [
+            [_e(n), _n(np.degrees(v), ".5f"), _n(np.degrees(s), ".5f")]
+            for n, v, s in zip(
+                (
+                    t("boresight d_omega (deg)"),
+                    t("boresight d_phi (deg)"),
+                    t("boresight d_kappa (deg)"),
+                ),
+                m["boresight_rad"],
+                m["boresight_std_rad"],
+            )
+        ]
+        parts += [
+            f"<h2>{t('Lever arm and boresight corrections (camera axes)')}</h2>",
+            _table([t("parameter"), t("value"), t("std")], rows),
+        ]
     return parts
 
 
@@ -277,14 +381,35 @@ def _images(res: BundleResult) -> list[str]:
     for k, im in enumerate(res.eo.image_id):
         rc, rr = res.image_rms[im]
         n_used = int(np.sum(res.used & (np.array(res.observations.image_id) == im)))
-        rows.append([_e(im), _e(res.image_camera[k]), _e(n_used), _n(rc), _n(rr),
-                     *(_n(v, ".3f") for v in res.eo_sigma[k, :3]),
-                     *(_n(np.degrees(v) * 3600, ".1f") for v in res.eo_sigma[k, 3:])])  # fmt: skip
+        rows.append(
+            [
+                _e(im),
+                _e(res.image_camera[k]),
+                _e(n_used),
+                _n(rc),
+                _n(rr),
+                *(_n(v, ".3f") for v in res.eo_sigma[k, :3]),
+                *(_n(np.degrees(v) * 3600, ".1f") for v in res.eo_sigma[k, 3:]),
+            ]
+        )
     parts += [
         f"<h2>{t('Images')}</h2>",
-        _table([t("image"), t("camera"), t("points used"), t("RMS col (px)"), t("RMS row (px)"),
-                "sigma X (m)", "sigma Y (m)", "sigma Z (m)", 'sigma omega (")', 'sigma phi (")',
-                'sigma kappa (")'], rows),
+        _table(
+            [
+                t("image"),
+                t("camera"),
+                t("points used"),
+                t("RMS col (px)"),
+                t("RMS row (px)"),
+                "sigma X (m)",
+                "sigma Y (m)",
+                "sigma Z (m)",
+                'sigma omega (")',
+                'sigma phi (")',
+                'sigma kappa (")',
+            ],
+            rows,
+        ),
     ]
     return parts
 
@@ -296,9 +421,10 @@ def _check_points(res: BundleResult) -> list[str]:
     if len(c.point_id):
         st = c.statistics()
         d = c.discrepancy
-        rows = [[_e(p), *(_n(v) for v in dd), _n(math.hypot(dd[0], dd[1])),
-                 *(_n(v) for v in s), _e(n)]
-                for p, dd, s, n in zip(c.point_id, d, c.sigma, c.n_images)]  # fmt: skip
+        rows = [
+            [_e(p), *(_n(v) for v in dd), _n(math.hypot(dd[0], dd[1])), *(_n(v) for v in s), _e(n)]
+            for p, dd, s, n in zip(c.point_id, d, c.sigma, c.n_images)
+        ]
         parts += [
             f"<h2>{t('Check points (not in the adjustment)')}</h2>",
             "<p>"
@@ -307,12 +433,29 @@ def _check_points(res: BundleResult) -> list[str]:
                 "{} m; RMSE_E / RMSE_N / RMSE_U {} / {} / {} m; RMSE_3D {} m. Intersected with "
                 "the adjusted orientations; their sigmas carry the image noise only."
             ).format(
-                _n(st["mean_planimetric"]), _n(st["std_planimetric"]), _n(st["rms_planimetric"]),
-                _n(st["rms_e"]), _n(st["rms_n"]), _n(st["rms_h"]), _n(st["rms_3d"]),
+                _n(st["mean_planimetric"]),
+                _n(st["std_planimetric"]),
+                _n(st["rms_planimetric"]),
+                _n(st["rms_e"]),
+                _n(st["rms_n"]),
+                _n(st["rms_h"]),
+                _n(st["rms_3d"]),
             )
             + "</p>",
-            _table([t("point"), "dE (m)", "dN (m)", "dU (m)", "dHorizontal (m)", "sigma E (m)",
-                    "sigma N (m)", "sigma H (m)", t("images")], rows),
+            _table(
+                [
+                    t("point"),
+                    "dE (m)",
+                    "dN (m)",
+                    "dU (m)",
+                    "dHorizontal (m)",
+                    "sigma E (m)",
+                    "sigma N (m)",
+                    "sigma H (m)",
+                    t("images"),
+                ],
+                rows,
+            ),
         ]
     return parts
 
@@ -329,10 +472,17 @@ def _residuals(res: BundleResult) -> list[str]:
     for name, camera in res.cameras.items():
         sel = res.used & (cam_of_obs == name)
         if sel.any():
-            plots.append(image_vector_field(
-                obs.pixels[sel, 0], obs.pixels[sel, 1], res.v_px[sel, 0], res.v_px[sel, 1],
-                camera.width_px, camera.height_px,
-                title=t("Image residuals: {}").format(name)))  # fmt: skip
+            plots.append(
+                image_vector_field(
+                    obs.pixels[sel, 0],
+                    obs.pixels[sel, 1],
+                    res.v_px[sel, 0],
+                    res.v_px[sel, 1],
+                    camera.width_px,
+                    camera.height_px,
+                    title=t("Image residuals: {}").format(name),
+                )
+            )
     used_v = res.v_px[res.used]
     if used_v.size:
         plots.append(histogram(used_v[:, 0], title=t("v col"), xlabel=t("residual (px)")))
@@ -341,13 +491,22 @@ def _residuals(res: BundleResult) -> list[str]:
         parts += [f"<h2>{t('Residuals')}</h2>", '<div class="plots">', *plots, "</div>"]
     if res.rejected.any():
         rej = np.flatnonzero(res.rejected)[:200]
-        rows = [[_e(obs.image_id[i]), _e(obs.point_id[i]), _n(res.v_px[i, 0], ".2f"),
-                 _n(res.v_px[i, 1], ".2f"), _n(res.w[i, 0], ".2f"), _n(res.w[i, 1], ".2f")]
-                for i in rej]  # fmt: skip
+        rows = [
+            [
+                _e(obs.image_id[i]),
+                _e(obs.point_id[i]),
+                _n(res.v_px[i, 0], ".2f"),
+                _n(res.v_px[i, 1], ".2f"),
+                _n(res.w[i, 0], ".2f"),
+                _n(res.w[i, 1], ".2f"),
+            ]
+            for i in rej
+        ]
         title = t("Rejected measurements ({})").format(int(res.rejected.sum()))
-        parts += [f"<h2>{title}</h2>",
-                  _table([t("image"), t("point"), t("v col"), t("v row"), t("w col"),
-                          t("w row")], rows)]  # fmt: skip
+        parts += [
+            f"<h2>{title}</h2>",
+            _table([t("image"), t("point"), t("v col"), t("v row"), t("w col"), t("w row")], rows),
+        ]
     return parts
 
 
@@ -370,12 +529,45 @@ def _scale_bars(res: BundleResult) -> list[str]:
     b = res.scale_bars
     if b is None:
         return []
-    rows = [[_e(f"{pa} - {pb}"), _n(d, ".6g"), _n(s, ".3g"), _n(a, ".6g"), _n(sa, ".3g"),
-             _n(v, ".3g"), _n(w, ".2f"), _n(r, ".2f"), _e(t("rejected") if rej else "")]
-            for pa, pb, d, s, a, sa, v, w, r, rej in zip(
-                b.bars.point_a, b.bars.point_b, b.bars.distance, b.bars.sigma, b.adjusted,
-                b.sigma, b.v, b.w, b.redundancy, b.rejected)]  # fmt: skip
-    return [f"<h2>{t('Scale bars')}</h2>",
-            _table([t("bar"), t("distance (m)"), t("sigma (m)"), t("adjusted (m)"),
-                    t("adjusted sigma (m)"), t("v (m)"), "w", t("redundancy"), t("status")],
-                   rows)]  # fmt: skip
+    rows = [
+        [
+            _e(f"{pa} - {pb}"),
+            _n(d, ".6g"),
+            _n(s, ".3g"),
+            _n(a, ".6g"),
+            _n(sa, ".3g"),
+            _n(v, ".3g"),
+            _n(w, ".2f"),
+            _n(r, ".2f"),
+            _e(t("rejected") if rej else ""),
+        ]
+        for pa, pb, d, s, a, sa, v, w, r, rej in zip(
+            b.bars.point_a,
+            b.bars.point_b,
+            b.bars.distance,
+            b.bars.sigma,
+            b.adjusted,
+            b.sigma,
+            b.v,
+            b.w,
+            b.redundancy,
+            b.rejected,
+        )
+    ]
+    return [
+        f"<h2>{t('Scale bars')}</h2>",
+        _table(
+            [
+                t("bar"),
+                t("distance (m)"),
+                t("sigma (m)"),
+                t("adjusted (m)"),
+                t("adjusted sigma (m)"),
+                t("v (m)"),
+                "w",
+                t("redundancy"),
+                t("status"),
+            ],
+            rows,
+        ),
+    ]

@@ -55,7 +55,8 @@ def render_calibration_html(result: Any, settings: Mapping[str, str]) -> str:
         f'<html lang="{html_lang()}"><head><meta charset="utf-8">',
         f"<title>{t('Camera calibration')}</title>",
         f"<style>{_CSS}</style></head><body>",
-        "<h1>" + t("Camera calibration: {} ({})").format(_e(cam.name), _e(cam.projection))
+        "<h1>"
+        + t("Camera calibration: {} ({})").format(_e(cam.name), _e(cam.projection))
         + "</h1>",
         f'<p class="note">lidarphoto {_e(__version__)}. '
         + t(
@@ -73,26 +74,43 @@ def render_calibration_html(result: Any, settings: Mapping[str, str]) -> str:
             "f = {} px, principal point ({}, {}) px; RMS {} px over {} points; sigma0 {} "
             "(a-priori {} px), redundancy {}, global test {}."
         ).format(
-            _n(cam.focal_px, ".3f"), _n(cx, ".2f"), _n(cy, ".2f"), _n(result.rms_px, ".3f"),
-            result.n_points, _n(result.sigma0, ".3f"), _n(result.sigma_px, ".3g"),
+            _n(cam.focal_px, ".3f"),
+            _n(cx, ".2f"),
+            _n(cy, ".2f"),
+            _n(result.rms_px, ".3f"),
+            result.n_points,
+            _n(result.sigma0, ".3f"),
+            _n(result.sigma_px, ".3g"),
             result.redundancy,
             t("passed") if result.adjustment.global_test.passed else t("FAILED"),
         )
         + "</p>",
-    ]  # fmt: skip
+    ]
     rows, css = [], []
     values = dict(zip(cam.interior_names, cam.interior_params))
     for name in cam.interior_names:
         sig = result.sigmas.get(name)
         tv = result.t_values.get(name)
         sig_px = _n(sig / ps, ".3f") if sig is not None and name.endswith("_mm") else ""
-        verdict = "" if tv is None else (t("significant") if result.significant[name]
-                                         else t("not significant"))  # fmt: skip
-        rows.append([_e(name), _n(values[name], ".6g"), _n(sig, ".3g") if sig else t("fixed"),
-                     sig_px, _n(tv, ".2f") if tv is not None else "", verdict])  # fmt: skip
+        verdict = (
+            ""
+            if tv is None
+            else (t("significant") if result.significant[name] else t("not significant"))
+        )
+        rows.append(
+            [
+                _e(name),
+                _n(values[name], ".6g"),
+                _n(sig, ".3g") if sig else t("fixed"),
+                sig_px,
+                _n(tv, ".2f") if tv is not None else "",
+                verdict,
+            ]
+        )
         css.append("" if tv is None else ("pass" if result.significant[name] else "fail"))
-    parts.append(_table([t("parameter"), t("value"), "sigma", "sigma (px)", "t", t("test")],
-                        rows, css))  # fmt: skip
+    parts.append(
+        _table([t("parameter"), t("value"), "sigma", "sigma (px)", "t", t("test")], rows, css)
+    )
     names = list(result.parameter_names)
     corr = np.asarray(result.correlation)
     crow, ccss = [], []
@@ -109,15 +127,34 @@ def render_calibration_html(result: Any, settings: Mapping[str, str]) -> str:
             lens_radial_profile(cam, title=t("Radial profile: {}").format(cam.name)),
             "</div>",
         ]
-    vrows = [[_e(v), str(int(p)), _n(r, ".3f"), *(_n(x, ".4f") for x in e[:3]),
-              *(_n(math.degrees(a), ".3f") for a in e[3:])]
-             for v, p, r, e in zip(result.view_names, result.view_points, result.view_rms_px,
-                                   result.eo)]  # fmt: skip
-    vhead = [t("view"), t("points"), "RMS (px)", "X0", "Y0", "Z0", "omega (deg)", "phi (deg)",
-             "kappa (deg)"]  # fmt: skip
+    vrows = [
+        [
+            _e(v),
+            str(int(p)),
+            _n(r, ".3f"),
+            *(_n(x, ".4f") for x in e[:3]),
+            *(_n(math.degrees(a), ".3f") for a in e[3:]),
+        ]
+        for v, p, r, e in zip(result.view_names, result.view_points, result.view_rms_px, result.eo)
+    ]
+    vhead = [
+        t("view"),
+        t("points"),
+        "RMS (px)",
+        "X0",
+        "Y0",
+        "Z0",
+        "omega (deg)",
+        "phi (deg)",
+        "kappa (deg)",
+    ]
     parts += [f"<h2>{t('Views')}</h2>", _table(vhead, vrows)]
     if result.warnings:
-        parts += [f"<h2>{t('Warnings')}</h2>", "<ul>",
-                  *(f"<li>{_e(t(w))}</li>" for w in result.warnings), "</ul>"]  # fmt: skip
+        parts += [
+            f"<h2>{t('Warnings')}</h2>",
+            "<ul>",
+            *(f"<li>{_e(t(w))}</li>" for w in result.warnings),
+            "</ul>",
+        ]
     parts.append("</body></html>")
     return "\n".join(parts)

@@ -23,11 +23,14 @@ from .html_table import table as _table
 
 __all__ = ["png_data_uri", "render_location_html"]
 
-_CSS = report_css(1200, (
-    ".note{font-size:12px;color:#444}\n"
-    "figure{display:inline-block;margin:6px;padding:4px;border:1px solid #ccc;font-size:12px}\n"
-    "figure.fail{border-color:#c33}img{image-rendering:pixelated;margin:2px}"
-))
+_CSS = report_css(
+    1200,
+    (
+        ".note{font-size:12px;color:#444}\n"
+        "figure{display:inline-block;margin:6px;padding:4px;border:1px solid #ccc;font-size:12px}\n"
+        "figure.fail{border-color:#c33}img{image-rendering:pixelated;margin:2px}"
+    ),
+)
 
 
 def png_data_uri(grey: np.ndarray | None, zoom: int = 4) -> str:
@@ -56,8 +59,7 @@ def png_data_uri(grey: np.ndarray | None, zoom: int = 4) -> str:
 
 def _word(text: str) -> str:
     """A status or source word of a pair (``ok``, ``rejected``...) in the report's language."""
-    words = {"ok": t("ok"), "rejected": t("rejected"), "outside": t("outside"),
-             "chip": t("chip")}  # fmt: skip
+    words = {"ok": t("ok"), "rejected": t("rejected"), "outside": t("outside"), "chip": t("chip")}
     return words.get(text) or t(text)
 
 
@@ -99,15 +101,43 @@ def render_location_html(pairs: Sequence[LocatedPair], settings: Mapping[str, st
     ]
     rows, css = [], []
     for p in pairs:
-        rows.append([_e(p.point_id), _e(p.image_id), _e(_word(p.status)), _e(t(p.reason)),
-                     _e(_word(p.source) if p.image_id else ""), _n(p.col, 3), _n(p.row, 3),
-                     _n(p.sigma_col, 4), _n(p.sigma_row, 4), _n(p.ncc, 3),
-                     _n(p.lsm_correlation, 3), str(p.template_px or "")])  # fmt: skip
+        rows.append(
+            [
+                _e(p.point_id),
+                _e(p.image_id),
+                _e(_word(p.status)),
+                _e(t(p.reason)),
+                _e(_word(p.source) if p.image_id else ""),
+                _n(p.col, 3),
+                _n(p.row, 3),
+                _n(p.sigma_col, 4),
+                _n(p.sigma_row, 4),
+                _n(p.ncc, 3),
+                _n(p.lsm_correlation, 3),
+                str(p.template_px or ""),
+            ]
+        )
         css.append("pass" if p.status == "ok" else "fail")
-    parts.append(_table([t("point"), t("image"), t("status"), t("reason"), t("source"),
-                         "col", t("row"), "sigma col", t("sigma row"), "NCC", t("LSM corr."),
-                         t("template px")],
-                        rows, css))  # fmt: skip
+    parts.append(
+        _table(
+            [
+                t("point"),
+                t("image"),
+                t("status"),
+                t("reason"),
+                t("source"),
+                "col",
+                t("row"),
+                "sigma col",
+                t("sigma row"),
+                "NCC",
+                t("LSM corr."),
+                t("template px"),
+            ],
+            rows,
+            css,
+        )
+    )
     parts.append(f"<h2>{t('Chip gallery')}</h2>")
     parts.append(
         '<p class="note">'
@@ -121,8 +151,10 @@ def render_location_html(pairs: Sequence[LocatedPair], settings: Mapping[str, st
         cap = t("{} in {}: {}").format(_e(p.point_id), _e(p.image_id), _e(_word(p.status)))
         if p.reason:
             cap += f" ({_e(t(p.reason))})"
-        parts.append(f'<figure{cls}><img alt="chip" src="{png_data_uri(p.chip_patch)}">'
-                     f'<img alt="image" src="{png_data_uri(p.image_patch)}">'
-                     f"<figcaption>{cap}</figcaption></figure>")  # fmt: skip
+        parts.append(
+            f'<figure{cls}><img alt="chip" src="{png_data_uri(p.chip_patch)}">'
+            f'<img alt="image" src="{png_data_uri(p.image_patch)}">'
+            f"<figcaption>{cap}</figcaption></figure>"
+        )
     parts.append("</body></html>")
     return "\n".join(parts)

@@ -31,14 +31,15 @@ def report_css(max_width_px: int, rest: str, *, h2_top_px: int = 26, h3: str = "
     return (
         f"\nbody{{font-family:sans-serif;margin:24px;color:#222;max-width:{max_width_px}px}}\n"
         f"h1{{font-size:22px}}h2{{font-size:18px;border-bottom:1px solid #aaa;"
-        f"margin-top:{h2_top_px}px}}\n" + (f"{h3}\n" if h3 else "")
+        f"margin-top:{h2_top_px}px}}\n"
+        + (f"{h3}\n" if h3 else "")
         + "table{border-collapse:collapse;margin:8px 0 16px 0;font-size:13px}\n"
         "th,td{border:1px solid #bbb;padding:3px 7px;text-align:right}\n"
         "th{background:#eee}td.t,th.t{text-align:left}\n"
         # printed (the PDF): a heading stays with what follows, a plot or row is not cut
         "h2,h3{page-break-after:avoid}svg,tr{page-break-inside:avoid}\n"
         ".pass{background:#d8f0d8}.fail{background:#f7d4d4}" + rest + "\n"
-    )  # fmt: skip
+    )
 
 
 def escape(text: object) -> str:

@@ -96,9 +96,13 @@ def lens_radial_profile(camera: Any, *, title: str, samples: int = 60) -> str:
     """
     ppx, ppy = camera.principal_point_px
     corners = np.array(
-        [[0.0, 0.0], [camera.width_px, 0.0], [0.0, camera.height_px],
-         [camera.width_px, camera.height_px]]
-    )  # fmt: skip
+        [
+            [0.0, 0.0],
+            [camera.width_px, 0.0],
+            [0.0, camera.height_px],
+            [camera.width_px, camera.height_px],
+        ]
+    )
     far = corners[np.argmax(np.hypot(corners[:, 0] - ppx, corners[:, 1] - ppy))]
     s = np.linspace(0.0, 1.0, samples)
     cr = np.column_stack([ppx + s * (far[0] - ppx), ppy + s * (far[1] - ppy)])

@@ -45,10 +45,23 @@ __all__ = ["LIDAR_JSON_TOP_KEYS", "LidarAccuracyReport", "LidarCloud", "assess_l
 #: The top-level keys of the JSON (docs/formats.md "LiDAR accuracy"); the last two only when
 #: check points were given.
 LIDAR_JSON_TOP_KEYS = (
-    "standard", "source", "swath_method", "swaths", "grid", "cells", "pairs", "overall",
-    "within_swath", "limits", "raster_bands", "verdicts", "notes", "options", "vertical",
+    "standard",
+    "source",
+    "swath_method",
+    "swaths",
+    "grid",
+    "cells",
+    "pairs",
+    "overall",
+    "within_swath",
+    "limits",
+    "raster_bands",
+    "verdicts",
+    "notes",
+    "options",
+    "vertical",
     "check_points",
-)  # fmt: skip
+)
 
 
 @dataclass(frozen=True)
@@ -137,12 +150,20 @@ def _relative_verdicts(
         enough = st["n"] >= o.min_pair_cells
         few = "" if enough else f"; only {st['n']} of {o.min_pair_cells} smooth cells"
         if lim is None:
-            for what, key, factor in (("RMSDz", "rmsdz", SWATH_RMSDZ_FACTOR),
-                                      ("max |dz|", "max_abs", SWATH_MAX_FACTOR)):  # fmt: skip
+            for what, key, factor in (
+                ("RMSDz", "rmsdz", SWATH_RMSDZ_FACTOR),
+                ("max |dz|", "max_abs", SWATH_MAX_FACTOR),
+            ):
                 v = st[key]
-                out.append(Verdict(f"{name}: {what}", "info" if enough else "insufficient",
-                                   f"{what} = {_cm(v)} on {st['n']} cells: "
-                                   f"{_class_met(v, factor)}{few}", v, None))  # fmt: skip
+                out.append(
+                    Verdict(
+                        f"{name}: {what}",
+                        "info" if enough else "insufficient",
+                        f"{what} = {_cm(v)} on {st['n']} cells: {_class_met(v, factor)}{few}",
+                        v,
+                        None,
+                    )
+                )
             continue
         out.append(
             _limit_verdict(
@@ -166,45 +187,89 @@ def _relative_verdicts(
         name = f"swath {p.swath}: within-swath precision (Max Diff)"
         enough = p.cells >= o.min_pair_cells
         if lim is None:
-            out.append(Verdict(name, "info" if enough else "insufficient",
-                               f"largest cell range {_cm(p.range_max)} on {p.cells} cells "
-                               f"(95th percentile {_cm(p.range_p95)}): "
-                               f"{_class_met(p.range_max, WITHIN_SWATH_FACTOR)}",
-                               p.range_max, None))  # fmt: skip
+            out.append(
+                Verdict(
+                    name,
+                    "info" if enough else "insufficient",
+                    f"largest cell range {_cm(p.range_max)} on {p.cells} cells "
+                    f"(95th percentile {_cm(p.range_p95)}): "
+                    f"{_class_met(p.range_max, WITHIN_SWATH_FACTOR)}",
+                    p.range_max,
+                    None,
+                )
+            )
         else:
-            verdict = _limit_verdict(name, p.range_max, lim["within_swath_max"], enough,
-                                     f"largest cell range on {p.cells} cells")  # fmt: skip
+            verdict = _limit_verdict(
+                name,
+                p.range_max,
+                lim["within_swath_max"],
+                enough,
+                f"largest cell range on {p.cells} cells",
+            )
             m = (cells.swath == p.swath) & cells.smooth
             share = (
                 float(np.mean(cells.range[m] <= lim["within_swath_max"] + _TOL)) if p.cells else 0.0
             )
-            out.append(replace(verdict, reason=f"{verdict.reason}; {share:.1%} of the cells "
-                               f"within it, 95th percentile {_cm(p.range_p95)}"))  # fmt: skip
+            out.append(
+                replace(
+                    verdict,
+                    reason=f"{verdict.reason}; {share:.1%} of the cells "
+                    f"within it, 95th percentile {_cm(p.range_p95)}",
+                )
+            )
     return out
 
 
 def _vertical_verdicts(f: VerticalFigures, o: LidarAccuracyOptions) -> list[Verdict]:
     out = []
     enough = f.nva_n >= NVA_MIN_CHECKPOINTS
-    out.append(Verdict("NVA check-point count", "pass" if enough else "insufficient",
-                       f"{f.nva_n} non-vegetated check points; Ed. 2 requires at least "
-                       f"{NVA_MIN_CHECKPOINTS}", float(f.nva_n), float(NVA_MIN_CHECKPOINTS),
-                       unit="points"))  # fmt: skip
+    out.append(
+        Verdict(
+            "NVA check-point count",
+            "pass" if enough else "insufficient",
+            f"{f.nva_n} non-vegetated check points; Ed. 2 requires at least {NVA_MIN_CHECKPOINTS}",
+            float(f.nva_n),
+            float(NVA_MIN_CHECKPOINTS),
+            unit="points",
+        )
+    )
     if o.v_class_cm > 0:
-        out.append(_limit_verdict(f"NVA class {o.v_class_cm:g}-cm", f.nva_rmse_v,
-                                  o.v_class_cm / 100.0, enough, "RMSE_V"))  # fmt: skip
+        out.append(
+            _limit_verdict(
+                f"NVA class {o.v_class_cm:g}-cm",
+                f.nva_rmse_v,
+                o.v_class_cm / 100.0,
+                enough,
+                "RMSE_V",
+            )
+        )
     else:
-        out.append(Verdict("NVA class", "info" if enough else "insufficient",
-                           f"RMSE_V = {_cm(f.nva_rmse_v)}: meets any class of at least that",
-                           f.nva_rmse_v, None))  # fmt: skip
+        out.append(
+            Verdict(
+                "NVA class",
+                "info" if enough else "insufficient",
+                f"RMSE_V = {_cm(f.nva_rmse_v)}: meets any class of at least that",
+                f.nva_rmse_v,
+                None,
+            )
+        )
     vva_enough = f.vva_n >= VVA_MIN_CHECKPOINTS
-    guide = (f"; the class's VVA guidance is {VVA_FACTOR:g} x {o.v_class_cm:g} cm"
-             if o.v_class_cm > 0 else "")  # fmt: skip
-    out.append(Verdict("VVA (reported, no pass/fail in Ed. 2)",
-                       "info" if vva_enough else "insufficient",
-                       f"{f.vva_n} vegetated check points (at least {VVA_MIN_CHECKPOINTS}): "
-                       f"RMSE {_cm(f.vva_rmse)}, 95th percentile of |dz| {_cm(f.vva_p95)}"
-                       f"{guide}", f.vva_rmse, None))  # fmt: skip
+    guide = (
+        f"; the class's VVA guidance is {VVA_FACTOR:g} x {o.v_class_cm:g} cm"
+        if o.v_class_cm > 0
+        else ""
+    )
+    out.append(
+        Verdict(
+            "VVA (reported, no pass/fail in Ed. 2)",
+            "info" if vva_enough else "insufficient",
+            f"{f.vva_n} vegetated check points (at least {VVA_MIN_CHECKPOINTS}): "
+            f"RMSE {_cm(f.vva_rmse)}, 95th percentile of |dz| {_cm(f.vva_p95)}"
+            f"{guide}",
+            f.vva_rmse,
+            None,
+        )
+    )
     return out
 
 
@@ -232,12 +297,16 @@ def assess_lidar(
     names, counts = np.unique(swath, return_counts=True)
     grid = grid or CellGrid.covering(cloud.x, cloud.y, o.cell_size)
     stop_if_asked(should_stop, "fitting the cells")
-    cells = swath_cells(cloud.x, cloud.y, cloud.z, swath, grid, o,
-                        cloud.classification, cloud.number_of_returns)  # fmt: skip
+    cells = swath_cells(
+        cloud.x, cloud.y, cloud.z, swath, grid, o, cloud.classification, cloud.number_of_returns
+    )
     if progress is not None:
         progress(0.6)
-    headings = (swath_headings(swath, cloud.x, cloud.y, cloud.gps_time)
-                if cloud.gps_time is not None else {})  # fmt: skip
+    headings = (
+        swath_headings(swath, cloud.x, cloud.y, cloud.gps_time)
+        if cloud.gps_time is not None
+        else {}
+    )
     ground = None
     if checkpoints is not None and len(checkpoints.ids):
         cls = cloud.classification
@@ -245,9 +314,16 @@ def assess_lidar(
         ground = np.column_stack([cloud.x[keep], cloud.y[keep], cloud.z[keep]])
     stop_if_asked(should_stop, "comparing the swaths")
     report = report_from_cells(
-        cells, grid, o, method, {int(s): int(n) for s, n in zip(names, counts)}, headings,
-        checkpoints, ground, cloud.source,
-    )  # fmt: skip
+        cells,
+        grid,
+        o,
+        method,
+        {int(s): int(n) for s, n in zip(names, counts)},
+        headings,
+        checkpoints,
+        ground,
+        cloud.source,
+    )
     if progress is not None:
         progress(1.0)
     return report
@@ -281,17 +357,30 @@ def report_from_cells(
     vertical = None
     if checkpoints is not None and len(checkpoints.ids) and ground_xyz is not None:
         heights = ground_tin_heights(ground_xyz, checkpoints.xyz[:, :2], o.tin_radius)
-        vertical = vertical_figures(checkpoints.ids, checkpoints.xyz[:, 2],
-                                    checkpoints.groups, heights, o)  # fmt: skip
+        vertical = vertical_figures(
+            checkpoints.ids, checkpoints.xyz[:, 2], checkpoints.groups, heights, o
+        )
         verdicts += _vertical_verdicts(vertical, o)
         if vertical.outside:
-            notes.append(f"{len(vertical.outside)} check point(s) outside the ground TIN, not "
-                         f"assessed: {', '.join(vertical.outside)}")  # fmt: skip
+            notes.append(
+                f"{len(vertical.outside)} check point(s) outside the ground TIN, not "
+                f"assessed: {', '.join(vertical.outside)}"
+            )
     return LidarAccuracyReport(
-        options=o, swath_method=method, swath_counts=swath_counts, grid=grid, cells=cells,
-        pairs=pairs, precision=precision, overall=overall, verdicts=tuple(verdicts),
-        vertical=vertical, checkpoints=checkpoints, notes=tuple(notes), source=source,
-    )  # fmt: skip
+        options=o,
+        swath_method=method,
+        swath_counts=swath_counts,
+        grid=grid,
+        cells=cells,
+        pairs=pairs,
+        precision=precision,
+        overall=overall,
+        verdicts=tuple(verdicts),
+        vertical=vertical,
+        checkpoints=checkpoints,
+        notes=tuple(notes),
+        source=source,
+    )
 
 
 def pair_rows(report: LidarAccuracyReport) -> list[dict[str, Any]]:
@@ -352,13 +441,36 @@ def report_dict(report: LidarAccuracyReport, raster_bands: Sequence[str] = ()) -
     f = report.vertical
     if f is not None and report.checkpoints is not None:
         d["vertical"] = {
-            k: getattr(f, k) for k in ("nva_n", "nva_mean", "nva_std", "nva_rmse_v1",
-                                       "nva_rmse_v", "nva_95", "vva_n", "vva_rmse", "vva_p95")
-        }  # fmt: skip
+            k: getattr(f, k)
+            for k in (
+                "nva_n",
+                "nva_mean",
+                "nva_std",
+                "nva_rmse_v1",
+                "nva_rmse_v",
+                "nva_95",
+                "vva_n",
+                "vva_rmse",
+                "vva_p95",
+            )
+        }
         d["check_points"] = [
-            {"id": i, "e": float(p[0]), "n": float(p[1]), "h": float(p[2]), "group": g,
-             "vegetated": bool(v), "lidar_h": float(p[2] + dz), "dz": float(dz)}
-            for i, p, g, v, dz in zip(report.checkpoints.ids, report.checkpoints.xyz,
-                                      report.checkpoints.groups, f.vegetated, f.dz)
-        ]  # fmt: skip
+            {
+                "id": i,
+                "e": float(p[0]),
+                "n": float(p[1]),
+                "h": float(p[2]),
+                "group": g,
+                "vegetated": bool(v),
+                "lidar_h": float(p[2] + dz),
+                "dz": float(dz),
+            }
+            for i, p, g, v, dz in zip(
+                report.checkpoints.ids,
+                report.checkpoints.xyz,
+                report.checkpoints.groups,
+                f.vegetated,
+                f.dz,
+            )
+        ]
     return {k: _finite(x) for k, x in d.items()}  # _finite(d), keeping the dict type

@@ -319,8 +319,9 @@ def finish_cells(fits: Sequence[CellFits], grid: CellGrid, options: LidarAccurac
     gkey = sidx.astype(np.int64) * ncell + c["cell"]
     if np.any(np.diff(gkey) == 0):
         raise ValueError("a cell was fitted in two tiles")
-    step = _continuous(gkey, c["cell"], c["height"], c["gx"], c["gy"], c["solvable"], grid,
-                       options.max_step)  # fmt: skip
+    step = _continuous(
+        gkey, c["cell"], c["height"], c["gx"], c["gy"], c["solvable"], grid, options.max_step
+    )
     tests = [*c["passed"].T, step]
     smooth = np.ones(gkey.size, dtype=bool)
     rejected: dict[str, int] = {}
@@ -347,8 +348,12 @@ def _continuous(
     row, col = np.divmod(gcell, grid.cols)
     c = grid.cell
     for drow, dcol in ((0, 1), (0, -1), (1, 0), (-1, 0)):
-        inside = ((col + dcol >= 0) & (col + dcol < grid.cols) & (row + drow >= 0)
-                  & (row + drow < grid.rows))  # fmt: skip
+        inside = (
+            (col + dcol >= 0)
+            & (col + dcol < grid.cols)
+            & (row + drow >= 0)
+            & (row + drow < grid.rows)
+        )
         want = gkey + drow * grid.cols + dcol
         j = np.clip(np.searchsorted(gkey, want), 0, gkey.size - 1)
         found = inside & (gkey[j] == want) & solvable[j]

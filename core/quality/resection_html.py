@@ -79,14 +79,37 @@ def render_resection_html(
     for r in runs:
         res = r.result.result
         deg = np.degrees(r.result.opk)
-        rows.append([_e(r.image_id), *(_n(x, 3) for x in r.result.xyz),
-                     *(_n(a, 5) for a in deg), str(r.image.data.n_points),
-                     str(r.image.data.n_lines), _n(res.sigma0, 3),
-                     _verdict(res)])  # fmt: skip
+        rows.append(
+            [
+                _e(r.image_id),
+                *(_n(x, 3) for x in r.result.xyz),
+                *(_n(a, 5) for a in deg),
+                str(r.image.data.n_points),
+                str(r.image.data.n_lines),
+                _n(res.sigma0, 3),
+                _verdict(res),
+            ]
+        )
         css.append("pass" if res.chi2_passed and _doubt(res) is None else "fail")
-    parts.append(_table([t("image"), "X (m)", "Y (m)", "Z (m)", "omega (deg)", "phi (deg)",
-                         "kappa (deg)", t("points"), t("lines"), "sigma0", t("test")], rows,
-                        css))  # fmt: skip
+    parts.append(
+        _table(
+            [
+                t("image"),
+                "X (m)",
+                "Y (m)",
+                "Z (m)",
+                "omega (deg)",
+                "phi (deg)",
+                "kappa (deg)",
+                t("points"),
+                t("lines"),
+                "sigma0",
+                t("test"),
+            ],
+            rows,
+            css,
+        )
+    )
     by_image: dict[str, list] = {}
     for row in residuals:
         by_image.setdefault(str(row[0]), []).append(row)
@@ -105,11 +128,16 @@ def _image(r, residuals: list) -> list[str]:
             "Start: {}; line model: {}; {} iterations; {} control points, {} lines, {} check "
             "points, {} rows without control ignored."
         ).format(
-            _e(res.start), _e(res.model), res.iterations, r.image.data.n_points,
-            r.image.data.n_lines, len(r.image.check_rows), r.image.ignored,
+            _e(res.start),
+            _e(res.model),
+            res.iterations,
+            r.image.data.n_points,
+            r.image.data.n_lines,
+            len(r.image.check_rows),
+            r.image.ignored,
         )
         + "</p>"
-    )  # fmt: skip
+    )
     std = r.result.std
     prior = _prior_std(r)
     values = [*r.result.xyz, *np.degrees(r.result.opk)]
@@ -117,54 +145,95 @@ def _image(r, residuals: list) -> list[str]:
     rows = []
     for k, name in enumerate(_NAMES):
         scale = 1.0 if k < 3 else math.degrees(1.0)
-        rows.append([name, _n(values[k], 4 if k < 3 else 6), units[k], _n(std[k] * scale, 5),
-                     _n(prior[k] * scale, 5),
-                     _n(std[k] * 3600 * scale, 2) if k >= 3 else ""])  # fmt: skip
-    out.append(_table([t("parameter"), t("value"), t("unit"), t("std"), t("std a-priori"),
-                       t("std (arcsec)")], rows))  # fmt: skip
+        rows.append(
+            [
+                name,
+                _n(values[k], 4 if k < 3 else 6),
+                units[k],
+                _n(std[k] * scale, 5),
+                _n(prior[k] * scale, 5),
+                _n(std[k] * 3600 * scale, 2) if k >= 3 else "",
+            ]
+        )
+    out.append(
+        _table(
+            [t("parameter"), t("value"), t("unit"), t("std"), t("std a-priori"), t("std (arcsec)")],
+            rows,
+        )
+    )
     if res.interior is not None:
         out.append(f"<h3>{t('Interior orientation (refined)')}</h3>")
-        out.append(_table([t("parameter"), t("value (mm)"), t("std (mm)")], [
-            [n, _n(v, 5), _n(s, 5)] for n, v, s in zip(
-                ("focal", "x0", "y0"), res.interior, res.interior_std)]))  # fmt: skip
+        out.append(
+            _table(
+                [t("parameter"), t("value (mm)"), t("std (mm)")],
+                [
+                    [n, _n(v, 5), _n(s, 5)]
+                    for n, v, s in zip(("focal", "x0", "y0"), res.interior, res.interior_std)
+                ],
+            )
+        )
     gt = res.chi2
     verdict = _verdict(res)
     out.append(f"<h3>{t('Global test')}</h3>")
-    out.append(_table([t("quantity"), t("value")], [
-        [t("observations (condition rows)"), str(res.adjustment.n_observations)],
-        [t("redundancy"), str(res.redundancy)],
-        [t("sigma0 a-posteriori"), _n(res.sigma0, 4)],
-        [t("chi-square statistic v'Pv / sigma0_prior^2"), _n(gt.statistic, 3)],
-        [t("critical value, one-sided 5 % (as the source)"), _n(res.chi2_critical, 3)],
-        [t("two-sided acceptance range"), f"{_n(gt.lower, 3)} .. {_n(gt.upper, 3)}"],
-        [t("verdict (one-sided)"), verdict],
-        [t("condition number (scaled normal matrix)"),
-         f"{res.adjustment.condition_number:.3g}"],
-    ], ["", "", "", "", "", "pass" if res.chi2_passed and _doubt(res) is None else "fail"]
-    ))  # fmt: skip
+    out.append(
+        _table(
+            [t("quantity"), t("value")],
+            [
+                [t("observations (condition rows)"), str(res.adjustment.n_observations)],
+                [t("redundancy"), str(res.redundancy)],
+                [t("sigma0 a-posteriori"), _n(res.sigma0, 4)],
+                [t("chi-square statistic v'Pv / sigma0_prior^2"), _n(gt.statistic, 3)],
+                [t("critical value, one-sided 5 % (as the source)"), _n(res.chi2_critical, 3)],
+                [t("two-sided acceptance range"), f"{_n(gt.lower, 3)} .. {_n(gt.upper, 3)}"],
+                [t("verdict (one-sided)"), verdict],
+                [
+                    t("condition number (scaled normal matrix)"),
+                    f"{res.adjustment.condition_number:.3g}",
+                ],
+            ],
+            ["", "", "", "", "", "pass" if res.chi2_passed and _doubt(res) is None else "fail"],
+        )
+    )
     out.append(f"<h3>{t('Correlation of the six parameters')}</h3>")
     corr = res.correlation
-    out.append(_table(["", *_NAMES], [
-        [name, *(_n(corr[i, j], 2) for j in range(6))] for i, name in enumerate(_NAMES)]))
+    out.append(
+        _table(
+            ["", *_NAMES],
+            [[name, *(_n(corr[i, j], 2) for j in range(6))] for i, name in enumerate(_NAMES)],
+        )
+    )
     used = [row for row in residuals if row[12]]
     pts = [row for row in used if row[2] != "line"]
     lns = [row for row in used if row[2] == "line"]
     chk = [row for row in residuals if not row[12]]
     rows = [
-        [t("control points: RMS |v| (px)"), str(len(pts)),
-         _n(_rms(np.array([row[9] for row in pts])), 3)],
-        [t("line points: RMS distance from the projected line (px)"), str(len(lns)),
-         _n(_rms(np.array([row[9] for row in lns])), 3)],
-        [t("check points: RMS |projected - measured| (px)"), str(len(chk)),
-         _n(_rms(np.array([row[9] for row in chk])), 3)],
-    ]  # fmt: skip
+        [
+            t("control points: RMS |v| (px)"),
+            str(len(pts)),
+            _n(_rms(np.array([row[9] for row in pts])), 3),
+        ],
+        [
+            t("line points: RMS distance from the projected line (px)"),
+            str(len(lns)),
+            _n(_rms(np.array([row[9] for row in lns])), 3),
+        ],
+        [
+            t("check points: RMS |projected - measured| (px)"),
+            str(len(chk)),
+            _n(_rms(np.array([row[9] for row in chk])), 3),
+        ],
+    ]
     out.append(f"<h3>{t('Residuals')}</h3>")
     out.append(_table([t("what"), t("count"), t("value")], rows))
     rejected = [(b.block, b.label, b.row_name, b.w) for b in res.adjustment.rejected]
     if rejected:
         out.append(f"<h3>{t('Rejected by data snooping')}</h3>")
-        out.append(_table([t("block"), "id", t("row"), "w"],
-                          [[_e(b), _e(lab), _e(rn), _n(w, 2)] for b, lab, rn, w in rejected]))
+        out.append(
+            _table(
+                [t("block"), "id", t("row"), "w"],
+                [[_e(b), _e(lab), _e(rn), _n(w, 2)] for b, lab, rn, w in rejected],
+            )
+        )
     if res.warnings:
         out.append('<p class="note">' + "<br>".join(_e(t(w)) for w in res.warnings) + "</p>")
     return out

@@ -28,8 +28,9 @@ ASPRS_EXAMPLE_H_CLASSES_CM = (1.25, 2.5, 5.0, 7.5, 10.0, 12.5, 15.0, 17.5, 20.0,
 ASPRS_EXAMPLE_V_CLASSES_CM = (1.0, 2.5, 5.0, 10.0, 15.0, 20.0, 33.3, 66.7, 100.0, 333.3)
 
 
-def _class_verdict(label: str, sym: str, value: float, target: float | None, examples,
-                   enough: bool, few: str) -> Verdict:  # fmt: skip
+def _class_verdict(
+    label: str, sym: str, value: float, target: float | None, examples, enough: bool, few: str
+) -> Verdict:
     """The verdict of one axis (``label``; RMSE ``value`` in m, its symbol ``sym``): against
     the class ``target`` (cm) when one is given, else the tightest of the ``examples`` met
     (information only); insufficient with too few check points (``few`` says so)."""
@@ -50,13 +51,10 @@ def _class_verdict(label: str, sym: str, value: float, target: float | None, exa
     met = [c for c in examples if value <= c / 100.0 + _TOL]
     best = met[0] if met else None
     reason = _t(
-        "{symbol} = {value:.2f} cm: meets any class of at least {value:.2f} cm"
-        "{example}{few}",
+        "{symbol} = {value:.2f} cm: meets any class of at least {value:.2f} cm{example}{few}",
         symbol=sym,
         value=tightest,
-        example=(
-            _t("; tightest example class met: {best:g}-cm", best=best) if best else ""
-        ),
+        example=(_t("; tightest example class met: {best:g}-cm", best=best) if best else ""),
         few=few,
     )
     return Verdict(
@@ -137,8 +135,11 @@ def asprs_2023(
         (_t("Vertical (NVA)"), rmse_v, v_class_cm, ASPRS_EXAMPLE_V_CLASSES_CM),
     ):
         # the toolkit's name, then the standard's symbol (Table 7.1)
-        sym = ("RMSE_HORIZONTAL_TOTAL (ASPRS RMSE_H)" if label == "Horizontal"
-               else "RMSE_U_TOTAL (ASPRS RMSE_V)")  # fmt: skip
+        sym = (
+            "RMSE_HORIZONTAL_TOTAL (ASPRS RMSE_H)"
+            if label == "Horizontal"
+            else "RMSE_U_TOTAL (ASPRS RMSE_V)"
+        )
         verdicts.append(_class_verdict(label, sym, value, target, examples, enough, few))
     verdicts.append(
         Verdict(

@@ -76,8 +76,9 @@ def bivariate_radius(sigma_x: float, sigma_y: float, probability: float = 0.95) 
             c = math.cos(t)
             return math.exp(-0.5 * (radius * math.sin(t)) ** 2) * math.erf(radius * c * scale) * c
 
-        value, _ = integrate.quad(integrand, 0.0, 0.5 * math.pi, epsabs=1e-13, epsrel=1e-12,
-                                  limit=200)  # fmt: skip
+        value, _ = integrate.quad(
+            integrand, 0.0, 0.5 * math.pi, epsabs=1e-13, epsrel=1e-12, limit=200
+        )
         return 2.0 * radius * value / math.sqrt(2.0 * math.pi)
 
     lo, hi = z, math.sqrt(-2.0 * math.log1p(-probability))
@@ -149,11 +150,17 @@ def nssda(
             _t("Horizontal approximation condition"),
             "pass" if approx_ok else "fail",
             (
-                _t("RMSE_min/RMSE_max = {ratio:.3f} >= 0.6: Accuracy_r = 2.4477 x 0.5 "
-                   "(RMSE_x + RMSE_y)", ratio=ratio)
+                _t(
+                    "RMSE_min/RMSE_max = {ratio:.3f} >= 0.6: Accuracy_r = 2.4477 x 0.5 "
+                    "(RMSE_x + RMSE_y)",
+                    ratio=ratio,
+                )
                 if approx_ok
-                else _t("RMSE_min/RMSE_max = {ratio:.3f} < 0.6: the NSSDA approximation does "
-                        "not hold; exact 95 % radius used", ratio=ratio)
+                else _t(
+                    "RMSE_min/RMSE_max = {ratio:.3f} < 0.6: the NSSDA approximation does "
+                    "not hold; exact 95 % radius used",
+                    ratio=ratio,
+                )
             ),
             ratio,
             0.6,

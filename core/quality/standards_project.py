@@ -21,7 +21,6 @@ __all__ = [
 ]
 
 
-
 def stereo_height_precision(
     flight_height_m: float, base_m: float, focal_mm: float, pixel_um: float
 ) -> float:

@@ -470,9 +470,7 @@ def image_vector_field(
     biggest = float(length.max()) if length.size else 0.0
     cw, chh = pw / nx, ph / ny
     scale = 0.45 * min(cw, chh) / biggest if biggest > 0 else 0.0
-    body = [
-        f'<rect x="{left}" y="{top}" width="{pw}" height="{ph}" fill="white" stroke="#444"/>'
-    ]
+    body = [f'<rect x="{left}" y="{top}" width="{pw}" height="{ph}" fill="white" stroke="#444"/>']
     for gx in range(1, nx):
         x = left + gx * cw
         body.append(f'<line x1="{x:.1f}" y1="{top}" x2="{x:.1f}" y2="{top + ph}" stroke="#eee"/>')

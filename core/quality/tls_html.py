@@ -26,11 +26,17 @@ from .html_table import table as _table
 
 __all__ = ["render_tls_html"]
 
-_CSS = report_css(1200, (
-    ".diag{background:#fbecc4;padding:8px}\n"
-    "table.corr td{padding:2px 4px;font-size:11px}table.corr th{font-size:11px;padding:2px 4px}\n"
-    ".note{font-size:12px;color:#444}.alarm{background:#f7d4d4;border:2px solid #c33;padding:8px}"
-))
+_CSS = report_css(
+    1200,
+    (
+        ".diag{background:#fbecc4;padding:8px}\n"
+        "table.corr td{padding:2px 4px;font-size:11px}"
+        "table.corr th{font-size:11px;padding:2px 4px}\n"
+        ".note{font-size:12px;color:#444}"
+        ".alarm{background:#f7d4d4;border:2px solid #c33;padding:8px}"
+    ),
+)
+
 
 def _design() -> str:
     """How the network design breaks the correlations (Lichti 2010), translated."""
@@ -73,8 +79,10 @@ def _correlation_table(names: Sequence[str], corr: np.ndarray, n_ap: int) -> str
             for j in range(len(names))
         )
         body.append(f'<tr><th class="t">{_e(names[i])}</th>{cells}</tr>')
-    return (f'<div style="overflow-x:auto"><table class="corr"><thead><tr><th></th>{head}'
-            f"</tr></thead><tbody>{''.join(body)}</tbody></table></div>")  # fmt: skip
+    return (
+        f'<div style="overflow-x:auto"><table class="corr"><thead><tr><th></th>{head}'
+        f"</tr></thead><tbody>{''.join(body)}</tbody></table></div>"
+    )
 
 
 def _residual_parts(cal: TlsCalibration) -> list[str]:
@@ -97,8 +105,15 @@ def _residual_parts(cal: TlsCalibration) -> list[str]:
     obs = cal.observations
     out.append(
         _table(
-            [t("station / target"), t("row"), t("v range mm"), 'v hz "', 'v vt "', "max |w|",
-             t("rejected")],
+            [
+                t("station / target"),
+                t("row"),
+                t("v range mm"),
+                'v hz "',
+                'v vt "',
+                "max |w|",
+                t("rejected"),
+            ],
             [
                 (
                     _e(f"{obs.station[k]} / {obs.target[k]}"),
@@ -151,11 +166,21 @@ def _adjustment_parts(cal: TlsCalibration, rejections: RejectionTest | None) -> 
                 ),
                 (t("observations rejected (data snooping)"), str(int(cal.rejected.sum()))),
                 *(
-                    [(t("rejections explained by false alarms"),
-                      t("at most {bound} ({expected} expected); {k} rejected: P = {p}").format(
-                          bound=rejections.bound, expected=f"{rejections.expected:.2g}",
-                          k=rejections.rejected, p=f"{rejections.p_value:.2g}"))]
-                    if rejections is not None else []
+                    [
+                        (
+                            t("rejections explained by false alarms"),
+                            t(
+                                "at most {bound} ({expected} expected); {k} rejected: P = {p}"
+                            ).format(
+                                bound=rejections.bound,
+                                expected=f"{rejections.expected:.2g}",
+                                k=rejections.rejected,
+                                p=f"{rejections.p_value:.2g}",
+                            ),
+                        )
+                    ]
+                    if rejections is not None
+                    else []
                 ),
                 (
                     t("datum"),
@@ -167,8 +192,16 @@ def _adjustment_parts(cal: TlsCalibration, rejections: RejectionTest | None) -> 
                     ),
                 ),
             ],
-            ["", "", "", "", "pass" if gt.passed and (rejections is None or rejections.passed)
-             else "fail", "", "", "" if rejections is None or rejections.passed else "fail"],
+            [
+                "",
+                "",
+                "",
+                "",
+                "pass" if gt.passed and (rejections is None or rejections.passed) else "fail",
+                "",
+                "",
+                "" if rejections is None or rejections.passed else "fail",
+            ],
         ),
     ]
 
@@ -180,9 +213,19 @@ def _ap_parts(cal: TlsCalibration) -> list[str]:
         rows, css = [], []
         for a in cal.ap_report():
             d = 2 if a["unit"] != "mm" else 3
-            rows.append((_e(a["name"]), _e(a["formula"]), _e(a["cause"]), _n(a["value"], d),
-                         _n(a["std"], d), _n(a["std_prior"], d), _e(a["unit"]), _n(a["t"], 2),
-                         t("yes") if a["significant"] else t("no")))  # fmt: skip
+            rows.append(
+                (
+                    _e(a["name"]),
+                    _e(a["formula"]),
+                    _e(a["cause"]),
+                    _n(a["value"], d),
+                    _n(a["std"], d),
+                    _n(a["std_prior"], d),
+                    _e(a["unit"]),
+                    _n(a["t"], 2),
+                    t("yes") if a["significant"] else t("no"),
+                )
+            )
             css.append("" if a["significant"] else "fail")
         out += [
             f"<h2>{t('Additional parameters')}</h2>",
@@ -218,9 +261,16 @@ def _station_parts(cal: TlsCalibration) -> list[str]:
     srows = []
     for k, s in enumerate(cal.stations):
         p, sd = cal.pose[k], cal.pose_std[k]
-        srows.append((_e(s), *(_n(x, 4) for x in p[:3]), *(_n(math.degrees(x), 6) for x in p[3:]),
-                      *(_n(x * 1000, 2) for x in sd[:3]), *(_n(x / ARCSEC, 2) for x in sd[3:]),
-                      t("yes") if cal.levelled[k] else t("no")))  # fmt: skip
+        srows.append(
+            (
+                _e(s),
+                *(_n(x, 4) for x in p[:3]),
+                *(_n(math.degrees(x), 6) for x in p[3:]),
+                *(_n(x * 1000, 2) for x in sd[:3]),
+                *(_n(x / ARCSEC, 2) for x in sd[3:]),
+                t("yes") if cal.levelled[k] else t("no"),
+            )
+        )
     out += [
         f"<h2>{t('Stations')}</h2>",
         _table(
@@ -277,12 +327,17 @@ def render_tls_html(
     out += _station_parts(cal)
     out.append(f"<h2>{t('Correlations')}</h2>")
     if cal.strong_pairs:
-        prow = [(_e(a), _e(b), _n(r, 3), _e(explain_pair(a, b) or "")) for a, b, r in
-                cal.strong_pairs[:30]]  # fmt: skip
+        prow = [
+            (_e(a), _e(b), _n(r, 3), _e(explain_pair(a, b) or ""))
+            for a, b, r in cal.strong_pairs[:30]
+        ]
         limit = f"{cal.options.correlation_limit:g}"
         out.append("<p>" + t("Pairs with |r| &ge; {}:").format(limit) + "</p>")
-        out.append(_table([t("parameter"), t("parameter"), "r",
-                           t("why, and the design that breaks it")], prow))  # fmt: skip
+        out.append(
+            _table(
+                [t("parameter"), t("parameter"), "r", t("why, and the design that breaks it")], prow
+            )
+        )
     else:
         limit = f"{cal.options.correlation_limit:g}"
         out.append("<p>" + t("No pair involving an AP reaches |r| = {}.").format(limit) + "</p>")
@@ -302,7 +357,10 @@ def render_tls_html(
         ]
     out += _residual_parts(cal)
     if adj.warnings:
-        out.append(f"<h2>{t('Warnings')}</h2><ul>"
-                   + "".join(f"<li>{_e(t(x))}</li>" for x in adj.warnings) + "</ul>")  # fmt: skip
+        out.append(
+            f"<h2>{t('Warnings')}</h2><ul>"
+            + "".join(f"<li>{_e(t(x))}</li>" for x in adj.warnings)
+            + "</ul>"
+        )
     out.append("</body></html>")
     return "\n".join(out)

@@ -65,8 +65,9 @@ def town_tiles(
     """
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    _, pts = simulate_town(n_buildings=n_buildings, n_trees=n_trees, density=density,
-                           seed=seed, **town_kwargs)  # fmt: skip
+    _, pts = simulate_town(
+        n_buildings=n_buildings, n_trees=n_trees, density=density, seed=seed, **town_kwargs
+    )
     xyz, cls = pts.xyz, pts.classification
     col = np.floor(xyz[:, 0] / tile_size).astype(np.int64)
     row = np.floor(xyz[:, 1] / tile_size).astype(np.int64)
@@ -109,12 +110,21 @@ def large_block(
         c, r = t % cols, t // cols
         origin = (85000.0 + c * cells * 30.0, 447000.0 + r * cells * 30.0)
         nb = int(cells * cells * 0.55)
-        _, pts = simulate_town(n_buildings=nb, n_trees=cells * cells - nb, density=density,
-                               seed=seed + t, origin=origin)  # fmt: skip
+        _, pts = simulate_town(
+            n_buildings=nb,
+            n_trees=cells * cells - nb,
+            density=density,
+            seed=seed + t,
+            origin=origin,
+        )
         xyz = pts.xyz
         box = (origin[0], origin[1], origin[0] + cells * 30.0, origin[1] + cells * 30.0)
-        m = (xyz[:, 0] >= box[0]) & (xyz[:, 0] < box[2]) & (xyz[:, 1] >= box[1]) & (
-            xyz[:, 1] < box[3])  # fmt: skip
+        m = (
+            (xyz[:, 0] >= box[0])
+            & (xyz[:, 0] < box[2])
+            & (xyz[:, 1] >= box[1])
+            & (xyz[:, 1] < box[3])
+        )
         path = folder / f"tile_{t:05d}{suffix}"
         ids = np.arange(start, start + int(m.sum()), dtype=np.float64)
         write_las(path, xyz[m], None, ids)

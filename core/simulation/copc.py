@@ -49,15 +49,25 @@ def _octree(
         keep[first] = True
         nodes[key] = np.sort(idx[keep])
         rest = idx[~keep]
-        child = np.clip(np.floor((xyz[rest] - lo) / (side / 2 ** (level + 1))).astype(np.int64),
-                        0, 2 ** (level + 1) - 1)  # fmt: skip
-        code = (child[:, 0] - 2 * key[1]) + 2 * (child[:, 1] - 2 * key[2]) + 4 * (
-            child[:, 2] - 2 * key[3])  # fmt: skip
+        child = np.clip(
+            np.floor((xyz[rest] - lo) / (side / 2 ** (level + 1))).astype(np.int64),
+            0,
+            2 ** (level + 1) - 1,
+        )
+        code = (
+            (child[:, 0] - 2 * key[1])
+            + 2 * (child[:, 1] - 2 * key[2])
+            + 4 * (child[:, 2] - 2 * key[3])
+        )
         for c in range(8):
             sub = rest[code == c]
             if len(sub):
-                k = (level + 1, 2 * key[1] + (c & 1), 2 * key[2] + ((c >> 1) & 1),
-                     2 * key[3] + ((c >> 2) & 1))  # fmt: skip
+                k = (
+                    level + 1,
+                    2 * key[1] + (c & 1),
+                    2 * key[2] + ((c >> 1) & 1),
+                    2 * key[3] + ((c >> 2) & 1),
+                )
                 todo.append((k, sub))
     return nodes
 
@@ -114,8 +124,9 @@ def write_copc(
     nodes = _octree(q, lo, 2.0 * half, grid, leaf_points, rng.permutation(n))
 
     wkt = pyproj.CRS.from_epsg(epsg).to_wkt() if epsg is not None else ""
-    cfg = copclib.CopcConfigWriter(6, copclib.Vector3(scale, scale, scale),
-                                   copclib.Vector3(*offset.tolist()), wkt)  # fmt: skip
+    cfg = copclib.CopcConfigWriter(
+        6, copclib.Vector3(scale, scale, scale), copclib.Vector3(*offset.tolist()), wkt
+    )
     cfg.las_header.min = copclib.Vector3(*mins.tolist())
     cfg.las_header.max = copclib.Vector3(*maxs.tolist())
     cfg.copc_info.center_x, cfg.copc_info.center_y, cfg.copc_info.center_z = center.tolist()

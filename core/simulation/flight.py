@@ -228,9 +228,18 @@ class FlightSimulation:
     def calibrate(self, options: BoresightOptions | None = None) -> BoresightResult:
         """Boresight calibration of this simulation with every control it made."""
         return calibrate(
-            self.trajectory, self.camera, self.mount, self.crs, self.observations, self.planes,
-            self.lines, self.lcps, self.lidar_points, self.lidar_plane_ids, options=options,
-        )  # fmt: skip
+            self.trajectory,
+            self.camera,
+            self.mount,
+            self.crs,
+            self.observations,
+            self.planes,
+            self.lines,
+            self.lcps,
+            self.lidar_points,
+            self.lidar_plane_ids,
+            options=options,
+        )
 
     def true_boresight(self, groups: tuple[str, ...]) -> Array:
         """(G, 3) true boresight in the order of a result's groups, radians."""
@@ -455,17 +464,28 @@ def _observations(
         if "paper" in cfg.types:
             p = local.map_to_enu(_face_points(town, kept, 1, rng))
             px = project(p, eo_true[i], cam)
-            rec.add(ids[i], px, np.flatnonzero(cam.in_frame(px, cfg.margin_px)),
-                    [f"P{i}_{f}" for f in kept], "paper", [str(f) for f in kept])  # fmt: skip
+            rec.add(
+                ids[i],
+                px,
+                np.flatnonzero(cam.in_frame(px, cfg.margin_px)),
+                [f"P{i}_{f}" for f in kept],
+                "paper",
+                [str(f) for f in kept],
+            )
         if "line" in cfg.types and lines:
             t = rng.uniform(0.1, 0.9, (len(lines), per_line))
             seg = np.array(line_truth)
             p = seg[:, None, 0] + t[:, :, None] * (seg[:, None, 1] - seg[:, None, 0])
             px = project(local.map_to_enu(p.reshape(-1, 3)), eo_true[i], cam)
             m = len(px)
-            rec.add(ids[i], px, np.flatnonzero(cam.in_frame(px, cfg.margin_px)),
-                    [f"R{j // per_line}_{j % per_line}" for j in range(m)], "line",
-                    [str(lines[j // per_line].id) for j in range(m)])  # fmt: skip
+            rec.add(
+                ids[i],
+                px,
+                np.flatnonzero(cam.in_frame(px, cfg.margin_px)),
+                [f"R{j // per_line}_{j % per_line}" for j in range(m)],
+                "line",
+                [str(lines[j // per_line].id) for j in range(m)],
+            )
     rec_point, rec_target, rec_image = rec.point, rec.target, rec.image
     pixels = np.array(rec.px).reshape(-1, 2)
     kinds = np.array(rec.type)
@@ -556,9 +576,23 @@ def simulate_flight(config: FlightConfig, seed: int = 0, exact: bool = False) ->
     control_truth = [lcp_truth[i] for i in order[n_check:]]
 
     # ---- image observations: (true map point, type, target, point id)
-    obs, blunders = _observations(cfg, town, kept, local, eo_true, ids, cam, lines, line_truth,
-                                  control_truth, control_lcps, check_lcps, check_truth, exact,
-                                  rng)  # fmt: skip
+    obs, blunders = _observations(
+        cfg,
+        town,
+        kept,
+        local,
+        eo_true,
+        ids,
+        cam,
+        lines,
+        line_truth,
+        control_truth,
+        control_lcps,
+        check_lcps,
+        check_truth,
+        exact,
+        rng,
+    )
 
     # ---- INS measurements
     if exact:
@@ -609,8 +643,14 @@ def surveyed_control(
     check_ids = {str(p.id) for p in sim.check_lcps}
     obs = sim.observations.subset(np.isin(sim.observations.type, ("lcp", "check")))
     n = len(obs)
-    rows = ImageObservations(obs.image_id, tuple(f"GCP{t}" for t in obs.target_id), obs.pixels,
-                             obs.sigma_px, ("control",) * n, ("",) * n)  # fmt: skip
+    rows = ImageObservations(
+        obs.image_id,
+        tuple(f"GCP{t}" for t in obs.target_id),
+        obs.pixels,
+        obs.sigma_px,
+        ("control",) * n,
+        ("",) * n,
+    )
     ids = sorted(set(obs.target_id), key=int)
     sigma = np.asarray(survey_sigma_m, dtype=np.float64)
     noise = np.random.default_rng(survey_seed).normal(0.0, sigma, (len(ids), 3))
@@ -689,9 +729,13 @@ def _true_poses(traj: Trajectory, bore_of: dict, lever: Array, nominal: Array, f
     for g, b in bore_of.items():
         sel = groups == g
         sub = Trajectory(
-            tuple(np.array(traj.image_id)[sel]), traj.time[sel], tuple(groups[sel]),
-            traj.position[sel], False, traj.rph[sel],
-        )  # fmt: skip
+            tuple(np.array(traj.image_id)[sel]),
+            traj.time[sel],
+            tuple(groups[sel]),
+            traj.position[sel],
+            False,
+            traj.rph[sel],
+        )
         poses = georeference_ecef(sub, Mount(lever, nominal, b), frame)
         centre_l[sel] = local.ecef_to_enu(poses.centre_ecef)
         r_cl[sel] = local.rotation @ poses.camera_to_ecef

@@ -223,9 +223,14 @@ def simulate_flight_over(
             q = a[:, None] + t[:, :, None] * (b - a)[:, None]
             px = project(local.map_to_enu(q.reshape(-1, 3)), eo_true[i], cam)
             m = len(px)
-            rec.add(ids[i], px, np.flatnonzero(cam.in_frame(px, cfg.margin_px)),
-                    [f"R{lines[j // per_line].id}_{i}_{j % per_line}" for j in range(m)], "line",
-                    [str(lines[j // per_line].id) for j in range(m)])  # fmt: skip
+            rec.add(
+                ids[i],
+                px,
+                np.flatnonzero(cam.in_frame(px, cfg.margin_px)),
+                [f"R{lines[j // per_line].id}_{i}_{j % per_line}" for j in range(m)],
+                "line",
+                [str(lines[j // per_line].id) for j in range(m)],
+            )
     pixels = np.array(rec.px).reshape(-1, 2)
     kinds = np.array(rec.type)
     keep = _seen_twice(kinds, rec.point)

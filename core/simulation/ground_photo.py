@@ -75,9 +75,14 @@ class GroundPatch:
         my = np.concatenate([my, np.full(pad, -1e6, np.float32)]).reshape(-1, width)
         out = np.empty(mx.shape, np.float32)
         for s in range(0, len(mx), 16384):
-            out[s : s + 16384] = cv2.remap(self.grey, mx[s : s + 16384], my[s : s + 16384],
-                                           cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT,
-                                           borderValue=(0.0,))  # fmt: skip
+            out[s : s + 16384] = cv2.remap(
+                self.grey,
+                mx[s : s + 16384],
+                my[s : s + 16384],
+                cv2.INTER_LINEAR,
+                borderMode=cv2.BORDER_CONSTANT,
+                borderValue=(0.0,),
+            )
         out = out.ravel()[: xa.size]
         return out.reshape(xa.shape)
 
@@ -199,14 +204,29 @@ def ground_camera(projection: str = "perspective") -> Camera:
     5 um pixels, k1 4e-3) or a fisheye of the given projection (f 1.6 mm, 4.5 um pixels,
     principal point off the centre, k1 2e-3, k2 -1e-4: the image corners look beyond 90 deg)."""
     if projection == "perspective":
-        return camera_from_dict({"name": "ground", "focal_mm": 3.0, "pixel_size_mm": 0.005,
-                                 "width_px": 960, "height_px": 720,
-                                 "distortion": {"model": "brown_conrady", "k1": 4e-3}})  # fmt: skip
-    return camera_from_dict({"name": "fisheye", "focal_mm": 1.6, "pixel_size_mm": 0.0045,
-                             "width_px": 960, "height_px": 720, "projection": projection,
-                             "x0_mm": 0.02, "y0_mm": -0.015,
-                             "distortion": {"model": "brown_conrady", "k1": 2e-3,
-                                            "k2": -1e-4}})  # fmt: skip
+        return camera_from_dict(
+            {
+                "name": "ground",
+                "focal_mm": 3.0,
+                "pixel_size_mm": 0.005,
+                "width_px": 960,
+                "height_px": 720,
+                "distortion": {"model": "brown_conrady", "k1": 4e-3},
+            }
+        )
+    return camera_from_dict(
+        {
+            "name": "fisheye",
+            "focal_mm": 1.6,
+            "pixel_size_mm": 0.0045,
+            "width_px": 960,
+            "height_px": 720,
+            "projection": projection,
+            "x0_mm": 0.02,
+            "y0_mm": -0.015,
+            "distortion": {"model": "brown_conrady", "k1": 2e-3, "k2": -1e-4},
+        }
+    )
 
 
 def corner_errors(found: ArrayLike, truth: ArrayLike) -> NDArray[np.float64]:

@@ -65,5 +65,10 @@ class SimulatedFlight:
         llh = self.frame.ecef_to_geodetic(xyz)
         r_n_e = ned_to_ecef_rotation(llh[:, 0], llh[:, 1])
         v_ned = np.einsum("kji,kj->ki", r_n_e, v)
-        return {"time": np.asarray(t, dtype=np.float64), "llh": llh, "v_ned": v_ned,
-                "rph": self.attitude(t), "wander": self.wander(t)}  # fmt: skip
+        return {
+            "time": np.asarray(t, dtype=np.float64),
+            "llh": llh,
+            "v_ned": v_ned,
+            "rph": self.attitude(t),
+            "wander": self.wander(t),
+        }

@@ -48,7 +48,6 @@ faces apart; 8 bits hold the shading and the noise without loss and keep a 24-Mp
 16 MB with LZW (16 bits would double the files and need a contrast stretch to be seen).
 """
 
-
 from __future__ import annotations
 
 import logging
@@ -90,7 +89,6 @@ __all__ = [
     "render_image",
     "render_images",
 ]
-
 
 
 # --------------------------------------------------------------------------- rays
@@ -284,9 +282,9 @@ class RenderedImage:
     seconds: float
 
 
-
-def _paint_planes(base: NDArray, label: NDArray, scene: RenderScene, sun: Array,
-                  ambient: float) -> None:  # fmt: skip
+def _paint_planes(
+    base: NDArray, label: NDArray, scene: RenderScene, sun: Array, ambient: float
+) -> None:
     """The pixels of ``base`` (H, W, 3) whose ``label`` is a plane painted with its tint,
     shaded by the sun (in place)."""
     shade = lambert(scene.normals, sun, ambient)
@@ -356,8 +354,14 @@ def render_image(
     dirs = rays.on_grid((np.arange(w) + 0.5) * k, (np.arange(h) + 0.5) * k)
     n = dirs.shape[0]
     sub = None if progress is None else (lambda f: progress(0.6 * f))
-    hits = intersect_dsm(scene.tracer, np.broadcast_to(origin, (n, 3)), dirs,
-                         min_incidence_deg=0.0, progress=sub, should_stop=should_stop)  # fmt: skip
+    hits = intersect_dsm(
+        scene.tracer,
+        np.broadcast_to(origin, (n, 3)),
+        dirs,
+        min_incidence_deg=0.0,
+        progress=sub,
+        should_stop=should_stop,
+    )
     hit = np.isin(hits.status, (0, 1))
     px, py = hits.points[:, 0], hits.points[:, 1]
     sun = sun_vector(opt.sun_azimuth_deg, opt.sun_elevation_deg)
@@ -383,9 +387,15 @@ def render_image(
         todo = np.flatnonzero(many)
         if todo.size:
             label_c[todo] = _resolve(
-                scene, origin, dirs[todo], cand[todo], t_dsm[todo], lab_dsm[todo],
-                opt.occlusion_tol_m, opt.line_band_m,
-            )  # fmt: skip
+                scene,
+                origin,
+                dirs[todo],
+                cand[todo],
+                t_dsm[todo],
+                lab_dsm[todo],
+                opt.occlusion_tol_m,
+                opt.line_band_m,
+            )
     del dirs
     if progress is not None:
         progress(0.7)
@@ -412,8 +422,16 @@ def render_image(
             rk, ck = r // k, c // k
             d = rays.at(c + 0.5, r + 0.5)
             flat = rk * w + ck
-            label[r, c] = _resolve(scene, origin, d, cand_c[rk, ck], t_dsm[flat], lab_dsm[flat],
-                                   opt.occlusion_tol_m, opt.line_band_m)  # fmt: skip
+            label[r, c] = _resolve(
+                scene,
+                origin,
+                d,
+                cand_c[rk, ck],
+                t_dsm[flat],
+                lab_dsm[flat],
+                opt.occlusion_tol_m,
+                opt.line_band_m,
+            )
             if progress is not None:
                 progress(0.7 + 0.2 * min(1.0, (s + chunk) / max(br.size, 1)))
     base = cv2.resize(rgb_c, (w * k, h * k), interpolation=cv2.INTER_LINEAR)[:height, :width]
@@ -425,8 +443,9 @@ def render_image(
     plane_id = ids[label]  # -1 indexes the appended "no plane"
     if progress is not None:
         progress(1.0)
-    return RenderedImage(np.ascontiguousarray(base), plane_id, n, edge_pixels,
-                         time.perf_counter() - t0)  # fmt: skip
+    return RenderedImage(
+        np.ascontiguousarray(base), plane_id, n, edge_pixels, time.perf_counter() - t0
+    )
 
 
 def render_images(
@@ -462,15 +481,25 @@ def render_images(
     paths: dict[str, Path] = {}
     for m, name in enumerate(wanted):
         row = index[name]
-        sub = None if progress is None else (
-            lambda f, m=m: progress((m + f) / len(wanted)))  # fmt: skip
-        img = render_image(scene, camera, eo.xyz[row], eo.opk[row],
-                           replace(opt, seed=opt.seed + row), progress=sub,
-                           should_stop=should_stop)  # fmt: skip
+        sub = None if progress is None else (lambda f, m=m: progress((m + f) / len(wanted)))
+        img = render_image(
+            scene,
+            camera,
+            eo.xyz[row],
+            eo.opk[row],
+            replace(opt, seed=opt.seed + row),
+            progress=sub,
+            should_stop=should_stop,
+        )
         paths[name] = out / f"{name}.tif"
         write_rgb_tiff(paths[name], img.rgb)
-        LOG.info("rendered %s in %.2f s (%d rays, %d edge pixels)", name, img.seconds,
-                 img.coarse_rays, img.edge_pixels)  # fmt: skip
+        LOG.info(
+            "rendered %s in %.2f s (%d rays, %d edge pixels)",
+            name,
+            img.seconds,
+            img.coarse_rays,
+            img.edge_pixels,
+        )
     return paths
 
 
@@ -519,8 +548,11 @@ def edge_offsets(
     t = np.linspace(0.1, 0.9, samples)
     offs = np.arange(-reach_px, reach_px + 1e-9, step_px)
     # (L, S, O, 2) sample positions
-    pts = (a[:, None, None] + t[None, :, None, None] * d[:, None, None]
-           + offs[None, None, :, None] * normal[:, None, None])  # fmt: skip
+    pts = (
+        a[:, None, None]
+        + t[None, :, None, None] * d[:, None, None]
+        + offs[None, None, :, None] * normal[:, None, None]
+    )
     col = np.floor(pts[..., 0])
     row = np.floor(pts[..., 1])
     inside = (col >= 0) & (row >= 0) & (col < w) & (row < h) & np.isfinite(col) & np.isfinite(row)
@@ -535,4 +567,3 @@ def edge_offsets(
     mid = (offs[where] + offs[where + 1]) / 2.0
     line = np.broadcast_to(np.arange(len(a))[:, None], keep.shape)
     return mid[keep], line[keep].astype(np.int64)
-

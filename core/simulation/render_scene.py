@@ -3,7 +3,6 @@ shading, and the DSM with its region raster (the LAS class or the roof plane of 
 and the roof planes, in the mapping CRS.
 """
 
-
 from __future__ import annotations
 
 import logging
@@ -355,9 +354,10 @@ class RenderScene:
         rows, cols = (max(1, math.ceil(m * g.cell / region_cell)) for m in (g.rows, g.cols))
         rg = Grid(g.x0, g.y_top, float(region_cell), rows, cols)
         region = _Raster(
-            rg, _nearest_label_raster(rg, pts[:, 0], pts[:, 1], pts[:, 2], pidx, NO_PLANE, max_gap),
+            rg,
+            _nearest_label_raster(rg, pts[:, 0], pts[:, 1], pts[:, 2], pidx, NO_PLANE, max_gap),
             NO_PLANE,
-        )  # fmt: skip
+        )
         n_p = len(planes)
         normals = np.array([p.normal for p in planes], dtype=np.float64).reshape(n_p, 3)
         centroids = np.array([p.centroid for p in planes], dtype=np.float64).reshape(n_p, 3)
@@ -377,10 +377,17 @@ class RenderScene:
         tint = _colour_planes(region.values, edge != 0, len(PLANE_TINTS))
         LOG.info(
             "render scene: DSM %d x %d, %d planes, %d exact edges, regions %d x %d of %g",
-            g.rows, g.cols, n_p, int(np.count_nonzero(edge)) // 2, rg.rows, rg.cols, region_cell,
-        )  # fmt: skip
-        return cls(tracer, class_raster, region, ids, normals, centroids, edge, line_of, segs,
-                   tint, crs_)  # fmt: skip
+            g.rows,
+            g.cols,
+            n_p,
+            int(np.count_nonzero(edge)) // 2,
+            rg.rows,
+            rg.cols,
+            region_cell,
+        )
+        return cls(
+            tracer, class_raster, region, ids, normals, centroids, edge, line_of, segs, tint, crs_
+        )
 
     @property
     def dsm(self) -> Dsm:

@@ -55,16 +55,24 @@ class ResectionScene:
     ) -> ResectionData:
         """One draw of the measurements (noise-free with ``rng`` None)."""
         cam, eo = self.camera, self.eo
-        noise = (lambda shape: rng.normal(0.0, sigma_px, shape)) if rng is not None else (
-            lambda shape: np.zeros(shape))  # fmt: skip
+        noise = (
+            (lambda shape: rng.normal(0.0, sigma_px, shape))
+            if rng is not None
+            else (lambda shape: np.zeros(shape))
+        )
         kw: dict = {}
         if points:
             px = project(self.xyz, eo, cam) + noise((len(self.xyz), 2))
             xyz = self.xyz.copy()
             if rng is not None and noisy_control:
                 xyz += _draw(rng, self.point_cov)
-            kw.update(point_ids=tuple(f"P{i}" for i in range(len(xyz))), pixels=px,
-                      sigma_px=sigma_px, xyz=xyz, xyz_cov=self.point_cov)  # fmt: skip
+            kw.update(
+                point_ids=tuple(f"P{i}" for i in range(len(xyz))),
+                pixels=px,
+                sigma_px=sigma_px,
+                xyz=xyz,
+                xyz_cov=self.point_cov,
+            )
         if lines:
             # the first and last point in the outer quarters of the line, the rest between
             t = np.broadcast_to(np.linspace(0.1, 0.9, vertices), (len(self.p1), vertices))
@@ -79,9 +87,14 @@ class ResectionScene:
             p12 = np.hstack([self.p1, self.p2])
             if rng is not None and noisy_control:
                 p12 = p12 + _draw(rng, self.line_cov)
-            kw.update(line_ids=tuple(f"L{i}" for i in range(len(self.p1))),
-                      line_pixels=tuple(pix), line_sigma_px=(sigma_px,) * len(pix),
-                      line_p1=p12[:, :3], line_p2=p12[:, 3:], line_cov=self.line_cov)  # fmt: skip
+            kw.update(
+                line_ids=tuple(f"L{i}" for i in range(len(self.p1))),
+                line_pixels=tuple(pix),
+                line_sigma_px=(sigma_px,) * len(pix),
+                line_p1=p12[:, :3],
+                line_p2=p12[:, 3:],
+                line_cov=self.line_cov,
+            )
         return ResectionData(**kw)
 
 
@@ -116,13 +129,20 @@ def write_scene_files(
     out.mkdir(parents=True, exist_ok=True)
     mapping = MappingFrame.from_user_input(crs)
     local = LocalFrame.at_map_point(mapping, np.asarray(origin_map, dtype=np.float64))
-    paths = {k: out / f"{k}.csv" for k in ("observations", "control_points", "control_lines",
-                                            "eo_true")}  # fmt: skip
+    paths = {
+        k: out / f"{k}.csv" for k in ("observations", "control_points", "control_lines", "eo_true")
+    }
     paths["camera"] = out / "camera.json"
     write_camera_json(paths["camera"], scene.camera)
     rows: dict[str, list[Any]]  # the observation table's columns
-    rows = {"image_id": [], "point_id": [], "pixels": [], "sigma_px": [], "type": [],
-            "target_id": []}  # fmt: skip
+    rows = {
+        "image_id": [],
+        "point_id": [],
+        "pixels": [],
+        "sigma_px": [],
+        "type": [],
+        "target_id": [],
+    }
 
     def add(pid, px, sig, kind, target):
         rows["image_id"].append(image_id)
@@ -137,27 +157,54 @@ def write_scene_files(
     for lid, pxs, sigs in zip(data.line_ids, data.line_pixels, data.line_sigma_px):
         for j, (px, sig) in enumerate(zip(pxs, sigs)):
             add(f"{lid}_{j + 1}", px, sig, "line", lid)
-    write_observations_csv(paths["observations"], ImageObservations.from_arrays(
-        rows["image_id"], rows["point_id"], np.array(rows["pixels"]).reshape(-1, 2),
-        rows["sigma_px"], rows["type"], rows["target_id"]))  # fmt: skip
+    write_observations_csv(
+        paths["observations"],
+        ImageObservations.from_arrays(
+            rows["image_id"],
+            rows["point_id"],
+            np.array(rows["pixels"]).reshape(-1, 2),
+            rows["sigma_px"],
+            rows["type"],
+            rows["target_id"],
+        ),
+    )
     xyz = local.enu_to_map(data.xyz) if data.n_points else np.empty((0, 3))
     sig = np.sqrt(np.clip(np.diagonal(data.xyz_cov, axis1=1, axis2=2), 0, None))
-    write_csv_atomic(paths["control_points"], ("point_id", "X", "Y", "Z", "sx", "sy", "sz"),
-                     [(i, *map(repr, map(float, p)), *map(repr, map(float, s)))
-                      for i, p, s in zip(data.point_ids, xyz, sig)])  # fmt: skip
+    write_csv_atomic(
+        paths["control_points"],
+        ("point_id", "X", "Y", "Z", "sx", "sy", "sz"),
+        [
+            (i, *map(repr, map(float, p)), *map(repr, map(float, s)))
+            for i, p, s in zip(data.point_ids, xyz, sig)
+        ],
+    )
     p1 = local.enu_to_map(data.line_p1) if data.n_lines else np.empty((0, 3))
     p2 = local.enu_to_map(data.line_p2) if data.n_lines else np.empty((0, 3))
     # the 3D sigma of each end: sqrt of the trace of its 3 x 3 covariance
     s3 = np.sqrt(np.clip(np.trace(data.line_cov[:, :3, :3], axis1=1, axis2=2), 0, None))
     s3b = np.sqrt(np.clip(np.trace(data.line_cov[:, 3:, 3:], axis1=1, axis2=2), 0, None))
-    write_csv_atomic(paths["control_lines"],
-                     ("id", "x1", "y1", "z1", "x2", "y2", "z2", "sigma_start", "sigma_end"),
-                     [(i, *map(repr, map(float, a)), *map(repr, map(float, b)), repr(float(u)),
-                       repr(float(w))) for i, a, b, u, w in zip(data.line_ids, p1, p2, s3, s3b)])
+    write_csv_atomic(
+        paths["control_lines"],
+        ("id", "x1", "y1", "z1", "x2", "y2", "z2", "sigma_start", "sigma_end"),
+        [
+            (
+                i,
+                *map(repr, map(float, a)),
+                *map(repr, map(float, b)),
+                repr(float(u)),
+                repr(float(w)),
+            )
+            for i, a, b, u, w in zip(data.line_ids, p1, p2, s3, s3b)
+        ],
+    )
     m = opk_to_matrix(*scene.eo[3:])[None]
     exyz, eopk = eo_local_to_map(scene.eo[None, :3], m, local)
-    write_eo_csv(paths["eo_true"], ExteriorOrientationTable(
-        (image_id,), np.array([np.nan]), ("",), exyz, eopk, mapping.crs.to_wkt()))
+    write_eo_csv(
+        paths["eo_true"],
+        ExteriorOrientationTable(
+            (image_id,), np.array([np.nan]), ("",), exyz, eopk, mapping.crs.to_wkt()
+        ),
+    )
     return {**paths, "local": local}
 
 
@@ -212,8 +259,9 @@ def make_scene(
         Direction of the streets (the roofs' ridges and eaves follow it and its normal).
     """
     rng = np.random.default_rng(seed)
-    cam = camera or Camera("sim", focal_mm=100.0, pixel_size_mm=0.010, width_px=6000,
-                           height_px=4000)  # fmt: skip
+    cam = camera or Camera(
+        "sim", focal_mm=100.0, pixel_size_mm=0.010, width_px=6000, height_px=4000
+    )
     e = np.array([12.0, -7.0, height_m, 0.015, -0.02, 0.6]) if eo is None else np.asarray(eo)
     # ground footprint half-sizes (with a margin inside the frame)
     half = 0.42 * np.array([cam.width_px, cam.height_px]) * cam.pixel_size_mm / cam.focal_mm

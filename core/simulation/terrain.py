@@ -244,10 +244,16 @@ def _houses(
 ) -> list[_Box]:
     x0, y0, x1, y1 = box
     return [
-        _Box(rng.uniform(x0, x1), rng.uniform(y0, y1), big * rng.uniform(10, 22),
-             big * rng.uniform(8, 14), rng.uniform(0, math.pi), rng.uniform(4.0, 12.0))
+        _Box(
+            rng.uniform(x0, x1),
+            rng.uniform(y0, y1),
+            big * rng.uniform(10, 22),
+            big * rng.uniform(8, 14),
+            rng.uniform(0, math.pi),
+            rng.uniform(4.0, 12.0),
+        )
         for _ in range(n)
-    ]  # fmt: skip
+    ]
 
 
 class _Layout(NamedTuple):
@@ -268,8 +274,10 @@ def _layout_slopes(rng: np.random.Generator, L: float) -> _Layout:
     # a hillside steepening from 24 to 50 degrees, with spurs; closed forest on the upper
     # part, shrubs (1-2.5 m) everywhere, houses low down and on the steep part
     def ground(x, y):
-        return 0.45 * x + 0.25 * L * np.tanh((x - 0.6 * L) / (0.25 * L)) * 0.8 + (
-            6.0 * np.sin(y / 23.0) * np.cos(x / 31.0)
+        return (
+            0.45 * x
+            + 0.25 * L * np.tanh((x - 0.6 * L) / (0.25 * L)) * 0.8
+            + (6.0 * np.sin(y / 23.0) * np.cos(x / 31.0))
         )
 
     # a closed canopy: a crown every 25 m^2 (the ground seen only through it)
@@ -312,8 +320,7 @@ def _layout_terraces(rng: np.random.Generator, L: float) -> _Layout:
     boxes: list[_Box] = []
     for i in range(int(L / 16)):
         for j in range(3):
-            boxes.append(_Box(16.0 * i + 4.0 + 3.5 * j, L / 2, 1.0, 0.8 * L, 0.0, 1.6,
-                              VEGETATION))  # fmt: skip
+            boxes.append(_Box(16.0 * i + 4.0 + 3.5 * j, L / 2, 1.0, 0.8 * L, 0.0, 1.6, VEGETATION))
     trees = _scatter_trees(rng, int(L * L / 1500), full)
     boxes += _houses(rng, 3, (0.1 * L, 0.05 * L, 0.9 * L, 0.2 * L))
     return _Layout(ground, boxes, trees, None)
@@ -372,8 +379,10 @@ def _layout_gaps(rng: np.random.Generator, L: float) -> _Layout:
         strip = np.abs(x + 0.4 * y - 0.9 * L) < 4.0
         return lake1 | lake2 | strip
 
-    boxes = [_Box(0.3 * L + 0.23 * L, 0.35 * L, 18.0, 12.0, 0.3, 9.0),
-             _Box(0.75 * L - 0.17 * L, 0.7 * L + 0.1 * L, 24.0, 14.0, 1.2, 14.0)]  # fmt: skip
+    boxes = [
+        _Box(0.3 * L + 0.23 * L, 0.35 * L, 18.0, 12.0, 0.3, 9.0),
+        _Box(0.75 * L - 0.17 * L, 0.7 * L + 0.1 * L, 24.0, 14.0, 1.2, 14.0),
+    ]
     boxes += _houses(rng, 5, (0.05 * L, 0.65 * L, 0.45 * L, 0.95 * L))
     trees = _scatter_trees(rng, int(L * L / 800), full)
     boxes += _scatter_small(rng, 8, full)
@@ -410,8 +419,9 @@ def _layout_dense_buildings(rng: np.random.Generator, L: float) -> _Layout:
             wy = rng.uniform(25.0, 70.0)
             ww, hh = min(wx, L - x - 2), min(wy, L - y - 2)
             hole = rng.uniform(0.35, 0.6) if min(ww, hh) > 40 else 0.0
-            boxes.append(_Box(x + ww / 2, y + hh / 2, ww, hh, 0.0, rng.uniform(6.0, 30.0),
-                              hole=hole))  # fmt: skip
+            boxes.append(
+                _Box(x + ww / 2, y + hh / 2, ww, hh, 0.0, rng.uniform(6.0, 30.0), hole=hole)
+            )
             y += wy + street
         x += wx + street
     boxes += _scatter_small(rng, 25, full)
@@ -460,8 +470,9 @@ def _add_high_outliers(
     m = int(0.005 * n)
     src = rng.choice(n, m, replace=False)
     high = xyz[src].copy()
-    high[:, 2] += np.where(rng.random(m) < 0.3, rng.uniform(3.0, 12.0, m),
-                           rng.uniform(20.0, 250.0, m))  # fmt: skip
+    high[:, 2] += np.where(
+        rng.random(m) < 0.3, rng.uniform(3.0, 12.0, m), rng.uniform(20.0, 250.0, m)
+    )
     xyz = np.concatenate([xyz, high])
     kind = np.concatenate([kind, np.full(m, HIGH, dtype=np.int8)])
     return xyz, kind

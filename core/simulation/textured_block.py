@@ -50,8 +50,9 @@ class GroundTexture:
     cell: float
 
 
-def make_texture(extent: tuple[float, float, float, float], cell_m: float, seed: int = 0,
-                 max_octave: int = 64) -> GroundTexture:  # fmt: skip
+def make_texture(
+    extent: tuple[float, float, float, float], cell_m: float, seed: int = 0, max_octave: int = 64
+) -> GroundTexture:
     """Non-repeating multi-octave noise over ``(xmin, ymin, xmax, ymax)``, cell ``cell_m``.
 
     >>> t = make_texture((0.0, 0.0, 100.0, 50.0), 0.5, seed=1)
@@ -67,8 +68,9 @@ def make_texture(extent: tuple[float, float, float, float], cell_m: float, seed:
     size = 1
     while size <= max_octave:
         small = rng.standard_normal((rows // size + 2, cols // size + 2)).astype(np.float32)
-        up = cv2.resize(small, (small.shape[1] * size, small.shape[0] * size),
-                        interpolation=cv2.INTER_CUBIC)  # fmt: skip
+        up = cv2.resize(
+            small, (small.shape[1] * size, small.shape[0] * size), interpolation=cv2.INTER_CUBIC
+        )
         acc += (size**0.6) * up[:rows, :cols]
         size *= 2
     # mean and spread from exact integer sums: numpy's float32 sums (and, before NEP 50,
@@ -108,8 +110,7 @@ class TexturedBlock:
     @classmethod
     def of(cls, block: UavBlock) -> TexturedBlock:
         cfg = block.config
-        local = LocalFrame.at_map_point(block.mapping, np.array([*cfg.centre,
-                                                                cfg.ground_height_m]))  # fmt: skip
+        local = LocalFrame.at_map_point(block.mapping, np.array([*cfg.centre, cfg.ground_height_m]))
         centres, m = eo_map_to_local(block.eo_true.xyz, block.eo_true.opk, local)
         opk = np.column_stack(matrix_to_opk(m))
         return cls(block, local, np.column_stack([centres, opk]))
@@ -117,8 +118,9 @@ class TexturedBlock:
     def extent(self, margin_m: float = 30.0) -> tuple[float, float, float, float]:
         """Map extent of all footprints (corners met with the mean terrain), plus a margin."""
         cam = self.block.true_camera
-        corners = np.array([[0, 0], [cam.width_px, 0], [cam.width_px, cam.height_px],
-                            [0, cam.height_px]], float)  # fmt: skip
+        corners = np.array(
+            [[0, 0], [cam.width_px, 0], [cam.width_px, cam.height_px], [0, cam.height_px]], float
+        )
         pts = [ground_of_pixels(self, corners, k) for k in range(len(self.eo_local))]
         xy = np.vstack(pts)[:, :2]
         lo, hi = xy.min(0) - margin_m, xy.max(0) + margin_m
@@ -153,8 +155,15 @@ def _bilinear_matrix(n_out: int, step: float, n_nodes: int) -> NDArray[np.float3
     return a
 
 
-def render_view(tb: TexturedBlock, texture: GroundTexture, k: int, *, step_px: int = 16,
-                noise_dn: float = 2.0, seed: int = 0) -> NDArray[np.uint8]:  # fmt: skip
+def render_view(
+    tb: TexturedBlock,
+    texture: GroundTexture,
+    k: int,
+    *,
+    step_px: int = 16,
+    noise_dn: float = 2.0,
+    seed: int = 0,
+) -> NDArray[np.uint8]:
     """Render image ``k`` of the block (module docstring): (H, W) uint8 grey."""
     import cv2
 
@@ -172,8 +181,14 @@ def render_view(tb: TexturedBlock, texture: GroundTexture, k: int, *, step_px: i
     ac = _bilinear_matrix(w, step_px, nc)
     map_u = (ar @ u.astype(np.float32)) @ ac.T
     map_v = (ar @ v.astype(np.float32)) @ ac.T
-    img = cv2.remap(texture.values, map_u, map_v, cv2.INTER_LINEAR,
-                    borderMode=cv2.BORDER_CONSTANT, borderValue=(0,))  # fmt: skip
+    img = cv2.remap(
+        texture.values,
+        map_u,
+        map_v,
+        cv2.INTER_LINEAR,
+        borderMode=cv2.BORDER_CONSTANT,
+        borderValue=(0,),
+    )
     del map_u, map_v
     if noise_dn > 0:
         noise = np.empty(img.shape, np.int16)

@@ -82,8 +82,9 @@ class TlsTruth:
         """Targets as control with ``sigma`` (0: fixed), all or those of ``ids``."""
         keep = self.target_ids if ids is None else ids
         at = {t: i for i, t in enumerate(self.target_ids)}
-        return [ControlTarget(t, self.target_xyz[at[t]].copy(), np.full(3, float(sigma)))
-                for t in keep]  # fmt: skip
+        return [
+            ControlTarget(t, self.target_xyz[at[t]].copy(), np.full(3, float(sigma))) for t in keep
+        ]
 
     def station_info(self, with_pose: bool = False) -> list[StationInfo]:
         """Station table: levelled flags (compensator readings = true tilts), and the true
@@ -247,8 +248,14 @@ def paper_cube(
             [8.0, 8.0, 0.0, 12 * a, 25 * a, math.radians(10.0)],
         ]
     )
-    return TlsTruth(ids, xyz, ("1", "2", "3"), poses, np.zeros(3, dtype=bool),
-                    dict(PAPER_APS if aps is None else aps))  # fmt: skip
+    return TlsTruth(
+        ids,
+        xyz,
+        ("1", "2", "3"),
+        poses,
+        np.zeros(3, dtype=bool),
+        dict(PAPER_APS if aps is None else aps),
+    )
 
 
 def room_network(
@@ -308,18 +315,33 @@ def room_network(
     for q in range(levelled_stations):
         fx, fy = spots[q % len(spots)]
         tilt = rng.normal(0.0, 20 * ARCSEC, size=2)
-        poses.append([fx * lx, fy * ly, scanner_height, tilt[0], tilt[1],
-                      rng.uniform(-math.pi, math.pi)])  # fmt: skip
+        poses.append(
+            [fx * lx, fy * ly, scanner_height, tilt[0], tilt[1], rng.uniform(-math.pi, math.pi)]
+        )
         levelled.append(True)
     if tilted:
         for roll in (math.pi / 2, -math.pi / 2):
-            poses.append([cx, cy, scanner_height, roll, rng.normal(0.0, 0.01),
-                          rng.uniform(-math.pi, math.pi)])  # fmt: skip
+            poses.append(
+                [
+                    cx,
+                    cy,
+                    scanner_height,
+                    roll,
+                    rng.normal(0.0, 0.01),
+                    rng.uniform(-math.pi, math.pi),
+                ]
+            )
             levelled.append(False)
     ids_s = tuple(f"S{q + 1}" for q in range(len(poses)))
-    return TlsTruth(ids, xyz, ids_s, np.array(poses), np.array(levelled),
-                    dict(PAPER_APS if aps is None else aps),
-                    min_elevation_rad=math.radians(min_elevation_deg))  # fmt: skip
+    return TlsTruth(
+        ids,
+        xyz,
+        ids_s,
+        np.array(poses),
+        np.array(levelled),
+        dict(PAPER_APS if aps is None else aps),
+        min_elevation_rad=math.radians(min_elevation_deg),
+    )
 
 
 def with_aps(truth: TlsTruth, aps: dict[str, float]) -> TlsTruth:
@@ -384,8 +406,9 @@ def scene_from_network(
     """Targets of a room network as spheres (centres moved ``1.5 radius`` off their wall into
     the room, as on a bracket) or checkerboards (on the walls, ceiling and floor, turned at
     random about their normal); returns the scene and the network with the target centres."""
-    lx, ly, lz = room if room is not None else tuple(
-        float(v) for v in np.max(truth.target_xyz, axis=0))  # fmt: skip
+    lx, ly, lz = (
+        room if room is not None else tuple(float(v) for v in np.max(truth.target_xyz, axis=0))
+    )
     p = truth.target_xyz.copy()
     normal = np.zeros_like(p)
     for axis, top in ((0, lx), (1, ly), (2, lz)):
@@ -501,10 +524,15 @@ def simulate_scan(
     pose = truth.poses[station]
     m = opk_to_matrix(pose[3], pose[4], pose[5])
     x0 = pose[:3]
-    centres = np.vstack([scene.sphere_xyz, scene.board_xyz]) if len(scene.board_xyz) else (
-        scene.sphere_xyz)  # fmt: skip
-    sizes = np.r_[np.full(len(scene.sphere_xyz), scene.radius),
-                  np.full(len(scene.board_xyz), scene.half_size * math.sqrt(2))]  # fmt: skip
+    centres = (
+        np.vstack([scene.sphere_xyz, scene.board_xyz])
+        if len(scene.board_xyz)
+        else (scene.sphere_xyz)
+    )
+    sizes = np.r_[
+        np.full(len(scene.sphere_xyz), scene.radius),
+        np.full(len(scene.board_xyz), scene.half_size * math.sqrt(2)),
+    ]
     d = (centres - x0) @ m.T
     rho_c = np.linalg.norm(d, axis=1)
     theta_c = np.arctan2(d[:, 1], d[:, 0])
@@ -524,11 +552,13 @@ def simulate_scan(
         t2, a2 = np.meshgrid(tt, aa, indexing="ij")
         rays.append(np.column_stack([t2.ravel(), a2.ravel()]))
     if not rays:
-        return SimulatedScan(truth.station_ids[station], np.zeros((0, 3)), np.zeros(0),
-                             np.zeros(0, dtype=np.int64))  # fmt: skip
+        return SimulatedScan(
+            truth.station_ids[station], np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=np.int64)
+        )
     ta = np.vstack(rays)
-    u = np.column_stack([np.cos(ta[:, 1]) * np.cos(ta[:, 0]),
-                         np.cos(ta[:, 1]) * np.sin(ta[:, 0]), np.sin(ta[:, 1])])  # fmt: skip
+    u = np.column_stack(
+        [np.cos(ta[:, 1]) * np.cos(ta[:, 0]), np.cos(ta[:, 1]) * np.sin(ta[:, 0]), np.sin(ta[:, 1])]
+    )
     rho, inten, label = _hits(scene, m, x0, u)
     keep = np.isfinite(rho)
     if hide_below is not None and len(scene.sphere_xyz):
@@ -550,6 +580,7 @@ def simulate_scan(
         inten[bad] = rng.uniform(0.0, 1.0, int(bad.sum()))
         label[bad] = -2
     ca = np.cos(a_obs)
-    xyz = np.column_stack([r_obs * ca * np.cos(t_obs), r_obs * ca * np.sin(t_obs),
-                           r_obs * np.sin(a_obs)])  # fmt: skip
+    xyz = np.column_stack(
+        [r_obs * ca * np.cos(t_obs), r_obs * ca * np.sin(t_obs), r_obs * np.sin(a_obs)]
+    )
     return SimulatedScan(truth.station_ids[station], xyz, inten, label)

@@ -53,8 +53,9 @@ def canon_ixus_120() -> Camera:
 
     At 188 m this gives the 5.8 cm ground sample distance of the paper's block.
     """
-    return Camera("Canon IXUS 120 IS", focal_mm=5.0, pixel_size_mm=0.00154, width_px=4000,
-                  height_px=3000)  # fmt: skip
+    return Camera(
+        "Canon IXUS 120 IS", focal_mm=5.0, pixel_size_mm=0.00154, width_px=4000, height_px=3000
+    )
 
 
 @dataclass(frozen=True)
@@ -171,8 +172,9 @@ class UavBlock:
     def terrain(self, e: Array, n: Array) -> Array:
         """Ellipsoidal height (m) of the simulated terrain at easting/northing arrays (the
         surface the points lie on; for orthophotos and DSMs of the block)."""
-        return _terrain(self.config, np.asarray(e, dtype=np.float64),
-                        np.asarray(n, dtype=np.float64))  # fmt: skip
+        return _terrain(
+            self.config, np.asarray(e, dtype=np.float64), np.asarray(n, dtype=np.float64)
+        )
 
     def write(self, folder: Union[str, Path], eo: str = "dg") -> dict[str, Path]:
         """Write the bundle inputs (camera, observations, ground points, EO with sigmas) and
@@ -228,8 +230,9 @@ def _true_ap(family: str, cam: Camera, scale_px: float, rng) -> dict[str, float]
         # decentring (coefficients for millimetre coordinates, correction convention).
         return {"k1": 8.0e-4, "k2": -1.0e-5, "k3": 0.0, "p1": 6.0e-5, "p2": -4.0e-5}
     model = make_ap_model(family, w, h, cam.focal_mm)
-    grid = np.stack(np.meshgrid(np.linspace(-w / 2, w / 2, 9), np.linspace(-h / 2, h / 2, 7)),
-                    -1).reshape(-1, 2)  # fmt: skip
+    grid = np.stack(
+        np.meshgrid(np.linspace(-w / 2, w / 2, 9), np.linspace(-h / 2, h / 2, 7)), -1
+    ).reshape(-1, 2)
     basis = model.jacobian_params(grid)  # (n, 2, P) mm per unit
     peak = np.abs(basis).max(axis=(0, 1))
     p = model.n_params
@@ -256,8 +259,13 @@ def _true_camera(
         lens = nominal.distortion
     else:
         lens = make_ap_model(ap_model, w_mm, h_mm, nominal.focal_mm, **true_ap)
-    true_cam = replace(nominal, focal_mm=cfg.true_focal_mm, x0_mm=cfg.true_x0_mm,
-                       y0_mm=cfg.true_y0_mm, distortion=lens)  # fmt: skip
+    true_cam = replace(
+        nominal,
+        focal_mm=cfg.true_focal_mm,
+        x0_mm=cfg.true_x0_mm,
+        y0_mm=cfg.true_y0_mm,
+        distortion=lens,
+    )
     return true_ap, true_cam
 
 
@@ -301,22 +309,28 @@ def _flight_plan(cfg: UavBlockConfig) -> _Plan:
             headings.append(hd if sign > 0 else hd + math.pi)
             names.append(f"IMG_{s + 1:02d}{k + 1:02d}")
             strips.append(f"strip {s + 1}")
-    return _Plan(fwd, right, centre, along, across, base, spacing, np.array(plan_xy), headings,
-                 names, strips)  # fmt: skip
+    return _Plan(
+        fwd, right, centre, along, across, base, spacing, np.array(plan_xy), headings, names, strips
+    )
 
 
 def _true_poses(
-    cfg: UavBlockConfig, plan: _Plan, mapping: MappingFrame, local: LocalFrame,
+    cfg: UavBlockConfig,
+    plan: _Plan,
+    mapping: MappingFrame,
+    local: LocalFrame,
     rng: np.random.Generator,
 ) -> tuple[Array, Array, ExteriorOrientationTable]:
     """The plan plus jitter, camera looking down with the image top forward: (centres in the
     local frame (M, 3), local EO rows (M, 6), the true EO table on the map)."""
     M = plan.xy.shape[0]
     z_plan = float(_terrain(cfg, plan.centre[:1], plan.centre[1:])[0])
-    xyz_map = np.column_stack([
-        plan.xy + rng.normal(0, cfg.position_jitter_m, (M, 2)),
-        np.full(M, z_plan + cfg.flying_height_m) + rng.normal(0, cfg.position_jitter_m, M),
-    ])  # fmt: skip
+    xyz_map = np.column_stack(
+        [
+            plan.xy + rng.normal(0, cfg.position_jitter_m, (M, 2)),
+            np.full(M, z_plan + cfg.flying_height_m) + rng.normal(0, cfg.position_jitter_m, M),
+        ]
+    )
     centres = local.map_to_enu(xyz_map)
     jitter = np.radians(rng.normal(0, cfg.attitude_jitter_deg, (M, 3)))
     # camera -> local: kappa turns the image top to the heading (heading clockwise from north)
@@ -339,13 +353,17 @@ def _direct_georeferencing(
     dg_xyz = eo_true.xyz + nrng.normal(0, cfg.dg_position_sigma_m, (M, 3))
     dg_opk = eo_true.opk + np.radians(nrng.normal(0, cfg.dg_attitude_sigma_deg, (M, 3)))
     eo_dg = replace(eo_true, xyz=dg_xyz, opk=dg_opk)
-    eo_sigma = np.tile([cfg.dg_position_sigma_m] * 3 + [math.radians(cfg.dg_attitude_sigma_deg)]
-                       * 3, (M, 1))  # fmt: skip
+    eo_sigma = np.tile(
+        [cfg.dg_position_sigma_m] * 3 + [math.radians(cfg.dg_attitude_sigma_deg)] * 3, (M, 1)
+    )
     return eo_dg, eo_sigma
 
 
 def _surveyed_points(
-    cfg: UavBlockConfig, plan: _Plan, ext: tuple[float, float], rng: np.random.Generator,
+    cfg: UavBlockConfig,
+    plan: _Plan,
+    ext: tuple[float, float],
+    rng: np.random.Generator,
     nrng: np.random.Generator,
 ) -> tuple[Array, GroundPoints]:
     """A jittered grid of control points over the block's extent (along, across; metres),
@@ -357,9 +375,11 @@ def _surveyed_points(
     gu, gv = np.meshgrid(np.linspace(-0.42, 0.42, cols), np.linspace(-0.42, 0.42, rows_))
     cells = np.column_stack([gu.ravel(), gv.ravel()])[:n_gcp]
     cells = cells + rng.uniform(-0.04, 0.04, cells.shape)
-    gxy = plan.centre + (cells[:, :1] * ext_along) * plan.fwd + (cells[:, 1:] * ext_across) * (
-        plan.right
-    )  # fmt: skip
+    gxy = (
+        plan.centre
+        + (cells[:, :1] * ext_along) * plan.fwd
+        + (cells[:, 1:] * ext_across) * (plan.right)
+    )
     gcp_true = np.column_stack([gxy, _terrain(cfg, gxy[:, 0], gxy[:, 1])])
     order = rng.permutation(n_gcp)
     check_set = set(order[: cfg.n_check].tolist())
@@ -371,15 +391,21 @@ def _surveyed_points(
 
 
 def _project_all(
-    cfg: UavBlockConfig, plan: _Plan, true_cam: Camera, centres: Array, eo_local: Array,
+    cfg: UavBlockConfig,
+    plan: _Plan,
+    true_cam: Camera,
+    centres: Array,
+    eo_local: Array,
     pts_local: Array,
 ) -> tuple[NDArray[np.intp], NDArray[np.intp], Array]:
     """(image, point, pixel) of every point in front of a camera and inside its frame; only
     the points near each image's footprint are projected (large blocks)."""
     rec_img, rec_pt, rec_px = [], [], []
-    reach = 0.75 * math.hypot(plan.along, plan.across) + 3.0 * cfg.position_jitter_m + (
-        cfg.flying_height_m * math.tan(math.radians(4.0 * cfg.attitude_jitter_deg))
-    )  # fmt: skip
+    reach = (
+        0.75 * math.hypot(plan.along, plan.across)
+        + 3.0 * cfg.position_jitter_m
+        + (cfg.flying_height_m * math.tan(math.radians(4.0 * cfg.attitude_jitter_deg)))
+    )
     order = np.argsort(pts_local[:, 0])
     xs = pts_local[order, 0]
     for k in range(len(centres)):
@@ -396,8 +422,14 @@ def _project_all(
 
 
 def _measurements(
-    cfg: UavBlockConfig, names: list[str], all_ids: list[str], ground: GroundPoints,
-    img: NDArray[np.intp], pt: NDArray[np.intp], px: Array, nrng: np.random.Generator,
+    cfg: UavBlockConfig,
+    names: list[str],
+    all_ids: list[str],
+    ground: GroundPoints,
+    img: NDArray[np.intp],
+    pt: NDArray[np.intp],
+    px: Array,
+    nrng: np.random.Generator,
 ) -> tuple[ImageObservations, NDArray[np.intp]]:
     """The image observations (points seen twice or more, targets also once but for a check
     point), with pixel noise; and the indices of the tie points kept (into the tie list)."""
@@ -487,8 +519,18 @@ def simulate_uav_block(
     img, pt, px = _project_all(cfg, plan, true_cam, centres, eo_local, pts_local)
     obs, tie_keep = _measurements(cfg, plan.names, all_ids, ground, img, pt, px, nrng)
     return UavBlock(
-        config=cfg, mapping=mapping, camera=cfg.camera, true_camera=true_cam, ap_model=ap_model,
-        true_ap=true_ap, eo_true=eo_true, eo_dg=eo_dg, eo_sigma=eo_sigma, observations=obs,
-        ground=ground, ground_true=gcp_true, tie_id=tuple(tie_ids[k] for k in tie_keep),
+        config=cfg,
+        mapping=mapping,
+        camera=cfg.camera,
+        true_camera=true_cam,
+        ap_model=ap_model,
+        true_ap=true_ap,
+        eo_true=eo_true,
+        eo_dg=eo_dg,
+        eo_sigma=eo_sigma,
+        observations=obs,
+        ground=ground,
+        ground_true=gcp_true,
+        tie_id=tuple(tie_ids[k] for k in tie_keep),
         tie_true=tie_map[tie_keep],
-    )  # fmt: skip
+    )

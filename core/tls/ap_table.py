@@ -51,22 +51,48 @@ AP_TERMS: dict[str, ApTerm] = {
         ApTerm("a3", RANGE, "a3 cos(4 pi rho / U)", "cyclic range error (cosine)", "mm", _MM),
         ApTerm("b1", HORIZONTAL, "b1 sec(alpha)", "collimation axis error", "arcsec", _AS),
         ApTerm("b2", HORIZONTAL, "b2 tan(alpha)", "trunnion axis error", "arcsec", _AS),
-        ApTerm("b3", HORIZONTAL, "b3 sin(theta)", "horizontal circle eccentricity (sine)",
-               "arcsec", _AS),
-        ApTerm("b4", HORIZONTAL, "b4 cos(theta)", "horizontal circle eccentricity (cosine)",
-               "arcsec", _AS),
-        ApTerm("b5", HORIZONTAL, "b5 sin(2 theta)",
-               "non-orthogonality of the horizontal encoder (sine)", "arcsec", _AS),
-        ApTerm("b6", HORIZONTAL, "b6 cos(2 theta)",
-               "non-orthogonality of the horizontal encoder (cosine)", "arcsec", _AS),
+        ApTerm(
+            "b3",
+            HORIZONTAL,
+            "b3 sin(theta)",
+            "horizontal circle eccentricity (sine)",
+            "arcsec",
+            _AS,
+        ),
+        ApTerm(
+            "b4",
+            HORIZONTAL,
+            "b4 cos(theta)",
+            "horizontal circle eccentricity (cosine)",
+            "arcsec",
+            _AS,
+        ),
+        ApTerm(
+            "b5",
+            HORIZONTAL,
+            "b5 sin(2 theta)",
+            "non-orthogonality of the horizontal encoder (sine)",
+            "arcsec",
+            _AS,
+        ),
+        ApTerm(
+            "b6",
+            HORIZONTAL,
+            "b6 cos(2 theta)",
+            "non-orthogonality of the horizontal encoder (cosine)",
+            "arcsec",
+            _AS,
+        ),
         ApTerm("c0", VERTICAL, "c0", "vertical circle index error", "arcsec", _AS),
         ApTerm("c1", VERTICAL, "c1 alpha", "vertical encoder scale error", "arcsec", _AS),
-        ApTerm("c2", VERTICAL, "c2 sin(alpha)", "vertical circle eccentricity (sine)",
-               "arcsec", _AS),
-        ApTerm("c3", VERTICAL, "c3 cos(alpha)", "vertical circle eccentricity (cosine)",
-               "arcsec", _AS),
+        ApTerm(
+            "c2", VERTICAL, "c2 sin(alpha)", "vertical circle eccentricity (sine)", "arcsec", _AS
+        ),
+        ApTerm(
+            "c3", VERTICAL, "c3 cos(alpha)", "vertical circle eccentricity (cosine)", "arcsec", _AS
+        ),
     )
-}  # fmt: skip
+}
 
 #: Named AP sets: none (registration only), the paper's four, Lichti's (2007) physical set.
 AP_SETS: dict[str, tuple[str, ...]] = {

@@ -59,6 +59,8 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
+
+
 def ap_terms(selection: str | tuple[str, ...] | list[str]) -> tuple[str, ...]:
     """The term names of a set name (``"paper"``) or a list (``"a0,b1,c0"``), in table order.
 

@@ -389,19 +389,22 @@ def _build(
                 sigma=obs.cov[rows],
                 param_index=index,
                 model=model,
-                labels=[f"{obs.station[i]} / {obs.target[i]}"
-                        + (" (face II)" if face[i] else "") for i in rows],
+                labels=[
+                    f"{obs.station[i]} / {obs.target[i]}" + (" (face II)" if face[i] else "")
+                    for i in rows
+                ],
                 row_names=("range", "horizontal", "vertical"),
             )
-        )  # fmt: skip
+        )
         obs_of_block[label] = rows
     levelled = np.array(
         [
-            opts.levelled if infos.get(s) is None or infos[s].levelled is None
+            opts.levelled
+            if infos.get(s) is None or infos[s].levelled is None
             else bool(infos[s].levelled)
             for s in stations
         ]
-    )  # fmt: skip
+    )
     lev = [s for s, lv in zip(stations, levelled) if lv]
     if lev:
         idx, val = [], []
@@ -411,8 +414,11 @@ def _build(
             idx += [s_at[s] + 3, s_at[s] + 4]
             val += [float(given[0]), float(given[1])]
             x0a[s_at[s] + 3], x0a[s_at[s] + 4] = given[0], given[1]
-        blocks.append(prior_block("compensator", idx, val, opts.tilt_sigma_rad,
-                                  labels=[names[i] for i in idx]))  # fmt: skip
+        blocks.append(
+            prior_block(
+                "compensator", idx, val, opts.tilt_sigma_rad, labels=[names[i] for i in idx]
+            )
+        )
     if weighted:
         idx, val, sig = [], [], []
         for c in weighted:
@@ -425,8 +431,11 @@ def _build(
     if reference is not None and opts.datum == "inner" and free:
         d_idx = np.array([t_at[t] + q for t in free for q in range(3)], dtype=np.intp)
         rotations = (2,) if levelled.any() else (0, 1, 2)
-        constraints.append(Constraint("datum (inner constraints)", d_idx[None, :],
-                                      _InnerConstraint(x0a[d_idx], rotations)))  # fmt: skip
+        constraints.append(
+            Constraint(
+                "datum (inner constraints)", d_idx[None, :], _InnerConstraint(x0a[d_idx], rotations)
+            )
+        )
         datum_fixed = []
     elif reference is not None:
         base = s_at[reference]
@@ -435,8 +444,19 @@ def _build(
         values = x0a[d_idx].copy()
         constraints.append(Constraint("datum", d_idx[None, :], _DatumConstraint(values)))
         datum_fixed = [names[i] for i in d_idx]
-    return _Layout(aps, stations, free, fixed, names, x0a, blocks, constraints, obs_of_block,
-                   levelled, datum_fixed)  # fmt: skip
+    return _Layout(
+        aps,
+        stations,
+        free,
+        fixed,
+        names,
+        x0a,
+        blocks,
+        constraints,
+        obs_of_block,
+        levelled,
+        datum_fixed,
+    )
 
 
 def _run(
@@ -453,8 +473,15 @@ def _run(
         max_iterations=opts.max_iterations,
     )
     try:
-        return adjust(lay.x0, lay.names, lay.blocks, lay.constraints, options=aopts,
-                      progress=progress, should_stop=should_stop)  # fmt: skip
+        return adjust(
+            lay.x0,
+            lay.names,
+            lay.blocks,
+            lay.constraints,
+            options=aopts,
+            progress=progress,
+            should_stop=should_stop,
+        )
     except NotObservableError as exc:
         raise TlsNotObservable(exc, diagnose(exc.parameters, has_control)) from exc
 
@@ -513,8 +540,11 @@ def _select(
                 raise
             drop = named[-1]  # the later (less physical) term of the table
             current.remove(drop)
-            steps.append(SelectionStep(drop, "not determinable with the others "
-                                       f"({', '.join(named)})", tuple(current)))  # fmt: skip
+            steps.append(
+                SelectionStep(
+                    drop, f"not determinable with the others ({', '.join(named)})", tuple(current)
+                )
+            )
             continue
         k = len(current)
         t, tcrit = _ap_stats(res, k, opts.significance_alpha)
@@ -534,8 +564,10 @@ def _select(
             drop_i = i if t[i] < t[j] else j
             keep_i = j if drop_i == i else i
             drop = current[drop_i]
-            reason = (f"correlated with {current[keep_i]} (r = {corr[i, j]:+.3f}) and less "
-                      f"significant (t = {t[drop_i]:.2f} vs {t[keep_i]:.2f})")  # fmt: skip
+            reason = (
+                f"correlated with {current[keep_i]} (r = {corr[i, j]:+.3f}) and less "
+                f"significant (t = {t[drop_i]:.2f} vs {t[keep_i]:.2f})"
+            )
         else:
             low = int(np.nanargmin(t))
             if t[low] >= tcrit:
@@ -573,10 +605,9 @@ def _check_levelled(
                 f"place it at omega, phi = {np.degrees(poses[s][3]):.2f}, "
                 f"{np.degrees(poses[s][4]):.2f} deg: mark it levelled = 0 in the stations "
                 "table (a tilted or rotated scanner)"
-                + (", or check that the control is in a frame with z up" if has_control
-                   else ""),
+                + (", or check that the control is in a frame with z up" if has_control else ""),
                 **obs.where(k),
-            )  # fmt: skip
+            )
 
 
 def calibrate(
@@ -630,6 +661,7 @@ def calibrate(
     reference = opts.reference_station
     if reference is not None and reference not in known_stations:
         raise InputError(f"the reference station '{reference}' has no observations")
+
     def is_levelled(sid: str) -> bool:
         info = infos.get(sid)
         return opts.levelled if info is None or info.levelled is None else bool(info.levelled)
@@ -646,8 +678,9 @@ def calibrate(
     _check_levelled(obs, infos, levelled_ids, poses, has_control)
     steps: list[SelectionStep] = []
     if opts.select_aps and aps:
-        aps, steps = _select(obs, control, infos, opts, aps, poses, targets, ref, has_control,
-                             should_stop)  # fmt: skip
+        aps, steps = _select(
+            obs, control, infos, opts, aps, poses, targets, ref, has_control, should_stop
+        )
     lay = _build(obs, control, infos, opts, aps, poses, targets, ref, {})
     res = _run(lay, opts, opts.snooping, has_control, progress, should_stop)
     k = len(aps)

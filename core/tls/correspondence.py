@@ -72,8 +72,7 @@ def match_targets(
                 if k == kk:
                     continue
                 ok = np.flatnonzero(
-                    (np.abs(db[k] - da[i, m]) < tolerance)
-                    & (np.abs(db[kk] - da[j, m]) < tolerance)
+                    (np.abs(db[k] - da[i, m]) < tolerance) & (np.abs(db[kk] - da[j, m]) < tolerance)
                 )
                 for q in ok:
                     if q in (k, kk):
@@ -85,11 +84,13 @@ def match_targets(
                     # Regular target layouts repeat triangles: ask a fourth target of a to be
                     # at matching distances from some target of b before trying the motion.
                     if with_fourth and not any(
-                        np.any((np.abs(db[k] - da[i, n]) < tolerance)
-                               & (np.abs(db[kk] - da[j, n]) < tolerance)
-                               & (np.abs(db[q] - da[m, n]) < tolerance))
+                        np.any(
+                            (np.abs(db[k] - da[i, n]) < tolerance)
+                            & (np.abs(db[kk] - da[j, n]) < tolerance)
+                            & (np.abs(db[q] - da[m, n]) < tolerance)
+                        )
                         for n in fourth[(i, j, m)]
-                    ):  # fmt: skip
+                    ):
                         continue
                     try:
                         r, t, _ = kabsch(pa[[i, j, m]], pb[[k, kk, q]])
@@ -112,8 +113,9 @@ def match_targets(
         best = search(with_fourth=False)
     ia_all = np.arange(na)
     if best[1] is None or best[0] < min_matches:
-        raise InputError(f"fewer than {min_matches} targets in common could be matched "
-                         f"(best {best[0]})")  # fmt: skip
+        raise InputError(
+            f"fewer than {min_matches} targets in common could be matched (best {best[0]})"
+        )
     r, t = best[1]
     for _ in range(2):
         moved = pa @ r.T + t
@@ -197,9 +199,11 @@ def label_targets(
                 best = (s, ia, ib, r, t)
         if best is None:
             left = [s for s in range(len(cs)) if s not in done]
-            raise InputError(f"scan {left[0] + 1} shares fewer than three targets with the "
-                             "scans labelled so far (distances compared within "
-                             f"{tolerance:g} m)")  # fmt: skip
+            raise InputError(
+                f"scan {left[0] + 1} shares fewer than three targets with the "
+                "scans labelled so far (distances compared within "
+                f"{tolerance:g} m)"
+            )
         s, ia, ib, r, t = best
         moved = cs[s] @ r.T + t
         for a_i, b_i in zip(ia, ib):

@@ -87,10 +87,12 @@ def diagnose(parameters: Sequence[str], has_control: bool) -> list[str]:
             continue
         out.append(
             f"{ap} ({AP_TERMS[ap].cause}) is not determined by this network: "
-            + (explain_pair(ap, next((p for p in parameters if p not in AP_TERMS), ap))
-               or "observe a wider range of angles, ranges and station set-ups")
+            + (
+                explain_pair(ap, next((p for p in parameters if p not in AP_TERMS), ap))
+                or "observe a wider range of angles, ranges and station set-ups"
+            )
             + "."
-        )  # fmt: skip
+        )
     stations = sorted({p.split(".")[0] for p in parameters if p not in AP_TERMS})
     if stations and not aps:
         out.append(

@@ -214,8 +214,10 @@ def check_network(
     except np.linalg.LinAlgError:
         ev = np.linalg.eigvalsh(obs.cov)[:, 0]
         k = int(np.flatnonzero(ev <= 0)[0]) if (ev <= 0).any() else 0
-        raise InputError("the covariance of the observation is not positive definite "
-                         "(a sigma of zero?)", **obs.where(k)) from None  # fmt: skip
+        raise InputError(
+            "the covariance of the observation is not positive definite (a sigma of zero?)",
+            **obs.where(k),
+        ) from None
     face = obs.face_two
     seen: dict[tuple[str, str, bool], int] = {}
     for k, key in enumerate(zip(obs.station, obs.target, face)):

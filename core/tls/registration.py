@@ -77,7 +77,10 @@ def scanner_to_object(
     [[10.0, 21.0, 1.5]]
     """
     p = np.asarray(pose, dtype=np.float64)
-    d = remove_ap_corrections(xyz, names, values, wavelength_m) if len(names) else (
-        np.asarray(xyz, dtype=np.float64))  # fmt: skip
+    d = (
+        remove_ap_corrections(xyz, names, values, wavelength_m)
+        if len(names)
+        else (np.asarray(xyz, dtype=np.float64))
+    )
     m = opk_to_matrix(p[3], p[4], p[5])
     return d @ m + p[:3]

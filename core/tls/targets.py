@@ -155,8 +155,10 @@ def _ransac_sphere(
     rr = np.full(c.shape[0], radius) if radius is not None else r
     best, best_count = 0, -1
     for lo in range(0, c.shape[0], 64):  # (64, N) distances at a time
-        d = np.abs(np.linalg.norm(p[None, :, :] - c[lo : lo + 64, None, :], axis=2)
-                   - rr[lo : lo + 64, None])  # fmt: skip
+        d = np.abs(
+            np.linalg.norm(p[None, :, :] - c[lo : lo + 64, None, :], axis=2)
+            - rr[lo : lo + 64, None]
+        )
         counts = (d < threshold).sum(axis=1)
         q = int(np.argmax(counts))
         if counts[q] > best_count:
@@ -255,8 +257,10 @@ def fit_sphere(
     """
     p = np.asarray(points, dtype=np.float64)
     if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < max(min_points, 4):
-        raise InputError(f"a sphere fit needs at least {max(min_points, 4)} points, got "
-                         f"{p.shape[0] if p.ndim == 2 else 0}")  # fmt: skip
+        raise InputError(
+            f"a sphere fit needs at least {max(min_points, 4)} points, got "
+            f"{p.shape[0] if p.ndim == 2 else 0}"
+        )
     rng = np.random.default_rng(rng)
     cov = beam_covariance(p, sigma_range_m, sigma_angle_rad)
     point_sigma = float(np.sqrt(np.max(np.linalg.eigvalsh(cov)[:, -1])))
@@ -265,8 +269,9 @@ def fit_sphere(
     free = radius is None or estimate_radius
     for _ in range(2):
         if inl.sum() < min_points:
-            raise InputError(f"only {int(inl.sum())} points on the sphere (at least "
-                             f"{min_points} needed)")  # fmt: skip
+            raise InputError(
+                f"only {int(inl.sum())} points on the sphere (at least {min_points} needed)"
+            )
         c, ccov, r, s0 = _sphere_lsq(p[inl], cov[inl], c, r, free)
         fitted = inl  # the set the centre, radius and covariance come from
         d = np.linalg.norm(p - c, axis=1) - r
@@ -400,8 +405,7 @@ def fit_checkerboard(
     p = np.asarray(points, dtype=np.float64)
     it = np.asarray(intensity, dtype=np.float64)
     if p.shape[0] < min_points:
-        raise InputError(f"a checkerboard fit needs at least {min_points} points, got "
-                         f"{p.shape[0]}")  # fmt: skip
+        raise InputError(f"a checkerboard fit needs at least {min_points} points, got {p.shape[0]}")
     rng = np.random.default_rng(rng)
     rmax = float(np.max(np.linalg.norm(p, axis=1)))
     point_sigma = math.hypot(sigma_range_m, rmax * sigma_angle_rad)
@@ -418,8 +422,9 @@ def fit_checkerboard(
     b = np.where(iq > thr, 1.0, -1.0)
     u0, v0, beta, score = _checker_start(uv, b, half_size)
     if abs(score) < min_contrast:
-        raise InputError(f"no checker pattern in the points (score {abs(score):.2f} < "
-                         f"{min_contrast:g})")  # fmt: skip
+        raise InputError(
+            f"no checker pattern in the points (score {abs(score):.2f} < {min_contrast:g})"
+        )
     lo, hi = np.percentile(iq, [10, 90])
     spacing = _median_spacing(uv)
     s_blur = blur if blur is not None else max(0.5 * spacing, 1e-4)
@@ -429,8 +434,9 @@ def fit_checkerboard(
         vp = -du * math.sin(beta) + dv * math.cos(beta)
         use = (np.abs(up) < 0.9 * half_size) & (np.abs(vp) < 0.9 * half_size)
         if use.sum() < min_points:
-            raise InputError(f"only {int(use.sum())} points on the board (at least "
-                             f"{min_points} needed)")  # fmt: skip
+            raise InputError(
+                f"only {int(use.sum())} points on the board (at least {min_points} needed)"
+            )
         within = np.abs(iq[use] - np.where(b[use] > 0, hi, lo))
         sig_i = max(1.4826 * float(np.median(within)), 1e-6 * max(abs(hi - lo), 1e-12))
         model = _CheckerModel(uv[use], s_blur)
@@ -442,8 +448,12 @@ def fit_checkerboard(
             param_index=np.tile(np.arange(5), (int(use.sum()), 1)),
             model=model,
         )
-        res = adjust(x0, ["u0", "v0", "beta", "m", "a"], [block],
-                     options=AdjustmentOptions(max_iterations=40))  # fmt: skip
+        res = adjust(
+            x0,
+            ["u0", "v0", "beta", "m", "a"],
+            [block],
+            options=AdjustmentOptions(max_iterations=40),
+        )
         if not res.converged:
             raise AdjustmentError("the checkerboard fit did not converge")
         u_new, v_new, beta = float(res.x[0]), float(res.x[1]), float(res.x[2])
@@ -461,8 +471,17 @@ def fit_checkerboard(
     local[2, 2] = plane_var
     cov = basis @ local @ basis.T
     rms = float(np.sqrt(np.mean(dist**2)))
-    return TargetFit("checkerboard", centre, cov, p.shape[0], int(use.sum()), rms,
-                     float(res.sigma0), half_size, normal)  # fmt: skip
+    return TargetFit(
+        "checkerboard",
+        centre,
+        cov,
+        p.shape[0],
+        int(use.sum()),
+        rms,
+        float(res.sigma0),
+        half_size,
+        normal,
+    )
 
 
 def _otsu(values: Array, bins: int = 128) -> float:
@@ -552,8 +571,9 @@ def detect_spheres(
     order = np.argsort(-counts)
     tree = cKDTree(p)
     found: list[TargetFit] = []
-    point_sigma = math.hypot(sigma_range_m, float(np.median(np.linalg.norm(p, axis=1)))
-                             * sigma_angle_rad)  # fmt: skip
+    point_sigma = math.hypot(
+        sigma_range_m, float(np.median(np.linalg.norm(p, axis=1))) * sigma_angle_rad
+    )
     # A visible hemisphere fills about 2 pi R^2 / step^2 voxels of the thinned cloud (about
     # 100); a wall's offset plane puts about (cell / step)^2 = 4 votes in a cell.
     min_votes = max(12, int(0.2 * 2 * math.pi * (radius / step) ** 2))
@@ -568,8 +588,14 @@ def detect_spheres(
         if len(near) < min_points:
             continue
         try:
-            fit = fit_sphere(p[near], radius, sigma_range_m, sigma_angle_rad,
-                             min_points=min_points, estimate_radius=True)  # fmt: skip
+            fit = fit_sphere(
+                p[near],
+                radius,
+                sigma_range_m,
+                sigma_angle_rad,
+                min_points=min_points,
+                estimate_radius=True,
+            )
         except (InputError, AdjustmentError):
             continue
         if abs(fit.size - radius) > 0.1 * radius or fit.rms > max_rms_factor * point_sigma:
@@ -580,8 +606,7 @@ def detect_spheres(
             continue
         # Refit with the known radius (the estimated one only checked the candidate).
         try:
-            fit = fit_sphere(p[near], radius, sigma_range_m, sigma_angle_rad,
-                             min_points=min_points)  # fmt: skip
+            fit = fit_sphere(p[near], radius, sigma_range_m, sigma_angle_rad, min_points=min_points)
         except (InputError, AdjustmentError):
             continue
         found.append(fit)
@@ -653,8 +678,15 @@ def detect_checkerboards(
             continue
         nb = tree.query_ball_point(p[s], 1.2 * half_size)
         try:
-            fit = fit_checkerboard(p[nb], it[nb], half_size, sigma_range_m, sigma_angle_rad,
-                                   min_points=min_points, min_contrast=min_contrast)  # fmt: skip
+            fit = fit_checkerboard(
+                p[nb],
+                it[nb],
+                half_size,
+                sigma_range_m,
+                sigma_angle_rad,
+                min_points=min_points,
+                min_contrast=min_contrast,
+            )
         except (InputError, AdjustmentError):
             continue
         if np.linalg.norm(fit.centre - p[s]) > half_size:
@@ -662,8 +694,15 @@ def detect_checkerboards(
         # Refit centred on the found centre (the seed may sit off-centre).
         nb = tree.query_ball_point(fit.centre, 1.2 * half_size)
         try:
-            fit = fit_checkerboard(p[nb], it[nb], half_size, sigma_range_m, sigma_angle_rad,
-                                   min_points=min_points, min_contrast=min_contrast)  # fmt: skip
+            fit = fit_checkerboard(
+                p[nb],
+                it[nb],
+                half_size,
+                sigma_range_m,
+                sigma_angle_rad,
+                min_points=min_points,
+                min_contrast=min_contrast,
+            )
         except (InputError, AdjustmentError):
             continue
         if any(np.linalg.norm(f.centre - fit.centre) < half_size for f in found):

@@ -169,9 +169,11 @@ def test_fisheye_camera_in_the_dock(qgis_parent, qgis_app, fisheye_block, fishey
         checked += 1
         bows.append(bow)
     assert checked >= 3
-    print(f"\n{checked} long lines in {image}: vertices {[len(by_id[i]) for i in long_seen]}, "
-          f"off their chords up to {max(bows):.1f} px, drawn within {worst:.3f} px of the "
-          f"exact image; {overlays.line_vertices} vertices for {len(drawn)} lines drawn")
+    print(
+        f"\n{checked} long lines in {image}: vertices {[len(by_id[i]) for i in long_seen]}, "
+        f"off their chords up to {max(bows):.1f} px, drawn within {worst:.3f} px of the "
+        f"exact image; {overlays.line_vertices} vertices for {len(drawn)} lines drawn"
+    )
 
     # a real click on a roof (zoom 2, the centre of an outline wholly inside the image)
     k, centre = next((k, r.mean(axis=0))
@@ -257,7 +259,9 @@ def test_fisheye_resection_from_the_dock_leaves_the_lines_out(
     dopk = (run.result.opk - truth.opk[k] + np.pi) % (2 * np.pi) - np.pi
     assert np.all(np.abs(dxyz) < 4 * std[:3]), (dxyz, std[:3])
     assert np.all(np.abs(dopk) < 4 * std[3:]), (dopk, std[3:])
-    print(f"\nfisheye resection of {image} from {len(seen)} LCPs: dxyz {np.round(dxyz, 3)} m "
-          f"(sigma {np.round(std[:3], 3)}), dopk {np.round(np.degrees(dopk), 4)} deg "
-          f"(sigma {np.round(np.degrees(std[3:]), 4)})")
+    print(
+        f"\nfisheye resection of {image} from {len(seen)} LCPs: dxyz {np.round(dxyz, 3)} m "
+        f"(sigma {np.round(std[:3], 3)}), dopk {np.round(np.degrees(dopk), 4)} deg "
+        f"(sigma {np.round(np.degrees(std[3:]), 4)})"
+    )
     dock.close()

@@ -119,9 +119,14 @@ def test_image_lists_take_raster_layers_files_and_folders(provider, tmp_path):
                 assert d.checkValueIsAcceptable(value, context), (p.name, value)
             assert not d.checkValueIsAcceptable(str(tmp_path / "missing.tif"), context)
     assert sorted(names) == [
-        "autoboresight.IMAGES", "calibratecamera.IMAGES", "locatecontrolpoints.CHIPS",
-        "locatecontrolpoints.IMAGES", "makecontrolchips.PHOTOS", "orthomosaic.ORTHOPHOTOS",
-        "orthorectify.IMAGES", "tiepoints.IMAGES",
+        "autoboresight.IMAGES",
+        "calibratecamera.IMAGES",
+        "locatecontrolpoints.CHIPS",
+        "locatecontrolpoints.IMAGES",
+        "makecontrolchips.PHOTOS",
+        "orthomosaic.ORTHOPHOTOS",
+        "orthorectify.IMAGES",
+        "tiepoints.IMAGES",
     ], names
 
 

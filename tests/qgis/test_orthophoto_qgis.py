@@ -191,8 +191,11 @@ def test_images_and_orthophotos_from_raster_layers(provider, demo, tmp_path):
         project.addMapLayer(memory)
         refused = "IMAGES: the layer scratch is not backed by a raster file"
         with pytest.raises(QgsProcessingException, match=refused):
-            processing.run("lidarphoto:orthorectify", _params(
-                demo, tmp_path / "m", IMAGES=[layers[0].id(), memory.id()]), context=context)
+            processing.run(
+                "lidarphoto:orthorectify",
+                _params(demo, tmp_path / "m", IMAGES=[layers[0].id(), memory.id()]),
+                context=context,
+            )
         assert not (tmp_path / "m").exists() or not any((tmp_path / "m").iterdir())
     finally:
         project.removeAllMapLayers()

@@ -37,8 +37,9 @@ def town(tmp_path_factory):
     pts = sample_town(scene, density=8.0, noise_sigma=0.05, seed=3)
     roof = (pts.face_id >= 0) & ~pts.is_wall
     xyz, face = pts.xyz[roof], pts.face_id[roof]
-    write_planes_csv(folder / "planes.csv",
-                     [fit_plane(xyz[face == f], plane_id=int(f)) for f in np.unique(face)])
+    write_planes_csv(
+        folder / "planes.csv", [fit_plane(xyz[face == f], plane_id=int(f)) for f in np.unique(face)]
+    )
     header = laspy.LasHeader(point_format=1, version="1.2")
     header.offsets = xyz.min(axis=0)
     header.scales = np.array([0.001, 0.001, 0.001])
@@ -88,11 +89,11 @@ def test_a_coordinate_table_loads_as_a_point_layer(provider, town, tmp_path):
     for row in rows:
         p = by_id[row["id"]]
         assert (p.x(), p.y(), p.z()) == pytest.approx(
-            (float(row["X"]), float(row["Y"]), float(row["Z"])), abs=1e-6)
+            (float(row["X"]), float(row["Y"]), float(row["Z"])), abs=1e-6
+        )
     assert layer.renderer().type() == "singleSymbol"
     # the graph table has no coordinates: it stays a file
     assert (tmp_path / "graph.csv").is_file() and "GRAPH_CSV" not in loaded
-
 
 
 def test_a_table_whose_layer_twin_was_written_does_not_load_twice(provider, town, tmp_path):
@@ -131,8 +132,11 @@ def test_commented_table_and_flags(provider, tmp_path):
 def test_a_classified_laz_loads_as_a_point_cloud_where_qgis_can(provider, tmp_path):
     cloud = tmp_path / "ground.laz"
     context = _context()
-    result = processing.run("lidarphoto:groundfiltersmrf",
-                            {"INPUT": str(AHN3), "OUTPUT_CLOUD": str(cloud)}, context=context)
+    result = processing.run(
+        "lidarphoto:groundfiltersmrf",
+        {"INPUT": str(AHN3), "OUTPUT_CLOUD": str(cloud)},
+        context=context,
+    )
     assert cloud.is_file() and result["OUTPUT_CLOUD"] == str(cloud)
     loaded = _loaded(context)
     if "pdal" in QgsProviderRegistry.instance().providerList():
