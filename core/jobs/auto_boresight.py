@@ -30,11 +30,27 @@ log = logging.getLogger(__name__)
 _AUTO = Fields("photo.auto_boresight_options", "AutoBoresightOptions")
 _OPTIONS = Fields("photo.boresight_options", "BoresightOptions")
 #: Columns of the rounds table (OUTPUT_ROUNDS).
-ROUND_COLUMNS = ("round", "search_px", "gate_m", "line_points", "lines_seen", "tie_tracks",
-                 "ties_associated", "ties_refused", "group", "d_omega_deg", "d_phi_deg",
-                 "d_kappa_deg", "std_d_omega_arcsec", "std_d_phi_arcsec", "std_d_kappa_arcsec",
-                 "change_d_omega_arcsec", "change_d_phi_arcsec", "change_d_kappa_arcsec",
-                 "rejected")  # fmt: skip
+ROUND_COLUMNS = (
+    "round",
+    "search_px",
+    "gate_m",
+    "line_points",
+    "lines_seen",
+    "tie_tracks",
+    "ties_associated",
+    "ties_refused",
+    "group",
+    "d_omega_deg",
+    "d_phi_deg",
+    "d_kappa_deg",
+    "std_d_omega_arcsec",
+    "std_d_phi_arcsec",
+    "std_d_kappa_arcsec",
+    "change_d_omega_arcsec",
+    "change_d_phi_arcsec",
+    "change_d_kappa_arcsec",
+    "rejected",
+)
 
 SPEC = AlgorithmSpec(
     name="autoboresight",
@@ -66,58 +82,159 @@ calibration), the observations found (image-observation CSV: Boresight calibrati
 again, e.g. to compare with hand picks), the rounds (CSV) and the HTML summary, whose settings
 give the counts per round and the ties refused per reason.""",
     params=(
-        Param("IMAGES", "files", "Images (files or folders)", suffixes=IMAGE_SUFFIXES,
-              help="the image id is the file name without extension, as in the trajectory"),
+        Param(
+            "IMAGES",
+            "files",
+            "Images (files or folders)",
+            suffixes=IMAGE_SUFFIXES,
+            help="the image id is the file name without extension, as in the trajectory",
+        ),
         Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
         Param("TRAJECTORY", "table", "Trajectory table (CSV)", file_filter=CSV_FILTER),
-        Param("CRS", "crs", "Mapping CRS", qgis_default="ProjectCrs",
-              help="projected CRS of the trajectory and of the LiDAR tables"),
+        Param(
+            "CRS",
+            "crs",
+            "Mapping CRS",
+            qgis_default="ProjectCrs",
+            help="projected CRS of the trajectory and of the LiDAR tables",
+        ),
         *mount_params(initial_boresight=True),
         Param("LINES", "table", "Line table (CSV)", file_filter=CSV_FILTER),
-        Param("PLANES", "table", "Plane table (CSV)", optional=True, file_filter=CSV_FILTER,
-              help="the roof planes of the tie points and of the observability check"),
-        Param("CLOUD", "pointcloud", "Cloud with plane ids (LAS/LAZ)", optional=True,
-              file_filter=LAS_FILTER, advanced=True,
-              help="the planes' outlines (convex hull of their points): needed by tie points"),
-        Param("TIE_POINTS", "table", "Tie points (observation CSV)", optional=True,
-              file_filter=CSV_FILTER, advanced=True, help="the output of Automatic tie points"),
-        Param("FIND_TIES", "boolean", "Find tie points when none are given",
-              _AUTO.find_ties, advanced=True,
-              help="without TIE_POINTS, and with PLANES and CLOUD, run Automatic tie points "
-              "on the images (pairs from the footprints, least-squares refinement on)"),
-        Param("HAND_PICKS", "table", "Hand picks to compare with (observation CSV)",
-              optional=True, file_filter=CSV_FILTER, advanced=True,
-              help="observations picked in the dock: their tie and line rows are calibrated "
-              "alone and the summary compares the two boresights"),
-        Param("SEARCH", "number", "Search range of the boresight", _AUTO.search_deg,
-              unit="degrees", minimum=0.0, maximum=10.0, advanced=True,
-              help="half width of the angle search about BORESIGHT (0: none)"),
-        Param("MAX_ROUNDS", "integer", "Most rounds", _AUTO.max_rounds, minimum=1, maximum=50,
-              advanced=True),
-        Param("GROUPING", "enum", "Boresight groups", _OPTIONS.groups, options=GROUPINGS,
-              labels=("one boresight for all images",
-                      "one per trajectory group (flight line, direction, session)",
-                      "one per heading direction (octant)"), advanced=True),
-        Param("ESTIMATE_LEVER_ARM", "boolean", "Estimate the lever arm",
-              _OPTIONS.estimate_lever_arm, advanced=True),
-        Param("ESTIMATE_INTERIOR", "boolean", "Estimate focal length and principal point",
-              _OPTIONS.estimate_interior, advanced=True),
-        Param("ESTIMATE_TIMING", "boolean", "Estimate the camera timing offset",
-              _OPTIONS.estimate_timing, advanced=True,
-              help="a constant dt (exposure = recorded time + dt) from the trajectory's "
-              "velocities (v_north, v_east, v_up columns, as Import trajectory writes them) or "
-              "from neighbouring exposures of each line; with the lever arm it needs lines at "
-              "clearly different speeds"),
-        Param("INS_GRADE", "enum", "INS grade", _OPTIONS.ins_grade,
-              options=_GRADES, labels=_GRADE_LABELS,  # type: ignore[arg-type]  # Refs
-              advanced=True),
-        Param("INS_SIGMAS", "numbers",
-              "Custom INS sigmas: horizontal, vertical, roll/pitch, heading",
-              (0.02, 0.05, 0.015, 0.035), count=4, unit="m, m, deg, deg", optional=True,
-              advanced=True, minimum=0.0001, maximum=100.0),
-        Param("MAX_BORESIGHT", "number", "Largest plausible boresight angle", 2.0,
-              unit="degrees", minimum=0.001, maximum=45.0, advanced=True,
-              help="an estimated angle beyond this fails the run"),
+        Param(
+            "PLANES",
+            "table",
+            "Plane table (CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            help="the roof planes of the tie points and of the observability check",
+        ),
+        Param(
+            "CLOUD",
+            "pointcloud",
+            "Cloud with plane ids (LAS/LAZ)",
+            optional=True,
+            file_filter=LAS_FILTER,
+            advanced=True,
+            help="the planes' outlines (convex hull of their points): needed by tie points",
+        ),
+        Param(
+            "TIE_POINTS",
+            "table",
+            "Tie points (observation CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            advanced=True,
+            help="the output of Automatic tie points",
+        ),
+        Param(
+            "FIND_TIES",
+            "boolean",
+            "Find tie points when none are given",
+            _AUTO.find_ties,
+            advanced=True,
+            help="without TIE_POINTS, and with PLANES and CLOUD, run Automatic tie points "
+            "on the images (pairs from the footprints, least-squares refinement on)",
+        ),
+        Param(
+            "HAND_PICKS",
+            "table",
+            "Hand picks to compare with (observation CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+            advanced=True,
+            help="observations picked in the dock: their tie and line rows are calibrated "
+            "alone and the summary compares the two boresights",
+        ),
+        Param(
+            "SEARCH",
+            "number",
+            "Search range of the boresight",
+            _AUTO.search_deg,
+            unit="degrees",
+            minimum=0.0,
+            maximum=10.0,
+            advanced=True,
+            help="half width of the angle search about BORESIGHT (0: none)",
+        ),
+        Param(
+            "MAX_ROUNDS",
+            "integer",
+            "Most rounds",
+            _AUTO.max_rounds,
+            minimum=1,
+            maximum=50,
+            advanced=True,
+        ),
+        Param(
+            "GROUPING",
+            "enum",
+            "Boresight groups",
+            _OPTIONS.groups,
+            options=GROUPINGS,
+            labels=(
+                "one boresight for all images",
+                "one per trajectory group (flight line, direction, session)",
+                "one per heading direction (octant)",
+            ),
+            advanced=True,
+        ),
+        Param(
+            "ESTIMATE_LEVER_ARM",
+            "boolean",
+            "Estimate the lever arm",
+            _OPTIONS.estimate_lever_arm,
+            advanced=True,
+        ),
+        Param(
+            "ESTIMATE_INTERIOR",
+            "boolean",
+            "Estimate focal length and principal point",
+            _OPTIONS.estimate_interior,
+            advanced=True,
+        ),
+        Param(
+            "ESTIMATE_TIMING",
+            "boolean",
+            "Estimate the camera timing offset",
+            _OPTIONS.estimate_timing,
+            advanced=True,
+            help="a constant dt (exposure = recorded time + dt) from the trajectory's "
+            "velocities (v_north, v_east, v_up columns, as Import trajectory writes them) or "
+            "from neighbouring exposures of each line; with the lever arm it needs lines at "
+            "clearly different speeds",
+        ),
+        Param(
+            "INS_GRADE",
+            "enum",
+            "INS grade",
+            _OPTIONS.ins_grade,
+            options=_GRADES,  # type: ignore[arg-type]  # Refs
+            labels=_GRADE_LABELS,  # type: ignore[arg-type]
+            advanced=True,
+        ),
+        Param(
+            "INS_SIGMAS",
+            "numbers",
+            "Custom INS sigmas: horizontal, vertical, roll/pitch, heading",
+            (0.02, 0.05, 0.015, 0.035),
+            count=4,
+            unit="m, m, deg, deg",
+            optional=True,
+            advanced=True,
+            minimum=0.0001,
+            maximum=100.0,
+        ),
+        Param(
+            "MAX_BORESIGHT",
+            "number",
+            "Largest plausible boresight angle",
+            2.0,
+            unit="degrees",
+            minimum=0.001,
+            maximum=45.0,
+            advanced=True,
+            help="an estimated angle beyond this fails the run",
+        ),
         *doubt_params(
             "a failed global test with sigma0 above this fails the run",
             "no convergence, global test beyond MAX_SIGMA0, more rejections than false alarms "
@@ -125,12 +242,16 @@ give the counts per round and the ties refused per reason.""",
             "warning at its top",
         ),
         Param("OUTPUT_TABLE", "file_out", "Boresight per group (CSV)", file_filter=CSV_OUT),
-        Param("OUTPUT_EO", "file_out", "Updated exterior orientation (CSV)",
-              file_filter=CSV_OUT),
-        Param("OUTPUT_OBSERVATIONS", "file_out", "Observations found (CSV)",
-              file_filter=CSV_OUT),
-        Param("OUTPUT_ROUNDS", "file_out", "Rounds (CSV)", optional=True, file_filter=CSV_OUT,
-              advanced=True),
+        Param("OUTPUT_EO", "file_out", "Updated exterior orientation (CSV)", file_filter=CSV_OUT),
+        Param("OUTPUT_OBSERVATIONS", "file_out", "Observations found (CSV)", file_filter=CSV_OUT),
+        Param(
+            "OUTPUT_ROUNDS",
+            "file_out",
+            "Rounds (CSV)",
+            optional=True,
+            file_filter=CSV_OUT,
+            advanced=True,
+        ),
         Param("OUTPUT_HTML", "file_out", "Summary (HTML)", file_filter="HTML files (*.html)"),
     ),
     results=(
@@ -141,7 +262,7 @@ give the counts per round and the ties refused per reason.""",
     ),
     tags=("boresight", "automatic", "calibration", "lidar lines", "roof planes", "tie points"),
     references=("Pedrosa & dos Santos (2020)", "Baarda (1968)"),
-)  # fmt: skip
+)
 
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
@@ -160,43 +281,60 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     images = _read_images(v, traj)
     auto = options_from(AutoBoresightOptions, SPEC, v)
     cal = options_from(BoresightOptions, SPEC, v, ins_grade=grade)
-    ties, detected, rest = _tie_stage(v, auto, ties, images, cam, traj, mount, frame, planes,
-                                      progress, should_stop)  # fmt: skip
-    found = auto_calibrate(traj, cam, mount, frame, images, planes, lines, ties, None, auto, cal,
-                           progress=rest, should_stop=should_stop)  # fmt: skip
+    ties, detected, rest = _tie_stage(
+        v, auto, ties, images, cam, traj, mount, frame, planes, progress, should_stop
+    )
+    args = (traj, cam, mount, frame, images, planes, lines, ties, None, auto, cal)
+    found = auto_calibrate(*args, progress=rest, should_stop=should_stop)
     result = found.result
     doubts = doubts_about(result, v.max_boresight, v.max_sigma0, cal.snooping_alpha)
     run_ = _boresight_run(found, cam, traj, planes, lines, frame, cal)
     settings = _settings(v, cam, traj, found, frame, grade, detected)
     if v.hand_picks:
-        settings.update(_compare_hand_picks(v, cam, traj, mount, frame, planes, lines, cal,
-                                            result, should_stop))  # fmt: skip
+        settings.update(
+            _compare_hand_picks(v, cam, traj, mount, frame, planes, lines, cal, result, should_stop)
+        )
 
     def failed_page() -> str:
         from ..quality.boresight_html import render_boresight_html
 
         return render_boresight_html(run_, settings, problems=doubts, accepted=False)
 
-    warning = settle_doubts("automatic boresight calibration", doubts, v.accept_doubtful, out,
-                            failed_page, "HTML summary")  # fmt: skip
+    what = "automatic boresight calibration"
+    warning = settle_doubts(what, doubts, v.accept_doubtful, out, failed_page, "HTML summary")
     _write_outputs(out, found, run_, settings, doubts, warning)
-    last = found.rounds[-1]
-    lines_out = [
-        *warning,
-        *(f"round {r.round}: {r.line_points} line points on {r.lines_seen} lines, "
-          f"{r.ties_associated} of {r.tie_tracks} tie tracks on planes, search {r.search_px:.1f}"
-          f" px, gate {r.gate_m:.3f} m" for r in found.rounds),
-        *(f"{row['group']:8} {row['parameter']:8} {row['value_deg']:12.6f} deg "
-          f"+- {row['std_arcsec']:.1f} arcsec" for row in result.table_rows()),
-        "converged" if found.converged else f"not converged after {len(found.rounds)} rounds",
-    ]  # fmt: skip
+    lines_out = [*warning, *_summary_lines(found)]
     for line in lines_out:
         log.info("%s", line)
+    last = found.rounds[-1]
     return JobResult(
-        results={"SIGMA0": result.sigma0, "ROUNDS": len(found.rounds),
-                 "LINE_POINTS": last.line_points, "TIES_ASSOCIATED": last.ties_associated},
-        lines=lines_out, data=found,
-    )  # fmt: skip
+        results={
+            "SIGMA0": found.result.sigma0,
+            "ROUNDS": len(found.rounds),
+            "LINE_POINTS": last.line_points,
+            "TIES_ASSOCIATED": last.ties_associated,
+        },
+        lines=lines_out,
+        data=found,
+    )
+
+
+def _summary_lines(found) -> list[str]:
+    """The rounds, the boresight per group and the convergence, one line each."""
+    return [
+        *(
+            f"round {r.round}: {r.line_points} line points on {r.lines_seen} lines, "
+            f"{r.ties_associated} of {r.tie_tracks} tie tracks on planes, search {r.search_px:.1f}"
+            f" px, gate {r.gate_m:.3f} m"
+            for r in found.rounds
+        ),
+        *(
+            f"{row['group']:8} {row['parameter']:8} {row['value_deg']:12.6f} deg "
+            f"+- {row['std_arcsec']:.1f} arcsec"
+            for row in found.result.table_rows()
+        ),
+        "converged" if found.converged else f"not converged after {len(found.rounds)} rounds",
+    ]
 
 
 def _read_inputs(v: Values) -> tuple:
@@ -237,23 +375,31 @@ def _read_images(v: Values, traj) -> list:
     known = set(traj.image_id)
     images = [(f.stem, read_gray(f)) for f in files if f.stem in known]
     if not images:
-        raise InputError("IMAGES: no image is named in the trajectory (image id = file name "
-                         "without extension)", path=v.trajectory)  # fmt: skip
+        raise InputError(
+            "IMAGES: no image is named in the trajectory (image id = file name without extension)",
+            path=v.trajectory,
+        )
     return images
 
 
-def _tie_stage(v, auto, ties, images, cam, traj, mount, frame, planes, progress, should_stop
-               ) -> tuple:  # fmt: skip
+def _tie_stage(
+    v, auto, ties, images, cam, traj, mount, frame, planes, progress, should_stop
+) -> tuple:
     """(the tie points, the summary's line on those found or None, the calibration's share
     of the progress): TIE_POINTS when given, else those found between the images (FIND_TIES,
     with CLOUD: the planes' outlines), else None."""
-    find = ties is None and auto.find_ties and bool(v.cloud) and any(
-        len(p.outline) >= 3 for p in planes)  # fmt: skip
+    find = (
+        ties is None
+        and auto.find_ties
+        and bool(v.cloud)
+        and any(len(p.outline) >= 3 for p in planes)
+    )
     tie_progress, rest = stages(progress, 0.4 if find else 0.0, 1.0)
     detected = None
     if find:
-        ties, detected = _find_ties(images, cam, traj, mount, frame, planes, tie_progress,
-                                    should_stop)  # fmt: skip
+        ties, detected = _find_ties(
+            images, cam, traj, mount, frame, planes, tie_progress, should_stop
+        )
     return ties, detected, rest
 
 
@@ -268,14 +414,17 @@ def _find_ties(images, cam, traj, mount, frame, planes, progress, should_stop) -
     from ..photo.georeference import direct_georeference
 
     if len(images) < 2:
-        raise InputError("IMAGES: finding tie points needs at least two images (or give "
-                         "TIE_POINTS)")  # fmt: skip
+        raise InputError(
+            "IMAGES: finding tie points needs at least two images (or give TIE_POINTS)"
+        )
     eo = direct_georeference(traj, mount, frame)
     height = float(np.median([p.centroid[2] for p in planes]))
     res = find_ties(images, cam, eo, height, progress=progress, should_stop=should_stop)
     s = res.summary()
-    text = (f"{s['tracks']} tracks, {s['measurements']} measurements; pairs "
-            f"{s['pairs_kept']} of {s['pairs_tried']} kept")  # fmt: skip
+    text = (
+        f"{s['tracks']} tracks, {s['measurements']} measurements; pairs "
+        f"{s['pairs_kept']} of {s['pairs_tried']} kept"
+    )
     log.info("tie points found: %s", text)
     return res.observations(), text
 
@@ -289,9 +438,14 @@ def _boresight_run(found, cam, traj, planes, lines, frame, cal):
     obs = found.observations
     positions = ground_positions(found.result, obs, cam, planes, lines, [], None)
     image_group = dict(zip(traj.image_id, group_labels(traj, cal.groups)))
-    return BoresightRun(found.result, obs, positions,
-                        tuple(image_group.get(i, "") for i in obs.image_id), {},
-                        frame.crs.to_wkt())  # fmt: skip
+    return BoresightRun(
+        found.result,
+        obs,
+        positions,
+        tuple(image_group.get(i, "") for i in obs.image_id),
+        {},
+        frame.crs.to_wkt(),
+    )
 
 
 def _settings(v, cam, traj, found, frame, grade, detected) -> dict[str, str]:
@@ -305,9 +459,10 @@ def _settings(v, cam, traj, found, frame, grade, detected) -> dict[str, str]:
         "INS grade": grade.name,
         "initial boresight (deg)": ", ".join(f"{a:g}" for a in v.boresight),
         "boresight after the angle search (deg)": ", ".join(
-            f"{np.degrees(a):.4f}" for a in found.searched),
+            f"{np.degrees(a):.4f}" for a in found.searched
+        ),
         "converged": "yes" if found.converged else "no",
-    }  # fmt: skip
+    }
     for r in found.rounds:
         refused = ", ".join(f"{k} {n}" for k, n in r.ties_refused.items() if n) or "none"
         s[f"round {r.round}"] = (
@@ -324,8 +479,9 @@ def _settings(v, cam, traj, found, frame, grade, detected) -> dict[str, str]:
     return s
 
 
-def _compare_hand_picks(v, cam, traj, mount, frame, planes, lines, cal, result, should_stop
-                        ) -> dict[str, str]:  # fmt: skip
+def _compare_hand_picks(
+    v, cam, traj, mount, frame, planes, lines, cal, result, should_stop
+) -> dict[str, str]:
     """The calibration from the hand picks' tie and line rows, and its difference from the
     automatic one per group (arc-seconds, and in sigmas of the difference, the two taken as
     independent: an upper bound, both share the INS priors)."""
@@ -337,9 +493,17 @@ def _compare_hand_picks(v, cam, traj, mount, frame, planes, lines, cal, result, 
     from ..photo.boresight import calibrate
 
     picks = read_observations_csv(v.hand_picks, camera=cam)
-    hand = calibrate(traj, cam, mount, frame, picks, planes, lines,
-                     options=replace(cal, use_types=("tie", "line")),
-                     should_stop=should_stop)  # fmt: skip
+    hand = calibrate(
+        traj,
+        cam,
+        mount,
+        frame,
+        picks,
+        planes,
+        lines,
+        options=replace(cal, use_types=("tie", "line")),
+        should_stop=should_stop,
+    )
     out = {}
     arcsec = 3600.0 * 180.0 / np.pi
     for g, name in enumerate(result.groups):
@@ -350,10 +514,16 @@ def _compare_hand_picks(v, cam, traj, mount, frame, planes, lines, cal, result, 
         both = np.hypot(result.std[g], hand.std[h]) * arcsec
         out[f"hand picks, group {name}"] = (
             f"{sum(t in ('tie', 'line') for t in picks.type)} rows; boresight "
-            + ", ".join(f"{np.degrees(a):.5f}" for a in hand.boresight[h]) + " deg, sigmas "
-            + ", ".join(f"{a * arcsec:.1f}" for a in hand.std[h]) + " arcsec; automatic minus "
-            "hand " + ", ".join(f"{d:.1f}" for d in diff) + " arcsec ("
-            + ", ".join(f"{d / b:.1f}" for d, b in zip(diff, both)) + " sigma)")  # fmt: skip
+            + ", ".join(f"{np.degrees(a):.5f}" for a in hand.boresight[h])
+            + " deg, sigmas "
+            + ", ".join(f"{a * arcsec:.1f}" for a in hand.std[h])
+            + " arcsec; automatic minus "
+            "hand "
+            + ", ".join(f"{d:.1f}" for d in diff)
+            + " arcsec ("
+            + ", ".join(f"{d / b:.1f}" for d, b in zip(diff, both))
+            + " sigma)"
+        )
     return out
 
 
@@ -366,10 +536,25 @@ def _round_rows(found) -> list[tuple[str, ...]]:
     for r in found.rounds:
         refused = "; ".join(f"{k}: {n}" for k, n in r.ties_refused.items() if n)
         for g, name in enumerate(found.result.groups):
-            rows.append(_text((r.round, r.search_px, r.gate_m, r.line_points, r.lines_seen,
-                               r.tie_tracks, r.ties_associated, refused, name,
-                               *np.degrees(r.boresight[g]), *np.degrees(r.std[g]) * 3600,
-                               *np.degrees(r.change[g]) * 3600, r.rejected)))  # fmt: skip
+            rows.append(
+                _text(
+                    (
+                        r.round,
+                        r.search_px,
+                        r.gate_m,
+                        r.line_points,
+                        r.lines_seen,
+                        r.tie_tracks,
+                        r.ties_associated,
+                        refused,
+                        name,
+                        *np.degrees(r.boresight[g]),
+                        *np.degrees(r.std[g]) * 3600,
+                        *np.degrees(r.change[g]) * 3600,
+                        r.rejected,
+                    )
+                )
+            )
     return rows
 
 

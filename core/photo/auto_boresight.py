@@ -124,8 +124,11 @@ def _directions(lines: Sequence[ControlLine], min_length: float = 1.0) -> int:
     return count
 
 
-def scene_refusal(planes: Sequence[Plane], lines: Sequence[ControlLine],
-                  options: AutoBoresightOptions | None = None) -> str:  # fmt: skip
+def scene_refusal(
+    planes: Sequence[Plane],
+    lines: Sequence[ControlLine],
+    options: AutoBoresightOptions | None = None,
+) -> str:
     """Why the scene cannot determine the boresight ("" when it can; module docstring)."""
     opt = options or AutoBoresightOptions()
     sloped = [p for p in planes if opt.min_slope_deg <= p.slope_deg <= opt.max_roof_slope_deg]
@@ -145,9 +148,14 @@ def scene_refusal(planes: Sequence[Plane], lines: Sequence[ControlLine],
 
 
 # ------------------------------------------------------------------ angle search
-def _nominal_camera_vectors(traj: Trajectory, camera: Camera, mount: Mount,
-                            frame: MappingFrame, lines: Sequence[ControlLine], spacing_px: float
-                            ) -> list[Array]:  # fmt: skip
+def _nominal_camera_vectors(
+    traj: Trajectory,
+    camera: Camera,
+    mount: Mount,
+    frame: MappingFrame,
+    lines: Sequence[ControlLine],
+    spacing_px: float,
+) -> list[Array]:
     """Per image, LiDAR line samples (about ``spacing_px`` apart at the image scale) as vectors
     in the camera frame of a zero boresight: ``u = M0 (X - C)`` (local ENU, metres)."""
     zero = replace(mount, boresight=np.zeros(3))
@@ -173,8 +181,7 @@ _FIRST_STEPS = 8.0
 class _Search:
     """The line samples of all images (stacked) and the images' edge strength at one blur."""
 
-    def __init__(self, camera: Camera, us: list[Array], greys: list[NDArray[np.float32]]
-                 ) -> None:  # fmt: skip
+    def __init__(self, camera: Camera, us: list[Array], greys: list[NDArray[np.float32]]) -> None:
         self.camera = camera
         self.us = us
         self.greys = greys
@@ -226,8 +233,14 @@ class _Search:
                 total += float(map_coordinates(g, [p[:, 1], p[:, 0]], order=1).sum())
         return total / max(len(px), 1)
 
-    def grid_best(self, centre: Array, steps: Array, half: int, axes: tuple[int, ...],
-                  should_stop: Callable[[], bool] | None = None) -> Array:  # fmt: skip
+    def grid_best(
+        self,
+        centre: Array,
+        steps: Array,
+        half: int,
+        axes: tuple[int, ...],
+        should_stop: Callable[[], bool] | None = None,
+    ) -> Array:
         """The best candidate of a (2 half + 1)^len(axes) grid about ``centre``."""
         offsets = np.arange(-half, half + 1)
         grids = np.meshgrid(*[offsets * steps[a] for a in axes], indexing="ij")
@@ -305,6 +318,47 @@ def _counts(obs: ImageObservations, kind: str, key: str) -> dict[str, int]:
     return out
 
 
+def _round_observations(images, cam, eo, lines, ties, planes, dsm, opt, search_px, gate):
+    """One round's observations: the line points found along the projected lines within
+    ``search_px`` and the tie tracks associated with the planes within ``gate`` (m); returns
+    (line observations, all observations, tie refusals per reason, tie tracks tried)."""
+    line_obs = line_observations_block(
+        images, cam, eo, lines, replace(opt.lines, search_px=search_px)
+    )
+    if ties is None or not len(ties):
+        return line_obs, line_obs, dict.fromkeys(REASONS, 0), 0
+    assoc = associate_ties(
+        ties,
+        eo,
+        cam,
+        planes,
+        gate,
+        border_m=opt.border_m,
+        max_roof_slope_deg=opt.max_roof_slope_deg,
+        dsm=dsm,
+    )
+    return line_obs, line_obs.concat(assoc.observations), assoc.reasons, assoc.tracks
+
+
+def _round_record(k, search_px, gate, line_obs, obs, n_tracks, refused, result, change):
+    """The :class:`RoundRecord` of round ``k`` (counts, the boresight, its change)."""
+    tie_ids = {p for p, t in zip(obs.point_id, obs.type) if t == "tie"}
+    return RoundRecord(
+        k,
+        search_px,
+        gate,
+        len(line_obs),
+        len(set(line_obs.target_id)),
+        n_tracks,
+        len(tie_ids),
+        refused,
+        result.boresight.copy(),
+        result.std.copy(),
+        change,
+        int(result.residuals.rejected.sum()),
+    )
+
+
 def auto_calibrate(
     trajectory: Trajectory,
     camera: Camera,
@@ -366,8 +420,11 @@ def auto_calibrate(
     current = replace(mount, boresight=searched)
     eo: ExteriorOrientationTable = direct_georeference(trajectory, current, frame)
     bore_sigma = opt.fine_step_px / camera.focal_px if opt.search_deg > 0 else 0.0
-    height = float(np.median(eo.xyz[:, 2]) - np.median([p.centroid[2] for p in planes])) \
-        if planes else float(np.median(eo.xyz[:, 2]))  # fmt: skip
+    height = (
+        float(np.median(eo.xyz[:, 2]) - np.median([p.centroid[2] for p in planes]))
+        if planes
+        else float(np.median(eo.xyz[:, 2]))
+    )
     rounds: list[RoundRecord] = []
     cam = camera  # with the interior estimated, the last round's (and the lever arm's)
     last = np.asarray(searched, float)[None, :]
@@ -377,31 +434,30 @@ def auto_calibrate(
         spread = float(np.hypot(bore_sigma, att_sigma))
         search_px = max(opt.min_search_px, opt.sigmas * camera.focal_px * spread)
         gate = max(opt.min_gate_m, opt.sigmas * abs(height) * spread)
-        line_obs = line_observations_block(images, cam, eo, lines,
-                                           replace(opt.lines, search_px=search_px))  # fmt: skip
-        refused = dict.fromkeys(REASONS, 0)
-        n_tracks = 0
-        obs = line_obs
-        if ties is not None and len(ties):
-            assoc = associate_ties(ties, eo, cam, planes, gate, border_m=opt.border_m,
-                                   max_roof_slope_deg=opt.max_roof_slope_deg, dsm=dsm)  # fmt: skip
-            refused, n_tracks = assoc.reasons, assoc.tracks
-            obs = obs.concat(assoc.observations)
+        line_obs, obs, refused, n_tracks = _round_observations(
+            images, cam, eo, lines, ties, planes, dsm, opt, search_px, gate
+        )
         if len(obs) == 0:
             raise SceneNotObservable(
                 "no image edge was found along the projected LiDAR lines and no tie track lies "
                 f"on a roof plane (round {r + 1}, search {search_px:.1f} px): the approximate "
                 "boresight or the mount is too far off, or the lines are not in the images"
             )
-        result = calibrate(trajectory, cam, current, frame, obs, planes, lines, options=cal,
-                           should_stop=should_stop)  # fmt: skip
+        result = calibrate(
+            trajectory,
+            cam,
+            current,
+            frame,
+            obs,
+            planes,
+            lines,
+            options=cal,
+            should_stop=should_stop,
+        )
         change = result.boresight - last
-        n_ties = sum(1 for t in obs.type if t == "tie")
-        rounds.append(RoundRecord(
-            r + 1, search_px, gate, len(line_obs), len(set(line_obs.target_id)), n_tracks,
-            len(set(p for p, t in zip(obs.point_id, obs.type) if t == "tie")) if n_ties else 0,
-            refused, result.boresight.copy(), result.std.copy(), change,
-            int(result.residuals.rejected.sum())))  # fmt: skip
+        rounds.append(
+            _round_record(r + 1, search_px, gate, line_obs, obs, n_tracks, refused, result, change)
+        )
         if progress:
             progress(0.3 + 0.7 * (r + 1) / opt.max_rounds)
         if r >= 1 and bool(np.all(np.abs(change) < result.std)):

@@ -98,15 +98,18 @@ def _detector(options: TiePointOptions):
 
     if options.detector == "sift":
         try:
-            return cv2.SIFT_create(nfeatures=int(options.max_features),
-                                   contrastThreshold=float(options.contrast),
-                                   enable_precise_upscale=True), 0.0  # fmt: skip
+            return cv2.SIFT_create(
+                nfeatures=int(options.max_features),
+                contrastThreshold=float(options.contrast),
+                enable_precise_upscale=True,
+            ), 0.0
         except TypeError:  # OpenCV < 4.8
             return cv2.SIFT_create(
                 nfeatures=int(options.max_features), contrastThreshold=float(options.contrast)
             ), -0.25
-    return cv2.ORB_create(nfeatures=int(options.max_features), scaleFactor=1.2, nlevels=8,
-                          fastThreshold=10), 0.0  # fmt: skip
+    return cv2.ORB_create(
+        nfeatures=int(options.max_features), scaleFactor=1.2, nlevels=8, fastThreshold=10
+    ), 0.0
 
 
 def _detect(img: NDArray, options: TiePointOptions):
@@ -189,8 +192,14 @@ def detect_features(
     kps, desc, shift = _detect(img, options)
     if desc is None or not kps:
         width = 128 if options.detector == "sift" else 32
-        return ImageFeatures(image_id, (int(full[0]), int(full[1])), total, np.zeros((0, 2)),
-                             np.zeros(0, np.float32), np.zeros((0, width), np.uint8))  # fmt: skip
+        return ImageFeatures(
+            image_id,
+            (int(full[0]), int(full[1])),
+            total,
+            np.zeros((0, 2)),
+            np.zeros(0, np.float32),
+            np.zeros((0, width), np.uint8),
+        )
     xy = np.array([k.pt for k in kps], dtype=np.float64) + shift
     if options.detector == "orb":
         # ORB's pyramid levels are resized centre-aligned but their keypoints are scaled as
@@ -202,8 +211,14 @@ def detect_features(
     inside = (px[:, 0] > 0) & (px[:, 1] > 0) & (px[:, 0] < full[0]) & (px[:, 1] < full[1])
     # SIFT descriptors are whole numbers 0..255 in OpenCV: 8 bits keep them exactly
     d8 = np.clip(np.rint(desc), 0, 255).astype(np.uint8) if desc.dtype != np.uint8 else desc
-    return ImageFeatures(image_id, (int(full[0]), int(full[1])), total, px[inside],
-                         size[inside], np.ascontiguousarray(d8[inside]))  # fmt: skip
+    return ImageFeatures(
+        image_id,
+        (int(full[0]), int(full[1])),
+        total,
+        px[inside],
+        size[inside],
+        np.ascontiguousarray(d8[inside]),
+    )
 
 
 # --------------------------------------------------------------------------- matching
@@ -337,19 +352,20 @@ def match_pair(
     ia, ib = ia[single], ib[single]
     n_mutual = int(ia.size)
     if n_mutual < options.min_inliers:
-        return drop(f"too few matches ({n_mutual} after the ratio test and mutual check)",
-                    n_ratio, n_mutual)  # fmt: skip
+        return drop(
+            f"too few matches ({n_mutual} after the ratio test and mutual check)", n_ratio, n_mutual
+        )
     pa, pb = fa.pixels[ia], fb.pixels[ib]
     shift = float(np.median(np.hypot(*(pb - pa).T)))
     if shift < NO_PARALLAX_PX:  # the same view twice: no geometry to find
-        return drop(f"no parallax (median shift {shift:.2f} px over {n_mutual} matches)",
-                    n_ratio, n_mutual)  # fmt: skip
+        return drop(
+            f"no parallax (median shift {shift:.2f} px over {n_mutual} matches)", n_ratio, n_mutual
+        )
     if rays is None:
         method = cv2.USAC_MAGSAC if options.ransac_method == "magsac" else cv2.FM_RANSAC
         cv2.setRNGSeed(12345)
         try:
-            f, mask = cv2.findFundamentalMat(pa, pb, method, float(options.ransac_px), 0.999,
-                                             10000)  # fmt: skip
+            f, mask = cv2.findFundamentalMat(pa, pb, method, float(options.ransac_px), 0.999, 10000)
         except cv2.error:
             f, mask = None, None
         if f is None or mask is None or f.shape != (3, 3):
@@ -382,9 +398,18 @@ def match_pair(
         sel = sel[_coherent(pa[sel], pb[sel] - _global_map(pa[sel], pb[sel], tol), tol)]
     n_in = int(sel.size)
     if n_in < options.min_inliers:
-        return PairMatch(i, j, empty, empty, n_ratio, n_mutual, n_in, np.zeros(0),
-                         f"too few RANSAC inliers ({n_in} < {options.min_inliers})",
-                         overlap)  # fmt: skip
+        return PairMatch(
+            i,
+            j,
+            empty,
+            empty,
+            n_ratio,
+            n_mutual,
+            n_in,
+            np.zeros(0),
+            f"too few RANSAC inliers ({n_in} < {options.min_inliers})",
+            overlap,
+        )
     return PairMatch(i, j, ka[sel], kb[sel], n_ratio, n_mutual, n_in, res[sel], "ok", overlap)
 
 
@@ -392,10 +417,14 @@ def match_pair(
 _GUIDED_K = 8
 
 
-def _guided(idx: NDArray[np.intp], dist: Array,
-            distance: Callable[[NDArray[np.intp], NDArray[np.intp]], Array],
-            options: TiePointOptions, ka: NDArray[np.intp],
-            kb: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:  # fmt: skip
+def _guided(
+    idx: NDArray[np.intp],
+    dist: Array,
+    distance: Callable[[NDArray[np.intp], NDArray[np.intp]], Array],
+    options: TiePointOptions,
+    ka: NDArray[np.intp],
+    kb: NDArray[np.intp],
+) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """Guided matching along the epipolar lines (``distance(ka, kb)``: the epipolar distance
     of keypoints ``ka`` of a and ``kb`` of b, pixels; ``idx``,
     ``dist``: the descriptor neighbours in b of every keypoint of a, from :func:`_knn_k`):
@@ -614,9 +643,17 @@ def tie_points(
     results: list[PairMatch] = []
     for m, (i, j) in enumerate(pairs):
         stop_if_asked(should_stop, f"matching {image_ids[i]} with {image_ids[j]}")
-        results.append(match_pair(feats[i], feats[j], options, i, j,
-                                  overlap.get((i, j), math.nan),
-                                  (rays[i], rays[j]) if fisheye else None))  # fmt: skip
+        results.append(
+            match_pair(
+                feats[i],
+                feats[j],
+                options,
+                i,
+                j,
+                overlap.get((i, j), math.nan),
+                (rays[i], rays[j]) if fisheye else None,
+            )
+        )
         if progress is not None:
             progress(share[0] + (share[1] - share[0]) * (m + 1) / max(len(pairs), 1))
     tracks = build_tracks(feats, results, options.min_track_length)
@@ -631,9 +668,9 @@ def tie_points(
         # the descriptors are not needed any more: free them before the images
         del feats[:], rays[:]
         sub = None if progress is None else (lambda x: progress(share[1] + (1 - share[1]) * x))
-        tracks, sigma, stats = refine_tracks(tracks, sigma, n, load_image, options,
-                                             progress=sub, should_stop=should_stop)  # fmt: skip
+        tracks, sigma, stats = refine_tracks(
+            tracks, sigma, n, load_image, options, progress=sub, should_stop=should_stop
+        )
         if options.sigma_px > 0:  # the value given wins
             sigma = np.full(tracks.track.size, float(options.sigma_px))
-    return TiePointResult(tuple(image_ids), counts, factors, results, tracks, sigma,
-                          stats)  # fmt: skip
+    return TiePointResult(tuple(image_ids), counts, factors, results, tracks, sigma, stats)
