@@ -3,9 +3,9 @@
 Runs in a Python with pycolmap (4.2.1 here), numpy and opencv-python-headless, never a
 project dependency::
 
-    python3 -m venv /tmp/pycolmap-venv
-    /tmp/pycolmap-venv/bin/pip install pycolmap numpy opencv-python-headless
-    OMP_NUM_THREADS=1 /tmp/pycolmap-venv/bin/python bench/colmap_real.py make \
+    python3 -m venv ~/pycolmap-venv
+    ~/pycolmap-venv/bin/pip install pycolmap numpy opencv-python-headless
+    OMP_NUM_THREADS=1 ~/pycolmap-venv/bin/python bench/colmap_real.py make \
         --images ../shared/data/odm-copr-kap-gcp/images
 
 ``make``: six kite photos of odm-copr-kap-gcp (CC BY-SA 4.0, Tobias & Mandel /
@@ -44,7 +44,7 @@ record.json, e.g.::
         --output-points p.csv
     lidarphoto exportcolmap --camera c.json --eo eo.csv --observations o.csv --points p.csv \
         --output-folder out
-    /tmp/pycolmap-venv/bin/python bench/colmap_real.py check-export --model OPENCV out
+    ~/pycolmap-venv/bin/python bench/colmap_real.py check-export --model OPENCV out
 """
 
 from __future__ import annotations
