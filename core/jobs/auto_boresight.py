@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 
 from ..io.suffixes import IMAGE_SUFFIXES
-from .boresight_calibration import _GRADE_LABELS, _GRADES, GROUPINGS
+from .boresight_calibration import ESTIMATE_PARAMS, GROUPINGS
 from .common import (
     CSV_FILTER,
     CSV_OUT,
@@ -178,40 +178,7 @@ give the counts per round and the ties refused per reason.""",
             ),
             advanced=True,
         ),
-        Param(
-            "ESTIMATE_LEVER_ARM",
-            "boolean",
-            "Estimate the lever arm",
-            _OPTIONS.estimate_lever_arm,
-            advanced=True,
-        ),
-        Param(
-            "ESTIMATE_INTERIOR",
-            "boolean",
-            "Estimate focal length and principal point",
-            _OPTIONS.estimate_interior,
-            advanced=True,
-        ),
-        Param(
-            "ESTIMATE_TIMING",
-            "boolean",
-            "Estimate the camera timing offset",
-            _OPTIONS.estimate_timing,
-            advanced=True,
-            help="a constant dt (exposure = recorded time + dt) from the trajectory's "
-            "velocities (v_north, v_east, v_up columns, as Import trajectory writes them) or "
-            "from neighbouring exposures of each line; with the lever arm it needs lines at "
-            "clearly different speeds",
-        ),
-        Param(
-            "INS_GRADE",
-            "enum",
-            "INS grade",
-            _OPTIONS.ins_grade,
-            options=_GRADES,  # type: ignore[arg-type]  # Refs
-            labels=_GRADE_LABELS,  # type: ignore[arg-type]
-            advanced=True,
-        ),
+        *ESTIMATE_PARAMS,
         Param(
             "INS_SIGMAS",
             "numbers",

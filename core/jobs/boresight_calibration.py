@@ -101,6 +101,46 @@ RESIDUAL_COLUMNS = (
     "used",
 )
 
+#: The calibration's optional unknowns and the INS grade, shared with ``autoboresight`` (the
+#: same labels, defaults and help).
+ESTIMATE_PARAMS: tuple[Param, ...] = (
+    Param(
+        "ESTIMATE_LEVER_ARM",
+        "boolean",
+        "Estimate the lever arm",
+        _OPTIONS.estimate_lever_arm,
+        advanced=True,
+    ),
+    Param(
+        "ESTIMATE_INTERIOR",
+        "boolean",
+        "Estimate focal length and principal point",
+        _OPTIONS.estimate_interior,
+        advanced=True,
+    ),
+    Param(
+        "ESTIMATE_TIMING",
+        "boolean",
+        "Estimate the camera timing offset",
+        _OPTIONS.estimate_timing,
+        advanced=True,
+        help="a constant dt (exposure = recorded time + dt) from the trajectory's "
+        "velocities (v_north, v_east, v_up columns, as Import trajectory writes them) or "
+        "from neighbouring exposures of each line; with the lever arm it needs lines at "
+        "clearly different speeds",
+    ),
+    Param(
+        "INS_GRADE",
+        "enum",
+        "INS grade",
+        _OPTIONS.ins_grade,
+        options=_GRADES,
+        labels=_GRADE_LABELS,
+        advanced=True,
+    ),
+)
+
+
 SPEC = AlgorithmSpec(
     name="boresightcalibration",
     title="Boresight calibration",
@@ -213,40 +253,7 @@ comment lines beginning with #).""",
             multiple=True,
             advanced=True,
         ),
-        Param(
-            "ESTIMATE_LEVER_ARM",
-            "boolean",
-            "Estimate the lever arm",
-            _OPTIONS.estimate_lever_arm,
-            advanced=True,
-        ),
-        Param(
-            "ESTIMATE_INTERIOR",
-            "boolean",
-            "Estimate focal length and principal point",
-            _OPTIONS.estimate_interior,
-            advanced=True,
-        ),
-        Param(
-            "ESTIMATE_TIMING",
-            "boolean",
-            "Estimate the camera timing offset",
-            _OPTIONS.estimate_timing,
-            advanced=True,
-            help="a constant dt (exposure = recorded time + dt) from the trajectory's "
-            "velocities (v_north, v_east, v_up columns, as Import trajectory writes them) or "
-            "from neighbouring exposures of each line; with the lever arm it needs lines at "
-            "clearly different speeds",
-        ),
-        Param(
-            "INS_GRADE",
-            "enum",
-            "INS grade",
-            _OPTIONS.ins_grade,
-            options=_GRADES,
-            labels=_GRADE_LABELS,
-            advanced=True,
-        ),
+        *ESTIMATE_PARAMS,
         Param(
             "INS_SIGMAS",
             "numbers",
