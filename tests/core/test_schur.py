@@ -483,9 +483,12 @@ def test_banded_selected_inverse_equals_the_dense_inverse(monkeypatch, dense_min
     ref = qd.Q_eliminated
     assert np.abs(qb.Q_eliminated - ref).max() / np.abs(ref).max() < 1e-10
     assert_allclose(band.std, dense.std, rtol=1e-10)
-    assert_allclose(band.x, dense.x, rtol=0, atol=0)  # the solve is untouched
+    # the solve is the same: bit for bit on numpy 2; on Debian's numpy 1.24, whose BLAS rounds
+    # the two paths' products differently, within 3e-13 (x up to 100), and w-tests (|w| up to
+    # 3.3) within 4e-11
+    assert np.abs(band.x - dense.x).max() <= 1e-12 * np.abs(dense.x).max()
     t1, t2 = dense.residuals["img"], band.residuals["img"]
-    assert_allclose(t2.w, t1.w, rtol=1e-10, atol=1e-12)
+    assert_allclose(t2.w, t1.w, rtol=1e-10, atol=1e-9)
     assert_allclose(t2.redundancy_numbers, t1.redundancy_numbers, rtol=1e-10, atol=1e-12)
 
 
