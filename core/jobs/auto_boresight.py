@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 
 from ..io.suffixes import IMAGE_SUFFIXES
-from .boresight_calibration import ESTIMATE_PARAMS, GROUPINGS
+from .boresight_calibration import ESTIMATE_PARAMS, GROUPING_PARAM
 from .common import (
     CSV_FILTER,
     CSV_OUT,
@@ -165,19 +165,7 @@ give the counts per round and the ties refused per reason.""",
             maximum=50,
             advanced=True,
         ),
-        Param(
-            "GROUPING",
-            "enum",
-            "Boresight groups",
-            _OPTIONS.groups,
-            options=GROUPINGS,
-            labels=(
-                "one boresight for all images",
-                "one per trajectory group (flight line, direction, session)",
-                "one per heading direction (octant)",
-            ),
-            advanced=True,
-        ),
+        GROUPING_PARAM,
         *ESTIMATE_PARAMS,
         Param(
             "INS_SIGMAS",

@@ -101,6 +101,20 @@ RESIDUAL_COLUMNS = (
     "used",
 )
 
+#: How the images share boresights, shared with ``autoboresight``.
+GROUPING_PARAM = Param(
+    "GROUPING",
+    "enum",
+    "Boresight groups",
+    _OPTIONS.groups,
+    options=GROUPINGS,
+    labels=(
+        "one boresight for all images",
+        "one per trajectory group (flight line, direction, session)",
+        "one per heading direction (octant)",
+    ),
+    advanced=True,
+)
 #: The calibration's optional unknowns and the INS grade, shared with ``autoboresight`` (the
 #: same labels, defaults and help).
 ESTIMATE_PARAMS: tuple[Param, ...] = (
@@ -231,19 +245,7 @@ comment lines beginning with #).""",
             file_filter=LAS_FILTER,
             advanced=True,
         ),
-        Param(
-            "GROUPING",
-            "enum",
-            "Boresight groups",
-            _OPTIONS.groups,
-            options=GROUPINGS,
-            labels=(
-                "one boresight for all images",
-                "one per trajectory group (flight line, direction, session)",
-                "one per heading direction (octant)",
-            ),
-            advanced=True,
-        ),
+        GROUPING_PARAM,
         Param(
             "CONTROL_TYPES",
             "enum",
