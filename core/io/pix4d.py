@@ -23,12 +23,13 @@ point ``(x, y) = (X_c / Z_c, Y_c / Z_c)`` before K::
 
 That is :class:`~core.geometry.forward_lens.OpenCVLens` with ``k1..k3 = R1..R3``, ``p1 = T1``,
 ``p2 = T2`` (``scale_mm = fx * pixel size``, ``aspect = fy / fx``). **Assumed, not
-documented**: Pix4D's article on the internal parameters writes this formula for a camera
+established**: Pix4D's article on the internal parameters writes this formula for a camera
 frame with y *up* and its equations are pictures in the pages found; this module reads it in
-the y-down frame of ``K`` (tangential coefficients unchanged); the pixel origin is
+the y-down frame of ``K`` (tangential coefficients unchanged). The pixel origin is
 PIXEL_ORIGIN (default ``corner``: K's pixel coordinates start at the image's top-left
-corner, the project's convention; ``centre``: the first pixel's centre is (0, 0)). Both are
-stated in docs/formats.md. A nonzero skew in K is refused by name.
+corner, the project's convention, as Pix4D's own Inpho camera file beside K says: it puts
+the sensor centre at K's (W/2, H/2), tests/data/pix4d; ``centre``: the first pixel's centre
+is (0, 0)). Both are stated in docs/formats.md. A nonzero skew in K is refused by name.
 
 Images with the same size, K and coefficients share one camera (``pix4d_1``, ``pix4d_2``..,
 in the order of their first image). The offset is added to the centres; in a CRS (the
