@@ -24,7 +24,10 @@ sub-pixel corners) and calibrates the camera with the project's own least-square
 a self-calibrating bundle with one pose per view, the interior orientation f, x0, y0 and the
 Brown-Conrady coefficients k1 k2 k3 p1 p2 (any subset), for the perspective projection or a
 fisheye projection (equidistant, equisolid-angle, orthographic, stereographic; Schneider,
-Schwalbe & Maas 2009) with the Brown correction added.
+Schwalbe & Maas 2009) with the Brown correction added. LENS_MODEL opencv adjusts OpenCV's own
+radial-tangential model instead (perspective): the same least-squares problem as OpenCV's
+calibrateCamera with a fixed aspect ratio (on OpenCV's ChArUco views: the same focal length,
+principal point and sigmas), and a camera that OpenCV and COLMAP read without conversion.
 
 Target: chessboard COLUMNS x ROWS inner corners, SPACING the square side; ChArUco COLUMNS x ROWS
 squares, SPACING the square side, MARKER the marker side; ArUco grid board COLUMNS x ROWS
@@ -114,13 +117,29 @@ camera file: the calibration itself is in pixels.""",
             ),
         ),
         Param(
+            "LENS_MODEL",
+            "enum",
+            "Lens model",
+            _D.lens_model,
+            options=Ref("photo.calibration_options", "LENS_MODELS"),
+            labels=(
+                "Brown-Conrady correction (photogrammetric)",
+                "OpenCV / COLMAP distortion (perspective)",
+            ),
+            help="the same coefficients k1 k2 k3 p1 p2 in either direction: Brown-Conrady "
+            "corrects the measured point, OpenCV's model distorts the ideal one (the camera "
+            "then goes to OpenCV or COLMAP unchanged); OpenCV's model only with the "
+            "perspective projection",
+            advanced=True,
+        ),
+        Param(
             "LENS_PARAMETERS",
             "enum",
             "Lens coefficients estimated",
             _D.lens_parameters,
             options=Ref("photo.calibration_options", "LENS_NAMES"),
             multiple=True,
-            help="Brown-Conrady coefficients; the others are held at zero",
+            help="coefficients of the lens model; the others are held at zero",
         ),
         Param(
             "FIELD",
@@ -324,6 +343,7 @@ def _write_outputs(out, result, spec, opts, n_images: int, found: int) -> None:
             "images": f"{n_images} ({found} with the target)",
             "target": f"{spec.kind} {spec.cols} x {spec.rows}, spacing {spec.spacing_m:g} m",
             "field": opts.field,
+            "lens model": opts.lens_model,
             "lens coefficients": ", ".join(opts.lens_parameters) or "none",
             "initial values": result.initial["method"],
         }

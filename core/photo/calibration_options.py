@@ -12,6 +12,11 @@ from ..geometry.projection_names import PROJECTIONS
 INTERIOR_NAMES = ("focal_mm", "x0_mm", "y0_mm", "k1", "k2", "k3", "p1", "p2")
 LENS_NAMES = INTERIOR_NAMES[3:]
 FIELD_MODES = ("fixed", "free")
+#: Lens models of the calibration: the photogrammetric Brown-Conrady correction (measured ->
+#: ideal, :class:`core.geometry.distortion.BrownConrady`) or OpenCV's and COLMAP's forward
+#: distortion (ideal -> measured, :class:`core.geometry.forward_lens.OpenCVLens`), both with
+#: the coefficients k1 k2 k3 p1 p2.
+LENS_MODELS = ("brown_conrady", "opencv")
 
 
 @dataclass(frozen=True)
@@ -22,6 +27,11 @@ class CalibrationOptions:
     ----------
     projection : str
         ``"perspective"`` or a fisheye projection (:data:`core.geometry.projection.PROJECTIONS`).
+    lens_model : {"brown_conrady", "opencv"}
+        The lens model (:data:`LENS_MODELS`): ``opencv`` adjusts OpenCV's own model, so that
+        the result is the same least-squares problem as ``cv2.calibrateCamera`` with a fixed
+        aspect ratio and can be used by OpenCV or COLMAP without conversion (perspective
+        projection only).
     lens_parameters : tuple of str
         Lens coefficients to estimate (the others are held at zero), of
         ``k1 k2 k3 p1 p2``.
@@ -36,6 +46,7 @@ class CalibrationOptions:
     """
 
     projection: str = "perspective"
+    lens_model: str = "brown_conrady"
     lens_parameters: tuple[str, ...] = LENS_NAMES
     field: str = "fixed"
     sigma_px: float = 0.2
@@ -47,6 +58,15 @@ class CalibrationOptions:
         if self.projection not in PROJECTIONS:
             raise InputError(
                 f"projection must be one of {', '.join(PROJECTIONS)}, got {self.projection!r}"
+            )
+        if self.lens_model not in LENS_MODELS:
+            raise InputError(
+                f"lens model must be one of {', '.join(LENS_MODELS)}, got {self.lens_model!r}"
+            )
+        if self.lens_model == "opencv" and self.projection != "perspective":
+            raise InputError(
+                "the opencv lens model is OpenCV's perspective model: use it with the "
+                f"perspective projection (got {self.projection!r}), or brown_conrady"
             )
         bad = [p for p in self.lens_parameters if p not in LENS_NAMES]
         if bad:

@@ -6,7 +6,10 @@ Every detected target point (col, row) in view ``j`` is a Gauss-Markov observati
 collinearity equations (:func:`core.geometry.collinearity.collinearity_jacobians`) of the
 camera's projection (perspective, or a fisheye projection of :mod:`core.geometry.projection`)
 with the Brown-Conrady lens correction added (:class:`core.geometry.distortion.BrownConrady`:
-``ideal = measured + d(measured)``). Unknowns:
+``ideal = measured + d(measured)``), or, with ``lens_model="opencv"``, OpenCV's forward
+distortion (:class:`core.geometry.forward_lens.OpenCVLens`: ``measured = F(ideal)``; the
+coefficients act on coordinates normalised by the start focal length and are rescaled exactly
+for OpenCV, see :func:`core.geometry.forward_lens.opencv_coefficients`). Unknowns:
 
 - the interior orientation ``f, x0, y0`` (mm) and the lens coefficients ``k1 k2 k3 p1 p2``
   (any subset may be held at zero);
@@ -49,6 +52,7 @@ from ..errors import AdjustmentError, ConvergenceError, InputError, NotObservabl
 from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians
 from ..geometry.distortion import BrownConrady
+from ..geometry.forward_lens import OpenCVLens
 from ..geometry.projection import PROJECTIONS, ray_from_ideal
 from ..geometry.rotations import matrix_to_opk
 from ..i18n import mark as _t
@@ -79,7 +83,7 @@ class CalibrationResult:
     Attributes
     ----------
     camera : Camera
-        The calibrated camera (Brown-Conrady lens model, the chosen projection).
+        The calibrated camera (the chosen lens model and projection).
     sigmas : dict of str to float
         A-posteriori standard deviations of the estimated interior parameters (mm, per mm^n).
     parameter_names : list of str
@@ -427,7 +431,11 @@ def _initial_camera(
         height_px,
         x0_mm=(pp[0] - 0.5 * width_px) * ps,
         y0_mm=(0.5 * height_px - pp[1]) * ps,
-        distortion=BrownConrady(),
+        distortion=(
+            OpenCVLens(scale_mm=f_px * ps, aspect=1.0)
+            if opts.lens_model == "opencv"
+            else BrownConrady()
+        ),
         projection=opts.projection,
     )
     initial = {
@@ -465,11 +473,12 @@ def _unknowns(
 ) -> _Unknowns:
     """The parameters adjusted and their start values (a free field: its points but two of
     the datum)."""
+    lens = base.distortion.param_names  # the model's own order
     free_io = np.array(
-        [0, 1, 2] + [3 + LENS_NAMES.index(p) for p in LENS_NAMES if p in opts.lens_parameters],
+        [0, 1, 2] + [3 + i for i, p in enumerate(lens) if p in opts.lens_parameters],
         dtype=np.intp,
     )
-    io_names = [INTERIOR_NAMES[i] for i in free_io]
+    io_names = [base.interior_names[i] for i in free_io]
     n_io, n_views = free_io.size, len(view_names)
     x0 = [base.interior_params[free_io], eo0.ravel()]
     pnames = list(io_names)
