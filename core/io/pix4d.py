@@ -62,6 +62,7 @@ __all__ = [
     "Pix4dImage",
     "block_from_pix4d",
     "camera_from_pix4d",
+    "companion_files",
     "read_offset",
     "read_pix4d",
 ]
@@ -242,6 +243,36 @@ def read_offset(path: str | Path) -> Array:
     except OSError as exc:
         raise InputError(f"cannot read the Pix4D offset file: {exc}", path=src) from exc
     return np.array(_floats(tokens, 3, "offset X Y Z", src, 1))
+
+
+#: The suffix of the file PIX4Dmapper writes for other software; its companions share the stem.
+CAMERA_FILE_SUFFIX = "_calibrated_camera_parameters.txt"
+
+
+def companion_files(
+    path: str | Path, offset_path: str | Path | None = None, crs: str = ""
+) -> Tuple[Array, str, List[str]]:
+    """The offset (m) and the CRS of a calibrated_camera_parameters.txt, from the files Pix4D
+    writes beside it (``<project>_offset.xyz``, ``<project>_wkt.prj``) unless given, and notes
+    saying where each came from. A given offset file that does not exist is refused; a missing
+    companion gives offset 0 0 0 or no CRS (``""``)."""
+    src = Path(path)
+    name = src.name
+    stem = name[: -len(CAMERA_FILE_SUFFIX)] if name.endswith(CAMERA_FILE_SUFFIX) else src.stem
+    notes: List[str] = []
+    found = Path(offset_path) if offset_path else src.with_name(f"{stem}_offset.xyz")
+    if found.is_file():
+        offset = read_offset(found)
+    elif offset_path:
+        raise InputError("OFFSET: the file does not exist", path=str(found))
+    else:
+        offset = np.zeros(3)
+        notes.append(f"no offset file {found.name} beside INPUT: offset 0 0 0")
+    prj = src.with_name(f"{stem}_wkt.prj")
+    if not crs and prj.is_file():
+        crs = prj.read_text(encoding="utf-8-sig").strip()
+        notes.append(f"CRS from {prj.name}")
+    return offset, crs, notes
 
 
 def camera_from_pix4d(

@@ -12,7 +12,6 @@ from .spec import AlgorithmSpec, Param, Ref, Values
 
 log = logging.getLogger(__name__)
 
-_SUFFIX = "_calibrated_camera_parameters.txt"
 
 SPEC = AlgorithmSpec(
     name="importpix4d",
@@ -88,33 +87,12 @@ file has no tie points.""",
 
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the file and its offset, convert them (in CRS or LOCAL), write the tables."""
-    from pathlib import Path
+    from ..io.pix4d import block_from_pix4d, companion_files, read_pix4d
 
-    import numpy as np
-
-    from ..io.pix4d import block_from_pix4d, read_offset, read_pix4d
-
-    src = Path(v.input)
-    stem = src.name[: -len(_SUFFIX)] if src.name.endswith(_SUFFIX) else src.stem
-    notes = []
-    offset_path = Path(v.offset) if v.offset else src.with_name(f"{stem}_offset.xyz")
-    if offset_path.is_file():
-        offset = read_offset(offset_path)
-    elif v.offset:
-        from ..errors import InputError
-
-        raise InputError("OFFSET: the file does not exist", path=str(offset_path))
-    else:
-        offset = np.zeros(3)
-        notes.append(f"no offset file {offset_path.name} beside INPUT: offset 0 0 0")
-    crs = v.crs or ""
-    prj = src.with_name(f"{stem}_wkt.prj")
-    if not crs and prj.is_file():
-        crs = prj.read_text(encoding="utf-8-sig").strip()
-        notes.append(f"CRS from {prj.name}")
+    offset, crs, notes = companion_files(v.input, v.offset or None, v.crs or "")
     for note in notes:
         log.info(note)
-    block = block_from_pix4d(read_pix4d(src), offset, crs, v.pixel_size, v.pixel_origin)
+    block = block_from_pix4d(read_pix4d(v.input), offset, crs, v.pixel_size, v.pixel_origin)
     result = finish_import(block, out, progress, "images")
     result.lines.extend(notes)
     return result
