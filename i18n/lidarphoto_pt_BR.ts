@@ -2631,6 +2631,22 @@
             <translation>Número de pontos de verificação</translation>
         </message>
         <message>
+            <source>{symbol} = {value:.2f} cm: meets any class of at least {value:.2f} cm{example}{few}</source>
+            <translation>{symbol} = {value:.2f} cm: atende a qualquer classe de pelo menos {value:.2f} cm{example}{few}</translation>
+        </message>
+        <message>
+            <source>{symbol} = {value:.2f} cm {relation} {target:g} cm{few}</source>
+            <translation>{symbol} = {value:.2f} cm {relation} {target:g} cm{few}</translation>
+        </message>
+        <message>
+            <source>{axis} class {target:g}-cm</source>
+            <translation>Classe {axis} de {target:g} cm</translation>
+        </message>
+        <message>
+            <source>{axis} class</source>
+            <translation>Classe {axis}</translation>
+        </message>
+        <message>
             <source>; only {n} of {minimum} check points</source>
             <translation>; apenas {n} de {minimum} pontos de verificação</translation>
         </message>
@@ -2655,18 +2671,6 @@
             <translation>vertical (NVA)</translation>
         </message>
         <message>
-            <source>{symbol} = {value:.2f} cm {relation} {target:g} cm{few}</source>
-            <translation>{symbol} = {value:.2f} cm {relation} {target:g} cm{few}</translation>
-        </message>
-        <message>
-            <source>{axis} class {target:g}-cm</source>
-            <translation>Classe {axis} de {target:g} cm</translation>
-        </message>
-        <message>
-            <source>{symbol} = {value:.2f} cm: meets any class of at least {value:.2f} cm{example}{few}</source>
-            <translation>{symbol} = {value:.2f} cm: atende a qualquer classe de pelo menos {value:.2f} cm{example}{few}</translation>
-        </message>
-        <message>
             <source>Three-dimensional accuracy</source>
             <translation>Acurácia tridimensional</translation>
         </message>
@@ -2687,20 +2691,16 @@
             <translation>vertical</translation>
         </message>
         <message>
+            <source>; tightest example class met: {best:g}-cm</source>
+            <translation>; classe de exemplo mais restrita atendida: {best:g} cm</translation>
+        </message>
+        <message>
             <source>The {axis} check-point survey ({survey:.2f} cm) is not at least twice as accurate as the {target:g}-cm class (uncertain reading of Ed. 2).</source>
             <translation>O levantamento {axis} dos pontos de verificação ({survey:.2f} cm) não é pelo menos duas vezes mais acurado que a classe de {target:g} cm (leitura incerta da Ed. 2).</translation>
         </message>
         <message>
             <source>The {axis} mean error ({mean:.2f} cm) exceeds 25 % of the {target:g}-cm class: investigate a systematic error (Ed. 1 section 7.4; kept as guidance in Ed. 2, uncertain).</source>
             <translation>O erro médio {axis} ({mean:.2f} cm) excede 25 % da classe de {target:g} cm: investigue um erro sistemático (Ed. 1, seção 7.4; mantido como orientação na Ed. 2, incerto).</translation>
-        </message>
-        <message>
-            <source>{axis} class</source>
-            <translation>Classe {axis}</translation>
-        </message>
-        <message>
-            <source>; tightest example class met: {best:g}-cm</source>
-            <translation>; classe de exemplo mais restrita atendida: {best:g} cm</translation>
         </message>
         <message>
             <source> (only {n} of {minimum} check points)</source>
@@ -2763,6 +2763,10 @@
             <translation>aceita para E, N, H</translation>
         </message>
         <message>
+            <source>{share:.1f} % of {n} points within PEC {pec:.3f} m ({share_relation} 90 %); RMS {rms:.3f} m {rms_relation} EP {ep:.3f} m</source>
+            <translation>{share:.1f} % de {n} pontos dentro do PEC de {pec:.3f} m ({share_relation} 90 %); RMS {rms:.3f} m {rms_relation} EP {ep:.3f} m</translation>
+        </message>
+        <message>
             <source>none</source>
             <translation>nenhuma</translation>
         </message>
@@ -2779,10 +2783,6 @@
             <translation>{n} pontos de verificação; menos de {minimum} torna fraca a regra dos 90 % (prática usual, não consta do Decreto)</translation>
         </message>
         <message>
-            <source>{share:.1f} % of {n} points within PEC {pec:.3f} m ({share_relation} 90 %); RMS {rms:.3f} m {rms_relation} EP {ep:.3f} m</source>
-            <translation>{share:.1f} % de {n} pontos dentro do PEC de {pec:.3f} m ({share_relation} 90 %); RMS {rms:.3f} m {rms_relation} EP {ep:.3f} m</translation>
-        </message>
-        <message>
             <source>PEC-PCD (Decreto 89.817 / ET-CQDG), 1:{scale:,.0f}</source>
             <translation>PEC-PCD (Decreto 89.817 / ET-CQDG), 1:{scale:,.0f}</translation>
         </message>
@@ -2795,20 +2795,20 @@
             <translation>Classe {cls} altimétrica</translation>
         </message>
         <message>
-            <source>{value:g} m</source>
-            <translation>{value:g} m</translation>
-        </message>
-        <message>
-            <source>not given</source>
-            <translation>não informada</translation>
-        </message>
-        <message>
             <source>Declared class {cls} (planimetric)</source>
             <translation>Classe declarada {cls} (planimétrica)</translation>
         </message>
         <message>
             <source>Declared class {cls} (altimetric)</source>
             <translation>Classe declarada {cls} (altimétrica)</translation>
+        </message>
+        <message>
+            <source>{value:g} m</source>
+            <translation>{value:g} m</translation>
+        </message>
+        <message>
+            <source>not given</source>
+            <translation>não informada</translation>
         </message>
         <message>
             <source>no equidistance given for this scale</source>
@@ -2887,18 +2887,6 @@
             <translation>v distância mm</translation>
         </message>
         <message>
-            <source>TLS self-calibration</source>
-            <translation>Autocalibração TLS</translation>
-        </message>
-        <message>
-            <source>Terrestrial laser scanner: registration and self-calibration</source>
-            <translation>Laser scanner terrestre: registro e autocalibração</translation>
-        </message>
-        <message>
-            <source>Model: Carvalho, Correa &amp;amp; dos Santos (Eqs. 1-5), additional parameters after Lichti (2007), correlation analysis after Lichti (2010).</source>
-            <translation>Modelo: Carvalho, Correa &amp;amp; dos Santos (Eqs. 1-5), parâmetros adicionais segundo Lichti (2007), análise de correlação segundo Lichti (2010).</translation>
-        </message>
-        <message>
             <source>Stations</source>
             <translation>Estações</translation>
         </message>
@@ -2909,6 +2897,18 @@
         <message>
             <source>levelled</source>
             <translation>nivelada</translation>
+        </message>
+        <message>
+            <source>TLS self-calibration</source>
+            <translation>Autocalibração TLS</translation>
+        </message>
+        <message>
+            <source>Terrestrial laser scanner: registration and self-calibration</source>
+            <translation>Laser scanner terrestre: registro e autocalibração</translation>
+        </message>
+        <message>
+            <source>Model: Carvalho, Correa &amp;amp; dos Santos (Eqs. 1-5), additional parameters after Lichti (2007), correlation analysis after Lichti (2010).</source>
+            <translation>Modelo: Carvalho, Correa &amp;amp; dos Santos (Eqs. 1-5), parâmetros adicionais segundo Lichti (2007), análise de correlação segundo Lichti (2010).</translation>
         </message>
         <message>
             <source>range</source>
@@ -4713,14 +4713,21 @@ sub-pixel corners) and calibrates the camera with the project's own least-square
 a self-calibrating bundle with one pose per view, the interior orientation f, x0, y0 and the
 Brown-Conrady coefficients k1 k2 k3 p1 p2 (any subset), for the perspective projection or a
 fisheye projection (equidistant, equisolid-angle, orthographic, stereographic; Schneider,
-Schwalbe &amp; Maas 2009) with the Brown correction added.</source>
+Schwalbe &amp; Maas 2009) with the Brown correction added. LENS_MODEL opencv adjusts OpenCV's own
+radial-tangential model instead (perspective): the same least-squares problem as OpenCV's
+calibrateCamera with a fixed aspect ratio (on OpenCV's ChArUco views: the same focal length,
+principal point and sigmas), and a camera that OpenCV and COLMAP read without conversion.</source>
             <translation>Detecta um alvo plano em cada imagem de uma pasta com o OpenCV (xadrez:
 findChessboardCornersSB; ChArUco: CharucoDetector; placa em grade ArUco: ArucoDetector com
 cantos subpixel) e calibra a câmera com o ajustamento por mínimos quadrados do próprio projeto:
 um feixe autocalibrável com uma pose por vista, a orientação interior f, x0, y0 e os
 coeficientes de Brown-Conrady k1 k2 k3 p1 p2 (qualquer subconjunto), para a projeção perspectiva ou uma
 projeção olho de peixe (equidistante, de ângulo equissólido, ortográfica, estereográfica; Schneider,
-Schwalbe &amp; Maas 2009) com a correção de Brown acrescentada.</translation>
+Schwalbe &amp; Maas 2009) com a correção de Brown acrescentada. LENS_MODEL opencv ajusta, em vez dele, o
+próprio modelo radial-tangencial do OpenCV (perspectiva): o mesmo problema de mínimos quadrados do
+calibrateCamera do OpenCV com a razão de aspecto fixa (nas vistas ChArUco do OpenCV: a mesma distância
+focal, o mesmo ponto principal e os mesmos desvios-padrão), e uma câmera que o OpenCV e o COLMAP leem
+sem conversão.</translation>
         </message>
         <message>
             <source>Target: chessboard COLUMNS x ROWS inner corners, SPACING the square side; ChArUco COLUMNS x ROWS
@@ -4826,12 +4833,28 @@ arquivo da câmera: a calibração em si é em pixels.</translation>
             <translation>olho de peixe: estereográfica</translation>
         </message>
         <message>
+            <source>Lens model</source>
+            <translation>Modelo da lente</translation>
+        </message>
+        <message>
+            <source>the same coefficients k1 k2 k3 p1 p2 in either direction: Brown-Conrady corrects the measured point, OpenCV's model distorts the ideal one (the camera then goes to OpenCV or COLMAP unchanged); OpenCV's model only with the perspective projection</source>
+            <translation>os mesmos coeficientes k1 k2 k3 p1 p2 em um ou outro sentido: Brown-Conrady corrige o ponto medido, o modelo do OpenCV distorce o ideal (a câmera vai então para o OpenCV ou o COLMAP sem alteração); o modelo do OpenCV só com a projeção perspectiva</translation>
+        </message>
+        <message>
+            <source>Brown-Conrady correction (photogrammetric)</source>
+            <translation>correção de Brown-Conrady (fotogramétrica)</translation>
+        </message>
+        <message>
+            <source>OpenCV / COLMAP distortion (perspective)</source>
+            <translation>distorção do OpenCV / COLMAP (perspectiva)</translation>
+        </message>
+        <message>
             <source>Lens coefficients estimated</source>
             <translation>Coeficientes da lente estimados</translation>
         </message>
         <message>
-            <source>Brown-Conrady coefficients; the others are held at zero</source>
-            <translation>Coeficientes de Brown-Conrady; os demais são mantidos em zero</translation>
+            <source>coefficients of the lens model; the others are held at zero</source>
+            <translation>coeficientes do modelo da lente; os demais ficam fixos em zero</translation>
         </message>
         <message>
             <source>Target field</source>
@@ -4904,6 +4927,26 @@ arquivo da câmera: a calibração em si é em pixels.</translation>
         <message>
             <source>Focal length (px)</source>
             <translation>Distância focal (px)</translation>
+        </message>
+        <message>
+            <source>Detects a planar target in every image of a folder with OpenCV (chessboard:
+findChessboardCornersSB; ChArUco: CharucoDetector; ArUco grid board: ArucoDetector with
+sub-pixel corners) and calibrates the camera with the project's own least-squares adjustment:
+a self-calibrating bundle with one pose per view, the interior orientation f, x0, y0 and the
+Brown-Conrady coefficients k1 k2 k3 p1 p2 (any subset), for the perspective projection or a
+fisheye projection (equidistant, equisolid-angle, orthographic, stereographic; Schneider,
+Schwalbe &amp; Maas 2009) with the Brown correction added.</source>
+            <translation type="vanished">Detecta um alvo plano em cada imagem de uma pasta com o OpenCV (xadrez:
+findChessboardCornersSB; ChArUco: CharucoDetector; placa em grade ArUco: ArucoDetector com
+cantos subpixel) e calibra a câmera com o ajustamento por mínimos quadrados do próprio projeto:
+um feixe autocalibrável com uma pose por vista, a orientação interior f, x0, y0 e os
+coeficientes de Brown-Conrady k1 k2 k3 p1 p2 (qualquer subconjunto), para a projeção perspectiva ou uma
+projeção olho de peixe (equidistante, de ângulo equissólido, ortográfica, estereográfica; Schneider,
+Schwalbe &amp; Maas 2009) com a correção de Brown acrescentada.</translation>
+        </message>
+        <message>
+            <source>Brown-Conrady coefficients; the others are held at zero</source>
+            <translation type="vanished">Coeficientes de Brown-Conrady; os demais são mantidos em zero</translation>
         </message>
         <message>
             <source>Outputs: the camera JSON (a fisheye camera is taken by control chips, orthorectify (and so
