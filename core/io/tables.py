@@ -193,6 +193,39 @@ def choice_column(table: Table, index: int, allowed: Sequence[str], what: str) -
     return values
 
 
+def sigma_column(
+    table: Table, aliases: Sequence[str], default: float = 0.0
+) -> NDArray[np.float64] | None:
+    """The optional standard-deviation column named by one of ``aliases`` (in its own unit),
+    None where the table has none; an empty cell is ``default``.
+
+    Raises
+    ------
+    InputError
+        A value that is not a finite number or is negative, naming the file, row and column.
+
+    >>> t = Table("p.csv", ("id", "sigma"), (("a", "0.5"), ("b", "")), (2, 3))
+    >>> sigma_column(t, ("sigma",), 0.1).tolist()
+    [0.5, 0.1]
+    >>> sigma_column(t, ("s",)) is None
+    True
+    """
+    col = find_column(table, aliases, required=False)
+    if col is None:
+        return None
+    values = float_column(table, col, allow_empty=True)
+    values[np.isnan(values)] = default
+    bad = np.flatnonzero(values < 0)
+    if bad.size:
+        raise InputError(
+            f"a standard deviation cannot be negative ({values[bad[0]]:g})",
+            path=table.path,
+            row=table.line_numbers[bad[0]],
+            column=table.columns[col],
+        )
+    return values
+
+
 def check_covariance(cov: NDArray[np.float64], table: Table, k: int, what: str) -> None:
     """Refuse (naming the file and row) a covariance matrix that is not positive
     semi-definite: a negative variance or an impossible correlation.

@@ -47,6 +47,7 @@ from .tables import (
     float_column,
     number,
     read_table,
+    sigma_column,
     text_column,
     unique_ids,
     write_csv_atomic,
@@ -122,20 +123,8 @@ def _ids(table: Table, aliases: Sequence[str], what: str) -> tuple[str, ...]:
 
 
 def _optional(table: Table, aliases: Sequence[str], default: float) -> np.ndarray:
-    col = find_column(table, aliases, required=False)
-    if col is None:
-        return np.full(len(table), float(default))
-    values = float_column(table, col, allow_empty=True)
-    values[np.isnan(values)] = default
-    if (values < 0).any():
-        k = int(np.flatnonzero(values < 0)[0])
-        raise InputError(
-            "a standard deviation cannot be negative",
-            path=table.path,
-            row=table.line_numbers[k],
-            column=table.columns[col],
-        )
-    return values
+    values = sigma_column(table, aliases, default)
+    return np.full(len(table), float(default)) if values is None else values
 
 
 def _angle(table: Table, stem: str, unit: str) -> tuple[np.ndarray, str]:
