@@ -96,6 +96,48 @@ def mount_from(values: Mapping[str, Any]):
     )
 
 
+def csv_out(
+    name: str,
+    label: str,
+    *,
+    on_demand: bool = False,
+    advanced: bool = False,
+    twin: str = "",
+    help: str = "",
+) -> Param:
+    """An optional CSV table output (``file_out``); ``on_demand``: not written unless asked
+    (QGIS leaves it unchecked); ``twin``: the layer output (``sink``) that carries the same
+    rows (:attr:`Param.layer_twin`)."""
+    return Param(
+        name,
+        "file_out",
+        label,
+        help=help,
+        optional=True,
+        advanced=advanced,
+        file_filter=CSV_OUT,
+        create_by_default=not on_demand,
+        layer_twin=twin,
+    )
+
+
+def block_export_params() -> tuple[Param, ...]:
+    """CAMERA, EO and the optional OBSERVATIONS and POINTS: the oriented block an exporter
+    (``exportcolmap``, ``exportopensfm``) writes out."""
+    return (
+        Param("CAMERA", "file", "Camera(s) (JSON)", file_filter="JSON files (*.json)"),
+        Param("EO", "table", "Exterior orientation table (CSV)", file_filter=CSV_FILTER),
+        Param("OBSERVATIONS", "table", "Observations (CSV)", optional=True, file_filter=CSV_FILTER),
+        Param(
+            "POINTS",
+            "table",
+            "3D points (ground point table, CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+        ),
+    )
+
+
 def cloud_params(key: str = "INPUT", label: str = "Point cloud (LAS/LAZ)") -> tuple[Param, ...]:
     """The cloud file, ``CRS`` (overrides or supplies the file's) and ``DISTANCE_UNIT``."""
     return (

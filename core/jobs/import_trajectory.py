@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_FILTER, CSV_OUT, mount_from, mount_params
+from .common import CSV_FILTER, csv_out, mount_from, mount_params
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -124,22 +124,8 @@ trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""
         ),
         *mount_params(),
         Param("OUTPUT", "sink", "Perspective centres", geometry="point", optional=True),
-        Param(
-            "OUTPUT_TRAJECTORY",
-            "file_out",
-            "Trajectory table at the events (CSV)",
-            optional=True,
-            file_filter=CSV_OUT,
-            advanced=True,
-        ),
-        Param(
-            "OUTPUT_EO",
-            "file_out",
-            "Exterior orientation table (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-        ),
+        csv_out("OUTPUT_TRAJECTORY", "Trajectory table at the events (CSV)", advanced=True),
+        csv_out("OUTPUT_EO", "Exterior orientation table (CSV)", on_demand=True),
     ),
     results=(
         Result("IMAGE_COUNT", "number", "Number of images"),

@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 
 from .checks import DSM_BYTES_PER_CELL, check_cell_size, check_memory
-from .common import CSV_FILTER, CSV_OUT
+from .common import CSV_FILTER, csv_out
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Ref, Result, Values
 
@@ -130,23 +130,8 @@ projection's field: no ray).""",
         ),
         Param("OUTPUT_POINTS", "sink", "Monoplotted points", geometry="point", optional=True),
         Param("OUTPUT_LINES", "sink", "Monoplotted lines", geometry="line", optional=True),
-        Param(
-            "OUTPUT_CSV",
-            "file_out",
-            "Point table (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-            layer_twin="OUTPUT_POINTS",
-        ),
-        Param(
-            "LINES_CSV",
-            "file_out",
-            "Line table",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-        ),
+        csv_out("OUTPUT_CSV", "Point table (CSV)", on_demand=True, twin="OUTPUT_POINTS"),
+        csv_out("LINES_CSV", "Line table", on_demand=True),
         Param(
             "OUTPUT_DSM",
             "raster_out",

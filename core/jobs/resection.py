@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 import math
 
-from .common import CSV_FILTER, CSV_OUT, global_test_verdict
+from .common import CSV_FILTER, CSV_OUT, csv_out, global_test_verdict
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -155,9 +155,7 @@ lines parallel).""",
         Param(
             "OUTPUT_EO", "file_out", "Exterior orientation with sigmas (CSV)", file_filter=CSV_OUT
         ),
-        Param(
-            "OUTPUT_RESIDUALS", "file_out", "Residuals (CSV)", optional=True, file_filter=CSV_OUT
-        ),
+        csv_out("OUTPUT_RESIDUALS", "Residuals (CSV)"),
         Param(
             "OUTPUT_HTML",
             "file_out",

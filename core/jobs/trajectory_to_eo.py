@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_FILTER, CSV_OUT, mount_from, mount_params
+from .common import CSV_FILTER, csv_out, mount_from, mount_params
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -51,15 +51,7 @@ CSV (on the command line, printed when no file is given), and the number of imag
         ),
         *mount_params(),
         Param("OUTPUT", "sink", "Exterior orientation", geometry="point", optional=True),
-        Param(
-            "OUTPUT_CSV",
-            "file_out",
-            "Exterior orientation table (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-            layer_twin="OUTPUT",
-        ),
+        csv_out("OUTPUT_CSV", "Exterior orientation table (CSV)", on_demand=True, twin="OUTPUT"),
     ),
     results=(Result("IMAGE_COUNT", "number", "Number of images"),),
     tags=("trajectory", "ins", "gnss", "imu", "exterior orientation", "omega phi kappa"),
