@@ -52,7 +52,7 @@ from __future__ import annotations
 import math
 import os
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Hashable, Iterable, Sequence
 from typing import Any, Union
 
 import numpy as np
@@ -66,6 +66,7 @@ from .tables import (
     find_column,
     float_column,
     normalise,
+    note_unique,
     number,
     read_table,
     sigma_column,
@@ -206,18 +207,11 @@ def read_line_control_csv(path: PathLike) -> LineControl:
 
 
 def _unique(ids: Sequence[str], rows: Sequence[int], table, col: int) -> tuple[str, ...]:
-    first: dict[str, int] = {}
+    first: dict[Hashable, int] = {}
     for value, line_no in zip(ids, rows):
         if not value:
             raise InputError("empty id", path=table.path, row=line_no, column=table.columns[col])
-        if value in first:
-            raise InputError(
-                f"line id '{value}' already appears in row {first[value]}",
-                path=table.path,
-                row=line_no,
-                column=table.columns[col],
-            )
-        first[value] = line_no
+        note_unique(first, value, f"line id '{value}'", table, line_no, col)
     return tuple(ids)
 
 

@@ -250,7 +250,7 @@ def check_covariance(cov: NDArray[np.float64], table: Table, k: int, what: str) 
 
 def unique_integer_ids(table: Table, values: NDArray[np.float64], index: int) -> list[int]:
     """The id column as integers, each once; errors name the file, row and column."""
-    seen: dict[int, int] = {}
+    seen: dict[Hashable, int] = {}
     out = []
     for k, (value, number) in enumerate(zip(values, table.line_numbers)):
         if value != round(value):
@@ -261,14 +261,7 @@ def unique_integer_ids(table: Table, values: NDArray[np.float64], index: int) ->
                 column=table.columns[index],
             )
         key = int(value)
-        if key in seen:
-            raise InputError(
-                f"id {key} already appears in row {seen[key]}",
-                path=table.path,
-                row=number,
-                column=table.columns[index],
-            )
-        seen[key] = number
+        note_unique(seen, key, f"id {key}", table, number, index)
         out.append(key)
     return out
 

@@ -108,19 +108,9 @@ _PROJECT_NUMBERS = (
 
 
 def _numbers(rows) -> tuple[Param, ...]:
-    return tuple(
-        Param(
-            key,
-            "number",
-            label,
-            getattr(_D, field),
-            unit=unit,
-            minimum=minimum,
-            maximum=maximum,
-            advanced=advanced,
-        )
-        for key, field, label, unit, minimum, maximum, advanced in rows
-    )
+    """The ``number`` parameters of rows ``(parameter, field, label, unit, minimum, maximum,
+    advanced)`` of :class:`AccuracySettings`."""
+    return _D.params((key, field, label, "number", *rest) for key, field, label, *rest in rows)
 
 
 def _point_params(what: str) -> tuple[Param, ...]:

@@ -16,6 +16,7 @@ from .spec import Param, Ref
 CSV_FILTER = "CSV files (*.csv *.txt)"
 CSV_OUT = "CSV files (*.csv)"
 LAS_FILTER = "LAS/LAZ files (*.las *.laz *.LAS *.LAZ)"
+DSM_FILTER = "DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"
 DISTANCE_UNITS = ("crs", "metre")
 #: Largest lever-arm component (m): longer than any survey aircraft, so a larger value is a
 #: unit mistake (millimetres typed as metres).
@@ -41,12 +42,11 @@ def mount_params(initial_boresight: bool = False) -> tuple[Param, ...]:
             maximum=MAX_LEVER_ARM_M,
             help="camera perspective centre in the INS body frame (x forward, y right, z down)",
         ),
-        Param(
+        choice_param(
             "MOUNT",
-            "enum",
             "Camera mount",
-            Ref("photo.mount_choices", "MOUNT_CHOICES", convert=_first),
-            options=Ref("photo.mount_choices", "MOUNT_CHOICES"),
+            "photo.mount_choices",
+            "MOUNT_CHOICES",
             labels=Ref("photo.mount_choices", "MOUNT_LABELS", convert=_mount_labels),
             help="nominal camera-to-body rotation; custom uses MOUNT_MATRIX",
         ),
@@ -74,6 +74,19 @@ def mount_params(initial_boresight: bool = False) -> tuple[Param, ...]:
             help="small misalignment about the camera axes x, y, z (a larger rotation "
             "belongs in MOUNT)",
         ),
+    )
+
+
+def choice_param(name: str, label: str, module: str, constant: str, **extra: Any) -> Param:
+    """An ``enum`` parameter whose options are the tuple ``constant`` of the science module
+    ``module`` (below core, e.g. ``"io.colmap_names"``), the first of them its default."""
+    return Param(
+        name,
+        "enum",
+        label,
+        Ref(module, constant, convert=_first),
+        options=Ref(module, constant),  # type: ignore[arg-type]
+        **extra,
     )
 
 
@@ -118,6 +131,20 @@ def csv_out(
         file_filter=CSV_OUT,
         create_by_default=not on_demand,
         layer_twin=twin,
+    )
+
+
+def dsm_cell_param(advanced: bool = False) -> Param:
+    """CELL_SIZE: the cell (CRS units) of the DSM rasterised from a LAS/LAZ given as DSM."""
+    return Param(
+        "CELL_SIZE",
+        "number",
+        "DSM cell size for LAS/LAZ",
+        0.5,
+        unit="CRS unit",
+        minimum=0.01,
+        maximum=1000.0,
+        advanced=advanced,
     )
 
 

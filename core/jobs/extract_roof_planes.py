@@ -158,20 +158,7 @@ error.""",
             optional=True,
             help="LAS classes searched when POINTS is classes, e.g. 6 or 1,6",
         ),
-        *(
-            Param(
-                key,
-                kind,
-                label,
-                getattr(_D, field),
-                unit=unit,
-                minimum=minimum,
-                maximum=maximum,
-                advanced=advanced,
-                help=_HELP.get(key, ""),
-            )
-            for key, field, label, kind, unit, minimum, maximum, advanced in _NUMBERS
-        ),
+        *_D.params(_NUMBERS, _HELP),
         Param("OUTPUT", "sink", "Roof planes", geometry="polygon", optional=True),
         Param("OUTPUT_CSV", "file_out", "Plane table (CSV)", file_filter=CSV_OUT),
         Param(

@@ -5,17 +5,13 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_FILTER, csv_out, mount_from, mount_params
+from .common import CSV_FILTER, choice_param, csv_out, mount_from, mount_params
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
 _OPTIONS = Fields("photo.trajectory_options", "TrajectoryImportOptions")
-
-
-def _first(choices: tuple[str, ...]) -> str:
-    return choices[0]
 
 
 NAV_FILTER = "Trajectories (*.out *.sbet *.txt *.asc *.csv *.OUT);;All files (*)"
@@ -56,12 +52,11 @@ the trajectory time). OUTPUT_EO: the exterior orientation with the mount applied
 trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""",
     params=(
         Param("INPUT", "file", "Trajectory (SBET, ASCII export or CSV)", file_filter=NAV_FILTER),
-        Param(
+        choice_param(
             "FORMAT",
-            "enum",
             "Trajectory format",
-            Ref("photo.trajectory_options", "TRAJECTORY_FORMATS", convert=_first),
-            options=Ref("photo.trajectory_options", "TRAJECTORY_FORMATS"),
+            "photo.trajectory_options",
+            "TRAJECTORY_FORMATS",
             help="auto: by the file's ending (.out/.sbet SBET, .csv CSV, else ASCII)",
         ),
         Param("EVENTS", "table", "Camera events (CSV: image_id, time)", file_filter=CSV_FILTER),

@@ -187,19 +187,7 @@ that accuracyreport reads for the NSSDA and PEC-PCD sections.""",
             help="LAS classes of hard surfaces; a cell holding another "
             "class is not compared (class 1 holds cars that move between flights)",
         ),
-        *(
-            Param(
-                key,
-                kind,
-                label,
-                getattr(_D, field),
-                unit=unit,
-                minimum=minimum,
-                maximum=maximum,
-                advanced=advanced,
-            )
-            for key, field, label, kind, unit, minimum, maximum, advanced in _NUMBERS
-        ),
+        *_D.params(_NUMBERS),
         Param(
             "TILE_SIZE",
             "number",

@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 
 from .checks import DSM_BYTES_PER_CELL, check_cell_size, check_memory
-from .common import CSV_FILTER, csv_out
+from .common import CSV_FILTER, DSM_FILTER, choice_param, csv_out, dsm_cell_param
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Ref, Result, Values
 
@@ -56,7 +56,7 @@ projection's field: no ray).""",
             "DSM",
             "surface",
             "DSM (raster, or LAS/LAZ)",
-            file_filter="DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)",
+            file_filter=DSM_FILTER,
         ),
         Param("PLANES", "table", "Roof plane table (CSV)", optional=True, file_filter=CSV_FILTER),
         Param("CRS", "crs", "Mapping CRS of the EO", help="e.g. EPSG:28992"),
@@ -69,24 +69,14 @@ projection's field: no ray).""",
             "heights as ellipsoidal",
             advanced=True,
         ),
-        Param(
+        choice_param(
             "METHOD",
-            "enum",
             "Method",
-            Ref("photo.monoplot_options", "METHODS", convert=lambda methods: methods[0]),
-            options=Ref("photo.monoplot_options", "METHODS"),
+            "photo.monoplot_options",
+            "METHODS",
             labels=("direct (Dal Poz, DDA)", "Makarovic iteration"),
         ),
-        Param(
-            "CELL_SIZE",
-            "number",
-            "DSM cell size for LAS/LAZ",
-            0.5,
-            unit="CRS unit",
-            minimum=0.01,
-            maximum=1000.0,
-            advanced=True,
-        ),
+        dsm_cell_param(advanced=True),
         Param(
             "SIGMA_DSM",
             "number",

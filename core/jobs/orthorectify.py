@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..io.suffixes import IMAGE_SUFFIXES
-from .common import CSV_FILTER, compression_param
+from .common import CSV_FILTER, DSM_FILTER, compression_param, dsm_cell_param
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -22,7 +22,6 @@ log = logging.getLogger(__name__)
 _D = Fields("photo.ortho_options", "OrthoOptions")
 #: Name of the orthophoto of image ``<image_id>`` in the output folder.
 ORTHO_NAME = "{}_ortho.tif"
-DSM_FILTER = "DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"
 
 SPEC = AlgorithmSpec(
     name="orthorectify",
@@ -78,15 +77,7 @@ Nothing is written when an input is wrong; the files appear together when all ar
         ),
         Param("CRS", "crs", "Mapping CRS of the EO", help="e.g. EPSG:28992"),
         Param("DSM_CRS", "crs", "DSM CRS (if the file has none)", optional=True),
-        Param(
-            "CELL_SIZE",
-            "number",
-            "DSM cell size for LAS/LAZ",
-            0.5,
-            unit="CRS unit",
-            minimum=0.01,
-            maximum=1000.0,
-        ),
+        dsm_cell_param(),
         Param(
             "GSD",
             "number",
