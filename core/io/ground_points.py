@@ -23,10 +23,16 @@ from typing import Union
 
 import numpy as np
 
-from ..errors import InputError
 from ..photo.bundle_setup import DEFAULT_CONTROL_SIGMA_M, ROLES, GroundPoints
 from . import tables
-from .tables import find_column, float_column, read_table, text_column, write_csv_atomic
+from .tables import (
+    find_column,
+    float_column,
+    read_table,
+    refuse_rows,
+    text_column,
+    write_csv_atomic,
+)
 
 __all__ = ["GROUND_POINT_COLUMNS", "read_ground_points_csv", "write_ground_points_csv"]
 
@@ -58,14 +64,9 @@ def read_ground_points_csv(path: Union[str, Path]) -> GroundPoints:
         if col is None:
             continue
         v = float_column(table, col, allow_empty=True)
-        bad = np.flatnonzero(v <= 0)
-        if bad.size:
-            raise InputError(
-                f"a standard deviation must be > 0, got {v[bad[0]]}",
-                path=table.path,
-                row=table.line_numbers[bad[0]],
-                column=table.columns[col],
-            )
+        refuse_rows(
+            table, v <= 0, col, lambda i, v=v: f"a standard deviation must be > 0, got {v[i]}"
+        )
         sig[:, k] = np.where(np.isnan(v), DEFAULT_CONTROL_SIGMA_M, v)
     r_col = find_column(table, ("role", "type", "use"))
     roles = tables.choice_column(table, r_col, ROLES, "a role")

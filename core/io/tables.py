@@ -10,7 +10,7 @@ from __future__ import annotations
 import csv
 import math
 import os
-from collections.abc import Hashable, Iterable, Sequence
+from collections.abc import Callable, Hashable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal, Union, overload
@@ -193,6 +193,32 @@ def choice_column(table: Table, index: int, allowed: Sequence[str], what: str) -
     return values
 
 
+def refuse_rows(
+    table: Table, bad: NDArray[np.bool_], index: int | None, message: Callable[[int], str]
+) -> None:
+    """InputError at the first row where ``bad`` is True, naming the file, that row and column
+    ``index`` (none where None), with the text ``message(k)`` of its position ``k`` (0-based)
+    among the table's rows; nothing where no row is bad.
+
+    >>> t = Table("p.csv", ("id", "h"), (("a", "1"), ("b", "-2")), (2, 3))
+    >>> h = np.array([1.0, -2.0])
+    >>> try:
+    ...     refuse_rows(t, h < 0, 1, lambda k: f"{h[k]:g} m is below ground")
+    ... except InputError as exc:
+    ...     print(exc)
+    p.csv, row 3, column 'h': -2 m is below ground
+    """
+    rows = np.flatnonzero(bad)
+    if rows.size:
+        k = int(rows[0])
+        raise InputError(
+            message(k),
+            path=table.path,
+            row=table.line_numbers[k],
+            column=None if index is None else table.columns[index],
+        )
+
+
 def sigma_column(
     table: Table, aliases: Sequence[str], default: float = 0.0
 ) -> NDArray[np.float64] | None:
@@ -215,14 +241,9 @@ def sigma_column(
         return None
     values = float_column(table, col, allow_empty=True)
     values[np.isnan(values)] = default
-    bad = np.flatnonzero(values < 0)
-    if bad.size:
-        raise InputError(
-            f"a standard deviation cannot be negative ({values[bad[0]]:g})",
-            path=table.path,
-            row=table.line_numbers[bad[0]],
-            column=table.columns[col],
-        )
+    refuse_rows(
+        table, values < 0, col, lambda k: f"a standard deviation cannot be negative ({values[k]:g})"
+    )
     return values
 
 

@@ -47,6 +47,7 @@ from .tables import (
     float_column,
     number,
     read_table,
+    refuse_rows,
     sigma_column,
     text_column,
     unique_ids,
@@ -138,17 +139,16 @@ def _angle(table: Table, stem: str, unit: str) -> tuple[np.ndarray, str]:
         # A horizontal direction is within one turn and an elevation within half a turn (face
         # II: three quarters): a value beyond that is in another unit (gon read as degrees).
         limit = full if stem == "hz" else 0.75 * full
-        bad = np.flatnonzero(np.abs(values) > limit)
-        if bad.size:
-            k = int(bad[0])
-            raise InputError(
-                f"{values[k]:g} is beyond {limit:g} {u}: the angles are not in {u} (gon read "
-                "as degrees?). Name the column hz_deg/vt_deg or hz_gon/vt_gon, or choose the "
-                "angle unit",
-                path=table.path,
-                row=table.line_numbers[k],
-                column=table.columns[col],
-            )
+        refuse_rows(
+            table,
+            np.abs(values) > limit,
+            col,
+            lambda k, values=values, limit=limit, u=u: (
+                f"{values[k]:g} is beyond {limit:g} {u}: the angles are not in {u} (gon "
+                "read as degrees?). Name the column hz_deg/vt_deg or hz_gon/vt_gon, or choose the "
+                "angle unit"
+            ),
+        )
         return values * ANGLE_UNITS[u], u
     raise InputError(
         f"no column for the {'horizontal direction' if stem == 'hz' else 'vertical angle'} "
@@ -160,25 +160,19 @@ def _angle(table: Table, stem: str, unit: str) -> tuple[np.ndarray, str]:
 
 def _check_ranges(t: Table, rho: np.ndarray, what: str, col: int | None) -> None:
     """Distances from the scanner (m) that are > 0 and within a scanner's reach."""
-    where = {"path": t.path, "column": None if col is None else t.columns[col]}
-    bad = np.flatnonzero(rho <= 0)
-    if bad.size:
-        k = int(bad[0])
-        raise InputError(
-            f"{what} is {rho[k]:g} m from the scanner: it must be > 0",
-            row=t.line_numbers[k],
-            **where,
-        )
-    bad = np.flatnonzero(rho > MAX_SCANNER_RANGE_M)
-    if bad.size:
-        k = int(bad[0])
-        raise InputError(
-            f"{what} is {rho[k]:g} m from the scanner, beyond the {MAX_SCANNER_RANGE_M:g} m a "
-            "terrestrial scanner reaches: another unit, or coordinates that are not in the "
-            "scanner's frame",
-            row=t.line_numbers[k],
-            **where,
-        )
+    refuse_rows(
+        t, rho <= 0, col, lambda k: f"{what} is {rho[k]:g} m from the scanner: it must be > 0"
+    )
+    refuse_rows(
+        t,
+        rho > MAX_SCANNER_RANGE_M,
+        col,
+        lambda k: (
+            f"{what} is {rho[k]:g} m from the scanner, beyond the {MAX_SCANNER_RANGE_M:g} "
+            "m a terrestrial scanner reaches: another unit, or coordinates that are not in the "
+            "scanner's frame"
+        ),
+    )
 
 
 def read_tls_observations_csv(
