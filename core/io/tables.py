@@ -269,18 +269,25 @@ def check_covariance(cov: NDArray[np.float64], table: Table, k: int, what: str) 
         )
 
 
+def check_integers(
+    table: Table, values: NDArray[np.float64], index: int, what: str = "an integer"
+) -> None:
+    """Refuse (naming the file, row and column ``index``) the first of ``values``, read from
+    that column, that is not a whole number."""
+    refuse_rows(
+        table,
+        values != np.round(values),
+        index,
+        lambda k: f"'{table.rows[k][index]}' is not {what}",
+    )
+
+
 def unique_integer_ids(table: Table, values: NDArray[np.float64], index: int) -> list[int]:
     """The id column as integers, each once; errors name the file, row and column."""
+    check_integers(table, values, index, "an integer id")
     seen: dict[Hashable, int] = {}
     out = []
-    for k, (value, number) in enumerate(zip(values, table.line_numbers)):
-        if value != round(value):
-            raise InputError(
-                f"'{table.rows[k][index]}' is not an integer id",
-                path=table.path,
-                row=number,
-                column=table.columns[index],
-            )
+    for value, number in zip(values, table.line_numbers):
         key = int(value)
         note_unique(seen, key, f"id {key}", table, number, index)
         out.append(key)
