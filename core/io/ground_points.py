@@ -64,13 +64,18 @@ def read_ground_points_csv(path: Union[str, Path]) -> GroundPoints:
         if col is None:
             continue
         v = float_column(table, col, allow_empty=True)
-        refuse_rows(
-            table, v <= 0, col, lambda i, v=v: f"a standard deviation must be > 0, got {v[i]}"
-        )
+        _check_positive(table, v, col)
         sig[:, k] = np.where(np.isnan(v), DEFAULT_CONTROL_SIGMA_M, v)
     r_col = find_column(table, ("role", "type", "use"))
     roles = tables.choice_column(table, r_col, ROLES, "a role")
     return GroundPoints(ids, xyz, sig, roles, table.line_numbers, table.path)
+
+
+def _check_positive(table: tables.Table, sigma: np.ndarray, index: int) -> None:
+    """Standard deviations (column ``index``; empty cells NaN) that are > 0."""
+    refuse_rows(
+        table, sigma <= 0, index, lambda k: f"a standard deviation must be > 0, got {sigma[k]}"
+    )
 
 
 def write_ground_points_csv(path: Union[str, Path], ground: GroundPoints) -> None:

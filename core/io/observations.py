@@ -51,6 +51,7 @@ from ..errors import InputError
 from ..geometry.camera import Camera
 from ..photo.observations import DEFAULT_SIGMA_PX, OBSERVATION_TYPES, ImageObservations
 from .tables import (
+    Table,
     choice_column,
     find_column,
     float_column,
@@ -133,21 +134,8 @@ def read_observations_csv(
             )
         first[key] = number
     if camera is not None:
-        for values, index, size, what in (
-            (col, c_col, camera.width_px, "width_px"),
-            (row, r_col, camera.height_px, "height_px"),
-        ):
-            off = (values < 0) | (values > size)
-            refuse_rows(
-                table,
-                off,
-                index,
-                lambda k, values=values, size=size, what=what, off=off: (
-                    f"{values[k]:g} px is off the image: the camera '{camera.name}' has "
-                    f"{what} {size} (pixels from 0 to {size}); {np.count_nonzero(off)} row(s) "
-                    "affected"
-                ),
-            )
+        _check_in_image(table, col, c_col, camera.width_px, "width_px", camera.name)
+        _check_in_image(table, row, r_col, camera.height_px, "height_px", camera.name)
     return ImageObservations(
         image,
         point,
@@ -158,6 +146,23 @@ def read_observations_csv(
         table.line_numbers,
         table.path,
         cameras,
+    )
+
+
+def _check_in_image(
+    table: Table, values: NDArray[np.float64], index: int, size: int, what: str, camera: str
+) -> None:
+    """Pixel coordinates ``values`` (column ``index``) within 0 to ``size`` (the camera's
+    ``what``, width_px or height_px)."""
+    off = (values < 0) | (values > size)
+    refuse_rows(
+        table,
+        off,
+        index,
+        lambda k: (
+            f"{values[k]:g} px is off the image: the camera '{camera}' has {what} {size} "
+            f"(pixels from 0 to {size}); {np.count_nonzero(off)} row(s) affected"
+        ),
     )
 
 

@@ -130,32 +130,35 @@ def _optional(table: Table, aliases: Sequence[str], default: float) -> np.ndarra
 
 def _angle(table: Table, stem: str, unit: str) -> tuple[np.ndarray, str]:
     """An angle column in radians: ``<stem>_deg``, ``<stem>_gon`` or ``<stem>`` in ``unit``."""
-    for suffix, u in (("_deg", "degrees"), ("_gon", "gon"), ("_rad", "radians"), ("", unit)):
-        col = find_column(table, (stem + suffix,), required=False)
-        if col is None:
-            continue
-        values = float_column(table, col)
-        full = _FULL_CIRCLE[u]
-        # A horizontal direction is within one turn and an elevation within half a turn (face
-        # II: three quarters): a value beyond that is in another unit (gon read as degrees).
-        limit = full if stem == "hz" else 0.75 * full
-        refuse_rows(
-            table,
-            np.abs(values) > limit,
-            col,
-            lambda k, values=values, limit=limit, u=u: (
-                f"{values[k]:g} is beyond {limit:g} {u}: the angles are not in {u} (gon "
-                "read as degrees?). Name the column hz_deg/vt_deg or hz_gon/vt_gon, or choose the "
-                "angle unit"
-            ),
+    names = ((stem + "_deg", "degrees"), (stem + "_gon", "gon"), (stem + "_rad", "radians"))
+    found = [
+        (col, u)
+        for name, u in (*names, (stem, unit))
+        if (col := find_column(table, (name,), required=False)) is not None
+    ]
+    if not found:
+        raise InputError(
+            f"no column for the {'horizontal direction' if stem == 'hz' else 'vertical angle'} "
+            f"(accepted names: {stem}_deg, {stem}_gon, {stem}_rad, {stem}; found: "
+            f"{', '.join(table.columns)})",
+            path=table.path,
         )
-        return values * ANGLE_UNITS[u], u
-    raise InputError(
-        f"no column for the {'horizontal direction' if stem == 'hz' else 'vertical angle'} "
-        f"(accepted names: {stem}_deg, {stem}_gon, {stem}_rad, {stem}; found: "
-        f"{', '.join(table.columns)})",
-        path=table.path,
+    col, u = found[0]
+    values = float_column(table, col)
+    full = _FULL_CIRCLE[u]
+    # A horizontal direction is within one turn and an elevation within half a turn (face
+    # II: three quarters): a value beyond that is in another unit (gon read as degrees).
+    limit = full if stem == "hz" else 0.75 * full
+    refuse_rows(
+        table,
+        np.abs(values) > limit,
+        col,
+        lambda k: (
+            f"{values[k]:g} is beyond {limit:g} {u}: the angles are not in {u} (gon read "
+            "as degrees?). Name the column hz_deg/vt_deg or hz_gon/vt_gon, or choose the angle unit"
+        ),
     )
+    return values * ANGLE_UNITS[u], u
 
 
 def _check_ranges(t: Table, rho: np.ndarray, what: str, col: int | None) -> None:
