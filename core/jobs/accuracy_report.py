@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 
 from ..errors import InputError
-from .common import CSV_FILTER
+from .common import CSV_FILTER, html_out
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -267,13 +267,7 @@ for one release).""",
             maximum=100000.0,
         ),
         Param("OUTPUT", "sink", "Check points with discrepancies", geometry="point", optional=True),
-        Param(
-            "OUTPUT_HTML",
-            "file_out",
-            "Accuracy report (HTML)",
-            optional=True,
-            file_filter="HTML files (*.html)",
-        ),
+        html_out("OUTPUT_HTML", "Accuracy report (HTML)"),
         Param(
             "OUTPUT_JSON",
             "file_out",

@@ -113,22 +113,42 @@ def csv_out(
     name: str,
     label: str,
     *,
+    optional: bool = True,
     on_demand: bool = False,
     advanced: bool = False,
     twin: str = "",
     help: str = "",
 ) -> Param:
-    """An optional CSV table output (``file_out``); ``on_demand``: not written unless asked
-    (QGIS leaves it unchecked); ``twin``: the layer output (``sink``) that carries the same
-    rows (:attr:`Param.layer_twin`)."""
+    """A CSV table output (``file_out``), optional unless said; ``on_demand``: not written
+    unless asked (QGIS leaves it unchecked); ``twin``: the layer output (``sink``) that carries
+    the same rows (:attr:`Param.layer_twin`)."""
+    return _file_out(name, label, CSV_OUT, optional, on_demand, advanced, twin, help)
+
+
+def html_out(name: str, label: str, *, optional: bool = True, on_demand: bool = False) -> Param:
+    """An HTML report output (``file_out``), optional unless said; ``on_demand`` as in
+    :func:`csv_out`."""
+    return _file_out(name, label, "HTML files (*.html)", optional, on_demand, False, "", "")
+
+
+def _file_out(
+    name: str,
+    label: str,
+    file_filter: str,
+    optional: bool,
+    on_demand: bool,
+    advanced: bool,
+    twin: str,
+    help: str,
+) -> Param:
     return Param(
         name,
         "file_out",
         label,
         help=help,
-        optional=True,
+        optional=optional,
         advanced=advanced,
-        file_filter=CSV_OUT,
+        file_filter=file_filter,
         create_by_default=not on_demand,
         layer_twin=twin,
     )

@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 import math
 
-from .common import CSV_FILTER, CSV_OUT, csv_out, global_test_verdict
+from .common import CSV_FILTER, csv_out, global_test_verdict, html_out
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -152,17 +152,9 @@ lines parallel).""",
             _OPTIONS.estimate_interior,
         ),
         Param("SNOOPING", "boolean", "Data snooping (Baarda)", _OPTIONS.snooping, advanced=True),
-        Param(
-            "OUTPUT_EO", "file_out", "Exterior orientation with sigmas (CSV)", file_filter=CSV_OUT
-        ),
+        csv_out("OUTPUT_EO", "Exterior orientation with sigmas (CSV)", optional=False),
         csv_out("OUTPUT_RESIDUALS", "Residuals (CSV)"),
-        Param(
-            "OUTPUT_HTML",
-            "file_out",
-            "Summary (HTML)",
-            optional=True,
-            file_filter="HTML files (*.html)",
-        ),
+        html_out("OUTPUT_HTML", "Summary (HTML)"),
     ),
     results=(
         Result("IMAGE_COUNT", "number", "Images resected"),
