@@ -339,7 +339,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     import numpy as np
 
     from ..errors import stop_if_asked
-    from ..geometry.frames import check_area_of_use, parse_crs
+    from ..geometry.frames import check_points_in_area, parse_crs
     from ..io.atomic import write_text_atomic
     from ..quality.accuracy import AccuracySettings, assess_accuracy
     from ..quality.accuracy_html import render_html
@@ -349,11 +349,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     points = _points(v)
     log.info("%d check points from %s", len(points), points.source)
     if points.crs:  # coordinates that cannot be in the stated CRS are refused
-        xyz = np.vstack([points.measured, points.reference])
-        check_area_of_use(
+        check_points_in_area(
             parse_crs(points.crs),
-            xyz.min(axis=0),
-            xyz.max(axis=0),
+            np.vstack([points.measured, points.reference]),
             what="the check points",
             path=points.source or None,
         )

@@ -173,7 +173,7 @@ def _read_navigation(path: str, fmt: str, frame):
     CSV's eastings/northings are checked against the CRS's area of use."""
     from pathlib import Path
 
-    from ..geometry.frames import check_area_of_use
+    from ..geometry.frames import check_points_in_area
     from ..io.navigation_text import read_nav_ascii, read_nav_csv
     from ..io.sbet import read_sbet
 
@@ -182,11 +182,5 @@ def _read_navigation(path: str, fmt: str, frame):
         fmt = "sbet" if suffix in (".out", ".sbet") else "csv" if suffix == ".csv" else "ascii"
     nav = {"sbet": read_sbet, "ascii": read_nav_ascii, "csv": read_nav_csv}[fmt](path)
     if not nav.geodetic:
-        check_area_of_use(
-            frame.crs,
-            nav.position.min(axis=0),
-            nav.position.max(axis=0),
-            what="the trajectory",
-            path=path,
-        )
+        check_points_in_area(frame.crs, nav.position, what="the trajectory", path=path)
     return nav

@@ -174,7 +174,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 def _read_inputs(v: Values) -> tuple:
     """(camera, observations, EO, planes), the perspective centres checked against the CRS's
     area of use and the rays' memory against what is free."""
-    from ..geometry.frames import check_area_of_use, parse_crs
+    from ..geometry.frames import check_points_in_area, parse_crs
     from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.observations import read_observations_csv
@@ -184,12 +184,8 @@ def _read_inputs(v: Values) -> tuple:
     camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     obs = read_observations_csv(v.observations, camera=camera)
     eo = read_eo_csv(v.eo)
-    check_area_of_use(
-        parse_crs(v.crs, what="CRS"),
-        eo.xyz.min(axis=0),
-        eo.xyz.max(axis=0),
-        what="the perspective centres",
-        path=v.eo,
+    check_points_in_area(
+        parse_crs(v.crs, what="CRS"), eo.xyz, what="the perspective centres", path=v.eo
     )
     planes = read_planes_csv(v.planes) if v.planes else ()
     rays = ray_count(obs, v.line_step)

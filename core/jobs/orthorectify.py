@@ -329,7 +329,7 @@ def _read_inputs(v: Values, mapping):
     """The camera, the EO (checked against the mapping CRS's area of use), the images with
     their EO rows and their size against the camera: all checked before anything is computed."""
     from ..errors import InputError
-    from ..geometry.frames import check_area_of_use
+    from ..geometry.frames import check_points_in_area
     from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.images import list_image_files
@@ -338,9 +338,7 @@ def _read_inputs(v: Values, mapping):
 
     camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     eo = read_eo_csv(v.eo)
-    check_area_of_use(
-        mapping, eo.xyz.min(axis=0), eo.xyz.max(axis=0), what="the perspective centres", path=v.eo
-    )
+    check_points_in_area(mapping, eo.xyz, what="the perspective centres", path=v.eo)
     images = list_image_files(v.images)
     row_of = {name: k for k, name in enumerate(eo.image_id)}
     missing = [f.stem for f in images if f.stem not in row_of]

@@ -237,7 +237,7 @@ def _read_inputs(v: Values) -> tuple:
     import numpy as np
 
     from ..errors import InputError
-    from ..geometry.frames import MappingFrame, check_area_of_use
+    from ..geometry.frames import MappingFrame, check_points_in_area
     from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.observations import read_observations_csv
@@ -276,10 +276,8 @@ def _read_inputs(v: Values) -> tuple:
             None if lines is None else np.vstack([lines.p1, lines.p2]),
         ),
     ):
-        if xyz is not None and len(xyz):
-            check_area_of_use(
-                frame.crs, xyz.min(axis=0), xyz.max(axis=0), what=f"the {what}", path=path
-            )
+        if xyz is not None:
+            check_points_in_area(frame.crs, xyz, what=f"the {what}", path=path)
     return frame, camera, obs, points, lines
 
 
@@ -287,18 +285,14 @@ def _approximations(v: Values, frame) -> tuple[dict, tuple | None]:
     """The approximate orientations by image id ((xyz, opk, time, group)) and the sigmas of
     their prior (m, m, m, rad x 3; None without APPROX_EO_SIGMAS)."""
     from ..errors import InputError
-    from ..geometry.frames import check_area_of_use
+    from ..geometry.frames import check_points_in_area
     from ..io.orientation import read_eo_csv
 
     approx = {}
     if v.approx_eo:
         table = read_eo_csv(v.approx_eo)
-        check_area_of_use(
-            frame.crs,
-            table.xyz.min(axis=0),
-            table.xyz.max(axis=0),
-            what="the approximate perspective centres",
-            path=v.approx_eo,
+        check_points_in_area(
+            frame.crs, table.xyz, what="the approximate perspective centres", path=v.approx_eo
         )
         approx = {
             i: (table.xyz[k], table.opk[k], table.time[k], table.group[k])
