@@ -18,6 +18,7 @@ import hashlib
 import logging
 import os
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Callable
 
@@ -31,7 +32,7 @@ except Exception:  # ImportError, or a numba built against another numpy
 
 log = logging.getLogger(__name__)
 
-__all__ = ["AVAILABLE", "cache_folder", "cached_njit", "compiled_kernel"]
+__all__ = ["AVAILABLE", "Kernels", "cache_folder", "cached_njit", "compiled_kernel"]
 
 #: The package folder (the plugin's root, whatever it is named) and its import name.
 _ROOT = Path(__file__).resolve().parents[1]
@@ -135,3 +136,20 @@ def compiled_kernel(func: Callable[..., Any]) -> Callable[..., Any] | None:
     if func not in _KERNELS:
         _KERNELS[func] = cached_njit(func, nogil=True)
     return _KERNELS[func]
+
+
+class Kernels:
+    """One module's numba kernels by name, each compiled (:func:`cached_njit`, ``nogil`` and
+    ``options``) at its first use and kept: ``_compiled = Kernels({"cells": _cells_kernel})``,
+    then ``_compiled("cells")(...)``. Nothing is compiled (nor numba needed) until then."""
+
+    def __init__(self, kernels: Mapping[str, Callable[..., Any]], **options: Any) -> None:
+        self._kernels = dict(kernels)
+        self._options = {"nogil": True, **options}
+        self._done: dict[str, Callable[..., Any]] = {}
+
+    def __call__(self, name: str) -> Callable[..., Any]:
+        """The compiled kernel ``name``."""
+        if name not in self._done:
+            self._done[name] = cached_njit(self._kernels[name], **self._options)
+        return self._done[name]

@@ -23,17 +23,14 @@ if hasattr(Qgis, "ProcessingSourceType"):  # QGIS >= 3.36
     SOURCE_VECTOR_POINT = Qgis.ProcessingSourceType.VectorPoint
     SOURCE_VECTOR_LINE = Qgis.ProcessingSourceType.VectorLine
     SOURCE_VECTOR_POLYGON = Qgis.ProcessingSourceType.VectorPolygon
-else:  # QGIS 3.22-3.34
-    SOURCE_VECTOR_POINT = QgsProcessing.SourceType.TypeVectorPoint
-    SOURCE_VECTOR_LINE = QgsProcessing.SourceType.TypeVectorLine
-    SOURCE_VECTOR_POLYGON = QgsProcessing.SourceType.TypeVectorPolygon
-
-if hasattr(Qgis, "ProcessingSourceType"):  # QGIS >= 3.36
     SOURCE_FILE = Qgis.ProcessingSourceType.File
     SOURCE_RASTER = Qgis.ProcessingSourceType.Raster
     SOURCE_POINT_CLOUD = Qgis.ProcessingSourceType.PointCloud
     SOURCE_TABLE = Qgis.ProcessingSourceType.Vector  # any geometry or none
 else:  # QGIS 3.22-3.34
+    SOURCE_VECTOR_POINT = QgsProcessing.SourceType.TypeVectorPoint
+    SOURCE_VECTOR_LINE = QgsProcessing.SourceType.TypeVectorLine
+    SOURCE_VECTOR_POLYGON = QgsProcessing.SourceType.TypeVectorPolygon
     SOURCE_FILE = QgsProcessing.SourceType.TypeFile
     SOURCE_RASTER = QgsProcessing.SourceType.TypeRaster
     SOURCE_POINT_CLOUD = QgsProcessing.SourceType.TypePointCloud

@@ -129,6 +129,13 @@ _SINK_TYPES = {
     "line": SOURCE_VECTOR_LINE,
     "polygon": SOURCE_VECTOR_POLYGON,
 }
+#: The QGIS class of each output kind of the spec.
+_DESTINATIONS = {
+    "folder_out": QgsProcessingParameterFolderDestination,
+    "file_out": QgsProcessingParameterFileDestination,
+    "raster_out": QgsProcessingParameterRasterDestination,
+    "sink": QgsProcessingParameterFeatureSink,
+}
 
 
 def make_parameter(
@@ -197,27 +204,16 @@ def make_parameter(
         q = RasterFilesParameter(p.name, title, SOURCE_RASTER, None, p.optional)
     elif k == "files":
         q = QgsProcessingParameterMultipleLayers(p.name, title, SOURCE_FILE, None, p.optional)
-    elif k == "folder_out":
-        q = QgsProcessingParameterFolderDestination(
-            p.name, title, optional=p.optional, createByDefault=p.create_by_default
-        )
-    elif k == "file_out":
-        q = QgsProcessingParameterFileDestination(
+    elif k in _DESTINATIONS:  # an output: its class, and what it takes besides the name
+        extra = ()
+        if k == "file_out":
+            extra = (tr(p.file_filter),)
+        elif k == "sink":
+            extra = (_SINK_TYPES[p.geometry],)
+        q = _DESTINATIONS[k](
             p.name,
             title,
-            tr(p.file_filter),
-            optional=p.optional,
-            createByDefault=p.create_by_default,
-        )
-    elif k == "raster_out":
-        q = QgsProcessingParameterRasterDestination(
-            p.name, title, optional=p.optional, createByDefault=p.create_by_default
-        )
-    elif k == "sink":
-        q = QgsProcessingParameterFeatureSink(
-            p.name,
-            title,
-            _SINK_TYPES[p.geometry],
+            *extra,
             optional=p.optional,
             createByDefault=p.create_by_default,
         )

@@ -312,6 +312,28 @@ class Camera:
                 & (px[:, 1] <= self.height_px - margin_px)
             )
 
+    def border_pixels(self, samples: int) -> Array:
+        """(4 (samples + 1), 2) pixel positions (col, row) along the image's edges: top,
+        bottom, left and right, ``samples + 1`` evenly spaced from corner to corner on each.
+
+        >>> cam = Camera("c", focal_mm=10.0, pixel_size_mm=0.01, width_px=4, height_px=2)
+        >>> cam.border_pixels(1)[:4]
+        array([[0., 0.],
+               [4., 0.],
+               [0., 2.],
+               [4., 2.]])
+        """
+        k = np.linspace(0.0, 1.0, samples + 1)
+        w, h = self.width_px, self.height_px
+        return np.vstack(
+            [
+                np.column_stack([k * w, np.zeros_like(k)]),
+                np.column_stack([k * w, np.full_like(k, h)]),
+                np.column_stack([np.zeros_like(k), k * h]),
+                np.column_stack([np.full_like(k, w), k * h]),
+            ]
+        )
+
     # ------------------------------------------------------------------ files
     def to_dict(self) -> Dict[str, Any]:
         """Return the camera as a JSON-ready dict in millimetres (the format of this module).

@@ -441,3 +441,16 @@ def check_area_of_use(
             "axis order",
             path=path,
         )
+
+
+def check_points_in_area(
+    crs: CRS, xyz: ArrayLike, *, what: str = "the data", path: str | None = None
+) -> None:
+    """:func:`check_area_of_use` on the box of the points ``xyz`` ((N, 2) or (N, 3), in
+    ``crs``); nothing to check for no points.
+
+    >>> check_points_in_area(CRS.from_epsg(28992), [[84000.0, 446000.0, 0.0]])  # Delft
+    """
+    p = np.asarray(xyz, dtype=np.float64)
+    if p.size:
+        check_area_of_use(crs, p.min(axis=0), p.max(axis=0), what=what, path=path)

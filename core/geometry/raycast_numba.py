@@ -21,7 +21,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..compiled import cached_njit
+from ..compiled import Kernels
 
 numba: Any  # the module, or None without it
 register_jitable: Callable[[Callable[..., Any]], Callable[..., Any]]
@@ -312,18 +312,8 @@ def _trace(
         st_out[r] = status
 
 
-_COMPILED: dict[str, Callable[..., Any]] = {}
-
-
-def _compiled(name: str) -> Callable[..., Any]:
-    """The jitted function (compiled at its first call). cache=True keeps the machine code next
-    to this module (a plugin folder is writable; when it is not, numba warns and compiles again
-    next session: about 3 s). The cache is keyed by the module's import name: imported under
-    another package name, the functions compile again."""
-    if name not in _COMPILED:
-        kernels: dict[str, Callable[..., Any]] = {"order": _spatial_order, "trace": _trace}
-        _COMPILED[name] = cached_njit(kernels[name], nogil=True)
-    return _COMPILED[name]
+#: The jitted functions (each compiled at its first call, cached: core/compiled.py).
+_compiled = Kernels({"order": _spatial_order, "trace": _trace})
 
 
 def trace_rays(

@@ -24,7 +24,7 @@ import numpy as np
 from ..errors import InputError
 from ..photo.navigation import CameraEvents, gps_seconds_of_week
 from ..photo.trajectory_options import EVENT_TIMES, LEAP_SECONDS_SINCE_2017, WEEK_S
-from .tables import find_column, float_column, read_table, text_column, unique_ids
+from .tables import find_column, float_column, read_table, refuse_rows, text_column, unique_ids
 
 _FRACTION = re.compile(r"(?<=:\d\d)\.(\d+)")
 
@@ -45,14 +45,15 @@ def read_camera_events(
     where = {"path": table.path, "column": table.columns[t_col]}
     if event_time == "gps":
         time = float_column(table, t_col)
-        bad = np.flatnonzero((time < 0) | (time >= 2 * WEEK_S))
-        if bad.size:
-            raise InputError(
-                f"{time[bad[0]]:g} s is not a GPS second of week (0 to 604800; a UTC "
-                "date-time needs EVENT_TIME utc)",
-                row=table.line_numbers[bad[0]],
-                **where,
-            )
+        refuse_rows(
+            table,
+            (time < 0) | (time >= 2 * WEEK_S),
+            t_col,
+            lambda k: (
+                f"{time[k]:g} s is not a GPS second of week (0 to 604800; a UTC "
+                "date-time needs EVENT_TIME utc)"
+            ),
+        )
     else:
         cells = text_column(table, t_col)
         time = np.array(

@@ -46,14 +46,11 @@ from .tables import (
 _IU3 = np.triu_indices(3)
 _IU6 = np.triu_indices(6)
 LCP_COV = tuple(f"cov_{'xyz'[i]}{'xyz'[j]}" for i, j in zip(*_IU3))
+#: A 3D point (mapping CRS) and its standard deviations (CRS units), in the point tables.
+XYZ_SIGMA_COLUMNS = ("X", "Y", "Z", "sigma_x", "sigma_y", "sigma_z")
 LCP_COLUMNS = (
     "id",
-    "X",
-    "Y",
-    "Z",
-    "sigma_x",
-    "sigma_y",
-    "sigma_z",
+    *XYZ_SIGMA_COLUMNS,
     *LCP_COV,
     "ellipsoid_a",
     "ellipsoid_b",

@@ -23,10 +23,16 @@ from typing import Union
 
 import numpy as np
 
-from ..errors import InputError
 from ..photo.bundle_setup import DEFAULT_CONTROL_SIGMA_M, ROLES, GroundPoints
 from . import tables
-from .tables import find_column, float_column, read_table, text_column, write_csv_atomic
+from .tables import (
+    find_column,
+    float_column,
+    read_table,
+    refuse_rows,
+    text_column,
+    write_csv_atomic,
+)
 
 __all__ = ["GROUND_POINT_COLUMNS", "read_ground_points_csv", "write_ground_points_csv"]
 
@@ -58,18 +64,18 @@ def read_ground_points_csv(path: Union[str, Path]) -> GroundPoints:
         if col is None:
             continue
         v = float_column(table, col, allow_empty=True)
-        bad = np.flatnonzero(v <= 0)
-        if bad.size:
-            raise InputError(
-                f"a standard deviation must be > 0, got {v[bad[0]]}",
-                path=table.path,
-                row=table.line_numbers[bad[0]],
-                column=table.columns[col],
-            )
+        _check_positive(table, v, col)
         sig[:, k] = np.where(np.isnan(v), DEFAULT_CONTROL_SIGMA_M, v)
     r_col = find_column(table, ("role", "type", "use"))
     roles = tables.choice_column(table, r_col, ROLES, "a role")
     return GroundPoints(ids, xyz, sig, roles, table.line_numbers, table.path)
+
+
+def _check_positive(table: tables.Table, sigma: np.ndarray, index: int) -> None:
+    """Standard deviations (column ``index``; empty cells NaN) that are > 0."""
+    refuse_rows(
+        table, sigma <= 0, index, lambda k: f"a standard deviation must be > 0, got {sigma[k]}"
+    )
 
 
 def write_ground_points_csv(path: Union[str, Path], ground: GroundPoints) -> None:

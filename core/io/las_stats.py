@@ -14,11 +14,11 @@ statistics it grows too), :func:`HeaderStats.for_writer` returns None: laspy's o
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
-from ..compiled import cached_njit
+from ..compiled import Kernels
 from ..geometry.raycast_numba import AVAILABLE
 
 __all__ = ["HeaderStats"]
@@ -45,7 +45,8 @@ def _chunk_stats(xs, ys, zs, bits, mask, lsb, ints, counts):
     ints[0], ints[1], ints[2], ints[3], ints[4], ints[5] = lo_x, hi_x, lo_y, hi_y, lo_z, hi_z
 
 
-_COMPILED: dict[str, Callable[..., Any]] = {}
+#: The jitted chunk statistics (compiled at its first call, cached: core/compiled.py).
+_compiled = Kernels({"stats": _chunk_stats})
 
 
 class HeaderStats:
@@ -62,8 +63,6 @@ class HeaderStats:
         self._maxs = list(h.maxs)
         self._counts = np.zeros(16, np.int64)
         self._n = int(h.point_count)
-        if "stats" not in _COMPILED:
-            _COMPILED["stats"] = cached_njit(_chunk_stats, nogil=True)
 
     @classmethod
     def for_writer(cls, writer: Any) -> HeaderStats | None:
@@ -97,7 +96,7 @@ class HeaderStats:
         a = points.array
         rn = points.return_number  # laspy's bit-field view: its byte array, mask, shift
         ints = np.zeros(6, np.int64)
-        _COMPILED["stats"](
+        _compiled("stats")(
             a["X"], a["Y"], a["Z"], rn.array, int(rn.bit_mask), int(rn.lsb), ints, self._counts
         )
         for k in range(3):  # laspy's arithmetic: max(header, chunk's max * scale + offset)

@@ -9,6 +9,7 @@ from typing import Union
 import numpy as np
 
 from ..photo.monoplot import STATUS_TEXT, MonoplotResult
+from .control import XYZ_SIGMA_COLUMNS
 from .tables import number, write_csv_atomic
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -23,12 +24,7 @@ POINT_COLUMNS = (
     "vertex",
     "col",
     "row",
-    "X",
-    "Y",
-    "Z",
-    "sigma_x",
-    "sigma_y",
-    "sigma_z",
+    *XYZ_SIGMA_COLUMNS,
     "cov_xy",
     "cov_xz",
     "cov_yz",

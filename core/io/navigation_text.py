@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..photo.navigation import NavSolution
-from .tables import Table, find_column, float_column, read_table
+from .tables import Table, find_column, float_column, read_table, refuse_rows
 from .trajectory import HEIGHT_RANGE_M, MAX_TIME_S, velocity_columns
 
 _TIME = ("time", "gps_time", "gpstime", "sow", "gps_sow", "t", "time_sow")
@@ -196,25 +196,22 @@ def _solution(table: Table, units: tuple[str, ...]) -> NavSolution:
 
 
 def _check_abs(table: Table, col: int, values, limit: float, unit: str) -> None:
-    bad = np.flatnonzero(np.abs(values) > limit)
-    if bad.size:
-        raise InputError(
-            f"'{table.rows[bad[0]][col]}' is out of range ({unit})",
-            path=table.path,
-            row=table.line_numbers[bad[0]],
-            column=table.columns[col],
-        )
+    refuse_rows(
+        table,
+        np.abs(values) > limit,
+        col,
+        lambda k: f"'{table.rows[k][col]}' is out of range ({unit})",
+    )
 
 
 def _check_time(table: Table, col: int, time: np.ndarray) -> None:
     _check_abs(table, col, time, MAX_TIME_S, "seconds")
-    step = np.flatnonzero(np.diff(time) <= 0)
-    if step.size:
-        k = int(step[0]) + 1
-        raise InputError(
+    refuse_rows(
+        table,
+        np.r_[False, np.diff(time) <= 0],
+        col,
+        lambda k: (
             f"time {time[k]:.6f} s is not later than {time[k - 1]:.6f} s in row "
-            f"{table.line_numbers[k - 1]}: the records must rise strictly in time",
-            path=table.path,
-            row=table.line_numbers[k],
-            column=table.columns[col],
-        )
+            f"{table.line_numbers[k - 1]}: the records must rise strictly in time"
+        ),
+    )

@@ -51,10 +51,12 @@ from ..errors import InputError
 from ..geometry.camera import Camera
 from ..photo.observations import DEFAULT_SIGMA_PX, OBSERVATION_TYPES, ImageObservations
 from .tables import (
+    Table,
     choice_column,
     find_column,
     float_column,
     read_table,
+    refuse_rows,
     text_column,
     write_csv_atomic,
 )
@@ -101,14 +103,12 @@ def read_observations_csv(
     else:
         sigma = float_column(table, s_col, allow_empty=True)
         sigma = np.where(np.isnan(sigma), DEFAULT_SIGMA_PX, sigma)
-        bad = np.flatnonzero((sigma <= 0) | (sigma > MAX_SIGMA_PX))
-        if bad.size:
-            raise InputError(
-                f"sigma_px must be > 0 and <= {MAX_SIGMA_PX:g} pixels, got {sigma[bad[0]]:g}",
-                path=table.path,
-                row=table.line_numbers[bad[0]],
-                column=table.columns[s_col],
-            )
+        refuse_rows(
+            table,
+            (sigma <= 0) | (sigma > MAX_SIGMA_PX),
+            s_col,
+            lambda k: f"sigma_px must be > 0 and <= {MAX_SIGMA_PX:g} pixels, got {sigma[k]:g}",
+        )
     t_col = find_column(table, ("type", "kind", "control_type"), required=False)
     if t_col is None:
         kinds = ("tie",) * len(table)
@@ -134,20 +134,8 @@ def read_observations_csv(
             )
         first[key] = number
     if camera is not None:
-        for values, index, size, what in (
-            (col, c_col, camera.width_px, "width_px"),
-            (row, r_col, camera.height_px, "height_px"),
-        ):
-            off = np.flatnonzero((values < 0) | (values > size))
-            if off.size:
-                k = int(off[0])
-                raise InputError(
-                    f"{values[k]:g} px is off the image: the camera '{camera.name}' has "
-                    f"{what} {size} (pixels from 0 to {size}); {off.size} row(s) affected",
-                    path=table.path,
-                    row=table.line_numbers[k],
-                    column=table.columns[index],
-                )
+        _check_in_image(table, col, c_col, camera.width_px, "width_px", camera.name)
+        _check_in_image(table, row, r_col, camera.height_px, "height_px", camera.name)
     return ImageObservations(
         image,
         point,
@@ -158,6 +146,23 @@ def read_observations_csv(
         table.line_numbers,
         table.path,
         cameras,
+    )
+
+
+def _check_in_image(
+    table: Table, values: NDArray[np.float64], index: int, size: int, what: str, camera: str
+) -> None:
+    """Pixel coordinates ``values`` (column ``index``) within 0 to ``size`` (the camera's
+    ``what``, width_px or height_px)."""
+    off = (values < 0) | (values > size)
+    refuse_rows(
+        table,
+        off,
+        index,
+        lambda k: (
+            f"{values[k]:g} px is off the image: the camera '{camera}' has {what} {size} "
+            f"(pixels from 0 to {size}); {np.count_nonzero(off)} row(s) affected"
+        ),
     )
 
 

@@ -25,6 +25,7 @@ from ..errors import InputError
 from ..geometry.planes import Plane
 from .tables import (
     check_covariance,
+    check_integers,
     find_column,
     float_column,
     note_unique,
@@ -127,16 +128,9 @@ def read_planes_csv(path: Union[str, Path]) -> list[Plane]:
     np_col = find_column(table, ("n_points",))
     planes = []
     seen: dict[Hashable, int] = {}
+    check_integers(table, cols["id"], id_col)
+    check_integers(table, cols["n_points"], np_col)
     for k, row_no in enumerate(table.line_numbers):
-        for name, col in (("id", id_col), ("n_points", np_col)):
-            value = cols[name][k]
-            if value != round(value):
-                raise InputError(
-                    f"'{table.rows[k][col]}' is not an integer",
-                    path=table.path,
-                    row=row_no,
-                    column=table.columns[col],
-                )
         pid = int(cols["id"][k])
         note_unique(seen, pid, f"id {pid}", table, row_no, id_col)
         normal = np.array([cols["a"][k], cols["b"][k], cols["c"][k]])

@@ -17,12 +17,12 @@ first, then over the rows); a cell whose window has no valid pixel is 0 and mask
 from __future__ import annotations
 
 import math
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..compiled import cached_njit
+from ..compiled import Kernels
 from ..geometry.raycast_numba import AVAILABLE
 
 __all__ = ["OverviewBuilder", "average_level", "level_windows"]
@@ -183,7 +183,8 @@ def _average_rows_numpy(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_
     out_mask[...] = cnt > 0
 
 
-_COMPILED: dict[str, Callable[..., Any]] = {}
+#: The jitted level kernels (compiled at their first call, cached: core/compiled.py).
+_compiled = Kernels({"rows": _average_rows, "2x2": _average_rows_2x2})
 
 
 def _run_kernel(backend: str, src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask) -> None:
@@ -192,9 +193,6 @@ def _run_kernel(backend: str, src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out
     if backend == "numpy" or (backend == "auto" and not AVAILABLE):
         _average_rows_numpy(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask)
         return
-    if not _COMPILED:
-        _COMPILED["rows"] = cached_njit(_average_rows, nogil=True)
-        _COMPILED["2x2"] = cached_njit(_average_rows_2x2, nogil=True)
     two = ya.size == 0 or (
         np.all(yb - ya == 2)
         and ya[0] == 0
@@ -210,9 +208,9 @@ def _run_kernel(backend: str, src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out
         and np.all(xwr == 1.0)
     )
     if two:
-        _COMPILED["2x2"](src, mask, out, out_mask)
+        _compiled("2x2")(src, mask, out, out_mask)
     else:
-        _COMPILED["rows"](src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask)
+        _compiled("rows")(src, mask, ya, yb, ywl, ywr, xa, xb, xwl, xwr, out, out_mask)
 
 
 def average_level(

@@ -52,21 +52,24 @@ from __future__ import annotations
 import math
 import os
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Hashable, Iterable, Sequence
 from typing import Any, Union
 
 import numpy as np
 
 from ..errors import InputError
 from ..photo.resection_map import LineControl, PointControl, line_control_from_lines
-from .control import read_lines_csv
+from .control import LCP_COV, read_lines_csv
+from .orientation import EO_COLUMNS, EO_SIGMA_COLUMNS
 from .tables import (
     check_covariance,
     find_column,
     float_column,
     normalise,
+    note_unique,
     number,
     read_table,
+    sigma_column,
     text_column,
     unique_ids,
     write_csv_atomic,
@@ -74,22 +77,10 @@ from .tables import (
 
 PathLike = Union[str, "os.PathLike[str]"]
 
-EO_SIGMA_COLUMNS = (
-    "image_id",
-    "time",
-    "group",
-    "X",
-    "Y",
-    "Z",
-    "omega_deg",
-    "phi_deg",
-    "kappa_deg",
-    "sigma_X",
-    "sigma_Y",
-    "sigma_Z",
-    "sigma_omega_deg",
-    "sigma_phi_deg",
-    "sigma_kappa_deg",
+#: The resection's EO table: the EO columns, their standard deviations and the fit's figures.
+RESECTION_EO_COLUMNS = (
+    *EO_COLUMNS,
+    *EO_SIGMA_COLUMNS,
     "sigma0",
     "redundancy",
     "chi2",
@@ -117,7 +108,6 @@ RESIDUAL_COLUMNS = (
     "used",
 )
 _IU3 = np.triu_indices(3)
-_LCP_COV = tuple(f"cov_{'xyz'[i]}{'xyz'[j]}" for i, j in zip(*_IU3))
 _WKT = re.compile(r"^\s*LINESTRING\s*Z?\s*\((.*)\)\s*$", re.IGNORECASE)
 
 
@@ -141,8 +131,8 @@ def read_point_control_csv(path: PathLike) -> PointControl:
     )
     n = len(ids)
     cov = np.zeros((n, 3, 3))
-    if all(c in names for c in _LCP_COV):
-        vals = [float_column(table, names.index(c)) for c in _LCP_COV]
+    if all(c in names for c in LCP_COV):
+        vals = [float_column(table, names.index(c)) for c in LCP_COV]
         for k in range(n):
             c = np.zeros((3, 3))
             c[_IU3] = [v[k] for v in vals]
@@ -153,20 +143,9 @@ def read_point_control_csv(path: PathLike) -> PointControl:
     for axis, aliases in enumerate(
         (("sx", "sigma_x", "std_x"), ("sy", "sigma_y", "std_y"), ("sz", "sigma_z", "std_z"))
     ):
-        col = find_column(table, aliases, required=False)
-        if col is None:
-            continue
-        s = float_column(table, col, allow_empty=True)
-        s = np.where(np.isnan(s), 0.0, s)
-        bad = np.flatnonzero(s < 0)
-        if bad.size:
-            raise InputError(
-                f"a standard deviation cannot be negative ({s[bad[0]]:g})",
-                path=table.path,
-                row=table.line_numbers[bad[0]],
-                column=table.columns[col],
-            )
-        cov[:, axis, axis] = s**2
+        s = sigma_column(table, aliases)
+        if s is not None:
+            cov[:, axis, axis] = s**2
     return PointControl(ids, xyz, cov)
 
 
@@ -209,21 +188,8 @@ def read_line_control_csv(path: PathLike) -> LineControl:
         )
     sig = []
     for aliases in (("sigma_start", "sigma_1", "sigma1"), ("sigma_end", "sigma_2", "sigma2")):
-        col = find_column(table, aliases, required=False)
-        if col is None:
-            sig.append(np.zeros(len(keep)))
-            continue
-        s = float_column(table, col, allow_empty=True)[keep]
-        s = np.where(np.isnan(s), 0.0, s)
-        bad = np.flatnonzero(s < 0)
-        if bad.size:
-            raise InputError(
-                f"a standard deviation cannot be negative ({s[bad[0]]:g})",
-                path=table.path,
-                row=rows[bad[0]],
-                column=table.columns[col],
-            )
-        sig.append(s)
+        s = sigma_column(table, aliases)
+        sig.append(np.zeros(len(keep)) if s is None else s[keep])
     length = np.linalg.norm(p2 - p1, axis=1)
     short = np.flatnonzero(~(length > 1e-3))
     if short.size:
@@ -241,18 +207,11 @@ def read_line_control_csv(path: PathLike) -> LineControl:
 
 
 def _unique(ids: Sequence[str], rows: Sequence[int], table, col: int) -> tuple[str, ...]:
-    first: dict[str, int] = {}
+    first: dict[Hashable, int] = {}
     for value, line_no in zip(ids, rows):
         if not value:
             raise InputError("empty id", path=table.path, row=line_no, column=table.columns[col])
-        if value in first:
-            raise InputError(
-                f"line id '{value}' already appears in row {first[value]}",
-                path=table.path,
-                row=line_no,
-                column=table.columns[col],
-            )
-        first[value] = line_no
+        note_unique(first, value, f"line id '{value}'", table, line_no, col)
     return tuple(ids)
 
 
@@ -279,7 +238,7 @@ def _wkt_ends(text: str, path: str, row: int) -> tuple[list[float], list[float]]
 
 def write_eo_sigma_csv(path: PathLike, rows: Iterable[Sequence[Any]]) -> None:
     """Write the EO table with precision; ``rows`` hold the values of
-    :data:`EO_SIGMA_COLUMNS` (angles in radians, converted here), in that order."""
+    :data:`RESECTION_EO_COLUMNS` (angles in radians, converted here), in that order."""
     out = []
     for r in rows:
         (
@@ -332,7 +291,7 @@ def write_eo_sigma_csv(path: PathLike, rows: Iterable[Sequence[Any]]) -> None:
                 start,
             )
         )
-    write_csv_atomic(path, EO_SIGMA_COLUMNS, out)
+    write_csv_atomic(path, RESECTION_EO_COLUMNS, out)
 
 
 def write_residuals_csv(path: PathLike, rows: Iterable[Sequence[Any]]) -> None:

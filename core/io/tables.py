@@ -10,7 +10,7 @@ from __future__ import annotations
 import csv
 import math
 import os
-from collections.abc import Hashable, Iterable, Sequence
+from collections.abc import Callable, Hashable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal, Union, overload
@@ -193,6 +193,60 @@ def choice_column(table: Table, index: int, allowed: Sequence[str], what: str) -
     return values
 
 
+def refuse_rows(
+    table: Table, bad: NDArray[np.bool_], index: int | None, message: Callable[[int], str]
+) -> None:
+    """InputError at the first row where ``bad`` is True, naming the file, that row and column
+    ``index`` (none where None), with the text ``message(k)`` of its position ``k`` (0-based)
+    among the table's rows; nothing where no row is bad.
+
+    >>> t = Table("p.csv", ("id", "h"), (("a", "1"), ("b", "-2")), (2, 3))
+    >>> h = np.array([1.0, -2.0])
+    >>> try:
+    ...     refuse_rows(t, h < 0, 1, lambda k: f"{h[k]:g} m is below ground")
+    ... except InputError as exc:
+    ...     print(exc)
+    p.csv, row 3, column 'h': -2 m is below ground
+    """
+    rows = np.flatnonzero(bad)
+    if rows.size:
+        k = int(rows[0])
+        raise InputError(
+            message(k),
+            path=table.path,
+            row=table.line_numbers[k],
+            column=None if index is None else table.columns[index],
+        )
+
+
+def sigma_column(
+    table: Table, aliases: Sequence[str], default: float = 0.0
+) -> NDArray[np.float64] | None:
+    """The optional standard-deviation column named by one of ``aliases`` (in its own unit),
+    None where the table has none; an empty cell is ``default``.
+
+    Raises
+    ------
+    InputError
+        A value that is not a finite number or is negative, naming the file, row and column.
+
+    >>> t = Table("p.csv", ("id", "sigma"), (("a", "0.5"), ("b", "")), (2, 3))
+    >>> sigma_column(t, ("sigma",), 0.1).tolist()
+    [0.5, 0.1]
+    >>> sigma_column(t, ("s",)) is None
+    True
+    """
+    col = find_column(table, aliases, required=False)
+    if col is None:
+        return None
+    values = float_column(table, col, allow_empty=True)
+    values[np.isnan(values)] = default
+    refuse_rows(
+        table, values < 0, col, lambda k: f"a standard deviation cannot be negative ({values[k]:g})"
+    )
+    return values
+
+
 def check_covariance(cov: NDArray[np.float64], table: Table, k: int, what: str) -> None:
     """Refuse (naming the file and row) a covariance matrix that is not positive
     semi-definite: a negative variance or an impossible correlation.
@@ -215,27 +269,27 @@ def check_covariance(cov: NDArray[np.float64], table: Table, k: int, what: str) 
         )
 
 
+def check_integers(
+    table: Table, values: NDArray[np.float64], index: int, what: str = "an integer"
+) -> None:
+    """Refuse (naming the file, row and column ``index``) the first of ``values``, read from
+    that column, that is not a whole number."""
+    refuse_rows(
+        table,
+        values != np.round(values),
+        index,
+        lambda k: f"'{table.rows[k][index]}' is not {what}",
+    )
+
+
 def unique_integer_ids(table: Table, values: NDArray[np.float64], index: int) -> list[int]:
     """The id column as integers, each once; errors name the file, row and column."""
-    seen: dict[int, int] = {}
+    check_integers(table, values, index, "an integer id")
+    seen: dict[Hashable, int] = {}
     out = []
-    for k, (value, number) in enumerate(zip(values, table.line_numbers)):
-        if value != round(value):
-            raise InputError(
-                f"'{table.rows[k][index]}' is not an integer id",
-                path=table.path,
-                row=number,
-                column=table.columns[index],
-            )
+    for value, number in zip(values, table.line_numbers):
         key = int(value)
-        if key in seen:
-            raise InputError(
-                f"id {key} already appears in row {seen[key]}",
-                path=table.path,
-                row=number,
-                column=table.columns[index],
-            )
-        seen[key] = number
+        note_unique(seen, key, f"id {key}", table, number, index)
         out.append(key)
     return out
 

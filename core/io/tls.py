@@ -47,6 +47,8 @@ from .tables import (
     float_column,
     number,
     read_table,
+    refuse_rows,
+    sigma_column,
     text_column,
     unique_ids,
     write_csv_atomic,
@@ -122,74 +124,58 @@ def _ids(table: Table, aliases: Sequence[str], what: str) -> tuple[str, ...]:
 
 
 def _optional(table: Table, aliases: Sequence[str], default: float) -> np.ndarray:
-    col = find_column(table, aliases, required=False)
-    if col is None:
-        return np.full(len(table), float(default))
-    values = float_column(table, col, allow_empty=True)
-    values[np.isnan(values)] = default
-    if (values < 0).any():
-        k = int(np.flatnonzero(values < 0)[0])
-        raise InputError(
-            "a standard deviation cannot be negative",
-            path=table.path,
-            row=table.line_numbers[k],
-            column=table.columns[col],
-        )
-    return values
+    values = sigma_column(table, aliases, default)
+    return np.full(len(table), float(default)) if values is None else values
 
 
 def _angle(table: Table, stem: str, unit: str) -> tuple[np.ndarray, str]:
     """An angle column in radians: ``<stem>_deg``, ``<stem>_gon`` or ``<stem>`` in ``unit``."""
-    for suffix, u in (("_deg", "degrees"), ("_gon", "gon"), ("_rad", "radians"), ("", unit)):
-        col = find_column(table, (stem + suffix,), required=False)
-        if col is None:
-            continue
-        values = float_column(table, col)
-        full = _FULL_CIRCLE[u]
-        # A horizontal direction is within one turn and an elevation within half a turn (face
-        # II: three quarters): a value beyond that is in another unit (gon read as degrees).
-        limit = full if stem == "hz" else 0.75 * full
-        bad = np.flatnonzero(np.abs(values) > limit)
-        if bad.size:
-            k = int(bad[0])
-            raise InputError(
-                f"{values[k]:g} is beyond {limit:g} {u}: the angles are not in {u} (gon read "
-                "as degrees?). Name the column hz_deg/vt_deg or hz_gon/vt_gon, or choose the "
-                "angle unit",
-                path=table.path,
-                row=table.line_numbers[k],
-                column=table.columns[col],
-            )
-        return values * ANGLE_UNITS[u], u
-    raise InputError(
-        f"no column for the {'horizontal direction' if stem == 'hz' else 'vertical angle'} "
-        f"(accepted names: {stem}_deg, {stem}_gon, {stem}_rad, {stem}; found: "
-        f"{', '.join(table.columns)})",
-        path=table.path,
+    names = ((stem + "_deg", "degrees"), (stem + "_gon", "gon"), (stem + "_rad", "radians"))
+    found = [
+        (col, u)
+        for name, u in (*names, (stem, unit))
+        if (col := find_column(table, (name,), required=False)) is not None
+    ]
+    if not found:
+        raise InputError(
+            f"no column for the {'horizontal direction' if stem == 'hz' else 'vertical angle'} "
+            f"(accepted names: {stem}_deg, {stem}_gon, {stem}_rad, {stem}; found: "
+            f"{', '.join(table.columns)})",
+            path=table.path,
+        )
+    col, u = found[0]
+    values = float_column(table, col)
+    full = _FULL_CIRCLE[u]
+    # A horizontal direction is within one turn and an elevation within half a turn (face
+    # II: three quarters): a value beyond that is in another unit (gon read as degrees).
+    limit = full if stem == "hz" else 0.75 * full
+    refuse_rows(
+        table,
+        np.abs(values) > limit,
+        col,
+        lambda k: (
+            f"{values[k]:g} is beyond {limit:g} {u}: the angles are not in {u} (gon read "
+            "as degrees?). Name the column hz_deg/vt_deg or hz_gon/vt_gon, or choose the angle unit"
+        ),
     )
+    return values * ANGLE_UNITS[u], u
 
 
 def _check_ranges(t: Table, rho: np.ndarray, what: str, col: int | None) -> None:
     """Distances from the scanner (m) that are > 0 and within a scanner's reach."""
-    where = {"path": t.path, "column": None if col is None else t.columns[col]}
-    bad = np.flatnonzero(rho <= 0)
-    if bad.size:
-        k = int(bad[0])
-        raise InputError(
-            f"{what} is {rho[k]:g} m from the scanner: it must be > 0",
-            row=t.line_numbers[k],
-            **where,
-        )
-    bad = np.flatnonzero(rho > MAX_SCANNER_RANGE_M)
-    if bad.size:
-        k = int(bad[0])
-        raise InputError(
-            f"{what} is {rho[k]:g} m from the scanner, beyond the {MAX_SCANNER_RANGE_M:g} m a "
-            "terrestrial scanner reaches: another unit, or coordinates that are not in the "
-            "scanner's frame",
-            row=t.line_numbers[k],
-            **where,
-        )
+    refuse_rows(
+        t, rho <= 0, col, lambda k: f"{what} is {rho[k]:g} m from the scanner: it must be > 0"
+    )
+    refuse_rows(
+        t,
+        rho > MAX_SCANNER_RANGE_M,
+        col,
+        lambda k: (
+            f"{what} is {rho[k]:g} m from the scanner, beyond the {MAX_SCANNER_RANGE_M:g} "
+            "m a terrestrial scanner reaches: another unit, or coordinates that are not in the "
+            "scanner's frame"
+        ),
+    )
 
 
 def read_tls_observations_csv(

@@ -37,6 +37,7 @@ from .tables import (
     find_column,
     float_column,
     read_table,
+    refuse_rows,
     text_column,
     unique_ids,
     write_csv_atomic,
@@ -131,27 +132,26 @@ def check_speeds(table: Table, vel: Array, column: int) -> None:
 
 
 def _check_range(table, column: int, values: Array, limit: float) -> None:
-    bad = np.flatnonzero(np.abs(values) > limit)
-    if bad.size:
-        raise InputError(
-            f"{values[bad[0]]} is outside [-{limit:g}, {limit:g}] degrees",
-            path=table.path,
-            row=table.line_numbers[bad[0]],
-            column=table.columns[column],
-        )
+    refuse_rows(
+        table,
+        np.abs(values) > limit,
+        column,
+        lambda k: f"{values[k]} is outside [-{limit:g}, {limit:g}] degrees",
+    )
 
 
 def _check_times(table, column: int, time: Array, group: tuple[str, ...]) -> None:
     """Times within +-MAX_TIME_S, and never earlier than the row before in the same group."""
     where = {"path": table.path, "column": table.columns[column]}
-    bad = np.flatnonzero(np.abs(time) > MAX_TIME_S)
-    if bad.size:
-        raise InputError(
-            f"{time[bad[0]]:g} s is beyond the plausible +-{MAX_TIME_S:g} s of a time in "
-            "seconds (GPS week or standard time, UNIX time): another unit, or not a time",
-            row=table.line_numbers[bad[0]],
-            **where,
-        )
+    refuse_rows(
+        table,
+        np.abs(time) > MAX_TIME_S,
+        column,
+        lambda k: (
+            f"{time[k]:g} s is beyond the plausible +-{MAX_TIME_S:g} s of a time in "
+            "seconds (GPS week or standard time, UNIX time): another unit, or not a time"
+        ),
+    )
     last: dict[str, int] = {}
     for k, (t, g) in enumerate(zip(time, group)):
         if np.isnan(t):
@@ -171,15 +171,15 @@ def _check_times(table, column: int, time: Array, group: tuple[str, ...]) -> Non
 
 def _check_heights(table, column: int, height: Array) -> None:
     lo, hi = HEIGHT_RANGE_M
-    bad = np.flatnonzero((height < lo) | (height > hi))
-    if bad.size:
-        raise InputError(
-            f"{height[bad[0]]:g} m is outside the plausible heights {lo:g} to {hi:g} m of a "
-            "sensor (a height in another unit?)",
-            path=table.path,
-            row=table.line_numbers[bad[0]],
-            column=table.columns[column],
-        )
+    refuse_rows(
+        table,
+        (height < lo) | (height > hi),
+        column,
+        lambda k: (
+            f"{height[k]:g} m is outside the plausible heights {lo:g} to {hi:g} m of a "
+            "sensor (a height in another unit?)"
+        ),
+    )
 
 
 TRAJECTORY_COLUMNS = (

@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 
 from ..errors import InputError
-from .common import CSV_FILTER
+from .common import CSV_FILTER, html_out
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -108,19 +108,9 @@ _PROJECT_NUMBERS = (
 
 
 def _numbers(rows) -> tuple[Param, ...]:
-    return tuple(
-        Param(
-            key,
-            "number",
-            label,
-            getattr(_D, field),
-            unit=unit,
-            minimum=minimum,
-            maximum=maximum,
-            advanced=advanced,
-        )
-        for key, field, label, unit, minimum, maximum, advanced in rows
-    )
+    """The ``number`` parameters of rows ``(parameter, field, label, unit, minimum, maximum,
+    advanced)`` of :class:`AccuracySettings`."""
+    return _D.params((key, field, label, "number", *rest) for key, field, label, *rest in rows)
 
 
 def _point_params(what: str) -> tuple[Param, ...]:
@@ -277,13 +267,7 @@ for one release).""",
             maximum=100000.0,
         ),
         Param("OUTPUT", "sink", "Check points with discrepancies", geometry="point", optional=True),
-        Param(
-            "OUTPUT_HTML",
-            "file_out",
-            "Accuracy report (HTML)",
-            optional=True,
-            file_filter="HTML files (*.html)",
-        ),
+        html_out("OUTPUT_HTML", "Accuracy report (HTML)"),
         Param(
             "OUTPUT_JSON",
             "file_out",
@@ -355,7 +339,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     import numpy as np
 
     from ..errors import stop_if_asked
-    from ..geometry.frames import check_area_of_use, parse_crs
+    from ..geometry.frames import check_points_in_area, parse_crs
     from ..io.atomic import write_text_atomic
     from ..quality.accuracy import AccuracySettings, assess_accuracy
     from ..quality.accuracy_html import render_html
@@ -365,11 +349,9 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     points = _points(v)
     log.info("%d check points from %s", len(points), points.source)
     if points.crs:  # coordinates that cannot be in the stated CRS are refused
-        xyz = np.vstack([points.measured, points.reference])
-        check_area_of_use(
+        check_points_in_area(
             parse_crs(points.crs),
-            xyz.min(axis=0),
-            xyz.max(axis=0),
+            np.vstack([points.measured, points.reference]),
             what="the check points",
             path=points.source or None,
         )

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ..io.suffixes import IMAGE_SUFFIXES
+from .common import html_out
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -172,14 +173,7 @@ camera file: the calibration itself is in pixels.""",
             file_filter=JSON_FILTER,
             advanced=True,
         ),
-        Param(
-            "OUTPUT_HTML",
-            "file_out",
-            "Calibration report (HTML)",
-            optional=True,
-            create_by_default=False,
-            file_filter="HTML files (*.html)",
-        ),
+        html_out("OUTPUT_HTML", "Calibration report (HTML)", on_demand=True),
         Param(
             "OUTPUT_RESIDUALS",
             "file_out",

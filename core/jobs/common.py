@@ -16,6 +16,7 @@ from .spec import Param, Ref
 CSV_FILTER = "CSV files (*.csv *.txt)"
 CSV_OUT = "CSV files (*.csv)"
 LAS_FILTER = "LAS/LAZ files (*.las *.laz *.LAS *.LAZ)"
+DSM_FILTER = "DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"
 DISTANCE_UNITS = ("crs", "metre")
 #: Largest lever-arm component (m): longer than any survey aircraft, so a larger value is a
 #: unit mistake (millimetres typed as metres).
@@ -41,12 +42,11 @@ def mount_params(initial_boresight: bool = False) -> tuple[Param, ...]:
             maximum=MAX_LEVER_ARM_M,
             help="camera perspective centre in the INS body frame (x forward, y right, z down)",
         ),
-        Param(
+        choice_param(
             "MOUNT",
-            "enum",
             "Camera mount",
-            Ref("photo.mount_choices", "MOUNT_CHOICES", convert=_first),
-            options=Ref("photo.mount_choices", "MOUNT_CHOICES"),
+            "photo.mount_choices",
+            "MOUNT_CHOICES",
             labels=Ref("photo.mount_choices", "MOUNT_LABELS", convert=_mount_labels),
             help="nominal camera-to-body rotation; custom uses MOUNT_MATRIX",
         ),
@@ -77,6 +77,19 @@ def mount_params(initial_boresight: bool = False) -> tuple[Param, ...]:
     )
 
 
+def choice_param(name: str, label: str, module: str, constant: str, **extra: Any) -> Param:
+    """An ``enum`` parameter whose options are the tuple ``constant`` of the science module
+    ``module`` (below core, e.g. ``"io.colmap_names"``), the first of them its default."""
+    return Param(
+        name,
+        "enum",
+        label,
+        Ref(module, constant, convert=_first),
+        options=Ref(module, constant),  # type: ignore[arg-type]
+        **extra,
+    )
+
+
 def _first(choices: tuple[str, ...]) -> str:
     return choices[0]
 
@@ -93,6 +106,82 @@ def mount_from(values: Mapping[str, Any]):
 
     return Mount.from_parameters(
         values["LEVER_ARM"], values["MOUNT"], values["MOUNT_MATRIX"], values["BORESIGHT"]
+    )
+
+
+def csv_out(
+    name: str,
+    label: str,
+    *,
+    optional: bool = True,
+    on_demand: bool = False,
+    advanced: bool = False,
+    twin: str = "",
+    help: str = "",
+) -> Param:
+    """A CSV table output (``file_out``), optional unless said; ``on_demand``: not written
+    unless asked (QGIS leaves it unchecked); ``twin``: the layer output (``sink``) that carries
+    the same rows (:attr:`Param.layer_twin`)."""
+    return _file_out(name, label, CSV_OUT, optional, on_demand, advanced, twin, help)
+
+
+def html_out(name: str, label: str, *, optional: bool = True, on_demand: bool = False) -> Param:
+    """An HTML report output (``file_out``), optional unless said; ``on_demand`` as in
+    :func:`csv_out`."""
+    return _file_out(name, label, "HTML files (*.html)", optional, on_demand, False, "", "")
+
+
+def _file_out(
+    name: str,
+    label: str,
+    file_filter: str,
+    optional: bool,
+    on_demand: bool,
+    advanced: bool,
+    twin: str,
+    help: str,
+) -> Param:
+    return Param(
+        name,
+        "file_out",
+        label,
+        help=help,
+        optional=optional,
+        advanced=advanced,
+        file_filter=file_filter,
+        create_by_default=not on_demand,
+        layer_twin=twin,
+    )
+
+
+def dsm_cell_param(advanced: bool = False) -> Param:
+    """CELL_SIZE: the cell (CRS units) of the DSM rasterised from a LAS/LAZ given as DSM."""
+    return Param(
+        "CELL_SIZE",
+        "number",
+        "DSM cell size for LAS/LAZ",
+        0.5,
+        unit="CRS unit",
+        minimum=0.01,
+        maximum=1000.0,
+        advanced=advanced,
+    )
+
+
+def block_export_params() -> tuple[Param, ...]:
+    """CAMERA, EO and the optional OBSERVATIONS and POINTS: the oriented block an exporter
+    (``exportcolmap``, ``exportopensfm``) writes out."""
+    return (
+        Param("CAMERA", "file", "Camera(s) (JSON)", file_filter="JSON files (*.json)"),
+        Param("EO", "table", "Exterior orientation table (CSV)", file_filter=CSV_FILTER),
+        Param("OBSERVATIONS", "table", "Observations (CSV)", optional=True, file_filter=CSV_FILTER),
+        Param(
+            "POINTS",
+            "table",
+            "3D points (ground point table, CSV)",
+            optional=True,
+            file_filter=CSV_FILTER,
+        ),
     )
 
 

@@ -7,7 +7,7 @@ from dataclasses import replace
 
 from ..errors import InputError
 from ..i18n import mark as _t
-from .common import CSV_FILTER, CSV_OUT, cloud_params, lengths_in_cloud_units, unit_symbol
+from .common import CSV_FILTER, cloud_params, csv_out, lengths_in_cloud_units, unit_symbol
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
@@ -112,32 +112,9 @@ verbose mode (command line: -vv; QGIS: Processing options, logging level Verbose
         ),
         Param("OUTPUT_POINTS", "sink", "LiDAR control points", geometry="point", optional=True),
         Param("OUTPUT_LINES", "sink", "LiDAR control lines", geometry="line", optional=True),
-        Param(
-            "POINTS_CSV",
-            "file_out",
-            "Control point table (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-            layer_twin="OUTPUT_POINTS",
-        ),
-        Param(
-            "LINES_CSV",
-            "file_out",
-            "Control line table (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-        ),
-        Param(
-            "GRAPH_CSV",
-            "file_out",
-            "Plane adjacency graph (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-            advanced=True,
-        ),
+        csv_out("POINTS_CSV", "Control point table (CSV)", on_demand=True, twin="OUTPUT_POINTS"),
+        csv_out("LINES_CSV", "Control line table (CSV)", on_demand=True),
+        csv_out("GRAPH_CSV", "Plane adjacency graph (CSV)", on_demand=True, advanced=True),
     ),
     results=(
         Result("LCP_COUNT", "number", "Number of LCPs"),

@@ -3,7 +3,7 @@ model."""
 
 from __future__ import annotations
 
-from .common import CSV_FILTER
+from .common import block_export_params
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -28,16 +28,7 @@ own coordinates (the mapping CRS; COLMAP stores no CRS: import it back with FRAM
 CRS). OBSERVATIONS become each image's keypoints, tracked to the POINTS (a ground point table,
 e.g. importcolmap's OUTPUT_POINTS) that share their point_id; the others are untracked.""",
     params=(
-        Param("CAMERA", "file", "Camera(s) (JSON)", file_filter="JSON files (*.json)"),
-        Param("EO", "table", "Exterior orientation table (CSV)", file_filter=CSV_FILTER),
-        Param("OBSERVATIONS", "table", "Observations (CSV)", optional=True, file_filter=CSV_FILTER),
-        Param(
-            "POINTS",
-            "table",
-            "3D points (ground point table, CSV)",
-            optional=True,
-            file_filter=CSV_FILTER,
-        ),
+        *block_export_params(),
         Param("OUTPUT_FOLDER", "folder_out", "Output folder (the COLMAP model)"),
     ),
     results=(

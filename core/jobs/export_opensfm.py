@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from .common import CSV_FILTER
+from .common import block_export_params
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -29,16 +29,7 @@ north, up at reference_lla, the mean of the centres), the rotations turned from 
 frame through ECEF; without CRS as they are (LOCAL, no reference_lla).
 OBSERVATIONS of the POINTS (same point_id) become tracks.csv.""",
     params=(
-        Param("CAMERA", "file", "Camera(s) (JSON)", file_filter="JSON files (*.json)"),
-        Param("EO", "table", "Exterior orientation table (CSV)", file_filter=CSV_FILTER),
-        Param("OBSERVATIONS", "table", "Observations (CSV)", optional=True, file_filter=CSV_FILTER),
-        Param(
-            "POINTS",
-            "table",
-            "3D points (ground point table, CSV)",
-            optional=True,
-            file_filter=CSV_FILTER,
-        ),
+        *block_export_params(),
         Param(
             "CRS",
             "crs",

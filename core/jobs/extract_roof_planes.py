@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import InputError
 from .checks import check_memory
-from .common import CSV_OUT, cloud_params, lengths_in_cloud_units
+from .common import cloud_params, csv_out, lengths_in_cloud_units
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -158,22 +158,9 @@ error.""",
             optional=True,
             help="LAS classes searched when POINTS is classes, e.g. 6 or 1,6",
         ),
-        *(
-            Param(
-                key,
-                kind,
-                label,
-                getattr(_D, field),
-                unit=unit,
-                minimum=minimum,
-                maximum=maximum,
-                advanced=advanced,
-                help=_HELP.get(key, ""),
-            )
-            for key, field, label, kind, unit, minimum, maximum, advanced in _NUMBERS
-        ),
+        *_D.params(_NUMBERS, _HELP),
         Param("OUTPUT", "sink", "Roof planes", geometry="polygon", optional=True),
-        Param("OUTPUT_CSV", "file_out", "Plane table (CSV)", file_filter=CSV_OUT),
+        csv_out("OUTPUT_CSV", "Plane table (CSV)", optional=False),
         Param(
             "OUTPUT_CLOUD",
             "file_out",

@@ -7,7 +7,7 @@ import logging
 from pathlib import Path
 
 from ..io.suffixes import SCAN_SUFFIXES
-from .common import CSV_FILTER, CSV_OUT
+from .common import CSV_FILTER, csv_out
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -101,7 +101,7 @@ and take the ids of CONTROL points when given (matched the same way).""",
             optional=True,
             file_filter=CSV_FILTER,
         ),
-        Param("OUTPUT", "file_out", "Target observations (CSV)", file_filter=CSV_OUT),
+        csv_out("OUTPUT", "Target observations (CSV)", optional=False),
     ),
     results=(Result("TARGETS", "number", "Target centres found (all scans)"),),
     tags=("tls", "terrestrial laser scanner", "targets", "spheres", "checkerboards", "ransac"),

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_OUT
+from .common import csv_out
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Ref, Result, Values
 
@@ -22,28 +22,9 @@ BLOCK_OUTPUTS = (
         optional=True,
         file_filter="JSON files (*.json)",
     ),
-    Param(
-        "OUTPUT_EO",
-        "file_out",
-        "Exterior orientation table (CSV)",
-        optional=True,
-        file_filter=CSV_OUT,
-    ),
-    Param(
-        "OUTPUT_OBSERVATIONS",
-        "file_out",
-        "Observations (tie points, CSV)",
-        optional=True,
-        file_filter=CSV_OUT,
-    ),
-    Param(
-        "OUTPUT_POINTS",
-        "file_out",
-        "3D points (ground point table, CSV)",
-        optional=True,
-        create_by_default=False,
-        file_filter=CSV_OUT,
-    ),
+    csv_out("OUTPUT_EO", "Exterior orientation table (CSV)"),
+    csv_out("OUTPUT_OBSERVATIONS", "Observations (tie points, CSV)"),
+    csv_out("OUTPUT_POINTS", "3D points (ground point table, CSV)", on_demand=True),
 )
 
 

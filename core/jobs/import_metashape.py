@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import logging
 
-from .common import _first
+from .common import choice_param
 from .import_colmap import BLOCK_OUTPUTS, block_results, finish_import, pixel_size_param
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Ref, Result, Values
+from .spec import AlgorithmSpec, Param, Result, Values
 
 log = logging.getLogger(__name__)
 
@@ -64,12 +64,11 @@ sigma). The camera XML has no tie points.""",
             "used when a sensor states no pixel_width: it sets the "
             "millimetres of the camera, never the projection"
         ),
-        Param(
+        choice_param(
             "IMAGE_NAMES",
-            "enum",
             "Image names in the EO",
-            Ref("io.colmap_names", "METASHAPE_IMAGE_NAMES", convert=_first),
-            options=Ref("io.colmap_names", "METASHAPE_IMAGE_NAMES"),  # type: ignore[arg-type]
+            "io.colmap_names",
+            "METASHAPE_IMAGE_NAMES",
             help="label: the camera labels as Metashape shows them; file: their file names "
             "without folder and extension (how orthorectify and the picking dock find images)",
         ),

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import logging
 
-from .common import _first
+from .common import choice_param
 from .import_colmap import BLOCK_OUTPUTS, block_results, finish_import, pixel_size_param
 from .runner import JobResult
-from .spec import AlgorithmSpec, Param, Ref, Values
+from .spec import AlgorithmSpec, Param, Values
 
 log = logging.getLogger(__name__)
 
@@ -68,12 +68,11 @@ file has no tie points.""",
         pixel_size_param(
             "the file states none: it sets the millimetres of the camera, never the projection"
         ),
-        Param(
+        choice_param(
             "PIXEL_ORIGIN",
-            "enum",
             "Pixel origin of K",
-            Ref("io.colmap_names", "PIX4D_PIXEL_ORIGINS", convert=_first),
-            options=Ref("io.colmap_names", "PIX4D_PIXEL_ORIGINS"),  # type: ignore[arg-type]
+            "io.colmap_names",
+            "PIX4D_PIXEL_ORIGINS",
             help="corner: K's pixel coordinates start at the image's top-left corner; "
             "centre: the first pixel's centre is (0, 0)",
         ),

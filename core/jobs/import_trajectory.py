@@ -5,17 +5,13 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_FILTER, CSV_OUT, mount_from, mount_params
+from .common import CSV_FILTER, choice_param, csv_out, mount_from, mount_params
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
 _OPTIONS = Fields("photo.trajectory_options", "TrajectoryImportOptions")
-
-
-def _first(choices: tuple[str, ...]) -> str:
-    return choices[0]
 
 
 NAV_FILTER = "Trajectories (*.out *.sbet *.txt *.asc *.csv *.OUT);;All files (*)"
@@ -56,12 +52,11 @@ the trajectory time). OUTPUT_EO: the exterior orientation with the mount applied
 trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""",
     params=(
         Param("INPUT", "file", "Trajectory (SBET, ASCII export or CSV)", file_filter=NAV_FILTER),
-        Param(
+        choice_param(
             "FORMAT",
-            "enum",
             "Trajectory format",
-            Ref("photo.trajectory_options", "TRAJECTORY_FORMATS", convert=_first),
-            options=Ref("photo.trajectory_options", "TRAJECTORY_FORMATS"),
+            "photo.trajectory_options",
+            "TRAJECTORY_FORMATS",
             help="auto: by the file's ending (.out/.sbet SBET, .csv CSV, else ASCII)",
         ),
         Param("EVENTS", "table", "Camera events (CSV: image_id, time)", file_filter=CSV_FILTER),
@@ -124,22 +119,8 @@ trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""
         ),
         *mount_params(),
         Param("OUTPUT", "sink", "Perspective centres", geometry="point", optional=True),
-        Param(
-            "OUTPUT_TRAJECTORY",
-            "file_out",
-            "Trajectory table at the events (CSV)",
-            optional=True,
-            file_filter=CSV_OUT,
-            advanced=True,
-        ),
-        Param(
-            "OUTPUT_EO",
-            "file_out",
-            "Exterior orientation table (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-        ),
+        csv_out("OUTPUT_TRAJECTORY", "Trajectory table at the events (CSV)", advanced=True),
+        csv_out("OUTPUT_EO", "Exterior orientation table (CSV)", on_demand=True),
     ),
     results=(
         Result("IMAGE_COUNT", "number", "Number of images"),
@@ -192,7 +173,7 @@ def _read_navigation(path: str, fmt: str, frame):
     CSV's eastings/northings are checked against the CRS's area of use."""
     from pathlib import Path
 
-    from ..geometry.frames import check_area_of_use
+    from ..geometry.frames import check_points_in_area
     from ..io.navigation_text import read_nav_ascii, read_nav_csv
     from ..io.sbet import read_sbet
 
@@ -201,11 +182,5 @@ def _read_navigation(path: str, fmt: str, frame):
         fmt = "sbet" if suffix in (".out", ".sbet") else "csv" if suffix == ".csv" else "ascii"
     nav = {"sbet": read_sbet, "ascii": read_nav_ascii, "csv": read_nav_csv}[fmt](path)
     if not nav.geodetic:
-        check_area_of_use(
-            frame.crs,
-            nav.position.min(axis=0),
-            nav.position.max(axis=0),
-            what="the trajectory",
-            path=path,
-        )
+        check_points_in_area(frame.crs, nav.position, what="the trajectory", path=path)
     return nav

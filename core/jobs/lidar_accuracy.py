@@ -10,7 +10,7 @@ from typing import Any
 
 from ..errors import InputError
 from .checks import check_memory
-from .common import CSV_FILTER
+from .common import CSV_FILTER, html_out
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -187,19 +187,7 @@ that accuracyreport reads for the NSSDA and PEC-PCD sections.""",
             help="LAS classes of hard surfaces; a cell holding another "
             "class is not compared (class 1 holds cars that move between flights)",
         ),
-        *(
-            Param(
-                key,
-                kind,
-                label,
-                getattr(_D, field),
-                unit=unit,
-                minimum=minimum,
-                maximum=maximum,
-                advanced=advanced,
-            )
-            for key, field, label, kind, unit, minimum, maximum, advanced in _NUMBERS
-        ),
+        *_D.params(_NUMBERS),
         Param(
             "TILE_SIZE",
             "number",
@@ -253,12 +241,7 @@ that accuracyreport reads for the NSSDA and PEC-PCD sections.""",
             ),
             advanced=True,
         ),
-        Param(
-            "OUTPUT_HTML",
-            "file_out",
-            "LiDAR accuracy report (HTML)",
-            file_filter="HTML files (*.html)",
-        ),
+        html_out("OUTPUT_HTML", "LiDAR accuracy report (HTML)", optional=False),
         Param(
             "OUTPUT_JSON",
             "file_out",

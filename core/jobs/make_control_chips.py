@@ -372,7 +372,7 @@ def _read_inputs(v: Values) -> tuple:
     """The ground points (checked against the CRS's area of use), the CRS, the camera and the
     plate and free photos of each point, with the plate's sides checked."""
     from ..errors import InputError
-    from ..geometry.frames import check_area_of_use, parse_crs
+    from ..geometry.frames import check_points_in_area, parse_crs
     from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.control_chips import find_photo_pairs, read_photo_table
@@ -380,9 +380,7 @@ def _read_inputs(v: Values) -> tuple:
 
     points = read_ground_points_csv(v.points)
     crs = parse_crs(v.crs, what="mapping CRS")
-    check_area_of_use(
-        crs, points.xyz.min(axis=0), points.xyz.max(axis=0), what="the ground points", path=v.points
-    )
+    check_points_in_area(crs, points.xyz, what="the ground points", path=v.points)
     # any central projection: the plate's edges, the resection, the registration and the
     # rectification all go through the camera's own projection (a nadir fisheye, as in the
     # source)

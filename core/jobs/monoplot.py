@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 
 from .checks import DSM_BYTES_PER_CELL, check_cell_size, check_memory
-from .common import CSV_FILTER, CSV_OUT
+from .common import CSV_FILTER, DSM_FILTER, choice_param, csv_out, dsm_cell_param
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Ref, Result, Values
 
@@ -56,7 +56,7 @@ projection's field: no ray).""",
             "DSM",
             "surface",
             "DSM (raster, or LAS/LAZ)",
-            file_filter="DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)",
+            file_filter=DSM_FILTER,
         ),
         Param("PLANES", "table", "Roof plane table (CSV)", optional=True, file_filter=CSV_FILTER),
         Param("CRS", "crs", "Mapping CRS of the EO", help="e.g. EPSG:28992"),
@@ -69,24 +69,14 @@ projection's field: no ray).""",
             "heights as ellipsoidal",
             advanced=True,
         ),
-        Param(
+        choice_param(
             "METHOD",
-            "enum",
             "Method",
-            Ref("photo.monoplot_options", "METHODS", convert=lambda methods: methods[0]),
-            options=Ref("photo.monoplot_options", "METHODS"),
+            "photo.monoplot_options",
+            "METHODS",
             labels=("direct (Dal Poz, DDA)", "Makarovic iteration"),
         ),
-        Param(
-            "CELL_SIZE",
-            "number",
-            "DSM cell size for LAS/LAZ",
-            0.5,
-            unit="CRS unit",
-            minimum=0.01,
-            maximum=1000.0,
-            advanced=True,
-        ),
+        dsm_cell_param(advanced=True),
         Param(
             "SIGMA_DSM",
             "number",
@@ -130,23 +120,8 @@ projection's field: no ray).""",
         ),
         Param("OUTPUT_POINTS", "sink", "Monoplotted points", geometry="point", optional=True),
         Param("OUTPUT_LINES", "sink", "Monoplotted lines", geometry="line", optional=True),
-        Param(
-            "OUTPUT_CSV",
-            "file_out",
-            "Point table (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-            layer_twin="OUTPUT_POINTS",
-        ),
-        Param(
-            "LINES_CSV",
-            "file_out",
-            "Line table",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-        ),
+        csv_out("OUTPUT_CSV", "Point table (CSV)", on_demand=True, twin="OUTPUT_POINTS"),
+        csv_out("LINES_CSV", "Line table", on_demand=True),
         Param(
             "OUTPUT_DSM",
             "raster_out",
@@ -199,7 +174,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 def _read_inputs(v: Values) -> tuple:
     """(camera, observations, EO, planes), the perspective centres checked against the CRS's
     area of use and the rays' memory against what is free."""
-    from ..geometry.frames import check_area_of_use, parse_crs
+    from ..geometry.frames import check_points_in_area, parse_crs
     from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.observations import read_observations_csv
@@ -209,12 +184,8 @@ def _read_inputs(v: Values) -> tuple:
     camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     obs = read_observations_csv(v.observations, camera=camera)
     eo = read_eo_csv(v.eo)
-    check_area_of_use(
-        parse_crs(v.crs, what="CRS"),
-        eo.xyz.min(axis=0),
-        eo.xyz.max(axis=0),
-        what="the perspective centres",
-        path=v.eo,
+    check_points_in_area(
+        parse_crs(v.crs, what="CRS"), eo.xyz, what="the perspective centres", path=v.eo
     )
     planes = read_planes_csv(v.planes) if v.planes else ()
     rays = ray_count(obs, v.line_step)

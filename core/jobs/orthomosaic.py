@@ -7,7 +7,7 @@ import math
 from dataclasses import dataclass
 
 from ..io.suffixes import IMAGE_SUFFIXES
-from .common import CSV_OUT, compression_param
+from .common import compression_param, csv_out
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -72,14 +72,7 @@ MultiPolygon in the mosaic's CRS).""",
             geometry="polygon",
             optional=True,
         ),
-        Param(
-            "SEAMLINES_CSV",
-            "file_out",
-            "Seamline table (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-        ),
+        csv_out("SEAMLINES_CSV", "Seamline table (CSV)", on_demand=True),
     ),
     results=(
         Result("SOURCE_COUNT", "number", "Orthophotos mosaicked"),

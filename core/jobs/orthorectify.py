@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..io.suffixes import IMAGE_SUFFIXES
-from .common import CSV_FILTER, compression_param
+from .common import CSV_FILTER, DSM_FILTER, compression_param, dsm_cell_param
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -22,7 +22,6 @@ log = logging.getLogger(__name__)
 _D = Fields("photo.ortho_options", "OrthoOptions")
 #: Name of the orthophoto of image ``<image_id>`` in the output folder.
 ORTHO_NAME = "{}_ortho.tif"
-DSM_FILTER = "DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"
 
 SPEC = AlgorithmSpec(
     name="orthorectify",
@@ -78,15 +77,7 @@ Nothing is written when an input is wrong; the files appear together when all ar
         ),
         Param("CRS", "crs", "Mapping CRS of the EO", help="e.g. EPSG:28992"),
         Param("DSM_CRS", "crs", "DSM CRS (if the file has none)", optional=True),
-        Param(
-            "CELL_SIZE",
-            "number",
-            "DSM cell size for LAS/LAZ",
-            0.5,
-            unit="CRS unit",
-            minimum=0.01,
-            maximum=1000.0,
-        ),
+        dsm_cell_param(),
         Param(
             "GSD",
             "number",
@@ -338,7 +329,7 @@ def _read_inputs(v: Values, mapping):
     """The camera, the EO (checked against the mapping CRS's area of use), the images with
     their EO rows and their size against the camera: all checked before anything is computed."""
     from ..errors import InputError
-    from ..geometry.frames import check_area_of_use
+    from ..geometry.frames import check_points_in_area
     from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.images import list_image_files
@@ -347,9 +338,7 @@ def _read_inputs(v: Values, mapping):
 
     camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     eo = read_eo_csv(v.eo)
-    check_area_of_use(
-        mapping, eo.xyz.min(axis=0), eo.xyz.max(axis=0), what="the perspective centres", path=v.eo
-    )
+    check_points_in_area(mapping, eo.xyz, what="the perspective centres", path=v.eo)
     images = list_image_files(v.images)
     row_of = {name: k for k, name in enumerate(eo.image_id)}
     missing = [f.stem for f in images if f.stem not in row_of]

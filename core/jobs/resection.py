@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 import math
 
-from .common import CSV_FILTER, CSV_OUT, global_test_verdict
+from .common import CSV_FILTER, csv_out, global_test_verdict, html_out
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -152,19 +152,9 @@ lines parallel).""",
             _OPTIONS.estimate_interior,
         ),
         Param("SNOOPING", "boolean", "Data snooping (Baarda)", _OPTIONS.snooping, advanced=True),
-        Param(
-            "OUTPUT_EO", "file_out", "Exterior orientation with sigmas (CSV)", file_filter=CSV_OUT
-        ),
-        Param(
-            "OUTPUT_RESIDUALS", "file_out", "Residuals (CSV)", optional=True, file_filter=CSV_OUT
-        ),
-        Param(
-            "OUTPUT_HTML",
-            "file_out",
-            "Summary (HTML)",
-            optional=True,
-            file_filter="HTML files (*.html)",
-        ),
+        csv_out("OUTPUT_EO", "Exterior orientation with sigmas (CSV)", optional=False),
+        csv_out("OUTPUT_RESIDUALS", "Residuals (CSV)"),
+        html_out("OUTPUT_HTML", "Summary (HTML)"),
     ),
     results=(
         Result("IMAGE_COUNT", "number", "Images resected"),
@@ -247,7 +237,7 @@ def _read_inputs(v: Values) -> tuple:
     import numpy as np
 
     from ..errors import InputError
-    from ..geometry.frames import MappingFrame, check_area_of_use
+    from ..geometry.frames import MappingFrame, check_points_in_area
     from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.observations import read_observations_csv
@@ -286,10 +276,8 @@ def _read_inputs(v: Values) -> tuple:
             None if lines is None else np.vstack([lines.p1, lines.p2]),
         ),
     ):
-        if xyz is not None and len(xyz):
-            check_area_of_use(
-                frame.crs, xyz.min(axis=0), xyz.max(axis=0), what=f"the {what}", path=path
-            )
+        if xyz is not None:
+            check_points_in_area(frame.crs, xyz, what=f"the {what}", path=path)
     return frame, camera, obs, points, lines
 
 
@@ -297,18 +285,14 @@ def _approximations(v: Values, frame) -> tuple[dict, tuple | None]:
     """The approximate orientations by image id ((xyz, opk, time, group)) and the sigmas of
     their prior (m, m, m, rad x 3; None without APPROX_EO_SIGMAS)."""
     from ..errors import InputError
-    from ..geometry.frames import check_area_of_use
+    from ..geometry.frames import check_points_in_area
     from ..io.orientation import read_eo_csv
 
     approx = {}
     if v.approx_eo:
         table = read_eo_csv(v.approx_eo)
-        check_area_of_use(
-            frame.crs,
-            table.xyz.min(axis=0),
-            table.xyz.max(axis=0),
-            what="the approximate perspective centres",
-            path=v.approx_eo,
+        check_points_in_area(
+            frame.crs, table.xyz, what="the approximate perspective centres", path=v.approx_eo
         )
         approx = {
             i: (table.xyz[k], table.opk[k], table.time[k], table.group[k])

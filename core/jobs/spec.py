@@ -59,7 +59,7 @@ import dataclasses
 import importlib
 import math
 import re
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -162,6 +162,28 @@ class Fields:
         if field_name.startswith("_"):
             raise AttributeError(field_name)
         return Ref(self.module, self.name, field_name)
+
+    def params(
+        self, rows: Iterable[Sequence[Any]], help: Mapping[str, str] | None = None
+    ) -> tuple[Param, ...]:
+        """One :class:`Param` a row ``(parameter, field, label, kind, unit, minimum, maximum,
+        advanced)``, its default read from that field of the dataclass; ``help`` by
+        parameter name."""
+        notes = help or {}
+        return tuple(
+            Param(
+                key,
+                kind,
+                label,
+                getattr(self, field_name),
+                unit=unit,
+                minimum=minimum,
+                maximum=maximum,
+                advanced=advanced,
+                help=notes.get(key, ""),
+            )
+            for key, field_name, label, kind, unit, minimum, maximum, advanced in rows
+        )
 
 
 #: The fields of :class:`Param` a :class:`Ref` may stand for.

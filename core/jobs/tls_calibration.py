@@ -15,7 +15,7 @@ from pathlib import Path
 from ..i18n import joined as _joined
 from ..i18n import mark as _t
 from ..io.suffixes import SCAN_SUFFIXES
-from .common import CSV_FILTER, CSV_OUT, doubt_params, settle_doubts
+from .common import CSV_FILTER, csv_out, doubt_params, html_out, settle_doubts
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -232,25 +232,11 @@ beginning with #).""",
             help="face-I readings; off: the rigid pose only",
             advanced=True,
         ),
-        Param("OUTPUT_STATIONS", "file_out", "Station poses (CSV)", file_filter=CSV_OUT),
-        Param("OUTPUT_APS", "file_out", "Additional parameters (CSV)", file_filter=CSV_OUT),
-        Param(
-            "OUTPUT_TARGETS",
-            "file_out",
-            "Target coordinates (CSV)",
-            optional=True,
-            file_filter=CSV_OUT,
-        ),
-        Param(
-            "OUTPUT_RESIDUALS",
-            "file_out",
-            "Residuals (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-            advanced=True,
-        ),
-        Param("OUTPUT_HTML", "file_out", "Report (HTML)", file_filter="HTML files (*.html)"),
+        csv_out("OUTPUT_STATIONS", "Station poses (CSV)", optional=False),
+        csv_out("OUTPUT_APS", "Additional parameters (CSV)", optional=False),
+        csv_out("OUTPUT_TARGETS", "Target coordinates (CSV)"),
+        csv_out("OUTPUT_RESIDUALS", "Residuals (CSV)", on_demand=True, advanced=True),
+        html_out("OUTPUT_HTML", "Report (HTML)", optional=False),
         Param(
             "OUTPUT_FOLDER",
             "folder_out",

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_FILTER, CSV_OUT, mount_from, mount_params
+from .common import CSV_FILTER, csv_out, mount_from, mount_params
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -51,15 +51,7 @@ CSV (on the command line, printed when no file is given), and the number of imag
         ),
         *mount_params(),
         Param("OUTPUT", "sink", "Exterior orientation", geometry="point", optional=True),
-        Param(
-            "OUTPUT_CSV",
-            "file_out",
-            "Exterior orientation table (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-            layer_twin="OUTPUT",
-        ),
+        csv_out("OUTPUT_CSV", "Exterior orientation table (CSV)", on_demand=True, twin="OUTPUT"),
     ),
     results=(Result("IMAGE_COUNT", "number", "Number of images"),),
     tags=("trajectory", "ins", "gnss", "imu", "exterior orientation", "omega phi kappa"),
@@ -70,7 +62,7 @@ CSV (on the command line, printed when no file is given), and the number of imag
 def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     """Read the trajectory, georeference every image, write the EO table."""
     from ..errors import stop_if_asked
-    from ..geometry.frames import MappingFrame, check_area_of_use
+    from ..geometry.frames import MappingFrame, check_points_in_area
     from ..io.orientation import eo_csv_text, write_eo_csv
     from ..io.trajectory import read_trajectory_csv
     from ..photo.georeference import direct_georeference
@@ -79,13 +71,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     mount = mount_from(v)
     traj = read_trajectory_csv(v.input)
     if not traj.geodetic:
-        check_area_of_use(
-            frame.crs,
-            traj.position.min(axis=0),
-            traj.position.max(axis=0),
-            what="the trajectory",
-            path=v.input,
-        )
+        check_points_in_area(frame.crs, traj.position, what="the trajectory", path=v.input)
     log.info("read %d images from %s", len(traj), v.input)
     stop_if_asked(should_stop, "georeferencing")
     if progress is not None:

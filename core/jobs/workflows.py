@@ -65,6 +65,13 @@ _LOCATE_STEP = (
         "IMAGES; OUTPUT = the control points' image observations, without clicking them"
     ),
 )
+_ROOF_PLANES_STEP = (
+    "extractroofplanes",
+    _t(
+        "INPUT = the classified cloud; OUTPUT_CSV = the plane table, "
+        "OUTPUT_CLOUD = the cloud with plane_id"
+    ),
+)
 
 WORKFLOWS: tuple[Workflow, ...] = (
     Workflow(
@@ -84,13 +91,7 @@ WORKFLOWS: tuple[Workflow, ...] = (
                     "ground (2) and non-ground"
                 ),
             ),
-            (
-                "extractroofplanes",
-                _t(
-                    "INPUT = the classified cloud; OUTPUT_CSV = the plane table, "
-                    "OUTPUT_CLOUD = the cloud with plane_id"
-                ),
-            ),
+            _ROOF_PLANES_STEP,
             (
                 "createlcps",
                 _t(
@@ -269,13 +270,7 @@ WORKFLOWS: tuple[Workflow, ...] = (
     Workflow(
         _t("Boresight calibration without hand picks (automatic)"),
         (
-            (
-                "extractroofplanes",
-                _t(
-                    "INPUT = the classified cloud; OUTPUT_CSV = the plane table, "
-                    "OUTPUT_CLOUD = the cloud with plane_id"
-                ),
-            ),
+            _ROOF_PLANES_STEP,
             (
                 "createlcps",
                 _t(

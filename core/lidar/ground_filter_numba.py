@@ -32,7 +32,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..compiled import cached_njit
+from ..compiled import Kernels
 
 numba: Any  # the module, or None without it
 try:  # pragma: no cover - depends on the environment
@@ -331,25 +331,20 @@ def _rect_union_kernel(src, out, ws, ds, sign, y_first, y_stop):
                     oy[x] = big * sg
 
 
-_COMPILED: dict[str, Callable[..., Any]] = {}
 _POOL: list[Any] = []
 _POOL_LOCK = threading.Lock()
 
 
-def _compiled(name: str) -> Callable[..., Any]:
-    """The jitted function (compiled at its first call for each argument type, cached next to
-    this module, keyed by the module's import name)."""
-    if name not in _COMPILED:
-        kernels: dict[str, Callable[..., Any]]
-        kernels = {
-            "cells": _cells_kernel,
-            "low_pass": _low_pass_kernel,
-            "classify": _classify_kernel,
-            "bounds": _bounds_kernel,
-            "rect_union": _rect_union_kernel,
-        }
-        _COMPILED[name] = cached_njit(kernels[name], nogil=True)
-    return _COMPILED[name]
+#: The jitted functions (each compiled at its first call, cached: core/compiled.py).
+_compiled = Kernels(
+    {
+        "cells": _cells_kernel,
+        "low_pass": _low_pass_kernel,
+        "classify": _classify_kernel,
+        "bounds": _bounds_kernel,
+        "rect_union": _rect_union_kernel,
+    }
+)
 
 
 _NO_BOOL = np.zeros(0, dtype=bool)

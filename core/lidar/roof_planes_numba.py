@@ -24,7 +24,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..compiled import cached_njit
+from ..compiled import Kernels
 from ..geometry.sym3 import JACOBI_SWEEPS  # the numpy back end's sweeps
 
 try:  # pragma: no cover - depends on the environment
@@ -572,24 +572,19 @@ def _moments_kernel(q, labels, nl, counts, centroid, cov):
         cov[c, 5] += ez * ez
 
 
-_COMPILED: dict[str, Callable[..., Any]] = {}
-
-
-def _compiled(name: str) -> Callable[..., Any]:
-    """The jitted function (compiled at its first call, cached next to this module, the
-    helpers it calls compiled into its cache entry)."""
-    if name not in _COMPILED:
-        func = {
-            "local_planes": _local_planes_kernel,
-            "claims": _claims_kernel,
-            "reassign": _reassign_kernel,
-            "pairs": _pairs_kernel,
-            "order": _order_kernel,
-            "moments": _moments_kernel,
-            "normals": _normals_kernel,
-        }[name]
-        _COMPILED[name] = cached_njit(func, nogil=True)
-    return _COMPILED[name]
+#: The jitted functions (each compiled at its first call, cached: core/compiled.py; the
+#: helpers a kernel calls are compiled into its cache entry).
+_compiled = Kernels(
+    {
+        "local_planes": _local_planes_kernel,
+        "claims": _claims_kernel,
+        "reassign": _reassign_kernel,
+        "pairs": _pairs_kernel,
+        "order": _order_kernel,
+        "moments": _moments_kernel,
+        "normals": _normals_kernel,
+    }
+)
 
 
 def local_planes(

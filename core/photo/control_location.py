@@ -291,10 +291,6 @@ def locate_control_points(
                 size.size,
                 opt,
                 cv2,
-                eo_sigmas,
-                eo_local,
-                pts_local,
-                camera,
             )
         for i in sorted(results):
             r = results[i]
@@ -374,10 +370,6 @@ def _transfer_failed(
     size_px: int,
     opt: LocateOptions,
     cv2,
-    eo_sigmas: Array | None,
-    eo_local: Array,
-    pts_local: Array,
-    camera: Camera,
 ) -> None:
     """Transfer: the images where the chip failed (not for being outside the image) matched
     again from the best located image (smallest sigma); ``results`` updated in place."""
@@ -399,10 +391,6 @@ def _transfer_failed(
                 size_px,
                 opt,
                 cv2,
-                eo_sigmas,
-                eo_local,
-                pts_local,
-                camera,
                 r,
             )
             if t is not None:
@@ -544,10 +532,6 @@ def _transfer(
     size: int,
     opt,
     cv2,
-    eo_sigmas,
-    eo_local,
-    pts_local,
-    camera,
     old: LocatedPair,
 ) -> LocatedPair | None:
     """Image-to-image LSM from the master image's patch around its match into image i."""

@@ -489,6 +489,12 @@ class PointMatch:
         """True when accepted."""
         return not self.reason
 
+    @classmethod
+    def refused(cls, reason: str, correlation: float = math.nan) -> PointMatch:
+        """A refused match: no position, ``reason`` saying why (``correlation`` where one was
+        computed)."""
+        return cls(math.nan, math.nan, (math.nan, math.nan), correlation, reason)
+
 
 def match_point(
     template_window: ArrayLike,
@@ -520,35 +526,17 @@ def match_point(
     c, r = int(np.rint(template_xy[0])), int(np.rint(template_xy[1]))
     h = int(half_size)
     if c - h < 0 or r - h < 0 or c + h >= t.shape[1] or r + h >= t.shape[0]:
-        return PointMatch(
-            math.nan,
-            math.nan,
-            (math.nan, math.nan),
-            math.nan,
-            "the template point is too close to its image's border",
-        )
+        return PointMatch.refused("the template point is too close to its image's border")
     tmpl = t[r - h : r + h + 1, c - h : c + h + 1]
     ref = (template_xy[0] - (c - h), template_xy[1] - (r - h))
     sc, sr = int(np.rint(start_xy[0])), int(np.rint(start_xy[1]))
     reach = h + int(search_px)
     if sc - reach < 0 or sr - reach < 0 or sc + reach >= s.shape[1] or sr + reach >= s.shape[0]:
-        return PointMatch(
-            math.nan,
-            math.nan,
-            (math.nan, math.nan),
-            math.nan,
-            "the point is too close to the image's border",
-        )
+        return PointMatch.refused("the point is too close to the image's border")
     sub = s[sr - reach : sr + reach + 1, sc - reach : sc + reach + 1]
     m = ncc_search(tmpl, sub)
     if m.peak < min_ncc:
-        return PointMatch(
-            math.nan,
-            math.nan,
-            (math.nan, math.nan),
-            m.peak,
-            f"low correlation (NCC {m.peak:.2f} < {min_ncc:.2f})",
-        )
+        return PointMatch.refused(f"low correlation (NCC {m.peak:.2f} < {min_ncc:.2f})", m.peak)
     # the NCC centre is the template's centre pixel; the point is at ref from its corner
     start = np.array([sc - reach + m.col - h + ref[0], sr - reach + m.row - h + ref[1]])
     res = lsm_in_image(tmpl[None], s, affine_start(start[None]), reference=ref, options=options)

@@ -9,11 +9,10 @@ compare them); numba is optional: :data:`AVAILABLE` tells whether it imports.
 from __future__ import annotations
 
 from types import ModuleType
-from typing import Any, Callable
 
 import numpy as np
 
-from ..compiled import cached_njit
+from ..compiled import Kernels, cached_njit
 
 numba: ModuleType | None  # None without numba
 try:  # pragma: no cover - depends on the environment
@@ -132,15 +131,8 @@ def _samples(g, aff, x, y, out):  # pragma: no cover - compiled
             out[k, p] = val
 
 
-_COMPILED: dict[str, Callable[..., Any]] = {}
-
-
-def _compiled(name: str) -> Callable[..., Any]:
-    """The jitted function (compiled at its first call; cached next to this module)."""
-    if name not in _COMPILED:
-        kernels: dict[str, Callable[..., Any]] = {"normals": _normals, "samples": _samples}
-        _COMPILED[name] = cached_njit(kernels[name], nogil=True)
-    return _COMPILED[name]
+#: The jitted functions (each compiled at its first call, cached: core/compiled.py).
+_compiled = Kernels({"normals": _normals, "samples": _samples})
 
 
 def normals(g, idx, aff, rad, f, x, y):

@@ -61,16 +61,7 @@ def share_beyond_dsm(proj: OrthoProjector, ground_z: float) -> float:
     """Share (0-1) of the image's border whose ground, at height ``ground_z``, lies beyond the
     DSM's cell centres (33 points a side)."""
     cam = proj.camera
-    k = np.linspace(0.0, 1.0, 33)
-    w, h = cam.width_px, cam.height_px
-    border = np.vstack(
-        [
-            np.column_stack([k * w, np.zeros_like(k)]),
-            np.column_stack([k * w, np.full_like(k, h)]),
-            np.column_stack([np.zeros_like(k), k * h]),
-            np.column_stack([np.full_like(k, w), k * h]),
-        ]
-    )
+    border = cam.border_pixels(32)
     xy = proj.ground_points(border, ground_z)
     g = proj.dsm.grid
     xc, yc = proj.dsm.centre_origin

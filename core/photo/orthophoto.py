@@ -351,16 +351,7 @@ class OrthoProjector:
         and highest heights, clipped to the surface (unless ``clip`` is False); None when they
         do not overlap."""
         cam, dsm = self.camera, self.dsm
-        k = np.linspace(0.0, 1.0, samples + 1)
-        w, h = cam.width_px, cam.height_px
-        border = np.vstack(
-            [
-                np.column_stack([k * w, np.zeros_like(k)]),
-                np.column_stack([k * w, np.full_like(k, h)]),
-                np.column_stack([np.zeros_like(k), k * h]),
-                np.column_stack([np.full_like(k, w), k * h]),
-            ]
-        )
+        border = cam.border_pixels(samples)
         ideal = cam.ideal_from_pixel(border)
         ray_c = cam.ray_from_ideal(ideal)  # NaN beyond a fisheye's field: the whole surface
         d = ray_c @ self.m_local  # M^T r: camera -> local ENU

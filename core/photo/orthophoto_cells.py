@@ -27,16 +27,7 @@ def _lens_lattice(camera: Camera, tol_px: float = 1e-3) -> tuple[Array, float, f
     distortion."""
     if isinstance(camera.distortion, NoDistortion):
         return np.zeros((1, 1, 2)), 0.0, 0.0, 1.0
-    w, h = camera.width_px, camera.height_px
-    k = np.linspace(0.0, 1.0, 257)
-    border = np.vstack(
-        [
-            np.column_stack([k * w, np.zeros_like(k)]),
-            np.column_stack([k * w, np.full_like(k, h)]),
-            np.column_stack([np.zeros_like(k), k * h]),
-            np.column_stack([np.full_like(k, w), k * h]),
-        ]
-    )
+    border = camera.border_pixels(256)
     ideal = camera.ideal_from_pixel(border)
     lo, hi = ideal.min(axis=0), ideal.max(axis=0)
     margin = 0.02 * (hi - lo) + 2 * camera.pixel_size_mm

@@ -10,11 +10,11 @@ The compiled function releases the GIL, so that tiles run in parallel threads.
 from __future__ import annotations
 
 import math
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
-from ..compiled import cached_njit
+from ..compiled import Kernels
 from ..geometry.raycast_numba import AVAILABLE
 
 __all__ = [
@@ -231,22 +231,13 @@ def _cell_stats(col, row, z, valid):
     return n, no_z, c_lo, c_hi, r_lo, r_hi
 
 
-_COMPILED: dict[str, Callable[..., Any]] = {}
-
-
-def _compiled(name: str) -> Callable[..., Any]:
-    if name not in _COMPILED:
-        kernels: dict[str, Callable[..., Any]]
-        kernels = {
-            "cells": _cell_pixels,
-            "maps": _remap_maps,
-            "fixed": _remap_maps_fixed,
-            "stats": _cell_stats,
-        }
-        # numpy's error model: a float division by zero gives inf (checked after), with no
-        # test per division that would keep the cell loop from being vectorised
-        _COMPILED[name] = cached_njit(kernels[name], nogil=True, error_model="numpy")
-    return _COMPILED[name]
+#: The jitted functions (each compiled at its first call, cached: core/compiled.py), with
+#: numpy's error model: a float division by zero gives inf (checked after), with no test per
+#: division that would keep the cell loop from being vectorised.
+_compiled = Kernels(
+    {"cells": _cell_pixels, "maps": _remap_maps, "fixed": _remap_maps_fixed, "stats": _cell_stats},
+    error_model="numpy",
+)
 
 
 def cell_pixels(*args: Any) -> None:

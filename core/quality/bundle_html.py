@@ -21,7 +21,7 @@ import numpy as np
 
 from .. import __version__
 from .block_map import BlockMap, block_map_svg, footprints
-from .html_table import TR_CONTEXT, html_lang, report_css, t  # noqa: F401 - TR_CONTEXT: make i18n
+from .html_table import TR_CONTEXT, html_lang, rejections_explained, report_css, t  # noqa: F401 - TR_CONTEXT: make i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 from .lens_plots import lens_distortion_field, lens_radial_profile
@@ -156,12 +156,7 @@ def _adjustment(res: BundleResult) -> str:
                 [
                     t("rejections explained by false alarms"),
                     _e(doubt.rejected),
-                    t("at most {bound} ({expected} expected); {k} rejected: P = {p}").format(
-                        bound=doubt.bound,
-                        expected=f"{doubt.expected:.2g}",
-                        k=doubt.rejected,
-                        p=f"{doubt.p_value:.2g}",
-                    ),
+                    rejections_explained(doubt),
                 ]
             ]
             if doubt is not None

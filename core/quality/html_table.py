@@ -5,10 +5,23 @@ from __future__ import annotations
 
 import html
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from ..i18n import html_lang, render
 
-__all__ = ["TR_CONTEXT", "escape", "failed_checks", "html_lang", "report_css", "t", "table"]
+if TYPE_CHECKING:
+    from ..lsq.results import RejectionTest
+
+__all__ = [
+    "TR_CONTEXT",
+    "escape",
+    "failed_checks",
+    "html_lang",
+    "rejections_explained",
+    "report_css",
+    "t",
+    "table",
+]
 #: translation context of the reports' texts (``make i18n`` collects the ``t("...")`` calls of
 #: every module that defines or imports TR_CONTEXT)
 TR_CONTEXT = "Report"
@@ -87,3 +100,15 @@ def failed_checks(problems: Sequence[object], accepted: bool, refused: str) -> l
         )
     items = "".join(f"<li>{escape(t(p))}</li>" for p in problems)
     return [f'<div class="alarm"><p><b>{escape(verdict)}</b></p><ul>{items}</ul></div>']
+
+
+def rejections_explained(test: RejectionTest) -> str:
+    """The count test of data snooping's rejections in one translated line: the most that its
+    false alarms explain, how many they are expected to be, how many were rejected and the
+    probability of that many."""
+    return t("at most {bound} ({expected} expected); {k} rejected: P = {p}").format(
+        bound=test.bound,
+        expected=f"{test.expected:.2g}",
+        k=test.rejected,
+        p=f"{test.p_value:.2g}",
+    )

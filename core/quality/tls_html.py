@@ -20,7 +20,7 @@ from ..lsq.results import RejectionTest
 from ..tls.aps import ARCSEC
 from ..tls.calibration import TlsCalibration
 from ..tls.diagnosis import explain_pair
-from .html_table import TR_CONTEXT, failed_checks, html_lang, report_css, t  # noqa: F401 - TR_CONTEXT: i18n
+from .html_table import TR_CONTEXT, failed_checks, html_lang, rejections_explained, report_css, t  # noqa: F401 - TR_CONTEXT: i18n
 from .html_table import escape as _e
 from .html_table import table as _table
 
@@ -169,14 +169,7 @@ def _adjustment_parts(cal: TlsCalibration, rejections: RejectionTest | None) -> 
                     [
                         (
                             t("rejections explained by false alarms"),
-                            t(
-                                "at most {bound} ({expected} expected); {k} rejected: P = {p}"
-                            ).format(
-                                bound=rejections.bound,
-                                expected=f"{rejections.expected:.2g}",
-                                k=rejections.rejected,
-                                p=f"{rejections.p_value:.2g}",
-                            ),
+                            rejections_explained(rejections),
                         )
                     ]
                     if rejections is not None

@@ -671,39 +671,35 @@ def detect_checkerboards(
         nb = tree.query_ball_point(p[s], 0.7 * half_size)
         share[k] = np.mean(white[nb]) if len(nb) >= min_points else 0.0
     cand = seeds[(share > 0.25) & (share < 0.75)]
+
+    def fit_near(centre: np.ndarray) -> TargetFit | None:
+        """The checkerboard fitted to the points within 1.2 half sizes of ``centre`` (m,
+        scanner frame), or None where none fits."""
+        nb = tree.query_ball_point(centre, 1.2 * half_size)
+        try:
+            return fit_checkerboard(
+                p[nb],
+                it[nb],
+                half_size,
+                sigma_range_m,
+                sigma_angle_rad,
+                min_points=min_points,
+                min_contrast=min_contrast,
+            )
+        except (InputError, AdjustmentError):
+            return None
+
     found: list[TargetFit] = []
     for k, s in enumerate(cand):
         stop_if_asked(should_stop, "detecting checkerboards")
         if any(np.linalg.norm(f.centre - p[s]) < 0.7 * half_size for f in found):
             continue
-        nb = tree.query_ball_point(p[s], 1.2 * half_size)
-        try:
-            fit = fit_checkerboard(
-                p[nb],
-                it[nb],
-                half_size,
-                sigma_range_m,
-                sigma_angle_rad,
-                min_points=min_points,
-                min_contrast=min_contrast,
-            )
-        except (InputError, AdjustmentError):
-            continue
-        if np.linalg.norm(fit.centre - p[s]) > half_size:
+        fit = fit_near(p[s])
+        if fit is None or np.linalg.norm(fit.centre - p[s]) > half_size:
             continue
         # Refit centred on the found centre (the seed may sit off-centre).
-        nb = tree.query_ball_point(fit.centre, 1.2 * half_size)
-        try:
-            fit = fit_checkerboard(
-                p[nb],
-                it[nb],
-                half_size,
-                sigma_range_m,
-                sigma_angle_rad,
-                min_points=min_points,
-                min_contrast=min_contrast,
-            )
-        except (InputError, AdjustmentError):
+        fit = fit_near(fit.centre)
+        if fit is None:
             continue
         if any(np.linalg.norm(f.centre - fit.centre) < half_size for f in found):
             continue

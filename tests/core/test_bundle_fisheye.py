@@ -34,7 +34,7 @@ from lidarphoto.core.geometry.camera import Camera
 from lidarphoto.core.geometry.distortion import BrownConrady
 from lidarphoto.core.geometry.projection import FISHEYE_PROJECTIONS
 from lidarphoto.core.io.orientation import read_eo_csv
-from lidarphoto.core.io.resection import EO_SIGMA_COLUMNS
+from lidarphoto.core.io.resection import RESECTION_EO_COLUMNS
 from lidarphoto.core.jobs import resection as resection_job
 from lidarphoto.core.jobs.runner import run_job
 from lidarphoto.core.photo.bundle import bundle_adjust
@@ -208,7 +208,7 @@ def test_resection_job_orients_a_fisheye_image(tmp_path, projection):
     assert result.results["IMAGE_COUNT"] == 1
     truth, got = read_eo_csv(files["eo_true"]), read_eo_csv(tmp_path / "eo.csv")
     row = _rows(tmp_path / "eo.csv")[0]
-    sig = np.array([float(row[c]) for c in EO_SIGMA_COLUMNS[9:15]])
+    sig = np.array([float(row[c]) for c in RESECTION_EO_COLUMNS[9:15]])
     d_xyz = got.xyz[0] - truth.xyz[0]
     d_opk = (np.degrees(got.opk[0] - truth.opk[0]) + 180.0) % 360.0 - 180.0
     assert (np.abs(d_xyz) < 4.0 * sig[:3]).all(), (d_xyz, sig[:3])

@@ -13,7 +13,7 @@ from lidarphoto.core.cli import main as cli_main
 from lidarphoto.core.errors import InputError, NotObservableError
 from lidarphoto.core.io.camera import write_camera_json
 from lidarphoto.core.io.orientation import read_eo_csv
-from lidarphoto.core.io.resection import EO_SIGMA_COLUMNS, RESIDUAL_COLUMNS
+from lidarphoto.core.io.resection import RESECTION_EO_COLUMNS, RESIDUAL_COLUMNS
 from lidarphoto.core.jobs import resection
 from lidarphoto.core.jobs.runner import run_job
 from lidarphoto.core.photo.resection import resect
@@ -54,7 +54,7 @@ def _check_against_truth(files, eo_path, k=4.0):
     truth = read_eo_csv(files["eo_true"])
     got = read_eo_csv(eo_path)
     rows = _rows(eo_path)
-    sig = np.array([[float(r[c]) for c in EO_SIGMA_COLUMNS[9:15]] for r in rows])
+    sig = np.array([[float(r[c]) for c in RESECTION_EO_COLUMNS[9:15]] for r in rows])
     d_xyz = got.xyz[0] - truth.xyz[0]
     d_opk = _angle(np.degrees(got.opk[0] - truth.opk[0]))
     assert np.all(np.abs(d_xyz) < k * sig[0, :3]), (d_xyz, sig[0, :3])
@@ -72,7 +72,7 @@ def test_cli_points_and_lines_recover_the_truth(scene_files, tmp_path, capsys):
         args += [f"--{k.lower().replace('_', '-')}", val]
     assert cli_main(args) == 0
     row, sig = _check_against_truth(files, tmp_path / "eo.csv")
-    assert list(_rows(tmp_path / "eo.csv")[0].keys()) == list(EO_SIGMA_COLUMNS)
+    assert list(_rows(tmp_path / "eo.csv")[0].keys()) == list(RESECTION_EO_COLUMNS)
     assert 0.7 < float(row["sigma0"]) < 1.3
     assert row["chi2_passed"] == "1"
     assert int(row["points"]) == data.n_points and int(row["lines"]) == data.n_lines
@@ -160,7 +160,7 @@ def test_approximate_eo_weighted_as_observations(scene_files, tmp_path):
                                APPROX_EO_SIGMAS="500,500,500,45,45,45"))  # fmt: skip
     a, b = _rows(free / "eo.csv")[0], _rows(tmp_path / "eo.csv")[0]
     assert int(b["redundancy"]) == int(a["redundancy"]) + 6
-    for c, s in zip(EO_SIGMA_COLUMNS[3:9], EO_SIGMA_COLUMNS[9:15]):
+    for c, s in zip(RESECTION_EO_COLUMNS[3:9], RESECTION_EO_COLUMNS[9:15]):
         assert abs(float(a[c]) - float(b[c])) < 0.05 * float(a[s]), c
     assert read_eo_csv(tmp_path / "eo.csv").image_id == truth.image_id
 
@@ -203,7 +203,7 @@ def test_borea_real_images_through_the_algorithm(tmp_path):
         centre = _altitude_to_ellipsoidal(ign[None, :3])[0]
         xyz = np.array([float(r[c]) for c in ("X", "Y", "Z")])
         ang = np.array([float(r[c]) for c in ("omega_deg", "phi_deg", "kappa_deg")])
-        sig = np.array([float(r[c]) for c in EO_SIGMA_COLUMNS[9:15]])
+        sig = np.array([float(r[c]) for c in RESECTION_EO_COLUMNS[9:15]])
         n = len(meas[r["image_id"]][0])
         ground = np.mean(meas[r["image_id"]][1], axis=0)
         k = Proj("EPSG:2154").get_factors(*to_geo.transform(*ground[:2])).meridional_scale
