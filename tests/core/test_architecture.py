@@ -386,4 +386,5 @@ def test_the_duplicate_counter_sees_a_copied_function(tmp_path):
     (src / "tests").mkdir()
     (src / "tests" / "mod.py").write_text(code, encoding="utf-8")  # outside: not counted
     count, rows = _duplicate_pairs(src, tmp_path)
-    assert count == 1 and len(rows) == 1 and "core/mod.py" in rows[0] and "plugin/mod.py" in rows[0], rows
+    assert count == 1 and len(rows) == 1, rows
+    assert "core/mod.py" in rows[0] and "plugin/mod.py" in rows[0], rows
