@@ -6,10 +6,15 @@ the image's side), 15 m up, the point 5, 35 and 50 degrees off the axis in three
 (kappa 10, -5, 182 degrees), rendered through the fisheye's own rays (2 x 2 rays a pixel,
 1 grey value of noise); the chip at 7.5 cm (the nadir GSD), 1 grey value of noise.
 
-Tolerances: within 0.12 px of the true point's projection: the 0.1 px of the perspective
-test (tests/core/test_matching.py) and the bias the affine template model leaves on a
-fisheye's curved image of the ground (0.01-0.05 px noise-free; measured with noise at most
-0.090 px). The perspective formula on the same camera predicts the point tens of pixels off.
+Tolerances: within 0.15 px of the true point's projection. The affine of least-squares
+matching cannot follow the fisheye's curved image of the ground over the template (0.06-0.24
+px off the affine 10 chip pixels from the point): the mean of that curvature over the template
+is taken off the match (core/photo/control_location.py, _curvature_shift), which leaves
+0.002-0.017 px noise-free (0.01-0.05 px without it). With the image noise the point 50
+degrees off the axis, where the ground is seen at 2-3 times the nadir GSD and its contrast
+is low, lands up to 0.112 px off (measured: 0.014-0.039 px at 5 and 35 degrees, 0.017-0.112 px
+at 50), several times LSM's own sigma there (0.006-0.010 px). The perspective formula on the
+same camera predicts the point tens of pixels off.
 """
 
 from __future__ import annotations
@@ -88,7 +93,7 @@ def scenes():
 
 @pytest.mark.parametrize("projection", FISHEYE_PROJECTIONS)
 def test_fisheye_control_located_at_the_true_point(scenes, projection):
-    """Measured: 0.020-0.090 px from the truth (equidistant 50 degrees the largest), LSM
+    """Measured: 0.014-0.112 px from the truth (equisolid 50 degrees the largest), LSM
     sigmas 0.006-0.017 px."""
     cam, images, eo, chip = scenes[projection]
     truth = _truth(eo, cam)
@@ -101,7 +106,7 @@ def test_fisheye_control_located_at_the_true_point(scenes, projection):
         # the prediction with the true EO is the true point's projection
         assert math.hypot(p.predicted_col - t[0], p.predicted_row - t[1]) < 1e-6
         err = math.hypot(p.col - t[0], p.row - t[1])
-        assert err < 0.12, (p.image_id, err)
+        assert err < 0.15, (p.image_id, err)
         assert 0 < p.sigma_col < 0.05 and p.lsm_correlation > 0.9
     assert res.observations.type == ("control",) * 3
 
@@ -125,7 +130,7 @@ def test_the_perspective_formula_predicts_fisheye_points_far_off(scenes, project
 
 def test_the_job_locates_control_in_fisheye_images(scenes, tmp_path):
     """locatecontrolpoints on files with an equisolid camera JSON: three observations within
-    0.12 px of the truth."""
+    0.15 px of the truth."""
     from lidarphoto.core.io.camera import write_camera_json
     from lidarphoto.core.io.observations import read_observations_csv
     from lidarphoto.core.io.orientation import write_eo_csv
@@ -154,4 +159,4 @@ def test_the_job_locates_control_in_fisheye_images(scenes, tmp_path):
     obs = read_observations_csv(tmp_path / "obs.csv")
     truth = _truth(eo, cam)
     for iid, px in zip(obs.image_id, obs.pixels):
-        assert np.hypot(*(px - truth[iid])) < 0.12, iid
+        assert np.hypot(*(px - truth[iid])) < 0.15, iid
