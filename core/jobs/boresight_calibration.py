@@ -616,7 +616,7 @@ def _settings(
     types = tuple(v.control_types)
     return {
         "camera": f"{cam.name} (f = {cam.focal_mm:g} mm, {cam.width_px} x {cam.height_px} px "
-        f"of {cam.pixel_size_mm * 1000:g} um)",
+        f"of {cam.pixel_size_mm * 1000:g} um, {cam.projection} projection)",
         "images": str(len(traj)),
         "observations": ", ".join(
             f"{t} {n}" for t, n in zip(*np.unique(np.array(obs.type), return_counts=True))

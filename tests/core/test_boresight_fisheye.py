@@ -262,6 +262,7 @@ def test_the_job_calibrates_a_fisheye_camera_json(tmp_path):
         "OUTPUT_EO": str(tmp_path / "eo.csv"),
     }  # fmt: skip
     run = run_job(boresight_calibration, raw).data
+    assert "equisolid projection" in run.settings["camera"]  # the HTML summary says so
     res = run.result
     err = res.boresight - sim.true_boresight(res.groups)
     assert np.all(np.abs(err) < 3.0 * res.std_prior), err / res.std_prior
