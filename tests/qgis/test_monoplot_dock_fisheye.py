@@ -87,3 +87,51 @@ def test_fisheye_monoplot_and_footprint_in_the_dock(qgis_parent, qgis_app, qgis_
     assert err.max() < 1e-6, err.max()
     assert {f["status_text"] for f in feats} == {"ok"}
     dock.close()
+
+
+def test_fisheye_boresight_calibration_from_the_dock(qgis_parent, qgis_app, provider,
+                                                     fisheye_block, fisheye_layers,  # noqa: F811
+                                                     tmp_path):  # fmt: skip
+    """The dock's Run (boresightcalibration through Processing) with the equisolid camera:
+    the simulated block's tie, line and LCP rows with 0.5 px of noise added (the INS
+    noise-free): every angle within 3 sigma (+0.5 arc-second) of the truth, the residual
+    RMS about the noise put in."""
+    import csv
+
+    from lidarphoto.core.io.observations import write_observations_csv
+    from lidarphoto.core.photo.boresight_setup import ARCSEC
+    from qgis.PyQt.QtCore import Qt
+    from qgis.PyQt.QtTest import QTest
+    from test_image_dock import _wait
+
+    b, sim = fisheye_block, fisheye_block["sim"]
+    o = sim.observations
+    rng = np.random.default_rng(8)
+    noisy = type(o)(o.image_id, o.point_id, o.pixels + rng.normal(0, 0.5, o.pixels.shape),
+                    o.sigma_px, o.type, o.target_id)  # fmt: skip
+    write_observations_csv(tmp_path / "measured.csv", noisy)
+    dock = _dock(qgis_parent, qgis_app, b, fisheye_layers, tmp_path, obs_name="measured.csv")
+    paths = b["paths"]
+    panel = dock.calibration_panel
+    panel.trajectory_edit.setFilePath(str(paths["trajectory"]))
+    panel.lever_edit.setText(",".join(repr(float(v)) for v in sim.mount.lever_arm))
+    panel.planes_csv_edit.setFilePath(str(paths["planes"]))
+    panel.lines_csv_edit.setFilePath(str(paths["lines"]))
+    panel.lcps_csv_edit.setFilePath(str(paths["lcps"]))
+    done: list = []
+    dock.calibrationFinished.connect(done.append)
+    QTest.mouseClick(panel.run_button, Qt.MouseButton.LeftButton)
+    assert _wait(qgis_app, lambda: bool(done), 120.0), "the calibration task did not finish"
+    assert done == [True], panel.result_label.text()
+    with open(dock.calibration.params["OUTPUT_TABLE"], encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    assert rows
+    for row in rows:
+        true = sim.truth.boresight[row["group"]] / ARCSEC
+        for k, angle in enumerate(("omega", "phi", "kappa")):
+            est, sd = float(row[f"d_{angle}_arcsec"]), float(row[f"std_d_{angle}_arcsec"])
+            assert abs(est - true[k]) < 3 * sd + 0.5, (angle, est, true[k], sd)
+    v = np.array([np.hypot(*x) for x in dock.session.residuals().values() if np.isfinite(x).all()])
+    assert v.size > 50
+    assert 0.2 < float(np.sqrt(np.mean(v**2))) < 1.2
+    dock.close()
