@@ -95,7 +95,8 @@ def test_fisheye_boresight_calibration_from_the_dock(qgis_parent, qgis_app, prov
     """The dock's Run (boresightcalibration through Processing) with the equisolid camera:
     the simulated block's tie, line and LCP rows with 0.5 px of noise added (the INS
     noise-free): every angle within 3 sigma (+0.5 arc-second) of the truth, the residual
-    RMS about the noise put in."""
+    RMS about the noise put in (measured: within 0.76 sigma, sigma0 1.011, residuals 0.575 px
+    RMS)."""
     import csv
 
     from lidarphoto.core.io.observations import write_observations_csv
