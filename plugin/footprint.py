@@ -16,7 +16,8 @@ else:  # QGIS 3.22-3.28 (scoped: PyQt6 has no unscoped enum values)
 
 
 class CanvasFootprint:
-    """Draws four ground corners (mapping CRS) on the canvas of ``iface`` (none: nothing)."""
+    """Draws an image's ground outline (mapping CRS) on the canvas of ``iface`` (none:
+    nothing): four corners for a perspective camera, the curved outline of a fisheye."""
 
     def __init__(self, iface, project) -> None:
         self.iface = iface
@@ -24,7 +25,8 @@ class CanvasFootprint:
         self.rubber_band: QgsRubberBand | None = None
 
     def show(self, corners: np.ndarray | None, crs) -> None:
-        """Draw the footprint ((4, 3) corners in ``crs``; None or NaN: cleared)."""
+        """Draw the footprint ((K, 3) vertices in ``crs``: 4 corners, or a fisheye's outline;
+        None or NaN: cleared)."""
         canvas = self.iface.mapCanvas() if self.iface is not None else None
         if canvas is None:
             return
@@ -34,12 +36,14 @@ class CanvasFootprint:
             self.rubber_band.setFillColor(QColor(255, 212, 0, 40))
             self.rubber_band.setWidth(2)
         self.rubber_band.reset(_POLYGON_GEOMETRY)
-        if corners is None or not np.isfinite(corners).all():
+        if corners is None or not np.isfinite(corners).all() or len(corners) < 3:
             return
+        vertices = np.asarray(corners, dtype=float)
         dest = canvas.mapSettings().destinationCrs()
         ct = QgsCoordinateTransform(crs, dest, self.project)
-        for k, (x, y, _z) in enumerate(corners):
-            self.rubber_band.addPoint(ct.transform(QgsPointXY(x, y)), k == 3)
+        last = len(vertices) - 1
+        for k, (x, y, _z) in enumerate(vertices):
+            self.rubber_band.addPoint(ct.transform(QgsPointXY(x, y)), k == last)
         self.rubber_band.show()
 
     def remove(self) -> None:

@@ -170,7 +170,9 @@ corners) and the single-image model of Pedrosa & dos Santos (2020) (paper, its E
 needs the cloud with plane ids). INS positions and attitudes are weighted observations (the
 INS grade); optionally the lever arm and the interior orientation are estimated. The
 adjustment runs in a local east-north-up frame with the rigorous navigation frame of each
-image.
+image. The camera may be perspective or fisheye (equidistant, equisolid-angle, orthographic,
+stereographic, Brown added, as Calibrate camera writes it): every ray and collinearity goes
+through its own projection.
 
 Inputs: camera JSON, trajectory CSV (as Trajectory to exterior orientation), the mount with
 the initial boresight (degrees), the image observation CSV (image_id, point_id, col, row,
@@ -447,6 +449,7 @@ def _read_inputs(v: Values, frame) -> tuple:
     import numpy as np
 
     from ..geometry.frames import check_area_of_use
+    from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.control import read_lcps_csv, read_lines_csv
     from ..io.ground_points import read_ground_points_csv
@@ -454,7 +457,7 @@ def _read_inputs(v: Values, frame) -> tuple:
     from ..io.planes import read_planes_csv
     from ..io.trajectory import read_trajectory_csv
 
-    cam = read_camera_json(v.camera)
+    cam = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     traj = read_trajectory_csv(v.trajectory)
     if not traj.geodetic:
         check_area_of_use(
@@ -613,7 +616,7 @@ def _settings(
     types = tuple(v.control_types)
     return {
         "camera": f"{cam.name} (f = {cam.focal_mm:g} mm, {cam.width_px} x {cam.height_px} px "
-        f"of {cam.pixel_size_mm * 1000:g} um)",
+        f"of {cam.pixel_size_mm * 1000:g} um, {cam.projection} projection)",
         "images": str(len(traj)),
         "observations": ", ".join(
             f"{t} {n}" for t, n in zip(*np.unique(np.array(obs.type), return_counts=True))

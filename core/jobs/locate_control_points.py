@@ -33,7 +33,9 @@ window: the EO sigmas (columns sigma_X .. sigma_kappa_deg of the EO CSV) propaga
 image, times 3; without them +-SEARCH_PX pixels. A match is rejected, with the reason, for a
 chip without texture, low correlation, no convergence, a sigma above MAX_SIGMA, a match
 outside the search ellipse or a template partly outside the image. With TRANSFER, images where
-the chip match failed are matched from the point's best image (image-to-image LSM).
+the chip match failed are matched from the point's best image (image-to-image LSM). The camera
+may be perspective or fisheye (equidistant, equisolid-angle, orthographic, stereographic,
+Brown added): the prediction and the chip-to-image affine come from its own projection.
 
 Output: the image-observation CSV (image_id, point_id, col, row, sigma_px, type control,
 empty target_id; point_id = the control point's id, also for the rows transferred from another
@@ -230,6 +232,7 @@ def _read_inputs(v: Values) -> tuple:
 
     from ..errors import InputError
     from ..geometry.frames import check_area_of_use, parse_crs
+    from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.chips import list_chips, read_control_chip
     from ..io.images import image_size, list_image_files
@@ -237,7 +240,7 @@ def _read_inputs(v: Values) -> tuple:
     from ..io.resection import read_point_control_csv
 
     crs = parse_crs(v.crs, what="CRS")
-    camera = read_camera_json(v.camera)
+    camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     eo_file = read_eo_csv_full(v.eo, crs.to_wkt())
     eo = eo_file.eo
     check_area_of_use(

@@ -178,7 +178,6 @@ def calibrate(
     BoresightNotObservable
         With a diagnosis naming what would make the parameters observable.
     """
-    camera.require_perspective("the boresight calibration")
     opts = options if options is not None else BoresightOptions()
     frame = crs if isinstance(crs, MappingFrame) else MappingFrame.from_user_input(crs)
     grade = _grade(opts.ins_grade)

@@ -30,6 +30,7 @@ from numpy.typing import NDArray
 
 from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians
+from ..geometry.projection import radius_derivative, theta_from_radius
 from ..geometry.rotations import matrix_to_opk, rx, ry, rz, skew
 
 Array = NDArray[np.float64]
@@ -165,17 +166,78 @@ def collinearity(
     return out["pixels"], j_pose, j_point
 
 
+def _camera_frame_ray(ideal: Array, f: float, projection: str) -> tuple[Array, Array, Array]:
+    """Camera-frame rays of ideal centred image points, with their derivatives.
+
+    Perspective: ``(x / f, y / f, -1)`` (camera-frame z of -1). Fisheye: the unit vector at the
+    angle ``theta(r)`` off the axis (:func:`core.geometry.projection.ray_from_ideal`), which
+    also holds beyond 90 degrees; the conditions that use the ray do not depend on its length.
+
+    Parameters
+    ----------
+    ideal : ndarray, shape (G, 2)
+        Ideal centred image coordinates, millimetres.
+    f : float
+        Principal distance, millimetres.
+    projection : str
+        The camera's projection (:data:`core.geometry.projection.PROJECTIONS`).
+
+    Returns
+    -------
+    rc : (G, 3)
+        The rays; NaN beyond a fisheye's field.
+    d_ideal : (G, 3, 2)
+        ``d rc / d ideal``, per millimetre.
+    d_f : (G, 3)
+        ``d rc / d f`` at fixed ideal coordinates, per millimetre.
+    """
+    g = ideal.shape[0]
+    if projection == "perspective":
+        rc = np.column_stack([ideal / f, -np.ones(g)])
+        d_ideal = np.zeros((g, 3, 2))
+        d_ideal[:, 0, 0] = d_ideal[:, 1, 1] = 1.0 / f
+        d_f = np.zeros((g, 3))
+        d_f[:, :2] = -ideal / f**2
+        return rc, d_ideal, d_f
+    r = np.hypot(ideal[:, 0], ideal[:, 1])
+    theta = theta_from_radius(r / f, projection)
+    # d theta / d r = 1 / (f g'(theta)); every fisheye g has g'(0) = 1
+    t_r = 1.0 / (f * radius_derivative(theta, projection))
+    sin, cos = np.sin(theta), np.cos(theta)
+    axis = r <= 1e-12 * f
+    rs = np.where(axis, 1.0, r)
+    s = np.where(axis, 1.0 / f, sin / rs)  # rc_xy = s (x, y)
+    # (d s / d r) / r, which tends to a finite limit on the axis: its term vanishes there
+    ds_r = np.where(axis, 0.0, (cos * t_r * rs - sin) / rs**3)
+    rc = np.column_stack([ideal * s[:, None], -cos])
+    d_ideal = np.empty((g, 3, 2))
+    d_ideal[:, :2, :] = s[:, None, None] * np.eye(2) + ds_r[:, None, None] * (
+        ideal[:, :, None] * ideal[:, None, :]
+    )
+    d_ideal[:, 2, :] = (sin * t_r / rs)[:, None] * ideal
+    d_ideal[axis, 2, :] = ideal[axis] / f**2  # sin(theta) / r -> 1 / f, theta_r -> 1 / f
+    # theta depends on r / f: d theta / d f = -(r / f) d theta / d r
+    t_f = -r * t_r / f
+    d_f = np.column_stack([ideal * (cos * t_f / rs)[:, None], sin * t_f])
+    d_f[axis, :2] = -ideal[axis] / f**2
+    return rc, d_ideal, d_f
+
+
 def camera_ray(
     xp: Array, pixels: Array, r_nl: Array, spec: PoseSpec
 ) -> tuple[Array, Array, Array, Array, Array, Array]:
     """Object-space rays of measured pixels, with derivatives.
+
+    The camera's own projection (perspective or fisheye, :func:`_camera_frame_ray`) turns the
+    ideal image point into the camera-frame ray.
 
     Returns
     -------
     centre : (G, 3)
         Perspective centres.
     ray : (G, 3)
-        ``R_c^l (x_i / f, y_i / f, -1)``: not unit, its camera-frame z is -1.
+        ``R_c^l rc``: for a perspective camera ``rc = (x_i / f, y_i / f, -1)`` (not unit, its
+        camera-frame z is -1); for a fisheye one the unit ray.
     d_centre : (G, 3, P)
     d_ray_pose : (G, 3, P)
         d ray / d xp (interior included).
@@ -190,19 +252,18 @@ def camera_ray(
     measured = cam.pixel_to_image(pixels) - np.array([cam.x0_mm, cam.y0_mm])
     ideal = cam.distortion.undistort(measured)
     g = pixels.shape[0]
-    rc = np.column_stack([ideal / f, -np.ones(g)])
+    rc, drc_di, drc_df = _camera_frame_ray(ideal, f, cam.projection)
     ray = np.einsum("gij,gj->gi", r_cl, rc)
     d_ray_pose = np.einsum("gkij,gj->gik", d_rot, rc)
     jd = np.eye(2) + cam.distortion.jacobian_xy(measured)  # d ideal / d measured
-    drc_dpx = np.zeros((g, 3, 2))
-    drc_dpx[:, :2, 0] = jd[:, :, 0] * ps / f
-    drc_dpx[:, :2, 1] = -jd[:, :, 1] * ps / f
-    d_ray_px = r_cl @ drc_dpx
+    drc_dm = drc_di @ jd  # d rc / d measured
+    d_measured_d_px = np.array([[ps, 0.0], [0.0, -ps]])
+    d_ray_px = r_cl @ (drc_dm @ d_measured_d_px)
     if spec.estimate_interior:
         drc = np.zeros((g, 3, 3))
-        drc[:, :2, 0] = -ideal / f**2
-        drc[:, :2, 1] = -jd[:, :, 0] / f
-        drc[:, :2, 2] = -jd[:, :, 1] / f
+        drc[:, :, 0] = drc_df
+        drc[:, :, 1] = -drc_dm[:, :, 0]  # measured = image - x0
+        drc[:, :, 2] = -drc_dm[:, :, 1]
         d_ray_pose[:, :, -3:] += r_cl @ drc
     return centre, ray, d_centre, d_ray_pose, d_ray_px, r_cl
 
@@ -220,7 +281,8 @@ def coplanarity(
     Returns
     -------
     g : (G,)
-        Misclosure, m (the ray's camera-frame z is -1).
+        Misclosure, m (the ray of :func:`camera_ray`: camera-frame z of -1, or unit for a
+        fisheye camera; the Gauss-Helmert solution does not depend on its scale).
     j_pose : (G, P); j_px : (G, 2); j_point : (G, 3); j_dir : (G, 3)
         Its derivatives.
     """

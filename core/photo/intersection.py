@@ -132,7 +132,7 @@ def ground_positions(
     ok = img >= 0
     centres, m = eo_map_to_local(result.eo.xyz, result.eo.opk, local)
     ideal = cam.ideal_from_pixel(observations.pixels)
-    ray_c = np.column_stack([ideal, np.full(n, -cam.focal_mm)])
+    ray_c = cam.ray_from_ideal(ideal)  # the camera's own projection (perspective or fisheye)
     safe = np.where(ok, img, 0)
     c = centres[safe]
     d = np.einsum("nji,nj->ni", m[safe], ray_c)

@@ -42,6 +42,8 @@ from .orientation import ExteriorOrientationTable, eo_map_to_local
 
 __all__ = [
     "CHORD_TOL_PX",
+    "FOOTPRINT_BORDER_POINTS",
+    "FOOTPRINT_RANGE",
     "PickingScene",
     "PlaneCandidate",
     "nearest_point",
@@ -52,6 +54,11 @@ __all__ = [
 
 Array = NDArray[np.float64]
 
+#: border pixels a side of a fisheye image's footprint (:meth:`PickingScene.footprint`)
+FOOTPRINT_BORDER_POINTS = 64
+#: farthest ground of a fisheye footprint, in heights of the centre above the ground (84
+#: degrees below the horizontal)
+FOOTPRINT_RANGE = 10.0
 #: largest distance of a fisheye polyline from the exact image of its 3-D segment, pixels
 CHORD_TOL_PX = 0.25
 #: longest piece of a segment before the chord test, radians seen from the centre (so that a
@@ -554,18 +561,56 @@ class PickingScene:
         return {others[k]: px[k] for k in np.flatnonzero(keep)}
 
     def footprint(self, image_id: str, height: float) -> Array:
-        """Ground footprint of an image: its four corners cut with the level surface at
-        ``height`` (mapping CRS heights), (4, 3) mapping CRS, clockwise from the top-left."""
+        """Ground footprint of an image on the level surface at ``height`` (mapping CRS
+        heights), mapping CRS, clockwise from the top-left corner of the image.
+
+        Perspective camera: its four corners, (4, 3). Fisheye camera, whose border curves on
+        the ground: :data:`FOOTPRINT_BORDER_POINTS` pixels a side, (4 K, 3); a border pixel
+        beyond the projection's field, or whose ray meets the ground farther than
+        :data:`FOOTPRINT_RANGE` times the height of the centre above it (at or past the
+        horizon for a lens of more than 180 degrees), is moved towards the principal point
+        to where its ray reaches that range: the outline then bounds the part of the field
+        of view that reaches the ground. Rows that find no ground are NaN.
+        """
         w, h = self.camera.width_px, self.camera.height_px
         corners = np.array([[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]])
-        origin, direction = self.rays(image_id, corners)
+        if self.camera.is_perspective:
+            return self._level_hits(image_id, corners, height, np.inf)[0]
+        from .tie_pairs import _border
+
+        pixels = _border(w, h, FOOTPRINT_BORDER_POINTS)
+        out, far = self._level_hits(image_id, pixels, height, FOOTPRINT_RANGE)
+        if far.any():
+            pp = np.asarray(self.camera.principal_point_px, np.float64)
+            lo = np.zeros(int(far.sum()))  # fractions of the way to the border that reach
+            hi = np.ones_like(lo)
+            for _ in range(40):  # bisection: 1e-12 of the distance to the border
+                mid = 0.5 * (lo + hi)
+                _, miss = self._level_hits(
+                    image_id, pp + mid[:, None] * (pixels[far] - pp), height, FOOTPRINT_RANGE
+                )
+                lo, hi = np.where(miss, lo, mid), np.where(miss, mid, hi)
+            moved = pp + lo[:, None] * (pixels[far] - pp)
+            out[far] = self._level_hits(image_id, moved, height, np.inf)[0]
+        return out
+
+    def _level_hits(
+        self, image_id: str, pixels: Array, height: float, max_range: float
+    ) -> tuple[Array, NDArray[np.bool_]]:
+        """Rays of ``pixels`` (K, 2) cut with the level surface at ``height``: the points
+        (K, 3) mapping CRS (NaN where none) and where the ray has none within ``max_range``
+        times the centre's height above the surface (horizontally, tangent plane)."""
+        origin, direction = self.rays(image_id, pixels)
         # the level surface through a point below the centre, as a plane in the local frame
         below = self.local.enu_to_map(origin[:1])[0].copy()
+        depth = abs(below[2] - height)
         below[2] = height
         nl, q0 = self._planes_local([[0.0, 0.0, 1.0]], [below])
         with np.errstate(invalid="ignore", divide="ignore"):
             t = ((q0 - origin) @ nl[0]) / (direction @ nl[0])
         t = np.where(t > 0, t, np.nan)
+        reach = t * np.linalg.norm(direction - np.outer(direction @ nl[0], nl[0]), axis=1)
+        far = ~(reach <= max_range * depth)
         hit = origin + t[:, None] * direction
         # the tangent plane drops below the level surface away from the nadir (8 cm at 1 km):
         # a few Newton steps along each ray on the mapping-CRS height
@@ -576,8 +621,8 @@ class PickingScene:
             dz = self.local.enu_to_map(hit[good])[:, 2] - height
             t[good] -= dz / (direction[good] @ nl[0])
             hit = origin + t[:, None] * direction
-        out = np.full((4, 3), np.nan)
+        out = np.full((len(pixels), 3), np.nan)
         good = np.isfinite(hit).all(axis=1)
         if good.any():
             out[good] = self.local.enu_to_map(hit[good])
-        return out
+        return out, far

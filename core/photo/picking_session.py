@@ -221,7 +221,8 @@ class PickingSession:
         )
 
     def footprint(self, image_id: str) -> Array | None:
-        """(4, 3) ground corners of an image at the control's mean height, or None."""
+        """Ground footprint of an image at the control's mean height (mapping CRS; 4 corners,
+        or a fisheye's (4 K, 3) outline: :meth:`.picking.PickingScene.footprint`), or None."""
         if not self.oriented(image_id):
             return None
         return self.scene.footprint(image_id, self.control.ground_height())  # type: ignore[union-attr]

@@ -87,11 +87,20 @@ def render_plane_image(
     px = np.column_stack([cc.ravel(), rr.ravel()])
     o, d = image_rays(px, eo6, camera)
     z_loc = local.map_to_enu([[centre[0, 0], centre[0, 1], z0]])[0, 2]
-    t = (z_loc - o[:, 2]) / d[:, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (z_loc - o[:, 2]) / d[:, 2]
+    # rays that miss the plane (at or above the horizon, or beyond a fisheye's field) and those
+    # meeting it more than 10 flying heights away (84 degrees below the horizontal: the
+    # quadratic map fit below would lose its precision) see a black sky
+    ground = np.isfinite(t) & (t > 0)
+    reach = np.hypot(d[:, 0], d[:, 1]) * np.where(ground, t, 0.0)
+    ground &= reach <= 10.0 * abs(float(z_loc - o[0, 2]))
+    t = np.where(ground, t, 0.0)
+    d = np.where(ground[:, None], d, 0.0)
     hit = o + t[:, None] * d
     # local -> map is smooth over an image footprint: a quadratic fitted on an 11 x 11 grid of
     # exact transformations (residuals far below a micrometre) replaces millions of PROJ calls.
-    lo, hi = hit[:, :2].min(axis=0), hit[:, :2].max(axis=0)
+    lo, hi = hit[ground, :2].min(axis=0), hit[ground, :2].max(axis=0)
     ge, gn = np.meshgrid(np.linspace(lo[0], hi[0], 11), np.linspace(lo[1], hi[1], 11))
     grid = np.column_stack([ge.ravel(), gn.ravel(), np.full(ge.size, z_loc)])
     exact = local.enu_to_map(grid)
@@ -105,13 +114,15 @@ def render_plane_image(
     # d map / d local-up is 1 to first order: the map height of a hit differs from z0 by
     # micrometres to millimetres, corrected along the ray.
     zmap = design(hit[:, 0], hit[:, 1]) @ coef[:, 2] + (hit[:, 2] - z_loc)
-    t = t + (z0 - zmap) / d[:, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(ground, t + (z0 - zmap) / d[:, 2], 0.0)
     hit = o + t[:, None] * d
     m = design(hit[:, 0], hit[:, 1]) @ coef
     if texture is None:
         grey = np.full(len(m), float(flat_value if flat_value is not None else 100.0))
     else:
         grey = texture.at(m[:, 0], m[:, 1])
+    grey = np.where(ground, grey, 0.0)
     img = grey.reshape(h * s, w * s).reshape(h, s, w, s).mean(axis=(1, 3))
     if noise > 0:
         img = img + np.random.default_rng(seed).normal(0, noise, img.shape)

@@ -319,25 +319,14 @@ def test_fisheye_calibration_on_real_views_matches_boofcv():
     assert np.max(np.abs(ours - mei)) < 3.0
 
 
-def test_perspective_only_algorithms_refuse_a_fisheye_camera():
-    """Their kernels are perspective-only: a fisheye camera is refused, never treated as a
-    perspective one (the readers of the jobs refuse it first, naming the file)."""
-    import inspect
-
-    from lidarphoto.core.photo.boresight import calibrate
-
-    # the resection takes fisheye control points (its lines stay perspective-only, refused by
-    # name): tests/core/test_resection_fisheye.py; the bundle adjustment, monoplotting and
-    # orthophotos take fisheye cameras: tests/core/test_bundle_fisheye.py,
-    # tests/core/test_monoplot_fisheye.py, tests/core/test_orthophoto_fisheye.py
+def test_perspective_only_kernels_refuse_a_fisheye_camera():
+    """A perspective-only kernel refuses a fisheye camera by name (Camera.require_perspective),
+    never treating it as a perspective one. Every algorithm now takes fisheye cameras but the
+    resection's straight lines (tests/core/test_bundle_fisheye.py): the bundle adjustment,
+    resection from points, monoplotting, orthophotos, tie points, the boresight calibration
+    and control location (tests/core/test_*_fisheye.py, test_locate_fisheye.py)."""
     cam = _camera("equisolid")
-    for func, who in ((calibrate, "the boresight calibration"),):
-        params = inspect.signature(func).parameters
-        kwargs = {n: None for n, p in params.items()
-                  if p.default is inspect.Parameter.empty and n not in ("self", "cls")}  # fmt: skip
-        if "cameras" in kwargs:
-            kwargs["cameras"] = [cam]
-        else:
-            kwargs["camera"] = cam
-        with pytest.raises(InputError, match=f"equisolid \\(fisheye\\) projection; {who} handles"):
-            func(**kwargs)
+    who = "the resection from straight lines"
+    with pytest.raises(InputError, match=f"equisolid \\(fisheye\\) projection; {who} handles"):
+        cam.require_perspective(who)
+    _camera("perspective").require_perspective(who)  # no error
