@@ -91,6 +91,10 @@
             <translation>CHIPS = um recorte (chip) GeoTIFF por ponto de controle, CONTROL_POINTS, CAMERA, EO aproximada, IMAGES; OUTPUT = as observações de imagem dos pontos de controle, sem clicar neles</translation>
         </message>
         <message>
+            <source>INPUT = the classified cloud; OUTPUT_CSV = the plane table, OUTPUT_CLOUD = the cloud with plane_id</source>
+            <translation>INPUT = a nuvem classificada; OUTPUT_CSV = a tabela de planos, OUTPUT_CLOUD = a nuvem com plane_id</translation>
+        </message>
+        <message>
             <source>Boresight calibration with LiDAR control (Pedrosa &amp; dos Santos 2020)</source>
             <translation>Calibração de boresight com controle LiDAR (Pedrosa &amp; dos Santos 2020)</translation>
         </message>
@@ -149,10 +153,6 @@
         <message>
             <source>INPUT = the LAS/LAZ; OUTPUT_CLOUD = the cloud classified into ground (2) and non-ground</source>
             <translation>INPUT = o LAS/LAZ; OUTPUT_CLOUD = a nuvem classificada em terreno (2) e não terreno</translation>
-        </message>
-        <message>
-            <source>INPUT = the classified cloud; OUTPUT_CSV = the plane table, OUTPUT_CLOUD = the cloud with plane_id</source>
-            <translation>INPUT = a nuvem classificada; OUTPUT_CSV = a tabela de planos, OUTPUT_CLOUD = a nuvem com plane_id</translation>
         </message>
         <message>
             <source>PLANES and CLOUD = the two outputs of extractroofplanes; POINTS_CSV and LINES_CSV = LiDAR control points and lines</source>
@@ -2379,10 +2379,6 @@
             <translation>não observável: {}</translation>
         </message>
         <message>
-            <source>at most {bound} ({expected} expected); {k} rejected: P = {p}</source>
-            <translation>no máximo {bound} ({expected} esperadas); {k} rejeitadas: P = {p}</translation>
-        </message>
-        <message>
             <source>Lens correction: {}</source>
             <translation>Correção da lente: {}</translation>
         </message>
@@ -2497,6 +2493,10 @@
         <message>
             <source>These results FAILED their checks and were written only because the user asked for them (ACCEPT_DOUBTFUL): do not use them without review.</source>
             <translation>Estes resultados FALHARAM nas verificações e foram gravados apenas porque o usuário os pediu (ACCEPT_DOUBTFUL): não os use sem revisão.</translation>
+        </message>
+        <message>
+            <source>at most {bound} ({expected} expected); {k} rejected: P = {p}</source>
+            <translation>no máximo {bound} ({expected} esperadas); {k} rejeitadas: P = {p}</translation>
         </message>
         <message>
             <source>distance from the principal point (px)</source>
@@ -3948,7 +3948,9 @@ corners) and the single-image model of Pedrosa &amp; dos Santos (2020) (paper, i
 needs the cloud with plane ids). INS positions and attitudes are weighted observations (the
 INS grade); optionally the lever arm and the interior orientation are estimated. The
 adjustment runs in a local east-north-up frame with the rigorous navigation frame of each
-image.</source>
+image. The camera may be perspective or fisheye (equidistant, equisolid-angle, orthographic,
+stereographic, Brown added, as Calibrate camera writes it): every ray and collinearity goes
+through its own projection.</source>
             <translation>Estima o desalinhamento angular (boresight) entre a câmera e o INS, por grupo de imagens, a
 partir de pontos de imagem sobre telhados cuja geometria vem do LiDAR: pontos de enlace com
 restrição de plano (um ponto de telhado em duas ou mais imagens situado sobre o seu plano
@@ -3957,7 +3959,9 @@ pontos de controle LiDAR (lcp, cantos de três planos) e o modelo de imagem úni
 dos Santos (2020) (paper, suas Eqs. 12-17; requer a nuvem com os identificadores de plano). As
 posições e atitudes do INS são observações ponderadas (a classe do INS); opcionalmente, o braço
 de alavanca e a orientação interior são estimados. O ajustamento é feito em um referencial
-local leste-norte-acima, com o referencial de navegação rigoroso de cada imagem.</translation>
+local leste-norte-acima, com o referencial de navegação rigoroso de cada imagem. A câmera pode ser perspectiva ou olho de peixe (equidistante, de ângulo equissólido,
+orthográfica, estereográfica, com Brown acrescentado, como Calibrar câmera a escreve): cada raio e
+cada colinearidade passam pela sua própria projeção.</translation>
         </message>
         <message>
             <source>Inputs: camera JSON, trajectory CSV (as Trajectory to exterior orientation), the mount with
@@ -4255,6 +4259,26 @@ e cada uma começa com um aviso (CSV: linhas de comentário iniciadas por #).</t
         <message>
             <source>Sigma of the timing offset (ms)</source>
             <translation>Desvio-padrão do atraso de disparo (ms)</translation>
+        </message>
+        <message>
+            <source>Estimates the angular misalignment (boresight) between the camera and the INS, per group of
+images, from image points on roofs whose geometry comes from LiDAR: plane-constrained tie
+points (a roof point in two or more images lying on its LiDAR plane), points on LiDAR
+ridge/hip lines (coplanarity, one image suffices), LiDAR control points (lcp, three-plane
+corners) and the single-image model of Pedrosa &amp; dos Santos (2020) (paper, its Eqs. 12-17;
+needs the cloud with plane ids). INS positions and attitudes are weighted observations (the
+INS grade); optionally the lever arm and the interior orientation are estimated. The
+adjustment runs in a local east-north-up frame with the rigorous navigation frame of each
+image.</source>
+            <translation type="vanished">Estima o desalinhamento angular (boresight) entre a câmera e o INS, por grupo de imagens, a
+partir de pontos de imagem sobre telhados cuja geometria vem do LiDAR: pontos de enlace com
+restrição de plano (um ponto de telhado em duas ou mais imagens situado sobre o seu plano
+LiDAR), pontos sobre linhas de cumeeira/espigão do LiDAR (coplanaridade; uma imagem basta),
+pontos de controle LiDAR (lcp, cantos de três planos) e o modelo de imagem única de Pedrosa &amp;
+dos Santos (2020) (paper, suas Eqs. 12-17; requer a nuvem com os identificadores de plano). As
+posições e atitudes do INS são observações ponderadas (a classe do INS); opcionalmente, o braço
+de alavanca e a orientação interior são estimados. O ajustamento é feito em um referencial
+local leste-norte-acima, com o referencial de navegação rigoroso de cada imagem.</translation>
         </message>
     </context>
     <context>
@@ -7222,7 +7246,9 @@ window: the EO sigmas (columns sigma_X .. sigma_kappa_deg of the EO CSV) propaga
 image, times 3; without them +-SEARCH_PX pixels. A match is rejected, with the reason, for a
 chip without texture, low correlation, no convergence, a sigma above MAX_SIGMA, a match
 outside the search ellipse or a template partly outside the image. With TRANSFER, images where
-the chip match failed are matched from the point's best image (image-to-image LSM).</source>
+the chip match failed are matched from the point's best image (image-to-image LSM). The camera
+may be perspective or fisheye (equidistant, equisolid-angle, orthographic, stereographic,
+Brown added): the prediction and the chip-to-image affine come from its own projection.</source>
             <translation>Cada ponto de controle é projetado em cada imagem com a sua orientação exterior; o seu recorte (chip)
 de controle (um GeoTIFF com o norte para cima do terreno em torno do ponto, retificado sobre o plano Z = Z_point,
 nome do arquivo = id do ponto) é buscado ali por correlação cruzada normalizada com um tamanho de
@@ -7233,7 +7259,9 @@ de busca: os sigmas da EO (colunas sigma_X .. sigma_kappa_deg do CSV da EO) prop
 imagem, vezes 3; sem eles, +-SEARCH_PX pixels. Uma correspondência é rejeitada, com o motivo, para um
 recorte sem textura, correlação baixa, ausência de convergência, um sigma acima de MAX_SIGMA, uma correspondência
 fora da elipse de busca ou um modelo parcialmente fora da imagem. Com TRANSFER, as imagens em que
-a correspondência do recorte falhou são correspondidas a partir da melhor imagem do ponto (LSM imagem a imagem).</translation>
+a correspondência do recorte falhou são correspondidas a partir da melhor imagem do ponto (LSM imagem a imagem). A câmera pode
+ser perspectiva ou olho de peixe (equidistante, de ângulo equissólido, ortográfica, estereográfica,
+com Brown acrescentado): a predição e a afinidade recorte-imagem vêm da sua própria projeção.</translation>
         </message>
         <message>
             <source>Output: the image-observation CSV (image_id, point_id, col, row, sigma_px, type control,
@@ -7354,6 +7382,30 @@ o relatório HTML mostra os recortes.</translation>
         <message>
             <source>Point-image pairs rejected</source>
             <translation>Pares ponto-imagem rejeitados</translation>
+        </message>
+        <message>
+            <source>Each control point is projected into each image with its exterior orientation; its control
+chip (a north-up GeoTIFF of the ground around the point, rectified onto the plane Z = Z_point,
+file name = point id) is searched there by normalised cross-correlation with an adaptive
+template size (grown until the predicted least-squares precision from the texture, Förstner
+1986, passes), then refined by least-squares matching (Gruen 1985: 6 affine + 2 radiometric
+parameters) from the chip's pixels with the local chip-to-image affine as start. Search
+window: the EO sigmas (columns sigma_X .. sigma_kappa_deg of the EO CSV) propagated to the
+image, times 3; without them +-SEARCH_PX pixels. A match is rejected, with the reason, for a
+chip without texture, low correlation, no convergence, a sigma above MAX_SIGMA, a match
+outside the search ellipse or a template partly outside the image. With TRANSFER, images where
+the chip match failed are matched from the point's best image (image-to-image LSM).</source>
+            <translation type="vanished">Cada ponto de controle é projetado em cada imagem com a sua orientação exterior; o seu recorte (chip)
+de controle (um GeoTIFF com o norte para cima do terreno em torno do ponto, retificado sobre o plano Z = Z_point,
+nome do arquivo = id do ponto) é buscado ali por correlação cruzada normalizada com um tamanho de
+modelo (template) adaptativo (aumentado até que a precisão prevista por mínimos quadrados a partir da textura, Förstner
+1986, seja aceita), e então refinado por correspondência por mínimos quadrados (Gruen 1985: 6 parâmetros afins + 2 radiométricos)
+a partir dos pixels do recorte, com a afinidade local recorte-imagem como valor inicial. Janela
+de busca: os sigmas da EO (colunas sigma_X .. sigma_kappa_deg do CSV da EO) propagados para a
+imagem, vezes 3; sem eles, +-SEARCH_PX pixels. Uma correspondência é rejeitada, com o motivo, para um
+recorte sem textura, correlação baixa, ausência de convergência, um sigma acima de MAX_SIGMA, uma correspondência
+fora da elipse de busca ou um modelo parcialmente fora da imagem. Com TRANSFER, as imagens em que
+a correspondência do recorte falhou são correspondidas a partir da melhor imagem do ponto (LSM imagem a imagem).</translation>
         </message>
         <message>
             <source>Output: the image-observation CSV (image_id, point_id, col, row, sigma_px, type tie, empty
