@@ -171,6 +171,7 @@ def collinearity_jacobians(
     max_iter: int = DEFAULT_MAX_ITER,
     image_index: ArrayLike | None = None,
     compiled: bool = True,
+    out: Array | None = None,
 ) -> Dict[str, Any]:
     """Predicted measured pixels and their analytic Jacobians.
 
@@ -196,6 +197,10 @@ def collinearity_jacobians(
         kernels of :mod:`.collinearity_numba` in one pass over the rays, the lens model in
         numpy as here; equal to this numpy path to rounding. False: the numpy path (the
         reference; fisheye projections always take it).
+    out : (N, 2, K) ndarray, K >= 9, optional
+        Receives the EO Jacobian in its columns 0-5 and the point Jacobian in 6-8 (both
+        computed, whatever ``wrt``); the returned ``"eo"`` and ``"point"`` are then views of
+        it (a bundle's model writes its Jacobian in place, no copy of the batch).
 
     Returns
     -------
@@ -225,9 +230,11 @@ def collinearity_jacobians(
         raise ValueError(f"wrt: unknown Jacobian(s) {unknown}; use 'eo', 'point', 'interior'")
 
     if image_index is not None and compiled and camera.projection == "perspective":
-        fast = _compiled_jacobians(points, eo, image_index, camera, wanted, tol_px, max_iter)
+        fast = _compiled_jacobians(points, eo, image_index, camera, wanted, tol_px, max_iter, out)
         if fast is not None:
             return fast
+    if out is not None:
+        wanted = tuple(dict.fromkeys((*wanted, "eo", "point")))
     if image_index is None:
         e, d, rot, q = _to_camera_frame(points, eo)
         per_image = None
@@ -247,7 +254,7 @@ def collinearity_jacobians(
         ideal, in_front = _ideal(q, camera)
     measured, converged = camera.measured_from_ideal(ideal, tol_px=tol_px, max_iter=max_iter)
     pixels = camera.image_to_pixel(measured + np.array([camera.x0_mm, camera.y0_mm]))
-    out: Dict[str, Any] = {"pixels": pixels, "in_front": in_front, "converged": converged}
+    res: Dict[str, Any] = {"pixels": pixels, "in_front": in_front, "converged": converged}
 
     # S G: d pixel / d ideal, (N, 2, 2); the lens Jacobian is taken at the measured point.
     sg = inv2x2(np.eye(2) + camera.distortion.jacobian_xy(measured))
@@ -258,7 +265,7 @@ def collinearity_jacobians(
         dpx_dq = sg @ a
         dpx_dpoint = dpx_dq @ rot
         if "point" in wanted:
-            out["point"] = dpx_dpoint
+            res["point"] = dpx_dpoint
         if "eo" in wanted:
             if per_image is None:
                 dm = opk_derivatives(e[:, 3], e[:, 4], e[:, 5])  # (N, 3 angles, 3, 3)
@@ -269,17 +276,21 @@ def collinearity_jacobians(
                 dq_dangles = np.empty((d.shape[0], 3, 3))
                 for k in range(3):
                     dq_dangles[:, :, k] = np.einsum("nij,nj->ni", dm_img[per_image, k], d)
-            out["eo"] = np.concatenate([-dpx_dpoint, dpx_dq @ dq_dangles], axis=2)
+            res["eo"] = np.concatenate([-dpx_dpoint, dpx_dq @ dq_dangles], axis=2)
 
     if "interior" in wanted:
-        out["interior"] = _interior_jacobian(camera, sg, ideal, measured)
-        out["interior_names"] = camera.interior_names
+        res["interior"] = _interior_jacobian(camera, sg, ideal, measured)
+        res["interior_names"] = camera.interior_names
 
     valid = in_front & converged
     for key in ("eo", "point", "interior"):
-        if key in out:
-            out[key][~valid] = np.nan
-    return out
+        if key in res:
+            res[key][~valid] = np.nan
+    if out is not None:
+        out[:, :, :6] = res["eo"]
+        out[:, :, 6:9] = res["point"]
+        res["eo"], res["point"] = out[:, :, :6], out[:, :, 6:9]
+    return res
 
 
 def _interior_jacobian(camera: Camera, sg: Array, ideal: Array, measured: Array) -> Array:
@@ -307,6 +318,7 @@ def _compiled_jacobians(
     wanted: Tuple[str, ...],
     tol_px: float,
     max_iter: int,
+    into: Array | None = None,
 ) -> Dict[str, Any] | None:
     """:func:`collinearity_jacobians` of a perspective camera with ``image_index``: the
     geometry compiled (:mod:`.collinearity_numba`), the lens model in numpy; None without
@@ -335,15 +347,15 @@ def _compiled_jacobians(
         sg[:, 0, :] /= ps
         sg[:, 1, :] /= -ps
     valid = in_front & converged
-    if "eo" in wanted or "point" in wanted:
+    if "eo" in wanted or "point" in wanted or into is not None:
         drot = opk_derivatives(eo_img[:, 3], eo_img[:, 4], eo_img[:, 5])
-        jac = perspective_jacobians(p, eo_img, rot, drot, per_image, f, sg, valid)
+        jac = perspective_jacobians(p, eo_img, rot, drot, per_image, f, sg, valid, into)
         if jac is None:
             return None
-        if "eo" in wanted:
+        if "eo" in wanted or into is not None:
             out["eo"] = jac[:, :, :6]
-        if "point" in wanted:
-            out["point"] = jac[:, :, 6:]
+        if "point" in wanted or into is not None:
+            out["point"] = jac[:, :, 6:9]
     if "interior" in wanted:
         full = np.broadcast_to(sg, (n, 2, 2))
         out["interior"] = _interior_jacobian(camera, full, ideal, measured)

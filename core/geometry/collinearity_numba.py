@@ -119,13 +119,15 @@ def perspective_jacobians(
     focal_mm: float,
     sg: Array,
     ok: NDArray[np.bool_],
+    out: Array | None = None,
 ) -> Array | None:
     """d pixel / d (X0, Y0, Z0, omega, phi, kappa, X, Y, Z), (N, 2, 9) px/m and px/rad.
 
     ``drot`` (M, 3, 3, 3): d M / d (omega, phi, kappa) per image
     (:func:`core.geometry.rotations.opk_derivatives`); ``sg`` d pixel / d ideal (px/mm),
     (N, 2, 2) per ray or (1, 2, 2) for all (a camera without lens distortion); rows where
-    ``ok`` is False are NaN. None without numba.
+    ``ok`` is False are NaN. ``out`` (N, 2, K >= 9): written in its first 9 columns and
+    returned (else a new array). None without numba.
     """
     from ..compiled import compiled_kernel  # numba imported here: this module stays light
 
@@ -136,7 +138,9 @@ def perspective_jacobians(
     sg = np.ascontiguousarray(sg, dtype=np.float64).reshape(-1, 2, 2)
     if sg.shape[0] not in (1, n):
         raise ValueError(f"sg must have 1 or {n} rows, got {sg.shape[0]}")
-    jac = np.empty((n, 2, 9))
+    jac = np.empty((n, 2, 9)) if out is None else out
+    if jac.shape[0] != n or jac.shape[1] != 2 or jac.shape[2] < 9 or jac.dtype != np.float64:
+        raise ValueError(f"out must be a float64 array of shape ({n}, 2, >= 9), got {jac.shape}")
     kernel(
         np.ascontiguousarray(points, dtype=np.float64),
         np.ascontiguousarray(eo_img, dtype=np.float64),

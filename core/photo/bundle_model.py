@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import compiled
 from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians
 from ..geometry.rotations import matrix_to_opk, opk_derivatives, opk_to_matrix
@@ -114,8 +115,16 @@ class _ImageModel:
             cam = cam.with_interior(full)
         n = xl.shape[0]
         eo = xl[self.first, :6]
-        pixels = np.empty((n, 2))
         jac = np.empty((n, 2, 9 + self.free.size))
+        if cam.projection == "perspective" and compiled.AVAILABLE:
+            # the compiled geometry has no per-ray temporaries beyond (n, 2) ones and writes
+            # the EO and point columns in place: the whole batch at once
+            out = collinearity_jacobians(xl[:, 6:9], eo, cam, wrt=wrt, image_index=self.inv,
+                                         out=jac)  # fmt: skip
+            if self.free.size:
+                jac[:, :, 9:] = out["interior"][:, :, self.free]
+            return out["pixels"], jac
+        pixels = np.empty((n, 2))
         # in chunks of groups: the projection's per-ray temporaries (rotations, partial
         # derivatives: some 700 bytes a ray) stay bounded; every row is computed alone
         for s in range(0, n, _CHUNK):

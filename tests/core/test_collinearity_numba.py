@@ -119,3 +119,20 @@ def test_eo_subsets_and_bad_sg():
     with pytest.raises(ValueError, match="sg must have 1 or 200 rows"):
         perspective_jacobians(pts, eo, np.zeros((12, 3, 3)), np.zeros((12, 3, 3, 3)), img, F,
                               np.zeros((3, 2, 2)), np.ones(200, dtype=bool))  # fmt: skip
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_out_receives_eo_and_point_columns(compiled):
+    """``out``: the EO and point Jacobians written in place (both paths), returned as views;
+    the columns beyond 9 untouched."""
+    cam = _camera("jacobsen")
+    pts, eo, img = _block(n=300)
+    ref = collinearity_jacobians(pts, eo, cam, image_index=img, compiled=False)
+    buf = np.full((300, 2, 11), 7.0)
+    got = collinearity_jacobians(pts, eo, cam, wrt=("interior",), image_index=img, out=buf,
+                                 compiled=compiled)  # fmt: skip
+    assert np.shares_memory(got["eo"], buf) and np.shares_memory(got["point"], buf)
+    assert _relative(buf[:, :, :6], ref["eo"]) <= REL
+    assert _relative(buf[:, :, 6:9], ref["point"]) <= REL
+    assert _relative(got["interior"], ref["interior"]) <= REL
+    assert np.all(buf[:, :, 9:] == 7.0)
