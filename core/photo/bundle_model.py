@@ -100,6 +100,9 @@ class _ImageModel:
     ``img`` is the image of each group: the rotations are computed once per image.
     """
 
+    #: every call returns a new Jacobian (the adjustment may whiten it in place)
+    fresh_jacobian = True
+
     def __init__(self, cam: Camera, free: NDArray[np.intp], img: NDArray[np.intp]) -> None:
         self.cam = cam
         self.free = free
