@@ -131,7 +131,9 @@ def project(points: ArrayLike, eo: ArrayLike, camera: Camera) -> Array:
     return project_with_status(points, eo, camera)[0]
 
 
-def image_rays(pixels: ArrayLike, eo: ArrayLike, camera: Camera) -> Tuple[Array, Array]:
+def image_rays(
+    pixels: ArrayLike, eo: ArrayLike, camera: Camera, image_index: ArrayLike | None = None
+) -> Tuple[Array, Array]:
     """Back-project measured pixel positions to rays in object space.
 
     Parameters
@@ -142,6 +144,9 @@ def image_rays(pixels: ArrayLike, eo: ArrayLike, camera: Camera) -> Tuple[Array,
         ``(X0, Y0, Z0, omega, phi, kappa)``, metres and radians.
     camera : Camera
         Interior orientation; its lens correction is removed (measured -> ideal).
+    image_index : (N,) array_like of int, optional
+        With it, ``eo`` is (M, 6), one row per image, and pixel ``n`` lies in image
+        ``image_index[n]``: the rotations are computed once per image.
 
     Returns
     -------
@@ -152,8 +157,14 @@ def image_rays(pixels: ArrayLike, eo: ArrayLike, camera: Camera) -> Tuple[Array,
         ``M.T (x_i, y_i, -f)`` normalised.
     """
     ideal = camera.ideal_from_pixel(pixels)
-    e = _eo_rows(eo, ideal.shape[0])
-    m = opk_to_matrix(e[:, 3], e[:, 4], e[:, 5])
+    if image_index is None:
+        e = _eo_rows(eo, ideal.shape[0])
+        m = opk_to_matrix(e[:, 3], e[:, 4], e[:, 5])
+    else:
+        idx = np.asarray(image_index, dtype=np.intp)
+        eo_img = np.asarray(eo, dtype=np.float64).reshape(-1, 6)
+        e = eo_img[idx]
+        m = opk_to_matrix(eo_img[:, 3], eo_img[:, 4], eo_img[:, 5])[idx]
     ray_c = camera.ray_from_ideal(ideal)
     # M rotates object -> camera, so its transpose takes the camera-frame ray to object space.
     d = np.einsum("nji,nj->ni", m, ray_c)

@@ -531,7 +531,7 @@ def _rays(cams, image_cam, eo, obs, obs_img, rows):
     for c, cam in enumerate(cams):
         sel = np.flatnonzero(image_cam[obs_img[rows]] == c)
         if sel.size:
-            o, d = image_rays(obs.pixels[rows[sel]], eo[obs_img[rows[sel]]], cam)
+            o, d = image_rays(obs.pixels[rows[sel]], eo, cam, image_index=obs_img[rows[sel]])
             origins[sel], dirs[sel] = o, d
     return origins, dirs
 

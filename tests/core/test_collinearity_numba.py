@@ -136,3 +136,19 @@ def test_out_receives_eo_and_point_columns(compiled):
     assert _relative(buf[:, :, 6:9], ref["point"]) <= REL
     assert _relative(got["interior"], ref["interior"]) <= REL
     assert np.all(buf[:, :, 9:] == 7.0)
+
+
+def test_image_rays_with_image_index_equal_per_ray():
+    """image_rays with one EO per image and ``image_index`` (rotations once per image):
+    bit for bit the rays of one EO row per pixel."""
+    from lidarphoto.core.geometry.collinearity import image_rays
+
+    cam = _camera("conrady_brown")
+    pts, eo, img = _block(n=500)
+    px = collinearity_jacobians(pts, eo, cam, wrt=(), image_index=img)["pixels"]
+    o1, d1 = image_rays(px, eo[img], cam)
+    o2, d2 = image_rays(px, eo, cam, image_index=img)
+    assert np.array_equal(o1, o2) and np.array_equal(d1, d2)
+    # and they pass through the points they were projected from (to 1e-9 of the range)
+    t = np.einsum("ni,ni->n", pts - o2, d2)
+    assert np.max(np.linalg.norm(o2 + t[:, None] * d2 - pts, axis=1) / t) < 1e-9
