@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 from .. import compiled
 from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians
+from ..geometry.distortion import NoDistortion
 from ..geometry.rotations import matrix_to_opk, opk_derivatives, opk_to_matrix
 from ..lsq.adjustment import adjust
 from ..lsq.model import AdjustmentOptions, Constraint, GaussMarkovBlock
@@ -119,23 +120,23 @@ class _ImageModel:
         n = xl.shape[0]
         eo = xl[self.first, :6]
         jac = np.empty((n, 2, 9 + self.free.size))
-        if cam.projection == "perspective" and compiled.AVAILABLE:
-            # the compiled geometry has no per-ray temporaries beyond (n, 2) ones and writes
-            # the EO and point columns in place: the whole batch at once
-            out = collinearity_jacobians(xl[:, 6:9], eo, cam, wrt=wrt, image_index=self.inv,
-                                         out=jac)  # fmt: skip
-            if self.free.size:
-                jac[:, :, 9:] = out["interior"][:, :, self.free]
-            return out["pixels"], jac
         pixels = np.empty((n, 2))
-        # in chunks of groups: the projection's per-ray temporaries (rotations, partial
-        # derivatives: some 700 bytes a ray) stay bounded; every row is computed alone
-        for s in range(0, n, _CHUNK):
-            sl = slice(s, min(n, s + _CHUNK))
-            out = collinearity_jacobians(xl[sl, 6:9], eo, cam, wrt=wrt, image_index=self.inv[sl])
+        # the compiled geometry writes the EO and point columns in place and has no per-ray
+        # temporaries beyond (n, 2) ones: a camera without lens model or free interior
+        # parameters is projected at once; else in chunks of groups, which bound the lens
+        # model's temporaries (and the numpy path's rotations and partial derivatives: some
+        # 700 bytes a ray); every row is computed alone
+        fast = cam.projection == "perspective" and compiled.AVAILABLE
+        whole = fast and isinstance(cam.distortion, NoDistortion) and not self.free.size
+        step = max(n, 1) if whole else _CHUNK
+        for s in range(0, n, step):
+            sl = slice(s, min(n, s + step))
+            out = collinearity_jacobians(xl[sl, 6:9], eo, cam, wrt=wrt, image_index=self.inv[sl],
+                                         out=jac[sl] if fast else None)  # fmt: skip
             pixels[sl] = out["pixels"]
-            jac[sl, :, :6] = out["eo"]
-            jac[sl, :, 6:9] = out["point"]
+            if not fast:
+                jac[sl, :, :6] = out["eo"]
+                jac[sl, :, 6:9] = out["point"]
             if self.free.size:
                 jac[sl, :, 9:] = out["interior"][:, :, self.free]
         return pixels, jac
