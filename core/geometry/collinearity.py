@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .camera import DEFAULT_TOL_PX, Camera
-from .distortion import DEFAULT_MAX_ITER, as_points, inv2x2
+from .distortion import DEFAULT_MAX_ITER, NoDistortion, as_points, inv2x2
 from .projection import ideal_from_camera
 from .rotations import opk_derivatives, opk_to_matrix
 
@@ -131,7 +131,9 @@ def project(points: ArrayLike, eo: ArrayLike, camera: Camera) -> Array:
     return project_with_status(points, eo, camera)[0]
 
 
-def image_rays(pixels: ArrayLike, eo: ArrayLike, camera: Camera) -> Tuple[Array, Array]:
+def image_rays(
+    pixels: ArrayLike, eo: ArrayLike, camera: Camera, image_index: ArrayLike | None = None
+) -> Tuple[Array, Array]:
     """Back-project measured pixel positions to rays in object space.
 
     Parameters
@@ -142,6 +144,9 @@ def image_rays(pixels: ArrayLike, eo: ArrayLike, camera: Camera) -> Tuple[Array,
         ``(X0, Y0, Z0, omega, phi, kappa)``, metres and radians.
     camera : Camera
         Interior orientation; its lens correction is removed (measured -> ideal).
+    image_index : (N,) array_like of int, optional
+        With it, ``eo`` is (M, 6), one row per image, and pixel ``n`` lies in image
+        ``image_index[n]``: the rotations are computed once per image.
 
     Returns
     -------
@@ -152,8 +157,14 @@ def image_rays(pixels: ArrayLike, eo: ArrayLike, camera: Camera) -> Tuple[Array,
         ``M.T (x_i, y_i, -f)`` normalised.
     """
     ideal = camera.ideal_from_pixel(pixels)
-    e = _eo_rows(eo, ideal.shape[0])
-    m = opk_to_matrix(e[:, 3], e[:, 4], e[:, 5])
+    if image_index is None:
+        e = _eo_rows(eo, ideal.shape[0])
+        m = opk_to_matrix(e[:, 3], e[:, 4], e[:, 5])
+    else:
+        idx = np.asarray(image_index, dtype=np.intp)
+        eo_img = np.asarray(eo, dtype=np.float64).reshape(-1, 6)
+        e = eo_img[idx]
+        m = opk_to_matrix(eo_img[:, 3], eo_img[:, 4], eo_img[:, 5])[idx]
     ray_c = camera.ray_from_ideal(ideal)
     # M rotates object -> camera, so its transpose takes the camera-frame ray to object space.
     d = np.einsum("nji,nj->ni", m, ray_c)
@@ -170,6 +181,8 @@ def collinearity_jacobians(
     tol_px: float = DEFAULT_TOL_PX,
     max_iter: int = DEFAULT_MAX_ITER,
     image_index: ArrayLike | None = None,
+    compiled: bool = True,
+    out: Array | None = None,
 ) -> Dict[str, Any]:
     """Predicted measured pixels and their analytic Jacobians.
 
@@ -189,6 +202,16 @@ def collinearity_jacobians(
         With it, ``eo`` is (M, 6), one row per image, and point ``n`` is seen by image
         ``image_index[n]``: the rotations and their derivatives are computed once per image
         (a bundle adjustment has far fewer images than measurements).
+    compiled : bool
+        With ``image_index``, a perspective camera and numba, the geometry (camera-frame
+        vectors, ideal coordinates, the EO and point Jacobians) is evaluated by the compiled
+        kernels of :mod:`.collinearity_numba` in one pass over the rays, the lens model in
+        numpy as here; equal to this numpy path to rounding. False: the numpy path (the
+        reference; fisheye projections always take it).
+    out : (N, 2, K) ndarray, K >= 9, optional
+        Receives the EO Jacobian in its columns 0-5 and the point Jacobian in 6-8 (both
+        computed, whatever ``wrt``); the returned ``"eo"`` and ``"point"`` are then views of
+        it (a bundle's model writes its Jacobian in place, no copy of the batch).
 
     Returns
     -------
@@ -217,6 +240,12 @@ def collinearity_jacobians(
     if unknown:
         raise ValueError(f"wrt: unknown Jacobian(s) {unknown}; use 'eo', 'point', 'interior'")
 
+    if image_index is not None and compiled and camera.projection == "perspective":
+        fast = _compiled_jacobians(points, eo, image_index, camera, wanted, tol_px, max_iter, out)
+        if fast is not None:
+            return fast
+    if out is not None:
+        wanted = tuple(dict.fromkeys((*wanted, "eo", "point")))
     if image_index is None:
         e, d, rot, q = _to_camera_frame(points, eo)
         per_image = None
@@ -236,8 +265,7 @@ def collinearity_jacobians(
         ideal, in_front = _ideal(q, camera)
     measured, converged = camera.measured_from_ideal(ideal, tol_px=tol_px, max_iter=max_iter)
     pixels = camera.image_to_pixel(measured + np.array([camera.x0_mm, camera.y0_mm]))
-    out: Dict[str, Any] = {"pixels": pixels, "in_front": in_front, "converged": converged}
-    n = pixels.shape[0]
+    res: Dict[str, Any] = {"pixels": pixels, "in_front": in_front, "converged": converged}
 
     # S G: d pixel / d ideal, (N, 2, 2); the lens Jacobian is taken at the measured point.
     sg = inv2x2(np.eye(2) + camera.distortion.jacobian_xy(measured))
@@ -248,7 +276,7 @@ def collinearity_jacobians(
         dpx_dq = sg @ a
         dpx_dpoint = dpx_dq @ rot
         if "point" in wanted:
-            out["point"] = dpx_dpoint
+            res["point"] = dpx_dpoint
         if "eo" in wanted:
             if per_image is None:
                 dm = opk_derivatives(e[:, 3], e[:, 4], e[:, 5])  # (N, 3 angles, 3, 3)
@@ -259,22 +287,89 @@ def collinearity_jacobians(
                 dq_dangles = np.empty((d.shape[0], 3, 3))
                 for k in range(3):
                     dq_dangles[:, :, k] = np.einsum("nij,nj->ni", dm_img[per_image, k], d)
-            out["eo"] = np.concatenate([-dpx_dpoint, dpx_dq @ dq_dangles], axis=2)
+            res["eo"] = np.concatenate([-dpx_dpoint, dpx_dq @ dq_dangles], axis=2)
 
     if "interior" in wanted:
-        n_ap = camera.distortion.n_params
-        jac = np.empty((n, 2, 3 + n_ap))
-        # every projection's ideal point (r = f g(theta)) is linear in f, so di/df = i / f.
-        jac[:, :, 0] = np.einsum("nij,nj->ni", sg, ideal / f)
-        jac[:, 0, 1], jac[:, 1, 1] = 1.0 / ps, 0.0
-        jac[:, 0, 2], jac[:, 1, 2] = 0.0, -1.0 / ps
-        if n_ap:
-            jac[:, :, 3:] = -sg @ camera.distortion.jacobian_params(measured)
-        out["interior"] = jac
-        out["interior_names"] = camera.interior_names
+        res["interior"] = _interior_jacobian(camera, sg, ideal, measured)
+        res["interior_names"] = camera.interior_names
 
     valid = in_front & converged
     for key in ("eo", "point", "interior"):
-        if key in out:
-            out[key][~valid] = np.nan
+        if key in res:
+            res[key][~valid] = np.nan
+    if out is not None:
+        out[:, :, :6] = res["eo"]
+        out[:, :, 6:9] = res["point"]
+        res["eo"], res["point"] = out[:, :, :6], out[:, :, 6:9]
+    return res
+
+
+def _interior_jacobian(camera: Camera, sg: Array, ideal: Array, measured: Array) -> Array:
+    """d pixel / d :attr:`Camera.interior_params` (N, 2, 3 + P) from ``S G`` (N, 2, 2)
+    px/mm, the ideal and the measured centred coordinates (N, 2) mm."""
+    n = ideal.shape[0]
+    f = camera.focal_mm
+    ps = camera.pixel_size_mm
+    n_ap = camera.distortion.n_params
+    jac = np.empty((n, 2, 3 + n_ap))
+    # every projection's ideal point (r = f g(theta)) is linear in f, so di/df = i / f.
+    jac[:, :, 0] = np.einsum("nij,nj->ni", sg, ideal / f)
+    jac[:, 0, 1], jac[:, 1, 1] = 1.0 / ps, 0.0
+    jac[:, 0, 2], jac[:, 1, 2] = 0.0, -1.0 / ps
+    if n_ap:
+        jac[:, :, 3:] = -sg @ camera.distortion.jacobian_params(measured)
+    return jac
+
+
+def _compiled_jacobians(
+    points: ArrayLike,
+    eo: ArrayLike,
+    image_index: ArrayLike,
+    camera: Camera,
+    wanted: Tuple[str, ...],
+    tol_px: float,
+    max_iter: int,
+    into: Array | None = None,
+) -> Dict[str, Any] | None:
+    """:func:`collinearity_jacobians` of a perspective camera with ``image_index``: the
+    geometry compiled (:mod:`.collinearity_numba`), the lens model in numpy; None without
+    numba."""
+    from .collinearity_numba import perspective_ideal, perspective_jacobians
+
+    p = as_points(points, 3, "points")
+    per_image = np.asarray(image_index, dtype=np.intp)
+    eo_img = np.asarray(eo, dtype=np.float64).reshape(-1, 6)
+    rot = opk_to_matrix(eo_img[:, 3], eo_img[:, 4], eo_img[:, 5])
+    f = camera.focal_mm
+    ps = camera.pixel_size_mm
+    got = perspective_ideal(p, eo_img, rot, per_image, f)
+    if got is None:
+        return None
+    ideal, in_front = got
+    measured, converged = camera.measured_from_ideal(ideal, tol_px=tol_px, max_iter=max_iter)
+    pixels = camera.image_to_pixel(measured + np.array([camera.x0_mm, camera.y0_mm]))
+    out: Dict[str, Any] = {"pixels": pixels, "in_front": in_front, "converged": converged}
+    n = pixels.shape[0]
+    if isinstance(camera.distortion, NoDistortion):
+        # G = I: S alone, one (1, 2, 2) for every ray (as the numpy path's rows, exactly)
+        sg = np.array([[[1.0 / ps, 0.0], [0.0, 1.0 / -ps]]])
+    else:
+        sg = inv2x2(np.eye(2) + camera.distortion.jacobian_xy(measured))
+        sg[:, 0, :] /= ps
+        sg[:, 1, :] /= -ps
+    valid = in_front & converged
+    if "eo" in wanted or "point" in wanted or into is not None:
+        drot = opk_derivatives(eo_img[:, 3], eo_img[:, 4], eo_img[:, 5])
+        jac = perspective_jacobians(p, eo_img, rot, drot, per_image, f, sg, valid, into)
+        if jac is None:
+            return None
+        if "eo" in wanted or into is not None:
+            out["eo"] = jac[:, :, :6]
+        if "point" in wanted or into is not None:
+            out["point"] = jac[:, :, 6:9]
+    if "interior" in wanted:
+        full = np.broadcast_to(sg, (n, 2, 2))
+        out["interior"] = _interior_jacobian(camera, full, ideal, measured)
+        out["interior"][~valid] = np.nan
+        out["interior_names"] = camera.interior_names
     return out

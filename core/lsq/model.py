@@ -33,7 +33,9 @@ class GaussMarkovBlock:
         ``model(x_local) -> (f, J)`` with ``x_local = x[param_index]`` of shape (G, k),
         ``f`` of shape (G, c) and ``J = df/dx_local`` of shape (G, c, k). It is always called
         with all ``G`` groups (rejected groups are excluded afterwards), so it may close over
-        per-group arrays of length ``G``.
+        per-group arrays of length ``G``. A model whose attribute ``fresh_jacobian`` is
+        True promises a new ``J`` on every call, which the adjustment then whitens in place
+        (one (G, c, k) array less per evaluation).
     labels : sequence of str, shape (G,), optional
         Names of the groups (e.g. ``"img 12 / pt 345"``); default ``"<name>[g]"``.
     row_names : sequence of str, shape (c,), optional

@@ -246,7 +246,11 @@ class _Problem:
             _check_finite(b.name, b.labels, f, J)
             # B = -I: w = f - l does not depend on v^, and L is the Cholesky factor of S.
             if b.inv_sigma is not None:  # uncorrelated observations: L^-1 is diagonal
-                abar = J * b.inv_sigma[:, :, None]
+                if getattr(b.func, "fresh_jacobian", False) and J.flags.writeable:
+                    # the model hands over a new J on every call: whitened in place
+                    abar = np.multiply(J, b.inv_sigma[:, :, None], out=J)
+                else:
+                    abar = J * b.inv_sigma[:, :, None]
                 wbar = (f - b.observed) * b.inv_sigma
             else:
                 abar = b.chol_inv @ J

@@ -46,6 +46,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InputError
+from . import schur_numba as _nb
 from .scaling import jacobi_scale, scale_constraints
 from .schur_numba import back_substitute, dense_reduced, diag_grad, normal_sums, pair_sums
 from .schur_plan import EliminationPlan
@@ -113,6 +114,12 @@ class ReducedNormal:
         if key in self._cache:
             return self._cache[key]
         b = self.plan.b
+        got = _nb.point_factors(self.V, lam) if _COMPILED and self.plan.P >= _COMPILED_MIN else None
+        if isinstance(got, int):
+            raise SingularSystem("an eliminated block is singular")
+        if got is not None and np.isfinite(got[0]).all() and np.isfinite(got[1]).all():
+            self._cache[key] = got
+            return got
         Vl = self.V + lam * np.eye(b)
         try:
             L = np.linalg.cholesky(Vl)
@@ -193,6 +200,12 @@ class ReducedNormal:
         y = np.einsum("pij,pj->pi", Vinv, self.g_e)
         rhs = np.concatenate([-self.g_r, -self.hs])
         for T, s in zip(self.T, self.plan.sets):
+            if (
+                _COMPILED
+                and s.point.size >= _COMPILED_MIN
+                and _nb.add_point_rhs(T, y, s.point, s.rows, s.sig, rhs)
+            ):
+                continue
             contrib = (T @ y[s.point][:, :, None])[:, :, 0]
             rows = s.rows[s.sig]
             rhs += np.bincount(rows.ravel(), weights=contrib.ravel(), minlength=rhs.size)
@@ -272,6 +285,11 @@ class ReducedNormal:
         _, Vinv = self.point_factors(lam)
         acc = -self.g_e.copy()
         for T, s in zip(self.T, plan.sets):
+            big = _COMPILED and s.point.size >= _COMPILED_MIN
+            sums = _nb.point_back_sums(sol, s.rows, s.sig, T, s.point, plan.P) if big else None
+            if sums is not None:
+                acc -= sums
+                continue
             zs = sol[s.rows[s.sig]]  # (O, kk)
             contrib = (zs[:, None, :] @ T)[:, 0, :]
             for j in range(plan.b):
@@ -530,6 +548,10 @@ class BlockCofactor:
 def _point_products(Li: Array, point: Index, T: Array) -> Array:
     """``Li[point] @ T'`` (O, b, kk), in chunks of occurrences (the gathered factors are
     not held for all occurrences at once)."""
+    if _COMPILED and T.shape[0] >= _COMPILED_MIN:
+        Z = _nb.point_products(Li, point, T)
+        if Z is not None:
+            return Z
     out = np.empty((T.shape[0], Li.shape[1], T.shape[1]))
     for s in range(0, T.shape[0], _CHUNK):
         sl = slice(s, s + _CHUNK)

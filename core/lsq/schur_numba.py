@@ -369,3 +369,135 @@ def diag_grad(
         grad,
     )
     return True
+
+
+# ----------------------------------------------------------------------------- point blocks
+# The per-occurrence products of the sparse path of ReducedNormal (numpy: batched products
+# of 3 x 3 by 3 x 6 matrices, each a temporary of all occurrences).
+
+
+def _factors_kernel(V, lam, Li, Vinv):  # pragma: no cover - compiled
+    P, b = V.shape[0], V.shape[1]
+    L = np.empty((b, b))
+    for p in range(P):
+        for i in range(b):
+            for j in range(i + 1):
+                s = V[p, i, j] + (lam if i == j else 0.0)
+                for m in range(j):
+                    s -= L[i, m] * L[j, m]
+                if i == j:
+                    if not s > 0.0:
+                        return p + 1
+                    L[i, i] = np.sqrt(s)
+                else:
+                    L[i, j] = s / L[j, j]
+        for j in range(b):
+            for i in range(b):
+                if i < j:
+                    Li[p, i, j] = 0.0
+                    continue
+                s = 1.0 if i == j else 0.0
+                for m in range(j, i):
+                    s -= L[i, m] * Li[p, m, j]
+                Li[p, i, j] = s / L[i, i]
+        for i in range(b):  # Vinv = Li' Li
+            for j in range(b):
+                s = 0.0
+                for m in range(max(i, j), b):
+                    s += Li[p, m, i] * Li[p, m, j]
+                Vinv[p, i, j] = s
+    return 0
+
+
+def point_factors(V: Array, lam: float) -> tuple[Array, Array] | int | None:
+    """(Li, Vinv): the inverse lower Cholesky factors and the inverses of ``V_p + lam I``
+    (P, b, b); the 1-based index of the first block that is not positive definite (an int)
+    instead; None without numba."""
+    from ..compiled import compiled_kernel
+
+    kernel = compiled_kernel(_factors_kernel)
+    if kernel is None:
+        return None
+    Li = np.empty_like(V)
+    Vinv = np.empty_like(V)
+    bad = kernel(np.ascontiguousarray(V), float(lam), Li, Vinv)
+    return int(bad) if bad else (Li, Vinv)
+
+
+def _products_kernel(Li, point, T, Z):  # pragma: no cover - compiled
+    b = Li.shape[1]
+    kk = T.shape[1]
+    for o in range(T.shape[0]):
+        p = point[o]
+        for m in range(b):
+            for a in range(kk):
+                s = 0.0
+                for c in range(b):
+                    s += Li[p, m, c] * T[o, a, c]
+                Z[o, m, a] = s
+
+
+def point_products(Li: Array, point: Index, T: Array) -> Array | None:
+    """``Z_o = Li[point[o]] T_o'`` (O, b, kk) per occurrence; None without numba."""
+    from ..compiled import compiled_kernel
+
+    kernel = compiled_kernel(_products_kernel)
+    if kernel is None:
+        return None
+    Z = np.empty((T.shape[0], Li.shape[1], T.shape[1]))
+    kernel(np.ascontiguousarray(Li), point, np.ascontiguousarray(T), Z)
+    return Z
+
+
+def _rhs_kernel(T, y, point, rows, sig, acc):  # pragma: no cover - compiled
+    b = y.shape[1]
+    kk = T.shape[1]
+    for o in range(T.shape[0]):
+        p = point[o]
+        r = sig[o]
+        for a in range(kk):
+            s = 0.0
+            for m in range(b):
+                s += T[o, a, m] * y[p, m]
+            acc[rows[r, a]] += s
+
+
+def add_point_rhs(T: Array, y: Array, point: Index, rows: Index, sig: Index, rhs: Array) -> bool:
+    """``rhs[rows[sig[o]]] += T_o y[point[o]]`` over the occurrences (summed apart, then
+    added, as numpy's ``bincount``); False without numba (nothing added)."""
+    from ..compiled import compiled_kernel
+
+    kernel = compiled_kernel(_rhs_kernel)
+    if kernel is None:
+        return False
+    acc = np.zeros_like(rhs)
+    kernel(np.ascontiguousarray(T), np.ascontiguousarray(y), point,
+           np.ascontiguousarray(rows), sig, acc)  # fmt: skip
+    rhs += acc
+    return True
+
+
+def _back_sums_kernel(sol, rows, sig, T, point, acc):  # pragma: no cover - compiled
+    kk = T.shape[1]
+    b = T.shape[2]
+    for o in range(T.shape[0]):
+        r = sig[o]
+        p = point[o]
+        for j in range(b):
+            s = 0.0
+            for a in range(kk):
+                s += sol[rows[r, a]] * T[o, a, j]
+            acc[p, j] += s
+
+
+def point_back_sums(sol: Array, rows: Index, sig: Index, T: Array, point: Index, P: int):
+    """``sum_o T_o' sol[rows[sig[o]]]`` per point (P, b); None without numba."""
+    from ..compiled import compiled_kernel
+
+    kernel = compiled_kernel(_back_sums_kernel)
+    if kernel is None:
+        return None
+    acc = np.zeros((P, T.shape[2]))
+    kernel(np.ascontiguousarray(sol), np.ascontiguousarray(rows), sig,
+           np.ascontiguousarray(T), point, acc)  # fmt: skip
+    return acc

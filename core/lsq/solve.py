@@ -422,6 +422,10 @@ def _run(
                 nu = max(nu, 2.5 * float(np.abs(k).max()))
         if step <= tol:
             x, vhat = _apply(problem, lin, nrm, z)
+            # the final normal equations are built at the new point below: the old ones and
+            # the old linearisation are not held meanwhile (hundreds of MB on a large block)
+            del nrm, lin
+            nrm = None
             try:
                 lin = problem.linearize(x, vhat, active)
             except _NonFiniteError as exc:
@@ -499,6 +503,7 @@ def _run(
         warnings.append(_t("no convergence within {n} iterations", n=opts.max_iterations))
     # Final normal equations at the final linearisation point, checked before use.
     if final is None:
+        nrm = None  # not held while the final ones are built
         final, _ = problem.normal(lin, active, rowscale)
     if use_sparse is None:
         use_sparse = False

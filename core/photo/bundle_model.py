@@ -10,8 +10,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import compiled
 from ..geometry.camera import Camera
 from ..geometry.collinearity import collinearity_jacobians
+from ..geometry.distortion import NoDistortion
 from ..geometry.rotations import matrix_to_opk, opk_derivatives, opk_to_matrix
 from ..lsq.adjustment import adjust
 from ..lsq.model import AdjustmentOptions, Constraint, GaussMarkovBlock
@@ -99,6 +101,9 @@ class _ImageModel:
     ``img`` is the image of each group: the rotations are computed once per image.
     """
 
+    #: every call returns a new Jacobian (the adjustment may whiten it in place)
+    fresh_jacobian = True
+
     def __init__(self, cam: Camera, free: NDArray[np.intp], img: NDArray[np.intp]) -> None:
         self.cam = cam
         self.free = free
@@ -114,16 +119,24 @@ class _ImageModel:
             cam = cam.with_interior(full)
         n = xl.shape[0]
         eo = xl[self.first, :6]
-        pixels = np.empty((n, 2))
         jac = np.empty((n, 2, 9 + self.free.size))
-        # in chunks of groups: the projection's per-ray temporaries (rotations, partial
-        # derivatives: some 700 bytes a ray) stay bounded; every row is computed alone
-        for s in range(0, n, _CHUNK):
-            sl = slice(s, min(n, s + _CHUNK))
-            out = collinearity_jacobians(xl[sl, 6:9], eo, cam, wrt=wrt, image_index=self.inv[sl])
+        pixels = np.empty((n, 2))
+        # the compiled geometry writes the EO and point columns in place and has no per-ray
+        # temporaries beyond (n, 2) ones: a camera without lens model or free interior
+        # parameters is projected at once; else in chunks of groups, which bound the lens
+        # model's temporaries (and the numpy path's rotations and partial derivatives: some
+        # 700 bytes a ray); every row is computed alone
+        fast = cam.projection == "perspective" and compiled.AVAILABLE
+        whole = fast and isinstance(cam.distortion, NoDistortion) and not self.free.size
+        step = max(n, 1) if whole else _CHUNK
+        for s in range(0, n, step):
+            sl = slice(s, min(n, s + step))
+            out = collinearity_jacobians(xl[sl, 6:9], eo, cam, wrt=wrt, image_index=self.inv[sl],
+                                         out=jac[sl] if fast else None)  # fmt: skip
             pixels[sl] = out["pixels"]
-            jac[sl, :, :6] = out["eo"]
-            jac[sl, :, 6:9] = out["point"]
+            if not fast:
+                jac[sl, :, :6] = out["eo"]
+                jac[sl, :, 6:9] = out["point"]
             if self.free.size:
                 jac[sl, :, 9:] = out["interior"][:, :, self.free]
         return pixels, jac

@@ -334,17 +334,23 @@ def _prepare(
     free = options.datum != "control"
     adjusted: list[str] = []
     check_ids: list[str] = []
-    for p in dict.fromkeys(obs.point_id):
+    # every measured point once, in order of first measurement: one dict look-up a
+    # measurement, then the adjusted / check numbers of each distinct point by index
+    first = {p: i for i, p in enumerate(dict.fromkeys(obs.point_id))}
+    pt_of = np.full(len(first), -1, dtype=np.intp)
+    check_of = np.full(len(first), -1, dtype=np.intp)
+    for p, i in first.items():
         if roles.get(p) == "check":
+            check_of[i] = len(check_ids)
             check_ids.append(p)
         else:
+            pt_of[i] = len(adjusted)
             adjusted.append(p)
-    pnum = {p: i for i, p in enumerate(adjusted)}
-    cnum = {p: i for i, p in enumerate(check_ids)}
     img_num = {im: k for k, im in enumerate(images)}
     obs_img = np.array([img_num[i] for i in obs.image_id], dtype=np.intp)
-    obs_pt = np.array([pnum.get(p, -1) for p in obs.point_id], dtype=np.intp)
-    obs_check = np.array([cnum.get(p, -1) for p in obs.point_id], dtype=np.intp)
+    obs_code = np.array([first[p] for p in obs.point_id], dtype=np.intp)
+    obs_pt = pt_of[obs_code]
+    obs_check = check_of[obs_code]
     point_roles = tuple(
         "control" if (roles.get(p) == "control" and not free) else "tie" for p in adjusted
     )
@@ -531,7 +537,7 @@ def _rays(cams, image_cam, eo, obs, obs_img, rows):
     for c, cam in enumerate(cams):
         sel = np.flatnonzero(image_cam[obs_img[rows]] == c)
         if sel.size:
-            o, d = image_rays(obs.pixels[rows[sel]], eo[obs_img[rows[sel]]], cam)
+            o, d = image_rays(obs.pixels[rows[sel]], eo, cam, image_index=obs_img[rows[sel]])
             origins[sel], dirs[sel] = o, d
     return origins, dirs
 

@@ -344,15 +344,21 @@ def test_bal_reader_and_projection_on_dubrovnik():
     assert abs(cost / 2.764220e3 - 1) < 1e-6
 
 
+@pytest.mark.parametrize("sparse", [False, True])
 @pytest.mark.parametrize("datum", ["priors", "constraints"])
-def test_compiled_reduced_system_equals_numpy(monkeypatch, datum):
+def test_compiled_reduced_system_equals_numpy(monkeypatch, datum, sparse):
     """A BAL-like block (Snavely's model, every camera with its own 9 parameters, so the
     compiled per-block sums and the compiled dense reduced system both run): the same
     adjustment with the numba kernels and with the numpy code of core/lsq/schur.py, to
     rounding; the datum by priors on the cameras, or by hard constraints (the dense system's
-    bordered solve)."""
+    bordered solve). ``sparse``: the reduced system of the large blocks (sparse LU), whose
+    point factors, point products, right-hand side and back-substitution are compiled."""
     pytest.importorskip("numba")
     from lidarphoto.core.lsq import schur
+
+    if sparse:
+        monkeypatch.setattr(schur, "_DENSE_MAX", 0)
+        monkeypatch.setattr(schur, "_SPARSE_MAX_DENSITY", 2.0)
 
     rng = np.random.default_rng(4)
     nc, npt = 6, 80
