@@ -50,6 +50,10 @@ class _Obs:
     row_names: list[str]
     c: int | None  # condition rows per group (known after the first evaluation)
     inv_sigma: Array | None = None  # (G, o) 1/sigma when every cov is diagonal, else None
+    # Rows whose covariance has no off-diagonal entry in any group (a line's pixels beside its
+    # 6 x 6 (X0, u)), when the others are at most half: products with cov and weight then take
+    # those rows as a diagonal scaling and only the rest as a matrix (see :meth:`times_cov`).
+    sparse_rows: tuple[NDArray[np.intp], NDArray[np.intp]] | None = None
 
     @property
     def groups(self) -> int:
@@ -62,6 +66,26 @@ class _Obs:
     @property
     def k(self) -> int:
         return self.param_index.shape[1]
+
+    def times_cov(self, M: Array) -> Array:
+        """``cov @ M`` for M of shape (G, o, n) (:func:`_structured_times`)."""
+        return _structured_times(self.cov, self.sparse_rows, M)
+
+
+def _structured_times(
+    S: Array, sparse_rows: tuple[NDArray[np.intp], NDArray[np.intp]] | None, M: Array
+) -> Array:
+    """``S @ M`` for S (G, o, o) a covariance or weight matrix and M (G, o, n); with
+    ``sparse_rows`` (diagonal rows, coupled rows: :attr:`_Obs.sparse_rows`) the diagonal rows
+    are scaled and the coupled ones multiplied by their (coupled x coupled) part only: the two
+    parts do not couple, so the product is the same."""
+    if sparse_rows is None:
+        return S @ M
+    diag, dense = sparse_rows
+    out = np.empty(M.shape)
+    out[:, diag] = S[:, diag, diag][:, :, None] * M[:, diag]
+    out[:, dense] = S[:, dense[:, None], dense[None, :]] @ M[:, dense]
+    return out
 
 
 @dataclass
@@ -173,6 +197,10 @@ def _prepare_block(block: Block, n: int, names: list[str]) -> _Obs:
     off[:, np.arange(o), np.arange(o)] = 0.0
     inv_sigma = None if off.any() else np.ascontiguousarray(np.einsum("gii->gi", chol_inv))
     weight = np.swapaxes(chol_inv, 1, 2) @ chol_inv
+    coupled = off.any(axis=(0, 2)) if g else np.zeros(o, dtype=bool)
+    sparse_rows = None
+    if inv_sigma is None and 2 * int(coupled.sum()) <= o:
+        sparse_rows = (np.flatnonzero(~coupled), np.flatnonzero(coupled))
     func = block.model if gm else block.condition
     if isinstance(func, _PriorModel) and block.labels is None:
         labels = [names[i] for i in idx[:, 0]]
@@ -193,6 +221,7 @@ def _prepare_block(block: Block, n: int, names: list[str]) -> _Obs:
         row_names=row_names,
         c=o if gm else None,
         inv_sigma=inv_sigma,
+        sparse_rows=sparse_rows,
     )
 
 
@@ -270,7 +299,7 @@ class _Problem:
             raise _shape_error(where, "condition Jacobian B", B.shape, (g, c, o))
         _check_finite(b.name, b.labels, gv, A, B)
         w = gv - np.einsum("gco,go->gc", B, vhat)
-        SBt = b.cov @ np.swapaxes(B, 1, 2)  # (G, o, c)
+        SBt = b.times_cov(np.swapaxes(B, 1, 2))  # (G, o, c)
         M = B @ SBt
         try:
             L = np.linalg.cholesky(M)
