@@ -156,10 +156,16 @@ def check(out: Path) -> None:
               f"|error| / sigma {np.round(np.abs(err) / std, 2)}")
     rounds = out / "auto_rounds.csv"
     if rounds.exists():
+        first = next(csv.DictReader(rounds.open()))
+        # the angle search's result: round 1's boresight less its change from the search
+        search = np.array([float(first[f"d_{a}_deg"]) - float(first[f"change_d_{a}_arcsec"])
+                           / 3600 for a in ("omega", "phi", "kappa")])
+        print(f"angle search: {np.round(search, 4)} deg, error "
+              f"{np.round((search - TRUTH_DEG) * 3600, 1)} arcsec")
         for r in csv.DictReader(rounds.open()):
             print(f"round {r['round']}: line points {r['line_points']} on {r['lines_seen']} "
                   f"lines, tie tracks {r['tie_tracks']}, on planes {r['ties_associated']}, "
-                  f"refused {r['ties_refused']}")
+                  f"refused {r['ties_refused']}, rejected {r['rejected']}")
 
 
 def main() -> None:
