@@ -42,6 +42,23 @@ def _block_times(b: _Obs, M: Array, sel: NDArray[np.intp]) -> Array:
     return _structured_times(b.weight[sel], b.sparse_rows, M)
 
 
+def _coupled_rows(
+    rows: NDArray[np.intp], K: Array, ab: Array, Q: Array, sign: Array, P: Array, r: Array,
+    pqp: Array
+) -> None:
+    """``diag(Qvv P)`` and ``diag(P Qvv P)`` of the coupled rows (a line's X0 and u, whose
+    weights come from a covariance of rank 4 regularised by 1e-12: their products cancel to
+    rounding) recomputed in place from the rows' own block of ``Qvv = K (I -+ ab Q ab') K'``,
+    in the order of operations of the whole-matrix formula (only those rows' block is
+    formed): so these rows' tests are as before, not the rounding of the factored form."""
+    KX = K[:, rows]
+    inner = np.eye(ab.shape[1]) + sign * (ab @ Q @ np.swapaxes(ab, 1, 2))
+    QX = KX @ inner @ np.swapaxes(KX, 1, 2)
+    PX = P[:, rows[:, None], rows[None, :]]
+    r[:, rows] = np.einsum("gij,gji->gi", QX, PX)
+    pqp[:, rows] = np.einsum("gij,gjk,gki->gi", PX, QX, PX)
+
+
 def _residual_tables(
     problem: _Problem,
     lin: _Lin,
@@ -74,6 +91,8 @@ def _residual_tables(
             PG = PK + sign * (((PK @ ab) @ Q) @ abt)
             r = np.einsum("gil,gil->gi", G, PK)
             pqp = np.einsum("gil,gil->gi", PG, PK)
+            if b.sparse_rows is not None:
+                _coupled_rows(b.sparse_rows[1], K, ab, Q, sign, P, r, pqp)
             Pv = np.einsum("gij,gj->gi", P, v[sel])
             with np.errstate(invalid="ignore", divide="ignore"):
                 ws = Pv / (sigma0_prior * np.sqrt(np.where(pqp > 0, pqp, np.nan)))
