@@ -50,8 +50,12 @@ def _helpers():
     return t
 
 
-def _trajectory(rng, noise: bool):
-    """Two lines of five exposures, 1 s apart (velocities from neighbouring exposures)."""
+def _trajectory(noise: np.random.Generator | None):
+    """Two lines of five exposures, 1 s apart (velocities from neighbouring exposures): the
+    true poses, or with ``noise`` those plus INS errors of the POS AV 310 grade. The roll and
+    pitch (0.4 degree of turbulence) are drawn once from a fixed seed, so both share them (the
+    first version drew them again for the noisy trajectory: the trajectory written differed
+    from the rendered poses by some 0.5 degree, far beyond the INS noise)."""
     from lidarphoto.core.photo.georeference import Trajectory
 
     t = _helpers()
@@ -59,12 +63,11 @@ def _trajectory(rng, noise: bool):
     pos = np.vstack([np.column_stack([xs, np.full(5, 2.0), np.full(5, 150.0)]),
                      np.column_stack([xs[::-1], np.full(5, -2.0), np.full(5, 150.0)])])
     pos = pos + [t.X0, t.Y0, 0.0]
-    rph = np.column_stack([rng.normal(0, 0.4, (N_IMAGES, 2)), np.r_[np.full(5, 90.0),
-                                                                   np.full(5, 270.0)]])
-    rph = np.radians(rph)
-    if noise:  # POS AV 310: 0.02 m, 0.05 m, 0.015 deg, 0.035 deg
-        pos = pos + rng.normal(0, 1, (N_IMAGES, 3)) * [0.02, 0.02, 0.05]
-        rph = rph + np.radians(rng.normal(0, 1, (N_IMAGES, 3)) * [0.015, 0.015, 0.035])
+    tilt = np.random.default_rng(11).normal(0, 0.4, (N_IMAGES, 2))
+    rph = np.radians(np.column_stack([tilt, np.r_[np.full(5, 90.0), np.full(5, 270.0)]]))
+    if noise is not None:  # POS AV 310: 0.02 m, 0.05 m, 0.015 deg, 0.035 deg
+        pos = pos + noise.normal(0, 1, (N_IMAGES, 3)) * [0.02, 0.02, 0.05]
+        rph = rph + np.radians(noise.normal(0, 1, (N_IMAGES, 3)) * [0.015, 0.015, 0.035])
     ids = tuple(f"img{k:02d}" for k in range(N_IMAGES))
     return Trajectory(ids, np.arange(float(N_IMAGES)), ("E",) * 5 + ("W",) * 5, pos, False,
                       rph)
@@ -86,6 +89,10 @@ def make(data: Path, step_px: int) -> None:
     from lidarphoto.core.simulation.render import render_image
     from lidarphoto.core.simulation.render_scene import RenderOptions
 
+    # the trajectory is cheap: always rewritten (data made by the first version had a wrong
+    # one, see _trajectory); the images are rendered once
+    data.mkdir(parents=True, exist_ok=True)
+    write_trajectory_csv(data / "traj.csv", _trajectory(np.random.default_rng(12)))
     if (data / "ready").exists():
         return
     t = _helpers()
@@ -93,8 +100,7 @@ def make(data: Path, step_px: int) -> None:
     scene, _dsm, planes, lines, pts, pid = t._scene()
     cam = Camera("24mpx", focal_mm=85.0, pixel_size_mm=0.0039, width_px=6000, height_px=4000)
     frame = MappingFrame.from_user_input(CRS)
-    rng = np.random.default_rng(11)
-    true_eo = direct_georeference(_trajectory(rng, False),
+    true_eo = direct_georeference(_trajectory(None),
                                   Mount.from_parameters(boresight_deg=TRUTH_DEG), frame)
     start = time.perf_counter()
     for k, iid in enumerate(true_eo.image_id):
@@ -104,7 +110,6 @@ def make(data: Path, step_px: int) -> None:
                     [cv2.IMWRITE_JPEG_QUALITY, 92])
         print(f"rendered {iid} ({time.perf_counter() - start:.0f} s)", flush=True)
     write_camera_json(data / "camera.json", cam)
-    write_trajectory_csv(data / "traj.csv", _trajectory(rng, True))
     write_lines_csv(data / "lines.csv", lines)
     write_planes_csv(data / "planes.csv", planes)
     header = laspy.LasHeader(point_format=3, version="1.2")
@@ -143,7 +148,7 @@ def check(out: Path) -> None:
         path = out / f"{name}_bore.csv"
         if not path.exists():
             continue
-        row = next(csv.DictReader(path.open()))
+        row = next(csv.DictReader(s for s in path.open() if not s.startswith("#")))
         got = np.array([float(row[f"d_{a}_deg"]) for a in ("omega", "phi", "kappa")])
         std = np.array([float(row[f"std_d_{a}_arcsec"]) for a in ("omega", "phi", "kappa")])
         err = (got - TRUTH_DEG) * 3600
@@ -151,10 +156,16 @@ def check(out: Path) -> None:
               f"|error| / sigma {np.round(np.abs(err) / std, 2)}")
     rounds = out / "auto_rounds.csv"
     if rounds.exists():
+        first = next(csv.DictReader(rounds.open()))
+        # the angle search's result: round 1's boresight less its change from the search
+        search = np.array([float(first[f"d_{a}_deg"]) - float(first[f"change_d_{a}_arcsec"])
+                           / 3600 for a in ("omega", "phi", "kappa")])
+        print(f"angle search: {np.round(search, 4)} deg, error "
+              f"{np.round((search - TRUTH_DEG) * 3600, 1)} arcsec")
         for r in csv.DictReader(rounds.open()):
             print(f"round {r['round']}: line points {r['line_points']} on {r['lines_seen']} "
                   f"lines, tie tracks {r['tie_tracks']}, on planes {r['ties_associated']}, "
-                  f"refused {r['ties_refused']}")
+                  f"refused {r['ties_refused']}, rejected {r['rejected']}")
 
 
 def main() -> None:

@@ -50,6 +50,10 @@ class _Obs:
     row_names: list[str]
     c: int | None  # condition rows per group (known after the first evaluation)
     inv_sigma: Array | None = None  # (G, o) 1/sigma when every cov is diagonal, else None
+    # Rows whose covariance has no off-diagonal entry in any group (a line's pixels beside its
+    # 6 x 6 (X0, u)), when the others are at most half: products with cov and weight then take
+    # those rows as a diagonal scaling and only the rest as a matrix (see :meth:`times_cov`).
+    sparse_rows: tuple[NDArray[np.intp], NDArray[np.intp]] | None = None
 
     @property
     def groups(self) -> int:
@@ -62,6 +66,26 @@ class _Obs:
     @property
     def k(self) -> int:
         return self.param_index.shape[1]
+
+    def times_cov(self, M: Array) -> Array:
+        """``cov @ M`` for M of shape (G, o, n) (:func:`_structured_times`)."""
+        return _structured_times(self.cov, self.sparse_rows, M)
+
+
+def _structured_times(
+    S: Array, sparse_rows: tuple[NDArray[np.intp], NDArray[np.intp]] | None, M: Array
+) -> Array:
+    """``S @ M`` for S (G, o, o) a covariance or weight matrix and M (G, o, n); with
+    ``sparse_rows`` (diagonal rows, coupled rows: :attr:`_Obs.sparse_rows`) the diagonal rows
+    are scaled and the coupled ones multiplied by their (coupled x coupled) part only: the two
+    parts do not couple, so the product is the same."""
+    if sparse_rows is None:
+        return S @ M
+    diag, dense = sparse_rows
+    out = np.empty(M.shape)
+    out[:, diag] = S[:, diag, diag][:, :, None] * M[:, diag]
+    out[:, dense] = S[:, dense[:, None], dense[None, :]] @ M[:, dense]
+    return out
 
 
 @dataclass
@@ -160,19 +184,15 @@ def _prepare_block(block: Block, n: int, names: list[str]) -> _Obs:
             raise InputError(f"{where}: sigma must be finite and > 0")
         cov = np.zeros((g, o, o))
         cov[:, np.arange(o), np.arange(o)] = s**2
-    try:
-        chol = np.linalg.cholesky(cov) if g else np.zeros((0, o, o))
-    except np.linalg.LinAlgError:
-        bad = np.flatnonzero(np.linalg.eigvalsh(cov)[:, 0] <= 0)
-        raise InputError(
-            f"{where}: covariance of group {int(bad[0]) if bad.size else '?'} is not "
-            "positive definite"
-        ) from None
-    chol_inv = np.linalg.inv(chol) if g else chol
     off = cov.copy()
     off[:, np.arange(o), np.arange(o)] = 0.0
+    coupled = off.any(axis=(0, 2)) if g else np.zeros(o, dtype=bool)
+    sparse_rows = None
+    if coupled.any() and 2 * int(coupled.sum()) <= o:
+        sparse_rows = (np.flatnonzero(~coupled), np.flatnonzero(coupled))
+    # a Gauss-Helmert block's factors from its two parts (a line's 2,000 pixels: no o^3)
+    chol, chol_inv, weight = _factors(cov, sparse_rows if not gm else None, where)
     inv_sigma = None if off.any() else np.ascontiguousarray(np.einsum("gii->gi", chol_inv))
-    weight = np.swapaxes(chol_inv, 1, 2) @ chol_inv
     func = block.model if gm else block.condition
     if isinstance(func, _PriorModel) and block.labels is None:
         labels = [names[i] for i in idx[:, 0]]
@@ -193,7 +213,47 @@ def _prepare_block(block: Block, n: int, names: list[str]) -> _Obs:
         row_names=row_names,
         c=o if gm else None,
         inv_sigma=inv_sigma,
+        sparse_rows=sparse_rows,
     )
+
+
+def _factors(
+    cov: Array, sparse_rows: tuple[NDArray[np.intp], NDArray[np.intp]] | None, where: str
+) -> tuple[Array, Array, Array]:
+    """(lower Cholesky factor, its inverse, the weight matrix) of each group's covariance
+    (G, o, o); with ``sparse_rows`` (diagonal rows, coupled rows) from the diagonal and the
+    coupled part separately (the same factors: the parts do not couple)."""
+    g, o, _ = cov.shape
+    if not g:
+        return np.zeros((0, o, o)), np.zeros((0, o, o)), np.zeros((0, o, o))
+    parts = [np.arange(o)] if sparse_rows is None else [sparse_rows[1]]
+    chol = np.zeros_like(cov)
+    chol_inv = np.zeros_like(cov)
+    weight = np.zeros_like(cov)
+    if sparse_rows is not None:
+        diag = sparse_rows[0]
+        d = cov[:, diag, diag]
+        if not (d > 0).all():
+            bad = int(np.flatnonzero(~(d > 0).all(axis=1))[0])
+            raise InputError(f"{where}: covariance of group {bad} is not positive definite")
+        chol[:, diag, diag] = np.sqrt(d)
+        chol_inv[:, diag, diag] = 1.0 / np.sqrt(d)
+        weight[:, diag, diag] = 1.0 / d
+    for rows in parts:
+        at = (slice(None), rows[:, None], rows[None, :])
+        part = cov[at]
+        try:
+            L = np.linalg.cholesky(part)
+        except np.linalg.LinAlgError:
+            bad = np.flatnonzero(np.linalg.eigvalsh(part)[:, 0] <= 0)
+            raise InputError(
+                f"{where}: covariance of group {int(bad[0]) if bad.size else '?'} is not "
+                "positive definite"
+            ) from None
+        Li = np.linalg.inv(L)
+        chol[at], chol_inv[at] = L, Li
+        weight[at] = np.swapaxes(Li, 1, 2) @ Li
+    return chol, chol_inv, weight
 
 
 def _check_finite(block: str, labels: list[str], *arrays: Array) -> None:
@@ -203,6 +263,56 @@ def _check_finite(block: str, labels: list[str], *arrays: Array) -> None:
         ok = np.isfinite(a.reshape(a.shape[0], -1)).all(axis=1)
         if not ok.all():
             raise _NonFiniteError(block, labels[int(np.flatnonzero(~ok)[0])])
+
+
+#: Conditions per group from which a Gauss-Helmert group with :attr:`_Obs.sparse_rows` is
+#: whitened group by group with sparse products (:func:`_whiten_large`).
+_LARGE_GROUP = 64
+
+
+def _singular(where: str, label: str) -> AdjustmentError:
+    return AdjustmentError(
+        f"{where}: B S B' is singular for group {label}: the conditions of a group "
+        "must be independent functions of its observations"
+    )
+
+
+def _whiten_large(b: _Obs, A: Array, B: Array, w: Array, where: str) -> _BlockLin:
+    """The whitened linearisation of a Gauss-Helmert block of large groups (a LiDAR line with
+    the pixels of its ~1,000 measurements) whose covariance has rows without off-diagonal
+    entries (:attr:`_Obs.sparse_rows`): the same ``L = chol(B S B')``, ``abar = L^-1 A``,
+    ``wbar = L^-1 w`` and ``K = S B' L^-T`` as the batched path, with the products over the
+    diagonal rows taken sparse (B has few entries there: a measurement's pixel enters its own
+    condition only) and L inverted as a triangle, per group. Cost per group about
+    ``2/3 c^3`` instead of ``~3 c^2 o + 2 c^3``."""
+    from scipy.linalg.lapack import dtrtri
+
+    assert b.sparse_rows is not None
+    diag, dense = b.sparse_rows
+    g, c, k = A.shape
+    abar = np.empty((g, c, k))
+    wbar = np.empty((g, c))
+    K = np.empty((g, b.o, c))
+    for gi in range(g):
+        s = b.cov[gi, diag, diag]
+        SX = b.cov[gi][np.ix_(dense, dense)]
+        BD = sp.csr_matrix(B[gi][:, diag])  # (c, diagonal rows)
+        BX = B[gi][:, dense]
+        SBtD = BD.T.multiply(s[:, None]).tocsr()  # S B' over the diagonal rows, sparse
+        SBtX = SX @ BX.T
+        M = np.asarray((BD @ SBtD).todense()) + BX @ SBtX
+        try:
+            L = np.linalg.cholesky(M)
+        except np.linalg.LinAlgError:
+            raise _singular(where, b.labels[gi]) from None
+        Linv, info = dtrtri(L, lower=1)
+        if info != 0:
+            raise _singular(where, b.labels[gi])
+        abar[gi] = Linv @ A[gi]
+        wbar[gi] = Linv @ w[gi]
+        K[gi, diag] = SBtD @ Linv.T
+        K[gi, dense] = SBtX @ Linv.T
+    return _BlockLin(abar=abar, wbar=wbar, K=K)
 
 
 def _shape_error(where: str, what: str, got: tuple, want: tuple) -> InputError:
@@ -274,17 +384,15 @@ class _Problem:
             raise _shape_error(where, "condition Jacobian B", B.shape, (g, c, o))
         _check_finite(b.name, b.labels, gv, A, B)
         w = gv - np.einsum("gco,go->gc", B, vhat)
-        SBt = b.cov @ np.swapaxes(B, 1, 2)  # (G, o, c)
+        if b.sparse_rows is not None and c >= _LARGE_GROUP:
+            return _whiten_large(b, A, B, w, where)
+        SBt = b.times_cov(np.swapaxes(B, 1, 2))  # (G, o, c)
         M = B @ SBt
         try:
             L = np.linalg.cholesky(M)
         except np.linalg.LinAlgError:
             bad = np.flatnonzero(np.linalg.eigvalsh(M)[:, 0] <= 0)
-            label = b.labels[int(bad[0])] if bad.size else "?"
-            raise AdjustmentError(
-                f"{where}: B S B' is singular for group {label}: the conditions of a group "
-                "must be independent functions of its observations"
-            ) from None
+            raise _singular(where, b.labels[int(bad[0])] if bad.size else "?") from None
         Linv = np.linalg.inv(L)
         abar = Linv @ A
         wbar = np.einsum("gij,gj->gi", Linv, w)

@@ -16,7 +16,7 @@ from ..errors import AdjustmentError
 from ..i18n import mark as _t
 from .model import AdjustmentOptions
 from .observability import _check_observability
-from .problem import _Lin, _Problem
+from .problem import _Lin, _Obs, _Problem, _structured_times
 from .results import AdjustmentResult, ChiSquareTest, ResidualTable
 from .schur import ReducedNormal, SingularSystem
 from .solve import _Run, _scaled_cofactor
@@ -31,6 +31,32 @@ _REDUNDANCY_EPS = 1e-9
 # Groups per chunk when the standardised residuals are computed (bounds the k x k cofactor
 # blocks held at once).
 _RESIDUAL_CHUNK = 20000
+
+
+def _block_times(b: _Obs, M: Array, sel: NDArray[np.intp]) -> Array:
+    """``weight @ M`` for the groups ``sel`` of block ``b`` (M of shape (len(sel), o, n))."""
+    if b.inv_sigma is not None:  # diagonal weights
+        return (b.inv_sigma[sel] ** 2)[:, :, None] * M
+    if b.sparse_rows is None:
+        return b.weight[sel] @ M
+    return _structured_times(b.weight[sel], b.sparse_rows, M)
+
+
+def _coupled_rows(
+    rows: NDArray[np.intp], K: Array, ab: Array, Q: Array, sign: Array, P: Array, r: Array,
+    pqp: Array
+) -> None:
+    """``diag(Qvv P)`` and ``diag(P Qvv P)`` of the coupled rows (a line's X0 and u, whose
+    weights come from a covariance of rank 4 regularised by 1e-12: their products cancel to
+    rounding) recomputed in place from the rows' own block of ``Qvv = K (I -+ ab Q ab') K'``,
+    in the order of operations of the whole-matrix formula (only those rows' block is
+    formed): so these rows' tests are as before, not the rounding of the factored form."""
+    KX = K[:, rows]
+    inner = np.eye(ab.shape[1]) + sign * (ab @ Q @ np.swapaxes(ab, 1, 2))
+    QX = KX @ inner @ np.swapaxes(KX, 1, 2)
+    PX = P[:, rows[:, None], rows[None, :]]
+    r[:, rows] = np.einsum("gij,gji->gi", QX, PX)
+    pqp[:, rows] = np.einsum("gij,gjk,gki->gi", PX, QX, PX)
 
 
 def _residual_tables(
@@ -52,14 +78,21 @@ def _residual_tables(
         for lo in range(0, g if qgg is not None else 0, _RESIDUAL_CHUNK):
             sel = np.arange(lo, min(g, lo + _RESIDUAL_CHUNK))
             ab, K, ac = bl.abar[sel], bl.K[sel], a[sel]
-            S = ab @ qgg(bi, sel) @ np.swapaxes(ab, 1, 2)
-            eye = np.eye(S.shape[1])
+            abt = np.swapaxes(ab, 1, 2)
+            Q = qgg(bi, sel)
             # Kept groups: Q_ww = Pe^-1 - A Qxx A'; rejected: prediction, Pe^-1 + A Qxx A'.
-            inner = np.where(ac[:, None, None], eye - S, eye + S)
-            Qvv = K @ inner @ np.swapaxes(K, 1, 2)
+            # Qvv = K (I -+ ab Q ab') K' is never formed (o x o per group): with
+            # G = K (I -+ ab Q ab') and PK = P K, diag(Qvv P) = rowsum(G * PK) and
+            # diag(P Qvv P) = rowsum(P G * PK), P symmetric.
+            sign = np.where(ac, -1.0, 1.0)[:, None, None]
             P = b.weight[sel]
-            r = np.einsum("gij,gji->gi", Qvv, P)
-            pqp = np.einsum("gij,gjk,gki->gi", P, Qvv, P)
+            PK = _block_times(b, K, sel)
+            G = K + sign * (((K @ ab) @ Q) @ abt)
+            PG = PK + sign * (((PK @ ab) @ Q) @ abt)
+            r = np.einsum("gil,gil->gi", G, PK)
+            pqp = np.einsum("gil,gil->gi", PG, PK)
+            if b.sparse_rows is not None:
+                _coupled_rows(b.sparse_rows[1], K, ab, Q, sign, P, r, pqp)
             Pv = np.einsum("gij,gj->gi", P, v[sel])
             with np.errstate(invalid="ignore", divide="ignore"):
                 ws = Pv / (sigma0_prior * np.sqrt(np.where(pqp > 0, pqp, np.nan)))

@@ -177,6 +177,49 @@ def _nominal_camera_vectors(
 #: Most grid steps each side of the initial boresight at the search's first level.
 _FIRST_STEPS = 8.0
 
+#: Side of the tiles in which the edge strength is computed when the search first samples
+#: them (reduced pixels): lines cover a small part of a large image.
+_TILE = 64
+
+
+class _EdgeStrength:
+    """The gradient magnitude of one (reduced) grey image blurred by ``sigma`` pixels, computed
+    tile by tile where it is sampled: each tile is filtered with a margin of the Gaussian's
+    support (scipy's ``truncate`` of 4 sigma), or up to the image border, where the same
+    reflection applies, so every value is the one the whole image's filter gives."""
+
+    def __init__(self, grey: NDArray[np.float32], sigma: float) -> None:
+        self.grey = grey
+        self.sigma = float(sigma)
+        self.pad = int(4.0 * self.sigma + 0.5) + 1
+        # zeros are not touched until written: the memory follows the tiles computed
+        self.values = np.zeros(grey.shape, dtype=np.float32)
+        shape = (-(-grey.shape[0] // _TILE), -(-grey.shape[1] // _TILE))
+        self.done = np.zeros(shape, dtype=bool)
+
+    def sample(self, rows: Array, cols: Array) -> Array:
+        """Bilinear samples at (rows, cols) in pixel-index coordinates (pixel centres at
+        integers; ``scipy.ndimage.map_coordinates`` order 1: 0 outside the image)."""
+        from scipy.ndimage import gaussian_gradient_magnitude, map_coordinates
+
+        h, w = self.grey.shape
+        r0 = np.floor(rows).astype(np.intp)
+        c0 = np.floor(cols).astype(np.intp)
+        # the tiles of the four neighbours of each sample
+        ty = np.clip(np.concatenate([r0, r0, r0 + 1, r0 + 1]) // _TILE, 0, self.done.shape[0] - 1)
+        tx = np.clip(np.concatenate([c0, c0 + 1, c0, c0 + 1]) // _TILE, 0, self.done.shape[1] - 1)
+        need = np.zeros_like(self.done)
+        need[ty, tx] = True
+        for i, j in zip(*np.nonzero(need & ~self.done)):
+            y0, x0 = i * _TILE, j * _TILE
+            y1, x1 = min(h, y0 + _TILE), min(w, x0 + _TILE)
+            a0, b0 = max(0, y0 - self.pad), max(0, x0 - self.pad)
+            a1, b1 = min(h, y1 + self.pad), min(w, x1 + self.pad)
+            g = gaussian_gradient_magnitude(self.grey[a0:a1, b0:b1], self.sigma)
+            self.values[y0:y1, x0:x1] = g[y0 - a0 : y1 - a0, x0 - b0 : x1 - b0]
+            self.done[i, j] = True
+        return map_coordinates(self.values, [rows, cols], order=1)
+
 
 class _Search:
     """The line samples of all images (stacked) and the images' edge strength at one blur."""
@@ -185,7 +228,7 @@ class _Search:
         self.camera = camera
         self.us = us
         self.greys = greys
-        self.grads: list[NDArray[np.float32]] = []
+        self.grads: list[_EdgeStrength] = []
         self.stride = 1
         self.reduce = 1
         self._blurred: tuple[float, int] = (-1.0, 0)
@@ -195,9 +238,9 @@ class _Search:
         every ``stride``-th sample. A wide blur is computed on the image reduced by an integer
         factor (box average) that keeps at least 2 reduced pixels of sigma: the search needs
         the edges' position at the blur's scale only, and a 24-Mpx image blurred by 30 px
-        would otherwise cost seconds per candidate level."""
+        would otherwise cost seconds per candidate level. The blurred gradient is computed
+        where the candidates sample it (:class:`_EdgeStrength`)."""
         import cv2
-        from scipy.ndimage import gaussian_gradient_magnitude
 
         r = max(1, int(sigma_px // 2.0))
         if self._blurred != (sigma_px, r):
@@ -207,7 +250,7 @@ class _Search:
                 if r > 1:
                     h, w = (g.shape[0] // r) * r, (g.shape[1] // r) * r
                     g = cv2.resize(g[:h, :w], (w // r, h // r), interpolation=cv2.INTER_AREA)
-                grads.append(gaussian_gradient_magnitude(g, sigma_px / r))
+                grads.append(_EdgeStrength(g, sigma_px / r))
             self.grads, self.reduce, self._blurred = grads, r, (sigma_px, r)
         self.stride = max(1, int(stride))
         parts = [u[:: self.stride] for u in self.us]
@@ -216,8 +259,6 @@ class _Search:
 
     def score(self, bore: Array) -> float:
         """Mean edge strength under the projected lines (out-of-frame samples count 0)."""
-        from scipy.ndimage import map_coordinates
-
         cam = self.camera
         q = self.u @ boresight_matrix(*bore)  # v = dR^T u, in rows
         ideal, valid = ideal_from_camera(q, cam.focal_mm, cam.projection)[:2]
@@ -230,7 +271,7 @@ class _Search:
             # (j + 1/2) r in the project's pixel convention (first pixel's centre at 0.5)
             p = px[good & (self.owner == k)] / self.reduce - 0.5
             if len(p):
-                total += float(map_coordinates(g, [p[:, 1], p[:, 0]], order=1).sum())
+                total += float(g.sample(p[:, 1], p[:, 0]).sum())
         return total / max(len(px), 1)
 
     def grid_best(

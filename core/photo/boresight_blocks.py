@@ -350,11 +350,33 @@ def _tie_plane_block(name, k, sel, members, tie_idx, p_params, p_cov, rough, pla
     )
 
 
+def _distinct_index(full: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """(G, m) parameter indices with repeats -> ((G, u) the distinct indices of each group,
+    padded with its first index where a group has fewer than u, (G, m) the column of each
+    entry among them). The padding's Jacobian columns are left zero by the model (repeated
+    indices add up in the adjustment), so the group's equations are unchanged; only the
+    columns that are all zero are gone (a line seen in n images has 3 + 6 n parameters, not
+    9 per measurement)."""
+    g, m = full.shape
+    found = [np.unique(row, return_inverse=True) for row in full]
+    u = max((len(vals) for vals, _ in found), default=0)
+    index = np.empty((g, u), dtype=np.intp)
+    cols = np.empty((g, m), dtype=np.intp)
+    for i, (vals, inv) in enumerate(found):
+        index[i, : len(vals)] = vals
+        index[i, len(vals) :] = vals[0]
+        cols[i] = inv.ravel()
+    return index, cols
+
+
 def _line_block(name, k, sel, members, lx0, lu, lcov, obs, img, pose_idx, r_nl, spec, line_names):
-    """Gauss-Helmert: every measured ray of a line is coplanar with it."""
+    """Gauss-Helmert: every measured ray of a line is coplanar with it (the group's parameters
+    are the distinct pose parameters of its measurements: :func:`_distinct_index`)."""
     lk = len(sel)
     p = spec.size
     flat = members.ravel()
+    index, cols = _distinct_index(pose_idx[img[flat]].reshape(lk, k * p))
+    at = (np.arange(lk)[:, None, None], np.arange(k)[None, :, None], cols.reshape(lk, k, p))
     o = 2 * k + 6
     observed = np.hstack([obs.pixels[flat].reshape(lk, 2 * k), lx0[sel], lu[sel]])
     cov = np.zeros((lk, o, o))
@@ -365,7 +387,7 @@ def _line_block(name, k, sel, members, lx0, lu, lcov, obs, img, pose_idx, r_nl, 
     ar = np.arange(k)
 
     def condition(x_local: Array, l_hat: Array) -> tuple[Array, Array, Array]:
-        xp = x_local.reshape(-1, p)
+        xp = np.take_along_axis(x_local, cols, axis=1).reshape(-1, p)
         px = l_hat[:, : 2 * k].reshape(-1, 2)
         x0 = np.repeat(l_hat[:, 2 * k : 2 * k + 3], k, axis=0)
         u = np.repeat(l_hat[:, 2 * k + 3 :], k, axis=0)
@@ -377,13 +399,15 @@ def _line_block(name, k, sel, members, lx0, lu, lcov, obs, img, pose_idx, r_nl, 
         b[:, ar, 2 * ar + 1] = jp[:, :, 1]
         b[:, :, 2 * k : 2 * k + 3] = j_pt.reshape(n, k, 3)
         b[:, :, 2 * k + 3 :] = j_dir.reshape(n, k, 3)
-        return g.reshape(n, k), _block_diag(j_pose, k), b
+        a = np.zeros((n, k, index.shape[1]))
+        a[at] = j_pose.reshape(n, k, p)  # the p parameters of one measurement are distinct
+        return g.reshape(n, k), a, b
 
     return GaussHelmertBlock(
         name,
         observed,
         cov,
-        pose_idx[img[flat]].reshape(lk, k * p),
+        index,
         condition,
         labels=[f"line {s}" for s in line_names],
         row_names=(

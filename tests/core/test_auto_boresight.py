@@ -527,3 +527,23 @@ def test_the_job_refuses_bad_inputs_by_name(files, tmp_path):
     with pytest.raises(InputError, match="no image is named in the trajectory"):
         run_job(job, {**inputs, "IMAGES": [str(empty)], **out})
     assert not any(tmp_path.glob("*.csv")) and not any(tmp_path.glob("*.html"))
+
+
+@pytest.mark.parametrize("sigma", [0.7, 3.6, 14.0])
+def test_edge_strength_by_tiles_equals_the_whole_image_filter(sigma):
+    """The search's edge strength, filtered tile by tile where it is sampled, is bit for bit
+    the whole image's gradient magnitude (the tiles' margins cover the Gaussian's support,
+    the image border reflects as in the whole image), and only the sampled tiles are done."""
+    from lidarphoto.core.photo.auto_boresight import _EdgeStrength
+    from scipy.ndimage import gaussian_gradient_magnitude, map_coordinates
+
+    rng = np.random.default_rng(3)
+    grey = (rng.random((700, 900)) * 255).astype(np.float32)
+    whole = gaussian_gradient_magnitude(grey, sigma)
+    edge = _EdgeStrength(grey, sigma)
+    t = rng.random(400)  # samples along a diagonal line that leaves the image, and the corners
+    rows = np.r_[-0.7 + 720 * t, 0.0, 699.0, 0.3, 698.6]
+    cols = np.r_[5 + 300 * t, 0.0, 899.0, 898.7, 0.2]
+    got = edge.sample(rows, cols)
+    assert np.array_equal(got, map_coordinates(whole, [rows, cols], order=1))
+    assert 0 < edge.done.mean() < 0.5, edge.done.mean()
