@@ -16,7 +16,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
 
-from ..errors import AdjustmentError, ConvergenceError, stop_if_asked
+from ..errors import AdjustmentError, ConvergenceError, NotObservableError, stop_if_asked
 from ..i18n import mark as _t
 from .model import AdjustmentOptions
 from .observability import _DENSE_ANALYSIS_MAX_N, _check_observability
@@ -323,8 +323,23 @@ def _normal(
         n = problem.n
         use_sparse = n > _SPARSE_AUTO_MIN_N and nrm.Ns.nnz <= _SPARSE_AUTO_MAX_DENSITY * n * n
     if check:
+        _check_count(problem, active)
         _check_observability(nrm, problem.names, opts.condition_limit, problem.constraint_labels())
     return nrm, rowscale, use_sparse
+
+
+def _check_count(problem: _Problem, active: list[NDArray[np.bool_]]) -> None:
+    """Refuse fewer equations than unknowns before any analysis: no datum or weighting makes
+    such a system determined, and the message says so with the counts."""
+    rows, cons = problem.rows(active), problem.constraint_rows()
+    if rows + cons < problem.n:
+        raise NotObservableError(
+            f"Not observable: {problem.n} unknowns but {rows} observation rows and {cons} "
+            f"constraint rows (redundancy {rows + cons - problem.n}): fewer equations than "
+            "unknowns; add observations (more points, more images of each point) or hold "
+            "parameters fixed",
+            parameters=list(problem.names),
+        )
 
 
 def _function_tolerance_met(

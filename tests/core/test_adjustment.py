@@ -550,6 +550,19 @@ def test_parameter_without_observations_is_named():
     assert info.value.parameters == ["unused"]
 
 
+def test_fewer_equations_than_unknowns_are_refused_with_the_counts():
+    """Two observations of a line for three unknowns: refused before any analysis, the
+    message giving the counts (a BAL extract such as GTSAM's dubrovnik-3-7, 48 unknowns and
+    38 residuals, is refused the same way, where Ceres returns one of its solutions)."""
+    t = np.array([0.0, 1.0])
+    with pytest.raises(NotObservableError, match=r"3 unknowns but 2 observation rows") as info:
+        adjust([0, 0, 0], ["a", "b", "c"], [line_block(t, 1 + t, np.full(2, 0.1))])
+    assert "redundancy -1" in str(info.value)
+    # as many equations as unknowns is determined (redundancy 0)
+    res = adjust([0, 0], ["a", "b"], [line_block(t, 1 + t, np.full(2, 0.1))])
+    np.testing.assert_allclose(res.x, [1.0, 1.0], atol=1e-12)
+
+
 # ----------------------------------------------------------------------------- 8. snooping
 
 
