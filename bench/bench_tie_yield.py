@@ -73,6 +73,7 @@ VARIANTS = {
     "nocoh": {"coherence": 0.0},
     "half": {"max_dimension_px": 1068},
     "nopre": {"preemptive": 0.0},
+    "k32": {"checks": 32},
 }
 
 

@@ -37,6 +37,9 @@ class TiePointOptions:
     max_dimension_px : int
         Features are detected on the image reduced by the smallest integer factor that
         brings its longer side to at most this; 0 detects at full resolution.
+    checks : int
+        SIFT: leaves of FLANN's k-d trees visited per nearest-neighbour search (the search's
+        cost grows with it; fewer finds fewer true neighbours).
     ratio : float
         Lowe's ratio: best distance / second best must be below it.
     root_sift : bool
@@ -94,6 +97,7 @@ class TiePointOptions:
     keep: str = "scale"
     max_dimension_px: int = 3000
     ratio: float = 0.8
+    checks: int = 64
     root_sift: bool = True
     mutual: bool = True
     ransac_px: float = 2.0
@@ -122,6 +126,8 @@ class TiePointOptions:
             raise InputError(f"RANSAC method must be one of {', '.join(RANSAC_METHODS)}")
         if not 0.0 < self.ratio <= 1.0:
             raise InputError(f"ratio must be in (0, 1], got {self.ratio:g}")
+        if self.checks < 1:
+            raise InputError(f"FLANN checks must be at least 1, got {self.checks}")
         if self.min_track_length < 2:
             raise InputError("a track needs at least 2 images")
         if self.min_inliers < 8:

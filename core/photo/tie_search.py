@@ -36,7 +36,7 @@ def root_sift(d: NDArray) -> NDArray[np.float32]:
 
 
 class DescriptorIndex:
-    """FLANN's randomised k-d trees (4 trees, 64 checks) over one image's
+    """FLANN's randomised k-d trees (4 trees, ``checks`` leaves visited) over one image's
     float descriptors (RootSIFT when asked), built once per image and searched by every pair
     it is in, in both directions (OpenCV's matcher object rebuilt them for every search).
     The trees are drawn from OpenCV's random state seeded here, so a run is repeatable; a
@@ -48,9 +48,10 @@ class DescriptorIndex:
     ([[2, 0]], [[0.5, 1.118]])
     """
 
-    def __init__(self, descriptors: NDArray) -> None:
+    def __init__(self, descriptors: NDArray, checks: int = 64) -> None:
         import cv2
 
+        self.checks = int(checks)
         self.descriptors = np.ascontiguousarray(descriptors, np.float32)
         cv2.setRNGSeed(12345)
         self._flann = cv2.flann_Index(self.descriptors, {"algorithm": 1, "trees": 4})  # type: ignore[attr-defined]
@@ -65,7 +66,7 @@ class DescriptorIndex:
         q = np.ascontiguousarray(query, np.float32)
         if q.shape[0] == 0:
             return np.zeros((0, k), np.intp), np.zeros((0, k))
-        idx, d2 = self._flann.knnSearch(q, k, params={"checks": 64})
+        idx, d2 = self._flann.knnSearch(q, k, params={"checks": self.checks})
         idx = np.asarray(idx, np.intp).reshape(q.shape[0], k)
         dist = np.sqrt(np.maximum(np.asarray(d2, np.float64).reshape(idx.shape), 0.0))
         bad = (idx < 0) | (idx >= len(self))
@@ -80,7 +81,7 @@ def descriptor_index(features: ImageFeatures, options: TiePointOptions) -> Descr
     if options.detector == "orb" or len(features) < 2:
         return None
     d = features.descriptors
-    return DescriptorIndex(root_sift(d) if options.root_sift else d)
+    return DescriptorIndex(root_sift(d) if options.root_sift else d, options.checks)
 
 
 def epipolar_distances(f: Array, pa: Array, pb: Array) -> Array:
