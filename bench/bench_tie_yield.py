@@ -74,6 +74,7 @@ VARIANTS = {
     "half": {"max_dimension_px": 1068},
     "nopre": {"preemptive": 0.0},
     "k32": {"checks": 32},
+    "k24": {"checks": 24},
 }
 
 
