@@ -417,8 +417,9 @@ def lsm_in_image(
     cut around its start position, large enough for the template under its own start affine
     plus ``max_shift_px`` and a margin; positions are returned in the image's array
     coordinates. Windows that would leave the image are cut at its border (a patch that
-    reaches it is reported as having left the search window). The templates are matched in
-    groups of one window size: a single start affine of a large scale no longer enlarges
+    reaches it is reported as having left the search window). A start whose window would be
+    more than twice the median one is matched in a group of its own window size, the others
+    share the largest of theirs: a single start affine of a large scale no longer enlarges
     every window of the batch (6 kite images: 3,370 windows of 263 x 263 px, 1.9 GB, for one
     such start, where 37-47 px serve the others).
     """
@@ -435,6 +436,10 @@ def lsm_in_image(
     halves = np.ceil(reach + opt.max_shift_px + 3).astype(np.intp)
     if k_n == 0 or a.shape[0] != k_n:
         return lsm_batch(f, np.zeros((k_n, 1, 1)), a, reference, opt)
+    # the usual starts share the largest of their windows (a patch keeps room to drift and be
+    # called so); a start needing more than twice the median is matched in its own group
+    usual = halves <= 2 * np.median(halves)
+    halves[usual] = halves[usual].max()
     border = int(halves.max()) + 1
     pad = np.pad(img, border, mode="constant", constant_values=np.nan)
     out = LsmResult(
