@@ -21,7 +21,13 @@ measurement pairs of every track, refined when the refinement is on; COLMAP: its
 keypoint matches) to the common epipolar lines (mean of the two images' distances).
 
 Usage: OMP_NUM_THREADS=1 nice -n 10 python bench/bench_tie_yield.py [--variants default,...]
-[--colmap /path/to/python] [--colmap-features 8192]
+[--colmap /path/to/python] [--colmap-features 8192] [--no-warmup]
+
+The CPU of each stage (``stages_s``: detection and description, matching with the
+verification and the tracks, the least-squares refinement) is read at the chain's progress
+marks. For a whole-process comparison (interpreter start, imports and numba's cached kernel
+included, as for COLMAP's child) run one variant with ``--no-warmup`` and time the process
+and ``colmap_tp.py`` alternately from outside (e.g. ``/usr/bin/time -v``).
 """
 
 from __future__ import annotations
@@ -65,6 +71,10 @@ VARIANTS = {
     "nomutual": {"mutual": False},
     "ransac4": {"ransac_px": 4.0},
     "nocoh": {"coherence": 0.0},
+    "half": {"max_dimension_px": 1068},
+    "nopre": {"preemptive": 0.0},
+    "k32": {"checks": 32},
+    "k24": {"checks": 24},
 }
 
 
@@ -90,10 +100,23 @@ def run_ours(files: list[Path], options) -> tuple[dict, dict]:
     from lidarphoto.core.photo.tie_points import detect_features, tie_points
 
     ids = [f.stem for f in files]
+    marks: dict[str, float] = {}
+    edges = (0.4, 0.8) if options.refine else (0.5, 1.0)
+
+    def progress(x: float) -> None:  # CPU at the ends of detection and of matching
+        for name, edge in zip(("detect_s", "match_s"), edges):
+            if x >= edge - 1e-9 and name not in marks:
+                marks[name] = cpu()
+
     t0 = cpu()
     res = tie_points(ids, lambda k: detect_features(read_gray(files[k]), ids[k], options),
-                     options, load_image=lambda k: read_gray(files[k], 1))  # fmt: skip
+                     options, load_image=lambda k: read_gray(files[k], 1),
+                     progress=progress)  # fmt: skip
     t = cpu() - t0
+    stages = {"detect_s": round(marks["detect_s"] - t0, 1),
+              "match_s": round(marks["match_s"] - marks["detect_s"], 1)}  # fmt: skip
+    if options.refine:
+        stages["refine_s"] = round(t0 + t - marks["match_s"], 1)
     kept = [p for p in res.pairs if p.kept]
     lengths = res.tracks.lengths()
     fig = {"cpu_s": round(t, 1), "keypoints": int(sum(res.features)),
@@ -102,7 +125,8 @@ def run_ours(files: list[Path], options) -> tuple[dict, dict]:
            "mutual": int(sum(p.n_mutual for p in res.pairs)),
            "verified": int(sum(p.n_inliers for p in kept)),
            "tracks3": int((lengths >= 3).sum()), "tracks": int(lengths.size),
-           "dropped_two_in_one_image": int(res.tracks.rejected_inconsistent)}  # fmt: skip
+           "dropped_two_in_one_image": int(res.tracks.rejected_inconsistent),
+           "stages_s": stages}  # fmt: skip
     return fig, track_pairs(res.tracks)
 
 
@@ -198,9 +222,12 @@ def main() -> None:
     ap.add_argument("--variants", default="default")
     ap.add_argument("--colmap", help="a Python with pycolmap (the peer)")
     ap.add_argument("--colmap-features", type=int, default=8192)
+    ap.add_argument("--no-warmup", action="store_true",
+                    help="no warm-up run (the whole process timed from outside)")  # fmt: skip
     a = ap.parse_args()
     files = [DATA / f"{n}.jpg" for n in NAMES]
-    run_ours(files[:2], options_of("default"))  # warm-up: numba's LSM kernel loaded
+    if not a.no_warmup:
+        run_ours(files[:2], options_of("default"))  # warm-up: numba's LSM kernel loaded
     figures, matches = {}, {}
     for name in a.variants.split(","):
         figures[name], matches[name] = run_ours(files, options_of(name))

@@ -52,6 +52,13 @@ from .tie_options import DETECTORS, PAIR_MODES, RANSAC_METHODS, TiePointOptions
 from .tie_pairs import select_pairs
 from .tie_rays import KeypointRays, fit_essential, keypoint_rays, ray_epipolar_px
 from .tie_refine import RefineStats, refine_tracks
+from .tie_search import (
+    DescriptorIndex,
+    descriptor_index,
+    epipolar_distances,
+    root_sift,
+    search_neighbours,
+)
 from .tie_tracks import Tracks, build_tracks
 
 Array = NDArray[np.float64]
@@ -60,6 +67,7 @@ __all__ = [
     "DETECTORS",
     "PAIR_MODES",
     "RANSAC_METHODS",
+    "DescriptorIndex",
     "ImageFeatures",
     "PairMatch",
     "RefineStats",
@@ -67,9 +75,12 @@ __all__ = [
     "TiePointResult",
     "Tracks",
     "build_tracks",
+    "descriptor_index",
     "detect_features",
+    "epipolar_distances",
     "match_pair",
     "refine_tracks",
+    "root_sift",
     "tie_points",
 ]
 
@@ -257,52 +268,6 @@ def _knn(a: NDArray, b: NDArray, binary: bool, k: int):
     return idx, d1, d2
 
 
-def root_sift(d: NDArray) -> NDArray[np.float32]:
-    """RootSIFT (Arandjelovic & Zisserman 2012): each descriptor divided by its L1 norm and
-    square-rooted, so that the Euclidean distance compares them by the Hellinger kernel,
-    which separates true from false neighbours better than the Euclidean one (unit length).
-
-    >>> root_sift(np.array([[4, 0, 0, 12]], np.uint8)).astype(float).round(3).tolist()
-    [[0.5, 0.0, 0.0, 0.866]]
-    """
-    x = np.asarray(d, np.float32)
-    return np.sqrt(x / np.maximum(x.sum(axis=1, keepdims=True), 1e-12))
-
-
-def _knn_k(a: NDArray, b: NDArray, k: int) -> tuple[NDArray[np.intp], Array]:
-    """The ``k`` nearest rows of ``b`` of every row of ``a`` (FLANN, as :func:`_knn`):
-    indices (-1 where fewer were found) and distances, each (len(a), k)."""
-    import cv2
-
-    cv2.setRNGSeed(12345)
-    matcher = cv2.FlannBasedMatcher({"algorithm": 1, "trees": 4}, {"checks": 64})
-    res = matcher.knnMatch(a.astype(np.float32), b.astype(np.float32), k=k)
-    idx = np.full((len(res), k), -1, np.intp)
-    dist = np.full((len(res), k), np.inf)
-    for r, m in enumerate(res):
-        idx[r, : len(m)] = [x.trainIdx for x in m]
-        dist[r, : len(m)] = [x.distance for x in m]
-    return idx, dist
-
-
-def epipolar_distances(f: Array, pa: Array, pb: Array) -> Array:
-    """Mean of the distances of b to the epipolar line F a and of a to F^T b, pixels.
-
-    >>> f = np.array([[0, 0, 0], [0, 0, -1], [0, 1, 0.0]])  # a pure sideways shift
-    >>> epipolar_distances(f, np.array([[5.0, 3.0]]), np.array([[9.0, 3.5]])).tolist()
-    [0.5]
-    """
-    ha = np.column_stack([pa, np.ones(len(pa))])
-    hb = np.column_stack([pb, np.ones(len(pb))])
-    la = ha @ f.T  # lines in b
-    lb = hb @ f  # lines in a
-    num = np.abs(np.sum(hb * la, axis=1))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        db = num / np.hypot(la[:, 0], la[:, 1])
-        da = num / np.hypot(lb[:, 0], lb[:, 1])
-    return 0.5 * (da + db)
-
-
 def match_pair(
     fa: ImageFeatures,
     fb: ImageFeatures,
@@ -311,6 +276,7 @@ def match_pair(
     j: int = 1,
     overlap: float = math.nan,
     rays: tuple[KeypointRays, KeypointRays] | None = None,
+    index: tuple[DescriptorIndex | None, DescriptorIndex | None] | None = None,
 ) -> PairMatch:
     """Ratio test, mutual check and fundamental-matrix RANSAC between two images.
 
@@ -318,6 +284,9 @@ def match_pair(
     (OpenCV's), so a run is repeatable. ``rays``: the keypoints' camera rays of a fisheye
     camera (:func:`~core.photo.tie_rays.keypoint_rays`): the essential matrix on the rays
     instead, distances in pixels along the epipolar curves (:mod:`core.photo.tie_rays`).
+    ``index``: the two images' :func:`descriptor_index` (SIFT), built here when not given;
+    :func:`tie_points` builds each image's once. With ``options.preemptive`` the pair is
+    first tried on its largest keypoints only (:func:`~core.photo.tie_search.search_neighbours`).
     """
     import cv2
 
@@ -329,21 +298,28 @@ def match_pair(
     if len(fa) < 2 or len(fb) < 2:
         return drop("too few features")
     binary = options.detector == "orb"
-    da, db = fa.descriptors, fb.descriptors
-    if not binary and options.root_sift:
-        da, db = root_sift(da), root_sift(db)
     guided = options.guided and not binary
-    if guided:  # one search serves the ratio test and the guided matching
-        near, dist = _knn_k(da, db, min(_GUIDED_K, len(db)))
-        best, d1, d2 = near[:, 0], dist[:, 0], dist[:, 1]
+    near = dist = np.zeros((0, 0))
+    if binary:
+        best, d1, d2 = _knn(fa.descriptors, fb.descriptors, True, 2)
     else:
-        best, d1, d2 = _knn(da, db, binary, 2)
+        xa, xb = index if index is not None else (descriptor_index(fa, options), None)
+        xb = xb if xb is not None else descriptor_index(fb, options)
+        assert xa is not None and xb is not None
+        found = search_neighbours(fa, fb, xa, xb, options, rays is None)
+        if isinstance(found, str):
+            return drop(found)
+        near, dist = found
+        best, d1, d2 = near[:, 0], dist[:, 0], dist[:, 1]
     ok = (best >= 0) & (d1 < options.ratio * d2)
     ia = np.flatnonzero(ok)
     ib = best[ia]
     n_ratio = int(ia.size)
     if options.mutual and ia.size:
-        back, _, _ = _knn(db[ib], da, binary, 1)
+        if binary:
+            back = _knn(fb.descriptors[ib], fa.descriptors, True, 1)[0]
+        else:
+            back = xa.knn(xb.descriptors[ib], 1)[0][:, 0]
         keep = back == ia
         ia, ib = ia[keep], ib[keep]
     # a keypoint of b chosen by two of a (possible without the mutual check): drop both
@@ -413,10 +389,6 @@ def match_pair(
     return PairMatch(i, j, ka[sel], kb[sel], n_ratio, n_mutual, n_in, res[sel], "ok", overlap)
 
 
-#: Descriptor neighbours searched per keypoint by the guided matching.
-_GUIDED_K = 8
-
-
 def _guided(
     idx: NDArray[np.intp],
     dist: Array,
@@ -427,10 +399,11 @@ def _guided(
 ) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """Guided matching along the epipolar lines (``distance(ka, kb)``: the epipolar distance
     of keypoints ``ka`` of a and ``kb`` of b, pixels; ``idx``,
-    ``dist``: the descriptor neighbours in b of every keypoint of a, from :func:`_knn_k`):
-    each keypoint of a takes its nearest descriptor among the ``_GUIDED_K`` nearest of b that lie
+    ``dist``: the descriptor neighbours in b of every keypoint of a, from
+    :meth:`DescriptorIndex.knn`):
+    each keypoint of a takes its nearest descriptor among the ``GUIDED_K`` nearest of b that lie
     within ``ransac_px`` of its epipolar line, if that one is below ``ratio`` times the next
-    such neighbour (or, when it is the only one, the ``_GUIDED_K``-th neighbour's distance: a
+    such neighbour (or, when it is the only one, the ``GUIDED_K``-th neighbour's distance: a
     bound, so the test is stricter than with the true second). Keypoints of b taken twice
     are dropped; the matches ``ka``, ``kb`` already verified are kept. Returns the keypoint
     indices of all the matches (a one-to-one map)."""
@@ -507,6 +480,11 @@ def _coherent(p: Array, d: Array, tol_px: float) -> NDArray[np.bool_]:
 
 
 # --------------------------------------------------------------------------- the chain
+#: Images whose descriptor index :func:`tie_points` keeps for their next pairs (at 16,384
+#: RootSIFT features about 9 MB each).
+_INDEX_CACHE = 16
+
+
 @dataclass
 class TiePointResult:
     """Everything :func:`tie_points` found.
@@ -641,6 +619,15 @@ def tie_points(
         mode = "footprints" if footprint is not None else "sequential"
     pairs, overlap = select_pairs(n, mode, options.window, footprint, options.min_overlap)
     results: list[PairMatch] = []
+    cache: dict[int, DescriptorIndex | None] = {}
+
+    def index_of(k: int) -> DescriptorIndex | None:
+        if k not in cache:
+            if len(cache) >= _INDEX_CACHE:  # the oldest goes first
+                del cache[next(iter(cache))]
+            cache[k] = descriptor_index(feats[k], options)
+        return cache[k]
+
     for m, (i, j) in enumerate(pairs):
         stop_if_asked(should_stop, f"matching {image_ids[i]} with {image_ids[j]}")
         results.append(
@@ -652,6 +639,7 @@ def tie_points(
                 j,
                 overlap.get((i, j), math.nan),
                 (rays[i], rays[j]) if fisheye else None,
+                (index_of(i), index_of(j)),
             )
         )
         if progress is not None:
@@ -667,6 +655,7 @@ def tie_points(
     if options.refine:
         # the descriptors are not needed any more: free them before the images
         del feats[:], rays[:]
+        cache.clear()
         sub = None if progress is None else (lambda x: progress(share[1] + (1 - share[1]) * x))
         tracks, sigma, stats = refine_tracks(
             tracks, sigma, n, load_image, options, progress=sub, should_stop=should_stop

@@ -151,3 +151,34 @@ def test_keep_largest_scales(views):
         assert n_s >= 0.9 * n_r, b
     with pytest.raises(InputError, match="keep"):
         TiePointOptions(keep="largest")
+
+
+def test_preemptive_test_drops_only_the_pairs_without_overlap(views):
+    """The preemptive test (the largest-scale half of image a's keypoints first): an
+    overlapping pair, same or opposite heading, gives exactly the matches of the whole
+    search (the rest is searched and the neighbours of a query do not depend on the others),
+    and a pair over two different grounds (no true match) is dropped at the subset, as the
+    whole search drops it too. With fewer than PREEMPTIVE_MIN keypoints in the subset there
+    is no preemptive test (the same result as without)."""
+    from lidarphoto.core.photo.tie_search import PREEMPTIVE_MIN
+    from lidarphoto.core.simulation.textured_block import make_texture as texture
+
+    tb, img = views
+    on = TiePointOptions(max_features=4000, contrast=0.01, preemptive=0.5)
+    off = dataclasses.replace(on, preemptive=0.0)
+    f = {k: detect_features(img[k], str(k), on) for k in (0, 1, 7)}
+    assert len(f[0]) * on.preemptive >= PREEMPTIVE_MIN  # the test runs
+    for b in (1, 7):
+        m_on, m_off = match_pair(f[0], f[b], on), match_pair(f[0], f[b], off)
+        assert m_on.kept and m_off.n_inliers > 300
+        assert np.array_equal(m_on.idx_i, m_off.idx_i)
+        assert np.array_equal(m_on.idx_j, m_off.idx_j)
+        assert (m_on.n_ratio, m_on.n_mutual) == (m_off.n_ratio, m_off.n_mutual)
+    other = render_view(tb, texture(tb.extent(), 0.2, seed=7), 1, noise_dn=2.0)
+    g = detect_features(other, "other", on)
+    m_on, m_off = match_pair(f[0], g, on), match_pair(f[0], g, off)
+    assert not m_off.kept
+    assert not m_on.kept and m_on.status.startswith("too few inliers in the preemptive test")
+    small = dataclasses.replace(on, preemptive=(PREEMPTIVE_MIN - 1) / len(f[0]))
+    m_small = match_pair(f[0], g, small)
+    assert m_small.status == m_off.status
