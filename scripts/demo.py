@@ -294,8 +294,12 @@ def auto_step(
     and the cloud with plane ids (the planes' outlines), and no observation: the tie points
     are found between the images and the line points along the projected LiDAR lines. Outputs
     in auto_calibration/ (the simulated picks of step 3 given as hand picks to compare with).
-    ``per_line``: only the first images of each flight line (a reduced run). Returns the
-    figures: the seconds, counts and the boresight per group against the truth."""
+    ``per_line``: only the first images of each flight line (a reduced run). With
+    ``--accept-doubtful``: a run that fails its checks (e.g. data snooping rejecting more than
+    its false alarms explain) still writes its outputs, each with the warning at its top; the
+    warnings are printed and kept in the figures, and the comparison with the truth decides.
+    Returns the figures: the seconds, counts, warnings and the boresight per group against the
+    truth."""
     flight, lidar, auto = demo / "flight", demo / "lidar", demo / "auto_calibration"
     auto.mkdir(parents=True, exist_ok=True)
     files = sorted((flight / "images").glob("*.tif"))
@@ -320,6 +324,8 @@ def auto_step(
     )  # fmt: skip
     seconds = time.perf_counter() - t0
     last = read_table(auto / "rounds.csv")[-1]
+    with open(auto / "boresight.csv", encoding="utf-8") as fh:  # the job's doubts, if any
+        warnings = [line[2:].strip() for line in fh if line.startswith("# ")]
     return {
         "images": [f.stem for f in files],
         "seconds": round(seconds, 1),
@@ -330,6 +336,7 @@ def auto_step(
         "ties_associated": int(last["ties_associated"]),
         "ties_refused": last["ties_refused"],
         "groups": boresight_against_truth(auto / "boresight.csv"),
+        "warnings": warnings,
     }
 
 
@@ -531,6 +538,7 @@ def main() -> int:
         f"{auto['rounds']} rounds; {auto['line_points']} line points on {auto['lines_seen']} "
         f"LiDAR lines, {auto['ties_associated']} of {auto['tie_tracks']} tie tracks on roof "
         f"planes (refused: {auto['ties_refused'] or 'none'})"
+        + "".join(f"\n  WARNING: {w}" for w in auto["warnings"])
     )
     worst_auto = print_comparison(boresight_against_truth(cal / "boresight.csv"), auto["groups"])
 
