@@ -20,7 +20,8 @@
    with the LiDAR roof planes, image edges found along the projected LiDAR lines, from an
    approximate boresight of 0), in auto_calibration/; its boresight against the truth, in
    sigmas, next to step 6's (the simulated picks), and the run's seconds. The exit code is 1
-   when either calibration is beyond 4 sigma of the truth.
+   when either calibration is beyond 4 sigma of the truth. ``--auto-images-per-line N`` runs
+   this step on the first N images of each flight line only (a shorter run).
 9. True orthophotos of the images on the LiDAR DSM with the calibrated orientation
    (``lidarphoto orthorectify``), and their orthomosaic with its seamlines (``lidarphoto
    orthomosaic``: the most nadir image per cell, ground occluded in one image filled from
@@ -425,7 +426,16 @@ def project_step() -> Path | None:
     return OUT / "lidarphoto_demo.qgz"
 
 
-def main() -> int:
+def main(argv: list[str] | None = None) -> int:
+    import argparse
+
+    parser = argparse.ArgumentParser(description="The main job end to end (make demo).")
+    parser.add_argument(
+        "--auto-images-per-line", type=int, default=None, metavar="N",
+        help="step 8 (autoboresight) on the first N images of each flight line only "
+        "(default: all 10 images)",
+    )  # fmt: skip
+    args = parser.parse_args(argv)
     start = time.perf_counter()
     if OUT.exists():
         shutil.rmtree(OUT)
@@ -532,7 +542,7 @@ def main() -> int:
     )
 
     # ---- 8. the boresight calibrated automatically from the rendered images
-    auto = auto_step(OUT, config.mount)
+    auto = auto_step(OUT, config.mount, per_line=args.auto_images_per_line)
     print(
         f"\nautoboresight on the {len(auto['images'])} rendered images: {auto['seconds']:.0f} s; "
         f"{auto['rounds']} rounds; {auto['line_points']} line points on {auto['lines_seen']} "
