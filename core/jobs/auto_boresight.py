@@ -233,7 +233,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
     mount = mount_from(v)
     grade = ins_grade(v.ins_grade, v.ins_sigmas)
     cam, traj, planes, lines, ties = _read_inputs(v)
-    images = _read_images(v, traj)
+    images = _read_images(v, traj, should_stop)
     auto = options_from(AutoBoresightOptions, SPEC, v)
     cal = options_from(BoresightOptions, SPEC, v, ins_grade=grade)
     ties, detected, rest = _tie_stage(
@@ -321,14 +321,19 @@ def _read_inputs(v: Values) -> tuple:
     return cam, traj, planes, lines, ties
 
 
-def _read_images(v: Values, traj) -> list:
-    """(image id, 8-bit grey image) of the IMAGES named in the trajectory."""
-    from ..errors import InputError
+def _read_images(v: Values, traj, should_stop=None) -> list:
+    """(image id, 8-bit grey image) of the IMAGES named in the trajectory; ``should_stop``
+    asked before each image is read (cancellation)."""
+    from ..errors import InputError, stop_if_asked
     from ..io.images import list_image_files, read_gray
 
     files = list_image_files(v.images, ("IMAGES", "identical images have no parallax"))
     known = set(traj.image_id)
-    images = [(f.stem, read_gray(f)) for f in files if f.stem in known]
+    images = []
+    for f in files:
+        if f.stem in known:
+            stop_if_asked(should_stop, f"reading the images ({f.name})")
+            images.append((f.stem, read_gray(f)))
     if not images:
         raise InputError(
             "IMAGES: no image is named in the trajectory (image id = file name without extension)",

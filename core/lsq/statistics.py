@@ -43,8 +43,14 @@ def _block_times(b: _Obs, M: Array, sel: NDArray[np.intp]) -> Array:
 
 
 def _coupled_rows(
-    rows: NDArray[np.intp], K: Array, ab: Array, Q: Array, sign: Array, P: Array, r: Array,
-    pqp: Array
+    rows: NDArray[np.intp],
+    K: Array,
+    ab: Array,
+    Q: Array,
+    sign: Array,
+    P: Array,
+    r: Array,
+    pqp: Array,
 ) -> None:
     """``diag(Qvv P)`` and ``diag(P Qvv P)`` of the coupled rows (a line's X0 and u, whose
     weights come from a covariance of rank 4 regularised by 1e-12: their products cancel to

@@ -233,19 +233,23 @@ class _Search:
         self.reduce = 1
         self._blurred: tuple[float, int] = (-1.0, 0)
 
-    def blur(self, sigma_px: float, stride: int) -> None:
+    def blur(
+        self, sigma_px: float, stride: int, should_stop: Callable[[], bool] | None = None
+    ) -> None:
         """Gradient magnitude of the images blurred by ``sigma_px`` (full-resolution pixels);
         every ``stride``-th sample. A wide blur is computed on the image reduced by an integer
         factor (box average) that keeps at least 2 reduced pixels of sigma: the search needs
         the edges' position at the blur's scale only, and a 24-Mpx image blurred by 30 px
         would otherwise cost seconds per candidate level. The blurred gradient is computed
-        where the candidates sample it (:class:`_EdgeStrength`)."""
+        where the candidates sample it (:class:`_EdgeStrength`); ``should_stop`` is asked
+        before each image (cancellation)."""
         import cv2
 
         r = max(1, int(sigma_px // 2.0))
         if self._blurred != (sigma_px, r):
             grads = []
             for full in self.greys:
+                stop_if_asked(should_stop, "the boresight search (blurring the images)")
                 g: NDArray = full
                 if r > 1:
                     h, w = (g.shape[0] // r) * r, (g.shape[1] // r) * r
@@ -280,15 +284,16 @@ class _Search:
         steps: Array,
         half: int,
         axes: tuple[int, ...],
-        should_stop: Callable[[], bool] | None = None,
+        tick: Callable[[], None] | None = None,
     ) -> Array:
-        """The best candidate of a (2 half + 1)^len(axes) grid about ``centre``."""
+        """The best candidate of a (2 half + 1)^len(axes) grid about ``centre``; ``tick`` is
+        called before each candidate (:class:`_Ticker`: cancellation and progress)."""
         offsets = np.arange(-half, half + 1)
         grids = np.meshgrid(*[offsets * steps[a] for a in axes], indexing="ij")
         best, best_score = centre, -np.inf
-        for n, combo in enumerate(zip(*[g.ravel() for g in grids])):
-            if n % 64 == 0:
-                stop_if_asked(should_stop, "the boresight search")
+        for combo in zip(*[g.ravel() for g in grids]):
+            if tick is not None:
+                tick()
             cand = centre.copy()
             for a, d in zip(axes, combo):
                 cand[a] += d
@@ -296,6 +301,27 @@ class _Search:
             if s > best_score:
                 best, best_score = cand, s
         return best
+
+
+class _Ticker:
+    """Called before each candidate of the angle search: raises :class:`~..errors.Cancelled`
+    when ``should_stop()`` says so (a cancel stops the search before the next candidate) and
+    reports the fraction of the ``total`` candidates done to ``progress`` (0..1)."""
+
+    def __init__(
+        self,
+        total: int,
+        progress: Callable[[float], None] | None,
+        should_stop: Callable[[], bool] | None,
+    ) -> None:
+        self.total, self.done = max(int(total), 1), 0
+        self.progress, self.should_stop = progress, should_stop
+
+    def __call__(self) -> None:
+        stop_if_asked(self.should_stop, "the boresight search")
+        if self.progress is not None and self.done % 8 == 0:
+            self.progress(min(self.done / self.total, 1.0))
+        self.done += 1
 
 
 def search_boresight(
@@ -307,9 +333,11 @@ def search_boresight(
     lines: Sequence[ControlLine],
     options: AutoBoresightOptions | None = None,
     should_stop: Callable[[], bool] | None = None,
+    progress: Callable[[float], None] | None = None,
 ) -> Array:
     """Coarse-to-fine boresight (3,) radians whose projected LiDAR lines lie on the strongest
-    image edges (module docstring, step 2)."""
+    image edges (module docstring, step 2). ``should_stop`` is asked before every candidate
+    and every image's blur (cancellation); ``progress`` gets the fraction of candidates done."""
     opt = options or AutoBoresightOptions()
     if opt.search_deg == 0 or not lines:
         return np.asarray(mount.boresight, float).copy()
@@ -318,6 +346,7 @@ def search_boresight(
     row = {iid: k for k, iid in enumerate(traj.image_id)}
     chosen, greys = [], []
     for iid, img in images:
+        stop_if_asked(should_stop, "the boresight search")
         if iid not in row:
             raise InputError(f"image '{iid}' is not in the trajectory")
         chosen.append(us[row[iid]])
@@ -329,27 +358,58 @@ def search_boresight(
     # coarse_step_px): the search costs the same number of candidates at any image size
     range_px = f * np.radians(opt.search_deg)
     step_px = max(float(opt.coarse_step_px), range_px / _FIRST_STEPS)
+    levels = [step_px]  # the grid steps (px), halved down to fine_step_px
+    while levels[-1] > opt.fine_step_px * 1.0001:
+        levels.append(max(levels[-1] / 2.0, opt.fine_step_px))
+    # the whole range at the first level: omega and phi together, then kappa
+    n_op = int(np.ceil(np.radians(opt.search_deg) / (step_px / f)))
+    n_k = int(np.ceil(np.radians(opt.search_deg) / (step_px / half_diag)))
+    tick = _Ticker(
+        (2 * n_op + 1) ** 2 + 2 * n_k + 1 + len(levels) * 2 * (25 + 5), progress, should_stop
+    )
     bore = np.asarray(mount.boresight, float).copy()
-    first = True
-    while True:
+    for level, step_px in enumerate(levels):
         stop_if_asked(should_stop, "the boresight search")
-        search.blur(max(0.7, 0.6 * step_px), int(step_px / (2 * spacing)))
+        search.blur(max(0.7, 0.6 * step_px), int(step_px / (2 * spacing)), should_stop)
         steps = np.array([step_px / f, step_px / f, step_px / half_diag])
-        if first:  # the whole range: omega and phi together, then kappa
-            n_op = int(np.ceil(np.radians(opt.search_deg) / steps[0]))
-            n_k = int(np.ceil(np.radians(opt.search_deg) / steps[2]))
-            bore = search.grid_best(bore, steps, n_op, (0, 1), should_stop)
-            bore = search.grid_best(bore, steps, n_k, (2,), should_stop)
-            first = False
+        if level == 0:
+            bore = search.grid_best(bore, steps, n_op, (0, 1), tick)
+            bore = search.grid_best(bore, steps, n_k, (2,), tick)
         for _ in range(2):
-            bore = search.grid_best(bore, steps, 2, (0, 1))
-            bore = search.grid_best(bore, steps, 2, (2,))
-        if step_px <= opt.fine_step_px * 1.0001:
-            return bore
-        step_px = max(step_px / 2.0, opt.fine_step_px)
+            bore = search.grid_best(bore, steps, 2, (0, 1), tick)
+            bore = search.grid_best(bore, steps, 2, (2,), tick)
+    if progress is not None:
+        progress(1.0)
+    return bore
 
 
 # ------------------------------------------------------------------ rounds
+def _share(
+    progress: Callable[[float], None] | None, lo: float, hi: float
+) -> Callable[[float], None] | None:
+    """``progress`` of one stage: its fraction 0..1 reported as ``lo``..``hi`` of the whole."""
+    if progress is None:
+        return None
+    report = progress
+
+    def stage(f: float) -> None:
+        report(lo + (hi - lo) * min(max(float(f), 0.0), 1.0))
+
+    return stage
+
+
+def _checked(images: Images, should_stop, progress):
+    """The images one at a time, ``should_stop`` asked before each (cancellation) and the
+    fraction handed out reported to ``progress``."""
+    for k, image in enumerate(images):
+        stop_if_asked(should_stop, f"finding edges along the LiDAR lines (image {image[0]})")
+        if progress is not None:
+            progress(k / max(len(images), 1))
+        yield image
+    if progress is not None:
+        progress(1.0)
+
+
 def _counts(obs: ImageObservations, kind: str, key: str) -> dict[str, int]:
     out: dict[str, int] = {}
     for t, i, tid in zip(obs.type, obs.image_id, obs.target_id):
@@ -455,9 +515,9 @@ def auto_calibrate(
     cal = replace(base, use_types=("tie", "line"))
     grade = ins_grade(base.ins_grade) if isinstance(base.ins_grade, str) else base.ins_grade
     att_sigma = np.radians(max(grade.sigma_roll_pitch_deg, grade.sigma_heading_deg))
-    searched = search_boresight(trajectory, camera, mount, frame, images, lines, opt, should_stop)
-    if progress:
-        progress(0.3)
+    searched = search_boresight(
+        trajectory, camera, mount, frame, images, lines, opt, should_stop, _share(progress, 0, 0.3)
+    )
     current = replace(mount, boresight=searched)
     eo: ExteriorOrientationTable = direct_georeference(trajectory, current, frame)
     bore_sigma = opt.fine_step_px / camera.focal_px if opt.search_deg > 0 else 0.0
@@ -475,8 +535,10 @@ def auto_calibrate(
         spread = float(np.hypot(bore_sigma, att_sigma))
         search_px = max(opt.min_search_px, opt.sigmas * camera.focal_px * spread)
         gate = max(opt.min_gate_m, opt.sigmas * abs(height) * spread)
+        lo, half = 0.3 + 0.7 * r / opt.max_rounds, 0.35 / opt.max_rounds  # this round's share
         line_obs, obs, refused, n_tracks = _round_observations(
-            images, cam, eo, lines, ties, planes, dsm, opt, search_px, gate
+            _checked(images, should_stop, _share(progress, lo, lo + half)),
+            *(cam, eo, lines, ties, planes, dsm, opt, search_px, gate),
         )
         if len(obs) == 0:
             raise SceneNotObservable(
@@ -493,6 +555,7 @@ def auto_calibrate(
             planes,
             lines,
             options=cal,
+            progress=_share(progress, lo + half, lo + 2 * half),
             should_stop=should_stop,
         )
         change = result.boresight - last

@@ -547,3 +547,106 @@ def test_edge_strength_by_tiles_equals_the_whole_image_filter(sigma):
     got = edge.sample(rows, cols)
     assert np.array_equal(got, map_coordinates(whole, [rows, cols], order=1))
     assert 0 < edge.done.mean() < 0.5, edge.done.mean()
+
+
+def _counting(monkeypatch, owner, name: str, after: int, state: dict) -> None:
+    """Replace ``owner.name`` by a wrapper that counts its calls and asks for the cancel
+    (``state["stop"]``) once it has been called ``after`` times."""
+    real = getattr(owner, name)
+
+    def wrapper(*args, **kwargs):
+        state["calls"] += 1
+        try:
+            return real(*args, **kwargs)
+        finally:
+            if state["calls"] >= after:
+                state["stop"] = True
+
+    monkeypatch.setattr(owner, name, wrapper)
+
+
+@pytest.mark.parametrize(
+    ("stage", "after", "doing"),
+    [
+        ("reading", 1, "reading the images (b.png)"),
+        ("ties", 1, "detecting features (b)"),
+        ("search", 5, "the boresight search"),
+        ("edges", 1, "finding edges along the LiDAR lines (image b)"),
+        ("adjustment", 1, "adjusting"),
+    ],
+)
+def test_the_job_stops_within_one_step_of_a_cancel(files, tmp_path, monkeypatch, stage, after,
+                                                   doing):  # fmt: skip
+    """A cancel asked during a stage (reading the images, finding the tie points, the angle
+    search, the edges along the lines, the adjustment) stops the job before the stage's next
+    unit of work (image, candidate, adjustment iteration): the project's Cancelled error,
+    naming what it was doing, and no output written."""
+    from lidarphoto.core.errors import Cancelled
+    from lidarphoto.core.io import images as images_io
+    from lidarphoto.core.jobs import auto_boresight as job
+    from lidarphoto.core.jobs.runner import run_job
+    from lidarphoto.core.photo import auto_boresight as ab
+    from lidarphoto.core.photo import auto_lines, tie_points
+
+    _, inputs = files
+    if stage == "ties":
+        inputs = {**inputs, "TIE_POINTS": None}
+    state = {"calls": 0, "stop": False}
+    owner, name = {
+        "reading": (images_io, "read_gray"),
+        "ties": (tie_points, "detect_features"),
+        "search": (ab._Search, "score"),
+        "edges": (auto_lines, "line_observations"),
+        "adjustment": (ab, "calibrate"),
+    }[stage]
+    if stage == "adjustment":  # the cancel is asked as the adjustment starts
+        real = ab.calibrate
+
+        def entering(*args, **kwargs):
+            state["calls"] += 1
+            state["stop"] = True
+            return real(*args, **kwargs)
+
+        monkeypatch.setattr(ab, "calibrate", entering)
+    else:
+        _counting(monkeypatch, owner, name, after, state)
+    out = {"OUTPUT_TABLE": str(tmp_path / "b.csv"), "OUTPUT_EO": str(tmp_path / "e.csv"),
+           "OUTPUT_OBSERVATIONS": str(tmp_path / "o.csv"),
+           "OUTPUT_ROUNDS": str(tmp_path / "r.csv"),
+           "OUTPUT_HTML": str(tmp_path / "r.html")}  # fmt: skip
+    seen: list[float] = []
+    with pytest.raises(Cancelled) as caught:
+        run_job(job, {**inputs, **out}, progress=seen.append, should_stop=lambda: state["stop"])
+    assert str(caught.value) == f"cancelled while {doing}"
+    assert state["calls"] == after  # not one more image, candidate or adjustment
+    assert list(tmp_path.iterdir()) == []
+    assert np.all(np.diff(seen) >= -1e-12) and all(0.0 <= f <= 1.0 for f in seen)
+
+
+def test_the_search_reports_its_progress_per_candidate(block, lidar):
+    """The angle search reports its fraction of candidates done, rising to 1, many times (a
+    24-Mpx search takes minutes: the bar moves while it runs)."""
+    from lidarphoto.core.photo import auto_boresight as ab
+
+    cam, frame, _t, traj, images, _planes, lines, _dsm = block
+    calls = {"n": 0}
+    real = ab._Search.score
+
+    def counting(self, bore):
+        calls["n"] += 1
+        return real(self, bore)
+
+    seen: list[float] = []
+    mp = pytest.MonkeyPatch()
+    mp.setattr(ab._Search, "score", counting)
+    try:
+        ab.search_boresight(traj, cam, Mount.from_parameters(), frame, images, lines,
+                            AutoBoresightOptions(search_deg=0.6), progress=seen.append)  # fmt: skip
+    finally:
+        mp.undo()
+    assert seen[-1] == 1.0 and np.all(np.diff(seen) >= 0)
+    assert len(seen) >= calls["n"] // 8  # one report per 8 candidates
+    assert max(np.diff([0.0, *seen])) < 0.1
+    # the candidates counted in advance are those evaluated: no early 1, no jump at the end
+    assert seen.count(1.0) == 1 and seen[-2] >= 1.0 - 8.5 / calls["n"], (seen[-3:], calls)
+    print("search candidates", calls["n"], "progress reports", len(seen))
