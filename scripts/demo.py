@@ -426,6 +426,32 @@ def project_step() -> Path | None:
     return OUT / "lidarphoto_demo.qgz"
 
 
+def boresight_table(cal: Path, rmse: dict) -> tuple[list[dict], np.ndarray, float]:
+    """Step 6's printout: the recovered boresight against the truth and the check points'
+    RMSE; returns the table's rows, the truth (arc-seconds) and the largest |error| / sigma."""
+    with open(cal / "boresight.csv", encoding="utf-8") as fh:
+        rows = list(csv.DictReader(fh))
+    true = np.array(TRUE_BORESIGHT_DEG) * 3600.0
+    print("\nRecovered boresight against the truth (arc-seconds; initial value 0):")
+    print(f"{'group':6} {'angle':8} {'truth':>9} {'estimate':>10} {'sigma':>7} {'error':>8} "
+          f"{'error/sigma':>12}")  # fmt: skip
+    worst = 0.0
+    for row in rows:
+        for k, angle in enumerate(("omega", "phi", "kappa")):
+            est = float(row[f"d_{angle}_arcsec"])
+            sig = float(row[f"std_d_{angle}_arcsec"])
+            err = est - true[k]
+            worst = max(worst, abs(err) / sig)
+            print(f"{row['group']:6} d_{angle:6} {true[k]:9.1f} {est:10.1f} {sig:7.1f} "
+                  f"{err:8.1f} {err / sig:12.2f}")  # fmt: skip
+    print(f"sigma0 {float(rows[0]['sigma0']):.3f}; largest |error| / sigma {worst:.2f}")
+    print("\nCheck points intersected from the images (m, against the truth):")
+    print(f"{'orientation':12} {'points':>6} {'RMSE E':>8} {'RMSE N':>8} {'RMSE H':>8}")
+    for name, (n, e, nn, h) in rmse.items():
+        print(f"{name:12} {n:6d} {e:8.3f} {nn:8.3f} {h:8.3f}")
+    return rows, true, worst
+
+
 def main(argv: list[str] | None = None) -> int:
     import argparse
 
@@ -503,26 +529,7 @@ def main(argv: list[str] | None = None) -> int:
         rmse[name] = (len(ids), *np.sqrt(np.mean(d**2, axis=0)))
 
     # ---- 6. recovered boresight against the truth
-    with open(cal / "boresight.csv", encoding="utf-8") as fh:
-        rows = list(csv.DictReader(fh))
-    true = np.array(TRUE_BORESIGHT_DEG) * 3600.0
-    print("\nRecovered boresight against the truth (arc-seconds; initial value 0):")
-    print(f"{'group':6} {'angle':8} {'truth':>9} {'estimate':>10} {'sigma':>7} {'error':>8} "
-          f"{'error/sigma':>12}")  # fmt: skip
-    worst = 0.0
-    for row in rows:
-        for k, angle in enumerate(("omega", "phi", "kappa")):
-            est = float(row[f"d_{angle}_arcsec"])
-            sig = float(row[f"std_d_{angle}_arcsec"])
-            err = est - true[k]
-            worst = max(worst, abs(err) / sig)
-            print(f"{row['group']:6} d_{angle:6} {true[k]:9.1f} {est:10.1f} {sig:7.1f} "
-                  f"{err:8.1f} {err / sig:12.2f}")  # fmt: skip
-    print(f"sigma0 {float(rows[0]['sigma0']):.3f}; largest |error| / sigma {worst:.2f}")
-    print("\nCheck points intersected from the images (m, against the truth):")
-    print(f"{'orientation':12} {'points':>6} {'RMSE E':>8} {'RMSE N':>8} {'RMSE H':>8}")
-    for name, (n, e, nn, h) in rmse.items():
-        print(f"{name:12} {n:6d} {e:8.3f} {nn:8.3f} {h:8.3f}")
+    rows, true, worst = boresight_table(cal, rmse)
 
     # ---- 7. the images, rendered with the true orientation, and the check of their geometry
     t0 = time.perf_counter()
