@@ -132,17 +132,13 @@ def _lmeds_line(t: Array, off: Array) -> Array:
     return np.array([c1[best], c0[best]])
 
 
-def _fit_line(t: Array, off: Array, opt: AutoLineOptions) -> tuple[NDArray[np.bool_], float]:
-    """Keep mask and residual RMS (px) of the offsets fitted by ``c0 + c1 t``: a robust start
-    (:func:`_lmeds_line`), then least squares on the kept samples with the MAD cut."""
-    if t.size < max(3, opt.min_points):
-        return np.zeros(t.size, bool), 0.0
-    coef = _lmeds_line(t, off)
-    res = off - np.polyval(coef, t)
-    half = np.sort(np.abs(res))[: t.size // 2 + 1]
-    keep = np.abs(res) <= opt.outlier_sigmas * max(1.4826 * float(half[-1]), opt.min_sigma_px)
+def _refit(
+    t: Array, off: Array, keep: NDArray[np.bool_], opt: AutoLineOptions
+) -> tuple[NDArray[np.bool_], float]:
+    """Least squares ``c0 + c1 t`` on the kept samples and the MAD cut, until no sample leaves
+    (at most 5 times): keep mask and residual RMS (px)."""
     rms = 0.0
-    for _ in range(5):  # refit until no sample leaves
+    for _ in range(5):
         if keep.sum() < max(3, opt.min_points):
             return np.zeros(t.size, bool), 0.0
         coef = np.polyfit(t[keep], off[keep], 1)
@@ -154,6 +150,27 @@ def _fit_line(t: Array, off: Array, opt: AutoLineOptions) -> tuple[NDArray[np.bo
             break
         keep = new
     return keep, rms
+
+
+def _fit_line(t: Array, off: Array, opt: AutoLineOptions) -> tuple[NDArray[np.bool_], float]:
+    """Keep mask and residual RMS (px) of the offsets fitted by ``c0 + c1 t``: least squares
+    from all samples with the MAD cut (:func:`_refit`); when its RMS exceeds
+    ``outlier_sigmas`` times the robust scale of the least-median-of-squares line
+    (:func:`_lmeds_line`; Rousseeuw's scale ``1.4826 (1 + 5 / (n - 2)) sqrt(med r^2)``, at
+    least ``min_sigma_px``), a variance ratio chance does not give, the samples are two
+    populations (some on another edge, which pulled the least-squares start between them): the
+    fit restarts from the samples within ``outlier_sigmas`` scales of that line."""
+    if t.size < max(3, opt.min_points):
+        return np.zeros(t.size, bool), 0.0
+    keep, rms = _refit(t, off, np.ones(t.size, bool), opt)
+    coef = _lmeds_line(t, off)
+    res = np.abs(off - np.polyval(coef, t))
+    n = t.size
+    med = float(np.partition(res, n // 2)[n // 2])
+    scale = max(1.4826 * (1.0 + 5.0 / max(n - 2, 1)) * med, opt.min_sigma_px)
+    if keep.sum() >= max(3, opt.min_points) and rms <= opt.outlier_sigmas * scale:
+        return keep, rms
+    return _refit(t, off, res <= opt.outlier_sigmas * scale, opt)
 
 
 #: Fewest segments (lines) in an image for the screen of :func:`_screen_segments`: its model
