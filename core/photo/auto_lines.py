@@ -13,8 +13,10 @@ ambiguous (a second gradient peak, away from the chosen one, stronger than ``amb
 it). Per line, the signed offsets from the prediction are fitted by a straight function of
 the position along the line (a small pose error shifts and turns the projection); samples
 more than ``outlier_sigmas`` robust sigmas off the fit are refused and the fit's residual
-RMS is each kept point's ``sigma_px``. Lines with fewer than ``min_points`` kept points give
-nothing. Pixels follow docs/conventions.md ("Images"): (col, row), first pixel centre
+RMS is each kept point's ``sigma_px`` (a fit whose RMS shows two populations restarts from
+its least-median-of-squares line). Lines with fewer than ``min_points`` kept points give
+nothing. Per image, a line's segment off the displacement of the image's other segments (its
+pose error: :func:`_screen_segments`) is on another edge and is dropped. Pixels follow docs/conventions.md ("Images"): (col, row), first pixel centre
 (0.5, 0.5).
 """
 

@@ -132,7 +132,7 @@ def _distance_to_truth_of(obs, table, cam, lines, iid):
 def test_a_segment_on_another_edge_is_dropped_and_only_it(drawn, pose_error):
     """One line's edge drawn 12 px off (another edge within the search), the other 14 on their
     projections: the image's screen drops that segment alone, also under a pose error of
-    some 5 px (which moves every line's prediction; the screen's model absorbs it); without
+    some 3 px (which moves every line's prediction; the screen's model absorbs it); without
     the screen (segment_sigmas huge) the wrong segment is kept: the test can fail."""
     from lidarphoto.core.photo.auto_lines import REFUSALS
 
