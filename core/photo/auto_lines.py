@@ -16,9 +16,8 @@ more than ``outlier_sigmas`` robust sigmas off the fit are refused and the fit's
 RMS is each kept point's ``sigma_px`` (a fit whose RMS shows two populations restarts from
 its least-median-of-squares line). Lines with fewer than ``min_points`` kept points give
 nothing. Per image, a line's segment off the displacement of the image's other segments (its
-pose error: :func:`_screen_segments`) is on another edge and is dropped. Pixels follow docs/conventions.md ("Images"): (col, row), first pixel
-centre
-(0.5, 0.5).
+pose error: :func:`_screen_segments`) is on another edge and is dropped. Pixels follow
+docs/conventions.md ("Images"): (col, row), first pixel centre (0.5, 0.5).
 """
 
 from __future__ import annotations
