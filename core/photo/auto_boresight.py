@@ -16,7 +16,10 @@ boresight and the LiDAR roof planes and lines (mapping CRS), without any hand-pi
    edge refinement of step 3 only looks a few pixels across a line.
 3. Rounds: with the exterior orientation of the current estimate, line observations are
    found along the projected lines (:func:`.auto_lines.line_observations_block`, searched
-   within 3 sigma of the projection's uncertainty, the pose's and the boresight's), tie
+   within 3 sigma of the projection's uncertainty, the pose's and the boresight's; an image's
+   segment of a line off the displacement of the image's other segments is on another edge
+   and is dropped before the adjustment, so data snooping, which rejects a LiDAR line's
+   points in all images together, does not lose the good ones with it), tie
    tracks (optional input) are associated with roof planes within a gate of 3 sigma
    (:func:`.auto_ties.associate_ties`), and :func:`.boresight.calibrate` (robust stage and
    data snooping) adjusts them. The next round starts from the adjusted orientation; the
@@ -29,7 +32,7 @@ Angles are radians inside, pixel quantities (col, row) per docs/conventions.md.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Union
 
 import numpy as np
@@ -44,7 +47,7 @@ from ..geometry.rotations import boresight_matrix
 from ..geometry.surface import Dsm
 from ..lidar.control import ControlLine
 from .auto_boresight_options import AutoBoresightOptions
-from .auto_lines import _grey, line_observations_block
+from .auto_lines import REFUSALS, _grey, line_observations_block
 from .auto_ties import REASONS, associate_ties
 from .boresight import calibrate
 from .boresight_options import BoresightOptions
@@ -76,7 +79,9 @@ class SceneNotObservable(InputError):
 @dataclass(frozen=True)
 class RoundRecord:
     """One association-adjustment round: the search width (px) and tie gate (m) used, the
-    observation counts, the boresight after it (G, 3, radians), its sigmas and its change."""
+    observation counts, the boresight after it (G, 3, radians), its sigmas and its change, the
+    points rejected by data snooping and the edge points refused before the adjustment per
+    reason (:data:`.auto_lines.REFUSALS`)."""
 
     round: int
     search_px: float
@@ -90,6 +95,7 @@ class RoundRecord:
     std: Array
     change: Array
     rejected: int
+    lines_refused: dict[str, int] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -422,12 +428,14 @@ def _counts(obs: ImageObservations, kind: str, key: str) -> dict[str, int]:
 def _round_observations(images, cam, eo, lines, ties, planes, dsm, opt, search_px, gate):
     """One round's observations: the line points found along the projected lines within
     ``search_px`` and the tie tracks associated with the planes within ``gate`` (m); returns
-    (line observations, all observations, tie refusals per reason, tie tracks tried)."""
+    (line observations, all observations, tie refusals per reason, tie tracks tried, line
+    point refusals per reason)."""
+    line_refused = dict.fromkeys(REFUSALS, 0)
     line_obs = line_observations_block(
-        images, cam, eo, lines, replace(opt.lines, search_px=search_px)
+        images, cam, eo, lines, replace(opt.lines, search_px=search_px), line_refused
     )
     if ties is None or not len(ties):
-        return line_obs, line_obs, dict.fromkeys(REASONS, 0), 0
+        return line_obs, line_obs, dict.fromkeys(REASONS, 0), 0, line_refused
     assoc = associate_ties(
         ties,
         eo,
@@ -438,10 +446,16 @@ def _round_observations(images, cam, eo, lines, ties, planes, dsm, opt, search_p
         max_roof_slope_deg=opt.max_roof_slope_deg,
         dsm=dsm,
     )
-    return line_obs, line_obs.concat(assoc.observations), assoc.reasons, assoc.tracks
+    return (
+        line_obs,
+        line_obs.concat(assoc.observations),
+        assoc.reasons,
+        assoc.tracks,
+        line_refused,
+    )
 
 
-def _round_record(k, search_px, gate, line_obs, obs, n_tracks, refused, result, change):
+def _round_record(k, search_px, gate, line_obs, obs, n_tracks, refused, result, change, lines):
     """The :class:`RoundRecord` of round ``k`` (counts, the boresight, its change)."""
     tie_ids = {p for p, t in zip(obs.point_id, obs.type) if t == "tie"}
     return RoundRecord(
@@ -457,6 +471,7 @@ def _round_record(k, search_px, gate, line_obs, obs, n_tracks, refused, result, 
         result.std.copy(),
         change,
         int(result.residuals.rejected.sum()),
+        dict(lines),
     )
 
 
@@ -536,7 +551,7 @@ def auto_calibrate(
         search_px = max(opt.min_search_px, opt.sigmas * camera.focal_px * spread)
         gate = max(opt.min_gate_m, opt.sigmas * abs(height) * spread)
         lo, half = 0.3 + 0.7 * r / opt.max_rounds, 0.35 / opt.max_rounds  # this round's share
-        line_obs, obs, refused, n_tracks = _round_observations(
+        line_obs, obs, refused, n_tracks, line_refused = _round_observations(
             _checked(images, should_stop, _share(progress, lo, lo + half)),
             *(cam, eo, lines, ties, planes, dsm, opt, search_px, gate),
         )
@@ -560,7 +575,18 @@ def auto_calibrate(
         )
         change = result.boresight - last
         rounds.append(
-            _round_record(r + 1, search_px, gate, line_obs, obs, n_tracks, refused, result, change)
+            _round_record(
+                r + 1,
+                search_px,
+                gate,
+                line_obs,
+                obs,
+                n_tracks,
+                refused,
+                result,
+                change,
+                line_refused,
+            )
         )
         if progress:
             progress(0.3 + 0.7 * (r + 1) / opt.max_rounds)

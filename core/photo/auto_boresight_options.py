@@ -25,6 +25,10 @@ class AutoLineOptions:
     min_points: fewest accepted samples a line must keep.
     margin_px: samples nearer the frame border than this are dropped.
     outlier_sigmas: refusal threshold on the per-line fit's robust residual sigma.
+    segment_sigmas: an image's segment of a line whose offset is farther than this many robust
+        sigmas from the displacement the image's other segments give (shift, rotation and
+        scale of the image: its pose error) is on another edge and is dropped.
+    segment_min_px: floor of that robust sigma, pixels (the model's misfit).
     min_sigma_px: floor of the reported sigma (the fit's RMS can be tiny on few points).
     max_samples: most samples of one line in one image (a long line's samples are spread
         wider than ``spacing_px``): the boresight is bound by the INS priors long before, and
@@ -40,10 +44,19 @@ class AutoLineOptions:
     margin_px: float = 2.0
     outlier_sigmas: float = 3.0
     min_sigma_px: float = 0.05
+    segment_sigmas: float = 3.0
+    segment_min_px: float = 1.0
     max_samples: int = 100
 
     def __post_init__(self) -> None:
-        for name in ("spacing_px", "search_px", "min_sigma_px", "outlier_sigmas"):
+        for name in (
+            "spacing_px",
+            "search_px",
+            "min_sigma_px",
+            "outlier_sigmas",
+            "segment_sigmas",
+            "segment_min_px",
+        ):
             if not float(getattr(self, name)) > 0:
                 raise InputError(f"{name} must be > 0, got {getattr(self, name)!r}")
         for name in ("along_px", "min_contrast", "margin_px"):

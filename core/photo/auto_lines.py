@@ -13,9 +13,11 @@ ambiguous (a second gradient peak, away from the chosen one, stronger than ``amb
 it). Per line, the signed offsets from the prediction are fitted by a straight function of
 the position along the line (a small pose error shifts and turns the projection); samples
 more than ``outlier_sigmas`` robust sigmas off the fit are refused and the fit's residual
-RMS is each kept point's ``sigma_px``. Lines with fewer than ``min_points`` kept points give
-nothing. Pixels follow docs/conventions.md ("Images"): (col, row), first pixel centre
-(0.5, 0.5).
+RMS is each kept point's ``sigma_px`` (a fit whose RMS shows two populations restarts from
+its least-median-of-squares line). Lines with fewer than ``min_points`` kept points give
+nothing. Per image, a line's segment off the displacement of the image's other segments (its
+pose error: :func:`_screen_segments`) is on another edge and is dropped. Pixels follow
+docs/conventions.md ("Images"): (col, row), first pixel centre (0.5, 0.5).
 """
 
 from __future__ import annotations
@@ -35,7 +37,11 @@ from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable
 from .picking import PickingScene
 
-__all__ = ["AutoLineOptions", "line_observations", "line_observations_block"]
+__all__ = ["REFUSALS", "AutoLineOptions", "line_observations", "line_observations_block"]
+
+#: Why found edge points are refused (the counts of ``refused``): off the straight fit of their
+#: line's offsets in the image, or in a segment off the displacement of the image's other lines.
+REFUSALS = ("off the line's fit", "segment off the image's other lines")
 
 Array = NDArray[np.float64]
 
@@ -106,11 +112,35 @@ def _edge_checks(
     return (contrast >= opt.min_contrast) & (second <= opt.ambiguity * peak)
 
 
-def _fit_line(t: Array, off: Array, opt: AutoLineOptions) -> tuple[NDArray[np.bool_], float]:
-    """Keep mask and residual RMS (px) of the offsets fitted by ``c0 + c1 t``."""
-    keep = np.ones(t.size, bool)
+def _lmeds_line(t: Array, off: Array) -> Array:
+    """Least-median-of-squares line ``c0 + c1 t`` through two of the samples (every pair, or
+    400 drawn ones): the fit of the majority even when nearly half the samples lie on another
+    edge (a least-squares start is pulled between the two and its MAD cut keeps both)."""
+    n = t.size
+    i, j = np.triu_indices(n, 1)
+    if i.size > 400:  # deterministic subset of the pairs
+        pick = np.random.default_rng(n).choice(i.size, 400, replace=False)
+        i, j = i[pick], j[pick]
+    dt = t[j] - t[i]
+    ok = np.abs(dt) > 1e-12
+    if not ok.any():
+        return np.array([0.0, float(np.median(off))])
+    i, j, dt = i[ok], j[ok], dt[ok]
+    c1 = (off[j] - off[i]) / dt
+    c0 = off[i] - c1 * t[i]
+    res = np.abs(off[None, :] - (c0[:, None] + c1[:, None] * t[None, :]))
+    med = np.partition(res, n // 2, axis=1)[:, n // 2]
+    best = int(np.argmin(med))
+    return np.array([c1[best], c0[best]])
+
+
+def _refit(
+    t: Array, off: Array, keep: NDArray[np.bool_], opt: AutoLineOptions
+) -> tuple[NDArray[np.bool_], float]:
+    """Least squares ``c0 + c1 t`` on the kept samples and the MAD cut, until no sample leaves
+    (at most 5 times): keep mask and residual RMS (px)."""
     rms = 0.0
-    for _ in range(5):  # refit until no sample leaves
+    for _ in range(5):
         if keep.sum() < max(3, opt.min_points):
             return np.zeros(t.size, bool), 0.0
         coef = np.polyfit(t[keep], off[keep], 1)
@@ -124,6 +154,81 @@ def _fit_line(t: Array, off: Array, opt: AutoLineOptions) -> tuple[NDArray[np.bo
     return keep, rms
 
 
+def _fit_line(t: Array, off: Array, opt: AutoLineOptions) -> tuple[NDArray[np.bool_], float]:
+    """Keep mask and residual RMS (px) of the offsets fitted by ``c0 + c1 t``: least squares
+    from all samples with the MAD cut (:func:`_refit`); when its RMS exceeds
+    ``outlier_sigmas`` times the robust scale of the least-median-of-squares line
+    (:func:`_lmeds_line`; Rousseeuw's scale ``1.4826 (1 + 5 / (n - 2)) sqrt(med r^2)``, at
+    least ``min_sigma_px``), a variance ratio chance does not give, the samples are two
+    populations (some on another edge, which pulled the least-squares start between them): the
+    fit restarts from the samples within ``outlier_sigmas`` scales of that line."""
+    if t.size < max(3, opt.min_points):
+        return np.zeros(t.size, bool), 0.0
+    keep, rms = _refit(t, off, np.ones(t.size, bool), opt)
+    coef = _lmeds_line(t, off)
+    res = np.abs(off - np.polyval(coef, t))
+    n = t.size
+    med = float(np.partition(res, n // 2)[n // 2])
+    scale = max(1.4826 * (1.0 + 5.0 / max(n - 2, 1)) * med, opt.min_sigma_px)
+    if keep.sum() >= max(3, opt.min_points) and rms <= opt.outlier_sigmas * scale:
+        return keep, rms
+    return _refit(t, off, res <= opt.outlier_sigmas * scale, opt)
+
+
+#: Fewest segments (lines) in an image for the screen of :func:`_screen_segments`: its model
+#: has 4 parameters, and the least median of squares needs a clear majority over them.
+_SCREEN_MIN_SEGMENTS = 7
+
+
+def _screen_segments(
+    mid: Array, normal: Array, offset: Array, centre: Array, opt: AutoLineOptions
+) -> NDArray[np.bool_]:
+    """Keep mask of an image's line segments against the displacement its pose error gives
+    every line at once: a small error of the image's orientation moves the image by a shift,
+    a rotation and a scale about the frame's centre (pixel displacement ``d + r J (p - c) +
+    s (p - c)``, ``J`` the quarter turn), so each segment's fitted offset at its midpoint
+    ``p`` across its normal ``n`` is ``n . d + r n . J (p - c) + s n . (p - c)``. The 4
+    parameters are fitted by least median of squares over the segments (all 4-subsets, or 500
+    drawn), then least squares on the segments within ``segment_sigmas`` robust sigmas
+    (Rousseeuw's scale, at least ``segment_min_px``); a segment farther off is on another edge
+    in this image and is dropped. Images with fewer than ``_SCREEN_MIN_SEGMENTS`` segments are
+    not screened (the majority cannot be told)."""
+    n = len(offset)
+    keep = np.ones(n, bool)
+    if n < _SCREEN_MIN_SEGMENTS:
+        return keep
+    rel = (mid - centre) / max(float(np.max(np.abs(mid - centre))), 1.0)  # scaled: conditioning
+    quarter = np.column_stack([-rel[:, 1], rel[:, 0]])
+    a = np.column_stack(
+        [normal, np.einsum("ij,ij->i", normal, quarter), np.einsum("ij,ij->i", normal, rel)]
+    )
+    from itertools import combinations
+
+    subsets = np.array(list(combinations(range(n), 4)))
+    if len(subsets) > 500:
+        subsets = subsets[np.random.default_rng(n).choice(len(subsets), 500, replace=False)]
+    best, best_med = None, np.inf
+    for sub in subsets:
+        m = a[sub]
+        if np.linalg.cond(m) > 1e8:
+            continue
+        x = np.linalg.solve(m, offset[sub])
+        med = float(np.median((offset - a @ x) ** 2))
+        if med < best_med:
+            best, best_med = x, med
+    if best is None:
+        return keep
+    p = a.shape[1]
+    scale = max(1.4826 * (1 + 5.0 / (n - p)) * np.sqrt(best_med), opt.segment_min_px)
+    keep = np.abs(offset - a @ best) <= opt.segment_sigmas * scale
+    if keep.sum() > p:
+        x = np.linalg.lstsq(a[keep], offset[keep], rcond=None)[0]
+        res = offset - a @ x
+        s = np.sqrt(np.sum(res[keep] ** 2) / (keep.sum() - p))
+        keep = np.abs(res) <= opt.segment_sigmas * max(float(s), opt.segment_min_px)
+    return keep
+
+
 def line_observations(
     image: ArrayLike,
     image_id: str,
@@ -133,6 +238,7 @@ def line_observations(
     options: AutoLineOptions | None = None,
     *,
     scene: PickingScene | None = None,
+    refused: dict[str, int] | None = None,
 ) -> ImageObservations:
     """Line observations of one image (module docstring).
 
@@ -150,6 +256,9 @@ def line_observations(
     options : AutoLineOptions, optional
     scene : PickingScene, optional
         The projection chain, when the caller has built it for the block (else built here).
+    refused : dict, optional
+        Incremented by the points refused per reason (:data:`REFUSALS`): off their line's
+        fit in the image, or in a segment off the image's other lines (:func:`_screen_segments`).
 
     Returns
     -------
@@ -165,7 +274,7 @@ def line_observations(
             f"'{camera.name}' {camera.width_px} x {camera.height_px}"
         )
     sc = scene or PickingScene(eo, camera)
-    cols: dict[str, list] = {"pid": [], "tid": [], "px": [], "sig": []}
+    segments = []  # (line id, kept points, sigma, midpoint, normal, mean offset)
     for line in lines:
         pix, dirs, t = _samples(sc, image_id, line, camera, opt)
         if len(pix) < opt.min_points:
@@ -186,14 +295,39 @@ def line_observations(
         if ok.sum() < opt.min_points:
             continue
         keep, rms = _fit_line(t[ok], off[ok], opt)
+        if refused is not None:
+            refused[REFUSALS[0]] = refused.get(REFUSALS[0], 0) + int((~keep).sum())
         if keep.sum() < opt.min_points:
             continue
-        good = refined[ok][keep]
+        nm = normal[ok][keep].mean(axis=0)
+        segments.append(
+            (
+                str(line.id),
+                refined[ok][keep],
+                max(rms, opt.min_sigma_px),
+                pix[ok][keep].mean(axis=0),
+                nm / np.linalg.norm(nm),
+                float(off[ok][keep].mean()),
+            )
+        )
+    screen = _screen_segments(
+        np.reshape([s[3] for s in segments], (-1, 2)),
+        np.reshape([s[4] for s in segments], (-1, 2)),
+        np.array([s[5] for s in segments]),
+        np.array([camera.width_px, camera.height_px]) / 2.0,
+        opt,
+    )
+    cols: dict[str, list] = {"pid": [], "tid": [], "px": [], "sig": []}
+    for (tid, good, sig, *_), kept in zip(segments, screen):
+        if not kept:
+            if refused is not None:
+                refused[REFUSALS[1]] = refused.get(REFUSALS[1], 0) + len(good)
+            continue
         for k, p in enumerate(good):
-            cols["pid"].append(f"{image_id}:L{line.id}:{k}")
-            cols["tid"].append(str(line.id))
+            cols["pid"].append(f"{image_id}:L{tid}:{k}")
+            cols["tid"].append(tid)
             cols["px"].append(p)
-        cols["sig"].extend([max(rms, opt.min_sigma_px)] * len(good))
+        cols["sig"].extend([sig] * len(good))
     n = len(cols["pid"])
     return ImageObservations.from_arrays(
         [image_id] * n,
@@ -211,15 +345,19 @@ def line_observations_block(
     eo: ExteriorOrientationTable,
     lines: Sequence[ControlLine],
     options: AutoLineOptions | None = None,
+    refused: dict[str, int] | None = None,
 ) -> ImageObservations:
     """:func:`line_observations` of many images ((image_id, array) pairs, e.g. a generator
-    reading them one at a time), with one projection chain for the block; rows concatenated."""
+    reading them one at a time), with one projection chain for the block; rows concatenated;
+    ``refused`` counts the refused points per reason over the block."""
     scene = PickingScene(eo, camera)
     out = ImageObservations.from_arrays([], [], np.empty((0, 2)), [], [], [])
     for image_id, image in images:
         if not scene.has_image(image_id):
             raise InputError(f"image '{image_id}' has no exterior orientation")
         out = out.concat(
-            line_observations(image, image_id, camera, eo, lines, options, scene=scene)
+            line_observations(
+                image, image_id, camera, eo, lines, options, scene=scene, refused=refused
+            )
         )
     return out
