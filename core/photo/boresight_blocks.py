@@ -14,6 +14,7 @@ from scipy.spatial import cKDTree
 
 from ..errors import InputError
 from ..geometry.frames import NED_TO_ENU, LocalFrame
+from ..lidar.control import LINE_PARAMETERS
 from ..lsq.model import GaussHelmertBlock, GaussMarkovBlock, prior_block
 from .boresight_models import (
     PoseSpec,
@@ -412,12 +413,7 @@ def _line_block(name, k, sel, members, lx0, lu, lcov, obs, img, pose_idx, r_nl, 
         labels=[f"line {s}" for s in line_names],
         row_names=(
             *[f"{c}{j}" for j in range(k) for c in ("col", "row")],
-            "x0",
-            "y0",
-            "z0",
-            "ux",
-            "uy",
-            "uz",
+            *LINE_PARAMETERS,
         ),
     )
 

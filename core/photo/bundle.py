@@ -301,31 +301,15 @@ def _select_aps(
         new_cams = _cams_from(current)
         new_cams[c] = new_cams[c].with_interior(full)
         free = [f if k != c else f[f != pos] for k, f in enumerate(free)]
-        x = current.result.x
-        mnt, dt = _carried(current)
-        current = _run(
-            setup,
-            observations,
-            new_cams,
-            free,
-            opts,
-            keep,
-            "none",
-            False,
-            x[current.lay.eo],
-            x[current.lay.points],
-            mnt,
-            should_stop,
-            None,
-            dt,
+        current = _run_from(
+            current, setup, observations, new_cams, free, opts, keep, "none", False, should_stop
         )
         cams = new_cams
         changed = True
     if changed:
-        x = current.result.x
-        mnt, dt = _carried(current)
         keep = np.ones(len(observations), dtype=bool)
-        run = _run(
+        run = _run_from(
+            current,
             setup,
             observations,
             cams,
@@ -334,22 +318,44 @@ def _select_aps(
             keep,
             opts.robust,
             opts.snooping,
-            x[current.lay.eo],
-            x[current.lay.points],
-            mnt,
             should_stop,
-            None,
-            dt,
         )
     return run
 
 
-def _carried(run: _Run) -> tuple[Array | None, float | None]:
-    """The mount corrections and the timing offset of ``run`` (None where not estimated),
-    the starting values of the next run."""
-    x = run.result.x
-    mnt = x[run.lay.mount] if run.lay.mount is not None else None
-    return mnt, (float(x[run.lay.timing]) if run.lay.timing >= 0 else None)
+def _run_from(
+    prev: _Run,
+    setup,
+    observations: ImageObservations,
+    cams: list[Camera],
+    free: list[NDArray[np.intp]],
+    opts: BundleOptions,
+    keep: NDArray[np.bool_],
+    robust: str,
+    snooping: bool,
+    should_stop: Callable[[], bool] | None,
+) -> _Run:
+    """:func:`_run` started from the solution of ``prev``: its orientations (m, rad), object
+    points (frame units), mount corrections and timing offset (s; None where not estimated)."""
+    x = prev.result.x
+    mnt = x[prev.lay.mount] if prev.lay.mount is not None else None
+    dt = float(x[prev.lay.timing]) if prev.lay.timing >= 0 else None
+    return _run(
+        setup,
+        observations,
+        cams,
+        free,
+        opts,
+        keep,
+        robust,
+        snooping,
+        x[prev.lay.eo],
+        x[prev.lay.points],
+        mnt,
+        should_stop,
+        None,
+        dt,
+    )
 
 
 def _exposure_velocity(
