@@ -490,7 +490,7 @@ def _write_outputs(
     if out.requested("OUTPUT_COMPARISON"):
         write_comparison(out.path("OUTPUT_COMPARISON"), rows)
     if out.requested("OUTPUT_SCALE_BARS") and res.scale_bars is not None:
-        write_scale_bars_csv(out.path("OUTPUT_SCALE_BARS"), res.scale_bars, _unit(res))
+        write_scale_bars_csv(out.path("OUTPUT_SCALE_BARS"), res.scale_bars, res.length_unit)
     if out.requested("OUTPUT_HTML"):
         page = render_bundle_html(results, best, settings, rows if compared else ())
         write_text_atomic(out.path("OUTPUT_HTML"), page)
@@ -506,7 +506,7 @@ def _summary_lines(res, best: str, rows) -> list[str]:
     from ..photo.bundle_options import BundleOptions
 
     st = res.check.statistics()
-    u = _unit(res)
+    u = res.length_unit
     lines = [f"frame: {res.local.mapping.name}"] if u != "m" or _local(res) else []
     if rows:
         lines.append(
@@ -552,11 +552,6 @@ def _summary_lines(res, best: str, rows) -> list[str]:
 def _local(res) -> bool:
     """Whether a bundle result is in a local engineering frame."""
     return bool(getattr(res.local, "engineering", False))
-
-
-def _unit(res) -> str:
-    """The length unit of the frame of a bundle result: m, or an engineering frame's."""
-    return str(getattr(res.local.mapping, "unit", "m"))
 
 
 def _misfit(xyz, px, eo6, cam) -> float:
