@@ -150,6 +150,26 @@ def skew(v: ArrayLike) -> Array:
     return out
 
 
+def nearest_rotation(m: ArrayLike, tol: float = 1e-5) -> Array:
+    """The rotation nearest the (3, 3) matrix ``m`` (its orthogonal polar factor, by SVD);
+    ValueError, saying why, unless ``m`` is a rotation within ``tol``: every singular value
+    within ``tol`` of 1, no reflection, and every element within ``tol`` of the rotation.
+
+    >>> bool(np.allclose(nearest_rotation(np.diag([1.0, 1.0, 1.0 + 1e-7])), np.eye(3)))
+    True
+    """
+    a = np.asarray(m, dtype=np.float64)
+    u, s, vt = np.linalg.svd(a)
+    r = u @ vt
+    off = float(np.max(np.abs(r - a)))
+    if np.linalg.det(r) < 0 or np.max(np.abs(s - 1.0)) > tol or off > tol:
+        raise ValueError(
+            f"singular values {s.round(6)}, det {np.linalg.det(a):.6f}, {off:.2e} from the "
+            f"nearest rotation (tolerance {tol:g})"
+        )
+    return r
+
+
 def is_rotation(r: ArrayLike, atol: float = 1e-9) -> bool:
     """True when every matrix in ``r`` is orthonormal with determinant +1."""
     r = np.asarray(r, dtype=np.float64)

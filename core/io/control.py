@@ -31,7 +31,14 @@ from typing import Union
 import numpy as np
 
 from ..errors import InputError
-from ..lidar.control import LINE_KINDS, Adjacency, ControlLine, ControlPoint, error_ellipsoid
+from ..lidar.control import (
+    LINE_KINDS,
+    LINE_PARAMETERS,
+    Adjacency,
+    ControlLine,
+    ControlPoint,
+    error_ellipsoid,
+)
 from .tables import (
     check_covariance,
     find_column,
@@ -74,12 +81,7 @@ LINE_COLUMNS = (
     "y2",
     "z2",
     "length",
-    "x0",
-    "y0",
-    "z0",
-    "ux",
-    "uy",
-    "uz",
+    *LINE_PARAMETERS,
     "sigma_perpendicular",
     "sigma_start",
     "sigma_end",

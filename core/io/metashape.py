@@ -57,6 +57,7 @@ from numpy.typing import NDArray
 from ..errors import CrsError, InputError
 from ..geometry.camera import Camera
 from ..geometry.forward_lens import MetashapeLens
+from ..geometry.rotations import nearest_rotation
 from ..photo.bundle_setup import DEFAULT_CONTROL_SIGMA_M, GroundPoints
 from ..photo.observations import DEFAULT_SIGMA_PX, ImageObservations
 from .colmap_block import ColmapBlock, ColmapFrame, oriented
@@ -200,15 +201,10 @@ def _numbers(el: ET.Element | None, n: int, what: str, src: str) -> Array:
 
 def _rotation(m: Array, what: str, src: str) -> Array:
     """The rotation nearest ``m`` (3, 3), refused unless within :data:`_ROTATION_TOL`."""
-    u, s, vt = np.linalg.svd(m)
-    r = u @ vt
-    if (
-        np.linalg.det(r) < 0
-        or np.max(np.abs(s - 1.0)) > _ROTATION_TOL
-        or np.max(np.abs(r - m)) > _ROTATION_TOL
-    ):
-        raise InputError(f"{what}: not a rotation matrix (singular values {s.round(6)})", path=src)
-    return r
+    try:
+        return nearest_rotation(m, _ROTATION_TOL)
+    except ValueError as exc:
+        raise InputError(f"{what}: not a rotation matrix ({exc})", path=src) from None
 
 
 def _similarity(el: ET.Element | None, what: str, src: str) -> Similarity | None:

@@ -50,6 +50,7 @@ from ..errors import InputError
 from ..geometry.camera import Camera
 from ..geometry.distortion import DistortionModel, NoDistortion
 from ..geometry.forward_lens import OpenCVLens
+from ..geometry.rotations import nearest_rotation
 from ..photo.bundle_setup import GroundPoints
 from ..photo.observations import ImageObservations
 from .colmap_block import ColmapBlock, ColmapFrame, oriented
@@ -136,16 +137,13 @@ def _numeric(tokens: List[str]) -> bool:
 
 
 def _rotation(m: Array, name: str, src: str, row: int) -> Array:
-    err = float(np.max(np.abs(m @ m.T - np.eye(3))))
-    if err > _ROTATION_TOL or np.linalg.det(m) <= 0:
+    """:func:`~..geometry.rotations.nearest_rotation` of an image's R, refused with its row."""
+    try:
+        return nearest_rotation(m, _ROTATION_TOL)
+    except ValueError as exc:
         raise InputError(
-            f"image {name!r}: R is not a rotation (|R R^T - I| = {err:.2e}, "
-            f"det {np.linalg.det(m):.6f})",
-            path=src,
-            row=row,
-        )
-    u, _, vt = np.linalg.svd(m)
-    return u @ vt
+            f"image {name!r}: R is not a rotation ({exc})", path=src, row=row
+        ) from None
 
 
 def read_pix4d(path: str | Path) -> Tuple[Pix4dImage, ...]:

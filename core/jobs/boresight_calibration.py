@@ -19,10 +19,11 @@ from ..i18n import joined as _joined
 from ..i18n import mark as _t
 from .common import (
     CSV_FILTER,
-    CSV_OUT,
     LAS_FILTER,
+    csv_out,
     doubt_params,
     global_test_verdict,
+    html_out,
     mount_from,
     mount_params,
     rejection_doubts,
@@ -290,7 +291,7 @@ comment lines beginning with #).""",
             "explain or boresight beyond MAX_BORESIGHT: "
             "write the outputs anyway, each with a warning at its top",
         ),
-        Param("OUTPUT_TABLE", "file_out", "Boresight per group (CSV)", file_filter=CSV_OUT),
+        csv_out("OUTPUT_TABLE", "Boresight per group (CSV)", optional=False),
         Param(
             "OUTPUT_RESIDUALS",
             "sink",
@@ -299,18 +300,15 @@ comment lines beginning with #).""",
             optional=True,
             advanced=True,
         ),
-        Param(
+        csv_out(
             "RESIDUALS_CSV",
-            "file_out",
             "Image residuals (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
+            on_demand=True,
             advanced=True,
-            layer_twin="OUTPUT_RESIDUALS",
+            twin="OUTPUT_RESIDUALS",
         ),
-        Param("OUTPUT_EO", "file_out", "Updated exterior orientation (CSV)", file_filter=CSV_OUT),
-        Param("OUTPUT_HTML", "file_out", "Summary (HTML)", file_filter="HTML files (*.html)"),
+        csv_out("OUTPUT_EO", "Updated exterior orientation (CSV)", optional=False),
+        html_out("OUTPUT_HTML", "Summary (HTML)", optional=False),
     ),
     results=(
         Result("SIGMA0", "number", "Sigma0 a-posteriori"),
@@ -446,9 +444,8 @@ def _results(result) -> dict[str, float]:
 def _read_inputs(v: Values, frame) -> tuple:
     """The camera, trajectory, observations and the control (planes, lines, LCPs, ground
     points), each checked against the mapping CRS's area of use."""
-    import numpy as np
 
-    from ..geometry.frames import check_area_of_use
+    from ..geometry.frames import check_points_in_area
     from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.control import read_lcps_csv, read_lines_csv
@@ -460,13 +457,7 @@ def _read_inputs(v: Values, frame) -> tuple:
     cam = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     traj = read_trajectory_csv(v.trajectory)
     if not traj.geodetic:
-        check_area_of_use(
-            frame.crs,
-            traj.position.min(axis=0),
-            traj.position.max(axis=0),
-            what="the trajectory",
-            path=v.trajectory,
-        )
+        check_points_in_area(frame.crs, traj.position, what="the trajectory", path=v.trajectory)
     obs = read_observations_csv(v.observations, camera=cam)
     plane_list = read_planes_csv(v.planes) if v.planes else []
     line_list = read_lines_csv(v.lines) if v.lines else []
@@ -478,10 +469,7 @@ def _read_inputs(v: Values, frame) -> tuple:
         ("LCPs", v.lcps, [p.xyz for p in lcp_list]),
         ("ground points", v.ground_points, [] if ground is None else list(ground.xyz)),
     ):
-        if xyz:
-            check_area_of_use(
-                frame.crs, np.min(xyz, axis=0), np.max(xyz, axis=0), what=f"the {name}", path=path
-            )
+        check_points_in_area(frame.crs, xyz, what=f"the {name}", path=path)
     return cam, traj, obs, plane_list, line_list, lcp_list, ground
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_FILTER, CSV_OUT, global_test_verdict
+from .common import CSV_FILTER, csv_out, global_test_verdict, html_out
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -220,7 +220,7 @@ with the file and row named.""",
             "with the lever arm, different speeds",
             advanced=True,
         ),
-        Param("OUTPUT_EO", "file_out", "Adjusted exterior orientation (CSV)", file_filter=CSV_OUT),
+        csv_out("OUTPUT_EO", "Adjusted exterior orientation (CSV)", optional=False),
         Param(
             "OUTPUT_CAMERA",
             "file_out",
@@ -228,56 +228,18 @@ with the file and row named.""",
             optional=True,
             file_filter="JSON files (*.json)",
         ),
-        Param(
-            "OUTPUT_POINTS",
-            "file_out",
-            "Object points (CSV)",
-            optional=True,
-            file_filter=CSV_OUT,
-            layer_twin="OUTPUT_POINTS_LAYER",
-        ),
+        csv_out("OUTPUT_POINTS", "Object points (CSV)", twin="OUTPUT_POINTS_LAYER"),
         Param("OUTPUT_POINTS_LAYER", "sink", "Object points", geometry="point", optional=True),
-        Param(
-            "OUTPUT_RESIDUALS",
-            "file_out",
-            "Image residuals with w-tests (CSV)",
-            optional=True,
-            file_filter=CSV_OUT,
-            advanced=True,
-        ),
-        Param(
-            "OUTPUT_CHECK_CSV",
-            "file_out",
-            "Check-point discrepancies (CSV)",
-            optional=True,
-            file_filter=CSV_OUT,
-            advanced=True,
-        ),
-        Param(
-            "OUTPUT_COMPARISON",
-            "file_out",
-            "AP model comparison (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
-            advanced=True,
-        ),
-        Param(
+        csv_out("OUTPUT_RESIDUALS", "Image residuals with w-tests (CSV)", advanced=True),
+        csv_out("OUTPUT_CHECK_CSV", "Check-point discrepancies (CSV)", advanced=True),
+        csv_out("OUTPUT_COMPARISON", "AP model comparison (CSV)", on_demand=True, advanced=True),
+        csv_out(
             "OUTPUT_SCALE_BARS",
-            "file_out",
             "Adjusted scale bars with w-tests (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter=CSV_OUT,
+            on_demand=True,
             advanced=True,
         ),
-        Param(
-            "OUTPUT_HTML",
-            "file_out",
-            "Summary (HTML)",
-            optional=True,
-            file_filter="HTML files (*.html)",
-        ),
+        html_out("OUTPUT_HTML", "Summary (HTML)"),
     ),
     results=(
         Result("SIGMA0", "number", "Sigma0 a-posteriori"),
@@ -415,7 +377,7 @@ def _read_inputs(v: Values) -> tuple:
     import numpy as np
 
     from ..errors import InputError
-    from ..geometry.frames import check_area_of_use
+    from ..geometry.frames import check_points_in_area
     from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_cameras_json
     from ..io.ground_points import read_ground_points_csv
@@ -430,14 +392,8 @@ def _read_inputs(v: Values) -> tuple:
     # one camera: its image size bounds every pixel as the table is read (several: below)
     obs = read_observations_csv(v.observations, camera=cams[0] if len(cams) == 1 else None)
     ground = read_ground_points_csv(v.ground_points) if v.ground_points else GroundPoints.empty()
-    if len(ground) and crs is not None:
-        check_area_of_use(
-            crs,
-            ground.xyz.min(axis=0),
-            ground.xyz.max(axis=0),
-            what="the ground points",
-            path=v.ground_points,
-        )
+    if crs is not None:
+        check_points_in_area(crs, ground.xyz, what="the ground points", path=v.ground_points)
     eo = sigma = velocity = None
     eo_rows: tuple[int, ...] = ()
     eo_source = ""
@@ -446,13 +402,7 @@ def _read_inputs(v: Values) -> tuple:
         f = read_eo_csv_full(v.eo, crs.to_wkt() if crs is not None else "")
         eo, sigma, eo_rows, eo_source, velocity = f.eo, f.sigma, f.rows, f.path, f.velocity
         if crs is not None:
-            check_area_of_use(
-                crs,
-                eo.xyz.min(axis=0),
-                eo.xyz.max(axis=0),
-                what="the perspective centres",
-                path=v.eo,
-            )
+            check_points_in_area(crs, eo.xyz, what="the perspective centres", path=v.eo)
         if sigma is None and v.eo_sigmas:
             s6 = np.array(v.eo_sigmas, dtype=float)
             if not (s6 > 0).all():
@@ -540,7 +490,7 @@ def _write_outputs(
     if out.requested("OUTPUT_COMPARISON"):
         write_comparison(out.path("OUTPUT_COMPARISON"), rows)
     if out.requested("OUTPUT_SCALE_BARS") and res.scale_bars is not None:
-        write_scale_bars_csv(out.path("OUTPUT_SCALE_BARS"), res.scale_bars, _unit(res))
+        write_scale_bars_csv(out.path("OUTPUT_SCALE_BARS"), res.scale_bars, res.length_unit)
     if out.requested("OUTPUT_HTML"):
         page = render_bundle_html(results, best, settings, rows if compared else ())
         write_text_atomic(out.path("OUTPUT_HTML"), page)
@@ -556,7 +506,7 @@ def _summary_lines(res, best: str, rows) -> list[str]:
     from ..photo.bundle_options import BundleOptions
 
     st = res.check.statistics()
-    u = _unit(res)
+    u = res.length_unit
     lines = [f"frame: {res.local.mapping.name}"] if u != "m" or _local(res) else []
     if rows:
         lines.append(
@@ -602,11 +552,6 @@ def _summary_lines(res, best: str, rows) -> list[str]:
 def _local(res) -> bool:
     """Whether a bundle result is in a local engineering frame."""
     return bool(getattr(res.local, "engineering", False))
-
-
-def _unit(res) -> str:
-    """The length unit of the frame of a bundle result: m, or an engineering frame's."""
-    return str(getattr(res.local.mapping, "unit", "m"))
 
 
 def _misfit(xyz, px, eo6, cam) -> float:

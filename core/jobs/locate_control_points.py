@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from ..io.suffixes import CHIP_SUFFIXES, IMAGE_SUFFIXES
-from .common import CSV_FILTER, CSV_OUT
+from .common import CSV_FILTER, csv_out, html_out
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
@@ -123,21 +123,9 @@ shows the chips.""",
             advanced=True,
         ),
         Param("TRANSFER", "boolean", "Transfer to images where the chip failed", _D.transfer),
-        Param("OUTPUT", "file_out", "Image observations (CSV)", file_filter=CSV_OUT),
-        Param(
-            "OUTPUT_REPORT",
-            "file_out",
-            "Report per point and image (CSV)",
-            optional=True,
-            file_filter=CSV_OUT,
-        ),
-        Param(
-            "OUTPUT_HTML",
-            "file_out",
-            "Report with chip gallery (HTML)",
-            optional=True,
-            file_filter="HTML files (*.html)",
-        ),
+        csv_out("OUTPUT", "Image observations (CSV)", optional=False),
+        csv_out("OUTPUT_REPORT", "Report per point and image (CSV)"),
+        html_out("OUTPUT_HTML", "Report with chip gallery (HTML)"),
     ),
     results=(
         Result("LOCATED", "number", "Observations written"),
@@ -231,7 +219,7 @@ def _read_inputs(v: Values) -> tuple:
     from dataclasses import replace
 
     from ..errors import InputError
-    from ..geometry.frames import check_area_of_use, parse_crs
+    from ..geometry.frames import check_points_in_area, parse_crs
     from ..geometry.projection import PROJECTIONS
     from ..io.camera import read_camera_json
     from ..io.chips import list_chips, read_control_chip
@@ -243,17 +231,9 @@ def _read_inputs(v: Values) -> tuple:
     camera = read_camera_json(v.camera, projections=PROJECTIONS)  # perspective or fisheye
     eo_file = read_eo_csv_full(v.eo, crs.to_wkt())
     eo = eo_file.eo
-    check_area_of_use(
-        crs, eo.xyz.min(axis=0), eo.xyz.max(axis=0), what="the perspective centres", path=v.eo
-    )
+    check_points_in_area(crs, eo.xyz, what="the perspective centres", path=v.eo)
     control = read_point_control_csv(v.control_points)
-    check_area_of_use(
-        crs,
-        control.xyz.min(axis=0),
-        control.xyz.max(axis=0),
-        what="the control points",
-        path=v.control_points,
-    )
+    check_points_in_area(crs, control.xyz, what="the control points", path=v.control_points)
     chip_files = list_chips(v.chips)
     ids = list(control.ids)
     unknown = sorted(set(chip_files) - set(ids))

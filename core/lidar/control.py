@@ -38,6 +38,9 @@ log = logging.getLogger(__name__)
 Array = NDArray[np.float64]
 
 LINE_KINDS = ("ridge", "hip", "valley", "other")
+#: the six parameters of a :class:`ControlLine` in the order of its covariance: the line
+#: point X0 (CRS units) and the unit direction u
+LINE_PARAMETERS = ("x0", "y0", "z0", "ux", "uy", "uz")
 
 
 # ----------------------------------------------------------------------------- intersections

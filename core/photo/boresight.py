@@ -79,7 +79,7 @@ from ..lsq.model import AdjustmentOptions
 from .boresight_blocks import (
     _ins_blocks,
     _line_blocks,
-    _paper_block,
+    _paper_blocks,
     _point_blocks,
     _Stage,
     _tie_blocks,
@@ -215,28 +215,8 @@ def calibrate(
     _point_blocks(st, lcps, surveyed)
 
     # ---- 4. the single-image model of Pedrosa & dos Santos (2020)
-    paper_rows = st.rows("paper")
-    if paper_rows.size:
-        st.blocks.append(
-            _paper_block(
-                paper_rows,
-                observations,
-                img,
-                par.pose_idx,
-                r_nl,
-                spec,
-                planes,
-                plane_by_id,
-                p_params,
-                p_cov,
-                local,
-                lidar_points,
-                lidar_plane_ids,
-                opts,
-                st.x_init,
-            )
-        )
-        st.maps.append(("paper planes", paper_rows[:, None], "paper"))
+    cloud = (lidar_points, lidar_plane_ids)
+    _paper_blocks(st, planes, plane_by_id, p_params, p_cov, cloud, opts)
 
     if len(st.blocks) == 2:
         raise InputError("no image observations of the types in use: nothing to calibrate")

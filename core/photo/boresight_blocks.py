@@ -14,6 +14,7 @@ from scipy.spatial import cKDTree
 
 from ..errors import InputError
 from ..geometry.frames import NED_TO_ENU, LocalFrame
+from ..lidar.control import LINE_PARAMETERS
 from ..lsq.model import GaussHelmertBlock, GaussMarkovBlock, prior_block
 from .boresight_models import (
     PoseSpec,
@@ -412,40 +413,33 @@ def _line_block(name, k, sel, members, lx0, lu, lcov, obs, img, pose_idx, r_nl, 
         labels=[f"line {s}" for s in line_names],
         row_names=(
             *[f"{c}{j}" for j in range(k) for c in ("col", "row")],
-            "x0",
-            "y0",
-            "z0",
-            "ux",
-            "uy",
-            "uz",
+            *LINE_PARAMETERS,
         ),
     )
 
 
-def _paper_block(
-    rows,
-    obs,
-    img,
-    pose_idx,
-    r_nl,
-    spec,
-    planes,
-    plane_by_id,
-    p_params,
-    p_cov,
-    local,
-    lidar_points,
-    lidar_plane_ids,
-    opts,
-    x_init,
-) -> GaussMarkovBlock:
-    """Eq. 15 of Pedrosa & dos Santos (2020) with d observed; z from the LiDAR points near the
-    picked point."""
+def _paper_blocks(
+    st: _Stage,
+    planes: Sequence,
+    plane_by_id: Mapping[str, int],
+    p_params: Array,
+    p_cov: Array,
+    cloud: tuple[Array | None, NDArray | None],
+    opts: BoresightOptions,
+) -> None:
+    """4. Eq. 15 of Pedrosa & dos Santos (2020) with d observed, for the ``paper`` rows; z
+    from the LiDAR points near the picked point (``cloud``: the points (M, 3) in the mapping
+    CRS and their plane ids (M,))."""
+    rows = st.rows("paper")
+    if not rows.size:
+        return
+    lidar_points, lidar_plane_ids = cloud
     if lidar_points is None or lidar_plane_ids is None:
         raise InputError("paper-mode observations need the LiDAR points and their plane ids")
+    obs, img, spec, local = st.observations, st.img, st.spec, st.local
     pk = _index([obs.target_id[r] for r in rows], plane_by_id, "plane", rows)
-    xp0 = x_init[pose_idx[img[rows]]]
-    rn = r_nl[img[rows]]
+    xp0 = st.init_pose(rows)
+    rn = st.r_nl[img[rows]]
     centre, ray, *_ = camera_ray(xp0, obs.pixels[rows], rn, spec)
     pl = p_params[pk]
     t = -(np.einsum("ti,ti->t", pl[:, :3], centre) + pl[:, 3]) / np.einsum(
@@ -481,12 +475,15 @@ def _paper_block(
         d, j = paper_plane(x_local, px, normal, z, rn, spec)
         return d[:, None], j
 
-    return GaussMarkovBlock(
-        "paper planes",
-        pl[:, 3:4],
-        sigma[:, None],
-        pose_idx[img[rows]],
-        model,
-        labels=[f"{obs.image_id[r]} / {obs.point_id[r]}" for r in rows],
-        row_names=("d",),
+    st.blocks.append(
+        GaussMarkovBlock(
+            "paper planes",
+            pl[:, 3:4],
+            sigma[:, None],
+            st.pose_idx[img[rows]],
+            model,
+            labels=[f"{obs.image_id[r]} / {obs.point_id[r]}" for r in rows],
+            row_names=("d",),
+        )
     )
+    st.maps.append(("paper planes", rows[:, None], "paper"))

@@ -5,14 +5,13 @@ determined, and what a run of the job computed.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import DiagnosedNotObservable, NotObservableError
+from ..errors import DiagnosedNotObservable
 from ..geometry.frames import LocalFrame, MappingFrame
 from ..i18n import mark as _t
 from ..lsq.results import AdjustmentResult
@@ -24,7 +23,9 @@ from .boresight_setup import ANGLES, ARCSEC, BoresightOptions, _Parameters
 from .georeference import Trajectory
 from .observations import ImageObservations
 from .orientation import ExteriorOrientationTable, eo_local_to_map
-from .timing import TIMING_SEPARABILITY_MIN
+from .timing import TIMING_SEPARABILITY_MIN, timing_trade
+
+_LEVER_NAMES = ("lever_arm.x", "lever_arm.y", "lever_arm.z")
 
 #: catalogue context of this module's ``_t("...")`` sentences (the diagnosis the report shows)
 TR_CONTEXT = "Report"
@@ -347,20 +348,13 @@ def require_timing_separable(share: float, body_velocity: Array) -> None:
     """Refuse a timing offset estimated with the lever arm when the body-frame velocity is
     (nearly) the same at every image (``share`` below :data:`TIMING_SEPARABILITY_MIN`):
     dt times that velocity is then a lever arm. Names dt and the lever-arm component along
-    the velocity (``body_velocity``, the mean body-frame velocity, m/s)."""
-    if share >= TIMING_SEPARABILITY_MIN:
+    the velocity (``body_velocity``, the mean body-frame velocity, m/s); the rule is
+    :func:`~.timing.timing_trade`'s."""
+    cause = timing_trade(share, body_velocity, "timing.dt", _LEVER_NAMES, "body")
+    if cause is None:
         return
-    k = int(np.argmax(np.abs(body_velocity)))
-    axis = "xyz"[k]
+    axis = "xyz"[int(np.argmax(np.abs(body_velocity)))]
     speed = float(np.linalg.norm(body_velocity))
-    names = ["timing.dt", f"lever_arm.{axis}"]
-    cause = NotObservableError(
-        f"Not observable: timing.dt and lever_arm.{axis} cannot be separated (the body-frame "
-        f"velocity varies by {share:.1%} of the speed at the images, less than the "
-        f"{TIMING_SEPARABILITY_MIN:.0%} needed)",
-        parameters=names,
-        condition_number=math.inf if share == 0 else 1.0 / share**2,
-    )
     diagnosis: list[str] = [
         _t(
             "the camera timing offset dt cannot be separated from the lever arm's {axis} "

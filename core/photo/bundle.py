@@ -192,22 +192,8 @@ def bundle_adjust(
     keep = np.ones(len(observations), dtype=bool)
     report = progress if progress is not None else (lambda f: None)
     # 1. the full model, robust + snooping, from the approximate values
-    run = _run(
-        setup,
-        observations,
-        cams,
-        free,
-        opts,
-        keep,
-        opts.robust,
-        opts.snooping,
-        setup.eo0,
-        setup.xyz0,
-        mount,
-        should_stop,
-        None,
-        dt0,
-    )
+    start = (setup.eo0, setup.xyz0, mount, dt0)
+    run = _run_at(start, setup, observations, cams, free, opts, keep, True, should_stop)
     report(0.4)
     dropped: dict[tuple[str, str], str] = {}
     dropped_list: list[tuple[str, str, str]] = []
@@ -301,55 +287,51 @@ def _select_aps(
         new_cams = _cams_from(current)
         new_cams[c] = new_cams[c].with_interior(full)
         free = [f if k != c else f[f != pos] for k, f in enumerate(free)]
-        x = current.result.x
-        mnt, dt = _carried(current)
-        current = _run(
-            setup,
-            observations,
-            new_cams,
-            free,
-            opts,
-            keep,
-            "none",
-            False,
-            x[current.lay.eo],
-            x[current.lay.points],
-            mnt,
-            should_stop,
-            None,
-            dt,
+        start = _start_of(current)
+        current = _run_at(
+            start, setup, observations, new_cams, free, opts, keep, False, should_stop
         )
         cams = new_cams
         changed = True
     if changed:
-        x = current.result.x
-        mnt, dt = _carried(current)
         keep = np.ones(len(observations), dtype=bool)
-        run = _run(
-            setup,
-            observations,
-            cams,
-            free,
-            opts,
-            keep,
-            opts.robust,
-            opts.snooping,
-            x[current.lay.eo],
-            x[current.lay.points],
-            mnt,
-            should_stop,
-            None,
-            dt,
-        )
+        start = _start_of(current)
+        run = _run_at(start, setup, observations, cams, free, opts, keep, True, should_stop)
     return run
 
 
-def _carried(run: _Run) -> tuple[Array | None, float | None]:
-    """The mount corrections and the timing offset of ``run`` (None where not estimated),
-    the starting values of the next run."""
+_Start = tuple[Array, Array, "Array | None", "float | None"]
+
+
+def _start_of(run: _Run) -> _Start:
+    """The solution of ``run`` as the start of the next: orientations (m, rad), object points
+    (frame units), mount corrections and timing offset (s; None where not estimated)."""
     x = run.result.x
     mnt = x[run.lay.mount] if run.lay.mount is not None else None
-    return mnt, (float(x[run.lay.timing]) if run.lay.timing >= 0 else None)
+    dt = float(x[run.lay.timing]) if run.lay.timing >= 0 else None
+    return x[run.lay.eo], x[run.lay.points], mnt, dt
+
+
+def _run_at(
+    start: _Start,
+    setup,
+    observations: ImageObservations,
+    cams: list[Camera],
+    free: list[NDArray[np.intp]],
+    opts: BundleOptions,
+    keep: NDArray[np.bool_],
+    full: bool,
+    should_stop: Callable[[], bool] | None,
+) -> _Run:
+    """One adjustment (:func:`.bundle_model._run`) from ``start`` (:func:`_start_of`): the
+    full model (``opts.robust`` and ``opts.snooping``) when ``full``, else plain least squares
+    without data snooping (the AP-selection runs)."""
+    eo, xyz, mount, dt = start
+    robust, snooping = (opts.robust, opts.snooping) if full else ("none", False)
+    return _run(
+        setup, observations, cams, free, opts, keep, robust, snooping, eo, xyz, mount,
+        should_stop, None, dt,
+    )  # fmt: skip
 
 
 def _exposure_velocity(

@@ -192,6 +192,11 @@ class BundleResult:
         return self.adjustment.sigma0
 
     @property
+    def length_unit(self) -> str:
+        """The length unit of the frame: ``m``, or the unit of an engineering frame."""
+        return str(getattr(self.local.mapping, "unit", "m"))
+
+    @property
     def n_significant(self) -> int:
         """APs kept and significant in the final adjustment."""
         return sum(

@@ -15,7 +15,7 @@ from numpy.typing import NDArray
 
 from ..errors import InputError
 from ..geometry.planes import Plane, fit_plane, orient_up, slope_aspect_deg
-from ..lidar.control import LINE_KINDS, ControlLine, ControlPoint
+from ..lidar.control import LINE_KINDS, LINE_PARAMETERS, ControlLine, ControlPoint
 
 Array = NDArray[np.float64]
 
@@ -175,7 +175,7 @@ def line_from_feature(feature: ControlFeature) -> ControlLine | None:
     if length == 0.0:
         return None
     point, direction = 0.5 * (start + end), (end - start) / length
-    line_point = feature.numbers(("x0", "y0", "z0", "ux", "uy", "uz"))
+    line_point = feature.numbers(LINE_PARAMETERS)
     upper = feature.numbers(_LINE_COV)
     if line_point is not None and upper is not None:
         point, direction = np.array(line_point[:3]), np.array(line_point[3:])

@@ -300,7 +300,7 @@ def render_bundle_html(
             "</ul>",
         ]
     parts.append("</body></html>")
-    return _in_unit("\n".join(parts), _unit(res))
+    return _in_unit("\n".join(parts), res.length_unit)
 
 
 def _selection(res: BundleResult, max_correlation: float) -> list[str]:
@@ -503,11 +503,6 @@ def _residuals(res: BundleResult) -> list[str]:
             _table([t("image"), t("point"), t("v col"), t("v row"), t("w col"), t("w row")], rows),
         ]
     return parts
-
-
-def _unit(res: BundleResult) -> str:
-    """The length unit of the frame of ``res``: ``m``, or the unit of an engineering frame."""
-    return str(getattr(res.local.mapping, "unit", "m"))
 
 
 def _in_unit(page: str, unit: str) -> str:

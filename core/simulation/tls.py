@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..geometry.rotations import opk_to_matrix
+from ..tls.ap_table import ARCSEC
 from ..tls.network import ControlTarget, StationInfo, TlsObservations
 
 __all__ = [
@@ -34,7 +35,6 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
-ARCSEC = math.pi / (180.0 * 3600.0)
 
 #: name -> (sigma range m, sigma horizontal rad, sigma vertical rad) of a target centre.
 SCANNER_CLASSES = {

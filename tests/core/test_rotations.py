@@ -103,3 +103,18 @@ def test_mount_preset_meaning():
     np.testing.assert_allclose(up, [1.0, 0.0, 0.0])  # image top (y_c) -> forward
     right = MOUNT_PRESETS["image_right_forward"] @ np.array([1.0, 0.0, 0.0])
     np.testing.assert_allclose(right, [1.0, 0.0, 0.0])
+
+
+def test_nearest_rotation_recovers_a_noisy_rotation_and_refuses_the_rest():
+    """A rotation with 1e-7 noise on its elements (a file's rounding) comes back orthonormal
+    and within a few noise sigmas of the truth; 1e-3 noise, a scaled matrix or a reflection
+    is refused (tolerance 1e-5)."""
+    rng = np.random.default_rng(7)
+    truth = rot.opk_to_matrix(0.3, -0.2, 1.1)
+    noisy = truth + rng.normal(0.0, 1e-7, (3, 3))
+    r = rot.nearest_rotation(noisy)
+    assert rot.is_rotation(r, atol=1e-12)
+    assert np.max(np.abs(r - truth)) < 5e-7
+    for bad in (truth + rng.normal(0.0, 1e-3, (3, 3)), 1.001 * truth, truth @ np.diag([1, 1, -1])):
+        with pytest.raises(ValueError, match="nearest rotation"):
+            rot.nearest_rotation(bad)
