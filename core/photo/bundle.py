@@ -63,6 +63,7 @@ from ..geometry.camera import Camera
 from ..geometry.engineering import EngineeringFrame, EngineeringLocal
 from ..geometry.frames import MappingFrame
 from ..geometry.rotations import opk_to_matrix
+from ..lsq.adjustment import small_pages
 from .bundle_model import LEVER_NAMES, TIMING_NAME, _cams_from, _Run, _run
 from .bundle_result import BundleResult, _finish
 from .bundle_selection import ap_decisions, drop_candidate
@@ -101,6 +102,7 @@ def _drop_candidate(run: _Run, options: BundleOptions) -> tuple[int, int, str] |
     return None if d is None else (d.camera, d.position, d.reason)
 
 
+@small_pages()
 def bundle_adjust(
     cameras: Sequence[Camera],
     observations: ImageObservations,
