@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 
 from ..io.suffixes import IMAGE_SUFFIXES
-from .boresight_calibration import ESTIMATE_PARAMS, GROUPING_PARAM
+from .boresight_calibration import ESTIMATE_PARAMS, GROUPING_PARAM, INS_SIGMAS_PARAM
 from .common import (
     CSV_FILTER,
     CSV_OUT,
@@ -167,18 +167,7 @@ give the counts per round and the ties refused per reason.""",
         ),
         GROUPING_PARAM,
         *ESTIMATE_PARAMS,
-        Param(
-            "INS_SIGMAS",
-            "numbers",
-            "Custom INS sigmas: horizontal, vertical, roll/pitch, heading",
-            (0.02, 0.05, 0.015, 0.035),
-            count=4,
-            unit="m, m, deg, deg",
-            optional=True,
-            advanced=True,
-            minimum=0.0001,
-            maximum=100.0,
-        ),
+        INS_SIGMAS_PARAM,
         Param(
             "MAX_BORESIGHT",
             "number",

@@ -116,6 +116,20 @@ GROUPING_PARAM = Param(
     ),
     advanced=True,
 )
+#: The custom INS sigmas of both boresight algorithms (one definition: same label, default, range).
+INS_SIGMAS_PARAM = Param(
+    "INS_SIGMAS",
+    "numbers",
+    "Custom INS sigmas: horizontal, vertical, roll/pitch, heading",
+    (0.02, 0.05, 0.015, 0.035),
+    count=4,
+    unit="m, m, deg, deg",
+    optional=True,
+    advanced=True,
+    minimum=0.0001,
+    maximum=100.0,
+)
+
 #: The calibration's optional unknowns and the INS grade, shared with ``autoboresight`` (the
 #: same labels, defaults and help).
 ESTIMATE_PARAMS: tuple[Param, ...] = (
@@ -259,18 +273,7 @@ comment lines beginning with #).""",
             advanced=True,
         ),
         *ESTIMATE_PARAMS,
-        Param(
-            "INS_SIGMAS",
-            "numbers",
-            "Custom INS sigmas: horizontal, vertical, roll/pitch, heading",
-            (0.02, 0.05, 0.015, 0.035),
-            count=4,
-            unit="m, m, deg, deg",
-            optional=True,
-            advanced=True,
-            minimum=0.0001,
-            maximum=100.0,
-        ),
+        INS_SIGMAS_PARAM,
         Param("SNOOPING", "boolean", "Data snooping (Baarda)", _OPTIONS.snooping, advanced=True),
         Param(
             "MAX_BORESIGHT",
