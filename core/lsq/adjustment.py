@@ -99,6 +99,7 @@ unit weight, so ``Omega / sigma0_prior^2`` is chi-square distributed when the si
 from __future__ import annotations
 
 import contextlib
+import threading
 from collections.abc import Iterator, Sequence
 from typing import Callable
 
@@ -138,6 +139,10 @@ def _hugepage_switch() -> Callable[[bool], bool] | None:
     return None
 
 
+_PAGES_LOCK = threading.Lock()
+_PAGES_STATE: dict[str, int | bool] = {"depth": 0, "before": True}
+
+
 @contextlib.contextmanager
 def small_pages() -> Iterator[None]:
     """Within the block (or the decorated function), numpy's large arrays are not advised
@@ -155,11 +160,20 @@ def small_pages() -> Iterator[None]:
     if switch is None:
         yield
         return
-    before = switch(False)
+    # Counted, not saved per block: two adjustments in two threads must not restore each
+    # other's "off" as the previous state; the first block in switches off, the last out
+    # restores what it found.
+    with _PAGES_LOCK:
+        if _PAGES_STATE["depth"] == 0:
+            _PAGES_STATE["before"] = bool(switch(False))
+        _PAGES_STATE["depth"] += 1
     try:
         yield
     finally:
-        switch(bool(before))
+        with _PAGES_LOCK:
+            _PAGES_STATE["depth"] -= 1
+            if _PAGES_STATE["depth"] == 0:
+                switch(_PAGES_STATE["before"])
 
 
 def _problem(

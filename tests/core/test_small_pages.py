@@ -65,3 +65,39 @@ def test_adjust_sees_it_off_and_fits_a_line() -> None:
     design = np.stack([np.ones_like(t), t], axis=1)
     expected = np.linalg.lstsq(design, y, rcond=None)[0]
     np.testing.assert_allclose(res.x, expected, rtol=0, atol=1e-12)
+
+
+def test_overlapping_blocks_in_two_threads_restore_the_state_found_first() -> None:
+    """Thread A enters, thread B enters, A leaves while B still runs, B leaves: the advice
+    stays off until B leaves and is then what it was before A (a per-block save would have
+    left it off for good: B saved A's "off")."""
+    import threading
+
+    assert switch is not None
+    old = switch(True)
+    a_in, b_in, a_out = threading.Event(), threading.Event(), threading.Event()
+    seen: dict[str, bool] = {}
+
+    def run_a() -> None:
+        with small_pages():
+            a_in.set()
+            b_in.wait(5)
+        a_out.set()
+
+    def run_b() -> None:
+        a_in.wait(5)
+        with small_pages():
+            b_in.set()
+            a_out.wait(5)
+            seen["b after a left"] = _state()
+
+    try:
+        threads = [threading.Thread(target=run_a), threading.Thread(target=run_b)]
+        for th in threads:
+            th.start()
+        for th in threads:
+            th.join(10)
+        assert seen == {"b after a left": False}
+        assert _state() is True
+    finally:
+        switch(old)
