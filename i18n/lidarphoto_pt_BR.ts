@@ -1035,10 +1035,6 @@
             <translation>A imagem {} não tem orientação: a medição precisa da câmera e da orientação exterior.</translation>
         </message>
         <message>
-            <source>No image lines with camera {} ({} fisheye projection): straight LiDAR lines image as curves through it, and the resection and the calibration from lines handle perspective cameras only. Measure control points (lcp) instead.</source>
-            <translation>Sem linhas de imagem com a câmera {} (projeção olho de peixe {}): através dela, linhas LiDAR retas aparecem como curvas na imagem, e a resseção e a calibração a partir de linhas tratam apenas câmeras perspectivas. Meça pontos de controle (lcp) em vez disso.</translation>
-        </message>
-        <message>
             <source>No roof plane under the cursor.</source>
             <translation>Nenhum plano de telhado sob o cursor.</translation>
         </message>

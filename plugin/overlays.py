@@ -419,17 +419,30 @@ class Overlays:
 
     def add_line_prediction(self, start: np.ndarray, predicted: np.ndarray, label: str) -> None:
         """An image line being measured: its first click and the linked LiDAR line's
-        predicted position (its projected end points, (2, 2) px), drawn solid over the dashed
-        LiDAR lines (in the predictions group: the next :meth:`set_predictions` clears it)."""
+        predicted position (its projected end points (2, 2) through a perspective camera,
+        the curve it images as (K, 2) through a fisheye one; a NaN row breaks it), drawn
+        solid over the dashed LiDAR lines (in the predictions group: the next
+        :meth:`set_predictions` clears it)."""
         group = self.groups["predictions"]
-        a = np.reshape(predicted, (2, 2))
-        if _finite_rows(a).all():
-            path = QPainterPath(QPointF(*a[0].tolist()))
-            path.lineTo(*a[1].tolist())
+        a = np.reshape(predicted, (-1, 2))
+        ok = _finite_rows(a)
+        path, drawn, pen_down = QPainterPath(), [], False
+        for (x, y), good in zip(a.tolist(), ok.tolist()):
+            if not good:
+                pen_down = False
+                continue
+            if pen_down:
+                path.lineTo(x, y)
+            else:
+                path.moveTo(x, y)
+                pen_down = True
+            drawn.append((x, y))
+        if len(drawn) >= 2:
             item = QGraphicsPathItem(path)
             item.setPen(self._pen_of("predictions", 2.5))
             item.setParentItem(group)
-            self._label(group, label + "?", *a.mean(axis=0).tolist(), "predictions")
+            mx, my = drawn[len(drawn) // 2] if len(drawn) > 2 else np.mean(drawn, axis=0)
+            self._label(group, label + "?", float(mx), float(my), "predictions")
         x, y = np.reshape(start, 2).tolist()
         self._add_marker(group, x, y, "circle", 10, "predictions", 2.0)
         self.counts["predictions"] += 1

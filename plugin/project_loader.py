@@ -79,8 +79,8 @@ class ProjectLoader(QObject):
         self.session.set_orientation(None, None)
         try:
             # perspective or fisheye: a fisheye's lines and outlines are drawn as the curves
-            # they image as (core.photo.picking); image lines are measured with a
-            # perspective camera only (PickingSession.lines_refused)
+            # they image as (core.photo.picking), image lines measured as points on those
+            # curves (PickingSession.lines_curved)
             camera = read_camera_json(cam_path, projections=PROJECTIONS) if cam_path else None
             eo = read_eo_csv(eo_path, crs.toWkt()) if eo_path else None
             # keeps the camera and the table when the scene cannot be made (e.g. no CRS)

@@ -50,6 +50,7 @@ __all__ = [
     "nearest_polyline",
     "nearest_segment",
     "points_in_polygons",
+    "polyline_tangent",
 ]
 
 Array = NDArray[np.float64]
@@ -194,6 +195,37 @@ def nearest_polyline(
     if k < 0:
         return -1, float("inf")
     return int(np.repeat(np.arange(len(lines)), edges)[k]), dist
+
+
+def polyline_tangent(pixel: ArrayLike, polyline: ArrayLike) -> Array:
+    """The direction (unit, (2,)) of a projected line's polyline at the point nearest to
+    ``pixel``: the tangent of the curve it follows, interpolated along the nearest edge
+    between the tangents at its two vertices (each the mean of the unit directions of the
+    edges meeting there; an edge to or from a NaN row is no edge). A two-point polyline (a
+    perspective camera's line) gives its own direction; NaN when it has no edge.
+
+    >>> polyline_tangent((1.0, 0.2), [[0, 0], [1, 0], [2, 1]]).round(3).tolist()
+    [0.907, 0.421]
+    """
+    p = np.asarray(polyline, dtype=np.float64).reshape(-1, 2)
+    if len(p) < 2:
+        return np.full(2, np.nan)
+    d = p[1:] - p[:-1]
+    length = np.hypot(d[:, 0], d[:, 1])
+    ok = np.isfinite(length) & (length > 0)
+    if not ok.any():
+        return np.full(2, np.nan)
+    unit = np.where(ok[:, None], d / np.where(ok, length, 1.0)[:, None], 0.0)
+    k, _dist = nearest_segment(pixel, np.where(ok[:, None], p[:-1], np.nan), p[1:], np.inf)
+    a, ab = p[k], d[k]
+    t = float(np.clip(np.dot(np.asarray(pixel, dtype=np.float64) - a, ab) / length[k] ** 2, 0, 1))
+    # vertex tangents: the mean of the unit edges around vertex k and vertex k + 1
+    has_before, has_after = k > 0 and bool(ok[k - 1]), k + 1 < len(unit) and bool(ok[k + 1])
+    at_a = (unit[k] + unit[k - 1]) / 2 if has_before else unit[k]
+    at_b = (unit[k] + unit[k + 1]) / 2 if has_after else unit[k]
+    tangent = (1.0 - t) * at_a + t * at_b
+    norm = float(np.hypot(*tangent))
+    return tangent / norm if norm > 0 else unit[k].copy()
 
 
 def _densify(

@@ -30,12 +30,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InputError
 from ..geometry.camera import Camera
 from .control_features import ControlSet
 from .observation_list import Observation, ObservationList
 from .orientation import ExteriorOrientationTable
-from .picking import PickingScene, nearest_point, nearest_polyline
+from .picking import PickingScene, nearest_point, nearest_polyline, polyline_tangent
 
 if TYPE_CHECKING:
     from .boresight_result import BoresightRun
@@ -116,12 +115,22 @@ class PickTarget:
 class HalfLine:
     """An image line being measured: its first click (``start``, pixels) in ``image_id`` and
     the LiDAR line it is linked to (``target``); ``predicted`` (2, 2) the LiDAR line's end
-    points projected into that image with the current camera and EO (pixels, NaN behind)."""
+    points projected into that image with the current camera and EO (pixels, NaN behind);
+    ``curve`` (K, 2) the line as drawn (:attr:`ProjectedControl.lines`: the two end points
+    through a perspective camera, the curve it images as through a fisheye one)."""
 
     image_id: str
     target: PickTarget
     start: Array
     predicted: Array
+    curve: Array | None = None
+
+    def direction_at(self, pixel: ArrayLike) -> Array:
+        """The direction of the LiDAR line's image at ``pixel`` (unit (2,), NaN when it has
+        no edge): the tangent of its curve at the nearest point (:func:`.picking.polyline_tangent`),
+        the chord of its end points without a curve."""
+        curve = self.curve if self.curve is not None else self.predicted
+        return polyline_tangent(pixel, curve)
 
 
 #: shortest image line the dock stores, pixels (the resection refuses shorter ones)
@@ -203,22 +212,17 @@ class PickingSession:
             sg.project_segments(image_id, c.line_starts, c.line_ends),
         )
 
-    def lines_refused(self) -> str:
-        """Why image lines cannot be measured with the current camera ("" when they can).
+    def lines_curved(self) -> bool:
+        """Whether the LiDAR lines image as curves (a fisheye camera).
 
-        A straight LiDAR line images as a curve through a fisheye lens, and the models that
-        use image lines (the resection's coplanarity and equivalent planes, the boresight
-        calibration) hold for the perspective projection only: with a fisheye camera the
-        dock measures no lines (and so refines no line end on an image edge).
+        Through a fisheye lens an image line is measured as points on the curve the LiDAR
+        line images as (each click a ``line`` row): the boresight calibration models every
+        such point through the projection (its ray meets the line), while the resection's
+        straight image-line model holds for perspective cameras only and leaves those rows
+        out by name (plugin/resection_task.py).
         """
         cam = self.camera
-        if cam is None or cam.is_perspective:
-            return ""
-        return (
-            f"camera {cam.name!r} has the {cam.projection} (fisheye) projection: straight "
-            "LiDAR lines image as curves through it, and the resection and the calibration "
-            "from image lines handle perspective cameras only; measure control points (lcp)"
-        )
+        return cam is not None and not cam.is_perspective
 
     def footprint(self, image_id: str) -> Array | None:
         """Ground footprint of an image at the control's mean height (mapping CRS; 4 corners,
@@ -291,24 +295,18 @@ class PickingSession:
         projected: ProjectedControl | None = None,
     ) -> HalfLine:
         """The first click of an image line on the LiDAR line ``target`` (kind ``line``): kept
-        as :attr:`half_line` until :meth:`finish_line` or :meth:`cancel_line`.
-
-        Raises
-        ------
-        InputError
-            A fisheye camera (:meth:`lines_refused`).
-        """
+        as :attr:`half_line` until :meth:`finish_line` or :meth:`cancel_line`. Through a
+        fisheye camera the two clicks are points on the line's curved image
+        (:meth:`lines_curved`), and the half line holds that curve."""
         if target.kind != "line":
             raise ValueError(f"an image line is linked to a LiDAR line, not a {target.kind}")
-        refused = self.lines_refused()
-        if refused:
-            raise InputError(refused)
         if projected is None or projected.image_id != image_id:
             projected = self.project(image_id)
         k = target.index
         predicted = np.array([projected.line_starts[k], projected.line_ends[k]], dtype=float)
+        curve = np.asarray(projected.lines[k], dtype=np.float64).reshape(-1, 2)
         start = np.array(pixel, dtype=np.float64).reshape(2)
-        self.half_line = HalfLine(image_id, target, start, predicted)
+        self.half_line = HalfLine(image_id, target, start, predicted, curve)
         return self.half_line
 
     def finish_line(self, image_id: str, pixel: ArrayLike) -> int:

@@ -14,7 +14,9 @@ is taken off the match (core/photo/control_location.py, _curvature_shift), which
 degrees off the axis, where the ground is seen at 2-3 times the nadir GSD and its contrast
 is low, lands up to 0.112 px off (measured: 0.014-0.039 px at 5 and 35 degrees, 0.017-0.112 px
 at 50), several times LSM's own sigma there (0.006-0.010 px). The perspective formula on the
-same camera predicts the point tens of pixels off.
+same camera predicts the point tens of pixels off. Transfer (image to image, when the chip
+fails in an image): the master-to-image map curves in the same way and gets the same correction
+(_transfer_curvature_shift): 0.02-0.04 px from the truth, 0.16-0.26 px without it.
 """
 
 from __future__ import annotations
@@ -160,3 +162,63 @@ def test_the_job_locates_control_in_fisheye_images(scenes, tmp_path):
     truth = _truth(eo, cam)
     for iid, px in zip(obs.image_id, obs.pixels):
         assert np.hypot(*(px - truth[iid])) < 0.15, iid
+
+
+#: the transfer's template (chip pixels; the master image's patch has as many) per projection:
+#: 41 px, or 35 where the stereographic transfer's least-squares patch leaves its window at 41
+#: (rejected with and without the correction)
+TRANSFER_TEMPLATE = {"equidistant": 41, "equisolid": 41, "orthographic": 41, "stereographic": 35}
+
+
+def _transferred(scenes, projection, monkeypatch, corrected: bool):
+    """Locate with an EO whose centres are all 1.2 m / 0.8 m off (the chip found 10-25 px from
+    its prediction in I0 and I1, whose sigmas are 1 m and 10 mrad) and image I2 (50 degrees
+    off the axis) given sigmas so small that its search is the 5 px minimum: its chip match
+    fails there, and it is transferred from the best of the other two (the master's offset
+    carried over). ``corrected`` False: the transfer's curvature correction replaced by zero."""
+    from lidarphoto.core.photo import control_location
+    from lidarphoto.core.photo.matching_options import LocateOptions, TextureOptions
+
+    cam, images, eo, chip = scenes[projection]
+    if not corrected:
+        monkeypatch.setattr(
+            control_location, "_transfer_curvature_shift", lambda *a, **k: np.zeros(2)
+        )
+    wrong = dataclasses.replace(eo, xyz=eo.xyz + np.array([1.2, -0.8, 0.0]))
+    sigmas = np.array([[1.0, 1.0, 1.0, 0.01, 0.01, 0.01]] * 3)
+    sigmas[2] = 1e-5
+    size = TRANSFER_TEMPLATE[projection]
+    opt = LocateOptions(texture=TextureOptions(min_size=size))
+    res = locate_control_points([chip], wrong, cam, _reader(images), sigmas, opt)
+    return {p.image_id: p for p in res.pairs}, _truth(eo, cam), size
+
+
+@pytest.mark.parametrize("projection", FISHEYE_PROJECTIONS)
+def test_fisheye_transfer_corrected_for_the_curved_image(scenes, projection, monkeypatch):
+    """A transferred match (master image -> image 50 degrees off the axis) through a fisheye:
+    the master-to-image map curves over the patch as the chip-to-image one does, and the
+    same correction (the mean over the patch of the exact map minus the start affine) puts
+    it within the chip match's 0.15 px of the true point, where without it it is more than
+    0.15 px off. Measured: 0.02-0.04 px corrected, 0.16-0.26 px without (noise 1 grey value;
+    the chip matches of I0 and I1 0.03-0.11 px)."""
+    pairs, truth, size = _transferred(scenes, projection, monkeypatch, corrected=True)
+    for iid in ("I0", "I1"):
+        p = pairs[iid]
+        assert p.status == "ok" and p.source == "chip", p.reason
+        assert p.template_px == size
+        assert math.hypot(p.col - truth[iid][0], p.row - truth[iid][1]) < 0.15
+    t = pairs["I2"]
+    assert t.status == "ok" and t.source.startswith("transfer from I"), t.reason
+    # the chip could not find it: the EO's error put it outside I2's 5 px search
+    assert math.hypot(t.predicted_col - truth["I2"][0], t.predicted_row - truth["I2"][1]) > 5
+    err = math.hypot(t.col - truth["I2"][0], t.row - truth["I2"][1])
+    assert err < 0.15, err
+    assert 0 < t.sigma_col < 0.05
+    monkeypatch.undo()
+    plain, _truth2, _size = _transferred(scenes, projection, monkeypatch, corrected=False)
+    u = plain["I2"]
+    assert u.source == t.source
+    miss = math.hypot(u.col - truth["I2"][0], u.row - truth["I2"][1])
+    assert miss > 0.15 and miss > 3 * err, (miss, err)
+    print(f"\n{projection}: transfer {t.source}, {size} px: {err:.3f} px from the truth, "
+          f"{miss:.3f} px without the correction")  # fmt: skip

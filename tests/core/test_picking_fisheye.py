@@ -15,14 +15,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from lidarphoto.core.errors import InputError
 from lidarphoto.core.geometry.camera import Camera
 from lidarphoto.core.geometry.collinearity import project
 from lidarphoto.core.geometry.distortion import distortion_from_dict
 from lidarphoto.core.photo.control_features import ControlFeature, ControlSet
 from lidarphoto.core.photo.orientation import ExteriorOrientationTable
 from lidarphoto.core.photo.picking import CHORD_TOL_PX, PickingScene, points_in_polygons
-from lidarphoto.core.photo.picking_session import PickingSession, PickTarget
+from lidarphoto.core.photo.picking_session import PickingSession
 
 CRS = "EPSG:28992"
 FISHEYES = ("equidistant", "equisolid", "orthographic", "stereographic")
@@ -97,9 +96,11 @@ def test_fisheye_lines_within_the_tolerance_of_their_exact_image(projection):
     assert worst <= CHORD_TOL_PX and back <= CHORD_TOL_PX, (projection, worst, back)
     # lines through a fisheye are curves: many more vertices than the two ends
     assert np.median(vertices) > 4, vertices
-    print(f"\n{projection}: worst {worst:.3f} px (back {back:.3f}) over {counted} points, "
-          f"vertices median {np.median(vertices):.0f}, max {max(vertices)} "
-          f"({len(vertices)} lines seen)")
+    print(
+        f"\n{projection}: worst {worst:.3f} px (back {back:.3f}) over {counted} points, "
+        f"vertices median {np.median(vertices):.0f}, max {max(vertices)} "
+        f"({len(vertices)} lines seen)"
+    )
 
 
 def test_orthographic_line_beyond_its_field_is_cut_at_the_field_edge():
@@ -174,30 +175,56 @@ def _line_session(projection: str) -> tuple[PickingSession, np.ndarray, np.ndarr
     return session, a, b
 
 
-def test_session_hits_the_curved_line_and_refuses_line_measurement():
-    """The dock's session with an equidistant camera: the lines come as polylines, a click
-    on the exact image of a line's 3-D midpoint hits that line (0.5 px tolerance), and
-    starting an image line is refused by name (fisheye)."""
-    session, a, b = _line_session("equidistant")
+@pytest.mark.parametrize("projection", FISHEYES)
+def test_session_measures_points_on_the_curved_line(projection):
+    """The dock's session with a fisheye camera: the lines come as polylines, a click on the
+    exact image of a line's 3-D midpoint hits that line (0.5 px tolerance); an image line is
+    started there (no refusal), holds the line's curve, and gives the curve's direction at a
+    click (what the dock refines across) within 0.5 degrees of the exact image's tangent
+    (central differences of the projection, 1e-4 of the segment); the second click on the
+    curve gives two line rows on the LiDAR line. A perspective camera's lines are straight."""
+    session, a, b = _line_session(projection)
+    assert session.lines_curved()
     proj = session.project("img1")
     assert len(proj.lines) == len(a)
     assert np.nanmax([len(p) for p in proj.lines]) > 4
-    cam = session.camera
-    mids = session.scene.project("img1", 0.5 * (a + b))
-    hit = 0
-    for k, m in enumerate(mids):
-        if not (np.isfinite(m).all() and cam.in_frame(m[None], 5.0)[0]):
+    cam, scene = session.camera, session.scene
+    hit, worst, curved, most = 0, 0.0, 0, 0.0
+    for k in range(len(a)):
+        t = np.array([0.3, 0.5, 0.5 - 1e-4, 0.5 + 1e-4, 0.7])
+        exact = scene.project("img1", a[k] + t[:, None] * (b[k] - a[k]))
+        m = exact[1]
+        if not (np.isfinite(exact).all() and cam.in_frame(exact, 5.0).all()):
             continue
-        t = session.targets_at("img1", m, "line", 0.5, proj)
-        assert t and t[0].target_id == str(k), (k, t)
+        target = session.targets_at("img1", m, "line", 0.5, proj)
+        assert target and target[0].target_id == str(k), (k, target)
         hit += 1
-    assert hit >= 10
-    assert "fisheye" in session.lines_refused() and "'fish'" in session.lines_refused()
-    with pytest.raises(InputError, match="equidistant"):
-        session.start_line("img1", mids[0], PickTarget("line", 0, "0"), proj)
+        half = session.start_line("img1", m, target[0], proj)
+        assert half.curve is not None and np.array_equal(half.curve, proj.lines[k])
+        tangent = exact[3] - exact[2]
+        tangent /= np.hypot(*tangent)
+        got = half.direction_at(m)
+        assert abs(np.hypot(*got) - 1.0) < 1e-12
+        angle = np.degrees(np.arccos(min(1.0, abs(float(got @ tangent)))))
+        worst = max(worst, angle)
+        assert angle < 0.5, (k, angle)
+        # the chord of the projected end points (the perspective direction) is off the curve
+        ends = scene.project("img1", np.vstack([a[k], b[k]]))
+        chord = ends[1] - ends[0]
+        bend = np.degrees(np.arccos(min(1.0, abs(chord @ tangent) / np.hypot(*chord))))
+        curved += bend > 10 * max(angle, 0.05)
+        most = max(most, bend)
+        row = session.finish_line("img1", exact[4])
+        assert row >= 0
+        r0, r1 = session.observations.rows[row : row + 2]
+        assert (r0.type, r0.target_id, r1.target_id) == ("line", str(k), str(k))
+        assert (r0.col, r0.row, r1.col, r1.row) == (*m, *exact[4])
+    assert hit >= 10 and curved >= 3, (hit, curved)
+    print(f"\n{projection}: {hit} lines, tangent within {worst:.3f} deg, the end points' "
+          f"chord up to {most:.1f} deg off it")  # fmt: skip
     persp = PickingSession()
     persp.set_orientation(Camera("p", 8.0, 0.003, 2000, 1500), session.eo, CRS)
-    assert persp.lines_refused() == ""
+    assert not persp.lines_curved()
 
 
 @pytest.mark.parametrize("projection", ("equidistant", "equisolid", "stereographic"))

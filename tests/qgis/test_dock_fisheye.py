@@ -127,7 +127,7 @@ def test_fisheye_camera_in_the_dock(qgis_parent, qgis_app, fisheye_block, fishey
     lines with many vertices, every drawn vertex within CHORD_TOL_PX of the exact image and
     every exact point in the frame within CHORD_TOL_PX of the drawn path; a real click on a
     roof adds a tie observation at the clicked pixel with its prediction in the other
-    images; a click in line mode is refused by name (fisheye)."""
+    images; a click in line mode on a curve starts an image line of that LiDAR line."""
     b = fisheye_block
     dock = _dock(qgis_parent, qgis_app, b, fisheye_layers, tmp_path)
     assert dock.camera is not None and dock.camera.projection == "equisolid"
@@ -200,13 +200,16 @@ def test_fisheye_camera_in_the_dock(qgis_parent, qgis_app, fisheye_block, fishey
         np.testing.assert_allclose(px, scene.project(other, ground)[0], atol=1e-6)
     dock.session.cancel_prediction()
 
-    # line mode: refused by name, nothing added
+    # line mode: a click on the curve starts an image line of that LiDAR line (points on
+    # its curved image; tests/qgis/test_dock_fisheye_lines.py), nothing added yet
     lid = long_seen[0]
     on_line = by_id[lid][len(by_id[lid]) // 2]
     dock.viewer.type_combo.setCurrentText("line")
     assert dock.pick(float(on_line[0]), float(on_line[1])) == -1
-    assert "fisheye" in dock.messages[-1] and "equisolid" in dock.messages[-1]
-    assert len(dock.store.rows) == 1 and dock.session.half_line is None
+    half = dock.session.half_line
+    assert half is not None and half.target.target_id == lid, dock.messages[-1]
+    assert len(dock.store.rows) == 1
+    assert dock.picking.cancel_line() and dock.session.half_line is None
     # the hit test follows the curve: the line under the curve's middle vertex is found
     targets = dock.session.targets_at(image, on_line, "line", 0.5, proj)
     assert targets and targets[0].target_id == lid
