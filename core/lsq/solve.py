@@ -366,6 +366,35 @@ def _gradient_small(nrm: _Normal, lin: _Lin, opts: AdjustmentOptions) -> bool:
     return g <= opts.gradient_tolerance * math.sqrt(max(lin.phi, 0.0))
 
 
+def _tie_ends(
+    nrm: _Normal, z: Array, step: float, m_old: float, stalls: int, it: int,
+    opts: AdjustmentOptions,
+) -> tuple[str, str] | None:  # fmt: skip
+    """After a damped step that tied the cost (it did not move at all): the reason the run
+    ends and its warning (empty when converged), or None to go on. Near the optimum the
+    Gauss-Newton step was rejected by rounding and a damped one cannot help (the damping only
+    grows on ties: 36 idle iterations seen on a TLS network); the Gauss-Newton step ``z``
+    (``step`` its largest scaled component) tells the rounding floor from a stall: below the
+    step tolerance's root, or promising a decrease (z'Nz in the scaled space) below the
+    function tolerance, the point is the optimum by Ceres' rule and the rise seen is the
+    rounding of the cost (4e-13 of it on that network)."""
+    promised = abs(float(nrm.ns @ z)) if z.size else 0.0
+    if step <= math.sqrt(opts.tolerance) or promised <= opts.function_tolerance * m_old:
+        return ROUNDING_FLOOR, ""
+    if stalls < _MAX_TIES:
+        return None
+    return NO_DECREASE, _no_decrease(it, step)
+
+
+def _no_decrease(it: int, step: float) -> str:
+    return _t(
+        "the cost could not be reduced further at iteration {iteration} (step {step:.3g} "
+        "sigma): stopped without convergence",
+        iteration=it,
+        step=step,
+    )
+
+
 def _gauss_newton(
     problem: _Problem, nrm: _Normal, opts: AdjustmentOptions, use_sparse: bool
 ) -> tuple[Array, Array]:
@@ -400,15 +429,12 @@ def _run(
     use_sparse: bool | None = opts.sparse
     tol = opts.tolerance
     damp = _Damping()
-    nu = 0.0
-    prev_step = math.inf
+    nu, prev_step = 0.0, math.inf
     stalls = 0  # damped steps in a row that left the cost exactly where it was
-    converged = False
-    why = ITERATION_LIMIT
+    converged, why = False, ITERATION_LIMIT
     warnings: list[str] = []
     trace = [(0, lin.phi, time.perf_counter() - t0)]
-    it = 0
-    nrm: _Normal | None = None
+    it, nrm = 0, None
     final: _Normal | None = None  # the normal equations at the final lin, when built
     finishing = False  # the function tolerance was met: one last Gauss-Newton step
     for it in range(1, opts.max_iterations + 1):
@@ -487,46 +513,20 @@ def _run(
                     # last step) sat below the true cost at x: continue from the consistent one.
                     lin = fresh
                     continue
-                warnings.append(
-                    _t(
-                        "the cost could not be reduced further at iteration {iteration} (step "
-                        "{step:.3g} sigma): stopped without convergence",
-                        iteration=it,
-                        step=step,
-                    )
-                )
+                warnings.append(_no_decrease(it, step))
                 why, final = NO_DECREASE, nrm
                 break
         m_new = _merit(new, rowscale, nu)
         if opts.damping and damp.last > 0 and m_new >= m_old:
-            # A damped step accepted as a tie: the cost did not move at all. Near the optimum
-            # the Gauss-Newton step was rejected by rounding and a damped one cannot help (the
-            # damping only grows on ties: 36 idle iterations seen); the Gauss-Newton step
-            # tells the rounding floor from a stall.
+            stalls += 1
             if z is None:
                 z, _ = _gauss_newton(problem, nrm, opts, use_sparse)
                 step = float(np.abs(z).max()) if z.size else 0.0
-            stalls += 1
-            # the decrease the Gauss-Newton model promises (z'Nz in the scaled space): below
-            # the function tolerance the point is the optimum by Ceres' rule, and the rise seen
-            # is the rounding of the cost (about 4e-13 of it, measured)
-            promised = abs(float(nrm.ns @ z)) if z.size else 0.0
-            at_floor = step <= math.sqrt(tol) or promised <= opts.function_tolerance * m_old
-            if at_floor or stalls >= _MAX_TIES:
-                lin = new
+            if (ended := _tie_ends(nrm, z, step, m_old, stalls, it, opts)) is not None:
+                lin, (why, note) = new, ended
                 trace.append((it, lin.phi, time.perf_counter() - t0))
-                if at_floor:
-                    converged, why = True, ROUNDING_FLOOR
-                else:
-                    warnings.append(
-                        _t(
-                            "the cost could not be reduced further at iteration {iteration} "
-                            "(step {step:.3g} sigma): stopped without convergence",
-                            iteration=it,
-                            step=step,
-                        )
-                    )
-                    why = NO_DECREASE
+                converged = why == ROUNDING_FLOOR
+                warnings += [note] if note else []
                 break
         else:
             stalls = 0
