@@ -33,15 +33,11 @@ def mount_params(initial_boresight: bool = False) -> tuple[Param, ...]:
     ``initial_boresight``: BORESIGHT is only the start of an estimate (under Advanced: 0 is
     a fine first value)."""
     return (
-        Param(
+        _offsets(
             "LEVER_ARM",
-            "numbers",
             "Lever arm x,y,z",
-            (0.0, 0.0, 0.0),
-            count=3,
-            unit="m, body frame",
-            minimum=-MAX_LEVER_ARM_M,
-            maximum=MAX_LEVER_ARM_M,
+            "m, body frame",
+            MAX_LEVER_ARM_M,
             help="camera perspective centre in the INS body frame (x forward, y right, z down)",
         ),
         choice_param(
@@ -63,19 +59,23 @@ def mount_params(initial_boresight: bool = False) -> tuple[Param, ...]:
             maximum=1.0,
             help="the nominal mount R_c^b when MOUNT is custom",
         ),
-        Param(
+        _offsets(
             "BORESIGHT",
-            "numbers",
             "Boresight domega,dphi,dkappa",
-            (0.0, 0.0, 0.0),
-            count=3,
-            unit="degrees",
-            minimum=-MAX_BORESIGHT_DEG,
-            maximum=MAX_BORESIGHT_DEG,
+            "degrees",
+            MAX_BORESIGHT_DEG,
             advanced=initial_boresight,
             help="small misalignment about the camera axes x, y, z (a larger rotation "
             "belongs in MOUNT)",
         ),
+    )
+
+
+def _offsets(name: str, label: str, unit: str, limit: float, **extra: Any) -> Param:
+    """Three numbers, each within +-``limit``, 0 by default (a lever arm, a boresight)."""
+    zero = (0.0, 0.0, 0.0)
+    return Param(
+        name, "numbers", label, zero, count=3, unit=unit, minimum=-limit, maximum=limit, **extra
     )
 
 
