@@ -12,6 +12,7 @@ from typing import Any, Callable
 
 from qgis.core import (
     NULL,
+    QgsCoordinateReferenceSystem,
     QgsFeature,
     QgsField,
     QgsFields,
@@ -310,9 +311,13 @@ class BaseAlgorithm(QgsProcessingAlgorithm):
 
     # -- feature sinks described by (name, QVariant type) field specs -------------------------
     def field_sink(self, parameters, context, key, spec, wkb, crs):
-        """Open the sink ``key`` with the fields of ``spec``; returns ((sink, fields), dest id).
+        """Open the sink ``key`` with the fields of ``spec`` in ``crs`` (a
+        QgsCoordinateReferenceSystem, the WKT of one, e.g. a result's ``crs_wkt``, or None);
+        returns ((sink, fields), dest id).
 
         ((None, fields), None) when the user did not ask for the layer."""
+        if isinstance(crs, str):
+            crs = QgsCoordinateReferenceSystem.fromWkt(crs)
         fields = QgsFields()
         for name, kind in spec:
             fields.append(QgsField(name, kind))

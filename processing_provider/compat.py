@@ -19,64 +19,59 @@ from qgis.core import (
 )
 from qgis.PyQt.QtCore import QVariant
 
-if hasattr(Qgis, "ProcessingSourceType"):  # QGIS >= 3.36
-    SOURCE_VECTOR_POINT = Qgis.ProcessingSourceType.VectorPoint
-    SOURCE_VECTOR_LINE = Qgis.ProcessingSourceType.VectorLine
-    SOURCE_VECTOR_POLYGON = Qgis.ProcessingSourceType.VectorPolygon
-    SOURCE_FILE = Qgis.ProcessingSourceType.File
-    SOURCE_RASTER = Qgis.ProcessingSourceType.Raster
-    SOURCE_POINT_CLOUD = Qgis.ProcessingSourceType.PointCloud
-    SOURCE_TABLE = Qgis.ProcessingSourceType.Vector  # any geometry or none
-else:  # QGIS 3.22-3.34
-    SOURCE_VECTOR_POINT = QgsProcessing.SourceType.TypeVectorPoint
-    SOURCE_VECTOR_LINE = QgsProcessing.SourceType.TypeVectorLine
-    SOURCE_VECTOR_POLYGON = QgsProcessing.SourceType.TypeVectorPolygon
-    SOURCE_FILE = QgsProcessing.SourceType.TypeFile
-    SOURCE_RASTER = QgsProcessing.SourceType.TypeRaster
-    SOURCE_POINT_CLOUD = QgsProcessing.SourceType.TypePointCloud
-    SOURCE_TABLE = QgsProcessing.SourceType.TypeVector
 
-if hasattr(Qgis, "ProcessingParameterFlag"):  # QGIS >= 3.36
-    FLAG_ADVANCED = Qgis.ProcessingParameterFlag.Advanced
-    FLAG_OPTIONAL = Qgis.ProcessingParameterFlag.Optional
-else:
-    FLAG_ADVANCED = QgsProcessingParameterDefinition.Flag.FlagAdvanced
-    FLAG_OPTIONAL = QgsProcessingParameterDefinition.Flag.FlagOptional
+def _members(new: str, old: object, names: dict[str, str]) -> list:
+    """The values ``names`` (name in ``Qgis.<new>``: name in ``old``) of the enum ``Qgis.<new>``
+    where this QGIS has it, else of the old class-scoped enum ``old``."""
+    if hasattr(Qgis, new):
+        return [getattr(getattr(Qgis, new), n) for n in names]
+    return [getattr(old, n) for n in names.values()]
 
-if hasattr(Qgis, "ProcessingFileParameterBehavior"):  # QGIS >= 3.36
-    FILE_BEHAVIOR_FILE = Qgis.ProcessingFileParameterBehavior.File
-else:
-    FILE_BEHAVIOR_FILE = QgsProcessingParameterFile.Behavior.File
 
-if hasattr(Qgis, "WkbType"):  # QGIS >= 3.30
-    WKB_POINT_Z = Qgis.WkbType.PointZ
-    WKB_LINESTRING_Z = Qgis.WkbType.LineStringZ
-    WKB_POLYGON_Z = Qgis.WkbType.PolygonZ
-    WKB_MULTIPOLYGON = Qgis.WkbType.MultiPolygon
-else:
-    WKB_POINT_Z = QgsWkbTypes.Type.PointZ
-    WKB_LINESTRING_Z = QgsWkbTypes.Type.LineStringZ
-    WKB_POLYGON_Z = QgsWkbTypes.Type.PolygonZ
-    WKB_MULTIPOLYGON = QgsWkbTypes.Type.MultiPolygon
-
-if hasattr(Qgis, "ProcessingNumberParameterType"):  # QGIS >= 3.36
-    NUMBER_DOUBLE = Qgis.ProcessingNumberParameterType.Double
-    NUMBER_INTEGER = Qgis.ProcessingNumberParameterType.Integer
-else:  # QGIS 3.22-3.34
-    NUMBER_DOUBLE = QgsProcessingParameterNumber.Type.Double
-    NUMBER_INTEGER = QgsProcessingParameterNumber.Type.Integer
-
-if hasattr(Qgis, "ProcessingFieldParameterDataType"):  # QGIS >= 3.36
-    FIELD_TYPE_ANY = Qgis.ProcessingFieldParameterDataType.Any
-    FIELD_TYPE_NUMERIC = Qgis.ProcessingFieldParameterDataType.Numeric
-else:
-    FIELD_TYPE_ANY = QgsProcessingParameterField.DataType.Any
-    FIELD_TYPE_NUMERIC = QgsProcessingParameterField.DataType.Numeric
-
-if hasattr(Qgis, "CrsWktVariant"):  # QGIS >= 3.36
-    WKT_PREFERRED = Qgis.CrsWktVariant.Preferred
-else:
-    WKT_PREFERRED = QgsCoordinateReferenceSystem.WktVariant.WKT_PREFERRED
+_SOURCES = {  # QGIS >= 3.36; before, QgsProcessing.SourceType
+    "VectorPoint": "TypeVectorPoint",
+    "VectorLine": "TypeVectorLine",
+    "VectorPolygon": "TypeVectorPolygon",
+    "File": "TypeFile",
+    "Raster": "TypeRaster",
+    "PointCloud": "TypePointCloud",
+    "Vector": "TypeVector",  # any geometry or none
+}
+(
+    SOURCE_VECTOR_POINT,
+    SOURCE_VECTOR_LINE,
+    SOURCE_VECTOR_POLYGON,
+    SOURCE_FILE,
+    SOURCE_RASTER,
+    SOURCE_POINT_CLOUD,
+    SOURCE_TABLE,
+) = _members("ProcessingSourceType", QgsProcessing.SourceType, _SOURCES)
+FLAG_ADVANCED, FLAG_OPTIONAL = _members(  # QGIS >= 3.36
+    "ProcessingParameterFlag",
+    QgsProcessingParameterDefinition.Flag,
+    {"Advanced": "FlagAdvanced", "Optional": "FlagOptional"},
+)
+(FILE_BEHAVIOR_FILE,) = _members(  # QGIS >= 3.36
+    "ProcessingFileParameterBehavior", QgsProcessingParameterFile.Behavior, {"File": "File"}
+)
+WKB_POINT_Z, WKB_LINESTRING_Z, WKB_POLYGON_Z, WKB_MULTIPOLYGON = _members(  # QGIS >= 3.30
+    "WkbType",
+    QgsWkbTypes.Type,
+    {n: n for n in ("PointZ", "LineStringZ", "PolygonZ", "MultiPolygon")},
+)
+NUMBER_DOUBLE, NUMBER_INTEGER = _members(  # QGIS >= 3.36
+    "ProcessingNumberParameterType",
+    QgsProcessingParameterNumber.Type,
+    {"Double": "Double", "Integer": "Integer"},
+)
+FIELD_TYPE_ANY, FIELD_TYPE_NUMERIC = _members(  # QGIS >= 3.36
+    "ProcessingFieldParameterDataType",
+    QgsProcessingParameterField.DataType,
+    {"Any": "Any", "Numeric": "Numeric"},
+)
+(WKT_PREFERRED,) = _members(  # QGIS >= 3.36
+    "CrsWktVariant", QgsCoordinateReferenceSystem.WktVariant, {"Preferred": "WKT_PREFERRED"}
+)
 
 SINK_FAST_INSERT = QgsFeatureSink.Flag.FastInsert  # same name on 3.22 and 4.x
 

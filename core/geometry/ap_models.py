@@ -242,9 +242,6 @@ class Ebner(PolynomialAP):
     param_names: ClassVar[Tuple[str, ...]] = tuple(f"b{k}" for k in range(1, 13))
     constant_names: ClassVar[Tuple[str, ...]] = ("b_mm",)
 
-    def __init__(self, *, b_mm: float, **coefficients: float) -> None:
-        super().__init__(b_mm=b_mm, **coefficients)
-
     def terms(self) -> List[Term]:
         """The twelve basis functions, expanded with ``q(u) = u^2 - 2 b^2 / 3``."""
         c = 2.0 * self._constants["b_mm"] ** 2 / 3.0
@@ -301,9 +298,6 @@ class Brown14(PolynomialAP):
     model: ClassVar[str] = "brown"
     param_names: ClassVar[Tuple[str, ...]] = tuple(f"a{k}" for k in range(1, 15))
     constant_names: ClassVar[Tuple[str, ...]] = ("c_mm",)
-
-    def __init__(self, *, c_mm: float, **coefficients: float) -> None:
-        super().__init__(c_mm=c_mm, **coefficients)
 
     def terms(self) -> List[Term]:
         """The fourteen basis functions, expanded."""

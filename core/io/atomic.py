@@ -165,6 +165,21 @@ def atomic_write(
             yield fh
 
 
+def folder_files(folder: Union[str, os.PathLike], *names: str) -> dict[str, Path]:
+    """The paths of the files ``names`` in ``folder`` (made, with its parents, if missing),
+    each by its name without the extension: the files a simulator writes and returns.
+
+    >>> root = Path(tempfile.mkdtemp())
+    >>> {k: p.name for k, p in folder_files(root / "sim", "camera.json", "eo.csv").items()}
+    {'camera': 'camera.json', 'eo': 'eo.csv'}
+    >>> (root / "sim").is_dir(), shutil.rmtree(root)
+    (True, None)
+    """
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    return {Path(name).stem: out / name for name in names}
+
+
 def write_text_atomic(path: PathLike, text: str) -> None:
     """Write ``text`` (UTF-8, ``\\n`` line ends) to ``path`` atomically."""
     with atomic_write(path, newline="\n") as fh:

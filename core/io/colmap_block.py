@@ -41,7 +41,7 @@ centres and points are transformed into the mapping CRS.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Dict, List, Sequence, Tuple
+from typing import Callable, Dict, List, Mapping, Sequence, Tuple, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -63,6 +63,8 @@ from ..photo.orientation import ExteriorOrientationTable
 from .colmap import ColmapCamera, ColmapImage, ColmapModel, ColmapPoint
 
 Array = NDArray[np.float64]
+K = TypeVar("K")
+C = TypeVar("C")
 
 __all__ = [
     "ColmapBlock",
@@ -72,7 +74,9 @@ __all__ = [
     "camera_to_colmap",
     "colmap_from_block",
     "frame_from_text",
+    "named_cameras",
     "quaternion_to_matrix",
+    "tie_block",
     "to_frame",
 ]
 
@@ -335,10 +339,7 @@ def oriented(
 
 def block_from_colmap(model: ColmapModel, frame: ColmapFrame, pixel_size_mm: float) -> ColmapBlock:
     """Convert a COLMAP model (see the module docstring for the rules)."""
-    cam_names = {k: f"colmap_{k}" for k in model.cameras}
-    cams = tuple(
-        camera_from_colmap(c, pixel_size_mm, cam_names[k]) for k, c in model.cameras.items()
-    )
+    cam_names, cams = named_cameras("colmap", model.cameras, camera_from_colmap, pixel_size_mm)
     images: List[ColmapImage] = sorted(model.images.values(), key=lambda im: im.image_id)
     if not images:
         raise InputError("the model has no registered image", path=model.source)
@@ -364,23 +365,61 @@ def block_from_colmap(model: ColmapModel, frame: ColmapFrame, pixel_size_mm: flo
             rows["image"].append(im.name)
             rows["point"].append(str(int(im.point3d_id[j])))
             rows["px"].append(im.xy[j])
-    n_obs = len(rows["image"])
+    per_image = tuple(cam_names[im.camera_id] for im in images)
+    obs, ground = tie_block(
+        rows["image"], rows["point"], rows["px"], [str(p.point_id) for p in pts], point_xyz
+    )
+    return ColmapBlock(cams, eo, per_image, obs, ground)
+
+
+def named_cameras(
+    prefix: str,
+    cameras: Mapping[K, C],
+    convert: Callable[[C, float, str], Camera],
+    pixel_size_mm: float,
+) -> Tuple[Dict[K, str], Tuple[Camera, ...]]:
+    """The project cameras of a reconstruction's ``cameras`` (key -> its own camera record),
+    each named ``<prefix>_<key>`` and made by ``convert(record, pixel_size_mm, name)``; and
+    the name of each key.
+
+    >>> named_cameras("x", {1: "a", 2: "b"}, lambda c, p, n: f"{n}={c}@{p}", 0.01)
+    ({1: 'x_1', 2: 'x_2'}, ('x_1=a@0.01', 'x_2=b@0.01'))
+    """
+    names = {k: f"{prefix}_{k}" for k in cameras}
+    return names, tuple(convert(c, pixel_size_mm, names[k]) for k, c in cameras.items())
+
+
+def tie_block(
+    image_ids: Sequence[str],
+    point_ids: Sequence[str],
+    pixels: Sequence[Sequence[float]] | Array,
+    ground_ids: Sequence[str],
+    ground_xyz: Array,
+) -> Tuple[ImageObservations, GroundPoints]:
+    """The observations and points of a reconstruction: its keypoints as ``tie`` observations
+    of sigma DEFAULT_SIGMA_PX (no group), its triangulated points as ``check`` points of
+    sigma DEFAULT_CONTROL_SIGMA_M (never control: :class:`ColmapBlock`).
+
+    >>> obs, pts = tie_block(["a"], ["7"], [[1.0, 2.0]], ["7"], np.zeros((1, 3)))
+    >>> obs.type, obs.pixels.tolist(), pts.role
+    (('tie',), [[1.0, 2.0]], ('check',))
+    """
+    n_obs = len(image_ids)
     obs = ImageObservations(
-        tuple(rows["image"]),
-        tuple(rows["point"]),
-        np.array(rows["px"], dtype=np.float64).reshape(-1, 2),
+        tuple(image_ids),
+        tuple(point_ids),
+        np.array(pixels, dtype=np.float64).reshape(-1, 2),
         np.full(n_obs, DEFAULT_SIGMA_PX),
         ("tie",) * n_obs,
         ("",) * n_obs,
     )
     ground = GroundPoints(
-        tuple(str(p.point_id) for p in pts),
-        point_xyz,
-        np.full((len(pts), 3), DEFAULT_CONTROL_SIGMA_M),
-        ("check",) * len(pts),
+        tuple(ground_ids),
+        ground_xyz,
+        np.full((len(ground_ids), 3), DEFAULT_CONTROL_SIGMA_M),
+        ("check",) * len(ground_ids),
     )
-    per_image = tuple(cam_names[im.camera_id] for im in images)
-    return ColmapBlock(cams, eo, per_image, obs, ground)
+    return obs, ground
 
 
 def colmap_from_block(

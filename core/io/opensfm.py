@@ -57,9 +57,7 @@ from ..errors import InputError
 from ..geometry.camera import Camera
 from ..geometry.distortion import DistortionModel
 from ..geometry.forward_lens import OpenCVFisheyeLens, OpenCVLens
-from ..photo.bundle_setup import DEFAULT_CONTROL_SIGMA_M, GroundPoints
-from ..photo.observations import DEFAULT_SIGMA_PX, ImageObservations
-from .colmap_block import ColmapBlock, ColmapFrame, oriented
+from .colmap_block import ColmapBlock, ColmapFrame, named_cameras, oriented, tie_block
 
 Array = NDArray[np.float64]
 
@@ -316,10 +314,7 @@ def topocentric_frame(reference_lla: Tuple[float, float, float] | None, crs: str
 def block_from_opensfm(rec: OpenSfmReconstruction, crs: str, pixel_size_mm: float) -> ColmapBlock:
     """Convert one reconstruction (see the module docstring): LOCAL, or into ``crs``."""
     frame = topocentric_frame(rec.reference_lla, crs)
-    cam_names = {k: f"opensfm_{k}" for k in rec.cameras}
-    cams = tuple(
-        camera_from_opensfm(c, pixel_size_mm, cam_names[k]) for k, c in rec.cameras.items()
-    )
+    cam_names, cams = named_cameras("opensfm", rec.cameras, camera_from_opensfm, pixel_size_mm)
     shots: List[OpenSfmShot] = sorted(rec.shots.values(), key=lambda s: s.name)
     if not shots:
         raise InputError("the reconstruction has no shot", path=rec.source)
@@ -333,19 +328,7 @@ def block_from_opensfm(rec: OpenSfmReconstruction, crs: str, pixel_size_mm: floa
         c = rec.cameras[rec.shots[img].camera]
         size = max(c.width, c.height)
         px[j] = (xn * size + 0.5 * c.width, yn * size + 0.5 * c.height)
-    n_obs = len(rec.tracks)
-    obs = ImageObservations(
-        tuple(r_[0] for r_ in rec.tracks),
-        tuple(r_[1] for r_ in rec.tracks),
-        px,
-        np.full(n_obs, DEFAULT_SIGMA_PX),
-        ("tie",) * n_obs,
-        ("",) * n_obs,
-    )
-    ground = GroundPoints(
-        tuple(pids),
-        point_xyz,
-        np.full((len(pids), 3), DEFAULT_CONTROL_SIGMA_M),
-        ("check",) * len(pids),
+    obs, ground = tie_block(
+        [r_[0] for r_ in rec.tracks], [r_[1] for r_ in rec.tracks], px, pids, point_xyz
     )
     return ColmapBlock(cams, eo, tuple(cam_names[s.camera] for s in shots), obs, ground)

@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-from ..io.suffixes import IMAGE_SUFFIXES
-from .common import html_out
+from .common import JSON_FILTER, html_out, images_param
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
 _D = Fields("photo.calibration_options", "CalibrationOptions")
 _T = Fields("photo.calibration_options", "TargetSpec")
-JSON_FILTER = "JSON files (*.json)"
 
 SPEC = AlgorithmSpec(
     name="calibratecamera",
@@ -47,13 +45,7 @@ sigma0, the t-test of every lens coefficient, per-view RMS and poses), the same 
 page, and the residual table (CSV). PIXEL_SIZE only scales the millimetre values of the
 camera file: the calibration itself is in pixels.""",
     params=(
-        Param(
-            "IMAGES",
-            "files",
-            "Target images (files or folders)",
-            suffixes=IMAGE_SUFFIXES,
-            help="image files, or folders whose images are all taken",
-        ),
+        images_param("Target images (files or folders)"),
         Param(
             "TARGET",
             "enum",

@@ -11,9 +11,11 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
+from ..io.suffixes import IMAGE_SUFFIXES
 from .spec import Param, Ref
 
 CSV_FILTER = "CSV files (*.csv *.txt)"
+JSON_FILTER = "JSON files (*.json)"
 CSV_OUT = "CSV files (*.csv)"
 LAS_FILTER = "LAS/LAZ files (*.las *.laz *.LAS *.LAZ)"
 DSM_FILTER = "DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"
@@ -31,15 +33,11 @@ def mount_params(initial_boresight: bool = False) -> tuple[Param, ...]:
     ``initial_boresight``: BORESIGHT is only the start of an estimate (under Advanced: 0 is
     a fine first value)."""
     return (
-        Param(
+        _offsets(
             "LEVER_ARM",
-            "numbers",
             "Lever arm x,y,z",
-            (0.0, 0.0, 0.0),
-            count=3,
-            unit="m, body frame",
-            minimum=-MAX_LEVER_ARM_M,
-            maximum=MAX_LEVER_ARM_M,
+            "m, body frame",
+            MAX_LEVER_ARM_M,
             help="camera perspective centre in the INS body frame (x forward, y right, z down)",
         ),
         choice_param(
@@ -61,19 +59,23 @@ def mount_params(initial_boresight: bool = False) -> tuple[Param, ...]:
             maximum=1.0,
             help="the nominal mount R_c^b when MOUNT is custom",
         ),
-        Param(
+        _offsets(
             "BORESIGHT",
-            "numbers",
             "Boresight domega,dphi,dkappa",
-            (0.0, 0.0, 0.0),
-            count=3,
-            unit="degrees",
-            minimum=-MAX_BORESIGHT_DEG,
-            maximum=MAX_BORESIGHT_DEG,
+            "degrees",
+            MAX_BORESIGHT_DEG,
             advanced=initial_boresight,
             help="small misalignment about the camera axes x, y, z (a larger rotation "
             "belongs in MOUNT)",
         ),
+    )
+
+
+def _offsets(name: str, label: str, unit: str, limit: float, **extra: Any) -> Param:
+    """Three numbers, each within +-``limit``, 0 by default (a lever arm, a boresight)."""
+    zero = (0.0, 0.0, 0.0)
+    return Param(
+        name, "numbers", label, zero, count=3, unit=unit, minimum=-limit, maximum=limit, **extra
     )
 
 
@@ -154,6 +156,35 @@ def _file_out(
     )
 
 
+def table_param(name: str, label: str, **extra: Any) -> Param:
+    """An input table ``name``: a CSV file (or, in QGIS, any layer with attributes)."""
+    return Param(name, "table", label, file_filter=CSV_FILTER, **extra)
+
+
+def camera_param(label: str = "Camera (JSON)", **extra: Any) -> Param:
+    """CAMERA: the camera file (JSON: ``core.io.camera``)."""
+    return Param("CAMERA", "file", label, file_filter=JSON_FILTER, **extra)
+
+
+def eo_param(label: str = "Exterior orientation (CSV)", **extra: Any) -> Param:
+    """EO: the exterior orientation table (``core.io.orientation``)."""
+    return table_param("EO", label, **extra)
+
+
+def images_param(
+    label: str = "Images (files or folders)",
+    help: str = "image files, or folders whose images are all taken",
+    **extra: Any,
+) -> Param:
+    """IMAGES: image files, or folders whose images are all taken (``core.io.suffixes``)."""
+    return Param("IMAGES", "files", label, suffixes=IMAGE_SUFFIXES, help=help, **extra)
+
+
+def mapping_crs_param(help: str, label: str = "Mapping CRS (projected)", **extra: Any) -> Param:
+    """CRS: the projected mapping CRS of the outputs, the QGIS project's by default."""
+    return Param("CRS", "crs", label, qgis_default="ProjectCrs", help=help, **extra)
+
+
 def dsm_cell_param(advanced: bool = False) -> Param:
     """CELL_SIZE: the cell (CRS units) of the DSM rasterised from a LAS/LAZ given as DSM."""
     return Param(
@@ -172,16 +203,10 @@ def block_export_params() -> tuple[Param, ...]:
     """CAMERA, EO and the optional OBSERVATIONS and POINTS: the oriented block an exporter
     (``exportcolmap``, ``exportopensfm``) writes out."""
     return (
-        Param("CAMERA", "file", "Camera(s) (JSON)", file_filter="JSON files (*.json)"),
-        Param("EO", "table", "Exterior orientation table (CSV)", file_filter=CSV_FILTER),
-        Param("OBSERVATIONS", "table", "Observations (CSV)", optional=True, file_filter=CSV_FILTER),
-        Param(
-            "POINTS",
-            "table",
-            "3D points (ground point table, CSV)",
-            optional=True,
-            file_filter=CSV_FILTER,
-        ),
+        camera_param("Camera(s) (JSON)"),
+        eo_param("Exterior orientation table (CSV)"),
+        table_param("OBSERVATIONS", "Observations (CSV)", optional=True),
+        table_param("POINTS", "3D points (ground point table, CSV)", optional=True),
     )
 
 

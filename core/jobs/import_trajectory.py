@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_FILTER, choice_param, csv_out, mount_from, mount_params
+from .common import CSV_FILTER, choice_param, csv_out, mapping_crs_param, mount_from, mount_params
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -110,13 +110,7 @@ trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""
             help="cubic: Hermite cubic on the rotation group with the neighbours' angular "
             "velocities; slerp: constant angular velocity between two records",
         ),
-        Param(
-            "CRS",
-            "crs",
-            "Mapping CRS (projected)",
-            qgis_default="ProjectCrs",
-            help="projected CRS of the outputs (and of a CSV's eastings/northings)",
-        ),
+        mapping_crs_param("projected CRS of the outputs (and of a CSV's eastings/northings)"),
         *mount_params(),
         Param("OUTPUT", "sink", "Perspective centres", geometry="point", optional=True),
         csv_out("OUTPUT_TRAJECTORY", "Trajectory table at the events (CSV)", advanced=True),

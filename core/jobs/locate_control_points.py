@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..io.suffixes import CHIP_SUFFIXES, IMAGE_SUFFIXES
-from .common import CSV_FILTER, csv_out, html_out
+from ..io.suffixes import CHIP_SUFFIXES
+from .common import camera_param, csv_out, eo_param, html_out, images_param, table_param
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
@@ -52,28 +52,14 @@ shows the chips.""",
             suffixes=CHIP_SUFFIXES,
             help="one GeoTIFF per point, named <point_id>.tif",
         ),
-        Param(
+        table_param(
             "CONTROL_POINTS",
-            "table",
             "Control points (CSV)",
-            file_filter=CSV_FILTER,
             help="point_id,X,Y,Z in the mapping CRS (the chips' CRS)",
         ),
-        Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
-        Param(
-            "EO",
-            "table",
-            "Exterior orientation (CSV)",
-            file_filter=CSV_FILTER,
-            help="with sigma columns: the search window follows from them",
-        ),
-        Param(
-            "IMAGES",
-            "files",
-            "Images (files or folders)",
-            suffixes=IMAGE_SUFFIXES,
-            help="image files (name = image_id), or folders whose images are all taken",
-        ),
+        camera_param(),
+        eo_param(help="with sigma columns: the search window follows from them"),
+        images_param(help="image files (name = image_id), or folders whose images are all taken"),
         Param("CRS", "crs", "Mapping CRS of the EO and control", help="e.g. EPSG:25832"),
         Param(
             "SEARCH_PX",

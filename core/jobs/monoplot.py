@@ -5,7 +5,15 @@ from __future__ import annotations
 import logging
 
 from .checks import DSM_BYTES_PER_CELL, check_cell_size, check_memory
-from .common import CSV_FILTER, DSM_FILTER, choice_param, csv_out, dsm_cell_param
+from .common import (
+    CSV_FILTER,
+    DSM_FILTER,
+    camera_param,
+    choice_param,
+    csv_out,
+    dsm_cell_param,
+    eo_param,
+)
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Ref, Result, Values
 
@@ -50,8 +58,8 @@ parallel / unknown_plane (planes), out_of_field (the point lies beyond a fisheye
 projection's field: no ray).""",
     params=(
         Param("OBSERVATIONS", "table", "Image observations (CSV)", file_filter=CSV_FILTER),
-        Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
-        Param("EO", "table", "Exterior orientation (CSV)", file_filter=CSV_FILTER),
+        camera_param(),
+        eo_param(),
         Param(
             "DSM",
             "surface",

@@ -12,8 +12,14 @@ from concurrent.futures import Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..io.suffixes import IMAGE_SUFFIXES
-from .common import CSV_FILTER, DSM_FILTER, compression_param, dsm_cell_param
+from .common import (
+    DSM_FILTER,
+    camera_param,
+    compression_param,
+    dsm_cell_param,
+    eo_param,
+    images_param,
+)
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -59,15 +65,9 @@ over the images, 2 significant digits); the grids are aligned on multiples of th
 extent is each image's footprint on the DSM, or the extent given (xmin, ymin, xmax, ymax).
 Nothing is written when an input is wrong; the files appear together when all are done.""",
     params=(
-        Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
-        Param("EO", "table", "Exterior orientation (CSV)", file_filter=CSV_FILTER),
-        Param(
-            "IMAGES",
-            "files",
-            "Images (files or folders)",
-            suffixes=IMAGE_SUFFIXES,
-            help="image files, or folders whose images are all taken",
-        ),
+        camera_param(),
+        eo_param(),
+        images_param(),
         Param(
             "DSM",
             "surface",

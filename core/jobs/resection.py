@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 import math
 
-from .common import CSV_FILTER, csv_out, global_test_verdict, html_out
+from .common import CSV_FILTER, camera_param, csv_out, global_test_verdict, html_out
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -64,7 +64,7 @@ standard deviations and correlations of the six parameters, Baarda's data snoopi
 and whole lines, and a diagnosis naming what the observations cannot determine (e.g. all
 lines parallel).""",
     params=(
-        Param("CAMERA", "file", "Camera (JSON)", file_filter="JSON files (*.json)"),
+        camera_param(),
         Param(
             "OBSERVATIONS",
             "table",

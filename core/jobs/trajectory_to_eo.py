@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_FILTER, csv_out, mount_from, mount_params
+from .common import CSV_FILTER, csv_out, mapping_crs_param, mount_from, mount_params
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -42,13 +42,7 @@ kappa_deg (angles relative to the grid frame at each image), optionally the same
 CSV (on the command line, printed when no file is given), and the number of images.""",
     params=(
         Param("INPUT", "table", "Trajectory table (CSV)", file_filter=CSV_FILTER),
-        Param(
-            "CRS",
-            "crs",
-            "Mapping CRS (projected)",
-            qgis_default="ProjectCrs",
-            help="projected CRS of the trajectory's eastings/northings and of the output",
-        ),
+        mapping_crs_param("projected CRS of the trajectory's eastings/northings and of the output"),
         *mount_params(),
         Param("OUTPUT", "sink", "Exterior orientation", geometry="point", optional=True),
         csv_out("OUTPUT_CSV", "Exterior orientation table (CSV)", on_demand=True, twin="OUTPUT"),

@@ -642,25 +642,13 @@ def low_pass_all(
     return sum(c for c, _ in results), zmin
 
 
-def classify_all(
-    parts: Any,
-    grid: Any,
-    flat: Any,
-    zr: Any,
-    dtm: Any,
-    thr: Any,
-    low: Any,
-    candidate: Any,
-    nodata: Any,
-    ground: Any,
-    hag: Any,
-) -> None:
+def classify_all(parts: Any, grid: Any, *arrays: Any) -> None:
     """:func:`classify` over every part, pieces shared out among the threads (each point is
-    written by one thread)."""
+    written by one thread); ``arrays``: those of :func:`classify` from ``flat`` to ``hag``."""
     pieces = _pieces(parts)
 
     def task(share: tuple[int, int]) -> None:
         for lo, part in pieces[share[0] : share[1]]:
-            classify(part, grid, lo, flat, zr, dtm, thr, low, candidate, nodata, ground, hag)
+            classify(part, grid, lo, *arrays)
 
     _run([partial(task, s) for s in _shares(len(pieces))])

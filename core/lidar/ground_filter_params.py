@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Union
+from typing import Union
 
 from ..errors import InputError
 
@@ -15,15 +15,35 @@ GROWTH_CHOICES = ("linear", "exponential")
 WINDOW_SHAPES = ("square", "disk")
 
 
-def _check_common(p: Any) -> None:
-    for name in ("low_outlier_height", "low_outlier_radius"):
-        value = getattr(p, name)
-        if not (value >= 0 and math.isfinite(value)):
-            raise InputError(f"{name} must be >= 0", column=name)
+@dataclass(frozen=True)
+class LowOutlierParams:
+    """What every method shares: the low-outlier pre-filter and the return filter.
+
+    Attributes
+    ----------
+    low_outlier_height : float
+        Depth below the local ground level that makes a point a low outlier (vertical unit);
+        0 disables the pre-filter. Default 1.0.
+    low_outlier_radius : float
+        Half-size of the neighbourhood the point is compared with (horizontal unit).
+        Default 5.0.
+    last_returns_only : bool
+        Only last/single returns can be ground when the file has return numbers. Default True.
+    """
+
+    low_outlier_height: float = 1.0
+    low_outlier_radius: float = 5.0
+    last_returns_only: bool = True
+
+    def _check_common(self) -> None:
+        for name in ("low_outlier_height", "low_outlier_radius"):
+            value = getattr(self, name)
+            if not (value >= 0 and math.isfinite(value)):
+                raise InputError(f"{name} must be >= 0", column=name)
 
 
 @dataclass(frozen=True)
-class GroundFilterParams:
+class GroundFilterParams(LowOutlierParams):
     """Parameters of the PMF (units: see the module docstring).
 
     Attributes
@@ -49,14 +69,8 @@ class GroundFilterParams:
         Final height above the DTM accepted as ground (vertical unit). Default 0.3.
     slope_scalar : float
         Added to ``ground_threshold`` per unit of local DTM slope (vertical unit). Default 1.0.
-    low_outlier_height : float
-        Depth below the local ground level that makes a point a low outlier (vertical unit);
-        0 disables the pre-filter. Default 1.0.
-    low_outlier_radius : float
-        Half-size of the neighbourhood the point is compared with (horizontal unit).
-        Default 5.0.
-    last_returns_only : bool
-        Only last/single returns can be ground when the file has return numbers. Default True.
+    low_outlier_height, low_outlier_radius, last_returns_only
+        As in :class:`LowOutlierParams`.
     """
 
     cell_size: float = 1.0
@@ -69,10 +83,6 @@ class GroundFilterParams:
     window_shape: str = "square"
     ground_threshold: float = 0.3
     slope_scalar: float = 1.0
-    low_outlier_height: float = 1.0
-    low_outlier_radius: float = 5.0
-    last_returns_only: bool = True
-
     method = "pmf"
 
     def validate(self) -> None:
@@ -92,7 +102,7 @@ class GroundFilterParams:
             value = getattr(self, name)
             if not (value >= 0 and math.isfinite(value)):
                 raise InputError(f"{name} must be >= 0", column=name)
-        _check_common(self)
+        self._check_common()
         if self.growth not in GROWTH_CHOICES:
             raise InputError(f"growth must be one of {GROWTH_CHOICES}", column="growth")
         if self.growth == "exponential" and self.window_base <= 1:
@@ -104,7 +114,7 @@ class GroundFilterParams:
 
 
 @dataclass(frozen=True)
-class SmrfParams:
+class SmrfParams(LowOutlierParams):
     """Parameters of SMRF (Pingel et al. 2013). The defaults are the paper's (and PDAL's,
     :data:`SMRF_PUBLISHED`) except ``threshold``, chosen on AHN3 (README).
 
@@ -126,7 +136,7 @@ class SmrfParams:
         Added to ``threshold`` per unit of local DTM slope (vertical unit). Default 1.25
         (published 1.25).
     low_outlier_height, low_outlier_radius, last_returns_only
-        As in :class:`GroundFilterParams`.
+        As in :class:`LowOutlierParams`.
     """
 
     cell_size: float = 1.0
@@ -134,10 +144,6 @@ class SmrfParams:
     max_window: float = 18.0
     threshold: float = 0.3
     scalar: float = 1.25
-    low_outlier_height: float = 1.0
-    low_outlier_radius: float = 5.0
-    last_returns_only: bool = True
-
     method = "smrf"
 
     def validate(self) -> None:
@@ -149,7 +155,7 @@ class SmrfParams:
             value = getattr(self, name)
             if not (value >= 0 and math.isfinite(value)):
                 raise InputError(f"{name} must be >= 0", column=name)
-        _check_common(self)
+        self._check_common()
         if self.max_window < self.cell_size:
             raise InputError("max_window must be at least one cell", column="max_window")
 
@@ -159,7 +165,7 @@ SMRF_PUBLISHED = SmrfParams(slope=0.15, max_window=18.0, threshold=0.5, scalar=1
 
 
 @dataclass(frozen=True)
-class CsfParams:
+class CsfParams(LowOutlierParams):
     """Parameters of the cloth simulation filter (Zhang et al. 2016); the defaults are those of
     the authors' package (``cloth-simulation-filter``).
 
@@ -178,7 +184,7 @@ class CsfParams:
     slope_smooth : bool
         Post-processing for steep slopes. Default True.
     low_outlier_height, low_outlier_radius, last_returns_only
-        As in :class:`GroundFilterParams`.
+        As in :class:`LowOutlierParams`.
     """
 
     resolution: float = 1.0
@@ -187,10 +193,6 @@ class CsfParams:
     threshold: float = 0.5
     iterations: int = 500
     slope_smooth: bool = True
-    low_outlier_height: float = 1.0
-    low_outlier_radius: float = 5.0
-    last_returns_only: bool = True
-
     method = "csf"
 
     @property
@@ -210,7 +212,7 @@ class CsfParams:
             raise InputError("threshold must be >= 0", column="threshold")
         if not self.iterations >= 1:
             raise InputError("iterations must be >= 1", column="iterations")
-        _check_common(self)
+        self._check_common()
 
 
 FilterParams = Union[GroundFilterParams, SmrfParams, CsfParams]

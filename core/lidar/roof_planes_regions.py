@@ -96,26 +96,13 @@ def _grow(
         retried = False
         while True:
             stop_if_asked(should_stop, "extracting roof planes")
+            wave = (q, keep, normals, labels, knn, frontier, reg_n, reg_c, cos_tol, params.epsilon)
             if compiled:
                 from . import roof_planes_numba
 
-                cand, reg = roof_planes_numba.claims(
-                    q,
-                    keep,
-                    normals,
-                    labels,
-                    knn,
-                    frontier,
-                    reg_n,
-                    reg_c,
-                    cos_tol,
-                    params.epsilon,
-                    scratch,
-                )
+                cand, reg = roof_planes_numba.claims(*wave, scratch)
             else:
-                cand, reg = _claims(
-                    q, keep, normals, labels, knn, frontier, reg_n, reg_c, cos_tol, params.epsilon
-                )
+                cand, reg = _claims(*wave)
             if not len(cand):
                 if retried:
                     break

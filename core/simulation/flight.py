@@ -37,7 +37,7 @@ from ..geometry.collinearity import project
 from ..geometry.frames import MappingFrame
 from ..geometry.planes import Plane, fit_plane
 from ..geometry.rotations import matrix_to_opk
-from ..io.atomic import write_text_atomic
+from ..io.atomic import folder_files, write_text_atomic
 from ..io.camera import write_camera_json
 from ..io.control import write_lcps_csv, write_lines_csv
 from ..io.ground_points import write_ground_points_csv
@@ -247,18 +247,8 @@ class FlightSimulation:
 
     def write(self, folder: Union[str, Path]) -> dict[str, Path]:
         """Write every input as the project's files; returns their paths by name."""
-        out = Path(folder)
-        out.mkdir(parents=True, exist_ok=True)
-        paths = {
-            "trajectory": out / "trajectory.csv",
-            "camera": out / "camera.json",
-            "planes": out / "planes.csv",
-            "lines": out / "lines.csv",
-            "lcps": out / "lcps.csv",
-            "observations": out / "observations.csv",
-            "lidar_points": out / "lidar_roof_points.csv",
-            "truth": out / "truth.json",
-        }
+        csv = ("trajectory", "planes", "lines", "lcps", "observations", "lidar_roof_points")
+        paths = folder_files(folder, "camera.json", *(f"{k}.csv" for k in csv), "truth.json")
         write_trajectory_csv(paths["trajectory"], self.trajectory)
         write_camera_json(paths["camera"], self.camera)
         write_planes_csv(paths["planes"], self.planes)
@@ -266,7 +256,7 @@ class FlightSimulation:
         write_lcps_csv(paths["lcps"], self.lcps + self.check_lcps)
         write_observations_csv(paths["observations"], self.observations)
         write_csv_atomic(
-            paths["lidar_points"],
+            paths["lidar_roof_points"],
             ("x", "y", "z", "plane_id"),
             [
                 (*(repr(float(v)) for v in p), int(i))

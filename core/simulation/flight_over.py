@@ -18,7 +18,7 @@ from ..geometry.camera import Camera
 from ..geometry.collinearity import project
 from ..geometry.planes import Plane
 from ..geometry.rotations import matrix_to_opk
-from ..io.atomic import write_text_atomic
+from ..io.atomic import folder_files, write_text_atomic
 from ..io.camera import write_camera_json
 from ..io.observations import write_observations_csv
 from ..io.tables import write_csv_atomic
@@ -106,10 +106,8 @@ class ControlFlightSimulation:
     def write(self, folder: Union[str, Path]) -> dict[str, Path]:
         """Write trajectory.csv, camera.json, observations.csv, check_points.csv (id, e, n, h:
         the truth) and truth.json; returns their paths by name."""
-        out = Path(folder)
-        out.mkdir(parents=True, exist_ok=True)
-        paths = {k: out / f"{k}.csv" for k in ("trajectory", "observations", "check_points")}
-        paths.update(camera=out / "camera.json", truth=out / "truth.json")
+        csv = ("trajectory", "observations", "check_points")
+        paths = folder_files(folder, "camera.json", *(f"{k}.csv" for k in csv), "truth.json")
         write_trajectory_csv(paths["trajectory"], self.trajectory)
         write_camera_json(paths["camera"], self.camera)
         write_observations_csv(paths["observations"], self.observations)

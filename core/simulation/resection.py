@@ -114,10 +114,10 @@ def write_scene_files(
     ``control_lines.csv`` (id,x1..z2,sigma_start,sigma_end) and ``eo_true.csv`` (the true
     orientation in the mapping CRS). Returns the paths by name and the ``local`` frame.
     """
-    from pathlib import Path
 
     from ..geometry.frames import LocalFrame, MappingFrame
     from ..geometry.rotations import opk_to_matrix
+    from ..io.atomic import folder_files
     from ..io.camera import write_camera_json
     from ..io.observations import write_observations_csv
     from ..io.orientation import write_eo_csv
@@ -125,14 +125,10 @@ def write_scene_files(
     from ..photo.observations import ImageObservations
     from ..photo.orientation import ExteriorOrientationTable, eo_local_to_map
 
-    out = Path(folder)
-    out.mkdir(parents=True, exist_ok=True)
     mapping = MappingFrame.from_user_input(crs)
     local = LocalFrame.at_map_point(mapping, np.asarray(origin_map, dtype=np.float64))
-    paths = {
-        k: out / f"{k}.csv" for k in ("observations", "control_points", "control_lines", "eo_true")
-    }
-    paths["camera"] = out / "camera.json"
+    csv = ("observations", "control_points", "control_lines", "eo_true")
+    paths = folder_files(folder, "camera.json", *(f"{k}.csv" for k in csv))
     write_camera_json(paths["camera"], scene.camera)
     rows: dict[str, list[Any]]  # the observation table's columns
     rows = {

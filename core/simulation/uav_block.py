@@ -35,7 +35,7 @@ from ..geometry.collinearity import project_with_status
 from ..geometry.distortion import BrownConrady, DistortionModel
 from ..geometry.frames import LocalFrame, MappingFrame
 from ..geometry.rotations import matrix_to_opk, opk_to_matrix
-from ..io.atomic import write_text_atomic
+from ..io.atomic import folder_files, write_text_atomic
 from ..io.camera import write_camera_json
 from ..io.ground_points import write_ground_points_csv
 from ..io.observations import write_observations_csv
@@ -182,15 +182,8 @@ class UavBlock:
         Returns the paths by name."""
         from ..io.orientation import write_eo_csv_with_sigmas
 
-        out = Path(folder)
-        out.mkdir(parents=True, exist_ok=True)
-        paths = {
-            "camera": out / "camera.json",
-            "observations": out / "observations.csv",
-            "ground_points": out / "ground_points.csv",
-            "eo": out / "eo.csv",
-            "truth": out / "truth.json",
-        }
+        csv = ("observations", "ground_points", "eo")
+        paths = folder_files(folder, "camera.json", *(f"{k}.csv" for k in csv), "truth.json")
         write_camera_json(paths["camera"], self.camera)
         write_observations_csv(paths["observations"], self.observations)
         write_ground_points_csv(paths["ground_points"], self.ground)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from qgis.core import QgsCoordinateReferenceSystem, QgsPoint, QgsProcessingException
+from qgis.core import QgsPoint, QgsProcessingException
 
 from ...core.jobs import boresight_calibration
 from ..base import BaseAlgorithm
@@ -37,9 +37,8 @@ class BoresightCalibrationAlgorithm(BaseAlgorithm):
 
     def write_layers(self, result, parameters, context, feedback) -> dict:
         run = result.data
-        crs = QgsCoordinateReferenceSystem.fromWkt(run.crs_wkt)
         sink, dest = self.field_sink(parameters, context, "OUTPUT_RESIDUALS", _FIELDS,
-                                     WKB_POINT_Z, crs)  # fmt: skip
+                                     WKB_POINT_Z, run.crs_wkt)  # fmt: skip
         for row in run.residual_rows():
             image, point, kind, target, group, x, y, z, *numbers, rejected, used = row
             if not all(math.isfinite(v) for v in (x, y, z)):

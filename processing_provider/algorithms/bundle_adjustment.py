@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from qgis.core import QgsCoordinateReferenceSystem, QgsPoint
+from qgis.core import QgsPoint
 
 from ...core.jobs import bundle_adjustment
 from ..base import BaseAlgorithm
@@ -24,9 +24,8 @@ class BundleAdjustmentAlgorithm(BaseAlgorithm):
 
     def write_layers(self, result, parameters, context, feedback) -> dict:
         res = result.data
-        crs = QgsCoordinateReferenceSystem.fromWkt(res.eo.crs_wkt)
         sink, dest = self.field_sink(parameters, context, "OUTPUT_POINTS_LAYER", _FIELDS,
-                                     WKB_POINT_Z, crs)  # fmt: skip
+                                     WKB_POINT_Z, res.eo.crs_wkt)  # fmt: skip
         for pid, role, xyz, sig, n in zip(res.point_id, res.point_role, res.point_xyz,
                                           res.point_sigma, res.point_images):  # fmt: skip
             if not all(math.isfinite(float(v)) for v in xyz):

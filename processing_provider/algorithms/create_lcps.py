@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from qgis.core import QgsCoordinateReferenceSystem, QgsLineString, QgsPoint
+from qgis.core import QgsLineString, QgsPoint
 
 from ...core.jobs import create_lcps
 from ..base import BaseAlgorithm
@@ -31,7 +31,7 @@ class CreateLcpsAlgorithm(BaseAlgorithm):
         from ...core.lidar.control import error_ellipsoid
 
         control, info = result.data
-        crs = QgsCoordinateReferenceSystem.fromWkt(info.crs.to_wkt()) if info.crs else None
+        crs = info.crs.to_wkt() if info.crs else None
         points, point_id = self.field_sink(
             parameters, context, "OUTPUT_POINTS", _POINT_FIELDS, WKB_POINT_Z, crs
         )

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from qgis.core import QgsCoordinateReferenceSystem, QgsLineString, QgsPolygon
+from qgis.core import QgsLineString, QgsPolygon
 
 from ...core.jobs import extract_roof_planes
 from ..base import BaseAlgorithm
@@ -27,8 +27,9 @@ class ExtractRoofPlanesAlgorithm(BaseAlgorithm):
 
     def write_layers(self, result, parameters, context, feedback) -> dict:
         run = result.data
-        crs = QgsCoordinateReferenceSystem.fromWkt(run.crs_wkt)
-        sink, dest = self.field_sink(parameters, context, "OUTPUT", _FIELDS, WKB_POLYGON_Z, crs)
+        sink, dest = self.field_sink(
+            parameters, context, "OUTPUT", _FIELDS, WKB_POLYGON_Z, run.crs_wkt
+        )
         for plane in run.result.planes:
             polygon = None
             if len(plane.outline) >= 3:

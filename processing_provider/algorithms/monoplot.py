@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from qgis.core import QgsCoordinateReferenceSystem, QgsLineString, QgsPoint
+from qgis.core import QgsLineString, QgsPoint
 
 from ...core.jobs import monoplot
 from ..base import BaseAlgorithm
@@ -31,9 +31,8 @@ class MonoplotAlgorithm(BaseAlgorithm):
         from ...core.photo.monoplot import STATUS_TEXT
 
         res = result.data
-        crs = QgsCoordinateReferenceSystem.fromWkt(res.crs_wkt)
         points, pid = self.field_sink(parameters, context, "OUTPUT_POINTS", _POINT_FIELDS,
-                                      WKB_POINT_Z, crs)  # fmt: skip
+                                      WKB_POINT_Z, res.crs_wkt)  # fmt: skip
         sig = res.sigmas
         for k, (img, pt, kind, tgt, li, vi, how) in enumerate(res.rows):
             p = res.points[k]
@@ -43,7 +42,7 @@ class MonoplotAlgorithm(BaseAlgorithm):
                       how, res.incidence_deg[k]]  # fmt: skip
             self.add_feature(points, _POINT_FIELDS, geom, values)
         lines, lid = self.field_sink(parameters, context, "OUTPUT_LINES", _LINE_FIELDS,
-                                     WKB_LINESTRING_Z, crs)  # fmt: skip
+                                     WKB_LINESTRING_Z, res.crs_wkt)  # fmt: skip
         for li, ln in enumerate(res.lines):
             v = [QgsPoint(*map(float, p)) for p in ln.vertices if all(map(math.isfinite, p))]
             length = sum(a.distance3D(b) for a, b in zip(v[:-1], v[1:]))

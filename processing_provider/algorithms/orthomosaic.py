@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from qgis.core import QgsCoordinateReferenceSystem, QgsGeometry
+from qgis.core import QgsGeometry
 
 from ...core.jobs import orthomosaic
 from ..base import BaseAlgorithm
@@ -19,9 +19,8 @@ class OrthomosaicAlgorithm(BaseAlgorithm):
 
     def write_layers(self, result, parameters, context, feedback) -> dict:
         res = result.data
-        crs = QgsCoordinateReferenceSystem.fromWkt(res.crs_wkt)
         sink, dest = self.field_sink(parameters, context, "OUTPUT_SEAMLINES", _FIELDS,
-                                     WKB_MULTIPOLYGON, crs)  # fmt: skip
+                                     WKB_MULTIPOLYGON, res.crs_wkt)  # fmt: skip
         for seam in res.seamlines:
             values = [seam.image_id, seam.cells, seam.area]
             self.add_feature(sink, _FIELDS, QgsGeometry.fromWkt(seam.wkt), values)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from qgis.core import QgsCoordinateReferenceSystem, QgsPoint
+from qgis.core import QgsPoint
 
 from ...core.jobs import trajectory_to_eo
 from ..base import BaseAlgorithm
@@ -24,8 +24,9 @@ class TrajectoryToEoAlgorithm(BaseAlgorithm):
 
     def write_layers(self, result, parameters, context, feedback) -> dict:
         table = result.data
-        crs = QgsCoordinateReferenceSystem.fromWkt(table.crs_wkt)
-        sink, dest = self.field_sink(parameters, context, "OUTPUT", _FIELDS, WKB_POINT_Z, crs)
+        sink, dest = self.field_sink(
+            parameters, context, "OUTPUT", _FIELDS, WKB_POINT_Z, table.crs_wkt
+        )
         for i, image_id in enumerate(table.image_id):
             x, y, z = (float(v) for v in table.xyz[i])
             opk = [math.degrees(float(a)) for a in table.opk[i]]
