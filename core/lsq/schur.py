@@ -403,7 +403,6 @@ class ReducedNormal:
             Q_eliminated=Qpp / (de[:, :, None] * de[:, None, :]),
             _plan=plan,
             _take=take,
-            _Qpp_s=Qpp,
             _cross=cross,
             _d=d,
         )
@@ -428,7 +427,6 @@ class BlockCofactor:
     Q_eliminated: Array
     _plan: EliminationPlan = field(repr=False)
     _take: Callable[[Index, Index], Array] = field(repr=False)  # entries of the scaled M
-    _Qpp_s: Array = field(repr=False)
     _cross: list[Array] = field(repr=False)
     _d: Array = field(repr=False)
 
@@ -487,10 +485,6 @@ class BlockCofactor:
         if ke:
             pt = bp.point[sel]
             es = bp.eslot[sel]
-            Qp = self._Qpp_s[pt]  # (g, b, b)
-            Q[:, bp.ec[:, None], bp.ec[None, :]] = Qp[
-                np.arange(g)[:, None, None], es[:, :, None], es[:, None, :]
-            ]
             if kr:
                 # cross block rows in rc order: varying columns from the group's own
                 # occurrence, shared columns from the block's occurrence at the point
@@ -515,7 +509,12 @@ class BlockCofactor:
         order = np.concatenate([bp.rc, bp.ec])
         dk = np.empty((g, k))
         dk[:, order] = dl
-        Q /= dk[:, :, None] * dk[:, None, :]  # in place: one (g, k, k) array less
+        for i in range(k):  # in place, a row at a time: no other (g, k, k) array
+            Q[:, i, :] /= dk[:, i, None] * dk
+        if ke:  # the block's own cofactors, already in the original units (the same quotients)
+            Q[:, bp.ec[:, None], bp.ec[None, :]] = self.Q_eliminated[
+                pt[:, None, None], es[:, :, None], es[:, None, :]
+            ]
         return Q
 
 

@@ -106,7 +106,14 @@ class BandedInverse:
     """
 
     def __init__(
-        self, perm: Index, n_band: int, Lb: Array, Zt: Array, Y: Array, Hinv: Array, E: Array
+        self,
+        perm: Index,
+        n_band: int,
+        band: sp.coo_matrix,
+        Zt: Array,
+        Y: Array,
+        Hinv: Array,
+        E: Array,
     ) -> None:
         self.perm = perm
         self.pos = np.empty_like(perm)
@@ -114,7 +121,10 @@ class BandedInverse:
         self.n = int(perm.size)
         self.n_band = n_band
         self.n_dense = self.n - n_band
-        self._Lb = Lb  # LAPACK lower band form, (w + 1, n_B)
+        # the band part's lower triangle (sparse): its factor is formed again when an entry
+        # outside the band is asked for (the factor is as large as Zt, kept only then)
+        self._band = band
+        self._Lb: Array | None = None  # LAPACK lower band form, (w + 1, n_B)
         self._Zt = Zt  # (n_B, w + 1)
         self.bandwidth = Zt.shape[1] - 1
         self._Y = Y  # (n_B, g) A^-1 E
@@ -183,11 +193,28 @@ class BandedInverse:
         nb = self.n_band
         rhs = np.zeros((nb, cc.size))
         rhs[cc, np.arange(cc.size)] = 1.0
+        if self._Lb is None:
+            self._Lb = _band_factor(self._band, self.bandwidth)
         yb = sla.cho_solve_banded((self._Lb, True), rhs, check_finite=False)
         if not self.n_dense:
             return yb
         xg = -self._Hinv @ (self._E.T @ yb)
         return np.vstack([yb - self._Y @ xg, xg])
+
+
+def _band_factor(band: sp.coo_matrix, w: int) -> Array:
+    """LAPACK's band Cholesky factor (lower band form, (w + 1, n)) of the symmetric matrix
+    whose lower triangle is ``band`` (bandwidth w).
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        When the matrix is not positive definite.
+    """
+    n = band.shape[0]
+    ab = np.zeros((w + 1, n))
+    ab[band.row - band.col, band.col] = band.data
+    return sla.cholesky_banded(ab, lower=True, check_finite=False) if n else ab
 
 
 def _order(S: sp.csr_matrix) -> tuple[Index, int]:
@@ -223,10 +250,8 @@ def banded_inverse(S: sp.spmatrix) -> BandedInverse | None:
     i, j, v = P.row, P.col, P.data
     low = (i >= j) & (i < nb)
     w = int((i[low] - j[low]).max()) if low.any() else 0
-    ab = np.zeros((w + 1, nb))
-    ab[i[low] - j[low], j[low]] = v[low]
-    Lb = sla.cholesky_banded(ab, lower=True, check_finite=False) if nb else ab
-    del ab
+    band = sp.coo_matrix((v[low], (i[low], j[low])), shape=(nb, nb))
+    Lb = _band_factor(band, w)
     g = S.shape[0] - nb
     E = np.zeros((nb, g))
     F = np.zeros((g, g))
@@ -244,9 +269,10 @@ def banded_inverse(S: sp.spmatrix) -> BandedInverse | None:
         Y, Hinv = np.zeros((nb, 0)), np.zeros((0, 0))
     Lt = np.ascontiguousarray(Lb.T)
     Zt = np.zeros_like(Lt)
+    del Lb
     kernel(Lt, Zt)
     del Lt
-    return BandedInverse(perm, nb, Lb, Zt, Y, Hinv, E)
+    return BandedInverse(perm, nb, band, Zt, Y, Hinv, E)
 
 
 def _add_sums(out: Array, by: Index, n: int, Mk: Array, keys: Index, T: Array, o: Index) -> None:
