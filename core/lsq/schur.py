@@ -50,7 +50,7 @@ from . import schur_numba as _nb
 from .scaling import jacobi_scale, scale_constraints
 from .schur_numba import back_substitute, dense_reduced, diag_grad, normal_sums, pair_sums
 from .schur_plan import EliminationPlan
-from .selected_inverse import banded_inverse
+from .selected_inverse import banded_inverse, cofactor_sums
 
 Array = NDArray[np.float64]
 Index = NDArray[np.intp]
@@ -386,38 +386,11 @@ class ReducedNormal:
         else:
             take = sel.take
         _, Vinv = self.point_factors(0.0)
-        acc = [np.zeros_like(T) for T in self.T]
-        for pl in plan.pairs:
-            a, b = plan.sets[pl.s1], plan.sets[pl.s2]
-            Ta, Tb = self.T[pl.s1], self.T[pl.s2]
-            kb = Tb.shape[1:]
-            ka = Ta.shape[1:]
-
-            def fwd(items: Index, a=a, b=b, Tb=Tb, o1=pl.o1, o2=pl.o2) -> Array:
-                ra, rb = a.rows[a.sig[o1[items]]], b.rows[b.sig[o2[items]]]
-                return take(ra[:, :, None], rb[:, None, :]) @ Tb[o2[items]]
-
-            acc[pl.s1] += pl.o1_reducer.sum(fwd, (ka[0], kb[1]))
-            if pl.o2_reducer is not None:
-
-                def bwd(items: Index, a=a, b=b, Ta=Ta, o1=pl.o1, o2=pl.o2) -> Array:
-                    ra, rb = a.rows[a.sig[o1[items]]], b.rows[b.sig[o2[items]]]
-                    return take(rb[:, :, None], ra[:, None, :]) @ Ta[o1[items]]
-
-                acc[pl.s2] += pl.o2_reducer.sum(bwd, (kb[0], ka[1]))
-        inner = np.zeros((plan.P, plan.b, plan.b))
-        for T, A, s in zip(self.T, acc, plan.sets):
-            contrib = np.swapaxes(T, 1, 2) @ A  # (O, b, b)
-            for i in range(plan.b):
-                for j in range(plan.b):
-                    inner[:, i, j] += np.bincount(
-                        s.point, weights=contrib[:, i, j], minlength=plan.P
-                    )
+        inner, cross = cofactor_sums(plan, self.T, Vinv, take)
         Qpp = Vinv + Vinv @ inner @ Vinv
         Qpp = 0.5 * (Qpp + np.swapaxes(Qpp, 1, 2))
         if self.dead is not None and self.dead.any():
             Qpp[self.dead] = np.nan  # not adjusted: no precision
-        cross = [-(A @ Vinv[s.point]) for A, s in zip(acc, plan.sets)]
         d = self.d
         de = d[plan.elim]  # (P, b)
         live = np.ones(plan.P, dtype=bool) if self.dead is None else ~self.dead
@@ -430,7 +403,6 @@ class ReducedNormal:
             Q_eliminated=Qpp / (de[:, :, None] * de[:, None, :]),
             _plan=plan,
             _take=take,
-            _Qpp_s=Qpp,
             _cross=cross,
             _d=d,
         )
@@ -455,7 +427,6 @@ class BlockCofactor:
     Q_eliminated: Array
     _plan: EliminationPlan = field(repr=False)
     _take: Callable[[Index, Index], Array] = field(repr=False)  # entries of the scaled M
-    _Qpp_s: Array = field(repr=False)
     _cross: list[Array] = field(repr=False)
     _d: Array = field(repr=False)
 
@@ -514,10 +485,6 @@ class BlockCofactor:
         if ke:
             pt = bp.point[sel]
             es = bp.eslot[sel]
-            Qp = self._Qpp_s[pt]  # (g, b, b)
-            Q[:, bp.ec[:, None], bp.ec[None, :]] = Qp[
-                np.arange(g)[:, None, None], es[:, :, None], es[:, None, :]
-            ]
             if kr:
                 # cross block rows in rc order: varying columns from the group's own
                 # occurrence, shared columns from the block's occurrence at the point
@@ -542,7 +509,13 @@ class BlockCofactor:
         order = np.concatenate([bp.rc, bp.ec])
         dk = np.empty((g, k))
         dk[:, order] = dl
-        return Q / (dk[:, :, None] * dk[:, None, :])
+        for i in range(k):  # in place, a row at a time: no other (g, k, k) array
+            Q[:, i, :] /= dk[:, i, None] * dk
+        if ke:  # the block's own cofactors, already in the original units (the same quotients)
+            Q[:, bp.ec[:, None], bp.ec[None, :]] = self.Q_eliminated[
+                pt[:, None, None], es[:, :, None], es[:, None, :]
+            ]
+        return Q
 
 
 def _point_products(Li: Array, point: Index, T: Array) -> Array:

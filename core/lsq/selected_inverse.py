@@ -34,16 +34,24 @@ gathers any entries; columns are solved in chunks).
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
+
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 from numpy.typing import NDArray
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
+from .schur_plan import _Reducer
+
+if TYPE_CHECKING:
+    from .schur_plan import EliminationPlan
+
 Array = NDArray[np.float64]
 Index = NDArray[np.intp]
 
-__all__ = ["BandedInverse", "banded_inverse"]
+__all__ = ["BandedInverse", "banded_inverse", "cofactor_sums"]
 
 # A parameter is "dense" (ordered last, outside the band) when it is coupled to more than
 # this share of all parameters, and to more than _DENSE_MIN_DEGREE of them.
@@ -51,6 +59,8 @@ _DENSE_SHARE = 0.1
 _DENSE_MIN_DEGREE = 200
 # Columns solved at once for entries outside the band (bounds the n x k work array).
 _CHUNK = 256
+# Occurrences per chunk of the point sums of :func:`cofactor_sums`.
+_OCC_CHUNK = 1 << 16
 
 
 def _takahashi_kernel(Lt, Zt):  # pragma: no cover - compiled
@@ -96,7 +106,14 @@ class BandedInverse:
     """
 
     def __init__(
-        self, perm: Index, n_band: int, Lb: Array, Zt: Array, Y: Array, Hinv: Array, E: Array
+        self,
+        perm: Index,
+        n_band: int,
+        band: sp.coo_matrix,
+        Zt: Array,
+        Y: Array,
+        Hinv: Array,
+        E: Array,
     ) -> None:
         self.perm = perm
         self.pos = np.empty_like(perm)
@@ -104,7 +121,10 @@ class BandedInverse:
         self.n = int(perm.size)
         self.n_band = n_band
         self.n_dense = self.n - n_band
-        self._Lb = Lb  # LAPACK lower band form, (w + 1, n_B)
+        # the band part's lower triangle (sparse): its factor is formed again when an entry
+        # outside the band is asked for (the factor is as large as Zt, kept only then)
+        self._band = band
+        self._Lb: Array | None = None  # LAPACK lower band form, (w + 1, n_B)
         self._Zt = Zt  # (n_B, w + 1)
         self.bandwidth = Zt.shape[1] - 1
         self._Y = Y  # (n_B, g) A^-1 E
@@ -173,11 +193,28 @@ class BandedInverse:
         nb = self.n_band
         rhs = np.zeros((nb, cc.size))
         rhs[cc, np.arange(cc.size)] = 1.0
+        if self._Lb is None:
+            self._Lb = _band_factor(self._band, self.bandwidth)
         yb = sla.cho_solve_banded((self._Lb, True), rhs, check_finite=False)
         if not self.n_dense:
             return yb
         xg = -self._Hinv @ (self._E.T @ yb)
         return np.vstack([yb - self._Y @ xg, xg])
+
+
+def _band_factor(band: sp.coo_matrix, w: int) -> Array:
+    """LAPACK's band Cholesky factor (lower band form, (w + 1, n)) of the symmetric matrix
+    whose lower triangle is ``band`` (bandwidth w).
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        When the matrix is not positive definite.
+    """
+    n = band.shape[0]
+    ab = np.zeros((w + 1, n))
+    ab[band.row - band.col, band.col] = band.data
+    return sla.cholesky_banded(ab, lower=True, check_finite=False) if n else ab
 
 
 def _order(S: sp.csr_matrix) -> tuple[Index, int]:
@@ -213,10 +250,8 @@ def banded_inverse(S: sp.spmatrix) -> BandedInverse | None:
     i, j, v = P.row, P.col, P.data
     low = (i >= j) & (i < nb)
     w = int((i[low] - j[low]).max()) if low.any() else 0
-    ab = np.zeros((w + 1, nb))
-    ab[i[low] - j[low], j[low]] = v[low]
-    Lb = sla.cholesky_banded(ab, lower=True, check_finite=False) if nb else ab
-    del ab
+    band = sp.coo_matrix((v[low], (i[low], j[low])), shape=(nb, nb))
+    Lb = _band_factor(band, w)
     g = S.shape[0] - nb
     E = np.zeros((nb, g))
     F = np.zeros((g, g))
@@ -234,6 +269,65 @@ def banded_inverse(S: sp.spmatrix) -> BandedInverse | None:
         Y, Hinv = np.zeros((nb, 0)), np.zeros((0, 0))
     Lt = np.ascontiguousarray(Lb.T)
     Zt = np.zeros_like(Lt)
+    del Lb
     kernel(Lt, Zt)
     del Lt
-    return BandedInverse(perm, nb, Lb, Zt, Y, Hinv, E)
+    return BandedInverse(perm, nb, band, Zt, Y, Hinv, E)
+
+
+def _add_sums(out: Array, by: Index, n: int, Mk: Array, keys: Index, T: Array, o: Index) -> None:
+    """``out[by[i]] += Mk[keys[i]] @ T[o[i]]`` summed over the items i of each ``by`` value,
+    chunk by chunk (the order and grouping of ``_Reducer.sum``, added straight into ``out``:
+    no array of all the sums is formed; the reducer is dropped after)."""
+    red = _Reducer(by, n)
+    ends = np.r_[red.starts[1:], red.n_items] if red.starts.size else red.starts
+    for a, b in zip(red.bounds[:-1], red.bounds[1:]):
+        lo, hi = int(red.starts[a]), int(ends[b - 1])
+        it = red.order[lo:hi]
+        vals = Mk[keys[it]] @ T[o[it]]
+        out[red.keys[a:b]] += np.add.reduceat(vals, red.starts[a:b] - lo, axis=0)
+
+
+def cofactor_sums(
+    plan: EliminationPlan,
+    T: Sequence[Array],
+    Vinv: Array,
+    take: Callable[[Index, Index], Array],
+) -> tuple[Array, list[Array]]:
+    """(inner, cross): the sums of the eliminated blocks' cofactors (:meth:`.schur.
+    ReducedNormal.cofactor`), with ``M`` the inverse reduced matrix (its entries from
+    ``take``, scaled variables) and ``T_o`` (kk, b) the reduced-eliminated products of each
+    occurrence ``o``::
+
+        A_o = sum_{o' at the block of o} M[rows_o, rows_o'] T_o'          (kk, b)
+        inner_p = sum_{o at p} T_o' A_o,    cross_o = -A_o Vinv_p          (b, b), (kk, b)
+
+    so that ``Q_pp = Vinv_p + Vinv_p inner_p Vinv_p`` and ``Q_rp = cross``. The blocks of
+    ``M`` are taken once per pair of signatures (e.g. of images), not per pair of
+    occurrences; ``A`` is summed in place and turned into ``cross`` chunk by chunk, so one
+    array of the size of ``T`` is formed (the peak memory of a large block's covariance), and
+    the sums by occurrence are planned here and dropped after (not kept with the plan).
+    """
+    acc = [np.zeros_like(t) for t in T]
+    for pl in plan.pairs:
+        a, b = plan.sets[pl.s1], plan.sets[pl.s2]
+        r1, r2 = a.rows[pl.key_sig1], b.rows[pl.key_sig2]
+        keys = pl.key_reducer.item_keys
+        Mf = take(r1[:, :, None], r2[:, None, :])  # (n_keys, kk1, kk2)
+        _add_sums(acc[pl.s1], pl.o1, pl.n1, Mf, keys, T[pl.s2], pl.o2)
+        if pl.mirror:  # the reverse pairs (o2, o1): the transposed blocks
+            Mb = take(r2[:, :, None], r1[:, None, :])
+            _add_sums(acc[pl.s2], pl.o2, pl.n2, Mb, keys, T[pl.s1], pl.o1)
+    P, b = plan.P, plan.b
+    inner = np.zeros((P, b, b))
+    flat = np.arange(b * b)
+    for t, A, s in zip(T, acc, plan.sets):
+        part = np.zeros(P * b * b)  # summed in the occurrences' order, as bincount does
+        for lo in range(0, t.shape[0], _OCC_CHUNK):
+            sl = slice(lo, lo + _OCC_CHUNK)
+            pt = s.point[sl]
+            contrib = np.swapaxes(t[sl], 1, 2) @ A[sl]  # (c, b, b)
+            np.add.at(part, (pt[:, None] * (b * b) + flat).ravel(), contrib.ravel())
+            A[sl] = -(A[sl] @ Vinv[pt])
+        inner += part.reshape(P, b, b)
+    return inner, acc
