@@ -89,6 +89,8 @@ def cookbook(problem: BalProblem) -> dict:
 
 
 class _SnavelyModel:
+    fresh_jacobian = True  # a new Jacobian on every call: whitened (or taken) in place
+
     def __call__(self, xl: np.ndarray):
         return snavely_project(xl[:, :9], xl[:, 9:12], joint=True)
 

@@ -35,8 +35,11 @@ _SPARSE_AUTO_MAX_DENSITY = 0.05
 _QXX_CHUNK = 512
 # Largest lambda of Levenberg-Marquardt before the cost is declared irreducible.
 _LAMBDA_MAX = 1e12
-# First lambda after a rejected Gauss-Newton step, and the smallest kept before returning to
-# Gauss-Newton (in the Jacobi-scaled space, where the diagonal of N is one).
+# First lambda after the first rejected Gauss-Newton step: Ceres' initial trust region
+# (radius 1e4, lambda = 1 / radius); the largest damping of a step after which the function
+# tolerance may stop the run; the smallest kept before returning to Gauss-Newton (all in the
+# Jacobi-scaled space, where the diagonal of N is one).
+_LAMBDA_FIRST = 1e-4
 _LAMBDA_START = 1e-3
 _LAMBDA_MIN = 1e-7
 #: The clock of :attr:`_Run.trace` (wall time; a benchmark may set ``time.process_time`` to
@@ -221,7 +224,7 @@ class _Damping:
     """Levenberg-Marquardt state carried from one iteration to the next."""
 
     memory: float = 0.0  # the damping the next iteration starts from (0: Gauss-Newton)
-    good: float = _LAMBDA_START  # the last positive damping that reduced the cost
+    good: float = _LAMBDA_FIRST  # the last positive damping that reduced the cost
     growth: float = 2.0  # growth factor of the damping after rejected steps (Nielsen 1999)
     # Damping below which Gauss-Newton is tried again; lowered after each rejected
     # Gauss-Newton step (nearly singular directions, e.g. points far away, need a little
