@@ -198,6 +198,9 @@ def _prepare_block(block: Block, n: int, names: list[str]) -> _Obs:
     func = block.model if gm else block.condition
     if isinstance(func, _PriorModel) and block.labels is None:
         labels = [names[i] for i in idx[:, 0]]
+    elif block.labels is None:  # the default names, without a call per group
+        name = block.name
+        labels = [f"{name}[{i}]" for i in range(g)]
     else:
         labels = _labels(block.labels, g, lambda i: f"{block.name}[{i}]", where, "labels")
     row_names = _labels(block.row_names, o, str, where, "row_names")
