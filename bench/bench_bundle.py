@@ -29,12 +29,16 @@ import numpy as np
 import scipy
 from lidarphoto.core.geometry.snavely import snavely_project
 from lidarphoto.core.io.bal import BalProblem, read_bal
+from lidarphoto.core.lsq import solve as _solve
 from lidarphoto.core.lsq.adjustment import adjust
 from lidarphoto.core.lsq.model import AdjustmentOptions, Constraint, GaussMarkovBlock
 
 HERE = Path(__file__).resolve().parent
 BAL = HERE.parent.parent / "shared" / "data" / "bal"
 PROBLEMS = ("problem-49-7776-pre.txt", "problem-39-18060-pre.txt")
+# the iteration trace in CPU time (user + sys of the process): on a shared machine the wall
+# time measures the other sessions' load as much as the run
+_solve.TRACE_CLOCK = time.process_time
 
 
 # ----------------------------------------------------------------------------- SciPy cookbook
@@ -67,12 +71,13 @@ def cookbook(problem: BalProblem) -> dict:
         A[2 * rows + 1, nc * 9 + pi * 3 + s] = 1
     x0 = np.hstack([problem.cameras.ravel(), problem.points.ravel()])
     f0 = residuals(x0)
-    t = time.perf_counter()
+    t, cpu = time.perf_counter(), time.process_time()
     res = least_squares(residuals, x0, jac_sparsity=A, verbose=0, x_scale="jac", ftol=1e-4,
                         method="trf")  # fmt: skip
-    elapsed = time.perf_counter() - t
+    elapsed, cpu = time.perf_counter() - t, time.process_time() - cpu
     return {
         "initial": 0.5 * float(f0 @ f0),
+        "cpu_seconds": cpu,
         "final": float(res.cost),
         "seconds": elapsed,
         "nfev": int(res.nfev),
@@ -84,6 +89,8 @@ def cookbook(problem: BalProblem) -> dict:
 
 
 class _SnavelyModel:
+    fresh_jacobian = True  # a new Jacobian on every call: whitened (or taken) in place
+
     def __call__(self, xl: np.ndarray):
         return snavely_project(xl[:, :9], xl[:, 9:12], joint=True)
 
@@ -127,9 +134,9 @@ def engine(problem: BalProblem, tolerance: float = 1e-10, max_iterations: int = 
                              compute_covariance=False, tolerance=tolerance,
                              max_iterations=max_iterations, condition_limit=1e16,
                              function_tolerance=function_tolerance)  # fmt: skip
-    t = time.perf_counter()
+    t, cpu = time.perf_counter(), time.process_time()
     res = adjust(x0, names, [block], [Constraint("gauge", held[None], gauge)], opts)
-    elapsed = time.perf_counter() - t
+    elapsed, cpu = time.perf_counter() - t, time.process_time() - cpu
     v = res.residuals["bal"].v
     r0 = snavely_project(problem.cameras[ci], problem.points[pi], jacobian=False)
     f0 = r0 - problem.observations
@@ -137,6 +144,7 @@ def engine(problem: BalProblem, tolerance: float = 1e-10, max_iterations: int = 
         "initial": 0.5 * float(np.sum(f0**2)),
         "final": 0.5 * res.omega,
         "seconds": elapsed,
+        "cpu_seconds": cpu,
         "iterations": res.iterations,
         "converged": res.converged,
         "rms": float(np.sqrt(np.mean(v**2))),
@@ -147,14 +155,14 @@ def engine(problem: BalProblem, tolerance: float = 1e-10, max_iterations: int = 
 
 
 def seconds_to_cost(run: dict, target: float) -> float:
-    """Seconds of a run of :func:`engine` until its cost first fell to ``target``: the whole
-    run less what followed the first iteration at or below it (conservative: the set-up and
-    the final statistics count in full). NaN when it never got there."""
+    """CPU seconds of a run of :func:`engine` until its cost first fell to ``target``: the
+    whole run less what followed the first iteration at or below it (conservative: the set-up
+    and the final statistics count in full). NaN when it never got there."""
     trace = run["trace"]
     hit = [t for _, c, t in trace if c <= target]
     if not hit:
         return float("nan")
-    return run["seconds"] - (trace[-1][2] - hit[0])
+    return run["cpu_seconds"] - (trace[-1][2] - hit[0])
 
 
 def warm_up() -> None:
@@ -181,44 +189,53 @@ def ceres_program() -> Path:
     return Path(os.environ.get("CERES_BAL", "~/.cache/ceres-bal/ceres_bal")).expanduser()
 
 
+def _child(cmd: list[str], env: dict | None = None) -> tuple[dict, float, float]:
+    """A program's last JSON line, its wall time and its CPU time (user + sys)."""
+    import json
+    import resource
+
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t = time.perf_counter()
+    out = subprocess.run(cmd, capture_output=True, text=True, check=True, env=env)
+    wall = time.perf_counter() - t
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+    return json.loads(out.stdout.strip().splitlines()[-1]), wall, cpu
+
+
 def ceres(path: Path, max_iterations: int = 100) -> dict:
     """Ceres' BAL run (DENSE_SCHUR, one thread) as its JSON, with the whole process's
-    wall time."""
-    import json
-
-    t = time.perf_counter()
-    out = subprocess.run([str(ceres_program()), str(path), "DENSE_SCHUR", "1",
-                          str(max_iterations)], capture_output=True, text=True,
-                         check=True)  # fmt: skip
-    d = json.loads(out.stdout.strip().splitlines()[-1])
-    d["process_s"] = time.perf_counter() - t
+    wall and CPU time."""
+    d, d["process_s"], d["process_cpu_s"] = _child(
+        [str(ceres_program()), str(path), "DENSE_SCHUR", "1", str(max_iterations)]
+    )
     return d
 
 
 def ours_process(path: Path) -> dict:
-    """:func:`ours_json` in a fresh process, with the whole process's wall time."""
-    import json
-
-    t = time.perf_counter()
-    out = subprocess.run([sys.executable, __file__, "ours", str(path)], capture_output=True,
-                         text=True, check=True, env=dict(os.environ))  # fmt: skip
-    d = json.loads(out.stdout.strip().splitlines()[-1])
-    d["process_s"] = time.perf_counter() - t
+    """:func:`ours_json` in a fresh process, with the whole process's wall and CPU time."""
+    d, d["process_s"], d["process_cpu_s"] = _child(
+        [sys.executable, __file__, "ours", str(path)], dict(os.environ)
+    )
     return d
 
 
 def against_ceres(path: Path, repeats: int = 3) -> dict:
-    """Interleaved runs (ours, Ceres, ours, Ceres, ...): per pair the ratios of the time to
-    Ceres' final cost and of the whole solve; medians over the pairs."""
+    """Interleaved runs (ours, Ceres, ours, Ceres, ...): per pair the CPU-time ratios of the
+    time to Ceres' final cost, of the whole solve and of the whole process; medians over the
+    pairs, with the load average before each pair."""
     pairs = []
     for _ in range(repeats):
+        load = os.getloadavg()[0]
         o = ours_process(path)
         c = ceres(path)
         to = seconds_to_cost(o, c["final_cost"])
-        pairs.append({"ours": o, "ceres": c, "to_cost": to / c["solve_wall_s"],
-                      "whole": o["seconds"] / c["solve_wall_s"],
-                      "process": o["process_s"] / c["process_s"]})  # fmt: skip
-    med = {k: float(np.median([p[k] for p in pairs])) for k in ("to_cost", "whole", "process")}
+        pairs.append({"ours": o, "ceres": c, "to_cost": to / c["solve_cpu_s"],
+                      "whole": o["cpu_seconds"] / c["solve_cpu_s"],
+                      "process": o["process_cpu_s"] / c["process_cpu_s"],
+                      "wall": o["seconds"] / c["solve_wall_s"], "load": load})  # fmt: skip
+    keys = ("to_cost", "whole", "process", "wall", "load")
+    med = {k: float(np.median([p[k] for p in pairs])) for k in keys}
     return {"pairs": pairs, **med}
 
 
@@ -268,7 +285,7 @@ def large(covariance: bool, strips: int = 25, n_tie: int = 200000) -> dict:
 # ----------------------------------------------------------------------------- report
 
 
-def main(what: str = "all") -> None:
+def main(what: str = "all", repeats: int = 3) -> None:
     head = [
         f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()} ({os.cpu_count()} cores, "
         f"shared), Python {platform.python_version()}, numpy {np.__version__}, scipy "
@@ -277,7 +294,7 @@ def main(what: str = "all") -> None:
         "",
     ]
     if what in ("ceres", "all"):
-        write_section(HERE / "bundle.md", "ceres", "\n".join(head + ceres_section()))
+        write_section(HERE / "bundle.md", "ceres", "\n".join(head + ceres_section(repeats)))
     if what in ("bal", "all"):
         lines = [
             *head,
@@ -288,7 +305,8 @@ def main(what: str = "all") -> None:
             "Ours: analytic Jacobians, points eliminated (reduced camera system), "
             "Levenberg-Marquardt, 40 iterations (BAL's nearly unobservable points keep drifting "
             "at tiny gains in cost, so neither solver converges in the strict sense); 'ours to "
-            "SciPy's cost' is the time until our cost first fell to SciPy's final cost.",
+            "SciPy's cost' is the CPU time until our cost first fell to SciPy's final cost; the "
+            "speed-ups are ratios of CPU time.",
             "",
             "| problem | residuals | initial cost | SciPy final cost | SciPy s (evals) | "
             "ours final cost | ours s (iterations) | ours to SciPy's cost s | speed-up (to "
@@ -308,8 +326,8 @@ def main(what: str = "all") -> None:
                 f"| {name} | {2 * prob.camera_index.size} | {ours['initial']:.6e} | "
                 f"{sc['final']:.6e} | {sc['seconds']:.1f} ({sc['nfev']}) | {ours['final']:.6e} | "
                 f"{ours['seconds']:.2f} ({ours['iterations']}) | {to['seconds_to_target']:.2f} | "
-                f"{sc['seconds'] / to['seconds_to_target']:.0f}x | "
-                f"{sc['seconds'] / ours['seconds']:.0f}x |"
+                f"{sc['cpu_seconds'] / to['seconds_to_target']:.0f}x | "
+                f"{sc['cpu_seconds'] / ours['cpu_seconds']:.0f}x |"
             )
             print(lines[-1], flush=True)
         lines.append("")
@@ -349,7 +367,7 @@ def main(what: str = "all") -> None:
         write_section(HERE / "bundle.md", "large", "\n".join(lines))
 
 
-def ceres_section() -> list[str]:
+def ceres_section(repeats: int = 3) -> list[str]:
     """The comparison with Ceres (see :func:`against_ceres`), as Markdown lines."""
     lines = [
         "### BAL problems: our engine against Ceres Solver, same start, interleaved runs",
@@ -359,34 +377,47 @@ def ceres_section() -> list[str]:
         "gradient 1e-10, parameter 1e-8). Ours: analytic Jacobians, points eliminated (reduced "
         "camera system), Levenberg-Marquardt, the default stopping rules (function tolerance "
         "1e-6, then one Gauss-Newton step), at most 100 iterations, the compiled kernels "
-        "loaded before the run (numba's cache: about 1.5 s once per process, in the "
-        "whole-process column). Runs alternate ours / Ceres, three pairs; the ratios are "
-        "taken pair by pair, medians. 'to Ceres' cost' is our time until our cost first "
-        "fell to Ceres' final cost, over Ceres' whole solve.",
+        "loaded before the run (numba's cache: once per process, in the whole-process "
+        f"column). Runs alternate ours / Ceres, {repeats} pairs; the ratios are CPU time (user "
+        "+ sys: on a shared machine the wall time measures the others' load), taken pair by "
+        "pair, medians. 'to Ceres' cost' is our CPU time until our cost first fell to Ceres' "
+        "final cost, over Ceres' whole solve; the wall-time ratio of the whole solve and the "
+        "load average (median of the pairs' starts) are given for reference.",
         "",
         "| problem | Ceres final cost (iterations) | ours final cost (iterations, stopped by) | "
-        "Ceres solve s | ours s | ours / Ceres to Ceres' cost | ours / Ceres whole solve | "
-        "ours / Ceres whole process |",
-        "|---|---|---|---|---|---|---|---|",
+        "Ceres solve CPU s | ours CPU s | ours / Ceres to Ceres' cost | ours / Ceres whole "
+        "solve | ours / Ceres whole process | wall ratio, whole solve | load |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     if not ceres_program().is_file():
-        return [*lines, "| (no Ceres program at $CERES_BAL) | | | | | | | |", ""]
+        return [*lines, "| (no Ceres program at $CERES_BAL) | | | | | | | | | |", ""]
+    per_pair = []
     for name in PROBLEMS:
         path = BAL / name
         if not path.is_file():
-            lines.append(f"| {name} | missing | | | | | | |")
+            lines.append(f"| {name} | missing | | | | | | | | |")
             continue
-        r = against_ceres(path)
+        r = against_ceres(path, repeats)
         o, c = r["pairs"][0]["ours"], r["pairs"][0]["ceres"]
-        cs = float(np.median([p["ceres"]["solve_wall_s"] for p in r["pairs"]]))
-        os_ = float(np.median([p["ours"]["seconds"] for p in r["pairs"]]))
+        cs = float(np.median([p["ceres"]["solve_cpu_s"] for p in r["pairs"]]))
+        os_ = float(np.median([p["ours"]["cpu_seconds"] for p in r["pairs"]]))
         lines.append(
             f"| {name} | {c['final_cost']:.2f} ({c['iterations']}) | {o['final']:.2f} "
             f"({o['iterations']}, {o['termination']}) | {cs:.2f} | {os_:.2f} | "
-            f"{r['to_cost']:.2f} | {r['whole']:.2f} | {r['process']:.2f} |"
+            f"{r['to_cost']:.2f} | {r['whole']:.2f} | {r['process']:.2f} | {r['wall']:.2f} | "
+            f"{r['load']:.1f} |"
         )
         print(lines[-1], flush=True)
-    return [*lines, ""]
+        per_pair.append(
+            f"{name}: to Ceres' cost "
+            + ", ".join(f"{p['to_cost']:.2f}" for p in r["pairs"])
+            + "; whole solve "
+            + ", ".join(f"{p['whole']:.2f}" for p in r["pairs"])
+            + "; final costs "
+            + ", ".join(f"{p['ours']['final']:.2f}" for p in r["pairs"])
+            + "."
+        )
+    return [*lines, "", "Pair by pair (ours / Ceres, CPU): " + " ".join(per_pair), ""]
 
 
 def write_section(path: Path, name: str, text: str) -> None:
@@ -405,4 +436,4 @@ if __name__ == "__main__":
     if len(sys.argv) > 2 and sys.argv[1] == "ours":
         print(ours_json(Path(sys.argv[2])), flush=True)
     else:
-        main(sys.argv[1] if len(sys.argv) > 1 else "all")
+        main(sys.argv[1] if len(sys.argv) > 1 else "all", *(int(a) for a in sys.argv[2:3]))

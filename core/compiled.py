@@ -127,13 +127,27 @@ def cached_njit(func: Callable[..., Any], **options: Any) -> Callable[..., Any]:
 _KERNELS: dict[Callable[..., Any], Callable[..., Any]] = {}
 
 
-def compiled_kernel(func: Callable[..., Any]) -> Callable[..., Any] | None:
+def compiled_kernel(
+    func: Callable[..., Any], helpers: tuple[Callable[..., Any], ...] = ()
+) -> Callable[..., Any] | None:
     """``func`` compiled once per process (:func:`cached_njit`, ``nogil``), or None without
     numba: for modules that stay light until a kernel is first asked for (they import this
-    function inside theirs)."""
+    function inside theirs).
+
+    ``helpers``: plain functions of ``func``'s module that it calls by name (one routine
+    that several kernels share instead of each writing it out); each is compiled once (the
+    same way) and put in place of its name in the module's globals before ``func`` is
+    compiled, so that the kernel calls compiled code.
+    """
     if not AVAILABLE:
         return None
     if func not in _KERNELS:
+        space = func.__globals__
+        for helper in helpers:
+            plain = getattr(helper, "py_func", helper)  # named again once put in place
+            if plain not in _KERNELS:
+                _KERNELS[plain] = cached_njit(plain, nogil=True)
+            space[plain.__name__] = _KERNELS[plain]
         _KERNELS[func] = cached_njit(func, nogil=True)
     return _KERNELS[func]
 

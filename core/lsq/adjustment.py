@@ -36,7 +36,8 @@ models), which is what the step acceptance compares.
 Each iteration computes the Gauss-Newton step; with ``damping`` it is kept only when it does
 not increase the cost, otherwise Levenberg-Marquardt steps ``(N_s + lambda I) z = -n_s``
 (Marquardt's scaling: ``lambda diag(N)`` in the original variables) are tried with growing
-``lambda`` (doubling factors after each rejection). The next iteration starts from the
+``lambda`` (from 1e-4, Ceres' initial trust region, then the last that worked; doubling
+factors after each rejection). The next iteration starts from the
 ``lambda`` that worked, reduced by Nielsen's (1999) rule from the gain ratio (by ten when the
 quadratic model predicted the decrease well), and Gauss-Newton is tried again once it falls
 below 1e-7 (lowered a hundredfold after each rejected Gauss-Newton step, so that nearly

@@ -54,6 +54,8 @@ class _Obs:
     # 6 x 6 (X0, u)), when the others are at most half: products with cov and weight then take
     # those rows as a diagonal scaling and only the rest as a matrix (see :meth:`times_cov`).
     sparse_rows: tuple[NDArray[np.intp], NDArray[np.intp]] | None = None
+    # every sigma is one (inv_sigma all ones): the whitening is the identity
+    unit_sigma: bool = False
 
     @property
     def groups(self) -> int:
@@ -196,6 +198,9 @@ def _prepare_block(block: Block, n: int, names: list[str]) -> _Obs:
     func = block.model if gm else block.condition
     if isinstance(func, _PriorModel) and block.labels is None:
         labels = [names[i] for i in idx[:, 0]]
+    elif block.labels is None:  # the default names, without a call per group
+        name = block.name
+        labels = [f"{name}[{i}]" for i in range(g)]
     else:
         labels = _labels(block.labels, g, lambda i: f"{block.name}[{i}]", where, "labels")
     row_names = _labels(block.row_names, o, str, where, "row_names")
@@ -214,6 +219,7 @@ def _prepare_block(block: Block, n: int, names: list[str]) -> _Obs:
         c=o if gm else None,
         inv_sigma=inv_sigma,
         sparse_rows=sparse_rows,
+        unit_sigma=inv_sigma is not None and bool((inv_sigma == 1.0).all()),
     )
 
 
@@ -356,7 +362,10 @@ class _Problem:
             _check_finite(b.name, b.labels, f, J)
             # B = -I: w = f - l does not depend on v^, and L is the Cholesky factor of S.
             if b.inv_sigma is not None:  # uncorrelated observations: L^-1 is diagonal
-                if getattr(b.func, "fresh_jacobian", False) and J.flags.writeable:
+                fresh = getattr(b.func, "fresh_jacobian", False) and J.flags.writeable
+                if b.unit_sigma:  # L = I: a fresh J is taken as it is, another one copied
+                    return _BlockLin(abar=J if fresh else J.copy(), wbar=f - b.observed, K=-b.chol)
+                if fresh:
                     # the model hands over a new J on every call: whitened in place
                     abar = np.multiply(J, b.inv_sigma[:, :, None], out=J)
                 else:

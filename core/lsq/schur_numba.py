@@ -128,6 +128,34 @@ def normal_sums(
     return U, V, g_e, T
 
 
+def _inverse_factor(V, p, lam, L, Li):  # pragma: no cover - compiled
+    """``Li[p]``: the inverse of the lower Cholesky factor ``L`` of ``V[p] + lam I`` (``L``
+    a b x b work array); False when that block is not positive definite. Shared by the
+    kernels below (``compiled_kernel(..., helpers=(_inverse_factor,))``)."""
+    b = V.shape[1]
+    for i in range(b):
+        for j in range(i + 1):
+            s = V[p, i, j] + (lam if i == j else 0.0)
+            for m in range(j):
+                s -= L[i, m] * L[j, m]
+            if i == j:
+                if not s > 0.0:
+                    return False
+                L[i, i] = np.sqrt(s)
+            else:
+                L[i, j] = s / L[j, j]
+    for j in range(b):
+        for i in range(b):
+            if i < j:
+                Li[p, i, j] = 0.0
+                continue
+            s = 1.0 if i == j else 0.0
+            for m in range(j, i):
+                s -= L[i, m] * Li[p, m, j]
+            Li[p, i, j] = s / L[i, i]
+    return True
+
+
 def _dense_kernel(
     V, lam, g_e, T, order, start, osig, srows, base, K, rhs, Li, y
 ):  # pragma: no cover - compiled
@@ -141,27 +169,9 @@ def _dense_kernel(
     L = np.empty((b, b))
     t = np.empty(b)
     for p in range(P):
-        # Cholesky factor of V_p + lam I and its inverse (lower triangular)
-        for i in range(b):
-            for j in range(i + 1):
-                s = V[p, i, j] + (lam if i == j else 0.0)
-                for m in range(j):
-                    s -= L[i, m] * L[j, m]
-                if i == j:
-                    if not s > 0.0:
-                        return 1
-                    L[i, i] = np.sqrt(s)
-                else:
-                    L[i, j] = s / L[j, j]
-        for j in range(b):
-            for i in range(b):
-                if i < j:
-                    Li[p, i, j] = 0.0
-                    continue
-                s = 1.0 if i == j else 0.0
-                for m in range(j, i):
-                    s -= L[i, m] * Li[p, m, j]
-                Li[p, i, j] = s / L[i, i]
+        # the inverse Cholesky factor of V_p + lam I (lower triangular)
+        if not _inverse_factor(V, p, lam, L, Li):
+            return 1
         # y_p = (V_p + lam I)^-1 g_e,p = Li' Li g_e,p
         for i in range(b):
             s = 0.0
@@ -250,7 +260,7 @@ def dense_reduced(
     point block is not positive definite; None without numba."""
     from ..compiled import compiled_kernel
 
-    kernel = compiled_kernel(_dense_kernel)
+    kernel = compiled_kernel(_dense_kernel, helpers=(_inverse_factor,))
     if kernel is None:
         return None
     P, b = V.shape[0], V.shape[1]
@@ -380,26 +390,8 @@ def _factors_kernel(V, lam, Li, Vinv):  # pragma: no cover - compiled
     P, b = V.shape[0], V.shape[1]
     L = np.empty((b, b))
     for p in range(P):
-        for i in range(b):
-            for j in range(i + 1):
-                s = V[p, i, j] + (lam if i == j else 0.0)
-                for m in range(j):
-                    s -= L[i, m] * L[j, m]
-                if i == j:
-                    if not s > 0.0:
-                        return p + 1
-                    L[i, i] = np.sqrt(s)
-                else:
-                    L[i, j] = s / L[j, j]
-        for j in range(b):
-            for i in range(b):
-                if i < j:
-                    Li[p, i, j] = 0.0
-                    continue
-                s = 1.0 if i == j else 0.0
-                for m in range(j, i):
-                    s -= L[i, m] * Li[p, m, j]
-                Li[p, i, j] = s / L[i, i]
+        if not _inverse_factor(V, p, lam, L, Li):
+            return p + 1
         for i in range(b):  # Vinv = Li' Li
             for j in range(b):
                 s = 0.0
@@ -415,7 +407,7 @@ def point_factors(V: Array, lam: float) -> tuple[Array, Array] | int | None:
     instead; None without numba."""
     from ..compiled import compiled_kernel
 
-    kernel = compiled_kernel(_factors_kernel)
+    kernel = compiled_kernel(_factors_kernel, helpers=(_inverse_factor,))
     if kernel is None:
         return None
     Li = np.empty_like(V)

@@ -450,6 +450,40 @@ def test_compiled_dense_reduced_system_with_scattered_rows():
     assert_allclose(ze, np.einsum("pij,pj->pi", Vinv, acc), rtol=1e-12, atol=1e-12)
 
 
+def test_compiled_point_factors_share_the_dense_kernels_factorisation():
+    """The point factors (core/lsq/schur_numba.py) and the dense reduced system compute the
+    inverse Cholesky factors of ``V_p + lam I`` with one compiled helper: both equal numpy's
+    (lower triangular, ``Li' Li`` the inverse), the same to the last bit in both kernels;
+    a block that is not positive definite is named (1-based) or refused."""
+    pytest.importorskip("numba")
+    from lidarphoto.core.lsq.schur_numba import dense_reduced, point_factors
+
+    rng = np.random.default_rng(11)
+    P, b, lam = 40, 3, 0.25
+    A = rng.normal(size=(P, b, b))
+    V = A @ np.swapaxes(A, 1, 2) + 0.1 * np.eye(b)
+    got = point_factors(V, lam)
+    assert isinstance(got, tuple)
+    Li, Vinv = got
+    L = np.linalg.cholesky(V + lam * np.eye(b))
+    assert_allclose(Li, np.linalg.inv(L), rtol=1e-12, atol=1e-12)
+    assert_allclose(Vinv, np.linalg.inv(V + lam * np.eye(b)), rtol=1e-10, atol=1e-12)
+    assert (np.triu(Li, 1) == 0.0).all()
+    point = np.arange(P, dtype=np.intp)
+    srows = np.arange(2, dtype=np.intp)[None, :]
+    T = rng.normal(size=(P, 2, b))
+    start = np.arange(P + 1, dtype=np.intp)
+    Li2, _ = dense_reduced(V, lam, np.zeros((P, b)), T, point, start, np.zeros(P, np.intp),
+                           srows, np.zeros((2, 2)), np.zeros(2))  # fmt: skip
+    np.testing.assert_array_equal(Li2, Li)
+    bad = V.copy()
+    bad[17] = -np.eye(b)
+    assert point_factors(bad, 0.0) == 18
+    with pytest.raises(ValueError):
+        dense_reduced(bad, 0.0, np.zeros((P, b)), T, point, start, np.zeros(P, np.intp),
+                      srows, np.zeros((2, 2)), np.zeros(2))  # fmt: skip
+
+
 @pytest.mark.parametrize("dense_min", [0, 10**9])
 def test_banded_selected_inverse_equals_the_dense_inverse(monkeypatch, dense_min):
     """The cofactor blocks from the band factor (Takahashi's recurrence, the interior
