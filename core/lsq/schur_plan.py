@@ -160,24 +160,6 @@ class _PairList:
     n1: int  # occurrences in s1 and s2
     n2: int
     mirror: bool = True
-    _o1_reducer: _Reducer | None = None
-    _o2_reducer: _Reducer | None = None
-
-    @property
-    def o1_reducer(self) -> _Reducer:
-        """By o1 (for the cofactor; made on first use)."""
-        if self._o1_reducer is None:
-            self._o1_reducer = _Reducer(self.o1, self.n1)
-        return self._o1_reducer
-
-    @property
-    def o2_reducer(self) -> _Reducer | None:
-        """By o2 for mirrored lists (the reverse direction), else None."""
-        if not self.mirror:
-            return None
-        if self._o2_reducer is None:
-            self._o2_reducer = _Reducer(self.o2, self.n2)
-        return self._o2_reducer
 
 
 def _pairs(pa: Index, pb: Index) -> tuple[Index, Index]:
