@@ -50,6 +50,9 @@ ROUND_COLUMNS = (
     "change_d_phi_arcsec",
     "change_d_kappa_arcsec",
     "rejected",
+    "line_sigma_scale",
+    "segment_offset_sigma_px",
+    "segment_tilt_sigma_px",
 )
 
 SPEC = AlgorithmSpec(
@@ -501,6 +504,7 @@ def _round_rows(found) -> list[tuple[str, ...]]:
                         *np.degrees(r.std[g]) * 3600,
                         *np.degrees(r.change[g]) * 3600,
                         r.rejected,
+                        *(r.weights if r.weights is not None else ("", "", "")),
                     )
                 )
             )

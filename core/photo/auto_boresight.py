@@ -52,6 +52,7 @@ from .auto_ties import REASONS, associate_ties
 from .boresight import calibrate
 from .boresight_options import BoresightOptions
 from .boresight_result import BoresightResult
+from .boresight_weights import line_variances
 from .georeference import Trajectory, direct_georeference
 from .ins import ins_grade
 from .mount import Mount
@@ -69,6 +70,9 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
+#: the rounds stop when the line points' variance components also changed by less than this
+#: factor (and the boresight by less than its sigma)
+WEIGHTS_SETTLED = 1.25
 Images = Sequence[tuple[str, ArrayLike]]
 
 
@@ -96,6 +100,11 @@ class RoundRecord:
     change: Array
     rejected: int
     lines_refused: dict[str, int] = field(default_factory=dict)
+    #: the line points' weighting of the round (:class:`.boresight_weights.LineVariances`: the
+    #: factor on their sigma_px, the segments' offset and tilt sigmas) and the variances the
+    #: round's residuals gave (the next round's); None without segment nuisances
+    weights: tuple[float, float, float] | None = None
+    estimated: tuple[float, float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -455,6 +464,26 @@ def _round_observations(images, cam, eo, lines, ties, planes, dsm, opt, search_p
     )
 
 
+def _settled(used, estimated, negligible: float) -> bool:
+    """Whether the line points' variance components settled: each changed by less than the
+    factor :data:`WEIGHTS_SETTLED`, or a segment sigma stayed below ``negligible`` px (the
+    points' sigma floor: the iteration creeps towards zero there)."""
+    for j, (a, b) in enumerate(zip(used, estimated)):
+        if j and max(a, b) <= negligible:
+            continue
+        if abs(np.log(b / a)) >= np.log(WEIGHTS_SETTLED):
+            return False
+    return True
+
+
+def _scaled(obs: ImageObservations, scale: float) -> ImageObservations:
+    """``obs`` with the sigma_px of its line points multiplied by ``scale``."""
+    if scale == 1.0:
+        return obs
+    line = np.array([t == "line" for t in obs.type], bool)
+    return replace(obs, sigma_px=np.where(line, obs.sigma_px * scale, obs.sigma_px))
+
+
 def _round_record(k, search_px, gate, line_obs, obs, n_tracks, refused, result, change, lines):
     """The :class:`RoundRecord` of round ``k`` (counts, the boresight, its change)."""
     tie_ids = {p for p, t in zip(obs.point_id, obs.type) if t == "tie"}
@@ -527,7 +556,7 @@ def auto_calibrate(
         raise SceneNotObservable(why)
     images = list(images)
     base = calibration or BoresightOptions()
-    cal = replace(base, use_types=("tie", "line"))
+    cal = replace(base, use_types=("tie", "line"), snooping_per_group=opt.segment_sigma_px > 0)
     grade = ins_grade(base.ins_grade) if isinstance(base.ins_grade, str) else base.ins_grade
     att_sigma = np.radians(max(grade.sigma_roll_pitch_deg, grade.sigma_heading_deg))
     searched = search_boresight(
@@ -545,6 +574,7 @@ def auto_calibrate(
     cam = camera  # with the interior estimated, the last round's (and the lever arm's)
     last = np.asarray(searched, float)[None, :]
     result, obs, converged = None, None, False
+    weights = (1.0, opt.segment_sigma_px, opt.segment_sigma_px)  # sigma scale, offset, tilt
     for r in range(int(opt.max_rounds)):
         stop_if_asked(should_stop, "the automatic calibration")
         spread = float(np.hypot(bore_sigma, att_sigma))
@@ -561,6 +591,7 @@ def auto_calibrate(
                 f"on a roof plane (round {r + 1}, search {search_px:.1f} px): the approximate "
                 "boresight or the mount is too far off, or the lines are not in the images"
             )
+        obs = _scaled(obs, weights[0])
         result = calibrate(
             trajectory,
             cam,
@@ -569,28 +600,26 @@ def auto_calibrate(
             obs,
             planes,
             lines,
-            options=cal,
+            options=replace(cal, line_segment_sigmas_px=weights[1:]),
             progress=_share(progress, lo + half, lo + 2 * half),
             should_stop=should_stop,
         )
         change = result.boresight - last
-        rounds.append(
-            _round_record(
-                r + 1,
-                search_px,
-                gate,
-                line_obs,
-                obs,
-                n_tracks,
-                refused,
-                result,
-                change,
-                line_refused,
-            )
+        used, estimated = weights, None
+        if opt.segment_sigma_px > 0:
+            v = line_variances(result, weights[1:])
+            estimated = (weights[0] * v.scale, max(v.offset_px, 0.01), max(v.tilt_px, 0.01))
+        record = _round_record(
+            *(r + 1, search_px, gate, line_obs, obs, n_tracks, refused, result, change),
+            line_refused,
         )
+        rounds.append(replace(record, weights=used if estimated else None, estimated=estimated))
+        if estimated:
+            weights = estimated
         if progress:
             progress(0.3 + 0.7 * (r + 1) / opt.max_rounds)
-        if r >= 1 and bool(np.all(np.abs(change) < result.std)):
+        settled = estimated is None or _settled(used, estimated, opt.lines.min_sigma_px)
+        if r >= 1 and settled and bool(np.all(np.abs(change) < result.std)):
             converged = True
             break
         last = result.boresight.copy()
