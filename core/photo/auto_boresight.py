@@ -23,8 +23,18 @@ boresight and the LiDAR roof planes and lines (mapping CRS), without any hand-pi
    tracks (optional input) are associated with roof planes within a gate of 3 sigma
    (:func:`.auto_ties.associate_ties`), and :func:`.boresight.calibrate` (robust stage and
    data snooping) adjusts them. The next round starts from the adjusted orientation; the
-   rounds stop when every boresight angle changed by less than its standard deviation (after
-   at least two rounds) or after ``max_rounds``.
+   rounds stop when every boresight angle changed by less than its standard deviation and
+   the line points' variance components settled (after at least two rounds) or after
+   ``max_rounds``.
+4. Weighting of the line points: the points of one line in one image (a segment) share an
+   error (the edge against the LiDAR line as seen from that image) that the sigma of the
+   segment's own straight fit cannot carry. Each segment gets an offset and a tilt across
+   the line as nuisance unknowns with priors (``BoresightOptions.line_segment_sigmas_px``;
+   ``segment_sigma_px`` in the first round), and after each round the three variance
+   components (the points' sigma scale, the offsets' and the tilts' sigma) are re-estimated
+   from the residuals (:mod:`.boresight_weights`) for the next. Data snooping then tests a
+   line's group at its significance per group (Bonferroni over its rows): a line of
+   hundreds of points is not set aside for the largest of hundreds of normal residuals.
 
 Angles are radians inside, pixel quantities (col, row) per docs/conventions.md.
 """

@@ -29,6 +29,11 @@ CFG = FlightConfig(
 )
 
 
+def _options(**kw) -> BoresightOptions:
+    """The calibration of the lines with the simulation's INS grade."""
+    return BoresightOptions(use_types=("line",), ins_grade=CFG.ins_grade, **kw)
+
+
 def _with_segment_errors(sim, rng):
     """The simulation's line points plus a common offset a and tilt b per segment (both
     N(0, SEGMENT_PX^2)) across the segment's image line: a + b tau, tau -1..1 along it
@@ -56,7 +61,7 @@ def _estimated(sim, sigmas=(0.1, 0.1), rounds=5, **kw):
     scale = 1.0
     for _ in range(rounds):
         obs = replace(sim.observations, sigma_px=sim.observations.sigma_px * scale)
-        opts = BoresightOptions(use_types=("line",), line_segment_sigmas_px=sigmas, **kw)
+        opts = _options(line_segment_sigmas_px=sigmas, **kw)
         res = replace(sim, observations=obs).calibrate(opts)
         v = line_variances(res, sigmas)
         scale, sigmas = scale * v.scale, (v.offset_px, v.tilt_px)
@@ -72,7 +77,7 @@ def test_independent_weighting_rejects_good_lines(flight):
     """The points weighted as independent at their own 0.1 px: sigma0 far above 1 and data
     snooping sets whole lines aside, though none has a gross error."""
     sim, _ = flight
-    res = sim.calibrate(BoresightOptions(use_types=("line",), snooping_per_group=True))
+    res = sim.calibrate(_options(snooping_per_group=True))
     n = len(sim.observations)
     print("independent: sigma0", res.sigma0, "rejected", int(res.residuals.rejected.sum()), n)
     assert res.residuals.rejected.sum() > 0.2 * n
@@ -109,7 +114,7 @@ def test_sigmas_honest_over_draws_and_independent_ones_not():
         )
         res, *_ = _estimated(sim, rounds=4, snooping=False)
         z_new.append((res.boresight - sim.true_boresight(res.groups)) / res.std)
-        old = sim.calibrate(BoresightOptions(use_types=("line",), snooping=False))
+        old = sim.calibrate(_options(snooping=False))
         z_old.append((old.boresight - sim.true_boresight(old.groups)) / old.std)
     chi_new, chi_old = float(np.sum(np.square(z_new))), float(np.sum(np.square(z_old)))
     print("chi2 (72 dof): segment nuisances", chi_new, "independent", chi_old)
