@@ -422,6 +422,10 @@ def _settings(v, cam, traj, found, frame, grade, detected) -> dict[str, str]:
             f"on {r.lines_seen} lines; tie tracks {r.tie_tracks}, on planes {r.ties_associated}"
             f", refused: {refused}; rejected by the adjustment {r.rejected}"
         )
+        if r.weights is not None:
+            s[f"round {r.round}"] += (
+                "; line points' sigma x {:.3f}, segment offset / tilt sigma {:.3f} / {:.3f} px"
+            ).format(*r.weights)
     if detected is not None:
         s["tie points found"] = detected
     s["line points per image"] = ", ".join(f"{k} {n}" for k, n in found.per_image.items())
