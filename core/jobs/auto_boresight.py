@@ -50,6 +50,9 @@ ROUND_COLUMNS = (
     "change_d_phi_arcsec",
     "change_d_kappa_arcsec",
     "rejected",
+    "line_sigma_scale",
+    "segment_offset_sigma_px",
+    "segment_tilt_sigma_px",
 )
 
 SPEC = AlgorithmSpec(
@@ -419,6 +422,10 @@ def _settings(v, cam, traj, found, frame, grade, detected) -> dict[str, str]:
             f"on {r.lines_seen} lines; tie tracks {r.tie_tracks}, on planes {r.ties_associated}"
             f", refused: {refused}; rejected by the adjustment {r.rejected}"
         )
+        if r.weights is not None:
+            s[f"round {r.round}"] += (
+                "; line points' sigma x {:.3f}, segment offset / tilt sigma {:.3f} / {:.3f} px"
+            ).format(*r.weights)
     if detected is not None:
         s["tie points found"] = detected
     s["line points per image"] = ", ".join(f"{k} {n}" for k, n in found.per_image.items())
@@ -501,6 +508,7 @@ def _round_rows(found) -> list[tuple[str, ...]]:
                         *np.degrees(r.std[g]) * 3600,
                         *np.degrees(r.change[g]) * 3600,
                         r.rejected,
+                        *(r.weights if r.weights is not None else ("", "", "")),
                     )
                 )
             )

@@ -227,6 +227,12 @@ class AdjustmentOptions:
     snooping_blocks : sequence of str or None
         Names of the blocks whose groups data snooping may reject; None: every block. The
         others are tested (their w is reported) but never removed.
+    snooping_per_group : bool
+        Data snooping at ``snooping_alpha`` per group instead of per observation: a group of
+        o observation rows is set aside when its largest |w| exceeds the normal quantile of
+        ``1 - snooping_alpha / (2 o)`` (Bonferroni over its rows: a good group is rejected
+        with probability at most ``snooping_alpha``), so that a group of hundreds of rows (a
+        LiDAR line's points) is not rejected by chance.
     """
 
     max_iterations: int = 50
@@ -248,3 +254,4 @@ class AdjustmentOptions:
     robust_iterations: int = 20
     robust_blocks: Sequence[str] | None = None
     snooping_blocks: Sequence[str] | None = None
+    snooping_per_group: bool = False

@@ -12,6 +12,7 @@ from typing import Callable
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import special
 
 from ..errors import InputError, NotObservableError
 from ..i18n import mark as _t
@@ -30,15 +31,20 @@ _ROBUST_K = {"huber": 1.5, "cauchy": 2.385}
 
 
 def _worst(
-    result: AdjustmentResult, blocks: Sequence[str] | None = None
+    result: AdjustmentResult,
+    blocks: Sequence[str] | None = None,
+    scale: Sequence[float] | None = None,
 ) -> tuple[int, int, int, float] | None:
     """(block number, group, row, w) of the largest |w| among the groups kept (of the named
-    blocks only, when given)."""
+    blocks only, when given); with ``scale`` (per block), of the largest ``|w| / scale``, the
+    value returned."""
     best = None
     for bi, (name, table) in enumerate(result.residuals.items()):
         if blocks is not None and name not in blocks:
             continue
         w = np.where(table.rejected[:, None], np.nan, np.abs(table.w))
+        if scale is not None:
+            w = w / scale[bi]
         if w.size == 0 or not np.isfinite(w).any():
             continue
         flat = int(np.nanargmax(w))
@@ -243,8 +249,12 @@ def _snoop(
         return result
     obs = problem.blocks
     round_no = 0
+    scale = None  # per group: each block's critical value over the per-observation one
+    if opts.snooping_per_group:
+        alpha = opts.snooping_alpha
+        scale = [float(special.ndtri(1 - alpha / (2 * max(int(b.o), 1)))) / crit for b in obs]
     while True:
-        worst = _worst(result, opts.snooping_blocks)
+        worst = _worst(result, opts.snooping_blocks, scale)
         if worst is None or worst[3] <= crit:
             break
         if len(rejected) >= opts.max_rejections:

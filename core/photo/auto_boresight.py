@@ -23,8 +23,18 @@ boresight and the LiDAR roof planes and lines (mapping CRS), without any hand-pi
    tracks (optional input) are associated with roof planes within a gate of 3 sigma
    (:func:`.auto_ties.associate_ties`), and :func:`.boresight.calibrate` (robust stage and
    data snooping) adjusts them. The next round starts from the adjusted orientation; the
-   rounds stop when every boresight angle changed by less than its standard deviation (after
-   at least two rounds) or after ``max_rounds``.
+   rounds stop when every boresight angle changed by less than its standard deviation and
+   the line points' variance components settled (after at least two rounds) or after
+   ``max_rounds``.
+4. Weighting of the line points: the points of one line in one image (a segment) share an
+   error (the edge against the LiDAR line as seen from that image) that the sigma of the
+   segment's own straight fit cannot carry. Each segment gets an offset and a tilt across
+   the line as nuisance unknowns with priors (``BoresightOptions.line_segment_sigmas_px``;
+   ``segment_sigma_px`` in the first round), and after each round the three variance
+   components (the points' sigma scale, the offsets' and the tilts' sigma) are re-estimated
+   from the residuals (:mod:`.boresight_weights`) for the next. Data snooping then tests a
+   line's group at its significance per group (Bonferroni over its rows): a line of
+   hundreds of points is not set aside for the largest of hundreds of normal residuals.
 
 Angles are radians inside, pixel quantities (col, row) per docs/conventions.md.
 """
@@ -52,6 +62,7 @@ from .auto_ties import REASONS, associate_ties
 from .boresight import calibrate
 from .boresight_options import BoresightOptions
 from .boresight_result import BoresightResult
+from .boresight_weights import line_variances
 from .georeference import Trajectory, direct_georeference
 from .ins import ins_grade
 from .mount import Mount
@@ -69,6 +80,9 @@ __all__ = [
 ]
 
 Array = NDArray[np.float64]
+#: the rounds stop when the line points' variance components also changed by less than this
+#: factor (and the boresight by less than its sigma)
+WEIGHTS_SETTLED = 1.25
 Images = Sequence[tuple[str, ArrayLike]]
 
 
@@ -96,6 +110,11 @@ class RoundRecord:
     change: Array
     rejected: int
     lines_refused: dict[str, int] = field(default_factory=dict)
+    #: the line points' weighting of the round (:class:`.boresight_weights.LineVariances`: the
+    #: factor on their sigma_px, the segments' offset and tilt sigmas) and the variances the
+    #: round's residuals gave (the next round's); None without segment nuisances
+    weights: tuple[float, float, float] | None = None
+    estimated: tuple[float, float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -455,6 +474,26 @@ def _round_observations(images, cam, eo, lines, ties, planes, dsm, opt, search_p
     )
 
 
+def _settled(used, estimated, negligible: float) -> bool:
+    """Whether the line points' variance components settled: each changed by less than the
+    factor :data:`WEIGHTS_SETTLED`, or a segment sigma stayed below ``negligible`` px (the
+    points' sigma floor: the iteration creeps towards zero there)."""
+    for j, (a, b) in enumerate(zip(used, estimated)):
+        if j and max(a, b) <= negligible:
+            continue
+        if abs(np.log(b / a)) >= np.log(WEIGHTS_SETTLED):
+            return False
+    return True
+
+
+def _scaled(obs: ImageObservations, scale: float) -> ImageObservations:
+    """``obs`` with the sigma_px of its line points multiplied by ``scale``."""
+    if scale == 1.0:
+        return obs
+    line = np.array([t == "line" for t in obs.type], bool)
+    return replace(obs, sigma_px=np.where(line, obs.sigma_px * scale, obs.sigma_px))
+
+
 def _round_record(k, search_px, gate, line_obs, obs, n_tracks, refused, result, change, lines):
     """The :class:`RoundRecord` of round ``k`` (counts, the boresight, its change)."""
     tie_ids = {p for p, t in zip(obs.point_id, obs.type) if t == "tie"}
@@ -527,7 +566,7 @@ def auto_calibrate(
         raise SceneNotObservable(why)
     images = list(images)
     base = calibration or BoresightOptions()
-    cal = replace(base, use_types=("tie", "line"))
+    cal = replace(base, use_types=("tie", "line"), snooping_per_group=opt.segment_sigma_px > 0)
     grade = ins_grade(base.ins_grade) if isinstance(base.ins_grade, str) else base.ins_grade
     att_sigma = np.radians(max(grade.sigma_roll_pitch_deg, grade.sigma_heading_deg))
     searched = search_boresight(
@@ -545,6 +584,7 @@ def auto_calibrate(
     cam = camera  # with the interior estimated, the last round's (and the lever arm's)
     last = np.asarray(searched, float)[None, :]
     result, obs, converged = None, None, False
+    weights = (1.0, opt.segment_sigma_px, opt.segment_sigma_px)  # sigma scale, offset, tilt
     for r in range(int(opt.max_rounds)):
         stop_if_asked(should_stop, "the automatic calibration")
         spread = float(np.hypot(bore_sigma, att_sigma))
@@ -561,6 +601,7 @@ def auto_calibrate(
                 f"on a roof plane (round {r + 1}, search {search_px:.1f} px): the approximate "
                 "boresight or the mount is too far off, or the lines are not in the images"
             )
+        obs = _scaled(obs, weights[0])
         result = calibrate(
             trajectory,
             cam,
@@ -569,28 +610,26 @@ def auto_calibrate(
             obs,
             planes,
             lines,
-            options=cal,
+            options=replace(cal, line_segment_sigmas_px=weights[1:]),
             progress=_share(progress, lo + half, lo + 2 * half),
             should_stop=should_stop,
         )
         change = result.boresight - last
-        rounds.append(
-            _round_record(
-                r + 1,
-                search_px,
-                gate,
-                line_obs,
-                obs,
-                n_tracks,
-                refused,
-                result,
-                change,
-                line_refused,
-            )
+        used, estimated = weights, None
+        if opt.segment_sigma_px > 0:
+            v = line_variances(result, weights[1:])
+            estimated = (weights[0] * v.scale, max(v.offset_px, 0.01), max(v.tilt_px, 0.01))
+        record = _round_record(
+            *(r + 1, search_px, gate, line_obs, obs, n_tracks, refused, result, change),
+            line_refused,
         )
+        rounds.append(replace(record, weights=used if estimated else None, estimated=estimated))
+        if estimated:
+            weights = estimated
         if progress:
             progress(0.3 + 0.7 * (r + 1) / opt.max_rounds)
-        if r >= 1 and bool(np.all(np.abs(change) < result.std)):
+        settled = estimated is None or _settled(used, estimated, opt.lines.min_sigma_px)
+        if r >= 1 and settled and bool(np.all(np.abs(change) < result.std)):
             converged = True
             break
         last = result.boresight.copy()

@@ -91,6 +91,9 @@ class AutoBoresightOptions:
     find_ties: without tie points given, find them between the images (the ``tiepoints``
         chain with its defaults: pairs from the footprints, least-squares refinement) when
         the planes have outlines.
+    segment_sigma_px: first round's sigma of a line segment's (one line in one image) common
+        offset and tilt across the line, pixels; later rounds use the variances estimated from
+        the round before (:mod:`.boresight_weights`; 0: the points weighted as independent).
     lines: options of the edge search (its ``search_px`` is set per round).
     """
 
@@ -106,6 +109,7 @@ class AutoBoresightOptions:
     min_line_directions: int = 2
     max_rounds: int = 6
     find_ties: bool = True
+    segment_sigma_px: float = 0.3
     lines: AutoLineOptions = field(default_factory=AutoLineOptions)
 
     def __post_init__(self) -> None:
@@ -116,5 +120,7 @@ class AutoBoresightOptions:
             raise InputError(f"search_deg must be in [0, 10] degrees, got {self.search_deg!r}")
         if self.fine_step_px > self.coarse_step_px:
             raise InputError("fine_step_px must not exceed coarse_step_px")
+        if not float(self.segment_sigma_px) >= 0:
+            raise InputError(f"segment_sigma_px must be >= 0, got {self.segment_sigma_px!r}")
         if int(self.max_rounds) < 1 or int(self.min_line_directions) < 1:
             raise InputError("max_rounds and min_line_directions must be >= 1")

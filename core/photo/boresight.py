@@ -202,7 +202,16 @@ def calibrate(
     # ---- observations in use
     kinds, used, img, surveyed = _rows_in_use(observations, trajectory, opts, ground_points)
     st = _Stage(
-        observations, kinds, used, img, par.pose_idx, r_nl, spec, local, par.names, np.array(par.x0)
+        observations,
+        kinds,
+        used,
+        img,
+        par.pose_idx,
+        r_nl,
+        spec,
+        local,
+        list(par.names),
+        np.array(par.x0),
     )
     velocity = _velocity(trajectory, ins_pos, r_nl, opts)
     st.blocks += _ins_blocks(
@@ -211,7 +220,7 @@ def calibrate(
     plane_by_id = {str(p.id): k for k, p in enumerate(planes)}
     p_params, p_cov, _ = transform_planes(list(planes), local)
     _tie_blocks(st, planes, plane_by_id, p_params, p_cov, opts.roof_roughness_m)
-    _line_blocks(st, lines)
+    _line_blocks(st, lines, opts.line_segment_sigmas_px)
     _point_blocks(st, lcps, surveyed)
 
     # ---- 4. the single-image model of Pedrosa & dos Santos (2020)
@@ -224,6 +233,7 @@ def calibrate(
     aopts = AdjustmentOptions(
         snooping=opts.snooping,
         snooping_alpha=opts.snooping_alpha,
+        snooping_per_group=opts.snooping_per_group,
         max_iterations=opts.max_iterations,
     )
     try:

@@ -217,8 +217,40 @@ def _tie_blocks(
         )
 
 
-def _line_blocks(st: _Stage, lines: Sequence) -> None:
-    """2. Points on LiDAR lines: per line, the rays of its points meet it."""
+def _segments(st: _Stage, line_rows: NDArray[np.intp], lk: NDArray[np.intp], sigmas) -> Array:
+    """The nuisance unknowns of the lines' segments (one line in one image): their offset and
+    tilt across the line (pixels) appended to the stage's parameters with their priors
+    (``sigmas``, :class:`~.boresight_options.BoresightOptions.line_segment_sigmas_px`); returns
+    (N, 3) per row of ``line_rows``: the offset's and the tilt's parameter index and the
+    row's position along its segment, -1 .. 1 from its middle (0 for fewer than 3 points)."""
+    pix = st.observations.pixels[line_rows]
+    key = st.img[line_rows].astype(np.int64) * (int(lk.max()) + 1) + lk
+    _, seg = np.unique(key, return_inverse=True)
+    seg = seg.ravel()
+    tau = np.zeros(len(line_rows))
+    for s in range(int(seg.max()) + 1):
+        at = np.flatnonzero(seg == s)
+        if at.size < 3:
+            continue
+        d = pix[at] - pix[at].mean(axis=0)
+        t = d @ np.linalg.svd(d, full_matrices=False)[2][0]
+        half = float(np.max(np.abs(t)))
+        tau[at] = t / half if half > 0 else 0.0
+    base, n_seg = len(st.names), int(seg.max()) + 1
+    for s in range(n_seg):
+        r = line_rows[np.flatnonzero(seg == s)[0]]
+        tag = f"{st.observations.image_id[r]}:L{st.observations.target_id[r]}"
+        st.names += [f"segment {tag} offset", f"segment {tag} tilt"]
+    st.x_init = np.concatenate([st.x_init, np.zeros(2 * n_seg)])
+    idx = base + 2 * np.arange(n_seg)
+    for j, what in enumerate(("offsets", "tilts")):
+        st.blocks.append(prior_block(f"line segment {what}", idx + j, 0.0, float(sigmas[j])))
+    return np.column_stack([base + 2 * seg, base + 2 * seg + 1, tau])
+
+
+def _line_blocks(st: _Stage, lines: Sequence, segment_sigmas=(0.0, 0.0)) -> None:
+    """2. Points on LiDAR lines: per line, the rays of its points meet it (with the nuisance
+    offset and tilt of each segment when ``segment_sigmas`` are > 0: :func:`_segments`)."""
     observations = st.observations
     line_rows = st.rows("line")
     if not line_rows.size:
@@ -226,6 +258,10 @@ def _line_blocks(st: _Stage, lines: Sequence) -> None:
     line_by_id = {str(ln.id): k for k, ln in enumerate(lines)}
     lk = _index([observations.target_id[r] for r in line_rows], line_by_id, "line", line_rows)
     lx0, lu, lcov = transform_lines(list(lines), st.local)
+    nuis = None
+    if min(segment_sigmas) > 0:
+        nuis = np.zeros((len(observations), 3))
+        nuis[line_rows] = _segments(st, line_rows, lk, segment_sigmas)
     counts = np.bincount(lk, minlength=len(lines))
     for k in np.unique(counts[counts > 0]):
         sel = np.flatnonzero(counts == k)
@@ -246,6 +282,7 @@ def _line_blocks(st: _Stage, lines: Sequence) -> None:
                 st.r_nl,
                 st.spec,
                 [str(lines[s].id) for s in sel],
+                None if nuis is None else nuis[members],
             )
         )
         st.maps.append((name, members, "line"))
@@ -370,14 +407,29 @@ def _distinct_index(full: NDArray[np.intp]) -> tuple[NDArray[np.intp], NDArray[n
     return index, cols
 
 
-def _line_block(name, k, sel, members, lx0, lu, lcov, obs, img, pose_idx, r_nl, spec, line_names):
+def _line_block(
+    name, k, sel, members, lx0, lu, lcov, obs, img, pose_idx, r_nl, spec, line_names, nuis=None
+):
     """Gauss-Helmert: every measured ray of a line is coplanar with it (the group's parameters
-    are the distinct pose parameters of its measurements: :func:`_distinct_index`)."""
+    are the distinct pose parameters of its measurements: :func:`_distinct_index`). With
+    ``nuis`` ((lines, k, 3): each measurement's segment offset and tilt parameter and its
+    position along the segment, :func:`_segments`), the condition is that of the pixel moved
+    across the projected line by the segment's offset + position * tilt (pixels): ``g -
+    (a + tau b) |dg/dpx|`` (``g / |dg/dpx|`` is the pixel's distance from the projected line;
+    the change of ``|dg/dpx|`` with the pose, a second-order term, is left out of the
+    Jacobians)."""
     lk = len(sel)
     p = spec.size
     flat = members.ravel()
-    index, cols = _distinct_index(pose_idx[img[flat]].reshape(lk, k * p))
-    at = (np.arange(lk)[:, None, None], np.arange(k)[None, :, None], cols.reshape(lk, k, p))
+    full = pose_idx[img[flat]].reshape(lk, k * p)
+    if nuis is not None:
+        full = np.hstack([full, nuis[:, :, :2].astype(np.intp).reshape(lk, 2 * k)])
+    index, cols = _distinct_index(full)
+    at = (
+        np.arange(lk)[:, None, None],
+        np.arange(k)[None, :, None],
+        cols[:, : k * p].reshape(lk, k, p),
+    )
     o = 2 * k + 6
     observed = np.hstack([obs.pixels[flat].reshape(lk, 2 * k), lx0[sel], lu[sel]])
     cov = np.zeros((lk, o, o))
@@ -386,9 +438,14 @@ def _line_block(name, k, sel, members, lx0, lu, lcov, obs, img, pose_idx, r_nl, 
     cov[:, 2 * k :, 2 * k :] = _regular(lcov[sel])
     rn = r_nl[img[flat]]
     ar = np.arange(k)
+    pose_cols = cols[:, : k * p]
+    if nuis is not None:
+        seg_cols = cols[:, k * p :].reshape(lk, k, 2)
+        at_seg = (np.arange(lk)[:, None, None], np.arange(k)[None, :, None], seg_cols)
+        tau = nuis[:, :, 2]
 
     def condition(x_local: Array, l_hat: Array) -> tuple[Array, Array, Array]:
-        xp = np.take_along_axis(x_local, cols, axis=1).reshape(-1, p)
+        xp = np.take_along_axis(x_local, pose_cols, axis=1).reshape(-1, p)
         px = l_hat[:, : 2 * k].reshape(-1, 2)
         x0 = np.repeat(l_hat[:, 2 * k : 2 * k + 3], k, axis=0)
         u = np.repeat(l_hat[:, 2 * k + 3 :], k, axis=0)
@@ -402,7 +459,13 @@ def _line_block(name, k, sel, members, lx0, lu, lcov, obs, img, pose_idx, r_nl, 
         b[:, :, 2 * k + 3 :] = j_dir.reshape(n, k, 3)
         a = np.zeros((n, k, index.shape[1]))
         a[at] = j_pose.reshape(n, k, p)  # the p parameters of one measurement are distinct
-        return g.reshape(n, k), a, b
+        g = g.reshape(n, k)
+        if nuis is not None:
+            rate = np.hypot(jp[:, :, 0], jp[:, :, 1])
+            ab = np.take_along_axis(x_local, seg_cols.reshape(n, 2 * k), axis=1).reshape(n, k, 2)
+            g = g - (ab[:, :, 0] + tau * ab[:, :, 1]) * rate
+            a[at_seg] = np.stack([-rate, -tau * rate], axis=2)
+        return g, a, b
 
     return GaussHelmertBlock(
         name,

@@ -51,7 +51,17 @@ class BoresightOptions:
         speeds are needed (else refused as not observable).
     snooping, snooping_alpha : bool, float
         Baarda data snooping and its significance per observation.
+    snooping_per_group : bool
+        Snooping's significance per group instead (a LiDAR line's points are one group: see
+        ``AdjustmentOptions.snooping_per_group``); the automatic calibration's setting.
     max_iterations : int
+    line_segment_sigmas_px : (float, float)
+        Standard deviations (pixels) of the error that the points of one LiDAR line in one
+        image share (a segment): its offset across the line and its tilt (the offset's change
+        from the segment's middle to its end). Each segment gets the two as nuisance
+        unknowns with these priors, i.e. its points' covariance carries the common part (edge
+        model against the LiDAR line, seen from that image). (0, 0): none (hand picks: each
+        point independent); the automatic calibration estimates them from the residuals.
     """
 
     groups: Union[str, Mapping[str, str]] = "group"
@@ -68,3 +78,5 @@ class BoresightOptions:
     snooping: bool = True
     snooping_alpha: float = 0.001
     max_iterations: int = 50
+    line_segment_sigmas_px: tuple[float, float] = (0.0, 0.0)
+    snooping_per_group: bool = False
