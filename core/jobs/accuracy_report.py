@@ -5,7 +5,7 @@ from __future__ import annotations
 import logging
 
 from ..errors import InputError
-from .common import CSV_FILTER, html_out
+from .common import html_out, json_out, table_param
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -186,12 +186,10 @@ the RMSE values as numeric outputs RMSE_E, RMSE_N, RMSE_U (height), RMSE_HORIZON
 (docs/formats.md, "Accuracy figures"; RMSE_H and RMSE_HORIZ, their former names, are kept
 for one release).""",
     params=(
-        Param(
+        table_param(
             "INPUT",
-            "table",
             "Check-point table (CSV: id, e, n, h, e_ref, n_ref, h_ref, group)",
             optional=True,
-            file_filter=CSV_FILTER,
         ),
         *_point_params("measured"),
         *_point_params("reference"),
@@ -268,14 +266,7 @@ for one release).""",
         ),
         Param("OUTPUT", "sink", "Check points with discrepancies", geometry="point", optional=True),
         html_out("OUTPUT_HTML", "Accuracy report (HTML)"),
-        Param(
-            "OUTPUT_JSON",
-            "file_out",
-            "Accuracy figures (JSON)",
-            optional=True,
-            create_by_default=False,
-            file_filter="JSON files (*.json)",
-        ),
+        json_out("OUTPUT_JSON", "Accuracy figures (JSON)", on_demand=True),
     ),
     results=(
         *(

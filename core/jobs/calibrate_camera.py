@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .common import JSON_FILTER, html_out, images_param
+from .common import csv_out, html_out, images_param, json_out
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -155,26 +155,10 @@ camera file: the calibration itself is in pixels.""",
             advanced=True,
         ),
         Param("CAMERA_NAME", "string", "Camera name", "camera", advanced=True),
-        Param("OUTPUT_CAMERA", "file_out", "Calibrated camera (JSON)", file_filter=JSON_FILTER),
-        Param(
-            "OUTPUT_REPORT",
-            "file_out",
-            "Calibration report (JSON)",
-            optional=True,
-            create_by_default=False,
-            file_filter=JSON_FILTER,
-            advanced=True,
-        ),
+        json_out("OUTPUT_CAMERA", "Calibrated camera (JSON)", optional=False),
+        json_out("OUTPUT_REPORT", "Calibration report (JSON)", on_demand=True, advanced=True),
         html_out("OUTPUT_HTML", "Calibration report (HTML)", on_demand=True),
-        Param(
-            "OUTPUT_RESIDUALS",
-            "file_out",
-            "Residuals per point (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter="CSV files (*.csv)",
-            advanced=True,
-        ),
+        csv_out("OUTPUT_RESIDUALS", "Residuals per point (CSV)", on_demand=True, advanced=True),
     ),
     results=(
         Result("VIEW_COUNT", "number", "Views used"),

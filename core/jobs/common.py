@@ -111,49 +111,39 @@ def mount_from(values: Mapping[str, Any]):
     )
 
 
-def csv_out(
-    name: str,
-    label: str,
-    *,
-    optional: bool = True,
-    on_demand: bool = False,
-    advanced: bool = False,
-    twin: str = "",
-    help: str = "",
-) -> Param:
-    """A CSV table output (``file_out``), optional unless said; ``on_demand``: not written
-    unless asked (QGIS leaves it unchecked); ``twin``: the layer output (``sink``) that carries
-    the same rows (:attr:`Param.layer_twin`)."""
-    return _file_out(name, label, CSV_OUT, optional, on_demand, advanced, twin, help)
-
-
-def html_out(name: str, label: str, *, optional: bool = True, on_demand: bool = False) -> Param:
-    """An HTML report output (``file_out``), optional unless said; ``on_demand`` as in
-    :func:`csv_out`."""
-    return _file_out(name, label, "HTML files (*.html)", optional, on_demand, False, "", "")
-
-
-def _file_out(
-    name: str,
-    label: str,
-    file_filter: str,
-    optional: bool,
-    on_demand: bool,
-    advanced: bool,
-    twin: str,
-    help: str,
-) -> Param:
+def file_out(name: str, label: str, file_filter: str, **options: Any) -> Param:
+    """A file output (``file_out``) of ``file_filter``. ``options``: those of :class:`Param`,
+    ``optional`` True unless said, and ``on_demand`` (not written unless asked: QGIS leaves it
+    unchecked) and ``twin`` (the layer output, ``sink``, that carries the same rows:
+    :attr:`Param.layer_twin`)."""
+    create = not options.pop("on_demand", False)
+    twin = options.pop("twin", "")
+    options.setdefault("optional", True)
     return Param(
         name,
         "file_out",
         label,
-        help=help,
-        optional=optional,
-        advanced=advanced,
         file_filter=file_filter,
-        create_by_default=not on_demand,
+        create_by_default=create,
         layer_twin=twin,
+        **options,
     )
+
+
+def csv_out(name: str, label: str, **extra: Any) -> Param:
+    """A CSV table output: :func:`file_out` with its options."""
+    return file_out(name, label, CSV_OUT, **extra)
+
+
+def html_out(name: str, label: str, **extra: Any) -> Param:
+    """An HTML report output: :func:`file_out` with its options."""
+    return file_out(name, label, "HTML files (*.html)", **extra)
+
+
+def json_out(name: str, label: str, **extra: Any) -> Param:
+    """A JSON file output (a camera, the figures of a report): :func:`file_out` with its
+    options."""
+    return file_out(name, label, JSON_FILTER, **extra)
 
 
 def table_param(name: str, label: str, **extra: Any) -> Param:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_FILTER, choice_param, csv_out, mapping_crs_param, mount_from, mount_params
+from .common import choice_param, csv_out, mapping_crs_param, mount_from, mount_params, table_param
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -59,7 +59,7 @@ trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""
             "TRAJECTORY_FORMATS",
             help="auto: by the file's ending (.out/.sbet SBET, .csv CSV, else ASCII)",
         ),
-        Param("EVENTS", "table", "Camera events (CSV: image_id, time)", file_filter=CSV_FILTER),
+        table_param("EVENTS", "Camera events (CSV: image_id, time)"),
         Param(
             "EVENT_TIME",
             "enum",

@@ -10,7 +10,7 @@ from typing import Any
 
 from ..errors import InputError
 from .checks import check_memory
-from .common import CSV_FILTER, html_out
+from .common import CSV_FILTER, html_out, json_out, table_param
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -162,12 +162,10 @@ that accuracyreport reads for the NSSDA and PEC-PCD sections.""",
             suffixes=_LAS_SUFFIXES,
             help="LAS/LAZ files of one survey, or folders of them",
         ),
-        Param(
+        table_param(
             "CHECKPOINTS",
-            "table",
             "Check points (CSV: id, e, n, h, group)",
             optional=True,
-            file_filter=CSV_FILTER,
             help="surveyed check points; group = land cover",
         ),
         Param(
@@ -242,14 +240,7 @@ that accuracyreport reads for the NSSDA and PEC-PCD sections.""",
             advanced=True,
         ),
         html_out("OUTPUT_HTML", "LiDAR accuracy report (HTML)", optional=False),
-        Param(
-            "OUTPUT_JSON",
-            "file_out",
-            "LiDAR accuracy figures (JSON)",
-            optional=True,
-            create_by_default=False,
-            file_filter="JSON files (*.json)",
-        ),
+        json_out("OUTPUT_JSON", "LiDAR accuracy figures (JSON)", on_demand=True),
         Param(
             "OUTPUT_RASTER",
             "raster_out",
