@@ -5,9 +5,9 @@ from __future__ import annotations
 import logging
 
 from ..errors import InputError
-from .common import html_out, json_out, table_param
+from .common import enum_param, html_out, json_out, table_param
 from .runner import JobResult
-from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
@@ -218,12 +218,11 @@ for one release).""",
             advanced=True,
         ),
         *_numbers(_NUMBERS),
-        Param(
+        enum_param(
             "OUTLIER_RULE",
-            "enum",
             "Outlier screening",
             _D.outlier_rule,
-            options=Ref("quality.accuracy_options", "OUTLIER_RULES"),
+            "OUTLIER_RULES",
             labels=_OUTLIER_LABELS,
             advanced=True,
         ),
@@ -234,23 +233,17 @@ for one release).""",
             _D.exclude_outliers,
             advanced=True,
         ),
-        Param(
+        enum_param(
             "STANDARDS",
-            "enum",
             "Standards",
             _D.standards,
-            options=Ref("quality.accuracy_options", "STANDARD_KEYS"),
+            "STANDARD_KEYS",
             labels=_STANDARD_LABELS,
             multiple=True,
         ),
         *_numbers(_STANDARD_NUMBERS),
-        Param(
-            "PEC_CLASS",
-            "enum",
-            "PEC-PCD declared class",
-            _D.pec_class,
-            options=Ref("quality.accuracy_options", "PEC_CLASSES"),
-            advanced=True,
+        enum_param(
+            "PEC_CLASS", "PEC-PCD declared class", _D.pec_class, "PEC_CLASSES", advanced=True
         ),
         *_numbers(_PROJECT_NUMBERS),
         Param(

@@ -92,6 +92,12 @@ def choice_param(name: str, label: str, module: str, constant: str, **extra: Any
     )
 
 
+def enum_param(name: str, label: str, default: Ref, choices: str, **extra: Any) -> Param:
+    """An ``enum`` parameter whose default is ``default``, a field of a science dataclass
+    (:class:`~.spec.Fields`), and whose options are the tuple ``choices`` of the same module."""
+    return Param(name, "enum", label, default, options=Ref(default.module, choices), **extra)
+
+
 def _first(choices: tuple[str, ...]) -> str:
     return choices[0]
 

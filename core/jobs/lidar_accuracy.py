@@ -10,9 +10,9 @@ from typing import Any
 
 from ..errors import InputError
 from .checks import check_memory
-from .common import CSV_FILTER, html_out, json_out, table_param
+from .common import CSV_FILTER, enum_param, html_out, json_out, table_param
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
@@ -168,12 +168,11 @@ that accuracyreport reads for the NSSDA and PEC-PCD sections.""",
             optional=True,
             help="surveyed check points; group = land cover",
         ),
-        Param(
+        enum_param(
             "SWATH_SOURCE",
-            "enum",
             "Swaths from",
             _D.swath_source,
-            options=Ref("quality.lidar_accuracy_options", "SWATH_SOURCES"),
+            "SWATH_SOURCES",
             labels=("point source id, else GPS time", "point source id", "GPS time gaps"),
         ),
         Param(

@@ -12,9 +12,9 @@ from __future__ import annotations
 import logging
 import math
 
-from .common import camera_param, csv_out, global_test_verdict, html_out, table_param
+from .common import camera_param, csv_out, enum_param, global_test_verdict, html_out, table_param
 from .runner import JobResult
-from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 _OPTIONS = Fields("photo.resection_options", "ResectionOptions")
@@ -123,12 +123,11 @@ lines parallel).""",
             optional=True,
             advanced=True,
         ),
-        Param(
+        enum_param(
             "MODEL",
-            "enum",
             "Line model",
             _OPTIONS.model,
-            options=Ref("photo.resection_options", "MODELS"),
+            "MODELS",
             labels=(
                 "coplanarity (no parametrisation)",
                 "equivalent planes (Tommaselli & Tozzi 1996)",
