@@ -263,8 +263,9 @@ def unit_symbol(name: str) -> str:
     return _UNIT_SYMBOLS.get(name.strip().lower(), name)
 
 
-def unit_text(info: Any, distance_unit: str) -> str:
-    """How the job reports the unit its lengths were taken in."""
+def length_unit_text(info: Any, distance_unit: str) -> str:
+    """How the job reports the unit its lengths were taken in (the cloud CRS unit, or metres
+    converted; not the help's unit of a parameter, :func:`.spec.unit_text`)."""
     return "metre (converted)" if distance_unit == "metre" else info.horizontal_unit
 
 
