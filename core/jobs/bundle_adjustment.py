@@ -14,6 +14,7 @@ import logging
 from .common import (
     camera_param,
     csv_out,
+    enum_param,
     eo_param,
     global_test_verdict,
     html_out,
@@ -27,8 +28,6 @@ log = logging.getLogger(__name__)
 
 _OPTIONS = Fields("photo.bundle_options", "BundleOptions")
 _AP_CHOICES = Ref("geometry.ap_families", "AP_FAMILIES", convert=lambda f: (*f, "all"))
-ROBUST_CHOICES = ("none", "huber", "cauchy")
-DATUM_CHOICES = ("control", "inner", "minimal")
 #: the frame of the coordinates: the mapping CRS, or a local engineering frame (no CRS)
 FRAME_CHOICES = ("crs", "local_m", "local_mm")
 
@@ -163,21 +162,19 @@ with the file and row named.""",
             _OPTIONS.ap_selection,
             advanced=True,
         ),
-        Param(
+        enum_param(
             "ROBUST",
-            "enum",
             "Robust reweighting before data snooping",
             _OPTIONS.robust,
-            options=ROBUST_CHOICES,
+            "ROBUSTS",
             advanced=True,
         ),
         Param("SNOOPING", "boolean", "Data snooping (Baarda)", _OPTIONS.snooping, advanced=True),
-        Param(
+        enum_param(
             "DATUM",
-            "enum",
             "Datum",
             _OPTIONS.datum,
-            options=DATUM_CHOICES,
+            "DATUMS",
             labels=(
                 "control points / observed EO",
                 "free network: inner constraints",
