@@ -263,6 +263,58 @@ def unit_symbol(name: str) -> str:
     return _UNIT_SYMBOLS.get(name.strip().lower(), name)
 
 
+def cluster_params(advanced: bool = False) -> tuple[Param, ...]:
+    """CLUSTER, WORKERS, MEMORY_LIMIT and LOCAL_CLUSTER: the dask cluster that processes tiles
+    (``lidar_block.cluster_session``); ``advanced``: all four among the advanced parameters
+    (else CLUSTER and WORKERS shown)."""
+    return (
+        Param(
+            "CLUSTER",
+            "string",
+            "dask scheduler address (empty: a local cluster)",
+            "",
+            optional=True,
+            advanced=advanced,
+            help="e.g. tcp://10.0.0.5:8786",
+        ),
+        Param(
+            "WORKERS",
+            "integer",
+            "Local cluster: workers (0 = one per core)",
+            0,
+            minimum=0,
+            maximum=1024,
+            advanced=advanced,
+        ),
+        Param(
+            "MEMORY_LIMIT",
+            "number",
+            "Local cluster: memory limit per worker (0 = RAM / workers)",
+            0.0,
+            unit="GB",
+            minimum=0.0,
+            maximum=4096.0,
+            advanced=True,
+        ),
+        Param(
+            "LOCAL_CLUSTER",
+            "enum",
+            "Local cluster workers",
+            "auto",
+            options=("auto", "processes", "threads"),
+            labels=(
+                "auto (processes on the command line, threads inside QGIS)",
+                "processes (one per worker)",
+                "threads of this process",
+            ),
+            advanced=True,
+            help="auto: processes on the command line, threads inside QGIS or "
+            "qgis_process, where a process cluster would start QGIS's own executable for "
+            "each worker",
+        ),
+    )
+
+
 def length_unit_text(info: Any, distance_unit: str) -> str:
     """How the job reports the unit its lengths were taken in (the cloud CRS unit, or metres
     converted; not the help's unit of a parameter, :func:`.spec.unit_text`)."""
