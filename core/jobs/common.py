@@ -18,6 +18,8 @@ CSV_FILTER = "CSV files (*.csv *.txt)"
 JSON_FILTER = "JSON files (*.json)"
 CSV_OUT = "CSV files (*.csv)"
 LAS_FILTER = "LAS/LAZ files (*.las *.laz *.LAS *.LAZ)"
+#: A point cloud output (LAZ first: the smaller file).
+LAS_OUT = "LAZ files (*.laz);;LAS files (*.las)"
 DSM_FILTER = "DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"
 DISTANCE_UNITS = ("crs", "metre")
 #: Largest lever-arm component (m): longer than any survey aircraft, so a larger value is a
@@ -134,6 +136,11 @@ def file_out(name: str, label: str, file_filter: str, **options: Any) -> Param:
         layer_twin=twin,
         **options,
     )
+
+
+def cloud_out(name: str, label: str, **extra: Any) -> Param:
+    """A LAS/LAZ point cloud output: :func:`file_out` with its options."""
+    return file_out(name, label, LAS_OUT, **extra)
 
 
 def csv_out(name: str, label: str, **extra: Any) -> Param:

@@ -6,7 +6,7 @@ import logging
 
 from ..errors import InputError
 from .checks import GROUND_FILTER_BYTES_PER_CELL, GROUND_FILTER_BYTES_PER_POINT, check_cell_size
-from .common import cloud_params, length_unit_text, lengths_in_cloud_units
+from .common import cloud_out, cloud_params, length_unit_text, lengths_in_cloud_units
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Ref, Result, Values
 
@@ -294,8 +294,7 @@ also the extra dimension height_above_ground (float32); optionally the DTM as Ge
         Param("HEIGHT_ABOVE_GROUND", "boolean", "Add the height above the DTM to the cloud",
               False, help="the extra dimension height_above_ground (float32, vertical unit); "
               "it changes the point format (extra bytes) and makes the file larger"),
-        Param("OUTPUT_CLOUD", "file_out", "Classified point cloud",
-              file_filter="LAZ files (*.laz);;LAS files (*.las)"),
+        cloud_out("OUTPUT_CLOUD", "Classified point cloud", optional=False),
         Param("OUTPUT_DTM", "raster_out", "DTM", optional=True, create_by_default=False),
     ),
     results=(
