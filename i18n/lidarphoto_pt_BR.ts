@@ -6906,6 +6906,10 @@ e_ref, n_ref, h_ref, group) que o accuracyreport lê para as seções NSSDA e PE
             <translation>Trabalhadores (workers) do cluster local</translation>
         </message>
         <message>
+            <source>auto: processes on the command line, threads inside QGIS or qgis_process, where a process cluster would start QGIS's own executable for each worker</source>
+            <translation>auto: processos na linha de comando, threads dentro do QGIS ou do qgis_process, onde um cluster de processos iniciaria o próprio executável do QGIS para cada trabalhador (worker)</translation>
+        </message>
+        <message>
             <source>auto (processes on the command line, threads inside QGIS)</source>
             <translation>auto (processos na linha de comando, threads dentro do QGIS)</translation>
         </message>

@@ -5,9 +5,9 @@ from __future__ import annotations
 import logging
 
 from ..errors import InputError
-from .common import CSV_FILTER, html_out
+from .common import enum_param, html_out, json_out, table_param
 from .runner import JobResult
-from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
@@ -186,12 +186,10 @@ the RMSE values as numeric outputs RMSE_E, RMSE_N, RMSE_U (height), RMSE_HORIZON
 (docs/formats.md, "Accuracy figures"; RMSE_H and RMSE_HORIZ, their former names, are kept
 for one release).""",
     params=(
-        Param(
+        table_param(
             "INPUT",
-            "table",
             "Check-point table (CSV: id, e, n, h, e_ref, n_ref, h_ref, group)",
             optional=True,
-            file_filter=CSV_FILTER,
         ),
         *_point_params("measured"),
         *_point_params("reference"),
@@ -220,12 +218,11 @@ for one release).""",
             advanced=True,
         ),
         *_numbers(_NUMBERS),
-        Param(
+        enum_param(
             "OUTLIER_RULE",
-            "enum",
             "Outlier screening",
             _D.outlier_rule,
-            options=Ref("quality.accuracy_options", "OUTLIER_RULES"),
+            "OUTLIER_RULES",
             labels=_OUTLIER_LABELS,
             advanced=True,
         ),
@@ -236,23 +233,17 @@ for one release).""",
             _D.exclude_outliers,
             advanced=True,
         ),
-        Param(
+        enum_param(
             "STANDARDS",
-            "enum",
             "Standards",
             _D.standards,
-            options=Ref("quality.accuracy_options", "STANDARD_KEYS"),
+            "STANDARD_KEYS",
             labels=_STANDARD_LABELS,
             multiple=True,
         ),
         *_numbers(_STANDARD_NUMBERS),
-        Param(
-            "PEC_CLASS",
-            "enum",
-            "PEC-PCD declared class",
-            _D.pec_class,
-            options=Ref("quality.accuracy_options", "PEC_CLASSES"),
-            advanced=True,
+        enum_param(
+            "PEC_CLASS", "PEC-PCD declared class", _D.pec_class, "PEC_CLASSES", advanced=True
         ),
         *_numbers(_PROJECT_NUMBERS),
         Param(
@@ -268,14 +259,7 @@ for one release).""",
         ),
         Param("OUTPUT", "sink", "Check points with discrepancies", geometry="point", optional=True),
         html_out("OUTPUT_HTML", "Accuracy report (HTML)"),
-        Param(
-            "OUTPUT_JSON",
-            "file_out",
-            "Accuracy figures (JSON)",
-            optional=True,
-            create_by_default=False,
-            file_filter="JSON files (*.json)",
-        ),
+        json_out("OUTPUT_JSON", "Accuracy figures (JSON)", on_demand=True),
     ),
     results=(
         *(

@@ -11,7 +11,16 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_FILTER, csv_out, global_test_verdict, html_out
+from .common import (
+    camera_param,
+    csv_out,
+    enum_param,
+    eo_param,
+    global_test_verdict,
+    html_out,
+    json_out,
+    table_param,
+)
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -19,8 +28,6 @@ log = logging.getLogger(__name__)
 
 _OPTIONS = Fields("photo.bundle_options", "BundleOptions")
 _AP_CHOICES = Ref("geometry.ap_families", "AP_FAMILIES", convert=lambda f: (*f, "all"))
-ROBUST_CHOICES = ("none", "huber", "cauchy")
-DATUM_CHOICES = ("control", "inner", "minimal")
 #: the frame of the coordinates: the mapping CRS, or a local engineering frame (no CRS)
 FRAME_CHOICES = ("crs", "local_m", "local_mm")
 
@@ -76,26 +83,14 @@ Tables that cannot make a block (an image without observations, a tie point seen
 duplicated rows, unknown images, ground points in another CRS, unconnected parts) are refused
 with the file and row named.""",
     params=(
-        Param(
-            "CAMERA",
-            "file",
-            'Camera (JSON; several as {"cameras": [...]})',
-            file_filter="JSON files (*.json)",
+        camera_param('Camera (JSON; several as {"cameras": [...]})'),
+        table_param("OBSERVATIONS", "Image observations (CSV)"),
+        table_param(
+            "GROUND_POINTS", "Ground points (CSV: point_id,X,Y,Z,sx,sy,sz,role)", optional=True
         ),
-        Param("OBSERVATIONS", "table", "Image observations (CSV)", file_filter=CSV_FILTER),
-        Param(
-            "GROUND_POINTS",
-            "table",
-            "Ground points (CSV: point_id,X,Y,Z,sx,sy,sz,role)",
-            optional=True,
-            file_filter=CSV_FILTER,
-        ),
-        Param(
-            "EO",
-            "table",
+        eo_param(
             "Exterior orientation, approximate or observed (CSV)",
             optional=True,
-            file_filter=CSV_FILTER,
             help="approximate values, or observations when the sigma columns are filled",
         ),
         Param(
@@ -167,21 +162,19 @@ with the file and row named.""",
             _OPTIONS.ap_selection,
             advanced=True,
         ),
-        Param(
+        enum_param(
             "ROBUST",
-            "enum",
             "Robust reweighting before data snooping",
             _OPTIONS.robust,
-            options=ROBUST_CHOICES,
+            "ROBUSTS",
             advanced=True,
         ),
         Param("SNOOPING", "boolean", "Data snooping (Baarda)", _OPTIONS.snooping, advanced=True),
-        Param(
+        enum_param(
             "DATUM",
-            "enum",
             "Datum",
             _OPTIONS.datum,
-            options=DATUM_CHOICES,
+            "DATUMS",
             labels=(
                 "control points / observed EO",
                 "free network: inner constraints",
@@ -189,12 +182,10 @@ with the file and row named.""",
             ),
             advanced=True,
         ),
-        Param(
+        table_param(
             "SCALE_BARS",
-            "table",
             "Scale bars / measured distances (CSV: point_a,point_b,distance,sigma)",
             optional=True,
-            file_filter=CSV_FILTER,
             help="distances between adjusted points, observations with their sigmas (frame "
             "units); with a free-network datum they give its scale (inner constraints "
             "without the scale row, or six parameters held)",
@@ -221,13 +212,7 @@ with the file and row named.""",
             advanced=True,
         ),
         csv_out("OUTPUT_EO", "Adjusted exterior orientation (CSV)", optional=False),
-        Param(
-            "OUTPUT_CAMERA",
-            "file_out",
-            "Adjusted camera (JSON)",
-            optional=True,
-            file_filter="JSON files (*.json)",
-        ),
+        json_out("OUTPUT_CAMERA", "Adjusted camera (JSON)"),
         csv_out("OUTPUT_POINTS", "Object points (CSV)", twin="OUTPUT_POINTS_LAYER"),
         Param("OUTPUT_POINTS_LAYER", "sink", "Object points", geometry="point", optional=True),
         csv_out("OUTPUT_RESIDUALS", "Image residuals with w-tests (CSV)", advanced=True),

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .common import JSON_FILTER, html_out, images_param
+from .common import csv_out, enum_param, html_out, images_param, json_out
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -46,12 +46,11 @@ page, and the residual table (CSV). PIXEL_SIZE only scales the millimetre values
 camera file: the calibration itself is in pixels.""",
     params=(
         images_param("Target images (files or folders)"),
-        Param(
+        enum_param(
             "TARGET",
-            "enum",
             "Target",
             _T.kind,
-            options=Ref("photo.calibration_options", "TARGET_KINDS"),
+            "TARGET_KINDS",
             labels=("chessboard", "ChArUco board", "ArUco grid board"),
         ),
         Param(
@@ -88,13 +87,7 @@ camera file: the calibration itself is in pixels.""",
             minimum=0.0,
             maximum=10.0,
         ),
-        Param(
-            "DICTIONARY",
-            "enum",
-            "ArUco dictionary",
-            _T.dictionary,
-            options=Ref("photo.calibration_options", "DICTIONARIES"),
-        ),
+        enum_param("DICTIONARY", "ArUco dictionary", _T.dictionary, "DICTIONARIES"),
         Param(
             "PROJECTION",
             "enum",
@@ -109,12 +102,11 @@ camera file: the calibration itself is in pixels.""",
                 "fisheye: stereographic",
             ),
         ),
-        Param(
+        enum_param(
             "LENS_MODEL",
-            "enum",
             "Lens model",
             _D.lens_model,
-            options=Ref("photo.calibration_options", "LENS_MODELS"),
+            "LENS_MODELS",
             labels=(
                 "Brown-Conrady correction (photogrammetric)",
                 "OpenCV / COLMAP distortion (perspective)",
@@ -125,21 +117,19 @@ camera file: the calibration itself is in pixels.""",
             "perspective projection",
             advanced=True,
         ),
-        Param(
+        enum_param(
             "LENS_PARAMETERS",
-            "enum",
             "Lens coefficients estimated",
             _D.lens_parameters,
-            options=Ref("photo.calibration_options", "LENS_NAMES"),
+            "LENS_NAMES",
             multiple=True,
             help="coefficients of the lens model; the others are held at zero",
         ),
-        Param(
+        enum_param(
             "FIELD",
-            "enum",
             "Target field",
             _D.field,
-            options=Ref("photo.calibration_options", "FIELD_MODES"),
+            "FIELD_MODES",
             labels=("fixed (nominal coordinates)", "free (estimated, minimal datum)"),
             advanced=True,
         ),
@@ -155,26 +145,10 @@ camera file: the calibration itself is in pixels.""",
             advanced=True,
         ),
         Param("CAMERA_NAME", "string", "Camera name", "camera", advanced=True),
-        Param("OUTPUT_CAMERA", "file_out", "Calibrated camera (JSON)", file_filter=JSON_FILTER),
-        Param(
-            "OUTPUT_REPORT",
-            "file_out",
-            "Calibration report (JSON)",
-            optional=True,
-            create_by_default=False,
-            file_filter=JSON_FILTER,
-            advanced=True,
-        ),
+        json_out("OUTPUT_CAMERA", "Calibrated camera (JSON)", optional=False),
+        json_out("OUTPUT_REPORT", "Calibration report (JSON)", on_demand=True, advanced=True),
         html_out("OUTPUT_HTML", "Calibration report (HTML)", on_demand=True),
-        Param(
-            "OUTPUT_RESIDUALS",
-            "file_out",
-            "Residuals per point (CSV)",
-            optional=True,
-            create_by_default=False,
-            file_filter="CSV files (*.csv)",
-            advanced=True,
-        ),
+        csv_out("OUTPUT_RESIDUALS", "Residuals per point (CSV)", on_demand=True, advanced=True),
     ),
     results=(
         Result("VIEW_COUNT", "number", "Views used"),

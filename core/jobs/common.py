@@ -18,6 +18,8 @@ CSV_FILTER = "CSV files (*.csv *.txt)"
 JSON_FILTER = "JSON files (*.json)"
 CSV_OUT = "CSV files (*.csv)"
 LAS_FILTER = "LAS/LAZ files (*.las *.laz *.LAS *.LAZ)"
+#: A point cloud output (LAZ first: the smaller file).
+LAS_OUT = "LAZ files (*.laz);;LAS files (*.las)"
 DSM_FILTER = "DSM (*.tif *.tiff *.img *.vrt *.asc *.las *.laz *.LAS *.LAZ)"
 DISTANCE_UNITS = ("crs", "metre")
 #: Largest lever-arm component (m): longer than any survey aircraft, so a larger value is a
@@ -92,6 +94,12 @@ def choice_param(name: str, label: str, module: str, constant: str, **extra: Any
     )
 
 
+def enum_param(name: str, label: str, default: Ref, choices: str, **extra: Any) -> Param:
+    """An ``enum`` parameter whose default is ``default``, a field of a science dataclass
+    (:class:`~.spec.Fields`), and whose options are the tuple ``choices`` of the same module."""
+    return Param(name, "enum", label, default, options=Ref(default.module, choices), **extra)
+
+
 def _first(choices: tuple[str, ...]) -> str:
     return choices[0]
 
@@ -111,49 +119,44 @@ def mount_from(values: Mapping[str, Any]):
     )
 
 
-def csv_out(
-    name: str,
-    label: str,
-    *,
-    optional: bool = True,
-    on_demand: bool = False,
-    advanced: bool = False,
-    twin: str = "",
-    help: str = "",
-) -> Param:
-    """A CSV table output (``file_out``), optional unless said; ``on_demand``: not written
-    unless asked (QGIS leaves it unchecked); ``twin``: the layer output (``sink``) that carries
-    the same rows (:attr:`Param.layer_twin`)."""
-    return _file_out(name, label, CSV_OUT, optional, on_demand, advanced, twin, help)
-
-
-def html_out(name: str, label: str, *, optional: bool = True, on_demand: bool = False) -> Param:
-    """An HTML report output (``file_out``), optional unless said; ``on_demand`` as in
-    :func:`csv_out`."""
-    return _file_out(name, label, "HTML files (*.html)", optional, on_demand, False, "", "")
-
-
-def _file_out(
-    name: str,
-    label: str,
-    file_filter: str,
-    optional: bool,
-    on_demand: bool,
-    advanced: bool,
-    twin: str,
-    help: str,
-) -> Param:
+def file_out(name: str, label: str, file_filter: str, **options: Any) -> Param:
+    """A file output (``file_out``) of ``file_filter``. ``options``: those of :class:`Param`,
+    ``optional`` True unless said, and ``on_demand`` (not written unless asked: QGIS leaves it
+    unchecked) and ``twin`` (the layer output, ``sink``, that carries the same rows:
+    :attr:`Param.layer_twin`)."""
+    create = not options.pop("on_demand", False)
+    twin = options.pop("twin", "")
+    options.setdefault("optional", True)
     return Param(
         name,
         "file_out",
         label,
-        help=help,
-        optional=optional,
-        advanced=advanced,
         file_filter=file_filter,
-        create_by_default=not on_demand,
+        create_by_default=create,
         layer_twin=twin,
+        **options,
     )
+
+
+def cloud_out(name: str, label: str, **extra: Any) -> Param:
+    """A LAS/LAZ point cloud output: :func:`file_out` with its options."""
+    return file_out(name, label, LAS_OUT, **extra)
+
+
+def csv_out(name: str, label: str, **extra: Any) -> Param:
+    """A CSV table output: :func:`file_out` with its options."""
+    return file_out(name, label, CSV_OUT, **extra)
+
+
+def html_out(name: str, label: str, **extra: Any) -> Param:
+    """An HTML report output: :func:`file_out` with its options."""
+    return file_out(name, label, "HTML files (*.html)", **extra)
+
+
+def json_out(name: str, label: str, **extra: Any) -> Param:
+    """A JSON file output (a camera, the figures of a report): :func:`file_out` with its
+    options."""
+    return file_out(name, label, JSON_FILTER, **extra)
 
 
 def table_param(name: str, label: str, **extra: Any) -> Param:
@@ -267,8 +270,61 @@ def unit_symbol(name: str) -> str:
     return _UNIT_SYMBOLS.get(name.strip().lower(), name)
 
 
-def unit_text(info: Any, distance_unit: str) -> str:
-    """How the job reports the unit its lengths were taken in."""
+def cluster_params(advanced: bool = False) -> tuple[Param, ...]:
+    """CLUSTER, WORKERS, MEMORY_LIMIT and LOCAL_CLUSTER: the dask cluster that processes tiles
+    (``lidar_block.cluster_session``); ``advanced``: all four among the advanced parameters
+    (else CLUSTER and WORKERS shown)."""
+    return (
+        Param(
+            "CLUSTER",
+            "string",
+            "dask scheduler address (empty: a local cluster)",
+            "",
+            optional=True,
+            advanced=advanced,
+            help="e.g. tcp://10.0.0.5:8786",
+        ),
+        Param(
+            "WORKERS",
+            "integer",
+            "Local cluster: workers (0 = one per core)",
+            0,
+            minimum=0,
+            maximum=1024,
+            advanced=advanced,
+        ),
+        Param(
+            "MEMORY_LIMIT",
+            "number",
+            "Local cluster: memory limit per worker (0 = RAM / workers)",
+            0.0,
+            unit="GB",
+            minimum=0.0,
+            maximum=4096.0,
+            advanced=True,
+        ),
+        Param(
+            "LOCAL_CLUSTER",
+            "enum",
+            "Local cluster workers",
+            "auto",
+            options=("auto", "processes", "threads"),
+            labels=(
+                "auto (processes on the command line, threads inside QGIS)",
+                "processes (one per worker)",
+                "threads of this process",
+            ),
+            advanced=True,
+            help="auto: processes on the command line, threads inside QGIS or "
+            "qgis_process, where a process cluster would start QGIS's own executable for "
+            "each worker",
+        ),
+    )
+
+
+def length_unit_text(info: Any, distance_unit: str) -> str:
+    """How the job reports the unit its lengths were taken in (the cloud CRS unit, or metres
+    converted; not the help's unit of a parameter, :func:`.spec.unit_text`)."""
     return "metre (converted)" if distance_unit == "metre" else info.horizontal_unit
 
 

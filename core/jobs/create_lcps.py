@@ -7,7 +7,7 @@ from dataclasses import replace
 
 from ..errors import InputError
 from ..i18n import mark as _t
-from .common import CSV_FILTER, cloud_params, csv_out, lengths_in_cloud_units, unit_symbol
+from .common import cloud_params, csv_out, lengths_in_cloud_units, table_param, unit_symbol
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
@@ -44,7 +44,7 @@ metres; the outputs are in the CRS unit. Optionally give your own plane-id tripl
 rejected candidates per reason; each one, with its numbers and units, is listed only in
 verbose mode (command line: -vv; QGIS: Processing options, logging level Verbose).""",
     params=(
-        Param("PLANES", "table", "Plane table (CSV)", file_filter=CSV_FILTER),
+        table_param("PLANES", "Plane table (CSV)"),
         *cloud_params("CLOUD", "Cloud with plane ids (LAS/LAZ)"),
         Param(
             "DELTA",

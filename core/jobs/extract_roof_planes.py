@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import InputError
 from .checks import check_memory
-from .common import cloud_params, csv_out, lengths_in_cloud_units
+from .common import cloud_out, cloud_params, csv_out, lengths_in_cloud_units
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -161,14 +161,7 @@ error.""",
         *_D.params(_NUMBERS, _HELP),
         Param("OUTPUT", "sink", "Roof planes", geometry="polygon", optional=True),
         csv_out("OUTPUT_CSV", "Plane table (CSV)", optional=False),
-        Param(
-            "OUTPUT_CLOUD",
-            "file_out",
-            "Point cloud with plane_id",
-            optional=True,
-            create_by_default=False,
-            file_filter="LAZ files (*.laz);;LAS files (*.las)",
-        ),
+        cloud_out("OUTPUT_CLOUD", "Point cloud with plane_id", on_demand=True),
     ),
     results=(
         Result("PLANE_COUNT", "number", "Number of planes"),

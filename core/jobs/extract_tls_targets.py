@@ -7,7 +7,7 @@ import logging
 from pathlib import Path
 
 from ..io.suffixes import SCAN_SUFFIXES
-from .common import CSV_FILTER, csv_out
+from .common import csv_out, table_param
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -94,13 +94,7 @@ and take the ids of CONTROL points when given (matched the same way).""",
             maximum=10.0,
             advanced=True,
         ),
-        Param(
-            "CONTROL",
-            "table",
-            "Control targets (CSV, for their ids)",
-            optional=True,
-            file_filter=CSV_FILTER,
-        ),
+        table_param("CONTROL", "Control targets (CSV, for their ids)", optional=True),
         csv_out("OUTPUT", "Target observations (CSV)", optional=False),
     ),
     results=(Result("TARGETS", "number", "Target centres found (all scans)"),),

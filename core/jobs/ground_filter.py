@@ -6,7 +6,7 @@ import logging
 
 from ..errors import InputError
 from .checks import GROUND_FILTER_BYTES_PER_CELL, GROUND_FILTER_BYTES_PER_POINT, check_cell_size
-from .common import cloud_params, lengths_in_cloud_units, unit_text
+from .common import cloud_out, cloud_params, length_unit_text, lengths_in_cloud_units
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Ref, Result, Values
 
@@ -294,8 +294,7 @@ also the extra dimension height_above_ground (float32); optionally the DTM as Ge
         Param("HEIGHT_ABOVE_GROUND", "boolean", "Add the height above the DTM to the cloud",
               False, help="the extra dimension height_above_ground (float32, vertical unit); "
               "it changes the point format (extra bytes) and makes the file larger"),
-        Param("OUTPUT_CLOUD", "file_out", "Classified point cloud",
-              file_filter="LAZ files (*.laz);;LAS files (*.las)"),
+        cloud_out("OUTPUT_CLOUD", "Classified point cloud", optional=False),
         Param("OUTPUT_DTM", "raster_out", "DTM", optional=True, create_by_default=False),
     ),
     results=(
@@ -374,7 +373,7 @@ def run(v: Values, out, progress=None, should_stop=None) -> JobResult:
 
 def _job_result(v: Values, info, result, out) -> JobResult:
     """The figures and the summary line of the run."""
-    unit = unit_text(info, v.distance_unit)
+    unit = length_unit_text(info, v.distance_unit)
     ground, low = result.stats["ground_count"], result.stats["low_outlier_count"]
     slope = result.stats.get("slope_estimated")
     estimated = f"; terrain slope estimated at {slope:.3f}" if slope is not None else ""

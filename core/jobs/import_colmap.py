@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import logging
 
-from .common import csv_out
+from .common import csv_out, json_out
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Ref, Result, Values
 
@@ -15,13 +15,7 @@ COLMAP_FILTER = "COLMAP cameras (cameras.txt cameras.bin);;All files (*)"
 
 #: The tables every block import writes (importcolmap, importopensfm).
 BLOCK_OUTPUTS = (
-    Param(
-        "OUTPUT_CAMERA",
-        "file_out",
-        "Cameras (JSON)",
-        optional=True,
-        file_filter="JSON files (*.json)",
-    ),
+    json_out("OUTPUT_CAMERA", "Cameras (JSON)"),
     csv_out("OUTPUT_EO", "Exterior orientation table (CSV)"),
     csv_out("OUTPUT_OBSERVATIONS", "Observations (tie points, CSV)"),
     csv_out("OUTPUT_POINTS", "3D points (ground point table, CSV)", on_demand=True),

@@ -5,9 +5,17 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_FILTER, choice_param, csv_out, mapping_crs_param, mount_from, mount_params
+from .common import (
+    choice_param,
+    csv_out,
+    enum_param,
+    mapping_crs_param,
+    mount_from,
+    mount_params,
+    table_param,
+)
 from .runner import JobResult
-from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
@@ -59,13 +67,12 @@ trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""
             "TRAJECTORY_FORMATS",
             help="auto: by the file's ending (.out/.sbet SBET, .csv CSV, else ASCII)",
         ),
-        Param("EVENTS", "table", "Camera events (CSV: image_id, time)", file_filter=CSV_FILTER),
-        Param(
+        table_param("EVENTS", "Camera events (CSV: image_id, time)"),
+        enum_param(
             "EVENT_TIME",
-            "enum",
             "Clock of the event times",
             _OPTIONS.event_time,
-            options=Ref("photo.trajectory_options", "EVENT_TIMES"),
+            "EVENT_TIMES",
             help="gps: GPS seconds of week; utc: ISO 8601 date-times in UTC",
         ),
         Param(
@@ -100,12 +107,11 @@ trajectorytoeo computes it. OUTPUT: the perspective centres as a PointZ layer.""
             help="an event between two records further apart than this is refused",
             advanced=True,
         ),
-        Param(
+        enum_param(
             "ATTITUDE",
-            "enum",
             "Attitude interpolation",
             _OPTIONS.attitude,
-            options=Ref("photo.trajectory_options", "ATTITUDE_METHODS"),
+            "ATTITUDE_METHODS",
             advanced=True,
             help="cubic: Hermite cubic on the rotation group with the neighbours' angular "
             "velocities; slerp: constant angular velocity between two records",

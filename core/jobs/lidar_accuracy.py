@@ -10,9 +10,9 @@ from typing import Any
 
 from ..errors import InputError
 from .checks import check_memory
-from .common import CSV_FILTER, html_out
+from .common import CSV_FILTER, cluster_params, enum_param, html_out, json_out, table_param
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
@@ -162,20 +162,17 @@ that accuracyreport reads for the NSSDA and PEC-PCD sections.""",
             suffixes=_LAS_SUFFIXES,
             help="LAS/LAZ files of one survey, or folders of them",
         ),
-        Param(
+        table_param(
             "CHECKPOINTS",
-            "table",
             "Check points (CSV: id, e, n, h, group)",
             optional=True,
-            file_filter=CSV_FILTER,
             help="surveyed check points; group = land cover",
         ),
-        Param(
+        enum_param(
             "SWATH_SOURCE",
-            "enum",
             "Swaths from",
             _D.swath_source,
-            options=Ref("quality.lidar_accuracy_options", "SWATH_SOURCES"),
+            "SWATH_SOURCES",
             labels=("point source id, else GPS time", "point source id", "GPS time gaps"),
         ),
         Param(
@@ -200,56 +197,9 @@ that accuracyreport reads for the NSSDA and PEC-PCD sections.""",
             "cluster, as lidarblock; needs point source ids",
             advanced=True,
         ),
-        Param(
-            "CLUSTER",
-            "string",
-            "dask scheduler address (empty: a local cluster)",
-            "",
-            optional=True,
-            advanced=True,
-            help="e.g. tcp://10.0.0.5:8786",
-        ),
-        Param(
-            "WORKERS",
-            "integer",
-            "Local cluster: workers (0 = one per core)",
-            0,
-            minimum=0,
-            maximum=1024,
-            advanced=True,
-        ),
-        Param(
-            "MEMORY_LIMIT",
-            "number",
-            "Local cluster: memory limit per worker (0 = RAM / workers)",
-            0.0,
-            unit="GB",
-            minimum=0.0,
-            maximum=4096.0,
-            advanced=True,
-        ),
-        Param(
-            "LOCAL_CLUSTER",
-            "enum",
-            "Local cluster workers",
-            "auto",
-            options=("auto", "processes", "threads"),
-            labels=(
-                "auto (processes on the command line, threads inside QGIS)",
-                "processes (one per worker)",
-                "threads of this process",
-            ),
-            advanced=True,
-        ),
+        *cluster_params(advanced=True),
         html_out("OUTPUT_HTML", "LiDAR accuracy report (HTML)", optional=False),
-        Param(
-            "OUTPUT_JSON",
-            "file_out",
-            "LiDAR accuracy figures (JSON)",
-            optional=True,
-            create_by_default=False,
-            file_filter="JSON files (*.json)",
-        ),
+        json_out("OUTPUT_JSON", "LiDAR accuracy figures (JSON)", on_demand=True),
         Param(
             "OUTPUT_RASTER",
             "raster_out",

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import Cancelled, InputError
-from .common import cloud_params, lengths_in_cloud_units
+from .common import cloud_params, cluster_params, lengths_in_cloud_units
 from .lidar_block_tiles import (
     ROOF_SCRATCH,
     BlockSettings,
@@ -121,20 +121,7 @@ DISTANCE_UNIT is metres.""",
               unit="length", minimum=0.001, maximum=1000.0),
         Param("MIN_BOUNDARY", "number", "Control: minimum common boundary", _C.min_boundary,
               unit="length", minimum=0.0, maximum=10000.0, advanced=True),
-        Param("CLUSTER", "string", "dask scheduler address (empty: a local cluster)", "",
-              optional=True, help="e.g. tcp://10.0.0.5:8786"),
-        Param("WORKERS", "integer", "Local cluster: workers (0 = one per core)", 0,
-              minimum=0, maximum=1024),
-        Param("MEMORY_LIMIT", "number", "Local cluster: memory limit per worker (0 = RAM / "
-              "workers)", 0.0, unit="GB", minimum=0.0, maximum=4096.0, advanced=True),
-        Param("LOCAL_CLUSTER", "enum", "Local cluster workers", "auto",
-              options=("auto", "processes", "threads"),
-              labels=("auto (processes on the command line, threads inside QGIS)",
-                      "processes (one per worker)", "threads of this process"),
-              advanced=True,
-              help="auto: processes on the command line, threads inside QGIS or "
-              "qgis_process, where a process cluster would start QGIS's own executable for "
-              "each worker"),
+        *cluster_params(),
         Param("OUTPUT_FOLDER", "folder_out", "Output folder (tiles, VPC, tables, report)"),
     ),
     results=(

@@ -7,7 +7,7 @@ import logging
 import math
 
 from ..io.suffixes import PHOTO_SUFFIXES
-from .common import CSV_FILTER
+from .common import camera_param, table_param
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
@@ -60,27 +60,19 @@ inliers). A point that fails (plate not found, only one square, ambiguous, resec
 too large, too few SIFT matches, chip partly outside the photo) gets its reason and no chip;
 the others are written.""",
     params=(
-        Param(
+        table_param(
             "POINTS",
-            "table",
             "Ground points (CSV)",
-            file_filter=CSV_FILTER,
             help="point_id, X, Y, Z, role (the bundle adjustment's table)",
         ),
         Param("CRS", "crs", "Mapping CRS of the points", help="e.g. EPSG:31983"),
-        Param(
-            "CAMERA",
-            "file",
-            "Ground camera (JSON)",
-            file_filter="JSON files (*.json)",
-            help="perspective or fisheye (as written by calibratecamera)",
+        camera_param(
+            "Ground camera (JSON)", help="perspective or fisheye (as written by calibratecamera)"
         ),
-        Param(
+        table_param(
             "PHOTO_TABLE",
-            "table",
             "Ground-photo table (CSV)",
             optional=True,
-            file_filter=CSV_FILTER,
             help="point_id, plate_photo, free_photo; else PHOTOS are searched by name",
         ),
         Param(

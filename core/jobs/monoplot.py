@@ -6,13 +6,13 @@ import logging
 
 from .checks import DSM_BYTES_PER_CELL, check_cell_size, check_memory
 from .common import (
-    CSV_FILTER,
     DSM_FILTER,
     camera_param,
     choice_param,
     csv_out,
     dsm_cell_param,
     eo_param,
+    table_param,
 )
 from .runner import JobResult, stages
 from .spec import AlgorithmSpec, Param, Ref, Result, Values
@@ -57,7 +57,7 @@ a hole first), no_orientation (image not in the EO table), not_converged (Makaro
 parallel / unknown_plane (planes), out_of_field (the point lies beyond a fisheye
 projection's field: no ray).""",
     params=(
-        Param("OBSERVATIONS", "table", "Image observations (CSV)", file_filter=CSV_FILTER),
+        table_param("OBSERVATIONS", "Image observations (CSV)"),
         camera_param(),
         eo_param(),
         Param(
@@ -66,7 +66,7 @@ projection's field: no ray).""",
             "DSM (raster, or LAS/LAZ)",
             file_filter=DSM_FILTER,
         ),
-        Param("PLANES", "table", "Roof plane table (CSV)", optional=True, file_filter=CSV_FILTER),
+        table_param("PLANES", "Roof plane table (CSV)", optional=True),
         Param("CRS", "crs", "Mapping CRS of the EO", help="e.g. EPSG:28992"),
         Param(
             "DSM_CRS",

@@ -7,9 +7,9 @@ import math
 from dataclasses import dataclass
 
 from ..io.suffixes import IMAGE_SUFFIXES
-from .common import compression_param, csv_out
+from .common import compression_param, csv_out, enum_param
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
@@ -46,12 +46,11 @@ the region each image fills, as a layer and as a CSV (image_id, cells, area, WKT
 MultiPolygon in the mosaic's CRS).""",
     params=(
         Param("ORTHOPHOTOS", "files", "Orthophotos (files or folders)", suffixes=IMAGE_SUFFIXES),
-        Param(
+        enum_param(
             "METHOD",
-            "enum",
             "Image chosen per cell",
             _D.method,
-            options=Ref("photo.ortho_options", "MOSAIC_METHODS"),
+            "MOSAIC_METHODS",
             labels=("most nadir view", "nearest image centre"),
         ),
         Param(

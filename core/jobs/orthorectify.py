@@ -17,11 +17,12 @@ from .common import (
     camera_param,
     compression_param,
     dsm_cell_param,
+    enum_param,
     eo_param,
     images_param,
 )
 from .runner import JobResult, stages
-from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 
@@ -95,13 +96,7 @@ Nothing is written when an input is wrong; the files appear together when all ar
             optional=True,
             unit="CRS unit",
         ),
-        Param(
-            "RESAMPLING",
-            "enum",
-            "Resampling",
-            _D.resampling,
-            options=Ref("photo.ortho_options", "RESAMPLING"),
-        ),
+        enum_param("RESAMPLING", "Resampling", _D.resampling, "RESAMPLING"),
         Param(
             "TRUE_ORTHO", "boolean", "True orthophoto (occluded ground = no data)", _D.true_ortho
         ),

@@ -12,9 +12,9 @@ from __future__ import annotations
 import logging
 import math
 
-from .common import CSV_FILTER, camera_param, csv_out, global_test_verdict, html_out
+from .common import camera_param, csv_out, enum_param, global_test_verdict, html_out, table_param
 from .runner import JobResult
-from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
+from .spec import AlgorithmSpec, Fields, Param, Result, Values, options_from
 
 log = logging.getLogger(__name__)
 _OPTIONS = Fields("photo.resection_options", "ResectionOptions")
@@ -65,36 +65,28 @@ and whole lines, and a diagnosis naming what the observations cannot determine (
 lines parallel).""",
     params=(
         camera_param(),
-        Param(
+        table_param(
             "OBSERVATIONS",
-            "table",
             "Image observations (CSV)",
             optional=True,
-            file_filter=CSV_FILTER,
             help="points (and line points) measured in the images",
         ),
-        Param(
+        table_param(
             "LINE_OBSERVATIONS",
-            "table",
             "Image line observations (CSV)",
             optional=True,
-            file_filter=CSV_FILTER,
             help="rows of type line in a second observation file",
         ),
-        Param(
+        table_param(
             "CONTROL_POINTS",
-            "table",
             "Control points (CSV)",
             optional=True,
-            file_filter=CSV_FILTER,
             help="point_id,X,Y,Z[,sx,sy,sz] or the LCP table",
         ),
-        Param(
+        table_param(
             "CONTROL_LINES",
-            "table",
             "Control lines (CSV)",
             optional=True,
-            file_filter=CSV_FILTER,
             help="LiDAR line table, 3D segments (id,x1..z2) or monoplotted lines",
         ),
         Param(
@@ -104,12 +96,10 @@ lines parallel).""",
             qgis_default="ProjectCrs",
             help="projected CRS of the control points and lines (and of APPROX_EO)",
         ),
-        Param(
+        table_param(
             "APPROX_EO",
-            "table",
             "Approximate exterior orientation (CSV)",
             optional=True,
-            file_filter=CSV_FILTER,
             help="start values instead of the automatic start (images not in it start "
             "automatically)",
         ),
@@ -133,12 +123,11 @@ lines parallel).""",
             optional=True,
             advanced=True,
         ),
-        Param(
+        enum_param(
             "MODEL",
-            "enum",
             "Line model",
             _OPTIONS.model,
-            options=Ref("photo.resection_options", "MODELS"),
+            "MODELS",
             labels=(
                 "coplanarity (no parametrisation)",
                 "equivalent planes (Tommaselli & Tozzi 1996)",

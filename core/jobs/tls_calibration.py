@@ -15,7 +15,7 @@ from pathlib import Path
 from ..i18n import joined as _joined
 from ..i18n import mark as _t
 from ..io.suffixes import SCAN_SUFFIXES
-from .common import CSV_FILTER, csv_out, doubt_params, html_out, settle_doubts
+from .common import csv_out, doubt_params, html_out, settle_doubts, table_param
 from .runner import JobResult
 from .spec import AlgorithmSpec, Fields, Param, Ref, Result, Values, options_from
 
@@ -91,14 +91,12 @@ blunders; the global test of the observations left then proves nothing). With AC
 DOUBTFUL the outputs are written and each table starts with a warning (comment lines
 beginning with #).""",
     params=(
-        Param("OBSERVATIONS", "table", "Observations (CSV)", file_filter=CSV_FILTER),
-        Param("CONTROL", "table", "Control targets (CSV)", optional=True, file_filter=CSV_FILTER),
-        Param(
+        table_param("OBSERVATIONS", "Observations (CSV)"),
+        table_param("CONTROL", "Control targets (CSV)", optional=True),
+        table_param(
             "STATIONS",
-            "table",
             "Stations (CSV)",
             optional=True,
-            file_filter=CSV_FILTER,
             help="approximate poses, compensator tilts, levelled flags; when given, every "
             "observed station must be in it",
         ),

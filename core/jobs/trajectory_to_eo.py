@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 
-from .common import CSV_FILTER, csv_out, mapping_crs_param, mount_from, mount_params
+from .common import csv_out, mapping_crs_param, mount_from, mount_params, table_param
 from .runner import JobResult
 from .spec import AlgorithmSpec, Param, Result, Values
 
@@ -41,7 +41,7 @@ A PointZ layer in the mapping CRS with image_id, time, group, X, Y, Z, omega_deg
 kappa_deg (angles relative to the grid frame at each image), optionally the same table as
 CSV (on the command line, printed when no file is given), and the number of images.""",
     params=(
-        Param("INPUT", "table", "Trajectory table (CSV)", file_filter=CSV_FILTER),
+        table_param("INPUT", "Trajectory table (CSV)"),
         mapping_crs_param("projected CRS of the trajectory's eastings/northings and of the output"),
         *mount_params(),
         Param("OUTPUT", "sink", "Exterior orientation", geometry="point", optional=True),

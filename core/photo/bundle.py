@@ -65,6 +65,7 @@ from ..geometry.frames import MappingFrame
 from ..geometry.rotations import opk_to_matrix
 from ..lsq.adjustment import small_pages
 from .bundle_model import LEVER_NAMES, TIMING_NAME, _cams_from, _Run, _run
+from .bundle_options import ROBUSTS
 from .bundle_result import BundleResult, _finish
 from .bundle_selection import ap_decisions, drop_candidate
 from .bundle_setup import BundleOptions, GroundPoints, _prepare
@@ -214,8 +215,9 @@ def _check_options(
 ) -> Array | None:
     """The options and the EO sigmas checked against each other (InputError naming what is
     wrong); the sigmas as a float64 array (m, m, m, rad, rad, rad) or None."""
-    if opts.robust not in ("none", "huber", "cauchy"):
-        raise InputError(f"robust must be none, huber or cauchy, got {opts.robust!r}")
+    if opts.robust not in ROBUSTS:
+        choices = f"{', '.join(ROBUSTS[:-1])} or {ROBUSTS[-1]}"
+        raise InputError(f"robust must be {choices}, got {opts.robust!r}")
     if eo is not None and eo_sigma is not None:
         eo_sigma = np.asarray(eo_sigma, dtype=np.float64)
         if eo_sigma.shape != (len(eo), 6) or not (

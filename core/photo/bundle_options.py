@@ -11,6 +11,8 @@ from ..geometry.ap_families import AP_FAMILIES
 
 #: Datum definitions of :class:`BundleOptions` (``datum``).
 DATUMS = ("control", "inner", "minimal")
+#: Robust reweightings of :class:`BundleOptions` (``robust``), those of `core.lsq.outliers`.
+ROBUSTS = ("none", "huber", "cauchy")
 
 
 @dataclass(frozen=True)

@@ -140,26 +140,19 @@ def ap_decisions(
             fcrit = float(stats.f.ppf(1 - alpha, sel.size, r))
             others = ", ".join(gnames)
             drop = bool(f <= fcrit)  # NaN: kept
+            joint = {"t": t[k], "critical": tcrit, "others": others, "f": f, "fcritical": fcrit}
             if drop:
                 reason = _t(
                     "insignificant (t = {t:.2f} <= {critical:.2f}, alpha {alpha:g}), also "
                     "jointly with {others} (F = {f:.2f} <= {fcritical:.2f})",
-                    t=t[k],
-                    critical=tcrit,
                     alpha=alpha,
-                    others=others,
-                    f=f,
-                    fcritical=fcrit,
+                    **joint,
                 )
             else:
                 reason = _t(
                     "kept: insignificant alone (t = {t:.2f} <= {critical:.2f}) but jointly "
                     "significant with {others} (F = {f:.2f} > {fcritical:.2f})",
-                    t=t[k],
-                    critical=tcrit,
-                    others=others,
-                    f=f,
-                    fcritical=fcrit,
+                    **joint,
                 )
             out.append(
                 ApDecision(c, int(pos[k]), nm, float(t[k]), tcrit, gnames, f, fcrit, drop, reason)

@@ -16,12 +16,14 @@ from numpy.typing import NDArray
 from ..errors import InputError
 from ..geometry.planes import Plane, fit_plane, orient_up, slope_aspect_deg
 from ..lidar.control import LINE_KINDS, LINE_PARAMETERS, ControlLine, ControlPoint
+from .boresight_options import BoresightOptions
 
 Array = NDArray[np.float64]
 
 #: Standard deviation (metres, each axis) given to a LiDAR line or control point whose layer
-#: carries no precision (the LiDAR sigma of :class:`core.photo.boresight_setup.BoresightOptions`).
-DEFAULT_CONTROL_SIGMA_M = 0.05
+#: carries no precision: the LiDAR sigma of :class:`~.boresight_options.BoresightOptions`
+#: (not a surveyed point's, :data:`~.bundle_setup.DEFAULT_CONTROL_SIGMA_M`).
+DEFAULT_LIDAR_SIGMA_M: float = BoresightOptions.lidar_sigma_m
 _PLANE_COV = tuple(f"cov_{'abcd'[i]}{'abcd'[j]}" for i, j in zip(*np.triu_indices(4)))
 _LINE_COV = tuple(f"cov_{i}{j}" for i, j in zip(*np.triu_indices(6)))
 _LCP_COV = tuple(f"cov_{'xyz'[i]}{'xyz'[j]}" for i, j in zip(*np.triu_indices(3)))
@@ -159,7 +161,7 @@ def line_from_feature(feature: ControlFeature) -> ControlLine | None:
     ``x0..z0``, ``ux..uz`` and ``cov_00..cov_55`` (the line table's) give the line point, the
     direction and their covariance when all present (layer in the mapping CRS); otherwise the
     point is the middle of the segment and the covariance that of a point known to
-    ``sigma_perpendicular`` (or :data:`DEFAULT_CONTROL_SIGMA_M`) across the line in every
+    ``sigma_perpendicular`` (or :data:`DEFAULT_LIDAR_SIGMA_M`) across the line in every
     direction. ``plane_1``, ``plane_2``, ``kind`` and ``dihedral_deg`` are read when present
     (else -1, ``"other"`` and 0: unknown).
 
@@ -182,7 +184,7 @@ def line_from_feature(feature: ControlFeature) -> ControlLine | None:
         direction = direction / np.linalg.norm(direction)
         cov = _symmetric(upper, 6)
     else:
-        sigma = feature.number("sigma_perpendicular") or DEFAULT_CONTROL_SIGMA_M
+        sigma = feature.number("sigma_perpendicular") or DEFAULT_LIDAR_SIGMA_M
         cov = np.zeros((6, 6))
         cov[:3, :3] = sigma**2 * np.eye(3)
     kind = str(feature.attributes.get("kind") or "other")
@@ -204,7 +206,7 @@ def lcp_from_feature(feature: ControlFeature) -> ControlPoint | None:
     """The LiDAR control point of a point feature, None without a height.
 
     The covariance is ``cov_xx..cov_zz`` (the LCP table's; layer in the mapping CRS), else
-    ``sigma_x, sigma_y, sigma_z`` on the diagonal, else :data:`DEFAULT_CONTROL_SIGMA_M` on
+    ``sigma_x, sigma_y, sigma_z`` on the diagonal, else :data:`DEFAULT_LIDAR_SIGMA_M` on
     each axis. ``plane_1..3``, ``min_angle_deg`` and ``condition`` are read when present (else
     -1, 0 and 0: unknown).
 
@@ -223,7 +225,7 @@ def lcp_from_feature(feature: ControlFeature) -> ControlPoint | None:
     elif sigmas is not None:
         cov = np.diag(np.square(sigmas))
     else:
-        cov = DEFAULT_CONTROL_SIGMA_M**2 * np.eye(3)
+        cov = DEFAULT_LIDAR_SIGMA_M**2 * np.eye(3)
     angle, condition = feature.number("min_angle_deg"), feature.number("condition")
     return ControlPoint(
         id=feature.int_id,

@@ -36,7 +36,7 @@ from ..errors import InputError
 from ..geometry.grid import Grid
 from .ortho_options import MOSAIC_METHODS as METHODS
 from .ortho_options import MosaicOptions
-from .orthophoto import ordered_map
+from .orthophoto import ordered_map, tile_windows
 
 #: read(k, (col0, row0, cols, rows)) -> (data (bands, rows, cols), valid (rows, cols)) of
 #: orthophoto k in its own pixels
@@ -258,12 +258,7 @@ def mosaic_tiles(
     offsets = [_offset(s.grid, grid) for s in sources]
     zs = [s.ground_z for s in sources if s.ground_z is not None and math.isfinite(s.ground_z)]
     z_ref = float(np.mean(zs)) if zs else 0.0
-    size = int(opt.tile_px)
-    windows = [
-        (r0, c0, min(size, grid.rows - r0), min(size, grid.cols - c0))
-        for r0 in range(0, grid.rows, size)
-        for c0 in range(0, grid.cols, size)
-    ]
+    windows = tile_windows(grid, opt.tile_px)
     kind = np.dtype(dtype)
 
     def one(win: tuple[int, int, int, int]) -> MosaicTile:

@@ -579,12 +579,7 @@ def orthorectify_tiles(
         Fraction of tiles done; cancellation (checked per tile: raises Cancelled).
     """
     opt = options or OrthoOptions()
-    size = int(opt.tile_px)
-    windows = [
-        (r0, c0, min(size, grid.rows - r0), min(size, grid.cols - c0))
-        for r0 in range(0, grid.rows, size)
-        for c0 in range(0, grid.cols, size)
-    ]
+    windows = tile_windows(grid, opt.tile_px)
     kind = np.dtype(dtype)
     if opt.true_ortho and projector.tracer is None:
         from dataclasses import replace
@@ -598,6 +593,21 @@ def orthorectify_tiles(
         return _tile(projector, grid, *win, read_window, bands, kind, opt, f)
 
     yield from ordered_map(one, windows, opt.workers, progress, should_stop, "orthorectifying")
+
+
+def tile_windows(grid: Grid, size: int) -> list[tuple[int, int, int, int]]:
+    """The (row0, col0, rows, cols) tiles of at most ``size`` cells that cover ``grid``,
+    row-major (the last row and column of tiles cut at the grid's edge).
+
+    >>> tile_windows(Grid(0.0, 0.0, 1.0, 3, 5), 2)
+    [(0, 0, 2, 2), (0, 2, 2, 2), (0, 4, 2, 1), (2, 0, 1, 2), (2, 2, 1, 2), (2, 4, 1, 1)]
+    """
+    size = int(size)
+    return [
+        (r0, c0, min(size, grid.rows - r0), min(size, grid.cols - c0))
+        for r0 in range(0, grid.rows, size)
+        for c0 in range(0, grid.cols, size)
+    ]
 
 
 def ordered_map(

@@ -22,7 +22,7 @@ from lidarphoto.core.io.control import (
 )
 from lidarphoto.core.io.planes import read_planes_csv, write_planes_csv
 from lidarphoto.core.photo.control_features import (
-    DEFAULT_CONTROL_SIGMA_M,
+    DEFAULT_LIDAR_SIGMA_M,
     ControlFeature,
     ControlSet,
 )
@@ -146,11 +146,11 @@ def test_control_from_layer_features(flight):
         assert got.id == true.id
     for got, true in zip(control.lines, sim.lines):
         np.testing.assert_array_equal([got.start, got.end], [true.start, true.end])
-        assert got.sigma_perpendicular == pytest.approx(DEFAULT_CONTROL_SIGMA_M)
+        assert got.sigma_perpendicular == pytest.approx(DEFAULT_LIDAR_SIGMA_M)
         assert got.plane_ids == (-1, -1) and got.kind == "other"
     for got, true in zip(control.lcps, sim.lcps):
         np.testing.assert_array_equal(got.xyz, true.xyz)
-        np.testing.assert_allclose(got.sigma, DEFAULT_CONTROL_SIGMA_M)
+        np.testing.assert_allclose(got.sigma, DEFAULT_LIDAR_SIGMA_M)
     heights = np.concatenate([r[:, 2] for r in outlines])
     assert control.ground_height() == pytest.approx(heights.mean())
     # with the tables' fields: plane parameters (heights put on the plane), sigmas, plane ids
