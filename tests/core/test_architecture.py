@@ -323,7 +323,7 @@ DUPLICATE_FOLDERS = ("core", "processing_provider", "plugin")
 #: merges and h38e (shared job outputs and area checks, one rotation check, one AP rerun); 99
 #: after h38dup (COLMAP/OpenSfM block helpers, CAMERA/EO/IMAGES/CRS/table parameter factories,
 #: one QGIS enum rule, simulators' folder_files, shared low-outlier ground-filter parameters).
-MAX_DUPLICATE_PAIRS = 95
+MAX_DUPLICATE_PAIRS = 94
 _PAIR_ROW = re.compile(r"^D\d+ (\S+):\d+-\d+ ~ (\S+):\d+-\d+")
 
 
