@@ -8511,15 +8511,17 @@ matching (Gruen 1985, 6 affine + 2 radiometric parameters) of every measurement 
 against a 21 x 21 px template around its measurement in the track's first image (kept
 fixed), in the full-resolution grey images (each read a second time, one at a time),
 starting from the local affine between the two images; a match the least-squares matching
-calls another point (moved more than 3 px, correlation below 0.7) is dropped, any other
-failure keeps the keypoint.</source>
+calls another point (moved more than 3 px, correlation below 0.7) is dropped, as is one it
+refuses for another reason (left its window, no convergence); a measurement it cannot try
+(template at the image border, no start affine) keeps the keypoint.</source>
             <translation>Refinamento (ligado por padrão; desmarcado, os pontos-chave são escritos como detectados): correspondência
 por mínimos quadrados (Gruen 1985, 6 parâmetros afins + 2 radiométricos) de cada medição de um rastro
 contra um modelo de 21 x 21 px em torno de sua medição na primeira imagem do rastro (mantida
 fixa), nas imagens em tons de cinza em resolução total (cada uma lida uma segunda vez, uma de cada vez),
 partindo da afim local entre as duas imagens; uma correspondência que a correspondência por mínimos quadrados
-leva a outro ponto (deslocada mais de 3 px, correlação abaixo de 0,7) é descartada; qualquer outra
-falha mantém o ponto-chave.</translation>
+leva a outro ponto (deslocada mais de 3 px, correlação abaixo de 0,7) é descartada, assim como uma
+que ela recusa por outro motivo (saiu da sua janela, sem convergência); uma medição que ela não pode
+tentar (modelo na borda da imagem, sem afim inicial) mantém o ponto-chave.</translation>
         </message>
         <message>
             <source>Output: the image-observation CSV (type tie, point ids tp000001 ..., target_id empty), read
@@ -8596,6 +8598,10 @@ medida da primeira imagem da trilha: a mediana dos sigmas refinados da sua trilh
             <translation>Feições por imagem</translation>
         </message>
         <message>
+            <source>SIFT keypoints kept per image (Keypoints kept); 6 kite images, all pairs: 16,384 (default) 3,664 tracks seen in 3 images, COLMAP at its 8,192 3,662-3,730, for about half its CPU; 4,000: 1,190 (bench/matching.md)</source>
+            <translation>pontos-chave SIFT mantidos por imagem (Pontos-chave mantidos); 6 imagens de pipa, todos os pares: 16.384 (padrão) 3.664 trilhas vistas em 3 imagens, o COLMAP com os seus 8.192 3.662-3.730, por cerca de metade da sua CPU; 4.000: 1.190 (bench/matching.md)</translation>
+        </message>
+        <message>
             <source>Keypoints kept (SIFT)</source>
             <translation>Pontos-chave mantidos (SIFT)</translation>
         </message>
@@ -8616,8 +8622,8 @@ medida da primeira imagem da trilha: a mediana dos sigmas refinados da sua trilh
             <translation>Limiar de contraste do SIFT</translation>
         </message>
         <message>
-            <source>OpenCV's contrastThreshold (grey levels / 255 over 3 layers per octave): lower finds weaker extrema, so that low-contrast images fill Features per image; 6 kite images at 8,192 features (strongest kept): OpenCV's 0.04 finds 5,116 per image, 0.02 (default) fills the budget, verified matches 5,954 -&gt; 9,874; 0.01 gives the same within 0.4 %</source>
-            <translation>o contrastThreshold do OpenCV (níveis de cinza / 255 em 3 camadas por oitava): um valor menor encontra extremos mais fracos, para que imagens de baixo contraste preencham as Feições por imagem; 6 imagens de pipa com 8.192 feições (as mais fortes mantidas): o 0,04 do OpenCV encontra 5.116 por imagem, 0,02 (padrão) preenche o orçamento, correspondências verificadas 5.954 -&gt; 9.874; 0,01 dá o mesmo a 0,4 %</translation>
+            <source>OpenCV's contrastThreshold (grey levels / 255 over 3 layers per octave): lower finds weaker extrema, so that low-contrast images fill Features per image; 6 kite images at 8,192 features (strongest kept): OpenCV's 0.04 finds 5,116 per image, 0.02 fills the budget, verified matches 5,954 -&gt; 9,874; 0.01 (default) gives the same within 0.4 % and fills it at half the detection size</source>
+            <translation>o contrastThreshold do OpenCV (níveis de cinza / 255 em 3 camadas por oitava): um valor menor encontra extremos mais fracos, para que imagens de baixo contraste preencham as Feições por imagem; 6 imagens de pipa com 8.192 feições (as mais fortes mantidas): o 0,04 do OpenCV encontra 5.116 por imagem, 0,02 preenche o orçamento, correspondências verificadas 5.954 -&gt; 9.874; 0,01 (padrão) dá o mesmo a 0,4 % e o preenche na metade do tamanho de detecção</translation>
         </message>
         <message>
             <source>RootSIFT descriptors (Arandjelovic &amp; Zisserman 2012)</source>
@@ -8638,6 +8644,10 @@ medida da primeira imagem da trilha: a mediana dos sigmas refinados da sua trilh
         <message>
             <source>Detection size (longer side, 0 = full resolution)</source>
             <translation>Tamanho de detecção (lado maior, 0 = resolução completa)</translation>
+        </message>
+        <message>
+            <source>the image is reduced by the smallest integer factor that brings its longer side to at most this (2,000 by default: images of 2,001-4,000 px at half size); 6 kite images (2,136 px), 16,384 features: half size 3,980 tracks seen in 3 images against 3,917 at full size, for 5.0 s of detection instead of 13.3 s</source>
+            <translation>a imagem é reduzida pelo menor fator inteiro que leva o seu lado maior a no máximo este valor (2.000 por padrão: imagens de 2.001-4.000 px na metade do tamanho); 6 imagens de pipa (2.136 px), 16.384 feições: na metade do tamanho 3.980 trilhas vistas em 3 imagens contra 3.917 em tamanho pleno, por 5,0 s de detecção em vez de 13,3 s</translation>
         </message>
         <message>
             <source>Ratio test (best / second best)</source>

@@ -23,23 +23,31 @@ class TiePointOptions:
 
     detector : "sift" or "orb"
     max_features : int
-        Keypoints kept per image (which ones: ``keep``).
+        Keypoints kept per image (which ones: ``keep``). 16,384 by default (COLMAP's
+        keypoint count at its 8,192: 6 kite images, 3,795 three-image tracks against its
+        3,662-3,730; 4,000 before 2026-12-04: 1,190; bench/matching.md).
     contrast : float
         SIFT's contrast threshold (OpenCV's ``contrastThreshold``, divided by the 3 layers
         per octave: grey levels / 255; OpenCV's default 0.04). Lower finds weaker extrema;
         ``max_features`` are kept either way (see ``keep``), so a low threshold fills the
         budget on low-contrast images instead of stopping short of it (6 kite images at
-        8,192 features: 0.04 finds 5,116 per image, 0.02 fills the budget).
+        8,192 features: 0.04 finds 5,116 per image, 0.02 fills the budget; 0.01 by default,
+        which finds more at the reduced detection size).
     keep : one of :data:`KEEP_MODES`
         SIFT: which ``max_features`` keypoints are kept when more are found: ``"scale"``
         those of the largest scale (COLMAP's rule; fine-scale extrema are many and repeat
         less between views), ``"response"`` the strongest (OpenCV's). ORB: the strongest.
     max_dimension_px : int
         Features are detected on the image reduced by the smallest integer factor that
-        brings its longer side to at most this; 0 detects at full resolution.
+        brings its longer side to at most this; 0 detects at full resolution. 2,000 by
+        default: images of 2,001-4,000 px at half size, where OpenCV's doubled first octave
+        is the full image's octave 0 (the largest scales kept come from octaves >= 0 at
+        full size: the same keypoints for a quarter of the detection's CPU).
     checks : int
         SIFT: leaves of FLANN's k-d trees visited per nearest-neighbour search (the search's
-        cost grows with it; fewer finds fewer true neighbours).
+        cost grows with it; fewer finds fewer true neighbours). 24 by default: 6 kite
+        images at 16,384 features, 64 checks 3,980 three-image tracks, 24 3,849, for 60 %
+        less matching CPU (bench/matching.md).
     ratio : float
         Lowe's ratio: best distance / second best must be below it.
     root_sift : bool
@@ -89,15 +97,22 @@ class TiePointOptions:
     refine_sigma_floor_px : float
         Smallest sigma_px written for a refined measurement (the LSM sigma ignores the
         model errors of the affine patch model, e.g. relief inside the patch).
+    refine_keep_unrefined : bool
+        A measurement the least-squares matching ran on and refused without calling it
+        another point (the patch left its window, no convergence, no texture, sigma too
+        large) is kept at its keypoint (True) or dropped (False, the default since
+        2026-12-04: on the simulated block at 1,500 features, 5 -> 1 wrong tracks of 4,400,
+        all of them such measurements). Measurements it could not try (template at the image
+        border, no start affine) are kept either way.
     """
 
     detector: str = "sift"
-    max_features: int = 4000
-    contrast: float = 0.02
+    max_features: int = 16384
+    contrast: float = 0.01
     keep: str = "scale"
-    max_dimension_px: int = 3000
+    max_dimension_px: int = 2000
     ratio: float = 0.8
-    checks: int = 64
+    checks: int = 24
     root_sift: bool = True
     mutual: bool = True
     ransac_px: float = 2.0
@@ -114,6 +129,7 @@ class TiePointOptions:
     refine: bool = True
     refine_half_px: int = 10
     refine_sigma_floor_px: float = 0.02
+    refine_keep_unrefined: bool = False
 
     def __post_init__(self) -> None:
         if self.detector not in DETECTORS:

@@ -25,6 +25,8 @@ Array = NDArray[np.float64]
 _BLUNDER_TEXT = ("moved too far", "low correlation")
 #: Correspondences a start affine is fitted to (nearest tracks seen in both images).
 _START_NEIGHBOURS = 12
+#: LSM statuses of a patch it ran on and refused without calling it another point.
+_RAN_TEXT = ("no texture", "left the search window", "not converged", "sigma too large")
 _LSM_CHUNK = 4000
 
 
@@ -90,6 +92,7 @@ class _Work:
     sigma: Array
     keep: NDArray[np.bool_]
     refined: NDArray[np.bool_]
+    failed: NDArray[np.bool_] | None = None  # the LSM ran and refused (not a blunder)
     kept: dict[str, int] = field(default_factory=dict)
     dropped: dict[str, int] = field(default_factory=dict)
 
@@ -196,6 +199,8 @@ def _match(
             work.keep[rows[res.status == code]] = False
             _count(work.dropped, reason, m)
         else:
+            if work.failed is not None:
+                work.failed[rows[res.status == code]] = True
             _count(work.kept, reason, m)
 
 
@@ -221,11 +226,17 @@ def _templates(t: Tracks, refs: NDArray[np.intp], img: Array, h: int) -> _Templa
 
 
 def _finish(
-    t: Tracks, ix: _Index, work: _Work, min_track_length: int
+    t: Tracks, ix: _Index, work: _Work, min_track_length: int, keep_unrefined: bool = True
 ) -> tuple[Tracks, Array, RefineStats]:
     """Reference sigmas (the median of the refined measurements of the track), the tracks
-    left too short dropped, the statistics."""
+    left too short dropped, the statistics. ``keep_unrefined`` False: a measurement the LSM
+    ran on and refused (``work.failed``) is dropped, its reason moved from ``kept`` to
+    ``dropped``."""
     sigma, refined, keep = work.sigma, work.refined, work.keep
+    if not keep_unrefined and work.failed is not None:
+        for reason in [r for r in work.kept if r in _RAN_TEXT]:
+            _count(work.dropped, reason, work.kept.pop(reason))
+        keep &= ~work.failed
     tr = np.flatnonzero(refined)
     if tr.size:
         order = np.argsort(t.track[tr], kind="stable")
@@ -288,7 +299,8 @@ def refine_tracks(
     another point (moved farther than 3 px from the keypoint, or correlation below 0.7)
     drops the measurement; any other failure (no texture, the template or patch reaches the
     image border, no convergence, sigma above 0.2 px, no start affine) keeps the keypoint
-    and its sigma. Tracks left shorter than ``min_track_length`` are dropped.
+    and its sigma (``refine_keep_unrefined`` False: drops those the LSM ran on). Tracks
+    left shorter than ``min_track_length`` are dropped.
 
     Returns
     -------
@@ -298,7 +310,11 @@ def refine_tracks(
     n = t.track.size
     h = int(options.refine_half_px)
     work = _Work(
-        t.pixels.copy(), np.asarray(sigma_px, float).copy(), np.ones(n, bool), np.zeros(n, bool)
+        t.pixels.copy(),
+        np.asarray(sigma_px, float).copy(),
+        np.ones(n, bool),
+        np.zeros(n, bool),
+        None if options.refine_keep_unrefined else np.zeros(n, bool),
     )
     if n == 0:
         return t, work.sigma, RefineStats(0, work.kept, work.dropped, 0, math.nan)
@@ -334,4 +350,4 @@ def refine_tracks(
         del img
         if progress is not None:
             progress((done + 1) / len(active))
-    return _finish(t, ix, work, options.min_track_length)
+    return _finish(t, ix, work, options.min_track_length, options.refine_keep_unrefined)

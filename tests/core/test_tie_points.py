@@ -373,7 +373,12 @@ def test_refinement_against_truth(block, matched, refined):
     # almost every measurement was refined; the rest kept or dropped with a reason
     assert rf.refined > 0.95 * (len(obs) - (t1.max() + 1))
     assert sum(rf.dropped.values()) < 0.01 * len(obs0)
-    assert set(rf.dropped) <= {"moved too far", "low correlation"}
+    # the LSM's blunders, and (refine_keep_unrefined False, the default since 2026-12-04)
+    # the patches it ran on and refused
+    allowed = {"moved too far", "low correlation"}
+    if not TiePointOptions().refine_keep_unrefined:
+        allowed |= {"no texture", "left the search window", "not converged", "sigma too large"}
+    assert set(rf.dropped) <= allowed
     assert len(seen) == 15 and seen[-1] == pytest.approx(1.0)
 
 
