@@ -22,8 +22,8 @@
    sigmas, next to step 6's (the simulated picks), and the run's seconds. The exit code is 1
    when either calibration is beyond 4 sigma of the truth. By default on the first
    ``--auto-images-per-line`` (2) images of each flight line, 4 of the 10 (about 1 min of
-   CPU); ``--auto`` runs it on all ten 24-Mpx images (more than 20 min of CPU today: data
-   snooping re-adjusts the whole block once per LiDAR line it rejects, issue 32,
+   CPU); ``--auto`` runs it on all ten 24-Mpx images (6.7 min of CPU with the segment
+   weighting: data snooping re-adjusts the whole block once per group it sets aside, issue 32,
    bench/auto_boresight.md), ``--no-auto`` skips it.
 9. True orthophotos of the images on the LiDAR DSM with the calibrated orientation
    (``lidarphoto orthorectify``), and their orthomosaic with its seamlines (``lidarphoto
@@ -486,7 +486,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description="The main job end to end (make demo).")
     parser.add_argument(
         "--auto", action="store_true",
-        help="run step 8 on all ten 24-Mpx rendered images (slow: more than 20 min of CPU, "
+        help="run step 8 on all ten 24-Mpx rendered images (slow: about 7 min of CPU, "
         "issue 32)",
     )  # fmt: skip
     parser.add_argument(
