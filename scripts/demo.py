@@ -21,8 +21,8 @@
    approximate boresight of 0), in auto_calibration/; its boresight against the truth, in
    sigmas, next to step 6's (the simulated picks), and the run's seconds. The exit code is 1
    when either calibration is beyond 4 sigma of the truth. By default on the first
-   ``--auto-images-per-line`` (2) images of each flight line, 4 of the 10 (about 1 min of
-   CPU); ``--auto`` runs it on all ten 24-Mpx images (6.7 min of CPU with the segment
+   ``--auto-images-per-line`` (2) images of each flight line, 4 of the 10 (about 1.5 min
+   of CPU); ``--auto`` runs it on all ten 24-Mpx images (6.7 min of CPU with the segment
    weighting: data snooping re-adjusts the whole block once per group it sets aside, issue 32,
    bench/auto_boresight.md), ``--no-auto`` skips it.
 9. True orthophotos of the images on the LiDAR DSM with the calibrated orientation
@@ -492,7 +492,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--auto-images-per-line", type=int, default=2, metavar="N",
         help="run step 8 on the first N images of each flight line (default 2: 4 of the 10 "
-        "images, about 1 min of CPU)",
+        "images, about 1.5 min of CPU)",
     )  # fmt: skip
     parser.add_argument(
         "--no-auto", action="store_true", help="skip step 8 (the automatic calibration)"
