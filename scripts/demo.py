@@ -15,15 +15,16 @@
 7. The images themselves, rendered by ray casting (``core.simulation.render``) from the camera
    and each image's *true* orientation onto the tile's DSM and roof planes, in flight/images/, and
    the check that the projected LiDAR lines fall on the rendered roof edges.
-8. On request (``--auto``; skipped by default: on the ten 24-Mpx images it still takes more
-   than 20 minutes of CPU, issue 32), the boresight calibrated automatically from those
-   rendered images (``lidarphoto
+8. The boresight calibrated automatically from those rendered images (``lidarphoto
    autoboresight``: no observation file; tie points found between the images and associated
    with the LiDAR roof planes, image edges found along the projected LiDAR lines, from an
    approximate boresight of 0), in auto_calibration/; its boresight against the truth, in
    sigmas, next to step 6's (the simulated picks), and the run's seconds. The exit code is 1
-   when either calibration is beyond 4 sigma of the truth. ``--auto-images-per-line N`` runs
-   this step on the first N images of each flight line only (a shorter run; implies --auto).
+   when either calibration is beyond 4 sigma of the truth. By default on the first
+   ``--auto-images-per-line`` (2) images of each flight line, 4 of the 10 (about 1.5 min
+   of CPU); ``--auto`` runs it on all ten 24-Mpx images (6.7 min of CPU with the segment
+   weighting: data snooping re-adjusts the whole block once per group it sets aside, issue 32,
+   bench/auto_boresight.md), ``--no-auto`` skips it.
 9. True orthophotos of the images on the LiDAR DSM with the calibrated orientation
    (``lidarphoto orthorectify``), and their orthomosaic with its seamlines (``lidarphoto
    orthomosaic``: the most nadir image per cell, ground occluded in one image filled from
@@ -301,8 +302,8 @@ def auto_step(
     ``--accept-doubtful``: a run that fails its checks (e.g. data snooping rejecting more than
     its false alarms explain) still writes its outputs, each with the warning at its top; the
     warnings are printed and kept in the figures, and the comparison with the truth decides.
-    Returns the figures: the seconds, counts, warnings and the boresight per group against the
-    truth."""
+    Returns the figures: the seconds (wall, and the job's CPU: user + system), counts,
+    warnings and the boresight per group against the truth."""
     flight, lidar, auto = demo / "flight", demo / "lidar", demo / "auto_calibration"
     auto.mkdir(parents=True, exist_ok=True)
     files = sorted((flight / "images").glob("*.tif"))
@@ -312,7 +313,7 @@ def auto_step(
             by_line.setdefault(f.stem.split("_")[0], []).append(f)
         files = [f for line in by_line.values() for f in line[:per_line]]
     picks = ["--hand-picks", str(flight / "observations.csv")] if hand_picks else []
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), os.times()
     lidarphoto(
         "autoboresight", "--images", *map(str, files), "--camera", str(flight / "camera.json"),
         "--trajectory", str(flight / "trajectory.csv"), "--crs", CRS,
@@ -325,13 +326,15 @@ def auto_step(
         "--output-rounds", str(auto / "rounds.csv"), "--output-html", str(auto / "summary.html"),
         "--accept-doubtful", "true",
     )  # fmt: skip
-    seconds = time.perf_counter() - t0
+    seconds, c1 = time.perf_counter() - t0, os.times()
+    cpu = (c1.children_user - c0.children_user) + (c1.children_system - c0.children_system)
     last = read_table(auto / "rounds.csv")[-1]
     with open(auto / "boresight.csv", encoding="utf-8") as fh:  # the job's doubts, if any
         warnings = [line[2:].strip() for line in fh if line.startswith("# ")]
     return {
         "images": [f.stem for f in files],
         "seconds": round(seconds, 1),
+        "cpu_seconds": round(cpu, 1),
         "rounds": int(last["round"]),
         "line_points": int(last["line_points"]),
         "lines_seen": int(last["lines_seen"]),
@@ -455,19 +458,20 @@ def boresight_table(cal: Path, rmse: dict) -> tuple[list[dict], np.ndarray, floa
 
 
 def auto_report(args, cal: Path, mount: str) -> tuple[dict | None, float]:
-    """Step 8 when asked (``--auto`` or ``--auto-images-per-line``): autoboresight on the
-    rendered images and its table next to step 6's; returns its figures and its largest
-    |error| / sigma (None and 0 when not asked)."""
-    if not (args.auto or args.auto_images_per_line):
+    """Step 8 unless ``--no-auto``: autoboresight on the first ``--auto-images-per-line``
+    rendered images of each flight line (all of them with ``--auto``) and its table next to
+    step 6's; returns its figures and its largest |error| / sigma (None and 0 when skipped)."""
+    if args.no_auto:
         print(
-            "\nStep 8 (autoboresight on the rendered images, no picked point) skipped: on the "
-            "ten 24-Mpx images it takes more than 20 min of CPU today; run "
-            "`.venv/bin/python scripts/demo.py --auto` (or --auto-images-per-line 2)"
+            "\nStep 8 (autoboresight on the rendered images, no picked point) skipped "
+            "(--no-auto)"
         )
         return None, 0.0
-    auto = auto_step(OUT, mount, per_line=args.auto_images_per_line)
+    per_line = None if args.auto else args.auto_images_per_line
+    auto = auto_step(OUT, mount, per_line=per_line)
     print(
-        f"\nautoboresight on the {len(auto['images'])} rendered images: {auto['seconds']:.0f} s; "
+        f"\nautoboresight on the {len(auto['images'])} rendered images: {auto['seconds']:.0f} s "
+        f"({auto['cpu_seconds']:.0f} s of CPU); "
         f"{auto['rounds']} rounds; {auto['line_points']} line points on {auto['lines_seen']} "
         f"LiDAR lines, {auto['ties_associated']} of {auto['tie_tracks']} tie tracks on roof "
         f"planes (refused: {auto['ties_refused'] or 'none'})"
@@ -482,11 +486,16 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description="The main job end to end (make demo).")
     parser.add_argument(
         "--auto", action="store_true",
-        help="run step 8 (autoboresight on the ten 24-Mpx rendered images; slow: issue 32)",
+        help="run step 8 on all ten 24-Mpx rendered images (slow: about 7 min of CPU, "
+        "issue 32)",
     )  # fmt: skip
     parser.add_argument(
-        "--auto-images-per-line", type=int, default=None, metavar="N",
-        help="run step 8 on the first N images of each flight line only (implies --auto)",
+        "--auto-images-per-line", type=int, default=2, metavar="N",
+        help="run step 8 on the first N images of each flight line (default 2: 4 of the 10 "
+        "images, about 1.5 min of CPU)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--no-auto", action="store_true", help="skip step 8 (the automatic calibration)"
     )  # fmt: skip
     args = parser.parse_args(argv)
     start = time.perf_counter()
@@ -575,7 +584,7 @@ def main(argv: list[str] | None = None) -> int:
         "within 1 px"
     )
 
-    # ---- 8. the boresight calibrated automatically from the rendered images (on request)
+    # ---- 8. the boresight calibrated automatically from the rendered images
     auto, worst_auto = auto_report(args, cal, config.mount)
 
     # ---- 9. true orthophotos and their mosaic, with the calibrated orientation
