@@ -350,12 +350,12 @@ def _tie_stage(
     detected = None
     if find:
         ties, detected = _find_ties(
-            images, cam, traj, mount, frame, planes, tie_progress, should_stop
+            images, cam, traj, mount, frame, planes, auto.ties, tie_progress, should_stop
         )
     return ties, detected, rest
 
 
-def _find_ties(images, cam, traj, mount, frame, planes, progress, should_stop) -> tuple:
+def _find_ties(images, cam, traj, mount, frame, planes, options, progress, should_stop) -> tuple:
     """Tie tracks found between the images read (FIND_TIES): the observations and a line of
     counts for the summary. Pairs from the footprints of the approximate orientation at the
     planes' median height."""
@@ -371,7 +371,7 @@ def _find_ties(images, cam, traj, mount, frame, planes, progress, should_stop) -
         )
     eo = direct_georeference(traj, mount, frame)
     height = float(np.median([p.centroid[2] for p in planes]))
-    res = find_ties(images, cam, eo, height, progress=progress, should_stop=should_stop)
+    res = find_ties(images, cam, eo, height, options, progress=progress, should_stop=should_stop)
     s = res.summary()
     text = (
         f"{s['tracks']} tracks, {s['measurements']} measurements; pairs "
