@@ -252,10 +252,9 @@ def _solve_normals(nn: Array, rhs: Array, first: bool) -> tuple[Array, NDArray[n
     Singular normal equations (a template without texture: zero gain, no gradient) are
     tested on the first iteration (an SVD per patch); later a failed solve is caught.
     """
-    if first:
-        det_ok = np.linalg.cond(nn) < 1e12
-    else:
-        det_ok = np.isfinite(nn).all(axis=(1, 2))
+    det_ok = np.isfinite(nn).all(axis=(1, 2))  # a patch sampled off the image: not solved
+    if first and det_ok.any():
+        det_ok[det_ok] = np.linalg.cond(nn[det_ok]) < 1e12
     sol = np.zeros((nn.shape[0], 8))
     if det_ok.any():
         try:
@@ -288,8 +287,6 @@ def lsm_batch(
     start: ArrayLike,
     reference: tuple[float, float] | None = None,
     options: LsmOptions | None = None,
-    *,
-    _at: tuple[Array, NDArray[np.int64], int, int] | None = None,
 ) -> LsmResult:
     """Least-squares matching of K templates in K search windows (module docstring).
 
@@ -305,10 +302,6 @@ def lsm_batch(
         Template array coordinates of the reference point (x = y = 0); the centre
         ``((n - 1) / 2, (m - 1) / 2)`` by default.
     options : LsmOptions, optional
-    _at : (image, origins, h, w), optional
-        The compiled path only (bicubic, numba): the windows are the (h, w) blocks of one
-        2-D image at the (K, 2) (row, col) ``origins`` (``searches`` is not read: ``()``), so that
-        none is cut (:func:`lsm_in_image`).
 
     Returns
     -------
@@ -326,20 +319,16 @@ def lsm_batch(
     """
     opt = options or LsmOptions()
     f = np.asarray(templates, dtype=np.float64)
+    g = np.ascontiguousarray(searches, dtype=np.float64)
     if f.ndim == 2:
         f = f[None]
+    if g.ndim == 2:
+        g = g[None]
     a = np.array(start, dtype=np.float64).reshape(-1, 2, 3)
     k_n, m, n = f.shape
-    if _at is None:
-        g = np.ascontiguousarray(searches, dtype=np.float64)
-        if g.ndim == 2:
-            g = g[None]
-        n_win, h, w = g.shape
-    else:
-        g = np.zeros((0, 1, 1))
-        n_win, h, w = _at[1].shape[0], int(_at[2]), int(_at[3])
-    if n_win != k_n or a.shape[0] != k_n:
+    if g.shape[0] != k_n or a.shape[0] != k_n:
         raise ValueError(f"{k_n} templates need as many search windows and start affines")
+    h, w = g.shape[1:]
     cubic = opt.interpolation == "bicubic"
     grads = None if cubic else tuple(np.gradient(g, axis=(1, 2))[::-1])
     box = (1.0, w - 3.0, h - 3.0) if cubic else (0.0, w - 1.0, h - 1.0)
@@ -355,16 +344,15 @@ def lsm_batch(
     iters = np.zeros(k_n, dtype=np.int32)
     active = np.ones(k_n, dtype=bool)
     nmat = np.zeros((k_n, 8, 8))
-    fast = _compiled(opt)
-    if _at is not None and not fast:
-        raise ValueError("windows of one image (_at) need the compiled bicubic path")
+    fast = cubic and opt.backend != "numpy" and _numba.AVAILABLE
     if fast:
+        g = np.ascontiguousarray(g)
         fv = np.ascontiguousarray(fv)
 
     def samples() -> Array:
         """(K, p) g resampled at the template points under the current affines."""
         if fast:
-            return _numba.samples(g, a, x, y, _at)
+            return _numba.samples(g, a, x, y)
         cs, rs = _search_coords(a, x, y)
         return _sample(g, np.arange(k_n)[:, None], cs, rs, cubic, grads)[0]
 
@@ -378,7 +366,7 @@ def lsm_batch(
         if idx.size == 0:
             break
         if fast:
-            nn, rhs, outside = _numba.normals(g, idx, a, rad, fv, x, y, _at)
+            nn, rhs, outside = _numba.normals(g, idx, a, rad, fv, x, y)
         else:
             nn, rhs, outside = _numpy_normals(g, idx, a, rad, fv, x, y, cubic, grads, box)
         sol, det_ok = _solve_normals(nn, rhs, it == 1)
@@ -417,11 +405,6 @@ def lsm_batch(
     return LsmResult(a, rad, sig, cov, s0, corr, iters, status)
 
 
-def _compiled(opt: LsmOptions) -> bool:
-    """Whether :func:`lsm_batch` runs numba's bicubic kernels with these options."""
-    return opt.interpolation == "bicubic" and opt.backend != "numpy" and _numba.AVAILABLE
-
-
 def lsm_in_image(
     templates: ArrayLike,
     image: ArrayLike,
@@ -457,7 +440,7 @@ def lsm_in_image(
     usual = halves <= 2 * np.median(halves)
     halves[usual] = halves[usual].max()
     border = int(halves.max()) + 1
-    pad = np.pad(img, border, mode="constant", constant_values=0.0)
+    pad = np.pad(img, border, mode="constant", constant_values=np.nan)
     out = LsmResult(
         np.zeros((k_n, 2, 3)),
         np.zeros((k_n, 2)),
@@ -487,56 +470,38 @@ def _in_windows(
     opt: LsmOptions,
 ) -> LsmResult:
     """:func:`lsm_in_image` for templates of one window size ``2 half + 1``; ``pad``: the image
-    padded by ``border`` (>= half + 1) pixels of 0 (the filler outside the image).
-
-    The compiled path reads each window where it lies in ``pad`` (none is cut: the copies cost
-    more than the matching where a batch's windows are large); a window reaching beyond the
-    padding (a start far outside the image) and the numpy path cut them, clipped to ``pad``.
-    """
-    _, m, n = f.shape
+    padded by ``border`` (>= half + 1) pixels of NaN."""
+    k_n, m, n = f.shape
     rc, rr = ref
     size = 2 * half + 1
-    shape = (pad.shape[0] - 2 * border, pad.shape[1] - 2 * border)
-    with np.errstate(invalid="ignore"):
-        origin = np.round(a[:, :, 0]).astype(np.intp) - half  # (col, row) in the image
-    lo = origin + border
-    in_pad = bool(
-        np.all(lo >= 0)
-        and np.all(lo[:, 1] + size <= pad.shape[0])
-        and np.all(lo[:, 0] + size <= pad.shape[1])
-    )
+    origin = np.round(a[:, :, 0]).astype(np.intp) - half
+    rows = origin[:, 1, None] + np.arange(size) + border
+    cols = origin[:, 0, None] + np.arange(size) + border
+    rows = np.clip(rows, 0, pad.shape[0] - 1)
+    cols = np.clip(cols, 0, pad.shape[1] - 1)
+    wins = pad[rows[:, :, None], cols[:, None, :]]
+    nan = np.isnan(wins)
     local = a.copy()
     local[:, :, 0] -= origin
-    if in_pad and _compiled(opt):
-        at = (pad, np.ascontiguousarray(lo[:, ::-1], np.int64), size, size)
-        res = lsm_batch(f, (), local, reference, opt, _at=at)
-    else:
-        rows = np.clip(lo[:, 1, None] + np.arange(size), 0, pad.shape[0] - 1)
-        cols = np.clip(lo[:, 0, None] + np.arange(size), 0, pad.shape[1] - 1)
-        res = lsm_batch(f, pad[rows[:, :, None], cols[:, None, :]], local, reference, opt)
+    res = lsm_batch(f, np.where(nan, 0.0, wins), local, reference, opt)
     aff = res.affine.copy()
     aff[:, :, 0] += origin
     status = res.status.copy()
     # A patch whose footprint (at the start or at the solution) touches pixels outside the
     # image was matched against filler: whatever happened next, that is the reason.
-    beyond = np.flatnonzero(
-        (origin[:, 0] < 0)
-        | (origin[:, 1] < 0)
-        | (origin[:, 0] + size > shape[1])
-        | (origin[:, 1] + size > shape[0])
-    )
-    if beyond.size:
+    if nan.any():
         yy, xx = np.mgrid[0:m, 0:n]
         x = xx.ravel() - rc
         y = yy.ravel() - rr
-        oc, orow = origin[beyond, 0, None], origin[beyond, 1, None]
-        for aff_w in (local[beyond], res.affine[beyond]):
+        k = np.arange(k_n)[:, None]
+        for aff_w in (local, res.affine):
             cs, rs = _search_coords(aff_w, x, y)
-            ci = np.clip(np.floor(cs).astype(np.intp), 0, size - 2) + oc
-            ri = np.clip(np.floor(rs).astype(np.intp), 0, size - 2) + orow
-            touch = ((ri < 0) | (ri + 1 >= shape[0]) | (ci < 0) | (ci + 1 >= shape[1])).any(axis=1)
-            hit = beyond[touch]
-            status[hit[status[hit] != NO_TEXTURE]] = LEFT_WINDOW
+            ci = np.clip(np.floor(cs).astype(np.intp), 0, size - 2)
+            ri = np.clip(np.floor(rs).astype(np.intp), 0, size - 2)
+            touch = (
+                nan[k, ri, ci] | nan[k, ri + 1, ci + 1] | nan[k, ri, ci + 1] | nan[k, ri + 1, ci]
+            ).any(axis=1)
+            status[(status != NO_TEXTURE) & touch] = LEFT_WINDOW
     return LsmResult(
         aff,
         res.radiometry,

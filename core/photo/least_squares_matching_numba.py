@@ -46,12 +46,13 @@ if AVAILABLE:  # inlined into the kernels (a plain function cannot be called fro
     _keys = cached_njit(_keys, inline="always")
 
 
-def _normals(g, org, h, w, idx, aff, rad, f, x, y, nn, rhs, outside):  # pragma: no cover
+def _normals(g, idx, aff, rad, f, x, y, nn, rhs, outside):  # pragma: no cover - compiled
+    h = g.shape[1]
+    w = g.shape[2]
     p_n = x.shape[0]
     jv = np.empty(8)
     for q in range(idx.shape[0]):
         k = idx[q]
-        o_r, o_c = org[k, 0], org[k, 1]
         a0, a1, a2 = aff[k, 0, 0], aff[k, 0, 1], aff[k, 0, 2]
         b0, b1, b2 = aff[k, 1, 0], aff[k, 1, 1], aff[k, 1, 2]
         r0, r1 = rad[k, 0], rad[k, 1]
@@ -75,12 +76,11 @@ def _normals(g, org, h, w, idx, aff, rad, f, x, y, nn, rhs, outside):  # pragma:
             gcol = 0.0
             grow = 0.0
             for m in range(4):
-                rr = o_r + ri - 1 + m
-                cc = o_c + ci
-                s0 = g[rr, cc - 1]
-                s1 = g[rr, cc]
-                s2 = g[rr, cc + 1]
-                s3 = g[rr, cc + 2]
+                rr = ri - 1 + m
+                s0 = g[k, rr, ci - 1]
+                s1 = g[k, rr, ci]
+                s2 = g[k, rr, ci + 1]
+                s3 = g[k, rr, ci + 2]
                 ax = wx0 * s0 + wx1 * s1 + wx2 * s2 + wx3 * s3
                 dxv = dx0 * s0 + dx1 * s1 + dx2 * s2 + dx3 * s3
                 wym = wy0 if m == 0 else (wy1 if m == 1 else (wy2 if m == 2 else wy3))
@@ -109,9 +109,10 @@ def _normals(g, org, h, w, idx, aff, rad, f, x, y, nn, rhs, outside):  # pragma:
         outside[q] = out
 
 
-def _samples(g, org, h, w, aff, x, y, out):  # pragma: no cover - compiled
+def _samples(g, aff, x, y, out):  # pragma: no cover - compiled
+    h = g.shape[1]
+    w = g.shape[2]
     for k in range(aff.shape[0]):
-        o_r, o_c = org[k, 0], org[k, 1]
         for p in range(x.shape[0]):
             c = aff[k, 0, 0] + aff[k, 0, 1] * x[p] + aff[k, 0, 2] * y[p]
             r = aff[k, 1, 0] + aff[k, 1, 1] * x[p] + aff[k, 1, 2] * y[p]
@@ -125,7 +126,7 @@ def _samples(g, org, h, w, aff, x, y, out):  # pragma: no cover - compiled
             for m in range(4):
                 ax = 0.0
                 for n in range(4):
-                    ax += wx[n] * g[o_r + ri - 1 + m, o_c + ci - 1 + n]
+                    ax += wx[n] * g[k, ri - 1 + m, ci - 1 + n]
                 val += wy[m] * ax
             out[k, p] = val
 
@@ -134,32 +135,19 @@ def _samples(g, org, h, w, aff, x, y, out):  # pragma: no cover - compiled
 _compiled = Kernels({"normals": _normals, "samples": _samples})
 
 
-def _stacked(g):
-    """(K, H, W) windows as one (K H, W) array and each window's (row, col) origin in it."""
-    k_n, h, w = g.shape
-    org = np.zeros((k_n, 2), np.int64)
-    org[:, 0] = np.arange(k_n) * h
-    return np.ascontiguousarray(g).reshape(k_n * h, w), org, h, w
-
-
-def normals(g, idx, aff, rad, f, x, y, at=None):
+def normals(g, idx, aff, rad, f, x, y):
     """(n, 8, 8) normal matrices, (n, 8) right-hand sides and (n,) "left the window" flags of
-    the patches ``idx`` (see :func:`core.photo.least_squares_matching.lsm_batch`). ``g``: the
-    (K, H, W) search windows, or with ``at = (image, origins, h, w)`` ignored: window k is
-    ``image[origins[k, 0]:][:h, origins[k, 1]:][:, :w]`` of one 2-D array (nothing cut)."""
-    g2, org, h, w = _stacked(g) if at is None else at
+    the patches ``idx`` (see :func:`core.photo.least_squares_matching.lsm_batch`)."""
     n = idx.shape[0]
     nn = np.empty((n, 8, 8))
     rhs = np.empty((n, 8))
     outside = np.empty(n, dtype=np.bool_)
-    _compiled("normals")(g2, org, h, w, idx.astype(np.int64), aff, rad, f, x, y, nn, rhs, outside)
+    _compiled("normals")(g, idx.astype(np.int64), aff, rad, f, x, y, nn, rhs, outside)
     return nn, rhs, outside
 
 
-def samples(g, aff, x, y, at=None):
-    """(K, P) bicubic samples of each patch's window at its affine positions (``at``: as in
-    :func:`normals`)."""
-    g2, org, h, w = _stacked(g) if at is None else at
+def samples(g, aff, x, y):
+    """(K, P) bicubic samples of each patch's window at its affine positions."""
     out = np.empty((aff.shape[0], x.shape[0]))
-    _compiled("samples")(g2, org, h, w, np.ascontiguousarray(aff), x, y, out)
+    _compiled("samples")(g, np.ascontiguousarray(aff), x, y, out)
     return out
