@@ -252,7 +252,7 @@ def _solve_normals(nn: Array, rhs: Array, first: bool) -> tuple[Array, NDArray[n
     Singular normal equations (a template without texture: zero gain, no gradient) are
     tested on the first iteration (an SVD per patch); later a failed solve is caught.
     """
-    det_ok = np.isfinite(nn).all(axis=(1, 2))  # a patch sampled off the image: not solved
+    det_ok = np.asarray(np.isfinite(nn).all(axis=(1, 2)))  # sampled off the image: not solved
     if first and det_ok.any():
         det_ok[det_ok] = np.linalg.cond(nn[det_ok]) < 1e12
     sol = np.zeros((nn.shape[0], 8))
