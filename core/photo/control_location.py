@@ -350,13 +350,23 @@ def _curvature_shift(
     exact projection of each chip pixel minus its affine image ``pred + J u`` (u its offset
     from the point, chip pixels), pixels (2,). The affine that fits the curved image best
     over a symmetric template is offset from the tangent one by about that mean."""
+    pc = np.asarray(pc, dtype=np.float64)
+    u = _patch_offsets(h, np.rint(pc) - pc)  # about the template's centre pixel
+    pts = local.map_to_enu(chip.array_to_map(pc + u))
+    px = project_with_status(pts, eo6, camera)[0]
+    return _finite_mean(px - (np.asarray(pred, dtype=np.float64) + u @ np.asarray(jac).T))
+
+
+def _patch_offsets(h: int, centre: Array) -> Array:
+    """(n, 2) offsets of a (2h + 1)^2 patch's pixels from a point at ``centre`` from the
+    patch's centre pixel (pixels, col row)."""
     k = np.arange(-h, h + 1, dtype=np.float64)
     uu, vv = np.meshgrid(k, k)
-    ctr = np.rint(np.asarray(pc, dtype=np.float64))  # the template's centre pixel
-    u = np.column_stack([uu.ravel(), vv.ravel()]) + (ctr - np.asarray(pc, dtype=np.float64))
-    pts = local.map_to_enu(chip.array_to_map(np.asarray(pc, dtype=np.float64) + u))
-    px = project_with_status(pts, eo6, camera)[0]
-    resid = px - (np.asarray(pred, dtype=np.float64) + u @ np.asarray(jac).T)
+    return np.column_stack([uu.ravel(), vv.ravel()]) + centre
+
+
+def _finite_mean(resid: Array) -> Array:
+    """Mean of the finite rows of ``resid`` (n, 2); zeros when none is finite."""
     good = np.isfinite(resid).all(axis=1)
     return resid[good].mean(axis=0) if good.any() else np.zeros(2)
 
@@ -383,10 +393,8 @@ def _transfer_curvature_shift(
     offset from the master's match ``m_array``, ``J`` the transfer's start affine), pixels (2,).
     Through a fisheye camera the master-to-image map curves over the patch like the
     chip-to-image one, and the affine of least-squares matching is offset by that mean."""
-    k = np.arange(-h, h + 1, dtype=np.float64)
-    uu, vv = np.meshgrid(k, k)
     m_array = np.asarray(m_array, dtype=np.float64)
-    u = np.column_stack([uu.ravel(), vv.ravel()]) + (np.array([ci, ri]) - m_array)
+    u = _patch_offsets(h, np.array([ci, ri]) - m_array)
     u = np.vstack([np.zeros((1, 2)), u])  # the match itself first: T(0)
     target = m_array + 0.5 + u  # master pixels, corner convention
     jinv = np.linalg.inv(jac_master)
@@ -398,11 +406,9 @@ def _transfer_curvature_shift(
         if not np.nanmax(np.abs(step)) > 1e-9:
             break
     exact = project_with_status(local.map_to_enu(chip.array_to_map(c)), eo_i, camera)[0]
-    resid = exact[1:] - (exact[0] + u[1:] @ np.asarray(jac).T)
-    good = np.isfinite(resid).all(axis=1)
-    if not np.isfinite(exact[0]).all() or not good.any():
+    if not np.isfinite(exact[0]).all():
         return np.zeros(2)
-    return resid[good].mean(axis=0)
+    return _finite_mean(exact[1:] - (exact[0] + u[1:] @ np.asarray(jac).T))
 
 
 def _search_ellipse(
